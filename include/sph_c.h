@@ -1,0 +1,398 @@
+/*
+ * sph_c.h - the C ABI of the sph fluid-simulation library.
+ *
+ * Smoothed Particle Hydrodynamics on the CPU and on NVIDIA GPUs, behind a C99 interface
+ * that engines and any language with a C FFI can load.
+ *
+ * Conventions (see docs/api.md for the long form):
+ * - Every fallible call returns sph_result: 0 is success, negative values are errors and
+ *   positive values mean "incomplete / not ready". On error, sph_get_last_error() returns a
+ *   message naming the offending argument, and the object the call was given is unchanged.
+ * - Description structs start with struct_size and are filled by their *_init() function;
+ *   fields are only ever appended, and zero in a new field keeps the old behaviour.
+ * - A world is used from one thread at a time. Different worlds are independent and may be
+ *   stepped concurrently from different threads. Version queries, sph_result_string() and
+ *   sph_get_last_error() are always thread-safe.
+ * - The library never aborts the host process and never lets an exception cross this boundary.
+ * - Units are SI (metres, kilograms, seconds) unless a field says otherwise.
+ */
+#ifndef SPH_C_H
+#define SPH_C_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* ---- version: the one place where the library version is defined ------------------------ */
+#define SPH_VERSION_MAJOR 0
+#define SPH_VERSION_MINOR 1
+#define SPH_VERSION_PATCH 0
+/** Packed version: (major << 22) | (minor << 12) | patch. */
+#define SPH_MAKE_VERSION(major, minor, patch) \
+  ((((uint32_t)(major)) << 22) | (((uint32_t)(minor)) << 12) | ((uint32_t)(patch)))
+#define SPH_VERSION SPH_MAKE_VERSION(SPH_VERSION_MAJOR, SPH_VERSION_MINOR, SPH_VERSION_PATCH)
+/** ABI version: equals the SONAME major (libsph.so.0). */
+#define SPH_ABI_VERSION 0
+
+/* ---- export and calling-convention macros ------------------------------------------------ */
+#if defined(_WIN32)
+#define SPH_CALL __cdecl
+#if defined(SPH_BUILDING_LIBRARY)
+#define SPH_API __declspec(dllexport)
+#else
+#define SPH_API __declspec(dllimport)
+#endif
+#else
+#define SPH_CALL
+#if defined(SPH_BUILDING_LIBRARY)
+#define SPH_API __attribute__((visibility("default")))
+#else
+#define SPH_API
+#endif
+#endif
+
+#if defined(__cplusplus)
+#define SPH_STATIC_ASSERT(cond, name) static_assert(cond, #name)
+#else
+#define SPH_STATIC_ASSERT(cond, name) typedef char sph_static_assert_##name[(cond) ? 1 : -1]
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- results ----------------------------------------------------------------------------- */
+typedef enum sph_result {
+  SPH_INCOMPLETE = 1,                  /* the call did part of the work; see its doc */
+  SPH_OK = 0,                          /* success */
+  SPH_ERROR_INVALID_ARGUMENT = -1,     /* NULL, NaN/Inf, zero/negative or out-of-range value */
+  SPH_ERROR_INVALID_HANDLE = -2,       /* a NULL, destroyed or foreign object */
+  SPH_ERROR_VERSION_MISMATCH = -3,     /* struct_size or header_version not accepted */
+  SPH_ERROR_UNSUPPORTED = -4,          /* not compiled in, no such device, unknown enum value */
+  SPH_ERROR_FEATURE_DISABLED = -5,     /* the feature was not enabled in the world's def */
+  SPH_ERROR_CAPACITY = -6,             /* more particles than the world's capacity */
+  SPH_ERROR_OUT_OF_HOST_MEMORY = -7,   /* a host allocation failed */
+  SPH_ERROR_OUT_OF_DEVICE_MEMORY = -8, /* a device allocation failed */
+  SPH_ERROR_WORLD_LOCKED = -9,         /* the world is in use by another call */
+  SPH_ERROR_BUSY = -10,                /* the object is still in use (a context with worlds) */
+  SPH_ERROR_DEVICE = -11,              /* a recoverable device/driver error */
+  SPH_ERROR_DEVICE_LOST = -12,         /* a sticky device error: destroy the world */
+  SPH_ERROR_INTERNAL = -13,            /* an invariant failed inside the library (a bug) */
+  SPH_ERROR_BUFFER_TOO_SMALL = -14,    /* a caller buffer cannot hold what was asked for */
+  SPH_ERROR_NON_FINITE = -15,          /* a step produced NaN/Inf; the world was rolled back */
+  SPH_RESULT_FORCE32 = 0x7fffffff
+} sph_result;
+
+typedef uint32_t sph_bool32;
+
+typedef struct sph_vec3 {
+  float x, y, z;
+} sph_vec3;
+
+/* ---- enums ------------------------------------------------------------------------------- */
+typedef enum sph_backend {
+  SPH_BACKEND_AUTO = 0, /* CUDA when a device is present, else the CPU */
+  SPH_BACKEND_CPU = 1,  /* the multithreaded reference solver */
+  SPH_BACKEND_CUDA = 2, /* NVIDIA GPU; SPH_ERROR_UNSUPPORTED when not built or no device */
+  SPH_BACKEND_FORCE32 = 0x7fffffff
+} sph_backend;
+
+typedef enum sph_integrator {
+  SPH_INTEGRATOR_SYMPLECTIC_EULER = 0, /* v += a dt, then x += v dt: one force evaluation */
+  SPH_INTEGRATOR_RK4 = 1,              /* classic Runge-Kutta: four force evaluations */
+  SPH_INTEGRATOR_FORCE32 = 0x7fffffff
+} sph_integrator;
+
+typedef enum sph_log_level {
+  SPH_LOG_DEBUG = 0,
+  SPH_LOG_INFO = 1,
+  SPH_LOG_WARNING = 2,
+  SPH_LOG_ERROR = 3,
+  SPH_LOG_LEVEL_FORCE32 = 0x7fffffff
+} sph_log_level;
+
+typedef enum sph_attribute {
+  SPH_ATTRIBUTE_POSITION = 0, /* 3 x float32, metres */
+  SPH_ATTRIBUTE_VELOCITY = 1, /* 3 x float32, metres per second */
+  SPH_ATTRIBUTE_DENSITY = 2,  /* float32, kg/m^3, from the last density evaluation */
+  SPH_ATTRIBUTE_PRESSURE = 3, /* float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation */
+  SPH_ATTRIBUTE_ID = 4,       /* uint32, persistent particle id, unique within a world */
+  SPH_ATTRIBUTE_COUNT = 5,
+  SPH_ATTRIBUTE_FORCE32 = 0x7fffffff
+} sph_attribute;
+
+/** Stages of a substep, indices into sph_stats.stage_ms. */
+typedef enum sph_stage {
+  SPH_STAGE_HASH_SORT = 0,   /* cell hash, stable sort, reorder of every attribute */
+  SPH_STAGE_CELL_RANGES = 1, /* start/end of each cell */
+  SPH_STAGE_DENSITY = 2,     /* density and pressure */
+  SPH_STAGE_FORCES = 3,      /* pressure, viscosity and external forces */
+  SPH_STAGE_INTEGRATE = 4,   /* time integration, max-speed reduction, next step size */
+  SPH_STAGE_COLLIDE = 5,     /* colliders (none yet) */
+  SPH_STAGE_EMIT = 6,        /* sources and sinks (none yet) */
+  SPH_STAGE_OTHER = 7,       /* everything else: statistics, transfers */
+  SPH_STAGE_COUNT = 8,
+  SPH_STAGE_FORCE32 = 0x7fffffff
+} sph_stage;
+
+/** World feature bits. None are defined yet: any set bit is rejected as unknown. */
+typedef uint32_t sph_feature_flags;
+#define SPH_FEATURE_NONE 0u
+
+/* ---- version and diagnostics (always thread-safe) ---------------------------------------- */
+
+/** The library's packed version (SPH_MAKE_VERSION), which may differ from SPH_VERSION. */
+SPH_API uint32_t SPH_CALL sph_get_version(void);
+/** The library's ABI version (SPH_ABI_VERSION when the header matches the library). */
+SPH_API uint32_t SPH_CALL sph_get_abi_version(void);
+/** A static string: version, git revision, compiler, backends and CUDA architectures built. */
+SPH_API const char* SPH_CALL sph_get_build_info(void);
+/** A static English name for a result code ("SPH_ERROR_CAPACITY: ..."); never NULL. */
+SPH_API const char* SPH_CALL sph_result_string(sph_result result);
+/**
+ * The message of the last failed sph_ call on this thread, or "" if the last call succeeded.
+ * Thread-local, UTF-8, never NULL; valid until the next sph_ call on this thread.
+ */
+SPH_API const char* SPH_CALL sph_get_last_error(void);
+/** Number of live contexts and worlds in the process (a leak check for long-lived hosts). */
+SPH_API sph_result SPH_CALL sph_get_live_object_count(uint32_t* out_count);
+
+/* ---- context ----------------------------------------------------------------------------- */
+typedef struct sph_context sph_context;
+
+/**
+ * Log callback. Called only on a thread that is inside an sph_ call on this context (never
+ * from internal worker threads). message is valid for the duration of the call.
+ */
+typedef void(SPH_CALL* sph_log_fn)(void* user_data, sph_log_level level, sph_result code,
+                                   const char* message);
+
+typedef struct sph_context_def {
+  uint32_t struct_size;      /* sizeof(sph_context_def), set by sph_context_def_init */
+  uint32_t header_version;   /* SPH_VERSION of the header the caller compiled against */
+  sph_backend backend;       /* default SPH_BACKEND_AUTO */
+  int32_t device_ordinal;    /* CUDA device; -1 (default) = device 0 */
+  uint32_t cpu_worker_count; /* CPU backend threads; 0 (default) = all hardware threads */
+  uint32_t reserved0;        /* must be 0 */
+  sph_log_fn log_fn;         /* optional; NULL = no logging */
+  void* log_user_data;       /* passed to log_fn */
+} sph_context_def;
+SPH_STATIC_ASSERT(sizeof(sph_context_def) == 24 + 2 * sizeof(void*), sph_context_def_size);
+
+/** Fills def with defaults; size is sizeof(*def). Prefer sph_context_def_init. */
+SPH_API sph_result SPH_CALL sph_context_def_init_sized(sph_context_def* def, uint32_t size);
+static inline sph_result sph_context_def_init(sph_context_def* def) {
+  sph_result r = sph_context_def_init_sized(def, (uint32_t)sizeof(*def));
+  if (r == SPH_OK) def->header_version = SPH_VERSION;
+  return r;
+}
+
+/**
+ * Creates a context: a backend (CPU or one CUDA device) that worlds are created on.
+ * Errors: INVALID_ARGUMENT (NULL, bad field), VERSION_MISMATCH (struct_size or a newer-major
+ * header), UNSUPPORTED (CUDA asked for but not built or no device), OUT_OF_HOST_MEMORY.
+ * *out is written only on success. Thread-safe.
+ */
+SPH_API sph_result SPH_CALL sph_context_create(const sph_context_def* def, sph_context** out);
+/** Destroys a context. NULL is a no-op. BUSY while worlds created on it are alive. */
+SPH_API sph_result SPH_CALL sph_context_destroy(sph_context* context);
+/** The backend the context resolved to (CPU or CUDA; never AUTO). */
+SPH_API sph_result SPH_CALL sph_context_get_backend(const sph_context* context, sph_backend* out_backend);
+
+/* ---- world ------------------------------------------------------------------------------- */
+typedef struct sph_world sph_world;
+
+/** Creation-time description of a world; fixed for the world's life. */
+typedef struct sph_world_def {
+  uint32_t struct_size;       /* sizeof(sph_world_def), set by sph_world_def_init */
+  uint32_t header_version;    /* SPH_VERSION of the caller's header */
+  uint32_t capacity;          /* most particles the world holds; default 65536; >= 1 */
+  sph_feature_flags features; /* SPH_FEATURE_* bits; default SPH_FEATURE_NONE */
+  sph_integrator integrator;  /* default SPH_INTEGRATOR_SYMPLECTIC_EULER */
+  uint32_t reserved0;         /* must be 0 */
+  float particle_spacing;     /* nearest-neighbour distance of the FCC lattice, m; default 0.02 */
+  float kernel_radius;        /* h, m; 0 (default) = 1.8 * particle_spacing; must be >= spacing */
+  float rest_density;         /* rho0, kg/m^3; default 1000 (water) */
+  float reserved1;            /* must be 0 */
+} sph_world_def;
+SPH_STATIC_ASSERT(sizeof(sph_world_def) == 40, sph_world_def_size);
+
+SPH_API sph_result SPH_CALL sph_world_def_init_sized(sph_world_def* def, uint32_t size);
+static inline sph_result sph_world_def_init(sph_world_def* def) {
+  sph_result r = sph_world_def_init_sized(def, (uint32_t)sizeof(*def));
+  if (r == SPH_OK) def->header_version = SPH_VERSION;
+  return r;
+}
+
+/**
+ * Creates an empty world on a context. The particle mass is derived here: the mass at which
+ * an FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass).
+ * Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range:
+ * capacity 0, spacing <= 0 or non-finite, kernel_radius < spacing, rest_density <= 0),
+ * UNSUPPORTED (unknown integrator or feature bit), VERSION_MISMATCH, OUT_OF_HOST_MEMORY,
+ * OUT_OF_DEVICE_MEMORY. *out is written only on success.
+ */
+SPH_API sph_result SPH_CALL sph_world_create(sph_context* context, const sph_world_def* def, sph_world** out);
+/** Destroys a world and everything in it. NULL is a no-op. */
+SPH_API sph_result SPH_CALL sph_world_destroy(sph_world* world);
+/** The def the world was created with, with defaults resolved (kernel_radius filled in). */
+SPH_API sph_result SPH_CALL sph_world_get_def(const sph_world* world, sph_world_def* out_def);
+/** Mass of every particle, kg. */
+SPH_API sph_result SPH_CALL sph_world_get_particle_mass(const sph_world* world, float* out_mass);
+
+/* ---- runtime parameters ------------------------------------------------------------------ */
+typedef struct sph_world_params {
+  uint32_t struct_size;  /* sizeof(sph_world_params), set by sph_world_params_init */
+  uint32_t max_substeps; /* most substeps one sph_world_step may take; default 10000; >= 1 */
+  sph_vec3 gravity;      /* m/s^2; default (0, -9.81, 0) */
+  float stiffness;       /* k of p = k (rho - rho0), m^2/s^2 (the squared numerical sound speed);
+                            default 100; > 0. Keep sqrt(k) * dt_max below about 0.4 h. */
+  float viscosity;       /* mu of Mueller's Laplacian viscosity (a numerical viscosity, not
+                            water's 0.001 Pa s); default 5; >= 0 */
+  float step_factor;     /* lambda of dt = lambda h / v_max; default 0.4; in (0, 10] */
+  float dt_min;          /* s; default 1e-6; > 0 */
+  float dt_max;          /* s; default 1e-3; >= dt_min */
+} sph_world_params;
+SPH_STATIC_ASSERT(sizeof(sph_world_params) == 40, sph_world_params_size);
+
+SPH_API sph_result SPH_CALL sph_world_params_init_sized(sph_world_params* params, uint32_t size);
+static inline sph_result sph_world_params_init(sph_world_params* params) {
+  return sph_world_params_init_sized(params, (uint32_t)sizeof(*params));
+}
+/** Replaces all runtime parameters at once; validated as a whole, nothing changes on error. */
+SPH_API sph_result SPH_CALL sph_world_set_params(sph_world* world, const sph_world_params* params);
+/** Reads all runtime parameters; out->struct_size must be set (sph_world_params_init). */
+SPH_API sph_result SPH_CALL sph_world_get_params(const sph_world* world, sph_world_params* out);
+
+/* ---- particles in -------------------------------------------------------------------------- */
+typedef struct sph_spawn_desc {
+  uint32_t struct_size;     /* sizeof(sph_spawn_desc), set by sph_spawn_desc_init */
+  uint32_t count;           /* particles to add; 0 is allowed and adds nothing */
+  const float* positions;   /* count x (x, y, z) float32, caller-owned, copied; required */
+  const float* velocities;  /* count x (x, y, z) float32, or NULL for zero velocity */
+  uint64_t position_stride; /* bytes between particles; 0 = 12 (packed) */
+  uint64_t velocity_stride; /* bytes between particles; 0 = 12 (packed) */
+} sph_spawn_desc;
+SPH_STATIC_ASSERT(sizeof(sph_spawn_desc) == 24 + 2 * sizeof(void*), sph_spawn_desc_size);
+
+SPH_API sph_result SPH_CALL sph_spawn_desc_init_sized(sph_spawn_desc* desc, uint32_t size);
+static inline sph_result sph_spawn_desc_init(sph_spawn_desc* desc) {
+  return sph_spawn_desc_init_sized(desc, (uint32_t)sizeof(*desc));
+}
+
+/**
+ * Adds particles from caller arrays (copied before return). All-or-nothing: on any error
+ * (non-finite value, count above the free capacity: SPH_ERROR_CAPACITY) nothing is added.
+ * out_first_id (optional) receives the id of the first new particle; ids are consecutive.
+ */
+SPH_API sph_result SPH_CALL sph_world_spawn(sph_world* world, const sph_spawn_desc* desc,
+                                            uint32_t* out_first_id);
+
+typedef struct sph_fill_box_desc {
+  uint32_t struct_size; /* set by sph_fill_box_desc_init */
+  uint32_t reserved0;   /* must be 0 */
+  sph_vec3 min;         /* box corner, m */
+  sph_vec3 max;         /* opposite corner, m; every component > min's */
+  sph_vec3 velocity;    /* initial velocity of every particle; default 0 */
+} sph_fill_box_desc;
+SPH_STATIC_ASSERT(sizeof(sph_fill_box_desc) == 44, sph_fill_box_desc_size);
+
+SPH_API sph_result SPH_CALL sph_fill_box_desc_init_sized(sph_fill_box_desc* desc, uint32_t size);
+static inline sph_result sph_fill_box_desc_init(sph_fill_box_desc* desc) {
+  return sph_fill_box_desc_init_sized(desc, (uint32_t)sizeof(*desc));
+}
+
+/**
+ * Fills an axis-aligned box with particles on an FCC lattice at the world's particle_spacing
+ * (points at least spacing/2 inside each face), at rest density. All-or-nothing:
+ * SPH_ERROR_CAPACITY if they do not fit. out_count (optional) receives the number added.
+ */
+SPH_API sph_result SPH_CALL sph_world_fill_box(sph_world* world, const sph_fill_box_desc* desc,
+                                               uint32_t* out_count);
+
+typedef struct sph_fill_sphere_desc {
+  uint32_t struct_size; /* set by sph_fill_sphere_desc_init */
+  uint32_t reserved0;   /* must be 0 */
+  sph_vec3 center;      /* m; a lattice point sits at the centre */
+  float radius;         /* m; > 0; points with |p - center| <= radius are filled */
+  sph_vec3 velocity;    /* initial velocity; default 0 */
+} sph_fill_sphere_desc;
+SPH_STATIC_ASSERT(sizeof(sph_fill_sphere_desc) == 36, sph_fill_sphere_desc_size);
+
+SPH_API sph_result SPH_CALL sph_fill_sphere_desc_init_sized(sph_fill_sphere_desc* desc, uint32_t size);
+static inline sph_result sph_fill_sphere_desc_init(sph_fill_sphere_desc* desc) {
+  return sph_fill_sphere_desc_init_sized(desc, (uint32_t)sizeof(*desc));
+}
+/** Fills a sphere on an FCC lattice; as sph_world_fill_box otherwise. */
+SPH_API sph_result SPH_CALL sph_world_fill_sphere(sph_world* world, const sph_fill_sphere_desc* desc,
+                                                  uint32_t* out_count);
+
+/* ---- stepping ---------------------------------------------------------------------------- */
+
+/**
+ * Advances the world by frame_dt seconds (> 0, finite) in adaptive substeps: each substep's
+ * dt = step_factor * h / v_max clamped to [dt_min, dt_max], shortened at the end so that the
+ * substeps add up to frame_dt exactly (the last one or two may be shorter than dt_min).
+ * Blocks until the frame is done. Returns SPH_INCOMPLETE if max_substeps ran out first
+ * (sph_stats.frame_time says how far it got). SPH_ERROR_NON_FINITE if a substep produced a
+ * NaN/Inf: the world is restored to its state before this call.
+ */
+SPH_API sph_result SPH_CALL sph_world_step(sph_world* world, float frame_dt);
+
+/* ---- particles out ----------------------------------------------------------------------- */
+
+/** Number of particles in the world. */
+SPH_API sph_result SPH_CALL sph_world_get_particle_count(const sph_world* world, uint32_t* out_count);
+
+/**
+ * Copies particles [first, first + count) of one attribute into caller memory. Particles come
+ * in the world's current order (cell order after the last step): use SPH_ATTRIBUTE_ID to
+ * match particles between calls. Each element is written at dst + i * dst_stride
+ * (dst_stride 0 = the element's size: 12 bytes for vectors, 4 for scalars); dst_size is the
+ * size of the buffer at dst in bytes. count is clamped to the particles available;
+ * out_written (optional) receives how many were written. Blocks until the data is ready.
+ * Errors: INVALID_ARGUMENT (NULL dst, stride smaller than the element, first > particle
+ * count), BUFFER_TOO_SMALL (dst_size cannot hold count elements), UNSUPPORTED (unknown
+ * attribute). Nothing is written on error.
+ */
+SPH_API sph_result SPH_CALL sph_world_copy_attribute(const sph_world* world, sph_attribute attribute,
+                                                     void* dst, uint64_t dst_size, uint64_t dst_stride,
+                                                     uint32_t first, uint32_t count, uint32_t* out_written);
+
+/* ---- statistics -------------------------------------------------------------------------- */
+typedef struct sph_stats {
+  uint32_t struct_size;    /* set by sph_stats_init */
+  uint32_t particle_count; /* particles after the last step */
+  uint32_t substeps;       /* substeps of the last sph_world_step */
+  uint32_t neighbors_max;  /* most neighbours (r < h, self excluded) of any particle */
+  double simulated_time;   /* seconds simulated since the world was created */
+  float frame_time;        /* seconds the last sph_world_step advanced */
+  float dt_min;            /* smallest substep of the last step, s */
+  float dt_max;            /* largest substep of the last step, s */
+  float max_speed;         /* largest particle speed at the end of the last step, m/s */
+  float density_min;       /* density statistics of the last density evaluation, kg/m^3 */
+  float density_mean;
+  float density_max;
+  float neighbors_mean;            /* mean neighbours per particle (self excluded) */
+  float stage_ms[SPH_STAGE_COUNT]; /* wall milliseconds per stage over the last step */
+  float step_ms;                   /* wall milliseconds of the whole last sph_world_step */
+  uint32_t reserved0;
+  uint64_t memory_bytes; /* bytes the world holds for particles and grids (device memory on
+                            the CUDA backend) */
+} sph_stats;
+SPH_STATIC_ASSERT(sizeof(sph_stats) == 104, sph_stats_size);
+
+SPH_API sph_result SPH_CALL sph_stats_init_sized(sph_stats* stats, uint32_t size);
+static inline sph_result sph_stats_init(sph_stats* stats) {
+  return sph_stats_init_sized(stats, (uint32_t)sizeof(*stats));
+}
+/**
+ * Statistics of the last sph_world_step (zeros before the first). out->struct_size must be
+ * set (sph_stats_init); only that many bytes are written.
+ */
+SPH_API sph_result SPH_CALL sph_world_get_stats(const sph_world* world, sph_stats* out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SPH_C_H */

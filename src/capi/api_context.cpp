@@ -1,0 +1,97 @@
+// Contexts: backend choice, device, CPU workers and logging.
+#include <thread>
+
+#include "guard.h"
+#include "handles.h"
+#include "struct_io.h"
+
+using sph::Error;
+using sph::Status;
+
+namespace {
+
+sph_context_def default_context_def() {
+  sph_context_def d;
+  std::memset(&d, 0, sizeof d);
+  d.struct_size = sizeof d;
+  d.backend = SPH_BACKEND_AUTO;
+  d.device_ordinal = -1;
+  return d;
+}
+
+}  // namespace
+
+extern "C" {
+
+SPH_API sph_result SPH_CALL sph_context_def_init_sized(sph_context_def* def, uint32_t size) {
+  return sph::guarded("sph_context_def_init", nullptr, [&] {
+    sph::require_init_size(def, size, "def");
+    sph::write_user_struct(def, size, default_context_def());
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_context_create(const sph_context_def* def, sph_context** out) {
+  return sph::guarded("sph_context_create", nullptr, [&] {
+    if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
+    const sph_context_def d = sph::read_user_struct(def, "def");
+    if (d.header_version != 0 && (d.header_version >> 22) != SPH_VERSION_MAJOR)
+      throw Error(Status::VersionMismatch, "def->header_version: the caller's header is version " +
+                                               std::to_string(d.header_version >> 22) +
+                                               ".x but the library is " + std::to_string(SPH_VERSION_MAJOR) +
+                                               ".x");
+    if (d.backend != SPH_BACKEND_AUTO && d.backend != SPH_BACKEND_CPU && d.backend != SPH_BACKEND_CUDA)
+      throw Error(Status::Unsupported, "def->backend: " + std::to_string(static_cast<int>(d.backend)) +
+                                           " is not an sph_backend value");
+    if (d.device_ordinal < -1)
+      throw Error(Status::InvalidArgument,
+                  "def->device_ordinal: must be -1 (default) or a device index, got " +
+                      std::to_string(d.device_ordinal));
+    if (d.reserved0 != 0) throw Error(Status::InvalidArgument, "def->reserved0: must be 0");
+    if (d.cpu_worker_count > 4096)
+      throw Error(Status::InvalidArgument,
+                  "def->cpu_worker_count: " + std::to_string(d.cpu_worker_count) + " is more than 4096");
+    const sph::BackendKind kind =
+        sph::resolve_backend(static_cast<sph::BackendKind>(d.backend), d.device_ordinal);
+    auto context = std::make_unique<sph_context>();
+    context->backend = kind;
+    context->device_ordinal = d.device_ordinal < 0 ? 0 : d.device_ordinal;
+    const unsigned hw = std::thread::hardware_concurrency();
+    context->cpu_workers = d.cpu_worker_count != 0 ? d.cpu_worker_count : (hw == 0 ? 1u : hw);
+    context->log_fn = d.log_fn;
+    context->log_user_data = d.log_user_data;
+    sph::register_handle(context.get(), sph::HandleKind::Context);
+    *out = context.release();
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_context_destroy(sph_context* context) {
+  if (!context) {
+    sph::clear_last_error();
+    return SPH_OK;
+  }
+  return sph::guarded("sph_context_destroy", nullptr, [&] {
+    if (!sph::is_live_handle(context, sph::HandleKind::Context))
+      throw Error(Status::InvalidHandle, "context: is not a live sph_context (destroyed or foreign pointer)");
+    const uint32_t worlds = context->world_count.load();
+    if (worlds != 0)
+      throw Error(Status::Busy, "context: " + std::to_string(worlds) +
+                                    " world(s) created on it are still alive; destroy them first");
+    sph::unregister_handle(context);
+    delete context;
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_context_get_backend(const sph_context* context, sph_backend* out_backend) {
+  return sph::guarded("sph_context_get_backend", nullptr, [&] {
+    if (!context || !sph::is_live_handle(context, sph::HandleKind::Context))
+      throw Error(Status::InvalidHandle, "context: is NULL or not a live sph_context");
+    if (!out_backend) throw Error(Status::InvalidArgument, "out_backend: is NULL");
+    *out_backend = context->backend == sph::BackendKind::Cuda ? SPH_BACKEND_CUDA : SPH_BACKEND_CPU;
+    return SPH_OK;
+  });
+}
+
+}  // extern "C"

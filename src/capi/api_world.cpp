@@ -1,0 +1,236 @@
+// Worlds: creation from a def, runtime parameters.
+#include "../core/fcc_lattice.h"
+#include "../physics/kernels.h"
+#include "guard.h"
+#include "handles.h"
+#include "struct_io.h"
+#include "validate.h"
+
+using sph::Error;
+using sph::Status;
+
+namespace {
+
+constexpr uint32_t kMaxCapacity = 1u << 30;
+constexpr float kDefaultKernelRadiusFactor = 1.8f;  // between the 3rd (sqrt 3) and 4th (2) FCC shell
+constexpr float kMaxKernelRadiusFactor = 5.0f;
+
+sph_world_def default_world_def() {
+  sph_world_def d;
+  std::memset(&d, 0, sizeof d);
+  d.struct_size = sizeof d;
+  d.capacity = 65536;
+  d.features = SPH_FEATURE_NONE;
+  d.integrator = SPH_INTEGRATOR_SYMPLECTIC_EULER;
+  d.particle_spacing = 0.02f;
+  d.kernel_radius = 0.0f;
+  d.rest_density = 1000.0f;
+  return d;
+}
+
+sph_world_params default_world_params() {
+  const sph::RuntimeParams p;
+  sph_world_params out;
+  std::memset(&out, 0, sizeof out);
+  out.struct_size = sizeof out;
+  out.max_substeps = p.max_substeps;
+  out.gravity = sph_vec3{p.gravity.x, p.gravity.y, p.gravity.z};
+  out.stiffness = p.stiffness;
+  out.viscosity = p.viscosity;
+  out.step_factor = p.step_factor;
+  out.dt_min = p.dt_min;
+  out.dt_max = p.dt_max;
+  return out;
+}
+
+// Validates a def and resolves defaults into the internal configuration.
+sph::WorldConfig config_from_def(const sph_world_def& d) {
+  if (d.header_version != 0 && (d.header_version >> 22) != SPH_VERSION_MAJOR)
+    throw Error(Status::VersionMismatch,
+                "def->header_version: the caller's header has another major version");
+  if (d.capacity == 0 || d.capacity > kMaxCapacity)
+    throw Error(Status::InvalidArgument,
+                "def->capacity: must be in [1, 2^30], got " + std::to_string(d.capacity));
+  if (d.features != SPH_FEATURE_NONE)
+    throw Error(
+        Status::Unsupported, "def->features: unknown feature bits 0x" + [&] {
+          char buf[16];
+          std::snprintf(buf, sizeof buf, "%x", d.features);
+          return std::string(buf);
+        }());
+  if (d.integrator != SPH_INTEGRATOR_SYMPLECTIC_EULER && d.integrator != SPH_INTEGRATOR_RK4)
+    throw Error(Status::Unsupported, "def->integrator: " + std::to_string(static_cast<int>(d.integrator)) +
+                                         " is not an sph_integrator value");
+  sph::require_zero(d.reserved0, "def->reserved0");
+  sph::require_zero(d.reserved1 != 0.0f ? 1u : 0u, "def->reserved1");
+  sph::require_positive(d.particle_spacing, "def->particle_spacing");
+  sph::require_positive(d.rest_density, "def->rest_density");
+  float h = d.kernel_radius;
+  if (h == 0.0f) {
+    h = kDefaultKernelRadiusFactor * d.particle_spacing;
+  } else {
+    sph::require_positive(h, "def->kernel_radius");
+    if (h < d.particle_spacing)
+      throw Error(Status::InvalidArgument, "def->kernel_radius: " + sph::describe(h) +
+                                               " is smaller than def->particle_spacing " +
+                                               sph::describe(d.particle_spacing));
+    if (h > kMaxKernelRadiusFactor * d.particle_spacing)
+      throw Error(Status::InvalidArgument, "def->kernel_radius: " + sph::describe(h) +
+                                               " is more than 5 x def->particle_spacing (hundreds of "
+                                               "neighbours per particle)");
+  }
+  const sph::KernelCoefficients k = sph::make_kernel_coefficients(h);
+  const bool representable = std::isfinite(h) && std::isfinite(k.poly6) && std::isfinite(k.spiky_grad) &&
+                             k.poly6 > 0.0f && k.visc_lap > 0.0f && std::isnormal(k.h2);
+  const float mass = representable ? sph::fcc_rest_mass(d.particle_spacing, h, d.rest_density) : 0.0f;
+  if (!representable || !std::isfinite(mass) || !(mass > 0.0f) || !std::isnormal(mass))
+    throw Error(Status::InvalidArgument, "def->particle_spacing: " + sph::describe(d.particle_spacing) +
+                                             " m gives kernel coefficients or a particle mass that float32 "
+                                             "cannot represent; choose other units or spacing");
+  sph::WorldConfig c;
+  c.capacity = d.capacity;
+  c.features = d.features;
+  c.integrator = static_cast<sph::Integrator>(d.integrator);
+  c.particle_spacing = d.particle_spacing;
+  c.kernel_radius = h;
+  c.rest_density = d.rest_density;
+  c.particle_mass = mass;
+  return c;
+}
+
+sph::RuntimeParams params_from_public(const sph_world_params& p) {
+  sph::require_finite_vec3(p.gravity, "params->gravity");
+  sph::require_positive(p.stiffness, "params->stiffness");
+  sph::require_non_negative(p.viscosity, "params->viscosity");
+  sph::require_positive(p.step_factor, "params->step_factor");
+  if (p.step_factor > 10.0f)
+    throw Error(Status::InvalidArgument,
+                "params->step_factor: must be <= 10, got " + sph::describe(p.step_factor));
+  sph::require_positive(p.dt_min, "params->dt_min");
+  sph::require_positive(p.dt_max, "params->dt_max");
+  if (p.dt_max < p.dt_min)
+    throw Error(Status::InvalidArgument, "params->dt_max: " + sph::describe(p.dt_max) +
+                                             " is smaller than params->dt_min " + sph::describe(p.dt_min));
+  if (p.max_substeps == 0) throw Error(Status::InvalidArgument, "params->max_substeps: must be >= 1");
+  sph::RuntimeParams r;
+  r.gravity = sph::Vec3{p.gravity.x, p.gravity.y, p.gravity.z};
+  r.stiffness = p.stiffness;
+  r.viscosity = p.viscosity;
+  r.step_factor = p.step_factor;
+  r.dt_min = p.dt_min;
+  r.dt_max = p.dt_max;
+  r.max_substeps = p.max_substeps;
+  return r;
+}
+
+}  // namespace
+
+extern "C" {
+
+SPH_API sph_result SPH_CALL sph_world_def_init_sized(sph_world_def* def, uint32_t size) {
+  return sph::guarded("sph_world_def_init", nullptr, [&] {
+    sph::require_init_size(def, size, "def");
+    sph::write_user_struct(def, size, default_world_def());
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_world_params_init_sized(sph_world_params* params, uint32_t size) {
+  return sph::guarded("sph_world_params_init", nullptr, [&] {
+    sph::require_init_size(params, size, "params");
+    sph::write_user_struct(params, size, default_world_params());
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_world_create(sph_context* context, const sph_world_def* def,
+                                             sph_world** out) {
+  const sph_context* log_context = sph::is_live_handle(context, sph::HandleKind::Context) ? context : nullptr;
+  return sph::guarded("sph_world_create", log_context, [&] {
+    if (!context) throw Error(Status::InvalidHandle, "context: is NULL");
+    if (!log_context) throw Error(Status::InvalidHandle, "context: is not a live sph_context");
+    if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
+    const sph_world_def d = sph::read_user_struct(def, "def");
+    const sph::WorldConfig config = config_from_def(d);
+    auto backend = sph::make_backend(context->backend, config, context->device_ordinal, context->cpu_workers);
+    auto world = std::make_unique<sph_world>();
+    world->context = context;
+    world->world = std::make_unique<sph::World>(config, std::move(backend));
+    sph::register_handle(world.get(), sph::HandleKind::World);
+    context->world_count.fetch_add(1);
+    *out = world.release();
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_world_destroy(sph_world* world) {
+  if (!world) {
+    sph::clear_last_error();
+    return SPH_OK;
+  }
+  return sph::guarded("sph_world_destroy", sph::context_of(world), [&] {
+    if (!sph::is_live_handle(world, sph::HandleKind::World))
+      throw Error(Status::InvalidHandle, "world: is not a live sph_world (destroyed or foreign pointer)");
+    if (world->busy.load()) throw Error(Status::WorldLocked, "world: is in use by another call");
+    sph::unregister_handle(world);
+    world->context->world_count.fetch_sub(1);
+    delete world;
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_world_get_def(const sph_world* world, sph_world_def* out_def) {
+  return sph::guarded("sph_world_get_def", sph::context_of(world), [&] {
+    sph::require_world(world);
+    if (!out_def) throw Error(Status::InvalidArgument, "out_def: is NULL");
+    const sph::WorldConfig& c = world->world->config();
+    sph_world_def d = default_world_def();
+    d.header_version = SPH_VERSION;
+    d.capacity = c.capacity;
+    d.features = c.features;
+    d.integrator = static_cast<sph_integrator>(c.integrator);
+    d.particle_spacing = c.particle_spacing;
+    d.kernel_radius = c.kernel_radius;
+    d.rest_density = c.rest_density;
+    sph::write_output_struct(out_def, d, "out_def");
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_world_get_particle_mass(const sph_world* world, float* out_mass) {
+  return sph::guarded("sph_world_get_particle_mass", sph::context_of(world), [&] {
+    sph::require_world(world);
+    if (!out_mass) throw Error(Status::InvalidArgument, "out_mass: is NULL");
+    *out_mass = world->world->config().particle_mass;
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_world_set_params(sph_world* world, const sph_world_params* params) {
+  return sph::guarded("sph_world_set_params", sph::context_of(world), [&] {
+    sph::require_world(world);
+    sph::WorldLock lock(world);
+    const sph::RuntimeParams p = params_from_public(sph::read_user_struct(params, "params"));
+    world->world->set_params(p);
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_world_get_params(const sph_world* world, sph_world_params* out) {
+  return sph::guarded("sph_world_get_params", sph::context_of(world), [&] {
+    sph::require_world(world);
+    const sph::RuntimeParams& p = world->world->params();
+    sph_world_params o = default_world_params();
+    o.max_substeps = p.max_substeps;
+    o.gravity = sph_vec3{p.gravity.x, p.gravity.y, p.gravity.z};
+    o.stiffness = p.stiffness;
+    o.viscosity = p.viscosity;
+    o.step_factor = p.step_factor;
+    o.dt_min = p.dt_min;
+    o.dt_max = p.dt_max;
+    sph::write_output_struct(out, o, "out");
+    return SPH_OK;
+  });
+}
+
+}  // extern "C"

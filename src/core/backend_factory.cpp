@@ -1,0 +1,58 @@
+#include "backend_factory.h"
+
+#include <string>
+
+#include "status.h"
+
+#if defined(SPH_HAVE_CUDA)
+#include "../../cuda/cuda_backend.h"
+#endif
+
+namespace sph {
+
+bool cuda_built() {
+#if defined(SPH_HAVE_CUDA)
+  return true;
+#else
+  return false;
+#endif
+}
+
+int cuda_device_count() {
+#if defined(SPH_HAVE_CUDA)
+  return cuda_usable_device_count();
+#else
+  return 0;
+#endif
+}
+
+BackendKind resolve_backend(BackendKind requested, int device_ordinal) {
+  if (requested == BackendKind::Cpu) return BackendKind::Cpu;
+  const int devices = cuda_device_count();
+  if (requested == BackendKind::Auto) return devices > 0 ? BackendKind::Cuda : BackendKind::Cpu;
+  if (!cuda_built())
+    throw Error(Status::Unsupported,
+                "backend: SPH_BACKEND_CUDA was asked for, but this library was built without CUDA");
+  if (devices == 0)
+    throw Error(Status::Unsupported,
+                "backend: SPH_BACKEND_CUDA was asked for, but no CUDA device is present");
+  if (device_ordinal >= devices)
+    throw Error(Status::Unsupported, "device_ordinal: " + std::to_string(device_ordinal) +
+                                         " is out of range; " + std::to_string(devices) +
+                                         " CUDA device(s) present");
+  return BackendKind::Cuda;
+}
+
+std::unique_ptr<Backend> make_backend(BackendKind kind, const WorldConfig& config, int device_ordinal,
+                                      unsigned cpu_workers) {
+#if defined(SPH_HAVE_CUDA)
+  if (kind == BackendKind::Cuda) return make_cuda_backend(config, device_ordinal < 0 ? 0 : device_ordinal);
+#else
+  (void)device_ordinal;
+#endif
+  if (kind == BackendKind::Cuda)
+    throw Error(Status::Unsupported, "backend: CUDA is not available in this build");
+  return make_cpu_backend(config, cpu_workers);
+}
+
+}  // namespace sph

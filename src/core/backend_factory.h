@@ -1,0 +1,22 @@
+// The one place that knows which backends exist: picks the CPU or CUDA implementation.
+#pragma once
+
+#include <memory>
+
+#include "backend.h"
+
+namespace sph {
+
+enum class BackendKind : uint32_t { Auto = 0, Cpu = 1, Cuda = 2 };
+
+// Number of usable CUDA devices; 0 when the library was built without CUDA or none is present.
+int cuda_device_count();
+bool cuda_built();
+
+// Resolves Auto to Cpu or Cuda. Throws Error(Unsupported) for Cuda without a device.
+BackendKind resolve_backend(BackendKind requested, int device_ordinal);
+
+std::unique_ptr<Backend> make_backend(BackendKind kind, const WorldConfig& config, int device_ordinal,
+                                      unsigned cpu_workers);
+
+}  // namespace sph

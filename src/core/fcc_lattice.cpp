@@ -1,0 +1,103 @@
+#include "fcc_lattice.h"
+
+#include <cmath>
+
+#include "../physics/kernels.h"
+
+namespace sph {
+namespace {
+
+// Half the cubic cell: the step of the underlying simple-cubic grid.
+double half_cell(float spacing) { return static_cast<double>(spacing) / std::sqrt(2.0); }
+
+// The points of a box: the sub-lattice from lo with n[i] steps per axis.
+struct BoxLattice {
+  double lo[3];
+  int64_t n[3];
+  double step;
+};
+
+BoxLattice box_lattice(Vec3 min, Vec3 max, float spacing) {
+  BoxLattice b;
+  b.step = half_cell(spacing);
+  const double margin = 0.5 * spacing;
+  const double lo[3] = {min.x + margin, min.y + margin, min.z + margin};
+  const double hi[3] = {max.x - margin, max.y - margin, max.z - margin};
+  for (int a = 0; a < 3; ++a) {
+    b.lo[a] = lo[a];
+    const double steps = hi[a] < lo[a] ? -1.0 : std::floor((hi[a] - lo[a]) / b.step);
+    b.n[a] = steps < 0.0 ? 0 : (steps > 4e9 ? static_cast<int64_t>(4e9) : static_cast<int64_t>(steps) + 1);
+  }
+  return b;
+}
+
+}  // namespace
+
+uint64_t fcc_box_point_count(Vec3 min, Vec3 max, float spacing) {
+  const BoxLattice b = box_lattice(min, max, spacing);
+  const double all = static_cast<double>(b.n[0]) * static_cast<double>(b.n[1]) * static_cast<double>(b.n[2]);
+  if (all > 1.8e19) return UINT64_MAX;
+  const uint64_t total =
+      static_cast<uint64_t>(b.n[0]) * static_cast<uint64_t>(b.n[1]) * static_cast<uint64_t>(b.n[2]);
+  // Points with an even index sum: half, plus one when every extent is odd (the corner counts).
+  return (total + 1) / 2;
+}
+
+double fcc_sphere_point_estimate(float radius, float spacing) {
+  const double r = radius, s = spacing;
+  return 4.0 / 3.0 * 3.14159265358979323846 * r * r * r * std::sqrt(2.0) / (s * s * s);
+}
+
+std::vector<Vec3> fcc_points_in_box(Vec3 min, Vec3 max, float spacing) {
+  const BoxLattice b = box_lattice(min, max, spacing);
+  std::vector<Vec3> points;
+  points.reserve(static_cast<size_t>(fcc_box_point_count(min, max, spacing)));
+  for (int64_t k = 0; k < b.n[2]; ++k)
+    for (int64_t j = 0; j < b.n[1]; ++j)
+      for (int64_t i = 0; i < b.n[0]; ++i) {
+        if ((i + j + k) % 2 != 0) continue;
+        points.push_back(Vec3{static_cast<float>(b.lo[0] + b.step * static_cast<double>(i)),
+                              static_cast<float>(b.lo[1] + b.step * static_cast<double>(j)),
+                              static_cast<float>(b.lo[2] + b.step * static_cast<double>(k))});
+      }
+  return points;
+}
+
+std::vector<Vec3> fcc_points_in_sphere(Vec3 center, float radius, float spacing) {
+  const double step = half_cell(spacing);
+  const int64_t n = static_cast<int64_t>(std::floor(radius / step));
+  const double r2 = static_cast<double>(radius) * radius;
+  std::vector<Vec3> points;
+  for (int64_t k = -n; k <= n; ++k)
+    for (int64_t j = -n; j <= n; ++j)
+      for (int64_t i = -n; i <= n; ++i) {
+        if (((i + j + k) % 2 + 2) % 2 != 0) continue;
+        const double x = step * static_cast<double>(i), y = step * static_cast<double>(j),
+                     z = step * static_cast<double>(k);
+        if (x * x + y * y + z * z > r2) continue;
+        points.push_back(Vec3{static_cast<float>(center.x + x), static_cast<float>(center.y + y),
+                              static_cast<float>(center.z + z)});
+      }
+  return points;
+}
+
+float fcc_rest_mass(float spacing, float kernel_radius, float rest_density) {
+  const double step = half_cell(spacing);
+  const double h = kernel_radius;
+  const double h2 = h * h;
+  const double poly6 = 315.0 / (64.0 * 3.14159265358979323846 * std::pow(h, 9.0));
+  const int64_t n = static_cast<int64_t>(std::ceil(h / step)) + 1;
+  double sum = 0.0;
+  for (int64_t k = -n; k <= n; ++k)
+    for (int64_t j = -n; j <= n; ++j)
+      for (int64_t i = -n; i <= n; ++i) {
+        if (((i + j + k) % 2 + 2) % 2 != 0) continue;
+        const double r2 = step * step * static_cast<double>(i * i + j * j + k * k);
+        if (r2 >= h2) continue;
+        const double d = h2 - r2;
+        sum += poly6 * d * d * d;
+      }
+  return static_cast<float>(rest_density / sum);
+}
+
+}  // namespace sph

@@ -1,0 +1,29 @@
+// Face-centred cubic lattice points (the thesis's "tetrahedral lattice"): the points of a
+// cubic grid of step spacing/sqrt(2) whose integer coordinates sum to an even number, so
+// every point has 12 nearest neighbours at exactly `spacing`.
+#pragma once
+
+#include <stdint.h>
+
+#include <vector>
+
+#include "../physics/vec3.h"
+
+namespace sph {
+
+// Exactly the number of points fcc_points_in_box returns, computed without generating them,
+// so a fill that cannot fit is refused before anything is allocated.
+uint64_t fcc_box_point_count(Vec3 min, Vec3 max, float spacing);
+// The volume estimate of the points in a sphere (sqrt(2) / spacing^3 per unit volume).
+double fcc_sphere_point_estimate(float radius, float spacing);
+
+// Points at least spacing/2 inside each face of [min, max].
+std::vector<Vec3> fcc_points_in_box(Vec3 min, Vec3 max, float spacing);
+// Points with |p - center| <= radius; the centre is a lattice point.
+std::vector<Vec3> fcc_points_in_sphere(Vec3 center, float radius, float spacing);
+
+// The particle mass at which an infinite FCC lattice at `spacing` has density rest_density
+// under W_poly6 with radius kernel_radius (sum over the lattice computed in double).
+float fcc_rest_mass(float spacing, float kernel_radius, float rest_density);
+
+}  // namespace sph

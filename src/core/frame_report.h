@@ -1,0 +1,35 @@
+// What a backend reports about one frame (one sph_world_step).
+#pragma once
+
+#include <stdint.h>
+
+namespace sph {
+
+enum StageIndex : int {
+  kStageHashSort = 0,
+  kStageCellRanges = 1,
+  kStageDensity = 2,
+  kStageForces = 3,
+  kStageIntegrate = 4,
+  kStageCollide = 5,
+  kStageEmit = 6,
+  kStageOther = 7,
+  kStageCount = 8,
+};
+
+struct FrameReport {
+  uint32_t substeps = 0;
+  bool completed = true;       // false when max_substeps ran out before the frame's end
+  double time_advanced = 0.0;  // seconds
+  float dt_min = 0.0f;
+  float dt_max = 0.0f;
+  float max_speed = 0.0f;
+  float density_min = 0.0f;
+  float density_mean = 0.0f;
+  float density_max = 0.0f;
+  float neighbors_mean = 0.0f;
+  uint32_t neighbors_max = 0;
+  float stage_ms[kStageCount] = {};
+};
+
+}  // namespace sph

@@ -1,0 +1,66 @@
+// The wrapped hashed uniform grid (thesis eq. 27-30): cell = floor(x / cell_size) per axis,
+// folded into an nx * ny * nz table in linear x-fastest order so neighbouring cells stay
+// close in memory. An unbounded domain maps onto a table sized by particle count.
+#pragma once
+
+#include <stdint.h>
+
+#include "host_device.h"
+#include "vec3.h"
+
+#if defined(__CUDACC__)
+#define SPH_FLOORF floorf
+#define SPH_FMINF fminf
+#define SPH_FMAXF fmaxf
+#else
+#include <cmath>
+#define SPH_FLOORF std::floor
+#define SPH_FMINF std::fmin
+#define SPH_FMAXF std::fmax
+#endif
+
+namespace sph {
+
+// Cell coordinates are clamped to this magnitude so a runaway particle cannot overflow int32.
+constexpr float kMaxCellCoordinate = 1073741824.0f;  // 2^30
+
+struct GridShape {
+  float inv_cell_size;  // 1 / cell size (cell size = kernel radius h)
+  int32_t nx, ny, nz;   // table dimensions, each >= 3 so the 27 neighbours are distinct slots
+  uint32_t cell_count;  // nx * ny * nz
+};
+
+struct CellCoord {
+  int32_t x, y, z;
+};
+
+SPH_HD int32_t cell_coordinate(float x, float inv_cell_size) {
+  float c = SPH_FLOORF(x * inv_cell_size);
+  c = SPH_FMINF(SPH_FMAXF(c, -kMaxCellCoordinate), kMaxCellCoordinate);
+  return static_cast<int32_t>(c);
+}
+
+SPH_HD CellCoord cell_of(const GridShape& g, Vec3 p) {
+  return CellCoord{cell_coordinate(p.x, g.inv_cell_size), cell_coordinate(p.y, g.inv_cell_size),
+                   cell_coordinate(p.z, g.inv_cell_size)};
+}
+
+// Non-negative remainder: wraps negative cell coordinates into [0, n).
+SPH_HD int32_t wrap_index(int32_t c, int32_t n) {
+  const int32_t m = c % n;
+  return m < 0 ? m + n : m;
+}
+
+SPH_HD uint32_t hash_wrapped(const GridShape& g, int32_t wx, int32_t wy, int32_t wz) {
+  return static_cast<uint32_t>(wx) +
+         static_cast<uint32_t>(g.nx) *
+             (static_cast<uint32_t>(wy) + static_cast<uint32_t>(g.ny) * static_cast<uint32_t>(wz));
+}
+
+SPH_HD uint32_t cell_hash(const GridShape& g, CellCoord c) {
+  return hash_wrapped(g, wrap_index(c.x, g.nx), wrap_index(c.y, g.ny), wrap_index(c.z, g.nz));
+}
+
+SPH_HD uint32_t cell_hash_of_position(const GridShape& g, Vec3 p) { return cell_hash(g, cell_of(g, p)); }
+
+}  // namespace sph
