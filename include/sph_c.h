@@ -247,7 +247,7 @@ typedef struct sph_world_params {
   float stiffness;       /* k of p = k (rho - rho0), m^2/s^2 (the squared numerical sound speed);
                             default 100; > 0. Keep sqrt(k) * dt_max below about 0.4 h. */
   float viscosity;       /* mu of Mueller's Laplacian viscosity (a numerical viscosity, not
-                            water's 0.001 Pa s); default 5; >= 0 */
+                            water's 0.001 Pa s); default 1; >= 0 */
   float step_factor;     /* lambda of dt = lambda h / v_max; default 0.4; in (0, 10] */
   float dt_min;          /* s; default 1e-6; > 0 */
   float dt_max;          /* s; default 1e-3; >= dt_min */

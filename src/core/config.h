@@ -24,7 +24,7 @@ struct WorldConfig {
 struct RuntimeParams {
   Vec3 gravity{0.0f, -9.81f, 0.0f};
   float stiffness = 100.0f;
-  float viscosity = 5.0f;
+  float viscosity = 1.0f;
   float step_factor = 0.4f;
   float dt_min = 1e-6f;
   float dt_max = 1e-3f;
