@@ -1,0 +1,119 @@
+# shellcheck shell=bash
+# Shared set-up for scripts/demo and scripts/test (sourced, not run).
+#
+# Provides:
+#   SPH_ROOT                      the repository root (the scripts cd there)
+#   sph_log / sph_warn / sph_die  messages on stderr, prefixed with the calling script's name
+#   sph_install_packages          apt-get installs whatever of SPH_PACKAGES is missing
+#   sph_configure DIR [ARGS...]   cmake -G Ninja into DIR (Release unless ARGS say otherwise)
+#   sph_build DIR [TARGETS...]    ninja in DIR
+#
+# Environment knobs:
+#   SPH_SKIP_PACKAGES=1   do not check or install Debian packages (a machine set up by hand)
+#   SPH_BUILD_JOBS=N      parallel compile jobs (default: ninja's own choice)
+
+SPH_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+SPH_SCRIPT_NAME="$(basename "${0}")"
+
+# The Debian 12 packages the build, the tests and the tools need. libclang-rt-14-dev is what
+# clang's Recommends would bring in; it holds libFuzzer and the sanitizer runtimes for clang.
+SPH_PACKAGES=(
+  cmake ninja-build g++ pkg-config git
+  libcmocka-dev libeigen3-dev
+  libopenvdb-dev libboost-iostreams-dev libtbb-dev nlohmann-json3-dev
+  clang libclang-rt-14-dev clang-format
+)
+
+sph_log() { printf '[%s] %s\n' "${SPH_SCRIPT_NAME}" "$*" >&2; }
+sph_warn() { printf '[%s] warning: %s\n' "${SPH_SCRIPT_NAME}" "$*" >&2; }
+sph_die() {
+  printf '[%s] error: %s\n' "${SPH_SCRIPT_NAME}" "$*" >&2
+  exit 1
+}
+
+# True when the Debian package is installed (not merely known or half-removed).
+sph_package_installed() {
+  [[ "$(dpkg-query -W -f='${db:Status-Status}' "$1" 2>/dev/null)" == "installed" ]]
+}
+
+# Installs the packages of SPH_PACKAGES that are missing: one `apt-get update`, then one
+# `apt-get install`, non-interactive, through sudo only when not already root.
+sph_install_packages() {
+  if [[ "${SPH_SKIP_PACKAGES:-0}" == "1" ]]; then
+    sph_log "SPH_SKIP_PACKAGES=1: not checking Debian packages"
+    return 0
+  fi
+  command -v dpkg-query >/dev/null 2>&1 ||
+    sph_die "dpkg-query not found: these scripts set up Debian 12; install the packages by hand (${SPH_PACKAGES[*]}) and run with SPH_SKIP_PACKAGES=1"
+
+  local missing=() pkg
+  for pkg in "${SPH_PACKAGES[@]}"; do
+    sph_package_installed "${pkg}" || missing+=("${pkg}")
+  done
+  if [[ ${#missing[@]} -eq 0 ]]; then
+    sph_log "all ${#SPH_PACKAGES[@]} required Debian packages are installed"
+    return 0
+  fi
+
+  local sudo=()
+  if [[ "$(id -u)" -ne 0 ]]; then
+    command -v sudo >/dev/null 2>&1 ||
+      sph_die "missing packages (${missing[*]}) and not root, and sudo is not installed"
+    sudo=(sudo)
+  fi
+  sph_log "installing missing Debian packages: ${missing[*]}"
+  "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update -q </dev/null ||
+    sph_die "apt-get update failed"
+  "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends \
+    "${missing[@]}" </dev/null || sph_die "apt-get install failed for: ${missing[*]}"
+  for pkg in "${missing[@]}"; do
+    sph_package_installed "${pkg}" || sph_die "package ${pkg} is still not installed after apt-get"
+  done
+}
+
+# Reports what the build will find, so a log says which backend was built.
+sph_describe_toolchain() {
+  if [[ -x /usr/local/cuda/bin/nvcc ]]; then
+    sph_log "nvcc found at /usr/local/cuda/bin/nvcc: the CUDA backend is compiled too"
+  else
+    sph_log "no /usr/local/cuda/bin/nvcc: building the CPU backend alone"
+  fi
+}
+
+# sph_configure DIR [CMAKE ARGS...]: configures DIR with Ninja. A cache left by another
+# generator (say a Makefile build in the same folder) is dropped first; a cache made from
+# another source tree is refused rather than reused.
+sph_configure() {
+  local dir="$1"
+  shift
+  local cache="${dir}/CMakeCache.txt"
+  if [[ -f "${cache}" ]]; then
+    local generator home
+    generator="$(sed -n 's/^CMAKE_GENERATOR:INTERNAL=//p' "${cache}")"
+    home="$(sed -n 's/^CMAKE_HOME_DIRECTORY:INTERNAL=//p' "${cache}")"
+    if [[ -n "${home}" && "$(cd "${home}" 2>/dev/null && pwd -P)" != "$(cd "${SPH_ROOT}" && pwd -P)" ]]; then
+      sph_die "${dir} was configured from another source tree (${home}); remove it or choose another folder"
+    fi
+    if [[ "${generator}" != "Ninja" ]]; then
+      sph_log "${dir} was configured with '${generator}', not Ninja: starting it afresh"
+      rm -rf "${cache}" "${dir}/CMakeFiles"
+    fi
+  fi
+  sph_log "configuring ${dir}: cmake -G Ninja -DCMAKE_BUILD_TYPE=Release $*"
+  cmake -S "${SPH_ROOT}" -B "${dir}" -G Ninja -DCMAKE_BUILD_TYPE=Release "$@"
+}
+
+# sph_build DIR [TARGETS...]
+sph_build() {
+  local dir="$1"
+  shift
+  local jobs=()
+  [[ -n "${SPH_BUILD_JOBS:-}" ]] && jobs=(-j "${SPH_BUILD_JOBS}")
+  sph_log "building ${dir}${*:+ (targets: $*)}"
+  ninja -C "${dir}" "${jobs[@]}" "$@"
+}
+
+# sph_has_target DIR TARGET: true when the configured build in DIR defines TARGET.
+sph_has_target() {
+  ninja -C "$1" -t query "$2" >/dev/null 2>&1
+}
