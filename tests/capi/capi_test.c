@@ -1,0 +1,140 @@
+#include "capi_test.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void capi_expect_error(sph_result got, sph_result expected, const char* name, const char* call,
+                       const char* file, int line) {
+  const char* message = sph_get_last_error();
+  if (message == NULL) {
+    print_error("%s: sph_get_last_error() returned NULL\n", call);
+    _fail(file, line);
+  }
+  if (got != expected) {
+    print_error("%s returned %d (%s), expected %d (%s); last error: \"%s\"\n", call, (int)got,
+                sph_result_string(got), (int)expected, sph_result_string(expected), message);
+    _fail(file, line);
+  }
+  if (expected >= 0 && message[0] != '\0') {
+    print_error("%s succeeded but sph_get_last_error() is \"%s\", expected \"\"\n", call, message);
+    _fail(file, line);
+  }
+  if (name != NULL && strstr(message, name) == NULL) {
+    print_error("%s: the message \"%s\" does not name \"%s\"\n", call, message, name);
+    _fail(file, line);
+  }
+}
+
+void capi_set_float(void* object, size_t offset, float value) {
+  memcpy((unsigned char*)object + offset, &value, sizeof value);
+}
+
+float capi_non_finite(int i) {
+  switch (i) {
+    case 0:
+      return NAN;
+    case 1:
+      return INFINITY;
+    default:
+      return -INFINITY;
+  }
+}
+
+int capi_fixture_setup(void** state) {
+  capi_fixture* f = (capi_fixture*)calloc(1, sizeof *f);
+  sph_world_def def;
+  sph_fill_box_desc box;
+  uint32_t added = 0;
+  if (f == NULL) return -1;
+  *state = f;
+  if (sph_test_context_create(&f->context) != SPH_OK) return -1;
+  if (sph_world_def_init(&def) != SPH_OK) return -1;
+  def.capacity = CAPI_FIXTURE_CAPACITY;
+  if (sph_world_create(f->context, &def, &f->world) != SPH_OK) return -1;
+  /* 108 particles: a 6 x 6 x 6 FCC block. */
+  sph_fill_box_desc_init(&box);
+  box.max.x = box.max.y = box.max.z = 0.1f;
+  box.velocity.x = 0.05f;
+  if (sph_world_fill_box(f->world, &box, &added) != SPH_OK || added == 0) return -1;
+  /* Every field differs from its default, so a call that resets params shows. */
+  sph_world_params_init(&f->params);
+  f->params.max_substeps = 777;
+  f->params.gravity.x = 0.5f;
+  f->params.gravity.y = -9.0f;
+  f->params.gravity.z = 0.25f;
+  f->params.stiffness = 120.0f;
+  f->params.viscosity = 3.0f;
+  f->params.step_factor = 0.3f;
+  f->params.dt_min = 2e-6f;
+  f->params.dt_max = 5e-4f;
+  if (sph_world_set_params(f->world, &f->params) != SPH_OK) return -1;
+  /* One frame, so that order, velocities and densities are no longer the initial ones. */
+  if (sph_world_step(f->world, 0.005f) != SPH_OK) return -1;
+  return 0;
+}
+
+int capi_fixture_teardown(void** state) {
+  capi_fixture* f = (capi_fixture*)*state;
+  int failed = 0;
+  if (f == NULL) return 0;
+  failed |= sph_world_destroy(f->world) != SPH_OK;
+  failed |= sph_context_destroy(f->context) != SPH_OK;
+  free(f);
+  *state = NULL;
+  return failed ? -1 : 0;
+}
+
+void capi_snapshot_take(const sph_world* world, capi_snapshot* out) {
+  sph_stats stats;
+  memset(out, 0, sizeof *out);
+  assert_int_equal(sph_world_get_particle_count(world, &out->count), SPH_OK);
+  assert_true(out->count <= CAPI_SNAPSHOT_MAX);
+  out->def.struct_size = sizeof out->def;
+  assert_int_equal(sph_world_get_def(world, &out->def), SPH_OK);
+  sph_world_params_init(&out->params);
+  assert_int_equal(sph_world_get_params(world, &out->params), SPH_OK);
+  sph_stats_init(&stats);
+  assert_int_equal(sph_world_get_stats(world, &stats), SPH_OK);
+  out->simulated_time = stats.simulated_time;
+  assert_int_equal(sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, out->positions,
+                                            sizeof out->positions, 0, 0, out->count, NULL),
+                   SPH_OK);
+  assert_int_equal(sph_world_copy_attribute(world, SPH_ATTRIBUTE_VELOCITY, out->velocities,
+                                            sizeof out->velocities, 0, 0, out->count, NULL),
+                   SPH_OK);
+  assert_int_equal(sph_world_copy_attribute(world, SPH_ATTRIBUTE_DENSITY, out->densities,
+                                            sizeof out->densities, 0, 0, out->count, NULL),
+                   SPH_OK);
+  assert_int_equal(
+      sph_world_copy_attribute(world, SPH_ATTRIBUTE_ID, out->ids, sizeof out->ids, 0, 0, out->count, NULL),
+      SPH_OK);
+}
+
+void capi_expect_unchanged(const sph_world* world, const capi_snapshot* before, const char* file, int line) {
+  /* Static: a snapshot is ~14 KiB and the tests are single-threaded. */
+  static capi_snapshot now;
+  const char* what = NULL;
+  capi_snapshot_take(world, &now);
+  if (now.count != before->count)
+    what = "particle count";
+  else if (memcmp(&now.def, &before->def, sizeof now.def) != 0)
+    what = "def";
+  else if (memcmp(&now.params, &before->params, sizeof now.params) != 0)
+    what = "params";
+  else if (now.simulated_time != before->simulated_time)
+    what = "simulated time";
+  else if (memcmp(now.positions, before->positions, sizeof(float) * 3 * now.count) != 0)
+    what = "positions";
+  else if (memcmp(now.velocities, before->velocities, sizeof(float) * 3 * now.count) != 0)
+    what = "velocities";
+  else if (memcmp(now.densities, before->densities, sizeof(float) * now.count) != 0)
+    what = "densities";
+  else if (memcmp(now.ids, before->ids, sizeof(uint32_t) * now.count) != 0)
+    what = "ids";
+  if (what != NULL) {
+    print_error("the world changed after a failed call: %s differ (count %u -> %u)\n", what, before->count,
+                now.count);
+    _fail(file, line);
+  }
+}

@@ -1,0 +1,66 @@
+/* What the C-API tests share: result/message expectations, a populated world fixture and a
+ * snapshot that proves a failed call left the world unchanged. */
+#ifndef SPH_CAPI_TEST_H
+#define SPH_CAPI_TEST_H
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "sph_c.h"
+#include "test_support.h"
+
+/* The call returns `expected` and sph_get_last_error() contains `name` (the argument). */
+#define EXPECT_ERROR(expected, name, call) \
+  capi_expect_error((call), (expected), (name), #call, __FILE__, __LINE__)
+/* The same, reporting the given line (for helpers that check on behalf of their caller). */
+#define EXPECT_ERROR_AT(line, expected, name, call) \
+  capi_expect_error((call), (expected), (name), #call, __FILE__, (line))
+/* The call returns SPH_OK and sph_get_last_error() is "". */
+#define EXPECT_OK(call) capi_expect_error((call), SPH_OK, NULL, #call, __FILE__, __LINE__)
+
+void capi_expect_error(sph_result got, sph_result expected, const char* name, const char* call,
+                       const char* file, int line);
+
+/* Writes a float (NaN, Inf, ...) into a struct at a byte offset. */
+void capi_set_float(void* object, size_t offset, float value);
+
+/* The non-finite values every float field is tried with. */
+#define CAPI_NON_FINITE_COUNT 3
+float capi_non_finite(int i);
+
+/* ---- a world with particles, non-default params and one step behind it ------------------- */
+#define CAPI_FIXTURE_CAPACITY 256u
+typedef struct capi_fixture {
+  sph_context* context;
+  sph_world* world;
+  sph_world_params params; /* the non-default params the fixture set */
+} capi_fixture;
+
+/* cmocka group/test setup and teardown: *state becomes a capi_fixture*. */
+int capi_fixture_setup(void** state);
+int capi_fixture_teardown(void** state);
+
+/* ---- "the world is unchanged" -------------------------------------------------------------- */
+#define CAPI_SNAPSHOT_MAX 512u
+typedef struct capi_snapshot {
+  uint32_t count;
+  sph_world_def def;
+  sph_world_params params;
+  double simulated_time;
+  float positions[3 * CAPI_SNAPSHOT_MAX];
+  float velocities[3 * CAPI_SNAPSHOT_MAX];
+  float densities[CAPI_SNAPSHOT_MAX];
+  uint32_t ids[CAPI_SNAPSHOT_MAX];
+} capi_snapshot;
+
+void capi_snapshot_take(const sph_world* world, capi_snapshot* out);
+#define EXPECT_UNCHANGED(world, snapshot) capi_expect_unchanged((world), (snapshot), __FILE__, __LINE__)
+#define EXPECT_UNCHANGED_AT(line, world, snapshot) \
+  capi_expect_unchanged((world), (snapshot), __FILE__, (line))
+void capi_expect_unchanged(const sph_world* world, const capi_snapshot* before, const char* file, int line);
+
+#endif /* SPH_CAPI_TEST_H */

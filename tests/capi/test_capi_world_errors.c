@@ -1,0 +1,546 @@
+/* Worlds and their parameters through the C API: every bad def, handle and parameter returns
+ * its code, names the argument, writes no output and leaves the world as it was. */
+#include <math.h>
+#include <string.h>
+
+#include "capi_test.h"
+
+typedef struct {
+  sph_world_def def;
+  unsigned char extra[16];
+} grown_world_def;
+
+typedef struct {
+  sph_world_params params;
+  unsigned char extra[16];
+} grown_world_params;
+
+typedef struct {
+  size_t offset;
+  const char* name;
+} float_field;
+
+static uint32_t live_objects(void) {
+  uint32_t n = 0xdeadbeefu;
+  assert_int_equal(sph_get_live_object_count(&n), SPH_OK);
+  return n;
+}
+
+static sph_context* make_context(void) {
+  sph_context* context = NULL;
+  EXPECT_OK(sph_test_context_create(&context));
+  return context;
+}
+
+static void small_world_def(sph_world_def* def) {
+  sph_world_def_init(def);
+  def->capacity = 64;
+}
+
+/* sph_world_create must fail with (code, name), leave *out alone and create nothing. */
+static void expect_create_fails_at(int line, sph_context* context, const sph_world_def* def, sph_result code,
+                                   const char* name) {
+  sph_world* const sentinel = (sph_world*)(uintptr_t)0x5678;
+  sph_world* out = sentinel;
+  const uint32_t before = live_objects();
+  EXPECT_ERROR_AT(line, code, name, sph_world_create(context, def, &out));
+  assert_ptr_equal(out, sentinel);
+  assert_int_equal(live_objects(), before);
+}
+#define EXPECT_CREATE_FAILS(...) expect_create_fails_at(__LINE__, __VA_ARGS__)
+
+static void expect_create_ok(sph_context* context, const sph_world_def* def) {
+  sph_world* world = NULL;
+  EXPECT_OK(sph_world_create(context, def, &world));
+  assert_non_null(world);
+  EXPECT_OK(sph_world_destroy(world));
+}
+
+/* ---- defs ------------------------------------------------------------------------------------ */
+
+static void test_def_init(void** state) {
+  sph_world_def def;
+  grown_world_def grown;
+  (void)state;
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "def", sph_world_def_init_sized(NULL, sizeof def));
+  memset(&def, 0xab, sizeof def);
+  EXPECT_ERROR(SPH_ERROR_VERSION_MISMATCH, "def", sph_world_def_init_sized(&def, sizeof def - 1));
+  assert_int_equal(def.struct_size, 0xababababu);
+  EXPECT_OK(sph_world_def_init(&def));
+  assert_int_equal(def.struct_size, sizeof def);
+  assert_int_equal(def.header_version, SPH_VERSION);
+  assert_int_equal(def.capacity, 65536);
+  assert_int_equal(def.features, SPH_FEATURE_NONE);
+  assert_int_equal(def.integrator, SPH_INTEGRATOR_SYMPLECTIC_EULER);
+  assert_int_equal(def.reserved0, 0);
+  assert_true(def.particle_spacing == 0.02f);
+  assert_true(def.kernel_radius == 0.0f);
+  assert_true(def.rest_density == 1000.0f);
+  assert_true(def.reserved1 == 0.0f);
+  memset(&grown, 0xab, sizeof grown);
+  EXPECT_OK(sph_world_def_init_sized(&grown.def, sizeof grown));
+  assert_int_equal(grown.def.struct_size, sizeof grown);
+  for (size_t i = 0; i < sizeof grown.extra; ++i) assert_int_equal(grown.extra[i], 0);
+}
+
+static void test_create_bad_context(void** state) {
+  sph_world_def def;
+  sph_context* stale = make_context();
+  sph_context* context = NULL;
+  sph_world* world = NULL;
+  int foreign = 0;
+  (void)state;
+  small_world_def(&def);
+  EXPECT_OK(sph_context_destroy(stale));
+  EXPECT_CREATE_FAILS(stale, &def, SPH_ERROR_INVALID_HANDLE, "context");
+  EXPECT_CREATE_FAILS(NULL, &def, SPH_ERROR_INVALID_HANDLE, "context");
+  EXPECT_CREATE_FAILS((sph_context*)(void*)&foreign, &def, SPH_ERROR_INVALID_HANDLE, "context");
+  context = make_context();
+  EXPECT_OK(sph_world_create(context, &def, &world));
+  EXPECT_CREATE_FAILS((sph_context*)(void*)world, &def, SPH_ERROR_INVALID_HANDLE, "context");
+  EXPECT_OK(sph_world_destroy(world));
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+static void test_create_null_arguments(void** state) {
+  sph_context* context = make_context();
+  sph_world_def def;
+  (void)state;
+  small_world_def(&def);
+  EXPECT_CREATE_FAILS(context, NULL, SPH_ERROR_INVALID_ARGUMENT, "def");
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "out", sph_world_create(context, &def, NULL));
+  assert_int_equal(live_objects(), 1);
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+static void test_create_struct_size(void** state) {
+  sph_context* context = make_context();
+  grown_world_def grown;
+  (void)state;
+  memset(&grown, 0, sizeof grown);
+  small_world_def(&grown.def);
+  grown.def.struct_size = sizeof grown.def - 4;
+  EXPECT_CREATE_FAILS(context, &grown.def, SPH_ERROR_VERSION_MISMATCH, "struct_size");
+  grown.def.struct_size = 0;
+  EXPECT_CREATE_FAILS(context, &grown.def, SPH_ERROR_VERSION_MISMATCH, "struct_size");
+  grown.def.struct_size = sizeof grown;
+  grown.extra[15] = 0x80;
+  EXPECT_CREATE_FAILS(context, &grown.def, SPH_ERROR_UNSUPPORTED, "struct_size");
+  grown.extra[15] = 0;
+  expect_create_ok(context, &grown.def);
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+static void test_create_header_version(void** state) {
+  sph_context* context = make_context();
+  sph_world_def def;
+  (void)state;
+  small_world_def(&def);
+  def.header_version = SPH_MAKE_VERSION(SPH_VERSION_MAJOR + 1, SPH_VERSION_MINOR, 0);
+  EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_VERSION_MISMATCH, "header_version");
+  def.header_version = SPH_MAKE_VERSION(SPH_VERSION_MAJOR, SPH_VERSION_MINOR + 1, 0);
+  expect_create_ok(context, &def);
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+static void test_create_capacity(void** state) {
+  sph_context* context = make_context();
+  sph_world_def def;
+  (void)state;
+  small_world_def(&def);
+  def.capacity = 0;
+  EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_INVALID_ARGUMENT, "capacity");
+  def.capacity = (1u << 30) + 1u; /* the documented limit is 2^30 */
+  EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_INVALID_ARGUMENT, "capacity");
+  def.capacity = 0xffffffffu;
+  EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_INVALID_ARGUMENT, "capacity");
+  def.capacity = 1;
+  expect_create_ok(context, &def);
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+static void test_create_unknown_enums_and_bits(void** state) {
+  const uint32_t features[] = {1u, 2u, 0x100u, 0x80000000u, 0xffffffffu};
+  const int32_t integrators[] = {2, 3, 1000, 0x7fffffff, -1};
+  sph_context* context = make_context();
+  sph_world_def def;
+  (void)state;
+  for (size_t i = 0; i < sizeof features / sizeof features[0]; ++i) {
+    small_world_def(&def);
+    def.features = features[i];
+    EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_UNSUPPORTED, "features");
+  }
+  for (size_t i = 0; i < sizeof integrators / sizeof integrators[0]; ++i) {
+    small_world_def(&def);
+    def.integrator = (sph_integrator)integrators[i];
+    EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_UNSUPPORTED, "integrator");
+  }
+  small_world_def(&def);
+  def.integrator = SPH_INTEGRATOR_RK4;
+  expect_create_ok(context, &def);
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+static void test_create_reserved(void** state) {
+  sph_context* context = make_context();
+  sph_world_def def;
+  (void)state;
+  small_world_def(&def);
+  def.reserved0 = 1;
+  EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_INVALID_ARGUMENT, "reserved0");
+  small_world_def(&def);
+  def.reserved1 = 1.0f;
+  EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_INVALID_ARGUMENT, "reserved1");
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+static void test_create_non_finite(void** state) {
+  const float_field fields[] = {
+      {offsetof(sph_world_def, particle_spacing), "particle_spacing"},
+      {offsetof(sph_world_def, kernel_radius), "kernel_radius"},
+      {offsetof(sph_world_def, rest_density), "rest_density"},
+      {offsetof(sph_world_def, reserved1), "reserved1"},
+  };
+  sph_context* context = make_context();
+  sph_world_def def;
+  (void)state;
+  for (size_t f = 0; f < sizeof fields / sizeof fields[0]; ++f)
+    for (int v = 0; v < CAPI_NON_FINITE_COUNT; ++v) {
+      small_world_def(&def);
+      capi_set_float(&def, fields[f].offset, capi_non_finite(v));
+      EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_INVALID_ARGUMENT, fields[f].name);
+    }
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+static void test_create_out_of_range(void** state) {
+  const float spacings[] = {0.0f, -0.02f, -1e-30f, 1e-30f /* coefficients overflow float */};
+  const float densities[] = {0.0f, -1000.0f, -1e-30f};
+  sph_context* context = make_context();
+  sph_world_def def;
+  (void)state;
+  for (size_t i = 0; i < sizeof spacings / sizeof spacings[0]; ++i) {
+    small_world_def(&def);
+    def.particle_spacing = spacings[i];
+    EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_INVALID_ARGUMENT, "particle_spacing");
+  }
+  for (size_t i = 0; i < sizeof densities / sizeof densities[0]; ++i) {
+    small_world_def(&def);
+    def.rest_density = densities[i];
+    EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_INVALID_ARGUMENT, "rest_density");
+  }
+  /* h < spacing, negative h, and h above the documented 5 x spacing. */
+  small_world_def(&def);
+  def.kernel_radius = 0.5f * def.particle_spacing;
+  EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_INVALID_ARGUMENT, "kernel_radius");
+  def.kernel_radius = nextafterf(def.particle_spacing, 0.0f);
+  EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_INVALID_ARGUMENT, "kernel_radius");
+  def.kernel_radius = -0.036f;
+  EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_INVALID_ARGUMENT, "kernel_radius");
+  def.kernel_radius = 5.5f * def.particle_spacing;
+  EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_INVALID_ARGUMENT, "kernel_radius");
+  /* The edges themselves are allowed. */
+  def.kernel_radius = def.particle_spacing;
+  expect_create_ok(context, &def);
+  def.kernel_radius = 4.0f * def.particle_spacing;
+  expect_create_ok(context, &def);
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+/* ---- destroy, get_def, particle mass --------------------------------------------------------- */
+
+static void test_destroy(void** state) {
+  sph_context* context = make_context();
+  sph_world_def def;
+  sph_world* world = NULL;
+  int foreign = 0;
+  (void)state;
+  small_world_def(&def);
+  EXPECT_OK(sph_world_destroy(NULL));
+  EXPECT_OK(sph_world_create(context, &def, &world));
+  EXPECT_OK(sph_world_destroy(world));
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world", sph_world_destroy(world));
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world", sph_world_destroy((sph_world*)(void*)&foreign));
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world", sph_world_destroy((sph_world*)(void*)context));
+  assert_int_equal(live_objects(), 1);
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+static void test_get_def(void** state) {
+  sph_context* context = make_context();
+  sph_world_def def, out;
+  sph_world* world = NULL;
+  grown_world_def grown;
+  int foreign = 0;
+  (void)state;
+  small_world_def(&def);
+  def.particle_spacing = 0.05f;
+  def.rest_density = 850.0f;
+  def.integrator = SPH_INTEGRATOR_RK4;
+  EXPECT_OK(sph_world_create(context, &def, &world));
+  sph_world_def_init(&out);
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world", sph_world_get_def(NULL, &out));
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world", sph_world_get_def((sph_world*)(void*)&foreign, &out));
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "out_def", sph_world_get_def(world, NULL));
+  out.struct_size = 4;
+  EXPECT_ERROR(SPH_ERROR_VERSION_MISMATCH, "struct_size", sph_world_get_def(world, &out));
+  assert_int_equal(out.struct_size, 4);
+
+  /* The resolved def: kernel_radius 0 became 1.8 x spacing, everything else as given. */
+  sph_world_def_init(&out);
+  EXPECT_OK(sph_world_get_def(world, &out));
+  assert_int_equal(out.struct_size, sizeof out);
+  assert_int_equal(out.header_version, SPH_VERSION);
+  assert_int_equal(out.capacity, 64);
+  assert_int_equal(out.features, SPH_FEATURE_NONE);
+  assert_int_equal(out.integrator, SPH_INTEGRATOR_RK4);
+  assert_true(out.particle_spacing == 0.05f);
+  assert_true(out.rest_density == 850.0f);
+  /* 1e-6 relative: the library may form 1.8 x spacing in float or double. */
+  assert_true(fabs(out.kernel_radius - 1.8 * 0.05) <= 1e-6 * 0.09);
+
+  /* A shorter struct_size (an older caller): only that prefix is written. */
+  memset(&out, 0xab, sizeof out);
+  out.struct_size = (uint32_t)offsetof(sph_world_def, particle_spacing);
+  EXPECT_OK(sph_world_get_def(world, &out));
+  assert_int_equal(out.struct_size, offsetof(sph_world_def, particle_spacing));
+  assert_int_equal(out.capacity, 64);
+  assert_int_equal(out.reserved0, 0);
+  {
+    uint32_t bits;
+    memcpy(&bits, &out.particle_spacing, sizeof bits);
+    assert_int_equal(bits, 0xababababu);
+  }
+  /* A longer one (a newer caller): the unknown tail is left alone. */
+  memset(&grown, 0xcd, sizeof grown);
+  grown.def.struct_size = sizeof grown;
+  EXPECT_OK(sph_world_get_def(world, &grown.def));
+  assert_true(grown.def.particle_spacing == 0.05f);
+  for (size_t i = 0; i < sizeof grown.extra; ++i) assert_int_equal(grown.extra[i], 0xcd);
+  EXPECT_OK(sph_world_destroy(world));
+
+  /* An explicit kernel radius is kept as given. */
+  small_world_def(&def);
+  def.kernel_radius = 0.05f;
+  EXPECT_OK(sph_world_create(context, &def, &world));
+  sph_world_def_init(&out);
+  EXPECT_OK(sph_world_get_def(world, &out));
+  assert_true(out.kernel_radius == 0.05f);
+  EXPECT_OK(sph_world_destroy(world));
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+static void test_particle_mass(void** state) {
+  sph_context* context = make_context();
+  sph_world_def def;
+  sph_world* world = NULL;
+  float mass = -1.0f, heavier = -1.0f;
+  int foreign = 0;
+  (void)state;
+  small_world_def(&def);
+  EXPECT_OK(sph_world_create(context, &def, &world));
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world", sph_world_get_particle_mass(NULL, &mass));
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world",
+               sph_world_get_particle_mass((sph_world*)(void*)&foreign, &mass));
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "out_mass", sph_world_get_particle_mass(world, NULL));
+  assert_true(mass == -1.0f);
+  EXPECT_OK(sph_world_get_particle_mass(world, &mass));
+  EXPECT_OK(sph_world_destroy(world));
+  /* An FCC cell of volume a^3 (a = spacing sqrt 2) holds 4 particles: rho0 s^3 / sqrt 2 each.
+   * The library sums W_poly6 over the lattice instead of integrating, which differs by about
+   * 1 % at h = 1.8 s; 5 % catches a wrong formula (a factor sqrt 2 or 4 is far outside). */
+  {
+    const double expected = 1000.0 * 0.02 * 0.02 * 0.02 / sqrt(2.0);
+    assert_true(fabs(mass - expected) <= 0.05 * expected);
+  }
+  /* Mass is linear in rest density. */
+  def.rest_density = 2000.0f;
+  EXPECT_OK(sph_world_create(context, &def, &world));
+  EXPECT_OK(sph_world_get_particle_mass(world, &heavier));
+  assert_true(fabs(heavier - 2.0 * mass) <= 1e-6 * mass);
+  EXPECT_OK(sph_world_destroy(world));
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+/* ---- runtime parameters ---------------------------------------------------------------------- */
+
+static void test_params_init(void** state) {
+  sph_world_params p;
+  grown_world_params grown;
+  (void)state;
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "params", sph_world_params_init_sized(NULL, sizeof p));
+  memset(&p, 0xab, sizeof p);
+  EXPECT_ERROR(SPH_ERROR_VERSION_MISMATCH, "params", sph_world_params_init_sized(&p, 8));
+  assert_int_equal(p.struct_size, 0xababababu);
+  EXPECT_OK(sph_world_params_init(&p));
+  assert_int_equal(p.struct_size, sizeof p);
+  assert_int_equal(p.max_substeps, 10000);
+  assert_true(p.gravity.x == 0.0f && p.gravity.y == -9.81f && p.gravity.z == 0.0f);
+  assert_true(p.stiffness == 100.0f);
+  assert_true(p.viscosity == 1.0f);
+  assert_true(p.step_factor == 0.4f);
+  assert_true(p.dt_min == 1e-6f);
+  assert_true(p.dt_max == 1e-3f);
+  memset(&grown, 0xab, sizeof grown);
+  EXPECT_OK(sph_world_params_init_sized(&grown.params, sizeof grown));
+  for (size_t i = 0; i < sizeof grown.extra; ++i) assert_int_equal(grown.extra[i], 0);
+}
+
+/* set_params with one bad field: (code, name), and the world unchanged. */
+static void expect_set_fails_at(int line, const capi_fixture* f, const sph_world_params* p, sph_result code,
+                                const char* name) {
+  static capi_snapshot before;
+  capi_snapshot_take(f->world, &before);
+  EXPECT_ERROR_AT(line, code, name, sph_world_set_params(f->world, p));
+  EXPECT_UNCHANGED_AT(line, f->world, &before);
+}
+#define EXPECT_SET_FAILS(...) expect_set_fails_at(__LINE__, __VA_ARGS__)
+
+static void test_set_params_handles_and_sizes(void** state) {
+  const capi_fixture* f = (const capi_fixture*)*state;
+  grown_world_params grown;
+  sph_world_params back;
+  int foreign = 0;
+  memset(&grown, 0, sizeof grown);
+  grown.params = f->params;
+  grown.params.viscosity = 1.0f;
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world", sph_world_set_params(NULL, &grown.params));
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world",
+               sph_world_set_params((sph_world*)(void*)&foreign, &grown.params));
+  EXPECT_SET_FAILS(f, NULL, SPH_ERROR_INVALID_ARGUMENT, "params");
+  grown.params.struct_size = sizeof grown.params - 4;
+  EXPECT_SET_FAILS(f, &grown.params, SPH_ERROR_VERSION_MISMATCH, "struct_size");
+  grown.params.struct_size = 0;
+  EXPECT_SET_FAILS(f, &grown.params, SPH_ERROR_VERSION_MISMATCH, "struct_size");
+  grown.params.struct_size = sizeof grown;
+  grown.extra[0] = 1;
+  EXPECT_SET_FAILS(f, &grown.params, SPH_ERROR_UNSUPPORTED, "struct_size");
+  /* Larger with a zero tail: accepted and applied. */
+  grown.extra[0] = 0;
+  EXPECT_OK(sph_world_set_params(f->world, &grown.params));
+  sph_world_params_init(&back);
+  EXPECT_OK(sph_world_get_params(f->world, &back));
+  assert_true(back.viscosity == 1.0f);
+  EXPECT_OK(sph_world_set_params(f->world, &f->params));
+}
+
+static void test_set_params_non_finite(void** state) {
+  const capi_fixture* f = (const capi_fixture*)*state;
+  const float_field fields[] = {
+      {offsetof(sph_world_params, gravity.x), "gravity"},
+      {offsetof(sph_world_params, gravity.y), "gravity"},
+      {offsetof(sph_world_params, gravity.z), "gravity"},
+      {offsetof(sph_world_params, stiffness), "stiffness"},
+      {offsetof(sph_world_params, viscosity), "viscosity"},
+      {offsetof(sph_world_params, step_factor), "step_factor"},
+      {offsetof(sph_world_params, dt_min), "dt_min"},
+      {offsetof(sph_world_params, dt_max), "dt_max"},
+  };
+  sph_world_params p;
+  for (size_t i = 0; i < sizeof fields / sizeof fields[0]; ++i)
+    for (int v = 0; v < CAPI_NON_FINITE_COUNT; ++v) {
+      p = f->params;
+      capi_set_float(&p, fields[i].offset, capi_non_finite(v));
+      EXPECT_SET_FAILS(f, &p, SPH_ERROR_INVALID_ARGUMENT, fields[i].name);
+    }
+}
+
+static void test_set_params_out_of_range(void** state) {
+  const capi_fixture* f = (const capi_fixture*)*state;
+  const struct {
+    size_t offset;
+    float value;
+    const char* name;
+  } cases[] = {
+      {offsetof(sph_world_params, stiffness), 0.0f, "stiffness"},
+      {offsetof(sph_world_params, stiffness), -100.0f, "stiffness"},
+      {offsetof(sph_world_params, viscosity), -0.001f, "viscosity"},
+      {offsetof(sph_world_params, step_factor), 0.0f, "step_factor"},
+      {offsetof(sph_world_params, step_factor), -0.4f, "step_factor"},
+      {offsetof(sph_world_params, step_factor), 10.5f, "step_factor"},
+      {offsetof(sph_world_params, dt_min), 0.0f, "dt_min"},
+      {offsetof(sph_world_params, dt_min), -1e-6f, "dt_min"},
+      {offsetof(sph_world_params, dt_max), 0.0f, "dt_max"},
+      {offsetof(sph_world_params, dt_max), -1e-3f, "dt_max"},
+      {offsetof(sph_world_params, dt_max), 1e-6f /* < the fixture's dt_min 2e-6 */, "dt_max"},
+  };
+  sph_world_params p;
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+    p = f->params;
+    capi_set_float(&p, cases[i].offset, cases[i].value);
+    EXPECT_SET_FAILS(f, &p, SPH_ERROR_INVALID_ARGUMENT, cases[i].name);
+  }
+  p = f->params;
+  p.dt_min = 0.01f; /* above the fixture's dt_max */
+  EXPECT_SET_FAILS(f, &p, SPH_ERROR_INVALID_ARGUMENT, "dt_max");
+  p = f->params;
+  p.max_substeps = 0;
+  EXPECT_SET_FAILS(f, &p, SPH_ERROR_INVALID_ARGUMENT, "max_substeps");
+  /* The edges of each range are accepted. */
+  p = f->params;
+  p.viscosity = 0.0f;
+  p.step_factor = 10.0f;
+  p.dt_max = p.dt_min;
+  p.max_substeps = 1;
+  EXPECT_OK(sph_world_set_params(f->world, &p));
+  EXPECT_OK(sph_world_set_params(f->world, &f->params));
+}
+
+static void test_get_params(void** state) {
+  const capi_fixture* f = (const capi_fixture*)*state;
+  sph_world_params out;
+  grown_world_params grown;
+  int foreign = 0;
+  sph_world_params_init(&out);
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world", sph_world_get_params(NULL, &out));
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world", sph_world_get_params((sph_world*)(void*)&foreign, &out));
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "out", sph_world_get_params(f->world, NULL));
+  out.struct_size = 0;
+  EXPECT_ERROR(SPH_ERROR_VERSION_MISMATCH, "struct_size", sph_world_get_params(f->world, &out));
+  /* Round trip of what the fixture set. */
+  sph_world_params_init(&out);
+  EXPECT_OK(sph_world_get_params(f->world, &out));
+  assert_memory_equal(&out, &f->params, sizeof out);
+  /* Shorter and longer struct_size: only the known prefix is written. */
+  memset(&out, 0xab, sizeof out);
+  out.struct_size = (uint32_t)offsetof(sph_world_params, stiffness);
+  EXPECT_OK(sph_world_get_params(f->world, &out));
+  assert_int_equal(out.max_substeps, 777);
+  assert_true(out.gravity.y == -9.0f);
+  {
+    uint32_t bits;
+    memcpy(&bits, &out.stiffness, sizeof bits);
+    assert_int_equal(bits, 0xababababu);
+  }
+  memset(&grown, 0xcd, sizeof grown);
+  grown.params.struct_size = sizeof grown;
+  EXPECT_OK(sph_world_get_params(f->world, &grown.params));
+  assert_true(grown.params.dt_max == f->params.dt_max);
+  for (size_t i = 0; i < sizeof grown.extra; ++i) assert_int_equal(grown.extra[i], 0xcd);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_def_init),
+      cmocka_unit_test(test_create_bad_context),
+      cmocka_unit_test(test_create_null_arguments),
+      cmocka_unit_test(test_create_struct_size),
+      cmocka_unit_test(test_create_header_version),
+      cmocka_unit_test(test_create_capacity),
+      cmocka_unit_test(test_create_unknown_enums_and_bits),
+      cmocka_unit_test(test_create_reserved),
+      cmocka_unit_test(test_create_non_finite),
+      cmocka_unit_test(test_create_out_of_range),
+      cmocka_unit_test(test_destroy),
+      cmocka_unit_test(test_get_def),
+      cmocka_unit_test(test_particle_mass),
+      cmocka_unit_test(test_params_init),
+      cmocka_unit_test_setup_teardown(test_set_params_handles_and_sizes, capi_fixture_setup,
+                                      capi_fixture_teardown),
+      cmocka_unit_test_setup_teardown(test_set_params_non_finite, capi_fixture_setup, capi_fixture_teardown),
+      cmocka_unit_test_setup_teardown(test_set_params_out_of_range, capi_fixture_setup,
+                                      capi_fixture_teardown),
+      cmocka_unit_test_setup_teardown(test_get_params, capi_fixture_setup, capi_fixture_teardown),
+  };
+  return cmocka_run_group_tests_name("capi_world_errors", tests, NULL, NULL);
+}
