@@ -205,7 +205,11 @@ SPH_API sph_result SPH_CALL sph_world_copy_attribute(const sph_world* world, sph
       throw Error(Status::InvalidArgument, "first: " + std::to_string(first) +
                                                " is beyond the particle count " + std::to_string(total));
     const uint32_t n = std::min(count, total - first);
-    const uint64_t needed = n == 0 ? 0 : (n - 1) * stride + element;
+    // (n - 1) * stride + element bytes, saturated: a huge stride must not wrap around 64 bits
+    // and pass the size check.
+    const uint64_t span = n == 0 ? 0 : static_cast<uint64_t>(n - 1);
+    const bool overflows = span != 0 && stride > (UINT64_MAX - element) / span;
+    const uint64_t needed = n == 0 ? 0 : (overflows ? UINT64_MAX : span * stride + element);
     if (dst_size < needed)
       throw Error(Status::BufferTooSmall, "dst_size: " + std::to_string(dst_size) + " bytes cannot hold " +
                                               std::to_string(n) + " elements at stride " +
