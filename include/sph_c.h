@@ -391,6 +391,320 @@ static inline sph_result sph_stats_init(sph_stats* stats) {
  */
 SPH_API sph_result SPH_CALL sph_world_get_stats(const sph_world* world, sph_stats* out);
 
+/* ---- SDF assets ------------------------------------------------------------------------
+ * A signed-distance grid (negative inside) shared by colliders, sources, sinks and force
+ * fields in any world of its context. Samples sit at voxel centres with integer indices, as in
+ * OpenVDB: local = index_to_local * (i, j, k, 1), so a VDB's index-to-world map can be passed
+ * unchanged. Sampling is trilinear; normals are the normalised gradient; outside the grid the
+ * boundary value grows by the distance to the grid's box. */
+typedef struct sph_sdf sph_sdf;
+
+typedef enum sph_memory_kind {
+  SPH_MEMORY_HOST = 0,        /* ordinary host memory */
+  SPH_MEMORY_CUDA_DEVICE = 1, /* device memory of the context's CUDA device (CUDA contexts only) */
+  SPH_MEMORY_KIND_FORCE32 = 0x7fffffff
+} sph_memory_kind;
+
+typedef struct sph_grid_desc {
+  uint32_t struct_size;     /* set by sph_grid_desc_init */
+  uint32_t dims[3];         /* samples along i, j, k (i fastest); each >= 1 */
+  float index_to_local[12]; /* row-major 3x4 affine map; default: identity (1 m voxels) */
+  sph_memory_kind memory;   /* where data lives; default SPH_MEMORY_HOST */
+  uint32_t components;      /* floats per voxel: 1 (distance, friction) or 3 (velocity) */
+  const float* data;        /* dims[0] * dims[1] * dims[2] * components floats, copied */
+} sph_grid_desc;
+SPH_STATIC_ASSERT(sizeof(sph_grid_desc) == 72 + sizeof(void*), sph_grid_desc_size);
+
+SPH_API sph_result SPH_CALL sph_grid_desc_init_sized(sph_grid_desc* desc, uint32_t size);
+static inline sph_result sph_grid_desc_init(sph_grid_desc* desc) {
+  return sph_grid_desc_init_sized(desc, (uint32_t)sizeof(*desc));
+}
+
+typedef struct sph_sdf_desc {
+  uint32_t struct_size;          /* set by sph_sdf_desc_init */
+  uint32_t reserved0;            /* must be 0 */
+  sph_grid_desc distance;        /* required, 1 component, metres in the local frame */
+  const sph_grid_desc* velocity; /* optional: surface velocity (3 components, m/s, local
+                                    frame) for deforming colliders and source velocities */
+  const sph_grid_desc* friction; /* optional: per-voxel friction coefficient (1 component) */
+} sph_sdf_desc;
+SPH_STATIC_ASSERT(sizeof(sph_sdf_desc) == 80 + 3 * sizeof(void*), sph_sdf_desc_size);
+
+SPH_API sph_result SPH_CALL sph_sdf_desc_init_sized(sph_sdf_desc* desc, uint32_t size);
+static inline sph_result sph_sdf_desc_init(sph_sdf_desc* desc) {
+  return sph_sdf_desc_init_sized(desc, (uint32_t)sizeof(*desc));
+}
+
+/**
+ * Creates an SDF asset from grids (copied). The optional grids must have the same dims as
+ * the distance grid (their index_to_local is ignored). Errors: INVALID_ARGUMENT (NULL data,
+ * zero dims, non-finite values, a singular index_to_local, wrong components), CAPACITY (more
+ * than 2^31 voxels), UNSUPPORTED (device memory on a CPU context), OUT_OF_HOST_MEMORY.
+ * Thread-safe with respect to other SDF calls on the context.
+ */
+SPH_API sph_result SPH_CALL sph_sdf_create(sph_context* context, const sph_sdf_desc* desc, sph_sdf** out);
+
+typedef enum sph_shape {
+  SPH_SHAPE_PLANE = 0,    /* solid below y = 0; half_extents.x/.z its size, .y its thickness */
+  SPH_SHAPE_BOX = 1,      /* half_extents; wall_thickness > 0 makes a hollow box (a tank) */
+  SPH_SHAPE_SPHERE = 2,   /* radius */
+  SPH_SHAPE_CAPSULE = 3,  /* radius around the segment y in [-half_height, half_height] */
+  SPH_SHAPE_CYLINDER = 4, /* radius, half_height, axis y */
+  SPH_SHAPE_CUP = 5,      /* an open cylinder: inner radius, half_height, wall_thickness */
+  SPH_SHAPE_FORCE32 = 0x7fffffff
+} sph_shape;
+
+#define SPH_SHAPE_FLAG_OPEN_TOP 0x1u /* hollow box: no lid (a tank open at +y) */
+
+typedef struct sph_shape_desc {
+  uint32_t struct_size;    /* set by sph_shape_desc_init */
+  sph_shape shape;         /* default SPH_SHAPE_BOX */
+  sph_vec3 half_extents;   /* m; default (0.5, 0.5, 0.5) */
+  float radius;            /* m; default 0.5 */
+  float half_height;       /* m; default 0.5 */
+  float wall_thickness;    /* m; default 0 (solid) */
+  float voxel_size;        /* m; default 0.01 */
+  uint32_t flags;          /* SPH_SHAPE_FLAG_* */
+  uint32_t padding_voxels; /* grid margin around the shape; 0 (default) = 4 */
+} sph_shape_desc;
+SPH_STATIC_ASSERT(sizeof(sph_shape_desc) == 44, sph_shape_desc_size);
+
+SPH_API sph_result SPH_CALL sph_shape_desc_init_sized(sph_shape_desc* desc, uint32_t size);
+static inline sph_result sph_shape_desc_init(sph_shape_desc* desc) {
+  return sph_shape_desc_init_sized(desc, (uint32_t)sizeof(*desc));
+}
+/** Samples an analytic shape (centred at its local origin, y up) into an SDF asset. */
+SPH_API sph_result SPH_CALL sph_sdf_create_shape(sph_context* context, const sph_shape_desc* desc,
+                                                 sph_sdf** out);
+
+typedef enum sph_sdf_channel {
+  SPH_SDF_CHANNEL_DISTANCE = 0,
+  SPH_SDF_CHANNEL_VELOCITY = 1, /* 3 floats per voxel */
+  SPH_SDF_CHANNEL_FRICTION = 2,
+  SPH_SDF_CHANNEL_FORCE32 = 0x7fffffff
+} sph_sdf_channel;
+
+/**
+ * Overwrites the box [origin, origin + size) of one channel with data (size[0] * size[1] *
+ * size[2] * components floats, i fastest, copied). Updating the velocity or friction channel
+ * of an asset created without it creates it (zero elsewhere). Do not update an asset while a
+ * world that uses it is inside sph_world_step on another thread. Errors: INVALID_ARGUMENT
+ * (box outside the grid, NULL or non-finite data), UNSUPPORTED (unknown channel or memory).
+ */
+SPH_API sph_result SPH_CALL sph_sdf_update(sph_sdf* sdf, sph_sdf_channel channel, const uint32_t origin[3],
+                                           const uint32_t size[3], const float* data, sph_memory_kind memory);
+/** Grid dimensions of an asset. */
+SPH_API sph_result SPH_CALL sph_sdf_get_dims(const sph_sdf* sdf, uint32_t out_dims[3]);
+/** Samples the signed distance at a point of the asset's local frame (for tools and tests). */
+SPH_API sph_result SPH_CALL sph_sdf_sample(const sph_sdf* sdf, sph_vec3 local_point, float* out_distance);
+/** Releases the caller's reference; colliders and the like keep the asset alive. NULL: no-op. */
+SPH_API sph_result SPH_CALL sph_sdf_destroy(sph_sdf* sdf);
+
+/* ---- placement --------------------------------------------------------------------------- */
+typedef struct sph_quat {
+  float x, y, z, w; /* a rotation; normalised by the library; (0, 0, 0, 1) is identity */
+} sph_quat;
+
+typedef struct sph_transform {
+  sph_vec3 position; /* m */
+  sph_quat rotation;
+} sph_transform;
+SPH_STATIC_ASSERT(sizeof(sph_transform) == 28, sph_transform_size);
+
+/** The identity transform (exported twin of a constant, for bindings). */
+SPH_API sph_transform SPH_CALL sph_transform_identity(void);
+
+/* ---- colliders --------------------------------------------------------------------------- */
+typedef struct sph_collider_id {
+  uint64_t bits; /* {0} is null */
+} sph_collider_id;
+
+#define SPH_COLLIDER_FLAG_INVERTED 0x1u /* solid where the SDF is positive: a container */
+
+typedef struct sph_collider_def {
+  uint32_t struct_size;    /* set by sph_collider_def_init */
+  uint32_t flags;          /* SPH_COLLIDER_FLAG_* */
+  sph_sdf* sdf;            /* required; the collider keeps a reference */
+  sph_transform transform; /* initial pose; default identity */
+  float restitution;       /* share of the normal approach speed returned, [0, 1]; default 0 */
+  float friction;          /* Coulomb coefficient >= 0 (ignored where the SDF has a friction
+                              channel); default 0 */
+  float stickiness;        /* pull toward the surface within one kernel radius, m/s^2 >= 0;
+                              default 0 */
+  uint32_t reserved0;      /* must be 0 */
+  uint32_t reserved1;      /* must be 0 */
+} sph_collider_def;
+SPH_STATIC_ASSERT(sizeof(sph_collider_def) == 56 + sizeof(void*), sph_collider_def_size);
+
+SPH_API sph_result SPH_CALL sph_collider_def_init_sized(sph_collider_def* def, uint32_t size);
+static inline sph_result sph_collider_def_init(sph_collider_def* def) {
+  return sph_collider_def_init_sized(def, (uint32_t)sizeof(*def));
+}
+
+/**
+ * Places an SDF asset in the world as a collider. A collider whose pose never changes and
+ * whose SDF has no moving surface is static and costs the least. Errors: INVALID_HANDLE,
+ * INVALID_ARGUMENT (NULL sdf, an asset of another context, non-finite transform, coefficient
+ * out of range), CAPACITY (more than 65,536 colliders).
+ */
+SPH_API sph_result SPH_CALL sph_collider_create(sph_world* world, const sph_collider_def* def,
+                                                sph_collider_id* out_id);
+/** Removes a collider. A null id is a no-op; a stale id is INVALID_HANDLE. */
+SPH_API sph_result SPH_CALL sph_collider_destroy(sph_world* world, sph_collider_id id);
+/**
+ * Kinematic motion: the collider moves from its current pose to `target` over the next
+ * sph_world_step, placed at every substep by interpolation; its velocity is derived from the
+ * motion. After that step the target is its pose.
+ */
+SPH_API sph_result SPH_CALL sph_collider_set_target_transform(sph_world* world, sph_collider_id id,
+                                                              const sph_transform* target);
+/** Moves a collider at once, with no velocity (nothing is pushed). */
+SPH_API sph_result SPH_CALL sph_collider_teleport(sph_world* world, sph_collider_id id,
+                                                  const sph_transform* transform);
+SPH_API sph_result SPH_CALL sph_collider_get_transform(const sph_world* world, sph_collider_id id,
+                                                       sph_transform* out_transform);
+/** Changes restitution, friction and stickiness (same ranges as sph_collider_def). */
+SPH_API sph_result SPH_CALL sph_collider_set_material(sph_world* world, sph_collider_id id, float restitution,
+                                                      float friction, float stickiness);
+
+/* ---- sources ----------------------------------------------------------------------------- */
+typedef struct sph_source_id {
+  uint64_t bits;
+} sph_source_id;
+
+typedef enum sph_source_mode {
+  SPH_SOURCE_FILL_ONCE = 0,  /* fill the region at the next step, then stay idle */
+  SPH_SOURCE_CONTINUOUS = 1, /* refill the region at every step, at most `rate` particles/s */
+  SPH_SOURCE_MODE_FORCE32 = 0x7fffffff
+} sph_source_mode;
+
+#define SPH_SOURCE_FLAG_VELOCITY_FROM_FIELD 0x1u /* initial velocity from the SDF's velocity */
+
+typedef struct sph_source_def {
+  uint32_t struct_size;    /* set by sph_source_def_init */
+  sph_source_mode mode;    /* default SPH_SOURCE_FILL_ONCE */
+  sph_sdf* region;         /* required: particles fill where the SDF is negative */
+  sph_transform transform; /* default identity */
+  float spacing;           /* FCC lattice spacing, m; 0 (default) = the world's spacing */
+  float min_distance;      /* skip lattice points closer than this to a particle, m; 0 (default)
+                              = 0.9 x spacing; at most the kernel radius */
+  sph_vec3 velocity;       /* initial velocity (unless VELOCITY_FROM_FIELD); default 0 */
+  uint32_t flags;          /* SPH_SOURCE_FLAG_* */
+  float rate;              /* CONTINUOUS: most particles per second; 0 (default) = no limit */
+  uint32_t reserved0;      /* must be 0 */
+  uint32_t reserved1;      /* must be 0 */
+} sph_source_def;
+SPH_STATIC_ASSERT(sizeof(sph_source_def) == 72 + sizeof(void*), sph_source_def_size);
+
+SPH_API sph_result SPH_CALL sph_source_def_init_sized(sph_source_def* def, uint32_t size);
+static inline sph_result sph_source_def_init(sph_source_def* def) {
+  return sph_source_def_init_sized(def, (uint32_t)sizeof(*def));
+}
+/**
+ * Adds a source (thesis 3.3). Emission happens at the start of each sph_world_step. When the
+ * world's capacity runs out, the source emits what fits and the step reports an
+ * SPH_EVENT_SOURCE_CAPACITY_REACHED event; nothing else changes. Errors: INVALID_ARGUMENT,
+ * CAPACITY (the region holds more than 2^28 lattice points).
+ */
+SPH_API sph_result SPH_CALL sph_source_create(sph_world* world, const sph_source_def* def,
+                                              sph_source_id* out_id);
+SPH_API sph_result SPH_CALL sph_source_destroy(sph_world* world, sph_source_id id);
+SPH_API sph_result SPH_CALL sph_source_set_transform(sph_world* world, sph_source_id id,
+                                                     const sph_transform* transform);
+
+/* ---- sinks ------------------------------------------------------------------------------- */
+typedef struct sph_sink_id {
+  uint64_t bits;
+} sph_sink_id;
+
+typedef enum sph_sink_mode {
+  SPH_SINK_REGION = 0,         /* remove particles where the region's SDF is negative */
+  SPH_SINK_OUTSIDE_BOUNDS = 1, /* remove particles outside [bounds_min, bounds_max] (world) */
+  SPH_SINK_MODE_FORCE32 = 0x7fffffff
+} sph_sink_mode;
+
+typedef struct sph_sink_def {
+  uint32_t struct_size;    /* set by sph_sink_def_init */
+  sph_sink_mode mode;      /* default SPH_SINK_REGION */
+  sph_sdf* region;         /* REGION: required */
+  sph_transform transform; /* REGION: placement; default identity */
+  sph_vec3 bounds_min;     /* OUTSIDE_BOUNDS: the box particles may stay in */
+  sph_vec3 bounds_max;
+  uint32_t reserved0; /* must be 0 */
+} sph_sink_def;
+SPH_STATIC_ASSERT(sizeof(sph_sink_def) == 64 + sizeof(void*), sph_sink_def_size);
+
+SPH_API sph_result SPH_CALL sph_sink_def_init_sized(sph_sink_def* def, uint32_t size);
+static inline sph_result sph_sink_def_init(sph_sink_def* def) {
+  return sph_sink_def_init_sized(def, (uint32_t)sizeof(*def));
+}
+/** Adds a sink (thesis 4.4.2.3); it acts at every substep. See sph_world_get_removed_ids. */
+SPH_API sph_result SPH_CALL sph_sink_create(sph_world* world, const sph_sink_def* def, sph_sink_id* out_id);
+SPH_API sph_result SPH_CALL sph_sink_destroy(sph_world* world, sph_sink_id id);
+
+/* ---- force fields ------------------------------------------------------------------------ */
+typedef struct sph_force_field_id {
+  uint64_t bits;
+} sph_force_field_id;
+
+typedef enum sph_force_field_kind {
+  SPH_FORCE_FIELD_UNIFORM = 0, /* acceleration `vector` (field frame) */
+  SPH_FORCE_FIELD_RADIAL = 1,  /* `strength` m/s^2 away from the origin (negative attracts) */
+  SPH_FORCE_FIELD_VORTEX = 2,  /* `strength` m/s^2 around the axis `vector` through the origin */
+  SPH_FORCE_FIELD_GRID = 3,    /* accelerations from a user grid (3 components, field frame) */
+  SPH_FORCE_FIELD_KIND_FORCE32 = 0x7fffffff
+} sph_force_field_kind;
+
+typedef struct sph_force_field_def {
+  uint32_t struct_size;      /* set by sph_force_field_def_init */
+  sph_force_field_kind kind; /* default SPH_FORCE_FIELD_UNIFORM */
+  sph_sdf* region;           /* optional: acts only where this SDF is negative; NULL = everywhere */
+  const sph_grid_desc* grid; /* GRID: the acceleration grid (3 components), copied */
+  sph_transform transform;   /* field frame (and the region's placement); default identity */
+  sph_vec3 vector;           /* UNIFORM: m/s^2; VORTEX: the axis (normalised by the library) */
+  float strength;            /* RADIAL, VORTEX: m/s^2 */
+  float falloff_radius;      /* RADIAL, VORTEX: linear fade to 0 at this distance, m; 0 = none */
+  uint32_t reserved0;        /* must be 0 */
+  uint32_t reserved1;        /* must be 0 */
+} sph_force_field_def;
+SPH_STATIC_ASSERT(sizeof(sph_force_field_def) == 64 + 2 * sizeof(void*), sph_force_field_def_size);
+
+SPH_API sph_result SPH_CALL sph_force_field_def_init_sized(sph_force_field_def* def, uint32_t size);
+static inline sph_result sph_force_field_def_init(sph_force_field_def* def) {
+  return sph_force_field_def_init_sized(def, (uint32_t)sizeof(*def));
+}
+/** Adds a force field (thesis 4.4.2.4); its acceleration adds to gravity at every substep. */
+SPH_API sph_result SPH_CALL sph_force_field_create(sph_world* world, const sph_force_field_def* def,
+                                                   sph_force_field_id* out_id);
+SPH_API sph_result SPH_CALL sph_force_field_destroy(sph_world* world, sph_force_field_id id);
+SPH_API sph_result SPH_CALL sph_force_field_set_transform(sph_world* world, sph_force_field_id id,
+                                                          const sph_transform* transform);
+
+/* ---- events of the last step ------------------------------------------------------------- */
+typedef enum sph_event_type {
+  SPH_EVENT_SOURCE_CAPACITY_REACHED = 1, /* object: the source; count: particles not emitted */
+  SPH_EVENT_SINK_REMOVED = 2,            /* object: the sink; count: particles removed */
+  SPH_EVENT_TYPE_FORCE32 = 0x7fffffff
+} sph_event_type;
+
+typedef struct sph_event {
+  sph_event_type type;
+  uint32_t count;
+  uint64_t object_bits; /* the bits of the source/sink id */
+} sph_event;
+SPH_STATIC_ASSERT(sizeof(sph_event) == 16, sph_event_size);
+
+/**
+ * Events of the last sph_world_step (two-call pattern): writes up to `capacity` events and
+ * sets *out_count to the number there are; SPH_INCOMPLETE when capacity was too small.
+ * events may be NULL when capacity is 0.
+ */
+SPH_API sph_result SPH_CALL sph_world_get_events(const sph_world* world, sph_event* events, uint32_t capacity,
+                                                 uint32_t* out_count);
+/** Ids of the particles sinks removed during the last sph_world_step (two-call pattern). */
+SPH_API sph_result SPH_CALL sph_world_get_removed_ids(const sph_world* world, uint32_t* ids,
+                                                      uint32_t capacity, uint32_t* out_count);
+
 #ifdef __cplusplus
 }
 #endif

@@ -78,6 +78,11 @@ SPH_API sph_result SPH_CALL sph_context_destroy(sph_context* context) {
     if (worlds != 0)
       throw Error(Status::Busy, "context: " + std::to_string(worlds) +
                                     " world(s) created on it are still alive; destroy them first");
+    const uint32_t sdfs = context->sdf_count.load();
+    if (sdfs != 0)
+      throw Error(Status::Busy, "context: " + std::to_string(sdfs) +
+                                    " SDF asset(s) created on it are still alive; "
+                                    "destroy them first");
     sph::unregister_handle(context);
     delete context;
     return SPH_OK;

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "../core/backend_factory.h"
+#include "../core/sdf_asset.h"
 #include "../core/world.h"
 #include "sph_c.h"
 
@@ -16,6 +17,12 @@ struct sph_context {
   sph_log_fn log_fn;
   void* log_user_data;
   std::atomic<uint32_t> world_count{0};
+  std::atomic<uint32_t> sdf_count{0};
+};
+
+struct sph_sdf {
+  sph_context* context;
+  std::shared_ptr<sph::SdfAsset> asset;
 };
 
 struct sph_world {
@@ -27,7 +34,7 @@ struct sph_world {
 
 namespace sph {
 
-enum class HandleKind { Context, World };
+enum class HandleKind { Context, World, Sdf };
 
 void register_handle(const void* handle, HandleKind kind);
 void unregister_handle(const void* handle);

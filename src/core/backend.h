@@ -11,10 +11,22 @@
 #include "../physics/vec3.h"
 #include "config.h"
 #include "frame_report.h"
+#include "scene_frame.h"
+#include "status.h"
 
 namespace sph {
 
 enum class AttributeKind : uint32_t { Position = 0, Velocity = 1, Density = 2, Pressure = 3, Id = 4 };
+
+// A device-resident attribute: element k of particle i is at address + i * stride.
+struct DeviceAttributeView {
+  uint64_t address = 0;
+  uint64_t stride = 0;        // bytes between particles
+  uint32_t element_size = 0;  // 12 (3 x float32) or 4
+  uint32_t count = 0;         // particles
+  uint64_t epoch = 0;         // data_epoch() when the view was taken
+  int device = 0;
+};
 
 class Backend {
  public:
@@ -32,6 +44,21 @@ class Backend {
   // Error(Status::NonFinite).
   virtual FrameReport step_frame(double frame_dt, const RuntimeParams& params) = 0;
 
+  // Runs a frame with colliders, force fields and sinks. A backend without scene support
+  // runs plain frames and refuses a non-empty scene.
+  virtual FrameReport step_scene_frame(double frame_dt, const RuntimeParams& params,
+                                       const SceneFrame& scene) {
+    if (!scene.empty())
+      throw Error(Status::Unsupported, "this backend does not support colliders, force fields or sinks yet");
+    return step_frame(frame_dt, params);
+  }
+
+  // Drops the particles from index `count` on (used to undo an emission when a step fails;
+  // emitted particles are appended, so they are the last ones).
+  virtual void truncate(uint32_t count) {
+    if (count != particle_count()) throw Error(Status::Unsupported, "this backend cannot remove particles");
+  }
+
   // Writes particles [first, first + count) of one attribute to dst with a byte stride, as
   // float32 x3 (position, velocity), float32 (density, pressure) or uint32 (id).
   virtual void copy_attribute(AttributeKind kind, uint32_t first, uint32_t count, void* dst,
@@ -39,6 +66,23 @@ class Backend {
 
   // Bytes held for particles and grids (device bytes on a GPU backend).
   virtual uint64_t memory_bytes() const = 0;
+
+  // ---- the CUDA interop tier (include/sph_cuda.h); other backends refuse it ----------------
+  // Where an attribute lives in device memory; the pointer stays valid for the backend's life.
+  virtual DeviceAttributeView device_attribute(AttributeKind) const { throw unsupported_interop(); }
+  // Increments on every call that changes particle data (append, frames, rollbacks).
+  virtual uint64_t data_epoch() const { throw unsupported_interop(); }
+  virtual int device_ordinal() const { throw unsupported_interop(); }
+  virtual void* device_stream() const { throw unsupported_interop(); }  // a cudaStream_t
+  // Records a caller-owned cudaEvent_t on the backend's stream / makes the stream wait for one.
+  virtual void record_device_event(void* /*event*/) { throw unsupported_interop(); }
+  virtual void wait_device_event(void* /*event*/) { throw unsupported_interop(); }
+
+ protected:
+  static Error unsupported_interop() {
+    return Error(Status::Unsupported,
+                 "world: it runs on the CPU backend; the CUDA interop calls need a CUDA world");
+  }
 };
 
 std::unique_ptr<Backend> make_cpu_backend(const WorldConfig& config, unsigned worker_count);

@@ -43,6 +43,18 @@ BackendKind resolve_backend(BackendKind requested, int device_ordinal) {
   return BackendKind::Cuda;
 }
 
+void copy_device_to_host(void* host_dst, const void* device_src, size_t bytes, int device_ordinal) {
+#if defined(SPH_HAVE_CUDA)
+  cuda_copy_to_host(host_dst, device_src, bytes, device_ordinal);
+#else
+  (void)host_dst;
+  (void)device_src;
+  (void)bytes;
+  (void)device_ordinal;
+  throw Error(Status::Unsupported, "memory: SPH_MEMORY_CUDA_DEVICE needs a library built with CUDA");
+#endif
+}
+
 std::unique_ptr<Backend> make_backend(BackendKind kind, const WorldConfig& config, int device_ordinal,
                                       unsigned cpu_workers) {
 #if defined(SPH_HAVE_CUDA)

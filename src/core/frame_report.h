@@ -3,6 +3,8 @@
 
 #include <stdint.h>
 
+#include <vector>
+
 namespace sph {
 
 enum StageIndex : int {
@@ -30,6 +32,8 @@ struct FrameReport {
   float neighbors_mean = 0.0f;
   uint32_t neighbors_max = 0;
   float stage_ms[kStageCount] = {};
+  std::vector<uint32_t> removed_ids;      // ids sinks removed during the frame
+  std::vector<uint32_t> removed_by_sink;  // count per sink, in SceneFrame::sinks order
 };
 
 }  // namespace sph

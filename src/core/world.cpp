@@ -1,11 +1,52 @@
 #include "world.h"
 
+#include <Eigen/Geometry>
 #include <chrono>
+#include <cmath>
 #include <string>
 
+#include "point_clearance.h"
 #include "status.h"
 
 namespace sph {
+namespace {
+
+Eigen::Quaterniond to_eigen(const Quat& q) { return Eigen::Quaterniond(q.w, q.x, q.y, q.z); }
+
+// Angular velocity (world frame) that turns `from` into `to` in `seconds`.
+Vec3 angular_velocity(const Quat& from, const Quat& to, double seconds) {
+  Eigen::Quaterniond delta = to_eigen(to) * to_eigen(from).conjugate();
+  if (delta.w() < 0.0) delta.coeffs() = -delta.coeffs();  // the shorter arc
+  const Eigen::AngleAxisd aa(delta.normalized());
+  const Eigen::Vector3d w = aa.axis() * (aa.angle() / seconds);
+  return Vec3{static_cast<float>(w.x()), static_cast<float>(w.y()), static_cast<float>(w.z())};
+}
+
+bool same_pose(const RigidTransform& a, const RigidTransform& b) {
+  return a.position.x == b.position.x && a.position.y == b.position.y && a.position.z == b.position.z &&
+         a.rotation.x == b.rotation.x && a.rotation.y == b.rotation.y && a.rotation.z == b.rotation.z &&
+         a.rotation.w == b.rotation.w;
+}
+
+// Largest distance from the asset's local origin to a corner of its grid.
+float bounding_radius(const SdfAsset& a) {
+  float r = 0.0f;
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 idx{(c & 1) ? static_cast<float>(a.nx() - 1) : 0.0f,
+                   (c & 2) ? static_cast<float>(a.ny() - 1) : 0.0f,
+                   (c & 4) ? static_cast<float>(a.nz() - 1) : 0.0f};
+    r = std::max(r, length(apply_affine(a.index_to_local(), idx)));
+  }
+  return r;
+}
+
+float max_field_speed(const SdfAsset& a) {
+  float v2 = 0.0f;
+  for (const Vec3& v : a.velocity()) v2 = std::max(v2, length_squared(v));
+  return std::sqrt(v2);
+}
+
+}  // namespace
 
 World::World(const WorldConfig& config, std::unique_ptr<Backend> backend)
     : config_(config), backend_(std::move(backend)) {}
@@ -26,14 +67,144 @@ uint32_t World::spawn(const std::vector<Vec3>& positions, const std::vector<Vec3
   return first;
 }
 
+void World::emit_sources(double frame_dt) {
+  std::vector<Vec3> existing;
+  bool have_existing = false;
+  sources_.for_each([&](uint64_t id, Source& s) {
+    if (s.mode == SourceMode::FillOnce && s.done) return;
+    if (!have_existing) {
+      existing.resize(particle_count());
+      if (!existing.empty())
+        backend_->copy_attribute(AttributeKind::Position, 0, particle_count(), existing.data(), sizeof(Vec3));
+      have_existing = true;
+    }
+    const SdfGridView region = s.region->host_view();
+    std::vector<Vec3> points(s.lattice.size());
+    for (size_t i = 0; i < points.size(); ++i) points[i] = to_world(s.pose, s.lattice[i]);
+    const std::vector<char> keep = clear_of_points(existing, points, s.min_distance);
+    std::vector<Vec3> accepted, velocities;
+    for (size_t i = 0; i < points.size(); ++i) {
+      if (!keep[i]) continue;
+      accepted.push_back(points[i]);
+      velocities.push_back(s.velocity_from_field
+                               ? direction_to_world(s.pose, sample_velocity(region, s.lattice[i]))
+                               : s.velocity);
+    }
+    size_t allowed = accepted.size();
+    if (s.mode == SourceMode::Continuous && s.rate > 0.0f) {
+      s.rate_budget += static_cast<double>(s.rate) * frame_dt;
+      allowed = std::min(allowed, static_cast<size_t>(s.rate_budget));
+    }
+    const size_t fits = std::min<size_t>(allowed, free_capacity());
+    if (fits < allowed)
+      events_.push_back(Event{EventType::SourceCapacityReached, id, static_cast<uint32_t>(allowed - fits)});
+    accepted.resize(fits);
+    velocities.resize(fits);
+    if (s.mode == SourceMode::Continuous && s.rate > 0.0f) s.rate_budget -= static_cast<double>(fits);
+    if (!accepted.empty()) {
+      spawn(accepted, &velocities);
+      existing.insert(existing.end(), accepted.begin(), accepted.end());
+    }
+    s.done = true;
+  });
+}
+
+SceneFrame World::build_scene_frame(double frame_dt) const {
+  SceneFrame scene;
+  colliders_.for_each([&](uint64_t, const Collider& c) {
+    ColliderFrame f;
+    f.sdf = c.sdf;
+    ColliderView& v = f.view;
+    v.pose_start = c.pose;
+    v.pose_end = c.target ? *c.target : c.pose;
+    v.moving = same_pose(v.pose_start, v.pose_end) ? 0u : 1u;
+    v.linear_velocity = (v.pose_end.position - v.pose_start.position) * static_cast<float>(1.0 / frame_dt);
+    v.angular_velocity = v.moving ? angular_velocity(v.pose_start.rotation, v.pose_end.rotation, frame_dt)
+                                  : Vec3{0.0f, 0.0f, 0.0f};
+    v.restitution = c.restitution;
+    v.friction = c.friction;
+    v.stickiness = c.stickiness;
+    v.sign = c.inverted ? -1.0f : 1.0f;
+    v.deforming = c.sdf->has_moving_surface() ? 1u : 0u;
+    float speed = 0.0f;
+    if (v.moving) speed += length(v.linear_velocity) + length(v.angular_velocity) * bounding_radius(*c.sdf);
+    if (v.deforming) speed += max_field_speed(*c.sdf);
+    scene.max_collider_speed = std::max(scene.max_collider_speed, speed);
+    scene.colliders.push_back(std::move(f));
+  });
+  force_fields_.for_each([&](uint64_t, const ForceField& f) {
+    ForceFieldFrame frame;
+    frame.region = f.region;
+    frame.grid = f.grid;
+    ForceFieldView& v = frame.view;
+    v = ForceFieldView{};
+    v.kind = f.kind;
+    v.has_region = f.region ? 1u : 0u;
+    v.pose = f.pose;
+    v.vector = f.vector;
+    v.strength = f.strength;
+    v.falloff_radius = f.falloff_radius;
+    scene.fields.push_back(std::move(frame));
+  });
+  sinks_.for_each([&](uint64_t id, const Sink& s) {
+    SinkFrame frame;
+    frame.id = id;
+    frame.region = s.region;
+    frame.view = SinkView{};
+    frame.view.mode = s.mode;
+    frame.view.pose = s.pose;
+    frame.view.bounds_min = s.bounds_min;
+    frame.view.bounds_max = s.bounds_max;
+    scene.sinks.push_back(std::move(frame));
+  });
+  return scene;
+}
+
 bool World::step(double frame_dt) {
   const auto start = std::chrono::steady_clock::now();
-  FrameReport report = backend_->step_frame(frame_dt, params_);
-  report_ = report;
-  simulated_time_ += report.time_advanced;
+  events_.clear();
+  // Everything a failed step must put back.
+  const uint32_t count_before = particle_count();
+  const uint32_t next_id_before = next_id_;
+  struct SourceState {
+    uint64_t id;
+    bool done;
+    double rate_budget;
+  };
+  std::vector<SourceState> sources_before;
+  sources_.for_each([&](uint64_t id, const Source& s) {
+    sources_before.push_back({id, s.done, s.rate_budget});
+  });
+  FrameReport report;
+  try {
+    emit_sources(frame_dt);
+    report = backend_->step_scene_frame(frame_dt, params_, build_scene_frame(frame_dt));
+  } catch (...) {
+    if (particle_count() > count_before) backend_->truncate(count_before);
+    next_id_ = next_id_before;
+    for (const SourceState& saved : sources_before) {
+      Source* s = sources_.find(saved.id);
+      s->done = saved.done;
+      s->rate_budget = saved.rate_budget;
+    }
+    events_.clear();
+    throw;
+  }
+  // Colliders arrive where they were sent.
+  colliders_.for_each([&](uint64_t, Collider& c) {
+    if (c.target) c.pose = *c.target;
+    c.target.reset();
+  });
+  sinks_.for_each([&, index = size_t{0}](uint64_t id, const Sink&) mutable {
+    const uint32_t removed = index < report.removed_by_sink.size() ? report.removed_by_sink[index] : 0u;
+    if (removed > 0) events_.push_back(Event{EventType::SinkRemoved, id, removed});
+    ++index;
+  });
+  report_ = std::move(report);
+  simulated_time_ += report_.time_advanced;
   last_step_ms_ = static_cast<float>(
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-  return report.completed;
+  return report_.completed;
 }
 
 }  // namespace sph

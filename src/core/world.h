@@ -1,5 +1,6 @@
 // A simulation world: its fixed configuration, runtime parameters, particle ids and time,
-// and the backend that holds and steps the particles.
+// its scene (colliders, sources, sinks, force fields), and the backend that holds and steps
+// the particles.
 #pragma once
 
 #include <stdint.h>
@@ -10,8 +11,12 @@
 #include "backend.h"
 #include "config.h"
 #include "frame_report.h"
+#include "scene_objects.h"
+#include "slot_map.h"
 
 namespace sph {
+
+enum ObjectTag : uint8_t { kTagCollider = 1, kTagSource = 2, kTagSink = 3, kTagForceField = 4 };
 
 class World {
  public:
@@ -27,16 +32,29 @@ class World {
   // Adds particles; throws Error(Capacity) if they do not fit. Returns the first new id.
   uint32_t spawn(const std::vector<Vec3>& positions, const std::vector<Vec3>* velocities);
 
-  // Runs one frame; returns false when max_substeps ran out before frame_dt.
+  // Runs one frame: sources emit, then substeps with colliders, fields and sinks. Returns
+  // false when max_substeps ran out before frame_dt. On an exception the world (particles,
+  // ids, sources, collider poses) is as it was before the call.
   bool step(double frame_dt);
 
   const FrameReport& last_report() const { return report_; }
   double simulated_time() const { return simulated_time_; }
   float last_step_ms() const { return last_step_ms_; }
+  const std::vector<Event>& events() const { return events_; }
+  const std::vector<uint32_t>& removed_ids() const { return report_.removed_ids; }
 
   const Backend& backend() const { return *backend_; }
 
+  SlotMap<Collider>& colliders() { return colliders_; }
+  SlotMap<Source>& sources() { return sources_; }
+  SlotMap<Sink>& sinks() { return sinks_; }
+  SlotMap<ForceField>& force_fields() { return force_fields_; }
+  const SlotMap<Collider>& colliders() const { return colliders_; }
+
  private:
+  void emit_sources(double frame_dt);
+  SceneFrame build_scene_frame(double frame_dt) const;
+
   WorldConfig config_;
   RuntimeParams params_;
   std::unique_ptr<Backend> backend_;
@@ -44,6 +62,11 @@ class World {
   double simulated_time_ = 0.0;
   FrameReport report_;
   float last_step_ms_ = 0.0f;
+  std::vector<Event> events_;
+  SlotMap<Collider> colliders_{kTagCollider};
+  SlotMap<Source> sources_{kTagSource};
+  SlotMap<Sink> sinks_{kTagSink};
+  SlotMap<ForceField> force_fields_{kTagForceField};
 };
 
 }  // namespace sph

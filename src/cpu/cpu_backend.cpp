@@ -11,6 +11,7 @@
 
 #include "../core/backend.h"
 #include "../core/grid_layout.h"
+#include "../core/scene_frame.h"
 #include "../core/status.h"
 #include "../physics/density.h"
 #include "../physics/forces.h"
@@ -66,22 +67,41 @@ class CpuBackend final : public Backend {
   }
 
   FrameReport step_frame(double frame_dt, const RuntimeParams& params) override {
+    return step_scene_frame(frame_dt, params, SceneFrame{});
+  }
+
+  FrameReport step_scene_frame(double frame_dt, const RuntimeParams& params,
+                               const SceneFrame& scene_in) override {
     FrameReport report;
     const FluidConstants fluid = make_fluid_constants(config_, params);
     const StepLimits limits = make_step_limits(config_, params);
+    SceneFrame scene = scene_in;
+    bind_scene_views(scene, [](const SdfAsset& a) { return a.host_view(); });
+    report.removed_by_sink.assign(scene.sinks.size(), 0u);
+    const uint32_t count_before = count_;
     const auto saved = store_.snapshot();
     const float saved_max_speed = max_speed_;
     const bool saved_max_speed_valid = max_speed_valid_;
     if (!max_speed_valid_) max_speed_ = compute_max_speed();
 
     double remaining = frame_dt;
+    double elapsed = 0.0;
     report.dt_min = std::numeric_limits<float>::max();
     while (remaining > 0.0 && report.substeps < params.max_substeps) {
-      const double dt = landing_dt(controller_dt(limits, max_speed_), remaining);
+      const float speed = std::max(max_speed_, scene.max_collider_speed);
+      const double dt = landing_dt(controller_dt(limits, speed), remaining);
       const float dtf = static_cast<float>(dt);
-      const uint32_t bad = config_.integrator == Integrator::Rk4 ? substep_rk4(fluid, dtf, report)
-                                                                 : substep_euler(fluid, dtf, report);
+      SubstepTime time;
+      time.tau0 = static_cast<float>(elapsed);
+      time.tau1 = static_cast<float>(elapsed + dt);
+      time.s0 = static_cast<float>(elapsed / frame_dt);
+      time.s1 = remaining <= dt ? 1.0f : static_cast<float>((elapsed + dt) / frame_dt);
+      time.dt = dtf;
+      const uint32_t bad = config_.integrator == Integrator::Rk4 ? substep_rk4(fluid, scene, time, report)
+                                                                 : substep_euler(fluid, scene, time, report);
       if (bad != kAllFinite) {
+        count_ = count_before;
+        store_.resize(count_);
         store_.restore(saved);
         max_speed_ = saved_max_speed;
         max_speed_valid_ = saved_max_speed_valid;
@@ -90,7 +110,9 @@ class CpuBackend final : public Backend {
                                            std::to_string(dtf) + " s) at particle id " + std::to_string(bad) +
                                            "; the world was restored to its state before sph_world_step");
       }
+      if (!scene.sinks.empty()) apply_sinks(scene, report);
       remaining -= dt;
+      elapsed += dt;
       ++report.substeps;
       report.time_advanced += dt;
       report.dt_min = std::min(report.dt_min, dtf);
@@ -103,6 +125,13 @@ class CpuBackend final : public Backend {
     summarize(report);
     report.stage_ms[kStageOther] += static_cast<float>(elapsed_ms(t));
     return report;
+  }
+
+  void truncate(uint32_t count) override {
+    if (count > count_) throw Error(Status::Internal, "truncate: beyond the particle count");
+    count_ = count;
+    store_.resize(count_);
+    max_speed_valid_ = false;
   }
 
   void copy_attribute(AttributeKind kind, uint32_t first, uint32_t count, void* dst,
@@ -172,7 +201,57 @@ class CpuBackend final : public Backend {
     report.stage_ms[kStageDensity] += static_cast<float>(elapsed_ms(t));
   }
 
-  uint32_t substep_euler(const FluidConstants& fluid, float dt, FrameReport& report) {
+  // Acceleration of particle i: the neighbour gather plus the scene's force fields.
+  static Vec3 acceleration(const FluidConstants& fluid, const GridView& view, const Float4* pos,
+                           const Float4* vel, const SceneFrame& scene, uint32_t i) {
+    Vec3 a = gather_acceleration(fluid, view, pos, vel, i);
+    for (const ForceFieldFrame& f : scene.fields) a += force_field_acceleration(f.view, xyz(pos[i]));
+    return a;
+  }
+
+  // Resolves colliders for the state in next_position_/next_velocity_, moved from x_old(i).
+  template <class OldPosition>
+  void collide(const SceneFrame& scene, const SubstepTime& time, OldPosition&& x_old, FrameReport& report) {
+    if (scene.colliders.empty()) return;
+    const auto t = Clock::now();
+    const float h = config_.kernel_radius;
+#pragma omp parallel for num_threads(workers_) schedule(static)
+    for (int i = 0; i < n(); ++i) {
+      Vec3 x = xyz(next_position_[i]);
+      Vec3 v = xyz(next_velocity_[i]);
+      const Vec3 from = x_old(static_cast<uint32_t>(i));
+      for (const ColliderFrame& c : scene.colliders) collide_particle(c.view, time, h, from, x, v);
+      next_position_[i] = make_float4_record(x, next_position_[i].w);
+      next_velocity_[i] = make_float4_record(v, next_velocity_[i].w);
+    }
+    report.stage_ms[kStageCollide] += static_cast<float>(elapsed_ms(t));
+  }
+
+  // Max speed and the first non-finite particle of the state in next_*.
+  uint32_t scan_next_state(float& v2max) const {
+    float m = 0.0f;
+    uint32_t bad_index = kAllFinite;
+#pragma omp parallel for num_threads(workers_) schedule(static) reduction(max : m) reduction(min : bad_index)
+    for (int i = 0; i < n(); ++i) {
+      const float v2 = length_squared(xyz(next_velocity_[i]));
+      m = std::max(m, v2);
+      if (!finite3(xyz(next_position_[i])) || !std::isfinite(v2))
+        bad_index = std::min(bad_index, static_cast<uint32_t>(i));
+    }
+    v2max = m;
+    return bad_index;
+  }
+
+  uint32_t finish_substep(float v2max, uint32_t bad_index) {
+    position_.data.swap(next_position_);
+    velocity_.data.swap(next_velocity_);
+    max_speed_ = std::sqrt(v2max);
+    max_speed_valid_ = true;
+    return bad_index == kAllFinite ? kAllFinite : id_.data[bad_index];
+  }
+
+  uint32_t substep_euler(const FluidConstants& fluid, const SceneFrame& scene, const SubstepTime& time,
+                         FrameReport& report) {
     sort_and_density(fluid, report);
     auto t = Clock::now();
     const GridView view = grid_.view();
@@ -180,37 +259,31 @@ class CpuBackend final : public Backend {
     next_velocity_.resize(count_);
     const Float4* pos = position_.data.data();
     const Float4* vel = velocity_.data.data();
-    float v2max = 0.0f;
-    uint32_t bad_index = kAllFinite;
-#pragma omp parallel for num_threads(workers_) schedule(static) reduction(max                    \
-                                                                          : v2max) reduction(min \
-                                                                                             : bad_index)
+    const float dt = time.dt;
+#pragma omp parallel for num_threads(workers_) schedule(static)
     for (int i = 0; i < n(); ++i) {
-      const Vec3 a = gather_acceleration(fluid, view, pos, vel, static_cast<uint32_t>(i));
+      const Vec3 a = acceleration(fluid, view, pos, vel, scene, static_cast<uint32_t>(i));
       const ParticleState s = symplectic_euler({xyz(pos[i]), xyz(vel[i])}, a, dt);
       next_position_[i] = make_float4_record(s.position, pos[i].w);
       next_velocity_[i] = make_float4_record(s.velocity, vel[i].w);
-      const float v2 = length_squared(s.velocity);
-      v2max = std::max(v2max, v2);
-      if (!finite3(s.position) || !std::isfinite(v2))
-        bad_index = std::min(bad_index, static_cast<uint32_t>(i));
     }
     report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
+    collide(
+        scene, time, [&](uint32_t i) { return xyz(pos[i]); }, report);
     t = Clock::now();
-    position_.data.swap(next_position_);
-    velocity_.data.swap(next_velocity_);
-    max_speed_ = std::sqrt(v2max);
-    max_speed_valid_ = true;
+    float v2max = 0.0f;
+    const uint32_t bad_index = scan_next_state(v2max);
+    const uint32_t bad = finish_substep(v2max, bad_index);
     report.stage_ms[kStageIntegrate] += static_cast<float>(elapsed_ms(t));
-    return bad_index == kAllFinite ? kAllFinite : id_.data[bad_index];
+    return bad;
   }
 
-  uint32_t substep_rk4(const FluidConstants& fluid, float dt, FrameReport& report) {
+  uint32_t substep_rk4(const FluidConstants& fluid, const SceneFrame& scene, const SubstepTime& time,
+                       FrameReport& report) {
     // Stage 0 starts from the current state.
     for (int i = 0; i < n(); ++i)
       rk4_start_->data[i] = ParticleState{xyz(position_.data[i]), xyz(velocity_.data[i])};
-    float v2max = 0.0f;
-    uint32_t bad_index = kAllFinite;
+    const float dt = time.dt;
     for (int stage = 0; stage < 4; ++stage) {
       sort_and_density(fluid, report);
       auto t = Clock::now();
@@ -219,30 +292,49 @@ class CpuBackend final : public Backend {
       next_velocity_.resize(count_);
       const Float4* pos = position_.data.data();
       const Float4* vel = velocity_.data.data();
-      v2max = 0.0f;
-      bad_index = kAllFinite;
-#pragma omp parallel for num_threads(workers_) schedule(static) reduction(max                    \
-                                                                          : v2max) reduction(min \
-                                                                                             : bad_index)
+#pragma omp parallel for num_threads(workers_) schedule(static)
       for (int i = 0; i < n(); ++i) {
-        const Vec3 a = gather_acceleration(fluid, view, pos, vel, static_cast<uint32_t>(i));
+        const Vec3 a = acceleration(fluid, view, pos, vel, scene, static_cast<uint32_t>(i));
         const ParticleState s =
             rk4_advance(stage, rk4_start_->data[i], {xyz(pos[i]), xyz(vel[i])}, a, dt, rk4_sum_->data[i]);
         next_position_[i] = make_float4_record(s.position, pos[i].w);
         next_velocity_[i] = make_float4_record(s.velocity, vel[i].w);
-        const float v2 = length_squared(s.velocity);
-        v2max = std::max(v2max, v2);
-        if (!finite3(s.position) || !std::isfinite(v2))
-          bad_index = std::min(bad_index, static_cast<uint32_t>(i));
       }
       report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
-      position_.data.swap(next_position_);
-      velocity_.data.swap(next_velocity_);
-      if (bad_index != kAllFinite) break;
+      if (stage == 3)
+        collide(
+            scene, time, [&](uint32_t i) { return rk4_start_->data[i].position; }, report);
+      t = Clock::now();
+      float v2max = 0.0f;
+      const uint32_t bad_index = scan_next_state(v2max);
+      const uint32_t bad = finish_substep(v2max, bad_index);
+      report.stage_ms[kStageIntegrate] += static_cast<float>(elapsed_ms(t));
+      if (bad != kAllFinite) return bad;
     }
-    max_speed_ = std::sqrt(v2max);
-    max_speed_valid_ = true;
-    return bad_index == kAllFinite ? kAllFinite : id_.data[bad_index];
+    return kAllFinite;
+  }
+
+  // Removes particles inside any sink, keeping the order of the rest; records their ids.
+  void apply_sinks(const SceneFrame& scene, FrameReport& report) {
+    const auto t = Clock::now();
+    keep_order_.clear();
+    for (uint32_t i = 0; i < count_; ++i) {
+      const Vec3 x = xyz(position_.data[i]);
+      bool removed = false;
+      for (size_t s = 0; s < scene.sinks.size() && !removed; ++s)
+        if (sink_removes(scene.sinks[s].view, x)) {
+          removed = true;
+          ++report.removed_by_sink[s];
+          report.removed_ids.push_back(id_.data[i]);
+        }
+      if (!removed) keep_order_.push_back(i);
+    }
+    if (keep_order_.size() != count_) {
+      store_.permute(keep_order_.data(), keep_order_.size());
+      count_ = static_cast<uint32_t>(keep_order_.size());
+      store_.resize(count_);
+    }
+    report.stage_ms[kStageEmit] += static_cast<float>(elapsed_ms(t));
   }
 
   // Density and neighbour statistics of the last density evaluation.
@@ -280,6 +372,7 @@ class CpuBackend final : public Backend {
   // Integration writes here and swaps, so the force gather reads a state nobody writes.
   std::vector<Float4> next_position_;
   std::vector<Float4> next_velocity_;
+  std::vector<uint32_t> keep_order_;
   uint32_t count_ = 0;
   float max_speed_ = 0.0f;
   bool max_speed_valid_ = false;

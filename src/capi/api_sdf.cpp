@@ -1,0 +1,294 @@
+// SDF assets: grids from the caller, analytic shapes, sub-box updates.
+#include <vector>
+
+#include "../core/sdf_shapes.h"
+#include "guard.h"
+#include "handles.h"
+#include "struct_io.h"
+#include "validate.h"
+
+using sph::Error;
+using sph::Status;
+
+namespace {
+
+constexpr uint64_t kMaxVoxels = 1ull << 31;
+
+const sph_context* context_of_sdf(const sph_sdf* sdf) {
+  return (sdf && sph::is_live_handle(sdf, sph::HandleKind::Sdf)) ? sdf->context : nullptr;
+}
+
+void require_sdf(const sph_sdf* sdf, const char* name) {
+  if (!sdf) throw Error(Status::InvalidHandle, std::string(name) + ": is NULL");
+  if (!sph::is_live_handle(sdf, sph::HandleKind::Sdf))
+    throw Error(Status::InvalidHandle,
+                std::string(name) + ": is not a live sph_sdf (destroyed or foreign pointer)");
+}
+
+void require_context(const sph_context* context) {
+  if (!context) throw Error(Status::InvalidHandle, "context: is NULL");
+  if (!sph::is_live_handle(context, sph::HandleKind::Context))
+    throw Error(Status::InvalidHandle, "context: is not a live sph_context");
+}
+
+// Copies `count` floats from caller memory (host or device) and checks they are finite.
+std::vector<float> read_floats(const sph_context* context, const float* data, uint64_t count,
+                               sph_memory_kind memory, const std::string& name) {
+  if (!data) throw Error(Status::InvalidArgument, name + "->data: is NULL");
+  std::vector<float> out(count);
+  if (memory == SPH_MEMORY_HOST) {
+    std::memcpy(out.data(), data, count * sizeof(float));
+  } else if (memory == SPH_MEMORY_CUDA_DEVICE) {
+    if (context->backend != sph::BackendKind::Cuda)
+      throw Error(Status::Unsupported, name + "->memory: device memory needs a CUDA context");
+    sph::copy_device_to_host(out.data(), data, count * sizeof(float), context->device_ordinal);
+  } else {
+    throw Error(Status::Unsupported, name + "->memory: " + std::to_string(static_cast<int>(memory)) +
+                                         " is not an sph_memory_kind value");
+  }
+  for (uint64_t i = 0; i < count; ++i)
+    if (!std::isfinite(out[i]))
+      throw Error(Status::InvalidArgument, name + "->data[" + std::to_string(i) + "]: is not finite");
+  return out;
+}
+
+uint64_t voxel_count(const uint32_t dims[3], const std::string& name) {
+  if (dims[0] == 0 || dims[1] == 0 || dims[2] == 0)
+    throw Error(Status::InvalidArgument, name + "->dims: every dimension must be >= 1");
+  const uint64_t n = static_cast<uint64_t>(dims[0]) * dims[1] * dims[2];
+  if (n > kMaxVoxels || dims[0] > (1u << 30) || dims[1] > (1u << 30) || dims[2] > (1u << 30))
+    throw Error(Status::Capacity, name + "->dims: more than 2^31 voxels");
+  return n;
+}
+
+// Builds an asset from a caller description (validated as a whole before anything is kept).
+std::shared_ptr<sph::SdfAsset> asset_from_desc(const sph_context* context, const sph_sdf_desc& d) {
+  sph::require_zero(d.reserved0, "desc->reserved0");
+  const sph_grid_desc g = sph::read_user_struct(&d.distance, "desc->distance");
+  if (g.components != 1) throw Error(Status::InvalidArgument, "desc->distance.components: must be 1");
+  const uint64_t n = voxel_count(g.dims, "desc->distance");
+  sph::Affine3x4 affine;
+  std::memcpy(affine.m, g.index_to_local, sizeof affine.m);
+  auto asset =
+      std::make_shared<sph::SdfAsset>(static_cast<int32_t>(g.dims[0]), static_cast<int32_t>(g.dims[1]),
+                                      static_cast<int32_t>(g.dims[2]), affine);
+  asset->distance() = read_floats(context, g.data, n, g.memory, "desc->distance");
+  auto same_dims = [&](const sph_grid_desc& o, const char* name) {
+    if (o.dims[0] != g.dims[0] || o.dims[1] != g.dims[1] || o.dims[2] != g.dims[2])
+      throw Error(Status::InvalidArgument, std::string(name) + "->dims: must equal desc->distance.dims");
+  };
+  if (d.velocity) {
+    const sph_grid_desc v = sph::read_user_struct(d.velocity, "desc->velocity");
+    same_dims(v, "desc->velocity");
+    if (v.components != 3) throw Error(Status::InvalidArgument, "desc->velocity->components: must be 3");
+    const std::vector<float> raw = read_floats(context, v.data, 3 * n, v.memory, "desc->velocity");
+    asset->velocity().resize(n);
+    std::memcpy(asset->velocity().data(), raw.data(), raw.size() * sizeof(float));
+  }
+  if (d.friction) {
+    const sph_grid_desc f = sph::read_user_struct(d.friction, "desc->friction");
+    same_dims(f, "desc->friction");
+    if (f.components != 1) throw Error(Status::InvalidArgument, "desc->friction->components: must be 1");
+    asset->friction() = read_floats(context, f.data, n, f.memory, "desc->friction");
+    for (float mu : asset->friction())
+      if (mu < 0.0f) throw Error(Status::InvalidArgument, "desc->friction->data: coefficients must be >= 0");
+  }
+  return asset;
+}
+
+sph_result publish(sph_context* context, std::shared_ptr<sph::SdfAsset> asset, sph_sdf** out) {
+  auto handle = std::make_unique<sph_sdf>();
+  handle->context = context;
+  handle->asset = std::move(asset);
+  sph::register_handle(handle.get(), sph::HandleKind::Sdf);
+  context->sdf_count.fetch_add(1);
+  *out = handle.release();
+  return SPH_OK;
+}
+
+}  // namespace
+
+extern "C" {
+
+SPH_API sph_result SPH_CALL sph_grid_desc_init_sized(sph_grid_desc* desc, uint32_t size) {
+  return sph::guarded("sph_grid_desc_init", nullptr, [&] {
+    sph::require_init_size(desc, size, "desc");
+    sph_grid_desc d;
+    std::memset(&d, 0, sizeof d);
+    d.struct_size = sizeof d;
+    d.index_to_local[0] = d.index_to_local[5] = d.index_to_local[10] = 1.0f;
+    d.memory = SPH_MEMORY_HOST;
+    d.components = 1;
+    sph::write_user_struct(desc, size, d);
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_sdf_desc_init_sized(sph_sdf_desc* desc, uint32_t size) {
+  return sph::guarded("sph_sdf_desc_init", nullptr, [&] {
+    sph::require_init_size(desc, size, "desc");
+    sph_sdf_desc d;
+    std::memset(&d, 0, sizeof d);
+    d.struct_size = sizeof d;
+    sph_grid_desc_init(&d.distance);
+    sph::write_user_struct(desc, size, d);
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_shape_desc_init_sized(sph_shape_desc* desc, uint32_t size) {
+  return sph::guarded("sph_shape_desc_init", nullptr, [&] {
+    sph::require_init_size(desc, size, "desc");
+    const sph::ShapeSpec defaults;
+    sph_shape_desc d;
+    std::memset(&d, 0, sizeof d);
+    d.struct_size = sizeof d;
+    d.shape = SPH_SHAPE_BOX;
+    d.half_extents = sph_vec3{defaults.half_extents.x, defaults.half_extents.y, defaults.half_extents.z};
+    d.radius = defaults.radius;
+    d.half_height = defaults.half_height;
+    d.wall_thickness = 0.0f;
+    d.voxel_size = defaults.voxel_size;
+    sph::write_user_struct(desc, size, d);
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_sdf_create(sph_context* context, const sph_sdf_desc* desc, sph_sdf** out) {
+  const sph_context* log_context = sph::is_live_handle(context, sph::HandleKind::Context) ? context : nullptr;
+  return sph::guarded("sph_sdf_create", log_context, [&] {
+    require_context(context);
+    if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
+    const sph_sdf_desc d = sph::read_user_struct(desc, "desc");
+    return publish(context, asset_from_desc(context, d), out);
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_sdf_create_shape(sph_context* context, const sph_shape_desc* desc,
+                                                 sph_sdf** out) {
+  const sph_context* log_context = sph::is_live_handle(context, sph::HandleKind::Context) ? context : nullptr;
+  return sph::guarded("sph_sdf_create_shape", log_context, [&] {
+    require_context(context);
+    if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
+    const sph_shape_desc d = sph::read_user_struct(desc, "desc");
+    if (static_cast<uint32_t>(d.shape) > SPH_SHAPE_CUP)
+      throw Error(Status::Unsupported,
+                  "desc->shape: " + std::to_string(static_cast<int>(d.shape)) + " is not an sph_shape value");
+    if (d.flags & ~SPH_SHAPE_FLAG_OPEN_TOP) throw Error(Status::Unsupported, "desc->flags: unknown bits");
+    sph::require_finite_vec3(d.half_extents, "desc->half_extents");
+    sph::require_finite(d.radius, "desc->radius");
+    sph::require_finite(d.half_height, "desc->half_height");
+    sph::require_non_negative(d.wall_thickness, "desc->wall_thickness");
+    sph::require_positive(d.voxel_size, "desc->voxel_size");
+    sph::ShapeSpec spec;
+    spec.kind = static_cast<sph::ShapeKind>(d.shape);
+    spec.half_extents = sph::Vec3{d.half_extents.x, d.half_extents.y, d.half_extents.z};
+    spec.radius = d.radius;
+    spec.half_height = d.half_height;
+    spec.wall_thickness = d.wall_thickness;
+    spec.open_top = (d.flags & SPH_SHAPE_FLAG_OPEN_TOP) != 0;
+    spec.voxel_size = d.voxel_size;
+    spec.padding_voxels =
+        d.padding_voxels == 0 ? 4 : static_cast<int32_t>(std::min<uint32_t>(d.padding_voxels, 1u << 20));
+    return publish(context, sph::build_shape_sdf(spec, kMaxVoxels), out);
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_sdf_update(sph_sdf* sdf, sph_sdf_channel channel, const uint32_t origin[3],
+                                           const uint32_t size[3], const float* data,
+                                           sph_memory_kind memory) {
+  return sph::guarded("sph_sdf_update", context_of_sdf(sdf), [&] {
+    require_sdf(sdf, "sdf");
+    if (!origin) throw Error(Status::InvalidArgument, "origin: is NULL");
+    if (!size) throw Error(Status::InvalidArgument, "size: is NULL");
+    uint32_t components;
+    switch (channel) {
+      case SPH_SDF_CHANNEL_DISTANCE:
+        components = 1;
+        break;
+      case SPH_SDF_CHANNEL_VELOCITY:
+        components = 3;
+        break;
+      case SPH_SDF_CHANNEL_FRICTION:
+        components = 1;
+        break;
+      default:
+        throw Error(Status::Unsupported, "channel: " + std::to_string(static_cast<int>(channel)) +
+                                             " is not an sph_sdf_channel value");
+    }
+    sph::SdfAsset& a = *sdf->asset;
+    const uint32_t dims[3] = {static_cast<uint32_t>(a.nx()), static_cast<uint32_t>(a.ny()),
+                              static_cast<uint32_t>(a.nz())};
+    for (int axis = 0; axis < 3; ++axis)
+      if (size[axis] == 0 || origin[axis] >= dims[axis] || size[axis] > dims[axis] - origin[axis])
+        throw Error(Status::InvalidArgument,
+                    "origin, size: the box [" + std::to_string(origin[axis]) + ", " +
+                        std::to_string(static_cast<uint64_t>(origin[axis]) + size[axis]) +
+                        ") leaves the grid along axis " + std::to_string(axis) + " (dimension " +
+                        std::to_string(dims[axis]) + ")");
+    const uint64_t n = static_cast<uint64_t>(size[0]) * size[1] * size[2];
+    const std::vector<float> values = read_floats(sdf->context, data, n * components, memory, "update");
+    if (channel == SPH_SDF_CHANNEL_FRICTION)
+      for (float mu : values)
+        if (mu < 0.0f) throw Error(Status::InvalidArgument, "data: friction coefficients must be >= 0");
+    float* target = nullptr;
+    if (channel == SPH_SDF_CHANNEL_DISTANCE) {
+      target = a.distance().data();
+    } else if (channel == SPH_SDF_CHANNEL_VELOCITY) {
+      if (a.velocity().empty()) a.velocity().assign(a.voxel_count(), sph::Vec3{0.0f, 0.0f, 0.0f});
+      target = &a.velocity()[0].x;
+    } else {
+      if (a.friction().empty()) a.friction().assign(a.voxel_count(), 0.0f);
+      target = a.friction().data();
+    }
+    for (uint32_t k = 0; k < size[2]; ++k)
+      for (uint32_t j = 0; j < size[1]; ++j) {
+        const uint64_t row =
+            (origin[0] + static_cast<uint64_t>(dims[0]) *
+                             (origin[1] + j + static_cast<uint64_t>(dims[1]) * (origin[2] + k)));
+        const uint64_t src = static_cast<uint64_t>(size[0]) * (j + static_cast<uint64_t>(size[1]) * k);
+        std::memcpy(target + row * components, values.data() + src * components,
+                    size[0] * components * sizeof(float));
+      }
+    a.touch();
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_sdf_get_dims(const sph_sdf* sdf, uint32_t out_dims[3]) {
+  return sph::guarded("sph_sdf_get_dims", context_of_sdf(sdf), [&] {
+    require_sdf(sdf, "sdf");
+    if (!out_dims) throw Error(Status::InvalidArgument, "out_dims: is NULL");
+    out_dims[0] = static_cast<uint32_t>(sdf->asset->nx());
+    out_dims[1] = static_cast<uint32_t>(sdf->asset->ny());
+    out_dims[2] = static_cast<uint32_t>(sdf->asset->nz());
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_sdf_sample(const sph_sdf* sdf, sph_vec3 local_point, float* out_distance) {
+  return sph::guarded("sph_sdf_sample", context_of_sdf(sdf), [&] {
+    require_sdf(sdf, "sdf");
+    sph::require_finite_vec3(local_point, "local_point");
+    if (!out_distance) throw Error(Status::InvalidArgument, "out_distance: is NULL");
+    *out_distance =
+        sph::sample_distance(sdf->asset->host_view(), sph::Vec3{local_point.x, local_point.y, local_point.z});
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_sdf_destroy(sph_sdf* sdf) {
+  if (!sdf) {
+    sph::clear_last_error();
+    return SPH_OK;
+  }
+  return sph::guarded("sph_sdf_destroy", context_of_sdf(sdf), [&] {
+    require_sdf(sdf, "sdf");
+    sph::unregister_handle(sdf);
+    sdf->context->sdf_count.fetch_sub(1);
+    delete sdf;
+    return SPH_OK;
+  });
+}
+
+}  // extern "C"

@@ -1,0 +1,75 @@
+// The small objects a world holds besides particles: colliders, sources, sinks and force
+// fields, as the core keeps them between frames.
+#pragma once
+
+#include <stdint.h>
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "../physics/force_fields.h"
+#include "../physics/rigid_transform.h"
+#include "../physics/sink_region.h"
+#include "sdf_asset.h"
+
+namespace sph {
+
+struct Collider {
+  std::shared_ptr<const SdfAsset> sdf;
+  RigidTransform pose{{0.0f, 0.0f, 0.0f},
+                      {0.0f, 0.0f, 0.0f, 1.0f}};  // where the collider is now (start of the next frame)
+  std::optional<RigidTransform> target;           // where it must be at the end of the next frame
+  float restitution = 0.0f;
+  float friction = 0.0f;
+  float stickiness = 0.0f;
+  bool inverted = false;
+};
+
+enum class SourceMode : uint32_t { FillOnce = 0, Continuous = 1 };
+
+struct Source {
+  std::shared_ptr<const SdfAsset> region;
+  RigidTransform pose{{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f, 1.0f}};
+  SourceMode mode = SourceMode::FillOnce;
+  float spacing = 0.0f;
+  float min_distance = 0.0f;
+  Vec3 velocity{0.0f, 0.0f, 0.0f};
+  bool velocity_from_field = false;
+  float rate = 0.0f;          // Continuous: particles per second at most; 0 = no limit
+  double rate_budget = 0.0;   // fractional particles carried between frames
+  bool done = false;          // FillOnce: already emitted
+  std::vector<Vec3> lattice;  // FCC points inside the region, in the region's frame
+};
+
+struct Sink {
+  SinkMode mode = SinkMode::Region;
+  std::shared_ptr<const SdfAsset> region;
+  RigidTransform pose{{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f, 1.0f}};
+  Vec3 bounds_min{0.0f, 0.0f, 0.0f};
+  Vec3 bounds_max{0.0f, 0.0f, 0.0f};
+};
+
+struct ForceField {
+  ForceFieldKind kind = ForceFieldKind::Uniform;
+  std::shared_ptr<const SdfAsset> region;
+  std::shared_ptr<const SdfAsset> grid;
+  RigidTransform pose{{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f, 1.0f}};
+  Vec3 vector{0.0f, 0.0f, 0.0f};
+  float strength = 0.0f;
+  float falloff_radius = 0.0f;
+};
+
+enum class EventType : uint32_t { SourceCapacityReached = 1, SinkRemoved = 2 };
+
+struct Event {
+  EventType type;
+  uint64_t object_id;
+  uint32_t count;
+};
+
+// FCC lattice points at `spacing` inside an asset's negative region, in the asset's frame.
+// Throws Error(Capacity) when the region's box holds more than max_points lattice points.
+std::vector<Vec3> lattice_inside(const SdfAsset& region, float spacing, uint64_t max_points);
+
+}  // namespace sph

@@ -1,0 +1,73 @@
+#include "sdf_asset.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <string>
+
+#include "status.h"
+
+namespace sph {
+namespace {
+
+std::atomic<uint64_t> g_next_uid{1};
+
+Eigen::Matrix4d to_matrix(const Affine3x4& a) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) m(r, c) = a.m[r * 4 + c];
+  return m;
+}
+
+Affine3x4 from_matrix(const Eigen::Matrix4d& m) {
+  Affine3x4 a;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) a.m[r * 4 + c] = static_cast<float>(m(r, c));
+  return a;
+}
+
+}  // namespace
+
+SdfAsset::SdfAsset(int32_t nx, int32_t ny, int32_t nz, const Affine3x4& index_to_local)
+    : nx_(nx), ny_(ny), nz_(nz), index_to_local_(index_to_local), uid_(g_next_uid.fetch_add(1)) {
+  if (nx < 1 || ny < 1 || nz < 1) throw Error(Status::InvalidArgument, "dims: every dimension must be >= 1");
+  for (float v : index_to_local.m)
+    if (!std::isfinite(v)) throw Error(Status::InvalidArgument, "index_to_local: has a non-finite entry");
+  const Eigen::Matrix4d m = to_matrix(index_to_local);
+  const Eigen::Matrix3d linear = m.topLeftCorner<3, 3>();
+  const double det = linear.determinant();
+  const double scale = linear.cwiseAbs().maxCoeff();
+  if (!(std::fabs(det) > 1e-12 * scale * scale * scale) || !std::isfinite(det))
+    throw Error(Status::InvalidArgument, "index_to_local: the linear part is singular");
+  local_to_index_ = from_matrix(m.inverse());
+  // The shortest voxel edge: the smallest column norm of the linear part.
+  min_voxel_size_ = static_cast<float>(linear.colwise().norm().minCoeff());
+  if (!(min_voxel_size_ > 0.0f) || !std::isfinite(min_voxel_size_))
+    throw Error(Status::InvalidArgument, "index_to_local: voxel size is not representable in float");
+  distance_.assign(voxel_count(), 0.0f);
+}
+
+bool SdfAsset::has_moving_surface() const {
+  for (const Vec3& v : velocity_)
+    if (v.x != 0.0f || v.y != 0.0f || v.z != 0.0f) return true;
+  return false;
+}
+
+SdfGridView SdfAsset::view_with(const float* distance, const Vec3* velocity, const float* friction) const {
+  SdfGridView v;
+  v.distance = distance;
+  v.velocity = velocity;
+  v.friction = friction;
+  v.nx = nx_;
+  v.ny = ny_;
+  v.nz = nz_;
+  v.local_to_index = local_to_index_;
+  v.min_voxel_size = min_voxel_size_;
+  return v;
+}
+
+SdfGridView SdfAsset::host_view() const {
+  return view_with(distance_.data(), velocity_.empty() ? nullptr : velocity_.data(),
+                   friction_.empty() ? nullptr : friction_.data());
+}
+
+}  // namespace sph

@@ -1,0 +1,62 @@
+// A signed-distance grid asset: distances (negative inside) at voxel centres with an
+// index-to-local affine map, and optional per-voxel surface velocity and friction. Assets are
+// shared: colliders, sources, sinks and fields in any world of a context hold references.
+#pragma once
+
+#include <stdint.h>
+
+#include <atomic>
+#include <vector>
+
+#include "../physics/sdf_sampling.h"
+
+namespace sph {
+
+class SdfAsset {
+ public:
+  // Throws Error(InvalidArgument) for a singular or non-finite affine map or empty dims.
+  SdfAsset(int32_t nx, int32_t ny, int32_t nz, const Affine3x4& index_to_local);
+
+  int32_t nx() const { return nx_; }
+  int32_t ny() const { return ny_; }
+  int32_t nz() const { return nz_; }
+  uint64_t voxel_count() const { return static_cast<uint64_t>(nx_) * ny_ * nz_; }
+  const Affine3x4& index_to_local() const { return index_to_local_; }
+
+  std::vector<float>& distance() { return distance_; }
+  std::vector<Vec3>& velocity() { return velocity_; }   // empty when the asset has none
+  std::vector<float>& friction() { return friction_; }  // empty when the asset has none
+  const std::vector<float>& distance() const { return distance_; }
+  const std::vector<Vec3>& velocity() const { return velocity_; }
+  const std::vector<float>& friction() const { return friction_; }
+
+  bool has_velocity() const { return !velocity_.empty(); }
+  // True when a velocity field exists and any of it is non-zero.
+  bool has_moving_surface() const;
+
+  // A view over host memory (the CPU backend samples it directly).
+  SdfGridView host_view() const;
+  SdfGridView view_with(const float* distance, const Vec3* velocity, const float* friction) const;
+
+  // Bumped on every change, so device copies know when to refresh.
+  uint64_t version() const { return version_.load(); }
+  void touch() { version_.fetch_add(1); }
+  uint64_t uid() const { return uid_; }
+  size_t bytes() const {
+    return distance_.size() * sizeof(float) + velocity_.size() * sizeof(Vec3) +
+           friction_.size() * sizeof(float);
+  }
+
+ private:
+  int32_t nx_, ny_, nz_;
+  Affine3x4 index_to_local_;
+  Affine3x4 local_to_index_;
+  float min_voxel_size_;
+  std::vector<float> distance_;
+  std::vector<Vec3> velocity_;
+  std::vector<float> friction_;
+  std::atomic<uint64_t> version_{1};
+  uint64_t uid_;
+};
+
+}  // namespace sph
