@@ -75,8 +75,8 @@ class Backend {
   virtual int device_ordinal() const { throw unsupported_interop(); }
   virtual void* device_stream() const { throw unsupported_interop(); }  // a cudaStream_t
   // Records a caller-owned cudaEvent_t on the backend's stream / makes the stream wait for one.
-  virtual void record_device_event(void* /*event*/) { throw unsupported_interop(); }
-  virtual void wait_device_event(void* /*event*/) { throw unsupported_interop(); }
+  virtual void record_device_event(void* /*event*/) const { throw unsupported_interop(); }
+  virtual void wait_device_event(void* /*event*/) const { throw unsupported_interop(); }
 
  protected:
   static Error unsupported_interop() {

@@ -1,0 +1,397 @@
+// The CUDA backend: device-resident particles, every substep stage on the world's own stream,
+// and the frame loop on the device (frame_graph.h). It mirrors the CPU backend's semantics:
+// the same sort, the same substep structure, the same step control and the same rollback.
+#include <cfloat>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "../src/core/grid_layout.h"
+#include "cuda_backend.h"
+#include "cuda_status.h"
+#include "device_array.h"
+#include "device_neighbor_grid.h"
+#include "device_particle_store.h"
+#include "frame_control.h"
+#include "frame_graph.h"
+#include "frame_statistics.h"
+#include "substep_pipeline.h"
+
+namespace sph {
+namespace {
+
+unsigned env_block_size(const char* name, unsigned fallback) {
+  const char* value = std::getenv(name);
+  if (!value) return fallback;
+  const long v = std::strtol(value, nullptr, 10);
+  return (v == 32 || v == 64 || v == 128 || v == 256 || v == 512 || v == 1024) ? static_cast<unsigned>(v)
+                                                                               : fallback;
+}
+
+bool env_graphs_enabled() {
+  const char* value = std::getenv("SPH_CUDA_GRAPHS");
+  return !(value && std::strcmp(value, "0") == 0);
+}
+
+bool same_setup(const PipelineSetup& a, const PipelineSetup& b) {
+  return a.count == b.count && a.integrator == b.integrator && a.max_substeps == b.max_substeps &&
+         std::memcmp(&a.fluid, &b.fluid, sizeof a.fluid) == 0 &&
+         std::memcmp(&a.limits, &b.limits, sizeof a.limits) == 0 &&
+         a.tuning.density_block == b.tuning.density_block && a.tuning.force_block == b.tuning.force_block;
+}
+
+// Everything the backend holds on the device. Released with the backend's device current.
+struct Resources {
+  cudaStream_t stream = nullptr;
+  cudaEvent_t frame_start = nullptr;
+  cudaEvent_t frame_stop = nullptr;
+  std::unique_ptr<DeviceParticleStore> store;
+  std::unique_ptr<DeviceNeighborGrid> grid;
+  std::unique_ptr<FrameStatistics> statistics;
+  DeviceArray<FrameState> state;
+  PinnedArray<double> frame_dt_input;
+  PinnedArray<FrameState> state_output;
+  FrameGraph graph;
+  PipelineSetup graph_setup;
+
+  ~Resources() {
+    if (stream && cudaStreamSynchronize(stream) != cudaSuccess) (void)cudaGetLastError();
+    graph.reset();
+    if (frame_start) cudaEventDestroy(frame_start);
+    if (frame_stop) cudaEventDestroy(frame_stop);
+    if (stream) cudaStreamDestroy(stream);
+    (void)cudaGetLastError();
+  }
+
+  PipelineBuffers buffers() {
+    return PipelineBuffers{store.get(), grid.get(),           statistics.get(),
+                           state.get(), frame_dt_input.get(), state_output.get()};
+  }
+};
+
+class CudaBackend final : public Backend {
+ public:
+  CudaBackend(const WorldConfig& config, int device) : config_(config), device_(device) {
+    DeviceGuard guard(device_);
+    auto r = std::make_unique<Resources>();
+    cuda_check(cudaStreamCreateWithFlags(&r->stream, cudaStreamNonBlocking), "cudaStreamCreate");
+    cuda_check(cudaEventCreate(&r->frame_start), "cudaEventCreate");
+    cuda_check(cudaEventCreate(&r->frame_stop), "cudaEventCreate");
+    r->store = std::make_unique<DeviceParticleStore>(config.capacity, config.integrator == Integrator::Rk4);
+    // The sorted positions are free while the sort runs: its temporary storage goes there.
+    r->grid = std::make_unique<DeviceNeighborGrid>(
+        make_grid_shape(config.kernel_radius, config.capacity), config.capacity, r->store->sort_scratch(),
+        r->store->arrays().sorted_position, sizeof(Float4) * static_cast<size_t>(config.capacity));
+    r->statistics = std::make_unique<FrameStatistics>(config.capacity);
+    r->state.allocate(1, "frame state");
+    cuda_check(cudaMemsetAsync(r->state.get(), 0, sizeof(FrameState), r->stream), "frame state reset");
+    r->frame_dt_input.allocate(1, "frame input");
+    r->state_output.allocate(1, "frame output");
+    cuda_check(cudaStreamSynchronize(r->stream), "backend set-up");
+    tuning_.density_block = env_block_size("SPH_CUDA_DENSITY_BLOCK", tuning_.density_block);
+    tuning_.force_block = env_block_size("SPH_CUDA_FORCE_BLOCK", tuning_.force_block);
+    use_graphs_ = env_graphs_enabled();
+    r_ = std::move(r);
+  }
+
+  ~CudaBackend() override {
+    DeviceGuard* guard = nullptr;
+    try {
+      guard = new DeviceGuard(device_);
+    } catch (...) {
+    }
+    r_.reset();
+    delete guard;
+  }
+
+  uint32_t particle_count() const override { return count_; }
+
+  void append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id) override {
+    require_alive();
+    DeviceGuard guard(device_);
+    std::vector<Float4> pos(n), vel(n);
+    std::vector<uint32_t> ids(n);
+    const std::vector<float> density(n, config_.rest_density);
+    for (uint32_t k = 0; k < n; ++k) {
+      const Vec3 v = velocities ? velocities[k] : Vec3{0.0f, 0.0f, 0.0f};
+      pos[k] = make_float4_record(positions[k], 0.0f);
+      vel[k] = make_float4_record(v, 1.0f / config_.rest_density);
+      ids[k] = first_id + k;
+    }
+    guarded([&] {
+      const ParticleArrays& a = r_->store->arrays();
+      cudaStream_t s = r_->stream;
+      cuda_check(
+          cudaMemcpyAsync(a.position + count_, pos.data(), sizeof(Float4) * n, cudaMemcpyHostToDevice, s),
+          "copy of new positions");
+      cuda_check(
+          cudaMemcpyAsync(a.velocity + count_, vel.data(), sizeof(Float4) * n, cudaMemcpyHostToDevice, s),
+          "copy of new velocities");
+      cuda_check(cudaMemcpyAsync(a.id + count_, ids.data(), sizeof(uint32_t) * n, cudaMemcpyHostToDevice, s),
+                 "copy of new ids");
+      cuda_check(
+          cudaMemcpyAsync(a.density + count_, density.data(), sizeof(float) * n, cudaMemcpyHostToDevice, s),
+          "copy of new densities");
+      enqueue_recompute_max_speed(a.velocity, count_ + n, r_->state.get(), s);
+      cuda_check(cudaStreamSynchronize(s), "append");
+    });
+    count_ += n;
+    ++epoch_;
+  }
+
+  // Drops particles [count, particle_count()) (an emission undone after a failed step).
+  void truncate(uint32_t count) override {
+    require_alive();
+    if (count > count_) throw Error(Status::Internal, "truncate: beyond the particle count");
+    if (count == count_) return;
+    DeviceGuard guard(device_);
+    guarded([&] {
+      enqueue_recompute_max_speed(r_->store->arrays().velocity, count, r_->state.get(), r_->stream);
+      cuda_check(cudaStreamSynchronize(r_->stream), "truncate");
+    });
+    count_ = count;
+    ++epoch_;
+  }
+
+  FrameReport step_frame(double frame_dt, const RuntimeParams& params) override {
+    require_alive();
+    DeviceGuard guard(device_);
+    PipelineSetup setup;
+    setup.count = count_;
+    setup.integrator = config_.integrator;
+    setup.fluid = make_fluid_constants(config_, params);
+    setup.limits = make_step_limits(config_, params);
+    setup.max_substeps = params.max_substeps;
+    setup.tuning = tuning_;
+    float frame_ms = 0.0f;
+    guarded([&] {
+      prepare_graph(setup);
+      *r_->frame_dt_input.get() = frame_dt;
+      cuda_check(cudaEventRecord(r_->frame_start, r_->stream), "cudaEventRecord");
+      if (use_graphs_)
+        r_->graph.launch(r_->stream);
+      else
+        run_frame_on_stream(setup);
+      cuda_check(cudaEventRecord(r_->frame_stop, r_->stream), "cudaEventRecord");
+      cuda_check(cudaStreamSynchronize(r_->stream), "frame");
+      cuda_check(cudaEventElapsedTime(&frame_ms, r_->frame_start, r_->frame_stop), "cudaEventElapsedTime");
+    });
+    const FrameState s = *r_->state_output.get();
+    ++epoch_;
+    if (s.non_finite) {
+      guarded([&] {
+        r_->store->enqueue_restore(count_, r_->stream);
+        enqueue_restore_max_speed(r_->state.get(), r_->stream);
+        cuda_check(cudaStreamSynchronize(r_->stream), "rollback");
+      });
+      throw Error(Status::NonFinite, "the step produced a non-finite position or velocity in substep " +
+                                         std::to_string(s.bad_substep) + " (dt " + std::to_string(s.bad_dt) +
+                                         " s) at particle id " + std::to_string(s.bad_id) +
+                                         "; the world was restored to its state before sph_world_step");
+    }
+    FrameReport report;
+    report.substeps = s.substeps;
+    report.completed = s.remaining <= 0.0;
+    report.time_advanced = s.time_advanced;
+    report.dt_min = s.substeps == 0 ? 0.0f : s.dt_min;
+    report.dt_max = s.dt_max;
+    report.max_speed = s.max_speed;
+    report.density_min = s.density_min;
+    report.density_mean = s.density_mean;
+    report.density_max = s.density_max;
+    report.neighbors_mean = s.neighbors_mean;
+    report.neighbors_max = s.neighbors_max;
+    double staged_ms = 0.0;
+    for (int k = 0; k < kStageCount; ++k) {
+      report.stage_ms[k] = static_cast<float>(static_cast<double>(s.stage_ns[k]) * 1e-6);
+      staged_ms += report.stage_ms[k];
+    }
+    // The device marks cover the frame from its first kernel to the statistics; what the
+    // events saw beyond that (the input and output copies, launch) is "other".
+    if (frame_ms > staged_ms) report.stage_ms[kStageOther] += static_cast<float>(frame_ms - staged_ms);
+    return report;
+  }
+
+  void copy_attribute(AttributeKind kind, uint32_t first, uint32_t count, void* dst,
+                      size_t stride) const override {
+    require_alive();
+    DeviceGuard guard(device_);
+    const ParticleArrays& a = r_->store->arrays();
+    unsigned char* out = static_cast<unsigned char*>(dst);
+    switch (kind) {
+      case AttributeKind::Position:
+      case AttributeKind::Velocity:
+      case AttributeKind::Pressure: {
+        const Float4* src = (kind == AttributeKind::Velocity ? a.velocity : a.position) + first;
+        const std::vector<Float4> host = download(src, count);
+        for (uint32_t k = 0; k < count; ++k) {
+          unsigned char* p = out + static_cast<size_t>(k) * stride;
+          if (kind == AttributeKind::Pressure) {
+            std::memcpy(p, &host[k].w, sizeof(float));
+          } else {
+            const float v[3] = {host[k].x, host[k].y, host[k].z};
+            std::memcpy(p, v, sizeof v);
+          }
+        }
+        break;
+      }
+      case AttributeKind::Density:
+        scatter(download(a.density + first, count), out, stride);
+        break;
+      case AttributeKind::Id:
+        scatter(download(a.id + first, count), out, stride);
+        break;
+    }
+  }
+
+  uint64_t memory_bytes() const override {
+    return r_->store->bytes() + r_->grid->bytes() + r_->statistics->bytes() + r_->state.bytes();
+  }
+
+  DeviceAttributeView device_attribute(AttributeKind kind) const override {
+    require_alive();
+    const ParticleArrays& a = r_->store->arrays();
+    DeviceAttributeView v;
+    v.count = count_;
+    v.epoch = epoch_;
+    v.device = device_;
+    switch (kind) {
+      case AttributeKind::Position:
+        v = with(v, reinterpret_cast<uintptr_t>(a.position), sizeof(Float4), 12);
+        break;
+      case AttributeKind::Velocity:
+        v = with(v, reinterpret_cast<uintptr_t>(a.velocity), sizeof(Float4), 12);
+        break;
+      case AttributeKind::Pressure:
+        v = with(v, reinterpret_cast<uintptr_t>(a.position) + offsetof(Float4, w), sizeof(Float4), 4);
+        break;
+      case AttributeKind::Density:
+        v = with(v, reinterpret_cast<uintptr_t>(a.density), sizeof(float), 4);
+        break;
+      case AttributeKind::Id:
+        v = with(v, reinterpret_cast<uintptr_t>(a.id), sizeof(uint32_t), 4);
+        break;
+    }
+    return v;
+  }
+
+  uint64_t data_epoch() const override { return epoch_; }
+  int device_ordinal() const override { return device_; }
+  void* device_stream() const override { return r_->stream; }
+
+  void record_device_event(void* event) const override {
+    require_alive();
+    DeviceGuard guard(device_);
+    guarded(
+        [&] { cuda_check(cudaEventRecord(static_cast<cudaEvent_t>(event), r_->stream), "cudaEventRecord"); });
+  }
+
+  void wait_device_event(void* event) const override {
+    require_alive();
+    DeviceGuard guard(device_);
+    guarded([&] {
+      cuda_check(cudaStreamWaitEvent(r_->stream, static_cast<cudaEvent_t>(event), 0), "cudaStreamWaitEvent");
+    });
+  }
+
+ private:
+  static DeviceAttributeView with(DeviceAttributeView v, uintptr_t address, uint64_t stride,
+                                  uint32_t element) {
+    v.address = address;
+    v.stride = stride;
+    v.element_size = element;
+    return v;
+  }
+
+  void require_alive() const {
+    if (lost_)
+      throw Error(Status::DeviceLost,
+                  "world: its CUDA device reported a sticky error earlier; destroy the world");
+  }
+
+  // Runs body; a sticky CUDA error marks the backend lost so every later call reports it.
+  template <class Body>
+  void guarded(Body&& body) const {
+    try {
+      body();
+    } catch (const Error& e) {
+      if (e.status() == Status::DeviceLost) lost_ = true;
+      throw;
+    }
+  }
+
+  template <class T>
+  std::vector<T> download(const T* src, uint32_t count) const {
+    std::vector<T> host(count);
+    guarded([&] {
+      cuda_check(cudaMemcpyAsync(host.data(), src, sizeof(T) * count, cudaMemcpyDeviceToHost, r_->stream),
+                 "copy of particle data to the host");
+      cuda_check(cudaStreamSynchronize(r_->stream), "copy of particle data to the host");
+    });
+    return host;
+  }
+
+  template <class T>
+  static void scatter(const std::vector<T>& host, unsigned char* out, size_t stride) {
+    for (size_t k = 0; k < host.size(); ++k) std::memcpy(out + k * stride, &host[k], sizeof(T));
+  }
+
+  // (Re)captures the frame graph when the particle count or a parameter changed. A graph that
+  // cannot be built for a non-sticky reason (an old driver without conditional nodes) leaves
+  // the world on the stream fallback.
+  void prepare_graph(const PipelineSetup& setup) {
+    if (!use_graphs_) return;
+    if (r_->graph.ready() && same_setup(setup, r_->graph_setup)) return;
+    try {
+      r_->graph.build(setup, r_->buffers(), r_->stream);
+      r_->graph_setup = setup;
+    } catch (const Error& e) {
+      if (e.status() == Status::DeviceLost || e.status() == Status::OutOfDeviceMemory) throw;
+      use_graphs_ = false;
+    }
+  }
+
+  // The fallback: the same work launched stage by stage, reading the loop condition back
+  // after every substep.
+  void run_frame_on_stream(const PipelineSetup& setup) {
+    const PipelineBuffers b = r_->buffers();
+    enqueue_frame_begin(setup, b, LoopCondition{}, r_->stream);
+    for (;;) {
+      cuda_check(cudaMemcpyAsync(&b.state_output->run, &b.state->run, sizeof(uint32_t),
+                                 cudaMemcpyDeviceToHost, r_->stream),
+                 "copy of the loop condition");
+      cuda_check(cudaStreamSynchronize(r_->stream), "substep");
+      if (!b.state_output->run) break;
+      enqueue_substep(setup, b, LoopCondition{}, r_->stream);
+    }
+    enqueue_frame_end(setup, b, r_->stream);
+  }
+
+  WorldConfig config_;
+  int device_;
+  KernelTuning tuning_;
+  bool use_graphs_ = true;
+  uint32_t count_ = 0;
+  uint64_t epoch_ = 1;
+  mutable bool lost_ = false;
+  std::unique_ptr<Resources> r_;
+};
+
+}  // namespace
+
+int cuda_usable_device_count() {
+  int count = 0;
+  if (cudaGetDeviceCount(&count) != cudaSuccess) {
+    (void)cudaGetLastError();
+    return 0;
+  }
+  return count;
+}
+
+std::unique_ptr<Backend> make_cuda_backend(const WorldConfig& config, int device_ordinal) {
+  return std::make_unique<CudaBackend>(config, device_ordinal);
+}
+
+}  // namespace sph

@@ -1,0 +1,50 @@
+// The CUDA backend's neighbour structure: each particle's wrapped cell hash, a stable radix
+// sort of (hash, index) pairs (CUB), and the dense cell-start table the shared neighbour walk
+// reads. The sort is stable over the current order, so the permutation is the CPU backend's.
+#pragma once
+
+#include <stdint.h>
+
+#include <cuda_runtime.h>
+
+#include "../src/physics/neighbor_walk.h"
+#include "device_array.h"
+#include "device_particle_store.h"
+#include "frame_state.cuh"
+
+namespace sph {
+
+class DeviceNeighborGrid {
+ public:
+  // scratch: the key/value buffers (capacity entries each). spare/spare_bytes: memory that is
+  // free while the sort runs, reused for the sort's temporary storage when large enough.
+  DeviceNeighborGrid(const GridShape& shape, uint32_t capacity, SortScratch scratch, void* spare,
+                     size_t spare_bytes);
+
+  // Hashes positions[0, n) and sorts. Afterwards order() gives, for each sorted place, the
+  // particle's index before the sort. The buffers order() and sorted_keys() point to are
+  // decided here, on the host, and are the same on every call with the same n (so the
+  // launches can be captured in a graph).
+  void enqueue_sort(const Float4* positions, uint32_t n, FrameState* state, cudaStream_t stream);
+  // Fills the dense cell-start table from the sorted keys: every one of cell_count + 1 entries
+  // is written once, without clearing the table first.
+  void enqueue_cell_starts(uint32_t n, FrameState* state, cudaStream_t stream);
+
+  const uint32_t* order() const { return order_; }
+  GridView view() const { return GridView{shape_, cell_start_.get()}; }
+  uint64_t bytes() const { return cell_start_.bytes() + temp_.bytes(); }
+
+ private:
+  GridShape shape_;
+  uint32_t capacity_;
+  int key_bits_;
+  SortScratch scratch_;
+  DeviceArray<uint32_t> cell_start_;
+  DeviceArray<unsigned char> temp_;  // only when the spare memory is too small
+  void* temp_storage_ = nullptr;
+  size_t temp_bytes_ = 0;
+  const uint32_t* sorted_keys_ = nullptr;
+  const uint32_t* order_ = nullptr;
+};
+
+}  // namespace sph

@@ -1,0 +1,77 @@
+#include "device_particle_store.h"
+
+namespace sph {
+
+DeviceParticleStore::DeviceParticleStore(uint32_t capacity, bool rk4) : capacity_(capacity) {
+  const size_t n = capacity;
+  position_.allocate(n, "positions");
+  velocity_.allocate(n, "velocities");
+  id_.allocate(n, "ids");
+  density_.allocate(n, "densities");
+  sorted_position_.allocate(n, "sorted positions");
+  sorted_velocity_.allocate(n, "sorted velocities");
+  sorted_id_.allocate(n, "sorted ids");
+  snapshot_position_.allocate(n, "snapshot positions");
+  snapshot_velocity_.allocate(n, "snapshot velocities");
+  snapshot_id_.allocate(n, "snapshot ids");
+  snapshot_density_.allocate(n, "snapshot densities");
+  if (rk4) {
+    for (int side = 0; side < 2; ++side) {
+      rk4_start_[side].allocate(n, "RK4 start states");
+      rk4_sum_[side].allocate(n, "RK4 slope sums");
+    }
+  }
+  arrays_.position = position_.get();
+  arrays_.velocity = velocity_.get();
+  arrays_.id = id_.get();
+  arrays_.density = density_.get();
+  arrays_.sorted_position = sorted_position_.get();
+  arrays_.sorted_velocity = sorted_velocity_.get();
+  arrays_.sorted_id = sorted_id_.get();
+  for (int side = 0; side < 2; ++side) {
+    arrays_.rk4_start[side] = rk4_start_[side].get();
+    arrays_.rk4_sum[side] = rk4_sum_[side].get();
+  }
+}
+
+SortScratch DeviceParticleStore::sort_scratch() const {
+  static_assert(sizeof(Float4) == 4 * sizeof(uint32_t), "four uint32 arrays fit in one Float4 array");
+  uint32_t* base = reinterpret_cast<uint32_t*>(sorted_velocity_.get());
+  const size_t n = capacity_;
+  return SortScratch{{base, base + n}, {base + 2 * n, base + 3 * n}};
+}
+
+namespace {
+
+template <class T>
+void copy_async(T* dst, const T* src, uint32_t n, cudaStream_t stream, const char* what) {
+  if (n == 0) return;
+  cuda_check(cudaMemcpyAsync(dst, src, sizeof(T) * n, cudaMemcpyDeviceToDevice, stream), what);
+}
+
+}  // namespace
+
+void DeviceParticleStore::enqueue_snapshot(uint32_t n, cudaStream_t stream) const {
+  copy_async(snapshot_position_.get(), position_.get(), n, stream, "snapshot of positions");
+  copy_async(snapshot_velocity_.get(), velocity_.get(), n, stream, "snapshot of velocities");
+  copy_async(snapshot_id_.get(), id_.get(), n, stream, "snapshot of ids");
+  copy_async(snapshot_density_.get(), density_.get(), n, stream, "snapshot of densities");
+}
+
+void DeviceParticleStore::enqueue_restore(uint32_t n, cudaStream_t stream) const {
+  copy_async(position_.get(), snapshot_position_.get(), n, stream, "restore of positions");
+  copy_async(velocity_.get(), snapshot_velocity_.get(), n, stream, "restore of velocities");
+  copy_async(id_.get(), snapshot_id_.get(), n, stream, "restore of ids");
+  copy_async(density_.get(), snapshot_density_.get(), n, stream, "restore of densities");
+}
+
+uint64_t DeviceParticleStore::bytes() const {
+  uint64_t total = position_.bytes() + velocity_.bytes() + id_.bytes() + density_.bytes() +
+                   sorted_position_.bytes() + sorted_velocity_.bytes() + sorted_id_.bytes() +
+                   snapshot_position_.bytes() + snapshot_velocity_.bytes() + snapshot_id_.bytes() +
+                   snapshot_density_.bytes();
+  for (int side = 0; side < 2; ++side) total += rk4_start_[side].bytes() + rk4_sum_[side].bytes();
+  return total;
+}
+
+}  // namespace sph

@@ -1,0 +1,69 @@
+// The device-resident particle state of one world, as a structure of arrays, allocated once
+// for the world's capacity:
+//   position/velocity/id/density  the state in the current order (what callers read)
+//   sorted_*                      the working copy in the order of the last sort; the density
+//                                 pass reads it and the force pass writes the state from it.
+//                                 sorted_velocity doubles as the radix sort's key/value
+//                                 buffers, which are dead before the density pass fills it.
+//   snapshot_*                    the state at the start of a frame, for the rollback
+//   rk4_*                         RK4 worlds only: start state and slope sums, two sides
+// Float4 records carry a second quantity in w: position.w = pressure, velocity.w = 1/density.
+#pragma once
+
+#include <stdint.h>
+
+#include <cuda_runtime.h>
+
+#include "../src/physics/float4_types.h"
+#include "../src/physics/integrate.h"
+#include "device_array.h"
+
+namespace sph {
+
+// Raw pointers, passed by value into kernels.
+struct ParticleArrays {
+  Float4* position;
+  Float4* velocity;
+  uint32_t* id;
+  float* density;
+  Float4* sorted_position;
+  Float4* sorted_velocity;
+  uint32_t* sorted_id;
+  ParticleState* rk4_start[2];  // null unless RK4
+  Rk4Accumulator* rk4_sum[2];
+};
+
+// The radix sort's buffers inside sorted_velocity: four uint32 arrays of `capacity` each.
+struct SortScratch {
+  uint32_t* keys[2];
+  uint32_t* values[2];
+};
+
+class DeviceParticleStore {
+ public:
+  DeviceParticleStore(uint32_t capacity, bool rk4);
+
+  const ParticleArrays& arrays() const { return arrays_; }
+  SortScratch sort_scratch() const;
+  uint32_t capacity() const { return capacity_; }
+
+  // Copies the state of particles [0, n) into the snapshot, and back.
+  void enqueue_snapshot(uint32_t n, cudaStream_t stream) const;
+  void enqueue_restore(uint32_t n, cudaStream_t stream) const;
+
+  uint64_t bytes() const;
+
+ private:
+  uint32_t capacity_;
+  DeviceArray<Float4> position_, velocity_, sorted_position_, sorted_velocity_;
+  DeviceArray<uint32_t> id_, sorted_id_;
+  DeviceArray<float> density_;
+  DeviceArray<Float4> snapshot_position_, snapshot_velocity_;
+  DeviceArray<uint32_t> snapshot_id_;
+  DeviceArray<float> snapshot_density_;
+  DeviceArray<ParticleState> rk4_start_[2];
+  DeviceArray<Rk4Accumulator> rk4_sum_[2];
+  ParticleArrays arrays_{};
+};
+
+}  // namespace sph

@@ -1,0 +1,108 @@
+#include <cfloat>
+
+#include "block_reduce.cuh"
+#include "frame_control.h"
+#include "kernel_launch.h"
+
+namespace sph {
+namespace {
+
+__device__ void pick_next_step(FrameState* s, const StepLimits& limits) {
+  s->dt = landing_dt(static_cast<double>(controller_dt(limits, s->max_speed)), s->remaining);
+  s->dt_float = static_cast<float>(s->dt);
+}
+
+__device__ void set_run(FrameState* s, uint32_t run, const LoopCondition& cond) {
+  s->run = run;
+  if (cond.in_graph) cudaGraphSetConditional(cond.handle, run);
+}
+
+__global__ void begin_frame_kernel(FrameState* s, StepLimits limits, uint32_t max_substeps,
+                                   LoopCondition cond) {
+  s->timing_last_ns = global_timer_ns();
+  s->timing_stage = kStageOther;
+  for (int k = 0; k < kStageCount; ++k) s->stage_ns[k] = 0;
+  s->remaining = s->frame_dt;
+  s->time_advanced = 0.0;
+  s->substeps = 0;
+  s->dt_min = FLT_MAX;
+  s->dt_max = 0.0f;
+  s->non_finite = 0;
+  s->v2max_bits = 0;
+  s->bad_id = 0;
+  s->bad_substep = 0;
+  s->bad_dt = 0.0f;
+  for (int k = 0; k < kRk4Stages; ++k) s->bad_key[k] = kNoBadParticle;
+  s->saved_max_speed = s->max_speed;
+  const uint32_t run = (s->remaining > 0.0 && max_substeps > 0) ? 1u : 0u;
+  if (run) pick_next_step(s, limits);
+  set_run(s, run, cond);
+}
+
+__global__ void end_substep_kernel(FrameState* s, StepLimits limits, uint32_t max_substeps, int stages,
+                                   LoopCondition cond) {
+  mark_stage(s, kStageIntegrate);
+  const float v2max = __uint_as_float(s->v2max_bits);
+  s->v2max_bits = 0;
+  for (int k = 0; k < stages; ++k) {
+    if (s->bad_key[k] != kNoBadParticle) {
+      s->non_finite = 1;
+      s->bad_id = static_cast<uint32_t>(s->bad_key[k] & 0xffffffffu);
+      s->bad_substep = s->substeps + 1;
+      s->bad_dt = s->dt_float;
+      set_run(s, 0, cond);
+      return;
+    }
+  }
+  s->max_speed = sqrtf(v2max);
+  s->remaining -= s->dt;
+  s->substeps += 1;
+  s->time_advanced += s->dt;
+  s->dt_min = fminf(s->dt_min, s->dt_float);
+  s->dt_max = fmaxf(s->dt_max, s->dt_float);
+  const uint32_t run = (s->remaining > 0.0 && s->substeps < max_substeps) ? 1u : 0u;
+  if (run) pick_next_step(s, limits);
+  set_run(s, run, cond);
+}
+
+__global__ void speed_max_kernel(const Float4* __restrict__ velocity, uint32_t n, FrameState* s) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  block_max_to(&s->v2max_bits, i < n ? length_squared(xyz(velocity[i])) : 0.0f);
+}
+
+__global__ void finish_speed_max_kernel(FrameState* s) {
+  s->max_speed = sqrtf(__uint_as_float(s->v2max_bits));
+  s->v2max_bits = 0;
+}
+
+__global__ void restore_max_speed_kernel(FrameState* s) { s->max_speed = s->saved_max_speed; }
+
+}  // namespace
+
+void enqueue_begin_frame(FrameState* state, const StepLimits& limits, uint32_t max_substeps,
+                         LoopCondition cond, cudaStream_t stream) {
+  begin_frame_kernel<<<1, 1, 0, stream>>>(state, limits, max_substeps, cond);
+  check_launch("begin_frame_kernel");
+}
+
+void enqueue_end_substep(FrameState* state, const StepLimits& limits, uint32_t max_substeps, int stages,
+                         LoopCondition cond, cudaStream_t stream) {
+  end_substep_kernel<<<1, 1, 0, stream>>>(state, limits, max_substeps, stages, cond);
+  check_launch("end_substep_kernel");
+}
+
+void enqueue_recompute_max_speed(const Float4* velocity, uint32_t n, FrameState* state, cudaStream_t stream) {
+  cuda_check(cudaMemsetAsync(&state->v2max_bits, 0, sizeof(uint32_t), stream),
+             "reset of the speed reduction");
+  speed_max_kernel<<<blocks_for(n, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(velocity, n, state);
+  check_launch("speed_max_kernel");
+  finish_speed_max_kernel<<<1, 1, 0, stream>>>(state);
+  check_launch("finish_speed_max_kernel");
+}
+
+void enqueue_restore_max_speed(FrameState* state, cudaStream_t stream) {
+  restore_max_speed_kernel<<<1, 1, 0, stream>>>(state);
+  check_launch("restore_max_speed_kernel");
+}
+
+}  // namespace sph

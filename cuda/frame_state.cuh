@@ -1,0 +1,71 @@
+// The frame's bookkeeping, kept on the device so that the substep loop decides its own next
+// step size and its own end without a round trip to the host. One per world.
+#pragma once
+
+#include <stdint.h>
+
+#include "../src/core/frame_report.h"
+#include "../src/physics/step_control.h"
+
+namespace sph {
+
+constexpr int kRk4Stages = 4;
+constexpr unsigned long long kNoBadParticle = ~0ull;
+
+struct FrameState {
+  // Input, written by the host before each frame.
+  double frame_dt;
+
+  // The substep loop (the CPU backend's loop variables, in the same precision).
+  double remaining;       // seconds of the frame still to simulate
+  double time_advanced;   // seconds simulated so far this frame
+  double dt;              // this substep's step
+  float dt_float;         // the same step as the kernels integrate with
+  float max_speed;        // |v|max after the last substep; persists across frames
+  float saved_max_speed;  // max_speed at the start of the frame, for a rollback
+  float dt_min;
+  float dt_max;
+  uint32_t substeps;
+  uint32_t run;         // 1 while the loop goes on
+  uint32_t non_finite;  // 1 once a substep produced NaN/Inf
+  uint32_t v2max_bits;  // max |v|^2 of this substep as float bits (non-negative: uint order)
+  uint32_t bad_id;      // id of the first non-finite particle
+  uint32_t bad_substep;
+  float bad_dt;
+  // Per RK4 stage (symplectic Euler uses [0]): (sorted index << 32 | id), the minimum wins,
+  // which is the particle the CPU backend names.
+  unsigned long long bad_key[kRk4Stages];
+
+  // Statistics of the last density evaluation, computed once at the end of the frame.
+  float density_min;
+  float density_mean;
+  float density_max;
+  float neighbors_mean;
+  uint32_t neighbors_max;
+
+  // Stage timing: the first thread of each stage's first kernel reads the GPU's global
+  // nanosecond timer and charges the time since the previous mark to the previous stage.
+  uint32_t timing_stage;
+  unsigned long long timing_last_ns;
+  unsigned long long stage_ns[kStageCount];
+};
+
+#if defined(__CUDACC__)
+__device__ __forceinline__ unsigned long long global_timer_ns() {
+  unsigned long long t;
+  asm volatile("mov.u64 %0, %%globaltimer;" : "=l"(t));
+  return t;
+}
+
+// Called at the top of a stage's first kernel by every thread; one thread records.
+__device__ __forceinline__ void mark_stage(FrameState* s, int next_stage) {
+  if (blockIdx.x == 0 && threadIdx.x == 0) {
+    const unsigned long long now = global_timer_ns();
+    s->stage_ns[s->timing_stage] += now - s->timing_last_ns;
+    s->timing_last_ns = now;
+    s->timing_stage = static_cast<uint32_t>(next_stage);
+  }
+}
+#endif
+
+}  // namespace sph

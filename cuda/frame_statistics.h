@@ -1,0 +1,39 @@
+// The frame's statistics, computed once at its end on the device: density min/mean/max of the
+// last density evaluation, and the neighbour counts of that evaluation (recounted here over
+// the sorted copy it read, which is still intact, instead of being stored every substep).
+#pragma once
+
+#include <stdint.h>
+
+#include <cuda_runtime.h>
+
+#include "../src/physics/fluid_constants.h"
+#include "../src/physics/neighbor_walk.h"
+#include "device_array.h"
+#include "device_particle_store.h"
+#include "frame_state.cuh"
+
+namespace sph {
+
+struct StatsPartial {
+  double density_sum;
+  unsigned long long neighbor_sum;
+  float density_min;
+  float density_max;
+  uint32_t neighbor_max;
+  uint32_t pad;
+};
+
+class FrameStatistics {
+ public:
+  explicit FrameStatistics(uint32_t capacity);
+  // Writes density_* and neighbors_* of *state for particles [0, n).
+  void enqueue(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a, uint32_t n,
+               FrameState* state, cudaStream_t stream) const;
+  uint64_t bytes() const { return partials_.bytes(); }
+
+ private:
+  DeviceArray<StatsPartial> partials_;
+};
+
+}  // namespace sph

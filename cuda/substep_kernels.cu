@@ -1,0 +1,154 @@
+#include "../src/physics/density.h"
+#include "../src/physics/equation_of_state.h"
+#include "../src/physics/forces.h"
+#include "../src/physics/integrate.h"
+#include "block_reduce.cuh"
+#include "kernel_launch.h"
+#include "substep_kernels.h"
+
+namespace sph {
+namespace {
+
+__device__ __forceinline__ bool finite3(Vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
+
+__device__ __forceinline__ void flag_non_finite(FrameState* s, int stage, uint32_t index, uint32_t id) {
+  atomicMin(&s->bad_key[stage], (static_cast<unsigned long long>(index) << 32) | id);
+}
+
+template <Rk4Carry Carry>
+__global__ void reorder_kernel(ParticleArrays a, const uint32_t* __restrict__ order, uint32_t n, int from,
+                               FrameState* state) {
+  mark_stage(state, kStageHashSort);
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const uint32_t k = order[i];
+  const Float4 p = a.position[k];
+  a.sorted_position[i] = Float4{p.x, p.y, p.z, __uint_as_float(k)};
+  a.sorted_id[i] = a.id[k];
+  if (Carry == Rk4Carry::BuildStart) {
+    a.rk4_start[1][i] = ParticleState{xyz(p), xyz(a.velocity[k])};
+  } else if (Carry == Rk4Carry::Gather) {
+    // Constant indices only: a run-time index into the by-value struct would put it in local memory.
+    if (from == 0) {
+      a.rk4_start[1][i] = a.rk4_start[0][k];
+      a.rk4_sum[1][i] = a.rk4_sum[0][k];
+    } else {
+      a.rk4_start[0][i] = a.rk4_start[1][k];
+      a.rk4_sum[0][i] = a.rk4_sum[1][k];
+    }
+  }
+}
+
+__global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
+                               FrameState* state) {
+  mark_stage(state, kStageDensity);
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  // The reorder left this particle's old index in w; read it before w becomes the pressure.
+  // Other threads read only x, y, z of this record.
+  const uint32_t k = __float_as_uint(a.sorted_position[i].w);
+  const DensitySample s = gather_density(fluid, grid, a.sorted_position, i);
+  a.density[i] = s.density;
+  a.sorted_position[i].w = pressure_from_density(s.density, fluid.rest_density, fluid.stiffness);
+  const Float4 v = a.velocity[k];
+  a.sorted_velocity[i] = make_float4_record(xyz(v), 1.0f / s.density);
+}
+
+__global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
+                                    FrameState* state) {
+  mark_stage(state, kStageForces);
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  float v2 = 0.0f;
+  if (i < n) {
+    const float dt = state->dt_float;
+    const Vec3 acc = gather_acceleration(fluid, grid, a.sorted_position, a.sorted_velocity, i);
+    const Float4 p = a.sorted_position[i];
+    const Float4 v = a.sorted_velocity[i];
+    const ParticleState next = symplectic_euler(ParticleState{xyz(p), xyz(v)}, acc, dt);
+    const uint32_t id = a.sorted_id[i];
+    a.position[i] = make_float4_record(next.position, p.w);
+    a.velocity[i] = make_float4_record(next.velocity, v.w);
+    a.id[i] = id;
+    v2 = length_squared(next.velocity);
+    if (!finite3(next.position) || !isfinite(v2)) {
+      flag_non_finite(state, 0, i, id);
+      v2 = 0.0f;
+    }
+  }
+  block_max_to(&state->v2max_bits, v2);
+}
+
+__global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
+                                  int stage, FrameState* state) {
+  mark_stage(state, kStageForces);
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  float v2 = 0.0f;
+  if (i < n) {
+    // This stage's side, (stage + 1) % 2, picked without a run-time index into the struct.
+    ParticleState* start = (stage & 1) ? a.rk4_start[0] : a.rk4_start[1];
+    Rk4Accumulator* sums = (stage & 1) ? a.rk4_sum[0] : a.rk4_sum[1];
+    const float dt = state->dt_float;
+    const Vec3 acc = gather_acceleration(fluid, grid, a.sorted_position, a.sorted_velocity, i);
+    const Float4 p = a.sorted_position[i];
+    const Float4 v = a.sorted_velocity[i];
+    Rk4Accumulator sum;
+    if (stage > 0) sum = sums[i];  // stage 0 starts the sums
+    const ParticleState next = rk4_advance(stage, start[i], ParticleState{xyz(p), xyz(v)}, acc, dt, sum);
+    sums[i] = sum;
+    const uint32_t id = a.sorted_id[i];
+    a.position[i] = make_float4_record(next.position, p.w);
+    a.velocity[i] = make_float4_record(next.velocity, v.w);
+    a.id[i] = id;
+    v2 = length_squared(next.velocity);
+    if (!finite3(next.position) || !isfinite(v2)) {
+      flag_non_finite(state, stage, i, id);
+      v2 = 0.0f;
+    }
+    if (stage != kRk4Stages - 1) v2 = 0.0f;  // the speed that counts is the final state's
+  }
+  if (stage == kRk4Stages - 1) block_max_to(&state->v2max_bits, v2);
+}
+
+}  // namespace
+
+void enqueue_reorder(const ParticleArrays& a, const uint32_t* order, uint32_t n, Rk4Carry carry, int from,
+                     FrameState* state, cudaStream_t stream) {
+  const unsigned blocks = blocks_for(n, kDefaultBlockSize);
+  switch (carry) {
+    case Rk4Carry::None:
+      reorder_kernel<Rk4Carry::None><<<blocks, kDefaultBlockSize, 0, stream>>>(a, order, n, from, state);
+      break;
+    case Rk4Carry::BuildStart:
+      reorder_kernel<Rk4Carry::BuildStart>
+          <<<blocks, kDefaultBlockSize, 0, stream>>>(a, order, n, from, state);
+      break;
+    case Rk4Carry::Gather:
+      reorder_kernel<Rk4Carry::Gather><<<blocks, kDefaultBlockSize, 0, stream>>>(a, order, n, from, state);
+      break;
+  }
+  check_launch("reorder_kernel");
+}
+
+void enqueue_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a, uint32_t n,
+                     const KernelTuning& tuning, FrameState* state, cudaStream_t stream) {
+  density_kernel<<<blocks_for(n, tuning.density_block), tuning.density_block, 0, stream>>>(fluid, grid, a, n,
+                                                                                           state);
+  check_launch("density_kernel");
+}
+
+void enqueue_forces_euler(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                          uint32_t n, const KernelTuning& tuning, FrameState* state, cudaStream_t stream) {
+  forces_euler_kernel<<<blocks_for(n, tuning.force_block), tuning.force_block, 0, stream>>>(fluid, grid, a, n,
+                                                                                            state);
+  check_launch("forces_euler_kernel");
+}
+
+void enqueue_forces_rk4(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                        uint32_t n, int stage, const KernelTuning& tuning, FrameState* state,
+                        cudaStream_t stream) {
+  forces_rk4_kernel<<<blocks_for(n, tuning.force_block), tuning.force_block, 0, stream>>>(fluid, grid, a, n,
+                                                                                          stage, state);
+  check_launch("forces_rk4_kernel");
+}
+
+}  // namespace sph

@@ -1,0 +1,45 @@
+// The per-particle passes of a substep on the device: reorder into the sorted working copy,
+// density and pressure, then forces with integration. Each kernel is one thread per particle
+// calling the shared physics of src/physics; the host functions here only launch them.
+#pragma once
+
+#include <stdint.h>
+
+#include <cuda_runtime.h>
+
+#include "../src/physics/fluid_constants.h"
+#include "../src/physics/neighbor_walk.h"
+#include "device_particle_store.h"
+#include "frame_state.cuh"
+
+namespace sph {
+
+struct KernelTuning {
+  unsigned density_block = 128;
+  unsigned force_block = 128;
+};
+
+// What the RK4 reorder carries along: nothing (Euler), the start state built from the current
+// state (stage 0), or the start state and slope sums of the previous stage.
+enum class Rk4Carry { None, BuildStart, Gather };
+
+// sorted_position[i] = position[order[i]] (w = order[i] as bits, read back by the density
+// pass), sorted_id likewise; RK4 state from side `from` to side 1 - from.
+void enqueue_reorder(const ParticleArrays& a, const uint32_t* order, uint32_t n, Rk4Carry carry, int from,
+                     FrameState* state, cudaStream_t stream);
+
+// density[i], sorted_position[i].w = pressure, sorted_velocity[i] = (velocity[order[i]], 1/rho).
+void enqueue_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a, uint32_t n,
+                     const KernelTuning& tuning, FrameState* state, cudaStream_t stream);
+
+// Symplectic Euler from the sorted copy into the state, with the max-speed reduction and the
+// non-finite check.
+void enqueue_forces_euler(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                          uint32_t n, const KernelTuning& tuning, FrameState* state, cudaStream_t stream);
+
+// One RK4 stage (0..3); its start state and slope sums are on side (stage + 1) % 2.
+void enqueue_forces_rk4(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                        uint32_t n, int stage, const KernelTuning& tuning, FrameState* state,
+                        cudaStream_t stream);
+
+}  // namespace sph

@@ -1,0 +1,40 @@
+#include "substep_pipeline.h"
+
+namespace sph {
+
+void enqueue_frame_begin(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
+                         cudaStream_t stream) {
+  cuda_check(
+      cudaMemcpyAsync(&b.state->frame_dt, b.frame_dt_input, sizeof(double), cudaMemcpyHostToDevice, stream),
+      "copy of frame_dt");
+  enqueue_begin_frame(b.state, setup.limits, setup.max_substeps, cond, stream);
+  b.store->enqueue_snapshot(setup.count, stream);
+}
+
+void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
+                     cudaStream_t stream) {
+  const ParticleArrays& a = b.store->arrays();
+  const uint32_t n = setup.count;
+  const bool rk4 = setup.integrator == Integrator::Rk4;
+  const int stages = rk4 ? kRk4Stages : 1;
+  for (int stage = 0; stage < stages; ++stage) {
+    b.grid->enqueue_sort(a.position, n, b.state, stream);
+    b.grid->enqueue_cell_starts(n, b.state, stream);
+    const Rk4Carry carry = !rk4 ? Rk4Carry::None : (stage == 0 ? Rk4Carry::BuildStart : Rk4Carry::Gather);
+    enqueue_reorder(a, b.grid->order(), n, carry, stage & 1, b.state, stream);
+    enqueue_density(setup.fluid, b.grid->view(), a, n, setup.tuning, b.state, stream);
+    if (rk4)
+      enqueue_forces_rk4(setup.fluid, b.grid->view(), a, n, stage, setup.tuning, b.state, stream);
+    else
+      enqueue_forces_euler(setup.fluid, b.grid->view(), a, n, setup.tuning, b.state, stream);
+  }
+  enqueue_end_substep(b.state, setup.limits, setup.max_substeps, stages, cond, stream);
+}
+
+void enqueue_frame_end(const PipelineSetup& setup, const PipelineBuffers& b, cudaStream_t stream) {
+  b.statistics->enqueue(setup.fluid, b.grid->view(), b.store->arrays(), setup.count, b.state, stream);
+  cuda_check(cudaMemcpyAsync(b.state_output, b.state, sizeof(FrameState), cudaMemcpyDeviceToHost, stream),
+             "copy of the frame state");
+}
+
+}  // namespace sph

@@ -1,0 +1,46 @@
+// The order of device work in a frame, written once and used two ways: captured into a CUDA
+// graph (frame_graph.h) or launched directly on the stream (the fallback). A frame is
+//   begin:    frame_dt in, counters reset, first step chosen, state snapshot
+//   substep:  (hash, sort, cell starts, reorder, density, forces + integrate) x 1 or 4 stages,
+//             then the end-of-substep kernel (max speed, non-finite check, clock, next step)
+//   end:      statistics, FrameState out to pinned host memory
+#pragma once
+
+#include <stdint.h>
+
+#include <cuda_runtime.h>
+
+#include "../src/core/config.h"
+#include "device_neighbor_grid.h"
+#include "device_particle_store.h"
+#include "frame_control.h"
+#include "frame_statistics.h"
+#include "substep_kernels.h"
+
+namespace sph {
+
+struct PipelineSetup {
+  uint32_t count = 0;  // particles
+  Integrator integrator = Integrator::SymplecticEuler;
+  FluidConstants fluid{};
+  StepLimits limits{};
+  uint32_t max_substeps = 1;
+  KernelTuning tuning{};
+};
+
+struct PipelineBuffers {
+  const DeviceParticleStore* store;
+  DeviceNeighborGrid* grid;
+  const FrameStatistics* statistics;
+  FrameState* state;             // device
+  const double* frame_dt_input;  // pinned host, copied into state->frame_dt
+  FrameState* state_output;      // pinned host, receives the state at the end
+};
+
+void enqueue_frame_begin(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
+                         cudaStream_t stream);
+void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
+                     cudaStream_t stream);
+void enqueue_frame_end(const PipelineSetup& setup, const PipelineBuffers& b, cudaStream_t stream);
+
+}  // namespace sph
