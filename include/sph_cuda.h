@@ -1,0 +1,109 @@
+/*
+ * sph_cuda.h - the zero-copy tier of the sph library for worlds on the CUDA backend.
+ *
+ * Lets a CUDA application read a world's particles where they live (device memory) and order
+ * its own GPU work against the world's, without copies through the host. Optional: nothing
+ * in sph_c.h needs it. C99; CUDA types cross as void* (cudaStream_t, cudaEvent_t) and
+ * uint64_t (device addresses), so this header compiles without the CUDA toolkit.
+ *
+ * Every call here returns SPH_ERROR_UNSUPPORTED for a world on the CPU backend and in a
+ * library built without CUDA. The thread rules of sph_c.h apply: a world is used from one
+ * thread at a time (a concurrent call returns SPH_ERROR_WORLD_LOCKED). A world whose device
+ * reported a sticky error returns SPH_ERROR_DEVICE_LOST from every call.
+ *
+ * Ordering: sph_world_step and the particle calls of sph_c.h return once their device work
+ * is done, so data read after they return is complete. To overlap with the world's work, or
+ * to make the world wait for yours, use sph_cuda_world_record_event and
+ * sph_cuda_world_wait_event with events you create on the world's device.
+ */
+#ifndef SPH_CUDA_H
+#define SPH_CUDA_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sph_c.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/**
+ * Where one attribute of a world lives in device memory. Particle i's element starts at
+ * device_address + i * stride (bytes) for i in [0, count), in the world's current order (the
+ * order sph_world_copy_attribute uses; SPH_ATTRIBUTE_ID gives each particle's id).
+ *   POSITION, VELOCITY: 3 x float32 (element_size 12) inside 16-byte records (stride 16);
+ *                       the fourth float of the record is internal and may change.
+ *   PRESSURE:           float32 (element_size 4), stride 16.
+ *   DENSITY:            float32, stride 4.       ID: uint32, stride 4.
+ * The address and layout stay valid for the world's life. The contents are those of data
+ * epoch `epoch`: every call that changes particles (spawn, fill, step, also a step that
+ * failed and rolled back) increments the world's epoch and rewrites them in place; compare
+ * with sph_cuda_world_get_epoch. The memory is the world's: read it, never write or free it.
+ */
+typedef struct sph_cuda_attribute_view {
+  uint32_t struct_size;    /* sizeof(sph_cuda_attribute_view), set by the init function */
+  sph_attribute attribute; /* the attribute described (written by the call) */
+  uint64_t device_address; /* CUdeviceptr / void* on the device of device_ordinal */
+  uint64_t stride;         /* bytes between consecutive particles */
+  uint32_t element_size;   /* bytes of one element: 12 or 4 */
+  uint32_t count;          /* particles in the world at this epoch */
+  uint64_t epoch;          /* the world's data epoch when the view was taken */
+  int32_t device_ordinal;  /* the CUDA device that holds the memory */
+  uint32_t reserved0;      /* 0 */
+} sph_cuda_attribute_view;
+SPH_STATIC_ASSERT(sizeof(sph_cuda_attribute_view) == 48, sph_cuda_attribute_view_size);
+
+/** Zeroes *view and sets struct_size (size = sizeof(*view)). Prefer sph_cuda_attribute_view_init. */
+SPH_API sph_result SPH_CALL sph_cuda_attribute_view_init_sized(sph_cuda_attribute_view* view, uint32_t size);
+static inline sph_result sph_cuda_attribute_view_init(sph_cuda_attribute_view* view) {
+  return sph_cuda_attribute_view_init_sized(view, (uint32_t)sizeof(*view));
+}
+
+/**
+ * Describes where `attribute` lives (see sph_cuda_attribute_view). out->struct_size must be
+ * set (sph_cuda_attribute_view_init); only that many bytes are written. Non-blocking.
+ * Errors: INVALID_HANDLE, INVALID_ARGUMENT (out NULL), VERSION_MISMATCH (struct_size too
+ * small), UNSUPPORTED (unknown attribute, CPU world, no CUDA build), DEVICE_LOST, WORLD_LOCKED.
+ */
+SPH_API sph_result SPH_CALL sph_cuda_world_get_attribute(const sph_world* world, sph_attribute attribute,
+                                                         sph_cuda_attribute_view* out);
+
+/**
+ * The world's data epoch: starts at 1 and increments on every call that changes particles.
+ * A view whose epoch equals it describes the current contents. Non-blocking.
+ * Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL), UNSUPPORTED, DEVICE_LOST, WORLD_LOCKED.
+ */
+SPH_API sph_result SPH_CALL sph_cuda_world_get_epoch(const sph_world* world, uint64_t* out_epoch);
+
+/** The CUDA device the world runs on. Errors: as sph_cuda_world_get_epoch. */
+SPH_API sph_result SPH_CALL sph_cuda_world_get_device(const sph_world* world, int32_t* out_device_ordinal);
+
+/**
+ * The world's own stream (a cudaStream_t, non-blocking with respect to the legacy default
+ * stream), on which all its device work runs. It is owned by the world and destroyed with
+ * it: enqueue work on it (it then runs before the world's next work), never destroy it.
+ * Errors: as sph_cuda_world_get_epoch.
+ */
+SPH_API sph_result SPH_CALL sph_cuda_world_get_stream(const sph_world* world, void** out_stream);
+
+/**
+ * Records `event` (a cudaEvent_t the caller created on the world's device and still owns)
+ * on the world's stream: it completes when all the world's device work enqueued so far has.
+ * Non-blocking. Errors: INVALID_HANDLE, INVALID_ARGUMENT (event NULL), UNSUPPORTED,
+ * DEVICE (CUDA refused the event, e.g. one from another device), DEVICE_LOST, WORLD_LOCKED.
+ */
+SPH_API sph_result SPH_CALL sph_cuda_world_record_event(sph_world* world, void* event);
+
+/**
+ * Makes the world's later device work wait for `event` (a cudaEvent_t the caller recorded on
+ * its own stream): e.g. a kernel of the caller that must finish before the next step.
+ * Non-blocking. Errors: as sph_cuda_world_record_event.
+ */
+SPH_API sph_result SPH_CALL sph_cuda_world_wait_event(sph_world* world, void* event);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SPH_CUDA_H */
