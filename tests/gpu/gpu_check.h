@@ -1,0 +1,232 @@
+// Shared helpers of the GPU check programs (run by scripts/gpu-test on a machine with an
+// NVIDIA GPU; never by ctest, so CI without a GPU does not see them). Each program prints one
+// "PASS <name>: <detail>" or "FAIL <name>: <detail>" line per check and exits non-zero if any
+// check failed, 77 if no CUDA device is present.
+#pragma once
+
+#include <stdint.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "sph_c.h"
+
+namespace gpu_check {
+
+inline int& failures() {
+  static int count = 0;
+  return count;
+}
+
+inline void report(bool ok, const char* name, const char* format, ...) {
+  char detail[512];
+  va_list args;
+  va_start(args, format);
+  std::vsnprintf(detail, sizeof detail, format, args);
+  va_end(args);
+  std::printf("%s %s: %s\n", ok ? "PASS" : "FAIL", name, detail);
+  std::fflush(stdout);
+  if (!ok) ++failures();
+}
+
+inline int finish() { return failures() == 0 ? 0 : 1; }
+
+// Stops the program with a FAIL line when an sph call does not return what it must.
+inline void require(sph_result r, sph_result expected, const char* what) {
+  if (r != expected) {
+    std::printf("FAIL %s: returned %d (%s), expected %d; last error: %s\n", what, static_cast<int>(r),
+                sph_result_string(r), static_cast<int>(expected), sph_get_last_error());
+    std::exit(1);
+  }
+}
+inline void require_ok(sph_result r, const char* what) {
+  if (r < 0) require(r, SPH_OK, what);
+}
+
+inline void exit_if_no_cuda() {
+  sph_context_def def;
+  sph_context_def_init(&def);
+  def.backend = SPH_BACKEND_CUDA;
+  sph_context* context = nullptr;
+  const sph_result r = sph_context_create(&def, &context);
+  if (r == SPH_ERROR_UNSUPPORTED) {
+    std::printf("SKIP: no CUDA device or no CUDA build (%s)\n", sph_get_last_error());
+    std::exit(77);
+  }
+  require_ok(r, "sph_context_create(CUDA)");
+  sph_context_destroy(context);
+}
+
+inline sph_context* make_context(sph_backend backend) {
+  sph_context_def def;
+  sph_context_def_init(&def);
+  def.backend = backend;
+  sph_context* context = nullptr;
+  require_ok(sph_context_create(&def, &context), "sph_context_create");
+  return context;
+}
+
+// A small deterministic generator (xorshift64*), so every run builds the same scene.
+struct Random {
+  uint64_t state;
+  explicit Random(uint64_t seed) : state(seed * 0x9E3779B97F4A7C15ull + 1) {}
+  double uniform() {  // [0, 1)
+    state ^= state >> 12;
+    state ^= state << 25;
+    state ^= state >> 27;
+    return static_cast<double>((state * 0x2545F4914F6CDD1Dull) >> 11) * (1.0 / 9007199254740992.0);
+  }
+};
+
+// FCC lattice points in a sphere (the lattice of sph_world_fill_sphere: a cubic grid of step
+// spacing/sqrt(2) with an even index sum).
+inline std::vector<float> fcc_sphere(float cx, float cy, float cz, float radius, float spacing) {
+  std::vector<float> p;
+  const double step = spacing / std::sqrt(2.0);
+  const int n = static_cast<int>(std::floor(radius / step));
+  for (int k = -n; k <= n; ++k)
+    for (int j = -n; j <= n; ++j)
+      for (int i = -n; i <= n; ++i) {
+        if (((i + j + k) % 2 + 2) % 2 != 0) continue;
+        const double x = step * i, y = step * j, z = step * k;
+        if (x * x + y * y + z * z > static_cast<double>(radius) * radius) continue;
+        p.push_back(static_cast<float>(cx + x));
+        p.push_back(static_cast<float>(cy + y));
+        p.push_back(static_cast<float>(cz + z));
+      }
+  return p;
+}
+
+struct SceneSpec {
+  const char* name = "scene";
+  sph_integrator integrator = SPH_INTEGRATOR_SYMPLECTIC_EULER;
+  float radius = 0.3f;  // sphere of particles at the origin
+  float spacing = 0.02f;
+  float random_speed = 0.0f;         // each velocity component uniform in [-s, s]
+  sph_vec3 drift{0.0f, 0.0f, 0.0f};  // added to every velocity
+  sph_vec3 gravity{0.0f, 0.0f, 0.0f};
+  float step_factor = 0.4f;
+  float dt_max = 1e-3f;
+  uint32_t spare_capacity = 0;
+};
+
+struct Loaded {
+  sph_context* context = nullptr;
+  sph_world* world = nullptr;
+  uint32_t count = 0;
+  void destroy() {
+    sph_world_destroy(world);
+    sph_context_destroy(context);
+    world = nullptr;
+    context = nullptr;
+  }
+};
+
+inline Loaded load_scene(sph_backend backend, const SceneSpec& s) {
+  Loaded l;
+  l.context = make_context(backend);
+  const std::vector<float> pos = fcc_sphere(0.0f, 0.0f, 0.0f, s.radius, s.spacing);
+  l.count = static_cast<uint32_t>(pos.size() / 3);
+  std::vector<float> vel(pos.size());
+  Random random(12345);
+  for (size_t i = 0; i < vel.size(); i += 3) {
+    const float d[3] = {s.drift.x, s.drift.y, s.drift.z};
+    for (int a = 0; a < 3; ++a)
+      vel[i + a] = d[a] + static_cast<float>((2.0 * random.uniform() - 1.0) * s.random_speed);
+  }
+  sph_world_def def;
+  sph_world_def_init(&def);
+  def.capacity = l.count + s.spare_capacity;
+  def.particle_spacing = s.spacing;
+  def.integrator = s.integrator;
+  require_ok(sph_world_create(l.context, &def, &l.world), "sph_world_create");
+  sph_world_params params;
+  sph_world_params_init(&params);
+  params.gravity = s.gravity;
+  params.step_factor = s.step_factor;
+  params.dt_max = s.dt_max;
+  require_ok(sph_world_set_params(l.world, &params), "sph_world_set_params");
+  sph_spawn_desc spawn;
+  sph_spawn_desc_init(&spawn);
+  spawn.count = l.count;
+  spawn.positions = pos.data();
+  spawn.velocities = vel.data();
+  require_ok(sph_world_spawn(l.world, &spawn, nullptr), "sph_world_spawn");
+  return l;
+}
+
+// Every attribute of a world, indexed by particle id.
+struct State {
+  std::vector<float> position, velocity, density, pressure;
+  std::vector<uint32_t> id;
+  uint32_t count = 0;
+};
+
+inline State read_state(const sph_world* world) {
+  uint32_t n = 0;
+  require_ok(sph_world_get_particle_count(world, &n), "sph_world_get_particle_count");
+  State raw;
+  raw.count = n;
+  raw.position.resize(3 * static_cast<size_t>(n));
+  raw.velocity.resize(3 * static_cast<size_t>(n));
+  raw.density.resize(n);
+  raw.pressure.resize(n);
+  raw.id.resize(n);
+  const uint64_t v = 12ull * n, s = 4ull * n;
+  require_ok(
+      sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, raw.position.data(), v, 0, 0, n, nullptr),
+      "copy positions");
+  require_ok(
+      sph_world_copy_attribute(world, SPH_ATTRIBUTE_VELOCITY, raw.velocity.data(), v, 0, 0, n, nullptr),
+      "copy velocities");
+  require_ok(sph_world_copy_attribute(world, SPH_ATTRIBUTE_DENSITY, raw.density.data(), s, 0, 0, n, nullptr),
+             "copy densities");
+  require_ok(
+      sph_world_copy_attribute(world, SPH_ATTRIBUTE_PRESSURE, raw.pressure.data(), s, 0, 0, n, nullptr),
+      "copy pressures");
+  require_ok(sph_world_copy_attribute(world, SPH_ATTRIBUTE_ID, raw.id.data(), s, 0, 0, n, nullptr),
+             "copy ids");
+  // Reorder by id (ids are 0..n-1 in these scenes).
+  State by_id = raw;
+  for (uint32_t i = 0; i < n; ++i) {
+    const uint32_t k = raw.id[i];
+    if (k >= n) {
+      std::printf("FAIL read_state: id %u out of range\n", k);
+      std::exit(1);
+    }
+    by_id.id[k] = k;
+    by_id.density[k] = raw.density[i];
+    by_id.pressure[k] = raw.pressure[i];
+    for (int a = 0; a < 3; ++a) {
+      by_id.position[3 * k + a] = raw.position[3 * i + a];
+      by_id.velocity[3 * k + a] = raw.velocity[3 * i + a];
+    }
+  }
+  return by_id;
+}
+
+template <class T>
+bool bitwise_equal(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+inline bool states_identical(const State& a, const State& b) {
+  return a.count == b.count && bitwise_equal(a.position, b.position) &&
+         bitwise_equal(a.velocity, b.velocity) && bitwise_equal(a.density, b.density) &&
+         bitwise_equal(a.pressure, b.pressure) && bitwise_equal(a.id, b.id);
+}
+
+inline sph_stats get_stats(const sph_world* world) {
+  sph_stats s;
+  sph_stats_init(&s);
+  require_ok(sph_world_get_stats(world, &s), "sph_world_get_stats");
+  return s;
+}
+
+}  // namespace gpu_check
