@@ -1,0 +1,334 @@
+/*
+ * rest_sphere - BENCHMARK.md case 1, the thesis benchmark: particles on an FCC lattice in a
+ * sphere at rest density, no gravity, no colliders, dt_max = 1 ms (40 substeps in a 25 fps
+ * frame at rest), library defaults otherwise. Case "rest" starts at zero velocity, case
+ * "moving" with every velocity component uniform in [-0.1, 0.1] m/s. Uses only the public C
+ * API (sph_c.h).
+ *
+ *   rest_sphere [--particles N] [--frames F] [--warmup W] [--backend cpu|cuda|auto]
+ *               [--case rest|moving|both] [--json FILE] [--csv FILE] [--label TEXT]
+ *
+ * Prints a table per case; --json writes the results as a JSON array, --csv appends rows
+ * (with a header when the file is new). Times are the wall time of sph_world_step (which
+ * blocks until the frame is done), median over the timed frames after the warm-up; the stage
+ * breakdown is the library's own per-stage timing (sph_stats.stage_ms).
+ */
+#define _POSIX_C_SOURCE 199309L /* clock_gettime */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "sph_c.h"
+
+#define FRAME_DT 0.04f /* 25 frames per second */
+
+typedef struct options {
+  uint32_t particles;
+  int frames;
+  int warmup;
+  sph_backend backend;
+  const char* which; /* rest | moving | both */
+  const char* json;
+  const char* csv;
+  const char* label;
+} options;
+
+typedef struct result {
+  const char* scene;
+  const char* backend;
+  uint32_t count;
+  uint32_t substeps_per_frame;
+  double ms_per_frame;   /* median */
+  double ms_per_substep; /* median of step_ms / substeps */
+  double particle_substeps_per_s;
+  double neighbors_mean;
+  uint32_t neighbors_max;
+  double bytes_per_particle;
+  double stage_ms_per_substep[SPH_STAGE_COUNT]; /* mean over the timed frames */
+  double density_error_mean;                    /* (mean density - rho0) / rho0 at the end */
+  double density_min, density_max;
+  double max_speed;
+  double setup_s;
+} result;
+
+static const char* const stage_names[SPH_STAGE_COUNT] = {"hash_sort", "cell_ranges", "density", "forces",
+                                                         "integrate", "collide",     "emit",    "other"};
+
+static void check(sph_result r, const char* what) {
+  if (r < 0) {
+    fprintf(stderr, "rest_sphere: %s failed: %s (%s)\n", what, sph_result_string(r), sph_get_last_error());
+    exit(1);
+  }
+}
+
+static int compare_double(const void* a, const void* b) {
+  const double x = *(const double*)a, y = *(const double*)b;
+  return x < y ? -1 : (x > y ? 1 : 0);
+}
+
+static double median(double* v, int n) {
+  qsort(v, (size_t)n, sizeof *v, compare_double);
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* xorshift64*: the same velocities on every run and platform. */
+static double uniform01(uint64_t* s) {
+  *s ^= *s >> 12;
+  *s ^= *s << 25;
+  *s ^= *s >> 27;
+  return (double)((*s * 0x2545F4914F6CDD1Dull) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* FCC points in a sphere: the cubic grid of step spacing/sqrt(2) with an even index sum. */
+static float* fcc_sphere(double radius, double spacing, uint32_t* out_count) {
+  const double step = spacing / sqrt(2.0);
+  const int64_t n = (int64_t)floor(radius / step);
+  const double estimate =
+      4.0 / 3.0 * 3.14159265358979 * radius * radius * radius * sqrt(2.0) / (spacing * spacing * spacing);
+  size_t cap = (size_t)(estimate * 1.1) + 64, count = 0;
+  float* p = malloc(cap * 3 * sizeof(float));
+  if (!p) return NULL;
+  for (int64_t k = -n; k <= n; ++k)
+    for (int64_t j = -n; j <= n; ++j)
+      for (int64_t i = -n; i <= n; ++i) {
+        if ((((i + j + k) % 2) + 2) % 2 != 0) continue;
+        const double x = step * (double)i, y = step * (double)j, z = step * (double)k;
+        if (x * x + y * y + z * z > radius * radius) continue;
+        if (count == cap) {
+          cap *= 2;
+          float* q = realloc(p, cap * 3 * sizeof(float));
+          if (!q) {
+            free(p);
+            return NULL;
+          }
+          p = q;
+        }
+        p[3 * count] = (float)x;
+        p[3 * count + 1] = (float)y;
+        p[3 * count + 2] = (float)z;
+        ++count;
+      }
+  *out_count = (uint32_t)count;
+  return p;
+}
+
+static double now_s(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static result run_case(const options* o, int moving) {
+  result r;
+  memset(&r, 0, sizeof r);
+  r.scene = moving ? "moving" : "rest";
+  const double t0 = now_s();
+  const float spacing = 0.02f;
+  const double radius = spacing * cbrt(3.0 * o->particles / (4.0 * 3.14159265358979 * sqrt(2.0)));
+  uint32_t count = 0;
+  float* positions = fcc_sphere(radius, spacing, &count);
+  float* velocities = calloc((size_t)count * 3, sizeof(float));
+  if (!positions || !velocities) {
+    fprintf(stderr, "rest_sphere: out of host memory\n");
+    exit(1);
+  }
+  if (moving) {
+    uint64_t seed = 0x5eed5eed12345ull;
+    for (size_t i = 0; i < (size_t)count * 3; ++i)
+      velocities[i] = (float)((2.0 * uniform01(&seed) - 1.0) * 0.1);
+  }
+
+  sph_context_def cdef;
+  sph_context_def_init(&cdef);
+  cdef.backend = o->backend;
+  sph_context* context = NULL;
+  check(sph_context_create(&cdef, &context), "sph_context_create");
+  sph_backend resolved;
+  check(sph_context_get_backend(context, &resolved), "sph_context_get_backend");
+  r.backend = resolved == SPH_BACKEND_CUDA ? "cuda" : "cpu";
+
+  sph_world_def def;
+  sph_world_def_init(&def);
+  def.capacity = count;
+  def.particle_spacing = spacing;
+  sph_world* world = NULL;
+  check(sph_world_create(context, &def, &world), "sph_world_create");
+  sph_world_params params;
+  sph_world_params_init(&params);
+  params.gravity.x = params.gravity.y = params.gravity.z = 0.0f;
+  params.dt_max = 1e-3f;
+  check(sph_world_set_params(world, &params), "sph_world_set_params");
+  sph_spawn_desc spawn;
+  sph_spawn_desc_init(&spawn);
+  spawn.count = count;
+  spawn.positions = positions;
+  spawn.velocities = velocities;
+  check(sph_world_spawn(world, &spawn, NULL), "sph_world_spawn");
+  free(positions);
+  free(velocities);
+  r.count = count;
+  r.setup_s = now_s() - t0;
+
+  for (int f = 0; f < o->warmup; ++f) check(sph_world_step(world, FRAME_DT), "sph_world_step (warm-up)");
+  double* frame_ms = malloc(sizeof(double) * (size_t)o->frames);
+  double* substep_ms = malloc(sizeof(double) * (size_t)o->frames);
+  double stage_sum[SPH_STAGE_COUNT] = {0};
+  uint64_t substeps_total = 0;
+  sph_stats s;
+  sph_stats_init(&s);
+  for (int f = 0; f < o->frames; ++f) {
+    check(sph_world_step(world, FRAME_DT), "sph_world_step");
+    check(sph_world_get_stats(world, &s), "sph_world_get_stats");
+    frame_ms[f] = s.step_ms;
+    substep_ms[f] = s.substeps ? s.step_ms / s.substeps : 0.0;
+    substeps_total += s.substeps;
+    for (int k = 0; k < SPH_STAGE_COUNT; ++k) stage_sum[k] += s.stage_ms[k];
+  }
+  r.substeps_per_frame = s.substeps;
+  r.ms_per_frame = median(frame_ms, o->frames);
+  r.ms_per_substep = median(substep_ms, o->frames);
+  r.particle_substeps_per_s = r.ms_per_substep > 0 ? count / (r.ms_per_substep * 1e-3) : 0.0;
+  r.neighbors_mean = s.neighbors_mean;
+  r.neighbors_max = s.neighbors_max;
+  r.bytes_per_particle = (double)s.memory_bytes / count;
+  for (int k = 0; k < SPH_STAGE_COUNT; ++k)
+    r.stage_ms_per_substep[k] = substeps_total ? stage_sum[k] / (double)substeps_total : 0.0;
+  r.density_error_mean = (s.density_mean - def.rest_density) / def.rest_density;
+  r.density_min = s.density_min;
+  r.density_max = s.density_max;
+  r.max_speed = s.max_speed;
+  free(frame_ms);
+  free(substep_ms);
+  check(sph_world_destroy(world), "sph_world_destroy");
+  check(sph_context_destroy(context), "sph_context_destroy");
+  return r;
+}
+
+static void print_result(const result* r, const options* o) {
+  double total = 0.0;
+  for (int k = 0; k < SPH_STAGE_COUNT; ++k) total += r->stage_ms_per_substep[k];
+  printf("\n%s sphere, %s backend, %u particles, %d frames of %.0f ms after %d warm-up%s\n", r->scene,
+         r->backend, r->count, o->frames, FRAME_DT * 1e3, o->warmup, o->label ? "" : "");
+  printf("  %-28s %12.4f\n", "s/frame (median)", r->ms_per_frame * 1e-3);
+  printf("  %-28s %12u\n", "substeps/frame", r->substeps_per_frame);
+  printf("  %-28s %12.4f\n", "ms/substep (median)", r->ms_per_substep);
+  printf("  %-28s %12.4g\n", "particle-substeps/s", r->particle_substeps_per_s);
+  printf("  %-28s %12.2f (max %u)\n", "neighbours/particle", r->neighbors_mean, r->neighbors_max);
+  printf("  %-28s %12.1f\n", "bytes/particle", r->bytes_per_particle);
+  printf("  %-28s %12.3g (min %.2f, max %.2f kg/m^3)\n", "end mean density error", r->density_error_mean,
+         r->density_min, r->density_max);
+  printf("  %-28s %12.4g m/s\n", "end max speed", r->max_speed);
+  printf("  stage breakdown (ms per substep, share):\n");
+  for (int k = 0; k < SPH_STAGE_COUNT; ++k)
+    printf("    %-14s %10.4f  %5.1f%%\n", stage_names[k], r->stage_ms_per_substep[k],
+           total > 0 ? 100.0 * r->stage_ms_per_substep[k] / total : 0.0);
+  fflush(stdout);
+}
+
+static void write_json(const char* path, const result* rs, int n, const options* o) {
+  FILE* f = fopen(path, "w");
+  if (!f) {
+    fprintf(stderr, "rest_sphere: cannot write %s\n", path);
+    exit(1);
+  }
+  fprintf(f, "[\n");
+  for (int i = 0; i < n; ++i) {
+    const result* r = &rs[i];
+    fprintf(
+        f,
+        "  {\"benchmark\": \"rest_sphere\", \"label\": \"%s\", \"scene\": \"%s\", \"backend\": \"%s\", "
+        "\"particles\": %u, \"frames\": %d, \"warmup\": %d, \"frame_dt\": %.3f, \"substeps_per_frame\": %u, "
+        "\"s_per_frame\": %.6g, \"ms_per_substep\": %.6g, \"particle_substeps_per_s\": %.6g, "
+        "\"neighbors_mean\": %.4f, \"neighbors_max\": %u, \"bytes_per_particle\": %.2f, "
+        "\"density_error_mean\": %.6g, \"density_min\": %.3f, \"density_max\": %.3f, \"max_speed\": %.6g, "
+        "\"stage_ms_per_substep\": {",
+        o->label ? o->label : "", r->scene, r->backend, r->count, o->frames, o->warmup, FRAME_DT,
+        r->substeps_per_frame, r->ms_per_frame * 1e-3, r->ms_per_substep, r->particle_substeps_per_s,
+        r->neighbors_mean, r->neighbors_max, r->bytes_per_particle, r->density_error_mean, r->density_min,
+        r->density_max, r->max_speed);
+    for (int k = 0; k < SPH_STAGE_COUNT; ++k)
+      fprintf(f, "\"%s\": %.6g%s", stage_names[k], r->stage_ms_per_substep[k],
+              k + 1 < SPH_STAGE_COUNT ? ", " : "");
+    fprintf(f, "}}%s\n", i + 1 < n ? "," : "");
+  }
+  fprintf(f, "]\n");
+  fclose(f);
+}
+
+static void append_csv(const char* path, const result* rs, int n, const options* o) {
+  FILE* probe = fopen(path, "r");
+  const int exists = probe != NULL;
+  if (probe) fclose(probe);
+  FILE* f = fopen(path, "a");
+  if (!f) {
+    fprintf(stderr, "rest_sphere: cannot write %s\n", path);
+    exit(1);
+  }
+  if (!exists) {
+    fprintf(f,
+            "label,scene,backend,particles,frames,substeps_per_frame,s_per_frame,ms_per_substep,"
+            "particle_substeps_per_s,neighbors_mean,bytes_per_particle,density_error_mean,max_speed");
+    for (int k = 0; k < SPH_STAGE_COUNT; ++k) fprintf(f, ",ms_%s", stage_names[k]);
+    fprintf(f, "\n");
+  }
+  for (int i = 0; i < n; ++i) {
+    const result* r = &rs[i];
+    fprintf(f, "%s,%s,%s,%u,%d,%u,%.6g,%.6g,%.6g,%.4f,%.2f,%.6g,%.6g", o->label ? o->label : "", r->scene,
+            r->backend, r->count, o->frames, r->substeps_per_frame, r->ms_per_frame * 1e-3, r->ms_per_substep,
+            r->particle_substeps_per_s, r->neighbors_mean, r->bytes_per_particle, r->density_error_mean,
+            r->max_speed);
+    for (int k = 0; k < SPH_STAGE_COUNT; ++k) fprintf(f, ",%.6g", r->stage_ms_per_substep[k]);
+    fprintf(f, "\n");
+  }
+  fclose(f);
+}
+
+static void usage(void) {
+  fprintf(stderr,
+          "usage: rest_sphere [--particles N] [--frames F] [--warmup W] [--backend cpu|cuda|auto]\n"
+          "                   [--case rest|moving|both] [--json FILE] [--csv FILE] [--label TEXT]\n");
+  exit(2);
+}
+
+int main(int argc, char** argv) {
+  options o = {100000, 100, 3, SPH_BACKEND_AUTO, "both", NULL, NULL, NULL};
+  for (int i = 1; i < argc; ++i) {
+    const char* a = argv[i];
+    const char* v = i + 1 < argc ? argv[i + 1] : NULL;
+    if (!v) usage();
+    if (strcmp(a, "--particles") == 0) {
+      o.particles = (uint32_t)strtoul(v, NULL, 10);
+    } else if (strcmp(a, "--frames") == 0) {
+      o.frames = atoi(v);
+    } else if (strcmp(a, "--warmup") == 0) {
+      o.warmup = atoi(v);
+    } else if (strcmp(a, "--backend") == 0) {
+      o.backend = strcmp(v, "cpu") == 0    ? SPH_BACKEND_CPU
+                  : strcmp(v, "cuda") == 0 ? SPH_BACKEND_CUDA
+                                           : SPH_BACKEND_AUTO;
+    } else if (strcmp(a, "--case") == 0) {
+      o.which = v;
+    } else if (strcmp(a, "--json") == 0) {
+      o.json = v;
+    } else if (strcmp(a, "--csv") == 0) {
+      o.csv = v;
+    } else if (strcmp(a, "--label") == 0) {
+      o.label = v;
+    } else {
+      usage();
+    }
+    ++i;
+  }
+  if (o.particles < 100 || o.frames < 1 || o.warmup < 0) usage();
+  result results[2];
+  int n = 0;
+  if (strcmp(o.which, "moving") != 0) results[n++] = run_case(&o, 0);
+  if (strcmp(o.which, "rest") != 0) results[n++] = run_case(&o, 1);
+  for (int i = 0; i < n; ++i) print_result(&results[i], &o);
+  if (o.json) write_json(o.json, results, n, &o);
+  if (o.csv) append_csv(o.csv, results, n, &o);
+  return 0;
+}
