@@ -1,0 +1,194 @@
+/* Version queries, result strings, the thread-local last error and the log callback. */
+#include <pthread.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "capi_test.h"
+
+static void test_version(void** state) {
+  (void)state;
+  assert_int_equal(sph_get_version(), SPH_VERSION);
+  assert_int_equal(sph_get_abi_version(), SPH_ABI_VERSION);
+  /* The packing the header documents: (major << 22) | (minor << 12) | patch. */
+  assert_int_equal(SPH_VERSION >> 22, SPH_VERSION_MAJOR);
+  assert_int_equal((SPH_VERSION >> 12) & 0x3ffu, SPH_VERSION_MINOR);
+  assert_int_equal(SPH_VERSION & 0xfffu, SPH_VERSION_PATCH);
+  assert_int_equal(SPH_ABI_VERSION, SPH_VERSION_MAJOR);
+}
+
+static void test_build_info(void** state) {
+  char version[32];
+  const char* info = sph_get_build_info();
+  (void)state;
+  assert_non_null(info);
+  assert_true(strlen(info) > 0);
+  snprintf(version, sizeof version, "%d.%d.%d", SPH_VERSION_MAJOR, SPH_VERSION_MINOR, SPH_VERSION_PATCH);
+  assert_non_null(strstr(info, version));
+  assert_non_null(strstr(info, "cpu"));         /* the CPU backend is always built */
+  assert_ptr_equal(sph_get_build_info(), info); /* static */
+}
+
+static void test_result_strings(void** state) {
+  static const struct {
+    sph_result code;
+    const char* name;
+  } codes[] = {
+      {SPH_INCOMPLETE, "SPH_INCOMPLETE"},
+      {SPH_OK, "SPH_OK"},
+      {SPH_ERROR_INVALID_ARGUMENT, "SPH_ERROR_INVALID_ARGUMENT"},
+      {SPH_ERROR_INVALID_HANDLE, "SPH_ERROR_INVALID_HANDLE"},
+      {SPH_ERROR_VERSION_MISMATCH, "SPH_ERROR_VERSION_MISMATCH"},
+      {SPH_ERROR_UNSUPPORTED, "SPH_ERROR_UNSUPPORTED"},
+      {SPH_ERROR_FEATURE_DISABLED, "SPH_ERROR_FEATURE_DISABLED"},
+      {SPH_ERROR_CAPACITY, "SPH_ERROR_CAPACITY"},
+      {SPH_ERROR_OUT_OF_HOST_MEMORY, "SPH_ERROR_OUT_OF_HOST_MEMORY"},
+      {SPH_ERROR_OUT_OF_DEVICE_MEMORY, "SPH_ERROR_OUT_OF_DEVICE_MEMORY"},
+      {SPH_ERROR_WORLD_LOCKED, "SPH_ERROR_WORLD_LOCKED"},
+      {SPH_ERROR_BUSY, "SPH_ERROR_BUSY"},
+      {SPH_ERROR_DEVICE, "SPH_ERROR_DEVICE"},
+      {SPH_ERROR_DEVICE_LOST, "SPH_ERROR_DEVICE_LOST"},
+      {SPH_ERROR_INTERNAL, "SPH_ERROR_INTERNAL"},
+      {SPH_ERROR_BUFFER_TOO_SMALL, "SPH_ERROR_BUFFER_TOO_SMALL"},
+      {SPH_ERROR_NON_FINITE, "SPH_ERROR_NON_FINITE"},
+  };
+  const size_t n = sizeof codes / sizeof codes[0];
+  const sph_result unknown[] = {(sph_result)2, (sph_result)-16, (sph_result)-1000, SPH_RESULT_FORCE32};
+  (void)state;
+  for (size_t i = 0; i < n; ++i) {
+    const char* s = sph_result_string(codes[i].code);
+    assert_non_null(s);
+    /* Starts with the code's own name, followed by ':' (so "SPH_OK" is not "SPH_OK_X"). */
+    assert_int_equal(strncmp(s, codes[i].name, strlen(codes[i].name)), 0);
+    assert_int_equal(s[strlen(codes[i].name)], ':');
+    for (size_t j = 0; j < i; ++j) assert_string_not_equal(s, sph_result_string(codes[j].code));
+  }
+  for (size_t u = 0; u < sizeof unknown / sizeof unknown[0]; ++u) {
+    const char* s = sph_result_string(unknown[u]);
+    assert_non_null(s);
+    assert_true(strlen(s) > 0);
+    for (size_t j = 0; j < n; ++j) assert_string_not_equal(s, sph_result_string(codes[j].code));
+  }
+}
+
+static void test_last_error(void** state) {
+  sph_context_def def;
+  sph_context* context = NULL;
+  uint32_t count = 0;
+  (void)state;
+  assert_string_equal(sph_get_last_error(), "");
+  sph_context_def_init(&def);
+  def.reserved0 = 1;
+  assert_int_equal(sph_context_create(&def, &context), SPH_ERROR_INVALID_ARGUMENT);
+  /* Names the function and the argument; stays until the next call. */
+  assert_non_null(strstr(sph_get_last_error(), "sph_context_create"));
+  assert_non_null(strstr(sph_get_last_error(), "reserved0"));
+  assert_non_null(strstr(sph_get_last_error(), "reserved0"));
+  /* Any successful call clears it, including ones that cannot fail in interesting ways. */
+  assert_int_equal(sph_get_live_object_count(&count), SPH_OK);
+  assert_string_equal(sph_get_last_error(), "");
+  assert_int_equal(sph_get_live_object_count(NULL), SPH_ERROR_INVALID_ARGUMENT);
+  assert_true(strlen(sph_get_last_error()) > 0);
+  assert_int_equal(sph_context_destroy(NULL), SPH_OK);
+  assert_string_equal(sph_get_last_error(), "");
+  assert_int_equal(sph_get_live_object_count(NULL), SPH_ERROR_INVALID_ARGUMENT);
+  EXPECT_OK(sph_test_context_create(&context));
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+static void* fail_on_other_thread(void* arg) {
+  sph_context_def def;
+  sph_context* context = NULL;
+  (void)arg;
+  sph_context_def_init(&def);
+  def.cpu_worker_count = 100000;
+  if (sph_context_create(&def, &context) != SPH_ERROR_INVALID_ARGUMENT) return (void*)1;
+  if (strstr(sph_get_last_error(), "cpu_worker_count") == NULL) return (void*)2;
+  return NULL;
+}
+
+/* The last error is per thread: another thread's failure does not touch this thread's. */
+static void test_last_error_thread_local(void** state) {
+  pthread_t thread;
+  void* result = (void*)99;
+  (void)state;
+  assert_int_equal(sph_get_live_object_count(NULL), SPH_ERROR_INVALID_ARGUMENT);
+  assert_non_null(strstr(sph_get_last_error(), "out_count"));
+  assert_int_equal(pthread_create(&thread, NULL, fail_on_other_thread, NULL), 0);
+  assert_int_equal(pthread_join(thread, &result), 0);
+  assert_null(result);
+  assert_non_null(strstr(sph_get_last_error(), "out_count"));
+  assert_null(strstr(sph_get_last_error(), "cpu_worker_count"));
+}
+
+/* ---- the log callback ------------------------------------------------------------------------ */
+
+typedef struct {
+  int calls;
+  sph_log_level level;
+  sph_result code;
+  char message[1024];
+} log_record;
+
+static void record_log(void* user_data, sph_log_level level, sph_result code, const char* message) {
+  log_record* r = (log_record*)user_data;
+  r->calls++;
+  r->level = level;
+  r->code = code;
+  snprintf(r->message, sizeof r->message, "%s", message ? message : "(null)");
+}
+
+static void test_log_callback(void** state) {
+  log_record log;
+  sph_context_def def;
+  sph_context* context = NULL;
+  sph_world_def wdef;
+  sph_world* world = NULL;
+  sph_world_params params;
+  (void)state;
+  memset(&log, 0, sizeof log);
+  sph_test_context_def_init(&def);
+  def.log_fn = record_log;
+  def.log_user_data = &log;
+  EXPECT_OK(sph_context_create(&def, &context));
+  /* A failed world creation on this context is logged, with the same message. */
+  sph_world_def_init(&wdef);
+  wdef.capacity = 0;
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "capacity", sph_world_create(context, &wdef, &world));
+  assert_int_equal(log.calls, 1);
+  assert_int_equal(log.level, SPH_LOG_ERROR);
+  assert_int_equal(log.code, SPH_ERROR_INVALID_ARGUMENT);
+  assert_string_equal(log.message, sph_get_last_error());
+  /* Successes are not logged as errors. */
+  wdef.capacity = 32;
+  EXPECT_OK(sph_world_create(context, &wdef, &world));
+  sph_world_params_init(&params);
+  EXPECT_OK(sph_world_set_params(world, &params));
+  EXPECT_OK(sph_world_step(world, 0.001f));
+  assert_int_equal(log.calls, 1);
+  /* A failed call on one of its worlds is logged too. */
+  params.step_factor = -1.0f;
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "step_factor", sph_world_set_params(world, &params));
+  assert_int_equal(log.calls, 2);
+  assert_int_equal(log.level, SPH_LOG_ERROR);
+  assert_int_equal(log.code, SPH_ERROR_INVALID_ARGUMENT);
+  assert_non_null(strstr(log.message, "step_factor"));
+  assert_string_equal(log.message, sph_get_last_error());
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "frame_dt", sph_world_step(world, -1.0f));
+  assert_int_equal(log.calls, 3);
+  assert_non_null(strstr(log.message, "frame_dt"));
+  EXPECT_OK(sph_world_destroy(world));
+  EXPECT_OK(sph_context_destroy(context));
+  assert_int_equal(log.calls, 3);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_version),
+      cmocka_unit_test(test_build_info),
+      cmocka_unit_test(test_result_strings),
+      cmocka_unit_test(test_last_error),
+      cmocka_unit_test(test_last_error_thread_local),
+      cmocka_unit_test(test_log_callback),
+  };
+  return cmocka_run_group_tests_name("capi_diagnostics", tests, NULL, NULL);
+}

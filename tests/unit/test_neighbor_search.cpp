@@ -1,0 +1,239 @@
+// The CPU neighbour grid (src/cpu/cpu_neighbor_grid.h) walked by the shared 27-cell search
+// (src/physics/neighbor_walk.h) finds, for every particle, exactly the particles a brute-force
+// O(n^2) search finds within the kernel radius: around the origin, at negative coordinates,
+// 10 km away, and in clouds many times wider than the wrapped table, where distant cells
+// share table slots.
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+extern "C" {
+#include <cmocka.h>
+}
+
+#include <algorithm>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+#include "core/grid_layout.h"
+#include "cpu/cpu_neighbor_grid.h"
+#include "physics/neighbor_walk.h"
+
+namespace {
+
+using sph::Float4;
+using sph::Vec3;
+
+constexpr float kH = 0.036f;  // 1.8 x the default 2 cm spacing
+
+struct Cloud {
+  const char* name;
+  Vec3 center;
+  float half_extent;  // points uniform in center +- half_extent per axis
+  uint32_t count;
+  uint32_t capacity;  // sets the table size: about one slot per unit of capacity, >= 3^3
+};
+
+std::vector<Vec3> random_points(const Cloud& cloud, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Vec3> points(cloud.count);
+  for (Vec3& p : points)
+    p = Vec3{static_cast<float>(cloud.center.x + cloud.half_extent * u(rng)),
+             static_cast<float>(cloud.center.y + cloud.half_extent * u(rng)),
+             static_cast<float>(cloud.center.z + cloud.half_extent * u(rng))};
+  return points;
+}
+
+// The distance test of the solver (density.h, forces.h): float r^2 < float h^2.
+bool within(Vec3 a, Vec3 b, float h2) { return sph::length_squared(a - b) < h2; }
+
+struct SearchResult {
+  size_t pairs = 0;        // neighbour pairs found (ordered, self excluded)
+  size_t mismatches = 0;   // particles whose grid set differs from brute force
+  size_t duplicates = 0;   // candidates visited twice for one query
+  size_t wrapped_far = 0;  // candidates beyond the 3x3x3 block (> 2 sqrt 3 h): from a folded slot
+};
+
+SearchResult search_and_compare(const std::vector<Vec3>& points, uint32_t capacity, float h) {
+  const uint32_t n = static_cast<uint32_t>(points.size());
+  const sph::GridShape shape = sph::make_grid_shape(h, capacity);
+  sph::CpuNeighborGrid grid(shape);
+  std::vector<Float4> records(n);
+  for (uint32_t i = 0; i < n; ++i) records[i] = sph::make_float4_record(points[i], static_cast<float>(i));
+  grid.build(records.data(), n, 2);
+
+  // order() is a permutation; the sort is by cell hash and stable (original order within a cell).
+  const std::vector<uint32_t>& order = grid.order();
+  assert_int_equal(order.size(), n);
+  std::vector<uint32_t> seen(n, 0);
+  for (uint32_t i = 0; i < n; ++i) {
+    assert_true(order[i] < n);
+    assert_int_equal(seen[order[i]]++, 0);
+  }
+  std::vector<Float4> sorted(n);
+  for (uint32_t i = 0; i < n; ++i) sorted[i] = records[order[i]];
+  const sph::GridView view = grid.view();
+  assert_int_equal(view.cell_start[0], 0);
+  assert_int_equal(view.cell_start[shape.cell_count], n);
+  for (uint32_t i = 0; i < n; ++i) {
+    const uint32_t cell = sph::cell_hash_of_position(shape, sph::xyz(sorted[i]));
+    assert_true(cell < shape.cell_count);
+    assert_true(view.cell_start[cell] <= i && i < view.cell_start[cell + 1]);
+    if (i > 0 && sph::cell_hash_of_position(shape, sph::xyz(sorted[i - 1])) == cell)
+      assert_true(order[i - 1] < order[i]);
+  }
+
+  const float h2 = h * h;
+  SearchResult result;
+  std::vector<uint32_t> from_grid, brute, visits(n, 0);
+  for (uint32_t i = 0; i < n; ++i) {
+    const Vec3 xi = sph::xyz(sorted[i]);
+    from_grid.clear();
+    brute.clear();
+    std::vector<uint32_t> visited;
+    sph::for_each_neighbor_candidate(view, xi, [&](uint32_t j) {
+      if (visits[j]++ != 0) ++result.duplicates;
+      visited.push_back(j);
+      if (j != i && within(xi, sph::xyz(sorted[j]), h2)) from_grid.push_back(j);
+      if (!within(xi, sph::xyz(sorted[j]), 12.25f * h2)) ++result.wrapped_far;
+    });
+    for (uint32_t j : visited) visits[j] = 0;
+    for (uint32_t j = 0; j < n; ++j)
+      if (j != i && within(xi, sph::xyz(sorted[j]), h2)) brute.push_back(j);
+    std::sort(from_grid.begin(), from_grid.end());
+    if (from_grid != brute) {
+      if (result.mismatches < 5)
+        std::printf("  particle at (%.9g, %.9g, %.9g): grid finds %zu neighbours, brute force %zu\n", xi.x,
+                    xi.y, xi.z, from_grid.size(), brute.size());
+      ++result.mismatches;
+    }
+    result.pairs += brute.size();
+  }
+  return result;
+}
+
+// wraps: whether the cloud is wider than the table, so distant cells share slots.
+void run_cloud(const Cloud& cloud, uint32_t seed, bool wraps) {
+  const sph::GridShape shape = sph::make_grid_shape(kH, cloud.capacity);
+  const SearchResult r = search_and_compare(random_points(cloud, seed), cloud.capacity, kH);
+  const double cells_across = 2.0 * cloud.half_extent / kH;
+  std::printf(
+      "%s: %u points, table %dx%dx%d, cloud %.0f cells across, %.1f neighbours per point, "
+      "%zu far candidates from wrapped slots, %zu mismatches\n",
+      cloud.name, cloud.count, shape.nx, shape.ny, shape.nz, cells_across,
+      static_cast<double>(r.pairs) / cloud.count, r.wrapped_far, r.mismatches);
+  assert_int_equal(r.duplicates, 0);  // the 27 cells are 27 distinct table slots
+  assert_int_equal(r.mismatches, 0);
+  if (wraps)
+    assert_true(r.wrapped_far > 0);  // the case really exercises folded slots
+  else
+    assert_int_equal(r.wrapped_far, 0);
+  assert_true(r.pairs > cloud.count);  // the clouds are dense enough to have neighbours
+}
+
+void test_cloud_at_origin(void**) {
+  // Straddles 0, where floor() of negative coordinates matters; fits the table (no wrap).
+  run_cloud(Cloud{"origin", Vec3{0.0f, 0.0f, 0.0f}, 0.2f, 2000, 2000}, 1, false);
+}
+
+void test_cloud_negative(void**) {
+  run_cloud(Cloud{"negative", Vec3{-3.3f, -7.1f, -0.5f}, 0.2f, 2000, 2000}, 2, false);
+}
+
+void test_cloud_far_away(void**) {
+  // 10 km out, float positions are spaced ~1 mm: still far finer than h.
+  run_cloud(Cloud{"far +1e4", Vec3{1e4f, 1e4f, 1e4f}, 0.2f, 2000, 2000}, 3, false);
+  run_cloud(Cloud{"far mixed", Vec3{-1e4f, 1e4f, -1e4f}, 0.2f, 2000, 2000}, 4, false);
+}
+
+void test_cloud_wraps_table(void**) {
+  // Capacity 8 gives the smallest table, 3x3x3: a cloud 14 cells across folds onto it almost
+  // 5 times per axis, so every slot holds particles from many distant cells.
+  run_cloud(Cloud{"wrap 3^3", Vec3{0.0f, 0.0f, 0.0f}, 0.25f, 3000, 8}, 5, true);
+  // A 4x4x4 table (not a multiple of 3) and a 7x7x7 one, at negative and far coordinates.
+  run_cloud(Cloud{"wrap 4^3", Vec3{-20.0f, 5.0f, -3.0f}, 0.25f, 3000, 64}, 6, true);
+  run_cloud(Cloud{"wrap far", Vec3{-1e4f, 1e4f, 5e3f}, 0.25f, 3000, 343}, 7, true);
+}
+
+void test_dense_cluster(void**) {
+  // Hundreds of particles per cell.
+  run_cloud(Cloud{"dense", Vec3{0.01f, 0.01f, 0.01f}, 0.03f, 1500, 1500}, 8, false);
+}
+
+// Points on and within a few float steps of cell boundaries (multiples of h), where the
+// rounding of x / h decides the cell.
+void test_points_on_cell_boundaries(void**) {
+  std::mt19937 rng(9);
+  std::uniform_int_distribution<int> cell(-6, 6), nudge(-3, 3), axis(0, 2);
+  std::uniform_real_distribution<float> u(-6.0f * kH, 6.0f * kH);
+  std::vector<Vec3> points(2000);
+  for (Vec3& p : points) {
+    float c[3] = {u(rng), u(rng), u(rng)};
+    // Put one or two coordinates on a boundary, moved by up to 3 float steps.
+    for (int k = 0, m = 1 + (axis(rng) > 0); k < m; ++k) {
+      float& v = c[axis(rng)];
+      v = static_cast<float>(cell(rng)) * kH;
+      for (int s = nudge(rng); s != 0; s += (s > 0 ? -1 : 1)) v = std::nextafter(v, s > 0 ? 1e9f : -1e9f);
+    }
+    p = Vec3{c[0], c[1], c[2]};
+  }
+  const SearchResult r = search_and_compare(points, 2000, kH);
+  std::printf("cell boundaries: %.1f neighbours per point, %zu mismatches\n",
+              static_cast<double>(r.pairs) / points.size(), r.mismatches);
+  assert_int_equal(r.duplicates, 0);
+  assert_int_equal(r.mismatches, 0);
+  assert_true(r.pairs > points.size());
+}
+
+// Pairs closer than h that straddle two cell boundaries: a just below the boundary k h (in
+// cell k - 1), b just under h further (near the boundary (k + 1) h). Whether b lands in
+// cell k or k + 1 depends on the rounding of b / h (and of 1 / h, which may exceed the exact
+// value); if it lands in k + 1, the pair is two cells apart and the 27-cell walk misses it.
+size_t straddle_pairs(double base, float h, size_t* mismatches) {
+  size_t cases = 0;
+  for (int k = -20; k <= 20; ++k)
+    for (int below = 0; below <= 4; ++below)
+      for (int shorter = 1; shorter <= 6; ++shorter) {
+        float a = static_cast<float>(base + k * static_cast<double>(h));
+        for (int s = 0; s < below; ++s) a = std::nextafter(a, -1e30f);
+        float b = a + h;
+        for (int s = 0; s < shorter; ++s) b = std::nextafter(b, -1e30f);
+        const std::vector<Vec3> pair = {Vec3{a, 0.25f * h, 0.25f * h}, Vec3{b, 0.25f * h, 0.25f * h}};
+        if (!within(pair[0], pair[1], h * h)) continue;
+        ++cases;
+        *mismatches += search_and_compare(pair, 2000, h).mismatches;
+      }
+  return cases;
+}
+
+void test_pairs_straddling_boundaries(void**) {
+  // Several kernel radii: whether float(1 / h) rounds up or down differs between them.
+  const float radii[] = {0.036f, 0.1f, 0.05f, 0.07f, 0.3f, 0.0125f, 0.9f, 1.0f / 3.0f, 0.045f, 0.018f};
+  for (float h : radii)
+    for (double base : {0.0, -1e3, 1e4}) {
+      size_t mismatches = 0;
+      const size_t cases = straddle_pairs(base, h, &mismatches);
+      if (mismatches != 0)
+        std::printf("h = %g around %g: %zu particles of %zu straddling pairs miss their neighbour\n", h, base,
+                    mismatches, 2 * cases);
+      assert_true(cases > 100);
+      assert_int_equal(mismatches, 0);
+    }
+}
+
+}  // namespace
+
+int main() {
+  const CMUnitTest tests[] = {
+      cmocka_unit_test(test_cloud_at_origin),
+      cmocka_unit_test(test_cloud_negative),
+      cmocka_unit_test(test_cloud_far_away),
+      cmocka_unit_test(test_cloud_wraps_table),
+      cmocka_unit_test(test_dense_cluster),
+      cmocka_unit_test(test_points_on_cell_boundaries),
+      cmocka_unit_test(test_pairs_straddling_boundaries),
+  };
+  return cmocka_run_group_tests_name("neighbor_search", tests, nullptr, nullptr);
+}
