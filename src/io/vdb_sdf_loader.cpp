@@ -1,0 +1,125 @@
+// Loads an OpenVDB level set into a dense SDF asset through the public C API. OpenVDB stays in
+// this library (libsph_vdb); libsph never sees it.
+#include <openvdb/openvdb.h>
+
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "sph_vdb.h"
+
+namespace {
+
+thread_local char g_vdb_error[1024] = "";
+
+sph_result fail(sph_result code, const std::string& message) {
+  std::snprintf(g_vdb_error, sizeof g_vdb_error, "sph_vdb_load_sdf: %s", message.c_str());
+  return code;
+}
+
+void initialize_openvdb() {
+  static std::once_flag once;
+  std::call_once(once, [] { openvdb::initialize(); });
+}
+
+openvdb::FloatGrid::Ptr find_level_set(openvdb::io::File& file, const char* grid_name, std::string& error) {
+  openvdb::GridPtrVecPtr grids = file.getGrids();
+  for (const openvdb::GridBase::Ptr& base : *grids) {
+    if (grid_name && grid_name[0] && base->getName() != grid_name) continue;
+    openvdb::FloatGrid::Ptr grid = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
+    if (!grid) {
+      if (grid_name && grid_name[0]) {
+        error = std::string("grid_name: grid '") + grid_name + "' is not a FloatGrid";
+        return nullptr;
+      }
+      continue;
+    }
+    if (grid->getGridClass() != openvdb::GRID_LEVEL_SET) {
+      if (grid_name && grid_name[0]) {
+        error = std::string("grid_name: grid '") + grid_name + "' is not a level set";
+        return nullptr;
+      }
+      continue;
+    }
+    return grid;
+  }
+  error = grid_name && grid_name[0] ? std::string("grid_name: no grid named '") + grid_name + "'"
+                                    : std::string("path: the file holds no float level set");
+  return nullptr;
+}
+
+}  // namespace
+
+extern "C" {
+
+SPH_API const char* SPH_CALL sph_vdb_get_last_error(void) { return g_vdb_error; }
+
+SPH_API sph_result SPH_CALL sph_vdb_load_sdf(sph_context* context, const char* path, const char* grid_name,
+                                             sph_sdf** out) {
+  g_vdb_error[0] = '\0';
+  if (!context) return fail(SPH_ERROR_INVALID_HANDLE, "context: is NULL");
+  if (!path) return fail(SPH_ERROR_INVALID_ARGUMENT, "path: is NULL");
+  if (!out) return fail(SPH_ERROR_INVALID_ARGUMENT, "out: is NULL");
+  try {
+    initialize_openvdb();
+    openvdb::io::File file(path);
+    try {
+      file.open();
+    } catch (const std::exception& e) {
+      return fail(SPH_ERROR_INVALID_ARGUMENT,
+                  std::string("path: cannot open '") + path + "' as a VDB file (" + e.what() + ")");
+    }
+    std::string error;
+    openvdb::FloatGrid::Ptr grid = find_level_set(file, grid_name, error);
+    file.close();
+    if (!grid) return fail(SPH_ERROR_INVALID_ARGUMENT, error);
+    if (!grid->transform().isLinear())
+      return fail(SPH_ERROR_INVALID_ARGUMENT,
+                  "the grid's transform is not linear (frustum maps are unsupported)");
+
+    openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
+    if (box.empty()) return fail(SPH_ERROR_INVALID_ARGUMENT, "the level set has no active voxels");
+    box.expand(1);
+    const openvdb::Coord dim = box.dim();
+    const double voxels = static_cast<double>(dim.x()) * dim.y() * dim.z();
+    if (voxels > 2147483648.0)
+      return fail(SPH_ERROR_CAPACITY,
+                  "the dense grid would have " + std::to_string(voxels) + " voxels (over 2^31)");
+
+    std::vector<float> dense(static_cast<size_t>(voxels));
+    openvdb::FloatGrid::ConstAccessor access = grid->getConstAccessor();
+    size_t at = 0;
+    for (int k = 0; k < dim.z(); ++k)
+      for (int j = 0; j < dim.y(); ++j)
+        for (int i = 0; i < dim.x(); ++i) dense[at++] = access.getValue(box.min() + openvdb::Coord(i, j, k));
+
+    // OpenVDB maps index to world with row vectors: world = (i, j, k, 1) * M. Our dense index
+    // (i, j, k) is the VDB index box.min() + (i, j, k).
+    const openvdb::Mat4d m = grid->transform().baseMap()->getAffineMap()->getMat4();
+    sph_sdf_desc desc;
+    sph_sdf_desc_init(&desc);
+    desc.distance.dims[0] = static_cast<uint32_t>(dim.x());
+    desc.distance.dims[1] = static_cast<uint32_t>(dim.y());
+    desc.distance.dims[2] = static_cast<uint32_t>(dim.z());
+    const openvdb::Vec3d origin = m.transform(box.min().asVec3d());
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) desc.distance.index_to_local[r * 4 + c] = static_cast<float>(m(c, r));
+      desc.distance.index_to_local[r * 4 + 3] = static_cast<float>(origin[r]);
+    }
+    desc.distance.data = dense.data();
+    const sph_result r = sph_sdf_create(context, &desc, out);
+    if (r != SPH_OK) return fail(r, sph_get_last_error());
+    return SPH_OK;
+  } catch (const std::bad_alloc&) {
+    return fail(SPH_ERROR_OUT_OF_HOST_MEMORY, "a host allocation failed");
+  } catch (const std::exception& e) {
+    return fail(SPH_ERROR_INVALID_ARGUMENT, std::string("OpenVDB: ") + e.what());
+  } catch (...) {
+    return fail(SPH_ERROR_INTERNAL, "unknown exception");
+  }
+}
+
+}  // extern "C"
