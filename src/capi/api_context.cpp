@@ -4,6 +4,7 @@
 #include "guard.h"
 #include "handles.h"
 #include "struct_io.h"
+#include "validate.h"
 
 using sph::Error;
 using sph::Status;
@@ -40,8 +41,9 @@ SPH_API sph_result SPH_CALL sph_context_create(const sph_context_def* def, sph_c
                                                std::to_string(d.header_version >> 22) +
                                                ".x but the library is " + std::to_string(SPH_VERSION_MAJOR) +
                                                ".x");
-    if (d.backend != SPH_BACKEND_AUTO && d.backend != SPH_BACKEND_CPU && d.backend != SPH_BACKEND_CUDA)
-      throw Error(Status::Unsupported, "def->backend: " + std::to_string(static_cast<int>(d.backend)) +
+    const uint32_t backend = sph::enum_bits(d.backend);
+    if (backend != SPH_BACKEND_AUTO && backend != SPH_BACKEND_CPU && backend != SPH_BACKEND_CUDA)
+      throw Error(Status::Unsupported, "def->backend: " + std::to_string(static_cast<int32_t>(backend)) +
                                            " is not an sph_backend value");
     if (d.device_ordinal < -1)
       throw Error(Status::InvalidArgument,
@@ -52,7 +54,7 @@ SPH_API sph_result SPH_CALL sph_context_create(const sph_context_def* def, sph_c
       throw Error(Status::InvalidArgument,
                   "def->cpu_worker_count: " + std::to_string(d.cpu_worker_count) + " is more than 4096");
     const sph::BackendKind kind =
-        sph::resolve_backend(static_cast<sph::BackendKind>(d.backend), d.device_ordinal);
+        sph::resolve_backend(static_cast<sph::BackendKind>(backend), d.device_ordinal);
     auto context = std::make_unique<sph_context>();
     context->backend = kind;
     context->device_ordinal = d.device_ordinal < 0 ? 0 : d.device_ordinal;

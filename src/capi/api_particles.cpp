@@ -190,9 +190,10 @@ SPH_API sph_result SPH_CALL sph_world_copy_attribute(const sph_world* world, sph
   return sph::guarded("sph_world_copy_attribute", sph::context_of(world), [&] {
     sph::require_world(world);
     sph::WorldLock lock(world);
-    if (static_cast<uint32_t>(attribute) >= SPH_ATTRIBUTE_COUNT)
-      throw Error(Status::Unsupported, "attribute: " + std::to_string(static_cast<int>(attribute)) +
-                                           " is not an sph_attribute value");
+    if (sph::enum_bits(attribute) >= SPH_ATTRIBUTE_COUNT)
+      throw Error(Status::Unsupported,
+                  "attribute: " + std::to_string(static_cast<int32_t>(sph::enum_bits(attribute))) +
+                      " is not an sph_attribute value");
     if (!dst) throw Error(Status::InvalidArgument, "dst: is NULL");
     const uint64_t element = element_size(attribute);
     const uint64_t stride = dst_stride == 0 ? element : dst_stride;

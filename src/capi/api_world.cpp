@@ -58,8 +58,9 @@ sph::WorldConfig config_from_def(const sph_world_def& d) {
           std::snprintf(buf, sizeof buf, "%x", d.features);
           return std::string(buf);
         }());
-  if (d.integrator != SPH_INTEGRATOR_SYMPLECTIC_EULER && d.integrator != SPH_INTEGRATOR_RK4)
-    throw Error(Status::Unsupported, "def->integrator: " + std::to_string(static_cast<int>(d.integrator)) +
+  const uint32_t integrator = sph::enum_bits(d.integrator);
+  if (integrator != SPH_INTEGRATOR_SYMPLECTIC_EULER && integrator != SPH_INTEGRATOR_RK4)
+    throw Error(Status::Unsupported, "def->integrator: " + std::to_string(static_cast<int32_t>(integrator)) +
                                          " is not an sph_integrator value");
   sph::require_zero(d.reserved0, "def->reserved0");
   sph::require_zero(d.reserved1 != 0.0f ? 1u : 0u, "def->reserved1");
@@ -90,7 +91,7 @@ sph::WorldConfig config_from_def(const sph_world_def& d) {
   sph::WorldConfig c;
   c.capacity = d.capacity;
   c.features = d.features;
-  c.integrator = static_cast<sph::Integrator>(d.integrator);
+  c.integrator = static_cast<sph::Integrator>(integrator);
   c.particle_spacing = d.particle_spacing;
   c.kernel_radius = h;
   c.rest_density = d.rest_density;
