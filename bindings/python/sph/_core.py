@@ -1,0 +1,409 @@
+"""Context and World: the Pythonic layer over the generated ctypes declarations."""
+import ctypes
+import re
+import sys
+import weakref
+
+import numpy as np
+
+from . import _generated as _g
+from ._cuda import WorldCudaMixin
+from ._errors import SphError, check
+from ._loader import library
+from ._scene import Sdf, WorldSceneMixin
+
+__all__ = ["Context", "World", "attribute_format", "version", "abi_version", "build_info", "result_string",
+           "live_object_count", "make_version"]
+
+
+# ---- library-wide queries ----------------------------------------------------------------------
+def make_version(major, minor, patch):
+    """Packs a version like SPH_MAKE_VERSION: (major << 22) | (minor << 12) | patch."""
+    return (major << 22) | (minor << 12) | patch
+
+
+def version():
+    """The loaded library's version as (major, minor, patch) (sph_get_version)."""
+    v = library().sph_get_version()
+    return (v >> 22, (v >> 12) & 0x3FF, v & 0xFFF)
+
+
+def abi_version():
+    """The loaded library's ABI version (sph_get_abi_version); the SONAME major."""
+    return library().sph_get_abi_version()
+
+
+def build_info():
+    """Version, git revision, compiler and backends of the loaded library (sph_get_build_info)."""
+    return library().sph_get_build_info().decode("utf-8", "replace")
+
+
+def result_string(result):
+    """The library's English description of an sph_result code (sph_result_string)."""
+    return library().sph_result_string(int(result)).decode("utf-8", "replace")
+
+
+def live_object_count():
+    """Contexts and worlds alive in the process (sph_get_live_object_count): a leak check."""
+    n = ctypes.c_uint32()
+    check(library().sph_get_live_object_count(ctypes.byref(n)), "sph_get_live_object_count")
+    return n.value
+
+
+# ---- attributes ----------------------------------------------------------------------------------
+_FORMAT = re.compile(r"^\s*(?:(\d+)\s*x\s*)?(float32|float64|uint32|int32|uint64|int64)\b")
+
+
+def attribute_format(attribute):
+    """(numpy dtype, components) of an attribute, read from its documentation in the header
+    ("3 x float32, metres", "uint32, ..."), so attributes added to the header need no code."""
+    attribute = _g.Attribute(attribute)
+    doc = _g.ENUM_MEMBER_DOCS.get(f"SPH_ATTRIBUTE_{attribute.name}", "")
+    m = _FORMAT.match(doc)
+    if not m:
+        raise ValueError(f"attribute {attribute.name}: the header does not document its element format ({doc!r})")
+    return np.dtype(m.group(2)), int(m.group(1) or 1)
+
+
+def _vec3_rows(values, what):
+    """values as an (n, 3) float32 array whose rows may be strided but whose three floats are
+    packed: numpy views pass through without a copy, anything else is converted once."""
+    a = np.asarray(values)
+    if a.ndim == 1 and a.shape[0] == 3:
+        a = a.reshape(1, 3)
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise ValueError(f"{what}: expected an array of shape (n, 3), got {a.shape}")
+    if a.dtype != np.float32 or a.strides[1] != 4 or a.strides[0] < 12 or a.strides[0] % 4:
+        a = np.ascontiguousarray(a, dtype=np.float32)
+    return a
+
+
+def _float_ptr(a):
+    return a.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
+
+
+# ---- context --------------------------------------------------------------------------------------
+class Context:
+    """A backend (the CPU, or one CUDA device) that worlds are created on (sph_context).
+
+    ``Context("cpu")``, ``Context(Backend.CUDA, device_ordinal=0)``. Use it as a context
+    manager or call close(), which first closes the worlds and SDF assets created on it that
+    are still open (the C library refuses to destroy a context that has them).
+
+    Args:
+        backend: a Backend member or "auto" / "cpu" / "cuda" (default AUTO: CUDA when a device
+            is present, else the CPU).
+        device_ordinal: CUDA device (default -1 = device 0).
+        cpu_worker_count: CPU backend threads (default 0 = all hardware threads).
+        log: optional callable(level: LogLevel, code: Result, message: str), called on the
+            calling thread when a call on this context or its worlds fails. Exceptions it
+            raises are printed and swallowed (they cannot cross the C library).
+        definition: a ContextDef to start from instead of the defaults.
+    """
+
+    def __init__(self, backend=None, *, device_ordinal=None, cpu_worker_count=None, log=None, definition=None):
+        lib = library()
+        d = definition.copy() if definition is not None else _g.ContextDef()
+        if backend is not None:
+            d.backend = _g.Backend[backend.upper()] if isinstance(backend, str) else _g.Backend(backend)
+        if device_ordinal is not None:
+            d.device_ordinal = device_ordinal
+        if cpu_worker_count is not None:
+            d.cpu_worker_count = cpu_worker_count
+        self._log = log
+        self._log_fn = _g.sph_log_fn(self._on_log) if log is not None else None
+        if self._log_fn is not None:
+            d.log_fn = self._log_fn
+        out = ctypes.POINTER(_g.sph_context)()
+        check(lib.sph_context_create(ctypes.byref(d), ctypes.byref(out)), "sph_context_create")
+        self._ptr = out
+        self._children = weakref.WeakSet()  # worlds and SDF assets created on this context
+
+    def _on_log(self, _user_data, level, code, message):
+        try:
+            self._log(_g.LogLevel(level), _g.Result(code), message.decode("utf-8", "replace") if message else "")
+        except Exception:  # noqa: BLE001 - nothing may propagate into C
+            sys.excepthook(*sys.exc_info())
+
+    @property
+    def handle(self):
+        """The sph_context* (a NULL pointer once closed)."""
+        return self._ptr if self._ptr is not None else ctypes.POINTER(_g.sph_context)()
+
+    @property
+    def closed(self):
+        return self._ptr is None
+
+    @property
+    def backend(self):
+        """The Backend the context resolved to (CPU or CUDA; never AUTO)."""
+        out = _g.sph_backend()
+        check(library().sph_context_get_backend(self.handle, ctypes.byref(out)), "sph_context_get_backend")
+        return _g.Backend(out.value)
+
+    def world(self, definition=None, **fields):
+        """A new World on this context; see World."""
+        return World(self, definition, **fields)
+
+    def shape(self, shape="box", **fields):
+        """An SDF asset of an analytic shape on this context; see Sdf.shape."""
+        return Sdf.shape(self, shape, **fields)
+
+    def sdf(self, distance, **kwargs):
+        """An SDF asset from sampled grids on this context; see Sdf.from_grid."""
+        return Sdf.from_grid(self, distance, **kwargs)
+
+    def load_vdb(self, path, grid_name=None):
+        """An SDF asset from a level set in a .vdb file (libsph_vdb); see Sdf.from_vdb."""
+        return Sdf.from_vdb(self, path, grid_name)
+
+    def close(self):
+        """Closes the worlds, then the SDF assets, created on this context that are still
+        open, then destroys the context (sph_context_destroy). Idempotent."""
+        if self._ptr is not None:
+            children = sorted(self._children, key=lambda c: not isinstance(c, World))
+            for child in children:
+                child.close()
+            check(library().sph_context_destroy(self._ptr), "sph_context_destroy")
+            self._ptr = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            if getattr(self, "_ptr", None) is not None:
+                library().sph_context_destroy(self._ptr)
+                self._ptr = None
+        except Exception:  # noqa: BLE001 - interpreter shutdown
+            pass
+
+    def __repr__(self):
+        if self._ptr is None:
+            return "<sph.Context closed>"
+        return f"<sph.Context {self.backend.name}>"
+
+
+# ---- world -------------------------------------------------------------------------------------------
+class World(WorldSceneMixin, WorldCudaMixin):
+    """A particle fluid (sph_world): created on a Context, stepped, read back into numpy.
+
+    ``World(ctx, capacity=100_000, particle_spacing=0.01)``: keyword arguments set fields of a
+    default WorldDef (or of ``definition``). The world keeps its context alive. Use it as a
+    context manager or call close(). Colliders, sources, sinks and force fields are added
+    with add_collider/add_source/add_sink/add_force_field (see sph._scene); the zero-copy
+    CUDA tier is cuda_attribute/cuda_array/cuda_epoch/... (see sph._cuda).
+    """
+
+    def __init__(self, context, definition=None, **fields):
+        d = definition.copy() if definition is not None else _g.WorldDef()
+        for name, value in fields.items():
+            setattr(d, name, value)
+        out = ctypes.POINTER(_g.sph_world)()
+        check(library().sph_world_create(context.handle, ctypes.byref(d), ctypes.byref(out)), "sph_world_create")
+        self._ptr = out
+        self.context = context
+        context._children.add(self)
+
+    # -- lifetime
+    @property
+    def handle(self):
+        """The sph_world* (a NULL pointer once closed)."""
+        return self._ptr if self._ptr is not None else ctypes.POINTER(_g.sph_world)()
+
+    @property
+    def closed(self):
+        return self._ptr is None
+
+    def close(self):
+        """Destroys the world and everything in it (sph_world_destroy). Idempotent."""
+        if self._ptr is not None:
+            check(library().sph_world_destroy(self._ptr), "sph_world_destroy")
+            self._ptr = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            if getattr(self, "_ptr", None) is not None:
+                library().sph_world_destroy(self._ptr)
+                self._ptr = None
+        except Exception:  # noqa: BLE001
+            pass
+
+    def __repr__(self):
+        if self._ptr is None:
+            return "<sph.World closed>"
+        return f"<sph.World {self.particle_count} particles>"
+
+    # -- creation-time facts
+    @property
+    def definition(self):
+        """The WorldDef the world was created with, defaults resolved (sph_world_get_def)."""
+        d = _g.WorldDef()
+        check(library().sph_world_get_def(self.handle, ctypes.byref(d)), "sph_world_get_def")
+        return d
+
+    @property
+    def particle_mass(self):
+        """Mass of every particle, kg (sph_world_get_particle_mass)."""
+        m = ctypes.c_float()
+        check(library().sph_world_get_particle_mass(self.handle, ctypes.byref(m)), "sph_world_get_particle_mass")
+        return m.value
+
+    # -- runtime parameters
+    @property
+    def params(self):
+        """The runtime WorldParams (sph_world_get_params); assign a WorldParams to replace them
+        all at once (sph_world_set_params: validated as a whole, unchanged on error)."""
+        p = _g.WorldParams()
+        check(library().sph_world_get_params(self.handle, ctypes.byref(p)), "sph_world_get_params")
+        return p
+
+    @params.setter
+    def params(self, params):
+        check(library().sph_world_set_params(self.handle, ctypes.byref(params)), "sph_world_set_params")
+
+    def set_params(self, **fields):
+        """Changes some runtime parameters, keeping the others: ``w.set_params(gravity=(0, 0, 0))``."""
+        p = self.params
+        for name, value in fields.items():
+            setattr(p, name, value)
+        self.params = p
+        return p
+
+    # -- particles in
+    def spawn(self, positions, velocities=None):
+        """Adds particles from (n, 3) arrays (sph_world_spawn; copied, all-or-nothing).
+
+        float32 arrays whose rows are packed triples are passed as they are, row stride
+        included (a column slice of a wider array costs no copy); others are converted once.
+        Returns the id of the first new particle; the ids are consecutive.
+        """
+        pos = _vec3_rows(positions, "positions")
+        desc = _g.SpawnDesc(count=pos.shape[0], positions=_float_ptr(pos), position_stride=pos.strides[0])
+        if velocities is not None:
+            vel = _vec3_rows(velocities, "velocities")
+            if vel.shape[0] != pos.shape[0]:
+                raise ValueError(f"velocities: {vel.shape[0]} rows for {pos.shape[0]} positions")
+            desc.velocities = _float_ptr(vel)
+            desc.velocity_stride = vel.strides[0]
+        first = ctypes.c_uint32()
+        check(library().sph_world_spawn(self.handle, ctypes.byref(desc), ctypes.byref(first)), "sph_world_spawn")
+        return first.value
+
+    def fill_box(self, min, max, velocity=(0.0, 0.0, 0.0)):  # noqa: A002 - the C field names
+        """Fills the box [min, max] on an FCC lattice at rest density (sph_world_fill_box;
+        all-or-nothing). Returns the number of particles added."""
+        desc = _g.FillBoxDesc(min=min, max=max, velocity=velocity)
+        n = ctypes.c_uint32()
+        check(library().sph_world_fill_box(self.handle, ctypes.byref(desc), ctypes.byref(n)), "sph_world_fill_box")
+        return n.value
+
+    def fill_sphere(self, center, radius, velocity=(0.0, 0.0, 0.0)):
+        """Fills a sphere on an FCC lattice (sph_world_fill_sphere). Returns the number added."""
+        desc = _g.FillSphereDesc(center=center, radius=radius, velocity=velocity)
+        n = ctypes.c_uint32()
+        check(library().sph_world_fill_sphere(self.handle, ctypes.byref(desc), ctypes.byref(n)),
+              "sph_world_fill_sphere")
+        return n.value
+
+    # -- stepping
+    def step(self, frame_dt):
+        """Advances the world by frame_dt seconds in adaptive substeps (sph_world_step; blocks).
+
+        Returns Result.OK, or Result.INCOMPLETE when max_substeps ran out first
+        (stats().frame_time says how far it got). Raises SphError(NON_FINITE) if a substep
+        produced NaN/Inf; the world is then as it was before the call.
+        """
+        return check(library().sph_world_step(self.handle, float(frame_dt)), "sph_world_step")
+
+    # -- particles out
+    @property
+    def particle_count(self):
+        """Number of particles in the world (sph_world_get_particle_count)."""
+        n = ctypes.c_uint32()
+        check(library().sph_world_get_particle_count(self.handle, ctypes.byref(n)), "sph_world_get_particle_count")
+        return n.value
+
+    def __len__(self):
+        return self.particle_count
+
+    def copy_attribute(self, attribute, out=None, first=0, count=None):
+        """Copies particles [first, first + count) of one attribute (sph_world_copy_attribute).
+
+        The library writes straight into the returned array's buffer (np.empty, no second
+        copy). Pass ``out`` to reuse an array: (n, 3) for vectors or (n,) for scalars of the
+        attribute's dtype; its rows may be strided (e.g. a column block of a wider array).
+        Particles come in the world's current order; read Attribute.ID to match them up.
+        Returns the array (trimmed to the particles written).
+        """
+        attribute = _g.Attribute(attribute)
+        dtype, comps = attribute_format(attribute)
+        if count is None:
+            count = max(self.particle_count - first, 0) if out is None else len(out)
+        if out is None:
+            out = np.empty((count, comps) if comps > 1 else (count,), dtype)
+        else:
+            want = (comps,) if comps > 1 else ()
+            if out.dtype != dtype or out.shape[1:] != want:
+                shape = f"(n, {comps})" if want else "(n,)"
+                raise ValueError(f"out: {attribute.name} needs dtype {dtype} and shape {shape}, got {out.dtype} {out.shape}")
+            if comps > 1 and out.strides[1] != dtype.itemsize:
+                raise ValueError("out: the components of each row must be contiguous")
+            if not out.flags.writeable:
+                raise ValueError("out: array is read-only")
+        elem = comps * dtype.itemsize
+        stride = out.strides[0] if out.ndim and len(out) > 1 else elem
+        if stride < elem:
+            raise ValueError(f"out: row stride {stride} is smaller than an element ({elem} bytes)")
+        size = 0 if len(out) == 0 else (len(out) - 1) * stride + elem
+        written = ctypes.c_uint32()
+        check(library().sph_world_copy_attribute(self.handle, int(attribute), ctypes.c_void_p(out.ctypes.data), size,
+                                                 stride, first, count, ctypes.byref(written)),
+              "sph_world_copy_attribute")
+        return out[:written.value]
+
+    def positions(self, out=None):
+        """(n, 3) float32 positions, m, in the world's current order."""
+        return self.copy_attribute(_g.Attribute.POSITION, out)
+
+    def velocities(self, out=None):
+        """(n, 3) float32 velocities, m/s."""
+        return self.copy_attribute(_g.Attribute.VELOCITY, out)
+
+    def densities(self, out=None):
+        """(n,) float32 densities, kg/m^3, from the last density evaluation."""
+        return self.copy_attribute(_g.Attribute.DENSITY, out)
+
+    def pressures(self, out=None):
+        """(n,) float32 pressures, Pa, from the last density evaluation."""
+        return self.copy_attribute(_g.Attribute.PRESSURE, out)
+
+    def ids(self, out=None):
+        """(n,) uint32 persistent particle ids, in the same order as the other attributes."""
+        return self.copy_attribute(_g.Attribute.ID, out)
+
+    # -- statistics
+    def stats(self):
+        """Statistics of the last step as a Stats struct (sph_world_get_stats): attribute
+        access (``s.substeps``), ``s.to_dict()``, and ``stage_times(s)`` for stage_ms by Stage."""
+        s = _g.Stats()
+        check(library().sph_world_get_stats(self.handle, ctypes.byref(s)), "sph_world_get_stats")
+        return s
+
+
+def stage_times(stats):
+    """{Stage: milliseconds} from a Stats struct's stage_ms array."""
+    return {stage: stats.stage_ms[int(stage)] for stage in _g.Stage}
+
+
+__all__.append("stage_times")
+_ = SphError  # re-exported by the package

@@ -1,0 +1,94 @@
+"""The zero-copy CUDA tier (sph_cuda.h): a CUDA world's particles where they live on the GPU."""
+import ctypes
+
+from . import _generated as _g
+from ._errors import check
+from ._loader import library
+
+__all__ = ["CudaArray", "WorldCudaMixin"]
+
+_TYPESTR = {"float32": "<f4", "uint32": "<u4", "int32": "<i4"}
+
+
+class CudaArray:
+    """One attribute of a CUDA world as a device array, without a copy.
+
+    Implements ``__cuda_array_interface__`` (version 3, read-only), so CuPy, Numba and
+    PyTorch can wrap it: ``cupy.asarray(world.cuda_array(sph.Attribute.POSITION))``. The
+    memory is the world's: valid for the world's life, rewritten in place by every call that
+    changes particles (check ``current``), never to be written or freed.
+    """
+
+    def __init__(self, world, view, dtype, components):
+        self.world = world
+        self.view = view
+        self._typestr = _TYPESTR[str(dtype)]
+        self._components = components
+
+    @property
+    def shape(self):
+        return (self.view.count, self._components) if self._components > 1 else (self.view.count,)
+
+    @property
+    def current(self):
+        """True while the world's data epoch is still the one the view was taken at."""
+        return self.world.cuda_epoch == self.view.epoch
+
+    @property
+    def __cuda_array_interface__(self):
+        item = int(self._typestr[-1])
+        strides = (self.view.stride, item) if self._components > 1 else (self.view.stride,)
+        return {"shape": self.shape, "typestr": self._typestr, "data": (self.view.device_address, True),
+                "strides": strides, "version": 3, "stream": None}
+
+
+class WorldCudaMixin:
+    """World methods of the CUDA tier. On the CPU backend (or a library built without CUDA)
+    each raises SphError(ERROR_UNSUPPORTED)."""
+
+    def cuda_attribute(self, attribute):
+        """Where an attribute lives in device memory (sph_cuda_world_get_attribute): a
+        CudaAttributeView (device_address, stride, element_size, count, epoch, device_ordinal)."""
+        v = _g.CudaAttributeView()
+        check(library().sph_cuda_world_get_attribute(self.handle, int(_g.Attribute(attribute)), ctypes.byref(v)),
+              "sph_cuda_world_get_attribute")
+        return v
+
+    def cuda_array(self, attribute):
+        """The attribute as a CudaArray (``__cuda_array_interface__``) for CuPy/Numba/PyTorch."""
+        from ._core import attribute_format
+
+        dtype, components = attribute_format(attribute)
+        return CudaArray(self, self.cuda_attribute(attribute), dtype, components)
+
+    @property
+    def cuda_epoch(self):
+        """The world's data epoch (sph_cuda_world_get_epoch): +1 on every call that changes particles."""
+        e = ctypes.c_uint64()
+        check(library().sph_cuda_world_get_epoch(self.handle, ctypes.byref(e)), "sph_cuda_world_get_epoch")
+        return e.value
+
+    @property
+    def cuda_device(self):
+        """The CUDA device ordinal the world runs on (sph_cuda_world_get_device)."""
+        d = ctypes.c_int32()
+        check(library().sph_cuda_world_get_device(self.handle, ctypes.byref(d)), "sph_cuda_world_get_device")
+        return d.value
+
+    @property
+    def cuda_stream(self):
+        """The world's cudaStream_t as an int (sph_cuda_world_get_stream); e.g.
+        ``cupy.cuda.ExternalStream(world.cuda_stream)``. Owned by the world."""
+        s = ctypes.c_void_p()
+        check(library().sph_cuda_world_get_stream(self.handle, ctypes.byref(s)), "sph_cuda_world_get_stream")
+        return s.value or 0
+
+    def cuda_record_event(self, event):
+        """Records a cudaEvent_t (an int pointer you own) on the world's stream
+        (sph_cuda_world_record_event)."""
+        check(library().sph_cuda_world_record_event(self.handle, ctypes.c_void_p(event)),
+              "sph_cuda_world_record_event")
+
+    def cuda_wait_event(self, event):
+        """Makes the world's later device work wait for a cudaEvent_t (sph_cuda_world_wait_event)."""
+        check(library().sph_cuda_world_wait_event(self.handle, ctypes.c_void_p(event)), "sph_cuda_world_wait_event")

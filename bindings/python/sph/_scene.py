@@ -1,0 +1,369 @@
+"""SDF assets and the objects placed in a world: colliders, sources, sinks, force fields."""
+import ctypes
+import os
+
+import numpy as np
+
+from . import _generated as _g
+from ._errors import check
+from ._loader import library
+
+__all__ = ["Sdf", "Collider", "Source", "Sink", "ForceField", "as_transform", "grid_transform", "WorldSceneMixin"]
+
+
+def as_transform(t):
+    """A Transform from a Transform, a dict of its fields, a position (x, y, z), or a pair
+    (position, rotation) with rotation a quaternion (x, y, z, w). None is the identity."""
+    if t is None:
+        return _g.Transform()
+    if isinstance(t, _g.Transform):
+        return t
+    if isinstance(t, dict):
+        return _g.Transform(**t)
+    t = list(t)
+    if len(t) == 3 and all(np.isscalar(v) for v in t):
+        return _g.Transform(position=t)
+    if len(t) == 2 and not any(np.isscalar(v) for v in t):
+        return _g.Transform(position=t[0], rotation=t[1])
+    raise ValueError("a transform is a Transform, a dict, a position (x, y, z) or (position, rotation)")
+
+
+def grid_transform(voxel_size=1.0, origin=(0.0, 0.0, 0.0)):
+    """index_to_local for an axis-aligned grid: sample (i, j, k) sits at origin + voxel_size * (i, j, k)."""
+    s = float(voxel_size)
+    ox, oy, oz = (float(v) for v in origin)
+    return [s, 0, 0, ox, 0, s, 0, oy, 0, 0, s, oz]
+
+
+def _grid(values, components, index_to_local, what):
+    """(GridDesc, array kept alive) for a (nk, nj, ni) or (nk, nj, ni, 3) array; i is fastest."""
+    a = np.ascontiguousarray(values, dtype=np.float32)
+    want = 4 if components == 3 else 3
+    if a.ndim != want or (components == 3 and a.shape[3] != 3):
+        shape = "(nk, nj, ni, 3)" if components == 3 else "(nk, nj, ni)"
+        raise ValueError(f"{what}: expected an array of shape {shape} (i fastest), got {a.shape}")
+    d = _g.GridDesc(dims=(a.shape[2], a.shape[1], a.shape[0]), components=components,
+                    data=a.ctypes.data_as(ctypes.POINTER(ctypes.c_float)))
+    if index_to_local is not None:
+        d.index_to_local = np.asarray(index_to_local, np.float32).reshape(12)
+    return d, a
+
+
+class Sdf:
+    """A signed-distance asset (sph_sdf; negative inside) owned by a context, shared by the
+    colliders, sources, sinks and force fields of any world on that context.
+
+    Create one with ``Sdf.shape(ctx, "box", half_extents=(1, 0.5, 1), wall_thickness=0.05)``
+    (or ``ctx.shape(...)``) or ``Sdf.from_grid(ctx, distance, voxel_size=0.01)``. close()
+    releases the caller's reference; objects that use the asset keep it alive. Closing the
+    context closes its assets.
+    """
+
+    def __init__(self, context, ptr):
+        self._ptr = ptr
+        self.context = context
+        if ptr is not None:
+            context._children.add(self)
+
+    @classmethod
+    def shape(cls, context, shape=_g.Shape.BOX, **fields):
+        """An analytic shape sampled into a grid (sph_sdf_create_shape); fields are those of
+        ShapeDesc (half_extents, radius, half_height, wall_thickness, voxel_size, flags,
+        padding_voxels). ``open_top=True`` sets SPH_SHAPE_FLAG_OPEN_TOP."""
+        if fields.pop("open_top", False):
+            fields["flags"] = fields.get("flags", 0) | _g.SPH_SHAPE_FLAG_OPEN_TOP
+        shape = _g.Shape[shape.upper()] if isinstance(shape, str) else _g.Shape(shape)
+        desc = _g.ShapeDesc(shape=shape, **fields)
+        out = ctypes.POINTER(_g.sph_sdf)()
+        check(library().sph_sdf_create_shape(context.handle, ctypes.byref(desc), ctypes.byref(out)),
+              "sph_sdf_create_shape")
+        return cls(context, out)
+
+    @classmethod
+    def from_grid(cls, context, distance, *, index_to_local=None, voxel_size=None, origin=(0, 0, 0),
+                  velocity=None, friction=None):
+        """An asset from sampled grids (sph_sdf_create; copied).
+
+        distance: (nk, nj, ni) signed distances in metres (i fastest, like OpenVDB's index
+        space); velocity: optional (nk, nj, ni, 3) surface velocity, m/s; friction: optional
+        (nk, nj, ni) coefficients. The grid's placement is index_to_local (12 floats, a
+        row-major 3x4 map) or voxel_size and origin (see grid_transform).
+        """
+        if index_to_local is None and voxel_size is not None:
+            index_to_local = grid_transform(voxel_size, origin)
+        dist, keep = _grid(distance, 1, index_to_local, "distance")
+        desc = _g.SdfDesc(distance=dist)
+        keep = [keep]
+        if velocity is not None:
+            vel, a = _grid(velocity, 3, index_to_local, "velocity")
+            keep += [vel, a]
+            desc.velocity = ctypes.pointer(vel)
+        if friction is not None:
+            fri, a = _grid(friction, 1, index_to_local, "friction")
+            keep += [fri, a]
+            desc.friction = ctypes.pointer(fri)
+        out = ctypes.POINTER(_g.sph_sdf)()
+        check(library().sph_sdf_create(context.handle, ctypes.byref(desc), ctypes.byref(out)), "sph_sdf_create")
+        return cls(context, out)
+
+    @classmethod
+    def from_vdb(cls, context, path, grid_name=None):
+        """Loads a level-set FloatGrid from a .vdb file (sph_vdb_load_sdf, in the optional
+        helper library libsph_vdb; SphLoadError when it is not built). The asset's local frame
+        is the file's world frame. grid_name None takes the first float level set."""
+        from ._errors import SphError
+        from ._loader import helper_library
+
+        vdb = helper_library("sph_vdb")
+        out = ctypes.POINTER(_g.sph_sdf)()
+        code = vdb.sph_vdb_load_sdf(context.handle, os.fsencode(path),
+                                    grid_name.encode("utf-8") if grid_name else None, ctypes.byref(out))
+        if code < 0:
+            raise SphError(code, vdb.sph_vdb_get_last_error().decode("utf-8", "replace"), "sph_vdb_load_sdf")
+        return cls(context, out)
+
+    @property
+    def handle(self):
+        """The sph_sdf* (a NULL pointer once closed)."""
+        return self._ptr if self._ptr is not None else ctypes.POINTER(_g.sph_sdf)()
+
+    @property
+    def dims(self):
+        """Grid samples along (i, j, k) (sph_sdf_get_dims)."""
+        dims = (ctypes.c_uint32 * 3)()
+        check(library().sph_sdf_get_dims(self.handle, dims), "sph_sdf_get_dims")
+        return tuple(dims)
+
+    def sample(self, local_point):
+        """Signed distance at a point of the asset's local frame, m (sph_sdf_sample)."""
+        d = ctypes.c_float()
+        check(library().sph_sdf_sample(self.handle, _g.Vec3(*local_point), ctypes.byref(d)), "sph_sdf_sample")
+        return d.value
+
+    def update(self, channel, data, origin=(0, 0, 0)):
+        """Overwrites a box of one channel starting at grid index origin (i, j, k) with data
+        of shape (sk, sj, si) or, for the velocity channel, (sk, sj, si, 3) (sph_sdf_update).
+        Updating a channel the asset lacks creates it."""
+        channel = _g.SdfChannel[channel.upper()] if isinstance(channel, str) else _g.SdfChannel(channel)
+        a = np.ascontiguousarray(data, dtype=np.float32)
+        if a.ndim == 4:
+            a3 = a.shape[:3]
+        elif a.ndim == 3:
+            a3 = a.shape
+        else:
+            raise ValueError(f"data: expected (sk, sj, si) or (sk, sj, si, 3), got {a.shape}")
+        size = (ctypes.c_uint32 * 3)(a3[2], a3[1], a3[0])
+        at = (ctypes.c_uint32 * 3)(*origin)
+        check(library().sph_sdf_update(self.handle, int(channel), at, size,
+                                       a.ctypes.data_as(ctypes.POINTER(ctypes.c_float)), _g.SPH_MEMORY_HOST),
+              "sph_sdf_update")
+
+    def close(self):
+        """Releases the caller's reference (sph_sdf_destroy). Idempotent."""
+        if self._ptr is not None:
+            check(library().sph_sdf_destroy(self._ptr), "sph_sdf_destroy")
+            self._ptr = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            if getattr(self, "_ptr", None) is not None:
+                library().sph_sdf_destroy(self._ptr)
+                self._ptr = None
+        except Exception:  # noqa: BLE001
+            pass
+
+    def __repr__(self):
+        return "<sph.Sdf closed>" if self._ptr is None else f"<sph.Sdf {self.dims}>"
+
+
+class _WorldObject:
+    """An object inside a world, named by a generational id (ids of destroyed objects are
+    rejected with SphError(ERROR_INVALID_HANDLE))."""
+
+    def __init__(self, world, id_):
+        self.world = world
+        self.id = id_
+
+    @property
+    def bits(self):
+        """The id's bits (what events name as object_bits)."""
+        return self.id.bits
+
+    def destroy(self):
+        """Removes the object from its world. Idempotent (a null id is a no-op in C)."""
+        if self.id.bits:
+            self._destroy()
+            self.id = type(self.id)()
+
+    def close(self):
+        self.destroy()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.destroy()
+
+    def __repr__(self):
+        return f"<sph.{type(self).__name__} {self.id.bits:#x}>"
+
+
+class Collider(_WorldObject):
+    """A placed SDF the fluid cannot enter (World.add_collider)."""
+
+    def _destroy(self):
+        check(library().sph_collider_destroy(self.world.handle, self.id), "sph_collider_destroy")
+
+    @property
+    def transform(self):
+        """The current pose (sph_collider_get_transform)."""
+        t = _g.Transform()
+        check(library().sph_collider_get_transform(self.world.handle, self.id, ctypes.byref(t)),
+              "sph_collider_get_transform")
+        return t
+
+    def move_to(self, target):
+        """Kinematic motion: reach `target` over the next step, pushing fluid on the way
+        (sph_collider_set_target_transform)."""
+        t = as_transform(target)
+        check(library().sph_collider_set_target_transform(self.world.handle, self.id, ctypes.byref(t)),
+              "sph_collider_set_target_transform")
+
+    def teleport(self, transform):
+        """Moves at once, with no velocity (sph_collider_teleport)."""
+        t = as_transform(transform)
+        check(library().sph_collider_teleport(self.world.handle, self.id, ctypes.byref(t)), "sph_collider_teleport")
+
+    def set_material(self, restitution=0.0, friction=0.0, stickiness=0.0):
+        """Changes restitution [0, 1], friction >= 0 and stickiness >= 0 (sph_collider_set_material)."""
+        check(library().sph_collider_set_material(self.world.handle, self.id, restitution, friction, stickiness),
+              "sph_collider_set_material")
+
+
+class Source(_WorldObject):
+    """Emits particles where its region SDF is negative (World.add_source)."""
+
+    def _destroy(self):
+        check(library().sph_source_destroy(self.world.handle, self.id), "sph_source_destroy")
+
+    def set_transform(self, transform):
+        t = as_transform(transform)
+        check(library().sph_source_set_transform(self.world.handle, self.id, ctypes.byref(t)),
+              "sph_source_set_transform")
+
+
+class Sink(_WorldObject):
+    """Removes particles in a region or outside bounds (World.add_sink)."""
+
+    def _destroy(self):
+        check(library().sph_sink_destroy(self.world.handle, self.id), "sph_sink_destroy")
+
+
+class ForceField(_WorldObject):
+    """Adds an acceleration to particles (World.add_force_field)."""
+
+    def _destroy(self):
+        check(library().sph_force_field_destroy(self.world.handle, self.id), "sph_force_field_destroy")
+
+    def set_transform(self, transform):
+        t = as_transform(transform)
+        check(library().sph_force_field_set_transform(self.world.handle, self.id, ctypes.byref(t)),
+              "sph_force_field_set_transform")
+
+
+# ---- World methods --------------------------------------------------------------------------------
+def _enum(cls, value):
+    return cls[value.upper()] if isinstance(value, str) else cls(value)
+
+
+class WorldSceneMixin:
+    """The World methods that place objects in it and read its events."""
+
+    def add_collider(self, sdf, transform=None, *, inverted=False, **fields):
+        """Places an SDF asset of this world's context as a collider (sph_collider_create).
+
+        ``inverted=True`` makes the solid where the SDF is positive (a container). Other fields
+        are those of ColliderDef: restitution, friction, stickiness, flags.
+        """
+        d = _g.ColliderDef(transform=as_transform(transform), **fields)
+        d.sdf = sdf.handle
+        if inverted:
+            d.flags |= _g.SPH_COLLIDER_FLAG_INVERTED
+        out = _g.ColliderId()
+        check(library().sph_collider_create(self.handle, ctypes.byref(d), ctypes.byref(out)), "sph_collider_create")
+        return Collider(self, out)
+
+    def add_source(self, region, transform=None, *, mode=_g.SourceMode.FILL_ONCE, **fields):
+        """Adds a source that fills `region` (an Sdf, negative inside) with particles
+        (sph_source_create). mode: SourceMode or "fill_once" / "continuous"; other fields are
+        those of SourceDef (spacing, min_distance, velocity, flags, rate)."""
+        d = _g.SourceDef(transform=as_transform(transform), mode=_enum(_g.SourceMode, mode), **fields)
+        d.region = region.handle
+        out = _g.SourceId()
+        check(library().sph_source_create(self.handle, ctypes.byref(d), ctypes.byref(out)), "sph_source_create")
+        return Source(self, out)
+
+    def add_sink(self, region=None, transform=None, *, bounds=None, **fields):
+        """Adds a sink (sph_sink_create): with `region` (an Sdf) it removes particles inside it;
+        with ``bounds=(min, max)`` it removes particles outside that world-space box."""
+        if bounds is not None:
+            fields.setdefault("mode", _g.SinkMode.OUTSIDE_BOUNDS)
+            fields["bounds_min"], fields["bounds_max"] = bounds
+        if "mode" in fields:
+            fields["mode"] = _enum(_g.SinkMode, fields["mode"])
+        d = _g.SinkDef(transform=as_transform(transform), **fields)
+        if region is not None:
+            d.region = region.handle
+        out = _g.SinkId()
+        check(library().sph_sink_create(self.handle, ctypes.byref(d), ctypes.byref(out)), "sph_sink_create")
+        return Sink(self, out)
+
+    def add_force_field(self, kind=_g.ForceFieldKind.UNIFORM, transform=None, *, region=None, grid=None,
+                        grid_index_to_local=None, **fields):
+        """Adds a force field (sph_force_field_create). kind: ForceFieldKind or "uniform",
+        "radial", "vortex", "grid"; fields of ForceFieldDef: vector, strength, falloff_radius.
+        region: optional Sdf limiting it; grid: (nk, nj, ni, 3) accelerations for kind GRID."""
+        d = _g.ForceFieldDef(kind=_enum(_g.ForceFieldKind, kind), transform=as_transform(transform), **fields)
+        if region is not None:
+            d.region = region.handle
+        keep = None
+        if grid is not None:
+            g, a = _grid(grid, 3, grid_index_to_local, "grid")
+            keep = (g, a)
+            d.grid = ctypes.pointer(g)
+        out = _g.ForceFieldId()
+        check(library().sph_force_field_create(self.handle, ctypes.byref(d), ctypes.byref(out)),
+              "sph_force_field_create")
+        del keep
+        return ForceField(self, out)
+
+    def events(self):
+        """Events of the last step as a list of Event (type: EventType, count, object_bits;
+        compare object_bits with a Source's or Sink's .bits) (sph_world_get_events)."""
+        n = ctypes.c_uint32()
+        lib = library()
+        check(lib.sph_world_get_events(self.handle, None, 0, ctypes.byref(n)), "sph_world_get_events")
+        while True:  # the two-call pattern: count, then fetch (again if it grew)
+            buf = (_g.Event * n.value)()
+            r = check(lib.sph_world_get_events(self.handle, buf, n.value, ctypes.byref(n)), "sph_world_get_events")
+            if r != _g.Result.INCOMPLETE:
+                return list(buf[:n.value])
+
+    def removed_ids(self):
+        """Ids of the particles sinks removed during the last step, as a uint32 array
+        (sph_world_get_removed_ids)."""
+        n = ctypes.c_uint32()
+        lib = library()
+        check(lib.sph_world_get_removed_ids(self.handle, None, 0, ctypes.byref(n)), "sph_world_get_removed_ids")
+        while True:
+            out = np.empty(n.value, np.uint32)
+            r = check(lib.sph_world_get_removed_ids(self.handle, out.ctypes.data_as(ctypes.POINTER(ctypes.c_uint32)),
+                                                    n.value, ctypes.byref(n)), "sph_world_get_removed_ids")
+            if r != _g.Result.INCOMPLETE:
+                return out[:n.value]

@@ -1,0 +1,139 @@
+"""Base classes of the generated ctypes structs and opaque types."""
+import ctypes
+
+
+class Opaque(ctypes.Structure):
+    """An opaque C object (sph_context, sph_world, ...): only ever used through pointers."""
+
+    _fields_ = []
+    _sph_destroy_ = None
+
+
+def _field_types(cls):
+    cached = cls.__dict__.get("_sph_field_types_")
+    if cached is None:
+        cached = dict(cls._fields_)
+        cls._sph_field_types_ = cached
+    return cached
+
+
+def _convert(ftype, value):
+    """Accepts tuples/lists/arrays for struct and fixed-array fields."""
+    if isinstance(value, ftype):
+        return value
+    if isinstance(ftype, type) and issubclass(ftype, SphStruct):
+        if isinstance(value, dict):
+            return ftype(**value)
+        return ftype(*value)
+    if isinstance(ftype, type) and issubclass(ftype, ctypes.Array):
+        values = list(value)
+        if len(values) != ftype._length_:
+            raise ValueError(f"expected {ftype._length_} values, got {len(values)}")
+        return ftype(*values)
+    return value
+
+
+class SphStruct(ctypes.Structure):
+    """A C struct of sph_c.h with keyword construction and defaults.
+
+    Constructing one calls its C init function (``sph_<name>_init_sized``) when the header has
+    one (or the exported default value, e.g. ``sph_transform_identity``), so every field
+    starts at the library's default, then applies positional and keyword
+    arguments: ``WorldParams(gravity=(0, 0, 0), viscosity=2.0)``. Struct and array fields
+    accept tuples, lists and numpy arrays. Unknown field names raise AttributeError (a typo
+    never passes silently). Enum fields read back as IntEnum members.
+    """
+
+    _fields_ = []
+    _sph_c_name_ = ""  # the C name, e.g. "sph_world_params"
+    _sph_size_ = 0  # sizeof() measured by the C compiler when sph_api.json was generated
+    _sph_offsets_ = ()  # (field, offsetof()) pairs from the same measurement
+    _sph_init_ = None  # name of the exported sized init function, if any
+    _sph_assigns_ = {}  # fields the header's inline init sets after the sized init
+    _sph_default_ = None  # or an exported function returning the default value (sph_transform_identity)
+    _sph_enums_ = {}  # field -> IntEnum class
+
+    def __init__(self, *args, **kwargs):
+        super().__init__()
+        if self._sph_init_:
+            from . import _errors, _loader
+
+            fn = getattr(_loader.library(), self._sph_init_)
+            _errors.check(fn(ctypes.byref(self), ctypes.sizeof(self)), self._sph_init_)
+            for name, value in self._sph_assigns_.items():
+                setattr(self, name, value)
+        elif self._sph_default_:
+            from . import _loader
+
+            value = getattr(_loader.library(), self._sph_default_)()
+            ctypes.memmove(ctypes.byref(self), ctypes.byref(value), ctypes.sizeof(self))
+        names = [f[0] for f in self._fields_]
+        if len(args) > len(names):
+            raise TypeError(f"{type(self).__name__} takes at most {len(names)} positional arguments")
+        for name, value in zip(names, args):
+            setattr(self, name, value)
+        for name, value in kwargs.items():
+            setattr(self, name, value)
+
+    def __setattr__(self, name, value):
+        ftype = _field_types(type(self)).get(name)
+        if ftype is None:
+            raise AttributeError(f"{type(self).__name__} has no field {name!r}")
+        super().__setattr__(name, _convert(ftype, value))
+
+    def __getattribute__(self, name):
+        value = super().__getattribute__(name)
+        enums = type(self)._sph_enums_
+        if enums and name in enums:
+            try:
+                return enums[name](value)
+            except ValueError:
+                return value  # a value this binding does not know (a newer library)
+        return value
+
+    # Plain value structs (no struct_size: vectors, quaternions, ids) unpack like tuples.
+    def __iter__(self):
+        if "struct_size" in _field_types(type(self)):
+            raise TypeError(f"{type(self).__name__} is not iterable; use to_dict()")
+        return (getattr(self, f[0]) for f in self._fields_)
+
+    def __eq__(self, other):
+        if type(other) is not type(self):
+            return NotImplemented
+        return bytes(self) == bytes(other)
+
+    __hash__ = None
+
+    def copy(self):
+        """A copy of the struct."""
+        return type(self).from_buffer_copy(self)
+
+    def to_dict(self):
+        """The fields as a dict; nested structs become dicts, arrays lists, enums IntEnums."""
+        out = {}
+        for name, ftype in self._fields_:
+            value = getattr(self, name)
+            if isinstance(value, SphStruct):
+                value = value.to_dict()
+            elif isinstance(value, ctypes.Array):
+                value = [v.to_dict() if isinstance(v, SphStruct) else v for v in value]
+            elif isinstance(value, ctypes._Pointer) or isinstance(value, ctypes._CFuncPtr):
+                value = ctypes.cast(value, ctypes.c_void_p).value
+            out[name] = value
+        return out
+
+    def __repr__(self):
+        parts = []
+        for name, _ in self._fields_:
+            value = getattr(self, name)
+            if isinstance(value, ctypes.Array):
+                value = list(value)
+            elif isinstance(value, ctypes._Pointer) or isinstance(value, ctypes._CFuncPtr):
+                addr = ctypes.cast(value, ctypes.c_void_p).value
+                value = "NULL" if not addr else hex(addr)
+                parts.append(f"{name}={value}")
+                continue
+            if isinstance(value, float):
+                value = float(f"{value:.7g}")  # float32 fields: no 0.1 -> 0.10000000149
+            parts.append(f"{name}={value!r}")
+        return f"{type(self).__name__}({', '.join(parts)})"

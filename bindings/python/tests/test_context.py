@@ -1,0 +1,102 @@
+"""Contexts: creation, backend, errors with the right sph_result, closing, logging."""
+import pytest
+
+import sph
+
+
+def test_cpu_context(ctx):
+    assert ctx.backend == sph.Backend.CPU
+    assert "CPU" in repr(ctx)
+
+
+def test_backend_by_name_and_enum():
+    for backend in ("cpu", sph.Backend.CPU, 1):
+        with sph.Context(backend, cpu_worker_count=1) as c:
+            assert c.backend == sph.Backend.CPU
+
+
+def test_auto_resolves_to_a_real_backend():
+    with sph.Context() as c:
+        assert c.backend in (sph.Backend.CPU, sph.Backend.CUDA)
+
+
+def test_cuda_without_cuda_is_unsupported():
+    if "cuda" in sph.build_info():
+        pytest.skip("this library has the CUDA backend")
+    with pytest.raises(sph.SphError) as e:
+        sph.Context("cuda")
+    assert e.value.result == sph.Result.ERROR_UNSUPPORTED
+    assert e.value.function == "sph_context_create"
+    assert e.value.message and e.value.message in str(e.value)
+
+
+@pytest.mark.parametrize("field, value, result", [
+    ("struct_size", 4, sph.Result.ERROR_VERSION_MISMATCH),
+    ("header_version", sph.make_version(sph.BINDINGS_VERSION[0] + 1, 0, 0), sph.Result.ERROR_VERSION_MISMATCH),
+    ("backend", 7, sph.Result.ERROR_UNSUPPORTED),
+    ("reserved0", 1, sph.Result.ERROR_INVALID_ARGUMENT),
+])
+def test_bad_context_def(field, value, result):
+    d = sph.ContextDef(backend=sph.Backend.CPU)
+    setattr(d, field, value)
+    with pytest.raises(sph.SphError) as e:
+        sph.Context(definition=d)
+    assert e.value.result == result, e.value
+
+
+def test_close_closes_the_worlds_and_assets_created_on_it():
+    before = sph.live_object_count()
+    c = sph.Context("cpu", cpu_worker_count=1)
+    w = c.world(capacity=10)
+    s = c.shape("sphere", radius=0.1, voxel_size=0.05)
+    w.add_collider(s)
+    assert sph.live_object_count() == before + 3
+    # The C library itself refuses while they live:
+    assert sph.library().sph_context_destroy(c.handle) == sph.Result.ERROR_BUSY
+    c.close()
+    c.close()
+    assert c.closed and w.closed and repr(s) == "<sph.Sdf closed>"
+    assert sph.live_object_count() == before
+    assert repr(c) == "<sph.Context closed>"
+
+
+def test_closed_context_is_an_invalid_handle():
+    c = sph.Context("cpu", cpu_worker_count=1)
+    c.close()
+    with pytest.raises(sph.SphError) as e:
+        c.backend
+    assert e.value.result == sph.Result.ERROR_INVALID_HANDLE
+    with pytest.raises(sph.SphError) as e:
+        c.world()
+    assert e.value.result == sph.Result.ERROR_INVALID_HANDLE
+
+
+def test_world_keeps_its_context_alive():
+    before = sph.live_object_count()
+    w = sph.Context("cpu", cpu_worker_count=1).world(capacity=100)
+    assert sph.live_object_count() == before + 2
+    assert w.context.backend == sph.Backend.CPU
+    w.close()
+    w.context.close()
+    assert sph.live_object_count() == before
+
+
+def test_log_callback_gets_failures():
+    messages = []
+    with sph.Context("cpu", cpu_worker_count=1, log=lambda *m: messages.append(m)) as c:
+        with pytest.raises(sph.SphError):
+            c.world(capacity=0)
+    assert messages, "the log callback was called"
+    level, code, text = messages[-1]
+    assert level == sph.LogLevel.ERROR and code == sph.Result.ERROR_INVALID_ARGUMENT
+    assert "capacity" in text
+
+
+def test_log_callback_exceptions_do_not_escape(capsys):
+    def bad_log(*_):
+        raise RuntimeError("from the log callback")
+    with sph.Context("cpu", cpu_worker_count=1, log=bad_log) as c:
+        with pytest.raises(sph.SphError) as e:
+            c.world(capacity=0)
+    assert e.value.result == sph.Result.ERROR_INVALID_ARGUMENT
+    assert "from the log callback" in capsys.readouterr().err

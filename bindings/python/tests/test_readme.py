@@ -1,0 +1,19 @@
+"""The README's two-line example runs as written."""
+import os
+import re
+import subprocess
+import sys
+
+README = os.path.join(os.path.dirname(__file__), "..", "README.md")
+
+
+def test_readme_snippet_runs():
+    text = open(README, encoding="utf-8").read()
+    m = re.search(r"<!-- snippet: python[^>]*-->\s*```python\n(.*?)```", text, re.S)
+    assert m, "README.md has no python snippet after the marker"
+    code = m.group(1)
+    assert len(code.strip().splitlines()) == 2
+    env = dict(os.environ, PYTHONPATH=os.path.join(os.path.dirname(__file__), ".."))
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert "[[" in out.stdout  # printed the (n, 3) positions

@@ -1,0 +1,245 @@
+"""SDF assets, colliders, sources, sinks, force fields and events."""
+import ctypes
+
+import numpy as np
+import pytest
+
+import sph
+
+
+def error(fn, *args, **kwargs):
+    with pytest.raises(sph.SphError) as e:
+        fn(*args, **kwargs)
+    assert e.value.message, "the library explained the failure"
+    return e.value.result
+
+
+def sphere_grid(n=13, radius=0.1):
+    """A sphere's signed distance on an n^3 grid of voxel radius/3, centred on the origin."""
+    voxel = radius / 3
+    origin = -(n - 1) / 2 * voxel
+    c = origin + voxel * np.arange(n)
+    z, y, x = np.meshgrid(c, c, c, indexing="ij")  # (k, j, i): i fastest
+    return np.sqrt(x * x + y * y + z * z) - radius, voxel, (origin,) * 3
+
+
+# ---- SDF assets -------------------------------------------------------------------------------------
+def test_shape_assets(ctx):
+    with ctx.shape("sphere", radius=0.2, voxel_size=0.02) as ball:
+        assert ball.sample((0, 0, 0)) == pytest.approx(-0.2, abs=0.01)
+        assert ball.sample((0.5, 0, 0)) == pytest.approx(0.3, abs=0.02)
+        assert all(d > 20 for d in ball.dims)
+        assert "Sdf" in repr(ball)
+    assert repr(ball) == "<sph.Sdf closed>"
+    assert error(ball.sample, (0, 0, 0)) == sph.Result.ERROR_INVALID_HANDLE
+    ball.close()  # idempotent
+    tank = sph.Sdf.shape(ctx, sph.Shape.BOX, half_extents=(0.3, 0.3, 0.3), wall_thickness=0.05, voxel_size=0.05,
+                         open_top=True)
+    assert tank.sample((0, 0, 0)) > 0  # the cavity is outside the solid
+    tank.close()
+    assert error(ctx.shape, "sphere", radius=-1.0) == sph.Result.ERROR_INVALID_ARGUMENT
+    with pytest.raises(ValueError):
+        ctx.shape(42)  # not a Shape member
+
+
+def test_unknown_shape_value_is_unsupported(ctx):
+    d = sph.ShapeDesc()
+    d.shape = 42
+    out = ctypes.POINTER(sph.raw.sph_sdf)()
+    r = sph.library().sph_sdf_create_shape(ctx.handle, ctypes.byref(d), ctypes.byref(out))
+    assert r == sph.Result.ERROR_UNSUPPORTED
+
+
+def test_grid_assets_and_updates(ctx):
+    dist, voxel, origin = sphere_grid()
+    vel = np.zeros(dist.shape + (3,), np.float32)
+    with ctx.sdf(dist, voxel_size=voxel, origin=origin, velocity=vel, friction=np.ones(dist.shape)) as s:
+        assert s.dims == (13, 13, 13)
+        assert s.sample((0, 0, 0)) == pytest.approx(-0.1, abs=0.01)
+        s.update("distance", np.full((2, 2, 2), 0.5), origin=(5, 5, 5))
+        assert s.sample((0, 0, 0)) > 0.3
+        s.update(sph.SdfChannel.VELOCITY, np.ones((1, 1, 1, 3)))
+        assert error(s.update, "distance", np.zeros((2, 2, 2)), origin=(12, 12, 12)) \
+            == sph.Result.ERROR_INVALID_ARGUMENT
+        assert error(s.update, "distance", np.full((1, 1, 1), np.nan)) == sph.Result.ERROR_INVALID_ARGUMENT
+        with pytest.raises(ValueError):
+            s.update("distance", np.zeros(4))
+    with sph.Sdf.from_grid(ctx, dist, index_to_local=sph.grid_transform(voxel, origin)) as s2:
+        assert s2.sample((0, 0, 0)) == pytest.approx(-0.1, abs=0.01)
+    bad = dist.copy()
+    bad[0, 0, 0] = np.inf
+    assert error(ctx.sdf, bad) == sph.Result.ERROR_INVALID_ARGUMENT
+    assert error(ctx.sdf, dist, index_to_local=np.zeros(12)) == sph.Result.ERROR_INVALID_ARGUMENT  # singular
+    with pytest.raises(ValueError):
+        ctx.sdf(np.zeros((4, 4)))
+
+
+def test_raw_sdf_errors(ctx):
+    lib = sph.library()
+    with ctx.shape("sphere", radius=0.1, voxel_size=0.05) as s:
+        one = (ctypes.c_uint32 * 3)(1, 1, 1)
+        data = (ctypes.c_float * 1)(0.0)
+        r = lib.sph_sdf_update(s.handle, 0, one, one, data, sph.MemoryKind.CUDA_DEVICE)
+        assert r == sph.Result.ERROR_UNSUPPORTED  # device memory on a CPU context
+        assert lib.sph_sdf_update(s.handle, 9, one, one, data, 0) == sph.Result.ERROR_UNSUPPORTED
+    d = sph.SdfDesc()  # distance.data NULL
+    out = ctypes.POINTER(sph.raw.sph_sdf)()
+    assert lib.sph_sdf_create(ctx.handle, ctypes.byref(d), ctypes.byref(out)) == sph.Result.ERROR_INVALID_ARGUMENT
+
+
+def test_context_is_busy_while_assets_live():
+    c = sph.Context("cpu", cpu_worker_count=1)
+    s = c.shape("sphere", radius=0.1, voxel_size=0.05)
+    assert sph.library().sph_context_destroy(c.handle) == sph.Result.ERROR_BUSY
+    s.close()
+    assert sph.library().sph_context_destroy(c.handle) == sph.Result.OK
+    c._ptr = None
+
+
+# ---- colliders -------------------------------------------------------------------------------------
+def test_a_floor_holds_the_water(ctx):
+    def drop(with_floor):
+        with ctx.world(capacity=4000, particle_spacing=0.03) as w, \
+                ctx.shape("plane", half_extents=(1, 0.1, 1), voxel_size=0.03) as floor:
+            if with_floor:
+                w.add_collider(floor)
+            w.fill_box((-0.1, 0.02, -0.1), (0.1, 0.2, 0.1))
+            for _ in range(30):
+                w.step(1 / 60)
+            return w.positions()[:, 1].min()
+    assert drop(False) < -1.0  # free fall: g t^2 / 2 = 1.23 m in 0.5 s
+    assert drop(True) > -0.05  # held by the plane at y = 0
+
+
+def test_collider_pose_material_and_lifetime(ctx, world):
+    with ctx.shape("box", half_extents=(0.1, 0.1, 0.1), voxel_size=0.05) as box:
+        c = world.add_collider(box, (1, 2, 3), restitution=0.5, friction=0.2)
+    assert c.bits != 0 and "Collider" in repr(c)
+    assert tuple(c.transform.position) == (1, 2, 3)
+    c.teleport(((0, 1, 0), (0, 0, 0, 2)))  # normalised by the library
+    t = c.transform
+    assert tuple(t.position) == (0, 1, 0) and tuple(t.rotation) == (0, 0, 0, 1)
+    c.move_to({"position": (0, 1.01, 0)})
+    world.step(1 / 60)
+    assert tuple(c.transform.position) == pytest.approx((0, 1.01, 0))
+    c.set_material(restitution=1.0, friction=0.0, stickiness=2.0)
+    assert error(c.set_material, restitution=2.0) == sph.Result.ERROR_INVALID_ARGUMENT
+    assert error(c.teleport, (0, np.nan, 0)) == sph.Result.ERROR_INVALID_ARGUMENT
+    assert error(c.teleport, ((0, 0, 0), (0, 0, 0, 0))) == sph.Result.ERROR_INVALID_ARGUMENT
+    stale = sph.Collider(world, c.id.copy())
+    c.destroy()
+    c.destroy()  # a null id is a no-op
+    assert error(stale.destroy) == sph.Result.ERROR_INVALID_HANDLE
+    assert error(lambda: stale.transform) == sph.Result.ERROR_INVALID_HANDLE
+    with pytest.raises(ValueError):
+        sph.as_transform((1, 2))
+
+
+def test_collider_errors(ctx, world):
+    with ctx.shape("sphere", radius=0.1, voxel_size=0.05) as s:
+        assert error(world.add_collider, s, restitution=-1.0) == sph.Result.ERROR_INVALID_ARGUMENT
+        assert error(world.add_collider, s, flags=0x80) == sph.Result.ERROR_UNSUPPORTED
+        assert error(world.add_collider, s, reserved0=1) == sph.Result.ERROR_INVALID_ARGUMENT
+        inverted = world.add_collider(s, inverted=True)
+        inverted.destroy()
+    closed = sph.Sdf(ctx, None)
+    assert error(world.add_collider, closed) == sph.Result.ERROR_INVALID_ARGUMENT  # NULL sdf
+    with sph.Context("cpu", cpu_worker_count=1) as other:
+        foreign = other.shape("sphere", radius=0.1, voxel_size=0.05)
+        assert error(world.add_collider, foreign) == sph.Result.ERROR_INVALID_ARGUMENT
+        foreign.close()
+
+
+# ---- sources, sinks, events ------------------------------------------------------------------------
+def test_source_fills_its_region_and_reports_capacity(ctx):
+    with ctx.world(capacity=300, particle_spacing=0.02) as w, ctx.shape("sphere", radius=0.05,
+                                                                             voxel_size=0.01) as ball:
+        w.set_params(gravity=(0, 0, 0))
+        src = w.add_source(ball, (0, 0, 0))
+        w.step(1 / 60)
+        n = len(w)
+        assert n > 20
+        assert np.linalg.norm(w.positions(), axis=1).max() <= 0.05 + 0.01
+        assert w.events() == []
+        src.set_transform((1, 0, 0))
+        flood = w.add_source(ctx.shape("box", half_extents=(0.2, 0.2, 0.2), voxel_size=0.02), (3, 0, 0),
+                             mode="continuous")
+        w.step(1 / 60)
+        assert len(w) == 300
+        ev = w.events()
+        assert any(e.type == sph.EventType.SOURCE_CAPACITY_REACHED and e.object_bits == flood.bits and e.count > 0
+                   for e in ev), ev
+        flood.destroy()
+        src.destroy()
+        assert error(w.add_source, ball, spacing=-1.0) == sph.Result.ERROR_INVALID_ARGUMENT
+
+
+def test_sink_removes_particles_and_reports_their_ids(ctx):
+    with ctx.world(capacity=4000, particle_spacing=0.03) as w:
+        w.fill_box((-0.1, 0.0, -0.1), (0.1, 0.2, 0.1))
+        below = w.ids()[w.positions()[:, 1] < 0.1]
+        sink = w.add_sink(bounds=((-1, 0.1, -1), (1, 1, 1)))
+        w.set_params(gravity=(0, 0, 0))
+        w.step(1 / 240)
+        removed = w.removed_ids()
+        assert removed.dtype == np.uint32 and set(removed) == set(below)
+        assert len(w) > 0 and (w.positions()[:, 1] >= 0.1).all()
+        ev = w.events()
+        assert [(e.type, e.count, e.object_bits) for e in ev] == [(sph.EventType.SINK_REMOVED, len(below), sink.bits)]
+        sink.destroy()
+        with ctx.shape("sphere", radius=0.05, voxel_size=0.01) as ball:
+            region = w.add_sink(ball, (0, 0.15, 0))
+            w.step(1 / 240)
+            assert len(w.removed_ids()) > 0
+            region.destroy()
+        assert error(w.add_sink) == sph.Result.ERROR_INVALID_ARGUMENT  # REGION mode without a region
+
+
+def test_force_fields(ctx):
+    with ctx.world(capacity=2000, particle_spacing=0.03) as w:
+        w.set_params(gravity=(0, 0, 0))
+        w.fill_sphere((0, 0, 0), 0.06)
+        push = w.add_force_field("uniform", vector=(2, 0, 0))
+        w.step(0.05)
+        assert w.velocities()[:, 0].mean() == pytest.approx(0.1, rel=0.05)
+        push.set_transform(((0, 0, 0), (0, 0, 1, 0)))  # rotated 180 degrees about z: now -x
+        w.step(0.05)
+        assert abs(w.velocities()[:, 0].mean()) < 0.02
+        push.destroy()
+        grid = np.zeros((4, 4, 4, 3), np.float32)
+        grid[..., 1] = 3.0
+        up = w.add_force_field("grid", grid=grid, grid_index_to_local=sph.grid_transform(0.2, (-0.3, -0.3, -0.3)))
+        w.step(0.05)
+        assert w.velocities()[:, 1].mean() == pytest.approx(0.15, rel=0.1)
+        up.destroy()
+        with ctx.shape("sphere", radius=0.5, voxel_size=0.1) as region:
+            radial = w.add_force_field(sph.ForceFieldKind.RADIAL, region=region, strength=1.0, falloff_radius=1.0)
+            radial.destroy()
+        assert error(w.add_force_field, "grid") == sph.Result.ERROR_INVALID_ARGUMENT  # no grid
+        assert error(w.add_force_field, "uniform", vector=(np.nan, 0, 0)) == sph.Result.ERROR_INVALID_ARGUMENT
+
+
+def test_events_two_call_pattern_raw(world):
+    n = ctypes.c_uint32(7)
+    lib = sph.library()
+    assert lib.sph_world_get_events(world.handle, None, 0, ctypes.byref(n)) == sph.Result.OK and n.value == 0
+    assert lib.sph_world_get_events(world.handle, None, 1, ctypes.byref(n)) == sph.Result.ERROR_INVALID_ARGUMENT
+    assert lib.sph_world_get_removed_ids(world.handle, None, 0, None) == sph.Result.ERROR_INVALID_ARGUMENT
+
+
+# ---- the CUDA tier ---------------------------------------------------------------------------------------
+def test_cuda_tier_on_a_cpu_world_is_unsupported(world):
+    for call in (lambda: world.cuda_attribute(sph.Attribute.POSITION), lambda: world.cuda_array(sph.Attribute.ID),
+                 lambda: world.cuda_epoch, lambda: world.cuda_device, lambda: world.cuda_stream,
+                 lambda: world.cuda_record_event(1), lambda: world.cuda_wait_event(1)):
+        assert error(call) == sph.Result.ERROR_UNSUPPORTED
+
+
+def test_cuda_array_interface_shape():
+    view = sph.CudaAttributeView(count=5, stride=16, element_size=12, device_address=0x1000, epoch=3)
+    a = sph.CudaArray(None, view, np.dtype(np.float32), 3)
+    cai = a.__cuda_array_interface__
+    assert cai == {"shape": (5, 3), "typestr": "<f4", "data": (0x1000, True), "strides": (16, 4), "version": 3,
+                   "stream": None}
+    ids = sph.CudaArray(None, sph.CudaAttributeView(count=5, stride=4), np.dtype(np.uint32), 1)
+    assert ids.__cuda_array_interface__["shape"] == (5,) and ids.__cuda_array_interface__["typestr"] == "<u4"

@@ -1,0 +1,262 @@
+"""Worlds: defs, params, spawning from numpy, fills, stepping, reading back, stats, errors."""
+import ctypes
+
+import numpy as np
+import pytest
+
+import sph
+
+
+def raw(name, *args):
+    """Calls a C function directly (for arguments the Pythonic layer never passes)."""
+    return sph._errors.check(getattr(sph.library(), name)(*args), name)
+
+
+def error(fn, *args, **kwargs):
+    with pytest.raises(sph.SphError) as e:
+        fn(*args, **kwargs)
+    assert e.value.message, "the library explained the failure"
+    return e.value.result
+
+
+# ---- creation -------------------------------------------------------------------------------------
+def test_definition_resolves_defaults(world):
+    d = world.definition
+    assert isinstance(d, sph.WorldDef)
+    assert d.capacity == 4096
+    assert d.kernel_radius == pytest.approx(1.8 * 0.02)
+    assert d.integrator == sph.Integrator.SYMPLECTIC_EULER and isinstance(d.integrator, sph.Integrator)
+    assert d.rest_density == 1000
+    assert world.particle_mass > 0
+
+
+def test_world_from_a_def_and_keywords(ctx):
+    d = sph.WorldDef(particle_spacing=0.05, integrator=sph.Integrator.RK4)
+    with ctx.world(d, capacity=7) as w:
+        assert (w.definition.capacity, w.definition.integrator) == (7, sph.Integrator.RK4)
+    assert d.capacity == 65536  # the caller's def is not modified
+
+
+@pytest.mark.parametrize("fields, result", [
+    ({"capacity": 0}, sph.Result.ERROR_INVALID_ARGUMENT),
+    ({"particle_spacing": -1.0}, sph.Result.ERROR_INVALID_ARGUMENT),
+    ({"particle_spacing": float("nan")}, sph.Result.ERROR_INVALID_ARGUMENT),
+    ({"kernel_radius": 0.01}, sph.Result.ERROR_INVALID_ARGUMENT),
+    ({"rest_density": 0.0}, sph.Result.ERROR_INVALID_ARGUMENT),
+    ({"integrator": 9}, sph.Result.ERROR_UNSUPPORTED),
+    ({"features": 0x80}, sph.Result.ERROR_UNSUPPORTED),
+    ({"struct_size": 8}, sph.Result.ERROR_VERSION_MISMATCH),
+])
+def test_bad_world_def(ctx, fields, result):
+    assert error(ctx.world, **fields) == result
+
+
+def test_unknown_field_is_an_error_not_a_silent_typo(ctx):
+    with pytest.raises(AttributeError, match="capacityy"):
+        ctx.world(capacityy=10)
+
+
+# ---- runtime parameters ------------------------------------------------------------------------
+def test_params_round_trip(world):
+    p = world.params
+    assert tuple(p.gravity) == pytest.approx((0, -9.81, 0))
+    p.gravity = (0, 0, -1)
+    p.viscosity = 2.5
+    world.params = p
+    assert world.params == p
+    q = world.set_params(step_factor=0.2)
+    assert world.params.step_factor == pytest.approx(0.2) and tuple(q.gravity) == (0, 0, -1)
+
+
+def test_bad_params_change_nothing(world):
+    before = world.params
+    assert error(world.set_params, stiffness=-1.0) == sph.Result.ERROR_INVALID_ARGUMENT
+    assert error(world.set_params, dt_max=1e-9) == sph.Result.ERROR_INVALID_ARGUMENT  # < dt_min
+    assert error(world.set_params, max_substeps=0) == sph.Result.ERROR_INVALID_ARGUMENT
+    assert world.params == before
+    p = sph.WorldParams()
+    p.struct_size = 4
+    assert error(setattr, world, "params", p) == sph.Result.ERROR_VERSION_MISMATCH
+    assert error(raw, "sph_world_get_params", world.handle, ctypes.byref(p)) == sph.Result.ERROR_VERSION_MISMATCH
+    s = sph.Stats()
+    s.struct_size = 4
+    assert error(raw, "sph_world_get_stats", world.handle, ctypes.byref(s)) == sph.Result.ERROR_VERSION_MISMATCH
+    d = sph.WorldDef()
+    d.struct_size = 4
+    assert error(raw, "sph_world_get_def", world.handle, ctypes.byref(d)) == sph.Result.ERROR_VERSION_MISMATCH
+
+
+# ---- spawning and reading back -----------------------------------------------------------------
+def _by_id(world, first):
+    order = np.argsort(world.ids())
+    return order, world.ids()[order] - first
+
+
+def test_spawn_and_read_back_by_id(world):
+    rng = np.random.default_rng(1)
+    pos = rng.uniform(-1, 1, (300, 3)).astype(np.float32)
+    vel = rng.uniform(-2, 2, (300, 3)).astype(np.float32)
+    first = world.spawn(pos, vel)
+    assert len(world) == world.particle_count == 300
+    ids = world.ids()
+    assert ids.dtype == np.uint32 and sorted(ids - first) == list(range(300))
+    got_pos, got_vel = world.positions(), world.velocities()
+    assert got_pos.dtype == np.float32 and got_pos.shape == (300, 3)
+    np.testing.assert_array_equal(got_pos, pos[ids - first])
+    np.testing.assert_array_equal(got_vel, vel[ids - first])
+    second = world.spawn(np.zeros((2, 3)))  # float64 is converted; ids continue
+    assert second == first + 300
+
+
+def test_spawn_uses_the_row_stride_of_numpy_views(world):
+    table = np.zeros((100, 7), np.float32)  # x y z vx vy vz tag
+    table[:, 0] = np.arange(100)
+    table[:, 3:6] = 1.5
+    pos, vel = table[:, 0:3], table[:, 3:6]
+    assert pos.strides == (28, 4) and not pos.flags.c_contiguous
+    first = world.spawn(pos, vel)
+    ids = world.ids()
+    np.testing.assert_array_equal(world.positions()[:, 0], ids - first)
+    assert (world.velocities() == 1.5).all()
+
+
+def test_spawn_single_point_and_empty(world):
+    world.spawn((0.1, 0.2, 0.3))
+    world.spawn(np.empty((0, 3), np.float32))
+    assert len(world) == 1
+    np.testing.assert_allclose(world.positions(), [[0.1, 0.2, 0.3]])
+
+
+def test_spawn_errors_leave_the_world_unchanged(ctx):
+    with ctx.world(capacity=8) as w:
+        assert error(w.spawn, np.zeros((9, 3))) == sph.Result.ERROR_CAPACITY
+        bad = np.zeros((3, 3))
+        bad[1, 1] = np.inf
+        assert error(w.spawn, bad) == sph.Result.ERROR_INVALID_ARGUMENT
+        assert error(w.spawn, np.zeros((2, 3)), np.full((2, 3), np.nan)) == sph.Result.ERROR_INVALID_ARGUMENT
+        assert len(w) == 0
+        with pytest.raises(ValueError):
+            w.spawn(np.zeros((2, 2)))
+        with pytest.raises(ValueError):
+            w.spawn(np.zeros((2, 3)), np.zeros((3, 3)))
+
+
+def test_raw_spawn_desc_errors(world):
+    d = sph.SpawnDesc(count=1)  # positions NULL
+    assert error(raw, "sph_world_spawn", world.handle, ctypes.byref(d), None) == sph.Result.ERROR_INVALID_ARGUMENT
+    pos = np.zeros((2, 3), np.float32)
+    d = sph.SpawnDesc(count=2, positions=pos.ctypes.data_as(ctypes.POINTER(ctypes.c_float)), position_stride=8)
+    assert error(raw, "sph_world_spawn", world.handle, ctypes.byref(d), None) == sph.Result.ERROR_INVALID_ARGUMENT
+    assert len(world) == 0
+
+
+def test_copy_attribute_into_given_and_strided_arrays(world):
+    n = world.fill_box((0, 0, 0), (0.1, 0.1, 0.1))
+    table = np.full((n, 8), -7, np.float32)
+    out = world.copy_attribute(sph.Attribute.POSITION, out=table[:, 2:5])
+    assert np.shares_memory(out, table) and out.base is not None
+    np.testing.assert_array_equal(table[:, 2:5], world.positions())
+    assert (table[:, :2] == -7).all() and (table[:, 5:] == -7).all()
+    dens = np.empty(n, np.float32)
+    assert world.copy_attribute(sph.Attribute.DENSITY, out=dens) is not None
+    part = world.copy_attribute(sph.Attribute.ID, first=n - 3)
+    assert len(part) == 3 and (part == world.ids()[-3:]).all()
+    assert len(world.copy_attribute(sph.Attribute.VELOCITY, first=2, count=5)) == 5
+    assert len(world.copy_attribute(sph.Attribute.PRESSURE, first=n)) == 0
+    with pytest.raises(ValueError):
+        world.copy_attribute(sph.Attribute.POSITION, out=np.empty((n, 3), np.float64))
+    with pytest.raises(ValueError):
+        world.copy_attribute(sph.Attribute.ID, out=np.empty(n, np.float32))
+
+
+def test_copy_attribute_errors(world):
+    world.fill_sphere((0, 0, 0), 0.04)
+    n = len(world)
+    assert error(world.copy_attribute, sph.Attribute.ID, first=n + 1) == sph.Result.ERROR_INVALID_ARGUMENT
+    buf = np.empty(30, np.float32)
+
+    def copy(attribute, dst, size, stride, first, count):
+        return raw("sph_world_copy_attribute", world.handle, attribute, dst, size, stride, first, count, None)
+    p = buf.ctypes.data
+    assert error(copy, 0, p, 8, 0, 0, 10) == sph.Result.ERROR_BUFFER_TOO_SMALL
+    assert error(copy, 0, p, 120, 4, 0, 10) == sph.Result.ERROR_INVALID_ARGUMENT  # stride < 12
+    assert error(copy, 0, None, 120, 0, 0, 10) == sph.Result.ERROR_INVALID_ARGUMENT
+    assert error(copy, 99, p, 120, 0, 0, 10) == sph.Result.ERROR_UNSUPPORTED
+
+
+def test_attribute_formats_come_from_the_header():
+    assert sph.attribute_format(sph.Attribute.POSITION) == (np.dtype(np.float32), 3)
+    assert sph.attribute_format(sph.Attribute.DENSITY) == (np.dtype(np.float32), 1)
+    assert sph.attribute_format(sph.Attribute.ID) == (np.dtype(np.uint32), 1)
+    for a in sph.Attribute:
+        sph.attribute_format(a)  # every attribute documents its format
+
+
+# ---- fills ---------------------------------------------------------------------------------------------
+def test_fills(ctx):
+    with ctx.world(capacity=20000, particle_spacing=0.02) as w:
+        box = w.fill_box((0, 0, 0), (0.1, 0.1, 0.1), velocity=(1, 0, 0))
+        sphere = w.fill_sphere(center=(1, 1, 1), radius=0.05)
+        assert box > 50 and sphere > 20 and len(w) == box + sphere
+        v = w.velocities()
+        assert (v[:, 0] == 1).sum() == box
+        inside = np.linalg.norm(w.positions() - 1, axis=1) <= 0.05 + 1e-6
+        assert inside.sum() == sphere
+        assert error(w.fill_box, (1, 1, 1), (0, 0, 0)) == sph.Result.ERROR_INVALID_ARGUMENT
+        assert error(w.fill_sphere, (0, 0, 0), -1) == sph.Result.ERROR_INVALID_ARGUMENT
+        assert error(w.fill_sphere, (0, 0, np.nan), 1) == sph.Result.ERROR_INVALID_ARGUMENT
+    with ctx.world(capacity=10) as small:
+        assert error(small.fill_box, (0, 0, 0), (0.2, 0.2, 0.2)) == sph.Result.ERROR_CAPACITY
+        assert len(small) == 0
+
+
+# ---- stepping and statistics ---------------------------------------------------------------------
+def test_step_and_stats(world):
+    s = world.stats()
+    assert s.substeps == 0 and s.simulated_time == 0
+    n = world.fill_sphere((0, 0, 0), 0.06)
+    assert world.step(1 / 120) == sph.Result.OK
+    s = world.stats()
+    assert s.particle_count == n and 0 < s.substeps <= 20
+    assert s.frame_time == pytest.approx(1 / 120) and s.simulated_time == pytest.approx(1 / 120)
+    assert 500 < s.density_mean < 1100 and s.density_min <= s.density_mean <= s.density_max
+    assert s.memory_bytes > 0
+    d = s.to_dict()
+    assert d["substeps"] == s.substeps and len(d["stage_ms"]) == 8
+    times = sph.stage_times(s)
+    assert set(times) == set(sph.Stage) and all(t >= 0 for t in times.values())
+    # Gravity pulled everything down.
+    assert world.velocities()[:, 1].mean() < 0
+
+
+def test_step_incomplete_when_substeps_run_out(world):
+    world.fill_sphere((0, 0, 0), 0.04)
+    world.set_params(max_substeps=2)
+    assert world.step(0.5) == sph.Result.INCOMPLETE
+    s = world.stats()
+    assert s.substeps == 2 and s.frame_time < 0.5
+
+
+@pytest.mark.parametrize("dt", [0.0, -1.0, float("nan"), float("inf")])
+def test_bad_frame_dt(world, dt):
+    assert error(world.step, dt) == sph.Result.ERROR_INVALID_ARGUMENT
+
+
+def test_closed_world_is_an_invalid_handle(ctx):
+    w = ctx.world(capacity=10)
+    w.close()
+    assert w.closed and repr(w) == "<sph.World closed>"
+    for call in (lambda: w.particle_count, lambda: w.step(0.01), w.positions, w.stats, lambda: w.params,
+                 lambda: w.definition, lambda: w.particle_mass, lambda: w.fill_sphere((0, 0, 0), 1)):
+        assert error(call) == sph.Result.ERROR_INVALID_HANDLE
+
+
+def test_two_worlds_are_independent(ctx):
+    with ctx.world(capacity=1000) as a, ctx.world(capacity=1000) as b:
+        a.fill_sphere((0, 0, 0), 0.05)
+        b.set_params(gravity=(0, 0, 0))
+        b.fill_sphere((0, 0, 0), 0.05)
+        a.step(0.01)
+        b.step(0.01)
+        assert a.velocities()[:, 1].mean() < -0.05
+        assert abs(b.velocities()[:, 1].mean()) < 1e-3
