@@ -1,0 +1,914 @@
+// Sph.cs - the idiomatic C# layer over Sph.Generated.cs: Context, World, SphException.
+//
+// Unity-friendly: no unsafe code, blittable structs, Cdecl, SafeHandles for the heavy objects,
+// bulk data through pinned arrays or raw pointers (NativeArray) with a stride, never one call
+// per particle. The log callback is a static [MonoPInvokeCallback] method (IL2CPP needs that).
+using System;
+using System.Collections.Generic;
+using System.Runtime.InteropServices;
+using System.Text;
+using System.Text.RegularExpressions;
+
+#if !UNITY_5_3_OR_NEWER
+namespace AOT
+{
+    /// <summary>Unity's IL2CPP marker for static methods called from native code (defined
+    /// here outside Unity so the same source compiles with mono/.NET).</summary>
+    [AttributeUsage(AttributeTargets.Method)]
+    public sealed class MonoPInvokeCallbackAttribute : Attribute
+    {
+        public MonoPInvokeCallbackAttribute(Type type) { Type = type; }
+        public Type Type { get; private set; }
+    }
+}
+#endif
+
+namespace Sph
+{
+    /// <summary>A failed sph_ call: <see cref="Result"/> is the sph_result code and
+    /// <see cref="LibraryMessage"/> the library's sph_get_last_error() text.</summary>
+    public class SphException : Exception
+    {
+        public Result Result { get; private set; }
+        public string Function { get; private set; }
+        public string LibraryMessage { get; private set; }
+
+        public SphException(Result result, string function, string message)
+            : base(Format(result, function, message))
+        {
+            Result = result;
+            Function = function;
+            LibraryMessage = message;
+        }
+
+        static string Format(Result result, string function, string message)
+        {
+            string name = Enum.IsDefined(typeof(Result), result) ? result.ToString() : "sph_result " + (int)result;
+            return (function != null ? function + ": " : "") + name + (string.IsNullOrEmpty(message) ? "" : ": " + message);
+        }
+
+        /// <summary>Throws for a negative result (reading the thread's last error at once);
+        /// returns Ok or Incomplete.</summary>
+        public static Result Check(Result result, string function)
+        {
+            if ((int)result < 0) throw new SphException(result, function, Library.LastError);
+            return result;
+        }
+    }
+
+    /// <summary>Library-wide queries, and the check that the loaded library matches these bindings.</summary>
+    public static class Library
+    {
+        static bool verified;
+        static readonly object verifyLock = new object();
+
+        /// <summary>The loaded library's packed version (SPH_MAKE_VERSION).</summary>
+        public static uint Version { get { return Native.sph_get_version(); } }
+        public static uint AbiVersion { get { return Native.sph_get_abi_version(); } }
+        public static string BuildInfo { get { return Utf8.FromNative(Native.sph_get_build_info()); } }
+        /// <summary>The message of the last failed sph_ call on this thread ("" after a success).</summary>
+        public static string LastError { get { return Utf8.FromNative(Native.sph_get_last_error()); } }
+
+        public static string ResultString(Result result) { return Utf8.FromNative(Native.sph_result_string(result)); }
+
+        public static uint MakeVersion(uint major, uint minor, uint patch) { return (major << 22) | (minor << 12) | patch; }
+
+        public static string VersionString(uint packed)
+        {
+            return (packed >> 22) + "." + ((packed >> 12) & 0x3FF) + "." + (packed & 0xFFF);
+        }
+
+        /// <summary>Contexts and worlds alive in the process (a leak check for long-lived hosts).</summary>
+        public static uint LiveObjectCount
+        {
+            get
+            {
+                uint n;
+                SphException.Check(Native.sph_get_live_object_count(out n), "sph_get_live_object_count");
+                return n;
+            }
+        }
+
+        /// <summary>Every struct whose Marshal.SizeOf or field offset differs from what the C
+        /// compiler measured when the bindings were generated (empty when all match).</summary>
+        public static List<string> LayoutProblems()
+        {
+            var problems = new List<string>();
+            if (IntPtr.Size != Layout.PointerSize)
+                problems.Add("bindings generated for " + (Layout.PointerSize * 8) + "-bit pointers, process is " + (IntPtr.Size * 8) + "-bit");
+            for (int i = 0; i < Layout.StructTypes.Length; ++i)
+            {
+                int size = Marshal.SizeOf(Layout.StructTypes[i]);
+                if (size != Layout.StructSizes[i])
+                    problems.Add(Layout.StructNames[i] + ": Marshal.SizeOf " + size + " != C sizeof " + Layout.StructSizes[i]);
+            }
+            for (int i = 0; i < Layout.FieldNames.Length; ++i)
+            {
+                int offset = Marshal.OffsetOf(Layout.FieldStructs[i], Layout.FieldNames[i]).ToInt32();
+                if (offset != Layout.FieldOffsets[i])
+                    problems.Add(Layout.FieldStructs[i].Name + "." + Layout.FieldNames[i] + ": offset " + offset + " != C offsetof " + Layout.FieldOffsets[i]);
+            }
+            return problems;
+        }
+
+        /// <summary>Checks once per process that the library's ABI version is the one the
+        /// bindings were generated for and that every struct layout matches; throws
+        /// SphException(ErrorVersionMismatch) otherwise. Context's constructor calls it.</summary>
+        public static void EnsureCompatible()
+        {
+            if (verified) return;
+            lock (verifyLock)
+            {
+                if (verified) return;
+                uint abi = AbiVersion;
+                if (abi != Layout.AbiVersion)
+                    throw new SphException(Result.ErrorVersionMismatch, "Library.EnsureCompatible",
+                        "the sph library has ABI " + abi + " but these bindings were generated for ABI " + Layout.AbiVersion +
+                        " (sph " + VersionString(Layout.Version) + ")");
+                var problems = LayoutProblems();
+                if (problems.Count > 0)
+                    throw new SphException(Result.ErrorVersionMismatch, "Library.EnsureCompatible",
+                        "struct layouts differ from the C library's: " + string.Join("; ", problems.ToArray()));
+                verified = true;
+            }
+        }
+
+        static readonly Regex formatPattern = new Regex(@"^\s*(?:(\d+)\s*x\s*)?(float32|uint32|int32)\b");
+
+        /// <summary>Components and bytes per component of an attribute, read from its doc in the
+        /// header ("3 x float32, metres"), so attributes added later need no code here.</summary>
+        public static void AttributeFormat(SphAttribute attribute, out int components, out int componentBytes)
+        {
+            string key = null;
+            foreach (var pair in Layout.EnumMemberDocs)
+                if (pair.Key.StartsWith("SPH_ATTRIBUTE_") && pair.Key.Replace("_", "").Equals("SPHATTRIBUTE" + attribute.ToString(), StringComparison.OrdinalIgnoreCase))
+                    key = pair.Key;
+            Match m = key == null ? Match.Empty : formatPattern.Match(Layout.EnumMemberDocs[key]);
+            if (!m.Success) throw new ArgumentException("attribute " + attribute + ": no documented element format");
+            components = m.Groups[1].Success ? int.Parse(m.Groups[1].Value) : 1;
+            componentBytes = 4;
+        }
+    }
+
+    /// <summary>UTF-8 strings across the boundary (Marshal.PtrToStringUTF8 is not everywhere).</summary>
+    public static class Utf8
+    {
+        public static string FromNative(IntPtr p)
+        {
+            if (p == IntPtr.Zero) return null;
+            int n = 0;
+            while (Marshal.ReadByte(p, n) != 0) ++n;
+            var bytes = new byte[n];
+            Marshal.Copy(p, bytes, 0, n);
+            return Encoding.UTF8.GetString(bytes);
+        }
+
+        /// <summary>A NUL-terminated UTF-8 copy, for const char* parameters.</summary>
+        public static byte[] ToNative(string s)
+        {
+            var bytes = Encoding.UTF8.GetBytes(s);
+            Array.Resize(ref bytes, bytes.Length + 1);
+            return bytes;
+        }
+    }
+
+    /// <summary>Called when a call on a context (or its worlds) fails; on the calling thread.</summary>
+    public delegate void LogHandler(LogLevel level, Result code, string message);
+
+    public sealed partial class ContextHandle
+    {
+        internal GCHandle LogTarget;
+
+        partial void OnReleased()
+        {
+            if (LogTarget.IsAllocated) LogTarget.Free();
+        }
+    }
+
+    /// <summary>A backend (the CPU or one CUDA device) that worlds are created on (sph_context).
+    /// Dispose it when done; worlds keep it alive until they are disposed too.</summary>
+    public sealed class Context : IDisposable
+    {
+        // One static delegate for every context: IL2CPP can only call static methods marked
+        // [MonoPInvokeCallback]; the context's handler travels in user_data as a GCHandle.
+        static readonly LogFn logThunk = OnLog;
+        static readonly IntPtr logThunkPointer = Marshal.GetFunctionPointerForDelegate(logThunk);
+
+        public ContextHandle Handle { get; private set; }
+
+        public Context(Backend backend = Backend.Auto) : this(DefFor(backend), null) { }
+
+        public Context(ContextDef def, LogHandler log = null)
+        {
+            Library.EnsureCompatible();
+            GCHandle target = default(GCHandle);
+            if (log != null)
+            {
+                target = GCHandle.Alloc(log);
+                def.LogFn = logThunkPointer;
+                def.LogUserData = GCHandle.ToIntPtr(target);
+            }
+            ContextHandle handle;
+            Result r = Native.sph_context_create(ref def, out handle);
+            if ((int)r < 0)
+            {
+                string message = Library.LastError;
+                if (target.IsAllocated) target.Free();
+                throw new SphException(r, "sph_context_create", message);
+            }
+            handle.LogTarget = target;
+            Handle = handle;
+        }
+
+        static ContextDef DefFor(Backend backend)
+        {
+            var def = ContextDef.Default();
+            def.Backend = backend;
+            return def;
+        }
+
+        [AOT.MonoPInvokeCallback(typeof(LogFn))]
+        static void OnLog(IntPtr userData, LogLevel level, Result code, IntPtr message)
+        {
+            try
+            {
+                var handler = (LogHandler)GCHandle.FromIntPtr(userData).Target;
+                handler(level, code, Utf8.FromNative(message));
+            }
+            catch (Exception e)
+            {
+                // Nothing may unwind into C.
+                Console.Error.WriteLine("sph: log handler threw: " + e);
+            }
+        }
+
+        /// <summary>The backend the context resolved to (CPU or CUDA; never Auto).</summary>
+        public Backend Backend
+        {
+            get
+            {
+                Backend b;
+                SphException.Check(Native.sph_context_get_backend(Handle, out b), "sph_context_get_backend");
+                return b;
+            }
+        }
+
+        public World CreateWorld(WorldDef def) { return new World(this, def); }
+
+        public World CreateWorld() { return new World(this, WorldDef.Default()); }
+
+        /// <summary>True after Dispose (the native context may live on while worlds use it).</summary>
+        public bool IsDisposed { get; private set; }
+
+        public void Dispose()
+        {
+            IsDisposed = true;
+            Handle.Dispose();
+        }
+    }
+
+    /// <summary>A particle fluid on a context (sph_world). Not thread-safe: use one thread at a time.</summary>
+    public sealed class World : IDisposable
+    {
+        public WorldHandle Handle { get; private set; }
+        public Context Context { get; private set; }
+
+        public World(Context context, WorldDef def)
+        {
+            WorldHandle handle;
+            SphException.Check(Native.sph_world_create(context.Handle, ref def, out handle), "sph_world_create");
+            handle.SetParent(context.Handle);  // the context outlives its worlds
+            Handle = handle;
+            Context = context;
+        }
+
+        public bool IsDisposed { get; private set; }
+
+        public void Dispose()
+        {
+            IsDisposed = true;
+            Handle.Dispose();
+        }
+
+        /// <summary>The def the world was created with, defaults resolved.</summary>
+        public WorldDef Def
+        {
+            get
+            {
+                var d = WorldDef.Default();
+                SphException.Check(Native.sph_world_get_def(Handle, ref d), "sph_world_get_def");
+                return d;
+            }
+        }
+
+        public float ParticleMass
+        {
+            get
+            {
+                float m;
+                SphException.Check(Native.sph_world_get_particle_mass(Handle, out m), "sph_world_get_particle_mass");
+                return m;
+            }
+        }
+
+        /// <summary>Runtime parameters; setting replaces them all at once (validated as a whole).</summary>
+        public WorldParams Params
+        {
+            get
+            {
+                var p = WorldParams.Default();
+                SphException.Check(Native.sph_world_get_params(Handle, ref p), "sph_world_get_params");
+                return p;
+            }
+            set { SphException.Check(Native.sph_world_set_params(Handle, ref value), "sph_world_set_params"); }
+        }
+
+        // ---- particles in ---------------------------------------------------------------------
+
+        /// <summary>Adds particles from raw memory (e.g. NativeArray.GetUnsafeReadOnlyPtr()):
+        /// count elements of 3 floats, `stride` bytes apart (0 = packed); velocities may be
+        /// IntPtr.Zero. Copied before return; all-or-nothing. Returns the first new id.</summary>
+        public uint Spawn(IntPtr positions, ulong positionStride, IntPtr velocities, ulong velocityStride, uint count)
+        {
+            var desc = SpawnDesc.Default();
+            desc.Count = count;
+            desc.Positions = positions;
+            desc.PositionStride = positionStride;
+            desc.Velocities = velocities;
+            desc.VelocityStride = velocityStride;
+            uint first;
+            SphException.Check(Native.sph_world_spawn(Handle, ref desc, out first), "sph_world_spawn");
+            return first;
+        }
+
+        /// <summary>Adds particles from xyz triples (positions.Length / 3 particles).</summary>
+        public uint Spawn(float[] positions, float[] velocities = null)
+        {
+            if (positions == null || positions.Length % 3 != 0) throw new ArgumentException("positions: a multiple of 3 floats");
+            if (velocities != null && velocities.Length != positions.Length) throw new ArgumentException("velocities: one triple per position");
+            return SpawnPinned(positions, velocities, 12, (uint)(positions.Length / 3));
+        }
+
+        /// <summary>Adds particles from arrays of any blittable vector struct whose first three
+        /// fields are x, y, z floats (Vec3, UnityEngine.Vector3, or a larger particle struct:
+        /// the stride is its size).</summary>
+        public uint Spawn<T>(T[] positions, T[] velocities = null) where T : struct
+        {
+            if (positions == null) throw new ArgumentNullException("positions");
+            if (velocities != null && velocities.Length != positions.Length) throw new ArgumentException("velocities: one per position");
+            int stride = Marshal.SizeOf(typeof(T));
+            if (stride < 12) throw new ArgumentException(typeof(T).Name + " is smaller than 3 floats");
+            return SpawnPinned(positions, velocities, (ulong)stride, (uint)positions.Length);
+        }
+
+        uint SpawnPinned(Array positions, Array velocities, ulong stride, uint count)
+        {
+            GCHandle p = GCHandle.Alloc(positions, GCHandleType.Pinned);
+            GCHandle v = velocities != null ? GCHandle.Alloc(velocities, GCHandleType.Pinned) : default(GCHandle);
+            try
+            {
+                return Spawn(p.AddrOfPinnedObject(), stride, v.IsAllocated ? v.AddrOfPinnedObject() : IntPtr.Zero, stride, count);
+            }
+            finally
+            {
+                p.Free();
+                if (v.IsAllocated) v.Free();
+            }
+        }
+
+        /// <summary>Fills the box [min, max] on an FCC lattice at rest density; returns the count added.</summary>
+        public uint FillBox(Vec3 min, Vec3 max, Vec3 velocity = default(Vec3))
+        {
+            var desc = FillBoxDesc.Default();
+            desc.Min = min;
+            desc.Max = max;
+            desc.Velocity = velocity;
+            uint n;
+            SphException.Check(Native.sph_world_fill_box(Handle, ref desc, out n), "sph_world_fill_box");
+            return n;
+        }
+
+        /// <summary>Fills a sphere on an FCC lattice; returns the count added.</summary>
+        public uint FillSphere(Vec3 center, float radius, Vec3 velocity = default(Vec3))
+        {
+            var desc = FillSphereDesc.Default();
+            desc.Center = center;
+            desc.Radius = radius;
+            desc.Velocity = velocity;
+            uint n;
+            SphException.Check(Native.sph_world_fill_sphere(Handle, ref desc, out n), "sph_world_fill_sphere");
+            return n;
+        }
+
+        // ---- stepping -------------------------------------------------------------------------
+
+        /// <summary>Advances by frameDt seconds (blocks). Returns Ok, or Incomplete when
+        /// max_substeps ran out; throws SphException (e.g. ErrorNonFinite, world rolled back).</summary>
+        public Result Step(float frameDt)
+        {
+            return SphException.Check(Native.sph_world_step(Handle, frameDt), "sph_world_step");
+        }
+
+        // ---- particles out --------------------------------------------------------------------
+
+        public uint ParticleCount
+        {
+            get
+            {
+                uint n;
+                SphException.Check(Native.sph_world_get_particle_count(Handle, out n), "sph_world_get_particle_count");
+                return n;
+            }
+        }
+
+        /// <summary>Copies particles [first, first + count) of an attribute into raw memory
+        /// (e.g. NativeArray.GetUnsafePtr()): element i at dst + i * stride (0 = packed);
+        /// dstSize is the buffer's size in bytes. Returns the number written.</summary>
+        public uint CopyAttribute(SphAttribute attribute, IntPtr dst, ulong dstSize, ulong dstStride, uint first, uint count)
+        {
+            uint written;
+            SphException.Check(Native.sph_world_copy_attribute(Handle, attribute, dst, dstSize, dstStride, first, count, out written),
+                "sph_world_copy_attribute");
+            return written;
+        }
+
+        /// <summary>Copies into a float array (3 floats per particle for vectors, 1 for
+        /// scalars), as many particles as fit from `first`. Returns the number written.</summary>
+        public uint CopyAttribute(SphAttribute attribute, float[] dst, uint first = 0)
+        {
+            int components, bytes;
+            Library.AttributeFormat(attribute, out components, out bytes);
+            return CopyPinned(attribute, dst, (ulong)(components * bytes), (uint)(dst.Length / components), first);
+        }
+
+        /// <summary>Copies a uint attribute (ids) into an array. Returns the number written.</summary>
+        public uint CopyAttribute(SphAttribute attribute, uint[] dst, uint first = 0)
+        {
+            return CopyPinned(attribute, dst, 4, (uint)dst.Length, first);
+        }
+
+        /// <summary>Copies into an array of blittable structs, one per particle, the attribute
+        /// written at the start of each element (stride = the struct's size): Vec3 or
+        /// UnityEngine.Vector3 arrays for positions, or an interleaved particle struct.</summary>
+        public uint CopyAttribute<T>(SphAttribute attribute, T[] dst, uint first = 0) where T : struct
+        {
+            return CopyPinned(attribute, dst, (ulong)Marshal.SizeOf(typeof(T)), (uint)dst.Length, first);
+        }
+
+        uint CopyPinned(SphAttribute attribute, Array dst, ulong stride, uint count, uint first)
+        {
+            if (dst == null) throw new ArgumentNullException("dst");
+            ulong size = (ulong)dst.LongLength * (ulong)Marshal.SizeOf(dst.GetType().GetElementType());
+            GCHandle h = GCHandle.Alloc(dst, GCHandleType.Pinned);
+            try
+            {
+                return CopyAttribute(attribute, h.AddrOfPinnedObject(), size, stride, first, count);
+            }
+            finally
+            {
+                h.Free();
+            }
+        }
+
+        /// <summary>Positions as a new Vec3 array (current particle order).</summary>
+        public Vec3[] Positions()
+        {
+            var a = new Vec3[ParticleCount];
+            CopyAttribute(SphAttribute.Position, a);
+            return a;
+        }
+
+        /// <summary>Persistent particle ids, in the same order as the other attributes.</summary>
+        public uint[] Ids()
+        {
+            var a = new uint[ParticleCount];
+            CopyAttribute(SphAttribute.Id, a);
+            return a;
+        }
+
+        // ---- statistics -----------------------------------------------------------------------
+
+        /// <summary>Statistics of the last Step (zeros before the first).</summary>
+        public Stats GetStats()
+        {
+            var s = Stats.Default();
+            SphException.Check(Native.sph_world_get_stats(Handle, ref s), "sph_world_get_stats");
+            return s;
+        }
+
+        // ---- colliders, sources, sinks, force fields, events ----------------------------------
+
+        /// <summary>Places an SDF asset of this world's context as a collider (def from
+        /// ColliderDef.Default(); its Sdf field is set from `sdf`).</summary>
+        public Collider CreateCollider(Sdf sdf, ColliderDef def)
+        {
+            ColliderId id;
+            using (var borrowed = new Borrowed(sdf.Handle))
+            {
+                def.Sdf = borrowed.Pointer;
+                SphException.Check(Native.sph_collider_create(Handle, ref def, out id), "sph_collider_create");
+            }
+            return new Collider(this, id);
+        }
+
+        /// <summary>A collider at `transform` with the default material.</summary>
+        public Collider CreateCollider(Sdf sdf, Transform transform, bool inverted = false)
+        {
+            var def = ColliderDef.Default();
+            def.Transform = transform;
+            if (inverted) def.Flags |= Constants.SPH_COLLIDER_FLAG_INVERTED;
+            return CreateCollider(sdf, def);
+        }
+
+        /// <summary>Adds a source that fills `region` (negative inside) with particles.</summary>
+        public Source CreateSource(Sdf region, SourceDef def)
+        {
+            SourceId id;
+            using (var borrowed = new Borrowed(region.Handle))
+            {
+                def.Region = borrowed.Pointer;
+                SphException.Check(Native.sph_source_create(Handle, ref def, out id), "sph_source_create");
+            }
+            return new Source(this, id);
+        }
+
+        /// <summary>Adds a sink: with a region (SinkMode.Region) or, region null, the def's
+        /// bounds (SinkMode.OutsideBounds).</summary>
+        public Sink CreateSink(Sdf region, SinkDef def)
+        {
+            SinkId id;
+            using (var borrowed = new Borrowed(region != null ? region.Handle : null))
+            {
+                def.Region = borrowed.Pointer;
+                SphException.Check(Native.sph_sink_create(Handle, ref def, out id), "sph_sink_create");
+            }
+            return new Sink(this, id);
+        }
+
+        /// <summary>Adds a force field; `region` (optional) limits it to where that SDF is negative.</summary>
+        public ForceField CreateForceField(ForceFieldDef def, Sdf region = null)
+        {
+            return CreateForceField(def, region, null, 0, 0, 0, GridDesc.Default().IndexToLocal);
+        }
+
+        /// <summary>Adds a ForceFieldKind.Grid force field: accelerations are ni*nj*nk xyz
+        /// triples, i fastest, placed by indexToLocal (row-major 3x4).</summary>
+        public ForceField CreateForceField(ForceFieldDef def, Sdf region, float[] accelerations, uint ni, uint nj, uint nk,
+                                           FixedFloat12 indexToLocal)
+        {
+            ForceFieldId id;
+            GCHandle data = default(GCHandle), grid = default(GCHandle);
+            try
+            {
+                if (accelerations != null)
+                {
+                    if ((ulong)accelerations.Length != 3UL * ni * nj * nk) throw new ArgumentException("accelerations: 3 floats per voxel");
+                    data = GCHandle.Alloc(accelerations, GCHandleType.Pinned);
+                    var g = GridDesc.Default();
+                    g.Dims = FixedUint3.From(new uint[] { ni, nj, nk });
+                    g.IndexToLocal = indexToLocal;
+                    g.Components = 3;
+                    g.Data = data.AddrOfPinnedObject();
+                    grid = GCHandle.Alloc(new GridDesc[] { g }, GCHandleType.Pinned);
+                    def.Grid = grid.AddrOfPinnedObject();
+                }
+                using (var borrowed = new Borrowed(region != null ? region.Handle : null))
+                {
+                    def.Region = borrowed.Pointer;
+                    SphException.Check(Native.sph_force_field_create(Handle, ref def, out id), "sph_force_field_create");
+                }
+            }
+            finally
+            {
+                if (grid.IsAllocated) grid.Free();
+                if (data.IsAllocated) data.Free();
+            }
+            return new ForceField(this, id);
+        }
+
+        /// <summary>Events of the last Step (source capacity reached, particles removed by sinks).</summary>
+        public Event[] GetEvents()
+        {
+            uint n;
+            SphException.Check(Native.sph_world_get_events(Handle, null, 0, out n), "sph_world_get_events");
+            while (true)
+            {
+                var events = new Event[n];
+                Result r = SphException.Check(Native.sph_world_get_events(Handle, events, n, out n), "sph_world_get_events");
+                if (r != Result.Incomplete) return events;
+            }
+        }
+
+        /// <summary>Ids of the particles sinks removed during the last Step.</summary>
+        public uint[] GetRemovedIds()
+        {
+            uint n;
+            SphException.Check(Native.sph_world_get_removed_ids(Handle, null, 0, out n), "sph_world_get_removed_ids");
+            while (true)
+            {
+                var ids = new uint[n];
+                Result r = SphException.Check(Native.sph_world_get_removed_ids(Handle, ids, n, out n), "sph_world_get_removed_ids");
+                if (r != Result.Incomplete) return ids;
+            }
+        }
+
+        // ---- the zero-copy CUDA tier (sph_cuda.h); ErrorUnsupported on the CPU backend ------
+
+        /// <summary>Where an attribute lives in device memory (address, stride, count, epoch).</summary>
+        public CudaAttributeView GetCudaAttribute(SphAttribute attribute)
+        {
+            var view = CudaAttributeView.Default();
+            SphException.Check(Native.sph_cuda_world_get_attribute(Handle, attribute, ref view), "sph_cuda_world_get_attribute");
+            return view;
+        }
+
+        /// <summary>The world's data epoch: +1 on every call that changes particles.</summary>
+        public ulong CudaEpoch
+        {
+            get
+            {
+                ulong e;
+                SphException.Check(Native.sph_cuda_world_get_epoch(Handle, out e), "sph_cuda_world_get_epoch");
+                return e;
+            }
+        }
+
+        public int CudaDevice
+        {
+            get
+            {
+                int d;
+                SphException.Check(Native.sph_cuda_world_get_device(Handle, out d), "sph_cuda_world_get_device");
+                return d;
+            }
+        }
+
+        /// <summary>The world's cudaStream_t (owned by the world).</summary>
+        public IntPtr CudaStream
+        {
+            get
+            {
+                IntPtr s;
+                SphException.Check(Native.sph_cuda_world_get_stream(Handle, out s), "sph_cuda_world_get_stream");
+                return s;
+            }
+        }
+
+        /// <summary>Records a cudaEvent_t you own on the world's stream.</summary>
+        public void CudaRecordEvent(IntPtr cudaEvent)
+        {
+            SphException.Check(Native.sph_cuda_world_record_event(Handle, cudaEvent), "sph_cuda_world_record_event");
+        }
+
+        /// <summary>Makes the world's later device work wait for a cudaEvent_t.</summary>
+        public void CudaWaitEvent(IntPtr cudaEvent)
+        {
+            SphException.Check(Native.sph_cuda_world_wait_event(Handle, cudaEvent), "sph_cuda_world_wait_event");
+        }
+    }
+
+    /// <summary>A SafeHandle's pointer, kept alive (AddRef) while a call uses it; null gives IntPtr.Zero.</summary>
+    struct Borrowed : IDisposable
+    {
+        readonly SafeHandle handle;
+        readonly bool added;
+        public readonly IntPtr Pointer;
+
+        public Borrowed(SafeHandle h)
+        {
+            handle = h;
+            added = false;
+            Pointer = IntPtr.Zero;
+            if (h == null) return;
+            h.DangerousAddRef(ref added);
+            Pointer = h.DangerousGetHandle();
+        }
+
+        public void Dispose()
+        {
+            if (added) handle.DangerousRelease();
+        }
+    }
+
+    /// <summary>A signed-distance asset (sph_sdf; negative inside) owned by a context and
+    /// shared by colliders, sources, sinks and force fields of its worlds. Dispose releases
+    /// the caller's reference; objects using it keep it alive.</summary>
+    public sealed class Sdf : IDisposable
+    {
+        public SdfHandle Handle { get; private set; }
+        public Context Context { get; private set; }
+
+        Sdf(Context context, SdfHandle handle)
+        {
+            handle.SetParent(context.Handle);  // the context outlives its assets
+            Handle = handle;
+            Context = context;
+        }
+
+        /// <summary>An analytic shape sampled into a grid (ShapeDesc.Default() for the defaults).</summary>
+        public static Sdf CreateShape(Context context, ShapeDesc desc)
+        {
+            SdfHandle h;
+            SphException.Check(Native.sph_sdf_create_shape(context.Handle, ref desc, out h), "sph_sdf_create_shape");
+            return new Sdf(context, h);
+        }
+
+        /// <summary>An asset from sampled grids (copied): distance has ni*nj*nk floats, i
+        /// fastest; velocity (3 floats per voxel) and friction are optional.</summary>
+        public static Sdf Create(Context context, float[] distance, uint ni, uint nj, uint nk, FixedFloat12 indexToLocal,
+                                 float[] velocity = null, float[] friction = null)
+        {
+            ulong voxels = (ulong)ni * nj * nk;
+            if (distance == null || (ulong)distance.Length != voxels) throw new ArgumentException("distance: ni*nj*nk floats");
+            if (velocity != null && (ulong)velocity.Length != 3 * voxels) throw new ArgumentException("velocity: 3 floats per voxel");
+            if (friction != null && (ulong)friction.Length != voxels) throw new ArgumentException("friction: one float per voxel");
+            var pins = new List<GCHandle>();
+            try
+            {
+                var desc = SdfDesc.Default();
+                desc.Distance = Grid(distance, 1, ni, nj, nk, indexToLocal, pins);
+                if (velocity != null) desc.Velocity = Pin(new GridDesc[] { Grid(velocity, 3, ni, nj, nk, indexToLocal, pins) }, pins);
+                if (friction != null) desc.Friction = Pin(new GridDesc[] { Grid(friction, 1, ni, nj, nk, indexToLocal, pins) }, pins);
+                SdfHandle h;
+                SphException.Check(Native.sph_sdf_create(context.Handle, ref desc, out h), "sph_sdf_create");
+                return new Sdf(context, h);
+            }
+            finally
+            {
+                foreach (var p in pins) p.Free();
+            }
+        }
+
+        static IntPtr Pin(Array a, List<GCHandle> pins)
+        {
+            var h = GCHandle.Alloc(a, GCHandleType.Pinned);
+            pins.Add(h);
+            return h.AddrOfPinnedObject();
+        }
+
+        static GridDesc Grid(float[] data, uint components, uint ni, uint nj, uint nk, FixedFloat12 indexToLocal, List<GCHandle> pins)
+        {
+            var g = GridDesc.Default();
+            g.Dims = FixedUint3.From(new uint[] { ni, nj, nk });
+            g.IndexToLocal = indexToLocal;
+            g.Components = components;
+            g.Data = Pin(data, pins);
+            return g;
+        }
+
+        /// <summary>Loads a level-set FloatGrid from a .vdb file (the optional helper library
+        /// libsph_vdb: DllNotFoundException where it is not built). The asset's local frame is
+        /// the file's world frame; gridName null takes the first float level set.</summary>
+        public static Sdf LoadVdb(Context context, string path, string gridName = null)
+        {
+            SdfHandle h;
+            Result r = Native.sph_vdb_load_sdf(context.Handle, Utf8.ToNative(path),
+                                               gridName != null ? Utf8.ToNative(gridName) : null, out h);
+            if ((int)r < 0) throw new SphException(r, "sph_vdb_load_sdf", Utf8.FromNative(Native.sph_vdb_get_last_error()));
+            return new Sdf(context, h);
+        }
+
+        /// <summary>index_to_local of an axis-aligned grid: sample (i, j, k) at origin + voxelSize * (i, j, k).</summary>
+        public static FixedFloat12 GridTransform(float voxelSize, Vec3 origin)
+        {
+            return FixedFloat12.From(new float[] { voxelSize, 0, 0, origin.X, 0, voxelSize, 0, origin.Y, 0, 0, voxelSize, origin.Z });
+        }
+
+        /// <summary>Grid samples along i, j, k.</summary>
+        public uint[] Dims
+        {
+            get
+            {
+                var dims = new uint[3];
+                SphException.Check(Native.sph_sdf_get_dims(Handle, dims), "sph_sdf_get_dims");
+                return dims;
+            }
+        }
+
+        /// <summary>Signed distance at a point of the asset's local frame, m.</summary>
+        public float Sample(Vec3 localPoint)
+        {
+            float d;
+            SphException.Check(Native.sph_sdf_sample(Handle, localPoint, out d), "sph_sdf_sample");
+            return d;
+        }
+
+        /// <summary>Overwrites the box [origin, origin + size) of one channel (i fastest; 3
+        /// floats per voxel for velocity). Updating a channel the asset lacks creates it.</summary>
+        public void Update(SdfChannel channel, uint[] origin, uint[] size, float[] data)
+        {
+            SphException.Check(Native.sph_sdf_update(Handle, channel, origin, size, data, MemoryKind.Host), "sph_sdf_update");
+        }
+
+        public bool IsDisposed { get; private set; }
+
+        public void Dispose()
+        {
+            IsDisposed = true;
+            Handle.Dispose();
+        }
+    }
+
+    /// <summary>A placed SDF the fluid cannot enter.</summary>
+    public sealed class Collider : IDisposable
+    {
+        public World World { get; private set; }
+        public ColliderId Id { get; private set; }
+
+        internal Collider(World world, ColliderId id) { World = world; Id = id; }
+
+        /// <summary>The current pose.</summary>
+        public Transform Transform
+        {
+            get
+            {
+                Transform t;
+                SphException.Check(Native.sph_collider_get_transform(World.Handle, Id, out t), "sph_collider_get_transform");
+                return t;
+            }
+        }
+
+        /// <summary>Kinematic motion: reach `target` over the next Step, pushing fluid.</summary>
+        public void MoveTo(Transform target)
+        {
+            SphException.Check(Native.sph_collider_set_target_transform(World.Handle, Id, ref target), "sph_collider_set_target_transform");
+        }
+
+        /// <summary>Moves at once, with no velocity.</summary>
+        public void Teleport(Transform transform)
+        {
+            SphException.Check(Native.sph_collider_teleport(World.Handle, Id, ref transform), "sph_collider_teleport");
+        }
+
+        public void SetMaterial(float restitution, float friction, float stickiness)
+        {
+            SphException.Check(Native.sph_collider_set_material(World.Handle, Id, restitution, friction, stickiness), "sph_collider_set_material");
+        }
+
+        /// <summary>Removes the collider (idempotent).</summary>
+        public void Dispose()
+        {
+            if (Id.Bits == 0) return;
+            SphException.Check(Native.sph_collider_destroy(World.Handle, Id), "sph_collider_destroy");
+            Id = default(ColliderId);
+        }
+    }
+
+    /// <summary>Emits particles where its region SDF is negative.</summary>
+    public sealed class Source : IDisposable
+    {
+        public World World { get; private set; }
+        public SourceId Id { get; private set; }
+
+        internal Source(World world, SourceId id) { World = world; Id = id; }
+
+        public void SetTransform(Transform transform)
+        {
+            SphException.Check(Native.sph_source_set_transform(World.Handle, Id, ref transform), "sph_source_set_transform");
+        }
+
+        public void Dispose()
+        {
+            if (Id.Bits == 0) return;
+            SphException.Check(Native.sph_source_destroy(World.Handle, Id), "sph_source_destroy");
+            Id = default(SourceId);
+        }
+    }
+
+    /// <summary>Removes particles inside a region or outside bounds.</summary>
+    public sealed class Sink : IDisposable
+    {
+        public World World { get; private set; }
+        public SinkId Id { get; private set; }
+
+        internal Sink(World world, SinkId id) { World = world; Id = id; }
+
+        public void Dispose()
+        {
+            if (Id.Bits == 0) return;
+            SphException.Check(Native.sph_sink_destroy(World.Handle, Id), "sph_sink_destroy");
+            Id = default(SinkId);
+        }
+    }
+
+    /// <summary>Adds an acceleration to particles.</summary>
+    public sealed class ForceField : IDisposable
+    {
+        public World World { get; private set; }
+        public ForceFieldId Id { get; private set; }
+
+        internal ForceField(World world, ForceFieldId id) { World = world; Id = id; }
+
+        public void SetTransform(Transform transform)
+        {
+            SphException.Check(Native.sph_force_field_set_transform(World.Handle, Id, ref transform), "sph_force_field_set_transform");
+        }
+
+        public void Dispose()
+        {
+            if (Id.Bits == 0) return;
+            SphException.Check(Native.sph_force_field_destroy(World.Handle, Id), "sph_force_field_destroy");
+            Id = default(ForceFieldId);
+        }
+    }
+}

@@ -1,0 +1,48 @@
+# cmake -DMCS=mcs -DMONO=mono -DSOURCE_DIR=bindings/csharp -DWORK_DIR=<build dir> -P run_tests.cmake
+#
+# Compiles the bindings into Sph.dll, the sample, the tests and README.md's snippet against it
+# (mcs, warnings as errors), then runs the snippet and the tests with mono. libsph.so must be on LD_LIBRARY_PATH ([DllImport("sph")]).
+foreach(var MCS MONO SOURCE_DIR WORK_DIR)
+  if(NOT DEFINED ${var})
+    message(FATAL_ERROR "run_tests.cmake: -D${var}=... is required")
+  endif()
+endforeach()
+file(MAKE_DIRECTORY "${WORK_DIR}")
+
+function(sph_mcs)
+  execute_process(COMMAND "${MCS}" -nologo -warnaserror+ ${ARGN} WORKING_DIRECTORY "${WORK_DIR}" RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "mcs ${ARGN} failed (${rc})")
+  endif()
+endfunction()
+
+sph_mcs(-target:library -doc:Sph.xml -nowarn:1591 -out:Sph.dll "${SOURCE_DIR}/Sph.Generated.cs" "${SOURCE_DIR}/Sph.cs")
+sph_mcs(-r:Sph.dll -out:Droplets.exe "${SOURCE_DIR}/samples/Droplets.cs")
+sph_mcs(-r:Sph.dll -out:SphTests.exe "${SOURCE_DIR}/tests/SphTests.cs")
+
+# README.md's two-line snippet (the block after the "snippet: csharp" marker), as a program.
+file(READ "${SOURCE_DIR}/README.md" readme)
+string(FIND "${readme}" "<!-- snippet: csharp" at)
+if(at EQUAL -1)
+  message(FATAL_ERROR "README.md has no '<!-- snippet: csharp' marker")
+endif()
+string(SUBSTRING "${readme}" ${at} -1 readme)
+string(FIND "${readme}" "```csharp\n" begin)
+string(SUBSTRING "${readme}" ${begin} -1 readme)
+string(LENGTH "```csharp\n" skip)
+string(SUBSTRING "${readme}" ${skip} -1 readme)
+string(FIND "${readme}" "```" end)
+string(SUBSTRING "${readme}" 0 ${end} snippet)
+file(WRITE "${WORK_DIR}/ReadmeSnippet.cs"
+     "static class ReadmeSnippet\n{\n    static int Main()\n    {\n${snippet}"
+     "        System.Console.WriteLine(\"README snippet ran\");\n        return 0;\n    }\n}\n")
+sph_mcs(-r:Sph.dll -out:ReadmeSnippet.exe ReadmeSnippet.cs)
+
+execute_process(COMMAND "${MONO}" ReadmeSnippet.exe WORKING_DIRECTORY "${WORK_DIR}" RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "the README snippet failed (exit ${rc})")
+endif()
+execute_process(COMMAND "${MONO}" --debug SphTests.exe "${SOURCE_DIR}" WORKING_DIRECTORY "${WORK_DIR}" RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "the C# binding tests failed (exit ${rc})")
+endif()

@@ -1,0 +1,630 @@
+// SphTests.cs - tests of the C# bindings, with a tiny runner (no NuGet: mcs + mono only).
+//
+//   mcs -target:library -out:Sph.dll ../Sph.Generated.cs ../Sph.cs
+//   mcs -r:Sph.dll -out:SphTests.exe SphTests.cs
+//   LD_LIBRARY_PATH=<dir of libsph.so> mono SphTests.exe <bindings/csharp dir>
+//
+// Every public static method named Test* runs; the last line is "N passed, M failed" and the
+// exit code is non-zero when anything failed.
+using System;
+using System.IO;
+using System.Reflection;
+using System.Runtime.InteropServices;
+using Sph;
+
+[StructLayout(LayoutKind.Sequential)]
+struct Particle  // an interleaved engine-side particle: position, then other data (stride 20)
+{
+    public Vec3 Position;
+    public float Age;
+    public uint Tag;
+}
+
+static class Tests
+{
+    public static string SourceDir = ".";
+
+    static void Assert(bool condition, string what)
+    {
+        if (!condition) throw new Exception("assertion failed: " + what);
+    }
+
+    static void AssertEqual<T>(T expected, T actual, string what)
+    {
+        if (!Equals(expected, actual)) throw new Exception(what + ": expected " + expected + ", got " + actual);
+    }
+
+    static SphException Throws(Result expected, Action action)
+    {
+        try
+        {
+            action();
+        }
+        catch (SphException e)
+        {
+            AssertEqual(expected, e.Result, "SphException.Result");
+            Assert(!string.IsNullOrEmpty(e.LibraryMessage), "the exception carries the library's message");
+            return e;
+        }
+        throw new Exception("expected SphException(" + expected + "), nothing was thrown");
+    }
+
+    static Context Cpu()
+    {
+        var def = ContextDef.Default();
+        def.Backend = Backend.Cpu;
+        def.CpuWorkerCount = 1;  // the tests are small; one thread is fastest on a busy machine
+        return new Context(def);
+    }
+
+    static WorldDef SmallWorld(uint capacity = 4096)
+    {
+        var d = WorldDef.Default();
+        d.Capacity = capacity;
+        d.ParticleSpacing = 0.02f;
+        return d;
+    }
+
+    // ---- library, versions, layouts ---------------------------------------------------------
+
+    public static void TestAbiAndVersionMatch()
+    {
+        AssertEqual(Layout.AbiVersion, Library.AbiVersion, "ABI version");
+        AssertEqual(Layout.Version >> 22, Library.Version >> 22, "major version");
+        Assert(Library.BuildInfo.StartsWith("sph "), "build info: " + Library.BuildInfo);
+        AssertEqual(Constants.SPH_VERSION, Library.MakeVersion(Constants.SPH_VERSION_MAJOR, Constants.SPH_VERSION_MINOR, Constants.SPH_VERSION_PATCH), "MakeVersion");
+        Library.EnsureCompatible();
+    }
+
+    public static void TestStructSizesMatchC()
+    {
+        var problems = Library.LayoutProblems();
+        Assert(problems.Count == 0, string.Join("; ", problems.ToArray()));
+        Assert(Layout.StructTypes.Length > 0, "structs listed");
+        for (int i = 0; i < Layout.StructTypes.Length; ++i)
+        {
+            Type t = Layout.StructTypes[i];
+            AssertEqual(Layout.StructSizes[i], Marshal.SizeOf(t), t.Name + " size");
+            // Every struct is blittable: pinning throws for anything that is not.
+            GCHandle.Alloc(Array.CreateInstance(t, 1), GCHandleType.Pinned).Free();
+        }
+    }
+
+    public static void TestResultStringsAndLastError()
+    {
+        foreach (Result r in Enum.GetValues(typeof(Result)))
+            Assert(Library.ResultString(r).StartsWith("SPH_"), "result string of " + r);
+        Assert(Library.ResultString((Result)12345).Length > 0, "unknown result string");
+        Throws(Result.ErrorInvalidHandle, () => SphException.Check(Native.sph_world_step(IntPtr.Zero, 0.1f), "sph_world_step"));
+        uint n = Library.LiveObjectCount;  // a successful call clears the last error
+        AssertEqual("", Library.LastError, "last error after a success (" + n + ")");
+    }
+
+    // ---- contexts ---------------------------------------------------------------------------
+
+    public static void TestContextCpu()
+    {
+        uint before = Library.LiveObjectCount;
+        using (var ctx = Cpu())
+        {
+            AssertEqual(Backend.Cpu, ctx.Backend, "backend");
+            AssertEqual(before + 1, Library.LiveObjectCount, "live objects with a context");
+        }
+        AssertEqual(before, Library.LiveObjectCount, "live objects after Dispose");
+    }
+
+    public static void TestContextErrors()
+    {
+        if (!Library.BuildInfo.Contains("cuda"))
+            Throws(Result.ErrorUnsupported, () => new Context(Backend.Cuda));
+        var def = ContextDef.Default();
+        def.StructSize = 4;
+        Throws(Result.ErrorVersionMismatch, () => new Context(def));
+        def = ContextDef.Default();
+        def.Reserved0 = 1;
+        Throws(Result.ErrorInvalidArgument, () => new Context(def));
+        def = ContextDef.Default();
+        def.HeaderVersion = Library.MakeVersion(Constants.SPH_VERSION_MAJOR + 1, 0, 0);
+        Throws(Result.ErrorVersionMismatch, () => new Context(def));
+        Throws(Result.ErrorInvalidHandle, () => SphException.Check(Native.sph_context_get_backend(IntPtr.Zero, IntPtr.Zero), "sph_context_get_backend"));
+    }
+
+    public static void TestLogCallback()
+    {
+        int calls = 0;
+        Result code = Result.Ok;
+        LogLevel level = LogLevel.Debug;
+        string message = null;
+        var def = ContextDef.Default();
+        def.Backend = Backend.Cpu;
+        def.CpuWorkerCount = 1;
+        using (var ctx = new Context(def, (l, c, m) => { ++calls; level = l; code = c; message = m; }))
+        {
+            var wd = SmallWorld();
+            wd.Capacity = 0;
+            Throws(Result.ErrorInvalidArgument, () => ctx.CreateWorld(wd));
+        }
+        Assert(calls >= 1, "the log handler was called");
+        AssertEqual(LogLevel.Error, level, "log level");
+        AssertEqual(Result.ErrorInvalidArgument, code, "log code");
+        Assert(message != null && message.Contains("capacity"), "log message: " + message);
+    }
+
+    public static void TestWorldKeepsContextAlive()
+    {
+        uint before = Library.LiveObjectCount;
+        var ctx = Cpu();
+        var world = ctx.CreateWorld(SmallWorld());
+        ctx.Dispose();  // the native context lives on while the world holds it
+        Assert(ctx.IsDisposed, "context disposed");
+        world.FillSphere(new Vec3(0, 0, 0), 0.05f);
+        world.Step(0.001f);
+        AssertEqual(before + 2, Library.LiveObjectCount, "context and world still alive");
+        world.Dispose();
+        AssertEqual(before, Library.LiveObjectCount, "both released");
+        try
+        {
+            var unused = world.ParticleCount;
+            throw new Exception("expected ObjectDisposedException, got " + unused);
+        }
+        catch (ObjectDisposedException)
+        {
+        }
+    }
+
+    // ---- worlds -----------------------------------------------------------------------------
+
+    public static void TestWorldDefAndMass()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(SmallWorld(1000)))
+        {
+            WorldDef d = world.Def;
+            AssertEqual(1000u, d.Capacity, "capacity");
+            Assert(Math.Abs(d.KernelRadius - 1.8f * 0.02f) < 1e-6f, "kernel radius resolved: " + d.KernelRadius);
+            AssertEqual(Integrator.SymplecticEuler, d.Integrator, "integrator");
+            Assert(world.ParticleMass > 0, "particle mass");
+            var bad = SmallWorld();
+            bad.KernelRadius = 0.01f;  // smaller than the spacing
+            Throws(Result.ErrorInvalidArgument, () => ctx.CreateWorld(bad));
+        }
+    }
+
+    public static void TestParamsRoundTripAndValidation()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(SmallWorld()))
+        {
+            WorldParams p = world.Params;
+            AssertEqual(-9.81f, p.Gravity.Y, "default gravity");
+            p.Gravity = new Vec3(0, 0, -1);
+            p.Viscosity = 2.5f;
+            world.Params = p;
+            WorldParams q = world.Params;
+            AssertEqual(-1f, q.Gravity.Z, "gravity set");
+            AssertEqual(2.5f, q.Viscosity, "viscosity set");
+            q.Stiffness = -1;
+            Throws(Result.ErrorInvalidArgument, () => world.Params = q);
+            AssertEqual(100f, world.Params.Stiffness, "params unchanged after an error");
+        }
+    }
+
+    public static void TestSpawnAndReadBackById()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(SmallWorld()))
+        {
+            const int n = 50;
+            var pos = new float[3 * n];
+            var vel = new float[3 * n];
+            for (int i = 0; i < n; ++i)
+            {
+                pos[3 * i] = 0.05f * (i % 5);
+                pos[3 * i + 1] = 0.05f * ((i / 5) % 5);
+                pos[3 * i + 2] = 0.05f * (i / 25);
+                vel[3 * i] = i;
+                vel[3 * i + 1] = -i;
+                vel[3 * i + 2] = 0.5f;
+            }
+            uint first = world.Spawn(pos, vel);
+            AssertEqual((uint)n, world.ParticleCount, "count");
+            var ids = world.Ids();
+            var outPos = new float[3 * n];
+            var outVel = new Vec3[n];
+            AssertEqual((uint)n, world.CopyAttribute(SphAttribute.Position, outPos), "positions written");
+            AssertEqual((uint)n, world.CopyAttribute(SphAttribute.Velocity, outVel), "velocities written");
+            for (int k = 0; k < n; ++k)
+            {
+                int i = (int)(ids[k] - first);
+                Assert(i >= 0 && i < n, "id in range");
+                for (int c = 0; c < 3; ++c) AssertEqual(pos[3 * i + c], outPos[3 * k + c], "position " + i);
+                AssertEqual(vel[3 * i], outVel[k].X, "velocity x " + i);
+                AssertEqual(vel[3 * i + 1], outVel[k].Y, "velocity y " + i);
+            }
+        }
+    }
+
+    public static void TestInterleavedStridedSpawnAndCopy()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(SmallWorld()))
+        {
+            var particles = new Particle[10];
+            for (int i = 0; i < particles.Length; ++i)
+            {
+                particles[i].Position = new Vec3(0.1f * i, 0, 0);
+                particles[i].Tag = 0xABCD0000u + (uint)i;
+            }
+            AssertEqual(20, Marshal.SizeOf(typeof(Particle)), "particle stride");
+            world.Spawn(particles);
+            var back = new Particle[10];
+            for (int i = 0; i < back.Length; ++i) back[i].Tag = 7;
+            world.CopyAttribute(SphAttribute.Position, back);
+            var ids = world.Ids();
+            for (int k = 0; k < back.Length; ++k)
+            {
+                AssertEqual(0.1f * ids[k], back[k].Position.X, "strided position");
+                AssertEqual(7u, back[k].Tag, "bytes between elements untouched");
+            }
+            var densities = new float[10];
+            AssertEqual(10u, world.CopyAttribute(SphAttribute.Density, densities), "scalar attribute");
+            var some = new float[3 * 4];
+            AssertEqual(4u, world.CopyAttribute(SphAttribute.Position, some, 6), "count clamped from first=6");
+        }
+    }
+
+    public static void TestSpawnErrorsLeaveWorldUnchanged()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(SmallWorld(8)))
+        {
+            Throws(Result.ErrorCapacity, () => world.Spawn(new float[3 * 9]));
+            AssertEqual(0u, world.ParticleCount, "nothing added over capacity");
+            var pos = new float[] { 0, float.NaN, 0 };
+            Throws(Result.ErrorInvalidArgument, () => world.Spawn(pos));
+            AssertEqual(0u, world.ParticleCount, "nothing added with a NaN");
+            Throws(Result.ErrorInvalidArgument, () => world.Spawn(IntPtr.Zero, 0, IntPtr.Zero, 0, 3));
+        }
+    }
+
+    public static void TestFills()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(SmallWorld(20000)))
+        {
+            uint box = world.FillBox(new Vec3(0, 0, 0), new Vec3(0.1f, 0.1f, 0.1f));
+            Assert(box > 50, "box filled: " + box);
+            uint sphere = world.FillSphere(new Vec3(1, 1, 1), 0.05f, new Vec3(1, 0, 0));
+            Assert(sphere > 20, "sphere filled: " + sphere);
+            AssertEqual(box + sphere, world.ParticleCount, "count");
+            Throws(Result.ErrorInvalidArgument, () => world.FillBox(new Vec3(1, 1, 1), new Vec3(0, 0, 0)));
+            Throws(Result.ErrorInvalidArgument, () => world.FillSphere(new Vec3(0, 0, 0), -1));
+            using (var small = ctx.CreateWorld(SmallWorld(10)))
+                Throws(Result.ErrorCapacity, () => small.FillBox(new Vec3(0, 0, 0), new Vec3(0.2f, 0.2f, 0.2f)));
+        }
+    }
+
+    public static void TestStepStatsAndIncomplete()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(SmallWorld()))
+        {
+            AssertEqual(0u, world.GetStats().Substeps, "no substeps before the first step");
+            uint n = world.FillSphere(new Vec3(0, 0, 0), 0.06f);
+            AssertEqual(Result.Ok, world.Step(1f / 120f), "step");
+            Stats s = world.GetStats();
+            AssertEqual(n, s.ParticleCount, "stats particle count");
+            Assert(s.Substeps > 0 && s.Substeps <= 20, "substeps: " + s.Substeps);
+            Assert(Math.Abs(s.FrameTime - 1f / 120f) < 1e-6f, "frame time");
+            Assert(s.DensityMean > 500 && s.DensityMean < 1100, "density mean " + s.DensityMean);
+            Assert(s.StageMs[(int)Stage.Density] >= 0, "stage times indexable");
+            Assert(s.MemoryBytes > 0, "memory bytes");
+            var p = world.Params;
+            p.MaxSubsteps = 1;
+            world.Params = p;
+            AssertEqual(Result.Incomplete, world.Step(0.1f), "max_substeps ran out");
+            Throws(Result.ErrorInvalidArgument, () => world.Step(-1));
+            Throws(Result.ErrorInvalidArgument, () => world.Step(float.NaN));
+        }
+    }
+
+    public static void TestCopyAttributeErrors()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(SmallWorld()))
+        {
+            world.FillSphere(new Vec3(0, 0, 0), 0.04f);
+            var buffer = new float[30];
+            GCHandle h = GCHandle.Alloc(buffer, GCHandleType.Pinned);
+            try
+            {
+                IntPtr p = h.AddrOfPinnedObject();
+                Throws(Result.ErrorBufferTooSmall, () => world.CopyAttribute(SphAttribute.Position, p, 8, 0, 0, 10));
+                Throws(Result.ErrorInvalidArgument, () => world.CopyAttribute(SphAttribute.Position, p, 120, 4, 0, 10));
+                Throws(Result.ErrorInvalidArgument, () => world.CopyAttribute(SphAttribute.Position, p, 120, 0, world.ParticleCount + 1, 1));
+                Throws(Result.ErrorInvalidArgument, () => world.CopyAttribute(SphAttribute.Position, IntPtr.Zero, 120, 0, 0, 10));
+                Throws(Result.ErrorUnsupported, () => world.CopyAttribute((SphAttribute)99, p, 120, 0, 0, 10));
+            }
+            finally
+            {
+                h.Free();
+            }
+        }
+    }
+
+    public static void TestStructDefaultsAndConstructors()
+    {
+        AssertEqual((uint)Marshal.SizeOf(typeof(WorldParams)), WorldParams.Default().StructSize, "struct_size");
+        AssertEqual(Constants.SPH_VERSION, WorldDef.Default().HeaderVersion, "header_version set like the inline init");
+        AssertEqual(Constants.SPH_VERSION, ContextDef.Default().HeaderVersion, "context header_version");
+        var v = new Vec3(1, 2, 3);
+        AssertEqual(3f, v.Z, "Vec3 constructor");
+        var stats = Stats.Default();
+        stats.StageMs[2] = 5;
+        AssertEqual(5f, stats.StageMs.ToArray()[2], "fixed array indexer");
+        AssertEqual(Constants.SPH_STAGE_COUNT, FixedFloat8.Length, "stage array length");
+    }
+
+    // ---- SDF assets, colliders, sources, sinks, force fields, events -------------------------
+
+    static Sdf Ball(Context ctx, float radius)
+    {
+        var d = ShapeDesc.Default();
+        d.Shape = Shape.Sphere;
+        d.Radius = radius;
+        d.VoxelSize = radius / 5;
+        return Sdf.CreateShape(ctx, d);
+    }
+
+    static Transform At(float x, float y, float z)
+    {
+        var t = Transform.Default();
+        t.Position = new Vec3(x, y, z);
+        return t;
+    }
+
+    public static void TestSdfAssets()
+    {
+        using (var ctx = Cpu())
+        {
+            using (var ball = Ball(ctx, 0.2f))
+            {
+                Assert(Math.Abs(ball.Sample(new Vec3(0, 0, 0)) + 0.2f) < 0.01f, "inside is negative");
+                Assert(ball.Dims[0] > 5, "dims");
+                var bad = ShapeDesc.Default();
+                bad.Radius = -1;
+                bad.Shape = Shape.Sphere;
+                Throws(Result.ErrorInvalidArgument, () => Sdf.CreateShape(ctx, bad));
+                Throws(Result.ErrorBusy, () => SphException.Check(Native.sph_context_destroy(ctx.Handle.DangerousGetHandle()), "sph_context_destroy"));
+            }
+            // A grid: the distance to a sphere of radius 0.1 on 9^3 samples, centre at a sample.
+            const int n = 9;
+            float voxel = 0.05f, origin = -(n - 1) / 2f * voxel;
+            var dist = new float[n * n * n];
+            for (int k = 0; k < n; ++k)
+                for (int j = 0; j < n; ++j)
+                    for (int i = 0; i < n; ++i)
+                    {
+                        float x = origin + voxel * i, y = origin + voxel * j, z = origin + voxel * k;
+                        dist[(k * n + j) * n + i] = (float)Math.Sqrt(x * x + y * y + z * z) - 0.1f;
+                    }
+            var map = Sdf.GridTransform(voxel, new Vec3(origin, origin, origin));
+            using (var grid = Sdf.Create(ctx, dist, n, n, n, map, new float[3 * n * n * n], new float[n * n * n]))
+            {
+                AssertEqual(9u, grid.Dims[2], "grid dims");
+                Assert(Math.Abs(grid.Sample(new Vec3(0, 0, 0)) + 0.1f) < 1e-4f, "grid sample at the centre");
+                grid.Update(SdfChannel.Distance, new uint[] { 4, 4, 4 }, new uint[] { 1, 1, 1 }, new float[] { 0.5f });
+                Assert(Math.Abs(grid.Sample(new Vec3(0, 0, 0)) - 0.5f) < 1e-4f, "updated");
+                Throws(Result.ErrorInvalidArgument, () => grid.Update(SdfChannel.Distance, new uint[] { 8, 8, 8 }, new uint[] { 2, 2, 2 }, new float[8]));
+                Throws(Result.ErrorUnsupported, () => SphException.Check(Native.sph_sdf_update(grid.Handle, SdfChannel.Distance, new uint[] { 0, 0, 0 },
+                    new uint[] { 1, 1, 1 }, new float[1], MemoryKind.CudaDevice), "sph_sdf_update"));
+            }
+            dist[0] = float.NaN;
+            Throws(Result.ErrorInvalidArgument, () => Sdf.Create(ctx, dist, n, n, n, map));
+        }
+    }
+
+    public static void TestCollidersHoldWater()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(SmallWorld()))
+        {
+            var plane = ShapeDesc.Default();
+            plane.Shape = Shape.Plane;
+            plane.HalfExtents = new Vec3(1, 0.1f, 1);
+            plane.VoxelSize = 0.03f;
+            using (var floor = Sdf.CreateShape(ctx, plane))
+            {
+                var c = world.CreateCollider(floor, Transform.Default());
+                world.FillBox(new Vec3(-0.08f, 0.02f, -0.08f), new Vec3(0.08f, 0.15f, 0.08f));
+                for (int i = 0; i < 20; ++i) world.Step(1f / 60f);
+                float lowest = float.MaxValue;
+                foreach (var p in world.Positions()) lowest = Math.Min(lowest, p.Y);
+                Assert(lowest > -0.05f, "held by the floor, lowest " + lowest);
+                c.Teleport(At(0, -1, 0));
+                AssertEqual(-1f, c.Transform.Position.Y, "teleported");
+                c.MoveTo(At(0, -0.9f, 0));
+                world.Step(1f / 60f);
+                Assert(Math.Abs(c.Transform.Position.Y + 0.9f) < 1e-5f, "moved to the target");
+                c.SetMaterial(0.5f, 0.1f, 0);
+                Throws(Result.ErrorInvalidArgument, () => c.SetMaterial(2, 0, 0));
+                var stale = c.Id;
+                c.Dispose();
+                c.Dispose();
+                Throws(Result.ErrorInvalidHandle, () => SphException.Check(Native.sph_collider_destroy(world.Handle, stale), "sph_collider_destroy"));
+                using (var inverted = world.CreateCollider(floor, Transform.Default(), true)) { }
+            }
+        }
+    }
+
+    public static void TestSourcesSinksEvents()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(SmallWorld(300)))
+        using (var ball = Ball(ctx, 0.05f))
+        {
+            var p = world.Params;
+            p.Gravity = new Vec3(0, 0, 0);
+            world.Params = p;
+            var def = SourceDef.Default();
+            def.Transform = At(0, 0, 0);
+            var source = world.CreateSource(ball, def);
+            world.Step(1f / 60f);
+            uint n = world.ParticleCount;
+            Assert(n > 20, "the source filled its region: " + n);
+            AssertEqual(0, world.GetEvents().Length, "no events");
+            source.SetTransform(At(1, 0, 0));
+            var flood = SourceDef.Default();
+            flood.Mode = SourceMode.Continuous;
+            flood.Transform = At(3, 0, 0);
+            var big = ShapeDesc.Default();
+            big.HalfExtents = new Vec3(0.2f, 0.2f, 0.2f);
+            big.VoxelSize = 0.02f;
+            using (var box = Sdf.CreateShape(ctx, big))
+            using (var f = world.CreateSource(box, flood))
+            {
+                world.Step(1f / 60f);
+                AssertEqual(300u, world.ParticleCount, "filled to capacity");
+                var events = world.GetEvents();
+                Assert(events.Length >= 1 && events[0].Type == EventType.SourceCapacityReached && events[0].ObjectBits == f.Id.Bits,
+                       "capacity event from the flooding source");
+            }
+            source.Dispose();
+
+            var sinkDef = SinkDef.Default();
+            sinkDef.Mode = SinkMode.OutsideBounds;
+            sinkDef.BoundsMin = new Vec3(-0.5f, -0.5f, -0.5f);
+            sinkDef.BoundsMax = new Vec3(0.5f, 0.5f, 0.5f);
+            using (var sink = world.CreateSink(null, sinkDef))
+            {
+                world.Step(1f / 240f);
+                var removed = world.GetRemovedIds();
+                Assert(removed.Length > 0, "particles outside the bounds removed");
+                AssertEqual(300u - (uint)removed.Length, world.ParticleCount, "count after the sink");
+                var events = world.GetEvents();
+                Assert(events.Length == 1 && events[0].Type == EventType.SinkRemoved && events[0].Count == removed.Length &&
+                       events[0].ObjectBits == sink.Id.Bits, "sink event");
+            }
+            Throws(Result.ErrorInvalidArgument, () => world.CreateSink(null, SinkDef.Default()));
+        }
+    }
+
+    public static void TestForceFields()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(SmallWorld()))
+        {
+            var p = world.Params;
+            p.Gravity = new Vec3(0, 0, 0);
+            world.Params = p;
+            world.FillSphere(new Vec3(0, 0, 0), 0.05f);
+            var def = ForceFieldDef.Default();
+            def.Vector = new Vec3(2, 0, 0);
+            using (var push = world.CreateForceField(def))
+            {
+                world.Step(0.05f);
+                push.SetTransform(At(1, 0, 0));
+            }
+            float vx = 0;
+            var v = new Vec3[world.ParticleCount];
+            world.CopyAttribute(SphAttribute.Velocity, v);
+            foreach (var x in v) vx += x.X / v.Length;
+            Assert(Math.Abs(vx - 0.1f) < 0.01f, "uniform field accelerated the drop: " + vx);
+            var grid = ForceFieldDef.Default();
+            grid.Kind = ForceFieldKind.Grid;
+            var acc = new float[3 * 8];
+            for (int i = 0; i < 8; ++i) acc[3 * i + 1] = 1;
+            using (var ball = Ball(ctx, 0.5f))
+            using (var g = world.CreateForceField(grid, ball, acc, 2, 2, 2, Sdf.GridTransform(1, new Vec3(-0.5f, -0.5f, -0.5f))))
+                world.Step(0.01f);
+            Throws(Result.ErrorInvalidArgument, () => world.CreateForceField(grid));  // GRID without a grid
+        }
+    }
+
+    public static void TestCudaTierOnCpuIsUnsupported()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(SmallWorld()))
+        {
+            Throws(Result.ErrorUnsupported, () => world.GetCudaAttribute(SphAttribute.Position));
+            Throws(Result.ErrorUnsupported, () => { var e = world.CudaEpoch; });
+            Throws(Result.ErrorUnsupported, () => { var d = world.CudaDevice; });
+            Throws(Result.ErrorUnsupported, () => { var s = world.CudaStream; });
+            Throws(Result.ErrorUnsupported, () => world.CudaRecordEvent(new IntPtr(1)));
+            Throws(Result.ErrorUnsupported, () => world.CudaWaitEvent(new IntPtr(1)));
+        }
+    }
+
+    public static void TestVdbHelperErrors()
+    {
+        using (var ctx = Cpu())
+        {
+            string garbage = Path.GetTempFileName();
+            File.WriteAllText(garbage, "not a vdb file");
+            try
+            {
+                Sdf.LoadVdb(ctx, garbage);
+                throw new Exception("a garbage file loaded");
+            }
+            catch (DllNotFoundException)
+            {
+                Console.WriteLine("  (libsph_vdb is not built here: skipped)");
+            }
+            catch (SphException e)
+            {
+                AssertEqual(Result.ErrorInvalidArgument, e.Result, "garbage file");
+                Assert(e.LibraryMessage.Length > 0, "sph_vdb_get_last_error explains");
+                Throws(Result.ErrorInvalidArgument, () => Sdf.LoadVdb(ctx, "/nonexistent/file.vdb", "grid"));
+            }
+            finally
+            {
+                File.Delete(garbage);
+            }
+        }
+    }
+
+    // ---- coverage ---------------------------------------------------------------------------
+
+    /// Every exported function is called by the idiomatic layer (Sph.cs) or is the sized init
+    /// of a struct (called by the generated Default()).
+    public static void TestEveryFunctionIsWrapped()
+    {
+        string wrapper = File.ReadAllText(Path.Combine(SourceDir, "Sph.cs"));
+        string generated = File.ReadAllText(Path.Combine(SourceDir, "Sph.Generated.cs"));
+        var missing = new System.Collections.Generic.List<string>();
+        foreach (string fn in Layout.Functions)
+        {
+            bool used = wrapper.Contains("Native." + fn + "(") ||
+                        (fn.EndsWith("_init_sized") && generated.Contains("SphException.Check(Native." + fn + "(")) ||
+                        (fn.EndsWith("_destroy") && generated.Contains("Native." + fn + "(handle)")) ||
+                        generated.Contains("return Native." + fn + "();");  // a struct's Default()
+            if (!used) missing.Add(fn);
+        }
+        Assert(missing.Count == 0, "not wrapped in Sph.cs: " + string.Join(", ", missing.ToArray()));
+    }
+
+    // ---- runner -----------------------------------------------------------------------------
+
+    static int Main(string[] args)
+    {
+        if (args.Length > 0) SourceDir = args[0];
+        int passed = 0, failed = 0;
+        foreach (MethodInfo m in typeof(Tests).GetMethods(BindingFlags.Public | BindingFlags.Static))
+        {
+            if (!m.Name.StartsWith("Test")) continue;
+            try
+            {
+                m.Invoke(null, null);
+                ++passed;
+                Console.WriteLine("PASS " + m.Name);
+            }
+            catch (TargetInvocationException e)
+            {
+                ++failed;
+                Console.WriteLine("FAIL " + m.Name + ": " + e.InnerException);
+            }
+        }
+        Console.WriteLine(passed + " passed, " + failed + " failed");
+        return failed == 0 ? 0 : 1;
+    }
+}
