@@ -1,11 +1,10 @@
-# The exported-symbol allowlist: every dynamic symbol libsph.so defines starts with sph_ (the
-# version-script node SPH_<n> aside), every function the public headers (include/*.h: sph_c.h
-# and the optional sph_cuda.h) declare with SPH_API is exported, and nothing else is: the
-# SONAME is libsph.so.<ABI>.
-# Usage: cmake -DLIBRARY=<libsph.so> -DNM=<nm> -DREADELF=<readelf> -DINCLUDE_DIR=<include>
-#              -P check_exports.cmake
+# The exported-symbol allowlist of one shared library: every dynamic symbol it defines starts
+# with sph_ (the version-script node SPH_<n> aside), every function its public headers
+# declare with SPH_API is exported, nothing else is, and the SONAME is <name>.so.<ABI>.
+# Usage: cmake -DLIBRARY=<libsph.so> -DNM=<nm> [-DREADELF=<readelf>] -DINCLUDE_DIR=<include>
+#              -DHEADERS=sph_c.h,sph_cuda.h -DSONAME_PREFIX=libsph -P check_exports.cmake
 cmake_minimum_required(VERSION 3.24)
-foreach(var LIBRARY NM INCLUDE_DIR)
+foreach(var LIBRARY NM INCLUDE_DIR HEADERS SONAME_PREFIX)
   if(NOT ${var})
     message(FATAL_ERROR "check_exports.cmake: -D${var}= is required")
   endif()
@@ -48,11 +47,14 @@ if(bad)
   message(FATAL_ERROR "libsph.so exports symbols outside the sph_ namespace:\n  ${bad_text}")
 endif()
 
-# Every SPH_API function of the public headers is exported, and every export is declared.
-file(GLOB headers "${INCLUDE_DIR}/*.h")
+# Every SPH_API function of the library's headers is exported, and every export is declared.
+string(REPLACE "," ";" headers "${HEADERS}")
 set(declared "")
 foreach(header IN LISTS headers)
-  file(READ "${header}" header_text)
+  if(NOT EXISTS "${INCLUDE_DIR}/${header}")
+    message(FATAL_ERROR "no header ${INCLUDE_DIR}/${header}")
+  endif()
+  file(READ "${INCLUDE_DIR}/${header}" header_text)
   string(REGEX MATCHALL "SPH_API[^;(]*SPH_CALL[ \t\r\n]+sph_[a-z0-9_]+" declarations "${header_text}")
   foreach(declaration IN LISTS declarations)
     string(REGEX MATCH "sph_[a-z0-9_]+$" name "${declaration}")
@@ -61,8 +63,8 @@ foreach(header IN LISTS headers)
 endforeach()
 list(LENGTH declared n_declared)
 message(STATUS "${n_declared} SPH_API functions declared in ${headers}")
-if(n_declared LESS 20)
-  message(FATAL_ERROR "found only ${n_declared} SPH_API declarations in ${INCLUDE_DIR}: the pattern is broken")
+if(n_declared EQUAL 0)
+  message(FATAL_ERROR "found no SPH_API declarations in ${HEADERS}: the pattern is broken")
 endif()
 set(missing "")
 foreach(name IN LISTS declared)
@@ -85,13 +87,13 @@ if(undeclared)
   message(FATAL_ERROR "exported but declared in no public header: ${undeclared_text}")
 endif()
 
-# SONAME = libsph.so.<ABI major>.
+# SONAME = <name>.so.<ABI major>.
 if(READELF)
   execute_process(COMMAND ${READELF} -d ${LIBRARY} OUTPUT_VARIABLE dyn RESULT_VARIABLE rc)
   file(STRINGS "${INCLUDE_DIR}/sph_c.h" abi_line REGEX "^#define SPH_ABI_VERSION [0-9]+")
   string(REGEX MATCH "[0-9]+$" abi "${abi_line}")
-  if(NOT dyn MATCHES "Library soname: \\[libsph\\.so\\.${abi}\\]")
-    message(FATAL_ERROR "the SONAME of ${LIBRARY} is not libsph.so.${abi}:\n${dyn}")
+  if(NOT dyn MATCHES "Library soname: \\[${SONAME_PREFIX}\\.so\\.${abi}\\]")
+    message(FATAL_ERROR "the SONAME of ${LIBRARY} is not ${SONAME_PREFIX}.so.${abi}:\n${dyn}")
   endif()
-  message(STATUS "SONAME libsph.so.${abi}")
+  message(STATUS "SONAME ${SONAME_PREFIX}.so.${abi}")
 endif()
