@@ -13,15 +13,18 @@ _TYPESTR = {"float32": "<f4", "uint32": "<u4", "int32": "<i4"}
 class CudaArray:
     """One attribute of a CUDA world as a device array, without a copy.
 
-    Implements ``__cuda_array_interface__`` (version 3, read-only), so CuPy, Numba and
-    PyTorch can wrap it: ``cupy.asarray(world.cuda_array(sph.Attribute.POSITION))``. The
-    memory is the world's: valid for the world's life, rewritten in place by every call that
-    changes particles (check ``current``), never to be written or freed.
+    Implements ``__cuda_array_interface__`` (version 3), so CuPy, Numba and PyTorch can wrap
+    it: ``cupy.asarray(world.cuda_array(sph.Attribute.POSITION))``. The memory is the
+    world's: valid for the world's life, rewritten in place by every call that changes
+    particles (check ``current``), never to be written or freed. It is flagged read-only;
+    PyTorch refuses that flag, so for ``torch.as_tensor`` ask for
+    ``world.cuda_array(attribute, readonly=False)`` (and still do not write).
     """
 
-    def __init__(self, world, view, dtype, components):
+    def __init__(self, world, view, dtype, components, readonly=True):
         self.world = world
         self.view = view
+        self.readonly = readonly
         self._typestr = _TYPESTR[str(dtype)]
         self._components = components
 
@@ -38,7 +41,7 @@ class CudaArray:
     def __cuda_array_interface__(self):
         item = int(self._typestr[-1])
         strides = (self.view.stride, item) if self._components > 1 else (self.view.stride,)
-        return {"shape": self.shape, "typestr": self._typestr, "data": (self.view.device_address, True),
+        return {"shape": self.shape, "typestr": self._typestr, "data": (self.view.device_address, self.readonly),
                 "strides": strides, "version": 3, "stream": None}
 
 
@@ -54,12 +57,13 @@ class WorldCudaMixin:
               "sph_cuda_world_get_attribute")
         return v
 
-    def cuda_array(self, attribute):
-        """The attribute as a CudaArray (``__cuda_array_interface__``) for CuPy/Numba/PyTorch."""
+    def cuda_array(self, attribute, readonly=True):
+        """The attribute as a CudaArray (``__cuda_array_interface__``) for CuPy/Numba/PyTorch;
+        readonly=False for PyTorch, which rejects the read-only flag."""
         from ._core import attribute_format
 
         dtype, components = attribute_format(attribute)
-        return CudaArray(self, self.cuda_attribute(attribute), dtype, components)
+        return CudaArray(self, self.cuda_attribute(attribute), dtype, components, readonly)
 
     @property
     def cuda_epoch(self):
