@@ -440,7 +440,7 @@ static void test_fills_success(void** state) {
   static uint32_t ids[CAPI_SNAPSHOT_MAX];
   sph_fill_box_desc box;
   sph_fill_sphere_desc sphere;
-  uint32_t in_box = 0, in_sphere = 0;
+  uint32_t in_box = 0, in_sphere = 0, n0_far = 0;
   const float s = 0.02f; /* the fixture's spacing */
 
   small_box(&box);
@@ -448,18 +448,40 @@ static void test_fills_success(void** state) {
   EXPECT_OK(sph_world_fill_box(f->world, &box, &in_box));
   assert_true(in_box > 0);
   assert_int_equal(particle_count(f->world), n0 + in_box);
+  {
+    /* Grown descs with a zero tail are accepted (and out_count is optional); removing what
+     * they add is impossible, so they go far away where they do not disturb the checks below. */
+    grown_fill_box_desc gb;
+    grown_fill_sphere_desc gp;
+    uint32_t n_before = particle_count(f->world), added = 0;
+    memset(&gb, 0, sizeof gb);
+    small_box(&gb.desc);
+    gb.desc.struct_size = sizeof gb;
+    gb.desc.min.y = gb.desc.min.y + 10.0f;
+    gb.desc.max.y = gb.desc.max.y + 10.0f;
+    EXPECT_OK(sph_world_fill_box(f->world, &gb.desc, NULL));
+    assert_int_equal(particle_count(f->world), n_before + in_box);
+    memset(&gp, 0, sizeof gp);
+    sph_fill_sphere_desc_init(&gp.desc);
+    gp.desc.struct_size = sizeof gp;
+    gp.desc.center.y = 20.0f;
+    gp.desc.radius = 0.01f;
+    EXPECT_OK(sph_world_fill_sphere(f->world, &gp.desc, &added));
+    assert_int_equal(added, 1);
+    n0_far = in_box + 1;
+  }
   sph_fill_sphere_desc_init(&sphere);
   sphere.center.x = -1.0f;
   sphere.radius = 0.03f;
   sphere.velocity.z = 3.0f;
   EXPECT_OK(sph_world_fill_sphere(f->world, &sphere, &in_sphere));
   assert_true(in_sphere > 0);
-  assert_int_equal(particle_count(f->world), n0 + in_box + in_sphere);
+  assert_int_equal(particle_count(f->world), n0 + n0_far + in_box + in_sphere);
   /* out_count is optional. */
   sphere.center.x = -2.0f;
   sphere.radius = 0.01f;
   EXPECT_OK(sph_world_fill_sphere(f->world, &sphere, NULL));
-  assert_int_equal(particle_count(f->world), n0 + in_box + in_sphere + 1); /* just the centre */
+  assert_int_equal(particle_count(f->world), n0 + n0_far + in_box + in_sphere + 1); /* just the centre */
 
   {
     const uint32_t n = particle_count(f->world);
@@ -470,7 +492,8 @@ static void test_fills_success(void** state) {
     for (uint32_t i = 0; i < n; ++i) {
       const float* p = pos + 3 * i;
       const float* v = vel + 3 * i;
-      if (p[0] > 0.4f) { /* the box: points at least spacing/2 inside each face */
+      if (p[1] > 5.0f) continue; /* the grown-desc fills */
+      if (p[0] > 0.4f) {         /* the box: points at least spacing/2 inside each face */
         ++box_seen;
         for (int c = 0; c < 3; ++c)
           assert_true(p[c] >= 0.5f + 0.5f * s - 1e-6f && p[c] <= 0.55f - 0.5f * s + 1e-6f);
