@@ -11,6 +11,44 @@ namespace {
 
 __device__ __forceinline__ bool finite3(Vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 
+// gather_acceleration (src/physics/forces.h) for SIMT: the same neighbours in the same order
+// and the same per-neighbour arithmetic (add_neighbor_acceleration, finish_acceleration), in
+// two phases per run of up to 32 candidates. First every candidate is only tested (a tight
+// loop: load, distance, compare) into a bit mask; then the costly pair term runs for the set
+// bits in ascending order. In one pass a warp would run the pair term whenever any of its 32
+// threads had a neighbour, i.e. for almost every candidate, since only about a fifth of the
+// 27-cell candidates are within h. (Collecting a whole particle's neighbours in a shared-memory
+// list first, for one longer second phase, measured slower: occupancy and latency.)
+__device__ __forceinline__ Vec3 gather_acceleration_masked(const FluidConstants& f, const GridView& grid,
+                                                           const Float4* __restrict__ positions,
+                                                           const Float4* __restrict__ velocities,
+                                                           uint32_t i) {
+  const Float4 pi = positions[i];
+  const Float4 vi = velocities[i];
+  const Vec3 xi = xyz(pi);
+  const Vec3 v_i = xyz(vi);
+  AccelerationSums sums = zero_acceleration_sums();
+  for_each_neighbor_range(grid, xi, [&](uint32_t begin, uint32_t end) {
+    for (uint32_t base = begin; base < end; base += 32u) {
+      const uint32_t count = min(32u, end - base);
+      uint32_t hits = 0;
+#pragma unroll 4
+      for (uint32_t k = 0; k < count; ++k) {
+        const float r2 = length_squared(xi - xyz(positions[base + k]));
+        hits |= (is_force_neighbor(f, r2, i, base + k) ? 1u : 0u) << k;
+      }
+      while (hits != 0u) {
+        const uint32_t j = base + static_cast<uint32_t>(__ffs(hits) - 1);
+        hits &= hits - 1u;
+        const Float4 pj = positions[j];
+        const Vec3 d = xi - xyz(pj);
+        add_neighbor_acceleration(f, pi, v_i, pj, velocities[j], d, length_squared(d), sums);
+      }
+    }
+  });
+  return finish_acceleration(f, vi, sums);
+}
+
 __device__ __forceinline__ void flag_non_finite(FrameState* s, int stage, uint32_t index, uint32_t id) {
   atomicMin(&s->bad_key[stage], (static_cast<unsigned long long>(index) << 32) | id);
 }
@@ -61,7 +99,7 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
   float v2 = 0.0f;
   if (i < n) {
     const float dt = state->dt_float;
-    const Vec3 acc = gather_acceleration(fluid, grid, a.sorted_position, a.sorted_velocity, i);
+    const Vec3 acc = gather_acceleration_masked(fluid, grid, a.sorted_position, a.sorted_velocity, i);
     const Float4 p = a.sorted_position[i];
     const Float4 v = a.sorted_velocity[i];
     const ParticleState next = symplectic_euler(ParticleState{xyz(p), xyz(v)}, acc, dt);
@@ -88,7 +126,7 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
     ParticleState* start = (stage & 1) ? a.rk4_start[0] : a.rk4_start[1];
     Rk4Accumulator* sums = (stage & 1) ? a.rk4_sum[0] : a.rk4_sum[1];
     const float dt = state->dt_float;
-    const Vec3 acc = gather_acceleration(fluid, grid, a.sorted_position, a.sorted_velocity, i);
+    const Vec3 acc = gather_acceleration_masked(fluid, grid, a.sorted_position, a.sorted_velocity, i);
     const Float4 p = a.sorted_position[i];
     const Float4 v = a.sorted_velocity[i];
     Rk4Accumulator sum;

@@ -51,6 +51,12 @@ SPH_HD int32_t wrap_index(int32_t c, int32_t n) {
   return m < 0 ? m + n : m;
 }
 
+// wrap_index(w + step, n) for a slot w already in [0, n) and step in {-1, 0, 1}.
+SPH_HD int32_t wrap_step(int32_t w, int32_t step, int32_t n) {
+  const int32_t s = w + step;
+  return s < 0 ? n - 1 : (s >= n ? 0 : s);
+}
+
 SPH_HD uint32_t hash_wrapped(const GridShape& g, int32_t wx, int32_t wy, int32_t wz) {
   return static_cast<uint32_t>(wx) +
          static_cast<uint32_t>(g.nx) *

@@ -6,3 +6,12 @@
 #else
 #define SPH_HD inline
 #endif
+
+// Asks nvcc to unroll the next loop n times; nothing for host compilers (g++ would warn about
+// an unknown pragma). Never changes what a loop computes.
+#if defined(__CUDACC__)
+#define SPH_PRAGMA(x) _Pragma(#x)
+#define SPH_UNROLL(n) SPH_PRAGMA(unroll n)
+#else
+#define SPH_UNROLL(n)
+#endif

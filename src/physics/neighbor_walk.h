@@ -17,34 +17,44 @@ struct GridView {
   const uint32_t* cell_start;  // cell_count + 1 entries
 };
 
-// Calls visit(j) for each particle j in the 3x3x3 block of cells around p. Candidates are
-// not filtered by distance: the caller tests r < h (wrapped slots can hold far particles).
-template <class Visit>
-SPH_HD void for_each_neighbor_candidate(const GridView& grid, Vec3 p, Visit&& visit) {
+// Calls visit_range(begin, end) for each run of consecutive particle indices in the 3x3x3
+// block of cells around p: one run per row of three cells (two where the row wraps around the
+// table), nine rows in a fixed order. Candidates are not filtered by distance: the caller
+// tests r < h (wrapped slots can hold far particles).
+template <class VisitRange>
+SPH_HD void for_each_neighbor_range(const GridView& grid, Vec3 p, VisitRange&& visit_range) {
   const GridShape& g = grid.shape;
   const CellCoord c = cell_of(g, p);
-  const int32_t x_lo = wrap_index(c.x - 1, g.nx);
-  const int32_t x_hi = wrap_index(c.x + 1, g.nx);
+  // One remainder per axis; the neighbouring slots follow by stepping (each n >= 3).
+  const int32_t cx = wrap_index(c.x, g.nx), cy = wrap_index(c.y, g.ny), cz = wrap_index(c.z, g.nz);
+  const int32_t x_lo = wrap_step(cx, -1, g.nx);
+  const int32_t x_hi = wrap_step(cx, 1, g.nx);
   for (int32_t dz = -1; dz <= 1; ++dz) {
-    const int32_t wz = wrap_index(c.z + dz, g.nz);
+    const int32_t wz = wrap_step(cz, dz, g.nz);
     for (int32_t dy = -1; dy <= 1; ++dy) {
-      const int32_t wy = wrap_index(c.y + dy, g.ny);
+      const int32_t wy = wrap_step(cy, dy, g.ny);
       const uint32_t row = hash_wrapped(g, 0, wy, wz);
       if (x_lo < x_hi) {
-        const uint32_t begin = grid.cell_start[row + static_cast<uint32_t>(x_lo)];
-        const uint32_t end = grid.cell_start[row + static_cast<uint32_t>(x_hi) + 1u];
-        for (uint32_t j = begin; j < end; ++j) visit(j);
+        visit_range(grid.cell_start[row + static_cast<uint32_t>(x_lo)],
+                    grid.cell_start[row + static_cast<uint32_t>(x_hi) + 1u]);
       } else {
         // The row wraps: [x_lo, nx) then [0, x_hi].
-        const uint32_t begin_a = grid.cell_start[row + static_cast<uint32_t>(x_lo)];
-        const uint32_t end_a = grid.cell_start[row + static_cast<uint32_t>(g.nx)];
-        for (uint32_t j = begin_a; j < end_a; ++j) visit(j);
-        const uint32_t begin_b = grid.cell_start[row];
-        const uint32_t end_b = grid.cell_start[row + static_cast<uint32_t>(x_hi) + 1u];
-        for (uint32_t j = begin_b; j < end_b; ++j) visit(j);
+        visit_range(grid.cell_start[row + static_cast<uint32_t>(x_lo)],
+                    grid.cell_start[row + static_cast<uint32_t>(g.nx)]);
+        visit_range(grid.cell_start[row], grid.cell_start[row + static_cast<uint32_t>(x_hi) + 1u]);
       }
     }
   }
+}
+
+// Calls visit(j) for each particle j in the 3x3x3 block of cells around p, in the order of
+// for_each_neighbor_range.
+template <class Visit>
+SPH_HD void for_each_neighbor_candidate(const GridView& grid, Vec3 p, Visit&& visit) {
+  for_each_neighbor_range(grid, p, [&](uint32_t begin, uint32_t end) {
+    SPH_UNROLL(4)
+    for (uint32_t j = begin; j < end; ++j) visit(j);
+  });
 }
 
 }  // namespace sph
