@@ -1,0 +1,237 @@
+#include "scene_runtime.h"
+
+#include "library_error.h"
+#include "scene_error.h"
+#include "sdf_factory.h"
+
+namespace sph_tools {
+
+namespace {
+
+// Scheduled things happen at the first frame boundary at or after their time.
+constexpr double kTimeTolerance = 1e-6;
+
+bool due(double when, double now) { return when <= now + kTimeTolerance; }
+
+void check_object(sph_result r, const std::string& path, const char* what) {
+  if (r < 0)
+    throw SceneError(path, std::string("the library rejected the ") + what + ": " + sph_get_last_error());
+}
+
+}  // namespace
+
+SceneRuntime::SceneRuntime(const SceneDesc& scene, sph_context* context) : scene_(scene), context_(context) {
+  try {
+    sph_result r = sph_world_create(context, &scene.world, &world_);
+    if (r < 0) {
+      if (r == SPH_ERROR_INVALID_ARGUMENT || r == SPH_ERROR_UNSUPPORTED)
+        throw SceneError("world", std::string("the library rejected the world: ") + sph_get_last_error());
+      throw LibraryError(r, "creating the world");
+    }
+    r = sph_world_set_params(world_, &scene.params);
+    if (r < 0)
+      throw SceneError("params", std::string("the library rejected the parameters: ") + sph_get_last_error());
+
+    for (const ColliderDesc& c : scene.colliders) {
+      Collider placed{&c, create_sdf(context, c.shape), sph_collider_id{0}};
+      colliders_.push_back(placed);
+      sph_collider_def def;
+      sph_collider_def_init(&def);
+      def.sdf = placed.sdf;
+      def.transform = c.transform;
+      def.flags = c.inverted ? SPH_COLLIDER_FLAG_INVERTED : 0u;
+      def.restitution = c.restitution;
+      def.friction = c.friction;
+      def.stickiness = c.stickiness;
+      check_object(sph_collider_create(world_, &def, &colliders_.back().id), c.path, "collider");
+    }
+    for (const SinkDesc& s : scene.sinks) {
+      sph_sink_def def;
+      sph_sink_def_init(&def);
+      def.mode = s.mode;
+      if (s.mode == SPH_SINK_REGION) {
+        sink_sdfs_.push_back(create_sdf(context, s.shape));
+        def.region = sink_sdfs_.back();
+        def.transform = s.transform;
+      } else {
+        def.bounds_min = s.bounds_min;
+        def.bounds_max = s.bounds_max;
+      }
+      sph_sink_id id;
+      check_object(sph_sink_create(world_, &def, &id), s.path, "sink");
+    }
+    sources_.resize(scene.sources.size());
+    fields_.resize(scene.force_fields.size());
+    fluid_added_.assign(scene.fluids.size(), false);
+    // Everything of time 0 exists before the first frame, so frame 0 shows it.
+    apply_schedule(0.0, 0.0);
+  } catch (...) {
+    destroy_all();
+    throw;
+  }
+}
+
+SceneRuntime::~SceneRuntime() { destroy_all(); }
+
+void SceneRuntime::destroy_all() {
+  sph_world_destroy(world_);
+  world_ = nullptr;
+  for (Collider& c : colliders_) sph_sdf_destroy(c.sdf);
+  colliders_.clear();
+  for (Source& s : sources_) sph_sdf_destroy(s.sdf);
+  sources_.clear();
+  for (sph_sdf* sdf : sink_sdfs_) sph_sdf_destroy(sdf);
+  sink_sdfs_.clear();
+  for (ForceField& f : fields_) sph_sdf_destroy(f.region);
+  fields_.clear();
+}
+
+sph_transform SceneRuntime::collider_pose(size_t i) const {
+  sph_transform t = colliders_[i].desc->transform;
+  sph_collider_get_transform(world_, colliders_[i].id, &t);
+  return t;
+}
+
+void SceneRuntime::add_fluid(const FluidDesc& f) {
+  sph_result r;
+  uint32_t added = 0;
+  if (f.kind == FluidDesc::Kind::kBox) {
+    sph_fill_box_desc d;
+    sph_fill_box_desc_init(&d);
+    d.min = f.min;
+    d.max = f.max;
+    d.velocity = f.velocity;
+    r = sph_world_fill_box(world_, &d, &added);
+  } else if (f.kind == FluidDesc::Kind::kSphere) {
+    sph_fill_sphere_desc d;
+    sph_fill_sphere_desc_init(&d);
+    d.center = f.center;
+    d.radius = f.radius;
+    d.velocity = f.velocity;
+    r = sph_world_fill_sphere(world_, &d, &added);
+  } else {
+    std::vector<float> velocities = f.velocities;
+    if (velocities.empty())
+      for (size_t i = 0; i < f.positions.size(); i += 3)
+        velocities.insert(velocities.end(), {f.velocity.x, f.velocity.y, f.velocity.z});
+    sph_spawn_desc d;
+    sph_spawn_desc_init(&d);
+    d.count = static_cast<uint32_t>(f.positions.size() / 3);
+    d.positions = f.positions.data();
+    d.velocities = velocities.data();
+    r = sph_world_spawn(world_, &d, nullptr);
+  }
+  if (r == SPH_ERROR_CAPACITY) {
+    uint32_t count = 0;
+    sph_world_get_particle_count(world_, &count);
+    throw SceneError(f.path, "the fluid body does not fit: the world holds " + std::to_string(count) +
+                                 " of " + std::to_string(scene_.world.capacity) +
+                                 " particles (raise world.capacity)");
+  }
+  check_object(r, f.path, "fluid body");
+}
+
+void SceneRuntime::start_source(size_t i) {
+  const SourceDesc& s = scene_.sources[i];
+  Source& state = sources_[i];
+  state.sdf = create_sdf(context_, s.shape);
+  sph_source_def def;
+  sph_source_def_init(&def);
+  def.mode = s.mode;
+  def.region = state.sdf;
+  def.transform = s.transform;
+  def.spacing = s.spacing;
+  def.min_distance = s.min_distance;
+  def.velocity = s.velocity;
+  def.rate = s.rate;
+  check_object(sph_source_create(world_, &def, &state.id), s.path, "source");
+  state.started = true;
+}
+
+void SceneRuntime::start_force_field(size_t i) {
+  const ForceFieldDesc& f = scene_.force_fields[i];
+  ForceField& state = fields_[i];
+  if (f.has_region) state.region = create_sdf(context_, f.region);
+  sph_force_field_def def;
+  sph_force_field_def_init(&def);
+  def.kind = f.kind;
+  def.region = state.region;
+  def.transform = f.transform;
+  def.vector = f.vector;
+  def.strength = f.strength;
+  def.falloff_radius = f.falloff_radius;
+  check_object(sph_force_field_create(world_, &def, &state.id), f.path, "force field");
+  state.started = true;
+}
+
+void SceneRuntime::apply_schedule(double t, double next_t) {
+  for (size_t i = 0; i < scene_.fluids.size(); ++i)
+    if (!fluid_added_[i] && due(scene_.fluids[i].time, t)) {
+      add_fluid(scene_.fluids[i]);
+      fluid_added_[i] = true;
+    }
+  for (size_t i = 0; i < scene_.sources.size(); ++i) {
+    const SourceDesc& s = scene_.sources[i];
+    Source& state = sources_[i];
+    if (!state.started && !state.stopped && due(s.start, t)) start_source(i);
+    if (state.started && !state.stopped && due(s.stop, t)) {
+      sph_source_destroy(world_, state.id);
+      state.stopped = true;
+    }
+    if (state.started && !state.stopped && !s.motion.empty()) {
+      const sph_transform pose = s.motion.at(t);
+      check_object(sph_source_set_transform(world_, state.id, &pose), s.path + ".motion", "source pose");
+    }
+  }
+  for (size_t i = 0; i < scene_.force_fields.size(); ++i) {
+    const ForceFieldDesc& f = scene_.force_fields[i];
+    ForceField& state = fields_[i];
+    if (!state.started && !state.stopped && due(f.start, t)) start_force_field(i);
+    if (state.started && !state.stopped && due(f.stop, t)) {
+      sph_force_field_destroy(world_, state.id);
+      state.stopped = true;
+    }
+    if (state.started && !state.stopped && !f.motion.empty()) {
+      const sph_transform pose = f.motion.at(t);
+      check_object(sph_force_field_set_transform(world_, state.id, &pose), f.path + ".motion",
+                   "force field pose");
+    }
+  }
+  if (next_t > t)
+    for (const Collider& c : colliders_)
+      if (!c.desc->motion.empty()) {
+        const sph_transform target = c.desc->motion.at(next_t);
+        check_object(sph_collider_set_target_transform(world_, c.id, &target), c.desc->path + ".motion",
+                     "collider target");
+      }
+}
+
+void SceneRuntime::collect_events() {
+  warnings_.clear();
+  uint32_t count = 0;
+  if (sph_world_get_events(world_, nullptr, 0, &count) < 0 || count == 0) return;
+  std::vector<sph_event> events(count);
+  sph_world_get_events(world_, events.data(), count, &count);
+  for (const sph_event& e : events) {
+    if (e.type != SPH_EVENT_SOURCE_CAPACITY_REACHED) continue;
+    std::string path = "sources";
+    for (size_t i = 0; i < sources_.size(); ++i)
+      if (sources_[i].id.bits == e.object_bits) path = scene_.sources[i].path;
+    warnings_.push_back(path + ": the world's capacity (" + std::to_string(scene_.world.capacity) +
+                        ") is reached; " + std::to_string(e.count) +
+                        " particles were not emitted (raise world.capacity)");
+  }
+}
+
+sph_result SceneRuntime::step_frame() {
+  const double dt = 1.0 / static_cast<double>(scene_.fps);
+  const double t = time(), next_t = (frame_ + 1) * dt;
+  apply_schedule(t, next_t);
+  const sph_result r = sph_world_step(world_, static_cast<float>(dt));
+  if (r < 0) throw LibraryError(r, "stepping frame " + std::to_string(frame_ + 1));
+  ++frame_;
+  collect_events();
+  return r;
+}
+
+}  // namespace sph_tools

@@ -1,0 +1,78 @@
+// SceneRuntime: a SceneDesc built into a world through the public C API, and stepped frame by
+// frame with its schedule (fluid bodies and sources that start later, sources and fields that
+// stop, keyframed motion sent as target transforms).
+#ifndef SPH_TOOLS_SCENE_RUNTIME_H
+#define SPH_TOOLS_SCENE_RUNTIME_H
+
+#include <string>
+#include <vector>
+
+#include "scene_desc.h"
+#include "sph_c.h"
+
+namespace sph_tools {
+
+class SceneRuntime {
+ public:
+  struct Collider {
+    const ColliderDesc* desc;
+    sph_sdf* sdf;  // owned by the runtime (one reference)
+    sph_collider_id id;
+  };
+
+  // Creates a world on `context` (which must outlive the runtime) holding the scene's objects
+  // and the fluid bodies of time 0. Throws SceneError (the object's path and the library's
+  // message) when the library rejects a scene object, LibraryError for other failures.
+  SceneRuntime(const SceneDesc& scene, sph_context* context);
+  ~SceneRuntime();
+  SceneRuntime(const SceneRuntime&) = delete;
+  SceneRuntime& operator=(const SceneRuntime&) = delete;
+
+  sph_world* world() const { return world_; }
+  const SceneDesc& scene() const { return scene_; }
+  uint32_t frame() const { return frame_; }
+  double time() const { return frame_ / static_cast<double>(scene_.fps); }
+  const std::vector<Collider>& colliders() const { return colliders_; }
+  // The current pose of colliders()[i].
+  sph_transform collider_pose(size_t i) const;
+
+  // Steps one frame (1 / fps): first what is scheduled at its start, then sph_world_step.
+  // Returns SPH_OK or SPH_INCOMPLETE (max_substeps ran out); throws SceneError or LibraryError.
+  sph_result step_frame();
+
+  // Warnings of the last step_frame (a source that reached the capacity), for the user.
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+ private:
+  void destroy_all();
+  void apply_schedule(double t, double next_t);
+  void add_fluid(const FluidDesc& fluid);
+  void start_source(size_t i);
+  void start_force_field(size_t i);
+  void collect_events();
+
+  const SceneDesc& scene_;
+  sph_context* context_ = nullptr;
+  sph_world* world_ = nullptr;
+  uint32_t frame_ = 0;
+  std::vector<Collider> colliders_;
+  std::vector<bool> fluid_added_;
+  struct Source {
+    sph_sdf* sdf = nullptr;
+    sph_source_id id{0};
+    bool started = false, stopped = false;
+  };
+  std::vector<Source> sources_;
+  std::vector<sph_sdf*> sink_sdfs_;
+  struct ForceField {
+    sph_sdf* region = nullptr;
+    sph_force_field_id id{0};
+    bool started = false, stopped = false;
+  };
+  std::vector<ForceField> fields_;
+  std::vector<std::string> warnings_;
+};
+
+}  // namespace sph_tools
+
+#endif
