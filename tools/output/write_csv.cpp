@@ -1,0 +1,27 @@
+// CSV frames: a header line and one particle per line.
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <stdexcept>
+
+#include "writers.h"
+
+namespace sph_tools {
+
+void write_csv(const ParticleFrame& f, const std::string& path) {
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "w"), std::fclose);
+  if (!file) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  std::FILE* out = file.get();
+  std::fputs("id,x,y,z,vx,vy,vz,density,pressure\n", out);
+  for (uint32_t i = 0; i < f.count; ++i) {
+    const float* x = &f.position[3 * static_cast<size_t>(i)];
+    const float* v = &f.velocity[3 * static_cast<size_t>(i)];
+    std::fprintf(out, "%u,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", f.id[i], x[0], x[1], x[2], v[0], v[1],
+                 v[2], f.density[i], f.pressure[i]);
+  }
+  if (std::ferror(out) || std::fclose(file.release()) != 0)
+    throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+}
+
+}  // namespace sph_tools

@@ -1,0 +1,32 @@
+// The per-frame file writers. Each writes one file at `path` (the caller's temporary name)
+// and throws std::runtime_error when it cannot.
+#ifndef SPH_TOOLS_WRITERS_H
+#define SPH_TOOLS_WRITERS_H
+
+#include <string>
+
+#include "particle_frame.h"
+#include "surface_mesh.h"
+
+namespace sph_tools {
+
+// CSV with a header line: id,x,y,z,vx,vy,vz,density,pressure; floats with 9 significant
+// digits, so every value reads back to the same float.
+void write_csv(const ParticleFrame& frame, const std::string& path);
+
+// Binary little-endian PLY: one vertex element with float x y z vx vy vz density, uint id.
+void write_ply(const ParticleFrame& frame, const std::string& path);
+
+// OpenVDB points (grid "points"): P, v (velocity), density (float) and id (int64), with the
+// frame number and time as grid metadata. Only in builds with OpenVDB.
+void write_vdb_points(const ParticleFrame& frame, const std::string& path);
+
+// The fluid surface (builds with OpenVDB): particles to a level set (grid "surface") written
+// as .vdb, and that level set's zero isosurface written as a Wavefront OBJ mesh (also
+// returned in `mesh`, for the preview). radius and voxel in metres.
+void write_surface(const ParticleFrame& frame, float radius, float voxel, const std::string& vdb_path,
+                   const std::string& obj_path, SurfaceMesh* mesh);
+
+}  // namespace sph_tools
+
+#endif

@@ -1,0 +1,57 @@
+// PNG files through libpng.
+#include <png.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+#include <vector>
+
+#include "image.h"
+
+namespace sph_tools {
+
+namespace {
+
+unsigned char encode_srgb(float linear) {
+  const float c = std::clamp(linear, 0.0f, 1.0f);
+  const float s = c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+  return static_cast<unsigned char>(std::lround(255.0f * s));
+}
+
+// libpng reports errors by longjmp, so this function holds no object with a destructor.
+bool encode(std::FILE* file, const unsigned char* pixels, uint32_t width, uint32_t height) {
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  if (!png) return false;
+  png_infop info = png_create_info_struct(png);
+  if (!info || setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    return false;
+  }
+  png_init_io(png, file);
+  png_set_IHDR(png, info, width, height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_set_compression_level(png, 3);
+  png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+  png_write_info(png, info);
+  for (uint32_t y = 0; y < height; ++y) png_write_row(png, pixels + 3 * static_cast<size_t>(width) * y);
+  png_write_end(png, info);
+  png_destroy_write_struct(&png, &info);
+  return true;
+}
+
+}  // namespace
+
+void write_png(const Image& image, const std::string& path) {
+  std::vector<unsigned char> pixels(image.rgb.size());
+  for (size_t i = 0; i < pixels.size(); ++i) pixels[i] = encode_srgb(image.rgb[i]);
+  std::FILE* file = std::fopen(path.c_str(), "wb");
+  if (!file) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  const bool ok = encode(file, pixels.data(), image.width, image.height);
+  if (std::fclose(file) != 0 || !ok)
+    throw std::runtime_error("cannot write " + path + ": libpng or the file failed");
+}
+
+}  // namespace sph_tools

@@ -1,0 +1,52 @@
+#include "run_stats.h"
+
+#include <algorithm>
+
+namespace sph_tools {
+
+void RunStats::add_frame(const sph_stats& s, double step_wall_ms, double output_wall_ms) {
+  if (frames_ == 0 || s.dt_min < dt_min_) dt_min_ = s.dt_min;
+  dt_max_ = std::max(dt_max_, s.dt_max);
+  speed_max_ = std::max(speed_max_, s.max_speed);
+  particles_max_ = std::max(particles_max_, s.particle_count);
+  substeps_ += s.substeps;
+  step_ms_ += step_wall_ms;
+  output_ms_ += output_wall_ms;
+  for (int i = 0; i < SPH_STAGE_COUNT; ++i) stage_ms_[i] += s.stage_ms[i];
+  last_ = s;
+  ++frames_;
+}
+
+void RunStats::print(std::FILE* out, const std::string& what, const std::string& backend,
+                     double wall_s) const {
+  std::fprintf(out, "sph-run: %s in %.1f s on the %s backend\n", what.c_str(), wall_s, backend.c_str());
+  if (frames_ == 0) {
+    std::fprintf(out, "  output %.1f ms\n", output_ms_);
+    return;
+  }
+  std::fprintf(out, "  time per frame: %.1f ms simulating, %.1f ms writing output\n", step_ms_ / frames_,
+               output_ms_ / (frames_ + 1));
+  std::fprintf(out,
+               "  particles: %u at the end, %u at most; substeps %llu (%.1f per frame, dt %.3g..%.3g s)\n",
+               last_.particle_count, particles_max_, static_cast<unsigned long long>(substeps_),
+               static_cast<double>(substeps_) / frames_, dt_min_, dt_max_);
+  std::fprintf(out,
+               "  last frame: density %.1f / %.1f / %.1f kg/m^3 (min/mean/max), %.1f neighbours (max %u), "
+               "max speed %.2f m/s (%.2f in the run)\n",
+               last_.density_min, last_.density_mean, last_.density_max, last_.neighbors_mean,
+               last_.neighbors_max, last_.max_speed, speed_max_);
+  static const char* kStages[SPH_STAGE_COUNT] = {"hash+sort", "cells",   "density", "forces",
+                                                 "integrate", "collide", "emit",    "other"};
+  double total = 0.0;
+  for (double ms : stage_ms_) total += ms;
+  if (total > 0.0) {
+    std::fprintf(out, "  stages:");
+    for (int i = 0; i < SPH_STAGE_COUNT; ++i)
+      std::fprintf(out, " %s %.0f%%", kStages[i], 100.0 * stage_ms_[i] / total);
+    std::fprintf(out, "\n");
+  }
+  std::fprintf(out, "  world memory: %.1f MiB\n",
+               static_cast<double>(last_.memory_bytes) / (1024.0 * 1024.0));
+}
+
+}  // namespace sph_tools

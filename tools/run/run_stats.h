@@ -1,0 +1,33 @@
+// What a run did, gathered frame by frame from sph_stats and printed when it ends.
+#ifndef SPH_TOOLS_RUN_STATS_H
+#define SPH_TOOLS_RUN_STATS_H
+
+#include <cstdint>
+#include <cstdio>
+#include <string>
+
+#include "sph_c.h"
+
+namespace sph_tools {
+
+class RunStats {
+ public:
+  void add_frame(const sph_stats& stats, double step_wall_ms, double output_wall_ms);
+  void add_output(double output_wall_ms) { output_ms_ += output_wall_ms; }
+  // Prints the summary. `what` heads it ("dam_break.json: 120 frames").
+  void print(std::FILE* out, const std::string& what, const std::string& backend, double wall_s) const;
+  uint32_t frames() const { return frames_; }
+
+ private:
+  uint32_t frames_ = 0;
+  uint64_t substeps_ = 0;
+  uint32_t particles_max_ = 0;
+  double step_ms_ = 0.0, output_ms_ = 0.0;
+  float dt_min_ = 0.0f, dt_max_ = 0.0f, speed_max_ = 0.0f;
+  double stage_ms_[SPH_STAGE_COUNT] = {};
+  sph_stats last_{};
+};
+
+}  // namespace sph_tools
+
+#endif
