@@ -1,0 +1,164 @@
+// sph-run's exit codes (issue 7, items 2 and 6): usage errors, scene-file errors, backends that
+// are not there, and an interrupted run that keeps only complete frames.
+//   usage: cli_exit_codes SPH_RUN SCENES_DIR
+#include <signal.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <thread>
+
+extern "C" {
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+}
+
+#include "cli_test_support.h"
+#include "sph_c.h"
+
+namespace {
+
+std::string g_sph_run, g_scenes;
+
+int run(const std::vector<std::string>& args, std::string* output) {
+  std::vector<std::string> argv = {g_sph_run};
+  argv.insert(argv.end(), args.begin(), args.end());
+  const int status = cli_test::run(argv, output);
+  std::printf("$ sph-run");
+  for (const std::string& a : args) std::printf(" %s", a.c_str());
+  std::printf("  -> %d\n%s", status, output->c_str());
+  return status;
+}
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+void test_usage_errors_exit_2(void**) {
+  std::string out;
+  assert_int_equal(run({}, &out), 2);
+  assert_true(contains(out, "missing the scene file") && contains(out, "usage: sph-run"));
+  assert_int_equal(run({"--help"}, &out), 0);
+  assert_true(contains(out, "exit codes"));
+  const std::string scene = g_scenes + "/tiny.json";
+  assert_int_equal(run({scene, "--bogus"}, &out), 2);
+  assert_true(contains(out, "unknown option --bogus"));
+  assert_int_equal(run({scene, "--backend", "gpu"}, &out), 2);
+  assert_true(contains(out, "--backend: expected auto, cpu or cuda, got \"gpu\""));
+  assert_int_equal(run({scene, "--frames", "-1"}, &out), 2);
+  assert_true(contains(out, "--frames: expected an integer"));
+  assert_int_equal(run({scene, "--frames"}, &out), 2);
+  assert_true(contains(out, "--frames: missing its value"));
+  assert_int_equal(run({scene, "--format", "exr"}, &out), 2);
+  assert_int_equal(run({scene, scene}, &out), 2);
+}
+
+void test_scene_errors_exit_3(void**) {
+  std::string out;
+  assert_int_equal(run({"/nonexistent/scene.json"}, &out), 3);
+  assert_true(contains(out, "cannot open /nonexistent/scene.json"));
+  const std::string dir = cli_test::make_temp_dir("bad_scene");
+  const std::string bad = dir + "/bad.json";
+  cli_test::write_text(bad, R"({"colliders": [{"shape": {"type": "sphere", "radius": -0.5}}]})");
+  assert_int_equal(run({bad, "--out", dir + "/out"}, &out), 3);
+  assert_true(contains(out, "colliders[0].shape.radius: expected a positive number, got -0.5"));
+  cli_test::write_text(bad, R"({"world": {"surface_tension": 0.07}})");
+  assert_int_equal(run({bad, "--out", dir + "/out"}, &out), 3);
+  assert_true(contains(out, "world.surface_tension: unknown field"));
+  cli_test::write_text(bad, "{\"world\": }");
+  assert_int_equal(run({bad, "--out", dir + "/out"}, &out), 3);
+  assert_true(contains(out, "not valid JSON: parse error at line 1"));
+  // Rejected by the library while building: still a scene error, at the object's path.
+  cli_test::write_text(
+      bad,
+      R"({"world": {"capacity": 10}, "fluids": [{"type": "sphere", "center": [0,0,0], "radius": 0.2}]})");
+  assert_int_equal(run({bad, "--out", dir + "/out", "--backend", "cpu"}, &out), 3);
+  assert_true(contains(out, "fluids[0]: the fluid body does not fit"));
+}
+
+// CUDA asked for where there is none (a CPU-only build, or no GPU) is a clean error with its
+// own code; where a GPU is there, the run works.
+void test_cuda_without_gpu_exits_4(void**) {
+  sph_context_def def;
+  sph_context_def_init(&def);
+  def.backend = SPH_BACKEND_CUDA;
+  sph_context* context = nullptr;
+  const bool have_cuda = sph_context_create(&def, &context) == SPH_OK;
+  sph_context_destroy(context);
+  const std::string dir = cli_test::make_temp_dir("cuda");
+  std::string out;
+  const int status = run({g_scenes + "/tiny.json", "--backend", "cuda", "--frames", "1", "--out", dir}, &out);
+  if (have_cuda) {
+    assert_int_equal(status, 0);
+  } else {
+    assert_int_equal(status, 4);
+    assert_true(contains(out, "the CUDA backend is not available"));
+    assert_true(contains(out, "--backend cpu"));
+  }
+}
+
+// SIGINT in the middle of a long run: exit 130, frames 0..k all complete (each PLY parses to
+// the length its header gives), nothing under a temporary name, nothing of frame k+1.
+void test_interrupt_keeps_only_complete_frames(void**) {
+  const std::string dir = cli_test::make_temp_dir("interrupt");
+  const pid_t pid = cli_test::start({g_sph_run, g_scenes + "/tiny.json", "--frames", "100000", "--backend",
+                                     "cpu", "--format", "ply,csv", "--out", dir, "--threads", "1"},
+                                    dir + ".log");
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!cli_test::file_exists(dir + "/fluid_0005.ply") && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  assert_true(cli_test::file_exists(dir + "/fluid_0005.ply"));
+  kill(pid, SIGINT);
+  const int status = cli_test::wait_for(pid, 60);
+  const std::string log = cli_test::read_text(dir + ".log");
+  std::printf("%s", log.c_str());
+  assert_int_equal(status, 130);
+  assert_true(contains(log, "interrupted; frames 0.."));
+  std::vector<std::string> names = cli_test::list_dir(dir);
+  std::sort(names.begin(), names.end());
+  size_t frames = 0;
+  for (const std::string& name : names) {
+    assert_true(name.find(".tmp") == std::string::npos);
+    if (name.size() > 4 && name.compare(name.size() - 4, 4, ".ply") == 0) {
+      char expected[32];
+      std::snprintf(expected, sizeof expected, "fluid_%04zu.ply", frames);
+      assert_string_equal(name.c_str(), expected);
+      cli_test::Particles p;
+      std::string error;
+      if (!cli_test::read_ply(dir + "/" + name, &p, &error)) std::printf("%s\n", error.c_str());
+      assert_true(cli_test::read_ply(dir + "/" + name, &p, &error));
+      char csv[32];
+      std::snprintf(csv, sizeof csv, "fluid_%04zu.csv", frames);
+      cli_test::Particles q;
+      assert_true(cli_test::read_csv(dir + "/" + csv, &q, &error));
+      assert_int_equal(p.count(), q.count());
+      ++frames;
+    }
+  }
+  assert_true(frames >= 6);
+  assert_int_equal(names.size(), 2 * frames);  // a .ply and a .csv of every frame, nothing else
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 3) {
+    std::fprintf(stderr, "usage: %s SPH_RUN SCENES_DIR\n", argv[0]);
+    return 2;
+  }
+  g_sph_run = argv[1];
+  g_scenes = argv[2];
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_usage_errors_exit_2),
+      cmocka_unit_test(test_scene_errors_exit_3),
+      cmocka_unit_test(test_cuda_without_gpu_exits_4),
+      cmocka_unit_test(test_interrupt_keeps_only_complete_frames),
+  };
+  return cmocka_run_group_tests(tests, nullptr, nullptr);
+}

@@ -1,0 +1,263 @@
+// Outputs read back equal the particle arrays (issue 7, items 3 and 6): the CSV, PLY and VDB
+// points writers round-trip a frame exactly (VDB positions to float precision), sph-run's frame
+// files hold what the world held after the same frames, and the surface encloses the fluid.
+//   usage: cli_outputs SPH_RUN SCENES_DIR
+#ifdef SPH_TOOLS_HAVE_OPENVDB
+#include <openvdb/openvdb.h>
+#include <openvdb/points/PointDataGrid.h>
+#include <openvdb/tools/Interpolation.h>
+#endif
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <string>
+
+#include "cli_test_support.h"
+#include "particle_frame.h"
+#include "scene_parser.h"
+#include "scene_runtime.h"
+#include "writers.h"
+
+// cmocka defines _skip, which OpenVDB uses as a name: it comes last.
+extern "C" {
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+}
+
+namespace {
+
+std::string g_sph_run, g_scenes;
+
+// A frame with awkward values: negative zero, tiny and large magnitudes, ids out of order.
+sph_tools::ParticleFrame crafted_frame() {
+  sph_tools::ParticleFrame f;
+  f.frame = 7;
+  f.time = 0.125;
+  f.particle_spacing = 0.02f;
+  f.count = 500;
+  for (uint32_t i = 0; i < f.count; ++i) {
+    const float a = static_cast<float>(i);
+    f.position.insert(f.position.end(), {std::sin(a) * 0.7f, -0.0f + 1e-7f * a, 3.0f + std::cos(a * 1.3f)});
+    f.velocity.insert(f.velocity.end(), {1e-30f * a, -12345.678f + a, 0.1f * a});
+    f.density.push_back(900.0f + std::sqrt(a));
+    f.pressure.push_back(std::fmod(a * 7.1f, 13.0f));
+    f.id.push_back((i * 7919u) % 100003u + (i == 3 ? 4000000000u : 0u));
+  }
+  return f;
+}
+
+bool same_floats(const std::vector<float>& a, const std::vector<float>& b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](float x, float y) {
+           return std::memcmp(&x, &y, 4) == 0 || x == y;  // bit-equal (or both zeros)
+         });
+}
+
+void expect_equal(const sph_tools::ParticleFrame& f, const cli_test::Particles& p, bool with_pressure) {
+  assert_int_equal(p.count(), f.count);
+  assert_true(std::equal(p.id.begin(), p.id.end(), f.id.begin()));
+  assert_true(same_floats(p.position, f.position));
+  assert_true(same_floats(p.velocity, f.velocity));
+  assert_true(same_floats(p.density, f.density));
+  if (with_pressure) assert_true(same_floats(p.pressure, f.pressure));
+}
+
+#ifdef SPH_TOOLS_HAVE_OPENVDB
+// Reads a VDB points frame into arrays ordered by id.
+std::map<uint32_t, std::array<float, 7>> read_vdb_points(const std::string& path, int32_t* frame_meta) {
+  openvdb::initialize();
+  openvdb::io::File file(path);
+  file.open();
+  openvdb::GridBase::Ptr base = file.readGrid("points");
+  file.close();
+  auto grid = openvdb::gridPtrCast<openvdb::points::PointDataGrid>(base);
+  assert_non_null(grid.get());
+  *frame_meta = grid->metaValue<int32_t>("frame");
+  std::map<uint32_t, std::array<float, 7>> out;
+  for (auto leaf = grid->tree().cbeginLeaf(); leaf; ++leaf) {
+    openvdb::points::AttributeHandle<openvdb::Vec3f> p(leaf->constAttributeArray("P"));
+    openvdb::points::AttributeHandle<openvdb::Vec3f> v(leaf->constAttributeArray("v"));
+    openvdb::points::AttributeHandle<float> rho(leaf->constAttributeArray("density"));
+    openvdb::points::AttributeHandle<int64_t> id(leaf->constAttributeArray("id"));
+    for (auto index = leaf->beginIndexOn(); index; ++index) {
+      const openvdb::Vec3d world = grid->transform().indexToWorld(index.getCoord().asVec3d() + p.get(*index));
+      const openvdb::Vec3f vel = v.get(*index);
+      out[static_cast<uint32_t>(id.get(*index))] = {static_cast<float>(world.x()),
+                                                    static_cast<float>(world.y()),
+                                                    static_cast<float>(world.z()),
+                                                    vel.x(),
+                                                    vel.y(),
+                                                    vel.z(),
+                                                    rho.get(*index)};
+    }
+  }
+  return out;
+}
+
+void expect_vdb_equal(const sph_tools::ParticleFrame& f, const std::string& path) {
+  int32_t frame = -1;
+  const auto points = read_vdb_points(path, &frame);
+  assert_int_equal(frame, static_cast<int32_t>(f.frame));
+  assert_int_equal(points.size(), f.count);
+  for (uint32_t i = 0; i < f.count; ++i) {
+    const auto it = points.find(f.id[i]);
+    assert_true(it != points.end());
+    // Positions are stored relative to their voxel: exact to float rounding of that offset.
+    for (int a = 0; a < 3; ++a) assert_true(std::fabs(it->second[a] - f.position[3 * i + a]) <= 1e-6f);
+    for (int a = 0; a < 3; ++a) assert_true(it->second[3 + a] == f.velocity[3 * i + a]);
+    assert_true(it->second[6] == f.density[i]);
+  }
+}
+#endif
+
+void test_writers_round_trip(void**) {
+  const sph_tools::ParticleFrame f = crafted_frame();
+  const std::string dir = cli_test::make_temp_dir("writers");
+  std::string error;
+  cli_test::Particles p;
+  sph_tools::write_ply(f, dir + "/f.ply");
+  if (!cli_test::read_ply(dir + "/f.ply", &p, &error)) std::printf("%s\n", error.c_str());
+  expect_equal(f, p, false);
+  sph_tools::write_csv(f, dir + "/f.csv");
+  assert_true(cli_test::read_csv(dir + "/f.csv", &p, &error));
+  expect_equal(f, p, true);
+#ifdef SPH_TOOLS_HAVE_OPENVDB
+  sph_tools::write_vdb_points(f, dir + "/f.vdb");
+  expect_vdb_equal(f, dir + "/f.vdb");
+#endif
+  // An empty frame is a valid file of each kind.
+  sph_tools::ParticleFrame empty;
+  sph_tools::write_ply(empty, dir + "/e.ply");
+  assert_true(cli_test::read_ply(dir + "/e.ply", &p, &error) && p.count() == 0);
+  sph_tools::write_csv(empty, dir + "/e.csv");
+  assert_true(cli_test::read_csv(dir + "/e.csv", &p, &error) && p.count() == 0);
+#ifdef SPH_TOOLS_HAVE_OPENVDB
+  sph_tools::write_vdb_points(empty, dir + "/e.vdb");
+  int32_t frame = -1;
+  assert_int_equal(read_vdb_points(dir + "/e.vdb", &frame).size(), 0);
+#endif
+}
+
+// sph-run's frame files against the same scene stepped here through the scene loader: the CPU
+// backend is deterministic, so the arrays are equal bit for bit.
+void test_run_outputs_equal_world(void**) {
+  const std::string scene_file = g_scenes + "/tiny.json";
+  const std::string dir = cli_test::make_temp_dir("run_outputs");
+  std::string formats = "ply,csv";
+#ifdef SPH_TOOLS_HAVE_OPENVDB
+  formats += ",vdb";
+#endif
+  std::string log;
+  const int status = cli_test::run({g_sph_run, scene_file, "--frames", "3", "--backend", "cpu", "--threads",
+                                    "2", "--format", formats, "--out", dir, "--quiet"},
+                                   &log);
+  std::printf("%s", log.c_str());
+  assert_int_equal(status, 0);
+
+  sph_context_def def;
+  sph_context_def_init(&def);
+  def.backend = SPH_BACKEND_CPU;
+  def.cpu_worker_count = 2;
+  sph_context* context = nullptr;
+  assert_int_equal(sph_context_create(&def, &context), SPH_OK);
+  {
+    const sph_tools::SceneDesc scene = sph_tools::load_scene_file(scene_file);
+    sph_tools::SceneRuntime runtime(scene, context);
+    sph_tools::ParticleFrame f;
+    for (uint32_t frame = 0; frame <= 3; ++frame) {
+      if (frame > 0) runtime.step_frame();
+      sph_tools::read_particles(runtime.world(), frame, runtime.time(), &f);
+      assert_true(f.count > 100);
+      char name[64];
+      std::snprintf(name, sizeof name, "%s/fluid_%04u", dir.c_str(), frame);
+      cli_test::Particles p;
+      std::string error;
+      assert_true(cli_test::read_ply(std::string(name) + ".ply", &p, &error));
+      expect_equal(f, p, false);
+      assert_true(cli_test::read_csv(std::string(name) + ".csv", &p, &error));
+      expect_equal(f, p, true);
+#ifdef SPH_TOOLS_HAVE_OPENVDB
+      expect_vdb_equal(f, std::string(name) + ".vdb");
+#endif
+    }
+  }
+  assert_int_equal(sph_context_destroy(context), SPH_OK);
+}
+
+#ifdef SPH_TOOLS_HAVE_OPENVDB
+// The surface level set is negative at every particle (it encloses the fluid) and its mesh is
+// closed, wound outward, and holds about the fluid's volume.
+void test_surface_encloses_fluid(void**) {
+  const std::string dir = cli_test::make_temp_dir("surface");
+  std::string log;
+  assert_int_equal(cli_test::run({g_sph_run, g_scenes + "/tiny.json", "--frames", "1", "--backend", "cpu",
+                                  "--format", "ply", "--surface", "--out", dir, "--quiet"},
+                                 &log),
+                   0);
+  cli_test::Particles p;
+  std::string error;
+  assert_true(cli_test::read_ply(dir + "/fluid_0001.ply", &p, &error));
+  openvdb::initialize();
+  openvdb::io::File file(dir + "/surface_0001.vdb");
+  file.open();
+  auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid("surface"));
+  file.close();
+  assert_true(grid && grid->getGridClass() == openvdb::GRID_LEVEL_SET);
+  openvdb::tools::GridSampler<openvdb::FloatGrid, openvdb::tools::BoxSampler> sampler(*grid);
+  size_t inside = 0;
+  for (size_t i = 0; i < p.count(); ++i)
+    inside += sampler.wsSample(
+                  openvdb::Vec3d(p.position[3 * i], p.position[3 * i + 1], p.position[3 * i + 2])) < 0.0f;
+  assert_true(inside >= p.count() * 99 / 100);  // a lone particle may thin out below a voxel
+
+  std::vector<std::array<double, 3>> v;
+  double volume = 0.0;
+  size_t faces = 0;
+  std::FILE* obj = std::fopen((dir + "/surface_0001.obj").c_str(), "r");
+  assert_non_null(obj);
+  char line[256];
+  while (std::fgets(line, sizeof line, obj)) {
+    double x, y, z;
+    unsigned a, b, c;
+    if (std::sscanf(line, "v %lf %lf %lf", &x, &y, &z) == 3) v.push_back({x, y, z});
+    if (std::sscanf(line, "f %u %u %u", &a, &b, &c) == 3) {
+      const auto &p0 = v.at(a - 1), &p1 = v.at(b - 1), &p2 = v.at(c - 1);
+      volume += (p0[0] * (p1[1] * p2[2] - p1[2] * p2[1]) + p0[1] * (p1[2] * p2[0] - p1[0] * p2[2]) +
+                 p0[2] * (p1[0] * p2[1] - p1[1] * p2[0])) /
+                6.0;
+      ++faces;
+    }
+  }
+  std::fclose(obj);
+  const double fluid = p.count() * std::pow(0.02, 3) / std::sqrt(2.0);  // FCC: sqrt(2) / s^3 per m^3
+  std::printf("surface: %zu faces, volume %.5f m^3, fluid %.5f m^3\n", faces, volume, fluid);
+  assert_true(faces > 100);
+  assert_true(volume > 0.7 * fluid && volume < 1.5 * fluid);
+}
+#endif
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 3) {
+    std::fprintf(stderr, "usage: %s SPH_RUN SCENES_DIR\n", argv[0]);
+    return 2;
+  }
+  g_sph_run = argv[1];
+  g_scenes = argv[2];
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_writers_round_trip),
+      cmocka_unit_test(test_run_outputs_equal_world),
+#ifdef SPH_TOOLS_HAVE_OPENVDB
+      cmocka_unit_test(test_surface_encloses_fluid),
+#endif
+  };
+  return cmocka_run_group_tests(tests, nullptr, nullptr);
+}

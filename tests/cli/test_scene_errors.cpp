@@ -1,0 +1,180 @@
+// Scene-file errors (issue 7, item 6): every bad field is reported with its path and what was
+// expected there; unknown fields (physics options of later issues among them) are rejected;
+// scene objects the library refuses are reported at their path too.
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+extern "C" {
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+}
+
+#include "scene_error.h"
+#include "scene_parser.h"
+#include "scene_runtime.h"
+
+namespace {
+
+using sph_tools::SceneError;
+
+struct Case {
+  const char* json;
+  const char* message;  // the whole "path: message" must start with this
+};
+
+const Case kCases[] = {
+    {R"({"world": {"capacity": -5}})", "world.capacity: expected an integer >= 1, got -5"},
+    {R"({"world": {"capacity": 1.5}})", "world.capacity: expected an integer >= 1, got 1.5"},
+    {R"({"world": {"particle_spacing": "small"}})",
+     "world.particle_spacing: expected a positive number, got the string \"small\""},
+    {R"({"world": {"particle_spacing": 0.02, "kernel_radius": 0.01}})",
+     "world.kernel_radius: expected a radius >= particle_spacing (0.02)"},
+    {R"({"world": {"integrator": "verlet"}})", "world.integrator: expected \"symplectic_euler\" or \"rk4\""},
+    {R"({"world": {"surface_tension": 0.07}})", "world.surface_tension: unknown field; world takes capacity"},
+    {R"({"surface_tension": {"coefficient": 0.07}})",
+     "surface_tension: unknown field; a scene takes version"},
+    {R"({"version": 2})", "version: expected an integer in [1, 1], got 2"},
+    {R"({"params": {"gravity": [0, -9.81]}})", "params.gravity: expected an array of 3 numbers [x, y, z]"},
+    {R"({"params": {"gravity": [0, "down", 0]}})", "params.gravity[1]: expected a number"},
+    {R"({"params": {"dt_min": 0.001, "dt_max": 0.0001}})",
+     "params.dt_max: expected a step >= dt_min (0.001)"},
+    {R"({"params": {"viscosity": -1}})", "params.viscosity: expected a number >= 0, got -1"},
+    {R"({"time": {"fps": 0}})", "time.fps: expected a positive number, got 0"},
+    {R"({"fluids": {"type": "box"}})", "fluids: expected a list of fluid bodies (an array), got an object"},
+    {R"({"fluids": [{"type": "cube"}]})",
+     "fluids[0].type: expected \"box\", \"sphere\" or \"particles\", got the string \"cube\""},
+    {R"({"fluids": [{"type": "sphere", "center": [0, 0, 0]}]})",
+     "fluids[0].radius: missing (expected a positive number)"},
+    {R"({"fluids": [{"type": "box", "min": [0, 0, 0], "max": [1, 0, 1]}]})",
+     "fluids[0].max: expected a corner above min in every component"},
+    {R"({"fluids": [{"type": "particles", "positions": [[0, 0, 0]], "velocities": []}]})",
+     "fluids[0].velocities: expected an array of 1 velocities (one per position)"},
+    {R"({"colliders": [{"shape": {"type": "sphere", "radius": 1}}, {"shape": {"type": "sphere", "radius": 1}},
+                       {"shape": {"type": "sphere", "radius": -1}}]})",
+     "colliders[2].shape.radius: expected a positive number, got -1"},
+    {R"({"colliders": [{"shape": {"type": "cup", "radius": 0.1, "half_height": 0.1}}]})",
+     "colliders[0].shape.wall_thickness: missing (expected a positive number)"},
+    {R"({"colliders": [{"shape": {"type": "box", "half_extents": [1, 0, 1]}}]})",
+     "colliders[0].shape.half_extents[1]: expected a positive number, got 0"},
+    {R"({"colliders": [{"shape": {"type": "box", "half_extents": [1, 1, 1], "open_top": true}}]})",
+     "colliders[0].shape.open_top: expected false (an open top needs a hollow box"},
+    {R"({"colliders": [{"shape": {"type": "sphere", "radius": 1, "half_height": 2}}]})",
+     "colliders[0].shape.half_height: unknown field; a sphere takes type, radius"},
+    {R"({"colliders": [{"shape": {"type": "sphere", "radius": 1}, "restitution": 2}]})",
+     "colliders[0].restitution: expected a number in [0, 1], got 2"},
+    {R"({"colliders": [{"shape": {"type": "sphere", "radius": 1},
+                        "transform": {"rotation": {"axis": [0, 1, 0], "degrees": 90, "quaternion": [0, 0, 0, 1]}}}]})",
+     "colliders[0].transform.rotation: give either \"quaternion\" or \"axis\""},
+    {R"({"colliders": [{"shape": {"type": "sphere", "radius": 1},
+                        "transform": {"rotation": {"axis": [0, 0, 0], "degrees": 90}}}]})",
+     "colliders[0].transform.rotation.axis: expected a non-zero vector"},
+    {R"({"colliders": [{"shape": {"type": "sphere", "radius": 1},
+                        "motion": {"keyframes": [{"time": 1, "position": [0, 0, 0]}, {"time": 0.5}]}}]})",
+     "colliders[0].motion.keyframes[1].time: expected a time greater than the previous keyframe's (1)"},
+    {R"({"colliders": [{"shape": {"type": "sphere", "radius": 1}, "motion": {"keyframes": []}}]})",
+     "colliders[0].motion.keyframes: expected keyframes (an array of at least 1)"},
+    {R"({"colliders": [{"shape": {"type": "sphere", "radius": 1}, "motion": {"keyframes": [{"time": 0}],
+                        "interpolation": "cubic"}}]})",
+     "colliders[0].motion.interpolation: expected \"linear\" or \"smooth\""},
+    {R"({"sources": [{"shape": {"type": "sphere", "radius": 0.1}, "start": 2, "stop": 1}]})",
+     "sources[0].stop: expected a time after start (2 s), got 1"},
+    {R"({"sources": [{"shape": {"type": "sphere", "radius": 0.1}, "mode": "once", "rate": 100}]})",
+     "sources[0].rate: expected no rate for a \"once\" source"},
+    {R"({"sinks": [{"type": "outside_bounds", "min": [0, 0, 0], "max": [1, 1, -1]}]})",
+     "sinks[0].max: expected a corner above min in every component"},
+    {R"({"sinks": [{"type": "region"}]})", "sinks[0].shape: missing (expected a shape"},
+    {R"({"force_fields": [{"type": "vortex", "strength": 1}]})",
+     "force_fields[0].axis: missing (expected an array of 3 numbers [x, y, z])"},
+    {R"({"force_fields": [{"type": "grid"}]})",
+     "force_fields[0].type: expected \"uniform\", \"radial\" or \"vortex\", got the string \"grid\""},
+    {R"({"output": {"format": "exr"}})",
+     "output.format: expected \"vdb\", \"ply\" or \"csv\", got the string \"exr\""},
+    {R"({"output": {"preview": {"camera": {"position": [1, 1, 1], "target": [1, 1, 1]}}}})",
+     "output.preview.camera.target: expected a point other than the position"},
+    {R"({"output": {"preview": {"width": 4}}})",
+     "output.preview.width: expected an integer in [16, 8192], got 4"},
+    {R"({"output": {"surface": {"enabled": true, "iso": 0.5}}})", "output.surface.iso: unknown field"},
+    {"{\"world\": {\n  \"capacity\": 10,\n}}", "not valid JSON: parse error at line 3, column 1"},
+    {"[1, 2]", "expected a scene (an object), got an array of 2"},
+};
+
+void test_each_bad_field_names_its_path(void**) {
+  int failures = 0;
+  for (const Case& c : kCases) {
+    std::string what = "(no error)";
+    try {
+      sph_tools::parse_scene(c.json, ".");
+    } catch (const SceneError& e) {
+      what = e.what();
+    }
+    if (what.compare(0, std::strlen(c.message), c.message) != 0) {
+      std::printf("scene %s\n  expected: %s...\n  got:      %s\n", c.json, c.message, what.c_str());
+      ++failures;
+    }
+  }
+  assert_int_equal(failures, 0);
+}
+
+// Errors found while building the world carry the path of the object the library refused.
+void expect_build_error(const char* json, const char* message) {
+  sph_context_def def;
+  sph_context_def_init(&def);
+  def.backend = SPH_BACKEND_CPU;
+  def.cpu_worker_count = 1;
+  sph_context* context = nullptr;
+  assert_int_equal(sph_context_create(&def, &context), SPH_OK);
+  std::string what = "(no error)";
+  try {
+    const sph_tools::SceneDesc scene = sph_tools::parse_scene(json, ".");
+    sph_tools::SceneRuntime runtime(scene, context);
+    while (runtime.frame() < 3) runtime.step_frame();
+  } catch (const SceneError& e) {
+    what = e.what();
+  }
+  if (what.compare(0, std::strlen(message), message) != 0)
+    std::printf("scene %s\n  expected: %s...\n  got:      %s\n", json, message, what.c_str());
+  assert_true(what.compare(0, std::strlen(message), message) == 0);
+  assert_int_equal(sph_context_destroy(context), SPH_OK);
+}
+
+void test_library_rejections_name_the_object(void**) {
+  expect_build_error(
+      R"({"world": {"capacity": 100}, "fluids": [{"type": "box", "min": [0, 0, 0], "max": [1, 1, 1]}]})",
+      "fluids[0]: the fluid body does not fit: the world holds 0 of 100 particles (raise world.capacity)");
+  // A later body that does not fit is reported when its time comes.
+  expect_build_error(R"({"world": {"capacity": 1000}, "time": {"fps": 60},
+                         "fluids": [{"type": "sphere", "center": [0, 0, 0], "radius": 0.1},
+                                    {"type": "sphere", "center": [1, 0, 0], "radius": 0.1, "time": 0.02}]})",
+                     "fluids[1]: the fluid body does not fit");
+  expect_build_error(
+      R"({"colliders": [{"shape": {"type": "box", "half_extents": [100, 100, 100], "voxel_size": 0.001}}]})",
+      "colliders[0].shape: the library rejected the shape: ");
+  expect_build_error(R"({"colliders": [{"shape": {"type": "vdb", "file": "no_such_file.vdb"}}]})",
+                     "colliders[0].shape.file: cannot load a level set from ./no_such_file.vdb");
+}
+
+void test_missing_file_is_a_scene_error(void**) {
+  std::string what;
+  try {
+    sph_tools::load_scene_file("/nonexistent/scene.json");
+  } catch (const SceneError& e) {
+    what = e.what();
+  }
+  assert_true(what.find("cannot open /nonexistent/scene.json") == 0);
+}
+
+}  // namespace
+
+int main() {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_each_bad_field_names_its_path),
+      cmocka_unit_test(test_library_rejections_name_the_object),
+      cmocka_unit_test(test_missing_file_is_a_scene_error),
+  };
+  return cmocka_run_group_tests(tests, nullptr, nullptr);
+}
