@@ -87,7 +87,7 @@ __global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArra
   const uint32_t k = __float_as_uint(a.sorted_position[i].w);
   const DensitySample s = gather_density(fluid, grid, a.sorted_position, i);
   a.density[i] = s.density;
-  a.sorted_position[i].w = pressure_from_density(s.density, fluid.rest_density, fluid.stiffness);
+  a.sorted_position[i].w = pressure_from_density(fluid.eos, s.density);
   const Float4 v = a.velocity[k];
   a.sorted_velocity[i] = make_float4_record(xyz(v), 1.0f / s.density);
 }

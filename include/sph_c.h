@@ -134,9 +134,39 @@ typedef enum sph_stage {
   SPH_STAGE_FORCE32 = 0x7fffffff
 } sph_stage;
 
-/** World feature bits. None are defined yet: any set bit is rejected as unknown. */
+/**
+ * World feature bits, fixed at world creation. A feature that is off allocates nothing and
+ * costs no work (docs/physics.md, docs/performance.md); its parameter calls return
+ * SPH_ERROR_FEATURE_DISABLED. Unknown bits are SPH_ERROR_UNSUPPORTED.
+ */
 typedef uint32_t sph_feature_flags;
 #define SPH_FEATURE_NONE 0u
+/** Surface tension from the colour field (Morris 2000; thesis eq. 20-23), with parameters in
+ *  sph_surface_tension_params. EXPERIMENTAL: it yields the Laplace pressure only to within a
+ *  factor of two at 8 particles per radius, and at sigma of about 1 N/m on centimetre drops it
+ *  can fling stray surface particles off (docs/physics.md). */
+#define SPH_FEATURE_SURFACE_TENSION 0x1u
+/** Normalised density (thesis eq. 31): a second density pass, a Shepard filter that evens out
+ *  the density deficit of particles near a free surface (it narrows it; it does not remove it:
+ *  about 48 % -> 34 % on the outermost layer of a resting sphere). */
+#define SPH_FEATURE_NORMALIZED_DENSITY 0x2u
+
+typedef enum sph_viscosity_method {
+  SPH_VISCOSITY_MUELLER = 0, /* Laplacian viscosity (eq. 17), coefficient sph_world_params.viscosity */
+  SPH_VISCOSITY_CLAVET = 1,  /* radial impulses between approaching pairs (eq. 18-19),
+                                sph_clavet_viscosity_params */
+  SPH_VISCOSITY_METHOD_FORCE32 = 0x7fffffff
+} sph_viscosity_method;
+
+typedef enum sph_equation_of_state {
+  SPH_EOS_IDEAL_GAS = 0, /* the thesis's modified ideal gas p = k (rho - rho0) (eq. 15) */
+  SPH_EOS_TAIT = 1,      /* p = B ((rho / rho0)^7 - 1), B = rho0 c^2 / 7, sph_tait_params */
+  SPH_EOS_FORCE32 = 0x7fffffff
+} sph_equation_of_state;
+
+/** Step-size limits beyond eq. 32, for sph_world_params.step_limits. */
+#define SPH_STEP_LIMIT_ACOUSTIC 0x1u /* dt <= step_factor h / c, c the EOS's speed of sound */
+#define SPH_STEP_LIMIT_FORCE 0x2u    /* dt <= step_factor sqrt(h / |a|_max) */
 
 /* ---- version and diagnostics (always thread-safe) ---------------------------------------- */
 
@@ -203,16 +233,16 @@ typedef struct sph_world sph_world;
 
 /** Creation-time description of a world; fixed for the world's life. */
 typedef struct sph_world_def {
-  uint32_t struct_size;       /* sizeof(sph_world_def), set by sph_world_def_init */
-  uint32_t header_version;    /* SPH_VERSION of the caller's header */
-  uint32_t capacity;          /* most particles the world holds; default 65536; >= 1 */
-  sph_feature_flags features; /* SPH_FEATURE_* bits; default SPH_FEATURE_NONE */
-  sph_integrator integrator;  /* default SPH_INTEGRATOR_SYMPLECTIC_EULER */
-  uint32_t reserved0;         /* must be 0 */
-  float particle_spacing;     /* nearest-neighbour distance of the FCC lattice, m; default 0.02 */
-  float kernel_radius;        /* h, m; 0 (default) = 1.8 * particle_spacing; must be >= spacing */
-  float rest_density;         /* rho0, kg/m^3; default 1000 (water) */
-  float reserved1;            /* must be 0 */
+  uint32_t struct_size;                  /* sizeof(sph_world_def), set by sph_world_def_init */
+  uint32_t header_version;               /* SPH_VERSION of the caller's header */
+  uint32_t capacity;                     /* most particles the world holds; default 65536; >= 1 */
+  sph_feature_flags features;            /* SPH_FEATURE_* bits; default SPH_FEATURE_NONE */
+  sph_integrator integrator;             /* default SPH_INTEGRATOR_SYMPLECTIC_EULER */
+  sph_viscosity_method viscosity_method; /* default SPH_VISCOSITY_MUELLER */
+  float particle_spacing;                /* nearest-neighbour distance of the FCC lattice, m; default 0.02 */
+  float kernel_radius;                   /* h, m; 0 (default) = 1.8 * particle_spacing; must be >= spacing */
+  float rest_density;                    /* rho0, kg/m^3; default 1000 (water) */
+  sph_equation_of_state equation_of_state; /* default SPH_EOS_IDEAL_GAS */
 } sph_world_def;
 SPH_STATIC_ASSERT(sizeof(sph_world_def) == 40, sph_world_def_size);
 
@@ -251,8 +281,10 @@ typedef struct sph_world_params {
   float step_factor;     /* lambda of dt = lambda h / v_max; default 0.4; in (0, 10] */
   float dt_min;          /* s; default 1e-6; > 0 */
   float dt_max;          /* s; default 1e-3; >= dt_min */
+  uint32_t step_limits;  /* SPH_STEP_LIMIT_* bits; default 0 (eq. 32 alone) */
+  uint32_t reserved0;    /* must be 0 */
 } sph_world_params;
-SPH_STATIC_ASSERT(sizeof(sph_world_params) == 40, sph_world_params_size);
+SPH_STATIC_ASSERT(sizeof(sph_world_params) == 48, sph_world_params_size);
 
 SPH_API sph_result SPH_CALL sph_world_params_init_sized(sph_world_params* params, uint32_t size);
 static inline sph_result sph_world_params_init(sph_world_params* params) {
@@ -262,6 +294,62 @@ static inline sph_result sph_world_params_init(sph_world_params* params) {
 SPH_API sph_result SPH_CALL sph_world_set_params(sph_world* world, const sph_world_params* params);
 /** Reads all runtime parameters; out->struct_size must be set (sph_world_params_init). */
 SPH_API sph_result SPH_CALL sph_world_get_params(const sph_world* world, sph_world_params* out);
+
+/* ---- parameters of optional physics (each its own struct, set and read whole) ----------- */
+typedef struct sph_surface_tension_params {
+  uint32_t struct_size;   /* set by sph_surface_tension_params_init */
+  float coefficient;      /* sigma, N/m; default 0.0728 (water at 20 C); >= 0 */
+  float normal_threshold; /* |grad c| above which a particle counts as surface, 1/m; 0 (default)
+                             = 0.2 / kernel_radius; >= 0 */
+  uint32_t reserved0;     /* must be 0 */
+} sph_surface_tension_params;
+SPH_STATIC_ASSERT(sizeof(sph_surface_tension_params) == 16, sph_surface_tension_params_size);
+
+SPH_API sph_result SPH_CALL sph_surface_tension_params_init_sized(sph_surface_tension_params* params,
+                                                                  uint32_t size);
+static inline sph_result sph_surface_tension_params_init(sph_surface_tension_params* params) {
+  return sph_surface_tension_params_init_sized(params, (uint32_t)sizeof(*params));
+}
+/** FEATURE_DISABLED unless the world has SPH_FEATURE_SURFACE_TENSION. */
+SPH_API sph_result SPH_CALL sph_world_set_surface_tension_params(sph_world* world,
+                                                                 const sph_surface_tension_params* params);
+SPH_API sph_result SPH_CALL sph_world_get_surface_tension_params(const sph_world* world,
+                                                                 sph_surface_tension_params* out);
+
+typedef struct sph_clavet_viscosity_params {
+  uint32_t struct_size; /* set by sph_clavet_viscosity_params_init */
+  float linear;         /* sigma of I = dt (1 - q)(sigma u + beta u^2), 1/s; default 10; >= 0 */
+  float quadratic;      /* beta, 1/m; default 0; >= 0 */
+  uint32_t reserved0;   /* must be 0 */
+} sph_clavet_viscosity_params;
+SPH_STATIC_ASSERT(sizeof(sph_clavet_viscosity_params) == 16, sph_clavet_viscosity_params_size);
+
+SPH_API sph_result SPH_CALL sph_clavet_viscosity_params_init_sized(sph_clavet_viscosity_params* params,
+                                                                   uint32_t size);
+static inline sph_result sph_clavet_viscosity_params_init(sph_clavet_viscosity_params* params) {
+  return sph_clavet_viscosity_params_init_sized(params, (uint32_t)sizeof(*params));
+}
+/** FEATURE_DISABLED unless the world's viscosity_method is SPH_VISCOSITY_CLAVET. */
+SPH_API sph_result SPH_CALL sph_world_set_clavet_viscosity_params(sph_world* world,
+                                                                  const sph_clavet_viscosity_params* params);
+SPH_API sph_result SPH_CALL sph_world_get_clavet_viscosity_params(const sph_world* world,
+                                                                  sph_clavet_viscosity_params* out);
+
+typedef struct sph_tait_params {
+  uint32_t struct_size; /* set by sph_tait_params_init */
+  float speed_of_sound; /* c, m/s; default 10; > 0. Use >= 10 x the fastest flow speed to keep
+                           density errors near 1 %; lower dt_max (or SPH_STEP_LIMIT_ACOUSTIC)
+                           so that c dt stays below about 0.4 h */
+} sph_tait_params;
+SPH_STATIC_ASSERT(sizeof(sph_tait_params) == 8, sph_tait_params_size);
+
+SPH_API sph_result SPH_CALL sph_tait_params_init_sized(sph_tait_params* params, uint32_t size);
+static inline sph_result sph_tait_params_init(sph_tait_params* params) {
+  return sph_tait_params_init_sized(params, (uint32_t)sizeof(*params));
+}
+/** FEATURE_DISABLED unless the world's equation_of_state is SPH_EOS_TAIT. */
+SPH_API sph_result SPH_CALL sph_world_set_tait_params(sph_world* world, const sph_tait_params* params);
+SPH_API sph_result SPH_CALL sph_world_get_tait_params(const sph_world* world, sph_tait_params* out);
 
 /* ---- particles in -------------------------------------------------------------------------- */
 typedef struct sph_spawn_desc {

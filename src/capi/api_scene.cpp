@@ -211,8 +211,9 @@ SPH_API sph_result SPH_CALL sph_source_create(sph_world* world, const sph_source
     sph::WorldLock lock(world);
     if (!out_id) throw Error(Status::InvalidArgument, "out_id: is NULL");
     const sph_source_def d = sph::read_user_struct(def, "def");
-    if (d.mode != SPH_SOURCE_FILL_ONCE && d.mode != SPH_SOURCE_CONTINUOUS)
-      throw Error(Status::Unsupported, "def->mode: " + std::to_string(static_cast<int>(d.mode)) +
+    const uint32_t mode = sph::enum_bits(d.mode);
+    if (mode != SPH_SOURCE_FILL_ONCE && mode != SPH_SOURCE_CONTINUOUS)
+      throw Error(Status::Unsupported, "def->mode: " + std::to_string(static_cast<int32_t>(mode)) +
                                            " is not an sph_source_mode value");
     if (d.flags & ~SPH_SOURCE_FLAG_VELOCITY_FROM_FIELD)
       throw Error(Status::Unsupported, "def->flags: unknown bits");
@@ -229,7 +230,7 @@ SPH_API sph_result SPH_CALL sph_source_create(sph_world* world, const sph_source
       throw Error(Status::InvalidArgument,
                   "def->flags: VELOCITY_FROM_FIELD but def->region has no velocity channel");
     s.pose = read_transform(d.transform, "def->transform");
-    s.mode = static_cast<sph::SourceMode>(d.mode);
+    s.mode = static_cast<sph::SourceMode>(mode);
     s.spacing = d.spacing == 0.0f ? cfg.particle_spacing : d.spacing;
     if (s.spacing < 0.25f * cfg.particle_spacing)
       throw Error(Status::InvalidArgument, "def->spacing: " + sph::describe(s.spacing) +
@@ -294,11 +295,12 @@ SPH_API sph_result SPH_CALL sph_sink_create(sph_world* world, const sph_sink_def
     const sph_sink_def d = sph::read_user_struct(def, "def");
     sph::require_zero(d.reserved0, "def->reserved0");
     sph::Sink s;
-    if (d.mode == SPH_SINK_REGION) {
+    const uint32_t mode = sph::enum_bits(d.mode);
+    if (mode == SPH_SINK_REGION) {
       s.mode = sph::SinkMode::Region;
       s.region = require_world_sdf(world, d.region, "def->region");
       s.pose = read_transform(d.transform, "def->transform");
-    } else if (d.mode == SPH_SINK_OUTSIDE_BOUNDS) {
+    } else if (mode == SPH_SINK_OUTSIDE_BOUNDS) {
       s.mode = sph::SinkMode::OutsideBounds;
       sph::require_finite_vec3(d.bounds_min, "def->bounds_min");
       sph::require_finite_vec3(d.bounds_max, "def->bounds_max");
@@ -309,7 +311,7 @@ SPH_API sph_result SPH_CALL sph_sink_create(sph_world* world, const sph_sink_def
       s.bounds_max = sph::Vec3{d.bounds_max.x, d.bounds_max.y, d.bounds_max.z};
       s.pose = identity();
     } else {
-      throw Error(Status::Unsupported, "def->mode: " + std::to_string(static_cast<int>(d.mode)) +
+      throw Error(Status::Unsupported, "def->mode: " + std::to_string(static_cast<int32_t>(mode)) +
                                            " is not an sph_sink_mode value");
     }
     require_room(world->world->sinks().size(), "sinks");
@@ -348,8 +350,9 @@ SPH_API sph_result SPH_CALL sph_force_field_create(sph_world* world, const sph_f
     sph::WorldLock lock(world);
     if (!out_id) throw Error(Status::InvalidArgument, "out_id: is NULL");
     const sph_force_field_def d = sph::read_user_struct(def, "def");
-    if (static_cast<uint32_t>(d.kind) > SPH_FORCE_FIELD_GRID)
-      throw Error(Status::Unsupported, "def->kind: " + std::to_string(static_cast<int>(d.kind)) +
+    const uint32_t kind = sph::enum_bits(d.kind);
+    if (kind > SPH_FORCE_FIELD_GRID)
+      throw Error(Status::Unsupported, "def->kind: " + std::to_string(static_cast<int32_t>(kind)) +
                                            " is not an sph_force_field_kind value");
     sph::require_zero(d.reserved0, "def->reserved0");
     sph::require_zero(d.reserved1, "def->reserved1");
@@ -357,7 +360,7 @@ SPH_API sph_result SPH_CALL sph_force_field_create(sph_world* world, const sph_f
     sph::require_finite(d.strength, "def->strength");
     sph::require_non_negative(d.falloff_radius, "def->falloff_radius");
     sph::ForceField f;
-    f.kind = static_cast<sph::ForceFieldKind>(d.kind);
+    f.kind = static_cast<sph::ForceFieldKind>(kind);
     f.pose = read_transform(d.transform, "def->transform");
     if (d.region) f.region = require_world_sdf(world, d.region, "def->region");
     f.vector = sph::Vec3{d.vector.x, d.vector.y, d.vector.z};

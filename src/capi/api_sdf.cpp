@@ -36,14 +36,15 @@ std::vector<float> read_floats(const sph_context* context, const float* data, ui
                                sph_memory_kind memory, const std::string& name) {
   if (!data) throw Error(Status::InvalidArgument, name + "->data: is NULL");
   std::vector<float> out(count);
-  if (memory == SPH_MEMORY_HOST) {
+  const uint32_t memory_bits = sph::enum_bits(memory);
+  if (memory_bits == SPH_MEMORY_HOST) {
     std::memcpy(out.data(), data, count * sizeof(float));
-  } else if (memory == SPH_MEMORY_CUDA_DEVICE) {
+  } else if (memory_bits == SPH_MEMORY_CUDA_DEVICE) {
     if (context->backend != sph::BackendKind::Cuda)
       throw Error(Status::Unsupported, name + "->memory: device memory needs a CUDA context");
     sph::copy_device_to_host(out.data(), data, count * sizeof(float), context->device_ordinal);
   } else {
-    throw Error(Status::Unsupported, name + "->memory: " + std::to_string(static_cast<int>(memory)) +
+    throw Error(Status::Unsupported, name + "->memory: " + std::to_string(static_cast<int32_t>(memory_bits)) +
                                          " is not an sph_memory_kind value");
   }
   for (uint64_t i = 0; i < count; ++i)
@@ -171,9 +172,10 @@ SPH_API sph_result SPH_CALL sph_sdf_create_shape(sph_context* context, const sph
     require_context(context);
     if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
     const sph_shape_desc d = sph::read_user_struct(desc, "desc");
-    if (static_cast<uint32_t>(d.shape) > SPH_SHAPE_CUP)
-      throw Error(Status::Unsupported,
-                  "desc->shape: " + std::to_string(static_cast<int>(d.shape)) + " is not an sph_shape value");
+    const uint32_t shape = sph::enum_bits(d.shape);
+    if (shape > SPH_SHAPE_CUP)
+      throw Error(Status::Unsupported, "desc->shape: " + std::to_string(static_cast<int32_t>(shape)) +
+                                           " is not an sph_shape value");
     if (d.flags & ~SPH_SHAPE_FLAG_OPEN_TOP) throw Error(Status::Unsupported, "desc->flags: unknown bits");
     sph::require_finite_vec3(d.half_extents, "desc->half_extents");
     sph::require_finite(d.radius, "desc->radius");
@@ -181,7 +183,7 @@ SPH_API sph_result SPH_CALL sph_sdf_create_shape(sph_context* context, const sph
     sph::require_non_negative(d.wall_thickness, "desc->wall_thickness");
     sph::require_positive(d.voxel_size, "desc->voxel_size");
     sph::ShapeSpec spec;
-    spec.kind = static_cast<sph::ShapeKind>(d.shape);
+    spec.kind = static_cast<sph::ShapeKind>(shape);
     spec.half_extents = sph::Vec3{d.half_extents.x, d.half_extents.y, d.half_extents.z};
     spec.radius = d.radius;
     spec.half_height = d.half_height;
@@ -202,7 +204,8 @@ SPH_API sph_result SPH_CALL sph_sdf_update(sph_sdf* sdf, sph_sdf_channel channel
     if (!origin) throw Error(Status::InvalidArgument, "origin: is NULL");
     if (!size) throw Error(Status::InvalidArgument, "size: is NULL");
     uint32_t components;
-    switch (channel) {
+    const uint32_t channel_bits = sph::enum_bits(channel);
+    switch (channel_bits) {
       case SPH_SDF_CHANNEL_DISTANCE:
         components = 1;
         break;
@@ -213,7 +216,7 @@ SPH_API sph_result SPH_CALL sph_sdf_update(sph_sdf* sdf, sph_sdf_channel channel
         components = 1;
         break;
       default:
-        throw Error(Status::Unsupported, "channel: " + std::to_string(static_cast<int>(channel)) +
+        throw Error(Status::Unsupported, "channel: " + std::to_string(static_cast<int32_t>(channel_bits)) +
                                              " is not an sph_sdf_channel value");
     }
     sph::SdfAsset& a = *sdf->asset;
@@ -228,13 +231,13 @@ SPH_API sph_result SPH_CALL sph_sdf_update(sph_sdf* sdf, sph_sdf_channel channel
                         std::to_string(dims[axis]) + ")");
     const uint64_t n = static_cast<uint64_t>(size[0]) * size[1] * size[2];
     const std::vector<float> values = read_floats(sdf->context, data, n * components, memory, "update");
-    if (channel == SPH_SDF_CHANNEL_FRICTION)
+    if (channel_bits == SPH_SDF_CHANNEL_FRICTION)
       for (float mu : values)
         if (mu < 0.0f) throw Error(Status::InvalidArgument, "data: friction coefficients must be >= 0");
     float* target = nullptr;
-    if (channel == SPH_SDF_CHANNEL_DISTANCE) {
+    if (channel_bits == SPH_SDF_CHANNEL_DISTANCE) {
       target = a.distance().data();
-    } else if (channel == SPH_SDF_CHANNEL_VELOCITY) {
+    } else if (channel_bits == SPH_SDF_CHANNEL_VELOCITY) {
       if (a.velocity().empty()) a.velocity().assign(a.voxel_count(), sph::Vec3{0.0f, 0.0f, 0.0f});
       target = &a.velocity()[0].x;
     } else {

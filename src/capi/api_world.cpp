@@ -51,19 +51,24 @@ sph::WorldConfig config_from_def(const sph_world_def& d) {
   if (d.capacity == 0 || d.capacity > kMaxCapacity)
     throw Error(Status::InvalidArgument,
                 "def->capacity: must be in [1, 2^30], got " + std::to_string(d.capacity));
-  if (d.features != SPH_FEATURE_NONE)
-    throw Error(
-        Status::Unsupported, "def->features: unknown feature bits 0x" + [&] {
-          char buf[16];
-          std::snprintf(buf, sizeof buf, "%x", d.features);
-          return std::string(buf);
-        }());
+  if (d.features & ~static_cast<uint32_t>(sph::kFeatureAll)) {
+    char buf[16];
+    std::snprintf(buf, sizeof buf, "%x", d.features & ~static_cast<uint32_t>(sph::kFeatureAll));
+    throw Error(Status::Unsupported, std::string("def->features: unknown feature bits 0x") + buf);
+  }
   const uint32_t integrator = sph::enum_bits(d.integrator);
   if (integrator != SPH_INTEGRATOR_SYMPLECTIC_EULER && integrator != SPH_INTEGRATOR_RK4)
     throw Error(Status::Unsupported, "def->integrator: " + std::to_string(static_cast<int32_t>(integrator)) +
                                          " is not an sph_integrator value");
-  sph::require_zero(d.reserved0, "def->reserved0");
-  sph::require_zero(d.reserved1 != 0.0f ? 1u : 0u, "def->reserved1");
+  const uint32_t viscosity = sph::enum_bits(d.viscosity_method);
+  if (viscosity != SPH_VISCOSITY_MUELLER && viscosity != SPH_VISCOSITY_CLAVET)
+    throw Error(Status::Unsupported,
+                "def->viscosity_method: " + std::to_string(static_cast<int32_t>(viscosity)) +
+                    " is not an sph_viscosity_method value");
+  const uint32_t eos = sph::enum_bits(d.equation_of_state);
+  if (eos != SPH_EOS_IDEAL_GAS && eos != SPH_EOS_TAIT)
+    throw Error(Status::Unsupported, "def->equation_of_state: " + std::to_string(static_cast<int32_t>(eos)) +
+                                         " is not an sph_equation_of_state value");
   sph::require_positive(d.particle_spacing, "def->particle_spacing");
   sph::require_positive(d.rest_density, "def->rest_density");
   float h = d.kernel_radius;
@@ -92,6 +97,8 @@ sph::WorldConfig config_from_def(const sph_world_def& d) {
   c.capacity = d.capacity;
   c.features = d.features;
   c.integrator = static_cast<sph::Integrator>(integrator);
+  c.viscosity_method = static_cast<sph::ViscosityMethod>(viscosity);
+  c.equation_of_state = static_cast<sph::EquationOfState>(eos);
   c.particle_spacing = d.particle_spacing;
   c.kernel_radius = h;
   c.rest_density = d.rest_density;
@@ -99,7 +106,8 @@ sph::WorldConfig config_from_def(const sph_world_def& d) {
   return c;
 }
 
-sph::RuntimeParams params_from_public(const sph_world_params& p) {
+// Validates public params and merges them into the current ones (module parameters are kept).
+sph::RuntimeParams params_from_public(const sph_world_params& p, const sph::RuntimeParams& current) {
   sph::require_finite_vec3(p.gravity, "params->gravity");
   sph::require_positive(p.stiffness, "params->stiffness");
   sph::require_non_negative(p.viscosity, "params->viscosity");
@@ -113,7 +121,10 @@ sph::RuntimeParams params_from_public(const sph_world_params& p) {
     throw Error(Status::InvalidArgument, "params->dt_max: " + sph::describe(p.dt_max) +
                                              " is smaller than params->dt_min " + sph::describe(p.dt_min));
   if (p.max_substeps == 0) throw Error(Status::InvalidArgument, "params->max_substeps: must be >= 1");
-  sph::RuntimeParams r;
+  if (p.step_limits & ~static_cast<uint32_t>(sph::kStepLimitAll))
+    throw Error(Status::Unsupported, "params->step_limits: unknown bits");
+  sph::require_zero(p.reserved0, "params->reserved0");
+  sph::RuntimeParams r = current;
   r.gravity = sph::Vec3{p.gravity.x, p.gravity.y, p.gravity.z};
   r.stiffness = p.stiffness;
   r.viscosity = p.viscosity;
@@ -121,6 +132,7 @@ sph::RuntimeParams params_from_public(const sph_world_params& p) {
   r.dt_min = p.dt_min;
   r.dt_max = p.dt_max;
   r.max_substeps = p.max_substeps;
+  r.step_limits = p.step_limits;
   return r;
 }
 
@@ -190,6 +202,8 @@ SPH_API sph_result SPH_CALL sph_world_get_def(const sph_world* world, sph_world_
     d.capacity = c.capacity;
     d.features = c.features;
     d.integrator = static_cast<sph_integrator>(c.integrator);
+    d.viscosity_method = static_cast<sph_viscosity_method>(c.viscosity_method);
+    d.equation_of_state = static_cast<sph_equation_of_state>(c.equation_of_state);
     d.particle_spacing = c.particle_spacing;
     d.kernel_radius = c.kernel_radius;
     d.rest_density = c.rest_density;
@@ -211,7 +225,8 @@ SPH_API sph_result SPH_CALL sph_world_set_params(sph_world* world, const sph_wor
   return sph::guarded("sph_world_set_params", sph::context_of(world), [&] {
     sph::require_world(world);
     sph::WorldLock lock(world);
-    const sph::RuntimeParams p = params_from_public(sph::read_user_struct(params, "params"));
+    const sph::RuntimeParams p =
+        params_from_public(sph::read_user_struct(params, "params"), world->world->params());
     world->world->set_params(p);
     return SPH_OK;
   });
@@ -229,6 +244,7 @@ SPH_API sph_result SPH_CALL sph_world_get_params(const sph_world* world, sph_wor
     o.step_factor = p.step_factor;
     o.dt_min = p.dt_min;
     o.dt_max = p.dt_max;
+    o.step_limits = p.step_limits;
     sph::write_output_struct(out, o, "out");
     return SPH_OK;
   });

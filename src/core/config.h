@@ -3,7 +3,9 @@
 
 #include <stdint.h>
 
+#include "../physics/equation_of_state.h"
 #include "../physics/fluid_constants.h"
+#include "../physics/forces.h"
 #include "../physics/step_control.h"
 #include "../physics/vec3.h"
 
@@ -11,10 +13,22 @@ namespace sph {
 
 enum class Integrator : uint32_t { SymplecticEuler = 0, Rk4 = 1 };
 
+// Feature bits, equal to the SPH_FEATURE_* values of the C header.
+enum FeatureBits : uint32_t {
+  kFeatureSurfaceTension = 1u << 0,
+  kFeatureNormalizedDensity = 1u << 1,
+  kFeatureAll = kFeatureSurfaceTension | kFeatureNormalizedDensity,
+};
+
+// Step-size limits beyond eq. 32, equal to the SPH_STEP_LIMIT_* values.
+enum StepLimitBits : uint32_t { kStepLimitAcoustic = 1u << 0, kStepLimitForce = 1u << 1, kStepLimitAll = 3u };
+
 struct WorldConfig {
   uint32_t capacity = 0;
   uint32_t features = 0;
   Integrator integrator = Integrator::SymplecticEuler;
+  ViscosityMethod viscosity_method = ViscosityMethod::Mueller;
+  EquationOfState equation_of_state = EquationOfState::IdealGas;
   float particle_spacing = 0.0f;
   float kernel_radius = 0.0f;
   float rest_density = 0.0f;
@@ -29,21 +43,51 @@ struct RuntimeParams {
   float dt_min = 1e-6f;
   float dt_max = 1e-3f;
   uint32_t max_substeps = 10000;
+  uint32_t step_limits = 0;  // StepLimitBits
+  // Options' parameters; each is used only when its feature or method is on.
+  float surface_tension = 0.0728f;  // N/m (water at 20 C)
+  float surface_threshold = 0.0f;   // |grad c| above which surface tension acts, 1/m; 0 = 0.2 / h
+  float clavet_linear = 10.0f;      // 1/s
+  float clavet_quadratic = 0.0f;    // 1/m
+  float tait_sound_speed = 10.0f;   // m/s
 };
+
+inline EosConstants make_eos(const WorldConfig& c, const RuntimeParams& p) {
+  EosConstants e;
+  e.kind = c.equation_of_state;
+  e.rest_density = c.rest_density;
+  e.stiffness = p.stiffness;
+  e.tait_b = c.rest_density * p.tait_sound_speed * p.tait_sound_speed / 7.0f;
+  return e;
+}
 
 inline FluidConstants make_fluid_constants(const WorldConfig& c, const RuntimeParams& p) {
   FluidConstants f;
   f.kernel = make_kernel_coefficients(c.kernel_radius);
   f.particle_mass = c.particle_mass;
   f.rest_density = c.rest_density;
-  f.stiffness = p.stiffness;
+  f.eos = make_eos(c, p);
   f.viscosity = p.viscosity;
   f.gravity = p.gravity;
+  f.surface_tension = p.surface_tension;
+  const float threshold = p.surface_threshold > 0.0f ? p.surface_threshold : 0.2f / c.kernel_radius;
+  f.surface_threshold_sq = threshold * threshold;
+  f.clavet_linear = p.clavet_linear;
+  f.clavet_quadratic = p.clavet_quadratic;
+  f.dt = 0.0f;  // set by the backend for each substep
   return f;
 }
 
 inline StepLimits make_step_limits(const WorldConfig& c, const RuntimeParams& p) {
-  return StepLimits{p.step_factor, c.kernel_radius, p.dt_min, p.dt_max};
+  StepLimits s;
+  s.step_factor = p.step_factor;
+  s.kernel_radius = c.kernel_radius;
+  s.dt_min = p.dt_min;
+  s.dt_max = p.dt_max;
+  s.sound_speed = 0.0f;
+  if (p.step_limits & kStepLimitAcoustic) s.sound_speed = speed_of_sound(make_eos(c, p));
+  s.use_force_limit = (p.step_limits & kStepLimitForce) ? 1u : 0u;
+  return s;
 }
 
 }  // namespace sph

@@ -14,8 +14,10 @@
 #include "../core/scene_frame.h"
 #include "../core/status.h"
 #include "../physics/density.h"
+#include "../physics/density_normalization.h"
 #include "../physics/forces.h"
 #include "../physics/integrate.h"
+#include "../physics/surface_normal.h"
 #include "cpu_neighbor_grid.h"
 #include "host_particle_store.h"
 
@@ -73,7 +75,7 @@ class CpuBackend final : public Backend {
   FrameReport step_scene_frame(double frame_dt, const RuntimeParams& params,
                                const SceneFrame& scene_in) override {
     FrameReport report;
-    const FluidConstants fluid = make_fluid_constants(config_, params);
+    FluidConstants fluid = make_fluid_constants(config_, params);
     const StepLimits limits = make_step_limits(config_, params);
     SceneFrame scene = scene_in;
     bind_scene_views(scene, [](const SdfAsset& a) { return a.host_view(); });
@@ -89,7 +91,7 @@ class CpuBackend final : public Backend {
     report.dt_min = std::numeric_limits<float>::max();
     while (remaining > 0.0 && report.substeps < params.max_substeps) {
       const float speed = std::max(max_speed_, scene.max_collider_speed);
-      const double dt = landing_dt(controller_dt(limits, speed), remaining);
+      const double dt = landing_dt(controller_dt(limits, speed, max_acceleration_), remaining);
       const float dtf = static_cast<float>(dt);
       SubstepTime time;
       time.tau0 = static_cast<float>(elapsed);
@@ -97,6 +99,7 @@ class CpuBackend final : public Backend {
       time.s0 = static_cast<float>(elapsed / frame_dt);
       time.s1 = remaining <= dt ? 1.0f : static_cast<float>((elapsed + dt) / frame_dt);
       time.dt = dtf;
+      fluid.dt = dtf;
       const uint32_t bad = config_.integrator == Integrator::Rk4 ? substep_rk4(fluid, scene, time, report)
                                                                  : substep_euler(fluid, scene, time, report);
       if (bad != kAllFinite) {
@@ -195,18 +198,51 @@ class CpuBackend final : public Backend {
       density_.data[i] = s.density;
       neighbors_.data[i] = s.neighbor_count;
       // Only the w slots are written; neighbours read x, y, z alone.
-      pos[i].w = pressure_from_density(s.density, fluid.rest_density, fluid.stiffness);
+      pos[i].w = pressure_from_density(fluid.eos, s.density);
       vel[i].w = 1.0f / s.density;
+    }
+    if (config_.features & kFeatureNormalizedDensity) {
+      // Eq. 31 needs every rho_j of the first pass: compute into a side array, then publish.
+      normalized_.resize(count_);
+#pragma omp parallel for num_threads(workers_) schedule(static)
+      for (int i = 0; i < n(); ++i)
+        normalized_[i] = gather_normalized_density(fluid, view, pos, vel, static_cast<uint32_t>(i));
+#pragma omp parallel for num_threads(workers_) schedule(static)
+      for (int i = 0; i < n(); ++i) {
+        density_.data[i] = normalized_[i];
+        pos[i].w = pressure_from_density(fluid.eos, normalized_[i]);
+        vel[i].w = 1.0f / normalized_[i];
+      }
+    }
+    if (config_.features & kFeatureSurfaceTension) {
+      // Colour-field normals of every particle, which the force gather reads for neighbours.
+      normals_.resize(count_);
+#pragma omp parallel for num_threads(workers_) schedule(static)
+      for (int i = 0; i < n(); ++i)
+        normals_[i] = gather_colour_normal(fluid, view, pos, vel, static_cast<uint32_t>(i));
     }
     report.stage_ms[kStageDensity] += static_cast<float>(elapsed_ms(t));
   }
 
-  // Acceleration of particle i: the neighbour gather plus the scene's force fields.
-  static Vec3 acceleration(const FluidConstants& fluid, const GridView& view, const Float4* pos,
-                           const Float4* vel, const SceneFrame& scene, uint32_t i) {
-    Vec3 a = gather_acceleration(fluid, view, pos, vel, i);
+  // Acceleration of particle i: the neighbour gather with the world's options compiled in,
+  // plus the scene's force fields.
+  template <bool kSurfaceTension, ViscosityMethod kViscosity>
+  static Vec3 acceleration_with(const FluidConstants& fluid, const GridView& view, const Float4* pos,
+                                const Float4* vel, const uint32_t* counts, const Float4* normals,
+                                const SceneFrame& scene, uint32_t i) {
+    Vec3 a = gather_acceleration_with<kSurfaceTension, kViscosity>(fluid, view, pos, vel, counts, normals, i);
     for (const ForceFieldFrame& f : scene.fields) a += force_field_acceleration(f.view, xyz(pos[i]));
     return a;
+  }
+  using AccelerationFn = Vec3 (*)(const FluidConstants&, const GridView&, const Float4*, const Float4*,
+                                  const uint32_t*, const Float4*, const SceneFrame&, uint32_t);
+  AccelerationFn acceleration_function() const {
+    const bool surface = (config_.features & kFeatureSurfaceTension) != 0;
+    if (config_.viscosity_method == ViscosityMethod::Clavet)
+      return surface ? &acceleration_with<true, ViscosityMethod::Clavet>
+                     : &acceleration_with<false, ViscosityMethod::Clavet>;
+    return surface ? &acceleration_with<true, ViscosityMethod::Mueller>
+                   : &acceleration_with<false, ViscosityMethod::Mueller>;
   }
 
   // Resolves colliders for the state in next_position_/next_velocity_, moved from x_old(i).
@@ -260,13 +296,19 @@ class CpuBackend final : public Backend {
     const Float4* pos = position_.data.data();
     const Float4* vel = velocity_.data.data();
     const float dt = time.dt;
-#pragma omp parallel for num_threads(workers_) schedule(static)
+    const AccelerationFn acceleration = acceleration_function();
+    const uint32_t* counts = neighbors_.data.data();
+    float a2max = 0.0f;
+#pragma omp parallel for num_threads(workers_) schedule(static) reduction(max : a2max)
     for (int i = 0; i < n(); ++i) {
-      const Vec3 a = acceleration(fluid, view, pos, vel, scene, static_cast<uint32_t>(i));
+      const Vec3 a =
+          acceleration(fluid, view, pos, vel, counts, normals_.data(), scene, static_cast<uint32_t>(i));
+      a2max = std::max(a2max, length_squared(a));
       const ParticleState s = symplectic_euler({xyz(pos[i]), xyz(vel[i])}, a, dt);
       next_position_[i] = make_float4_record(s.position, pos[i].w);
       next_velocity_[i] = make_float4_record(s.velocity, vel[i].w);
     }
+    max_acceleration_ = std::sqrt(a2max);
     report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
     collide(
         scene, time, [&](uint32_t i) { return xyz(pos[i]); }, report);
@@ -284,6 +326,8 @@ class CpuBackend final : public Backend {
     for (int i = 0; i < n(); ++i)
       rk4_start_->data[i] = ParticleState{xyz(position_.data[i]), xyz(velocity_.data[i])};
     const float dt = time.dt;
+    const AccelerationFn acceleration = acceleration_function();
+    float a2max = 0.0f;
     for (int stage = 0; stage < 4; ++stage) {
       sort_and_density(fluid, report);
       auto t = Clock::now();
@@ -292,9 +336,12 @@ class CpuBackend final : public Backend {
       next_velocity_.resize(count_);
       const Float4* pos = position_.data.data();
       const Float4* vel = velocity_.data.data();
-#pragma omp parallel for num_threads(workers_) schedule(static)
+      const uint32_t* counts = neighbors_.data.data();
+#pragma omp parallel for num_threads(workers_) schedule(static) reduction(max : a2max)
       for (int i = 0; i < n(); ++i) {
-        const Vec3 a = acceleration(fluid, view, pos, vel, scene, static_cast<uint32_t>(i));
+        const Vec3 a =
+            acceleration(fluid, view, pos, vel, counts, normals_.data(), scene, static_cast<uint32_t>(i));
+        a2max = std::max(a2max, length_squared(a));
         const ParticleState s =
             rk4_advance(stage, rk4_start_->data[i], {xyz(pos[i]), xyz(vel[i])}, a, dt, rk4_sum_->data[i]);
         next_position_[i] = make_float4_record(s.position, pos[i].w);
@@ -311,6 +358,7 @@ class CpuBackend final : public Backend {
       report.stage_ms[kStageIntegrate] += static_cast<float>(elapsed_ms(t));
       if (bad != kAllFinite) return bad;
     }
+    max_acceleration_ = std::sqrt(a2max);
     return kAllFinite;
   }
 
@@ -373,8 +421,11 @@ class CpuBackend final : public Backend {
   std::vector<Float4> next_position_;
   std::vector<Float4> next_velocity_;
   std::vector<uint32_t> keep_order_;
+  std::vector<float> normalized_;  // normalised density (eq. 31), when that feature is on
+  std::vector<Float4> normals_;    // colour-field normals, when surface tension is on
   uint32_t count_ = 0;
   float max_speed_ = 0.0f;
+  float max_acceleration_ = 0.0f;  // of the last force evaluation, for the force step limit
   bool max_speed_valid_ = false;
 };
 

@@ -2,6 +2,7 @@
 // (no globals: two worlds in one process, even on two devices, keep their own).
 #pragma once
 
+#include "equation_of_state.h"
 #include "kernels.h"
 #include "vec3.h"
 
@@ -11,9 +12,16 @@ struct FluidConstants {
   KernelCoefficients kernel;
   float particle_mass;  // kg
   float rest_density;   // rho0, kg/m^3
-  float stiffness;      // k of p = k (rho - rho0)
-  float viscosity;      // mu of Mueller's viscosity
-  Vec3 gravity;         // m/s^2
+  EosConstants eos;
+  float viscosity;  // mu of Mueller's viscosity
+  Vec3 gravity;     // m/s^2
+  // Surface tension (Morris/Mueller colour field), used when the feature is on.
+  float surface_tension;       // sigma, N/m
+  float surface_threshold_sq;  // |grad c|^2 above which the force applies, 1/m^2
+  // Clavet radial impulses, used when that viscosity method is chosen.
+  float clavet_linear;     // sigma, 1/s
+  float clavet_quadratic;  // beta, 1/m
+  float dt;                // the substep's length (impulse-based terms need it)
 };
 
 }  // namespace sph

@@ -1,7 +1,13 @@
 // Acceleration of a particle from its neighbours: the symmetric pressure force (thesis eq. 14
-// with grad W_spiky), Mueller's viscosity (eq. 17 with lap W_viscosity), and gravity.
+// with grad W_spiky), viscosity (Mueller's eq. 17 with lap W_viscosity, or Clavet's radial
+// impulses, eq. 18-19), surface tension from the colour field (eq. 20-23), and gravity.
 // Inputs are the packed records written by the density pass: position.w = p_j and
 // velocity.w = 1 / rho_j, so a neighbour costs two 16-byte loads and no division.
+//
+// The pair term (add_neighbor_acceleration) and the final combination (finish_acceleration)
+// are separate so that a backend may walk neighbours its own way (the CUDA backend tests a
+// whole run of candidates before evaluating pair terms) and still use this arithmetic.
+// Options are template parameters: a world that does not use one compiles it away.
 #pragma once
 
 #include <stdint.h>
@@ -12,54 +18,130 @@
 
 namespace sph {
 
-// The neighbour sums of one particle; finish_acceleration turns them into a_i.
+enum class ViscosityMethod : uint32_t { Mueller = 0, Clavet = 1 };
+
 struct AccelerationSums {
-  Vec3 pressure;   // sum_j -(p_i + p_j) / rho_j grad W_spiky (the 1/2 and m applied at the end)
-  Vec3 viscosity;  // sum_j (v_j - v_i) / rho_j lap W_visc
+  Vec3 pressure;     // sum -(p_i + p_j) / rho_j grad W_spiky
+  Vec3 viscosity;    // Mueller: sum (v_j - v_i) / rho_j lap W; Clavet: sum of velocity changes
+  float divergence;  // surface tension: sum (n^_j - n^_i) . grad W_poly6 / rho_j over surface j
+  float shepard;     // surface tension: sum W_poly6 / rho_j over the same j (normalises the above)
 };
 
 SPH_HD AccelerationSums zero_acceleration_sums() {
-  return AccelerationSums{Vec3{0.0f, 0.0f, 0.0f}, Vec3{0.0f, 0.0f, 0.0f}};
+  return AccelerationSums{Vec3{0.0f, 0.0f, 0.0f}, Vec3{0.0f, 0.0f, 0.0f}, 0.0f, 0.0f};
 }
 
-// Whether candidate j contributes to particle i's force, given r2 = |x_i - x_j|^2.
+// The unit normal of a colour-field record (n, |n|), or zero where it does not mark a surface.
+SPH_HD Vec3 surface_unit_normal(const FluidConstants& f, const Float4& normal) {
+  if (normal.w * normal.w <= f.surface_threshold_sq) return Vec3{0.0f, 0.0f, 0.0f};
+  return xyz(normal) * (1.0f / normal.w);
+}
+
+// Neighbour j contributes to particle i's forces when within h and not i itself.
 SPH_HD bool is_force_neighbor(const FluidConstants& f, float r2, uint32_t i, uint32_t j) {
-  return !(r2 >= f.kernel.h2) && j != i;
+  return r2 < f.kernel.h2 && j != i;
 }
 
-// Adds neighbour j to particle i's sums. pi, vi: particle i's records (p_i in pi.w); pj, vj:
-// neighbour j's (p_j in pj.w, 1/rho_j in vj.w); d = x_i - x_j and r2 = |d|^2.
+// The contribution of neighbour j (d = x_i - x_j, r2 = |d|^2, within h, j != i).
+// normal_i, normal_j: colour-field records (surface tension only; may be null otherwise).
+// pair_neighbors = n_i + n_j, the two particles' neighbour counts (Clavet only): they bound
+// the impulses, I_ij <= 4 u_ij / (n_i + n_j), so the simultaneous pairwise exchange can only
+// remove kinetic energy (the gain from the squared velocity changes stays below the loss).
+template <bool kSurfaceTension = false, ViscosityMethod kViscosity = ViscosityMethod::Mueller>
 SPH_HD void add_neighbor_acceleration(const FluidConstants& f, const Float4& pi, Vec3 v_i, const Float4& pj,
-                                      const Float4& vj, Vec3 d, float r2, AccelerationSums& sums) {
+                                      const Float4& vj, Vec3 d, float r2, AccelerationSums& sums,
+                                      float pair_neighbors = 0.0f, const Float4* normal_i = nullptr,
+                                      const Float4* normal_j = nullptr) {
   const float r = SPH_SQRTF(r2);
   const float inv_rho_j = vj.w;
-  // -(p_i + p_j) / (2 rho_j) grad W_spiky; the 1/2 and m are applied once in finish_acceleration.
+  // -(p_i + p_j) / (2 rho_j) grad W_spiky; the 1/2 and m are applied once in finish.
   sums.pressure += spiky_gradient(f.kernel, d, r) * (-(pi.w + pj.w) * inv_rho_j);
-  // (v_j - v_i) / rho_j lap W_visc
-  sums.viscosity += (xyz(vj) - v_i) * (viscosity_laplacian(f.kernel, r) * inv_rho_j);
+  if (kViscosity == ViscosityMethod::Mueller) {
+    sums.viscosity += (xyz(vj) - v_i) * (viscosity_laplacian(f.kernel, r) * inv_rho_j);
+  } else if (r > 0.0f) {
+    // Approaching pairs (u > 0 along i -> j) exchange I = dt (1 - q)(sigma u + beta u^2);
+    // i takes half of it, pointing away from j.
+    const Vec3 unit = d * (-1.0f / r);
+    const float u = dot(v_i - xyz(vj), unit);
+    if (u > 0.0f) {
+      const float q = r / f.kernel.h;
+      float impulse = f.dt * (1.0f - q) * (f.clavet_linear * u + f.clavet_quadratic * u * u);
+      const float bound = 4.0f * u / pair_neighbors;
+      if (impulse > bound) impulse = bound;
+      sums.viscosity += unit * (-0.5f * impulse);
+    }
+  }
+  if (kSurfaceTension) {
+    // Curvature as the divergence of the unit normal (Morris 2000), over neighbours that are
+    // surface particles themselves, Shepard-normalised so a half-empty neighbourhood still
+    // gives 2/R on a sphere.
+    const Vec3 nj = surface_unit_normal(f, *normal_j);
+    if (nj.x != 0.0f || nj.y != 0.0f || nj.z != 0.0f) {
+      const Vec3 ni = surface_unit_normal(f, *normal_i);
+      sums.divergence += dot(nj - ni, poly6_gradient(f.kernel, d, r2)) * inv_rho_j;
+      sums.shepard += poly6(f.kernel, r2) * inv_rho_j;
+    }
+  }
 }
 
-// a_i = f_i / rho_i + g, with 1/rho_i = vi.w.
-SPH_HD Vec3 finish_acceleration(const FluidConstants& f, const Float4& vi, const AccelerationSums& sums) {
+template <bool kSurfaceTension = false, ViscosityMethod kViscosity = ViscosityMethod::Mueller>
+SPH_HD Vec3 finish_acceleration(const FluidConstants& f, const Float4& vi, const AccelerationSums& sums,
+                                const Float4* normal_i = nullptr) {
+  // f_i / rho_i with 1/rho_i = vi.w
   const float m_over_rho_i = f.particle_mass * vi.w;
-  return sums.pressure * (0.5f * m_over_rho_i) + sums.viscosity * (f.viscosity * m_over_rho_i) + f.gravity;
+  Vec3 a = sums.pressure * (0.5f * m_over_rho_i) + f.gravity;
+  if (kViscosity == ViscosityMethod::Mueller) {
+    a += sums.viscosity * (f.viscosity * m_over_rho_i);
+  } else if (f.dt > 0.0f) {
+    a += sums.viscosity * (1.0f / f.dt);  // the velocity change spread over the substep
+  }
+  if (kSurfaceTension && normal_i->w * normal_i->w > f.surface_threshold_sq) {
+    // kappa = -div n^, f = sigma kappa n (force per volume; n = grad c points into the fluid
+    // and its length is the surface's delta function), a = f / rho_i.
+    const float self = poly6(f.kernel, 0.0f) * vi.w;  // particle i's own weight in the Shepard sum
+    float kappa = -sums.divergence / (sums.shepard + self);
+    // No resolvable surface is curved more tightly than a droplet of radius h: clamp, so a few
+    // stray particles with noisy normals cannot kick each other apart.
+    const float kappa_max = 2.0f / f.kernel.h;
+    kappa = kappa > kappa_max ? kappa_max : (kappa < -kappa_max ? -kappa_max : kappa);
+    a += xyz(*normal_i) * (f.surface_tension * kappa * vi.w);
+  }
+  return a;
 }
 
-SPH_HD Vec3 gather_acceleration(const FluidConstants& f, const GridView& grid, const Float4* positions,
-                                const Float4* velocities, uint32_t i) {
+// The whole gather for particle i. neighbor_counts (the density pass's counts) is read only
+// by the Clavet method, normals (the colour-field pass) only with surface tension; either may
+// be null otherwise.
+template <bool kSurfaceTension, ViscosityMethod kViscosity>
+SPH_HD Vec3 gather_acceleration_with(const FluidConstants& f, const GridView& grid, const Float4* positions,
+                                     const Float4* velocities, const uint32_t* neighbor_counts,
+                                     const Float4* normals, uint32_t i) {
   const Float4 pi = positions[i];
   const Float4 vi = velocities[i];
   const Vec3 xi = xyz(pi);
   const Vec3 v_i = xyz(vi);
+  const float n_i = kViscosity == ViscosityMethod::Clavet ? static_cast<float>(neighbor_counts[i]) : 0.0f;
   AccelerationSums sums = zero_acceleration_sums();
   for_each_neighbor_candidate(grid, xi, [&](uint32_t j) {
     const Float4 pj = positions[j];
     const Vec3 d = xi - xyz(pj);
     const float r2 = length_squared(d);
     if (!is_force_neighbor(f, r2, i, j)) return;
-    add_neighbor_acceleration(f, pi, v_i, pj, velocities[j], d, r2, sums);
+    const float pair =
+        kViscosity == ViscosityMethod::Clavet ? n_i + static_cast<float>(neighbor_counts[j]) : 0.0f;
+    add_neighbor_acceleration<kSurfaceTension, kViscosity>(f, pi, v_i, pj, velocities[j], d, r2, sums, pair,
+                                                           kSurfaceTension ? normals + i : nullptr,
+                                                           kSurfaceTension ? normals + j : nullptr);
   });
-  return finish_acceleration(f, vi, sums);
+  return finish_acceleration<kSurfaceTension, kViscosity>(f, vi, sums,
+                                                          kSurfaceTension ? normals + i : nullptr);
+}
+
+// The thesis's default combination: Mueller viscosity, no surface tension.
+SPH_HD Vec3 gather_acceleration(const FluidConstants& f, const GridView& grid, const Float4* positions,
+                                const Float4* velocities, uint32_t i) {
+  return gather_acceleration_with<false, ViscosityMethod::Mueller>(f, grid, positions, velocities, nullptr,
+                                                                   nullptr, i);
 }
 
 }  // namespace sph

@@ -16,6 +16,7 @@ struct KernelCoefficients {
   float poly6;       // 315 / (64 pi h^9)
   float spiky_grad;  // -45 / (pi h^6)
   float visc_lap;    // 45 / (pi h^6)
+  float poly6_grad;  // -945 / (32 pi h^9): grad W_poly6 = poly6_grad (h^2 - r^2)^2 r_vec
 };
 
 SPH_HD KernelCoefficients make_kernel_coefficients(float h) {
@@ -27,6 +28,7 @@ SPH_HD KernelCoefficients make_kernel_coefficients(float h) {
   c.poly6 = 315.0f / (64.0f * kPi * h6 * h3);
   c.spiky_grad = -45.0f / (kPi * h6);
   c.visc_lap = 45.0f / (kPi * h6);
+  c.poly6_grad = -945.0f / (32.0f * kPi * h6 * h3);
   return c;
 }
 
@@ -54,6 +56,19 @@ SPH_HD Vec3 spiky_gradient(const KernelCoefficients& c, Vec3 r_vec, float r) {
 SPH_HD float viscosity_laplacian(const KernelCoefficients& c, float r) {
   if (r >= c.h) return 0.0f;
   return c.visc_lap * (c.h - r);
+}
+
+// grad W_poly6(r_vec) for the colour field of surface tension.
+SPH_HD Vec3 poly6_gradient(const KernelCoefficients& c, Vec3 r_vec, float r2) {
+  if (r2 >= c.h2) return Vec3{0.0f, 0.0f, 0.0f};
+  const float d = c.h2 - r2;
+  return r_vec * (c.poly6_grad * d * d);
+}
+
+// lap W_poly6(r) = -945 / (32 pi h^9) (h^2 - r^2) (3 h^2 - 7 r^2).
+SPH_HD float poly6_laplacian(const KernelCoefficients& c, float r2) {
+  if (r2 >= c.h2) return 0.0f;
+  return c.poly6_grad * (c.h2 - r2) * (3.0f * c.h2 - 7.0f * r2);
 }
 
 // The kernels themselves (not only their derivatives), for normalisation tests and tools.

@@ -72,11 +72,11 @@ static void test_def_init(void** state) {
   assert_int_equal(def.capacity, 65536);
   assert_int_equal(def.features, SPH_FEATURE_NONE);
   assert_int_equal(def.integrator, SPH_INTEGRATOR_SYMPLECTIC_EULER);
-  assert_int_equal(def.reserved0, 0);
+  assert_int_equal(def.viscosity_method, SPH_VISCOSITY_MUELLER);
   assert_true(def.particle_spacing == 0.02f);
   assert_true(def.kernel_radius == 0.0f);
   assert_true(def.rest_density == 1000.0f);
-  assert_true(def.reserved1 == 0.0f);
+  assert_int_equal(def.equation_of_state, SPH_EOS_IDEAL_GAS);
   memset(&grown, 0xab, sizeof grown);
   EXPECT_OK(sph_world_def_init_sized(&grown.def, sizeof grown));
   assert_int_equal(grown.def.struct_size, sizeof grown);
@@ -160,7 +160,7 @@ static void test_create_capacity(void** state) {
 }
 
 static void test_create_unknown_enums_and_bits(void** state) {
-  const uint32_t features[] = {1u, 2u, 0x100u, 0x80000000u, 0xffffffffu};
+  const uint32_t features[] = {4u, 8u, 0x100u, 0x80000000u, 0xffffffffu};
   const int32_t integrators[] = {2, 3, 1000, 0x7fffffff, -1};
   sph_context* context = make_context();
   sph_world_def def;
@@ -186,11 +186,11 @@ static void test_create_reserved(void** state) {
   sph_world_def def;
   (void)state;
   small_world_def(&def);
-  def.reserved0 = 1;
-  EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_INVALID_ARGUMENT, "reserved0");
+  def.viscosity_method = (sph_viscosity_method)7;
+  EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_UNSUPPORTED, "viscosity_method");
   small_world_def(&def);
-  def.reserved1 = 1.0f;
-  EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_INVALID_ARGUMENT, "reserved1");
+  def.equation_of_state = (sph_equation_of_state)9;
+  EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_UNSUPPORTED, "equation_of_state");
   EXPECT_OK(sph_context_destroy(context));
 }
 
@@ -199,7 +199,6 @@ static void test_create_non_finite(void** state) {
       {offsetof(sph_world_def, particle_spacing), "particle_spacing"},
       {offsetof(sph_world_def, kernel_radius), "kernel_radius"},
       {offsetof(sph_world_def, rest_density), "rest_density"},
-      {offsetof(sph_world_def, reserved1), "reserved1"},
   };
   sph_context* context = make_context();
   sph_world_def def;
@@ -305,7 +304,7 @@ static void test_get_def(void** state) {
   EXPECT_OK(sph_world_get_def(world, &out));
   assert_int_equal(out.struct_size, offsetof(sph_world_def, particle_spacing));
   assert_int_equal(out.capacity, 64);
-  assert_int_equal(out.reserved0, 0);
+  assert_int_equal(out.viscosity_method, SPH_VISCOSITY_MUELLER);
   {
     uint32_t bits;
     memcpy(&bits, &out.particle_spacing, sizeof bits);
