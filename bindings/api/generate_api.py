@@ -277,9 +277,10 @@ def preprocess(toks: list[Tok]):
             macro_names.add(mname)
             top = len(stack) == (1 if guard else 0) and (not stack or stack[0]["guard"])
             if top and mname != guard:
-                doc = _leading_doc(toks, idx)
-                trailing = [clean_comment(c) for c in comments]
-                doc = doc or " ".join(x for x in trailing if x)
+                # A doc comment above and a comment on the line: both (the one above may
+                # introduce a group of flags, the one on the line says what this one does).
+                trailing = " ".join(x for x in (clean_comment(c) for c in comments) if x)
+                doc = " ".join(x for x in (_leading_doc(toks, idx), trailing) if x)
                 entry = {"name": mname, "doc": doc, "line": t.line}
                 if is_fn is not None:
                     entry.update({"params": [p.strip() for p in params.split(",") if p.strip()], "body": body})

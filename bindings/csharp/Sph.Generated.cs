@@ -19,6 +19,26 @@ namespace Sph
         /// <summary>ABI version: equals the SONAME major (libsph.so.0).</summary>
         public const int SPH_ABI_VERSION = 0;
         public const uint SPH_FEATURE_NONE = 0u;
+        /// <summary>
+        /// Surface tension from the colour field (Morris 2000; thesis eq. 20-23), with parameters in
+        /// sph_surface_tension_params. EXPERIMENTAL: it yields the Laplace pressure only to within a
+        /// factor of two at 8 particles per radius, and at sigma of about 1 N/m on centimetre drops it
+        /// can fling stray surface particles off (docs/physics.md).
+        /// </summary>
+        public const uint SPH_FEATURE_SURFACE_TENSION = 1u;
+        /// <summary>
+        /// Normalised density (thesis eq. 31): a second density pass, a Shepard filter that evens out
+        /// the density deficit of particles near a free surface (it narrows it; it does not remove it:
+        /// about 48 % -&gt; 34 % on the outermost layer of a resting sphere).
+        /// </summary>
+        public const uint SPH_FEATURE_NORMALIZED_DENSITY = 2u;
+        /// <summary>
+        /// Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt &lt;= step_factor h /
+        /// c, c the EOS's speed of sound
+        /// </summary>
+        public const uint SPH_STEP_LIMIT_ACOUSTIC = 1u;
+        /// <summary>dt &lt;= step_factor sqrt(h / |a|_max)</summary>
+        public const uint SPH_STEP_LIMIT_FORCE = 2u;
         /// <summary>hollow box: no lid (a tank open at +y)</summary>
         public const uint SPH_SHAPE_FLAG_OPEN_TOP = 1u;
         /// <summary>solid where the SDF is positive: a container</summary>
@@ -33,6 +53,8 @@ namespace Sph
         public const int SPH_ATTRIBUTE_FORCE32 = 2147483647;
         public const int SPH_STAGE_COUNT = 8;
         public const int SPH_STAGE_FORCE32 = 2147483647;
+        public const int SPH_VISCOSITY_METHOD_FORCE32 = 2147483647;
+        public const int SPH_EOS_FORCE32 = 2147483647;
         public const int SPH_MEMORY_KIND_FORCE32 = 2147483647;
         public const int SPH_SHAPE_FORCE32 = 2147483647;
         public const int SPH_SDF_CHANNEL_FORCE32 = 2147483647;
@@ -145,6 +167,24 @@ namespace Sph
         Emit = 6,
         /// <summary>everything else: statistics, transfers</summary>
         Other = 7,
+    }
+
+    /// <summary>sph_viscosity_method</summary>
+    public enum ViscosityMethod : int
+    {
+        /// <summary>Laplacian viscosity (eq. 17), coefficient sph_world_params.viscosity</summary>
+        Mueller = 0,
+        /// <summary>radial impulses between approaching pairs (eq. 18-19), sph_clavet_viscosity_params</summary>
+        Clavet = 1,
+    }
+
+    /// <summary>sph_equation_of_state</summary>
+    public enum EquationOfState : int
+    {
+        /// <summary>the thesis's modified ideal gas p = k (rho - rho0) (eq. 15)</summary>
+        IdealGas = 0,
+        /// <summary>p = B ((rho / rho0)^7 - 1), B = rho0 c^2 / 7, sph_tait_params</summary>
+        Tait = 1,
     }
 
     /// <summary>sph_memory_kind</summary>
@@ -460,16 +500,16 @@ namespace Sph
         public uint Features;
         /// <summary>sph_integrator integrator: default SPH_INTEGRATOR_SYMPLECTIC_EULER</summary>
         public Integrator Integrator;
-        /// <summary>uint32_t reserved0: must be 0</summary>
-        public uint Reserved0;
+        /// <summary>sph_viscosity_method viscosity_method: default SPH_VISCOSITY_MUELLER</summary>
+        public ViscosityMethod ViscosityMethod;
         /// <summary>float particle_spacing: nearest-neighbour distance of the FCC lattice, m; default 0.02</summary>
         public float ParticleSpacing;
         /// <summary>float kernel_radius: h, m; 0 (default) = 1.8 * particle_spacing; must be &gt;= spacing</summary>
         public float KernelRadius;
         /// <summary>float rest_density: rho0, kg/m^3; default 1000 (water)</summary>
         public float RestDensity;
-        /// <summary>float reserved1: must be 0</summary>
-        public float Reserved1;
+        /// <summary>sph_equation_of_state equation_of_state: default SPH_EOS_IDEAL_GAS</summary>
+        public EquationOfState EquationOfState;
 
         /// <summary>A WorldDef with the library's defaults (sph_world_def_init_sized).</summary>
         public static WorldDef Default()
@@ -482,7 +522,7 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_world_params (40 bytes)</summary>
+    /// <summary>sph_world_params (48 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
     public struct WorldParams
     {
@@ -508,6 +548,10 @@ namespace Sph
         public float DtMin;
         /// <summary>float dt_max: s; default 1e-3; &gt;= dt_min</summary>
         public float DtMax;
+        /// <summary>uint32_t step_limits: SPH_STEP_LIMIT_* bits; default 0 (eq. 32 alone)</summary>
+        public uint StepLimits;
+        /// <summary>uint32_t reserved0: must be 0</summary>
+        public uint Reserved0;
 
         /// <summary>A WorldParams with the library's defaults (sph_world_params_init_sized).</summary>
         public static WorldParams Default()
@@ -515,6 +559,78 @@ namespace Sph
             var value = new WorldParams();
             uint size = (uint)Marshal.SizeOf(typeof(WorldParams));
             SphException.Check(Native.sph_world_params_init_sized(ref value, size), "sph_world_params_init_sized");
+            return value;
+        }
+    }
+
+    /// <summary>sph_surface_tension_params (16 bytes)</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct SurfaceTensionParams
+    {
+        /// <summary>uint32_t struct_size: set by sph_surface_tension_params_init</summary>
+        public uint StructSize;
+        /// <summary>float coefficient: sigma, N/m; default 0.0728 (water at 20 C); &gt;= 0</summary>
+        public float Coefficient;
+        /// <summary>
+        /// float normal_threshold: |grad c| above which a particle counts as surface, 1/m; 0 (default)
+        /// = 0.2 / kernel_radius; &gt;= 0
+        /// </summary>
+        public float NormalThreshold;
+        /// <summary>uint32_t reserved0: must be 0</summary>
+        public uint Reserved0;
+
+        /// <summary>A SurfaceTensionParams with the library's defaults (sph_surface_tension_params_init_sized).</summary>
+        public static SurfaceTensionParams Default()
+        {
+            var value = new SurfaceTensionParams();
+            uint size = (uint)Marshal.SizeOf(typeof(SurfaceTensionParams));
+            SphException.Check(Native.sph_surface_tension_params_init_sized(ref value, size), "sph_surface_tension_params_init_sized");
+            return value;
+        }
+    }
+
+    /// <summary>sph_clavet_viscosity_params (16 bytes)</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct ClavetViscosityParams
+    {
+        /// <summary>uint32_t struct_size: set by sph_clavet_viscosity_params_init</summary>
+        public uint StructSize;
+        /// <summary>float linear: sigma of I = dt (1 - q)(sigma u + beta u^2), 1/s; default 10; &gt;= 0</summary>
+        public float Linear;
+        /// <summary>float quadratic: beta, 1/m; default 0; &gt;= 0</summary>
+        public float Quadratic;
+        /// <summary>uint32_t reserved0: must be 0</summary>
+        public uint Reserved0;
+
+        /// <summary>A ClavetViscosityParams with the library's defaults (sph_clavet_viscosity_params_init_sized).</summary>
+        public static ClavetViscosityParams Default()
+        {
+            var value = new ClavetViscosityParams();
+            uint size = (uint)Marshal.SizeOf(typeof(ClavetViscosityParams));
+            SphException.Check(Native.sph_clavet_viscosity_params_init_sized(ref value, size), "sph_clavet_viscosity_params_init_sized");
+            return value;
+        }
+    }
+
+    /// <summary>sph_tait_params (8 bytes)</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct TaitParams
+    {
+        /// <summary>uint32_t struct_size: set by sph_tait_params_init</summary>
+        public uint StructSize;
+        /// <summary>
+        /// float speed_of_sound: c, m/s; default 10; &gt; 0. Use &gt;= 10 x the fastest flow speed to
+        /// keep density errors near 1 %; lower dt_max (or SPH_STEP_LIMIT_ACOUSTIC) so that c dt stays
+        /// below about 0.4 h
+        /// </summary>
+        public float SpeedOfSound;
+
+        /// <summary>A TaitParams with the library's defaults (sph_tait_params_init_sized).</summary>
+        public static TaitParams Default()
+        {
+            var value = new TaitParams();
+            uint size = (uint)Marshal.SizeOf(typeof(TaitParams));
+            SphException.Check(Native.sph_tait_params_init_sized(ref value, size), "sph_tait_params_init_sized");
             return value;
         }
     }
@@ -1244,6 +1360,60 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_params")]
         public static extern Result sph_world_get_params(IntPtr world, IntPtr @out);
 
+        /// <summary>sph_surface_tension_params_init_sized</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_surface_tension_params_init_sized(ref SurfaceTensionParams @params, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_surface_tension_params_init_sized")]
+        public static extern Result sph_surface_tension_params_init_sized(IntPtr @params, uint size);
+
+        /// <summary>FEATURE_DISABLED unless the world has SPH_FEATURE_SURFACE_TENSION.</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_set_surface_tension_params(WorldHandle world, ref SurfaceTensionParams @params);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_set_surface_tension_params")]
+        public static extern Result sph_world_set_surface_tension_params(IntPtr world, IntPtr @params);
+
+        /// <summary>sph_world_get_surface_tension_params</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_get_surface_tension_params(WorldHandle world, ref SurfaceTensionParams @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_surface_tension_params")]
+        public static extern Result sph_world_get_surface_tension_params(IntPtr world, IntPtr @out);
+
+        /// <summary>sph_clavet_viscosity_params_init_sized</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_clavet_viscosity_params_init_sized(ref ClavetViscosityParams @params, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_clavet_viscosity_params_init_sized")]
+        public static extern Result sph_clavet_viscosity_params_init_sized(IntPtr @params, uint size);
+
+        /// <summary>FEATURE_DISABLED unless the world's viscosity_method is SPH_VISCOSITY_CLAVET.</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_set_clavet_viscosity_params(WorldHandle world, ref ClavetViscosityParams @params);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_set_clavet_viscosity_params")]
+        public static extern Result sph_world_set_clavet_viscosity_params(IntPtr world, IntPtr @params);
+
+        /// <summary>sph_world_get_clavet_viscosity_params</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_get_clavet_viscosity_params(WorldHandle world, ref ClavetViscosityParams @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_clavet_viscosity_params")]
+        public static extern Result sph_world_get_clavet_viscosity_params(IntPtr world, IntPtr @out);
+
+        /// <summary>sph_tait_params_init_sized</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_tait_params_init_sized(ref TaitParams @params, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_tait_params_init_sized")]
+        public static extern Result sph_tait_params_init_sized(IntPtr @params, uint size);
+
+        /// <summary>FEATURE_DISABLED unless the world's equation_of_state is SPH_EOS_TAIT.</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_set_tait_params(WorldHandle world, ref TaitParams @params);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_set_tait_params")]
+        public static extern Result sph_world_set_tait_params(IntPtr world, IntPtr @params);
+
+        /// <summary>sph_world_get_tait_params</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_get_tait_params(WorldHandle world, ref TaitParams @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_tait_params")]
+        public static extern Result sph_world_get_tait_params(IntPtr world, IntPtr @out);
+
         /// <summary>sph_spawn_desc_init_sized</summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_spawn_desc_init_sized(ref SpawnDesc desc, uint size);
@@ -1646,6 +1816,9 @@ namespace Sph
             typeof(ContextDef),
             typeof(WorldDef),
             typeof(WorldParams),
+            typeof(SurfaceTensionParams),
+            typeof(ClavetViscosityParams),
+            typeof(TaitParams),
             typeof(SpawnDesc),
             typeof(FillBoxDesc),
             typeof(FillSphereDesc),
@@ -1671,6 +1844,9 @@ namespace Sph
             "sph_context_def",
             "sph_world_def",
             "sph_world_params",
+            "sph_surface_tension_params",
+            "sph_clavet_viscosity_params",
+            "sph_tait_params",
             "sph_spawn_desc",
             "sph_fill_box_desc",
             "sph_fill_sphere_desc",
@@ -1695,7 +1871,10 @@ namespace Sph
             12,
             40,
             40,
-            40,
+            48,
+            16,
+            16,
+            8,
             40,
             44,
             36,
@@ -1748,6 +1927,18 @@ namespace Sph
             typeof(WorldParams),
             typeof(WorldParams),
             typeof(WorldParams),
+            typeof(WorldParams),
+            typeof(WorldParams),
+            typeof(SurfaceTensionParams),
+            typeof(SurfaceTensionParams),
+            typeof(SurfaceTensionParams),
+            typeof(SurfaceTensionParams),
+            typeof(ClavetViscosityParams),
+            typeof(ClavetViscosityParams),
+            typeof(ClavetViscosityParams),
+            typeof(ClavetViscosityParams),
+            typeof(TaitParams),
+            typeof(TaitParams),
             typeof(SpawnDesc),
             typeof(SpawnDesc),
             typeof(SpawnDesc),
@@ -1878,11 +2069,11 @@ namespace Sph
             "Capacity",
             "Features",
             "Integrator",
-            "Reserved0",
+            "ViscosityMethod",
             "ParticleSpacing",
             "KernelRadius",
             "RestDensity",
-            "Reserved1",
+            "EquationOfState",
             "StructSize",
             "MaxSubsteps",
             "Gravity",
@@ -1891,6 +2082,18 @@ namespace Sph
             "StepFactor",
             "DtMin",
             "DtMax",
+            "StepLimits",
+            "Reserved0",
+            "StructSize",
+            "Coefficient",
+            "NormalThreshold",
+            "Reserved0",
+            "StructSize",
+            "Linear",
+            "Quadratic",
+            "Reserved0",
+            "StructSize",
+            "SpeedOfSound",
             "StructSize",
             "Count",
             "Positions",
@@ -2034,6 +2237,18 @@ namespace Sph
             28,
             32,
             36,
+            40,
+            44,
+            0,
+            4,
+            8,
+            12,
+            0,
+            4,
+            8,
+            12,
+            0,
+            4,
             0,
             4,
             8,
@@ -2168,6 +2383,15 @@ namespace Sph
             "sph_world_params_init_sized",
             "sph_world_set_params",
             "sph_world_get_params",
+            "sph_surface_tension_params_init_sized",
+            "sph_world_set_surface_tension_params",
+            "sph_world_get_surface_tension_params",
+            "sph_clavet_viscosity_params_init_sized",
+            "sph_world_set_clavet_viscosity_params",
+            "sph_world_get_clavet_viscosity_params",
+            "sph_tait_params_init_sized",
+            "sph_world_set_tait_params",
+            "sph_world_get_tait_params",
             "sph_spawn_desc_init_sized",
             "sph_world_spawn",
             "sph_fill_box_desc_init_sized",
@@ -2287,6 +2511,15 @@ namespace Sph
             "sph",
             "sph",
             "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
             "sph_vdb",
             "sph_vdb",
         };
@@ -2329,6 +2562,10 @@ namespace Sph
             { "SPH_STAGE_COLLIDE", "colliders (none yet)" },
             { "SPH_STAGE_EMIT", "sources and sinks (none yet)" },
             { "SPH_STAGE_OTHER", "everything else: statistics, transfers" },
+            { "SPH_VISCOSITY_MUELLER", "Laplacian viscosity (eq. 17), coefficient sph_world_params.viscosity" },
+            { "SPH_VISCOSITY_CLAVET", "radial impulses between approaching pairs (eq. 18-19), sph_clavet_viscosity_params" },
+            { "SPH_EOS_IDEAL_GAS", "the thesis's modified ideal gas p = k (rho - rho0) (eq. 15)" },
+            { "SPH_EOS_TAIT", "p = B ((rho / rho0)^7 - 1), B = rho0 c^2 / 7, sph_tait_params" },
             { "SPH_MEMORY_HOST", "ordinary host memory" },
             { "SPH_MEMORY_CUDA_DEVICE", "device memory of the context's CUDA device (CUDA contexts only)" },
             { "SPH_SHAPE_PLANE", "solid below y = 0; half_extents.x/.z its size, .y its thickness" },

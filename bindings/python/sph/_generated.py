@@ -10,7 +10,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '26fb78cd012ef6ab6be665e1a1d1ac421ee579aa2f121100f24999f67808b86d', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
+HEADERS = {'include/sph_c.h': '4093fddce71ca04be9fca1e40aed42c67836b0c4762657fd35a807c9d78f904a', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -25,6 +25,20 @@ SPH_VERSION = 4096
 #: ABI version: equals the SONAME major (libsph.so.0).
 SPH_ABI_VERSION = 0
 SPH_FEATURE_NONE = 0
+#: Surface tension from the colour field (Morris 2000; thesis eq. 20-23), with parameters in
+#: sph_surface_tension_params. EXPERIMENTAL: it yields the Laplace pressure only to within a factor
+#: of two at 8 particles per radius, and at sigma of about 1 N/m on centimetre drops it can fling
+#: stray surface particles off (docs/physics.md).
+SPH_FEATURE_SURFACE_TENSION = 1
+#: Normalised density (thesis eq. 31): a second density pass, a Shepard filter that evens out the
+#: density deficit of particles near a free surface (it narrows it; it does not remove it: about 48
+#: % -> 34 % on the outermost layer of a resting sphere).
+SPH_FEATURE_NORMALIZED_DENSITY = 2
+#: Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt <= step_factor h / c, c the
+#: EOS's speed of sound
+SPH_STEP_LIMIT_ACOUSTIC = 1
+#: dt <= step_factor sqrt(h / |a|_max)
+SPH_STEP_LIMIT_FORCE = 2
 #: hollow box: no lid (a tank open at +y)
 SPH_SHAPE_FLAG_OPEN_TOP = 1
 #: solid where the SDF is positive: a container
@@ -198,6 +212,34 @@ class Stage(_enum.IntEnum):
     OTHER = 7
 
 
+sph_viscosity_method = _c.c_int32
+SPH_VISCOSITY_MUELLER = 0  # Laplacian viscosity (eq. 17), coefficient sph_world_params.viscosity
+SPH_VISCOSITY_CLAVET = 1  # radial impulses between approaching pairs (eq. 18-19), sph_clavet_viscosity_params
+SPH_VISCOSITY_METHOD_FORCE32 = 2147483647
+
+
+class ViscosityMethod(_enum.IntEnum):
+    """sph_viscosity_method"""
+    #: Laplacian viscosity (eq. 17), coefficient sph_world_params.viscosity
+    MUELLER = 0
+    #: radial impulses between approaching pairs (eq. 18-19), sph_clavet_viscosity_params
+    CLAVET = 1
+
+
+sph_equation_of_state = _c.c_int32
+SPH_EOS_IDEAL_GAS = 0  # the thesis's modified ideal gas p = k (rho - rho0) (eq. 15)
+SPH_EOS_TAIT = 1  # p = B ((rho / rho0)^7 - 1), B = rho0 c^2 / 7, sph_tait_params
+SPH_EOS_FORCE32 = 2147483647
+
+
+class EquationOfState(_enum.IntEnum):
+    """sph_equation_of_state"""
+    #: the thesis's modified ideal gas p = k (rho - rho0) (eq. 15)
+    IDEAL_GAS = 0
+    #: p = B ((rho / rho0)^7 - 1), B = rho0 c^2 / 7, sph_tait_params
+    TAIT = 1
+
+
 sph_memory_kind = _c.c_int32
 SPH_MEMORY_HOST = 0  # ordinary host memory
 SPH_MEMORY_CUDA_DEVICE = 1  # device memory of the context's CUDA device (CUDA contexts only)
@@ -352,6 +394,10 @@ ENUM_MEMBER_DOCS = {
     'SPH_STAGE_COLLIDE': 'colliders (none yet)',
     'SPH_STAGE_EMIT': 'sources and sinks (none yet)',
     'SPH_STAGE_OTHER': 'everything else: statistics, transfers',
+    'SPH_VISCOSITY_MUELLER': 'Laplacian viscosity (eq. 17), coefficient sph_world_params.viscosity',
+    'SPH_VISCOSITY_CLAVET': 'radial impulses between approaching pairs (eq. 18-19), sph_clavet_viscosity_params',
+    'SPH_EOS_IDEAL_GAS': "the thesis's modified ideal gas p = k (rho - rho0) (eq. 15)",
+    'SPH_EOS_TAIT': 'p = B ((rho / rho0)^7 - 1), B = rho0 c^2 / 7, sph_tait_params',
     'SPH_MEMORY_HOST': 'ordinary host memory',
     'SPH_MEMORY_CUDA_DEVICE': "device memory of the context's CUDA device (CUDA contexts only)",
     'SPH_SHAPE_PLANE': 'solid below y = 0; half_extents.x/.z its size, .y its thickness',
@@ -376,7 +422,9 @@ ENUM_MEMBER_DOCS = {
 # ---- type aliases -----------------------------------------------------------------------------
 
 sph_bool32 = _c.c_uint32
-#: World feature bits. None are defined yet: any set bit is rejected as unknown.
+#: World feature bits, fixed at world creation. A feature that is off allocates nothing and costs
+#: no work (docs/physics.md, docs/performance.md); its parameter calls return
+#: SPH_ERROR_FEATURE_DISABLED. Unknown bits are SPH_ERROR_UNSUPPORTED.
 sph_feature_flags = _c.c_uint32
 
 # ---- opaque objects ---------------------------------------------------------------------------
@@ -472,11 +520,11 @@ class WorldDef(_SphStruct):
         capacity (uint32_t): most particles the world holds; default 65536; >= 1
         features (sph_feature_flags): SPH_FEATURE_* bits; default SPH_FEATURE_NONE
         integrator (sph_integrator): default SPH_INTEGRATOR_SYMPLECTIC_EULER
-        reserved0 (uint32_t): must be 0
+        viscosity_method (sph_viscosity_method): default SPH_VISCOSITY_MUELLER
         particle_spacing (float): nearest-neighbour distance of the FCC lattice, m; default 0.02
         kernel_radius (float): h, m; 0 (default) = 1.8 * particle_spacing; must be >= spacing
         rest_density (float): rho0, kg/m^3; default 1000 (water)
-        reserved1 (float): must be 0
+        equation_of_state (sph_equation_of_state): default SPH_EOS_IDEAL_GAS
     """
     _fields_ = [
         ('struct_size', _c.c_uint32),
@@ -484,18 +532,18 @@ class WorldDef(_SphStruct):
         ('capacity', _c.c_uint32),
         ('features', sph_feature_flags),
         ('integrator', sph_integrator),
-        ('reserved0', _c.c_uint32),
+        ('viscosity_method', sph_viscosity_method),
         ('particle_spacing', _c.c_float),
         ('kernel_radius', _c.c_float),
         ('rest_density', _c.c_float),
-        ('reserved1', _c.c_float),
+        ('equation_of_state', sph_equation_of_state),
     ]
     _sph_c_name_ = 'sph_world_def'
     _sph_size_ = 40
-    _sph_offsets_ = (('struct_size', 0), ('header_version', 4), ('capacity', 8), ('features', 12), ('integrator', 16), ('reserved0', 20), ('particle_spacing', 24), ('kernel_radius', 28), ('rest_density', 32), ('reserved1', 36))
+    _sph_offsets_ = (('struct_size', 0), ('header_version', 4), ('capacity', 8), ('features', 12), ('integrator', 16), ('viscosity_method', 20), ('particle_spacing', 24), ('kernel_radius', 28), ('rest_density', 32), ('equation_of_state', 36))
     _sph_init_ = 'sph_world_def_init_sized'
     _sph_assigns_ = {'header_version': SPH_VERSION}
-    _sph_enums_ = {'integrator': Integrator}
+    _sph_enums_ = {'integrator': Integrator, 'viscosity_method': ViscosityMethod, 'equation_of_state': EquationOfState}
 
 
 sph_world_def = WorldDef
@@ -514,6 +562,8 @@ class WorldParams(_SphStruct):
         step_factor (float): lambda of dt = lambda h / v_max; default 0.4; in (0, 10]
         dt_min (float): s; default 1e-6; > 0
         dt_max (float): s; default 1e-3; >= dt_min
+        step_limits (uint32_t): SPH_STEP_LIMIT_* bits; default 0 (eq. 32 alone)
+        reserved0 (uint32_t): must be 0
     """
     _fields_ = [
         ('struct_size', _c.c_uint32),
@@ -524,14 +574,87 @@ class WorldParams(_SphStruct):
         ('step_factor', _c.c_float),
         ('dt_min', _c.c_float),
         ('dt_max', _c.c_float),
+        ('step_limits', _c.c_uint32),
+        ('reserved0', _c.c_uint32),
     ]
     _sph_c_name_ = 'sph_world_params'
-    _sph_size_ = 40
-    _sph_offsets_ = (('struct_size', 0), ('max_substeps', 4), ('gravity', 8), ('stiffness', 20), ('viscosity', 24), ('step_factor', 28), ('dt_min', 32), ('dt_max', 36))
+    _sph_size_ = 48
+    _sph_offsets_ = (('struct_size', 0), ('max_substeps', 4), ('gravity', 8), ('stiffness', 20), ('viscosity', 24), ('step_factor', 28), ('dt_min', 32), ('dt_max', 36), ('step_limits', 40), ('reserved0', 44))
     _sph_init_ = 'sph_world_params_init_sized'
 
 
 sph_world_params = WorldParams
+
+
+class SurfaceTensionParams(_SphStruct):
+    """
+    sph_surface_tension_params.
+
+    Fields:
+        struct_size (uint32_t): set by sph_surface_tension_params_init
+        coefficient (float): sigma, N/m; default 0.0728 (water at 20 C); >= 0
+        normal_threshold (float): |grad c| above which a particle counts as surface, 1/m; 0 (default) = 0.2 / kernel_radius; >= 0
+        reserved0 (uint32_t): must be 0
+    """
+    _fields_ = [
+        ('struct_size', _c.c_uint32),
+        ('coefficient', _c.c_float),
+        ('normal_threshold', _c.c_float),
+        ('reserved0', _c.c_uint32),
+    ]
+    _sph_c_name_ = 'sph_surface_tension_params'
+    _sph_size_ = 16
+    _sph_offsets_ = (('struct_size', 0), ('coefficient', 4), ('normal_threshold', 8), ('reserved0', 12))
+    _sph_init_ = 'sph_surface_tension_params_init_sized'
+
+
+sph_surface_tension_params = SurfaceTensionParams
+
+
+class ClavetViscosityParams(_SphStruct):
+    """
+    sph_clavet_viscosity_params.
+
+    Fields:
+        struct_size (uint32_t): set by sph_clavet_viscosity_params_init
+        linear (float): sigma of I = dt (1 - q)(sigma u + beta u^2), 1/s; default 10; >= 0
+        quadratic (float): beta, 1/m; default 0; >= 0
+        reserved0 (uint32_t): must be 0
+    """
+    _fields_ = [
+        ('struct_size', _c.c_uint32),
+        ('linear', _c.c_float),
+        ('quadratic', _c.c_float),
+        ('reserved0', _c.c_uint32),
+    ]
+    _sph_c_name_ = 'sph_clavet_viscosity_params'
+    _sph_size_ = 16
+    _sph_offsets_ = (('struct_size', 0), ('linear', 4), ('quadratic', 8), ('reserved0', 12))
+    _sph_init_ = 'sph_clavet_viscosity_params_init_sized'
+
+
+sph_clavet_viscosity_params = ClavetViscosityParams
+
+
+class TaitParams(_SphStruct):
+    """
+    sph_tait_params.
+
+    Fields:
+        struct_size (uint32_t): set by sph_tait_params_init
+        speed_of_sound (float): c, m/s; default 10; > 0. Use >= 10 x the fastest flow speed to keep density errors near 1 %; lower dt_max (or SPH_STEP_LIMIT_ACOUSTIC) so that c dt stays below about 0.4 h
+    """
+    _fields_ = [
+        ('struct_size', _c.c_uint32),
+        ('speed_of_sound', _c.c_float),
+    ]
+    _sph_c_name_ = 'sph_tait_params'
+    _sph_size_ = 8
+    _sph_offsets_ = (('struct_size', 0), ('speed_of_sound', 4))
+    _sph_init_ = 'sph_tait_params_init_sized'
+
+
+sph_tait_params = TaitParams
 
 
 class SpawnDesc(_SphStruct):
@@ -1098,7 +1221,7 @@ class CudaAttributeView(_SphStruct):
 sph_cuda_attribute_view = CudaAttributeView
 
 
-STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, Quat, Transform, ColliderId, ColliderDef, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, Event, CudaAttributeView, )
+STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, Quat, Transform, ColliderId, ColliderDef, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, Event, CudaAttributeView, )
 
 # ---- functions --------------------------------------------------------------------------------
 
@@ -1140,6 +1263,24 @@ FUNCTIONS = {
         'Replaces all runtime parameters at once; validated as a whole, nothing changes on error.', 'sph'),
     'sph_world_get_params': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_world_params)), ('world', 'out'),
         'Reads all runtime parameters; out->struct_size must be set (sph_world_params_init).', 'sph'),
+    'sph_surface_tension_params_init_sized': (sph_result, (_c.POINTER(sph_surface_tension_params), _c.c_uint32), ('params', 'size'),
+        '', 'sph'),
+    'sph_world_set_surface_tension_params': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_surface_tension_params)), ('world', 'params'),
+        'FEATURE_DISABLED unless the world has SPH_FEATURE_SURFACE_TENSION.', 'sph'),
+    'sph_world_get_surface_tension_params': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_surface_tension_params)), ('world', 'out'),
+        '', 'sph'),
+    'sph_clavet_viscosity_params_init_sized': (sph_result, (_c.POINTER(sph_clavet_viscosity_params), _c.c_uint32), ('params', 'size'),
+        '', 'sph'),
+    'sph_world_set_clavet_viscosity_params': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_clavet_viscosity_params)), ('world', 'params'),
+        "FEATURE_DISABLED unless the world's viscosity_method is SPH_VISCOSITY_CLAVET.", 'sph'),
+    'sph_world_get_clavet_viscosity_params': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_clavet_viscosity_params)), ('world', 'out'),
+        '', 'sph'),
+    'sph_tait_params_init_sized': (sph_result, (_c.POINTER(sph_tait_params), _c.c_uint32), ('params', 'size'),
+        '', 'sph'),
+    'sph_world_set_tait_params': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_tait_params)), ('world', 'params'),
+        "FEATURE_DISABLED unless the world's equation_of_state is SPH_EOS_TAIT.", 'sph'),
+    'sph_world_get_tait_params': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_tait_params)), ('world', 'out'),
+        '', 'sph'),
     'sph_spawn_desc_init_sized': (sph_result, (_c.POINTER(sph_spawn_desc), _c.c_uint32), ('desc', 'size'),
         '', 'sph'),
     'sph_world_spawn': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_spawn_desc), _c.POINTER(_c.c_uint32)), ('world', 'desc', 'out_first_id'),
