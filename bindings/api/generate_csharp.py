@@ -294,7 +294,8 @@ class Gen:
     def struct(self, s: dict) -> list[str]:
         name = self.struct_names[s["name"]]
         out = self.summary(f"{s['name']} ({s['size']} bytes)" + (f": {s['doc']}" if s["doc"] else ""), "    ")
-        out += ["    [StructLayout(LayoutKind.Sequential)]", f"    public struct {name}", "    {"]
+        # partial: Sph.cs may add typed views of fields (flag enums over uint fields, ...).
+        out += ["    [StructLayout(LayoutKind.Sequential)]", f"    public partial struct {name}", "    {"]
         for f in s["fields"]:
             doc = f"{f['type']['c']} {f['name']}" + (f": {f['doc']}" if f["doc"] else "")
             out += self.summary(doc, "        ")

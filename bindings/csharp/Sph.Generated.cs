@@ -437,7 +437,7 @@ namespace Sph
 
     /// <summary>sph_vec3 (12 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct Vec3
+    public partial struct Vec3
     {
         /// <summary>float x</summary>
         public float X;
@@ -456,7 +456,7 @@ namespace Sph
 
     /// <summary>sph_context_def (40 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct ContextDef
+    public partial struct ContextDef
     {
         /// <summary>uint32_t struct_size: sizeof(sph_context_def), set by sph_context_def_init</summary>
         public uint StructSize;
@@ -488,7 +488,7 @@ namespace Sph
 
     /// <summary>sph_world_def (40 bytes): Creation-time description of a world; fixed for the world's life.</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct WorldDef
+    public partial struct WorldDef
     {
         /// <summary>uint32_t struct_size: sizeof(sph_world_def), set by sph_world_def_init</summary>
         public uint StructSize;
@@ -524,7 +524,7 @@ namespace Sph
 
     /// <summary>sph_world_params (48 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct WorldParams
+    public partial struct WorldParams
     {
         /// <summary>uint32_t struct_size: sizeof(sph_world_params), set by sph_world_params_init</summary>
         public uint StructSize;
@@ -565,7 +565,7 @@ namespace Sph
 
     /// <summary>sph_surface_tension_params (16 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct SurfaceTensionParams
+    public partial struct SurfaceTensionParams
     {
         /// <summary>uint32_t struct_size: set by sph_surface_tension_params_init</summary>
         public uint StructSize;
@@ -591,7 +591,7 @@ namespace Sph
 
     /// <summary>sph_clavet_viscosity_params (16 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct ClavetViscosityParams
+    public partial struct ClavetViscosityParams
     {
         /// <summary>uint32_t struct_size: set by sph_clavet_viscosity_params_init</summary>
         public uint StructSize;
@@ -614,7 +614,7 @@ namespace Sph
 
     /// <summary>sph_tait_params (8 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct TaitParams
+    public partial struct TaitParams
     {
         /// <summary>uint32_t struct_size: set by sph_tait_params_init</summary>
         public uint StructSize;
@@ -637,7 +637,7 @@ namespace Sph
 
     /// <summary>sph_spawn_desc (40 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct SpawnDesc
+    public partial struct SpawnDesc
     {
         /// <summary>uint32_t struct_size: sizeof(sph_spawn_desc), set by sph_spawn_desc_init</summary>
         public uint StructSize;
@@ -664,7 +664,7 @@ namespace Sph
 
     /// <summary>sph_fill_box_desc (44 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct FillBoxDesc
+    public partial struct FillBoxDesc
     {
         /// <summary>uint32_t struct_size: set by sph_fill_box_desc_init</summary>
         public uint StructSize;
@@ -689,7 +689,7 @@ namespace Sph
 
     /// <summary>sph_fill_sphere_desc (36 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct FillSphereDesc
+    public partial struct FillSphereDesc
     {
         /// <summary>uint32_t struct_size: set by sph_fill_sphere_desc_init</summary>
         public uint StructSize;
@@ -714,7 +714,7 @@ namespace Sph
 
     /// <summary>sph_stats (104 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct Stats
+    public partial struct Stats
     {
         /// <summary>uint32_t struct_size: set by sph_stats_init</summary>
         public uint StructSize;
@@ -766,7 +766,7 @@ namespace Sph
 
     /// <summary>sph_grid_desc (80 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct GridDesc
+    public partial struct GridDesc
     {
         /// <summary>uint32_t struct_size: set by sph_grid_desc_init</summary>
         public uint StructSize;
@@ -793,7 +793,7 @@ namespace Sph
 
     /// <summary>sph_sdf_desc (104 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct SdfDesc
+    public partial struct SdfDesc
     {
         /// <summary>uint32_t struct_size: set by sph_sdf_desc_init</summary>
         public uint StructSize;
@@ -821,7 +821,7 @@ namespace Sph
 
     /// <summary>sph_shape_desc (44 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct ShapeDesc
+    public partial struct ShapeDesc
     {
         /// <summary>uint32_t struct_size: set by sph_shape_desc_init</summary>
         public uint StructSize;
@@ -854,7 +854,7 @@ namespace Sph
 
     /// <summary>sph_quat (16 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct Quat
+    public partial struct Quat
     {
         /// <summary>float x: a rotation; normalised by the library; (0, 0, 0, 1) is identity</summary>
         public float X;
@@ -876,7 +876,7 @@ namespace Sph
 
     /// <summary>sph_transform (28 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct Transform
+    public partial struct Transform
     {
         /// <summary>sph_vec3 position: m</summary>
         public Vec3 Position;
@@ -898,7 +898,7 @@ namespace Sph
 
     /// <summary>sph_collider_id (8 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct ColliderId
+    public partial struct ColliderId
     {
         /// <summary>uint64_t bits: {0} is null</summary>
         public ulong Bits;
@@ -911,7 +911,7 @@ namespace Sph
 
     /// <summary>sph_collider_def (64 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct ColliderDef
+    public partial struct ColliderDef
     {
         /// <summary>uint32_t struct_size: set by sph_collider_def_init</summary>
         public uint StructSize;
@@ -947,7 +947,7 @@ namespace Sph
 
     /// <summary>sph_source_id (8 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct SourceId
+    public partial struct SourceId
     {
         /// <summary>uint64_t bits</summary>
         public ulong Bits;
@@ -960,7 +960,7 @@ namespace Sph
 
     /// <summary>sph_source_def (80 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct SourceDef
+    public partial struct SourceDef
     {
         /// <summary>uint32_t struct_size: set by sph_source_def_init</summary>
         public uint StructSize;
@@ -1000,7 +1000,7 @@ namespace Sph
 
     /// <summary>sph_sink_id (8 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct SinkId
+    public partial struct SinkId
     {
         /// <summary>uint64_t bits</summary>
         public ulong Bits;
@@ -1013,7 +1013,7 @@ namespace Sph
 
     /// <summary>sph_sink_def (72 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct SinkDef
+    public partial struct SinkDef
     {
         /// <summary>uint32_t struct_size: set by sph_sink_def_init</summary>
         public uint StructSize;
@@ -1042,7 +1042,7 @@ namespace Sph
 
     /// <summary>sph_force_field_id (8 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct ForceFieldId
+    public partial struct ForceFieldId
     {
         /// <summary>uint64_t bits</summary>
         public ulong Bits;
@@ -1055,7 +1055,7 @@ namespace Sph
 
     /// <summary>sph_force_field_def (80 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct ForceFieldDef
+    public partial struct ForceFieldDef
     {
         /// <summary>uint32_t struct_size: set by sph_force_field_def_init</summary>
         public uint StructSize;
@@ -1090,7 +1090,7 @@ namespace Sph
 
     /// <summary>sph_event (16 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct Event
+    public partial struct Event
     {
         /// <summary>sph_event_type type</summary>
         public EventType Type;
@@ -1113,7 +1113,7 @@ namespace Sph
     /// sph_cuda_world_get_epoch. The memory is the world's: read it, never write or free it.
     /// </summary>
     [StructLayout(LayoutKind.Sequential)]
-    public struct CudaAttributeView
+    public partial struct CudaAttributeView
     {
         /// <summary>uint32_t struct_size: sizeof(sph_cuda_attribute_view), set by the init function</summary>
         public uint StructSize;
