@@ -10,6 +10,7 @@ from . import _generated as _g
 from ._cuda import WorldCudaMixin
 from ._errors import SphError, check
 from ._loader import library
+from ._options import WorldOptionsMixin
 from ._scene import Sdf, WorldSceneMixin
 
 __all__ = ["Context", "World", "attribute_format", "version", "abi_version", "build_info", "result_string",
@@ -188,7 +189,7 @@ class Context:
 
 
 # ---- world -------------------------------------------------------------------------------------------
-class World(WorldSceneMixin, WorldCudaMixin):
+class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin):
     """A particle fluid (sph_world): created on a Context, stepped, read back into numpy.
 
     ``World(ctx, capacity=100_000, particle_spacing=0.01)``: keyword arguments set fields of a
@@ -196,6 +197,13 @@ class World(WorldSceneMixin, WorldCudaMixin):
     context manager or call close(). Colliders, sources, sinks and force fields are added
     with add_collider/add_source/add_sink/add_force_field (see sph._scene); the zero-copy
     CUDA tier is cuda_attribute/cuda_array/cuda_epoch/... (see sph._cuda).
+
+    Optional physics is chosen here and fixed for the world's life (see sph._options):
+    ``viscosity_method="clavet"`` (ViscosityMethod), ``equation_of_state="tait"``
+    (EquationOfState), ``features="surface_tension|normalized_density"`` (Feature bits, also
+    a list of names or ``Feature.A | Feature.B``). Their parameters are
+    surface_tension_params, clavet_viscosity_params and tait_params (get/set, or
+    set_*_params(**fields)); the step-size limits are ``set_params(step_limits=...)``.
     """
 
     def __init__(self, context, definition=None, **fields):
@@ -272,7 +280,9 @@ class World(WorldSceneMixin, WorldCudaMixin):
         check(library().sph_world_set_params(self.handle, ctypes.byref(params)), "sph_world_set_params")
 
     def set_params(self, **fields):
-        """Changes some runtime parameters, keeping the others: ``w.set_params(gravity=(0, 0, 0))``."""
+        """Changes some runtime parameters, keeping the others: ``w.set_params(gravity=(0, 0, 0))``,
+        ``w.set_params(step_limits="acoustic|force")`` (StepLimit bits). Returns the
+        parameters now set."""
         p = self.params
         for name, value in fields.items():
             setattr(p, name, value)

@@ -1,5 +1,6 @@
 """Base classes of the generated ctypes structs and opaque types."""
 import ctypes
+import enum
 
 
 class Opaque(ctypes.Structure):
@@ -33,6 +34,32 @@ def _convert(ftype, value):
     return value
 
 
+def _enum_value(enum_cls, value, what):
+    """An enum field's value from a member, an int, or a member name in any case ("rk4");
+    for IntFlag fields also "a|b" or an iterable of names and members (or'ed together)."""
+    is_flag = issubclass(enum_cls, enum.IntFlag)
+    if isinstance(value, str):
+        names = [n.strip() for n in value.split("|")] if is_flag else [value.strip()]
+    elif is_flag and not isinstance(value, int) and hasattr(value, "__iter__"):
+        names = list(value)
+    else:
+        return value
+    bits = 0
+    for name in names:
+        if not isinstance(name, str):
+            bits |= int(name)
+            continue
+        try:
+            member = enum_cls[name.upper()]
+        except KeyError:
+            choices = ", ".join(m.name.lower() for m in enum_cls)
+            raise ValueError(f"{what}: {name!r} is not one of {choices}") from None
+        if not is_flag:
+            return member
+        bits |= member
+    return enum_cls(bits)
+
+
 class SphStruct(ctypes.Structure):
     """A C struct of sph_c.h with keyword construction and defaults.
 
@@ -41,7 +68,9 @@ class SphStruct(ctypes.Structure):
     starts at the library's default, then applies positional and keyword
     arguments: ``WorldParams(gravity=(0, 0, 0), viscosity=2.0)``. Struct and array fields
     accept tuples, lists and numpy arrays. Unknown field names raise AttributeError (a typo
-    never passes silently). Enum fields read back as IntEnum members.
+    never passes silently). Enum fields read back as IntEnum members and also accept member
+    names (``WorldDef(integrator="rk4")``); flag fields (``WorldDef.features``,
+    ``WorldParams.step_limits``) read back as IntFlags and accept ``"a|b"`` or a list of names.
     """
 
     _fields_ = []
@@ -79,6 +108,9 @@ class SphStruct(ctypes.Structure):
         ftype = _field_types(type(self)).get(name)
         if ftype is None:
             raise AttributeError(f"{type(self).__name__} has no field {name!r}")
+        enums = type(self)._sph_enums_
+        if enums and name in enums:
+            value = _enum_value(enums[name], value, f"{type(self).__name__}.{name}")
         super().__setattr__(name, _convert(ftype, value))
 
     def __getattribute__(self, name):

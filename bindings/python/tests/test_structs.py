@@ -9,7 +9,7 @@ import sph
 
 def test_defaults_come_from_the_init_functions():
     p = sph.WorldParams()
-    assert p.struct_size == ctypes.sizeof(sph.WorldParams) == 40
+    assert p.struct_size == ctypes.sizeof(sph.WorldParams) == 48
     assert (p.max_substeps, p.stiffness, p.viscosity) == (10000, 100, 1)
     d = sph.WorldDef()
     assert d.header_version == sph.raw.SPH_VERSION  # what the inline sph_world_def_init adds

@@ -1,0 +1,163 @@
+"""Optional physics (docs/physics.md): feature bits, step limits, and the parameters of the
+options a world turned on at creation.
+
+Options are chosen when the world is created, through fields of its WorldDef::
+
+    ctx.world(viscosity_method="clavet",                          # ViscosityMethod.CLAVET
+              equation_of_state="tait",                           # EquationOfState.TAIT
+              features="surface_tension|normalized_density")      # or Feature.X | Feature.Y
+
+Their parameters are structs of their own, read and replaced whole (world.tait_params, ...)
+or changed field by field (world.set_tait_params(speed_of_sound=40)). Reading or setting the
+parameters of an option the world did not turn on raises SphError with
+Result.ERROR_FEATURE_DISABLED. The step-size limits are bits of WorldParams.step_limits:
+``world.set_params(step_limits="acoustic|force")``.
+"""
+import collections.abc
+import ctypes
+import enum
+
+from . import _generated as _g
+from ._errors import check
+from ._loader import library
+
+__all__ = ["Feature", "StepLimit", "WorldOptionsMixin"]
+
+
+def _flags(name, prefix, doc):
+    """An IntFlag whose members are the header's #defines named prefix + MEMBER, so bits added
+    to the header appear here without code."""
+    members = {k[len(prefix):]: v for k, v in vars(_g).items()
+               if k.startswith(prefix) and isinstance(v, int) and not isinstance(v, bool)}
+    cls = enum.IntFlag(name, members, module=__name__.rsplit(".", 1)[0])
+    cls.__doc__ = doc
+    return cls
+
+
+Feature = _flags("Feature", "SPH_FEATURE_", """World feature bits (SPH_FEATURE_*; WorldDef.features), fixed at creation.
+
+    SURFACE_TENSION: surface tension from the colour field (Morris 2000), parameters in
+    World.surface_tension_params; EXPERIMENTAL (docs/physics.md). NORMALIZED_DENSITY: a second,
+    Shepard-filtered density pass (thesis eq. 31) that narrows the density deficit at a free
+    surface. A feature that is off allocates nothing and costs no work.""")
+
+StepLimit = _flags("StepLimit", "SPH_STEP_LIMIT_", """Step-size limits beyond eq. 32 (SPH_STEP_LIMIT_*; WorldParams.step_limits).
+
+    ACOUSTIC: dt <= step_factor h / c, c the equation of state's speed of sound. FORCE:
+    dt <= step_factor sqrt(h / |a|_max).""")
+
+# WorldDef.features and WorldParams.step_limits read back as these flags and accept their names.
+_g.WorldDef._sph_enums_ = {**_g.WorldDef._sph_enums_, "features": Feature}
+_g.WorldParams._sph_enums_ = {**_g.WorldParams._sph_enums_, "step_limits": StepLimit}
+
+
+def _as_struct(cls, value):
+    """value as a cls: a cls passes through, a mapping gives cls(**mapping) (defaults + those)."""
+    if isinstance(value, cls):
+        return value
+    if isinstance(value, collections.abc.Mapping):
+        return cls(**value)
+    raise TypeError(f"expected {cls.__name__} or a dict of its fields, got {type(value).__name__}")
+
+
+def _changed(struct, fields):
+    for name, value in fields.items():
+        setattr(struct, name, value)
+    return struct
+
+
+class WorldOptionsMixin:
+    """The parameters of a World's optional physics; mixed into sph.World."""
+
+    # -- what the world turned on (from its WorldDef)
+    @property
+    def features(self):
+        """The world's Feature bits (WorldDef.features, fixed at creation)."""
+        return self.definition.features
+
+    @property
+    def viscosity_method(self):
+        """The world's ViscosityMethod (WorldDef.viscosity_method, fixed at creation)."""
+        return self.definition.viscosity_method
+
+    @property
+    def equation_of_state(self):
+        """The world's EquationOfState (WorldDef.equation_of_state, fixed at creation)."""
+        return self.definition.equation_of_state
+
+    # -- surface tension (Feature.SURFACE_TENSION)
+    @property
+    def surface_tension_params(self):
+        """SurfaceTensionParams (coefficient sigma in N/m, normal_threshold in 1/m) of a world
+        created with Feature.SURFACE_TENSION (sph_world_get_surface_tension_params). Assign a
+        SurfaceTensionParams (or a dict of its fields, the others at their defaults) to
+        replace them (sph_world_set_surface_tension_params; validated, unchanged on error).
+        Raises SphError(ERROR_FEATURE_DISABLED) when the world does not have the feature."""
+        p = _g.SurfaceTensionParams()
+        check(library().sph_world_get_surface_tension_params(self.handle, ctypes.byref(p)),
+              "sph_world_get_surface_tension_params")
+        return p
+
+    @surface_tension_params.setter
+    def surface_tension_params(self, params):
+        p = _as_struct(_g.SurfaceTensionParams, params)
+        check(library().sph_world_set_surface_tension_params(self.handle, ctypes.byref(p)),
+              "sph_world_set_surface_tension_params")
+
+    def set_surface_tension_params(self, **fields):
+        """Changes some surface-tension parameters, keeping the others:
+        ``w.set_surface_tension_params(coefficient=0.5)``. Returns the parameters now set."""
+        p = _changed(self.surface_tension_params, fields)
+        self.surface_tension_params = p
+        return p
+
+    # -- Clavet viscosity (ViscosityMethod.CLAVET)
+    @property
+    def clavet_viscosity_params(self):
+        """ClavetViscosityParams (linear sigma in 1/s, quadratic beta in 1/m) of a world created
+        with viscosity_method=ViscosityMethod.CLAVET (sph_world_get_clavet_viscosity_params).
+        Assign a ClavetViscosityParams (or a dict of its fields) to replace them
+        (sph_world_set_clavet_viscosity_params). Raises SphError(ERROR_FEATURE_DISABLED) on a
+        world that uses another viscosity method."""
+        p = _g.ClavetViscosityParams()
+        check(library().sph_world_get_clavet_viscosity_params(self.handle, ctypes.byref(p)),
+              "sph_world_get_clavet_viscosity_params")
+        return p
+
+    @clavet_viscosity_params.setter
+    def clavet_viscosity_params(self, params):
+        p = _as_struct(_g.ClavetViscosityParams, params)
+        check(library().sph_world_set_clavet_viscosity_params(self.handle, ctypes.byref(p)),
+              "sph_world_set_clavet_viscosity_params")
+
+    def set_clavet_viscosity_params(self, **fields):
+        """Changes some Clavet viscosity parameters, keeping the others:
+        ``w.set_clavet_viscosity_params(linear=20)``. Returns the parameters now set."""
+        p = _changed(self.clavet_viscosity_params, fields)
+        self.clavet_viscosity_params = p
+        return p
+
+    # -- Tait equation of state (EquationOfState.TAIT)
+    @property
+    def tait_params(self):
+        """TaitParams (speed_of_sound c in m/s) of a world created with
+        equation_of_state=EquationOfState.TAIT (sph_world_get_tait_params). Assign a TaitParams
+        (or a dict of its fields) to replace them (sph_world_set_tait_params). Raises
+        SphError(ERROR_FEATURE_DISABLED) on a world with another equation of state.
+        Keep c >= 10 x the fastest flow, and c dt below about 0.4 h (lower dt_max, or
+        StepLimit.ACOUSTIC in WorldParams.step_limits)."""
+        p = _g.TaitParams()
+        check(library().sph_world_get_tait_params(self.handle, ctypes.byref(p)), "sph_world_get_tait_params")
+        return p
+
+    @tait_params.setter
+    def tait_params(self, params):
+        p = _as_struct(_g.TaitParams, params)
+        check(library().sph_world_set_tait_params(self.handle, ctypes.byref(p)), "sph_world_set_tait_params")
+
+    def set_tait_params(self, **fields):
+        """Changes some Tait parameters, keeping the others: ``w.set_tait_params(speed_of_sound=40)``.
+        Returns the parameters now set."""
+        p = _changed(self.tait_params, fields)
+        self.tait_params = p
+        return p

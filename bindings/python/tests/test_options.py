@@ -1,0 +1,208 @@
+"""Optional physics: world def options, feature and step-limit flags, the option parameter
+structs (round trips, validation, ERROR_FEATURE_DISABLED when the option is off)."""
+import ctypes
+
+import numpy as np
+import pytest
+
+import sph
+
+
+def raw(name, *args):
+    return sph._errors.check(getattr(sph.library(), name)(*args), name)
+
+
+def error(fn, *args, **kwargs):
+    with pytest.raises(sph.SphError) as e:
+        fn(*args, **kwargs)
+    assert e.value.message, "the library explained the failure"
+    return e.value
+
+
+def _get(world, attr):
+    return getattr(world, attr)
+
+
+@pytest.fixture
+def full(ctx):
+    """A world with every option on."""
+    with ctx.world(capacity=4096, viscosity_method="clavet", equation_of_state="tait",
+                   features="surface_tension|normalized_density") as w:
+        yield w
+
+
+# The three option structs: (world attribute, set_ method, struct, defaults, a changed field, value).
+OPTIONS = [
+    ("surface_tension_params", "set_surface_tension_params", sph.SurfaceTensionParams,
+     {"coefficient": 0.0728, "normal_threshold": 0.0}, "coefficient", 0.5),
+    ("clavet_viscosity_params", "set_clavet_viscosity_params", sph.ClavetViscosityParams,
+     {"linear": 10.0, "quadratic": 0.0}, "quadratic", 2.0),
+    ("tait_params", "set_tait_params", sph.TaitParams, {"speed_of_sound": 10.0}, "speed_of_sound", 40.0),
+]
+OPTION_IDS = [o[0] for o in OPTIONS]
+
+
+# ---- flags and enums --------------------------------------------------------------------------
+def test_flag_classes_mirror_the_header_defines():
+    assert {name: int(m) for name, m in sph.Feature.__members__.items()} == {
+        k[len("SPH_FEATURE_"):]: v for k, v in vars(sph.raw).items() if k.startswith("SPH_FEATURE_")}
+    assert sph.Feature.SURFACE_TENSION == sph.raw.SPH_FEATURE_SURFACE_TENSION
+    assert sph.Feature.NORMALIZED_DENSITY == sph.raw.SPH_FEATURE_NORMALIZED_DENSITY
+    assert sph.StepLimit.ACOUSTIC == sph.raw.SPH_STEP_LIMIT_ACOUSTIC
+    assert sph.StepLimit.FORCE == sph.raw.SPH_STEP_LIMIT_FORCE
+    assert sph.ViscosityMethod.CLAVET == sph.raw.SPH_VISCOSITY_CLAVET
+    assert sph.EquationOfState.TAIT == sph.raw.SPH_EOS_TAIT
+
+
+def test_def_and_params_accept_names_and_read_back_flags():
+    d = sph.WorldDef(viscosity_method="Clavet", equation_of_state="tait",
+                     features=["surface_tension", sph.Feature.NORMALIZED_DENSITY])
+    assert d.viscosity_method is sph.ViscosityMethod.CLAVET
+    assert d.equation_of_state is sph.EquationOfState.TAIT
+    assert d.features == sph.Feature.SURFACE_TENSION | sph.Feature.NORMALIZED_DENSITY
+    assert isinstance(d.features, sph.Feature)
+    assert sph.WorldDef(features="normalized_density").features is sph.Feature.NORMALIZED_DENSITY
+    assert sph.WorldDef(features=sph.Feature.SURFACE_TENSION).features is sph.Feature.SURFACE_TENSION
+    assert sph.WorldDef().features == sph.Feature.NONE == 0
+    assert sph.WorldDef(integrator="rk4").integrator is sph.Integrator.RK4  # every enum field takes names
+    p = sph.WorldParams(step_limits="acoustic | force")
+    assert p.step_limits == sph.StepLimit.ACOUSTIC | sph.StepLimit.FORCE and isinstance(p.step_limits, sph.StepLimit)
+    assert sph.WorldParams().step_limits == 0
+    assert sph.WorldParams(step_limits=[]).step_limits == 0
+    with pytest.raises(ValueError, match="surface_tension"):
+        sph.WorldDef(features="surface_tenson")  # the message lists the valid names
+    with pytest.raises(ValueError, match="clavet"):
+        sph.WorldDef(viscosity_method="clavett")
+
+
+def test_world_def_options_reach_the_library(full, world):
+    d = full.definition
+    assert d.viscosity_method is sph.ViscosityMethod.CLAVET
+    assert d.equation_of_state is sph.EquationOfState.TAIT
+    assert d.features == sph.Feature.SURFACE_TENSION | sph.Feature.NORMALIZED_DENSITY
+    assert (full.features, full.viscosity_method, full.equation_of_state) == (
+        d.features, sph.ViscosityMethod.CLAVET, sph.EquationOfState.TAIT)
+    assert world.features == sph.Feature.NONE
+    assert world.viscosity_method is sph.ViscosityMethod.MUELLER
+    assert world.equation_of_state is sph.EquationOfState.IDEAL_GAS
+
+
+@pytest.mark.parametrize("fields", [{"viscosity_method": 9}, {"equation_of_state": 9}, {"features": 0x80}])
+def test_unknown_options_are_unsupported(ctx, fields):
+    assert error(ctx.world, **fields).result == sph.Result.ERROR_UNSUPPORTED
+
+
+# ---- parameters of the options -----------------------------------------------------------------
+@pytest.mark.parametrize("attr, setter, cls, defaults, field, value", OPTIONS, ids=OPTION_IDS)
+def test_option_params_feature_disabled(world, attr, setter, cls, defaults, field, value):
+    """A world that did not turn the option on refuses its parameters, both ways."""
+    e = error(_get, world, attr)
+    assert e.result == sph.Result.ERROR_FEATURE_DISABLED and e.function.startswith("sph_world_get_")
+    e = error(setattr, world, attr, cls())
+    assert e.result == sph.Result.ERROR_FEATURE_DISABLED and e.function.startswith("sph_world_set_")
+    e = error(getattr(world, setter), **{field: value})
+    assert e.result == sph.Result.ERROR_FEATURE_DISABLED
+
+
+@pytest.mark.parametrize("attr, setter, cls, defaults, field, value", OPTIONS, ids=OPTION_IDS)
+def test_option_params_defaults_and_round_trip(full, attr, setter, cls, defaults, field, value):
+    p = getattr(full, attr)
+    assert isinstance(p, cls) and p.struct_size == ctypes.sizeof(cls)
+    assert p == cls(), "a new world starts at the struct's init defaults"
+    assert {k: pytest.approx(v) for k, v in defaults.items()} == {k: getattr(p, k) for k in defaults}
+    p = cls(**{field: value})
+    setattr(full, attr, p)
+    assert getattr(full, attr) == p
+    setattr(full, attr, {field: value / 2})  # a dict: its fields over the defaults
+    assert getattr(getattr(full, attr), field) == pytest.approx(value / 2)
+    q = getattr(full, setter)(**{field: value * 2})
+    assert getattr(q, field) == pytest.approx(value * 2) and getattr(full, attr) == q
+    with pytest.raises(AttributeError):
+        getattr(full, setter)(no_such_field=1)
+    with pytest.raises(TypeError):
+        setattr(full, attr, sph.WorldParams())
+
+
+@pytest.mark.parametrize("attr, setter, cls, defaults, field, value", OPTIONS, ids=OPTION_IDS)
+def test_option_params_validation_changes_nothing(full, attr, setter, cls, defaults, field, value):
+    before = getattr(full, attr)
+    for bad in (-1.0, float("nan"), float("inf")):
+        assert error(getattr(full, setter), **{field: bad}).result == sph.Result.ERROR_INVALID_ARGUMENT
+    if "reserved0" in dict(cls._fields_):
+        assert error(getattr(full, setter), reserved0=1).result == sph.Result.ERROR_INVALID_ARGUMENT
+    assert getattr(full, attr) == before
+    p = cls()
+    p.struct_size = 2
+    assert error(setattr, full, attr, p).result == sph.Result.ERROR_VERSION_MISMATCH
+    fn = "sph_world_get_" + attr
+    assert error(raw, fn, full.handle, ctypes.byref(p)).result == sph.Result.ERROR_VERSION_MISMATCH
+    assert error(raw, fn, full.handle, None).result == sph.Result.ERROR_INVALID_ARGUMENT
+    assert getattr(full, attr) == before
+
+
+def test_tait_speed_of_sound_must_be_positive(full):
+    assert error(full.set_tait_params, speed_of_sound=0.0).result == sph.Result.ERROR_INVALID_ARGUMENT
+    full.set_surface_tension_params(coefficient=0.0)  # sigma = 0 and beta = 0 are allowed
+    full.set_clavet_viscosity_params(linear=0.0, quadratic=0.0)
+
+
+def test_each_option_alone_enables_only_its_params(ctx):
+    with ctx.world(capacity=16, equation_of_state=sph.EquationOfState.TAIT) as w:
+        w.tait_params = sph.TaitParams(speed_of_sound=25)
+        assert w.tait_params.speed_of_sound == 25
+        assert error(_get, w, "clavet_viscosity_params").result == sph.Result.ERROR_FEATURE_DISABLED
+        assert error(_get, w, "surface_tension_params").result == sph.Result.ERROR_FEATURE_DISABLED
+    with ctx.world(capacity=16, features=sph.Feature.NORMALIZED_DENSITY) as w:
+        assert error(_get, w, "surface_tension_params").result == sph.Result.ERROR_FEATURE_DISABLED
+    with ctx.world(capacity=16, features="surface_tension") as w:
+        assert w.surface_tension_params.coefficient == pytest.approx(0.0728)
+
+
+def test_closed_world_option_calls_are_invalid_handle(ctx):
+    w = ctx.world(capacity=16, viscosity_method="clavet", equation_of_state="tait", features="surface_tension")
+    w.close()
+    for attr, _, cls, *_ in OPTIONS:
+        assert error(_get, w, attr).result == sph.Result.ERROR_INVALID_HANDLE
+        assert error(setattr, w, attr, cls()).result == sph.Result.ERROR_INVALID_HANDLE
+
+
+# ---- step limits ------------------------------------------------------------------------------------
+def test_step_limits_round_trip_and_validation(world):
+    p = world.set_params(step_limits=sph.StepLimit.ACOUSTIC)
+    assert world.params.step_limits is sph.StepLimit.ACOUSTIC and p == world.params
+    world.set_params(step_limits="acoustic|force")
+    assert world.params.step_limits == sph.StepLimit.ACOUSTIC | sph.StepLimit.FORCE
+    world.set_params(step_limits=0)
+    assert world.params.step_limits == 0
+    before = world.params
+    assert error(world.set_params, step_limits=0x80).result == sph.Result.ERROR_UNSUPPORTED
+    assert error(world.set_params, reserved0=1).result == sph.Result.ERROR_INVALID_ARGUMENT
+    assert world.params == before
+
+
+def test_acoustic_limit_with_a_fast_tait_sound_speed_takes_more_substeps(ctx):
+    """c = 100 m/s: dt <= 0.4 h / c = 1.4e-4 s, so a 1/120 s frame needs about 58 substeps."""
+    counts = {}
+    for limits in (0, sph.StepLimit.ACOUSTIC):
+        with ctx.world(capacity=2000, equation_of_state="tait") as w:
+            w.set_tait_params(speed_of_sound=100)
+            w.set_params(step_limits=limits)
+            w.fill_sphere((0, 0, 0), 0.04)
+            assert w.step(1 / 120) == sph.Result.OK
+            counts[limits] = w.stats().substeps
+    h = 1.8 * 0.02
+    assert counts[sph.StepLimit.ACOUSTIC] >= (1 / 120) / (0.4 * h / 100) - 1
+    assert counts[sph.StepLimit.ACOUSTIC] > 3 * counts[0]
+
+
+# ---- every option on: the world still steps ---------------------------------------------------------
+def test_a_world_with_every_option_steps(full):
+    full.set_params(step_limits="acoustic|force")
+    full.set_tait_params(speed_of_sound=30)
+    full.set_clavet_viscosity_params(linear=5, quadratic=1)
+    full.set_surface_tension_params(coefficient=0.05)
+    n = full.fill_sphere((0, 0, 0), 0.05)
+    assert full.step(1 / 240) == sph.Result.OK
+    s = full.stats()
+    assert s.particle_count == n and s.substeps > 0
+    assert np.isfinite(full.positions()).all() and np.isfinite(full.densities()).all()
