@@ -172,6 +172,58 @@ namespace Sph
         }
     }
 
+    /// <summary>World feature bits (SPH_FEATURE_*), fixed at world creation: set them with
+    /// <see cref="WorldDef.FeatureFlags"/>. A feature that is off allocates nothing and costs no
+    /// work; the parameters of a feature that is off throw <c>Result.ErrorFeatureDisabled</c>.</summary>
+    [Flags]
+    public enum FeatureFlags : uint
+    {
+        None = Constants.SPH_FEATURE_NONE,
+        /// <summary>Surface tension from the colour field (Morris 2000), parameters in
+        /// <see cref="World.SurfaceTensionParams"/>. EXPERIMENTAL (docs/physics.md).</summary>
+        SurfaceTension = Constants.SPH_FEATURE_SURFACE_TENSION,
+        /// <summary>Normalised density (thesis eq. 31): a second, Shepard-filtered density pass
+        /// that narrows the density deficit of particles near a free surface.</summary>
+        NormalizedDensity = Constants.SPH_FEATURE_NORMALIZED_DENSITY,
+    }
+
+    /// <summary>Step-size limits beyond eq. 32 (SPH_STEP_LIMIT_*): set them with
+    /// <see cref="WorldParams.StepLimitFlags"/>.</summary>
+    [Flags]
+    public enum StepLimitFlags : uint
+    {
+        /// <summary>eq. 32 alone (dt = step_factor h / v_max, within [dt_min, dt_max]).</summary>
+        None = 0,
+        /// <summary>dt &lt;= step_factor h / c, c the equation of state's speed of sound.</summary>
+        Acoustic = Constants.SPH_STEP_LIMIT_ACOUSTIC,
+        /// <summary>dt &lt;= step_factor sqrt(h / |a|_max).</summary>
+        Force = Constants.SPH_STEP_LIMIT_FORCE,
+    }
+
+    public partial struct WorldDef
+    {
+        /// <summary>The <see cref="Features"/> field as <see cref="Sph.FeatureFlags"/>:
+        /// <c>def.FeatureFlags = FeatureFlags.SurfaceTension | FeatureFlags.NormalizedDensity</c>.
+        /// The other options are the <see cref="ViscosityMethod"/> and
+        /// <see cref="EquationOfState"/> fields.</summary>
+        public FeatureFlags FeatureFlags
+        {
+            get { return (FeatureFlags)Features; }
+            set { Features = (uint)value; }
+        }
+    }
+
+    public partial struct WorldParams
+    {
+        /// <summary>The <see cref="StepLimits"/> field as <see cref="Sph.StepLimitFlags"/>:
+        /// <c>p.StepLimitFlags = StepLimitFlags.Acoustic</c>.</summary>
+        public StepLimitFlags StepLimitFlags
+        {
+            get { return (StepLimitFlags)StepLimits; }
+            set { StepLimits = (uint)value; }
+        }
+    }
+
     /// <summary>Called when a call on a context (or its worlds) fails; on the calling thread.</summary>
     public delegate void LogHandler(LogLevel level, Result code, string message);
 
@@ -321,6 +373,69 @@ namespace Sph
                 return p;
             }
             set { SphException.Check(Native.sph_world_set_params(Handle, ref value), "sph_world_set_params"); }
+        }
+
+        // ---- optional physics (docs/physics.md): chosen in the WorldDef, tuned here -----------
+
+        /// <summary>The feature bits the world was created with (WorldDef.Features).</summary>
+        public FeatureFlags Features { get { return Def.FeatureFlags; } }
+
+        /// <summary>The viscosity method the world was created with (WorldDef.ViscosityMethod).</summary>
+        public ViscosityMethod ViscosityMethod { get { return Def.ViscosityMethod; } }
+
+        /// <summary>The equation of state the world was created with (WorldDef.EquationOfState).</summary>
+        public EquationOfState EquationOfState { get { return Def.EquationOfState; } }
+
+        /// <summary>Surface-tension parameters (coefficient sigma in N/m, normal threshold in
+        /// 1/m) of a world created with <see cref="Sph.FeatureFlags.SurfaceTension"/>; setting
+        /// replaces them whole (validated, unchanged on error). Throws SphException
+        /// (<c>Result.ErrorFeatureDisabled</c>) when the world does not have the feature.</summary>
+        public SurfaceTensionParams SurfaceTensionParams
+        {
+            get
+            {
+                var p = SurfaceTensionParams.Default();
+                SphException.Check(Native.sph_world_get_surface_tension_params(Handle, ref p), "sph_world_get_surface_tension_params");
+                return p;
+            }
+            set
+            {
+                SphException.Check(Native.sph_world_set_surface_tension_params(Handle, ref value), "sph_world_set_surface_tension_params");
+            }
+        }
+
+        /// <summary>Clavet viscosity parameters (linear sigma in 1/s, quadratic beta in 1/m) of a
+        /// world created with <c>ViscosityMethod.Clavet</c>; setting replaces them whole. Throws
+        /// SphException (<c>Result.ErrorFeatureDisabled</c>) on a world with another viscosity
+        /// method.</summary>
+        public ClavetViscosityParams ClavetViscosityParams
+        {
+            get
+            {
+                var p = ClavetViscosityParams.Default();
+                SphException.Check(Native.sph_world_get_clavet_viscosity_params(Handle, ref p), "sph_world_get_clavet_viscosity_params");
+                return p;
+            }
+            set
+            {
+                SphException.Check(Native.sph_world_set_clavet_viscosity_params(Handle, ref value), "sph_world_set_clavet_viscosity_params");
+            }
+        }
+
+        /// <summary>Tait equation-of-state parameters (speed of sound c in m/s) of a world created
+        /// with <c>EquationOfState.Tait</c>; setting replaces them whole. Throws SphException
+        /// (<c>Result.ErrorFeatureDisabled</c>) on a world with another equation of state. Keep
+        /// c &gt;= 10 x the fastest flow and c dt below about 0.4 h (lower DtMax, or
+        /// <see cref="Sph.StepLimitFlags.Acoustic"/>).</summary>
+        public TaitParams TaitParams
+        {
+            get
+            {
+                var p = TaitParams.Default();
+                SphException.Check(Native.sph_world_get_tait_params(Handle, ref p), "sph_world_get_tait_params");
+                return p;
+            }
+            set { SphException.Check(Native.sph_world_set_tait_params(Handle, ref value), "sph_world_set_tait_params"); }
         }
 
         // ---- particles in ---------------------------------------------------------------------

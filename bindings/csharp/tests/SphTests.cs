@@ -365,6 +365,233 @@ static class Tests
         AssertEqual(Constants.SPH_STAGE_COUNT, FixedFloat8.Length, "stage array length");
     }
 
+    // ---- optional physics: def options, flags, option parameters ------------------------------
+
+    static WorldDef AllOptions(uint capacity = 4096)
+    {
+        var d = SmallWorld(capacity);
+        d.ViscosityMethod = ViscosityMethod.Clavet;
+        d.EquationOfState = EquationOfState.Tait;
+        d.FeatureFlags = FeatureFlags.SurfaceTension | FeatureFlags.NormalizedDensity;
+        return d;
+    }
+
+    static string Pascal(string upperSnake)
+    {
+        var sb = new System.Text.StringBuilder();
+        foreach (string part in upperSnake.Split('_'))
+            if (part.Length > 0) sb.Append(part.Substring(0, 1)).Append(part.Substring(1).ToLowerInvariant());
+        return sb.ToString();
+    }
+
+    /// Every SPH_FEATURE_* and SPH_STEP_LIMIT_* constant of the header has its member in the
+    /// hand-written flag enums (a bit added to the header fails here until Sph.cs has it).
+    public static void TestFlagEnumsCoverTheHeaderConstants()
+    {
+        int checkedCount = 0;
+        foreach (FieldInfo f in typeof(Constants).GetFields(BindingFlags.Public | BindingFlags.Static))
+        {
+            Type flags = f.Name.StartsWith("SPH_FEATURE_") ? typeof(FeatureFlags)
+                       : f.Name.StartsWith("SPH_STEP_LIMIT_") ? typeof(StepLimitFlags) : null;
+            if (flags == null) continue;
+            string member = Pascal(f.Name.Substring(flags == typeof(FeatureFlags) ? "SPH_FEATURE_".Length : "SPH_STEP_LIMIT_".Length));
+            object value = Enum.ToObject(flags, Convert.ToUInt32(f.GetValue(null)));
+            Assert(Enum.IsDefined(flags, value), flags.Name + " lacks " + f.Name);
+            AssertEqual(member, Enum.GetName(flags, value), flags.Name + " member of " + f.Name);
+            ++checkedCount;
+        }
+        Assert(checkedCount >= 5, "feature and step-limit constants found: " + checkedCount);
+        AssertEqual(3u, (uint)(FeatureFlags.SurfaceTension | FeatureFlags.NormalizedDensity), "feature bits");
+        var d = WorldDef.Default();
+        AssertEqual(FeatureFlags.None, d.FeatureFlags, "default features");
+        d.FeatureFlags = FeatureFlags.NormalizedDensity;
+        AssertEqual(Constants.SPH_FEATURE_NORMALIZED_DENSITY, d.Features, "FeatureFlags writes Features");
+        var p = WorldParams.Default();
+        AssertEqual(StepLimitFlags.None, p.StepLimitFlags, "default step limits");
+        p.StepLimitFlags = StepLimitFlags.Acoustic | StepLimitFlags.Force;
+        AssertEqual(Constants.SPH_STEP_LIMIT_ACOUSTIC | Constants.SPH_STEP_LIMIT_FORCE, p.StepLimits, "StepLimitFlags writes StepLimits");
+    }
+
+    public static void TestWorldDefOptions()
+    {
+        using (var ctx = Cpu())
+        {
+            using (var world = ctx.CreateWorld(AllOptions()))
+            {
+                WorldDef d = world.Def;
+                AssertEqual(ViscosityMethod.Clavet, d.ViscosityMethod, "viscosity method");
+                AssertEqual(EquationOfState.Tait, d.EquationOfState, "equation of state");
+                AssertEqual(FeatureFlags.SurfaceTension | FeatureFlags.NormalizedDensity, d.FeatureFlags, "features");
+                AssertEqual(d.FeatureFlags, world.Features, "World.Features");
+                AssertEqual(ViscosityMethod.Clavet, world.ViscosityMethod, "World.ViscosityMethod");
+                AssertEqual(EquationOfState.Tait, world.EquationOfState, "World.EquationOfState");
+            }
+            using (var plain = ctx.CreateWorld(SmallWorld()))
+            {
+                AssertEqual(FeatureFlags.None, plain.Features, "no features by default");
+                AssertEqual(ViscosityMethod.Mueller, plain.ViscosityMethod, "Mueller by default");
+                AssertEqual(EquationOfState.IdealGas, plain.EquationOfState, "ideal gas by default");
+            }
+            var bad = SmallWorld();
+            bad.ViscosityMethod = (ViscosityMethod)9;
+            Throws(Result.ErrorUnsupported, () => ctx.CreateWorld(bad));
+            bad = SmallWorld();
+            bad.EquationOfState = (EquationOfState)9;
+            Throws(Result.ErrorUnsupported, () => ctx.CreateWorld(bad));
+            bad = SmallWorld();
+            bad.FeatureFlags = (FeatureFlags)0x80;
+            Throws(Result.ErrorUnsupported, () => ctx.CreateWorld(bad));
+        }
+    }
+
+    public static void TestOptionParamsFeatureDisabled()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(SmallWorld()))
+        {
+            Throws(Result.ErrorFeatureDisabled, () => { var p = world.SurfaceTensionParams; });
+            Throws(Result.ErrorFeatureDisabled, () => world.SurfaceTensionParams = SurfaceTensionParams.Default());
+            Throws(Result.ErrorFeatureDisabled, () => { var p = world.ClavetViscosityParams; });
+            Throws(Result.ErrorFeatureDisabled, () => world.ClavetViscosityParams = ClavetViscosityParams.Default());
+            Throws(Result.ErrorFeatureDisabled, () => { var p = world.TaitParams; });
+            var e = Throws(Result.ErrorFeatureDisabled, () => world.TaitParams = TaitParams.Default());
+            AssertEqual("sph_world_set_tait_params", e.Function, "the failing function");
+        }
+        using (var ctx = Cpu())
+        {
+            var d = SmallWorld();
+            d.FeatureFlags = FeatureFlags.NormalizedDensity;  // not surface tension
+            d.EquationOfState = EquationOfState.Tait;
+            using (var world = ctx.CreateWorld(d))
+            {
+                Throws(Result.ErrorFeatureDisabled, () => { var p = world.SurfaceTensionParams; });
+                Throws(Result.ErrorFeatureDisabled, () => { var p = world.ClavetViscosityParams; });
+                AssertEqual(10f, world.TaitParams.SpeedOfSound, "only Tait is on");
+            }
+        }
+    }
+
+    public static void TestOptionParamsRoundTripAndValidation()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(AllOptions()))
+        {
+            // Defaults: the structs' Default() (the library's init functions).
+            SurfaceTensionParams st = world.SurfaceTensionParams;
+            AssertEqual(SurfaceTensionParams.Default(), st, "surface tension defaults");
+            AssertEqual(0.0728f, st.Coefficient, "sigma default");
+            AssertEqual(0f, st.NormalThreshold, "threshold default");
+            ClavetViscosityParams cv = world.ClavetViscosityParams;
+            AssertEqual(ClavetViscosityParams.Default(), cv, "Clavet defaults");
+            AssertEqual(10f, cv.Linear, "linear default");
+            TaitParams tp = world.TaitParams;
+            AssertEqual(TaitParams.Default(), tp, "Tait defaults");
+            AssertEqual(10f, tp.SpeedOfSound, "speed of sound default");
+
+            // Round trips.
+            st.Coefficient = 0.5f;
+            st.NormalThreshold = 3f;
+            world.SurfaceTensionParams = st;
+            AssertEqual(st, world.SurfaceTensionParams, "surface tension round trip");
+            cv.Linear = 20f;
+            cv.Quadratic = 2f;
+            world.ClavetViscosityParams = cv;
+            AssertEqual(cv, world.ClavetViscosityParams, "Clavet round trip");
+            tp.SpeedOfSound = 40f;
+            world.TaitParams = tp;
+            AssertEqual(tp, world.TaitParams, "Tait round trip");
+
+            // Validation: refused, nothing changes.
+            var badSt = st;
+            badSt.Coefficient = -1f;
+            Throws(Result.ErrorInvalidArgument, () => world.SurfaceTensionParams = badSt);
+            badSt = st;
+            badSt.NormalThreshold = float.NaN;
+            Throws(Result.ErrorInvalidArgument, () => world.SurfaceTensionParams = badSt);
+            badSt = st;
+            badSt.Reserved0 = 1;
+            Throws(Result.ErrorInvalidArgument, () => world.SurfaceTensionParams = badSt);
+            badSt = st;
+            badSt.StructSize = 4;
+            Throws(Result.ErrorVersionMismatch, () => world.SurfaceTensionParams = badSt);
+            AssertEqual(st, world.SurfaceTensionParams, "surface tension unchanged after errors");
+
+            var badCv = cv;
+            badCv.Quadratic = -2f;
+            Throws(Result.ErrorInvalidArgument, () => world.ClavetViscosityParams = badCv);
+            badCv = cv;
+            badCv.Linear = float.PositiveInfinity;
+            Throws(Result.ErrorInvalidArgument, () => world.ClavetViscosityParams = badCv);
+            badCv = cv;
+            badCv.Reserved0 = 1;
+            Throws(Result.ErrorInvalidArgument, () => world.ClavetViscosityParams = badCv);
+            AssertEqual(cv, world.ClavetViscosityParams, "Clavet unchanged after errors");
+
+            var badTp = tp;
+            badTp.SpeedOfSound = 0f;
+            Throws(Result.ErrorInvalidArgument, () => world.TaitParams = badTp);
+            badTp.SpeedOfSound = float.NaN;
+            Throws(Result.ErrorInvalidArgument, () => world.TaitParams = badTp);
+            badTp = tp;
+            badTp.StructSize = 4;
+            Throws(Result.ErrorVersionMismatch, () => world.TaitParams = badTp);
+            AssertEqual(tp, world.TaitParams, "Tait unchanged after errors");
+
+            // Every option on: the world still steps.
+            var p = world.Params;
+            p.StepLimitFlags = StepLimitFlags.Acoustic | StepLimitFlags.Force;
+            world.Params = p;
+            uint n = world.FillSphere(new Vec3(0, 0, 0), 0.05f);
+            AssertEqual(Result.Ok, world.Step(1f / 240f), "step with every option");
+            AssertEqual(n, world.GetStats().ParticleCount, "particles after the step");
+            foreach (var x in world.Positions())
+                Assert(!float.IsNaN(x.X + x.Y + x.Z) && !float.IsInfinity(x.X + x.Y + x.Z), "finite positions");
+        }
+    }
+
+    public static void TestStepLimits()
+    {
+        using (var ctx = Cpu())
+        {
+            using (var world = ctx.CreateWorld(SmallWorld()))
+            {
+                var p = world.Params;
+                p.StepLimitFlags = StepLimitFlags.Acoustic | StepLimitFlags.Force;
+                world.Params = p;
+                AssertEqual(StepLimitFlags.Acoustic | StepLimitFlags.Force, world.Params.StepLimitFlags, "step limits round trip");
+                var bad = p;
+                bad.StepLimits = 0x80;
+                Throws(Result.ErrorUnsupported, () => world.Params = bad);
+                bad = p;
+                bad.Reserved0 = 1;
+                Throws(Result.ErrorInvalidArgument, () => world.Params = bad);
+                AssertEqual(p, world.Params, "params unchanged after errors");
+            }
+            // Tait with c = 100 m/s: the acoustic limit gives dt <= 0.4 h / c, about 58 substeps per 1/120 s.
+            var substeps = new uint[2];
+            for (int i = 0; i < 2; ++i)
+            {
+                var d = SmallWorld(2000);
+                d.EquationOfState = EquationOfState.Tait;
+                using (var world = ctx.CreateWorld(d))
+                {
+                    var tp = world.TaitParams;
+                    tp.SpeedOfSound = 100f;
+                    world.TaitParams = tp;
+                    var p = world.Params;
+                    p.StepLimitFlags = i == 0 ? StepLimitFlags.None : StepLimitFlags.Acoustic;
+                    world.Params = p;
+                    world.FillSphere(new Vec3(0, 0, 0), 0.04f);
+                    AssertEqual(Result.Ok, world.Step(1f / 120f), "step");
+                    substeps[i] = world.GetStats().Substeps;
+                }
+            }
+            double h = 1.8 * 0.02;
+            Assert(substeps[1] >= (1.0 / 120) / (0.4 * h / 100) - 1, "acoustic limit substeps: " + substeps[1]);
+            Assert(substeps[1] > 3 * substeps[0], "acoustic limit " + substeps[1] + " vs none " + substeps[0]);
+        }
+    }
+
     // ---- SDF assets, colliders, sources, sinks, force fields, events -------------------------
 
     static Sdf Ball(Context ctx, float radius)
