@@ -172,11 +172,15 @@ class CpuBackend final : public Backend {
  private:
   static constexpr uint32_t kAllFinite = 0xffffffffu;
 
+  // Threads for a loop over the particles: small worlds run on the calling thread alone, where
+  // waking a team (and its spinning idle threads) would cost more than the work.
+  unsigned threads() const { return count_ >= kParallelMinimum ? workers_ : 1u; }
+
   int n() const { return static_cast<int>(count_); }
 
   float compute_max_speed() const {
     float v2max = 0.0f;
-#pragma omp parallel for num_threads(workers_) schedule(static) reduction(max : v2max)
+#pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : v2max)
     for (int i = 0; i < n(); ++i) v2max = std::max(v2max, length_squared(xyz(velocity_.data[i])));
     return std::sqrt(v2max);
   }
@@ -192,7 +196,7 @@ class CpuBackend final : public Backend {
     const GridView view = grid_.view();
     Float4* pos = position_.data.data();
     Float4* vel = velocity_.data.data();
-#pragma omp parallel for num_threads(workers_) schedule(static)
+#pragma omp parallel for num_threads(threads()) schedule(static)
     for (int i = 0; i < n(); ++i) {
       const DensitySample s = gather_density(fluid, view, pos, static_cast<uint32_t>(i));
       density_.data[i] = s.density;
@@ -204,10 +208,10 @@ class CpuBackend final : public Backend {
     if (config_.features & kFeatureNormalizedDensity) {
       // Eq. 31 needs every rho_j of the first pass: compute into a side array, then publish.
       normalized_.resize(count_);
-#pragma omp parallel for num_threads(workers_) schedule(static)
+#pragma omp parallel for num_threads(threads()) schedule(static)
       for (int i = 0; i < n(); ++i)
         normalized_[i] = gather_normalized_density(fluid, view, pos, vel, static_cast<uint32_t>(i));
-#pragma omp parallel for num_threads(workers_) schedule(static)
+#pragma omp parallel for num_threads(threads()) schedule(static)
       for (int i = 0; i < n(); ++i) {
         density_.data[i] = normalized_[i];
         pos[i].w = pressure_from_density(fluid.eos, normalized_[i]);
@@ -217,7 +221,7 @@ class CpuBackend final : public Backend {
     if (config_.features & kFeatureSurfaceTension) {
       // Colour-field normals of every particle, which the force gather reads for neighbours.
       normals_.resize(count_);
-#pragma omp parallel for num_threads(workers_) schedule(static)
+#pragma omp parallel for num_threads(threads()) schedule(static)
       for (int i = 0; i < n(); ++i)
         normals_[i] = gather_colour_normal(fluid, view, pos, vel, static_cast<uint32_t>(i));
     }
@@ -251,7 +255,7 @@ class CpuBackend final : public Backend {
     if (scene.colliders.empty()) return;
     const auto t = Clock::now();
     const float h = config_.kernel_radius;
-#pragma omp parallel for num_threads(workers_) schedule(static)
+#pragma omp parallel for num_threads(threads()) schedule(static)
     for (int i = 0; i < n(); ++i) {
       Vec3 x = xyz(next_position_[i]);
       Vec3 v = xyz(next_velocity_[i]);
@@ -267,7 +271,7 @@ class CpuBackend final : public Backend {
   uint32_t scan_next_state(float& v2max) const {
     float m = 0.0f;
     uint32_t bad_index = kAllFinite;
-#pragma omp parallel for num_threads(workers_) schedule(static) reduction(max : m) reduction(min : bad_index)
+#pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : m) reduction(min : bad_index)
     for (int i = 0; i < n(); ++i) {
       const float v2 = length_squared(xyz(next_velocity_[i]));
       m = std::max(m, v2);
@@ -299,7 +303,7 @@ class CpuBackend final : public Backend {
     const AccelerationFn acceleration = acceleration_function();
     const uint32_t* counts = neighbors_.data.data();
     float a2max = 0.0f;
-#pragma omp parallel for num_threads(workers_) schedule(static) reduction(max : a2max)
+#pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
     for (int i = 0; i < n(); ++i) {
       const Vec3 a =
           acceleration(fluid, view, pos, vel, counts, normals_.data(), scene, static_cast<uint32_t>(i));
@@ -337,7 +341,7 @@ class CpuBackend final : public Backend {
       const Float4* pos = position_.data.data();
       const Float4* vel = velocity_.data.data();
       const uint32_t* counts = neighbors_.data.data();
-#pragma omp parallel for num_threads(workers_) schedule(static) reduction(max : a2max)
+#pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
       for (int i = 0; i < n(); ++i) {
         const Vec3 a =
             acceleration(fluid, view, pos, vel, counts, normals_.data(), scene, static_cast<uint32_t>(i));

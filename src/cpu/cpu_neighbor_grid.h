@@ -11,6 +11,9 @@
 
 namespace sph {
 
+// Below this many particles the CPU backend's loops run on one thread.
+constexpr uint32_t kParallelMinimum = 4096;
+
 class CpuNeighborGrid {
  public:
   explicit CpuNeighborGrid(const GridShape& shape) : shape_(shape) {}
