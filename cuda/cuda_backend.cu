@@ -39,7 +39,10 @@ bool same_setup(const PipelineSetup& a, const PipelineSetup& b) {
   return a.count == b.count && a.integrator == b.integrator && a.max_substeps == b.max_substeps &&
          std::memcmp(&a.fluid, &b.fluid, sizeof a.fluid) == 0 &&
          std::memcmp(&a.limits, &b.limits, sizeof a.limits) == 0 &&
-         a.tuning.density_block == b.tuning.density_block && a.tuning.force_block == b.tuning.force_block;
+         a.tuning.density_block == b.tuning.density_block && a.tuning.force_block == b.tuning.force_block &&
+         a.options.surface_tension == b.options.surface_tension &&
+         a.options.normalized_density == b.options.normalized_density &&
+         a.options.viscosity == b.options.viscosity;
 }
 
 // Everything the backend holds on the device. Released with the backend's device current.
@@ -79,7 +82,15 @@ class CudaBackend final : public Backend {
     cuda_check(cudaStreamCreateWithFlags(&r->stream, cudaStreamNonBlocking), "cudaStreamCreate");
     cuda_check(cudaEventCreate(&r->frame_start), "cudaEventCreate");
     cuda_check(cudaEventCreate(&r->frame_stop), "cudaEventCreate");
-    r->store = std::make_unique<DeviceParticleStore>(config.capacity, config.integrator == Integrator::Rk4);
+    options_.surface_tension = (config.features & kFeatureSurfaceTension) != 0;
+    options_.normalized_density = (config.features & kFeatureNormalizedDensity) != 0;
+    options_.viscosity = config.viscosity_method;
+    StoreOptions store_options;
+    store_options.rk4 = config.integrator == Integrator::Rk4;
+    store_options.neighbor_counts = options_.viscosity == ViscosityMethod::Clavet;
+    store_options.normalized_density = options_.normalized_density;
+    store_options.colour_normals = options_.surface_tension;
+    r->store = std::make_unique<DeviceParticleStore>(config.capacity, store_options);
     // The sorted positions are free while the sort runs: its temporary storage goes there.
     r->grid = std::make_unique<DeviceNeighborGrid>(
         make_grid_shape(config.kernel_radius, config.capacity), config.capacity, r->store->sort_scratch(),
@@ -164,6 +175,7 @@ class CudaBackend final : public Backend {
     setup.fluid = make_fluid_constants(config_, params);
     setup.limits = make_step_limits(config_, params);
     setup.max_substeps = params.max_substeps;
+    setup.options = options_;
     setup.tuning = tuning_;
     float frame_ms = 0.0f;
     guarded([&] {
@@ -372,6 +384,7 @@ class CudaBackend final : public Backend {
   WorldConfig config_;
   int device_;
   KernelTuning tuning_;
+  SubstepOptions options_;
   bool use_graphs_ = true;
   uint32_t count_ = 0;
   uint64_t epoch_ = 1;

@@ -2,7 +2,8 @@
 
 namespace sph {
 
-DeviceParticleStore::DeviceParticleStore(uint32_t capacity, bool rk4) : capacity_(capacity) {
+DeviceParticleStore::DeviceParticleStore(uint32_t capacity, const StoreOptions& options)
+    : capacity_(capacity) {
   const size_t n = capacity;
   position_.allocate(n, "positions");
   velocity_.allocate(n, "velocities");
@@ -15,7 +16,10 @@ DeviceParticleStore::DeviceParticleStore(uint32_t capacity, bool rk4) : capacity
   snapshot_velocity_.allocate(n, "snapshot velocities");
   snapshot_id_.allocate(n, "snapshot ids");
   snapshot_density_.allocate(n, "snapshot densities");
-  if (rk4) {
+  if (options.neighbor_counts) neighbor_count_.allocate(n, "neighbour counts");
+  if (options.normalized_density) normalized_density_.allocate(n, "normalised densities");
+  if (options.colour_normals) colour_normal_.allocate(n, "colour-field normals");
+  if (options.rk4) {
     for (int side = 0; side < 2; ++side) {
       rk4_start_[side].allocate(n, "RK4 start states");
       rk4_sum_[side].allocate(n, "RK4 slope sums");
@@ -28,6 +32,9 @@ DeviceParticleStore::DeviceParticleStore(uint32_t capacity, bool rk4) : capacity
   arrays_.sorted_position = sorted_position_.get();
   arrays_.sorted_velocity = sorted_velocity_.get();
   arrays_.sorted_id = sorted_id_.get();
+  arrays_.neighbor_count = neighbor_count_.get();
+  arrays_.normalized_density = normalized_density_.get();
+  arrays_.colour_normal = colour_normal_.get();
   for (int side = 0; side < 2; ++side) {
     arrays_.rk4_start[side] = rk4_start_[side].get();
     arrays_.rk4_sum[side] = rk4_sum_[side].get();
@@ -71,6 +78,7 @@ uint64_t DeviceParticleStore::bytes() const {
                    snapshot_position_.bytes() + snapshot_velocity_.bytes() + snapshot_id_.bytes() +
                    snapshot_density_.bytes();
   for (int side = 0; side < 2; ++side) total += rk4_start_[side].bytes() + rk4_sum_[side].bytes();
+  total += neighbor_count_.bytes() + normalized_density_.bytes() + colour_normal_.bytes();
   return total;
 }
 

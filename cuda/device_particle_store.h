@@ -7,6 +7,10 @@
 //                                 buffers, which are dead before the density pass fills it.
 //   snapshot_*                    the state at the start of a frame, for the rollback
 //   rk4_*                         RK4 worlds only: start state and slope sums, two sides
+//   neighbor_count, normalized_density, colour_normal
+//                                 per-substep side arrays of the physics options (Clavet
+//                                 viscosity, normalised density, surface tension), allocated
+//                                 only for a world that uses the option
 // Float4 records carry a second quantity in w: position.w = pressure, velocity.w = 1/density.
 #pragma once
 
@@ -31,6 +35,17 @@ struct ParticleArrays {
   uint32_t* sorted_id;
   ParticleState* rk4_start[2];  // null unless RK4
   Rk4Accumulator* rk4_sum[2];
+  uint32_t* neighbor_count;   // null unless Clavet viscosity: the density pass's counts
+  float* normalized_density;  // null unless normalised density: eq. 31 before it is published
+  Float4* colour_normal;      // null unless surface tension: (n, |n|) of the colour field
+};
+
+// Which optional arrays a world needs.
+struct StoreOptions {
+  bool rk4 = false;
+  bool neighbor_counts = false;
+  bool normalized_density = false;
+  bool colour_normals = false;
 };
 
 // The radix sort's buffers inside sorted_velocity: four uint32 arrays of `capacity` each.
@@ -41,7 +56,7 @@ struct SortScratch {
 
 class DeviceParticleStore {
  public:
-  DeviceParticleStore(uint32_t capacity, bool rk4);
+  DeviceParticleStore(uint32_t capacity, const StoreOptions& options);
 
   const ParticleArrays& arrays() const { return arrays_; }
   SortScratch sort_scratch() const;
@@ -63,6 +78,9 @@ class DeviceParticleStore {
   DeviceArray<float> snapshot_density_;
   DeviceArray<ParticleState> rk4_start_[2];
   DeviceArray<Rk4Accumulator> rk4_sum_[2];
+  DeviceArray<uint32_t> neighbor_count_;
+  DeviceArray<float> normalized_density_;
+  DeviceArray<Float4> colour_normal_;
   ParticleArrays arrays_{};
 };
 

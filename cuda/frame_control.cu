@@ -8,7 +8,8 @@ namespace sph {
 namespace {
 
 __device__ void pick_next_step(FrameState* s, const StepLimits& limits) {
-  s->dt = landing_dt(static_cast<double>(controller_dt(limits, s->max_speed)), s->remaining);
+  s->dt =
+      landing_dt(static_cast<double>(controller_dt(limits, s->max_speed, s->max_acceleration)), s->remaining);
   s->dt_float = static_cast<float>(s->dt);
 }
 
@@ -29,6 +30,7 @@ __global__ void begin_frame_kernel(FrameState* s, StepLimits limits, uint32_t ma
   s->dt_max = 0.0f;
   s->non_finite = 0;
   s->v2max_bits = 0;
+  s->a2max_bits = 0;
   s->bad_id = 0;
   s->bad_substep = 0;
   s->bad_dt = 0.0f;
@@ -43,7 +45,12 @@ __global__ void end_substep_kernel(FrameState* s, StepLimits limits, uint32_t ma
                                    LoopCondition cond) {
   mark_stage(s, kStageIntegrate);
   const float v2max = __uint_as_float(s->v2max_bits);
+  const float a2max = __uint_as_float(s->a2max_bits);
   s->v2max_bits = 0;
+  s->a2max_bits = 0;
+  // As the CPU backend: symplectic Euler keeps the force pass's |a|max even when the substep
+  // then fails; RK4 keeps the max over its four stages only when all of them succeeded.
+  if (stages == 1) s->max_acceleration = sqrtf(a2max);
   for (int k = 0; k < stages; ++k) {
     if (s->bad_key[k] != kNoBadParticle) {
       s->non_finite = 1;
@@ -55,6 +62,7 @@ __global__ void end_substep_kernel(FrameState* s, StepLimits limits, uint32_t ma
     }
   }
   s->max_speed = sqrtf(v2max);
+  if (stages != 1) s->max_acceleration = sqrtf(a2max);
   s->remaining -= s->dt;
   s->substeps += 1;
   s->time_advanced += s->dt;

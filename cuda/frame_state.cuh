@@ -26,10 +26,12 @@ struct FrameState {
   float dt_min;
   float dt_max;
   uint32_t substeps;
-  uint32_t run;         // 1 while the loop goes on
-  uint32_t non_finite;  // 1 once a substep produced NaN/Inf
-  uint32_t v2max_bits;  // max |v|^2 of this substep as float bits (non-negative: uint order)
-  uint32_t bad_id;      // id of the first non-finite particle
+  uint32_t run;            // 1 while the loop goes on
+  uint32_t non_finite;     // 1 once a substep produced NaN/Inf
+  uint32_t v2max_bits;     // max |v|^2 of this substep as float bits (non-negative: uint order)
+  uint32_t a2max_bits;     // max |a|^2 of this substep's force evaluations, likewise
+  float max_acceleration;  // |a|max of the last substep, for the force step limit; persists
+  uint32_t bad_id;         // id of the first non-finite particle
   uint32_t bad_substep;
   float bad_dt;
   // Per RK4 stage (symplectic Euler uses [0]): (sorted index << 32 | id), the minimum wins,

@@ -1,7 +1,9 @@
 #include "../src/physics/density.h"
+#include "../src/physics/density_normalization.h"
 #include "../src/physics/equation_of_state.h"
 #include "../src/physics/forces.h"
 #include "../src/physics/integrate.h"
+#include "../src/physics/surface_normal.h"
 #include "block_reduce.cuh"
 #include "kernel_launch.h"
 #include "substep_kernels.h"
@@ -19,14 +21,19 @@ __device__ __forceinline__ bool finite3(Vec3 v) { return isfinite(v.x) && isfini
 // threads had a neighbour, i.e. for almost every candidate, since only about a fifth of the
 // 27-cell candidates are within h. (Collecting a whole particle's neighbours in a shared-memory
 // list first, for one longer second phase, measured slower: occupancy and latency.)
+// The options as in gather_acceleration_with: neighbor_counts for Clavet viscosity, normals for
+// surface tension (either may be null otherwise).
+template <bool kSurfaceTension, ViscosityMethod kViscosity>
 __device__ __forceinline__ Vec3 gather_acceleration_masked(const FluidConstants& f, const GridView& grid,
                                                            const Float4* __restrict__ positions,
                                                            const Float4* __restrict__ velocities,
-                                                           uint32_t i) {
+                                                           const uint32_t* __restrict__ neighbor_counts,
+                                                           const Float4* __restrict__ normals, uint32_t i) {
   const Float4 pi = positions[i];
   const Float4 vi = velocities[i];
   const Vec3 xi = xyz(pi);
   const Vec3 v_i = xyz(vi);
+  const float n_i = kViscosity == ViscosityMethod::Clavet ? static_cast<float>(neighbor_counts[i]) : 0.0f;
   AccelerationSums sums = zero_acceleration_sums();
   for_each_neighbor_range(grid, xi, [&](uint32_t begin, uint32_t end) {
     for (uint32_t base = begin; base < end; base += 32u) {
@@ -42,11 +49,16 @@ __device__ __forceinline__ Vec3 gather_acceleration_masked(const FluidConstants&
         hits &= hits - 1u;
         const Float4 pj = positions[j];
         const Vec3 d = xi - xyz(pj);
-        add_neighbor_acceleration(f, pi, v_i, pj, velocities[j], d, length_squared(d), sums);
+        const float pair =
+            kViscosity == ViscosityMethod::Clavet ? n_i + static_cast<float>(neighbor_counts[j]) : 0.0f;
+        add_neighbor_acceleration<kSurfaceTension, kViscosity>(
+            f, pi, v_i, pj, velocities[j], d, length_squared(d), sums, pair,
+            kSurfaceTension ? normals + i : nullptr, kSurfaceTension ? normals + j : nullptr);
       }
     }
   });
-  return finish_acceleration(f, vi, sums);
+  return finish_acceleration<kSurfaceTension, kViscosity>(f, vi, sums,
+                                                          kSurfaceTension ? normals + i : nullptr);
 }
 
 __device__ __forceinline__ void flag_non_finite(FrameState* s, int stage, uint32_t index, uint32_t id) {
@@ -77,6 +89,7 @@ __global__ void reorder_kernel(ParticleArrays a, const uint32_t* __restrict__ or
   }
 }
 
+template <bool kCounts>
 __global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
                                FrameState* state) {
   mark_stage(state, kStageDensity);
@@ -87,22 +100,49 @@ __global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArra
   const uint32_t k = __float_as_uint(a.sorted_position[i].w);
   const DensitySample s = gather_density(fluid, grid, a.sorted_position, i);
   a.density[i] = s.density;
+  if (kCounts) a.neighbor_count[i] = s.neighbor_count;
   a.sorted_position[i].w = pressure_from_density(fluid.eos, s.density);
   const Float4 v = a.velocity[k];
   a.sorted_velocity[i] = make_float4_record(xyz(v), 1.0f / s.density);
 }
 
+// Eq. 31 reads every rho_j of the first pass: computed into a side array, then published.
+__global__ void normalized_density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  a.normalized_density[i] = gather_normalized_density(fluid, grid, a.sorted_position, a.sorted_velocity, i);
+}
+
+__global__ void publish_normalized_density_kernel(FluidConstants fluid, ParticleArrays a, uint32_t n) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const float rho = a.normalized_density[i];
+  a.density[i] = rho;
+  a.sorted_position[i].w = pressure_from_density(fluid.eos, rho);
+  a.sorted_velocity[i].w = 1.0f / rho;
+}
+
+__global__ void colour_normal_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  a.colour_normal[i] = gather_colour_normal(fluid, grid, a.sorted_position, a.sorted_velocity, i);
+}
+
+template <bool kSurfaceTension, ViscosityMethod kViscosity>
 __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
                                     FrameState* state) {
   mark_stage(state, kStageForces);
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  float v2 = 0.0f;
+  float v2 = 0.0f, a2 = 0.0f;
   if (i < n) {
-    const float dt = state->dt_float;
-    const Vec3 acc = gather_acceleration_masked(fluid, grid, a.sorted_position, a.sorted_velocity, i);
+    FluidConstants f = fluid;
+    f.dt = state->dt_float;  // impulse-based terms need the substep's length
+    const Vec3 acc = gather_acceleration_masked<kSurfaceTension, kViscosity>(
+        f, grid, a.sorted_position, a.sorted_velocity, a.neighbor_count, a.colour_normal, i);
+    a2 = length_squared(acc);
     const Float4 p = a.sorted_position[i];
     const Float4 v = a.sorted_velocity[i];
-    const ParticleState next = symplectic_euler(ParticleState{xyz(p), xyz(v)}, acc, dt);
+    const ParticleState next = symplectic_euler(ParticleState{xyz(p), xyz(v)}, acc, f.dt);
     const uint32_t id = a.sorted_id[i];
     a.position[i] = make_float4_record(next.position, p.w);
     a.velocity[i] = make_float4_record(next.velocity, v.w);
@@ -114,24 +154,30 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
     }
   }
   block_max_to(&state->v2max_bits, v2);
+  __syncthreads();  // block_max_to's shared slots are reused
+  block_max_to(&state->a2max_bits, a2);
 }
 
+template <bool kSurfaceTension, ViscosityMethod kViscosity>
 __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
                                   int stage, FrameState* state) {
   mark_stage(state, kStageForces);
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  float v2 = 0.0f;
+  float v2 = 0.0f, a2 = 0.0f;
   if (i < n) {
     // This stage's side, (stage + 1) % 2, picked without a run-time index into the struct.
     ParticleState* start = (stage & 1) ? a.rk4_start[0] : a.rk4_start[1];
     Rk4Accumulator* sums = (stage & 1) ? a.rk4_sum[0] : a.rk4_sum[1];
-    const float dt = state->dt_float;
-    const Vec3 acc = gather_acceleration_masked(fluid, grid, a.sorted_position, a.sorted_velocity, i);
+    FluidConstants f = fluid;
+    f.dt = state->dt_float;
+    const Vec3 acc = gather_acceleration_masked<kSurfaceTension, kViscosity>(
+        f, grid, a.sorted_position, a.sorted_velocity, a.neighbor_count, a.colour_normal, i);
+    a2 = length_squared(acc);
     const Float4 p = a.sorted_position[i];
     const Float4 v = a.sorted_velocity[i];
     Rk4Accumulator sum;
     if (stage > 0) sum = sums[i];  // stage 0 starts the sums
-    const ParticleState next = rk4_advance(stage, start[i], ParticleState{xyz(p), xyz(v)}, acc, dt, sum);
+    const ParticleState next = rk4_advance(stage, start[i], ParticleState{xyz(p), xyz(v)}, acc, f.dt, sum);
     sums[i] = sum;
     const uint32_t id = a.sorted_id[i];
     a.position[i] = make_float4_record(next.position, p.w);
@@ -144,8 +190,47 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
     }
     if (stage != kRk4Stages - 1) v2 = 0.0f;  // the speed that counts is the final state's
   }
-  if (stage == kRk4Stages - 1) block_max_to(&state->v2max_bits, v2);
+  if (stage == kRk4Stages - 1) {
+    block_max_to(&state->v2max_bits, v2);
+    __syncthreads();
+  }
+  block_max_to(&state->a2max_bits, a2);  // over all four stages, as the CPU backend
 }
+
+// One launch site per option combination: a world that does not use an option runs code
+// without it.
+template <template <bool, ViscosityMethod> class Launch, class... Args>
+void dispatch_options(const SubstepOptions& o, Args&&... args) {
+  if (o.viscosity == ViscosityMethod::Clavet) {
+    if (o.surface_tension)
+      Launch<true, ViscosityMethod::Clavet>::run(args...);
+    else
+      Launch<false, ViscosityMethod::Clavet>::run(args...);
+  } else {
+    if (o.surface_tension)
+      Launch<true, ViscosityMethod::Mueller>::run(args...);
+    else
+      Launch<false, ViscosityMethod::Mueller>::run(args...);
+  }
+}
+
+template <bool kSurfaceTension, ViscosityMethod kViscosity>
+struct LaunchEuler {
+  static void run(unsigned blocks, unsigned threads, cudaStream_t stream, const FluidConstants& fluid,
+                  const GridView& grid, const ParticleArrays& a, uint32_t n, FrameState* state) {
+    forces_euler_kernel<kSurfaceTension, kViscosity>
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, state);
+  }
+};
+
+template <bool kSurfaceTension, ViscosityMethod kViscosity>
+struct LaunchRk4 {
+  static void run(unsigned blocks, unsigned threads, cudaStream_t stream, const FluidConstants& fluid,
+                  const GridView& grid, const ParticleArrays& a, uint32_t n, int stage, FrameState* state) {
+    forces_rk4_kernel<kSurfaceTension, kViscosity>
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, state);
+  }
+};
 
 }  // namespace
 
@@ -168,24 +253,39 @@ void enqueue_reorder(const ParticleArrays& a, const uint32_t* order, uint32_t n,
 }
 
 void enqueue_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a, uint32_t n,
-                     const KernelTuning& tuning, FrameState* state, cudaStream_t stream) {
-  density_kernel<<<blocks_for(n, tuning.density_block), tuning.density_block, 0, stream>>>(fluid, grid, a, n,
-                                                                                           state);
+                     const SubstepOptions& options, const KernelTuning& tuning, FrameState* state,
+                     cudaStream_t stream) {
+  const unsigned threads = tuning.density_block, blocks = blocks_for(n, threads);
+  if (options.viscosity == ViscosityMethod::Clavet)
+    density_kernel<true><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, state);
+  else
+    density_kernel<false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, state);
   check_launch("density_kernel");
+  if (options.normalized_density) {
+    normalized_density_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n);
+    check_launch("normalized_density_kernel");
+    publish_normalized_density_kernel<<<blocks, threads, 0, stream>>>(fluid, a, n);
+    check_launch("publish_normalized_density_kernel");
+  }
+  if (options.surface_tension) {
+    colour_normal_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n);
+    check_launch("colour_normal_kernel");
+  }
 }
 
 void enqueue_forces_euler(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
-                          uint32_t n, const KernelTuning& tuning, FrameState* state, cudaStream_t stream) {
-  forces_euler_kernel<<<blocks_for(n, tuning.force_block), tuning.force_block, 0, stream>>>(fluid, grid, a, n,
-                                                                                            state);
+                          uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
+                          FrameState* state, cudaStream_t stream) {
+  dispatch_options<LaunchEuler>(options, blocks_for(n, tuning.force_block), tuning.force_block, stream, fluid,
+                                grid, a, n, state);
   check_launch("forces_euler_kernel");
 }
 
 void enqueue_forces_rk4(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
-                        uint32_t n, int stage, const KernelTuning& tuning, FrameState* state,
-                        cudaStream_t stream) {
-  forces_rk4_kernel<<<blocks_for(n, tuning.force_block), tuning.force_block, 0, stream>>>(fluid, grid, a, n,
-                                                                                          stage, state);
+                        uint32_t n, int stage, const SubstepOptions& options, const KernelTuning& tuning,
+                        FrameState* state, cudaStream_t stream) {
+  dispatch_options<LaunchRk4>(options, blocks_for(n, tuning.force_block), tuning.force_block, stream, fluid,
+                              grid, a, n, stage, state);
   check_launch("forces_rk4_kernel");
 }
 

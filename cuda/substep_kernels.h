@@ -8,6 +8,7 @@
 #include <cuda_runtime.h>
 
 #include "../src/physics/fluid_constants.h"
+#include "../src/physics/forces.h"
 #include "../src/physics/neighbor_walk.h"
 #include "device_particle_store.h"
 #include "frame_state.cuh"
@@ -28,18 +29,29 @@ enum class Rk4Carry { None, BuildStart, Gather };
 void enqueue_reorder(const ParticleArrays& a, const uint32_t* order, uint32_t n, Rk4Carry carry, int from,
                      FrameState* state, cudaStream_t stream);
 
-// density[i], sorted_position[i].w = pressure, sorted_velocity[i] = (velocity[order[i]], 1/rho).
-void enqueue_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a, uint32_t n,
-                     const KernelTuning& tuning, FrameState* state, cudaStream_t stream);
+// The physics options a world was created with (src/core/config.h).
+struct SubstepOptions {
+  bool surface_tension = false;
+  bool normalized_density = false;
+  ViscosityMethod viscosity = ViscosityMethod::Mueller;
+};
 
-// Symplectic Euler from the sorted copy into the state, with the max-speed reduction and the
-// non-finite check.
+// density[i], sorted_position[i].w = pressure, sorted_velocity[i] = (velocity[order[i]], 1/rho);
+// with the options, the neighbour counts, the normalised density (eq. 31, published into the
+// same three places) and the colour-field normals, in the CPU backend's order.
+void enqueue_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a, uint32_t n,
+                     const SubstepOptions& options, const KernelTuning& tuning, FrameState* state,
+                     cudaStream_t stream);
+
+// Symplectic Euler from the sorted copy into the state, with the max-speed and
+// max-acceleration reductions and the non-finite check.
 void enqueue_forces_euler(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
-                          uint32_t n, const KernelTuning& tuning, FrameState* state, cudaStream_t stream);
+                          uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
+                          FrameState* state, cudaStream_t stream);
 
 // One RK4 stage (0..3); its start state and slope sums are on side (stage + 1) % 2.
 void enqueue_forces_rk4(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
-                        uint32_t n, int stage, const KernelTuning& tuning, FrameState* state,
-                        cudaStream_t stream);
+                        uint32_t n, int stage, const SubstepOptions& options, const KernelTuning& tuning,
+                        FrameState* state, cudaStream_t stream);
 
 }  // namespace sph

@@ -22,11 +22,12 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
     b.grid->enqueue_cell_starts(n, b.state, stream);
     const Rk4Carry carry = !rk4 ? Rk4Carry::None : (stage == 0 ? Rk4Carry::BuildStart : Rk4Carry::Gather);
     enqueue_reorder(a, b.grid->order(), n, carry, stage & 1, b.state, stream);
-    enqueue_density(setup.fluid, b.grid->view(), a, n, setup.tuning, b.state, stream);
+    enqueue_density(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, b.state, stream);
     if (rk4)
-      enqueue_forces_rk4(setup.fluid, b.grid->view(), a, n, stage, setup.tuning, b.state, stream);
+      enqueue_forces_rk4(setup.fluid, b.grid->view(), a, n, stage, setup.options, setup.tuning, b.state,
+                         stream);
     else
-      enqueue_forces_euler(setup.fluid, b.grid->view(), a, n, setup.tuning, b.state, stream);
+      enqueue_forces_euler(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, b.state, stream);
   }
   enqueue_end_substep(b.state, setup.limits, setup.max_substeps, stages, cond, stream);
 }

@@ -25,6 +25,7 @@ struct PipelineSetup {
   FluidConstants fluid{};
   StepLimits limits{};
   uint32_t max_substeps = 1;
+  SubstepOptions options{};
   KernelTuning tuning{};
 };
 

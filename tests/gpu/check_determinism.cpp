@@ -86,6 +86,13 @@ int main() {
   rk4.integrator = SPH_INTEGRATOR_RK4;
   twice(rk4, 2, 0.04f);
 
+  SceneSpec options = moving;
+  options.name = "moving_sphere_all_options_euler";
+  options.features = SPH_FEATURE_SURFACE_TENSION | SPH_FEATURE_NORMALIZED_DENSITY;
+  options.viscosity_method = SPH_VISCOSITY_CLAVET;
+  options.step_limits = SPH_STEP_LIMIT_ACOUSTIC | SPH_STEP_LIMIT_FORCE;
+  twice(options, 3, 0.02f);
+
   SceneSpec small = moving;
   small.radius = 0.25f;
   concurrent(small, 3, 0.02f);

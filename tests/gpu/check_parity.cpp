@@ -102,5 +102,25 @@ int main() {
   moving_rk4.name = "moving_sphere_gravity_rk4";
   moving_rk4.integrator = SPH_INTEGRATOR_RK4;
   compare(moving_rk4, 0.010f);
+
+  // The physics options: each must give the CPU's result on the GPU too.
+  SceneSpec tait = moving;
+  tait.name = "options_tait_clavet_acoustic_force_limit_euler";
+  tait.random_speed = 0.5f;
+  tait.equation_of_state = SPH_EOS_TAIT;
+  tait.viscosity_method = SPH_VISCOSITY_CLAVET;
+  tait.step_limits = SPH_STEP_LIMIT_ACOUSTIC | SPH_STEP_LIMIT_FORCE;
+  compare(tait, 0.010f);
+
+  SceneSpec surface = moving;
+  surface.name = "options_surface_tension_normalized_density_euler";
+  surface.features = SPH_FEATURE_SURFACE_TENSION | SPH_FEATURE_NORMALIZED_DENSITY;
+  compare(surface, 0.010f);
+
+  SceneSpec all_rk4 = tait;
+  all_rk4.name = "options_all_rk4";
+  all_rk4.integrator = SPH_INTEGRATOR_RK4;
+  all_rk4.features = SPH_FEATURE_SURFACE_TENSION | SPH_FEATURE_NORMALIZED_DENSITY;
+  compare(all_rk4, 0.010f);
   return finish();
 }

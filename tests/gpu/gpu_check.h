@@ -114,6 +114,11 @@ struct SceneSpec {
   float step_factor = 0.4f;
   float dt_max = 1e-3f;
   uint32_t spare_capacity = 0;
+  // Physics options (src/physics; CPU and CUDA must agree with them on too).
+  sph_feature_flags features = SPH_FEATURE_NONE;
+  sph_viscosity_method viscosity_method = SPH_VISCOSITY_MUELLER;
+  sph_equation_of_state equation_of_state = SPH_EOS_IDEAL_GAS;
+  uint32_t step_limits = 0;
 };
 
 struct Loaded {
@@ -145,12 +150,16 @@ inline Loaded load_scene(sph_backend backend, const SceneSpec& s) {
   def.capacity = l.count + s.spare_capacity;
   def.particle_spacing = s.spacing;
   def.integrator = s.integrator;
+  def.features = s.features;
+  def.viscosity_method = s.viscosity_method;
+  def.equation_of_state = s.equation_of_state;
   require_ok(sph_world_create(l.context, &def, &l.world), "sph_world_create");
   sph_world_params params;
   sph_world_params_init(&params);
   params.gravity = s.gravity;
   params.step_factor = s.step_factor;
   params.dt_max = s.dt_max;
+  params.step_limits = s.step_limits;
   require_ok(sph_world_set_params(l.world, &params), "sph_world_set_params");
   sph_spawn_desc spawn;
   sph_spawn_desc_init(&spawn);
