@@ -5,6 +5,7 @@
 #include "../physics/grid_hash.h"
 #include "guard.h"
 #include "handles.h"
+#include "init_struct.h"
 #include "struct_io.h"
 #include "validate.h"
 
@@ -60,36 +61,15 @@ size_t element_size(sph_attribute a) {
 extern "C" {
 
 SPH_API sph_result SPH_CALL sph_spawn_desc_init_sized(sph_spawn_desc* desc, uint32_t size) {
-  return sph::guarded("sph_spawn_desc_init", nullptr, [&] {
-    sph::require_init_size(desc, size, "desc");
-    sph_spawn_desc d;
-    std::memset(&d, 0, sizeof d);
-    d.struct_size = sizeof d;
-    sph::write_user_struct(desc, size, d);
-    return SPH_OK;
-  });
+  return sph::init_user_struct("sph_spawn_desc_init", "desc", desc, size);
 }
 
 SPH_API sph_result SPH_CALL sph_fill_box_desc_init_sized(sph_fill_box_desc* desc, uint32_t size) {
-  return sph::guarded("sph_fill_box_desc_init", nullptr, [&] {
-    sph::require_init_size(desc, size, "desc");
-    sph_fill_box_desc d;
-    std::memset(&d, 0, sizeof d);
-    d.struct_size = sizeof d;
-    sph::write_user_struct(desc, size, d);
-    return SPH_OK;
-  });
+  return sph::init_user_struct("sph_fill_box_desc_init", "desc", desc, size);
 }
 
 SPH_API sph_result SPH_CALL sph_fill_sphere_desc_init_sized(sph_fill_sphere_desc* desc, uint32_t size) {
-  return sph::guarded("sph_fill_sphere_desc_init", nullptr, [&] {
-    sph::require_init_size(desc, size, "desc");
-    sph_fill_sphere_desc d;
-    std::memset(&d, 0, sizeof d);
-    d.struct_size = sizeof d;
-    sph::write_user_struct(desc, size, d);
-    return SPH_OK;
-  });
+  return sph::init_user_struct("sph_fill_sphere_desc_init", "desc", desc, size);
 }
 
 SPH_API sph_result SPH_CALL sph_world_spawn(sph_world* world, const sph_spawn_desc* desc,

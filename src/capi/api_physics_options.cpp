@@ -3,6 +3,7 @@
 #include "../core/config.h"
 #include "guard.h"
 #include "handles.h"
+#include "init_struct.h"
 #include "struct_io.h"
 #include "validate.h"
 
@@ -41,17 +42,12 @@ extern "C" {
 
 SPH_API sph_result SPH_CALL sph_surface_tension_params_init_sized(sph_surface_tension_params* params,
                                                                   uint32_t size) {
-  return sph::guarded("sph_surface_tension_params_init", nullptr, [&] {
-    sph::require_init_size(params, size, "params");
-    const sph::RuntimeParams defaults;
-    sph_surface_tension_params d;
-    std::memset(&d, 0, sizeof d);
-    d.struct_size = sizeof d;
-    d.coefficient = defaults.surface_tension;
-    d.normal_threshold = defaults.surface_threshold;
-    sph::write_user_struct(params, size, d);
-    return SPH_OK;
-  });
+  return sph::init_user_struct("sph_surface_tension_params_init", "params", params, size,
+                               [](sph_surface_tension_params& d) {
+                                 const sph::RuntimeParams defaults;
+                                 d.coefficient = defaults.surface_tension;
+                                 d.normal_threshold = defaults.surface_threshold;
+                               });
 }
 
 SPH_API sph_result SPH_CALL sph_world_set_surface_tension_params(sph_world* world,
@@ -89,17 +85,12 @@ SPH_API sph_result SPH_CALL sph_world_get_surface_tension_params(const sph_world
 
 SPH_API sph_result SPH_CALL sph_clavet_viscosity_params_init_sized(sph_clavet_viscosity_params* params,
                                                                    uint32_t size) {
-  return sph::guarded("sph_clavet_viscosity_params_init", nullptr, [&] {
-    sph::require_init_size(params, size, "params");
-    const sph::RuntimeParams defaults;
-    sph_clavet_viscosity_params d;
-    std::memset(&d, 0, sizeof d);
-    d.struct_size = sizeof d;
-    d.linear = defaults.clavet_linear;
-    d.quadratic = defaults.clavet_quadratic;
-    sph::write_user_struct(params, size, d);
-    return SPH_OK;
-  });
+  return sph::init_user_struct("sph_clavet_viscosity_params_init", "params", params, size,
+                               [](sph_clavet_viscosity_params& d) {
+                                 const sph::RuntimeParams defaults;
+                                 d.linear = defaults.clavet_linear;
+                                 d.quadratic = defaults.clavet_quadratic;
+                               });
 }
 
 SPH_API sph_result SPH_CALL sph_world_set_clavet_viscosity_params(sph_world* world,
@@ -136,15 +127,9 @@ SPH_API sph_result SPH_CALL sph_world_get_clavet_viscosity_params(const sph_worl
 }
 
 SPH_API sph_result SPH_CALL sph_tait_params_init_sized(sph_tait_params* params, uint32_t size) {
-  return sph::guarded("sph_tait_params_init", nullptr, [&] {
-    sph::require_init_size(params, size, "params");
+  return sph::init_user_struct("sph_tait_params_init", "params", params, size, [](sph_tait_params& d) {
     const sph::RuntimeParams defaults;
-    sph_tait_params d;
-    std::memset(&d, 0, sizeof d);
-    d.struct_size = sizeof d;
     d.speed_of_sound = defaults.tait_sound_speed;
-    sph::write_user_struct(params, size, d);
-    return SPH_OK;
   });
 }
 

@@ -2,6 +2,7 @@
 #include "../core/scene_objects.h"
 #include "guard.h"
 #include "handles.h"
+#include "init_struct.h"
 #include "struct_io.h"
 #include "validate.h"
 
@@ -95,15 +96,8 @@ SPH_API sph_transform SPH_CALL sph_transform_identity(void) { return to_public(i
 /* ---- colliders ---- */
 
 SPH_API sph_result SPH_CALL sph_collider_def_init_sized(sph_collider_def* def, uint32_t size) {
-  return sph::guarded("sph_collider_def_init", nullptr, [&] {
-    sph::require_init_size(def, size, "def");
-    sph_collider_def d;
-    std::memset(&d, 0, sizeof d);
-    d.struct_size = sizeof d;
-    d.transform = to_public(identity());
-    sph::write_user_struct(def, size, d);
-    return SPH_OK;
-  });
+  return sph::init_user_struct("sph_collider_def_init", "def", def, size,
+                               [](sph_collider_def& d) { d.transform = to_public(identity()); });
 }
 
 SPH_API sph_result SPH_CALL sph_collider_create(sph_world* world, const sph_collider_def* def,
@@ -192,15 +186,9 @@ SPH_API sph_result SPH_CALL sph_collider_set_material(sph_world* world, sph_coll
 /* ---- sources ---- */
 
 SPH_API sph_result SPH_CALL sph_source_def_init_sized(sph_source_def* def, uint32_t size) {
-  return sph::guarded("sph_source_def_init", nullptr, [&] {
-    sph::require_init_size(def, size, "def");
-    sph_source_def d;
-    std::memset(&d, 0, sizeof d);
-    d.struct_size = sizeof d;
+  return sph::init_user_struct("sph_source_def_init", "def", def, size, [](sph_source_def& d) {
     d.mode = SPH_SOURCE_FILL_ONCE;
     d.transform = to_public(identity());
-    sph::write_user_struct(def, size, d);
-    return SPH_OK;
   });
 }
 
@@ -275,15 +263,9 @@ SPH_API sph_result SPH_CALL sph_source_set_transform(sph_world* world, sph_sourc
 /* ---- sinks ---- */
 
 SPH_API sph_result SPH_CALL sph_sink_def_init_sized(sph_sink_def* def, uint32_t size) {
-  return sph::guarded("sph_sink_def_init", nullptr, [&] {
-    sph::require_init_size(def, size, "def");
-    sph_sink_def d;
-    std::memset(&d, 0, sizeof d);
-    d.struct_size = sizeof d;
+  return sph::init_user_struct("sph_sink_def_init", "def", def, size, [](sph_sink_def& d) {
     d.mode = SPH_SINK_REGION;
     d.transform = to_public(identity());
-    sph::write_user_struct(def, size, d);
-    return SPH_OK;
   });
 }
 
@@ -331,15 +313,9 @@ SPH_API sph_result SPH_CALL sph_sink_destroy(sph_world* world, sph_sink_id id) {
 /* ---- force fields ---- */
 
 SPH_API sph_result SPH_CALL sph_force_field_def_init_sized(sph_force_field_def* def, uint32_t size) {
-  return sph::guarded("sph_force_field_def_init", nullptr, [&] {
-    sph::require_init_size(def, size, "def");
-    sph_force_field_def d;
-    std::memset(&d, 0, sizeof d);
-    d.struct_size = sizeof d;
+  return sph::init_user_struct("sph_force_field_def_init", "def", def, size, [](sph_force_field_def& d) {
     d.kind = SPH_FORCE_FIELD_UNIFORM;
     d.transform = to_public(identity());
-    sph::write_user_struct(def, size, d);
-    return SPH_OK;
   });
 }
 

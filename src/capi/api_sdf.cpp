@@ -4,6 +4,7 @@
 #include "../core/sdf_shapes.h"
 #include "guard.h"
 #include "handles.h"
+#include "init_struct.h"
 #include "struct_io.h"
 #include "validate.h"
 
@@ -112,16 +113,10 @@ sph_result publish(sph_context* context, std::shared_ptr<sph::SdfAsset> asset, s
 extern "C" {
 
 SPH_API sph_result SPH_CALL sph_grid_desc_init_sized(sph_grid_desc* desc, uint32_t size) {
-  return sph::guarded("sph_grid_desc_init", nullptr, [&] {
-    sph::require_init_size(desc, size, "desc");
-    sph_grid_desc d;
-    std::memset(&d, 0, sizeof d);
-    d.struct_size = sizeof d;
+  return sph::init_user_struct("sph_grid_desc_init", "desc", desc, size, [](sph_grid_desc& d) {
     d.index_to_local[0] = d.index_to_local[5] = d.index_to_local[10] = 1.0f;
     d.memory = SPH_MEMORY_HOST;
     d.components = 1;
-    sph::write_user_struct(desc, size, d);
-    return SPH_OK;
   });
 }
 

@@ -1,6 +1,7 @@
 // Stepping and statistics.
 #include "guard.h"
 #include "handles.h"
+#include "init_struct.h"
 #include "struct_io.h"
 #include "validate.h"
 
@@ -24,14 +25,7 @@ SPH_API sph_result SPH_CALL sph_world_step(sph_world* world, float frame_dt) {
 }
 
 SPH_API sph_result SPH_CALL sph_stats_init_sized(sph_stats* stats, uint32_t size) {
-  return sph::guarded("sph_stats_init", nullptr, [&] {
-    sph::require_init_size(stats, size, "stats");
-    sph_stats s;
-    std::memset(&s, 0, sizeof s);
-    s.struct_size = sizeof s;
-    sph::write_user_struct(stats, size, s);
-    return SPH_OK;
-  });
+  return sph::init_user_struct("sph_stats_init", "stats", stats, size);
 }
 
 SPH_API sph_result SPH_CALL sph_world_get_stats(const sph_world* world, sph_stats* out) {
