@@ -1,7 +1,4 @@
 // sph-run: runs a scene file and writes its frames (docs/cli.md).
-#include <unistd.h>
-
-#include <chrono>
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -9,25 +6,15 @@
 #include "cli_options.h"
 #include "exit_codes.h"
 #include "frame_writer.h"
-#include "interrupt.h"
+#include "json_node.h"
 #include "library_error.h"
-#include "particle_frame.h"
-#include "progress.h"
-#include "run_stats.h"
+#include "run_loop.h"
 #include "scene_error.h"
 #include "scene_parser.h"
-#include "scene_runtime.h"
 #include "sph_c.h"
-#include "video.h"
 
 namespace sph_tools {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 std::string file_stem(const std::string& path) {
   const size_t slash = path.find_last_of('/');
@@ -36,9 +23,9 @@ std::string file_stem(const std::string& path) {
   return dot == std::string::npos || dot == 0 ? name : name.substr(0, dot);
 }
 
-struct Sink {
+struct ContextOwner {
   sph_context* context = nullptr;
-  ~Sink() { sph_context_destroy(context); }
+  ~ContextOwner() { sph_context_destroy(context); }
 };
 
 int fail(int code, const std::string& message) {
@@ -100,10 +87,10 @@ int run(int argc, char** argv) {
   out.surface_voxel = scene.output.surface_voxel > 0.0f ? scene.output.surface_voxel : 0.5f * spacing;
   if (out.surface && out.surface_radius < 1.5f * out.surface_voxel)
     return fail(kExitScene, cli.scene + ": output.surface.particle_radius: expected at least 1.5 voxels (" +
-                                std::to_string(1.5f * out.surface_voxel) + " m)");
+                                number_text(1.5f * out.surface_voxel) + " m)");
 
   // ---- the backend and the world ---------------------------------------------------------------
-  Sink owner;
+  ContextOwner owner;
   sph_context_def context_def;
   sph_context_def_init(&context_def);
   context_def.backend = cli.backend;
@@ -118,82 +105,24 @@ int run(int argc, char** argv) {
   sph_context_get_backend(owner.context, &used);
   const std::string backend_name = used == SPH_BACKEND_CUDA ? "CUDA" : "CPU";
 
-  const bool tty = isatty(STDERR_FILENO) != 0;
-  try {
-    SceneRuntime runtime(scene, owner.context);
-    FrameWriter writer(out, runtime);
-    if (!cli.quiet) {
-      std::string formats;
-      for (OutputFormat f : out.formats)
-        formats += std::string(formats.empty() ? "" : ",") + format_extension(f);
-      std::fprintf(stderr, "sph-run: %s: %u frames at %g fps on the %s backend -> %s/ (%s%s%s)\n",
-                   cli.scene.c_str(), scene.frames, static_cast<double>(scene.fps), backend_name.c_str(),
-                   out.directory.c_str(), formats.empty() ? "no particles" : formats.c_str(),
-                   out.surface ? ", surface" : "", out.preview ? ", preview" : "");
-    }
-    install_interrupt_handlers();
-    Progress progress(scene.frames, tty, cli.quiet);
-    RunStats stats;
-    ParticleFrame frame;
-    const Clock::time_point run_start = Clock::now();
-
-    Clock::time_point t = Clock::now();
-    read_particles(runtime.world(), 0, 0.0, &frame);
-    writer.write(runtime, frame);
-    stats.add_output(ms_since(t));
-    uint32_t written = 1;
-    for (uint32_t i = 1; i <= scene.frames && !interrupt_signal(); ++i) {
-      t = Clock::now();
-      const sph_result step = runtime.step_frame();
-      const double step_ms = ms_since(t);
-      if (interrupt_signal()) break;  // the frame is not written: only whole frames stay
-      for (const std::string& w : runtime.warnings()) progress.note("sph-run: warning: " + w);
-      if (step == SPH_INCOMPLETE)
-        progress.note("sph-run: warning: frame " + std::to_string(i) +
-                      ": max_substeps ran out before the frame's end (raise params.max_substeps or dt_min)");
-      sph_stats s;
-      sph_stats_init(&s);
-      sph_world_get_stats(runtime.world(), &s);
-      t = Clock::now();
-      read_particles(runtime.world(), i, runtime.time(), &frame);
-      writer.write(runtime, frame);
-      const double output_ms = ms_since(t);
-      ++written;
-      stats.add_frame(s, step_ms, output_ms);
-      progress.frame_done(FrameReport{i, s.particle_count, s.substeps, step_ms, output_ms});
-    }
-    progress.finish();
-    const int signal = interrupt_signal();
-    if (signal)
-      std::fprintf(stderr, "sph-run: interrupted; frames 0..%u are complete in %s/\n", written - 1,
-                   out.directory.c_str());
-    if (out.preview && !signal) {
-      const std::string mp4 = out.directory + "/preview.mp4";
-      if (!ffmpeg_on_path()) {
-        if (!cli.quiet)
-          std::fprintf(stderr, "sph-run: no ffmpeg on PATH: no preview.mp4 (the PNGs are there)\n");
-      } else {
-        const std::string problem = encode_mp4(out.directory + "/preview_%04d.png", 0, scene.fps, mp4);
-        if (!problem.empty())
-          std::fprintf(stderr, "sph-run: warning: preview.mp4: %s\n", problem.c_str());
-        else if (!cli.quiet)
-          std::fprintf(stderr, "sph-run: wrote %s\n", mp4.c_str());
-      }
-    }
-    const double wall_s = std::chrono::duration<double>(Clock::now() - run_start).count();
-    stats.print(stdout,
-                cli.scene + ": " + std::to_string(stats.frames()) + " frames (" + std::to_string(written) +
-                    " written to " + out.directory + "/)",
-                backend_name, wall_s);
-    std::fflush(stdout);
-    return signal ? kExitInterrupted + signal : kExitOk;
-  } catch (const SceneError& e) {
-    return fail(kExitScene, cli.scene + ": " + e.what());
-  } catch (const LibraryError& e) {
-    return fail(kExitRuntime, e.what());
-  } catch (const std::exception& e) {
-    return fail(kExitRuntime, e.what());
+  bool refused = false;
+  std::string why;
+  int code = run_scene(owner.context, backend_name, scene, out, cli, &refused, &why);
+  if (refused && cli.backend == SPH_BACKEND_AUTO && used == SPH_BACKEND_CUDA) {
+    // --backend auto took the GPU, whose backend cannot run this scene: say so and use the CPU.
+    std::fprintf(stderr,
+                 "sph-run: warning: the CUDA backend cannot run this scene (%s); running it on the CPU\n",
+                 why.c_str());
+    ContextOwner cpu;
+    context_def.backend = SPH_BACKEND_CPU;
+    r = sph_context_create(&context_def, &cpu.context);
+    if (r < 0) return fail(kExitRuntime, LibraryError(r, "creating a CPU context").what());
+    code = run_scene(cpu.context, "CPU", scene, out, cli, &refused, &why);
   }
+  if (refused)
+    return fail(kExitBackend, "the " + backend_name + " backend cannot run this scene: " + why +
+                                  "\n  (use --backend cpu, or auto to fall back to the CPU)");
+  return code;
 }
 
 }  // namespace

@@ -24,8 +24,12 @@ void RunStats::print(std::FILE* out, const std::string& what, const std::string&
     std::fprintf(out, "  output %.1f ms\n", output_ms_);
     return;
   }
-  std::fprintf(out, "  time per frame: %.1f ms simulating, %.1f ms writing output\n", step_ms_ / frames_,
-               output_ms_ / (frames_ + 1));
+  const double written = frames_ + 1.0;
+  std::fprintf(out,
+               "  time per frame: %.1f ms simulating, %.1f ms writing output (particles %.1f, surface %.1f, "
+               "preview %.1f)\n",
+               step_ms_ / frames_, output_ms_ / written, particles_ms_ / written, surface_ms_ / written,
+               preview_ms_ / written);
   std::fprintf(out,
                "  particles: %u at the end, %u at most; substeps %llu (%.1f per frame, dt %.3g..%.3g s)\n",
                last_.particle_count, particles_max_, static_cast<unsigned long long>(substeps_),

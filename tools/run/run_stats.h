@@ -14,6 +14,12 @@ class RunStats {
  public:
   void add_frame(const sph_stats& stats, double step_wall_ms, double output_wall_ms);
   void add_output(double output_wall_ms) { output_ms_ += output_wall_ms; }
+  // The output's share by kind (particles, surface, preview), in ms.
+  void add_output_kinds(double particles_ms, double surface_ms, double preview_ms) {
+    particles_ms_ += particles_ms;
+    surface_ms_ += surface_ms;
+    preview_ms_ += preview_ms;
+  }
   // Prints the summary. `what` heads it ("dam_break.json: 120 frames").
   void print(std::FILE* out, const std::string& what, const std::string& backend, double wall_s) const;
   uint32_t frames() const { return frames_; }
@@ -22,7 +28,7 @@ class RunStats {
   uint32_t frames_ = 0;
   uint64_t substeps_ = 0;
   uint32_t particles_max_ = 0;
-  double step_ms_ = 0.0, output_ms_ = 0.0;
+  double step_ms_ = 0.0, output_ms_ = 0.0, particles_ms_ = 0.0, surface_ms_ = 0.0, preview_ms_ = 0.0;
   float dt_min_ = 0.0f, dt_max_ = 0.0f, speed_max_ = 0.0f;
   double stage_ms_[SPH_STAGE_COUNT] = {};
   sph_stats last_{};
