@@ -15,10 +15,20 @@ namespace sph_tools {
 
 namespace {
 
+// Linear [0, 1] to 8-bit sRGB through a table of 4096 steps (finer than 8 bits everywhere
+// except the darkest shades, which the table's linear segment covers exactly).
 unsigned char encode_srgb(float linear) {
+  static const std::vector<unsigned char> table = [] {
+    std::vector<unsigned char> t(4097);
+    for (size_t i = 0; i < t.size(); ++i) {
+      const double c = static_cast<double>(i) / 4096.0;
+      const double s = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
+      t[i] = static_cast<unsigned char>(std::lround(255.0 * s));
+    }
+    return t;
+  }();
   const float c = std::clamp(linear, 0.0f, 1.0f);
-  const float s = c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
-  return static_cast<unsigned char>(std::lround(255.0f * s));
+  return table[static_cast<size_t>(c * 4096.0f + 0.5f)];
 }
 
 // libpng reports errors by longjmp, so this function holds no object with a destructor.

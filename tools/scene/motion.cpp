@@ -68,7 +68,7 @@ sph_transform Motion::at(double t) const {
   const long li = static_cast<long>(i);
   const sph_vec3 p0 = key(li - 1, &t0), p1 = key(li, &t1), p2 = key(li + 1, &t2), p3 = key(li + 2, &t3);
   out.position = catmull_rom(p0, p1, p2, p3, t0, t1, t2, t3, u);
-  out.rotation = quat_slerp(a.transform.rotation, b.transform.rotation, u * u * (3.0f - 2.0f * u));
+  out.rotation = quat_slerp(a.transform.rotation, b.transform.rotation, u);
   return out;
 }
 

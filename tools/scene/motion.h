@@ -17,7 +17,7 @@ struct Keyframe {
 struct Motion {
   enum class Interpolation {
     kLinear,  // positions linearly, rotations by slerp
-    kSmooth,  // positions by Catmull-Rom splines (C1), rotations by slerp with eased timing
+    kSmooth,  // positions by a Catmull-Rom spline through the keys (C1), rotations by slerp
   };
   std::vector<Keyframe> keys;  // empty: no motion
   Interpolation interpolation = Interpolation::kLinear;
