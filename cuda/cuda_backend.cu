@@ -14,6 +14,8 @@
 #include "device_array.h"
 #include "device_neighbor_grid.h"
 #include "device_particle_store.h"
+#include "device_scene.h"
+#include "device_sinks.h"
 #include "frame_control.h"
 #include "frame_graph.h"
 #include "frame_statistics.h"
@@ -42,7 +44,9 @@ bool same_setup(const PipelineSetup& a, const PipelineSetup& b) {
          a.tuning.density_block == b.tuning.density_block && a.tuning.force_block == b.tuning.force_block &&
          a.options.surface_tension == b.options.surface_tension &&
          a.options.normalized_density == b.options.normalized_density &&
-         a.options.viscosity == b.options.viscosity;
+         a.options.viscosity == b.options.viscosity && a.scene.colliders == b.scene.colliders &&
+         a.scene.fields == b.scene.fields && a.scene.collider_count == b.scene.collider_count &&
+         a.scene.field_count == b.scene.field_count && a.scene.kernel_radius == b.scene.kernel_radius;
 }
 
 // Everything the backend holds on the device. Released with the backend's device current.
@@ -54,10 +58,14 @@ struct Resources {
   std::unique_ptr<DeviceNeighborGrid> grid;
   std::unique_ptr<FrameStatistics> statistics;
   DeviceArray<FrameState> state;
-  PinnedArray<double> frame_dt_input;
+  PinnedArray<FrameInput> input;
   PinnedArray<FrameState> state_output;
+  PinnedArray<uint32_t> sink_kept;
   FrameGraph graph;
   PipelineSetup graph_setup;
+  DeviceSdfCache sdf_cache;
+  DeviceSceneBuffer scene_buffer;
+  DeviceSinkCompactor sinks;
 
   ~Resources() {
     if (stream && cudaStreamSynchronize(stream) != cudaSuccess) (void)cudaGetLastError();
@@ -69,8 +77,8 @@ struct Resources {
   }
 
   PipelineBuffers buffers() {
-    return PipelineBuffers{store.get(), grid.get(),           statistics.get(),
-                           state.get(), frame_dt_input.get(), state_output.get()};
+    return PipelineBuffers{store.get(), grid.get(),  statistics.get(),
+                           state.get(), input.get(), state_output.get()};
   }
 };
 
@@ -98,8 +106,9 @@ class CudaBackend final : public Backend {
     r->statistics = std::make_unique<FrameStatistics>(config.capacity);
     r->state.allocate(1, "frame state");
     cuda_check(cudaMemsetAsync(r->state.get(), 0, sizeof(FrameState), r->stream), "frame state reset");
-    r->frame_dt_input.allocate(1, "frame input");
+    r->input.allocate(1, "frame input");
     r->state_output.allocate(1, "frame output");
+    r->sink_kept.allocate(1, "sink survivor count");
     cuda_check(cudaStreamSynchronize(r->stream), "backend set-up");
     tuning_.density_block = env_block_size("SPH_CUDA_DENSITY_BLOCK", tuning_.density_block);
     tuning_.force_block = env_block_size("SPH_CUDA_FORCE_BLOCK", tuning_.force_block);
@@ -167,6 +176,14 @@ class CudaBackend final : public Backend {
   }
 
   FrameReport step_frame(double frame_dt, const RuntimeParams& params) override {
+    return step_scene_frame(frame_dt, params, SceneFrame{});
+  }
+
+  // A frame with colliders and force fields runs in the frame graph like any other: the
+  // scene's assets and views are uploaded first, outside the graph. A frame with sinks runs on
+  // the stream (the particle count changes inside it; see docs/cuda.md).
+  FrameReport step_scene_frame(double frame_dt, const RuntimeParams& params,
+                               const SceneFrame& scene_in) override {
     require_alive();
     DeviceGuard guard(device_);
     PipelineSetup setup;
@@ -178,11 +195,29 @@ class CudaBackend final : public Backend {
     setup.options = options_;
     setup.tuning = tuning_;
     float frame_ms = 0.0f;
+    const bool with_sinks = !scene_in.sinks.empty();
+    uint32_t count_after = count_;
+    std::vector<uint32_t> removed_ids, removed_by_sink(scene_in.sinks.size(), 0u);
     guarded([&] {
-      prepare_graph(setup);
-      *r_->frame_dt_input.get() = frame_dt;
+      if (!scene_in.empty()) {
+        SceneFrame scene = scene_in;
+        r_->sdf_cache.begin_frame();
+        bind_scene_views(scene, [&](const SdfAsset& a) { return r_->sdf_cache.bind(a, r_->stream); });
+        r_->sdf_cache.end_frame();
+        setup.scene = r_->scene_buffer.upload(scene, config_.kernel_radius, r_->stream);
+        if (with_sinks) r_->sinks.reserve(config_.capacity);
+        cuda_check(cudaStreamSynchronize(r_->stream), "upload of the scene");
+      }
+      FrameInput* input = r_->input.get();
+      input->frame_dt = frame_dt;
+      input->max_collider_speed = scene_in.max_collider_speed;
+      input->pad = 0;
+      if (!with_sinks) prepare_graph(setup);
       cuda_check(cudaEventRecord(r_->frame_start, r_->stream), "cudaEventRecord");
-      if (use_graphs_)
+      if (with_sinks)
+        count_after = run_sink_frame_on_stream(setup, static_cast<uint32_t>(scene_in.sinks.size()),
+                                               removed_ids, removed_by_sink);
+      else if (use_graphs_)
         r_->graph.launch(r_->stream);
       else
         run_frame_on_stream(setup);
@@ -203,7 +238,10 @@ class CudaBackend final : public Backend {
                                          " s) at particle id " + std::to_string(s.bad_id) +
                                          "; the world was restored to its state before sph_world_step");
     }
+    count_ = count_after;
     FrameReport report;
+    report.removed_ids = std::move(removed_ids);
+    report.removed_by_sink = std::move(removed_by_sink);
     report.substeps = s.substeps;
     report.completed = s.remaining <= 0.0;
     report.time_advanced = s.time_advanced;
@@ -259,7 +297,8 @@ class CudaBackend final : public Backend {
   }
 
   uint64_t memory_bytes() const override {
-    return r_->store->bytes() + r_->grid->bytes() + r_->statistics->bytes() + r_->state.bytes();
+    return r_->store->bytes() + r_->grid->bytes() + r_->statistics->bytes() + r_->state.bytes() +
+           r_->sdf_cache.bytes() + r_->scene_buffer.bytes() + r_->sinks.bytes();
   }
 
   DeviceAttributeView device_attribute(AttributeKind kind) const override {
@@ -379,6 +418,75 @@ class CudaBackend final : public Backend {
       enqueue_substep(setup, b, LoopCondition{}, r_->stream);
     }
     enqueue_frame_end(setup, b, r_->stream);
+  }
+
+  // A frame with sinks: the fallback's loop, and after every substep the sinks' stable
+  // compaction, whose survivor count comes back to the host with the loop condition (one
+  // synchronisation per substep, a second one only when particles were removed). Returns the
+  // particle count after the frame; the removed ids, in the CPU backend's order, and the
+  // per-sink counts are appended.
+  uint32_t run_sink_frame_on_stream(PipelineSetup setup, uint32_t sink_count,
+                                    std::vector<uint32_t>& removed_ids,
+                                    std::vector<uint32_t>& removed_by_sink) {
+    const PipelineBuffers b = r_->buffers();
+    const ParticleArrays& a = b.store->arrays();
+    cudaStream_t s = r_->stream;
+    FrameState* out = b.state_output;
+    uint32_t* kept_out = r_->sink_kept.get();
+    uint32_t n = count_;
+    setup.count = n;
+    enqueue_frame_begin(setup, b, LoopCondition{}, s);
+    cuda_check(cudaMemcpyAsync(&out->run, &b.state->run, sizeof(uint32_t), cudaMemcpyDeviceToHost, s),
+               "copy of the loop condition");
+    cuda_check(cudaStreamSynchronize(s), "frame begin");
+    bool counts_from_compaction = false;
+    std::vector<uint32_t> ids, sinks;
+    while (out->run) {
+      setup.count = n;
+      enqueue_substep(setup, b, LoopCondition{}, s);
+      r_->sinks.enqueue_flag(r_->scene_buffer.sinks(), sink_count, a, n, b.state, s);
+      cuda_check(cudaMemcpyAsync(&out->run, &b.state->run, sizeof(uint32_t), cudaMemcpyDeviceToHost, s),
+                 "copy of the loop condition");
+      cuda_check(cudaMemcpyAsync(&out->non_finite, &b.state->non_finite, sizeof(uint32_t),
+                                 cudaMemcpyDeviceToHost, s),
+                 "copy of the non-finite flag");
+      cuda_check(
+          cudaMemcpyAsync(kept_out, r_->sinks.kept_device(), sizeof(uint32_t), cudaMemcpyDeviceToHost, s),
+          "copy of the sink survivor count");
+      cuda_check(cudaStreamSynchronize(s), "substep");
+      counts_from_compaction = false;
+      if (out->non_finite) break;  // as on the CPU: no sinks after a failed substep
+      const uint32_t kept = *kept_out;
+      if (kept == n) continue;
+      // After the last substep the statistics need the neighbour counts of its density pass,
+      // which the compaction carries along (the sorted copy it reads becomes scratch).
+      uint32_t* counts = nullptr;
+      if (!out->run) {
+        counts = r_->sinks.counts();
+        b.statistics->enqueue_neighbor_counts(setup.fluid, b.grid->view(), a, n, counts, s);
+      }
+      r_->sinks.enqueue_compact(a, n, kept, counts, s);
+      const uint32_t removed = n - kept;
+      ids.resize(removed);
+      sinks.resize(removed);
+      cuda_check(cudaMemcpyAsync(ids.data(), r_->sinks.removed_ids(), sizeof(uint32_t) * removed,
+                                 cudaMemcpyDeviceToHost, s),
+                 "copy of the removed ids");
+      cuda_check(cudaMemcpyAsync(sinks.data(), r_->sinks.removed_sinks(), sizeof(uint32_t) * removed,
+                                 cudaMemcpyDeviceToHost, s),
+                 "copy of the removed ids' sinks");
+      cuda_check(cudaStreamSynchronize(s), "sinks");
+      removed_ids.insert(removed_ids.end(), ids.begin(), ids.end());
+      for (uint32_t k : sinks) ++removed_by_sink[k];
+      n = kept;
+      counts_from_compaction = counts != nullptr;
+    }
+    setup.count = n;
+    b.statistics->enqueue(setup.fluid, b.grid->view(), a, n, b.state, s,
+                          counts_from_compaction ? r_->sinks.counts() : nullptr);
+    cuda_check(cudaMemcpyAsync(out, b.state, sizeof(FrameState), cudaMemcpyDeviceToHost, s),
+               "copy of the frame state");
+    return n;
   }
 
   WorldConfig config_;

@@ -7,10 +7,18 @@
 namespace sph {
 namespace {
 
+// The CPU backend's step choice and SubstepTime: the controller sees the faster of the fluid
+// and the colliders' surfaces, so a fast paddle cannot skip a particle between substeps.
 __device__ void pick_next_step(FrameState* s, const StepLimits& limits) {
-  s->dt =
-      landing_dt(static_cast<double>(controller_dt(limits, s->max_speed, s->max_acceleration)), s->remaining);
+  const float speed = fmaxf(s->max_speed, s->max_collider_speed);
+  s->dt = landing_dt(static_cast<double>(controller_dt(limits, speed, s->max_acceleration)), s->remaining);
   s->dt_float = static_cast<float>(s->dt);
+  const double elapsed = s->time_advanced;
+  s->time.tau0 = static_cast<float>(elapsed);
+  s->time.tau1 = static_cast<float>(elapsed + s->dt);
+  s->time.s0 = static_cast<float>(elapsed / s->frame_dt);
+  s->time.s1 = s->remaining <= s->dt ? 1.0f : static_cast<float>((elapsed + s->dt) / s->frame_dt);
+  s->time.dt = s->dt_float;
 }
 
 __device__ void set_run(FrameState* s, uint32_t run, const LoopCondition& cond) {

@@ -2,9 +2,11 @@
 // step size and its own end without a round trip to the host. One per world.
 #pragma once
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "../src/core/frame_report.h"
+#include "../src/physics/collider_response.h"
 #include "../src/physics/step_control.h"
 
 namespace sph {
@@ -12,9 +14,19 @@ namespace sph {
 constexpr int kRk4Stages = 4;
 constexpr unsigned long long kNoBadParticle = ~0ull;
 
-struct FrameState {
-  // Input, written by the host before each frame.
+// What the host writes before each frame (one copy from pinned memory into the head of
+// FrameState).
+struct FrameInput {
   double frame_dt;
+  float max_collider_speed;  // fastest collider surface point, m/s (0 without colliders)
+  uint32_t pad;
+};
+
+struct FrameState {
+  // Input, written by the host before each frame (FrameInput's layout).
+  double frame_dt;
+  float max_collider_speed;
+  uint32_t input_pad;
 
   // The substep loop (the CPU backend's loop variables, in the same precision).
   double remaining;       // seconds of the frame still to simulate
@@ -34,6 +46,9 @@ struct FrameState {
   uint32_t bad_id;         // id of the first non-finite particle
   uint32_t bad_substep;
   float bad_dt;
+  // This substep's place in the frame for moving colliders, computed with the step as the CPU
+  // backend computes it (s0, s1, tau0, tau1 from the double clock).
+  SubstepTime time;
   // Per RK4 stage (symplectic Euler uses [0]): (sorted index << 32 | id), the minimum wins,
   // which is the particle the CPU backend names.
   unsigned long long bad_key[kRk4Stages];
@@ -51,6 +66,10 @@ struct FrameState {
   unsigned long long timing_last_ns;
   unsigned long long stage_ns[kStageCount];
 };
+
+static_assert(offsetof(FrameState, frame_dt) == offsetof(FrameInput, frame_dt) &&
+                  offsetof(FrameState, max_collider_speed) == offsetof(FrameInput, max_collider_speed),
+              "FrameInput is the head of FrameState");
 
 #if defined(__CUDACC__)
 __device__ __forceinline__ unsigned long long global_timer_ns() {

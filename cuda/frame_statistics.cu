@@ -31,15 +31,16 @@ __device__ void tree_reduce(StatsPartial* slots) {
 
 __global__ void __launch_bounds__(kStatsBlock)
     stats_partial_kernel(FluidConstants fluid, GridView grid, const Float4* sorted_position,
-                         const float* __restrict__ density, uint32_t n, StatsPartial* partials,
-                         FrameState* state) {
+                         const float* __restrict__ density, const uint32_t* __restrict__ counts, uint32_t n,
+                         StatsPartial* partials, FrameState* state) {
   mark_stage(state, kStageOther);
   __shared__ StatsPartial slots[kStatsBlock];
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   StatsPartial p = empty_partial();
   if (i < n) {
     const float d = density[i];
-    const uint32_t neighbors = gather_density(fluid, grid, sorted_position, i).neighbor_count;
+    const uint32_t neighbors =
+        counts ? counts[i] : gather_density(fluid, grid, sorted_position, i).neighbor_count;
     p = StatsPartial{d, neighbors, d, d, neighbors, 0u};
   }
   slots[threadIdx.x] = p;
@@ -66,6 +67,12 @@ __global__ void __launch_bounds__(kStatsBlock)
   }
 }
 
+__global__ void neighbor_count_kernel(FluidConstants fluid, GridView grid, const Float4* sorted_position,
+                                      uint32_t n, uint32_t* counts) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i < n) counts[i] = gather_density(fluid, grid, sorted_position, i).neighbor_count;
+}
+
 }  // namespace
 
 FrameStatistics::FrameStatistics(uint32_t capacity) {
@@ -73,13 +80,22 @@ FrameStatistics::FrameStatistics(uint32_t capacity) {
 }
 
 void FrameStatistics::enqueue(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
-                              uint32_t n, FrameState* state, cudaStream_t stream) const {
+                              uint32_t n, FrameState* state, cudaStream_t stream,
+                              const uint32_t* counts) const {
   const unsigned blocks = blocks_for(n, kStatsBlock);
-  stats_partial_kernel<<<blocks, kStatsBlock, 0, stream>>>(fluid, grid, a.sorted_position, a.density, n,
-                                                           partials_.get(), state);
+  stats_partial_kernel<<<blocks, kStatsBlock, 0, stream>>>(fluid, grid, a.sorted_position, a.density, counts,
+                                                           n, partials_.get(), state);
   check_launch("stats_partial_kernel");
   stats_final_kernel<<<1, kStatsBlock, 0, stream>>>(partials_.get(), blocks, n, state);
   check_launch("stats_final_kernel");
+}
+
+void FrameStatistics::enqueue_neighbor_counts(const FluidConstants& fluid, const GridView& grid,
+                                              const ParticleArrays& a, uint32_t n, uint32_t* counts,
+                                              cudaStream_t stream) const {
+  neighbor_count_kernel<<<blocks_for(n, kStatsBlock), kStatsBlock, 0, stream>>>(fluid, grid,
+                                                                                a.sorted_position, n, counts);
+  check_launch("neighbor_count_kernel");
 }
 
 }  // namespace sph

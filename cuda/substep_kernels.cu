@@ -65,6 +65,19 @@ __device__ __forceinline__ void flag_non_finite(FrameState* s, int stage, uint32
   atomicMin(&s->bad_key[stage], (static_cast<unsigned long long>(index) << 32) | id);
 }
 
+// The scene's force fields at a particle (after the neighbour gather, as the CPU backend).
+__device__ __forceinline__ Vec3 add_force_fields(const DeviceScene& scene, Vec3 acc, Vec3 x) {
+  for (uint32_t f = 0; f < scene.field_count; ++f) acc += force_field_acceleration(scene.fields[f], x);
+  return acc;
+}
+
+// Every collider against the integrated state, moved from x_old during the substep.
+__device__ __forceinline__ void collide_all(const DeviceScene& scene, const SubstepTime& time, Vec3 x_old,
+                                            ParticleState& s) {
+  for (uint32_t c = 0; c < scene.collider_count; ++c)
+    collide_particle(scene.colliders[c], time, scene.kernel_radius, x_old, s.position, s.velocity);
+}
+
 template <Rk4Carry Carry>
 __global__ void reorder_kernel(ParticleArrays a, const uint32_t* __restrict__ order, uint32_t n, int from,
                                FrameState* state) {
@@ -128,21 +141,23 @@ __global__ void colour_normal_kernel(FluidConstants fluid, GridView grid, Partic
   a.colour_normal[i] = gather_colour_normal(fluid, grid, a.sorted_position, a.sorted_velocity, i);
 }
 
-template <bool kSurfaceTension, ViscosityMethod kViscosity>
+template <bool kSurfaceTension, ViscosityMethod kViscosity, bool kScene>
 __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
-                                    FrameState* state) {
+                                    DeviceScene scene, FrameState* state) {
   mark_stage(state, kStageForces);
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   float v2 = 0.0f, a2 = 0.0f;
   if (i < n) {
     FluidConstants f = fluid;
     f.dt = state->dt_float;  // impulse-based terms need the substep's length
-    const Vec3 acc = gather_acceleration_masked<kSurfaceTension, kViscosity>(
+    Vec3 acc = gather_acceleration_masked<kSurfaceTension, kViscosity>(
         f, grid, a.sorted_position, a.sorted_velocity, a.neighbor_count, a.colour_normal, i);
-    a2 = length_squared(acc);
     const Float4 p = a.sorted_position[i];
     const Float4 v = a.sorted_velocity[i];
-    const ParticleState next = symplectic_euler(ParticleState{xyz(p), xyz(v)}, acc, f.dt);
+    if (kScene) acc = add_force_fields(scene, acc, xyz(p));
+    a2 = length_squared(acc);
+    ParticleState next = symplectic_euler(ParticleState{xyz(p), xyz(v)}, acc, f.dt);
+    if (kScene) collide_all(scene, state->time, xyz(p), next);
     const uint32_t id = a.sorted_id[i];
     a.position[i] = make_float4_record(next.position, p.w);
     a.velocity[i] = make_float4_record(next.velocity, v.w);
@@ -158,9 +173,9 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
   block_max_to(&state->a2max_bits, a2);
 }
 
-template <bool kSurfaceTension, ViscosityMethod kViscosity>
+template <bool kSurfaceTension, ViscosityMethod kViscosity, bool kScene>
 __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
-                                  int stage, FrameState* state) {
+                                  int stage, DeviceScene scene, FrameState* state) {
   mark_stage(state, kStageForces);
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   float v2 = 0.0f, a2 = 0.0f;
@@ -170,15 +185,18 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
     Rk4Accumulator* sums = (stage & 1) ? a.rk4_sum[0] : a.rk4_sum[1];
     FluidConstants f = fluid;
     f.dt = state->dt_float;
-    const Vec3 acc = gather_acceleration_masked<kSurfaceTension, kViscosity>(
+    Vec3 acc = gather_acceleration_masked<kSurfaceTension, kViscosity>(
         f, grid, a.sorted_position, a.sorted_velocity, a.neighbor_count, a.colour_normal, i);
-    a2 = length_squared(acc);
     const Float4 p = a.sorted_position[i];
     const Float4 v = a.sorted_velocity[i];
+    if (kScene) acc = add_force_fields(scene, acc, xyz(p));
+    a2 = length_squared(acc);
     Rk4Accumulator sum;
     if (stage > 0) sum = sums[i];  // stage 0 starts the sums
-    const ParticleState next = rk4_advance(stage, start[i], ParticleState{xyz(p), xyz(v)}, acc, f.dt, sum);
+    const ParticleState from = start[i];
+    ParticleState next = rk4_advance(stage, from, ParticleState{xyz(p), xyz(v)}, acc, f.dt, sum);
     sums[i] = sum;
+    if (kScene && stage == kRk4Stages - 1) collide_all(scene, state->time, from.position, next);
     const uint32_t id = a.sorted_id[i];
     a.position[i] = make_float4_record(next.position, p.w);
     a.velocity[i] = make_float4_record(next.velocity, v.w);
@@ -199,36 +217,47 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
 
 // One launch site per option combination: a world that does not use an option runs code
 // without it.
-template <template <bool, ViscosityMethod> class Launch, class... Args>
-void dispatch_options(const SubstepOptions& o, Args&&... args) {
+// A frame without colliders and force fields runs kernels without the scene code.
+template <template <bool, ViscosityMethod, bool> class Launch, bool kScene, class... Args>
+void dispatch_viscosity(const SubstepOptions& o, Args&&... args) {
   if (o.viscosity == ViscosityMethod::Clavet) {
     if (o.surface_tension)
-      Launch<true, ViscosityMethod::Clavet>::run(args...);
+      Launch<true, ViscosityMethod::Clavet, kScene>::run(args...);
     else
-      Launch<false, ViscosityMethod::Clavet>::run(args...);
+      Launch<false, ViscosityMethod::Clavet, kScene>::run(args...);
   } else {
     if (o.surface_tension)
-      Launch<true, ViscosityMethod::Mueller>::run(args...);
+      Launch<true, ViscosityMethod::Mueller, kScene>::run(args...);
     else
-      Launch<false, ViscosityMethod::Mueller>::run(args...);
+      Launch<false, ViscosityMethod::Mueller, kScene>::run(args...);
   }
 }
 
-template <bool kSurfaceTension, ViscosityMethod kViscosity>
+template <template <bool, ViscosityMethod, bool> class Launch, class... Args>
+void dispatch_options(const SubstepOptions& o, bool scene, Args&&... args) {
+  if (scene)
+    dispatch_viscosity<Launch, true>(o, args...);
+  else
+    dispatch_viscosity<Launch, false>(o, args...);
+}
+
+template <bool kSurfaceTension, ViscosityMethod kViscosity, bool kScene>
 struct LaunchEuler {
   static void run(unsigned blocks, unsigned threads, cudaStream_t stream, const FluidConstants& fluid,
-                  const GridView& grid, const ParticleArrays& a, uint32_t n, FrameState* state) {
-    forces_euler_kernel<kSurfaceTension, kViscosity>
-        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, state);
+                  const GridView& grid, const ParticleArrays& a, uint32_t n, const DeviceScene& scene,
+                  FrameState* state) {
+    forces_euler_kernel<kSurfaceTension, kViscosity, kScene>
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
   }
 };
 
-template <bool kSurfaceTension, ViscosityMethod kViscosity>
+template <bool kSurfaceTension, ViscosityMethod kViscosity, bool kScene>
 struct LaunchRk4 {
   static void run(unsigned blocks, unsigned threads, cudaStream_t stream, const FluidConstants& fluid,
-                  const GridView& grid, const ParticleArrays& a, uint32_t n, int stage, FrameState* state) {
-    forces_rk4_kernel<kSurfaceTension, kViscosity>
-        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, state);
+                  const GridView& grid, const ParticleArrays& a, uint32_t n, int stage,
+                  const DeviceScene& scene, FrameState* state) {
+    forces_rk4_kernel<kSurfaceTension, kViscosity, kScene>
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, scene, state);
   }
 };
 
@@ -275,17 +304,17 @@ void enqueue_density(const FluidConstants& fluid, const GridView& grid, const Pa
 
 void enqueue_forces_euler(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                           uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
-                          FrameState* state, cudaStream_t stream) {
-  dispatch_options<LaunchEuler>(options, blocks_for(n, tuning.force_block), tuning.force_block, stream, fluid,
-                                grid, a, n, state);
+                          const DeviceScene& scene, FrameState* state, cudaStream_t stream) {
+  dispatch_options<LaunchEuler>(options, scene.active(), blocks_for(n, tuning.force_block),
+                                tuning.force_block, stream, fluid, grid, a, n, scene, state);
   check_launch("forces_euler_kernel");
 }
 
 void enqueue_forces_rk4(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                         uint32_t n, int stage, const SubstepOptions& options, const KernelTuning& tuning,
-                        FrameState* state, cudaStream_t stream) {
-  dispatch_options<LaunchRk4>(options, blocks_for(n, tuning.force_block), tuning.force_block, stream, fluid,
-                              grid, a, n, stage, state);
+                        const DeviceScene& scene, FrameState* state, cudaStream_t stream) {
+  dispatch_options<LaunchRk4>(options, scene.active(), blocks_for(n, tuning.force_block), tuning.force_block,
+                              stream, fluid, grid, a, n, stage, scene, state);
   check_launch("forces_rk4_kernel");
 }
 

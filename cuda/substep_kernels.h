@@ -7,7 +7,9 @@
 
 #include <cuda_runtime.h>
 
+#include "../src/physics/collider_response.h"
 #include "../src/physics/fluid_constants.h"
+#include "../src/physics/force_fields.h"
 #include "../src/physics/forces.h"
 #include "../src/physics/neighbor_walk.h"
 #include "device_particle_store.h"
@@ -18,6 +20,19 @@ namespace sph {
 struct KernelTuning {
   unsigned density_block = 128;
   unsigned force_block = 128;
+};
+
+// The scene inside a substep, as the kernels see it: the views live in a per-world device
+// buffer uploaded before each frame (their SdfGridViews point at the world's device copies of
+// the assets). All zero for a frame without colliders or force fields.
+struct DeviceScene {
+  const ColliderView* colliders = nullptr;
+  const ForceFieldView* fields = nullptr;
+  uint32_t collider_count = 0;
+  uint32_t field_count = 0;
+  float kernel_radius = 0.0f;  // for stickiness
+
+  bool active() const { return collider_count != 0 || field_count != 0; }
 };
 
 // What the RK4 reorder carries along: nothing (Euler), the start state built from the current
@@ -45,13 +60,16 @@ void enqueue_density(const FluidConstants& fluid, const GridView& grid, const Pa
 
 // Symplectic Euler from the sorted copy into the state, with the max-speed and
 // max-acceleration reductions and the non-finite check.
+// With a scene: the force fields add to the gathered acceleration, and the colliders resolve
+// the integrated state from the particle's position before the step (FrameState::time).
 void enqueue_forces_euler(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                           uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
-                          FrameState* state, cudaStream_t stream);
+                          const DeviceScene& scene, FrameState* state, cudaStream_t stream);
 
-// One RK4 stage (0..3); its start state and slope sums are on side (stage + 1) % 2.
+// One RK4 stage (0..3); its start state and slope sums are on side (stage + 1) % 2. The
+// colliders act after the last stage, from the start position.
 void enqueue_forces_rk4(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                         uint32_t n, int stage, const SubstepOptions& options, const KernelTuning& tuning,
-                        FrameState* state, cudaStream_t stream);
+                        const DeviceScene& scene, FrameState* state, cudaStream_t stream);
 
 }  // namespace sph

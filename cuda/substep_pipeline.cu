@@ -4,9 +4,8 @@ namespace sph {
 
 void enqueue_frame_begin(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
                          cudaStream_t stream) {
-  cuda_check(
-      cudaMemcpyAsync(&b.state->frame_dt, b.frame_dt_input, sizeof(double), cudaMemcpyHostToDevice, stream),
-      "copy of frame_dt");
+  cuda_check(cudaMemcpyAsync(b.state, b.input, sizeof(FrameInput), cudaMemcpyHostToDevice, stream),
+             "copy of the frame input");
   enqueue_begin_frame(b.state, setup.limits, setup.max_substeps, cond, stream);
   b.store->enqueue_snapshot(setup.count, stream);
 }
@@ -24,10 +23,11 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
     enqueue_reorder(a, b.grid->order(), n, carry, stage & 1, b.state, stream);
     enqueue_density(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, b.state, stream);
     if (rk4)
-      enqueue_forces_rk4(setup.fluid, b.grid->view(), a, n, stage, setup.options, setup.tuning, b.state,
-                         stream);
+      enqueue_forces_rk4(setup.fluid, b.grid->view(), a, n, stage, setup.options, setup.tuning, setup.scene,
+                         b.state, stream);
     else
-      enqueue_forces_euler(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, b.state, stream);
+      enqueue_forces_euler(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene,
+                           b.state, stream);
   }
   enqueue_end_substep(b.state, setup.limits, setup.max_substeps, stages, cond, stream);
 }

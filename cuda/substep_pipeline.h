@@ -27,15 +27,16 @@ struct PipelineSetup {
   uint32_t max_substeps = 1;
   SubstepOptions options{};
   KernelTuning tuning{};
+  DeviceScene scene{};  // colliders and force fields inside the substep (none: all zero)
 };
 
 struct PipelineBuffers {
   const DeviceParticleStore* store;
   DeviceNeighborGrid* grid;
   const FrameStatistics* statistics;
-  FrameState* state;             // device
-  const double* frame_dt_input;  // pinned host, copied into state->frame_dt
-  FrameState* state_output;      // pinned host, receives the state at the end
+  FrameState* state;         // device
+  const FrameInput* input;   // pinned host, copied into the head of *state
+  FrameState* state_output;  // pinned host, receives the state at the end
 };
 
 void enqueue_frame_begin(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,

@@ -1,0 +1,105 @@
+#include <cub/device/device_scan.cuh>
+
+#include "device_sinks.h"
+#include "kernel_launch.h"
+
+namespace sph {
+namespace {
+
+constexpr uint32_t kKept = 0xffffffffu;
+
+__global__ void sink_flag_kernel(const SinkView* __restrict__ sinks, uint32_t sink_count,
+                                 const Float4* __restrict__ position, uint32_t n, uint32_t* keep,
+                                 uint32_t* sink_of, FrameState* state) {
+  mark_stage(state, kStageEmit);
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const Vec3 x = xyz(position[i]);
+  uint32_t by = kKept;
+  for (uint32_t s = 0; s < sink_count && by == kKept; ++s)
+    if (sink_removes(sinks[s], x)) by = s;
+  sink_of[i] = by;
+  keep[i] = by == kKept ? 1u : 0u;
+}
+
+__global__ void kept_total_kernel(const uint32_t* keep, const uint32_t* scan, uint32_t n, uint32_t* kept) {
+  *kept = n == 0 ? 0u : scan[n - 1] + keep[n - 1];
+}
+
+// Survivor i goes to scan[i]; the r-th removed particle (r = i - scan[i]) to the removed lists.
+__global__ void sink_scatter_kernel(ParticleArrays a, uint32_t n, const uint32_t* __restrict__ keep,
+                                    const uint32_t* __restrict__ scan, const uint32_t* __restrict__ sink_of,
+                                    const uint32_t* __restrict__ counts, uint32_t* counts_out,
+                                    float* density_out, uint32_t* removed_id, uint32_t* removed_sink) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const uint32_t dst = scan[i];
+  if (keep[i]) {
+    a.sorted_position[dst] = a.position[i];
+    a.sorted_velocity[dst] = a.velocity[i];
+    a.sorted_id[dst] = a.id[i];
+    density_out[dst] = a.density[i];
+    if (counts) counts_out[dst] = counts[i];
+  } else {
+    const uint32_t r = i - dst;
+    removed_id[r] = a.id[i];
+    removed_sink[r] = sink_of[i];
+  }
+}
+
+template <class T>
+void copy_back(T* dst, const T* src, uint32_t n, cudaStream_t stream, const char* what) {
+  if (n == 0) return;
+  cuda_check(cudaMemcpyAsync(dst, src, sizeof(T) * n, cudaMemcpyDeviceToDevice, stream), what);
+}
+
+}  // namespace
+
+void DeviceSinkCompactor::reserve(uint32_t capacity) {
+  if (capacity_ != 0 || capacity == 0) return;
+  const size_t n = capacity;
+  keep_.allocate(n, "sink flags");
+  scan_.allocate(n, "sink scan");
+  sink_of_.allocate(n, "sink indices");
+  removed_id_.allocate(n, "removed ids");
+  removed_sink_.allocate(n, "removed sink indices");
+  counts_.allocate(n, "sink neighbour counts");
+  counts_out_.allocate(n, "sink neighbour counts (compacted)");
+  density_out_.allocate(n, "sink densities (compacted)");
+  kept_.allocate(1, "sink survivor count");
+  cuda_check(
+      cub::DeviceScan::ExclusiveSum(nullptr, temp_bytes_, keep_.get(), scan_.get(), static_cast<int>(n)),
+      "sink scan size");
+  temp_.allocate(temp_bytes_ == 0 ? 1 : temp_bytes_, "sink scan storage");
+  capacity_ = capacity;
+}
+
+void DeviceSinkCompactor::enqueue_flag(const SinkView* sinks, uint32_t sink_count, const ParticleArrays& a,
+                                       uint32_t n, FrameState* state, cudaStream_t stream) {
+  sink_flag_kernel<<<blocks_for(n, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
+      sinks, sink_count, a.position, n, keep_.get(), sink_of_.get(), state);
+  check_launch("sink_flag_kernel");
+  if (n > 0) {
+    size_t bytes = temp_bytes_;
+    cuda_check(cub::DeviceScan::ExclusiveSum(temp_.get(), bytes, keep_.get(), scan_.get(),
+                                             static_cast<int>(n), stream),
+               "sink scan");
+  }
+  kept_total_kernel<<<1, 1, 0, stream>>>(keep_.get(), scan_.get(), n, kept_.get());
+  check_launch("kept_total_kernel");
+}
+
+void DeviceSinkCompactor::enqueue_compact(const ParticleArrays& a, uint32_t n, uint32_t kept,
+                                          uint32_t* counts, cudaStream_t stream) {
+  sink_scatter_kernel<<<blocks_for(n, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
+      a, n, keep_.get(), scan_.get(), sink_of_.get(), counts, counts_out_.get(), density_out_.get(),
+      removed_id_.get(), removed_sink_.get());
+  check_launch("sink_scatter_kernel");
+  copy_back(a.position, a.sorted_position, kept, stream, "compaction of positions");
+  copy_back(a.velocity, a.sorted_velocity, kept, stream, "compaction of velocities");
+  copy_back(a.id, a.sorted_id, kept, stream, "compaction of ids");
+  copy_back(a.density, density_out_.get(), kept, stream, "compaction of densities");
+  if (counts) copy_back(counts, counts_out_.get(), kept, stream, "compaction of neighbour counts");
+}
+
+}  // namespace sph
