@@ -1,6 +1,8 @@
 // A small scene for compute-sanitizer (memcheck, racecheck, synccheck): Euler and RK4 frames,
-// a spawn between frames, a rollback, and the copy-out of every attribute.
+// a spawn between frames, a rollback, and the copy-out of every attribute; then the scene
+// kernels: colliders (tank, paddle, deforming ball), every force field, sinks and a source.
 #include "gpu_check.h"
+#include "scene_parity.h"
 
 using namespace gpu_check;
 
@@ -31,6 +33,17 @@ int main() {
     report(s.count == l.count + 2,
            integrator == SPH_INTEGRATOR_RK4 ? "sanitizer_scene/rk4" : "sanitizer_scene/euler",
            "%u particles stepped, spawned, rolled back and read", s.count);
+    l.destroy();
+  }
+  spec.integrator = SPH_INTEGRATOR_SYMPLECTIC_EULER;
+  spec.spare_capacity = 2000;
+  for (void (*build)(sph_context*, sph_world*) :
+       {build_tank, build_paddle, build_deforming, build_fields, build_sinks, build_source}) {
+    Loaded l = load_scene(SPH_BACKEND_CUDA, spec);
+    build(l.context, l.world);
+    for (int frame = 0; frame < 2; ++frame) require_ok(sph_world_step(l.world, 0.004f), "scene step");
+    const RawState s = read_raw(l.world);
+    report(true, "sanitizer_scene/scene", "%u particles after two scene frames", s.count);
     l.destroy();
   }
   return finish();
