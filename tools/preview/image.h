@@ -24,6 +24,8 @@ struct Image {
 
 // Writes an 8-bit RGB PNG (sRGB-encoded) with libpng. Throws std::runtime_error.
 void write_png(const Image& image, const std::string& path);
+// Whether this build has libpng (write_png throws without it).
+bool png_available();
 
 }  // namespace sph_tools
 

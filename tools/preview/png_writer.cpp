@@ -1,5 +1,7 @@
-// PNG files through libpng.
+// PNG files through libpng (in builds that found it).
+#ifdef SPH_TOOLS_HAVE_PNG
 #include <png.h>
+#endif
 
 #include <algorithm>
 #include <cerrno>
@@ -12,6 +14,9 @@
 #include "image.h"
 
 namespace sph_tools {
+
+#ifdef SPH_TOOLS_HAVE_PNG
+bool png_available() { return true; }
 
 namespace {
 
@@ -43,7 +48,8 @@ bool encode(std::FILE* file, const unsigned char* pixels, uint32_t width, uint32
   png_init_io(png, file);
   png_set_IHDR(png, info, width, height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_set_compression_level(png, 3);
+  png_set_compression_level(png, 1);  // fast: a preview is written every frame
+  png_set_filter(png, 0, PNG_FILTER_SUB);
   png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
   png_write_info(png, info);
   for (uint32_t y = 0; y < height; ++y) png_write_row(png, pixels + 3 * static_cast<size_t>(width) * y);
@@ -63,5 +69,13 @@ void write_png(const Image& image, const std::string& path) {
   if (std::fclose(file) != 0 || !ok)
     throw std::runtime_error("cannot write " + path + ": libpng or the file failed");
 }
+
+#else
+bool png_available() { return false; }
+
+void write_png(const Image&, const std::string& path) {
+  throw std::runtime_error("cannot write " + path + ": this build has no libpng");
+}
+#endif
 
 }  // namespace sph_tools

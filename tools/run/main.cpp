@@ -6,6 +6,7 @@
 #include "cli_options.h"
 #include "exit_codes.h"
 #include "frame_writer.h"
+#include "image.h"
 #include "json_node.h"
 #include "library_error.h"
 #include "run_loop.h"
@@ -47,8 +48,9 @@ int run(int argc, char** argv) {
   }
   if (cli.version) {
     std::printf("sph-run, %s\n", sph_get_build_info());
-    std::printf("outputs: csv, ply%s%s\n", format_available(OutputFormat::kVdb) ? ", vdb" : "",
-                surface_available() ? ", surfaces (vdb + obj)" : "");
+    std::printf("outputs: csv, ply%s%s%s\n", format_available(OutputFormat::kVdb) ? ", vdb" : "",
+                surface_available() ? ", surfaces (vdb + obj)" : "",
+                png_available() ? ", preview (png)" : "");
     return kExitOk;
   }
 
@@ -81,6 +83,10 @@ int run(int argc, char** argv) {
     return fail(kExitUnavailable, std::string(cli.surface ? "--surface" : "output.surface") +
                                       ": surfaces need OpenVDB, which this build lacks");
   out.preview = cli.preview || scene.output.preview;
+  if (out.preview && !png_available())
+    return fail(kExitUnavailable,
+                std::string(cli.preview ? "--preview" : "output.preview") +
+                    ": preview images need libpng, which this build lacks (install libpng-dev)");
   out.preview_surface = scene.output.preview_surface;
   const float spacing = scene.world.particle_spacing;
   out.surface_radius = scene.output.surface_radius > 0.0f ? scene.output.surface_radius : spacing;
