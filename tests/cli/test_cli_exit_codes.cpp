@@ -105,6 +105,28 @@ void test_cuda_without_gpu_exits_4(void**) {
   }
 }
 
+// Outputs a build lacks are refused up front with their own code (5), saying what is missing.
+void test_missing_outputs_exit_5(void**) {
+  const std::string dir = cli_test::make_temp_dir("unavailable");
+  const std::string scene = g_scenes + "/tiny.json";
+  std::string out;
+#ifdef CLI_TEST_NO_OPENVDB
+  assert_int_equal(run({scene, "--format", "vdb", "--out", dir}, &out), 5);
+  assert_true(contains(out, "this build has no OpenVDB"));
+  assert_int_equal(run({scene, "--surface", "--out", dir}, &out), 5);
+  assert_true(contains(out, "surfaces need OpenVDB"));
+#else
+  assert_int_equal(run({scene, "--frames", "0", "--format", "vdb", "--surface", "--out", dir}, &out), 0);
+#endif
+#ifdef CLI_TEST_NO_PNG
+  assert_int_equal(run({scene, "--preview", "--out", dir}, &out), 5);
+  assert_true(contains(out, "preview images need libpng"));
+#else
+  assert_int_equal(run({scene, "--frames", "0", "--format", "none", "--preview", "--out", dir}, &out), 0);
+  assert_true(cli_test::file_exists(dir + "/preview_0000.png"));
+#endif
+}
+
 // SIGINT in the middle of a long run: exit 130, frames 0..k all complete (each PLY parses to
 // the length its header gives), nothing under a temporary name, nothing of frame k+1.
 void test_interrupt_keeps_only_complete_frames(void**) {
@@ -160,6 +182,7 @@ int main(int argc, char** argv) {
       cmocka_unit_test(test_usage_errors_exit_2),
       cmocka_unit_test(test_scene_errors_exit_3),
       cmocka_unit_test(test_cuda_without_gpu_exits_4),
+      cmocka_unit_test(test_missing_outputs_exit_5),
       cmocka_unit_test(test_interrupt_keeps_only_complete_frames),
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);

@@ -154,8 +154,13 @@ void test_library_rejections_name_the_object(void**) {
   expect_build_error(
       R"({"colliders": [{"shape": {"type": "box", "half_extents": [100, 100, 100], "voxel_size": 0.001}}]})",
       "colliders[0].shape: the library rejected the shape: ");
+#ifdef SPH_TOOLS_HAVE_VDB
   expect_build_error(R"({"colliders": [{"shape": {"type": "vdb", "file": "no_such_file.vdb"}}]})",
                      "colliders[0].shape.file: cannot load a level set from ./no_such_file.vdb");
+#else
+  expect_build_error(R"({"colliders": [{"shape": {"type": "vdb", "file": "no_such_file.vdb"}}]})",
+                     "colliders[0].shape.type: \"vdb\" shapes need tools built with OpenVDB");
+#endif
 }
 
 void test_missing_file_is_a_scene_error(void**) {
