@@ -13,6 +13,7 @@
 #include "scene_error.h"
 #include "scene_parser.h"
 #include "sph_c.h"
+#include "vdb_bounds.h"
 
 namespace sph_tools {
 namespace {
@@ -62,6 +63,7 @@ int run(int argc, char** argv) {
     return fail(kExitScene, cli.scene + ": " + e.what());
   }
   if (cli.frames) scene.frames = *cli.frames;
+  fill_vdb_bounds(&scene);  // the extent of .vdb level sets, for the preview
   FrameWriterOptions out;
   out.directory = cli.out                           ? *cli.out
                   : !scene.output.directory.empty() ? scene.output.directory

@@ -21,6 +21,10 @@ struct ShapeDesc {
   std::string vdb_file;       // kVdb: absolute path
   std::string vdb_grid;       // kVdb: grid name, "" = the first float level set
   std::string path;           // where in the file, for errors ("colliders[1].shape")
+  // kVdb: the box of the level set's active voxels in its local frame, when a tool that reads
+  // OpenVDB files has filled it in (sph-run does, for the preview's camera and silhouettes).
+  bool has_vdb_bounds = false;
+  sph_vec3 vdb_bounds_min{}, vdb_bounds_max{};
 };
 
 // A fluid body added at `time` (s): a box or sphere filled on the FCC lattice, or explicit

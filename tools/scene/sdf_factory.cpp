@@ -42,7 +42,11 @@ sph_sdf* create_sdf(sph_context* context, const ShapeDesc& shape) {
 }
 
 bool shape_local_bounds(const ShapeDesc& shape, sph_vec3* min, sph_vec3* max) {
-  if (shape.kind != ShapeDesc::Kind::kAnalytic) return false;
+  if (shape.kind == ShapeDesc::Kind::kVdb) {
+    *min = shape.vdb_bounds_min;
+    *max = shape.vdb_bounds_max;
+    return shape.has_vdb_bounds;
+  }
   const sph_shape_desc& d = shape.analytic;
   const float w = d.wall_thickness;
   sph_vec3 h{0.0f, 0.0f, 0.0f};

@@ -14,8 +14,8 @@ sph_sdf* create_sdf(sph_context* context, const ShapeDesc& shape);
 // Whether .vdb shapes can be loaded (the tools were built with libsph_vdb).
 bool vdb_shapes_supported();
 
-// The box in the asset's local frame that holds the shape's surface (analytic shapes:
-// exact; .vdb level sets: false, unknown).
+// The box in the asset's local frame that holds the shape's surface (analytic shapes: exact;
+// .vdb level sets: the active voxels' box when ShapeDesc has it, else false).
 bool shape_local_bounds(const ShapeDesc& shape, sph_vec3* min, sph_vec3* max);
 
 }  // namespace sph_tools

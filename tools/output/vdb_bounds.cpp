@@ -1,0 +1,70 @@
+#include "vdb_bounds.h"
+
+#ifdef SPH_TOOLS_HAVE_OPENVDB
+#include <openvdb/openvdb.h>
+
+#include <cmath>
+#include <mutex>
+#endif
+
+namespace sph_tools {
+
+#ifdef SPH_TOOLS_HAVE_OPENVDB
+namespace {
+
+void fill_one(ShapeDesc* shape) {
+  if (shape->kind != ShapeDesc::Kind::kVdb) return;
+  static std::once_flag once;
+  std::call_once(once, [] { openvdb::initialize(); });
+  try {
+    openvdb::io::File file(shape->vdb_file);
+    file.open();
+    openvdb::FloatGrid::Ptr grid;
+    for (auto it = file.beginName(); it != file.endName() && !grid; ++it) {
+      if (!shape->vdb_grid.empty() && it.gridName() != shape->vdb_grid) continue;
+      openvdb::FloatGrid::Ptr candidate =
+          openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(it.gridName()));
+      if (candidate && (!shape->vdb_grid.empty() || candidate->getGridClass() == openvdb::GRID_LEVEL_SET))
+        grid = candidate;
+    }
+    file.close();
+    if (!grid) return;
+    const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
+    if (box.empty()) return;
+    bool first = true;
+    for (int k = 0; k < 8; ++k) {
+      const openvdb::Vec3d corner((k & 1 ? box.max().x() : box.min().x()) + (k & 1 ? 0.5 : -0.5),
+                                  (k & 2 ? box.max().y() : box.min().y()) + (k & 2 ? 0.5 : -0.5),
+                                  (k & 4 ? box.max().z() : box.min().z()) + (k & 4 ? 0.5 : -0.5));
+      const openvdb::Vec3d w = grid->indexToWorld(corner);
+      const sph_vec3 p{static_cast<float>(w.x()), static_cast<float>(w.y()), static_cast<float>(w.z())};
+      shape->vdb_bounds_min =
+          first ? p
+                : sph_vec3{std::fmin(shape->vdb_bounds_min.x, p.x), std::fmin(shape->vdb_bounds_min.y, p.y),
+                           std::fmin(shape->vdb_bounds_min.z, p.z)};
+      shape->vdb_bounds_max =
+          first ? p
+                : sph_vec3{std::fmax(shape->vdb_bounds_max.x, p.x), std::fmax(shape->vdb_bounds_max.y, p.y),
+                           std::fmax(shape->vdb_bounds_max.z, p.z)};
+      first = false;
+    }
+    shape->has_vdb_bounds = true;
+  } catch (const openvdb::Exception&) {
+    // Unreadable: building the world says why.
+  }
+}
+
+}  // namespace
+
+void fill_vdb_bounds(SceneDesc* scene) {
+  for (ColliderDesc& c : scene->colliders) fill_one(&c.shape);
+  for (SourceDesc& s : scene->sources) fill_one(&s.shape);
+  for (SinkDesc& s : scene->sinks) fill_one(&s.shape);
+  for (ForceFieldDesc& f : scene->force_fields)
+    if (f.has_region) fill_one(&f.region);
+}
+#else
+void fill_vdb_bounds(SceneDesc*) {}
+#endif
+
+}  // namespace sph_tools
