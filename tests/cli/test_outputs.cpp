@@ -6,6 +6,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/points/PointDataGrid.h>
 #include <openvdb/tools/Interpolation.h>
+#include <openvdb/tools/LevelSetSphere.h>
 #endif
 
 #include <algorithm>
@@ -241,6 +242,47 @@ void test_surface_encloses_fluid(void**) {
   assert_true(faces > 100);
   assert_true(volume > 0.7 * fluid && volume < 1.5 * fluid);
 }
+
+// A collider from a .vdb level set (sph_vdb_load_sdf through the scene file, the file name
+// relative to the scene): fluid dropped onto a sphere read from a file stays out of it.
+void test_vdb_level_set_collider(void**) {
+  const std::string dir = cli_test::make_temp_dir("vdb_collider");
+  openvdb::initialize();
+  openvdb::FloatGrid::Ptr ball = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
+      0.1f, openvdb::Vec3f(0.0f, 0.1f, 0.0f), 0.005f, 3.0f);
+  ball->setName("ball");
+  openvdb::io::File file(dir + "/ball.vdb");
+  file.write(openvdb::GridPtrVec{ball});
+  file.close();
+  cli_test::write_text(dir + "/scene.json", R"({
+    "world": {"capacity": 4000, "particle_spacing": 0.02},
+    "time": {"fps": 50, "frames": 12},
+    "fluids": [{"type": "box", "min": [-0.06, 0.25, -0.06], "max": [0.06, 0.35, 0.06]}],
+    "colliders": [{"shape": {"type": "vdb", "file": "ball.vdb", "grid": "ball"}}],
+    "output": {"format": "ply"}})");
+  std::string log;
+  const int status = cli_test::run(
+      {g_sph_run, dir + "/scene.json", "--backend", "cpu", "--out", dir + "/out", "--preview", "--quiet"},
+      &log);
+  std::printf("%s", log.c_str());
+  assert_int_equal(status, 0);
+  cli_test::Particles p;
+  std::string error;
+  assert_true(cli_test::read_ply(dir + "/out/fluid_0012.ply", &p, &error));
+  float lowest = 1e9f;
+  for (size_t i = 0; i < p.count(); ++i) {
+    const float x = p.position[3 * i], y = p.position[3 * i + 1] - 0.1f, z = p.position[3 * i + 2];
+    assert_true(std::sqrt(x * x + y * y + z * z) > 0.1f - 0.01f);  // outside the ball (half a spacing)
+    lowest = std::min(lowest, p.position[3 * i + 1]);
+  }
+  assert_true(lowest < 0.25f);  // the fluid did fall onto the ball
+  // A missing grid name is a scene error at the shape's file.
+  cli_test::write_text(dir + "/bad.json",
+                       R"({"colliders": [{"shape": {"type": "vdb", "file": "ball.vdb", "grid": "cube"}}]})");
+  assert_int_equal(cli_test::run({g_sph_run, dir + "/bad.json", "--out", dir + "/bad"}, &log), 3);
+  assert_true(log.find("colliders[0].shape.file: cannot load a level set from " + dir + "/ball.vdb") !=
+              std::string::npos);
+}
 #endif
 
 }  // namespace
@@ -257,6 +299,7 @@ int main(int argc, char** argv) {
       cmocka_unit_test(test_run_outputs_equal_world),
 #ifdef SPH_TOOLS_HAVE_OPENVDB
       cmocka_unit_test(test_surface_encloses_fluid),
+      cmocka_unit_test(test_vdb_level_set_collider),
 #endif
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);
