@@ -101,6 +101,10 @@ const Case kCases[] = {
     {R"({"output": {"surface": {"enabled": true, "iso": 0.5}}})", "output.surface.iso: unknown field"},
     {"{\"world\": {\n  \"capacity\": 10,\n}}", "not valid JSON: parse error at line 3, column 1"},
     {"[1, 2]", "expected a scene (an object), got an array of 2"},
+    {R"({"colliders": [{"shape": {"type": "sphere", "radius": 1}},
+                       {"shape": {"type": "sphere", "radius": 1, "radius": 2}}]})",
+     "colliders[1].shape.radius: given twice in one object"},
+    {R"({"time": {"fps": 30}, "time": {"fps": 60}})", "time: given twice in one object"},
 };
 
 void test_each_bad_field_names_its_path(void**) {

@@ -1,8 +1,11 @@
 #include "scene_parser.h"
 
+#include <sys/stat.h>
+
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "json_node.h"
@@ -20,12 +23,61 @@ void parse_list(const JsonNode& node, const char* what, std::vector<T>* out, F p
   for (size_t i = 0; i < n; ++i) out->push_back(parse_one(node.index(i)));
 }
 
+// Rejects a key given twice in one object (JSON parsers keep one of them silently), with the
+// path of the second.
+class DuplicateKeyCheck {
+ public:
+  bool operator()(int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+    using Event = nlohmann::json::parse_event_t;
+    switch (event) {
+      case Event::object_start:
+      case Event::array_start:
+        if (!frames_.empty() && frames_.back().is_array) ++frames_.back().index;
+        frames_.push_back(Frame{event == Event::array_start, -1, {}, {}});
+        break;
+      case Event::object_end:
+      case Event::array_end:
+        if (!frames_.empty()) frames_.pop_back();
+        break;
+      case Event::key: {
+        Frame& top = frames_.back();
+        top.key = parsed.get<std::string>();
+        if (!top.seen.insert(top.key).second) throw SceneError(path(), "given twice in one object");
+        break;
+      }
+      case Event::value:
+        if (!frames_.empty() && frames_.back().is_array) ++frames_.back().index;
+        break;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool is_array;
+    long index;
+    std::string key;
+    std::set<std::string> seen;
+  };
+  std::string path() const {
+    std::string p;
+    for (const Frame& f : frames_) {
+      if (f.is_array)
+        p += "[" + std::to_string(f.index) + "]";
+      else
+        p += (p.empty() ? "" : ".") + f.key;
+    }
+    return p;
+  }
+  std::vector<Frame> frames_;
+};
+
 }  // namespace
 
 SceneDesc parse_scene(const std::string& text, const std::string& base_dir) {
   nlohmann::json root;
   try {
-    root = nlohmann::json::parse(text);
+    root = nlohmann::json::parse(text, DuplicateKeyCheck());
   } catch (const nlohmann::json::parse_error& e) {
     // e.what() reads "[json.exception.parse_error.101] parse error at line 3, column 5: ..."
     std::string what = e.what();
@@ -57,6 +109,9 @@ SceneDesc parse_scene(const std::string& text, const std::string& base_dir) {
 }
 
 SceneDesc load_scene_file(const std::string& file) {
+  struct stat st;
+  if (stat(file.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+    throw SceneError("", "cannot open " + file + ": a directory, not a scene file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw SceneError("", "cannot open " + file + ": " + std::strerror(errno));
   std::stringstream text;
