@@ -474,8 +474,9 @@ static inline sph_result sph_stats_init(sph_stats* stats) {
   return sph_stats_init_sized(stats, (uint32_t)sizeof(*stats));
 }
 /**
- * Statistics of the last sph_world_step (zeros before the first). out->struct_size must be
- * set (sph_stats_init); only that many bytes are written.
+ * Statistics of the last sph_world_step: before the first step its fields are zero, except
+ * particle_count, simulated_time and memory_bytes, which are always current.
+ * out->struct_size must be set (sph_stats_init); only that many bytes are written.
  */
 SPH_API sph_result SPH_CALL sph_world_get_stats(const sph_world* world, sph_stats* out);
 

@@ -1499,8 +1499,9 @@ namespace Sph
         public static extern Result sph_stats_init_sized(IntPtr stats, uint size);
 
         /// <summary>
-        /// Statistics of the last sph_world_step (zeros before the first). out-&gt;struct_size must be
-        /// set (sph_stats_init); only that many bytes are written.
+        /// Statistics of the last sph_world_step: before the first step its fields are zero, except
+        /// particle_count, simulated_time and memory_bytes, which are always current.
+        /// out-&gt;struct_size must be set (sph_stats_init); only that many bytes are written.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_get_stats(WorldHandle world, ref Stats @out);

@@ -10,7 +10,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '4093fddce71ca04be9fca1e40aed42c67836b0c4762657fd35a807c9d78f904a', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
+HEADERS = {'include/sph_c.h': '7f81740dfa9e15336a87ee17a26d3ab4dbc1bae5abc317e04c18d33ec5bbe23f', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -1302,7 +1302,7 @@ FUNCTIONS = {
     'sph_stats_init_sized': (sph_result, (_c.POINTER(sph_stats), _c.c_uint32), ('stats', 'size'),
         '', 'sph'),
     'sph_world_get_stats': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_stats)), ('world', 'out'),
-        'Statistics of the last sph_world_step (zeros before the first). out->struct_size must be set (sph_stats_init); only that many bytes are written.', 'sph'),
+        'Statistics of the last sph_world_step: before the first step its fields are zero, except particle_count, simulated_time and memory_bytes, which are always current. out->struct_size must be set (sph_stats_init); only that many bytes are written.', 'sph'),
     'sph_grid_desc_init_sized': (sph_result, (_c.POINTER(sph_grid_desc), _c.c_uint32), ('desc', 'size'),
         '', 'sph'),
     'sph_sdf_desc_init_sized': (sph_result, (_c.POINTER(sph_sdf_desc), _c.c_uint32), ('desc', 'size'),
