@@ -535,11 +535,13 @@ SPH_API sph_result SPH_CALL sph_sdf_create(sph_context* context, const sph_sdf_d
 
 typedef enum sph_shape {
   SPH_SHAPE_PLANE = 0,    /* solid below y = 0; half_extents.x/.z its size, .y its thickness */
-  SPH_SHAPE_BOX = 1,      /* half_extents; wall_thickness > 0 makes a hollow box (a tank) */
+  SPH_SHAPE_BOX = 1,      /* half_extents; wall_thickness > 0 makes a hollow box (a tank) whose
+                             cavity is half_extents, walls outside it */
   SPH_SHAPE_SPHERE = 2,   /* radius */
   SPH_SHAPE_CAPSULE = 3,  /* radius around the segment y in [-half_height, half_height] */
   SPH_SHAPE_CYLINDER = 4, /* radius, half_height, axis y */
-  SPH_SHAPE_CUP = 5,      /* an open cylinder: inner radius, half_height, wall_thickness */
+  SPH_SHAPE_CUP = 5,      /* an open cylinder: radius is the cavity's, the wall (wall_thickness)
+                             lies outside it and the floor inside half_height */
   SPH_SHAPE_FORCE32 = 0x7fffffff
 } sph_shape;
 

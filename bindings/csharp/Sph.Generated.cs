@@ -201,7 +201,10 @@ namespace Sph
     {
         /// <summary>solid below y = 0; half_extents.x/.z its size, .y its thickness</summary>
         Plane = 0,
-        /// <summary>half_extents; wall_thickness &gt; 0 makes a hollow box (a tank)</summary>
+        /// <summary>
+        /// half_extents; wall_thickness &gt; 0 makes a hollow box (a tank) whose cavity is
+        /// half_extents, walls outside it
+        /// </summary>
         Box = 1,
         /// <summary>radius</summary>
         Sphere = 2,
@@ -209,7 +212,10 @@ namespace Sph
         Capsule = 3,
         /// <summary>radius, half_height, axis y</summary>
         Cylinder = 4,
-        /// <summary>an open cylinder: inner radius, half_height, wall_thickness</summary>
+        /// <summary>
+        /// an open cylinder: radius is the cavity's, the wall (wall_thickness) lies outside it and the
+        /// floor inside half_height
+        /// </summary>
         Cup = 5,
     }
 
@@ -2570,11 +2576,11 @@ namespace Sph
             { "SPH_MEMORY_HOST", "ordinary host memory" },
             { "SPH_MEMORY_CUDA_DEVICE", "device memory of the context's CUDA device (CUDA contexts only)" },
             { "SPH_SHAPE_PLANE", "solid below y = 0; half_extents.x/.z its size, .y its thickness" },
-            { "SPH_SHAPE_BOX", "half_extents; wall_thickness > 0 makes a hollow box (a tank)" },
+            { "SPH_SHAPE_BOX", "half_extents; wall_thickness > 0 makes a hollow box (a tank) whose cavity is half_extents, walls outside it" },
             { "SPH_SHAPE_SPHERE", "radius" },
             { "SPH_SHAPE_CAPSULE", "radius around the segment y in [-half_height, half_height]" },
             { "SPH_SHAPE_CYLINDER", "radius, half_height, axis y" },
-            { "SPH_SHAPE_CUP", "an open cylinder: inner radius, half_height, wall_thickness" },
+            { "SPH_SHAPE_CUP", "an open cylinder: radius is the cavity's, the wall (wall_thickness) lies outside it and the floor inside half_height" },
             { "SPH_SDF_CHANNEL_VELOCITY", "3 floats per voxel" },
             { "SPH_SOURCE_FILL_ONCE", "fill the region at the next step, then stay idle" },
             { "SPH_SOURCE_CONTINUOUS", "refill the region at every step, at most `rate` particles/s" },

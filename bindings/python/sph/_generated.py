@@ -10,7 +10,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '7f81740dfa9e15336a87ee17a26d3ab4dbc1bae5abc317e04c18d33ec5bbe23f', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
+HEADERS = {'include/sph_c.h': '52c081d9e9620ef370591b3b9d77dd7e82285823448ac1850291b7efb8112115', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -256,11 +256,11 @@ class MemoryKind(_enum.IntEnum):
 
 sph_shape = _c.c_int32
 SPH_SHAPE_PLANE = 0  # solid below y = 0; half_extents.x/.z its size, .y its thickness
-SPH_SHAPE_BOX = 1  # half_extents; wall_thickness > 0 makes a hollow box (a tank)
+SPH_SHAPE_BOX = 1  # half_extents; wall_thickness > 0 makes a hollow box (a tank) whose cavity is half_extents, walls outside it
 SPH_SHAPE_SPHERE = 2  # radius
 SPH_SHAPE_CAPSULE = 3  # radius around the segment y in [-half_height, half_height]
 SPH_SHAPE_CYLINDER = 4  # radius, half_height, axis y
-SPH_SHAPE_CUP = 5  # an open cylinder: inner radius, half_height, wall_thickness
+SPH_SHAPE_CUP = 5  # an open cylinder: radius is the cavity's, the wall (wall_thickness) lies outside it and the floor inside half_height
 SPH_SHAPE_FORCE32 = 2147483647
 
 
@@ -268,7 +268,8 @@ class Shape(_enum.IntEnum):
     """sph_shape"""
     #: solid below y = 0; half_extents.x/.z its size, .y its thickness
     PLANE = 0
-    #: half_extents; wall_thickness > 0 makes a hollow box (a tank)
+    #: half_extents; wall_thickness > 0 makes a hollow box (a tank) whose cavity is half_extents,
+    #: walls outside it
     BOX = 1
     #: radius
     SPHERE = 2
@@ -276,7 +277,8 @@ class Shape(_enum.IntEnum):
     CAPSULE = 3
     #: radius, half_height, axis y
     CYLINDER = 4
-    #: an open cylinder: inner radius, half_height, wall_thickness
+    #: an open cylinder: radius is the cavity's, the wall (wall_thickness) lies outside it and the
+    #: floor inside half_height
     CUP = 5
 
 
@@ -401,11 +403,11 @@ ENUM_MEMBER_DOCS = {
     'SPH_MEMORY_HOST': 'ordinary host memory',
     'SPH_MEMORY_CUDA_DEVICE': "device memory of the context's CUDA device (CUDA contexts only)",
     'SPH_SHAPE_PLANE': 'solid below y = 0; half_extents.x/.z its size, .y its thickness',
-    'SPH_SHAPE_BOX': 'half_extents; wall_thickness > 0 makes a hollow box (a tank)',
+    'SPH_SHAPE_BOX': 'half_extents; wall_thickness > 0 makes a hollow box (a tank) whose cavity is half_extents, walls outside it',
     'SPH_SHAPE_SPHERE': 'radius',
     'SPH_SHAPE_CAPSULE': 'radius around the segment y in [-half_height, half_height]',
     'SPH_SHAPE_CYLINDER': 'radius, half_height, axis y',
-    'SPH_SHAPE_CUP': 'an open cylinder: inner radius, half_height, wall_thickness',
+    'SPH_SHAPE_CUP': "an open cylinder: radius is the cavity's, the wall (wall_thickness) lies outside it and the floor inside half_height",
     'SPH_SDF_CHANNEL_VELOCITY': '3 floats per voxel',
     'SPH_SOURCE_FILL_ONCE': 'fill the region at the next step, then stay idle',
     'SPH_SOURCE_CONTINUOUS': 'refill the region at every step, at most `rate` particles/s',
