@@ -15,74 +15,12 @@
 #include <sys/stat.h>
 #include <sys/types.h>
 
+#include "sample_io.h"
 #include "sph_c.h"
-
-static int failed(sph_result r, const char* what) {
-  if (r < 0) {
-    fprintf(stderr, "fig6_pour_into_cup: %s failed: %s\n  %s\n", what, sph_result_string(r),
-            sph_get_last_error());
-    return 1;
-  }
-  return 0;
-}
-
-static int make_dirs(const char* path) {
-  char buf[4096];
-  size_t i, n = strlen(path);
-  if (n >= sizeof buf) return -1;
-  memcpy(buf, path, n + 1);
-  for (i = 1; i <= n; ++i) {
-    if (buf[i] == '/' || buf[i] == '\0') {
-      char saved = buf[i];
-      buf[i] = '\0';
-      if (mkdir(buf, 0755) != 0 && errno != EEXIST) return -1;
-      buf[i] = saved;
-    }
-  }
-  return 0;
-}
-
-/* Copies the particles out and writes DIR/frame_NNNN.csv through a temporary name. */
-static int write_frame(const sph_world* world, const char* dir, int frame) {
-  char path[4200], tmp[4300];
-  uint32_t n = 0, i;
-  float *x = NULL, *v = NULL, *rho = NULL;
-  uint32_t* id = NULL;
-  FILE* f = NULL;
-  int status = 1;
-  if (failed(sph_world_get_particle_count(world, &n), "sph_world_get_particle_count")) return 1;
-  x = malloc(12 * (size_t)n + 12);
-  v = malloc(12 * (size_t)n + 12);
-  rho = malloc(4 * (size_t)n + 4);
-  id = malloc(4 * (size_t)n + 4);
-  if (!x || !v || !rho || !id) goto done;
-  if (n > 0 &&
-      (failed(sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, x, 12ull * n, 0, 0, n, NULL), "copy") ||
-       failed(sph_world_copy_attribute(world, SPH_ATTRIBUTE_VELOCITY, v, 12ull * n, 0, 0, n, NULL), "copy") ||
-       failed(sph_world_copy_attribute(world, SPH_ATTRIBUTE_DENSITY, rho, 4ull * n, 0, 0, n, NULL), "copy") ||
-       failed(sph_world_copy_attribute(world, SPH_ATTRIBUTE_ID, id, 4ull * n, 0, 0, n, NULL), "copy")))
-    goto done;
-  snprintf(path, sizeof path, "%s/frame_%04d.csv", dir, frame);
-  snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  f = fopen(tmp, "w");
-  if (!f) goto done;
-  fprintf(f, "id,x,y,z,vx,vy,vz,density\n");
-  for (i = 0; i < n; ++i)
-    fprintf(f, "%u,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g\n", id[i], x[3 * i], x[3 * i + 1], x[3 * i + 2],
-            v[3 * i], v[3 * i + 1], v[3 * i + 2], rho[i]);
-  status = fclose(f) != 0 || rename(tmp, path) != 0;
-done:
-  if (status) fprintf(stderr, "fig6_pour_into_cup: cannot write frame %d to %s\n", frame, dir);
-  free(x);
-  free(v);
-  free(rho);
-  free(id);
-  return status;
-}
 
 int main(int argc, char** argv) {
   const char* out_dir = "out/fig6_pour_into_cup_c";
-  int frames = 360, frame, i, status = 1;
+  int frames = 360, frame, status = 1;
   sph_backend backend = SPH_BACKEND_AUTO;
   sph_context_def context_def;
   sph_context* context = NULL;
@@ -100,37 +38,21 @@ int main(int argc, char** argv) {
   sph_sdf *ground_sdf = NULL, *cup_sdf = NULL, *spout_sdf = NULL;
   int pouring = 1;
   const double pi = 3.14159265358979;
-  for (i = 1; i < argc; ++i) {
-    if (strcmp(argv[i], "--frames") == 0 && i + 1 < argc) {
-      frames = atoi(argv[++i]);
-    } else if (strcmp(argv[i], "--backend") == 0 && i + 1 < argc) {
-      const char* b = argv[++i];
-      backend = strcmp(b, "cpu") == 0    ? SPH_BACKEND_CPU
-                : strcmp(b, "cuda") == 0 ? SPH_BACKEND_CUDA
-                                         : SPH_BACKEND_AUTO;
-    } else if (argv[i][0] != '-') {
-      out_dir = argv[i];
-    } else {
-      fprintf(stderr, "usage: fig6_pour_into_cup [OUTPUT_DIR] [--frames N] [--backend auto|cpu|cuda]\n");
-      return 2;
-    }
-  }
-  if (make_dirs(out_dir) != 0) {
-    fprintf(stderr, "fig6_pour_into_cup: cannot create %s: %s\n", out_dir, strerror(errno));
-    return 1;
-  }
+  status = sample_parse_args(argc, argv, "fig6_pour_into_cup", &out_dir, &frames, &backend);
+  if (status != 0) return status;
+  status = 1;
 
   sph_context_def_init(&context_def);
   context_def.backend = backend;
-  if (failed(sph_context_create(&context_def, &context), "sph_context_create")) return 1;
+  if (sample_failed(sph_context_create(&context_def, &context), "sph_context_create")) return 1;
 
   sph_world_def_init(&world_def);
   world_def.capacity = 320000;
   world_def.particle_spacing = 0.005f;
-  if (failed(sph_world_create(context, &world_def, &world), "sph_world_create")) goto done;
+  if (sample_failed(sph_world_create(context, &world_def, &world), "sph_world_create")) goto done;
   sph_world_params_init(&params);
   params.dt_max = 0.0003f; /* sqrt(k) dt below 0.4 h at h = 9 mm */
-  if (failed(sph_world_set_params(world, &params), "sph_world_set_params")) goto done;
+  if (sample_failed(sph_world_set_params(world, &params), "sph_world_set_params")) goto done;
 
   /* The ground: solid below y = 0 over 2.4 m x 2.4 m. */
   sph_shape_desc_init(&shape);
@@ -139,12 +61,12 @@ int main(int argc, char** argv) {
   shape.half_extents.y = 0.05f;
   shape.half_extents.z = 1.2f;
   shape.voxel_size = 0.01f;
-  if (failed(sph_sdf_create_shape(context, &shape, &ground_sdf), "sph_sdf_create_shape")) goto done;
+  if (sample_failed(sph_sdf_create_shape(context, &shape, &ground_sdf), "sph_sdf_create_shape")) goto done;
   sph_collider_def_init(&def);
   def.sdf = ground_sdf;
   def.transform = sph_transform_identity();
   def.friction = 0.2f;
-  if (failed(sph_collider_create(world, &def, &ground_id), "sph_collider_create")) goto done;
+  if (sample_failed(sph_collider_create(world, &def, &ground_id), "sph_collider_create")) goto done;
 
   /* The cup: inner radius 16 cm, 40 cm tall, 1.5 cm walls and floor, standing on the ground. */
   sph_shape_desc_init(&shape);
@@ -153,13 +75,13 @@ int main(int argc, char** argv) {
   shape.half_height = 0.2f;
   shape.wall_thickness = 0.015f;
   shape.voxel_size = 0.0025f;
-  if (failed(sph_sdf_create_shape(context, &shape, &cup_sdf), "sph_sdf_create_shape")) goto done;
+  if (sample_failed(sph_sdf_create_shape(context, &shape, &cup_sdf), "sph_sdf_create_shape")) goto done;
   sph_collider_def_init(&def);
   def.sdf = cup_sdf;
   def.transform = sph_transform_identity();
   def.transform.position.y = 0.2f;
   def.friction = 0.1f;
-  if (failed(sph_collider_create(world, &def, &cup_id), "sph_collider_create")) goto done;
+  if (sample_failed(sph_collider_create(world, &def, &cup_id), "sph_collider_create")) goto done;
 
   /* The spout: a disc 9 cm across, 20 cm above the rim, refilled every step as the stream
    * leaves it (at 1.5 m/s the liquid falls 2.5 cm a frame, less than the disc's 3 cm, so the
@@ -169,7 +91,7 @@ int main(int argc, char** argv) {
   shape.radius = 0.045f;
   shape.half_height = 0.015f;
   shape.voxel_size = 0.0025f;
-  if (failed(sph_sdf_create_shape(context, &shape, &spout_sdf), "sph_sdf_create_shape")) goto done;
+  if (sample_failed(sph_sdf_create_shape(context, &shape, &spout_sdf), "sph_sdf_create_shape")) goto done;
   sph_source_def_init(&spout);
   spout.mode = SPH_SOURCE_CONTINUOUS;
   spout.region = spout_sdf;
@@ -178,7 +100,7 @@ int main(int argc, char** argv) {
   spout.transform.position.y = 0.6f;
   spout.velocity.y = -1.5f;
   spout.rate = 120000.0f;
-  if (failed(sph_source_create(world, &spout, &spout_id), "sph_source_create")) goto done;
+  if (sample_failed(sph_source_create(world, &spout, &spout_id), "sph_source_create")) goto done;
 
   /* Whatever leaves the ground's extent is removed. */
   sph_sink_def_init(&bounds);
@@ -189,14 +111,14 @@ int main(int argc, char** argv) {
   bounds.bounds_max.x = 1.2f;
   bounds.bounds_max.y = 1.5f;
   bounds.bounds_max.z = 1.2f;
-  if (failed(sph_sink_create(world, &bounds, &bounds_id), "sph_sink_create")) goto done;
+  if (sample_failed(sph_sink_create(world, &bounds, &bounds_id), "sph_sink_create")) goto done;
 
   printf("fig6_pour_into_cup: %d frames -> %s/\n", frames, out_dir);
-  if (write_frame(world, out_dir, 0)) goto done;
+  if (sample_write_frame(world, out_dir, 0)) goto done;
   for (frame = 1; frame <= frames; ++frame) {
     const double t = (frame - 1) / 60.0; /* the time at the frame's start */
     if (pouring && t >= 2.5 - 1e-6) {    /* the pour stops after 2.5 s */
-      if (failed(sph_source_destroy(world, spout_id), "sph_source_destroy")) goto done;
+      if (sample_failed(sph_source_destroy(world, spout_id), "sph_source_destroy")) goto done;
       pouring = 0;
     }
     { /* from 2.8 s to 4.3 s the cup tips 95 degrees about its bottom edge (x = 0.175, y = 0) */
@@ -208,12 +130,12 @@ int main(int argc, char** argv) {
       target.position.y = (float)(0.175 * sin(angle) + 0.2 * cos(angle));
       target.rotation.z = (float)sin(-0.5 * angle);
       target.rotation.w = (float)cos(-0.5 * angle);
-      if (failed(sph_collider_set_target_transform(world, cup_id, &target),
-                 "sph_collider_set_target_transform"))
+      if (sample_failed(sph_collider_set_target_transform(world, cup_id, &target),
+                        "sph_collider_set_target_transform"))
         goto done;
     }
-    if (failed(sph_world_step(world, 1.0f / 60.0f), "sph_world_step")) goto done;
-    if (write_frame(world, out_dir, frame)) goto done;
+    if (sample_failed(sph_world_step(world, 1.0f / 60.0f), "sph_world_step")) goto done;
+    if (sample_write_frame(world, out_dir, frame)) goto done;
     sph_stats_init(&stats);
     sph_world_get_stats(world, &stats);
     if (frame % 30 == 0 || frame == frames)

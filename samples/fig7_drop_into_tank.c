@@ -13,74 +13,12 @@
 #include <sys/stat.h>
 #include <sys/types.h>
 
+#include "sample_io.h"
 #include "sph_c.h"
-
-static int failed(sph_result r, const char* what) {
-  if (r < 0) {
-    fprintf(stderr, "fig7_drop_into_tank: %s failed: %s\n  %s\n", what, sph_result_string(r),
-            sph_get_last_error());
-    return 1;
-  }
-  return 0;
-}
-
-static int make_dirs(const char* path) {
-  char buf[4096];
-  size_t i, n = strlen(path);
-  if (n >= sizeof buf) return -1;
-  memcpy(buf, path, n + 1);
-  for (i = 1; i <= n; ++i) {
-    if (buf[i] == '/' || buf[i] == '\0') {
-      char saved = buf[i];
-      buf[i] = '\0';
-      if (mkdir(buf, 0755) != 0 && errno != EEXIST) return -1;
-      buf[i] = saved;
-    }
-  }
-  return 0;
-}
-
-/* Copies the particles out and writes DIR/frame_NNNN.csv through a temporary name. */
-static int write_frame(const sph_world* world, const char* dir, int frame) {
-  char path[4200], tmp[4300];
-  uint32_t n = 0, i;
-  float *x = NULL, *v = NULL, *rho = NULL;
-  uint32_t* id = NULL;
-  FILE* f = NULL;
-  int status = 1;
-  if (failed(sph_world_get_particle_count(world, &n), "sph_world_get_particle_count")) return 1;
-  x = malloc(12 * (size_t)n + 12);
-  v = malloc(12 * (size_t)n + 12);
-  rho = malloc(4 * (size_t)n + 4);
-  id = malloc(4 * (size_t)n + 4);
-  if (!x || !v || !rho || !id) goto done;
-  if (n > 0 &&
-      (failed(sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, x, 12ull * n, 0, 0, n, NULL), "copy") ||
-       failed(sph_world_copy_attribute(world, SPH_ATTRIBUTE_VELOCITY, v, 12ull * n, 0, 0, n, NULL), "copy") ||
-       failed(sph_world_copy_attribute(world, SPH_ATTRIBUTE_DENSITY, rho, 4ull * n, 0, 0, n, NULL), "copy") ||
-       failed(sph_world_copy_attribute(world, SPH_ATTRIBUTE_ID, id, 4ull * n, 0, 0, n, NULL), "copy")))
-    goto done;
-  snprintf(path, sizeof path, "%s/frame_%04d.csv", dir, frame);
-  snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  f = fopen(tmp, "w");
-  if (!f) goto done;
-  fprintf(f, "id,x,y,z,vx,vy,vz,density\n");
-  for (i = 0; i < n; ++i)
-    fprintf(f, "%u,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g\n", id[i], x[3 * i], x[3 * i + 1], x[3 * i + 2],
-            v[3 * i], v[3 * i + 1], v[3 * i + 2], rho[i]);
-  status = fclose(f) != 0 || rename(tmp, path) != 0;
-done:
-  if (status) fprintf(stderr, "fig7_drop_into_tank: cannot write frame %d to %s\n", frame, dir);
-  free(x);
-  free(v);
-  free(rho);
-  free(id);
-  return status;
-}
 
 int main(int argc, char** argv) {
   const char* out_dir = "out/fig7_drop_into_tank_c";
-  int frames = 300, frame, i, status = 1;
+  int frames = 300, frame, status = 1;
   sph_backend backend = SPH_BACKEND_AUTO;
   sph_context_def context_def;
   sph_context* context = NULL;
@@ -96,37 +34,21 @@ int main(int argc, char** argv) {
   sph_fill_sphere_desc drop;
   sph_sdf* tank_sdf = NULL;
   int second_added = 0;
-  for (i = 1; i < argc; ++i) {
-    if (strcmp(argv[i], "--frames") == 0 && i + 1 < argc) {
-      frames = atoi(argv[++i]);
-    } else if (strcmp(argv[i], "--backend") == 0 && i + 1 < argc) {
-      const char* b = argv[++i];
-      backend = strcmp(b, "cpu") == 0    ? SPH_BACKEND_CPU
-                : strcmp(b, "cuda") == 0 ? SPH_BACKEND_CUDA
-                                         : SPH_BACKEND_AUTO;
-    } else if (argv[i][0] != '-') {
-      out_dir = argv[i];
-    } else {
-      fprintf(stderr, "usage: fig7_drop_into_tank [OUTPUT_DIR] [--frames N] [--backend auto|cpu|cuda]\n");
-      return 2;
-    }
-  }
-  if (make_dirs(out_dir) != 0) {
-    fprintf(stderr, "fig7_drop_into_tank: cannot create %s: %s\n", out_dir, strerror(errno));
-    return 1;
-  }
+  status = sample_parse_args(argc, argv, "fig7_drop_into_tank", &out_dir, &frames, &backend);
+  if (status != 0) return status;
+  status = 1;
 
   sph_context_def_init(&context_def);
   context_def.backend = backend;
-  if (failed(sph_context_create(&context_def, &context), "sph_context_create")) return 1;
+  if (sample_failed(sph_context_create(&context_def, &context), "sph_context_create")) return 1;
 
   sph_world_def_init(&world_def); /* water at 1 cm */
   world_def.capacity = 64000;
   world_def.particle_spacing = 0.01f;
-  if (failed(sph_world_create(context, &world_def, &world), "sph_world_create")) goto done;
+  if (sample_failed(sph_world_create(context, &world_def, &world), "sph_world_create")) goto done;
   sph_world_params_init(&params);
   params.dt_max = 0.0005f; /* a 1 m/s splash at 1 cm spacing wants shorter steps than the default */
-  if (failed(sph_world_set_params(world, &params), "sph_world_set_params")) goto done;
+  if (sample_failed(sph_world_set_params(world, &params), "sph_world_set_params")) goto done;
 
   /* The tank: a hollow box, inside 60 cm x 70 cm x 60 cm with 2 cm walls, open at the top. */
   sph_shape_desc_init(&tank_shape);
@@ -137,13 +59,13 @@ int main(int argc, char** argv) {
   tank_shape.wall_thickness = 0.02f;
   tank_shape.flags = SPH_SHAPE_FLAG_OPEN_TOP;
   tank_shape.voxel_size = 0.005f;
-  if (failed(sph_sdf_create_shape(context, &tank_shape, &tank_sdf), "sph_sdf_create_shape")) goto done;
+  if (sample_failed(sph_sdf_create_shape(context, &tank_shape, &tank_sdf), "sph_sdf_create_shape")) goto done;
   sph_collider_def_init(&tank);
   tank.sdf = tank_sdf;
   tank.transform = sph_transform_identity();
   tank.transform.position.y = 0.35f; /* the floor at y = 0 */
   tank.friction = 0.1f;
-  if (failed(sph_collider_create(world, &tank, &tank_id), "sph_collider_create")) goto done;
+  if (sample_failed(sph_collider_create(world, &tank, &tank_id), "sph_collider_create")) goto done;
 
   /* Whatever splashes out of the tank and falls away is removed. */
   sph_sink_def_init(&bounds);
@@ -154,27 +76,27 @@ int main(int argc, char** argv) {
   bounds.bounds_max.x = 1.0f;
   bounds.bounds_max.y = 2.0f;
   bounds.bounds_max.z = 1.0f;
-  if (failed(sph_sink_create(world, &bounds, &bounds_id), "sph_sink_create")) goto done;
+  if (sample_failed(sph_sink_create(world, &bounds, &bounds_id), "sph_sink_create")) goto done;
 
   /* The first sphere, 34 cm across, its bottom 25 cm above the floor. */
   sph_fill_sphere_desc_init(&drop);
   drop.center.y = 0.42f;
   drop.radius = 0.17f;
-  if (failed(sph_world_fill_sphere(world, &drop, NULL), "sph_world_fill_sphere")) goto done;
+  if (sample_failed(sph_world_fill_sphere(world, &drop, NULL), "sph_world_fill_sphere")) goto done;
 
   printf("fig7_drop_into_tank: %d frames -> %s/\n", frames, out_dir);
-  if (write_frame(world, out_dir, 0)) goto done;
+  if (sample_write_frame(world, out_dir, 0)) goto done;
   for (frame = 1; frame <= frames; ++frame) {
     const double t = (frame - 1) / 60.0;    /* the time at the frame's start */
     if (!second_added && t >= 2.5 - 1e-6) { /* the second sphere */
       drop.center.x = 0.05f;
       drop.center.y = 0.62f;
       drop.center.z = -0.04f;
-      if (failed(sph_world_fill_sphere(world, &drop, NULL), "sph_world_fill_sphere")) goto done;
+      if (sample_failed(sph_world_fill_sphere(world, &drop, NULL), "sph_world_fill_sphere")) goto done;
       second_added = 1;
     }
-    if (failed(sph_world_step(world, 1.0f / 60.0f), "sph_world_step")) goto done;
-    if (write_frame(world, out_dir, frame)) goto done;
+    if (sample_failed(sph_world_step(world, 1.0f / 60.0f), "sph_world_step")) goto done;
+    if (sample_write_frame(world, out_dir, frame)) goto done;
     sph_stats_init(&stats);
     sph_world_get_stats(world, &stats);
     if (frame % 30 == 0 || frame == frames)
