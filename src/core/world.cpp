@@ -163,6 +163,9 @@ SceneFrame World::build_scene_frame(double frame_dt) const {
 bool World::step(double frame_dt) {
   const auto start = std::chrono::steady_clock::now();
   events_.clear();
+  // Reserved up front, so that nothing after the backend's frame can fail on an allocation:
+  // once the particles have moved, the rest of the step must not throw.
+  events_.reserve(sources_.size() + sinks_.size());
   // Everything a failed step must put back.
   const uint32_t count_before = particle_count();
   const uint32_t next_id_before = next_id_;
