@@ -198,41 +198,50 @@ class CudaBackend final : public Backend {
     const bool with_sinks = !scene_in.sinks.empty();
     uint32_t count_after = count_;
     std::vector<uint32_t> removed_ids, removed_by_sink(scene_in.sinks.size(), 0u);
-    guarded([&] {
-      if (!scene_in.empty()) {
-        SceneFrame scene = scene_in;
-        r_->sdf_cache.begin_frame();
-        bind_scene_views(scene, [&](const SdfAsset& a) { return r_->sdf_cache.bind(a, r_->stream); });
-        r_->sdf_cache.end_frame();
-        setup.scene = r_->scene_buffer.upload(scene, config_.kernel_radius, r_->stream);
-        if (with_sinks) r_->sinks.reserve(config_.capacity);
-        cuda_check(cudaStreamSynchronize(r_->stream), "upload of the scene");
-      }
-      FrameInput* input = r_->input.get();
-      input->frame_dt = frame_dt;
-      input->max_collider_speed = scene_in.max_collider_speed;
-      input->pad = 0;
-      if (!with_sinks) prepare_graph(setup);
-      cuda_check(cudaEventRecord(r_->frame_start, r_->stream), "cudaEventRecord");
-      if (with_sinks)
-        count_after = run_sink_frame_on_stream(setup, static_cast<uint32_t>(scene_in.sinks.size()),
-                                               removed_ids, removed_by_sink);
-      else if (use_graphs_)
-        r_->graph.launch(r_->stream);
-      else
-        run_frame_on_stream(setup);
-      cuda_check(cudaEventRecord(r_->frame_stop, r_->stream), "cudaEventRecord");
-      cuda_check(cudaStreamSynchronize(r_->stream), "frame");
-      cuda_check(cudaEventElapsedTime(&frame_ms, r_->frame_start, r_->frame_stop), "cudaEventElapsedTime");
-    });
+    bool frame_enqueued = false;  // the frame's first work (the rollback snapshot) is on the stream
+    try {
+      guarded([&] {
+        if (!scene_in.empty()) {
+          SceneFrame scene = scene_in;
+          r_->sdf_cache.begin_frame();
+          bind_scene_views(scene, [&](const SdfAsset& a) { return r_->sdf_cache.bind(a, r_->stream); });
+          r_->sdf_cache.end_frame();
+          setup.scene = r_->scene_buffer.upload(scene, config_.kernel_radius, r_->stream);
+          if (with_sinks) r_->sinks.reserve(config_.capacity);
+          cuda_check(cudaStreamSynchronize(r_->stream), "upload of the scene");
+        }
+        FrameInput* input = r_->input.get();
+        input->frame_dt = frame_dt;
+        input->max_collider_speed = scene_in.max_collider_speed;
+        input->pad = 0;
+        if (!with_sinks) prepare_graph(setup);
+        cuda_check(cudaEventRecord(r_->frame_start, r_->stream), "cudaEventRecord");
+        frame_enqueued = true;
+        if (with_sinks)
+          count_after = run_sink_frame_on_stream(setup, static_cast<uint32_t>(scene_in.sinks.size()),
+                                                 removed_ids, removed_by_sink);
+        else if (use_graphs_)
+          r_->graph.launch(r_->stream);
+        else
+          run_frame_on_stream(setup);
+        cuda_check(cudaEventRecord(r_->frame_stop, r_->stream), "cudaEventRecord");
+        cuda_check(cudaStreamSynchronize(r_->stream), "frame");
+        cuda_check(cudaEventElapsedTime(&frame_ms, r_->frame_start, r_->frame_stop), "cudaEventElapsedTime");
+      });
+    } catch (const Error& e) {
+      // A failure in the middle of a frame that did not lose the device (a host allocation
+      // for the removed ids, say): the substeps already run are undone from the frame's
+      // snapshot, so the failed step changes nothing.
+      if (frame_enqueued && e.status() != Status::DeviceLost) roll_back_frame();
+      throw;
+    } catch (const std::exception&) {
+      if (frame_enqueued) roll_back_frame();
+      throw;
+    }
     const FrameState s = *r_->state_output.get();
     ++epoch_;
     if (s.non_finite) {
-      guarded([&] {
-        r_->store->enqueue_restore(count_, r_->stream);
-        enqueue_restore_max_speed(r_->state.get(), r_->stream);
-        cuda_check(cudaStreamSynchronize(r_->stream), "rollback");
-      });
+      roll_back_frame();
       throw Error(Status::NonFinite, "the step produced a non-finite position or velocity in substep " +
                                          std::to_string(s.bad_substep) + " (dt " + std::to_string(s.bad_dt) +
                                          " s) at particle id " + std::to_string(s.bad_id) +
@@ -354,6 +363,17 @@ class CudaBackend final : public Backend {
     v.stride = stride;
     v.element_size = element;
     return v;
+  }
+
+  // Restores the particles (and the cached max speed) from the snapshot taken at the start of
+  // the frame; count_ is still the count before the frame.
+  void roll_back_frame() {
+    ++epoch_;
+    guarded([&] {
+      r_->store->enqueue_restore(count_, r_->stream);
+      enqueue_restore_max_speed(r_->state.get(), r_->stream);
+      cuda_check(cudaStreamSynchronize(r_->stream), "rollback");
+    });
   }
 
   void require_alive() const {
