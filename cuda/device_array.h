@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "cuda_status.h"
+#include "device_allocation_faults.h"
 
 namespace sph {
 
@@ -34,7 +35,8 @@ class DeviceArray {
     release();
     if (count == 0) return;
     void* p = nullptr;
-    const cudaError_t e = cudaMalloc(&p, count * sizeof(T));
+    const cudaError_t e = testing::device_allocation_fault_due() ? cudaErrorMemoryAllocation
+                                                                 : cudaMalloc(&p, count * sizeof(T));
     if (e != cudaSuccess) {
       (void)cudaGetLastError();
       if (e == cudaErrorMemoryAllocation)
@@ -73,7 +75,8 @@ class PinnedArray {
   void allocate(size_t count, const char* name) {
     release();
     void* p = nullptr;
-    const cudaError_t e = cudaMallocHost(&p, count * sizeof(T));
+    const cudaError_t e = testing::device_allocation_fault_due() ? cudaErrorMemoryAllocation
+                                                                 : cudaMallocHost(&p, count * sizeof(T));
     if (e != cudaSuccess) {
       (void)cudaGetLastError();
       if (e == cudaErrorMemoryAllocation)

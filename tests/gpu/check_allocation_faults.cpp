@@ -1,0 +1,256 @@
+// Device and pinned-host allocation failures on the CUDA backend (issue 9, item 6), injected
+// at every device allocation point of every call in turn through the hook in
+// cuda/device_allocation_faults.h (linked from sph_internal; libsph does not export it).
+//
+// For each call, n runs 0, 1, 2, ... until the call completes without reaching the n-th device
+// allocation. Every injected failure must come back as SPH_ERROR_OUT_OF_DEVICE_MEMORY (or
+// OUT_OF_HOST_MEMORY for pinned memory) with a message, leave the world bitwise as it was, and
+// the world must then step bitwise like an undisturbed copy (the CUDA backend is
+// deterministic: gpu_check_determinism).
+#include <functional>
+
+#include "../../cuda/device_allocation_faults.h"
+#include "gpu_check.h"
+
+using namespace gpu_check;
+namespace faults = sph::testing;
+
+namespace {
+
+constexpr float kFrameDt = 1.0f / 60.0f;
+
+struct Scene {
+  sph_context* context = nullptr;
+  sph_world* world = nullptr;
+  sph_sdf* tank = nullptr;
+  sph_sdf* blob = nullptr;
+};
+
+sph_transform at(float x, float y, float z) {
+  sph_transform t = sph_transform_identity();
+  t.position = sph_vec3{x, y, z};
+  return t;
+}
+
+enum class Objects { None, BeforeFirstStep, AfterFirstStep };
+
+// A tank with water and one frame behind it; with a tank collider, a continuous source and a
+// sink added before that frame, or after it (so the next step is their first).
+void build_scene(Scene* s, Objects objects) {
+  s->context = make_context(SPH_BACKEND_CUDA);
+  sph_world_def def;
+  sph_world_def_init(&def);
+  def.capacity = 4000;
+  def.particle_spacing = 0.02f;
+  require_ok(sph_world_create(s->context, &def, &s->world), "sph_world_create");
+  sph_shape_desc shape;
+  sph_shape_desc_init(&shape);
+  shape.shape = SPH_SHAPE_BOX;
+  shape.half_extents = sph_vec3{0.2f, 0.2f, 0.1f};
+  shape.wall_thickness = 0.04f;
+  shape.voxel_size = 0.02f;
+  require_ok(sph_sdf_create_shape(s->context, &shape, &s->tank), "tank");
+  sph_shape_desc_init(&shape);
+  shape.shape = SPH_SHAPE_SPHERE;
+  shape.radius = 0.04f;
+  shape.voxel_size = 0.02f;
+  require_ok(sph_sdf_create_shape(s->context, &shape, &s->blob), "blob");
+  sph_fill_box_desc box;
+  sph_fill_box_desc_init(&box);
+  box.min = sph_vec3{-0.18f, -0.18f, -0.08f};
+  box.max = sph_vec3{-0.02f, 0.02f, 0.08f};
+  require_ok(sph_world_fill_box(s->world, &box, nullptr), "fill");
+  if (objects == Objects::AfterFirstStep) require_ok(sph_world_step(s->world, kFrameDt), "first step");
+  if (objects != Objects::None) {
+    sph_collider_def collider;
+    sph_collider_def_init(&collider);
+    collider.sdf = s->tank;
+    collider.flags = SPH_COLLIDER_FLAG_INVERTED;
+    sph_collider_id cid;
+    require_ok(sph_collider_create(s->world, &collider, &cid), "collider");
+    sph_source_def source;
+    sph_source_def_init(&source);
+    source.mode = SPH_SOURCE_CONTINUOUS;
+    source.region = s->blob;
+    source.transform = at(0.1f, 0.1f, 0.0f);
+    source.rate = 600.0f;
+    sph_source_id sid;
+    require_ok(sph_source_create(s->world, &source, &sid), "source");
+    sph_sink_def sink;
+    sph_sink_def_init(&sink);
+    sink.region = s->blob;
+    sink.transform = at(0.15f, -0.17f, 0.0f);
+    sph_sink_id kid;
+    require_ok(sph_sink_create(s->world, &sink, &kid), "sink");
+  }
+  if (objects != Objects::AfterFirstStep) require_ok(sph_world_step(s->world, kFrameDt), "first step");
+}
+
+void destroy_scene(Scene* s) {
+  sph_world_destroy(s->world);
+  sph_sdf_destroy(s->tank);
+  sph_sdf_destroy(s->blob);
+  sph_context_destroy(s->context);
+  *s = Scene{};
+}
+
+struct Snapshot {
+  uint32_t count = 0;
+  double time = 0.0;
+  std::vector<float> position, velocity, density;
+  std::vector<uint32_t> id;
+  bool operator==(const Snapshot& o) const {
+    return count == o.count && time == o.time && position == o.position && velocity == o.velocity &&
+           density == o.density && id == o.id;
+  }
+};
+
+Snapshot take(const sph_world* world) {
+  Snapshot s;
+  require_ok(sph_world_get_particle_count(world, &s.count), "count");
+  sph_stats stats;
+  sph_stats_init(&stats);
+  require_ok(sph_world_get_stats(world, &stats), "stats");
+  s.time = stats.simulated_time;
+  s.position.resize(3 * size_t{s.count});
+  s.velocity.resize(3 * size_t{s.count});
+  s.density.resize(s.count);
+  s.id.resize(s.count);
+  const uint32_t n = s.count;
+  require_ok(
+      sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, s.position.data(), 12ull * n, 0, 0, n, nullptr),
+      "positions");
+  require_ok(
+      sph_world_copy_attribute(world, SPH_ATTRIBUTE_VELOCITY, s.velocity.data(), 12ull * n, 0, 0, n, nullptr),
+      "velocities");
+  require_ok(
+      sph_world_copy_attribute(world, SPH_ATTRIBUTE_DENSITY, s.density.data(), 4ull * n, 0, 0, n, nullptr),
+      "densities");
+  require_ok(sph_world_copy_attribute(world, SPH_ATTRIBUTE_ID, s.id.data(), 4ull * n, 0, 0, n, nullptr),
+             "ids");
+  return s;
+}
+
+struct Call {
+  const char* name;
+  Objects objects;
+  std::function<sph_result(Scene&)> run;
+  std::function<void(Scene&)> undo;  // releases what a successful call made (not the world's)
+  bool changes_world;
+};
+
+void check_call(const Call& call) {
+  Scene scene;
+  build_scene(&scene, call.objects);
+  long faults_injected = 0;
+  bool ok = true;
+  std::string problem;
+  for (long n = 0; ok; ++n) {
+    const Snapshot before = take(scene.world);
+    uint32_t objects_before = 0;
+    sph_get_live_object_count(&objects_before);
+    faults::arm_device_allocation_fault(n);
+    const sph_result r = call.run(scene);
+    const bool injected = faults::disarm_device_allocation_fault();
+    if (!injected) {
+      if (r != SPH_OK) {
+        ok = false;
+        problem = std::string("without a fault: ") + sph_result_string(r) + " (" + sph_get_last_error() + ")";
+      }
+      if (r == SPH_OK && call.undo) call.undo(scene);
+      break;
+    }
+    ++faults_injected;
+    if (r == SPH_OK) {  // absorbed (a fallback path): start again from a fresh scene
+      if (call.undo) call.undo(scene);
+      destroy_scene(&scene);
+      build_scene(&scene, call.objects);
+      continue;
+    }
+    uint32_t objects_after = 0;
+    sph_get_live_object_count(&objects_after);
+    if (r != SPH_ERROR_OUT_OF_DEVICE_MEMORY && r != SPH_ERROR_OUT_OF_HOST_MEMORY) {
+      ok = false;
+      problem = "allocation " + std::to_string(n) + " failing gave " + sph_result_string(r) + " (" +
+                sph_get_last_error() + ")";
+    } else if (std::strstr(sph_get_last_error(), "cudaMalloc") == nullptr) {
+      ok = false;
+      problem = std::string("the message does not name the allocation: ") + sph_get_last_error();
+    } else if (objects_after != objects_before) {
+      ok = false;
+      problem = "allocation " + std::to_string(n) + " failing leaked a handle";
+    } else if (!(take(scene.world) == before)) {
+      ok = false;
+      problem = "allocation " + std::to_string(n) + " failing changed the world";
+    }
+  }
+  if (ok && call.changes_world) {
+    Scene reference;
+    build_scene(&reference, call.objects);
+    require_ok(call.run(reference), call.name);
+    require_ok(sph_world_step(scene.world, kFrameDt), "step after the faults");
+    require_ok(sph_world_step(reference.world, kFrameDt), "reference step");
+    if (!(take(scene.world) == take(reference.world))) {
+      ok = false;
+      problem = "after the faults the world steps differently from an undisturbed copy";
+    }
+    destroy_scene(&reference);
+  }
+  destroy_scene(&scene);
+  report(ok, (std::string("allocation_faults/") + call.name).c_str(),
+         "%ld device allocation points failed once each%s%s", faults_injected, ok ? "" : "; ",
+         problem.c_str());
+}
+
+}  // namespace
+
+int main() {
+  exit_if_no_cuda();
+  sph_world* made_world = nullptr;
+  sph_context* made_context = nullptr;
+  const Call calls[] = {
+      {"sph_context_create", Objects::None,
+       [&](Scene&) {
+         sph_context_def def;
+         sph_context_def_init(&def);
+         def.backend = SPH_BACKEND_CUDA;
+         return sph_context_create(&def, &made_context);
+       },
+       [&](Scene&) { sph_context_destroy(made_context); }, false},
+      {"sph_world_create", Objects::None,
+       [&](Scene& s) {
+         sph_world_def def;
+         sph_world_def_init(&def);
+         def.capacity = 100000;
+         return sph_world_create(s.context, &def, &made_world);
+       },
+       [&](Scene&) { sph_world_destroy(made_world); }, false},
+      {"sph_world_create (RK4, every option)", Objects::None,
+       [&](Scene& s) {
+         sph_world_def def;
+         sph_world_def_init(&def);
+         def.capacity = 20000;
+         def.integrator = SPH_INTEGRATOR_RK4;
+         def.features = SPH_FEATURE_SURFACE_TENSION | SPH_FEATURE_NORMALIZED_DENSITY;
+         return sph_world_create(s.context, &def, &made_world);
+       },
+       [&](Scene&) { sph_world_destroy(made_world); }, false},
+      {"sph_world_fill_box", Objects::None,
+       [](Scene& s) {
+         sph_fill_box_desc box;
+         sph_fill_box_desc_init(&box);
+         box.min = sph_vec3{0.05f, -0.18f, -0.08f};
+         box.max = sph_vec3{0.15f, -0.1f, 0.08f};
+         return sph_world_fill_box(s.world, &box, nullptr);
+       },
+       nullptr, true},
+      {"sph_world_step (the first frame of a collider, a source and a sink)", Objects::AfterFirstStep,
+       [](Scene& s) { return sph_world_step(s.world, kFrameDt); }, nullptr, true},
+      {"sph_world_step (scene)", Objects::BeforeFirstStep,
+       [](Scene& s) { return sph_world_step(s.world, kFrameDt); }, nullptr, true},
+      {"sph_world_step (plain)", Objects::None, [](Scene& s) { return sph_world_step(s.world, kFrameDt); },
+       nullptr, true},
+  };
+  for (const Call& call : calls) check_call(call);
+  return finish();
+}
