@@ -5,8 +5,14 @@
  * "moving" with every velocity component uniform in [-0.1, 0.1] m/s. Uses only the public C
  * API (sph_c.h).
  *
- *   rest_sphere [--particles N] [--frames F] [--warmup W] [--backend cpu|cuda|auto]
- *               [--case rest|moving|both] [--json FILE] [--csv FILE] [--label TEXT]
+ *   rest_sphere [--particles N|largest] [--frames F] [--warmup W] [--backend cpu|cuda|auto]
+ *               [--case rest|moving|both] [--option NAME] [--json FILE] [--csv FILE] [--label TEXT]
+ *
+ * --option turns one optional piece of physics on, to measure what it costs (BENCHMARK.md,
+ * issue 5): none (default), surface_tension, normalized_density, clavet (viscosity), tait
+ * (equation of state), rk4 (integrator), acoustic_limit (step limit). --particles largest
+ * finds the largest world the device holds (world creation refused with OUT_OF_*_MEMORY
+ * above it) and runs 95 % of that.
  *
  * Prints a table per case; --json writes the results as a JSON array, --csv appends rows
  * (with a header when the file is new). Times are the wall time of sph_world_step (which
@@ -27,6 +33,8 @@
 
 typedef struct options {
   uint32_t particles;
+  int largest; /* --particles largest */
+  const char* option;
   int frames;
   int warmup;
   sph_backend backend;
@@ -38,6 +46,7 @@ typedef struct options {
 
 typedef struct result {
   const char* scene;
+  const char* option;
   const char* backend;
   uint32_t count;
   uint32_t substeps_per_frame;
@@ -121,15 +130,86 @@ static double now_s(void) {
   return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
+/* The world definition and parameters of the case, with --option applied. */
+static void describe_world(const options* o, uint32_t capacity, sph_world_def* def,
+                           sph_world_params* params) {
+  sph_world_def_init(def);
+  def->capacity = capacity;
+  def->particle_spacing = 0.02f;
+  sph_world_params_init(params);
+  params->gravity.x = params->gravity.y = params->gravity.z = 0.0f;
+  params->dt_max = 1e-3f;
+  if (strcmp(o->option, "surface_tension") == 0) {
+    def->features |= SPH_FEATURE_SURFACE_TENSION;
+  } else if (strcmp(o->option, "normalized_density") == 0) {
+    def->features |= SPH_FEATURE_NORMALIZED_DENSITY;
+  } else if (strcmp(o->option, "clavet") == 0) {
+    def->viscosity_method = SPH_VISCOSITY_CLAVET;
+  } else if (strcmp(o->option, "tait") == 0) {
+    def->equation_of_state = SPH_EOS_TAIT;
+  } else if (strcmp(o->option, "rk4") == 0) {
+    def->integrator = SPH_INTEGRATOR_RK4;
+  } else if (strcmp(o->option, "acoustic_limit") == 0) {
+    params->step_limits = SPH_STEP_LIMIT_ACOUSTIC;
+  } else if (strcmp(o->option, "none") != 0) {
+    fprintf(stderr, "rest_sphere: unknown --option '%s'\n", o->option);
+    exit(2);
+  }
+}
+
+/* The largest capacity a world can be created with on this backend: halves down from 2^32 - 1
+ * until a world fits, then bisects (to 1 %) between the largest that fit and the smallest that
+ * did not. Only out-of-memory refusals count as "does not fit". */
+static uint32_t largest_capacity(const options* o, sph_context* context) {
+  double fits = 0.0, too_big = 4294967295.0;
+  while (too_big - fits > 0.01 * too_big) {
+    const double trial = fits > 0.0 ? 0.5 * (fits + too_big) : 0.5 * too_big;
+    sph_world_def def;
+    sph_world_params params;
+    describe_world(o, (uint32_t)trial, &def, &params);
+    sph_world* world = NULL;
+    const sph_result r = sph_world_create(context, &def, &world);
+    if (r == SPH_OK) {
+      sph_world_destroy(world);
+      fits = trial;
+      if (fits == 0.5 * too_big && too_big == 4294967295.0) break; /* everything fits */
+    } else if (r == SPH_ERROR_OUT_OF_DEVICE_MEMORY || r == SPH_ERROR_OUT_OF_HOST_MEMORY) {
+      too_big = trial;
+    } else {
+      check(r, "sph_world_create (probing the largest world)");
+    }
+  }
+  printf("largest world that can be created: %.0f particles (refused at %.0f)\n", fits, too_big);
+  return (uint32_t)fits;
+}
+
 static result run_case(const options* o, int moving) {
   result r;
   memset(&r, 0, sizeof r);
   r.scene = moving ? "moving" : "rest";
+  r.option = o->option;
   const double t0 = now_s();
   const float spacing = 0.02f;
-  const double radius = spacing * cbrt(3.0 * o->particles / (4.0 * 3.14159265358979 * sqrt(2.0)));
+
+  sph_context_def cdef;
+  sph_context_def_init(&cdef);
+  cdef.backend = o->backend;
+  sph_context* context = NULL;
+  check(sph_context_create(&cdef, &context), "sph_context_create");
+  sph_backend resolved;
+  check(sph_context_get_backend(context, &resolved), "sph_context_get_backend");
+  r.backend = resolved == SPH_BACKEND_CUDA ? "cuda" : "cpu";
+
+  /* The largest run: 95 % of the largest world, leaving room for what a step allocates. */
+  const double wanted = o->largest ? 0.95 * largest_capacity(o, context) : (double)o->particles;
+  double radius = spacing * cbrt(3.0 * wanted / (4.0 * 3.14159265358979 * sqrt(2.0)));
   uint32_t count = 0;
   float* positions = fcc_sphere(radius, spacing, &count);
+  while (positions && o->largest && count > wanted) { /* the volume estimate can overshoot */
+    free(positions);
+    radius *= 0.999;
+    positions = fcc_sphere(radius, spacing, &count);
+  }
   float* velocities = calloc((size_t)count * 3, sizeof(float));
   if (!positions || !velocities) {
     fprintf(stderr, "rest_sphere: out of host memory\n");
@@ -141,25 +221,11 @@ static result run_case(const options* o, int moving) {
       velocities[i] = (float)((2.0 * uniform01(&seed) - 1.0) * 0.1);
   }
 
-  sph_context_def cdef;
-  sph_context_def_init(&cdef);
-  cdef.backend = o->backend;
-  sph_context* context = NULL;
-  check(sph_context_create(&cdef, &context), "sph_context_create");
-  sph_backend resolved;
-  check(sph_context_get_backend(context, &resolved), "sph_context_get_backend");
-  r.backend = resolved == SPH_BACKEND_CUDA ? "cuda" : "cpu";
-
   sph_world_def def;
-  sph_world_def_init(&def);
-  def.capacity = count;
-  def.particle_spacing = spacing;
+  sph_world_params params;
+  describe_world(o, count, &def, &params);
   sph_world* world = NULL;
   check(sph_world_create(context, &def, &world), "sph_world_create");
-  sph_world_params params;
-  sph_world_params_init(&params);
-  params.gravity.x = params.gravity.y = params.gravity.z = 0.0f;
-  params.dt_max = 1e-3f;
   check(sph_world_set_params(world, &params), "sph_world_set_params");
   sph_spawn_desc spawn;
   sph_spawn_desc_init(&spawn);
@@ -210,8 +276,8 @@ static result run_case(const options* o, int moving) {
 static void print_result(const result* r, const options* o) {
   double total = 0.0;
   for (int k = 0; k < SPH_STAGE_COUNT; ++k) total += r->stage_ms_per_substep[k];
-  printf("\n%s sphere, %s backend, %u particles, %d frames of %.0f ms after %d warm-up%s\n", r->scene,
-         r->backend, r->count, o->frames, FRAME_DT * 1e3, o->warmup, o->label ? "" : "");
+  printf("\n%s sphere, %s backend, option %s, %u particles, %d frames of %.0f ms after %d warm-up\n",
+         r->scene, r->backend, r->option, r->count, o->frames, FRAME_DT * 1e3, o->warmup);
   printf("  %-28s %12.4f\n", "s/frame (median)", r->ms_per_frame * 1e-3);
   printf("  %-28s %12u\n", "substeps/frame", r->substeps_per_frame);
   printf("  %-28s %12.4f\n", "ms/substep (median)", r->ms_per_substep);
@@ -239,13 +305,14 @@ static void write_json(const char* path, const result* rs, int n, const options*
     const result* r = &rs[i];
     fprintf(
         f,
-        "  {\"benchmark\": \"rest_sphere\", \"label\": \"%s\", \"scene\": \"%s\", \"backend\": \"%s\", "
+        "  {\"benchmark\": \"rest_sphere\", \"label\": \"%s\", \"scene\": \"%s\", \"option\": \"%s\", "
+        "\"backend\": \"%s\", "
         "\"particles\": %u, \"frames\": %d, \"warmup\": %d, \"frame_dt\": %.3f, \"substeps_per_frame\": %u, "
         "\"s_per_frame\": %.6g, \"ms_per_substep\": %.6g, \"particle_substeps_per_s\": %.6g, "
         "\"neighbors_mean\": %.4f, \"neighbors_max\": %u, \"bytes_per_particle\": %.2f, "
         "\"density_error_mean\": %.6g, \"density_min\": %.3f, \"density_max\": %.3f, \"max_speed\": %.6g, "
         "\"stage_ms_per_substep\": {",
-        o->label ? o->label : "", r->scene, r->backend, r->count, o->frames, o->warmup, FRAME_DT,
+        o->label ? o->label : "", r->scene, r->option, r->backend, r->count, o->frames, o->warmup, FRAME_DT,
         r->substeps_per_frame, r->ms_per_frame * 1e-3, r->ms_per_substep, r->particle_substeps_per_s,
         r->neighbors_mean, r->neighbors_max, r->bytes_per_particle, r->density_error_mean, r->density_min,
         r->density_max, r->max_speed);
@@ -269,17 +336,17 @@ static void append_csv(const char* path, const result* rs, int n, const options*
   }
   if (!exists) {
     fprintf(f,
-            "label,scene,backend,particles,frames,substeps_per_frame,s_per_frame,ms_per_substep,"
+            "label,scene,option,backend,particles,frames,substeps_per_frame,s_per_frame,ms_per_substep,"
             "particle_substeps_per_s,neighbors_mean,bytes_per_particle,density_error_mean,max_speed");
     for (int k = 0; k < SPH_STAGE_COUNT; ++k) fprintf(f, ",ms_%s", stage_names[k]);
     fprintf(f, "\n");
   }
   for (int i = 0; i < n; ++i) {
     const result* r = &rs[i];
-    fprintf(f, "%s,%s,%s,%u,%d,%u,%.6g,%.6g,%.6g,%.4f,%.2f,%.6g,%.6g", o->label ? o->label : "", r->scene,
-            r->backend, r->count, o->frames, r->substeps_per_frame, r->ms_per_frame * 1e-3, r->ms_per_substep,
-            r->particle_substeps_per_s, r->neighbors_mean, r->bytes_per_particle, r->density_error_mean,
-            r->max_speed);
+    fprintf(f, "%s,%s,%s,%s,%u,%d,%u,%.6g,%.6g,%.6g,%.4f,%.2f,%.6g,%.6g", o->label ? o->label : "", r->scene,
+            r->option, r->backend, r->count, o->frames, r->substeps_per_frame, r->ms_per_frame * 1e-3,
+            r->ms_per_substep, r->particle_substeps_per_s, r->neighbors_mean, r->bytes_per_particle,
+            r->density_error_mean, r->max_speed);
     for (int k = 0; k < SPH_STAGE_COUNT; ++k) fprintf(f, ",%.6g", r->stage_ms_per_substep[k]);
     fprintf(f, "\n");
   }
@@ -288,19 +355,23 @@ static void append_csv(const char* path, const result* rs, int n, const options*
 
 static void usage(void) {
   fprintf(stderr,
-          "usage: rest_sphere [--particles N] [--frames F] [--warmup W] [--backend cpu|cuda|auto]\n"
-          "                   [--case rest|moving|both] [--json FILE] [--csv FILE] [--label TEXT]\n");
+          "usage: rest_sphere [--particles N|largest] [--frames F] [--warmup W] [--backend cpu|cuda|auto]\n"
+          "                   [--case rest|moving|both] [--option none|surface_tension|normalized_density|\n"
+          "                   clavet|tait|rk4|acoustic_limit] [--json FILE] [--csv FILE] [--label TEXT]\n");
   exit(2);
 }
 
 int main(int argc, char** argv) {
-  options o = {100000, 100, 3, SPH_BACKEND_AUTO, "both", NULL, NULL, NULL};
+  options o = {100000, 0, "none", 100, 3, SPH_BACKEND_AUTO, "both", NULL, NULL, NULL};
   for (int i = 1; i < argc; ++i) {
     const char* a = argv[i];
     const char* v = i + 1 < argc ? argv[i + 1] : NULL;
     if (!v) usage();
     if (strcmp(a, "--particles") == 0) {
-      o.particles = (uint32_t)strtoul(v, NULL, 10);
+      o.largest = strcmp(v, "largest") == 0;
+      o.particles = o.largest ? 100 : (uint32_t)strtoul(v, NULL, 10);
+    } else if (strcmp(a, "--option") == 0) {
+      o.option = v;
     } else if (strcmp(a, "--frames") == 0) {
       o.frames = atoi(v);
     } else if (strcmp(a, "--warmup") == 0) {
