@@ -1,5 +1,6 @@
-// Acceleration of a particle from its neighbours: the symmetric pressure force (thesis eq. 14
-// with grad W_spiky), viscosity (Mueller's eq. 17 with lap W_viscosity, or Clavet's radial
+// Acceleration of a particle from its neighbours: the symmetric pressure force (Monaghan's
+// p_i / rho_i^2 + p_j / rho_j^2 form with grad W_spiky; see below why not the thesis's eq. 14),
+// viscosity (Mueller's eq. 17 with lap W_viscosity, or Clavet's radial
 // impulses, eq. 18-19), surface tension from the colour field (eq. 20-23), and gravity.
 // Inputs are the packed records written by the density pass: position.w = p_j and
 // velocity.w = 1 / rho_j, so a neighbour costs two 16-byte loads and no division.
@@ -20,15 +21,25 @@ namespace sph {
 
 enum class ViscosityMethod : uint32_t { Mueller = 0, Clavet = 1 };
 
+// The pressure force is the symmetric form a_i = -sum_j m (p_i / rho_i^2 + p_j / rho_j^2)
+// grad W_ij (Monaghan 1992), not the thesis's eq. 14 (Mueller 2003), -sum_j m (p_i + p_j) /
+// (2 rho_j) grad W_ij / rho_i. Both are antisymmetric in i and j (momentum is conserved), but in
+// a full neighbourhood sum_j (m / rho_j) grad W_ij vanishes, so eq. 14's p_i half drops out and it
+// yields only grad p / 2: a tank at rest then holds twice the hydrostatic pressure and the
+// fluid's sound speed is sqrt(k / 2), not the sqrt(k) the step limits assume (tests/validation,
+// hydrostatic tank; docs/physics.md). Monaghan's form gives grad p, and with summation density it
+// is the form whose work is exactly the change of the equation of state's internal energy, so
+// the total energy of a closed box only falls (by viscosity and collisions).
 struct AccelerationSums {
-  Vec3 pressure;     // sum -(p_i + p_j) / rho_j grad W_spiky
-  Vec3 viscosity;    // Mueller: sum (v_j - v_i) / rho_j lap W; Clavet: sum of velocity changes
-  float divergence;  // surface tension: sum (n^_j - n^_i) . grad W_poly6 / rho_j over surface j
-  float shepard;     // surface tension: sum W_poly6 / rho_j over the same j (normalises the above)
+  Vec3 pressure;      // sum -(p_j / rho_j^2) grad W_spiky
+  Vec3 own_pressure;  // sum -p_i grad W_spiky (times 1 / rho_i^2 in finish_acceleration)
+  Vec3 viscosity;     // Mueller: sum (v_j - v_i) / rho_j lap W; Clavet: sum of velocity changes
+  float divergence;   // surface tension: sum (n^_j - n^_i) . grad W_poly6 / rho_j over surface j
+  float shepard;      // surface tension: sum W_poly6 / rho_j over the same j (normalises the above)
 };
 
 SPH_HD AccelerationSums zero_acceleration_sums() {
-  return AccelerationSums{Vec3{0.0f, 0.0f, 0.0f}, Vec3{0.0f, 0.0f, 0.0f}, 0.0f, 0.0f};
+  return AccelerationSums{Vec3{0.0f, 0.0f, 0.0f}, Vec3{0.0f, 0.0f, 0.0f}, Vec3{0.0f, 0.0f, 0.0f}, 0.0f, 0.0f};
 }
 
 // The unit normal of a colour-field record (n, |n|), or zero where it does not mark a surface.
@@ -54,8 +65,10 @@ SPH_HD void add_neighbor_acceleration(const FluidConstants& f, const Float4& pi,
                                       const Float4* normal_j = nullptr) {
   const float r = SPH_SQRTF(r2);
   const float inv_rho_j = vj.w;
-  // -(p_i + p_j) / (2 rho_j) grad W_spiky; the 1/2 and m are applied once in finish.
-  sums.pressure += spiky_gradient(f.kernel, d, r) * (-(pi.w + pj.w) * inv_rho_j);
+  // -(p_i / rho_i^2 + p_j / rho_j^2) grad W_spiky; m and 1 / rho_i^2 are applied once in finish.
+  const Vec3 grad = spiky_gradient(f.kernel, d, r);
+  sums.pressure += grad * (-pj.w * inv_rho_j * inv_rho_j);
+  sums.own_pressure += grad * (-pi.w);
   if (kViscosity == ViscosityMethod::Mueller) {
     sums.viscosity += (xyz(vj) - v_i) * (viscosity_laplacian(f.kernel, r) * inv_rho_j);
   } else if (r > 0.0f) {
@@ -89,7 +102,7 @@ SPH_HD Vec3 finish_acceleration(const FluidConstants& f, const Float4& vi, const
                                 const Float4* normal_i = nullptr) {
   // f_i / rho_i with 1/rho_i = vi.w
   const float m_over_rho_i = f.particle_mass * vi.w;
-  Vec3 a = sums.pressure * (0.5f * m_over_rho_i) + f.gravity;
+  Vec3 a = (sums.pressure + sums.own_pressure * (vi.w * vi.w)) * f.particle_mass + f.gravity;
   if (kViscosity == ViscosityMethod::Mueller) {
     a += sums.viscosity * (f.viscosity * m_over_rho_i);
   } else if (f.dt > 0.0f) {

@@ -1,0 +1,84 @@
+/* The dam-break case of Martin & Moyce (1952), shared by the validation test
+ * (test_dam_break.c) and the speed-accuracy benchmark (bench/speed_accuracy.c). Plain C on the
+ * public API only, no test framework, so a benchmark can link it.
+ *
+ * A column of water, width a and height 2a, stands against the back wall of a long tank and is
+ * released at t = 0. The surge front z(t) along the floor is compared with the measurements in
+ * dimensionless form, Z = z / a against T = t sqrt(2 g / a) (n^2 = 2 in their notation). The
+ * setup and every choice in it are explained in docs/validation.md and in dam_break.c. */
+#ifndef SPH_VALIDATION_DAM_BREAK_H
+#define SPH_VALIDATION_DAM_BREAK_H
+
+#include <stdint.h>
+
+#include "sph_c.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Martin & Moyce's column width, 2.25 in (their Table 2 for n^2 = 2). */
+#define DAM_BREAK_COLUMN_WIDTH 0.05715f
+/* The measured points: T and Z, from ../shared/data/martin_moyce_1952_front_n2.csv. */
+#define DAM_BREAK_MEASUREMENTS 16
+extern const double dam_break_measured_T[DAM_BREAK_MEASUREMENTS];
+extern const double dam_break_measured_Z[DAM_BREAK_MEASUREMENTS];
+/* The comparison window and its one allowed time shift. */
+#define DAM_BREAK_T_FIRST 0.8
+#define DAM_BREAK_T_LAST 3.3
+#define DAM_BREAK_MAX_SHIFT 0.2
+
+typedef struct dam_break_config {
+  uint32_t layers_across;    /* lattice layers across the column width a (the resolution) */
+  uint32_t slab_layers;      /* lattice layers across the slab (the thin z direction) */
+  sph_integrator integrator; /* symplectic Euler or RK4 */
+  float step_factor;         /* lambda of the step controller (and of the acoustic limit) */
+  float speed_of_sound;      /* Tait's c, m/s */
+  float viscosity;           /* Mueller's mu, Pa s */
+  float friction;            /* Coulomb coefficient of the tank walls (0: free slip) */
+  double end_T;              /* simulate until this T */
+  double sample_T;           /* sample the front every sample_T */
+} dam_break_config;
+
+/* The configuration the validation uses (docs/validation.md says why each value). */
+void dam_break_config_default(dam_break_config* config, uint32_t layers_across);
+
+#define DAM_BREAK_MAX_SAMPLES 1024
+
+typedef struct dam_break_result {
+  uint32_t particles;
+  uint32_t samples;
+  double T[DAM_BREAK_MAX_SAMPLES]; /* sample times (dimensionless) */
+  double Z[DAM_BREAK_MAX_SAMPLES]; /* the surge front at those times (dimensionless) */
+  double spacing;                  /* particle spacing, m */
+  double simulated_seconds;
+  double wall_seconds; /* inside sph_world_step only */
+  uint64_t substeps;
+  double mean_compression; /* mean over samples of the mean (rho/rho0 - 1) of the
+                              particles above rest density */
+  double max_compression;  /* the largest density_max / rho0 - 1 seen */
+  /* The comparison with the measurements over T in [T_FIRST, T_LAST]: */
+  double shift_T;              /* the fitted shift: simulation at T + shift against data at T */
+  double mean_error;           /* mean |Z_sim - Z_meas| / Z_meas at the fitted shift */
+  double max_error;            /* worst point at the fitted shift */
+  double mean_error_unshifted; /* the same without a shift */
+  double max_error_unshifted;
+  uint32_t compared; /* measured points in the window */
+  uint32_t escaped;  /* particles outside the tank at the end */
+  char message[256]; /* the failing call's message when the run failed */
+} dam_break_result;
+
+/* Runs the case on `context`. Returns SPH_OK or the first failing call's result (its message
+ * in result->message). trace (optional) receives one line per sample: T, Z. */
+sph_result dam_break_run(sph_context* context, const dam_break_config* config, dam_break_result* result,
+                         void (*trace)(void* user, double T, double Z), void* trace_user);
+
+/* Compares a front history with the measurements at a given shift (no fitting). */
+void dam_break_compare(const dam_break_result* result, double shift_T, double* mean_error, double* max_error,
+                       uint32_t* compared);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

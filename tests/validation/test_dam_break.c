@@ -1,0 +1,94 @@
+/* Dam break against Martin & Moyce (1952): the surge front's mean error <= 8 % and worst point
+ * <= 15 % over T in [0.8, 3.3], after at most one fitted time shift |dT| <= 0.2, which the
+ * test reports. The case itself (tank, slab, equation of state, front) is dam_break.c; why each
+ * choice is what it is, and what was tried, is in docs/validation.md.
+ *
+ * The bounds are the issue's. They are wide for a reason: the measurements scatter by several
+ * percent between repeats, the gate of the experiment took time to lift (hence the one time
+ * shift), and the simulation has free-slip walls where the experiment had a real floor.
+ *
+ * CI runs 20 lattice layers across the column (2,400 particles); SPH_VALIDATION_FULL=1 runs 40
+ * (9,600). SPH_VALIDATION_OUT receives the front history and the comparison. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "dam_break.h"
+#include "validation_util.h"
+
+static void trace_line(void* user, double T, double Z) {
+  if (user) fprintf((FILE*)user, "%.4f,%.4f\n", T, Z);
+}
+
+static void test_dam_break(void** state) {
+  sph_context* context = NULL;
+  dam_break_config config;
+  dam_break_result* result = (dam_break_result*)malloc(sizeof(dam_break_result));
+  FILE* trace = validation_open_output("dam_break_front.csv");
+  sph_result r;
+  (void)state;
+  assert_non_null(result);
+  EXPECT_OK(sph_test_context_create(&context));
+  dam_break_config_default(&config, validation_full() ? 40 : 20);
+  if (trace) fprintf(trace, "T,Z\n");
+  r = dam_break_run(context, &config, result, trace_line, trace);
+  if (trace) fclose(trace);
+  if (r != SPH_OK) printf("dam break failed: %s: %s\n", sph_result_string(r), result->message);
+  assert_int_equal(r, SPH_OK);
+  printf(
+      "dam break: %u lattice layers across the column, %u particles, spacing %.2f mm, c = %.1f m/s, mu = "
+      "%.3f Pa s, "
+      "%llu substeps, %.2f s wall for %.3f s simulated\n",
+      config.layers_across, result->particles, 1e3 * result->spacing, config.speed_of_sound, config.viscosity,
+      (unsigned long long)result->substeps, result->wall_seconds, result->simulated_seconds);
+  printf(
+      "  fitted time shift dT = %+.3f (bound |dT| <= %.1f): mean error %.2f %% (bound 8 %%), worst %.2f %% "
+      "(bound 15 "
+      "%%) over %u points; without the shift %.2f %% / %.2f %%\n",
+      result->shift_T, DAM_BREAK_MAX_SHIFT, 100.0 * result->mean_error, 100.0 * result->max_error,
+      result->compared, 100.0 * result->mean_error_unshifted, 100.0 * result->max_error_unshifted);
+  printf(
+      "  mean compression of the particles above rest density %.2f %%, largest %.2f %%; %u particles outside "
+      "the "
+      "tank\n",
+      100.0 * result->mean_compression, 100.0 * result->max_compression, result->escaped);
+  printf("  %-6s %-8s %-8s %s\n", "T", "Z meas.", "Z SPH", "error");
+  for (int m = 0; m < DAM_BREAK_MEASUREMENTS; ++m) {
+    const double T = dam_break_measured_T[m] + result->shift_T;
+    uint32_t i = 1;
+    double w;
+    if (dam_break_measured_T[m] < DAM_BREAK_T_FIRST || dam_break_measured_T[m] > DAM_BREAK_T_LAST) continue;
+    while (i < result->samples - 1 && result->T[i] < T) ++i;
+    w = (T - result->T[i - 1]) / (result->T[i] - result->T[i - 1]);
+    {
+      const double Z = result->Z[i - 1] + w * (result->Z[i] - result->Z[i - 1]);
+      printf("  %-6.2f %-8.2f %-8.3f %+.1f %%\n", dam_break_measured_T[m], dam_break_measured_Z[m], Z,
+             100.0 * (Z / dam_break_measured_Z[m] - 1.0));
+    }
+  }
+  {
+    FILE* out = validation_open_output("dam_break.txt");
+    if (out) {
+      fprintf(out, "%u %u %.4f %.3f %.3f %.3f %.3f %.3f %u\n", config.layers_across, result->particles,
+              result->shift_T, 100.0 * result->mean_error, 100.0 * result->max_error,
+              100.0 * result->mean_error_unshifted, 100.0 * result->max_error_unshifted,
+              100.0 * result->mean_compression, result->escaped);
+      fclose(out);
+    }
+  }
+  assert_true(result->compared >= 10);
+  assert_true(fabs(result->shift_T) <= DAM_BREAK_MAX_SHIFT + 1e-9);
+  assert_true(result->mean_error <= 0.08);
+  assert_true(result->max_error <= 0.15);
+  /* The tank is closed: every particle is still inside it (to half a lattice step). */
+  assert_int_equal(result->escaped, 0);
+  free(result);
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_dam_break),
+  };
+  return cmocka_run_group_tests_name("validation_dam_break", tests, NULL, NULL);
+}

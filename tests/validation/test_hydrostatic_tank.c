@@ -1,0 +1,261 @@
+/* Hydrostatic tank: water at rest in a closed box under gravity. The interior pressure must
+ * follow the exact equilibrium of the equation of state in use within 3 %, and no particle may
+ * cross the floor.
+ *
+ * The exact equilibrium: dp/dd = rho g at depth d, with p(0) = 0 at the free surface.
+ *   ideal gas p = k (rho - rho0):         p(d) = k rho0 (exp(g d / k) - 1)
+ *   Tait p = B ((rho / rho0)^7 - 1),
+ *        B = rho0 c^2 / 7:                (rho / rho0)^6 = 1 + 6 g d / c^2,
+ *                                         p(d) = B ((1 + 6 g d / c^2)^(7/6) - 1)
+ *
+ * What is compared, and why (docs/validation.md):
+ * - Interior: particles more than one kernel radius h from every side wall and the floor, and
+ *   more than 2 h below the free surface. Within h of a wall or the surface a particle misses
+ *   neighbours (there are no wall particles), so its summed density, and pressure, is low; that
+ *   is the boundary model, not the equilibrium.
+ * - Pressure is averaged per horizontal slice (one kernel radius thick) and over the second half
+ *   of the run (the first half damps the start-up waves), so the comparison is of the mean
+ *   field, not of the particle noise.
+ * - The free surface of an SPH fluid is not sharp: the outermost kernel radius has a density
+ *   deficit, and the particles near the side walls pack tighter than the lattice, so the level
+ *   sinks by a few percent. Its height y_s is therefore one fitted parameter (least squares of
+ *   the relative error); the test requires it within 2 h of the top particle layer and reports
+ *   it. The shape of p(d), its slope rho g and its curvature from the EOS, is what is tested.
+ * - 3 %: the issue's bound. The EOS's own nonlinearity (exp(g d / k) against the linear
+ *   rho0 g d) is 3 % at the bottom of the CI tank, so the test does tell the exact profile from
+ *   a linear one only marginally there; at full resolution the tank is deeper (6 %). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "validation_util.h"
+
+#define GRAVITY 9.81
+
+typedef struct tank_case {
+  const char* name;
+  sph_equation_of_state eos;
+  uint32_t width_layers; /* lattice layers across the tank in x and z */
+  uint32_t depth_layers; /* lattice layers of water */
+  double step;           /* lattice step (spacing / sqrt 2), m */
+  double seconds;        /* simulated time */
+} tank_case;
+
+static int ascending(const void* a, const void* b) {
+  const float x = *(const float*)a, y = *(const float*)b;
+  return (x > y) - (x < y);
+}
+
+static double exact_pressure(sph_equation_of_state eos, double k, double c, double rho0, double d) {
+  if (d <= 0.0) return 0.0;
+  if (eos == SPH_EOS_TAIT) {
+    const double b = rho0 * c * c / 7.0;
+    return b * (pow(1.0 + 6.0 * GRAVITY * d / (c * c), 7.0 / 6.0) - 1.0);
+  }
+  return k * rho0 * (exp(GRAVITY * d / k) - 1.0);
+}
+
+static void run_tank(const tank_case* tc) {
+  const uint32_t nl = tc->depth_layers;
+  const double step = tc->step;
+  const double width = tc->width_layers * step, depth = nl * step;
+  const uint32_t lattice[3] = {tc->width_layers, nl, tc->width_layers};
+  const double origin[3] = {0.0, 0.0, 0.0};
+  const double tank_min[3] = {0.0, 0.0, 0.0};
+  const double tank_max[3] = {width, 2.0 * depth, width};
+  sph_context* context = NULL;
+  sph_world* world = NULL;
+  sph_world_def def;
+  sph_world_params params;
+  sph_spawn_desc spawn;
+  sph_sdf* sdf = NULL;
+  float* lattice_points = NULL;
+  float* x = NULL;
+  float* p = NULL;
+  float mass = 0.0f;
+  double *layer_sum, *layer_y;
+  uint32_t* layer_count;
+  double k, c = 0.0, h, rho0, lowest = 1e30, top_layer = -1e30;
+  const uint32_t n = validation_lattice_box(lattice, step, origin, &lattice_points);
+  const int frames = (int)(tc->seconds * 50.0 + 0.5);
+  double bin;
+
+  sph_world_def_init(&def);
+  def.capacity = n;
+  def.particle_spacing = (float)(step * sqrt(2.0));
+  def.equation_of_state = tc->eos;
+  physics_create(&def, &context, &world);
+  EXPECT_OK(sph_world_get_def(world, &def));
+  h = def.kernel_radius;
+  rho0 = def.rest_density;
+  /* Pressure is averaged over horizontal slices one kernel radius thick: a single particle's
+   * pressure carries the noise of its summed density (0.1 % of rho0 is 100 Pa at k = 100, 10 %
+   * of the pressure at 0.1 m depth), and a slice of several hundred particle samples brings that
+   * below 1 %. */
+  bin = h;
+  sph_world_params_init(&params);
+  /* Viscosity at its default (1 Pa s) damps the start-up sloshing within the first half; the
+   * acoustic limit keeps c dt below 0.4 h whatever the speeds. */
+  params.step_limits = SPH_STEP_LIMIT_ACOUSTIC;
+  EXPECT_OK(sph_world_set_params(world, &params));
+  k = params.stiffness;
+  if (tc->eos == SPH_EOS_TAIT) {
+    sph_tait_params tait;
+    sph_tait_params_init(&tait);
+    EXPECT_OK(sph_world_get_tait_params(world, &tait));
+    c = tait.speed_of_sound;
+  }
+  validation_tank(context, world, tank_min, tank_max, 0.5 * step, 0.0f, &sdf);
+  sph_spawn_desc_init(&spawn);
+  spawn.count = n;
+  spawn.positions = lattice_points;
+  EXPECT_OK(sph_world_spawn(world, &spawn, NULL));
+  EXPECT_OK(sph_world_get_particle_mass(world, &mass));
+  free(lattice_points);
+
+  layer_sum = (double*)calloc(nl, sizeof(double));
+  layer_y = (double*)calloc(nl, sizeof(double));
+  layer_count = (uint32_t*)calloc(nl, sizeof(uint32_t));
+  assert_true(layer_sum && layer_y && layer_count);
+  for (int f = 0; f < frames; ++f) {
+    EXPECT_OK(sph_world_step(world, 0.02f));
+    assert_int_equal(physics_copy_by_id(world, SPH_ATTRIBUTE_POSITION, (void**)&x), n);
+    physics_copy_by_id(world, SPH_ATTRIBUTE_PRESSURE, (void**)&p);
+    for (uint32_t i = 0; i < n; ++i) {
+      if (x[3 * i + 1] < lowest) lowest = x[3 * i + 1];
+      if (f < frames / 2) continue;
+      if (x[3 * i] < h || x[3 * i] > width - h || x[3 * i + 2] < h || x[3 * i + 2] > width - h) continue;
+      {
+        const int layer = (int)floor(x[3 * i + 1] / bin);
+        if (layer < 0 || layer >= (int)nl) continue;
+        layer_sum[layer] += p[i];
+        layer_y[layer] += x[3 * i + 1];
+        ++layer_count[layer];
+      }
+    }
+    if (f == frames - 1) {
+      /* The top particle layer: the median height of the highest layer's worth of particles
+       * (a stray particle thrown up by the start-up waves does not count). */
+      const uint32_t per_layer = tc->width_layers * tc->width_layers / 2;
+      float* heights = (float*)malloc(sizeof(float) * n);
+      assert_non_null(heights);
+      for (uint32_t i = 0; i < n; ++i) heights[i] = x[3 * i + 1];
+      qsort(heights, n, sizeof(float), ascending);
+      top_layer = heights[n - 1 - per_layer / 2];
+      free(heights);
+    }
+    free(x);
+    free(p);
+  }
+
+  /* Fit the surface height y_s, then compare the interior layers. */
+  {
+    double best_s = 0.0, best_cost = 1e30, worst = 0.0, mean = 0.0;
+    uint32_t used = 0;
+    for (uint32_t l = 0; l < nl; ++l)
+      if (layer_count[l]) {
+        layer_sum[l] /= layer_count[l];
+        layer_y[l] /= layer_count[l];
+      }
+    for (int s = -400; s <= 400; ++s) {
+      const double ys = top_layer + 0.5 * step + s * (2.0 * h / 400.0);
+      double cost = 0.0;
+      for (uint32_t l = 0; l < nl; ++l) {
+        double e;
+        if (layer_count[l] == 0 || layer_y[l] < h || ys - layer_y[l] < 2.0 * h) continue;
+        e = layer_sum[l] / exact_pressure(tc->eos, k, c, rho0, ys - layer_y[l]) - 1.0;
+        cost += e * e;
+      }
+      if (cost < best_cost) {
+        best_cost = cost;
+        best_s = ys;
+      }
+    }
+    printf(
+        "%s: %u particles, h = %.4f m, %u layers deep; fitted surface y_s = %.4f m, top particle layer %.4f "
+        "m "
+        "(y_s - top = %.2f h)\n",
+        tc->name, n, h, nl, best_s, top_layer, (best_s - top_layer) / h);
+    printf("  %-9s %-9s %-11s %-11s %-8s\n", "y, m", "depth, m", "p SPH, Pa", "p exact, Pa", "error");
+    for (uint32_t l = 0; l < nl; ++l) {
+      double exact, e;
+      if (layer_count[l] == 0) continue;
+      exact = exact_pressure(tc->eos, k, c, rho0, best_s - layer_y[l]);
+      e = exact > 0.0 ? layer_sum[l] / exact - 1.0 : 0.0;
+      {
+        const int interior = layer_y[l] >= h && best_s - layer_y[l] >= 2.0 * h;
+        printf("  %-9.4f %-9.4f %-11.1f %-11.1f %+6.2f %%%s\n", layer_y[l], best_s - layer_y[l], layer_sum[l],
+               exact, 100.0 * e, interior ? "" : "  (boundary layer, not compared)");
+        if (!interior) continue;
+      }
+      if (fabs(e) > worst) worst = fabs(e);
+      mean += fabs(e);
+      ++used;
+    }
+    mean /= used ? used : 1;
+    printf(
+        "  interior layers %u: mean |error| %.2f %%, worst %.2f %% (bound 3 %%); lowest particle y = %.2e m "
+        "(%.3f spacings)\n",
+        used, 100.0 * mean, 100.0 * worst, lowest, lowest / def.particle_spacing);
+    {
+      FILE* out = validation_open_output(tc->eos == SPH_EOS_TAIT ? "hydrostatic_tait.txt"
+                                                                 : "hydrostatic_ideal_gas.txt");
+      if (out) {
+        fprintf(out, "%s %u %.3f %.3f %.2f %.3e\n", tc->name, n, 100.0 * mean, 100.0 * worst,
+                (best_s - top_layer) / h, lowest / def.particle_spacing);
+        fclose(out);
+      }
+    }
+    assert_true(used >= 5);
+    assert_true(worst <= 0.03);
+    /* The fitted surface lies where the fluid is: within 2 h of the top particle layer. */
+    assert_true(fabs(best_s - top_layer) <= 2.0 * h);
+    /* Nothing crosses the floor: the collider puts particles back on the trilinear SDF's zero
+     * level, which matches the box's floor to float rounding; 5 % of a spacing allows for that
+     * and still catches any particle that leaks through (it would be a spacing or more out). */
+    assert_true(lowest > -0.05 * def.particle_spacing);
+  }
+  free(layer_sum);
+  free(layer_y);
+  free(layer_count);
+  EXPECT_OK(sph_sdf_destroy(sdf));
+  physics_destroy(context, world);
+}
+
+static void test_hydrostatic_ideal_gas(void** state) {
+  tank_case tc = {"ideal gas p = k (rho - rho0), k = 100", SPH_EOS_IDEAL_GAS, 16, 30, 0.01, 1.0};
+  (void)state;
+
+  if (validation_full()) {
+    tc.width_layers = 32;
+    tc.depth_layers = 60;
+    tc.step = 0.01;
+    tc.seconds = 2.0;
+  }
+  run_tank(&tc);
+}
+
+static void test_hydrostatic_tait(void** state) {
+  tank_case tc = {"Tait, c = 10 m/s", SPH_EOS_TAIT, 16, 30, 0.01, 1.0};
+  (void)state;
+  if (validation_full()) {
+    tc.width_layers = 32;
+    tc.depth_layers = 60;
+    tc.step = 0.01;
+    tc.seconds = 2.0;
+  }
+  run_tank(&tc);
+}
+
+/* argv[1] picks one equation of state (tait | ideal_gas); none runs both. */
+int main(int argc, char** argv) {
+  const struct CMUnitTest tait[] = {cmocka_unit_test(test_hydrostatic_tait)};
+  const struct CMUnitTest ideal_gas[] = {cmocka_unit_test(test_hydrostatic_ideal_gas)};
+  int failed = 0;
+  if (argc < 2 || strcmp(argv[1], "tait") == 0)
+    failed += cmocka_run_group_tests_name("hydrostatic_tait", tait, NULL, NULL);
+  if (argc < 2 || strcmp(argv[1], "ideal_gas") == 0)
+    failed += cmocka_run_group_tests_name("hydrostatic_ideal_gas", ideal_gas, NULL, NULL);
+  return failed;
+}
