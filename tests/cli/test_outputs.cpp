@@ -17,6 +17,8 @@
 #include <map>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "cli_test_support.h"
 #include "particle_frame.h"
 #include "scene_parser.h"
@@ -156,11 +158,20 @@ void test_run_outputs_equal_world(void**) {
   formats += ",vdb";
 #endif
   std::string log;
-  const int status = cli_test::run({g_sph_run, scene_file, "--frames", "3", "--backend", "cpu", "--threads",
-                                    "2", "--format", formats, "--out", dir, "--quiet"},
-                                   &log);
+  const std::string stats_file = dir + "/stats.json";
+  const int status =
+      cli_test::run({g_sph_run, scene_file, "--frames", "3", "--backend", "cpu", "--threads", "2", "--format",
+                     formats, "--out", dir, "--quiet", "--stats-json", stats_file},
+                    &log);
   std::printf("%s", log.c_str());
   assert_int_equal(status, 0);
+  // --stats-json: the run's figures, consistent with the frames it wrote.
+  const nlohmann::json stats = nlohmann::json::parse(cli_test::read_text(stats_file));
+  assert_int_equal(stats.at("frames").get<int>(), 3);
+  assert_true(stats.at("substeps").get<long>() >= 3);
+  assert_true(stats.at("s_per_frame").get<double>() > 0.0);
+  assert_true(stats.at("stage_ms").at("density").get<double>() > 0.0);
+  const uint32_t particles_end = stats.at("particles_end").get<uint32_t>();
 
   sph_context_def def;
   sph_context_def_init(&def);
@@ -182,6 +193,7 @@ void test_run_outputs_equal_world(void**) {
       std::string error;
       assert_true(cli_test::read_ply(std::string(name) + ".ply", &p, &error));
       expect_equal(f, p, false);
+      if (frame == 3) assert_int_equal(p.count(), particles_end);
       assert_true(cli_test::read_csv(std::string(name) + ".csv", &p, &error));
       expect_equal(f, p, true);
 #ifdef SPH_TOOLS_HAVE_OPENVDB

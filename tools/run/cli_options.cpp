@@ -23,6 +23,7 @@ const char* usage_text() {
          "  --preview           draw every frame to PNG, and an MP4 when ffmpeg is on PATH\n"
          "  --threads N         CPU backend threads (default: all)\n"
          "  --quiet             no progress, only warnings, errors and the summary\n"
+         "  --stats-json FILE   also write the summary's figures to FILE as JSON (benchmarks)\n"
          "  --version           print the library's build information\n"
          "  -h, --help          this text\n"
          "\n"
@@ -123,6 +124,9 @@ CliOptions parse_cli(int argc, char** argv) {
     } else if (arg == "--quiet") {
       no_value();
       o.quiet = true;
+    } else if (arg == "--stats-json") {
+      o.stats_json = next();
+      if (o.stats_json->empty()) throw UsageError("--stats-json: expected a file name");
     } else if (arg.size() > 1 && arg[0] == '-') {
       throw UsageError("unknown option " + arg);
     } else if (o.scene.empty()) {

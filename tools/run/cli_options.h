@@ -22,6 +22,7 @@ struct CliOptions {
   bool preview = false;
   uint32_t threads = 0;
   bool quiet = false;
+  std::optional<std::string> stats_json;  // --stats-json FILE: the run's figures, machine-readable
   bool help = false;
   bool version = false;
 };

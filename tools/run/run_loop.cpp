@@ -110,6 +110,8 @@ int run_scene(sph_context* context, const std::string& backend_name, const Scene
                     " written to " + out.directory + "/)",
                 backend_name, wall_s);
     std::fflush(stdout);
+    if (cli.stats_json && !stats.write_json(*cli.stats_json, cli.scene, backend_name, wall_s))
+      std::fprintf(stderr, "sph-run: warning: cannot write %s\n", cli.stats_json->c_str());
     return signal ? kExitInterrupted + signal : kExitOk;
   } catch (const SceneError& e) {
     return fail(kExitScene, cli.scene + ": " + e.what());

@@ -53,4 +53,31 @@ void RunStats::print(std::FILE* out, const std::string& what, const std::string&
                static_cast<double>(last_.memory_bytes) / (1024.0 * 1024.0));
 }
 
+bool RunStats::write_json(const std::string& path, const std::string& scene, const std::string& backend,
+                          double wall_s) const {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) return false;
+  static const char* kStages[SPH_STAGE_COUNT] = {"hash_sort", "cell_ranges", "density", "forces",
+                                                 "integrate", "collide",     "emit",    "other"};
+  const double frames = frames_ > 0 ? frames_ : 1.0;
+  std::string escaped;
+  for (char c : scene) {
+    if (c == '"' || c == '\\') escaped += '\\';
+    escaped += c;
+  }
+  std::fprintf(f,
+               "{\"benchmark\": \"sph-run\", \"scene\": \"%s\", \"backend\": \"%s\", \"frames\": %u, "
+               "\"wall_s\": %.4f, \"s_per_frame\": %.6g, \"output_s_per_frame\": %.6g, \"substeps\": %llu, "
+               "\"particles_end\": %u, \"particles_max\": %u, \"dt_min\": %.6g, \"dt_max\": %.6g, "
+               "\"max_speed\": %.6g, \"neighbors_mean\": %.4f, \"memory_bytes\": %llu, \"stage_ms\": {",
+               escaped.c_str(), backend.c_str(), frames_, wall_s, step_ms_ * 1e-3 / frames,
+               output_ms_ * 1e-3 / (frames_ + 1.0), static_cast<unsigned long long>(substeps_),
+               last_.particle_count, particles_max_, dt_min_, dt_max_, speed_max_, last_.neighbors_mean,
+               static_cast<unsigned long long>(last_.memory_bytes));
+  for (int i = 0; i < SPH_STAGE_COUNT; ++i)
+    std::fprintf(f, "\"%s\": %.6g%s", kStages[i], stage_ms_[i], i + 1 < SPH_STAGE_COUNT ? ", " : "");
+  std::fprintf(f, "}}\n");
+  return std::fclose(f) == 0;
+}
+
 }  // namespace sph_tools
