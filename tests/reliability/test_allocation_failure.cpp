@@ -153,7 +153,6 @@ void build_scene(Scene* s) {
   sph_shape_desc_init(&shape);
   shape.shape = SPH_SHAPE_BOX;
   shape.half_extents = sph_vec3{0.2f, 0.2f, 0.1f};
-  shape.wall_thickness = 0.04f;
   shape.voxel_size = 0.025f;
   EXPECT_OK(sph_sdf_create_shape(s->context, &shape, &s->tank));
   sph_shape_desc_init(&shape);

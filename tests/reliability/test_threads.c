@@ -56,7 +56,6 @@ static sph_result build_world(sph_context* context, int variant, sph_world** out
   shape.half_extents.x = 0.3f;
   shape.half_extents.y = 0.3f;
   shape.half_extents.z = 0.15f;
-  shape.wall_thickness = 0.04f;
   shape.voxel_size = 0.02f;
   if ((r = sph_sdf_create_shape(context, &shape, &tank)) != SPH_OK) goto fail;
   sph_collider_def_init(&collider);
