@@ -15,10 +15,13 @@ import json
 import os
 import sys
 
-import matplotlib
+try:  # the tables need nothing; the plots need matplotlib (python3-matplotlib on Debian)
+    import matplotlib
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+except ImportError:
+    plt = None
 
 # The thesis's Figure 8 (GeForce 8 GPU and its CPU), s/frame (BENCHMARK.md case 1).
 THESIS_N = [25000, 100000, 200000, 400000, 600000]
@@ -173,6 +176,20 @@ def summary(rows, ceilings, share, scenes, out_dir):
         lines.append("|---|---:|---:|---:|")
         for k in share["by_kernel"]:
             lines.append(f"| {k['name']} | {k['ms_per_substep']:.4f} | {k['dram_gb_s']:.0f} | {k['fp32_tflop_s']:.2f} |")
+    dams = []
+    for backend in ("cuda", "cpu"):
+        dams += load(os.path.join(out_dir, f"dam_break_{backend}.json"), [])
+    if dams:
+        lines.append("\n### Case 2: dam break (1 simulated second, median over the frames after the first)\n")
+        lines.append("| backend | particles | s/frame | substeps/frame | ms/substep | particle-substeps/s | neighbours | "
+                     "bytes/particle | " + " | ".join(STAGES) + " |")
+        lines.append("|---|---:|---:|---:|---:|---:|---:|---:|" + "---:|" * len(STAGES))
+        for d in dams:
+            total = sum(d["stage_ms_per_substep"].values()) or 1.0
+            lines.append(f"| {d['backend']} | {d['particles']} | {d['s_per_frame']:.4g} | {d['substeps_per_frame']:.1f} | "
+                         f"{d['ms_per_substep']:.4g} | {d['particle_substeps_per_s']:.3g} | {d['neighbors_mean']:.1f} | "
+                         f"{d['bytes_per_particle']:.1f} | " + " | ".join(
+                             f"{100 * d['stage_ms_per_substep'].get(s, 0.0) / total:.1f}" for s in STAGES) + " |")
     if scenes:
         lines.append("\n### Case 3: the thesis scenes (sph-run, no output)\n")
         lines.append("| scene | backend | particles at most | frames | s/frame | thesis s/frame |")
@@ -197,7 +214,10 @@ def main():
     if share and ceilings:
         share["dram_share"] = share["dram_gb_s"] / ceilings["stream_gb_s"]
         share["fp32_share"] = share["fp32_tflop_s"] / ceilings["fp32_tflop_s"]
-    if rows:
+    if rows and plt is None:
+        print("plot_results: no matplotlib here: tables only; rerun where python3-matplotlib is installed "
+              "for the plots", file=sys.stderr)
+    elif rows:
         fig8(rows, out_dir)
         fig9(rows, out_dir)
         scaling(rows, out_dir)
