@@ -242,10 +242,20 @@ class CudaBackend final : public Backend {
     ++epoch_;
     if (s.non_finite) {
       roll_back_frame();
-      throw Error(Status::NonFinite, "the step produced a non-finite position or velocity in substep " +
-                                         std::to_string(s.bad_substep) + " (dt " + std::to_string(s.bad_dt) +
-                                         " s) at particle id " + std::to_string(s.bad_id) +
-                                         "; the world was restored to its state before sph_world_step");
+      static const char* const kStages[] = {
+          "density stage (SPH_STAGE_DENSITY)", "forces stage (SPH_STAGE_FORCES)",
+          "integrate stage (SPH_STAGE_INTEGRATE)", "collide stage (SPH_STAGE_COLLIDE)"};
+      throw Error(
+          Status::NonFinite,
+          "the step produced non-finite values in the " + std::string(kStages[s.bad_stage & 3u]) +
+              " of substep " + std::to_string(s.bad_substep) + " (dt " + std::to_string(s.bad_dt) + " s" +
+              (setup.limits.stability_dt > 0.0f && s.bad_dt > setup.limits.stability_dt
+                   ? ", above this world's stable step " + std::to_string(setup.limits.stability_dt) +
+                         " s (0.4 h / c, 0.05 h^2 rho0 / mu), forced by dt_min"
+                   : std::string()) +
+              "): " + std::to_string(s.bad_count) +
+              (s.bad_count == 1 ? " particle, id " : " particles, first id ") + std::to_string(s.bad_id) +
+              "; the world was restored to its state before sph_world_step");
     }
     count_ = count_after;
     FrameReport report;

@@ -42,7 +42,13 @@ __global__ void begin_frame_kernel(FrameState* s, StepLimits limits, uint32_t ma
   s->bad_id = 0;
   s->bad_substep = 0;
   s->bad_dt = 0.0f;
-  for (int k = 0; k < kRk4Stages; ++k) s->bad_key[k] = kNoBadParticle;
+  s->bad_stage = 0;
+  s->bad_count = 0;
+  s->saved_max_acceleration = s->max_acceleration;
+  for (int k = 0; k < kRk4Stages; ++k) {
+    s->bad_key[k] = kNoBadParticle;
+    s->bad_counts[k] = 0;
+  }
   s->saved_max_speed = s->max_speed;
   const uint32_t run = (s->remaining > 0.0 && max_substeps > 0) ? 1u : 0u;
   if (run) pick_next_step(s, limits);
@@ -63,6 +69,8 @@ __global__ void end_substep_kernel(FrameState* s, StepLimits limits, uint32_t ma
     if (s->bad_key[k] != kNoBadParticle) {
       s->non_finite = 1;
       s->bad_id = static_cast<uint32_t>(s->bad_key[k] & 0xffffffffu);
+      s->bad_stage = static_cast<uint32_t>((s->bad_key[k] >> 32) & 3u);
+      s->bad_count = s->bad_counts[k];
       s->bad_substep = s->substeps + 1;
       s->bad_dt = s->dt_float;
       set_run(s, 0, cond);
@@ -91,7 +99,11 @@ __global__ void finish_speed_max_kernel(FrameState* s) {
   s->v2max_bits = 0;
 }
 
-__global__ void restore_max_speed_kernel(FrameState* s) { s->max_speed = s->saved_max_speed; }
+// A rolled-back frame leaves the step controller's inputs as they were too.
+__global__ void restore_max_speed_kernel(FrameState* s) {
+  s->max_speed = s->saved_max_speed;
+  s->max_acceleration = s->saved_max_acceleration;
+}
 
 }  // namespace
 

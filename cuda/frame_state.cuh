@@ -14,6 +14,15 @@ namespace sph {
 constexpr int kRk4Stages = 4;
 constexpr unsigned long long kNoBadParticle = ~0ull;
 
+// Where a particle went non-finite: the first of its density and pressure, its acceleration,
+// its integrated state and the collision response that is not finite (as the CPU backend).
+enum NonFiniteStage : uint32_t {
+  kNonFiniteDensity = 0,
+  kNonFiniteForces = 1,
+  kNonFiniteIntegrate = 2,
+  kNonFiniteCollide = 3
+};
+
 // What the host writes before each frame (one copy from pinned memory into the head of
 // FrameState).
 struct FrameInput {
@@ -46,12 +55,16 @@ struct FrameState {
   uint32_t bad_id;         // id of the first non-finite particle
   uint32_t bad_substep;
   float bad_dt;
+  uint32_t bad_stage;            // NonFiniteStage of that particle
+  uint32_t bad_count;            // non-finite particles of the RK4 stage (or Euler step) that failed
+  float saved_max_acceleration;  // max_acceleration at the start of the frame, for a rollback
   // This substep's place in the frame for moving colliders, computed with the step as the CPU
   // backend computes it (s0, s1, tau0, tau1 from the double clock).
   SubstepTime time;
-  // Per RK4 stage (symplectic Euler uses [0]): (sorted index << 32 | id), the minimum wins,
-  // which is the particle the CPU backend names.
+  // Per RK4 stage (symplectic Euler uses [0]): ((sorted index << 2 | NonFiniteStage) << 32 | id),
+  // the minimum wins, which is the particle the CPU backend names (indices < 2^30 = capacity).
   unsigned long long bad_key[kRk4Stages];
+  uint32_t bad_counts[kRk4Stages];  // non-finite particles flagged per stage
 
   // Statistics of the last density evaluation, computed once at the end of the frame.
   float density_min;

@@ -61,8 +61,20 @@ __device__ __forceinline__ Vec3 gather_acceleration_masked(const FluidConstants&
                                                           kSurfaceTension ? normals + i : nullptr);
 }
 
-__device__ __forceinline__ void flag_non_finite(FrameState* s, int stage, uint32_t index, uint32_t id) {
-  atomicMin(&s->bad_key[stage], (static_cast<unsigned long long>(index) << 32) | id);
+__device__ __forceinline__ void flag_non_finite(FrameState* s, int stage, uint32_t index, uint32_t id,
+                                                uint32_t where) {
+  atomicMin(&s->bad_key[stage], ((static_cast<unsigned long long>(index) << 2 | where) << 32) | id);
+  atomicAdd(&s->bad_counts[stage], 1u);
+}
+
+// The NonFiniteStage of a particle whose new state is not finite (the failure path only).
+__device__ __forceinline__ uint32_t non_finite_stage(const Float4& p, const Float4& v, Vec3 acc,
+                                                     const ParticleState& integrated) {
+  if (!isfinite(p.w) || !isfinite(v.w)) return kNonFiniteDensity;
+  if (!finite3(acc)) return kNonFiniteForces;
+  if (!finite3(integrated.position) || !isfinite(length_squared(integrated.velocity)))
+    return kNonFiniteIntegrate;
+  return kNonFiniteCollide;
 }
 
 // The scene's force fields at a particle (after the neighbour gather, as the CPU backend).
@@ -157,6 +169,7 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
     if (kScene) acc = add_force_fields(scene, acc, xyz(p));
     a2 = length_squared(acc);
     ParticleState next = symplectic_euler(ParticleState{xyz(p), xyz(v)}, acc, f.dt);
+    const ParticleState integrated = next;
     if (kScene) collide_all(scene, state->time, xyz(p), next);
     const uint32_t id = a.sorted_id[i];
     a.position[i] = make_float4_record(next.position, p.w);
@@ -164,7 +177,7 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
     a.id[i] = id;
     v2 = length_squared(next.velocity);
     if (!finite3(next.position) || !isfinite(v2)) {
-      flag_non_finite(state, 0, i, id);
+      flag_non_finite(state, 0, i, id, non_finite_stage(p, v, acc, integrated));
       v2 = 0.0f;
     }
   }
@@ -196,6 +209,7 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
     const ParticleState from = start[i];
     ParticleState next = rk4_advance(stage, from, ParticleState{xyz(p), xyz(v)}, acc, f.dt, sum);
     sums[i] = sum;
+    const ParticleState integrated = next;
     if (kScene && stage == kRk4Stages - 1) collide_all(scene, state->time, from.position, next);
     const uint32_t id = a.sorted_id[i];
     a.position[i] = make_float4_record(next.position, p.w);
@@ -203,7 +217,7 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
     a.id[i] = id;
     v2 = length_squared(next.velocity);
     if (!finite3(next.position) || !isfinite(v2)) {
-      flag_non_finite(state, stage, i, id);
+      flag_non_finite(state, stage, i, id, non_finite_stage(p, v, acc, integrated));
       v2 = 0.0f;
     }
     if (stage != kRk4Stages - 1) v2 = 0.0f;  // the speed that counts is the final state's

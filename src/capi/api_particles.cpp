@@ -14,13 +14,21 @@ using sph::Status;
 
 namespace {
 
-// Beyond this many cells from the origin the grid's cell coordinates would overflow.
-void require_in_grid(const sph::Vec3& p, float kernel_radius, const std::string& name) {
-  const float limit = sph::kMaxCellCoordinate * 0.5f * kernel_radius;
-  if (!(std::fabs(p.x) < limit && std::fabs(p.y) < limit && std::fabs(p.z) < limit))
-    throw Error(Status::InvalidArgument, name + ": lies farther than " + std::to_string(limit) +
-                                             " m from the origin, outside the range the neighbour grid "
-                                             "can represent");
+// Float32 resolves a position x to steps of about |x| 2^-23. Beyond 2^16 particle spacings
+// from the origin a step exceeds 1/128 of the spacing, and neighbour distances, densities and
+// small moves turn to rounding noise (at 1e6 m with a 2 cm spacing the steps are 6 cm: silent
+// garbage), so such positions are refused. The bound lies far inside the neighbour grid's
+// cell-coordinate range (2^30 cells of h >= spacing).
+constexpr float kMaxPositionInSpacings = 65536.0f;
+
+void require_resolvable(const sph::Vec3& p, const sph::WorldConfig& c, const std::string& name) {
+  const float limit = kMaxPositionInSpacings * c.particle_spacing;
+  if (!(std::fabs(p.x) <= limit && std::fabs(p.y) <= limit && std::fabs(p.z) <= limit))
+    throw Error(Status::InvalidArgument,
+                name + ": (" + sph::describe(p.x) + ", " + sph::describe(p.y) + ", " + sph::describe(p.z) +
+                    ") lies farther than " + sph::describe(limit) +
+                    " m (65536 particle spacings) from the origin, where float32 positions no longer "
+                    "resolve the spacing to 1/128; move the scene's origin closer or use a larger spacing");
 }
 
 sph::Vec3 read_vec3(const float* base, uint64_t stride, uint32_t i) {
@@ -46,7 +54,7 @@ void check_fill_fits(const sph_world* world, uint64_t count) {
 uint32_t add_lattice(sph_world* world, const std::vector<sph::Vec3>& points, const sph_vec3& velocity) {
   check_fill_fits(world, points.size());
   const sph::WorldConfig& c = world->world->config();
-  for (const sph::Vec3& p : points) require_in_grid(p, c.kernel_radius, "desc (a lattice point)");
+  for (const sph::Vec3& p : points) require_resolvable(p, c, "desc (a lattice point)");
   const std::vector<sph::Vec3> velocities(points.size(), sph::Vec3{velocity.x, velocity.y, velocity.z});
   world->world->spawn(points, &velocities);
   return static_cast<uint32_t>(points.size());
@@ -88,14 +96,14 @@ SPH_API sph_result SPH_CALL sph_world_spawn(sph_world* world, const sph_spawn_de
       throw Error(Status::Capacity, "desc->count: " + std::to_string(d.count) + " particles do not fit; " +
                                         std::to_string(world->world->free_capacity()) + " of the capacity " +
                                         std::to_string(world->world->config().capacity) + " are free");
-    const float h = world->world->config().kernel_radius;
+    const sph::WorldConfig& config = world->world->config();
     std::vector<sph::Vec3> positions(d.count);
     std::vector<sph::Vec3> velocities;
     for (uint32_t i = 0; i < d.count; ++i) {
       positions[i] = read_vec3(d.positions, pstride, i);
       const std::string name = "desc->positions[" + std::to_string(i) + "]";
       require_finite_point(positions[i], name);
-      require_in_grid(positions[i], h, name);
+      require_resolvable(positions[i], config, name);
     }
     if (d.velocities) {
       velocities.resize(d.count);

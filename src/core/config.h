@@ -87,6 +87,9 @@ inline StepLimits make_step_limits(const WorldConfig& c, const RuntimeParams& p)
   s.sound_speed = 0.0f;
   if (p.step_limits & kStepLimitAcoustic) s.sound_speed = speed_of_sound(make_eos(c, p));
   s.use_force_limit = (p.step_limits & kStepLimitForce) ? 1u : 0u;
+  // Clavet's impulses are bounded per pair (forces.h), so only Mueller's viscosity limits dt.
+  const float nu = c.viscosity_method == ViscosityMethod::Mueller ? p.viscosity / c.rest_density : 0.0f;
+  s.stability_dt = stability_ceiling(c.kernel_radius, speed_of_sound(make_eos(c, p)), nu);
   return s;
 }
 

@@ -84,6 +84,7 @@ class CpuBackend final : public Backend {
     const auto saved = store_.snapshot();
     const float saved_max_speed = max_speed_;
     const bool saved_max_speed_valid = max_speed_valid_;
+    const float saved_max_acceleration = max_acceleration_;
     if (!max_speed_valid_) max_speed_ = compute_max_speed();
 
     // Puts the particles back as they were before the frame: on a non-finite state and on any
@@ -95,6 +96,7 @@ class CpuBackend final : public Backend {
       store_.restore(saved);
       max_speed_ = saved_max_speed;
       max_speed_valid_ = saved_max_speed_valid;
+      max_acceleration_ = saved_max_acceleration;  // the force step limit reads it next step
     };
     double remaining = frame_dt;
     double elapsed = 0.0;
@@ -116,10 +118,10 @@ class CpuBackend final : public Backend {
                                  : substep_euler(fluid, scene, time, report);
         if (bad != kAllFinite) {
           roll_back();
-          throw Error(Status::NonFinite, "the step produced a non-finite position or velocity in substep " +
-                                             std::to_string(report.substeps + 1) + " (dt " +
-                                             std::to_string(dtf) + " s) at particle id " +
-                                             std::to_string(bad) +
+          throw Error(Status::NonFinite, "the step produced non-finite values in the " + non_finite_.where +
+                                             " of substep " + std::to_string(report.substeps + 1) + " (dt " +
+                                             std::to_string(dtf) + " s" + above_stable_step(dtf, limits) +
+                                             "): " + non_finite_.particles +
                                              "; the world was restored to its state before sph_world_step");
         }
         if (!scene.sinks.empty()) apply_sinks(scene, report);
@@ -298,6 +300,51 @@ class CpuBackend final : public Backend {
     return bad_index;
   }
 
+  // Says when a failed substep was longer than the stability ceiling (only dt_min can force it).
+  static std::string above_stable_step(float dt, const StepLimits& limits) {
+    if (!(limits.stability_dt > 0.0f) || dt <= limits.stability_dt) return "";
+    return ", above this world's stable step " + std::to_string(limits.stability_dt) +
+           " s (0.4 h / c, 0.05 h^2 rho0 / mu), forced by dt_min";
+  }
+
+  // Where a failed substep went non-finite, worked out on the failure path only, before the new
+  // state replaces the old: the particle with the lowest index names the stage (the first of
+  // its density and pressure, its acceleration, its integrated state and the collision response
+  // that is not finite; the CUDA backend names the same), and up to 8 ids are listed.
+  void diagnose_non_finite(const FluidConstants& fluid, const SceneFrame& scene, int rk4_stage,
+                           uint32_t first) {
+    const Float4* pos = position_.data.data();
+    const Float4* vel = velocity_.data.data();
+    const uint32_t i = first;
+    const char* stage = "collide stage (SPH_STAGE_COLLIDE)";
+    if (!std::isfinite(density_.data[i]) || !std::isfinite(pos[i].w) || !std::isfinite(vel[i].w)) {
+      stage = "density stage (SPH_STAGE_DENSITY)";
+    } else {
+      const Vec3 a = acceleration_function()(fluid, grid_.view(), pos, vel, neighbors_.data.data(),
+                                             normals_.data(), scene, i);
+      if (!finite3(a)) {
+        stage = "forces stage (SPH_STAGE_FORCES)";
+      } else if (rk4_stage >= 0) {
+        // The RK4 sums were updated in place, so the integrated state cannot be recomputed.
+        stage = rk4_stage == 3 && !scene.colliders.empty() ? "integrate or collide stage (RK4 stage 4)"
+                                                           : "integrate stage (SPH_STAGE_INTEGRATE)";
+      } else {
+        const ParticleState s = symplectic_euler({xyz(pos[i]), xyz(vel[i])}, a, fluid.dt);
+        if (!finite3(s.position) || !std::isfinite(length_squared(s.velocity)))
+          stage = "integrate stage (SPH_STAGE_INTEGRATE)";
+      }
+    }
+    uint32_t count = 0;
+    std::string ids;
+    for (uint32_t k = 0; k < count_; ++k) {
+      if (finite3(xyz(next_position_[k])) && std::isfinite(length_squared(xyz(next_velocity_[k])))) continue;
+      if (++count <= 8) ids += (count > 1 ? ", " : "") + std::to_string(id_.data[k]);
+    }
+    non_finite_.where = stage;
+    non_finite_.particles = std::to_string(count) + (count == 1 ? " particle, id " : " particles, ids ") +
+                            ids + (count > 8 ? ", ..." : "");
+  }
+
   uint32_t finish_substep(float v2max, uint32_t bad_index) {
     position_.data.swap(next_position_);
     velocity_.data.swap(next_velocity_);
@@ -335,6 +382,7 @@ class CpuBackend final : public Backend {
     t = Clock::now();
     float v2max = 0.0f;
     const uint32_t bad_index = scan_next_state(v2max);
+    if (bad_index != kAllFinite) diagnose_non_finite(fluid, scene, -1, bad_index);
     const uint32_t bad = finish_substep(v2max, bad_index);
     report.stage_ms[kStageIntegrate] += static_cast<float>(elapsed_ms(t));
     return bad;
@@ -374,6 +422,7 @@ class CpuBackend final : public Backend {
       t = Clock::now();
       float v2max = 0.0f;
       const uint32_t bad_index = scan_next_state(v2max);
+      if (bad_index != kAllFinite) diagnose_non_finite(fluid, scene, stage, bad_index);
       const uint32_t bad = finish_substep(v2max, bad_index);
       report.stage_ms[kStageIntegrate] += static_cast<float>(elapsed_ms(t));
       if (bad != kAllFinite) return bad;
@@ -446,6 +495,10 @@ class CpuBackend final : public Backend {
   uint32_t count_ = 0;
   float max_speed_ = 0.0f;
   float max_acceleration_ = 0.0f;  // of the last force evaluation, for the force step limit
+  struct {
+    std::string where;      // the stage of the first non-finite particle
+    std::string particles;  // how many, and their ids
+  } non_finite_;            // of the last failed substep, for its error message
   bool max_speed_valid_ = false;
 };
 

@@ -1,0 +1,160 @@
+#include "extremes_util.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void ext_ok(sph_result r, const char* call, const char* file, int line) {
+  if (r < 0) {
+    print_error("%s -> %s: %s\n", call, sph_result_string(r), sph_get_last_error());
+    _fail(file, line);
+  }
+}
+
+void ext_open_def(ext_world* w, sph_world_def def) {
+  sph_world_def init;
+  memset(w, 0, sizeof *w);
+  sph_world_def_init(&init);
+  def.struct_size = init.struct_size;
+  def.header_version = init.header_version;
+  EXT_OK(sph_test_context_create(&w->context));
+  EXT_OK(sph_world_create(w->context, &def, &w->world));
+  EXT_OK(sph_world_get_particle_mass(w->world, &w->mass));
+  EXT_OK(sph_world_get_def(w->world, &def));
+  w->kernel_radius = def.kernel_radius;
+  sph_world_params_init(&w->params);
+  EXT_OK(sph_world_get_params(w->world, &w->params));
+}
+
+void ext_open(ext_world* w, uint32_t capacity, float spacing) {
+  sph_world_def def;
+  sph_world_def_init(&def);
+  def.capacity = capacity;
+  def.particle_spacing = spacing;
+  ext_open_def(w, def);
+}
+
+void ext_close(ext_world* w) {
+  EXT_OK(sph_world_destroy(w->world));
+  EXT_OK(sph_context_destroy(w->context));
+}
+
+void ext_set_params(ext_world* w) { EXT_OK(sph_world_set_params(w->world, &w->params)); }
+
+void ext_spawn(ext_world* w, const float* positions, const float* velocities, uint32_t count) {
+  sph_spawn_desc d;
+  sph_spawn_desc_init(&d);
+  d.count = count;
+  d.positions = positions;
+  d.velocities = velocities;
+  EXT_OK(sph_world_spawn(w->world, &d, NULL));
+}
+
+void* ext_copy(const sph_world* world, sph_attribute attribute, uint32_t* out_count) {
+  const size_t element =
+      (attribute == SPH_ATTRIBUTE_POSITION || attribute == SPH_ATTRIBUTE_VELOCITY) ? 12 : 4;
+  uint32_t n = 0, written = 0;
+  void* buffer;
+  EXT_OK(sph_world_get_particle_count(world, &n));
+  *out_count = n;
+  if (n == 0) return NULL;
+  buffer = malloc(element * n);
+  assert_non_null(buffer);
+  EXT_OK(sph_world_copy_attribute(world, attribute, buffer, (uint64_t)element * n, 0, 0, n, &written));
+  assert_int_equal(written, n);
+  return buffer;
+}
+
+double ext_mechanical_energy(const sph_world* world, float mass, float g) {
+  uint32_t n = 0, i;
+  float* x = (float*)ext_copy(world, SPH_ATTRIBUTE_POSITION, &n);
+  float* v = (float*)ext_copy(world, SPH_ATTRIBUTE_VELOCITY, &n);
+  double e = 0.0;
+  for (i = 0; i < n; ++i) {
+    const double v2 = (double)v[3 * i] * v[3 * i] + (double)v[3 * i + 1] * v[3 * i + 1] +
+                      (double)v[3 * i + 2] * v[3 * i + 2];
+    e += 0.5 * mass * v2 + (double)mass * g * x[3 * i + 1];
+  }
+  free(x);
+  free(v);
+  return e;
+}
+
+void ext_tank_build(ext_world* w, ext_tank* t) {
+  sph_shape_desc shape;
+  sph_collider_def collider;
+  sph_fill_box_desc fill;
+  uint32_t added = 0;
+  sph_shape_desc_init(&shape);
+  shape.shape = SPH_SHAPE_BOX;
+  shape.half_extents.x = t->hx;
+  shape.half_extents.y = t->hy;
+  shape.half_extents.z = t->hz;
+  shape.voxel_size = 0.01f;
+  EXT_OK(sph_sdf_create_shape(w->context, &shape, &t->sdf));
+  sph_collider_def_init(&collider);
+  collider.sdf = t->sdf;
+  collider.flags = SPH_COLLIDER_FLAG_INVERTED;
+  collider.transform = sph_transform_identity();
+  collider.transform.position.y = t->hy;
+  EXT_OK(sph_collider_create(w->world, &collider, &t->collider));
+  sph_fill_box_desc_init(&fill);
+  fill.min.x = -t->hx;
+  fill.min.y = 0.0f;
+  fill.min.z = -t->hz;
+  fill.max.x = -t->hx + t->column_width;
+  fill.max.y = t->column_height;
+  fill.max.z = t->hz;
+  EXT_OK(sph_world_fill_box(w->world, &fill, &added));
+  assert_true(added > 0);
+}
+
+void ext_tank_destroy(ext_world* w, ext_tank* t) {
+  EXT_OK(sph_collider_destroy(w->world, t->collider));
+  EXT_OK(sph_sdf_destroy(t->sdf));
+}
+
+static int finite3(const float* p) { return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]); }
+
+ext_measure ext_tank_run(ext_world* w, const ext_tank* t, int frames, float frame_dt) {
+  ext_measure m;
+  uint32_t n = 0, i;
+  float* x = (float*)ext_copy(w->world, SPH_ATTRIBUTE_POSITION, &n);
+  const double e0 = ext_mechanical_energy(w->world, w->mass, EXT_G);
+  int frame;
+  memset(&m, 0, sizeof m);
+  m.finite = 1;
+  m.worst_depth = -1.0f;
+  for (i = 0; i < n; ++i) m.drop_energy += w->mass * EXT_G * x[3 * i + 1];
+  free(x);
+  for (frame = 0; frame < frames; ++frame) {
+    sph_stats st;
+    float *v, *rho;
+    double e;
+    EXT_OK(sph_world_step(w->world, frame_dt));
+    sph_stats_init(&st);
+    EXT_OK(sph_world_get_stats(w->world, &st));
+    m.substeps += st.substeps;
+    if (st.dt_max > m.largest_dt) m.largest_dt = st.dt_max;
+    x = (float*)ext_copy(w->world, SPH_ATTRIBUTE_POSITION, &m.count);
+    v = (float*)ext_copy(w->world, SPH_ATTRIBUTE_VELOCITY, &m.count);
+    rho = (float*)ext_copy(w->world, SPH_ATTRIBUTE_DENSITY, &m.count);
+    for (i = 0; i < m.count; ++i) {
+      const float* p = x + 3 * i;
+      const float* u = v + 3 * i;
+      const float speed = sqrtf(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+      const float depth = fmaxf(fmaxf(fabsf(p[0]) - t->hx, fabsf(p[1] - t->hy) - t->hy), fabsf(p[2]) - t->hz);
+      if (!finite3(p) || !finite3(u) || !isfinite(rho[i])) m.finite = 0;
+      if (speed > m.max_speed) m.max_speed = speed;
+      if (rho[i] > m.density_max) m.density_max = rho[i];
+      if (depth > m.worst_depth) m.worst_depth = depth;
+    }
+    free(x);
+    free(v);
+    free(rho);
+    e = ext_mechanical_energy(w->world, w->mass, EXT_G);
+    if ((float)(e - e0) > m.max_energy_gain) m.max_energy_gain = (float)(e - e0);
+  }
+  return m;
+}
