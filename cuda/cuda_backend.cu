@@ -315,6 +315,57 @@ class CudaBackend final : public Backend {
     }
   }
 
+  // Checkpoints: the state in storage order and the frame state that carries over (max speed,
+  // max acceleration); everything else in FrameState is reset when a frame begins.
+  ParticleSnapshot export_particles() const override {
+    require_alive();
+    DeviceGuard guard(device_);
+    const ParticleArrays& a = r_->store->arrays();
+    ParticleSnapshot s;
+    s.position = download(a.position, count_);
+    s.velocity = download(a.velocity, count_);
+    s.id = download(a.id, count_);
+    s.density = download(a.density, count_);
+    const std::vector<FrameState> state = download(static_cast<const FrameState*>(r_->state.get()), 1u);
+    s.max_speed = state[0].max_speed;
+    s.max_acceleration = state[0].max_acceleration;
+    return s;
+  }
+
+  void import_particles(const ParticleSnapshot& s) override {
+    require_alive();
+    const uint32_t n = static_cast<uint32_t>(s.id.size());
+    if (n > config_.capacity || s.position.size() != n || s.velocity.size() != n || s.density.size() != n)
+      throw Error(Status::Internal, "import_particles: inconsistent snapshot");
+    DeviceGuard guard(device_);
+    ++epoch_;
+    guarded([&] {
+      const ParticleArrays& a = r_->store->arrays();
+      cudaStream_t st = r_->stream;
+      if (n > 0) {
+        cuda_check(
+            cudaMemcpyAsync(a.position, s.position.data(), sizeof(Float4) * n, cudaMemcpyHostToDevice, st),
+            "copy of checkpoint positions");
+        cuda_check(
+            cudaMemcpyAsync(a.velocity, s.velocity.data(), sizeof(Float4) * n, cudaMemcpyHostToDevice, st),
+            "copy of checkpoint velocities");
+        cuda_check(cudaMemcpyAsync(a.id, s.id.data(), sizeof(uint32_t) * n, cudaMemcpyHostToDevice, st),
+                   "copy of checkpoint ids");
+        cuda_check(
+            cudaMemcpyAsync(a.density, s.density.data(), sizeof(float) * n, cudaMemcpyHostToDevice, st),
+            "copy of checkpoint densities");
+      }
+      FrameState* state = r_->state.get();
+      cuda_check(cudaMemcpyAsync(&state->max_speed, &s.max_speed, sizeof(float), cudaMemcpyHostToDevice, st),
+                 "copy of the checkpoint's max speed");
+      cuda_check(cudaMemcpyAsync(&state->max_acceleration, &s.max_acceleration, sizeof(float),
+                                 cudaMemcpyHostToDevice, st),
+                 "copy of the checkpoint's max acceleration");
+      cuda_check(cudaStreamSynchronize(st), "import of a checkpoint");
+    });
+    count_ = n;
+  }
+
   uint64_t memory_bytes() const override {
     return r_->store->bytes() + r_->grid->bytes() + r_->statistics->bytes() + r_->state.bytes() +
            r_->sdf_cache.bytes() + r_->scene_buffer.bytes() + r_->sinks.bytes();

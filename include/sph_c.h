@@ -79,6 +79,7 @@ typedef enum sph_result {
   SPH_ERROR_INTERNAL = -13,            /* an invariant failed inside the library (a bug) */
   SPH_ERROR_BUFFER_TOO_SMALL = -14,    /* a caller buffer cannot hold what was asked for */
   SPH_ERROR_NON_FINITE = -15,          /* a step produced NaN/Inf; the world was rolled back */
+  SPH_ERROR_CORRUPT_DATA = -16,        /* input data (a checkpoint) is truncated, damaged or inconsistent */
   SPH_RESULT_FORCE32 = 0x7fffffff
 } sph_result;
 
@@ -795,6 +796,59 @@ SPH_API sph_result SPH_CALL sph_world_get_events(const sph_world* world, sph_eve
 /** Ids of the particles sinks removed during the last sph_world_step (two-call pattern). */
 SPH_API sph_result SPH_CALL sph_world_get_removed_ids(const sph_world* world, uint32_t* ids,
                                                       uint32_t capacity, uint32_t* out_count);
+
+/* ---- checkpoints ---------------------------------------------------------------------------
+ * A checkpoint is a world's whole state as a self-contained byte string: the def, the
+ * parameters (those of the physics options included), the clock, the id counters, every
+ * particle in the world's storage order, and the scene (colliders with their pose and pending
+ * target, sources with their emission state, sinks, force fields, and every SDF asset they use,
+ * embedded once each). Object ids stay valid: a loaded world accepts the ids of the saved one.
+ * Loading and stepping continues bit for bit as the saved world would have, when both run on
+ * the same backend (CPU -> CPU, or CUDA -> CUDA on the same device model and library build);
+ * any checkpoint loads on any backend, then agreeing to float tolerance. The format is
+ * versioned and checksummed (docs/checkpoint.md); little-endian on every platform. The
+ * statistics, events and removed ids of the last step come along too. */
+
+/**
+ * Saves a world into caller memory. Size query: buffer NULL and buffer_size 0 set *out_size to
+ * the bytes needed and return SPH_OK. Otherwise the checkpoint is written when it fits
+ * (*out_size: the bytes written), else SPH_ERROR_BUFFER_TOO_SMALL with *out_size the bytes
+ * needed and nothing written. The size can change whenever the world does. Blocks (a CUDA
+ * world copies its particles to the host). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL
+ * out_size, NULL buffer with a non-zero size), BUFFER_TOO_SMALL, WORLD_LOCKED,
+ * OUT_OF_HOST_MEMORY, DEVICE.
+ */
+SPH_API sph_result SPH_CALL sph_world_save(const sph_world* world, void* buffer, uint64_t buffer_size,
+                                           uint64_t* out_size);
+/**
+ * Saves a world into a file, atomically: the checkpoint goes to a new file next to `path`
+ * (path + ".tmp-" + a unique suffix), is flushed to the disk (fsync), and is then renamed to
+ * `path`, replacing any file there. A crash leaves either the old file or the new one, never
+ * a partial one; on any error the temporary file is removed and a file at `path` is untouched.
+ * path is UTF-8 (a narrow path on POSIX). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL or
+ * empty path; the file cannot be created, written or renamed: the message says why),
+ * WORLD_LOCKED, OUT_OF_HOST_MEMORY, DEVICE.
+ */
+SPH_API sph_result SPH_CALL sph_world_save_file(const sph_world* world, const char* path);
+/**
+ * Creates a new world on `context` from a checkpoint in memory (data is read only during the
+ * call). The context decides the backend, whichever backend saved it. The whole checkpoint is
+ * validated before anything is created: on any error no world is created and *out is not
+ * written. Errors: INVALID_HANDLE (context), INVALID_ARGUMENT (NULL data or out),
+ * CORRUPT_DATA (truncated, damaged or inconsistent data; the message names the section and
+ * what is wrong), VERSION_MISMATCH (a checkpoint format this library does not read),
+ * OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY.
+ */
+SPH_API sph_result SPH_CALL sph_world_load(sph_context* context, const void* data, uint64_t size,
+                                           sph_world** out);
+/** sph_world_load from a file. INVALID_ARGUMENT also when the file cannot be opened or read. */
+SPH_API sph_result SPH_CALL sph_world_load_file(sph_context* context, const char* path, sph_world** out);
+/**
+ * Replaces a world's whole state with a checkpoint's (undo, retry): afterwards the world is as
+ * a world loaded from it on the same context, and keeps its handle. All-or-nothing: on any
+ * error the world is unchanged. Errors: as sph_world_load, and WORLD_LOCKED.
+ */
+SPH_API sph_result SPH_CALL sph_world_restore(sph_world* world, const void* data, uint64_t size);
 
 #ifdef __cplusplus
 }

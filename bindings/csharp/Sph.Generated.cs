@@ -102,6 +102,8 @@ namespace Sph
         ErrorBufferTooSmall = -14,
         /// <summary>a step produced NaN/Inf; the world was rolled back</summary>
         ErrorNonFinite = -15,
+        /// <summary>input data (a checkpoint) is truncated, damaged or inconsistent</summary>
+        ErrorCorruptData = -16,
     }
 
     /// <summary>sph_backend</summary>
@@ -1721,6 +1723,64 @@ namespace Sph
         public static extern Result sph_world_get_removed_ids(IntPtr world, IntPtr ids, uint capacity, IntPtr outCount);
 
         /// <summary>
+        /// Saves a world into caller memory. Size query: buffer NULL and buffer_size 0 set *out_size to
+        /// the bytes needed and return SPH_OK. Otherwise the checkpoint is written when it fits
+        /// (*out_size: the bytes written), else SPH_ERROR_BUFFER_TOO_SMALL with *out_size the bytes
+        /// needed and nothing written. The size can change whenever the world does. Blocks (a CUDA
+        /// world copies its particles to the host). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL
+        /// out_size, NULL buffer with a non-zero size), BUFFER_TOO_SMALL, WORLD_LOCKED,
+        /// OUT_OF_HOST_MEMORY, DEVICE.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_save(WorldHandle world, IntPtr buffer, ulong bufferSize, out ulong outSize);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_save")]
+        public static extern Result sph_world_save(IntPtr world, IntPtr buffer, ulong bufferSize, IntPtr outSize);
+
+        /// <summary>
+        /// Saves a world into a file, atomically: the checkpoint goes to a new file next to `path`
+        /// (path + ".tmp-" + a unique suffix), is flushed to the disk (fsync), and is then renamed to
+        /// `path`, replacing any file there. A crash leaves either the old file or the new one, never a
+        /// partial one; on any error the temporary file is removed and a file at `path` is untouched.
+        /// path is UTF-8 (a narrow path on POSIX). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL or
+        /// empty path; the file cannot be created, written or renamed: the message says why),
+        /// WORLD_LOCKED, OUT_OF_HOST_MEMORY, DEVICE.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_save_file(WorldHandle world, byte[] path);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_save_file")]
+        public static extern Result sph_world_save_file(IntPtr world, IntPtr path);
+
+        /// <summary>
+        /// Creates a new world on `context` from a checkpoint in memory (data is read only during the
+        /// call). The context decides the backend, whichever backend saved it. The whole checkpoint is
+        /// validated before anything is created: on any error no world is created and *out is not
+        /// written. Errors: INVALID_HANDLE (context), INVALID_ARGUMENT (NULL data or out), CORRUPT_DATA
+        /// (truncated, damaged or inconsistent data; the message names the section and what is wrong),
+        /// VERSION_MISMATCH (a checkpoint format this library does not read), OUT_OF_HOST_MEMORY,
+        /// OUT_OF_DEVICE_MEMORY.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_load(ContextHandle context, IntPtr data, ulong size, out WorldHandle @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_load")]
+        public static extern Result sph_world_load(IntPtr context, IntPtr data, ulong size, IntPtr @out);
+
+        /// <summary>sph_world_load from a file. INVALID_ARGUMENT also when the file cannot be opened or read.</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_load_file(ContextHandle context, byte[] path, out WorldHandle @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_load_file")]
+        public static extern Result sph_world_load_file(IntPtr context, IntPtr path, IntPtr @out);
+
+        /// <summary>
+        /// Replaces a world's whole state with a checkpoint's (undo, retry): afterwards the world is as
+        /// a world loaded from it on the same context, and keeps its handle. All-or-nothing: on any
+        /// error the world is unchanged. Errors: as sph_world_load, and WORLD_LOCKED.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_restore(WorldHandle world, IntPtr data, ulong size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_restore")]
+        public static extern Result sph_world_restore(IntPtr world, IntPtr data, ulong size);
+
+        /// <summary>
         /// Zeroes *view and sets struct_size (size = sizeof(*view)). Prefer
         /// sph_cuda_attribute_view_init.
         /// </summary>
@@ -2440,6 +2500,11 @@ namespace Sph
             "sph_force_field_set_transform",
             "sph_world_get_events",
             "sph_world_get_removed_ids",
+            "sph_world_save",
+            "sph_world_save_file",
+            "sph_world_load",
+            "sph_world_load_file",
+            "sph_world_restore",
             "sph_cuda_attribute_view_init_sized",
             "sph_cuda_world_get_attribute",
             "sph_cuda_world_get_epoch",
@@ -2452,6 +2517,11 @@ namespace Sph
         };
         /// <summary>The shared library of each function ("sph", or an optional helper).</summary>
         public static readonly string[] FunctionLibraries = {
+            "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
             "sph",
             "sph",
             "sph",
@@ -2551,6 +2621,7 @@ namespace Sph
             { "SPH_ERROR_INTERNAL", "an invariant failed inside the library (a bug)" },
             { "SPH_ERROR_BUFFER_TOO_SMALL", "a caller buffer cannot hold what was asked for" },
             { "SPH_ERROR_NON_FINITE", "a step produced NaN/Inf; the world was rolled back" },
+            { "SPH_ERROR_CORRUPT_DATA", "input data (a checkpoint) is truncated, damaged or inconsistent" },
             { "SPH_BACKEND_AUTO", "CUDA when a device is present, else the CPU" },
             { "SPH_BACKEND_CPU", "the multithreaded reference solver" },
             { "SPH_BACKEND_CUDA", "NVIDIA GPU; SPH_ERROR_UNSUPPORTED when not built or no device" },

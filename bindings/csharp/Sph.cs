@@ -309,6 +309,34 @@ namespace Sph
 
         public World CreateWorld() { return new World(this, WorldDef.Default()); }
 
+        /// <summary>A new world on this context from checkpoint bytes (sph_world_load; see
+        /// World.Save). The context decides the backend, whichever saved it. Throws
+        /// SphException (ErrorCorruptData for a damaged checkpoint; no world is created).</summary>
+        public World LoadWorld(byte[] data)
+        {
+            if (data == null) throw new ArgumentNullException("data");
+            WorldHandle handle;
+            GCHandle pin = GCHandle.Alloc(data, GCHandleType.Pinned);
+            try
+            {
+                SphException.Check(Native.sph_world_load(Handle, pin.AddrOfPinnedObject(), (ulong)data.Length, out handle),
+                    "sph_world_load");
+            }
+            finally
+            {
+                pin.Free();
+            }
+            return new World(this, handle);
+        }
+
+        /// <summary>A new world on this context from a checkpoint file (sph_world_load_file).</summary>
+        public World LoadWorldFile(string path)
+        {
+            WorldHandle handle;
+            SphException.Check(Native.sph_world_load_file(Handle, Utf8.ToNative(path), out handle), "sph_world_load_file");
+            return new World(this, handle);
+        }
+
         /// <summary>True after Dispose (the native context may live on while worlds use it).</summary>
         public bool IsDisposed { get; private set; }
 
@@ -334,12 +362,65 @@ namespace Sph
             Context = context;
         }
 
+        // A world the library created from a checkpoint.
+        internal World(Context context, WorldHandle handle)
+        {
+            handle.SetParent(context.Handle);
+            Handle = handle;
+            Context = context;
+        }
+
         public bool IsDisposed { get; private set; }
 
         public void Dispose()
         {
             IsDisposed = true;
             Handle.Dispose();
+        }
+
+        // ---- checkpoints ----------------------------------------------------------------------
+
+        /// <summary>The world's whole state as checkpoint bytes (sph_world_save: a size query,
+        /// then the save). A world loaded from them continues bit for bit on the same backend.</summary>
+        public byte[] Save()
+        {
+            ulong size;
+            SphException.Check(Native.sph_world_save(Handle, IntPtr.Zero, 0, out size), "sph_world_save");
+            byte[] data = new byte[size];
+            GCHandle pin = GCHandle.Alloc(data, GCHandleType.Pinned);
+            try
+            {
+                SphException.Check(Native.sph_world_save(Handle, pin.AddrOfPinnedObject(), size, out size), "sph_world_save");
+            }
+            finally
+            {
+                pin.Free();
+            }
+            return data;
+        }
+
+        /// <summary>Saves atomically to a file (sph_world_save_file): a temporary file next to
+        /// path, flushed, then renamed over it; on error a file at path is untouched.</summary>
+        public void SaveFile(string path)
+        {
+            SphException.Check(Native.sph_world_save_file(Handle, Utf8.ToNative(path)), "sph_world_save_file");
+        }
+
+        /// <summary>Replaces the whole world with a checkpoint's (sph_world_restore;
+        /// all-or-nothing: on error the world is unchanged).</summary>
+        public void Restore(byte[] data)
+        {
+            if (data == null) throw new ArgumentNullException("data");
+            GCHandle pin = GCHandle.Alloc(data, GCHandleType.Pinned);
+            try
+            {
+                SphException.Check(Native.sph_world_restore(Handle, pin.AddrOfPinnedObject(), (ulong)data.Length),
+                    "sph_world_restore");
+            }
+            finally
+            {
+                pin.Free();
+            }
         }
 
         /// <summary>The def the world was created with, defaults resolved.</summary>

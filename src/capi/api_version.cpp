@@ -15,6 +15,7 @@
 #define SPH_STRINGIFY(x) SPH_STRINGIFY2(x)
 
 static_assert(static_cast<int>(sph::Status::NonFinite) == SPH_ERROR_NON_FINITE, "status codes match");
+static_assert(static_cast<int>(sph::Status::CorruptData) == SPH_ERROR_CORRUPT_DATA, "status codes match");
 static_assert(static_cast<int>(sph::Status::Capacity) == SPH_ERROR_CAPACITY, "status codes match");
 static_assert(static_cast<int>(sph::Status::Incomplete) == SPH_INCOMPLETE, "status codes match");
 
@@ -74,6 +75,8 @@ SPH_API const char* SPH_CALL sph_result_string(sph_result result) {
       return "SPH_ERROR_BUFFER_TOO_SMALL: a caller buffer is too small";
     case SPH_ERROR_NON_FINITE:
       return "SPH_ERROR_NON_FINITE: a step produced NaN or Inf; the world was rolled back";
+    case SPH_ERROR_CORRUPT_DATA:
+      return "SPH_ERROR_CORRUPT_DATA: input data is truncated, damaged or inconsistent";
     default:
       return "unknown sph_result";
   }

@@ -7,7 +7,9 @@
 #include <stdint.h>
 
 #include <memory>
+#include <vector>
 
+#include "../physics/float4_types.h"
 #include "../physics/vec3.h"
 #include "config.h"
 #include "frame_report.h"
@@ -26,6 +28,18 @@ struct DeviceAttributeView {
   uint32_t count = 0;         // particles
   uint64_t epoch = 0;         // data_epoch() when the view was taken
   int device = 0;
+};
+
+// Everything a backend carries from one frame to the next, in storage order (the order of the
+// last sort, which fixes the summation order of the next one): loading it into a fresh backend
+// of the same kind continues bit for bit (checkpoints).
+struct ParticleSnapshot {
+  std::vector<Float4> position;  // w: pressure of the last density pass
+  std::vector<Float4> velocity;  // w: 1 / density of the last density pass
+  std::vector<uint32_t> id;
+  std::vector<float> density;
+  float max_speed = 0.0f;         // |v|max the next frame's first step is chosen from
+  float max_acceleration = 0.0f;  // |a|max of the last force evaluation (the force step limit)
 };
 
 class Backend {
@@ -63,6 +77,12 @@ class Backend {
   // float32 x3 (position, velocity), float32 (density, pressure) or uint32 (id).
   virtual void copy_attribute(AttributeKind kind, uint32_t first, uint32_t count, void* dst,
                               size_t stride) const = 0;
+
+  // The whole particle state (see ParticleSnapshot). Blocks until the data is on the host.
+  virtual ParticleSnapshot export_particles() const = 0;
+  // Replaces the whole particle state. The caller has checked count <= capacity, that the
+  // arrays have equal lengths and that the values are finite. Throws on failure.
+  virtual void import_particles(const ParticleSnapshot& snapshot) = 0;
 
   // Bytes held for particles and grids (device bytes on a GPU backend).
   virtual uint64_t memory_bytes() const = 0;

@@ -54,6 +54,27 @@ class SlotMap {
 
   size_t size() const { return count_; }
 
+  // The raw table, for checkpoints: a loaded world issues and accepts the same ids.
+  uint32_t slot_count() const { return static_cast<uint32_t>(slots_.size()); }
+  uint32_t generation_at(uint32_t slot) const { return slots_[slot].generation; }
+  const T* value_at(uint32_t slot) const { return slots_[slot].value ? &*slots_[slot].value : nullptr; }
+  const std::vector<uint32_t>& free_slots() const { return free_; }
+  // Replaces the whole table. The caller has validated it: generations in [1, 2^24), and
+  // the free list names every empty slot exactly once.
+  void restore(const std::vector<uint32_t>& generations, std::vector<std::optional<T>> values,
+               std::vector<uint32_t> free_list) {
+    std::vector<Slot> slots(generations.size());
+    size_t count = 0;
+    for (size_t i = 0; i < slots.size(); ++i) {
+      slots[i].generation = generations[i];
+      slots[i].value = std::move(values[i]);
+      if (slots[i].value) ++count;
+    }
+    slots_ = std::move(slots);
+    free_ = std::move(free_list);
+    count_ = count;
+  }
+
   // Visits live values in slot order (deterministic).
   template <class F>
   void for_each(F&& f) {

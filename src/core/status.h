@@ -25,6 +25,7 @@ enum class Status : int {
   Internal = -13,
   BufferTooSmall = -14,
   NonFinite = -15,
+  CorruptData = -16,
 };
 
 class Error : public std::runtime_error {

@@ -44,12 +44,28 @@ class World {
   const std::vector<uint32_t>& removed_ids() const { return report_.removed_ids; }
 
   const Backend& backend() const { return *backend_; }
+  Backend& backend() { return *backend_; }
+
+  // The id the next particle gets.
+  uint32_t next_id() const { return next_id_; }
+  // Puts back the bookkeeping of a saved world (checkpoints); the caller has validated it.
+  void restore_counters(uint32_t next_id, double simulated_time, const FrameReport& report,
+                        float last_step_ms, const std::vector<Event>& events) {
+    next_id_ = next_id;
+    simulated_time_ = simulated_time;
+    report_ = report;
+    last_step_ms_ = last_step_ms;
+    events_ = events;
+  }
 
   SlotMap<Collider>& colliders() { return colliders_; }
   SlotMap<Source>& sources() { return sources_; }
   SlotMap<Sink>& sinks() { return sinks_; }
   SlotMap<ForceField>& force_fields() { return force_fields_; }
   const SlotMap<Collider>& colliders() const { return colliders_; }
+  const SlotMap<Source>& sources() const { return sources_; }
+  const SlotMap<Sink>& sinks() const { return sinks_; }
+  const SlotMap<ForceField>& force_fields() const { return force_fields_; }
 
  private:
   void emit_sources(double frame_dt);

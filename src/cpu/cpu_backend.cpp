@@ -185,6 +185,39 @@ class CpuBackend final : public Backend {
     }
   }
 
+  ParticleSnapshot export_particles() const override {
+    ParticleSnapshot s;
+    s.position.assign(position_.data.begin(), position_.data.begin() + count_);
+    s.velocity.assign(velocity_.data.begin(), velocity_.data.begin() + count_);
+    s.id.assign(id_.data.begin(), id_.data.begin() + count_);
+    s.density.assign(density_.data.begin(), density_.data.begin() + count_);
+    // The lazily computed max speed is a pure function of the velocities: taking it now gives
+    // the value the next frame would compute.
+    s.max_speed = max_speed_valid_ ? max_speed_ : compute_max_speed();
+    s.max_acceleration = max_acceleration_;
+    return s;
+  }
+
+  void import_particles(const ParticleSnapshot& s) override {
+    const uint32_t n = static_cast<uint32_t>(s.id.size());
+    if (n > config_.capacity || s.position.size() != n || s.velocity.size() != n || s.density.size() != n)
+      throw Error(Status::Internal, "import_particles: inconsistent snapshot");
+    // Copies first (they may throw), then swaps, so a failure leaves the state as it was.
+    std::vector<Float4> position(s.position), velocity(s.velocity);
+    std::vector<uint32_t> id(s.id), neighbors(n, 0u);
+    std::vector<float> density(s.density);
+    store_.resize(n);
+    position_.data.swap(position);
+    velocity_.data.swap(velocity);
+    id_.data.swap(id);
+    density_.data.swap(density);
+    neighbors_.data.swap(neighbors);
+    count_ = n;
+    max_speed_ = s.max_speed;
+    max_speed_valid_ = true;
+    max_acceleration_ = s.max_acceleration;
+  }
+
   uint64_t memory_bytes() const override { return store_.bytes() + grid_.bytes(); }
 
  private:

@@ -50,9 +50,10 @@ static void test_result_strings(void** state) {
       {SPH_ERROR_INTERNAL, "SPH_ERROR_INTERNAL"},
       {SPH_ERROR_BUFFER_TOO_SMALL, "SPH_ERROR_BUFFER_TOO_SMALL"},
       {SPH_ERROR_NON_FINITE, "SPH_ERROR_NON_FINITE"},
+      {SPH_ERROR_CORRUPT_DATA, "SPH_ERROR_CORRUPT_DATA"},
   };
   const size_t n = sizeof codes / sizeof codes[0];
-  const sph_result unknown[] = {(sph_result)2, (sph_result)-16, (sph_result)-1000, SPH_RESULT_FORCE32};
+  const sph_result unknown[] = {(sph_result)2, (sph_result)-17, (sph_result)-1000, SPH_RESULT_FORCE32};
   (void)state;
   for (size_t i = 0; i < n; ++i) {
     const char* s = sph_result_string(codes[i].code);

@@ -814,6 +814,50 @@ static class Tests
 
     /// Every exported function is called by the idiomatic layer (Sph.cs) or is the sized init
     /// of a struct (called by the generated Default()).
+    public static void TestCheckpoints()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(SmallWorld(500)))
+        {
+            world.FillBox(new Vec3(0, 0, 0), new Vec3(0.1f, 0.1f, 0.1f), new Vec3(0.2f, 0, 0));
+            world.Step(1f / 60f);
+            byte[] data = world.Save();
+            Assert(data.Length > 48 && data[0] == (byte)'S', "a checkpoint with its magic bytes");
+            string path = Path.Combine(Path.GetTempPath(), "sph_cs_" + Guid.NewGuid().ToString("N") + ".sphckpt");
+            world.SaveFile(path);
+            try
+            {
+                world.Step(1f / 60f);
+                float[] expected = new float[3 * world.ParticleCount];
+                world.CopyAttribute(SphAttribute.Position, expected);
+                using (var fromBytes = ctx.LoadWorld(data))
+                using (var fromFile = ctx.LoadWorldFile(path))
+                {
+                    foreach (var loaded in new[] { fromBytes, fromFile })
+                    {
+                        loaded.Step(1f / 60f);
+                        float[] got = new float[expected.Length];
+                        loaded.CopyAttribute(SphAttribute.Position, got);
+                        for (int i = 0; i < got.Length; ++i)
+                            Assert(BitConverter.ToInt32(BitConverter.GetBytes(got[i]), 0) ==
+                                   BitConverter.ToInt32(BitConverter.GetBytes(expected[i]), 0), "bitwise continuation");
+                    }
+                }
+                world.Restore(data);
+                Assert(Math.Abs(world.GetStats().SimulatedTime - 1.0 / 60.0) < 1e-6, "restored to the first frame");
+            }
+            finally
+            {
+                File.Delete(path);
+            }
+            byte[] damaged = (byte[])data.Clone();
+            damaged[damaged.Length / 2] ^= 0x20;
+            Throws(Result.ErrorCorruptData, () => ctx.LoadWorld(damaged));
+            Throws(Result.ErrorCorruptData, () => world.Restore(damaged));
+            Throws(Result.ErrorInvalidArgument, () => ctx.LoadWorldFile(path));
+        }
+    }
+
     public static void TestEveryFunctionIsWrapped()
     {
         string wrapper = File.ReadAllText(Path.Combine(SourceDir, "Sph.cs"));

@@ -7,6 +7,7 @@ import weakref
 import numpy as np
 
 from . import _generated as _g
+from ._checkpoint import WorldCheckpointMixin, load_world, load_world_file
 from ._cuda import WorldCudaMixin
 from ._errors import SphError, check
 from ._loader import library
@@ -158,6 +159,15 @@ class Context:
         """An SDF asset from a level set in a .vdb file (libsph_vdb); see Sdf.from_vdb."""
         return Sdf.from_vdb(self, path, grid_name)
 
+    def load_world(self, data):
+        """A new World on this context from checkpoint bytes (sph_world_load; see World.save).
+        The context decides the backend, whichever saved it."""
+        return load_world(World, self, data)
+
+    def load_world_file(self, path):
+        """A new World on this context from a checkpoint file (sph_world_load_file)."""
+        return load_world_file(World, self, path)
+
     def close(self):
         """Closes the worlds, then the SDF assets, created on this context that are still
         open, then destroys the context (sph_context_destroy). Idempotent."""
@@ -189,7 +199,7 @@ class Context:
 
 
 # ---- world -------------------------------------------------------------------------------------------
-class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin):
+class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointMixin):
     """A particle fluid (sph_world): created on a Context, stepped, read back into numpy.
 
     ``World(ctx, capacity=100_000, particle_spacing=0.01)``: keyword arguments set fields of a
@@ -197,6 +207,9 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin):
     context manager or call close(). Colliders, sources, sinks and force fields are added
     with add_collider/add_source/add_sink/add_force_field (see sph._scene); the zero-copy
     CUDA tier is cuda_attribute/cuda_array/cuda_epoch/... (see sph._cuda).
+
+    Checkpoints: save() / save_file(path) / restore(data), and Context.load_world(data) /
+    Context.load_world_file(path) (see sph._checkpoint).
 
     Optional physics is chosen here and fixed for the world's life (see sph._options):
     ``viscosity_method="clavet"`` (ViscosityMethod), ``equation_of_state="tait"``
@@ -215,6 +228,17 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin):
         self._ptr = out
         self.context = context
         context._children.add(self)
+
+    _sph_type_ = _g.sph_world
+
+    @classmethod
+    def _adopt(cls, context, ptr):
+        """A World object owning an sph_world* the library just created (a loaded checkpoint)."""
+        self = cls.__new__(cls)
+        self._ptr = ptr
+        self.context = context
+        context._children.add(self)
+        return self
 
     # -- lifetime
     @property

@@ -10,7 +10,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '52c081d9e9620ef370591b3b9d77dd7e82285823448ac1850291b7efb8112115', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
+HEADERS = {'include/sph_c.h': '1b2abdc31b6c1bed89d5b8cef36b50f3e3aa33068ba6e0182ec230c3e88d5219', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -67,6 +67,7 @@ SPH_ERROR_DEVICE_LOST = -12  # a sticky device error: destroy the world
 SPH_ERROR_INTERNAL = -13  # an invariant failed inside the library (a bug)
 SPH_ERROR_BUFFER_TOO_SMALL = -14  # a caller buffer cannot hold what was asked for
 SPH_ERROR_NON_FINITE = -15  # a step produced NaN/Inf; the world was rolled back
+SPH_ERROR_CORRUPT_DATA = -16  # input data (a checkpoint) is truncated, damaged or inconsistent
 SPH_RESULT_FORCE32 = 2147483647
 
 
@@ -106,6 +107,8 @@ class Result(_enum.IntEnum):
     ERROR_BUFFER_TOO_SMALL = -14
     #: a step produced NaN/Inf; the world was rolled back
     ERROR_NON_FINITE = -15
+    #: input data (a checkpoint) is truncated, damaged or inconsistent
+    ERROR_CORRUPT_DATA = -16
 
 
 sph_backend = _c.c_int32
@@ -378,6 +381,7 @@ ENUM_MEMBER_DOCS = {
     'SPH_ERROR_INTERNAL': 'an invariant failed inside the library (a bug)',
     'SPH_ERROR_BUFFER_TOO_SMALL': 'a caller buffer cannot hold what was asked for',
     'SPH_ERROR_NON_FINITE': 'a step produced NaN/Inf; the world was rolled back',
+    'SPH_ERROR_CORRUPT_DATA': 'input data (a checkpoint) is truncated, damaged or inconsistent',
     'SPH_BACKEND_AUTO': 'CUDA when a device is present, else the CPU',
     'SPH_BACKEND_CPU': 'the multithreaded reference solver',
     'SPH_BACKEND_CUDA': 'NVIDIA GPU; SPH_ERROR_UNSUPPORTED when not built or no device',
@@ -1365,6 +1369,16 @@ FUNCTIONS = {
         'Events of the last sph_world_step (two-call pattern): writes up to `capacity` events and sets *out_count to the number there are; SPH_INCOMPLETE when capacity was too small. events may be NULL when capacity is 0.', 'sph'),
     'sph_world_get_removed_ids': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_uint32), _c.c_uint32, _c.POINTER(_c.c_uint32)), ('world', 'ids', 'capacity', 'out_count'),
         'Ids of the particles sinks removed during the last sph_world_step (two-call pattern).', 'sph'),
+    'sph_world_save': (sph_result, (_c.POINTER(sph_world), _c.c_void_p, _c.c_uint64, _c.POINTER(_c.c_uint64)), ('world', 'buffer', 'buffer_size', 'out_size'),
+        'Saves a world into caller memory. Size query: buffer NULL and buffer_size 0 set *out_size to the bytes needed and return SPH_OK. Otherwise the checkpoint is written when it fits (*out_size: the bytes written), else SPH_ERROR_BUFFER_TOO_SMALL with *out_size the bytes needed and nothing written. The size can change whenever the world does. Blocks (a CUDA world copies its particles to the host). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL out_size, NULL buffer with a non-zero size), BUFFER_TOO_SMALL, WORLD_LOCKED, OUT_OF_HOST_MEMORY, DEVICE.', 'sph'),
+    'sph_world_save_file': (sph_result, (_c.POINTER(sph_world), _c.c_char_p), ('world', 'path'),
+        'Saves a world into a file, atomically: the checkpoint goes to a new file next to `path` (path + ".tmp-" + a unique suffix), is flushed to the disk (fsync), and is then renamed to `path`, replacing any file there. A crash leaves either the old file or the new one, never a partial one; on any error the temporary file is removed and a file at `path` is untouched. path is UTF-8 (a narrow path on POSIX). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL or empty path; the file cannot be created, written or renamed: the message says why), WORLD_LOCKED, OUT_OF_HOST_MEMORY, DEVICE.', 'sph'),
+    'sph_world_load': (sph_result, (_c.POINTER(sph_context), _c.c_void_p, _c.c_uint64, _c.POINTER(_c.POINTER(sph_world))), ('context', 'data', 'size', 'out'),
+        'Creates a new world on `context` from a checkpoint in memory (data is read only during the call). The context decides the backend, whichever backend saved it. The whole checkpoint is validated before anything is created: on any error no world is created and *out is not written. Errors: INVALID_HANDLE (context), INVALID_ARGUMENT (NULL data or out), CORRUPT_DATA (truncated, damaged or inconsistent data; the message names the section and what is wrong), VERSION_MISMATCH (a checkpoint format this library does not read), OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY.', 'sph'),
+    'sph_world_load_file': (sph_result, (_c.POINTER(sph_context), _c.c_char_p, _c.POINTER(_c.POINTER(sph_world))), ('context', 'path', 'out'),
+        'sph_world_load from a file. INVALID_ARGUMENT also when the file cannot be opened or read.', 'sph'),
+    'sph_world_restore': (sph_result, (_c.POINTER(sph_world), _c.c_void_p, _c.c_uint64), ('world', 'data', 'size'),
+        "Replaces a world's whole state with a checkpoint's (undo, retry): afterwards the world is as a world loaded from it on the same context, and keeps its handle. All-or-nothing: on any error the world is unchanged. Errors: as sph_world_load, and WORLD_LOCKED.", 'sph'),
     'sph_cuda_attribute_view_init_sized': (sph_result, (_c.POINTER(sph_cuda_attribute_view), _c.c_uint32), ('view', 'size'),
         'Zeroes *view and sets struct_size (size = sizeof(*view)). Prefer sph_cuda_attribute_view_init.', 'sph'),
     'sph_cuda_world_get_attribute': (sph_result, (_c.POINTER(sph_world), sph_attribute, _c.POINTER(sph_cuda_attribute_view)), ('world', 'attribute', 'out'),

@@ -1,0 +1,57 @@
+// The checkpoint layout shared by the writer and the reader (docs/checkpoint.md). All numbers
+// little-endian; floats IEEE 754. Version 1:
+//   header (48 bytes): magic[8] "SPHCKPT\x1a", u32 format version, u32 flags (0), u32 writer
+//     backend, u32 writer library version, u64 payload size, u64 checksum, u32 section count,
+//     u32 reserved (0). The checksum is FNV-1a 64 over the header with the checksum field
+//     left out, then the payload.
+//   payload: sections in the order of kSectionOrder, each u32 tag, u32 reserved (0), u64 body
+//     length, body.
+#pragma once
+
+#include <stddef.h>
+#include <stdint.h>
+
+namespace sph {
+namespace checkpoint {
+
+constexpr uint8_t kMagic[8] = {'S', 'P', 'H', 'C', 'K', 'P', 'T', 0x1a};
+constexpr uint32_t kFormatVersion = 1;
+constexpr size_t kHeaderSize = 48;
+constexpr size_t kChecksumOffset = 32;
+constexpr size_t kSectionHeaderSize = 16;
+
+constexpr uint32_t tag(char a, char b, char c, char d) {
+  return static_cast<uint32_t>(static_cast<uint8_t>(a)) |
+         (static_cast<uint32_t>(static_cast<uint8_t>(b)) << 8) |
+         (static_cast<uint32_t>(static_cast<uint8_t>(c)) << 16) |
+         (static_cast<uint32_t>(static_cast<uint8_t>(d)) << 24);
+}
+
+struct SectionInfo {
+  uint32_t tag;
+  const char* name;
+};
+
+// Every section, in the only order version 1 accepts.
+constexpr SectionInfo kSectionOrder[] = {
+    {tag('C', 'O', 'N', 'F'), "world definition"},
+    {tag('P', 'A', 'R', 'M'), "parameters"},
+    {tag('T', 'I', 'M', 'E'), "clock and statistics"},
+    {tag('P', 'A', 'R', 'T'), "particles"},
+    {tag('S', 'D', 'F', 'A'), "SDF assets"},
+    {tag('C', 'O', 'L', 'L'), "colliders"},
+    {tag('S', 'R', 'C', 'E'), "sources"},
+    {tag('S', 'I', 'N', 'K'), "sinks"},
+    {tag('F', 'F', 'L', 'D'), "force fields"},
+};
+constexpr uint32_t kSectionCount = sizeof(kSectionOrder) / sizeof(kSectionOrder[0]);
+
+constexpr uint32_t kNoAsset = 0xffffffffu;       // an object without this asset
+constexpr uint32_t kAssetHasVelocity = 1u << 0;  // SDF asset channel bits
+constexpr uint32_t kAssetHasFriction = 1u << 1;
+constexpr uint32_t kMaxObjectSlots = 65536;  // the C layer's limit per kind
+constexpr uint32_t kMaxAssetDim = 1u << 30;
+constexpr uint64_t kMaxAssetVoxels = 1ull << 31;
+
+}  // namespace checkpoint
+}  // namespace sph

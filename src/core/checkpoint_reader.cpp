@@ -1,0 +1,531 @@
+// Reads a checkpoint into a new world. Everything is parsed and validated before the backend
+// is created, so a damaged file allocates nothing beyond what its own bytes describe and
+// leaves nothing behind; the checks mirror the C layer's for the same fields.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <optional>
+#include <string>
+
+#include "../physics/kernels.h"
+#include "byte_io.h"
+#include "checkpoint.h"
+#include "checkpoint_format.h"
+
+namespace sph {
+namespace {
+
+using namespace checkpoint;
+
+[[noreturn]] void corrupt(const std::string& message) {
+  throw Error(Status::CorruptData, "checkpoint: " + message);
+}
+
+std::string hex32(uint32_t v) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%08x", v);
+  return buf;
+}
+
+// Field readers that validate as they go; `name` is the field's path in messages.
+float finite(ByteReader& r, const std::string& name) {
+  const float v = r.f32();
+  if (!std::isfinite(v)) corrupt(r.what() + ": " + name + " is not finite");
+  return v;
+}
+
+float non_negative(ByteReader& r, const std::string& name) {
+  const float v = finite(r, name);
+  if (v < 0.0f) corrupt(r.what() + ": " + name + " is negative (" + std::to_string(v) + ")");
+  return v;
+}
+
+float positive(ByteReader& r, const std::string& name) {
+  const float v = finite(r, name);
+  if (!(v > 0.0f)) corrupt(r.what() + ": " + name + " must be > 0, is " + std::to_string(v));
+  return v;
+}
+
+uint32_t flag(ByteReader& r, const std::string& name) {
+  const uint32_t v = r.u32();
+  if (v > 1) corrupt(r.what() + ": " + name + " is " + std::to_string(v) + ", not 0 or 1");
+  return v;
+}
+
+uint32_t below(ByteReader& r, uint32_t limit, const std::string& name) {
+  const uint32_t v = r.u32();
+  if (v >= limit)
+    corrupt(r.what() + ": " + name + " is " + std::to_string(v) + ", not below " + std::to_string(limit));
+  return v;
+}
+
+void zero(ByteReader& r, const std::string& name) {
+  if (r.u32() != 0) corrupt(r.what() + ": " + name + " is reserved and must be 0");
+}
+
+Vec3 vec3(ByteReader& r, const std::string& name) {
+  Vec3 v;
+  v.x = finite(r, name + ".x");
+  v.y = finite(r, name + ".y");
+  v.z = finite(r, name + ".z");
+  return v;
+}
+
+RigidTransform pose(ByteReader& r, const std::string& name) {
+  RigidTransform t;
+  t.position = vec3(r, name + ".position");
+  t.rotation.x = finite(r, name + ".rotation.x");
+  t.rotation.y = finite(r, name + ".rotation.y");
+  t.rotation.z = finite(r, name + ".rotation.z");
+  t.rotation.w = finite(r, name + ".rotation.w");
+  const Quat& q = t.rotation;
+  const double n2 = double(q.x) * q.x + double(q.y) * q.y + double(q.z) * q.z + double(q.w) * q.w;
+  // The library stores unit quaternions (normalised in float when set).
+  if (!(std::fabs(n2 - 1.0) < 1e-3)) corrupt(r.what() + ": " + name + ".rotation is not a unit quaternion");
+  return t;
+}
+
+// Bulk floats: the message is built only on failure (a checkpoint may hold millions).
+float bulk_finite(ByteReader& r, const char* what, uint32_t index) {
+  const float v = r.f32();
+  if (!std::isfinite(v)) corrupt(r.what() + ": " + what + " " + std::to_string(index) + " is not finite");
+  return v;
+}
+
+Float4 float4(ByteReader& r, const char* what, uint32_t index) {
+  Float4 v;
+  v.x = bulk_finite(r, what, index);
+  v.y = bulk_finite(r, what, index);
+  v.z = bulk_finite(r, what, index);
+  v.w = bulk_finite(r, what, index);
+  return v;
+}
+
+Vec3 bulk_vec3(ByteReader& r, const char* what, uint32_t index) {
+  Vec3 v;
+  v.x = bulk_finite(r, what, index);
+  v.y = bulk_finite(r, what, index);
+  v.z = bulk_finite(r, what, index);
+  return v;
+}
+
+WorldConfig read_config(ByteReader& r) {
+  WorldConfig c;
+  c.capacity = r.u32();
+  if (c.capacity == 0 || c.capacity > (1u << 30))
+    corrupt(r.what() + ": capacity " + std::to_string(c.capacity) + " is outside [1, 2^30]");
+  c.features = r.u32();
+  if (c.features & ~static_cast<uint32_t>(kFeatureAll))
+    corrupt(r.what() + ": unknown feature bits " + hex32(c.features));
+  c.integrator = static_cast<Integrator>(below(r, 2, "integrator"));
+  c.viscosity_method = static_cast<ViscosityMethod>(below(r, 2, "viscosity method"));
+  c.equation_of_state = static_cast<EquationOfState>(below(r, 2, "equation of state"));
+  c.particle_spacing = positive(r, "particle spacing");
+  c.kernel_radius = positive(r, "kernel radius");
+  c.rest_density = positive(r, "rest density");
+  c.particle_mass = positive(r, "particle mass");
+  if (c.kernel_radius < c.particle_spacing || c.kernel_radius > 5.0f * c.particle_spacing)
+    corrupt(r.what() + ": kernel radius is outside [1, 5] x the particle spacing");
+  const KernelCoefficients k = make_kernel_coefficients(c.kernel_radius);
+  if (!std::isfinite(k.poly6) || !std::isfinite(k.spiky_grad) || !(k.poly6 > 0.0f) || !(k.visc_lap > 0.0f) ||
+      !std::isnormal(k.h2) || !std::isnormal(c.particle_mass))
+    corrupt(r.what() + ": kernel radius or particle mass not representable in float32");
+  return c;
+}
+
+RuntimeParams read_params(ByteReader& r) {
+  RuntimeParams p;
+  p.gravity = vec3(r, "gravity");
+  p.stiffness = positive(r, "stiffness");
+  p.viscosity = non_negative(r, "viscosity");
+  p.step_factor = positive(r, "step factor");
+  if (p.step_factor > 10.0f) corrupt(r.what() + ": step factor is above 10");
+  p.dt_min = positive(r, "dt_min");
+  p.dt_max = positive(r, "dt_max");
+  if (p.dt_max < p.dt_min) corrupt(r.what() + ": dt_max is smaller than dt_min");
+  p.max_substeps = r.u32();
+  if (p.max_substeps == 0) corrupt(r.what() + ": max_substeps is 0");
+  p.step_limits = r.u32();
+  if (p.step_limits & ~static_cast<uint32_t>(kStepLimitAll)) corrupt(r.what() + ": unknown step-limit bits");
+  p.surface_tension = non_negative(r, "surface tension");
+  p.surface_threshold = non_negative(r, "surface threshold");
+  p.clavet_linear = non_negative(r, "Clavet linear coefficient");
+  p.clavet_quadratic = non_negative(r, "Clavet quadratic coefficient");
+  p.tait_sound_speed = positive(r, "Tait speed of sound");
+  return p;
+}
+
+struct Clock {
+  uint32_t next_id = 0;
+  double simulated_time = 0.0;
+  float last_step_ms = 0.0f;
+  FrameReport report;
+  std::vector<Event> events;
+};
+
+Clock read_clock(ByteReader& r) {
+  Clock c;
+  c.next_id = r.u32();
+  zero(r, "reserved");
+  c.simulated_time = r.f64();
+  if (!std::isfinite(c.simulated_time) || c.simulated_time < 0.0)
+    corrupt(r.what() + ": simulated time is negative or not finite");
+  c.last_step_ms = non_negative(r, "last step time");
+  FrameReport& f = c.report;
+  f.substeps = r.u32();
+  f.completed = flag(r, "completed") != 0;
+  f.time_advanced = r.f64();
+  if (!std::isfinite(f.time_advanced) || f.time_advanced < 0.0)
+    corrupt(r.what() + ": frame time is negative or not finite");
+  f.dt_min = non_negative(r, "dt_min");
+  f.dt_max = non_negative(r, "dt_max");
+  f.max_speed = non_negative(r, "max speed");
+  f.density_min = finite(r, "density min");
+  f.density_mean = finite(r, "density mean");
+  f.density_max = finite(r, "density max");
+  f.neighbors_mean = non_negative(r, "neighbours mean");
+  f.neighbors_max = r.u32();
+  for (int k = 0; k < kStageCount; ++k) f.stage_ms[k] = non_negative(r, "stage time");
+  const uint32_t events = r.u32();
+  r.need_elements(events, 16, "events");
+  c.events.resize(events);
+  for (Event& e : c.events) {
+    const uint32_t type = r.u32();
+    if (type != static_cast<uint32_t>(EventType::SourceCapacityReached) &&
+        type != static_cast<uint32_t>(EventType::SinkRemoved))
+      corrupt(r.what() + ": unknown event type " + std::to_string(type));
+    e.type = static_cast<EventType>(type);
+    e.count = r.u32();
+    e.object_id = r.u64();
+  }
+  const uint32_t removed = r.u32();
+  r.need_elements(removed, 4, "removed ids");
+  f.removed_ids.resize(removed);
+  for (uint32_t& id : f.removed_ids) id = r.u32();
+  return c;
+}
+
+ParticleSnapshot read_particles(ByteReader& r, const WorldConfig& config, uint32_t next_id) {
+  ParticleSnapshot s;
+  const uint32_t n = r.u32();
+  zero(r, "reserved");
+  s.max_speed = non_negative(r, "max speed");
+  s.max_acceleration = non_negative(r, "max acceleration");
+  if (n > config.capacity)
+    corrupt(r.what() + ": " + std::to_string(n) + " particles exceed the capacity " +
+            std::to_string(config.capacity));
+  r.need_elements(n, 2 * sizeof(Float4) + 2 * sizeof(uint32_t), "particles");
+  s.position.resize(n);
+  s.velocity.resize(n);
+  s.id.resize(n);
+  s.density.resize(n);
+  for (uint32_t i = 0; i < n; ++i) s.position[i] = float4(r, "position of particle", i);
+  for (uint32_t i = 0; i < n; ++i) s.velocity[i] = float4(r, "velocity of particle", i);
+  for (uint32_t i = 0; i < n; ++i) {
+    s.id[i] = r.u32();
+    if (s.id[i] >= next_id)
+      corrupt(r.what() + ": particle id " + std::to_string(s.id[i]) + " was never issued (next id " +
+              std::to_string(next_id) + ")");
+  }
+  for (uint32_t i = 0; i < n; ++i) s.density[i] = bulk_finite(r, "density of particle", i);
+  std::vector<uint32_t> sorted(s.id);
+  std::sort(sorted.begin(), sorted.end());
+  const auto dup = std::adjacent_find(sorted.begin(), sorted.end());
+  if (dup != sorted.end()) corrupt(r.what() + ": particle id " + std::to_string(*dup) + " appears twice");
+  return s;
+}
+
+std::shared_ptr<SdfAsset> read_asset(ByteReader& r, uint32_t index) {
+  const std::string name = "asset " + std::to_string(index);
+  uint32_t dims[3];
+  for (uint32_t& d : dims) {
+    d = r.u32();
+    if (d == 0 || d > kMaxAssetDim)
+      corrupt(r.what() + ": " + name + " has a dimension of " + std::to_string(d));
+  }
+  const uint64_t n = uint64_t{dims[0]} * dims[1] * dims[2];
+  if (n > kMaxAssetVoxels) corrupt(r.what() + ": " + name + " has more than 2^31 voxels");
+  const uint32_t channels = r.u32();
+  if (channels & ~(kAssetHasVelocity | kAssetHasFriction))
+    corrupt(r.what() + ": " + name + " has unknown channel bits " + hex32(channels));
+  Affine3x4 affine;
+  for (float& m : affine.m) m = finite(r, name + " index_to_local");
+  const uint64_t floats_per_voxel =
+      1 + ((channels & kAssetHasVelocity) ? 3 : 0) + ((channels & kAssetHasFriction) ? 1 : 0);
+  r.need_elements(n, floats_per_voxel * sizeof(float), "voxels");  // before any allocation
+  std::shared_ptr<SdfAsset> asset;
+  try {
+    asset = std::make_shared<SdfAsset>(static_cast<int32_t>(dims[0]), static_cast<int32_t>(dims[1]),
+                                       static_cast<int32_t>(dims[2]), affine);
+  } catch (const Error& e) {
+    corrupt(r.what() + ": " + name + ": " + e.what());
+  }
+  const std::string where = name + ": voxel";
+  std::vector<float>& distance = asset->distance();
+  for (uint64_t i = 0; i < n; ++i) distance[i] = bulk_finite(r, where.c_str(), static_cast<uint32_t>(i));
+  if (channels & kAssetHasVelocity) {
+    asset->velocity().resize(n);
+    std::vector<Vec3>& velocity = asset->velocity();
+    for (uint64_t i = 0; i < n; ++i) velocity[i] = bulk_vec3(r, where.c_str(), static_cast<uint32_t>(i));
+  }
+  if (channels & kAssetHasFriction) {
+    asset->friction().resize(n);
+    std::vector<float>& friction = asset->friction();
+    for (uint64_t i = 0; i < n; ++i) {
+      friction[i] = bulk_finite(r, where.c_str(), static_cast<uint32_t>(i));
+      if (friction[i] < 0.0f)
+        corrupt(r.what() + ": " + where + " " + std::to_string(i) + " has a negative friction");
+    }
+  }
+  return asset;
+}
+
+using Assets = std::vector<std::shared_ptr<SdfAsset>>;
+
+std::shared_ptr<const SdfAsset> asset_ref(ByteReader& r, const Assets& assets, bool required,
+                                          const std::string& name) {
+  const uint32_t k = r.u32();
+  if (k == kNoAsset) {
+    if (required) corrupt(r.what() + ": " + name + " is missing");
+    return nullptr;
+  }
+  if (k >= assets.size())
+    corrupt(r.what() + ": " + name + " refers to asset " + std::to_string(k) + " of " +
+            std::to_string(assets.size()));
+  return assets[k];
+}
+
+template <class T>
+struct SlotTable {
+  std::vector<uint32_t> generations;
+  std::vector<std::optional<T>> values;
+  std::vector<uint32_t> free_list;
+};
+
+// The slot table of one kind of object (see write_slots); read_value reads one live body.
+template <class T, class ReadValue>
+SlotTable<T> read_slots(ByteReader& r, ReadValue&& read_value) {
+  SlotTable<T> t;
+  const uint32_t slots = r.u32();
+  if (slots > kMaxObjectSlots) corrupt(r.what() + ": " + std::to_string(slots) + " slots, more than 65536");
+  r.need_elements(slots, 2 * sizeof(uint32_t), "slots");
+  t.generations.resize(slots);
+  t.values.resize(slots);
+  uint32_t dead = 0;
+  for (uint32_t i = 0; i < slots; ++i) {
+    const std::string name = "slot " + std::to_string(i);
+    t.generations[i] = r.u32();
+    if (t.generations[i] == 0 || t.generations[i] > 0xffffffu)
+      corrupt(r.what() + ": " + name + " has generation " + std::to_string(t.generations[i]));
+    if (flag(r, name + " live"))
+      t.values[i] = read_value(name);
+    else
+      ++dead;
+  }
+  const uint32_t free_count = r.u32();
+  if (free_count != dead)
+    corrupt(r.what() + ": the free list has " + std::to_string(free_count) + " slots, but " +
+            std::to_string(dead) + " slots are empty");
+  std::vector<char> seen(slots, 0);
+  t.free_list.resize(free_count);
+  for (uint32_t& slot : t.free_list) {
+    slot = r.u32();
+    if (slot >= slots || t.values[slot] || seen[slot])
+      corrupt(r.what() + ": the free list names slot " + std::to_string(slot) +
+              ", which is not a distinct empty slot");
+    seen[slot] = 1;
+  }
+  return t;
+}
+
+void check_material(ByteReader& r, float restitution, const std::string& name) {
+  if (restitution > 1.0f) corrupt(r.what() + ": " + name + " restitution is above 1");
+}
+
+Collider read_collider(ByteReader& r, const Assets& assets, const std::string& name) {
+  Collider c;
+  c.sdf = asset_ref(r, assets, true, name + " SDF");
+  c.pose = pose(r, name + " pose");
+  if (flag(r, name + " has target")) c.target = pose(r, name + " target");
+  c.restitution = non_negative(r, name + " restitution");
+  check_material(r, c.restitution, name);
+  c.friction = non_negative(r, name + " friction");
+  c.stickiness = non_negative(r, name + " stickiness");
+  c.inverted = flag(r, name + " inverted") != 0;
+  return c;
+}
+
+Source read_source(ByteReader& r, const Assets& assets, const WorldConfig& config, const std::string& name) {
+  Source s;
+  s.region = asset_ref(r, assets, true, name + " region");
+  s.pose = pose(r, name + " pose");
+  s.mode = static_cast<SourceMode>(below(r, 2, name + " mode"));
+  s.spacing = positive(r, name + " spacing");
+  if (s.spacing < 0.25f * config.particle_spacing)
+    corrupt(r.what() + ": " + name + " spacing is below a quarter of the world's");
+  s.min_distance = non_negative(r, name + " min distance");
+  if (s.min_distance > config.kernel_radius || s.min_distance > s.spacing)
+    corrupt(r.what() + ": " + name + " min distance exceeds the kernel radius or the spacing");
+  s.velocity = vec3(r, name + " velocity");
+  s.velocity_from_field = flag(r, name + " velocity from field") != 0;
+  if (s.velocity_from_field && !s.region->has_velocity())
+    corrupt(r.what() + ": " + name + " takes velocities from a region without a velocity channel");
+  s.rate = non_negative(r, name + " rate");
+  s.rate_budget = r.f64();
+  // A budget grows by at most rate x frame time per step; far below the size_t range.
+  if (!std::isfinite(s.rate_budget) || s.rate_budget < 0.0 || s.rate_budget > 1e15)
+    corrupt(r.what() + ": " + name + " rate budget is outside [0, 1e15]");
+  s.done = flag(r, name + " done") != 0;
+  const uint32_t points = r.u32();
+  r.need_elements(points, 3 * sizeof(float), "lattice points");
+  s.lattice.resize(points);
+  const std::string where = name + " lattice point";
+  for (uint32_t i = 0; i < points; ++i) s.lattice[i] = bulk_vec3(r, where.c_str(), i);
+  return s;
+}
+
+Sink read_sink(ByteReader& r, const Assets& assets, const std::string& name) {
+  Sink s;
+  s.mode = static_cast<SinkMode>(below(r, 2, name + " mode"));
+  s.region = asset_ref(r, assets, s.mode == SinkMode::Region, name + " region");
+  if (s.mode == SinkMode::OutsideBounds && s.region)
+    corrupt(r.what() + ": " + name + " has bounds and a region");
+  s.pose = pose(r, name + " pose");
+  s.bounds_min = vec3(r, name + " bounds_min");
+  s.bounds_max = vec3(r, name + " bounds_max");
+  if (!(s.bounds_max.x >= s.bounds_min.x && s.bounds_max.y >= s.bounds_min.y &&
+        s.bounds_max.z >= s.bounds_min.z))
+    corrupt(r.what() + ": " + name + " bounds_max is below bounds_min");
+  return s;
+}
+
+ForceField read_force_field(ByteReader& r, const Assets& assets, const std::string& name) {
+  ForceField f;
+  f.kind = static_cast<ForceFieldKind>(below(r, 4, name + " kind"));
+  f.region = asset_ref(r, assets, false, name + " region");
+  f.grid = asset_ref(r, assets, f.kind == ForceFieldKind::Grid, name + " grid");
+  if (f.kind != ForceFieldKind::Grid && f.grid)
+    corrupt(r.what() + ": " + name + " has a grid but is no grid field");
+  if (f.grid && !f.grid->has_velocity())
+    corrupt(r.what() + ": " + name + " grid has no acceleration channel");
+  f.pose = pose(r, name + " pose");
+  f.vector = vec3(r, name + " vector");
+  if (f.kind == ForceFieldKind::Vortex && !(length(f.vector) > 0.0f))
+    corrupt(r.what() + ": " + name + " is a vortex without an axis");
+  f.strength = finite(r, name + " strength");
+  f.falloff_radius = non_negative(r, name + " falloff radius");
+  return f;
+}
+
+template <class T>
+void install(SlotMap<T>& map, SlotTable<T>&& t) {
+  map.restore(t.generations, std::move(t.values), std::move(t.free_list));
+}
+
+}  // namespace
+
+std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const BackendMaker& make_backend) {
+  // Header: magic and version first (a later version may lay out the rest differently), then
+  // the sizes, then the checksum over everything.
+  if (size < kHeaderSize)
+    corrupt("truncated: " + std::to_string(size) + " bytes, shorter than the " + std::to_string(kHeaderSize) +
+            "-byte header");
+  if (std::memcmp(data, kMagic, sizeof kMagic) != 0) corrupt("not a checkpoint (wrong magic bytes)");
+  ByteReader h(data + sizeof kMagic, kHeaderSize - sizeof kMagic, "header");
+  const uint32_t version = h.u32();
+  if (version != kFormatVersion)
+    throw Error(Status::VersionMismatch, "checkpoint: format version " + std::to_string(version) +
+                                             "; this library reads version " +
+                                             std::to_string(kFormatVersion));
+  const uint32_t flags = h.u32();
+  h.u32();  // writer backend: informational
+  h.u32();  // writer library version: informational
+  const uint64_t payload_size = h.u64();
+  const uint64_t checksum = h.u64();
+  const uint32_t section_count = h.u32();
+  const uint32_t reserved = h.u32();
+  const uint64_t present = size - kHeaderSize;
+  if (payload_size > present)
+    corrupt("truncated: the header promises " + std::to_string(payload_size) + " payload bytes, " +
+            std::to_string(present) + " are present");
+  if (payload_size < present)
+    corrupt(std::to_string(present - payload_size) + " bytes follow the end of the checkpoint");
+  Fnv1a64 sum;
+  sum.add(data, kChecksumOffset);
+  sum.add(data + kChecksumOffset + 8, size - kChecksumOffset - 8);
+  if (sum.value() != checksum) corrupt("checksum mismatch: the data is damaged");
+  if (flags != 0) corrupt("unknown flags " + hex32(flags));
+  if (reserved != 0) corrupt("a reserved header field is not 0");
+  if (section_count != kSectionCount)
+    corrupt(std::to_string(section_count) + " sections; version 1 has " + std::to_string(kSectionCount));
+
+  ByteReader payload(data + kHeaderSize, static_cast<size_t>(payload_size), "payload");
+  auto next_section = [&](uint32_t k) {
+    const SectionInfo& info = kSectionOrder[k];
+    const std::string what = std::string("section '") + info.name + "'";
+    if (payload.remaining() < kSectionHeaderSize) payload.need(kSectionHeaderSize);
+    const uint32_t found = payload.u32();
+    if (found != info.tag)
+      corrupt("section " + std::to_string(k) + " has tag " + hex32(found) + ", expected " + what);
+    if (payload.u32() != 0) corrupt(what + ": a reserved field is not 0");
+    const uint64_t length = payload.u64();
+    if (length > payload.remaining())
+      corrupt("truncated in " + what + " (needs " + std::to_string(length) + " bytes, " +
+              std::to_string(payload.remaining()) + " left)");
+    return payload.sub(length, what);
+  };
+
+  ByteReader conf = next_section(0);
+  const WorldConfig config = read_config(conf);
+  conf.expect_end();
+  ByteReader parm = next_section(1);
+  const RuntimeParams params = read_params(parm);
+  parm.expect_end();
+  ByteReader time = next_section(2);
+  const Clock clock = read_clock(time);
+  time.expect_end();
+  ByteReader part = next_section(3);
+  const ParticleSnapshot particles = read_particles(part, config, clock.next_id);
+  part.expect_end();
+
+  ByteReader sdfa = next_section(4);
+  const uint32_t asset_count = sdfa.u32();
+  sdfa.need_elements(asset_count, 16 + 12 * sizeof(float) + sizeof(float), "assets");
+  Assets assets;
+  for (uint32_t k = 0; k < asset_count; ++k) assets.push_back(read_asset(sdfa, k));
+  sdfa.expect_end();
+
+  ByteReader coll = next_section(5);
+  auto colliders = read_slots<Collider>(
+      coll, [&](const std::string& n) { return read_collider(coll, assets, "collider " + n); });
+  coll.expect_end();
+  ByteReader srce = next_section(6);
+  auto sources = read_slots<Source>(
+      srce, [&](const std::string& n) { return read_source(srce, assets, config, "source " + n); });
+  srce.expect_end();
+  ByteReader sink = next_section(7);
+  auto sinks =
+      read_slots<Sink>(sink, [&](const std::string& n) { return read_sink(sink, assets, "sink " + n); });
+  sink.expect_end();
+  ByteReader ffld = next_section(8);
+  auto fields = read_slots<ForceField>(
+      ffld, [&](const std::string& n) { return read_force_field(ffld, assets, "force field " + n); });
+  ffld.expect_end();
+  payload.expect_end();
+
+  // Everything is valid: build the world.
+  std::unique_ptr<Backend> backend = make_backend(config);
+  backend->import_particles(particles);
+  auto world = std::make_unique<World>(config, std::move(backend));
+  world->set_params(params);
+  world->restore_counters(clock.next_id, clock.simulated_time, clock.report, clock.last_step_ms,
+                          clock.events);
+  install(world->colliders(), std::move(colliders));
+  install(world->sources(), std::move(sources));
+  install(world->sinks(), std::move(sinks));
+  install(world->force_fields(), std::move(fields));
+  return world;
+}
+
+}  // namespace sph
