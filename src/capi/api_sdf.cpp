@@ -66,7 +66,15 @@ uint64_t voxel_count(const uint32_t dims[3], const std::string& name) {
 // Builds an asset from a caller description (validated as a whole before anything is kept).
 std::shared_ptr<sph::SdfAsset> asset_from_desc(const sph_context* context, const sph_sdf_desc& d) {
   sph::require_zero(d.reserved0, "desc->reserved0");
-  const sph_grid_desc g = sph::read_user_struct(&d.distance, "desc->distance");
+  // The distance grid is embedded in sph_sdf_desc, so the outer struct's layout fixes its size:
+  // the bytes after it are the outer struct's next fields (and past the end of our copy of it),
+  // never the tail of a newer grid desc. Only this version's size can be right.
+  const uint32_t grid_size = d.distance.struct_size;
+  if (grid_size != sizeof(sph_grid_desc))
+    throw Error(grid_size < sizeof(sph_grid_desc) ? Status::VersionMismatch : Status::Unsupported,
+                "desc->distance.struct_size: " + std::to_string(grid_size) + " is not " +
+                    std::to_string(sizeof(sph_grid_desc)) + "; fill it with sph_grid_desc_init()");
+  const sph_grid_desc g = d.distance;
   if (g.components != 1) throw Error(Status::InvalidArgument, "desc->distance.components: must be 1");
   const uint64_t n = voxel_count(g.dims, "desc->distance");
   sph::Affine3x4 affine;

@@ -67,7 +67,12 @@ SPH_API sph_result SPH_CALL sph_vdb_load_sdf(sph_context* context, const char* p
     initialize_openvdb();
     openvdb::io::File file(path);
     try {
-      file.open();
+      // No delayed loading: every voxel is read now anyway (into the dense grid), and OpenVDB's
+      // delayed-load path trusts the file's "file_delayed_load" metadata, indexing its mask table
+      // with the leaf count without a bounds check (an assertion, i.e. abort(), in Debian's
+      // libopenvdb; a read past the table otherwise) and leaves file data memory-mapped, where
+      // a file truncated by someone else would raise SIGBUS on a later read.
+      file.open(/*delayLoad=*/false);
     } catch (const std::exception& e) {
       return fail(SPH_ERROR_INVALID_ARGUMENT,
                   std::string("path: cannot open '") + path + "' as a VDB file (" + e.what() + ")");

@@ -1,0 +1,1261 @@
+// libFuzzer harness: the input is a program of C-API calls with hostile arguments. Each op
+// picks a function and its arguments (fuzzed defs and descs, NaN/Inf/huge floats, wrong struct
+// sizes, stale and foreign handles and ids); after each call the harness checks the contract
+// of sph_c.h: a known result code, a message on failure, a failed call changes nothing, a
+// successful step leaves only finite particles, and at the end every object is destroyed and
+// nothing leaks. Work per input is bounded (capacity <= 1024, <= 4 substeps per step, grids of
+// at most 32^3 voxels) so libFuzzer stays fast; absurd sizes are still passed where the
+// library must refuse them before it allocates or reads anything.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <vector>
+
+#include "fuzz_check.h"
+#include "fuzz_input.h"
+#include "shape_grid_estimate.h"
+#include "sph_c.h"
+
+using sph_fuzz::FuzzInput;
+using sph_fuzz::violation;
+
+namespace {
+
+constexpr uint32_t kMaxCapacity = 1024;   // particles per world the harness allows
+constexpr uint32_t kMaxSubsteps = 4;      // substeps per sph_world_step
+constexpr uint64_t kMaxVoxels = 32768;    // voxels per grid the harness builds
+constexpr double kMaxLattice = 1u << 16;  // source lattice points the harness allows
+constexpr double kLibraryVoxelLimit = 2147483648.0;
+constexpr int kContexts = 3, kWorlds = 4, kSdfs = 6, kIds = 8, kStale = 8;
+
+struct ContextSlot {
+  sph_context* ptr = nullptr;
+};
+struct WorldSlot {
+  sph_world* ptr = nullptr;
+  int context = -1;
+  uint32_t capacity = 0;
+  uint32_t features = 0;
+  uint32_t integrator = 0, viscosity = 0, eos = 0;
+  float spacing = 0.0f;
+};
+struct SdfSlot {
+  sph_sdf* ptr = nullptr;
+  int context = -1;
+  double volume = 0.0;  // of its grid box, m^3 (for bounding source lattices)
+  bool has_velocity = false;
+};
+struct IdSlot {
+  uint64_t bits = 0;
+  int world = -1;
+};
+
+struct Particles {
+  std::vector<float> position, velocity;
+  std::vector<uint32_t> id;
+  bool operator==(const Particles& o) const {
+    return position.size() == o.position.size() &&
+           std::memcmp(position.data(), o.position.data(), position.size() * sizeof(float)) == 0 &&
+           std::memcmp(velocity.data(), o.velocity.data(), velocity.size() * sizeof(float)) == 0 &&
+           id == o.id;
+  }
+};
+
+class Program {
+ public:
+  explicit Program(FuzzInput& in) : in_(in) {}
+  ~Program() { teardown(); }
+
+  void run() {
+    int ops = 0;
+    while (!in_.empty() && ops++ < 64) step_op();
+  }
+
+ private:
+  FuzzInput& in_;
+  ContextSlot contexts_[kContexts];
+  WorldSlot worlds_[kWorlds];
+  SdfSlot sdfs_[kSdfs];
+  IdSlot colliders_[kIds], sources_[kIds], sinks_[kIds], fields_[kIds];
+  const void* stale_[kStale] = {};  // destroyed handles (never dereferenced by the harness)
+  int stale_next_ = 0;
+
+  // ---- handle choice: live, NULL, stale, or a handle of another kind -------------------------
+  bool is_live_pointer(const void* p) const {
+    for (const auto& c : contexts_)
+      if (c.ptr == p) return true;
+    for (const auto& w : worlds_)
+      if (w.ptr == p) return true;
+    for (const auto& s : sdfs_)
+      if (s.ptr == p) return true;
+    return false;
+  }
+  void remember_stale(const void* p) {
+    stale_[stale_next_] = p;
+    stale_next_ = (stale_next_ + 1) % kStale;
+  }
+  // A pointer that is not a live handle: NULL, a destroyed one (if its address was not reused),
+  // or a pointer into the harness's own memory.
+  const void* dead_pointer() {
+    switch (in_.u8() % 3) {
+      case 0:
+        return nullptr;
+      case 1: {
+        const void* p = stale_[in_.u8() % kStale];
+        return is_live_pointer(p) ? nullptr : p;
+      }
+      default:
+        return &stale_;  // foreign memory, never a handle
+    }
+  }
+  int pick_context() { return in_.u8() % kContexts; }
+  int pick_world() { return in_.u8() % kWorlds; }
+  sph_context* context_arg(int* slot) {
+    *slot = pick_context();
+    if (in_.chance(24)) {
+      *slot = -1;
+      if (in_.chance(64)) {  // a live handle of another kind
+        for (const auto& w : worlds_)
+          if (w.ptr) return reinterpret_cast<sph_context*>(w.ptr);
+      }
+      return static_cast<sph_context*>(const_cast<void*>(dead_pointer()));
+    }
+    return contexts_[*slot].ptr;
+  }
+  sph_world* world_arg(int* slot) {
+    *slot = pick_world();
+    if (in_.chance(24)) {
+      *slot = -1;
+      if (in_.chance(64)) {
+        for (const auto& c : contexts_)
+          if (c.ptr) return reinterpret_cast<sph_world*>(c.ptr);
+      }
+      return static_cast<sph_world*>(const_cast<void*>(dead_pointer()));
+    }
+    return worlds_[*slot].ptr;
+  }
+  sph_sdf* sdf_arg(int* slot) {
+    *slot = in_.u8() % kSdfs;
+    if (in_.chance(24)) {
+      *slot = -1;
+      return static_cast<sph_sdf*>(const_cast<void*>(dead_pointer()));
+    }
+    return sdfs_[*slot].ptr;
+  }
+  // An id: one of this kind's (maybe destroyed, maybe of another world), null, or random bits.
+  uint64_t id_arg(IdSlot* ids) {
+    switch (in_.u8() % 8) {
+      case 0:
+        return 0;
+      case 1:
+        return in_.u64();
+      default:
+        return ids[in_.u8() % kIds].bits;
+    }
+  }
+
+  // ---- invariants -------------------------------------------------------------------------------
+  uint32_t count_of(sph_world* w) {
+    uint32_t n = 0;
+    if (FUZZ_CALL(sph_world_get_particle_count(w, &n)) != SPH_OK)
+      violation("particle count of a live world failed");
+    return n;
+  }
+  Particles snapshot(sph_world* w) {
+    Particles p;
+    const uint32_t n = count_of(w);
+    p.position.resize(3 * static_cast<size_t>(n) + 3);
+    p.velocity.resize(3 * static_cast<size_t>(n) + 3);
+    p.id.resize(n + 1);
+    uint32_t written = 0;
+    FUZZ_CALL(sph_world_copy_attribute(w, SPH_ATTRIBUTE_POSITION, p.position.data(),
+                                       p.position.size() * sizeof(float), 0, 0, n, &written));
+    if (written != n) violation("copied %u positions of %u", written, n);
+    FUZZ_CALL(sph_world_copy_attribute(w, SPH_ATTRIBUTE_VELOCITY, p.velocity.data(),
+                                       p.velocity.size() * sizeof(float), 0, 0, n, &written));
+    FUZZ_CALL(sph_world_copy_attribute(w, SPH_ATTRIBUTE_ID, p.id.data(), p.id.size() * sizeof(uint32_t), 0, 0,
+                                       n, &written));
+    p.position.resize(3 * static_cast<size_t>(n));
+    p.velocity.resize(3 * static_cast<size_t>(n));
+    p.id.resize(n);
+    return p;
+  }
+  void check_particles(const WorldSlot& slot, const Particles& p) {
+    if (p.id.size() > slot.capacity)
+      violation("%zu particles in a world of capacity %u", p.id.size(), slot.capacity);
+    for (float v : p.position)
+      if (!std::isfinite(v)) violation("a non-finite position after a successful step");
+    for (float v : p.velocity)
+      if (!std::isfinite(v)) violation("a non-finite velocity after a successful step");
+    std::vector<uint32_t> ids = p.id;
+    std::sort(ids.begin(), ids.end());
+    if (std::adjacent_find(ids.begin(), ids.end()) != ids.end()) violation("two particles share an id");
+  }
+
+  // ---- values -----------------------------------------------------------------------------------
+  sph_vec3 vec3(float lo, float hi) {
+    return sph_vec3{in_.maybe_hostile(lo, hi), in_.maybe_hostile(lo, hi), in_.maybe_hostile(lo, hi)};
+  }
+  sph_transform transform() {
+    sph_transform t = sph_transform_identity();
+    if (in_.chance(128)) return t;
+    t.position = vec3(-1.0f, 1.0f);
+    t.rotation = sph_quat{in_.maybe_hostile(-1, 1), in_.maybe_hostile(-1, 1), in_.maybe_hostile(-1, 1),
+                          in_.maybe_hostile(-1, 1)};
+    return t;
+  }
+  // struct_size: nearly always right; sometimes too small, too large or zero.
+  uint32_t struct_size(uint32_t right) {
+    if (!in_.chance(16)) return right;
+    switch (in_.u8() % 4) {
+      case 0:
+        return 0;
+      case 1:
+        return right - 4;
+      case 2:
+        return right + 4;
+      default:
+        return in_.u32() % 256;  // a def lives in a 256-byte buffer, so reading it stays inside
+    }
+  }
+  // Bytes that hold a struct of type T, padded to 256 so that a fuzzed struct_size up to 256
+  // never makes the library read outside the caller's memory.
+  template <class T>
+  struct Padded {
+    union {
+      T value;
+      unsigned char bytes[256];
+    };
+    Padded() { std::memset(bytes, 0, sizeof bytes); }
+  };
+
+  // ---- ops --------------------------------------------------------------------------------------
+  void step_op() {
+    switch (in_.u8() % 27) {
+      case 0:
+        return op_context_create();
+      case 1:
+        return op_context_destroy();
+      case 2:
+        return op_world_create();
+      case 3:
+        return op_world_destroy();
+      case 4:
+        return op_set_params();
+      case 5:
+        return op_queries();
+      case 6:
+        return op_spawn();
+      case 7:
+        return op_fill_box();
+      case 8:
+        return op_fill_sphere();
+      case 9:
+        return op_step();
+      case 10:
+        return op_copy_attribute();
+      case 11:
+        return op_sdf_create();
+      case 12:
+        return op_sdf_create_shape();
+      case 13:
+        return op_sdf_update();
+      case 14:
+        return op_sdf_queries();
+      case 15:
+        return op_sdf_destroy();
+      case 16:
+        return op_collider_create();
+      case 17:
+        return op_collider_ops();
+      case 18:
+        return op_source_create();
+      case 19:
+        return op_source_ops();
+      case 20:
+        return op_sink();
+      case 21:
+        return op_force_field_create();
+      case 22:
+        return op_force_field_ops();
+      case 23:
+        return op_events();
+      case 24:
+        return op_physics_params();
+      case 25:
+        return op_init_sized();
+      default:
+        return op_misc();
+    }
+  }
+
+  void op_context_create() {
+    const int slot = pick_context();
+    if (contexts_[slot].ptr) return;
+    Padded<sph_context_def> def;
+    FUZZ_CALL(sph_context_def_init(&def.value));
+    // CPU only: the fuzz build has no CUDA; AUTO resolves to the CPU there. Odd values must fail.
+    const uint32_t backends[] = {SPH_BACKEND_CPU, SPH_BACKEND_AUTO, SPH_BACKEND_CUDA, 7u, 0x80000000u};
+    const uint32_t backend = backends[in_.chance(200) ? 0 : in_.u8() % 5];
+    std::memcpy(&def.value.backend, &backend, sizeof backend);
+    def.value.cpu_worker_count = in_.chance(240) ? 1 : in_.u32();
+    if (def.value.cpu_worker_count > 4 && def.value.cpu_worker_count < 100000) def.value.cpu_worker_count = 2;
+    if (in_.chance(8)) def.value.reserved0 = in_.u32();
+    if (in_.chance(8)) def.value.header_version = in_.u32();
+    if (in_.chance(8)) def.value.device_ordinal = static_cast<int32_t>(in_.u32());
+    def.value.struct_size = struct_size(sizeof(sph_context_def));
+    sph_context* out = reinterpret_cast<sph_context*>(&stale_);  // must stay untouched on failure
+    sph_context* const before = out;
+    const sph_result r = FUZZ_CALL(sph_context_create(in_.chance(8) ? nullptr : &def.value, &out));
+    if (r == SPH_OK) {
+      if (!out) violation("sph_context_create succeeded with a NULL context");
+      contexts_[slot].ptr = out;
+      sph_backend b;
+      FUZZ_CALL(sph_context_get_backend(out, &b));
+      if (b != SPH_BACKEND_CPU && b != SPH_BACKEND_CUDA) violation("a context resolved to backend %d", b);
+    } else if (out != before) {
+      violation("sph_context_create wrote *out on failure");
+    }
+  }
+
+  void op_context_destroy() {
+    int slot;
+    sph_context* c = context_arg(&slot);
+    const sph_result r = FUZZ_CALL(sph_context_destroy(c));
+    if (slot < 0) {
+      if (r == SPH_OK && c) violation("sph_context_destroy accepted a dead or foreign handle");
+      return;
+    }
+    if (!c) {
+      if (r != SPH_OK) violation("sph_context_destroy(NULL) is not a no-op");
+      return;
+    }
+    bool has_worlds = false;
+    for (const auto& w : worlds_) has_worlds |= w.ptr && w.context == slot;
+    if (r == SPH_OK) {
+      if (has_worlds) violation("sph_context_destroy destroyed a context with live worlds");
+      // SDF assets of a destroyed context would dangle: the library must refuse it instead.
+      for (const auto& s : sdfs_)
+        if (s.ptr && s.context == slot)
+          violation("sph_context_destroy destroyed a context with live SDF assets");
+      contexts_[slot].ptr = nullptr;
+      remember_stale(c);
+    } else if (!has_worlds && r != SPH_ERROR_BUSY) {
+      violation("sph_context_destroy of an idle context failed with %d", r);
+    }
+  }
+
+  void op_world_create() {
+    const int slot = pick_world();
+    if (worlds_[slot].ptr) return;
+    int cslot;
+    sph_context* c = context_arg(&cslot);
+    Padded<sph_world_def> def;
+    FUZZ_CALL(sph_world_def_init(&def.value));
+    sph_world_def& d = def.value;
+    d.capacity = in_.range(1, kMaxCapacity);
+    if (in_.chance(16)) {
+      const uint32_t raw = in_.u32();
+      // Valid capacities above the harness's bound size the neighbour grid (legitimately
+      // large); invalid ones (0, > 2^30) must be refused.
+      if (raw == 0 || raw > (1u << 30)) d.capacity = raw;
+    }
+    d.features = in_.chance(224) ? in_.u8() % 4 : in_.u32();
+    const uint32_t integrator = in_.chance(224) ? in_.u8() % 2 : in_.u32();
+    const uint32_t viscosity = in_.chance(224) ? in_.u8() % 2 : in_.u32();
+    const uint32_t eos = in_.chance(224) ? in_.u8() % 2 : in_.u32();
+    std::memcpy(&d.integrator, &integrator, 4);
+    std::memcpy(&d.viscosity_method, &viscosity, 4);
+    std::memcpy(&d.equation_of_state, &eos, 4);
+    if (in_.chance(128)) {
+      d.particle_spacing = in_.maybe_hostile(0.005f, 0.2f);
+      d.kernel_radius = in_.chance(128) ? 0.0f : d.particle_spacing * in_.maybe_hostile(0.5f, 6.0f);
+      d.rest_density = in_.maybe_hostile(1.0f, 3000.0f);
+    }
+    if (in_.chance(8)) d.header_version = in_.u32();
+    d.struct_size = struct_size(sizeof(sph_world_def));
+    sph_world* out = nullptr;
+    const sph_result r = FUZZ_CALL(sph_world_create(c, in_.chance(8) ? nullptr : &d, &out));
+    if (r != SPH_OK) {
+      if (out) violation("sph_world_create wrote *out on failure");
+      return;
+    }
+    if (cslot < 0) violation("sph_world_create succeeded on a dead or foreign context");
+    WorldSlot& w = worlds_[slot];
+    w.ptr = out;
+    w.context = cslot;
+    sph_world_def got;
+    sph_world_def_init(&got);
+    FUZZ_CALL(sph_world_get_def(out, &got));
+    w.capacity = got.capacity;
+    w.features = got.features;
+    w.integrator = static_cast<uint32_t>(got.integrator);
+    w.viscosity = static_cast<uint32_t>(got.viscosity_method);
+    w.eos = static_cast<uint32_t>(got.equation_of_state);
+    w.spacing = got.particle_spacing;
+    if (w.capacity != d.capacity)
+      violation("the world's capacity %u is not the def's %u", w.capacity, d.capacity);
+    if (!(got.kernel_radius >= got.particle_spacing)) violation("kernel radius below the spacing");
+    if (w.capacity > kMaxCapacity) {
+      // Valid but beyond what the harness steps through: drop the world again.
+      destroy_world(slot);
+      return;
+    }
+    // Bound the work of every step of this world.
+    sph_world_params p;
+    sph_world_params_init(&p);
+    FUZZ_CALL(sph_world_get_params(out, &p));
+    p.max_substeps = kMaxSubsteps;
+    if (FUZZ_CALL(sph_world_set_params(out, &p)) != SPH_OK) {
+      // A def can make the default params unstable for the world (a tiny rest density puts the
+      // viscous step limit below dt_min); set_params refuses them, and the harness cannot bound
+      // the world's steps, so it drops it.
+      destroy_world(slot);
+    }
+  }
+
+  void destroy_world(int slot) {
+    WorldSlot& w = worlds_[slot];
+    if (FUZZ_CALL(sph_world_destroy(w.ptr)) != SPH_OK) violation("sph_world_destroy of a live world failed");
+    remember_stale(w.ptr);
+    w = WorldSlot{};
+  }
+
+  void op_world_destroy() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    if (slot >= 0 && w) return destroy_world(slot);
+    const sph_result r = FUZZ_CALL(sph_world_destroy(w));
+    if (!w && r != SPH_OK) violation("sph_world_destroy(NULL) is not a no-op");
+    if (w && r == SPH_OK) violation("sph_world_destroy accepted a dead or foreign handle");
+  }
+
+  void op_set_params() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    Padded<sph_world_params> buf;
+    sph_world_params& p = buf.value;
+    sph_world_params_init(&p);
+    if (slot >= 0 && w) FUZZ_CALL(sph_world_get_params(w, &p));
+    switch (in_.u8() % 10) {
+      case 0:
+        p.max_substeps = in_.chance(128) ? 0 : in_.range(1, kMaxSubsteps);
+        break;
+      case 1:
+        p.gravity = vec3(-20.0f, 20.0f);
+        break;
+      case 2:
+        p.stiffness = in_.maybe_hostile(0.0f, 1000.0f);
+        break;
+      case 3:
+        p.viscosity = in_.maybe_hostile(0.0f, 10.0f);
+        break;
+      case 4:
+        p.step_factor = in_.maybe_hostile(0.0f, 12.0f);
+        break;
+      case 5:
+        p.dt_min = in_.maybe_hostile(0.0f, 1e-3f);
+        break;
+      case 6:
+        p.dt_max = in_.maybe_hostile(0.0f, 1e-2f);
+        break;
+      case 7:
+        p.step_limits = in_.chance(200) ? in_.u8() % 4 : in_.u32();
+        break;
+      case 8:
+        p.reserved0 = in_.u32();
+        break;
+      default:
+        p.struct_size = struct_size(sizeof p);
+        break;
+    }
+    if (p.max_substeps > kMaxSubsteps) p.max_substeps = kMaxSubsteps;
+    sph_world_params before;
+    sph_world_params_init(&before);
+    if (slot >= 0 && w) FUZZ_CALL(sph_world_get_params(w, &before));
+    const sph_result r = FUZZ_CALL(sph_world_set_params(w, in_.chance(8) ? nullptr : &p));
+    if (slot < 0 || !w) {
+      if (r == SPH_OK) violation("sph_world_set_params succeeded on a dead world");
+      return;
+    }
+    sph_world_params after;
+    sph_world_params_init(&after);
+    FUZZ_CALL(sph_world_get_params(w, &after));
+    if (r != SPH_OK && std::memcmp(&before, &after, sizeof before) != 0)
+      violation("a failed sph_world_set_params changed the params");
+    if (after.max_substeps > kMaxSubsteps) violation("max_substeps grew beyond what was set");
+  }
+
+  void op_queries() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    switch (in_.u8() % 5) {
+      case 0: {
+        Padded<sph_world_def> d;
+        sph_world_def_init(&d.value);
+        d.value.struct_size = struct_size(sizeof(sph_world_def));
+        FUZZ_CALL(sph_world_get_def(w, in_.chance(16) ? nullptr : &d.value));
+        break;
+      }
+      case 1: {
+        float m = 0.0f;
+        if (FUZZ_CALL(sph_world_get_particle_mass(w, in_.chance(16) ? nullptr : &m)) == SPH_OK &&
+            !(std::isfinite(m) && m > 0.0f))
+          violation("particle mass %g", static_cast<double>(m));
+        break;
+      }
+      case 2: {
+        Padded<sph_stats> s;
+        sph_stats_init(&s.value);
+        s.value.struct_size = struct_size(sizeof(sph_stats));
+        const uint32_t size = s.value.struct_size;
+        std::memset(s.bytes + std::min<uint32_t>(size, 256), 0xAB, 256 - std::min<uint32_t>(size, 256));
+        const sph_result r = FUZZ_CALL(sph_world_get_stats(w, in_.chance(16) ? nullptr : &s.value));
+        // "only that many bytes are written"
+        for (uint32_t i = std::max<uint32_t>(size, 0); i < 256; ++i)
+          if (s.bytes[i] != 0xAB) violation("sph_world_get_stats wrote past struct_size %u (r=%d)", size, r);
+        break;
+      }
+      case 3: {
+        Padded<sph_world_params> p;
+        sph_world_params_init(&p.value);
+        p.value.struct_size = struct_size(sizeof(sph_world_params));
+        FUZZ_CALL(sph_world_get_params(w, in_.chance(16) ? nullptr : &p.value));
+        break;
+      }
+      default: {
+        uint32_t n;
+        FUZZ_CALL(sph_world_get_particle_count(w, in_.chance(16) ? nullptr : &n));
+      }
+    }
+  }
+
+  void op_spawn() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    const uint32_t count = in_.chance(16) ? in_.u32() : in_.range(0, 300);
+    // Caller arrays sized by what the library may read: count particles at the stride.
+    const uint64_t pstride =
+        in_.chance(200) ? 0 : (in_.chance(128) ? in_.u8() % 32 : 12 + 4 * (in_.u8() % 4));
+    const uint64_t vstride =
+        in_.chance(200) ? 0 : (in_.chance(128) ? in_.u8() % 32 : 12 + 4 * (in_.u8() % 4));
+    const bool with_velocity = in_.chance(128);
+    const uint32_t stored = std::min<uint32_t>(count, 300);
+    const uint64_t pstep = pstride == 0 ? 12 : std::max<uint64_t>(pstride, 12);
+    const uint64_t vstep = vstride == 0 ? 12 : std::max<uint64_t>(vstride, 12);
+    std::vector<float> pos(static_cast<size_t>(pstep / 4 * (stored + 1))),
+        vel(static_cast<size_t>(vstep / 4 * (stored + 1)));
+    const float s = slot >= 0 && w ? worlds_[slot].spacing : 0.02f;
+    const float origin = in_.unit(-1.0f, 1.0f);
+    for (uint32_t i = 0; i < stored; ++i) {
+      float* p = &pos[static_cast<size_t>(pstep / 4 * i)];
+      if (in_.chance(240)) {
+        // A loose cloud: about one particle per spacing^3, so neighbour counts stay sane.
+        p[0] = origin + s * static_cast<float>(i % 8) + in_.unit(0.0f, s);
+        p[1] = s * static_cast<float>((i / 8) % 8) + in_.unit(0.0f, s);
+        p[2] = s * static_cast<float>(i / 64) + in_.unit(0.0f, s);
+      } else {
+        p[0] = in_.hostile(), p[1] = in_.hostile(), p[2] = in_.hostile();
+      }
+      float* v = &vel[static_cast<size_t>(vstep / 4 * i)];
+      for (int k = 0; k < 3; ++k) v[k] = in_.maybe_hostile(-2.0f, 2.0f);
+    }
+    Padded<sph_spawn_desc> buf;
+    sph_spawn_desc& d = buf.value;
+    sph_spawn_desc_init(&d);
+    d.count = count;
+    d.positions = in_.chance(8) ? nullptr : pos.data();
+    d.velocities = with_velocity ? vel.data() : nullptr;
+    d.position_stride = pstride;
+    d.velocity_stride = vstride;
+    d.struct_size = struct_size(sizeof d);
+    if (count > stored) {
+      // More particles than the arrays hold: only legal to pass when the library must refuse
+      // the count for the world's capacity before reading (capacity <= 1024 < 1025 < count).
+      if (count <= kMaxCapacity || (slot >= 0 && w && count <= worlds_[slot].capacity)) return;
+    }
+    const uint32_t before = (slot >= 0 && w) ? count_of(w) : 0;
+    uint32_t first = 0xFFFFFFFFu;
+    const sph_result r = FUZZ_CALL(sph_world_spawn(w, in_.chance(8) ? nullptr : &d, &first));
+    if (slot < 0 || !w) {
+      if (r == SPH_OK) violation("sph_world_spawn succeeded on a dead world");
+      return;
+    }
+    const uint32_t after = count_of(w);
+    if (r != SPH_OK && after != before) violation("a failed spawn changed the count %u -> %u", before, after);
+    if (r == SPH_OK && after != before + count)
+      violation("spawn of %u: count %u -> %u", count, before, after);
+  }
+
+  void op_fill_box() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    Padded<sph_fill_box_desc> buf;
+    sph_fill_box_desc& d = buf.value;
+    sph_fill_box_desc_init(&d);
+    d.min = vec3(-0.3f, 0.3f);
+    const sph_vec3 size = vec3(-0.05f, 0.3f);
+    d.max = sph_vec3{d.min.x + size.x, d.min.y + size.y, d.min.z + size.z};
+    if (in_.chance(32)) d.max = vec3(-1e6f, 1e6f);
+    d.velocity = vec3(-1.0f, 1.0f);
+    if (in_.chance(8)) d.reserved0 = in_.u32();
+    d.struct_size = struct_size(sizeof d);
+    fill_common(slot, w, [&](uint32_t* n) { return sph_world_fill_box(w, in_.chance(8) ? nullptr : &d, n); });
+  }
+
+  void op_fill_sphere() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    Padded<sph_fill_sphere_desc> buf;
+    sph_fill_sphere_desc& d = buf.value;
+    sph_fill_sphere_desc_init(&d);
+    d.center = vec3(-0.5f, 0.5f);
+    d.radius = in_.chance(32) ? in_.hostile() : in_.unit(0.0f, 0.2f);
+    d.velocity = vec3(-1.0f, 1.0f);
+    if (in_.chance(8)) d.reserved0 = in_.u32();
+    d.struct_size = struct_size(sizeof d);
+    fill_common(slot, w,
+                [&](uint32_t* n) { return sph_world_fill_sphere(w, in_.chance(8) ? nullptr : &d, n); });
+  }
+
+  template <class Fill>
+  void fill_common(int slot, sph_world* w, Fill fill) {
+    const uint32_t before = (slot >= 0 && w) ? count_of(w) : 0;
+    uint32_t added = 0xFFFFFFFFu;
+    const sph_result r = FUZZ_CALL(fill(&added));
+    if (slot < 0 || !w) {
+      if (r == SPH_OK) violation("a fill succeeded on a dead world");
+      return;
+    }
+    const uint32_t after = count_of(w);
+    if (r != SPH_OK && after != before) violation("a failed fill changed the count %u -> %u", before, after);
+    if (r == SPH_OK && after != before + added)
+      violation("fill added %u: count %u -> %u", added, before, after);
+  }
+
+  void op_step() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    const float dt = in_.chance(24) ? in_.hostile() : in_.unit(0.0f, 0.01f);
+    if (slot < 0 || !w) {
+      if (FUZZ_CALL(sph_world_step(w, dt)) == SPH_OK) violation("sph_world_step succeeded on a dead world");
+      return;
+    }
+    const Particles before = snapshot(w);
+    const sph_result r = FUZZ_CALL(sph_world_step(w, dt));
+    const Particles after = snapshot(w);
+    if (r == SPH_OK || r == SPH_INCOMPLETE) {
+      check_particles(worlds_[slot], after);
+      sph_stats s;
+      sph_stats_init(&s);
+      FUZZ_CALL(sph_world_get_stats(w, &s));
+      if (s.substeps > kMaxSubsteps) violation("%u substeps with max_substeps %u", s.substeps, kMaxSubsteps);
+      if (s.particle_count != after.id.size())
+        violation("stats count %u != %zu", s.particle_count, after.id.size());
+    } else if (!(before == after)) {
+      violation("sph_world_step failed with %d and changed the particles", r);
+    }
+  }
+
+  void op_copy_attribute() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    uint32_t attribute = in_.u8() % 6;
+    if (in_.chance(8)) attribute = in_.u32();
+    const uint64_t dst_size = in_.chance(16) ? in_.u64() % (1u << 16) : in_.u32() % 8192;
+    const uint64_t stride = in_.chance(128) ? 0 : (in_.chance(224) ? in_.u8() % 40 : in_.u64());
+    const uint32_t first = in_.chance(200) ? in_.u8() % 16 : in_.u32();
+    const uint32_t count = in_.chance(200) ? in_.range(0, 2048) : in_.u32();
+    // The library may write anywhere in [dst, dst + dst_size); canaries past it catch overruns.
+    std::vector<unsigned char> buf(static_cast<size_t>(dst_size) + 64, 0xCD);
+    uint32_t written = 0xFFFFFFFFu;
+    sph_attribute a;
+    std::memcpy(&a, &attribute, 4);
+    const sph_result r = FUZZ_CALL(sph_world_copy_attribute(w, a, in_.chance(8) ? nullptr : buf.data(),
+                                                            dst_size, stride, first, count, &written));
+    for (size_t i = static_cast<size_t>(dst_size); i < buf.size(); ++i)
+      if (buf[i] != 0xCD) violation("sph_world_copy_attribute wrote past dst_size");
+    if (r != SPH_OK) {
+      for (unsigned char b : buf)
+        if (b != 0xCD) violation("a failed sph_world_copy_attribute wrote to dst");
+      return;
+    }
+    if (slot < 0 || !w) violation("sph_world_copy_attribute succeeded on a dead world");
+    const uint32_t n = count_of(w);
+    if (written != std::min(count, n - first))
+      violation("copy wrote %u of %u from %u", written, count, first);
+  }
+
+  // ---- SDF assets ------------------------------------------------------------------------------
+  int free_sdf_slot() {
+    const int slot = in_.u8() % kSdfs;
+    return sdfs_[slot].ptr ? -1 : slot;
+  }
+  // A grid desc with dims in [1, 32] per axis (data sized to match) or absurd dims with a
+  // small buffer, which the library must refuse before it reads: kept in `storage`.
+  void fill_grid(sph_grid_desc& g, uint32_t components, std::vector<float>& storage, bool* absurd) {
+    sph_grid_desc_init(&g);
+    *absurd = false;
+    for (int a = 0; a < 3; ++a) g.dims[a] = in_.range(1, 12);
+    if (in_.chance(16)) {
+      for (int a = 0; a < 3; ++a) g.dims[a] = in_.chance(128) ? in_.u32() : in_.range(0, 64);
+    }
+    const double voxels = static_cast<double>(g.dims[0]) * g.dims[1] * g.dims[2];
+    if (voxels > kMaxVoxels) *absurd = true;
+    const float voxel = in_.chance(224) ? in_.unit(0.005f, 0.1f) : in_.hostile();
+    for (int r = 0; r < 3; ++r) {
+      g.index_to_local[r * 4 + r] = voxel;
+      g.index_to_local[r * 4 + 3] = -0.5f * voxel * static_cast<float>(g.dims[r]);
+    }
+    if (in_.chance(16)) g.index_to_local[in_.u8() % 12] = in_.hostile();
+    g.components = in_.chance(240) ? components : in_.u32() % 5;
+    if (in_.chance(8)) {
+      const uint32_t memory = in_.u32() % 3;
+      std::memcpy(&g.memory, &memory, 4);
+    }
+    const size_t floats = *absurd ? 16 : static_cast<size_t>(voxels) * std::max<uint32_t>(g.components, 1);
+    storage.assign(floats, 0.0f);
+    // A sphere-ish distance with an occasional hostile value.
+    for (size_t i = 0; i < storage.size(); ++i) storage[i] = static_cast<float>(i % 7) * 0.01f - 0.02f;
+    if (in_.chance(32) && !storage.empty()) storage[in_.u16() % storage.size()] = in_.hostile();
+    g.data = in_.chance(8) ? nullptr : storage.data();
+    if (in_.chance(8)) g.struct_size = struct_size(sizeof g);
+  }
+  static double grid_volume(const sph_grid_desc& g) {
+    const float* m = g.index_to_local;
+    const double det = m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) +
+                       m[2] * (m[4] * m[9] - m[5] * m[8]);
+    return std::fabs(det) * g.dims[0] * g.dims[1] * g.dims[2];
+  }
+
+  void op_sdf_create() {
+    const int slot = free_sdf_slot();
+    int cslot;
+    sph_context* c = context_arg(&cslot);
+    Padded<sph_sdf_desc> buf;
+    sph_sdf_desc& d = buf.value;
+    sph_sdf_desc_init(&d);
+    std::vector<float> dist, vel, fric;
+    bool absurd = false, absurd_v = false, absurd_f = false;
+    fill_grid(d.distance, 1, dist, &absurd);
+    // Padded: their struct_size may be fuzzed up to 255 bytes, which the library may read.
+    Padded<sph_grid_desc> vbuf, fbuf;
+    sph_grid_desc& vg = vbuf.value;
+    sph_grid_desc& fg = fbuf.value;
+    const bool with_velocity = in_.chance(64), with_friction = in_.chance(64);
+    if (with_velocity) {
+      fill_grid(vg, 3, vel, &absurd_v);
+      if (in_.chance(200))
+        std::memcpy(vg.dims, d.distance.dims, sizeof vg.dims), vel.resize(dist.size() * 3 + 48);
+      if (vg.data) vg.data = vel.data();
+      d.velocity = &vg;
+    }
+    if (with_friction) {
+      fill_grid(fg, 1, fric, &absurd_f);
+      if (in_.chance(200))
+        std::memcpy(fg.dims, d.distance.dims, sizeof fg.dims), fric.resize(dist.size() + 16);
+      if (fg.data) fg.data = fric.data();
+      d.friction = &fg;
+    }
+    if (in_.chance(8)) d.reserved0 = in_.u32();
+    d.struct_size = struct_size(sizeof d);
+    // Absurd grids are only passed where the library must refuse them (over 2^31 voxels);
+    // anything in between is a legitimate allocation the harness does not make.
+    const double voxels = static_cast<double>(d.distance.dims[0]) * d.distance.dims[1] * d.distance.dims[2];
+    if (absurd && voxels <= kLibraryVoxelLimit) return;
+    if (absurd_v || absurd_f) return;
+    sph_sdf* out = nullptr;
+    const sph_result r = FUZZ_CALL(sph_sdf_create(c, in_.chance(8) ? nullptr : &d, &out));
+    if (r != SPH_OK) {
+      if (out) violation("sph_sdf_create wrote *out on failure");
+      return;
+    }
+    if (cslot < 0) violation("sph_sdf_create succeeded on a dead context");
+    if (absurd) violation("sph_sdf_create accepted %g voxels", voxels);
+    if (slot < 0) {
+      FUZZ_CALL(sph_sdf_destroy(out));
+      return;
+    }
+    sdfs_[slot] = SdfSlot{out, cslot, grid_volume(d.distance), with_velocity};
+  }
+
+  void op_sdf_create_shape() {
+    const int slot = free_sdf_slot();
+    int cslot;
+    sph_context* c = context_arg(&cslot);
+    Padded<sph_shape_desc> buf;
+    sph_shape_desc& d = buf.value;
+    sph_shape_desc_init(&d);
+    uint32_t shape = in_.u8() % 6;
+    if (in_.chance(8)) shape = in_.u32();
+    std::memcpy(&d.shape, &shape, 4);
+    d.half_extents = vec3(0.0f, 0.3f);
+    d.radius = in_.maybe_hostile(0.0f, 0.3f);
+    d.half_height = in_.maybe_hostile(0.0f, 0.3f);
+    d.wall_thickness = in_.chance(128) ? 0.0f : in_.maybe_hostile(0.0f, 0.05f);
+    d.voxel_size = in_.maybe_hostile(0.02f, 0.1f);
+    d.flags = in_.chance(224) ? in_.u8() % 2 : in_.u32();
+    d.padding_voxels = in_.chance(224) ? in_.u8() % 6 : in_.u32();
+    d.struct_size = struct_size(sizeof d);
+    // The grid build_shape_sdf would make (src/core/sdf_shapes.cpp): skip sizes that are legal
+    // but too slow to build here; pass those the library must refuse.
+    const double voxels = sph_fuzz::shape_grid_voxels(d);
+    if (std::isfinite(voxels) && voxels > kMaxVoxels && voxels <= 4.0 * kLibraryVoxelLimit) return;
+    sph_sdf* out = nullptr;
+    const sph_result r = FUZZ_CALL(sph_sdf_create_shape(c, in_.chance(8) ? nullptr : &d, &out));
+    if (r != SPH_OK) {
+      if (out) violation("sph_sdf_create_shape wrote *out on failure");
+      return;
+    }
+    if (cslot < 0) violation("sph_sdf_create_shape succeeded on a dead context");
+    uint32_t dims[3];
+    FUZZ_CALL(sph_sdf_get_dims(out, dims));
+    const double got = static_cast<double>(dims[0]) * dims[1] * dims[2];
+    if (got > kMaxVoxels) violation("shape grid of %g voxels, estimated %g", got, voxels);
+    if (slot < 0) {
+      FUZZ_CALL(sph_sdf_destroy(out));
+      return;
+    }
+    const double v = d.voxel_size;
+    sdfs_[slot] = SdfSlot{out, cslot, got * v * v * v, false};
+  }
+
+  void op_sdf_update() {
+    int slot;
+    sph_sdf* s = sdf_arg(&slot);
+    uint32_t dims[3] = {1, 1, 1};
+    if (slot >= 0 && s) FUZZ_CALL(sph_sdf_get_dims(s, dims));
+    uint32_t channel = in_.u8() % 3;
+    if (in_.chance(8)) channel = in_.u32();
+    uint32_t origin[3], size[3];
+    bool inside = true;
+    for (int a = 0; a < 3; ++a) {
+      origin[a] = in_.chance(224) ? in_.range(0, dims[a] - 1) : in_.u32();
+      size[a] = in_.chance(224) ? in_.range(0, dims[a] - std::min(origin[a], dims[a])) : in_.u32();
+      inside &= static_cast<uint64_t>(origin[a]) + size[a] <= dims[a];
+    }
+    const size_t components = channel == SPH_SDF_CHANNEL_VELOCITY ? 3 : 1;
+    const size_t floats = inside ? components * size[0] * size[1] * size[2] : 16;
+    std::vector<float> data(floats + 1, -0.01f);
+    if (in_.chance(32)) data[in_.u16() % data.size()] = in_.hostile();
+    uint32_t memory = in_.chance(240) ? 0 : in_.u32() % 3;
+    sph_memory_kind m;
+    std::memcpy(&m, &memory, 4);
+    sph_sdf_channel ch;
+    std::memcpy(&ch, &channel, 4);
+    const uint32_t* origin_arg = in_.chance(8) ? nullptr : origin;
+    const uint32_t* size_arg = in_.chance(8) ? nullptr : size;
+    const float* data_arg = in_.chance(8) ? nullptr : data.data();
+    const sph_result r = FUZZ_CALL(sph_sdf_update(s, ch, origin_arg, size_arg, data_arg, m));
+    if (r == SPH_OK && !inside) violation("sph_sdf_update accepted a box outside the grid");
+    if (r == SPH_OK && slot >= 0 && channel == SPH_SDF_CHANNEL_VELOCITY) sdfs_[slot].has_velocity = true;
+  }
+
+  void op_sdf_queries() {
+    int slot;
+    sph_sdf* s = sdf_arg(&slot);
+    if (in_.chance(128)) {
+      uint32_t dims[3];
+      const sph_result r = FUZZ_CALL(sph_sdf_get_dims(s, in_.chance(16) ? nullptr : dims));
+      if (r == SPH_OK && (dims[0] == 0 || dims[1] == 0 || dims[2] == 0)) violation("an SDF with a zero dim");
+    } else {
+      float d = 0.0f;
+      const sph_vec3 point = vec3(-0.5f, 0.5f);
+      FUZZ_CALL(sph_sdf_sample(s, point, in_.chance(16) ? nullptr : &d));
+    }
+  }
+
+  void op_sdf_destroy() {
+    int slot;
+    sph_sdf* s = sdf_arg(&slot);
+    const sph_result r = FUZZ_CALL(sph_sdf_destroy(s));
+    if (slot >= 0 && s) {
+      if (r != SPH_OK) violation("sph_sdf_destroy of a live asset failed");
+      remember_stale(s);
+      sdfs_[slot] = SdfSlot{};
+    } else if (!s && r != SPH_OK) {
+      violation("sph_sdf_destroy(NULL) is not a no-op");
+    } else if (s && r == SPH_OK) {
+      violation("sph_sdf_destroy accepted a dead handle");
+    }
+  }
+
+  // ---- scene objects ---------------------------------------------------------------------------
+  static void store_id(IdSlot* ids, int at, uint64_t bits, int world) {
+    ids[at % kIds] = IdSlot{bits, world};
+  }
+  bool world_ok(int slot, sph_world* w) const { return slot >= 0 && w; }
+
+  void op_collider_create() {
+    int slot, sslot;
+    sph_world* w = world_arg(&slot);
+    Padded<sph_collider_def> buf;
+    sph_collider_def& d = buf.value;
+    sph_collider_def_init(&d);
+    d.sdf = sdf_arg(&sslot);
+    d.flags = in_.chance(224) ? in_.u8() % 2 : in_.u32();
+    d.transform = transform();
+    d.restitution = in_.maybe_hostile(0.0f, 1.0f);
+    d.friction = in_.maybe_hostile(0.0f, 1.0f);
+    d.stickiness = in_.maybe_hostile(0.0f, 5.0f);
+    if (in_.chance(8)) d.reserved0 = in_.u32();
+    if (in_.chance(8)) d.reserved1 = in_.u32();
+    d.struct_size = struct_size(sizeof d);
+    sph_collider_id id{0};
+    const sph_collider_def* def_arg = in_.chance(8) ? nullptr : &d;
+    sph_collider_id* id_arg = in_.chance(8) ? nullptr : &id;
+    const sph_result r = FUZZ_CALL(sph_collider_create(w, def_arg, id_arg));
+    if (r == SPH_OK) {
+      if (!world_ok(slot, w) || sslot < 0 || !d.sdf) violation("sph_collider_create accepted a dead handle");
+      if (sdfs_[sslot].context != worlds_[slot].context) violation("a collider from another context's SDF");
+      if (id.bits == 0) violation("a null collider id");
+      store_id(colliders_, in_.u8(), id.bits, slot);
+    }
+  }
+
+  void op_collider_ops() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    const sph_collider_id id{id_arg(colliders_)};
+    sph_transform t = transform();
+    sph_result r;
+    switch (in_.u8() % 5) {
+      case 0:
+        r = FUZZ_CALL(sph_collider_destroy(w, id));
+        break;
+      case 1:
+        r = FUZZ_CALL(sph_collider_set_target_transform(w, id, in_.chance(8) ? nullptr : &t));
+        break;
+      case 2:
+        r = FUZZ_CALL(sph_collider_teleport(w, id, in_.chance(8) ? nullptr : &t));
+        break;
+      case 3: {
+        sph_transform out;
+        r = FUZZ_CALL(sph_collider_get_transform(w, id, in_.chance(8) ? nullptr : &out));
+        if (r == SPH_OK && !(std::isfinite(out.position.x) && std::isfinite(out.rotation.w)))
+          violation("a collider with a non-finite pose");
+        break;
+      }
+      default:
+        const float restitution = in_.maybe_hostile(0, 1);
+        const float friction = in_.maybe_hostile(0, 1);
+        const float stickiness = in_.maybe_hostile(0, 5);
+        r = FUZZ_CALL(sph_collider_set_material(w, id, restitution, friction, stickiness));
+    }
+    if (r == SPH_OK && !world_ok(slot, w)) violation("a collider call succeeded on a dead world");
+  }
+
+  void op_source_create() {
+    int slot, sslot;
+    sph_world* w = world_arg(&slot);
+    Padded<sph_source_def> buf;
+    sph_source_def& d = buf.value;
+    sph_source_def_init(&d);
+    uint32_t mode = in_.u8() % 2;
+    if (in_.chance(8)) mode = in_.u32();
+    std::memcpy(&d.mode, &mode, 4);
+    d.region = sdf_arg(&sslot);
+    d.transform = transform();
+    d.spacing = in_.chance(128) ? 0.0f : in_.maybe_hostile(0.0f, 0.1f);
+    d.min_distance = in_.chance(128) ? 0.0f : in_.maybe_hostile(0.0f, 0.1f);
+    d.velocity = vec3(-1.0f, 1.0f);
+    d.flags = in_.chance(224) ? in_.u8() % 2 : in_.u32();
+    d.rate = in_.chance(128) ? 0.0f : in_.maybe_hostile(0.0f, 1e5f);
+    if (in_.chance(8)) d.reserved0 = in_.u32();
+    if (in_.chance(8)) d.reserved1 = in_.u32();
+    d.struct_size = struct_size(sizeof d);
+    // The library keeps the region's lattice (up to 2^28 points, legitimately); skip regions
+    // whose lattice is large but legal. FCC: sqrt(2) / s^3 points per m^3.
+    if (world_ok(slot, w) && sslot >= 0 && d.region) {
+      const double s = d.spacing > 0.0f ? d.spacing : worlds_[slot].spacing;
+      const double points = sdfs_[sslot].volume * std::sqrt(2.0) / (s * s * s);
+      if (std::isfinite(points) && points > kMaxLattice && points < 4.0 * (1u << 28)) return;
+    }
+    sph_source_id id{0};
+    const sph_source_def* def_arg = in_.chance(8) ? nullptr : &d;
+    sph_source_id* id_arg = in_.chance(8) ? nullptr : &id;
+    const sph_result r = FUZZ_CALL(sph_source_create(w, def_arg, id_arg));
+    if (r == SPH_OK) {
+      if (!world_ok(slot, w) || sslot < 0) violation("sph_source_create accepted a dead handle");
+      if (id.bits == 0) violation("a null source id");
+      store_id(sources_, in_.u8(), id.bits, slot);
+    }
+  }
+
+  void op_source_ops() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    const sph_source_id id{id_arg(sources_)};
+    const sph_transform t = transform();
+    const sph_result r = in_.chance(128)
+                             ? FUZZ_CALL(sph_source_destroy(w, id))
+                             : FUZZ_CALL(sph_source_set_transform(w, id, in_.chance(8) ? nullptr : &t));
+    if (r == SPH_OK && !world_ok(slot, w)) violation("a source call succeeded on a dead world");
+  }
+
+  void op_sink() {
+    int slot, sslot;
+    sph_world* w = world_arg(&slot);
+    if (in_.chance(96)) {
+      const sph_result r = FUZZ_CALL(sph_sink_destroy(w, sph_sink_id{id_arg(sinks_)}));
+      if (r == SPH_OK && !world_ok(slot, w)) violation("sph_sink_destroy succeeded on a dead world");
+      return;
+    }
+    Padded<sph_sink_def> buf;
+    sph_sink_def& d = buf.value;
+    sph_sink_def_init(&d);
+    uint32_t mode = in_.u8() % 2;
+    if (in_.chance(8)) mode = in_.u32();
+    std::memcpy(&d.mode, &mode, 4);
+    d.region = sdf_arg(&sslot);
+    d.transform = transform();
+    d.bounds_min = vec3(-1.0f, 0.0f);
+    d.bounds_max = vec3(-0.1f, 1.0f);
+    if (in_.chance(8)) d.reserved0 = in_.u32();
+    d.struct_size = struct_size(sizeof d);
+    sph_sink_id id{0};
+    const sph_sink_def* def_arg = in_.chance(8) ? nullptr : &d;
+    sph_sink_id* id_arg = in_.chance(8) ? nullptr : &id;
+    const sph_result r = FUZZ_CALL(sph_sink_create(w, def_arg, id_arg));
+    if (r == SPH_OK) {
+      if (!world_ok(slot, w)) violation("sph_sink_create accepted a dead world");
+      if (id.bits == 0) violation("a null sink id");
+      store_id(sinks_, in_.u8(), id.bits, slot);
+    }
+  }
+
+  void op_force_field_create() {
+    int slot, sslot;
+    sph_world* w = world_arg(&slot);
+    Padded<sph_force_field_def> buf;
+    sph_force_field_def& d = buf.value;
+    sph_force_field_def_init(&d);
+    uint32_t kind = in_.u8() % 4;
+    if (in_.chance(8)) kind = in_.u32();
+    std::memcpy(&d.kind, &kind, 4);
+    d.region = in_.chance(128) ? nullptr : sdf_arg(&sslot);
+    Padded<sph_grid_desc> gbuf;  // a fuzzed struct_size up to 255 stays inside
+    sph_grid_desc& g = gbuf.value;
+    std::vector<float> storage;
+    bool absurd = false;
+    if (in_.chance(128)) {
+      fill_grid(g, 3, storage, &absurd);
+      const double voxels = static_cast<double>(g.dims[0]) * g.dims[1] * g.dims[2];
+      if (absurd && voxels <= kLibraryVoxelLimit) return;
+      d.grid = &g;
+    }
+    d.transform = transform();
+    d.vector = vec3(-10.0f, 10.0f);
+    d.strength = in_.maybe_hostile(-10.0f, 10.0f);
+    d.falloff_radius = in_.chance(128) ? 0.0f : in_.maybe_hostile(0.0f, 1.0f);
+    if (in_.chance(8)) d.reserved0 = in_.u32();
+    if (in_.chance(8)) d.reserved1 = in_.u32();
+    d.struct_size = struct_size(sizeof d);
+    sph_force_field_id id{0};
+    const sph_force_field_def* def_arg = in_.chance(8) ? nullptr : &d;
+    sph_force_field_id* id_arg = in_.chance(8) ? nullptr : &id;
+    const sph_result r = FUZZ_CALL(sph_force_field_create(w, def_arg, id_arg));
+    if (r == SPH_OK) {
+      if (!world_ok(slot, w)) violation("sph_force_field_create accepted a dead world");
+      if (absurd) violation("sph_force_field_create accepted an absurd grid");
+      if (id.bits == 0) violation("a null force field id");
+      store_id(fields_, in_.u8(), id.bits, slot);
+    }
+  }
+
+  void op_force_field_ops() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    const sph_force_field_id id{id_arg(fields_)};
+    const sph_transform t = transform();
+    const sph_result r = in_.chance(128)
+                             ? FUZZ_CALL(sph_force_field_destroy(w, id))
+                             : FUZZ_CALL(sph_force_field_set_transform(w, id, in_.chance(8) ? nullptr : &t));
+    if (r == SPH_OK && !world_ok(slot, w)) violation("a force field call succeeded on a dead world");
+  }
+
+  void op_events() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    const uint32_t capacity = in_.chance(224) ? in_.u8() % 8 : in_.u32();
+    const bool null_buffer = in_.chance(24);
+    const uint32_t held = std::min<uint32_t>(capacity, 64);
+    if (!null_buffer && capacity > held) return;  // the buffer must hold what capacity says
+    uint32_t n = 0xFFFFFFFFu;
+    sph_result r;
+    if (in_.chance(128)) {
+      std::vector<sph_event> events(held + 1);
+      r = FUZZ_CALL(sph_world_get_events(w, null_buffer ? nullptr : events.data(), capacity, &n));
+    } else {
+      std::vector<uint32_t> ids(held + 1);
+      r = FUZZ_CALL(sph_world_get_removed_ids(w, null_buffer ? nullptr : ids.data(), capacity, &n));
+    }
+    if (r == SPH_INCOMPLETE && n <= capacity)
+      violation("INCOMPLETE with %u items and capacity %u", n, capacity);
+    if (r == SPH_OK && n > capacity) violation("OK with %u items and capacity %u", n, capacity);
+  }
+
+  void op_physics_params() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    sph_result r = SPH_OK;
+    const bool set = in_.chance(160);
+    switch (in_.u8() % 3) {
+      case 0: {
+        Padded<sph_surface_tension_params> p;
+        sph_surface_tension_params_init(&p.value);
+        p.value.coefficient = in_.maybe_hostile(0.0f, 1.0f);
+        p.value.normal_threshold = in_.maybe_hostile(0.0f, 100.0f);
+        if (in_.chance(8)) p.value.reserved0 = in_.u32();
+        p.value.struct_size = struct_size(sizeof p.value);
+        r = set ? FUZZ_CALL(sph_world_set_surface_tension_params(w, &p.value))
+                : FUZZ_CALL(sph_world_get_surface_tension_params(w, &p.value));
+        if (r == SPH_OK && world_ok(slot, w) && !(worlds_[slot].features & SPH_FEATURE_SURFACE_TENSION))
+          violation("surface tension params on a world without the feature");
+        break;
+      }
+      case 1: {
+        Padded<sph_clavet_viscosity_params> p;
+        sph_clavet_viscosity_params_init(&p.value);
+        p.value.linear = in_.maybe_hostile(0.0f, 20.0f);
+        p.value.quadratic = in_.maybe_hostile(0.0f, 5.0f);
+        if (in_.chance(8)) p.value.reserved0 = in_.u32();
+        p.value.struct_size = struct_size(sizeof p.value);
+        r = set ? FUZZ_CALL(sph_world_set_clavet_viscosity_params(w, &p.value))
+                : FUZZ_CALL(sph_world_get_clavet_viscosity_params(w, &p.value));
+        if (r == SPH_OK && world_ok(slot, w) && worlds_[slot].viscosity != SPH_VISCOSITY_CLAVET)
+          violation("Clavet params on a Mueller world");
+        break;
+      }
+      default: {
+        Padded<sph_tait_params> p;
+        sph_tait_params_init(&p.value);
+        p.value.speed_of_sound = in_.maybe_hostile(0.0f, 50.0f);
+        p.value.struct_size = struct_size(sizeof p.value);
+        r = set ? FUZZ_CALL(sph_world_set_tait_params(w, &p.value))
+                : FUZZ_CALL(sph_world_get_tait_params(w, &p.value));
+        if (r == SPH_OK && world_ok(slot, w) && worlds_[slot].eos != SPH_EOS_TAIT)
+          violation("Tait params on an ideal-gas world");
+      }
+    }
+    if (r == SPH_OK && !world_ok(slot, w)) violation("physics params on a dead world");
+  }
+
+  // Every *_init_sized with a fuzzed size, into a heap buffer of exactly that many bytes
+  // (ASan catches a write past it).
+  void op_init_sized() {
+    const uint32_t size = in_.chance(224) ? in_.u8() : in_.u32() % 4096;
+    std::vector<unsigned char> storage(std::max<uint32_t>(size, 1));
+    void* p = in_.chance(8) ? nullptr : static_cast<void*>(storage.data());
+    sph_result r;
+    switch (in_.u8() % 17) {
+      case 0:
+        r = FUZZ_CALL(sph_context_def_init_sized(static_cast<sph_context_def*>(p), size));
+        break;
+      case 1:
+        r = FUZZ_CALL(sph_world_def_init_sized(static_cast<sph_world_def*>(p), size));
+        break;
+      case 2:
+        r = FUZZ_CALL(sph_world_params_init_sized(static_cast<sph_world_params*>(p), size));
+        break;
+      case 3:
+        r = FUZZ_CALL(
+            sph_surface_tension_params_init_sized(static_cast<sph_surface_tension_params*>(p), size));
+        break;
+      case 4:
+        r = FUZZ_CALL(
+            sph_clavet_viscosity_params_init_sized(static_cast<sph_clavet_viscosity_params*>(p), size));
+        break;
+      case 5:
+        r = FUZZ_CALL(sph_tait_params_init_sized(static_cast<sph_tait_params*>(p), size));
+        break;
+      case 6:
+        r = FUZZ_CALL(sph_spawn_desc_init_sized(static_cast<sph_spawn_desc*>(p), size));
+        break;
+      case 7:
+        r = FUZZ_CALL(sph_fill_box_desc_init_sized(static_cast<sph_fill_box_desc*>(p), size));
+        break;
+      case 8:
+        r = FUZZ_CALL(sph_fill_sphere_desc_init_sized(static_cast<sph_fill_sphere_desc*>(p), size));
+        break;
+      case 9:
+        r = FUZZ_CALL(sph_stats_init_sized(static_cast<sph_stats*>(p), size));
+        break;
+      case 10:
+        r = FUZZ_CALL(sph_grid_desc_init_sized(static_cast<sph_grid_desc*>(p), size));
+        break;
+      case 11:
+        r = FUZZ_CALL(sph_sdf_desc_init_sized(static_cast<sph_sdf_desc*>(p), size));
+        break;
+      case 12:
+        r = FUZZ_CALL(sph_shape_desc_init_sized(static_cast<sph_shape_desc*>(p), size));
+        break;
+      case 13:
+        r = FUZZ_CALL(sph_collider_def_init_sized(static_cast<sph_collider_def*>(p), size));
+        break;
+      case 14:
+        r = FUZZ_CALL(sph_source_def_init_sized(static_cast<sph_source_def*>(p), size));
+        break;
+      case 15:
+        r = FUZZ_CALL(sph_sink_def_init_sized(static_cast<sph_sink_def*>(p), size));
+        break;
+      default:
+        r = FUZZ_CALL(sph_force_field_def_init_sized(static_cast<sph_force_field_def*>(p), size));
+        break;
+    }
+    if (r == SPH_OK && !p) violation("an init accepted NULL");
+  }
+
+  void op_misc() {
+    switch (in_.u8() % 4) {
+      case 0: {
+        const uint32_t code =
+            in_.chance(128) ? static_cast<uint32_t>(static_cast<int32_t>(in_.u8() % 20) - 16) : in_.u32();
+        sph_result r;
+        std::memcpy(&r, &code, 4);
+        const char* s = sph_result_string(r);
+        if (!s || !s[0]) violation("sph_result_string(%d) is empty", static_cast<int>(code));
+        break;
+      }
+      case 1: {
+        uint32_t n;
+        FUZZ_CALL(sph_get_live_object_count(in_.chance(16) ? nullptr : &n));
+        break;
+      }
+      case 2: {
+        int slot;
+        sph_backend b;
+        sph_context* c = context_arg(&slot);
+        FUZZ_CALL(sph_context_get_backend(c, in_.chance(16) ? nullptr : &b));
+        break;
+      }
+      default:
+        if (sph_get_version() == 0 || !sph_get_build_info()) violation("version or build info missing");
+    }
+  }
+
+  // Destroys everything; afterwards no handle of this input may be left alive.
+  void teardown() {
+    for (int i = 0; i < kWorlds; ++i)
+      if (worlds_[i].ptr) destroy_world(i);
+    for (auto& s : sdfs_)
+      if (s.ptr && FUZZ_CALL(sph_sdf_destroy(s.ptr)) != SPH_OK)
+        violation("sph_sdf_destroy failed at teardown");
+    for (auto& c : contexts_)
+      if (c.ptr && FUZZ_CALL(sph_context_destroy(c.ptr)) != SPH_OK)
+        violation("sph_context_destroy failed at teardown: %s", sph_get_last_error());
+    uint32_t live = 1;
+    FUZZ_CALL(sph_get_live_object_count(&live));
+    if (live != 0) violation("%u library objects alive after every handle was destroyed", live);
+  }
+};
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  FuzzInput in(data, size);
+  Program program(in);
+  program.run();
+  return 0;
+}
