@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -117,12 +118,13 @@ void write_file_atomically(const std::string& path, const std::vector<uint8_t>& 
                   "path: cannot create the temporary file '" + temp + "' (" + system_error() + ")");
   }
   // On any failure from here on: close, remove the temporary file, report.
+  // The clean-up comes before anything that allocates (building the message may throw).
   auto fail = [&](const char* step) {
-    const std::string why = system_error();
+    const int error = errno;
     if (fd >= 0) ::close(fd);
     ::unlink(temp.c_str());
-    throw Error(Status::InvalidArgument, "path: " + std::string(step) + " '" + path + "' failed (" + why +
-                                             "); the file there is unchanged");
+    throw Error(Status::InvalidArgument, "path: " + std::string(step) + " '" + path + "' failed (" +
+                                             std::strerror(error) + "); the file there is unchanged");
   };
   size_t done = 0;
   while (done < bytes.size()) {
@@ -148,22 +150,26 @@ void write_file_atomically(const std::string& path, const std::vector<uint8_t>& 
 #endif
 
 std::vector<uint8_t> read_file(const char* path) {
-  std::FILE* file = std::fopen(path, "rb");
+  // Closed on every path out, exceptions (a failed allocation) included.
+  struct Closer {
+    void operator()(std::FILE* f) const { std::fclose(f); }
+  };
+  std::unique_ptr<std::FILE, Closer> file(std::fopen(path, "rb"));
   if (!file)
     throw Error(Status::InvalidArgument,
                 std::string("path: cannot open '") + path + "' (" + system_error() + ")");
   std::vector<uint8_t> bytes;
   uint8_t chunk[1 << 16];
   for (;;) {
-    const size_t n = std::fread(chunk, 1, sizeof chunk, file);
+    const size_t n = std::fread(chunk, 1, sizeof chunk, file.get());
     bytes.insert(bytes.end(), chunk, chunk + n);
     if (n < sizeof chunk) break;
   }
-  const bool failed = std::ferror(file) != 0;
-  const std::string why = failed ? system_error() : std::string();
-  std::fclose(file);
-  if (failed)
-    throw Error(Status::InvalidArgument, std::string("path: cannot read '") + path + "' (" + why + ")");
+  if (std::ferror(file.get()) != 0) {
+    const int error = errno;
+    throw Error(Status::InvalidArgument,
+                std::string("path: cannot read '") + path + "' (" + std::strerror(error) + ")");
+  }
   return bytes;
 }
 
