@@ -157,13 +157,15 @@ static void describe_world(const options* o, uint32_t capacity, sph_world_def* d
   }
 }
 
-/* The largest capacity a world can be created with on this backend: halves down from 2^32 - 1
- * until a world fits, then bisects (to 1 %) between the largest that fit and the smallest that
- * did not. Only out-of-memory refusals count as "does not fit". */
+/* The largest capacity a world can be created with on this backend: halves down from the
+ * API's limit (2^30 particles) until a world fits, then bisects (to 1 %) between the largest
+ * that fit and the smallest that did not. Only out-of-memory refusals count as "does not
+ * fit". */
+#define CAPACITY_LIMIT 1073741824.0 /* sph_world_def.capacity <= 2^30 */
 static uint32_t largest_capacity(const options* o, sph_context* context) {
-  double fits = 0.0, too_big = 4294967295.0;
+  double fits = 0.0, too_big = 2.0 * CAPACITY_LIMIT;
   while (too_big - fits > 0.01 * too_big) {
-    const double trial = fits > 0.0 ? 0.5 * (fits + too_big) : 0.5 * too_big;
+    const double trial = floor(fits > 0.0 ? 0.5 * (fits + too_big) : 0.5 * too_big);
     sph_world_def def;
     sph_world_params params;
     describe_world(o, (uint32_t)trial, &def, &params);
@@ -172,7 +174,7 @@ static uint32_t largest_capacity(const options* o, sph_context* context) {
     if (r == SPH_OK) {
       sph_world_destroy(world);
       fits = trial;
-      if (fits == 0.5 * too_big && too_big == 4294967295.0) break; /* everything fits */
+      if (fits >= CAPACITY_LIMIT) break; /* the API's limit fits */
     } else if (r == SPH_ERROR_OUT_OF_DEVICE_MEMORY || r == SPH_ERROR_OUT_OF_HOST_MEMORY) {
       too_big = trial;
     } else {
