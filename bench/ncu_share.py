@@ -26,6 +26,15 @@ METRICS = {
 }
 
 
+def kernel_name(signature):
+    """'void sph::<unnamed>::density_kernel<0>(...)' -> 'density_kernel'."""
+    name = signature.replace("(anonymous namespace)::", "").replace("<unnamed>::", "")
+    if name.startswith("void "):
+        name = name[5:]
+    name = name.split("(")[0].split("<")[0].strip()
+    return name.split("::")[-1]
+
+
 def number(text):
     return float(text.replace(",", "")) if text not in ("", "n/a") else 0.0
 
@@ -43,7 +52,7 @@ def main():
         if key is None:
             continue
         launch = launches[row["ID"]]
-        launch["kernel"] = row["Kernel Name"].split("(")[0].split("<")[0].strip()
+        launch["kernel"] = kernel_name(row["Kernel Name"])
         unit = row.get("Metric Unit", "")
         value = number(row["Metric Value"])
         if key == "ns" and unit in ("usecond", "us"):
