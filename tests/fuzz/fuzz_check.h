@@ -24,7 +24,8 @@ namespace sph_fuzz {
 
 inline bool is_known_result(sph_result r) {
   const int v = static_cast<int>(r);
-  return v == SPH_OK || v == SPH_INCOMPLETE || (v <= SPH_ERROR_INVALID_ARGUMENT && v >= SPH_ERROR_NON_FINITE);
+  return v == SPH_OK || v == SPH_INCOMPLETE ||
+         (v <= SPH_ERROR_INVALID_ARGUMENT && v >= SPH_ERROR_CORRUPT_DATA);
 }
 
 // The result contract of every sph_ call (sph_c.h, "Conventions"); returns r.

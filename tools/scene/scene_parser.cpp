@@ -83,6 +83,12 @@ SceneDesc parse_scene(const std::string& text, const std::string& base_dir) {
     std::string what = e.what();
     const size_t at = what.find("parse error");
     throw SceneError("", "not valid JSON: " + (at == std::string::npos ? what : what.substr(at)));
+  } catch (const nlohmann::json::exception& e) {
+    // Other errors of the parser: a number beyond double's range (3e9619) is out_of_range.406,
+    // "[json.exception.out_of_range.406] number overflow parsing '3e9619'".
+    std::string what = e.what();
+    const size_t at = what.find("] ");
+    throw SceneError("", "not valid JSON: " + (at == std::string::npos ? what : what.substr(at + 2)));
   }
   SceneDesc scene;
   scene.base_dir = base_dir;
