@@ -567,7 +567,8 @@ static class Tests
                 Throws(Result.ErrorInvalidArgument, () => world.Params = bad);
                 AssertEqual(p, world.Params, "params unchanged after errors");
             }
-            // Tait with c = 100 m/s: the acoustic limit gives dt <= 0.4 h / c, about 58 substeps per 1/120 s.
+            // Tait with c = 100 m/s, step factor 0.1: without the flag the always-on stability ceiling
+            // gives dt <= 0.4 h / c (about 58 substeps per 1/120 s); the acoustic limit 0.1 h / c (about 231).
             var substeps = new uint[2];
             for (int i = 0; i < 2; ++i)
             {
@@ -580,6 +581,7 @@ static class Tests
                     world.TaitParams = tp;
                     var p = world.Params;
                     p.StepLimitFlags = i == 0 ? StepLimitFlags.None : StepLimitFlags.Acoustic;
+                    p.StepFactor = 0.1f;
                     world.Params = p;
                     world.FillSphere(new Vec3(0, 0, 0), 0.04f);
                     AssertEqual(Result.Ok, world.Step(1f / 120f), "step");
@@ -587,7 +589,8 @@ static class Tests
                 }
             }
             double h = 1.8 * 0.02;
-            Assert(substeps[1] >= (1.0 / 120) / (0.4 * h / 100) - 1, "acoustic limit substeps: " + substeps[1]);
+            Assert(substeps[0] >= (1.0 / 120) / (0.4 * h / 100) - 1, "stability ceiling substeps: " + substeps[0]);
+            Assert(substeps[1] >= (1.0 / 120) / (0.1 * h / 100) - 1, "acoustic limit substeps: " + substeps[1]);
             Assert(substeps[1] > 3 * substeps[0], "acoustic limit " + substeps[1] + " vs none " + substeps[0]);
         }
     }

@@ -181,17 +181,20 @@ def test_step_limits_round_trip_and_validation(world):
 
 
 def test_acoustic_limit_with_a_fast_tait_sound_speed_takes_more_substeps(ctx):
-    """c = 100 m/s: dt <= 0.4 h / c = 1.4e-4 s, so a 1/120 s frame needs about 58 substeps."""
+    """c = 100 m/s, step factor 0.1. Without the flag the always-on stability ceiling still holds
+    dt <= 0.4 h / c = 1.4e-4 s (about 58 substeps in a 1/120 s frame); the acoustic limit makes
+    it dt <= 0.1 h / c (about 231)."""
     counts = {}
     for limits in (0, sph.StepLimit.ACOUSTIC):
         with ctx.world(capacity=2000, equation_of_state="tait") as w:
             w.set_tait_params(speed_of_sound=100)
-            w.set_params(step_limits=limits)
+            w.set_params(step_limits=limits, step_factor=0.1)
             w.fill_sphere((0, 0, 0), 0.04)
             assert w.step(1 / 120) == sph.Result.OK
             counts[limits] = w.stats().substeps
     h = 1.8 * 0.02
-    assert counts[sph.StepLimit.ACOUSTIC] >= (1 / 120) / (0.4 * h / 100) - 1
+    assert counts[0] >= (1 / 120) / (0.4 * h / 100) - 1
+    assert counts[sph.StepLimit.ACOUSTIC] >= (1 / 120) / (0.1 * h / 100) - 1
     assert counts[sph.StepLimit.ACOUSTIC] > 3 * counts[0]
 
 
