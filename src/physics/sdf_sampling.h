@@ -50,7 +50,9 @@ struct TrilinearCell {
   float outside;     // distance from the query to the grid's box, local units (0 inside)
 };
 
-SPH_HD float clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
+// NaN clamps to lo: a NaN query point (inf - inf from an extreme but finite position or map)
+// must still index inside the grid; the NaN it yields is caught as a non-finite step.
+SPH_HD float clampf(float v, float lo, float hi) { return !(v >= lo) ? lo : (v > hi ? hi : v); }
 
 SPH_HD TrilinearCell locate(const SdfGridView& g, Vec3 local) {
   const Vec3 idx = apply_affine(g.local_to_index, local);
