@@ -149,8 +149,48 @@ void non_finite_rollback() {
   report(results[1] == SPH_ERROR_NON_FINITE && restored[1] && steps_after[1], "errors/non_finite_rollback",
          "GPU: %s; state after the failed step bitwise equal to before: %s; steps again: %s",
          sph_result_string(results[1]), restored[1] ? "yes" : "NO", steps_after[1] ? "yes" : "NO");
-  report(results[0] == results[1] && ids[0] == ids[1] && ids[0] != "?", "errors/non_finite_same_particle",
-         "CPU names particle id %s, GPU names particle id %s", ids[0].c_str(), ids[1].c_str());
+  // Under a stiffness of 1e37 nearly every compressed particle overflows, and which one has the
+  // lowest storage index depends on densities at round-off (CPU and GPU agree to 1e-7, not
+  // bitwise), so that step names some particle on each backend without naming the same one.
+  report(results[0] == SPH_ERROR_NON_FINITE && ids[0] != "?" && ids[1] != "?",
+         "errors/non_finite_names_a_particle", "CPU names particle id %s, GPU names particle id %s",
+         ids[0].c_str(), ids[1].c_str());
+
+  // The same particle on both backends: one particle thrown at 1e20 m/s, far from the others,
+  // whose squared speed overflows in the integration of the first substep; nothing else fails.
+  std::string named[2];
+  uint32_t thrown_id[2] = {0, 0};
+  for (int b = 0; b < 2; ++b) {
+    sph_context* context = make_context(backends[b]);
+    const std::vector<float> pos = fcc_sphere(0, 0, 0, 0.1f, 0.02f);
+    sph_world_def def;
+    sph_world_def_init(&def);
+    def.capacity = static_cast<uint32_t>(pos.size() / 3) + 1;
+    sph_world* world = nullptr;
+    require_ok(sph_world_create(context, &def, &world), "sph_world_create");
+    sph_spawn_desc spawn;
+    sph_spawn_desc_init(&spawn);
+    spawn.count = def.capacity - 1;
+    spawn.positions = pos.data();
+    require_ok(sph_world_spawn(world, &spawn, nullptr), "spawn");
+    require_ok(sph_world_step(world, 0.002f), "first step");
+    const float thrown_position[3] = {0.0f, 0.5f, 0.0f};
+    const float thrown_velocity[3] = {1e20f, 0.0f, 0.0f};
+    sph_spawn_desc_init(&spawn);
+    spawn.count = 1;
+    spawn.positions = thrown_position;
+    spawn.velocities = thrown_velocity;
+    require_ok(sph_world_spawn(world, &spawn, &thrown_id[b]), "spawn the thrown particle");
+    const sph_result r = sph_world_step(world, 0.002f);
+    named[b] = r == SPH_ERROR_NON_FINITE ? message_id(sph_get_last_error())
+                                         : std::string("(step: ") + sph_result_string(r) + ")";
+    sph_world_destroy(world);
+    sph_context_destroy(context);
+  }
+  report(named[0] == std::to_string(thrown_id[0]) && named[1] == std::to_string(thrown_id[1]) &&
+             thrown_id[0] == thrown_id[1],
+         "errors/non_finite_same_particle", "thrown particle id %u; CPU names %s, GPU names %s", thrown_id[1],
+         named[0].c_str(), named[1].c_str());
 }
 
 __global__ void scale_kernel(float* data, int n) {
