@@ -38,6 +38,12 @@ def load(path, default):
         return default
 
 
+def stage_shares(row):
+    """Percent of the substep per stage, in STAGES order."""
+    total = sum(row["stage_ms_per_substep"].values()) or 1.0
+    return [100.0 * row["stage_ms_per_substep"].get(stage, 0.0) / total for stage in STAGES]
+
+
 def rows_of(rows, backend, scene, option="none"):
     out = [r for r in rows if r["backend"] == backend and r["scene"] == scene and r.get("option", "none") == option]
     return sorted(out, key=lambda r: r["particles"])
@@ -74,11 +80,9 @@ def fig9(rows, out_dir):
     for ax, (backend, rs) in zip(axes[0], groups):
         labels = [f"{r['particles'] / 1000:.0f}k" for r in rs]
         bottoms = [0.0] * len(rs)
-        for stage in STAGES:
-            shares = []
-            for r in rs:
-                total = sum(r["stage_ms_per_substep"].values()) or 1.0
-                shares.append(100.0 * r["stage_ms_per_substep"].get(stage, 0.0) / total)
+        per_row = [stage_shares(r) for r in rs]
+        for k, stage in enumerate(STAGES):
+            shares = [row[k] for row in per_row]
             if max(shares) > 0.0:
                 ax.bar(labels, shares, bottom=bottoms, label=stage)
                 bottoms = [b + s for b, s in zip(bottoms, shares)]
@@ -144,9 +148,7 @@ def summary(rows, ceilings, share, scenes, out_dir):
     lines.append("|---|---:|" + "---:|" * len(STAGES))
     for backend in ("cuda", "cpu"):
         for r in rows_of(rows, backend, "rest"):
-            total = sum(r["stage_ms_per_substep"].values()) or 1.0
-            lines.append(f"| {backend} | {r['particles']} | " + " | ".join(
-                f"{100 * r['stage_ms_per_substep'].get(s, 0.0) / total:.1f}" for s in STAGES) + " |")
+            lines.append(f"| {backend} | {r['particles']} | " + " | ".join(f"{x:.1f}" for x in stage_shares(r)) + " |")
     # Options.
     options = sorted({r.get("option", "none") for r in rows} - {"none"})
     if options:
@@ -185,11 +187,9 @@ def summary(rows, ceilings, share, scenes, out_dir):
                      "bytes/particle | " + " | ".join(STAGES) + " |")
         lines.append("|---|---:|---:|---:|---:|---:|---:|---:|" + "---:|" * len(STAGES))
         for d in dams:
-            total = sum(d["stage_ms_per_substep"].values()) or 1.0
             lines.append(f"| {d['backend']} | {d['particles']} | {d['s_per_frame']:.4g} | {d['substeps_per_frame']:.1f} | "
                          f"{d['ms_per_substep']:.4g} | {d['particle_substeps_per_s']:.3g} | {d['neighbors_mean']:.1f} | "
-                         f"{d['bytes_per_particle']:.1f} | " + " | ".join(
-                             f"{100 * d['stage_ms_per_substep'].get(s, 0.0) / total:.1f}" for s in STAGES) + " |")
+                         f"{d['bytes_per_particle']:.1f} | " + " | ".join(f"{x:.1f}" for x in stage_shares(d)) + " |")
     if scenes:
         lines.append("\n### Case 3: the thesis scenes (sph-run, no output)\n")
         lines.append("| scene | backend | particles at most | frames | s/frame | thesis s/frame |")
