@@ -66,3 +66,23 @@ void physics_set_params(sph_world* world, float gx, float gy, float gz, float dt
   p.dt_max = dt_max;
   EXPECT_OK(sph_world_set_params(world, &p));
 }
+
+double physics_spawn_disturbed(sph_world* world, const float* positions, uint32_t n, double disturbance,
+                               uint64_t* rng) {
+  sph_spawn_desc spawn;
+  float mass = 0.0f;
+  double ke = 0.0;
+  float* velocities = (float*)malloc(sizeof(float) * 3 * (n > 0 ? n : 1));
+  assert_non_null(velocities);
+  for (uint32_t i = 0; i < 3 * n; ++i)
+    velocities[i] = (float)(disturbance * (2.0 * sph_test_random(rng) - 1.0));
+  sph_spawn_desc_init(&spawn);
+  spawn.count = n;
+  spawn.positions = positions;
+  spawn.velocities = velocities;
+  EXPECT_OK(sph_world_spawn(world, &spawn, NULL));
+  EXPECT_OK(sph_world_get_particle_mass(world, &mass));
+  for (uint32_t i = 0; i < 3 * n; ++i) ke += 0.5 * mass * (double)velocities[i] * velocities[i];
+  free(velocities);
+  return ke;
+}

@@ -18,6 +18,12 @@ uint32_t physics_copy_by_id(const sph_world* world, sph_attribute attribute, voi
 /* The FCC points sph_world_fill_sphere makes for this spacing (from a scratch world). */
 uint32_t physics_fcc_sphere(float spacing, float radius, float** positions);
 
+/* Spawns n particles at positions with every velocity component uniform in
+ * [-disturbance, disturbance] m/s (sph_test_random from *rng, so runs repeat); returns their
+ * kinetic energy, sum 0.5 m v^2 in double. */
+double physics_spawn_disturbed(sph_world* world, const float* positions, uint32_t n, double disturbance,
+                               uint64_t* rng);
+
 /* Sets gravity, dt limits and keeps the other params at their defaults. */
 void physics_set_params(sph_world* world, float gx, float gy, float gz, float dt_min, float dt_max);
 

@@ -28,10 +28,8 @@ static void test_sphere_stays_at_rest(void** state) {
   sph_context* context = NULL;
   sph_world* world = NULL;
   sph_world_def def;
-  sph_spawn_desc spawn;
   float mass = 0.0f, h, rest;
   float* lattice = NULL;
-  float* velocities;
   uint64_t rng = 12345;
   uint32_t n = 0;
   double ke0 = 0.0;
@@ -47,19 +45,9 @@ static void test_sphere_stays_at_rest(void** state) {
   rest = def.rest_density;
   physics_set_params(world, 0.0f, 0.0f, 0.0f, 1e-6f, 1e-3f);
   n = physics_fcc_sphere(spacing, radius, &lattice);
-  velocities = (float*)malloc(sizeof(float) * 3 * n);
-  assert_non_null(velocities);
-  for (uint32_t i = 0; i < 3 * n; ++i)
-    velocities[i] = (float)(disturbance * (2.0 * sph_test_random(&rng) - 1.0));
-  sph_spawn_desc_init(&spawn);
-  spawn.count = n;
-  spawn.positions = lattice;
-  spawn.velocities = velocities;
-  EXPECT_OK(sph_world_spawn(world, &spawn, NULL));
+  ke0 = physics_spawn_disturbed(world, lattice, n, disturbance, &rng);
   EXPECT_OK(sph_world_get_particle_mass(world, &mass));
-  for (uint32_t i = 0; i < 3 * n; ++i) ke0 += 0.5 * mass * (double)velocities[i] * velocities[i];
   free(lattice);
-  free(velocities);
 
   for (int f = 0; f < FRAMES; ++f) {
     float* x = NULL;
