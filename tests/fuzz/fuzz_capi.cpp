@@ -1058,7 +1058,9 @@ class Program {
     const sph_result r = FUZZ_CALL(sph_force_field_create(w, def_arg, id_arg));
     if (r == SPH_OK) {
       if (!world_ok(slot, w)) violation("sph_force_field_create accepted a dead world");
-      if (absurd) violation("sph_force_field_create accepted an absurd grid");
+      // Only a grid field reads the grid; the other kinds ignore def->grid (documented).
+      if (absurd && d.kind == SPH_FORCE_FIELD_GRID)
+        violation("sph_force_field_create accepted an absurd grid");
       if (id.bits == 0) violation("a null force field id");
       store_id(fields_, in_.u8(), id.bits, slot);
     }
