@@ -881,6 +881,41 @@ static void test_save_file_is_atomic(void** state) {
 }
 
 /* ---- (d) argument errors -------------------------------------------------------------------- */
+/* A world whose caller pinned a fixed step above the stability ceiling (dt_min = dt_max, which
+ * sph_world_set_params accepts: dt_min is the caller's floor and wins over the ceiling) must
+ * load back. The reader once refused it as corrupt, so such a world could be saved but never
+ * restored. */
+static void test_fixed_step_above_ceiling_round_trips(void** state) {
+  sph_context* context = NULL;
+  sph_world* world = NULL;
+  sph_world* loaded = NULL;
+  sph_world_def def;
+  sph_world_params params, read_back;
+  uint64_t size = 0;
+  uint8_t* checkpoint;
+  (void)state;
+
+  EXPECT_OK(sph_test_context_create(&context));
+  sph_world_def_init(&def);
+  def.capacity = 64;
+  EXPECT_OK(sph_world_create(context, &def, &world));
+  sph_world_params_init(&params);
+  EXPECT_OK(sph_world_get_params(world, &params));
+  /* Defaults: h = 0.036 m, c = 10 m/s, so the ceiling 0.4 h / c is 1.44 ms; pin 10 ms. */
+  params.dt_min = params.dt_max = 0.01f;
+  EXPECT_OK(sph_world_set_params(world, &params));
+  checkpoint = save_to_memory(world, &size);
+  EXPECT_OK(sph_world_load(context, checkpoint, size, &loaded));
+  sph_world_params_init(&read_back);
+  EXPECT_OK(sph_world_get_params(loaded, &read_back));
+  assert_true(read_back.dt_min == 0.01f && read_back.dt_max == 0.01f);
+  EXPECT_OK(sph_world_restore(world, checkpoint, size));
+  free(checkpoint);
+  EXPECT_OK(sph_world_destroy(loaded));
+  EXPECT_OK(sph_world_destroy(world));
+  EXPECT_OK(sph_context_destroy(context));
+}
+
 static void test_argument_errors(void** state) {
   sph_context* context = NULL;
   sph_world* world = NULL;
@@ -940,6 +975,7 @@ int main(void) {
       cmocka_unit_test(test_options_continue_bitwise),
       cmocka_unit_test(test_save_file_is_atomic),
       cmocka_unit_test(test_argument_errors),
+      cmocka_unit_test(test_fixed_step_above_ceiling_round_trips),
   };
   const struct CMUnitTest damaged[] = {
       cmocka_unit_test(test_every_truncation_is_refused),
