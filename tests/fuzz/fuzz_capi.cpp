@@ -408,9 +408,8 @@ class Program {
     FUZZ_CALL(sph_world_get_params(out, &p));
     p.max_substeps = kMaxSubsteps;
     if (FUZZ_CALL(sph_world_set_params(out, &p)) != SPH_OK) {
-      // A def can make the default params unstable for the world (a tiny rest density puts the
-      // viscous step limit below dt_min); set_params refuses them, and the harness cannot bound
-      // the world's steps, so it drops it.
+      // The world's own params with a smaller max_substeps are valid, so this should not
+      // fail; if it ever does, the harness cannot bound the world's steps and drops it.
       destroy_world(slot);
     }
   }
