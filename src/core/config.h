@@ -33,6 +33,9 @@ struct WorldConfig {
   float kernel_radius = 0.0f;
   float rest_density = 0.0f;
   float particle_mass = 0.0f;  // derived from the FCC lattice at creation
+  // The density's self term (FluidConstants::density_self_weight), derived with the mass at
+  // creation and when a checkpoint is loaded (it is not stored).
+  float density_self_weight = 0.0f;
 };
 
 struct RuntimeParams {
@@ -65,6 +68,7 @@ inline FluidConstants make_fluid_constants(const WorldConfig& c, const RuntimePa
   FluidConstants f;
   f.kernel = make_kernel_coefficients(c.kernel_radius);
   f.particle_mass = c.particle_mass;
+  f.density_self_weight = c.density_self_weight;
   f.rest_density = c.rest_density;
   f.eos = make_eos(c, p);
   f.viscosity = p.viscosity;

@@ -100,4 +100,23 @@ float fcc_rest_mass(float spacing, float kernel_radius, float rest_density) {
   return static_cast<float>(rest_density / sum);
 }
 
+float fcc_density_self_weight(float spacing, float kernel_radius, float rest_density, float mass) {
+  const double step = half_cell(spacing);
+  const double h = kernel_radius;
+  const double h2 = h * h;
+  const double spiky = 15.0 / (3.14159265358979323846 * std::pow(h, 6.0));
+  const int64_t n = static_cast<int64_t>(std::ceil(h / step)) + 1;
+  double sum = 0.0;
+  for (int64_t k = -n; k <= n; ++k)
+    for (int64_t j = -n; j <= n; ++j)
+      for (int64_t i = -n; i <= n; ++i) {
+        if (((i + j + k) % 2 + 2) % 2 != 0 || (i == 0 && j == 0 && k == 0)) continue;
+        const double r2 = step * step * static_cast<double>(i * i + j * j + k * k);
+        if (r2 >= h2) continue;
+        const double d = h - std::sqrt(r2);
+        sum += spiky * d * d * d;
+      }
+  return static_cast<float>(static_cast<double>(rest_density) / mass - sum);
+}
+
 }  // namespace sph

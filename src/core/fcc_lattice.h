@@ -26,4 +26,11 @@ std::vector<Vec3> fcc_points_in_sphere(Vec3 center, float radius, float spacing)
 // under W_poly6 with radius kernel_radius (sum over the lattice computed in double).
 float fcc_rest_mass(float spacing, float kernel_radius, float rest_density);
 
+// The density's self term w0 (1/m^3) for particles of `mass`: rest_density / mass minus the sum
+// of W_spiky over the lattice neighbours (r < kernel_radius, the particle itself excluded), so
+// that m (w0 + sum_{j != i} W_spiky) is rest_density on the infinite lattice at `spacing`
+// (density.h says why the pair terms use W_spiky). Positive for kernel_radius in [1, 5] x
+// spacing (0.36 / V at the default 1.8, V = spacing^3 / sqrt 2 the volume per particle).
+float fcc_density_self_weight(float spacing, float kernel_radius, float rest_density, float mass);
+
 }  // namespace sph

@@ -11,7 +11,10 @@ namespace sph {
 struct FluidConstants {
   KernelCoefficients kernel;
   float particle_mass;  // kg
-  float rest_density;   // rho0, kg/m^3
+  // The density's self term, 1/m^3: rho_i = m (density_self_weight + sum_{j != i} W_spiky(r_ij))
+  // (density.h); set so that the FCC lattice at the world's spacing has rest density.
+  float density_self_weight;
+  float rest_density;  // rho0, kg/m^3
   EosConstants eos;
   float viscosity;  // mu of Mueller's viscosity
   Vec3 gravity;     // m/s^2

@@ -14,6 +14,7 @@ struct KernelCoefficients {
   float h;
   float h2;
   float poly6;       // 315 / (64 pi h^9)
+  float spiky;       // 15 / (pi h^6): W_spiky = spiky (h - r)^3 (the density's pair term)
   float spiky_grad;  // -45 / (pi h^6)
   float visc_lap;    // 45 / (pi h^6)
   float poly6_grad;  // -945 / (32 pi h^9): grad W_poly6 = poly6_grad (h^2 - r^2)^2 r_vec
@@ -26,6 +27,7 @@ SPH_HD KernelCoefficients make_kernel_coefficients(float h) {
   c.h = h;
   c.h2 = h * h;
   c.poly6 = 315.0f / (64.0f * kPi * h6 * h3);
+  c.spiky = 15.0f / (kPi * h6);
   c.spiky_grad = -45.0f / (kPi * h6);
   c.visc_lap = 45.0f / (kPi * h6);
   c.poly6_grad = -945.0f / (32.0f * kPi * h6 * h3);
@@ -37,6 +39,13 @@ SPH_HD float poly6(const KernelCoefficients& c, float r2) {
   if (r2 >= c.h2) return 0.0f;
   const float d = c.h2 - r2;
   return c.poly6 * d * d * d;
+}
+
+// W_spiky(r) = 15 / (pi h^6) (h - r)^3, whose gradient the pressure force uses.
+SPH_HD float spiky_value(const KernelCoefficients& c, float r) {
+  if (r >= c.h) return 0.0f;
+  const float d = c.h - r;
+  return c.spiky * d * d * d;
 }
 
 // Magnitude factor of grad W_spiky: grad W = spiky_grad_scalar(r) * (r_vec / r).

@@ -5,7 +5,10 @@
  * floor) + the equation of state's internal energy, sum m e(rho_i) with de/drho = p / rho^2:
  * for the ideal gas clamped at zero below rho0, e(rho) = k (ln(rho / rho0) + rho0 / rho - 1)
  * above rho0 and 0 below. That is the energy the pressure force exchanges with the motion
- * (with summation density and the p / rho^2 pressure form the exchange is exact in time), so
+ * (with summation density and the p / rho^2 pressure form over the same kernel, W_spiky in both
+ * since the density follows the force, the exchange is exact in time; with the thesis's W_poly6
+ * density against the W_spiky force this box gained 18 %, 58 % at the full resolution:
+ * docs/validation.md, "Closed box"), so
  * leaving it out would make a compressed column look as if it lost energy. Viscosity and
  * the inelastic wall contacts (restitution 0) only remove energy; what the test catches is
  * energy made by the integrator, an unstable step or a collision that throws a particle.
