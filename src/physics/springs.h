@@ -87,15 +87,18 @@ SPH_HD void spring_candidates(const SpringConstants& c, const GridView& grid, co
                               const uint32_t* ids, uint32_t link_from, const SpringList& own, uint32_t i,
                               uint32_t* out) {
   const bool i_waits = waits_for_springs(ids[i], link_from);
+  float best_r2[kSpringSlots];
+  uint32_t best_id[kSpringSlots];
+  uint32_t best_j[kSpringSlots];
   uint32_t free_slots = 0;
   for (uint32_t k = 0; k < kSpringSlots; ++k) {
     free_slots += own.partner[k] == kNoSpring ? 1u : 0u;
     out[k] = kNoSpring;
+    best_r2[k] = 0.0f;
+    best_id[k] = 0;
+    best_j[k] = kNoSpring;
   }
   if (free_slots == 0) return;
-  float best_r2[kSpringSlots];
-  uint32_t best_id[kSpringSlots];
-  uint32_t best_j[kSpringSlots];
   uint32_t count = 0;
   const Vec3 xi = xyz(positions[i]);
   for_each_neighbor_candidate(grid, xi, [&](uint32_t j) {
