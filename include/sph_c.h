@@ -372,7 +372,7 @@ typedef struct sph_spring_params {
                            beyond the yield band; default 0 (purely elastic); >= 0. A rest
                            length that grows past kernel_radius drops its spring */
   float damping;        /* c of a = -c (v_i - v_j) . r^ along each spring, 1/s; default 0; >= 0.
-                           Shortens the step: dt <= 0.5 / (16 c) */
+                           Shortens the step: dt <= 2 / (16 c) */
   uint32_t reserved0;   /* must be 0 */
 } sph_spring_params;
 SPH_STATIC_ASSERT(sizeof(sph_spring_params) == 28, sph_spring_params_size);
