@@ -10,7 +10,10 @@
  *
  * --option turns one optional piece of physics on, to measure what it costs (BENCHMARK.md,
  * issue 5): none (default), surface_tension, normalized_density, clavet (viscosity), tait
- * (equation of state), rk4 (integrator), acoustic_limit (step limit). --particles largest
+ * (equation of state), rk4 (integrator), acoustic_limit (step limit), springs (elasticity with
+ * the default sph_spring_params, whose step ceiling, 1.25 ms, is above dt_max: the same
+ * substeps, so the cost is the spring work; the springs are made in the first warm-up
+ * substep). --particles largest
  * finds the largest world the device holds (world creation refused with OUT_OF_*_MEMORY
  * above it) and runs 95 % of that.
  *
@@ -151,6 +154,8 @@ static void describe_world(const options* o, uint32_t capacity, sph_world_def* d
     def->integrator = SPH_INTEGRATOR_RK4;
   } else if (strcmp(o->option, "acoustic_limit") == 0) {
     params->step_limits = SPH_STEP_LIMIT_ACOUSTIC;
+  } else if (strcmp(o->option, "springs") == 0) {
+    def->features |= SPH_FEATURE_SPRINGS;
   } else if (strcmp(o->option, "none") != 0) {
     fprintf(stderr, "rest_sphere: unknown --option '%s'\n", o->option);
     exit(2);
@@ -359,7 +364,8 @@ static void usage(void) {
   fprintf(stderr,
           "usage: rest_sphere [--particles N|largest] [--frames F] [--warmup W] [--backend cpu|cuda|auto]\n"
           "                   [--case rest|moving|both] [--option none|surface_tension|normalized_density|\n"
-          "                   clavet|tait|rk4|acoustic_limit] [--json FILE] [--csv FILE] [--label TEXT]\n");
+          "                   clavet|tait|rk4|acoustic_limit|springs] [--json FILE] [--csv FILE]\n"
+          "                   [--label TEXT]\n");
   exit(2);
 }
 

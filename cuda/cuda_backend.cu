@@ -16,6 +16,7 @@
 #include "device_particle_store.h"
 #include "device_scene.h"
 #include "device_sinks.h"
+#include "device_springs.h"
 #include "frame_control.h"
 #include "frame_graph.h"
 #include "frame_statistics.h"
@@ -44,9 +45,11 @@ bool same_setup(const PipelineSetup& a, const PipelineSetup& b) {
          a.tuning.density_block == b.tuning.density_block && a.tuning.force_block == b.tuning.force_block &&
          a.options.surface_tension == b.options.surface_tension &&
          a.options.normalized_density == b.options.normalized_density &&
-         a.options.viscosity == b.options.viscosity && a.scene.colliders == b.scene.colliders &&
-         a.scene.fields == b.scene.fields && a.scene.collider_count == b.scene.collider_count &&
-         a.scene.field_count == b.scene.field_count && a.scene.kernel_radius == b.scene.kernel_radius;
+         a.options.viscosity == b.options.viscosity && a.options.springs == b.options.springs &&
+         std::memcmp(&a.springs, &b.springs, sizeof a.springs) == 0 &&
+         a.scene.colliders == b.scene.colliders && a.scene.fields == b.scene.fields &&
+         a.scene.collider_count == b.scene.collider_count && a.scene.field_count == b.scene.field_count &&
+         a.scene.kernel_radius == b.scene.kernel_radius;
 }
 
 // Everything the backend holds on the device. Released with the backend's device current.
@@ -93,11 +96,13 @@ class CudaBackend final : public Backend {
     options_.surface_tension = (config.features & kFeatureSurfaceTension) != 0;
     options_.normalized_density = (config.features & kFeatureNormalizedDensity) != 0;
     options_.viscosity = config.viscosity_method;
+    options_.springs = (config.features & kFeatureSprings) != 0;
     StoreOptions store_options;
     store_options.rk4 = config.integrator == Integrator::Rk4;
     store_options.neighbor_counts = options_.viscosity == ViscosityMethod::Clavet;
     store_options.normalized_density = options_.normalized_density;
     store_options.colour_normals = options_.surface_tension;
+    store_options.springs = options_.springs;
     r->store = std::make_unique<DeviceParticleStore>(config.capacity, store_options);
     // The sorted positions are free while the sort runs: its temporary storage goes there.
     r->grid = std::make_unique<DeviceNeighborGrid>(
@@ -106,6 +111,7 @@ class CudaBackend final : public Backend {
     r->statistics = std::make_unique<FrameStatistics>(config.capacity);
     r->state.allocate(1, "frame state");
     cuda_check(cudaMemsetAsync(r->state.get(), 0, sizeof(FrameState), r->stream), "frame state reset");
+    r->store->enqueue_reset_link_state(r->stream);
     r->input.allocate(1, "frame input");
     r->state_output.allocate(1, "frame output");
     r->sink_kept.allocate(1, "sink survivor count");
@@ -154,6 +160,14 @@ class CudaBackend final : public Backend {
       cuda_check(
           cudaMemcpyAsync(a.density + count_, density.data(), sizeof(float) * n, cudaMemcpyHostToDevice, s),
           "copy of new densities");
+      if (options_.springs && n > 0) {
+        // New particles have no springs yet; they make them at their first substep.
+        const std::vector<SpringList> empty(n, empty_spring_list());
+        cuda_check(cudaMemcpyAsync(a.springs + count_, empty.data(), sizeof(SpringList) * n,
+                                   cudaMemcpyHostToDevice, s),
+                   "copy of new spring lists");
+        enqueue_springs_appended(a, first_id, s);
+      }
       enqueue_recompute_max_speed(a.velocity, count_ + n, r_->state.get(), s);
       cuda_check(cudaStreamSynchronize(s), "append");
     });
@@ -194,6 +208,7 @@ class CudaBackend final : public Backend {
     setup.max_substeps = params.max_substeps;
     setup.options = options_;
     setup.tuning = tuning_;
+    if (options_.springs) setup.springs = make_spring_constants(config_, params);
     float frame_ms = 0.0f;
     const bool with_sinks = !scene_in.sinks.empty();
     uint32_t count_after = count_;
@@ -329,6 +344,10 @@ class CudaBackend final : public Backend {
     const std::vector<FrameState> state = download(static_cast<const FrameState*>(r_->state.get()), 1u);
     s.max_speed = state[0].max_speed;
     s.max_acceleration = state[0].max_acceleration;
+    if (options_.springs) {
+      s.springs = download(static_cast<const SpringList*>(a.springs), count_);
+      s.link_from = download(static_cast<const uint32_t*>(a.link_from), 1u)[0];
+    }
     return s;
   }
 
@@ -337,6 +356,8 @@ class CudaBackend final : public Backend {
     const uint32_t n = static_cast<uint32_t>(s.id.size());
     if (n > config_.capacity || s.position.size() != n || s.velocity.size() != n || s.density.size() != n)
       throw Error(Status::Internal, "import_particles: inconsistent snapshot");
+    if (options_.springs ? s.springs.size() != n : !s.springs.empty())
+      throw Error(Status::Internal, "import_particles: spring lists do not match the particles");
     DeviceGuard guard(device_);
     ++epoch_;
     guarded([&] {
@@ -354,7 +375,14 @@ class CudaBackend final : public Backend {
         cuda_check(
             cudaMemcpyAsync(a.density, s.density.data(), sizeof(float) * n, cudaMemcpyHostToDevice, st),
             "copy of checkpoint densities");
+        if (options_.springs)
+          cuda_check(cudaMemcpyAsync(a.springs, s.springs.data(), sizeof(SpringList) * n,
+                                     cudaMemcpyHostToDevice, st),
+                     "copy of checkpoint spring lists");
       }
+      if (options_.springs)
+        cuda_check(cudaMemcpyAsync(a.link_from, &s.link_from, sizeof(uint32_t), cudaMemcpyHostToDevice, st),
+                   "copy of the checkpoint's spring link state");
       FrameState* state = r_->state.get();
       cuda_check(cudaMemcpyAsync(&state->max_speed, &s.max_speed, sizeof(float), cudaMemcpyHostToDevice, st),
                  "copy of the checkpoint's max speed");

@@ -19,6 +19,16 @@ DeviceParticleStore::DeviceParticleStore(uint32_t capacity, const StoreOptions& 
   if (options.neighbor_counts) neighbor_count_.allocate(n, "neighbour counts");
   if (options.normalized_density) normalized_density_.allocate(n, "normalised densities");
   if (options.colour_normals) colour_normal_.allocate(n, "colour-field normals");
+  if (options.springs) {
+    springs_.allocate(n, "spring lists");
+    sorted_springs_.allocate(n, "sorted spring lists");
+    snapshot_springs_.allocate(n, "snapshot spring lists");
+    spring_inverse_.allocate(n, "spring index map");
+    spring_candidates_.allocate(n * kSpringSlots, "spring link candidates");
+    spring_acceleration_.allocate(n, "spring accelerations");
+    link_from_.allocate(1, "first id waiting for springs");
+    snapshot_link_from_.allocate(1, "snapshot first id waiting for springs");
+  }
   if (options.rk4) {
     for (int side = 0; side < 2; ++side) {
       rk4_start_[side].allocate(n, "RK4 start states");
@@ -35,6 +45,12 @@ DeviceParticleStore::DeviceParticleStore(uint32_t capacity, const StoreOptions& 
   arrays_.neighbor_count = neighbor_count_.get();
   arrays_.normalized_density = normalized_density_.get();
   arrays_.colour_normal = colour_normal_.get();
+  arrays_.springs = springs_.get();
+  arrays_.sorted_springs = sorted_springs_.get();
+  arrays_.spring_inverse = spring_inverse_.get();
+  arrays_.spring_candidates = spring_candidates_.get();
+  arrays_.spring_acceleration = spring_acceleration_.get();
+  arrays_.link_from = link_from_.get();
   for (int side = 0; side < 2; ++side) {
     arrays_.rk4_start[side] = rk4_start_[side].get();
     arrays_.rk4_sum[side] = rk4_sum_[side].get();
@@ -63,6 +79,10 @@ void DeviceParticleStore::enqueue_snapshot(uint32_t n, cudaStream_t stream) cons
   copy_async(snapshot_velocity_.get(), velocity_.get(), n, stream, "snapshot of velocities");
   copy_async(snapshot_id_.get(), id_.get(), n, stream, "snapshot of ids");
   copy_async(snapshot_density_.get(), density_.get(), n, stream, "snapshot of densities");
+  if (springs_.get()) {
+    copy_async(snapshot_springs_.get(), springs_.get(), n, stream, "snapshot of spring lists");
+    copy_async(snapshot_link_from_.get(), link_from_.get(), 1, stream, "snapshot of the spring link state");
+  }
 }
 
 void DeviceParticleStore::enqueue_restore(uint32_t n, cudaStream_t stream) const {
@@ -70,6 +90,18 @@ void DeviceParticleStore::enqueue_restore(uint32_t n, cudaStream_t stream) const
   copy_async(velocity_.get(), snapshot_velocity_.get(), n, stream, "restore of velocities");
   copy_async(id_.get(), snapshot_id_.get(), n, stream, "restore of ids");
   copy_async(density_.get(), snapshot_density_.get(), n, stream, "restore of densities");
+  if (springs_.get()) {
+    copy_async(springs_.get(), snapshot_springs_.get(), n, stream, "restore of spring lists");
+    copy_async(link_from_.get(), snapshot_link_from_.get(), 1, stream, "restore of the spring link state");
+  }
+}
+
+void DeviceParticleStore::enqueue_reset_link_state(cudaStream_t stream) const {
+  if (!link_from_.get()) return;
+  // No particle waits yet; the snapshot word too, so a rollback before any frame keeps it.
+  cuda_check(cudaMemsetAsync(link_from_.get(), 0xff, sizeof(uint32_t), stream), "spring link state reset");
+  cuda_check(cudaMemsetAsync(snapshot_link_from_.get(), 0xff, sizeof(uint32_t), stream),
+             "spring link state reset");
 }
 
 uint64_t DeviceParticleStore::bytes() const {
@@ -79,6 +111,9 @@ uint64_t DeviceParticleStore::bytes() const {
                    snapshot_density_.bytes();
   for (int side = 0; side < 2; ++side) total += rk4_start_[side].bytes() + rk4_sum_[side].bytes();
   total += neighbor_count_.bytes() + normalized_density_.bytes() + colour_normal_.bytes();
+  total += springs_.bytes() + sorted_springs_.bytes() + snapshot_springs_.bytes() + spring_inverse_.bytes() +
+           spring_candidates_.bytes() + spring_acceleration_.bytes() + link_from_.bytes() +
+           snapshot_link_from_.bytes();
   return total;
 }
 

@@ -11,6 +11,10 @@
 //                                 per-substep side arrays of the physics options (Clavet
 //                                 viscosity, normalised density, surface tension), allocated
 //                                 only for a world that uses the option
+//   springs, sorted_springs, ...  SPH_FEATURE_SPRINGS only (device_springs.h): the spring lists
+//                                 in state order, their reordered working copy, the inverse
+//                                 permutation, link candidates, spring accelerations, the
+//                                 lowest id waiting for springs (one word), and snapshots
 // Float4 records carry a second quantity in w: position.w = pressure, velocity.w = 1/density.
 #pragma once
 
@@ -20,6 +24,7 @@
 
 #include "../src/physics/float4_types.h"
 #include "../src/physics/integrate.h"
+#include "../src/physics/springs.h"
 #include "device_array.h"
 
 namespace sph {
@@ -38,6 +43,13 @@ struct ParticleArrays {
   uint32_t* neighbor_count;   // null unless Clavet viscosity: the density pass's counts
   float* normalized_density;  // null unless normalised density: eq. 31 before it is published
   Float4* colour_normal;      // null unless surface tension: (n, |n|) of the colour field
+  // Null unless SPH_FEATURE_SPRINGS.
+  SpringList* springs;          // the lists in state order (partners: state indices)
+  SpringList* sorted_springs;   // the lists in the order of the last sort (working copy)
+  uint32_t* spring_inverse;     // new index of each old index, for the partner rewrite
+  uint32_t* spring_candidates;  // kSpringSlots per particle: linking pass 1
+  Float4* spring_acceleration;  // the spring pass's acceleration, which the force pass adds
+  uint32_t* link_from;          // one word: the lowest id waiting for springs, or kNoPendingLinks
 };
 
 // Which optional arrays a world needs.
@@ -46,6 +58,7 @@ struct StoreOptions {
   bool neighbor_counts = false;
   bool normalized_density = false;
   bool colour_normals = false;
+  bool springs = false;
 };
 
 // The radix sort's buffers inside sorted_velocity: four uint32 arrays of `capacity` each.
@@ -65,6 +78,8 @@ class DeviceParticleStore {
   // Copies the state of particles [0, n) into the snapshot, and back.
   void enqueue_snapshot(uint32_t n, cudaStream_t stream) const;
   void enqueue_restore(uint32_t n, cudaStream_t stream) const;
+  // Springs only: marks that no particle waits for springs (a new world).
+  void enqueue_reset_link_state(cudaStream_t stream) const;
 
   uint64_t bytes() const;
 
@@ -81,6 +96,9 @@ class DeviceParticleStore {
   DeviceArray<uint32_t> neighbor_count_;
   DeviceArray<float> normalized_density_;
   DeviceArray<Float4> colour_normal_;
+  DeviceArray<SpringList> springs_, sorted_springs_, snapshot_springs_;
+  DeviceArray<uint32_t> spring_inverse_, spring_candidates_, link_from_, snapshot_link_from_;
+  DeviceArray<Float4> spring_acceleration_;
   ParticleArrays arrays_{};
 };
 

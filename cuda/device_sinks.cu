@@ -1,6 +1,7 @@
 #include <cub/device/device_scan.cuh>
 
 #include "device_sinks.h"
+#include "device_springs.h"
 #include "kernel_launch.h"
 
 namespace sph {
@@ -100,6 +101,7 @@ void DeviceSinkCompactor::enqueue_compact(const ParticleArrays& a, uint32_t n, u
   copy_back(a.id, a.sorted_id, kept, stream, "compaction of ids");
   copy_back(a.density, density_out_.get(), kept, stream, "compaction of densities");
   if (counts) copy_back(counts, counts_out_.get(), kept, stream, "compaction of neighbour counts");
+  if (a.springs) enqueue_spring_compact(a, n, kept, keep_.get(), scan_.get(), stream);  // SPH_FEATURE_SPRINGS
 }
 
 }  // namespace sph

@@ -167,6 +167,7 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
     const Float4 p = a.sorted_position[i];
     const Float4 v = a.sorted_velocity[i];
     if (kScene) acc = add_force_fields(scene, acc, xyz(p));
+    if (a.spring_acceleration) acc += xyz(a.spring_acceleration[i]);  // springs (device_springs.h)
     a2 = length_squared(acc);
     ParticleState next = symplectic_euler(ParticleState{xyz(p), xyz(v)}, acc, f.dt);
     const ParticleState integrated = next;
@@ -203,6 +204,7 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
     const Float4 p = a.sorted_position[i];
     const Float4 v = a.sorted_velocity[i];
     if (kScene) acc = add_force_fields(scene, acc, xyz(p));
+    if (a.spring_acceleration) acc += xyz(a.spring_acceleration[i]);  // springs (device_springs.h)
     a2 = length_squared(acc);
     Rk4Accumulator sum;
     if (stage > 0) sum = sums[i];  // stage 0 starts the sums

@@ -49,6 +49,7 @@ struct SubstepOptions {
   bool surface_tension = false;
   bool normalized_density = false;
   ViscosityMethod viscosity = ViscosityMethod::Mueller;
+  bool springs = false;  // a.spring_acceleration adds to the force pass
 };
 
 // density[i], sorted_position[i].w = pressure, sorted_velocity[i] = (velocity[order[i]], 1/rho);

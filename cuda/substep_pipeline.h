@@ -13,6 +13,7 @@
 #include "../src/core/config.h"
 #include "device_neighbor_grid.h"
 #include "device_particle_store.h"
+#include "device_springs.h"
 #include "frame_control.h"
 #include "frame_statistics.h"
 #include "substep_kernels.h"
@@ -27,7 +28,8 @@ struct PipelineSetup {
   uint32_t max_substeps = 1;
   SubstepOptions options{};
   KernelTuning tuning{};
-  DeviceScene scene{};  // colliders and force fields inside the substep (none: all zero)
+  DeviceScene scene{};        // colliders and force fields inside the substep (none: all zero)
+  SpringConstants springs{};  // used when options.springs
 };
 
 struct PipelineBuffers {

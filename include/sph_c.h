@@ -151,6 +151,11 @@ typedef uint32_t sph_feature_flags;
  *  the density deficit of particles near a free surface (it narrows it; it does not remove it:
  *  about 48 % -> 34 % on the outermost layer of a resting sphere). */
 #define SPH_FEATURE_NORMALIZED_DENSITY 0x2u
+/** Elasticity and plasticity (thesis 4.4.2.1; Clavet, Beaudoin & Poulin 2005): springs between
+ *  neighbouring particles, made once per particle at its first substep (so the rest shape is
+ *  the spawn shape), with rest lengths that yield and creep; sph_spring_params. Costs 128 bytes
+ *  per particle (host) or 256 (device) and a spring pass per force evaluation. */
+#define SPH_FEATURE_SPRINGS 0x4u
 
 typedef enum sph_viscosity_method {
   SPH_VISCOSITY_MUELLER = 0, /* Laplacian viscosity (eq. 17), coefficient sph_world_params.viscosity */
@@ -351,6 +356,36 @@ static inline sph_result sph_tait_params_init(sph_tait_params* params) {
 /** FEATURE_DISABLED unless the world's equation_of_state is SPH_EOS_TAIT. */
 SPH_API sph_result SPH_CALL sph_world_set_tait_params(sph_world* world, const sph_tait_params* params);
 SPH_API sph_result SPH_CALL sph_world_get_tait_params(const sph_world* world, sph_tait_params* out);
+
+typedef struct sph_spring_params {
+  uint32_t struct_size; /* set by sph_spring_params_init */
+  float stiffness;      /* k of a = -k (1 - L/h)(r - L), 1/s^2 (acceleration per metre of
+                           stretch); default 1e4; >= 0. Young's modulus of an FCC block is about
+                           (2/3) rho0 s^2 k (1 - s/h) (s: particle spacing). Stiffer springs
+                           shorten the step: dt <= 0.5 / sqrt(16 k) */
+  float link_radius;    /* springs are made to neighbours closer than this, m; 0 (default) =
+                           1.2 x particle_spacing (the lattice's 12 nearest neighbours);
+                           <= kernel_radius. Applies to particles linked after the change */
+  float yield_ratio;    /* gamma: a spring deforms plastically beyond r = L (1 +- gamma);
+                           default 0.1; [0, 1] */
+  float plasticity;     /* alpha, 1/s: how fast rest lengths creep toward the deformed length
+                           beyond the yield band; default 0 (purely elastic); >= 0. A rest
+                           length that grows past kernel_radius drops its spring */
+  float damping;        /* c of a = -c (v_i - v_j) . r^ along each spring, 1/s; default 0; >= 0.
+                           Shortens the step: dt <= 2 / (16 c) */
+  uint32_t reserved0;   /* must be 0 */
+} sph_spring_params;
+SPH_STATIC_ASSERT(sizeof(sph_spring_params) == 28, sph_spring_params_size);
+
+SPH_API sph_result SPH_CALL sph_spring_params_init_sized(sph_spring_params* params, uint32_t size);
+static inline sph_result sph_spring_params_init(sph_spring_params* params) {
+  return sph_spring_params_init_sized(params, (uint32_t)sizeof(*params));
+}
+/** FEATURE_DISABLED unless the world has SPH_FEATURE_SPRINGS. INVALID_ARGUMENT for a value out
+ *  of range (the message names it); nothing changes on error. Springs already made keep their
+ *  rest lengths; the new stiffness, damping and plasticity act from the next substep. */
+SPH_API sph_result SPH_CALL sph_world_set_spring_params(sph_world* world, const sph_spring_params* params);
+SPH_API sph_result SPH_CALL sph_world_get_spring_params(const sph_world* world, sph_spring_params* out);
 
 /* ---- particles in -------------------------------------------------------------------------- */
 typedef struct sph_spawn_desc {

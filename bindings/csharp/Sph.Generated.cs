@@ -33,6 +33,13 @@ namespace Sph
         /// </summary>
         public const uint SPH_FEATURE_NORMALIZED_DENSITY = 2u;
         /// <summary>
+        /// Elasticity and plasticity (thesis 4.4.2.1; Clavet, Beaudoin &amp; Poulin 2005): springs
+        /// between neighbouring particles, made once per particle at its first substep (so the rest
+        /// shape is the spawn shape), with rest lengths that yield and creep; sph_spring_params. Costs
+        /// 128 bytes per particle (host) or 256 (device) and a spring pass per force evaluation.
+        /// </summary>
+        public const uint SPH_FEATURE_SPRINGS = 4u;
+        /// <summary>
         /// Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt &lt;= step_factor h /
         /// c, c the EOS's speed of sound
         /// </summary>
@@ -639,6 +646,53 @@ namespace Sph
             var value = new TaitParams();
             uint size = (uint)Marshal.SizeOf(typeof(TaitParams));
             SphException.Check(Native.sph_tait_params_init_sized(ref value, size), "sph_tait_params_init_sized");
+            return value;
+        }
+    }
+
+    /// <summary>sph_spring_params (28 bytes)</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public partial struct SpringParams
+    {
+        /// <summary>uint32_t struct_size: set by sph_spring_params_init</summary>
+        public uint StructSize;
+        /// <summary>
+        /// float stiffness: k of a = -k (1 - L/h)(r - L), 1/s^2 (acceleration per metre of stretch);
+        /// default 1e4; &gt;= 0. Young's modulus of an FCC block is about (2/3) rho0 s^2 k (1 - s/h)
+        /// (s: particle spacing). Stiffer springs shorten the step: dt &lt;= 0.5 / sqrt(16 k)
+        /// </summary>
+        public float Stiffness;
+        /// <summary>
+        /// float link_radius: springs are made to neighbours closer than this, m; 0 (default) = 1.2 x
+        /// particle_spacing (the lattice's 12 nearest neighbours); &lt;= kernel_radius. Applies to
+        /// particles linked after the change
+        /// </summary>
+        public float LinkRadius;
+        /// <summary>
+        /// float yield_ratio: gamma: a spring deforms plastically beyond r = L (1 +- gamma); default
+        /// 0.1; [0, 1]
+        /// </summary>
+        public float YieldRatio;
+        /// <summary>
+        /// float plasticity: alpha, 1/s: how fast rest lengths creep toward the deformed length beyond
+        /// the yield band; default 0 (purely elastic); &gt;= 0. A rest length that grows past
+        /// kernel_radius drops its spring
+        /// </summary>
+        public float Plasticity;
+        /// <summary>
+        /// float damping: c of a = -c (v_i - v_j) . r^ along each spring, 1/s; default 0; &gt;= 0.
+        /// Shortens the step: dt &lt;= 2 / (16 c)
+        /// </summary>
+        public float Damping;
+        /// <summary>uint32_t reserved0: must be 0</summary>
+        public uint Reserved0;
+
+        /// <summary>A SpringParams with the library's defaults (sph_spring_params_init_sized).</summary>
+        public static SpringParams Default()
+        {
+            var value = new SpringParams();
+            uint size = (uint)Marshal.SizeOf(typeof(SpringParams));
+            SphException.Check(Native.sph_spring_params_init_sized(ref value, size), "sph_spring_params_init_sized");
             return value;
         }
     }
@@ -1422,6 +1476,28 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_tait_params")]
         public static extern Result sph_world_get_tait_params(IntPtr world, IntPtr @out);
 
+        /// <summary>sph_spring_params_init_sized</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_spring_params_init_sized(ref SpringParams @params, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_spring_params_init_sized")]
+        public static extern Result sph_spring_params_init_sized(IntPtr @params, uint size);
+
+        /// <summary>
+        /// FEATURE_DISABLED unless the world has SPH_FEATURE_SPRINGS. INVALID_ARGUMENT for a value out
+        /// of range (the message names it); nothing changes on error. Springs already made keep their
+        /// rest lengths; the new stiffness, damping and plasticity act from the next substep.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_set_spring_params(WorldHandle world, ref SpringParams @params);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_set_spring_params")]
+        public static extern Result sph_world_set_spring_params(IntPtr world, IntPtr @params);
+
+        /// <summary>sph_world_get_spring_params</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_get_spring_params(WorldHandle world, ref SpringParams @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_spring_params")]
+        public static extern Result sph_world_get_spring_params(IntPtr world, IntPtr @out);
+
         /// <summary>sph_spawn_desc_init_sized</summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_spawn_desc_init_sized(ref SpawnDesc desc, uint size);
@@ -1886,6 +1962,7 @@ namespace Sph
             typeof(SurfaceTensionParams),
             typeof(ClavetViscosityParams),
             typeof(TaitParams),
+            typeof(SpringParams),
             typeof(SpawnDesc),
             typeof(FillBoxDesc),
             typeof(FillSphereDesc),
@@ -1914,6 +1991,7 @@ namespace Sph
             "sph_surface_tension_params",
             "sph_clavet_viscosity_params",
             "sph_tait_params",
+            "sph_spring_params",
             "sph_spawn_desc",
             "sph_fill_box_desc",
             "sph_fill_sphere_desc",
@@ -1942,6 +2020,7 @@ namespace Sph
             16,
             16,
             8,
+            28,
             40,
             44,
             36,
@@ -2006,6 +2085,13 @@ namespace Sph
             typeof(ClavetViscosityParams),
             typeof(TaitParams),
             typeof(TaitParams),
+            typeof(SpringParams),
+            typeof(SpringParams),
+            typeof(SpringParams),
+            typeof(SpringParams),
+            typeof(SpringParams),
+            typeof(SpringParams),
+            typeof(SpringParams),
             typeof(SpawnDesc),
             typeof(SpawnDesc),
             typeof(SpawnDesc),
@@ -2161,6 +2247,13 @@ namespace Sph
             "Reserved0",
             "StructSize",
             "SpeedOfSound",
+            "StructSize",
+            "Stiffness",
+            "LinkRadius",
+            "YieldRatio",
+            "Plasticity",
+            "Damping",
+            "Reserved0",
             "StructSize",
             "Count",
             "Positions",
@@ -2319,6 +2412,13 @@ namespace Sph
             0,
             4,
             8,
+            12,
+            16,
+            20,
+            24,
+            0,
+            4,
+            8,
             16,
             24,
             32,
@@ -2459,6 +2559,9 @@ namespace Sph
             "sph_tait_params_init_sized",
             "sph_world_set_tait_params",
             "sph_world_get_tait_params",
+            "sph_spring_params_init_sized",
+            "sph_world_set_spring_params",
+            "sph_world_get_spring_params",
             "sph_spawn_desc_init_sized",
             "sph_world_spawn",
             "sph_fill_box_desc_init_sized",
@@ -2517,6 +2620,9 @@ namespace Sph
         };
         /// <summary>The shared library of each function ("sph", or an optional helper).</summary>
         public static readonly string[] FunctionLibraries = {
+            "sph",
+            "sph",
+            "sph",
             "sph",
             "sph",
             "sph",

@@ -185,6 +185,9 @@ namespace Sph
         /// <summary>Normalised density (thesis eq. 31): a second, Shepard-filtered density pass
         /// that narrows the density deficit of particles near a free surface.</summary>
         NormalizedDensity = Constants.SPH_FEATURE_NORMALIZED_DENSITY,
+        /// <summary>Elasticity and plasticity: springs between neighbours made at each particle's
+        /// first substep (Clavet et al. 2005), parameters in <see cref="World.SpringParams"/>.</summary>
+        Springs = Constants.SPH_FEATURE_SPRINGS,
     }
 
     /// <summary>Step-size limits beyond eq. 32 (SPH_STEP_LIMIT_*): set them with
@@ -517,6 +520,21 @@ namespace Sph
                 return p;
             }
             set { SphException.Check(Native.sph_world_set_tait_params(Handle, ref value), "sph_world_set_tait_params"); }
+        }
+
+        /// <summary>Spring parameters (stiffness k in 1/s^2, link radius in m, yield ratio gamma,
+        /// plasticity alpha in 1/s, damping c in 1/s) of a world created with
+        /// <see cref="FeatureFlags.Springs"/>; setting replaces them whole. Throws SphException
+        /// (<c>Result.ErrorFeatureDisabled</c>) on a world without the feature.</summary>
+        public SpringParams SpringParams
+        {
+            get
+            {
+                var p = SpringParams.Default();
+                SphException.Check(Native.sph_world_get_spring_params(Handle, ref p), "sph_world_get_spring_params");
+                return p;
+            }
+            set { SphException.Check(Native.sph_world_set_spring_params(Handle, ref value), "sph_world_set_spring_params"); }
         }
 
         // ---- particles in ---------------------------------------------------------------------

@@ -24,6 +24,7 @@ bool has_surface_tension(const sph_world* w) {
 bool has_clavet(const sph_world* w) {
   return w->world->config().viscosity_method == sph::ViscosityMethod::Clavet;
 }
+bool has_springs(const sph_world* w) { return (w->world->config().features & sph::kFeatureSprings) != 0; }
 bool has_tait(const sph_world* w) {
   return w->world->config().equation_of_state == sph::EquationOfState::Tait;
 }
@@ -153,6 +154,65 @@ SPH_API sph_result SPH_CALL sph_world_get_tait_params(const sph_world* world, sp
     std::memset(&p, 0, sizeof p);
     p.struct_size = sizeof p;
     p.speed_of_sound = world->world->params().tait_sound_speed;
+    sph::write_output_struct(out, p, "out");
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_spring_params_init_sized(sph_spring_params* params, uint32_t size) {
+  return sph::init_user_struct("sph_spring_params_init", "params", params, size, [](sph_spring_params& d) {
+    const sph::RuntimeParams defaults;
+    d.stiffness = defaults.spring_stiffness;
+    d.link_radius = defaults.spring_link_radius;
+    d.yield_ratio = defaults.spring_yield_ratio;
+    d.plasticity = defaults.spring_plasticity;
+    d.damping = defaults.spring_damping;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_world_set_spring_params(sph_world* world, const sph_spring_params* params) {
+  return sph::guarded("sph_world_set_spring_params", sph::context_of(world), [&] {
+    sph::require_world(world);
+    sph::WorldLock lock(world);
+    require_feature(has_springs(world), "SPH_FEATURE_SPRINGS");
+    const sph_spring_params p = sph::read_user_struct(params, "params");
+    sph::require_non_negative(p.stiffness, "params->stiffness");
+    sph::require_non_negative(p.link_radius, "params->link_radius");
+    const float h = world->world->config().kernel_radius;
+    if (p.link_radius > h)
+      throw Error(Status::InvalidArgument, "params->link_radius: " + sph::describe(p.link_radius) +
+                                               " m is above the kernel radius " + sph::describe(h) + " m");
+    sph::require_non_negative(p.yield_ratio, "params->yield_ratio");
+    if (p.yield_ratio > 1.0f)
+      throw Error(Status::InvalidArgument,
+                  "params->yield_ratio: must be in [0, 1], got " + sph::describe(p.yield_ratio));
+    sph::require_non_negative(p.plasticity, "params->plasticity");
+    sph::require_non_negative(p.damping, "params->damping");
+    sph::require_zero(p.reserved0, "params->reserved0");
+    update_params(world, [&](sph::RuntimeParams& r) {
+      r.spring_stiffness = p.stiffness;
+      r.spring_link_radius = p.link_radius;
+      r.spring_yield_ratio = p.yield_ratio;
+      r.spring_plasticity = p.plasticity;
+      r.spring_damping = p.damping;
+    });
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_world_get_spring_params(const sph_world* world, sph_spring_params* out) {
+  return sph::guarded("sph_world_get_spring_params", sph::context_of(world), [&] {
+    sph::require_world(world);
+    require_feature(has_springs(world), "SPH_FEATURE_SPRINGS");
+    const sph::RuntimeParams& r = world->world->params();
+    sph_spring_params p;
+    std::memset(&p, 0, sizeof p);
+    p.struct_size = sizeof p;
+    p.stiffness = r.spring_stiffness;
+    p.link_radius = r.spring_link_radius;
+    p.yield_ratio = r.spring_yield_ratio;
+    p.plasticity = r.spring_plasticity;
+    p.damping = r.spring_damping;
     sph::write_output_struct(out, p, "out");
     return SPH_OK;
   });

@@ -40,6 +40,10 @@ struct ParticleSnapshot {
   std::vector<float> density;
   float max_speed = 0.0f;         // |v|max the next frame's first step is chosen from
   float max_acceleration = 0.0f;  // |a|max of the last force evaluation (the force step limit)
+  // SPH_FEATURE_SPRINGS only (empty otherwise): each particle's springs, partners as storage
+  // indices, and the lowest id still waiting for its springs (kNoPendingLinks: none).
+  std::vector<SpringList> springs;
+  uint32_t link_from = kNoPendingLinks;
 };
 
 class Backend {

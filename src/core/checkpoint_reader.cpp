@@ -162,6 +162,66 @@ RuntimeParams read_params(ByteReader& r) {
   return p;
 }
 
+// SPH_FEATURE_SPRINGS worlds only (checkpoint_writer.cpp), with the C layer's ranges.
+void read_spring_params(ByteReader& r, const WorldConfig& config, RuntimeParams& p) {
+  p.spring_stiffness = non_negative(r, "spring stiffness");
+  p.spring_link_radius = non_negative(r, "spring link radius");
+  if (p.spring_link_radius > config.kernel_radius) corrupt(r.what() + ": spring link radius is above h");
+  p.spring_yield_ratio = non_negative(r, "spring yield ratio");
+  if (p.spring_yield_ratio > 1.0f) corrupt(r.what() + ": spring yield ratio is above 1");
+  p.spring_plasticity = non_negative(r, "spring plasticity");
+  p.spring_damping = non_negative(r, "spring damping");
+}
+
+// The spring lists: every partner an index of another particle, every rest length in
+// [0, h], and every spring stored at both ends with the same rest length (bit for bit), as
+// the solver keeps them.
+void read_springs(ByteReader& r, const WorldConfig& config, uint32_t next_id, ParticleSnapshot& s) {
+  const uint32_t n = static_cast<uint32_t>(s.id.size());
+  s.link_from = r.u32();
+  if (s.link_from != kNoPendingLinks && s.link_from > next_id)
+    corrupt(r.what() + ": the first id waiting for springs, " + std::to_string(s.link_from) +
+            ", was never issued");
+  if (r.u32() != kSpringSlots)
+    corrupt(r.what() + ": spring lists do not have " + std::to_string(kSpringSlots) + " slots");
+  r.need_elements(n, kSpringSlots * 8, "spring lists");
+  s.springs.resize(n);
+  for (uint32_t i = 0; i < n; ++i) {
+    SpringList& list = s.springs[i];
+    for (uint32_t k = 0; k < kSpringSlots; ++k) {
+      list.partner[k] = r.u32();
+      list.rest[k] = bulk_finite(r, "spring rest length of particle", i);
+      const uint32_t j = list.partner[k];
+      if (j == kNoSpring) {
+        if (list.rest[k] != 0.0f)
+          corrupt(r.what() + ": an empty spring slot of particle " + std::to_string(i) +
+                  " has a rest length");
+        continue;
+      }
+      if (j >= n || j == i)
+        corrupt(r.what() + ": particle " + std::to_string(i) + " has a spring to " + std::to_string(j) +
+                ", which is not another particle");
+      if (list.rest[k] < 0.0f || list.rest[k] > config.kernel_radius)
+        corrupt(r.what() + ": a spring rest length of particle " + std::to_string(i) + " is outside [0, h]");
+    }
+  }
+  for (uint32_t i = 0; i < n; ++i)
+    for (uint32_t k = 0; k < kSpringSlots; ++k) {
+      const uint32_t j = s.springs[i].partner[k];
+      if (j == kNoSpring) continue;
+      uint32_t matches = 0;
+      for (uint32_t m = 0; m < kSpringSlots; ++m)
+        if (s.springs[j].partner[m] == i &&
+            std::memcmp(&s.springs[j].rest[m], &s.springs[i].rest[k], sizeof(float)) == 0)
+          ++matches;
+      uint32_t copies = 0;
+      for (uint32_t m = 0; m < kSpringSlots; ++m) copies += s.springs[i].partner[m] == j ? 1u : 0u;
+      if (matches != 1 || copies != 1)
+        corrupt(r.what() + ": the spring between particles " + std::to_string(i) + " and " +
+                std::to_string(j) + " is not stored once at each end with one rest length");
+    }
+}
+
 struct Clock {
   uint32_t next_id = 0;
   double simulated_time = 0.0;
@@ -486,7 +546,8 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   const WorldConfig config = read_config(conf);
   conf.expect_end();
   ByteReader parm = next_section(1);
-  const RuntimeParams params = read_params(parm);
+  RuntimeParams params = read_params(parm);
+  if (config.features & kFeatureSprings) read_spring_params(parm, config, params);
   parm.expect_end();
   // A dt_min above the stability ceiling is accepted, as sph_world_set_params accepts it (the
   // caller's fixed step wins over the ceiling; a step that then fails says so and rolls back).
@@ -494,7 +555,8 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   const Clock clock = read_clock(time);
   time.expect_end();
   ByteReader part = next_section(3);
-  const ParticleSnapshot particles = read_particles(part, config, clock.next_id);
+  ParticleSnapshot particles = read_particles(part, config, clock.next_id);
+  if (config.features & kFeatureSprings) read_springs(part, config, clock.next_id, particles);
   part.expect_end();
 
   ByteReader sdfa = next_section(4);

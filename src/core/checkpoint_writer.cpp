@@ -83,6 +83,32 @@ void write_params(ByteWriter& w, const RuntimeParams& p) {
   w.f32(p.tait_sound_speed);
 }
 
+// SPH_FEATURE_SPRINGS worlds only: their parameters after the others, and after the particles
+// the lowest id still waiting for springs and each particle's spring slots (partner storage
+// index or 0xffffffff, rest length). A world without springs writes the format as before.
+void write_spring_params(ByteWriter& w, const RuntimeParams& p) {
+  w.f32(p.spring_stiffness);
+  w.f32(p.spring_link_radius);
+  w.f32(p.spring_yield_ratio);
+  w.f32(p.spring_plasticity);
+  w.f32(p.spring_damping);
+}
+
+void write_springs(ByteWriter& w, const ParticleSnapshot& s) {
+  w.u32(s.link_from);
+  w.u32(kSpringSlots);
+  for (const SpringList& list : s.springs)
+    for (uint32_t k = 0; k < kSpringSlots; ++k) {
+      w.u32(list.partner[k]);
+      w.f32(list.rest[k]);
+    }
+}
+
+void write_params_section(ByteWriter& w, const World& world) {
+  write_params(w, world.params());
+  if (world.config().features & kFeatureSprings) write_spring_params(w, world.params());
+}
+
 void write_clock(ByteWriter& w, const World& world) {
   const FrameReport& r = world.last_report();
   w.u32(world.next_id());
@@ -159,6 +185,11 @@ void write_slots(ByteWriter& w, const SlotMap<T>& map, Body&& body) {
   for (uint32_t slot : map.free_slots()) w.u32(slot);
 }
 
+void write_particle_section(ByteWriter& w, const World& world, const ParticleSnapshot& particles) {
+  write_particles(w, particles);
+  if (world.config().features & kFeatureSprings) write_springs(w, particles);
+}
+
 }  // namespace
 
 std::vector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin& origin) {
@@ -174,7 +205,7 @@ std::vector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin
   const ParticleSnapshot particles = world.backend().export_particles();
 
   ByteWriter w;
-  w.bytes(kMagic, sizeof kMagic);
+  for (uint8_t b : kMagic) w.u8(b);  // (not bytes(): GCC 12 flags its insert into an empty vector here)
   w.u32(kFormatVersion);
   w.u32(0);  // flags
   w.u32(origin.backend);
@@ -185,9 +216,9 @@ std::vector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin
   w.u32(0);
 
   section(w, kSectionOrder[0].tag, [&] { write_config(w, world.config()); });
-  section(w, kSectionOrder[1].tag, [&] { write_params(w, world.params()); });
+  section(w, kSectionOrder[1].tag, [&] { write_params_section(w, world); });
   section(w, kSectionOrder[2].tag, [&] { write_clock(w, world); });
-  section(w, kSectionOrder[3].tag, [&] { write_particles(w, particles); });
+  section(w, kSectionOrder[3].tag, [&] { write_particle_section(w, world, particles); });
   section(w, kSectionOrder[4].tag, [&] {
     w.u32(static_cast<uint32_t>(assets.assets().size()));
     for (const SdfAsset* a : assets.assets()) write_asset(w, *a);

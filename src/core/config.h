@@ -6,6 +6,7 @@
 #include "../physics/equation_of_state.h"
 #include "../physics/fluid_constants.h"
 #include "../physics/forces.h"
+#include "../physics/springs.h"
 #include "../physics/step_control.h"
 #include "../physics/vec3.h"
 
@@ -17,7 +18,8 @@ enum class Integrator : uint32_t { SymplecticEuler = 0, Rk4 = 1 };
 enum FeatureBits : uint32_t {
   kFeatureSurfaceTension = 1u << 0,
   kFeatureNormalizedDensity = 1u << 1,
-  kFeatureAll = kFeatureSurfaceTension | kFeatureNormalizedDensity,
+  kFeatureSprings = 1u << 2,
+  kFeatureAll = kFeatureSurfaceTension | kFeatureNormalizedDensity | kFeatureSprings,
 };
 
 // Step-size limits beyond eq. 32, equal to the SPH_STEP_LIMIT_* values.
@@ -53,7 +55,33 @@ struct RuntimeParams {
   float clavet_linear = 10.0f;      // 1/s
   float clavet_quadratic = 0.0f;    // 1/m
   float tait_sound_speed = 10.0f;   // m/s
+  // Springs (elasticity and plasticity, SPH_FEATURE_SPRINGS).
+  float spring_stiffness = 1e4f;    // k, 1/s^2
+  float spring_link_radius = 0.0f;  // m; 0 = 1.2 x particle spacing, at most h
+  float spring_yield_ratio = 0.1f;  // gamma
+  float spring_plasticity = 0.0f;   // alpha, 1/s; 0 = elastic
+  float spring_damping = 0.0f;      // c, 1/s
 };
+
+// The link radius a world uses: the parameter, or 1.2 particle spacings (the FCC lattice's
+// nearest neighbours only), never more than h.
+inline float spring_link_radius(const WorldConfig& c, const RuntimeParams& p) {
+  const float r = p.spring_link_radius > 0.0f ? p.spring_link_radius : 1.2f * c.particle_spacing;
+  return r < c.kernel_radius ? r : c.kernel_radius;
+}
+
+inline SpringConstants make_spring_constants(const WorldConfig& c, const RuntimeParams& p) {
+  SpringConstants s;
+  s.stiffness = p.spring_stiffness;
+  s.damping = p.spring_damping;
+  s.yield_ratio = p.spring_yield_ratio;
+  s.plasticity = p.spring_plasticity;
+  const float link = spring_link_radius(c, p);
+  s.link_radius_sq = link * link;
+  s.kernel_radius = c.kernel_radius;
+  s.inv_kernel_radius = 1.0f / c.kernel_radius;
+  return s;
+}
 
 inline EosConstants make_eos(const WorldConfig& c, const RuntimeParams& p) {
   EosConstants e;
@@ -94,6 +122,10 @@ inline StepLimits make_step_limits(const WorldConfig& c, const RuntimeParams& p)
   // Clavet's impulses are bounded per pair (forces.h), so only Mueller's viscosity limits dt.
   const float nu = c.viscosity_method == ViscosityMethod::Mueller ? p.viscosity / c.rest_density : 0.0f;
   s.stability_dt = stability_ceiling(c.kernel_radius, speed_of_sound(make_eos(c, p)), nu);
+  if (c.features & kFeatureSprings) {
+    const float springs = spring_stability_ceiling(p.spring_stiffness, p.spring_damping);
+    if (springs > 0.0f && (s.stability_dt == 0.0f || springs < s.stability_dt)) s.stability_dt = springs;
+  }
   return s;
 }
 

@@ -17,9 +17,11 @@
 #include "../physics/density_normalization.h"
 #include "../physics/forces.h"
 #include "../physics/integrate.h"
+#include "../physics/springs.h"
 #include "../physics/surface_normal.h"
 #include "cpu_neighbor_grid.h"
 #include "host_particle_store.h"
+#include "host_spring_array.h"
 
 namespace sph {
 namespace {
@@ -48,6 +50,8 @@ class CpuBackend final : public Backend {
       rk4_start_ = &store_.add<ParticleState>();
       rk4_sum_ = &store_.add<Rk4Accumulator>();
     }
+    // Only a world with springs pays for the spring lists.
+    if (config.features & kFeatureSprings) springs_ = &store_.add_array(std::make_unique<HostSpringArray>());
   }
 
   uint32_t particle_count() const override { return count_; }
@@ -66,6 +70,8 @@ class CpuBackend final : public Backend {
     }
     count_ = total;
     max_speed_valid_ = false;
+    if (springs_ && n > 0 && first_id < link_from_)
+      link_from_ = first_id;  // they link at their first substep
   }
 
   FrameReport step_frame(double frame_dt, const RuntimeParams& params) override {
@@ -85,6 +91,8 @@ class CpuBackend final : public Backend {
     const float saved_max_speed = max_speed_;
     const bool saved_max_speed_valid = max_speed_valid_;
     const float saved_max_acceleration = max_acceleration_;
+    const uint32_t saved_link_from = link_from_;
+    spring_constants_ = make_spring_constants(config_, params);
     if (!max_speed_valid_) max_speed_ = compute_max_speed();
 
     // Puts the particles back as they were before the frame: on a non-finite state and on any
@@ -97,6 +105,7 @@ class CpuBackend final : public Backend {
       max_speed_ = saved_max_speed;
       max_speed_valid_ = saved_max_speed_valid;
       max_acceleration_ = saved_max_acceleration;  // the force step limit reads it next step
+      link_from_ = saved_link_from;
     };
     double remaining = frame_dt;
     double elapsed = 0.0;
@@ -195,6 +204,10 @@ class CpuBackend final : public Backend {
     // the value the next frame would compute.
     s.max_speed = max_speed_valid_ ? max_speed_ : compute_max_speed();
     s.max_acceleration = max_acceleration_;
+    if (springs_) {
+      s.springs.assign(springs_->data.begin(), springs_->data.begin() + count_);
+      s.link_from = link_from_;
+    }
     return s;
   }
 
@@ -202,6 +215,9 @@ class CpuBackend final : public Backend {
     const uint32_t n = static_cast<uint32_t>(s.id.size());
     if (n > config_.capacity || s.position.size() != n || s.velocity.size() != n || s.density.size() != n)
       throw Error(Status::Internal, "import_particles: inconsistent snapshot");
+    if (springs_ ? s.springs.size() != n : !s.springs.empty())
+      throw Error(Status::Internal, "import_particles: spring lists do not match the particles");
+    std::vector<SpringList> springs(s.springs);
     // Copies first (they may throw), then swaps, so a failure leaves the state as it was.
     std::vector<Float4> position(s.position), velocity(s.velocity);
     std::vector<uint32_t> id(s.id), neighbors(n, 0u);
@@ -212,6 +228,10 @@ class CpuBackend final : public Backend {
     id_.data.swap(id);
     density_.data.swap(density);
     neighbors_.data.swap(neighbors);
+    if (springs_) {
+      springs_->data.swap(springs);
+      link_from_ = s.link_from;
+    }
     count_ = n;
     max_speed_ = s.max_speed;
     max_speed_valid_ = true;
@@ -353,8 +373,9 @@ class CpuBackend final : public Backend {
     if (!std::isfinite(density_.data[i]) || !std::isfinite(pos[i].w) || !std::isfinite(vel[i].w)) {
       stage = "density stage (SPH_STAGE_DENSITY)";
     } else {
-      const Vec3 a = acceleration_function()(fluid, grid_.view(), pos, vel, neighbors_.data.data(),
-                                             normals_.data(), scene, i);
+      Vec3 a = acceleration_function()(fluid, grid_.view(), pos, vel, neighbors_.data.data(), normals_.data(),
+                                       scene, i);
+      if (springs_) a += spring_acceleration_[i];
       if (!finite3(a)) {
         stage = "forces stage (SPH_STAGE_FORCES)";
       } else if (rk4_stage >= 0) {
@@ -389,6 +410,7 @@ class CpuBackend final : public Backend {
   uint32_t substep_euler(const FluidConstants& fluid, const SceneFrame& scene, const SubstepTime& time,
                          FrameReport& report) {
     sort_and_density(fluid, report);
+    spring_pass(time.dt, true, report);
     auto t = Clock::now();
     const GridView view = grid_.view();
     next_position_.resize(count_);
@@ -401,8 +423,8 @@ class CpuBackend final : public Backend {
     float a2max = 0.0f;
 #pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
     for (int i = 0; i < n(); ++i) {
-      const Vec3 a =
-          acceleration(fluid, view, pos, vel, counts, normals_.data(), scene, static_cast<uint32_t>(i));
+      Vec3 a = acceleration(fluid, view, pos, vel, counts, normals_.data(), scene, static_cast<uint32_t>(i));
+      if (springs_) a += spring_acceleration_[i];
       a2max = std::max(a2max, length_squared(a));
       const ParticleState s = symplectic_euler({xyz(pos[i]), xyz(vel[i])}, a, dt);
       next_position_[i] = make_float4_record(s.position, pos[i].w);
@@ -431,6 +453,7 @@ class CpuBackend final : public Backend {
     float a2max = 0.0f;
     for (int stage = 0; stage < 4; ++stage) {
       sort_and_density(fluid, report);
+      spring_pass(dt, stage == 0, report);
       auto t = Clock::now();
       const GridView view = grid_.view();
       next_position_.resize(count_);
@@ -440,8 +463,9 @@ class CpuBackend final : public Backend {
       const uint32_t* counts = neighbors_.data.data();
 #pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
       for (int i = 0; i < n(); ++i) {
-        const Vec3 a =
+        Vec3 a =
             acceleration(fluid, view, pos, vel, counts, normals_.data(), scene, static_cast<uint32_t>(i));
+        if (springs_) a += spring_acceleration_[i];
         a2max = std::max(a2max, length_squared(a));
         const ParticleState s =
             rk4_advance(stage, rk4_start_->data[i], {xyz(pos[i]), xyz(vel[i])}, a, dt, rk4_sum_->data[i]);
@@ -462,6 +486,45 @@ class CpuBackend final : public Backend {
     }
     max_acceleration_ = std::sqrt(a2max);
     return kAllFinite;
+  }
+
+  // Springs (SPH_FEATURE_SPRINGS), after the sort: the particles that wait for springs make
+  // them (two passes, springs.h), then every particle gathers its spring acceleration into a
+  // side array that the force pass adds. first_evaluation: the substep's first force
+  // evaluation, where the rest lengths flow (plasticity).
+  void spring_pass(float dt, bool first_evaluation, FrameReport& report) {
+    if (!springs_) return;
+    const auto t = Clock::now();
+    const Float4* pos = position_.data.data();
+    const Float4* vel = velocity_.data.data();
+    SpringList* lists = springs_->data.data();
+    const SpringConstants& c = spring_constants_;
+    if (link_from_ != kNoPendingLinks) {
+      const GridView view = grid_.view();
+      const uint32_t* ids = id_.data.data();
+      const uint32_t from = link_from_;
+      spring_candidates_.resize(static_cast<size_t>(count_) * kSpringSlots);
+      uint32_t* candidates = spring_candidates_.data();
+#pragma omp parallel for num_threads(threads()) schedule(static)
+      for (int i = 0; i < n(); ++i)
+        spring_candidates(c, view, pos, ids, from, lists[i], static_cast<uint32_t>(i),
+                          candidates + static_cast<size_t>(i) * kSpringSlots);
+#pragma omp parallel for num_threads(threads()) schedule(static)
+      for (int i = 0; i < n(); ++i) spring_link(pos, candidates, static_cast<uint32_t>(i), lists[i]);
+      link_from_ = kNoPendingLinks;
+    }
+    spring_acceleration_.resize(count_);
+    Vec3* out = spring_acceleration_.data();
+    if (first_evaluation) {
+#pragma omp parallel for num_threads(threads()) schedule(static)
+      for (int i = 0; i < n(); ++i)
+        out[i] = spring_acceleration<true>(c, pos, vel, static_cast<uint32_t>(i), lists[i], dt);
+    } else {
+#pragma omp parallel for num_threads(threads()) schedule(static)
+      for (int i = 0; i < n(); ++i)
+        out[i] = spring_acceleration<false>(c, pos, vel, static_cast<uint32_t>(i), lists[i], dt);
+    }
+    report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
   }
 
   // Removes particles inside any sink, keeping the order of the rest; records their ids.
@@ -525,6 +588,13 @@ class CpuBackend final : public Backend {
   std::vector<uint32_t> keep_order_;
   std::vector<float> normalized_;  // normalised density (eq. 31), when that feature is on
   std::vector<Float4> normals_;    // colour-field normals, when surface tension is on
+  // Springs (SPH_FEATURE_SPRINGS only): the lists live in the store; the link candidates
+  // and the spring accelerations of the current evaluation are side arrays.
+  HostSpringArray* springs_ = nullptr;
+  std::vector<uint32_t> spring_candidates_;
+  std::vector<Vec3> spring_acceleration_;
+  SpringConstants spring_constants_{};
+  uint32_t link_from_ = kNoPendingLinks;  // lowest id that waits for its springs
   uint32_t count_ = 0;
   float max_speed_ = 0.0f;
   float max_acceleration_ = 0.0f;  // of the last force evaluation, for the force step limit

@@ -54,6 +54,14 @@ class HostParticleStore {
     return static_cast<HostArray<T>&>(*arrays_.back());
   }
 
+  // Registers an array of a custom kind (one whose gather does more than move elements).
+  template <class A>
+  A& add_array(std::unique_ptr<A> array) {
+    A& ref = *array;
+    arrays_.push_back(std::move(array));
+    return ref;
+  }
+
   void resize(size_t n) {
     for (auto& a : arrays_) a->resize(n);
   }

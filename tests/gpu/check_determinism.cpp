@@ -93,6 +93,11 @@ int main() {
   options.step_limits = SPH_STEP_LIMIT_ACOUSTIC | SPH_STEP_LIMIT_FORCE;
   twice(options, 3, 0.02f);
 
+  SceneSpec springs = moving;
+  springs.name = "moving_sphere_springs_euler";
+  springs.features = SPH_FEATURE_SPRINGS;
+  twice(springs, 3, 0.02f);
+
   SceneSpec small = moving;
   small.radius = 0.25f;
   concurrent(small, 3, 0.02f);

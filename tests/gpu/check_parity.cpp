@@ -125,6 +125,15 @@ int main() {
   all_rk4.features = SPH_FEATURE_SURFACE_TENSION | SPH_FEATURE_NORMALIZED_DENSITY;
   compare(all_rk4, 0.010f);
 
+  SceneSpec springs = moving;
+  springs.name = "options_springs_plastic_euler";
+  springs.features = SPH_FEATURE_SPRINGS;
+  compare(springs, 0.010f);
+  SceneSpec springs_rk4 = springs;
+  springs_rk4.name = "options_springs_plastic_rk4";
+  springs_rk4.integrator = SPH_INTEGRATOR_RK4;
+  compare(springs_rk4, 0.010f);
+
   // Scenes: colliders, force fields, sinks and a source on both backends.
   run_scene_parity();
   return finish();

@@ -119,6 +119,12 @@ struct SceneSpec {
   sph_viscosity_method viscosity_method = SPH_VISCOSITY_MUELLER;
   sph_equation_of_state equation_of_state = SPH_EOS_IDEAL_GAS;
   uint32_t step_limits = 0;
+  // SPH_FEATURE_SPRINGS: stiff, damped and plastic, so linking, the force, the rest-length flow
+  // and the dropping of springs all run.
+  float spring_stiffness = 1e5f;
+  float spring_damping = 50.0f;
+  float spring_plasticity = 20.0f;
+  float spring_yield_ratio = 0.02f;
 };
 
 struct Loaded {
@@ -161,6 +167,15 @@ inline Loaded load_scene(sph_backend backend, const SceneSpec& s) {
   params.dt_max = s.dt_max;
   params.step_limits = s.step_limits;
   require_ok(sph_world_set_params(l.world, &params), "sph_world_set_params");
+  if (s.features & SPH_FEATURE_SPRINGS) {
+    sph_spring_params springs;
+    sph_spring_params_init(&springs);
+    springs.stiffness = s.spring_stiffness;
+    springs.damping = s.spring_damping;
+    springs.plasticity = s.spring_plasticity;
+    springs.yield_ratio = s.spring_yield_ratio;
+    require_ok(sph_world_set_spring_params(l.world, &springs), "sph_world_set_spring_params");
+  }
   sph_spawn_desc spawn;
   sph_spawn_desc_init(&spawn);
   spawn.count = l.count;

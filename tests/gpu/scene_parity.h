@@ -362,6 +362,17 @@ inline void run_scene_parity() {
   compare_scene(source);
 
   compare_scene(SceneHooks{"force_fields_all_kinds_euler", base, build_fields});
+
+  // Springs through the sinks' compaction (springs to removed particles drop) and with a
+  // source whose new particles link to the old ones at their first substep.
+  SceneHooks spring_sinks = sinks;
+  spring_sinks.name = "springs_sinks_euler";
+  spring_sinks.spec.features = SPH_FEATURE_SPRINGS;
+  compare_scene(spring_sinks);
+  SceneHooks spring_source = source;
+  spring_source.name = "springs_continuous_source_euler";
+  spring_source.spec.features = SPH_FEATURE_SPRINGS;
+  compare_scene(spring_source);
 }
 
 }  // namespace gpu_check

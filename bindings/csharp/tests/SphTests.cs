@@ -471,6 +471,40 @@ static class Tests
         }
     }
 
+    public static void TestSpringParams()
+    {
+        using (var ctx = Cpu())
+        {
+            using (var plain = ctx.CreateWorld(SmallWorld()))
+            {
+                Throws(Result.ErrorFeatureDisabled, () => { var p = plain.SpringParams; });
+                Throws(Result.ErrorFeatureDisabled, () => plain.SpringParams = SpringParams.Default());
+            }
+            var d = SmallWorld();
+            d.FeatureFlags = FeatureFlags.Springs;
+            using (var world = ctx.CreateWorld(d))
+            {
+                SpringParams sp = world.SpringParams;
+                AssertEqual(SpringParams.Default(), sp, "spring defaults");
+                AssertEqual(1e4f, sp.Stiffness, "stiffness default");
+                AssertEqual(0f, sp.Plasticity, "plasticity default (elastic)");
+                sp.Stiffness = 2e5f;
+                sp.Plasticity = 3f;
+                sp.YieldRatio = 0.2f;
+                sp.Damping = 5f;
+                world.SpringParams = sp;
+                AssertEqual(sp, world.SpringParams, "spring round trip");
+                var bad = sp;
+                bad.YieldRatio = 2f;
+                Throws(Result.ErrorInvalidArgument, () => world.SpringParams = bad);
+                bad = sp;
+                bad.Stiffness = float.NaN;
+                Throws(Result.ErrorInvalidArgument, () => world.SpringParams = bad);
+                AssertEqual(sp, world.SpringParams, "springs unchanged after errors");
+            }
+        }
+    }
+
     public static void TestOptionParamsRoundTripAndValidation()
     {
         using (var ctx = Cpu())

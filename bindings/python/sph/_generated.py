@@ -10,7 +10,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '1b2abdc31b6c1bed89d5b8cef36b50f3e3aa33068ba6e0182ec230c3e88d5219', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
+HEADERS = {'include/sph_c.h': 'd4bd2fe53b94e311dd65e2927643a14880fa21a196e02eaced6c79f45b17b2bc', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -34,6 +34,11 @@ SPH_FEATURE_SURFACE_TENSION = 1
 #: density deficit of particles near a free surface (it narrows it; it does not remove it: about 48
 #: % -> 34 % on the outermost layer of a resting sphere).
 SPH_FEATURE_NORMALIZED_DENSITY = 2
+#: Elasticity and plasticity (thesis 4.4.2.1; Clavet, Beaudoin & Poulin 2005): springs between
+#: neighbouring particles, made once per particle at its first substep (so the rest shape is the
+#: spawn shape), with rest lengths that yield and creep; sph_spring_params. Costs 128 bytes per
+#: particle (host) or 256 (device) and a spring pass per force evaluation.
+SPH_FEATURE_SPRINGS = 4
 #: Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt <= step_factor h / c, c the
 #: EOS's speed of sound
 SPH_STEP_LIMIT_ACOUSTIC = 1
@@ -663,6 +668,37 @@ class TaitParams(_SphStruct):
 sph_tait_params = TaitParams
 
 
+class SpringParams(_SphStruct):
+    """
+    sph_spring_params.
+
+    Fields:
+        struct_size (uint32_t): set by sph_spring_params_init
+        stiffness (float): k of a = -k (1 - L/h)(r - L), 1/s^2 (acceleration per metre of stretch); default 1e4; >= 0. Young's modulus of an FCC block is about (2/3) rho0 s^2 k (1 - s/h) (s: particle spacing). Stiffer springs shorten the step: dt <= 0.5 / sqrt(16 k)
+        link_radius (float): springs are made to neighbours closer than this, m; 0 (default) = 1.2 x particle_spacing (the lattice's 12 nearest neighbours); <= kernel_radius. Applies to particles linked after the change
+        yield_ratio (float): gamma: a spring deforms plastically beyond r = L (1 +- gamma); default 0.1; [0, 1]
+        plasticity (float): alpha, 1/s: how fast rest lengths creep toward the deformed length beyond the yield band; default 0 (purely elastic); >= 0. A rest length that grows past kernel_radius drops its spring
+        damping (float): c of a = -c (v_i - v_j) . r^ along each spring, 1/s; default 0; >= 0. Shortens the step: dt <= 2 / (16 c)
+        reserved0 (uint32_t): must be 0
+    """
+    _fields_ = [
+        ('struct_size', _c.c_uint32),
+        ('stiffness', _c.c_float),
+        ('link_radius', _c.c_float),
+        ('yield_ratio', _c.c_float),
+        ('plasticity', _c.c_float),
+        ('damping', _c.c_float),
+        ('reserved0', _c.c_uint32),
+    ]
+    _sph_c_name_ = 'sph_spring_params'
+    _sph_size_ = 28
+    _sph_offsets_ = (('struct_size', 0), ('stiffness', 4), ('link_radius', 8), ('yield_ratio', 12), ('plasticity', 16), ('damping', 20), ('reserved0', 24))
+    _sph_init_ = 'sph_spring_params_init_sized'
+
+
+sph_spring_params = SpringParams
+
+
 class SpawnDesc(_SphStruct):
     """
     sph_spawn_desc.
@@ -1227,7 +1263,7 @@ class CudaAttributeView(_SphStruct):
 sph_cuda_attribute_view = CudaAttributeView
 
 
-STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, Quat, Transform, ColliderId, ColliderDef, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, Event, CudaAttributeView, )
+STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpringParams, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, Quat, Transform, ColliderId, ColliderDef, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, Event, CudaAttributeView, )
 
 # ---- functions --------------------------------------------------------------------------------
 
@@ -1286,6 +1322,12 @@ FUNCTIONS = {
     'sph_world_set_tait_params': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_tait_params)), ('world', 'params'),
         "FEATURE_DISABLED unless the world's equation_of_state is SPH_EOS_TAIT.", 'sph'),
     'sph_world_get_tait_params': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_tait_params)), ('world', 'out'),
+        '', 'sph'),
+    'sph_spring_params_init_sized': (sph_result, (_c.POINTER(sph_spring_params), _c.c_uint32), ('params', 'size'),
+        '', 'sph'),
+    'sph_world_set_spring_params': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_spring_params)), ('world', 'params'),
+        'FEATURE_DISABLED unless the world has SPH_FEATURE_SPRINGS. INVALID_ARGUMENT for a value out of range (the message names it); nothing changes on error. Springs already made keep their rest lengths; the new stiffness, damping and plasticity act from the next substep.', 'sph'),
+    'sph_world_get_spring_params': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_spring_params)), ('world', 'out'),
         '', 'sph'),
     'sph_spawn_desc_init_sized': (sph_result, (_c.POINTER(sph_spawn_desc), _c.c_uint32), ('desc', 'size'),
         '', 'sph'),

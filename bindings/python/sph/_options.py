@@ -39,7 +39,9 @@ Feature = _flags("Feature", "SPH_FEATURE_", """World feature bits (SPH_FEATURE_*
     SURFACE_TENSION: surface tension from the colour field (Morris 2000), parameters in
     World.surface_tension_params; EXPERIMENTAL (docs/physics.md). NORMALIZED_DENSITY: a second,
     Shepard-filtered density pass (thesis eq. 31) that narrows the density deficit at a free
-    surface. A feature that is off allocates nothing and costs no work.""")
+    surface. SPRINGS: elasticity and plasticity, springs between neighbours made at each
+    particle's first substep (Clavet et al. 2005), parameters in World.spring_params. A feature
+    that is off allocates nothing and costs no work.""")
 
 StepLimit = _flags("StepLimit", "SPH_STEP_LIMIT_", """Step-size limits beyond eq. 32 (SPH_STEP_LIMIT_*; WorldParams.step_limits).
 
@@ -160,4 +162,28 @@ class WorldOptionsMixin:
         Returns the parameters now set."""
         p = _changed(self.tait_params, fields)
         self.tait_params = p
+        return p
+
+    # -- springs (Feature.SPRINGS)
+    @property
+    def spring_params(self):
+        """SpringParams (stiffness k in 1/s^2, link_radius in m (0 = 1.2 x spacing), yield_ratio
+        gamma, plasticity alpha in 1/s (0 = elastic), damping c in 1/s) of a world created with
+        Feature.SPRINGS (sph_world_get_spring_params). Assign a SpringParams (or a dict of its
+        fields) to replace them (sph_world_set_spring_params; validated, unchanged on error).
+        Raises SphError(ERROR_FEATURE_DISABLED) when the world does not have the feature."""
+        p = _g.SpringParams()
+        check(library().sph_world_get_spring_params(self.handle, ctypes.byref(p)), "sph_world_get_spring_params")
+        return p
+
+    @spring_params.setter
+    def spring_params(self, params):
+        p = _as_struct(_g.SpringParams, params)
+        check(library().sph_world_set_spring_params(self.handle, ctypes.byref(p)), "sph_world_set_spring_params")
+
+    def set_spring_params(self, **fields):
+        """Changes some spring parameters, keeping the others: ``w.set_spring_params(plasticity=5)``.
+        Returns the parameters now set."""
+        p = _changed(self.spring_params, fields)
+        self.spring_params = p
         return p

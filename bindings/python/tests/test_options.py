@@ -209,3 +209,20 @@ def test_a_world_with_every_option_steps(full):
     s = full.stats()
     assert s.particle_count == n and s.substeps > 0
     assert np.isfinite(full.positions()).all() and np.isfinite(full.densities()).all()
+
+
+# ---- springs (Feature.SPRINGS) ------------------------------------------------------------------
+def test_spring_params_round_trip_validation_and_feature(ctx):
+    with ctx.world(capacity=16) as plain:
+        assert error(_get, plain, "spring_params").result == sph.Result.ERROR_FEATURE_DISABLED
+    with ctx.world(capacity=16, features="springs") as w:
+        assert w.features == sph.Feature.SPRINGS
+        p = w.spring_params
+        assert (p.stiffness, p.link_radius, p.yield_ratio, p.plasticity, p.damping) == pytest.approx(
+            (1e4, 0.0, 0.1, 0.0, 0.0))
+        w.set_spring_params(plasticity=5.0, stiffness=2e5)
+        assert w.spring_params.plasticity == 5.0 and w.spring_params.stiffness == 2e5
+        assert error(w.set_spring_params, yield_ratio=1.5).result == sph.Result.ERROR_INVALID_ARGUMENT
+        assert w.spring_params.yield_ratio == pytest.approx(0.1)
+        w.spring_params = {"damping": 3.0}
+        assert w.spring_params.damping == 3.0 and w.spring_params.plasticity == 0.0
