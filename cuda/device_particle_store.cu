@@ -17,7 +17,11 @@ DeviceParticleStore::DeviceParticleStore(uint32_t capacity, const StoreOptions& 
   snapshot_id_.allocate(n, "snapshot ids");
   snapshot_density_.allocate(n, "snapshot densities");
   if (options.neighbor_counts) neighbor_count_.allocate(n, "neighbour counts");
-  if (options.normalized_density) normalized_density_.allocate(n, "normalised densities");
+  if (options.normalized_density) {
+    normalized_density_.allocate(n, "normalised densities");
+    density_factor_.allocate(n, "density factors");
+    snapshot_density_factor_.allocate(n, "snapshot density factors");
+  }
   if (options.colour_normals) colour_normal_.allocate(n, "colour-field normals");
   if (options.rk4) {
     for (int side = 0; side < 2; ++side) {
@@ -34,6 +38,7 @@ DeviceParticleStore::DeviceParticleStore(uint32_t capacity, const StoreOptions& 
   arrays_.sorted_id = sorted_id_.get();
   arrays_.neighbor_count = neighbor_count_.get();
   arrays_.normalized_density = normalized_density_.get();
+  arrays_.density_factor = density_factor_.get();
   arrays_.colour_normal = colour_normal_.get();
   for (int side = 0; side < 2; ++side) {
     arrays_.rk4_start[side] = rk4_start_[side].get();
@@ -63,6 +68,9 @@ void DeviceParticleStore::enqueue_snapshot(uint32_t n, cudaStream_t stream) cons
   copy_async(snapshot_velocity_.get(), velocity_.get(), n, stream, "snapshot of velocities");
   copy_async(snapshot_id_.get(), id_.get(), n, stream, "snapshot of ids");
   copy_async(snapshot_density_.get(), density_.get(), n, stream, "snapshot of densities");
+  if (density_factor_.get())
+    copy_async(snapshot_density_factor_.get(), density_factor_.get(), n, stream,
+               "snapshot of density factors");
 }
 
 void DeviceParticleStore::enqueue_restore(uint32_t n, cudaStream_t stream) const {
@@ -70,6 +78,9 @@ void DeviceParticleStore::enqueue_restore(uint32_t n, cudaStream_t stream) const
   copy_async(velocity_.get(), snapshot_velocity_.get(), n, stream, "restore of velocities");
   copy_async(id_.get(), snapshot_id_.get(), n, stream, "restore of ids");
   copy_async(density_.get(), snapshot_density_.get(), n, stream, "restore of densities");
+  if (density_factor_.get())
+    copy_async(density_factor_.get(), snapshot_density_factor_.get(), n, stream,
+               "restore of density factors");
 }
 
 uint64_t DeviceParticleStore::bytes() const {
@@ -79,6 +90,7 @@ uint64_t DeviceParticleStore::bytes() const {
                    snapshot_density_.bytes();
   for (int side = 0; side < 2; ++side) total += rk4_start_[side].bytes() + rk4_sum_[side].bytes();
   total += neighbor_count_.bytes() + normalized_density_.bytes() + colour_normal_.bytes();
+  total += density_factor_.bytes() + snapshot_density_factor_.bytes();
   return total;
 }
 

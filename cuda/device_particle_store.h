@@ -11,6 +11,8 @@
 //                                 per-substep side arrays of the physics options (Clavet
 //                                 viscosity, normalised density, surface tension), allocated
 //                                 only for a world that uses the option
+//   density_factor                normalised density's carried factor (state, in the current
+//                                 order, with a snapshot), only for a world that uses it
 // Float4 records carry a second quantity in w: position.w = pressure, velocity.w = 1/density.
 #pragma once
 
@@ -36,7 +38,8 @@ struct ParticleArrays {
   ParticleState* rk4_start[2];  // null unless RK4
   Rk4Accumulator* rk4_sum[2];
   uint32_t* neighbor_count;   // null unless Clavet viscosity: the density pass's counts
-  float* normalized_density;  // null unless normalised density: eq. 31 before it is published
+  float* normalized_density;  // null unless normalised density: the kernel sum, then eq. 31
+  float* density_factor;      // null unless normalised density: carried factor (state)
   Float4* colour_normal;      // null unless surface tension: (n, |n|) of the colour field
 };
 
@@ -80,6 +83,7 @@ class DeviceParticleStore {
   DeviceArray<Rk4Accumulator> rk4_sum_[2];
   DeviceArray<uint32_t> neighbor_count_;
   DeviceArray<float> normalized_density_;
+  DeviceArray<float> density_factor_, snapshot_density_factor_;
   DeviceArray<Float4> colour_normal_;
   ParticleArrays arrays_{};
 };

@@ -40,6 +40,8 @@ __global__ void sink_scatter_kernel(ParticleArrays a, uint32_t n, const uint32_t
     a.sorted_id[dst] = a.id[i];
     density_out[dst] = a.density[i];
     if (counts) counts_out[dst] = counts[i];
+    // The normalised density's side array is free between substeps: the factors go there.
+    if (a.density_factor) a.normalized_density[dst] = a.density_factor[i];
   } else {
     const uint32_t r = i - dst;
     removed_id[r] = a.id[i];
@@ -100,6 +102,8 @@ void DeviceSinkCompactor::enqueue_compact(const ParticleArrays& a, uint32_t n, u
   copy_back(a.id, a.sorted_id, kept, stream, "compaction of ids");
   copy_back(a.density, density_out_.get(), kept, stream, "compaction of densities");
   if (counts) copy_back(counts, counts_out_.get(), kept, stream, "compaction of neighbour counts");
+  if (a.density_factor)
+    copy_back(a.density_factor, a.normalized_density, kept, stream, "compaction of density factors");
 }
 
 }  // namespace sph

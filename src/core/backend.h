@@ -38,8 +38,9 @@ struct ParticleSnapshot {
   std::vector<Float4> velocity;  // w: 1 / density of the last density pass
   std::vector<uint32_t> id;
   std::vector<float> density;
-  float max_speed = 0.0f;         // |v|max the next frame's first step is chosen from
-  float max_acceleration = 0.0f;  // |a|max of the last force evaluation (the force step limit)
+  std::vector<float> density_factor;  // normalised density's carried factors; empty when off
+  float max_speed = 0.0f;             // |v|max the next frame's first step is chosen from
+  float max_acceleration = 0.0f;      // |a|max of the last force evaluation (the force step limit)
 };
 
 class Backend {
