@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "../src/core/grid_layout.h"
+#include "../src/physics/density_normalization.h"
 #include "cuda_backend.h"
 #include "cuda_status.h"
 #include "device_array.h"
@@ -140,6 +141,8 @@ class CudaBackend final : public Backend {
     std::vector<Float4> pos(n), vel(n);
     std::vector<uint32_t> ids(n);
     const std::vector<float> density(n, config_.rest_density);
+    // Normalised density: a fresh particle's factor is resolved by its first density pass.
+    const std::vector<float> fresh(options_.normalized_density ? n : 0u, fresh_density_factor());
     for (uint32_t k = 0; k < n; ++k) {
       const Vec3 v = velocities ? velocities[k] : Vec3{0.0f, 0.0f, 0.0f};
       pos[k] = make_float4_record(positions[k], 0.0f);
@@ -168,6 +171,10 @@ class CudaBackend final : public Backend {
                    "copy of new spring lists");
         enqueue_springs_appended(a, first_id, s);
       }
+      if (a.density_factor)
+        cuda_check(cudaMemcpyAsync(a.density_factor + count_, fresh.data(), sizeof(float) * n,
+                                   cudaMemcpyHostToDevice, s),
+                   "copy of new density factors");
       enqueue_recompute_max_speed(a.velocity, count_ + n, r_->state.get(), s);
       cuda_check(cudaStreamSynchronize(s), "append");
     });
@@ -341,6 +348,7 @@ class CudaBackend final : public Backend {
     s.velocity = download(a.velocity, count_);
     s.id = download(a.id, count_);
     s.density = download(a.density, count_);
+    if (a.density_factor) s.density_factor = download(a.density_factor, count_);
     const std::vector<FrameState> state = download(static_cast<const FrameState*>(r_->state.get()), 1u);
     s.max_speed = state[0].max_speed;
     s.max_acceleration = state[0].max_acceleration;
@@ -354,10 +362,15 @@ class CudaBackend final : public Backend {
   void import_particles(const ParticleSnapshot& s) override {
     require_alive();
     const uint32_t n = static_cast<uint32_t>(s.id.size());
-    if (n > config_.capacity || s.position.size() != n || s.velocity.size() != n || s.density.size() != n)
+    if (n > config_.capacity || s.position.size() != n || s.velocity.size() != n || s.density.size() != n ||
+        (!s.density_factor.empty() && s.density_factor.size() != n))
       throw Error(Status::Internal, "import_particles: inconsistent snapshot");
     if (options_.springs ? s.springs.size() != n : !s.springs.empty())
       throw Error(Status::Internal, "import_particles: spring lists do not match the particles");
+    const std::vector<float> factor = !options_.normalized_density ? std::vector<float>()
+                                      : s.density_factor.empty()
+                                          ? std::vector<float>(n, fresh_density_factor())
+                                          : s.density_factor;
     DeviceGuard guard(device_);
     ++epoch_;
     guarded([&] {
@@ -379,6 +392,12 @@ class CudaBackend final : public Backend {
           cuda_check(cudaMemcpyAsync(a.springs, s.springs.data(), sizeof(SpringList) * n,
                                      cudaMemcpyHostToDevice, st),
                      "copy of checkpoint spring lists");
+        if (a.density_factor)
+          // A snapshot without factors (a checkpoint written before they existed) starts every
+          // particle fresh, as if it had just been spawned.
+          cuda_check(
+              cudaMemcpyAsync(a.density_factor, factor.data(), sizeof(float) * n, cudaMemcpyHostToDevice, st),
+              "copy of checkpoint density factors");
       }
       if (options_.springs)
         cuda_check(cudaMemcpyAsync(a.link_from, &s.link_from, sizeof(uint32_t), cudaMemcpyHostToDevice, st),

@@ -17,7 +17,11 @@ DeviceParticleStore::DeviceParticleStore(uint32_t capacity, const StoreOptions& 
   snapshot_id_.allocate(n, "snapshot ids");
   snapshot_density_.allocate(n, "snapshot densities");
   if (options.neighbor_counts) neighbor_count_.allocate(n, "neighbour counts");
-  if (options.normalized_density) normalized_density_.allocate(n, "normalised densities");
+  if (options.normalized_density) {
+    normalized_density_.allocate(n, "normalised densities");
+    density_factor_.allocate(n, "density factors");
+    snapshot_density_factor_.allocate(n, "snapshot density factors");
+  }
   if (options.colour_normals) colour_normal_.allocate(n, "colour-field normals");
   if (options.springs) {
     springs_.allocate(n, "spring lists");
@@ -44,6 +48,7 @@ DeviceParticleStore::DeviceParticleStore(uint32_t capacity, const StoreOptions& 
   arrays_.sorted_id = sorted_id_.get();
   arrays_.neighbor_count = neighbor_count_.get();
   arrays_.normalized_density = normalized_density_.get();
+  arrays_.density_factor = density_factor_.get();
   arrays_.colour_normal = colour_normal_.get();
   arrays_.springs = springs_.get();
   arrays_.sorted_springs = sorted_springs_.get();
@@ -83,6 +88,9 @@ void DeviceParticleStore::enqueue_snapshot(uint32_t n, cudaStream_t stream) cons
     copy_async(snapshot_springs_.get(), springs_.get(), n, stream, "snapshot of spring lists");
     copy_async(snapshot_link_from_.get(), link_from_.get(), 1, stream, "snapshot of the spring link state");
   }
+  if (density_factor_.get())
+    copy_async(snapshot_density_factor_.get(), density_factor_.get(), n, stream,
+               "snapshot of density factors");
 }
 
 void DeviceParticleStore::enqueue_restore(uint32_t n, cudaStream_t stream) const {
@@ -94,6 +102,9 @@ void DeviceParticleStore::enqueue_restore(uint32_t n, cudaStream_t stream) const
     copy_async(springs_.get(), snapshot_springs_.get(), n, stream, "restore of spring lists");
     copy_async(link_from_.get(), snapshot_link_from_.get(), 1, stream, "restore of the spring link state");
   }
+  if (density_factor_.get())
+    copy_async(density_factor_.get(), snapshot_density_factor_.get(), n, stream,
+               "restore of density factors");
 }
 
 void DeviceParticleStore::enqueue_reset_link_state(cudaStream_t stream) const {
@@ -114,6 +125,7 @@ uint64_t DeviceParticleStore::bytes() const {
   total += springs_.bytes() + sorted_springs_.bytes() + snapshot_springs_.bytes() + spring_inverse_.bytes() +
            spring_candidates_.bytes() + spring_acceleration_.bytes() + link_from_.bytes() +
            snapshot_link_from_.bytes();
+  total += density_factor_.bytes() + snapshot_density_factor_.bytes();
   return total;
 }
 

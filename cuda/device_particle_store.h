@@ -15,6 +15,8 @@
 //                                 in state order, their reordered working copy, the inverse
 //                                 permutation, link candidates, spring accelerations, the
 //                                 lowest id waiting for springs (one word), and snapshots
+//   density_factor                normalised density's carried factor (state, in the current
+//                                 order, with a snapshot), only for a world that uses it
 // Float4 records carry a second quantity in w: position.w = pressure, velocity.w = 1/density.
 #pragma once
 
@@ -41,7 +43,8 @@ struct ParticleArrays {
   ParticleState* rk4_start[2];  // null unless RK4
   Rk4Accumulator* rk4_sum[2];
   uint32_t* neighbor_count;   // null unless Clavet viscosity: the density pass's counts
-  float* normalized_density;  // null unless normalised density: eq. 31 before it is published
+  float* normalized_density;  // null unless normalised density: the kernel sum, then eq. 31
+  float* density_factor;      // null unless normalised density: carried factor (state)
   Float4* colour_normal;      // null unless surface tension: (n, |n|) of the colour field
   // Null unless SPH_FEATURE_SPRINGS.
   SpringList* springs;          // the lists in state order (partners: state indices)
@@ -95,6 +98,7 @@ class DeviceParticleStore {
   DeviceArray<Rk4Accumulator> rk4_sum_[2];
   DeviceArray<uint32_t> neighbor_count_;
   DeviceArray<float> normalized_density_;
+  DeviceArray<float> density_factor_, snapshot_density_factor_;
   DeviceArray<Float4> colour_normal_;
   DeviceArray<SpringList> springs_, sorted_springs_, snapshot_springs_;
   DeviceArray<uint32_t> spring_inverse_, spring_candidates_, link_from_, snapshot_link_from_;

@@ -41,6 +41,8 @@ __global__ void sink_scatter_kernel(ParticleArrays a, uint32_t n, const uint32_t
     a.sorted_id[dst] = a.id[i];
     density_out[dst] = a.density[i];
     if (counts) counts_out[dst] = counts[i];
+    // The normalised density's side array is free between substeps: the factors go there.
+    if (a.density_factor) a.normalized_density[dst] = a.density_factor[i];
   } else {
     const uint32_t r = i - dst;
     removed_id[r] = a.id[i];
@@ -102,6 +104,8 @@ void DeviceSinkCompactor::enqueue_compact(const ParticleArrays& a, uint32_t n, u
   copy_back(a.density, density_out_.get(), kept, stream, "compaction of densities");
   if (counts) copy_back(counts, counts_out_.get(), kept, stream, "compaction of neighbour counts");
   if (a.springs) enqueue_spring_compact(a, n, kept, keep_.get(), scan_.get(), stream);  // SPH_FEATURE_SPRINGS
+  if (a.density_factor)
+    copy_back(a.density_factor, a.normalized_density, kept, stream, "compaction of density factors");
 }
 
 }  // namespace sph

@@ -114,7 +114,7 @@ __global__ void reorder_kernel(ParticleArrays a, const uint32_t* __restrict__ or
   }
 }
 
-template <bool kCounts>
+template <bool kCounts, bool kNormalized>
 __global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
                                FrameState* state) {
   mark_stage(state, kStageDensity);
@@ -124,18 +124,30 @@ __global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArra
   // Other threads read only x, y, z of this record.
   const uint32_t k = __float_as_uint(a.sorted_position[i].w);
   const DensitySample s = gather_density(fluid, grid, a.sorted_position, i);
-  a.density[i] = s.density;
+  float rho = s.density;
+  if (kNormalized) {
+    // The carried factor, in the old order (nothing writes the factors in this kernel); the
+    // kernel sum goes to the side array for the factor after the filter.
+    float factor = a.density_factor[k];
+    rho = carried_density(fluid, s.density, factor);
+    a.normalized_density[i] = s.density;
+  }
+  a.density[i] = rho;
   if (kCounts) a.neighbor_count[i] = s.neighbor_count;
-  a.sorted_position[i].w = pressure_from_density(fluid.eos, s.density);
+  a.sorted_position[i].w = pressure_from_density(fluid.eos, rho);
   const Float4 v = a.velocity[k];
-  a.sorted_velocity[i] = make_float4_record(xyz(v), 1.0f / s.density);
+  a.sorted_velocity[i] = make_float4_record(xyz(v), 1.0f / rho);
 }
 
-// Eq. 31 reads every rho_j of the first pass: computed into a side array, then published.
+// Eq. 31 reads every carried rho_j: the factor is written in the new order
+// (the density kernel is done reading the old), the filtered density into the side array,
+// and both are published after every particle has been filtered.
 __global__ void normalized_density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n) {
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
-  a.normalized_density[i] = gather_normalized_density(fluid, grid, a.sorted_position, a.sorted_velocity, i);
+  const float filtered = gather_normalized_density(fluid, grid, a.sorted_position, a.sorted_velocity, i);
+  a.density_factor[i] = filtered / a.normalized_density[i];
+  a.normalized_density[i] = filtered;
 }
 
 __global__ void publish_normalized_density_kernel(FluidConstants fluid, ParticleArrays a, uint32_t n) {
@@ -301,10 +313,15 @@ void enqueue_density(const FluidConstants& fluid, const GridView& grid, const Pa
                      const SubstepOptions& options, const KernelTuning& tuning, FrameState* state,
                      cudaStream_t stream) {
   const unsigned threads = tuning.density_block, blocks = blocks_for(n, threads);
-  if (options.viscosity == ViscosityMethod::Clavet)
-    density_kernel<true><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, state);
+  const bool counts = options.viscosity == ViscosityMethod::Clavet;
+  if (counts && options.normalized_density)
+    density_kernel<true, true><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, state);
+  else if (counts)
+    density_kernel<true, false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, state);
+  else if (options.normalized_density)
+    density_kernel<false, true><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, state);
   else
-    density_kernel<false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, state);
+    density_kernel<false, false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, state);
   check_launch("density_kernel");
   if (options.normalized_density) {
     normalized_density_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n);

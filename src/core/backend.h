@@ -44,6 +44,7 @@ struct ParticleSnapshot {
   // indices, and the lowest id still waiting for its springs (kNoPendingLinks: none).
   std::vector<SpringList> springs;
   uint32_t link_from = kNoPendingLinks;
+  std::vector<float> density_factor;  // normalised density's carried factors; empty when off
 };
 
 class Backend {

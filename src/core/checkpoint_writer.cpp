@@ -157,6 +157,8 @@ void write_particles(ByteWriter& w, const ParticleSnapshot& s) {
   }
   for (uint32_t id : s.id) w.u32(id);
   for (float d : s.density) w.f32(d);
+  // Normalised density only: each particle's carried factor (NaN: not resolved yet).
+  for (float d : s.density_factor) w.f32(d);
 }
 
 void write_asset(ByteWriter& w, const SdfAsset& a) {

@@ -52,6 +52,9 @@ class CpuBackend final : public Backend {
     }
     // Only a world with springs pays for the spring lists.
     if (config.features & kFeatureSprings) springs_ = &store_.add_array(std::make_unique<HostSpringArray>());
+    // Normalised density carries a per-particle factor (density_normalization.h): sorted, rolled
+    // back and checkpointed with the particles; allocated only when the feature is on.
+    if (config.features & kFeatureNormalizedDensity) density_factor_ = &store_.add<float>();
   }
 
   uint32_t particle_count() const override { return count_; }
@@ -67,6 +70,7 @@ class CpuBackend final : public Backend {
       id_.data[i] = first_id + k;
       density_.data[i] = config_.rest_density;
       neighbors_.data[i] = 0;
+      if (density_factor_) density_factor_->data[i] = fresh_density_factor();
     }
     count_ = total;
     max_speed_valid_ = false;
@@ -200,6 +204,8 @@ class CpuBackend final : public Backend {
     s.velocity.assign(velocity_.data.begin(), velocity_.data.begin() + count_);
     s.id.assign(id_.data.begin(), id_.data.begin() + count_);
     s.density.assign(density_.data.begin(), density_.data.begin() + count_);
+    if (density_factor_)
+      s.density_factor.assign(density_factor_->data.begin(), density_factor_->data.begin() + count_);
     // The lazily computed max speed is a pure function of the velocities: taking it now gives
     // the value the next frame would compute.
     s.max_speed = max_speed_valid_ ? max_speed_ : compute_max_speed();
@@ -222,6 +228,14 @@ class CpuBackend final : public Backend {
     std::vector<Float4> position(s.position), velocity(s.velocity);
     std::vector<uint32_t> id(s.id), neighbors(n, 0u);
     std::vector<float> density(s.density);
+    std::vector<float> factor;
+    if (density_factor_) {
+      // A snapshot without factors (a checkpoint written before they existed) starts every
+      // particle fresh, as if it had just been spawned.
+      if (!s.density_factor.empty() && s.density_factor.size() != n)
+        throw Error(Status::Internal, "import_particles: inconsistent snapshot");
+      factor = s.density_factor.empty() ? std::vector<float>(n, fresh_density_factor()) : s.density_factor;
+    }
     store_.resize(n);
     position_.data.swap(position);
     velocity_.data.swap(velocity);
@@ -232,6 +246,7 @@ class CpuBackend final : public Backend {
       springs_->data.swap(springs);
       link_from_ = s.link_from;
     }
+    if (density_factor_) density_factor_->data.swap(factor);
     count_ = n;
     max_speed_ = s.max_speed;
     max_speed_valid_ = true;
@@ -267,21 +282,31 @@ class CpuBackend final : public Backend {
     const GridView view = grid_.view();
     Float4* pos = position_.data.data();
     Float4* vel = velocity_.data.data();
+    float* factor = density_factor_ ? density_factor_->data.data() : nullptr;
+    if (factor) normalized_.resize(count_);
 #pragma omp parallel for num_threads(threads()) schedule(static)
     for (int i = 0; i < n(); ++i) {
       const DensitySample s = gather_density(fluid, view, pos, static_cast<uint32_t>(i));
-      density_.data[i] = s.density;
+      float rho = s.density;
+      if (factor) {
+        normalized_[i] = s.density;  // the summation, for the factor after the filter
+        rho = carried_density(fluid, s.density, factor[i]);
+      }
+      density_.data[i] = rho;
       neighbors_.data[i] = s.neighbor_count;
       // Only the w slots are written; neighbours read x, y, z alone.
-      pos[i].w = pressure_from_density(fluid.eos, s.density);
-      vel[i].w = 1.0f / s.density;
+      pos[i].w = pressure_from_density(fluid.eos, rho);
+      vel[i].w = 1.0f / rho;
     }
-    if (config_.features & kFeatureNormalizedDensity) {
-      // Eq. 31 needs every rho_j of the first pass: compute into a side array, then publish.
-      normalized_.resize(count_);
+    if (factor) {
+      // Eq. 31 over every carried rho_j: each particle writes only its own factor and side
+      // slot (the first pass is done reading the factors), then the filtered values are published.
 #pragma omp parallel for num_threads(threads()) schedule(static)
-      for (int i = 0; i < n(); ++i)
-        normalized_[i] = gather_normalized_density(fluid, view, pos, vel, static_cast<uint32_t>(i));
+      for (int i = 0; i < n(); ++i) {
+        const float filtered = gather_normalized_density(fluid, view, pos, vel, static_cast<uint32_t>(i));
+        factor[i] = filtered / normalized_[i];
+        normalized_[i] = filtered;
+      }
 #pragma omp parallel for num_threads(threads()) schedule(static)
       for (int i = 0; i < n(); ++i) {
         density_.data[i] = normalized_[i];
@@ -582,11 +607,12 @@ class CpuBackend final : public Backend {
   HostArray<uint32_t>& neighbors_;
   HostArray<ParticleState>* rk4_start_ = nullptr;
   HostArray<Rk4Accumulator>* rk4_sum_ = nullptr;
+  HostArray<float>* density_factor_ = nullptr;  // normalised density's carried factor, when on
   // Integration writes here and swaps, so the force gather reads a state nobody writes.
   std::vector<Float4> next_position_;
   std::vector<Float4> next_velocity_;
   std::vector<uint32_t> keep_order_;
-  std::vector<float> normalized_;  // normalised density (eq. 31), when that feature is on
+  std::vector<float> normalized_;  // normalised density: the summation, then eq. 31 (side array)
   std::vector<Float4> normals_;    // colour-field normals, when surface tension is on
   // Springs (SPH_FEATURE_SPRINGS only): the lists live in the store; the link candidates
   // and the spring accelerations of the current evaluation are side arrays.

@@ -1,10 +1,42 @@
-// Normalised density (thesis eq. 31): rho~_i = sum_j m W_ij / sum_j (m / rho_j) W_ij. Near a
-// free surface the plain sum misses neighbours and reads low; dividing by the kernel's
-// discrete partition of unity corrects that deficit. Needs rho_j from a first density pass
-// (velocity.w = 1 / rho_j).
+// Normalised density (thesis eq. 31) over densities carried per particle.
+//
+// Near a free surface (and near a collider wall: there are no wall particles) the plain sum
+// rho_i = sum_j m W_ij (eq. 9) misses the neighbours beyond it and reads low: about half of the
+// interior's on the outermost layer of a resting body. Eq. 31, rho~_i = sum_j m W_ij /
+// sum_j (m / rho_j) W_ij, divides by the kernel's discrete partition of unity; but with rho_j
+// from the same plain pass it is only a Shepard filter (a W-weighted harmonic mean of the
+// neighbours' densities) and cannot restore values the whole neighbourhood lacks (48 % -> 34 %
+// on the outer layer). Nothing computed from the current positions alone can: a half-empty
+// neighbourhood at a surface and a uniformly expanded fluid sum to the same.
+//
+// So every particle carries a factor g_i and its density is rho_i = g_i sum_j m W_ij:
+//   - between filters g_i is constant, so rho_i changes in the same ratio as its kernel sum:
+//     d ln rho_i / dt = d ln (sum_j m W_ij) / dt, the continuity equation with the divergence
+//     taken from the density kernel and normalised by the kernel sum, integrated exactly along
+//     the particle paths (no time-step error). In the bulk (g = 1) this is the plain
+//     summation; at a surface it makes a uniformly compressed body read compressed to its last
+//     layer (an offset added instead of a factor reads the surface layer too little
+//     compressed, by its missing fraction, and measured worse: docs/physics.md);
+//   - a particle enters the world with g_i = max(1, rho0 / sum_j m W_ij) at its first density
+//     pass: fluid is assumed placed at (or above) rest density, so a missing neighbourhood is
+//     read as free surface, while a block spawned compressed reads compressed;
+//   - every density pass then applies eq. 31 to the carried densities as a Shepard filter (the
+//     re-initialisation of Colagrossi & Landrini 2003): rho_i <- sum_j m W_ij /
+//     sum_j (m / rho_j) W_ij, and g_i takes the ratio to the kernel sum. The filter keeps a
+//     constant field exactly, even at a surface, so a resting body stays at rho0 to its last
+//     layer and a uniformly compressed one stays compressed; it spreads a stale factor into
+//     the neighbours when a particle moves from the surface into the bulk or back. It does
+//     not keep a linear field at a surface or wall (it pulls the boundary value towards the
+//     interior's), which bends a hydrostatic profile near them (docs/physics.md has the
+//     numbers; a first-order, MLS, filter keeps linear fields but measured much worse in a
+//     dynamic tank: it amplifies particle noise at boundaries).
+// g_i is per-particle state: sorted, rolled back and checkpointed with the particles; a fresh
+// particle's factor is NaN until its first density pass.
 #pragma once
 
 #include <stdint.h>
+
+#include <limits>
 
 #include "float4_types.h"
 #include "fluid_constants.h"
@@ -12,6 +44,19 @@
 
 namespace sph {
 
+// The factor of a particle that has not had a density pass yet (set on the host, at append).
+inline float fresh_density_factor() { return std::numeric_limits<float>::quiet_NaN(); }
+
+SPH_HD bool is_fresh_density_factor(float factor) { return factor != factor; }
+
+// rho_i = g_i * summed, resolving a fresh particle's factor first (written back). summed > 0:
+// it includes the particle's own m W(0).
+SPH_HD float carried_density(const FluidConstants& f, float summed, float& factor) {
+  if (is_fresh_density_factor(factor)) factor = summed < f.rest_density ? f.rest_density / summed : 1.0f;
+  return summed * factor;
+}
+
+// Eq. 31 over the carried densities (velocities[j].w = 1 / rho_j), self included.
 SPH_HD float gather_normalized_density(const FluidConstants& f, const GridView& grid, const Float4* positions,
                                        const Float4* velocities, uint32_t i) {
   const Vec3 xi = xyz(positions[i]);

@@ -57,7 +57,8 @@ SPH_HD bool is_force_neighbor(const FluidConstants& f, float r2, uint32_t i, uin
 // normal_i, normal_j: colour-field records (surface tension only; may be null otherwise).
 // pair_neighbors = n_i + n_j, the two particles' neighbour counts (Clavet only): they bound
 // the impulses, I_ij <= 4 u_ij / (n_i + n_j), so the simultaneous pairwise exchange can only
-// remove kinetic energy (the gain from the squared velocity changes stays below the loss).
+// remove kinetic energy (the gain from the squared velocity changes stays below the loss);
+// and I_ij <= u_ij, so a pair's impulse never reverses its approach.
 template <bool kSurfaceTension = false, ViscosityMethod kViscosity = ViscosityMethod::Mueller>
 SPH_HD void add_neighbor_acceleration(const FluidConstants& f, const Float4& pi, Vec3 v_i, const Float4& pj,
                                       const Float4& vj, Vec3 d, float r2, AccelerationSums& sums,
@@ -79,7 +80,11 @@ SPH_HD void add_neighbor_acceleration(const FluidConstants& f, const Float4& pi,
     if (u > 0.0f) {
       const float q = r / f.kernel.h;
       float impulse = f.dt * (1.0f - q) * (f.clavet_linear * u + f.clavet_quadratic * u * u);
-      const float bound = 4.0f * u / pair_neighbors;
+      // At most u: the pair's own impulse may stop its approach but never reverse it (with
+      // few neighbours the energy bound alone, up to 2u, would let a large coefficient turn
+      // an inelastic collision into an elastic bounce).
+      const float energy_bound = 4.0f * u / pair_neighbors;
+      const float bound = energy_bound < u ? energy_bound : u;
       if (impulse > bound) impulse = bound;
       sums.viscosity += unit * (-0.5f * impulse);
     }
