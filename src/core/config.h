@@ -9,6 +9,7 @@
 #include "../physics/springs.h"
 #include "../physics/step_control.h"
 #include "../physics/vec3.h"
+#include "fcc_lattice.h"
 
 namespace sph {
 
@@ -103,7 +104,12 @@ inline FluidConstants make_fluid_constants(const WorldConfig& c, const RuntimePa
   f.gravity = p.gravity;
   f.surface_tension = p.surface_tension;
   const float threshold = p.surface_threshold > 0.0f ? p.surface_threshold : 0.2f / c.kernel_radius;
-  f.surface_threshold_sq = threshold * threshold;
+  f.surface_threshold = threshold;
+  f.surface_delta_scale = 1.0f;
+  if (c.features & kFeatureSurfaceTension) {
+    const double integral = fcc_surface_delta_integral(c.particle_spacing, c.kernel_radius, threshold);
+    f.surface_delta_scale = integral > 0.0 ? static_cast<float>(1.0 / integral) : 1.0f;
+  }
   f.clavet_linear = p.clavet_linear;
   f.clavet_quadratic = p.clavet_quadratic;
   f.dt = 0.0f;  // set by the backend for each substep

@@ -119,4 +119,67 @@ float fcc_density_self_weight(float spacing, float kernel_radius, float rest_den
   return static_cast<float>(static_cast<double>(rest_density) / mass - sum);
 }
 
+double fcc_surface_delta_integral(float spacing, float kernel_radius, float threshold) {
+  const double pi = 3.14159265358979323846;
+  const double step = half_cell(spacing);
+  const double h = kernel_radius;
+  const double h2 = h * h;
+  const double poly6 = 315.0 / (64.0 * pi * std::pow(h, 9.0));
+  const double poly6_grad = -945.0 / (32.0 * pi * std::pow(h, 9.0));
+  const double cell_volume = 2.0 * step * step * step;  // volume per lattice point
+  const int64_t reach = static_cast<int64_t>(std::ceil(h / step)) + 1;
+  // Rest volume m / rho0 = 1 / sum_lattice W (fcc_rest_mass).
+  double w_sum = 0.0;
+  for (int64_t k = -reach; k <= reach; ++k)
+    for (int64_t j = -reach; j <= reach; ++j)
+      for (int64_t i = -reach; i <= reach; ++i) {
+        if (((i + j + k) % 2 + 2) % 2 != 0) continue;
+        const double r2 = step * step * static_cast<double>(i * i + j * j + k * k);
+        if (r2 < h2) w_sum += poly6 * (h2 - r2) * (h2 - r2) * (h2 - r2);
+      }
+  const double volume = 1.0 / w_sum;
+  // Face normals as integer directions and the step of u . (i, j, k) between lattice planes.
+  const int64_t faces[3][4] = {{1, 0, 0, 1}, {1, 1, 0, 1}, {1, 1, 1, 2}};
+  double total = 0.0;
+  for (const auto& f : faces) {
+    const double norm = std::sqrt(static_cast<double>(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]));
+    const double layer_gap = static_cast<double>(f[3]) * step / norm;
+    double integral = 0.0;
+    // Every plane of a Bravais lattice is one orbit of in-plane translations, so one point per
+    // plane (the one nearest the origin) stands for all; area per point = cell_volume / gap.
+    for (int64_t layer = 0; static_cast<double>(layer) * step / norm < h; layer += f[3]) {
+      int64_t best[3] = {0, 0, 0};
+      int64_t best_norm = -1;
+      for (int64_t k = -2 * reach; k <= 2 * reach; ++k)
+        for (int64_t j = -2 * reach; j <= 2 * reach; ++j)
+          for (int64_t i = -2 * reach; i <= 2 * reach; ++i) {
+            if (((i + j + k) % 2 + 2) % 2 != 0 || f[0] * i + f[1] * j + f[2] * k != -layer) continue;
+            const int64_t n2 = i * i + j * j + k * k;
+            if (best_norm < 0 || n2 < best_norm) {
+              best_norm = n2;
+              best[0] = i, best[1] = j, best[2] = k;
+            }
+          }
+      // Colour gradient at that point from the fluid half-space u . q <= 0.
+      double g[3] = {0.0, 0.0, 0.0};
+      for (int64_t k = best[2] - reach; k <= best[2] + reach; ++k)
+        for (int64_t j = best[1] - reach; j <= best[1] + reach; ++j)
+          for (int64_t i = best[0] - reach; i <= best[0] + reach; ++i) {
+            if (((i + j + k) % 2 + 2) % 2 != 0 || f[0] * i + f[1] * j + f[2] * k > 0) continue;
+            const double d[3] = {step * static_cast<double>(best[0] - i),
+                                 step * static_cast<double>(best[1] - j),
+                                 step * static_cast<double>(best[2] - k)};
+            const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            if (r2 >= h2) continue;
+            const double c = poly6_grad * (h2 - r2) * (h2 - r2) * volume;
+            for (int a = 0; a < 3; ++a) g[a] += c * d[a];
+          }
+      const double length = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+      if (length > threshold) integral += volume * (length - threshold) * layer_gap / cell_volume;
+    }
+    total += integral;
+  }
+  return total / 3.0;
+}
+
 }  // namespace sph

@@ -19,8 +19,9 @@ struct FluidConstants {
   float viscosity;  // mu of Mueller's viscosity
   Vec3 gravity;     // m/s^2
   // Surface tension (Morris/Mueller colour field), used when the feature is on.
-  float surface_tension;       // sigma, N/m
-  float surface_threshold_sq;  // |grad c|^2 above which the force applies, 1/m^2
+  float surface_tension;      // sigma, N/m
+  float surface_threshold;    // |grad c| above which the surface stress acts, 1/m
+  float surface_delta_scale;  // 1 / the flat lattice surface's sampled delta integral (CSF)
   // Clavet radial impulses, used when that viscosity method is chosen.
   float clavet_linear;     // sigma, 1/s
   float clavet_quadratic;  // beta, 1/m

@@ -34,18 +34,25 @@ struct AccelerationSums {
   Vec3 pressure;      // sum -(p_j / rho_j^2) grad W_spiky
   Vec3 own_pressure;  // sum -p_i grad W_spiky (times 1 / rho_i^2 in finish_acceleration)
   Vec3 viscosity;     // Mueller: sum (v_j - v_i) / rho_j lap W; Clavet: sum of velocity changes
-  float divergence;   // surface tension: sum (n^_j - n^_i) . grad W_poly6 / rho_j over surface j
-  float shepard;      // surface tension: sum W_poly6 / rho_j over the same j (normalises the above)
+  Vec3 tension;       // surface tension: sum T_j . grad W_poly6 over neighbours j
+  Vec3 gradient;      // surface tension: sum grad W_poly6 (T_i . it in finish_acceleration)
 };
 
 SPH_HD AccelerationSums zero_acceleration_sums() {
-  return AccelerationSums{Vec3{0.0f, 0.0f, 0.0f}, Vec3{0.0f, 0.0f, 0.0f}, Vec3{0.0f, 0.0f, 0.0f}, 0.0f, 0.0f};
+  const Vec3 zero{0.0f, 0.0f, 0.0f};
+  return AccelerationSums{zero, zero, zero, zero, zero};
 }
 
-// The unit normal of a colour-field record (n, |n|), or zero where it does not mark a surface.
-SPH_HD Vec3 surface_unit_normal(const FluidConstants& f, const Float4& normal) {
-  if (normal.w * normal.w <= f.surface_threshold_sq) return Vec3{0.0f, 0.0f, 0.0f};
-  return xyz(normal) * (1.0f / normal.w);
+// The capillary stress of a colour-field record applied to a vector g, without sigma:
+// T . g = t (g - n^ (n^ . g)) with T = t (I - n^ n^) (Lafaurie et al. 1994) and t = |n| less
+// the surface threshold (zero below it): the threshold keeps the noisy normals of interior
+// particles out, and the ramp (not a switch) keeps the stress continuous as a particle crosses
+// it.
+SPH_HD Vec3 surface_stress_times(const FluidConstants& f, const Float4& normal, Vec3 g) {
+  const float t = normal.w - f.surface_threshold;
+  if (t <= 0.0f) return Vec3{0.0f, 0.0f, 0.0f};
+  const Vec3 unit = xyz(normal) * (1.0f / normal.w);
+  return (g - unit * dot(unit, g)) * t;
 }
 
 // Neighbour j contributes to particle i's forces when within h and not i itself.
@@ -62,7 +69,7 @@ SPH_HD bool is_force_neighbor(const FluidConstants& f, float r2, uint32_t i, uin
 template <bool kSurfaceTension = false, ViscosityMethod kViscosity = ViscosityMethod::Mueller>
 SPH_HD void add_neighbor_acceleration(const FluidConstants& f, const Float4& pi, Vec3 v_i, const Float4& pj,
                                       const Float4& vj, Vec3 d, float r2, AccelerationSums& sums,
-                                      float pair_neighbors = 0.0f, const Float4* normal_i = nullptr,
+                                      float pair_neighbors = 0.0f, const Float4* /*normal_i*/ = nullptr,
                                       const Float4* normal_j = nullptr) {
   const float r = SPH_SQRTF(r2);
   const float inv_rho_j = vj.w;
@@ -90,15 +97,9 @@ SPH_HD void add_neighbor_acceleration(const FluidConstants& f, const Float4& pi,
     }
   }
   if (kSurfaceTension) {
-    // Curvature as the divergence of the unit normal (Morris 2000), over neighbours that are
-    // surface particles themselves, Shepard-normalised so a half-empty neighbourhood still
-    // gives 2/R on a sphere.
-    const Vec3 nj = surface_unit_normal(f, *normal_j);
-    if (nj.x != 0.0f || nj.y != 0.0f || nj.z != 0.0f) {
-      const Vec3 ni = surface_unit_normal(f, *normal_i);
-      sums.divergence += dot(nj - ni, poly6_gradient(f.kernel, d, r2)) * inv_rho_j;
-      sums.shepard += poly6(f.kernel, r2) * inv_rho_j;
-    }
+    const Vec3 g = poly6_gradient(f.kernel, d, r2);
+    sums.tension += surface_stress_times(f, *normal_j, g);
+    sums.gradient += g;
   }
 }
 
@@ -113,16 +114,22 @@ SPH_HD Vec3 finish_acceleration(const FluidConstants& f, const Float4& vi, const
   } else if (f.dt > 0.0f) {
     a += sums.viscosity * (1.0f / f.dt);  // the velocity change spread over the substep
   }
-  if (kSurfaceTension && normal_i->w * normal_i->w > f.surface_threshold_sq) {
-    // kappa = -div n^, f = sigma kappa n (force per volume; n = grad c points into the fluid
-    // and its length is the surface's delta function), a = f / rho_i.
-    const float self = poly6(f.kernel, 0.0f) * vi.w;  // particle i's own weight in the Shepard sum
-    float kappa = -sums.divergence / (sums.shepard + self);
-    // No resolvable surface is curved more tightly than a droplet of radius h: clamp, so a few
-    // stray particles with noisy normals cannot kick each other apart.
-    const float kappa_max = 2.0f / f.kernel.h;
-    kappa = kappa > kappa_max ? kappa_max : (kappa < -kappa_max ? -kappa_max : kappa);
-    a += xyz(*normal_i) * (f.surface_tension * kappa * vi.w);
+  if (kSurfaceTension) {
+    // Surface tension as the divergence of the capillary stress sigma T, T = |n| (I - n^ n^)
+    // (Lafaurie et al. 1994; Hu and Adams 2006): a tension sigma |n| along the surface and
+    // none across it. Its divergence is the CSF force sigma kappa n (Brackbill et al. 1992,
+    // Morris 2000, thesis eq. 20-23) plus tangential terms that vanish for constant sigma, so
+    // it yields the Laplace pressure without a curvature estimate, which at the particle scale
+    // was too noisy to use (it flung particles off). Discretised like the pressure,
+    // a_i = (m / rho0^2) sigma S sum_j (T_i + T_j) . grad W_poly6: symmetric in i and j, so
+    // momentum is conserved, and on a flat surface the normal parts cancel exactly (T n^ = 0),
+    // so a free surface feels no spurious push. The particles sample only the fluid side of
+    // the smoothed delta |n|, which across a flat lattice surface integrates to about 0.45
+    // instead of 1: S = surface_delta_scale, 1 / that integral, restores the full tension.
+    const Vec3 own = surface_stress_times(f, *normal_i, sums.gradient);
+    const float scale =
+        f.surface_tension * f.surface_delta_scale * f.particle_mass / (f.rest_density * f.rest_density);
+    a += (sums.tension + own) * scale;
   }
   return a;
 }
