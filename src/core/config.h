@@ -3,6 +3,8 @@
 
 #include <stdint.h>
 
+#include <cmath>
+
 #include "../physics/equation_of_state.h"
 #include "../physics/fluid_constants.h"
 #include "../physics/forces.h"
@@ -93,6 +95,23 @@ inline EosConstants make_eos(const WorldConfig& c, const RuntimeParams& p) {
   return e;
 }
 
+// Surface tension's constants from sigma and the lattice (docs/physics.md, Surface tension):
+// the cohesion carries kSurfaceCohesionShare of sigma and the capillary stress the rest; each
+// share is calibrated on the flat FCC lattice at the world's spacing (the cohesion by its
+// separation energy, the stress by its sampled delta integral).
+constexpr float kSurfaceCohesionShare = 0.2f;
+inline void set_surface_tension_constants(const WorldConfig& c, FluidConstants& f) {
+  const float share = kSurfaceCohesionShare;
+  const double integral =
+      fcc_surface_delta_integral(c.particle_spacing, c.kernel_radius, f.surface_threshold);
+  f.surface_delta_scale = integral > 0.0 ? static_cast<float>((1.0 - share) / integral) : 0.0f;
+  const CohesionLattice lattice = fcc_cohesion_lattice(c.particle_spacing, c.kernel_radius);
+  const double h = c.kernel_radius, m = c.particle_mass;
+  const double gamma_m =
+      lattice.surface_energy > 0.0 ? share * f.surface_tension / (m * lattice.surface_energy) : 0.0;
+  f.surface_cohesion = static_cast<float>(gamma_m * 32.0 / (3.14159265358979323846 * std::pow(h, 9.0)));
+}
+
 inline FluidConstants make_fluid_constants(const WorldConfig& c, const RuntimeParams& p) {
   FluidConstants f;
   f.kernel = make_kernel_coefficients(c.kernel_radius);
@@ -106,10 +125,8 @@ inline FluidConstants make_fluid_constants(const WorldConfig& c, const RuntimePa
   const float threshold = p.surface_threshold > 0.0f ? p.surface_threshold : 0.2f / c.kernel_radius;
   f.surface_threshold = threshold;
   f.surface_delta_scale = 1.0f;
-  if (c.features & kFeatureSurfaceTension) {
-    const double integral = fcc_surface_delta_integral(c.particle_spacing, c.kernel_radius, threshold);
-    f.surface_delta_scale = integral > 0.0 ? static_cast<float>(1.0 / integral) : 1.0f;
-  }
+  f.surface_cohesion = 0.0f;
+  if (c.features & kFeatureSurfaceTension) set_surface_tension_constants(c, f);
   f.clavet_linear = p.clavet_linear;
   f.clavet_quadratic = p.clavet_quadratic;
   f.dt = 0.0f;  // set by the backend for each substep

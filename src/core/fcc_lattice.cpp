@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "../physics/kernels.h"
+#include "../physics/surface_tension_cohesion.h"
 
 namespace sph {
 namespace {
@@ -180,6 +181,96 @@ double fcc_surface_delta_integral(float spacing, float kernel_radius, float thre
     total += integral;
   }
   return total / 3.0;
+}
+
+namespace {
+
+// C(r) with its coefficient 32 / (pi h^9), in double.
+double cohesion_c(double h, double r) {
+  const double pi = 3.14159265358979323846;
+  if (r <= 0.0 || r >= h) return 0.0;
+  const double d = h - r;
+  const double p = d * d * d * r * r * r;
+  const double shape = 2.0 * r > h ? p : 2.0 * p - std::pow(h, 6.0) / 64.0;
+  return 32.0 / (pi * std::pow(h, 9.0)) * shape;
+}
+
+// Phi(r) = int_r^h C: 4-point Gauss-Legendre on each polynomial piece (degree 6, exact).
+double cohesion_potential(double h, double r) {
+  static const double x[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563,
+                              0.8611363115940526};
+  static const double w[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538};
+  auto integrate = [&](double a, double b) {
+    double s = 0.0;
+    for (int k = 0; k < 4; ++k) s += w[k] * cohesion_c(h, 0.5 * (a + b) + 0.5 * (b - a) * x[k]);
+    return 0.5 * (b - a) * s;
+  };
+  if (r >= h) return 0.0;
+  if (2.0 * r >= h) return integrate(r, h);
+  return integrate(r, 0.5 * h) + integrate(0.5 * h, h);
+}
+
+}  // namespace
+
+CohesionLattice fcc_cohesion_lattice(float spacing, float kernel_radius) {
+  const double step = half_cell(spacing);
+  const double h = kernel_radius;
+  const double h2 = h * h;
+  const double cell_volume = 2.0 * step * step * step;  // volume per lattice point
+  const int64_t reach = static_cast<int64_t>(std::ceil(h / step)) + 1;
+  CohesionLattice out{0.0, 0.0};
+  // Bulk virial: one particle and its neighbours.
+  double virial = 0.0;
+  for (int64_t k = -reach; k <= reach; ++k)
+    for (int64_t j = -reach; j <= reach; ++j)
+      for (int64_t i = -reach; i <= reach; ++i) {
+        if (((i + j + k) % 2 + 2) % 2 != 0) continue;
+        const double r2 = step * step * static_cast<double>(i * i + j * j + k * k);
+        if (r2 <= 0.0 || r2 >= h2) continue;
+        const double r = std::sqrt(r2);
+        virial += cohesion_c(h, r) * r;
+      }
+  out.bulk_pressure = virial / (6.0 * cell_volume);
+  // Separation energy: for each lattice plane of B (u . q = layer > 0) one point stands for the
+  // plane (every plane is one orbit of in-plane translations; area per point cell_volume / gap),
+  // and sums Phi over the points of A (u . q <= 0).
+  const int64_t faces[3][4] = {{1, 0, 0, 1}, {1, 1, 0, 1}, {1, 1, 1, 2}};
+  double total = 0.0;
+  for (const auto& f : faces) {
+    const double norm = std::sqrt(static_cast<double>(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]));
+    const double layer_gap = static_cast<double>(f[3]) * step / norm;
+    double energy = 0.0;
+    for (int64_t layer = f[3]; static_cast<double>(layer - f[3]) * step / norm < h; layer += f[3]) {
+      int64_t best[3] = {0, 0, 0};
+      int64_t best_norm = -1;
+      for (int64_t k = -2 * reach; k <= 2 * reach; ++k)
+        for (int64_t j = -2 * reach; j <= 2 * reach; ++j)
+          for (int64_t i = -2 * reach; i <= 2 * reach; ++i) {
+            if (((i + j + k) % 2 + 2) % 2 != 0 || f[0] * i + f[1] * j + f[2] * k != layer) continue;
+            const int64_t n2 = i * i + j * j + k * k;
+            if (best_norm < 0 || n2 < best_norm) {
+              best_norm = n2;
+              best[0] = i, best[1] = j, best[2] = k;
+            }
+          }
+      if (best_norm < 0) continue;
+      double sum = 0.0;
+      for (int64_t k = best[2] - reach; k <= best[2] + reach; ++k)
+        for (int64_t j = best[1] - reach; j <= best[1] + reach; ++j)
+          for (int64_t i = best[0] - reach; i <= best[0] + reach; ++i) {
+            if (((i + j + k) % 2 + 2) % 2 != 0 || f[0] * i + f[1] * j + f[2] * k > 0) continue;
+            const double d[3] = {step * static_cast<double>(best[0] - i),
+                                 step * static_cast<double>(best[1] - j),
+                                 step * static_cast<double>(best[2] - k)};
+            const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            if (r2 < h2) sum += cohesion_potential(h, std::sqrt(r2));
+          }
+      energy += sum * layer_gap / cell_volume;
+    }
+    total += 0.5 * energy;
+  }
+  out.surface_energy = total / 3.0;
+  return out;
 }
 
 }  // namespace sph

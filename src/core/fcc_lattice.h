@@ -41,4 +41,18 @@ float fcc_density_self_weight(float spacing, float kernel_radius, float rest_den
 // Averaged over the (100), (110) and (111) faces (they differ by about 5 %).
 double fcc_surface_delta_integral(float spacing, float kernel_radius, float threshold);
 
+// Surface tension's cohesion (surface_tension_cohesion.h) on the FCC lattice at `spacing`, per
+// unit gamma m^2 (so both scale with the world's gamma and particle mass):
+// - surface_energy: half the work, per unit area, to pull two lattice half-spaces apart along a
+//   lattice plane, sum_{i in A, j in B} Phi(r_ij) / (2 area) with Phi(r) = int_r^h C, i.e. the
+//   cohesion's share of sigma (J/m^2); averaged over the (100), (110) and (111) faces;
+// - bulk_pressure: the pressure the equation of state must hold in the bulk against the
+//   attraction, the virial (n / 6) sum_j C(r_j) r_j over one particle's neighbours (n the
+//   number density); a drop's core holds this plus its Laplace pressure.
+struct CohesionLattice {
+  double surface_energy;
+  double bulk_pressure;
+};
+CohesionLattice fcc_cohesion_lattice(float spacing, float kernel_radius);
+
 }  // namespace sph

@@ -21,7 +21,10 @@ struct FluidConstants {
   // Surface tension (Morris/Mueller colour field), used when the feature is on.
   float surface_tension;      // sigma, N/m
   float surface_threshold;    // |grad c| above which the surface stress acts, 1/m
-  float surface_delta_scale;  // 1 / the flat lattice surface's sampled delta integral (CSF)
+  float surface_delta_scale;  // the capillary stress's share of sigma / the flat lattice
+                              // surface's sampled delta integral (CSF)
+  float surface_cohesion;     // gamma m 32 / (pi h^9) of the cohesion, set from its share of
+                              // sigma (surface_tension_cohesion.h), 1/(m^5 s^2)
   // Clavet radial impulses, used when that viscosity method is chosen.
   float clavet_linear;     // sigma, 1/s
   float clavet_quadratic;  // beta, 1/m

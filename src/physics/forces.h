@@ -16,6 +16,7 @@
 #include "float4_types.h"
 #include "fluid_constants.h"
 #include "neighbor_walk.h"
+#include "surface_tension_cohesion.h"
 
 namespace sph {
 
@@ -36,11 +37,12 @@ struct AccelerationSums {
   Vec3 viscosity;     // Mueller: sum (v_j - v_i) / rho_j lap W; Clavet: sum of velocity changes
   Vec3 tension;       // surface tension: sum T_j . grad W_poly6 over neighbours j
   Vec3 gradient;      // surface tension: sum grad W_poly6 (T_i . it in finish_acceleration)
+  Vec3 cohesion;      // surface tension: sum C(r) (x_i - x_j) / r (without C's coefficient)
 };
 
 SPH_HD AccelerationSums zero_acceleration_sums() {
   const Vec3 zero{0.0f, 0.0f, 0.0f};
-  return AccelerationSums{zero, zero, zero, zero, zero};
+  return AccelerationSums{zero, zero, zero, zero, zero, zero};
 }
 
 // The capillary stress of a colour-field record applied to a vector g, without sigma:
@@ -100,6 +102,7 @@ SPH_HD void add_neighbor_acceleration(const FluidConstants& f, const Float4& pi,
     const Vec3 g = poly6_gradient(f.kernel, d, r2);
     sums.tension += surface_stress_times(f, *normal_j, g);
     sums.gradient += g;
+    if (r > 0.0f) sums.cohesion += d * (cohesion_spline(f.kernel.h, r) / r);
   }
 }
 
@@ -130,6 +133,8 @@ SPH_HD Vec3 finish_acceleration(const FluidConstants& f, const Float4& vi, const
     const float scale =
         f.surface_tension * f.surface_delta_scale * f.particle_mass / (f.rest_density * f.rest_density);
     a += (sums.tension + own) * scale;
+    // The cohesion (surface_tension_cohesion.h), its share of sigma calibrated on the lattice.
+    a += sums.cohesion * (-f.surface_cohesion);
   }
   return a;
 }
