@@ -132,8 +132,9 @@ WorldConfig read_config(ByteReader& r) {
   if (!std::isfinite(k.poly6) || !std::isfinite(k.spiky_grad) || !(k.poly6 > 0.0f) || !(k.visc_lap > 0.0f) ||
       !std::isnormal(k.h2) || !std::isnormal(c.particle_mass))
     corrupt(r.what() + ": kernel radius or particle mass not representable in float32");
-  c.density_self_weight =
-      fcc_density_self_weight(c.particle_spacing, c.kernel_radius, c.rest_density, c.particle_mass);
+  c.spiky_scale = fcc_spiky_scale(c.particle_spacing, c.kernel_radius);
+  c.density_self_weight = fcc_density_self_weight(c.particle_spacing, c.kernel_radius, c.rest_density,
+                                                  c.particle_mass, c.spiky_scale);
   if (!std::isfinite(c.density_self_weight) || !(c.density_self_weight > 0.0f))
     corrupt(r.what() + ": the particle mass " + std::to_string(c.particle_mass) +
             " does not fit the spacing and kernel radius (no positive density self term)");
