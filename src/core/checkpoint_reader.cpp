@@ -296,16 +296,17 @@ ParticleSnapshot read_particles(ByteReader& r, const WorldConfig& config, uint32
               std::to_string(next_id) + ")");
   }
   for (uint32_t i = 0; i < n; ++i) s.density[i] = bulk_finite(r, "density of particle", i);
-  // Normalised density: the carried factors, finite or NaN (a particle spawned since its last
-  // density pass). A checkpoint written before the factors existed ends here: its particles
-  // start fresh.
+  // Normalised density: the carried factors, positive and finite, or NaN (a particle spawned
+  // since its last density pass). A checkpoint written before the factors existed ends here:
+  // its particles start fresh.
   if ((config.features & kFeatureNormalizedDensity) && r.remaining() != 0) {
     r.need_elements(n, sizeof(float), "density factors");
     s.density_factor.resize(n);
     for (uint32_t i = 0; i < n; ++i) {
       const float d = r.f32();
-      if (std::isinf(d))
-        corrupt(r.what() + ": density offset of particle " + std::to_string(i) + " is infinite");
+      if (!std::isnan(d) && !(d > 0.0f && std::isfinite(d)))
+        corrupt(r.what() + ": density factor of particle " + std::to_string(i) + " is " + std::to_string(d) +
+                ", not positive and finite");
       s.density_factor[i] = d;
     }
   }
