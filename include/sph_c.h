@@ -147,9 +147,12 @@ typedef uint32_t sph_feature_flags;
  *  factor of two at 8 particles per radius, and at sigma of about 1 N/m on centimetre drops it
  *  can fling stray surface particles off (docs/physics.md). */
 #define SPH_FEATURE_SURFACE_TENSION 0x1u
-/** Normalised density (thesis eq. 31): a second density pass, a Shepard filter that evens out
- *  the density deficit of particles near a free surface (it narrows it; it does not remove it:
- *  about 48 % -> 34 % on the outermost layer of a resting sphere). */
+/** Normalised density (thesis eq. 31): every particle carries a density factor (4 B of state,
+ *  sorted, rolled back and saved in checkpoints) so that particles at a free surface or a
+ *  collider wall read the bulk's density instead of up to half of it; eq. 31 re-normalises the
+ *  carried densities on every density pass (one more gather). Fluid is assumed spawned at or
+ *  above rest density; surfaces made later (sinks, splitting) read the plain deficit, and a
+ *  tank at rest bends away from the hydrostatic profile near its walls (docs/physics.md). */
 #define SPH_FEATURE_NORMALIZED_DENSITY 0x2u
 /** Elasticity and plasticity (thesis 4.4.2.1; Clavet, Beaudoin & Poulin 2005): springs between
  *  neighbouring particles, made once per particle at its first substep (so the rest shape is

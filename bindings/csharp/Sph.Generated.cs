@@ -27,9 +27,12 @@ namespace Sph
         /// </summary>
         public const uint SPH_FEATURE_SURFACE_TENSION = 1u;
         /// <summary>
-        /// Normalised density (thesis eq. 31): a second density pass, a Shepard filter that evens out
-        /// the density deficit of particles near a free surface (it narrows it; it does not remove it:
-        /// about 48 % -&gt; 34 % on the outermost layer of a resting sphere).
+        /// Normalised density (thesis eq. 31): every particle carries a density factor (4 B of state,
+        /// sorted, rolled back and saved in checkpoints) so that particles at a free surface or a
+        /// collider wall read the bulk's density instead of up to half of it; eq. 31 re-normalises the
+        /// carried densities on every density pass (one more gather). Fluid is assumed spawned at or
+        /// above rest density; surfaces made later (sinks, splitting) read the plain deficit, and a
+        /// tank at rest bends away from the hydrostatic profile near its walls (docs/physics.md).
         /// </summary>
         public const uint SPH_FEATURE_NORMALIZED_DENSITY = 2u;
         /// <summary>

@@ -103,7 +103,9 @@ sph::WorldConfig config_from_def(const sph_world_def& d) {
   c.kernel_radius = h;
   c.rest_density = d.rest_density;
   c.particle_mass = mass;
-  c.density_self_weight = sph::fcc_density_self_weight(d.particle_spacing, h, d.rest_density, mass);
+  c.spiky_scale = sph::fcc_spiky_scale(d.particle_spacing, h);
+  c.density_self_weight =
+      sph::fcc_density_self_weight(d.particle_spacing, h, d.rest_density, mass, c.spiky_scale);
   return c;
 }
 

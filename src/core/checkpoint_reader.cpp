@@ -132,8 +132,9 @@ WorldConfig read_config(ByteReader& r) {
   if (!std::isfinite(k.poly6) || !std::isfinite(k.spiky_grad) || !(k.poly6 > 0.0f) || !(k.visc_lap > 0.0f) ||
       !std::isnormal(k.h2) || !std::isnormal(c.particle_mass))
     corrupt(r.what() + ": kernel radius or particle mass not representable in float32");
-  c.density_self_weight =
-      fcc_density_self_weight(c.particle_spacing, c.kernel_radius, c.rest_density, c.particle_mass);
+  c.spiky_scale = fcc_spiky_scale(c.particle_spacing, c.kernel_radius);
+  c.density_self_weight = fcc_density_self_weight(c.particle_spacing, c.kernel_radius, c.rest_density,
+                                                  c.particle_mass, c.spiky_scale);
   if (!std::isfinite(c.density_self_weight) || !(c.density_self_weight > 0.0f))
     corrupt(r.what() + ": the particle mass " + std::to_string(c.particle_mass) +
             " does not fit the spacing and kernel radius (no positive density self term)");
@@ -295,16 +296,17 @@ ParticleSnapshot read_particles(ByteReader& r, const WorldConfig& config, uint32
               std::to_string(next_id) + ")");
   }
   for (uint32_t i = 0; i < n; ++i) s.density[i] = bulk_finite(r, "density of particle", i);
-  // Normalised density: the carried factors, finite or NaN (a particle spawned since its last
-  // density pass). A checkpoint written before the factors existed ends here: its particles
-  // start fresh.
+  // Normalised density: the carried factors, positive and finite, or NaN (a particle spawned
+  // since its last density pass). A checkpoint written before the factors existed ends here:
+  // its particles start fresh.
   if ((config.features & kFeatureNormalizedDensity) && r.remaining() != 0) {
     r.need_elements(n, sizeof(float), "density factors");
     s.density_factor.resize(n);
     for (uint32_t i = 0; i < n; ++i) {
       const float d = r.f32();
-      if (std::isinf(d))
-        corrupt(r.what() + ": density offset of particle " + std::to_string(i) + " is infinite");
+      if (!std::isnan(d) && !(d > 0.0f && std::isfinite(d)))
+        corrupt(r.what() + ": density factor of particle " + std::to_string(i) + " is " + std::to_string(d) +
+                ", not positive and finite");
       s.density_factor[i] = d;
     }
   }

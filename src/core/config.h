@@ -41,6 +41,8 @@ struct WorldConfig {
   // The density's self term (FluidConstants::density_self_weight), derived with the mass at
   // creation and when a checkpoint is loaded (it is not stored).
   float density_self_weight = 0.0f;
+  // The lattice normalisation of W_spiky (fcc_spiky_scale), derived like density_self_weight.
+  float spiky_scale = 1.0f;
 };
 
 struct RuntimeParams {
@@ -115,6 +117,8 @@ inline void set_surface_tension_constants(const WorldConfig& c, FluidConstants& 
 inline FluidConstants make_fluid_constants(const WorldConfig& c, const RuntimeParams& p) {
   FluidConstants f;
   f.kernel = make_kernel_coefficients(c.kernel_radius);
+  f.kernel.spiky *= c.spiky_scale;
+  f.kernel.spiky_grad *= c.spiky_scale;
   f.particle_mass = c.particle_mass;
   f.density_self_weight = c.density_self_weight;
   f.rest_density = c.rest_density;

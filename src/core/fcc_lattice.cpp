@@ -101,11 +101,37 @@ float fcc_rest_mass(float spacing, float kernel_radius, float rest_density) {
   return static_cast<float>(rest_density / sum);
 }
 
-float fcc_density_self_weight(float spacing, float kernel_radius, float rest_density, float mass) {
+float fcc_spiky_scale(float spacing, float kernel_radius) {
+  const double pi = 3.14159265358979323846;
   const double step = half_cell(spacing);
   const double h = kernel_radius;
   const double h2 = h * h;
-  const double spiky = 15.0 / (3.14159265358979323846 * std::pow(h, 6.0));
+  const double poly6 = 315.0 / (64.0 * pi * std::pow(h, 9.0));
+  const double spiky_grad = 45.0 / (pi * std::pow(h, 6.0));
+  const int64_t n = static_cast<int64_t>(std::ceil(h / step)) + 1;
+  double w_sum = 0.0;   // sum W_poly6: 1 / (rest volume m / rho0), as fcc_rest_mass
+  double moment = 0.0;  // sum x_j |dW_spiky/dx| along x over the neighbours
+  for (int64_t k = -n; k <= n; ++k)
+    for (int64_t j = -n; j <= n; ++j)
+      for (int64_t i = -n; i <= n; ++i) {
+        if (((i + j + k) % 2 + 2) % 2 != 0) continue;
+        const double r2 = step * step * static_cast<double>(i * i + j * j + k * k);
+        if (r2 >= h2) continue;
+        w_sum += poly6 * (h2 - r2) * (h2 - r2) * (h2 - r2);
+        if (r2 == 0.0) continue;
+        const double r = std::sqrt(r2);
+        const double x = step * static_cast<double>(i);
+        moment += spiky_grad * (h - r) * (h - r) * x * x / r;
+      }
+  return static_cast<float>(w_sum / moment);
+}
+
+float fcc_density_self_weight(float spacing, float kernel_radius, float rest_density, float mass,
+                              float spiky_scale) {
+  const double step = half_cell(spacing);
+  const double h = kernel_radius;
+  const double h2 = h * h;
+  const double spiky = spiky_scale * 15.0 / (3.14159265358979323846 * std::pow(h, 6.0));
   const int64_t n = static_cast<int64_t>(std::ceil(h / step)) + 1;
   double sum = 0.0;
   for (int64_t k = -n; k <= n; ++k)

@@ -43,23 +43,27 @@ static void test_zero_particles(void** state) {
   ext_close(&w);
 }
 
-/* The density's self term w0 (src/physics/density.h): rho0 / m minus the sum of W_spiky over the
- * FCC lattice's neighbours at `spacing`, so that the lattice sits at rho0. Computed here in
- * double from the definition. */
+/* The density's self term w0 (src/physics/density.h): rho0 / m minus the sum of the scaled
+ * W_spiky over the FCC lattice's neighbours at `spacing`, so that the lattice sits at rho0. The
+ * scale (fcc_spiky_scale) makes the lattice's first moment of grad W exact:
+ * (m / rho0) sum_j x_j^2 / r_j |W'(r_j)| = 1. Computed here in double from the definitions. */
 static double density_self_weight(double spacing, double h, double rho0, double mass) {
   const double step = spacing / sqrt(2.0);
   const int n = (int)ceil(h / step) + 1;
-  double sum = 0.0;
+  const double pi = 3.14159265358979;
+  double sum = 0.0, moment = 0.0;
   for (int k = -n; k <= n; ++k)
     for (int j = -n; j <= n; ++j)
       for (int i = -n; i <= n; ++i) {
-        double r;
+        double r, x;
         if (((i + j + k) % 2 + 2) % 2 != 0 || (i == 0 && j == 0 && k == 0)) continue;
         r = step * sqrt((double)(i * i + j * j + k * k));
         if (r >= h) continue;
-        sum += 15.0 / (3.14159265358979 * pow(h, 6.0)) * (h - r) * (h - r) * (h - r);
+        x = step * i;
+        sum += 15.0 / (pi * pow(h, 6.0)) * (h - r) * (h - r) * (h - r);
+        moment += 45.0 / (pi * pow(h, 6.0)) * (h - r) * (h - r) * x * x / r;
       }
-  return rho0 / mass - sum;
+  return rho0 / mass - sum / (mass / rho0 * moment);
 }
 
 /* One particle has no neighbours: density m w0, the self term alone (below rho0, so no

@@ -15,6 +15,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "physics_util.h"
 #include "validation_util.h"
@@ -287,6 +288,114 @@ static void test_factors_follow_particles_through_sinks(void** state) {
   physics_destroy(context, world);
 }
 
+/* FNV-1a 64 and the header reseal of docs/checkpoint.md (as tests/reliability does), to forge
+ * checkpoints. */
+static uint64_t fnv1a(const uint8_t* p, size_t n, uint64_t h) {
+  for (size_t i = 0; i < n; ++i) {
+    h ^= p[i];
+    h *= 0x100000001b3ull;
+  }
+  return h;
+}
+
+static void put_u64(uint8_t* p, uint64_t v) {
+  for (int k = 0; k < 8; ++k) p[k] = (uint8_t)(v >> (8 * k));
+}
+
+static uint64_t get_u64(const uint8_t* p) {
+  uint64_t v = 0;
+  for (int k = 7; k >= 0; --k) v = (v << 8) | p[k];
+  return v;
+}
+
+static void reseal(uint8_t* data, size_t size) {
+  uint64_t h;
+  put_u64(data + 24, (uint64_t)(size - 48));
+  h = fnv1a(data, 32, 0xcbf29ce484222325ull);
+  h = fnv1a(data + 40, size - 40, h);
+  put_u64(data + 32, h);
+}
+
+/* Offset of the 'PART' section's header in a checkpoint (sections follow the 48-byte header,
+ * each a 16-byte header: tag, 0, u64 body length). */
+static size_t part_section(const uint8_t* data, size_t size) {
+  size_t at = 48;
+  while (at + 16 <= size) {
+    if (memcmp(data + at, "PART", 4) == 0) return at;
+    at += 16 + (size_t)get_u64(data + at + 8);
+  }
+  fail_msg("no PART section");
+  return 0;
+}
+
+/* The carried factors are saved: a loaded world continues bit for bit (densities compared with
+ * memcmp after one more frame), a checkpoint without them (the format before they existed,
+ * forged by cutting them off) still loads and its particles start fresh (the surface reads the
+ * interior's density again after a step, within the issue's 5 %), and a factor that is not
+ * positive is refused as corrupt. */
+static void test_factors_in_checkpoints(void** state) {
+  const double centre[3] = {0.0, 0.0, 0.0};
+  const float radius = 5.0f * kSpacing;
+  sph_context* context = NULL;
+  sph_world *world = NULL, *loaded = NULL;
+  sph_world_def def = make_def(1, 4096);
+  float *lattice = NULL, *a = NULL, *b = NULL;
+  uint64_t rng = 9, size = 0;
+  uint8_t *data, *forged;
+  uint32_t n;
+  size_t part, body, cut;
+  layers l;
+  float minus_one = -1.0f;
+  (void)state;
+  physics_create(&def, &context, &world);
+  EXPECT_OK(sph_world_get_def(world, &def));
+  physics_set_params(world, 0.0f, -9.81f, 0.0f, 1e-6f, 1e-3f);
+  n = physics_fcc_sphere(kSpacing, radius, &lattice);
+  physics_spawn_disturbed(world, lattice, n, 0.05, &rng);
+  free(lattice);
+  EXPECT_OK(sph_world_step(world, 0.02f));
+  EXPECT_OK(sph_world_save(world, NULL, 0, &size)); /* the size it needs */
+  data = (uint8_t*)malloc(size);
+  forged = (uint8_t*)malloc(size);
+  assert_true(data && forged);
+  EXPECT_OK(sph_world_save(world, data, size, &size));
+  EXPECT_OK(sph_world_load(context, data, size, &loaded));
+  EXPECT_OK(sph_world_step(world, 0.02f));
+  EXPECT_OK(sph_world_step(loaded, 0.02f));
+  assert_int_equal(physics_copy_by_id(world, SPH_ATTRIBUTE_DENSITY, (void**)&a), n);
+  assert_int_equal(physics_copy_by_id(loaded, SPH_ATTRIBUTE_DENSITY, (void**)&b), n);
+  assert_memory_equal(a, b, 4 * (size_t)n);
+  EXPECT_OK(sph_world_destroy(loaded));
+
+  /* The factors are the last 4 n bytes of PART. */
+  part = part_section(data, (size_t)size);
+  body = (size_t)get_u64(data + part + 8);
+  cut = part + 16 + body - 4 * (size_t)n;
+  memcpy(forged, data, cut);
+  memcpy(forged + cut, data + cut + 4 * (size_t)n, (size_t)size - cut - 4 * (size_t)n);
+  put_u64(forged + part + 8, body - 4 * (uint64_t)n);
+  reseal(forged, (size_t)size - 4 * (size_t)n);
+  EXPECT_OK(sph_world_load(context, forged, size - 4 * (uint64_t)n, &loaded));
+  physics_set_params(loaded, 0.0f, 0.0f, 0.0f, 1e-6f, 1e-5f);
+  EXPECT_OK(sph_world_step(loaded, 1e-5f));
+  l = measure(loaded, centre, radius, def.kernel_radius);
+  print_message("checkpoint without factors: loads; surface within %.2f %% of the interior after a step\n",
+                100.0 * l.surface_worst);
+  assert_true(l.surface_worst <= 0.05);
+  EXPECT_OK(sph_world_destroy(loaded));
+
+  memcpy(forged, data, (size_t)size);
+  memcpy(forged + cut, &minus_one, 4); /* little-endian hosts, as the format */
+  reseal(forged, (size_t)size);
+  assert_int_equal(sph_world_load(context, forged, size, &loaded), SPH_ERROR_CORRUPT_DATA);
+  assert_non_null(strstr(sph_get_last_error(), "density factor"));
+  free(a);
+  free(b);
+  free(data);
+  free(forged);
+  physics_destroy(context, world);
+}
+
 /* A ball of radius 5 s (s = 1 cm, 515 particles) dropped from 10 cm onto the floor of a closed
  * 30 cm tank (default k, mu; impact at 1.4 m/s, a seventh of the sound speed), for 0.8 s: it
  * splashes, spreads and sloshes. Stable means: every step succeeds, every particle stays in the
@@ -363,6 +472,7 @@ int main(void) {
       cmocka_unit_test(test_resting_sphere_surface_within_5_percent),
       cmocka_unit_test(test_compression_is_visible),
       cmocka_unit_test(test_factors_follow_particles_through_sinks),
+      cmocka_unit_test(test_factors_in_checkpoints),
       cmocka_unit_test(test_drop_into_tank_is_stable),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

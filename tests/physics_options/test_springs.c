@@ -172,12 +172,15 @@ static void test_elastic_blob_returns_to_rest_shape(void** state) {
   assert_true(fabs(r.aspect - 1.0) < 0.01);
 }
 
-/* Plastic (alpha = 50 1/s, yield band gamma = 2 %): the same landing leaves a dent that stays:
- * unloaded height/width below 0.95 (measured 0.90), the shape more than 2 % of R from the
- * spawn shape (measured 4.8 %), and no more than 0.02 of drift in the ratio over 0.1 s
- * unloaded (measured 0.004): the rest lengths moved, so the springs hold the new shape. */
+/* Plastic (alpha = 50 1/s, yield band gamma = 3 %): the same landing leaves a dent that stays:
+ * unloaded height/width below 0.95 (measured 0.915), the shape more than 2 % of R from the
+ * spawn shape (measured 4.0 %), and no more than 0.02 of drift in the ratio over 0.1 s
+ * unloaded (measured 0.003): the rest lengths moved, so the springs hold the new shape. The
+ * band is the material's: with the energy-consistent density (density.h) the flattened
+ * blob's own pressure strains its springs by more than 2 %, so a 2 % band kept creeping back
+ * (0.85 -> 0.90 in 0.1 s); the band must exceed the strain the body's own load causes. */
 static void test_plastic_blob_keeps_its_dent(void** state) {
-  const drop_result r = drop_blob(50.0f, 0.02f);
+  const drop_result r = drop_blob(50.0f, 0.03f);
   (void)state;
   printf("plastic: min aspect %.4f, unloaded aspect %.4f (0.1 s before: %.4f), deviation %.5f R\n",
          r.min_aspect, r.aspect, r.aspect_earlier, r.deviation);

@@ -12,6 +12,7 @@
  * Worker threads never call cmocka (its failure path longjmps); they record results and the
  * main thread checks them. */
 #include <pthread.h>
+#include <sched.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -186,6 +187,7 @@ typedef struct intruder {
   sph_world* world;
   sph_world_params params; /* what set_params writes: the values the world already has */
   int stop;                /* guarded by mutex */
+  long rounds;             /* loop rounds begun, guarded by mutex */
   pthread_mutex_t mutex;
   long ok_calls;
   long locked_calls;
@@ -199,8 +201,22 @@ static int intruder_should_stop(intruder* in) {
   int stop;
   pthread_mutex_lock(&in->mutex);
   stop = in->stop;
+  if (!stop) ++in->rounds;
   pthread_mutex_unlock(&in->mutex);
   return stop;
+}
+
+static long intruder_rounds(intruder* in) {
+  long rounds;
+  pthread_mutex_lock(&in->mutex);
+  rounds = in->rounds;
+  pthread_mutex_unlock(&in->mutex);
+  return rounds;
+}
+
+/* Waits until the intruder has begun `rounds` loop rounds. */
+static void wait_for_rounds(intruder* in, long rounds) {
+  while (intruder_rounds(in) < rounds) sched_yield();
 }
 
 static void intruder_record(intruder* in, sph_result r) {
@@ -248,6 +264,9 @@ static void test_world_used_from_two_threads(void** state) {
   EXPECT_OK(sph_world_get_params(world, &in.params));
   assert_int_equal(pthread_mutex_init(&in.mutex, NULL), 0);
   assert_int_equal(pthread_create(&thread, NULL, intruder_thread, &in), 0);
+  /* The intruder is running before the owner's first step (a GPU frame can be over before a
+   * new thread is scheduled). */
+  wait_for_rounds(&in, 1);
 
   /* The owner steps kFrames frames; a step that finds the intruder inside the world gets
    * WORLD_LOCKED, did nothing, and is retried. */
@@ -261,6 +280,10 @@ static void test_world_used_from_two_threads(void** state) {
       fail_msg("owner's step: %s (%s)", sph_result_string(r), sph_get_last_error());
     }
   }
+  /* Two more rounds with the world free: the second runs wholly after the owner's last step,
+   * so its calls must succeed (on the GPU the owner can hold the world for every round the
+   * intruder made during the frames). */
+  wait_for_rounds(&in, intruder_rounds(&in) + 2);
   pthread_mutex_lock(&in.mutex);
   in.stop = 1;
   pthread_mutex_unlock(&in.mutex);

@@ -13,6 +13,7 @@ extern "C" {
 #include <cstdio>
 #include <random>
 
+#include "core/fcc_lattice.h"
 #include "physics/kernels.h"
 
 namespace {
@@ -248,13 +249,55 @@ void test_coefficients(void**) {
   }
 }
 
+// The lattice scale of W_spiky (core/fcc_lattice.h): with it, the symmetric pressure
+// acceleration a_i = -sum_j m (p_i + p_j) / rho0^2 grad W_ij over an FCC lattice at rest density
+// recovers a linear pressure field's gradient, -grad p / rho0, along every axis (the scale is
+// derived from the x moment alone, so y and z check the lattice's cubic symmetry), to 1e-4.
+// Without it the recovered gradient is the lattice moment, 0.899 at h = 1.8 spacings: checked
+// too, so a scale of 1 cannot pass. Sums in double over float coefficients.
+void test_spiky_lattice_scale(void**) {
+  const double spacing = 0.02, rho0 = 1000.0;
+  for (double factor : {1.5, 1.8, 2.0, 2.5}) {
+    const double h = factor * spacing;
+    const float scale = sph::fcc_spiky_scale(static_cast<float>(spacing), static_cast<float>(h));
+    const float mass =
+        sph::fcc_rest_mass(static_cast<float>(spacing), static_cast<float>(h), static_cast<float>(rho0));
+    KernelCoefficients c = sph::make_kernel_coefficients(static_cast<float>(h));
+    const double step = spacing / std::sqrt(2.0);
+    const int n = static_cast<int>(std::ceil(h / step)) + 1;
+    for (int axis = 0; axis < 3; ++axis) {
+      const double gradient = 1.0e4;  // Pa/m along the axis; p_i = 0 at the origin
+      double a = 0.0;
+      for (int k = -n; k <= n; ++k)
+        for (int j = -n; j <= n; ++j)
+          for (int i = -n; i <= n; ++i) {
+            if (((i + j + k) % 2 + 2) % 2 != 0 || (i == 0 && j == 0 && k == 0)) continue;
+            const double x[3] = {step * i, step * j, step * k};
+            const double r = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+            if (r >= h) continue;
+            // d = x_i - x_j = -x; grad W along the axis.
+            const Vec3 d{static_cast<float>(-x[0]), static_cast<float>(-x[1]), static_cast<float>(-x[2])};
+            const Vec3 g = sph::spiky_gradient(c, d, static_cast<float>(r));
+            const double g_axis = axis == 0 ? g.x : axis == 1 ? g.y : g.z;
+            a += -mass * (gradient * x[axis]) / (rho0 * rho0) * g_axis;
+          }
+      const double exact = -gradient / rho0;
+      std::printf("h = %.1f s, axis %d: unscaled %.4f, scaled %.6f of -grad p / rho0\n", factor, axis,
+                  a / exact, a * scale / exact);
+      assert_true(std::fabs(a * scale / exact - 1.0) < 1e-4);
+      if (factor == 1.8) assert_true(std::fabs(a / exact - 0.899) < 0.002);
+    }
+  }
+}
+
 }  // namespace
 
 int main() {
   const CMUnitTest tests[] = {
-      cmocka_unit_test(test_coefficients),      cmocka_unit_test(test_normalisation),
-      cmocka_unit_test(test_support_and_shape), cmocka_unit_test(test_spiky_gradient),
-      cmocka_unit_test(test_poly6_gradient),    cmocka_unit_test(test_viscosity_laplacian),
+      cmocka_unit_test(test_coefficients),        cmocka_unit_test(test_normalisation),
+      cmocka_unit_test(test_support_and_shape),   cmocka_unit_test(test_spiky_gradient),
+      cmocka_unit_test(test_poly6_gradient),      cmocka_unit_test(test_viscosity_laplacian),
+      cmocka_unit_test(test_spiky_lattice_scale),
   };
   return cmocka_run_group_tests_name("kernels", tests, nullptr, nullptr);
 }

@@ -10,7 +10,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'd4bd2fe53b94e311dd65e2927643a14880fa21a196e02eaced6c79f45b17b2bc', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
+HEADERS = {'include/sph_c.h': '67aa35c68464e22ae198d3026eb4f18a13cc352070c90fc4890d7f263ec63f5e', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -30,9 +30,12 @@ SPH_FEATURE_NONE = 0
 #: of two at 8 particles per radius, and at sigma of about 1 N/m on centimetre drops it can fling
 #: stray surface particles off (docs/physics.md).
 SPH_FEATURE_SURFACE_TENSION = 1
-#: Normalised density (thesis eq. 31): a second density pass, a Shepard filter that evens out the
-#: density deficit of particles near a free surface (it narrows it; it does not remove it: about 48
-#: % -> 34 % on the outermost layer of a resting sphere).
+#: Normalised density (thesis eq. 31): every particle carries a density factor (4 B of state,
+#: sorted, rolled back and saved in checkpoints) so that particles at a free surface or a collider
+#: wall read the bulk's density instead of up to half of it; eq. 31 re-normalises the carried
+#: densities on every density pass (one more gather). Fluid is assumed spawned at or above rest
+#: density; surfaces made later (sinks, splitting) read the plain deficit, and a tank at rest bends
+#: away from the hydrostatic profile near its walls (docs/physics.md).
 SPH_FEATURE_NORMALIZED_DENSITY = 2
 #: Elasticity and plasticity (thesis 4.4.2.1; Clavet, Beaudoin & Poulin 2005): springs between
 #: neighbouring particles, made once per particle at its first substep (so the rest shape is the
