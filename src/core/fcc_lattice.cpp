@@ -32,6 +32,22 @@ BoxLattice box_lattice(Vec3 min, Vec3 max, float spacing) {
   return b;
 }
 
+// Calls visit(i, j, k, r2) for every FCC point (i + j + k even, in half-cell steps) closer than
+// h to the origin, the origin included, always in the same order (so every lattice sum below is
+// the same number on every machine).
+template <class Visit>
+void for_each_lattice_point_within(double step, double h, Visit&& visit) {
+  const double h2 = h * h;
+  const int64_t n = static_cast<int64_t>(std::ceil(h / step)) + 1;
+  for (int64_t k = -n; k <= n; ++k)
+    for (int64_t j = -n; j <= n; ++j)
+      for (int64_t i = -n; i <= n; ++i) {
+        if (((i + j + k) % 2 + 2) % 2 != 0) continue;
+        const double r2 = step * step * static_cast<double>(i * i + j * j + k * k);
+        if (r2 < h2) visit(i, j, k, r2);
+      }
+}
+
 }  // namespace
 
 uint64_t fcc_box_point_count(Vec3 min, Vec3 max, float spacing) {
@@ -87,17 +103,11 @@ float fcc_rest_mass(float spacing, float kernel_radius, float rest_density) {
   const double h = kernel_radius;
   const double h2 = h * h;
   const double poly6 = 315.0 / (64.0 * 3.14159265358979323846 * std::pow(h, 9.0));
-  const int64_t n = static_cast<int64_t>(std::ceil(h / step)) + 1;
   double sum = 0.0;
-  for (int64_t k = -n; k <= n; ++k)
-    for (int64_t j = -n; j <= n; ++j)
-      for (int64_t i = -n; i <= n; ++i) {
-        if (((i + j + k) % 2 + 2) % 2 != 0) continue;
-        const double r2 = step * step * static_cast<double>(i * i + j * j + k * k);
-        if (r2 >= h2) continue;
-        const double d = h2 - r2;
-        sum += poly6 * d * d * d;
-      }
+  for_each_lattice_point_within(step, h, [&](int64_t, int64_t, int64_t, double r2) {
+    const double d = h2 - r2;
+    sum += poly6 * d * d * d;
+  });
   return static_cast<float>(rest_density / sum);
 }
 
@@ -108,21 +118,15 @@ float fcc_spiky_scale(float spacing, float kernel_radius) {
   const double h2 = h * h;
   const double poly6 = 315.0 / (64.0 * pi * std::pow(h, 9.0));
   const double spiky_grad = 45.0 / (pi * std::pow(h, 6.0));
-  const int64_t n = static_cast<int64_t>(std::ceil(h / step)) + 1;
   double w_sum = 0.0;   // sum W_poly6: 1 / (rest volume m / rho0), as fcc_rest_mass
   double moment = 0.0;  // sum x_j |dW_spiky/dx| along x over the neighbours
-  for (int64_t k = -n; k <= n; ++k)
-    for (int64_t j = -n; j <= n; ++j)
-      for (int64_t i = -n; i <= n; ++i) {
-        if (((i + j + k) % 2 + 2) % 2 != 0) continue;
-        const double r2 = step * step * static_cast<double>(i * i + j * j + k * k);
-        if (r2 >= h2) continue;
-        w_sum += poly6 * (h2 - r2) * (h2 - r2) * (h2 - r2);
-        if (r2 == 0.0) continue;
-        const double r = std::sqrt(r2);
-        const double x = step * static_cast<double>(i);
-        moment += spiky_grad * (h - r) * (h - r) * x * x / r;
-      }
+  for_each_lattice_point_within(step, h, [&](int64_t i, int64_t, int64_t, double r2) {
+    w_sum += poly6 * (h2 - r2) * (h2 - r2) * (h2 - r2);
+    if (r2 == 0.0) return;
+    const double r = std::sqrt(r2);
+    const double x = step * static_cast<double>(i);
+    moment += spiky_grad * (h - r) * (h - r) * x * x / r;
+  });
   return static_cast<float>(w_sum / moment);
 }
 
@@ -130,19 +134,13 @@ float fcc_density_self_weight(float spacing, float kernel_radius, float rest_den
                               float spiky_scale) {
   const double step = half_cell(spacing);
   const double h = kernel_radius;
-  const double h2 = h * h;
   const double spiky = spiky_scale * 15.0 / (3.14159265358979323846 * std::pow(h, 6.0));
-  const int64_t n = static_cast<int64_t>(std::ceil(h / step)) + 1;
   double sum = 0.0;
-  for (int64_t k = -n; k <= n; ++k)
-    for (int64_t j = -n; j <= n; ++j)
-      for (int64_t i = -n; i <= n; ++i) {
-        if (((i + j + k) % 2 + 2) % 2 != 0 || (i == 0 && j == 0 && k == 0)) continue;
-        const double r2 = step * step * static_cast<double>(i * i + j * j + k * k);
-        if (r2 >= h2) continue;
-        const double d = h - std::sqrt(r2);
-        sum += spiky * d * d * d;
-      }
+  for_each_lattice_point_within(step, h, [&](int64_t, int64_t, int64_t, double r2) {
+    if (r2 == 0.0) return;  // the self term is what this returns
+    const double d = h - std::sqrt(r2);
+    sum += spiky * d * d * d;
+  });
   return static_cast<float>(static_cast<double>(rest_density) / mass - sum);
 }
 
@@ -157,13 +155,9 @@ double fcc_surface_delta_integral(float spacing, float kernel_radius, float thre
   const int64_t reach = static_cast<int64_t>(std::ceil(h / step)) + 1;
   // Rest volume m / rho0 = 1 / sum_lattice W (fcc_rest_mass).
   double w_sum = 0.0;
-  for (int64_t k = -reach; k <= reach; ++k)
-    for (int64_t j = -reach; j <= reach; ++j)
-      for (int64_t i = -reach; i <= reach; ++i) {
-        if (((i + j + k) % 2 + 2) % 2 != 0) continue;
-        const double r2 = step * step * static_cast<double>(i * i + j * j + k * k);
-        if (r2 < h2) w_sum += poly6 * (h2 - r2) * (h2 - r2) * (h2 - r2);
-      }
+  for_each_lattice_point_within(step, h, [&](int64_t, int64_t, int64_t, double r2) {
+    w_sum += poly6 * (h2 - r2) * (h2 - r2) * (h2 - r2);
+  });
   const double volume = 1.0 / w_sum;
   // Face normals as integer directions and the step of u . (i, j, k) between lattice planes.
   const int64_t faces[3][4] = {{1, 0, 0, 1}, {1, 1, 0, 1}, {1, 1, 1, 2}};
@@ -247,15 +241,11 @@ CohesionLattice fcc_cohesion_lattice(float spacing, float kernel_radius) {
   CohesionLattice out{0.0, 0.0};
   // Bulk virial: one particle and its neighbours.
   double virial = 0.0;
-  for (int64_t k = -reach; k <= reach; ++k)
-    for (int64_t j = -reach; j <= reach; ++j)
-      for (int64_t i = -reach; i <= reach; ++i) {
-        if (((i + j + k) % 2 + 2) % 2 != 0) continue;
-        const double r2 = step * step * static_cast<double>(i * i + j * j + k * k);
-        if (r2 <= 0.0 || r2 >= h2) continue;
-        const double r = std::sqrt(r2);
-        virial += cohesion_c(h, r) * r;
-      }
+  for_each_lattice_point_within(step, h, [&](int64_t, int64_t, int64_t, double r2) {
+    if (r2 <= 0.0) return;
+    const double r = std::sqrt(r2);
+    virial += cohesion_c(h, r) * r;
+  });
   out.bulk_pressure = virial / (6.0 * cell_volume);
   // Separation energy: for each lattice plane of B (u . q = layer > 0) one point stands for the
   // plane (every plane is one orbit of in-plane translations; area per point cell_volume / gap),
