@@ -48,6 +48,43 @@ void for_each_lattice_point_within(double step, double h, Visit&& visit) {
       }
 }
 
+// The three faces a lattice sum over a flat surface averages: the integer normal (i, j, k) and
+// the step of f . q between neighbouring lattice planes.
+const int64_t kFccFaces[3][4] = {{1, 0, 0, 1}, {1, 1, 0, 1}, {1, 1, 1, 2}};
+
+// The FCC point q of the plane f . q = plane nearest the origin (searched within 2 reach steps
+// per axis, first found on a tie); false, and `best` untouched, if the search finds none.
+bool nearest_point_on_plane(const int64_t f[4], int64_t plane, int64_t reach, int64_t best[3]) {
+  int64_t best_norm = -1;
+  for (int64_t k = -2 * reach; k <= 2 * reach; ++k)
+    for (int64_t j = -2 * reach; j <= 2 * reach; ++j)
+      for (int64_t i = -2 * reach; i <= 2 * reach; ++i) {
+        if (((i + j + k) % 2 + 2) % 2 != 0 || f[0] * i + f[1] * j + f[2] * k != plane) continue;
+        const int64_t n2 = i * i + j * j + k * k;
+        if (best_norm < 0 || n2 < best_norm) {
+          best_norm = n2;
+          best[0] = i, best[1] = j, best[2] = k;
+        }
+      }
+  return best_norm >= 0;
+}
+
+// Calls visit(d, r2) for every FCC point q of the half-space f . q <= 0 within reach steps per
+// axis of p and closer than sqrt(h2), with d = (p - q) step, always in the same order.
+template <class Visit>
+void for_each_half_space_point_near(const int64_t f[4], const int64_t p[3], int64_t reach, double step,
+                                    double h2, Visit&& visit) {
+  for (int64_t k = p[2] - reach; k <= p[2] + reach; ++k)
+    for (int64_t j = p[1] - reach; j <= p[1] + reach; ++j)
+      for (int64_t i = p[0] - reach; i <= p[0] + reach; ++i) {
+        if (((i + j + k) % 2 + 2) % 2 != 0 || f[0] * i + f[1] * j + f[2] * k > 0) continue;
+        const double d[3] = {step * static_cast<double>(p[0] - i), step * static_cast<double>(p[1] - j),
+                             step * static_cast<double>(p[2] - k)};
+        const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        if (r2 < h2) visit(d, r2);
+      }
+}
+
 }  // namespace
 
 uint64_t fcc_box_point_count(Vec3 min, Vec3 max, float spacing) {
@@ -159,10 +196,8 @@ double fcc_surface_delta_integral(float spacing, float kernel_radius, float thre
     w_sum += poly6 * (h2 - r2) * (h2 - r2) * (h2 - r2);
   });
   const double volume = 1.0 / w_sum;
-  // Face normals as integer directions and the step of u . (i, j, k) between lattice planes.
-  const int64_t faces[3][4] = {{1, 0, 0, 1}, {1, 1, 0, 1}, {1, 1, 1, 2}};
   double total = 0.0;
-  for (const auto& f : faces) {
+  for (const auto& f : kFccFaces) {
     const double norm = std::sqrt(static_cast<double>(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]));
     const double layer_gap = static_cast<double>(f[3]) * step / norm;
     double integral = 0.0;
@@ -170,31 +205,13 @@ double fcc_surface_delta_integral(float spacing, float kernel_radius, float thre
     // plane (the one nearest the origin) stands for all; area per point = cell_volume / gap.
     for (int64_t layer = 0; static_cast<double>(layer) * step / norm < h; layer += f[3]) {
       int64_t best[3] = {0, 0, 0};
-      int64_t best_norm = -1;
-      for (int64_t k = -2 * reach; k <= 2 * reach; ++k)
-        for (int64_t j = -2 * reach; j <= 2 * reach; ++j)
-          for (int64_t i = -2 * reach; i <= 2 * reach; ++i) {
-            if (((i + j + k) % 2 + 2) % 2 != 0 || f[0] * i + f[1] * j + f[2] * k != -layer) continue;
-            const int64_t n2 = i * i + j * j + k * k;
-            if (best_norm < 0 || n2 < best_norm) {
-              best_norm = n2;
-              best[0] = i, best[1] = j, best[2] = k;
-            }
-          }
+      nearest_point_on_plane(f, -layer, reach, best);
       // Colour gradient at that point from the fluid half-space u . q <= 0.
       double g[3] = {0.0, 0.0, 0.0};
-      for (int64_t k = best[2] - reach; k <= best[2] + reach; ++k)
-        for (int64_t j = best[1] - reach; j <= best[1] + reach; ++j)
-          for (int64_t i = best[0] - reach; i <= best[0] + reach; ++i) {
-            if (((i + j + k) % 2 + 2) % 2 != 0 || f[0] * i + f[1] * j + f[2] * k > 0) continue;
-            const double d[3] = {step * static_cast<double>(best[0] - i),
-                                 step * static_cast<double>(best[1] - j),
-                                 step * static_cast<double>(best[2] - k)};
-            const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-            if (r2 >= h2) continue;
-            const double c = poly6_grad * (h2 - r2) * (h2 - r2) * volume;
-            for (int a = 0; a < 3; ++a) g[a] += c * d[a];
-          }
+      for_each_half_space_point_near(f, best, reach, step, h2, [&](const double d[3], double r2) {
+        const double c = poly6_grad * (h2 - r2) * (h2 - r2) * volume;
+        for (int a = 0; a < 3; ++a) g[a] += c * d[a];
+      });
       const double length = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
       if (length > threshold) integral += volume * (length - threshold) * layer_gap / cell_volume;
     }
@@ -250,37 +267,18 @@ CohesionLattice fcc_cohesion_lattice(float spacing, float kernel_radius) {
   // Separation energy: for each lattice plane of B (u . q = layer > 0) one point stands for the
   // plane (every plane is one orbit of in-plane translations; area per point cell_volume / gap),
   // and sums Phi over the points of A (u . q <= 0).
-  const int64_t faces[3][4] = {{1, 0, 0, 1}, {1, 1, 0, 1}, {1, 1, 1, 2}};
   double total = 0.0;
-  for (const auto& f : faces) {
+  for (const auto& f : kFccFaces) {
     const double norm = std::sqrt(static_cast<double>(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]));
     const double layer_gap = static_cast<double>(f[3]) * step / norm;
     double energy = 0.0;
     for (int64_t layer = f[3]; static_cast<double>(layer - f[3]) * step / norm < h; layer += f[3]) {
       int64_t best[3] = {0, 0, 0};
-      int64_t best_norm = -1;
-      for (int64_t k = -2 * reach; k <= 2 * reach; ++k)
-        for (int64_t j = -2 * reach; j <= 2 * reach; ++j)
-          for (int64_t i = -2 * reach; i <= 2 * reach; ++i) {
-            if (((i + j + k) % 2 + 2) % 2 != 0 || f[0] * i + f[1] * j + f[2] * k != layer) continue;
-            const int64_t n2 = i * i + j * j + k * k;
-            if (best_norm < 0 || n2 < best_norm) {
-              best_norm = n2;
-              best[0] = i, best[1] = j, best[2] = k;
-            }
-          }
-      if (best_norm < 0) continue;
+      if (!nearest_point_on_plane(f, layer, reach, best)) continue;
       double sum = 0.0;
-      for (int64_t k = best[2] - reach; k <= best[2] + reach; ++k)
-        for (int64_t j = best[1] - reach; j <= best[1] + reach; ++j)
-          for (int64_t i = best[0] - reach; i <= best[0] + reach; ++i) {
-            if (((i + j + k) % 2 + 2) % 2 != 0 || f[0] * i + f[1] * j + f[2] * k > 0) continue;
-            const double d[3] = {step * static_cast<double>(best[0] - i),
-                                 step * static_cast<double>(best[1] - j),
-                                 step * static_cast<double>(best[2] - k)};
-            const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-            if (r2 < h2) sum += cohesion_potential(h, std::sqrt(r2));
-          }
+      for_each_half_space_point_near(f, best, reach, step, h2, [&](const double*, double r2) {
+        sum += cohesion_potential(h, std::sqrt(r2));
+      });
       energy += sum * layer_gap / cell_volume;
     }
     total += 0.5 * energy;
