@@ -1,0 +1,427 @@
+// Neighbour-search variants for the two gather passes, measured alone on the GPU (issue 18):
+// how many candidates each cell layout makes a particle test, and what a density pass and a
+// force-like pass cost with each, on the benchmark's rest sphere (FCC lattice, h = 1.8
+// spacings). Standalone: it reimplements the hash, sort and cell table so variants can be
+// swapped without touching the library; the library's formulas are not needed to compare
+// search strategies (the pair terms here have the library's shape and cost: W_spiky for the
+// density, grad W_spiky pressure plus Laplacian viscosity for the force).
+//
+// Variants (cell size c, dense cell-start table over a wrapped grid, as in the library):
+//   h27     c = h, 9 rows of 3 cells (the library today)
+//   h27p    c = h, the same rows, but rows whose y-z box is farther than h are skipped
+//   h2_125  c = h/2, 25 rows of 5 cells, no pruning
+//   h2_p    c = h/2, per particle: rows farther than h in y-z skipped, and each row cut to the
+//           cells that overlap [x - h, x + h] (4 or 5 of them)
+// Each variant's densities are checked against h27's (same neighbours, other summation order:
+// relative difference below 1e-5).
+//
+// Usage: neighbor_search_variants [--particles N] [--repeat R] [--jitter J]
+#include <cuda_runtime.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <cub/device/device_radix_sort.cuh>
+#include <string>
+#include <vector>
+
+namespace {
+
+#define CHECK(call)                                                                               \
+  do {                                                                                            \
+    cudaError_t e_ = (call);                                                                      \
+    if (e_ != cudaSuccess) {                                                                      \
+      std::fprintf(stderr, "%s:%d: %s: %s\n", __FILE__, __LINE__, #call, cudaGetErrorString(e_)); \
+      std::exit(1);                                                                               \
+    }                                                                                             \
+  } while (0)
+
+struct Grid {
+  float inv_cell;
+  int nx, ny, nz;
+  unsigned cells;
+  const unsigned* start;  // cells + 1 entries
+};
+
+__host__ __device__ inline int wrap(int c, int n) {
+  const int m = c % n;
+  return m < 0 ? m + n : m;
+}
+
+__device__ inline int cell_coord(float x, float inv) { return static_cast<int>(floorf(x * inv)); }
+
+__global__ void hash_kernel(Grid g, const float4* p, unsigned n, unsigned* keys, unsigned* values) {
+  const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const float4 q = p[i];
+  const int cx = wrap(cell_coord(q.x, g.inv_cell), g.nx), cy = wrap(cell_coord(q.y, g.inv_cell), g.ny),
+            cz = wrap(cell_coord(q.z, g.inv_cell), g.nz);
+  keys[i] = static_cast<unsigned>(cx + g.nx * (cy + g.ny * cz));
+  values[i] = i;
+}
+
+__global__ void gather_kernel(const float4* in, const unsigned* order, unsigned n, float4* out) {
+  const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i < n) out[i] = in[order[i]];
+}
+
+__global__ void cell_start_kernel(const unsigned* keys, unsigned n, unsigned cells, unsigned* start) {
+  const unsigned c = blockIdx.x * blockDim.x + threadIdx.x;
+  if (c > cells) return;
+  unsigned lo = 0, hi = n;
+  while (lo < hi) {
+    const unsigned mid = lo + (hi - lo) / 2;
+    if (keys[mid] < c)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  start[c] = lo;
+}
+
+enum Variant { kH27 = 0, kH27Pruned = 1, kHalf125 = 2, kHalfPruned = 3 };
+const char* kVariantNames[] = {"h27", "h27p", "h2_125", "h2_p"};
+
+// Calls visit(begin, end) for each contiguous run of candidates of particle at p.
+template <int V, class Visit>
+__device__ inline void for_each_run(const Grid& g, float3 p, float h, Visit&& visit) {
+  const float c = 1.0f / g.inv_cell;
+  const int cx = cell_coord(p.x, g.inv_cell), cy = cell_coord(p.y, g.inv_cell),
+            cz = cell_coord(p.z, g.inv_cell);
+  constexpr int R = (V == kH27 || V == kH27Pruned) ? 1 : 2;
+  const float h2 = h * h;
+  int x_lo = cx - R, x_hi = cx + R;
+  if (V == kHalfPruned) {
+    x_lo = cell_coord(p.x - h, g.inv_cell);
+    x_hi = cell_coord(p.x + h, g.inv_cell);
+  }
+  for (int dz = -R; dz <= R; ++dz) {
+    // Distance in z from p to the slab of cells cz + dz.
+    float ez = 0.0f;
+    if (V == kH27Pruned || V == kHalfPruned) {
+      const float lo = (cz + dz) * c, hi = lo + c;
+      ez = p.z < lo ? lo - p.z : (p.z > hi ? p.z - hi : 0.0f);
+      if (ez * ez >= h2) continue;
+    }
+    const int wz = wrap(cz + dz, g.nz);
+    for (int dy = -R; dy <= R; ++dy) {
+      if (V == kH27Pruned || V == kHalfPruned) {
+        const float lo = (cy + dy) * c, hi = lo + c;
+        const float ey = p.y < lo ? lo - p.y : (p.y > hi ? p.y - hi : 0.0f);
+        if (ey * ey + ez * ez >= h2) continue;
+      }
+      const int wy = wrap(cy + dy, g.ny);
+      const unsigned row =
+          static_cast<unsigned>(g.nx) * (static_cast<unsigned>(wy) + g.ny * static_cast<unsigned>(wz));
+      const int a = wrap(x_lo, g.nx), b = wrap(x_hi, g.nx);
+      if (a <= b) {
+        visit(g.start[row + a], g.start[row + b + 1]);
+      } else {
+        visit(g.start[row + a], g.start[row + g.nx]);
+        visit(g.start[row], g.start[row + b + 1]);
+      }
+    }
+  }
+}
+
+struct Consts {
+  float h, h2, spiky, spiky_grad, visc_lap, mass, self, k, rho0, mu;
+};
+
+template <int V>
+__global__ void density_kernel(Grid g, Consts k, const float4* __restrict__ p, unsigned n, float* rho,
+                               unsigned* candidates, unsigned* neighbours) {
+  const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const float4 pi = p[i];
+  const float3 xi = make_float3(pi.x, pi.y, pi.z);
+  float sum = 0.0f;
+  unsigned cand = 0, nb = 0;
+  for_each_run<V>(g, xi, k.h, [&](unsigned b, unsigned e) {
+    cand += e - b;
+#pragma unroll 4
+    for (unsigned j = b; j < e; ++j) {
+      const float4 q = p[j];
+      const float dx = xi.x - q.x, dy = xi.y - q.y, dz = xi.z - q.z;
+      const float r2 = dx * dx + dy * dy + dz * dz;
+      if (r2 < k.h2 && j != i) {
+        const float d = k.h - sqrtf(r2);
+        sum += d * d * d;
+        ++nb;
+      }
+    }
+  });
+  rho[i] = k.mass * (k.self + k.spiky * sum);
+  if (candidates) {
+    candidates[i] = cand;
+    neighbours[i] = nb;
+  }
+}
+
+// The library's two-phase force gather (cuda/substep_kernels.cu): test a run of up to 32
+// candidates into a mask, then evaluate the pair terms of the set bits.
+template <int V>
+__global__ void force_kernel(Grid g, Consts k, const float4* __restrict__ p, const float4* __restrict__ v,
+                             unsigned n, float4* acc) {
+  const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const float4 pi = p[i];
+  const float4 vi = v[i];
+  const float3 xi = make_float3(pi.x, pi.y, pi.z);
+  float ax = 0, ay = 0, az = 0, ox = 0, oy = 0, oz = 0, vx = 0, vy = 0, vz = 0;
+  for_each_run<V>(g, xi, k.h, [&](unsigned b, unsigned e) {
+    for (unsigned base = b; base < e; base += 32u) {
+      const unsigned count = min(32u, e - base);
+      unsigned hits = 0;
+#pragma unroll 4
+      for (unsigned t = 0; t < count; ++t) {
+        const float4 q = p[base + t];
+        const float dx = xi.x - q.x, dy = xi.y - q.y, dz = xi.z - q.z;
+        const float r2 = dx * dx + dy * dy + dz * dz;
+        hits |= ((r2 < k.h2 && base + t != i) ? 1u : 0u) << t;
+      }
+      while (hits) {
+        const unsigned j = base + static_cast<unsigned>(__ffs(hits) - 1);
+        hits &= hits - 1u;
+        const float4 q = p[j];
+        const float4 w = v[j];
+        const float dx = xi.x - q.x, dy = xi.y - q.y, dz = xi.z - q.z;
+        const float r = sqrtf(dx * dx + dy * dy + dz * dz);
+        if (r <= 0.0f) continue;
+        const float d = k.h - r;
+        const float gm = k.spiky_grad * d * d / r;
+        const float pj = -q.w * w.w * w.w;
+        ax += gm * dx * pj;
+        ay += gm * dy * pj;
+        az += gm * dz * pj;
+        ox += gm * dx * -pi.w;
+        oy += gm * dy * -pi.w;
+        oz += gm * dz * -pi.w;
+        const float l = k.visc_lap * d * w.w;
+        vx += (w.x - vi.x) * l;
+        vy += (w.y - vi.y) * l;
+        vz += (w.z - vi.z) * l;
+      }
+    }
+  });
+  const float s = vi.w * vi.w;
+  const float m_rho = k.mass * vi.w;
+  acc[i] = make_float4((ax + ox * s) * k.mass + vx * k.mu * m_rho,
+                       (ay + oy * s) * k.mass + vy * k.mu * m_rho - 9.81f,
+                       (az + oz * s) * k.mass + vz * k.mu * m_rho, 0.0f);
+}
+
+__global__ void pack_kernel(float4* p, float4* v, const float* rho, Consts k, unsigned n) {
+  const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const float r = rho[i];
+  p[i].w = fmaxf(0.0f, k.k * (r - k.rho0));
+  v[i].w = 1.0f / r;
+}
+
+float median(std::vector<float> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  unsigned target = 1000000;
+  int repeat = 20;
+  float jitter = 0.1f;  // fraction of the spacing: a lattice disturbed like the moving sphere
+  for (int a = 1; a + 1 < argc; a += 2) {
+    if (!std::strcmp(argv[a], "--particles")) target = static_cast<unsigned>(std::atof(argv[a + 1]));
+    if (!std::strcmp(argv[a], "--repeat")) repeat = std::atoi(argv[a + 1]);
+    if (!std::strcmp(argv[a], "--jitter")) jitter = static_cast<float>(std::atof(argv[a + 1]));
+  }
+  const float s = 0.02f, h = 1.8f * s;
+  // FCC sphere with about `target` points (4 per cube of side s sqrt 2).
+  const double step = s / std::sqrt(2.0);
+  const double radius = std::cbrt(3.0 * target * std::pow(s, 3) / (4.0 * M_PI * std::sqrt(2.0)));
+  const int m = static_cast<int>(radius / step) + 1;
+  std::vector<float4> pos;
+  unsigned long long rng = 88172645463325252ull;
+  auto uniform = [&]() {
+    rng ^= rng << 13;
+    rng ^= rng >> 7;
+    rng ^= rng << 17;
+    return static_cast<float>((rng >> 11) * (1.0 / 9007199254740992.0)) - 0.5f;
+  };
+  for (int z = -m; z <= m; ++z)
+    for (int y = -m; y <= m; ++y)
+      for (int x = -m; x <= m; ++x) {
+        if (((x + y + z) & 1) != 0) continue;
+        const double px = x * step, py = y * step, pz = z * step;
+        if (px * px + py * py + pz * pz > radius * radius) continue;
+        pos.push_back(make_float4(static_cast<float>(px) + jitter * s * uniform(),
+                                  static_cast<float>(py) + jitter * s * uniform(),
+                                  static_cast<float>(pz) + jitter * s * uniform(), 0.0f));
+      }
+  const unsigned n = static_cast<unsigned>(pos.size());
+  std::vector<float4> vel(n);
+  for (auto& w : vel) w = make_float4(0.1f * uniform(), 0.1f * uniform(), 0.1f * uniform(), 0.0f);
+
+  Consts k;
+  k.h = h;
+  k.h2 = h * h;
+  k.spiky = 15.0f / (3.14159265f * std::pow(h, 6.0f));
+  k.spiky_grad = -45.0f / (3.14159265f * std::pow(h, 6.0f));
+  k.visc_lap = 45.0f / (3.14159265f * std::pow(h, 6.0f));
+  k.rho0 = 1000.0f;
+  k.mass = k.rho0 * s * s * s / std::sqrt(2.0f);
+  k.self = 0.0f;
+  k.k = 100.0f;
+  k.mu = 1.0f;
+
+  float4 *d_pos, *d_vel, *d_spos, *d_svel, *d_acc;
+  unsigned *keys[2], *vals[2], *d_start, *d_cand, *d_nb;
+  float *d_rho, *d_rho_ref;
+  CHECK(cudaMalloc(&d_pos, n * sizeof(float4)));
+  CHECK(cudaMalloc(&d_vel, n * sizeof(float4)));
+  CHECK(cudaMalloc(&d_spos, n * sizeof(float4)));
+  CHECK(cudaMalloc(&d_svel, n * sizeof(float4)));
+  CHECK(cudaMalloc(&d_acc, n * sizeof(float4)));
+  for (int b = 0; b < 2; ++b) {
+    CHECK(cudaMalloc(&keys[b], n * sizeof(unsigned)));
+    CHECK(cudaMalloc(&vals[b], n * sizeof(unsigned)));
+  }
+  CHECK(cudaMalloc(&d_cand, n * sizeof(unsigned)));
+  CHECK(cudaMalloc(&d_nb, n * sizeof(unsigned)));
+  CHECK(cudaMalloc(&d_rho, n * sizeof(float)));
+  CHECK(cudaMalloc(&d_rho_ref, n * sizeof(float)));
+  CHECK(cudaMemcpy(d_pos, pos.data(), n * sizeof(float4), cudaMemcpyHostToDevice));
+  CHECK(cudaMemcpy(d_vel, vel.data(), n * sizeof(float4), cudaMemcpyHostToDevice));
+  cudaEvent_t e0, e1;
+  CHECK(cudaEventCreate(&e0));
+  CHECK(cudaEventCreate(&e1));
+
+  std::printf("particles %u, h %.4f, jitter %.2f spacing, %d repeats (median ms)\n", n, h, jitter, repeat);
+  std::printf("%-8s %6s %9s %7s %7s %9s %9s %8s %10s\n", "variant", "cell", "table", "cand", "neigh",
+              "density", "force", "sort", "max_rel");
+  std::vector<float> rho_ref;
+  for (int v = 0; v < 4; ++v) {
+    const bool half = v == kHalf125 || v == kHalfPruned;
+    const float cell = half ? 0.5f * h : h;
+    // h cells: about one table slot per particle (the library); h/2 cells: two per particle.
+    const int side = std::max(5, static_cast<int>(std::ceil(std::cbrt((half ? 2.0 : 1.0) * n))));
+    Grid g;
+    g.inv_cell = 1.0f / cell;
+    g.nx = g.ny = g.nz = side;
+    g.cells = static_cast<unsigned>(side) * side * side;
+    CHECK(cudaMalloc(&d_start, (g.cells + 1) * sizeof(unsigned)));
+    g.start = d_start;
+    const unsigned blocks = (n + 127) / 128;
+    // Sort once (timed), reorder positions and velocities.
+    size_t temp_bytes = 0;
+    cub::DoubleBuffer<unsigned> kb(keys[0], keys[1]), vb(vals[0], vals[1]);
+    CHECK(cub::DeviceRadixSort::SortPairs(nullptr, temp_bytes, kb, vb, static_cast<int>(n)));
+    void* temp = nullptr;
+    CHECK(cudaMalloc(&temp, temp_bytes));
+    std::vector<float> sort_ms;
+    for (int r = 0; r < repeat; ++r) {
+      CHECK(cudaEventRecord(e0));
+      hash_kernel<<<blocks, 128>>>(g, d_pos, n, keys[0], vals[0]);
+      cub::DoubleBuffer<unsigned> kb2(keys[0], keys[1]), vb2(vals[0], vals[1]);
+      CHECK(cub::DeviceRadixSort::SortPairs(temp, temp_bytes, kb2, vb2, static_cast<int>(n)));
+      gather_kernel<<<blocks, 128>>>(d_pos, vb2.Current(), n, d_spos);
+      gather_kernel<<<blocks, 128>>>(d_vel, vb2.Current(), n, d_svel);
+      cell_start_kernel<<<(g.cells + 1 + 127) / 128, 128>>>(kb2.Current(), n, g.cells, d_start);
+      CHECK(cudaEventRecord(e1));
+      CHECK(cudaEventSynchronize(e1));
+      float ms = 0;
+      CHECK(cudaEventElapsedTime(&ms, e0, e1));
+      sort_ms.push_back(ms);
+    }
+    std::vector<unsigned> order(n);
+    {
+      // Recompute the permutation for this variant (the last sort's).
+      hash_kernel<<<blocks, 128>>>(g, d_pos, n, keys[0], vals[0]);
+      cub::DoubleBuffer<unsigned> kb2(keys[0], keys[1]), vb2(vals[0], vals[1]);
+      CHECK(cub::DeviceRadixSort::SortPairs(temp, temp_bytes, kb2, vb2, static_cast<int>(n)));
+      CHECK(cudaMemcpy(order.data(), vb2.Current(), n * sizeof(unsigned), cudaMemcpyDeviceToHost));
+    }
+    auto run_density = [&](bool count) {
+      unsigned* c = count ? d_cand : nullptr;
+      unsigned* nb = count ? d_nb : nullptr;
+      switch (v) {
+        case kH27:
+          density_kernel<kH27><<<blocks, 128>>>(g, k, d_spos, n, d_rho, c, nb);
+          break;
+        case kH27Pruned:
+          density_kernel<kH27Pruned><<<blocks, 128>>>(g, k, d_spos, n, d_rho, c, nb);
+          break;
+        case kHalf125:
+          density_kernel<kHalf125><<<blocks, 128>>>(g, k, d_spos, n, d_rho, c, nb);
+          break;
+        default:
+          density_kernel<kHalfPruned><<<blocks, 128>>>(g, k, d_spos, n, d_rho, c, nb);
+          break;
+      }
+    };
+    auto run_force = [&]() {
+      switch (v) {
+        case kH27:
+          force_kernel<kH27><<<blocks, 128>>>(g, k, d_spos, d_svel, n, d_acc);
+          break;
+        case kH27Pruned:
+          force_kernel<kH27Pruned><<<blocks, 128>>>(g, k, d_spos, d_svel, n, d_acc);
+          break;
+        case kHalf125:
+          force_kernel<kHalf125><<<blocks, 128>>>(g, k, d_spos, d_svel, n, d_acc);
+          break;
+        default:
+          force_kernel<kHalfPruned><<<blocks, 128>>>(g, k, d_spos, d_svel, n, d_acc);
+          break;
+      }
+    };
+    run_density(true);
+    CHECK(cudaGetLastError());
+    CHECK(cudaDeviceSynchronize());
+    std::vector<unsigned> cand(n), nb(n);
+    std::vector<float> rho(n);
+    CHECK(cudaMemcpy(cand.data(), d_cand, n * sizeof(unsigned), cudaMemcpyDeviceToHost));
+    CHECK(cudaMemcpy(nb.data(), d_nb, n * sizeof(unsigned), cudaMemcpyDeviceToHost));
+    CHECK(cudaMemcpy(rho.data(), d_rho, n * sizeof(float), cudaMemcpyDeviceToHost));
+    // Densities by original index, compared with the first variant's.
+    std::vector<float> by_index(n);
+    for (unsigned i = 0; i < n; ++i) by_index[order[i]] = rho[i];
+    double max_rel = 0.0;
+    if (v == 0)
+      rho_ref = by_index;
+    else
+      for (unsigned i = 0; i < n; ++i)
+        max_rel =
+            std::max(max_rel, std::fabs(double(by_index[i]) - rho_ref[i]) / std::fabs(double(rho_ref[i])));
+    double mean_c = 0, mean_n = 0;
+    for (unsigned i = 0; i < n; ++i) {
+      mean_c += cand[i];
+      mean_n += nb[i];
+    }
+    pack_kernel<<<blocks, 128>>>(d_spos, d_svel, d_rho, k, n);
+    std::vector<float> dens_ms, force_ms;
+    for (int r = 0; r < repeat + 3; ++r) {
+      CHECK(cudaEventRecord(e0));
+      run_density(false);
+      CHECK(cudaEventRecord(e1));
+      CHECK(cudaEventSynchronize(e1));
+      float ms = 0;
+      CHECK(cudaEventElapsedTime(&ms, e0, e1));
+      if (r >= 3) dens_ms.push_back(ms);
+      CHECK(cudaEventRecord(e0));
+      run_force();
+      CHECK(cudaEventRecord(e1));
+      CHECK(cudaEventSynchronize(e1));
+      CHECK(cudaEventElapsedTime(&ms, e0, e1));
+      if (r >= 3) force_ms.push_back(ms);
+    }
+    CHECK(cudaGetLastError());
+    std::printf("%-8s %6.4f %9u %7.1f %7.1f %9.4f %9.4f %8.4f %10.2e\n", kVariantNames[v], cell, g.cells + 1,
+                mean_c / n, mean_n / n, median(dens_ms), median(force_ms), median(sort_ms), max_rel);
+    CHECK(cudaFree(temp));
+    CHECK(cudaFree(d_start));
+  }
+  return 0;
+}
