@@ -84,19 +84,28 @@ __global__ void cell_start_kernel(const unsigned* keys, unsigned n, unsigned cel
 enum Variant { kH27 = 0, kH27Pruned = 1, kHalf125 = 2, kHalfPruned = 3 };
 const char* kVariantNames[] = {"h27", "h27p", "h2_125", "h2_p"};
 
-// Calls visit(begin, end) for each contiguous run of candidates of particle at p.
+// w + step wrapped into [0, n) for w in [0, n) and |step| < n: no integer division.
+__device__ inline int wrap_add(int w, int step, int n) {
+  const int s = w + step;
+  return s < 0 ? s + n : (s >= n ? s - n : s);
+}
+
+// Calls visit(begin, end) for each contiguous run of candidates of particle at p. One integer
+// remainder per axis (as the library's for_each_neighbor_range), the rest by stepping.
 template <int V, class Visit>
 __device__ inline void for_each_run(const Grid& g, float3 p, float h, Visit&& visit) {
   const float c = 1.0f / g.inv_cell;
   const int cx = cell_coord(p.x, g.inv_cell), cy = cell_coord(p.y, g.inv_cell),
             cz = cell_coord(p.z, g.inv_cell);
+  const int wx = wrap(cx, g.nx), wy0 = wrap(cy, g.ny), wz0 = wrap(cz, g.nz);
   constexpr int R = (V == kH27 || V == kH27Pruned) ? 1 : 2;
   const float h2 = h * h;
-  int x_lo = cx - R, x_hi = cx + R;
+  int lo_step = -R, hi_step = R;
   if (V == kHalfPruned) {
-    x_lo = cell_coord(p.x - h, g.inv_cell);
-    x_hi = cell_coord(p.x + h, g.inv_cell);
+    lo_step = cell_coord(p.x - h, g.inv_cell) - cx;
+    hi_step = cell_coord(p.x + h, g.inv_cell) - cx;
   }
+  const int a = wrap_add(wx, lo_step, g.nx), b = wrap_add(wx, hi_step, g.nx);
   for (int dz = -R; dz <= R; ++dz) {
     // Distance in z from p to the slab of cells cz + dz.
     float ez = 0.0f;
@@ -105,22 +114,21 @@ __device__ inline void for_each_run(const Grid& g, float3 p, float h, Visit&& vi
       ez = p.z < lo ? lo - p.z : (p.z > hi ? p.z - hi : 0.0f);
       if (ez * ez >= h2) continue;
     }
-    const int wz = wrap(cz + dz, g.nz);
+    const int wz = wrap_add(wz0, dz, g.nz);
     for (int dy = -R; dy <= R; ++dy) {
       if (V == kH27Pruned || V == kHalfPruned) {
         const float lo = (cy + dy) * c, hi = lo + c;
         const float ey = p.y < lo ? lo - p.y : (p.y > hi ? p.y - hi : 0.0f);
         if (ey * ey + ez * ez >= h2) continue;
       }
-      const int wy = wrap(cy + dy, g.ny);
+      const int wy = wrap_add(wy0, dy, g.ny);
       const unsigned row =
           static_cast<unsigned>(g.nx) * (static_cast<unsigned>(wy) + g.ny * static_cast<unsigned>(wz));
-      const int a = wrap(x_lo, g.nx), b = wrap(x_hi, g.nx);
       if (a <= b) {
-        visit(g.start[row + a], g.start[row + b + 1]);
+        visit(__ldg(g.start + row + a), __ldg(g.start + row + b + 1));
       } else {
-        visit(g.start[row + a], g.start[row + g.nx]);
-        visit(g.start[row], g.start[row + b + 1]);
+        visit(__ldg(g.start + row + a), __ldg(g.start + row + g.nx));
+        visit(__ldg(g.start + row), __ldg(g.start + row + b + 1));
       }
     }
   }
@@ -158,6 +166,136 @@ __global__ void density_kernel(Grid g, Consts k, const float4* __restrict__ p, u
     candidates[i] = cand;
     neighbours[i] = nb;
   }
+}
+
+// Branchless density: every candidate adds max(h - r, 0)^3, the particle itself included (its
+// W(0) is taken back out once), so a warp never diverges on the hit test.
+template <int V>
+__global__ void density_branchless_kernel(Grid g, Consts k, const float4* __restrict__ p, unsigned n,
+                                          float* rho) {
+  const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const float4 pi = p[i];
+  const float3 xi = make_float3(pi.x, pi.y, pi.z);
+  float sum = 0.0f;
+  for_each_run<V>(g, xi, k.h, [&](unsigned b, unsigned e) {
+#pragma unroll 4
+    for (unsigned j = b; j < e; ++j) {
+      const float4 q = p[j];
+      const float dx = xi.x - q.x, dy = xi.y - q.y, dz = xi.z - q.z;
+      const float r2 = dx * dx + dy * dy + dz * dz;
+      const float d = fmaxf(k.h - sqrtf(r2), 0.0f);
+      sum += d * d * d;
+    }
+  });
+  rho[i] = k.mass * (k.self + k.spiky * (sum - k.h * k.h * k.h));
+}
+
+// Neighbour masks: bit t of word w says candidate 32 w + t of the particle's candidate sequence
+// (its runs, concatenated in visiting order) is a neighbour. kMaskWords words per particle,
+// stored word-major (mask[w * n + i]) so a warp's loads coalesce; a particle with more
+// candidates than the mask holds sets overflow[i] and the force pass tests it itself.
+constexpr int kMaskWords = 8;
+
+template <int V>
+__global__ void density_mask_kernel(Grid g, Consts k, const float4* __restrict__ p, unsigned n, float* rho,
+                                    unsigned* __restrict__ mask, unsigned* __restrict__ overflow) {
+  const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const float4 pi = p[i];
+  const float3 xi = make_float3(pi.x, pi.y, pi.z);
+  float sum = 0.0f;
+  unsigned seq = 0;  // candidates seen so far
+  unsigned words[kMaskWords];
+#pragma unroll
+  for (int w = 0; w < kMaskWords; ++w) words[w] = 0u;
+  for_each_run<V>(g, xi, k.h, [&](unsigned b, unsigned e) {
+    for (unsigned base = b; base < e; base += 32u) {
+      const unsigned count = min(32u, e - base);
+      unsigned hits = 0;
+#pragma unroll 4
+      for (unsigned t = 0; t < count; ++t) {
+        const float4 q = p[base + t];
+        const float dx = xi.x - q.x, dy = xi.y - q.y, dz = xi.z - q.z;
+        const float r2 = dx * dx + dy * dy + dz * dz;
+        hits |= ((r2 < k.h2 && base + t != i) ? 1u : 0u) << t;
+      }
+      // Record the hits at sequence positions seq .. seq + count (two words at most).
+      const unsigned w0 = seq >> 5, sh = seq & 31u;
+#pragma unroll
+      for (int w = 0; w < kMaskWords; ++w) {
+        if (w == static_cast<int>(w0)) words[w] |= hits << sh;
+        if (sh != 0u && w == static_cast<int>(w0) + 1) words[w] |= hits >> (32u - sh);
+      }
+      seq += count;
+      while (hits) {
+        const unsigned j = base + static_cast<unsigned>(__ffs(hits) - 1);
+        hits &= hits - 1u;
+        const float4 q = p[j];
+        const float dx = xi.x - q.x, dy = xi.y - q.y, dz = xi.z - q.z;
+        const float d = k.h - sqrtf(dx * dx + dy * dy + dz * dz);
+        sum += d * d * d;
+      }
+    }
+  });
+  rho[i] = k.mass * (k.self + k.spiky * sum);
+#pragma unroll
+  for (int w = 0; w < kMaskWords; ++w) mask[static_cast<size_t>(w) * n + i] = words[w];
+  overflow[i] = seq > 32u * kMaskWords ? 1u : 0u;
+}
+
+// The force pass from the density pass's masks: no candidate is tested again.
+template <int V>
+__global__ void force_from_mask_kernel(Grid g, Consts k, const float4* __restrict__ p,
+                                       const float4* __restrict__ v, unsigned n,
+                                       const unsigned* __restrict__ mask, float4* acc) {
+  const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const float4 pi = p[i];
+  const float4 vi = v[i];
+  const float3 xi = make_float3(pi.x, pi.y, pi.z);
+  float ax = 0, ay = 0, az = 0, ox = 0, oy = 0, oz = 0, vx = 0, vy = 0, vz = 0;
+  unsigned seq = 0;
+  for_each_run<V>(g, xi, k.h, [&](unsigned b, unsigned e) {
+    // The bits of this run: candidates seq .. seq + (e - b).
+    unsigned pos = seq;
+    const unsigned end_seq = seq + (e - b);
+    while (pos < end_seq) {
+      const unsigned w = pos >> 5;
+      unsigned bits = __ldg(mask + static_cast<size_t>(w) * n + i) >> (pos & 31u);
+      const unsigned span = min(32u - (pos & 31u), end_seq - pos);
+      if (span < 32u) bits &= (1u << span) - 1u;
+      while (bits) {
+        const unsigned j = b + (pos - seq) + static_cast<unsigned>(__ffs(bits) - 1);
+        bits &= bits - 1u;
+        const float4 q = p[j];
+        const float4 wv = v[j];
+        const float dx = xi.x - q.x, dy = xi.y - q.y, dz = xi.z - q.z;
+        const float r = sqrtf(dx * dx + dy * dy + dz * dz);
+        if (r <= 0.0f) continue;
+        const float d = k.h - r;
+        const float gm = k.spiky_grad * d * d / r;
+        const float pj = -q.w * wv.w * wv.w;
+        ax += gm * dx * pj;
+        ay += gm * dy * pj;
+        az += gm * dz * pj;
+        ox += gm * dx * -pi.w;
+        oy += gm * dy * -pi.w;
+        oz += gm * dz * -pi.w;
+        const float l = k.visc_lap * d * wv.w;
+        vx += (wv.x - vi.x) * l;
+        vy += (wv.y - vi.y) * l;
+        vz += (wv.z - vi.z) * l;
+      }
+      pos += span;
+    }
+    seq = end_seq;
+  });
+  const float s = vi.w * vi.w;
+  const float m_rho = k.mass * vi.w;
+  acc[i] = make_float4((ax + ox * s) * k.mass + vx * k.mu * m_rho,
+                       (ay + oy * s) * k.mass + vy * k.mu * m_rho - 9.81f,
+                       (az + oz * s) * k.mass + vz * k.mu * m_rho, 0.0f);
 }
 
 // The library's two-phase force gather (cuda/substep_kernels.cu): test a run of up to 32
@@ -292,6 +430,9 @@ int main(int argc, char** argv) {
   CHECK(cudaMalloc(&d_nb, n * sizeof(unsigned)));
   CHECK(cudaMalloc(&d_rho, n * sizeof(float)));
   CHECK(cudaMalloc(&d_rho_ref, n * sizeof(float)));
+  unsigned *d_mask, *d_overflow;
+  CHECK(cudaMalloc(&d_mask, size_t(kMaskWords) * n * sizeof(unsigned)));
+  CHECK(cudaMalloc(&d_overflow, n * sizeof(unsigned)));
   CHECK(cudaMemcpy(d_pos, pos.data(), n * sizeof(float4), cudaMemcpyHostToDevice));
   CHECK(cudaMemcpy(d_vel, vel.data(), n * sizeof(float4), cudaMemcpyHostToDevice));
   cudaEvent_t e0, e1;
@@ -420,6 +561,69 @@ int main(int argc, char** argv) {
     CHECK(cudaGetLastError());
     std::printf("%-8s %6.4f %9u %7.1f %7.1f %9.4f %9.4f %8.4f %10.2e\n", kVariantNames[v], cell, g.cells + 1,
                 mean_c / n, mean_n / n, median(dens_ms), median(force_ms), median(sort_ms), max_rel);
+    if (v == kH27 || v == kHalfPruned) {
+      // The same layout with the branchless density, and with masks handed to the force pass.
+      std::vector<float4> acc_ref(n), acc(n);
+      CHECK(cudaMemcpy(acc_ref.data(), d_acc, n * sizeof(float4), cudaMemcpyDeviceToHost));
+      auto time = [&](auto&& launch) {
+        std::vector<float> t;
+        for (int r = 0; r < repeat + 3; ++r) {
+          CHECK(cudaEventRecord(e0));
+          launch();
+          CHECK(cudaEventRecord(e1));
+          CHECK(cudaEventSynchronize(e1));
+          float ms = 0;
+          CHECK(cudaEventElapsedTime(&ms, e0, e1));
+          if (r >= 3) t.push_back(ms);
+        }
+        CHECK(cudaGetLastError());
+        return median(t);
+      };
+      auto rel_rho = [&]() {
+        std::vector<float> r2(n);
+        CHECK(cudaMemcpy(r2.data(), d_rho, n * sizeof(float), cudaMemcpyDeviceToHost));
+        double worst = 0.0;
+        for (unsigned i = 0; i < n; ++i)
+          worst = std::max(worst, std::fabs(double(r2[i]) - rho[i]) / std::fabs(double(rho[i])));
+        return worst;
+      };
+      const float branchless = time([&] {
+        if (v == kH27)
+          density_branchless_kernel<kH27><<<blocks, 128>>>(g, k, d_spos, n, d_rho);
+        else
+          density_branchless_kernel<kHalfPruned><<<blocks, 128>>>(g, k, d_spos, n, d_rho);
+      });
+      const double branchless_rel = rel_rho();
+      const float masked = time([&] {
+        if (v == kH27)
+          density_mask_kernel<kH27><<<blocks, 128>>>(g, k, d_spos, n, d_rho, d_mask, d_overflow);
+        else
+          density_mask_kernel<kHalfPruned><<<blocks, 128>>>(g, k, d_spos, n, d_rho, d_mask, d_overflow);
+      });
+      const double masked_rel = rel_rho();
+      const float from_mask = time([&] {
+        if (v == kH27)
+          force_from_mask_kernel<kH27><<<blocks, 128>>>(g, k, d_spos, d_svel, n, d_mask, d_acc);
+        else
+          force_from_mask_kernel<kHalfPruned><<<blocks, 128>>>(g, k, d_spos, d_svel, n, d_mask, d_acc);
+      });
+      CHECK(cudaMemcpy(acc.data(), d_acc, n * sizeof(float4), cudaMemcpyDeviceToHost));
+      std::vector<unsigned> overflow(n);
+      CHECK(cudaMemcpy(overflow.data(), d_overflow, n * sizeof(unsigned), cudaMemcpyDeviceToHost));
+      unsigned overflowed = 0;
+      double acc_rel = 0.0;
+      for (unsigned i = 0; i < n; ++i) {
+        overflowed += overflow[i];
+        const double dx = acc[i].x - acc_ref[i].x, dy = acc[i].y - acc_ref[i].y, dz = acc[i].z - acc_ref[i].z;
+        const double m = std::sqrt(double(acc_ref[i].x) * acc_ref[i].x + double(acc_ref[i].y) * acc_ref[i].y +
+                                   double(acc_ref[i].z) * acc_ref[i].z);
+        acc_rel = std::max(acc_rel, std::sqrt(dx * dx + dy * dy + dz * dz) / std::max(m, 1e-3));
+      }
+      std::printf(
+          "  %-6s branchless density %.4f ms (rel %.1e); mask density %.4f ms (rel %.1e) + force from "
+          "mask %.4f ms (rel %.1e, %u overflowed)\n",
+          kVariantNames[v], branchless, branchless_rel, masked, masked_rel, from_mask, acc_rel, overflowed);
+    }
     CHECK(cudaFree(temp));
     CHECK(cudaFree(d_start));
   }
