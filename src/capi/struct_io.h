@@ -1,6 +1,8 @@
 // Reading caller structs by their struct_size (the kernel's copy_struct_from_user rule):
-// smaller than the first version is a version mismatch; larger than ours is accepted only if
-// the extra bytes are zero.
+// smaller than the struct's first released size is a version mismatch; between that and ours
+// (a caller built against an older header) the fields it does not have read as zero, which
+// keeps the old behaviour since fields are only appended and zero means the old behaviour;
+// larger than ours is accepted only if the extra bytes are zero.
 #pragma once
 
 #include <cstring>
@@ -10,14 +12,28 @@
 
 namespace sph {
 
+// The size of a public struct in the first release that had it. A struct that grows gets a
+// specialisation with its old size (docs/versioning.md), so callers built against the older
+// header keep working:
+//   template <> constexpr uint32_t kFirstStructSize<sph_context_def> = 40;
+template <class T>
+constexpr uint32_t kFirstStructSize = static_cast<uint32_t>(sizeof(T));
+
 template <class T>
 T read_user_struct(const T* user, const char* name) {
   if (!user) throw Error(Status::InvalidArgument, std::string(name) + ": is NULL");
   const uint32_t size = user->struct_size;
-  if (size < sizeof(T))
+  if (size < kFirstStructSize<T>)
     throw Error(Status::VersionMismatch, std::string(name) + "->struct_size: " + std::to_string(size) +
-                                             " is smaller than " + std::to_string(sizeof(T)) +
+                                             " is smaller than " + std::to_string(kFirstStructSize<T>) +
                                              "; fill the struct with its _init() function");
+  if (size < sizeof(T)) {
+    T copy;
+    std::memset(&copy, 0, sizeof copy);
+    std::memcpy(&copy, user, size);
+    copy.struct_size = sizeof(T);
+    return copy;
+  }
   const unsigned char* bytes = reinterpret_cast<const unsigned char*>(user);
   for (uint32_t i = sizeof(T); i < size; ++i)
     if (bytes[i] != 0)
@@ -29,20 +45,21 @@ T read_user_struct(const T* user, const char* name) {
   return copy;
 }
 
-// For _init_sized(): zero the caller's whole struct, then fill our known prefix.
+// For _init_sized(): zero the caller's whole struct, then fill the prefix both know (an older
+// caller's struct is shorter than ours).
 template <class T>
 void write_user_struct(T* user, uint32_t size, const T& value) {
   std::memset(user, 0, size);
-  std::memcpy(user, &value, sizeof(T));
+  std::memcpy(user, &value, size < sizeof(T) ? size : sizeof(T));
   user->struct_size = size;
 }
 
 template <class T>
 void require_init_size(const T* user, uint32_t size, const char* name) {
   if (!user) throw Error(Status::InvalidArgument, std::string(name) + ": is NULL");
-  if (size < sizeof(T))
+  if (size < kFirstStructSize<T>)
     throw Error(Status::VersionMismatch, std::string(name) + ": size " + std::to_string(size) +
-                                             " is smaller than " + std::to_string(sizeof(T)));
+                                             " is smaller than " + std::to_string(kFirstStructSize<T>));
 }
 
 // Output structs: the caller sets struct_size; we write min(that, ours) bytes.
