@@ -351,6 +351,107 @@ __global__ void force_kernel(Grid g, Consts k, const float4* __restrict__ p, con
                        (az + oz * s) * k.mass + vz * k.mu * m_rho, 0.0f);
 }
 
+// Tuning variants of the h27 force pass: kFast evaluates 1/r with rsqrtf instead of an IEEE
+// square root and division (about 16 instructions fewer a pair); kPrefetch loads the next
+// neighbour's records before the current pair's arithmetic, so a load's latency overlaps work;
+// kMinBlocks caps registers through __launch_bounds__ (more warps in flight).
+template <bool kFast, bool kPrefetch, int kMinBlocks>
+__global__ void __launch_bounds__(128, kMinBlocks)
+    force_tuned_kernel(Grid g, Consts k, const float4* __restrict__ p, const float4* __restrict__ v,
+                       unsigned n, float4* acc) {
+  const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const float4 pi = p[i];
+  const float4 vi = v[i];
+  const float3 xi = make_float3(pi.x, pi.y, pi.z);
+  float ax = 0, ay = 0, az = 0, ox = 0, oy = 0, oz = 0, vx = 0, vy = 0, vz = 0;
+  auto pair = [&](const float4& q, const float4& w) {
+    const float dx = xi.x - q.x, dy = xi.y - q.y, dz = xi.z - q.z;
+    const float r2 = dx * dx + dy * dy + dz * dz;
+    float r, inv_r;
+    if (kFast) {
+      inv_r = rsqrtf(fmaxf(r2, 1e-30f));
+      r = r2 * inv_r;
+    } else {
+      r = sqrtf(r2);
+      if (r <= 0.0f) return;
+      inv_r = 1.0f / r;
+    }
+    const float d = k.h - r;
+    const float gm = k.spiky_grad * d * d * inv_r;
+    const float pj = -q.w * w.w * w.w;
+    ax += gm * dx * pj;
+    ay += gm * dy * pj;
+    az += gm * dz * pj;
+    ox += gm * dx * -pi.w;
+    oy += gm * dy * -pi.w;
+    oz += gm * dz * -pi.w;
+    const float l = k.visc_lap * d * w.w;
+    vx += (w.x - vi.x) * l;
+    vy += (w.y - vi.y) * l;
+    vz += (w.z - vi.z) * l;
+  };
+  for_each_run<kH27>(g, xi, k.h, [&](unsigned b, unsigned e) {
+    for (unsigned base = b; base < e; base += 32u) {
+      const unsigned count = min(32u, e - base);
+      unsigned hits = 0;
+#pragma unroll 4
+      for (unsigned t = 0; t < count; ++t) {
+        const float4 q = p[base + t];
+        const float dx = xi.x - q.x, dy = xi.y - q.y, dz = xi.z - q.z;
+        const float r2 = dx * dx + dy * dy + dz * dz;
+        hits |= ((r2 < k.h2 && base + t != i) ? 1u : 0u) << t;
+      }
+      if (kPrefetch) {
+        if (!hits) continue;
+        unsigned j = base + static_cast<unsigned>(__ffs(hits) - 1);
+        hits &= hits - 1u;
+        float4 q = p[j], w = v[j];
+        while (hits) {
+          const unsigned jn = base + static_cast<unsigned>(__ffs(hits) - 1);
+          hits &= hits - 1u;
+          const float4 qn = p[jn], wn = v[jn];
+          pair(q, w);
+          q = qn;
+          w = wn;
+        }
+        pair(q, w);
+      } else {
+        while (hits) {
+          const unsigned j = base + static_cast<unsigned>(__ffs(hits) - 1);
+          hits &= hits - 1u;
+          pair(p[j], v[j]);
+        }
+      }
+    }
+  });
+  const float s = vi.w * vi.w;
+  const float m_rho = k.mass * vi.w;
+  acc[i] = make_float4((ax + ox * s) * k.mass + vx * k.mu * m_rho,
+                       (ay + oy * s) * k.mass + vy * k.mu * m_rho - 9.81f,
+                       (az + oz * s) * k.mass + vz * k.mu * m_rho, 0.0f);
+}
+
+// The density pass with r = r2 rsqrt(r2), branchless like density_branchless_kernel.
+__global__ void density_fast_kernel(Grid g, Consts k, const float4* __restrict__ p, unsigned n, float* rho) {
+  const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const float4 pi = p[i];
+  const float3 xi = make_float3(pi.x, pi.y, pi.z);
+  float sum = 0.0f;
+  for_each_run<kH27>(g, xi, k.h, [&](unsigned b, unsigned e) {
+#pragma unroll 4
+    for (unsigned j = b; j < e; ++j) {
+      const float4 q = p[j];
+      const float dx = xi.x - q.x, dy = xi.y - q.y, dz = xi.z - q.z;
+      const float r2 = dx * dx + dy * dy + dz * dz;
+      const float d = fmaxf(k.h - r2 * rsqrtf(fmaxf(r2, 1e-30f)), 0.0f);
+      sum += d * d * d;
+    }
+  });
+  rho[i] = k.mass * (k.self + k.spiky * (sum - k.h * k.h * k.h));
+}
+
 __global__ void pack_kernel(float4* p, float4* v, const float* rho, Consts k, unsigned n) {
   const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
@@ -618,6 +719,61 @@ int main(int argc, char** argv) {
         const double m = std::sqrt(double(acc_ref[i].x) * acc_ref[i].x + double(acc_ref[i].y) * acc_ref[i].y +
                                    double(acc_ref[i].z) * acc_ref[i].z);
         acc_rel = std::max(acc_rel, std::sqrt(dx * dx + dy * dy + dz * dz) / std::max(m, 1e-3));
+      }
+      if (v == kH27) {
+        // Tuning variants of the h27 passes, each checked against the plain force pass.
+        auto check_acc = [&]() {
+          CHECK(cudaMemcpy(acc.data(), d_acc, n * sizeof(float4), cudaMemcpyDeviceToHost));
+          double worst = 0.0;
+          for (unsigned i = 0; i < n; ++i) {
+            const double dx = acc[i].x - acc_ref[i].x, dy = acc[i].y - acc_ref[i].y,
+                         dz = acc[i].z - acc_ref[i].z;
+            const double m =
+                std::sqrt(double(acc_ref[i].x) * acc_ref[i].x + double(acc_ref[i].y) * acc_ref[i].y +
+                          double(acc_ref[i].z) * acc_ref[i].z);
+            worst = std::max(worst, std::sqrt(dx * dx + dy * dy + dz * dz) / std::max(m, 1e-3));
+          }
+          return worst;
+        };
+        struct Row {
+          const char* name;
+          float ms;
+          double rel;
+        };
+        std::vector<Row> rows;
+        auto force_row = [&](const char* name, auto&& launch) {
+          const float ms = time(launch);
+          rows.push_back(Row{name, ms, check_acc()});
+        };
+        force_row("force plain (launch_bounds 128,1)", [&] {
+          force_tuned_kernel<false, false, 1><<<blocks, 128>>>(g, k, d_spos, d_svel, n, d_acc);
+        });
+        force_row("force fast rsqrt", [&] {
+          force_tuned_kernel<true, false, 1><<<blocks, 128>>>(g, k, d_spos, d_svel, n, d_acc);
+        });
+        force_row("force prefetch", [&] {
+          force_tuned_kernel<false, true, 1><<<blocks, 128>>>(g, k, d_spos, d_svel, n, d_acc);
+        });
+        force_row("force fast + prefetch", [&] {
+          force_tuned_kernel<true, true, 1><<<blocks, 128>>>(g, k, d_spos, d_svel, n, d_acc);
+        });
+        force_row("force fast, min 12 blocks (<= 40 regs)", [&] {
+          force_tuned_kernel<true, false, 12><<<blocks, 128>>>(g, k, d_spos, d_svel, n, d_acc);
+        });
+        force_row("force fast + prefetch, min 12 blocks", [&] {
+          force_tuned_kernel<true, true, 12><<<blocks, 128>>>(g, k, d_spos, d_svel, n, d_acc);
+        });
+        for (unsigned bs : {64u, 256u}) {
+          const unsigned nb = (n + bs - 1) / bs;
+          const float ms = time([&] { force_kernel<kH27><<<nb, bs>>>(g, k, d_spos, d_svel, n, d_acc); });
+          rows.push_back(
+              Row{bs == 64 ? "force plain, 64 threads a block" : "force plain, 256 threads a block", ms,
+                  check_acc()});
+        }
+        const float fast_density =
+            time([&] { density_fast_kernel<<<blocks, 128>>>(g, k, d_spos, n, d_rho); });
+        rows.push_back(Row{"density fast rsqrt, branchless", fast_density, rel_rho()});
+        for (const Row& r : rows) std::printf("  h27    %-42s %.4f ms (rel %.1e)\n", r.name, r.ms, r.rel);
       }
       std::printf(
           "  %-6s branchless density %.4f ms (rel %.1e); mask density %.4f ms (rel %.1e) + force from "
