@@ -128,8 +128,10 @@ typedef enum sph_stage {
   SPH_STAGE_DENSITY = 2,     /* density and pressure */
   SPH_STAGE_FORCES = 3,      /* pressure, viscosity and external forces */
   SPH_STAGE_INTEGRATE = 4,   /* time integration, max-speed reduction, next step size */
-  SPH_STAGE_COLLIDE = 5,     /* colliders (none yet) */
-  SPH_STAGE_EMIT = 6,        /* sources and sinks (none yet) */
+  SPH_STAGE_COLLIDE = 5,     /* particles against colliders (CPU; the CUDA backend does it inside
+                                the forces kernel, so it counts under SPH_STAGE_FORCES there) */
+  SPH_STAGE_EMIT = 6,        /* sinks removing particles; sources emit before the substeps and
+                                count only in sph_stats.step_ms */
   SPH_STAGE_OTHER = 7,       /* everything else: statistics, transfers */
   SPH_STAGE_COUNT = 8,
   SPH_STAGE_FORCE32 = 0x7fffffff
@@ -647,9 +649,18 @@ SPH_STATIC_ASSERT(sizeof(sph_transform) == 28, sph_transform_size);
 /** The identity transform (exported twin of a constant, for bindings). */
 SPH_API sph_transform SPH_CALL sph_transform_identity(void);
 
+/* ---- ids of objects inside a world --------------------------------------------------------
+ * Colliders, sources, sinks and force fields are generational ids: a struct holding 64 bits.
+ * {0} is null: no call ever returns it, destroying it is a no-op, and every other call refuses
+ * it with SPH_ERROR_INVALID_HANDLE, as it refuses the id of a destroyed object (an id is never
+ * reused) or of another world or kind. */
+
+/** True when an id (any sph_*_id) is null. */
+#define SPH_ID_IS_NULL(id) ((id).bits == 0)
+
 /* ---- colliders --------------------------------------------------------------------------- */
 typedef struct sph_collider_id {
-  uint64_t bits; /* {0} is null */
+  uint64_t bits; /* {0} is null (SPH_ID_IS_NULL) */
 } sph_collider_id;
 
 #define SPH_COLLIDER_FLAG_INVERTED 0x1u /* solid where the SDF is positive: a container */
@@ -696,13 +707,51 @@ SPH_API sph_result SPH_CALL sph_collider_teleport(sph_world* world, sph_collider
                                                   const sph_transform* transform);
 SPH_API sph_result SPH_CALL sph_collider_get_transform(const sph_world* world, sph_collider_id id,
                                                        sph_transform* out_transform);
-/** Changes restitution, friction and stickiness (same ranges as sph_collider_def). */
+/**
+ * Deprecated: use sph_collider_set_material_struct. Kept, with its arguments, so that programs
+ * built against earlier headers keep working (the ABI does not change); it sets the three
+ * coefficients as that call does, with the same checks.
+ */
 SPH_API sph_result SPH_CALL sph_collider_set_material(sph_world* world, sph_collider_id id, float restitution,
                                                       float friction, float stickiness);
 
+/**
+ * How a collider's surface answers particles that reach it. Zero means default: a zeroed
+ * struct (struct_size set) is what sph_collider_material_init gives, a surface that returns
+ * no normal speed, has no friction and pulls nothing.
+ */
+typedef struct sph_collider_material {
+  uint32_t struct_size; /* set by sph_collider_material_init */
+  float restitution;    /* share of the normal approach speed returned, [0, 1]; default 0 */
+  float friction;       /* Coulomb coefficient >= 0 (ignored where the SDF has a friction
+                           channel); default 0 */
+  float stickiness;     /* pull toward the surface within one kernel radius, m/s^2 >= 0;
+                           default 0 */
+} sph_collider_material;
+SPH_STATIC_ASSERT(sizeof(sph_collider_material) == 16, sph_collider_material_size);
+
+SPH_API sph_result SPH_CALL sph_collider_material_init_sized(sph_collider_material* material, uint32_t size);
+static inline sph_result sph_collider_material_init(sph_collider_material* material) {
+  return sph_collider_material_init_sized(material, (uint32_t)sizeof(*material));
+}
+/**
+ * Replaces a collider's material; acts from the next substep. Errors: INVALID_HANDLE (world;
+ * a null, stale or foreign id), INVALID_ARGUMENT (NULL material; a coefficient out of range or
+ * not finite, named), VERSION_MISMATCH (struct_size), WORLD_LOCKED. Nothing changes on error.
+ */
+SPH_API sph_result SPH_CALL sph_collider_set_material_struct(sph_world* world, sph_collider_id id,
+                                                             const sph_collider_material* material);
+/**
+ * Reads a collider's material (as the def or the last set call gave it). out->struct_size
+ * must be set (sph_collider_material_init); only that many bytes are written.
+ * Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL out), VERSION_MISMATCH, WORLD_LOCKED.
+ */
+SPH_API sph_result SPH_CALL sph_collider_get_material(const sph_world* world, sph_collider_id id,
+                                                      sph_collider_material* out);
+
 /* ---- sources ----------------------------------------------------------------------------- */
 typedef struct sph_source_id {
-  uint64_t bits;
+  uint64_t bits; /* {0} is null (SPH_ID_IS_NULL) */
 } sph_source_id;
 
 typedef enum sph_source_mode {
@@ -747,7 +796,7 @@ SPH_API sph_result SPH_CALL sph_source_set_transform(sph_world* world, sph_sourc
 
 /* ---- sinks ------------------------------------------------------------------------------- */
 typedef struct sph_sink_id {
-  uint64_t bits;
+  uint64_t bits; /* {0} is null (SPH_ID_IS_NULL) */
 } sph_sink_id;
 
 typedef enum sph_sink_mode {
@@ -777,7 +826,7 @@ SPH_API sph_result SPH_CALL sph_sink_destroy(sph_world* world, sph_sink_id id);
 
 /* ---- force fields ------------------------------------------------------------------------ */
 typedef struct sph_force_field_id {
-  uint64_t bits;
+  uint64_t bits; /* {0} is null (SPH_ID_IS_NULL) */
 } sph_force_field_id;
 
 typedef enum sph_force_field_kind {
