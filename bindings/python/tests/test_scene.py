@@ -122,10 +122,20 @@ def test_collider_pose_material_and_lifetime(ctx, world):
     c.move_to({"position": (0, 1.01, 0)})
     world.step(1 / 60)
     assert tuple(c.transform.position) == pytest.approx((0, 1.01, 0))
+    m = c.material  # as the def gave it
+    assert (m.restitution, m.friction, m.stickiness) == pytest.approx((0.5, 0.2, 0.0))
+    c.material = {"restitution": 0.25, "stickiness": 3.0}  # friction back to its default, 0
+    m = c.material
+    assert (m.restitution, m.friction, m.stickiness) == (0.25, 0.0, 3.0)
+    assert error(setattr, c, "material", {"friction": -1.0}) == sph.Result.ERROR_INVALID_ARGUMENT
+    assert c.material.stickiness == 3.0  # a refused material changes nothing
     c.set_material(restitution=1.0, friction=0.0, stickiness=2.0)
+    assert (c.material.restitution, c.material.stickiness) == (1.0, 2.0)
     assert error(c.set_material, restitution=2.0) == sph.Result.ERROR_INVALID_ARGUMENT
     assert error(c.teleport, (0, np.nan, 0)) == sph.Result.ERROR_INVALID_ARGUMENT
-    assert error(c.teleport, ((0, 0, 0), (0, 0, 0, 0))) == sph.Result.ERROR_INVALID_ARGUMENT
+    assert error(c.teleport, ((0, 0, 0), (0, 0, 0, 1e-9))) == sph.Result.ERROR_INVALID_ARGUMENT
+    c.teleport(((0, 1, 0), (0, 0, 0, 0)))  # the all-zero quaternion (a zeroed struct) is the identity
+    assert tuple(c.transform.rotation) == (0, 0, 0, 1)
     stale = sph.Collider(world, c.id.copy())
     c.destroy()
     c.destroy()  # a null id is a no-op
