@@ -141,7 +141,7 @@ static class Tests
         using (var ctx = new Context(def, (l, c, m) => { ++calls; level = l; code = c; message = m; }))
         {
             var wd = SmallWorld();
-            wd.Capacity = 0;
+            wd.Capacity = 1u << 31;  // above 2^30 (0 is the default)
             Throws(Result.ErrorInvalidArgument, () => ctx.CreateWorld(wd));
         }
         Assert(calls >= 1, "the log handler was called");

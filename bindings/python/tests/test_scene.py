@@ -69,7 +69,10 @@ def test_grid_assets_and_updates(ctx):
     bad = dist.copy()
     bad[0, 0, 0] = np.inf
     assert error(ctx.sdf, bad) == sph.Result.ERROR_INVALID_ARGUMENT
-    assert error(ctx.sdf, dist, index_to_local=np.zeros(12)) == sph.Result.ERROR_INVALID_ARGUMENT  # singular
+    singular = [1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0]  # no y axis
+    assert error(ctx.sdf, dist, index_to_local=singular) == sph.Result.ERROR_INVALID_ARGUMENT
+    with ctx.sdf(dist, index_to_local=np.zeros(12)) as s3:  # all zeros: the identity (1 m voxels)
+        assert s3.sample((0, 0, 0)) == np.float32(dist[0, 0, 0])  # the sample at voxel (0, 0, 0)
     with pytest.raises(ValueError):
         ctx.sdf(np.zeros((4, 4)))
 
