@@ -68,7 +68,7 @@ extern "C" {
 typedef enum sph_result {
   SPH_INCOMPLETE = 1,                  /* the call did part of the work; see its doc */
   SPH_OK = 0,                          /* success */
-  SPH_ERROR_INVALID_ARGUMENT = -1,     /* NULL, NaN/Inf, zero/negative or out-of-range value */
+  SPH_ERROR_INVALID_ARGUMENT = -1,     /* NULL, NaN/Inf, out-of-range value, required field left zero */
   SPH_ERROR_INVALID_HANDLE = -2,       /* a NULL, destroyed or foreign object */
   SPH_ERROR_VERSION_MISMATCH = -3,     /* struct_size or header_version not accepted */
   SPH_ERROR_UNSUPPORTED = -4,          /* not compiled in, no such device, unknown enum value */

@@ -85,7 +85,7 @@ namespace Sph
         Incomplete = 1,
         /// <summary>success</summary>
         Ok = 0,
-        /// <summary>NULL, NaN/Inf, zero/negative or out-of-range value</summary>
+        /// <summary>NULL, NaN/Inf, out-of-range value, required field left zero</summary>
         ErrorInvalidArgument = -1,
         /// <summary>a NULL, destroyed or foreign object</summary>
         ErrorInvalidHandle = -2,
@@ -2871,7 +2871,7 @@ namespace Sph
         {
             { "SPH_INCOMPLETE", "the call did part of the work; see its doc" },
             { "SPH_OK", "success" },
-            { "SPH_ERROR_INVALID_ARGUMENT", "NULL, NaN/Inf, zero/negative or out-of-range value" },
+            { "SPH_ERROR_INVALID_ARGUMENT", "NULL, NaN/Inf, out-of-range value, required field left zero" },
             { "SPH_ERROR_INVALID_HANDLE", "a NULL, destroyed or foreign object" },
             { "SPH_ERROR_VERSION_MISMATCH", "struct_size or header_version not accepted" },
             { "SPH_ERROR_UNSUPPORTED", "not compiled in, no such device, unknown enum value" },

@@ -10,7 +10,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'bfb79badeaa77fa7561acda73df7c35c7484edbb334621147679e49b6ef32813', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
+HEADERS = {'include/sph_c.h': '7570bce9237cd0f0009540b3c422b90d0d1083b2700c09152cf8780ec48e05c5', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -63,7 +63,7 @@ SPH_SOURCE_FLAG_VELOCITY_FROM_FIELD = 1
 sph_result = _c.c_int32
 SPH_INCOMPLETE = 1  # the call did part of the work; see its doc
 SPH_OK = 0  # success
-SPH_ERROR_INVALID_ARGUMENT = -1  # NULL, NaN/Inf, zero/negative or out-of-range value
+SPH_ERROR_INVALID_ARGUMENT = -1  # NULL, NaN/Inf, out-of-range value, required field left zero
 SPH_ERROR_INVALID_HANDLE = -2  # a NULL, destroyed or foreign object
 SPH_ERROR_VERSION_MISMATCH = -3  # struct_size or header_version not accepted
 SPH_ERROR_UNSUPPORTED = -4  # not compiled in, no such device, unknown enum value
@@ -88,7 +88,7 @@ class Result(_enum.IntEnum):
     INCOMPLETE = 1
     #: success
     OK = 0
-    #: NULL, NaN/Inf, zero/negative or out-of-range value
+    #: NULL, NaN/Inf, out-of-range value, required field left zero
     ERROR_INVALID_ARGUMENT = -1
     #: a NULL, destroyed or foreign object
     ERROR_INVALID_HANDLE = -2
@@ -379,7 +379,7 @@ class EventType(_enum.IntEnum):
 ENUM_MEMBER_DOCS = {
     'SPH_INCOMPLETE': 'the call did part of the work; see its doc',
     'SPH_OK': 'success',
-    'SPH_ERROR_INVALID_ARGUMENT': 'NULL, NaN/Inf, zero/negative or out-of-range value',
+    'SPH_ERROR_INVALID_ARGUMENT': 'NULL, NaN/Inf, out-of-range value, required field left zero',
     'SPH_ERROR_INVALID_HANDLE': 'a NULL, destroyed or foreign object',
     'SPH_ERROR_VERSION_MISMATCH': 'struct_size or header_version not accepted',
     'SPH_ERROR_UNSUPPORTED': 'not compiled in, no such device, unknown enum value',
