@@ -10,6 +10,10 @@
  *   message naming the offending argument, and the object the call was given is unchanged.
  * - Description structs start with struct_size and are filled by their *_init() function;
  *   fields are only ever appended, and zero in a new field keeps the old behaviour.
+ * - Zero means default: a def or desc that is all zeros except struct_size is valid and gets
+ *   the defaults, or, where a struct cannot be valid without some field (a collider needs an
+ *   SDF), the error names that field; each struct's comment says which (docs/api.md lists
+ *   them). Where zero is itself a value (a velocity, a restitution), it keeps its meaning.
  * - A world is used from one thread at a time. Different worlds are independent and may be
  *   stepped concurrently from different threads. Version queries, sph_result_string() and
  *   sph_get_last_error() are always thread-safe.
@@ -64,7 +68,7 @@ extern "C" {
 typedef enum sph_result {
   SPH_INCOMPLETE = 1,                  /* the call did part of the work; see its doc */
   SPH_OK = 0,                          /* success */
-  SPH_ERROR_INVALID_ARGUMENT = -1,     /* NULL, NaN/Inf, zero/negative or out-of-range value */
+  SPH_ERROR_INVALID_ARGUMENT = -1,     /* NULL, NaN/Inf, out-of-range value, required field left zero */
   SPH_ERROR_INVALID_HANDLE = -2,       /* a NULL, destroyed or foreign object */
   SPH_ERROR_VERSION_MISMATCH = -3,     /* struct_size or header_version not accepted */
   SPH_ERROR_UNSUPPORTED = -4,          /* not compiled in, no such device, unknown enum value */
@@ -128,8 +132,10 @@ typedef enum sph_stage {
   SPH_STAGE_DENSITY = 2,     /* density and pressure */
   SPH_STAGE_FORCES = 3,      /* pressure, viscosity and external forces */
   SPH_STAGE_INTEGRATE = 4,   /* time integration, max-speed reduction, next step size */
-  SPH_STAGE_COLLIDE = 5,     /* colliders (none yet) */
-  SPH_STAGE_EMIT = 6,        /* sources and sinks (none yet) */
+  SPH_STAGE_COLLIDE = 5,     /* particles against colliders (CPU; the CUDA backend does it inside
+                                the forces kernel, so it counts under SPH_STAGE_FORCES there) */
+  SPH_STAGE_EMIT = 6,        /* sinks removing particles; sources emit before the substeps and
+                                count only in sph_stats.step_ms */
   SPH_STAGE_OTHER = 7,       /* everything else: statistics, transfers */
   SPH_STAGE_COUNT = 8,
   SPH_STAGE_FORCE32 = 0x7fffffff
@@ -208,11 +214,13 @@ typedef struct sph_context sph_context;
 typedef void(SPH_CALL* sph_log_fn)(void* user_data, sph_log_level level, sph_result code,
                                    const char* message);
 
+/** Zero means default: a zeroed def is valid (AUTO backend, device 0, every hardware thread,
+ *  no logging; header_version 0 skips the header check). */
 typedef struct sph_context_def {
   uint32_t struct_size;      /* sizeof(sph_context_def), set by sph_context_def_init */
-  uint32_t header_version;   /* SPH_VERSION of the header the caller compiled against */
+  uint32_t header_version;   /* SPH_VERSION of the header the caller compiled against; 0 = unchecked */
   sph_backend backend;       /* default SPH_BACKEND_AUTO */
-  int32_t device_ordinal;    /* CUDA device; -1 (default) = device 0 */
+  int32_t device_ordinal;    /* CUDA device; -1 (default) and 0 = device 0 */
   uint32_t cpu_worker_count; /* CPU backend threads; 0 (default) = all hardware threads */
   uint32_t reserved0;        /* must be 0 */
   sph_log_fn log_fn;         /* optional; NULL = no logging */
@@ -243,17 +251,20 @@ SPH_API sph_result SPH_CALL sph_context_get_backend(const sph_context* context, 
 /* ---- world ------------------------------------------------------------------------------- */
 typedef struct sph_world sph_world;
 
-/** Creation-time description of a world; fixed for the world's life. */
+/** Creation-time description of a world; fixed for the world's life. Zero means default for
+ *  every field: a zeroed def is the def sph_world_def_init gives. */
 typedef struct sph_world_def {
   uint32_t struct_size;                  /* sizeof(sph_world_def), set by sph_world_def_init */
-  uint32_t header_version;               /* SPH_VERSION of the caller's header */
-  uint32_t capacity;                     /* most particles the world holds; default 65536; >= 1 */
+  uint32_t header_version;               /* SPH_VERSION of the caller's header; 0 = unchecked */
+  uint32_t capacity;                     /* most particles the world holds; 0 (default) = 65536;
+                                            at most 2^30 */
   sph_feature_flags features;            /* SPH_FEATURE_* bits; default SPH_FEATURE_NONE */
   sph_integrator integrator;             /* default SPH_INTEGRATOR_SYMPLECTIC_EULER */
   sph_viscosity_method viscosity_method; /* default SPH_VISCOSITY_MUELLER */
-  float particle_spacing;                /* nearest-neighbour distance of the FCC lattice, m; default 0.02 */
+  float particle_spacing;                /* nearest-neighbour distance of the FCC lattice, m;
+                                            0 (default) = 0.02 */
   float kernel_radius;                   /* h, m; 0 (default) = 1.8 * particle_spacing; must be >= spacing */
-  float rest_density;                    /* rho0, kg/m^3; default 1000 (water) */
+  float rest_density;                    /* rho0, kg/m^3; 0 (default) = 1000 (water) */
   sph_equation_of_state equation_of_state; /* default SPH_EOS_IDEAL_GAS */
 } sph_world_def;
 SPH_STATIC_ASSERT(sizeof(sph_world_def) == 40, sph_world_def_size);
@@ -269,14 +280,14 @@ static inline sph_result sph_world_def_init(sph_world_def* def) {
  * Creates an empty world on a context. The particle mass is derived here: the mass at which
  * an FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass).
  * Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range:
- * capacity 0, spacing <= 0 or non-finite, kernel_radius < spacing, rest_density <= 0),
+ * capacity above 2^30, spacing < 0 or non-finite, kernel_radius < spacing, rest_density < 0),
  * UNSUPPORTED (unknown integrator or feature bit), VERSION_MISMATCH, OUT_OF_HOST_MEMORY,
  * OUT_OF_DEVICE_MEMORY. *out is written only on success.
  */
 SPH_API sph_result SPH_CALL sph_world_create(sph_context* context, const sph_world_def* def, sph_world** out);
 /** Destroys a world and everything in it. NULL is a no-op. */
 SPH_API sph_result SPH_CALL sph_world_destroy(sph_world* world);
-/** The def the world was created with, with defaults resolved (kernel_radius filled in). */
+/** The def the world was created with, with defaults resolved (zeros and kernel_radius filled in). */
 SPH_API sph_result SPH_CALL sph_world_get_def(const sph_world* world, sph_world_def* out_def);
 /** Mass of every particle, kg. */
 SPH_API sph_result SPH_CALL sph_world_get_particle_mass(const sph_world* world, float* out_mass);
@@ -394,10 +405,12 @@ SPH_API sph_result SPH_CALL sph_world_set_spring_params(sph_world* world, const 
 SPH_API sph_result SPH_CALL sph_world_get_spring_params(const sph_world* world, sph_spring_params* out);
 
 /* ---- particles in -------------------------------------------------------------------------- */
+/** Zero means default: a zeroed desc spawns nothing (count 0); positions is required once
+ *  count > 0 (INVALID_ARGUMENT naming desc->positions). */
 typedef struct sph_spawn_desc {
   uint32_t struct_size;     /* sizeof(sph_spawn_desc), set by sph_spawn_desc_init */
   uint32_t count;           /* particles to add; 0 is allowed and adds nothing */
-  const float* positions;   /* count x (x, y, z) float32, caller-owned, copied; required */
+  const float* positions;   /* count x (x, y, z) float32, caller-owned, copied; required when count > 0 */
   const float* velocities;  /* count x (x, y, z) float32, or NULL for zero velocity */
   uint64_t position_stride; /* bytes between particles; 0 = 12 (packed) */
   uint64_t velocity_stride; /* bytes between particles; 0 = 12 (packed) */
@@ -417,11 +430,12 @@ static inline sph_result sph_spawn_desc_init(sph_spawn_desc* desc) {
 SPH_API sph_result SPH_CALL sph_world_spawn(sph_world* world, const sph_spawn_desc* desc,
                                             uint32_t* out_first_id);
 
+/** Zero means default: a zeroed desc is an empty box and fills nothing. */
 typedef struct sph_fill_box_desc {
   uint32_t struct_size; /* set by sph_fill_box_desc_init */
   uint32_t reserved0;   /* must be 0 */
   sph_vec3 min;         /* box corner, m */
-  sph_vec3 max;         /* opposite corner, m; every component > min's */
+  sph_vec3 max;         /* opposite corner, m; every component >= min's (equal: an empty box) */
   sph_vec3 velocity;    /* initial velocity of every particle; default 0 */
 } sph_fill_box_desc;
 SPH_STATIC_ASSERT(sizeof(sph_fill_box_desc) == 44, sph_fill_box_desc_size);
@@ -439,11 +453,12 @@ static inline sph_result sph_fill_box_desc_init(sph_fill_box_desc* desc) {
 SPH_API sph_result SPH_CALL sph_world_fill_box(sph_world* world, const sph_fill_box_desc* desc,
                                                uint32_t* out_count);
 
+/** Zero means default: a zeroed desc (radius 0) fills nothing. */
 typedef struct sph_fill_sphere_desc {
   uint32_t struct_size; /* set by sph_fill_sphere_desc_init */
   uint32_t reserved0;   /* must be 0 */
   sph_vec3 center;      /* m; a lattice point sits at the centre */
-  float radius;         /* m; > 0; points with |p - center| <= radius are filled */
+  float radius;         /* m; >= 0; points with |p - center| <= radius are filled; 0 = none */
   sph_vec3 velocity;    /* initial velocity; default 0 */
 } sph_fill_sphere_desc;
 SPH_STATIC_ASSERT(sizeof(sph_fill_sphere_desc) == 36, sph_fill_sphere_desc_size);
@@ -536,13 +551,16 @@ typedef enum sph_memory_kind {
   SPH_MEMORY_KIND_FORCE32 = 0x7fffffff
 } sph_memory_kind;
 
+/** Zero means default, except that a grid cannot be empty: dims and data are required (the
+ *  error names the first of them that is zero). */
 typedef struct sph_grid_desc {
   uint32_t struct_size;     /* set by sph_grid_desc_init */
-  uint32_t dims[3];         /* samples along i, j, k (i fastest); each >= 1 */
-  float index_to_local[12]; /* row-major 3x4 affine map; default: identity (1 m voxels) */
+  uint32_t dims[3];         /* samples along i, j, k (i fastest); each >= 1; required */
+  float index_to_local[12]; /* row-major 3x4 affine map; default (and all zeros): identity (1 m voxels) */
   sph_memory_kind memory;   /* where data lives; default SPH_MEMORY_HOST */
-  uint32_t components;      /* floats per voxel: 1 (distance, friction) or 3 (velocity) */
-  const float* data;        /* dims[0] * dims[1] * dims[2] * components floats, copied */
+  uint32_t components;      /* floats per voxel: 1 (distance, friction) or 3 (velocity, force
+                               field accelerations); 0 (default) = the channel's own count */
+  const float* data;        /* dims[0] * dims[1] * dims[2] * components floats, copied; required */
 } sph_grid_desc;
 SPH_STATIC_ASSERT(sizeof(sph_grid_desc) == 72 + sizeof(void*), sph_grid_desc_size);
 
@@ -551,6 +569,8 @@ static inline sph_result sph_grid_desc_init(sph_grid_desc* desc) {
   return sph_grid_desc_init_sized(desc, (uint32_t)sizeof(*desc));
 }
 
+/** A zeroed desc is refused: the distance grid is required (INVALID_ARGUMENT naming
+ *  desc->distance.dims, then desc->distance.data). The embedded grid's struct_size may be 0. */
 typedef struct sph_sdf_desc {
   uint32_t struct_size;          /* set by sph_sdf_desc_init */
   uint32_t reserved0;            /* must be 0 */
@@ -589,14 +609,16 @@ typedef enum sph_shape {
 
 #define SPH_SHAPE_FLAG_OPEN_TOP 0x1u /* hollow box: no lid (a tank open at +y) */
 
+/** Zero means default for every size; shape 0 is SPH_SHAPE_PLANE (zero keeps its meaning), so
+ *  a zeroed desc is a plane of the default sizes, and sph_shape_desc_init picks SPH_SHAPE_BOX. */
 typedef struct sph_shape_desc {
   uint32_t struct_size;    /* set by sph_shape_desc_init */
-  sph_shape shape;         /* default SPH_SHAPE_BOX */
-  sph_vec3 half_extents;   /* m; default (0.5, 0.5, 0.5) */
-  float radius;            /* m; default 0.5 */
-  float half_height;       /* m; default 0.5 */
+  sph_shape shape;         /* sph_shape_desc_init: SPH_SHAPE_BOX; 0 = SPH_SHAPE_PLANE */
+  sph_vec3 half_extents;   /* m; each component 0 (default) = 0.5 */
+  float radius;            /* m; 0 (default) = 0.5 */
+  float half_height;       /* m; 0 (default) = 0.5 */
   float wall_thickness;    /* m; default 0 (solid) */
-  float voxel_size;        /* m; default 0.01 */
+  float voxel_size;        /* m; 0 (default) = 0.01 */
   uint32_t flags;          /* SPH_SHAPE_FLAG_* */
   uint32_t padding_voxels; /* grid margin around the shape; 0 (default) = 4 */
 } sph_shape_desc;
@@ -635,7 +657,8 @@ SPH_API sph_result SPH_CALL sph_sdf_destroy(sph_sdf* sdf);
 
 /* ---- placement --------------------------------------------------------------------------- */
 typedef struct sph_quat {
-  float x, y, z, w; /* a rotation; normalised by the library; (0, 0, 0, 1) is identity */
+  float x, y, z, w; /* a rotation; normalised by the library; (0, 0, 0, 1) is identity, and so
+                       is (0, 0, 0, 0), the quaternion of a zeroed struct */
 } sph_quat;
 
 typedef struct sph_transform {
@@ -647,13 +670,25 @@ SPH_STATIC_ASSERT(sizeof(sph_transform) == 28, sph_transform_size);
 /** The identity transform (exported twin of a constant, for bindings). */
 SPH_API sph_transform SPH_CALL sph_transform_identity(void);
 
+/* ---- ids of objects inside a world --------------------------------------------------------
+ * Colliders, sources, sinks and force fields are generational ids: a struct holding 64 bits.
+ * {0} is null: no call ever returns it, destroying it is a no-op, and every other call refuses
+ * it with SPH_ERROR_INVALID_HANDLE, as it refuses the id of a destroyed object (an id is never
+ * reused) or of another world or kind. */
+
+/** True when an id (any sph_*_id) is null. */
+#define SPH_ID_IS_NULL(id) ((id).bits == 0)
+
 /* ---- colliders --------------------------------------------------------------------------- */
 typedef struct sph_collider_id {
-  uint64_t bits; /* {0} is null */
+  uint64_t bits; /* {0} is null (SPH_ID_IS_NULL) */
 } sph_collider_id;
 
 #define SPH_COLLIDER_FLAG_INVERTED 0x1u /* solid where the SDF is positive: a container */
 
+/** Zero means default, but a collider needs its SDF: a zeroed def is refused with
+ *  INVALID_ARGUMENT naming def->sdf, and with sdf set it is a static collider at the identity
+ *  pose with the default material (sph_collider_material). */
 typedef struct sph_collider_def {
   uint32_t struct_size;    /* set by sph_collider_def_init */
   uint32_t flags;          /* SPH_COLLIDER_FLAG_* */
@@ -696,13 +731,51 @@ SPH_API sph_result SPH_CALL sph_collider_teleport(sph_world* world, sph_collider
                                                   const sph_transform* transform);
 SPH_API sph_result SPH_CALL sph_collider_get_transform(const sph_world* world, sph_collider_id id,
                                                        sph_transform* out_transform);
-/** Changes restitution, friction and stickiness (same ranges as sph_collider_def). */
+/**
+ * Deprecated: use sph_collider_set_material_struct. Kept, with its arguments, so that programs
+ * built against earlier headers keep working (the ABI does not change); it sets the three
+ * coefficients as that call does, with the same checks.
+ */
 SPH_API sph_result SPH_CALL sph_collider_set_material(sph_world* world, sph_collider_id id, float restitution,
                                                       float friction, float stickiness);
 
+/**
+ * How a collider's surface answers particles that reach it. Zero means default: a zeroed
+ * struct (struct_size set) is what sph_collider_material_init gives, a surface that returns
+ * no normal speed, has no friction and pulls nothing.
+ */
+typedef struct sph_collider_material {
+  uint32_t struct_size; /* set by sph_collider_material_init */
+  float restitution;    /* share of the normal approach speed returned, [0, 1]; default 0 */
+  float friction;       /* Coulomb coefficient >= 0 (ignored where the SDF has a friction
+                           channel); default 0 */
+  float stickiness;     /* pull toward the surface within one kernel radius, m/s^2 >= 0;
+                           default 0 */
+} sph_collider_material;
+SPH_STATIC_ASSERT(sizeof(sph_collider_material) == 16, sph_collider_material_size);
+
+SPH_API sph_result SPH_CALL sph_collider_material_init_sized(sph_collider_material* material, uint32_t size);
+static inline sph_result sph_collider_material_init(sph_collider_material* material) {
+  return sph_collider_material_init_sized(material, (uint32_t)sizeof(*material));
+}
+/**
+ * Replaces a collider's material; acts from the next substep. Errors: INVALID_HANDLE (world;
+ * a null, stale or foreign id), INVALID_ARGUMENT (NULL material; a coefficient out of range or
+ * not finite, named), VERSION_MISMATCH (struct_size), WORLD_LOCKED. Nothing changes on error.
+ */
+SPH_API sph_result SPH_CALL sph_collider_set_material_struct(sph_world* world, sph_collider_id id,
+                                                             const sph_collider_material* material);
+/**
+ * Reads a collider's material (as the def or the last set call gave it). out->struct_size
+ * must be set (sph_collider_material_init); only that many bytes are written.
+ * Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL out), VERSION_MISMATCH, WORLD_LOCKED.
+ */
+SPH_API sph_result SPH_CALL sph_collider_get_material(const sph_world* world, sph_collider_id id,
+                                                      sph_collider_material* out);
+
 /* ---- sources ----------------------------------------------------------------------------- */
 typedef struct sph_source_id {
-  uint64_t bits;
+  uint64_t bits; /* {0} is null (SPH_ID_IS_NULL) */
 } sph_source_id;
 
 typedef enum sph_source_mode {
@@ -713,6 +786,9 @@ typedef enum sph_source_mode {
 
 #define SPH_SOURCE_FLAG_VELOCITY_FROM_FIELD 0x1u /* initial velocity from the SDF's velocity */
 
+/** Zero means default, but a source needs its region: a zeroed def is refused with
+ *  INVALID_ARGUMENT naming def->region; with region set it fills the region once, at the
+ *  world's spacing, at rest. */
 typedef struct sph_source_def {
   uint32_t struct_size;    /* set by sph_source_def_init */
   sph_source_mode mode;    /* default SPH_SOURCE_FILL_ONCE */
@@ -747,7 +823,7 @@ SPH_API sph_result SPH_CALL sph_source_set_transform(sph_world* world, sph_sourc
 
 /* ---- sinks ------------------------------------------------------------------------------- */
 typedef struct sph_sink_id {
-  uint64_t bits;
+  uint64_t bits; /* {0} is null (SPH_ID_IS_NULL) */
 } sph_sink_id;
 
 typedef enum sph_sink_mode {
@@ -756,14 +832,17 @@ typedef enum sph_sink_mode {
   SPH_SINK_MODE_FORCE32 = 0x7fffffff
 } sph_sink_mode;
 
+/** Zero means default: a zeroed def is a REGION sink and needs its region (INVALID_ARGUMENT
+ *  naming def->region); an OUTSIDE_BOUNDS sink with zero bounds keeps only particles at the
+ *  origin. */
 typedef struct sph_sink_def {
   uint32_t struct_size;    /* set by sph_sink_def_init */
   sph_sink_mode mode;      /* default SPH_SINK_REGION */
   sph_sdf* region;         /* REGION: required */
   sph_transform transform; /* REGION: placement; default identity */
   sph_vec3 bounds_min;     /* OUTSIDE_BOUNDS: the box particles may stay in */
-  sph_vec3 bounds_max;
-  uint32_t reserved0; /* must be 0 */
+  sph_vec3 bounds_max;     /* OUTSIDE_BOUNDS: every component >= bounds_min's */
+  uint32_t reserved0;      /* must be 0 */
 } sph_sink_def;
 SPH_STATIC_ASSERT(sizeof(sph_sink_def) == 64 + sizeof(void*), sph_sink_def_size);
 
@@ -777,7 +856,7 @@ SPH_API sph_result SPH_CALL sph_sink_destroy(sph_world* world, sph_sink_id id);
 
 /* ---- force fields ------------------------------------------------------------------------ */
 typedef struct sph_force_field_id {
-  uint64_t bits;
+  uint64_t bits; /* {0} is null (SPH_ID_IS_NULL) */
 } sph_force_field_id;
 
 typedef enum sph_force_field_kind {
@@ -788,6 +867,9 @@ typedef enum sph_force_field_kind {
   SPH_FORCE_FIELD_KIND_FORCE32 = 0x7fffffff
 } sph_force_field_kind;
 
+/** Zero means default: a zeroed def is a UNIFORM field of zero acceleration acting everywhere
+ *  (valid, and it changes nothing). A VORTEX needs a non-zero def->vector and a GRID def->grid;
+ *  the errors name them. */
 typedef struct sph_force_field_def {
   uint32_t struct_size;      /* set by sph_force_field_def_init */
   sph_force_field_kind kind; /* default SPH_FORCE_FIELD_UNIFORM */

@@ -34,7 +34,7 @@ int main(void) {
     return 1;
   }
 
-  sph_fill_box_desc_init(&box); /* a 20 cm cube of water resting on y = 0 */
+  sph_fill_box_desc_init(&box); /* a 20 cm cube of water; nothing holds it: it falls freely */
   box.min.x = 0.0f;
   box.min.y = 0.0f;
   box.min.z = 0.0f;

@@ -75,6 +75,7 @@ namespace Sph
         public const int SPH_FORCE_FIELD_KIND_FORCE32 = 2147483647;
         public const int SPH_EVENT_TYPE_FORCE32 = 2147483647;
         // SPH_MAKE_VERSION(major, minor, patch) is a function-like macro: not generated.
+        // SPH_ID_IS_NULL(id) is a function-like macro: not generated.
     }
 
     /// <summary>sph_result</summary>
@@ -84,7 +85,7 @@ namespace Sph
         Incomplete = 1,
         /// <summary>success</summary>
         Ok = 0,
-        /// <summary>NULL, NaN/Inf, zero/negative or out-of-range value</summary>
+        /// <summary>NULL, NaN/Inf, out-of-range value, required field left zero</summary>
         ErrorInvalidArgument = -1,
         /// <summary>a NULL, destroyed or foreign object</summary>
         ErrorInvalidHandle = -2,
@@ -175,9 +176,15 @@ namespace Sph
         Forces = 3,
         /// <summary>time integration, max-speed reduction, next step size</summary>
         Integrate = 4,
-        /// <summary>colliders (none yet)</summary>
+        /// <summary>
+        /// particles against colliders (CPU; the CUDA backend does it inside the forces kernel, so it
+        /// counts under SPH_STAGE_FORCES there)
+        /// </summary>
         Collide = 5,
-        /// <summary>sources and sinks (none yet)</summary>
+        /// <summary>
+        /// sinks removing particles; sources emit before the substeps and count only in
+        /// sph_stats.step_ms
+        /// </summary>
         Emit = 6,
         /// <summary>everything else: statistics, transfers</summary>
         Other = 7,
@@ -474,17 +481,23 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_context_def (40 bytes)</summary>
+    /// <summary>
+    /// sph_context_def (40 bytes): Zero means default: a zeroed def is valid (AUTO backend, device 0,
+    /// every hardware thread, no logging; header_version 0 skips the header check).
+    /// </summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct ContextDef
     {
         /// <summary>uint32_t struct_size: sizeof(sph_context_def), set by sph_context_def_init</summary>
         public uint StructSize;
-        /// <summary>uint32_t header_version: SPH_VERSION of the header the caller compiled against</summary>
+        /// <summary>
+        /// uint32_t header_version: SPH_VERSION of the header the caller compiled against; 0 =
+        /// unchecked
+        /// </summary>
         public uint HeaderVersion;
         /// <summary>sph_backend backend: default SPH_BACKEND_AUTO</summary>
         public Backend Backend;
-        /// <summary>int32_t device_ordinal: CUDA device; -1 (default) = device 0</summary>
+        /// <summary>int32_t device_ordinal: CUDA device; -1 (default) and 0 = device 0</summary>
         public int DeviceOrdinal;
         /// <summary>uint32_t cpu_worker_count: CPU backend threads; 0 (default) = all hardware threads</summary>
         public uint CpuWorkerCount;
@@ -506,15 +519,18 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_world_def (40 bytes): Creation-time description of a world; fixed for the world's life.</summary>
+    /// <summary>
+    /// sph_world_def (40 bytes): Creation-time description of a world; fixed for the world's life. Zero
+    /// means default for every field: a zeroed def is the def sph_world_def_init gives.
+    /// </summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct WorldDef
     {
         /// <summary>uint32_t struct_size: sizeof(sph_world_def), set by sph_world_def_init</summary>
         public uint StructSize;
-        /// <summary>uint32_t header_version: SPH_VERSION of the caller's header</summary>
+        /// <summary>uint32_t header_version: SPH_VERSION of the caller's header; 0 = unchecked</summary>
         public uint HeaderVersion;
-        /// <summary>uint32_t capacity: most particles the world holds; default 65536; &gt;= 1</summary>
+        /// <summary>uint32_t capacity: most particles the world holds; 0 (default) = 65536; at most 2^30</summary>
         public uint Capacity;
         /// <summary>sph_feature_flags features: SPH_FEATURE_* bits; default SPH_FEATURE_NONE</summary>
         public uint Features;
@@ -522,11 +538,11 @@ namespace Sph
         public Integrator Integrator;
         /// <summary>sph_viscosity_method viscosity_method: default SPH_VISCOSITY_MUELLER</summary>
         public ViscosityMethod ViscosityMethod;
-        /// <summary>float particle_spacing: nearest-neighbour distance of the FCC lattice, m; default 0.02</summary>
+        /// <summary>float particle_spacing: nearest-neighbour distance of the FCC lattice, m; 0 (default) = 0.02</summary>
         public float ParticleSpacing;
         /// <summary>float kernel_radius: h, m; 0 (default) = 1.8 * particle_spacing; must be &gt;= spacing</summary>
         public float KernelRadius;
-        /// <summary>float rest_density: rho0, kg/m^3; default 1000 (water)</summary>
+        /// <summary>float rest_density: rho0, kg/m^3; 0 (default) = 1000 (water)</summary>
         public float RestDensity;
         /// <summary>sph_equation_of_state equation_of_state: default SPH_EOS_IDEAL_GAS</summary>
         public EquationOfState EquationOfState;
@@ -702,7 +718,10 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_spawn_desc (40 bytes)</summary>
+    /// <summary>
+    /// sph_spawn_desc (40 bytes): Zero means default: a zeroed desc spawns nothing (count 0); positions
+    /// is required once count &gt; 0 (INVALID_ARGUMENT naming desc-&gt;positions).
+    /// </summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct SpawnDesc
     {
@@ -710,7 +729,10 @@ namespace Sph
         public uint StructSize;
         /// <summary>uint32_t count: particles to add; 0 is allowed and adds nothing</summary>
         public uint Count;
-        /// <summary>const float* positions: count x (x, y, z) float32, caller-owned, copied; required</summary>
+        /// <summary>
+        /// const float* positions: count x (x, y, z) float32, caller-owned, copied; required when count
+        /// &gt; 0
+        /// </summary>
         public IntPtr Positions;
         /// <summary>const float* velocities: count x (x, y, z) float32, or NULL for zero velocity</summary>
         public IntPtr Velocities;
@@ -729,7 +751,10 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_fill_box_desc (44 bytes)</summary>
+    /// <summary>
+    /// sph_fill_box_desc (44 bytes): Zero means default: a zeroed desc is an empty box and fills
+    /// nothing.
+    /// </summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct FillBoxDesc
     {
@@ -739,7 +764,7 @@ namespace Sph
         public uint Reserved0;
         /// <summary>sph_vec3 min: box corner, m</summary>
         public Vec3 Min;
-        /// <summary>sph_vec3 max: opposite corner, m; every component &gt; min's</summary>
+        /// <summary>sph_vec3 max: opposite corner, m; every component &gt;= min's (equal: an empty box)</summary>
         public Vec3 Max;
         /// <summary>sph_vec3 velocity: initial velocity of every particle; default 0</summary>
         public Vec3 Velocity;
@@ -754,7 +779,7 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_fill_sphere_desc (36 bytes)</summary>
+    /// <summary>sph_fill_sphere_desc (36 bytes): Zero means default: a zeroed desc (radius 0) fills nothing.</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct FillSphereDesc
     {
@@ -764,7 +789,7 @@ namespace Sph
         public uint Reserved0;
         /// <summary>sph_vec3 center: m; a lattice point sits at the centre</summary>
         public Vec3 Center;
-        /// <summary>float radius: m; &gt; 0; points with |p - center| &lt;= radius are filled</summary>
+        /// <summary>float radius: m; &gt;= 0; points with |p - center| &lt;= radius are filled; 0 = none</summary>
         public float Radius;
         /// <summary>sph_vec3 velocity: initial velocity; default 0</summary>
         public Vec3 Velocity;
@@ -831,21 +856,30 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_grid_desc (80 bytes)</summary>
+    /// <summary>
+    /// sph_grid_desc (80 bytes): Zero means default, except that a grid cannot be empty: dims and data
+    /// are required (the error names the first of them that is zero).
+    /// </summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct GridDesc
     {
         /// <summary>uint32_t struct_size: set by sph_grid_desc_init</summary>
         public uint StructSize;
-        /// <summary>uint32_t [3] dims: samples along i, j, k (i fastest); each &gt;= 1</summary>
+        /// <summary>uint32_t [3] dims: samples along i, j, k (i fastest); each &gt;= 1; required</summary>
         public FixedUint3 Dims;
-        /// <summary>float [12] index_to_local: row-major 3x4 affine map; default: identity (1 m voxels)</summary>
+        /// <summary>
+        /// float [12] index_to_local: row-major 3x4 affine map; default (and all zeros): identity (1 m
+        /// voxels)
+        /// </summary>
         public FixedFloat12 IndexToLocal;
         /// <summary>sph_memory_kind memory: where data lives; default SPH_MEMORY_HOST</summary>
         public MemoryKind Memory;
-        /// <summary>uint32_t components: floats per voxel: 1 (distance, friction) or 3 (velocity)</summary>
+        /// <summary>
+        /// uint32_t components: floats per voxel: 1 (distance, friction) or 3 (velocity, force field
+        /// accelerations); 0 (default) = the channel's own count
+        /// </summary>
         public uint Components;
-        /// <summary>const float* data: dims[0] * dims[1] * dims[2] * components floats, copied</summary>
+        /// <summary>const float* data: dims[0] * dims[1] * dims[2] * components floats, copied; required</summary>
         public IntPtr Data;
 
         /// <summary>A GridDesc with the library's defaults (sph_grid_desc_init_sized).</summary>
@@ -858,7 +892,11 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_sdf_desc (104 bytes)</summary>
+    /// <summary>
+    /// sph_sdf_desc (104 bytes): A zeroed desc is refused: the distance grid is required
+    /// (INVALID_ARGUMENT naming desc-&gt;distance.dims, then desc-&gt;distance.data). The embedded
+    /// grid's struct_size may be 0.
+    /// </summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct SdfDesc
     {
@@ -886,23 +924,27 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_shape_desc (44 bytes)</summary>
+    /// <summary>
+    /// sph_shape_desc (44 bytes): Zero means default for every size; shape 0 is SPH_SHAPE_PLANE (zero
+    /// keeps its meaning), so a zeroed desc is a plane of the default sizes, and sph_shape_desc_init
+    /// picks SPH_SHAPE_BOX.
+    /// </summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct ShapeDesc
     {
         /// <summary>uint32_t struct_size: set by sph_shape_desc_init</summary>
         public uint StructSize;
-        /// <summary>sph_shape shape: default SPH_SHAPE_BOX</summary>
+        /// <summary>sph_shape shape: sph_shape_desc_init: SPH_SHAPE_BOX; 0 = SPH_SHAPE_PLANE</summary>
         public Shape Shape;
-        /// <summary>sph_vec3 half_extents: m; default (0.5, 0.5, 0.5)</summary>
+        /// <summary>sph_vec3 half_extents: m; each component 0 (default) = 0.5</summary>
         public Vec3 HalfExtents;
-        /// <summary>float radius: m; default 0.5</summary>
+        /// <summary>float radius: m; 0 (default) = 0.5</summary>
         public float Radius;
-        /// <summary>float half_height: m; default 0.5</summary>
+        /// <summary>float half_height: m; 0 (default) = 0.5</summary>
         public float HalfHeight;
         /// <summary>float wall_thickness: m; default 0 (solid)</summary>
         public float WallThickness;
-        /// <summary>float voxel_size: m; default 0.01</summary>
+        /// <summary>float voxel_size: m; 0 (default) = 0.01</summary>
         public float VoxelSize;
         /// <summary>uint32_t flags: SPH_SHAPE_FLAG_*</summary>
         public uint Flags;
@@ -923,13 +965,25 @@ namespace Sph
     [StructLayout(LayoutKind.Sequential)]
     public partial struct Quat
     {
-        /// <summary>float x: a rotation; normalised by the library; (0, 0, 0, 1) is identity</summary>
+        /// <summary>
+        /// float x: a rotation; normalised by the library; (0, 0, 0, 1) is identity, and so is (0, 0,
+        /// 0, 0), the quaternion of a zeroed struct
+        /// </summary>
         public float X;
-        /// <summary>float y: a rotation; normalised by the library; (0, 0, 0, 1) is identity</summary>
+        /// <summary>
+        /// float y: a rotation; normalised by the library; (0, 0, 0, 1) is identity, and so is (0, 0,
+        /// 0, 0), the quaternion of a zeroed struct
+        /// </summary>
         public float Y;
-        /// <summary>float z: a rotation; normalised by the library; (0, 0, 0, 1) is identity</summary>
+        /// <summary>
+        /// float z: a rotation; normalised by the library; (0, 0, 0, 1) is identity, and so is (0, 0,
+        /// 0, 0), the quaternion of a zeroed struct
+        /// </summary>
         public float Z;
-        /// <summary>float w: a rotation; normalised by the library; (0, 0, 0, 1) is identity</summary>
+        /// <summary>
+        /// float w: a rotation; normalised by the library; (0, 0, 0, 1) is identity, and so is (0, 0,
+        /// 0, 0), the quaternion of a zeroed struct
+        /// </summary>
         public float W;
 
         public Quat(float x, float y, float z, float w)
@@ -967,7 +1021,7 @@ namespace Sph
     [StructLayout(LayoutKind.Sequential)]
     public partial struct ColliderId
     {
-        /// <summary>uint64_t bits: {0} is null</summary>
+        /// <summary>uint64_t bits: {0} is null (SPH_ID_IS_NULL)</summary>
         public ulong Bits;
 
         public ColliderId(ulong bits)
@@ -976,7 +1030,11 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_collider_def (64 bytes)</summary>
+    /// <summary>
+    /// sph_collider_def (64 bytes): Zero means default, but a collider needs its SDF: a zeroed def is
+    /// refused with INVALID_ARGUMENT naming def-&gt;sdf, and with sdf set it is a static collider at
+    /// the identity pose with the default material (sph_collider_material).
+    /// </summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct ColliderDef
     {
@@ -1012,11 +1070,41 @@ namespace Sph
         }
     }
 
+    /// <summary>
+    /// sph_collider_material (16 bytes): How a collider's surface answers particles that reach it. Zero
+    /// means default: a zeroed struct (struct_size set) is what sph_collider_material_init gives, a
+    /// surface that returns no normal speed, has no friction and pulls nothing.
+    /// </summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public partial struct ColliderMaterial
+    {
+        /// <summary>uint32_t struct_size: set by sph_collider_material_init</summary>
+        public uint StructSize;
+        /// <summary>float restitution: share of the normal approach speed returned, [0, 1]; default 0</summary>
+        public float Restitution;
+        /// <summary>
+        /// float friction: Coulomb coefficient &gt;= 0 (ignored where the SDF has a friction channel);
+        /// default 0
+        /// </summary>
+        public float Friction;
+        /// <summary>float stickiness: pull toward the surface within one kernel radius, m/s^2 &gt;= 0; default 0</summary>
+        public float Stickiness;
+
+        /// <summary>A ColliderMaterial with the library's defaults (sph_collider_material_init_sized).</summary>
+        public static ColliderMaterial Default()
+        {
+            var value = new ColliderMaterial();
+            uint size = (uint)Marshal.SizeOf(typeof(ColliderMaterial));
+            SphException.Check(Native.sph_collider_material_init_sized(ref value, size), "sph_collider_material_init_sized");
+            return value;
+        }
+    }
+
     /// <summary>sph_source_id (8 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct SourceId
     {
-        /// <summary>uint64_t bits</summary>
+        /// <summary>uint64_t bits: {0} is null (SPH_ID_IS_NULL)</summary>
         public ulong Bits;
 
         public SourceId(ulong bits)
@@ -1025,7 +1113,11 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_source_def (80 bytes)</summary>
+    /// <summary>
+    /// sph_source_def (80 bytes): Zero means default, but a source needs its region: a zeroed def is
+    /// refused with INVALID_ARGUMENT naming def-&gt;region; with region set it fills the region once,
+    /// at the world's spacing, at rest.
+    /// </summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct SourceDef
     {
@@ -1069,7 +1161,7 @@ namespace Sph
     [StructLayout(LayoutKind.Sequential)]
     public partial struct SinkId
     {
-        /// <summary>uint64_t bits</summary>
+        /// <summary>uint64_t bits: {0} is null (SPH_ID_IS_NULL)</summary>
         public ulong Bits;
 
         public SinkId(ulong bits)
@@ -1078,7 +1170,11 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_sink_def (72 bytes)</summary>
+    /// <summary>
+    /// sph_sink_def (72 bytes): Zero means default: a zeroed def is a REGION sink and needs its region
+    /// (INVALID_ARGUMENT naming def-&gt;region); an OUTSIDE_BOUNDS sink with zero bounds keeps only
+    /// particles at the origin.
+    /// </summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct SinkDef
     {
@@ -1092,7 +1188,7 @@ namespace Sph
         public Transform Transform;
         /// <summary>sph_vec3 bounds_min: OUTSIDE_BOUNDS: the box particles may stay in</summary>
         public Vec3 BoundsMin;
-        /// <summary>sph_vec3 bounds_max</summary>
+        /// <summary>sph_vec3 bounds_max: OUTSIDE_BOUNDS: every component &gt;= bounds_min's</summary>
         public Vec3 BoundsMax;
         /// <summary>uint32_t reserved0: must be 0</summary>
         public uint Reserved0;
@@ -1111,7 +1207,7 @@ namespace Sph
     [StructLayout(LayoutKind.Sequential)]
     public partial struct ForceFieldId
     {
-        /// <summary>uint64_t bits</summary>
+        /// <summary>uint64_t bits: {0} is null (SPH_ID_IS_NULL)</summary>
         public ulong Bits;
 
         public ForceFieldId(ulong bits)
@@ -1120,7 +1216,11 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_force_field_def (80 bytes)</summary>
+    /// <summary>
+    /// sph_force_field_def (80 bytes): Zero means default: a zeroed def is a UNIFORM field of zero
+    /// acceleration acting everywhere (valid, and it changes nothing). A VORTEX needs a non-zero
+    /// def-&gt;vector and a GRID def-&gt;grid; the errors name them.
+    /// </summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct ForceFieldDef
     {
@@ -1384,9 +1484,9 @@ namespace Sph
         /// Creates an empty world on a context. The particle mass is derived here: the mass at which an
         /// FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass).
         /// Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range:
-        /// capacity 0, spacing &lt;= 0 or non-finite, kernel_radius &lt; spacing, rest_density &lt;=
-        /// 0), UNSUPPORTED (unknown integrator or feature bit), VERSION_MISMATCH, OUT_OF_HOST_MEMORY,
-        /// OUT_OF_DEVICE_MEMORY. *out is written only on success.
+        /// capacity above 2^30, spacing &lt; 0 or non-finite, kernel_radius &lt; spacing, rest_density
+        /// &lt; 0), UNSUPPORTED (unknown integrator or feature bit), VERSION_MISMATCH,
+        /// OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY. *out is written only on success.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_create(ContextHandle context, ref WorldDef def, out WorldHandle @out);
@@ -1397,7 +1497,10 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_destroy(IntPtr world);
 
-        /// <summary>The def the world was created with, with defaults resolved (kernel_radius filled in).</summary>
+        /// <summary>
+        /// The def the world was created with, with defaults resolved (zeros and kernel_radius filled
+        /// in).
+        /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_get_def(WorldHandle world, ref WorldDef outDef);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_def")]
@@ -1710,11 +1813,41 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_get_transform")]
         public static extern Result sph_collider_get_transform(IntPtr world, ColliderId id, IntPtr outTransform);
 
-        /// <summary>Changes restitution, friction and stickiness (same ranges as sph_collider_def).</summary>
+        /// <summary>
+        /// Deprecated: use sph_collider_set_material_struct. Kept, with its arguments, so that programs
+        /// built against earlier headers keep working (the ABI does not change); it sets the three
+        /// coefficients as that call does, with the same checks.
+        /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_collider_set_material(WorldHandle world, ColliderId id, float restitution, float friction, float stickiness);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_set_material")]
         public static extern Result sph_collider_set_material(IntPtr world, ColliderId id, float restitution, float friction, float stickiness);
+
+        /// <summary>sph_collider_material_init_sized</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_collider_material_init_sized(ref ColliderMaterial material, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_material_init_sized")]
+        public static extern Result sph_collider_material_init_sized(IntPtr material, uint size);
+
+        /// <summary>
+        /// Replaces a collider's material; acts from the next substep. Errors: INVALID_HANDLE (world; a
+        /// null, stale or foreign id), INVALID_ARGUMENT (NULL material; a coefficient out of range or
+        /// not finite, named), VERSION_MISMATCH (struct_size), WORLD_LOCKED. Nothing changes on error.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_collider_set_material_struct(WorldHandle world, ColliderId id, ref ColliderMaterial material);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_set_material_struct")]
+        public static extern Result sph_collider_set_material_struct(IntPtr world, ColliderId id, IntPtr material);
+
+        /// <summary>
+        /// Reads a collider's material (as the def or the last set call gave it). out-&gt;struct_size
+        /// must be set (sph_collider_material_init); only that many bytes are written. Errors:
+        /// INVALID_HANDLE, INVALID_ARGUMENT (NULL out), VERSION_MISMATCH, WORLD_LOCKED.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_collider_get_material(WorldHandle world, ColliderId id, ref ColliderMaterial @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_get_material")]
+        public static extern Result sph_collider_get_material(IntPtr world, ColliderId id, IntPtr @out);
 
         /// <summary>sph_source_def_init_sized</summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
@@ -1979,6 +2112,7 @@ namespace Sph
             typeof(Transform),
             typeof(ColliderId),
             typeof(ColliderDef),
+            typeof(ColliderMaterial),
             typeof(SourceId),
             typeof(SourceDef),
             typeof(SinkId),
@@ -2008,6 +2142,7 @@ namespace Sph
             "sph_transform",
             "sph_collider_id",
             "sph_collider_def",
+            "sph_collider_material",
             "sph_source_id",
             "sph_source_def",
             "sph_sink_id",
@@ -2037,6 +2172,7 @@ namespace Sph
             28,
             8,
             64,
+            16,
             8,
             80,
             8,
@@ -2166,6 +2302,10 @@ namespace Sph
             typeof(ColliderDef),
             typeof(ColliderDef),
             typeof(ColliderDef),
+            typeof(ColliderMaterial),
+            typeof(ColliderMaterial),
+            typeof(ColliderMaterial),
+            typeof(ColliderMaterial),
             typeof(SourceId),
             typeof(SourceDef),
             typeof(SourceDef),
@@ -2328,6 +2468,10 @@ namespace Sph
             "Stickiness",
             "Reserved0",
             "Reserved1",
+            "StructSize",
+            "Restitution",
+            "Friction",
+            "Stickiness",
             "Bits",
             "StructSize",
             "Mode",
@@ -2491,6 +2635,10 @@ namespace Sph
             56,
             60,
             0,
+            4,
+            8,
+            12,
+            0,
             0,
             4,
             8,
@@ -2595,6 +2743,9 @@ namespace Sph
             "sph_collider_teleport",
             "sph_collider_get_transform",
             "sph_collider_set_material",
+            "sph_collider_material_init_sized",
+            "sph_collider_set_material_struct",
+            "sph_collider_get_material",
             "sph_source_def_init_sized",
             "sph_source_create",
             "sph_source_destroy",
@@ -2708,6 +2859,9 @@ namespace Sph
             "sph",
             "sph",
             "sph",
+            "sph",
+            "sph",
+            "sph",
             "sph_vdb",
             "sph_vdb",
         };
@@ -2717,7 +2871,7 @@ namespace Sph
         {
             { "SPH_INCOMPLETE", "the call did part of the work; see its doc" },
             { "SPH_OK", "success" },
-            { "SPH_ERROR_INVALID_ARGUMENT", "NULL, NaN/Inf, zero/negative or out-of-range value" },
+            { "SPH_ERROR_INVALID_ARGUMENT", "NULL, NaN/Inf, out-of-range value, required field left zero" },
             { "SPH_ERROR_INVALID_HANDLE", "a NULL, destroyed or foreign object" },
             { "SPH_ERROR_VERSION_MISMATCH", "struct_size or header_version not accepted" },
             { "SPH_ERROR_UNSUPPORTED", "not compiled in, no such device, unknown enum value" },
@@ -2748,8 +2902,8 @@ namespace Sph
             { "SPH_STAGE_DENSITY", "density and pressure" },
             { "SPH_STAGE_FORCES", "pressure, viscosity and external forces" },
             { "SPH_STAGE_INTEGRATE", "time integration, max-speed reduction, next step size" },
-            { "SPH_STAGE_COLLIDE", "colliders (none yet)" },
-            { "SPH_STAGE_EMIT", "sources and sinks (none yet)" },
+            { "SPH_STAGE_COLLIDE", "particles against colliders (CPU; the CUDA backend does it inside the forces kernel, so it counts under SPH_STAGE_FORCES there)" },
+            { "SPH_STAGE_EMIT", "sinks removing particles; sources emit before the substeps and count only in sph_stats.step_ms" },
             { "SPH_STAGE_OTHER", "everything else: statistics, transfers" },
             { "SPH_VISCOSITY_MUELLER", "Laplacian viscosity (eq. 17), coefficient sph_world_params.viscosity" },
             { "SPH_VISCOSITY_CLAVET", "radial impulses between approaching pairs (eq. 18-19), sph_clavet_viscosity_params" },

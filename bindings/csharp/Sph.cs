@@ -1054,6 +1054,22 @@ namespace Sph
             SphException.Check(Native.sph_collider_teleport(World.Handle, Id, ref transform), "sph_collider_teleport");
         }
 
+        /// <summary>The surface material (restitution, friction, stickiness); setting it replaces all three.</summary>
+        public ColliderMaterial Material
+        {
+            get
+            {
+                var m = ColliderMaterial.Default();
+                SphException.Check(Native.sph_collider_get_material(World.Handle, Id, ref m), "sph_collider_get_material");
+                return m;
+            }
+            set
+            {
+                SphException.Check(Native.sph_collider_set_material_struct(World.Handle, Id, ref value), "sph_collider_set_material_struct");
+            }
+        }
+
+        /// <summary>As setting Material (the C API's older positional call).</summary>
         public void SetMaterial(float restitution, float friction, float stickiness)
         {
             SphException.Check(Native.sph_collider_set_material(World.Handle, Id, restitution, friction, stickiness), "sph_collider_set_material");

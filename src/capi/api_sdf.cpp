@@ -2,6 +2,7 @@
 #include <vector>
 
 #include "../core/sdf_shapes.h"
+#include "grid_from_public.h"
 #include "guard.h"
 #include "handles.h"
 #include "init_struct.h"
@@ -33,33 +34,34 @@ void require_context(const sph_context* context) {
 }
 
 // Copies `count` floats from caller memory (host or device) and checks they are finite.
+// `name` is the grid's path with its separator ("desc->distance.", "desc->velocity->").
 std::vector<float> read_floats(const sph_context* context, const float* data, uint64_t count,
                                sph_memory_kind memory, const std::string& name) {
-  if (!data) throw Error(Status::InvalidArgument, name + "->data: is NULL");
+  if (!data) throw Error(Status::InvalidArgument, name + "data: is NULL (required)");
   std::vector<float> out(count);
   const uint32_t memory_bits = sph::enum_bits(memory);
   if (memory_bits == SPH_MEMORY_HOST) {
     std::memcpy(out.data(), data, count * sizeof(float));
   } else if (memory_bits == SPH_MEMORY_CUDA_DEVICE) {
     if (context->backend != sph::BackendKind::Cuda)
-      throw Error(Status::Unsupported, name + "->memory: device memory needs a CUDA context");
+      throw Error(Status::Unsupported, name + "memory: device memory needs a CUDA context");
     sph::copy_device_to_host(out.data(), data, count * sizeof(float), context->device_ordinal);
   } else {
-    throw Error(Status::Unsupported, name + "->memory: " + std::to_string(static_cast<int32_t>(memory_bits)) +
+    throw Error(Status::Unsupported, name + "memory: " + std::to_string(static_cast<int32_t>(memory_bits)) +
                                          " is not an sph_memory_kind value");
   }
   for (uint64_t i = 0; i < count; ++i)
     if (!std::isfinite(out[i]))
-      throw Error(Status::InvalidArgument, name + "->data[" + std::to_string(i) + "]: is not finite");
+      throw Error(Status::InvalidArgument, name + "data[" + std::to_string(i) + "]: is not finite");
   return out;
 }
 
 uint64_t voxel_count(const uint32_t dims[3], const std::string& name) {
   if (dims[0] == 0 || dims[1] == 0 || dims[2] == 0)
-    throw Error(Status::InvalidArgument, name + "->dims: every dimension must be >= 1");
+    throw Error(Status::InvalidArgument, name + "dims: every dimension must be >= 1 (required)");
   const uint64_t n = static_cast<uint64_t>(dims[0]) * dims[1] * dims[2];
   if (n > kMaxVoxels || dims[0] > (1u << 30) || dims[1] > (1u << 30) || dims[2] > (1u << 30))
-    throw Error(Status::Capacity, name + "->dims: more than 2^31 voxels");
+    throw Error(Status::Capacity, name + "dims: more than 2^31 voxels");
   return n;
 }
 
@@ -69,20 +71,21 @@ std::shared_ptr<sph::SdfAsset> asset_from_desc(const sph_context* context, const
   // The distance grid is embedded in sph_sdf_desc, so the outer struct's layout fixes its size:
   // the bytes after it are the outer struct's next fields (and past the end of our copy of it),
   // never the tail of a newer grid desc. Only this version's size can be right.
+  // Zero (a zeroed sph_sdf_desc) means this version's size too.
   const uint32_t grid_size = d.distance.struct_size;
-  if (grid_size != sizeof(sph_grid_desc))
+  if (grid_size != 0 && grid_size != sizeof(sph_grid_desc))
     throw Error(grid_size < sizeof(sph_grid_desc) ? Status::VersionMismatch : Status::Unsupported,
                 "desc->distance.struct_size: " + std::to_string(grid_size) + " is not " +
-                    std::to_string(sizeof(sph_grid_desc)) + "; fill it with sph_grid_desc_init()");
+                    std::to_string(sizeof(sph_grid_desc)) + " (or 0); fill it with sph_grid_desc_init()");
   const sph_grid_desc g = d.distance;
-  if (g.components != 1) throw Error(Status::InvalidArgument, "desc->distance.components: must be 1");
-  const uint64_t n = voxel_count(g.dims, "desc->distance");
-  sph::Affine3x4 affine;
-  std::memcpy(affine.m, g.index_to_local, sizeof affine.m);
+  if (sph::grid_components(g, 1) != 1)
+    throw Error(Status::InvalidArgument, "desc->distance.components: must be 1 (or 0, meaning 1)");
+  const uint64_t n = voxel_count(g.dims, "desc->distance.");
+  if (!g.data) throw Error(Status::InvalidArgument, "desc->distance.data: is NULL (required)");
   auto asset =
       std::make_shared<sph::SdfAsset>(static_cast<int32_t>(g.dims[0]), static_cast<int32_t>(g.dims[1]),
-                                      static_cast<int32_t>(g.dims[2]), affine);
-  asset->distance() = read_floats(context, g.data, n, g.memory, "desc->distance");
+                                      static_cast<int32_t>(g.dims[2]), sph::index_to_local_from_public(g));
+  asset->distance() = read_floats(context, g.data, n, g.memory, "desc->distance.");
   auto same_dims = [&](const sph_grid_desc& o, const char* name) {
     if (o.dims[0] != g.dims[0] || o.dims[1] != g.dims[1] || o.dims[2] != g.dims[2])
       throw Error(Status::InvalidArgument, std::string(name) + "->dims: must equal desc->distance.dims");
@@ -90,16 +93,18 @@ std::shared_ptr<sph::SdfAsset> asset_from_desc(const sph_context* context, const
   if (d.velocity) {
     const sph_grid_desc v = sph::read_user_struct(d.velocity, "desc->velocity");
     same_dims(v, "desc->velocity");
-    if (v.components != 3) throw Error(Status::InvalidArgument, "desc->velocity->components: must be 3");
-    const std::vector<float> raw = read_floats(context, v.data, 3 * n, v.memory, "desc->velocity");
+    if (sph::grid_components(v, 3) != 3)
+      throw Error(Status::InvalidArgument, "desc->velocity->components: must be 3 (or 0, meaning 3)");
+    const std::vector<float> raw = read_floats(context, v.data, 3 * n, v.memory, "desc->velocity->");
     asset->velocity().resize(n);
     std::memcpy(asset->velocity().data(), raw.data(), raw.size() * sizeof(float));
   }
   if (d.friction) {
     const sph_grid_desc f = sph::read_user_struct(d.friction, "desc->friction");
     same_dims(f, "desc->friction");
-    if (f.components != 1) throw Error(Status::InvalidArgument, "desc->friction->components: must be 1");
-    asset->friction() = read_floats(context, f.data, n, f.memory, "desc->friction");
+    if (sph::grid_components(f, 1) != 1)
+      throw Error(Status::InvalidArgument, "desc->friction->components: must be 1 (or 0, meaning 1)");
+    asset->friction() = read_floats(context, f.data, n, f.memory, "desc->friction->");
     for (float mu : asset->friction())
       if (mu < 0.0f) throw Error(Status::InvalidArgument, "desc->friction->data: coefficients must be >= 0");
   }
@@ -124,7 +129,7 @@ SPH_API sph_result SPH_CALL sph_grid_desc_init_sized(sph_grid_desc* desc, uint32
   return sph::init_user_struct("sph_grid_desc_init", "desc", desc, size, [](sph_grid_desc& d) {
     d.index_to_local[0] = d.index_to_local[5] = d.index_to_local[10] = 1.0f;
     d.memory = SPH_MEMORY_HOST;
-    d.components = 1;
+    d.components = 0;  // the channel's own count
   });
 }
 
@@ -184,15 +189,20 @@ SPH_API sph_result SPH_CALL sph_sdf_create_shape(sph_context* context, const sph
     sph::require_finite(d.radius, "desc->radius");
     sph::require_finite(d.half_height, "desc->half_height");
     sph::require_non_negative(d.wall_thickness, "desc->wall_thickness");
-    sph::require_positive(d.voxel_size, "desc->voxel_size");
+    // Zero means default for every size (a zeroed desc is a plane of the default sizes).
+    const sph::ShapeSpec defaults;
+    auto or_default = [](float value, float fallback) { return value == 0.0f ? fallback : value; };
     sph::ShapeSpec spec;
     spec.kind = static_cast<sph::ShapeKind>(shape);
-    spec.half_extents = sph::Vec3{d.half_extents.x, d.half_extents.y, d.half_extents.z};
-    spec.radius = d.radius;
-    spec.half_height = d.half_height;
+    spec.half_extents = sph::Vec3{or_default(d.half_extents.x, defaults.half_extents.x),
+                                  or_default(d.half_extents.y, defaults.half_extents.y),
+                                  or_default(d.half_extents.z, defaults.half_extents.z)};
+    spec.radius = or_default(d.radius, defaults.radius);
+    spec.half_height = or_default(d.half_height, defaults.half_height);
     spec.wall_thickness = d.wall_thickness;
     spec.open_top = (d.flags & SPH_SHAPE_FLAG_OPEN_TOP) != 0;
-    spec.voxel_size = d.voxel_size;
+    spec.voxel_size = or_default(d.voxel_size, defaults.voxel_size);
+    sph::require_positive(spec.voxel_size, "desc->voxel_size");
     spec.padding_voxels =
         d.padding_voxels == 0 ? 4 : static_cast<int32_t>(std::min<uint32_t>(d.padding_voxels, 1u << 20));
     return publish(context, sph::build_shape_sdf(spec, kMaxVoxels), out);
@@ -233,7 +243,7 @@ SPH_API sph_result SPH_CALL sph_sdf_update(sph_sdf* sdf, sph_sdf_channel channel
                         ") leaves the grid along axis " + std::to_string(axis) + " (dimension " +
                         std::to_string(dims[axis]) + ")");
     const uint64_t n = static_cast<uint64_t>(size[0]) * size[1] * size[2];
-    const std::vector<float> values = read_floats(sdf->context, data, n * components, memory, "update");
+    const std::vector<float> values = read_floats(sdf->context, data, n * components, memory, "");
     if (channel_bits == SPH_SDF_CHANNEL_FRICTION)
       for (float mu : values)
         if (mu < 0.0f) throw Error(Status::InvalidArgument, "data: friction coefficients must be >= 0");

@@ -43,14 +43,20 @@ sph_world_params default_world_params() {
   return out;
 }
 
-// Validates a def and resolves defaults into the internal configuration.
-sph::WorldConfig config_from_def(const sph_world_def& d) {
+// Validates a def and resolves defaults into the internal configuration. Zero means default
+// for every field (a zeroed def, struct_size set, is the def sph_world_def_init gives).
+sph::WorldConfig config_from_def(const sph_world_def& def) {
+  const sph_world_def defaults = default_world_def();
+  sph_world_def d = def;
+  if (d.capacity == 0) d.capacity = defaults.capacity;
+  if (d.particle_spacing == 0.0f) d.particle_spacing = defaults.particle_spacing;
+  if (d.rest_density == 0.0f) d.rest_density = defaults.rest_density;
   if (d.header_version != 0 && (d.header_version >> 22) != SPH_VERSION_MAJOR)
     throw Error(Status::VersionMismatch,
                 "def->header_version: the caller's header has another major version");
-  if (d.capacity == 0 || d.capacity > kMaxCapacity)
-    throw Error(Status::InvalidArgument,
-                "def->capacity: must be in [1, 2^30], got " + std::to_string(d.capacity));
+  if (d.capacity > kMaxCapacity)
+    throw Error(Status::InvalidArgument, "def->capacity: must be at most 2^30 (0 = the default 65536), got " +
+                                             std::to_string(d.capacity));
   if (d.features & ~static_cast<uint32_t>(sph::kFeatureAll)) {
     char buf[16];
     std::snprintf(buf, sizeof buf, "%x", d.features & ~static_cast<uint32_t>(sph::kFeatureAll));

@@ -1,6 +1,7 @@
 // Reads a checkpoint into a new world. Everything is parsed and validated before the backend
 // is created, so a damaged file allocates nothing beyond what its own bytes describe and
-// leaves nothing behind; the checks mirror the C layer's for the same fields.
+// leaves nothing behind. Scene objects are made by the same rules as a caller's
+// (scene_build.h); their slot layouts are restored as saved, so ids stay valid.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -13,6 +14,9 @@
 #include "checkpoint.h"
 #include "checkpoint_format.h"
 #include "fcc_lattice.h"
+#include "field_error.h"
+#include "pose_rules.h"
+#include "scene_build.h"
 
 namespace sph {
 namespace {
@@ -73,18 +77,25 @@ Vec3 vec3(ByteReader& r, const std::string& name) {
   return v;
 }
 
-RigidTransform pose(ByteReader& r, const std::string& name) {
+// A pose as stored; the scene's rules (pose_rules.h) check it where the object is made.
+RigidTransform raw_pose(ByteReader& r) {
   RigidTransform t;
-  t.position = vec3(r, name + ".position");
-  t.rotation.x = finite(r, name + ".rotation.x");
-  t.rotation.y = finite(r, name + ".rotation.y");
-  t.rotation.z = finite(r, name + ".rotation.z");
-  t.rotation.w = finite(r, name + ".rotation.w");
-  const Quat& q = t.rotation;
-  const double n2 = double(q.x) * q.x + double(q.y) * q.y + double(q.z) * q.z + double(q.w) * q.w;
-  // The library stores unit quaternions (normalised in float when set).
-  if (!(std::fabs(n2 - 1.0) < 1e-3)) corrupt(r.what() + ": " + name + ".rotation is not a unit quaternion");
+  t.position.x = r.f32();
+  t.position.y = r.f32();
+  t.position.z = r.f32();
+  t.rotation.x = r.f32();
+  t.rotation.y = r.f32();
+  t.rotation.z = r.f32();
+  t.rotation.w = r.f32();
   return t;
+}
+
+Vec3 raw_vec3(ByteReader& r) {
+  Vec3 v;
+  v.x = r.f32();
+  v.y = r.f32();
+  v.z = r.f32();
+  return v;
 }
 
 // Bulk floats: the message is built only on failure (a checkpoint may hold millions).
@@ -364,25 +375,15 @@ std::shared_ptr<SdfAsset> read_asset(ByteReader& r, uint32_t index) {
 
 using Assets = std::vector<std::shared_ptr<SdfAsset>>;
 
-std::shared_ptr<const SdfAsset> asset_ref(ByteReader& r, const Assets& assets, bool required,
-                                          const std::string& name) {
+// An asset of the table, or none; whether the object needs one is the scene's rule.
+std::shared_ptr<const SdfAsset> asset_ref(ByteReader& r, const Assets& assets, const std::string& name) {
   const uint32_t k = r.u32();
-  if (k == kNoAsset) {
-    if (required) corrupt(r.what() + ": " + name + " is missing");
-    return nullptr;
-  }
+  if (k == kNoAsset) return nullptr;
   if (k >= assets.size())
     corrupt(r.what() + ": " + name + " refers to asset " + std::to_string(k) + " of " +
             std::to_string(assets.size()));
   return assets[k];
 }
-
-template <class T>
-struct SlotTable {
-  std::vector<uint32_t> generations;
-  std::vector<std::optional<T>> values;
-  std::vector<uint32_t> free_list;
-};
 
 // The slot table of one kind of object (see write_slots); read_value reads one live body.
 template <class T, class ReadValue>
@@ -420,39 +421,47 @@ SlotTable<T> read_slots(ByteReader& r, ReadValue&& read_value) {
   return t;
 }
 
-void check_material(ByteReader& r, float restitution, const std::string& name) {
-  if (restitution > 1.0f) corrupt(r.what() + ": " + name + " restitution is above 1");
+// Runs one of the scene's rules (scene_build.h, pose_rules.h: the same the world's entry
+// points apply to callers) on what the file holds; a violation is corrupt data, named by slot.
+template <class Check>
+auto by_scene_rules(ByteReader& r, const std::string& name, Check&& check) -> decltype(check()) {
+  try {
+    return with_field_prefix(name + " ", std::forward<Check>(check));
+  } catch (const Error& e) {
+    corrupt(r.what() + ": " + e.what());
+  }
 }
 
 Collider read_collider(ByteReader& r, const Assets& assets, const std::string& name) {
-  Collider c;
-  c.sdf = asset_ref(r, assets, true, name + " SDF");
-  c.pose = pose(r, name + " pose");
-  if (flag(r, name + " has target")) c.target = pose(r, name + " target");
-  c.restitution = non_negative(r, name + " restitution");
-  check_material(r, c.restitution, name);
-  c.friction = non_negative(r, name + " friction");
-  c.stickiness = non_negative(r, name + " stickiness");
-  c.inverted = flag(r, name + " inverted") != 0;
+  ColliderSpec spec;
+  spec.sdf = asset_ref(r, assets, name + " SDF");
+  spec.pose = raw_pose(r);
+  std::optional<RigidTransform> target;
+  if (flag(r, name + " has target")) target = raw_pose(r);
+  spec.material.restitution = r.f32();
+  spec.material.friction = r.f32();
+  spec.material.stickiness = r.f32();
+  spec.inverted = flag(r, name + " inverted") != 0;
+  Collider c = by_scene_rules(r, name, [&] { return make_collider(spec); });
+  if (target) by_scene_rules(r, name, [&] { require_pose(*target, "target"); });
+  c.target = target;
   return c;
 }
 
 Source read_source(ByteReader& r, const Assets& assets, const WorldConfig& config, const std::string& name) {
-  Source s;
-  s.region = asset_ref(r, assets, true, name + " region");
-  s.pose = pose(r, name + " pose");
-  s.mode = static_cast<SourceMode>(below(r, 2, name + " mode"));
-  s.spacing = positive(r, name + " spacing");
-  if (s.spacing < 0.25f * config.particle_spacing)
-    corrupt(r.what() + ": " + name + " spacing is below a quarter of the world's");
-  s.min_distance = non_negative(r, name + " min distance");
-  if (s.min_distance > config.kernel_radius || s.min_distance > s.spacing)
-    corrupt(r.what() + ": " + name + " min distance exceeds the kernel radius or the spacing");
-  s.velocity = vec3(r, name + " velocity");
-  s.velocity_from_field = flag(r, name + " velocity from field") != 0;
-  if (s.velocity_from_field && !s.region->has_velocity())
-    corrupt(r.what() + ": " + name + " takes velocities from a region without a velocity channel");
-  s.rate = non_negative(r, name + " rate");
+  SourceSpec spec;
+  spec.region = asset_ref(r, assets, name + " region");
+  spec.pose = raw_pose(r);
+  spec.mode = static_cast<SourceMode>(below(r, 2, name + " mode"));
+  spec.spacing = r.f32();
+  spec.min_distance = r.f32();
+  spec.velocity = raw_vec3(r);
+  spec.velocity_from_field = flag(r, name + " velocity from field") != 0;
+  spec.rate = r.f32();
+  // Stored values are resolved: a zero here would be read as "the default" by the rules.
+  if (spec.spacing == 0.0f || spec.min_distance == 0.0f)
+    corrupt(r.what() + ": " + name + " spacing or min distance is 0 (never written)");
+  Source s = by_scene_rules(r, name, [&] { return make_source(spec, config); });
   s.rate_budget = r.f64();
   // A budget grows by at most rate x frame time per step; far below the size_t range.
   if (!std::isfinite(s.rate_budget) || s.rate_budget < 0.0 || s.rate_budget > 1e15)
@@ -467,41 +476,25 @@ Source read_source(ByteReader& r, const Assets& assets, const WorldConfig& confi
 }
 
 Sink read_sink(ByteReader& r, const Assets& assets, const std::string& name) {
-  Sink s;
-  s.mode = static_cast<SinkMode>(below(r, 2, name + " mode"));
-  s.region = asset_ref(r, assets, s.mode == SinkMode::Region, name + " region");
-  if (s.mode == SinkMode::OutsideBounds && s.region)
-    corrupt(r.what() + ": " + name + " has bounds and a region");
-  s.pose = pose(r, name + " pose");
-  s.bounds_min = vec3(r, name + " bounds_min");
-  s.bounds_max = vec3(r, name + " bounds_max");
-  if (!(s.bounds_max.x >= s.bounds_min.x && s.bounds_max.y >= s.bounds_min.y &&
-        s.bounds_max.z >= s.bounds_min.z))
-    corrupt(r.what() + ": " + name + " bounds_max is below bounds_min");
-  return s;
+  SinkSpec spec;
+  spec.mode = static_cast<SinkMode>(below(r, 2, name + " mode"));
+  spec.region = asset_ref(r, assets, name + " region");
+  spec.pose = raw_pose(r);
+  spec.bounds_min = raw_vec3(r);
+  spec.bounds_max = raw_vec3(r);
+  return by_scene_rules(r, name, [&] { return make_sink(spec); });
 }
 
 ForceField read_force_field(ByteReader& r, const Assets& assets, const std::string& name) {
-  ForceField f;
-  f.kind = static_cast<ForceFieldKind>(below(r, 4, name + " kind"));
-  f.region = asset_ref(r, assets, false, name + " region");
-  f.grid = asset_ref(r, assets, f.kind == ForceFieldKind::Grid, name + " grid");
-  if (f.kind != ForceFieldKind::Grid && f.grid)
-    corrupt(r.what() + ": " + name + " has a grid but is no grid field");
-  if (f.grid && !f.grid->has_velocity())
-    corrupt(r.what() + ": " + name + " grid has no acceleration channel");
-  f.pose = pose(r, name + " pose");
-  f.vector = vec3(r, name + " vector");
-  if (f.kind == ForceFieldKind::Vortex && !(length(f.vector) > 0.0f))
-    corrupt(r.what() + ": " + name + " is a vortex without an axis");
-  f.strength = finite(r, name + " strength");
-  f.falloff_radius = non_negative(r, name + " falloff radius");
-  return f;
-}
-
-template <class T>
-void install(SlotMap<T>& map, SlotTable<T>&& t) {
-  map.restore(t.generations, std::move(t.values), std::move(t.free_list));
+  ForceFieldSpec spec;
+  spec.kind = static_cast<ForceFieldKind>(below(r, 4, name + " kind"));
+  spec.region = asset_ref(r, assets, name + " region");
+  spec.grid = asset_ref(r, assets, name + " grid");
+  spec.pose = raw_pose(r);
+  spec.vector = raw_vec3(r);
+  spec.strength = r.f32();
+  spec.falloff_radius = r.f32();
+  return by_scene_rules(r, name, [&] { return make_force_field(spec); });
 }
 
 }  // namespace
@@ -606,10 +599,8 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   world->set_params(params);
   world->restore_counters(clock.next_id, clock.simulated_time, clock.report, clock.last_step_ms,
                           clock.events);
-  install(world->colliders(), std::move(colliders));
-  install(world->sources(), std::move(sources));
-  install(world->sinks(), std::move(sinks));
-  install(world->force_fields(), std::move(fields));
+  world->restore_scene(
+      SceneTables{std::move(colliders), std::move(sources), std::move(sinks), std::move(fields)});
   return world;
 }
 

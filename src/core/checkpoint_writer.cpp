@@ -231,9 +231,9 @@ std::vector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin
       write_pose(w, c.pose);
       w.u32(c.target ? 1u : 0u);
       if (c.target) write_pose(w, *c.target);
-      w.f32(c.restitution);
-      w.f32(c.friction);
-      w.f32(c.stickiness);
+      w.f32(c.material.restitution);
+      w.f32(c.material.friction);
+      w.f32(c.material.stickiness);
       w.u32(c.inverted ? 1u : 0u);
     });
   });

@@ -1,5 +1,5 @@
 // The small objects a world holds besides particles: colliders, sources, sinks and force
-// fields, as the core keeps them between frames.
+// fields, as the core keeps them between frames (made from specs by scene_build.h).
 #pragma once
 
 #include <stdint.h>
@@ -8,29 +8,21 @@
 #include <optional>
 #include <vector>
 
-#include "../physics/force_fields.h"
-#include "../physics/rigid_transform.h"
-#include "../physics/sink_region.h"
-#include "sdf_asset.h"
+#include "scene_specs.h"
 
 namespace sph {
 
 struct Collider {
   std::shared_ptr<const SdfAsset> sdf;
-  RigidTransform pose{{0.0f, 0.0f, 0.0f},
-                      {0.0f, 0.0f, 0.0f, 1.0f}};  // where the collider is now (start of the next frame)
-  std::optional<RigidTransform> target;           // where it must be at the end of the next frame
-  float restitution = 0.0f;
-  float friction = 0.0f;
-  float stickiness = 0.0f;
+  RigidTransform pose = identity_pose();  // where the collider is now (start of the next frame)
+  std::optional<RigidTransform> target;   // where it must be at the end of the next frame
+  ColliderMaterial material;
   bool inverted = false;
 };
 
-enum class SourceMode : uint32_t { FillOnce = 0, Continuous = 1 };
-
 struct Source {
   std::shared_ptr<const SdfAsset> region;
-  RigidTransform pose{{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f, 1.0f}};
+  RigidTransform pose = identity_pose();
   SourceMode mode = SourceMode::FillOnce;
   float spacing = 0.0f;
   float min_distance = 0.0f;
@@ -45,7 +37,7 @@ struct Source {
 struct Sink {
   SinkMode mode = SinkMode::Region;
   std::shared_ptr<const SdfAsset> region;
-  RigidTransform pose{{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f, 1.0f}};
+  RigidTransform pose = identity_pose();
   Vec3 bounds_min{0.0f, 0.0f, 0.0f};
   Vec3 bounds_max{0.0f, 0.0f, 0.0f};
 };
@@ -54,7 +46,7 @@ struct ForceField {
   ForceFieldKind kind = ForceFieldKind::Uniform;
   std::shared_ptr<const SdfAsset> region;
   std::shared_ptr<const SdfAsset> grid;
-  RigidTransform pose{{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f, 1.0f}};
+  RigidTransform pose = identity_pose();
   Vec3 vector{0.0f, 0.0f, 0.0f};
   float strength = 0.0f;
   float falloff_radius = 0.0f;

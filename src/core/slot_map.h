@@ -10,6 +10,15 @@
 
 namespace sph {
 
+// The raw table of a SlotMap (checkpoints): one generation and an optional value per slot,
+// and the free slots in the order they will be reused.
+template <class T>
+struct SlotTable {
+  std::vector<uint32_t> generations;
+  std::vector<std::optional<T>> values;
+  std::vector<uint32_t> free_list;
+};
+
 template <class T>
 class SlotMap {
  public:
@@ -61,17 +70,16 @@ class SlotMap {
   const std::vector<uint32_t>& free_slots() const { return free_; }
   // Replaces the whole table. The caller has validated it: generations in [1, 2^24), and
   // the free list names every empty slot exactly once.
-  void restore(const std::vector<uint32_t>& generations, std::vector<std::optional<T>> values,
-               std::vector<uint32_t> free_list) {
-    std::vector<Slot> slots(generations.size());
+  void restore(SlotTable<T> table) {
+    std::vector<Slot> slots(table.generations.size());
     size_t count = 0;
     for (size_t i = 0; i < slots.size(); ++i) {
-      slots[i].generation = generations[i];
-      slots[i].value = std::move(values[i]);
+      slots[i].generation = table.generations[i];
+      slots[i].value = std::move(table.values[i]);
       if (slots[i].value) ++count;
     }
     slots_ = std::move(slots);
-    free_ = std::move(free_list);
+    free_ = std::move(table.free_list);
     count_ = count;
   }
 

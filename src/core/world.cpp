@@ -121,9 +121,9 @@ SceneFrame World::build_scene_frame(double frame_dt) const {
     v.linear_velocity = (v.pose_end.position - v.pose_start.position) * static_cast<float>(1.0 / frame_dt);
     v.angular_velocity = v.moving ? angular_velocity(v.pose_start.rotation, v.pose_end.rotation, frame_dt)
                                   : Vec3{0.0f, 0.0f, 0.0f};
-    v.restitution = c.restitution;
-    v.friction = c.friction;
-    v.stickiness = c.stickiness;
+    v.restitution = c.material.restitution;
+    v.friction = c.material.friction;
+    v.stickiness = c.material.stickiness;
     v.sign = c.inverted ? -1.0f : 1.0f;
     v.deforming = c.sdf->has_moving_surface() ? 1u : 0u;
     float speed = 0.0f;

@@ -12,11 +12,22 @@
 #include "config.h"
 #include "frame_report.h"
 #include "scene_objects.h"
+#include "scene_specs.h"
 #include "slot_map.h"
 
 namespace sph {
 
 enum ObjectTag : uint8_t { kTagCollider = 1, kTagSource = 2, kTagSink = 3, kTagForceField = 4 };
+
+// A world's whole scene as slot tables (checkpoints): objects made by scene_build.h's make_*,
+// slot layouts the caller has validated (generations in [1, 2^24), the free list naming every
+// empty slot once), so that a restored world issues and accepts the same ids.
+struct SceneTables {
+  SlotTable<Collider> colliders;
+  SlotTable<Source> sources;
+  SlotTable<Sink> sinks;
+  SlotTable<ForceField> force_fields;
+};
 
 class World {
  public:
@@ -29,8 +40,21 @@ class World {
   uint32_t particle_count() const { return backend_->particle_count(); }
   uint32_t free_capacity() const { return config_.capacity - particle_count(); }
 
-  // Adds particles; throws Error(Capacity) if they do not fit. Returns the first new id.
-  uint32_t spawn(const std::vector<Vec3>& positions, const std::vector<Vec3>* velocities);
+  // ---- particles in (world_particles.cpp) ----
+  // The entry points validate everything before they change anything: on any error the world
+  // is as it was. Field errors are FieldErrors named as the public descs name them
+  // ("positions[3]", "max"); the C layer puts "desc->" in front.
+  //
+  // FieldError(Capacity) "count" unless `count` more particles fit (callers check before
+  // they copy a large input).
+  void require_room_for_particles(uint64_t count) const;
+  // Adds particles at finite positions within 65536 particle spacings of the origin, with
+  // finite velocities (or none: at rest). Returns the first new id; ids are consecutive.
+  uint32_t add_particles(const std::vector<Vec3>& positions, const std::vector<Vec3>* velocities);
+  // FCC lattices at the world's spacing in a box or a sphere (fcc_lattice.h); an empty box or
+  // radius 0 fills nothing. Error(Capacity) when the lattice does not fit. Returns the count.
+  uint32_t fill_box(const FillBoxSpec& spec);
+  uint32_t fill_sphere(const FillSphereSpec& spec);
 
   // Runs one frame: sources emit, then substeps with colliders, fields and sinks. Returns
   // false when max_substeps ran out before frame_dt. On an exception the world (particles,
@@ -58,16 +82,45 @@ class World {
     events_ = events;
   }
 
-  SlotMap<Collider>& colliders() { return colliders_; }
-  SlotMap<Source>& sources() { return sources_; }
-  SlotMap<Sink>& sinks() { return sinks_; }
-  SlotMap<ForceField>& force_fields() { return force_fields_; }
+  // ---- scene objects (world_scene.cpp) ----
+  // add_* validates its spec (scene_build.h), throws a FieldError naming the field, or
+  // Error(Capacity) past 65536 objects of a kind (or a source region of more than 2^28
+  // lattice points), and leaves the world unchanged on error. Returns the new generational id
+  // (slot_map.h); ids are never 0.
+  uint64_t add_collider(const ColliderSpec& spec);
+  uint64_t add_source(const SourceSpec& spec);
+  uint64_t add_sink(const SinkSpec& spec);
+  uint64_t add_force_field(const ForceFieldSpec& spec);
+  // Removes an object. Id 0 is a no-op; a stale id or one of another kind or world is
+  // Error(InvalidHandle).
+  void remove_collider(uint64_t id);
+  void remove_source(uint64_t id);
+  void remove_sink(uint64_t id);
+  void remove_force_field(uint64_t id);
+  // Setters: Error(InvalidHandle) "id: ..." for an id that names no live object of the kind,
+  // FieldError for a bad value (a pose must pass require_pose, pose_rules.h).
+  void set_collider_target(uint64_t id, const RigidTransform& target);
+  void teleport_collider(uint64_t id, const RigidTransform& pose);
+  void set_collider_material(uint64_t id, const ColliderMaterial& material);
+  void set_source_pose(uint64_t id, const RigidTransform& pose);
+  void set_force_field_pose(uint64_t id, const RigidTransform& pose);
+  // A live collider; Error(InvalidHandle) otherwise.
+  const Collider& collider(uint64_t id) const;
+  // Replaces the whole scene (checkpoints; see SceneTables).
+  void restore_scene(SceneTables tables);
+
+  // Read-only views; everything that changes the scene goes through the entry points above.
   const SlotMap<Collider>& colliders() const { return colliders_; }
   const SlotMap<Source>& sources() const { return sources_; }
   const SlotMap<Sink>& sinks() const { return sinks_; }
   const SlotMap<ForceField>& force_fields() const { return force_fields_; }
 
  private:
+  // Adds particles without the entry point's checks (sources emit inside their region).
+  uint32_t spawn(const std::vector<Vec3>& positions, const std::vector<Vec3>* velocities);
+  // The end of fill_box and fill_sphere: checks the points (errors name region_fields) and
+  // adds them at one velocity.
+  uint32_t fill(const std::vector<Vec3>& points, const Vec3& velocity, const char* region_fields);
   void emit_sources(double frame_dt);
   SceneFrame build_scene_frame(double frame_dt) const;
 

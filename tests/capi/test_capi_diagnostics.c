@@ -153,7 +153,7 @@ static void test_log_callback(void** state) {
   EXPECT_OK(sph_context_create(&def, &context));
   /* A failed world creation on this context is logged, with the same message. */
   sph_world_def_init(&wdef);
-  wdef.capacity = 0;
+  wdef.capacity = 0xffffffffu;
   EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "capacity", sph_world_create(context, &wdef, &world));
   assert_int_equal(log.calls, 1);
   assert_int_equal(log.level, SPH_LOG_ERROR);

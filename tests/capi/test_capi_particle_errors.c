@@ -334,6 +334,7 @@ static void test_fill_box_errors(void** state) {
   };
   grown_fill_box_desc grown;
   sph_fill_box_desc d;
+  uint32_t count = 1;
 
   EXPECT_BOX_FAILS(f, NULL, SPH_ERROR_INVALID_ARGUMENT, "desc");
   memset(&grown, 0, sizeof grown);
@@ -353,10 +354,11 @@ static void test_fill_box_errors(void** state) {
       capi_set_float(&d, fields[i].offset, capi_non_finite(v));
       EXPECT_BOX_FAILS(f, &d, SPH_ERROR_INVALID_ARGUMENT, fields[i].name);
     }
-  /* Empty or inverted along each axis (zero or negative size). */
+  /* Inverted along each axis (negative size); an empty box (zero size) fills nothing. */
   small_box(&d);
   d.max.x = d.min.x;
-  EXPECT_BOX_FAILS(f, &d, SPH_ERROR_INVALID_ARGUMENT, "max");
+  EXPECT_OK(sph_world_fill_box(f->world, &d, &count));
+  assert_int_equal(count, 0);
   small_box(&d);
   d.max.y = d.min.y - 0.1f;
   EXPECT_BOX_FAILS(f, &d, SPH_ERROR_INVALID_ARGUMENT, "max");
@@ -397,6 +399,7 @@ static void test_fill_sphere_errors(void** state) {
   };
   grown_fill_sphere_desc grown;
   sph_fill_sphere_desc d;
+  uint32_t count = 1;
 
   EXPECT_SPHERE_FAILS(f, NULL, SPH_ERROR_INVALID_ARGUMENT, "desc");
   memset(&grown, 0, sizeof grown);
@@ -420,8 +423,9 @@ static void test_fill_sphere_errors(void** state) {
       EXPECT_SPHERE_FAILS(f, &d, SPH_ERROR_INVALID_ARGUMENT, fields[i].name);
     }
   sph_fill_sphere_desc_init(&d);
-  d.radius = 0.0f;
-  EXPECT_SPHERE_FAILS(f, &d, SPH_ERROR_INVALID_ARGUMENT, "radius");
+  d.radius = 0.0f; /* zero means an empty sphere (a zeroed desc is valid) */
+  EXPECT_OK(sph_world_fill_sphere(f->world, &d, &count));
+  assert_int_equal(count, 0);
   d.radius = -0.1f;
   EXPECT_SPHERE_FAILS(f, &d, SPH_ERROR_INVALID_ARGUMENT, "radius");
   d.radius = 0.2f; /* ~ 1400 points, capacity 256 */

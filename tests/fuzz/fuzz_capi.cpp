@@ -358,7 +358,7 @@ class Program {
     if (in_.chance(16)) {
       const uint32_t raw = in_.u32();
       // Valid capacities above the harness's bound size the neighbour grid (legitimately
-      // large); invalid ones (0, > 2^30) must be refused.
+      // large); invalid ones (> 2^30) must be refused; 0 is the default, 65536.
       if (raw == 0 || raw > (1u << 30)) d.capacity = raw;
     }
     d.features = in_.chance(224) ? in_.u8() % 4 : in_.u32();
@@ -394,7 +394,7 @@ class Program {
     w.viscosity = static_cast<uint32_t>(got.viscosity_method);
     w.eos = static_cast<uint32_t>(got.equation_of_state);
     w.spacing = got.particle_spacing;
-    if (w.capacity != d.capacity)
+    if (w.capacity != (d.capacity == 0 ? 65536u : d.capacity))
       violation("the world's capacity %u is not the def's %u", w.capacity, d.capacity);
     if (!(got.kernel_radius >= got.particle_spacing)) violation("kernel radius below the spacing");
     if (w.capacity > kMaxCapacity) {
@@ -713,7 +713,9 @@ class Program {
       const uint32_t memory = in_.u32() % 3;
       std::memcpy(&g.memory, &memory, 4);
     }
-    const size_t floats = *absurd ? 16 : static_cast<size_t>(voxels) * std::max<uint32_t>(g.components, 1);
+    // components 0 means the channel's own count (sph_grid_desc): size the data for that.
+    const uint32_t per_voxel = g.components == 0 ? components : g.components;
+    const size_t floats = *absurd ? 16 : static_cast<size_t>(voxels) * per_voxel;
     storage.assign(floats, 0.0f);
     // A sphere-ish distance with an occasional hostile value.
     for (size_t i = 0; i < storage.size(); ++i) storage[i] = static_cast<float>(i % 7) * 0.01f - 0.02f;
@@ -936,11 +938,30 @@ class Program {
           violation("a collider with a non-finite pose");
         break;
       }
-      default:
+      default: {
         const float restitution = in_.maybe_hostile(0, 1);
         const float friction = in_.maybe_hostile(0, 1);
         const float stickiness = in_.maybe_hostile(0, 5);
-        r = FUZZ_CALL(sph_collider_set_material(w, id, restitution, friction, stickiness));
+        if (!in_.chance(96)) {
+          r = FUZZ_CALL(sph_collider_set_material(w, id, restitution, friction, stickiness));
+          break;
+        }
+        // The struct calls: set whole (a fuzzed struct_size), then read back what is there.
+        Padded<sph_collider_material> m;
+        sph_collider_material_init(&m.value);
+        m.value.restitution = restitution;
+        m.value.friction = friction;
+        m.value.stickiness = stickiness;
+        m.value.struct_size = struct_size(sizeof m.value);
+        r = FUZZ_CALL(sph_collider_set_material_struct(w, id, in_.chance(8) ? nullptr : &m.value));
+        sph_collider_material out;
+        sph_collider_material_init(&out);
+        const sph_result got = FUZZ_CALL(sph_collider_get_material(w, id, &out));
+        if (got == SPH_OK && !(out.restitution >= 0.0f && out.restitution <= 1.0f && out.friction >= 0.0f &&
+                               out.stickiness >= 0.0f))
+          violation("a collider holds a material out of range");
+        if (r == SPH_OK && got != SPH_OK) violation("a material was set but cannot be read");
+      }
     }
     if (r == SPH_OK && !world_ok(slot, w)) violation("a collider call succeeded on a dead world");
   }

@@ -32,7 +32,8 @@ constexpr double kMaxLattice = 1 << 16;
 double shape_voxels(const sph_tools::ShapeDesc& s, double* volume) {
   *volume = 0.0;
   if (s.kind != sph_tools::ShapeDesc::Kind::kAnalytic) return 0.0;
-  const double voxels = sph_fuzz::shape_grid_voxels(s.analytic), v = s.analytic.voxel_size;
+  const double voxels = sph_fuzz::shape_grid_voxels(s.analytic),
+               v = sph_fuzz::shape_size_or_default(s.analytic.voxel_size, 0.01);
   *volume = voxels * v * v * v;
   return voxels;
 }

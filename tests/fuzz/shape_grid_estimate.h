@@ -13,18 +13,26 @@
 
 namespace sph_fuzz {
 
+// A size of the desc with its zero rule applied (0 = the default, sph_shape_desc).
+inline double shape_size_or_default(float value, double fallback) { return value == 0.0f ? fallback : value; }
+
 // Voxels of the shape's grid; 0 for a kind the library does not know (it must refuse it).
 inline double shape_grid_voxels(const sph_shape_desc& d) {
   uint32_t kind;
   std::memcpy(&kind, &d.shape, sizeof kind);
-  const double w = d.wall_thickness, r = d.radius, hh = d.half_height;
+  const double w = d.wall_thickness, r = shape_size_or_default(d.radius, 0.5),
+               hh = shape_size_or_default(d.half_height, 0.5);
+  const double ex = shape_size_or_default(d.half_extents.x, 0.5),
+               ey = shape_size_or_default(d.half_extents.y, 0.5),
+               ez = shape_size_or_default(d.half_extents.z, 0.5);
+  const double voxel = shape_size_or_default(d.voxel_size, 0.01);
   double half[3];
   switch (kind) {
     case SPH_SHAPE_PLANE:
-      half[0] = d.half_extents.x, half[1] = d.half_extents.y, half[2] = d.half_extents.z;
+      half[0] = ex, half[1] = ey, half[2] = ez;
       break;
     case SPH_SHAPE_BOX:
-      half[0] = d.half_extents.x + w, half[1] = d.half_extents.y + w, half[2] = d.half_extents.z + w;
+      half[0] = ex + w, half[1] = ey + w, half[2] = ez + w;
       break;
     case SPH_SHAPE_SPHERE:
       half[0] = half[1] = half[2] = r;
@@ -43,7 +51,7 @@ inline double shape_grid_voxels(const sph_shape_desc& d) {
   }
   const double pad = d.padding_voxels == 0 ? 4.0 : static_cast<double>(d.padding_voxels);
   double voxels = 1.0;
-  for (double h : half) voxels *= 2.0 * std::ceil(std::fabs(h) / d.voxel_size) + 2.0 * pad + 1.0;
+  for (double h : half) voxels *= 2.0 * std::ceil(std::fabs(h) / voxel) + 2.0 * pad + 1.0;
   return voxels;
 }
 

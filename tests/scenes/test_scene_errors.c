@@ -81,7 +81,7 @@ static void test_sdf_errors(void** state) {
   shape.radius = -1.0f;
   EXPECT(SPH_ERROR_INVALID_ARGUMENT, "radius", sph_sdf_create_shape(s.context, &shape, &sdf));
   shape.radius = 0.1f;
-  shape.voxel_size = 0.0f;
+  shape.voxel_size = -0.01f; /* (0 is the default) */
   EXPECT(SPH_ERROR_INVALID_ARGUMENT, "voxel_size", sph_sdf_create_shape(s.context, &shape, &sdf));
   shape.voxel_size = 1e-6f; /* 2e5 voxels per axis */
   EXPECT(SPH_ERROR_CAPACITY, "voxel", sph_sdf_create_shape(s.context, &shape, &sdf));
@@ -130,7 +130,9 @@ static void test_collider_errors(void** state) {
   def.flags = 0x80;
   EXPECT(SPH_ERROR_UNSUPPORTED, "flags", sph_collider_create(s.world, &def, &id));
   def.flags = 0;
-  def.transform.rotation.w = 0.0f;
+  def.transform.rotation.w = 1e-7f; /* (all zero is the identity) */
+  EXPECT(SPH_ERROR_INVALID_ARGUMENT, "rotation", sph_collider_create(s.world, &def, &id));
+  def.transform.rotation.w = NAN;
   EXPECT(SPH_ERROR_INVALID_ARGUMENT, "rotation", sph_collider_create(s.world, &def, &id));
   def.transform.rotation.w = 1.0f;
   def.transform.position.y = INFINITY;
@@ -219,6 +221,7 @@ static void test_source_sink_field_errors(void** state) {
   EXPECT(SPH_ERROR_INVALID_ARGUMENT, "def->grid", sph_force_field_create(s.world, &field, &field_id));
   sph_grid_desc_init(&grid);
   grid.dims[0] = grid.dims[1] = grid.dims[2] = 1;
+  grid.components = 1; /* (0 means 3 here) */
   field.grid = &grid;
   EXPECT(SPH_ERROR_INVALID_ARGUMENT, "components", sph_force_field_create(s.world, &field, &field_id));
   field.kind = (sph_force_field_kind)11;

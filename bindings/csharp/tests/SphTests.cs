@@ -141,7 +141,7 @@ static class Tests
         using (var ctx = new Context(def, (l, c, m) => { ++calls; level = l; code = c; message = m; }))
         {
             var wd = SmallWorld();
-            wd.Capacity = 0;
+            wd.Capacity = 1u << 31;  // above 2^30 (0 is the default)
             Throws(Result.ErrorInvalidArgument, () => ctx.CreateWorld(wd));
         }
         Assert(calls >= 1, "the log handler was called");
@@ -711,7 +711,18 @@ static class Tests
                 world.Step(1f / 60f);
                 Assert(Math.Abs(c.Transform.Position.Y + 0.9f) < 1e-5f, "moved to the target");
                 c.SetMaterial(0.5f, 0.1f, 0);
+                AssertEqual(0.5f, c.Material.Restitution, "material from SetMaterial");
                 Throws(Result.ErrorInvalidArgument, () => c.SetMaterial(2, 0, 0));
+                var material = ColliderMaterial.Default();
+                material.Friction = 0.25f;
+                material.Stickiness = 3f;
+                c.Material = material;
+                AssertEqual(0f, c.Material.Restitution, "material restitution");
+                AssertEqual(0.25f, c.Material.Friction, "material friction");
+                AssertEqual(3f, c.Material.Stickiness, "material stickiness");
+                material.Restitution = 2f;
+                Throws(Result.ErrorInvalidArgument, () => { c.Material = material; });
+                AssertEqual(0.25f, c.Material.Friction, "a refused material changes nothing");
                 var stale = c.Id;
                 c.Dispose();
                 c.Dispose();

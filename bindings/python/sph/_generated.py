@@ -10,7 +10,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '722154f10bca70651e57bc85c1e3761e26b6a6e4dae8027681ff22384678c531', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
+HEADERS = {'include/sph_c.h': '7570bce9237cd0f0009540b3c422b90d0d1083b2700c09152cf8780ec48e05c5', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -56,13 +56,14 @@ SPH_COLLIDER_FLAG_INVERTED = 1
 #: initial velocity from the SDF's velocity
 SPH_SOURCE_FLAG_VELOCITY_FROM_FIELD = 1
 # SPH_MAKE_VERSION(major, minor, patch) is a function-like macro: not generated.
+# SPH_ID_IS_NULL(id) is a function-like macro: not generated.
 
 # ---- enums ------------------------------------------------------------------------------------
 
 sph_result = _c.c_int32
 SPH_INCOMPLETE = 1  # the call did part of the work; see its doc
 SPH_OK = 0  # success
-SPH_ERROR_INVALID_ARGUMENT = -1  # NULL, NaN/Inf, zero/negative or out-of-range value
+SPH_ERROR_INVALID_ARGUMENT = -1  # NULL, NaN/Inf, out-of-range value, required field left zero
 SPH_ERROR_INVALID_HANDLE = -2  # a NULL, destroyed or foreign object
 SPH_ERROR_VERSION_MISMATCH = -3  # struct_size or header_version not accepted
 SPH_ERROR_UNSUPPORTED = -4  # not compiled in, no such device, unknown enum value
@@ -87,7 +88,7 @@ class Result(_enum.IntEnum):
     INCOMPLETE = 1
     #: success
     OK = 0
-    #: NULL, NaN/Inf, zero/negative or out-of-range value
+    #: NULL, NaN/Inf, out-of-range value, required field left zero
     ERROR_INVALID_ARGUMENT = -1
     #: a NULL, destroyed or foreign object
     ERROR_INVALID_HANDLE = -2
@@ -198,8 +199,8 @@ SPH_STAGE_CELL_RANGES = 1  # start/end of each cell
 SPH_STAGE_DENSITY = 2  # density and pressure
 SPH_STAGE_FORCES = 3  # pressure, viscosity and external forces
 SPH_STAGE_INTEGRATE = 4  # time integration, max-speed reduction, next step size
-SPH_STAGE_COLLIDE = 5  # colliders (none yet)
-SPH_STAGE_EMIT = 6  # sources and sinks (none yet)
+SPH_STAGE_COLLIDE = 5  # particles against colliders (CPU; the CUDA backend does it inside the forces kernel, so it counts under SPH_STAGE_FORCES there)
+SPH_STAGE_EMIT = 6  # sinks removing particles; sources emit before the substeps and count only in sph_stats.step_ms
 SPH_STAGE_OTHER = 7  # everything else: statistics, transfers
 SPH_STAGE_COUNT = 8
 SPH_STAGE_FORCE32 = 2147483647
@@ -217,9 +218,11 @@ class Stage(_enum.IntEnum):
     FORCES = 3
     #: time integration, max-speed reduction, next step size
     INTEGRATE = 4
-    #: colliders (none yet)
+    #: particles against colliders (CPU; the CUDA backend does it inside the forces kernel, so it
+    #: counts under SPH_STAGE_FORCES there)
     COLLIDE = 5
-    #: sources and sinks (none yet)
+    #: sinks removing particles; sources emit before the substeps and count only in
+    #: sph_stats.step_ms
     EMIT = 6
     #: everything else: statistics, transfers
     OTHER = 7
@@ -376,7 +379,7 @@ class EventType(_enum.IntEnum):
 ENUM_MEMBER_DOCS = {
     'SPH_INCOMPLETE': 'the call did part of the work; see its doc',
     'SPH_OK': 'success',
-    'SPH_ERROR_INVALID_ARGUMENT': 'NULL, NaN/Inf, zero/negative or out-of-range value',
+    'SPH_ERROR_INVALID_ARGUMENT': 'NULL, NaN/Inf, out-of-range value, required field left zero',
     'SPH_ERROR_INVALID_HANDLE': 'a NULL, destroyed or foreign object',
     'SPH_ERROR_VERSION_MISMATCH': 'struct_size or header_version not accepted',
     'SPH_ERROR_UNSUPPORTED': 'not compiled in, no such device, unknown enum value',
@@ -407,8 +410,8 @@ ENUM_MEMBER_DOCS = {
     'SPH_STAGE_DENSITY': 'density and pressure',
     'SPH_STAGE_FORCES': 'pressure, viscosity and external forces',
     'SPH_STAGE_INTEGRATE': 'time integration, max-speed reduction, next step size',
-    'SPH_STAGE_COLLIDE': 'colliders (none yet)',
-    'SPH_STAGE_EMIT': 'sources and sinks (none yet)',
+    'SPH_STAGE_COLLIDE': 'particles against colliders (CPU; the CUDA backend does it inside the forces kernel, so it counts under SPH_STAGE_FORCES there)',
+    'SPH_STAGE_EMIT': 'sinks removing particles; sources emit before the substeps and count only in sph_stats.step_ms',
     'SPH_STAGE_OTHER': 'everything else: statistics, transfers',
     'SPH_VISCOSITY_MUELLER': 'Laplacian viscosity (eq. 17), coefficient sph_world_params.viscosity',
     'SPH_VISCOSITY_CLAVET': 'radial impulses between approaching pairs (eq. 18-19), sph_clavet_viscosity_params',
@@ -493,13 +496,14 @@ sph_vec3 = Vec3
 
 class ContextDef(_SphStruct):
     """
-    sph_context_def.
+    Zero means default: a zeroed def is valid (AUTO backend, device 0, every hardware thread, no
+    logging; header_version 0 skips the header check).
 
     Fields:
         struct_size (uint32_t): sizeof(sph_context_def), set by sph_context_def_init
-        header_version (uint32_t): SPH_VERSION of the header the caller compiled against
+        header_version (uint32_t): SPH_VERSION of the header the caller compiled against; 0 = unchecked
         backend (sph_backend): default SPH_BACKEND_AUTO
-        device_ordinal (int32_t): CUDA device; -1 (default) = device 0
+        device_ordinal (int32_t): CUDA device; -1 (default) and 0 = device 0
         cpu_worker_count (uint32_t): CPU backend threads; 0 (default) = all hardware threads
         reserved0 (uint32_t): must be 0
         log_fn (sph_log_fn): optional; NULL = no logging
@@ -528,18 +532,19 @@ sph_context_def = ContextDef
 
 class WorldDef(_SphStruct):
     """
-    Creation-time description of a world; fixed for the world's life.
+    Creation-time description of a world; fixed for the world's life. Zero means default for
+    every field: a zeroed def is the def sph_world_def_init gives.
 
     Fields:
         struct_size (uint32_t): sizeof(sph_world_def), set by sph_world_def_init
-        header_version (uint32_t): SPH_VERSION of the caller's header
-        capacity (uint32_t): most particles the world holds; default 65536; >= 1
+        header_version (uint32_t): SPH_VERSION of the caller's header; 0 = unchecked
+        capacity (uint32_t): most particles the world holds; 0 (default) = 65536; at most 2^30
         features (sph_feature_flags): SPH_FEATURE_* bits; default SPH_FEATURE_NONE
         integrator (sph_integrator): default SPH_INTEGRATOR_SYMPLECTIC_EULER
         viscosity_method (sph_viscosity_method): default SPH_VISCOSITY_MUELLER
-        particle_spacing (float): nearest-neighbour distance of the FCC lattice, m; default 0.02
+        particle_spacing (float): nearest-neighbour distance of the FCC lattice, m; 0 (default) = 0.02
         kernel_radius (float): h, m; 0 (default) = 1.8 * particle_spacing; must be >= spacing
-        rest_density (float): rho0, kg/m^3; default 1000 (water)
+        rest_density (float): rho0, kg/m^3; 0 (default) = 1000 (water)
         equation_of_state (sph_equation_of_state): default SPH_EOS_IDEAL_GAS
     """
     _fields_ = [
@@ -706,12 +711,13 @@ sph_spring_params = SpringParams
 
 class SpawnDesc(_SphStruct):
     """
-    sph_spawn_desc.
+    Zero means default: a zeroed desc spawns nothing (count 0); positions is required once count
+    > 0 (INVALID_ARGUMENT naming desc->positions).
 
     Fields:
         struct_size (uint32_t): sizeof(sph_spawn_desc), set by sph_spawn_desc_init
         count (uint32_t): particles to add; 0 is allowed and adds nothing
-        positions (const float*): count x (x, y, z) float32, caller-owned, copied; required
+        positions (const float*): count x (x, y, z) float32, caller-owned, copied; required when count > 0
         velocities (const float*): count x (x, y, z) float32, or NULL for zero velocity
         position_stride (uint64_t): bytes between particles; 0 = 12 (packed)
         velocity_stride (uint64_t): bytes between particles; 0 = 12 (packed)
@@ -735,13 +741,13 @@ sph_spawn_desc = SpawnDesc
 
 class FillBoxDesc(_SphStruct):
     """
-    sph_fill_box_desc.
+    Zero means default: a zeroed desc is an empty box and fills nothing.
 
     Fields:
         struct_size (uint32_t): set by sph_fill_box_desc_init
         reserved0 (uint32_t): must be 0
         min (sph_vec3): box corner, m
-        max (sph_vec3): opposite corner, m; every component > min's
+        max (sph_vec3): opposite corner, m; every component >= min's (equal: an empty box)
         velocity (sph_vec3): initial velocity of every particle; default 0
     """
     _fields_ = [
@@ -762,13 +768,13 @@ sph_fill_box_desc = FillBoxDesc
 
 class FillSphereDesc(_SphStruct):
     """
-    sph_fill_sphere_desc.
+    Zero means default: a zeroed desc (radius 0) fills nothing.
 
     Fields:
         struct_size (uint32_t): set by sph_fill_sphere_desc_init
         reserved0 (uint32_t): must be 0
         center (sph_vec3): m; a lattice point sits at the centre
-        radius (float): m; > 0; points with |p - center| <= radius are filled
+        radius (float): m; >= 0; points with |p - center| <= radius are filled; 0 = none
         velocity (sph_vec3): initial velocity; default 0
     """
     _fields_ = [
@@ -840,15 +846,16 @@ sph_stats = Stats
 
 class GridDesc(_SphStruct):
     """
-    sph_grid_desc.
+    Zero means default, except that a grid cannot be empty: dims and data are required (the
+    error names the first of them that is zero).
 
     Fields:
         struct_size (uint32_t): set by sph_grid_desc_init
-        dims (uint32_t [3]): samples along i, j, k (i fastest); each >= 1
-        index_to_local (float [12]): row-major 3x4 affine map; default: identity (1 m voxels)
+        dims (uint32_t [3]): samples along i, j, k (i fastest); each >= 1; required
+        index_to_local (float [12]): row-major 3x4 affine map; default (and all zeros): identity (1 m voxels)
         memory (sph_memory_kind): where data lives; default SPH_MEMORY_HOST
-        components (uint32_t): floats per voxel: 1 (distance, friction) or 3 (velocity)
-        data (const float*): dims[0] * dims[1] * dims[2] * components floats, copied
+        components (uint32_t): floats per voxel: 1 (distance, friction) or 3 (velocity, force field accelerations); 0 (default) = the channel's own count
+        data (const float*): dims[0] * dims[1] * dims[2] * components floats, copied; required
     """
     _fields_ = [
         ('struct_size', _c.c_uint32),
@@ -870,7 +877,8 @@ sph_grid_desc = GridDesc
 
 class SdfDesc(_SphStruct):
     """
-    sph_sdf_desc.
+    A zeroed desc is refused: the distance grid is required (INVALID_ARGUMENT naming
+    desc->distance.dims, then desc->distance.data). The embedded grid's struct_size may be 0.
 
     Fields:
         struct_size (uint32_t): set by sph_sdf_desc_init
@@ -897,16 +905,17 @@ sph_sdf_desc = SdfDesc
 
 class ShapeDesc(_SphStruct):
     """
-    sph_shape_desc.
+    Zero means default for every size; shape 0 is SPH_SHAPE_PLANE (zero keeps its meaning), so a
+    zeroed desc is a plane of the default sizes, and sph_shape_desc_init picks SPH_SHAPE_BOX.
 
     Fields:
         struct_size (uint32_t): set by sph_shape_desc_init
-        shape (sph_shape): default SPH_SHAPE_BOX
-        half_extents (sph_vec3): m; default (0.5, 0.5, 0.5)
-        radius (float): m; default 0.5
-        half_height (float): m; default 0.5
+        shape (sph_shape): sph_shape_desc_init: SPH_SHAPE_BOX; 0 = SPH_SHAPE_PLANE
+        half_extents (sph_vec3): m; each component 0 (default) = 0.5
+        radius (float): m; 0 (default) = 0.5
+        half_height (float): m; 0 (default) = 0.5
         wall_thickness (float): m; default 0 (solid)
-        voxel_size (float): m; default 0.01
+        voxel_size (float): m; 0 (default) = 0.01
         flags (uint32_t): SPH_SHAPE_FLAG_*
         padding_voxels (uint32_t): grid margin around the shape; 0 (default) = 4
     """
@@ -936,10 +945,10 @@ class Quat(_SphStruct):
     sph_quat.
 
     Fields:
-        x (float): a rotation; normalised by the library; (0, 0, 0, 1) is identity
-        y (float): a rotation; normalised by the library; (0, 0, 0, 1) is identity
-        z (float): a rotation; normalised by the library; (0, 0, 0, 1) is identity
-        w (float): a rotation; normalised by the library; (0, 0, 0, 1) is identity
+        x (float): a rotation; normalised by the library; (0, 0, 0, 1) is identity, and so is (0, 0, 0, 0), the quaternion of a zeroed struct
+        y (float): a rotation; normalised by the library; (0, 0, 0, 1) is identity, and so is (0, 0, 0, 0), the quaternion of a zeroed struct
+        z (float): a rotation; normalised by the library; (0, 0, 0, 1) is identity, and so is (0, 0, 0, 0), the quaternion of a zeroed struct
+        w (float): a rotation; normalised by the library; (0, 0, 0, 1) is identity, and so is (0, 0, 0, 0), the quaternion of a zeroed struct
     """
     _fields_ = [
         ('x', _c.c_float),
@@ -983,7 +992,7 @@ class ColliderId(_SphStruct):
     sph_collider_id.
 
     Fields:
-        bits (uint64_t): {0} is null
+        bits (uint64_t): {0} is null (SPH_ID_IS_NULL)
     """
     _fields_ = [
         ('bits', _c.c_uint64),
@@ -999,7 +1008,9 @@ sph_collider_id = ColliderId
 
 class ColliderDef(_SphStruct):
     """
-    sph_collider_def.
+    Zero means default, but a collider needs its SDF: a zeroed def is refused with
+    INVALID_ARGUMENT naming def->sdf, and with sdf set it is a static collider at the identity
+    pose with the default material (sph_collider_material).
 
     Fields:
         struct_size (uint32_t): set by sph_collider_def_init
@@ -1032,12 +1043,39 @@ class ColliderDef(_SphStruct):
 sph_collider_def = ColliderDef
 
 
+class ColliderMaterial(_SphStruct):
+    """
+    How a collider's surface answers particles that reach it. Zero means default: a zeroed
+    struct (struct_size set) is what sph_collider_material_init gives, a surface that returns no
+    normal speed, has no friction and pulls nothing.
+
+    Fields:
+        struct_size (uint32_t): set by sph_collider_material_init
+        restitution (float): share of the normal approach speed returned, [0, 1]; default 0
+        friction (float): Coulomb coefficient >= 0 (ignored where the SDF has a friction channel); default 0
+        stickiness (float): pull toward the surface within one kernel radius, m/s^2 >= 0; default 0
+    """
+    _fields_ = [
+        ('struct_size', _c.c_uint32),
+        ('restitution', _c.c_float),
+        ('friction', _c.c_float),
+        ('stickiness', _c.c_float),
+    ]
+    _sph_c_name_ = 'sph_collider_material'
+    _sph_size_ = 16
+    _sph_offsets_ = (('struct_size', 0), ('restitution', 4), ('friction', 8), ('stickiness', 12))
+    _sph_init_ = 'sph_collider_material_init_sized'
+
+
+sph_collider_material = ColliderMaterial
+
+
 class SourceId(_SphStruct):
     """
     sph_source_id.
 
     Fields:
-        bits (uint64_t)
+        bits (uint64_t): {0} is null (SPH_ID_IS_NULL)
     """
     _fields_ = [
         ('bits', _c.c_uint64),
@@ -1053,7 +1091,9 @@ sph_source_id = SourceId
 
 class SourceDef(_SphStruct):
     """
-    sph_source_def.
+    Zero means default, but a source needs its region: a zeroed def is refused with
+    INVALID_ARGUMENT naming def->region; with region set it fills the region once, at the
+    world's spacing, at rest.
 
     Fields:
         struct_size (uint32_t): set by sph_source_def_init
@@ -1096,7 +1136,7 @@ class SinkId(_SphStruct):
     sph_sink_id.
 
     Fields:
-        bits (uint64_t)
+        bits (uint64_t): {0} is null (SPH_ID_IS_NULL)
     """
     _fields_ = [
         ('bits', _c.c_uint64),
@@ -1112,7 +1152,9 @@ sph_sink_id = SinkId
 
 class SinkDef(_SphStruct):
     """
-    sph_sink_def.
+    Zero means default: a zeroed def is a REGION sink and needs its region (INVALID_ARGUMENT
+    naming def->region); an OUTSIDE_BOUNDS sink with zero bounds keeps only particles at the
+    origin.
 
     Fields:
         struct_size (uint32_t): set by sph_sink_def_init
@@ -1120,7 +1162,7 @@ class SinkDef(_SphStruct):
         region (sph_sdf*): REGION: required
         transform (sph_transform): REGION: placement; default identity
         bounds_min (sph_vec3): OUTSIDE_BOUNDS: the box particles may stay in
-        bounds_max (sph_vec3)
+        bounds_max (sph_vec3): OUTSIDE_BOUNDS: every component >= bounds_min's
         reserved0 (uint32_t): must be 0
     """
     _fields_ = [
@@ -1147,7 +1189,7 @@ class ForceFieldId(_SphStruct):
     sph_force_field_id.
 
     Fields:
-        bits (uint64_t)
+        bits (uint64_t): {0} is null (SPH_ID_IS_NULL)
     """
     _fields_ = [
         ('bits', _c.c_uint64),
@@ -1163,7 +1205,9 @@ sph_force_field_id = ForceFieldId
 
 class ForceFieldDef(_SphStruct):
     """
-    sph_force_field_def.
+    Zero means default: a zeroed def is a UNIFORM field of zero acceleration acting everywhere
+    (valid, and it changes nothing). A VORTEX needs a non-zero def->vector and a GRID def->grid;
+    the errors name them.
 
     Fields:
         struct_size (uint32_t): set by sph_force_field_def_init
@@ -1268,7 +1312,7 @@ class CudaAttributeView(_SphStruct):
 sph_cuda_attribute_view = CudaAttributeView
 
 
-STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpringParams, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, Quat, Transform, ColliderId, ColliderDef, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, Event, CudaAttributeView, )
+STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpringParams, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, Quat, Transform, ColliderId, ColliderDef, ColliderMaterial, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, Event, CudaAttributeView, )
 
 # ---- functions --------------------------------------------------------------------------------
 
@@ -1297,11 +1341,11 @@ FUNCTIONS = {
     'sph_world_def_init_sized': (sph_result, (_c.POINTER(sph_world_def), _c.c_uint32), ('def', 'size'),
         '', 'sph'),
     'sph_world_create': (sph_result, (_c.POINTER(sph_context), _c.POINTER(sph_world_def), _c.POINTER(_c.POINTER(sph_world))), ('context', 'def', 'out'),
-        'Creates an empty world on a context. The particle mass is derived here: the mass at which an FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass). Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range: capacity 0, spacing <= 0 or non-finite, kernel_radius < spacing, rest_density <= 0), UNSUPPORTED (unknown integrator or feature bit), VERSION_MISMATCH, OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY. *out is written only on success.', 'sph'),
+        'Creates an empty world on a context. The particle mass is derived here: the mass at which an FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass). Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range: capacity above 2^30, spacing < 0 or non-finite, kernel_radius < spacing, rest_density < 0), UNSUPPORTED (unknown integrator or feature bit), VERSION_MISMATCH, OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY. *out is written only on success.', 'sph'),
     'sph_world_destroy': (sph_result, (_c.POINTER(sph_world),), ('world',),
         'Destroys a world and everything in it. NULL is a no-op.', 'sph'),
     'sph_world_get_def': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_world_def)), ('world', 'out_def'),
-        'The def the world was created with, with defaults resolved (kernel_radius filled in).', 'sph'),
+        'The def the world was created with, with defaults resolved (zeros and kernel_radius filled in).', 'sph'),
     'sph_world_get_particle_mass': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_float)), ('world', 'out_mass'),
         'Mass of every particle, kg.', 'sph'),
     'sph_world_params_init_sized': (sph_result, (_c.POINTER(sph_world_params), _c.c_uint32), ('params', 'size'),
@@ -1389,7 +1433,13 @@ FUNCTIONS = {
     'sph_collider_get_transform': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_transform)), ('world', 'id', 'out_transform'),
         '', 'sph'),
     'sph_collider_set_material': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.c_float, _c.c_float, _c.c_float), ('world', 'id', 'restitution', 'friction', 'stickiness'),
-        'Changes restitution, friction and stickiness (same ranges as sph_collider_def).', 'sph'),
+        'Deprecated: use sph_collider_set_material_struct. Kept, with its arguments, so that programs built against earlier headers keep working (the ABI does not change); it sets the three coefficients as that call does, with the same checks.', 'sph'),
+    'sph_collider_material_init_sized': (sph_result, (_c.POINTER(sph_collider_material), _c.c_uint32), ('material', 'size'),
+        '', 'sph'),
+    'sph_collider_set_material_struct': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_collider_material)), ('world', 'id', 'material'),
+        "Replaces a collider's material; acts from the next substep. Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (NULL material; a coefficient out of range or not finite, named), VERSION_MISMATCH (struct_size), WORLD_LOCKED. Nothing changes on error.", 'sph'),
+    'sph_collider_get_material': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_collider_material)), ('world', 'id', 'out'),
+        "Reads a collider's material (as the def or the last set call gave it). out->struct_size must be set (sph_collider_material_init); only that many bytes are written. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL out), VERSION_MISMATCH, WORLD_LOCKED.", 'sph'),
     'sph_source_def_init_sized': (sph_result, (_c.POINTER(sph_source_def), _c.c_uint32), ('def', 'size'),
         '', 'sph'),
     'sph_source_create': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_source_def), _c.POINTER(sph_source_id)), ('world', 'def', 'out_id'),

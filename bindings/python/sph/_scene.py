@@ -240,8 +240,26 @@ class Collider(_WorldObject):
         t = as_transform(transform)
         check(library().sph_collider_teleport(self.world.handle, self.id, ctypes.byref(t)), "sph_collider_teleport")
 
+    @property
+    def material(self):
+        """The surface material, a ColliderMaterial: restitution, friction, stickiness
+        (sph_collider_get_material)."""
+        m = _g.ColliderMaterial()
+        check(library().sph_collider_get_material(self.world.handle, self.id, ctypes.byref(m)),
+              "sph_collider_get_material")
+        return m
+
+    @material.setter
+    def material(self, material):
+        """Replaces the material: a ColliderMaterial, or a dict of its fields with the others at
+        their defaults (0) (sph_collider_set_material_struct)."""
+        m = material if isinstance(material, _g.ColliderMaterial) else _g.ColliderMaterial(**dict(material))
+        check(library().sph_collider_set_material_struct(self.world.handle, self.id, ctypes.byref(m)),
+              "sph_collider_set_material_struct")
+
     def set_material(self, restitution=0.0, friction=0.0, stickiness=0.0):
-        """Changes restitution [0, 1], friction >= 0 and stickiness >= 0 (sph_collider_set_material)."""
+        """Changes restitution [0, 1], friction >= 0 and stickiness >= 0, as setting ``material``
+        does (sph_collider_set_material, the C API's older positional call)."""
         check(library().sph_collider_set_material(self.world.handle, self.id, restitution, friction, stickiness),
               "sph_collider_set_material")
 

@@ -85,7 +85,7 @@ def test_log_callback_gets_failures():
     messages = []
     with sph.Context("cpu", cpu_worker_count=1, log=lambda *m: messages.append(m)) as c:
         with pytest.raises(sph.SphError):
-            c.world(capacity=0)
+            c.world(capacity=2**31)
     assert messages, "the log callback was called"
     level, code, text = messages[-1]
     assert level == sph.LogLevel.ERROR and code == sph.Result.ERROR_INVALID_ARGUMENT
@@ -97,6 +97,6 @@ def test_log_callback_exceptions_do_not_escape(capsys):
         raise RuntimeError("from the log callback")
     with sph.Context("cpu", cpu_worker_count=1, log=bad_log) as c:
         with pytest.raises(sph.SphError) as e:
-            c.world(capacity=0)
+            c.world(capacity=2**31)
     assert e.value.result == sph.Result.ERROR_INVALID_ARGUMENT
     assert "from the log callback" in capsys.readouterr().err

@@ -69,7 +69,10 @@ def test_grid_assets_and_updates(ctx):
     bad = dist.copy()
     bad[0, 0, 0] = np.inf
     assert error(ctx.sdf, bad) == sph.Result.ERROR_INVALID_ARGUMENT
-    assert error(ctx.sdf, dist, index_to_local=np.zeros(12)) == sph.Result.ERROR_INVALID_ARGUMENT  # singular
+    singular = [1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0]  # no y axis
+    assert error(ctx.sdf, dist, index_to_local=singular) == sph.Result.ERROR_INVALID_ARGUMENT
+    with ctx.sdf(dist, index_to_local=np.zeros(12)) as s3:  # all zeros: the identity (1 m voxels)
+        assert s3.sample((0, 0, 0)) == np.float32(dist[0, 0, 0])  # the sample at voxel (0, 0, 0)
     with pytest.raises(ValueError):
         ctx.sdf(np.zeros((4, 4)))
 
@@ -122,10 +125,20 @@ def test_collider_pose_material_and_lifetime(ctx, world):
     c.move_to({"position": (0, 1.01, 0)})
     world.step(1 / 60)
     assert tuple(c.transform.position) == pytest.approx((0, 1.01, 0))
+    m = c.material  # as the def gave it
+    assert (m.restitution, m.friction, m.stickiness) == pytest.approx((0.5, 0.2, 0.0))
+    c.material = {"restitution": 0.25, "stickiness": 3.0}  # friction back to its default, 0
+    m = c.material
+    assert (m.restitution, m.friction, m.stickiness) == (0.25, 0.0, 3.0)
+    assert error(setattr, c, "material", {"friction": -1.0}) == sph.Result.ERROR_INVALID_ARGUMENT
+    assert c.material.stickiness == 3.0  # a refused material changes nothing
     c.set_material(restitution=1.0, friction=0.0, stickiness=2.0)
+    assert (c.material.restitution, c.material.stickiness) == (1.0, 2.0)
     assert error(c.set_material, restitution=2.0) == sph.Result.ERROR_INVALID_ARGUMENT
     assert error(c.teleport, (0, np.nan, 0)) == sph.Result.ERROR_INVALID_ARGUMENT
-    assert error(c.teleport, ((0, 0, 0), (0, 0, 0, 0))) == sph.Result.ERROR_INVALID_ARGUMENT
+    assert error(c.teleport, ((0, 0, 0), (0, 0, 0, 1e-9))) == sph.Result.ERROR_INVALID_ARGUMENT
+    c.teleport(((0, 1, 0), (0, 0, 0, 0)))  # the all-zero quaternion (a zeroed struct) is the identity
+    assert tuple(c.transform.rotation) == (0, 0, 0, 1)
     stale = sph.Collider(world, c.id.copy())
     c.destroy()
     c.destroy()  # a null id is a no-op

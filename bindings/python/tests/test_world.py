@@ -38,17 +38,24 @@ def test_world_from_a_def_and_keywords(ctx):
 
 
 @pytest.mark.parametrize("fields, result", [
-    ({"capacity": 0}, sph.Result.ERROR_INVALID_ARGUMENT),
+    ({"capacity": 2**31}, sph.Result.ERROR_INVALID_ARGUMENT),
     ({"particle_spacing": -1.0}, sph.Result.ERROR_INVALID_ARGUMENT),
     ({"particle_spacing": float("nan")}, sph.Result.ERROR_INVALID_ARGUMENT),
     ({"kernel_radius": 0.01}, sph.Result.ERROR_INVALID_ARGUMENT),
-    ({"rest_density": 0.0}, sph.Result.ERROR_INVALID_ARGUMENT),
+    ({"rest_density": -1.0}, sph.Result.ERROR_INVALID_ARGUMENT),
     ({"integrator": 9}, sph.Result.ERROR_UNSUPPORTED),
     ({"features": 0x80}, sph.Result.ERROR_UNSUPPORTED),
     ({"struct_size": 8}, sph.Result.ERROR_VERSION_MISMATCH),
 ])
 def test_bad_world_def(ctx, fields, result):
     assert error(ctx.world, **fields) == result
+
+
+def test_zero_fields_of_the_world_def_are_its_defaults(ctx):
+    with ctx.world(capacity=0, particle_spacing=0.0, rest_density=0.0) as w:
+        d = w.definition
+        assert (d.capacity, d.rest_density) == (65536, 1000.0)
+        assert d.particle_spacing == pytest.approx(0.02) and d.kernel_radius == pytest.approx(1.8 * 0.02)
 
 
 def test_unknown_field_is_an_error_not_a_silent_typo(ctx):

@@ -1,0 +1,29 @@
+// Range checks of spec fields for the world's entry points; each throws a FieldError that
+// names the field (field_error.h).
+#pragma once
+
+#include <cmath>
+#include <string>
+
+#include "../physics/vec3.h"
+#include "field_error.h"
+
+namespace sph {
+
+inline std::string describe_value(float v) { return std::to_string(v); }
+
+inline void require_finite_field(float v, const std::string& field) {
+  if (!std::isfinite(v)) throw FieldError(Status::InvalidArgument, field, "is not finite");
+}
+
+inline void require_non_negative_field(float v, const std::string& field) {
+  require_finite_field(v, field);
+  if (v < 0.0f) throw FieldError(Status::InvalidArgument, field, "must be >= 0, got " + describe_value(v));
+}
+
+inline void require_finite_vec3_field(const Vec3& v, const std::string& field) {
+  if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+    throw FieldError(Status::InvalidArgument, field, "has a non-finite component");
+}
+
+}  // namespace sph

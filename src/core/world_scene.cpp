@@ -1,0 +1,112 @@
+// The world's entry points for its scene: colliders, sources, sinks and force fields made from
+// specs (rules in scene_build.h), their setters, and the restore of a saved scene.
+#include <string>
+
+#include "field_error.h"
+#include "pose_rules.h"
+#include "scene_build.h"
+#include "status.h"
+#include "world.h"
+
+namespace sph {
+namespace {
+
+constexpr size_t kMaxObjectsPerKind = 65536;
+constexpr uint64_t kMaxSourceLatticePoints = 1ull << 28;
+
+template <class T>
+void require_room(const SlotMap<T>& map, const char* kind) {
+  if (map.size() >= kMaxObjectsPerKind)
+    throw Error(Status::Capacity, std::string("a world holds at most 65536 ") + kind);
+}
+
+template <class T>
+T& live(SlotMap<T>& map, uint64_t id) {
+  T* object = map.find(id);
+  if (!object) throw Error(Status::InvalidHandle, "id: is null, stale or not of this world");
+  return *object;
+}
+
+template <class T>
+void remove(SlotMap<T>& map, uint64_t id) {
+  if (id == 0) return;
+  if (!map.erase(id)) throw Error(Status::InvalidHandle, "id: is stale or not of this world");
+}
+
+}  // namespace
+
+uint64_t World::add_collider(const ColliderSpec& spec) {
+  Collider c = make_collider(spec);
+  require_room(colliders_, "colliders");
+  return colliders_.insert(std::move(c));
+}
+
+uint64_t World::add_source(const SourceSpec& spec) {
+  Source s = make_source(spec, config_);
+  s.lattice = lattice_inside(*s.region, s.spacing, kMaxSourceLatticePoints);
+  require_room(sources_, "sources");
+  return sources_.insert(std::move(s));
+}
+
+uint64_t World::add_sink(const SinkSpec& spec) {
+  Sink s = make_sink(spec);
+  require_room(sinks_, "sinks");
+  return sinks_.insert(std::move(s));
+}
+
+uint64_t World::add_force_field(const ForceFieldSpec& spec) {
+  ForceField f = make_force_field(spec);
+  require_room(force_fields_, "force fields");
+  return force_fields_.insert(std::move(f));
+}
+
+void World::remove_collider(uint64_t id) { remove(colliders_, id); }
+void World::remove_source(uint64_t id) { remove(sources_, id); }
+void World::remove_sink(uint64_t id) { remove(sinks_, id); }
+void World::remove_force_field(uint64_t id) { remove(force_fields_, id); }
+
+void World::set_collider_target(uint64_t id, const RigidTransform& target) {
+  Collider& c = live(colliders_, id);
+  require_pose(target, "target");
+  c.target = target;
+}
+
+void World::teleport_collider(uint64_t id, const RigidTransform& pose) {
+  Collider& c = live(colliders_, id);
+  require_pose(pose, "transform");
+  c.pose = pose;
+  c.target.reset();
+}
+
+void World::set_collider_material(uint64_t id, const ColliderMaterial& material) {
+  Collider& c = live(colliders_, id);
+  check_collider_material(material);
+  c.material = material;
+}
+
+void World::set_source_pose(uint64_t id, const RigidTransform& pose) {
+  Source& s = live(sources_, id);
+  require_pose(pose, "transform");
+  s.pose = pose;
+}
+
+void World::set_force_field_pose(uint64_t id, const RigidTransform& pose) {
+  ForceField& f = live(force_fields_, id);
+  require_pose(pose, "transform");
+  f.pose = pose;
+}
+
+const Collider& World::collider(uint64_t id) const {
+  const Collider* c = colliders_.find(id);
+  if (!c) throw Error(Status::InvalidHandle, "id: is null, stale or not of this world");
+  return *c;
+}
+
+void World::restore_scene(SceneTables tables) {
+  colliders_.restore(std::move(tables.colliders));
+  sources_.restore(std::move(tables.sources));
+  sinks_.restore(std::move(tables.sinks));
+  force_fields_.restore(std::move(tables.force_fields));
+}
+
+}  // namespace sph
