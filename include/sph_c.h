@@ -732,14 +732,6 @@ SPH_API sph_result SPH_CALL sph_collider_teleport(sph_world* world, sph_collider
 SPH_API sph_result SPH_CALL sph_collider_get_transform(const sph_world* world, sph_collider_id id,
                                                        sph_transform* out_transform);
 /**
- * Deprecated: use sph_collider_set_material_struct. Kept, with its arguments, so that programs
- * built against earlier headers keep working (the ABI does not change); it sets the three
- * coefficients as that call does, with the same checks.
- */
-SPH_API sph_result SPH_CALL sph_collider_set_material(sph_world* world, sph_collider_id id, float restitution,
-                                                      float friction, float stickiness);
-
-/**
  * How a collider's surface answers particles that reach it. Zero means default: a zeroed
  * struct (struct_size set) is what sph_collider_material_init gives, a surface that returns
  * no normal speed, has no friction and pulls nothing.
@@ -763,8 +755,8 @@ static inline sph_result sph_collider_material_init(sph_collider_material* mater
  * a null, stale or foreign id), INVALID_ARGUMENT (NULL material; a coefficient out of range or
  * not finite, named), VERSION_MISMATCH (struct_size), WORLD_LOCKED. Nothing changes on error.
  */
-SPH_API sph_result SPH_CALL sph_collider_set_material_struct(sph_world* world, sph_collider_id id,
-                                                             const sph_collider_material* material);
+SPH_API sph_result SPH_CALL sph_collider_set_material(sph_world* world, sph_collider_id id,
+                                                      const sph_collider_material* material);
 /**
  * Reads a collider's material (as the def or the last set call gave it). out->struct_size
  * must be set (sph_collider_material_init); only that many bytes are written.

@@ -1813,16 +1813,6 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_get_transform")]
         public static extern Result sph_collider_get_transform(IntPtr world, ColliderId id, IntPtr outTransform);
 
-        /// <summary>
-        /// Deprecated: use sph_collider_set_material_struct. Kept, with its arguments, so that programs
-        /// built against earlier headers keep working (the ABI does not change); it sets the three
-        /// coefficients as that call does, with the same checks.
-        /// </summary>
-        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
-        public static extern Result sph_collider_set_material(WorldHandle world, ColliderId id, float restitution, float friction, float stickiness);
-        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_set_material")]
-        public static extern Result sph_collider_set_material(IntPtr world, ColliderId id, float restitution, float friction, float stickiness);
-
         /// <summary>sph_collider_material_init_sized</summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_collider_material_init_sized(ref ColliderMaterial material, uint size);
@@ -1835,9 +1825,9 @@ namespace Sph
         /// not finite, named), VERSION_MISMATCH (struct_size), WORLD_LOCKED. Nothing changes on error.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
-        public static extern Result sph_collider_set_material_struct(WorldHandle world, ColliderId id, ref ColliderMaterial material);
-        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_set_material_struct")]
-        public static extern Result sph_collider_set_material_struct(IntPtr world, ColliderId id, IntPtr material);
+        public static extern Result sph_collider_set_material(WorldHandle world, ColliderId id, ref ColliderMaterial material);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_set_material")]
+        public static extern Result sph_collider_set_material(IntPtr world, ColliderId id, IntPtr material);
 
         /// <summary>
         /// Reads a collider's material (as the def or the last set call gave it). out-&gt;struct_size
@@ -2742,9 +2732,8 @@ namespace Sph
             "sph_collider_set_target_transform",
             "sph_collider_teleport",
             "sph_collider_get_transform",
-            "sph_collider_set_material",
             "sph_collider_material_init_sized",
-            "sph_collider_set_material_struct",
+            "sph_collider_set_material",
             "sph_collider_get_material",
             "sph_source_def_init_sized",
             "sph_source_create",
@@ -2776,7 +2765,6 @@ namespace Sph
         };
         /// <summary>The shared library of each function ("sph", or an optional helper).</summary>
         public static readonly string[] FunctionLibraries = {
-            "sph",
             "sph",
             "sph",
             "sph",

@@ -1065,14 +1065,18 @@ namespace Sph
             }
             set
             {
-                SphException.Check(Native.sph_collider_set_material_struct(World.Handle, Id, ref value), "sph_collider_set_material_struct");
+                SphException.Check(Native.sph_collider_set_material(World.Handle, Id, ref value), "sph_collider_set_material");
             }
         }
 
-        /// <summary>As setting Material (the C API's older positional call).</summary>
+        /// <summary>As setting Material to these three coefficients.</summary>
         public void SetMaterial(float restitution, float friction, float stickiness)
         {
-            SphException.Check(Native.sph_collider_set_material(World.Handle, Id, restitution, friction, stickiness), "sph_collider_set_material");
+            var m = ColliderMaterial.Default();
+            m.Restitution = restitution;
+            m.Friction = friction;
+            m.Stickiness = stickiness;
+            Material = m;
         }
 
         /// <summary>Removes the collider (idempotent).</summary>

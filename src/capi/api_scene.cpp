@@ -162,20 +162,13 @@ SPH_API sph_result SPH_CALL sph_collider_get_transform(const sph_world* world, s
   });
 }
 
-SPH_API sph_result SPH_CALL sph_collider_set_material(sph_world* world, sph_collider_id id, float restitution,
-                                                      float friction, float stickiness) {
-  return change_world("sph_collider_set_material", world, [&](sph::World& w) {
-    w.set_collider_material(id.bits, sph::ColliderMaterial{restitution, friction, stickiness});
-  });
-}
-
 SPH_API sph_result SPH_CALL sph_collider_material_init_sized(sph_collider_material* material, uint32_t size) {
   return sph::init_user_struct("sph_collider_material_init", "material", material, size);
 }
 
-SPH_API sph_result SPH_CALL sph_collider_set_material_struct(sph_world* world, sph_collider_id id,
-                                                             const sph_collider_material* material) {
-  return change_world("sph_collider_set_material_struct", world, [&](sph::World& w) {
+SPH_API sph_result SPH_CALL sph_collider_set_material(sph_world* world, sph_collider_id id,
+                                                      const sph_collider_material* material) {
+  return change_world("sph_collider_set_material", world, [&](sph::World& w) {
     const sph_collider_material m = sph::read_user_struct(material, "material");
     sph::with_field_prefix("material->", [&] { w.set_collider_material(id.bits, material_from_public(m)); });
   });

@@ -246,26 +246,25 @@ static void test_collider_def_and_material(void** state) {
   material.restitution = 0.25f;
   material.friction = 0.5f;
   material.stickiness = 2.0f;
-  EXPECT_OK(sph_collider_set_material_struct(world, id, &material));
+  EXPECT_OK(sph_collider_set_material(world, id, &material));
   EXPECT_OK(sph_collider_get_material(world, id, &out));
   assert_true(out.struct_size == sizeof out && out.restitution == 0.25f && out.friction == 0.5f &&
               out.stickiness == 2.0f);
   /* A bad value names its field and changes nothing. */
   material.restitution = 1.5f;
   EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "material->restitution",
-               sph_collider_set_material_struct(world, id, &material));
+               sph_collider_set_material(world, id, &material));
   material.restitution = 0.0f;
   material.friction = NAN;
   EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "material->friction",
-               sph_collider_set_material_struct(world, id, &material));
+               sph_collider_set_material(world, id, &material));
   material.friction = 0.0f;
   material.stickiness = -1.0f;
   EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "material->stickiness",
-               sph_collider_set_material_struct(world, id, &material));
-  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "material", sph_collider_set_material_struct(world, id, NULL));
+               sph_collider_set_material(world, id, &material));
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "material", sph_collider_set_material(world, id, NULL));
   material.struct_size = 8;
-  EXPECT_ERROR(SPH_ERROR_VERSION_MISMATCH, "struct_size",
-               sph_collider_set_material_struct(world, id, &material));
+  EXPECT_ERROR(SPH_ERROR_VERSION_MISMATCH, "struct_size", sph_collider_set_material(world, id, &material));
   EXPECT_OK(sph_collider_get_material(world, id, &out));
   assert_true(out.restitution == 0.25f && out.friction == 0.5f && out.stickiness == 2.0f);
   /* An older, smaller out struct gets only its bytes. */
@@ -278,19 +277,12 @@ static void test_collider_def_and_material(void** state) {
     memset(&untouched, 0x7f, sizeof untouched);
     assert_memory_equal(&out.friction, &untouched, sizeof untouched);
   }
-  /* The deprecated positional setter is the same call. */
-  EXPECT_OK(sph_collider_set_material(world, id, 1.0f, 0.0f, 3.0f));
-  ZEROED(out);
-  EXPECT_OK(sph_collider_get_material(world, id, &out));
-  assert_true(out.restitution == 1.0f && out.friction == 0.0f && out.stickiness == 3.0f);
-  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "restitution", sph_collider_set_material(world, id, -0.5f, 0, 0));
 
   /* Null ids: refused by every call but destroy. */
   assert_true(SPH_ID_IS_NULL(null_id));
   EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "id", sph_collider_get_material(world, null_id, &out));
   EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "id", sph_collider_get_transform(world, null_id, &t));
-  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "id",
-               sph_collider_set_material_struct(world, null_id, &initialised));
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "id", sph_collider_set_material(world, null_id, &initialised));
   EXPECT_OK(sph_collider_destroy(world, null_id));
 
   /* A zeroed transform teleports to the identity too. */
@@ -419,7 +411,7 @@ static void test_material_survives_a_checkpoint(void** state) {
   m.restitution = 0.75f;
   m.friction = 0.125f;
   m.stickiness = 4.0f;
-  EXPECT_OK(sph_collider_set_material_struct(world, id, &m));
+  EXPECT_OK(sph_collider_set_material(world, id, &m));
   EXPECT_OK(sph_world_save(world, NULL, 0, &size));
   bytes = test_malloc((size_t)size);
   EXPECT_OK(sph_world_save(world, bytes, size, &size));

@@ -942,18 +942,14 @@ class Program {
         const float restitution = in_.maybe_hostile(0, 1);
         const float friction = in_.maybe_hostile(0, 1);
         const float stickiness = in_.maybe_hostile(0, 5);
-        if (!in_.chance(96)) {
-          r = FUZZ_CALL(sph_collider_set_material(w, id, restitution, friction, stickiness));
-          break;
-        }
-        // The struct calls: set whole (a fuzzed struct_size), then read back what is there.
+        // Set whole (a fuzzed struct_size), then read back what is there.
         Padded<sph_collider_material> m;
         sph_collider_material_init(&m.value);
         m.value.restitution = restitution;
         m.value.friction = friction;
         m.value.stickiness = stickiness;
         m.value.struct_size = struct_size(sizeof m.value);
-        r = FUZZ_CALL(sph_collider_set_material_struct(w, id, in_.chance(8) ? nullptr : &m.value));
+        r = FUZZ_CALL(sph_collider_set_material(w, id, in_.chance(8) ? nullptr : &m.value));
         sph_collider_material out;
         sph_collider_material_init(&out);
         const sph_result got = FUZZ_CALL(sph_collider_get_material(w, id, &out));

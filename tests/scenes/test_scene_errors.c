@@ -144,8 +144,12 @@ static void test_collider_errors(void** state) {
   EXPECT(SPH_ERROR_INVALID_ARGUMENT, "target", sph_collider_set_target_transform(s.world, id, NULL));
   EXPECT(SPH_ERROR_INVALID_HANDLE, "id", sph_collider_set_target_transform(s.world, null_id, &t));
   EXPECT(SPH_ERROR_INVALID_HANDLE, "id", sph_collider_set_target_transform(other.world, id, &t));
-  EXPECT(SPH_ERROR_INVALID_ARGUMENT, "restitution",
-         sph_collider_set_material(s.world, id, -0.1f, 0.0f, 0.0f));
+  {
+    sph_collider_material material;
+    sph_collider_material_init(&material);
+    material.restitution = -0.1f;
+    EXPECT(SPH_ERROR_INVALID_ARGUMENT, "restitution", sph_collider_set_material(s.world, id, &material));
+  }
   stale = id;
   SCENE_OK(sph_collider_destroy(s.world, id));
   EXPECT(SPH_ERROR_INVALID_HANDLE, "id", sph_collider_destroy(s.world, stale));

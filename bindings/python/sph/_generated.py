@@ -10,7 +10,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '7570bce9237cd0f0009540b3c422b90d0d1083b2700c09152cf8780ec48e05c5', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
+HEADERS = {'include/sph_c.h': 'fa63fc92fdeaf8171ec8a94ebbf52349141ea4bc01bc947882b706a026910783', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -1432,11 +1432,9 @@ FUNCTIONS = {
         'Moves a collider at once, with no velocity (nothing is pushed).', 'sph'),
     'sph_collider_get_transform': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_transform)), ('world', 'id', 'out_transform'),
         '', 'sph'),
-    'sph_collider_set_material': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.c_float, _c.c_float, _c.c_float), ('world', 'id', 'restitution', 'friction', 'stickiness'),
-        'Deprecated: use sph_collider_set_material_struct. Kept, with its arguments, so that programs built against earlier headers keep working (the ABI does not change); it sets the three coefficients as that call does, with the same checks.', 'sph'),
     'sph_collider_material_init_sized': (sph_result, (_c.POINTER(sph_collider_material), _c.c_uint32), ('material', 'size'),
         '', 'sph'),
-    'sph_collider_set_material_struct': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_collider_material)), ('world', 'id', 'material'),
+    'sph_collider_set_material': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_collider_material)), ('world', 'id', 'material'),
         "Replaces a collider's material; acts from the next substep. Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (NULL material; a coefficient out of range or not finite, named), VERSION_MISMATCH (struct_size), WORLD_LOCKED. Nothing changes on error.", 'sph'),
     'sph_collider_get_material': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_collider_material)), ('world', 'id', 'out'),
         "Reads a collider's material (as the def or the last set call gave it). out->struct_size must be set (sph_collider_material_init); only that many bytes are written. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL out), VERSION_MISMATCH, WORLD_LOCKED.", 'sph'),

@@ -252,16 +252,15 @@ class Collider(_WorldObject):
     @material.setter
     def material(self, material):
         """Replaces the material: a ColliderMaterial, or a dict of its fields with the others at
-        their defaults (0) (sph_collider_set_material_struct)."""
+        their defaults (0) (sph_collider_set_material)."""
         m = material if isinstance(material, _g.ColliderMaterial) else _g.ColliderMaterial(**dict(material))
-        check(library().sph_collider_set_material_struct(self.world.handle, self.id, ctypes.byref(m)),
-              "sph_collider_set_material_struct")
+        check(library().sph_collider_set_material(self.world.handle, self.id, ctypes.byref(m)),
+              "sph_collider_set_material")
 
     def set_material(self, restitution=0.0, friction=0.0, stickiness=0.0):
-        """Changes restitution [0, 1], friction >= 0 and stickiness >= 0, as setting ``material``
-        does (sph_collider_set_material, the C API's older positional call)."""
-        check(library().sph_collider_set_material(self.world.handle, self.id, restitution, friction, stickiness),
-              "sph_collider_set_material")
+        """Changes restitution [0, 1], friction >= 0 and stickiness >= 0: the same as setting
+        ``material`` to a ColliderMaterial of these three."""
+        self.material = _g.ColliderMaterial(restitution=restitution, friction=friction, stickiness=stickiness)
 
 
 class Source(_WorldObject):
