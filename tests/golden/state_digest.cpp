@@ -37,7 +37,8 @@ struct Digest {
 
 std::vector<float> copy_scalar(const sph_world* world, sph_attribute attribute, uint32_t n) {
   std::vector<float> out(n);
-  if (n) require_ok(sph_world_copy_attribute(world, attribute, out.data(), 4ull * n, 0, 0, n, nullptr), "copy");
+  uint32_t count = 0;
+  require_ok(support_read(world, attribute, out.data(), n, &count), "copy");
   return out;
 }
 
@@ -62,8 +63,8 @@ void digest_scene(sph_backend backend, const SceneHooks& h) {
     d.add(&st.max_speed, sizeof st.max_speed);
     substeps += st.substeps;
   }
-  std::printf("%-56s %016llx  (%u particles, %u substeps)\n", h.name, static_cast<unsigned long long>(d.value),
-              l.count, substeps);
+  std::printf("%-56s %016llx  (%u particles, %u substeps)\n", h.name,
+              static_cast<unsigned long long>(d.value), l.count, substeps);
   std::fflush(stdout);
   l.destroy();
 }
