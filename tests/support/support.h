@@ -172,8 +172,10 @@ typedef struct support_tank {
 } support_tank;
 
 /** Creates the tank's SDF on `context` and its collider in `world`. *sdf receives the asset
- * (the caller destroys it; the collider keeps its own reference), or, with sdf NULL, the asset
- * is released at once. collider (optional) receives the collider's id. */
+ * (the caller destroys it; the collider keeps its own reference; also after a failure), or, with
+ * sdf NULL, the asset is released once the collider holds it (a failure before that leaves it
+ * unreleased, so that no call overwrites the failing call's message). collider (optional)
+ * receives the collider's id. */
 sph_result support_tank_create(sph_context* context, sph_world* world, const support_tank* tank,
                                sph_sdf** sdf, sph_collider_id* collider);
 
