@@ -30,10 +30,13 @@ sph_result support_fcc_sphere(const double* centre, double radius, double spacin
                               uint32_t* count) {
   static const double origin[3] = {0.0, 0.0, 0.0};
   const double* c = centre ? centre : origin;
-  const uint64_t n = sphere_points(c, radius, spacing, NULL);
-  float* p = (float*)malloc(sizeof(float) * 3 * (size_t)(n + 1));
+  uint64_t n;
+  float* p;
   *positions = NULL;
   *count = 0;
+  if (!(spacing > 0.0) || !(radius >= 0.0) || radius / spacing > 1e6) return SPH_ERROR_INVALID_ARGUMENT;
+  n = sphere_points(c, radius, spacing, NULL);
+  p = (float*)malloc(sizeof(float) * 3 * (size_t)(n + 1));
   if (p == NULL || n > UINT32_MAX) {
     free(p);
     return SPH_ERROR_OUT_OF_HOST_MEMORY;

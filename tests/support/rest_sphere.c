@@ -8,12 +8,15 @@ sph_result support_rest_sphere_open(support_world* w, sph_backend backend, const
   sph_world_def d;
   float* positions = NULL;
   float* velocities = NULL;
+  double spacing;
   uint32_t n = 0;
   sph_result r;
   if ((r = sph_world_def_init(&d)) != SPH_OK) return r;
+  spacing = d.particle_spacing; /* the default, for a def that leaves it 0 */
   if (def) d = *def;
-  r = support_fcc_sphere(sphere->centre, sphere->radius,
-                         sphere->spacing > 0.0 ? sphere->spacing : d.particle_spacing, &positions, &n);
+  if (d.particle_spacing > 0.0f) spacing = d.particle_spacing;
+  if (sphere->spacing > 0.0) spacing = sphere->spacing;
+  r = support_fcc_sphere(sphere->centre, sphere->radius, spacing, &positions, &n);
   if (r == SPH_OK) {
     velocities = (float*)malloc(sizeof(float) * 3 * ((size_t)n + 1));
     if (velocities == NULL) r = SPH_ERROR_OUT_OF_HOST_MEMORY;

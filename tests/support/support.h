@@ -61,7 +61,8 @@ void support_random_velocities(float* velocities, uint32_t count, double speed, 
  * index sum, ordered by z, then y, then x index. These are exactly the points, in the same order,
  * that sph_world_fill_sphere makes for a float centre, radius and spacing (so its particle ids
  * follow this order). *positions (3 floats a point) is malloc'd; the caller frees it. Errors:
- * OUT_OF_HOST_MEMORY. */
+ * INVALID_ARGUMENT (spacing not positive, radius negative or above 1e6 spacings; no library
+ * message), OUT_OF_HOST_MEMORY. */
 sph_result support_fcc_sphere(const double* centre, double radius, double spacing, float** positions,
                               uint32_t* count);
 
@@ -148,7 +149,7 @@ sph_result support_kinetic_energy(const sph_world* world, float mass, double* en
 typedef struct support_sphere {
   double centre[3];
   double radius;           /* m */
-  double spacing;          /* of the lattice, m; 0: the world's particle_spacing */
+  double spacing;          /* of the lattice, m; 0: the def's particle_spacing (0 there: the default) */
   double speed;            /* each velocity component uniform in [-speed, speed], m/s */
   const float* drift;      /* NULL, or 3 floats added to every velocity */
   uint64_t random_state;   /* support_random's state for the velocities; advanced */
@@ -156,8 +157,8 @@ typedef struct support_sphere {
 } support_sphere;
 
 /** support_world_open (backend, def, params; a def->capacity of 0 becomes the ball's count plus
- * sphere->spare_capacity), then spawns the ball with velocities from
- * support_random_velocities(speed, drift). *count (optional) receives the particle count.
+ * sphere->spare_capacity, where sph_world_create would read it as its default), then spawns the ball with
+ * velocities from support_random_velocities(speed, drift). *count (optional) receives the particle count.
  * Errors: those of the calls, OUT_OF_HOST_MEMORY; on failure *w holds what was made. */
 sph_result support_rest_sphere_open(support_world* w, sph_backend backend, const sph_world_def* def,
                                     const sph_world_params* params, support_sphere* sphere, uint32_t* count);
