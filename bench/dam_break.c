@@ -2,7 +2,8 @@
  * dam_break - BENCHMARK.md case 2, the realistic load: a water column of width a, height 2a and
  * depth a at one end of a tank 5a long, gravity, the tank a collider (an inverted hollow-box
  * SDF), library defaults otherwise. The spacing is chosen so the column holds about
- * --particles particles. Uses only the public C API.
+ * --particles particles. Uses only the public C API; the tank and column are tests/support's
+ * support_dam_break.
  *
  *   dam_break [--particles N] [--seconds S] [--backend cpu|cuda|auto] [--width A]
  *             [--json FILE] [--front-csv FILE] [--label TEXT]
@@ -22,6 +23,7 @@
 #include <string.h>
 
 #include "sph_c.h"
+#include "support.h"
 
 #define FRAME_DT 0.04f /* 25 frames per second */
 #define GRAVITY 9.81f
@@ -62,9 +64,7 @@ int main(int argc, char** argv) {
     else if (strcmp(argv[i], "--width") == 0)
       a = atof(v);
     else if (strcmp(argv[i], "--backend") == 0)
-      backend = strcmp(v, "cpu") == 0    ? SPH_BACKEND_CPU
-                : strcmp(v, "cuda") == 0 ? SPH_BACKEND_CUDA
-                                         : SPH_BACKEND_AUTO;
+      backend = support_backend_from_name(v, SPH_BACKEND_AUTO);
     else if (strcmp(argv[i], "--json") == 0)
       json = v;
     else if (strcmp(argv[i], "--front-csv") == 0)
@@ -80,48 +80,26 @@ int main(int argc, char** argv) {
   const double column_volume = a * 2.0 * a * a;
   const float spacing = (float)cbrt(sqrt(2.0) * column_volume / wanted);
 
-  sph_context_def cdef;
-  sph_context_def_init(&cdef);
-  cdef.backend = backend;
   sph_context* context = NULL;
-  check(sph_context_create(&cdef, &context), "sph_context_create");
+  check(support_context_create(backend, &context), "sph_context_create");
   sph_backend resolved;
   check(sph_context_get_backend(context, &resolved), "sph_context_get_backend");
 
-  /* The tank's cavity: x in [0, 5a], y in [0, 3a], z in [0, a]. */
-  sph_shape_desc shape;
-  sph_shape_desc_init(&shape);
-  shape.shape = SPH_SHAPE_BOX;
-  shape.half_extents.x = (float)(2.5 * a);
-  shape.half_extents.y = (float)(1.5 * a);
-  shape.half_extents.z = (float)(0.5 * a);
-  shape.voxel_size = spacing;
-  sph_sdf* tank = NULL;
-  check(sph_sdf_create_shape(context, &shape, &tank), "sph_sdf_create_shape");
   sph_world_def def;
   sph_world_def_init(&def);
   def.particle_spacing = spacing;
   def.capacity = (uint32_t)(1.2 * wanted) + 1000u;
   sph_world* world = NULL;
   check(sph_world_create(context, &def, &world), "sph_world_create");
-  sph_collider_def collider;
-  sph_collider_def_init(&collider);
-  collider.sdf = tank;
-  collider.flags = SPH_COLLIDER_FLAG_INVERTED;
-  collider.transform = sph_transform_identity();
-  collider.transform.position.x = (float)(2.5 * a);
-  collider.transform.position.y = (float)(1.5 * a);
-  collider.transform.position.z = (float)(0.5 * a);
-  sph_collider_id collider_id;
-  check(sph_collider_create(world, &collider, &collider_id), "sph_collider_create");
-  check(sph_sdf_destroy(tank), "sph_sdf_destroy");
-  sph_fill_box_desc box;
-  sph_fill_box_desc_init(&box);
-  box.max.x = (float)a;
-  box.max.y = (float)(2.0 * a);
-  box.max.z = (float)a;
+  /* The tank's cavity: x in [0, 5a], y in [0, 3a], z in [0, a]; the column [0, a] x [0, 2a] x
+   * [0, a] against its x = 0 wall. */
+  const sph_vec3 half = {(float)(2.5 * a), (float)(1.5 * a), (float)(0.5 * a)};
+  const support_tank tank = {half, half, spacing, 0.0f};
+  const sph_vec3 column_min = {0.0f, 0.0f, 0.0f};
+  const sph_vec3 column_max = {(float)a, (float)(2.0 * a), (float)a};
   uint32_t count = 0;
-  check(sph_world_fill_box(world, &box, &count), "sph_world_fill_box");
+  check(support_dam_break(context, world, &tank, column_min, column_max, NULL, NULL, &count),
+        "support_dam_break");
 
   FILE* front = front_csv ? fopen(front_csv, "w") : NULL;
   if (front_csv && !front) {

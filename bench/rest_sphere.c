@@ -3,7 +3,8 @@
  * sphere at rest density, no gravity, no colliders, dt_max = 1 ms (40 substeps in a 25 fps
  * frame at rest), library defaults otherwise. Case "rest" starts at zero velocity, case
  * "moving" with every velocity component uniform in [-0.1, 0.1] m/s. Uses only the public C
- * API (sph_c.h).
+ * API (sph_c.h); the sphere and its velocities come from tests/support (support_fcc_sphere,
+ * support_random_velocities).
  *
  *   rest_sphere [--particles N|largest] [--frames F] [--warmup W] [--backend cpu|cuda|auto]
  *               [--case rest|moving|both] [--option NAME] [--json FILE] [--csv FILE] [--label TEXT]
@@ -31,6 +32,7 @@
 #include <time.h>
 
 #include "sph_c.h"
+#include "support.h"
 
 #define FRAME_DT 0.04f /* 25 frames per second */
 
@@ -84,47 +86,6 @@ static int compare_double(const void* a, const void* b) {
 static double median(double* v, int n) {
   qsort(v, (size_t)n, sizeof *v, compare_double);
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-/* xorshift64*: the same velocities on every run and platform. */
-static double uniform01(uint64_t* s) {
-  *s ^= *s >> 12;
-  *s ^= *s << 25;
-  *s ^= *s >> 27;
-  return (double)((*s * 0x2545F4914F6CDD1Dull) >> 11) * (1.0 / 9007199254740992.0);
-}
-
-/* FCC points in a sphere: the cubic grid of step spacing/sqrt(2) with an even index sum. */
-static float* fcc_sphere(double radius, double spacing, uint32_t* out_count) {
-  const double step = spacing / sqrt(2.0);
-  const int64_t n = (int64_t)floor(radius / step);
-  const double estimate =
-      4.0 / 3.0 * 3.14159265358979 * radius * radius * radius * sqrt(2.0) / (spacing * spacing * spacing);
-  size_t cap = (size_t)(estimate * 1.1) + 64, count = 0;
-  float* p = malloc(cap * 3 * sizeof(float));
-  if (!p) return NULL;
-  for (int64_t k = -n; k <= n; ++k)
-    for (int64_t j = -n; j <= n; ++j)
-      for (int64_t i = -n; i <= n; ++i) {
-        if ((((i + j + k) % 2) + 2) % 2 != 0) continue;
-        const double x = step * (double)i, y = step * (double)j, z = step * (double)k;
-        if (x * x + y * y + z * z > radius * radius) continue;
-        if (count == cap) {
-          cap *= 2;
-          float* q = realloc(p, cap * 3 * sizeof(float));
-          if (!q) {
-            free(p);
-            return NULL;
-          }
-          p = q;
-        }
-        p[3 * count] = (float)x;
-        p[3 * count + 1] = (float)y;
-        p[3 * count + 2] = (float)z;
-        ++count;
-      }
-  *out_count = (uint32_t)count;
-  return p;
 }
 
 static double now_s(void) {
@@ -198,11 +159,8 @@ static result run_case(const options* o, int moving) {
   const double t0 = now_s();
   const float spacing = 0.02f;
 
-  sph_context_def cdef;
-  sph_context_def_init(&cdef);
-  cdef.backend = o->backend;
   sph_context* context = NULL;
-  check(sph_context_create(&cdef, &context), "sph_context_create");
+  check(support_context_create(o->backend, &context), "sph_context_create");
   sph_backend resolved;
   check(sph_context_get_backend(context, &resolved), "sph_context_get_backend");
   r.backend = resolved == SPH_BACKEND_CUDA ? "cuda" : "cpu";
@@ -211,21 +169,21 @@ static result run_case(const options* o, int moving) {
   const double wanted = o->largest ? 0.95 * largest_capacity(o, context) : (double)o->particles;
   double radius = spacing * cbrt(3.0 * wanted / (4.0 * 3.14159265358979 * sqrt(2.0)));
   uint32_t count = 0;
-  float* positions = fcc_sphere(radius, spacing, &count);
-  while (positions && o->largest && count > wanted) { /* the volume estimate can overshoot */
+  float* positions = NULL;
+  sph_result lattice = support_fcc_sphere(NULL, radius, spacing, &positions, &count);
+  while (lattice == SPH_OK && o->largest && count > wanted) { /* the volume estimate can overshoot */
     free(positions);
     radius *= 0.999;
-    positions = fcc_sphere(radius, spacing, &count);
+    lattice = support_fcc_sphere(NULL, radius, spacing, &positions, &count);
   }
-  float* velocities = calloc((size_t)count * 3, sizeof(float));
-  if (!positions || !velocities) {
+  float* velocities = calloc((size_t)count * 3 + 3, sizeof(float));
+  if (lattice != SPH_OK || !velocities) {
     fprintf(stderr, "rest_sphere: out of host memory\n");
     exit(1);
   }
   if (moving) {
     uint64_t seed = 0x5eed5eed12345ull;
-    for (size_t i = 0; i < (size_t)count * 3; ++i)
-      velocities[i] = (float)((2.0 * uniform01(&seed) - 1.0) * 0.1);
+    support_random_velocities(velocities, count, 0.1, NULL, &seed);
   }
 
   sph_world_def def;
@@ -234,12 +192,7 @@ static result run_case(const options* o, int moving) {
   sph_world* world = NULL;
   check(sph_world_create(context, &def, &world), "sph_world_create");
   check(sph_world_set_params(world, &params), "sph_world_set_params");
-  sph_spawn_desc spawn;
-  sph_spawn_desc_init(&spawn);
-  spawn.count = count;
-  spawn.positions = positions;
-  spawn.velocities = velocities;
-  check(sph_world_spawn(world, &spawn, NULL), "sph_world_spawn");
+  check(support_spawn(world, positions, velocities, count), "sph_world_spawn");
   free(positions);
   free(velocities);
   r.count = count;
@@ -385,9 +338,7 @@ int main(int argc, char** argv) {
     } else if (strcmp(a, "--warmup") == 0) {
       o.warmup = atoi(v);
     } else if (strcmp(a, "--backend") == 0) {
-      o.backend = strcmp(v, "cpu") == 0    ? SPH_BACKEND_CPU
-                  : strcmp(v, "cuda") == 0 ? SPH_BACKEND_CUDA
-                                           : SPH_BACKEND_AUTO;
+      o.backend = support_backend_from_name(v, SPH_BACKEND_AUTO);
     } else if (strcmp(a, "--case") == 0) {
       o.which = v;
     } else if (strcmp(a, "--json") == 0) {

@@ -1,5 +1,5 @@
 /* The speed-accuracy trade (../shared/BENCHMARK.md case 4): the dam break of Martin & Moyce
- * (tests/validation/dam_break.c) for integrator (symplectic Euler, RK4) x step factor lambda
+ * (tests/support/dam_break.c) for integrator (symplectic Euler, RK4) x step factor lambda
  * (0.1, 0.2, 0.4, 0.8) x three resolutions. For each run: the surge front's error against the
  * measurements (mean and worst over T in [0.8, 3.3], with and without the one fitted time
  * shift), the mean compression (density error) and the wall seconds per simulated second.
@@ -16,6 +16,7 @@
 
 #include "dam_break.h"
 #include "sph_c.h"
+#include "support.h"
 
 #define MAX_RESOLUTIONS 8
 
@@ -40,7 +41,6 @@ int main(int argc, char** argv) {
   int resolutions = 3;
   const char* out_path = "speed_accuracy.csv";
   sph_backend backend = SPH_BACKEND_AUTO;
-  sph_context_def context_def;
   sph_context* context = NULL;
   sph_backend resolved = SPH_BACKEND_CPU;
   dam_break_result* result = (dam_break_result*)malloc(sizeof(dam_break_result));
@@ -49,9 +49,7 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--backend") == 0 && i + 1 < argc) {
       const char* b = argv[++i];
-      backend = strcmp(b, "cpu") == 0    ? SPH_BACKEND_CPU
-                : strcmp(b, "cuda") == 0 ? SPH_BACKEND_CUDA
-                                         : SPH_BACKEND_AUTO;
+      backend = support_backend_from_name(b, SPH_BACKEND_AUTO);
     } else if (strcmp(argv[i], "--layers") == 0 && i + 1 < argc) {
       resolutions = parse_layers(argv[++i], layers);
       if (resolutions == 0) {
@@ -66,9 +64,7 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  sph_context_def_init(&context_def);
-  context_def.backend = backend;
-  if (sph_context_create(&context_def, &context) != SPH_OK) {
+  if (support_context_create(backend, &context) != SPH_OK) {
     fprintf(stderr, "speed_accuracy: %s\n", sph_get_last_error());
     return 1;
   }

@@ -1,7 +1,10 @@
 /* The default demo scene, a dam break, built through the C API alone as an engine would
  * (the same scene as samples/scenes/dam_break.json, which sph-run plays): a column of water
- * collapses in a closed tank, an inverted box collider. Every frame's particles are written as
- * CSV (id, x, y, z, vx, vy, vz, density) to the output directory.
+ * collapses in a closed tank, an inverted box collider. The tank and the column come from
+ * support_dam_break (tests/support/tank.c: a box SDF from sph_sdf_create_shape placed with
+ * SPH_COLLIDER_FLAG_INVERTED, then sph_world_fill_box), the builder the tests and the dam-break
+ * benchmark use. Every frame's particles are written as CSV (id, x, y, z, vx, vy, vz, density) to
+ * the output directory.
  *
  * Usage: dam_break [OUTPUT_DIR] [--frames N] [--backend auto|cpu|cuda]
  *        (default out/dam_break_c, 120 frames at 60 fps) */
@@ -14,6 +17,7 @@
 
 #include "sample_io.h"
 #include "sph_c.h"
+#include "support.h"
 
 int main(int argc, char** argv) {
   const char* out_dir = "out/dam_break_c";
@@ -22,10 +26,10 @@ int main(int argc, char** argv) {
   sph_context_def context_def;
   sph_world_def world_def;
   sph_world_params params;
-  sph_shape_desc tank_shape;
-  sph_collider_def tank;
-  sph_collider_id tank_id;
-  sph_fill_box_desc column;
+  /* The tank: inside 1 m x 0.6 m x 0.3 m, the floor at y = 0; an SDF of 1 cm voxels. */
+  const support_tank tank = {{0.0f, 0.3f, 0.0f}, {0.5f, 0.3f, 0.15f}, 0.01f, 0.0f};
+  /* The water column against the left wall. */
+  const sph_vec3 column_min = {-0.5f, 0.0f, -0.15f}, column_max = {-0.15f, 0.5f, 0.15f};
   sph_context* context = NULL;
   sph_world* world = NULL;
   sph_sdf* tank_sdf = NULL;
@@ -47,31 +51,9 @@ int main(int argc, char** argv) {
   sph_world_params_init(&params); /* gravity -9.81 y, k = 100, mu = 1, dt_max = 1 ms: the defaults */
   if (sample_failed(sph_world_set_params(world, &params), "sph_world_set_params")) goto done;
 
-  /* The tank: a box SDF whose interior is 1 m x 0.6 m x 0.3 m, inverted so that the fluid stays
-   * inside it. The floor is at y = 0. */
-  sph_shape_desc_init(&tank_shape);
-  tank_shape.shape = SPH_SHAPE_BOX;
-  tank_shape.half_extents.x = 0.5f;
-  tank_shape.half_extents.y = 0.3f;
-  tank_shape.half_extents.z = 0.15f;
-  tank_shape.voxel_size = 0.01f;
-  if (sample_failed(sph_sdf_create_shape(context, &tank_shape, &tank_sdf), "sph_sdf_create_shape")) goto done;
-  sph_collider_def_init(&tank);
-  tank.sdf = tank_sdf;
-  tank.flags = SPH_COLLIDER_FLAG_INVERTED;
-  tank.transform = sph_transform_identity();
-  tank.transform.position.y = 0.3f;
-  if (sample_failed(sph_collider_create(world, &tank, &tank_id), "sph_collider_create")) goto done;
-
-  /* The water column against the left wall. */
-  sph_fill_box_desc_init(&column);
-  column.min.x = -0.5f;
-  column.min.y = 0.0f;
-  column.min.z = -0.15f;
-  column.max.x = -0.15f;
-  column.max.y = 0.5f;
-  column.max.z = 0.15f;
-  if (sample_failed(sph_world_fill_box(world, &column, &count), "sph_world_fill_box")) goto done;
+  if (sample_failed(support_dam_break(context, world, &tank, column_min, column_max, &tank_sdf, NULL, &count),
+                    "support_dam_break"))
+    goto done;
 
   printf("dam_break: %u particles, %d frames -> %s/\n", count, frames, out_dir);
   if (sample_write_frame(world, out_dir, 0)) goto done;

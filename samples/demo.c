@@ -11,31 +11,8 @@
 #include <sys/stat.h>
 #include <sys/types.h>
 
+#include "sample_io.h"
 #include "sph_c.h"
-
-static int failed(sph_result r, const char* what) {
-  if (r < 0) {
-    fprintf(stderr, "demo: %s failed: %s\n  %s\n", what, sph_result_string(r), sph_get_last_error());
-    return 1;
-  }
-  return 0;
-}
-
-static int make_dirs(const char* path) {
-  char buf[4096];
-  size_t i, n = strlen(path);
-  if (n >= sizeof buf) return -1;
-  memcpy(buf, path, n + 1);
-  for (i = 1; i <= n; ++i) {
-    if (buf[i] == '/' || buf[i] == '\0') {
-      char saved = buf[i];
-      buf[i] = '\0';
-      if (mkdir(buf, 0755) != 0 && errno != EEXIST) return -1;
-      buf[i] = saved;
-    }
-  }
-  return 0;
-}
 
 /* Writes one frame to DIR/frame_NNNN.csv through a temporary name, so an interrupted run
  * leaves only complete frames. */
@@ -50,13 +27,15 @@ static int write_frame(sph_world* world, const char* dir, int frame, float* vec,
   vel = vec + 3 * (size_t)n;
   rho = scalar;
   p = scalar + n;
-  if (failed(sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, pos, 12ull * n, 0, 0, n, NULL),
-             "copy") ||
-      failed(sph_world_copy_attribute(world, SPH_ATTRIBUTE_VELOCITY, vel, 12ull * n, 0, 0, n, NULL),
-             "copy") ||
-      failed(sph_world_copy_attribute(world, SPH_ATTRIBUTE_DENSITY, rho, 4ull * n, 0, 0, n, NULL), "copy") ||
-      failed(sph_world_copy_attribute(world, SPH_ATTRIBUTE_PRESSURE, p, 4ull * n, 0, 0, n, NULL), "copy") ||
-      failed(sph_world_copy_attribute(world, SPH_ATTRIBUTE_ID, ids, 4ull * n, 0, 0, n, NULL), "copy"))
+  if (sample_failed(sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, pos, 12ull * n, 0, 0, n, NULL),
+                    "copy") ||
+      sample_failed(sph_world_copy_attribute(world, SPH_ATTRIBUTE_VELOCITY, vel, 12ull * n, 0, 0, n, NULL),
+                    "copy") ||
+      sample_failed(sph_world_copy_attribute(world, SPH_ATTRIBUTE_DENSITY, rho, 4ull * n, 0, 0, n, NULL),
+                    "copy") ||
+      sample_failed(sph_world_copy_attribute(world, SPH_ATTRIBUTE_PRESSURE, p, 4ull * n, 0, 0, n, NULL),
+                    "copy") ||
+      sample_failed(sph_world_copy_attribute(world, SPH_ATTRIBUTE_ID, ids, 4ull * n, 0, 0, n, NULL), "copy"))
     return 1;
   snprintf(path, sizeof path, "%s/frame_%04d.csv", dir, frame);
   snprintf(tmp, sizeof tmp, "%s.tmp", path);
@@ -78,7 +57,7 @@ static int write_frame(sph_world* world, const char* dir, int frame, float* vec,
 
 int main(int argc, char** argv) {
   const char* out_dir = "out/demo";
-  int frames = 90, frame, i, status = 1;
+  int frames = 90, frame, status = 1;
   sph_backend backend = SPH_BACKEND_AUTO;
   sph_context_def context_def;
   sph_world_def world_def;
@@ -92,51 +71,35 @@ int main(int argc, char** argv) {
   uint32_t* ids = NULL;
   sph_backend used;
 
-  for (i = 1; i < argc; ++i) {
-    if (strcmp(argv[i], "--frames") == 0 && i + 1 < argc) {
-      frames = atoi(argv[++i]);
-    } else if (strcmp(argv[i], "--backend") == 0 && i + 1 < argc) {
-      const char* b = argv[++i];
-      backend = strcmp(b, "cpu") == 0    ? SPH_BACKEND_CPU
-                : strcmp(b, "cuda") == 0 ? SPH_BACKEND_CUDA
-                                         : SPH_BACKEND_AUTO;
-    } else if (argv[i][0] != '-') {
-      out_dir = argv[i];
-    } else {
-      fprintf(stderr, "usage: demo [OUTPUT_DIR] [--frames N] [--backend auto|cpu|cuda]\n");
-      return 2;
-    }
-  }
+  status = sample_parse_args(argc, argv, "demo", &out_dir, &frames, &backend);
+  if (status != 0) return status;
+  status = 1;
   if (frames < 1) frames = 1;
-  if (make_dirs(out_dir) != 0) {
-    fprintf(stderr, "demo: cannot create %s: %s\n", out_dir, strerror(errno));
-    return 1;
-  }
 
   sph_context_def_init(&context_def);
   context_def.backend = backend;
-  if (failed(sph_context_create(&context_def, &context), "sph_context_create")) return 1;
+  if (sample_failed(sph_context_create(&context_def, &context), "sph_context_create")) return 1;
   sph_context_get_backend(context, &used);
 
   sph_world_def_init(&world_def); /* water at 1 cm spacing */
   world_def.particle_spacing = 0.01f;
   world_def.capacity = 40000;
-  if (failed(sph_world_create(context, &world_def, &world), "sph_world_create")) goto done;
+  if (sample_failed(sph_world_create(context, &world_def, &world), "sph_world_create")) goto done;
 
   sph_world_params_init(&params);
   params.gravity.x = params.gravity.y = params.gravity.z = 0.0f;
-  if (failed(sph_world_set_params(world, &params), "sph_world_set_params")) goto done;
+  if (sample_failed(sph_world_set_params(world, &params), "sph_world_set_params")) goto done;
 
   sph_fill_sphere_desc_init(&drop);
   drop.radius = 0.06f;
   drop.center.x = -0.08f;
   drop.velocity.x = 1.5f;
-  if (failed(sph_world_fill_sphere(world, &drop, &added), "sph_world_fill_sphere")) goto done;
+  if (sample_failed(sph_world_fill_sphere(world, &drop, &added), "sph_world_fill_sphere")) goto done;
   count += added;
   drop.center.x = 0.08f;
   drop.center.y = 0.03f; /* off-centre, so the splash turns */
   drop.velocity.x = -1.5f;
-  if (failed(sph_world_fill_sphere(world, &drop, &added), "sph_world_fill_sphere")) goto done;
+  if (sample_failed(sph_world_fill_sphere(world, &drop, &added), "sph_world_fill_sphere")) goto done;
   count += added;
 
   vec = malloc(sizeof(float) * 6 * count);
@@ -150,7 +113,7 @@ int main(int argc, char** argv) {
          used == SPH_BACKEND_CUDA ? "CUDA" : "CPU", frames, out_dir);
   if (write_frame(world, out_dir, 0, vec, scalar, ids)) goto done;
   for (frame = 1; frame <= frames; ++frame) {
-    if (failed(sph_world_step(world, 1.0f / 60.0f), "sph_world_step")) goto done;
+    if (sample_failed(sph_world_step(world, 1.0f / 60.0f), "sph_world_step")) goto done;
     if (write_frame(world, out_dir, frame, vec, scalar, ids)) goto done;
     sph_stats_init(&stats);
     sph_world_get_stats(world, &stats);

@@ -23,7 +23,6 @@ int main(int argc, char** argv) {
   sph_context_def context_def;
   sph_context* context = NULL;
   sph_world* world = NULL;
-  sph_stats stats;
   sph_world_def world_def;
   sph_world_params params;
   sph_shape_desc tank_shape;
@@ -95,13 +94,7 @@ int main(int argc, char** argv) {
       if (sample_failed(sph_world_fill_sphere(world, &drop, NULL), "sph_world_fill_sphere")) goto done;
       second_added = 1;
     }
-    if (sample_failed(sph_world_step(world, 1.0f / 60.0f), "sph_world_step")) goto done;
-    if (sample_write_frame(world, out_dir, frame)) goto done;
-    sph_stats_init(&stats);
-    sph_world_get_stats(world, &stats);
-    if (frame % 30 == 0 || frame == frames)
-      printf("frame %3d/%d  %6u particles  substeps %3u  max speed %5.2f m/s  %7.1f ms\n", frame, frames,
-             stats.particle_count, stats.substeps, stats.max_speed, stats.step_ms);
+    if (sample_step_and_write(world, out_dir, frame, frames)) goto done;
   }
   status = 0;
 

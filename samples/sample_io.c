@@ -7,6 +7,8 @@
 #include <sys/stat.h>
 #include <sys/types.h>
 
+#include "support.h"
+
 static const char* sample_name = "sample";
 
 int sample_failed(sph_result r, const char* what) {
@@ -42,10 +44,7 @@ int sample_parse_args(int argc, char** argv, const char* name, const char** out_
     if (strcmp(argv[i], "--frames") == 0 && i + 1 < argc) {
       *frames = atoi(argv[++i]);
     } else if (strcmp(argv[i], "--backend") == 0 && i + 1 < argc) {
-      const char* b = argv[++i];
-      *backend = strcmp(b, "cpu") == 0    ? SPH_BACKEND_CPU
-                 : strcmp(b, "cuda") == 0 ? SPH_BACKEND_CUDA
-                                          : SPH_BACKEND_AUTO;
+      *backend = support_backend_from_name(argv[++i], SPH_BACKEND_AUTO);
     } else if (argv[i][0] != '-') {
       *out_dir = argv[i];
     } else {
@@ -98,4 +97,16 @@ done:
   free(rho);
   free(id);
   return status;
+}
+
+int sample_step_and_write(sph_world* world, const char* dir, int frame, int frames) {
+  sph_stats stats;
+  if (sample_failed(sph_world_step(world, 1.0f / 60.0f), "sph_world_step")) return 1;
+  if (sample_write_frame(world, dir, frame)) return 1;
+  sph_stats_init(&stats);
+  sph_world_get_stats(world, &stats);
+  if (frame % 30 == 0 || frame == frames)
+    printf("frame %3d/%d  %6u particles  substeps %3u  max speed %5.2f m/s  %7.1f ms\n", frame, frames,
+           stats.particle_count, stats.substeps, stats.max_speed, stats.step_ms);
+  return 0;
 }

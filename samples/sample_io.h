@@ -1,7 +1,7 @@
 /* What the scene samples share and a user would write once: reporting a failed call, the
  * command line (OUTPUT_DIR --frames N --backend auto|cpu|cuda), and writing each frame's
  * particles as CSV (id, x, y, z, vx, vy, vz, density) through a temporary name, so an
- * interrupted run leaves only complete frames. */
+ * interrupted run leaves only complete frames, with a progress line now and then. */
 #ifndef SPH_SAMPLE_IO_H
 #define SPH_SAMPLE_IO_H
 
@@ -19,5 +19,9 @@ int sample_parse_args(int argc, char** argv, const char* name, const char** out_
 
 /* Writes DIR/frame_NNNN.csv with every particle of the world. Returns 0 or 1 (reported). */
 int sample_write_frame(const sph_world* world, const char* dir, int frame);
+
+/* Steps the world one frame of 1/60 s, writes it as frame `frame` of `frames` and prints a
+ * progress line every 30 frames and at the last. Returns 0 or 1 (reported). */
+int sample_step_and_write(sph_world* world, const char* dir, int frame, int frames);
 
 #endif

@@ -17,6 +17,7 @@
 
 #include "sample_io.h"
 #include "sph_c.h"
+#include "support.h"
 
 int main(int argc, char** argv) {
   const char* out_dir = "out/wave_tank_c";
@@ -25,12 +26,14 @@ int main(int argc, char** argv) {
   sph_context_def context_def;
   sph_context* context = NULL;
   sph_world* world = NULL;
-  sph_stats stats;
   sph_world_def world_def;
   sph_world_params params;
   sph_shape_desc shape;
   sph_collider_def def;
-  sph_collider_id tank_id, paddle_id;
+  sph_collider_id paddle_id;
+  /* The tank: an inverted box, inside 2 m x 0.6 m x 0.3 m, floor at y = 0 (support_tank_create,
+   * tests/support/tank.c: a box SDF placed with SPH_COLLIDER_FLAG_INVERTED). */
+  const support_tank tank = {{0.0f, 0.3f, 0.0f}, {1.0f, 0.3f, 0.15f}, 0.01f, 0.0f};
   sph_fill_box_desc water;
   sph_sdf *tank_sdf = NULL, *paddle_sdf = NULL;
   const double period = 1.0; /* s */
@@ -49,20 +52,8 @@ int main(int argc, char** argv) {
   sph_world_params_init(&params);
   if (sample_failed(sph_world_set_params(world, &params), "sph_world_set_params")) goto done;
 
-  /* The tank: an inverted box, inside 2 m x 0.6 m x 0.3 m, floor at y = 0. */
-  sph_shape_desc_init(&shape);
-  shape.shape = SPH_SHAPE_BOX;
-  shape.half_extents.x = 1.0f;
-  shape.half_extents.y = 0.3f;
-  shape.half_extents.z = 0.15f;
-  shape.voxel_size = 0.01f;
-  if (sample_failed(sph_sdf_create_shape(context, &shape, &tank_sdf), "sph_sdf_create_shape")) goto done;
-  sph_collider_def_init(&def);
-  def.sdf = tank_sdf;
-  def.flags = SPH_COLLIDER_FLAG_INVERTED;
-  def.transform = sph_transform_identity();
-  def.transform.position.y = 0.3f;
-  if (sample_failed(sph_collider_create(world, &def, &tank_id), "sph_collider_create")) goto done;
+  if (sample_failed(support_tank_create(context, world, &tank, &tank_sdf, NULL), "support_tank_create"))
+    goto done;
 
   /* The paddle: a 3 cm board across the tank near its left wall. */
   sph_shape_desc_init(&shape);
@@ -106,13 +97,7 @@ int main(int argc, char** argv) {
                         "sph_collider_set_target_transform"))
         goto done;
     }
-    if (sample_failed(sph_world_step(world, 1.0f / 60.0f), "sph_world_step")) goto done;
-    if (sample_write_frame(world, out_dir, frame)) goto done;
-    sph_stats_init(&stats);
-    sph_world_get_stats(world, &stats);
-    if (frame % 30 == 0 || frame == frames)
-      printf("frame %3d/%d  %6u particles  substeps %3u  max speed %5.2f m/s  %7.1f ms\n", frame, frames,
-             stats.particle_count, stats.substeps, stats.max_speed, stats.step_ms);
+    if (sample_step_and_write(world, out_dir, frame, frames)) goto done;
   }
   status = 0;
 

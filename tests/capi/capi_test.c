@@ -87,6 +87,7 @@ int capi_fixture_teardown(void** state) {
 
 void capi_snapshot_take(const sph_world* world, capi_snapshot* out) {
   sph_stats stats;
+  uint32_t n = 0;
   memset(out, 0, sizeof *out);
   assert_int_equal(sph_world_get_particle_count(world, &out->count), SPH_OK);
   assert_true(out->count <= CAPI_SNAPSHOT_MAX);
@@ -97,18 +98,13 @@ void capi_snapshot_take(const sph_world* world, capi_snapshot* out) {
   sph_stats_init(&stats);
   assert_int_equal(sph_world_get_stats(world, &stats), SPH_OK);
   out->simulated_time = stats.simulated_time;
-  assert_int_equal(sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, out->positions,
-                                            sizeof out->positions, 0, 0, out->count, NULL),
+  assert_int_equal(support_read(world, SPH_ATTRIBUTE_POSITION, out->positions, CAPI_SNAPSHOT_MAX, &n),
                    SPH_OK);
-  assert_int_equal(sph_world_copy_attribute(world, SPH_ATTRIBUTE_VELOCITY, out->velocities,
-                                            sizeof out->velocities, 0, 0, out->count, NULL),
+  assert_int_equal(support_read(world, SPH_ATTRIBUTE_VELOCITY, out->velocities, CAPI_SNAPSHOT_MAX, &n),
                    SPH_OK);
-  assert_int_equal(sph_world_copy_attribute(world, SPH_ATTRIBUTE_DENSITY, out->densities,
-                                            sizeof out->densities, 0, 0, out->count, NULL),
-                   SPH_OK);
-  assert_int_equal(
-      sph_world_copy_attribute(world, SPH_ATTRIBUTE_ID, out->ids, sizeof out->ids, 0, 0, out->count, NULL),
-      SPH_OK);
+  assert_int_equal(support_read(world, SPH_ATTRIBUTE_DENSITY, out->densities, CAPI_SNAPSHOT_MAX, &n), SPH_OK);
+  assert_int_equal(support_read(world, SPH_ATTRIBUTE_ID, out->ids, CAPI_SNAPSHOT_MAX, &n), SPH_OK);
+  assert_int_equal(n, out->count);
 }
 
 void capi_expect_unchanged(const sph_world* world, const capi_snapshot* before, const char* file, int line) {

@@ -11,7 +11,7 @@
 #include <cmocka.h>
 
 #include "sph_c.h"
-#include "test_support.h"
+#include "support.h"
 
 /* The call returns `expected` and sph_get_last_error() contains `name` (the argument). */
 #define EXPECT_ERROR(expected, name, call) \

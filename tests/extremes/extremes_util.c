@@ -13,18 +13,7 @@ void ext_ok(sph_result r, const char* call, const char* file, int line) {
 }
 
 void ext_open_def(ext_world* w, sph_world_def def) {
-  sph_world_def init;
-  memset(w, 0, sizeof *w);
-  sph_world_def_init(&init);
-  def.struct_size = init.struct_size;
-  def.header_version = init.header_version;
-  EXT_OK(sph_test_context_create(&w->context));
-  EXT_OK(sph_world_create(w->context, &def, &w->world));
-  EXT_OK(sph_world_get_particle_mass(w->world, &w->mass));
-  EXT_OK(sph_world_get_def(w->world, &def));
-  w->kernel_radius = def.kernel_radius;
-  sph_world_params_init(&w->params);
-  EXT_OK(sph_world_get_params(w->world, &w->params));
+  EXT_OK(support_world_open(w, sph_test_backend(), &def, NULL));
 }
 
 void ext_open(ext_world* w, uint32_t capacity, float spacing) {
@@ -35,34 +24,17 @@ void ext_open(ext_world* w, uint32_t capacity, float spacing) {
   ext_open_def(w, def);
 }
 
-void ext_close(ext_world* w) {
-  EXT_OK(sph_world_destroy(w->world));
-  EXT_OK(sph_context_destroy(w->context));
-}
+void ext_close(ext_world* w) { EXT_OK(support_world_close(w)); }
 
-void ext_set_params(ext_world* w) { EXT_OK(sph_world_set_params(w->world, &w->params)); }
+void ext_set_params(ext_world* w) { EXT_OK(support_world_set_params(w)); }
 
 void ext_spawn(ext_world* w, const float* positions, const float* velocities, uint32_t count) {
-  sph_spawn_desc d;
-  sph_spawn_desc_init(&d);
-  d.count = count;
-  d.positions = positions;
-  d.velocities = velocities;
-  EXT_OK(sph_world_spawn(w->world, &d, NULL));
+  EXT_OK(support_spawn(w->world, positions, velocities, count));
 }
 
 void* ext_copy(const sph_world* world, sph_attribute attribute, uint32_t* out_count) {
-  const size_t element =
-      (attribute == SPH_ATTRIBUTE_POSITION || attribute == SPH_ATTRIBUTE_VELOCITY) ? 12 : 4;
-  uint32_t n = 0, written = 0;
-  void* buffer;
-  EXT_OK(sph_world_get_particle_count(world, &n));
-  *out_count = n;
-  if (n == 0) return NULL;
-  buffer = malloc(element * n);
-  assert_non_null(buffer);
-  EXT_OK(sph_world_copy_attribute(world, attribute, buffer, (uint64_t)element * n, 0, 0, n, &written));
-  assert_int_equal(written, n);
+  void* buffer = NULL;
+  EXT_OK(support_copy(world, attribute, &buffer, out_count));
   return buffer;
 }
 
@@ -82,31 +54,25 @@ double ext_mechanical_energy(const sph_world* world, float mass, float g) {
 }
 
 void ext_tank_build(ext_world* w, ext_tank* t) {
-  sph_shape_desc shape;
-  sph_collider_def collider;
-  sph_fill_box_desc fill;
+  support_tank tank;
+  sph_vec3 column_min, column_max;
   uint32_t added = 0;
-  sph_shape_desc_init(&shape);
-  shape.shape = SPH_SHAPE_BOX;
-  shape.half_extents.x = t->hx;
-  shape.half_extents.y = t->hy;
-  shape.half_extents.z = t->hz;
-  shape.voxel_size = 0.01f;
-  EXT_OK(sph_sdf_create_shape(w->context, &shape, &t->sdf));
-  sph_collider_def_init(&collider);
-  collider.sdf = t->sdf;
-  collider.flags = SPH_COLLIDER_FLAG_INVERTED;
-  collider.transform = sph_transform_identity();
-  collider.transform.position.y = t->hy;
-  EXT_OK(sph_collider_create(w->world, &collider, &t->collider));
-  sph_fill_box_desc_init(&fill);
-  fill.min.x = -t->hx;
-  fill.min.y = 0.0f;
-  fill.min.z = -t->hz;
-  fill.max.x = -t->hx + t->column_width;
-  fill.max.y = t->column_height;
-  fill.max.z = t->hz;
-  EXT_OK(sph_world_fill_box(w->world, &fill, &added));
+  tank.centre.x = 0.0f;
+  tank.centre.y = t->hy;
+  tank.centre.z = 0.0f;
+  tank.half_extents.x = t->hx;
+  tank.half_extents.y = t->hy;
+  tank.half_extents.z = t->hz;
+  tank.voxel_size = 0.01f;
+  tank.friction = 0.0f;
+  column_min.x = -t->hx;
+  column_min.y = 0.0f;
+  column_min.z = -t->hz;
+  column_max.x = -t->hx + t->column_width;
+  column_max.y = t->column_height;
+  column_max.z = t->hz;
+  EXT_OK(
+      support_dam_break(w->context, w->world, &tank, column_min, column_max, &t->sdf, &t->collider, &added));
   assert_true(added > 0);
 }
 

@@ -1,6 +1,7 @@
 /* Helpers of the extremes tests (issue 6 item 3): a world on the test backend, a small dam
- * break in a closed tank, and the measurements that define a "stable state" (finite values,
- * particle count, speed and mechanical energy bounded by the drop, density band, containment). */
+ * break in a closed tank (both tests/support's), and the measurements that define a "stable
+ * state" (finite values, particle count, speed and mechanical energy bounded by the drop, density
+ * band, containment). */
 #ifndef SPH_EXTREMES_UTIL_H
 #define SPH_EXTREMES_UTIL_H
 
@@ -12,13 +13,8 @@
 #define EXT_OK(call) ext_ok((call), #call, __FILE__, __LINE__)
 void ext_ok(sph_result r, const char* call, const char* file, int line);
 
-typedef struct ext_world {
-  sph_context* context;
-  sph_world* world;
-  sph_world_params params;
-  float mass;
-  float kernel_radius;
-} ext_world;
+/* context, world, def (kernel radius filled in), params, mass: tests/support's world */
+typedef support_world ext_world;
 
 /* A context on the test backend and a world of `capacity` at `spacing` (default params). */
 void ext_open(ext_world* w, uint32_t capacity, float spacing);
@@ -47,7 +43,8 @@ typedef struct ext_measure {
 } ext_measure;
 
 /* The tank: an inverted box collider whose cavity is [-hx, hx] x [0, 2 hy] x [-hz, hz], and a
- * column of water in its -x end, [-hx, -hx + column_width] x [0, column_height] x [-hz, hz]. */
+ * column of water in its -x end, [-hx, -hx + column_width] x [0, column_height] x [-hz, hz]
+ * (support_dam_break). */
 typedef struct ext_tank {
   float hx, hy, hz;
   float column_width, column_height;

@@ -90,7 +90,7 @@ static void test_one_particle(void** state) {
   assert_true(x[1] <= 1.0 - 0.5 * EXT_G * t * t + 1e-6);
   assert_true(x[1] >= 1.0 - 0.5 * EXT_G * t * t - 0.5 * EXT_G * t * st.dt_max - 1e-6);
   {
-    const double h = w.kernel_radius;
+    const double h = w.def.kernel_radius;
     const double expected = w.mass * density_self_weight(0.02, h, 1000.0, w.mass);
     assert_true(fabs(rho - expected) <= 1e-5 * expected);
   }
@@ -202,7 +202,7 @@ static float* run_block(float spacing, float offset, int frames, uint32_t* out_n
   ext_close(&w);
   v = (float*)malloc(12 * (size_t)n);
   assert_non_null(v);
-  for (i = 0; i < 3 * n; ++i) v[i] = (float)(sph_test_random(&seed) - 0.5) * 0.01f * spacing;
+  for (i = 0; i < 3 * n; ++i) v[i] = (float)(support_random(&seed) - 0.5) * 0.01f * spacing;
   for (i = 0; i < n; ++i) x[3 * i] += offset;
   ext_open(&w, 512, spacing);
   w.params.gravity.y = 0.0f;

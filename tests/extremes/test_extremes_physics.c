@@ -125,7 +125,7 @@ static void test_viscosity_extreme_work_is_bounded(void** state) {
   sph_stats_init(&st);
   EXT_OK(sph_world_get_stats(w.world, &st));
   assert_int_equal(st.substeps, 100);
-  assert_true(st.dt_max <= 0.05f * w.kernel_radius * w.kernel_radius * 1000.0f / 1e9f * 1.0001f);
+  assert_true(st.dt_max <= 0.05f * w.def.kernel_radius * w.def.kernel_radius * 1000.0f / 1e9f * 1.0001f);
   assert_true(st.frame_time < 1.0f / 60.0f);
   ext_close(&w);
 }
@@ -144,7 +144,7 @@ static void test_dt_max_far_above_stable_limit(void** state) {
     uint32_t n;
     float ceiling;
     ext_open(&w, 1024, 0.02f);
-    ceiling = 0.4f * w.kernel_radius / 100.0f;
+    ceiling = 0.4f * w.def.kernel_radius / 100.0f;
     w.params.stiffness = 1e4f;
     w.params.dt_max = dts[c];
     ext_set_params(&w);
@@ -224,7 +224,7 @@ static void test_velocity_1e4_work_is_bounded(void** state) {
   EXT_OK(sph_world_get_stats(w.world, &st));
   assert_int_equal(st.substeps, 10000);
   assert_true(st.frame_time < 1.0f / 60.0f);
-  assert_true(fabsf(st.frame_time - 10000.0f * 0.4f * w.kernel_radius / 1e4f) <= 1e-3f * st.frame_time);
+  assert_true(fabsf(st.frame_time - 10000.0f * 0.4f * w.def.kernel_radius / 1e4f) <= 1e-3f * st.frame_time);
   ext_close(&w);
 }
 

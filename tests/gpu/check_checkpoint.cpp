@@ -24,29 +24,7 @@ std::vector<uint8_t> save(const sph_world* world) {
 
 // Every attribute in the world's storage order (sinks leave gaps in the ids, and the storage
 // order is part of what a checkpoint must reproduce).
-State raw_state(const sph_world* world) {
-  uint32_t n = 0;
-  require_ok(sph_world_get_particle_count(world, &n), "sph_world_get_particle_count");
-  State s;
-  s.count = n;
-  s.position.resize(3 * static_cast<size_t>(n));
-  s.velocity.resize(3 * static_cast<size_t>(n));
-  s.density.resize(n);
-  s.pressure.resize(n);
-  s.id.resize(n);
-  if (n == 0) return s;
-  const uint64_t v = 12ull * n, f = 4ull * n;
-  require_ok(sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, s.position.data(), v, 0, 0, n, nullptr),
-             "copy positions");
-  require_ok(sph_world_copy_attribute(world, SPH_ATTRIBUTE_VELOCITY, s.velocity.data(), v, 0, 0, n, nullptr),
-             "copy velocities");
-  require_ok(sph_world_copy_attribute(world, SPH_ATTRIBUTE_DENSITY, s.density.data(), f, 0, 0, n, nullptr),
-             "copy densities");
-  require_ok(sph_world_copy_attribute(world, SPH_ATTRIBUTE_PRESSURE, s.pressure.data(), f, 0, 0, n, nullptr),
-             "copy pressures");
-  require_ok(sph_world_copy_attribute(world, SPH_ATTRIBUTE_ID, s.id.data(), f, 0, 0, n, nullptr), "copy ids");
-  return s;
-}
+State raw_state(const sph_world* world) { return read_attributes(world, false); }
 
 // A tank-less scene piece: a sphere collider the drop falls onto, an outside-bounds sink and a
 // vortex, so the sink path (stream) and the scene upload run after the load too.

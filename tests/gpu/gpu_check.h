@@ -1,7 +1,7 @@
 // Shared helpers of the GPU check programs (run by scripts/gpu-test on a machine with an
 // NVIDIA GPU; never by ctest, so CI without a GPU does not see them). Each program prints one
 // "PASS <name>: <detail>" or "FAIL <name>: <detail>" line per check and exits non-zero if any
-// check failed, 77 if no CUDA device is present.
+// check failed, 77 if no CUDA device is present. The scenes come from tests/support (support.h).
 #pragma once
 
 #include <stdint.h>
@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "sph_c.h"
+#include "support.h"
 
 namespace gpu_check {
 
@@ -64,42 +65,27 @@ inline void exit_if_no_cuda() {
 }
 
 inline sph_context* make_context(sph_backend backend) {
-  sph_context_def def;
-  sph_context_def_init(&def);
-  def.backend = backend;
   sph_context* context = nullptr;
-  require_ok(sph_context_create(&def, &context), "sph_context_create");
+  require_ok(support_context_create(backend, &context), "sph_context_create");
   return context;
 }
 
-// A small deterministic generator (xorshift64*), so every run builds the same scene.
+// A small deterministic generator (support_random, xorshift64*), so every run builds the same
+// scene.
 struct Random {
   uint64_t state;
   explicit Random(uint64_t seed) : state(seed * 0x9E3779B97F4A7C15ull + 1) {}
-  double uniform() {  // [0, 1)
-    state ^= state >> 12;
-    state ^= state << 25;
-    state ^= state >> 27;
-    return static_cast<double>((state * 0x2545F4914F6CDD1Dull) >> 11) * (1.0 / 9007199254740992.0);
-  }
+  double uniform() { return support_random(&state); }  // [0, 1)
 };
 
-// FCC lattice points in a sphere (the lattice of sph_world_fill_sphere: a cubic grid of step
-// spacing/sqrt(2) with an even index sum).
+// FCC lattice points in a sphere (support_fcc_sphere: the lattice of sph_world_fill_sphere).
 inline std::vector<float> fcc_sphere(float cx, float cy, float cz, float radius, float spacing) {
-  std::vector<float> p;
-  const double step = spacing / std::sqrt(2.0);
-  const int n = static_cast<int>(std::floor(radius / step));
-  for (int k = -n; k <= n; ++k)
-    for (int j = -n; j <= n; ++j)
-      for (int i = -n; i <= n; ++i) {
-        if (((i + j + k) % 2 + 2) % 2 != 0) continue;
-        const double x = step * i, y = step * j, z = step * k;
-        if (x * x + y * y + z * z > static_cast<double>(radius) * radius) continue;
-        p.push_back(static_cast<float>(cx + x));
-        p.push_back(static_cast<float>(cy + y));
-        p.push_back(static_cast<float>(cz + z));
-      }
+  const double centre[3] = {cx, cy, cz};
+  float* points = nullptr;
+  uint32_t n = 0;
+  require_ok(support_fcc_sphere(centre, radius, spacing, &points, &n), "support_fcc_sphere");
+  std::vector<float> p(points, points + 3 * static_cast<size_t>(n));
+  std::free(points);
   return p;
 }
 
@@ -144,13 +130,10 @@ inline Loaded load_scene(sph_backend backend, const SceneSpec& s) {
   l.context = make_context(backend);
   const std::vector<float> pos = fcc_sphere(0.0f, 0.0f, 0.0f, s.radius, s.spacing);
   l.count = static_cast<uint32_t>(pos.size() / 3);
-  std::vector<float> vel(pos.size());
+  std::vector<float> vel(pos.size() + 3);
   Random random(12345);
-  for (size_t i = 0; i < vel.size(); i += 3) {
-    const float d[3] = {s.drift.x, s.drift.y, s.drift.z};
-    for (int a = 0; a < 3; ++a)
-      vel[i + a] = d[a] + static_cast<float>((2.0 * random.uniform() - 1.0) * s.random_speed);
-  }
+  const float drift[3] = {s.drift.x, s.drift.y, s.drift.z};
+  support_random_velocities(vel.data(), l.count, s.random_speed, drift, &random.state);
   sph_world_def def;
   sph_world_def_init(&def);
   def.capacity = l.count + s.spare_capacity;
@@ -176,12 +159,7 @@ inline Loaded load_scene(sph_backend backend, const SceneSpec& s) {
     springs.yield_ratio = s.spring_yield_ratio;
     require_ok(sph_world_set_spring_params(l.world, &springs), "sph_world_set_spring_params");
   }
-  sph_spawn_desc spawn;
-  sph_spawn_desc_init(&spawn);
-  spawn.count = l.count;
-  spawn.positions = pos.data();
-  spawn.velocities = vel.data();
-  require_ok(sph_world_spawn(l.world, &spawn, nullptr), "sph_world_spawn");
+  require_ok(support_spawn(l.world, pos.data(), vel.data(), l.count), "sph_world_spawn");
   return l;
 }
 
@@ -192,48 +170,29 @@ struct State {
   uint32_t count = 0;
 };
 
-inline State read_state(const sph_world* world) {
+// Every attribute of a world, in storage order (by_id false) or indexed by particle id
+// (support_read_by_id: the ids must be 0..n-1, as in load_scene's scenes without sinks).
+inline State read_attributes(const sph_world* world, bool by_id) {
+  State out;
   uint32_t n = 0;
   require_ok(sph_world_get_particle_count(world, &n), "sph_world_get_particle_count");
-  State raw;
-  raw.count = n;
-  raw.position.resize(3 * static_cast<size_t>(n));
-  raw.velocity.resize(3 * static_cast<size_t>(n));
-  raw.density.resize(n);
-  raw.pressure.resize(n);
-  raw.id.resize(n);
-  const uint64_t v = 12ull * n, s = 4ull * n;
-  require_ok(
-      sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, raw.position.data(), v, 0, 0, n, nullptr),
-      "copy positions");
-  require_ok(
-      sph_world_copy_attribute(world, SPH_ATTRIBUTE_VELOCITY, raw.velocity.data(), v, 0, 0, n, nullptr),
-      "copy velocities");
-  require_ok(sph_world_copy_attribute(world, SPH_ATTRIBUTE_DENSITY, raw.density.data(), s, 0, 0, n, nullptr),
-             "copy densities");
-  require_ok(
-      sph_world_copy_attribute(world, SPH_ATTRIBUTE_PRESSURE, raw.pressure.data(), s, 0, 0, n, nullptr),
-      "copy pressures");
-  require_ok(sph_world_copy_attribute(world, SPH_ATTRIBUTE_ID, raw.id.data(), s, 0, 0, n, nullptr),
-             "copy ids");
-  // Reorder by id (ids are 0..n-1 in these scenes).
-  State by_id = raw;
-  for (uint32_t i = 0; i < n; ++i) {
-    const uint32_t k = raw.id[i];
-    if (k >= n) {
-      std::printf("FAIL read_state: id %u out of range\n", k);
-      std::exit(1);
-    }
-    by_id.id[k] = k;
-    by_id.density[k] = raw.density[i];
-    by_id.pressure[k] = raw.pressure[i];
-    for (int a = 0; a < 3; ++a) {
-      by_id.position[3 * k + a] = raw.position[3 * i + a];
-      by_id.velocity[3 * k + a] = raw.velocity[3 * i + a];
-    }
-  }
-  return by_id;
+  out.count = n;
+  out.position.resize(3 * static_cast<size_t>(n));
+  out.velocity.resize(3 * static_cast<size_t>(n));
+  out.density.resize(n);
+  out.pressure.resize(n);
+  out.id.resize(n);
+  auto read = by_id ? support_read_by_id : support_read;
+  uint32_t count = 0;
+  require_ok(read(world, SPH_ATTRIBUTE_POSITION, out.position.data(), n, &count), "copy positions");
+  require_ok(read(world, SPH_ATTRIBUTE_VELOCITY, out.velocity.data(), n, &count), "copy velocities");
+  require_ok(read(world, SPH_ATTRIBUTE_DENSITY, out.density.data(), n, &count), "copy densities");
+  require_ok(read(world, SPH_ATTRIBUTE_PRESSURE, out.pressure.data(), n, &count), "copy pressures");
+  require_ok(read(world, SPH_ATTRIBUTE_ID, out.id.data(), n, &count), "copy ids");
+  return out;
 }
+
+inline State read_state(const sph_world* world) { return read_attributes(world, true); }
 
 template <class T>
 bool bitwise_equal(const std::vector<T>& a, const std::vector<T>& b) {

@@ -85,15 +85,10 @@ inline RawState read_raw(const sph_world* world) {
   s.position.resize(3 * size_t(n));
   s.velocity.resize(3 * size_t(n));
   s.id.resize(n);
-  if (n == 0) return s;
-  require_ok(
-      sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, s.position.data(), 12ull * n, 0, 0, n, nullptr),
-      "copy positions");
-  require_ok(
-      sph_world_copy_attribute(world, SPH_ATTRIBUTE_VELOCITY, s.velocity.data(), 12ull * n, 0, 0, n, nullptr),
-      "copy velocities");
-  require_ok(sph_world_copy_attribute(world, SPH_ATTRIBUTE_ID, s.id.data(), 4ull * n, 0, 0, n, nullptr),
-             "copy ids");
+  uint32_t count = 0;
+  require_ok(support_read(world, SPH_ATTRIBUTE_POSITION, s.position.data(), n, &count), "copy positions");
+  require_ok(support_read(world, SPH_ATTRIBUTE_VELOCITY, s.velocity.data(), n, &count), "copy velocities");
+  require_ok(support_read(world, SPH_ATTRIBUTE_ID, s.id.data(), n, &count), "copy ids");
   return s;
 }
 

@@ -6,7 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "physics_util.h"
+#include "capi_test.h"
 
 #define G 9.81
 
@@ -19,10 +19,8 @@ typedef struct {
 
 /* Starts at the origin with horizontal velocity 1 m/s and falls for 1 s at a fixed dt. */
 static fall run(sph_integrator integrator, float dt) {
-  sph_context* context = NULL;
-  sph_world* world = NULL;
+  support_world w;
   sph_world_def def;
-  sph_spawn_desc spawn;
   sph_stats stats;
   const float position[3] = {0.0f, 0.0f, 0.0f};
   const float velocity[3] = {1.0f, 0.0f, 0.0f};
@@ -31,19 +29,16 @@ static fall run(sph_integrator integrator, float dt) {
   sph_world_def_init(&def);
   def.capacity = 1;
   def.integrator = integrator;
-  physics_create(&def, &context, &world);
-  physics_set_params(world, 0.0f, (float)-G, 0.0f, dt, dt); /* dt_min = dt_max: a fixed step */
-  sph_spawn_desc_init(&spawn);
-  spawn.count = 1;
-  spawn.positions = position;
-  spawn.velocities = velocity;
-  EXPECT_OK(sph_world_spawn(world, &spawn, NULL));
-  EXPECT_OK(sph_world_step(world, 1.0f));
+  EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
+  /* dt_min = dt_max: a fixed step */
+  EXPECT_OK(support_set_gravity_and_steps(w.world, 0.0f, (float)-G, 0.0f, dt, dt));
+  EXPECT_OK(support_spawn(w.world, position, velocity, 1));
+  EXPECT_OK(sph_world_step(w.world, 1.0f));
   sph_stats_init(&stats);
-  EXPECT_OK(sph_world_get_stats(world, &stats));
-  EXPECT_OK(sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, x, sizeof x, 0, 0, 1, NULL));
-  EXPECT_OK(sph_world_copy_attribute(world, SPH_ATTRIBUTE_VELOCITY, v, sizeof v, 0, 0, 1, NULL));
-  physics_destroy(context, world);
+  EXPECT_OK(sph_world_get_stats(w.world, &stats));
+  EXPECT_OK(sph_world_copy_attribute(w.world, SPH_ATTRIBUTE_POSITION, x, sizeof x, 0, 0, 1, NULL));
+  EXPECT_OK(sph_world_copy_attribute(w.world, SPH_ATTRIBUTE_VELOCITY, v, sizeof v, 0, 0, 1, NULL));
+  EXPECT_OK(support_world_close(&w));
   out.t = stats.simulated_time;
   out.x = x[0];
   out.y = x[1];

@@ -5,12 +5,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "physics_util.h"
+#include "capi_test.h"
 
 static void momentum(const sph_world* world, double p[3], double* sum_abs) {
   float* v = NULL;
   float mass = 0.0f;
-  const uint32_t n = physics_copy_by_id(world, SPH_ATTRIBUTE_VELOCITY, (void**)&v);
+  uint32_t n = 0;
+  EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_VELOCITY, (void**)&v, &n));
   EXPECT_OK(sph_world_get_particle_mass(world, &mass));
   p[0] = p[1] = p[2] = 0.0;
   *sum_abs = 0.0;
@@ -27,35 +28,25 @@ static void momentum(const sph_world* world, double p[3], double* sum_abs) {
 /* A blob of ~740 particles (an FCC ball of radius 5 spacings) with a common drift plus random
  * velocities; no gravity; `frames` frames of 0.1 s at a fixed dt of 1 ms. */
 static void run(sph_integrator integrator, int frames) {
-  sph_context* context = NULL;
-  sph_world* world = NULL;
+  const float drift_velocity[3] = {0.3f, -0.2f, 0.1f};
+  support_world w;
   sph_world_def def;
-  sph_spawn_desc spawn;
+  sph_world_params params;
   sph_stats stats;
-  float* positions = NULL;
-  float* velocities;
   double p0[3], p1[3], abs0, abs1, drift;
-  uint32_t substeps = 0;
-  uint64_t rng = 0x9e3779b97f4a7c15ull;
-  const uint32_t n = physics_fcc_sphere(0.02f, 0.1f, &positions);
+  uint32_t substeps = 0, n = 0;
+  /* velocity components uniform in drift + [-0.5, 0.5] m/s */
+  support_sphere ball = {{0.0, 0.0, 0.0}, 0.1f, 0.0, 0.5, NULL, 0x9e3779b97f4a7c15ull, 0};
+  sph_world* world;
+  ball.drift = drift_velocity;
 
-  velocities = (float*)malloc(sizeof(float) * 3 * n);
-  assert_non_null(velocities);
-  for (uint32_t i = 0; i < 3 * n; ++i) {
-    const float drift_velocity[3] = {0.3f, -0.2f, 0.1f};
-    velocities[i] = drift_velocity[i % 3] + (float)(sph_test_random(&rng) - 0.5);
-  }
   sph_world_def_init(&def);
-  def.capacity = n;
+  def.capacity = 0; /* the ball's particles */
   def.integrator = integrator;
-  physics_create(&def, &context, &world);
   /* dt fixed at 1 ms: sqrt(k) dt = 0.01 m < 0.4 h, and the speeds stay ~1 m/s. */
-  physics_set_params(world, 0.0f, 0.0f, 0.0f, 1e-3f, 1e-3f);
-  sph_spawn_desc_init(&spawn);
-  spawn.count = n;
-  spawn.positions = positions;
-  spawn.velocities = velocities;
-  EXPECT_OK(sph_world_spawn(world, &spawn, NULL));
+  EXPECT_OK(support_params_gravity_and_steps(&params, 0.0f, 0.0f, 0.0f, 1e-3f, 1e-3f));
+  EXPECT_OK(support_rest_sphere_open(&w, sph_test_backend(), &def, &params, &ball, &n));
+  world = w.world;
   momentum(world, p0, &abs0);
   for (int f = 0; f < frames; ++f) {
     EXPECT_OK(sph_world_step(world, 0.1f));
@@ -85,9 +76,7 @@ static void run(sph_integrator integrator, int frames) {
      * a one-sided neighbour list), which breaks conservation by percents. */
     assert_true(drift < 1e-5 * p0_norm);
   }
-  physics_destroy(context, world);
-  free(positions);
-  free(velocities);
+  EXPECT_OK(support_world_close(&w));
 }
 
 static void test_momentum_symplectic_euler(void** state) {

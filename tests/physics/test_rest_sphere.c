@@ -16,7 +16,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "physics_util.h"
+#include "capi_test.h"
 
 #define FRAMES 100
 
@@ -25,12 +25,12 @@ static double disturbance = 1e-4; /* m/s, the largest velocity component at the 
 static void test_sphere_stays_at_rest(void** state) {
   const float spacing = 0.02f;
   const float radius = 6.0f * spacing; /* ~1,280 particles; ~80 of them interior */
-  sph_context* context = NULL;
-  sph_world* world = NULL;
+  support_world w;
   sph_world_def def;
+  sph_world_params params;
+  support_sphere ball = {{0.0, 0.0, 0.0}, 0.0, 0.0, 0.0, NULL, 12345, 0};
+  sph_world* world;
   float mass = 0.0f, h, rest;
-  float* lattice = NULL;
-  uint64_t rng = 12345;
   uint32_t n = 0;
   double ke0 = 0.0;
   double ke[FRAMES], worst_density_error = 0.0, max_first = 0.0, max_last = 0.0;
@@ -39,15 +39,15 @@ static void test_sphere_stays_at_rest(void** state) {
   sph_world_def_init(&def);
   def.particle_spacing = spacing;
   def.capacity = 4096;
-  physics_create(&def, &context, &world);
-  EXPECT_OK(sph_world_get_def(world, &def));
-  h = def.kernel_radius;
-  rest = def.rest_density;
-  physics_set_params(world, 0.0f, 0.0f, 0.0f, 1e-6f, 1e-3f);
-  n = physics_fcc_sphere(spacing, radius, &lattice);
-  ke0 = physics_spawn_disturbed(world, lattice, n, disturbance, &rng);
-  EXPECT_OK(sph_world_get_particle_mass(world, &mass));
-  free(lattice);
+  EXPECT_OK(support_params_gravity_and_steps(&params, 0.0f, 0.0f, 0.0f, 1e-6f, 1e-3f));
+  ball.radius = radius;
+  ball.speed = disturbance;
+  EXPECT_OK(support_rest_sphere_open(&w, sph_test_backend(), &def, &params, &ball, &n));
+  world = w.world;
+  h = w.def.kernel_radius;
+  rest = w.def.rest_density;
+  mass = w.mass;
+  EXPECT_OK(support_kinetic_energy(world, mass, &ke0));
 
   for (int f = 0; f < FRAMES; ++f) {
     float* x = NULL;
@@ -55,10 +55,12 @@ static void test_sphere_stays_at_rest(void** state) {
     float* rho = NULL;
     double c[3] = {0.0, 0.0, 0.0}, energy = 0.0, density_sum = 0.0;
     uint32_t interior = 0;
+    uint32_t count = 0;
     EXPECT_OK(sph_world_step(world, 1.0f / 25.0f));
-    assert_int_equal(physics_copy_by_id(world, SPH_ATTRIBUTE_POSITION, (void**)&x), n);
-    physics_copy_by_id(world, SPH_ATTRIBUTE_VELOCITY, (void**)&v);
-    physics_copy_by_id(world, SPH_ATTRIBUTE_DENSITY, (void**)&rho);
+    EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_POSITION, (void**)&x, &count));
+    assert_int_equal(count, n);
+    EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_VELOCITY, (void**)&v, &count));
+    EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_DENSITY, (void**)&rho, &count));
     for (uint32_t i = 0; i < n; ++i) {
       for (int k = 0; k < 3; ++k) c[k] += x[3 * i + k] / (double)n;
       energy += 0.5 * mass *
@@ -110,7 +112,7 @@ static void test_sphere_stays_at_rest(void** state) {
     assert_true(ke[FRAMES - 1] < ke0);
     assert_true(final_speed < initial_speed);
   }
-  physics_destroy(context, world);
+  EXPECT_OK(support_world_close(&w));
 }
 
 int main(int argc, char** argv) {

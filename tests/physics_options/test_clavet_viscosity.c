@@ -16,31 +16,29 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "physics_util.h"
+#include "capi_test.h"
 
 static const float kSpacing = 0.02f;
 static const float kDt = 1e-3f;
 
-static void open_clavet_world(float linear, float quadratic, uint32_t capacity, sph_context** context,
-                              sph_world** world, sph_world_def* def) {
+static void open_clavet_world(float linear, float quadratic, uint32_t capacity, support_world* w) {
+  sph_world_def def;
   sph_world_params p;
   sph_clavet_viscosity_params cp;
-  sph_world_def_init(def);
-  def->particle_spacing = kSpacing;
-  def->capacity = capacity;
-  def->viscosity_method = SPH_VISCOSITY_CLAVET;
-  physics_create(def, context, world);
-  EXPECT_OK(sph_world_get_def(*world, def));
+  sph_world_def_init(&def);
+  def.particle_spacing = kSpacing;
+  def.capacity = capacity;
+  def.viscosity_method = SPH_VISCOSITY_CLAVET;
   sph_world_params_init(&p);
   p.gravity.y = 0.0f;
   p.stiffness = 1e-6f;
   p.dt_min = kDt; /* fixed substeps: one sph_world_step of kDt is one substep */
   p.dt_max = kDt;
-  EXPECT_OK(sph_world_set_params(*world, &p));
+  EXPECT_OK(support_world_open(w, sph_test_backend(), &def, &p));
   sph_clavet_viscosity_params_init(&cp);
   cp.linear = linear;
   cp.quadratic = quadratic;
-  EXPECT_OK(sph_world_set_clavet_viscosity_params(*world, &cp));
+  EXPECT_OK(sph_world_set_clavet_viscosity_params(w->world, &cp));
 }
 
 /* Two particles on the x axis, r = 0.5 h apart, closing at u = 1 m/s. After one substep the
@@ -52,25 +50,20 @@ static void test_pair_impulse_and_no_reversal(void** state) {
   } cases[] = {{10.0f, 0.0f}, {0.0f, 20.0f}, {100.0f, 100.0f}, {1e4f, 0.0f}, {0.0f, 1e4f}, {1e6f, 1e6f}};
   (void)state;
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
-    sph_context* context = NULL;
-    sph_world* world = NULL;
-    sph_world_def def;
-    sph_spawn_desc spawn;
+    support_world w;
     float x[6] = {0}, v[6] = {0}, *vout = NULL;
     const float u = 1.0f;
     double expected_impulse, closing;
-    open_clavet_world(cases[c].linear, cases[c].quadratic, 16, &context, &world, &def);
-    x[0] = -0.25f * def.kernel_radius;
-    x[3] = 0.25f * def.kernel_radius;
+    uint32_t count = 0;
+    open_clavet_world(cases[c].linear, cases[c].quadratic, 16, &w);
+    x[0] = -0.25f * w.def.kernel_radius;
+    x[3] = 0.25f * w.def.kernel_radius;
     v[0] = 0.5f * u;
     v[3] = -0.5f * u;
-    sph_spawn_desc_init(&spawn);
-    spawn.count = 2;
-    spawn.positions = x;
-    spawn.velocities = v;
-    EXPECT_OK(sph_world_spawn(world, &spawn, NULL));
-    EXPECT_OK(sph_world_step(world, kDt));
-    assert_int_equal(physics_copy_by_id(world, SPH_ATTRIBUTE_VELOCITY, (void**)&vout), 2);
+    EXPECT_OK(support_spawn(w.world, x, v, 2));
+    EXPECT_OK(sph_world_step(w.world, kDt));
+    EXPECT_OK(support_copy_by_id(w.world, SPH_ATTRIBUTE_VELOCITY, (void**)&vout, &count));
+    assert_int_equal(count, 2);
     closing = (double)vout[0] - vout[3];
     expected_impulse = kDt * 0.5 * (cases[c].linear * u + cases[c].quadratic * u * u);
     if (expected_impulse > u) expected_impulse = u;
@@ -81,7 +74,7 @@ static void test_pair_impulse_and_no_reversal(void** state) {
     assert_true(fabs((double)vout[0] + vout[3]) <= 1e-6); /* momentum (equal masses) */
     assert_true(vout[1] == 0.0f && vout[2] == 0.0f && vout[4] == 0.0f && vout[5] == 0.0f);
     free(vout);
-    physics_destroy(context, world);
+    EXPECT_OK(support_world_close(&w));
   }
 }
 
@@ -93,9 +86,10 @@ typedef struct motion {
 
 static motion measure(const sph_world* world, float mass) {
   float* v = NULL;
-  const uint32_t n = physics_copy_by_id(world, SPH_ATTRIBUTE_VELOCITY, (void**)&v);
+  uint32_t n = 0;
   motion m = {{0.0, 0.0, 0.0}, 0.0, 0.0};
   double vcm[3];
+  EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_VELOCITY, (void**)&v, &n));
   for (uint32_t i = 0; i < n; ++i) {
     for (int k = 0; k < 3; ++k) m.momentum[k] += mass * (double)v[3 * i + k];
     m.speed_sum += mass * sqrt((double)v[3 * i] * v[3 * i] + (double)v[3 * i + 1] * v[3 * i + 1] +
@@ -116,31 +110,30 @@ static motion measure(const sph_world* world, float mass) {
  * not change by more than 1e-5 of sum m |v| (float sums over a thousand particles), and the
  * energy must fall (by at least 10 %) so the test cannot pass on impulses that never act. */
 static void run_cloud(int scenario, float linear, float quadratic) {
-  sph_context* context = NULL;
-  sph_world* world = NULL;
-  sph_world_def def;
-  sph_spawn_desc spawn;
+  static const float drift[3] = {0.3f, 0.0f, 0.0f};
+  support_world w;
+  sph_world* world;
   float mass = 0.0f;
   float *a = NULL, *b = NULL, *x, *v;
-  uint32_t na, nb = 0, n;
+  uint32_t na = 0, nb = 0, n;
   uint64_t rng = 7;
   motion m0, prev, m;
   int step;
-  open_clavet_world(linear, quadratic, 4096, &context, &world, &def);
+  open_clavet_world(linear, quadratic, 4096, &w);
+  world = w.world;
   EXPECT_OK(sph_world_get_particle_mass(world, &mass));
-  na = physics_fcc_sphere(kSpacing, (scenario == 0 ? 6.0f : 4.0f) * kSpacing, &a);
-  if (scenario == 1) nb = physics_fcc_sphere(kSpacing, 4.0f * kSpacing, &b);
+  EXPECT_OK(support_fcc_sphere(NULL, (scenario == 0 ? 6.0f : 4.0f) * kSpacing, kSpacing, &a, &na));
+  if (scenario == 1) EXPECT_OK(support_fcc_sphere(NULL, 4.0f * kSpacing, kSpacing, &b, &nb));
   n = na + nb;
   x = (float*)malloc(12 * (size_t)n);
   v = (float*)malloc(12 * (size_t)n);
   assert_true(x && v);
+  /* the cloud: velocities in [-0.5, 0.5] m/s plus the drift; the streams: 1 m/s along x */
+  if (scenario == 0) support_random_velocities(v, na, 0.5, drift, &rng);
   for (uint32_t i = 0; i < na; ++i)
     for (int k = 0; k < 3; ++k) {
       x[3 * i + k] = a[3 * i + k];
-      if (scenario == 0)
-        v[3 * i + k] = (float)(sph_test_random(&rng) - 0.5) + (k == 0 ? 0.3f : 0.0f);
-      else
-        v[3 * i + k] = k == 0 ? 1.0f : 0.0f;
+      if (scenario == 1) v[3 * i + k] = k == 0 ? 1.0f : 0.0f;
     }
   for (uint32_t i = 0; i < nb; ++i)
     for (int k = 0; k < 3; ++k) {
@@ -148,11 +141,7 @@ static void run_cloud(int scenario, float linear, float quadratic) {
       x[3 * (na + i) + k] = b[3 * i + k] + (k == 0 ? 9.5f * kSpacing : 0.0f);
       v[3 * (na + i) + k] = k == 0 ? -1.0f : 0.0f;
     }
-  sph_spawn_desc_init(&spawn);
-  spawn.count = n;
-  spawn.positions = x;
-  spawn.velocities = v;
-  EXPECT_OK(sph_world_spawn(world, &spawn, NULL));
+  EXPECT_OK(support_spawn(world, x, v, n));
   m0 = prev = measure(world, mass);
   for (step = 0; step < 60; ++step) {
     EXPECT_OK(sph_world_step(world, kDt));
@@ -171,7 +160,7 @@ static void run_cloud(int scenario, float linear, float quadratic) {
   free(b);
   free(x);
   free(v);
-  physics_destroy(context, world);
+  EXPECT_OK(support_world_close(&w));
 }
 
 static void test_relative_energy_never_rises(void** state) {

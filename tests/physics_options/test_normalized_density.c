@@ -17,8 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "physics_util.h"
-#include "validation_util.h"
+#include "capi_test.h"
 
 static const float kSpacing = 0.02f;
 
@@ -33,11 +32,13 @@ typedef struct layers {
 
 static layers measure(const sph_world* world, const double centre[3], double radius, double h) {
   float *x = NULL, *rho = NULL;
-  const uint32_t n = physics_copy_by_id(world, SPH_ATTRIBUTE_POSITION, (void**)&x);
+  uint32_t n = 0;
   layers l = {0.0, 0.0, 0.0, 0, 0};
-  double* r = (double*)malloc(sizeof(double) * (n ? n : 1));
+  double* r;
+  EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_POSITION, (void**)&x, &n));
+  r = (double*)malloc(sizeof(double) * (n ? n : 1));
   assert_non_null(r);
-  physics_copy_by_id(world, SPH_ATTRIBUTE_DENSITY, (void**)&rho);
+  EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_DENSITY, (void**)&rho, &n));
   for (uint32_t i = 0; i < n; ++i) {
     const double dx = x[3 * i] - centre[0], dy = x[3 * i + 1] - centre[1], dz = x[3 * i + 2] - centre[2];
     r[i] = sqrt(dx * dx + dy * dy + dz * dz);
@@ -61,6 +62,13 @@ static layers measure(const sph_world* world, const double centre[3], double rad
   return l;
 }
 
+/* Gravity (0, gravity_y, 0), steps in [1 us, dt_max], the other parameters at their defaults. */
+static sph_world_params resting_params(float gravity_y, float dt_max) {
+  sph_world_params p;
+  EXPECT_OK(support_params_gravity_and_steps(&p, 0.0f, gravity_y, 0.0f, 1e-6f, dt_max));
+  return p;
+}
+
 static sph_world_def make_def(int normalized, uint32_t capacity) {
   sph_world_def def;
   sph_world_def_init(&def);
@@ -79,20 +87,18 @@ static void test_resting_sphere_surface_within_5_percent(void** state) {
   const double centre[3] = {0.0, 0.0, 0.0};
   (void)state;
   for (int normalized = 0; normalized < 2; ++normalized) {
-    sph_context* context = NULL;
-    sph_world* world = NULL;
-    sph_world_def def = make_def(normalized, 4096);
-    float* lattice = NULL;
-    uint64_t rng = 12345;
+    const sph_world_def resting = make_def(normalized, 4096);
+    const sph_world_params params = resting_params(0.0f, 1e-3f);
+    support_world w;
+    sph_world* world;
+    sph_world_def def;
     const float radius = 5.0f * kSpacing;
-    uint32_t n;
+    support_sphere ball = {{0.0, 0.0, 0.0}, 0.0, 0.0, 1e-4, NULL, 12345, 0};
     layers l;
-    physics_create(&def, &context, &world);
-    EXPECT_OK(sph_world_get_def(world, &def));
-    physics_set_params(world, 0.0f, 0.0f, 0.0f, 1e-6f, 1e-3f);
-    n = physics_fcc_sphere(kSpacing, radius, &lattice);
-    physics_spawn_disturbed(world, lattice, n, 1e-4, &rng);
-    free(lattice);
+    ball.radius = radius;
+    EXPECT_OK(support_rest_sphere_open(&w, sph_test_backend(), &resting, &params, &ball, NULL));
+    world = w.world;
+    def = w.def;
     for (int frame = 0; frame < 10; ++frame) EXPECT_OK(sph_world_step(world, 0.04f));
     l = measure(world, centre, radius, def.kernel_radius);
     print_message(
@@ -106,7 +112,7 @@ static void test_resting_sphere_surface_within_5_percent(void** state) {
     } else {
       assert_true(l.surface_worst > 0.4);
     }
-    physics_destroy(context, world);
+    EXPECT_OK(support_world_close(&w));
   }
 }
 
@@ -128,33 +134,29 @@ static void test_compression_is_visible(void** state) {
   (void)state;
   for (int rate = 0; rate < 2; ++rate)
     for (int normalized = 0; normalized < 2; ++normalized) {
-      sph_context* context = NULL;
-      sph_world* world = NULL;
-      sph_world_def def = make_def(normalized, 4096);
+      const sph_world_def converging = make_def(normalized, 4096);
+      support_world w;
+      sph_world* world;
+      sph_world_def def;
       sph_world_params p;
-      sph_spawn_desc spawn;
       float *lattice = NULL, *v;
       const float alpha = rates[rate];
-      uint32_t n;
+      uint32_t n = 0;
       layers l;
       double expected;
-      physics_create(&def, &context, &world);
-      EXPECT_OK(sph_world_get_def(world, &def));
       sph_world_params_init(&p);
       p.gravity.y = 0.0f;
       p.stiffness = 1e-6f;
       p.viscosity = 0.0f;
       p.dt_max = 1e-3f;
-      EXPECT_OK(sph_world_set_params(world, &p));
-      n = physics_fcc_sphere(kSpacing, radius, &lattice);
+      EXPECT_OK(support_world_open(&w, sph_test_backend(), &converging, &p));
+      world = w.world;
+      def = w.def;
+      EXPECT_OK(support_fcc_sphere(NULL, radius, kSpacing, &lattice, &n));
       v = (float*)malloc(12 * (size_t)n);
       assert_non_null(v);
       for (uint32_t i = 0; i < 3 * n; ++i) v[i] = -alpha * lattice[i];
-      sph_spawn_desc_init(&spawn);
-      spawn.count = n;
-      spawn.positions = lattice;
-      spawn.velocities = v;
-      EXPECT_OK(sph_world_spawn(world, &spawn, NULL));
+      EXPECT_OK(support_spawn(world, lattice, v, n));
       EXPECT_OK(sph_world_step(world, duration));
       l = measure(world, centre, radius * (1.0f - alpha * duration), def.kernel_radius);
       expected = def.rest_density / pow(1.0 - alpha * duration, 3.0);
@@ -174,25 +176,25 @@ static void test_compression_is_visible(void** state) {
       }
       free(lattice);
       free(v);
-      physics_destroy(context, world);
+      EXPECT_OK(support_world_close(&w));
     }
 
   /* Spawned compressed (the lattice at 0.9 s): a fresh particle starts from its summation
    * density where that is above rho0, so the bulk reads compressed from the first step. */
   for (int normalized = 0; normalized < 2; ++normalized) {
-    sph_context* context = NULL;
-    sph_world* world = NULL;
-    sph_world_def def = make_def(normalized, 4096);
-    float* lattice = NULL;
-    uint64_t rng = 1;
-    uint32_t n;
+    const sph_world_def compressed = make_def(normalized, 4096);
+    const sph_world_params params = resting_params(0.0f, 1e-5f);
+    support_world w;
+    sph_world* world;
+    sph_world_def def;
+    /* the lattice at 0.9 of the world's spacing, at rest (speed 0) */
+    support_sphere ball = {{0.0, 0.0, 0.0}, 0.0, 0.0, 0.0, NULL, 1, 0};
     layers l;
-    physics_create(&def, &context, &world);
-    EXPECT_OK(sph_world_get_def(world, &def));
-    physics_set_params(world, 0.0f, 0.0f, 0.0f, 1e-6f, 1e-5f);
-    n = physics_fcc_sphere(0.9f * kSpacing, 0.9f * radius, &lattice);
-    physics_spawn_disturbed(world, lattice, n, 0.0, &rng);
-    free(lattice);
+    ball.radius = 0.9f * radius;
+    ball.spacing = 0.9f * kSpacing;
+    EXPECT_OK(support_rest_sphere_open(&w, sph_test_backend(), &compressed, &params, &ball, NULL));
+    world = w.world;
+    def = w.def;
     EXPECT_OK(sph_world_step(world, 1e-5f));
     l = measure(world, centre, 0.9 * radius, def.kernel_radius);
     print_message("spawned compressed, normalised density %s: interior %.1f\n", normalized ? "on " : "off",
@@ -202,7 +204,7 @@ static void test_compression_is_visible(void** state) {
     else
       assert_true(fabs(l.interior_mean / plain_interior - 1.0) <= 0.005);
     assert_true(l.interior_mean > 1.3 * def.rest_density);
-    physics_destroy(context, world);
+    EXPECT_OK(support_world_close(&w));
   }
 }
 
@@ -248,22 +250,21 @@ static void lower_cap(const sph_world* world, uint32_t capacity, float radius, f
 
 static void test_factors_follow_particles_through_sinks(void** state) {
   const float radius = 5.0f * kSpacing;
-  sph_context* context = NULL;
-  sph_world* world = NULL;
-  sph_world_def def = make_def(1, 4096);
+  const sph_world_def normalized = make_def(1, 4096);
+  const sph_world_params params = resting_params(0.0f, 1e-3f);
+  support_world w;
+  sph_world* world;
+  sph_world_def def;
+  support_sphere ball = {{0.0, 0.0, 0.0}, 0.0, 0.0, 1e-4, NULL, 5, 0};
   sph_sink_def sink;
   sph_sink_id sink_id;
-  float* lattice = NULL;
-  uint64_t rng = 5;
-  uint32_t n, kept;
+  uint32_t n = 0, kept;
   double interior_mean, worst;
   (void)state;
-  physics_create(&def, &context, &world);
-  EXPECT_OK(sph_world_get_def(world, &def));
-  physics_set_params(world, 0.0f, 0.0f, 0.0f, 1e-6f, 1e-3f);
-  n = physics_fcc_sphere(kSpacing, radius, &lattice);
-  physics_spawn_disturbed(world, lattice, n, 1e-4, &rng);
-  free(lattice);
+  ball.radius = radius;
+  EXPECT_OK(support_rest_sphere_open(&w, sph_test_backend(), &normalized, &params, &ball, &n));
+  world = w.world;
+  def = w.def;
   sph_sink_def_init(&sink);
   sink.mode = SPH_SINK_OUTSIDE_BOUNDS;
   sink.bounds_min.x = sink.bounds_min.y = sink.bounds_min.z = -1.0f;
@@ -285,7 +286,7 @@ static void test_factors_follow_particles_through_sinks(void** state) {
   print_message(
       "  0.2 s later: within %.2f %% of the interior, which the cut's deficit has lowered to %.1f\n",
       100.0 * worst, interior_mean);
-  physics_destroy(context, world);
+  EXPECT_OK(support_world_close(&w));
 }
 
 /* FNV-1a 64 and the header reseal of docs/checkpoint.md (as tests/reliability does), to forge
@@ -336,23 +337,26 @@ static size_t part_section(const uint8_t* data, size_t size) {
 static void test_factors_in_checkpoints(void** state) {
   const double centre[3] = {0.0, 0.0, 0.0};
   const float radius = 5.0f * kSpacing;
-  sph_context* context = NULL;
-  sph_world *world = NULL, *loaded = NULL;
-  sph_world_def def = make_def(1, 4096);
-  float *lattice = NULL, *a = NULL, *b = NULL;
-  uint64_t rng = 9, size = 0;
+  const sph_world_def normalized = make_def(1, 4096);
+  const sph_world_params params = resting_params(-9.81f, 1e-3f);
+  support_world w;
+  sph_context* context;
+  sph_world *world, *loaded = NULL;
+  sph_world_def def;
+  support_sphere ball = {{0.0, 0.0, 0.0}, 0.0, 0.0, 0.05, NULL, 9, 0};
+  float *a = NULL, *b = NULL;
+  uint64_t size = 0;
   uint8_t *data, *forged;
-  uint32_t n;
+  uint32_t n = 0, count = 0;
   size_t part, body, cut;
   layers l;
   float minus_one = -1.0f;
   (void)state;
-  physics_create(&def, &context, &world);
-  EXPECT_OK(sph_world_get_def(world, &def));
-  physics_set_params(world, 0.0f, -9.81f, 0.0f, 1e-6f, 1e-3f);
-  n = physics_fcc_sphere(kSpacing, radius, &lattice);
-  physics_spawn_disturbed(world, lattice, n, 0.05, &rng);
-  free(lattice);
+  ball.radius = radius;
+  EXPECT_OK(support_rest_sphere_open(&w, sph_test_backend(), &normalized, &params, &ball, &n));
+  context = w.context;
+  world = w.world;
+  def = w.def;
   EXPECT_OK(sph_world_step(world, 0.02f));
   EXPECT_OK(sph_world_save(world, NULL, 0, &size)); /* the size it needs */
   data = (uint8_t*)malloc(size);
@@ -362,8 +366,10 @@ static void test_factors_in_checkpoints(void** state) {
   EXPECT_OK(sph_world_load(context, data, size, &loaded));
   EXPECT_OK(sph_world_step(world, 0.02f));
   EXPECT_OK(sph_world_step(loaded, 0.02f));
-  assert_int_equal(physics_copy_by_id(world, SPH_ATTRIBUTE_DENSITY, (void**)&a), n);
-  assert_int_equal(physics_copy_by_id(loaded, SPH_ATTRIBUTE_DENSITY, (void**)&b), n);
+  EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_DENSITY, (void**)&a, &count));
+  assert_int_equal(count, n);
+  EXPECT_OK(support_copy_by_id(loaded, SPH_ATTRIBUTE_DENSITY, (void**)&b, &count));
+  assert_int_equal(count, n);
   assert_memory_equal(a, b, 4 * (size_t)n);
   EXPECT_OK(sph_world_destroy(loaded));
 
@@ -376,7 +382,7 @@ static void test_factors_in_checkpoints(void** state) {
   put_u64(forged + part + 8, body - 4 * (uint64_t)n);
   reseal(forged, (size_t)size - 4 * (size_t)n);
   EXPECT_OK(sph_world_load(context, forged, size - 4 * (uint64_t)n, &loaded));
-  physics_set_params(loaded, 0.0f, 0.0f, 0.0f, 1e-6f, 1e-5f);
+  EXPECT_OK(support_set_gravity_and_steps(loaded, 0.0f, 0.0f, 0.0f, 1e-6f, 1e-5f));
   EXPECT_OK(sph_world_step(loaded, 1e-5f));
   l = measure(loaded, centre, radius, def.kernel_radius);
   print_message("checkpoint without factors: loads; surface within %.2f %% of the interior after a step\n",
@@ -393,7 +399,7 @@ static void test_factors_in_checkpoints(void** state) {
   free(b);
   free(data);
   free(forged);
-  physics_destroy(context, world);
+  EXPECT_OK(support_world_close(&w));
 }
 
 /* A ball of radius 5 s (s = 1 cm, 515 particles) dropped from 10 cm onto the floor of a closed
@@ -409,35 +415,38 @@ static void test_drop_into_tank_is_stable(void** state) {
   const float spacing = 0.01f, radius = 0.05f, drop = 0.1f, g = 9.81f;
   (void)state;
   for (int normalized = 0; normalized < 2; ++normalized) {
-    sph_context* context = NULL;
-    sph_world* world = NULL;
+    support_world w;
+    sph_world* world;
     sph_world_def def;
     sph_sdf* sdf = NULL;
     sph_stats st;
     float *lattice = NULL, mass = 0.0f, *x = NULL;
     uint64_t rng = 3;
-    uint32_t n;
+    uint32_t n = 0, count = 0;
     double e0 = 0.0, e_max = 0.0, rho_max = 0.0;
     sph_world_def_init(&def);
     def.particle_spacing = spacing;
     def.capacity = 2048;
     def.features = normalized ? SPH_FEATURE_NORMALIZED_DENSITY : SPH_FEATURE_NONE;
-    physics_create(&def, &context, &world);
-    EXPECT_OK(sph_world_get_def(world, &def));
-    physics_set_params(world, 0.0f, -g, 0.0f, 1e-6f, 1e-3f);
-    validation_tank(context, world, tank_min, tank_max, 0.005, 0.0f, &sdf);
-    n = physics_fcc_sphere(spacing, radius, &lattice);
+    EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
+    world = w.world;
+    def = w.def;
+    EXPECT_OK(support_set_gravity_and_steps(world, 0.0f, -g, 0.0f, 1e-6f, 1e-3f));
+    EXPECT_OK(support_tank_between(w.context, world, tank_min, tank_max, 0.005, 0.0f, &sdf, NULL));
+    EXPECT_OK(support_fcc_sphere(NULL, radius, spacing, &lattice, &n));
     for (uint32_t i = 0; i < n; ++i) {
       lattice[3 * i] += 0.15f;
       lattice[3 * i + 1] += radius + drop;
       lattice[3 * i + 2] += 0.15f;
     }
-    physics_spawn_disturbed(world, lattice, n, 0.0, &rng);
+    EXPECT_OK(support_spawn_disturbed(world, lattice, n, 0.0, &rng, NULL));
     free(lattice);
     EXPECT_OK(sph_world_get_particle_mass(world, &mass));
     for (int frame = 0; frame <= 40; ++frame) {
-      double e = validation_kinetic_energy(world, mass);
-      assert_int_equal(physics_copy_by_id(world, SPH_ATTRIBUTE_POSITION, (void**)&x), n);
+      double e = 0.0;
+      EXPECT_OK(support_kinetic_energy(world, mass, &e));
+      EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_POSITION, (void**)&x, &count));
+      assert_int_equal(count, n);
       for (uint32_t i = 0; i < n; ++i) {
         e += mass * g * x[3 * i + 1];
         for (int k = 0; k < 3; ++k) {
@@ -463,7 +472,7 @@ static void test_drop_into_tank_is_stable(void** state) {
     /* The impact compresses by about v / c (acoustic impedance: 1.4 / 10 m/s); twice that. */
     assert_true(rho_max <= def.rest_density * (1.0 + 2.0 * sqrt(2.0 * g * drop) / 10.0));
     EXPECT_OK(sph_sdf_destroy(sdf));
-    physics_destroy(context, world);
+    EXPECT_OK(support_world_close(&w));
   }
 }
 

@@ -11,13 +11,11 @@
 #include "scene_test.h"
 
 static void open_world(scene* s, sph_world_def* def, float gravity_y, float dt_max) {
-  memset(s, 0, sizeof *s);
-  SCENE_OK(sph_test_context_create(&s->context));
-  SCENE_OK(sph_world_create(s->context, def, &s->world));
-  sph_world_params_init(&s->params);
-  s->params.gravity.y = gravity_y;
-  s->params.dt_max = dt_max;
-  scene_set_params(s);
+  sph_world_params params;
+  sph_world_params_init(&params);
+  params.gravity.y = gravity_y;
+  params.dt_max = dt_max;
+  SCENE_OK(support_world_open(s, sph_test_backend(), def, &params));
 }
 
 static double kinetic_energy(scene* s, float* v, uint32_t n, float mass) {
@@ -38,10 +36,8 @@ static void test_clavet_damps_and_never_adds_energy(void** state) {
   for (method = 0; method < 2; ++method) {
     scene s;
     sph_world_def def;
-    sph_fill_sphere_desc ball;
-    sph_spawn_desc spawn;
-    uint32_t n, i;
-    float *x, *v;
+    uint32_t n = 0;
+    float *x = NULL, *v;
     uint64_t seed = 42;
     double previous = 0.0, e = 0.0;
     int frame;
@@ -59,29 +55,12 @@ static void test_clavet_damps_and_never_adds_energy(void** state) {
       cp.quadratic = 5.0f;
       SCENE_OK(sph_world_set_clavet_viscosity_params(s.world, &cp));
     }
-    sph_fill_sphere_desc_init(&ball);
-    ball.radius = 0.1f;
-    SCENE_OK(sph_world_fill_sphere(s.world, &ball, &n));
-    x = malloc(12 * (size_t)n);
+    /* The ball sph_world_fill_sphere makes (radius 10 cm), velocities in [-0.5, 0.5] m/s. */
+    SCENE_OK(support_fcc_sphere(NULL, 0.1f, s.def.particle_spacing, &x, &n));
     v = malloc(12 * (size_t)n);
-    assert_true(x && v);
-    scene_positions(&s, x, n);
-    for (i = 0; i < 3 * n; ++i) v[i] = (float)(sph_test_random(&seed) - 0.5);
-    SCENE_OK(sph_world_destroy(s.world));
-    SCENE_OK(sph_world_create(s.context, &def, &s.world));
-    scene_set_params(&s);
-    if (method == 1) {
-      sph_clavet_viscosity_params cp;
-      sph_clavet_viscosity_params_init(&cp);
-      cp.linear = 20.0f;
-      cp.quadratic = 5.0f;
-      SCENE_OK(sph_world_set_clavet_viscosity_params(s.world, &cp));
-    }
-    sph_spawn_desc_init(&spawn);
-    spawn.count = n;
-    spawn.positions = x;
-    spawn.velocities = v;
-    SCENE_OK(sph_world_spawn(s.world, &spawn, NULL));
+    assert_non_null(v);
+    support_random_velocities(v, n, 0.5, NULL, &seed);
+    SCENE_OK(support_spawn(s.world, x, v, n));
     previous = kinetic_energy(&s, v, n, mass_dummy);
     for (frame = 0; frame < 20; ++frame) {
       SCENE_OK(sph_world_step(s.world, 0.01f));

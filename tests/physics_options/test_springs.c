@@ -16,15 +16,13 @@ static const float kRadius = 0.08f;
 
 static void open_springs_world(scene* s, uint32_t features, uint32_t capacity) {
   sph_world_def def;
-  memset(s, 0, sizeof *s);
-  SCENE_OK(sph_test_context_create(&s->context));
+  sph_world_params params;
   sph_world_def_init(&def);
   def.capacity = capacity;
   def.particle_spacing = kSpacing;
   def.features = features;
-  SCENE_OK(sph_world_create(s->context, &def, &s->world));
-  sph_world_params_init(&s->params);
-  scene_set_params(s);
+  sph_world_params_init(&params);
+  SCENE_OK(support_world_open(s, sph_test_backend(), &def, &params));
 }
 
 static void set_springs(scene* s, float stiffness, float damping, float plasticity, float yield_ratio) {
@@ -39,18 +37,9 @@ static void set_springs(scene* s, float stiffness, float damping, float plastici
 
 /* Positions indexed by particle id (ids are 0..n-1 here). */
 static void positions_by_id(scene* s, float* out, uint32_t n) {
-  float* x = malloc(12 * (size_t)n);
-  uint32_t* ids = malloc(4 * (size_t)n);
-  uint32_t i;
-  assert_true(x && ids);
-  assert_int_equal(scene_positions(s, x, n), n);
-  assert_int_equal(scene_ids(s, ids, n), n);
-  for (i = 0; i < n; ++i) {
-    assert_true(ids[i] < n);
-    memcpy(out + 3 * (size_t)ids[i], x + 3 * (size_t)i, 12);
-  }
-  free(x);
-  free(ids);
+  uint32_t count = 0;
+  SCENE_OK(support_read_by_id(s->world, SPH_ATTRIBUTE_POSITION, out, n, &count));
+  assert_int_equal(count, n);
 }
 
 /* Height over width of a particle cloud: the rms y offset from the centre of mass over the
@@ -198,10 +187,9 @@ static void test_plastic_blob_keeps_its_dent(void** state) {
  * kinetic energy falls by more than 10 % over the run (damping and plastic flow). */
 static void test_spring_momentum_conserved(void** state) {
   scene s;
-  sph_fill_sphere_desc ball;
   uint32_t n = 0, i;
   uint64_t rng = 12345;
-  float *x, *v;
+  float *x = NULL, *v;
   double p0[3] = {0, 0, 0}, p1[3] = {0, 0, 0}, speed_sum = 0.0, e0 = 0.0, e1 = 0.0;
   int k;
   (void)state;
@@ -209,28 +197,12 @@ static void test_spring_momentum_conserved(void** state) {
   s.params.gravity.y = 0.0f;
   scene_set_params(&s);
   set_springs(&s, 1e6f, 100.0f, 20.0f, 0.05f);
-  sph_fill_sphere_desc_init(&ball);
-  ball.radius = kRadius;
-  SCENE_OK(sph_world_fill_sphere(s.world, &ball, &n));
-  x = malloc(12 * (size_t)n);
+  /* The blob sph_world_fill_sphere makes, with velocities in [-0.5, 0.5] m/s. */
+  SCENE_OK(support_fcc_sphere(NULL, kRadius, kSpacing, &x, &n));
   v = malloc(12 * (size_t)n);
-  assert_true(x && v);
-  scene_positions(&s, x, n);
-  for (i = 0; i < 3 * n; ++i) v[i] = (float)(sph_test_random(&rng) - 0.5);
-  {
-    /* Replace the blob by the same particles with random velocities. */
-    sph_spawn_desc d;
-    scene_close(&s);
-    open_springs_world(&s, SPH_FEATURE_SPRINGS, 1000);
-    s.params.gravity.y = 0.0f;
-    scene_set_params(&s);
-    set_springs(&s, 1e6f, 100.0f, 20.0f, 0.05f);
-    sph_spawn_desc_init(&d);
-    d.count = n;
-    d.positions = x;
-    d.velocities = v;
-    SCENE_OK(sph_world_spawn(s.world, &d, NULL));
-  }
+  assert_non_null(v);
+  support_random_velocities(v, n, 0.5, NULL, &rng);
+  SCENE_OK(support_spawn(s.world, x, v, n));
   for (i = 0; i < n; ++i) {
     for (k = 0; k < 3; ++k) p0[k] += v[3 * i + k];
     speed_sum += sqrt((double)v[3 * i] * v[3 * i] + (double)v[3 * i + 1] * v[3 * i + 1] +

@@ -36,23 +36,22 @@ typedef struct drop {
 /* A world with surface tension, Tait's law, no gravity and Mueller viscosity mu (Pa s). */
 static void drop_open(drop* d, float viscosity) {
   sph_world_def def;
+  sph_world_params params;
   sph_surface_tension_params st;
   sph_tait_params tait;
   memset(d, 0, sizeof *d);
-  SCENE_OK(sph_test_context_create(&d->s.context));
   sph_world_def_init(&def);
   def.capacity = kMaxParticles;
   def.particle_spacing = kSpacing;
   def.rest_density = kRho;
   def.features = SPH_FEATURE_SURFACE_TENSION;
   def.equation_of_state = SPH_EOS_TAIT;
-  SCENE_OK(sph_world_create(d->s.context, &def, &d->s.world));
-  sph_world_params_init(&d->s.params);
-  d->s.params.gravity.y = 0.0f;
-  d->s.params.viscosity = viscosity;
-  d->s.params.dt_max = 1e-3f;
-  d->s.params.step_limits = SPH_STEP_LIMIT_ACOUSTIC;
-  scene_set_params(&d->s);
+  sph_world_params_init(&params);
+  params.gravity.y = 0.0f;
+  params.viscosity = viscosity;
+  params.dt_max = 1e-3f;
+  params.step_limits = SPH_STEP_LIMIT_ACOUSTIC;
+  SCENE_OK(support_world_open(&d->s, sph_test_backend(), &def, &params));
   sph_tait_params_init(&tait);
   tait.speed_of_sound = kSoundSpeed;
   SCENE_OK(sph_world_set_tait_params(d->s.world, &tait));

@@ -31,16 +31,13 @@ typedef struct particle_dump {
 } particle_dump;
 
 /* A small dam break in a tank, different per variant so no two worlds do the same work. The
- * tank's SDF asset is created here and released right away (the collider keeps it). */
+ * tank's SDF asset is released right away (the collider keeps it). */
 static sph_result build_world(sph_context* context, int variant, sph_world** out) {
+  const support_tank tank = {{0.0f, 0.0f, 0.0f}, {0.3f, 0.3f, 0.15f}, 0.02f, 0.0f};
   sph_world_def def;
   sph_world_params params;
-  sph_shape_desc shape;
-  sph_collider_def collider;
-  sph_fill_box_desc box;
-  sph_sdf* tank = NULL;
+  sph_vec3 column_min, column_max;
   sph_world* world = NULL;
-  sph_collider_id collider_id;
   sph_result r;
 
   sph_world_def_init(&def);
@@ -52,28 +49,14 @@ static sph_result build_world(sph_context* context, int variant, sph_world** out
   params.gravity.x = 0.5f * (float)variant; /* a different slosh per variant */
   if ((r = sph_world_set_params(world, &params)) != SPH_OK) goto fail;
 
-  sph_shape_desc_init(&shape);
-  shape.shape = SPH_SHAPE_BOX;
-  shape.half_extents.x = 0.3f;
-  shape.half_extents.y = 0.3f;
-  shape.half_extents.z = 0.15f;
-  shape.voxel_size = 0.02f;
-  if ((r = sph_sdf_create_shape(context, &shape, &tank)) != SPH_OK) goto fail;
-  sph_collider_def_init(&collider);
-  collider.sdf = tank;
-  collider.flags = SPH_COLLIDER_FLAG_INVERTED;
-  r = sph_collider_create(world, &collider, &collider_id);
-  sph_sdf_destroy(tank);
+  column_min.x = -0.28f;
+  column_min.y = -0.28f;
+  column_min.z = -0.13f;
+  column_max.x = -0.28f + 0.16f + 0.02f * (float)variant;
+  column_max.y = 0.05f;
+  column_max.z = 0.13f;
+  r = support_dam_break(context, world, &tank, column_min, column_max, NULL, NULL, NULL);
   if (r != SPH_OK) goto fail;
-
-  sph_fill_box_desc_init(&box);
-  box.min.x = -0.28f;
-  box.min.y = -0.28f;
-  box.min.z = -0.13f;
-  box.max.x = -0.28f + 0.16f + 0.02f * (float)variant;
-  box.max.y = 0.05f;
-  box.max.z = 0.13f;
-  if ((r = sph_world_fill_box(world, &box, NULL)) != SPH_OK) goto fail;
   *out = world;
   return SPH_OK;
 fail:

@@ -15,24 +15,19 @@ void scene_ok(sph_result r, const char* call, const char* file, int line) {
 
 void scene_open(scene* s, uint32_t capacity, float spacing, float gravity_y, float dt_max) {
   sph_world_def def;
-  memset(s, 0, sizeof *s);
-  SCENE_OK(sph_test_context_create(&s->context));
+  sph_world_params params;
   sph_world_def_init(&def);
   def.capacity = capacity;
   def.particle_spacing = spacing;
-  SCENE_OK(sph_world_create(s->context, &def, &s->world));
-  sph_world_params_init(&s->params);
-  s->params.gravity.y = gravity_y;
-  s->params.dt_max = dt_max;
-  scene_set_params(s);
+  sph_world_params_init(&params);
+  params.gravity.y = gravity_y;
+  params.dt_max = dt_max;
+  SCENE_OK(support_world_open(s, sph_test_backend(), &def, &params));
 }
 
-void scene_set_params(scene* s) { SCENE_OK(sph_world_set_params(s->world, &s->params)); }
+void scene_set_params(scene* s) { SCENE_OK(support_world_set_params(s)); }
 
-void scene_close(scene* s) {
-  SCENE_OK(sph_world_destroy(s->world));
-  SCENE_OK(sph_context_destroy(s->context));
-}
+void scene_close(scene* s) { SCENE_OK(support_world_close(s)); }
 
 sph_sdf* scene_shape(scene* s, const sph_shape_desc* desc) {
   sph_sdf* sdf = NULL;
@@ -48,25 +43,21 @@ sph_transform scene_at(float x, float y, float z) {
   return t;
 }
 
-static uint32_t copy_out(scene* s, sph_attribute a, void* dst, size_t element, uint32_t max) {
-  uint32_t n = 0, written = 0;
+static uint32_t copy_out(scene* s, sph_attribute a, void* dst, uint32_t max) {
+  uint32_t n = 0;
   SCENE_OK(sph_world_get_particle_count(s->world, &n));
   assert_true(n <= max);
-  if (n == 0) return 0;
-  SCENE_OK(sph_world_copy_attribute(s->world, a, dst, (uint64_t)element * max, 0, 0, n, &written));
-  assert_int_equal(written, n);
+  SCENE_OK(support_read(s->world, a, dst, max, &n));
   return n;
 }
 
 uint32_t scene_positions(scene* s, float* p, uint32_t max) {
-  return copy_out(s, SPH_ATTRIBUTE_POSITION, p, 12, max);
+  return copy_out(s, SPH_ATTRIBUTE_POSITION, p, max);
 }
 uint32_t scene_velocities(scene* s, float* v, uint32_t max) {
-  return copy_out(s, SPH_ATTRIBUTE_VELOCITY, v, 12, max);
+  return copy_out(s, SPH_ATTRIBUTE_VELOCITY, v, max);
 }
-uint32_t scene_ids(scene* s, uint32_t* ids, uint32_t max) {
-  return copy_out(s, SPH_ATTRIBUTE_ID, ids, 4, max);
-}
+uint32_t scene_ids(scene* s, uint32_t* ids, uint32_t max) { return copy_out(s, SPH_ATTRIBUTE_ID, ids, max); }
 
 uint32_t scene_spawn_one(scene* s, float x, float y, float z, float vx, float vy, float vz) {
   const float p[3] = {x, y, z}, v[3] = {vx, vy, vz};

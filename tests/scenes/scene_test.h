@@ -1,5 +1,5 @@
 /* Helpers shared by the scene tests: a world on the test backend with chosen parameters, a
- * particle's state by id, and shape assets. */
+ * particle's state by id, and shape assets, over tests/support's worlds and readers. */
 #ifndef SPH_SCENE_TEST_H
 #define SPH_SCENE_TEST_H
 
@@ -11,13 +11,10 @@
 #include <cmocka.h>
 
 #include "sph_c.h"
-#include "test_support.h"
+#include "support.h"
 
-typedef struct scene {
-  sph_context* context;
-  sph_world* world;
-  sph_world_params params;
-} scene;
+/* context, world, params (and def, mass): tests/support's world */
+typedef support_world scene;
 
 /* A context on the test backend and a world of `capacity` at `spacing`; params default but
  * gravity and dt_max as given. Fails the test on error. */

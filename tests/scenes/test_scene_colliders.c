@@ -103,32 +103,17 @@ static void test_sliding_stops_where_coulomb_predicts(void** state) {
  * goes deeper into a wall than half a spacing (the issue's bound). */
 static void test_dam_break_stays_in_tank(void** state) {
   const float spacing = 0.02f;
+  const support_tank tank = {{0.0f, 0.3f, 0.0f}, {0.5f, 0.3f, 0.1f}, 0.01f, 0.0f};
+  const sph_vec3 column_min = {-0.5f, 0.0f, -0.1f}, column_max = {-0.2f, 0.4f, 0.1f};
   scene s;
-  sph_shape_desc d;
   sph_sdf* box;
-  sph_fill_box_desc fill;
   uint32_t n = 0, total_substeps = 0, i;
   float* x;
   float worst = -1.0f;
   int frame;
   (void)state;
   scene_open(&s, 8000, spacing, -kG, 1e-3f);
-  sph_shape_desc_init(&d);
-  d.shape = SPH_SHAPE_BOX;
-  d.half_extents.x = 0.5f;
-  d.half_extents.y = 0.3f;
-  d.half_extents.z = 0.1f;
-  d.voxel_size = 0.01f;
-  box = scene_shape(&s, &d);
-  add_collider(&s, box, scene_at(0.0f, 0.3f, 0.0f), SPH_COLLIDER_FLAG_INVERTED, 0.0f, 0.0f);
-  sph_fill_box_desc_init(&fill);
-  fill.min.x = -0.5f;
-  fill.min.y = 0.0f;
-  fill.min.z = -0.1f;
-  fill.max.x = -0.2f;
-  fill.max.y = 0.4f;
-  fill.max.z = 0.1f;
-  SCENE_OK(sph_world_fill_box(s.world, &fill, &n));
+  SCENE_OK(support_dam_break(s.context, s.world, &tank, column_min, column_max, &box, NULL, &n));
   assert_true(n > 1000);
   x = malloc(12 * (size_t)n);
   assert_non_null(x);

@@ -22,7 +22,7 @@ extern "C" {
 }
 
 #include "sph_vdb.h"
-#include "test_support.h"
+#include "support.h"
 
 namespace {
 

@@ -38,9 +38,10 @@ static double total_energy(const sph_world* world, float mass, double k, double 
   float* x = NULL;
   float* rho = NULL;
   double e_kin = 0.0, e_pot = 0.0, e_int = 0.0;
-  const uint32_t n = physics_copy_by_id(world, SPH_ATTRIBUTE_VELOCITY, (void**)&v);
-  physics_copy_by_id(world, SPH_ATTRIBUTE_POSITION, (void**)&x);
-  physics_copy_by_id(world, SPH_ATTRIBUTE_DENSITY, (void**)&rho);
+  uint32_t n = 0;
+  EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_VELOCITY, (void**)&v, &n));
+  EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_POSITION, (void**)&x, &n));
+  EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_DENSITY, (void**)&rho, &n));
   for (uint32_t i = 0; i < n; ++i) {
     e_kin += 0.5 * mass *
              ((double)v[3 * i] * v[3 * i] + (double)v[3 * i + 1] * v[3 * i + 1] +
@@ -63,33 +64,30 @@ static void test_energy_never_grows(void** state) {
   const double origin[3] = {0.0, 0.0, 0.0};
   const double box_min[3] = {0.0, 0.0, 0.0};
   const double box_max[3] = {4.0 * across * step, 3.0 * across * step, 0.5 * across * step};
-  sph_context* context = NULL;
-  sph_world* world = NULL;
+  support_world w;
+  sph_world* world;
   sph_world_def def;
   sph_world_params params;
-  sph_spawn_desc spawn;
   sph_sdf* sdf = NULL;
   float* points = NULL;
   float mass = 0.0f;
   double e0, worst = -1e30, kinetic, peak_kinetic = 0.0, e_end = 0.0;
   const int frames = 60; /* 1.2 s: the column collapses, hits the far wall and sloshes back */
-  const uint32_t n = validation_lattice_box(lattice, step, origin, &points);
+  uint32_t n = 0;
   (void)state;
 
+  EXPECT_OK(support_fcc_box(lattice, step, origin, &points, &n));
   sph_world_def_init(&def);
   def.capacity = n;
   def.particle_spacing = (float)(step * sqrt(2.0));
-  physics_create(&def, &context, &world);
-  EXPECT_OK(sph_world_get_def(world, &def));
   sph_world_params_init(&params);
   params.step_limits = SPH_STEP_LIMIT_ACOUSTIC;
   params.viscosity = 0.05f;
-  EXPECT_OK(sph_world_set_params(world, &params));
-  validation_tank(context, world, box_min, box_max, 0.5 * step, 0.0f, &sdf);
-  sph_spawn_desc_init(&spawn);
-  spawn.count = n;
-  spawn.positions = points;
-  EXPECT_OK(sph_world_spawn(world, &spawn, NULL));
+  EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, &params));
+  world = w.world;
+  def = w.def;
+  EXPECT_OK(support_tank_between(w.context, world, box_min, box_max, 0.5 * step, 0.0f, &sdf, NULL));
+  EXPECT_OK(support_spawn(world, points, NULL, n));
   EXPECT_OK(sph_world_get_particle_mass(world, &mass));
   free(points);
 
@@ -122,7 +120,7 @@ static void test_energy_never_grows(void** state) {
   assert_true(peak_kinetic > 0.05 * e0);
   assert_true(worst <= 0.005);
   EXPECT_OK(sph_sdf_destroy(sdf));
-  physics_destroy(context, world);
+  EXPECT_OK(support_world_close(&w));
 }
 
 static void test_momentum_round_off(void** state) {
@@ -131,19 +129,19 @@ static void test_momentum_round_off(void** state) {
   const double box = 1.0; /* the ball sits in the middle of a 1 m box */
   const double box_min[3] = {0.0, 0.0, 0.0};
   const double box_max[3] = {box, box, box};
-  sph_context* context = NULL;
-  sph_world* world = NULL;
+  support_world w;
+  sph_world* world;
   sph_world_def def;
-  sph_spawn_desc spawn;
   sph_sdf* sdf = NULL;
   float* points = NULL;
   float* v0;
   float mass = 0.0f;
   uint64_t rng = 0x2545f4914f6cdd1dull;
   double mean[3] = {0.0, 0.0, 0.0}, p[3] = {0.0, 0.0, 0.0}, scale = 0.0, nearest_wall = 1e30;
-  const uint32_t n = physics_fcc_sphere(spacing, radius, &points);
+  uint32_t n = 0;
   (void)state;
 
+  EXPECT_OK(support_fcc_sphere(NULL, radius, spacing, &points, &n));
   v0 = (float*)malloc(sizeof(float) * 3 * n);
   assert_non_null(v0);
   for (uint32_t i = 0; i < n; ++i) {
@@ -151,7 +149,7 @@ static void test_momentum_round_off(void** state) {
     points[3 * i + 1] += (float)(0.5 * box);
     points[3 * i + 2] += (float)(0.5 * box);
     for (int k = 0; k < 3; ++k) {
-      v0[3 * i + k] = (float)(0.2 * (sph_test_random(&rng) - 0.5));
+      v0[3 * i + k] = (float)(0.2 * (support_random(&rng) - 0.5));
       mean[k] += v0[3 * i + k] / n;
     }
   }
@@ -159,14 +157,11 @@ static void test_momentum_round_off(void** state) {
   sph_world_def_init(&def);
   def.capacity = n;
   def.particle_spacing = spacing;
-  physics_create(&def, &context, &world);
-  physics_set_params(world, 0.0f, 0.0f, 0.0f, 1e-6f, 1e-3f);
-  validation_tank(context, world, box_min, box_max, 0.02, 0.0f, &sdf);
-  sph_spawn_desc_init(&spawn);
-  spawn.count = n;
-  spawn.positions = points;
-  spawn.velocities = v0;
-  EXPECT_OK(sph_world_spawn(world, &spawn, NULL));
+  EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
+  world = w.world;
+  EXPECT_OK(support_set_gravity_and_steps(world, 0.0f, 0.0f, 0.0f, 1e-6f, 1e-3f));
+  EXPECT_OK(support_tank_between(w.context, world, box_min, box_max, 0.02, 0.0f, &sdf, NULL));
+  EXPECT_OK(support_spawn(world, points, v0, n));
   EXPECT_OK(sph_world_get_particle_mass(world, &mass));
   for (uint32_t i = 0; i < 3 * n; ++i) scale += mass * fabs((double)v0[i]);
   free(points);
@@ -175,8 +170,9 @@ static void test_momentum_round_off(void** state) {
   {
     float* v = NULL;
     float* x = NULL;
-    physics_copy_by_id(world, SPH_ATTRIBUTE_VELOCITY, (void**)&v);
-    physics_copy_by_id(world, SPH_ATTRIBUTE_POSITION, (void**)&x);
+    uint32_t count = 0;
+    EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_VELOCITY, (void**)&v, &count));
+    EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_POSITION, (void**)&x, &count));
     for (uint32_t i = 0; i < n; ++i)
       for (int k = 0; k < 3; ++k) {
         const double wall = fmin(x[3 * i + k], box - x[3 * i + k]);
@@ -208,7 +204,7 @@ static void test_momentum_round_off(void** state) {
     assert_true(drift <= 1e-5 * scale);
   }
   EXPECT_OK(sph_sdf_destroy(sdf));
-  physics_destroy(context, world);
+  EXPECT_OK(support_world_close(&w));
 }
 
 /* argv[1] picks one check (energy | momentum); none runs both. */

@@ -70,11 +70,10 @@ static void run_tank(const tank_case* tc) {
   const double origin[3] = {0.0, 0.0, 0.0};
   const double tank_min[3] = {0.0, 0.0, 0.0};
   const double tank_max[3] = {width, 2.0 * depth, width};
-  sph_context* context = NULL;
-  sph_world* world = NULL;
+  support_world w;
+  sph_world* world;
   sph_world_def def;
   sph_world_params params;
-  sph_spawn_desc spawn;
   sph_sdf* sdf = NULL;
   float* lattice_points = NULL;
   float* x = NULL;
@@ -83,17 +82,19 @@ static void run_tank(const tank_case* tc) {
   double *layer_sum, *layer_y;
   uint32_t* layer_count;
   double k, c = 0.0, h, rho0, lowest = 1e30, top_layer = -1e30;
-  const uint32_t n = validation_lattice_box(lattice, step, origin, &lattice_points);
+  uint32_t n = 0;
   const int frames = (int)(tc->seconds * 50.0 + 0.5);
   double bin, window_ke = 0.0;
   int window_frames = 0;
 
+  EXPECT_OK(support_fcc_box(lattice, step, origin, &lattice_points, &n));
   sph_world_def_init(&def);
   def.capacity = n;
   def.particle_spacing = (float)(step * sqrt(2.0));
   def.equation_of_state = tc->eos;
-  physics_create(&def, &context, &world);
-  EXPECT_OK(sph_world_get_def(world, &def));
+  EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
+  world = w.world;
+  def = w.def;
   h = def.kernel_radius;
   rho0 = def.rest_density;
   /* Pressure is averaged over horizontal slices one kernel radius thick: a single particle's
@@ -113,11 +114,8 @@ static void run_tank(const tank_case* tc) {
     EXPECT_OK(sph_world_get_tait_params(world, &tait));
     c = tait.speed_of_sound;
   }
-  validation_tank(context, world, tank_min, tank_max, 0.5 * step, 0.0f, &sdf);
-  sph_spawn_desc_init(&spawn);
-  spawn.count = n;
-  spawn.positions = lattice_points;
-  EXPECT_OK(sph_world_spawn(world, &spawn, NULL));
+  EXPECT_OK(support_tank_between(w.context, world, tank_min, tank_max, 0.5 * step, 0.0f, &sdf, NULL));
+  EXPECT_OK(support_spawn(world, lattice_points, NULL, n));
   EXPECT_OK(sph_world_get_particle_mass(world, &mass));
   free(lattice_points);
 
@@ -128,15 +126,20 @@ static void run_tank(const tank_case* tc) {
   for (int f = 0; f < frames; ++f) {
     EXPECT_OK(sph_world_step(world, 0.02f));
     {
-      const double ke = validation_kinetic_energy(world, mass);
+      double ke = 0.0;
+      EXPECT_OK(support_kinetic_energy(world, mass, &ke));
       if (f >= frames / 2) {
         window_ke += ke;
         ++window_frames;
       }
       if (f % 10 == 9) printf("  t = %.1f s: kinetic energy %.3g J\n", 0.02 * (f + 1), ke);
     }
-    assert_int_equal(physics_copy_by_id(world, SPH_ATTRIBUTE_POSITION, (void**)&x), n);
-    physics_copy_by_id(world, SPH_ATTRIBUTE_PRESSURE, (void**)&p);
+    {
+      uint32_t count = 0;
+      EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_POSITION, (void**)&x, &count));
+      assert_int_equal(count, n);
+      EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_PRESSURE, (void**)&p, &count));
+    }
     for (uint32_t i = 0; i < n; ++i) {
       if (x[3 * i + 1] < lowest) lowest = x[3 * i + 1];
       if (f < frames / 2) continue;
@@ -243,40 +246,34 @@ static void run_tank(const tank_case* tc) {
   free(layer_y);
   free(layer_count);
   EXPECT_OK(sph_sdf_destroy(sdf));
-  physics_destroy(context, world);
+  EXPECT_OK(support_world_close(&w));
+}
+
+/* The tank of the case's equation of state at the resolution asked for: 16 x 30 x 16 layers for
+ * 1 s in CI, 32 x 60 x 32 for 4 s at full resolution. */
+static void run_tank_at_resolution(const char* name, sph_equation_of_state eos) {
+  tank_case tc = {name, eos, 16, 30, 0.01, 1.0};
+  if (validation_full()) {
+    tc.width_layers = 32;
+    tc.depth_layers = 60;
+    tc.step = 0.01;
+    /* The 0.6 m deep tank keeps a sloshing mode (kinetic energy swinging 0.01-0.35 J with a
+     * period of about 1.2 s at the default viscosity, measured on the H100), so the averaging
+     * window, the second half of the run, must span more than one period: 4 s. With 2 s the
+     * window caught less than one swing and the Tait tank read 1.80 % mean, 3.80 % worst. */
+    tc.seconds = 4.0;
+  }
+  run_tank(&tc);
 }
 
 static void test_hydrostatic_ideal_gas(void** state) {
-  tank_case tc = {"ideal gas p = k (rho - rho0), k = 100", SPH_EOS_IDEAL_GAS, 16, 30, 0.01, 1.0};
   (void)state;
-
-  if (validation_full()) {
-    tc.width_layers = 32;
-    tc.depth_layers = 60;
-    tc.step = 0.01;
-    /* The 0.6 m deep tank keeps a sloshing mode (kinetic energy swinging 0.01-0.35 J with a
-     * period of about 1.2 s at the default viscosity, measured on the H100), so the averaging
-     * window, the second half of the run, must span more than one period: 4 s. With 2 s the
-     * window caught less than one swing and the Tait tank read 1.80 % mean, 3.80 % worst. */
-    tc.seconds = 4.0;
-  }
-  run_tank(&tc);
+  run_tank_at_resolution("ideal gas p = k (rho - rho0), k = 100", SPH_EOS_IDEAL_GAS);
 }
 
 static void test_hydrostatic_tait(void** state) {
-  tank_case tc = {"Tait, c = 10 m/s", SPH_EOS_TAIT, 16, 30, 0.01, 1.0};
   (void)state;
-  if (validation_full()) {
-    tc.width_layers = 32;
-    tc.depth_layers = 60;
-    tc.step = 0.01;
-    /* The 0.6 m deep tank keeps a sloshing mode (kinetic energy swinging 0.01-0.35 J with a
-     * period of about 1.2 s at the default viscosity, measured on the H100), so the averaging
-     * window, the second half of the run, must span more than one period: 4 s. With 2 s the
-     * window caught less than one swing and the Tait tank read 1.80 % mean, 3.80 % worst. */
-    tc.seconds = 4.0;
-  }
-  run_tank(&tc);
+  run_tank_at_resolution("Tait, c = 10 m/s", SPH_EOS_TAIT);
 }
 
 /* argv[1] picks one equation of state (tait | ideal_gas); none runs both. */

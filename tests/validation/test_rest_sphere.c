@@ -47,30 +47,34 @@ static void run_sphere(const sphere_case* sc) {
   const float spacing = 0.02f;
   const float radius = (validation_full() ? 14.0f : 6.0f) * spacing;
   const double disturbance = sc->disturbance;
-  sph_context* context = NULL;
-  sph_world* world = NULL;
+  support_world w;
+  sph_world* world;
   sph_world_def def;
+  sph_world_params params;
+  support_sphere ball = {{0.0, 0.0, 0.0}, 0.0, 0.0, 0.0, NULL, 12345, 0};
   float mass = 0.0f, h, rest;
   float* lattice = NULL;
-  uint64_t rng = 12345;
   uint32_t n;
   double ke0, gyration0 = 0.0, ke[FRAMES], worst_mean = 0.0, worst_particle = 0.0, worst_radius = 0.0;
   double max_first = 0.0, max_last = 0.0, end_speed = 0.0;
 
-  n = physics_fcc_sphere(spacing, radius, &lattice);
   sph_world_def_init(&def);
   def.particle_spacing = spacing;
-  def.capacity = n;
-  physics_create(&def, &context, &world);
-  EXPECT_OK(sph_world_get_def(world, &def));
-  h = def.kernel_radius;
-  rest = def.rest_density;
-  physics_set_params(world, 0.0f, 0.0f, 0.0f, 1e-6f, 1e-3f);
-  physics_spawn_disturbed(world, lattice, n, disturbance, &rng);
-  EXPECT_OK(sph_world_get_particle_mass(world, &mass));
-  ke0 = validation_kinetic_energy(world, mass);
+  def.capacity = 0; /* the ball's particles */
+  EXPECT_OK(support_params_gravity_and_steps(&params, 0.0f, 0.0f, 0.0f, 1e-6f, 1e-3f));
+  ball.radius = radius;
+  ball.speed = disturbance;
+  EXPECT_OK(support_rest_sphere_open(&w, sph_test_backend(), &def, &params, &ball, &n));
+  world = w.world;
+  h = w.def.kernel_radius;
+  rest = w.def.rest_density;
+  mass = w.mass;
+  EXPECT_OK(support_kinetic_energy(world, mass, &ke0));
   {
+    uint32_t count = 0;
     double c[3] = {0.0, 0.0, 0.0};
+    /* the lattice as spawned */
+    EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_POSITION, (void**)&lattice, &count));
     for (uint32_t i = 0; i < n; ++i)
       for (int k = 0; k < 3; ++k) c[k] += lattice[3 * i + k] / (double)n;
     for (uint32_t i = 0; i < n; ++i)
@@ -84,9 +88,11 @@ static void run_sphere(const sphere_case* sc) {
     float* rho = NULL;
     double c[3] = {0.0, 0.0, 0.0}, density_sum = 0.0, gyration = 0.0, worst = 0.0;
     uint32_t interior = 0;
+    uint32_t count = 0;
     EXPECT_OK(sph_world_step(world, 1.0f / 25.0f));
-    assert_int_equal(physics_copy_by_id(world, SPH_ATTRIBUTE_POSITION, (void**)&x), n);
-    physics_copy_by_id(world, SPH_ATTRIBUTE_DENSITY, (void**)&rho);
+    EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_POSITION, (void**)&x, &count));
+    assert_int_equal(count, n);
+    EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_DENSITY, (void**)&rho, &count));
     for (uint32_t i = 0; i < n; ++i)
       for (int k = 0; k < 3; ++k) c[k] += x[3 * i + k] / (double)n;
     for (uint32_t i = 0; i < n; ++i) {
@@ -102,7 +108,7 @@ static void run_sphere(const sphere_case* sc) {
     }
     gyration = sqrt(gyration);
     assert_true(interior >= 50);
-    ke[f] = validation_kinetic_energy(world, mass);
+    EXPECT_OK(support_kinetic_energy(world, mass, &ke[f]));
     {
       const double mean_error = fabs(density_sum / interior - rest) / rest;
       const double radius_change = fabs(gyration / gyration0 - 1.0);
@@ -122,7 +128,8 @@ static void run_sphere(const sphere_case* sc) {
   }
   {
     float* v = NULL;
-    physics_copy_by_id(world, SPH_ATTRIBUTE_VELOCITY, (void**)&v);
+    uint32_t count = 0;
+    EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_VELOCITY, (void**)&v, &count));
     for (uint32_t i = 0; i < n; ++i) {
       const double s2 = (double)v[3 * i] * v[3 * i] + (double)v[3 * i + 1] * v[3 * i + 1] +
                         (double)v[3 * i + 2] * v[3 * i + 2];
@@ -171,7 +178,7 @@ static void run_sphere(const sphere_case* sc) {
     /* and the round-off motion, like a disturbance, is damped: no instability grows. */
     assert_true(max_last <= max_first);
   }
-  physics_destroy(context, world);
+  EXPECT_OK(support_world_close(&w));
 }
 
 static void test_rest(void** state) {

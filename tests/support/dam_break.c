@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "support.h"
+
 /* Martin & Moyce (1952), Table 2, n^2 = 2 (../shared/data/martin_moyce_1952_front_n2.csv). */
 const double dam_break_measured_T[DAM_BREAK_MEASUREMENTS] = {0.00, 0.41, 0.84, 1.19, 1.43, 1.63, 1.83, 1.98,
                                                              2.20, 2.32, 2.51, 2.65, 2.83, 2.98, 3.11, 3.33};
@@ -71,14 +73,12 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
   const double spacing = step * sqrt(2.0);
   const double slab = step * config->slab_layers;
   const double tank_length = 6.0 * a, tank_height = 3.0 * a;
-  const uint32_t nx = config->layers_across, ny = 2 * config->layers_across, nz = config->slab_layers;
+  const uint32_t layers[3] = {config->layers_across, 2 * config->layers_across, config->slab_layers};
+  const double tank_min[3] = {0.0, 0.0, 0.0};
+  const double tank_max[3] = {tank_length, tank_height, slab};
   sph_world_def def;
   sph_world_params params;
   sph_tait_params tait;
-  sph_shape_desc shape;
-  sph_collider_def collider;
-  sph_collider_id collider_id;
-  sph_spawn_desc spawn;
   sph_world* world = NULL;
   sph_sdf* tank = NULL;
   float* positions = NULL;
@@ -90,25 +90,16 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
 
   memset(result, 0, sizeof *result);
   result->spacing = spacing;
-  positions = (float*)malloc(sizeof(float) * 3 * nx * ny * nz);
-  density = (float*)malloc(sizeof(float) * nx * ny * nz);
-  scratch = (float*)malloc(sizeof(float) * nx * ny * nz);
-  if (!positions || !density || !scratch) {
+  /* FCC: the simple-cubic points with an even index sum, half a step inside every face. */
+  r = support_fcc_box(layers, step, NULL, &positions, &n);
+  density = (float*)malloc(sizeof(float) * ((size_t)n + 1));
+  scratch = (float*)malloc(sizeof(float) * ((size_t)n + 1));
+  if (r != SPH_OK || !density || !scratch) {
     free(positions);
     free(density);
     free(scratch);
     return SPH_ERROR_OUT_OF_HOST_MEMORY;
   }
-  /* FCC: the simple-cubic points with an even index sum, half a step inside every face. */
-  for (uint32_t k = 0; k < nz; ++k)
-    for (uint32_t j = 0; j < ny; ++j)
-      for (uint32_t i = 0; i < nx; ++i) {
-        if ((i + j + k) % 2) continue;
-        positions[3 * n] = (float)((i + 0.5) * step);
-        positions[3 * n + 1] = (float)((j + 0.5) * step);
-        positions[3 * n + 2] = (float)((k + 0.5) * step);
-        ++n;
-      }
   result->particles = n;
 
   sph_world_def_init(&def);
@@ -133,29 +124,11 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
   tait.speed_of_sound = config->speed_of_sound;
   if ((r = sph_world_set_tait_params(world, &tait)) != SPH_OK) goto done;
 
-  /* The tank: a solid box used as an inverted collider, so its inside is the fluid's space;
-   * closed on every side (nothing leaves), long enough that the front never reaches the end. */
-  sph_shape_desc_init(&shape);
-  shape.shape = SPH_SHAPE_BOX;
-  shape.half_extents.x = (float)(0.5 * tank_length);
-  shape.half_extents.y = (float)(0.5 * tank_height);
-  shape.half_extents.z = (float)(0.5 * slab);
-  shape.voxel_size = (float)(0.5 * step);
-  if ((r = sph_sdf_create_shape(context, &shape, &tank)) != SPH_OK) goto done;
-  sph_collider_def_init(&collider);
-  collider.flags = SPH_COLLIDER_FLAG_INVERTED;
-  collider.sdf = tank;
-  collider.transform = sph_transform_identity();
-  collider.transform.position.x = (float)(0.5 * tank_length);
-  collider.transform.position.y = (float)(0.5 * tank_height);
-  collider.transform.position.z = (float)(0.5 * slab);
-  collider.friction = config->friction;
-  if ((r = sph_collider_create(world, &collider, &collider_id)) != SPH_OK) goto done;
-
-  sph_spawn_desc_init(&spawn);
-  spawn.count = n;
-  spawn.positions = positions;
-  if ((r = sph_world_spawn(world, &spawn, NULL)) != SPH_OK) goto done;
+  /* The tank: closed on every side (nothing leaves), long enough that the front never reaches
+   * the end. */
+  r = support_tank_between(context, world, tank_min, tank_max, 0.5 * step, config->friction, &tank, NULL);
+  if (r != SPH_OK) goto done;
+  if ((r = support_spawn(world, positions, NULL, n)) != SPH_OK) goto done;
 
   {
     const double scale = time_scale();

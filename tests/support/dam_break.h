@@ -1,6 +1,7 @@
 /* The dam-break case of Martin & Moyce (1952), shared by the validation test
- * (test_dam_break.c) and the speed-accuracy benchmark (bench/speed_accuracy.c). Plain C on the
- * public API only, no test framework, so a benchmark can link it.
+ * (tests/validation/test_dam_break.c) and the speed-accuracy benchmark (bench/speed_accuracy.c).
+ * Plain C on the public API only, no test framework, so a benchmark can link it (part of
+ * tests/support; its lattice and tank are support.h's).
  *
  * A column of water, width a and height 2a, stands against the back wall of a long tank and is
  * released at t = 0. The surge front z(t) along the floor is compared with the measurements in

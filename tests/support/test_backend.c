@@ -1,14 +1,12 @@
-#include "test_support.h"
-
+/* The backend of the tests' contexts (SPH_TEST_BACKEND) and backends named on a command line. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "support.h"
+
 sph_backend sph_test_backend(void) {
-  const char* name = sph_test_backend_name();
-  if (strcmp(name, "cpu") == 0) return SPH_BACKEND_CPU;
-  if (strcmp(name, "cuda") == 0) return SPH_BACKEND_CUDA;
-  return SPH_BACKEND_AUTO;
+  return support_backend_from_name(sph_test_backend_name(), SPH_BACKEND_AUTO);
 }
 
 const char* sph_test_backend_name(void) {
@@ -28,17 +26,21 @@ sph_result sph_test_context_def_init(sph_context_def* def) {
 }
 
 sph_result sph_test_context_create(sph_context** out) {
-  sph_context_def def;
-  const sph_result r = sph_test_context_def_init(&def);
-  if (r != SPH_OK) return r;
-  return sph_context_create(&def, out);
+  return support_context_create(sph_test_backend(), out);
 }
 
-double sph_test_random(uint64_t* state) {
-  uint64_t x = *state;
-  x ^= x >> 12;
-  x ^= x << 25;
-  x ^= x >> 27;
-  *state = x;
-  return (double)((x * 0x2545F4914F6CDD1Dull) >> 11) * (1.0 / 9007199254740992.0);
+sph_backend support_backend_from_name(const char* name, sph_backend otherwise) {
+  if (name == NULL) return otherwise;
+  if (strcmp(name, "cpu") == 0) return SPH_BACKEND_CPU;
+  if (strcmp(name, "cuda") == 0) return SPH_BACKEND_CUDA;
+  if (strcmp(name, "auto") == 0) return SPH_BACKEND_AUTO;
+  return otherwise;
+}
+
+sph_result support_context_create(sph_backend backend, sph_context** out) {
+  sph_context_def def;
+  const sph_result r = sph_context_def_init(&def);
+  if (r != SPH_OK) return r;
+  def.backend = backend;
+  return sph_context_create(&def, out);
 }
