@@ -1,0 +1,151 @@
+// The CPU backend's class, shared by the files of src/cpu/ that implement it (one per stage of a
+// frame, each the twin of a file of cuda/; see docs/architecture.md). Each substep sorts
+// particles into the wrapped grid, then loops the shared per-particle physics (src/physics) over
+// all particles on OpenMP threads. Results do not depend on the thread count: every particle is
+// a pure gather and the only reduction (max speed) is order-independent.
+#pragma once
+
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "../core/backend.h"
+#include "../physics/forces.h"
+#include "../physics/integrate.h"
+#include "../physics/springs.h"
+#include "cpu_neighbor_grid.h"
+#include "host_particle_store.h"
+#include "host_spring_array.h"
+
+namespace sph {
+
+using Clock = std::chrono::steady_clock;
+
+inline double elapsed_ms(Clock::time_point since) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - since).count();
+}
+
+inline bool finite3(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+class CpuBackend final : public Backend {
+ public:
+  CpuBackend(const WorldConfig& config, unsigned workers);
+
+  uint32_t particle_count() const override { return count_; }
+
+  void append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id) override;
+
+  FrameReport step_frame(double frame_dt, const RuntimeParams& params) override;
+
+  FrameReport step_scene_frame(double frame_dt, const RuntimeParams& params,
+                               const SceneFrame& scene_in) override;
+
+  void truncate(uint32_t count) override;
+
+  void copy_attribute(AttributeKind kind, uint32_t first, uint32_t count, void* dst,
+                      size_t stride) const override;
+
+  ParticleSnapshot export_particles() const override;
+
+  void import_particles(const ParticleSnapshot& s) override;
+
+  uint64_t memory_bytes() const override { return store_.bytes() + grid_.bytes(); }
+
+ private:
+  static constexpr uint32_t kAllFinite = 0xffffffffu;
+
+  // Threads for a loop over the particles: small worlds run on the calling thread alone, where
+  // waking a team (and its spinning idle threads) would cost more than the work.
+  unsigned threads() const { return count_ >= kParallelMinimum ? workers_ : 1u; }
+
+  int n() const { return static_cast<int>(count_); }
+
+  float compute_max_speed() const;
+
+  // Hash, sort, reorder every attribute, then density and pressure (packed into the w slots).
+  void sort_and_density(const FluidConstants& fluid, FrameReport& report);
+
+  // Acceleration of particle i: the neighbour gather with the world's options compiled in,
+  // plus the scene's force fields.
+  template <bool kSurfaceTension, ViscosityMethod kViscosity>
+  static Vec3 acceleration_with(const FluidConstants& fluid, const GridView& view, const Float4* pos,
+                                const Float4* vel, const uint32_t* counts, const Float4* normals,
+                                const SceneFrame& scene, uint32_t i);
+  using AccelerationFn = Vec3 (*)(const FluidConstants&, const GridView&, const Float4*, const Float4*,
+                                  const uint32_t*, const Float4*, const SceneFrame&, uint32_t);
+  AccelerationFn acceleration_function() const;
+
+  // Resolves colliders for the state in next_position_/next_velocity_, moved from x_old(i).
+  template <class OldPosition>
+  void collide(const SceneFrame& scene, const SubstepTime& time, OldPosition&& x_old, FrameReport& report);
+
+  // Max speed and the first non-finite particle of the state in next_*.
+  uint32_t scan_next_state(float& v2max) const;
+
+  // Says when a failed substep was longer than the stability ceiling (only dt_min can force it).
+  static std::string above_stable_step(float dt, const StepLimits& limits);
+
+  // Where a failed substep went non-finite, worked out on the failure path only, before the new
+  // state replaces the old: the particle with the lowest index names the stage (the first of
+  // its density and pressure, its acceleration, its integrated state and the collision response
+  // that is not finite; the CUDA backend names the same), and up to 8 ids are listed.
+  void diagnose_non_finite(const FluidConstants& fluid, const SceneFrame& scene, int rk4_stage,
+                           uint32_t first);
+
+  uint32_t finish_substep(float v2max, uint32_t bad_index);
+
+  uint32_t substep_euler(const FluidConstants& fluid, const SceneFrame& scene, const SubstepTime& time,
+                         FrameReport& report);
+
+  uint32_t substep_rk4(const FluidConstants& fluid, const SceneFrame& scene, const SubstepTime& time,
+                       FrameReport& report);
+
+  // Springs (SPH_FEATURE_SPRINGS), after the sort: the particles that wait for springs make
+  // them (two passes, springs.h), then every particle gathers its spring acceleration into a
+  // side array that the force pass adds. first_evaluation: the substep's first force
+  // evaluation, where the rest lengths flow (plasticity).
+  void spring_pass(float dt, bool first_evaluation, FrameReport& report);
+
+  // Removes particles inside any sink, keeping the order of the rest; records their ids.
+  void apply_sinks(const SceneFrame& scene, FrameReport& report);
+
+  // Density and neighbour statistics of the last density evaluation.
+  void summarize(FrameReport& report) const;
+
+  WorldConfig config_;
+  unsigned workers_;
+  CpuNeighborGrid grid_;
+  HostParticleStore store_;
+  HostArray<Float4>& position_;
+  HostArray<Float4>& velocity_;
+  HostArray<uint32_t>& id_;
+  HostArray<float>& density_;
+  HostArray<uint32_t>& neighbors_;
+  HostArray<ParticleState>* rk4_start_ = nullptr;
+  HostArray<Rk4Accumulator>* rk4_sum_ = nullptr;
+  HostArray<float>* density_factor_ = nullptr;  // normalised density's carried factor, when on
+  // Integration writes here and swaps, so the force gather reads a state nobody writes.
+  std::vector<Float4> next_position_;
+  std::vector<Float4> next_velocity_;
+  std::vector<uint32_t> keep_order_;
+  std::vector<float> normalized_;  // normalised density: the summation, then eq. 31 (side array)
+  std::vector<Float4> normals_;    // colour-field normals, when surface tension is on
+  // Springs (SPH_FEATURE_SPRINGS only): the lists live in the store; the link candidates
+  // and the spring accelerations of the current evaluation are side arrays.
+  HostSpringArray* springs_ = nullptr;
+  std::vector<uint32_t> spring_candidates_;
+  std::vector<Vec3> spring_acceleration_;
+  SpringConstants spring_constants_{};
+  uint32_t link_from_ = kNoPendingLinks;  // lowest id that waits for its springs
+  uint32_t count_ = 0;
+  float max_speed_ = 0.0f;
+  float max_acceleration_ = 0.0f;  // of the last force evaluation, for the force step limit
+  struct {
+    std::string where;      // the stage of the first non-finite particle
+    std::string particles;  // how many, and their ids
+  } non_finite_;            // of the last failed substep, for its error message
+  bool max_speed_valid_ = false;
+};
+
+}  // namespace sph
