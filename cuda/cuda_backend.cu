@@ -264,36 +264,21 @@ class CudaBackend final : public Backend {
     ++epoch_;
     if (s.non_finite) {
       roll_back_frame();
-      static const char* const kStages[] = {
-          "density stage (SPH_STAGE_DENSITY)", "forces stage (SPH_STAGE_FORCES)",
-          "integrate stage (SPH_STAGE_INTEGRATE)", "collide stage (SPH_STAGE_COLLIDE)"};
-      throw Error(
-          Status::NonFinite,
-          "the step produced non-finite values in the " + std::string(kStages[s.bad_stage & 3u]) +
-              " of substep " + std::to_string(s.bad_substep) + " (dt " + std::to_string(s.bad_dt) + " s" +
-              (setup.limits.stability_dt > 0.0f && s.bad_dt > setup.limits.stability_dt
-                   ? ", above this world's stable step " + std::to_string(setup.limits.stability_dt) +
-                         " s (0.4 h / c, 0.05 h^2 rho0 / mu), forced by dt_min"
-                   : std::string()) +
-              "): " + std::to_string(s.bad_count) +
-              (s.bad_count == 1 ? " particle, id " : " particles, first id ") + std::to_string(s.bad_id) +
-              "; the world was restored to its state before sph_world_step");
+      NonFiniteFailure failure;
+      failure.stage = s.bad_stage;
+      failure.substep = s.bad_substep;
+      failure.dt = s.bad_dt;
+      failure.count = s.bad_count;
+      failure.ids.push_back(s.bad_id);  // the first; the device keeps no other ids
+      throw Error(Status::NonFinite, non_finite_message(failure, setup.limits));
     }
     count_ = count_after;
     FrameReport report;
     report.removed_ids = std::move(removed_ids);
     report.removed_by_sink = std::move(removed_by_sink);
-    report.substeps = s.substeps;
-    report.completed = s.remaining <= 0.0;
-    report.time_advanced = s.time_advanced;
-    report.dt_min = s.substeps == 0 ? 0.0f : s.dt_min;
-    report.dt_max = s.dt_max;
+    report_clock(s.clock, report);
     report.max_speed = s.max_speed;
-    report.density_min = s.density_min;
-    report.density_mean = s.density_mean;
-    report.density_max = s.density_max;
-    report.neighbors_mean = s.neighbors_mean;
-    report.neighbors_max = s.neighbors_max;
+    report_density(s.density, report);
     double staged_ms = 0.0;
     for (int k = 0; k < kStageCount; ++k) {
       report.stage_ms[k] = static_cast<float>(static_cast<double>(s.stage_ns[k]) * 1e-6);

@@ -40,8 +40,8 @@ __global__ void spring_force_kernel(SpringConstants c, ParticleArrays a, uint32_
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
   SpringList own = a.sorted_springs[i];
-  const Vec3 acc =
-      spring_acceleration<kUpdateRest>(c, a.sorted_position, a.sorted_velocity, i, own, state->dt_float);
+  const Vec3 acc = spring_acceleration<kUpdateRest>(c, a.sorted_position, a.sorted_velocity, i, own,
+                                                    state->clock.dt_float);
   a.spring_acceleration[i] = make_float4_record(acc, 0.0f);
   a.springs[i] = own;
 }

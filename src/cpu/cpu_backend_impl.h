@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "../core/backend.h"
+#include "../core/non_finite.h"
 #include "../physics/forces.h"
 #include "../physics/integrate.h"
 #include "../physics/springs.h"
@@ -25,8 +26,6 @@ using Clock = std::chrono::steady_clock;
 inline double elapsed_ms(Clock::time_point since) {
   return std::chrono::duration<double, std::milli>(Clock::now() - since).count();
 }
-
-inline bool finite3(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 class CpuBackend final : public Backend {
  public:
@@ -83,13 +82,7 @@ class CpuBackend final : public Backend {
   // Max speed and the first non-finite particle of the state in next_*.
   uint32_t scan_next_state(float& v2max) const;
 
-  // Says when a failed substep was longer than the stability ceiling (only dt_min can force it).
-  static std::string above_stable_step(float dt, const StepLimits& limits);
-
-  // Where a failed substep went non-finite, worked out on the failure path only, before the new
-  // state replaces the old: the particle with the lowest index names the stage (the first of
-  // its density and pressure, its acceleration, its integrated state and the collision response
-  // that is not finite; the CUDA backend names the same), and up to 8 ids are listed.
+  // Fills non_finite_ for the first non-finite particle of the state in next_* (the failure path).
   void diagnose_non_finite(const FluidConstants& fluid, const SceneFrame& scene, int rk4_stage,
                            uint32_t first);
 
@@ -141,10 +134,7 @@ class CpuBackend final : public Backend {
   uint32_t count_ = 0;
   float max_speed_ = 0.0f;
   float max_acceleration_ = 0.0f;  // of the last force evaluation, for the force step limit
-  struct {
-    std::string where;      // the stage of the first non-finite particle
-    std::string particles;  // how many, and their ids
-  } non_finite_;            // of the last failed substep, for its error message
+  NonFiniteFailure non_finite_;    // of the last failed substep, for its error message
   bool max_speed_valid_ = false;
 };
 

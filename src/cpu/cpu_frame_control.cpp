@@ -2,7 +2,6 @@
 // diagnosis, and the swap to the new state (the twin of cuda/frame_control.cu).
 #include <algorithm>
 #include <cmath>
-#include <string>
 
 #include "cpu_backend_impl.h"
 
@@ -30,50 +29,40 @@ uint32_t CpuBackend::scan_next_state(float& v2max) const {
   return bad_index;
 }
 
-// Says when a failed substep was longer than the stability ceiling (only dt_min can force it).
-std::string CpuBackend::above_stable_step(float dt, const StepLimits& limits) {
-  if (!(limits.stability_dt > 0.0f) || dt <= limits.stability_dt) return "";
-  return ", above this world's stable step " + std::to_string(limits.stability_dt) +
-         " s (0.4 h / c, 0.05 h^2 rho0 / mu), forced by dt_min";
-}
-
 // Where a failed substep went non-finite, worked out on the failure path only, before the new
-// state replaces the old: the particle with the lowest index names the stage (the first of
-// its density and pressure, its acceleration, its integrated state and the collision response
-// that is not finite; the CUDA backend names the same), and up to 8 ids are listed.
+// state replaces the old: the particle with the lowest index is classified (non_finite.h, as on
+// the CUDA backend) from its density pass, its acceleration and its integrated state, which are
+// recomputed here; up to 8 ids are listed.
 void CpuBackend::diagnose_non_finite(const FluidConstants& fluid, const SceneFrame& scene, int rk4_stage,
                                      uint32_t first) {
   const Float4* pos = position_.data.data();
   const Float4* vel = velocity_.data.data();
   const uint32_t i = first;
-  const char* stage = "collide stage (SPH_STAGE_COLLIDE)";
-  if (!std::isfinite(density_.data[i]) || !std::isfinite(pos[i].w) || !std::isfinite(vel[i].w)) {
-    stage = "density stage (SPH_STAGE_DENSITY)";
+  Vec3 a = acceleration_function()(fluid, grid_.view(), pos, vel, neighbors_.data.data(), normals_.data(),
+                                   scene, i);
+  if (springs_) a += spring_acceleration_[i];
+  const ParticleState current{xyz(pos[i]), xyz(vel[i])};
+  ParticleState integrated;
+  if (rk4_stage < 0) {
+    integrated = symplectic_euler(current, a, fluid.dt);
+  } else if (rk4_stage < 3) {
+    Rk4Accumulator sums = rk4_sum_->data[i];  // a copy: the stage has updated the sums already
+    integrated = rk4_advance(rk4_stage, rk4_start_->data[i], current, a, fluid.dt, sums);
   } else {
-    Vec3 a = acceleration_function()(fluid, grid_.view(), pos, vel, neighbors_.data.data(), normals_.data(),
-                                     scene, i);
-    if (springs_) a += spring_acceleration_[i];
-    if (!finite3(a)) {
-      stage = "forces stage (SPH_STAGE_FORCES)";
-    } else if (rk4_stage >= 0) {
-      // The RK4 sums were updated in place, so the integrated state cannot be recomputed.
-      stage = rk4_stage == 3 && !scene.colliders.empty() ? "integrate or collide stage (RK4 stage 4)"
-                                                         : "integrate stage (SPH_STAGE_INTEGRATE)";
-    } else {
-      const ParticleState s = symplectic_euler({xyz(pos[i]), xyz(vel[i])}, a, fluid.dt);
-      if (!finite3(s.position) || !std::isfinite(length_squared(s.velocity)))
-        stage = "integrate stage (SPH_STAGE_INTEGRATE)";
-    }
+    // The last stage's state is start + dt * sums, and the sums hold all four slopes already:
+    // a stage with zero slopes adds nothing to them and returns that state.
+    Rk4Accumulator sums = rk4_sum_->data[i];
+    const Vec3 zero{0.0f, 0.0f, 0.0f};
+    integrated =
+        rk4_advance(3, rk4_start_->data[i], ParticleState{current.position, zero}, zero, fluid.dt, sums);
   }
-  uint32_t count = 0;
-  std::string ids;
+  non_finite_.stage = classify_non_finite(density_.data[i], pos[i], vel[i], a, integrated);
+  non_finite_.count = 0;
+  non_finite_.ids.clear();
   for (uint32_t k = 0; k < count_; ++k) {
     if (finite3(xyz(next_position_[k])) && std::isfinite(length_squared(xyz(next_velocity_[k])))) continue;
-    if (++count <= 8) ids += (count > 1 ? ", " : "") + std::to_string(id_.data[k]);
+    if (++non_finite_.count <= 8) non_finite_.ids.push_back(id_.data[k]);
   }
-  non_finite_.where = stage;
-  non_finite_.particles = std::to_string(count) + (count == 1 ? " particle, id " : " particles, ids ") + ids +
-                          (count > 8 ? ", ..." : "");
 }
 
 uint32_t CpuBackend::finish_substep(float v2max, uint32_t bad_index) {

@@ -2,11 +2,10 @@
 // and the rollback that puts the particles back when a substep fails (the twin of
 // cuda/frame_loop.cu).
 #include <algorithm>
-#include <limits>
-#include <string>
 
 #include "../core/scene_frame.h"
 #include "../core/status.h"
+#include "../core/substep_clock.h"
 #include "cpu_backend_impl.h"
 
 namespace sph {
@@ -44,38 +43,24 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
     max_acceleration_ = saved_max_acceleration;  // the force step limit reads it next step
     link_from_ = saved_link_from;
   };
-  double remaining = frame_dt;
-  double elapsed = 0.0;
-  report.dt_min = std::numeric_limits<float>::max();
+  SubstepClock clock;
+  start_clock(clock, frame_dt);
   try {
-    while (remaining > 0.0 && report.substeps < params.max_substeps) {
-      const float speed = std::max(max_speed_, scene.max_collider_speed);
-      const double dt = landing_dt(controller_dt(limits, speed, max_acceleration_), remaining);
-      const float dtf = static_cast<float>(dt);
-      SubstepTime time;
-      time.tau0 = static_cast<float>(elapsed);
-      time.tau1 = static_cast<float>(elapsed + dt);
-      time.s0 = static_cast<float>(elapsed / frame_dt);
-      time.s1 = remaining <= dt ? 1.0f : static_cast<float>((elapsed + dt) / frame_dt);
-      time.dt = dtf;
-      fluid.dt = dtf;
-      const uint32_t bad = config_.integrator == Integrator::Rk4 ? substep_rk4(fluid, scene, time, report)
-                                                                 : substep_euler(fluid, scene, time, report);
+    while (clock_running(clock, params.max_substeps)) {
+      pick_next_step(clock, frame_dt, limits, std::max(max_speed_, scene.max_collider_speed),
+                     max_acceleration_);
+      fluid.dt = clock.dt_float;
+      const uint32_t bad = config_.integrator == Integrator::Rk4
+                               ? substep_rk4(fluid, scene, clock.time, report)
+                               : substep_euler(fluid, scene, clock.time, report);
       if (bad != kAllFinite) {
         roll_back();
-        throw Error(Status::NonFinite, "the step produced non-finite values in the " + non_finite_.where +
-                                           " of substep " + std::to_string(report.substeps + 1) + " (dt " +
-                                           std::to_string(dtf) + " s" + above_stable_step(dtf, limits) +
-                                           "): " + non_finite_.particles +
-                                           "; the world was restored to its state before sph_world_step");
+        non_finite_.substep = clock.substeps + 1;
+        non_finite_.dt = clock.dt_float;
+        throw Error(Status::NonFinite, non_finite_message(non_finite_, limits));
       }
       if (!scene.sinks.empty()) apply_sinks(scene, report);
-      remaining -= dt;
-      elapsed += dt;
-      ++report.substeps;
-      report.time_advanced += dt;
-      report.dt_min = std::min(report.dt_min, dtf);
-      report.dt_max = std::max(report.dt_max, dtf);
+      advance_clock(clock);
     }
   } catch (const Error& e) {
     if (e.status() != Status::NonFinite) roll_back();  // NonFinite has rolled back already
@@ -84,8 +69,7 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
     roll_back();
     throw;
   }
-  if (report.substeps == 0) report.dt_min = 0.0f;
-  report.completed = remaining <= 0.0;
+  report_clock(clock, report);
   report.max_speed = max_speed_;
   const auto t = Clock::now();
   summarize(report);
