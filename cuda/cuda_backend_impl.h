@@ -70,9 +70,6 @@ class CudaBackend final : public Backend {
 
   FrameReport step_frame(double frame_dt, const RuntimeParams& params) override;
 
-  // A frame with colliders and force fields runs in the frame graph like any other: the
-  // scene's assets and views are uploaded first, outside the graph. A frame with sinks runs on
-  // the stream (the particle count changes inside it; see docs/cuda.md).
   FrameReport step_scene_frame(double frame_dt, const RuntimeParams& params,
                                const SceneFrame& scene_in) override;
 
@@ -143,23 +140,12 @@ class CudaBackend final : public Backend {
     for (size_t k = 0; k < host.size(); ++k) std::memcpy(out + k * stride, &host[k], sizeof(T));
   }
 
-  // (Re)captures the frame graph when the particle count or a parameter changed. A graph that
-  // cannot be built for a non-sticky reason (an old driver without conditional nodes) leaves
-  // the world on the stream fallback.
-  void prepare_graph(const PipelineSetup& setup);
+  // (Re)captures the frame graph when needed; false when it cannot be built (see frame_loop.cu).
+  bool prepare_graph(const PipelineSetup& setup);
 
-  // The fallback: the same work launched stage by stage, reading the loop condition back
-  // after every substep.
-  void run_frame_on_stream(const PipelineSetup& setup);
-
-  // A frame with sinks: the fallback's loop, and after every substep the sinks' stable
-  // compaction, whose survivor count comes back to the host with the loop condition (one
-  // synchronisation per substep, a second one only when particles were removed). Returns the
-  // particle count after the frame; the removed ids, in the CPU backend's order, and the
-  // per-sink counts are appended.
-  uint32_t run_sink_frame_on_stream(PipelineSetup setup, uint32_t sink_count,
-                                    std::vector<uint32_t>& removed_ids,
-                                    std::vector<uint32_t>& removed_by_sink);
+  // The stream driver (frame_loop.cu): frames with sinks, and every frame without graphs.
+  uint32_t run_frame_on_stream(PipelineSetup setup, uint32_t sink_count, std::vector<uint32_t>& removed_ids,
+                               std::vector<uint32_t>& removed_by_sink);
 
   WorldConfig config_;
   int device_;

@@ -30,9 +30,10 @@ FrameReport CudaBackend::step_frame(double frame_dt, const RuntimeParams& params
   return step_scene_frame(frame_dt, params, SceneFrame{});
 }
 
-// A frame with colliders and force fields runs in the frame graph like any other: the
-// scene's assets and views are uploaded first, outside the graph. A frame with sinks runs on
-// the stream (the particle count changes inside it; see docs/cuda.md).
+// One frame, run by one of two drivers (docs/cuda.md): the frame graph (frame_graph.h), or the
+// stream driver (run_frame_on_stream) for frames with sinks and when graphs are off. A frame
+// with colliders and force fields runs in the frame graph like any other: the scene's assets
+// and views are uploaded first, outside the graph.
 FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& params,
                                           const SceneFrame& scene_in) {
   require_alive();
@@ -66,16 +67,14 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
       input->frame_dt = frame_dt;
       input->max_collider_speed = scene_in.max_collider_speed;
       input->pad = 0;
-      if (!with_sinks) prepare_graph(setup);
+      const bool on_graph = use_graphs_ && !with_sinks && prepare_graph(setup);
       cuda_check(cudaEventRecord(r_->frame_start, r_->stream), "cudaEventRecord");
       frame_enqueued = true;
-      if (with_sinks)
-        count_after = run_sink_frame_on_stream(setup, static_cast<uint32_t>(scene_in.sinks.size()),
-                                               removed_ids, removed_by_sink);
-      else if (use_graphs_)
+      if (on_graph)
         r_->graph.launch(r_->stream);
       else
-        run_frame_on_stream(setup);
+        count_after = run_frame_on_stream(setup, static_cast<uint32_t>(scene_in.sinks.size()), removed_ids,
+                                          removed_by_sink);
       cuda_check(cudaEventRecord(r_->frame_stop, r_->stream), "cudaEventRecord");
       cuda_check(cudaStreamSynchronize(r_->stream), "frame");
       cuda_check(cudaEventElapsedTime(&frame_ms, r_->frame_start, r_->frame_stop), "cudaEventElapsedTime");
@@ -133,43 +132,30 @@ void CudaBackend::roll_back_frame() {
 
 // (Re)captures the frame graph when the particle count or a parameter changed. A graph that
 // cannot be built for a non-sticky reason (an old driver without conditional nodes) leaves
-// the world on the stream fallback.
-void CudaBackend::prepare_graph(const PipelineSetup& setup) {
-  if (!use_graphs_) return;
-  if (r_->graph.ready() && same_setup(setup, r_->graph_setup)) return;
+// the world on the stream driver for good; returns whether the graph is ready.
+bool CudaBackend::prepare_graph(const PipelineSetup& setup) {
+  if (r_->graph.ready() && same_setup(setup, r_->graph_setup)) return true;
   try {
     r_->graph.build(setup, r_->buffers(), r_->stream);
     r_->graph_setup = setup;
+    return true;
   } catch (const Error& e) {
     if (e.status() == Status::DeviceLost || e.status() == Status::OutOfDeviceMemory) throw;
     use_graphs_ = false;
+    return false;
   }
 }
 
-// The fallback: the same work launched stage by stage, reading the loop condition back
-// after every substep.
-void CudaBackend::run_frame_on_stream(const PipelineSetup& setup) {
-  const PipelineBuffers b = r_->buffers();
-  enqueue_frame_begin(setup, b, LoopCondition{}, r_->stream);
-  for (;;) {
-    cuda_check(cudaMemcpyAsync(&b.state_output->run, &b.state->run, sizeof(uint32_t), cudaMemcpyDeviceToHost,
-                               r_->stream),
-               "copy of the loop condition");
-    cuda_check(cudaStreamSynchronize(r_->stream), "substep");
-    if (!b.state_output->run) break;
-    enqueue_substep(setup, b, LoopCondition{}, r_->stream);
-  }
-  enqueue_frame_end(setup, b, r_->stream);
-}
-
-// A frame with sinks: the fallback's loop, and after every substep the sinks' stable
-// compaction, whose survivor count comes back to the host with the loop condition (one
-// synchronisation per substep, a second one only when particles were removed). Returns the
-// particle count after the frame; the removed ids, in the CPU backend's order, and the
-// per-sink counts are appended.
-uint32_t CudaBackend::run_sink_frame_on_stream(PipelineSetup setup, uint32_t sink_count,
-                                               std::vector<uint32_t>& removed_ids,
-                                               std::vector<uint32_t>& removed_by_sink) {
+// The stream driver: the frame's work launched stage by stage on the stream, reading the loop
+// condition back after every substep. It runs what the frame graph cannot: every frame with
+// sinks (their compaction changes the particle count inside the frame, and a captured graph
+// has its launch sizes fixed), and every frame when graphs are off or the driver cannot build
+// them. With sinks, the survivor count comes back with the loop condition (one synchronisation
+// per substep, a second one only when particles were removed). Returns the particle count after
+// the frame; the removed ids, in the CPU backend's order, and the per-sink counts are appended.
+uint32_t CudaBackend::run_frame_on_stream(PipelineSetup setup, uint32_t sink_count,
+                                          std::vector<uint32_t>& removed_ids,
+                                          std::vector<uint32_t>& removed_by_sink) {
   const PipelineBuffers b = r_->buffers();
   const ParticleArrays& a = b.store->arrays();
   cudaStream_t s = r_->stream;
@@ -181,22 +167,25 @@ uint32_t CudaBackend::run_sink_frame_on_stream(PipelineSetup setup, uint32_t sin
   cuda_check(cudaMemcpyAsync(&out->run, &b.state->run, sizeof(uint32_t), cudaMemcpyDeviceToHost, s),
              "copy of the loop condition");
   cuda_check(cudaStreamSynchronize(s), "frame begin");
-  bool counts_from_compaction = false;
+  const uint32_t* counts_after_sinks = nullptr;
   std::vector<uint32_t> ids, sinks;
   while (out->run) {
     setup.count = n;
     enqueue_substep(setup, b, LoopCondition{}, s);
-    r_->sinks.enqueue_flag(r_->scene_buffer.sinks(), sink_count, a, n, b.state, s);
+    if (sink_count > 0) r_->sinks.enqueue_flag(r_->scene_buffer.sinks(), sink_count, a, n, b.state, s);
     cuda_check(cudaMemcpyAsync(&out->run, &b.state->run, sizeof(uint32_t), cudaMemcpyDeviceToHost, s),
                "copy of the loop condition");
-    cuda_check(
-        cudaMemcpyAsync(&out->non_finite, &b.state->non_finite, sizeof(uint32_t), cudaMemcpyDeviceToHost, s),
-        "copy of the non-finite flag");
-    cuda_check(
-        cudaMemcpyAsync(kept_out, r_->sinks.kept_device(), sizeof(uint32_t), cudaMemcpyDeviceToHost, s),
-        "copy of the sink survivor count");
+    if (sink_count > 0) {
+      cuda_check(cudaMemcpyAsync(&out->non_finite, &b.state->non_finite, sizeof(uint32_t),
+                                 cudaMemcpyDeviceToHost, s),
+                 "copy of the non-finite flag");
+      cuda_check(
+          cudaMemcpyAsync(kept_out, r_->sinks.kept_device(), sizeof(uint32_t), cudaMemcpyDeviceToHost, s),
+          "copy of the sink survivor count");
+    }
     cuda_check(cudaStreamSynchronize(s), "substep");
-    counts_from_compaction = false;
+    if (sink_count == 0) continue;
+    counts_after_sinks = nullptr;
     if (out->non_finite) break;  // as on the CPU: no sinks after a failed substep
     const uint32_t kept = *kept_out;
     if (kept == n) continue;
@@ -221,13 +210,10 @@ uint32_t CudaBackend::run_sink_frame_on_stream(PipelineSetup setup, uint32_t sin
     removed_ids.insert(removed_ids.end(), ids.begin(), ids.end());
     for (uint32_t k : sinks) ++removed_by_sink[k];
     n = kept;
-    counts_from_compaction = counts != nullptr;
+    counts_after_sinks = counts;
   }
   setup.count = n;
-  b.statistics->enqueue(setup.fluid, b.grid->view(), a, n, b.state, s,
-                        counts_from_compaction ? r_->sinks.counts() : nullptr);
-  cuda_check(cudaMemcpyAsync(out, b.state, sizeof(FrameState), cudaMemcpyDeviceToHost, s),
-             "copy of the frame state");
+  enqueue_frame_end(setup, b, s, counts_after_sinks);
   return n;
 }
 
