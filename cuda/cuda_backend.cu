@@ -1,6 +1,5 @@
 // The CUDA backend's particles: creation, appends, truncation, copies out, checkpoints and the
 // interop tier of sph_cuda.h (the twin of src/cpu/cpu_backend.cpp; frames are frame_loop.cu).
-#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -13,24 +12,9 @@
 #include "device_springs.h"
 
 namespace sph {
-namespace {
 
-unsigned env_block_size(const char* name, unsigned fallback) {
-  const char* value = std::getenv(name);
-  if (!value) return fallback;
-  const long v = std::strtol(value, nullptr, 10);
-  return (v == 32 || v == 64 || v == 128 || v == 256 || v == 512 || v == 1024) ? static_cast<unsigned>(v)
-                                                                               : fallback;
-}
-
-bool env_graphs_enabled() {
-  const char* value = std::getenv("SPH_CUDA_GRAPHS");
-  return !(value && std::strcmp(value, "0") == 0);
-}
-
-}  // namespace
-
-CudaBackend::CudaBackend(const WorldConfig& config, int device) : config_(config), device_(device) {
+CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBackendOptions& options)
+    : config_(config), device_(device) {
   DeviceGuard guard(device_);
   auto r = std::make_unique<DeviceResources>();
   cuda_check(cudaStreamCreateWithFlags(&r->stream, cudaStreamNonBlocking), "cudaStreamCreate");
@@ -59,9 +43,9 @@ CudaBackend::CudaBackend(const WorldConfig& config, int device) : config_(config
   r->state_output.allocate(1, "frame output");
   r->sink_kept.allocate(1, "sink survivor count");
   cuda_check(cudaStreamSynchronize(r->stream), "backend set-up");
-  tuning_.density_block = env_block_size("SPH_CUDA_DENSITY_BLOCK", tuning_.density_block);
-  tuning_.force_block = env_block_size("SPH_CUDA_FORCE_BLOCK", tuning_.force_block);
-  use_graphs_ = env_graphs_enabled();
+  tuning_.density_block = options.density_block;
+  tuning_.force_block = options.force_block;
+  use_graphs_ = !options.stream_frames;
   r_ = std::move(r);
 }
 
@@ -298,8 +282,9 @@ int cuda_usable_device_count() {
   return count;
 }
 
-std::unique_ptr<Backend> make_cuda_backend(const WorldConfig& config, int device_ordinal) {
-  return std::make_unique<CudaBackend>(config, device_ordinal);
+std::unique_ptr<Backend> make_cuda_backend(const WorldConfig& config, int device_ordinal,
+                                           const CudaBackendOptions& options) {
+  return std::make_unique<CudaBackend>(config, device_ordinal, options);
 }
 
 }  // namespace sph

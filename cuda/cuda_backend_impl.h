@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "../src/core/backend.h"
+#include "cuda_backend.h"
 #include "cuda_status.h"
 #include "device_array.h"
 #include "device_neighbor_grid.h"
@@ -58,7 +59,7 @@ struct DeviceResources {
 
 class CudaBackend final : public Backend {
  public:
-  CudaBackend(const WorldConfig& config, int device);
+  CudaBackend(const WorldConfig& config, int device, const CudaBackendOptions& options);
   ~CudaBackend() override;
 
   uint32_t particle_count() const override { return count_; }
@@ -67,8 +68,6 @@ class CudaBackend final : public Backend {
 
   // Drops particles [count, particle_count()) (an emission undone after a failed step).
   void truncate(uint32_t count) override;
-
-  FrameReport step_frame(double frame_dt, const RuntimeParams& params) override;
 
   FrameReport step_scene_frame(double frame_dt, const RuntimeParams& params,
                                const SceneFrame& scene_in) override;

@@ -26,10 +26,6 @@ bool same_setup(const PipelineSetup& a, const PipelineSetup& b) {
 
 }  // namespace
 
-FrameReport CudaBackend::step_frame(double frame_dt, const RuntimeParams& params) {
-  return step_scene_frame(frame_dt, params, SceneFrame{});
-}
-
 // One frame, run by one of two drivers (docs/cuda.md): the frame graph (frame_graph.h), or the
 // stream driver (run_frame_on_stream) for frames with sinks and when graphs are off. A frame
 // with colliders and force fields runs in the frame graph like any other: the scene's assets

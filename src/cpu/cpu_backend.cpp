@@ -5,6 +5,7 @@
 
 #include "../core/grid_layout.h"
 #include "../physics/density_normalization.h"
+#include "cpu_backend.h"
 #include "cpu_backend_impl.h"
 
 namespace sph {

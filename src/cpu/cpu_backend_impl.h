@@ -35,8 +35,6 @@ class CpuBackend final : public Backend {
 
   void append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id) override;
 
-  FrameReport step_frame(double frame_dt, const RuntimeParams& params) override;
-
   FrameReport step_scene_frame(double frame_dt, const RuntimeParams& params,
                                const SceneFrame& scene_in) override;
 

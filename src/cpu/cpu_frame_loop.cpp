@@ -10,10 +10,6 @@
 
 namespace sph {
 
-FrameReport CpuBackend::step_frame(double frame_dt, const RuntimeParams& params) {
-  return step_scene_frame(frame_dt, params, SceneFrame{});
-}
-
 FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& params,
                                          const SceneFrame& scene_in) {
   FrameReport report;
