@@ -6,7 +6,6 @@
 #include <vector>
 
 #include "../src/core/grid_layout.h"
-#include "../src/physics/density_normalization.h"
 #include "cuda_backend.h"
 #include "cuda_backend_impl.h"
 #include "device_springs.h"
@@ -24,13 +23,11 @@ CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBacken
   options_.normalized_density = (config.features & kFeatureNormalizedDensity) != 0;
   options_.viscosity = config.viscosity_method;
   options_.springs = (config.features & kFeatureSprings) != 0;
-  StoreOptions store_options;
-  store_options.rk4 = config.integrator == Integrator::Rk4;
-  store_options.neighbor_counts = options_.viscosity == ViscosityMethod::Clavet;
-  store_options.normalized_density = options_.normalized_density;
-  store_options.colour_normals = options_.surface_tension;
-  store_options.springs = options_.springs;
-  r->store = std::make_unique<DeviceParticleStore>(config.capacity, store_options);
+  // The methods' arrays (particle_arrays.h), and this backend's working arrays for springs.
+  std::vector<ParticleArraySpec> arrays = method_particle_arrays(config);
+  if (options_.springs)
+    for (const ParticleArraySpec& spec : spring_device_arrays()) arrays.push_back(spec);
+  r->store = std::make_unique<DeviceParticleStore>(config.capacity, arrays);
   // The sorted positions are free while the sort runs: its temporary storage goes there.
   r->grid = std::make_unique<DeviceNeighborGrid>(
       make_grid_shape(config.kernel_radius, config.capacity), config.capacity, r->store->sort_scratch(),
@@ -38,7 +35,7 @@ CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBacken
   r->statistics = std::make_unique<FrameStatistics>(config.capacity);
   r->state.allocate(1, "frame state");
   cuda_check(cudaMemsetAsync(r->state.get(), 0, sizeof(FrameState), r->stream), "frame state reset");
-  r->store->enqueue_reset_link_state(r->stream);
+  r->store->enqueue_initial_world_words(r->stream);
   r->input.allocate(1, "frame input");
   r->state_output.allocate(1, "frame output");
   r->sink_kept.allocate(1, "sink survivor count");
@@ -65,8 +62,12 @@ void CudaBackend::append(const Vec3* positions, const Vec3* velocities, uint32_t
   std::vector<Float4> pos(n), vel(n);
   std::vector<uint32_t> ids(n);
   const std::vector<float> density(n, config_.rest_density);
-  // Normalised density: a fresh particle's factor is resolved by its first density pass.
-  const std::vector<float> fresh(options_.normalized_density ? n : 0u, fresh_density_factor());
+  // The methods' carried arrays start at their initial values (a fresh density factor, which
+  // the first density pass resolves; an empty spring list).
+  std::vector<std::vector<unsigned char>> initial;
+  for (const auto& m : r_->store->method_arrays())
+    if (m->spec.role == ParticleArrayRole::Carried && m->spec.elements_per_particle != 0)
+      initial.push_back(carried_bytes(ParticleSnapshot{}, m->spec, n));
   for (uint32_t k = 0; k < n; ++k) {
     const Vec3 v = velocities ? velocities[k] : Vec3{0.0f, 0.0f, 0.0f};
     pos[k] = make_float4_record(positions[k], 0.0f);
@@ -87,18 +88,17 @@ void CudaBackend::append(const Vec3* positions, const Vec3* velocities, uint32_t
     cuda_check(
         cudaMemcpyAsync(a.density + count_, density.data(), sizeof(float) * n, cudaMemcpyHostToDevice, s),
         "copy of new densities");
-    if (options_.springs && n > 0) {
-      // New particles have no springs yet; they make them at their first substep.
-      const std::vector<SpringList> empty(n, empty_spring_list());
-      cuda_check(cudaMemcpyAsync(a.springs + count_, empty.data(), sizeof(SpringList) * n,
-                                 cudaMemcpyHostToDevice, s),
-                 "copy of new spring lists");
-      enqueue_springs_appended(a, first_id, s);
+    size_t k = 0;
+    for (const auto& m : r_->store->method_arrays()) {
+      if (m->spec.role != ParticleArrayRole::Carried || m->spec.elements_per_particle == 0) continue;
+      if (n > 0)
+        cuda_check(cudaMemcpyAsync(m->side[0].get() + m->bytes_for(count_), initial[k].data(),
+                                   m->bytes_for(n), cudaMemcpyHostToDevice, s),
+                   m->spec.name);
+      ++k;
     }
-    if (a.density_factor)
-      cuda_check(cudaMemcpyAsync(a.density_factor + count_, fresh.data(), sizeof(float) * n,
-                                 cudaMemcpyHostToDevice, s),
-                 "copy of new density factors");
+    // New particles have no springs yet; they make them at their first substep.
+    if (a.springs && n > 0) enqueue_springs_appended(a, first_id, s);
     enqueue_recompute_max_speed(a.velocity, count_ + n, r_->state.get(), s);
     cuda_check(cudaStreamSynchronize(s), "append");
   });
@@ -163,13 +163,16 @@ ParticleSnapshot CudaBackend::export_particles() const {
   s.velocity = download(a.velocity, count_);
   s.id = download(a.id, count_);
   s.density = download(a.density, count_);
-  if (a.density_factor) s.density_factor = download(a.density_factor, count_);
   const std::vector<FrameState> state = download(static_cast<const FrameState*>(r_->state.get()), 1u);
   s.max_speed = state[0].max_speed;
   s.max_acceleration = state[0].max_acceleration;
-  if (options_.springs) {
-    s.springs = download(static_cast<const SpringList*>(a.springs), count_);
-    s.link_from = download(static_cast<const uint32_t*>(a.link_from), 1u)[0];
+  for (const auto& m : r_->store->method_arrays()) {
+    if (m->spec.role != ParticleArrayRole::Carried) continue;
+    CarriedArray c;
+    c.name = m->spec.name;
+    c.element_size = m->spec.element_size;
+    c.bytes = download(static_cast<const unsigned char*>(m->side[0].get()), m->bytes_for(count_));
+    s.carried.push_back(std::move(c));
   }
   return s;
 }
@@ -177,14 +180,16 @@ ParticleSnapshot CudaBackend::export_particles() const {
 void CudaBackend::import_particles(const ParticleSnapshot& s) {
   require_alive();
   const uint32_t n = static_cast<uint32_t>(s.id.size());
-  if (n > config_.capacity || s.position.size() != n || s.velocity.size() != n || s.density.size() != n ||
-      (!s.density_factor.empty() && s.density_factor.size() != n))
+  if (n > config_.capacity || s.position.size() != n || s.velocity.size() != n || s.density.size() != n)
     throw Error(Status::Internal, "import_particles: inconsistent snapshot");
-  if (options_.springs ? s.springs.size() != n : !s.springs.empty())
-    throw Error(Status::Internal, "import_particles: spring lists do not match the particles");
-  const std::vector<float> factor = !options_.normalized_density ? std::vector<float>()
-                                    : s.density_factor.empty() ? std::vector<float>(n, fresh_density_factor())
-                                                               : s.density_factor;
+  std::vector<ParticleArraySpec> specs;
+  for (const auto& m : r_->store->method_arrays()) specs.push_back(m->spec);
+  check_carried_arrays(s, specs, n);
+  // A carried array the snapshot lacks (a checkpoint written before the method carried it)
+  // starts every particle fresh, as if it had just been spawned.
+  std::vector<std::vector<unsigned char>> carried;
+  for (const auto& m : r_->store->method_arrays())
+    if (m->spec.role == ParticleArrayRole::Carried) carried.push_back(carried_bytes(s, m->spec, n));
   DeviceGuard guard(device_);
   ++epoch_;
   guarded([&] {
@@ -201,20 +206,16 @@ void CudaBackend::import_particles(const ParticleSnapshot& s) {
                  "copy of checkpoint ids");
       cuda_check(cudaMemcpyAsync(a.density, s.density.data(), sizeof(float) * n, cudaMemcpyHostToDevice, st),
                  "copy of checkpoint densities");
-      if (options_.springs)
-        cuda_check(
-            cudaMemcpyAsync(a.springs, s.springs.data(), sizeof(SpringList) * n, cudaMemcpyHostToDevice, st),
-            "copy of checkpoint spring lists");
-      if (a.density_factor)
-        // A snapshot without factors (a checkpoint written before they existed) starts every
-        // particle fresh, as if it had just been spawned.
-        cuda_check(
-            cudaMemcpyAsync(a.density_factor, factor.data(), sizeof(float) * n, cudaMemcpyHostToDevice, st),
-            "copy of checkpoint density factors");
     }
-    if (options_.springs)
-      cuda_check(cudaMemcpyAsync(a.link_from, &s.link_from, sizeof(uint32_t), cudaMemcpyHostToDevice, st),
-                 "copy of the checkpoint's spring link state");
+    size_t k = 0;
+    for (const auto& m : r_->store->method_arrays()) {
+      if (m->spec.role != ParticleArrayRole::Carried) continue;
+      if (!carried[k].empty())
+        cuda_check(cudaMemcpyAsync(m->side[0].get(), carried[k].data(), carried[k].size(),
+                                   cudaMemcpyHostToDevice, st),
+                   m->spec.name);
+      ++k;
+    }
     FrameState* state = r_->state.get();
     cuda_check(cudaMemcpyAsync(&state->max_speed, &s.max_speed, sizeof(float), cudaMemcpyHostToDevice, st),
                "copy of the checkpoint's max speed");

@@ -124,7 +124,7 @@ class CudaBackend final : public Backend {
   }
 
   template <class T>
-  std::vector<T> download(const T* src, uint32_t count) const {
+  std::vector<T> download(const T* src, size_t count) const {
     std::vector<T> host(count);
     guarded([&] {
       cuda_check(cudaMemcpyAsync(host.data(), src, sizeof(T) * count, cudaMemcpyDeviceToHost, r_->stream),

@@ -66,6 +66,13 @@ __global__ void springs_appended_kernel(uint32_t* link_from, uint32_t first_id) 
 
 }  // namespace
 
+std::vector<ParticleArraySpec> spring_device_arrays() {
+  return {ParticleArraySpec{kArraySortedSprings, sizeof(SpringList), ParticleArrayRole::Scratch, 1, nullptr,
+                            nullptr},
+          ParticleArraySpec{kArraySpringInverse, sizeof(uint32_t), ParticleArrayRole::Scratch, 1, nullptr,
+                            nullptr}};
+}
+
 void enqueue_spring_reorder(const ParticleArrays& a, const uint32_t* order, uint32_t n, cudaStream_t stream) {
   const unsigned blocks = blocks_for(n, kDefaultBlockSize);
   spring_inverse_kernel<<<blocks, kDefaultBlockSize, 0, stream>>>(order, n, a.spring_inverse);

@@ -56,7 +56,7 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
         bind_scene_views(scene, [&](const SdfAsset& a) { return r_->sdf_cache.bind(a, r_->stream); });
         r_->sdf_cache.end_frame();
         setup.scene = r_->scene_buffer.upload(scene, config_.kernel_radius, r_->stream);
-        if (with_sinks) r_->sinks.reserve(config_.capacity);
+        if (with_sinks) r_->sinks.reserve(config_.capacity, *r_->store);
         cuda_check(cudaStreamSynchronize(r_->stream), "upload of the scene");
       }
       FrameInput* input = r_->input.get();
@@ -192,7 +192,7 @@ uint32_t CudaBackend::run_frame_on_stream(PipelineSetup setup, uint32_t sink_cou
       counts = r_->sinks.counts();
       b.statistics->enqueue_neighbor_counts(setup.fluid, b.grid->view(), a, n, counts, s);
     }
-    r_->sinks.enqueue_compact(a, n, kept, counts, s);
+    r_->sinks.enqueue_compact(*b.store, n, kept, counts, s);
     const uint32_t removed = n - kept;
     ids.resize(removed);
     sinks.resize(removed);

@@ -13,6 +13,7 @@
 #include "../physics/vec3.h"
 #include "config.h"
 #include "frame_report.h"
+#include "particle_snapshot.h"
 #include "scene_frame.h"
 #include "status.h"
 
@@ -28,23 +29,6 @@ struct DeviceAttributeView {
   uint32_t count = 0;         // particles
   uint64_t epoch = 0;         // data_epoch() when the view was taken
   int device = 0;
-};
-
-// Everything a backend carries from one frame to the next, in storage order (the order of the
-// last sort, which fixes the summation order of the next one): loading it into a fresh backend
-// of the same kind continues bit for bit (checkpoints).
-struct ParticleSnapshot {
-  std::vector<Float4> position;  // w: pressure of the last density pass
-  std::vector<Float4> velocity;  // w: 1 / density of the last density pass
-  std::vector<uint32_t> id;
-  std::vector<float> density;
-  float max_speed = 0.0f;         // |v|max the next frame's first step is chosen from
-  float max_acceleration = 0.0f;  // |a|max of the last force evaluation (the force step limit)
-  // SPH_FEATURE_SPRINGS only (empty otherwise): each particle's springs, partners as storage
-  // indices, and the lowest id still waiting for its springs (kNoPendingLinks: none).
-  std::vector<SpringList> springs;
-  uint32_t link_from = kNoPendingLinks;
-  std::vector<float> density_factor;  // normalised density's carried factors; empty when off
 };
 
 class Backend {

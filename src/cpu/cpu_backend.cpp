@@ -1,10 +1,11 @@
 // The CPU backend's particles: creation, appends, truncation, copies out, checkpoints (the twin
 // of cuda/cuda_backend.cu).
+#include <algorithm>
 #include <cstring>
 #include <memory>
+#include <utility>
 
 #include "../core/grid_layout.h"
-#include "../physics/density_normalization.h"
 #include "cpu_backend.h"
 #include "cpu_backend_impl.h"
 
@@ -14,39 +15,52 @@ CpuBackend::CpuBackend(const WorldConfig& config, unsigned workers)
     : config_(config),
       workers_(workers == 0 ? 1u : workers),
       grid_(make_grid_shape(config.kernel_radius, config.capacity)),
-      position_(store_.add<Float4>()),  // w: pressure after the density pass
-      velocity_(store_.add<Float4>()),  // w: 1 / density after the density pass
-      id_(store_.add<uint32_t>()),
-      density_(store_.add<float>()),
-      neighbors_(store_.add<uint32_t>()) {
-  if (config.integrator == Integrator::Rk4) {
-    // Only an RK4 world pays for the start state and the slope accumulators.
-    rk4_start_ = &store_.add<ParticleState>();
-    rk4_sum_ = &store_.add<Rk4Accumulator>();
-  }
-  // Only a world with springs pays for the spring lists.
-  if (config.features & kFeatureSprings) springs_ = &store_.add_array(std::make_unique<HostSpringArray>());
-  // Normalised density carries a per-particle factor (density_normalization.h): sorted, rolled
-  // back and checkpointed with the particles; allocated only when the feature is on.
-  if (config.features & kFeatureNormalizedDensity) density_factor_ = &store_.add<float>();
+      method_arrays_(method_particle_arrays(config)) {
+  using Role = ParticleArrayRole;
+  const auto array = [](const char* name, uint32_t size, Role role) {
+    return ParticleArraySpec{name, size, role, 1, nullptr, nullptr};
+  };
+  position_ = store_.add_typed<Float4>(array(kArrayPosition, sizeof(Float4), Role::Carried));
+  velocity_ = store_.add_typed<Float4>(array(kArrayVelocity, sizeof(Float4), Role::Carried));
+  id_ = store_.add_typed<uint32_t>(array(kArrayId, sizeof(uint32_t), Role::Carried));
+  density_ = store_.add_typed<float>(array(kArrayDensity, sizeof(float), Role::Carried));
+  // The statistics read the last density pass's counts after a sink's compaction: they follow it.
+  neighbors_ = store_.add_typed<uint32_t>(array(kArrayNeighborCount, sizeof(uint32_t), Role::Sorted));
+  next_position_ = store_.add_typed<Float4>(array("next_position", sizeof(Float4), Role::Scratch));
+  next_velocity_ = store_.add_typed<Float4>(array("next_velocity", sizeof(Float4), Role::Scratch));
+  // Only a world that uses a method pays for its arrays.
+  for (const ParticleArraySpec& spec : method_arrays_) store_.add(spec);
+  rk4_start_ = store_.find_typed<ParticleState>(kArrayRk4Start);
+  rk4_sum_ = store_.find_typed<Rk4Accumulator>(kArrayRk4Sum);
+  density_factor_ = store_.find_typed<float>(kArrayDensityFactor);
+  normalized_ = store_.find_typed<float>(kArrayNormalizedDensity);
+  normals_ = store_.find_typed<Float4>(kArrayColourNormal);
+  springs_ = store_.find_typed<SpringList>(kArraySprings);
+  link_from_ = store_.find_typed<uint32_t>(kArraySpringLinkFrom);
+  spring_candidates_ = store_.find_typed<uint32_t>(kArraySpringCandidates);
+  spring_acceleration_ = store_.find_typed<Float4>(kArraySpringAcceleration);
 }
 
 void CpuBackend::append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id) {
   const uint32_t total = count_ + n;
-  store_.resize(total);  // std::bad_alloc leaves count_ unchanged; the C layer maps it
+  // New elements of the methods' arrays take their initial values (a fresh density factor, an
+  // empty spring list). std::bad_alloc leaves count_ unchanged; the C layer maps it.
+  store_.resize(total);
+  Float4* position = position_.data();
+  Float4* velocity = velocity_.data();
   for (uint32_t k = 0; k < n; ++k) {
     const uint32_t i = count_ + k;
     const Vec3 v = velocities ? velocities[k] : Vec3{0.0f, 0.0f, 0.0f};
-    position_.data[i] = make_float4_record(positions[k], 0.0f);
-    velocity_.data[i] = make_float4_record(v, 1.0f / config_.rest_density);
-    id_.data[i] = first_id + k;
-    density_.data[i] = config_.rest_density;
-    neighbors_.data[i] = 0;
-    if (density_factor_) density_factor_->data[i] = fresh_density_factor();
+    position[i] = make_float4_record(positions[k], 0.0f);
+    velocity[i] = make_float4_record(v, 1.0f / config_.rest_density);
+    id_[i] = first_id + k;
+    density_[i] = config_.rest_density;
+    neighbors_[i] = 0;
   }
   count_ = total;
   max_speed_valid_ = false;
-  if (springs_ && n > 0 && first_id < link_from_) link_from_ = first_id;  // they link at their first substep
+  if (link_from_ && n > 0 && first_id < link_from_[0])
+    link_from_[0] = first_id;  // they link at their first substep
 }
 
 void CpuBackend::truncate(uint32_t count) {
@@ -64,23 +78,23 @@ void CpuBackend::copy_attribute(AttributeKind kind, uint32_t first, uint32_t cou
     unsigned char* p = out + static_cast<size_t>(k) * stride;
     switch (kind) {
       case AttributeKind::Position: {
-        const float v[3] = {position_.data[i].x, position_.data[i].y, position_.data[i].z};
+        const float v[3] = {position_[i].x, position_[i].y, position_[i].z};
         std::memcpy(p, v, sizeof v);
         break;
       }
       case AttributeKind::Velocity: {
-        const float v[3] = {velocity_.data[i].x, velocity_.data[i].y, velocity_.data[i].z};
+        const float v[3] = {velocity_[i].x, velocity_[i].y, velocity_[i].z};
         std::memcpy(p, v, sizeof v);
         break;
       }
       case AttributeKind::Density:
-        std::memcpy(p, &density_.data[i], sizeof(float));
+        std::memcpy(p, &density_[i], sizeof(float));
         break;
       case AttributeKind::Pressure:
-        std::memcpy(p, &position_.data[i].w, sizeof(float));
+        std::memcpy(p, &position_[i].w, sizeof(float));
         break;
       case AttributeKind::Id:
-        std::memcpy(p, &id_.data[i], sizeof(uint32_t));
+        std::memcpy(p, &id_[i], sizeof(uint32_t));
         break;
     }
   }
@@ -88,19 +102,22 @@ void CpuBackend::copy_attribute(AttributeKind kind, uint32_t first, uint32_t cou
 
 ParticleSnapshot CpuBackend::export_particles() const {
   ParticleSnapshot s;
-  s.position.assign(position_.data.begin(), position_.data.begin() + count_);
-  s.velocity.assign(velocity_.data.begin(), velocity_.data.begin() + count_);
-  s.id.assign(id_.data.begin(), id_.data.begin() + count_);
-  s.density.assign(density_.data.begin(), density_.data.begin() + count_);
-  if (density_factor_)
-    s.density_factor.assign(density_factor_->data.begin(), density_factor_->data.begin() + count_);
+  s.position.assign(position_.data(), position_.data() + count_);
+  s.velocity.assign(velocity_.data(), velocity_.data() + count_);
+  s.id.assign(id_.data(), id_.data() + count_);
+  s.density.assign(density_.data(), density_.data() + count_);
   // The lazily computed max speed is a pure function of the velocities: taking it now gives
   // the value the next frame would compute.
   s.max_speed = max_speed_valid_ ? max_speed_ : compute_max_speed();
   s.max_acceleration = max_acceleration_;
-  if (springs_) {
-    s.springs.assign(springs_->data.begin(), springs_->data.begin() + count_);
-    s.link_from = link_from_;
+  for (const ParticleArraySpec& spec : method_arrays_) {
+    if (spec.role != ParticleArrayRole::Carried) continue;
+    const CpuParticleArray& a = *store_.find(spec.name);
+    CarriedArray c;
+    c.name = spec.name;
+    c.element_size = spec.element_size;
+    c.bytes.assign(a.bytes.begin(), a.bytes.begin() + a.elements(count_) * spec.element_size);
+    s.carried.push_back(std::move(c));
   }
   return s;
 }
@@ -109,32 +126,19 @@ void CpuBackend::import_particles(const ParticleSnapshot& s) {
   const uint32_t n = static_cast<uint32_t>(s.id.size());
   if (n > config_.capacity || s.position.size() != n || s.velocity.size() != n || s.density.size() != n)
     throw Error(Status::Internal, "import_particles: inconsistent snapshot");
-  if (springs_ ? s.springs.size() != n : !s.springs.empty())
-    throw Error(Status::Internal, "import_particles: spring lists do not match the particles");
-  std::vector<SpringList> springs(s.springs);
-  // Copies first (they may throw), then swaps, so a failure leaves the state as it was.
-  std::vector<Float4> position(s.position), velocity(s.velocity);
-  std::vector<uint32_t> id(s.id), neighbors(n, 0u);
-  std::vector<float> density(s.density);
-  std::vector<float> factor;
-  if (density_factor_) {
-    // A snapshot without factors (a checkpoint written before they existed) starts every
-    // particle fresh, as if it had just been spawned.
-    if (!s.density_factor.empty() && s.density_factor.size() != n)
-      throw Error(Status::Internal, "import_particles: inconsistent snapshot");
-    factor = s.density_factor.empty() ? std::vector<float>(n, fresh_density_factor()) : s.density_factor;
-  }
+  check_carried_arrays(s, method_arrays_, n);
+  // Copies first (they may throw), then the store, so a failure leaves the state as it was.
+  std::vector<std::pair<CpuParticleArray*, std::vector<unsigned char>>> carried;
+  for (const ParticleArraySpec& spec : method_arrays_)
+    if (spec.role == ParticleArrayRole::Carried)
+      carried.emplace_back(store_.find(spec.name), carried_bytes(s, spec, n));
   store_.resize(n);
-  position_.data.swap(position);
-  velocity_.data.swap(velocity);
-  id_.data.swap(id);
-  density_.data.swap(density);
-  neighbors_.data.swap(neighbors);
-  if (springs_) {
-    springs_->data.swap(springs);
-    link_from_ = s.link_from;
-  }
-  if (density_factor_) density_factor_->data.swap(factor);
+  std::copy(s.position.begin(), s.position.end(), position_.data());
+  std::copy(s.velocity.begin(), s.velocity.end(), velocity_.data());
+  std::copy(s.id.begin(), s.id.end(), id_.data());
+  std::copy(s.density.begin(), s.density.end(), density_.data());
+  std::fill(neighbors_.data(), neighbors_.data() + n, 0u);
+  for (auto& c : carried) c.first->bytes.swap(c.second);
   count_ = n;
   max_speed_ = s.max_speed;
   max_speed_valid_ = true;

@@ -12,12 +12,12 @@
 
 #include "../core/backend.h"
 #include "../core/non_finite.h"
+#include "../core/particle_arrays.h"
 #include "../physics/forces.h"
 #include "../physics/integrate.h"
 #include "../physics/springs.h"
 #include "cpu_neighbor_grid.h"
-#include "host_particle_store.h"
-#include "host_spring_array.h"
+#include "cpu_particle_store.h"
 
 namespace sph {
 
@@ -107,28 +107,28 @@ class CpuBackend final : public Backend {
   WorldConfig config_;
   unsigned workers_;
   CpuNeighborGrid grid_;
-  HostParticleStore store_;
-  HostArray<Float4>& position_;
-  HostArray<Float4>& velocity_;
-  HostArray<uint32_t>& id_;
-  HostArray<float>& density_;
-  HostArray<uint32_t>& neighbors_;
-  HostArray<ParticleState>* rk4_start_ = nullptr;
-  HostArray<Rk4Accumulator>* rk4_sum_ = nullptr;
-  HostArray<float>* density_factor_ = nullptr;  // normalised density's carried factor, when on
+  CpuParticleStore store_;
+  std::vector<ParticleArraySpec> method_arrays_;  // method_particle_arrays(config_)
+  CpuArrayRef<Float4> position_;                  // w: pressure after the density pass
+  CpuArrayRef<Float4> velocity_;                  // w: 1 / density after the density pass
+  CpuArrayRef<uint32_t> id_;
+  CpuArrayRef<float> density_;
+  CpuArrayRef<uint32_t> neighbors_;  // of the last density pass (statistics, Clavet viscosity)
   // Integration writes here and swaps, so the force gather reads a state nobody writes.
-  std::vector<Float4> next_position_;
-  std::vector<Float4> next_velocity_;
+  CpuArrayRef<Float4> next_position_;
+  CpuArrayRef<Float4> next_velocity_;
+  // The methods' arrays (particle_arrays.h); null when the world does not use the method.
+  CpuArrayRef<ParticleState> rk4_start_;
+  CpuArrayRef<Rk4Accumulator> rk4_sum_;
+  CpuArrayRef<float> density_factor_;  // normalised density's carried factor
+  CpuArrayRef<float> normalized_;      // normalised density: the summation, then eq. 31
+  CpuArrayRef<Float4> normals_;        // colour-field normals (surface tension)
+  CpuArrayRef<SpringList> springs_;    // springs: the lists, their link candidates, the accelerations
+  CpuArrayRef<uint32_t> link_from_;    // one word: the lowest id that waits for its springs
+  CpuArrayRef<uint32_t> spring_candidates_;
+  CpuArrayRef<Float4> spring_acceleration_;
   std::vector<uint32_t> keep_order_;
-  std::vector<float> normalized_;  // normalised density: the summation, then eq. 31 (side array)
-  std::vector<Float4> normals_;    // colour-field normals, when surface tension is on
-  // Springs (SPH_FEATURE_SPRINGS only): the lists live in the store; the link candidates
-  // and the spring accelerations of the current evaluation are side arrays.
-  HostSpringArray* springs_ = nullptr;
-  std::vector<uint32_t> spring_candidates_;
-  std::vector<Vec3> spring_acceleration_;
   SpringConstants spring_constants_{};
-  uint32_t link_from_ = kNoPendingLinks;  // lowest id that waits for its springs
   uint32_t count_ = 0;
   float max_speed_ = 0.0f;
   float max_acceleration_ = 0.0f;  // of the last force evaluation, for the force step limit

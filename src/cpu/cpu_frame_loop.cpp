@@ -23,7 +23,6 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
   const float saved_max_speed = max_speed_;
   const bool saved_max_speed_valid = max_speed_valid_;
   const float saved_max_acceleration = max_acceleration_;
-  const uint32_t saved_link_from = link_from_;
   spring_constants_ = make_spring_constants(config_, params);
   if (!max_speed_valid_) max_speed_ = compute_max_speed();
 
@@ -37,7 +36,6 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
     max_speed_ = saved_max_speed;
     max_speed_valid_ = saved_max_speed_valid;
     max_acceleration_ = saved_max_acceleration;  // the force step limit reads it next step
-    link_from_ = saved_link_from;
   };
   SubstepClock clock;
   start_clock(clock, frame_dt);

@@ -6,8 +6,10 @@
 namespace sph {
 
 void CpuBackend::summarize(FrameReport& report) const {
+  const float* density = density_.data();
+  const uint32_t* neighbors = neighbors_.data();
   DensityTally total = empty_tally();
-  for (uint32_t i = 0; i < count_; ++i) combine(total, particle_tally(density_.data[i], neighbors_.data[i]));
+  for (uint32_t i = 0; i < count_; ++i) combine(total, particle_tally(density[i], neighbors[i]));
   report_density(finish_record(total, count_), report);
 }
 

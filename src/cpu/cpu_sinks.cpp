@@ -7,14 +7,15 @@ namespace sph {
 void CpuBackend::apply_sinks(const SceneFrame& scene, FrameReport& report) {
   const auto t = Clock::now();
   keep_order_.clear();
+  const Float4* position = position_.data();
   for (uint32_t i = 0; i < count_; ++i) {
-    const Vec3 x = xyz(position_.data[i]);
+    const Vec3 x = xyz(position[i]);
     bool removed = false;
     for (size_t s = 0; s < scene.sinks.size() && !removed; ++s)
       if (sink_removes(scene.sinks[s].view, x)) {
         removed = true;
         ++report.removed_by_sink[s];
-        report.removed_ids.push_back(id_.data[i]);
+        report.removed_ids.push_back(id_[i]);
       }
     if (!removed) keep_order_.push_back(i);
   }

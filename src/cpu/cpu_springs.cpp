@@ -11,15 +11,14 @@ namespace sph {
 void CpuBackend::spring_pass(float dt, bool first_evaluation, FrameReport& report) {
   if (!springs_) return;
   const auto t = Clock::now();
-  const Float4* pos = position_.data.data();
-  const Float4* vel = velocity_.data.data();
-  SpringList* lists = springs_->data.data();
+  const Float4* pos = position_.data();
+  const Float4* vel = velocity_.data();
+  SpringList* lists = springs_.data();
   const SpringConstants& c = spring_constants_;
-  if (link_from_ != kNoPendingLinks) {
+  if (link_from_[0] != kNoPendingLinks) {
     const GridView view = grid_.view();
-    const uint32_t* ids = id_.data.data();
-    const uint32_t from = link_from_;
-    spring_candidates_.resize(static_cast<size_t>(count_) * kSpringSlots);
+    const uint32_t* ids = id_.data();
+    const uint32_t from = link_from_[0];
     uint32_t* candidates = spring_candidates_.data();
 #pragma omp parallel for num_threads(threads()) schedule(static)
     for (int i = 0; i < n(); ++i)
@@ -27,18 +26,19 @@ void CpuBackend::spring_pass(float dt, bool first_evaluation, FrameReport& repor
                         candidates + static_cast<size_t>(i) * kSpringSlots);
 #pragma omp parallel for num_threads(threads()) schedule(static)
     for (int i = 0; i < n(); ++i) spring_link(pos, candidates, static_cast<uint32_t>(i), lists[i]);
-    link_from_ = kNoPendingLinks;
+    link_from_[0] = kNoPendingLinks;
   }
-  spring_acceleration_.resize(count_);
-  Vec3* out = spring_acceleration_.data();
+  Float4* out = spring_acceleration_.data();  // w unused
   if (first_evaluation) {
 #pragma omp parallel for num_threads(threads()) schedule(static)
     for (int i = 0; i < n(); ++i)
-      out[i] = spring_acceleration<true>(c, pos, vel, static_cast<uint32_t>(i), lists[i], dt);
+      out[i] = make_float4_record(
+          spring_acceleration<true>(c, pos, vel, static_cast<uint32_t>(i), lists[i], dt), 0.0f);
   } else {
 #pragma omp parallel for num_threads(threads()) schedule(static)
     for (int i = 0; i < n(); ++i)
-      out[i] = spring_acceleration<false>(c, pos, vel, static_cast<uint32_t>(i), lists[i], dt);
+      out[i] = make_float4_record(
+          spring_acceleration<false>(c, pos, vel, static_cast<uint32_t>(i), lists[i], dt), 0.0f);
   }
   report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
 }

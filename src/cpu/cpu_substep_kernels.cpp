@@ -11,16 +11,15 @@ namespace sph {
 // Hash, sort, reorder every attribute, then density and pressure (packed into the w slots).
 void CpuBackend::sort_and_density(const FluidConstants& fluid, FrameReport& report) {
   auto t = Clock::now();
-  grid_.build(position_.data.data(), count_, workers_);
+  grid_.build(position_.data(), count_, workers_);
   store_.permute(grid_.order().data(), count_);
   report.stage_ms[kStageHashSort] += static_cast<float>(elapsed_ms(t));
 
   t = Clock::now();
   const GridView view = grid_.view();
-  Float4* pos = position_.data.data();
-  Float4* vel = velocity_.data.data();
-  float* factor = density_factor_ ? density_factor_->data.data() : nullptr;
-  if (factor) normalized_.resize(count_);
+  Float4* pos = position_.data();
+  Float4* vel = velocity_.data();
+  float* factor = density_factor_.data();
 #pragma omp parallel for num_threads(threads()) schedule(static)
   for (int i = 0; i < n(); ++i) {
     const DensitySample s = gather_density(fluid, view, pos, static_cast<uint32_t>(i));
@@ -29,8 +28,8 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, FrameReport& repo
       normalized_[i] = s.density;  // the summation, for the factor after the filter
       rho = carried_density(fluid, s.density, factor[i]);
     }
-    density_.data[i] = rho;
-    neighbors_.data[i] = s.neighbor_count;
+    density_[i] = rho;
+    neighbors_[i] = s.neighbor_count;
     // Only the w slots are written; neighbours read x, y, z alone.
     pos[i].w = pressure_from_density(fluid.eos, rho);
     vel[i].w = 1.0f / rho;
@@ -46,14 +45,13 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, FrameReport& repo
     }
 #pragma omp parallel for num_threads(threads()) schedule(static)
     for (int i = 0; i < n(); ++i) {
-      density_.data[i] = normalized_[i];
+      density_[i] = normalized_[i];
       pos[i].w = pressure_from_density(fluid.eos, normalized_[i]);
       vel[i].w = 1.0f / normalized_[i];
     }
   }
   if (config_.features & kFeatureSurfaceTension) {
     // Colour-field normals of every particle, which the force gather reads for neighbours.
-    normals_.resize(count_);
 #pragma omp parallel for num_threads(threads()) schedule(static)
     for (int i = 0; i < n(); ++i)
       normals_[i] = gather_colour_normal(fluid, view, pos, vel, static_cast<uint32_t>(i));

@@ -15,14 +15,16 @@ void CpuBackend::collide(const SceneFrame& scene, const SubstepTime& time, OldPo
   if (scene.colliders.empty()) return;
   const auto t = Clock::now();
   const float h = config_.kernel_radius;
+  Float4* next_pos = next_position_.data();
+  Float4* next_vel = next_velocity_.data();
 #pragma omp parallel for num_threads(threads()) schedule(static)
   for (int i = 0; i < n(); ++i) {
-    Vec3 x = xyz(next_position_[i]);
-    Vec3 v = xyz(next_velocity_[i]);
+    Vec3 x = xyz(next_pos[i]);
+    Vec3 v = xyz(next_vel[i]);
     const Vec3 from = x_old(static_cast<uint32_t>(i));
     for (const ColliderFrame& c : scene.colliders) collide_particle(c.view, time, h, from, x, v);
-    next_position_[i] = make_float4_record(x, next_position_[i].w);
-    next_velocity_[i] = make_float4_record(v, next_velocity_[i].w);
+    next_pos[i] = make_float4_record(x, next_pos[i].w);
+    next_vel[i] = make_float4_record(v, next_vel[i].w);
   }
   report.stage_ms[kStageCollide] += static_cast<float>(elapsed_ms(t));
 }
@@ -33,22 +35,24 @@ uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame
   spring_pass(time.dt, true, report);
   auto t = Clock::now();
   const GridView view = grid_.view();
-  next_position_.resize(count_);
-  next_velocity_.resize(count_);
-  const Float4* pos = position_.data.data();
-  const Float4* vel = velocity_.data.data();
+  Float4* next_pos = next_position_.data();
+  Float4* next_vel = next_velocity_.data();
+  const Float4* pos = position_.data();
+  const Float4* vel = velocity_.data();
+  const Float4* spring = spring_acceleration_.data();
   const float dt = time.dt;
   const AccelerationFn acceleration = acceleration_function();
-  const uint32_t* counts = neighbors_.data.data();
+  const uint32_t* counts = neighbors_.data();
+  const Float4* normals = normals_.data();
   float a2max = 0.0f;
 #pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
   for (int i = 0; i < n(); ++i) {
-    Vec3 a = acceleration(fluid, view, pos, vel, counts, normals_.data(), scene, static_cast<uint32_t>(i));
-    if (springs_) a += spring_acceleration_[i];
+    Vec3 a = acceleration(fluid, view, pos, vel, counts, normals, scene, static_cast<uint32_t>(i));
+    if (spring) a += xyz(spring[i]);
     a2max = std::max(a2max, length_squared(a));
     const ParticleState s = symplectic_euler({xyz(pos[i]), xyz(vel[i])}, a, dt);
-    next_position_[i] = make_float4_record(s.position, pos[i].w);
-    next_velocity_[i] = make_float4_record(s.velocity, vel[i].w);
+    next_pos[i] = make_float4_record(s.position, pos[i].w);
+    next_vel[i] = make_float4_record(s.velocity, vel[i].w);
   }
   max_acceleration_ = std::sqrt(a2max);
   report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
@@ -67,7 +71,7 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
                                  const SubstepTime& time, FrameReport& report) {
   // Stage 0 starts from the current state.
   for (int i = 0; i < n(); ++i)
-    rk4_start_->data[i] = ParticleState{xyz(position_.data[i]), xyz(velocity_.data[i])};
+    rk4_start_[i] = ParticleState{xyz(position_[i]), xyz(velocity_[i])};  // (not a hot loop)
   const float dt = time.dt;
   const AccelerationFn acceleration = acceleration_function();
   float a2max = 0.0f;
@@ -76,25 +80,28 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
     spring_pass(dt, stage == 0, report);
     auto t = Clock::now();
     const GridView view = grid_.view();
-    next_position_.resize(count_);
-    next_velocity_.resize(count_);
-    const Float4* pos = position_.data.data();
-    const Float4* vel = velocity_.data.data();
-    const uint32_t* counts = neighbors_.data.data();
+    Float4* next_pos = next_position_.data();
+    Float4* next_vel = next_velocity_.data();
+    const Float4* pos = position_.data();
+    const Float4* vel = velocity_.data();
+    const Float4* spring = spring_acceleration_.data();
+    const uint32_t* counts = neighbors_.data();
+    const Float4* normals = normals_.data();
+    const ParticleState* start = rk4_start_.data();
+    Rk4Accumulator* sums = rk4_sum_.data();
 #pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
     for (int i = 0; i < n(); ++i) {
-      Vec3 a = acceleration(fluid, view, pos, vel, counts, normals_.data(), scene, static_cast<uint32_t>(i));
-      if (springs_) a += spring_acceleration_[i];
+      Vec3 a = acceleration(fluid, view, pos, vel, counts, normals, scene, static_cast<uint32_t>(i));
+      if (spring) a += xyz(spring[i]);
       a2max = std::max(a2max, length_squared(a));
-      const ParticleState s =
-          rk4_advance(stage, rk4_start_->data[i], {xyz(pos[i]), xyz(vel[i])}, a, dt, rk4_sum_->data[i]);
-      next_position_[i] = make_float4_record(s.position, pos[i].w);
-      next_velocity_[i] = make_float4_record(s.velocity, vel[i].w);
+      const ParticleState s = rk4_advance(stage, start[i], {xyz(pos[i]), xyz(vel[i])}, a, dt, sums[i]);
+      next_pos[i] = make_float4_record(s.position, pos[i].w);
+      next_vel[i] = make_float4_record(s.velocity, vel[i].w);
     }
     report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
     if (stage == 3)
       collide(
-          scene, time, [&](uint32_t i) { return rk4_start_->data[i].position; }, report);
+          scene, time, [start](uint32_t i) { return start[i].position; }, report);
     t = Clock::now();
     float v2max = 0.0f;
     const uint32_t bad_index = scan_next_state(v2max);
