@@ -8,6 +8,7 @@
  *
  *   rest_sphere [--particles N|largest] [--frames F] [--warmup W] [--backend cpu|cuda|auto]
  *               [--case rest|moving|both] [--option NAME] [--json FILE] [--csv FILE] [--label TEXT]
+ *               [--cuda-frames graph|stream] [--density-block N] [--force-block N]
  *
  * --option turns one optional piece of physics on, to measure what it costs (BENCHMARK.md,
  * issue 5): none (default), surface_tension, normalized_density, clavet (viscosity), tait
@@ -17,6 +18,10 @@
  * substep). --particles largest
  * finds the largest world the device holds (world creation refused with OUT_OF_*_MEMORY
  * above it) and runs 95 % of that.
+ *
+ * --cuda-frames, --density-block and --force-block set the CUDA tuning of sph_context_def
+ * (cuda_frames, cuda_density_block, cuda_force_block; docs/cuda.md): the stream driver launches
+ * kernel by kernel, which is what a profiler such as ncu needs (scripts/bench-gpu).
  *
  * Prints a table per case; --json writes the results as a JSON array, --csv appends rows
  * (with a header when the file is new). Times are the wall time of sph_world_step (which
@@ -47,6 +52,9 @@ typedef struct options {
   const char* json;
   const char* csv;
   const char* label;
+  sph_cuda_frames cuda_frames;
+  uint32_t density_block; /* 0: the library's default */
+  uint32_t force_block;
 } options;
 
 typedef struct result {
@@ -159,8 +167,14 @@ static result run_case(const options* o, int moving) {
   const double t0 = now_s();
   const float spacing = 0.02f;
 
+  sph_context_def cdef;
+  sph_context_def_init(&cdef);
+  cdef.backend = o->backend;
+  cdef.cuda_frames = o->cuda_frames;
+  cdef.cuda_density_block = o->density_block;
+  cdef.cuda_force_block = o->force_block;
   sph_context* context = NULL;
-  check(support_context_create(o->backend, &context), "sph_context_create");
+  check(sph_context_create(&cdef, &context), "sph_context_create");
   sph_backend resolved;
   check(sph_context_get_backend(context, &resolved), "sph_context_get_backend");
   r.backend = resolved == SPH_BACKEND_CUDA ? "cuda" : "cpu";
@@ -318,12 +332,14 @@ static void usage(void) {
           "usage: rest_sphere [--particles N|largest] [--frames F] [--warmup W] [--backend cpu|cuda|auto]\n"
           "                   [--case rest|moving|both] [--option none|surface_tension|normalized_density|\n"
           "                   clavet|tait|rk4|acoustic_limit|springs] [--json FILE] [--csv FILE]\n"
-          "                   [--label TEXT]\n");
+          "                   [--label TEXT] [--cuda-frames graph|stream] [--density-block N]\n"
+          "                   [--force-block N]\n");
   exit(2);
 }
 
 int main(int argc, char** argv) {
-  options o = {100000, 0, "none", 100, 3, SPH_BACKEND_AUTO, "both", NULL, NULL, NULL};
+  options o = {100000, 0, "none", 100, 3, SPH_BACKEND_AUTO, "both", NULL, NULL, NULL, SPH_CUDA_FRAMES_GRAPH,
+               0,      0};
   for (int i = 1; i < argc; ++i) {
     const char* a = argv[i];
     const char* v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -347,6 +363,13 @@ int main(int argc, char** argv) {
       o.csv = v;
     } else if (strcmp(a, "--label") == 0) {
       o.label = v;
+    } else if (strcmp(a, "--cuda-frames") == 0) {
+      if (strcmp(v, "graph") != 0 && strcmp(v, "stream") != 0) usage();
+      o.cuda_frames = strcmp(v, "stream") == 0 ? SPH_CUDA_FRAMES_STREAM : SPH_CUDA_FRAMES_GRAPH;
+    } else if (strcmp(a, "--density-block") == 0) {
+      o.density_block = (uint32_t)strtoul(v, NULL, 10);
+    } else if (strcmp(a, "--force-block") == 0) {
+      o.force_block = (uint32_t)strtoul(v, NULL, 10);
     } else {
       usage();
     }

@@ -1,4 +1,4 @@
-// Entry points of the CUDA backend, seen by the backend factory only.
+// Entry points of the CUDA backend, seen by the backend factory (src/factory) only.
 #pragma once
 
 #include <memory>
@@ -10,7 +10,16 @@ namespace sph {
 // Devices the CUDA runtime reports (0 on any error: no driver, no device).
 int cuda_usable_device_count();
 
-std::unique_ptr<Backend> make_cuda_backend(const WorldConfig& config, int device_ordinal);
+// The backend's tuning (sph_context_def's cuda_* fields, checked by the C layer; docs/cuda.md).
+// No choice changes results.
+struct CudaBackendOptions {
+  bool stream_frames = false;    // every frame on the stream driver (profilers, sanitizers)
+  unsigned density_block = 128;  // threads per block of the density kernels (32..1024, powers of two)
+  unsigned force_block = 128;    // threads per block of the force kernels
+};
+
+std::unique_ptr<Backend> make_cuda_backend(const WorldConfig& config, int device_ordinal,
+                                           const CudaBackendOptions& options);
 
 }  // namespace sph
 

@@ -1,8 +1,13 @@
 #include "device_particle_store.h"
 
+#include <cstring>
+
+#include "device_springs.h"
+
 namespace sph {
 
-DeviceParticleStore::DeviceParticleStore(uint32_t capacity, const StoreOptions& options)
+DeviceParticleStore::DeviceParticleStore(uint32_t capacity,
+                                         const std::vector<ParticleArraySpec>& method_arrays)
     : capacity_(capacity) {
   const size_t n = capacity;
   position_.allocate(n, "positions");
@@ -16,28 +21,16 @@ DeviceParticleStore::DeviceParticleStore(uint32_t capacity, const StoreOptions& 
   snapshot_velocity_.allocate(n, "snapshot velocities");
   snapshot_id_.allocate(n, "snapshot ids");
   snapshot_density_.allocate(n, "snapshot densities");
-  if (options.neighbor_counts) neighbor_count_.allocate(n, "neighbour counts");
-  if (options.normalized_density) {
-    normalized_density_.allocate(n, "normalised densities");
-    density_factor_.allocate(n, "density factors");
-    snapshot_density_factor_.allocate(n, "snapshot density factors");
-  }
-  if (options.colour_normals) colour_normal_.allocate(n, "colour-field normals");
-  if (options.springs) {
-    springs_.allocate(n, "spring lists");
-    sorted_springs_.allocate(n, "sorted spring lists");
-    snapshot_springs_.allocate(n, "snapshot spring lists");
-    spring_inverse_.allocate(n, "spring index map");
-    spring_candidates_.allocate(n * kSpringSlots, "spring link candidates");
-    spring_acceleration_.allocate(n, "spring accelerations");
-    link_from_.allocate(1, "first id waiting for springs");
-    snapshot_link_from_.allocate(1, "snapshot first id waiting for springs");
-  }
-  if (options.rk4) {
-    for (int side = 0; side < 2; ++side) {
-      rk4_start_[side].allocate(n, "RK4 start states");
-      rk4_sum_[side].allocate(n, "RK4 slope sums");
-    }
+  for (const ParticleArraySpec& spec : method_arrays) {
+    auto a = std::make_unique<DeviceMethodArray>();
+    a->spec = spec;
+    a->elements =
+        spec.elements_per_particle == 0 ? 1u : static_cast<uint64_t>(n) * spec.elements_per_particle;
+    const size_t bytes = a->elements * spec.element_size;
+    a->side[0].allocate(bytes, spec.name);
+    if (spec.role == ParticleArrayRole::Sorted) a->side[1].allocate(bytes, spec.name);
+    if (spec.role == ParticleArrayRole::Carried) a->snapshot.allocate(a->bytes_for(capacity), spec.name);
+    methods_.push_back(std::move(a));
   }
   arrays_.position = position_.get();
   arrays_.velocity = velocity_.get();
@@ -46,20 +39,26 @@ DeviceParticleStore::DeviceParticleStore(uint32_t capacity, const StoreOptions& 
   arrays_.sorted_position = sorted_position_.get();
   arrays_.sorted_velocity = sorted_velocity_.get();
   arrays_.sorted_id = sorted_id_.get();
-  arrays_.neighbor_count = neighbor_count_.get();
-  arrays_.normalized_density = normalized_density_.get();
-  arrays_.density_factor = density_factor_.get();
-  arrays_.colour_normal = colour_normal_.get();
-  arrays_.springs = springs_.get();
-  arrays_.sorted_springs = sorted_springs_.get();
-  arrays_.spring_inverse = spring_inverse_.get();
-  arrays_.spring_candidates = spring_candidates_.get();
-  arrays_.spring_acceleration = spring_acceleration_.get();
-  arrays_.link_from = link_from_.get();
+  arrays_.neighbor_count = static_cast<uint32_t*>(find(kArrayNeighborCount));
+  arrays_.normalized_density = static_cast<float*>(find(kArrayNormalizedDensity));
+  arrays_.density_factor = static_cast<float*>(find(kArrayDensityFactor));
+  arrays_.colour_normal = static_cast<Float4*>(find(kArrayColourNormal));
+  arrays_.springs = static_cast<SpringList*>(find(kArraySprings));
+  arrays_.sorted_springs = static_cast<SpringList*>(find(kArraySortedSprings));
+  arrays_.spring_inverse = static_cast<uint32_t*>(find(kArraySpringInverse));
+  arrays_.spring_candidates = static_cast<uint32_t*>(find(kArraySpringCandidates));
+  arrays_.spring_acceleration = static_cast<Float4*>(find(kArraySpringAcceleration));
+  arrays_.link_from = static_cast<uint32_t*>(find(kArraySpringLinkFrom));
   for (int side = 0; side < 2; ++side) {
-    arrays_.rk4_start[side] = rk4_start_[side].get();
-    arrays_.rk4_sum[side] = rk4_sum_[side].get();
+    arrays_.rk4_start[side] = static_cast<ParticleState*>(find(kArrayRk4Start, side));
+    arrays_.rk4_sum[side] = static_cast<Rk4Accumulator*>(find(kArrayRk4Sum, side));
   }
+}
+
+void* DeviceParticleStore::find(const char* name, int side) const {
+  for (const auto& a : methods_)
+    if (std::strcmp(a->spec.name, name) == 0) return a->side[side].get();
+  return nullptr;
 }
 
 SortScratch DeviceParticleStore::sort_scratch() const {
@@ -72,7 +71,7 @@ SortScratch DeviceParticleStore::sort_scratch() const {
 namespace {
 
 template <class T>
-void copy_async(T* dst, const T* src, uint32_t n, cudaStream_t stream, const char* what) {
+void copy_async(T* dst, const T* src, uint64_t n, cudaStream_t stream, const char* what) {
   if (n == 0) return;
   cuda_check(cudaMemcpyAsync(dst, src, sizeof(T) * n, cudaMemcpyDeviceToDevice, stream), what);
 }
@@ -84,13 +83,9 @@ void DeviceParticleStore::enqueue_snapshot(uint32_t n, cudaStream_t stream) cons
   copy_async(snapshot_velocity_.get(), velocity_.get(), n, stream, "snapshot of velocities");
   copy_async(snapshot_id_.get(), id_.get(), n, stream, "snapshot of ids");
   copy_async(snapshot_density_.get(), density_.get(), n, stream, "snapshot of densities");
-  if (springs_.get()) {
-    copy_async(snapshot_springs_.get(), springs_.get(), n, stream, "snapshot of spring lists");
-    copy_async(snapshot_link_from_.get(), link_from_.get(), 1, stream, "snapshot of the spring link state");
-  }
-  if (density_factor_.get())
-    copy_async(snapshot_density_factor_.get(), density_factor_.get(), n, stream,
-               "snapshot of density factors");
+  for (const auto& a : methods_)
+    if (a->spec.role == ParticleArrayRole::Carried)
+      copy_async(a->snapshot.get(), a->side[0].get(), a->bytes_for(n), stream, a->spec.name);
 }
 
 void DeviceParticleStore::enqueue_restore(uint32_t n, cudaStream_t stream) const {
@@ -98,21 +93,21 @@ void DeviceParticleStore::enqueue_restore(uint32_t n, cudaStream_t stream) const
   copy_async(velocity_.get(), snapshot_velocity_.get(), n, stream, "restore of velocities");
   copy_async(id_.get(), snapshot_id_.get(), n, stream, "restore of ids");
   copy_async(density_.get(), snapshot_density_.get(), n, stream, "restore of densities");
-  if (springs_.get()) {
-    copy_async(springs_.get(), snapshot_springs_.get(), n, stream, "restore of spring lists");
-    copy_async(link_from_.get(), snapshot_link_from_.get(), 1, stream, "restore of the spring link state");
-  }
-  if (density_factor_.get())
-    copy_async(density_factor_.get(), snapshot_density_factor_.get(), n, stream,
-               "restore of density factors");
+  for (const auto& a : methods_)
+    if (a->spec.role == ParticleArrayRole::Carried)
+      copy_async(a->side[0].get(), a->snapshot.get(), a->bytes_for(n), stream, a->spec.name);
 }
 
-void DeviceParticleStore::enqueue_reset_link_state(cudaStream_t stream) const {
-  if (!link_from_.get()) return;
-  // No particle waits yet; the snapshot word too, so a rollback before any frame keeps it.
-  cuda_check(cudaMemsetAsync(link_from_.get(), 0xff, sizeof(uint32_t), stream), "spring link state reset");
-  cuda_check(cudaMemsetAsync(snapshot_link_from_.get(), 0xff, sizeof(uint32_t), stream),
-             "spring link state reset");
+void DeviceParticleStore::enqueue_initial_world_words(cudaStream_t stream) const {
+  for (const auto& a : methods_) {
+    if (a->spec.elements_per_particle != 0 || !a->spec.initial) continue;
+    // The snapshot too, so a rollback before any frame keeps the value.
+    for (unsigned char* dst : {a->side[0].get(), a->snapshot.get()})
+      if (dst)
+        cuda_check(
+            cudaMemcpyAsync(dst, a->spec.initial, a->spec.element_size, cudaMemcpyHostToDevice, stream),
+            a->spec.name);
+  }
 }
 
 uint64_t DeviceParticleStore::bytes() const {
@@ -120,12 +115,7 @@ uint64_t DeviceParticleStore::bytes() const {
                    sorted_position_.bytes() + sorted_velocity_.bytes() + sorted_id_.bytes() +
                    snapshot_position_.bytes() + snapshot_velocity_.bytes() + snapshot_id_.bytes() +
                    snapshot_density_.bytes();
-  for (int side = 0; side < 2; ++side) total += rk4_start_[side].bytes() + rk4_sum_[side].bytes();
-  total += neighbor_count_.bytes() + normalized_density_.bytes() + colour_normal_.bytes();
-  total += springs_.bytes() + sorted_springs_.bytes() + snapshot_springs_.bytes() + spring_inverse_.bytes() +
-           spring_candidates_.bytes() + spring_acceleration_.bytes() + link_from_.bytes() +
-           snapshot_link_from_.bytes();
-  total += density_factor_.bytes() + snapshot_density_factor_.bytes();
+  for (const auto& a : methods_) total += a->side[0].bytes() + a->side[1].bytes() + a->snapshot.bytes();
   return total;
 }
 

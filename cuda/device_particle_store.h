@@ -1,22 +1,20 @@
 // The device-resident particle state of one world, as a structure of arrays, allocated once
-// for the world's capacity:
+// for the world's capacity. The core state has fixed arrays:
 //   position/velocity/id/density  the state in the current order (what callers read)
 //   sorted_*                      the working copy in the order of the last sort; the density
 //                                 pass reads it and the force pass writes the state from it.
 //                                 sorted_velocity doubles as the radix sort's key/value
 //                                 buffers, which are dead before the density pass fills it.
 //   snapshot_*                    the state at the start of a frame, for the rollback
-//   rk4_*                         RK4 worlds only: start state and slope sums, two sides
-//   neighbor_count, normalized_density, colour_normal
-//                                 per-substep side arrays of the physics options (Clavet
-//                                 viscosity, normalised density, surface tension), allocated
-//                                 only for a world that uses the option
-//   springs, sorted_springs, ...  SPH_FEATURE_SPRINGS only (device_springs.h): the spring lists
-//                                 in state order, their reordered working copy, the inverse
-//                                 permutation, link candidates, spring accelerations, the
-//                                 lowest id waiting for springs (one word), and snapshots
-//   density_factor                normalised density's carried factor (state, in the current
-//                                 order, with a snapshot), only for a world that uses it
+// The methods' arrays are allocated from their registrations (src/core/particle_arrays.h:
+// name, element size, role), only for a world that uses the method, with their role's
+// bookkeeping: a Carried array gets a snapshot copy, which enqueue_snapshot/enqueue_restore
+// fill and read with the core state, and travels in appends and checkpoints by name; a Sorted
+// array gets two sides, between which the reorder gathers (RK4's start state and slope sums); a
+// Scratch array is one buffer. The kernels see raw pointers (ParticleArrays), looked up by name
+// once, when the store is made. Reordering a method's carried array at a sort is its own
+// kernels' work (the density pass gathers the density factor through the old index; the spring
+// pass remaps the spring lists), a sink's compaction moves it (device_sinks.cu).
 // Float4 records carry a second quantity in w: position.w = pressure, velocity.w = 1/density.
 #pragma once
 
@@ -24,6 +22,10 @@
 
 #include <cuda_runtime.h>
 
+#include <memory>
+#include <vector>
+
+#include "../src/core/particle_arrays.h"
 #include "../src/physics/float4_types.h"
 #include "../src/physics/integrate.h"
 #include "../src/physics/springs.h"
@@ -31,7 +33,8 @@
 
 namespace sph {
 
-// Raw pointers, passed by value into kernels.
+// Raw pointers, passed by value into kernels; the methods' are looked up by name once
+// (particle_arrays.h names them), null where the world does not use the method.
 struct ParticleArrays {
   Float4* position;
   Float4* velocity;
@@ -55,13 +58,19 @@ struct ParticleArrays {
   uint32_t* link_from;          // one word: the lowest id waiting for springs, or kNoPendingLinks
 };
 
-// Which optional arrays a world needs.
-struct StoreOptions {
-  bool rk4 = false;
-  bool neighbor_counts = false;
-  bool normalized_density = false;
-  bool colour_normals = false;
-  bool springs = false;
+// A method's array on the device: its elements (two sides for a Sorted array) and, for a
+// Carried one, the snapshot of the frame's start.
+struct DeviceMethodArray {
+  ParticleArraySpec spec;
+  DeviceArray<unsigned char> side[2];
+  DeviceArray<unsigned char> snapshot;
+  uint64_t elements = 0;  // of each side: capacity * elements_per_particle, or 1 for a world word
+
+  // Bytes of the first n particles (a world word: its one element).
+  uint64_t bytes_for(uint32_t n) const {
+    return static_cast<uint64_t>(spec.element_size) *
+           (spec.elements_per_particle == 0 ? 1u : static_cast<uint64_t>(n) * spec.elements_per_particle);
+  }
 };
 
 // The radix sort's buffers inside sorted_velocity: four uint32 arrays of `capacity` each.
@@ -72,17 +81,21 @@ struct SortScratch {
 
 class DeviceParticleStore {
  public:
-  DeviceParticleStore(uint32_t capacity, const StoreOptions& options);
+  DeviceParticleStore(uint32_t capacity, const std::vector<ParticleArraySpec>& method_arrays);
 
   const ParticleArrays& arrays() const { return arrays_; }
+  const std::vector<std::unique_ptr<DeviceMethodArray>>& method_arrays() const { return methods_; }
+  // A method array's side (0 or 1) by name; null when the world has no such array.
+  void* find(const char* name, int side = 0) const;
   SortScratch sort_scratch() const;
   uint32_t capacity() const { return capacity_; }
 
-  // Copies the state of particles [0, n) into the snapshot, and back.
+  // Copies the state of particles [0, n), the core's and the Carried arrays', into the
+  // snapshot, and back.
   void enqueue_snapshot(uint32_t n, cudaStream_t stream) const;
   void enqueue_restore(uint32_t n, cudaStream_t stream) const;
-  // Springs only: marks that no particle waits for springs (a new world).
-  void enqueue_reset_link_state(cudaStream_t stream) const;
+  // Sets the methods' world words (and their snapshots) to their initial values (a new world).
+  void enqueue_initial_world_words(cudaStream_t stream) const;
 
   uint64_t bytes() const;
 
@@ -94,15 +107,7 @@ class DeviceParticleStore {
   DeviceArray<Float4> snapshot_position_, snapshot_velocity_;
   DeviceArray<uint32_t> snapshot_id_;
   DeviceArray<float> snapshot_density_;
-  DeviceArray<ParticleState> rk4_start_[2];
-  DeviceArray<Rk4Accumulator> rk4_sum_[2];
-  DeviceArray<uint32_t> neighbor_count_;
-  DeviceArray<float> normalized_density_;
-  DeviceArray<float> density_factor_, snapshot_density_factor_;
-  DeviceArray<Float4> colour_normal_;
-  DeviceArray<SpringList> springs_, sorted_springs_, snapshot_springs_;
-  DeviceArray<uint32_t> spring_inverse_, spring_candidates_, link_from_, snapshot_link_from_;
-  DeviceArray<Float4> spring_acceleration_;
+  std::vector<std::unique_ptr<DeviceMethodArray>> methods_;
   ParticleArrays arrays_{};
 };
 

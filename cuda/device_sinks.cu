@@ -41,13 +41,31 @@ __global__ void sink_scatter_kernel(ParticleArrays a, uint32_t n, const uint32_t
     a.sorted_id[dst] = a.id[i];
     density_out[dst] = a.density[i];
     if (counts) counts_out[dst] = counts[i];
-    // The normalised density's side array is free between substeps: the factors go there.
-    if (a.density_factor) a.normalized_density[dst] = a.density_factor[i];
   } else {
     const uint32_t r = i - dst;
     removed_id[r] = a.id[i];
     removed_sink[r] = sink_of[i];
   }
+}
+
+// A carried array of `words` 32-bit words per particle: survivor i's words to place scan[i].
+__global__ void compact_words_kernel(const uint32_t* __restrict__ in, uint32_t words, uint32_t n,
+                                     const uint32_t* __restrict__ keep, const uint32_t* __restrict__ scan,
+                                     uint32_t* out) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n || !keep[i]) return;
+  for (uint32_t w = 0; w < words; ++w)
+    out[static_cast<uint64_t>(scan[i]) * words + w] = in[static_cast<uint64_t>(i) * words + w];
+}
+
+// The carried arrays this compaction moves as plain words (elements holding indices are their
+// method's), and their words per particle.
+bool compacted_as_words(const DeviceMethodArray& m) {
+  return m.spec.role == ParticleArrayRole::Carried && m.spec.elements_per_particle != 0 &&
+         !m.spec.rewrite_indices;
+}
+uint32_t words_of(const DeviceMethodArray& m) {
+  return m.spec.element_size / 4u * m.spec.elements_per_particle;
 }
 
 template <class T>
@@ -58,9 +76,12 @@ void copy_back(T* dst, const T* src, uint32_t n, cudaStream_t stream, const char
 
 }  // namespace
 
-void DeviceSinkCompactor::reserve(uint32_t capacity) {
+void DeviceSinkCompactor::reserve(uint32_t capacity, const DeviceParticleStore& store) {
   if (capacity_ != 0 || capacity == 0) return;
   const size_t n = capacity;
+  words_per_particle_ = 1;  // the densities
+  for (const auto& m : store.method_arrays())
+    if (compacted_as_words(*m) && words_of(*m) > words_per_particle_) words_per_particle_ = words_of(*m);
   keep_.allocate(n, "sink flags");
   scan_.allocate(n, "sink scan");
   sink_of_.allocate(n, "sink indices");
@@ -68,7 +89,7 @@ void DeviceSinkCompactor::reserve(uint32_t capacity) {
   removed_sink_.allocate(n, "removed sink indices");
   counts_.allocate(n, "sink neighbour counts");
   counts_out_.allocate(n, "sink neighbour counts (compacted)");
-  density_out_.allocate(n, "sink densities (compacted)");
+  words_out_.allocate(n * words_per_particle_, "sink compaction output");
   kept_.allocate(1, "sink survivor count");
   cuda_check(
       cub::DeviceScan::ExclusiveSum(nullptr, temp_bytes_, keep_.get(), scan_.get(), static_cast<int>(n)),
@@ -92,20 +113,31 @@ void DeviceSinkCompactor::enqueue_flag(const SinkView* sinks, uint32_t sink_coun
   check_launch("kept_total_kernel");
 }
 
-void DeviceSinkCompactor::enqueue_compact(const ParticleArrays& a, uint32_t n, uint32_t kept,
+void DeviceSinkCompactor::enqueue_compact(const DeviceParticleStore& store, uint32_t n, uint32_t kept,
                                           uint32_t* counts, cudaStream_t stream) {
-  sink_scatter_kernel<<<blocks_for(n, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
-      a, n, keep_.get(), scan_.get(), sink_of_.get(), counts, counts_out_.get(), density_out_.get(),
+  const ParticleArrays& a = store.arrays();
+  float* density_out = reinterpret_cast<float*>(words_out_.get());
+  const unsigned blocks = blocks_for(n, kDefaultBlockSize);
+  sink_scatter_kernel<<<blocks, kDefaultBlockSize, 0, stream>>>(
+      a, n, keep_.get(), scan_.get(), sink_of_.get(), counts, counts_out_.get(), density_out,
       removed_id_.get(), removed_sink_.get());
   check_launch("sink_scatter_kernel");
   copy_back(a.position, a.sorted_position, kept, stream, "compaction of positions");
   copy_back(a.velocity, a.sorted_velocity, kept, stream, "compaction of velocities");
   copy_back(a.id, a.sorted_id, kept, stream, "compaction of ids");
-  copy_back(a.density, density_out_.get(), kept, stream, "compaction of densities");
+  copy_back(a.density, density_out, kept, stream, "compaction of densities");
   if (counts) copy_back(counts, counts_out_.get(), kept, stream, "compaction of neighbour counts");
   if (a.springs) enqueue_spring_compact(a, n, kept, keep_.get(), scan_.get(), stream);  // SPH_FEATURE_SPRINGS
-  if (a.density_factor)
-    copy_back(a.density_factor, a.normalized_density, kept, stream, "compaction of density factors");
+  // The methods' other carried arrays (the normalised density's factors, say), one at a time
+  // through the output buffer, in stream order after the densities.
+  for (const auto& m : store.method_arrays()) {
+    if (!compacted_as_words(*m)) continue;
+    uint32_t* words = reinterpret_cast<uint32_t*>(m->side[0].get());
+    compact_words_kernel<<<blocks, kDefaultBlockSize, 0, stream>>>(words, words_of(*m), n, keep_.get(),
+                                                                   scan_.get(), words_out_.get());
+    check_launch("compact_words_kernel");
+    copy_back(words, words_out_.get(), kept * words_of(*m), stream, m->spec.name);
+  }
 }
 
 }  // namespace sph

@@ -18,8 +18,9 @@ namespace sph {
 
 class DeviceSinkCompactor {
  public:
-  // Allocates the buffers for `capacity` particles (once; throws OUT_OF_DEVICE_MEMORY).
-  void reserve(uint32_t capacity);
+  // Allocates the buffers for `capacity` particles (once; throws OUT_OF_DEVICE_MEMORY), with room
+  // for the widest of the store's carried arrays.
+  void reserve(uint32_t capacity, const DeviceParticleStore& store);
   bool ready() const { return capacity_ != 0; }
 
   // Tests particles [0, n) of a.position against the sinks and counts the survivors into
@@ -28,10 +29,11 @@ class DeviceSinkCompactor {
                     FrameState* state, cudaStream_t stream);
   const uint32_t* kept_device() const { return kept_.get(); }
 
-  // Compacts the state (position, velocity, id, density; and counts, when given, in place)
-  // to the `kept` survivors, and writes the n - kept removed ids and their sink indices.
-  // Uses the sorted working copy as scratch (dead between substeps).
-  void enqueue_compact(const ParticleArrays& a, uint32_t n, uint32_t kept, uint32_t* counts,
+  // Compacts the state (position, velocity, id, density, the methods' carried arrays; and
+  // counts, when given, in place) to the `kept` survivors, and writes the n - kept removed ids and
+  // their sink indices. Uses the sorted working copy as scratch (dead between substeps). A
+  // carried array whose elements hold particle indices is its method's to compact (springs).
+  void enqueue_compact(const DeviceParticleStore& store, uint32_t n, uint32_t kept, uint32_t* counts,
                        cudaStream_t stream);
   const uint32_t* removed_ids() const { return removed_id_.get(); }
   const uint32_t* removed_sinks() const { return removed_sink_.get(); }
@@ -40,13 +42,14 @@ class DeviceSinkCompactor {
 
   uint64_t bytes() const {
     return keep_.bytes() + scan_.bytes() + sink_of_.bytes() + removed_id_.bytes() + removed_sink_.bytes() +
-           counts_.bytes() + counts_out_.bytes() + density_out_.bytes() + kept_.bytes() + temp_.bytes();
+           counts_.bytes() + counts_out_.bytes() + words_out_.bytes() + kept_.bytes() + temp_.bytes();
   }
 
  private:
   uint32_t capacity_ = 0;
   DeviceArray<uint32_t> keep_, scan_, sink_of_, removed_id_, removed_sink_, counts_, counts_out_;
-  DeviceArray<float> density_out_;
+  DeviceArray<uint32_t> words_out_;  // the compacted densities, then each carried array in turn
+  uint32_t words_per_particle_ = 1;  // of words_out_
   DeviceArray<uint32_t> kept_;
   DeviceArray<unsigned char> temp_;
   size_t temp_bytes_ = 0;

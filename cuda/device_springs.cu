@@ -40,8 +40,8 @@ __global__ void spring_force_kernel(SpringConstants c, ParticleArrays a, uint32_
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
   SpringList own = a.sorted_springs[i];
-  const Vec3 acc =
-      spring_acceleration<kUpdateRest>(c, a.sorted_position, a.sorted_velocity, i, own, state->dt_float);
+  const Vec3 acc = spring_acceleration<kUpdateRest>(c, a.sorted_position, a.sorted_velocity, i, own,
+                                                    state->clock.dt_float);
   a.spring_acceleration[i] = make_float4_record(acc, 0.0f);
   a.springs[i] = own;
 }
@@ -65,6 +65,13 @@ __global__ void springs_appended_kernel(uint32_t* link_from, uint32_t first_id) 
 }
 
 }  // namespace
+
+std::vector<ParticleArraySpec> spring_device_arrays() {
+  return {ParticleArraySpec{kArraySortedSprings, sizeof(SpringList), ParticleArrayRole::Scratch, 1, nullptr,
+                            nullptr},
+          ParticleArraySpec{kArraySpringInverse, sizeof(uint32_t), ParticleArrayRole::Scratch, 1, nullptr,
+                            nullptr}};
+}
 
 void enqueue_spring_reorder(const ParticleArrays& a, const uint32_t* order, uint32_t n, cudaStream_t stream) {
   const unsigned blocks = blocks_for(n, kDefaultBlockSize);

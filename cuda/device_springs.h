@@ -11,12 +11,21 @@
 
 #include <cuda_runtime.h>
 
+#include <vector>
+
 #include "../src/physics/neighbor_walk.h"
 #include "../src/physics/springs.h"
 #include "device_particle_store.h"
 #include "frame_state.cuh"
 
 namespace sph {
+
+// The CUDA backend's own working arrays for springs, beyond the method's (particle_arrays.h):
+// the lists' sorted working copy (also the compaction's target) and the inverse permutation for
+// the partner rewrite. Added to a springs world's registrations (cuda_backend.cu).
+constexpr const char* kArraySortedSprings = "sorted_springs";
+constexpr const char* kArraySpringInverse = "spring_inverse";
+std::vector<ParticleArraySpec> spring_device_arrays();
 
 // sorted_springs[i] = springs[order[i]] with partners mapped to their new indices.
 void enqueue_spring_reorder(const ParticleArrays& a, const uint32_t* order, uint32_t n, cudaStream_t stream);

@@ -1,5 +1,3 @@
-#include <cfloat>
-
 #include "block_reduce.cuh"
 #include "frame_control.h"
 #include "kernel_launch.h"
@@ -7,18 +5,11 @@
 namespace sph {
 namespace {
 
-// The CPU backend's step choice and SubstepTime: the controller sees the faster of the fluid
+// The CPU backend's step choice (substep_clock.h): the controller sees the faster of the fluid
 // and the colliders' surfaces, so a fast paddle cannot skip a particle between substeps.
-__device__ void pick_next_step(FrameState* s, const StepLimits& limits) {
-  const float speed = fmaxf(s->max_speed, s->max_collider_speed);
-  s->dt = landing_dt(static_cast<double>(controller_dt(limits, speed, s->max_acceleration)), s->remaining);
-  s->dt_float = static_cast<float>(s->dt);
-  const double elapsed = s->time_advanced;
-  s->time.tau0 = static_cast<float>(elapsed);
-  s->time.tau1 = static_cast<float>(elapsed + s->dt);
-  s->time.s0 = static_cast<float>(elapsed / s->frame_dt);
-  s->time.s1 = s->remaining <= s->dt ? 1.0f : static_cast<float>((elapsed + s->dt) / s->frame_dt);
-  s->time.dt = s->dt_float;
+__device__ void pick_step(FrameState* s, const StepLimits& limits) {
+  pick_next_step(s->clock, s->frame_dt, limits, fmaxf(s->max_speed, s->max_collider_speed),
+                 s->max_acceleration);
 }
 
 __device__ void set_run(FrameState* s, uint32_t run, const LoopCondition& cond) {
@@ -31,11 +22,7 @@ __global__ void begin_frame_kernel(FrameState* s, StepLimits limits, uint32_t ma
   s->timing_last_ns = global_timer_ns();
   s->timing_stage = kStageOther;
   for (int k = 0; k < kStageCount; ++k) s->stage_ns[k] = 0;
-  s->remaining = s->frame_dt;
-  s->time_advanced = 0.0;
-  s->substeps = 0;
-  s->dt_min = FLT_MAX;
-  s->dt_max = 0.0f;
+  start_clock(s->clock, s->frame_dt);
   s->non_finite = 0;
   s->v2max_bits = 0;
   s->a2max_bits = 0;
@@ -50,8 +37,8 @@ __global__ void begin_frame_kernel(FrameState* s, StepLimits limits, uint32_t ma
     s->bad_counts[k] = 0;
   }
   s->saved_max_speed = s->max_speed;
-  const uint32_t run = (s->remaining > 0.0 && max_substeps > 0) ? 1u : 0u;
-  if (run) pick_next_step(s, limits);
+  const uint32_t run = clock_running(s->clock, max_substeps) ? 1u : 0u;
+  if (run) pick_step(s, limits);
   set_run(s, run, cond);
 }
 
@@ -71,21 +58,17 @@ __global__ void end_substep_kernel(FrameState* s, StepLimits limits, uint32_t ma
       s->bad_id = static_cast<uint32_t>(s->bad_key[k] & 0xffffffffu);
       s->bad_stage = static_cast<uint32_t>((s->bad_key[k] >> 32) & 3u);
       s->bad_count = s->bad_counts[k];
-      s->bad_substep = s->substeps + 1;
-      s->bad_dt = s->dt_float;
+      s->bad_substep = s->clock.substeps + 1;
+      s->bad_dt = s->clock.dt_float;
       set_run(s, 0, cond);
       return;
     }
   }
   s->max_speed = sqrtf(v2max);
   if (stages != 1) s->max_acceleration = sqrtf(a2max);
-  s->remaining -= s->dt;
-  s->substeps += 1;
-  s->time_advanced += s->dt;
-  s->dt_min = fminf(s->dt_min, s->dt_float);
-  s->dt_max = fmaxf(s->dt_max, s->dt_float);
-  const uint32_t run = (s->remaining > 0.0 && s->substeps < max_substeps) ? 1u : 0u;
-  if (run) pick_next_step(s, limits);
+  advance_clock(s->clock);
+  const uint32_t run = clock_running(s->clock, max_substeps) ? 1u : 0u;
+  if (run) pick_step(s, limits);
   set_run(s, run, cond);
 }
 

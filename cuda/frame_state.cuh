@@ -5,23 +5,15 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "../src/core/density_record.h"
 #include "../src/core/frame_report.h"
-#include "../src/physics/collider_response.h"
-#include "../src/physics/step_control.h"
+#include "../src/core/non_finite.h"
+#include "../src/core/substep_clock.h"
 
 namespace sph {
 
 constexpr int kRk4Stages = 4;
 constexpr unsigned long long kNoBadParticle = ~0ull;
-
-// Where a particle went non-finite: the first of its density and pressure, its acceleration,
-// its integrated state and the collision response that is not finite (as the CPU backend).
-enum NonFiniteStage : uint32_t {
-  kNonFiniteDensity = 0,
-  kNonFiniteForces = 1,
-  kNonFiniteIntegrate = 2,
-  kNonFiniteCollide = 3
-};
 
 // What the host writes before each frame (one copy from pinned memory into the head of
 // FrameState).
@@ -37,16 +29,9 @@ struct FrameState {
   float max_collider_speed;
   uint32_t input_pad;
 
-  // The substep loop (the CPU backend's loop variables, in the same precision).
-  double remaining;       // seconds of the frame still to simulate
-  double time_advanced;   // seconds simulated so far this frame
-  double dt;              // this substep's step
-  float dt_float;         // the same step as the kernels integrate with
-  float max_speed;        // |v|max after the last substep; persists across frames
-  float saved_max_speed;  // max_speed at the start of the frame, for a rollback
-  float dt_min;
-  float dt_max;
-  uint32_t substeps;
+  SubstepClock clock;      // the substep loop, advanced as on the CPU (substep_clock.h)
+  float max_speed;         // |v|max after the last substep; persists across frames
+  float saved_max_speed;   // max_speed at the start of the frame, for a rollback
   uint32_t run;            // 1 while the loop goes on
   uint32_t non_finite;     // 1 once a substep produced NaN/Inf
   uint32_t v2max_bits;     // max |v|^2 of this substep as float bits (non-negative: uint order)
@@ -58,20 +43,12 @@ struct FrameState {
   uint32_t bad_stage;            // NonFiniteStage of that particle
   uint32_t bad_count;            // non-finite particles of the RK4 stage (or Euler step) that failed
   float saved_max_acceleration;  // max_acceleration at the start of the frame, for a rollback
-  // This substep's place in the frame for moving colliders, computed with the step as the CPU
-  // backend computes it (s0, s1, tau0, tau1 from the double clock).
-  SubstepTime time;
   // Per RK4 stage (symplectic Euler uses [0]): ((sorted index << 2 | NonFiniteStage) << 32 | id),
   // the minimum wins, which is the particle the CPU backend names (indices < 2^30 = capacity).
   unsigned long long bad_key[kRk4Stages];
   uint32_t bad_counts[kRk4Stages];  // non-finite particles flagged per stage
 
-  // Statistics of the last density evaluation, computed once at the end of the frame.
-  float density_min;
-  float density_mean;
-  float density_max;
-  float neighbors_mean;
-  uint32_t neighbors_max;
+  DensityRecord density;  // of the last density evaluation, computed once at the end of the frame
 
   // Stage timing: the first thread of each stage's first kernel reads the GPU's global
   // nanosecond timer and charges the time since the previous mark to the previous stage.

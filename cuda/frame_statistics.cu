@@ -1,5 +1,3 @@
-#include <cfloat>
-
 #include "../src/physics/density.h"
 #include "frame_statistics.h"
 #include "kernel_launch.h"
@@ -9,19 +7,9 @@ namespace {
 
 constexpr unsigned kStatsBlock = 256;
 
-__device__ void combine(StatsPartial& a, const StatsPartial& b) {
-  a.density_sum += b.density_sum;
-  a.neighbor_sum += b.neighbor_sum;
-  a.density_min = fminf(a.density_min, b.density_min);
-  a.density_max = fmaxf(a.density_max, b.density_max);
-  a.neighbor_max = max(a.neighbor_max, b.neighbor_max);
-}
-
-__device__ StatsPartial empty_partial() { return StatsPartial{0.0, 0ull, FLT_MAX, -FLT_MAX, 0u, 0u}; }
-
 // Fixed-shape tree over the block's shared slots: the same additions in the same order on
 // every run.
-__device__ void tree_reduce(StatsPartial* slots) {
+__device__ void tree_reduce(DensityTally* slots) {
   for (unsigned stride = kStatsBlock / 2; stride > 0; stride >>= 1) {
     __syncthreads();
     if (threadIdx.x < stride) combine(slots[threadIdx.x], slots[threadIdx.x + stride]);
@@ -32,16 +20,16 @@ __device__ void tree_reduce(StatsPartial* slots) {
 __global__ void __launch_bounds__(kStatsBlock)
     stats_partial_kernel(FluidConstants fluid, GridView grid, const Float4* sorted_position,
                          const float* __restrict__ density, const uint32_t* __restrict__ counts, uint32_t n,
-                         StatsPartial* partials, FrameState* state) {
+                         DensityTally* partials, FrameState* state) {
   mark_stage(state, kStageOther);
-  __shared__ StatsPartial slots[kStatsBlock];
+  __shared__ DensityTally slots[kStatsBlock];
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  StatsPartial p = empty_partial();
+  DensityTally p = empty_tally();
   if (i < n) {
     const float d = density[i];
     const uint32_t neighbors =
         counts ? counts[i] : gather_density(fluid, grid, sorted_position, i).neighbor_count;
-    p = StatsPartial{d, neighbors, d, d, neighbors, 0u};
+    p = particle_tally(d, neighbors);
   }
   slots[threadIdx.x] = p;
   tree_reduce(slots);
@@ -49,20 +37,14 @@ __global__ void __launch_bounds__(kStatsBlock)
 }
 
 __global__ void __launch_bounds__(kStatsBlock)
-    stats_final_kernel(const StatsPartial* partials, uint32_t blocks, uint32_t n, FrameState* state) {
-  __shared__ StatsPartial slots[kStatsBlock];
-  StatsPartial p = empty_partial();
+    stats_final_kernel(const DensityTally* partials, uint32_t blocks, uint32_t n, FrameState* state) {
+  __shared__ DensityTally slots[kStatsBlock];
+  DensityTally p = empty_tally();
   for (uint32_t b = threadIdx.x; b < blocks; b += kStatsBlock) combine(p, partials[b]);
   slots[threadIdx.x] = p;
   tree_reduce(slots);
   if (threadIdx.x == 0) {
-    const StatsPartial& t = slots[0];
-    const bool any = n > 0;
-    state->density_min = any ? t.density_min : 0.0f;
-    state->density_max = any ? t.density_max : 0.0f;
-    state->density_mean = any ? static_cast<float>(t.density_sum / n) : 0.0f;
-    state->neighbors_mean = any ? static_cast<float>(static_cast<double>(t.neighbor_sum) / n) : 0.0f;
-    state->neighbors_max = any ? t.neighbor_max : 0u;
+    state->density = finish_record(slots[0], n);
     mark_stage(state, kStageOther);
   }
 }

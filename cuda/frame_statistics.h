@@ -1,12 +1,14 @@
-// The frame's statistics, computed once at its end on the device: density min/mean/max of the
-// last density evaluation, and the neighbour counts of that evaluation (recounted here over
-// the sorted copy it read, which is still intact, instead of being stored every substep).
+// The frame's statistics, computed once at its end on the device: the density record
+// (src/core/density_record.h) of the last density evaluation, and the neighbour counts of that evaluation
+// (recounted here over the sorted copy it read, which is still intact, instead of being stored every
+// substep).
 #pragma once
 
 #include <stdint.h>
 
 #include <cuda_runtime.h>
 
+#include "../src/core/density_record.h"
 #include "../src/physics/fluid_constants.h"
 #include "../src/physics/neighbor_walk.h"
 #include "device_array.h"
@@ -14,15 +16,6 @@
 #include "frame_state.cuh"
 
 namespace sph {
-
-struct StatsPartial {
-  double density_sum;
-  unsigned long long neighbor_sum;
-  float density_min;
-  float density_max;
-  uint32_t neighbor_max;
-  uint32_t pad;
-};
 
 class FrameStatistics {
  public:
@@ -38,7 +31,7 @@ class FrameStatistics {
   uint64_t bytes() const { return partials_.bytes(); }
 
  private:
-  DeviceArray<StatsPartial> partials_;
+  DeviceArray<DensityTally> partials_;
 };
 
 }  // namespace sph

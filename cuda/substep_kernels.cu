@@ -11,8 +11,6 @@
 namespace sph {
 namespace {
 
-__device__ __forceinline__ bool finite3(Vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
-
 // gather_acceleration (src/physics/forces.h) for SIMT: the same neighbours in the same order
 // and the same per-neighbour arithmetic (add_neighbor_acceleration, finish_acceleration), in
 // two phases per run of up to 32 candidates. First every candidate is only tested (a tight
@@ -65,16 +63,6 @@ __device__ __forceinline__ void flag_non_finite(FrameState* s, int stage, uint32
                                                 uint32_t where) {
   atomicMin(&s->bad_key[stage], ((static_cast<unsigned long long>(index) << 2 | where) << 32) | id);
   atomicAdd(&s->bad_counts[stage], 1u);
-}
-
-// The NonFiniteStage of a particle whose new state is not finite (the failure path only).
-__device__ __forceinline__ uint32_t non_finite_stage(const Float4& p, const Float4& v, Vec3 acc,
-                                                     const ParticleState& integrated) {
-  if (!isfinite(p.w) || !isfinite(v.w)) return kNonFiniteDensity;
-  if (!finite3(acc)) return kNonFiniteForces;
-  if (!finite3(integrated.position) || !isfinite(length_squared(integrated.velocity)))
-    return kNonFiniteIntegrate;
-  return kNonFiniteCollide;
 }
 
 // The scene's force fields at a particle (after the neighbour gather, as the CPU backend).
@@ -173,7 +161,7 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
   float v2 = 0.0f, a2 = 0.0f;
   if (i < n) {
     FluidConstants f = fluid;
-    f.dt = state->dt_float;  // impulse-based terms need the substep's length
+    f.dt = state->clock.dt_float;  // impulse-based terms need the substep's length
     Vec3 acc = gather_acceleration_masked<kSurfaceTension, kViscosity>(
         f, grid, a.sorted_position, a.sorted_velocity, a.neighbor_count, a.colour_normal, i);
     const Float4 p = a.sorted_position[i];
@@ -183,14 +171,14 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
     a2 = length_squared(acc);
     ParticleState next = symplectic_euler(ParticleState{xyz(p), xyz(v)}, acc, f.dt);
     const ParticleState integrated = next;
-    if (kScene) collide_all(scene, state->time, xyz(p), next);
+    if (kScene) collide_all(scene, state->clock.time, xyz(p), next);
     const uint32_t id = a.sorted_id[i];
     a.position[i] = make_float4_record(next.position, p.w);
     a.velocity[i] = make_float4_record(next.velocity, v.w);
     a.id[i] = id;
     v2 = length_squared(next.velocity);
     if (!finite3(next.position) || !isfinite(v2)) {
-      flag_non_finite(state, 0, i, id, non_finite_stage(p, v, acc, integrated));
+      flag_non_finite(state, 0, i, id, classify_non_finite(a.density[i], p, v, acc, integrated));
       v2 = 0.0f;
     }
   }
@@ -210,7 +198,7 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
     ParticleState* start = (stage & 1) ? a.rk4_start[0] : a.rk4_start[1];
     Rk4Accumulator* sums = (stage & 1) ? a.rk4_sum[0] : a.rk4_sum[1];
     FluidConstants f = fluid;
-    f.dt = state->dt_float;
+    f.dt = state->clock.dt_float;
     Vec3 acc = gather_acceleration_masked<kSurfaceTension, kViscosity>(
         f, grid, a.sorted_position, a.sorted_velocity, a.neighbor_count, a.colour_normal, i);
     const Float4 p = a.sorted_position[i];
@@ -224,14 +212,14 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
     ParticleState next = rk4_advance(stage, from, ParticleState{xyz(p), xyz(v)}, acc, f.dt, sum);
     sums[i] = sum;
     const ParticleState integrated = next;
-    if (kScene && stage == kRk4Stages - 1) collide_all(scene, state->time, from.position, next);
+    if (kScene && stage == kRk4Stages - 1) collide_all(scene, state->clock.time, from.position, next);
     const uint32_t id = a.sorted_id[i];
     a.position[i] = make_float4_record(next.position, p.w);
     a.velocity[i] = make_float4_record(next.velocity, v.w);
     a.id[i] = id;
     v2 = length_squared(next.velocity);
     if (!finite3(next.position) || !isfinite(v2)) {
-      flag_non_finite(state, stage, i, id, non_finite_stage(p, v, acc, integrated));
+      flag_non_finite(state, stage, i, id, classify_non_finite(a.density[i], p, v, acc, integrated));
       v2 = 0.0f;
     }
     if (stage != kRk4Stages - 1) v2 = 0.0f;  // the speed that counts is the final state's

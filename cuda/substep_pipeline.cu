@@ -35,8 +35,9 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
   enqueue_end_substep(b.state, setup.limits, setup.max_substeps, stages, cond, stream);
 }
 
-void enqueue_frame_end(const PipelineSetup& setup, const PipelineBuffers& b, cudaStream_t stream) {
-  b.statistics->enqueue(setup.fluid, b.grid->view(), b.store->arrays(), setup.count, b.state, stream);
+void enqueue_frame_end(const PipelineSetup& setup, const PipelineBuffers& b, cudaStream_t stream,
+                       const uint32_t* counts) {
+  b.statistics->enqueue(setup.fluid, b.grid->view(), b.store->arrays(), setup.count, b.state, stream, counts);
   cuda_check(cudaMemcpyAsync(b.state_output, b.state, sizeof(FrameState), cudaMemcpyDeviceToHost, stream),
              "copy of the frame state");
 }

@@ -45,6 +45,9 @@ void enqueue_frame_begin(const PipelineSetup& setup, const PipelineBuffers& b, L
                          cudaStream_t stream);
 void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
                      cudaStream_t stream);
-void enqueue_frame_end(const PipelineSetup& setup, const PipelineBuffers& b, cudaStream_t stream);
+// counts: the neighbour counts of the last density pass when a sink compaction left the sorted
+// copy behind (FrameStatistics::enqueue); null otherwise.
+void enqueue_frame_end(const PipelineSetup& setup, const PipelineBuffers& b, cudaStream_t stream,
+                       const uint32_t* counts = nullptr);
 
 }  // namespace sph

@@ -101,6 +101,13 @@ typedef enum sph_backend {
   SPH_BACKEND_FORCE32 = 0x7fffffff
 } sph_backend;
 
+/* How a CUDA world runs its frames (sph_context_def.cuda_frames; docs/cuda.md). */
+typedef enum sph_cuda_frames {
+  SPH_CUDA_FRAMES_GRAPH = 0,  /* default: each frame as one CUDA graph where it can (not with sinks) */
+  SPH_CUDA_FRAMES_STREAM = 1, /* each frame launched kernel by kernel: for profilers and sanitizers */
+  SPH_CUDA_FRAMES_FORCE32 = 0x7fffffff
+} sph_cuda_frames;
+
 typedef enum sph_integrator {
   SPH_INTEGRATOR_SYMPLECTIC_EULER = 0, /* v += a dt, then x += v dt: one force evaluation */
   SPH_INTEGRATOR_RK4 = 1,              /* classic Runge-Kutta: four force evaluations */
@@ -225,8 +232,15 @@ typedef struct sph_context_def {
   uint32_t reserved0;        /* must be 0 */
   sph_log_fn log_fn;         /* optional; NULL = no logging */
   void* log_user_data;       /* passed to log_fn */
+  /* Tuning of the CUDA backend (a CPU context checks and ignores it; docs/cuda.md). Results do
+     not depend on it: every choice computes the same particles bit for bit. */
+  sph_cuda_frames cuda_frames; /* default SPH_CUDA_FRAMES_GRAPH */
+  uint32_t cuda_density_block; /* threads per block of the density kernels: 0 (default) = 128, or
+                                  32, 64, 128, 256, 512, 1024 */
+  uint32_t cuda_force_block;   /* threads per block of the force kernels: 0 (default) = 128, or as above */
+  uint32_t reserved1;          /* must be 0 */
 } sph_context_def;
-SPH_STATIC_ASSERT(sizeof(sph_context_def) == 24 + 2 * sizeof(void*), sph_context_def_size);
+SPH_STATIC_ASSERT(sizeof(sph_context_def) == 40 + 2 * sizeof(void*), sph_context_def_size);
 
 /** Fills def with defaults; size is sizeof(*def). Prefer sph_context_def_init. */
 SPH_API sph_result SPH_CALL sph_context_def_init_sized(sph_context_def* def, uint32_t size);
@@ -238,9 +252,10 @@ static inline sph_result sph_context_def_init(sph_context_def* def) {
 
 /**
  * Creates a context: a backend (CPU or one CUDA device) that worlds are created on.
- * Errors: INVALID_ARGUMENT (NULL, bad field), VERSION_MISMATCH (struct_size or a newer-major
- * header), UNSUPPORTED (CUDA asked for but not built or no device), OUT_OF_HOST_MEMORY.
- * *out is written only on success. Thread-safe.
+ * Errors: INVALID_ARGUMENT (NULL, bad field: a cuda_*_block that is not 0 or a power of two from
+ * 32 to 1024, say), VERSION_MISMATCH (struct_size or a newer-major header), UNSUPPORTED (CUDA
+ * asked for but not built or no device; an unknown backend or cuda_frames value),
+ * OUT_OF_HOST_MEMORY. *out is written only on success. Thread-safe.
  */
 SPH_API sph_result SPH_CALL sph_context_create(const sph_context_def* def, sph_context** out);
 /** Destroys a context. NULL is a no-op. BUSY while worlds created on it are alive. */

@@ -59,6 +59,7 @@ namespace Sph
         public const uint SPH_SOURCE_FLAG_VELOCITY_FROM_FIELD = 1u;
         public const int SPH_RESULT_FORCE32 = 2147483647;
         public const int SPH_BACKEND_FORCE32 = 2147483647;
+        public const int SPH_CUDA_FRAMES_FORCE32 = 2147483647;
         public const int SPH_INTEGRATOR_FORCE32 = 2147483647;
         public const int SPH_LOG_LEVEL_FORCE32 = 2147483647;
         public const int SPH_ATTRIBUTE_COUNT = 5;
@@ -128,6 +129,15 @@ namespace Sph
         Cpu = 1,
         /// <summary>NVIDIA GPU; SPH_ERROR_UNSUPPORTED when not built or no device</summary>
         Cuda = 2,
+    }
+
+    /// <summary>sph_cuda_frames: How a CUDA world runs its frames (sph_context_def.cuda_frames; docs/cuda.md).</summary>
+    public enum CudaFrames : int
+    {
+        /// <summary>default: each frame as one CUDA graph where it can (not with sinks)</summary>
+        Graph = 0,
+        /// <summary>each frame launched kernel by kernel: for profilers and sanitizers</summary>
+        Stream = 1,
     }
 
     /// <summary>sph_integrator</summary>
@@ -482,7 +492,7 @@ namespace Sph
     }
 
     /// <summary>
-    /// sph_context_def (40 bytes): Zero means default: a zeroed def is valid (AUTO backend, device 0,
+    /// sph_context_def (56 bytes): Zero means default: a zeroed def is valid (AUTO backend, device 0,
     /// every hardware thread, no logging; header_version 0 skips the header check).
     /// </summary>
     [StructLayout(LayoutKind.Sequential)]
@@ -507,6 +517,24 @@ namespace Sph
         public IntPtr LogFn;
         /// <summary>void* log_user_data: passed to log_fn</summary>
         public IntPtr LogUserData;
+        /// <summary>
+        /// sph_cuda_frames cuda_frames: Tuning of the CUDA backend (a CPU context checks and ignores
+        /// it; docs/cuda.md). Results do not depend on it: every choice computes the same particles bit
+        /// for bit.
+        /// </summary>
+        public CudaFrames CudaFrames;
+        /// <summary>
+        /// uint32_t cuda_density_block: threads per block of the density kernels: 0 (default) = 128, or
+        /// 32, 64, 128, 256, 512, 1024
+        /// </summary>
+        public uint CudaDensityBlock;
+        /// <summary>
+        /// uint32_t cuda_force_block: threads per block of the force kernels: 0 (default) = 128, or as
+        /// above
+        /// </summary>
+        public uint CudaForceBlock;
+        /// <summary>uint32_t reserved1: must be 0</summary>
+        public uint Reserved1;
 
         /// <summary>A ContextDef with the library's defaults (sph_context_def_init_sized).</summary>
         public static ContextDef Default()
@@ -1455,9 +1483,10 @@ namespace Sph
 
         /// <summary>
         /// Creates a context: a backend (CPU or one CUDA device) that worlds are created on. Errors:
-        /// INVALID_ARGUMENT (NULL, bad field), VERSION_MISMATCH (struct_size or a newer-major header),
-        /// UNSUPPORTED (CUDA asked for but not built or no device), OUT_OF_HOST_MEMORY. *out is written
-        /// only on success. Thread-safe.
+        /// INVALID_ARGUMENT (NULL, bad field: a cuda_*_block that is not 0 or a power of two from 32 to
+        /// 1024, say), VERSION_MISMATCH (struct_size or a newer-major header), UNSUPPORTED (CUDA asked
+        /// for but not built or no device; an unknown backend or cuda_frames value),
+        /// OUT_OF_HOST_MEMORY. *out is written only on success. Thread-safe.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_context_create(ref ContextDef def, out ContextHandle @out);
@@ -2144,7 +2173,7 @@ namespace Sph
         };
         public static readonly int[] StructSizes = {
             12,
-            40,
+            56,
             40,
             48,
             16,
@@ -2178,6 +2207,10 @@ namespace Sph
             typeof(Vec3),
             typeof(Vec3),
             typeof(Vec3),
+            typeof(ContextDef),
+            typeof(ContextDef),
+            typeof(ContextDef),
+            typeof(ContextDef),
             typeof(ContextDef),
             typeof(ContextDef),
             typeof(ContextDef),
@@ -2352,6 +2385,10 @@ namespace Sph
             "Reserved0",
             "LogFn",
             "LogUserData",
+            "CudaFrames",
+            "CudaDensityBlock",
+            "CudaForceBlock",
+            "Reserved1",
             "StructSize",
             "HeaderVersion",
             "Capacity",
@@ -2518,6 +2555,10 @@ namespace Sph
             20,
             24,
             32,
+            40,
+            44,
+            48,
+            52,
             0,
             4,
             8,
@@ -2878,6 +2919,8 @@ namespace Sph
             { "SPH_BACKEND_AUTO", "CUDA when a device is present, else the CPU" },
             { "SPH_BACKEND_CPU", "the multithreaded reference solver" },
             { "SPH_BACKEND_CUDA", "NVIDIA GPU; SPH_ERROR_UNSUPPORTED when not built or no device" },
+            { "SPH_CUDA_FRAMES_GRAPH", "default: each frame as one CUDA graph where it can (not with sinks)" },
+            { "SPH_CUDA_FRAMES_STREAM", "each frame launched kernel by kernel: for profilers and sanitizers" },
             { "SPH_INTEGRATOR_SYMPLECTIC_EULER", "v += a dt, then x += v dt: one force evaluation" },
             { "SPH_INTEGRATOR_RK4", "classic Runge-Kutta: four force evaluations" },
             { "SPH_ATTRIBUTE_POSITION", "3 x float32, metres" },

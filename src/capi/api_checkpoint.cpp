@@ -43,7 +43,7 @@ std::unique_ptr<sph::World> load_world(sph_context* context, const void* data, u
   return sph::read_checkpoint(static_cast<const uint8_t*>(data), static_cast<size_t>(size),
                               [context](const sph::WorldConfig& config) {
                                 return sph::make_backend(context->backend, config, context->device_ordinal,
-                                                         context->cpu_workers);
+                                                         context->cpu_workers, context->cuda_tuning);
                               });
 }
 

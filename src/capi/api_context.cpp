@@ -1,4 +1,4 @@
-// Contexts: backend choice, device, CPU workers and logging.
+// Contexts: backend choice, device, CPU workers, CUDA tuning and logging.
 #include <thread>
 
 #include "guard.h"
@@ -18,6 +18,28 @@ sph_context_def default_context_def() {
   d.backend = SPH_BACKEND_AUTO;
   d.device_ordinal = -1;
   return d;
+}
+
+// The CUDA tuning fields: the one place the library reads them (docs/cuda.md).
+sph::CudaTuning cuda_tuning_from_def(const sph_context_def& d) {
+  const uint32_t frames = sph::enum_bits(d.cuda_frames);
+  if (frames != SPH_CUDA_FRAMES_GRAPH && frames != SPH_CUDA_FRAMES_STREAM)
+    throw Error(Status::Unsupported,
+                "def->cuda_frames: " + std::to_string(frames) + " is not an sph_cuda_frames value");
+  const auto block = [](uint32_t value, const char* field) {
+    const bool valid = value == 0 || (value >= 32 && value <= 1024 && (value & (value - 1)) == 0);
+    if (!valid)
+      throw Error(Status::InvalidArgument, std::string("def->") + field + ": " + std::to_string(value) +
+                                               " threads per block; use 0 (default 128) or a power of two "
+                                               "from 32 to 1024");
+    return value;
+  };
+  if (d.reserved1 != 0) throw Error(Status::InvalidArgument, "def->reserved1: must be 0");
+  sph::CudaTuning t;
+  t.stream_frames = frames == SPH_CUDA_FRAMES_STREAM;
+  t.density_block = block(d.cuda_density_block, "cuda_density_block");
+  t.force_block = block(d.cuda_force_block, "cuda_force_block");
+  return t;
 }
 
 }  // namespace
@@ -53,6 +75,7 @@ SPH_API sph_result SPH_CALL sph_context_create(const sph_context_def* def, sph_c
     if (d.cpu_worker_count > 4096)
       throw Error(Status::InvalidArgument,
                   "def->cpu_worker_count: " + std::to_string(d.cpu_worker_count) + " is more than 4096");
+    const sph::CudaTuning cuda_tuning = cuda_tuning_from_def(d);
     const sph::BackendKind kind =
         sph::resolve_backend(static_cast<sph::BackendKind>(backend), d.device_ordinal);
     auto context = std::make_unique<sph_context>();
@@ -60,6 +83,7 @@ SPH_API sph_result SPH_CALL sph_context_create(const sph_context_def* def, sph_c
     context->device_ordinal = d.device_ordinal < 0 ? 0 : d.device_ordinal;
     const unsigned hw = std::thread::hardware_concurrency();
     context->cpu_workers = d.cpu_worker_count != 0 ? d.cpu_worker_count : (hw == 0 ? 1u : hw);
+    context->cuda_tuning = cuda_tuning;
     context->log_fn = d.log_fn;
     context->log_user_data = d.log_user_data;
     sph::register_handle(context.get(), sph::HandleKind::Context);

@@ -5,15 +5,16 @@
 #include <atomic>
 #include <memory>
 
-#include "../core/backend_factory.h"
 #include "../core/sdf_asset.h"
 #include "../core/world.h"
+#include "../factory/backend_factory.h"
 #include "sph_c.h"
 
 struct sph_context {
   sph::BackendKind backend;
   int device_ordinal;
   unsigned cpu_workers;
+  sph::CudaTuning cuda_tuning;
   sph_log_fn log_fn;
   void* log_user_data;
   std::atomic<uint32_t> world_count{0};

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "../core/status.h"
+#include "sph_c.h"
 
 namespace sph {
 
@@ -18,6 +19,11 @@ namespace sph {
 //   template <> constexpr uint32_t kFirstStructSize<sph_context_def> = 40;
 template <class T>
 constexpr uint32_t kFirstStructSize = static_cast<uint32_t>(sizeof(T));
+
+// Structs that grew after their first release, with the size they had then.
+template <>
+constexpr uint32_t kFirstStructSize<sph_context_def> =
+    24 + 2 * sizeof(void*);  // 0.1.0; 0.2.0 adds the CUDA tuning
 
 template <class T>
 T read_user_struct(const T* user, const char* name) {

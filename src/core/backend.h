@@ -1,6 +1,6 @@
-// The interface the core drives a backend through. A backend owns the particle state (host
-// arrays on the CPU, device arrays on CUDA) and runs whole frames; the core validates input,
-// assigns ids and keeps parameters.
+// The interface the core drives a backend through. A backend owns the particle state (in host
+// or device memory) and runs whole frames; the core validates input, assigns ids and keeps
+// parameters. The core never names a backend: src/factory makes them.
 #pragma once
 
 #include <stddef.h>
@@ -13,6 +13,7 @@
 #include "../physics/vec3.h"
 #include "config.h"
 #include "frame_report.h"
+#include "particle_snapshot.h"
 #include "scene_frame.h"
 #include "status.h"
 
@@ -30,23 +31,6 @@ struct DeviceAttributeView {
   int device = 0;
 };
 
-// Everything a backend carries from one frame to the next, in storage order (the order of the
-// last sort, which fixes the summation order of the next one): loading it into a fresh backend
-// of the same kind continues bit for bit (checkpoints).
-struct ParticleSnapshot {
-  std::vector<Float4> position;  // w: pressure of the last density pass
-  std::vector<Float4> velocity;  // w: 1 / density of the last density pass
-  std::vector<uint32_t> id;
-  std::vector<float> density;
-  float max_speed = 0.0f;         // |v|max the next frame's first step is chosen from
-  float max_acceleration = 0.0f;  // |a|max of the last force evaluation (the force step limit)
-  // SPH_FEATURE_SPRINGS only (empty otherwise): each particle's springs, partners as storage
-  // indices, and the lowest id still waiting for its springs (kNoPendingLinks: none).
-  std::vector<SpringList> springs;
-  uint32_t link_from = kNoPendingLinks;
-  std::vector<float> density_factor;  // normalised density's carried factors; empty when off
-};
-
 class Backend {
  public:
   virtual ~Backend() = default;
@@ -58,25 +42,15 @@ class Backend {
   // leaves the particles as they were.
   virtual void append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id) = 0;
 
-  // Runs adaptive substeps until frame_dt is reached or params.max_substeps is spent. On a
-  // non-finite state it restores the particles as they were before the call and throws
-  // Error(Status::NonFinite).
-  virtual FrameReport step_frame(double frame_dt, const RuntimeParams& params) = 0;
-
-  // Runs a frame with colliders, force fields and sinks. A backend without scene support
-  // runs plain frames and refuses a non-empty scene.
+  // Runs adaptive substeps until frame_dt is reached or params.max_substeps is spent, with the
+  // scene's colliders, force fields and sinks. On a non-finite state it restores the particles
+  // as they were before the call and throws Error(Status::NonFinite).
   virtual FrameReport step_scene_frame(double frame_dt, const RuntimeParams& params,
-                                       const SceneFrame& scene) {
-    if (!scene.empty())
-      throw Error(Status::Unsupported, "this backend does not support colliders, force fields or sinks yet");
-    return step_frame(frame_dt, params);
-  }
+                                       const SceneFrame& scene) = 0;
 
   // Drops the particles from index `count` on (used to undo an emission when a step fails;
   // emitted particles are appended, so they are the last ones).
-  virtual void truncate(uint32_t count) {
-    if (count != particle_count()) throw Error(Status::Unsupported, "this backend cannot remove particles");
-  }
+  virtual void truncate(uint32_t count) = 0;
 
   // Writes particles [first, first + count) of one attribute to dst with a byte stride, as
   // float32 x3 (position, velocity), float32 (density, pressure) or uint32 (id).
@@ -92,7 +66,8 @@ class Backend {
   // Bytes held for particles and grids (device bytes on a GPU backend).
   virtual uint64_t memory_bytes() const = 0;
 
-  // ---- the CUDA interop tier (include/sph_cuda.h); other backends refuse it ----------------
+  // ---- the device interop tier (include/sph_cuda.h); a backend whose particles live in host
+  // memory refuses it with the defaults below ---------------------------------------------------
   // Where an attribute lives in device memory; the pointer stays valid for the backend's life.
   virtual DeviceAttributeView device_attribute(AttributeKind) const { throw unsupported_interop(); }
   // Increments on every call that changes particle data (append, frames, rollbacks).
@@ -105,11 +80,11 @@ class Backend {
 
  protected:
   static Error unsupported_interop() {
-    return Error(Status::Unsupported,
-                 "world: it runs on the CPU backend; the CUDA interop calls need a CUDA world");
+    return Error(
+        Status::Unsupported,
+        "world: its particles live in host memory; the interop calls of sph_cuda.h need a world on a "
+        "CUDA context");
   }
 };
-
-std::unique_ptr<Backend> make_cpu_backend(const WorldConfig& config, unsigned worker_count);
 
 }  // namespace sph

@@ -190,16 +190,16 @@ void read_spring_params(ByteReader& r, const WorldConfig& config, RuntimeParams&
 // the solver keeps them.
 void read_springs(ByteReader& r, const WorldConfig& config, uint32_t next_id, ParticleSnapshot& s) {
   const uint32_t n = static_cast<uint32_t>(s.id.size());
-  s.link_from = r.u32();
-  if (s.link_from != kNoPendingLinks && s.link_from > next_id)
-    corrupt(r.what() + ": the first id waiting for springs, " + std::to_string(s.link_from) +
+  const uint32_t link_from = r.u32();
+  if (link_from != kNoPendingLinks && link_from > next_id)
+    corrupt(r.what() + ": the first id waiting for springs, " + std::to_string(link_from) +
             ", was never issued");
   if (r.u32() != kSpringSlots)
     corrupt(r.what() + ": spring lists do not have " + std::to_string(kSpringSlots) + " slots");
   r.need_elements(n, kSpringSlots * 8, "spring lists");
-  s.springs.resize(n);
+  std::vector<SpringList> springs(n);
   for (uint32_t i = 0; i < n; ++i) {
-    SpringList& list = s.springs[i];
+    SpringList& list = springs[i];
     for (uint32_t k = 0; k < kSpringSlots; ++k) {
       list.partner[k] = r.u32();
       list.rest[k] = bulk_finite(r, "spring rest length of particle", i);
@@ -219,19 +219,21 @@ void read_springs(ByteReader& r, const WorldConfig& config, uint32_t next_id, Pa
   }
   for (uint32_t i = 0; i < n; ++i)
     for (uint32_t k = 0; k < kSpringSlots; ++k) {
-      const uint32_t j = s.springs[i].partner[k];
+      const uint32_t j = springs[i].partner[k];
       if (j == kNoSpring) continue;
       uint32_t matches = 0;
       for (uint32_t m = 0; m < kSpringSlots; ++m)
-        if (s.springs[j].partner[m] == i &&
-            std::memcmp(&s.springs[j].rest[m], &s.springs[i].rest[k], sizeof(float)) == 0)
+        if (springs[j].partner[m] == i &&
+            std::memcmp(&springs[j].rest[m], &springs[i].rest[k], sizeof(float)) == 0)
           ++matches;
       uint32_t copies = 0;
-      for (uint32_t m = 0; m < kSpringSlots; ++m) copies += s.springs[i].partner[m] == j ? 1u : 0u;
+      for (uint32_t m = 0; m < kSpringSlots; ++m) copies += springs[i].partner[m] == j ? 1u : 0u;
       if (matches != 1 || copies != 1)
         corrupt(r.what() + ": the spring between particles " + std::to_string(i) + " and " +
                 std::to_string(j) + " is not stored once at each end with one rest length");
     }
+  s.set_carried(kArraySprings, springs);
+  s.set_carried(kArraySpringLinkFrom, std::vector<uint32_t>{link_from});
 }
 
 struct Clock {
@@ -312,14 +314,15 @@ ParticleSnapshot read_particles(ByteReader& r, const WorldConfig& config, uint32
   // its particles start fresh.
   if ((config.features & kFeatureNormalizedDensity) && r.remaining() != 0) {
     r.need_elements(n, sizeof(float), "density factors");
-    s.density_factor.resize(n);
+    std::vector<float> factors(n);
     for (uint32_t i = 0; i < n; ++i) {
       const float d = r.f32();
       if (!std::isnan(d) && !(d > 0.0f && std::isfinite(d)))
         corrupt(r.what() + ": density factor of particle " + std::to_string(i) + " is " + std::to_string(d) +
                 ", not positive and finite");
-      s.density_factor[i] = d;
+      factors[i] = d;
     }
+    s.set_carried(kArrayDensityFactor, factors);
   }
   std::vector<uint32_t> sorted(s.id);
   std::sort(sorted.begin(), sorted.end());

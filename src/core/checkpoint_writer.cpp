@@ -95,9 +95,10 @@ void write_spring_params(ByteWriter& w, const RuntimeParams& p) {
 }
 
 void write_springs(ByteWriter& w, const ParticleSnapshot& s) {
-  w.u32(s.link_from);
+  const std::vector<uint32_t> link_from = s.carried_as<uint32_t>(kArraySpringLinkFrom);
+  w.u32(link_from.empty() ? kNoPendingLinks : link_from[0]);
   w.u32(kSpringSlots);
-  for (const SpringList& list : s.springs)
+  for (const SpringList& list : s.carried_as<SpringList>(kArraySprings))
     for (uint32_t k = 0; k < kSpringSlots; ++k) {
       w.u32(list.partner[k]);
       w.f32(list.rest[k]);
@@ -158,7 +159,7 @@ void write_particles(ByteWriter& w, const ParticleSnapshot& s) {
   for (uint32_t id : s.id) w.u32(id);
   for (float d : s.density) w.f32(d);
   // Normalised density only: each particle's carried factor (NaN: not resolved yet).
-  for (float d : s.density_factor) w.f32(d);
+  for (float d : s.carried_as<float>(kArrayDensityFactor)) w.f32(d);
 }
 
 void write_asset(ByteWriter& w, const SdfAsset& a) {

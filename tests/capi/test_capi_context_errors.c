@@ -47,6 +47,10 @@ static void test_def_init(void** state) {
   assert_int_equal(def.reserved0, 0);
   assert_null(def.log_fn);
   assert_null(def.log_user_data);
+  assert_int_equal(def.cuda_frames, SPH_CUDA_FRAMES_GRAPH);
+  assert_int_equal(def.cuda_density_block, 0);
+  assert_int_equal(def.cuda_force_block, 0);
+  assert_int_equal(def.reserved1, 0);
   /* Larger (a newer caller): accepted, struct_size kept, the unknown tail zeroed. */
   memset(&grown, 0xab, sizeof grown);
   EXPECT_OK(sph_context_def_init_sized(&grown.def, sizeof grown));
@@ -74,8 +78,16 @@ static void test_create_struct_size(void** state) {
   (void)state;
   memset(&grown, 0, sizeof grown);
   sph_test_context_def_init(&grown.def);
-  grown.def.struct_size = sizeof grown.def - 4;
+  /* Below the struct's first released size (0.1.0: 24 + 2 pointers): refused. */
+  grown.def.struct_size = (uint32_t)(24 + 2 * sizeof(void*) - 4);
   EXPECT_CREATE_FAILS(&grown.def, SPH_ERROR_VERSION_MISMATCH, "struct_size");
+  /* A 0.1.0 caller's struct, without the CUDA tuning fields that came later: accepted, the
+     fields it lacks read as zero (the defaults), whatever the bytes after its struct hold. */
+  grown.def.struct_size = (uint32_t)(24 + 2 * sizeof(void*));
+  grown.def.cuda_density_block = 7; /* not a valid block size: it must not be read */
+  EXPECT_OK(sph_context_create(&grown.def, &out));
+  EXPECT_OK(sph_context_destroy(out));
+  grown.def.cuda_density_block = 0;
   grown.def.struct_size = 0;
   EXPECT_CREATE_FAILS(&grown.def, SPH_ERROR_VERSION_MISMATCH, "struct_size");
   /* Larger with a nonzero byte in the part this library does not know. */
@@ -127,6 +139,42 @@ static void test_create_bad_fields(void** state) {
   sph_test_context_def_init(&def);
   def.cpu_worker_count = 0xffffffffu;
   EXPECT_CREATE_FAILS(&def, SPH_ERROR_INVALID_ARGUMENT, "cpu_worker_count");
+  sph_test_context_def_init(&def);
+  def.reserved1 = 1;
+  EXPECT_CREATE_FAILS(&def, SPH_ERROR_INVALID_ARGUMENT, "reserved1");
+}
+
+/* The CUDA tuning fields are checked on every context (a CPU context ignores valid values): block
+ * sizes are 0 or a power of two from 32 to 1024, cuda_frames one of its two values. */
+static void test_create_cuda_tuning(void** state) {
+  static const uint32_t bad_blocks[] = {1, 16, 31, 33, 96, 100, 2048, 0x80000000u, 0xffffffffu};
+  static const uint32_t good_blocks[] = {0, 32, 64, 128, 256, 512, 1024};
+  static const uint32_t bad_frames[] = {2, 0x7fffffffu, 0x80000000u};
+  sph_context_def def;
+  sph_context* context = NULL;
+  size_t i;
+  (void)state;
+  for (i = 0; i < sizeof bad_blocks / sizeof bad_blocks[0]; ++i) {
+    sph_test_context_def_init(&def);
+    def.cuda_density_block = bad_blocks[i];
+    EXPECT_CREATE_FAILS(&def, SPH_ERROR_INVALID_ARGUMENT, "cuda_density_block");
+    sph_test_context_def_init(&def);
+    def.cuda_force_block = bad_blocks[i];
+    EXPECT_CREATE_FAILS(&def, SPH_ERROR_INVALID_ARGUMENT, "cuda_force_block");
+  }
+  for (i = 0; i < sizeof bad_frames / sizeof bad_frames[0]; ++i) {
+    sph_test_context_def_init(&def);
+    def.cuda_frames = (sph_cuda_frames)bad_frames[i];
+    EXPECT_CREATE_FAILS(&def, SPH_ERROR_UNSUPPORTED, "cuda_frames");
+  }
+  for (i = 0; i < sizeof good_blocks / sizeof good_blocks[0]; ++i) {
+    sph_test_context_def_init(&def);
+    def.cuda_frames = SPH_CUDA_FRAMES_STREAM;
+    def.cuda_density_block = good_blocks[i];
+    def.cuda_force_block = good_blocks[sizeof good_blocks / sizeof good_blocks[0] - 1 - i];
+    EXPECT_OK(sph_context_create(&def, &context));
+    EXPECT_OK(sph_context_destroy(context));
+  }
 }
 
 /* AUTO picks CUDA exactly when the library has CUDA and a usable device exists. */
@@ -257,6 +305,7 @@ int main(void) {
       cmocka_unit_test(test_create_header_version),
       cmocka_unit_test(test_create_unknown_backend),
       cmocka_unit_test(test_create_bad_fields),
+      cmocka_unit_test(test_create_cuda_tuning),
       cmocka_unit_test(test_create_cuda_unavailable),
       cmocka_unit_test(test_create_cuda_bad_ordinal),
       cmocka_unit_test(test_destroy),

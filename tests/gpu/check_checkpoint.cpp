@@ -143,12 +143,12 @@ int main() {
   rk4.viscosity_method = SPH_VISCOSITY_CLAVET;
 
   for (int stream = 0; stream < 2; ++stream) {
-    if (stream) setenv("SPH_CUDA_GRAPHS", "0", 1);
+    if (stream) context_tuning().stream_frames = true;
     const char* mode = stream ? "stream" : "graph";
     continuation(drop, false, 3, 3, mode);
     continuation(drop, true, 3, 3, mode);
     continuation(rk4, false, 2, 2, mode);
-    if (stream) unsetenv("SPH_CUDA_GRAPHS");
+    if (stream) context_tuning().stream_frames = false;
   }
   SceneSpec small = drop;
   small.radius = 0.15f;

@@ -40,14 +40,26 @@ void twice(const SceneSpec& spec, int frames, float frame_dt) {
          a.state.count, frames, a.stats.substeps,
          states_identical(a.state, b.state) && same_stats(a.stats, b.stats) ? "bitwise identical" : "DIFFER");
 
-  setenv("SPH_CUDA_GRAPHS", "0", 1);
+  context_tuning().stream_frames = true;
   const Run c = run(spec, frames, frame_dt);
-  unsetenv("SPH_CUDA_GRAPHS");
+  context_tuning().stream_frames = false;
   const std::string name2 = std::string("graph_vs_stream/") + spec.name;
   report(
       states_identical(a.state, c.state) && same_stats(a.stats, c.stats), name2.c_str(),
       "the CUDA-graph frame and the stream fallback give %s results",
       states_identical(a.state, c.state) && same_stats(a.stats, c.stats) ? "bitwise identical" : "DIFFERENT");
+
+  // The block sizes of sph_context_def only change how particles are grouped into blocks: each
+  // particle's gather and every reduction (max by integer bits) are the same.
+  context_tuning().density_block = 256;
+  context_tuning().force_block = 64;
+  const Run d = run(spec, frames, frame_dt);
+  context_tuning() = ContextTuning{};
+  const std::string name3 = std::string("block_sizes/") + spec.name;
+  report(
+      states_identical(a.state, d.state) && same_stats(a.stats, d.stats), name3.c_str(),
+      "density blocks of 256 and force blocks of 64 against the default 128: %s",
+      states_identical(a.state, d.state) && same_stats(a.stats, d.stats) ? "bitwise identical" : "DIFFERENT");
 }
 
 void concurrent(const SceneSpec& spec, int frames, float frame_dt) {

@@ -64,9 +64,40 @@ inline void exit_if_no_cuda() {
   sph_context_destroy(context);
 }
 
+// The CUDA tuning of the contexts make_context creates (sph_context_def's cuda_* fields): the
+// stream driver when stream_frames is set or SPH_CUDA_GRAPHS=0 is in the environment
+// (scripts/gpu-test sets it; the library itself reads no environment), and the block sizes.
+struct ContextTuning {
+  bool stream_frames = false;
+  uint32_t density_block = 0;  // 0: the library's default
+  uint32_t force_block = 0;
+};
+inline ContextTuning& context_tuning() {
+  static ContextTuning tuning;
+  return tuning;
+}
+
+// Written against the fields by template (a def without them is left alone), because
+// scripts/compare-state builds this header against revisions from before the fields existed.
+template <class Def>
+auto apply_context_tuning(Def& def, int) -> decltype(def.cuda_frames, def.cuda_density_block, void()) {
+  const char* graphs = std::getenv("SPH_CUDA_GRAPHS");
+  const bool stream = context_tuning().stream_frames || (graphs && std::strcmp(graphs, "0") == 0);
+  def.cuda_frames =
+      static_cast<decltype(def.cuda_frames)>(stream ? 1 : 0);  // SPH_CUDA_FRAMES_STREAM : _GRAPH
+  def.cuda_density_block = context_tuning().density_block;
+  def.cuda_force_block = context_tuning().force_block;
+}
+template <class Def>
+void apply_context_tuning(Def&, long) {}
+
 inline sph_context* make_context(sph_backend backend) {
+  sph_context_def def;
+  sph_context_def_init(&def);
+  def.backend = backend;
+  apply_context_tuning(def, 0);
   sph_context* context = nullptr;
-  require_ok(support_context_create(backend, &context), "sph_context_create");
+  require_ok(sph_context_create(&def, &context), "sph_context_create");
   return context;
 }
 

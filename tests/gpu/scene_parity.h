@@ -178,9 +178,9 @@ inline void compare_scene(const SceneHooks& h) {
       format_detail("max |v_gpu - v_cpu| = %.3g m/s, %.3g relative to max |v| = %.3g m/s (limit 1e-3)", dv,
                     dv / vscale, vscale));
   const SceneRun g2 = run_scene(SPH_BACKEND_CUDA, h);
-  setenv("SPH_CUDA_GRAPHS", "0", 1);
+  context_tuning().stream_frames = true;
   const SceneRun g3 = run_scene(SPH_BACKEND_CUDA, h);
-  unsetenv("SPH_CUDA_GRAPHS");
+  context_tuning().stream_frames = false;
   report(raw_identical(g, g2) && raw_identical(g, g3), (name + "/deterministic").c_str(),
          "two GPU runs %s, the stream fallback %s", raw_identical(g, g2) ? "identical" : "DIFFER",
          raw_identical(g, g3) ? "identical" : "DIFFERS");

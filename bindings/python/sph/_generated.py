@@ -10,7 +10,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'fa63fc92fdeaf8171ec8a94ebbf52349141ea4bc01bc947882b706a026910783', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
+HEADERS = {'include/sph_c.h': '6d676f1a89f7b5ed2af586f575041a28d6f938ea950f50a90cec00f2f1e8f2e7', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -137,6 +137,23 @@ class Backend(_enum.IntEnum):
     CPU = 1
     #: NVIDIA GPU; SPH_ERROR_UNSUPPORTED when not built or no device
     CUDA = 2
+
+
+sph_cuda_frames = _c.c_int32
+SPH_CUDA_FRAMES_GRAPH = 0  # default: each frame as one CUDA graph where it can (not with sinks)
+SPH_CUDA_FRAMES_STREAM = 1  # each frame launched kernel by kernel: for profilers and sanitizers
+SPH_CUDA_FRAMES_FORCE32 = 2147483647
+
+
+class CudaFrames(_enum.IntEnum):
+    """
+    sph_cuda_frames: How a CUDA world runs its frames (sph_context_def.cuda_frames;
+    docs/cuda.md).
+    """
+    #: default: each frame as one CUDA graph where it can (not with sinks)
+    GRAPH = 0
+    #: each frame launched kernel by kernel: for profilers and sanitizers
+    STREAM = 1
 
 
 sph_integrator = _c.c_int32
@@ -398,6 +415,8 @@ ENUM_MEMBER_DOCS = {
     'SPH_BACKEND_AUTO': 'CUDA when a device is present, else the CPU',
     'SPH_BACKEND_CPU': 'the multithreaded reference solver',
     'SPH_BACKEND_CUDA': 'NVIDIA GPU; SPH_ERROR_UNSUPPORTED when not built or no device',
+    'SPH_CUDA_FRAMES_GRAPH': 'default: each frame as one CUDA graph where it can (not with sinks)',
+    'SPH_CUDA_FRAMES_STREAM': 'each frame launched kernel by kernel: for profilers and sanitizers',
     'SPH_INTEGRATOR_SYMPLECTIC_EULER': 'v += a dt, then x += v dt: one force evaluation',
     'SPH_INTEGRATOR_RK4': 'classic Runge-Kutta: four force evaluations',
     'SPH_ATTRIBUTE_POSITION': '3 x float32, metres',
@@ -508,6 +527,10 @@ class ContextDef(_SphStruct):
         reserved0 (uint32_t): must be 0
         log_fn (sph_log_fn): optional; NULL = no logging
         log_user_data (void*): passed to log_fn
+        cuda_frames (sph_cuda_frames): Tuning of the CUDA backend (a CPU context checks and ignores it; docs/cuda.md). Results do not depend on it: every choice computes the same particles bit for bit.
+        cuda_density_block (uint32_t): threads per block of the density kernels: 0 (default) = 128, or 32, 64, 128, 256, 512, 1024
+        cuda_force_block (uint32_t): threads per block of the force kernels: 0 (default) = 128, or as above
+        reserved1 (uint32_t): must be 0
     """
     _fields_ = [
         ('struct_size', _c.c_uint32),
@@ -518,13 +541,17 @@ class ContextDef(_SphStruct):
         ('reserved0', _c.c_uint32),
         ('log_fn', sph_log_fn),
         ('log_user_data', _c.c_void_p),
+        ('cuda_frames', sph_cuda_frames),
+        ('cuda_density_block', _c.c_uint32),
+        ('cuda_force_block', _c.c_uint32),
+        ('reserved1', _c.c_uint32),
     ]
     _sph_c_name_ = 'sph_context_def'
-    _sph_size_ = 40
-    _sph_offsets_ = (('struct_size', 0), ('header_version', 4), ('backend', 8), ('device_ordinal', 12), ('cpu_worker_count', 16), ('reserved0', 20), ('log_fn', 24), ('log_user_data', 32))
+    _sph_size_ = 56
+    _sph_offsets_ = (('struct_size', 0), ('header_version', 4), ('backend', 8), ('device_ordinal', 12), ('cpu_worker_count', 16), ('reserved0', 20), ('log_fn', 24), ('log_user_data', 32), ('cuda_frames', 40), ('cuda_density_block', 44), ('cuda_force_block', 48), ('reserved1', 52))
     _sph_init_ = 'sph_context_def_init_sized'
     _sph_assigns_ = {'header_version': SPH_VERSION}
-    _sph_enums_ = {'backend': Backend}
+    _sph_enums_ = {'backend': Backend, 'cuda_frames': CudaFrames}
 
 
 sph_context_def = ContextDef
@@ -1333,7 +1360,7 @@ FUNCTIONS = {
     'sph_context_def_init_sized': (sph_result, (_c.POINTER(sph_context_def), _c.c_uint32), ('def', 'size'),
         'Fills def with defaults; size is sizeof(*def). Prefer sph_context_def_init.', 'sph'),
     'sph_context_create': (sph_result, (_c.POINTER(sph_context_def), _c.POINTER(_c.POINTER(sph_context))), ('def', 'out'),
-        'Creates a context: a backend (CPU or one CUDA device) that worlds are created on. Errors: INVALID_ARGUMENT (NULL, bad field), VERSION_MISMATCH (struct_size or a newer-major header), UNSUPPORTED (CUDA asked for but not built or no device), OUT_OF_HOST_MEMORY. *out is written only on success. Thread-safe.', 'sph'),
+        'Creates a context: a backend (CPU or one CUDA device) that worlds are created on. Errors: INVALID_ARGUMENT (NULL, bad field: a cuda_*_block that is not 0 or a power of two from 32 to 1024, say), VERSION_MISMATCH (struct_size or a newer-major header), UNSUPPORTED (CUDA asked for but not built or no device; an unknown backend or cuda_frames value), OUT_OF_HOST_MEMORY. *out is written only on success. Thread-safe.', 'sph'),
     'sph_context_destroy': (sph_result, (_c.POINTER(sph_context),), ('context',),
         'Destroys a context. NULL is a no-op. BUSY while worlds created on it are alive.', 'sph'),
     'sph_context_get_backend': (sph_result, (_c.POINTER(sph_context), _c.POINTER(sph_backend)), ('context', 'out_backend'),

@@ -2,7 +2,8 @@
 
 #include <string>
 
-#include "status.h"
+#include "../core/status.h"
+#include "../cpu/cpu_backend.h"
 
 #if defined(SPH_HAVE_CUDA)
 #include "../../cuda/cuda_backend.h"
@@ -56,11 +57,18 @@ void copy_device_to_host(void* host_dst, const void* device_src, size_t bytes, i
 }
 
 std::unique_ptr<Backend> make_backend(BackendKind kind, const WorldConfig& config, int device_ordinal,
-                                      unsigned cpu_workers) {
+                                      unsigned cpu_workers, const CudaTuning& cuda_tuning) {
 #if defined(SPH_HAVE_CUDA)
-  if (kind == BackendKind::Cuda) return make_cuda_backend(config, device_ordinal < 0 ? 0 : device_ordinal);
+  if (kind == BackendKind::Cuda) {
+    CudaBackendOptions options;
+    options.stream_frames = cuda_tuning.stream_frames;
+    if (cuda_tuning.density_block != 0) options.density_block = cuda_tuning.density_block;
+    if (cuda_tuning.force_block != 0) options.force_block = cuda_tuning.force_block;
+    return make_cuda_backend(config, device_ordinal < 0 ? 0 : device_ordinal, options);
+  }
 #else
   (void)device_ordinal;
+  (void)cuda_tuning;
 #endif
   if (kind == BackendKind::Cuda)
     throw Error(Status::Unsupported, "backend: CUDA is not available in this build");

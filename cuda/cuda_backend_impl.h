@@ -1,0 +1,160 @@
+// The CUDA backend's class, shared by cuda_backend.cu (particles, copies out, checkpoints, the
+// interop tier) and frame_loop.cu (frames and their rollback). Device-resident particles,
+// every substep stage on the world's own stream, and the frame loop on the device
+// (frame_graph.h). It mirrors the CPU backend's semantics: the same sort, the same substep
+// structure, the same step control and the same rollback.
+#pragma once
+
+#include <cstring>
+#include <memory>
+#include <vector>
+
+#include "../src/core/backend.h"
+#include "cuda_backend.h"
+#include "cuda_status.h"
+#include "device_array.h"
+#include "device_neighbor_grid.h"
+#include "device_particle_store.h"
+#include "device_scene.h"
+#include "device_sinks.h"
+#include "frame_control.h"
+#include "frame_graph.h"
+#include "frame_statistics.h"
+#include "substep_pipeline.h"
+
+namespace sph {
+
+// Everything the backend holds on the device. Released with the backend's device current.
+struct DeviceResources {
+  cudaStream_t stream = nullptr;
+  cudaEvent_t frame_start = nullptr;
+  cudaEvent_t frame_stop = nullptr;
+  std::unique_ptr<DeviceParticleStore> store;
+  std::unique_ptr<DeviceNeighborGrid> grid;
+  std::unique_ptr<FrameStatistics> statistics;
+  DeviceArray<FrameState> state;
+  PinnedArray<FrameInput> input;
+  PinnedArray<FrameState> state_output;
+  PinnedArray<uint32_t> sink_kept;
+  FrameGraph graph;
+  PipelineSetup graph_setup;
+  DeviceSdfCache sdf_cache;
+  DeviceSceneBuffer scene_buffer;
+  DeviceSinkCompactor sinks;
+
+  ~DeviceResources() {
+    if (stream && cudaStreamSynchronize(stream) != cudaSuccess) (void)cudaGetLastError();
+    graph.reset();
+    if (frame_start) cudaEventDestroy(frame_start);
+    if (frame_stop) cudaEventDestroy(frame_stop);
+    if (stream) cudaStreamDestroy(stream);
+    (void)cudaGetLastError();
+  }
+
+  PipelineBuffers buffers() {
+    return PipelineBuffers{store.get(), grid.get(),  statistics.get(),
+                           state.get(), input.get(), state_output.get()};
+  }
+};
+
+class CudaBackend final : public Backend {
+ public:
+  CudaBackend(const WorldConfig& config, int device, const CudaBackendOptions& options);
+  ~CudaBackend() override;
+
+  uint32_t particle_count() const override { return count_; }
+
+  void append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id) override;
+
+  // Drops particles [count, particle_count()) (an emission undone after a failed step).
+  void truncate(uint32_t count) override;
+
+  FrameReport step_scene_frame(double frame_dt, const RuntimeParams& params,
+                               const SceneFrame& scene_in) override;
+
+  void copy_attribute(AttributeKind kind, uint32_t first, uint32_t count, void* dst,
+                      size_t stride) const override;
+
+  // Checkpoints: the state in storage order and the frame state that carries over (max speed,
+  // max acceleration); everything else in FrameState is reset when a frame begins.
+  ParticleSnapshot export_particles() const override;
+
+  void import_particles(const ParticleSnapshot& s) override;
+
+  uint64_t memory_bytes() const override;
+
+  DeviceAttributeView device_attribute(AttributeKind kind) const override;
+
+  uint64_t data_epoch() const override { return epoch_; }
+  int device_ordinal() const override { return device_; }
+  void* device_stream() const override { return r_->stream; }
+
+  void record_device_event(void* event) const override;
+
+  void wait_device_event(void* event) const override;
+
+ private:
+  static DeviceAttributeView with(DeviceAttributeView v, uintptr_t address, uint64_t stride,
+                                  uint32_t element) {
+    v.address = address;
+    v.stride = stride;
+    v.element_size = element;
+    return v;
+  }
+
+  // Restores the particles (and the cached max speed) from the snapshot taken at the start of
+  // the frame; count_ is still the count before the frame.
+  void roll_back_frame();
+
+  void require_alive() const {
+    if (lost_)
+      throw Error(Status::DeviceLost,
+                  "world: its CUDA device reported a sticky error earlier; destroy the world");
+  }
+
+  // Runs body; a sticky CUDA error marks the backend lost so every later call reports it.
+  template <class Body>
+  void guarded(Body&& body) const {
+    try {
+      body();
+    } catch (const Error& e) {
+      if (e.status() == Status::DeviceLost) lost_ = true;
+      throw;
+    }
+  }
+
+  template <class T>
+  std::vector<T> download(const T* src, size_t count) const {
+    std::vector<T> host(count);
+    guarded([&] {
+      cuda_check(cudaMemcpyAsync(host.data(), src, sizeof(T) * count, cudaMemcpyDeviceToHost, r_->stream),
+                 "copy of particle data to the host");
+      cuda_check(cudaStreamSynchronize(r_->stream), "copy of particle data to the host");
+    });
+    return host;
+  }
+
+  template <class T>
+  static void scatter(const std::vector<T>& host, unsigned char* out, size_t stride) {
+    for (size_t k = 0; k < host.size(); ++k) std::memcpy(out + k * stride, &host[k], sizeof(T));
+  }
+
+  // (Re)captures the frame graph when needed; false when it cannot be built (see frame_loop.cu).
+  bool prepare_graph(const PipelineSetup& setup);
+
+  // The stream driver (frame_loop.cu): frames with sinks, and every frame without graphs.
+  uint32_t run_frame_on_stream(PipelineSetup setup, uint32_t sink_count, std::vector<uint32_t>& removed_ids,
+                               std::vector<uint32_t>& removed_by_sink);
+
+  WorldConfig config_;
+  int device_;
+  KernelTuning tuning_;
+  SubstepOptions options_;
+  bool use_graphs_ = true;
+  uint32_t count_ = 0;
+  uint64_t epoch_ = 1;
+  mutable bool lost_ = false;
+  std::unique_ptr<DeviceResources> r_;
+};
+
+}  // namespace sph

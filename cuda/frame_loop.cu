@@ -1,0 +1,216 @@
+// The CUDA backend's frame: the scene uploaded, the frame run by one of its drivers (the frame
+// graph, or the stream), the report read back, and the rollback that puts the particles back
+// when a substep fails (the twin of src/cpu/cpu_frame_loop.cpp).
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "cuda_backend_impl.h"
+
+namespace sph {
+namespace {
+
+bool same_setup(const PipelineSetup& a, const PipelineSetup& b) {
+  return a.count == b.count && a.integrator == b.integrator && a.max_substeps == b.max_substeps &&
+         std::memcmp(&a.fluid, &b.fluid, sizeof a.fluid) == 0 &&
+         std::memcmp(&a.limits, &b.limits, sizeof a.limits) == 0 &&
+         a.tuning.density_block == b.tuning.density_block && a.tuning.force_block == b.tuning.force_block &&
+         a.options.surface_tension == b.options.surface_tension &&
+         a.options.normalized_density == b.options.normalized_density &&
+         a.options.viscosity == b.options.viscosity && a.options.springs == b.options.springs &&
+         std::memcmp(&a.springs, &b.springs, sizeof a.springs) == 0 &&
+         a.scene.colliders == b.scene.colliders && a.scene.fields == b.scene.fields &&
+         a.scene.collider_count == b.scene.collider_count && a.scene.field_count == b.scene.field_count &&
+         a.scene.kernel_radius == b.scene.kernel_radius;
+}
+
+}  // namespace
+
+// One frame, run by one of two drivers (docs/cuda.md): the frame graph (frame_graph.h), or the
+// stream driver (run_frame_on_stream) for frames with sinks and when graphs are off. A frame
+// with colliders and force fields runs in the frame graph like any other: the scene's assets
+// and views are uploaded first, outside the graph.
+FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& params,
+                                          const SceneFrame& scene_in) {
+  require_alive();
+  DeviceGuard guard(device_);
+  PipelineSetup setup;
+  setup.count = count_;
+  setup.integrator = config_.integrator;
+  setup.fluid = make_fluid_constants(config_, params);
+  setup.limits = make_step_limits(config_, params);
+  setup.max_substeps = params.max_substeps;
+  setup.options = options_;
+  setup.tuning = tuning_;
+  if (options_.springs) setup.springs = make_spring_constants(config_, params);
+  float frame_ms = 0.0f;
+  const bool with_sinks = !scene_in.sinks.empty();
+  uint32_t count_after = count_;
+  std::vector<uint32_t> removed_ids, removed_by_sink(scene_in.sinks.size(), 0u);
+  bool frame_enqueued = false;  // the frame's first work (the rollback snapshot) is on the stream
+  try {
+    guarded([&] {
+      if (!scene_in.empty()) {
+        SceneFrame scene = scene_in;
+        r_->sdf_cache.begin_frame();
+        bind_scene_views(scene, [&](const SdfAsset& a) { return r_->sdf_cache.bind(a, r_->stream); });
+        r_->sdf_cache.end_frame();
+        setup.scene = r_->scene_buffer.upload(scene, config_.kernel_radius, r_->stream);
+        if (with_sinks) r_->sinks.reserve(config_.capacity, *r_->store);
+        cuda_check(cudaStreamSynchronize(r_->stream), "upload of the scene");
+      }
+      FrameInput* input = r_->input.get();
+      input->frame_dt = frame_dt;
+      input->max_collider_speed = scene_in.max_collider_speed;
+      input->pad = 0;
+      const bool on_graph = use_graphs_ && !with_sinks && prepare_graph(setup);
+      cuda_check(cudaEventRecord(r_->frame_start, r_->stream), "cudaEventRecord");
+      frame_enqueued = true;
+      if (on_graph)
+        r_->graph.launch(r_->stream);
+      else
+        count_after = run_frame_on_stream(setup, static_cast<uint32_t>(scene_in.sinks.size()), removed_ids,
+                                          removed_by_sink);
+      cuda_check(cudaEventRecord(r_->frame_stop, r_->stream), "cudaEventRecord");
+      cuda_check(cudaStreamSynchronize(r_->stream), "frame");
+      cuda_check(cudaEventElapsedTime(&frame_ms, r_->frame_start, r_->frame_stop), "cudaEventElapsedTime");
+    });
+  } catch (const Error& e) {
+    // A failure in the middle of a frame that did not lose the device (a host allocation
+    // for the removed ids, say): the substeps already run are undone from the frame's
+    // snapshot, so the failed step changes nothing.
+    if (frame_enqueued && e.status() != Status::DeviceLost) roll_back_frame();
+    throw;
+  } catch (const std::exception&) {
+    if (frame_enqueued) roll_back_frame();
+    throw;
+  }
+  const FrameState s = *r_->state_output.get();
+  ++epoch_;
+  if (s.non_finite) {
+    roll_back_frame();
+    NonFiniteFailure failure;
+    failure.stage = s.bad_stage;
+    failure.substep = s.bad_substep;
+    failure.dt = s.bad_dt;
+    failure.count = s.bad_count;
+    failure.ids.push_back(s.bad_id);  // the first; the device keeps no other ids
+    throw Error(Status::NonFinite, non_finite_message(failure, setup.limits));
+  }
+  count_ = count_after;
+  FrameReport report;
+  report.removed_ids = std::move(removed_ids);
+  report.removed_by_sink = std::move(removed_by_sink);
+  report_clock(s.clock, report);
+  report.max_speed = s.max_speed;
+  report_density(s.density, report);
+  double staged_ms = 0.0;
+  for (int k = 0; k < kStageCount; ++k) {
+    report.stage_ms[k] = static_cast<float>(static_cast<double>(s.stage_ns[k]) * 1e-6);
+    staged_ms += report.stage_ms[k];
+  }
+  // The device marks cover the frame from its first kernel to the statistics; what the
+  // events saw beyond that (the input and output copies, launch) is "other".
+  if (frame_ms > staged_ms) report.stage_ms[kStageOther] += static_cast<float>(frame_ms - staged_ms);
+  return report;
+}
+
+// Restores the particles (and the cached max speed) from the snapshot taken at the start of
+// the frame; count_ is still the count before the frame.
+void CudaBackend::roll_back_frame() {
+  ++epoch_;
+  guarded([&] {
+    r_->store->enqueue_restore(count_, r_->stream);
+    enqueue_restore_max_speed(r_->state.get(), r_->stream);
+    cuda_check(cudaStreamSynchronize(r_->stream), "rollback");
+  });
+}
+
+// (Re)captures the frame graph when the particle count or a parameter changed. A graph that
+// cannot be built for a non-sticky reason (an old driver without conditional nodes) leaves
+// the world on the stream driver for good; returns whether the graph is ready.
+bool CudaBackend::prepare_graph(const PipelineSetup& setup) {
+  if (r_->graph.ready() && same_setup(setup, r_->graph_setup)) return true;
+  try {
+    r_->graph.build(setup, r_->buffers(), r_->stream);
+    r_->graph_setup = setup;
+    return true;
+  } catch (const Error& e) {
+    if (e.status() == Status::DeviceLost || e.status() == Status::OutOfDeviceMemory) throw;
+    use_graphs_ = false;
+    return false;
+  }
+}
+
+// The stream driver: the frame's work launched stage by stage on the stream, reading the loop
+// condition back after every substep. It runs what the frame graph cannot: every frame with
+// sinks (their compaction changes the particle count inside the frame, and a captured graph
+// has its launch sizes fixed), and every frame when graphs are off or the driver cannot build
+// them. With sinks, the survivor count comes back with the loop condition (one synchronisation
+// per substep, a second one only when particles were removed). Returns the particle count after
+// the frame; the removed ids, in the CPU backend's order, and the per-sink counts are appended.
+uint32_t CudaBackend::run_frame_on_stream(PipelineSetup setup, uint32_t sink_count,
+                                          std::vector<uint32_t>& removed_ids,
+                                          std::vector<uint32_t>& removed_by_sink) {
+  const PipelineBuffers b = r_->buffers();
+  const ParticleArrays& a = b.store->arrays();
+  cudaStream_t s = r_->stream;
+  FrameState* out = b.state_output;
+  uint32_t* kept_out = r_->sink_kept.get();
+  uint32_t n = count_;
+  setup.count = n;
+  enqueue_frame_begin(setup, b, LoopCondition{}, s);
+  cuda_check(cudaMemcpyAsync(&out->run, &b.state->run, sizeof(uint32_t), cudaMemcpyDeviceToHost, s),
+             "copy of the loop condition");
+  cuda_check(cudaStreamSynchronize(s), "frame begin");
+  const uint32_t* counts_after_sinks = nullptr;
+  std::vector<uint32_t> ids, sinks;
+  while (out->run) {
+    setup.count = n;
+    enqueue_substep(setup, b, LoopCondition{}, s);
+    if (sink_count > 0) r_->sinks.enqueue_flag(r_->scene_buffer.sinks(), sink_count, a, n, b.state, s);
+    cuda_check(cudaMemcpyAsync(&out->run, &b.state->run, sizeof(uint32_t), cudaMemcpyDeviceToHost, s),
+               "copy of the loop condition");
+    if (sink_count > 0) {
+      cuda_check(cudaMemcpyAsync(&out->non_finite, &b.state->non_finite, sizeof(uint32_t),
+                                 cudaMemcpyDeviceToHost, s),
+                 "copy of the non-finite flag");
+      cuda_check(
+          cudaMemcpyAsync(kept_out, r_->sinks.kept_device(), sizeof(uint32_t), cudaMemcpyDeviceToHost, s),
+          "copy of the sink survivor count");
+    }
+    cuda_check(cudaStreamSynchronize(s), "substep");
+    if (sink_count == 0) continue;
+    counts_after_sinks = nullptr;
+    if (out->non_finite) break;  // as on the CPU: no sinks after a failed substep
+    const uint32_t kept = *kept_out;
+    if (kept == n) continue;
+    // After the last substep the statistics need the neighbour counts of its density pass,
+    // which the compaction carries along (the sorted copy it reads becomes scratch).
+    uint32_t* counts = nullptr;
+    if (!out->run) {
+      counts = r_->sinks.counts();
+      b.statistics->enqueue_neighbor_counts(setup.fluid, b.grid->view(), a, n, counts, s);
+    }
+    r_->sinks.enqueue_compact(*b.store, n, kept, counts, s);
+    const uint32_t removed = n - kept;
+    ids.resize(removed);
+    sinks.resize(removed);
+    cuda_check(cudaMemcpyAsync(ids.data(), r_->sinks.removed_ids(), sizeof(uint32_t) * removed,
+                               cudaMemcpyDeviceToHost, s),
+               "copy of the removed ids");
+    cuda_check(cudaMemcpyAsync(sinks.data(), r_->sinks.removed_sinks(), sizeof(uint32_t) * removed,
+                               cudaMemcpyDeviceToHost, s),
+               "copy of the removed ids' sinks");
+    cuda_check(cudaStreamSynchronize(s), "sinks");
+    removed_ids.insert(removed_ids.end(), ids.begin(), ids.end());
+    for (uint32_t k : sinks) ++removed_by_sink[k];
+    n = kept;
+    counts_after_sinks = counts;
+  }
+  setup.count = n;
+  enqueue_frame_end(setup, b, s, counts_after_sinks);
+  return n;
+}
+
+}  // namespace sph

@@ -1,0 +1,139 @@
+// The CPU backend's class, shared by the files of src/cpu/ that implement it (one per stage of a
+// frame, each the twin of a file of cuda/; see docs/architecture.md). Each substep sorts
+// particles into the wrapped grid, then loops the shared per-particle physics (src/physics) over
+// all particles on OpenMP threads. Results do not depend on the thread count: every particle is
+// a pure gather and the only reduction (max speed) is order-independent.
+#pragma once
+
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "../core/backend.h"
+#include "../core/non_finite.h"
+#include "../core/particle_arrays.h"
+#include "../physics/forces.h"
+#include "../physics/integrate.h"
+#include "../physics/springs.h"
+#include "cpu_neighbor_grid.h"
+#include "cpu_particle_store.h"
+
+namespace sph {
+
+using Clock = std::chrono::steady_clock;
+
+inline double elapsed_ms(Clock::time_point since) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - since).count();
+}
+
+class CpuBackend final : public Backend {
+ public:
+  CpuBackend(const WorldConfig& config, unsigned workers);
+
+  uint32_t particle_count() const override { return count_; }
+
+  void append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id) override;
+
+  FrameReport step_scene_frame(double frame_dt, const RuntimeParams& params,
+                               const SceneFrame& scene_in) override;
+
+  void truncate(uint32_t count) override;
+
+  void copy_attribute(AttributeKind kind, uint32_t first, uint32_t count, void* dst,
+                      size_t stride) const override;
+
+  ParticleSnapshot export_particles() const override;
+
+  void import_particles(const ParticleSnapshot& s) override;
+
+  uint64_t memory_bytes() const override { return store_.bytes() + grid_.bytes(); }
+
+ private:
+  static constexpr uint32_t kAllFinite = 0xffffffffu;
+
+  // Threads for a loop over the particles: small worlds run on the calling thread alone, where
+  // waking a team (and its spinning idle threads) would cost more than the work.
+  unsigned threads() const { return count_ >= kParallelMinimum ? workers_ : 1u; }
+
+  int n() const { return static_cast<int>(count_); }
+
+  float compute_max_speed() const;
+
+  // Hash, sort, reorder every attribute, then density and pressure (packed into the w slots).
+  void sort_and_density(const FluidConstants& fluid, FrameReport& report);
+
+  // Acceleration of particle i: the neighbour gather with the world's options compiled in,
+  // plus the scene's force fields.
+  template <bool kSurfaceTension, ViscosityMethod kViscosity>
+  static Vec3 acceleration_with(const FluidConstants& fluid, const GridView& view, const Float4* pos,
+                                const Float4* vel, const uint32_t* counts, const Float4* normals,
+                                const SceneFrame& scene, uint32_t i);
+  using AccelerationFn = Vec3 (*)(const FluidConstants&, const GridView&, const Float4*, const Float4*,
+                                  const uint32_t*, const Float4*, const SceneFrame&, uint32_t);
+  AccelerationFn acceleration_function() const;
+
+  // Resolves colliders for the state in next_position_/next_velocity_, moved from x_old(i).
+  template <class OldPosition>
+  void collide(const SceneFrame& scene, const SubstepTime& time, OldPosition&& x_old, FrameReport& report);
+
+  // Max speed and the first non-finite particle of the state in next_*.
+  uint32_t scan_next_state(float& v2max) const;
+
+  // Fills non_finite_ for the first non-finite particle of the state in next_* (the failure path).
+  void diagnose_non_finite(const FluidConstants& fluid, const SceneFrame& scene, int rk4_stage,
+                           uint32_t first);
+
+  uint32_t finish_substep(float v2max, uint32_t bad_index);
+
+  uint32_t substep_euler(const FluidConstants& fluid, const SceneFrame& scene, const SubstepTime& time,
+                         FrameReport& report);
+
+  uint32_t substep_rk4(const FluidConstants& fluid, const SceneFrame& scene, const SubstepTime& time,
+                       FrameReport& report);
+
+  // Springs (SPH_FEATURE_SPRINGS), after the sort: the particles that wait for springs make
+  // them (two passes, springs.h), then every particle gathers its spring acceleration into a
+  // side array that the force pass adds. first_evaluation: the substep's first force
+  // evaluation, where the rest lengths flow (plasticity).
+  void spring_pass(float dt, bool first_evaluation, FrameReport& report);
+
+  // Removes particles inside any sink, keeping the order of the rest; records their ids.
+  void apply_sinks(const SceneFrame& scene, FrameReport& report);
+
+  // Density and neighbour statistics of the last density evaluation.
+  void summarize(FrameReport& report) const;
+
+  WorldConfig config_;
+  unsigned workers_;
+  CpuNeighborGrid grid_;
+  CpuParticleStore store_;
+  std::vector<ParticleArraySpec> method_arrays_;  // method_particle_arrays(config_)
+  CpuArrayRef<Float4> position_;                  // w: pressure after the density pass
+  CpuArrayRef<Float4> velocity_;                  // w: 1 / density after the density pass
+  CpuArrayRef<uint32_t> id_;
+  CpuArrayRef<float> density_;
+  CpuArrayRef<uint32_t> neighbors_;  // of the last density pass (statistics, Clavet viscosity)
+  // Integration writes here and swaps, so the force gather reads a state nobody writes.
+  CpuArrayRef<Float4> next_position_;
+  CpuArrayRef<Float4> next_velocity_;
+  // The methods' arrays (particle_arrays.h); null when the world does not use the method.
+  CpuArrayRef<ParticleState> rk4_start_;
+  CpuArrayRef<Rk4Accumulator> rk4_sum_;
+  CpuArrayRef<float> density_factor_;  // normalised density's carried factor
+  CpuArrayRef<float> normalized_;      // normalised density: the summation, then eq. 31
+  CpuArrayRef<Float4> normals_;        // colour-field normals (surface tension)
+  CpuArrayRef<SpringList> springs_;    // springs: the lists, their link candidates, the accelerations
+  CpuArrayRef<uint32_t> link_from_;    // one word: the lowest id that waits for its springs
+  CpuArrayRef<uint32_t> spring_candidates_;
+  CpuArrayRef<Float4> spring_acceleration_;
+  std::vector<uint32_t> keep_order_;
+  SpringConstants spring_constants_{};
+  uint32_t count_ = 0;
+  float max_speed_ = 0.0f;
+  float max_acceleration_ = 0.0f;  // of the last force evaluation, for the force step limit
+  NonFiniteFailure non_finite_;    // of the last failed substep, for its error message
+  bool max_speed_valid_ = false;
+};
+
+}  // namespace sph

@@ -1,0 +1,74 @@
+// The CPU backend's frame: adaptive substeps until the frame time is reached, sinks after each,
+// and the rollback that puts the particles back when a substep fails (the twin of
+// cuda/frame_loop.cu).
+#include <algorithm>
+
+#include "../core/scene_frame.h"
+#include "../core/status.h"
+#include "../core/substep_clock.h"
+#include "cpu_backend_impl.h"
+
+namespace sph {
+
+FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& params,
+                                         const SceneFrame& scene_in) {
+  FrameReport report;
+  FluidConstants fluid = make_fluid_constants(config_, params);
+  const StepLimits limits = make_step_limits(config_, params);
+  SceneFrame scene = scene_in;
+  bind_scene_views(scene, [](const SdfAsset& a) { return a.host_view(); });
+  report.removed_by_sink.assign(scene.sinks.size(), 0u);
+  const uint32_t count_before = count_;
+  const auto saved = store_.snapshot();
+  const float saved_max_speed = max_speed_;
+  const bool saved_max_speed_valid = max_speed_valid_;
+  const float saved_max_acceleration = max_acceleration_;
+  spring_constants_ = make_spring_constants(config_, params);
+  if (!max_speed_valid_) max_speed_ = compute_max_speed();
+
+  // Puts the particles back as they were before the frame: on a non-finite state and on any
+  // exception (an allocation that fails halfway through a frame), so a failed step changes
+  // nothing. The store's arrays keep their capacity, so this copies and does not allocate.
+  auto roll_back = [&]() {
+    count_ = count_before;
+    store_.resize(count_);
+    store_.restore(saved);
+    max_speed_ = saved_max_speed;
+    max_speed_valid_ = saved_max_speed_valid;
+    max_acceleration_ = saved_max_acceleration;  // the force step limit reads it next step
+  };
+  SubstepClock clock;
+  start_clock(clock, frame_dt);
+  try {
+    while (clock_running(clock, params.max_substeps)) {
+      pick_next_step(clock, frame_dt, limits, std::max(max_speed_, scene.max_collider_speed),
+                     max_acceleration_);
+      fluid.dt = clock.dt_float;
+      const uint32_t bad = config_.integrator == Integrator::Rk4
+                               ? substep_rk4(fluid, scene, clock.time, report)
+                               : substep_euler(fluid, scene, clock.time, report);
+      if (bad != kAllFinite) {
+        roll_back();
+        non_finite_.substep = clock.substeps + 1;
+        non_finite_.dt = clock.dt_float;
+        throw Error(Status::NonFinite, non_finite_message(non_finite_, limits));
+      }
+      if (!scene.sinks.empty()) apply_sinks(scene, report);
+      advance_clock(clock);
+    }
+  } catch (const Error& e) {
+    if (e.status() != Status::NonFinite) roll_back();  // NonFinite has rolled back already
+    throw;
+  } catch (...) {
+    roll_back();
+    throw;
+  }
+  report_clock(clock, report);
+  report.max_speed = max_speed_;
+  const auto t = Clock::now();
+  summarize(report);
+  report.stage_ms[kStageOther] += static_cast<float>(elapsed_ms(t));
+  return report;
+}
+
+}  // namespace sph

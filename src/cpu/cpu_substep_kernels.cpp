@@ -1,0 +1,82 @@
+// The CPU backend's per-particle passes of a substep: hash and sort, density and pressure (with
+// the normalised density and the colour-field normals when on), and the acceleration gather
+// with the world's options compiled in (the twin of cuda/substep_kernels.cu).
+#include "../physics/density.h"
+#include "../physics/density_normalization.h"
+#include "../physics/surface_normal.h"
+#include "cpu_backend_impl.h"
+
+namespace sph {
+
+// Hash, sort, reorder every attribute, then density and pressure (packed into the w slots).
+void CpuBackend::sort_and_density(const FluidConstants& fluid, FrameReport& report) {
+  auto t = Clock::now();
+  grid_.build(position_.data(), count_, workers_);
+  store_.permute(grid_.order().data(), count_);
+  report.stage_ms[kStageHashSort] += static_cast<float>(elapsed_ms(t));
+
+  t = Clock::now();
+  const GridView view = grid_.view();
+  Float4* pos = position_.data();
+  Float4* vel = velocity_.data();
+  float* factor = density_factor_.data();
+#pragma omp parallel for num_threads(threads()) schedule(static)
+  for (int i = 0; i < n(); ++i) {
+    const DensitySample s = gather_density(fluid, view, pos, static_cast<uint32_t>(i));
+    float rho = s.density;
+    if (factor) {
+      normalized_[i] = s.density;  // the summation, for the factor after the filter
+      rho = carried_density(fluid, s.density, factor[i]);
+    }
+    density_[i] = rho;
+    neighbors_[i] = s.neighbor_count;
+    // Only the w slots are written; neighbours read x, y, z alone.
+    pos[i].w = pressure_from_density(fluid.eos, rho);
+    vel[i].w = 1.0f / rho;
+  }
+  if (factor) {
+    // Eq. 31 over every carried rho_j: each particle writes only its own factor and side
+    // slot (the first pass is done reading the factors), then the filtered values are published.
+#pragma omp parallel for num_threads(threads()) schedule(static)
+    for (int i = 0; i < n(); ++i) {
+      const float filtered = gather_normalized_density(fluid, view, pos, vel, static_cast<uint32_t>(i));
+      factor[i] = filtered / normalized_[i];
+      normalized_[i] = filtered;
+    }
+#pragma omp parallel for num_threads(threads()) schedule(static)
+    for (int i = 0; i < n(); ++i) {
+      density_[i] = normalized_[i];
+      pos[i].w = pressure_from_density(fluid.eos, normalized_[i]);
+      vel[i].w = 1.0f / normalized_[i];
+    }
+  }
+  if (config_.features & kFeatureSurfaceTension) {
+    // Colour-field normals of every particle, which the force gather reads for neighbours.
+#pragma omp parallel for num_threads(threads()) schedule(static)
+    for (int i = 0; i < n(); ++i)
+      normals_[i] = gather_colour_normal(fluid, view, pos, vel, static_cast<uint32_t>(i));
+  }
+  report.stage_ms[kStageDensity] += static_cast<float>(elapsed_ms(t));
+}
+
+// Acceleration of particle i: the neighbour gather with the world's options compiled in,
+// plus the scene's force fields.
+template <bool kSurfaceTension, ViscosityMethod kViscosity>
+Vec3 CpuBackend::acceleration_with(const FluidConstants& fluid, const GridView& view, const Float4* pos,
+                                   const Float4* vel, const uint32_t* counts, const Float4* normals,
+                                   const SceneFrame& scene, uint32_t i) {
+  Vec3 a = gather_acceleration_with<kSurfaceTension, kViscosity>(fluid, view, pos, vel, counts, normals, i);
+  for (const ForceFieldFrame& f : scene.fields) a += force_field_acceleration(f.view, xyz(pos[i]));
+  return a;
+}
+
+CpuBackend::AccelerationFn CpuBackend::acceleration_function() const {
+  const bool surface = (config_.features & kFeatureSurfaceTension) != 0;
+  if (config_.viscosity_method == ViscosityMethod::Clavet)
+    return surface ? &acceleration_with<true, ViscosityMethod::Clavet>
+                   : &acceleration_with<false, ViscosityMethod::Clavet>;
+  return surface ? &acceleration_with<true, ViscosityMethod::Mueller>
+                 : &acceleration_with<false, ViscosityMethod::Mueller>;
+}
+
+}  // namespace sph

@@ -1,0 +1,117 @@
+// The order of the CPU backend's passes in one substep: symplectic Euler (sort, density,
+// springs, forces + integration, colliders) or the four stages of RK4 (the twin of
+// cuda/substep_pipeline.cu).
+#include <algorithm>
+#include <cmath>
+
+#include "cpu_backend_impl.h"
+
+namespace sph {
+
+// Resolves colliders for the state in next_position_/next_velocity_, moved from x_old(i).
+template <class OldPosition>
+void CpuBackend::collide(const SceneFrame& scene, const SubstepTime& time, OldPosition&& x_old,
+                         FrameReport& report) {
+  if (scene.colliders.empty()) return;
+  const auto t = Clock::now();
+  const float h = config_.kernel_radius;
+  Float4* next_pos = next_position_.data();
+  Float4* next_vel = next_velocity_.data();
+#pragma omp parallel for num_threads(threads()) schedule(static)
+  for (int i = 0; i < n(); ++i) {
+    Vec3 x = xyz(next_pos[i]);
+    Vec3 v = xyz(next_vel[i]);
+    const Vec3 from = x_old(static_cast<uint32_t>(i));
+    for (const ColliderFrame& c : scene.colliders) collide_particle(c.view, time, h, from, x, v);
+    next_pos[i] = make_float4_record(x, next_pos[i].w);
+    next_vel[i] = make_float4_record(v, next_vel[i].w);
+  }
+  report.stage_ms[kStageCollide] += static_cast<float>(elapsed_ms(t));
+}
+
+uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame& scene,
+                                   const SubstepTime& time, FrameReport& report) {
+  sort_and_density(fluid, report);
+  spring_pass(time.dt, true, report);
+  auto t = Clock::now();
+  const GridView view = grid_.view();
+  Float4* next_pos = next_position_.data();
+  Float4* next_vel = next_velocity_.data();
+  const Float4* pos = position_.data();
+  const Float4* vel = velocity_.data();
+  const Float4* spring = spring_acceleration_.data();
+  const float dt = time.dt;
+  const AccelerationFn acceleration = acceleration_function();
+  const uint32_t* counts = neighbors_.data();
+  const Float4* normals = normals_.data();
+  float a2max = 0.0f;
+#pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
+  for (int i = 0; i < n(); ++i) {
+    Vec3 a = acceleration(fluid, view, pos, vel, counts, normals, scene, static_cast<uint32_t>(i));
+    if (spring) a += xyz(spring[i]);
+    a2max = std::max(a2max, length_squared(a));
+    const ParticleState s = symplectic_euler({xyz(pos[i]), xyz(vel[i])}, a, dt);
+    next_pos[i] = make_float4_record(s.position, pos[i].w);
+    next_vel[i] = make_float4_record(s.velocity, vel[i].w);
+  }
+  max_acceleration_ = std::sqrt(a2max);
+  report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
+  collide(
+      scene, time, [&](uint32_t i) { return xyz(pos[i]); }, report);
+  t = Clock::now();
+  float v2max = 0.0f;
+  const uint32_t bad_index = scan_next_state(v2max);
+  if (bad_index != kAllFinite) diagnose_non_finite(fluid, scene, -1, bad_index);
+  const uint32_t bad = finish_substep(v2max, bad_index);
+  report.stage_ms[kStageIntegrate] += static_cast<float>(elapsed_ms(t));
+  return bad;
+}
+
+uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& scene,
+                                 const SubstepTime& time, FrameReport& report) {
+  // Stage 0 starts from the current state.
+  for (int i = 0; i < n(); ++i)
+    rk4_start_[i] = ParticleState{xyz(position_[i]), xyz(velocity_[i])};  // (not a hot loop)
+  const float dt = time.dt;
+  const AccelerationFn acceleration = acceleration_function();
+  float a2max = 0.0f;
+  for (int stage = 0; stage < 4; ++stage) {
+    sort_and_density(fluid, report);
+    spring_pass(dt, stage == 0, report);
+    auto t = Clock::now();
+    const GridView view = grid_.view();
+    Float4* next_pos = next_position_.data();
+    Float4* next_vel = next_velocity_.data();
+    const Float4* pos = position_.data();
+    const Float4* vel = velocity_.data();
+    const Float4* spring = spring_acceleration_.data();
+    const uint32_t* counts = neighbors_.data();
+    const Float4* normals = normals_.data();
+    const ParticleState* start = rk4_start_.data();
+    Rk4Accumulator* sums = rk4_sum_.data();
+#pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
+    for (int i = 0; i < n(); ++i) {
+      Vec3 a = acceleration(fluid, view, pos, vel, counts, normals, scene, static_cast<uint32_t>(i));
+      if (spring) a += xyz(spring[i]);
+      a2max = std::max(a2max, length_squared(a));
+      const ParticleState s = rk4_advance(stage, start[i], {xyz(pos[i]), xyz(vel[i])}, a, dt, sums[i]);
+      next_pos[i] = make_float4_record(s.position, pos[i].w);
+      next_vel[i] = make_float4_record(s.velocity, vel[i].w);
+    }
+    report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
+    if (stage == 3)
+      collide(
+          scene, time, [start](uint32_t i) { return start[i].position; }, report);
+    t = Clock::now();
+    float v2max = 0.0f;
+    const uint32_t bad_index = scan_next_state(v2max);
+    if (bad_index != kAllFinite) diagnose_non_finite(fluid, scene, stage, bad_index);
+    const uint32_t bad = finish_substep(v2max, bad_index);
+    report.stage_ms[kStageIntegrate] += static_cast<float>(elapsed_ms(t));
+    if (bad != kAllFinite) return bad;
+  }
+  max_acceleration_ = std::sqrt(a2max);
+  return kAllFinite;
+}
+
+}  // namespace sph
