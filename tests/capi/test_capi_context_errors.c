@@ -34,9 +34,15 @@ static void test_def_init(void** state) {
   EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "def", sph_context_def_init_sized(NULL, sizeof def));
   /* Too small: an error, and nothing written. */
   memset(&def, 0xab, sizeof def);
-  EXPECT_ERROR(SPH_ERROR_VERSION_MISMATCH, "def", sph_context_def_init_sized(&def, sizeof def - 4));
+  EXPECT_ERROR(SPH_ERROR_VERSION_MISMATCH, "def",
+               sph_context_def_init_sized(&def, (uint32_t)(24 + 2 * sizeof(void*) - 4)));
   EXPECT_ERROR(SPH_ERROR_VERSION_MISMATCH, "def", sph_context_def_init_sized(&def, 0));
   assert_int_equal(def.struct_size, 0xababababu);
+  /* A 0.1.0 caller's size (before the CUDA tuning fields): its prefix is filled, nothing past it. */
+  EXPECT_OK(sph_context_def_init_sized(&def, (uint32_t)(24 + 2 * sizeof(void*))));
+  assert_int_equal(def.struct_size, 24 + 2 * sizeof(void*));
+  assert_int_equal(def.backend, SPH_BACKEND_AUTO);
+  assert_int_equal(def.cuda_density_block, 0xababababu);
   /* The defaults the header documents. */
   EXPECT_OK(sph_context_def_init(&def));
   assert_int_equal(def.struct_size, sizeof def);
