@@ -113,7 +113,7 @@ inline void set_surface_tension_constants(const WorldConfig& c, FluidConstants& 
   const double h = c.kernel_radius, m = c.particle_mass;
   const double gamma_m =
       lattice.surface_energy > 0.0 ? share * f.surface_tension / (m * lattice.surface_energy) : 0.0;
-  f.surface_cohesion = static_cast<float>(gamma_m * 32.0 / (3.14159265358979323846 * std::pow(h, 9.0)));
+  f.surface_cohesion = static_cast<float>(cohesion_coefficient(h, gamma_m));
 }
 
 inline FluidConstants make_fluid_constants(const WorldConfig& c, const RuntimeParams& p) {

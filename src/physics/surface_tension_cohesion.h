@@ -15,16 +15,25 @@
 #pragma once
 
 #include "host_device.h"
+#include "kernels.h"
 
 namespace sph {
 
-// C(r) without its 32 / (pi h^9) (which the world folds into its coefficient), for 0 < r < h.
-SPH_HD float cohesion_spline(float h, float r) {
-  const float d = h - r;
-  const float p = d * d * d * r * r * r;
-  if (2.0f * r > h) return p;
-  const float h3 = h * h * h;
-  return 2.0f * p - h3 * h3 * (1.0f / 64.0f);
+// C(r) without its 32 / (pi h^9) (cohesion_coefficient), for 0 < r < h.
+template <class T>
+SPH_HD T cohesion_spline(T h, T r) {
+  const T d = h - r;
+  const T p = d * d * d * r * r * r;
+  if (T(2) * r > h) return p;
+  const T h3 = h * h * h;
+  return T(2) * p - h3 * h3 * (T(1) / T(64));
+}
+
+// The spline's coefficient 32 / (pi h^9) times `scale`.
+template <class T>
+SPH_HD T cohesion_coefficient(T h, T scale) {
+  const T h3 = h * h * h;
+  return scale * T(32) / (kPiOf<T> * h3 * h3 * h3);
 }
 
 }  // namespace sph
