@@ -212,10 +212,10 @@ class CudaBackend final : public Backend {
     setup.integrator = config_.integrator;
     setup.fluid = make_fluid_constants(config_, params);
     setup.limits = make_step_limits(config_, params);
-    setup.max_substeps = params.max_substeps;
+    setup.max_substeps = params.stepping.max_substeps;
     setup.options = options_;
     setup.tuning = tuning_;
-    if (options_.springs) setup.springs = make_spring_constants(config_, params);
+    if (options_.springs) setup.springs = setup.fluid.methods.springs;
     float frame_ms = 0.0f;
     const bool with_sinks = !scene_in.sinks.empty();
     uint32_t count_after = count_;

@@ -143,35 +143,37 @@ WorldConfig read_config(ByteReader& r) {
 
 RuntimeParams read_params(ByteReader& r) {
   RuntimeParams p;
-  p.gravity = vec3(r, "gravity");
-  p.stiffness = positive(r, "stiffness");
-  p.viscosity = non_negative(r, "viscosity");
-  p.step_factor = positive(r, "step factor");
-  if (p.step_factor > 10.0f) corrupt(r.what() + ": step factor is above 10");
-  p.dt_min = positive(r, "dt_min");
-  p.dt_max = positive(r, "dt_max");
-  if (p.dt_max < p.dt_min) corrupt(r.what() + ": dt_max is smaller than dt_min");
-  p.max_substeps = r.u32();
-  if (p.max_substeps == 0) corrupt(r.what() + ": max_substeps is 0");
-  p.step_limits = r.u32();
-  if (p.step_limits & ~static_cast<uint32_t>(kStepLimitAll)) corrupt(r.what() + ": unknown step-limit bits");
-  p.surface_tension = non_negative(r, "surface tension");
-  p.surface_threshold = non_negative(r, "surface threshold");
-  p.clavet_linear = non_negative(r, "Clavet linear coefficient");
-  p.clavet_quadratic = non_negative(r, "Clavet quadratic coefficient");
-  p.tait_sound_speed = positive(r, "Tait speed of sound");
+  p.stepping.gravity = vec3(r, "gravity");
+  p.methods.ideal_gas.stiffness = positive(r, "stiffness");
+  p.methods.mueller.viscosity = non_negative(r, "viscosity");
+  p.stepping.step_factor = positive(r, "step factor");
+  if (p.stepping.step_factor > 10.0f) corrupt(r.what() + ": step factor is above 10");
+  p.stepping.dt_min = positive(r, "dt_min");
+  p.stepping.dt_max = positive(r, "dt_max");
+  if (p.stepping.dt_max < p.stepping.dt_min) corrupt(r.what() + ": dt_max is smaller than dt_min");
+  p.stepping.max_substeps = r.u32();
+  if (p.stepping.max_substeps == 0) corrupt(r.what() + ": max_substeps is 0");
+  p.stepping.step_limits = r.u32();
+  if (p.stepping.step_limits & ~static_cast<uint32_t>(kStepLimitAll))
+    corrupt(r.what() + ": unknown step-limit bits");
+  p.methods.surface_tension.coefficient = non_negative(r, "surface tension");
+  p.methods.surface_tension.normal_threshold = non_negative(r, "surface threshold");
+  p.methods.clavet.linear = non_negative(r, "Clavet linear coefficient");
+  p.methods.clavet.quadratic = non_negative(r, "Clavet quadratic coefficient");
+  p.methods.tait.speed_of_sound = positive(r, "Tait speed of sound");
   return p;
 }
 
 // SPH_FEATURE_SPRINGS worlds only (checkpoint_writer.cpp), with the C layer's ranges.
 void read_spring_params(ByteReader& r, const WorldConfig& config, RuntimeParams& p) {
-  p.spring_stiffness = non_negative(r, "spring stiffness");
-  p.spring_link_radius = non_negative(r, "spring link radius");
-  if (p.spring_link_radius > config.kernel_radius) corrupt(r.what() + ": spring link radius is above h");
-  p.spring_yield_ratio = non_negative(r, "spring yield ratio");
-  if (p.spring_yield_ratio > 1.0f) corrupt(r.what() + ": spring yield ratio is above 1");
-  p.spring_plasticity = non_negative(r, "spring plasticity");
-  p.spring_damping = non_negative(r, "spring damping");
+  p.methods.springs.stiffness = non_negative(r, "spring stiffness");
+  p.methods.springs.link_radius = non_negative(r, "spring link radius");
+  if (p.methods.springs.link_radius > config.kernel_radius)
+    corrupt(r.what() + ": spring link radius is above h");
+  p.methods.springs.yield_ratio = non_negative(r, "spring yield ratio");
+  if (p.methods.springs.yield_ratio > 1.0f) corrupt(r.what() + ": spring yield ratio is above 1");
+  p.methods.springs.plasticity = non_negative(r, "spring plasticity");
+  p.methods.springs.damping = non_negative(r, "spring damping");
 }
 
 // The spring lists: every partner an index of another particle, every rest length in

@@ -68,30 +68,30 @@ void write_config(ByteWriter& w, const WorldConfig& c) {
 }
 
 void write_params(ByteWriter& w, const RuntimeParams& p) {
-  write_vec3(w, p.gravity);
-  w.f32(p.stiffness);
-  w.f32(p.viscosity);
-  w.f32(p.step_factor);
-  w.f32(p.dt_min);
-  w.f32(p.dt_max);
-  w.u32(p.max_substeps);
-  w.u32(p.step_limits);
-  w.f32(p.surface_tension);
-  w.f32(p.surface_threshold);
-  w.f32(p.clavet_linear);
-  w.f32(p.clavet_quadratic);
-  w.f32(p.tait_sound_speed);
+  write_vec3(w, p.stepping.gravity);
+  w.f32(p.methods.ideal_gas.stiffness);
+  w.f32(p.methods.mueller.viscosity);
+  w.f32(p.stepping.step_factor);
+  w.f32(p.stepping.dt_min);
+  w.f32(p.stepping.dt_max);
+  w.u32(p.stepping.max_substeps);
+  w.u32(p.stepping.step_limits);
+  w.f32(p.methods.surface_tension.coefficient);
+  w.f32(p.methods.surface_tension.normal_threshold);
+  w.f32(p.methods.clavet.linear);
+  w.f32(p.methods.clavet.quadratic);
+  w.f32(p.methods.tait.speed_of_sound);
 }
 
 // SPH_FEATURE_SPRINGS worlds only: their parameters after the others, and after the particles
 // the lowest id still waiting for springs and each particle's spring slots (partner storage
 // index or 0xffffffff, rest length). A world without springs writes the format as before.
 void write_spring_params(ByteWriter& w, const RuntimeParams& p) {
-  w.f32(p.spring_stiffness);
-  w.f32(p.spring_link_radius);
-  w.f32(p.spring_yield_ratio);
-  w.f32(p.spring_plasticity);
-  w.f32(p.spring_damping);
+  w.f32(p.methods.springs.stiffness);
+  w.f32(p.methods.springs.link_radius);
+  w.f32(p.methods.springs.yield_ratio);
+  w.f32(p.methods.springs.plasticity);
+  w.f32(p.methods.springs.damping);
 }
 
 void write_springs(ByteWriter& w, const ParticleSnapshot& s) {

@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "../physics/kernels.h"
-#include "../physics/surface_tension_cohesion.h"
+#include "../physics/surface_tension.h"
 
 namespace sph {
 namespace {

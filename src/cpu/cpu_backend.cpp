@@ -18,7 +18,7 @@
 #include "../physics/forces.h"
 #include "../physics/integrate.h"
 #include "../physics/springs.h"
-#include "../physics/surface_normal.h"
+#include "../physics/surface_tension.h"
 #include "cpu_neighbor_grid.h"
 #include "host_particle_store.h"
 #include "host_spring_array.h"
@@ -96,7 +96,7 @@ class CpuBackend final : public Backend {
     const bool saved_max_speed_valid = max_speed_valid_;
     const float saved_max_acceleration = max_acceleration_;
     const uint32_t saved_link_from = link_from_;
-    spring_constants_ = make_spring_constants(config_, params);
+    spring_constants_ = fluid.methods.springs;
     if (!max_speed_valid_) max_speed_ = compute_max_speed();
 
     // Puts the particles back as they were before the frame: on a non-finite state and on any
@@ -115,7 +115,7 @@ class CpuBackend final : public Backend {
     double elapsed = 0.0;
     report.dt_min = std::numeric_limits<float>::max();
     try {
-      while (remaining > 0.0 && report.substeps < params.max_substeps) {
+      while (remaining > 0.0 && report.substeps < params.stepping.max_substeps) {
         const float speed = std::max(max_speed_, scene.max_collider_speed);
         const double dt = landing_dt(controller_dt(limits, speed, max_acceleration_), remaining);
         const float dtf = static_cast<float>(dt);
@@ -295,7 +295,7 @@ class CpuBackend final : public Backend {
       density_.data[i] = rho;
       neighbors_.data[i] = s.neighbor_count;
       // Only the w slots are written; neighbours read x, y, z alone.
-      pos[i].w = pressure_from_density(fluid.eos, rho);
+      pos[i].w = pressure_from_density(fluid.methods.eos, rho);
       vel[i].w = 1.0f / rho;
     }
     if (factor) {
@@ -310,7 +310,7 @@ class CpuBackend final : public Backend {
 #pragma omp parallel for num_threads(threads()) schedule(static)
       for (int i = 0; i < n(); ++i) {
         density_.data[i] = normalized_[i];
-        pos[i].w = pressure_from_density(fluid.eos, normalized_[i]);
+        pos[i].w = pressure_from_density(fluid.methods.eos, normalized_[i]);
         vel[i].w = 1.0f / normalized_[i];
       }
     }
@@ -324,25 +324,23 @@ class CpuBackend final : public Backend {
     report.stage_ms[kStageDensity] += static_cast<float>(elapsed_ms(t));
   }
 
-  // Acceleration of particle i: the neighbour gather with the world's options compiled in,
-  // plus the scene's force fields.
-  template <bool kSurfaceTension, ViscosityMethod kViscosity>
-  static Vec3 acceleration_with(const FluidConstants& fluid, const GridView& view, const Float4* pos,
-                                const Float4* vel, const uint32_t* counts, const Float4* normals,
+  // Acceleration of particle i: the neighbour gather with the world's force terms compiled in
+  // (forces.h), plus the scene's force fields.
+  template <class Terms>
+  static Vec3 acceleration_with(const FluidConstants& fluid, const GridView& view, const ForceInputs& in,
                                 const SceneFrame& scene, uint32_t i) {
-    Vec3 a = gather_acceleration_with<kSurfaceTension, kViscosity>(fluid, view, pos, vel, counts, normals, i);
-    for (const ForceFieldFrame& f : scene.fields) a += force_field_acceleration(f.view, xyz(pos[i]));
+    Vec3 a = gather_acceleration<Terms>(fluid, view, in, i);
+    for (const ForceFieldFrame& f : scene.fields) a += force_field_acceleration(f.view, xyz(in.positions[i]));
     return a;
   }
-  using AccelerationFn = Vec3 (*)(const FluidConstants&, const GridView&, const Float4*, const Float4*,
-                                  const uint32_t*, const Float4*, const SceneFrame&, uint32_t);
+  using AccelerationFn = Vec3 (*)(const FluidConstants&, const GridView&, const ForceInputs&,
+                                  const SceneFrame&, uint32_t);
   AccelerationFn acceleration_function() const {
-    const bool surface = (config_.features & kFeatureSurfaceTension) != 0;
-    if (config_.viscosity_method == ViscosityMethod::Clavet)
-      return surface ? &acceleration_with<true, ViscosityMethod::Clavet>
-                     : &acceleration_with<false, ViscosityMethod::Clavet>;
-    return surface ? &acceleration_with<true, ViscosityMethod::Mueller>
-                   : &acceleration_with<false, ViscosityMethod::Mueller>;
+    return with_force_terms(config_.selection(),
+                            [](auto terms) -> AccelerationFn { return &acceleration_with<decltype(terms)>; });
+  }
+  ForceInputs force_inputs() const {
+    return ForceInputs{position_.data.data(), velocity_.data.data(), neighbors_.data.data(), normals_.data()};
   }
 
   // Resolves colliders for the state in next_position_/next_velocity_, moved from x_old(i).
@@ -398,8 +396,7 @@ class CpuBackend final : public Backend {
     if (!std::isfinite(density_.data[i]) || !std::isfinite(pos[i].w) || !std::isfinite(vel[i].w)) {
       stage = "density stage (SPH_STAGE_DENSITY)";
     } else {
-      Vec3 a = acceleration_function()(fluid, grid_.view(), pos, vel, neighbors_.data.data(), normals_.data(),
-                                       scene, i);
+      Vec3 a = acceleration_function()(fluid, grid_.view(), force_inputs(), scene, i);
       if (springs_) a += spring_acceleration_[i];
       if (!finite3(a)) {
         stage = "forces stage (SPH_STAGE_FORCES)";
@@ -444,11 +441,11 @@ class CpuBackend final : public Backend {
     const Float4* vel = velocity_.data.data();
     const float dt = time.dt;
     const AccelerationFn acceleration = acceleration_function();
-    const uint32_t* counts = neighbors_.data.data();
+    const ForceInputs inputs = force_inputs();
     float a2max = 0.0f;
 #pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
     for (int i = 0; i < n(); ++i) {
-      Vec3 a = acceleration(fluid, view, pos, vel, counts, normals_.data(), scene, static_cast<uint32_t>(i));
+      Vec3 a = acceleration(fluid, view, inputs, scene, static_cast<uint32_t>(i));
       if (springs_) a += spring_acceleration_[i];
       a2max = std::max(a2max, length_squared(a));
       const ParticleState s = symplectic_euler({xyz(pos[i]), xyz(vel[i])}, a, dt);
@@ -485,11 +482,10 @@ class CpuBackend final : public Backend {
       next_velocity_.resize(count_);
       const Float4* pos = position_.data.data();
       const Float4* vel = velocity_.data.data();
-      const uint32_t* counts = neighbors_.data.data();
+      const ForceInputs inputs = force_inputs();
 #pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
       for (int i = 0; i < n(); ++i) {
-        Vec3 a =
-            acceleration(fluid, view, pos, vel, counts, normals_.data(), scene, static_cast<uint32_t>(i));
+        Vec3 a = acceleration(fluid, view, inputs, scene, static_cast<uint32_t>(i));
         if (springs_) a += spring_acceleration_[i];
         a2max = std::max(a2max, length_squared(a));
         const ParticleState s =

@@ -1,9 +1,12 @@
-// Equations of state: pressure from density. The thesis's modified ideal-gas law (eq. 15,
-// Desbrun & Cani) and Tait's law (gamma = 7) from a chosen speed of sound.
+// Equations of state: pressure from density, by the world's choice of the two EOS methods
+// (eos_ideal_gas.h, eos_tait.h). The choice is made at run time, per density evaluation: a
+// branch on a value every thread shares, cheaper than another template dimension.
 #pragma once
 
 #include <stdint.h>
 
+#include "eos_ideal_gas.h"
+#include "eos_tait.h"
 #include "host_device.h"
 #include "vec3.h"
 
@@ -14,8 +17,8 @@ enum class EquationOfState : uint32_t { IdealGas = 0, Tait = 1 };
 struct EosConstants {
   EquationOfState kind;
   float rest_density;  // rho0
-  float stiffness;     // ideal gas: k of p = k (rho - rho0)
-  float tait_b;        // Tait: B = rho0 c^2 / gamma
+  IdealGasEos::Constants ideal_gas;
+  TaitEos::Constants tait;
 };
 
 // Both laws are clamped at zero below rest density. Particles at a free surface miss
@@ -26,18 +29,14 @@ struct EosConstants {
 SPH_HD float pressure_from_density(const EosConstants& e, float density) {
   const float excess = density - e.rest_density;
   if (excess <= 0.0f) return 0.0f;
-  if (e.kind == EquationOfState::Tait) {
-    const float r = density / e.rest_density;
-    const float r2 = r * r;
-    const float r4 = r2 * r2;
-    return e.tait_b * (r4 * r2 * r - 1.0f);
-  }
-  return e.stiffness * excess;
+  if (e.kind == EquationOfState::Tait) return TaitEos::pressure(e.tait, density, e.rest_density);
+  return IdealGasEos::pressure(e.ideal_gas, excess);
 }
 
 // The numerical speed of sound of the law at rest density (for the acoustic step limit).
 SPH_HD float speed_of_sound(const EosConstants& e) {
-  const float c2 = e.kind == EquationOfState::Tait ? 7.0f * e.tait_b / e.rest_density : e.stiffness;
+  const float c2 = e.kind == EquationOfState::Tait ? TaitEos::squared_sound_speed(e.tait, e.rest_density)
+                                                   : IdealGasEos::squared_sound_speed(e.ideal_gas);
   return c2 > 0.0f ? SPH_SQRTF(c2) : 0.0f;
 }
 
