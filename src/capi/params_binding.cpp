@@ -81,7 +81,7 @@ void apply_public_params(const ParamsBinding& b, const PublicParams& in, const W
                          const char* name, RuntimeParams& into) {
   RuntimeParams r = into;
   for (const PartBinding& p : b.parts) p.read(p, in.bytes, r);
-  const ParamPath path{std::string(name) + "->", Status::InvalidArgument, Status::Unsupported};
+  const ParamPath path{"", std::string(name) + "->", Status::InvalidArgument, Status::Unsupported};
   for (const PartBinding& p : b.parts) p.check(r, shape, path);
   into = r;
 }

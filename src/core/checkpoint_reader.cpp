@@ -12,6 +12,7 @@
 #include "byte_io.h"
 #include "checkpoint.h"
 #include "checkpoint_format.h"
+#include "checkpoint_params.h"
 #include "fcc_lattice.h"
 
 namespace sph {
@@ -139,41 +140,6 @@ WorldConfig read_config(ByteReader& r) {
     corrupt(r.what() + ": the particle mass " + std::to_string(c.particle_mass) +
             " does not fit the spacing and kernel radius (no positive density self term)");
   return c;
-}
-
-RuntimeParams read_params(ByteReader& r) {
-  RuntimeParams p;
-  p.stepping.gravity = vec3(r, "gravity");
-  p.methods.ideal_gas.stiffness = positive(r, "stiffness");
-  p.methods.mueller.viscosity = non_negative(r, "viscosity");
-  p.stepping.step_factor = positive(r, "step factor");
-  if (p.stepping.step_factor > 10.0f) corrupt(r.what() + ": step factor is above 10");
-  p.stepping.dt_min = positive(r, "dt_min");
-  p.stepping.dt_max = positive(r, "dt_max");
-  if (p.stepping.dt_max < p.stepping.dt_min) corrupt(r.what() + ": dt_max is smaller than dt_min");
-  p.stepping.max_substeps = r.u32();
-  if (p.stepping.max_substeps == 0) corrupt(r.what() + ": max_substeps is 0");
-  p.stepping.step_limits = r.u32();
-  if (p.stepping.step_limits & ~static_cast<uint32_t>(kStepLimitAll))
-    corrupt(r.what() + ": unknown step-limit bits");
-  p.methods.surface_tension.coefficient = non_negative(r, "surface tension");
-  p.methods.surface_tension.normal_threshold = non_negative(r, "surface threshold");
-  p.methods.clavet.linear = non_negative(r, "Clavet linear coefficient");
-  p.methods.clavet.quadratic = non_negative(r, "Clavet quadratic coefficient");
-  p.methods.tait.speed_of_sound = positive(r, "Tait speed of sound");
-  return p;
-}
-
-// SPH_FEATURE_SPRINGS worlds only (checkpoint_writer.cpp), with the C layer's ranges.
-void read_spring_params(ByteReader& r, const WorldConfig& config, RuntimeParams& p) {
-  p.methods.springs.stiffness = non_negative(r, "spring stiffness");
-  p.methods.springs.link_radius = non_negative(r, "spring link radius");
-  if (p.methods.springs.link_radius > config.kernel_radius)
-    corrupt(r.what() + ": spring link radius is above h");
-  p.methods.springs.yield_ratio = non_negative(r, "spring yield ratio");
-  if (p.methods.springs.yield_ratio > 1.0f) corrupt(r.what() + ": spring yield ratio is above 1");
-  p.methods.springs.plasticity = non_negative(r, "spring plasticity");
-  p.methods.springs.damping = non_negative(r, "spring damping");
 }
 
 // The spring lists: every partner an index of another particle, every rest length in
@@ -517,10 +483,10 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   if (std::memcmp(data, kMagic, sizeof kMagic) != 0) corrupt("not a checkpoint (wrong magic bytes)");
   ByteReader h(data + sizeof kMagic, kHeaderSize - sizeof kMagic, "header");
   const uint32_t version = h.u32();
-  if (version != kFormatVersion)
-    throw Error(Status::VersionMismatch, "checkpoint: format version " + std::to_string(version) +
-                                             "; this library reads version " +
-                                             std::to_string(kFormatVersion));
+  if (version < kOldestReadableVersion || version > kFormatVersion)
+    throw Error(Status::VersionMismatch,
+                "checkpoint: format version " + std::to_string(version) + "; this library reads versions " +
+                    std::to_string(kOldestReadableVersion) + " to " + std::to_string(kFormatVersion));
   const uint32_t flags = h.u32();
   h.u32();  // writer backend: informational
   h.u32();  // writer library version: informational
@@ -541,7 +507,8 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   if (flags != 0) corrupt("unknown flags " + hex32(flags));
   if (reserved != 0) corrupt("a reserved header field is not 0");
   if (section_count != kSectionCount)
-    corrupt(std::to_string(section_count) + " sections; version 1 has " + std::to_string(kSectionCount));
+    corrupt(std::to_string(section_count) + " sections; version " + std::to_string(version) + " has " +
+            std::to_string(kSectionCount));
 
   ByteReader payload(data + kHeaderSize, static_cast<size_t>(payload_size), "payload");
   auto next_section = [&](uint32_t k) {
@@ -563,8 +530,7 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   const WorldConfig config = read_config(conf);
   conf.expect_end();
   ByteReader parm = next_section(1);
-  RuntimeParams params = read_params(parm);
-  if (config.features & kFeatureSprings) read_spring_params(parm, config, params);
+  const RuntimeParams params = version == 1 ? read_params_v1(parm, config) : read_params(parm, config);
   parm.expect_end();
   // A dt_min above the stability ceiling is accepted, as sph_world_set_params accepts it (the
   // caller's fixed step wins over the ceiling; a step that then fails says so and rolls back).

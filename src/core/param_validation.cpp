@@ -14,7 +14,7 @@ std::string number(double v) {
 }
 
 [[noreturn]] void fail(Status status, const ParamPath& path, const char* name, const std::string& what) {
-  throw Error(status, path.prefix + name + ": " + what);
+  throw Error(status, path.where + path.scope + name + ": " + what);
 }
 
 bool below_lower(double v, const ParamRange& r) {
@@ -74,7 +74,7 @@ void check_bits(uint32_t value, const char* name, uint32_t known_bits, const Par
 
 void throw_conflict(const ParamConflict& c, const ParamPath& path) {
   std::string what = describe_value(c.value) + " " + c.relation + " ";
-  if (c.other_field) what += path.prefix + c.other_field + " ";
+  if (c.other_field) what += path.scope + c.other_field + " ";
   what += describe_value(c.other_value);
   fail(path.invalid, path, c.field, what);
 }

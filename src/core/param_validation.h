@@ -17,9 +17,11 @@
 
 namespace sph {
 
-// Where a check is asked from.
+// Where a check is asked from: a message reads where + scope + field + ": " + what, and a
+// cross-field rule names the other field as scope + field.
 struct ParamPath {
-  std::string prefix;                        // put before each field name
+  std::string where;                         // "" or "checkpoint: section 'parameters': "
+  std::string scope;                         // "params->" or "tait."
   Status invalid = Status::InvalidArgument;  // a value out of range or not finite
   Status unknown = Status::Unsupported;      // bits this library does not know
 };
