@@ -503,24 +503,24 @@ typedef enum sph_method_switch {
   SPH_METHOD_SWITCH_FORCE32 = 0x7fffffff
 } sph_method_switch;
 
-typedef struct sph_method_info {
-  uint32_t struct_size;        /* set by sph_method_info_init */
+typedef struct sph_physics_method_info {
+  uint32_t struct_size;        /* set by sph_physics_method_info_init */
   uint32_t method_count;       /* how many methods this library has (index runs below it) */
   sph_method_switch switch_by; /* the sph_world_def field that selects it */
   uint32_t value;              /* the SPH_FEATURE_* bit, sph_viscosity_method or sph_equation_of_state */
   uint32_t has_params;         /* 1 when its parameters are in the struct of params_kind */
   sph_params_kind params_kind; /* SPH_PARAMS_WORLD for the thesis's defaults (stiffness, viscosity) */
   const char* name;            /* "clavet", "surface_tension": a scene file's name; static */
-} sph_method_info;
-SPH_STATIC_ASSERT(sizeof(sph_method_info) == 24 + sizeof(void*), sph_method_info_size);
+} sph_physics_method_info;
+SPH_STATIC_ASSERT(sizeof(sph_physics_method_info) == 24 + sizeof(void*), sph_physics_method_info_size);
 
-SPH_API sph_result SPH_CALL sph_method_info_init_sized(sph_method_info* info, uint32_t size);
-static inline sph_result sph_method_info_init(sph_method_info* info) {
-  return sph_method_info_init_sized(info, (uint32_t)sizeof(*info));
+SPH_API sph_result SPH_CALL sph_physics_method_info_init_sized(sph_physics_method_info* info, uint32_t size);
+static inline sph_result sph_physics_method_info_init(sph_physics_method_info* info) {
+  return sph_physics_method_info_init_sized(info, (uint32_t)sizeof(*info));
 }
 /** Describes method `index` (0 .. method_count - 1; index 0 always exists and tells how many
  *  there are). INVALID_ARGUMENT past the last one. */
-SPH_API sph_result SPH_CALL sph_get_method_info(uint32_t index, sph_method_info* out);
+SPH_API sph_result SPH_CALL sph_get_physics_method_info(uint32_t index, sph_physics_method_info* out);
 
 /* ---- particles in -------------------------------------------------------------------------- */
 typedef struct sph_spawn_desc {

@@ -72,17 +72,17 @@ SPH_API sph_result SPH_CALL sph_params_get_field_info(sph_params_kind kind, uint
   });
 }
 
-SPH_API sph_result SPH_CALL sph_method_info_init_sized(sph_method_info* info, uint32_t size) {
-  return sph::init_user_struct("sph_method_info_init", "info", info, size);
+SPH_API sph_result SPH_CALL sph_physics_method_info_init_sized(sph_physics_method_info* info, uint32_t size) {
+  return sph::init_user_struct("sph_physics_method_info_init", "info", info, size);
 }
 
-SPH_API sph_result SPH_CALL sph_get_method_info(uint32_t index, sph_method_info* out) {
-  return sph::guarded("sph_get_method_info", nullptr, [&] {
+SPH_API sph_result SPH_CALL sph_get_physics_method_info(uint32_t index, sph_physics_method_info* out) {
+  return sph::guarded("sph_get_physics_method_info", nullptr, [&] {
     const std::vector<MethodEntry> all = methods();
     if (index >= all.size())
       throw Error(Status::InvalidArgument, "index: " + std::to_string(index) + " is past the last method (" +
                                                std::to_string(all.size()) + " methods)");
-    sph_method_info info = sph::zeroed_struct<sph_method_info>();
+    sph_physics_method_info info = sph::zeroed_struct<sph_physics_method_info>();
     info.method_count = static_cast<uint32_t>(all.size());
     info.switch_by = static_cast<sph_method_switch>(all[index].selector.kind);
     info.value = all[index].selector.value;

@@ -3,7 +3,7 @@
  *   values sph_c.h documents, for every params struct;
  * - every range rule and cross-field rule fires with its message, naming the field, and leaves
  *   the world unchanged;
- * - what sph_params_get_field_info / sph_get_method_info tell tools is what the set calls do
+ * - what sph_params_get_field_info / sph_get_physics_method_info tell tools is what the set calls do
  *   (each described bound is enforced at exactly that value, each offset is the header's). */
 #include <math.h>
 #include <stdio.h>
@@ -480,12 +480,12 @@ static void test_methods_are_listed_with_their_switches(void** state) {
       {"springs", SPH_METHOD_SWITCH_FEATURE, SPH_FEATURE_SPRINGS, 1, SPH_PARAMS_SPRINGS},
   };
   const uint32_t n = (uint32_t)(sizeof expected / sizeof expected[0]);
-  sph_method_info info;
+  sph_physics_method_info info;
   uint32_t i;
   (void)state;
   for (i = 0; i < n; ++i) {
-    sph_method_info_init(&info);
-    EXPECT_OK(sph_get_method_info(i, &info));
+    sph_physics_method_info_init(&info);
+    EXPECT_OK(sph_get_physics_method_info(i, &info));
     assert_int_equal(info.method_count, n);
     assert_string_equal(info.name, expected[i].name);
     assert_int_equal(info.switch_by, expected[i].by);
@@ -493,7 +493,7 @@ static void test_methods_are_listed_with_their_switches(void** state) {
     assert_int_equal(info.has_params, expected[i].has_params);
     if (info.has_params) assert_int_equal(info.params_kind, expected[i].params);
   }
-  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "index", sph_get_method_info(n, &info));
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "index", sph_get_physics_method_info(n, &info));
 }
 
 /* The generic calls are the typed ones; a method the world does not run refuses both. */
