@@ -47,6 +47,7 @@ bool same_setup(const PipelineSetup& a, const PipelineSetup& b) {
          a.options.surface_tension == b.options.surface_tension &&
          a.options.normalized_density == b.options.normalized_density &&
          a.options.viscosity == b.options.viscosity && a.options.springs == b.options.springs &&
+         std::memcmp(&a.options.methods, &b.options.methods, sizeof a.options.methods) == 0 &&
          std::memcmp(&a.springs, &b.springs, sizeof a.springs) == 0 &&
          a.scene.colliders == b.scene.colliders && a.scene.fields == b.scene.fields &&
          a.scene.collider_count == b.scene.collider_count && a.scene.field_count == b.scene.field_count &&
@@ -94,6 +95,7 @@ class CudaBackend final : public Backend {
     cuda_check(cudaStreamCreateWithFlags(&r->stream, cudaStreamNonBlocking), "cudaStreamCreate");
     cuda_check(cudaEventCreate(&r->frame_start), "cudaEventCreate");
     cuda_check(cudaEventCreate(&r->frame_stop), "cudaEventCreate");
+    options_.methods = config.selection();
     options_.surface_tension = (config.features & kFeatureSurfaceTension) != 0;
     options_.normalized_density = (config.features & kFeatureNormalizedDensity) != 0;
     options_.viscosity = config.viscosity_method;

@@ -1,6 +1,5 @@
 #include "../src/physics/density.h"
 #include "../src/physics/density_normalization.h"
-#include "../src/physics/equation_of_state.h"
 #include "../src/physics/forces.h"
 #include "../src/physics/integrate.h"
 #include "../src/physics/surface_tension.h"
@@ -237,12 +236,6 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
 // One launch site per combination of force terms (with_force_terms, methods.h): a world that
 // does not use a method runs code without it. A frame without colliders and force fields runs
 // kernels without the scene code.
-MethodSelection selection_of(const SubstepOptions& o) {
-  MethodSelection s;
-  s.features = o.surface_tension ? static_cast<uint32_t>(kFeatureSurfaceTension) : 0u;
-  s.viscosity = o.viscosity;
-  return s;
-}
 
 }  // namespace
 
@@ -294,7 +287,7 @@ void enqueue_forces_euler(const FluidConstants& fluid, const GridView& grid, con
                           uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
                           const DeviceScene& scene, FrameState* state, cudaStream_t stream) {
   const unsigned threads = tuning.force_block, blocks = blocks_for(n, threads);
-  with_force_terms(selection_of(options), [&](auto terms) {
+  with_force_terms(options.methods, [&](auto terms) {
     using Terms = decltype(terms);
     if (scene.active())
       forces_euler_kernel<Terms, true><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
@@ -308,7 +301,7 @@ void enqueue_forces_rk4(const FluidConstants& fluid, const GridView& grid, const
                         uint32_t n, int stage, const SubstepOptions& options, const KernelTuning& tuning,
                         const DeviceScene& scene, FrameState* state, cudaStream_t stream) {
   const unsigned threads = tuning.force_block, blocks = blocks_for(n, threads);
-  with_force_terms(selection_of(options), [&](auto terms) {
+  with_force_terms(options.methods, [&](auto terms) {
     using Terms = decltype(terms);
     if (scene.active())
       forces_rk4_kernel<Terms, true><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, scene, state);

@@ -46,12 +46,12 @@ sph::WorldConfig config_from_def(const sph_world_def& d) {
     throw Error(Status::Unsupported, "def->integrator: " + std::to_string(static_cast<int32_t>(integrator)) +
                                          " is not an sph_integrator value");
   const uint32_t viscosity = sph::enum_bits(d.viscosity_method);
-  if (viscosity != SPH_VISCOSITY_MUELLER && viscosity != SPH_VISCOSITY_CLAVET)
+  if (!sph::selects_a_method(sph::SwitchKind::Viscosity, viscosity))
     throw Error(Status::Unsupported,
                 "def->viscosity_method: " + std::to_string(static_cast<int32_t>(viscosity)) +
                     " is not an sph_viscosity_method value");
   const uint32_t eos = sph::enum_bits(d.equation_of_state);
-  if (eos != SPH_EOS_IDEAL_GAS && eos != SPH_EOS_TAIT)
+  if (!sph::selects_a_method(sph::SwitchKind::EquationOfState, eos))
     throw Error(Status::Unsupported, "def->equation_of_state: " + std::to_string(static_cast<int32_t>(eos)) +
                                          " is not an sph_equation_of_state value");
   sph::require_positive(d.particle_spacing, "def->particle_spacing");

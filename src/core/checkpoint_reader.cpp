@@ -62,6 +62,14 @@ uint32_t below(ByteReader& r, uint32_t limit, const std::string& name) {
   return v;
 }
 
+// A value of a world-def field that selects one method of the list (physics/methods.h).
+uint32_t method(ByteReader& r, SwitchKind kind, const std::string& name) {
+  const uint32_t v = r.u32();
+  if (!selects_a_method(kind, v))
+    corrupt(r.what() + ": " + name + " is " + std::to_string(v) + ", no method of this library");
+  return v;
+}
+
 void zero(ByteReader& r, const std::string& name) {
   if (r.u32() != 0) corrupt(r.what() + ": " + name + " is reserved and must be 0");
 }
@@ -121,8 +129,9 @@ WorldConfig read_config(ByteReader& r) {
   if (c.features & ~static_cast<uint32_t>(kFeatureAll))
     corrupt(r.what() + ": unknown feature bits " + hex32(c.features));
   c.integrator = static_cast<Integrator>(below(r, 2, "integrator"));
-  c.viscosity_method = static_cast<ViscosityMethod>(below(r, 2, "viscosity method"));
-  c.equation_of_state = static_cast<EquationOfState>(below(r, 2, "equation of state"));
+  c.viscosity_method = static_cast<ViscosityMethod>(method(r, SwitchKind::Viscosity, "viscosity method"));
+  c.equation_of_state =
+      static_cast<EquationOfState>(method(r, SwitchKind::EquationOfState, "equation of state"));
   c.particle_spacing = positive(r, "particle spacing");
   c.kernel_radius = positive(r, "kernel radius");
   c.rest_density = positive(r, "rest density");

@@ -8,7 +8,7 @@
 // grad p, and with summation density it is the form whose work is exactly the change of the
 // equation of state's internal energy, so the total energy of a closed box only falls (by
 // viscosity and collisions). Every world runs it; its stability ceiling is the acoustic one of
-// the world's equation of state (step_control.h).
+// the world's equation of state (methods.h).
 #pragma once
 
 #include "fluid_base.h"
