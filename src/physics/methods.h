@@ -6,6 +6,8 @@
 
 #include <stdint.h>
 
+#include <type_traits>
+
 #include "density_normalization.h"
 #include "eos_ideal_gas.h"
 #include "eos_tait.h"
@@ -212,34 +214,52 @@ inline float method_stability_ceiling(const MethodParams& p, const MethodSelecti
 template <class... Terms>
 struct ForceTerms {};
 
-template <ViscosityMethod kViscosity>
-struct ViscosityTerm {
-  using type = MuellerViscosity;
-};
-template <>
-struct ViscosityTerm<ViscosityMethod::Clavet> {
-  using type = ClavetViscosity;
-};
+// A place in the force pass that one of its alternatives fills, in the order they are listed:
+// the first that the world runs, else the last (the default, or NoTerm for an option that is off).
+template <class... Alternatives>
+struct Slot {};
+struct NoTerm {};
 
-template <bool kSurfaceTension, ViscosityMethod kViscosity>
-struct ForceTermsOf {
-  using type = ForceTerms<typename ViscosityTerm<kViscosity>::type>;
+// The force pass's slots, in the order their terms add to the acceleration.
+using ForceSlots = ForceTerms<Slot<ClavetViscosity, MuellerViscosity>, Slot<SurfaceTension, NoTerm>>;
+
+template <class Chosen, class Slots>
+struct ForceDispatch;
+template <class... Chosen>
+struct ForceDispatch<ForceTerms<Chosen...>, ForceTerms<>> {
+  template <class F>
+  static auto run(const MethodSelection&, F&& f) {
+    return f(ForceTerms<Chosen...>{});
+  }
 };
-template <ViscosityMethod kViscosity>
-struct ForceTermsOf<true, kViscosity> {
-  using type = ForceTerms<typename ViscosityTerm<kViscosity>::type, SurfaceTension>;
+template <class... Chosen, class... Alternatives, class... Rest>
+struct ForceDispatch<ForceTerms<Chosen...>, ForceTerms<Slot<Alternatives...>, Rest...>> {
+  template <class F>
+  static auto run(const MethodSelection& s, F&& f) {
+    return pick<Alternatives...>(s, f);
+  }
+  template <class Alternative, class... Others, class F>
+  static auto pick(const MethodSelection& s, F&& f) {
+    if constexpr (sizeof...(Others) == 0) {
+      return take<Alternative>(s, f);
+    } else {
+      if (runs(s, Tag<Alternative>{})) return take<Alternative>(s, f);
+      return pick<Others...>(s, f);
+    }
+  }
+  template <class Alternative, class F>
+  static auto take(const MethodSelection& s, F&& f) {
+    using Next = std::conditional_t<std::is_same<Alternative, NoTerm>::value, ForceTerms<Chosen...>,
+                                    ForceTerms<Chosen..., Alternative>>;
+    return ForceDispatch<Next, ForceTerms<Rest...>>::run(s, f);
+  }
 };
 
 // Calls f(ForceTerms<...>{}) with the terms a world runs, each a compile-time type, so a backend
 // instantiates its force pass once per combination and a method that is off compiles away.
 template <class F>
 auto with_force_terms(const MethodSelection& s, F&& f) {
-  const bool surface = runs(s, Tag<SurfaceTension>{});
-  if (s.viscosity == ViscosityMethod::Clavet)
-    return surface ? f(typename ForceTermsOf<true, ViscosityMethod::Clavet>::type{})
-                   : f(typename ForceTermsOf<false, ViscosityMethod::Clavet>::type{});
-  return surface ? f(typename ForceTermsOf<true, ViscosityMethod::Mueller>::type{})
-                 : f(typename ForceTermsOf<false, ViscosityMethod::Mueller>::type{});
+  return ForceDispatch<ForceTerms<>, ForceSlots>::run(s, f);
 }
 
 }  // namespace sph
