@@ -19,6 +19,7 @@ CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBacken
   cuda_check(cudaStreamCreateWithFlags(&r->stream, cudaStreamNonBlocking), "cudaStreamCreate");
   cuda_check(cudaEventCreate(&r->frame_start), "cudaEventCreate");
   cuda_check(cudaEventCreate(&r->frame_stop), "cudaEventCreate");
+  options_.methods = config.selection();
   options_.surface_tension = (config.features & kFeatureSurfaceTension) != 0;
   options_.normalized_density = (config.features & kFeatureNormalizedDensity) != 0;
   options_.viscosity = config.viscosity_method;

@@ -18,6 +18,7 @@ bool same_setup(const PipelineSetup& a, const PipelineSetup& b) {
          a.options.surface_tension == b.options.surface_tension &&
          a.options.normalized_density == b.options.normalized_density &&
          a.options.viscosity == b.options.viscosity && a.options.springs == b.options.springs &&
+         std::memcmp(&a.options.methods, &b.options.methods, sizeof a.options.methods) == 0 &&
          std::memcmp(&a.springs, &b.springs, sizeof a.springs) == 0 &&
          a.scene.colliders == b.scene.colliders && a.scene.fields == b.scene.fields &&
          a.scene.collider_count == b.scene.collider_count && a.scene.field_count == b.scene.field_count &&
@@ -39,10 +40,10 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
   setup.integrator = config_.integrator;
   setup.fluid = make_fluid_constants(config_, params);
   setup.limits = make_step_limits(config_, params);
-  setup.max_substeps = params.max_substeps;
+  setup.max_substeps = params.stepping.max_substeps;
   setup.options = options_;
   setup.tuning = tuning_;
-  if (options_.springs) setup.springs = make_spring_constants(config_, params);
+  if (options_.springs) setup.springs = setup.fluid.methods.springs;
   float frame_ms = 0.0f;
   const bool with_sinks = !scene_in.sinks.empty();
   uint32_t count_after = count_;

@@ -1,9 +1,8 @@
 #include "../src/physics/density.h"
 #include "../src/physics/density_normalization.h"
-#include "../src/physics/equation_of_state.h"
 #include "../src/physics/forces.h"
 #include "../src/physics/integrate.h"
-#include "../src/physics/surface_normal.h"
+#include "../src/physics/surface_tension.h"
 #include "block_reduce.cuh"
 #include "kernel_launch.h"
 #include "substep_kernels.h"
@@ -12,27 +11,23 @@ namespace sph {
 namespace {
 
 // gather_acceleration (src/physics/forces.h) for SIMT: the same neighbours in the same order
-// and the same per-neighbour arithmetic (add_neighbor_acceleration, finish_acceleration), in
-// two phases per run of up to 32 candidates. First every candidate is only tested (a tight
-// loop: load, distance, compare) into a bit mask; then the costly pair term runs for the set
-// bits in ascending order. In one pass a warp would run the pair term whenever any of its 32
-// threads had a neighbour, i.e. for almost every candidate, since only about a fifth of the
-// 27-cell candidates are within h. (Collecting a whole particle's neighbours in a shared-memory
-// list first, for one longer second phase, measured slower: occupancy and latency.)
-// The options as in gather_acceleration_with: neighbor_counts for Clavet viscosity, normals for
-// surface tension (either may be null otherwise).
-template <bool kSurfaceTension, ViscosityMethod kViscosity>
+// and the same per-neighbour arithmetic (the composer's AccelerationGather), in two phases per
+// run of up to 32 candidates. First every candidate is only tested (a tight loop: load,
+// distance, compare) into a bit mask; then the costly pair terms run for the set bits in
+// ascending order. In one pass a warp would run the pair terms whenever any of its 32 threads
+// had a neighbour, i.e. for almost every candidate, since only about a fifth of the 27-cell
+// candidates are within h. (Collecting a whole particle's neighbours in a shared-memory list
+// first, for one longer second phase, measured slower: occupancy and latency.)
+// Terms: the world's force terms (methods.h); neighbor_counts and normals may be null unless a
+// term reads them.
+template <class Terms>
 __device__ __forceinline__ Vec3 gather_acceleration_masked(const FluidConstants& f, const GridView& grid,
                                                            const Float4* __restrict__ positions,
                                                            const Float4* __restrict__ velocities,
                                                            const uint32_t* __restrict__ neighbor_counts,
                                                            const Float4* __restrict__ normals, uint32_t i) {
-  const Float4 pi = positions[i];
-  const Float4 vi = velocities[i];
-  const Vec3 xi = xyz(pi);
-  const Vec3 v_i = xyz(vi);
-  const float n_i = kViscosity == ViscosityMethod::Clavet ? static_cast<float>(neighbor_counts[i]) : 0.0f;
-  AccelerationSums sums = zero_acceleration_sums();
+  AccelerationGather<Terms> gather(ForceInputs{positions, velocities, neighbor_counts, normals}, i);
+  const Vec3 xi = gather.position();
   for_each_neighbor_range(grid, xi, [&](uint32_t begin, uint32_t end) {
     for (uint32_t base = begin; base < end; base += 32u) {
       const uint32_t count = min(32u, end - base);
@@ -47,16 +42,11 @@ __device__ __forceinline__ Vec3 gather_acceleration_masked(const FluidConstants&
         hits &= hits - 1u;
         const Float4 pj = positions[j];
         const Vec3 d = xi - xyz(pj);
-        const float pair =
-            kViscosity == ViscosityMethod::Clavet ? n_i + static_cast<float>(neighbor_counts[j]) : 0.0f;
-        add_neighbor_acceleration<kSurfaceTension, kViscosity>(
-            f, pi, v_i, pj, velocities[j], d, length_squared(d), sums, pair,
-            kSurfaceTension ? normals + i : nullptr, kSurfaceTension ? normals + j : nullptr);
+        gather.add(f, j, pj, d, length_squared(d));
       }
     }
   });
-  return finish_acceleration<kSurfaceTension, kViscosity>(f, vi, sums,
-                                                          kSurfaceTension ? normals + i : nullptr);
+  return gather.finish(f);
 }
 
 __device__ __forceinline__ void flag_non_finite(FrameState* s, int stage, uint32_t index, uint32_t id,
@@ -122,7 +112,7 @@ __global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArra
   }
   a.density[i] = rho;
   if (kCounts) a.neighbor_count[i] = s.neighbor_count;
-  a.sorted_position[i].w = pressure_from_density(fluid.eos, rho);
+  a.sorted_position[i].w = pressure_from_density(fluid.methods.eos, rho);
   const Float4 v = a.velocity[k];
   a.sorted_velocity[i] = make_float4_record(xyz(v), 1.0f / rho);
 }
@@ -143,7 +133,7 @@ __global__ void publish_normalized_density_kernel(FluidConstants fluid, Particle
   if (i >= n) return;
   const float rho = a.normalized_density[i];
   a.density[i] = rho;
-  a.sorted_position[i].w = pressure_from_density(fluid.eos, rho);
+  a.sorted_position[i].w = pressure_from_density(fluid.methods.eos, rho);
   a.sorted_velocity[i].w = 1.0f / rho;
 }
 
@@ -153,7 +143,7 @@ __global__ void colour_normal_kernel(FluidConstants fluid, GridView grid, Partic
   a.colour_normal[i] = gather_colour_normal(fluid, grid, a.sorted_position, a.sorted_velocity, i);
 }
 
-template <bool kSurfaceTension, ViscosityMethod kViscosity, bool kScene>
+template <class Terms, bool kScene>
 __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
                                     DeviceScene scene, FrameState* state) {
   mark_stage(state, kStageForces);
@@ -162,8 +152,8 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
   if (i < n) {
     FluidConstants f = fluid;
     f.dt = state->clock.dt_float;  // impulse-based terms need the substep's length
-    Vec3 acc = gather_acceleration_masked<kSurfaceTension, kViscosity>(
-        f, grid, a.sorted_position, a.sorted_velocity, a.neighbor_count, a.colour_normal, i);
+    Vec3 acc = gather_acceleration_masked<Terms>(f, grid, a.sorted_position, a.sorted_velocity,
+                                                 a.neighbor_count, a.colour_normal, i);
     const Float4 p = a.sorted_position[i];
     const Float4 v = a.sorted_velocity[i];
     if (kScene) acc = add_force_fields(scene, acc, xyz(p));
@@ -187,7 +177,7 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
   block_max_to(&state->a2max_bits, a2);
 }
 
-template <bool kSurfaceTension, ViscosityMethod kViscosity, bool kScene>
+template <class Terms, bool kScene>
 __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
                                   int stage, DeviceScene scene, FrameState* state) {
   mark_stage(state, kStageForces);
@@ -199,8 +189,8 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
     Rk4Accumulator* sums = (stage & 1) ? a.rk4_sum[0] : a.rk4_sum[1];
     FluidConstants f = fluid;
     f.dt = state->clock.dt_float;
-    Vec3 acc = gather_acceleration_masked<kSurfaceTension, kViscosity>(
-        f, grid, a.sorted_position, a.sorted_velocity, a.neighbor_count, a.colour_normal, i);
+    Vec3 acc = gather_acceleration_masked<Terms>(f, grid, a.sorted_position, a.sorted_velocity,
+                                                 a.neighbor_count, a.colour_normal, i);
     const Float4 p = a.sorted_position[i];
     const Float4 v = a.sorted_velocity[i];
     if (kScene) acc = add_force_fields(scene, acc, xyz(p));
@@ -231,51 +221,9 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
   block_max_to(&state->a2max_bits, a2);  // over all four stages, as the CPU backend
 }
 
-// One launch site per option combination: a world that does not use an option runs code
-// without it.
-// A frame without colliders and force fields runs kernels without the scene code.
-template <template <bool, ViscosityMethod, bool> class Launch, bool kScene, class... Args>
-void dispatch_viscosity(const SubstepOptions& o, Args&&... args) {
-  if (o.viscosity == ViscosityMethod::Clavet) {
-    if (o.surface_tension)
-      Launch<true, ViscosityMethod::Clavet, kScene>::run(args...);
-    else
-      Launch<false, ViscosityMethod::Clavet, kScene>::run(args...);
-  } else {
-    if (o.surface_tension)
-      Launch<true, ViscosityMethod::Mueller, kScene>::run(args...);
-    else
-      Launch<false, ViscosityMethod::Mueller, kScene>::run(args...);
-  }
-}
-
-template <template <bool, ViscosityMethod, bool> class Launch, class... Args>
-void dispatch_options(const SubstepOptions& o, bool scene, Args&&... args) {
-  if (scene)
-    dispatch_viscosity<Launch, true>(o, args...);
-  else
-    dispatch_viscosity<Launch, false>(o, args...);
-}
-
-template <bool kSurfaceTension, ViscosityMethod kViscosity, bool kScene>
-struct LaunchEuler {
-  static void run(unsigned blocks, unsigned threads, cudaStream_t stream, const FluidConstants& fluid,
-                  const GridView& grid, const ParticleArrays& a, uint32_t n, const DeviceScene& scene,
-                  FrameState* state) {
-    forces_euler_kernel<kSurfaceTension, kViscosity, kScene>
-        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
-  }
-};
-
-template <bool kSurfaceTension, ViscosityMethod kViscosity, bool kScene>
-struct LaunchRk4 {
-  static void run(unsigned blocks, unsigned threads, cudaStream_t stream, const FluidConstants& fluid,
-                  const GridView& grid, const ParticleArrays& a, uint32_t n, int stage,
-                  const DeviceScene& scene, FrameState* state) {
-    forces_rk4_kernel<kSurfaceTension, kViscosity, kScene>
-        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, scene, state);
-  }
-};
+// One launch site per combination of force terms (with_force_terms, methods.h): a world that
+// does not use a method runs code without it. A frame without colliders and force fields runs
+// kernels without the scene code.
 
 }  // namespace
 
@@ -326,16 +274,28 @@ void enqueue_density(const FluidConstants& fluid, const GridView& grid, const Pa
 void enqueue_forces_euler(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                           uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
                           const DeviceScene& scene, FrameState* state, cudaStream_t stream) {
-  dispatch_options<LaunchEuler>(options, scene.active(), blocks_for(n, tuning.force_block),
-                                tuning.force_block, stream, fluid, grid, a, n, scene, state);
+  const unsigned threads = tuning.force_block, blocks = blocks_for(n, threads);
+  with_force_terms(options.methods, [&](auto terms) {
+    using Terms = decltype(terms);
+    if (scene.active())
+      forces_euler_kernel<Terms, true><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
+    else
+      forces_euler_kernel<Terms, false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
+  });
   check_launch("forces_euler_kernel");
 }
 
 void enqueue_forces_rk4(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                         uint32_t n, int stage, const SubstepOptions& options, const KernelTuning& tuning,
                         const DeviceScene& scene, FrameState* state, cudaStream_t stream) {
-  dispatch_options<LaunchRk4>(options, scene.active(), blocks_for(n, tuning.force_block), tuning.force_block,
-                              stream, fluid, grid, a, n, stage, scene, state);
+  const unsigned threads = tuning.force_block, blocks = blocks_for(n, threads);
+  with_force_terms(options.methods, [&](auto terms) {
+    using Terms = decltype(terms);
+    if (scene.active())
+      forces_rk4_kernel<Terms, true><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, scene, state);
+    else
+      forces_rk4_kernel<Terms, false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, scene, state);
+  });
   check_launch("forces_rk4_kernel");
 }
 

@@ -44,8 +44,9 @@ enum class Rk4Carry { None, BuildStart, Gather };
 void enqueue_reorder(const ParticleArrays& a, const uint32_t* order, uint32_t n, Rk4Carry carry, int from,
                      FrameState* state, cudaStream_t stream);
 
-// The physics options a world was created with (src/core/config.h).
+// The physics options a world was created with (methods: src/physics/methods.h).
 struct SubstepOptions {
+  MethodSelection methods{};  // every method the world runs; the force pass dispatches on it
   bool surface_tension = false;
   bool normalized_density = false;
   ViscosityMethod viscosity = ViscosityMethod::Mueller;

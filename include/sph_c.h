@@ -307,18 +307,23 @@ SPH_API sph_result SPH_CALL sph_world_get_def(const sph_world* world, sph_world_
 /** Mass of every particle, kg. */
 SPH_API sph_result SPH_CALL sph_world_get_particle_mass(const sph_world* world, float* out_mass);
 
-/* ---- runtime parameters ------------------------------------------------------------------ */
+/* ---- runtime parameters ------------------------------------------------------------------
+ * Every params struct that is all zeros but for struct_size is valid. A field whose 0 was never
+ * a valid value takes its default when 0 ("0 = default"); a field where 0 is itself a physical
+ * value keeps it ("0 is ..."): a zeroed sph_world_params has no gravity and no viscosity.
+ * sph_params_get_field_info() says the same per field. The getters return the values in use
+ * (a 0 that took a default reads back as the default). */
 typedef struct sph_world_params {
   uint32_t struct_size;  /* sizeof(sph_world_params), set by sph_world_params_init */
-  uint32_t max_substeps; /* most substeps one sph_world_step may take; default 10000; >= 1 */
-  sph_vec3 gravity;      /* m/s^2; default (0, -9.81, 0) */
+  uint32_t max_substeps; /* most substeps one sph_world_step may take; default 10000; 0 = default */
+  sph_vec3 gravity;      /* m/s^2; default (0, -9.81, 0); finite; 0 is no gravity */
   float stiffness;       /* k of p = k (rho - rho0), m^2/s^2 (the squared numerical sound speed);
-                            default 100; > 0. Keep sqrt(k) * dt_max below about 0.4 h. */
+                            default 100; > 0; 0 = default. Keep sqrt(k) * dt_max below about 0.4 h. */
   float viscosity;       /* mu of Mueller's Laplacian viscosity (a numerical viscosity, not
-                            water's 0.001 Pa s); default 1; >= 0 */
-  float step_factor;     /* lambda of dt = lambda h / v_max; default 0.4; in (0, 10] */
-  float dt_min;          /* s; default 1e-6; > 0 */
-  float dt_max;          /* s; default 1e-3; >= dt_min */
+                            water's 0.001 Pa s); default 1; >= 0; 0 is an inviscid fluid */
+  float step_factor;     /* lambda of dt = lambda h / v_max; default 0.4; in (0, 10]; 0 = default */
+  float dt_min;          /* s; default 1e-6; > 0; 0 = default */
+  float dt_max;          /* s; default 1e-3; >= dt_min (after defaults); 0 = default */
   uint32_t step_limits;  /* SPH_STEP_LIMIT_* bits; default 0 (eq. 32 alone) */
   uint32_t reserved0;    /* must be 0 */
 } sph_world_params;
@@ -336,7 +341,7 @@ SPH_API sph_result SPH_CALL sph_world_get_params(const sph_world* world, sph_wor
 /* ---- parameters of optional physics (each its own struct, set and read whole) ----------- */
 typedef struct sph_surface_tension_params {
   uint32_t struct_size;   /* set by sph_surface_tension_params_init */
-  float coefficient;      /* sigma, N/m; default 0.0728 (water at 20 C); >= 0 */
+  float coefficient;      /* sigma, N/m; default 0.0728 (water at 20 C); >= 0; 0 is no tension */
   float normal_threshold; /* |grad c| above which a particle counts as surface, 1/m; 0 (default)
                              = 0.2 / kernel_radius; >= 0 */
   uint32_t reserved0;     /* must be 0 */
@@ -356,8 +361,9 @@ SPH_API sph_result SPH_CALL sph_world_get_surface_tension_params(const sph_world
 
 typedef struct sph_clavet_viscosity_params {
   uint32_t struct_size; /* set by sph_clavet_viscosity_params_init */
-  float linear;         /* sigma of I = dt (1 - q)(sigma u + beta u^2), 1/s; default 10; >= 0 */
-  float quadratic;      /* beta, 1/m; default 0; >= 0 */
+  float linear;         /* sigma of I = dt (1 - q)(sigma u + beta u^2), 1/s; default 10; >= 0;
+                           0 is no linear term (beta alone, Clavet's choice for thin fluids) */
+  float quadratic;      /* beta, 1/m; default 0; >= 0; 0 is no quadratic term */
   uint32_t reserved0;   /* must be 0 */
 } sph_clavet_viscosity_params;
 SPH_STATIC_ASSERT(sizeof(sph_clavet_viscosity_params) == 16, sph_clavet_viscosity_params_size);
@@ -375,9 +381,9 @@ SPH_API sph_result SPH_CALL sph_world_get_clavet_viscosity_params(const sph_worl
 
 typedef struct sph_tait_params {
   uint32_t struct_size; /* set by sph_tait_params_init */
-  float speed_of_sound; /* c, m/s; default 10; > 0. Use >= 10 x the fastest flow speed to keep
-                           density errors near 1 %; lower dt_max (or SPH_STEP_LIMIT_ACOUSTIC)
-                           so that c dt stays below about 0.4 h */
+  float speed_of_sound; /* c, m/s; default 10; > 0; 0 = default. Use >= 10 x the fastest flow
+                           speed to keep density errors near 1 %; lower dt_max (or
+                           SPH_STEP_LIMIT_ACOUSTIC) so that c dt stays below about 0.4 h */
 } sph_tait_params;
 SPH_STATIC_ASSERT(sizeof(sph_tait_params) == 8, sph_tait_params_size);
 
@@ -392,19 +398,19 @@ SPH_API sph_result SPH_CALL sph_world_get_tait_params(const sph_world* world, sp
 typedef struct sph_spring_params {
   uint32_t struct_size; /* set by sph_spring_params_init */
   float stiffness;      /* k of a = -k (1 - L/h)(r - L), 1/s^2 (acceleration per metre of
-                           stretch); default 1e4; >= 0. Young's modulus of an FCC block is about
-                           (2/3) rho0 s^2 k (1 - s/h) (s: particle spacing). Stiffer springs
-                           shorten the step: dt <= 0.5 / sqrt(16 k) */
+                           stretch); default 1e4; >= 0; 0 is no elastic force. Young's modulus
+                           of an FCC block is about (2/3) rho0 s^2 k (1 - s/h) (s: particle
+                           spacing). Stiffer springs shorten the step: dt <= 0.5 / sqrt(16 k) */
   float link_radius;    /* springs are made to neighbours closer than this, m; 0 (default) =
                            1.2 x particle_spacing (the lattice's 12 nearest neighbours);
                            <= kernel_radius. Applies to particles linked after the change */
   float yield_ratio;    /* gamma: a spring deforms plastically beyond r = L (1 +- gamma);
-                           default 0.1; [0, 1] */
+                           default 0.1; [0, 1]; 0 is a value (every deformation yields) */
   float plasticity;     /* alpha, 1/s: how fast rest lengths creep toward the deformed length
-                           beyond the yield band; default 0 (purely elastic); >= 0. A rest
+                           beyond the yield band; default 0 (0 is purely elastic); >= 0. A rest
                            length that grows past kernel_radius drops its spring */
-  float damping;        /* c of a = -c (v_i - v_j) . r^ along each spring, 1/s; default 0; >= 0.
-                           Shortens the step: dt <= 2 / (16 c) */
+  float damping;        /* c of a = -c (v_i - v_j) . r^ along each spring, 1/s; default 0 (0 is
+                           no damping); >= 0. Shortens the step: dt <= 2 / (16 c) */
   uint32_t reserved0;   /* must be 0 */
 } sph_spring_params;
 SPH_STATIC_ASSERT(sizeof(sph_spring_params) == 28, sph_spring_params_size);
@@ -418,6 +424,129 @@ static inline sph_result sph_spring_params_init(sph_spring_params* params) {
  *  rest lengths; the new stiffness, damping and plasticity act from the next substep. */
 SPH_API sph_result SPH_CALL sph_world_set_spring_params(sph_world* world, const sph_spring_params* params);
 SPH_API sph_result SPH_CALL sph_world_get_spring_params(const sph_world* world, sph_spring_params* out);
+
+/* ---- every params struct by kind, and what tools need to know about them ----------------
+ * The physics methods and their parameters described as data (after SPlisHSPlasH's parameter
+ * objects), so that a tool (a scene format, an editor, a binding) can list, read, range-check
+ * and set every method's parameters without code of its own per method; sph-run's scene files
+ * use nothing else (docs/scenes.md, "physics"). The descriptions are static: they need no
+ * world, are thread-safe and name the same rules the set calls apply. */
+typedef enum sph_params_kind {
+  SPH_PARAMS_WORLD = 0,            /* sph_world_params */
+  SPH_PARAMS_SURFACE_TENSION = 1,  /* sph_surface_tension_params */
+  SPH_PARAMS_CLAVET_VISCOSITY = 2, /* sph_clavet_viscosity_params */
+  SPH_PARAMS_TAIT = 3,             /* sph_tait_params */
+  SPH_PARAMS_SPRINGS = 4,          /* sph_spring_params */
+  SPH_PARAMS_KIND_COUNT = 5,
+  SPH_PARAMS_KIND_FORCE32 = 0x7fffffff
+} sph_params_kind;
+
+/**
+ * Replaces the params struct of `kind` at once, as its typed set call does (sph_world_set_params,
+ * sph_world_set_tait_params, ...): params points to that struct, struct_size first.
+ * Errors: those of the typed call; UNSUPPORTED for an unknown kind.
+ */
+SPH_API sph_result SPH_CALL sph_world_set_physics_params(sph_world* world, sph_params_kind kind,
+                                                         const void* params);
+/** Reads the params struct of `kind`, as its typed get call does; out->struct_size must be set. */
+SPH_API sph_result SPH_CALL sph_world_get_physics_params(const sph_world* world, sph_params_kind kind,
+                                                         void* out);
+
+typedef struct sph_params_info {
+  uint32_t struct_size;  /* set by sph_params_info_init */
+  uint32_t params_size;  /* sizeof the params struct in this library */
+  uint32_t field_count;  /* its described fields (reserved fields are not described) */
+  uint32_t reserved0;    /* 0 */
+  const char* name;      /* "tait", "world": a scene file's key; static, never NULL */
+  const char* type_name; /* "sph_tait_params"; static, never NULL */
+} sph_params_info;
+SPH_STATIC_ASSERT(sizeof(sph_params_info) == 16 + 2 * sizeof(void*), sph_params_info_size);
+
+SPH_API sph_result SPH_CALL sph_params_info_init_sized(sph_params_info* info, uint32_t size);
+static inline sph_result sph_params_info_init(sph_params_info* info) {
+  return sph_params_info_init_sized(info, (uint32_t)sizeof(*info));
+}
+/** Describes the params struct of `kind`. UNSUPPORTED for an unknown kind. */
+SPH_API sph_result SPH_CALL sph_params_get_info(sph_params_kind kind, sph_params_info* out);
+
+typedef enum sph_param_type {
+  SPH_PARAM_FLOAT = 0,  /* float, finite */
+  SPH_PARAM_VEC3 = 1,   /* sph_vec3, every component finite */
+  SPH_PARAM_UINT32 = 2, /* uint32_t count */
+  SPH_PARAM_FLAGS = 3,  /* uint32_t bit set: only the bits of upper may be set */
+  SPH_PARAM_TYPE_FORCE32 = 0x7fffffff
+} sph_param_type;
+
+typedef enum sph_param_bound {
+  SPH_BOUND_NONE = 0,      /* no bound on this side */
+  SPH_BOUND_INCLUSIVE = 1, /* the value may equal it */
+  SPH_BOUND_EXCLUSIVE = 2, /* the value must pass it */
+  SPH_BOUND_FORCE32 = 0x7fffffff
+} sph_param_bound;
+
+/** What a 0 in a field asks for (the zero rule at "runtime parameters" above). */
+typedef enum sph_param_zero {
+  SPH_PARAM_ZERO_IS_VALUE = 0,   /* 0 is itself a value (no gravity, no damping) */
+  SPH_PARAM_ZERO_IS_DEFAULT = 1, /* 0 takes default_value */
+  SPH_PARAM_ZERO_IS_DERIVED = 2, /* 0 asks for a value derived from the world (see the field's doc) */
+  SPH_PARAM_ZERO_FORCE32 = 0x7fffffff
+} sph_param_zero;
+
+typedef struct sph_param_field_info {
+  uint32_t struct_size;        /* set by sph_param_field_info_init */
+  uint32_t offset;             /* byte offset of the field in its params struct */
+  sph_param_type type;         /* how to read it at offset */
+  sph_param_zero zero;         /* what a 0 in it asks for */
+  sph_param_bound lower_bound; /* the range of valid values (not for SPH_PARAM_VEC3) */
+  sph_param_bound upper_bound;
+  double lower;
+  double upper;           /* SPH_PARAM_FLAGS: the bits this library knows */
+  float default_value[3]; /* the default ([0] only, but for SPH_PARAM_VEC3) */
+  uint32_t reserved0;     /* 0 */
+  const char* name;       /* "speed_of_sound": the struct's field name; static, never NULL */
+  const char* unit;       /* SI unit ("m/s"), "" when dimensionless; static, never NULL */
+} sph_param_field_info;
+SPH_STATIC_ASSERT(sizeof(sph_param_field_info) == 56 + 2 * sizeof(void*), sph_param_field_info_size);
+
+SPH_API sph_result SPH_CALL sph_param_field_info_init_sized(sph_param_field_info* info, uint32_t size);
+static inline sph_result sph_param_field_info_init(sph_param_field_info* info) {
+  return sph_param_field_info_init_sized(info, (uint32_t)sizeof(*info));
+}
+/**
+ * Describes field `index` (0 .. field_count - 1, in the order of the struct) of the params
+ * struct of `kind`. Cross-field rules (dt_max >= dt_min; a spring link radius at most h) are
+ * checked by the set calls only. UNSUPPORTED for an unknown kind, INVALID_ARGUMENT for an index
+ * past the last field.
+ */
+SPH_API sph_result SPH_CALL sph_params_get_field_info(sph_params_kind kind, uint32_t index,
+                                                      sph_param_field_info* out);
+
+/** How a world turns a method on: which field of sph_world_def selects it. */
+typedef enum sph_method_switch {
+  SPH_METHOD_SWITCH_FEATURE = 1,           /* a bit of sph_world_def.features (value) */
+  SPH_METHOD_SWITCH_VISCOSITY = 2,         /* sph_world_def.viscosity_method == value */
+  SPH_METHOD_SWITCH_EQUATION_OF_STATE = 3, /* sph_world_def.equation_of_state == value */
+  SPH_METHOD_SWITCH_FORCE32 = 0x7fffffff
+} sph_method_switch;
+
+typedef struct sph_physics_method_info {
+  uint32_t struct_size;        /* set by sph_physics_method_info_init */
+  uint32_t method_count;       /* how many methods this library has (index runs below it) */
+  sph_method_switch switch_by; /* the sph_world_def field that selects it */
+  uint32_t value;              /* the SPH_FEATURE_* bit, sph_viscosity_method or sph_equation_of_state */
+  uint32_t has_params;         /* 1 when its parameters are in the struct of params_kind */
+  sph_params_kind params_kind; /* SPH_PARAMS_WORLD for the thesis's defaults (stiffness, viscosity) */
+  const char* name;            /* "clavet", "surface_tension": a scene file's name; static */
+} sph_physics_method_info;
+SPH_STATIC_ASSERT(sizeof(sph_physics_method_info) == 24 + sizeof(void*), sph_physics_method_info_size);
+
+SPH_API sph_result SPH_CALL sph_physics_method_info_init_sized(sph_physics_method_info* info, uint32_t size);
+static inline sph_result sph_physics_method_info_init(sph_physics_method_info* info) {
+  return sph_physics_method_info_init_sized(info, (uint32_t)sizeof(*info));
+}
+/** Describes method `index` (0 .. method_count - 1; index 0 always exists and tells how many
+ *  there are). INVALID_ARGUMENT past the last one. */
+SPH_API sph_result SPH_CALL sph_get_physics_method_info(uint32_t index, sph_physics_method_info* out);
 
 /* ---- particles in -------------------------------------------------------------------------- */
 /** Zero means default: a zeroed desc spawns nothing (count 0); positions is required once

@@ -68,6 +68,12 @@ namespace Sph
         public const int SPH_STAGE_FORCE32 = 2147483647;
         public const int SPH_VISCOSITY_METHOD_FORCE32 = 2147483647;
         public const int SPH_EOS_FORCE32 = 2147483647;
+        public const int SPH_PARAMS_KIND_COUNT = 5;
+        public const int SPH_PARAMS_KIND_FORCE32 = 2147483647;
+        public const int SPH_PARAM_TYPE_FORCE32 = 2147483647;
+        public const int SPH_BOUND_FORCE32 = 2147483647;
+        public const int SPH_PARAM_ZERO_FORCE32 = 2147483647;
+        public const int SPH_METHOD_SWITCH_FORCE32 = 2147483647;
         public const int SPH_MEMORY_KIND_FORCE32 = 2147483647;
         public const int SPH_SHAPE_FORCE32 = 2147483647;
         public const int SPH_SDF_CHANNEL_FORCE32 = 2147483647;
@@ -218,6 +224,67 @@ namespace Sph
         Tait = 1,
     }
 
+    /// <summary>sph_params_kind</summary>
+    public enum ParamsKind : int
+    {
+        /// <summary>sph_world_params</summary>
+        World = 0,
+        /// <summary>sph_surface_tension_params</summary>
+        SurfaceTension = 1,
+        /// <summary>sph_clavet_viscosity_params</summary>
+        ClavetViscosity = 2,
+        /// <summary>sph_tait_params</summary>
+        Tait = 3,
+        /// <summary>sph_spring_params</summary>
+        Springs = 4,
+    }
+
+    /// <summary>sph_param_type</summary>
+    public enum ParamType : int
+    {
+        /// <summary>float, finite</summary>
+        Float = 0,
+        /// <summary>sph_vec3, every component finite</summary>
+        Vec3 = 1,
+        /// <summary>uint32_t count</summary>
+        Uint32 = 2,
+        /// <summary>uint32_t bit set: only the bits of upper may be set</summary>
+        Flags = 3,
+    }
+
+    /// <summary>sph_param_bound</summary>
+    public enum ParamBound : int
+    {
+        /// <summary>no bound on this side</summary>
+        None = 0,
+        /// <summary>the value may equal it</summary>
+        Inclusive = 1,
+        /// <summary>the value must pass it</summary>
+        Exclusive = 2,
+    }
+
+    /// <summary>sph_param_zero: What a 0 in a field asks for (the zero rule at "runtime parameters" above).</summary>
+    public enum ParamZero : int
+    {
+        /// <summary>0 is itself a value (no gravity, no damping)</summary>
+        Value = 0,
+        /// <summary>0 takes default_value</summary>
+        Default = 1,
+        /// <summary>0 asks for a value derived from the world (see the field's doc)</summary>
+        Derived = 2,
+    }
+
+    /// <summary>sph_method_switch: How a world turns a method on: which field of sph_world_def selects it.</summary>
+    public enum MethodSwitch : int
+    {
+        /// <summary>a bit of sph_world_def.features (value)</summary>
+        Feature = 1,
+        /// <summary>sph_world_def.viscosity_method == value</summary>
+        Viscosity = 2,
+        /// <summary>sph_world_def.equation_of_state == value</summary>
+        EquationOfState = 3,
+    }
+
     /// <summary>sph_memory_kind</summary>
     public enum MemoryKind : int
     {
@@ -305,6 +372,52 @@ namespace Sph
     /// </summary>
     [UnmanagedFunctionPointer(CallingConvention.Cdecl)]
     public delegate void LogFn(IntPtr userData, LogLevel level, Result code, IntPtr message);
+
+    /// <summary>A C array float[3], blittable (no unsafe fixed buffer).</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct FixedFloat3
+    {
+        public float E0, E1, E2;
+        public const int Length = 3;
+
+        public float this[int index]
+        {
+            get
+            {
+                switch (index)
+                {
+                    case 0: return E0;
+                    case 1: return E1;
+                    case 2: return E2;
+                    default: throw new IndexOutOfRangeException();
+                }
+            }
+            set
+            {
+                switch (index)
+                {
+                    case 0: E0 = value; break;
+                    case 1: E1 = value; break;
+                    case 2: E2 = value; break;
+                    default: throw new IndexOutOfRangeException();
+                }
+            }
+        }
+
+        public float[] ToArray()
+        {
+            return new float[] { E0, E1, E2 };
+        }
+
+        public static FixedFloat3 From(float[] values)
+        {
+            if (values == null || values.Length != Length)
+                throw new ArgumentException("expected 3 values");
+            var a = new FixedFloat3();
+            for (int i = 0; i < Length; ++i) a[i] = values[i];
+            return a;
+        }
+    }
 
     /// <summary>A C array float[8], blittable (no unsafe fixed buffer).</summary>
     [StructLayout(LayoutKind.Sequential)]
@@ -592,25 +705,25 @@ namespace Sph
     {
         /// <summary>uint32_t struct_size: sizeof(sph_world_params), set by sph_world_params_init</summary>
         public uint StructSize;
-        /// <summary>uint32_t max_substeps: most substeps one sph_world_step may take; default 10000; &gt;= 1</summary>
+        /// <summary>uint32_t max_substeps: most substeps one sph_world_step may take; default 10000; 0 = default</summary>
         public uint MaxSubsteps;
-        /// <summary>sph_vec3 gravity: m/s^2; default (0, -9.81, 0)</summary>
+        /// <summary>sph_vec3 gravity: m/s^2; default (0, -9.81, 0); finite; 0 is no gravity</summary>
         public Vec3 Gravity;
         /// <summary>
         /// float stiffness: k of p = k (rho - rho0), m^2/s^2 (the squared numerical sound speed);
-        /// default 100; &gt; 0. Keep sqrt(k) * dt_max below about 0.4 h.
+        /// default 100; &gt; 0; 0 = default. Keep sqrt(k) * dt_max below about 0.4 h.
         /// </summary>
         public float Stiffness;
         /// <summary>
         /// float viscosity: mu of Mueller's Laplacian viscosity (a numerical viscosity, not water's
-        /// 0.001 Pa s); default 1; &gt;= 0
+        /// 0.001 Pa s); default 1; &gt;= 0; 0 is an inviscid fluid
         /// </summary>
         public float Viscosity;
-        /// <summary>float step_factor: lambda of dt = lambda h / v_max; default 0.4; in (0, 10]</summary>
+        /// <summary>float step_factor: lambda of dt = lambda h / v_max; default 0.4; in (0, 10]; 0 = default</summary>
         public float StepFactor;
-        /// <summary>float dt_min: s; default 1e-6; &gt; 0</summary>
+        /// <summary>float dt_min: s; default 1e-6; &gt; 0; 0 = default</summary>
         public float DtMin;
-        /// <summary>float dt_max: s; default 1e-3; &gt;= dt_min</summary>
+        /// <summary>float dt_max: s; default 1e-3; &gt;= dt_min (after defaults); 0 = default</summary>
         public float DtMax;
         /// <summary>uint32_t step_limits: SPH_STEP_LIMIT_* bits; default 0 (eq. 32 alone)</summary>
         public uint StepLimits;
@@ -633,7 +746,7 @@ namespace Sph
     {
         /// <summary>uint32_t struct_size: set by sph_surface_tension_params_init</summary>
         public uint StructSize;
-        /// <summary>float coefficient: sigma, N/m; default 0.0728 (water at 20 C); &gt;= 0</summary>
+        /// <summary>float coefficient: sigma, N/m; default 0.0728 (water at 20 C); &gt;= 0; 0 is no tension</summary>
         public float Coefficient;
         /// <summary>
         /// float normal_threshold: |grad c| above which a particle counts as surface, 1/m; 0 (default)
@@ -659,9 +772,12 @@ namespace Sph
     {
         /// <summary>uint32_t struct_size: set by sph_clavet_viscosity_params_init</summary>
         public uint StructSize;
-        /// <summary>float linear: sigma of I = dt (1 - q)(sigma u + beta u^2), 1/s; default 10; &gt;= 0</summary>
+        /// <summary>
+        /// float linear: sigma of I = dt (1 - q)(sigma u + beta u^2), 1/s; default 10; &gt;= 0; 0 is no
+        /// linear term (beta alone, Clavet's choice for thin fluids)
+        /// </summary>
         public float Linear;
-        /// <summary>float quadratic: beta, 1/m; default 0; &gt;= 0</summary>
+        /// <summary>float quadratic: beta, 1/m; default 0; &gt;= 0; 0 is no quadratic term</summary>
         public float Quadratic;
         /// <summary>uint32_t reserved0: must be 0</summary>
         public uint Reserved0;
@@ -683,9 +799,9 @@ namespace Sph
         /// <summary>uint32_t struct_size: set by sph_tait_params_init</summary>
         public uint StructSize;
         /// <summary>
-        /// float speed_of_sound: c, m/s; default 10; &gt; 0. Use &gt;= 10 x the fastest flow speed to
-        /// keep density errors near 1 %; lower dt_max (or SPH_STEP_LIMIT_ACOUSTIC) so that c dt stays
-        /// below about 0.4 h
+        /// float speed_of_sound: c, m/s; default 10; &gt; 0; 0 = default. Use &gt;= 10 x the fastest
+        /// flow speed to keep density errors near 1 %; lower dt_max (or SPH_STEP_LIMIT_ACOUSTIC) so
+        /// that c dt stays below about 0.4 h
         /// </summary>
         public float SpeedOfSound;
 
@@ -707,8 +823,9 @@ namespace Sph
         public uint StructSize;
         /// <summary>
         /// float stiffness: k of a = -k (1 - L/h)(r - L), 1/s^2 (acceleration per metre of stretch);
-        /// default 1e4; &gt;= 0. Young's modulus of an FCC block is about (2/3) rho0 s^2 k (1 - s/h)
-        /// (s: particle spacing). Stiffer springs shorten the step: dt &lt;= 0.5 / sqrt(16 k)
+        /// default 1e4; &gt;= 0; 0 is no elastic force. Young's modulus of an FCC block is about (2/3)
+        /// rho0 s^2 k (1 - s/h) (s: particle spacing). Stiffer springs shorten the step: dt &lt;= 0.5 /
+        /// sqrt(16 k)
         /// </summary>
         public float Stiffness;
         /// <summary>
@@ -719,18 +836,18 @@ namespace Sph
         public float LinkRadius;
         /// <summary>
         /// float yield_ratio: gamma: a spring deforms plastically beyond r = L (1 +- gamma); default
-        /// 0.1; [0, 1]
+        /// 0.1; [0, 1]; 0 is a value (every deformation yields)
         /// </summary>
         public float YieldRatio;
         /// <summary>
         /// float plasticity: alpha, 1/s: how fast rest lengths creep toward the deformed length beyond
-        /// the yield band; default 0 (purely elastic); &gt;= 0. A rest length that grows past
+        /// the yield band; default 0 (0 is purely elastic); &gt;= 0. A rest length that grows past
         /// kernel_radius drops its spring
         /// </summary>
         public float Plasticity;
         /// <summary>
-        /// float damping: c of a = -c (v_i - v_j) . r^ along each spring, 1/s; default 0; &gt;= 0.
-        /// Shortens the step: dt &lt;= 2 / (16 c)
+        /// float damping: c of a = -c (v_i - v_j) . r^ along each spring, 1/s; default 0 (0 is no
+        /// damping); &gt;= 0. Shortens the step: dt &lt;= 2 / (16 c)
         /// </summary>
         public float Damping;
         /// <summary>uint32_t reserved0: must be 0</summary>
@@ -742,6 +859,104 @@ namespace Sph
             var value = new SpringParams();
             uint size = (uint)Marshal.SizeOf(typeof(SpringParams));
             SphException.Check(Native.sph_spring_params_init_sized(ref value, size), "sph_spring_params_init_sized");
+            return value;
+        }
+    }
+
+    /// <summary>sph_params_info (32 bytes)</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public partial struct ParamsInfo
+    {
+        /// <summary>uint32_t struct_size: set by sph_params_info_init</summary>
+        public uint StructSize;
+        /// <summary>uint32_t params_size: sizeof the params struct in this library</summary>
+        public uint ParamsSize;
+        /// <summary>uint32_t field_count: its described fields (reserved fields are not described)</summary>
+        public uint FieldCount;
+        /// <summary>uint32_t reserved0: 0</summary>
+        public uint Reserved0;
+        /// <summary>const char* name: "tait", "world": a scene file's key; static, never NULL</summary>
+        public IntPtr Name;
+        /// <summary>const char* type_name: "sph_tait_params"; static, never NULL</summary>
+        public IntPtr TypeName;
+
+        /// <summary>A ParamsInfo with the library's defaults (sph_params_info_init_sized).</summary>
+        public static ParamsInfo Default()
+        {
+            var value = new ParamsInfo();
+            uint size = (uint)Marshal.SizeOf(typeof(ParamsInfo));
+            SphException.Check(Native.sph_params_info_init_sized(ref value, size), "sph_params_info_init_sized");
+            return value;
+        }
+    }
+
+    /// <summary>sph_param_field_info (72 bytes)</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public partial struct ParamFieldInfo
+    {
+        /// <summary>uint32_t struct_size: set by sph_param_field_info_init</summary>
+        public uint StructSize;
+        /// <summary>uint32_t offset: byte offset of the field in its params struct</summary>
+        public uint Offset;
+        /// <summary>sph_param_type type: how to read it at offset</summary>
+        public ParamType Type;
+        /// <summary>sph_param_zero zero: what a 0 in it asks for</summary>
+        public ParamZero Zero;
+        /// <summary>sph_param_bound lower_bound: the range of valid values (not for SPH_PARAM_VEC3)</summary>
+        public ParamBound LowerBound;
+        /// <summary>sph_param_bound upper_bound</summary>
+        public ParamBound UpperBound;
+        /// <summary>double lower</summary>
+        public double Lower;
+        /// <summary>double upper: SPH_PARAM_FLAGS: the bits this library knows</summary>
+        public double Upper;
+        /// <summary>float [3] default_value: the default ([0] only, but for SPH_PARAM_VEC3)</summary>
+        public FixedFloat3 DefaultValue;
+        /// <summary>uint32_t reserved0: 0</summary>
+        public uint Reserved0;
+        /// <summary>const char* name: "speed_of_sound": the struct's field name; static, never NULL</summary>
+        public IntPtr Name;
+        /// <summary>const char* unit: SI unit ("m/s"), "" when dimensionless; static, never NULL</summary>
+        public IntPtr Unit;
+
+        /// <summary>A ParamFieldInfo with the library's defaults (sph_param_field_info_init_sized).</summary>
+        public static ParamFieldInfo Default()
+        {
+            var value = new ParamFieldInfo();
+            uint size = (uint)Marshal.SizeOf(typeof(ParamFieldInfo));
+            SphException.Check(Native.sph_param_field_info_init_sized(ref value, size), "sph_param_field_info_init_sized");
+            return value;
+        }
+    }
+
+    /// <summary>sph_physics_method_info (32 bytes)</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public partial struct PhysicsMethodInfo
+    {
+        /// <summary>uint32_t struct_size: set by sph_physics_method_info_init</summary>
+        public uint StructSize;
+        /// <summary>uint32_t method_count: how many methods this library has (index runs below it)</summary>
+        public uint MethodCount;
+        /// <summary>sph_method_switch switch_by: the sph_world_def field that selects it</summary>
+        public MethodSwitch SwitchBy;
+        /// <summary>uint32_t value: the SPH_FEATURE_* bit, sph_viscosity_method or sph_equation_of_state</summary>
+        public uint Value;
+        /// <summary>uint32_t has_params: 1 when its parameters are in the struct of params_kind</summary>
+        public uint HasParams;
+        /// <summary>
+        /// sph_params_kind params_kind: SPH_PARAMS_WORLD for the thesis's defaults (stiffness,
+        /// viscosity)
+        /// </summary>
+        public ParamsKind ParamsKind;
+        /// <summary>const char* name: "clavet", "surface_tension": a scene file's name; static</summary>
+        public IntPtr Name;
+
+        /// <summary>A PhysicsMethodInfo with the library's defaults (sph_physics_method_info_init_sized).</summary>
+        public static PhysicsMethodInfo Default()
+        {
+            var value = new PhysicsMethodInfo();
+            uint size = (uint)Marshal.SizeOf(typeof(PhysicsMethodInfo));
+            SphException.Check(Native.sph_physics_method_info_init_sized(ref value, size), "sph_physics_method_info_init_sized");
             return value;
         }
     }
@@ -1635,6 +1850,69 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_spring_params")]
         public static extern Result sph_world_get_spring_params(IntPtr world, IntPtr @out);
 
+        /// <summary>
+        /// Replaces the params struct of `kind` at once, as its typed set call does
+        /// (sph_world_set_params, sph_world_set_tait_params, ...): params points to that struct,
+        /// struct_size first. Errors: those of the typed call; UNSUPPORTED for an unknown kind.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_set_physics_params(WorldHandle world, ParamsKind kind, IntPtr @params);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_set_physics_params")]
+        public static extern Result sph_world_set_physics_params(IntPtr world, ParamsKind kind, IntPtr @params);
+
+        /// <summary>
+        /// Reads the params struct of `kind`, as its typed get call does; out-&gt;struct_size must be
+        /// set.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_get_physics_params(WorldHandle world, ParamsKind kind, IntPtr @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_physics_params")]
+        public static extern Result sph_world_get_physics_params(IntPtr world, ParamsKind kind, IntPtr @out);
+
+        /// <summary>sph_params_info_init_sized</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_params_info_init_sized(ref ParamsInfo info, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_params_info_init_sized")]
+        public static extern Result sph_params_info_init_sized(IntPtr info, uint size);
+
+        /// <summary>Describes the params struct of `kind`. UNSUPPORTED for an unknown kind.</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_params_get_info(ParamsKind kind, ref ParamsInfo @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_params_get_info")]
+        public static extern Result sph_params_get_info(ParamsKind kind, IntPtr @out);
+
+        /// <summary>sph_param_field_info_init_sized</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_param_field_info_init_sized(ref ParamFieldInfo info, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_param_field_info_init_sized")]
+        public static extern Result sph_param_field_info_init_sized(IntPtr info, uint size);
+
+        /// <summary>
+        /// Describes field `index` (0 .. field_count - 1, in the order of the struct) of the params
+        /// struct of `kind`. Cross-field rules (dt_max &gt;= dt_min; a spring link radius at most h)
+        /// are checked by the set calls only. UNSUPPORTED for an unknown kind, INVALID_ARGUMENT for an
+        /// index past the last field.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_params_get_field_info(ParamsKind kind, uint index, ref ParamFieldInfo @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_params_get_field_info")]
+        public static extern Result sph_params_get_field_info(ParamsKind kind, uint index, IntPtr @out);
+
+        /// <summary>sph_physics_method_info_init_sized</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_physics_method_info_init_sized(ref PhysicsMethodInfo info, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_physics_method_info_init_sized")]
+        public static extern Result sph_physics_method_info_init_sized(IntPtr info, uint size);
+
+        /// <summary>
+        /// Describes method `index` (0 .. method_count - 1; index 0 always exists and tells how many
+        /// there are). INVALID_ARGUMENT past the last one.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_get_physics_method_info(uint index, ref PhysicsMethodInfo @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_get_physics_method_info")]
+        public static extern Result sph_get_physics_method_info(uint index, IntPtr @out);
+
         /// <summary>sph_spawn_desc_init_sized</summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_spawn_desc_init_sized(ref SpawnDesc desc, uint size);
@@ -2120,6 +2398,9 @@ namespace Sph
             typeof(ClavetViscosityParams),
             typeof(TaitParams),
             typeof(SpringParams),
+            typeof(ParamsInfo),
+            typeof(ParamFieldInfo),
+            typeof(PhysicsMethodInfo),
             typeof(SpawnDesc),
             typeof(FillBoxDesc),
             typeof(FillSphereDesc),
@@ -2150,6 +2431,9 @@ namespace Sph
             "sph_clavet_viscosity_params",
             "sph_tait_params",
             "sph_spring_params",
+            "sph_params_info",
+            "sph_param_field_info",
+            "sph_physics_method_info",
             "sph_spawn_desc",
             "sph_fill_box_desc",
             "sph_fill_sphere_desc",
@@ -2180,6 +2464,9 @@ namespace Sph
             16,
             8,
             28,
+            32,
+            72,
+            32,
             40,
             44,
             36,
@@ -2256,6 +2543,31 @@ namespace Sph
             typeof(SpringParams),
             typeof(SpringParams),
             typeof(SpringParams),
+            typeof(ParamsInfo),
+            typeof(ParamsInfo),
+            typeof(ParamsInfo),
+            typeof(ParamsInfo),
+            typeof(ParamsInfo),
+            typeof(ParamsInfo),
+            typeof(ParamFieldInfo),
+            typeof(ParamFieldInfo),
+            typeof(ParamFieldInfo),
+            typeof(ParamFieldInfo),
+            typeof(ParamFieldInfo),
+            typeof(ParamFieldInfo),
+            typeof(ParamFieldInfo),
+            typeof(ParamFieldInfo),
+            typeof(ParamFieldInfo),
+            typeof(ParamFieldInfo),
+            typeof(ParamFieldInfo),
+            typeof(ParamFieldInfo),
+            typeof(PhysicsMethodInfo),
+            typeof(PhysicsMethodInfo),
+            typeof(PhysicsMethodInfo),
+            typeof(PhysicsMethodInfo),
+            typeof(PhysicsMethodInfo),
+            typeof(PhysicsMethodInfo),
+            typeof(PhysicsMethodInfo),
             typeof(SpawnDesc),
             typeof(SpawnDesc),
             typeof(SpawnDesc),
@@ -2426,6 +2738,31 @@ namespace Sph
             "Plasticity",
             "Damping",
             "Reserved0",
+            "StructSize",
+            "ParamsSize",
+            "FieldCount",
+            "Reserved0",
+            "Name",
+            "TypeName",
+            "StructSize",
+            "Offset",
+            "Type",
+            "Zero",
+            "LowerBound",
+            "UpperBound",
+            "Lower",
+            "Upper",
+            "DefaultValue",
+            "Reserved0",
+            "Name",
+            "Unit",
+            "StructSize",
+            "MethodCount",
+            "SwitchBy",
+            "Value",
+            "HasParams",
+            "ParamsKind",
+            "Name",
             "StructSize",
             "Count",
             "Positions",
@@ -2599,6 +2936,31 @@ namespace Sph
             0,
             4,
             8,
+            12,
+            16,
+            24,
+            0,
+            4,
+            8,
+            12,
+            16,
+            20,
+            24,
+            32,
+            40,
+            52,
+            56,
+            64,
+            0,
+            4,
+            8,
+            12,
+            16,
+            20,
+            24,
+            0,
+            4,
+            8,
             16,
             24,
             32,
@@ -2746,6 +3108,14 @@ namespace Sph
             "sph_spring_params_init_sized",
             "sph_world_set_spring_params",
             "sph_world_get_spring_params",
+            "sph_world_set_physics_params",
+            "sph_world_get_physics_params",
+            "sph_params_info_init_sized",
+            "sph_params_get_info",
+            "sph_param_field_info_init_sized",
+            "sph_params_get_field_info",
+            "sph_physics_method_info_init_sized",
+            "sph_get_physics_method_info",
             "sph_spawn_desc_init_sized",
             "sph_world_spawn",
             "sph_fill_box_desc_init_sized",
@@ -2891,6 +3261,14 @@ namespace Sph
             "sph",
             "sph",
             "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
             "sph_vdb",
             "sph_vdb",
         };
@@ -2940,6 +3318,24 @@ namespace Sph
             { "SPH_VISCOSITY_CLAVET", "radial impulses between approaching pairs (eq. 18-19), sph_clavet_viscosity_params" },
             { "SPH_EOS_IDEAL_GAS", "the thesis's modified ideal gas p = k (rho - rho0) (eq. 15)" },
             { "SPH_EOS_TAIT", "p = B ((rho / rho0)^7 - 1), B = rho0 c^2 / 7, sph_tait_params" },
+            { "SPH_PARAMS_WORLD", "sph_world_params" },
+            { "SPH_PARAMS_SURFACE_TENSION", "sph_surface_tension_params" },
+            { "SPH_PARAMS_CLAVET_VISCOSITY", "sph_clavet_viscosity_params" },
+            { "SPH_PARAMS_TAIT", "sph_tait_params" },
+            { "SPH_PARAMS_SPRINGS", "sph_spring_params" },
+            { "SPH_PARAM_FLOAT", "float, finite" },
+            { "SPH_PARAM_VEC3", "sph_vec3, every component finite" },
+            { "SPH_PARAM_UINT32", "uint32_t count" },
+            { "SPH_PARAM_FLAGS", "uint32_t bit set: only the bits of upper may be set" },
+            { "SPH_BOUND_NONE", "no bound on this side" },
+            { "SPH_BOUND_INCLUSIVE", "the value may equal it" },
+            { "SPH_BOUND_EXCLUSIVE", "the value must pass it" },
+            { "SPH_PARAM_ZERO_IS_VALUE", "0 is itself a value (no gravity, no damping)" },
+            { "SPH_PARAM_ZERO_IS_DEFAULT", "0 takes default_value" },
+            { "SPH_PARAM_ZERO_IS_DERIVED", "0 asks for a value derived from the world (see the field's doc)" },
+            { "SPH_METHOD_SWITCH_FEATURE", "a bit of sph_world_def.features (value)" },
+            { "SPH_METHOD_SWITCH_VISCOSITY", "sph_world_def.viscosity_method == value" },
+            { "SPH_METHOD_SWITCH_EQUATION_OF_STATE", "sph_world_def.equation_of_state == value" },
             { "SPH_MEMORY_HOST", "ordinary host memory" },
             { "SPH_MEMORY_CUDA_DEVICE", "device memory of the context's CUDA device (CUDA contexts only)" },
             { "SPH_SHAPE_PLANE", "solid below y = 0; half_extents.x/.z its size, .y its thickness" },

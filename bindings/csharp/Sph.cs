@@ -89,6 +89,45 @@ namespace Sph
             }
         }
 
+        /// <summary>Describes the params struct of <paramref name="kind"/> (sph_params_get_info):
+        /// its scene-file name, C type name, size and number of described fields.</summary>
+        public static ParamsInfo ParamsInfo(ParamsKind kind)
+        {
+            var info = Sph.ParamsInfo.Default();
+            SphException.Check(Native.sph_params_get_info(kind, ref info), "sph_params_get_info");
+            return info;
+        }
+
+        /// <summary>Every described field of the params struct of <paramref name="kind"/>, in
+        /// struct order (sph_params_get_field_info): name, offset, type, range, default, unit and
+        /// what a zero in it means.</summary>
+        public static ParamFieldInfo[] ParamFields(ParamsKind kind)
+        {
+            var fields = new ParamFieldInfo[ParamsInfo(kind).FieldCount];
+            for (uint i = 0; i < fields.Length; ++i)
+            {
+                fields[i] = ParamFieldInfo.Default();
+                SphException.Check(Native.sph_params_get_field_info(kind, i, ref fields[i]), "sph_params_get_field_info");
+            }
+            return fields;
+        }
+
+        /// <summary>Every physics method of the library (sph_get_physics_method_info): its name,
+        /// the WorldDef field that turns it on, and where its parameters are.</summary>
+        public static PhysicsMethodInfo[] PhysicsMethods()
+        {
+            var first = PhysicsMethodInfo.Default();
+            SphException.Check(Native.sph_get_physics_method_info(0, ref first), "sph_get_physics_method_info");
+            var methods = new PhysicsMethodInfo[first.MethodCount];
+            methods[0] = first;
+            for (uint i = 1; i < methods.Length; ++i)
+            {
+                methods[i] = PhysicsMethodInfo.Default();
+                SphException.Check(Native.sph_get_physics_method_info(i, ref methods[i]), "sph_get_physics_method_info");
+            }
+            return methods;
+        }
+
         /// <summary>Every struct whose Marshal.SizeOf or field offset differs from what the C
         /// compiler measured when the bindings were generated (empty when all match).</summary>
         public static List<string> LayoutProblems()
@@ -535,6 +574,37 @@ namespace Sph
                 return p;
             }
             set { SphException.Check(Native.sph_world_set_spring_params(Handle, ref value), "sph_world_set_spring_params"); }
+        }
+
+        /// <summary>The params struct of <paramref name="kind"/> (T must be its struct:
+        /// WorldParams for ParamsKind.World, TaitParams for ParamsKind.Tait, ...), read from the
+        /// world (sph_world_get_physics_params).</summary>
+        public T GetPhysicsParams<T>(ParamsKind kind) where T : struct
+        {
+            int size = Marshal.SizeOf(typeof(T));
+            IntPtr buffer = Marshal.AllocHGlobal(size);
+            try
+            {
+                for (int i = 0; i < size; ++i) Marshal.WriteByte(buffer, i, 0);
+                Marshal.WriteInt32(buffer, size);
+                SphException.Check(Native.sph_world_get_physics_params(Handle, kind, buffer), "sph_world_get_physics_params");
+                return (T)Marshal.PtrToStructure(buffer, typeof(T));
+            }
+            finally { Marshal.FreeHGlobal(buffer); }
+        }
+
+        /// <summary>Replaces the params struct of <paramref name="kind"/> with
+        /// <paramref name="value"/> (its struct, struct_size set), as its typed setter does
+        /// (sph_world_set_physics_params).</summary>
+        public void SetPhysicsParams<T>(ParamsKind kind, T value) where T : struct
+        {
+            IntPtr buffer = Marshal.AllocHGlobal(Marshal.SizeOf(typeof(T)));
+            try
+            {
+                Marshal.StructureToPtr(value, buffer, false);
+                SphException.Check(Native.sph_world_set_physics_params(Handle, kind, buffer), "sph_world_set_physics_params");
+            }
+            finally { Marshal.FreeHGlobal(buffer); }
         }
 
         // ---- particles in ---------------------------------------------------------------------

@@ -1,221 +1,188 @@
-// Parameters of optional physics: each option has its own struct, set and read whole, and is
-// refused with SPH_ERROR_FEATURE_DISABLED on a world that did not turn the option on.
-#include "../core/config.h"
+// Runtime parameters: the world's (sph_world_params) and each optional method's own struct, all
+// set and read whole through one path (params_binding.h): read the caller's struct, apply the
+// zero rule, validate against the methods' tables, install; and described to tools from the same
+// tables. An option's struct is refused with SPH_ERROR_FEATURE_DISABLED on a world that does not
+// run the method.
+#include <cstddef>
+
 #include "guard.h"
 #include "handles.h"
-#include "init_struct.h"
+#include "params_binding.h"
 #include "struct_io.h"
 #include "validate.h"
 
 using sph::Error;
 using sph::Status;
 
+namespace sph {
+
+// The params structs, indexed by sph_params_kind: for each, the methods whose fields it holds
+// and where each field lives (one line per method; physics/methods.h is the method list).
+const std::vector<ParamsBinding>& params_bindings() {
+#define SPH_AT(type, field) static_cast<uint32_t>(offsetof(type, field))
+  static const std::vector<ParamsBinding> table = {
+      ParamsBinding{
+          SPH_PARAMS_WORLD,
+          "world",
+          "sph_world_params",
+          sizeof(sph_world_params),
+          nullptr,
+          nullptr,
+          {part<Stepping>({SPH_AT(sph_world_params, max_substeps), SPH_AT(sph_world_params, gravity),
+                           SPH_AT(sph_world_params, step_factor), SPH_AT(sph_world_params, dt_min),
+                           SPH_AT(sph_world_params, dt_max), SPH_AT(sph_world_params, step_limits)}),
+           part<IdealGasEos>({SPH_AT(sph_world_params, stiffness)}),
+           part<MuellerViscosity>({SPH_AT(sph_world_params, viscosity)})},
+          {{"reserved0", SPH_AT(sph_world_params, reserved0)}}},
+      option<SurfaceTension, sph_surface_tension_params>(
+          SPH_PARAMS_SURFACE_TENSION, "sph_surface_tension_params", "SPH_FEATURE_SURFACE_TENSION",
+          {SPH_AT(sph_surface_tension_params, coefficient),
+           SPH_AT(sph_surface_tension_params, normal_threshold)},
+          {{"reserved0", SPH_AT(sph_surface_tension_params, reserved0)}}),
+      option<ClavetViscosity, sph_clavet_viscosity_params>(
+          SPH_PARAMS_CLAVET_VISCOSITY, "sph_clavet_viscosity_params", "SPH_VISCOSITY_CLAVET",
+          {SPH_AT(sph_clavet_viscosity_params, linear), SPH_AT(sph_clavet_viscosity_params, quadratic)},
+          {{"reserved0", SPH_AT(sph_clavet_viscosity_params, reserved0)}}),
+      option<TaitEos, sph_tait_params>(SPH_PARAMS_TAIT, "sph_tait_params", "SPH_EOS_TAIT",
+                                       {SPH_AT(sph_tait_params, speed_of_sound)}, {}),
+      option<Springs, sph_spring_params>(
+          SPH_PARAMS_SPRINGS, "sph_spring_params", "SPH_FEATURE_SPRINGS",
+          {SPH_AT(sph_spring_params, stiffness), SPH_AT(sph_spring_params, link_radius),
+           SPH_AT(sph_spring_params, yield_ratio), SPH_AT(sph_spring_params, plasticity),
+           SPH_AT(sph_spring_params, damping)},
+          {{"reserved0", SPH_AT(sph_spring_params, reserved0)}}),
+  };
+#undef SPH_AT
+  for (const ParamsBinding& b : table)
+    if (b.size > kMaxPublicParamsSize)
+      throw Error(Status::Internal, "params binding: a struct outgrew PublicParams");
+  return table;
+}
+
+}  // namespace sph
+
 namespace {
 
-void require_feature(bool enabled, const char* what) {
-  if (!enabled)
+void require_enabled(const sph::ParamsBinding& b, const sph_world* world) {
+  if (b.enabled && !b.enabled(world->world->config().selection()))
     throw Error(Status::FeatureDisabled,
-                std::string("world: ") + what + " is not enabled in its sph_world_def");
+                std::string("world: ") + b.requirement + " is not enabled in its sph_world_def");
 }
 
-bool has_surface_tension(const sph_world* w) {
-  return (w->world->config().features & sph::kFeatureSurfaceTension) != 0;
-}
-bool has_clavet(const sph_world* w) {
-  return w->world->config().viscosity_method == sph::ViscosityMethod::Clavet;
-}
-bool has_springs(const sph_world* w) { return (w->world->config().features & sph::kFeatureSprings) != 0; }
-bool has_tait(const sph_world* w) {
-  return w->world->config().equation_of_state == sph::EquationOfState::Tait;
+sph_result init_params(const char* function, sph_params_kind kind, void* user, uint32_t size) {
+  return sph::guarded(function, nullptr, [&] {
+    const sph::ParamsBinding& b = sph::params_binding(kind, "kind");
+    if (!user) throw Error(Status::InvalidArgument, "params: is NULL");
+    if (size < b.size)
+      throw Error(Status::VersionMismatch,
+                  "params: size " + std::to_string(size) + " is smaller than " + std::to_string(b.size));
+    const sph::PublicParams defaults = sph::public_params(b, sph::RuntimeParams{});
+    std::memset(user, 0, size);
+    std::memcpy(user, defaults.bytes, b.size);
+    std::memcpy(user, &size, sizeof size);
+    return SPH_OK;
+  });
 }
 
-// Applies a change to a copy of the world's runtime parameters and installs it.
-template <class Change>
-void update_params(sph_world* world, Change&& change) {
-  sph::RuntimeParams p = world->world->params();
-  change(p);
-  world->world->set_params(p);
+sph_result set_params(const char* function, sph_world* world, uint32_t kind, const void* params) {
+  return sph::guarded(function, sph::context_of(world), [&] {
+    sph::require_world(world);
+    sph::WorldLock lock(world);
+    const sph::ParamsBinding& b = sph::params_binding(kind, "kind");
+    require_enabled(b, world);
+    const sph::PublicParams bytes = sph::read_public_params(b, params, "params");
+    sph::RuntimeParams r = world->world->params();
+    sph::apply_public_params(b, bytes, world->world->config().shape(), "params", r);
+    world->world->set_params(r);
+    return SPH_OK;
+  });
+}
+
+sph_result get_params(const char* function, const sph_world* world, uint32_t kind, void* out) {
+  return sph::guarded(function, sph::context_of(world), [&] {
+    sph::require_world(world);
+    const sph::ParamsBinding& b = sph::params_binding(kind, "kind");
+    require_enabled(b, world);
+    if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
+    uint32_t size;
+    std::memcpy(&size, out, sizeof size);
+    if (size < sizeof(uint32_t) * 2)
+      throw Error(Status::VersionMismatch, "out->struct_size: " + std::to_string(size) +
+                                               " is too small; fill the struct with its _init() function");
+    const sph::PublicParams bytes = sph::public_params(b, world->world->params());
+    std::memcpy(out, bytes.bytes, size < b.size ? size : b.size);
+    std::memcpy(out, &size, sizeof size);
+    return SPH_OK;
+  });
 }
 
 }  // namespace
 
 extern "C" {
 
+SPH_API sph_result SPH_CALL sph_world_set_physics_params(sph_world* world, sph_params_kind kind,
+                                                         const void* params) {
+  return set_params("sph_world_set_physics_params", world, sph::enum_bits(kind), params);
+}
+SPH_API sph_result SPH_CALL sph_world_get_physics_params(const sph_world* world, sph_params_kind kind,
+                                                         void* out) {
+  return get_params("sph_world_get_physics_params", world, sph::enum_bits(kind), out);
+}
+
+SPH_API sph_result SPH_CALL sph_world_params_init_sized(sph_world_params* params, uint32_t size) {
+  return init_params("sph_world_params_init", SPH_PARAMS_WORLD, params, size);
+}
+SPH_API sph_result SPH_CALL sph_world_set_params(sph_world* world, const sph_world_params* params) {
+  return set_params("sph_world_set_params", world, SPH_PARAMS_WORLD, params);
+}
+SPH_API sph_result SPH_CALL sph_world_get_params(const sph_world* world, sph_world_params* out) {
+  return get_params("sph_world_get_params", world, SPH_PARAMS_WORLD, out);
+}
+
 SPH_API sph_result SPH_CALL sph_surface_tension_params_init_sized(sph_surface_tension_params* params,
                                                                   uint32_t size) {
-  return sph::init_user_struct("sph_surface_tension_params_init", "params", params, size,
-                               [](sph_surface_tension_params& d) {
-                                 const sph::RuntimeParams defaults;
-                                 d.coefficient = defaults.surface_tension;
-                                 d.normal_threshold = defaults.surface_threshold;
-                               });
+  return init_params("sph_surface_tension_params_init", SPH_PARAMS_SURFACE_TENSION, params, size);
 }
-
 SPH_API sph_result SPH_CALL sph_world_set_surface_tension_params(sph_world* world,
                                                                  const sph_surface_tension_params* params) {
-  return sph::guarded("sph_world_set_surface_tension_params", sph::context_of(world), [&] {
-    sph::require_world(world);
-    sph::WorldLock lock(world);
-    require_feature(has_surface_tension(world), "SPH_FEATURE_SURFACE_TENSION");
-    const sph_surface_tension_params p = sph::read_user_struct(params, "params");
-    sph::require_non_negative(p.coefficient, "params->coefficient");
-    sph::require_non_negative(p.normal_threshold, "params->normal_threshold");
-    sph::require_zero(p.reserved0, "params->reserved0");
-    update_params(world, [&](sph::RuntimeParams& r) {
-      r.surface_tension = p.coefficient;
-      r.surface_threshold = p.normal_threshold;
-    });
-    return SPH_OK;
-  });
+  return set_params("sph_world_set_surface_tension_params", world, SPH_PARAMS_SURFACE_TENSION, params);
 }
-
 SPH_API sph_result SPH_CALL sph_world_get_surface_tension_params(const sph_world* world,
                                                                  sph_surface_tension_params* out) {
-  return sph::guarded("sph_world_get_surface_tension_params", sph::context_of(world), [&] {
-    sph::require_world(world);
-    require_feature(has_surface_tension(world), "SPH_FEATURE_SURFACE_TENSION");
-    sph_surface_tension_params p;
-    std::memset(&p, 0, sizeof p);
-    p.struct_size = sizeof p;
-    p.coefficient = world->world->params().surface_tension;
-    p.normal_threshold = world->world->params().surface_threshold;
-    sph::write_output_struct(out, p, "out");
-    return SPH_OK;
-  });
+  return get_params("sph_world_get_surface_tension_params", world, SPH_PARAMS_SURFACE_TENSION, out);
 }
 
 SPH_API sph_result SPH_CALL sph_clavet_viscosity_params_init_sized(sph_clavet_viscosity_params* params,
                                                                    uint32_t size) {
-  return sph::init_user_struct("sph_clavet_viscosity_params_init", "params", params, size,
-                               [](sph_clavet_viscosity_params& d) {
-                                 const sph::RuntimeParams defaults;
-                                 d.linear = defaults.clavet_linear;
-                                 d.quadratic = defaults.clavet_quadratic;
-                               });
+  return init_params("sph_clavet_viscosity_params_init", SPH_PARAMS_CLAVET_VISCOSITY, params, size);
 }
-
 SPH_API sph_result SPH_CALL sph_world_set_clavet_viscosity_params(sph_world* world,
                                                                   const sph_clavet_viscosity_params* params) {
-  return sph::guarded("sph_world_set_clavet_viscosity_params", sph::context_of(world), [&] {
-    sph::require_world(world);
-    sph::WorldLock lock(world);
-    require_feature(has_clavet(world), "SPH_VISCOSITY_CLAVET");
-    const sph_clavet_viscosity_params p = sph::read_user_struct(params, "params");
-    sph::require_non_negative(p.linear, "params->linear");
-    sph::require_non_negative(p.quadratic, "params->quadratic");
-    sph::require_zero(p.reserved0, "params->reserved0");
-    update_params(world, [&](sph::RuntimeParams& r) {
-      r.clavet_linear = p.linear;
-      r.clavet_quadratic = p.quadratic;
-    });
-    return SPH_OK;
-  });
+  return set_params("sph_world_set_clavet_viscosity_params", world, SPH_PARAMS_CLAVET_VISCOSITY, params);
 }
-
 SPH_API sph_result SPH_CALL sph_world_get_clavet_viscosity_params(const sph_world* world,
                                                                   sph_clavet_viscosity_params* out) {
-  return sph::guarded("sph_world_get_clavet_viscosity_params", sph::context_of(world), [&] {
-    sph::require_world(world);
-    require_feature(has_clavet(world), "SPH_VISCOSITY_CLAVET");
-    sph_clavet_viscosity_params p;
-    std::memset(&p, 0, sizeof p);
-    p.struct_size = sizeof p;
-    p.linear = world->world->params().clavet_linear;
-    p.quadratic = world->world->params().clavet_quadratic;
-    sph::write_output_struct(out, p, "out");
-    return SPH_OK;
-  });
+  return get_params("sph_world_get_clavet_viscosity_params", world, SPH_PARAMS_CLAVET_VISCOSITY, out);
 }
 
 SPH_API sph_result SPH_CALL sph_tait_params_init_sized(sph_tait_params* params, uint32_t size) {
-  return sph::init_user_struct("sph_tait_params_init", "params", params, size, [](sph_tait_params& d) {
-    const sph::RuntimeParams defaults;
-    d.speed_of_sound = defaults.tait_sound_speed;
-  });
+  return init_params("sph_tait_params_init", SPH_PARAMS_TAIT, params, size);
 }
-
 SPH_API sph_result SPH_CALL sph_world_set_tait_params(sph_world* world, const sph_tait_params* params) {
-  return sph::guarded("sph_world_set_tait_params", sph::context_of(world), [&] {
-    sph::require_world(world);
-    sph::WorldLock lock(world);
-    require_feature(has_tait(world), "SPH_EOS_TAIT");
-    const sph_tait_params p = sph::read_user_struct(params, "params");
-    sph::require_positive(p.speed_of_sound, "params->speed_of_sound");
-    update_params(world, [&](sph::RuntimeParams& r) { r.tait_sound_speed = p.speed_of_sound; });
-    return SPH_OK;
-  });
+  return set_params("sph_world_set_tait_params", world, SPH_PARAMS_TAIT, params);
 }
-
 SPH_API sph_result SPH_CALL sph_world_get_tait_params(const sph_world* world, sph_tait_params* out) {
-  return sph::guarded("sph_world_get_tait_params", sph::context_of(world), [&] {
-    sph::require_world(world);
-    require_feature(has_tait(world), "SPH_EOS_TAIT");
-    sph_tait_params p;
-    std::memset(&p, 0, sizeof p);
-    p.struct_size = sizeof p;
-    p.speed_of_sound = world->world->params().tait_sound_speed;
-    sph::write_output_struct(out, p, "out");
-    return SPH_OK;
-  });
+  return get_params("sph_world_get_tait_params", world, SPH_PARAMS_TAIT, out);
 }
 
 SPH_API sph_result SPH_CALL sph_spring_params_init_sized(sph_spring_params* params, uint32_t size) {
-  return sph::init_user_struct("sph_spring_params_init", "params", params, size, [](sph_spring_params& d) {
-    const sph::RuntimeParams defaults;
-    d.stiffness = defaults.spring_stiffness;
-    d.link_radius = defaults.spring_link_radius;
-    d.yield_ratio = defaults.spring_yield_ratio;
-    d.plasticity = defaults.spring_plasticity;
-    d.damping = defaults.spring_damping;
-  });
+  return init_params("sph_spring_params_init", SPH_PARAMS_SPRINGS, params, size);
 }
-
 SPH_API sph_result SPH_CALL sph_world_set_spring_params(sph_world* world, const sph_spring_params* params) {
-  return sph::guarded("sph_world_set_spring_params", sph::context_of(world), [&] {
-    sph::require_world(world);
-    sph::WorldLock lock(world);
-    require_feature(has_springs(world), "SPH_FEATURE_SPRINGS");
-    const sph_spring_params p = sph::read_user_struct(params, "params");
-    sph::require_non_negative(p.stiffness, "params->stiffness");
-    sph::require_non_negative(p.link_radius, "params->link_radius");
-    const float h = world->world->config().kernel_radius;
-    if (p.link_radius > h)
-      throw Error(Status::InvalidArgument, "params->link_radius: " + sph::describe(p.link_radius) +
-                                               " m is above the kernel radius " + sph::describe(h) + " m");
-    sph::require_non_negative(p.yield_ratio, "params->yield_ratio");
-    if (p.yield_ratio > 1.0f)
-      throw Error(Status::InvalidArgument,
-                  "params->yield_ratio: must be in [0, 1], got " + sph::describe(p.yield_ratio));
-    sph::require_non_negative(p.plasticity, "params->plasticity");
-    sph::require_non_negative(p.damping, "params->damping");
-    sph::require_zero(p.reserved0, "params->reserved0");
-    update_params(world, [&](sph::RuntimeParams& r) {
-      r.spring_stiffness = p.stiffness;
-      r.spring_link_radius = p.link_radius;
-      r.spring_yield_ratio = p.yield_ratio;
-      r.spring_plasticity = p.plasticity;
-      r.spring_damping = p.damping;
-    });
-    return SPH_OK;
-  });
+  return set_params("sph_world_set_spring_params", world, SPH_PARAMS_SPRINGS, params);
 }
-
 SPH_API sph_result SPH_CALL sph_world_get_spring_params(const sph_world* world, sph_spring_params* out) {
-  return sph::guarded("sph_world_get_spring_params", sph::context_of(world), [&] {
-    sph::require_world(world);
-    require_feature(has_springs(world), "SPH_FEATURE_SPRINGS");
-    const sph::RuntimeParams& r = world->world->params();
-    sph_spring_params p;
-    std::memset(&p, 0, sizeof p);
-    p.struct_size = sizeof p;
-    p.stiffness = r.spring_stiffness;
-    p.link_radius = r.spring_link_radius;
-    p.yield_ratio = r.spring_yield_ratio;
-    p.plasticity = r.spring_plasticity;
-    p.damping = r.spring_damping;
-    sph::write_output_struct(out, p, "out");
-    return SPH_OK;
-  });
+  return get_params("sph_world_get_spring_params", world, SPH_PARAMS_SPRINGS, out);
 }
 
 }  // extern "C"

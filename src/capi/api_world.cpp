@@ -1,4 +1,4 @@
-// Worlds: creation from a def, runtime parameters.
+// Worlds: creation from a def (runtime parameters: api_physics_options.cpp).
 #include "../core/fcc_lattice.h"
 #include "../physics/kernels.h"
 #include "guard.h"
@@ -28,21 +28,6 @@ sph_world_def default_world_def() {
   return d;
 }
 
-sph_world_params default_world_params() {
-  const sph::RuntimeParams p;
-  sph_world_params out;
-  std::memset(&out, 0, sizeof out);
-  out.struct_size = sizeof out;
-  out.max_substeps = p.max_substeps;
-  out.gravity = sph_vec3{p.gravity.x, p.gravity.y, p.gravity.z};
-  out.stiffness = p.stiffness;
-  out.viscosity = p.viscosity;
-  out.step_factor = p.step_factor;
-  out.dt_min = p.dt_min;
-  out.dt_max = p.dt_max;
-  return out;
-}
-
 // Validates a def and resolves defaults into the internal configuration. Zero means default
 // for every field (a zeroed def, struct_size set, is the def sph_world_def_init gives).
 sph::WorldConfig config_from_def(const sph_world_def& def) {
@@ -67,12 +52,12 @@ sph::WorldConfig config_from_def(const sph_world_def& def) {
     throw Error(Status::Unsupported, "def->integrator: " + std::to_string(static_cast<int32_t>(integrator)) +
                                          " is not an sph_integrator value");
   const uint32_t viscosity = sph::enum_bits(d.viscosity_method);
-  if (viscosity != SPH_VISCOSITY_MUELLER && viscosity != SPH_VISCOSITY_CLAVET)
+  if (!sph::selects_a_method(sph::SwitchKind::Viscosity, viscosity))
     throw Error(Status::Unsupported,
                 "def->viscosity_method: " + std::to_string(static_cast<int32_t>(viscosity)) +
                     " is not an sph_viscosity_method value");
   const uint32_t eos = sph::enum_bits(d.equation_of_state);
-  if (eos != SPH_EOS_IDEAL_GAS && eos != SPH_EOS_TAIT)
+  if (!sph::selects_a_method(sph::SwitchKind::EquationOfState, eos))
     throw Error(Status::Unsupported, "def->equation_of_state: " + std::to_string(static_cast<int32_t>(eos)) +
                                          " is not an sph_equation_of_state value");
   sph::require_positive(d.particle_spacing, "def->particle_spacing");
@@ -115,36 +100,6 @@ sph::WorldConfig config_from_def(const sph_world_def& def) {
   return c;
 }
 
-// Validates public params and merges them into the current ones (module parameters are kept).
-sph::RuntimeParams params_from_public(const sph_world_params& p, const sph::RuntimeParams& current) {
-  sph::require_finite_vec3(p.gravity, "params->gravity");
-  sph::require_positive(p.stiffness, "params->stiffness");
-  sph::require_non_negative(p.viscosity, "params->viscosity");
-  sph::require_positive(p.step_factor, "params->step_factor");
-  if (p.step_factor > 10.0f)
-    throw Error(Status::InvalidArgument,
-                "params->step_factor: must be <= 10, got " + sph::describe(p.step_factor));
-  sph::require_positive(p.dt_min, "params->dt_min");
-  sph::require_positive(p.dt_max, "params->dt_max");
-  if (p.dt_max < p.dt_min)
-    throw Error(Status::InvalidArgument, "params->dt_max: " + sph::describe(p.dt_max) +
-                                             " is smaller than params->dt_min " + sph::describe(p.dt_min));
-  if (p.max_substeps == 0) throw Error(Status::InvalidArgument, "params->max_substeps: must be >= 1");
-  if (p.step_limits & ~static_cast<uint32_t>(sph::kStepLimitAll))
-    throw Error(Status::Unsupported, "params->step_limits: unknown bits");
-  sph::require_zero(p.reserved0, "params->reserved0");
-  sph::RuntimeParams r = current;
-  r.gravity = sph::Vec3{p.gravity.x, p.gravity.y, p.gravity.z};
-  r.stiffness = p.stiffness;
-  r.viscosity = p.viscosity;
-  r.step_factor = p.step_factor;
-  r.dt_min = p.dt_min;
-  r.dt_max = p.dt_max;
-  r.max_substeps = p.max_substeps;
-  r.step_limits = p.step_limits;
-  return r;
-}
-
 }  // namespace
 
 extern "C" {
@@ -153,14 +108,6 @@ SPH_API sph_result SPH_CALL sph_world_def_init_sized(sph_world_def* def, uint32_
   return sph::guarded("sph_world_def_init", nullptr, [&] {
     sph::require_init_size(def, size, "def");
     sph::write_user_struct(def, size, default_world_def());
-    return SPH_OK;
-  });
-}
-
-SPH_API sph_result SPH_CALL sph_world_params_init_sized(sph_world_params* params, uint32_t size) {
-  return sph::guarded("sph_world_params_init", nullptr, [&] {
-    sph::require_init_size(params, size, "params");
-    sph::write_user_struct(params, size, default_world_params());
     return SPH_OK;
   });
 }
@@ -227,35 +174,6 @@ SPH_API sph_result SPH_CALL sph_world_get_particle_mass(const sph_world* world, 
     sph::require_world(world);
     if (!out_mass) throw Error(Status::InvalidArgument, "out_mass: is NULL");
     *out_mass = world->world->config().particle_mass;
-    return SPH_OK;
-  });
-}
-
-SPH_API sph_result SPH_CALL sph_world_set_params(sph_world* world, const sph_world_params* params) {
-  return sph::guarded("sph_world_set_params", sph::context_of(world), [&] {
-    sph::require_world(world);
-    sph::WorldLock lock(world);
-    const sph::RuntimeParams p =
-        params_from_public(sph::read_user_struct(params, "params"), world->world->params());
-    world->world->set_params(p);
-    return SPH_OK;
-  });
-}
-
-SPH_API sph_result SPH_CALL sph_world_get_params(const sph_world* world, sph_world_params* out) {
-  return sph::guarded("sph_world_get_params", sph::context_of(world), [&] {
-    sph::require_world(world);
-    const sph::RuntimeParams& p = world->world->params();
-    sph_world_params o = default_world_params();
-    o.max_substeps = p.max_substeps;
-    o.gravity = sph_vec3{p.gravity.x, p.gravity.y, p.gravity.z};
-    o.stiffness = p.stiffness;
-    o.viscosity = p.viscosity;
-    o.step_factor = p.step_factor;
-    o.dt_min = p.dt_min;
-    o.dt_max = p.dt_max;
-    o.step_limits = p.step_limits;
-    sph::write_output_struct(out, o, "out");
     return SPH_OK;
   });
 }

@@ -1,5 +1,6 @@
 // The checkpoint layout shared by the writer and the reader (docs/checkpoint.md). All numbers
-// little-endian; floats IEEE 754. Version 1:
+// little-endian; floats IEEE 754. Version 2 (version 1 differs only in the parameters section,
+// checkpoint_params.h; both load):
 //   header (48 bytes): magic[8] "SPHCKPT\x1a", u32 format version, u32 flags (0), u32 writer
 //     backend, u32 writer library version, u64 payload size, u64 checksum, u32 section count,
 //     u32 reserved (0). The checksum is FNV-1a 64 over the header with the checksum field
@@ -15,7 +16,8 @@ namespace sph {
 namespace checkpoint {
 
 constexpr uint8_t kMagic[8] = {'S', 'P', 'H', 'C', 'K', 'P', 'T', 0x1a};
-constexpr uint32_t kFormatVersion = 1;
+constexpr uint32_t kFormatVersion = 2;          // what the writer writes
+constexpr uint32_t kOldestReadableVersion = 1;  // the oldest the reader still loads
 constexpr size_t kHeaderSize = 48;
 constexpr size_t kChecksumOffset = 32;
 constexpr size_t kSectionHeaderSize = 16;
@@ -32,7 +34,7 @@ struct SectionInfo {
   const char* name;
 };
 
-// Every section, in the only order version 1 accepts.
+// Every section, in the only order the format accepts.
 constexpr SectionInfo kSectionOrder[] = {
     {tag('C', 'O', 'N', 'F'), "world definition"},
     {tag('P', 'A', 'R', 'M'), "parameters"},

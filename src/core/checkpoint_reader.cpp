@@ -13,6 +13,7 @@
 #include "byte_io.h"
 #include "checkpoint.h"
 #include "checkpoint_format.h"
+#include "checkpoint_params.h"
 #include "fcc_lattice.h"
 #include "field_error.h"
 #include "pose_rules.h"
@@ -62,6 +63,14 @@ uint32_t below(ByteReader& r, uint32_t limit, const std::string& name) {
   const uint32_t v = r.u32();
   if (v >= limit)
     corrupt(r.what() + ": " + name + " is " + std::to_string(v) + ", not below " + std::to_string(limit));
+  return v;
+}
+
+// A value of a world-def field that selects one method of the list (physics/methods.h).
+uint32_t method(ByteReader& r, SwitchKind kind, const std::string& name) {
+  const uint32_t v = r.u32();
+  if (!selects_a_method(kind, v))
+    corrupt(r.what() + ": " + name + " is " + std::to_string(v) + ", no method of this library");
   return v;
 }
 
@@ -131,8 +140,9 @@ WorldConfig read_config(ByteReader& r) {
   if (c.features & ~static_cast<uint32_t>(kFeatureAll))
     corrupt(r.what() + ": unknown feature bits " + hex32(c.features));
   c.integrator = static_cast<Integrator>(below(r, 2, "integrator"));
-  c.viscosity_method = static_cast<ViscosityMethod>(below(r, 2, "viscosity method"));
-  c.equation_of_state = static_cast<EquationOfState>(below(r, 2, "equation of state"));
+  c.viscosity_method = static_cast<ViscosityMethod>(method(r, SwitchKind::Viscosity, "viscosity method"));
+  c.equation_of_state =
+      static_cast<EquationOfState>(method(r, SwitchKind::EquationOfState, "equation of state"));
   c.particle_spacing = positive(r, "particle spacing");
   c.kernel_radius = positive(r, "kernel radius");
   c.rest_density = positive(r, "rest density");
@@ -150,39 +160,6 @@ WorldConfig read_config(ByteReader& r) {
     corrupt(r.what() + ": the particle mass " + std::to_string(c.particle_mass) +
             " does not fit the spacing and kernel radius (no positive density self term)");
   return c;
-}
-
-RuntimeParams read_params(ByteReader& r) {
-  RuntimeParams p;
-  p.gravity = vec3(r, "gravity");
-  p.stiffness = positive(r, "stiffness");
-  p.viscosity = non_negative(r, "viscosity");
-  p.step_factor = positive(r, "step factor");
-  if (p.step_factor > 10.0f) corrupt(r.what() + ": step factor is above 10");
-  p.dt_min = positive(r, "dt_min");
-  p.dt_max = positive(r, "dt_max");
-  if (p.dt_max < p.dt_min) corrupt(r.what() + ": dt_max is smaller than dt_min");
-  p.max_substeps = r.u32();
-  if (p.max_substeps == 0) corrupt(r.what() + ": max_substeps is 0");
-  p.step_limits = r.u32();
-  if (p.step_limits & ~static_cast<uint32_t>(kStepLimitAll)) corrupt(r.what() + ": unknown step-limit bits");
-  p.surface_tension = non_negative(r, "surface tension");
-  p.surface_threshold = non_negative(r, "surface threshold");
-  p.clavet_linear = non_negative(r, "Clavet linear coefficient");
-  p.clavet_quadratic = non_negative(r, "Clavet quadratic coefficient");
-  p.tait_sound_speed = positive(r, "Tait speed of sound");
-  return p;
-}
-
-// SPH_FEATURE_SPRINGS worlds only (checkpoint_writer.cpp), with the C layer's ranges.
-void read_spring_params(ByteReader& r, const WorldConfig& config, RuntimeParams& p) {
-  p.spring_stiffness = non_negative(r, "spring stiffness");
-  p.spring_link_radius = non_negative(r, "spring link radius");
-  if (p.spring_link_radius > config.kernel_radius) corrupt(r.what() + ": spring link radius is above h");
-  p.spring_yield_ratio = non_negative(r, "spring yield ratio");
-  if (p.spring_yield_ratio > 1.0f) corrupt(r.what() + ": spring yield ratio is above 1");
-  p.spring_plasticity = non_negative(r, "spring plasticity");
-  p.spring_damping = non_negative(r, "spring damping");
 }
 
 // The spring lists: every partner an index of another particle, every rest length in
@@ -511,10 +488,10 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   if (std::memcmp(data, kMagic, sizeof kMagic) != 0) corrupt("not a checkpoint (wrong magic bytes)");
   ByteReader h(data + sizeof kMagic, kHeaderSize - sizeof kMagic, "header");
   const uint32_t version = h.u32();
-  if (version != kFormatVersion)
-    throw Error(Status::VersionMismatch, "checkpoint: format version " + std::to_string(version) +
-                                             "; this library reads version " +
-                                             std::to_string(kFormatVersion));
+  if (version < kOldestReadableVersion || version > kFormatVersion)
+    throw Error(Status::VersionMismatch,
+                "checkpoint: format version " + std::to_string(version) + "; this library reads versions " +
+                    std::to_string(kOldestReadableVersion) + " to " + std::to_string(kFormatVersion));
   const uint32_t flags = h.u32();
   h.u32();  // writer backend: informational
   h.u32();  // writer library version: informational
@@ -535,7 +512,8 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   if (flags != 0) corrupt("unknown flags " + hex32(flags));
   if (reserved != 0) corrupt("a reserved header field is not 0");
   if (section_count != kSectionCount)
-    corrupt(std::to_string(section_count) + " sections; version 1 has " + std::to_string(kSectionCount));
+    corrupt(std::to_string(section_count) + " sections; version " + std::to_string(version) + " has " +
+            std::to_string(kSectionCount));
 
   ByteReader payload(data + kHeaderSize, static_cast<size_t>(payload_size), "payload");
   auto next_section = [&](uint32_t k) {
@@ -557,8 +535,7 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   const WorldConfig config = read_config(conf);
   conf.expect_end();
   ByteReader parm = next_section(1);
-  RuntimeParams params = read_params(parm);
-  if (config.features & kFeatureSprings) read_spring_params(parm, config, params);
+  const RuntimeParams params = version == 1 ? read_params_v1(parm, config) : read_params(parm, config);
   parm.expect_end();
   // A dt_min above the stability ceiling is accepted, as sph_world_set_params accepts it (the
   // caller's fixed step wins over the ceiling; a step that then fails says so and rolls back).

@@ -4,6 +4,7 @@
 #include "byte_io.h"
 #include "checkpoint.h"
 #include "checkpoint_format.h"
+#include "checkpoint_params.h"
 
 namespace sph {
 namespace {
@@ -67,33 +68,8 @@ void write_config(ByteWriter& w, const WorldConfig& c) {
   w.f32(c.particle_mass);
 }
 
-void write_params(ByteWriter& w, const RuntimeParams& p) {
-  write_vec3(w, p.gravity);
-  w.f32(p.stiffness);
-  w.f32(p.viscosity);
-  w.f32(p.step_factor);
-  w.f32(p.dt_min);
-  w.f32(p.dt_max);
-  w.u32(p.max_substeps);
-  w.u32(p.step_limits);
-  w.f32(p.surface_tension);
-  w.f32(p.surface_threshold);
-  w.f32(p.clavet_linear);
-  w.f32(p.clavet_quadratic);
-  w.f32(p.tait_sound_speed);
-}
-
-// SPH_FEATURE_SPRINGS worlds only: their parameters after the others, and after the particles
-// the lowest id still waiting for springs and each particle's spring slots (partner storage
-// index or 0xffffffff, rest length). A world without springs writes the format as before.
-void write_spring_params(ByteWriter& w, const RuntimeParams& p) {
-  w.f32(p.spring_stiffness);
-  w.f32(p.spring_link_radius);
-  w.f32(p.spring_yield_ratio);
-  w.f32(p.spring_plasticity);
-  w.f32(p.spring_damping);
-}
-
+// SPH_FEATURE_SPRINGS worlds only, after the particles: the lowest id still waiting for springs
+// and each particle's spring slots (partner storage index or 0xffffffff, rest length).
 void write_springs(ByteWriter& w, const ParticleSnapshot& s) {
   const std::vector<uint32_t> link_from = s.carried_as<uint32_t>(kArraySpringLinkFrom);
   w.u32(link_from.empty() ? kNoPendingLinks : link_from[0]);
@@ -103,11 +79,6 @@ void write_springs(ByteWriter& w, const ParticleSnapshot& s) {
       w.u32(list.partner[k]);
       w.f32(list.rest[k]);
     }
-}
-
-void write_params_section(ByteWriter& w, const World& world) {
-  write_params(w, world.params());
-  if (world.config().features & kFeatureSprings) write_spring_params(w, world.params());
 }
 
 void write_clock(ByteWriter& w, const World& world) {
@@ -219,7 +190,7 @@ std::vector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin
   w.u32(0);
 
   section(w, kSectionOrder[0].tag, [&] { write_config(w, world.config()); });
-  section(w, kSectionOrder[1].tag, [&] { write_params_section(w, world); });
+  section(w, kSectionOrder[1].tag, [&] { write_params(w, world.params()); });
   section(w, kSectionOrder[2].tag, [&] { write_clock(w, world); });
   section(w, kSectionOrder[3].tag, [&] { write_particle_section(w, world, particles); });
   section(w, kSectionOrder[4].tag, [&] {

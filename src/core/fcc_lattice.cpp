@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "../physics/kernels.h"
-#include "../physics/surface_tension_cohesion.h"
+#include "../physics/surface_tension.h"
 
 namespace sph {
 namespace {
@@ -137,32 +137,24 @@ std::vector<Vec3> fcc_points_in_sphere(Vec3 center, float radius, float spacing)
 
 float fcc_rest_mass(float spacing, float kernel_radius, float rest_density) {
   const double step = half_cell(spacing);
-  const double h = kernel_radius;
-  const double h2 = h * h;
-  const double poly6 = 315.0 / (64.0 * 3.14159265358979323846 * std::pow(h, 9.0));
+  const KernelCoefficientsOf<double> k = make_kernel_coefficients<double>(kernel_radius);
   double sum = 0.0;
-  for_each_lattice_point_within(step, h, [&](int64_t, int64_t, int64_t, double r2) {
-    const double d = h2 - r2;
-    sum += poly6 * d * d * d;
-  });
+  for_each_lattice_point_within(step, k.h,
+                                [&](int64_t, int64_t, int64_t, double r2) { sum += poly6(k, r2); });
   return static_cast<float>(rest_density / sum);
 }
 
 float fcc_spiky_scale(float spacing, float kernel_radius) {
-  const double pi = 3.14159265358979323846;
   const double step = half_cell(spacing);
-  const double h = kernel_radius;
-  const double h2 = h * h;
-  const double poly6 = 315.0 / (64.0 * pi * std::pow(h, 9.0));
-  const double spiky_grad = 45.0 / (pi * std::pow(h, 6.0));
+  const KernelCoefficientsOf<double> k = make_kernel_coefficients<double>(kernel_radius);
   double w_sum = 0.0;   // sum W_poly6: 1 / (rest volume m / rho0), as fcc_rest_mass
   double moment = 0.0;  // sum x_j |dW_spiky/dx| along x over the neighbours
-  for_each_lattice_point_within(step, h, [&](int64_t i, int64_t, int64_t, double r2) {
-    w_sum += poly6 * (h2 - r2) * (h2 - r2) * (h2 - r2);
+  for_each_lattice_point_within(step, k.h, [&](int64_t i, int64_t, int64_t, double r2) {
+    w_sum += poly6(k, r2);
     if (r2 == 0.0) return;
     const double r = std::sqrt(r2);
     const double x = step * static_cast<double>(i);
-    moment += spiky_grad * (h - r) * (h - r) * x * x / r;
+    moment += -spiky_gradient_magnitude(k, r) * x * x / r;
   });
   return static_cast<float>(w_sum / moment);
 }
@@ -170,31 +162,27 @@ float fcc_spiky_scale(float spacing, float kernel_radius) {
 float fcc_density_self_weight(float spacing, float kernel_radius, float rest_density, float mass,
                               float spiky_scale) {
   const double step = half_cell(spacing);
-  const double h = kernel_radius;
-  const double spiky = spiky_scale * 15.0 / (3.14159265358979323846 * std::pow(h, 6.0));
+  KernelCoefficientsOf<double> k = make_kernel_coefficients<double>(kernel_radius);
+  k.spiky *= spiky_scale;  // as the world's float coefficients (FluidConstants)
   double sum = 0.0;
-  for_each_lattice_point_within(step, h, [&](int64_t, int64_t, int64_t, double r2) {
+  for_each_lattice_point_within(step, k.h, [&](int64_t, int64_t, int64_t, double r2) {
     if (r2 == 0.0) return;  // the self term is what this returns
-    const double d = h - std::sqrt(r2);
-    sum += spiky * d * d * d;
+    sum += spiky_value(k, std::sqrt(r2));
   });
   return static_cast<float>(static_cast<double>(rest_density) / mass - sum);
 }
 
 double fcc_surface_delta_integral(float spacing, float kernel_radius, float threshold) {
-  const double pi = 3.14159265358979323846;
   const double step = half_cell(spacing);
-  const double h = kernel_radius;
-  const double h2 = h * h;
-  const double poly6 = 315.0 / (64.0 * pi * std::pow(h, 9.0));
-  const double poly6_grad = -945.0 / (32.0 * pi * std::pow(h, 9.0));
+  const KernelCoefficientsOf<double> k = make_kernel_coefficients<double>(kernel_radius);
+  const double h = k.h;
+  const double h2 = k.h2;
   const double cell_volume = 2.0 * step * step * step;  // volume per lattice point
   const int64_t reach = static_cast<int64_t>(std::ceil(h / step)) + 1;
   // Rest volume m / rho0 = 1 / sum_lattice W (fcc_rest_mass).
   double w_sum = 0.0;
-  for_each_lattice_point_within(step, h, [&](int64_t, int64_t, int64_t, double r2) {
-    w_sum += poly6 * (h2 - r2) * (h2 - r2) * (h2 - r2);
-  });
+  for_each_lattice_point_within(step, h,
+                                [&](int64_t, int64_t, int64_t, double r2) { w_sum += poly6(k, r2); });
   const double volume = 1.0 / w_sum;
   double total = 0.0;
   for (const auto& f : kFccFaces) {
@@ -209,7 +197,7 @@ double fcc_surface_delta_integral(float spacing, float kernel_radius, float thre
       // Colour gradient at that point from the fluid half-space u . q <= 0.
       double g[3] = {0.0, 0.0, 0.0};
       for_each_half_space_point_near(f, best, reach, step, h2, [&](const double d[3], double r2) {
-        const double c = poly6_grad * (h2 - r2) * (h2 - r2) * volume;
+        const double c = poly6_gradient_factor(k, r2) * volume;
         for (int a = 0; a < 3; ++a) g[a] += c * d[a];
       });
       const double length = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
@@ -224,12 +212,8 @@ namespace {
 
 // C(r) with its coefficient 32 / (pi h^9), in double.
 double cohesion_c(double h, double r) {
-  const double pi = 3.14159265358979323846;
   if (r <= 0.0 || r >= h) return 0.0;
-  const double d = h - r;
-  const double p = d * d * d * r * r * r;
-  const double shape = 2.0 * r > h ? p : 2.0 * p - std::pow(h, 6.0) / 64.0;
-  return 32.0 / (pi * std::pow(h, 9.0)) * shape;
+  return cohesion_coefficient(h, 1.0) * cohesion_spline(h, r);
 }
 
 // Phi(r) = int_r^h C: 4-point Gauss-Legendre on each polynomial piece (degree 6, exact).

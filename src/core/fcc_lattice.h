@@ -52,7 +52,7 @@ float fcc_spiky_scale(float spacing, float kernel_radius);
 // Averaged over the (100), (110) and (111) faces (they differ by about 5 %).
 double fcc_surface_delta_integral(float spacing, float kernel_radius, float threshold);
 
-// Surface tension's cohesion (surface_tension_cohesion.h) on the FCC lattice at `spacing`, per
+// Surface tension's cohesion (physics/surface_tension.h) on the FCC lattice at `spacing`, per
 // unit gamma m^2 (so both scale with the world's gamma and particle mass):
 // - surface_energy: half the work, per unit area, to pull two lattice half-spaces apart along a
 //   lattice plane, sum_{i in A, j in B} Phi(r_ij) / (2 area) with Phi(r) = int_r^h C, i.e. the

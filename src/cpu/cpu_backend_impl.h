@@ -63,15 +63,16 @@ class CpuBackend final : public Backend {
   // Hash, sort, reorder every attribute, then density and pressure (packed into the w slots).
   void sort_and_density(const FluidConstants& fluid, FrameReport& report);
 
-  // Acceleration of particle i: the neighbour gather with the world's options compiled in,
-  // plus the scene's force fields.
-  template <bool kSurfaceTension, ViscosityMethod kViscosity>
-  static Vec3 acceleration_with(const FluidConstants& fluid, const GridView& view, const Float4* pos,
-                                const Float4* vel, const uint32_t* counts, const Float4* normals,
+  // Acceleration of particle i: the neighbour gather with the world's force terms compiled in
+  // (forces.h), plus the scene's force fields.
+  template <class Terms>
+  static Vec3 acceleration_with(const FluidConstants& fluid, const GridView& view, const ForceInputs& in,
                                 const SceneFrame& scene, uint32_t i);
-  using AccelerationFn = Vec3 (*)(const FluidConstants&, const GridView&, const Float4*, const Float4*,
-                                  const uint32_t*, const Float4*, const SceneFrame&, uint32_t);
+  using AccelerationFn = Vec3 (*)(const FluidConstants&, const GridView&, const ForceInputs&, const SceneFrame&,
+                                  uint32_t);
   AccelerationFn acceleration_function() const;
+  // The arrays the force gather reads (normals and counts only where a term reads them).
+  ForceInputs force_inputs() const;
 
   // Resolves colliders for the state in next_position_/next_velocity_, moved from x_old(i).
   template <class OldPosition>

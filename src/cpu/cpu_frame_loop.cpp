@@ -23,7 +23,7 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
   const float saved_max_speed = max_speed_;
   const bool saved_max_speed_valid = max_speed_valid_;
   const float saved_max_acceleration = max_acceleration_;
-  spring_constants_ = make_spring_constants(config_, params);
+  spring_constants_ = fluid.methods.springs;
   if (!max_speed_valid_) max_speed_ = compute_max_speed();
 
   // Puts the particles back as they were before the frame: on a non-finite state and on any
@@ -40,7 +40,7 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
   SubstepClock clock;
   start_clock(clock, frame_dt);
   try {
-    while (clock_running(clock, params.max_substeps)) {
+    while (clock_running(clock, params.stepping.max_substeps)) {
       pick_next_step(clock, frame_dt, limits, std::max(max_speed_, scene.max_collider_speed),
                      max_acceleration_);
       fluid.dt = clock.dt_float;

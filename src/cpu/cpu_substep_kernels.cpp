@@ -3,7 +3,7 @@
 // with the world's options compiled in (the twin of cuda/substep_kernels.cu).
 #include "../physics/density.h"
 #include "../physics/density_normalization.h"
-#include "../physics/surface_normal.h"
+#include "../physics/surface_tension.h"
 #include "cpu_backend_impl.h"
 
 namespace sph {
@@ -31,7 +31,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, FrameReport& repo
     density_[i] = rho;
     neighbors_[i] = s.neighbor_count;
     // Only the w slots are written; neighbours read x, y, z alone.
-    pos[i].w = pressure_from_density(fluid.eos, rho);
+    pos[i].w = pressure_from_density(fluid.methods.eos, rho);
     vel[i].w = 1.0f / rho;
   }
   if (factor) {
@@ -46,7 +46,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, FrameReport& repo
 #pragma omp parallel for num_threads(threads()) schedule(static)
     for (int i = 0; i < n(); ++i) {
       density_[i] = normalized_[i];
-      pos[i].w = pressure_from_density(fluid.eos, normalized_[i]);
+      pos[i].w = pressure_from_density(fluid.methods.eos, normalized_[i]);
       vel[i].w = 1.0f / normalized_[i];
     }
   }
@@ -59,24 +59,23 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, FrameReport& repo
   report.stage_ms[kStageDensity] += static_cast<float>(elapsed_ms(t));
 }
 
-// Acceleration of particle i: the neighbour gather with the world's options compiled in,
-// plus the scene's force fields.
-template <bool kSurfaceTension, ViscosityMethod kViscosity>
-Vec3 CpuBackend::acceleration_with(const FluidConstants& fluid, const GridView& view, const Float4* pos,
-                                   const Float4* vel, const uint32_t* counts, const Float4* normals,
+// Acceleration of particle i: the neighbour gather with the world's force terms compiled in
+// (forces.h), plus the scene's force fields.
+template <class Terms>
+Vec3 CpuBackend::acceleration_with(const FluidConstants& fluid, const GridView& view, const ForceInputs& in,
                                    const SceneFrame& scene, uint32_t i) {
-  Vec3 a = gather_acceleration_with<kSurfaceTension, kViscosity>(fluid, view, pos, vel, counts, normals, i);
-  for (const ForceFieldFrame& f : scene.fields) a += force_field_acceleration(f.view, xyz(pos[i]));
+  Vec3 a = gather_acceleration<Terms>(fluid, view, in, i);
+  for (const ForceFieldFrame& f : scene.fields) a += force_field_acceleration(f.view, xyz(in.positions[i]));
   return a;
 }
 
 CpuBackend::AccelerationFn CpuBackend::acceleration_function() const {
-  const bool surface = (config_.features & kFeatureSurfaceTension) != 0;
-  if (config_.viscosity_method == ViscosityMethod::Clavet)
-    return surface ? &acceleration_with<true, ViscosityMethod::Clavet>
-                   : &acceleration_with<false, ViscosityMethod::Clavet>;
-  return surface ? &acceleration_with<true, ViscosityMethod::Mueller>
-                 : &acceleration_with<false, ViscosityMethod::Mueller>;
+  return with_force_terms(config_.selection(),
+                          [](auto terms) -> AccelerationFn { return &acceleration_with<decltype(terms)>; });
+}
+
+ForceInputs CpuBackend::force_inputs() const {
+  return ForceInputs{position_.data(), velocity_.data(), neighbors_.data(), normals_.data()};
 }
 
 }  // namespace sph

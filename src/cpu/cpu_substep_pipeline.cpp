@@ -42,12 +42,11 @@ uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame
   const Float4* spring = spring_acceleration_.data();
   const float dt = time.dt;
   const AccelerationFn acceleration = acceleration_function();
-  const uint32_t* counts = neighbors_.data();
-  const Float4* normals = normals_.data();
+  const ForceInputs inputs = force_inputs();
   float a2max = 0.0f;
 #pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
   for (int i = 0; i < n(); ++i) {
-    Vec3 a = acceleration(fluid, view, pos, vel, counts, normals, scene, static_cast<uint32_t>(i));
+    Vec3 a = acceleration(fluid, view, inputs, scene, static_cast<uint32_t>(i));
     if (spring) a += xyz(spring[i]);
     a2max = std::max(a2max, length_squared(a));
     const ParticleState s = symplectic_euler({xyz(pos[i]), xyz(vel[i])}, a, dt);
@@ -85,13 +84,12 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
     const Float4* pos = position_.data();
     const Float4* vel = velocity_.data();
     const Float4* spring = spring_acceleration_.data();
-    const uint32_t* counts = neighbors_.data();
-    const Float4* normals = normals_.data();
+    const ForceInputs inputs = force_inputs();
     const ParticleState* start = rk4_start_.data();
     Rk4Accumulator* sums = rk4_sum_.data();
 #pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
     for (int i = 0; i < n(); ++i) {
-      Vec3 a = acceleration(fluid, view, pos, vel, counts, normals, scene, static_cast<uint32_t>(i));
+      Vec3 a = acceleration(fluid, view, inputs, scene, static_cast<uint32_t>(i));
       if (spring) a += xyz(spring[i]);
       a2max = std::max(a2max, length_squared(a));
       const ParticleState s = rk4_advance(stage, start[i], {xyz(pos[i]), xyz(vel[i])}, a, dt, sums[i]);

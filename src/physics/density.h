@@ -16,9 +16,8 @@
 
 #include <stdint.h>
 
-#include "equation_of_state.h"
 #include "float4_types.h"
-#include "fluid_constants.h"
+#include "fluid_base.h"
 #include "neighbor_walk.h"
 
 namespace sph {
@@ -29,7 +28,7 @@ struct DensitySample {
 };
 
 // positions: sorted particle records (xyz used, w ignored). Returns rho_i for particle i.
-SPH_HD DensitySample gather_density(const FluidConstants& f, const GridView& grid, const Float4* positions,
+SPH_HD DensitySample gather_density(const FluidBase& f, const GridView& grid, const Float4* positions,
                                     uint32_t i) {
   const Vec3 xi = xyz(positions[i]);
   float sum = 0.0f;

@@ -39,10 +39,18 @@
 #include <limits>
 
 #include "float4_types.h"
-#include "fluid_constants.h"
+#include "fluid_base.h"
 #include "neighbor_walk.h"
+#include "param_table.h"
 
 namespace sph {
+
+struct NormalizedDensity {
+  static constexpr const char* kName = "normalized_density";
+  // g_i is state; the plain kernel sum, then the filtered density, a per-pass side array.
+  static constexpr ParticleArrayDecl kArrays[] = {{"density_factor", 4, ArrayLifetime::State},
+                                                  {"normalized_density", 4, ArrayLifetime::Scratch}};
+};
 
 // The factor of a particle that has not had a density pass yet (set on the host, at append).
 inline float fresh_density_factor() { return std::numeric_limits<float>::quiet_NaN(); }
@@ -51,13 +59,13 @@ SPH_HD bool is_fresh_density_factor(float factor) { return factor != factor; }
 
 // rho_i = g_i * summed, resolving a fresh particle's factor first (written back). summed > 0:
 // it includes the particle's own m W(0).
-SPH_HD float carried_density(const FluidConstants& f, float summed, float& factor) {
+SPH_HD float carried_density(const FluidBase& f, float summed, float& factor) {
   if (is_fresh_density_factor(factor)) factor = summed < f.rest_density ? f.rest_density / summed : 1.0f;
   return summed * factor;
 }
 
 // Eq. 31 over the carried densities (velocities[j].w = 1 / rho_j), self included.
-SPH_HD float gather_normalized_density(const FluidConstants& f, const GridView& grid, const Float4* positions,
+SPH_HD float gather_normalized_density(const FluidBase& f, const GridView& grid, const Float4* positions,
                                        const Float4* velocities, uint32_t i) {
   const Vec3 xi = xyz(positions[i]);
   float mass_sum = 0.0f;

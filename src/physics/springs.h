@@ -25,7 +25,9 @@
 #include "float4_types.h"
 #include "host_device.h"
 #include "neighbor_walk.h"
+#include "param_table.h"
 #include "vec3.h"
+#include "world_shape.h"
 
 namespace sph {
 
@@ -186,13 +188,14 @@ SPH_HD Vec3 spring_acceleration(const SpringConstants& c, const Float4* position
   return a;
 }
 
-// The explicit scheme's limits for springs, as stability_ceiling() (step_control.h) for the
-// fluid: dt <= 0.5 / sqrt(kSpringSlots k) for the stiffness (a particle with kSpringSlots
-// springs has its fastest mode at omega^2 <= 2 kSpringSlots k by Gershgorin, (1 - L/h) <= 1,
-// and symplectic Euler needs omega dt < 2) and dt <= 2 / (kSpringSlots c) for the damping.
-// Measured on a free blob with random velocities (fixed steps, 4000 of them; docs/physics.md):
-// stiffness alone is stable at 2x its limit and blows up at 2.5x; damping alone is stable at
-// 2x its limit and blows up at 3x. So both leave a margin of 2. 0 when springs impose none.
+// The explicit scheme's limits for springs, as the fluid's stability ceilings (pressure_force.h,
+// viscosity_mueller.h): dt <= 0.5 / sqrt(kSpringSlots k) for the stiffness (a particle with
+// kSpringSlots springs has its fastest mode at omega^2 <= 2 kSpringSlots k by Gershgorin,
+// (1 - L/h) <= 1, and symplectic Euler needs omega dt < 2) and dt <= 2 / (kSpringSlots c) for the
+// damping. Measured on a free blob with random velocities (fixed steps, 4000 of them;
+// docs/physics.md): stiffness alone is stable at 2x its limit and blows up at 2.5x; damping alone
+// is stable at 2x its limit and blows up at 3x. So both leave a margin of 2. 0 when springs
+// impose none.
 constexpr float kSpringStabilityFactor = 0.5f;
 constexpr float kSpringDampingStabilityFactor = 2.0f;
 
@@ -205,5 +208,62 @@ SPH_HD float spring_stability_ceiling(float stiffness, float damping) {
   }
   return dt;
 }
+
+// The method (SPH_FEATURE_SPRINGS): its parameters, constants, arrays and step ceiling.
+struct Springs {
+  static constexpr const char* kName = "springs";
+
+  struct Params {
+    float stiffness = 1e4f;    // k, 1/s^2
+    float link_radius = 0.0f;  // m; 0 = 1.2 x particle spacing, at most h
+    float yield_ratio = 0.1f;  // gamma
+    float plasticity = 0.0f;   // alpha, 1/s; 0 = elastic
+    float damping = 0.0f;      // c, 1/s
+  };
+  static constexpr ParamField<Params> kFields[] = {
+      real_field("stiffness", &Params::stiffness, at_least(0.0), ZeroMeans::Value, "1/s^2"),
+      real_field("link_radius", &Params::link_radius, at_least(0.0), ZeroMeans::Derived, "m"),
+      real_field("yield_ratio", &Params::yield_ratio, within(0.0, 1.0), ZeroMeans::Value, ""),
+      real_field("plasticity", &Params::plasticity, at_least(0.0), ZeroMeans::Value, "1/s"),
+      real_field("damping", &Params::damping, at_least(0.0), ZeroMeans::Value, "1/s"),
+  };
+  static bool check(const Params& p, const WorldShape& s, ParamConflict& out) {
+    if (p.link_radius > s.kernel_radius) {
+      out = ParamConflict{"link_radius", p.link_radius, "m is above the kernel radius", nullptr,
+                          s.kernel_radius};
+      return false;
+    }
+    return true;
+  }
+
+  using Constants = SpringConstants;
+  // The link radius a world uses: the parameter, or 1.2 particle spacings (the FCC lattice's
+  // nearest neighbours only), never more than h.
+  static float link_radius(const Params& p, const WorldShape& s) {
+    const float r = p.link_radius > 0.0f ? p.link_radius : 1.2f * s.particle_spacing;
+    return r < s.kernel_radius ? r : s.kernel_radius;
+  }
+  static Constants make_constants(const Params& p, const WorldShape& s) {
+    Constants c;
+    c.stiffness = p.stiffness;
+    c.damping = p.damping;
+    c.yield_ratio = p.yield_ratio;
+    c.plasticity = p.plasticity;
+    const float link = link_radius(p, s);
+    c.link_radius_sq = link * link;
+    c.kernel_radius = s.kernel_radius;
+    c.inv_kernel_radius = 1.0f / s.kernel_radius;
+    return c;
+  }
+  static float stability_ceiling(const Params& p) { return spring_stability_ceiling(p.stiffness, p.damping); }
+
+  // The lists are state; the link candidates and the evaluation's accelerations (a Vec3; the
+  // device keeps it in a Float4 for aligned loads) are rebuilt by each spring pass.
+  static constexpr ParticleArrayDecl kArrays[] = {
+      {"spring_lists", sizeof(SpringList), ArrayLifetime::State},
+      {"spring_candidates", kSpringSlots * sizeof(uint32_t), ArrayLifetime::Scratch},
+      {"spring_acceleration", sizeof(Vec3), ArrayLifetime::Scratch},
+  };
+};
 
 }  // namespace sph

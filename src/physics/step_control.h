@@ -5,9 +5,44 @@
 #include <stdint.h>
 
 #include "host_device.h"
+#include "param_table.h"
 #include "vec3.h"
+#include "world_shape.h"
 
 namespace sph {
+
+// Step-size limits beyond eq. 32, equal to the SPH_STEP_LIMIT_* values.
+enum StepLimitBits : uint32_t { kStepLimitAcoustic = 1u << 0, kStepLimitForce = 1u << 1, kStepLimitAll = 3u };
+
+// The world's own runtime parameters (the rest of sph_world_params belongs to the equation of
+// state and the viscosity): gravity, and how substeps are chosen.
+struct Stepping {
+  static constexpr const char* kName = "stepping";
+
+  struct Params {
+    Vec3 gravity{0.0f, -9.81f, 0.0f};  // m/s^2
+    float step_factor = 0.4f;          // lambda of dt = lambda h / v_max
+    float dt_min = 1e-6f;              // s
+    float dt_max = 1e-3f;              // s
+    uint32_t max_substeps = 10000;     // per frame
+    uint32_t step_limits = 0;          // StepLimitBits
+  };
+  static constexpr ParamField<Params> kFields[] = {
+      count_field("max_substeps", &Params::max_substeps, at_least(1.0), ZeroMeans::Default),
+      vector_field("gravity", &Params::gravity, ZeroMeans::Value, "m/s^2"),
+      real_field("step_factor", &Params::step_factor, above_up_to(0.0, 10.0), ZeroMeans::Default, ""),
+      real_field("dt_min", &Params::dt_min, above(0.0), ZeroMeans::Default, "s"),
+      real_field("dt_max", &Params::dt_max, above(0.0), ZeroMeans::Default, "s"),
+      bits_field("step_limits", &Params::step_limits, kStepLimitAll),
+  };
+  static bool check(const Params& p, const WorldShape&, ParamConflict& out) {
+    if (p.dt_max < p.dt_min) {
+      out = ParamConflict{"dt_max", p.dt_max, "is smaller than", "dt_min", p.dt_min};
+      return false;
+    }
+    return true;
+  }
+};
 
 struct StepLimits {
   float step_factor;  // lambda
@@ -16,29 +51,8 @@ struct StepLimits {
   float dt_max;
   float sound_speed;         // > 0: the acoustic limit dt <= lambda h / c applies
   uint32_t use_force_limit;  // the force limit dt <= lambda sqrt(h / |a|_max) applies
-  float stability_dt;        // > 0: the ceiling of stability_ceiling(), applied whatever dt_max says
+  float stability_dt;        // > 0: the methods' stability ceiling (methods.h), whatever dt_max says
 };
-
-// The explicit scheme's hard stability limits, which hold whatever dt_max and lambda are:
-// - acoustic: dt <= 0.4 h / c. A pressure wave must not cross more than a fraction of a kernel
-//   radius per step; measured on a dam break (tests/extremes), fixed steps of 1 h/c stay
-//   bounded and 2 h/c blow up (energy x1000), so 0.4 leaves a margin of 2.5.
-// - viscous (Mueller's Laplacian, kinematic viscosity nu = mu / rho0): dt <= 0.05 h^2 / nu, the
-//   explicit diffusion limit; measured, 0.1 h^2 / nu is stable and 0.15 blows up, so 0.05
-//   leaves a margin of 2.
-// sound_speed or kinematic_viscosity 0 drops that limit; both 0 gives 0 (no ceiling).
-constexpr float kAcousticStabilityFactor = 0.4f;
-constexpr float kViscousStabilityFactor = 0.05f;
-
-SPH_HD float stability_ceiling(float kernel_radius, float sound_speed, float kinematic_viscosity) {
-  float dt = 0.0f;
-  if (sound_speed > 0.0f) dt = kAcousticStabilityFactor * kernel_radius / sound_speed;
-  if (kinematic_viscosity > 0.0f) {
-    const float viscous = kViscousStabilityFactor * kernel_radius * kernel_radius / kinematic_viscosity;
-    if (dt == 0.0f || viscous < dt) dt = viscous;
-  }
-  return dt;
-}
 
 // dt = lambda h / v_max (eq. 32), with the acoustic and force limits where asked for and the
 // stability ceiling always, clamped to [dt_min, dt_max]; v_max = 0 and no other limit gives

@@ -74,12 +74,26 @@ void test_scene_errors_exit_3(void**) {
   cli_test::write_text(bad, "{\"world\": }");
   assert_int_equal(run({bad, "--out", dir + "/out"}, &out), 3);
   assert_true(contains(out, "not valid JSON: parse error at line 1"));
+  // A parameter the library refuses: a scene error at the field's path, with its rule.
+  cli_test::write_text(
+      bad, R"({"world": {"equation_of_state": "tait"}, "physics": {"tait": {"speed_of_sound": -1}}})");
+  assert_int_equal(run({bad, "--out", dir + "/out", "--backend", "cpu"}, &out), 3);
+  assert_true(contains(out, "physics.tait.speed_of_sound: must be > 0, got -1"));
   // Rejected by the library while building: still a scene error, at the object's path.
   cli_test::write_text(
       bad,
       R"({"world": {"capacity": 10}, "fluids": [{"type": "sphere", "center": [0,0,0], "radius": 0.2}]})");
   assert_int_equal(run({bad, "--out", dir + "/out", "--backend", "cpu"}, &out), 3);
   assert_true(contains(out, "fluids[0]: the fluid body does not fit"));
+}
+
+// A scene that turns every physics option on and sets their parameters runs (exit 0).
+void test_options_scene_runs(void**) {
+  const std::string dir = cli_test::make_temp_dir("options");
+  std::string out;
+  assert_int_equal(run({g_scenes + "/options.json", "--backend", "cpu", "--frames", "2", "--out", dir}, &out),
+                   0);
+  assert_true(contains(out, "2 frames"));
 }
 
 // CUDA asked for where there is none (a CPU-only build, or no GPU) is a clean error with its
@@ -181,6 +195,7 @@ int main(int argc, char** argv) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_usage_errors_exit_2),
       cmocka_unit_test(test_scene_errors_exit_3),
+      cmocka_unit_test(test_options_scene_runs),
       cmocka_unit_test(test_cuda_without_gpu_exits_4),
       cmocka_unit_test(test_missing_outputs_exit_5),
       cmocka_unit_test(test_interrupt_keeps_only_complete_frames),

@@ -41,9 +41,31 @@ const Case kCases[] = {
     {R"({"version": 2})", "version: expected an integer in [1, 1], got 2"},
     {R"({"params": {"gravity": [0, -9.81]}})", "params.gravity: expected an array of 3 numbers [x, y, z]"},
     {R"({"params": {"gravity": [0, "down", 0]}})", "params.gravity[1]: expected a number"},
-    {R"({"params": {"dt_min": 0.001, "dt_max": 0.0001}})",
-     "params.dt_max: expected a step >= dt_min (0.001)"},
-    {R"({"params": {"viscosity": -1}})", "params.viscosity: expected a number >= 0, got -1"},
+    {R"({"params": {"viscosity": "thick"}})",
+     "params.viscosity: expected a number, got the string \"thick\""},
+    {R"({"params": {"max_substeps": -1}})", "params.max_substeps: expected an integer >= 0, got -1"},
+    {R"({"params": {"surface_tension": 0.07}})",
+     "params.surface_tension: unknown field; params takes max_substeps, gravity, stiffness, viscosity, "
+     "step_factor, "
+     "dt_min, dt_max, step_limits"},
+    {R"({"world": {"features": ["surface_tension", "foam"]}})",
+     "world.features[1]: expected \"surface_tension\", \"normalized_density\" or \"springs\", got the string "
+     "\"foam\""},
+    {R"({"world": {"features": "springs"}})", "world.features: expected a list of feature names (an array)"},
+    {R"({"world": {"viscosity_method": "xsph"}})",
+     "world.viscosity_method: expected \"mueller\" or \"clavet\""},
+    {R"({"world": {"equation_of_state": 7}})",
+     "world.equation_of_state: expected \"ideal_gas\" or \"tait\", got 7"},
+    {R"({"physics": {"tait": {"speed_of_sound": 20}}})",
+     "physics.tait: the world does not use tait (set world.equation_of_state to \"tait\")"},
+    {R"({"physics": {"springs": {}}})",
+     "physics.springs: the world does not use springs (add \"springs\" to world.features)"},
+    {R"({"physics": {"foam": {}}})",
+     "physics.foam: unknown field; physics takes surface_tension, clavet, tait, springs (and \"comment\")"},
+    {R"({"world": {"equation_of_state": "tait"}, "physics": {"tait": {"speed": 20}}})",
+     "physics.tait.speed: unknown field; tait takes speed_of_sound (and \"comment\")"},
+    {R"({"world": {"features": ["springs"]}, "physics": {"springs": {"stiffness": "hard"}}})",
+     "physics.springs.stiffness: expected a number, got the string \"hard\""},
     {R"({"time": {"fps": 0}})", "time.fps: expected a positive number, got 0"},
     {R"({"fluids": {"type": "box"}})", "fluids: expected a list of fluid bodies (an array), got an object"},
     {R"({"fluids": [{"type": "cube"}]})",
@@ -155,6 +177,17 @@ void test_library_rejections_name_the_object(void**) {
                          "fluids": [{"type": "sphere", "center": [0, 0, 0], "radius": 0.1},
                                     {"type": "sphere", "center": [1, 0, 0], "radius": 0.1, "time": 0.02}]})",
                      "fluids[1]: the fluid body does not fit");
+  // Parameters: the library's rules and messages, at the field's path in the file.
+  expect_build_error(R"({"params": {"viscosity": -1}})", "params.viscosity: must be >= 0, got -1");
+  expect_build_error(R"({"params": {"dt_min": 0.001, "dt_max": 0.0001}})",
+                     "params.dt_max: 0.0001 is smaller than params.dt_min 0.001");
+  expect_build_error(R"({"params": {"step_factor": 11}})", "params.step_factor: must be in (0, 10], got 11");
+  expect_build_error(
+      R"({"world": {"equation_of_state": "tait"}, "physics": {"tait": {"speed_of_sound": -5}}})",
+      "physics.tait.speed_of_sound: must be > 0, got -5");
+  expect_build_error(R"({"world": {"features": ["springs"], "particle_spacing": 0.02},
+                         "physics": {"springs": {"link_radius": 0.5}}})",
+                     "physics.springs.link_radius: 0.5 m is above the kernel radius 0.036");
   expect_build_error(
       R"({"colliders": [{"shape": {"type": "box", "half_extents": [100, 100, 100], "voxel_size": 0.001}}]})",
       "colliders[0].shape: the library rejected the shape: ");
@@ -165,6 +198,52 @@ void test_library_rejections_name_the_object(void**) {
   expect_build_error(R"({"colliders": [{"shape": {"type": "vdb", "file": "no_such_file.vdb"}}]})",
                      "colliders[0].shape.type: \"vdb\" shapes need tools built with OpenVDB");
 #endif
+}
+
+// The physics section sets the methods' parameters by the C structs' field names; the fields
+// the file leaves out keep their defaults (tests/cli/scenes/options.json).
+void test_physics_section_sets_the_methods(void**) {
+  sph_context_def def;
+  sph_context_def_init(&def);
+  def.backend = SPH_BACKEND_CPU;
+  def.cpu_worker_count = 1;
+  sph_context* context = nullptr;
+  assert_int_equal(sph_context_create(&def, &context), SPH_OK);
+  {
+    const sph_tools::SceneDesc scene = sph_tools::load_scene_file(CLI_SCENES_DIR "/options.json");
+    sph_tools::SceneRuntime runtime(scene, context);
+    sph_world* w = runtime.world();
+    sph_world_def d;
+    sph_world_def_init(&d);
+    assert_int_equal(sph_world_get_def(w, &d), SPH_OK);
+    assert_int_equal(d.features,
+                     SPH_FEATURE_SURFACE_TENSION | SPH_FEATURE_NORMALIZED_DENSITY | SPH_FEATURE_SPRINGS);
+    assert_int_equal(d.viscosity_method, SPH_VISCOSITY_CLAVET);
+    assert_int_equal(d.equation_of_state, SPH_EOS_TAIT);
+    sph_world_params p;
+    sph_world_params_init(&p);
+    assert_int_equal(sph_world_get_params(w, &p), SPH_OK);
+    assert_true(p.dt_max == 0.001f && p.step_limits == 3u && p.stiffness == 100.0f);  // stiffness: default
+    sph_surface_tension_params st;
+    sph_surface_tension_params_init(&st);
+    assert_int_equal(sph_world_get_surface_tension_params(w, &st), SPH_OK);
+    assert_true(st.coefficient == 0.05f && st.normal_threshold == 0.0f);
+    sph_clavet_viscosity_params cv;
+    sph_clavet_viscosity_params_init(&cv);
+    assert_int_equal(sph_world_get_clavet_viscosity_params(w, &cv), SPH_OK);
+    assert_true(cv.linear == 12.0f && cv.quadratic == 0.5f);
+    sph_tait_params tait;
+    sph_tait_params_init(&tait);
+    assert_int_equal(sph_world_get_tait_params(w, &tait), SPH_OK);
+    assert_true(tait.speed_of_sound == 20.0f);
+    sph_spring_params sp;
+    sph_spring_params_init(&sp);
+    assert_int_equal(sph_world_get_spring_params(w, &sp), SPH_OK);
+    assert_true(sp.stiffness == 2000.0f && sp.yield_ratio == 0.2f && sp.plasticity == 1.5f &&
+                sp.damping == 3.0f && sp.link_radius == 0.0f);
+    assert_int_equal(runtime.step_frame(), SPH_OK);
+  }
+  assert_int_equal(sph_context_destroy(context), SPH_OK);
 }
 
 void test_missing_file_is_a_scene_error(void**) {
@@ -183,6 +262,7 @@ int main() {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_each_bad_field_names_its_path),
       cmocka_unit_test(test_library_rejections_name_the_object),
+      cmocka_unit_test(test_physics_section_sets_the_methods),
       cmocka_unit_test(test_missing_file_is_a_scene_error),
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);

@@ -772,10 +772,10 @@ static void test_wrong_magic_future_version_and_trailing_bytes(void** state) {
   assert_non_null(strstr(g_message, "magic"));
 
   memcpy(d->scratch, d->checkpoint, (size_t)d->size);
-  d->scratch[8] = 2; /* format version 2, resealed: a file from a later library */
+  d->scratch[8] = 3; /* format version 3, resealed: a file from a later library */
   reseal(d->scratch, (size_t)d->size);
   expect_refused(d, d->scratch, d->size, SPH_ERROR_VERSION_MISMATCH, "future version", 8);
-  assert_non_null(strstr(g_message, "version 2"));
+  assert_non_null(strstr(g_message, "version 3"));
 
   memcpy(d->scratch, d->checkpoint, (size_t)d->size);
   d->scratch[d->size] = 0;

@@ -10,7 +10,7 @@
  * - disturbed: random start velocities of up to 1 mm/s, so that every term works: the kinetic
  *   energy must decay and the radius stay within 2 %. Its interior density is reported.
  * - disturbed_density (a known issue): the same run with the density bounds. The equation of
- *   state has no tension (equation_of_state.h), so every local compression of the disturbance
+ *   state has no tension (methods.h), so every local compression of the disturbance
  *   pushes particles apart and nothing pulls them back: the ball swells until its interior sits
  *   about 2.4 % below rho0, while its kinetic energy decays. That is the model (a fluid without
  *   cohesion), not a numerical fault; BENCHMARK.md's "moving" run at +-0.1 m/s disperses the

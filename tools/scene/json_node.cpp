@@ -42,19 +42,31 @@ void JsonNode::fail(const std::string& expected) const {
 }
 
 void JsonNode::expect_object(const char* what, std::initializer_list<const char*> allowed) const {
+  expect_object(what, std::vector<std::string>(allowed.begin(), allowed.end()));
+}
+
+void JsonNode::expect_object(const char* what, const std::vector<std::string>& allowed) const {
   if (missing() || !value_->is_object()) fail(std::string(what) + " (an object)");
   for (auto it = value_->begin(); it != value_->end(); ++it) {
     if (it.key() == "comment") continue;
     bool known = false;
-    for (const char* key : allowed) known = known || it.key() == key;
+    for (const std::string& key : allowed) known = known || it.key() == key;
     if (!known) {
       std::string list;
-      for (const char* key : allowed) list += std::string(list.empty() ? "" : ", ") + key;
+      for (const std::string& key : allowed) list += (list.empty() ? "" : ", ") + key;
       const std::string child = path_.empty() ? it.key() : path_ + "." + it.key();
       throw SceneError(child,
                        "unknown field; " + std::string(what) + " takes " + list + " (and \"comment\")");
     }
   }
+}
+
+std::vector<std::string> JsonNode::keys() const {
+  std::vector<std::string> out;
+  if (missing() || !value_->is_object()) return out;
+  for (auto it = value_->begin(); it != value_->end(); ++it)
+    if (it.key() != "comment") out.push_back(it.key());
+  return out;
 }
 
 bool JsonNode::has(const char* key) const {
@@ -129,19 +141,20 @@ std::string JsonNode::string() const {
 }
 
 size_t JsonNode::choice(std::initializer_list<const char*> choices) const {
+  return choice(std::vector<std::string>(choices.begin(), choices.end()));
+}
+
+size_t JsonNode::choice(const std::vector<std::string>& choices) const {
   std::string list;
   size_t n = 0;
-  for (const char* c : choices) {
+  for (const std::string& c : choices) {
     list += std::string(n == 0 ? "" : n + 1 == choices.size() ? " or " : ", ") + "\"" + c + "\"";
     ++n;
   }
   if (missing() || !value_->is_string()) fail(list);
   const std::string s = value_->get<std::string>();
-  size_t i = 0;
-  for (const char* c : choices) {
-    if (s == c) return i;
-    ++i;
-  }
+  for (size_t i = 0; i < choices.size(); ++i)
+    if (s == choices[i]) return i;
   fail(list);
 }
 

@@ -29,6 +29,9 @@ class JsonNode {
   // An object whose keys are all in `allowed` ("comment" is always allowed). `what` names the
   // object in the error ("a collider").
   void expect_object(const char* what, std::initializer_list<const char*> allowed) const;
+  void expect_object(const char* what, const std::vector<std::string>& allowed) const;
+  // The keys of an object, in the file's order ("comment" left out).
+  std::vector<std::string> keys() const;
   bool has(const char* key) const;
   JsonNode operator[](const char* key) const;  // a missing child when absent
   // An array (of any length when min == 0); its elements are index(i).
@@ -45,6 +48,7 @@ class JsonNode {
   std::string string() const;
   // One of `choices`; returns its index.
   size_t choice(std::initializer_list<const char*> choices) const;
+  size_t choice(const std::vector<std::string>& choices) const;
   sph_vec3 vec3() const;
   sph_vec3 direction() const;  // a vec3 that is not zero
 

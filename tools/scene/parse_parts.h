@@ -22,6 +22,16 @@ ShapeDesc parse_shape(const JsonNode& node, const std::string& base_dir);
 
 void parse_world(const JsonNode& node, sph_world_def* def);
 void parse_params(const JsonNode& node, sph_world_params* params);
+// "physics": {"<method>": {"<field>": value, ...}, ...} for the methods the world turns on.
+std::vector<PhysicsDesc> parse_physics(const JsonNode& node, const sph_world_def& world);
+// The fields of a params struct of `kind` that the object gives, written into `bytes` (a
+// struct of that kind); `what` names the object in errors. Types only: the library checks
+// ranges when the world is built.
+void parse_params_fields(const JsonNode& node, sph_params_kind kind, const char* what, unsigned char* bytes);
+// A method's name for a sph_world_def field that selects one (world.viscosity_method,
+// world.equation_of_state), and a list of feature names (world.features).
+uint32_t parse_method(const JsonNode& node, sph_method_switch field);
+uint32_t parse_features(const JsonNode& node);
 void parse_time(const JsonNode& node, SceneDesc* scene);
 FluidDesc parse_fluid(const JsonNode& node);
 ColliderDesc parse_collider(const JsonNode& node, const std::string& base_dir);

@@ -1,4 +1,5 @@
-// The world (creation-time settings), its runtime parameters and the run's timing.
+// The world (creation-time settings and the methods it runs), its runtime parameters and the
+// run's timing.
 #include <limits>
 
 #include "parse_parts.h"
@@ -8,8 +9,8 @@ namespace sph_tools {
 void parse_world(const JsonNode& node, sph_world_def* def) {
   sph_world_def_init(def);
   if (node.missing()) return;
-  node.expect_object("world",
-                     {"capacity", "particle_spacing", "kernel_radius", "rest_density", "integrator"});
+  node.expect_object("world", {"capacity", "particle_spacing", "kernel_radius", "rest_density", "integrator",
+                               "features", "viscosity_method", "equation_of_state"});
   def->capacity = node["capacity"].opt_count(def->capacity, 1, std::numeric_limits<uint32_t>::max());
   def->particle_spacing = node["particle_spacing"].opt_positive(def->particle_spacing);
   def->kernel_radius = node["kernel_radius"].opt_positive(def->kernel_radius);
@@ -20,27 +21,21 @@ void parse_world(const JsonNode& node, sph_world_def* def) {
     def->integrator = node["integrator"].choice({"symplectic_euler", "rk4"}) == 0
                           ? SPH_INTEGRATOR_SYMPLECTIC_EULER
                           : SPH_INTEGRATOR_RK4;
+  if (!node["features"].missing()) def->features = parse_features(node["features"]);
+  if (!node["viscosity_method"].missing())
+    def->viscosity_method = static_cast<sph_viscosity_method>(
+        parse_method(node["viscosity_method"], SPH_METHOD_SWITCH_VISCOSITY));
+  if (!node["equation_of_state"].missing())
+    def->equation_of_state = static_cast<sph_equation_of_state>(
+        parse_method(node["equation_of_state"], SPH_METHOD_SWITCH_EQUATION_OF_STATE));
 }
 
+// The world's runtime parameters: the fields of sph_world_params by the library's description
+// of them; the library checks their values when the world is built.
 void parse_params(const JsonNode& node, sph_world_params* p) {
   sph_world_params_init(p);
   if (node.missing()) return;
-  node.expect_object(
-      "params", {"gravity", "stiffness", "viscosity", "step_factor", "dt_min", "dt_max", "max_substeps"});
-  p->gravity = node["gravity"].opt_vec3(p->gravity);
-  p->stiffness = node["stiffness"].opt_positive(p->stiffness);
-  p->viscosity = node["viscosity"].opt_non_negative(p->viscosity);
-  if (!node["step_factor"].missing()) {
-    p->step_factor = node["step_factor"].positive();
-    if (p->step_factor > 10.0f) node["step_factor"].fail("a number in (0, 10]");
-  }
-  p->dt_min = node["dt_min"].opt_positive(p->dt_min);
-  p->dt_max = node["dt_max"].opt_positive(p->dt_max);
-  if (p->dt_max < p->dt_min) {
-    if (node.has("dt_max")) node["dt_max"].fail("a step >= dt_min (" + number_text(p->dt_min) + ")");
-    node["dt_min"].fail("a step <= dt_max (" + number_text(p->dt_max) + ")");
-  }
-  p->max_substeps = node["max_substeps"].opt_count(p->max_substeps, 1, std::numeric_limits<uint32_t>::max());
+  parse_params_fields(node, SPH_PARAMS_WORLD, "params", reinterpret_cast<unsigned char*>(p));
 }
 
 void parse_time(const JsonNode& node, SceneDesc* scene) {

@@ -87,6 +87,15 @@ struct ForceFieldDesc {
   std::string path;
 };
 
+// The parameters of one physics method as the file sets them ("physics": {"tait": {...}}): a
+// whole params struct of the library, the fields the file does not give at their defaults
+// (from the library's description of the struct, sph_params_get_field_info).
+struct PhysicsDesc {
+  sph_params_kind kind = SPH_PARAMS_WORLD;
+  std::vector<unsigned char> bytes;  // the struct, struct_size first
+  std::string path;                  // "physics.tait"
+};
+
 enum class OutputFormat { kVdb, kPly, kCsv };
 
 struct CameraDesc {
@@ -114,6 +123,7 @@ struct SceneDesc {
   std::string name, description;
   sph_world_def world{};
   sph_world_params params{};
+  std::vector<PhysicsDesc> physics;  // in the file's order
   uint32_t frames = 120;
   float fps = 60.0f;
   std::vector<FluidDesc> fluids;

@@ -93,13 +93,14 @@ SceneDesc parse_scene(const std::string& text, const std::string& base_dir) {
   SceneDesc scene;
   scene.base_dir = base_dir;
   const JsonNode top(&root, "");
-  top.expect_object("a scene", {"version", "name", "description", "world", "params", "time", "fluids",
-                                "colliders", "sources", "sinks", "force_fields", "output"});
+  top.expect_object("a scene", {"version", "name", "description", "world", "params", "physics", "time",
+                                "fluids", "colliders", "sources", "sinks", "force_fields", "output"});
   if (!top["version"].missing()) top["version"].count(1, 1);
   scene.name = top["name"].opt_string("");
   scene.description = top["description"].opt_string("");
   parse_world(top["world"], &scene.world);
   parse_params(top["params"], &scene.params);
+  scene.physics = parse_physics(top["physics"], scene.world);
   parse_time(top["time"], &scene);
   parse_list(top["fluids"], "a list of fluid bodies", &scene.fluids, parse_fluid);
   parse_list(top["colliders"], "a list of colliders", &scene.colliders,

@@ -13,6 +13,24 @@ constexpr double kTimeTolerance = 1e-6;
 
 bool due(double when, double now) { return when <= now + kTimeTolerance; }
 
+// A params struct the library refused: its message ("sph_world_set_params: params->dt_max:
+// 1e-07 is smaller than params->dt_min 1e-06") at the field's path in the file ("params.dt_max:
+// 1e-07 is smaller than params.dt_min 1e-06").
+void check_params(sph_result r, const std::string& path) {
+  if (r >= 0) return;
+  const std::string message = sph_get_last_error();
+  const std::string marker = "params->";
+  const size_t at = message.find(marker);
+  if (at == std::string::npos)
+    throw SceneError(path, std::string("the library rejected the parameters: ") + message);
+  std::string rest = message.substr(at + marker.size());
+  for (size_t k = rest.find(marker); k != std::string::npos; k = rest.find(marker, k))
+    rest.replace(k, marker.size(), path + ".");
+  const size_t colon = rest.find(": ");
+  if (colon == std::string::npos) throw SceneError(path, rest);
+  throw SceneError(path + "." + rest.substr(0, colon), rest.substr(colon + 2));
+}
+
 void check_object(sph_result r, const std::string& path, const char* what) {
   if (r < 0)
     throw SceneError(path, std::string("the library rejected the ") + what + ": " + sph_get_last_error());
@@ -28,9 +46,9 @@ SceneRuntime::SceneRuntime(const SceneDesc& scene, sph_context* context) : scene
         throw SceneError("world", std::string("the library rejected the world: ") + sph_get_last_error());
       throw LibraryError(r, "creating the world");
     }
-    r = sph_world_set_params(world_, &scene.params);
-    if (r < 0)
-      throw SceneError("params", std::string("the library rejected the parameters: ") + sph_get_last_error());
+    check_params(sph_world_set_params(world_, &scene.params), "params");
+    for (const PhysicsDesc& p : scene.physics)
+      check_params(sph_world_set_physics_params(world_, p.kind, p.bytes.data()), p.path);
 
     for (const ColliderDesc& c : scene.colliders) {
       Collider placed{&c, create_sdf(context, c.shape), sph_collider_id{0}};

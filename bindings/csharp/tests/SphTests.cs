@@ -471,6 +471,41 @@ static class Tests
         }
     }
 
+    public static void TestPhysicsParamsByKindAndTheirDescriptions()
+    {
+        AssertEqual("tait", Utf8.FromNative(Library.ParamsInfo(ParamsKind.Tait).Name), "params name");
+        AssertEqual((uint)Marshal.SizeOf(typeof(SpringParams)), Library.ParamsInfo(ParamsKind.Springs).ParamsSize, "size");
+        ParamFieldInfo[] fields = Library.ParamFields(ParamsKind.World);
+        AssertEqual(8, fields.Length, "sph_world_params fields");
+        AssertEqual("gravity", Utf8.FromNative(fields[1].Name), "second field");
+        AssertEqual(ParamZero.Value, fields[1].Zero, "gravity: 0 is no gravity");
+        AssertEqual(-9.81f, fields[1].DefaultValue.E1, "gravity default y");
+        ParamFieldInfo speed = Library.ParamFields(ParamsKind.Tait)[0];
+        AssertEqual(ParamZero.Default, speed.Zero, "speed of sound: 0 is the default");
+        AssertEqual(ParamBound.Exclusive, speed.LowerBound, "speed of sound > 0");
+        PhysicsMethodInfo[] methods = Library.PhysicsMethods();
+        AssertEqual(7, methods.Length, "methods");
+        AssertEqual("clavet", Utf8.FromNative(methods[3].Name), "the fourth method");
+        AssertEqual(MethodSwitch.Viscosity, methods[3].SwitchBy, "Clavet is a viscosity method");
+        AssertEqual(ParamsKind.ClavetViscosity, methods[3].ParamsKind, "its params");
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(AllOptions()))
+        {
+            var tait = TaitParams.Default();
+            tait.SpeedOfSound = 33f;
+            world.SetPhysicsParams(ParamsKind.Tait, tait);
+            AssertEqual(33f, world.TaitParams.SpeedOfSound, "set by kind, read typed");
+            AssertEqual(world.Params, world.GetPhysicsParams<WorldParams>(ParamsKind.World), "read by kind");
+            tait.SpeedOfSound = -1f;
+            var e = Throws(Result.ErrorInvalidArgument, () => world.SetPhysicsParams(ParamsKind.Tait, tait));
+            Assert(e.Message.Contains("params->speed_of_sound: must be > 0, got -1"), e.Message);
+            var zero = new TaitParams();
+            zero.StructSize = (uint)Marshal.SizeOf(typeof(TaitParams));
+            world.TaitParams = zero;
+            AssertEqual(10f, world.TaitParams.SpeedOfSound, "a zeroed struct takes the defaults");
+        }
+    }
+
     public static void TestSpringParams()
     {
         using (var ctx = Cpu())
@@ -562,7 +597,7 @@ static class Tests
             AssertEqual(cv, world.ClavetViscosityParams, "Clavet unchanged after errors");
 
             var badTp = tp;
-            badTp.SpeedOfSound = 0f;
+            badTp.SpeedOfSound = -1f;
             Throws(Result.ErrorInvalidArgument, () => world.TaitParams = badTp);
             badTp.SpeedOfSound = float.NaN;
             Throws(Result.ErrorInvalidArgument, () => world.TaitParams = badTp);

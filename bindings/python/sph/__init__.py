@@ -14,7 +14,9 @@ layouts these bindings were generated for (see sph._loader). Failures raise SphE
 Structs are the generated ctypes classes with keyword construction and library defaults:
 ``sph.WorldParams(gravity=(0, 0, 0))``. Optional physics is chosen at world creation
 (``ctx.world(equation_of_state="tait", features=sph.Feature.NORMALIZED_DENSITY)``) and tuned
-through World.tait_params, .clavet_viscosity_params and .surface_tension_params. The raw declarations of every C function are in
+through World.tait_params, .clavet_viscosity_params and .surface_tension_params (or any of them by
+kind: World.physics_params("tait"); sph.param_fields(kind) and sph.methods() describe them). The
+raw declarations of every C function are in
 sph._generated (FUNCTIONS) and are bound on sph.library().
 """
 from . import _generated as raw
@@ -24,7 +26,7 @@ from ._cuda import CudaArray
 from ._errors import SphError, SphLoadError, last_error
 from ._generated import (ABI_VERSION, STRUCTS, Attribute, Backend, Integrator, LogLevel, Result, Stage)
 from ._loader import helper_library, library, library_path
-from ._options import Feature, StepLimit
+from ._options import Feature, StepLimit, methods, param_fields, params_info, params_kind
 from ._scene import Collider, ForceField, Sdf, Sink, Source, as_transform, grid_transform
 
 # Every generated struct under its Python name (ContextDef, WorldDef, WorldParams, Stats, ...).
@@ -40,4 +42,4 @@ __all__ = ["Context", "World", "SphError", "SphLoadError", "Result", "Backend", 
            "Attribute", "Stage", "version", "abi_version", "build_info", "result_string", "last_error",
            "live_object_count", "make_version", "attribute_format", "stage_times", "library", "library_path", "helper_library",
            "ABI_VERSION", "BINDINGS_VERSION", "raw", "Sdf", "Collider", "Source", "Sink", "ForceField", "CudaArray",
-           "as_transform", "grid_transform", "Feature", "StepLimit", "ViscosityMethod", "EquationOfState"] + [cls.__name__ for cls in STRUCTS]
+           "as_transform", "grid_transform", "Feature", "StepLimit", "params_info", "param_fields", "methods", "params_kind", "ViscosityMethod", "EquationOfState"] + [cls.__name__ for cls in STRUCTS]

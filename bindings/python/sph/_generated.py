@@ -10,7 +10,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '6d676f1a89f7b5ed2af586f575041a28d6f938ea950f50a90cec00f2f1e8f2e7', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
+HEADERS = {'include/sph_c.h': '436aef93b798522d5d9f86d7855b4fc1320ded56fc8114b24e33b5f43a5ab6b2', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -273,6 +273,103 @@ class EquationOfState(_enum.IntEnum):
     TAIT = 1
 
 
+sph_params_kind = _c.c_int32
+SPH_PARAMS_WORLD = 0  # sph_world_params
+SPH_PARAMS_SURFACE_TENSION = 1  # sph_surface_tension_params
+SPH_PARAMS_CLAVET_VISCOSITY = 2  # sph_clavet_viscosity_params
+SPH_PARAMS_TAIT = 3  # sph_tait_params
+SPH_PARAMS_SPRINGS = 4  # sph_spring_params
+SPH_PARAMS_KIND_COUNT = 5
+SPH_PARAMS_KIND_FORCE32 = 2147483647
+
+
+class ParamsKind(_enum.IntEnum):
+    """sph_params_kind"""
+    #: sph_world_params
+    WORLD = 0
+    #: sph_surface_tension_params
+    SURFACE_TENSION = 1
+    #: sph_clavet_viscosity_params
+    CLAVET_VISCOSITY = 2
+    #: sph_tait_params
+    TAIT = 3
+    #: sph_spring_params
+    SPRINGS = 4
+
+
+sph_param_type = _c.c_int32
+SPH_PARAM_FLOAT = 0  # float, finite
+SPH_PARAM_VEC3 = 1  # sph_vec3, every component finite
+SPH_PARAM_UINT32 = 2  # uint32_t count
+SPH_PARAM_FLAGS = 3  # uint32_t bit set: only the bits of upper may be set
+SPH_PARAM_TYPE_FORCE32 = 2147483647
+
+
+class ParamType(_enum.IntEnum):
+    """sph_param_type"""
+    #: float, finite
+    FLOAT = 0
+    #: sph_vec3, every component finite
+    VEC3 = 1
+    #: uint32_t count
+    UINT32 = 2
+    #: uint32_t bit set: only the bits of upper may be set
+    FLAGS = 3
+
+
+sph_param_bound = _c.c_int32
+SPH_BOUND_NONE = 0  # no bound on this side
+SPH_BOUND_INCLUSIVE = 1  # the value may equal it
+SPH_BOUND_EXCLUSIVE = 2  # the value must pass it
+SPH_BOUND_FORCE32 = 2147483647
+
+
+class ParamBound(_enum.IntEnum):
+    """sph_param_bound"""
+    #: no bound on this side
+    NONE = 0
+    #: the value may equal it
+    INCLUSIVE = 1
+    #: the value must pass it
+    EXCLUSIVE = 2
+
+
+sph_param_zero = _c.c_int32
+SPH_PARAM_ZERO_IS_VALUE = 0  # 0 is itself a value (no gravity, no damping)
+SPH_PARAM_ZERO_IS_DEFAULT = 1  # 0 takes default_value
+SPH_PARAM_ZERO_IS_DERIVED = 2  # 0 asks for a value derived from the world (see the field's doc)
+SPH_PARAM_ZERO_FORCE32 = 2147483647
+
+
+class ParamZero(_enum.IntEnum):
+    """
+    sph_param_zero: What a 0 in a field asks for (the zero rule at "runtime parameters" above).
+    """
+    #: 0 is itself a value (no gravity, no damping)
+    VALUE = 0
+    #: 0 takes default_value
+    DEFAULT = 1
+    #: 0 asks for a value derived from the world (see the field's doc)
+    DERIVED = 2
+
+
+sph_method_switch = _c.c_int32
+SPH_METHOD_SWITCH_FEATURE = 1  # a bit of sph_world_def.features (value)
+SPH_METHOD_SWITCH_VISCOSITY = 2  # sph_world_def.viscosity_method == value
+SPH_METHOD_SWITCH_EQUATION_OF_STATE = 3  # sph_world_def.equation_of_state == value
+SPH_METHOD_SWITCH_FORCE32 = 2147483647
+
+
+class MethodSwitch(_enum.IntEnum):
+    """sph_method_switch: How a world turns a method on: which field of sph_world_def selects it."""
+    #: a bit of sph_world_def.features (value)
+    FEATURE = 1
+    #: sph_world_def.viscosity_method == value
+    VISCOSITY = 2
+    #: sph_world_def.equation_of_state == value
+    EQUATION_OF_STATE = 3
+
+
 sph_memory_kind = _c.c_int32
 SPH_MEMORY_HOST = 0  # ordinary host memory
 SPH_MEMORY_CUDA_DEVICE = 1  # device memory of the context's CUDA device (CUDA contexts only)
@@ -436,6 +533,24 @@ ENUM_MEMBER_DOCS = {
     'SPH_VISCOSITY_CLAVET': 'radial impulses between approaching pairs (eq. 18-19), sph_clavet_viscosity_params',
     'SPH_EOS_IDEAL_GAS': "the thesis's modified ideal gas p = k (rho - rho0) (eq. 15)",
     'SPH_EOS_TAIT': 'p = B ((rho / rho0)^7 - 1), B = rho0 c^2 / 7, sph_tait_params',
+    'SPH_PARAMS_WORLD': 'sph_world_params',
+    'SPH_PARAMS_SURFACE_TENSION': 'sph_surface_tension_params',
+    'SPH_PARAMS_CLAVET_VISCOSITY': 'sph_clavet_viscosity_params',
+    'SPH_PARAMS_TAIT': 'sph_tait_params',
+    'SPH_PARAMS_SPRINGS': 'sph_spring_params',
+    'SPH_PARAM_FLOAT': 'float, finite',
+    'SPH_PARAM_VEC3': 'sph_vec3, every component finite',
+    'SPH_PARAM_UINT32': 'uint32_t count',
+    'SPH_PARAM_FLAGS': 'uint32_t bit set: only the bits of upper may be set',
+    'SPH_BOUND_NONE': 'no bound on this side',
+    'SPH_BOUND_INCLUSIVE': 'the value may equal it',
+    'SPH_BOUND_EXCLUSIVE': 'the value must pass it',
+    'SPH_PARAM_ZERO_IS_VALUE': '0 is itself a value (no gravity, no damping)',
+    'SPH_PARAM_ZERO_IS_DEFAULT': '0 takes default_value',
+    'SPH_PARAM_ZERO_IS_DERIVED': "0 asks for a value derived from the world (see the field's doc)",
+    'SPH_METHOD_SWITCH_FEATURE': 'a bit of sph_world_def.features (value)',
+    'SPH_METHOD_SWITCH_VISCOSITY': 'sph_world_def.viscosity_method == value',
+    'SPH_METHOD_SWITCH_EQUATION_OF_STATE': 'sph_world_def.equation_of_state == value',
     'SPH_MEMORY_HOST': 'ordinary host memory',
     'SPH_MEMORY_CUDA_DEVICE': "device memory of the context's CUDA device (CUDA contexts only)",
     'SPH_SHAPE_PLANE': 'solid below y = 0; half_extents.x/.z its size, .y its thickness',
@@ -603,13 +718,13 @@ class WorldParams(_SphStruct):
 
     Fields:
         struct_size (uint32_t): sizeof(sph_world_params), set by sph_world_params_init
-        max_substeps (uint32_t): most substeps one sph_world_step may take; default 10000; >= 1
-        gravity (sph_vec3): m/s^2; default (0, -9.81, 0)
-        stiffness (float): k of p = k (rho - rho0), m^2/s^2 (the squared numerical sound speed); default 100; > 0. Keep sqrt(k) * dt_max below about 0.4 h.
-        viscosity (float): mu of Mueller's Laplacian viscosity (a numerical viscosity, not water's 0.001 Pa s); default 1; >= 0
-        step_factor (float): lambda of dt = lambda h / v_max; default 0.4; in (0, 10]
-        dt_min (float): s; default 1e-6; > 0
-        dt_max (float): s; default 1e-3; >= dt_min
+        max_substeps (uint32_t): most substeps one sph_world_step may take; default 10000; 0 = default
+        gravity (sph_vec3): m/s^2; default (0, -9.81, 0); finite; 0 is no gravity
+        stiffness (float): k of p = k (rho - rho0), m^2/s^2 (the squared numerical sound speed); default 100; > 0; 0 = default. Keep sqrt(k) * dt_max below about 0.4 h.
+        viscosity (float): mu of Mueller's Laplacian viscosity (a numerical viscosity, not water's 0.001 Pa s); default 1; >= 0; 0 is an inviscid fluid
+        step_factor (float): lambda of dt = lambda h / v_max; default 0.4; in (0, 10]; 0 = default
+        dt_min (float): s; default 1e-6; > 0; 0 = default
+        dt_max (float): s; default 1e-3; >= dt_min (after defaults); 0 = default
         step_limits (uint32_t): SPH_STEP_LIMIT_* bits; default 0 (eq. 32 alone)
         reserved0 (uint32_t): must be 0
     """
@@ -640,7 +755,7 @@ class SurfaceTensionParams(_SphStruct):
 
     Fields:
         struct_size (uint32_t): set by sph_surface_tension_params_init
-        coefficient (float): sigma, N/m; default 0.0728 (water at 20 C); >= 0
+        coefficient (float): sigma, N/m; default 0.0728 (water at 20 C); >= 0; 0 is no tension
         normal_threshold (float): |grad c| above which a particle counts as surface, 1/m; 0 (default) = 0.2 / kernel_radius; >= 0
         reserved0 (uint32_t): must be 0
     """
@@ -665,8 +780,8 @@ class ClavetViscosityParams(_SphStruct):
 
     Fields:
         struct_size (uint32_t): set by sph_clavet_viscosity_params_init
-        linear (float): sigma of I = dt (1 - q)(sigma u + beta u^2), 1/s; default 10; >= 0
-        quadratic (float): beta, 1/m; default 0; >= 0
+        linear (float): sigma of I = dt (1 - q)(sigma u + beta u^2), 1/s; default 10; >= 0; 0 is no linear term (beta alone, Clavet's choice for thin fluids)
+        quadratic (float): beta, 1/m; default 0; >= 0; 0 is no quadratic term
         reserved0 (uint32_t): must be 0
     """
     _fields_ = [
@@ -690,7 +805,7 @@ class TaitParams(_SphStruct):
 
     Fields:
         struct_size (uint32_t): set by sph_tait_params_init
-        speed_of_sound (float): c, m/s; default 10; > 0. Use >= 10 x the fastest flow speed to keep density errors near 1 %; lower dt_max (or SPH_STEP_LIMIT_ACOUSTIC) so that c dt stays below about 0.4 h
+        speed_of_sound (float): c, m/s; default 10; > 0; 0 = default. Use >= 10 x the fastest flow speed to keep density errors near 1 %; lower dt_max (or SPH_STEP_LIMIT_ACOUSTIC) so that c dt stays below about 0.4 h
     """
     _fields_ = [
         ('struct_size', _c.c_uint32),
@@ -711,11 +826,11 @@ class SpringParams(_SphStruct):
 
     Fields:
         struct_size (uint32_t): set by sph_spring_params_init
-        stiffness (float): k of a = -k (1 - L/h)(r - L), 1/s^2 (acceleration per metre of stretch); default 1e4; >= 0. Young's modulus of an FCC block is about (2/3) rho0 s^2 k (1 - s/h) (s: particle spacing). Stiffer springs shorten the step: dt <= 0.5 / sqrt(16 k)
+        stiffness (float): k of a = -k (1 - L/h)(r - L), 1/s^2 (acceleration per metre of stretch); default 1e4; >= 0; 0 is no elastic force. Young's modulus of an FCC block is about (2/3) rho0 s^2 k (1 - s/h) (s: particle spacing). Stiffer springs shorten the step: dt <= 0.5 / sqrt(16 k)
         link_radius (float): springs are made to neighbours closer than this, m; 0 (default) = 1.2 x particle_spacing (the lattice's 12 nearest neighbours); <= kernel_radius. Applies to particles linked after the change
-        yield_ratio (float): gamma: a spring deforms plastically beyond r = L (1 +- gamma); default 0.1; [0, 1]
-        plasticity (float): alpha, 1/s: how fast rest lengths creep toward the deformed length beyond the yield band; default 0 (purely elastic); >= 0. A rest length that grows past kernel_radius drops its spring
-        damping (float): c of a = -c (v_i - v_j) . r^ along each spring, 1/s; default 0; >= 0. Shortens the step: dt <= 2 / (16 c)
+        yield_ratio (float): gamma: a spring deforms plastically beyond r = L (1 +- gamma); default 0.1; [0, 1]; 0 is a value (every deformation yields)
+        plasticity (float): alpha, 1/s: how fast rest lengths creep toward the deformed length beyond the yield band; default 0 (0 is purely elastic); >= 0. A rest length that grows past kernel_radius drops its spring
+        damping (float): c of a = -c (v_i - v_j) . r^ along each spring, 1/s; default 0 (0 is no damping); >= 0. Shortens the step: dt <= 2 / (16 c)
         reserved0 (uint32_t): must be 0
     """
     _fields_ = [
@@ -734,6 +849,109 @@ class SpringParams(_SphStruct):
 
 
 sph_spring_params = SpringParams
+
+
+class ParamsInfo(_SphStruct):
+    """
+    sph_params_info.
+
+    Fields:
+        struct_size (uint32_t): set by sph_params_info_init
+        params_size (uint32_t): sizeof the params struct in this library
+        field_count (uint32_t): its described fields (reserved fields are not described)
+        reserved0 (uint32_t): 0
+        name (const char*): "tait", "world": a scene file's key; static, never NULL
+        type_name (const char*): "sph_tait_params"; static, never NULL
+    """
+    _fields_ = [
+        ('struct_size', _c.c_uint32),
+        ('params_size', _c.c_uint32),
+        ('field_count', _c.c_uint32),
+        ('reserved0', _c.c_uint32),
+        ('name', _c.c_char_p),
+        ('type_name', _c.c_char_p),
+    ]
+    _sph_c_name_ = 'sph_params_info'
+    _sph_size_ = 32
+    _sph_offsets_ = (('struct_size', 0), ('params_size', 4), ('field_count', 8), ('reserved0', 12), ('name', 16), ('type_name', 24))
+    _sph_init_ = 'sph_params_info_init_sized'
+
+
+sph_params_info = ParamsInfo
+
+
+class ParamFieldInfo(_SphStruct):
+    """
+    sph_param_field_info.
+
+    Fields:
+        struct_size (uint32_t): set by sph_param_field_info_init
+        offset (uint32_t): byte offset of the field in its params struct
+        type (sph_param_type): how to read it at offset
+        zero (sph_param_zero): what a 0 in it asks for
+        lower_bound (sph_param_bound): the range of valid values (not for SPH_PARAM_VEC3)
+        upper_bound (sph_param_bound)
+        lower (double)
+        upper (double): SPH_PARAM_FLAGS: the bits this library knows
+        default_value (float [3]): the default ([0] only, but for SPH_PARAM_VEC3)
+        reserved0 (uint32_t): 0
+        name (const char*): "speed_of_sound": the struct's field name; static, never NULL
+        unit (const char*): SI unit ("m/s"), "" when dimensionless; static, never NULL
+    """
+    _fields_ = [
+        ('struct_size', _c.c_uint32),
+        ('offset', _c.c_uint32),
+        ('type', sph_param_type),
+        ('zero', sph_param_zero),
+        ('lower_bound', sph_param_bound),
+        ('upper_bound', sph_param_bound),
+        ('lower', _c.c_double),
+        ('upper', _c.c_double),
+        ('default_value', (_c.c_float * 3)),
+        ('reserved0', _c.c_uint32),
+        ('name', _c.c_char_p),
+        ('unit', _c.c_char_p),
+    ]
+    _sph_c_name_ = 'sph_param_field_info'
+    _sph_size_ = 72
+    _sph_offsets_ = (('struct_size', 0), ('offset', 4), ('type', 8), ('zero', 12), ('lower_bound', 16), ('upper_bound', 20), ('lower', 24), ('upper', 32), ('default_value', 40), ('reserved0', 52), ('name', 56), ('unit', 64))
+    _sph_init_ = 'sph_param_field_info_init_sized'
+    _sph_enums_ = {'type': ParamType, 'zero': ParamZero, 'lower_bound': ParamBound, 'upper_bound': ParamBound}
+
+
+sph_param_field_info = ParamFieldInfo
+
+
+class PhysicsMethodInfo(_SphStruct):
+    """
+    sph_physics_method_info.
+
+    Fields:
+        struct_size (uint32_t): set by sph_physics_method_info_init
+        method_count (uint32_t): how many methods this library has (index runs below it)
+        switch_by (sph_method_switch): the sph_world_def field that selects it
+        value (uint32_t): the SPH_FEATURE_* bit, sph_viscosity_method or sph_equation_of_state
+        has_params (uint32_t): 1 when its parameters are in the struct of params_kind
+        params_kind (sph_params_kind): SPH_PARAMS_WORLD for the thesis's defaults (stiffness, viscosity)
+        name (const char*): "clavet", "surface_tension": a scene file's name; static
+    """
+    _fields_ = [
+        ('struct_size', _c.c_uint32),
+        ('method_count', _c.c_uint32),
+        ('switch_by', sph_method_switch),
+        ('value', _c.c_uint32),
+        ('has_params', _c.c_uint32),
+        ('params_kind', sph_params_kind),
+        ('name', _c.c_char_p),
+    ]
+    _sph_c_name_ = 'sph_physics_method_info'
+    _sph_size_ = 32
+    _sph_offsets_ = (('struct_size', 0), ('method_count', 4), ('switch_by', 8), ('value', 12), ('has_params', 16), ('params_kind', 20), ('name', 24))
+    _sph_init_ = 'sph_physics_method_info_init_sized'
+    _sph_enums_ = {'switch_by': MethodSwitch, 'params_kind': ParamsKind}
+
+
+sph_physics_method_info = PhysicsMethodInfo
 
 
 class SpawnDesc(_SphStruct):
@@ -1339,7 +1557,7 @@ class CudaAttributeView(_SphStruct):
 sph_cuda_attribute_view = CudaAttributeView
 
 
-STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpringParams, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, Quat, Transform, ColliderId, ColliderDef, ColliderMaterial, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, Event, CudaAttributeView, )
+STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpringParams, ParamsInfo, ParamFieldInfo, PhysicsMethodInfo, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, Quat, Transform, ColliderId, ColliderDef, ColliderMaterial, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, Event, CudaAttributeView, )
 
 # ---- functions --------------------------------------------------------------------------------
 
@@ -1405,6 +1623,22 @@ FUNCTIONS = {
         'FEATURE_DISABLED unless the world has SPH_FEATURE_SPRINGS. INVALID_ARGUMENT for a value out of range (the message names it); nothing changes on error. Springs already made keep their rest lengths; the new stiffness, damping and plasticity act from the next substep.', 'sph'),
     'sph_world_get_spring_params': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_spring_params)), ('world', 'out'),
         '', 'sph'),
+    'sph_world_set_physics_params': (sph_result, (_c.POINTER(sph_world), sph_params_kind, _c.c_void_p), ('world', 'kind', 'params'),
+        'Replaces the params struct of `kind` at once, as its typed set call does (sph_world_set_params, sph_world_set_tait_params, ...): params points to that struct, struct_size first. Errors: those of the typed call; UNSUPPORTED for an unknown kind.', 'sph'),
+    'sph_world_get_physics_params': (sph_result, (_c.POINTER(sph_world), sph_params_kind, _c.c_void_p), ('world', 'kind', 'out'),
+        'Reads the params struct of `kind`, as its typed get call does; out->struct_size must be set.', 'sph'),
+    'sph_params_info_init_sized': (sph_result, (_c.POINTER(sph_params_info), _c.c_uint32), ('info', 'size'),
+        '', 'sph'),
+    'sph_params_get_info': (sph_result, (sph_params_kind, _c.POINTER(sph_params_info)), ('kind', 'out'),
+        'Describes the params struct of `kind`. UNSUPPORTED for an unknown kind.', 'sph'),
+    'sph_param_field_info_init_sized': (sph_result, (_c.POINTER(sph_param_field_info), _c.c_uint32), ('info', 'size'),
+        '', 'sph'),
+    'sph_params_get_field_info': (sph_result, (sph_params_kind, _c.c_uint32, _c.POINTER(sph_param_field_info)), ('kind', 'index', 'out'),
+        'Describes field `index` (0 .. field_count - 1, in the order of the struct) of the params struct of `kind`. Cross-field rules (dt_max >= dt_min; a spring link radius at most h) are checked by the set calls only. UNSUPPORTED for an unknown kind, INVALID_ARGUMENT for an index past the last field.', 'sph'),
+    'sph_physics_method_info_init_sized': (sph_result, (_c.POINTER(sph_physics_method_info), _c.c_uint32), ('info', 'size'),
+        '', 'sph'),
+    'sph_get_physics_method_info': (sph_result, (_c.c_uint32, _c.POINTER(sph_physics_method_info)), ('index', 'out'),
+        'Describes method `index` (0 .. method_count - 1; index 0 always exists and tells how many there are). INVALID_ARGUMENT past the last one.', 'sph'),
     'sph_spawn_desc_init_sized': (sph_result, (_c.POINTER(sph_spawn_desc), _c.c_uint32), ('desc', 'size'),
         '', 'sph'),
     'sph_world_spawn': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_spawn_desc), _c.POINTER(_c.c_uint32)), ('world', 'desc', 'out_first_id'),

@@ -12,6 +12,11 @@ or changed field by field (world.set_tait_params(speed_of_sound=40)). Reading or
 parameters of an option the world did not turn on raises SphError with
 Result.ERROR_FEATURE_DISABLED. The step-size limits are bits of WorldParams.step_limits:
 ``world.set_params(step_limits="acoustic|force")``.
+
+Every params struct can also be read and set by kind (world.physics_params("tait"),
+world.set_physics_params("springs", damping=2)), and the library describes them for tools:
+params_info(kind), param_fields(kind) (names, offsets, ranges, defaults, what a zero means) and
+methods() (every method, how WorldDef turns it on, where its parameters are).
 """
 import collections.abc
 import ctypes
@@ -21,7 +26,7 @@ from . import _generated as _g
 from ._errors import check
 from ._loader import library
 
-__all__ = ["Feature", "StepLimit", "WorldOptionsMixin"]
+__all__ = ["Feature", "StepLimit", "WorldOptionsMixin", "params_info", "param_fields", "methods", "params_kind"]
 
 
 def _flags(name, prefix, doc):
@@ -187,3 +192,82 @@ class WorldOptionsMixin:
         p = _changed(self.spring_params, fields)
         self.spring_params = p
         return p
+
+    # -- any params struct by kind (the generic calls, for tools that read the descriptions)
+    def physics_params(self, kind):
+        """The params struct of `kind` (a ParamsKind or its name, "world", "tait", ...), read
+        from the world (sph_world_get_physics_params): a WorldParams, TaitParams, ... Raises
+        SphError(ERROR_FEATURE_DISABLED) for a method the world does not run."""
+        kind = params_kind(kind)
+        p = _struct_of(kind)()
+        check(library().sph_world_get_physics_params(self.handle, kind, ctypes.byref(p)),
+              "sph_world_get_physics_params")
+        return p
+
+    def set_physics_params(self, kind, params=None, **fields):
+        """Replaces the params struct of `kind` (sph_world_set_physics_params) with `params`
+        (its struct, or a dict of its fields, the others at their defaults), or changes only
+        the given fields: ``w.set_physics_params("tait", speed_of_sound=40)``. Returns the
+        parameters now set."""
+        kind = params_kind(kind)
+        if params is None:
+            p = _changed(self.physics_params(kind), fields)
+        else:
+            p = _changed(_as_struct(_struct_of(kind), params), fields)
+        check(library().sph_world_set_physics_params(self.handle, kind, ctypes.byref(p)),
+              "sph_world_set_physics_params")
+        return p
+
+
+# ---- the descriptions of parameters and methods (static; for tools) ----------------------------
+def params_info(kind):
+    """The ParamsInfo of a params struct (sph_params_get_info): its scene-file name, C type name,
+    size and number of described fields. kind: a ParamsKind or its name ("world", "tait")."""
+    info = _g.ParamsInfo()
+    check(library().sph_params_get_info(params_kind(kind), ctypes.byref(info)), "sph_params_get_info")
+    return info
+
+
+def param_fields(kind):
+    """Every described field of a params struct as a ParamFieldInfo, in the order of the struct
+    (sph_params_get_field_info): name, offset, type, range and bound kinds, default, unit and
+    what a zero in it means (ParamZero)."""
+    kind = params_kind(kind)
+    fields = []
+    for index in range(params_info(kind).field_count):
+        f = _g.ParamFieldInfo()
+        check(library().sph_params_get_field_info(kind, index, ctypes.byref(f)), "sph_params_get_field_info")
+        fields.append(f)
+    return fields
+
+
+def methods():
+    """Every physics method the library has, as PhysicsMethodInfo (sph_get_physics_method_info): its name, the
+    WorldDef field that turns it on (MethodSwitch) and value, and the ParamsKind of its
+    parameters when it has any."""
+    out = []
+    index = 0
+    while True:
+        m = _g.PhysicsMethodInfo()
+        check(library().sph_get_physics_method_info(index, ctypes.byref(m)), "sph_get_physics_method_info")
+        out.append(m)
+        index += 1
+        if index >= m.method_count:
+            return out
+
+
+def params_kind(kind):
+    """A ParamsKind from itself, its int value or its name (the member's, "SPRINGS", or the
+    library's scene-file name, "springs", "clavet")."""
+    if isinstance(kind, str):
+        for k in _g.ParamsKind:
+            if kind.upper() == k.name or kind == params_info(k).name.decode():
+                return k
+        raise ValueError(f"{kind!r} names no params struct")
+    return _g.ParamsKind(kind)
+
+
+def _struct_of(kind):
+    """The generated struct class of a params kind, found by its C type name."""
+    name = params_info(kind).type_name.decode()
+    return next(cls for cls in _g.STRUCTS if cls._sph_c_name_ == name)

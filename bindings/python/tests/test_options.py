@@ -141,9 +141,52 @@ def test_option_params_validation_changes_nothing(full, attr, setter, cls, defau
 
 
 def test_tait_speed_of_sound_must_be_positive(full):
-    assert error(full.set_tait_params, speed_of_sound=0.0).result == sph.Result.ERROR_INVALID_ARGUMENT
-    full.set_surface_tension_params(coefficient=0.0)  # sigma = 0 and beta = 0 are allowed
+    e = error(full.set_tait_params, speed_of_sound=-1.0)
+    assert e.result == sph.Result.ERROR_INVALID_ARGUMENT
+    assert "params->speed_of_sound: must be > 0, got -1" in e.message
+    full.set_tait_params(speed_of_sound=0.0)
+    assert full.tait_params.speed_of_sound == 10.0  # 0 takes the default
+    full.set_surface_tension_params(coefficient=0.0)  # sigma = 0 and beta = 0 are values
     full.set_clavet_viscosity_params(linear=0.0, quadratic=0.0)
+    assert (full.clavet_viscosity_params.linear, full.surface_tension_params.coefficient) == (0.0, 0.0)
+
+
+# ---- every params struct by kind, and the descriptions tools read -------------------------------
+def test_params_are_described_for_tools():
+    assert [sph.params_info(k).name for k in sph.ParamsKind] == [
+        b"world", b"surface_tension", b"clavet", b"tait", b"springs"]
+    assert sph.params_info("tait").type_name == b"sph_tait_params"
+    assert sph.params_info("clavet").params_size == ctypes.sizeof(sph.ClavetViscosityParams)
+    names = [f.name for f in sph.param_fields(sph.ParamsKind.WORLD)]
+    assert names == [b"max_substeps", b"gravity", b"stiffness", b"viscosity", b"step_factor", b"dt_min", b"dt_max",
+                     b"step_limits"]
+    speed = sph.param_fields("tait")[0]
+    assert (speed.name, speed.unit, speed.offset) == (b"speed_of_sound", b"m/s", sph.TaitParams.speed_of_sound.offset)
+    assert speed.lower == 0.0 and speed.lower_bound == sph.ParamBound.EXCLUSIVE
+    assert speed.zero == sph.ParamZero.DEFAULT and speed.default_value[0] == 10.0
+    gravity = sph.param_fields("world")[1]
+    assert gravity.type == sph.ParamType.VEC3 and gravity.zero == sph.ParamZero.VALUE
+    assert tuple(gravity.default_value) == pytest.approx((0, -9.81, 0))
+    methods = {m.name: m for m in sph.methods()}
+    assert list(methods) == [b"ideal_gas", b"tait", b"mueller", b"clavet", b"surface_tension",
+                             b"normalized_density", b"springs"]
+    assert methods[b"springs"].switch_by == sph.MethodSwitch.FEATURE
+    assert methods[b"springs"].value == sph.Feature.SPRINGS and methods[b"springs"].has_params
+    assert methods[b"tait"].params_kind == sph.ParamsKind.TAIT
+    assert not methods[b"normalized_density"].has_params
+    with pytest.raises(ValueError):
+        sph.params_kind("no such params")
+
+
+def test_params_by_kind_are_the_typed_params(full):
+    p = full.set_physics_params("tait", speed_of_sound=33)
+    assert isinstance(p, sph.TaitParams) and full.tait_params.speed_of_sound == 33
+    full.set_physics_params(sph.ParamsKind.CLAVET_VISCOSITY, {"linear": 4})
+    assert full.clavet_viscosity_params.linear == 4 and full.clavet_viscosity_params.quadratic == 0
+    assert full.physics_params("world") == full.params
+    e = error(full.set_physics_params, "tait", speed_of_sound=-2)
+    assert "params->speed_of_sound: must be > 0, got -2" in e.message
+    assert error(full.physics_params, "springs").result == sph.Result.ERROR_FEATURE_DISABLED
 
 
 def test_each_option_alone_enables_only_its_params(ctx):

@@ -79,8 +79,12 @@ def test_bad_params_change_nothing(world):
     before = world.params
     assert error(world.set_params, stiffness=-1.0) == sph.Result.ERROR_INVALID_ARGUMENT
     assert error(world.set_params, dt_max=1e-9) == sph.Result.ERROR_INVALID_ARGUMENT  # < dt_min
-    assert error(world.set_params, max_substeps=0) == sph.Result.ERROR_INVALID_ARGUMENT
+    assert error(world.set_params, step_factor=11.0) == sph.Result.ERROR_INVALID_ARGUMENT
     assert world.params == before
+    # A 0 that was never a valid value takes the default (zero means default, sph_c.h).
+    world.set_params(max_substeps=0)
+    assert world.params.max_substeps == 10000
+    world.params = before
     p = sph.WorldParams()
     p.struct_size = 4
     assert error(setattr, world, "params", p) == sph.Result.ERROR_VERSION_MISMATCH

@@ -1,0 +1,21 @@
+// What a method derives its constants from and checks its parameters against (host only): the
+// world's fixed shape, and the lattice sums it may calibrate on. Core fills both (config.h and
+// fcc_lattice.cpp); the physics layer only names them, so it includes nothing from core.
+#pragma once
+
+namespace sph {
+
+struct WorldShape {
+  float particle_spacing;  // m
+  float kernel_radius;     // h, m
+  float rest_density;      // rho0, kg/m^3
+  float particle_mass;     // kg, from the FCC lattice at the spacing
+};
+
+// Sums over the FCC lattice at the world's spacing (core/fcc_lattice.h says what each is).
+struct LatticeSums {
+  double (*surface_delta_integral)(float spacing, float kernel_radius, float threshold);
+  double (*cohesion_surface_energy)(float spacing, float kernel_radius);
+};
+
+}  // namespace sph
