@@ -78,14 +78,6 @@ void zero(ByteReader& r, const std::string& name) {
   if (r.u32() != 0) corrupt(r.what() + ": " + name + " is reserved and must be 0");
 }
 
-Vec3 vec3(ByteReader& r, const std::string& name) {
-  Vec3 v;
-  v.x = finite(r, name + ".x");
-  v.y = finite(r, name + ".y");
-  v.z = finite(r, name + ".z");
-  return v;
-}
-
 // A pose as stored; the scene's rules (pose_rules.h) check it where the object is made.
 RigidTransform raw_pose(ByteReader& r) {
   RigidTransform t;

@@ -42,14 +42,18 @@
 #include "fluid_base.h"
 #include "neighbor_walk.h"
 #include "param_table.h"
+#include "particle_array_spec.h"
 
 namespace sph {
 
 struct NormalizedDensity {
   static constexpr const char* kName = "normalized_density";
-  // g_i is state; the plain kernel sum, then the filtered density, a per-pass side array.
-  static constexpr ParticleArrayDecl kArrays[] = {{"density_factor", 4, ArrayLifetime::State},
-                                                  {"normalized_density", 4, ArrayLifetime::Scratch}};
+  // g_i is carried state (NaN until the particle's first density pass); the plain kernel sum,
+  // then the filtered density, is a per-pass side array.
+  static constexpr float kFreshFactor = std::numeric_limits<float>::quiet_NaN();
+  static constexpr ParticleArraySpec kArrays[] = {
+      {kArrayDensityFactor, sizeof(float), ParticleArrayRole::Carried, 1, &kFreshFactor, nullptr},
+      {kArrayNormalizedDensity, sizeof(float), ParticleArrayRole::Scratch, 1, nullptr, nullptr}};
 };
 
 // The factor of a particle that has not had a density pass yet (set on the host, at append).

@@ -115,14 +115,4 @@ struct ParamConflict {
   float other_value = 0.0f;
 };
 
-// A method's per-particle arrays. State is sorted with the particles, rolled back with a failed
-// step and saved in checkpoints; Scratch is rebuilt by every substep that uses it.
-enum class ArrayLifetime : uint32_t { State = 0, Scratch = 1 };
-
-struct ParticleArrayDecl {
-  const char* name;
-  uint32_t element_bytes;
-  ArrayLifetime lifetime;
-};
-
 }  // namespace sph

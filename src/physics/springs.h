@@ -26,6 +26,7 @@
 #include "host_device.h"
 #include "neighbor_walk.h"
 #include "param_table.h"
+#include "particle_array_spec.h"
 #include "vec3.h"
 #include "world_shape.h"
 
@@ -257,12 +258,20 @@ struct Springs {
   }
   static float stability_ceiling(const Params& p) { return spring_stability_ceiling(p.stiffness, p.damping); }
 
-  // The lists are state; the link candidates and the evaluation's accelerations (a Vec3; the
-  // device keeps it in a Float4 for aligned loads) are rebuilt by each spring pass.
-  static constexpr ParticleArrayDecl kArrays[] = {
-      {"spring_lists", sizeof(SpringList), ArrayLifetime::State},
-      {"spring_candidates", kSpringSlots * sizeof(uint32_t), ArrayLifetime::Scratch},
-      {"spring_acceleration", sizeof(Vec3), ArrayLifetime::Scratch},
+  // Each particle's list (partners as storage indices, rewritten at every reorder) and the lowest
+  // id that waits for its springs (one word per world) are carried state; the link candidates
+  // and the evaluation's accelerations (Float4 for aligned loads) are rebuilt by each spring pass.
+  static void rewrite_partners(void* element, const uint32_t* new_index_of_old) {
+    SpringList* list = static_cast<SpringList*>(element);
+    *list = remap_spring_list(*list, new_index_of_old);
+  }
+  inline static const SpringList kEmptyList = empty_spring_list();
+  static constexpr uint32_t kNoLinksPending = kNoPendingLinks;
+  inline static const ParticleArraySpec kArrays[] = {
+      {kArraySprings, sizeof(SpringList), ParticleArrayRole::Carried, 1, &kEmptyList, &rewrite_partners},
+      {kArraySpringLinkFrom, sizeof(uint32_t), ParticleArrayRole::Carried, 0, &kNoLinksPending, nullptr},
+      {kArraySpringCandidates, sizeof(uint32_t), ParticleArrayRole::Scratch, kSpringSlots, nullptr, nullptr},
+      {kArraySpringAcceleration, sizeof(Float4), ParticleArrayRole::Scratch, 1, nullptr, nullptr},
   };
 };
 

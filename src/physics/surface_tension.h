@@ -42,6 +42,7 @@
 #include "kernels.h"
 #include "neighbor_walk.h"
 #include "param_table.h"
+#include "particle_array_spec.h"
 #include "world_shape.h"
 
 namespace sph {
@@ -105,7 +106,8 @@ struct SurfaceTension {
   }
 
   // The colour-field records, rebuilt after every density pass.
-  static constexpr ParticleArrayDecl kArrays[] = {{"colour_normal", 16, ArrayLifetime::Scratch}};
+  static constexpr ParticleArraySpec kArrays[] = {
+      {kArrayColourNormal, sizeof(Float4), ParticleArrayRole::Scratch, 1, nullptr, nullptr}};
 
   // The capillary stress of a colour-field record applied to a vector g, without sigma:
   // T . g = t (g - n^ (n^ . g)) with t = |n| less the threshold (zero below it): the threshold

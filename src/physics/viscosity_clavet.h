@@ -8,6 +8,7 @@
 #include "force_pair.h"
 #include "host_device.h"
 #include "param_table.h"
+#include "particle_array_spec.h"
 #include "world_shape.h"
 
 namespace sph {
@@ -32,7 +33,8 @@ struct ClavetViscosity {
   static Constants make_constants(const Params& p) { return Constants{p.linear, p.quadratic}; }
 
   // The density pass's neighbour counts (a per-substep array, n_i + n_j bounds the impulses).
-  static constexpr ParticleArrayDecl kArrays[] = {{"neighbor_count", 4, ArrayLifetime::Scratch}};
+  static constexpr ParticleArraySpec kArrays[] = {
+      {kArrayNeighborCount, sizeof(uint32_t), ParticleArrayRole::Scratch, 1, nullptr, nullptr}};
 
   static constexpr bool kReadsNeighborCounts = true;
   static constexpr bool kReadsColourNormals = false;
