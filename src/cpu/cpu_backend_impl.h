@@ -68,8 +68,8 @@ class CpuBackend final : public Backend {
   template <class Terms>
   static Vec3 acceleration_with(const FluidConstants& fluid, const GridView& view, const ForceInputs& in,
                                 const SceneFrame& scene, uint32_t i);
-  using AccelerationFn = Vec3 (*)(const FluidConstants&, const GridView&, const ForceInputs&, const SceneFrame&,
-                                  uint32_t);
+  using AccelerationFn = Vec3 (*)(const FluidConstants&, const GridView&, const ForceInputs&,
+                                  const SceneFrame&, uint32_t);
   AccelerationFn acceleration_function() const;
   // The arrays the force gather reads (normals and counts only where a term reads them).
   ForceInputs force_inputs() const;
