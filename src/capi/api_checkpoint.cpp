@@ -47,19 +47,12 @@ std::unique_ptr<sph::World> load_world(sph_context* context, const void* data, u
                               });
 }
 
-void require_context(const sph_context* context) {
-  if (!context) throw Error(Status::InvalidHandle, "context: is NULL");
-  if (!sph::is_live_handle(context, sph::HandleKind::Context))
-    throw Error(Status::InvalidHandle, "context: is not a live sph_context");
-}
-
-sph_result publish(sph_context* context, std::unique_ptr<sph::World> loaded, sph_world** out) {
+// `hold` keeps the context alive from the start of the call to the new world's registration.
+sph_result publish(const sph::ContextHold& hold, std::unique_ptr<sph::World> loaded, sph_world** out) {
   auto world = std::make_unique<sph_world>();
-  world->context = context;
+  world->context = hold.get();
   world->world = std::move(loaded);
-  sph::register_handle(world.get(), sph::HandleKind::World);
-  context->world_count.fetch_add(1);
-  *out = world.release();
+  *out = sph::publish_world(std::move(world));
   return SPH_OK;
 }
 
@@ -215,24 +208,22 @@ SPH_API sph_result SPH_CALL sph_world_save_file(const sph_world* world, const ch
 
 SPH_API sph_result SPH_CALL sph_world_load(sph_context* context, const void* data, uint64_t size,
                                            sph_world** out) {
-  const sph_context* log_context = sph::is_live_handle(context, sph::HandleKind::Context) ? context : nullptr;
-  return sph::guarded("sph_world_load", log_context, [&] {
-    require_context(context);
+  return sph::guarded("sph_world_load", context, [&] {
+    const sph::ContextHold hold(context);
     if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
-    return publish(context, load_world(context, data, size), out);
+    return publish(hold, load_world(hold.get(), data, size), out);
   });
 }
 
 SPH_API sph_result SPH_CALL sph_world_load_file(sph_context* context, const char* path, sph_world** out) {
-  const sph_context* log_context = sph::is_live_handle(context, sph::HandleKind::Context) ? context : nullptr;
-  return sph::guarded("sph_world_load_file", log_context, [&] {
-    require_context(context);
+  return sph::guarded("sph_world_load_file", context, [&] {
+    const sph::ContextHold hold(context);
     require_path(path);
     if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
     const std::vector<uint8_t> bytes = read_file(path);
     try {
       static const uint8_t nothing = 0;  // an empty file is a truncated checkpoint, not NULL data
-      return publish(context, load_world(context, bytes.empty() ? &nothing : bytes.data(), bytes.size()),
+      return publish(hold, load_world(hold.get(), bytes.empty() ? &nothing : bytes.data(), bytes.size()),
                      out);
     } catch (const Error& e) {
       throw Error(e.status(), std::string(e.what()) + " (file '" + path + "')");

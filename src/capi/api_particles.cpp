@@ -109,6 +109,7 @@ SPH_API sph_result SPH_CALL sph_world_fill_sphere(sph_world* world, const sph_fi
 SPH_API sph_result SPH_CALL sph_world_get_particle_count(const sph_world* world, uint32_t* out_count) {
   return sph::guarded("sph_world_get_particle_count", sph::context_of(world), [&] {
     sph::require_world(world);
+    sph::WorldLock lock(world);
     if (!out_count) throw Error(Status::InvalidArgument, "out_count: is NULL");
     *out_count = world->world->particle_count();
     return SPH_OK;

@@ -101,6 +101,7 @@ sph_result set_params(const char* function, sph_world* world, uint32_t kind, con
 sph_result get_params(const char* function, const sph_world* world, uint32_t kind, void* out) {
   return sph::guarded(function, sph::context_of(world), [&] {
     sph::require_world(world);
+    sph::WorldLock lock(world);
     const sph::ParamsBinding& b = sph::params_binding(kind, "kind");
     require_enabled(b, world);
     if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
