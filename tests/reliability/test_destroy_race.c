@@ -26,7 +26,7 @@
 #include "capi_test.h"
 
 #ifdef SPH_TEST_TSAN_BUILD
-enum { kWorldRounds = 1000, kContextRounds = 300, kSdfRounds = 1000 };
+enum { kWorldRounds = 800, kContextRounds = 250, kSdfRounds = 800 };
 #else
 enum { kWorldRounds = 2000, kContextRounds = 500, kSdfRounds = 2000 };
 #endif
