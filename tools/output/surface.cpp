@@ -13,6 +13,7 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "new_file.h"
 #include "writers.h"
 
 namespace sph_tools {
@@ -39,8 +40,7 @@ class ParticleList {
 };
 
 void write_obj(const SurfaceMesh& mesh, const ParticleFrame& f, const std::string& path) {
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "w"), std::fclose);
-  if (!file) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  NewFile file(path);
   std::FILE* out = file.get();
   std::fprintf(out, "# sph-run fluid surface, frame %u, time %.9g s, %zu vertices, %zu triangles\n", f.frame,
                f.time, mesh.vertices.size() / 3, mesh.triangles.size() / 3);
@@ -49,8 +49,7 @@ void write_obj(const SurfaceMesh& mesh, const ParticleFrame& f, const std::strin
   for (size_t i = 0; i < mesh.triangles.size(); i += 3)
     std::fprintf(out, "f %u %u %u\n", mesh.triangles[i] + 1, mesh.triangles[i + 1] + 1,
                  mesh.triangles[i + 2] + 1);
-  if (std::ferror(out) || std::fclose(file.release()) != 0)
-    throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  file.close();
 }
 
 }  // namespace
