@@ -2051,13 +2051,13 @@ namespace Sph
         /// outside the grid, NULL or non-finite data), UNSUPPORTED (unknown channel or memory).
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
-        public static extern Result sph_sdf_update(SdfHandle sdf, SdfChannel channel, [In] uint[] origin, [In] uint[] size, [In] float[] data, MemoryKind memory);
+        public static extern Result sph_sdf_update(SdfHandle sdf, SdfChannel channel, ref FixedUint3 origin, ref FixedUint3 size, [In] float[] data, MemoryKind memory);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_sdf_update")]
         public static extern Result sph_sdf_update(IntPtr sdf, SdfChannel channel, IntPtr origin, IntPtr size, IntPtr data, MemoryKind memory);
 
         /// <summary>Grid dimensions of an asset.</summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
-        public static extern Result sph_sdf_get_dims(SdfHandle sdf, [In, Out] uint[] outDims);
+        public static extern Result sph_sdf_get_dims(SdfHandle sdf, ref FixedUint3 outDims);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_sdf_get_dims")]
         public static extern Result sph_sdf_get_dims(IntPtr sdf, IntPtr outDims);
 
