@@ -490,7 +490,13 @@ static void touch(const char* path) {
 }
 
 static void test_save_removes_temporaries_of_killed_saves(void** state) {
-  sph_context* context = make_context(NULL, NULL);
+  /* The CPU backend whatever SPH_TEST_BACKEND says: a child of fork() must not use CUDA. */
+  sph_context_def cpu;
+  sph_context* context = NULL;
+  sph_context_def_init(&cpu);
+  cpu.backend = SPH_BACKEND_CPU;
+  cpu.cpu_worker_count = 1;
+  EXPECT_OK(sph_context_create(&cpu, &context));
   sph_world* world = make_world(context, 200000);
   sph_fill_box_desc box;
   char dir[] = "/tmp/sph_hostile_XXXXXX";
