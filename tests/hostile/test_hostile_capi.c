@@ -508,7 +508,7 @@ static void test_save_removes_temporaries_of_killed_saves(void** state) {
   assert_non_null(mkdtemp(dir));
   snprintf(path, sizeof path, "%s/world.sph", dir);
   sph_fill_box_desc_init(&box);
-  box.max.x = box.max.y = box.max.z = 0.5f; /* ~40,000 particles: a save of a few MB */
+  box.max.x = box.max.y = box.max.z = 0.5f; /* 19,652 particles: a save of about 1 MB */
   EXPECT_OK(sph_world_fill_box(world, &box, NULL));
   /* The temporary-name tag of this host, as the library writes it. */
   assert_int_equal(gethostname(host, sizeof host - 1), 0);

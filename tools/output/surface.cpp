@@ -77,6 +77,7 @@ void write_surface(const ParticleFrame& f, float radius, float voxel, const std:
   grid->setName("surface");
   grid->insertMeta("frame", openvdb::Int32Metadata(static_cast<int32_t>(f.frame)));
   grid->insertMeta("time", openvdb::DoubleMetadata(f.time));
+  create_new_file(vdb_path);  // claimed exclusively; OpenVDB opens it by name (write_vdb_points.cpp)
   try {
     openvdb::io::File file(vdb_path);
     file.write(openvdb::GridCPtrVec{grid});
