@@ -261,6 +261,16 @@ void test_file_size_limit_is_an_error(void**) {
   assert_true(contains(output, "File too large"));
   // Nothing of the frame was committed.
   assert_false(cli_test::file_exists(out + "/fluid_0000.ply"));
+#ifndef CLI_TEST_NO_OPENVDB
+  // OpenVDB's own io::File::write never checked its stream: the truncated .vdb was committed
+  // as a whole frame, and the run exited 0.
+  command = "ulimit -f 8 && exec '" + g_sph_run + "'";
+  for (const std::string& a : tiny(out, "1", "vdb")) command += " '" + a + "'";
+  assert_int_equal(cli_test::run({"/bin/bash", "-c", command}, &output), 1);
+  std::printf("%s", output.c_str());
+  assert_true(contains(output, "fluid_0000.vdb: File too large"));
+  assert_false(cli_test::file_exists(out + "/fluid_0000.vdb"));
+#endif
 }
 
 // ---- item 8: scene values that pass the schema but cannot run -------------------------------

@@ -14,6 +14,7 @@
 #include <stdexcept>
 
 #include "new_file.h"
+#include "vdb_file.h"
 #include "writers.h"
 
 namespace sph_tools {
@@ -77,14 +78,7 @@ void write_surface(const ParticleFrame& f, float radius, float voxel, const std:
   grid->setName("surface");
   grid->insertMeta("frame", openvdb::Int32Metadata(static_cast<int32_t>(f.frame)));
   grid->insertMeta("time", openvdb::DoubleMetadata(f.time));
-  create_new_file(vdb_path);  // claimed exclusively; OpenVDB opens it by name (write_vdb_points.cpp)
-  try {
-    openvdb::io::File file(vdb_path);
-    file.write(openvdb::GridCPtrVec{grid});
-    file.close();
-  } catch (const openvdb::Exception& e) {
-    throw std::runtime_error("cannot write " + vdb_path + ": " + e.what());
-  }
+  write_vdb_file(vdb_path, openvdb::GridCPtrVec{grid});
 
   std::vector<openvdb::Vec3s> points;
   std::vector<openvdb::Vec3I> triangles;
