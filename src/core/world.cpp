@@ -162,9 +162,7 @@ SceneFrame World::build_scene_frame(double frame_dt) const {
 
 bool World::step(double frame_dt) {
   const auto start = std::chrono::steady_clock::now();
-  // Everything a failed step must put back: the last step's events among them.
-  std::vector<Event> events_before;
-  events_before.swap(events_);
+  // Everything a failed step must put back.
   const uint32_t count_before = particle_count();
   const uint32_t next_id_before = next_id_;
   struct SourceState {
@@ -176,6 +174,9 @@ bool World::step(double frame_dt) {
   sources_.for_each([&](uint64_t id, const Source& s) {
     sources_before.push_back({id, s.done, s.rate_budget});
   });
+  // The last step's events, kept aside (no allocation: nothing can fail from here to the try).
+  std::vector<Event> events_before;
+  events_before.swap(events_);
   FrameReport report;
   try {
     // Reserved up front, so that nothing after the backend's frame can fail on an allocation:
