@@ -16,13 +16,15 @@ namespace sph {
 // The size of a public struct in the first release that had it. A struct that grows gets a
 // specialisation with its old size (docs/versioning.md), so callers built against the older
 // header keep working:
-//   template <> constexpr uint32_t kFirstStructSize<sph_context_def> = 40;
+//   template <> inline constexpr uint32_t kFirstStructSize<sph_context_def> = 40;
+// (inline: an explicit specialisation of a variable template is not inline by itself, and
+// clang then defines it in every object that includes this header: a duplicate at link time.)
 template <class T>
-constexpr uint32_t kFirstStructSize = static_cast<uint32_t>(sizeof(T));
+inline constexpr uint32_t kFirstStructSize = static_cast<uint32_t>(sizeof(T));
 
 // Structs that grew after their first release, with the size they had then.
 template <>
-constexpr uint32_t kFirstStructSize<sph_context_def> =
+inline constexpr uint32_t kFirstStructSize<sph_context_def> =
     24 + 2 * sizeof(void*);  // 0.1.0; 0.2.0 adds the CUDA tuning
 
 // No public struct comes near this size. A larger struct_size is garbage, not a newer header:
