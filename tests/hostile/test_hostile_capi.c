@@ -122,6 +122,23 @@ static void test_struct_size_beyond_any_struct_is_refused(void** state) {
   assert_int_equal(big_init[sizeof big_init - 1], 0xab);
   /* Exactly 64 KiB is still a plausible (zero-padded) struct. */
   EXPECT_OK(sph_world_def_init_sized((sph_world_def*)big_init, 64u * 1024u));
+  /* The parameter structs (read through their own tables) follow the same rule. */
+  {
+    static unsigned char params_buffer[sizeof(sph_world_params) + 64];
+    sph_world_params* params = (sph_world_params*)params_buffer;
+    world = NULL;
+    def->struct_size = sizeof(sph_world_def);
+    EXPECT_OK(sph_world_create(context, def, &world));
+    sph_world_params_init(params);
+    EXPECT_OK(sph_world_get_params(world, params));
+    params->struct_size = UINT32_MAX;
+    EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "struct_size", sph_world_set_params(world, params));
+    memset(big_init, 0xab, sizeof big_init);
+    EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "size",
+                 sph_world_params_init_sized((sph_world_params*)big_init, (uint32_t)sizeof big_init));
+    assert_int_equal(big_init[0], 0xab);
+    EXPECT_OK(sph_world_destroy(world));
+  }
   EXPECT_OK(sph_context_destroy(context));
 }
 
