@@ -121,6 +121,31 @@ void CudaBackend::truncate(uint32_t count) {
   ++epoch_;
 }
 
+void CudaBackend::save_step_inputs() {
+  require_alive();
+  DeviceGuard guard(device_);
+  guarded([&] { copy_step_inputs(/*save=*/true); });
+}
+
+void CudaBackend::restore_step_inputs() {
+  require_alive();
+  DeviceGuard guard(device_);
+  guarded([&] {
+    copy_step_inputs(/*save=*/false);
+    cuda_check(cudaStreamSynchronize(r_->stream), "restore of the step inputs");
+  });
+}
+
+void CudaBackend::copy_step_inputs(bool save) {
+  FrameState* s = r_->state.get();
+  float* const carried[2] = {&s->max_speed, &s->max_acceleration};
+  float* const saved[2] = {&s->emission_saved_max_speed, &s->emission_saved_max_acceleration};
+  for (int k = 0; k < 2; ++k)
+    cuda_check(cudaMemcpyAsync(save ? saved[k] : carried[k], save ? carried[k] : saved[k], sizeof(float),
+                               cudaMemcpyDeviceToDevice, r_->stream),
+               "copy of the step inputs");
+}
+
 void CudaBackend::copy_attribute(AttributeKind kind, uint32_t first, uint32_t count, void* dst,
                                  size_t stride) const {
   require_alive();

@@ -40,6 +40,15 @@ class CpuBackend final : public Backend {
 
   void truncate(uint32_t count) override;
 
+  void save_step_inputs() override {
+    saved_inputs_ = StepInputs{max_speed_, max_acceleration_, max_speed_valid_};
+  }
+  void restore_step_inputs() override {
+    max_speed_ = saved_inputs_.max_speed;
+    max_acceleration_ = saved_inputs_.max_acceleration;
+    max_speed_valid_ = saved_inputs_.max_speed_valid;
+  }
+
   void copy_attribute(AttributeKind kind, uint32_t first, uint32_t count, void* dst,
                       size_t stride) const override;
 
@@ -135,6 +144,10 @@ class CpuBackend final : public Backend {
   float max_acceleration_ = 0.0f;  // of the last force evaluation, for the force step limit
   NonFiniteFailure non_finite_;    // of the last failed substep, for its error message
   bool max_speed_valid_ = false;
+  struct StepInputs {
+    float max_speed = 0.0f, max_acceleration = 0.0f;
+    bool max_speed_valid = false;
+  } saved_inputs_;  // save_step_inputs()
 };
 
 }  // namespace sph
