@@ -52,6 +52,16 @@ float fcc_spiky_scale(float spacing, float kernel_radius);
 // Averaged over the (100), (110) and (111) faces (they differ by about 5 %).
 double fcc_surface_delta_integral(float spacing, float kernel_radius, float threshold);
 
+// The boundary density's scale per unit particle mass (1/m^3; physics/boundary_density.h): the
+// sum of the world's density kernel s W_spiky over the half lattice that a flat wall takes away
+// from a particle of the first layer, spacing/2 from the wall (as fcc_points_in_box places it),
+// averaged over walls along the (100), (110) and (111) planes, divided by the continuous share
+// of the kernel beyond the wall there (spiky_half_space(spacing/2)). So m times this times the
+// half-space share is the missing density of an average first layer. The three faces differ:
+// at h = 1.8 spacings they miss 23.1 %, 29.3 % and 18.7 % of rho0 (the (110) lattice continues
+// with a plane on the wall itself), and this averages them (1.55 rho0 / m at 1.8 spacings).
+double fcc_boundary_density_scale(float spacing, float kernel_radius);
+
 // Surface tension's cohesion (physics/surface_tension.h) on the FCC lattice at `spacing`, per
 // unit gamma m^2 (so both scale with the world's gamma and particle mass):
 // - surface_energy: half the work, per unit area, to pull two lattice half-spaces apart along a
