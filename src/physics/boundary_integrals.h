@@ -7,9 +7,9 @@
 // With W(r) = 15 / (pi h^6) (h - r)^3 (unit integral over the ball of radius h):
 //   radial_volume(r) = int_0^r W(t) t^2 dt, so int over a cone of solid angle dOmega between
 //     radii r0 and r1 of W dV is dOmega (radial_volume(r1) - radial_volume(r0));
-//   radial_gradient(r) = int_0^r -W'(t) t^2 dt, the same for |grad W| (grad_x W(|x - y|) points
-//     from y to x: the integral of grad_x W over the solid is -sum over directions w of
-//     w dOmega (radial_gradient(r1) - radial_gradient(r0)));
+//   radial_gradient(r) = int_0^r -W'(t) t^2 dt, the same for |grad W| (grad_x W(|x - y|) =
+//     -W'(r) w for y = x + r w points from x to y: the integral of grad_x W over the solid is the
+//     sum over directions w of w dOmega (radial_gradient(r1) - radial_gradient(r0)));
 //   half_space(d) = int over {z > d} of W(|x|) dV = a^5 (1.5 h - a) / h^6 with a = h - d, for
 //     0 <= d <= h (1/2 at d = 0, 0 at d >= h), and 1 - half_space(-d) for d < 0: the share of
 //     the kernel's unit mass that lies beyond a plane at signed distance d.

@@ -133,7 +133,7 @@ SPH_HD Float4 boundary_map_correction(const SdfGridView& g, const Affine3x4& ind
         const Vec3 w = n * mu + (t1 * SPH_COSF(angle) + t2 * SPH_SINF(angle)) * sin_theta;
         const RayIntegral ray = integrate_ray(g, x, w, h, steps, phi);
         share += w_mu * ray.volume;
-        gradient += w * (-w_mu * ray.gradient);
+        gradient += w * (w_mu * ray.gradient);
       }
     }
   }

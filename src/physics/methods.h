@@ -29,7 +29,8 @@ enum FeatureBits : uint32_t {
   kFeatureNormalizedDensity = 1u << 1,
   kFeatureSprings = 1u << 2,
   kFeatureBoundaryDensity = 1u << 3,
-  kFeatureAll = kFeatureSurfaceTension | kFeatureNormalizedDensity | kFeatureSprings | kFeatureBoundaryDensity,
+  kFeatureAll =
+      kFeatureSurfaceTension | kFeatureNormalizedDensity | kFeatureSprings | kFeatureBoundaryDensity,
 };
 
 enum class ViscosityMethod : uint32_t { Mueller = 0, Clavet = 1 };
