@@ -178,8 +178,9 @@ typedef uint32_t sph_feature_flags;
 /** Walls in the density: every collider's solid counts as fluid at rest density in the
  *  particles' density sums (a density map per SDF asset, Koschier & Bender 2017), and the wall
  *  pushes back through the pressure force, so particles at a wall no longer read low density
- *  (a resting FCC block reads rho0 at a wall within 1 % for an axis-aligned wall, 6 % for any
- *  orientation, against 77 % without). The maps are computed per asset and kernel radius when a
+ *  (a resting FCC block from sph_world_fill_box reads rho0 at axis-aligned walls, within 6.2 %
+ *  for other lattice orientations, +5 % at edges and +14 % at corners, against 77 %, 59 % and
+ *  48 % of rho0 without). The maps are computed per asset and kernel radius when a
  *  collider first steps with the asset and after sph_sdf_update (16 bytes per SDF voxel; on the
  *  device for CUDA). The collision response stays the no-penetration safeguard. Costs one SDF
  *  and map sample per particle and collider in each density pass (docs/physics.md). */

@@ -179,15 +179,13 @@ double fcc_boundary_density_scale(float spacing, float kernel_radius) {
   k.spiky *= fcc_spiky_scale(spacing, kernel_radius);  // the world's density kernel
   const int64_t reach = static_cast<int64_t>(std::ceil(k.h / step)) + 1;
   double missing = 0.0;
-  for (const auto& f : kFccFaces) {
-    // The particle on the first plane above f . q = 0; the half space f . q <= 0 is what a wall
-    // there takes away. Its first layer is one plane gap from the wall's lattice continuation.
-    int64_t p[3] = {0, 0, 0};
-    nearest_point_on_plane(f, f[3], reach, p);
-    for_each_half_space_point_near(f, p, reach, step, k.h2,
-                                   [&](const double*, double r2) { missing += spiky_value(k, std::sqrt(r2)); });
-  }
-  missing /= 3.0;
+  // The (100) face: the particle on the first plane above f . q = 0; the half space f . q <= 0
+  // is what a wall there takes away.
+  const int64_t* f = kFccFaces[0];
+  int64_t p[3] = {0, 0, 0};
+  nearest_point_on_plane(f, f[3], reach, p);
+  for_each_half_space_point_near(f, p, reach, step, k.h2,
+                                 [&](const double*, double r2) { missing += spiky_value(k, std::sqrt(r2)); });
   return missing / spiky_half_space<double>(0.5 * static_cast<double>(spacing), k.h);
 }
 

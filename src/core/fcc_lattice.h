@@ -53,13 +53,15 @@ float fcc_spiky_scale(float spacing, float kernel_radius);
 double fcc_surface_delta_integral(float spacing, float kernel_radius, float threshold);
 
 // The boundary density's scale per unit particle mass (1/m^3; physics/boundary_density.h): the
-// sum of the world's density kernel s W_spiky over the half lattice that a flat wall takes away
-// from a particle of the first layer, spacing/2 from the wall (as fcc_points_in_box places it),
-// averaged over walls along the (100), (110) and (111) planes, divided by the continuous share
-// of the kernel beyond the wall there (spiky_half_space(spacing/2)). So m times this times the
-// half-space share is the missing density of an average first layer. The three faces differ:
-// at h = 1.8 spacings they miss 23.1 %, 29.3 % and 18.7 % of rho0 (the (110) lattice continues
-// with a plane on the wall itself), and this averages them (1.55 rho0 / m at 1.8 spacings).
+// sum of the world's density kernel s W_spiky over the half lattice that a flat wall along a
+// (100) plane takes away from a particle of the first layer, spacing/2 from the wall (as
+// fcc_points_in_box places it against an axis-aligned wall), divided by the continuous share of
+// the kernel beyond the wall there (spiky_half_space(spacing/2)). So m times this times the
+// half-space share is the missing density of that first layer. Other faces differ: at h = 1.8
+// spacings the (100), (110) and (111) faces miss 23.1 %, 29.3 % and 18.7 % of rho0 (the (110)
+// lattice continues with a plane on the wall itself); calibrated on (100), the others read -6.2 %
+// and +4.4 % (1.51 rho0 / m at 1.8 spacings). Averaging the three faces was tried: +0.6 % on
+// (100), and a hydrostatic tank's wall pressure twice as far off.
 double fcc_boundary_density_scale(float spacing, float kernel_radius);
 
 // Surface tension's cohesion (physics/surface_tension.h) on the FCC lattice at `spacing`, per

@@ -9,8 +9,9 @@
 // the FCC lattice (core/fcc_lattice.h, fcc_boundary_density_scale): the fluid's density is a
 // discrete sum, rho_i = m (w0 + sum_{j != i} s W_spiky(r_ij)), and a lattice whose first layer
 // sits spacing/2 from a wall misses the sum over the half lattice beyond it, which is not
-// rho0 Phi: K = m T / Phi_flat(spacing/2), with T the missing sum averaged over walls along the
-// (100), (110) and (111) lattice planes (1.55 rho0 at h = 1.8 spacings; docs/physics.md).
+// rho0 Phi: K = m T / Phi_flat(spacing/2), with T the missing sum at a wall along the lattice's
+// (100) plane, the face a box fill puts against axis-aligned walls (1.51 rho0 at h = 1.8
+// spacings; other faces read -6.2 % and +4.4 %; docs/physics.md).
 //
 // Phi is sampled, per collider, as the flat-wall value of the collider's own signed distance
 // plus a correction stored per SDF voxel (boundary_map.h):
