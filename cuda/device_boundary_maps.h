@@ -10,7 +10,8 @@
 
 #include <cuda_runtime.h>
 
-#include <unordered_map>
+#include <map>
+#include <utility>
 
 #include "../src/core/sdf_asset.h"
 #include "../src/physics/float4_types.h"
@@ -21,8 +22,10 @@ namespace sph {
 class DeviceBoundaryMaps {
  public:
   void begin_frame() { ++frame_; }
-  // The map of an asset for kernel radius h; `sdf` is the asset's device view.
-  const Float4* bind(const SdfAsset& asset, const SdfGridView& sdf, float h, cudaStream_t stream);
+  // The map of an asset for kernel radius h and SDF level `level` (boundary_map.h); `sdf` is the
+  // asset's device view.
+  const Float4* bind(const SdfAsset& asset, const SdfGridView& sdf, float h, float level,
+                     cudaStream_t stream);
   void end_frame();
   // 16 bytes per voxel of every map held.
   uint64_t bytes() const;
@@ -34,7 +37,7 @@ class DeviceBoundaryMaps {
     uint64_t last_frame = 0;
     DeviceArray<Float4> correction;
   };
-  std::unordered_map<uint64_t, Entry> entries_;
+  std::map<std::pair<uint64_t, float>, Entry> entries_;  // by asset uid and level
   uint64_t frame_ = 0;
 };
 

@@ -60,8 +60,9 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
         if (options_.boundary_density) {
           r_->boundary_maps.begin_frame();
           for (ColliderFrame& c : scene.colliders)
-            c.view.boundary_map =
-                r_->boundary_maps.bind(*c.sdf, c.view.sdf, config_.kernel_radius, r_->stream);
+            c.view.boundary_map = r_->boundary_maps.bind(
+                *c.sdf, c.view.sdf, config_.kernel_radius,
+                BoundaryDensity::map_level(setup.fluid.methods.boundary, c.view.sign), r_->stream);
           r_->boundary_maps.end_frame();
         }
         setup.scene = r_->scene_buffer.upload(scene, config_.kernel_radius, r_->stream);

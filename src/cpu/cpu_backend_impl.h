@@ -69,7 +69,7 @@ class CpuBackend final : public Backend {
 
   // Binds the world's boundary-density maps into the scene's collider views (computing those
   // that are new or stale) and lists the views for the density pass.
-  void bind_boundary_maps(SceneFrame& scene);
+  void bind_boundary_maps(const FluidConstants& fluid, SceneFrame& scene);
 
   // The wall's pressure acceleration of particle i (zero without SPH_FEATURE_BOUNDARY_DENSITY).
   Vec3 wall_acceleration(uint32_t i) const {

@@ -4,7 +4,7 @@
 
 namespace sph {
 
-std::vector<Float4> compute_boundary_map(const SdfAsset& asset, float h, unsigned workers) {
+std::vector<Float4> compute_boundary_map(const SdfAsset& asset, float h, float level, unsigned workers) {
   std::vector<Float4> map(asset.voxel_count(), Float4{0.0f, 0.0f, 0.0f, 0.0f});
   const SdfGridView g = asset.host_view();
   const Affine3x4 index_to_local = asset.index_to_local();
@@ -16,17 +16,17 @@ std::vector<Float4> compute_boundary_map(const SdfAsset& asset, float h, unsigne
     const int32_t j = static_cast<int32_t>(row % asset.ny()), k = static_cast<int32_t>(row / asset.ny());
     for (int32_t i = 0; i < asset.nx(); ++i)
       map[static_cast<size_t>(i) + static_cast<size_t>(asset.nx()) * static_cast<size_t>(row)] =
-          boundary_map_correction(g, index_to_local, i, j, k, h);
+          boundary_map_correction(g, index_to_local, i, j, k, h, level);
   }
   return map;
 }
 
-const Float4* CpuBoundaryMaps::bind(const SdfAsset& asset, float h, unsigned workers) {
-  Entry& e = entries_[asset.uid()];
+const Float4* CpuBoundaryMaps::bind(const SdfAsset& asset, float h, float level, unsigned workers) {
+  Entry& e = entries_[std::make_pair(asset.uid(), level)];
   e.last_frame = frame_;
   if (e.version != asset.version() || e.kernel_radius != h || e.correction.size() != asset.voxel_count()) {
     e.version = 0;  // until the map below is complete
-    e.correction = compute_boundary_map(asset, h, workers);
+    e.correction = compute_boundary_map(asset, h, level, workers);
     e.kernel_radius = h;
     e.version = asset.version();
     ++builds_;

@@ -7,7 +7,8 @@
 
 #include <stdint.h>
 
-#include <unordered_map>
+#include <map>
+#include <utility>
 #include <vector>
 
 #include "../core/sdf_asset.h"
@@ -19,8 +20,9 @@ class CpuBoundaryMaps {
  public:
   // Marks the start of a frame's binding: maps not bound again until end_frame() are dropped.
   void begin_frame() { ++frame_; }
-  // The map of an asset for kernel radius h, computed on `workers` threads when new or stale.
-  const Float4* bind(const SdfAsset& asset, float h, unsigned workers);
+  // The map of an asset for kernel radius h and SDF level `level` (boundary_map.h), computed on
+  // `workers` threads when new or stale.
+  const Float4* bind(const SdfAsset& asset, float h, float level, unsigned workers);
   void end_frame();
   // 16 bytes per voxel of every map held.
   uint64_t bytes() const;
@@ -35,13 +37,14 @@ class CpuBoundaryMaps {
     uint64_t last_frame = 0;
     std::vector<Float4> correction;
   };
-  std::unordered_map<uint64_t, Entry> entries_;
+  std::map<std::pair<uint64_t, float>, Entry> entries_;  // by asset uid and level
   uint64_t frame_ = 0;
   uint64_t builds_ = 0;
 };
 
-// The map of an asset for kernel radius h (every voxel; zero outside the band |phi| < h), on
-// `workers` threads. Exposed for tests, which compare it with a brute-force integral.
-std::vector<Float4> compute_boundary_map(const SdfAsset& asset, float h, unsigned workers);
+// The map of an asset for kernel radius h and SDF level `level` (every voxel; zero outside the band
+// |phi - level| < h), on `workers` threads. Exposed for tests, which compare it with a brute-force
+// integral.
+std::vector<Float4> compute_boundary_map(const SdfAsset& asset, float h, float level, unsigned workers);
 
 }  // namespace sph

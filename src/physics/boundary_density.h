@@ -1,37 +1,37 @@
-// Walls in the density (SPH_FEATURE_BOUNDARY_DENSITY): a collider's solid counts as fluid at
-// rest density in every particle's density sum, as a density map (Koschier & Bender 2017,
-// "Density maps for improved SPH boundary handling"), so particles at a wall read the bulk's
-// density instead of 70-80 % of it, and the wall pushes back through the pressure force.
+// Walls in the density (SPH_FEATURE_BOUNDARY_DENSITY): a collider's solid counts in every
+// particle's density sum, as a density map (Koschier & Bender 2017, "Density maps for improved
+// SPH boundary handling"), so particles at a wall read the bulk's density instead of 70-80 % of
+// it, and the wall pushes back through the pressure force.
 //
 // The boundary's share of particle i's density is
-//     rho_b(x_i) = K Phi(x_i),   Phi(x) = int over the solid of W_spiky(|x - y|, h) dy,
-// Phi in [0, 1] the share of the kernel's unit mass inside the solid. K (kg/m^3) is calibrated on
-// the FCC lattice (core/fcc_lattice.h, fcc_boundary_density_scale): the fluid's density is a
-// discrete sum, rho_i = m (w0 + sum_{j != i} s W_spiky(r_ij)), and a lattice whose first layer
-// sits spacing/2 from a wall misses the sum over the half lattice beyond it, which is not
-// rho0 Phi: K = m T / Phi_flat(spacing/2), with T the missing sum at a wall along the lattice's
-// (100) plane, the face a box fill puts against axis-aligned walls (1.51 rho0 at h = 1.8
-// spacings; other faces read -6.2 % and +4.4 %; docs/physics.md).
+//     rho_b(x_i) = K Phi(x_i),   Phi(x) = int over the solid moved back by delta of W_spiky(|x - y|, h) dy,
+// Phi in [0, 1] the share of the kernel's unit mass inside the solid whose surface is moved delta
+// into it (the level set sigma phi = -delta of the collider's SDF). K (kg/m^3) and delta (m) are
+// calibrated on the FCC lattice (core/fcc_lattice.h, fcc_boundary_calibration): the fluid's
+// density is a discrete sum, rho_i = m (w0 + sum_{j != i} s W_spiky(r_ij)), and at a wall along
+// the lattice's (100) plane the first layer (spacing/2 from the wall) misses the sum over the half
+// lattice beyond it; K and delta make rho_b equal that sum there and its slope twice the sum's
+// (the fluid's pairs, each counted by both its particles, push the layer towards the wall by
+// that much at uniform pressure). 12.0 rho0 and 0.49 spacings at h = 1.8 spacings; docs/physics.md.
 //
 // Phi is sampled, per collider, as the flat-wall value of the collider's own signed distance
 // plus a correction stored per SDF voxel (boundary_map.h):
-//     Phi(x) = Phi_flat(sigma phi(x)) + sigma dPhi(x),  grad Phi = Phi_flat'(sigma phi) sigma grad phi
-//              + sigma d(grad Phi)(x),
+//     Phi(x) = Phi_flat(sigma (phi(x) - L)) + sigma dPhi_L(x),   L = -sigma delta,
+//     grad Phi = Phi_flat'(...) sigma grad phi + sigma d(grad Phi)_L(x),
 // phi the SDF (trilinear), sigma the collider's sign (-1 for an inverted collider, whose solid is
-// the complement), Phi_flat the closed-form half-space share (boundary_integrals.h), and the
-// correction (trilinear) what curvature, corners and thin walls add, computed per asset and
-// kernel radius by a quadrature over the solid. A flat wall is exact at any voxel size (the
-// trilinear SDF of a plane is the plane); the correction varies on the body's scale, not on h's.
+// the complement: Phi = 1 - the share of {phi < L}), Phi_flat the closed-form half-space share
+// (boundary_integrals.h), and the correction (trilinear) for the level L what curvature, corners
+// and thin walls add, computed per asset, kernel radius and level by a quadrature over the solid.
+// A flat wall is exact at any voxel size (the trilinear SDF of a plane is the plane).
 //
 // The pressure force of the wall (Akinci et al. 2012 with the wall's share as the boundary
-// "particles", and the particle's own pressure mirrored onto them):
-//     a_i = -2 (p_i / rho_i^2) grad rho_b(x_i),
-// the symmetric pair force -m (p_i / rho_i^2 + p_b / rho_b^2) grad W with p_b / rho_b^2 =
-// p_i / rho_i^2. The factor 2 is what balances a fluid at uniform pressure: near a wall the
-// fluid-fluid pairs push a particle towards the wall by 2 (p / rho^2) grad rho_b (their
-// missing half), and the wall must return that. Its reaction on the collider is
-// +2 m (p_i / rho_i^2) grad rho_b(x_i) per particle and collider (collider_boundary_share keeps
-// each collider's share apart for a reduction of loads).
+// "particles"): a_i = -(p_i / rho_i^2) grad rho_b(x_i). It is minus the gradient of the fluid's
+// internal energy sum_i m e(rho_i) through rho_b (de/drho = p / rho^2), as the symmetric pair force
+// is through the pairs, so a static wall does no net work on the fluid (a mirrored pressure,
+// 2 p_i / rho_i^2, is not a gradient: measured, it kept a tank at rest sloshing at 0.3-0.8 J where
+// this one settles). Its reaction on the collider is +m (p_i / rho_i^2) grad rho_b(x_i) per
+// particle and collider (collider_boundary_share keeps each collider's share apart for a
+// reduction of loads).
 //
 // Interface for the solvers (the density pass and DFSPH): per particle, boundary_share() sums the
 // colliders' shares at the particle's position and the stage's time; the density pass adds
@@ -65,21 +65,23 @@ struct BoundaryDensity {
       {kArrayBoundaryGradient, sizeof(Float4), ParticleArrayRole::Scratch, 1, nullptr, nullptr}};
 
   struct Constants {
-    float density_scale;  // K, kg/m^3: rho_b = K Phi
-    float kernel_radius;  // h, m (the maps are made for it)
+    float density_scale;   // K, kg/m^3: rho_b = K Phi
+    float kernel_radius;   // h, m (the maps are made for it)
+    float surface_offset;  // delta, m: Phi is the share of the solid moved this far into it
   };
 
-  // The wall's pressure is the particle's own, mirrored (header comment).
-  static constexpr float kPressureMirror = 2.0f;
-
   static Constants make_constants(const WorldShape& shape, const LatticeSums& lattice) {
+    double scale = 0.0, offset = 0.0;
+    lattice.boundary_calibration(shape.particle_spacing, shape.kernel_radius, &scale, &offset);
     Constants c;
-    c.density_scale =
-        static_cast<float>(lattice.boundary_density_scale(shape.particle_spacing, shape.kernel_radius) *
-                           static_cast<double>(shape.particle_mass));
+    c.density_scale = static_cast<float>(scale * static_cast<double>(shape.particle_mass));
     c.kernel_radius = shape.kernel_radius;
+    c.surface_offset = static_cast<float>(offset);
     return c;
   }
+
+  // The SDF level whose solid a collider of this sign counts (the map is made for it).
+  SPH_HD static float map_level(const Constants& c, float sign) { return -sign * c.surface_offset; }
 };
 
 // One collider's share of a particle's density, or the sum of several.
@@ -127,15 +129,16 @@ SPH_HD TrilinearGradient trilinear_with_gradient(const float* data, const SdfGri
   return out;
 }
 
-// Phi and grad Phi (local frame) of a solid where sigma phi < 0, at a local point: the flat-wall
-// share of the trilinear SDF plus the map's correction (null map: the flat-wall share alone).
+// Phi and grad Phi (local frame) of the solid where sigma (phi - level) < 0, at a local point: the
+// flat-wall share of the trilinear SDF plus the map's correction for that level (null map: the
+// flat-wall share alone).
 struct LocalBoundaryShare {
   float share;    // Phi in [0, 1] (up to the correction's error)
   Vec3 gradient;  // grad Phi, 1/m, local frame
 };
 
 SPH_HD LocalBoundaryShare local_boundary_share(const SdfGridView& g, const Float4* correction, float sign,
-                                               float h, Vec3 local) {
+                                               float level, float h, Vec3 local) {
   const Vec3 idx = apply_affine(g.local_to_index, local);
   const TrilinearCell cell = locate(g, local);
   const TrilinearGradient phi = trilinear_with_gradient(g.distance, g, cell);
@@ -150,7 +153,7 @@ SPH_HD LocalBoundaryShare local_boundary_share(const SdfGridView& g, const Float
     const float n = length(away);
     if (n > 0.0f) gradient_index += away * (g.min_voxel_size / n);
   }
-  distance *= sign;
+  distance = sign * (distance - level);
   LocalBoundaryShare out;
   out.share = spiky_half_space(distance, h);
   out.gradient = apply_linear_transposed(g.local_to_index, gradient_index) *
@@ -172,7 +175,8 @@ SPH_HD BoundaryShare collider_boundary_share(const BoundaryDensity::Constants& b
   RigidTransform pose = c.moving ? interpolate(c.pose_start, c.pose_end, s) : c.pose_start;
   Vec3 local = to_local(pose, world);
   if (c.deforming) local = local - sample_velocity(c.sdf, local) * tau;
-  const LocalBoundaryShare l = local_boundary_share(c.sdf, c.boundary_map, c.sign, b.kernel_radius, local);
+  const LocalBoundaryShare l = local_boundary_share(
+      c.sdf, c.boundary_map, c.sign, BoundaryDensity::map_level(b, c.sign), b.kernel_radius, local);
   BoundaryShare out;
   out.density = b.density_scale * l.share;
   out.gradient = direction_to_world(pose, l.gradient) * b.density_scale;
@@ -214,14 +218,14 @@ SPH_HD float boundary_density_rate(const Float4& record, Vec3 velocity) {
 
 // The wall's pressure acceleration of a particle of pressure p and inverse density inv_rho.
 SPH_HD Vec3 boundary_pressure_acceleration(const Float4& record, float pressure, float inv_rho) {
-  return xyz(record) * (-BoundaryDensity::kPressureMirror * pressure * inv_rho * inv_rho);
+  return xyz(record) * (-pressure * inv_rho * inv_rho);
 }
 
 // The force (N) of one particle on one collider: minus the wall's force on the particle
 // (momentum is exchanged, not made), for a reduction of loads per collider.
 SPH_HD Vec3 boundary_reaction_force(const BoundaryShare& collider_share, float mass, float pressure,
                                     float inv_rho) {
-  return collider_share.gradient * (BoundaryDensity::kPressureMirror * mass * pressure * inv_rho * inv_rho);
+  return collider_share.gradient * (mass * pressure * inv_rho * inv_rho);
 }
 
 // The frame fraction and time of an integration stage: the substep's start for symplectic Euler

@@ -1,9 +1,9 @@
-// The boundary density's map of an SDF asset for a kernel radius h (boundary_density.h): per
-// voxel, what the solid's true kernel share Phi and its gradient differ by from the flat-wall
-// share of the SDF, which the sampling adds back:
+// The boundary density's map of an SDF asset for a kernel radius h and an SDF level L (the solid
+// {phi < L}; boundary_density.h: L = -sigma delta): per voxel, what the solid's true kernel share
+// Phi and its gradient differ by from the flat-wall share of the SDF, which the sampling adds back:
 //     correction(node) = (Phi(x) - Phi_flat, grad Phi(x) - grad Phi_flat)
 // with Phi_flat and its gradient exactly as local_boundary_share computes them at the node (so a
-// sample at a node returns the quadrature's values). Zero where |phi| >= h: the kernel sees one
+// sample at a node returns the quadrature's values). Zero where |phi - L| >= h: the kernel sees one
 // side only there (for an SDF that is a distance), so the voxels to compute are a band of 2 h
 // around the surface; the rest of the map is zero. Both backends call boundary_map_correction
 // per band voxel: the CPU backend on host threads, the CUDA backend one thread per voxel.
@@ -69,12 +69,13 @@ struct RayIntegral {
   float gradient;  // sum of spiky_radial_gradient differences
 };
 
-SPH_HD RayIntegral integrate_ray(const SdfGridView& g, Vec3 x, Vec3 w, float h, int steps, float phi0) {
+SPH_HD RayIntegral integrate_ray(const SdfGridView& g, Vec3 x, Vec3 w, float h, float level, int steps,
+                                 float phi0) {
   RayIntegral out{0.0f, 0.0f};
   float r0 = 0.0f, a = phi0;
   for (int k = 1; k <= steps; ++k) {
     const float r1 = h * static_cast<float>(k) / static_cast<float>(steps);
-    const float b = sample_distance(g, x + w * r1);
+    const float b = sample_distance(g, x + w * r1) - level;
     float lo = 1.0f, hi = 0.0f;  // the solid's part of [r0, r1], empty unless set
     if (a < 0.0f && b < 0.0f) {
       lo = r0, hi = r1;
@@ -98,10 +99,12 @@ SPH_HD int boundary_map_ray_steps(const SdfGridView& g, float h) {
   return n < 8.0f ? 8 : (n > 64.0f ? 64 : static_cast<int>(SPH_CEILF(n)));
 }
 
-// The correction of voxel (i, j, k); index_to_local is the inverse of g.local_to_index.
+// The correction of voxel (i, j, k) for the solid {phi < level}; index_to_local is the inverse of
+// g.local_to_index.
 SPH_HD Float4 boundary_map_correction(const SdfGridView& g, const Affine3x4& index_to_local, int32_t i,
-                                      int32_t j, int32_t k, float h) {
+                                      int32_t j, int32_t k, float h, float level) {
   const float phi =
+      -level +
       g.distance[static_cast<int64_t>(i) + static_cast<int64_t>(g.nx) * (j + static_cast<int64_t>(g.ny) * k)];
   if (!(phi > -h && phi < h)) return Float4{0.0f, 0.0f, 0.0f, 0.0f};
   const Vec3 x =
@@ -131,13 +134,13 @@ SPH_HD Float4 boundary_map_correction(const SdfGridView& g, const Affine3x4& ind
       for (int p = 0; p < kBoundaryMapAzimuths; ++p) {
         const float angle = azimuth_weight * (static_cast<float>(p) + 0.5f);
         const Vec3 w = n * mu + (t1 * SPH_COSF(angle) + t2 * SPH_SINF(angle)) * sin_theta;
-        const RayIntegral ray = integrate_ray(g, x, w, h, steps, phi);
+        const RayIntegral ray = integrate_ray(g, x, w, h, level, steps, phi);
         share += w_mu * ray.volume;
         gradient += w * (w_mu * ray.gradient);
       }
     }
   }
-  const LocalBoundaryShare flat = local_boundary_share(g, nullptr, 1.0f, h, x);
+  const LocalBoundaryShare flat = local_boundary_share(g, nullptr, 1.0f, level, h, x);
   const Vec3 dg = gradient - flat.gradient;
   return Float4{share - flat.share, dg.x, dg.y, dg.z};
 }

@@ -16,9 +16,9 @@ struct WorldShape {
 struct LatticeSums {
   double (*surface_delta_integral)(float spacing, float kernel_radius, float threshold);
   double (*cohesion_surface_energy)(float spacing, float kernel_radius);
-  // 1/m^3: the missing half-lattice sum at a wall over the half-space share there
-  // (fcc_boundary_density_scale); times the particle mass, the boundary density's scale K.
-  double (*boundary_density_scale)(float spacing, float kernel_radius);
+  // The boundary density's scale (1/m^3; times the particle mass, K) and its wall offset (m)
+  // (fcc_boundary_calibration).
+  void (*boundary_calibration)(float spacing, float kernel_radius, double* scale, double* offset);
 };
 
 }  // namespace sph

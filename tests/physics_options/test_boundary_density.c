@@ -197,16 +197,18 @@ static void block_against_walls(int closed, uint32_t features, layer_stats faces
 }
 
 /* The floor is the (100) case of the test above: rho0 with the feature (bound 0.3 %), 23.1 %
- * low without. In the box the faces read as the floor; edges and corners add the shares of two
- * or three walls, where the calibration's factor (1.51, which makes up for the lattice's nearest
- * missing plane lying closer behind a flat wall than the continuum's mass) overcounts the
- * overlapping quarter and eighth spaces: measured +5.3 % at edges and +13.8 % at corners
- * (without: -41 % and -52 %); faces near an edge read up to +0.3 % (a second wall within h);
- * bounds 0.3 % (faces) and 0.4 % around the measured ranges. The bulk reads rho0 either way
+ * low without. In the box the faces read as the floor (down to -1.1 % near an edge, where a
+ * second wall is within h); edges and corners add the shares of two or three walls, where the
+ * calibration (a steep share, 12 rho0 times the kernel's share beyond the wall moved 0.49 spacings
+ * into the solid, fitted to a flat wall's value and slope) overcounts the overlapping quarter and
+ * eighth spaces: measured +26 % along edges and +67 % in corners at this placement (without:
+ * -41 % and -52 %). Such particles are pushed off the corner at the first steps; settled, the
+ * tank below reads at most +2.5 %. Bounds 0.3 % (faces) and 0.4 % around the measured ranges.
+ * The bulk reads rho0 either way
  * (0.1 %: the lattice's own calibration). */
 static void test_block_on_a_floor_and_in_a_box(void** state) {
   const char* names[4] = {"bulk", "faces", "edges", "corners"};
-  const double expected_on[4][2] = {{1.0, 1.0}, {1.0000, 1.0029}, {1.0531, 1.0537}, {1.1379, 1.1379}};
+  const double expected_on[4][2] = {{1.0, 1.0}, {0.9890, 1.0000}, {1.2565, 1.2607}, {1.6673, 1.6673}};
   const double expected_off[4] = {1.0, 0.768, 0.593, 0.476};
   (void)state;
   for (int closed = 0; closed < 2; ++closed) {
@@ -233,12 +235,15 @@ static void test_block_on_a_floor_and_in_a_box(void** state) {
  * its depth below the top of the fluid (the top layer plus half a step): the mean of
  * p / (rho0 g d) - 1 over those particles. Without the walls' share they read low by the
  * summation's deficit (the EOS clamps it to zero pressure at rest density); with it they read
- * nearer the hydrostatic value, but high: measured +38 % at the floor (-39 % without) and +71 %
- * at the side walls away from edges (-72 % without). The hydrostatic signal is small in density
- * at the default stiffness (k = 100: 1.4 % of rho0 at the floor, 0.7 % at mid-depth), so a bias
- * of half a percent in the walls' share shows as tens of percent of pressure; the test asserts
- * what the issue asks (closer than without) and that nothing falls through the floor. */
-static void tank_wall_pressure(uint32_t features, double* floor_error, double* side_error, float* lowest) {
+ * nearer the hydrostatic value, a little high: measured +19 % at the floor (-39 % without) and
+ * +26 % at the side walls away from edges (-72 % without). The hydrostatic signal is small in
+ * density at the default stiffness (k = 100: 1.4 % of rho0 at the floor, 0.7 % at mid-depth), so
+ * a bias of a quarter percent of density near the walls shows as a fifth of the pressure. Bounds:
+ * closer than without (the issue's criterion), and 25 % / 35 %; the tank must settle (kinetic
+ * energy below 2 mJ at the end, measured 0.63 mJ; with the wall's pressure mirrored, 2 p / rho^2,
+ * it kept sloshing at 0.3-0.8 J) and nothing may fall through the floor. */
+static void tank_wall_pressure(uint32_t features, double* floor_error, double* side_error, float* lowest,
+                               double* kinetic) {
   const uint32_t layers[3] = {10, 14, 10};
   const double step = 0.01, origin[3] = {0.0, 0.0, 0.0};
   const double width = layers[0] * step, depth = layers[1] * step;
@@ -277,6 +282,7 @@ static void tank_wall_pressure(uint32_t features, double* floor_error, double* s
     ++samples;
   }
   EXPECT_OK(support_copy_by_id(w.world, SPH_ATTRIBUTE_POSITION, (void**)&x, &m));
+  EXPECT_OK(support_kinetic_energy(w.world, w.mass, kinetic));
   {
     double f = 0.0, s = 0.0;
     uint32_t nf = 0, ns = 0;
@@ -299,17 +305,20 @@ static void tank_wall_pressure(uint32_t features, double* floor_error, double* s
 }
 
 static void test_hydrostatic_tank_near_walls(void** state) {
-  double floor_on, side_on, floor_off, side_off;
+  double floor_on, side_on, floor_off, side_off, ke_on, ke_off;
   float lowest_on, lowest_off;
   (void)state;
-  tank_wall_pressure(SPH_FEATURE_BOUNDARY_DENSITY, &floor_on, &side_on, &lowest_on);
-  tank_wall_pressure(SPH_FEATURE_NONE, &floor_off, &side_off, &lowest_off);
+  tank_wall_pressure(SPH_FEATURE_BOUNDARY_DENSITY, &floor_on, &side_on, &lowest_on, &ke_on);
+  tank_wall_pressure(SPH_FEATURE_NONE, &floor_off, &side_off, &lowest_off, &ke_off);
   print_message(
       "hydrostatic tank, p / (rho0 g d) - 1 near the floor: %+.1f %% with walls in the density, "
-      "%+.1f %% without; near the side walls: %+.1f %% / %+.1f %%; lowest particle %.4f / %.4f m\n",
-      100.0 * floor_on, 100.0 * floor_off, 100.0 * side_on, 100.0 * side_off, lowest_on, lowest_off);
-  assert_true(fabs(floor_on) < fabs(floor_off));
-  assert_true(fabs(side_on) < fabs(side_off));
+      "%+.1f %% without; near the side walls: %+.1f %% / %+.1f %%; lowest particle %.4f / %.4f m; "
+      "kinetic energy at the end %.2g / %.2g J\n",
+      100.0 * floor_on, 100.0 * floor_off, 100.0 * side_on, 100.0 * side_off, lowest_on, lowest_off, ke_on,
+      ke_off);
+  assert_true(fabs(floor_on) < fabs(floor_off) && fabs(floor_on) <= 0.25);
+  assert_true(fabs(side_on) < fabs(side_off) && fabs(side_on) <= 0.35);
+  assert_true(ke_on < 2e-3);
   assert_true(lowest_on > -0.0005f); /* no particle below the floor */
 }
 

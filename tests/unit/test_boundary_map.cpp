@@ -49,7 +49,7 @@ double ball_share(double D, double R, double h) {
 void sampled_ball(const sph::SdfAsset& asset, const std::vector<sph::Float4>& map, double D, double h,
                   double& share, double& slope) {
   const sph::LocalBoundaryShare s =
-      sph::local_boundary_share(asset.host_view(), map.data(), 1.0f, static_cast<float>(h),
+      sph::local_boundary_share(asset.host_view(), map.data(), 1.0f, 0.0f, static_cast<float>(h),
                                 sph::Vec3{static_cast<float>(D), 0.0f, 0.0f});
   share = s.share;
   slope = s.gradient.x;
@@ -90,7 +90,7 @@ void test_ball_against_brute_force(void**) {
   spec.voxel_size = 0.01f;
   const auto asset = sph::build_shape_sdf(spec, 1u << 24);
   const double h = 0.036, R = 0.1;
-  const std::vector<sph::Float4> map = sph::compute_boundary_map(*asset, static_cast<float>(h), 2);
+  const std::vector<sph::Float4> map = sph::compute_boundary_map(*asset, static_cast<float>(h), 0.0f, 2);
   const std::vector<sph::Float4> none(map.size(), sph::Float4{0.0f, 0.0f, 0.0f, 0.0f});
   double worst = 0.0, worst_flat = 0.0, worst_slope = 0.0;
   for (double d = -h; d <= h + 1e-9; d += h / 7.0) {
@@ -123,17 +123,17 @@ void test_map_cache(void**) {
   sph::CpuBoundaryMaps maps;
   for (int frame = 0; frame < 3; ++frame) {
     maps.begin_frame();
-    maps.bind(*asset, 0.036f, 1);
+    maps.bind(*asset, 0.036f, 0.0f, 1);
     maps.end_frame();
   }
   assert_int_equal(maps.builds(), 1);
   asset->touch();
   maps.begin_frame();
-  maps.bind(*asset, 0.036f, 1);
+  maps.bind(*asset, 0.036f, 0.0f, 1);
   maps.end_frame();
   assert_int_equal(maps.builds(), 2);
   maps.begin_frame();
-  maps.bind(*asset, 0.05f, 1);
+  maps.bind(*asset, 0.05f, 0.0f, 1);
   maps.end_frame();
   assert_int_equal(maps.builds(), 3);
   assert_int_equal(maps.bytes(), asset->voxel_count() * sizeof(sph::Float4));
