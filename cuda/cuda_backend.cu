@@ -24,6 +24,7 @@ CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBacken
   options_.normalized_density = (config.features & kFeatureNormalizedDensity) != 0;
   options_.viscosity = config.viscosity_method;
   options_.springs = (config.features & kFeatureSprings) != 0;
+  options_.boundary_density = (config.features & kFeatureBoundaryDensity) != 0;
   // The methods' arrays (particle_arrays.h), and this backend's working arrays for springs.
   std::vector<ParticleArraySpec> arrays = method_particle_arrays(config);
   if (options_.springs)
@@ -255,7 +256,7 @@ void CudaBackend::import_particles(const ParticleSnapshot& s) {
 
 uint64_t CudaBackend::memory_bytes() const {
   return r_->store->bytes() + r_->grid->bytes() + r_->statistics->bytes() + r_->state.bytes() +
-         r_->sdf_cache.bytes() + r_->scene_buffer.bytes() + r_->sinks.bytes();
+         r_->sdf_cache.bytes() + r_->scene_buffer.bytes() + r_->sinks.bytes() + r_->boundary_maps.bytes();
 }
 
 DeviceAttributeView CudaBackend::device_attribute(AttributeKind kind) const {

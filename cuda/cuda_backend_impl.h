@@ -13,6 +13,7 @@
 #include "cuda_backend.h"
 #include "cuda_status.h"
 #include "device_array.h"
+#include "device_boundary_maps.h"
 #include "device_neighbor_grid.h"
 #include "device_particle_store.h"
 #include "device_scene.h"
@@ -39,6 +40,7 @@ struct DeviceResources {
   FrameGraph graph;
   PipelineSetup graph_setup;
   DeviceSdfCache sdf_cache;
+  DeviceBoundaryMaps boundary_maps;
   DeviceSceneBuffer scene_buffer;
   DeviceSinkCompactor sinks;
 

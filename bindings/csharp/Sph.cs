@@ -227,6 +227,9 @@ namespace Sph
         /// <summary>Elasticity and plasticity: springs between neighbours made at each particle's
         /// first substep (Clavet et al. 2005), parameters in <see cref="World.SpringParams"/>.</summary>
         Springs = Constants.SPH_FEATURE_SPRINGS,
+        /// <summary>Walls in the density: colliders count in the density sums and push back through
+        /// the pressure force (a density map per SDF asset; docs/physics.md).</summary>
+        BoundaryDensity = Constants.SPH_FEATURE_BOUNDARY_DENSITY,
     }
 
     /// <summary>Step-size limits beyond eq. 32 (SPH_STEP_LIMIT_*): set them with

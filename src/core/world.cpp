@@ -126,6 +126,7 @@ SceneFrame World::build_scene_frame(double frame_dt) const {
     v.stickiness = c.material.stickiness;
     v.sign = c.inverted ? -1.0f : 1.0f;
     v.deforming = c.sdf->has_moving_surface() ? 1u : 0u;
+    v.boundary_map = nullptr;  // the backend binds its map (SPH_FEATURE_BOUNDARY_DENSITY)
     float speed = 0.0f;
     if (v.moving) speed += length(v.linear_velocity) + length(v.angular_velocity) * bounding_radius(*c.sdf);
     if (v.deforming) speed += max_field_speed(*c.sdf);
