@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -42,6 +43,20 @@ std::string read_whole(const std::string& path) {
   return bytes;
 }
 
+// Three numbers as text; false when a token is missing or not a number. Values beyond float's
+// range come back infinite (add_vertex reports them), not as a parse failure.
+bool read_xyz(std::istream& in, float xyz[3]) {
+  for (int a = 0; a < 3; ++a) {
+    std::string token;
+    if (!(in >> token)) return false;
+    char* end = nullptr;
+    const double value = std::strtod(token.c_str(), &end);
+    if (end == token.c_str() || *end != '\0') return false;
+    xyz[a] = static_cast<float>(value);
+  }
+  return true;
+}
+
 void add_vertex(MeshData& m, const std::string& path, const std::string& where, const float xyz[3],
                 float scale) {
   for (int a = 0; a < 3; ++a) {
@@ -70,7 +85,7 @@ MeshData read_obj(const std::string& path, const std::string& text, float scale)
     fields >> record;
     if (record == "v") {
       float xyz[3];
-      if (!(fields >> xyz[0] >> xyz[1] >> xyz[2])) fail(path, where + ": a vertex needs x y z");
+      if (!read_xyz(fields, xyz)) fail(path, where + ": a vertex needs x y z");
       add_vertex(m, path, where, xyz, scale);
     } else if (record == "f") {
       polygon.clear();
@@ -129,7 +144,7 @@ MeshData read_ascii_stl(const std::string& path, const std::string& text, float 
     } else if (word == "vertex") {
       float xyz[3];
       const std::string where = "facet " + std::to_string(facet);
-      if (!(words >> xyz[0] >> xyz[1] >> xyz[2])) fail(path, where + ": a vertex needs x y z");
+      if (!read_xyz(words, xyz)) fail(path, where + ": a vertex needs x y z");
       add_vertex(m, path, where, xyz, scale);
       ++corners;
     } else if (word == "endfacet") {
