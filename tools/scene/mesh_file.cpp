@@ -17,7 +17,7 @@ namespace {
 
 // More would not fit the library's uint32 vertex indices three to a triangle.
 constexpr uint64_t kMaxTriangles = 1ull << 28;
-constexpr uint64_t kMaxFileBytes = 1ull << 33;
+constexpr uint64_t kMaxFileBytes = 1ull << 31;
 
 [[noreturn]] void fail(const std::string& path, const std::string& what) {
   throw std::runtime_error(path + ": " + what);
@@ -34,7 +34,7 @@ std::string read_whole(const std::string& path) {
   struct stat st;
   if (::stat(path.c_str(), &st) != 0) fail(path, std::string("cannot open: ") + std::strerror(errno));
   if (!S_ISREG(st.st_mode)) fail(path, "is not a regular file");
-  if (static_cast<uint64_t>(st.st_size) > kMaxFileBytes) fail(path, "is larger than 8 GiB");
+  if (static_cast<uint64_t>(st.st_size) > kMaxFileBytes) fail(path, "is larger than 2 GiB");
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, "cannot open");
   std::string bytes(static_cast<size_t>(st.st_size), '\0');
