@@ -79,11 +79,16 @@ void fill_band(const Grid& g, const std::vector<MeshTriangle>& triangles, double
       lo[a] = std::max(0, static_cast<int32_t>(std::ceil(low[a] / g.voxel)));
       hi[a] = std::min(g.n[a] - 1, static_cast<int32_t>(std::floor(high[a] / g.voxel)));
     }
+    // Voxels farther than the band from the triangle's plane are farther from the triangle:
+    // the slab test skips most of its box before the closest-point search.
+    const V3 normal = tri.degenerate ? V3::Zero() : V3((tri.b - tri.a).cross(tri.c - tri.a).normalized());
     for (int32_t k = lo[2]; k <= hi[2]; ++k)
       for (int32_t j = lo[1]; j <= hi[1]; ++j)
         for (int32_t i = lo[0]; i <= hi[0]; ++i) {
           const size_t v = g.at(i, j, k);
-          const double d = point_triangle_distance(g.centre(i, j, k), tri);
+          const V3 p = g.centre(i, j, k);
+          if (std::fabs(normal.dot(p - tri.a)) > band) continue;
+          const double d = point_triangle_distance(p, tri);
           if (d < distance[v]) {
             distance[v] = static_cast<float>(d);
             closest[v] = static_cast<int32_t>(t);
@@ -95,8 +100,8 @@ void fill_band(const Grid& g, const std::vector<MeshTriangle>& triangles, double
 // The far field: two rounds of sweeps in the eight diagonal orders (Bridson's makelevelset3),
 // each voxel taking the closest of its upwind neighbours' closest triangles. Distances stay
 // exact point-triangle distances; only the triangle may be a near-best one far from the band.
-void sweep_far_field(const Grid& g, const std::vector<MeshTriangle>& triangles, std::vector<float>& distance,
-                     std::vector<int32_t>& closest) {
+void sweep_far_field(const Grid& g, const std::vector<MeshTriangle>& triangles, double band,
+                     std::vector<float>& distance, std::vector<int32_t>& closest) {
   for (int round = 0; round < 2; ++round)
     for (int order = 0; order < 8; ++order) {
       const int di = (order & 1) ? -1 : 1, dj = (order & 2) ? -1 : 1, dk = (order & 4) ? -1 : 1;
@@ -105,14 +110,21 @@ void sweep_far_field(const Grid& g, const std::vector<MeshTriangle>& triangles, 
         for (int32_t j = j0; j >= 0 && j < g.n[1]; j += dj)
           for (int32_t i = i0; i >= 0 && i < g.n[0]; i += di) {
             const size_t v = g.at(i, j, k);
+            // Band voxels already hold their exact nearest distance.
+            if (distance[v] <= band) continue;
             const int32_t candidates[7][3] = {
                 {i - di, j, k},      {i, j - dj, k},      {i - di, j - dj, k},     {i, j, k - dk},
                 {i - di, j, k - dk}, {i, j - dj, k - dk}, {i - di, j - dj, k - dk}};
+            int32_t tried[7];
+            int tried_count = 0;
             for (const auto& c : candidates) {
               if (c[0] < 0 || c[0] >= g.n[0] || c[1] < 0 || c[1] >= g.n[1] || c[2] < 0 || c[2] >= g.n[2])
                 continue;
               const int32_t t = closest[g.at(c[0], c[1], c[2])];
-              if (t < 0 || t == closest[v]) continue;
+              // Neighbours mostly share their triangle: each distinct one is measured once.
+              if (t < 0 || t == closest[v] || std::find(tried, tried + tried_count, t) != tried + tried_count)
+                continue;
+              tried[tried_count++] = t;
               const double d = point_triangle_distance(g.centre(i, j, k), triangles[t]);
               if (d < distance[v]) {
                 distance[v] = static_cast<float>(d);
@@ -200,7 +212,7 @@ std::shared_ptr<SdfAsset> build_mesh_sdf(const MeshSpec& s, uint64_t max_voxels)
   std::vector<int32_t> closest(asset->voxel_count(), -1);
   const double band = s.band_width * g.voxel;
   fill_band(g, triangles, band, distance, closest);
-  sweep_far_field(g, triangles, distance, closest);
+  sweep_far_field(g, triangles, band, distance, closest);
   closest = std::vector<int32_t>();
   apply_sign(g, triangles, band, distance);
   return asset;
