@@ -203,7 +203,8 @@ static void test_meshed_sphere_matches_analytic(void** state) {
 }
 
 /* A box (0.2, 0.1, 0.15) m as 12 triangles: every voxel centre, inside (up to the box's medial
- * planes) and out (edge and corner regions), within half a voxel of the exact box distance. */
+ * planes) and out (edge and corner regions), within half a voxel of the exact box distance;
+ * packed and interleaved vertices alike. */
 static void test_meshed_box_matches_analytic(void** state) {
   static const float centre[3] = {0.0f, 0.0f, 0.0f}, half[3] = {0.2f, 0.1f, 0.15f};
   const float voxel = 0.02f;
@@ -216,6 +217,29 @@ static void test_meshed_box_matches_analytic(void** state) {
   SCENE_OK(mesh_sdf(s.context, &m, voxel, &sdf));
   assert_true(worst_voxel_error(sdf, bounds_min, voxel, box_exact, half) < 0.5f * voxel);
   SCENE_OK(sph_sdf_destroy(sdf));
+  {
+    /* The same box from an interleaved vertex buffer (position, then a normal and a uv: 8
+     * floats, a 32-byte stride), as engines hold them: the same asset. */
+    float* interleaved = calloc(8 * 3 * (size_t)m.triangles, sizeof(float));
+    sph_mesh_desc d;
+    uint32_t v;
+    assert_non_null(interleaved);
+    for (v = 0; v < 3 * m.triangles; ++v) {
+      memcpy(&interleaved[8 * v], &m.vertices[3 * v], 3 * sizeof(float));
+      interleaved[8 * v + 3] = NAN; /* never read */
+    }
+    sph_mesh_desc_init(&d);
+    d.vertices = interleaved;
+    d.vertex_stride = 8 * sizeof(float);
+    d.vertex_count = 3 * m.triangles;
+    d.indices = m.indices;
+    d.index_count = 3 * m.triangles;
+    d.voxel_size = voxel;
+    SCENE_OK(sph_sdf_create_from_mesh(s.context, &d, &sdf));
+    assert_true(worst_voxel_error(sdf, bounds_min, voxel, box_exact, half) < 0.5f * voxel);
+    SCENE_OK(sph_sdf_destroy(sdf));
+    free(interleaved);
+  }
   scene_close(&s);
   soup_free(&m);
 }
