@@ -12,6 +12,7 @@
  *     LOADS_STRICT=1 (for the solver that should meet it, DFSPH, when it merges); by default the
  *     bound is the solver's accuracy now, 10 % and 15 %, with the walls in the density closer
  *     than without (a regression guard, not the goal);
+ *   - the loads pass leaves the trajectory alone (bit for bit, friction on);
  *   - the C API: FEATURE_DISABLED without the bit, a handle check, the load point's torque.
  * LOADS_MEASURE=1 prints the measurements without asserting the bounds. */
 #include <math.h>
@@ -144,6 +145,42 @@ static void test_momentum_balance_boundary_density(void** state) {
   (void)state;
   momentum_balance(SPH_FEATURE_BOUNDARY_DENSITY, SPH_INTEGRATOR_SYMPLECTIC_EULER);
   momentum_balance(SPH_FEATURE_BOUNDARY_DENSITY, SPH_INTEGRATOR_RK4);
+}
+
+/* The loads pass applies the collision response the world would apply without it (the same calls
+ * in the same order): with and without the feature, the particles end bit for bit the same. */
+static float* collapse_positions(uint32_t features, uint32_t* count) {
+  const uint32_t layers[3] = {6, 14, 8};
+  const double tank_min[3] = {0.0, 0.0, 0.0}, tank_max[3] = {0.16, 0.30, 0.08};
+  float *lattice = NULL, *x = NULL;
+  uint32_t n = 0;
+  support_world w;
+  sph_sdf* sdf = NULL;
+  sph_world_def def;
+  assert_int_equal(support_fcc_box(layers, kStep, NULL, &lattice, &n), SPH_OK);
+  def = loads_def(features, n, SPH_INTEGRATOR_SYMPLECTIC_EULER);
+  EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
+  EXPECT_OK(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * kStep, 0.2f, &sdf, NULL));
+  EXPECT_OK(support_spawn(w.world, lattice, NULL, n));
+  for (int frame = 0; frame < 8; ++frame) EXPECT_OK(sph_world_step(w.world, 0.02f));
+  EXPECT_OK(support_copy_by_id(w.world, SPH_ATTRIBUTE_POSITION, (void**)&x, count));
+  free(lattice);
+  EXPECT_OK(sph_sdf_destroy(sdf));
+  EXPECT_OK(support_world_close(&w));
+  return x;
+}
+
+static void test_loads_leave_the_trajectory_alone(void** state) {
+  const uint32_t options[2] = {SPH_FEATURE_NONE, SPH_FEATURE_BOUNDARY_DENSITY};
+  (void)state;
+  for (int k = 0; k < 2; ++k) {
+    uint32_t n_on = 0, n_off = 0;
+    float* on = collapse_positions(options[k] | SPH_FEATURE_COLLIDER_LOADS, &n_on);
+    float* off = collapse_positions(options[k], &n_off);
+    assert_int_equal(n_on, n_off);
+    assert_memory_equal(on, off, 3 * sizeof(float) * n_on);
+    free(on), free(off);
+  }
 }
 
 /* ---- a hydrostatic tank's side wall ------------------------------------------------------------ */
@@ -349,6 +386,7 @@ static void test_loads_api(void** state) {
 int main(int argc, char** argv) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_loads_api),
+      cmocka_unit_test(test_loads_leave_the_trajectory_alone),
       cmocka_unit_test(test_momentum_balance_contacts),
       cmocka_unit_test(test_momentum_balance_boundary_density),
       cmocka_unit_test(test_hydrostatic_side_wall),
