@@ -105,7 +105,7 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
       next_vel[i] = make_float4_record(s.velocity, vel[i].w);
     }
     report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
-    if (loads_on()) {
+    if (loads_on() && (boundary_ || stage == 3)) {  // the walls' reactions, the contacts after the last
       OldPositions old;
       if (stage == 3) old.states = start;
       collide_with_loads(fluid, scene, time, stage_time(time, rk4_stage_fraction(stage)),
