@@ -38,7 +38,7 @@ struct SceneFrame {
   std::vector<ForceFieldFrame> fields;
   std::vector<SinkFrame> sinks;
   float max_collider_speed = 0.0f;  // fastest collider surface point, m/s (for the step size)
-  StepInterrupt interrupt;          // checked between substeps (the CPU backend; CUDA: before the frame)
+  StepInterrupt interrupt;          // checked between substeps (CUDA: on its stream driver only)
 
   bool empty() const { return colliders.empty() && fields.empty() && sinks.empty(); }
 };
