@@ -153,7 +153,8 @@ class CudaBackend final : public Backend {
 
   // The stream driver (frame_loop.cu): frames with sinks, and every frame without graphs.
   uint32_t run_frame_on_stream(PipelineSetup setup, uint32_t sink_count, std::vector<uint32_t>& removed_ids,
-                               std::vector<uint32_t>& removed_by_sink);
+                               std::vector<uint32_t>& removed_by_sink, const StepInterrupt& interrupt,
+                               bool& interrupted);
 
   WorldConfig config_;
   int device_;

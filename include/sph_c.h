@@ -341,7 +341,8 @@ SPH_API sph_result SPH_CALL sph_world_get_particle_mass(const sph_world* world, 
  * (a 0 that took a default reads back as the default). */
 typedef struct sph_world_params {
   uint32_t struct_size;  /* sizeof(sph_world_params), set by sph_world_params_init */
-  uint32_t max_substeps; /* most substeps one sph_world_step may take; default 10000; 0 = default */
+  uint32_t max_substeps; /* most substeps one sph_world_step may take; default 10000; 0 = default;
+                            at most 1000000 (a bound on one call's cost; see also the step budget) */
   sph_vec3 gravity;      /* m/s^2; default (0, -9.81, 0); finite; 0 is no gravity */
   float stiffness;       /* k of p = k (rho - rho0), m^2/s^2 (the squared numerical sound speed);
                             default 100; > 0; 0 = default. Keep sqrt(k) * dt_max below about 0.4 h. */
@@ -649,11 +650,38 @@ SPH_API sph_result SPH_CALL sph_world_fill_sphere(sph_world* world, const sph_fi
  * Advances the world by frame_dt seconds (> 0, finite) in adaptive substeps: each substep's
  * dt = step_factor * h / v_max clamped to [dt_min, dt_max], shortened at the end so that the
  * substeps add up to frame_dt exactly (the last one or two may be shorter than dt_min).
- * Blocks until the frame is done. Returns SPH_INCOMPLETE if max_substeps ran out first
- * (sph_stats.frame_time says how far it got). SPH_ERROR_NON_FINITE if a substep produced a
- * NaN/Inf: the world is restored to its state before this call.
+ * Blocks until the frame is done. Returns SPH_INCOMPLETE if max_substeps ran out first, or
+ * the step budget (sph_world_set_step_budget) or a cancel (sph_world_cancel_step) stopped it:
+ * the world is then as after its last whole substep, consistent and ready to step again
+ * (sph_stats.frame_time and substeps say how far it got). SPH_ERROR_NON_FINITE if a substep
+ * produced a NaN/Inf, SPH_ERROR_CAPACITY if more particles than 64 times the rest density
+ * allows piled into one cell of side h (the neighbour work would grow with their square; the
+ * message says where): the world is restored to its state before this call.
  */
 SPH_API sph_result SPH_CALL sph_world_step(sph_world* world, float frame_dt);
+
+/**
+ * Bounds the wall-clock time of each later sph_world_step of this world: a step still running
+ * max_seconds after it began stops at its next substep boundary and returns SPH_INCOMPLETE
+ * (one substep may overrun the budget). Both backends check it between substeps: the CUDA
+ * backend runs a frame with a budget on its stream driver instead of its device graph (one host
+ * synchronisation a substep). 0 (the default) is no budget. Not saved in checkpoints. Errors: INVALID_HANDLE, INVALID_ARGUMENT
+ * (NaN, negative or above 86400), WORLD_LOCKED.
+ */
+SPH_API sph_result SPH_CALL sph_world_set_step_budget(sph_world* world, double max_seconds);
+/** The step budget in seconds (0: none). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL). */
+SPH_API sph_result SPH_CALL sph_world_get_step_budget(const sph_world* world, double* out_seconds);
+
+/**
+ * Asks the world's step to stop at its next substep boundary (it returns SPH_INCOMPLETE with
+ * the world consistent; on the CUDA backend a frame on the device graph, which is every frame
+ * without a step budget or sinks, sees it only at its end). The one call that may run on another thread while a step holds the
+ * world: it never blocks and never answers WORLD_LOCKED. A request made while no step runs
+ * stops the next step before its first substep (that step changes nothing and reports 0
+ * substeps); a step that stops for it clears it. Errors: INVALID_HANDLE (NULL or destroyed:
+ * safe to call racing sph_world_destroy).
+ */
+SPH_API sph_result SPH_CALL sph_world_cancel_step(sph_world* world);
 
 /* ---- particles out ----------------------------------------------------------------------- */
 

@@ -728,7 +728,10 @@ namespace Sph
     {
         /// <summary>uint32_t struct_size: sizeof(sph_world_params), set by sph_world_params_init</summary>
         public uint StructSize;
-        /// <summary>uint32_t max_substeps: most substeps one sph_world_step may take; default 10000; 0 = default</summary>
+        /// <summary>
+        /// uint32_t max_substeps: most substeps one sph_world_step may take; default 10000; 0 =
+        /// default; at most 1000000 (a bound on one call's cost; see also the step budget)
+        /// </summary>
         public uint MaxSubsteps;
         /// <summary>sph_vec3 gravity: m/s^2; default (0, -9.81, 0); finite; 0 is no gravity</summary>
         public Vec3 Gravity;
@@ -2078,14 +2081,51 @@ namespace Sph
         /// Advances the world by frame_dt seconds (&gt; 0, finite) in adaptive substeps: each substep's
         /// dt = step_factor * h / v_max clamped to [dt_min, dt_max], shortened at the end so that the
         /// substeps add up to frame_dt exactly (the last one or two may be shorter than dt_min). Blocks
-        /// until the frame is done. Returns SPH_INCOMPLETE if max_substeps ran out first
-        /// (sph_stats.frame_time says how far it got). SPH_ERROR_NON_FINITE if a substep produced a
-        /// NaN/Inf: the world is restored to its state before this call.
+        /// until the frame is done. Returns SPH_INCOMPLETE if max_substeps ran out first, or the step
+        /// budget (sph_world_set_step_budget) or a cancel (sph_world_cancel_step) stopped it: the world
+        /// is then as after its last whole substep, consistent and ready to step again
+        /// (sph_stats.frame_time and substeps say how far it got). SPH_ERROR_NON_FINITE if a substep
+        /// produced a NaN/Inf, SPH_ERROR_CAPACITY if more particles than 64 times the rest density
+        /// allows piled into one cell of side h (the neighbour work would grow with their square; the
+        /// message says where): the world is restored to its state before this call.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_step(WorldHandle world, float frameDt);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_step")]
         public static extern Result sph_world_step(IntPtr world, float frameDt);
+
+        /// <summary>
+        /// Bounds the wall-clock time of each later sph_world_step of this world: a step still running
+        /// max_seconds after it began stops at its next substep boundary and returns SPH_INCOMPLETE
+        /// (one substep may overrun the budget). Both backends check it between substeps: the CUDA
+        /// backend runs a frame with a budget on its stream driver instead of its device graph (one
+        /// host synchronisation a substep). 0 (the default) is no budget. Not saved in checkpoints.
+        /// Errors: INVALID_HANDLE, INVALID_ARGUMENT (NaN, negative or above 86400), WORLD_LOCKED.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_set_step_budget(WorldHandle world, double maxSeconds);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_set_step_budget")]
+        public static extern Result sph_world_set_step_budget(IntPtr world, double maxSeconds);
+
+        /// <summary>The step budget in seconds (0: none). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL).</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_get_step_budget(WorldHandle world, out double outSeconds);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_step_budget")]
+        public static extern Result sph_world_get_step_budget(IntPtr world, IntPtr outSeconds);
+
+        /// <summary>
+        /// Asks the world's step to stop at its next substep boundary (it returns SPH_INCOMPLETE with
+        /// the world consistent; on the CUDA backend a frame on the device graph, which is every frame
+        /// without a step budget or sinks, sees it only at its end). The one call that may run on
+        /// another thread while a step holds the world: it never blocks and never answers WORLD_LOCKED.
+        /// A request made while no step runs stops the next step before its first substep (that step
+        /// changes nothing and reports 0 substeps); a step that stops for it clears it. Errors:
+        /// INVALID_HANDLE (NULL or destroyed: safe to call racing sph_world_destroy).
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_cancel_step(WorldHandle world);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_cancel_step")]
+        public static extern Result sph_world_cancel_step(IntPtr world);
 
         /// <summary>Number of particles in the world.</summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
@@ -3355,6 +3395,9 @@ namespace Sph
             "sph_fill_sphere_desc_init_sized",
             "sph_world_fill_sphere",
             "sph_world_step",
+            "sph_world_set_step_budget",
+            "sph_world_get_step_budget",
+            "sph_world_cancel_step",
             "sph_world_get_particle_count",
             "sph_world_copy_attribute",
             "sph_stats_init_sized",
@@ -3413,6 +3456,9 @@ namespace Sph
         };
         /// <summary>The shared library of each function ("sph", or an optional helper).</summary>
         public static readonly string[] FunctionLibraries = {
+            "sph",
+            "sph",
+            "sph",
             "sph",
             "sph",
             "sph",

@@ -699,6 +699,26 @@ namespace Sph
             return SphException.Check(Native.sph_world_step(Handle, frameDt), "sph_world_step");
         }
 
+        /// <summary>Wall-clock seconds one Step may take before it stops at a substep boundary
+        /// and returns Incomplete; 0 is no budget (sph_world_set/get_step_budget).</summary>
+        public double StepBudget
+        {
+            get
+            {
+                double seconds;
+                SphException.Check(Native.sph_world_get_step_budget(Handle, out seconds), "sph_world_get_step_budget");
+                return seconds;
+            }
+            set { SphException.Check(Native.sph_world_set_step_budget(Handle, value), "sph_world_set_step_budget"); }
+        }
+
+        /// <summary>Asks the Step running on another thread (or else the next one) to stop at its
+        /// next substep boundary, returning Incomplete. Safe from any thread while the world steps.</summary>
+        public void CancelStep()
+        {
+            SphException.Check(Native.sph_world_cancel_step(Handle), "sph_world_cancel_step");
+        }
+
         // ---- particles out --------------------------------------------------------------------
 
         public uint ParticleCount

@@ -479,6 +479,12 @@ ForceField read_force_field(ByteReader& r, const Assets& assets, const std::stri
   return by_scene_rules(r, name, [&] { return make_force_field(spec); });
 }
 
+// SPH_MAKE_VERSION's packing: (major << 22) | (minor << 12) | patch.
+std::string library_version_text(uint32_t packed) {
+  return std::to_string(packed >> 22) + "." + std::to_string((packed >> 12) & 0x3ffu) + "." +
+         std::to_string(packed & 0xfffu);
+}
+
 }  // namespace
 
 std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const BackendMaker& make_backend) {
@@ -490,13 +496,19 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   if (std::memcmp(data, kMagic, sizeof kMagic) != 0) corrupt("not a checkpoint (wrong magic bytes)");
   ByteReader h(data + sizeof kMagic, kHeaderSize - sizeof kMagic, "header");
   const uint32_t version = h.u32();
-  if (version < kOldestReadableVersion || version > kFormatVersion)
-    throw Error(Status::VersionMismatch,
-                "checkpoint: format version " + std::to_string(version) + "; this library reads versions " +
-                    std::to_string(kOldestReadableVersion) + " to " + std::to_string(kFormatVersion));
   const uint32_t flags = h.u32();
-  h.u32();  // writer backend: informational
-  h.u32();  // writer library version: informational
+  h.u32();                                  // writer backend: informational
+  const uint32_t writer_library = h.u32();  // informational, but named when refusing a version
+  if (version > kFormatVersion)
+    throw Error(Status::VersionMismatch,
+                "checkpoint: format version " + std::to_string(version) +
+                    " is newer than this library reads (versions " + std::to_string(kOldestReadableVersion) +
+                    " to " + std::to_string(kFormatVersion) + "); it was written by sph " +
+                    library_version_text(writer_library) + ": load it with that library or a later one");
+  if (version < kOldestReadableVersion)
+    throw Error(Status::VersionMismatch, "checkpoint: format version " + std::to_string(version) +
+                                             " is older than the oldest this library reads (" +
+                                             std::to_string(kOldestReadableVersion) + ")");
   const uint64_t payload_size = h.u64();
   const uint64_t checksum = h.u64();
   const uint32_t section_count = h.u32();

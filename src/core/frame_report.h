@@ -29,6 +29,7 @@ struct ColliderLoadSums {
 struct FrameReport {
   uint32_t substeps = 0;
   bool completed = true;       // false when max_substeps ran out before the frame's end
+  bool interrupted = false;    // the step budget or a cancel stopped the frame (completed is false)
   double time_advanced = 0.0;  // seconds
   float dt_min = 0.0f;
   float dt_max = 0.0f;

@@ -177,8 +177,16 @@ ColliderLoadResult load_result(const ColliderLoadSums& sums, const Collider& c, 
 }
 }  // namespace
 
-bool World::step(double frame_dt) {
+bool World::step(double frame_dt, const StepInterrupt& interrupt) {
   const auto start = std::chrono::steady_clock::now();
+  if (interrupt.requested()) {
+    report_ = FrameReport{};
+    report_.completed = false;
+    report_.interrupted = true;
+    events_.clear();
+    last_step_ms_ = 0.0f;
+    return false;
+  }
   // Everything a failed step must put back.
   const uint32_t count_before = particle_count();
   const uint32_t next_id_before = next_id_;
@@ -201,7 +209,9 @@ bool World::step(double frame_dt) {
     events_.reserve(sources_.size() + sinks_.size());
     if (sources_.size() > 0) backend_->save_step_inputs();
     emit_sources(frame_dt);
-    report = backend_->step_scene_frame(frame_dt, params_, build_scene_frame(frame_dt));
+    SceneFrame scene = build_scene_frame(frame_dt);
+    scene.interrupt = interrupt;
+    report = backend_->step_scene_frame(frame_dt, params_, scene);
   } catch (...) {
     if (particle_count() > count_before) {
       backend_->truncate(count_before);

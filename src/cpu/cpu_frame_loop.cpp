@@ -55,6 +55,10 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
   start_clock(clock, frame_dt);
   try {
     while (clock_running(clock, params.stepping.max_substeps)) {
+      if (scene.interrupt.requested()) {
+        report.interrupted = true;
+        break;
+      }
       pick_next_step(clock, frame_dt, limits, std::max(max_speed_, scene.max_collider_speed),
                      max_acceleration_);
       fluid.dt = clock.dt_float;

@@ -325,6 +325,20 @@ static class Tests
             AssertEqual(Result.Incomplete, world.Step(0.1f), "max_substeps ran out");
             Throws(Result.ErrorInvalidArgument, () => world.Step(-1));
             Throws(Result.ErrorInvalidArgument, () => world.Step(float.NaN));
+            // What one call may cost (issue 23 item 9): the budget, a cancel, max_substeps' bound.
+            AssertEqual(0.0, world.StepBudget, "no budget by default");
+            world.StepBudget = 0.25;
+            AssertEqual(0.25, world.StepBudget, "budget read back");
+            Throws(Result.ErrorInvalidArgument, () => world.StepBudget = -1);
+            Throws(Result.ErrorInvalidArgument, () => world.StepBudget = double.NaN);
+            world.StepBudget = 0;
+            p.MaxSubsteps = 1000;
+            world.Params = p;
+            world.CancelStep();
+            AssertEqual(Result.Incomplete, world.Step(0.01f), "a cancel before the step stops it");
+            AssertEqual(0u, world.GetStats().Substeps, "no substep after a cancel");
+            p.MaxSubsteps = 1000001;
+            Throws(Result.ErrorInvalidArgument, () => world.Params = p);
         }
     }
 

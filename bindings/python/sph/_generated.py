@@ -10,7 +10,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'b3ef67d9166b01d7869f10a7c14ab5642a2f4b8e57ac1909c1ee49542b4db020', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
+HEADERS = {'include/sph_c.h': '0e4b6f6edf8897f1a03e9ced22614b5ad92c36ca01511cd00f2e631ef5817407', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -736,7 +736,7 @@ class WorldParams(_SphStruct):
 
     Fields:
         struct_size (uint32_t): sizeof(sph_world_params), set by sph_world_params_init
-        max_substeps (uint32_t): most substeps one sph_world_step may take; default 10000; 0 = default
+        max_substeps (uint32_t): most substeps one sph_world_step may take; default 10000; 0 = default; at most 1000000 (a bound on one call's cost; see also the step budget)
         gravity (sph_vec3): m/s^2; default (0, -9.81, 0); finite; 0 is no gravity
         stiffness (float): k of p = k (rho - rho0), m^2/s^2 (the squared numerical sound speed); default 100; > 0; 0 = default. Keep sqrt(k) * dt_max below about 0.4 h.
         viscosity (float): mu of Mueller's Laplacian viscosity (a numerical viscosity, not water's 0.001 Pa s); default 1; >= 0; 0 is an inviscid fluid
@@ -1747,7 +1747,13 @@ FUNCTIONS = {
     'sph_world_fill_sphere': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_fill_sphere_desc), _c.POINTER(_c.c_uint32)), ('world', 'desc', 'out_count'),
         'Fills a sphere on an FCC lattice; as sph_world_fill_box otherwise.', 'sph'),
     'sph_world_step': (sph_result, (_c.POINTER(sph_world), _c.c_float), ('world', 'frame_dt'),
-        "Advances the world by frame_dt seconds (> 0, finite) in adaptive substeps: each substep's dt = step_factor * h / v_max clamped to [dt_min, dt_max], shortened at the end so that the substeps add up to frame_dt exactly (the last one or two may be shorter than dt_min). Blocks until the frame is done. Returns SPH_INCOMPLETE if max_substeps ran out first (sph_stats.frame_time says how far it got). SPH_ERROR_NON_FINITE if a substep produced a NaN/Inf: the world is restored to its state before this call.", 'sph'),
+        "Advances the world by frame_dt seconds (> 0, finite) in adaptive substeps: each substep's dt = step_factor * h / v_max clamped to [dt_min, dt_max], shortened at the end so that the substeps add up to frame_dt exactly (the last one or two may be shorter than dt_min). Blocks until the frame is done. Returns SPH_INCOMPLETE if max_substeps ran out first, or the step budget (sph_world_set_step_budget) or a cancel (sph_world_cancel_step) stopped it: the world is then as after its last whole substep, consistent and ready to step again (sph_stats.frame_time and substeps say how far it got). SPH_ERROR_NON_FINITE if a substep produced a NaN/Inf, SPH_ERROR_CAPACITY if more particles than 64 times the rest density allows piled into one cell of side h (the neighbour work would grow with their square; the message says where): the world is restored to its state before this call.", 'sph'),
+    'sph_world_set_step_budget': (sph_result, (_c.POINTER(sph_world), _c.c_double), ('world', 'max_seconds'),
+        'Bounds the wall-clock time of each later sph_world_step of this world: a step still running max_seconds after it began stops at its next substep boundary and returns SPH_INCOMPLETE (one substep may overrun the budget). Both backends check it between substeps: the CUDA backend runs a frame with a budget on its stream driver instead of its device graph (one host synchronisation a substep). 0 (the default) is no budget. Not saved in checkpoints. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NaN, negative or above 86400), WORLD_LOCKED.', 'sph'),
+    'sph_world_get_step_budget': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_double)), ('world', 'out_seconds'),
+        'The step budget in seconds (0: none). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL).', 'sph'),
+    'sph_world_cancel_step': (sph_result, (_c.POINTER(sph_world),), ('world',),
+        "Asks the world's step to stop at its next substep boundary (it returns SPH_INCOMPLETE with the world consistent; on the CUDA backend a frame on the device graph, which is every frame without a step budget or sinks, sees it only at its end). The one call that may run on another thread while a step holds the world: it never blocks and never answers WORLD_LOCKED. A request made while no step runs stops the next step before its first substep (that step changes nothing and reports 0 substeps); a step that stops for it clears it. Errors: INVALID_HANDLE (NULL or destroyed: safe to call racing sph_world_destroy).", 'sph'),
     'sph_world_get_particle_count': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_uint32)), ('world', 'out_count'),
         'Number of particles in the world.', 'sph'),
     'sph_world_copy_attribute': (sph_result, (_c.POINTER(sph_world), sph_attribute, _c.c_void_p, _c.c_uint64, _c.c_uint64, _c.c_uint32, _c.c_uint32, _c.POINTER(_c.c_uint32)), ('world', 'attribute', 'dst', 'dst_size', 'dst_stride', 'first', 'count', 'out_written'),
