@@ -51,6 +51,7 @@ struct SubstepOptions {
   bool normalized_density = false;
   ViscosityMethod viscosity = ViscosityMethod::Mueller;
   bool springs = false;  // a.spring_acceleration adds to the force pass
+  bool dfsph = false;    // the DFSPH solver (dfsph_solver.h) instead of the weakly compressible passes
 };
 
 // density[i], sorted_position[i].w = pressure, sorted_velocity[i] = (velocity[order[i]], 1/rho);
@@ -59,6 +60,10 @@ struct SubstepOptions {
 void enqueue_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a, uint32_t n,
                      const SubstepOptions& options, const KernelTuning& tuning, FrameState* state,
                      cudaStream_t stream);
+
+// colour_normal[i] for surface tension, after the density pass (enqueue_density calls it).
+void enqueue_colour_normals(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                            uint32_t n, const KernelTuning& tuning, cudaStream_t stream);
 
 // Symplectic Euler from the sorted copy into the state, with the max-speed and
 // max-acceleration reductions and the non-finite check.

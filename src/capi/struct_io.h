@@ -24,6 +24,10 @@ constexpr uint32_t kFirstStructSize = static_cast<uint32_t>(sizeof(T));
 template <>
 constexpr uint32_t kFirstStructSize<sph_context_def> =
     24 + 2 * sizeof(void*);  // 0.1.0; 0.2.0 adds the CUDA tuning
+template <>
+constexpr uint32_t kFirstStructSize<sph_world_def> = 40;  // 0.1.0; 0.2.0 adds the solver
+template <>
+constexpr uint32_t kFirstStructSize<sph_stats> = 104;  // 0.1.0; 0.2.0 adds DFSPH's solves
 
 template <class T>
 T read_user_struct(const T* user, const char* name) {
