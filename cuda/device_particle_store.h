@@ -65,6 +65,8 @@ struct ParticleArrays {
   float* dfsph_step;           // the iteration's p / rho^2, which neighbours read
   float* dfsph_warm_pressure;  // the density solve's warm start in the sorted order
   Float4* dfsph_contact;       // the particle's contact with the colliders (n, smallest normal speed)
+  // Null unless SPH_FEATURE_BOUNDARY_DENSITY: (grad rho_b, v_b . grad rho_b) of the density pass.
+  Float4* boundary_gradient;
 };
 
 // A method's array on the device: its elements (two sides for a Sorted array) and, for a

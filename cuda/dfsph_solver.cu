@@ -22,6 +22,9 @@ __device__ void tree_sum(double* slots) {
   __syncthreads();
 }
 
+// kBoundary: SPH_FEATURE_BOUNDARY_DENSITY, the walls' share (dfsph_boundary.h, place 1) at the
+// substep's start, its record kept for the solves.
+template <bool kBoundary>
 __global__ void dfsph_density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
                                      DeviceScene scene, FrameState* state) {
   mark_stage(state, kStageDensity);
@@ -31,7 +34,14 @@ __global__ void dfsph_density_kernel(FluidConstants fluid, GridView grid, Partic
   // old order (nothing writes them in this kernel), their sorted copies go to scratch arrays.
   const Float4 p = a.sorted_position[i];
   const uint32_t k = __float_as_uint(p.w);
-  const DfsphDensitySample s = gather_density_and_factor(fluid, grid, a.sorted_position, DfsphWalls{}, i);
+  BoundaryShare wall = no_boundary_share();
+  if (kBoundary) {
+    const StageTime at = stage_time(state->clock.time, 0.0f);
+    wall =
+        boundary_share(fluid.methods.boundary, scene.colliders, scene.collider_count, xyz(p), at.s, at.tau);
+    a.boundary_gradient[i] = pack_boundary(wall);
+  }
+  const DfsphDensitySample s = gather_density_and_factor(fluid, grid, a.sorted_position, wall, i);
   a.density[i] = s.density;
   a.neighbor_count[i] = s.neighbor_count;
   a.dfsph_factor[i] = s.factor;
@@ -64,7 +74,8 @@ __global__ void dfsph_correct_kernel(FluidConstants fluid, GridView grid, Partic
   if (i >= n) return;
   const float dt = state->clock.dt_float;
   const float scale = divergence ? dt : 1.0f;
-  Vec3 vi = xyz(v[i]) + pressure_velocity_change(fluid, grid, a.sorted_position, k, DfsphWalls{}, i, dt);
+  Vec3 vi = xyz(v[i]) + pressure_velocity_change(fluid, grid, a.sorted_position, k,
+                                                 DfsphWalls{a.boundary_gradient}, i, dt);
   if (contacts) vi = respect_contact(a.dfsph_contact[i], vi);
   v[i] = make_float4_record(vi, v[i].w);
   carried[i] = (kWarm ? 0.0f : carried[i]) + k[i] * scale;
@@ -81,7 +92,7 @@ __global__ void __launch_bounds__(kDfsphSolveBlock)
   double error = 0.0;
   if (i < n) {
     const float dt = state->clock.dt_float;
-    const float rate = density_rate(fluid, grid, a.sorted_position, v, DfsphWalls{}, i);
+    const float rate = density_rate(fluid, grid, a.sorted_position, v, DfsphWalls{a.boundary_gradient}, i);
     // The pressure given so far (the carried array is in the sorted order since the warm start).
     const float applied = kDivergence ? a.dfsph_divergence[i] / dt : a.dfsph_pressure[i];
     const DfsphResidual r =
@@ -286,7 +297,10 @@ void enqueue_dfsph_density(const FluidConstants& fluid, const GridView& grid, co
                            uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
                            const DeviceScene& scene, FrameState* state, cudaStream_t stream) {
   const unsigned threads = tuning.density_block, blocks = blocks_for(n, threads);
-  dfsph_density_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
+  if (options.boundary_density)
+    dfsph_density_kernel<true><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
+  else
+    dfsph_density_kernel<false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
   check_launch("dfsph_density_kernel");
   if (options.surface_tension) enqueue_colour_normals(fluid, grid, a, n, tuning, stream);
 }

@@ -45,6 +45,7 @@ CpuBackend::CpuBackend(const WorldConfig& config, unsigned workers)
   dfsph_step_ = store_.find_typed<float>(kArrayDfsphStep);
   dfsph_residual_ = store_.find_typed<float>(kArrayDfsphResidual);
   dfsph_contact_ = store_.find_typed<Float4>(kArrayDfsphContact);
+  boundary_ = store_.find_typed<Float4>(kArrayBoundaryGradient);
 }
 
 void CpuBackend::append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id) {

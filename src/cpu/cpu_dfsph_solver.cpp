@@ -13,14 +13,14 @@
 namespace sph {
 
 void CpuBackend::dfsph_find_contacts(const SceneFrame& scene, const SubstepTime& time) {
-  collider_views_.clear();
-  for (const ColliderFrame& c : scene.colliders) collider_views_.push_back(c.view);
-  dfsph_contacts_ = !collider_views_.empty();
+  dfsph_colliders_.clear();
+  for (const ColliderFrame& c : scene.colliders) dfsph_colliders_.push_back(c.view);
+  dfsph_contacts_ = !dfsph_colliders_.empty();
   if (!dfsph_contacts_) return;
   const Float4* pos = position_.data();
   Float4* contact = dfsph_contact_.data();
-  const ColliderView* views = collider_views_.data();
-  const uint32_t count = static_cast<uint32_t>(collider_views_.size());
+  const ColliderView* views = dfsph_colliders_.data();
+  const uint32_t count = static_cast<uint32_t>(dfsph_colliders_.size());
   const float h = config_.kernel_radius;
 #pragma omp parallel for num_threads(threads()) schedule(static)
   for (int i = 0; i < n(); ++i) contact[i] = wall_contact(views, count, time, h, xyz(pos[i]));
@@ -97,11 +97,11 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
 
 uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame& scene,
                                    const SubstepTime& time, FrameReport& report, DfsphTallies& tallies) {
-  sort_and_density(fluid, report);
+  sort_and_density(fluid, scene, stage_time(time, 0.0f), report);
   spring_pass(time.dt, true, report);
   auto t = Clock::now();
   const float dt = time.dt;
-  const DfsphWalls walls{};  // the walls' share: none until a boundary model fills it
+  const DfsphWalls walls{boundary_.data()};  // the walls' share (dfsph_boundary.h), null without it
   dfsph_find_contacts(scene, time);
   // 2. The divergence solve corrects the current velocities in place (a failed frame restores
   // them from the snapshot).

@@ -10,7 +10,8 @@
 namespace sph {
 
 // Hash, sort, reorder every attribute, then density and pressure (packed into the w slots).
-void CpuBackend::sort_and_density(const FluidConstants& fluid, FrameReport& report) {
+void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame& scene, StageTime at,
+                                  FrameReport& report) {
   auto t = Clock::now();
   grid_.build(position_.data(), count_, workers_);
   store_.permute(grid_.order().data(), count_);
@@ -21,15 +22,27 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, FrameReport& repo
   Float4* pos = position_.data();
   Float4* vel = velocity_.data();
   float* factor = density_factor_.data();
+  Float4* boundary = boundary_.data();
+  const ColliderView* colliders = collider_views_.data();
+  const uint32_t collider_count = static_cast<uint32_t>(collider_views_.size());
+  (void)scene;  // its colliders, with their maps bound, are collider_views_
+  // The walls' share at particle i (SPH_FEATURE_BOUNDARY_DENSITY), its record kept for the force
+  // pass and DFSPH's solves; none without the feature.
+  auto wall = [&](int i) {
+    if (!boundary) return no_boundary_share();
+    const BoundaryShare b =
+        boundary_share(fluid.methods.boundary, colliders, collider_count, xyz(pos[i]), at.s, at.tau);
+    boundary[i] = pack_boundary(b);
+    return b;
+  };
   if (config_.solver == Solver::Dfsph) {
     // DFSPH: the density and the factor alpha / rho in one walk; no equation of state (w: the
     // pressure, written when the density solve has found it).
     float* dfsph_factor = dfsph_factor_.data();
-    const DfsphWalls walls{};  // the walls' share: none until a boundary model fills it
 #pragma omp parallel for num_threads(threads()) schedule(static)
     for (int i = 0; i < n(); ++i) {
       const DfsphDensitySample s =
-          gather_density_and_factor(fluid, view, pos, walls, static_cast<uint32_t>(i));
+          gather_density_and_factor(fluid, view, pos, wall(i), static_cast<uint32_t>(i));
       density_[i] = s.density;
       neighbors_[i] = s.neighbor_count;
       dfsph_factor[i] = s.factor;
@@ -39,7 +52,9 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, FrameReport& repo
   } else {
 #pragma omp parallel for num_threads(threads()) schedule(static)
     for (int i = 0; i < n(); ++i) {
-      const DensitySample s = gather_density(fluid, view, pos, static_cast<uint32_t>(i));
+      DensitySample s = gather_density(fluid, view, pos, static_cast<uint32_t>(i));
+      // The walls' share is part of the summation (and so of a normalised density's kernel sum).
+      s.density += wall(i).density;
       float rho = s.density;
       if (factor) {
         normalized_[i] = s.density;  // the summation, for the factor after the filter

@@ -46,8 +46,9 @@ struct DfsphDensitySample {
 };
 
 // The density of density.h (the same sum in the same order) and the factor, in one walk.
+// wall: the walls' share at x_i (boundary_share; no_boundary_share() without the feature).
 SPH_HD DfsphDensitySample gather_density_and_factor(const FluidBase& f, const GridView& grid,
-                                                    const Float4* positions, const DfsphWalls& walls,
+                                                    const Float4* positions, const BoundaryShare& wall,
                                                     uint32_t i) {
   const KernelCoefficients mk = mass_gradient_kernel(f);
   const Vec3 xi = xyz(positions[i]);
@@ -67,7 +68,7 @@ SPH_HD DfsphDensitySample gather_density_and_factor(const FluidBase& f, const Gr
       squares += length_squared(g);
     }
   });
-  const WallShare wall = wall_share(walls, xi);  // boundary place 1: density and alpha
+  // Boundary place 1: the walls' density and their gradient in alpha (dfsph_boundary.h).
   const float density = f.particle_mass * (f.density_self_weight + sum) + wall.density;
   gradient += wall.gradient;
   const float denominator = length_squared(gradient) + squares;
@@ -90,8 +91,7 @@ SPH_HD float density_rate(const FluidBase& f, const GridView& grid, const Float4
     if (r2 < f.kernel.h2 && j != i)
       rate += dot(vi - xyz(velocities[j]), spiky_gradient(mk, d, SPH_SQRTF(r2)));
   });
-  const WallShare wall = wall_share(walls, xi);  // boundary place 2: the wall's relative motion
-  return rate + dot(vi - wall.velocity, wall.gradient);
+  return rate + wall_density_rate(walls, i, vi);  // boundary place 2: the walls' relative motion
 }
 
 // The velocity change of particle i from the pressures k (k_j = p_j / rho_j^2 of this
@@ -107,8 +107,7 @@ SPH_HD Vec3 pressure_velocity_change(const FluidBase& f, const GridView& grid, c
     const float r2 = length_squared(d);
     if (r2 < f.kernel.h2 && j != i) sum += spiky_gradient(mk, d, SPH_SQRTF(r2)) * (ki + k[j]);
   });
-  const WallShare wall = wall_share(walls, xi);  // boundary place 3: the wall's share, k_i alone
-  sum += wall.gradient * ki;
+  sum += wall_pressure_gradient(walls, i) * ki;  // boundary place 3: the walls' share, k_i alone
   return sum * (-dt);
 }
 

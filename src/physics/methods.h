@@ -8,6 +8,7 @@
 
 #include <type_traits>
 
+#include "boundary_density.h"
 #include "density_normalization.h"
 #include "dfsph.h"
 #include "eos_ideal_gas.h"
@@ -29,7 +30,9 @@ enum FeatureBits : uint32_t {
   kFeatureSurfaceTension = 1u << 0,
   kFeatureNormalizedDensity = 1u << 1,
   kFeatureSprings = 1u << 2,
-  kFeatureAll = kFeatureSurfaceTension | kFeatureNormalizedDensity | kFeatureSprings,
+  kFeatureBoundaryDensity = 1u << 3,
+  kFeatureAll =
+      kFeatureSurfaceTension | kFeatureNormalizedDensity | kFeatureSprings | kFeatureBoundaryDensity,
 };
 
 enum class ViscosityMethod : uint32_t { Mueller = 0, Clavet = 1 };
@@ -108,6 +111,9 @@ constexpr MethodSwitch switch_of(Tag<WeaklyCompressible>) {
 constexpr MethodSwitch switch_of(Tag<Dfsph>) {
   return {SwitchKind::Solver, static_cast<uint32_t>(Solver::Dfsph)};
 }
+constexpr MethodSwitch switch_of(Tag<BoundaryDensity>) {
+  return {SwitchKind::Feature, kFeatureBoundaryDensity};
+}
 
 // Calls visit(Tag<Method>{}) for every method a world can choose, in the list's order.
 template <class Visit>
@@ -121,6 +127,7 @@ void for_each_method(Visit&& visit) {
   visit(Tag<Springs>{});
   visit(Tag<WeaklyCompressible>{});
   visit(Tag<Dfsph>{});
+  visit(Tag<BoundaryDensity>{});
 }
 
 // Whether a value of a sph_world_def method field (or a feature bit) names a method of the list,
@@ -180,6 +187,7 @@ struct MethodConstants {
   SurfaceTension::Constants surface_tension;
   Springs::Constants springs;
   Dfsph::Constants dfsph;
+  BoundaryDensity::Constants boundary;
 };
 
 inline EosConstants make_eos_constants(const MethodParams& p, const MethodSelection& s,
@@ -202,6 +210,7 @@ inline MethodConstants make_method_constants(const MethodParams& p, const Method
     m.surface_tension = SurfaceTension::make_constants(p.surface_tension, shape, lattice);
   if (runs(s, Tag<Springs>{})) m.springs = Springs::make_constants(p.springs, shape);
   if (runs(s, Tag<Dfsph>{})) m.dfsph = Dfsph::make_constants(p.dfsph, shape, lattice);
+  if (runs(s, Tag<BoundaryDensity>{})) m.boundary = BoundaryDensity::make_constants(shape, lattice);
   return m;
 }
 
