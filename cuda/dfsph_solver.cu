@@ -93,13 +93,10 @@ __global__ void __launch_bounds__(kDfsphSolveBlock)
   if (i < n) {
     const float dt = state->clock.dt_float;
     const float rate = density_rate(fluid, grid, a.sorted_position, v, DfsphWalls{a.boundary_gradient}, i);
-    // The pressure given so far (the carried array is in the sorted order since the warm start).
-    const float applied = kDivergence ? a.dfsph_divergence[i] / dt : a.dfsph_pressure[i];
     const DfsphResidual r =
-        kDivergence
-            ? divergence_residual(fluid.methods.dfsph, rate, a.neighbor_count[i], a.dfsph_factor[i],
-                                  fluid.rest_density, dt, applied)
-            : density_residual(rate, a.density[i], a.dfsph_factor[i], fluid.rest_density, dt, applied);
+        kDivergence ? divergence_residual(fluid.methods.dfsph, rate, a.neighbor_count[i], a.dfsph_factor[i],
+                                          fluid.rest_density, dt)
+                    : density_residual(rate, a.density[i], a.dfsph_factor[i], fluid.rest_density, dt);
     a.dfsph_step[i] = r.k;
     error = r.error;
   }

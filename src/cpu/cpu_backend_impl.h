@@ -149,7 +149,7 @@ class CpuBackend final : public Backend {
                      float* carried, float carry_scale);
   // New pressures and errors from the rates over v; returns the mean error.
   float dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls, float dt,
-                        const Float4* v, const float* carried, float carry_scale);
+                        const Float4* v);
 
   // Springs (SPH_FEATURE_SPRINGS), after the sort: the particles that wait for springs make
   // them (two passes, springs.h), then every particle gathers its spring acceleration into a

@@ -43,7 +43,7 @@ void CpuBackend::dfsph_correct(const FluidConstants& fluid, const DfsphWalls& wa
 }
 
 float CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls,
-                                  float dt, const Float4* v, const float* carried, float carry_scale) {
+                                  float dt, const Float4* v) {
   const GridView view = grid_.view();
   const Float4* pos = position_.data();
   const float* factor = dfsph_factor_.data();
@@ -56,10 +56,9 @@ float CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, 
 #pragma omp parallel for num_threads(threads()) schedule(static)
   for (int i = 0; i < n(); ++i) {
     const float rate = density_rate(fluid, view, pos, v, walls, static_cast<uint32_t>(i));
-    const float applied = carried[i] / carry_scale;
     const DfsphResidual r = kind == DfsphSolve::Divergence
-                                ? divergence_residual(c, rate, neighbors[i], factor[i], rho0, dt, applied)
-                                : density_residual(rate, density[i], factor[i], rho0, dt, applied);
+                                ? divergence_residual(c, rate, neighbors[i], factor[i], rho0, dt)
+                                : density_residual(rate, density[i], factor[i], rho0, dt);
     k[i] = r.k;
     error[i] = r.error;
   }
@@ -85,11 +84,11 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
     carried[i] = 0.0f;
   }
   dfsph_correct(fluid, walls, dt, v, carried, carry_scale);
-  float error = dfsph_residuals(kind, fluid, walls, dt, v, carried, carry_scale);
+  float error = dfsph_residuals(kind, fluid, walls, dt, v);
   uint32_t iterations = 0;
   while ((error > bound || iterations < min_iterations) && iterations < max_iterations) {
     dfsph_correct(fluid, walls, dt, v, carried, carry_scale);
-    error = dfsph_residuals(kind, fluid, walls, dt, v, carried, carry_scale);
+    error = dfsph_residuals(kind, fluid, walls, dt, v);
     ++iterations;
   }
   return SolveOutcome{iterations, error, error > bound};

@@ -117,30 +117,21 @@ struct DfsphResidual {
   float error;  // its share of the solve's mean error: e_i / rho0
 };
 
-// A pressure is never negative (the fluid resists compression, not expansion), so each
-// iteration's step may lower a particle's pressure only down to zero: k_i = max(step, -applied),
-// applied the p / rho^2 the solve has given it so far (warm start included). The reference
-// implementation only ever adds (it clamps the step at zero); then a warm start that was too
-// high could never be taken back and had to be halved every substep, and a tank at rest, whose
-// pressure is the same from one substep to the next, paid for rebuilding the lost half with
-// tens of iterations (measured: 25 a substep at dt = 4 ms). Only compression counts as error.
-
-// The divergence solve: e = D rho / Dt, and 0 for a particle with fewer neighbours than the
-// constants allow (a free surface, a splash). error in 1/s.
+// The divergence solve: e = D rho / Dt, clamped at 0 (only compression is corrected), and 0 for
+// a particle with fewer neighbours than the constants allow (a free surface, a splash).
+// error in 1/s.
 SPH_HD DfsphResidual divergence_residual(const Dfsph::Constants& c, float rate, uint32_t neighbors,
-                                         float factor, float rest_density, float dt, float applied) {
-  const float e = neighbors >= c.min_divergence_neighbors ? rate : 0.0f;
-  const float k = e * factor / dt;
-  return DfsphResidual{k > -applied ? k : -applied, e > 0.0f ? e / rest_density : 0.0f};
+                                         float factor, float rest_density, float dt) {
+  const float e = (neighbors >= c.min_divergence_neighbors && rate > 0.0f) ? rate : 0.0f;
+  return DfsphResidual{e * factor / dt, e / rest_density};
 }
 
-// The density solve: e = rho* - rho0, rho* = rho_i + dt D rho_i / Dt the density the velocities
-// would give after the step. error dimensionless.
-SPH_HD DfsphResidual density_residual(float rate, float density, float factor, float rest_density, float dt,
-                                      float applied) {
-  const float e = density + dt * rate - rest_density;
-  const float k = e * factor / (dt * dt);
-  return DfsphResidual{k > -applied ? k : -applied, e > 0.0f ? e / rest_density : 0.0f};
+// The density solve: e = max(rho* - rho0, 0), rho* = rho_i + dt D rho_i / Dt the density the
+// velocities would give after the step. error dimensionless.
+SPH_HD DfsphResidual density_residual(float rate, float density, float factor, float rest_density, float dt) {
+  const float predicted = density + dt * rate;
+  const float e = predicted > rest_density ? predicted - rest_density : 0.0f;
+  return DfsphResidual{e * factor / (dt * dt), e / rest_density};
 }
 
 // The colliders' no-penetration inside the solves. The collision response after the step stops a
