@@ -107,6 +107,7 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
   def.particle_spacing = (float)spacing;
   def.integrator = config->integrator;
   def.solver = config->solver;
+  def.features |= config->features;
   /* DFSPH has no equation of state (Tait is refused with it). */
   def.equation_of_state = config->solver == SPH_SOLVER_DFSPH ? SPH_EOS_IDEAL_GAS : SPH_EOS_TAIT;
   r = sph_world_create(context, &def, &world);
