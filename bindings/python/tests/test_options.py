@@ -169,7 +169,8 @@ def test_params_are_described_for_tools():
     assert tuple(gravity.default_value) == pytest.approx((0, -9.81, 0))
     methods = {m.name: m for m in sph.methods()}
     assert list(methods) == [b"ideal_gas", b"tait", b"mueller", b"clavet", b"surface_tension",
-                             b"normalized_density", b"springs", b"wcsph", b"dfsph"]
+                             b"normalized_density", b"springs", b"wcsph", b"dfsph",
+                             b"boundary_density", b"collider_loads"]
     assert methods[b"dfsph"].switch_by == sph.MethodSwitch.SOLVER and methods[b"dfsph"].value == sph.Solver.DFSPH
     assert methods[b"dfsph"].params_kind == sph.ParamsKind.DFSPH and not methods[b"wcsph"].has_params
     assert methods[b"springs"].switch_by == sph.MethodSwitch.FEATURE
