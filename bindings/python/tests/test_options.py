@@ -276,7 +276,7 @@ def test_spring_params_round_trip_validation_and_feature(ctx):
 
 # ---- the solver (WorldDef.solver) -------------------------------------------------------------------
 def test_dfsph_world_has_its_params_and_refuses_what_it_does_not_support(ctx):
-    with ctx.world(capacity=64, solver="dfsph") as w:
+    with ctx.world(capacity=256, solver="dfsph") as w:
         assert w.definition.solver is sph.Solver.DFSPH
         p = w.dfsph_params
         assert (p.density_error, p.divergence_error, p.max_iterations, p.max_divergence_iterations, p.flags) == (
@@ -288,7 +288,7 @@ def test_dfsph_world_has_its_params_and_refuses_what_it_does_not_support(ctx):
         assert "params->max_iterations" in e.message and w.dfsph_params.max_iterations == 100
         w.fill_box((0, 0, 0), (0.1, 0.1, 0.1))
         w.step(1 / 60)
-        s = w.stats
+        s = w.stats()
         assert s.pressure_iterations >= 2 * s.substeps and s.density_error_max <= 1e-4
     with ctx.world(capacity=16) as w:
         assert w.definition.solver is sph.Solver.WCSPH
