@@ -34,6 +34,7 @@ struct DeviceResources {
   std::unique_ptr<DeviceNeighborGrid> grid;
   std::unique_ptr<FrameStatistics> statistics;
   DeviceArray<FrameState> state;
+  DeviceArray<double> solve_partials;  // DFSPH only: the block sums of a solve's error
   PinnedArray<FrameInput> input;
   PinnedArray<FrameState> state_output;
   PinnedArray<uint32_t> sink_kept;
@@ -55,8 +56,8 @@ struct DeviceResources {
   }
 
   PipelineBuffers buffers() {
-    return PipelineBuffers{store.get(), grid.get(),  statistics.get(),
-                           state.get(), input.get(), state_output.get()};
+    return PipelineBuffers{store.get(), grid.get(),         statistics.get(),    state.get(),
+                           input.get(), state_output.get(), solve_partials.get()};
   }
 };
 

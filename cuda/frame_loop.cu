@@ -18,7 +18,7 @@ bool same_setup(const PipelineSetup& a, const PipelineSetup& b) {
          a.options.surface_tension == b.options.surface_tension &&
          a.options.normalized_density == b.options.normalized_density &&
          a.options.viscosity == b.options.viscosity && a.options.springs == b.options.springs &&
-         a.options.boundary_density == b.options.boundary_density &&
+         a.options.dfsph == b.options.dfsph && a.options.boundary_density == b.options.boundary_density &&
          std::memcmp(&a.options.methods, &b.options.methods, sizeof a.options.methods) == 0 &&
          std::memcmp(&a.springs, &b.springs, sizeof a.springs) == 0 &&
          a.scene.colliders == b.scene.colliders && a.scene.fields == b.scene.fields &&
@@ -129,6 +129,8 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
   report.interrupted = interrupted;
   report.max_speed = s.max_speed;
   report_density(s.density, report);
+  report.pressure_solve = finish_solve(s.pressure_tally);
+  report.divergence_solve = finish_solve(s.divergence_tally);
   double staged_ms = 0.0;
   for (int k = 0; k < kStageCount; ++k) {
     report.stage_ms[k] = static_cast<float>(static_cast<double>(s.stage_ns[k]) * 1e-6);

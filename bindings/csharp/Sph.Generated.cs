@@ -69,11 +69,13 @@ namespace Sph
         public const uint SPH_FEATURE_COLLIDER_LOADS = 16u;
         /// <summary>
         /// Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt &lt;= step_factor h /
-        /// c, c the EOS's speed of sound
+        /// c, c the EOS's speed of sound \ (weakly compressible worlds only)
         /// </summary>
         public const uint SPH_STEP_LIMIT_ACOUSTIC = 1u;
         /// <summary>dt &lt;= step_factor sqrt(h / |a|_max)</summary>
         public const uint SPH_STEP_LIMIT_FORCE = 2u;
+        /// <summary>sph_dfsph_params.flags no divergence solve (cheaper; a noisier pressure)</summary>
+        public const uint SPH_DFSPH_SKIP_DIVERGENCE_SOLVE = 1u;
         /// <summary>hollow box: no lid (a tank open at +y)</summary>
         public const uint SPH_SHAPE_FLAG_OPEN_TOP = 1u;
         /// <summary>solid where the SDF is positive: a container</summary>
@@ -91,7 +93,8 @@ namespace Sph
         public const int SPH_STAGE_FORCE32 = 2147483647;
         public const int SPH_VISCOSITY_METHOD_FORCE32 = 2147483647;
         public const int SPH_EOS_FORCE32 = 2147483647;
-        public const int SPH_PARAMS_KIND_COUNT = 5;
+        public const int SPH_SOLVER_FORCE32 = 2147483647;
+        public const int SPH_PARAMS_KIND_COUNT = 6;
         public const int SPH_PARAMS_KIND_FORCE32 = 2147483647;
         public const int SPH_PARAM_TYPE_FORCE32 = 2147483647;
         public const int SPH_BOUND_FORCE32 = 2147483647;
@@ -196,7 +199,10 @@ namespace Sph
         Velocity = 1,
         /// <summary>float32, kg/m^3, from the last density evaluation</summary>
         Density = 2,
-        /// <summary>float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation</summary>
+        /// <summary>
+        /// float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure its
+        /// density solve found in the last substep
+        /// </summary>
         Pressure = 3,
         /// <summary>uint32, persistent particle id, unique within a world</summary>
         Id = 4,
@@ -211,7 +217,7 @@ namespace Sph
         CellRanges = 1,
         /// <summary>density and pressure</summary>
         Density = 2,
-        /// <summary>pressure, viscosity and external forces</summary>
+        /// <summary>pressure, viscosity and external forces (DFSPH: and its two solves)</summary>
         Forces = 3,
         /// <summary>time integration, max-speed reduction, next step size</summary>
         Integrate = 4,
@@ -247,6 +253,24 @@ namespace Sph
         Tait = 1,
     }
 
+    /// <summary>sph_solver: The pressure solver, fixed at world creation (docs/physics.md, "Solvers").</summary>
+    public enum Solver : int
+    {
+        /// <summary>
+        /// the thesis's weakly compressible SPH: pressure from the equation of state, explicit steps
+        /// under the acoustic ceiling 0.4 h / c
+        /// </summary>
+        Wcsph = 0,
+        /// <summary>
+        /// divergence-free SPH (Bender &amp; Koschier 2015, 2017): pressure from two iterative solves
+        /// that hold the density error below a bound (sph_dfsph_params); steps bounded by the flow
+        /// speed alone. No equation of state: the stiffness, Tait's parameters and
+        /// SPH_STEP_LIMIT_ACOUSTIC have no effect. Not with SPH_INTEGRATOR_RK4, SPH_EOS_TAIT or
+        /// SPH_FEATURE_NORMALIZED_DENSITY (SPH_ERROR_UNSUPPORTED at creation)
+        /// </summary>
+        Dfsph = 1,
+    }
+
     /// <summary>sph_params_kind</summary>
     public enum ParamsKind : int
     {
@@ -260,6 +284,8 @@ namespace Sph
         Tait = 3,
         /// <summary>sph_spring_params</summary>
         Springs = 4,
+        /// <summary>sph_dfsph_params</summary>
+        Dfsph = 5,
     }
 
     /// <summary>sph_param_type</summary>
@@ -306,6 +332,8 @@ namespace Sph
         Viscosity = 2,
         /// <summary>sph_world_def.equation_of_state == value</summary>
         EquationOfState = 3,
+        /// <summary>sph_world_def.solver == value</summary>
+        Solver = 4,
     }
 
     /// <summary>sph_memory_kind</summary>
@@ -387,6 +415,16 @@ namespace Sph
         SourceCapacityReached = 1,
         /// <summary>object: the sink; count: particles removed</summary>
         SinkRemoved = 2,
+        /// <summary>
+        /// DFSPH; object: none (0); count: substeps whose density solve stopped at max_iterations above
+        /// its bound
+        /// </summary>
+        PressureSolveCapped = 3,
+        /// <summary>
+        /// DFSPH; object: none (0); count: substeps whose divergence solve stopped at its cap above its
+        /// bound
+        /// </summary>
+        DivergenceSolveCapped = 4,
     }
 
     /// <summary>
@@ -684,7 +722,7 @@ namespace Sph
     }
 
     /// <summary>
-    /// sph_world_def (40 bytes): Creation-time description of a world; fixed for the world's life. Zero
+    /// sph_world_def (44 bytes): Creation-time description of a world; fixed for the world's life. Zero
     /// means default for every field: a zeroed def is the def sph_world_def_init gives.
     /// </summary>
     [StructLayout(LayoutKind.Sequential)]
@@ -710,6 +748,8 @@ namespace Sph
         public float RestDensity;
         /// <summary>sph_equation_of_state equation_of_state: default SPH_EOS_IDEAL_GAS</summary>
         public EquationOfState EquationOfState;
+        /// <summary>sph_solver solver: default SPH_SOLVER_WCSPH</summary>
+        public Solver Solver;
 
         /// <summary>A WorldDef with the library's defaults (sph_world_def_init_sized).</summary>
         public static WorldDef Default()
@@ -889,6 +929,47 @@ namespace Sph
         }
     }
 
+    /// <summary>sph_dfsph_params (24 bytes)</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public partial struct DfsphParams
+    {
+        /// <summary>uint32_t struct_size: set by sph_dfsph_params_init</summary>
+        public uint StructSize;
+        /// <summary>
+        /// float density_error: bound on the density solve's mean error, the mean over the particles of
+        /// max(rho* - rho0, 0) / rho0 (rho*: the density the step would give); dimensionless; default
+        /// 0.001 (0.1 %); in (0, 1]; 0 = default
+        /// </summary>
+        public float DensityError;
+        /// <summary>
+        /// float divergence_error: bound on the divergence solve's mean of max(D rho / Dt, 0) / rho0,
+        /// 1/s; default 1; &gt; 0; 0 = default
+        /// </summary>
+        public float DivergenceError;
+        /// <summary>
+        /// uint32_t max_iterations: cap of the density solve per substep; default 100; &gt;= 2; 0 =
+        /// default. A solve that stops here above its bound is counted in sph_stats and reported as an
+        /// event
+        /// </summary>
+        public uint MaxIterations;
+        /// <summary>
+        /// uint32_t max_divergence_iterations: cap of the divergence solve; default 100; &gt;= 1; 0 =
+        /// default
+        /// </summary>
+        public uint MaxDivergenceIterations;
+        /// <summary>uint32_t flags: SPH_DFSPH_* bits; default 0</summary>
+        public uint Flags;
+
+        /// <summary>A DfsphParams with the library's defaults (sph_dfsph_params_init_sized).</summary>
+        public static DfsphParams Default()
+        {
+            var value = new DfsphParams();
+            uint size = (uint)Marshal.SizeOf(typeof(DfsphParams));
+            SphException.Check(Native.sph_dfsph_params_init_sized(ref value, size), "sph_dfsph_params_init_sized");
+            return value;
+        }
+    }
+
     /// <summary>sph_params_info (32 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct ParamsInfo
@@ -965,7 +1046,10 @@ namespace Sph
         public uint MethodCount;
         /// <summary>sph_method_switch switch_by: the sph_world_def field that selects it</summary>
         public MethodSwitch SwitchBy;
-        /// <summary>uint32_t value: the SPH_FEATURE_* bit, sph_viscosity_method or sph_equation_of_state</summary>
+        /// <summary>
+        /// uint32_t value: the SPH_FEATURE_* bit, sph_viscosity_method, sph_equation_of_state or
+        /// sph_solver
+        /// </summary>
         public uint Value;
         /// <summary>uint32_t has_params: 1 when its parameters are in the struct of params_kind</summary>
         public uint HasParams;
@@ -1073,7 +1157,7 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_stats (104 bytes)</summary>
+    /// <summary>sph_stats (144 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct Stats
     {
@@ -1114,6 +1198,36 @@ namespace Sph
         /// CUDA backend)
         /// </summary>
         public ulong MemoryBytes;
+        /// <summary>
+        /// uint32_t pressure_iterations: DFSPH's two solves over the substeps of the last step (all
+        /// zero on a WCSPH world). An iteration is one velocity update and one new residual, after the
+        /// warm start's.
+        /// </summary>
+        public uint PressureIterations;
+        /// <summary>uint32_t pressure_iterations_max: most in one substep</summary>
+        public uint PressureIterationsMax;
+        /// <summary>uint32_t divergence_iterations: the divergence solve's iterations, summed</summary>
+        public uint DivergenceIterations;
+        /// <summary>uint32_t divergence_iterations_max: most in one substep</summary>
+        public uint DivergenceIterationsMax;
+        /// <summary>
+        /// float density_error_mean: the density solve's achieved mean error (see
+        /// sph_dfsph_params.density_error), averaged over the substeps
+        /// </summary>
+        public float DensityErrorMean;
+        /// <summary>float density_error_max: the largest of any substep</summary>
+        public float DensityErrorMax;
+        /// <summary>float divergence_error_mean: the divergence solve's achieved mean error, 1/s</summary>
+        public float DivergenceErrorMean;
+        /// <summary>float divergence_error_max: the largest of any substep</summary>
+        public float DivergenceErrorMax;
+        /// <summary>
+        /// uint32_t pressure_solves_capped: substeps whose density solve stopped at its cap above its
+        /// bound (also SPH_EVENT_PRESSURE_SOLVE_CAPPED)
+        /// </summary>
+        public uint PressureSolvesCapped;
+        /// <summary>uint32_t divergence_solves_capped: likewise (SPH_EVENT_DIVERGENCE_SOLVE_CAPPED)</summary>
+        public uint DivergenceSolvesCapped;
 
         /// <summary>A Stats with the library's defaults (sph_stats_init_sized).</summary>
         public static Stats Default()
@@ -1843,8 +1957,9 @@ namespace Sph
         /// FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass).
         /// Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range:
         /// capacity above 2^30, spacing &lt; 0 or non-finite, kernel_radius &lt; spacing, rest_density
-        /// &lt; 0), UNSUPPORTED (unknown integrator or feature bit), VERSION_MISMATCH,
-        /// OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY. *out is written only on success.
+        /// &lt; 0), UNSUPPORTED (unknown integrator, feature bit, method or solver; a combination a
+        /// solver does not support, see sph_solver), VERSION_MISMATCH, OUT_OF_HOST_MEMORY,
+        /// OUT_OF_DEVICE_MEMORY. *out is written only on success.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_create(ContextHandle context, ref WorldDef def, out WorldHandle @out);
@@ -1968,6 +2083,27 @@ namespace Sph
         public static extern Result sph_world_get_spring_params(WorldHandle world, ref SpringParams @out);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_spring_params")]
         public static extern Result sph_world_get_spring_params(IntPtr world, IntPtr @out);
+
+        /// <summary>sph_dfsph_params_init_sized</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_dfsph_params_init_sized(ref DfsphParams @params, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_dfsph_params_init_sized")]
+        public static extern Result sph_dfsph_params_init_sized(IntPtr @params, uint size);
+
+        /// <summary>
+        /// FEATURE_DISABLED unless the world's solver is SPH_SOLVER_DFSPH. INVALID_ARGUMENT for a value
+        /// out of range (the message names it); nothing changes on error. Acts from the next substep.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_set_dfsph_params(WorldHandle world, ref DfsphParams @params);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_set_dfsph_params")]
+        public static extern Result sph_world_set_dfsph_params(IntPtr world, IntPtr @params);
+
+        /// <summary>sph_world_get_dfsph_params</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_get_dfsph_params(WorldHandle world, ref DfsphParams @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_dfsph_params")]
+        public static extern Result sph_world_get_dfsph_params(IntPtr world, IntPtr @out);
 
         /// <summary>
         /// Replaces the params struct of `kind` at once, as its typed set call does
@@ -2616,6 +2752,7 @@ namespace Sph
             typeof(ClavetViscosityParams),
             typeof(TaitParams),
             typeof(SpringParams),
+            typeof(DfsphParams),
             typeof(ParamsInfo),
             typeof(ParamFieldInfo),
             typeof(PhysicsMethodInfo),
@@ -2651,6 +2788,7 @@ namespace Sph
             "sph_clavet_viscosity_params",
             "sph_tait_params",
             "sph_spring_params",
+            "sph_dfsph_params",
             "sph_params_info",
             "sph_param_field_info",
             "sph_physics_method_info",
@@ -2680,19 +2818,20 @@ namespace Sph
         public static readonly int[] StructSizes = {
             12,
             56,
-            40,
+            44,
             48,
             16,
             16,
             8,
             28,
+            24,
             32,
             72,
             32,
             40,
             44,
             36,
-            104,
+            144,
             80,
             104,
             44,
@@ -2740,6 +2879,7 @@ namespace Sph
             typeof(WorldDef),
             typeof(WorldDef),
             typeof(WorldDef),
+            typeof(WorldDef),
             typeof(WorldParams),
             typeof(WorldParams),
             typeof(WorldParams),
@@ -2767,6 +2907,12 @@ namespace Sph
             typeof(SpringParams),
             typeof(SpringParams),
             typeof(SpringParams),
+            typeof(DfsphParams),
+            typeof(DfsphParams),
+            typeof(DfsphParams),
+            typeof(DfsphParams),
+            typeof(DfsphParams),
+            typeof(DfsphParams),
             typeof(ParamsInfo),
             typeof(ParamsInfo),
             typeof(ParamsInfo),
@@ -2808,6 +2954,16 @@ namespace Sph
             typeof(FillSphereDesc),
             typeof(FillSphereDesc),
             typeof(FillSphereDesc),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
             typeof(Stats),
             typeof(Stats),
             typeof(Stats),
@@ -2951,6 +3107,7 @@ namespace Sph
             "KernelRadius",
             "RestDensity",
             "EquationOfState",
+            "Solver",
             "StructSize",
             "MaxSubsteps",
             "Gravity",
@@ -2978,6 +3135,12 @@ namespace Sph
             "Plasticity",
             "Damping",
             "Reserved0",
+            "StructSize",
+            "DensityError",
+            "DivergenceError",
+            "MaxIterations",
+            "MaxDivergenceIterations",
+            "Flags",
             "StructSize",
             "ParamsSize",
             "FieldCount",
@@ -3036,6 +3199,16 @@ namespace Sph
             "StepMs",
             "Reserved0",
             "MemoryBytes",
+            "PressureIterations",
+            "PressureIterationsMax",
+            "DivergenceIterations",
+            "DivergenceIterationsMax",
+            "DensityErrorMean",
+            "DensityErrorMax",
+            "DivergenceErrorMean",
+            "DivergenceErrorMax",
+            "PressureSolvesCapped",
+            "DivergenceSolvesCapped",
             "StructSize",
             "Dims",
             "IndexToLocal",
@@ -3162,6 +3335,7 @@ namespace Sph
             28,
             32,
             36,
+            40,
             0,
             4,
             8,
@@ -3189,6 +3363,12 @@ namespace Sph
             16,
             20,
             24,
+            0,
+            4,
+            8,
+            12,
+            16,
+            20,
             0,
             4,
             8,
@@ -3247,6 +3427,16 @@ namespace Sph
             88,
             92,
             96,
+            104,
+            108,
+            112,
+            116,
+            120,
+            124,
+            128,
+            132,
+            136,
+            140,
             0,
             4,
             16,
@@ -3380,6 +3570,9 @@ namespace Sph
             "sph_spring_params_init_sized",
             "sph_world_set_spring_params",
             "sph_world_get_spring_params",
+            "sph_dfsph_params_init_sized",
+            "sph_world_set_dfsph_params",
+            "sph_world_get_dfsph_params",
             "sph_world_set_physics_params",
             "sph_world_get_physics_params",
             "sph_params_info_init_sized",
@@ -3557,6 +3750,9 @@ namespace Sph
             "sph",
             "sph",
             "sph",
+            "sph",
+            "sph",
+            "sph",
             "sph_vdb",
             "sph_vdb",
         };
@@ -3592,12 +3788,12 @@ namespace Sph
             { "SPH_ATTRIBUTE_POSITION", "3 x float32, metres" },
             { "SPH_ATTRIBUTE_VELOCITY", "3 x float32, metres per second" },
             { "SPH_ATTRIBUTE_DENSITY", "float32, kg/m^3, from the last density evaluation" },
-            { "SPH_ATTRIBUTE_PRESSURE", "float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation" },
+            { "SPH_ATTRIBUTE_PRESSURE", "float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure its density solve found in the last substep" },
             { "SPH_ATTRIBUTE_ID", "uint32, persistent particle id, unique within a world" },
             { "SPH_STAGE_HASH_SORT", "cell hash, stable sort, reorder of every attribute" },
             { "SPH_STAGE_CELL_RANGES", "start/end of each cell" },
             { "SPH_STAGE_DENSITY", "density and pressure" },
-            { "SPH_STAGE_FORCES", "pressure, viscosity and external forces" },
+            { "SPH_STAGE_FORCES", "pressure, viscosity and external forces (DFSPH: and its two solves)" },
             { "SPH_STAGE_INTEGRATE", "time integration, max-speed reduction, next step size" },
             { "SPH_STAGE_COLLIDE", "particles against colliders (CPU; the CUDA backend does it inside the forces kernel, so it counts under SPH_STAGE_FORCES there)" },
             { "SPH_STAGE_EMIT", "sinks removing particles; sources emit before the substeps and count only in sph_stats.step_ms" },
@@ -3606,11 +3802,14 @@ namespace Sph
             { "SPH_VISCOSITY_CLAVET", "radial impulses between approaching pairs (eq. 18-19), sph_clavet_viscosity_params" },
             { "SPH_EOS_IDEAL_GAS", "the thesis's modified ideal gas p = k (rho - rho0) (eq. 15)" },
             { "SPH_EOS_TAIT", "p = B ((rho / rho0)^7 - 1), B = rho0 c^2 / 7, sph_tait_params" },
+            { "SPH_SOLVER_WCSPH", "the thesis's weakly compressible SPH: pressure from the equation of state, explicit steps under the acoustic ceiling 0.4 h / c" },
+            { "SPH_SOLVER_DFSPH", "divergence-free SPH (Bender & Koschier 2015, 2017): pressure from two iterative solves that hold the density error below a bound (sph_dfsph_params); steps bounded by the flow speed alone. No equation of state: the stiffness, Tait's parameters and SPH_STEP_LIMIT_ACOUSTIC have no effect. Not with SPH_INTEGRATOR_RK4, SPH_EOS_TAIT or SPH_FEATURE_NORMALIZED_DENSITY (SPH_ERROR_UNSUPPORTED at creation)" },
             { "SPH_PARAMS_WORLD", "sph_world_params" },
             { "SPH_PARAMS_SURFACE_TENSION", "sph_surface_tension_params" },
             { "SPH_PARAMS_CLAVET_VISCOSITY", "sph_clavet_viscosity_params" },
             { "SPH_PARAMS_TAIT", "sph_tait_params" },
             { "SPH_PARAMS_SPRINGS", "sph_spring_params" },
+            { "SPH_PARAMS_DFSPH", "sph_dfsph_params" },
             { "SPH_PARAM_FLOAT", "float, finite" },
             { "SPH_PARAM_VEC3", "sph_vec3, every component finite" },
             { "SPH_PARAM_UINT32", "uint32_t count" },
@@ -3624,6 +3823,7 @@ namespace Sph
             { "SPH_METHOD_SWITCH_FEATURE", "a bit of sph_world_def.features (value)" },
             { "SPH_METHOD_SWITCH_VISCOSITY", "sph_world_def.viscosity_method == value" },
             { "SPH_METHOD_SWITCH_EQUATION_OF_STATE", "sph_world_def.equation_of_state == value" },
+            { "SPH_METHOD_SWITCH_SOLVER", "sph_world_def.solver == value" },
             { "SPH_MEMORY_HOST", "ordinary host memory" },
             { "SPH_MEMORY_CUDA_DEVICE", "device memory of the context's CUDA device (CUDA contexts only)" },
             { "SPH_SHAPE_PLANE", "solid below y = 0; half_extents.x/.z its size, .y its thickness" },
@@ -3643,6 +3843,8 @@ namespace Sph
             { "SPH_FORCE_FIELD_GRID", "accelerations from a user grid (3 components, field frame)" },
             { "SPH_EVENT_SOURCE_CAPACITY_REACHED", "object: the source; count: particles not emitted" },
             { "SPH_EVENT_SINK_REMOVED", "object: the sink; count: particles removed" },
+            { "SPH_EVENT_PRESSURE_SOLVE_CAPPED", "DFSPH; object: none (0); count: substeps whose density solve stopped at max_iterations above its bound" },
+            { "SPH_EVENT_DIVERGENCE_SOLVE_CAPPED", "DFSPH; object: none (0); count: substeps whose divergence solve stopped at its cap above its bound" },
         };
     }
 }

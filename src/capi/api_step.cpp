@@ -99,6 +99,16 @@ SPH_API sph_result SPH_CALL sph_world_get_stats(const sph_world* world, sph_stat
     for (int i = 0; i < SPH_STAGE_COUNT; ++i) s.stage_ms[i] = r.stage_ms[i];
     s.step_ms = w.last_step_ms();
     s.memory_bytes = w.backend().memory_bytes();
+    s.pressure_iterations = r.pressure_solve.iterations;
+    s.pressure_iterations_max = r.pressure_solve.iterations_max;
+    s.divergence_iterations = r.divergence_solve.iterations;
+    s.divergence_iterations_max = r.divergence_solve.iterations_max;
+    s.density_error_mean = r.pressure_solve.error_mean;
+    s.density_error_max = r.pressure_solve.error_max;
+    s.divergence_error_mean = r.divergence_solve.error_mean;
+    s.divergence_error_max = r.divergence_solve.error_max;
+    s.pressure_solves_capped = r.pressure_solve.capped;
+    s.divergence_solves_capped = r.divergence_solve.capped;
     sph::write_output_struct(out, s, "out");
     return SPH_OK;
   });

@@ -133,7 +133,7 @@ Vec3 bulk_vec3(ByteReader& r, const char* what, uint32_t index) {
   return v;
 }
 
-WorldConfig read_config(ByteReader& r) {
+WorldConfig read_config(ByteReader& r, uint32_t version) {
   WorldConfig c;
   c.capacity = r.u32();
   if (c.capacity == 0 || c.capacity > (1u << 30))
@@ -149,6 +149,15 @@ WorldConfig read_config(ByteReader& r) {
   c.kernel_radius = positive(r, "kernel radius");
   c.rest_density = positive(r, "rest density");
   c.particle_mass = positive(r, "particle mass");
+  if (version >= kFirstSolverVersion) {
+    c.solver = static_cast<Solver>(method(r, SwitchKind::Solver, "solver"));
+    if (c.solver == Solver::Dfsph &&
+        (c.integrator == Integrator::Rk4 || c.equation_of_state != EquationOfState::IdealGas ||
+         (c.features & kFeatureNormalizedDensity)))
+      corrupt(r.what() +
+              ": the DFSPH solver with RK4, an equation of state other than the ideal gas, or "
+              "the normalised density (no world can be made so)");
+  }
   if (c.kernel_radius < c.particle_spacing || c.kernel_radius > 5.0f * c.particle_spacing)
     corrupt(r.what() + ": kernel radius is outside [1, 5] x the particle spacing");
   const KernelCoefficients k = make_kernel_coefficients(c.kernel_radius);
@@ -223,7 +232,19 @@ struct Clock {
   std::vector<Event> events;
 };
 
-Clock read_clock(ByteReader& r) {
+SolveReport read_solve(ByteReader& r, const std::string& name) {
+  SolveReport s;
+  s.iterations = r.u32();
+  s.iterations_max = r.u32();
+  s.capped = r.u32();
+  s.error_mean = non_negative(r, name + " mean error");
+  s.error_max = non_negative(r, name + " largest error");
+  if (s.iterations_max > s.iterations || s.capped > s.iterations)
+    corrupt(r.what() + ": " + name + " counts more in one substep or more capped solves than iterations");
+  return s;
+}
+
+Clock read_clock(ByteReader& r, uint32_t version) {
   Clock c;
   c.next_id = r.u32();
   zero(r, "reserved");
@@ -246,13 +267,19 @@ Clock read_clock(ByteReader& r) {
   f.neighbors_mean = non_negative(r, "neighbours mean");
   f.neighbors_max = r.u32();
   for (int k = 0; k < kStageCount; ++k) f.stage_ms[k] = non_negative(r, "stage time");
+  if (version >= kFirstSolverVersion) {
+    f.pressure_solve = read_solve(r, "density solve");
+    f.divergence_solve = read_solve(r, "divergence solve");
+  }
   const uint32_t events = r.u32();
   r.need_elements(events, 16, "events");
   c.events.resize(events);
   for (Event& e : c.events) {
     const uint32_t type = r.u32();
     if (type != static_cast<uint32_t>(EventType::SourceCapacityReached) &&
-        type != static_cast<uint32_t>(EventType::SinkRemoved))
+        type != static_cast<uint32_t>(EventType::SinkRemoved) &&
+        type != static_cast<uint32_t>(EventType::PressureSolveCapped) &&
+        type != static_cast<uint32_t>(EventType::DivergenceSolveCapped))
       corrupt(r.what() + ": unknown event type " + std::to_string(type));
     e.type = static_cast<EventType>(type);
     e.count = r.u32();
@@ -302,6 +329,21 @@ ParticleSnapshot read_particles(ByteReader& r, const WorldConfig& config, uint32
       factors[i] = d;
     }
     s.set_carried(kArrayDensityFactor, factors);
+  }
+  // DFSPH: the warm starts of its two solves (finite; the density solve's pressure is never
+  // negative). Every DFSPH checkpoint has them (DFSPH came with version 3).
+  if (config.solver == Solver::Dfsph) {
+    r.need_elements(n, 2 * sizeof(float), "DFSPH warm starts");
+    std::vector<float> pressure(n), divergence(n);
+    for (uint32_t i = 0; i < n; ++i) {
+      pressure[i] = bulk_finite(r, "DFSPH pressure of particle", i);
+      if (pressure[i] < 0.0f)
+        corrupt(r.what() + ": DFSPH pressure of particle " + std::to_string(i) + " is negative");
+    }
+    for (uint32_t i = 0; i < n; ++i)
+      divergence[i] = bulk_finite(r, "DFSPH divergence pressure of particle", i);
+    s.set_carried(kArrayDfsphPressure, pressure);
+    s.set_carried(kArrayDfsphDivergencePressure, divergence);
   }
   std::vector<uint32_t> sorted(s.id);
   std::sort(sorted.begin(), sorted.end());
@@ -546,7 +588,7 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   };
 
   ByteReader conf = next_section(0);
-  const WorldConfig config = read_config(conf);
+  const WorldConfig config = read_config(conf, version);
   conf.expect_end();
   ByteReader parm = next_section(1);
   const RuntimeParams params = version == 1 ? read_params_v1(parm, config) : read_params(parm, config);
@@ -554,7 +596,7 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   // A dt_min above the stability ceiling is accepted, as sph_world_set_params accepts it (the
   // caller's fixed step wins over the ceiling; a step that then fails says so and rolls back).
   ByteReader time = next_section(2);
-  const Clock clock = read_clock(time);
+  const Clock clock = read_clock(time, version);
   time.expect_end();
   ByteReader part = next_section(3);
   ParticleSnapshot particles = read_particles(part, config, clock.next_id);

@@ -206,7 +206,7 @@ bool World::step(double frame_dt, const StepInterrupt& interrupt) {
   try {
     // Reserved up front, so that nothing after the backend's frame can fail on an allocation:
     // once the particles have moved, the rest of the step must not throw.
-    events_.reserve(sources_.size() + sinks_.size());
+    events_.reserve(sources_.size() + sinks_.size() + 2);  // + the solves' capped events
     if (sources_.size() > 0) backend_->save_step_inputs();
     emit_sources(frame_dt);
     SceneFrame scene = build_scene_frame(frame_dt);
@@ -238,6 +238,11 @@ bool World::step(double frame_dt, const StepInterrupt& interrupt) {
     if (removed > 0) events_.push_back(Event{EventType::SinkRemoved, id, removed});
     ++index;
   });
+  // A DFSPH solve that stopped at its cap is never silent.
+  if (report.pressure_solve.capped > 0)
+    events_.push_back(Event{EventType::PressureSolveCapped, 0, report.pressure_solve.capped});
+  if (report.divergence_solve.capped > 0)
+    events_.push_back(Event{EventType::DivergenceSolveCapped, 0, report.divergence_solve.capped});
   report_ = std::move(report);
   simulated_time_ += report_.time_advanced;
   last_step_ms_ = static_cast<float>(

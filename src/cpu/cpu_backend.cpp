@@ -38,6 +38,12 @@ CpuBackend::CpuBackend(const WorldConfig& config, unsigned workers)
   link_from_ = store_.find_typed<uint32_t>(kArraySpringLinkFrom);
   spring_candidates_ = store_.find_typed<uint32_t>(kArraySpringCandidates);
   spring_acceleration_ = store_.find_typed<Float4>(kArraySpringAcceleration);
+  dfsph_pressure_ = store_.find_typed<float>(kArrayDfsphPressure);
+  dfsph_divergence_ = store_.find_typed<float>(kArrayDfsphDivergencePressure);
+  dfsph_factor_ = store_.find_typed<float>(kArrayDfsphFactor);
+  dfsph_step_ = store_.find_typed<float>(kArrayDfsphStep);
+  dfsph_residual_ = store_.find_typed<float>(kArrayDfsphResidual);
+  dfsph_contact_ = store_.find_typed<Float4>(kArrayDfsphContact);
   boundary_ = store_.find_typed<Float4>(kArrayBoundaryGradient);
 }
 

@@ -485,6 +485,29 @@ static class Tests
         }
     }
 
+    public static void TestDfsphSolverAndItsParams()
+    {
+        using (var context = Cpu())
+        {
+            WorldDef d = WorldDef.Default();
+            d.Capacity = 64;
+            d.Solver = Solver.Dfsph;
+            using (var world = new World(context, d))
+            {
+                AssertEqual(Solver.Dfsph, world.Solver, "World.Solver");
+                DfsphParams p = world.DfsphParams;
+                AssertEqual(100u, p.MaxIterations, "default cap");
+                p.DensityError = 1e-4f;
+                world.DfsphParams = p;
+                AssertEqual(1e-4f, world.DfsphParams.DensityError, "set and read back");
+                p.MaxIterations = 1;
+                Throws(Result.ErrorInvalidArgument, () => world.DfsphParams = p);
+            }
+            d.Integrator = Integrator.Rk4;
+            Throws(Result.ErrorUnsupported, () => new World(context, d));
+        }
+    }
+
     public static void TestPhysicsParamsByKindAndTheirDescriptions()
     {
         AssertEqual("tait", Utf8.FromNative(Library.ParamsInfo(ParamsKind.Tait).Name), "params name");
@@ -498,7 +521,10 @@ static class Tests
         AssertEqual(ParamZero.Default, speed.Zero, "speed of sound: 0 is the default");
         AssertEqual(ParamBound.Exclusive, speed.LowerBound, "speed of sound > 0");
         PhysicsMethodInfo[] methods = Library.PhysicsMethods();
-        AssertEqual(9, methods.Length, "methods");  // through boundary_density and collider_loads
+        AssertEqual(11, methods.Length, "methods");  // through boundary_density and collider_loads
+        AssertEqual("dfsph", Utf8.FromNative(methods[8].Name), "the last method");
+        AssertEqual(MethodSwitch.Solver, methods[8].SwitchBy, "DFSPH is a solver");
+        AssertEqual(ParamsKind.Dfsph, methods[8].ParamsKind, "its params");
         AssertEqual("clavet", Utf8.FromNative(methods[3].Name), "the fourth method");
         AssertEqual(MethodSwitch.Viscosity, methods[3].SwitchBy, "Clavet is a viscosity method");
         AssertEqual(ParamsKind.ClavetViscosity, methods[3].ParamsKind, "its params");
