@@ -129,7 +129,7 @@ void FrameWriter::write(const SceneRuntime& runtime, const ParticleFrame& frame)
   if (preview_) {
     const bool draw_surface = options_.surface && options_.preview_surface;
     preview_->render(runtime, frame.position.data(), frame.velocity.data(), frame.count,
-                     draw_surface ? &mesh_ : nullptr, &image_);
+                     draw_surface ? &mesh_ : nullptr, frame.frame, frame.time, &image_);
     NewFile png(staged.add(name("preview", frame.frame, "png")));
     write_png(image_, png.get(), png.path());
     png.close();

@@ -20,9 +20,10 @@ class PreviewRenderer {
   explicit PreviewRenderer(const SceneRuntime& runtime);
 
   // Draws one frame. positions/velocities: 3 floats per particle. With a mesh, the surface is
-  // drawn instead of the particles.
+  // drawn instead of the particles. The caption gives the frame's number and time (s), the
+  // particle count and, for particles, the speed legend.
   void render(const SceneRuntime& runtime, const float* positions, const float* velocities, uint32_t count,
-              const SurfaceMesh* mesh, Image* image);
+              const SurfaceMesh* mesh, uint32_t frame, double time, Image* image);
 
   const Camera& camera() const { return camera_; }
 
