@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # shellcheck shell=bash
 # Shared set-up for scripts/demo and scripts/test (sourced, not run).
 #

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Regenerates everything derived from include/sph_c.h, or checks that it is up to date.
 
     python3 bindings/api/generate.py            # rewrite the generated files in place

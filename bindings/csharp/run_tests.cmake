@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # cmake -DMCS=mcs -DMONO=mono -DSOURCE_DIR=bindings/csharp -DWORK_DIR=<build dir> -P run_tests.cmake
 #
 # Compiles the bindings into Sph.dll, the sample, the tests and README.md's snippet against it

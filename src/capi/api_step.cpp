@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Stepping and statistics.
 #include "guard.h"
 #include "handles.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The checkpoint layout shared by the writer and the reader (docs/checkpoint.md). All numbers
 // little-endian; floats IEEE 754. Version 2 (version 1 differs only in the parameters section,
 // checkpoint_params.h; both load):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Chooses the wrapped grid's table size from the world's capacity: about one table slot per
 // particle, so memory scales with particles and never with the extent of the domain.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sph-run's exit codes (issue 7, items 2 and 6): usage errors, scene-file errors, backends that
 // are not there, and an interrupted run that keeps only complete frames.
 //   usage: cli_exit_codes SPH_RUN SCENES_DIR

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Outputs read back equal the particle arrays (issue 7, items 3 and 6): the CSV, PLY and VDB
 // points writers round-trip a frame exactly (VDB positions to float precision), sph-run's frame
 // files hold what the world held after the same frames, and the surface encloses the fluid.

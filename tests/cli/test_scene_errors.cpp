@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Scene-file errors (issue 7, item 6): every bad field is reported with its path and what was
 // expected there; unknown fields (physics options of later issues among them) are rejected;
 // scene objects the library refuses are reported at their path too.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "frame_writer.h"
 
 #include <chrono>

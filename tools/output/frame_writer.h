@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // FrameWriter: every file of one frame (particles in the chosen formats, the surface, the
 // preview image), written in the run's private staging directory, then moved into the output
 // directory between a "writing" and a "complete" line of the run's manifest, which is what

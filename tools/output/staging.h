@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Where a frame's files are written before they are committed: a private directory inside the
 // output directory, made by mkdtemp (".sph-run-XXXXXX": an unpredictable name, created
 // exclusively with mode 0700, so nobody else can plant a file or a link in it), locked with

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The fluid surface: particles rasterised into a narrow-band level set with OpenVDB's
 // ParticlesToLevelSet, smoothed, written as .vdb, and meshed with volumeToMesh into an OBJ.
 #include <openvdb/openvdb.h>

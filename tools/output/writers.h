@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The per-frame file writers. Each writes one file at `path` (the caller's temporary name)
 // and throws std::runtime_error when it cannot.
 #ifndef SPH_TOOLS_WRITERS_H

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The preview's caption: simulated time, frame number and particle count in the top-left
 // corner and, when particles are drawn coloured by speed, the colour legend in the bottom-left,
 // in a 5 x 7 bitmap font (no font library: the preview stays headless and self-contained).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "preview_renderer.h"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The headless preview: each frame's particles (or the fluid surface) drawn on the CPU with
 // the colliders as faint glass, from the scene's camera or one that frames the scene.
 #ifndef SPH_TOOLS_PREVIEW_RENDERER_H

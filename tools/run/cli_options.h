@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sph-run's command line.
 #ifndef SPH_TOOLS_CLI_OPTIONS_H
 #define SPH_TOOLS_CLI_OPTIONS_H

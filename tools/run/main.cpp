@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sph-run: runs a scene file and writes its frames (docs/cli.md).
 #include <csignal>
 #include <cstdio>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Output settings: where frames go, in which formats, the surface and the preview images.
 #include "parse_parts.h"
 #include "scene_error.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Shapes of a scene file: the library's analytic shapes, or a level set from a .vdb file.
 #include "parse_parts.h"
 #include "scene_error.h"

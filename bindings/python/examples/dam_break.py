@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """A dam break in a tank, simulated with sph from Python and plotted with matplotlib.
 
     SPH_LIBRARY=build/libsph.so python3 bindings/python/examples/dam_break.py [--out dam_break.png]

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Test set-up: imports the package from this checkout, counts the C functions the tests reach.
 
 Run from the repository root with the library to test in SPH_LIBRARY:

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """The README's two-line example runs as written."""
 import os
 import re
