@@ -16,6 +16,7 @@
 #include "scene_desc.h"
 #include "scene_runtime.h"
 #include "surface_mesh.h"
+#include "writers.h"
 
 namespace sph_tools {
 
@@ -67,6 +68,7 @@ class FrameWriter {
   SurfaceMesh mesh_;
   Image image_;
   FrameWriteTimes times_;
+  std::vector<SeriesEntry> vtp_series_;  // the committed .vtp frames, for fluid.pvd
 };
 
 }  // namespace sph_tools

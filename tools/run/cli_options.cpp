@@ -19,7 +19,7 @@ const char* usage_text() {
          "  --backend B         auto | cpu | cuda (default auto: CUDA when a GPU is present)\n"
          "  --out DIR           output directory (default: the scene's output.directory,\n"
          "                      else out/<scene file name>)\n"
-         "  --format F          vdb | ply | csv | none; several as vdb,ply (default: the scene's,\n"
+         "  --format F          vdb | ply | csv | vtp | none; several as vdb,vtp (default: the scene's,\n"
          "                      else vdb; ply in builds without OpenVDB)\n"
          "  --surface           also write the fluid surface: level set (.vdb) and mesh (.obj)\n"
          "  --preview           draw every frame to PNG, and an MP4 when ffmpeg is on PATH\n"
@@ -99,8 +99,11 @@ std::vector<OutputFormat> parse_formats(const char* text) {
       formats.push_back(OutputFormat::kPly);
     else if (f == "csv")
       formats.push_back(OutputFormat::kCsv);
+    else if (f == "vtp")
+      formats.push_back(OutputFormat::kVtp);
     else
-      throw UsageError("--format: expected vdb, ply, csv or none (several as vdb,ply), got \"" + all + "\"");
+      throw UsageError("--format: expected vdb, ply, csv, vtp or none (several as vtp,ply), got \"" + all +
+                       "\"");
     if (comma == std::string::npos) break;
     start = comma + 1;
   }

@@ -52,9 +52,9 @@ int run(int argc, char** argv) {
   }
   if (cli.version) {
     std::printf("sph-run, %s\n", sph_get_build_info());
-    std::printf("outputs: csv, ply%s%s%s\n", format_available(OutputFormat::kVdb) ? ", vdb" : "",
-                surface_available() ? ", surfaces (vdb + obj)" : "",
-                png_available() ? ", preview (png)" : "");
+    std::printf(
+        "outputs: csv, ply, vtp (+ fluid.pvd)%s%s%s\n", format_available(OutputFormat::kVdb) ? ", vdb" : "",
+        surface_available() ? ", surfaces (vdb + obj)" : "", png_available() ? ", preview (png)" : "");
     return kExitOk;
   }
 

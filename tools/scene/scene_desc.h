@@ -97,7 +97,7 @@ struct PhysicsDesc {
   std::string path;                  // "physics.tait"
 };
 
-enum class OutputFormat { kVdb, kPly, kCsv };
+enum class OutputFormat { kVdb, kPly, kCsv, kVtp };
 
 struct CameraDesc {
   bool automatic = true;
