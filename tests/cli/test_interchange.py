@@ -117,7 +117,7 @@ with tempfile.TemporaryDirectory() as tmp:
 
     # ---- surface normals ----
     if have_surface:
-        v, vn, faces = [], [], []
+        v, vn, faces, corners = [], [], [], []
         with open(os.path.join(out, "surface_0003.obj")) as f:
             for line in f:
                 w = line.split()
@@ -127,14 +127,21 @@ with tempfile.TemporaryDirectory() as tmp:
                     vn.append([float(x) for x in w[1:4]])
                 elif w and w[0] == "f":
                     faces.append([int(x.split("//")[0]) for x in w[1:4]])
-        v, vn = np.array(v), np.array(vn)
+                    corners += [x.split("//") for x in w[1:4]]
+        v, vn, faces = np.array(v), np.array(vn), np.array(faces) - 1
         check("obj: one normal a vertex", len(v) == len(vn) > 0, (len(v), len(vn)))
         check("obj: unit normals", np.allclose(np.linalg.norm(vn, axis=1), 1.0, atol=1e-4))
-        # The main body is a box of water: a surface normal points away from the water's
-        # middle, so along (vertex - centroid) for nearly all vertices (a few on folds may not).
-        out_going = np.einsum("ij,ij->i", vn, v - v.mean(axis=0)) > 0
-        check(f"obj: normals point out ({out_going.mean():.1%})", out_going.mean() > 0.9)
-        check("obj: faces name their normals (f a//a)", all(len(f) == 3 for f in faces))
+        # The faces wind counter-clockwise seen from outside: the signed volume they enclose
+        # (divergence theorem, sum of a . (b x c) / 6) is positive. Each vertex normal then
+        # points out where its faces do: it agrees in sign with the normal of (nearly) every
+        # face that uses it (a few corners on sharp folds of the mesh may not).
+        a, b, c = v[faces[:, 0]], v[faces[:, 1]], v[faces[:, 2]]
+        volume = np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6
+        check(f"obj: faces wind outward (enclosed volume {volume:.3g} m^3 > 0)", volume > 0)
+        face_n = np.cross(b - a, c - a)
+        agree = np.concatenate([np.einsum("ij,ij->i", face_n, vn[faces[:, k]]) > 0 for k in range(3)])
+        check(f"obj: vertex normals agree with their faces ({agree.mean():.1%} of corners)", agree.mean() > 0.97)
+        check("obj: each corner names its vertex's normal (f a//a)", all(len(c) == 2 and c[0] == c[1] for c in corners))
     else:
         skip("obj normals", "this build has no OpenVDB (no surfaces)")
 

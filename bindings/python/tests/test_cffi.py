@@ -36,9 +36,15 @@ def test_every_struct_has_the_compilers_layout(ffi, api):
 
 
 def test_every_function_and_enum_is_declared(ffi, api):
+    import sph
+
+    lib = ffi.dlopen(str(sph.library_path()))
     for e in api["enums"]:
         for m in e["members"]:
-            assert ffi.integer_const(m["name"]) == m["value"], m["name"]
+            assert getattr(lib, m["name"]) == m["value"], m["name"]
+    for d in api["defines"]:
+        if isinstance(d.get("value"), int):
+            assert getattr(lib, d["name"]) == d["value"], d["name"]
     names = {f["name"] for f in api["functions"]}
     with open(CDEF) as fh:
         text = fh.read()
