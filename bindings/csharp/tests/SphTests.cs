@@ -485,7 +485,7 @@ static class Tests
         AssertEqual(ParamZero.Default, speed.Zero, "speed of sound: 0 is the default");
         AssertEqual(ParamBound.Exclusive, speed.LowerBound, "speed of sound > 0");
         PhysicsMethodInfo[] methods = Library.PhysicsMethods();
-        AssertEqual(7, methods.Length, "methods");
+        AssertEqual(8, methods.Length, "methods");  // ... normalized_density, springs, boundary_density
         AssertEqual("clavet", Utf8.FromNative(methods[3].Name), "the fourth method");
         AssertEqual(MethodSwitch.Viscosity, methods[3].SwitchBy, "Clavet is a viscosity method");
         AssertEqual(ParamsKind.ClavetViscosity, methods[3].ParamsKind, "its params");

@@ -18,7 +18,7 @@ CHECKOUT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.pa
 def test_the_package_is_the_installed_one():
     package = os.path.dirname(os.path.abspath(sph.__file__))
     assert package.startswith(os.path.abspath(sys.prefix) + os.sep), (package, sys.prefix)
-    assert not package.startswith(CHECKOUT + os.sep), package
+    assert not package.startswith(os.path.join(CHECKOUT, "bindings", "python") + os.sep), package
     assert sys.prefix != sys.base_prefix, "not in a virtual environment"
 
 
