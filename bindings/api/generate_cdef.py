@@ -45,7 +45,8 @@ def generate(api: dict) -> str:
     out = am.header_banner(api, "generate_cdef.py", "//")
     out += ["// For cffi: ffi.cdef(open(\"sph_cdef.h\").read()); lib = ffi.dlopen(\"libsph.so.0\").",
             "// The static inline *_init() helpers of the header are not here (they are not exported):",
-            "// call *_init_sized(p, ffi.sizeof(p[0])) instead.", ""]
+            "// call *_init_sized(p, ffi.sizeof(p[0])) instead.",
+            "// One declaration a line, as generated: the format check leaves it alone.", "// clang-format off", ""]
     for d in api["defines"]:
         if isinstance(d.get("value"), int):
             out.append(f"#define {d['name']} {d['value']}")

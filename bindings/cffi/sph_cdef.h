@@ -5,6 +5,8 @@
 // For cffi: ffi.cdef(open("sph_cdef.h").read()); lib = ffi.dlopen("libsph.so.0").
 // The static inline *_init() helpers of the header are not here (they are not exported):
 // call *_init_sized(p, ffi.sizeof(p[0])) instead.
+// One declaration a line, as generated: the format check leaves it alone.
+// clang-format off
 
 #define SPH_VERSION_MAJOR 0
 #define SPH_VERSION_MINOR 1
