@@ -799,6 +799,47 @@ static inline sph_result sph_shape_desc_init(sph_shape_desc* desc) {
 SPH_API sph_result SPH_CALL sph_sdf_create_shape(sph_context* context, const sph_shape_desc* desc,
                                                  sph_sdf** out);
 
+/** A triangle mesh to turn into an SDF asset (sph_sdf_create_from_mesh). Triangles are
+ *  counter-clockwise seen from outside (clockwise throughout works too: the inside is where the
+ *  winding number is at least 1/2 in magnitude). The mesh need not be closed or manifold: holes
+ *  narrower than about twice band_width voxels still leave a signed inside. Zero means default,
+ *  except that the arrays and their counts are required (the error names the first missing). */
+typedef struct sph_mesh_desc {
+  uint32_t struct_size;    /* set by sph_mesh_desc_init */
+  uint32_t vertex_count;   /* required, >= 3 */
+  uint32_t vertex_stride;  /* bytes from one vertex to the next; 0 (default) = 12 (packed
+                              x, y, z floats); otherwise >= 12 */
+  uint32_t index_count;    /* three per triangle; required, a multiple of 3 */
+  const float* vertices;   /* x, y, z (m, the asset's local frame) per vertex; finite; copied */
+  const uint32_t* indices; /* vertex indices, each < vertex_count; copied */
+  float voxel_size;        /* m; 0 (default) = 0.01 */
+  float band_width;        /* voxels of exact point-triangle distance on each side of the
+                              surface, in [1, 64]; 0 (default) = 3. Beyond it the closest
+                              triangle is swept outward (distances within a voxel or so) */
+  uint32_t padding_voxels; /* grid margin around the mesh's bounds, <= 1024; 0 (default) = 4 */
+  uint32_t reserved0;      /* must be 0 */
+} sph_mesh_desc;
+SPH_STATIC_ASSERT(sizeof(sph_mesh_desc) == 32 + 2 * sizeof(void*), sph_mesh_desc_size);
+
+SPH_API sph_result SPH_CALL sph_mesh_desc_init_sized(sph_mesh_desc* desc, uint32_t size);
+static inline sph_result sph_mesh_desc_init(sph_mesh_desc* desc) {
+  return sph_mesh_desc_init_sized(desc, (uint32_t)sizeof(*desc));
+}
+/**
+ * Builds an SDF asset from a triangle mesh (the arrays are read during the call, not kept): a
+ * grid of voxel_size over the mesh's bounds plus padding, axis-aligned, voxel (0, 0, 0) centred
+ * at the bounds' minimum corner less padding_voxels voxels (index_to_local is a scale by
+ * voxel_size and that translation); exact distances to the nearest triangle within band_width
+ * voxels of the surface, the nearest triangle swept outward beyond; negative inside by the
+ * generalised winding number. Host memory only; no OpenVDB needed.
+ * Blocking; costs about (triangles * (2 band_width + 1)^3 + voxels) distance evaluations.
+ * Thread-safe with respect to other SDF calls on the context. Errors: INVALID_ARGUMENT (NULL
+ * arrays, counts, an index out of range, a non-finite vertex, a size out of range, reserved0),
+ * CAPACITY (more than 2^31 voxels: a larger voxel_size is needed), OUT_OF_HOST_MEMORY.
+ */
+SPH_API sph_result SPH_CALL sph_sdf_create_from_mesh(sph_context* context, const sph_mesh_desc* desc,
+                                                     sph_sdf** out);
+
 typedef enum sph_sdf_channel {
   SPH_SDF_CHANNEL_DISTANCE = 0,
   SPH_SDF_CHANNEL_VELOCITY = 1, /* 3 floats per voxel */

@@ -351,6 +351,18 @@ typedef struct sph_shape_desc {
   uint32_t flags;
   uint32_t padding_voxels;
 } sph_shape_desc;
+typedef struct sph_mesh_desc {
+  uint32_t struct_size;
+  uint32_t vertex_count;
+  uint32_t vertex_stride;
+  uint32_t index_count;
+  const float* vertices;
+  const uint32_t* indices;
+  float voxel_size;
+  float band_width;
+  uint32_t padding_voxels;
+  uint32_t reserved0;
+} sph_mesh_desc;
 typedef struct sph_quat {
   float x;
   float y;
@@ -496,6 +508,8 @@ sph_result sph_sdf_desc_init_sized(sph_sdf_desc* desc, uint32_t size);
 sph_result sph_sdf_create(sph_context* context, const sph_sdf_desc* desc, sph_sdf** out);
 sph_result sph_shape_desc_init_sized(sph_shape_desc* desc, uint32_t size);
 sph_result sph_sdf_create_shape(sph_context* context, const sph_shape_desc* desc, sph_sdf** out);
+sph_result sph_mesh_desc_init_sized(sph_mesh_desc* desc, uint32_t size);
+sph_result sph_sdf_create_from_mesh(sph_context* context, const sph_mesh_desc* desc, sph_sdf** out);
 sph_result sph_sdf_update(sph_sdf* sdf, sph_sdf_channel channel, const uint32_t origin[3], const uint32_t size[3], const float* data, sph_memory_kind memory);
 sph_result sph_sdf_get_dims(const sph_sdf* sdf, uint32_t out_dims[3]);
 sph_result sph_sdf_sample(const sph_sdf* sdf, sph_vec3 local_point, float* out_distance);

@@ -1218,6 +1218,55 @@ namespace Sph
         }
     }
 
+    /// <summary>
+    /// sph_mesh_desc (48 bytes): A triangle mesh to turn into an SDF asset (sph_sdf_create_from_mesh).
+    /// Triangles are counter-clockwise seen from outside (clockwise throughout works too: the inside is
+    /// where the winding number is at least 1/2 in magnitude). The mesh need not be closed or manifold:
+    /// holes narrower than about twice band_width voxels still leave a signed inside. Zero means
+    /// default, except that the arrays and their counts are required (the error names the first
+    /// missing).
+    /// </summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public partial struct MeshDesc
+    {
+        /// <summary>uint32_t struct_size: set by sph_mesh_desc_init</summary>
+        public uint StructSize;
+        /// <summary>uint32_t vertex_count: required, &gt;= 3</summary>
+        public uint VertexCount;
+        /// <summary>
+        /// uint32_t vertex_stride: bytes from one vertex to the next; 0 (default) = 12 (packed x, y, z
+        /// floats); otherwise &gt;= 12
+        /// </summary>
+        public uint VertexStride;
+        /// <summary>uint32_t index_count: three per triangle; required, a multiple of 3</summary>
+        public uint IndexCount;
+        /// <summary>const float* vertices: x, y, z (m, the asset's local frame) per vertex; finite; copied</summary>
+        public IntPtr Vertices;
+        /// <summary>const uint32_t* indices: vertex indices, each &lt; vertex_count; copied</summary>
+        public IntPtr Indices;
+        /// <summary>float voxel_size: m; 0 (default) = 0.01</summary>
+        public float VoxelSize;
+        /// <summary>
+        /// float band_width: voxels of exact point-triangle distance on each side of the surface, in
+        /// [1, 64]; 0 (default) = 3. Beyond it the closest triangle is swept outward (distances within
+        /// a voxel or so)
+        /// </summary>
+        public float BandWidth;
+        /// <summary>uint32_t padding_voxels: grid margin around the mesh's bounds, &lt;= 1024; 0 (default) = 4</summary>
+        public uint PaddingVoxels;
+        /// <summary>uint32_t reserved0: must be 0</summary>
+        public uint Reserved0;
+
+        /// <summary>A MeshDesc with the library's defaults (sph_mesh_desc_init_sized).</summary>
+        public static MeshDesc Default()
+        {
+            var value = new MeshDesc();
+            uint size = (uint)Marshal.SizeOf(typeof(MeshDesc));
+            SphException.Check(Native.sph_mesh_desc_init_sized(ref value, size), "sph_mesh_desc_init_sized");
+            return value;
+        }
+    }
+
     /// <summary>sph_quat (16 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct Quat
@@ -2067,6 +2116,29 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_sdf_create_shape")]
         public static extern Result sph_sdf_create_shape(IntPtr context, IntPtr desc, IntPtr @out);
 
+        /// <summary>sph_mesh_desc_init_sized</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_mesh_desc_init_sized(ref MeshDesc desc, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_mesh_desc_init_sized")]
+        public static extern Result sph_mesh_desc_init_sized(IntPtr desc, uint size);
+
+        /// <summary>
+        /// Builds an SDF asset from a triangle mesh (the arrays are read during the call, not kept): a
+        /// grid of voxel_size over the mesh's bounds plus padding, axis-aligned, voxel (0, 0, 0)
+        /// centred at the bounds' minimum corner less padding_voxels voxels (index_to_local is a scale
+        /// by voxel_size and that translation); exact distances to the nearest triangle within
+        /// band_width voxels of the surface, the nearest triangle swept outward beyond; negative inside
+        /// by the generalised winding number. Host memory only; no OpenVDB needed. Blocking; costs
+        /// about (triangles * (2 band_width + 1)^3 + voxels) distance evaluations. Thread-safe with
+        /// respect to other SDF calls on the context. Errors: INVALID_ARGUMENT (NULL arrays, counts, an
+        /// index out of range, a non-finite vertex, a size out of range, reserved0), CAPACITY (more
+        /// than 2^31 voxels: a larger voxel_size is needed), OUT_OF_HOST_MEMORY.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_sdf_create_from_mesh(ContextHandle context, ref MeshDesc desc, out SdfHandle @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_sdf_create_from_mesh")]
+        public static extern Result sph_sdf_create_from_mesh(IntPtr context, IntPtr desc, IntPtr @out);
+
         /// <summary>
         /// Overwrites the box [origin, origin + size) of one channel with data (size[0] * size[1] *
         /// size[2] * components floats, i fastest, copied). Updating the velocity or friction channel
@@ -2440,6 +2512,7 @@ namespace Sph
             typeof(GridDesc),
             typeof(SdfDesc),
             typeof(ShapeDesc),
+            typeof(MeshDesc),
             typeof(Quat),
             typeof(Transform),
             typeof(ColliderId),
@@ -2473,6 +2546,7 @@ namespace Sph
             "sph_grid_desc",
             "sph_sdf_desc",
             "sph_shape_desc",
+            "sph_mesh_desc",
             "sph_quat",
             "sph_transform",
             "sph_collider_id",
@@ -2506,6 +2580,7 @@ namespace Sph
             80,
             104,
             44,
+            48,
             16,
             28,
             8,
@@ -2653,6 +2728,16 @@ namespace Sph
             typeof(ShapeDesc),
             typeof(ShapeDesc),
             typeof(ShapeDesc),
+            typeof(MeshDesc),
+            typeof(MeshDesc),
+            typeof(MeshDesc),
+            typeof(MeshDesc),
+            typeof(MeshDesc),
+            typeof(MeshDesc),
+            typeof(MeshDesc),
+            typeof(MeshDesc),
+            typeof(MeshDesc),
+            typeof(MeshDesc),
             typeof(Quat),
             typeof(Quat),
             typeof(Quat),
@@ -2848,6 +2933,16 @@ namespace Sph
             "VoxelSize",
             "Flags",
             "PaddingVoxels",
+            "StructSize",
+            "VertexCount",
+            "VertexStride",
+            "IndexCount",
+            "Vertices",
+            "Indices",
+            "VoxelSize",
+            "BandWidth",
+            "PaddingVoxels",
+            "Reserved0",
             "X",
             "Y",
             "Z",
@@ -3047,6 +3142,16 @@ namespace Sph
             4,
             8,
             12,
+            16,
+            24,
+            32,
+            36,
+            40,
+            44,
+            0,
+            4,
+            8,
+            12,
             0,
             12,
             0,
@@ -3164,6 +3269,8 @@ namespace Sph
             "sph_sdf_create",
             "sph_shape_desc_init_sized",
             "sph_sdf_create_shape",
+            "sph_mesh_desc_init_sized",
+            "sph_sdf_create_from_mesh",
             "sph_sdf_update",
             "sph_sdf_get_dims",
             "sph_sdf_sample",
@@ -3208,6 +3315,8 @@ namespace Sph
         };
         /// <summary>The shared library of each function ("sph", or an optional helper).</summary>
         public static readonly string[] FunctionLibraries = {
+            "sph",
+            "sph",
             "sph",
             "sph",
             "sph",

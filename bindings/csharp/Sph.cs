@@ -1001,6 +1001,34 @@ namespace Sph
             return new Sdf(context, h);
         }
 
+        /// <summary>An asset from a triangle mesh (copied): vertices holds x, y, z per vertex
+        /// (m, the asset's local frame), indices three vertex indices per triangle,
+        /// counter-clockwise seen from outside (clockwise throughout works too; small holes are
+        /// fine). desc (MeshDesc.Default() when null) gives voxel size, band width and padding;
+        /// its array fields are filled here.</summary>
+        public static Sdf CreateFromMesh(Context context, float[] vertices, uint[] indices, MeshDesc? desc = null)
+        {
+            if (vertices == null || vertices.Length % 3 != 0) throw new ArgumentException("vertices: x, y, z per vertex");
+            if (indices == null || indices.Length % 3 != 0) throw new ArgumentException("indices: three per triangle");
+            var d = desc ?? MeshDesc.Default();
+            var pins = new List<GCHandle>();
+            try
+            {
+                d.Vertices = Pin(vertices, pins);
+                d.VertexCount = (uint)(vertices.Length / 3);
+                d.VertexStride = 0;
+                d.Indices = Pin(indices, pins);
+                d.IndexCount = (uint)indices.Length;
+                SdfHandle h;
+                SphException.Check(Native.sph_sdf_create_from_mesh(context.Handle, ref d, out h), "sph_sdf_create_from_mesh");
+                return new Sdf(context, h);
+            }
+            finally
+            {
+                foreach (var p in pins) p.Free();
+            }
+        }
+
         /// <summary>An asset from sampled grids (copied): distance has ni*nj*nk floats, i
         /// fastest; velocity (3 floats per voxel) and friction are optional.</summary>
         public static Sdf Create(Context context, float[] distance, uint ni, uint nj, uint nk, FixedFloat12 indexToLocal,

@@ -75,9 +75,12 @@ def shape_schema():
              **grid}, ["type", "radius", "half_height", "wall_thickness"]),
         obj({"type": const_type("vdb"), "file": {"type": "string", "minLength": 1}, "grid": STRING},
             ["type", "file"]),
+        obj({"type": const_type("mesh"), "file": {"type": "string", "minLength": 1}, "scale": POSITIVE,
+             "voxel_size": POSITIVE, "band_width": POSITIVE,
+             "padding_voxels": {"type": "integer", "minimum": 1, "maximum": 1024}}, ["type", "file"]),
     ]
-    return {"description": "An SDF asset: an analytic shape centred at its local origin (y up) or a level set "
-                           "from a .vdb file (docs/scenes.md, Shapes).",
+    return {"description": "An SDF asset: an analytic shape centred at its local origin (y up), a level set "
+                           "from a .vdb file or a triangle mesh from an .obj or .stl file (docs/scenes.md, Shapes).",
             "type": "object", "required": ["type"],
             "properties": {"type": {"enum": [v["properties"]["type"]["const"] for v in variants]}},
             "oneOf": variants}

@@ -735,6 +735,26 @@ static class Tests
                 Throws(Result.ErrorInvalidArgument, () => Sdf.CreateShape(ctx, bad));
                 Throws(Result.ErrorBusy, () => SphException.Check(Native.sph_context_destroy(ctx.Handle.DangerousGetHandle()), "sph_context_destroy"));
             }
+            // A mesh: a cube of side 0.2 m as 12 triangles; at its centre the distance is -0.1 m
+            // (within half a 2 cm voxel).
+            var corners = new float[24];
+            for (int c = 0; c < 8; ++c)
+            {
+                corners[3 * c] = (c & 1) != 0 ? 0.1f : -0.1f;
+                corners[3 * c + 1] = (c & 2) != 0 ? 0.1f : -0.1f;
+                corners[3 * c + 2] = (c & 4) != 0 ? 0.1f : -0.1f;
+            }
+            var cube = new uint[] { 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4,
+                                    2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5 };
+            var meshDesc = MeshDesc.Default();
+            meshDesc.VoxelSize = 0.02f;
+            using (var mesh = Sdf.CreateFromMesh(ctx, corners, cube, meshDesc))
+            {
+                Assert(Math.Abs(mesh.Sample(new Vec3(0, 0, 0)) + 0.1f) < 0.01f, "mesh inside");
+                Assert(Math.Abs(mesh.Sample(new Vec3(0.2f, 0, 0)) - 0.1f) < 0.01f, "mesh outside");
+            }
+            cube[5] = 8;  // past the last vertex
+            Throws(Result.ErrorInvalidArgument, () => Sdf.CreateFromMesh(ctx, corners, cube));
             // A grid: the distance to a sphere of radius 0.1 on 9^3 samples, centre at a sample.
             const int n = 9;
             float voxel = 0.05f, origin = -(n - 1) / 2f * voxel;

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '7c999059ed0a5a465a9c4b5ce4b5aaf37d51698820bed1197b8185def0f9fbfd', 'include/sph_cuda.h': 'c1e5f4a373709b9455db5a1b4ddf62c758bf7cd4957138c00f657beb8bd5e34c', 'include/sph_vdb.h': '4db54f0da4e9840c311d039ff56bcf1df493198edf3b329576b873c06af4ac48'}
+HEADERS = {'include/sph_c.h': '701b796216da8115fa6bf0521d8f7de6a8e99e3804842e867e6ceb2445f2a083', 'include/sph_cuda.h': 'c1e5f4a373709b9455db5a1b4ddf62c758bf7cd4957138c00f657beb8bd5e34c', 'include/sph_vdb.h': '4db54f0da4e9840c311d039ff56bcf1df493198edf3b329576b873c06af4ac48'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -1197,6 +1197,47 @@ class ShapeDesc(_SphStruct):
 sph_shape_desc = ShapeDesc
 
 
+class MeshDesc(_SphStruct):
+    """
+    A triangle mesh to turn into an SDF asset (sph_sdf_create_from_mesh). Triangles are counter-
+    clockwise seen from outside (clockwise throughout works too: the inside is where the winding
+    number is at least 1/2 in magnitude). The mesh need not be closed or manifold: holes
+    narrower than about twice band_width voxels still leave a signed inside. Zero means default,
+    except that the arrays and their counts are required (the error names the first missing).
+
+    Fields:
+        struct_size (uint32_t): set by sph_mesh_desc_init
+        vertex_count (uint32_t): required, >= 3
+        vertex_stride (uint32_t): bytes from one vertex to the next; 0 (default) = 12 (packed x, y, z floats); otherwise >= 12
+        index_count (uint32_t): three per triangle; required, a multiple of 3
+        vertices (const float*): x, y, z (m, the asset's local frame) per vertex; finite; copied
+        indices (const uint32_t*): vertex indices, each < vertex_count; copied
+        voxel_size (float): m; 0 (default) = 0.01
+        band_width (float): voxels of exact point-triangle distance on each side of the surface, in [1, 64]; 0 (default) = 3. Beyond it the closest triangle is swept outward (distances within a voxel or so)
+        padding_voxels (uint32_t): grid margin around the mesh's bounds, <= 1024; 0 (default) = 4
+        reserved0 (uint32_t): must be 0
+    """
+    _fields_ = [
+        ('struct_size', _c.c_uint32),
+        ('vertex_count', _c.c_uint32),
+        ('vertex_stride', _c.c_uint32),
+        ('index_count', _c.c_uint32),
+        ('vertices', _c.POINTER(_c.c_float)),
+        ('indices', _c.POINTER(_c.c_uint32)),
+        ('voxel_size', _c.c_float),
+        ('band_width', _c.c_float),
+        ('padding_voxels', _c.c_uint32),
+        ('reserved0', _c.c_uint32),
+    ]
+    _sph_c_name_ = 'sph_mesh_desc'
+    _sph_size_ = 48
+    _sph_offsets_ = (('struct_size', 0), ('vertex_count', 4), ('vertex_stride', 8), ('index_count', 12), ('vertices', 16), ('indices', 24), ('voxel_size', 32), ('band_width', 36), ('padding_voxels', 40), ('reserved0', 44))
+    _sph_init_ = 'sph_mesh_desc_init_sized'
+
+
+sph_mesh_desc = MeshDesc
+
+
 class Quat(_SphStruct):
     """
     sph_quat.
@@ -1569,7 +1610,7 @@ class CudaAttributeView(_SphStruct):
 sph_cuda_attribute_view = CudaAttributeView
 
 
-STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpringParams, ParamsInfo, ParamFieldInfo, PhysicsMethodInfo, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, Quat, Transform, ColliderId, ColliderDef, ColliderMaterial, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, Event, CudaAttributeView, )
+STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpringParams, ParamsInfo, ParamFieldInfo, PhysicsMethodInfo, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, MeshDesc, Quat, Transform, ColliderId, ColliderDef, ColliderMaterial, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, Event, CudaAttributeView, )
 
 # ---- functions --------------------------------------------------------------------------------
 
@@ -1683,6 +1724,10 @@ FUNCTIONS = {
         '', 'sph'),
     'sph_sdf_create_shape': (sph_result, (_c.POINTER(sph_context), _c.POINTER(sph_shape_desc), _c.POINTER(_c.POINTER(sph_sdf))), ('context', 'desc', 'out'),
         'Samples an analytic shape (centred at its local origin, y up) into an SDF asset.', 'sph'),
+    'sph_mesh_desc_init_sized': (sph_result, (_c.POINTER(sph_mesh_desc), _c.c_uint32), ('desc', 'size'),
+        '', 'sph'),
+    'sph_sdf_create_from_mesh': (sph_result, (_c.POINTER(sph_context), _c.POINTER(sph_mesh_desc), _c.POINTER(_c.POINTER(sph_sdf))), ('context', 'desc', 'out'),
+        "Builds an SDF asset from a triangle mesh (the arrays are read during the call, not kept): a grid of voxel_size over the mesh's bounds plus padding, axis-aligned, voxel (0, 0, 0) centred at the bounds' minimum corner less padding_voxels voxels (index_to_local is a scale by voxel_size and that translation); exact distances to the nearest triangle within band_width voxels of the surface, the nearest triangle swept outward beyond; negative inside by the generalised winding number. Host memory only; no OpenVDB needed. Blocking; costs about (triangles * (2 band_width + 1)^3 + voxels) distance evaluations. Thread-safe with respect to other SDF calls on the context. Errors: INVALID_ARGUMENT (NULL arrays, counts, an index out of range, a non-finite vertex, a size out of range, reserved0), CAPACITY (more than 2^31 voxels: a larger voxel_size is needed), OUT_OF_HOST_MEMORY.", 'sph'),
     'sph_sdf_update': (sph_result, (_c.POINTER(sph_sdf), sph_sdf_channel, _c.POINTER(_c.c_uint32), _c.POINTER(_c.c_uint32), _c.POINTER(_c.c_float), sph_memory_kind), ('sdf', 'channel', 'origin', 'size', 'data', 'memory'),
         'Overwrites the box [origin, origin + size) of one channel with data (size[0] * size[1] * size[2] * components floats, i fastest, copied). Updating the velocity or friction channel of an asset created without it creates it (zero elsewhere). Do not update an asset while a world that uses it is inside sph_world_step on another thread. Errors: INVALID_ARGUMENT (box outside the grid, NULL or non-finite data), UNSUPPORTED (unknown channel or memory).', 'sph'),
     'sph_sdf_get_dims': (sph_result, (_c.POINTER(sph_sdf), _c.POINTER(_c.c_uint32)), ('sdf', 'out_dims'),

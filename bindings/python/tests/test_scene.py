@@ -43,6 +43,28 @@ def test_shape_assets(ctx):
         ctx.shape(42)  # not a Shape member
 
 
+def test_mesh_assets(ctx):
+    """A cube of side 0.2 m as 12 triangles: its asset is the box's distance (here at the
+    centre, -0.1 m, and 0.1 m outside a face), within half a voxel."""
+    corners = np.array([[x, y, z] for z in (-0.1, 0.1) for y in (-0.1, 0.1) for x in (-0.1, 0.1)])
+    quads = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
+    triangles = [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))]
+    with sph.Sdf.from_mesh(ctx, corners, triangles, voxel_size=0.02) as cube:
+        assert cube.sample((0, 0, 0)) == pytest.approx(-0.1, abs=0.01)
+        assert cube.sample((0.2, 0, 0)) == pytest.approx(0.1, abs=0.01)
+        assert cube.dims == (19, 19, 19)  # 0.2 m is 10 voxels of 2 cm: 11 centres, and 4 each side
+    flipped = [(a, c, b) for a, b, c in triangles]  # either orientation has the same inside
+    with sph.Sdf.from_mesh(ctx, corners, np.array(flipped), voxel_size=0.02, band_width=2,
+                           padding_voxels=2) as cube:
+        assert cube.sample((0, 0, 0)) == pytest.approx(-0.1, abs=0.01)
+    assert error(sph.Sdf.from_mesh, ctx, corners, [(0, 1, 8)]) == sph.Result.ERROR_INVALID_ARGUMENT
+    assert error(sph.Sdf.from_mesh, ctx, corners, triangles, band_width=0.5) == sph.Result.ERROR_INVALID_ARGUMENT
+    with pytest.raises(ValueError):
+        sph.Sdf.from_mesh(ctx, np.zeros((4, 2)), triangles)
+    with pytest.raises(ValueError):
+        sph.Sdf.from_mesh(ctx, corners, [(0, -1, 2)])
+
+
 def test_unknown_shape_value_is_unsupported(ctx):
     d = sph.ShapeDesc()
     d.shape = 42
