@@ -18,6 +18,7 @@
 #define SPH_FEATURE_NORMALIZED_DENSITY 2
 #define SPH_FEATURE_SPRINGS 4
 #define SPH_FEATURE_BOUNDARY_DENSITY 8
+#define SPH_FEATURE_COLLIDER_LOADS 16
 #define SPH_STEP_LIMIT_ACOUSTIC 1
 #define SPH_STEP_LIMIT_FORCE 2
 #define SPH_SHAPE_FLAG_OPEN_TOP 1
@@ -393,6 +394,14 @@ typedef struct sph_collider_material {
   float friction;
   float stickiness;
 } sph_collider_material;
+typedef struct sph_collider_loads {
+  uint32_t struct_size;
+  uint32_t reserved0;
+  sph_vec3 force;
+  sph_vec3 torque;
+  sph_vec3 point;
+  double frame_time;
+} sph_collider_loads;
 typedef struct sph_source_id {
   uint64_t bits;
 } sph_source_id;
@@ -524,6 +533,9 @@ sph_result sph_collider_get_transform(const sph_world* world, sph_collider_id id
 sph_result sph_collider_material_init_sized(sph_collider_material* material, uint32_t size);
 sph_result sph_collider_set_material(sph_world* world, sph_collider_id id, const sph_collider_material* material);
 sph_result sph_collider_get_material(const sph_world* world, sph_collider_id id, sph_collider_material* out);
+sph_result sph_collider_loads_init_sized(sph_collider_loads* loads, uint32_t size);
+sph_result sph_collider_get_loads(const sph_world* world, sph_collider_id id, sph_collider_loads* out);
+sph_result sph_collider_set_load_point(sph_world* world, sph_collider_id id, const sph_vec3* point);
 sph_result sph_source_def_init_sized(sph_source_def* def, uint32_t size);
 sph_result sph_source_create(sph_world* world, const sph_source_def* def, sph_source_id* out_id);
 sph_result sph_source_destroy(sph_world* world, sph_source_id id);

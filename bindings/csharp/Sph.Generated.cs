@@ -59,6 +59,16 @@ namespace Sph
         /// </summary>
         public const uint SPH_FEATURE_BOUNDARY_DENSITY = 8u;
         /// <summary>
+        /// Loads on colliders: the force and torque of the fluid on each collider over every step
+        /// (sph_collider_get_loads): the collision response's contact impulses and, with
+        /// SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions, summed on the device per
+        /// substep in a fixed order (bitwise deterministic) and averaged over the step's time. Costs,
+        /// per substep, a reduction over the particles per collider (and with the boundary density one
+        /// SDF sample per particle and collider per force evaluation); no host round trip inside a
+        /// step.
+        /// </summary>
+        public const uint SPH_FEATURE_COLLIDER_LOADS = 16u;
+        /// <summary>
         /// Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt &lt;= step_factor h /
         /// c, c the EOS's speed of sound
         /// </summary>
@@ -1406,6 +1416,42 @@ namespace Sph
         }
     }
 
+    /// <summary>
+    /// sph_collider_loads (56 bytes): The fluid's loads on a collider over the last sph_world_step
+    /// (SPH_FEATURE_COLLIDER_LOADS): the time averages over the step's substeps of the force and of the
+    /// torque about the collider's load point, in world coordinates. What counts: the momentum the
+    /// collision response took from particles (contacts, friction, stickiness) and, with
+    /// SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions; force times frame_time is the
+    /// impulse the fluid gave the collider. The torque of each impulse is taken about the load point
+    /// posed at the impulse's time (it moves with the collider). Zero before the first step (frame_time
+    /// 0). docs/physics.md "Loads".
+    /// </summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public partial struct ColliderLoads
+    {
+        /// <summary>uint32_t struct_size: set by sph_collider_loads_init</summary>
+        public uint StructSize;
+        /// <summary>uint32_t reserved0: written as 0</summary>
+        public uint Reserved0;
+        /// <summary>sph_vec3 force: N, world frame</summary>
+        public Vec3 Force;
+        /// <summary>sph_vec3 torque: N m, world frame, about point</summary>
+        public Vec3 Torque;
+        /// <summary>sph_vec3 point: the load point in the world at the end of the step, m</summary>
+        public Vec3 Point;
+        /// <summary>double frame_time: s: the time the step advanced, over which force and torque are averaged</summary>
+        public double FrameTime;
+
+        /// <summary>A ColliderLoads with the library's defaults (sph_collider_loads_init_sized).</summary>
+        public static ColliderLoads Default()
+        {
+            var value = new ColliderLoads();
+            uint size = (uint)Marshal.SizeOf(typeof(ColliderLoads));
+            SphException.Check(Native.sph_collider_loads_init_sized(ref value, size), "sph_collider_loads_init_sized");
+            return value;
+        }
+    }
+
     /// <summary>sph_source_id (8 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct SourceId
@@ -2245,6 +2291,35 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_get_material")]
         public static extern Result sph_collider_get_material(IntPtr world, ColliderId id, IntPtr @out);
 
+        /// <summary>sph_collider_loads_init_sized</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_collider_loads_init_sized(ref ColliderLoads loads, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_loads_init_sized")]
+        public static extern Result sph_collider_loads_init_sized(IntPtr loads, uint size);
+
+        /// <summary>
+        /// Reads a collider's loads of the last step. Non-blocking (the step brought them to the host).
+        /// out-&gt;struct_size must be set (sph_collider_loads_init); only that many bytes are written.
+        /// Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (NULL out),
+        /// VERSION_MISMATCH, FEATURE_DISABLED (the world lacks SPH_FEATURE_COLLIDER_LOADS),
+        /// WORLD_LOCKED.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_collider_get_loads(WorldHandle world, ColliderId id, ref ColliderLoads @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_get_loads")]
+        public static extern Result sph_collider_get_loads(IntPtr world, ColliderId id, IntPtr @out);
+
+        /// <summary>
+        /// Sets the point, in the collider's own frame, that its loads' torque is taken about (default
+        /// its origin; an engine passes the body's centre of mass). Acts from the next step. Errors:
+        /// INVALID_HANDLE, INVALID_ARGUMENT (NULL point; a non-finite component, named),
+        /// FEATURE_DISABLED, WORLD_LOCKED. Nothing changes on error.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_collider_set_load_point(WorldHandle world, ColliderId id, ref Vec3 point);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_set_load_point")]
+        public static extern Result sph_collider_set_load_point(IntPtr world, ColliderId id, IntPtr point);
+
         /// <summary>sph_source_def_init_sized</summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_source_def_init_sized(ref SourceDef def, uint size);
@@ -2518,6 +2593,7 @@ namespace Sph
             typeof(ColliderId),
             typeof(ColliderDef),
             typeof(ColliderMaterial),
+            typeof(ColliderLoads),
             typeof(SourceId),
             typeof(SourceDef),
             typeof(SinkId),
@@ -2552,6 +2628,7 @@ namespace Sph
             "sph_collider_id",
             "sph_collider_def",
             "sph_collider_material",
+            "sph_collider_loads",
             "sph_source_id",
             "sph_source_def",
             "sph_sink_id",
@@ -2586,6 +2663,7 @@ namespace Sph
             8,
             64,
             16,
+            56,
             8,
             80,
             8,
@@ -2758,6 +2836,12 @@ namespace Sph
             typeof(ColliderMaterial),
             typeof(ColliderMaterial),
             typeof(ColliderMaterial),
+            typeof(ColliderLoads),
+            typeof(ColliderLoads),
+            typeof(ColliderLoads),
+            typeof(ColliderLoads),
+            typeof(ColliderLoads),
+            typeof(ColliderLoads),
             typeof(SourceId),
             typeof(SourceDef),
             typeof(SourceDef),
@@ -2963,6 +3047,12 @@ namespace Sph
             "Restitution",
             "Friction",
             "Stickiness",
+            "StructSize",
+            "Reserved0",
+            "Force",
+            "Torque",
+            "Point",
+            "FrameTime",
             "Bits",
             "StructSize",
             "Mode",
@@ -3169,6 +3259,12 @@ namespace Sph
             8,
             12,
             0,
+            4,
+            8,
+            20,
+            32,
+            48,
+            0,
             0,
             4,
             8,
@@ -3285,6 +3381,9 @@ namespace Sph
             "sph_collider_material_init_sized",
             "sph_collider_set_material",
             "sph_collider_get_material",
+            "sph_collider_loads_init_sized",
+            "sph_collider_get_loads",
+            "sph_collider_set_load_point",
             "sph_source_def_init_sized",
             "sph_source_create",
             "sph_source_destroy",
@@ -3315,6 +3414,9 @@ namespace Sph
         };
         /// <summary>The shared library of each function ("sph", or an optional helper).</summary>
         public static readonly string[] FunctionLibraries = {
+            "sph",
+            "sph",
+            "sph",
             "sph",
             "sph",
             "sph",

@@ -231,6 +231,9 @@ namespace Sph
         /// <summary>Walls in the density: colliders count in the density sums and push back through
         /// the pressure force (a density map per SDF asset; docs/physics.md).</summary>
         BoundaryDensity = Constants.SPH_FEATURE_BOUNDARY_DENSITY,
+        /// <summary>Loads on colliders: the fluid's force and torque on each collider over every
+        /// step (<see cref="Collider.Loads"/>; docs/physics.md).</summary>
+        ColliderLoads = Constants.SPH_FEATURE_COLLIDER_LOADS,
     }
 
     /// <summary>Step-size limits beyond eq. 32 (SPH_STEP_LIMIT_*): set them with
@@ -1199,6 +1202,26 @@ namespace Sph
             m.Friction = friction;
             m.Stickiness = stickiness;
             Material = m;
+        }
+
+        /// <summary>The fluid's loads on the collider over the last Step (time averages of the force
+        /// and of the torque about the load point, world frame); needs
+        /// <see cref="FeatureFlags.ColliderLoads"/>.</summary>
+        public ColliderLoads Loads
+        {
+            get
+            {
+                var l = ColliderLoads.Default();
+                SphException.Check(Native.sph_collider_get_loads(World.Handle, Id, ref l), "sph_collider_get_loads");
+                return l;
+            }
+        }
+
+        /// <summary>The point, in the collider's own frame, that the loads' torque is taken about
+        /// (default its origin; pass the body's centre of mass).</summary>
+        public void SetLoadPoint(Vec3 point)
+        {
+            SphException.Check(Native.sph_collider_set_load_point(World.Handle, Id, ref point), "sph_collider_set_load_point");
         }
 
         /// <summary>Removes the collider (idempotent).</summary>

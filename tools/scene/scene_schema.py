@@ -38,7 +38,7 @@ PHYSICS_PARAMS = {
     "springs": {"stiffness": "float", "link_radius": "float", "yield_ratio": "float", "plasticity": "float",
                 "damping": "float"},
 }
-FEATURES = ["surface_tension", "normalized_density", "springs", "boundary_density"]
+FEATURES = ["surface_tension", "normalized_density", "springs", "boundary_density", "collider_loads"]
 VISCOSITY_METHODS = ["mueller", "clavet"]
 EQUATIONS_OF_STATE = ["ideal_gas", "tait"]
 FORMATS = ["vdb", "ply", "csv", "vtp"]
@@ -170,7 +170,7 @@ def build():
             "colliders": {"type": "array", "items": obj({
                 "name": STRING, "shape": {"$ref": "#/definitions/shape"}, **placed, "inverted": BOOLEAN,
                 "restitution": {"type": "number", "minimum": 0, "maximum": 1}, "friction": NON_NEGATIVE,
-                "stickiness": NON_NEGATIVE}, ["shape"])},
+                "stickiness": NON_NEGATIVE, "loads": obj({"point": VEC3})}, ["shape"])},
             "sources": {"type": "array", "items": obj({
                 "name": STRING, "shape": {"$ref": "#/definitions/shape"}, **placed,
                 "mode": {"enum": ["once", "continuous"]}, "velocity": VEC3, "spacing": POSITIVE,

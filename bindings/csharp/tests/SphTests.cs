@@ -485,7 +485,7 @@ static class Tests
         AssertEqual(ParamZero.Default, speed.Zero, "speed of sound: 0 is the default");
         AssertEqual(ParamBound.Exclusive, speed.LowerBound, "speed of sound > 0");
         PhysicsMethodInfo[] methods = Library.PhysicsMethods();
-        AssertEqual(8, methods.Length, "methods");  // ... normalized_density, springs, boundary_density
+        AssertEqual(9, methods.Length, "methods");  // through boundary_density and collider_loads
         AssertEqual("clavet", Utf8.FromNative(methods[3].Name), "the fourth method");
         AssertEqual(MethodSwitch.Viscosity, methods[3].SwitchBy, "Clavet is a viscosity method");
         AssertEqual(ParamsKind.ClavetViscosity, methods[3].ParamsKind, "its params");
@@ -781,6 +781,41 @@ static class Tests
             }
             dist[0] = float.NaN;
             Throws(Result.ErrorInvalidArgument, () => Sdf.Create(ctx, dist, n, n, n, map));
+        }
+    }
+
+    // Loads on colliders (issue 17): refused without the feature; with it, water resting on a
+    // floor presses it with about its weight, the torque about the load point.
+    public static void TestColliderLoads()
+    {
+        var plane = ShapeDesc.Default();
+        plane.Shape = Shape.Plane;
+        plane.HalfExtents = new Vec3(1, 0.1f, 1);
+        plane.VoxelSize = 0.03f;
+        using (var ctx = Cpu())
+        using (var floor = Sdf.CreateShape(ctx, plane))
+        {
+            using (var world = ctx.CreateWorld(SmallWorld()))
+            {
+                var c = world.CreateCollider(floor, Transform.Default());
+                Throws(Result.ErrorFeatureDisabled, () => { var l = c.Loads; });
+                Throws(Result.ErrorFeatureDisabled, () => c.SetLoadPoint(new Vec3(0, 0, 0)));
+            }
+            var d = SmallWorld();
+            d.FeatureFlags = FeatureFlags.ColliderLoads;
+            using (var world = ctx.CreateWorld(d))
+            {
+                var c = world.CreateCollider(floor, Transform.Default());
+                AssertEqual(0.0, c.Loads.FrameTime, "no loads before a step");
+                c.SetLoadPoint(new Vec3(0.1f, 0, 0));
+                uint n = world.FillBox(new Vec3(-0.08f, 0.0f, -0.08f), new Vec3(0.08f, 0.06f, 0.08f));
+                for (int i = 0; i < 10; ++i) world.Step(1f / 60f);
+                var loads = c.Loads;
+                float weight = n * world.ParticleMass * 9.81f;
+                Assert(Math.Abs(loads.Force.Y + weight) < 0.3f * weight, "the floor carries the weight: " + loads.Force.Y);
+                Assert(Math.Abs(loads.Torque.Z + 0.1f * loads.Force.Y) < 0.2f * Math.Abs(0.1f * loads.Force.Y),
+                       "torque about the load point: " + loads.Torque.Z);
+            }
         }
     }
 

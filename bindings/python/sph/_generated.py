@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '701b796216da8115fa6bf0521d8f7de6a8e99e3804842e867e6ceb2445f2a083', 'include/sph_cuda.h': 'c1e5f4a373709b9455db5a1b4ddf62c758bf7cd4957138c00f657beb8bd5e34c', 'include/sph_vdb.h': '4db54f0da4e9840c311d039ff56bcf1df493198edf3b329576b873c06af4ac48'}
+HEADERS = {'include/sph_c.h': '4de04e2576d44c6f6a0ea258c7cb2b20882a5477ef48b02d59f7d891cc9874cc', 'include/sph_cuda.h': 'c1e5f4a373709b9455db5a1b4ddf62c758bf7cd4957138c00f657beb8bd5e34c', 'include/sph_vdb.h': '4db54f0da4e9840c311d039ff56bcf1df493198edf3b329576b873c06af4ac48'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -56,6 +56,13 @@ SPH_FEATURE_SPRINGS = 4
 #: collision response stays the no-penetration safeguard. Costs one SDF sample per particle and
 #: collider in each density pass.
 SPH_FEATURE_BOUNDARY_DENSITY = 8
+#: Loads on colliders: the force and torque of the fluid on each collider over every step
+#: (sph_collider_get_loads): the collision response's contact impulses and, with
+#: SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions, summed on the device per substep in
+#: a fixed order (bitwise deterministic) and averaged over the step's time. Costs, per substep, a
+#: reduction over the particles per collider (and with the boundary density one SDF sample per
+#: particle and collider per force evaluation); no host round trip inside a step.
+SPH_FEATURE_COLLIDER_LOADS = 16
 #: Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt <= step_factor h / c, c the
 #: EOS's speed of sound
 SPH_STEP_LIMIT_ACOUSTIC = 1
@@ -1368,6 +1375,42 @@ class ColliderMaterial(_SphStruct):
 sph_collider_material = ColliderMaterial
 
 
+class ColliderLoads(_SphStruct):
+    """
+    The fluid's loads on a collider over the last sph_world_step (SPH_FEATURE_COLLIDER_LOADS):
+    the time averages over the step's substeps of the force and of the torque about the
+    collider's load point, in world coordinates. What counts: the momentum the collision
+    response took from particles (contacts, friction, stickiness) and, with
+    SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions; force times frame_time is the
+    impulse the fluid gave the collider. The torque of each impulse is taken about the load
+    point posed at the impulse's time (it moves with the collider). Zero before the first step
+    (frame_time 0). docs/physics.md "Loads".
+
+    Fields:
+        struct_size (uint32_t): set by sph_collider_loads_init
+        reserved0 (uint32_t): written as 0
+        force (sph_vec3): N, world frame
+        torque (sph_vec3): N m, world frame, about point
+        point (sph_vec3): the load point in the world at the end of the step, m
+        frame_time (double): s: the time the step advanced, over which force and torque are averaged
+    """
+    _fields_ = [
+        ('struct_size', _c.c_uint32),
+        ('reserved0', _c.c_uint32),
+        ('force', sph_vec3),
+        ('torque', sph_vec3),
+        ('point', sph_vec3),
+        ('frame_time', _c.c_double),
+    ]
+    _sph_c_name_ = 'sph_collider_loads'
+    _sph_size_ = 56
+    _sph_offsets_ = (('struct_size', 0), ('reserved0', 4), ('force', 8), ('torque', 20), ('point', 32), ('frame_time', 48))
+    _sph_init_ = 'sph_collider_loads_init_sized'
+
+
+sph_collider_loads = ColliderLoads
+
+
 class SourceId(_SphStruct):
     """
     sph_source_id.
@@ -1610,7 +1653,7 @@ class CudaAttributeView(_SphStruct):
 sph_cuda_attribute_view = CudaAttributeView
 
 
-STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpringParams, ParamsInfo, ParamFieldInfo, PhysicsMethodInfo, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, MeshDesc, Quat, Transform, ColliderId, ColliderDef, ColliderMaterial, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, Event, CudaAttributeView, )
+STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpringParams, ParamsInfo, ParamFieldInfo, PhysicsMethodInfo, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, MeshDesc, Quat, Transform, ColliderId, ColliderDef, ColliderMaterial, ColliderLoads, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, Event, CudaAttributeView, )
 
 # ---- functions --------------------------------------------------------------------------------
 
@@ -1756,6 +1799,12 @@ FUNCTIONS = {
         "Replaces a collider's material; acts from the next substep. Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (NULL material; a coefficient out of range or not finite, named), VERSION_MISMATCH (struct_size), WORLD_LOCKED. Nothing changes on error.", 'sph'),
     'sph_collider_get_material': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_collider_material)), ('world', 'id', 'out'),
         "Reads a collider's material (as the def or the last set call gave it). out->struct_size must be set (sph_collider_material_init); only that many bytes are written. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL out), VERSION_MISMATCH, WORLD_LOCKED.", 'sph'),
+    'sph_collider_loads_init_sized': (sph_result, (_c.POINTER(sph_collider_loads), _c.c_uint32), ('loads', 'size'),
+        '', 'sph'),
+    'sph_collider_get_loads': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_collider_loads)), ('world', 'id', 'out'),
+        "Reads a collider's loads of the last step. Non-blocking (the step brought them to the host). out->struct_size must be set (sph_collider_loads_init); only that many bytes are written. Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (NULL out), VERSION_MISMATCH, FEATURE_DISABLED (the world lacks SPH_FEATURE_COLLIDER_LOADS), WORLD_LOCKED.", 'sph'),
+    'sph_collider_set_load_point': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_vec3)), ('world', 'id', 'point'),
+        "Sets the point, in the collider's own frame, that its loads' torque is taken about (default its origin; an engine passes the body's centre of mass). Acts from the next step. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL point; a non-finite component, named), FEATURE_DISABLED, WORLD_LOCKED. Nothing changes on error.", 'sph'),
     'sph_source_def_init_sized': (sph_result, (_c.POINTER(sph_source_def), _c.c_uint32), ('def', 'size'),
         '', 'sph'),
     'sph_source_create': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_source_def), _c.POINTER(sph_source_id)), ('world', 'def', 'out_id'),
