@@ -1,4 +1,4 @@
-// SPDX-License-Identifier: MIT
+/* SPDX-License-Identifier: MIT */
 /*
  * sph_c.h - the C ABI of the sph fluid-simulation library.
  *

@@ -1,4 +1,4 @@
-// SPDX-License-Identifier: MIT
+/* SPDX-License-Identifier: MIT */
 /*
  * sph_cuda.h - the zero-copy tier of the sph library for worlds on the CUDA backend.
  *

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '4de04e2576d44c6f6a0ea258c7cb2b20882a5477ef48b02d59f7d891cc9874cc', 'include/sph_cuda.h': 'c1e5f4a373709b9455db5a1b4ddf62c758bf7cd4957138c00f657beb8bd5e34c', 'include/sph_vdb.h': '4db54f0da4e9840c311d039ff56bcf1df493198edf3b329576b873c06af4ac48'}
+HEADERS = {'include/sph_c.h': 'f990c82460878629a079a19b9a46b1292d3043d1577387db8b5aca031eb85d56', 'include/sph_cuda.h': '8fe2c1988d9c8456a91fb26b7863765759ab8ad17bd1ff44b457c77af0bc7985', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
