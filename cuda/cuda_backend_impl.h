@@ -35,6 +35,7 @@ struct DeviceResources {
   std::unique_ptr<DeviceNeighborGrid> grid;
   std::unique_ptr<FrameStatistics> statistics;
   DeviceArray<FrameState> state;
+  DeviceArray<double> solve_partials;  // DFSPH only: the block sums of a solve's error
   PinnedArray<FrameInput> input;
   PinnedArray<FrameState> state_output;
   PinnedArray<uint32_t> sink_kept;
@@ -56,8 +57,8 @@ struct DeviceResources {
   }
 
   PipelineBuffers buffers() {
-    return PipelineBuffers{store.get(), grid.get(),  statistics.get(),
-                           state.get(), input.get(), state_output.get()};
+    return PipelineBuffers{store.get(), grid.get(),         statistics.get(),    state.get(),
+                           input.get(), state_output.get(), solve_partials.get()};
   }
 };
 
@@ -154,7 +155,8 @@ class CudaBackend final : public Backend {
 
   // The stream driver (frame_loop.cu): frames with sinks, and every frame without graphs.
   uint32_t run_frame_on_stream(PipelineSetup setup, uint32_t sink_count, std::vector<uint32_t>& removed_ids,
-                               std::vector<uint32_t>& removed_by_sink);
+                               std::vector<uint32_t>& removed_by_sink, const StepInterrupt& interrupt,
+                               bool& interrupted);
 
   WorldConfig config_;
   int device_;

@@ -19,7 +19,7 @@ bool same_setup(const PipelineSetup& a, const PipelineSetup& b) {
          a.options.surface_tension == b.options.surface_tension &&
          a.options.normalized_density == b.options.normalized_density &&
          a.options.viscosity == b.options.viscosity && a.options.springs == b.options.springs &&
-         a.options.boundary_density == b.options.boundary_density &&
+         a.options.dfsph == b.options.dfsph && a.options.boundary_density == b.options.boundary_density &&
          std::memcmp(&a.options.methods, &b.options.methods, sizeof a.options.methods) == 0 &&
          std::memcmp(&a.springs, &b.springs, sizeof a.springs) == 0 &&
          a.scene.colliders == b.scene.colliders && a.scene.fields == b.scene.fields &&
@@ -53,6 +53,7 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
   uint32_t count_after = count_;
   std::vector<uint32_t> removed_ids, removed_by_sink(scene_in.sinks.size(), 0u);
   bool frame_enqueued = false;  // the frame's first work (the rollback snapshot) is on the stream
+  bool interrupted = false;     // the stream driver stopped at a substep boundary (StepInterrupt)
   try {
     guarded([&] {
       if (!scene_in.empty()) {
@@ -78,14 +79,17 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
       input->frame_dt = frame_dt;
       input->max_collider_speed = scene_in.max_collider_speed;
       input->pad = 0;
-      const bool on_graph = use_graphs_ && !with_sinks && prepare_graph(setup);
+      // A step budget needs the stream driver, which checks it between substeps (the graph
+      // runs the whole frame on the device).
+      const bool on_graph =
+          use_graphs_ && !with_sinks && !scene_in.interrupt.has_deadline() && prepare_graph(setup);
       cuda_check(cudaEventRecord(r_->frame_start, r_->stream), "cudaEventRecord");
       frame_enqueued = true;
       if (on_graph)
         r_->graph.launch(r_->stream);
       else
         count_after = run_frame_on_stream(setup, static_cast<uint32_t>(scene_in.sinks.size()), removed_ids,
-                                          removed_by_sink);
+                                          removed_by_sink, scene_in.interrupt, interrupted);
       cuda_check(cudaEventRecord(r_->frame_stop, r_->stream), "cudaEventRecord");
       cuda_check(cudaStreamSynchronize(r_->stream), "frame");
       cuda_check(cudaEventElapsedTime(&frame_ms, r_->frame_start, r_->frame_stop), "cudaEventElapsedTime");
@@ -123,8 +127,11 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
       for (uint32_t c = 0; c < setup.loads.colliders; ++c) report.collider_loads[c] = setup.loads.output[c];
   }
   report_clock(s.clock, report);
+  report.interrupted = interrupted;
   report.max_speed = s.max_speed;
   report_density(s.density, report);
+  report.pressure_solve = finish_solve(s.pressure_tally);
+  report.divergence_solve = finish_solve(s.divergence_tally);
   double staged_ms = 0.0;
   for (int k = 0; k < kStageCount; ++k) {
     report.stage_ms[k] = static_cast<float>(static_cast<double>(s.stage_ns[k]) * 1e-6);
@@ -170,9 +177,12 @@ bool CudaBackend::prepare_graph(const PipelineSetup& setup) {
 // them. With sinks, the survivor count comes back with the loop condition (one synchronisation
 // per substep, a second one only when particles were removed). Returns the particle count after
 // the frame; the removed ids, in the CPU backend's order, and the per-sink counts are appended.
+// `interrupt` is checked after every substep that removed no particle (so the statistics read
+// what a frame's natural end leaves); when it stops the frame, `interrupted` is set.
 uint32_t CudaBackend::run_frame_on_stream(PipelineSetup setup, uint32_t sink_count,
                                           std::vector<uint32_t>& removed_ids,
-                                          std::vector<uint32_t>& removed_by_sink) {
+                                          std::vector<uint32_t>& removed_by_sink,
+                                          const StepInterrupt& interrupt, bool& interrupted) {
   const PipelineBuffers b = r_->buffers();
   const ParticleArrays& a = b.store->arrays();
   cudaStream_t s = r_->stream;
@@ -201,11 +211,18 @@ uint32_t CudaBackend::run_frame_on_stream(PipelineSetup setup, uint32_t sink_cou
           "copy of the sink survivor count");
     }
     cuda_check(cudaStreamSynchronize(s), "substep");
-    if (sink_count == 0) continue;
+    const auto stop_here = [&] { return out->run && (interrupted = interrupt.requested()); };
+    if (sink_count == 0) {
+      if (stop_here()) break;
+      continue;
+    }
     counts_after_sinks = nullptr;
     if (out->non_finite) break;  // as on the CPU: no sinks after a failed substep
     const uint32_t kept = *kept_out;
-    if (kept == n) continue;
+    if (kept == n) {
+      if (stop_here()) break;
+      continue;
+    }
     // After the last substep the statistics need the neighbour counts of its density pass,
     // which the compaction carries along (the sorted copy it reads becomes scratch).
     uint32_t* counts = nullptr;

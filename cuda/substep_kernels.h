@@ -51,7 +51,8 @@ struct SubstepOptions {
   bool surface_tension = false;
   bool normalized_density = false;
   ViscosityMethod viscosity = ViscosityMethod::Mueller;
-  bool springs = false;           // a.spring_acceleration adds to the force pass
+  bool springs = false;  // a.spring_acceleration adds to the force pass
+  bool dfsph = false;    // the DFSPH solver (dfsph_solver.h) instead of the weakly compressible passes
   bool boundary_density = false;  // the colliders' share joins the density; the walls' pressure the forces
 };
 
@@ -63,6 +64,10 @@ struct SubstepOptions {
 void enqueue_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a, uint32_t n,
                      const SubstepOptions& options, const KernelTuning& tuning, const DeviceScene& scene,
                      float stage_fraction, FrameState* state, cudaStream_t stream);
+
+// colour_normal[i] for surface tension, after the density pass (enqueue_density calls it).
+void enqueue_colour_normals(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                            uint32_t n, const KernelTuning& tuning, cudaStream_t stream);
 
 // Symplectic Euler from the sorted copy into the state, with the max-speed and
 // max-acceleration reductions and the non-finite check.

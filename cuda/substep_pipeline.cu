@@ -18,6 +18,21 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
   const uint32_t n = setup.count;
   const bool rk4 = setup.integrator == Integrator::Rk4;
   const int stages = rk4 ? kRk4Stages : 1;
+  if (setup.options.dfsph) {
+    b.grid->enqueue_sort(a.position, n, b.state, stream);
+    b.grid->enqueue_cell_starts(n, b.state, stream);
+    enqueue_reorder(a, b.grid->order(), n, Rk4Carry::None, 0, b.state, stream);
+    if (setup.options.springs) enqueue_spring_reorder(a, b.grid->order(), n, stream);
+    enqueue_dfsph_density(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene,
+                          b.state, stream);
+    if (setup.options.springs)
+      enqueue_spring_pass(setup.springs, b.grid->view(), a, n, true, b.state, stream);
+    const DfsphLoops loops{cond.in_graph, b.solve_partials, b.state_output};
+    enqueue_dfsph_step(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene, loops,
+                       b.state, stream);
+    enqueue_end_substep(b.state, setup.limits, setup.max_substeps, 1, cond, stream);
+    return;
+  }
   for (int stage = 0; stage < stages; ++stage) {
     b.grid->enqueue_sort(a.position, n, b.state, stream);
     b.grid->enqueue_cell_starts(n, b.state, stream);

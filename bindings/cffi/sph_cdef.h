@@ -21,6 +21,7 @@
 #define SPH_FEATURE_COLLIDER_LOADS 16
 #define SPH_STEP_LIMIT_ACOUSTIC 1
 #define SPH_STEP_LIMIT_FORCE 2
+#define SPH_DFSPH_SKIP_DIVERGENCE_SOLVE 1
 #define SPH_SHAPE_FLAG_OPEN_TOP 1
 #define SPH_COLLIDER_FLAG_INVERTED 1
 #define SPH_SOURCE_FLAG_VELOCITY_FROM_FIELD 1
@@ -108,12 +109,18 @@ typedef enum {
   SPH_EOS_FORCE32 = 2147483647,
 } sph_equation_of_state;
 typedef enum {
+  SPH_SOLVER_WCSPH = 0,
+  SPH_SOLVER_DFSPH = 1,
+  SPH_SOLVER_FORCE32 = 2147483647,
+} sph_solver;
+typedef enum {
   SPH_PARAMS_WORLD = 0,
   SPH_PARAMS_SURFACE_TENSION = 1,
   SPH_PARAMS_CLAVET_VISCOSITY = 2,
   SPH_PARAMS_TAIT = 3,
   SPH_PARAMS_SPRINGS = 4,
-  SPH_PARAMS_KIND_COUNT = 5,
+  SPH_PARAMS_DFSPH = 5,
+  SPH_PARAMS_KIND_COUNT = 6,
   SPH_PARAMS_KIND_FORCE32 = 2147483647,
 } sph_params_kind;
 typedef enum {
@@ -139,6 +146,7 @@ typedef enum {
   SPH_METHOD_SWITCH_FEATURE = 1,
   SPH_METHOD_SWITCH_VISCOSITY = 2,
   SPH_METHOD_SWITCH_EQUATION_OF_STATE = 3,
+  SPH_METHOD_SWITCH_SOLVER = 4,
   SPH_METHOD_SWITCH_FORCE32 = 2147483647,
 } sph_method_switch;
 typedef enum {
@@ -181,6 +189,8 @@ typedef enum {
 typedef enum {
   SPH_EVENT_SOURCE_CAPACITY_REACHED = 1,
   SPH_EVENT_SINK_REMOVED = 2,
+  SPH_EVENT_PRESSURE_SOLVE_CAPPED = 3,
+  SPH_EVENT_DIVERGENCE_SOLVE_CAPPED = 4,
   SPH_EVENT_TYPE_FORCE32 = 2147483647,
 } sph_event_type;
 
@@ -216,6 +226,7 @@ typedef struct sph_world_def {
   float kernel_radius;
   float rest_density;
   sph_equation_of_state equation_of_state;
+  sph_solver solver;
 } sph_world_def;
 typedef struct sph_world_params {
   uint32_t struct_size;
@@ -254,6 +265,14 @@ typedef struct sph_spring_params {
   float damping;
   uint32_t reserved0;
 } sph_spring_params;
+typedef struct sph_dfsph_params {
+  uint32_t struct_size;
+  float density_error;
+  float divergence_error;
+  uint32_t max_iterations;
+  uint32_t max_divergence_iterations;
+  uint32_t flags;
+} sph_dfsph_params;
 typedef struct sph_params_info {
   uint32_t struct_size;
   uint32_t params_size;
@@ -325,6 +344,16 @@ typedef struct sph_stats {
   float step_ms;
   uint32_t reserved0;
   uint64_t memory_bytes;
+  uint32_t pressure_iterations;
+  uint32_t pressure_iterations_max;
+  uint32_t divergence_iterations;
+  uint32_t divergence_iterations_max;
+  float density_error_mean;
+  float density_error_max;
+  float divergence_error_mean;
+  float divergence_error_max;
+  uint32_t pressure_solves_capped;
+  uint32_t divergence_solves_capped;
 } sph_stats;
 typedef struct sph_grid_desc {
   uint32_t struct_size;
@@ -493,6 +522,9 @@ sph_result sph_world_get_tait_params(const sph_world* world, sph_tait_params* ou
 sph_result sph_spring_params_init_sized(sph_spring_params* params, uint32_t size);
 sph_result sph_world_set_spring_params(sph_world* world, const sph_spring_params* params);
 sph_result sph_world_get_spring_params(const sph_world* world, sph_spring_params* out);
+sph_result sph_dfsph_params_init_sized(sph_dfsph_params* params, uint32_t size);
+sph_result sph_world_set_dfsph_params(sph_world* world, const sph_dfsph_params* params);
+sph_result sph_world_get_dfsph_params(const sph_world* world, sph_dfsph_params* out);
 sph_result sph_world_set_physics_params(sph_world* world, sph_params_kind kind, const void* params);
 sph_result sph_world_get_physics_params(const sph_world* world, sph_params_kind kind, void* out);
 sph_result sph_params_info_init_sized(sph_params_info* info, uint32_t size);
@@ -508,6 +540,9 @@ sph_result sph_world_fill_box(sph_world* world, const sph_fill_box_desc* desc, u
 sph_result sph_fill_sphere_desc_init_sized(sph_fill_sphere_desc* desc, uint32_t size);
 sph_result sph_world_fill_sphere(sph_world* world, const sph_fill_sphere_desc* desc, uint32_t* out_count);
 sph_result sph_world_step(sph_world* world, float frame_dt);
+sph_result sph_world_set_step_budget(sph_world* world, double max_seconds);
+sph_result sph_world_get_step_budget(const sph_world* world, double* out_seconds);
+sph_result sph_world_cancel_step(sph_world* world);
 sph_result sph_world_get_particle_count(const sph_world* world, uint32_t* out_count);
 sph_result sph_world_copy_attribute(const sph_world* world, sph_attribute attribute, void* dst, uint64_t dst_size, uint64_t dst_stride, uint32_t first, uint32_t count, uint32_t* out_written);
 sph_result sph_stats_init_sized(sph_stats* stats, uint32_t size);

@@ -70,11 +70,13 @@ namespace Sph
         public const uint SPH_FEATURE_COLLIDER_LOADS = 16u;
         /// <summary>
         /// Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt &lt;= step_factor h /
-        /// c, c the EOS's speed of sound
+        /// c, c the EOS's speed of sound \ (weakly compressible worlds only)
         /// </summary>
         public const uint SPH_STEP_LIMIT_ACOUSTIC = 1u;
         /// <summary>dt &lt;= step_factor sqrt(h / |a|_max)</summary>
         public const uint SPH_STEP_LIMIT_FORCE = 2u;
+        /// <summary>sph_dfsph_params.flags no divergence solve (cheaper; a noisier pressure)</summary>
+        public const uint SPH_DFSPH_SKIP_DIVERGENCE_SOLVE = 1u;
         /// <summary>hollow box: no lid (a tank open at +y)</summary>
         public const uint SPH_SHAPE_FLAG_OPEN_TOP = 1u;
         /// <summary>solid where the SDF is positive: a container</summary>
@@ -92,7 +94,8 @@ namespace Sph
         public const int SPH_STAGE_FORCE32 = 2147483647;
         public const int SPH_VISCOSITY_METHOD_FORCE32 = 2147483647;
         public const int SPH_EOS_FORCE32 = 2147483647;
-        public const int SPH_PARAMS_KIND_COUNT = 5;
+        public const int SPH_SOLVER_FORCE32 = 2147483647;
+        public const int SPH_PARAMS_KIND_COUNT = 6;
         public const int SPH_PARAMS_KIND_FORCE32 = 2147483647;
         public const int SPH_PARAM_TYPE_FORCE32 = 2147483647;
         public const int SPH_BOUND_FORCE32 = 2147483647;
@@ -197,7 +200,10 @@ namespace Sph
         Velocity = 1,
         /// <summary>float32, kg/m^3, from the last density evaluation</summary>
         Density = 2,
-        /// <summary>float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation</summary>
+        /// <summary>
+        /// float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure its
+        /// density solve found in the last substep
+        /// </summary>
         Pressure = 3,
         /// <summary>uint32, persistent particle id, unique within a world</summary>
         Id = 4,
@@ -212,7 +218,7 @@ namespace Sph
         CellRanges = 1,
         /// <summary>density and pressure</summary>
         Density = 2,
-        /// <summary>pressure, viscosity and external forces</summary>
+        /// <summary>pressure, viscosity and external forces (DFSPH: and its two solves)</summary>
         Forces = 3,
         /// <summary>time integration, max-speed reduction, next step size</summary>
         Integrate = 4,
@@ -248,6 +254,24 @@ namespace Sph
         Tait = 1,
     }
 
+    /// <summary>sph_solver: The pressure solver, fixed at world creation (docs/physics.md, "Solvers").</summary>
+    public enum Solver : int
+    {
+        /// <summary>
+        /// the thesis's weakly compressible SPH: pressure from the equation of state, explicit steps
+        /// under the acoustic ceiling 0.4 h / c
+        /// </summary>
+        Wcsph = 0,
+        /// <summary>
+        /// divergence-free SPH (Bender &amp; Koschier 2015, 2017): pressure from two iterative solves
+        /// that hold the density error below a bound (sph_dfsph_params); steps bounded by the flow
+        /// speed alone. No equation of state: the stiffness, Tait's parameters and
+        /// SPH_STEP_LIMIT_ACOUSTIC have no effect. Not with SPH_INTEGRATOR_RK4, SPH_EOS_TAIT or
+        /// SPH_FEATURE_NORMALIZED_DENSITY (SPH_ERROR_UNSUPPORTED at creation)
+        /// </summary>
+        Dfsph = 1,
+    }
+
     /// <summary>sph_params_kind</summary>
     public enum ParamsKind : int
     {
@@ -261,6 +285,8 @@ namespace Sph
         Tait = 3,
         /// <summary>sph_spring_params</summary>
         Springs = 4,
+        /// <summary>sph_dfsph_params</summary>
+        Dfsph = 5,
     }
 
     /// <summary>sph_param_type</summary>
@@ -307,6 +333,8 @@ namespace Sph
         Viscosity = 2,
         /// <summary>sph_world_def.equation_of_state == value</summary>
         EquationOfState = 3,
+        /// <summary>sph_world_def.solver == value</summary>
+        Solver = 4,
     }
 
     /// <summary>sph_memory_kind</summary>
@@ -388,6 +416,16 @@ namespace Sph
         SourceCapacityReached = 1,
         /// <summary>object: the sink; count: particles removed</summary>
         SinkRemoved = 2,
+        /// <summary>
+        /// DFSPH; object: none (0); count: substeps whose density solve stopped at max_iterations above
+        /// its bound
+        /// </summary>
+        PressureSolveCapped = 3,
+        /// <summary>
+        /// DFSPH; object: none (0); count: substeps whose divergence solve stopped at its cap above its
+        /// bound
+        /// </summary>
+        DivergenceSolveCapped = 4,
     }
 
     /// <summary>
@@ -685,7 +723,7 @@ namespace Sph
     }
 
     /// <summary>
-    /// sph_world_def (40 bytes): Creation-time description of a world; fixed for the world's life. Zero
+    /// sph_world_def (44 bytes): Creation-time description of a world; fixed for the world's life. Zero
     /// means default for every field: a zeroed def is the def sph_world_def_init gives.
     /// </summary>
     [StructLayout(LayoutKind.Sequential)]
@@ -711,6 +749,8 @@ namespace Sph
         public float RestDensity;
         /// <summary>sph_equation_of_state equation_of_state: default SPH_EOS_IDEAL_GAS</summary>
         public EquationOfState EquationOfState;
+        /// <summary>sph_solver solver: default SPH_SOLVER_WCSPH</summary>
+        public Solver Solver;
 
         /// <summary>A WorldDef with the library's defaults (sph_world_def_init_sized).</summary>
         public static WorldDef Default()
@@ -729,7 +769,10 @@ namespace Sph
     {
         /// <summary>uint32_t struct_size: sizeof(sph_world_params), set by sph_world_params_init</summary>
         public uint StructSize;
-        /// <summary>uint32_t max_substeps: most substeps one sph_world_step may take; default 10000; 0 = default</summary>
+        /// <summary>
+        /// uint32_t max_substeps: most substeps one sph_world_step may take; default 10000; 0 =
+        /// default; at most 1000000 (a bound on one call's cost; see also the step budget)
+        /// </summary>
         public uint MaxSubsteps;
         /// <summary>sph_vec3 gravity: m/s^2; default (0, -9.81, 0); finite; 0 is no gravity</summary>
         public Vec3 Gravity;
@@ -887,6 +930,47 @@ namespace Sph
         }
     }
 
+    /// <summary>sph_dfsph_params (24 bytes)</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public partial struct DfsphParams
+    {
+        /// <summary>uint32_t struct_size: set by sph_dfsph_params_init</summary>
+        public uint StructSize;
+        /// <summary>
+        /// float density_error: bound on the density solve's mean error, the mean over the particles of
+        /// max(rho* - rho0, 0) / rho0 (rho*: the density the step would give); dimensionless; default
+        /// 0.001 (0.1 %); in (0, 1]; 0 = default
+        /// </summary>
+        public float DensityError;
+        /// <summary>
+        /// float divergence_error: bound on the divergence solve's mean of max(D rho / Dt, 0) / rho0,
+        /// 1/s; default 1; &gt; 0; 0 = default
+        /// </summary>
+        public float DivergenceError;
+        /// <summary>
+        /// uint32_t max_iterations: cap of the density solve per substep; default 100; &gt;= 2; 0 =
+        /// default. A solve that stops here above its bound is counted in sph_stats and reported as an
+        /// event
+        /// </summary>
+        public uint MaxIterations;
+        /// <summary>
+        /// uint32_t max_divergence_iterations: cap of the divergence solve; default 100; &gt;= 1; 0 =
+        /// default
+        /// </summary>
+        public uint MaxDivergenceIterations;
+        /// <summary>uint32_t flags: SPH_DFSPH_* bits; default 0</summary>
+        public uint Flags;
+
+        /// <summary>A DfsphParams with the library's defaults (sph_dfsph_params_init_sized).</summary>
+        public static DfsphParams Default()
+        {
+            var value = new DfsphParams();
+            uint size = (uint)Marshal.SizeOf(typeof(DfsphParams));
+            SphException.Check(Native.sph_dfsph_params_init_sized(ref value, size), "sph_dfsph_params_init_sized");
+            return value;
+        }
+    }
+
     /// <summary>sph_params_info (32 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct ParamsInfo
@@ -963,7 +1047,10 @@ namespace Sph
         public uint MethodCount;
         /// <summary>sph_method_switch switch_by: the sph_world_def field that selects it</summary>
         public MethodSwitch SwitchBy;
-        /// <summary>uint32_t value: the SPH_FEATURE_* bit, sph_viscosity_method or sph_equation_of_state</summary>
+        /// <summary>
+        /// uint32_t value: the SPH_FEATURE_* bit, sph_viscosity_method, sph_equation_of_state or
+        /// sph_solver
+        /// </summary>
         public uint Value;
         /// <summary>uint32_t has_params: 1 when its parameters are in the struct of params_kind</summary>
         public uint HasParams;
@@ -1071,7 +1158,7 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_stats (104 bytes)</summary>
+    /// <summary>sph_stats (144 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct Stats
     {
@@ -1112,6 +1199,36 @@ namespace Sph
         /// CUDA backend)
         /// </summary>
         public ulong MemoryBytes;
+        /// <summary>
+        /// uint32_t pressure_iterations: DFSPH's two solves over the substeps of the last step (all
+        /// zero on a WCSPH world). An iteration is one velocity update and one new residual, after the
+        /// warm start's.
+        /// </summary>
+        public uint PressureIterations;
+        /// <summary>uint32_t pressure_iterations_max: most in one substep</summary>
+        public uint PressureIterationsMax;
+        /// <summary>uint32_t divergence_iterations: the divergence solve's iterations, summed</summary>
+        public uint DivergenceIterations;
+        /// <summary>uint32_t divergence_iterations_max: most in one substep</summary>
+        public uint DivergenceIterationsMax;
+        /// <summary>
+        /// float density_error_mean: the density solve's achieved mean error (see
+        /// sph_dfsph_params.density_error), averaged over the substeps
+        /// </summary>
+        public float DensityErrorMean;
+        /// <summary>float density_error_max: the largest of any substep</summary>
+        public float DensityErrorMax;
+        /// <summary>float divergence_error_mean: the divergence solve's achieved mean error, 1/s</summary>
+        public float DivergenceErrorMean;
+        /// <summary>float divergence_error_max: the largest of any substep</summary>
+        public float DivergenceErrorMax;
+        /// <summary>
+        /// uint32_t pressure_solves_capped: substeps whose density solve stopped at its cap above its
+        /// bound (also SPH_EVENT_PRESSURE_SOLVE_CAPPED)
+        /// </summary>
+        public uint PressureSolvesCapped;
+        /// <summary>uint32_t divergence_solves_capped: likewise (SPH_EVENT_DIVERGENCE_SOLVE_CAPPED)</summary>
+        public uint DivergenceSolvesCapped;
 
         /// <summary>A Stats with the library's defaults (sph_stats_init_sized).</summary>
         public static Stats Default()
@@ -1841,8 +1958,9 @@ namespace Sph
         /// FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass).
         /// Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range:
         /// capacity above 2^30, spacing &lt; 0 or non-finite, kernel_radius &lt; spacing, rest_density
-        /// &lt; 0), UNSUPPORTED (unknown integrator or feature bit), VERSION_MISMATCH,
-        /// OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY. *out is written only on success.
+        /// &lt; 0), UNSUPPORTED (unknown integrator, feature bit, method or solver; a combination a
+        /// solver does not support, see sph_solver), VERSION_MISMATCH, OUT_OF_HOST_MEMORY,
+        /// OUT_OF_DEVICE_MEMORY. *out is written only on success.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_create(ContextHandle context, ref WorldDef def, out WorldHandle @out);
@@ -1967,6 +2085,27 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_spring_params")]
         public static extern Result sph_world_get_spring_params(IntPtr world, IntPtr @out);
 
+        /// <summary>sph_dfsph_params_init_sized</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_dfsph_params_init_sized(ref DfsphParams @params, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_dfsph_params_init_sized")]
+        public static extern Result sph_dfsph_params_init_sized(IntPtr @params, uint size);
+
+        /// <summary>
+        /// FEATURE_DISABLED unless the world's solver is SPH_SOLVER_DFSPH. INVALID_ARGUMENT for a value
+        /// out of range (the message names it); nothing changes on error. Acts from the next substep.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_set_dfsph_params(WorldHandle world, ref DfsphParams @params);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_set_dfsph_params")]
+        public static extern Result sph_world_set_dfsph_params(IntPtr world, IntPtr @params);
+
+        /// <summary>sph_world_get_dfsph_params</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_get_dfsph_params(WorldHandle world, ref DfsphParams @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_dfsph_params")]
+        public static extern Result sph_world_get_dfsph_params(IntPtr world, IntPtr @out);
+
         /// <summary>
         /// Replaces the params struct of `kind` at once, as its typed set call does
         /// (sph_world_set_params, sph_world_set_tait_params, ...): params points to that struct,
@@ -2079,14 +2218,51 @@ namespace Sph
         /// Advances the world by frame_dt seconds (&gt; 0, finite) in adaptive substeps: each substep's
         /// dt = step_factor * h / v_max clamped to [dt_min, dt_max], shortened at the end so that the
         /// substeps add up to frame_dt exactly (the last one or two may be shorter than dt_min). Blocks
-        /// until the frame is done. Returns SPH_INCOMPLETE if max_substeps ran out first
-        /// (sph_stats.frame_time says how far it got). SPH_ERROR_NON_FINITE if a substep produced a
-        /// NaN/Inf: the world is restored to its state before this call.
+        /// until the frame is done. Returns SPH_INCOMPLETE if max_substeps ran out first, or the step
+        /// budget (sph_world_set_step_budget) or a cancel (sph_world_cancel_step) stopped it: the world
+        /// is then as after its last whole substep, consistent and ready to step again
+        /// (sph_stats.frame_time and substeps say how far it got). SPH_ERROR_NON_FINITE if a substep
+        /// produced a NaN/Inf, SPH_ERROR_CAPACITY if more particles than 64 times the rest density
+        /// allows piled into one cell of side h (the neighbour work would grow with their square; the
+        /// message says where): the world is restored to its state before this call.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_step(WorldHandle world, float frameDt);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_step")]
         public static extern Result sph_world_step(IntPtr world, float frameDt);
+
+        /// <summary>
+        /// Bounds the wall-clock time of each later sph_world_step of this world: a step still running
+        /// max_seconds after it began stops at its next substep boundary and returns SPH_INCOMPLETE
+        /// (one substep may overrun the budget). Both backends check it between substeps: the CUDA
+        /// backend runs a frame with a budget on its stream driver instead of its device graph (one
+        /// host synchronisation a substep). 0 (the default) is no budget. Not saved in checkpoints.
+        /// Errors: INVALID_HANDLE, INVALID_ARGUMENT (NaN, negative or above 86400), WORLD_LOCKED.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_set_step_budget(WorldHandle world, double maxSeconds);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_set_step_budget")]
+        public static extern Result sph_world_set_step_budget(IntPtr world, double maxSeconds);
+
+        /// <summary>The step budget in seconds (0: none). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL).</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_get_step_budget(WorldHandle world, out double outSeconds);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_step_budget")]
+        public static extern Result sph_world_get_step_budget(IntPtr world, IntPtr outSeconds);
+
+        /// <summary>
+        /// Asks the world's step to stop at its next substep boundary (it returns SPH_INCOMPLETE with
+        /// the world consistent; on the CUDA backend a frame on the device graph, which is every frame
+        /// without a step budget or sinks, sees it only at its end). The one call that may run on
+        /// another thread while a step holds the world: it never blocks and never answers WORLD_LOCKED.
+        /// A request made while no step runs stops the next step before its first substep (that step
+        /// changes nothing and reports 0 substeps); a step that stops for it clears it. Errors:
+        /// INVALID_HANDLE (NULL or destroyed: safe to call racing sph_world_destroy).
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_cancel_step(WorldHandle world);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_cancel_step")]
+        public static extern Result sph_world_cancel_step(IntPtr world);
 
         /// <summary>Number of particles in the world.</summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
@@ -2577,6 +2753,7 @@ namespace Sph
             typeof(ClavetViscosityParams),
             typeof(TaitParams),
             typeof(SpringParams),
+            typeof(DfsphParams),
             typeof(ParamsInfo),
             typeof(ParamFieldInfo),
             typeof(PhysicsMethodInfo),
@@ -2612,6 +2789,7 @@ namespace Sph
             "sph_clavet_viscosity_params",
             "sph_tait_params",
             "sph_spring_params",
+            "sph_dfsph_params",
             "sph_params_info",
             "sph_param_field_info",
             "sph_physics_method_info",
@@ -2641,19 +2819,20 @@ namespace Sph
         public static readonly int[] StructSizes = {
             12,
             56,
-            40,
+            44,
             48,
             16,
             16,
             8,
             28,
+            24,
             32,
             72,
             32,
             40,
             44,
             36,
-            104,
+            144,
             80,
             104,
             44,
@@ -2701,6 +2880,7 @@ namespace Sph
             typeof(WorldDef),
             typeof(WorldDef),
             typeof(WorldDef),
+            typeof(WorldDef),
             typeof(WorldParams),
             typeof(WorldParams),
             typeof(WorldParams),
@@ -2728,6 +2908,12 @@ namespace Sph
             typeof(SpringParams),
             typeof(SpringParams),
             typeof(SpringParams),
+            typeof(DfsphParams),
+            typeof(DfsphParams),
+            typeof(DfsphParams),
+            typeof(DfsphParams),
+            typeof(DfsphParams),
+            typeof(DfsphParams),
             typeof(ParamsInfo),
             typeof(ParamsInfo),
             typeof(ParamsInfo),
@@ -2769,6 +2955,16 @@ namespace Sph
             typeof(FillSphereDesc),
             typeof(FillSphereDesc),
             typeof(FillSphereDesc),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
             typeof(Stats),
             typeof(Stats),
             typeof(Stats),
@@ -2912,6 +3108,7 @@ namespace Sph
             "KernelRadius",
             "RestDensity",
             "EquationOfState",
+            "Solver",
             "StructSize",
             "MaxSubsteps",
             "Gravity",
@@ -2939,6 +3136,12 @@ namespace Sph
             "Plasticity",
             "Damping",
             "Reserved0",
+            "StructSize",
+            "DensityError",
+            "DivergenceError",
+            "MaxIterations",
+            "MaxDivergenceIterations",
+            "Flags",
             "StructSize",
             "ParamsSize",
             "FieldCount",
@@ -2997,6 +3200,16 @@ namespace Sph
             "StepMs",
             "Reserved0",
             "MemoryBytes",
+            "PressureIterations",
+            "PressureIterationsMax",
+            "DivergenceIterations",
+            "DivergenceIterationsMax",
+            "DensityErrorMean",
+            "DensityErrorMax",
+            "DivergenceErrorMean",
+            "DivergenceErrorMax",
+            "PressureSolvesCapped",
+            "DivergenceSolvesCapped",
             "StructSize",
             "Dims",
             "IndexToLocal",
@@ -3123,6 +3336,7 @@ namespace Sph
             28,
             32,
             36,
+            40,
             0,
             4,
             8,
@@ -3150,6 +3364,12 @@ namespace Sph
             16,
             20,
             24,
+            0,
+            4,
+            8,
+            12,
+            16,
+            20,
             0,
             4,
             8,
@@ -3208,6 +3428,16 @@ namespace Sph
             88,
             92,
             96,
+            104,
+            108,
+            112,
+            116,
+            120,
+            124,
+            128,
+            132,
+            136,
+            140,
             0,
             4,
             16,
@@ -3341,6 +3571,9 @@ namespace Sph
             "sph_spring_params_init_sized",
             "sph_world_set_spring_params",
             "sph_world_get_spring_params",
+            "sph_dfsph_params_init_sized",
+            "sph_world_set_dfsph_params",
+            "sph_world_get_dfsph_params",
             "sph_world_set_physics_params",
             "sph_world_get_physics_params",
             "sph_params_info_init_sized",
@@ -3356,6 +3589,9 @@ namespace Sph
             "sph_fill_sphere_desc_init_sized",
             "sph_world_fill_sphere",
             "sph_world_step",
+            "sph_world_set_step_budget",
+            "sph_world_get_step_budget",
+            "sph_world_cancel_step",
             "sph_world_get_particle_count",
             "sph_world_copy_attribute",
             "sph_stats_init_sized",
@@ -3512,6 +3748,12 @@ namespace Sph
             "sph",
             "sph",
             "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
             "sph_vdb",
             "sph_vdb",
         };
@@ -3547,12 +3789,12 @@ namespace Sph
             { "SPH_ATTRIBUTE_POSITION", "3 x float32, metres" },
             { "SPH_ATTRIBUTE_VELOCITY", "3 x float32, metres per second" },
             { "SPH_ATTRIBUTE_DENSITY", "float32, kg/m^3, from the last density evaluation" },
-            { "SPH_ATTRIBUTE_PRESSURE", "float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation" },
+            { "SPH_ATTRIBUTE_PRESSURE", "float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure its density solve found in the last substep" },
             { "SPH_ATTRIBUTE_ID", "uint32, persistent particle id, unique within a world" },
             { "SPH_STAGE_HASH_SORT", "cell hash, stable sort, reorder of every attribute" },
             { "SPH_STAGE_CELL_RANGES", "start/end of each cell" },
             { "SPH_STAGE_DENSITY", "density and pressure" },
-            { "SPH_STAGE_FORCES", "pressure, viscosity and external forces" },
+            { "SPH_STAGE_FORCES", "pressure, viscosity and external forces (DFSPH: and its two solves)" },
             { "SPH_STAGE_INTEGRATE", "time integration, max-speed reduction, next step size" },
             { "SPH_STAGE_COLLIDE", "particles against colliders (CPU; the CUDA backend does it inside the forces kernel, so it counts under SPH_STAGE_FORCES there)" },
             { "SPH_STAGE_EMIT", "sinks removing particles; sources emit before the substeps and count only in sph_stats.step_ms" },
@@ -3561,11 +3803,14 @@ namespace Sph
             { "SPH_VISCOSITY_CLAVET", "radial impulses between approaching pairs (eq. 18-19), sph_clavet_viscosity_params" },
             { "SPH_EOS_IDEAL_GAS", "the thesis's modified ideal gas p = k (rho - rho0) (eq. 15)" },
             { "SPH_EOS_TAIT", "p = B ((rho / rho0)^7 - 1), B = rho0 c^2 / 7, sph_tait_params" },
+            { "SPH_SOLVER_WCSPH", "the thesis's weakly compressible SPH: pressure from the equation of state, explicit steps under the acoustic ceiling 0.4 h / c" },
+            { "SPH_SOLVER_DFSPH", "divergence-free SPH (Bender & Koschier 2015, 2017): pressure from two iterative solves that hold the density error below a bound (sph_dfsph_params); steps bounded by the flow speed alone. No equation of state: the stiffness, Tait's parameters and SPH_STEP_LIMIT_ACOUSTIC have no effect. Not with SPH_INTEGRATOR_RK4, SPH_EOS_TAIT or SPH_FEATURE_NORMALIZED_DENSITY (SPH_ERROR_UNSUPPORTED at creation)" },
             { "SPH_PARAMS_WORLD", "sph_world_params" },
             { "SPH_PARAMS_SURFACE_TENSION", "sph_surface_tension_params" },
             { "SPH_PARAMS_CLAVET_VISCOSITY", "sph_clavet_viscosity_params" },
             { "SPH_PARAMS_TAIT", "sph_tait_params" },
             { "SPH_PARAMS_SPRINGS", "sph_spring_params" },
+            { "SPH_PARAMS_DFSPH", "sph_dfsph_params" },
             { "SPH_PARAM_FLOAT", "float, finite" },
             { "SPH_PARAM_VEC3", "sph_vec3, every component finite" },
             { "SPH_PARAM_UINT32", "uint32_t count" },
@@ -3579,6 +3824,7 @@ namespace Sph
             { "SPH_METHOD_SWITCH_FEATURE", "a bit of sph_world_def.features (value)" },
             { "SPH_METHOD_SWITCH_VISCOSITY", "sph_world_def.viscosity_method == value" },
             { "SPH_METHOD_SWITCH_EQUATION_OF_STATE", "sph_world_def.equation_of_state == value" },
+            { "SPH_METHOD_SWITCH_SOLVER", "sph_world_def.solver == value" },
             { "SPH_MEMORY_HOST", "ordinary host memory" },
             { "SPH_MEMORY_CUDA_DEVICE", "device memory of the context's CUDA device (CUDA contexts only)" },
             { "SPH_SHAPE_PLANE", "solid below y = 0; half_extents.x/.z its size, .y its thickness" },
@@ -3598,6 +3844,8 @@ namespace Sph
             { "SPH_FORCE_FIELD_GRID", "accelerations from a user grid (3 components, field frame)" },
             { "SPH_EVENT_SOURCE_CAPACITY_REACHED", "object: the source; count: particles not emitted" },
             { "SPH_EVENT_SINK_REMOVED", "object: the sink; count: particles removed" },
+            { "SPH_EVENT_PRESSURE_SOLVE_CAPPED", "DFSPH; object: none (0); count: substeps whose density solve stopped at max_iterations above its bound" },
+            { "SPH_EVENT_DIVERGENCE_SOLVE_CAPPED", "DFSPH; object: none (0); count: substeps whose divergence solve stopped at its cap above its bound" },
         };
     }
 }

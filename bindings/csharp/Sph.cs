@@ -583,6 +583,24 @@ namespace Sph
             set { SphException.Check(Native.sph_world_set_spring_params(Handle, ref value), "sph_world_set_spring_params"); }
         }
 
+        /// <summary>DFSPH's parameters (the bound on the density solve's mean error, that of the
+        /// divergence solve in 1/s, the two iteration caps, flags) of a world created with
+        /// <c>Solver.Dfsph</c>; setting replaces them whole. Throws SphException
+        /// (<c>Result.ErrorFeatureDisabled</c>) on a weakly compressible world.</summary>
+        public DfsphParams DfsphParams
+        {
+            get
+            {
+                var p = DfsphParams.Default();
+                SphException.Check(Native.sph_world_get_dfsph_params(Handle, ref p), "sph_world_get_dfsph_params");
+                return p;
+            }
+            set { SphException.Check(Native.sph_world_set_dfsph_params(Handle, ref value), "sph_world_set_dfsph_params"); }
+        }
+
+        /// <summary>The solver the world was created with (WorldDef.Solver).</summary>
+        public Solver Solver { get { return Def.Solver; } }
+
         /// <summary>The params struct of <paramref name="kind"/> (T must be its struct:
         /// WorldParams for ParamsKind.World, TaitParams for ParamsKind.Tait, ...), read from the
         /// world (sph_world_get_physics_params).</summary>
@@ -698,6 +716,26 @@ namespace Sph
         public Result Step(float frameDt)
         {
             return SphException.Check(Native.sph_world_step(Handle, frameDt), "sph_world_step");
+        }
+
+        /// <summary>Wall-clock seconds one Step may take before it stops at a substep boundary
+        /// and returns Incomplete; 0 is no budget (sph_world_set/get_step_budget).</summary>
+        public double StepBudget
+        {
+            get
+            {
+                double seconds;
+                SphException.Check(Native.sph_world_get_step_budget(Handle, out seconds), "sph_world_get_step_budget");
+                return seconds;
+            }
+            set { SphException.Check(Native.sph_world_set_step_budget(Handle, value), "sph_world_set_step_budget"); }
+        }
+
+        /// <summary>Asks the Step running on another thread (or else the next one) to stop at its
+        /// next substep boundary, returning Incomplete. Safe from any thread while the world steps.</summary>
+        public void CancelStep()
+        {
+            SphException.Check(Native.sph_world_cancel_step(Handle), "sph_world_cancel_step");
         }
 
         // ---- particles out --------------------------------------------------------------------

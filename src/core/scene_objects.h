@@ -63,7 +63,13 @@ struct ForceField {
   float falloff_radius = 0.0f;
 };
 
-enum class EventType : uint32_t { SourceCapacityReached = 1, SinkRemoved = 2 };
+// Values equal to sph_event_type. The solver's events name no object (object_id 0).
+enum class EventType : uint32_t {
+  SourceCapacityReached = 1,
+  SinkRemoved = 2,
+  PressureSolveCapped = 3,
+  DivergenceSolveCapped = 4,
+};
 
 struct Event {
   EventType type;

@@ -178,8 +178,16 @@ ColliderLoadResult load_result(const ColliderLoadSums& sums, const Collider& c, 
 }
 }  // namespace
 
-bool World::step(double frame_dt) {
+bool World::step(double frame_dt, const StepInterrupt& interrupt) {
   const auto start = std::chrono::steady_clock::now();
+  if (interrupt.requested()) {
+    report_ = FrameReport{};
+    report_.completed = false;
+    report_.interrupted = true;
+    events_.clear();
+    last_step_ms_ = 0.0f;
+    return false;
+  }
   // Everything a failed step must put back.
   const uint32_t count_before = particle_count();
   const uint32_t next_id_before = next_id_;
@@ -199,10 +207,12 @@ bool World::step(double frame_dt) {
   try {
     // Reserved up front, so that nothing after the backend's frame can fail on an allocation:
     // once the particles have moved, the rest of the step must not throw.
-    events_.reserve(sources_.size() + sinks_.size());
+    events_.reserve(sources_.size() + sinks_.size() + 2);  // + the solves' capped events
     if (sources_.size() > 0) backend_->save_step_inputs();
     emit_sources(frame_dt);
-    report = backend_->step_scene_frame(frame_dt, params_, build_scene_frame(frame_dt));
+    SceneFrame scene = build_scene_frame(frame_dt);
+    scene.interrupt = interrupt;
+    report = backend_->step_scene_frame(frame_dt, params_, scene);
   } catch (...) {
     if (particle_count() > count_before) {
       backend_->truncate(count_before);
@@ -229,6 +239,11 @@ bool World::step(double frame_dt) {
     if (removed > 0) events_.push_back(Event{EventType::SinkRemoved, id, removed});
     ++index;
   });
+  // A DFSPH solve that stopped at its cap is never silent.
+  if (report.pressure_solve.capped > 0)
+    events_.push_back(Event{EventType::PressureSolveCapped, 0, report.pressure_solve.capped});
+  if (report.divergence_solve.capped > 0)
+    events_.push_back(Event{EventType::DivergenceSolveCapped, 0, report.divergence_solve.capped});
   report_ = std::move(report);
   simulated_time_ += report_.time_advanced;
   last_step_ms_ = static_cast<float>(

@@ -58,9 +58,11 @@ class World {
   uint32_t fill_sphere(const FillSphereSpec& spec);
 
   // Runs one frame: sources emit, then substeps with colliders, fields and sinks. Returns
-  // false when max_substeps ran out before frame_dt. On an exception the world (particles,
-  // ids, sources, collider poses) is as it was before the call.
-  bool step(double frame_dt);
+  // false when max_substeps ran out before frame_dt, or `interrupt` stopped it at a substep
+  // boundary (raised before the step starts: nothing changes but the report, which says no
+  // substep ran). On an exception the world (particles, ids, sources, collider poses) is as it
+  // was before the call.
+  bool step(double frame_dt, const StepInterrupt& interrupt = StepInterrupt{});
 
   const FrameReport& last_report() const { return report_; }
   double simulated_time() const { return simulated_time_; }

@@ -54,14 +54,20 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
   };
   SubstepClock clock;
   start_clock(clock, frame_dt);
+  DfsphTallies tallies;
   try {
     while (clock_running(clock, params.stepping.max_substeps)) {
+      if (scene.interrupt.requested()) {
+        report.interrupted = true;
+        break;
+      }
       pick_next_step(clock, frame_dt, limits, std::max(max_speed_, scene.max_collider_speed),
                      max_acceleration_);
       fluid.dt = clock.dt_float;
-      const uint32_t bad = config_.integrator == Integrator::Rk4
-                               ? substep_rk4(fluid, scene, clock.time, report)
-                               : substep_euler(fluid, scene, clock.time, report);
+      const uint32_t bad =
+          config_.solver == Solver::Dfsph         ? substep_dfsph(fluid, scene, clock.time, report, tallies)
+          : config_.integrator == Integrator::Rk4 ? substep_rk4(fluid, scene, clock.time, report)
+                                                  : substep_euler(fluid, scene, clock.time, report);
       if (bad != kAllFinite) {
         roll_back();
         non_finite_.substep = clock.substeps + 1;
@@ -79,6 +85,8 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
     throw;
   }
   report_clock(clock, report);
+  report.pressure_solve = finish_solve(tallies.pressure);
+  report.divergence_solve = finish_solve(tallies.divergence);
   report.max_speed = max_speed_;
   report.collider_loads = load_sums_;
   const auto t = Clock::now();

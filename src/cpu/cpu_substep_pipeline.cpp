@@ -30,6 +30,12 @@ void CpuBackend::collide(const SceneFrame& scene, const SubstepTime& time, OldPo
   report.stage_ms[kStageCollide] += static_cast<float>(elapsed_ms(t));
 }
 
+void CpuBackend::collide_from(const SceneFrame& scene, const SubstepTime& time, const Float4* old,
+                              FrameReport& report) {
+  collide(
+      scene, time, [old](uint32_t i) { return xyz(old[i]); }, report);
+}
+
 uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame& scene,
                                    const SubstepTime& time, FrameReport& report) {
   sort_and_density(fluid, scene, stage_time(time, 0.0f), report);

@@ -125,6 +125,8 @@ else:
           sorted(by_switch.get(int(S.VISCOSITY), [])) == sorted(scene_schema.VISCOSITY_METHODS), by_switch)
     check("equations of state are the library's",
           sorted(by_switch.get(int(S.EQUATION_OF_STATE), [])) == sorted(scene_schema.EQUATIONS_OF_STATE), by_switch)
+    check("solvers are the library's", sorted(by_switch.get(int(S.SOLVER), [])) == sorted(scene_schema.SOLVERS),
+          by_switch)
 
 print(f"{passed} passed, {len(failures)} failed, 0 skipped")
 sys.exit(1 if failures else 0)

@@ -37,10 +37,13 @@ PHYSICS_PARAMS = {
     "tait": {"speed_of_sound": "float"},
     "springs": {"stiffness": "float", "link_radius": "float", "yield_ratio": "float", "plasticity": "float",
                 "damping": "float"},
+    "dfsph": {"density_error": "float", "divergence_error": "float", "max_iterations": "uint",
+              "max_divergence_iterations": "uint", "flags": "uint"},
 }
 FEATURES = ["surface_tension", "normalized_density", "springs", "boundary_density", "collider_loads"]
 VISCOSITY_METHODS = ["mueller", "clavet"]
 EQUATIONS_OF_STATE = ["ideal_gas", "tait"]
+SOLVERS = ["wcsph", "dfsph"]
 FORMATS = ["vdb", "ply", "csv", "vtp"]
 FIELD_KINDS = {"float": NUMBER, "vec3": VEC3, "uint": COUNT}
 
@@ -161,7 +164,8 @@ def build():
                 "integrator": {"enum": ["symplectic_euler", "rk4"]},
                 "features": {"type": "array", "items": {"enum": FEATURES}},
                 "viscosity_method": {"enum": VISCOSITY_METHODS},
-                "equation_of_state": {"enum": EQUATIONS_OF_STATE}}),
+                "equation_of_state": {"enum": EQUATIONS_OF_STATE},
+                "solver": {"enum": SOLVERS}}),
             "params": params_object(WORLD_PARAMS),
             "physics": obj({k: params_object(v) for k, v in PHYSICS_PARAMS.items()}),
             "time": obj({"fps": {"type": "number", "minimum": 0.001, "maximum": 100000},

@@ -326,6 +326,20 @@ static class Tests
             AssertEqual(Result.Incomplete, world.Step(0.1f), "max_substeps ran out");
             Throws(Result.ErrorInvalidArgument, () => world.Step(-1));
             Throws(Result.ErrorInvalidArgument, () => world.Step(float.NaN));
+            // What one call may cost (issue 23 item 9): the budget, a cancel, max_substeps' bound.
+            AssertEqual(0.0, world.StepBudget, "no budget by default");
+            world.StepBudget = 0.25;
+            AssertEqual(0.25, world.StepBudget, "budget read back");
+            Throws(Result.ErrorInvalidArgument, () => world.StepBudget = -1);
+            Throws(Result.ErrorInvalidArgument, () => world.StepBudget = double.NaN);
+            world.StepBudget = 0;
+            p.MaxSubsteps = 1000;
+            world.Params = p;
+            world.CancelStep();
+            AssertEqual(Result.Incomplete, world.Step(0.01f), "a cancel before the step stops it");
+            AssertEqual(0u, world.GetStats().Substeps, "no substep after a cancel");
+            p.MaxSubsteps = 1000001;
+            Throws(Result.ErrorInvalidArgument, () => world.Params = p);
         }
     }
 
@@ -472,6 +486,29 @@ static class Tests
         }
     }
 
+    public static void TestDfsphSolverAndItsParams()
+    {
+        using (var context = Cpu())
+        {
+            WorldDef d = WorldDef.Default();
+            d.Capacity = 64;
+            d.Solver = Solver.Dfsph;
+            using (var world = new World(context, d))
+            {
+                AssertEqual(Solver.Dfsph, world.Solver, "World.Solver");
+                DfsphParams p = world.DfsphParams;
+                AssertEqual(100u, p.MaxIterations, "default cap");
+                p.DensityError = 1e-4f;
+                world.DfsphParams = p;
+                AssertEqual(1e-4f, world.DfsphParams.DensityError, "set and read back");
+                p.MaxIterations = 1;
+                Throws(Result.ErrorInvalidArgument, () => world.DfsphParams = p);
+            }
+            d.Integrator = Integrator.Rk4;
+            Throws(Result.ErrorUnsupported, () => new World(context, d));
+        }
+    }
+
     public static void TestPhysicsParamsByKindAndTheirDescriptions()
     {
         AssertEqual("tait", Utf8.FromNative(Library.ParamsInfo(ParamsKind.Tait).Name), "params name");
@@ -485,7 +522,10 @@ static class Tests
         AssertEqual(ParamZero.Default, speed.Zero, "speed of sound: 0 is the default");
         AssertEqual(ParamBound.Exclusive, speed.LowerBound, "speed of sound > 0");
         PhysicsMethodInfo[] methods = Library.PhysicsMethods();
-        AssertEqual(9, methods.Length, "methods");  // through boundary_density and collider_loads
+        AssertEqual(11, methods.Length, "methods");  // through boundary_density and collider_loads
+        AssertEqual("dfsph", Utf8.FromNative(methods[8].Name), "the last method");
+        AssertEqual(MethodSwitch.Solver, methods[8].SwitchBy, "DFSPH is a solver");
+        AssertEqual(ParamsKind.Dfsph, methods[8].ParamsKind, "its params");
         AssertEqual("clavet", Utf8.FromNative(methods[3].Name), "the fourth method");
         AssertEqual(MethodSwitch.Viscosity, methods[3].SwitchBy, "Clavet is a viscosity method");
         AssertEqual(ParamsKind.ClavetViscosity, methods[3].ParamsKind, "its params");
