@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * sph_c.h - the C ABI of the sph fluid-simulation library.
  *

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // SDF assets: grids from the caller, analytic shapes, sub-box updates.
 #include <vector>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // libFuzzer harness: the input is a program of C-API calls with hostile arguments. Each op
 // picks a function and its arguments (fuzzed defs and descs, NaN/Inf/huge floats, wrong struct
 // sizes, stale and foreign handles and ids); after each call the harness checks the contract

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // libFuzzer harness: the input is a checkpoint given to sph_world_load (and to
 // sph_world_restore of a live world). The loader validates the whole checkpoint before it
 // creates anything (sph_c.h): it must return a world or an error with a message, and on error
