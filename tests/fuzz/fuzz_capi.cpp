@@ -207,7 +207,8 @@ class Program {
     if (checkpoint(loaded) != bytes) violation("a loaded world saves other bytes than it was loaded from");
     if (FUZZ_CALL(sph_world_restore(ws.ptr, bytes.data(), bytes.size())) != SPH_OK)
       violation("a world's own checkpoint does not restore: %s", sph_get_last_error());
-    if (checkpoint(ws.ptr) != bytes) violation("a restored world saves other bytes than it was restored from");
+    if (checkpoint(ws.ptr) != bytes)
+      violation("a restored world saves other bytes than it was restored from");
     const float dt = 1.0f / 600.0f;
     const sph_result a = FUZZ_CALL(sph_world_step(ws.ptr, dt));
     const sph_result b = FUZZ_CALL(sph_world_step(loaded, dt));

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '888352c4e6f0480ff7e8ca9a20fff93f7ce801158da0ba523e73e80104b146d8', 'include/sph_cuda.h': '8fe2c1988d9c8456a91fb26b7863765759ab8ad17bd1ff44b457c77af0bc7985', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '6d2e0443c63f45d869e01146dd2d2c77045b512358062557e2e764d0da3c66b4', 'include/sph_cuda.h': '8fe2c1988d9c8456a91fb26b7863765759ab8ad17bd1ff44b457c77af0bc7985', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
