@@ -1,8 +1,11 @@
 // The CPU backend's class, shared by the files of src/cpu/ that implement it (one per stage of a
 // frame, each the twin of a file of cuda/; see docs/architecture.md). Each substep sorts
 // particles into the wrapped grid, then loops the shared per-particle physics (src/physics) over
-// all particles on OpenMP threads. Results do not depend on the thread count: every particle is
-// a pure gather and the only reduction (max speed) is order-independent.
+// all particles on OpenMP threads, the neighbour gathers on SIMD lanes (cpu_simd_passes.h).
+// Results do not depend on the thread count nor on the processor's SIMD target: every particle
+// is a pure gather whose order of sums is fixed, and the only reductions (max speed and
+// acceleration) are order-independent. The loops hand out particles in chunks on demand, so a
+// core that something else keeps busy holds up only the chunk it is working on.
 #pragma once
 
 #include <chrono>
@@ -16,8 +19,10 @@
 #include "../physics/forces.h"
 #include "../physics/integrate.h"
 #include "../physics/springs.h"
+#include "cpu_neighbor_columns.h"
 #include "cpu_neighbor_grid.h"
 #include "cpu_particle_store.h"
+#include "cpu_simd_passes.h"
 
 namespace sph {
 
@@ -47,7 +52,7 @@ class CpuBackend final : public Backend {
 
   void import_particles(const ParticleSnapshot& s) override;
 
-  uint64_t memory_bytes() const override { return store_.bytes() + grid_.bytes(); }
+  uint64_t memory_bytes() const override { return store_.bytes() + grid_.bytes() + columns_.bytes(); }
 
  private:
   static constexpr uint32_t kAllFinite = 0xffffffffu;
@@ -63,16 +68,12 @@ class CpuBackend final : public Backend {
   // Hash, sort, reorder every attribute, then density and pressure (packed into the w slots).
   void sort_and_density(const FluidConstants& fluid, FrameReport& report);
 
-  // Acceleration of particle i: the neighbour gather with the world's force terms compiled in
-  // (forces.h), plus the scene's force fields.
-  template <class Terms>
-  static Vec3 acceleration_with(const FluidConstants& fluid, const GridView& view, const ForceInputs& in,
-                                const SceneFrame& scene, uint32_t i);
-  using AccelerationFn = Vec3 (*)(const FluidConstants&, const GridView&, const ForceInputs&, const SceneFrame&,
-                                  uint32_t);
-  AccelerationFn acceleration_function() const;
-  // The arrays the force gather reads (normals and counts only where a term reads them).
-  ForceInputs force_inputs() const;
+  // The neighbour gather of the world's force terms (with_force_terms) on the SIMD target.
+  using AccelerationFn = SimdPasses::AccelerationFn;
+  AccelerationFn acceleration_function() const { return simd_.acceleration_for(config_.selection()); }
+  // Acceleration of particle i: the neighbour gather plus the scene's force fields.
+  Vec3 acceleration(AccelerationFn gather, const FluidConstants& fluid, const GridView& view,
+                    const NeighborColumns& columns, const SceneFrame& scene, uint32_t i) const;
 
   // Resolves colliders for the state in next_position_/next_velocity_, moved from x_old(i).
   template <class OldPosition>
@@ -108,6 +109,8 @@ class CpuBackend final : public Backend {
   WorldConfig config_;
   unsigned workers_;
   CpuNeighborGrid grid_;
+  const SimdPasses& simd_;      // the processor's SIMD target
+  CpuNeighborColumns columns_;  // the sorted records as columns, for the SIMD passes
   CpuParticleStore store_;
   std::vector<ParticleArraySpec> method_arrays_;  // method_particle_arrays(config_)
   CpuArrayRef<Float4> position_;                  // w: pressure after the density pass

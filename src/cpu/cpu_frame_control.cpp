@@ -41,7 +41,7 @@ void CpuBackend::diagnose_non_finite(const FluidConstants& fluid, const SceneFra
   const Float4* pos = position_.data();
   const Float4* vel = velocity_.data();
   const uint32_t i = first;
-  Vec3 a = acceleration_function()(fluid, grid_.view(), force_inputs(), scene, i);
+  Vec3 a = acceleration(acceleration_function(), fluid, grid_.view(), columns_.view(), scene, i);
   if (spring_acceleration_) a += xyz(spring_acceleration_[i]);
   const ParticleState current{xyz(pos[i]), xyz(vel[i])};
   ParticleState integrated;

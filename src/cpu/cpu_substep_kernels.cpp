@@ -1,9 +1,11 @@
 // The CPU backend's per-particle passes of a substep: hash and sort, density and pressure (with
 // the normalised density and the colour-field normals when on), and the acceleration gather
-// with the world's options compiled in (the twin of cuda/substep_kernels.cu).
+// with the world's options compiled in (the twin of cuda/substep_kernels.cu). The neighbour
+// gathers run on the processor's SIMD target (cpu_simd_passes.h) and read the sorted records as
+// columns, which these passes keep up to date next to the records.
 #include "../physics/density.h"
 #include "../physics/density_normalization.h"
-#include "../physics/surface_tension.h"
+#include "../physics/force_fields.h"
 #include "cpu_backend_impl.h"
 
 namespace sph {
@@ -13,16 +15,18 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, FrameReport& repo
   auto t = Clock::now();
   grid_.build(position_.data(), count_, workers_);
   store_.permute(grid_.order().data(), count_);
+  columns_.fill_state(position_.data(), velocity_.data(), count_, threads());
   report.stage_ms[kStageHashSort] += static_cast<float>(elapsed_ms(t));
 
   t = Clock::now();
   const GridView view = grid_.view();
+  const NeighborColumns columns = columns_.view();
   Float4* pos = position_.data();
   Float4* vel = velocity_.data();
   float* factor = density_factor_.data();
 #pragma omp parallel for num_threads(threads()) schedule(static)
   for (int i = 0; i < n(); ++i) {
-    const DensitySample s = gather_density(fluid, view, pos, static_cast<uint32_t>(i));
+    const DensitySample s = simd_.density(fluid, view, columns, static_cast<uint32_t>(i));
     float rho = s.density;
     if (factor) {
       normalized_[i] = s.density;  // the summation, for the factor after the filter
@@ -33,13 +37,15 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, FrameReport& repo
     // Only the w slots are written; neighbours read x, y, z alone.
     pos[i].w = pressure_from_density(fluid.methods.eos, rho);
     vel[i].w = 1.0f / rho;
+    columns_.set_density(static_cast<uint32_t>(i), pos[i].w, vel[i].w);
+    columns_.set_neighbor_count(static_cast<uint32_t>(i), s.neighbor_count);
   }
   if (factor) {
     // Eq. 31 over every carried rho_j: each particle writes only its own factor and side
     // slot (the first pass is done reading the factors), then the filtered values are published.
 #pragma omp parallel for num_threads(threads()) schedule(static)
     for (int i = 0; i < n(); ++i) {
-      const float filtered = gather_normalized_density(fluid, view, pos, vel, static_cast<uint32_t>(i));
+      const float filtered = simd_.normalized_density(fluid, view, columns, static_cast<uint32_t>(i));
       factor[i] = filtered / normalized_[i];
       normalized_[i] = filtered;
     }
@@ -48,34 +54,28 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, FrameReport& repo
       density_[i] = normalized_[i];
       pos[i].w = pressure_from_density(fluid.methods.eos, normalized_[i]);
       vel[i].w = 1.0f / normalized_[i];
+      columns_.set_density(static_cast<uint32_t>(i), pos[i].w, vel[i].w);
     }
   }
   if (config_.features & kFeatureSurfaceTension) {
     // Colour-field normals of every particle, which the force gather reads for neighbours.
 #pragma omp parallel for num_threads(threads()) schedule(static)
-    for (int i = 0; i < n(); ++i)
-      normals_[i] = gather_colour_normal(fluid, view, pos, vel, static_cast<uint32_t>(i));
+    for (int i = 0; i < n(); ++i) {
+      normals_[i] = simd_.colour_normal(fluid, view, columns, static_cast<uint32_t>(i));
+      columns_.set_normal(static_cast<uint32_t>(i), normals_[i]);
+    }
   }
   report.stage_ms[kStageDensity] += static_cast<float>(elapsed_ms(t));
 }
 
 // Acceleration of particle i: the neighbour gather with the world's force terms compiled in
-// (forces.h), plus the scene's force fields.
-template <class Terms>
-Vec3 CpuBackend::acceleration_with(const FluidConstants& fluid, const GridView& view, const ForceInputs& in,
-                                   const SceneFrame& scene, uint32_t i) {
-  Vec3 a = gather_acceleration<Terms>(fluid, view, in, i);
-  for (const ForceFieldFrame& f : scene.fields) a += force_field_acceleration(f.view, xyz(in.positions[i]));
+// (forces.h, on the SIMD target), plus the scene's force fields.
+Vec3 CpuBackend::acceleration(AccelerationFn gather, const FluidConstants& fluid, const GridView& view,
+                              const NeighborColumns& columns, const SceneFrame& scene, uint32_t i) const {
+  Vec3 a = gather(fluid, view, columns, i);
+  const Vec3 x = xyz(position_[i]);
+  for (const ForceFieldFrame& f : scene.fields) a += force_field_acceleration(f.view, x);
   return a;
-}
-
-CpuBackend::AccelerationFn CpuBackend::acceleration_function() const {
-  return with_force_terms(config_.selection(),
-                          [](auto terms) -> AccelerationFn { return &acceleration_with<decltype(terms)>; });
-}
-
-ForceInputs CpuBackend::force_inputs() const {
-  return ForceInputs{position_.data(), velocity_.data(), neighbors_.data(), normals_.data()};
 }
 
 }  // namespace sph

@@ -41,12 +41,12 @@ uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame
   const Float4* vel = velocity_.data();
   const Float4* spring = spring_acceleration_.data();
   const float dt = time.dt;
-  const AccelerationFn acceleration = acceleration_function();
-  const ForceInputs inputs = force_inputs();
+  const AccelerationFn gather = acceleration_function();
+  const NeighborColumns columns = columns_.view();
   float a2max = 0.0f;
 #pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
   for (int i = 0; i < n(); ++i) {
-    Vec3 a = acceleration(fluid, view, inputs, scene, static_cast<uint32_t>(i));
+    Vec3 a = acceleration(gather, fluid, view, columns, scene, static_cast<uint32_t>(i));
     if (spring) a += xyz(spring[i]);
     a2max = std::max(a2max, length_squared(a));
     const ParticleState s = symplectic_euler({xyz(pos[i]), xyz(vel[i])}, a, dt);
@@ -72,7 +72,7 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
   for (int i = 0; i < n(); ++i)
     rk4_start_[i] = ParticleState{xyz(position_[i]), xyz(velocity_[i])};  // (not a hot loop)
   const float dt = time.dt;
-  const AccelerationFn acceleration = acceleration_function();
+  const AccelerationFn gather = acceleration_function();
   float a2max = 0.0f;
   for (int stage = 0; stage < 4; ++stage) {
     sort_and_density(fluid, report);
@@ -84,12 +84,12 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
     const Float4* pos = position_.data();
     const Float4* vel = velocity_.data();
     const Float4* spring = spring_acceleration_.data();
-    const ForceInputs inputs = force_inputs();
+    const NeighborColumns columns = columns_.view();
     const ParticleState* start = rk4_start_.data();
     Rk4Accumulator* sums = rk4_sum_.data();
 #pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
     for (int i = 0; i < n(); ++i) {
-      Vec3 a = acceleration(fluid, view, inputs, scene, static_cast<uint32_t>(i));
+      Vec3 a = acceleration(gather, fluid, view, columns, scene, static_cast<uint32_t>(i));
       if (spring) a += xyz(spring[i]);
       a2max = std::max(a2max, length_squared(a));
       const ParticleState s = rk4_advance(stage, start[i], {xyz(pos[i]), xyz(vel[i])}, a, dt, sums[i]);

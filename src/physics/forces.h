@@ -5,11 +5,14 @@
 // away. Inputs are the packed records written by the density pass: position.w = p_j and
 // velocity.w = 1 / rho_j, so a neighbour costs two 16-byte loads and no division.
 //
-// The pair terms (AccelerationGather::add) and the final combination (finish) are separate so
-// that a backend may walk neighbours its own way (the CUDA backend tests a whole run of
-// candidates before evaluating pair terms) and still use this arithmetic. Each term keeps its
-// own sums and adds into the acceleration in list order, so the floating-point operations are
-// those of one hand-written loop in that order.
+// The pair terms (AccelerationGather::add, TermList::add) and the final combination
+// (finish_acceleration) are separate so that a backend may walk neighbours its own way (the
+// CUDA backend tests a whole run of candidates before evaluating pair terms; the CPU backend
+// evaluates them on 16 SIMD lanes at once, src/cpu/cpu_simd_gathers.h) and still use this
+// arithmetic. The pair terms are templates on the value type (float, or a pack of lanes: see
+// force_pair.h); finish is scalar. Each term keeps its own sums and adds into the acceleration
+// in list order, so the floating-point operations of AccelerationGather are those of one
+// hand-written loop in that order.
 #pragma once
 
 #include <stdint.h>
