@@ -24,6 +24,7 @@ CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBacken
   options_.normalized_density = (config.features & kFeatureNormalizedDensity) != 0;
   options_.viscosity = config.viscosity_method;
   options_.springs = (config.features & kFeatureSprings) != 0;
+  options_.boundary_density = (config.features & kFeatureBoundaryDensity) != 0;
   // The methods' arrays (particle_arrays.h), and this backend's working arrays for springs.
   std::vector<ParticleArraySpec> arrays = method_particle_arrays(config);
   if (options_.springs)
@@ -119,6 +120,31 @@ void CudaBackend::truncate(uint32_t count) {
   });
   count_ = count;
   ++epoch_;
+}
+
+void CudaBackend::save_step_inputs() {
+  require_alive();
+  DeviceGuard guard(device_);
+  guarded([&] { copy_step_inputs(/*save=*/true); });
+}
+
+void CudaBackend::restore_step_inputs() {
+  require_alive();
+  DeviceGuard guard(device_);
+  guarded([&] {
+    copy_step_inputs(/*save=*/false);
+    cuda_check(cudaStreamSynchronize(r_->stream), "restore of the step inputs");
+  });
+}
+
+void CudaBackend::copy_step_inputs(bool save) {
+  FrameState* s = r_->state.get();
+  float* const carried[2] = {&s->max_speed, &s->max_acceleration};
+  float* const saved[2] = {&s->emission_saved_max_speed, &s->emission_saved_max_acceleration};
+  for (int k = 0; k < 2; ++k)
+    cuda_check(cudaMemcpyAsync(save ? saved[k] : carried[k], save ? carried[k] : saved[k], sizeof(float),
+                               cudaMemcpyDeviceToDevice, r_->stream),
+               "copy of the step inputs");
 }
 
 void CudaBackend::copy_attribute(AttributeKind kind, uint32_t first, uint32_t count, void* dst,
@@ -230,7 +256,7 @@ void CudaBackend::import_particles(const ParticleSnapshot& s) {
 
 uint64_t CudaBackend::memory_bytes() const {
   return r_->store->bytes() + r_->grid->bytes() + r_->statistics->bytes() + r_->state.bytes() +
-         r_->sdf_cache.bytes() + r_->scene_buffer.bytes() + r_->sinks.bytes();
+         r_->sdf_cache.bytes() + r_->scene_buffer.bytes() + r_->sinks.bytes() + r_->boundary_maps.bytes();
 }
 
 DeviceAttributeView CudaBackend::device_attribute(AttributeKind kind) const {

@@ -13,6 +13,7 @@
 #include "cuda_backend.h"
 #include "cuda_status.h"
 #include "device_array.h"
+#include "device_boundary_maps.h"
 #include "device_neighbor_grid.h"
 #include "device_particle_store.h"
 #include "device_scene.h"
@@ -39,6 +40,7 @@ struct DeviceResources {
   FrameGraph graph;
   PipelineSetup graph_setup;
   DeviceSdfCache sdf_cache;
+  DeviceBoundaryMaps boundary_maps;
   DeviceSceneBuffer scene_buffer;
   DeviceSinkCompactor sinks;
 
@@ -68,6 +70,11 @@ class CudaBackend final : public Backend {
 
   // Drops particles [count, particle_count()) (an emission undone after a failed step).
   void truncate(uint32_t count) override;
+
+  // Device-to-device copies of the carried max speed and max acceleration on the stream (no
+  // wait for the host when saving).
+  void save_step_inputs() override;
+  void restore_step_inputs() override;
 
   FrameReport step_scene_frame(double frame_dt, const RuntimeParams& params,
                                const SceneFrame& scene_in) override;
@@ -105,6 +112,7 @@ class CudaBackend final : public Backend {
   // Restores the particles (and the cached max speed) from the snapshot taken at the start of
   // the frame; count_ is still the count before the frame.
   void roll_back_frame();
+  void copy_step_inputs(bool save);
 
   void require_alive() const {
     if (lost_)

@@ -49,6 +49,7 @@ DeviceParticleStore::DeviceParticleStore(uint32_t capacity,
   arrays_.spring_candidates = static_cast<uint32_t*>(find(kArraySpringCandidates));
   arrays_.spring_acceleration = static_cast<Float4*>(find(kArraySpringAcceleration));
   arrays_.link_from = static_cast<uint32_t*>(find(kArraySpringLinkFrom));
+  arrays_.boundary_gradient = static_cast<Float4*>(find(kArrayBoundaryGradient));
   for (int side = 0; side < 2; ++side) {
     arrays_.rk4_start[side] = static_cast<ParticleState*>(find(kArrayRk4Start, side));
     arrays_.rk4_sum[side] = static_cast<Rk4Accumulator*>(find(kArrayRk4Sum, side));

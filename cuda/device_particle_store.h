@@ -56,6 +56,8 @@ struct ParticleArrays {
   uint32_t* spring_candidates;  // kSpringSlots per particle: linking pass 1
   Float4* spring_acceleration;  // the spring pass's acceleration, which the force pass adds
   uint32_t* link_from;          // one word: the lowest id waiting for springs, or kNoPendingLinks
+  // Null unless SPH_FEATURE_BOUNDARY_DENSITY: (grad rho_b, v_b . grad rho_b) of the density pass.
+  Float4* boundary_gradient;
 };
 
 // A method's array on the device: its elements (two sides for a Sorted array) and, for a

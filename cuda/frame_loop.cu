@@ -18,6 +18,7 @@ bool same_setup(const PipelineSetup& a, const PipelineSetup& b) {
          a.options.surface_tension == b.options.surface_tension &&
          a.options.normalized_density == b.options.normalized_density &&
          a.options.viscosity == b.options.viscosity && a.options.springs == b.options.springs &&
+         a.options.boundary_density == b.options.boundary_density &&
          std::memcmp(&a.options.methods, &b.options.methods, sizeof a.options.methods) == 0 &&
          std::memcmp(&a.springs, &b.springs, sizeof a.springs) == 0 &&
          a.scene.colliders == b.scene.colliders && a.scene.fields == b.scene.fields &&
@@ -56,6 +57,14 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
         r_->sdf_cache.begin_frame();
         bind_scene_views(scene, [&](const SdfAsset& a) { return r_->sdf_cache.bind(a, r_->stream); });
         r_->sdf_cache.end_frame();
+        if (options_.boundary_density) {
+          r_->boundary_maps.begin_frame();
+          for (ColliderFrame& c : scene.colliders)
+            c.view.boundary_map = r_->boundary_maps.bind(
+                *c.sdf, c.view.sdf, config_.kernel_radius,
+                BoundaryDensity::map_level(setup.fluid.methods.boundary, c.view.sign), r_->stream);
+          r_->boundary_maps.end_frame();
+        }
         setup.scene = r_->scene_buffer.upload(scene, config_.kernel_radius, r_->stream);
         if (with_sinks) r_->sinks.reserve(config_.capacity, *r_->store);
         cuda_check(cudaStreamSynchronize(r_->stream), "upload of the scene");

@@ -40,9 +40,11 @@ struct FrameState {
   uint32_t bad_id;         // id of the first non-finite particle
   uint32_t bad_substep;
   float bad_dt;
-  uint32_t bad_stage;            // NonFiniteStage of that particle
-  uint32_t bad_count;            // non-finite particles of the RK4 stage (or Euler step) that failed
-  float saved_max_acceleration;  // max_acceleration at the start of the frame, for a rollback
+  uint32_t bad_stage;                     // NonFiniteStage of that particle
+  uint32_t bad_count;                     // non-finite particles of the RK4 stage (or Euler step) that failed
+  float saved_max_acceleration;           // max_acceleration at the start of the frame, for a rollback
+  float emission_saved_max_speed;         // max_speed before a step's emission (save_step_inputs)
+  float emission_saved_max_acceleration;  // likewise max_acceleration
   // Per RK4 stage (symplectic Euler uses [0]): ((sorted index << 2 | NonFiniteStage) << 32 | id),
   // the minimum wins, which is the particle the CPU backend names (indices < 2^30 = capacity).
   unsigned long long bad_key[kRk4Stages];

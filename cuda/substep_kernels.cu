@@ -1,3 +1,4 @@
+#include "../src/physics/boundary_density.h"
 #include "../src/physics/density.h"
 #include "../src/physics/density_normalization.h"
 #include "../src/physics/forces.h"
@@ -92,16 +93,24 @@ __global__ void reorder_kernel(ParticleArrays a, const uint32_t* __restrict__ or
   }
 }
 
-template <bool kCounts, bool kNormalized>
+template <bool kCounts, bool kNormalized, bool kBoundary>
 __global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
-                               FrameState* state) {
+                               DeviceScene scene, float stage_fraction, FrameState* state) {
   mark_stage(state, kStageDensity);
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
   // The reorder left this particle's old index in w; read it before w becomes the pressure.
   // Other threads read only x, y, z of this record.
   const uint32_t k = __float_as_uint(a.sorted_position[i].w);
-  const DensitySample s = gather_density(fluid, grid, a.sorted_position, i);
+  DensitySample s = gather_density(fluid, grid, a.sorted_position, i);
+  if (kBoundary) {
+    // The walls' share is part of the summation (and so of a normalised density's kernel sum).
+    const StageTime at = stage_time(state->clock.time, stage_fraction);
+    const BoundaryShare b = boundary_share(fluid.methods.boundary, scene.colliders, scene.collider_count,
+                                           xyz(a.sorted_position[i]), at.s, at.tau);
+    s.density += b.density;
+    a.boundary_gradient[i] = pack_boundary(b);
+  }
   float rho = s.density;
   if (kNormalized) {
     // The carried factor, in the old order (nothing writes the factors in this kernel); the
@@ -158,6 +167,7 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
     const Float4 v = a.sorted_velocity[i];
     if (kScene) acc = add_force_fields(scene, acc, xyz(p));
     if (a.spring_acceleration) acc += xyz(a.spring_acceleration[i]);  // springs (device_springs.h)
+    if (a.boundary_gradient) acc += boundary_pressure_acceleration(a.boundary_gradient[i], p.w, v.w);
     a2 = length_squared(acc);
     ParticleState next = symplectic_euler(ParticleState{xyz(p), xyz(v)}, acc, f.dt);
     const ParticleState integrated = next;
@@ -195,6 +205,7 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
     const Float4 v = a.sorted_velocity[i];
     if (kScene) acc = add_force_fields(scene, acc, xyz(p));
     if (a.spring_acceleration) acc += xyz(a.spring_acceleration[i]);  // springs (device_springs.h)
+    if (a.boundary_gradient) acc += boundary_pressure_acceleration(a.boundary_gradient[i], p.w, v.w);
     a2 = length_squared(acc);
     Rk4Accumulator sum;
     if (stage > 0) sum = sums[i];  // stage 0 starts the sums
@@ -225,6 +236,19 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
 // does not use a method runs code without it. A frame without colliders and force fields runs
 // kernels without the scene code.
 
+// One launch of the density kernel with its options as template arguments.
+template <bool kCounts, bool kNormalized>
+void launch_density(bool boundary, unsigned blocks, unsigned threads, const FluidConstants& fluid,
+                    const GridView& grid, const ParticleArrays& a, uint32_t n, const DeviceScene& scene,
+                    float stage_fraction, FrameState* state, cudaStream_t stream) {
+  if (boundary)
+    density_kernel<kCounts, kNormalized, true>
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, stage_fraction, state);
+  else
+    density_kernel<kCounts, kNormalized, false>
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, stage_fraction, state);
+}
+
 }  // namespace
 
 void enqueue_reorder(const ParticleArrays& a, const uint32_t* order, uint32_t n, Rk4Carry carry, int from,
@@ -246,18 +270,23 @@ void enqueue_reorder(const ParticleArrays& a, const uint32_t* order, uint32_t n,
 }
 
 void enqueue_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a, uint32_t n,
-                     const SubstepOptions& options, const KernelTuning& tuning, FrameState* state,
-                     cudaStream_t stream) {
+                     const SubstepOptions& options, const KernelTuning& tuning, const DeviceScene& scene,
+                     float stage_fraction, FrameState* state, cudaStream_t stream) {
   const unsigned threads = tuning.density_block, blocks = blocks_for(n, threads);
   const bool counts = options.viscosity == ViscosityMethod::Clavet;
+  const bool boundary = options.boundary_density;
   if (counts && options.normalized_density)
-    density_kernel<true, true><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, state);
+    launch_density<true, true>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction, state,
+                               stream);
   else if (counts)
-    density_kernel<true, false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, state);
+    launch_density<true, false>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction, state,
+                                stream);
   else if (options.normalized_density)
-    density_kernel<false, true><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, state);
+    launch_density<false, true>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction, state,
+                                stream);
   else
-    density_kernel<false, false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, state);
+    launch_density<false, false>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction, state,
+                                 stream);
   check_launch("density_kernel");
   if (options.normalized_density) {
     normalized_density_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n);

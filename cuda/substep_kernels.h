@@ -50,15 +50,18 @@ struct SubstepOptions {
   bool surface_tension = false;
   bool normalized_density = false;
   ViscosityMethod viscosity = ViscosityMethod::Mueller;
-  bool springs = false;  // a.spring_acceleration adds to the force pass
+  bool springs = false;           // a.spring_acceleration adds to the force pass
+  bool boundary_density = false;  // the colliders' share joins the density; the walls' pressure the forces
 };
 
 // density[i], sorted_position[i].w = pressure, sorted_velocity[i] = (velocity[order[i]], 1/rho);
 // with the options, the neighbour counts, the normalised density (eq. 31, published into the
-// same three places) and the colour-field normals, in the CPU backend's order.
+// same three places) and the colour-field normals, in the CPU backend's order. With
+// options.boundary_density the scene's colliders add their share (posed at the substep's time
+// at `stage_fraction` of it, boundary_density.h's stage_time) and a.boundary_gradient is written.
 void enqueue_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a, uint32_t n,
-                     const SubstepOptions& options, const KernelTuning& tuning, FrameState* state,
-                     cudaStream_t stream);
+                     const SubstepOptions& options, const KernelTuning& tuning, const DeviceScene& scene,
+                     float stage_fraction, FrameState* state, cudaStream_t stream);
 
 // Symplectic Euler from the sorted copy into the state, with the max-speed and
 // max-acceleration reductions and the non-finite check.

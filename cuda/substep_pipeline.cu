@@ -22,7 +22,8 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
     const Rk4Carry carry = !rk4 ? Rk4Carry::None : (stage == 0 ? Rk4Carry::BuildStart : Rk4Carry::Gather);
     enqueue_reorder(a, b.grid->order(), n, carry, stage & 1, b.state, stream);
     if (setup.options.springs) enqueue_spring_reorder(a, b.grid->order(), n, stream);
-    enqueue_density(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, b.state, stream);
+    enqueue_density(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene,
+                    rk4 ? rk4_stage_fraction(stage) : 0.0f, b.state, stream);
     if (setup.options.springs)
       enqueue_spring_pass(setup.springs, b.grid->view(), a, n, stage == 0, b.state, stream);
     if (rk4)

@@ -175,6 +175,17 @@ typedef uint32_t sph_feature_flags;
  *  the spawn shape), with rest lengths that yield and creep; sph_spring_params. Costs 128 bytes
  *  per particle (host) or 256 (device) and a spring pass per force evaluation. */
 #define SPH_FEATURE_SPRINGS 0x4u
+/** Walls in the density: every collider's solid counts in the particles' density sums (a
+ *  density map per SDF asset, Koschier & Bender 2017, calibrated on the particle lattice), and
+ *  the wall pushes back through the pressure force, so particles at a wall no longer read low
+ *  density: a resting FCC block from sph_world_fill_box reads rho0 at axis-aligned walls
+ *  (77 % without), a settled tank's pressure near its walls is within 19-26 % of rho0 g d at the
+ *  default stiffness (40-72 % low without). Edges and corners read high when a lattice is placed
+ *  into them (docs/physics.md). The maps are computed per asset and kernel radius when a collider
+ *  first steps with the asset and after sph_sdf_update (16 bytes per SDF voxel; on the device for
+ *  CUDA). The collision response stays the no-penetration safeguard. Costs one SDF sample per
+ *  particle and collider in each density pass. */
+#define SPH_FEATURE_BOUNDARY_DENSITY 0x8u
 
 typedef enum sph_viscosity_method {
   SPH_VISCOSITY_MUELLER = 0, /* Laplacian viscosity (eq. 17), coefficient sph_world_params.viscosity */
@@ -258,7 +269,10 @@ static inline sph_result sph_context_def_init(sph_context_def* def) {
  * OUT_OF_HOST_MEMORY. *out is written only on success. Thread-safe.
  */
 SPH_API sph_result SPH_CALL sph_context_create(const sph_context_def* def, sph_context** out);
-/** Destroys a context. NULL is a no-op. BUSY while worlds created on it are alive. */
+/**
+ * Destroys a context. NULL is a no-op. BUSY while worlds or SDF assets created on it are alive,
+ * or while another thread is creating one on it.
+ */
 SPH_API sph_result SPH_CALL sph_context_destroy(sph_context* context);
 /** The backend the context resolved to (CPU or CUDA; never AUTO). */
 SPH_API sph_result SPH_CALL sph_context_get_backend(const sph_context* context, sph_backend* out_backend);
@@ -300,7 +314,12 @@ static inline sph_result sph_world_def_init(sph_world_def* def) {
  * OUT_OF_DEVICE_MEMORY. *out is written only on success.
  */
 SPH_API sph_result SPH_CALL sph_world_create(sph_context* context, const sph_world_def* def, sph_world** out);
-/** Destroys a world and everything in it. NULL is a no-op. */
+/**
+ * Destroys a world and everything in it. NULL is a no-op. It takes the world like every call
+ * that takes a world: WORLD_LOCKED while another thread's call is inside it (destroy again
+ * once that call returned); a call that races a destroy that won gets INVALID_HANDLE. Memory a
+ * call is using is never freed.
+ */
 SPH_API sph_result SPH_CALL sph_world_destroy(sph_world* world);
 /** The def the world was created with, with defaults resolved (zeros and kernel_radius filled in). */
 SPH_API sph_result SPH_CALL sph_world_get_def(const sph_world* world, sph_world_def* out_def);
@@ -568,7 +587,9 @@ static inline sph_result sph_spawn_desc_init(sph_spawn_desc* desc) {
 
 /**
  * Adds particles from caller arrays (copied before return). All-or-nothing: on any error
- * (non-finite value, count above the free capacity: SPH_ERROR_CAPACITY) nothing is added.
+ * (non-finite value, a speed of 1.8e19 m/s or more, whose square float32 cannot hold; strides
+ * whose span overflows 64 bits; count above the free capacity: SPH_ERROR_CAPACITY) nothing is
+ * added.
  * out_first_id (optional) receives the id of the first new particle; ids are consecutive.
  */
 SPH_API sph_result SPH_CALL sph_world_spawn(sph_world* world, const sph_spawn_desc* desc,
@@ -640,8 +661,9 @@ SPH_API sph_result SPH_CALL sph_world_get_particle_count(const sph_world* world,
  * size of the buffer at dst in bytes. count is clamped to the particles available;
  * out_written (optional) receives how many were written. Blocks until the data is ready.
  * Errors: INVALID_ARGUMENT (NULL dst, stride smaller than the element, first > particle
- * count), BUFFER_TOO_SMALL (dst_size cannot hold count elements), UNSUPPORTED (unknown
- * attribute). Nothing is written on error.
+ * count, a span (n - 1) * dst_stride + element that overflows 64 bits or exceeds PTRDIFF_MAX),
+ * BUFFER_TOO_SMALL (dst_size cannot hold count elements), UNSUPPORTED (unknown attribute).
+ * Nothing is written on error.
  */
 SPH_API sph_result SPH_CALL sph_world_copy_attribute(const sph_world* world, sph_attribute attribute,
                                                      void* dst, uint64_t dst_size, uint64_t dst_stride,
@@ -796,7 +818,10 @@ SPH_API sph_result SPH_CALL sph_sdf_update(sph_sdf* sdf, sph_sdf_channel channel
 SPH_API sph_result SPH_CALL sph_sdf_get_dims(const sph_sdf* sdf, uint32_t out_dims[3]);
 /** Samples the signed distance at a point of the asset's local frame (for tools and tests). */
 SPH_API sph_result SPH_CALL sph_sdf_sample(const sph_sdf* sdf, sph_vec3 local_point, float* out_distance);
-/** Releases the caller's reference; colliders and the like keep the asset alive. NULL: no-op. */
+/**
+ * Releases the caller's reference; colliders and the like keep the asset alive, and so do calls
+ * on the handle that other threads are in. NULL: no-op.
+ */
 SPH_API sph_result SPH_CALL sph_sdf_destroy(sph_sdf* sdf);
 
 /* ---- placement --------------------------------------------------------------------------- */
@@ -1084,6 +1109,8 @@ SPH_API sph_result SPH_CALL sph_world_save(const sph_world* world, void* buffer,
  * (path + ".tmp-" + a unique suffix), is flushed to the disk (fsync), and is then renamed to
  * `path`, replacing any file there. A crash leaves either the old file or the new one, never
  * a partial one; on any error the temporary file is removed and a file at `path` is untouched.
+ * Each save first removes the temporary files of killed saves to `path` on this host (those
+ * whose process is gone; docs/checkpoint.md).
  * path is UTF-8 (a narrow path on POSIX). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL or
  * empty path; the file cannot be created, written or renamed: the message says why),
  * WORLD_LOCKED, OUT_OF_HOST_MEMORY, DEVICE.
@@ -1100,7 +1127,11 @@ SPH_API sph_result SPH_CALL sph_world_save_file(const sph_world* world, const ch
  */
 SPH_API sph_result SPH_CALL sph_world_load(sph_context* context, const void* data, uint64_t size,
                                            sph_world** out);
-/** sph_world_load from a file. INVALID_ARGUMENT also when the file cannot be opened or read. */
+/**
+ * sph_world_load from a file. INVALID_ARGUMENT also when the file cannot be opened or read, is
+ * not a regular file (a FIFO, a device such as /dev/zero, a directory: refused without reading)
+ * or is larger than 256 GiB.
+ */
 SPH_API sph_result SPH_CALL sph_world_load_file(sph_context* context, const char* path, sph_world** out);
 /**
  * Replaces a world's whole state with a checkpoint's (undo, retry): afterwards the world is as

@@ -17,7 +17,9 @@ Parameter rules for the typed extern:
     T* named out_* (struct, no struct_size) -> out T
     T* / const T* (struct)              -> ref T
     T* named out_* (number or enum)     -> out T
-    const T* / T[N] (number)            -> T[]
+    T[N] (number)                       -> ref FixedTN      (exactly N elements: a shorter T[] would
+                                                             let the library read past its end)
+    const T* (number)                   -> T[]
     T* (number)                         -> ref T
     void** named out_*                  -> out IntPtr
     void*, const char*, anything else   -> IntPtr / byte[] (NUL-terminated UTF-8)
@@ -126,6 +128,8 @@ class Gen:
             return f"{self.callback_names[ty['name']]} {name}"
         if k == "array":
             elem = self.resolve(ty["of"])
+            if elem["kind"] in ("builtin", "enum") and ty.get("length"):
+                return f"ref {self.value_type(ty)} {name}"
             if elem["kind"] in ("builtin", "enum", "struct"):
                 attr = "[In] " if elem.get("const") else "[In, Out] "
                 return f"{attr}{self.value_type(elem)}[] {name}"
@@ -210,13 +214,14 @@ class Gen:
         structs = []
         for s in api["structs"]:
             structs += self.struct(s)
+        handles = []
+        for o in api["opaque_types"]:
+            handles += self.handle(o)
+        native = self.native()  # before the arrays: parameters may name fixed arrays too
         arrays = []
         for (elem, length), name in self.arrays.items():
             arrays += self.fixed_array(name, elem, length)
-        out += arrays + structs
-        for o in api["opaque_types"]:
-            out += self.handle(o)
-        out += self.native()
+        out += arrays + structs + handles + native
         out += self.layout()
         out.append("}")
         return "\n".join(out) + "\n"

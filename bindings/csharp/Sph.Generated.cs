@@ -45,6 +45,19 @@ namespace Sph
         /// </summary>
         public const uint SPH_FEATURE_SPRINGS = 4u;
         /// <summary>
+        /// Walls in the density: every collider's solid counts in the particles' density sums (a
+        /// density map per SDF asset, Koschier &amp; Bender 2017, calibrated on the particle lattice),
+        /// and the wall pushes back through the pressure force, so particles at a wall no longer read
+        /// low density: a resting FCC block from sph_world_fill_box reads rho0 at axis-aligned walls
+        /// (77 % without), a settled tank's pressure near its walls is within 19-26 % of rho0 g d at
+        /// the default stiffness (40-72 % low without). Edges and corners read high when a lattice is
+        /// placed into them (docs/physics.md). The maps are computed per asset and kernel radius when a
+        /// collider first steps with the asset and after sph_sdf_update (16 bytes per SDF voxel; on the
+        /// device for CUDA). The collision response stays the no-penetration safeguard. Costs one SDF
+        /// sample per particle and collider in each density pass.
+        /// </summary>
+        public const uint SPH_FEATURE_BOUNDARY_DENSITY = 8u;
+        /// <summary>
         /// Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt &lt;= step_factor h /
         /// c, c the EOS's speed of sound
         /// </summary>
@@ -1708,7 +1721,10 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_context_create")]
         public static extern Result sph_context_create(IntPtr def, IntPtr @out);
 
-        /// <summary>Destroys a context. NULL is a no-op. BUSY while worlds created on it are alive.</summary>
+        /// <summary>
+        /// Destroys a context. NULL is a no-op. BUSY while worlds or SDF assets created on it are
+        /// alive, or while another thread is creating one on it.
+        /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_context_destroy(IntPtr context);
 
@@ -1737,7 +1753,12 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_create")]
         public static extern Result sph_world_create(IntPtr context, IntPtr def, IntPtr @out);
 
-        /// <summary>Destroys a world and everything in it. NULL is a no-op.</summary>
+        /// <summary>
+        /// Destroys a world and everything in it. NULL is a no-op. It takes the world like every call
+        /// that takes a world: WORLD_LOCKED while another thread's call is inside it (destroy again
+        /// once that call returned); a call that races a destroy that won gets INVALID_HANDLE. Memory a
+        /// call is using is never freed.
+        /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_destroy(IntPtr world);
 
@@ -1921,7 +1942,8 @@ namespace Sph
 
         /// <summary>
         /// Adds particles from caller arrays (copied before return). All-or-nothing: on any error (non-
-        /// finite value, count above the free capacity: SPH_ERROR_CAPACITY) nothing is added.
+        /// finite value, a speed of 1.8e19 m/s or more, whose square float32 cannot hold; strides whose
+        /// span overflows 64 bits; count above the free capacity: SPH_ERROR_CAPACITY) nothing is added.
         /// out_first_id (optional) receives the id of the first new particle; ids are consecutive.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
@@ -1983,8 +2005,9 @@ namespace Sph
         /// element's size: 12 bytes for vectors, 4 for scalars); dst_size is the size of the buffer at
         /// dst in bytes. count is clamped to the particles available; out_written (optional) receives
         /// how many were written. Blocks until the data is ready. Errors: INVALID_ARGUMENT (NULL dst,
-        /// stride smaller than the element, first &gt; particle count), BUFFER_TOO_SMALL (dst_size
-        /// cannot hold count elements), UNSUPPORTED (unknown attribute). Nothing is written on error.
+        /// stride smaller than the element, first &gt; particle count, a span (n - 1) * dst_stride +
+        /// element that overflows 64 bits or exceeds PTRDIFF_MAX), BUFFER_TOO_SMALL (dst_size cannot
+        /// hold count elements), UNSUPPORTED (unknown attribute). Nothing is written on error.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_copy_attribute(WorldHandle world, SphAttribute attribute, IntPtr dst, ulong dstSize, ulong dstStride, uint first, uint count, out uint outWritten);
@@ -2051,13 +2074,13 @@ namespace Sph
         /// outside the grid, NULL or non-finite data), UNSUPPORTED (unknown channel or memory).
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
-        public static extern Result sph_sdf_update(SdfHandle sdf, SdfChannel channel, [In] uint[] origin, [In] uint[] size, [In] float[] data, MemoryKind memory);
+        public static extern Result sph_sdf_update(SdfHandle sdf, SdfChannel channel, ref FixedUint3 origin, ref FixedUint3 size, [In] float[] data, MemoryKind memory);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_sdf_update")]
         public static extern Result sph_sdf_update(IntPtr sdf, SdfChannel channel, IntPtr origin, IntPtr size, IntPtr data, MemoryKind memory);
 
         /// <summary>Grid dimensions of an asset.</summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
-        public static extern Result sph_sdf_get_dims(SdfHandle sdf, [In, Out] uint[] outDims);
+        public static extern Result sph_sdf_get_dims(SdfHandle sdf, ref FixedUint3 outDims);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_sdf_get_dims")]
         public static extern Result sph_sdf_get_dims(IntPtr sdf, IntPtr outDims);
 
@@ -2067,7 +2090,10 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_sdf_sample")]
         public static extern Result sph_sdf_sample(IntPtr sdf, Vec3 localPoint, IntPtr outDistance);
 
-        /// <summary>Releases the caller's reference; colliders and the like keep the asset alive. NULL: no-op.</summary>
+        /// <summary>
+        /// Releases the caller's reference; colliders and the like keep the asset alive, and so do
+        /// calls on the handle that other threads are in. NULL: no-op.
+        /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_sdf_destroy(IntPtr sdf);
 
@@ -2252,9 +2278,10 @@ namespace Sph
         /// (path + ".tmp-" + a unique suffix), is flushed to the disk (fsync), and is then renamed to
         /// `path`, replacing any file there. A crash leaves either the old file or the new one, never a
         /// partial one; on any error the temporary file is removed and a file at `path` is untouched.
-        /// path is UTF-8 (a narrow path on POSIX). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL or
-        /// empty path; the file cannot be created, written or renamed: the message says why),
-        /// WORLD_LOCKED, OUT_OF_HOST_MEMORY, DEVICE.
+        /// Each save first removes the temporary files of killed saves to `path` on this host (those
+        /// whose process is gone; docs/checkpoint.md). path is UTF-8 (a narrow path on POSIX). Errors:
+        /// INVALID_HANDLE, INVALID_ARGUMENT (NULL or empty path; the file cannot be created, written or
+        /// renamed: the message says why), WORLD_LOCKED, OUT_OF_HOST_MEMORY, DEVICE.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_save_file(WorldHandle world, byte[] path);
@@ -2275,7 +2302,11 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_load")]
         public static extern Result sph_world_load(IntPtr context, IntPtr data, ulong size, IntPtr @out);
 
-        /// <summary>sph_world_load from a file. INVALID_ARGUMENT also when the file cannot be opened or read.</summary>
+        /// <summary>
+        /// sph_world_load from a file. INVALID_ARGUMENT also when the file cannot be opened or read, is
+        /// not a regular file (a FIFO, a device such as /dev/zero, a directory: refused without
+        /// reading) or is larger than 256 GiB.
+        /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_load_file(ContextHandle context, byte[] path, out WorldHandle @out);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_load_file")]

@@ -227,6 +227,9 @@ namespace Sph
         /// <summary>Elasticity and plasticity: springs between neighbours made at each particle's
         /// first substep (Clavet et al. 2005), parameters in <see cref="World.SpringParams"/>.</summary>
         Springs = Constants.SPH_FEATURE_SPRINGS,
+        /// <summary>Walls in the density: colliders count in the density sums and push back through
+        /// the pressure force (a density map per SDF asset; docs/physics.md).</summary>
+        BoundaryDensity = Constants.SPH_FEATURE_BOUNDARY_DENSITY,
     }
 
     /// <summary>Step-size limits beyond eq. 32 (SPH_STEP_LIMIT_*): set them with
@@ -1063,9 +1066,9 @@ namespace Sph
         {
             get
             {
-                var dims = new uint[3];
-                SphException.Check(Native.sph_sdf_get_dims(Handle, dims), "sph_sdf_get_dims");
-                return dims;
+                var dims = new FixedUint3();
+                SphException.Check(Native.sph_sdf_get_dims(Handle, ref dims), "sph_sdf_get_dims");
+                return dims.ToArray();
             }
         }
 
@@ -1081,7 +1084,27 @@ namespace Sph
         /// floats per voxel for velocity). Updating a channel the asset lacks creates it.</summary>
         public void Update(SdfChannel channel, uint[] origin, uint[] size, float[] data)
         {
-            SphException.Check(Native.sph_sdf_update(Handle, channel, origin, size, data, MemoryKind.Host), "sph_sdf_update");
+            // The library reads size[0] * size[1] * size[2] * components floats from data, and
+            // three indices from origin and size: arrays of other lengths never reach it.
+            if (origin == null || origin.Length != 3) throw new ArgumentException("origin: 3 grid indices (i, j, k)");
+            if (size == null || size.Length != 3) throw new ArgumentException("size: 3 sample counts (i, j, k)");
+            if (data == null) throw new ArgumentNullException("data");
+            ulong components = channel == SdfChannel.Velocity ? 3UL : 1UL;
+            ulong floats;
+            try
+            {
+                floats = checked((ulong)size[0] * size[1] * size[2] * components);
+            }
+            catch (OverflowException)
+            {
+                throw new ArgumentException("size: the box holds more than 2^64 floats");
+            }
+            if (floats == 0 || (ulong)data.LongLength != floats)
+                throw new ArgumentException("data: " + data.LongLength + " floats for a box of " + size[0] + " x " + size[1] + " x " +
+                                            size[2] + " samples of " + components + " (" + floats + " floats)");
+            var o = FixedUint3.From(origin);
+            var s = FixedUint3.From(size);
+            SphException.Check(Native.sph_sdf_update(Handle, channel, ref o, ref s, data, MemoryKind.Host), "sph_sdf_update");
         }
 
         public bool IsDisposed { get; private set; }

@@ -98,18 +98,12 @@ SPH_API sph_result SPH_CALL sph_context_destroy(sph_context* context) {
     return SPH_OK;
   }
   return sph::guarded("sph_context_destroy", nullptr, [&] {
-    if (!sph::is_live_handle(context, sph::HandleKind::Context))
+    // What still uses the context is checked in the critical section that retires it.
+    std::string why;
+    const sph::Take take = sph::try_retire_context(context, &why);
+    if (take == sph::Take::NotLive)
       throw Error(Status::InvalidHandle, "context: is not a live sph_context (destroyed or foreign pointer)");
-    const uint32_t worlds = context->world_count.load();
-    if (worlds != 0)
-      throw Error(Status::Busy, "context: " + std::to_string(worlds) +
-                                    " world(s) created on it are still alive; destroy them first");
-    const uint32_t sdfs = context->sdf_count.load();
-    if (sdfs != 0)
-      throw Error(Status::Busy, "context: " + std::to_string(sdfs) +
-                                    " SDF asset(s) created on it are still alive; "
-                                    "destroy them first");
-    sph::unregister_handle(context);
+    if (take == sph::Take::Busy) throw Error(Status::Busy, "context: " + why);
     delete context;
     return SPH_OK;
   });
@@ -117,10 +111,9 @@ SPH_API sph_result SPH_CALL sph_context_destroy(sph_context* context) {
 
 SPH_API sph_result SPH_CALL sph_context_get_backend(const sph_context* context, sph_backend* out_backend) {
   return sph::guarded("sph_context_get_backend", nullptr, [&] {
-    if (!context || !sph::is_live_handle(context, sph::HandleKind::Context))
-      throw Error(Status::InvalidHandle, "context: is NULL or not a live sph_context");
+    const sph::ContextHold hold(context);
     if (!out_backend) throw Error(Status::InvalidArgument, "out_backend: is NULL");
-    *out_backend = context->backend == sph::BackendKind::Cuda ? SPH_BACKEND_CUDA : SPH_BACKEND_CPU;
+    *out_backend = hold.get()->backend == sph::BackendKind::Cuda ? SPH_BACKEND_CUDA : SPH_BACKEND_CPU;
     return SPH_OK;
   });
 }

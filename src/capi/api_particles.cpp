@@ -56,6 +56,8 @@ SPH_API sph_result SPH_CALL sph_world_spawn(sph_world* world, const sph_spawn_de
     if (pstride < 12) throw Error(Status::InvalidArgument, "desc->position_stride: must be 0 or >= 12");
     if (d.velocities && vstride < 12)
       throw Error(Status::InvalidArgument, "desc->velocity_stride: must be 0 or >= 12");
+    sph::require_array_span(d.positions, d.count, pstride, 12, "desc->position_stride");
+    if (d.velocities) sph::require_array_span(d.velocities, d.count, vstride, 12, "desc->velocity_stride");
     const uint32_t first = sph::with_field_prefix("desc->", [&] {
       world->world->require_room_for_particles(d.count);  // before copying a large input
       std::vector<sph::Vec3> positions(d.count);
@@ -109,6 +111,7 @@ SPH_API sph_result SPH_CALL sph_world_fill_sphere(sph_world* world, const sph_fi
 SPH_API sph_result SPH_CALL sph_world_get_particle_count(const sph_world* world, uint32_t* out_count) {
   return sph::guarded("sph_world_get_particle_count", sph::context_of(world), [&] {
     sph::require_world(world);
+    sph::WorldLock lock(world);
     if (!out_count) throw Error(Status::InvalidArgument, "out_count: is NULL");
     *out_count = world->world->particle_count();
     return SPH_OK;
@@ -137,11 +140,7 @@ SPH_API sph_result SPH_CALL sph_world_copy_attribute(const sph_world* world, sph
       throw Error(Status::InvalidArgument, "first: " + std::to_string(first) +
                                                " is beyond the particle count " + std::to_string(total));
     const uint32_t n = std::min(count, total - first);
-    // (n - 1) * stride + element bytes, saturated: a huge stride must not wrap around 64 bits
-    // and pass the size check.
-    const uint64_t span = n == 0 ? 0 : static_cast<uint64_t>(n - 1);
-    const bool overflows = span != 0 && stride > (UINT64_MAX - element) / span;
-    const uint64_t needed = n == 0 ? 0 : (overflows ? UINT64_MAX : span * stride + element);
+    const uint64_t needed = sph::require_array_span(dst, n, stride, element, "dst_stride");
     if (dst_size < needed)
       throw Error(Status::BufferTooSmall, "dst_size: " + std::to_string(dst_size) + " bytes cannot hold " +
                                               std::to_string(n) + " elements at stride " +

@@ -73,6 +73,7 @@ sph_result init_params(const char* function, sph_params_kind kind, void* user, u
   return sph::guarded(function, nullptr, [&] {
     const sph::ParamsBinding& b = sph::params_binding(kind, "kind");
     if (!user) throw Error(Status::InvalidArgument, "params: is NULL");
+    sph::require_plausible_struct_size(size, "params", ": size ");  // before `size` bytes are cleared
     if (size < b.size)
       throw Error(Status::VersionMismatch,
                   "params: size " + std::to_string(size) + " is smaller than " + std::to_string(b.size));
@@ -101,6 +102,7 @@ sph_result set_params(const char* function, sph_world* world, uint32_t kind, con
 sph_result get_params(const char* function, const sph_world* world, uint32_t kind, void* out) {
   return sph::guarded(function, sph::context_of(world), [&] {
     sph::require_world(world);
+    sph::WorldLock lock(world);
     const sph::ParamsBinding& b = sph::params_binding(kind, "kind");
     require_enabled(b, world);
     if (!out) throw Error(Status::InvalidArgument, "out: is NULL");

@@ -30,14 +30,15 @@ sph_transform to_public(const sph::RigidTransform& t) {
 sph::Vec3 vec3_from_public(const sph_vec3& v) { return sph::Vec3{v.x, v.y, v.z}; }
 
 // An SDF handle of the world's context, or NULL (whether one is required is the world's rule).
+// The asset is taken under the handle registry's lock (use_sdf), so a racing sph_sdf_destroy
+// cannot free it meanwhile.
 std::shared_ptr<const sph::SdfAsset> world_sdf_or_null(const sph_world* world, const sph_sdf* sdf,
                                                        const std::string& name) {
   if (!sdf) return nullptr;
-  if (!sph::is_live_handle(sdf, sph::HandleKind::Sdf))
-    throw Error(Status::InvalidHandle, name + ": is not a live sph_sdf");
-  if (sdf->context != world->context)
+  sph::SdfUse use = sph::use_sdf(sdf, name);
+  if (use.context.get() != world->context)
     throw Error(Status::InvalidArgument, name + ": belongs to another context than the world");
-  return sdf->asset;
+  return use.asset;
 }
 
 sph::ColliderMaterial material_from_public(const sph_collider_material& m) {
@@ -156,6 +157,7 @@ SPH_API sph_result SPH_CALL sph_collider_get_transform(const sph_world* world, s
                                                        sph_transform* out_transform) {
   return sph::guarded("sph_collider_get_transform", sph::context_of(world), [&] {
     sph::require_world(world);
+    sph::WorldLock lock(world);
     if (!out_transform) throw Error(Status::InvalidArgument, "out_transform: is NULL");
     *out_transform = to_public(world->world->collider(id.bits).pose);
     return SPH_OK;

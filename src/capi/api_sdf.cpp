@@ -16,30 +16,16 @@ namespace {
 
 constexpr uint64_t kMaxVoxels = 1ull << 31;
 
-const sph_context* context_of_sdf(const sph_sdf* sdf) {
-  return (sdf && sph::is_live_handle(sdf, sph::HandleKind::Sdf)) ? sdf->context : nullptr;
-}
-
-void require_sdf(const sph_sdf* sdf, const char* name) {
-  if (!sdf) throw Error(Status::InvalidHandle, std::string(name) + ": is NULL");
-  if (!sph::is_live_handle(sdf, sph::HandleKind::Sdf))
-    throw Error(Status::InvalidHandle,
-                std::string(name) + ": is not a live sph_sdf (destroyed or foreign pointer)");
-}
-
-void require_context(const sph_context* context) {
-  if (!context) throw Error(Status::InvalidHandle, "context: is NULL");
-  if (!sph::is_live_handle(context, sph::HandleKind::Context))
-    throw Error(Status::InvalidHandle, "context: is not a live sph_context");
-}
+sph::LogTarget context_of_sdf(const sph_sdf* sdf) { return sph::log_target_of(sdf); }
 
 // Copies `count` floats from caller memory (host or device) and checks they are finite.
-// `name` is the grid's path with its separator ("desc->distance.", "desc->velocity->").
+// `name` is the grid's path with its separator ("desc->distance.", "desc->velocity->");
+// `memory_bits` is the caller's sph_memory_kind read as an integer (sph::enum_bits): loading an
+// out-of-range value as the enum type is undefined behaviour.
 std::vector<float> read_floats(const sph_context* context, const float* data, uint64_t count,
-                               sph_memory_kind memory, const std::string& name) {
+                               uint32_t memory_bits, const std::string& name) {
   if (!data) throw Error(Status::InvalidArgument, name + "data: is NULL (required)");
   std::vector<float> out(count);
-  const uint32_t memory_bits = sph::enum_bits(memory);
   if (memory_bits == SPH_MEMORY_HOST) {
     std::memcpy(out.data(), data, count * sizeof(float));
   } else if (memory_bits == SPH_MEMORY_CUDA_DEVICE) {
@@ -85,7 +71,7 @@ std::shared_ptr<sph::SdfAsset> asset_from_desc(const sph_context* context, const
   auto asset =
       std::make_shared<sph::SdfAsset>(static_cast<int32_t>(g.dims[0]), static_cast<int32_t>(g.dims[1]),
                                       static_cast<int32_t>(g.dims[2]), sph::index_to_local_from_public(g));
-  asset->distance() = read_floats(context, g.data, n, g.memory, "desc->distance.");
+  asset->distance() = read_floats(context, g.data, n, sph::enum_bits(g.memory), "desc->distance.");
   auto same_dims = [&](const sph_grid_desc& o, const char* name) {
     if (o.dims[0] != g.dims[0] || o.dims[1] != g.dims[1] || o.dims[2] != g.dims[2])
       throw Error(Status::InvalidArgument, std::string(name) + "->dims: must equal desc->distance.dims");
@@ -95,7 +81,7 @@ std::shared_ptr<sph::SdfAsset> asset_from_desc(const sph_context* context, const
     same_dims(v, "desc->velocity");
     if (sph::grid_components(v, 3) != 3)
       throw Error(Status::InvalidArgument, "desc->velocity->components: must be 3 (or 0, meaning 3)");
-    const std::vector<float> raw = read_floats(context, v.data, 3 * n, v.memory, "desc->velocity->");
+    const std::vector<float> raw = read_floats(context, v.data, 3 * n, sph::enum_bits(v.memory), "desc->velocity->");
     asset->velocity().resize(n);
     std::memcpy(asset->velocity().data(), raw.data(), raw.size() * sizeof(float));
   }
@@ -104,20 +90,18 @@ std::shared_ptr<sph::SdfAsset> asset_from_desc(const sph_context* context, const
     same_dims(f, "desc->friction");
     if (sph::grid_components(f, 1) != 1)
       throw Error(Status::InvalidArgument, "desc->friction->components: must be 1 (or 0, meaning 1)");
-    asset->friction() = read_floats(context, f.data, n, f.memory, "desc->friction->");
+    asset->friction() = read_floats(context, f.data, n, sph::enum_bits(f.memory), "desc->friction->");
     for (float mu : asset->friction())
       if (mu < 0.0f) throw Error(Status::InvalidArgument, "desc->friction->data: coefficients must be >= 0");
   }
   return asset;
 }
 
-sph_result publish(sph_context* context, std::shared_ptr<sph::SdfAsset> asset, sph_sdf** out) {
+sph_result publish(const sph::ContextHold& hold, std::shared_ptr<sph::SdfAsset> asset, sph_sdf** out) {
   auto handle = std::make_unique<sph_sdf>();
-  handle->context = context;
+  handle->context = hold.get();
   handle->asset = std::move(asset);
-  sph::register_handle(handle.get(), sph::HandleKind::Sdf);
-  context->sdf_count.fetch_add(1);
-  *out = handle.release();
+  *out = sph::publish_sdf(std::move(handle));
   return SPH_OK;
 }
 
@@ -164,20 +148,18 @@ SPH_API sph_result SPH_CALL sph_shape_desc_init_sized(sph_shape_desc* desc, uint
 }
 
 SPH_API sph_result SPH_CALL sph_sdf_create(sph_context* context, const sph_sdf_desc* desc, sph_sdf** out) {
-  const sph_context* log_context = sph::is_live_handle(context, sph::HandleKind::Context) ? context : nullptr;
-  return sph::guarded("sph_sdf_create", log_context, [&] {
-    require_context(context);
+  return sph::guarded("sph_sdf_create", context, [&] {
+    const sph::ContextHold hold(context);
     if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
     const sph_sdf_desc d = sph::read_user_struct(desc, "desc");
-    return publish(context, asset_from_desc(context, d), out);
+    return publish(hold, asset_from_desc(hold.get(), d), out);
   });
 }
 
 SPH_API sph_result SPH_CALL sph_sdf_create_shape(sph_context* context, const sph_shape_desc* desc,
                                                  sph_sdf** out) {
-  const sph_context* log_context = sph::is_live_handle(context, sph::HandleKind::Context) ? context : nullptr;
-  return sph::guarded("sph_sdf_create_shape", log_context, [&] {
-    require_context(context);
+  return sph::guarded("sph_sdf_create_shape", context, [&] {
+    const sph::ContextHold hold(context);
     if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
     const sph_shape_desc d = sph::read_user_struct(desc, "desc");
     const uint32_t shape = sph::enum_bits(d.shape);
@@ -205,7 +187,7 @@ SPH_API sph_result SPH_CALL sph_sdf_create_shape(sph_context* context, const sph
     sph::require_positive(spec.voxel_size, "desc->voxel_size");
     spec.padding_voxels =
         d.padding_voxels == 0 ? 4 : static_cast<int32_t>(std::min<uint32_t>(d.padding_voxels, 1u << 20));
-    return publish(context, sph::build_shape_sdf(spec, kMaxVoxels), out);
+    return publish(hold, sph::build_shape_sdf(spec, kMaxVoxels), out);
   });
 }
 
@@ -213,7 +195,7 @@ SPH_API sph_result SPH_CALL sph_sdf_update(sph_sdf* sdf, sph_sdf_channel channel
                                            const uint32_t size[3], const float* data,
                                            sph_memory_kind memory) {
   return sph::guarded("sph_sdf_update", context_of_sdf(sdf), [&] {
-    require_sdf(sdf, "sdf");
+    const sph::SdfUse use = sph::use_sdf(sdf, "sdf");
     if (!origin) throw Error(Status::InvalidArgument, "origin: is NULL");
     if (!size) throw Error(Status::InvalidArgument, "size: is NULL");
     uint32_t components;
@@ -232,7 +214,7 @@ SPH_API sph_result SPH_CALL sph_sdf_update(sph_sdf* sdf, sph_sdf_channel channel
         throw Error(Status::Unsupported, "channel: " + std::to_string(static_cast<int32_t>(channel_bits)) +
                                              " is not an sph_sdf_channel value");
     }
-    sph::SdfAsset& a = *sdf->asset;
+    sph::SdfAsset& a = *use.asset;
     const uint32_t dims[3] = {static_cast<uint32_t>(a.nx()), static_cast<uint32_t>(a.ny()),
                               static_cast<uint32_t>(a.nz())};
     for (int axis = 0; axis < 3; ++axis)
@@ -243,7 +225,8 @@ SPH_API sph_result SPH_CALL sph_sdf_update(sph_sdf* sdf, sph_sdf_channel channel
                         ") leaves the grid along axis " + std::to_string(axis) + " (dimension " +
                         std::to_string(dims[axis]) + ")");
     const uint64_t n = static_cast<uint64_t>(size[0]) * size[1] * size[2];
-    const std::vector<float> values = read_floats(sdf->context, data, n * components, memory, "");
+    const std::vector<float> values =
+        read_floats(use.context.get(), data, n * components, sph::enum_bits(memory), "");
     if (channel_bits == SPH_SDF_CHANNEL_FRICTION)
       for (float mu : values)
         if (mu < 0.0f) throw Error(Status::InvalidArgument, "data: friction coefficients must be >= 0");
@@ -273,22 +256,22 @@ SPH_API sph_result SPH_CALL sph_sdf_update(sph_sdf* sdf, sph_sdf_channel channel
 
 SPH_API sph_result SPH_CALL sph_sdf_get_dims(const sph_sdf* sdf, uint32_t out_dims[3]) {
   return sph::guarded("sph_sdf_get_dims", context_of_sdf(sdf), [&] {
-    require_sdf(sdf, "sdf");
+    const sph::SdfUse use = sph::use_sdf(sdf, "sdf");
     if (!out_dims) throw Error(Status::InvalidArgument, "out_dims: is NULL");
-    out_dims[0] = static_cast<uint32_t>(sdf->asset->nx());
-    out_dims[1] = static_cast<uint32_t>(sdf->asset->ny());
-    out_dims[2] = static_cast<uint32_t>(sdf->asset->nz());
+    out_dims[0] = static_cast<uint32_t>(use.asset->nx());
+    out_dims[1] = static_cast<uint32_t>(use.asset->ny());
+    out_dims[2] = static_cast<uint32_t>(use.asset->nz());
     return SPH_OK;
   });
 }
 
 SPH_API sph_result SPH_CALL sph_sdf_sample(const sph_sdf* sdf, sph_vec3 local_point, float* out_distance) {
   return sph::guarded("sph_sdf_sample", context_of_sdf(sdf), [&] {
-    require_sdf(sdf, "sdf");
+    const sph::SdfUse use = sph::use_sdf(sdf, "sdf");
     sph::require_finite_vec3(local_point, "local_point");
     if (!out_distance) throw Error(Status::InvalidArgument, "out_distance: is NULL");
     *out_distance =
-        sph::sample_distance(sdf->asset->host_view(), sph::Vec3{local_point.x, local_point.y, local_point.z});
+        sph::sample_distance(use.asset->host_view(), sph::Vec3{local_point.x, local_point.y, local_point.z});
     return SPH_OK;
   });
 }
@@ -299,9 +282,9 @@ SPH_API sph_result SPH_CALL sph_sdf_destroy(sph_sdf* sdf) {
     return SPH_OK;
   }
   return sph::guarded("sph_sdf_destroy", context_of_sdf(sdf), [&] {
-    require_sdf(sdf, "sdf");
-    sph::unregister_handle(sdf);
-    sdf->context->sdf_count.fetch_sub(1);
+    // Calls in flight on the handle hold their own reference to the asset and its context.
+    if (!sph::try_retire_sdf(sdf))
+      throw Error(Status::InvalidHandle, "sdf: is not a live sph_sdf (destroyed or foreign pointer)");
     delete sdf;
     return SPH_OK;
   });

@@ -114,10 +114,8 @@ SPH_API sph_result SPH_CALL sph_world_def_init_sized(sph_world_def* def, uint32_
 
 SPH_API sph_result SPH_CALL sph_world_create(sph_context* context, const sph_world_def* def,
                                              sph_world** out) {
-  const sph_context* log_context = sph::is_live_handle(context, sph::HandleKind::Context) ? context : nullptr;
-  return sph::guarded("sph_world_create", log_context, [&] {
-    if (!context) throw Error(Status::InvalidHandle, "context: is NULL");
-    if (!log_context) throw Error(Status::InvalidHandle, "context: is not a live sph_context");
+  return sph::guarded("sph_world_create", context, [&] {
+    const sph::ContextHold hold(context);
     if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
     const sph_world_def d = sph::read_user_struct(def, "def");
     const sph::WorldConfig config = config_from_def(d);
@@ -126,9 +124,7 @@ SPH_API sph_result SPH_CALL sph_world_create(sph_context* context, const sph_wor
     auto world = std::make_unique<sph_world>();
     world->context = context;
     world->world = std::make_unique<sph::World>(config, std::move(backend));
-    sph::register_handle(world.get(), sph::HandleKind::World);
-    context->world_count.fetch_add(1);
-    *out = world.release();
+    *out = sph::publish_world(std::move(world));
     return SPH_OK;
   });
 }
@@ -139,11 +135,14 @@ SPH_API sph_result SPH_CALL sph_world_destroy(sph_world* world) {
     return SPH_OK;
   }
   return sph::guarded("sph_world_destroy", sph::context_of(world), [&] {
-    if (!sph::is_live_handle(world, sph::HandleKind::World))
+    // The world leaves the registry in the critical section that takes its lock, so no other
+    // call can be inside it or enter it afterwards.
+    const sph::Take take = sph::try_retire_world(world);
+    if (take == sph::Take::NotLive)
       throw Error(Status::InvalidHandle, "world: is not a live sph_world (destroyed or foreign pointer)");
-    if (world->busy.load()) throw Error(Status::WorldLocked, "world: is in use by another call");
-    sph::unregister_handle(world);
-    world->context->world_count.fetch_sub(1);
+    if (take == sph::Take::Busy)
+      throw Error(Status::WorldLocked,
+                  "world: is in use by another call; destroy it when that call returned");
     delete world;
     return SPH_OK;
   });
@@ -152,6 +151,7 @@ SPH_API sph_result SPH_CALL sph_world_destroy(sph_world* world) {
 SPH_API sph_result SPH_CALL sph_world_get_def(const sph_world* world, sph_world_def* out_def) {
   return sph::guarded("sph_world_get_def", sph::context_of(world), [&] {
     sph::require_world(world);
+    sph::WorldLock lock(world);
     if (!out_def) throw Error(Status::InvalidArgument, "out_def: is NULL");
     const sph::WorldConfig& c = world->world->config();
     sph_world_def d = default_world_def();
@@ -172,6 +172,7 @@ SPH_API sph_result SPH_CALL sph_world_get_def(const sph_world* world, sph_world_
 SPH_API sph_result SPH_CALL sph_world_get_particle_mass(const sph_world* world, float* out_mass) {
   return sph::guarded("sph_world_get_particle_mass", sph::context_of(world), [&] {
     sph::require_world(world);
+    sph::WorldLock lock(world);
     if (!out_mass) throw Error(Status::InvalidArgument, "out_mass: is NULL");
     *out_mass = world->world->config().particle_mass;
     return SPH_OK;

@@ -18,63 +18,79 @@ inline sph_result to_result(Status s) { return static_cast<sph_result>(static_ca
 
 inline sph_result fail(Status status, const std::string& message) { throw Error(status, message); }
 
-inline void report_failure(const sph_context* context, const char* function, sph_result code,
-                           const char* what) {
+// Sets the thread's last error and tells the log callback. The callback may call into the
+// library (sph_world_get_stats, say), which clears or replaces the thread's last error, so the
+// message is set again after it returns: the failing call's message is what its caller reads.
+// A failure inside the callback itself is not reported to the callback again (no recursion).
+inline void report_failure(const LogTarget& log, const char* function, sph_result code, const char* what) {
+  static thread_local bool in_callback = false;
   char message[1024];
   std::snprintf(message, sizeof message, "%s: %s", function, what);
   set_last_error(message);
-  if (context && context->log_fn) context->log_fn(context->log_user_data, SPH_LOG_ERROR, code, message);
+  if (log.fn && !in_callback) {
+    in_callback = true;
+    log.fn(log.user_data, SPH_LOG_ERROR, code, message);
+    in_callback = false;
+    set_last_error(message);
+  }
 }
 
 template <class Body>
-sph_result guarded(const char* function, const sph_context* context, Body&& body) noexcept {
+sph_result guarded(const char* function, const LogTarget& log, Body&& body) noexcept {
   clear_last_error();
   try {
     return body();
   } catch (const Error& e) {
     const sph_result code = to_result(e.status());
-    report_failure(context, function, code, e.what());
+    report_failure(log, function, code, e.what());
     return code;
   } catch (const std::bad_alloc&) {
-    report_failure(context, function, SPH_ERROR_OUT_OF_HOST_MEMORY, "a host allocation failed");
+    report_failure(log, function, SPH_ERROR_OUT_OF_HOST_MEMORY, "a host allocation failed");
     return SPH_ERROR_OUT_OF_HOST_MEMORY;
   } catch (const std::exception& e) {
-    report_failure(context, function, SPH_ERROR_INTERNAL, e.what());
+    report_failure(log, function, SPH_ERROR_INTERNAL, e.what());
     return SPH_ERROR_INTERNAL;
   } catch (...) {
-    report_failure(context, function, SPH_ERROR_INTERNAL, "unknown internal exception");
+    report_failure(log, function, SPH_ERROR_INTERNAL, "unknown internal exception");
     return SPH_ERROR_INTERNAL;
   }
 }
 
 // Holds a world for the duration of one call; a second concurrent call gets WORLD_LOCKED.
+// Every call that takes a world, const ones included, holds it: the lock is taken under the
+// handle registry's mutex, so a concurrent sph_world_destroy cannot free the world meanwhile
+// (destroy takes the same lock before the world leaves the registry).
 class WorldLock {
  public:
-  explicit WorldLock(const sph_world* world) : world_(const_cast<sph_world*>(world)) {
-    bool expected = false;
-    if (!world_->busy.compare_exchange_strong(expected, true))
+  explicit WorldLock(const sph_world* world) : world_(world) {
+    if (!world_) throw Error(Status::InvalidHandle, "world: is NULL");
+    const Take take = try_take_world(world_);
+    if (take == Take::NotLive)
+      throw Error(Status::InvalidHandle, "world: is not a live sph_world (destroyed or foreign pointer)");
+    if (take == Take::Busy)
       throw Error(Status::WorldLocked,
                   "world: it is in use by another call (a world is used from one thread at a time)");
+    if (world_->device_lost) {
+      release_world(world_);
+      throw Error(Status::DeviceLost, "world: its device was lost after a sticky device error; destroy it");
+    }
   }
-  ~WorldLock() { world_->busy.store(false); }
+  ~WorldLock() { release_world(world_); }
   WorldLock(const WorldLock&) = delete;
   WorldLock& operator=(const WorldLock&) = delete;
 
  private:
-  sph_world* world_;
+  const sph_world* world_;
 };
 
-// Validates a world handle and that its device is alive.
+// Validates a world handle without touching the world's memory (WorldLock checks the rest:
+// it must follow before the world is used).
 inline void require_world(const sph_world* world) {
   if (!world) throw Error(Status::InvalidHandle, "world: is NULL");
   if (!is_live_handle(world, HandleKind::World))
     throw Error(Status::InvalidHandle, "world: is not a live sph_world (destroyed or foreign pointer)");
-  if (world->device_lost)
-    throw Error(Status::DeviceLost, "world: its device was lost after a sticky device error; destroy it");
 }
 
-inline const sph_context* context_of(const sph_world* world) {
-  return (world && is_live_handle(world, HandleKind::World)) ? world->context : nullptr;
-}
+inline LogTarget context_of(const sph_world* world) { return log_target_of(world); }
 
 }  // namespace sph

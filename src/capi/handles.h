@@ -1,11 +1,20 @@
 // The opaque objects of the C ABI and the registry that tells a live handle from a dangling
 // or foreign pointer in every build.
+//
+// Lifetimes: a handle's memory is freed only after it left the registry, and it leaves the
+// registry only under the registry's mutex, in the same critical section that checks nobody
+// uses it. Every call takes what it needs under that mutex too (the world's lock, a hold on a
+// context, a reference to an SDF's asset), so a destroy racing another thread's call on the
+// same object either waits its turn (WORLD_LOCKED, BUSY) or leaves the other call with
+// memory it still owns; it never frees memory in use.
 #pragma once
 
 #include <atomic>
 #include <memory>
+#include <string>
 
 #include "../core/sdf_asset.h"
+#include "../core/status.h"
 #include "../core/world.h"
 #include "../factory/backend_factory.h"
 #include "sph_c.h"
@@ -17,8 +26,10 @@ struct sph_context {
   sph::CudaTuning cuda_tuning;
   sph_log_fn log_fn;
   void* log_user_data;
-  std::atomic<uint32_t> world_count{0};
-  std::atomic<uint32_t> sdf_count{0};
+  // What keeps the context alive; changed and read only under the registry's mutex.
+  uint32_t world_count = 0;    // worlds created on it
+  uint32_t sdf_count = 0;      // SDF assets created on it
+  uint32_t held_by_calls = 0;  // calls in flight that use it (ContextHold)
 };
 
 struct sph_sdf {
@@ -29,8 +40,8 @@ struct sph_sdf {
 struct sph_world {
   sph_context* context;
   std::unique_ptr<sph::World> world;
-  std::atomic<bool> busy{false};
-  bool device_lost = false;
+  std::atomic<bool> busy{false};  // taken under the registry's mutex (WorldLock, destroy)
+  bool device_lost = false;       // read and written only while busy is held
 };
 
 namespace sph {
@@ -38,8 +49,70 @@ namespace sph {
 enum class HandleKind { Context, World, Sdf };
 
 void register_handle(const void* handle, HandleKind kind);
-void unregister_handle(const void* handle);
 bool is_live_handle(const void* handle, HandleKind kind);
 uint32_t live_handle_count();
+
+// Where a failing call reports: the context's log callback, copied under the registry's
+// mutex when the call starts, so reporting never touches a context or world that another
+// thread destroyed meanwhile.
+struct LogTarget {
+  sph_log_fn fn = nullptr;
+  void* user_data = nullptr;
+  LogTarget() = default;
+  LogTarget(std::nullptr_t) {}            // NOLINT: guarded(name, nullptr, ...) for calls without a context
+  LogTarget(const sph_context* context);  // NOLINT: a live context's callback, else none
+};
+LogTarget log_target_of(const sph_world* world);
+LogTarget log_target_of(const sph_sdf* sdf);
+
+// Takes a world for one call: under the registry's mutex, the handle is live and its busy
+// flag was free. Results: Locked (the caller owns the world until unlock_world), NotLive, Busy.
+enum class Take { Taken, NotLive, Busy };
+Take try_take_world(const sph_world* world);
+void release_world(const sph_world* world);
+// Takes a world for destruction: as try_take_world, and on Taken the handle has left the
+// registry (and its context's count) in the same critical section; the caller deletes it.
+Take try_retire_world(sph_world* world);
+
+// Keeps a context alive while a call uses it (creating a world or SDF on it, copying through
+// its device): sph_context_destroy answers BUSY meanwhile. Throws InvalidHandle for a NULL or
+// dead context (named `name`).
+class ContextHold {
+ public:
+  ContextHold(const sph_context* context, const char* name = "context");
+  // Adopts a hold the registry already counted (use_sdf takes it with the SDF's asset).
+  struct Adopt {};
+  ContextHold(sph_context* held, Adopt) : context_(held) {}
+  ~ContextHold();
+  ContextHold(ContextHold&& other) noexcept : context_(other.context_) { other.context_ = nullptr; }
+  ContextHold(const ContextHold&) = delete;
+  ContextHold& operator=(const ContextHold&) = delete;
+  ContextHold& operator=(ContextHold&&) = delete;
+  sph_context* get() const { return context_; }
+
+ private:
+  sph_context* context_;
+};
+
+// Publishes a new object made on a held context: registers the handle and counts it on the
+// context in one critical section. Returns the handle (ownership passes to the caller's caller).
+sph_world* publish_world(std::unique_ptr<sph_world> world);
+sph_sdf* publish_sdf(std::unique_ptr<sph_sdf> sdf);
+
+// Takes a context for destruction: Taken means it left the registry and the caller deletes
+// it; otherwise *why says what still uses it (Busy) or that it is not live (NotLive).
+Take try_retire_context(sph_context* context, std::string* why);
+// Takes an SDF handle out of the registry (its context's count drops with it); the caller
+// deletes it. Calls in flight on it keep their own reference to the asset and hold the context.
+bool try_retire_sdf(sph_sdf* sdf);
+
+// What one call uses of an SDF handle: its asset and a hold on its context, taken under the
+// registry's mutex, so a concurrent sph_sdf_destroy frees neither. Throws InvalidHandle for a
+// NULL (`null_status` lets a caller report NULL as InvalidArgument) or dead handle.
+struct SdfUse {
+  ContextHold context;
+  std::shared_ptr<SdfAsset> asset;
+};
+SdfUse use_sdf(const sph_sdf* sdf, const std::string& name, Status null_status = Status::InvalidHandle);
 
 }  // namespace sph

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "struct_io.h"
+
 namespace sph {
 namespace binding_detail {
 
@@ -56,6 +58,7 @@ PublicParams read_public_params(const ParamsBinding& b, const void* user, const 
   if (!user) throw Error(Status::InvalidArgument, std::string(name) + ": is NULL");
   uint32_t size;
   std::memcpy(&size, user, sizeof size);
+  require_plausible_struct_size(size, name, "->struct_size: ");  // before its tail is read
   if (size < b.size)
     throw Error(Status::VersionMismatch, std::string(name) + "->struct_size: " + std::to_string(size) +
                                              " is smaller than " + std::to_string(b.size) +

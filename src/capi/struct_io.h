@@ -16,19 +16,34 @@ namespace sph {
 // The size of a public struct in the first release that had it. A struct that grows gets a
 // specialisation with its old size (docs/versioning.md), so callers built against the older
 // header keep working:
-//   template <> constexpr uint32_t kFirstStructSize<sph_context_def> = 40;
+//   template <> inline constexpr uint32_t kFirstStructSize<sph_context_def> = 40;
+// (inline: an explicit specialisation of a variable template is not inline by itself, and
+// clang then defines it in every object that includes this header: a duplicate at link time.)
 template <class T>
-constexpr uint32_t kFirstStructSize = static_cast<uint32_t>(sizeof(T));
+inline constexpr uint32_t kFirstStructSize = static_cast<uint32_t>(sizeof(T));
 
 // Structs that grew after their first release, with the size they had then.
 template <>
-constexpr uint32_t kFirstStructSize<sph_context_def> =
+inline constexpr uint32_t kFirstStructSize<sph_context_def> =
     24 + 2 * sizeof(void*);  // 0.1.0; 0.2.0 adds the CUDA tuning
+
+// No public struct comes near this size. A larger struct_size is garbage, not a newer header:
+// it is refused rather than read (its bytes past ours are checked to be zero one by one, and
+// _init_sized clears `size` bytes).
+constexpr uint32_t kMaxStructSize = 64u * 1024u;
+
+inline void require_plausible_struct_size(uint32_t size, const char* name, const char* field) {
+  if (size > kMaxStructSize)
+    throw Error(Status::InvalidArgument, std::string(name) + field + std::to_string(size) +
+                                             " is larger than any sph struct (64 KiB); fill the struct "
+                                             "with its _init() function");
+}
 
 template <class T>
 T read_user_struct(const T* user, const char* name) {
   if (!user) throw Error(Status::InvalidArgument, std::string(name) + ": is NULL");
   const uint32_t size = user->struct_size;
+  require_plausible_struct_size(size, name, "->struct_size: ");
   if (size < kFirstStructSize<T>)
     throw Error(Status::VersionMismatch, std::string(name) + "->struct_size: " + std::to_string(size) +
                                              " is smaller than " + std::to_string(kFirstStructSize<T>) +
@@ -63,6 +78,7 @@ void write_user_struct(T* user, uint32_t size, const T& value) {
 template <class T>
 void require_init_size(const T* user, uint32_t size, const char* name) {
   if (!user) throw Error(Status::InvalidArgument, std::string(name) + ": is NULL");
+  require_plausible_struct_size(size, name, ": size ");
   if (size < kFirstStructSize<T>)
     throw Error(Status::VersionMismatch, std::string(name) + ": size " + std::to_string(size) +
                                              " is smaller than " + std::to_string(kFirstStructSize<T>));

@@ -47,6 +47,29 @@ inline void require_finite_vec3(const sph_vec3& v, const char* name) {
     throw Error(Status::InvalidArgument, std::string(name) + ": has a non-finite component");
 }
 
+// The bytes an array of `count` elements of `element` bytes, `stride` bytes apart, covers from
+// its first byte to its last: (count - 1) * stride + element (0 for no element). A span that
+// does not fit in 64 bits, or that runs past the end of the address space from `base`, is no
+// real array: InvalidArgument naming `name` (a saturated size would pass a size check against
+// a caller's UINT64_MAX and let the copy wrap around memory).
+inline uint64_t require_array_span(const void* base, uint64_t count, uint64_t stride, uint64_t element,
+                                   const std::string& name) {
+  if (count == 0) return 0;
+  const uint64_t gaps = count - 1;
+  if (gaps != 0 && stride > (UINT64_MAX - element) / gaps)
+    throw Error(Status::InvalidArgument, name + ": " + std::to_string(count) + " elements at stride " +
+                                             std::to_string(stride) + " span more than 2^64 bytes");
+  const uint64_t span = gaps * stride + element;
+  if (span > static_cast<uint64_t>(PTRDIFF_MAX))
+    throw Error(Status::InvalidArgument, name + ": " + std::to_string(count) + " elements at stride " +
+                                             std::to_string(stride) + " span " + std::to_string(span) +
+                                             " bytes, more than any object can have (PTRDIFF_MAX)");
+  if (reinterpret_cast<uintptr_t>(base) > UINTPTR_MAX - (span - 1))
+    throw Error(Status::InvalidArgument, name + ": " + std::to_string(span) +
+                                             " bytes from its address run past the end of the address space");
+  return span;
+}
+
 inline void require_zero(uint32_t v, const char* name) {
   if (v != 0) throw Error(Status::InvalidArgument, std::string(name) + ": is reserved and must be 0");
 }

@@ -48,6 +48,15 @@ class Backend {
   virtual FrameReport step_scene_frame(double frame_dt, const RuntimeParams& params,
                                        const SceneFrame& scene) = 0;
 
+  // The step controller's carried inputs (the max speed and max acceleration the next step is
+  // chosen from). A step that emitted particles and then failed truncates them, and truncate()
+  // recomputes the max speed from the velocities left, which need not equal what the world
+  // carried (collisions and sinks change velocities after the max is taken): World::step saves
+  // these before its emission and restores them after the truncation, so a failed step changes
+  // no carried field.
+  virtual void save_step_inputs() = 0;
+  virtual void restore_step_inputs() = 0;
+
   // Drops the particles from index `count` on (used to undo an emission when a step fails;
   // emitted particles are appended, so they are the last ones).
   virtual void truncate(uint32_t count) = 0;

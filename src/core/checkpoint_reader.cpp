@@ -47,6 +47,16 @@ float non_negative(ByteReader& r, const std::string& name) {
   return v;
 }
 
+// A maximum of |v| or |a| over finite vectors: non-negative, and +infinity when a squared
+// length overflows float32 (a particle spawned at 2e19 m/s has finite components but an
+// infinite |v|^2); never NaN. The writer saves what the world carries, so this accepts
+// exactly that.
+float magnitude_max(ByteReader& r, const std::string& name) {
+  const float v = r.f32();
+  if (std::isnan(v) || v < 0.0f) corrupt(r.what() + ": " + name + " is negative or not a number");
+  return v;
+}
+
 float positive(ByteReader& r, const std::string& name) {
   const float v = finite(r, name);
   if (!(v > 0.0f)) corrupt(r.what() + ": " + name + " must be > 0, is " + std::to_string(v));
@@ -229,7 +239,7 @@ Clock read_clock(ByteReader& r) {
     corrupt(r.what() + ": frame time is negative or not finite");
   f.dt_min = non_negative(r, "dt_min");
   f.dt_max = non_negative(r, "dt_max");
-  f.max_speed = non_negative(r, "max speed");
+  f.max_speed = magnitude_max(r, "max speed");
   f.density_min = finite(r, "density min");
   f.density_mean = finite(r, "density mean");
   f.density_max = finite(r, "density max");
@@ -259,8 +269,8 @@ ParticleSnapshot read_particles(ByteReader& r, const WorldConfig& config, uint32
   ParticleSnapshot s;
   const uint32_t n = r.u32();
   zero(r, "reserved");
-  s.max_speed = non_negative(r, "max speed");
-  s.max_acceleration = non_negative(r, "max acceleration");
+  s.max_speed = magnitude_max(r, "max speed");
+  s.max_acceleration = magnitude_max(r, "max acceleration");
   if (n > config.capacity)
     corrupt(r.what() + ": " + std::to_string(n) + " particles exceed the capacity " +
             std::to_string(config.capacity));

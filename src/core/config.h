@@ -68,7 +68,12 @@ auto& params_of(Params& p) {
 // The lattice sums of fcc_lattice.h, for the methods that calibrate on them.
 inline LatticeSums fcc_lattice_sums() {
   return LatticeSums{&fcc_surface_delta_integral,
-                     [](float spacing, float h) { return fcc_cohesion_lattice(spacing, h).surface_energy; }};
+                     [](float spacing, float h) { return fcc_cohesion_lattice(spacing, h).surface_energy; },
+                     [](float spacing, float h, double* scale, double* offset) {
+                       const BoundaryCalibration c = fcc_boundary_calibration(spacing, h);
+                       *scale = c.scale;
+                       *offset = c.offset;
+                     }};
 }
 
 inline FluidConstants make_fluid_constants(const WorldConfig& c, const RuntimeParams& p) {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "../physics/boundary_integrals.h"
 #include "../physics/kernels.h"
 #include "../physics/surface_tension.h"
 
@@ -170,6 +171,41 @@ float fcc_density_self_weight(float spacing, float kernel_radius, float rest_den
     sum += spiky_value(k, std::sqrt(r2));
   });
   return static_cast<float>(static_cast<double>(rest_density) / mass - sum);
+}
+
+BoundaryCalibration fcc_boundary_calibration(float spacing, float kernel_radius) {
+  const double step = half_cell(spacing);
+  KernelCoefficientsOf<double> k = make_kernel_coefficients<double>(kernel_radius);
+  k.spiky *= fcc_spiky_scale(spacing, kernel_radius);  // the world's density kernel
+  k.spiky_grad *= fcc_spiky_scale(spacing, kernel_radius);
+  const int64_t reach = static_cast<int64_t>(std::ceil(k.h / step)) + 1;
+  // The (100) face: the particle on the first plane above f . q = 0; the half space f . q <= 0
+  // is what a wall there takes away: its sum and that sum's slope along the wall's normal.
+  const int64_t* f = kFccFaces[0];
+  int64_t p[3] = {0, 0, 0};
+  nearest_point_on_plane(f, f[3], reach, p);
+  double missing = 0.0, slope = 0.0;
+  for_each_half_space_point_near(f, p, reach, step, k.h2, [&](const double* d, double r2) {
+    const double r = std::sqrt(r2);
+    missing += spiky_value(k, r);
+    slope += -spiky_gradient_magnitude(k, r) * d[0] / r;  // d/dx of the sum as the particle nears the wall
+  });
+  // The continuous share's slope over value, (7.5 h - 6 a) / (a (1.5 h - a)) with a = h - d,
+  // falls from infinity at a = 0 to 3 / h at a = h: bisect for 2 slope / missing.
+  const double h = k.h, target = 2.0 * slope / missing;
+  double lo = 1e-9 * h, hi = h;
+  for (int i = 0; i < 200; ++i) {
+    const double a = 0.5 * (lo + hi);
+    if ((7.5 * h - 6.0 * a) / (a * (1.5 * h - a)) > target)
+      lo = a;
+    else
+      hi = a;
+  }
+  const double effective = h - 0.5 * (lo + hi);  // the first layer's distance from the shifted wall
+  BoundaryCalibration c;
+  c.scale = missing / spiky_half_space<double>(effective, h);
+  c.offset = effective - 0.5 * static_cast<double>(spacing);
+  return c;
 }
 
 double fcc_surface_delta_integral(float spacing, float kernel_radius, float threshold) {

@@ -52,6 +52,23 @@ float fcc_spiky_scale(float spacing, float kernel_radius);
 // Averaged over the (100), (110) and (111) faces (they differ by about 5 %).
 double fcc_surface_delta_integral(float spacing, float kernel_radius, float threshold);
 
+// The boundary density's calibration (physics/boundary_density.h): a wall's share is
+// rho_b = m scale Phi_flat(d + offset), the continuous share of the kernel beyond the wall moved
+// `offset` into the solid, d the particle's distance from the wall. Both are fitted to a wall
+// along the lattice's (100) plane (the face a box fill puts against axis-aligned walls) at the
+// first layer, spacing/2 from the wall (as fcc_points_in_box places it): the value is the sum of
+// the world's density kernel s W_spiky over the half lattice the wall takes away (so that layer
+// reads rho0), and the slope twice that sum's slope along the normal (so that a fluid at uniform
+// pressure is in equilibrium there under the wall's force, -(p / rho^2) grad rho_b, which is the
+// gradient of the fluid's energy: the fluid's own pairs push the first layer towards the wall by
+// 2 (p / rho^2) times the missing sum's slope, both particles of a pair counting it). At
+// h = 1.8 spacings: scale = 12.0 rho0 / m, offset = 0.49 spacings.
+struct BoundaryCalibration {
+  double scale;   // 1/m^3
+  double offset;  // m
+};
+BoundaryCalibration fcc_boundary_calibration(float spacing, float kernel_radius);
+
 // Surface tension's cohesion (physics/surface_tension.h) on the FCC lattice at `spacing`, per
 // unit gamma m^2 (so both scale with the world's gamma and particle mass):
 // - surface_energy: half the work, per unit area, to pull two lattice half-spaces apart along a

@@ -37,7 +37,7 @@ Source make_source(const SourceSpec& spec, const WorldConfig& config) {
   if (spec.mode != SourceMode::FillOnce && spec.mode != SourceMode::Continuous)
     throw FieldError(Status::Unsupported, "mode",
                      std::to_string(static_cast<uint32_t>(spec.mode)) + " is not a source mode");
-  require_finite_vec3_field(spec.velocity, "velocity");
+  require_particle_velocity_field(spec.velocity, "velocity");
   require_non_negative_field(spec.spacing, "spacing");
   require_non_negative_field(spec.min_distance, "min_distance");
   require_non_negative_field(spec.rate, "rate");

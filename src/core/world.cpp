@@ -126,6 +126,7 @@ SceneFrame World::build_scene_frame(double frame_dt) const {
     v.stickiness = c.material.stickiness;
     v.sign = c.inverted ? -1.0f : 1.0f;
     v.deforming = c.sdf->has_moving_surface() ? 1u : 0u;
+    v.boundary_map = nullptr;  // the backend binds its map (SPH_FEATURE_BOUNDARY_DENSITY)
     float speed = 0.0f;
     if (v.moving) speed += length(v.linear_velocity) + length(v.angular_velocity) * bounding_radius(*c.sdf);
     if (v.deforming) speed += max_field_speed(*c.sdf);
@@ -162,10 +163,6 @@ SceneFrame World::build_scene_frame(double frame_dt) const {
 
 bool World::step(double frame_dt) {
   const auto start = std::chrono::steady_clock::now();
-  events_.clear();
-  // Reserved up front, so that nothing after the backend's frame can fail on an allocation:
-  // once the particles have moved, the rest of the step must not throw.
-  events_.reserve(sources_.size() + sinks_.size());
   // Everything a failed step must put back.
   const uint32_t count_before = particle_count();
   const uint32_t next_id_before = next_id_;
@@ -178,19 +175,29 @@ bool World::step(double frame_dt) {
   sources_.for_each([&](uint64_t id, const Source& s) {
     sources_before.push_back({id, s.done, s.rate_budget});
   });
+  // The last step's events, kept aside (no allocation: nothing can fail from here to the try).
+  std::vector<Event> events_before;
+  events_before.swap(events_);
   FrameReport report;
   try {
+    // Reserved up front, so that nothing after the backend's frame can fail on an allocation:
+    // once the particles have moved, the rest of the step must not throw.
+    events_.reserve(sources_.size() + sinks_.size());
+    if (sources_.size() > 0) backend_->save_step_inputs();
     emit_sources(frame_dt);
     report = backend_->step_scene_frame(frame_dt, params_, build_scene_frame(frame_dt));
   } catch (...) {
-    if (particle_count() > count_before) backend_->truncate(count_before);
+    if (particle_count() > count_before) {
+      backend_->truncate(count_before);
+      backend_->restore_step_inputs();
+    }
     next_id_ = next_id_before;
     for (const SourceState& saved : sources_before) {
       Source* s = sources_.find(saved.id);
       s->done = saved.done;
       s->rate_budget = saved.rate_budget;
     }
-    events_.clear();
+    events_.swap(events_before);
     throw;
   }
   // Colliders arrive where they were sent.

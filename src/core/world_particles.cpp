@@ -53,6 +53,7 @@ uint32_t World::add_particles(const std::vector<Vec3>& positions, const std::vec
       const Vec3& v = (*velocities)[i];
       if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
         throw FieldError(Status::InvalidArgument, "velocities[" + std::to_string(i) + "]", "is not finite");
+      require_particle_velocity_field(v, "velocities[" + std::to_string(i) + "]");
     }
   }
   return spawn(positions, velocities);
@@ -72,7 +73,7 @@ void require_fill_fits(uint64_t count, uint32_t free, uint32_t capacity) {
 uint32_t World::fill_box(const FillBoxSpec& spec) {
   require_finite_vec3_field(spec.min, "min");
   require_finite_vec3_field(spec.max, "max");
-  require_finite_vec3_field(spec.velocity, "velocity");
+  require_particle_velocity_field(spec.velocity, "velocity");
   if (!(spec.max.x >= spec.min.x && spec.max.y >= spec.min.y && spec.max.z >= spec.min.z))
     throw FieldError(Status::InvalidArgument, "max", "every component must be >= min's");
   const float s = config_.particle_spacing;
@@ -84,7 +85,7 @@ uint32_t World::fill_box(const FillBoxSpec& spec) {
 uint32_t World::fill_sphere(const FillSphereSpec& spec) {
   require_finite_vec3_field(spec.center, "center");
   require_non_negative_field(spec.radius, "radius");
-  require_finite_vec3_field(spec.velocity, "velocity");
+  require_particle_velocity_field(spec.velocity, "velocity");
   if (spec.radius == 0.0f) return 0;  // a zeroed desc: an empty sphere
   const float s = config_.particle_spacing;
   // Refuse before generating anything when the lattice cannot possibly fit (the estimate

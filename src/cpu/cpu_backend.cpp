@@ -56,6 +56,7 @@ CpuBackend::CpuBackend(const WorldConfig& config, unsigned workers)
   link_from_ = store_.find_typed<uint32_t>(kArraySpringLinkFrom);
   spring_candidates_ = store_.find_typed<uint32_t>(kArraySpringCandidates);
   spring_acceleration_ = store_.find_typed<Float4>(kArraySpringAcceleration);
+  boundary_ = store_.find_typed<Float4>(kArrayBoundaryGradient);
 }
 
 void CpuBackend::append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id) {

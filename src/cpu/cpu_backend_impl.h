@@ -19,6 +19,7 @@
 #include "../physics/forces.h"
 #include "../physics/integrate.h"
 #include "../physics/springs.h"
+#include "cpu_boundary_maps.h"
 #include "cpu_neighbor_columns.h"
 #include "cpu_neighbor_grid.h"
 #include "cpu_particle_store.h"
@@ -45,6 +46,15 @@ class CpuBackend final : public Backend {
 
   void truncate(uint32_t count) override;
 
+  void save_step_inputs() override {
+    saved_inputs_ = StepInputs{max_speed_, max_acceleration_, max_speed_valid_};
+  }
+  void restore_step_inputs() override {
+    max_speed_ = saved_inputs_.max_speed;
+    max_acceleration_ = saved_inputs_.max_acceleration;
+    max_speed_valid_ = saved_inputs_.max_speed_valid;
+  }
+
   void copy_attribute(AttributeKind kind, uint32_t first, uint32_t count, void* dst,
                       size_t stride) const override;
 
@@ -52,7 +62,9 @@ class CpuBackend final : public Backend {
 
   void import_particles(const ParticleSnapshot& s) override;
 
-  uint64_t memory_bytes() const override { return store_.bytes() + grid_.bytes() + columns_.bytes(); }
+  uint64_t memory_bytes() const override {
+    return store_.bytes() + grid_.bytes() + columns_.bytes() + boundary_maps_.bytes();
+  }
 
  private:
   static constexpr uint32_t kAllFinite = 0xffffffffu;
@@ -66,7 +78,20 @@ class CpuBackend final : public Backend {
   float compute_max_speed() const;
 
   // Hash, sort, reorder every attribute, then density and pressure (packed into the w slots).
-  void sort_and_density(const FluidConstants& fluid, FrameReport& report);
+  // With SPH_FEATURE_BOUNDARY_DENSITY the colliders' share joins the density, their poses at
+  // the stage's time `at`.
+  void sort_and_density(const FluidConstants& fluid, const SceneFrame& scene, StageTime at,
+                        FrameReport& report);
+
+  // Binds the world's boundary-density maps into the scene's collider views (computing those
+  // that are new or stale) and lists the views for the density pass.
+  void bind_boundary_maps(const FluidConstants& fluid, SceneFrame& scene);
+
+  // The wall's pressure acceleration of particle i (zero without SPH_FEATURE_BOUNDARY_DENSITY).
+  Vec3 wall_acceleration(uint32_t i) const {
+    return boundary_ ? boundary_pressure_acceleration(boundary_[i], position_[i].w, velocity_[i].w)
+                     : Vec3{0.0f, 0.0f, 0.0f};
+  }
 
   // The neighbour gather of the world's force terms (with_force_terms) on the SIMD target.
   using AccelerationFn = SimdPasses::AccelerationFn;
@@ -131,6 +156,9 @@ class CpuBackend final : public Backend {
   CpuArrayRef<uint32_t> link_from_;    // one word: the lowest id that waits for its springs
   CpuArrayRef<uint32_t> spring_candidates_;
   CpuArrayRef<Float4> spring_acceleration_;
+  CpuArrayRef<Float4> boundary_;  // boundary density: (grad rho_b, v_b . grad rho_b) per particle
+  CpuBoundaryMaps boundary_maps_;
+  std::vector<ColliderView> collider_views_;  // the frame's colliders, for the density pass
   std::vector<uint32_t> keep_order_;
   SpringConstants spring_constants_{};
   uint32_t count_ = 0;
@@ -138,6 +166,10 @@ class CpuBackend final : public Backend {
   float max_acceleration_ = 0.0f;  // of the last force evaluation, for the force step limit
   NonFiniteFailure non_finite_;    // of the last failed substep, for its error message
   bool max_speed_valid_ = false;
+  struct StepInputs {
+    float max_speed = 0.0f, max_acceleration = 0.0f;
+    bool max_speed_valid = false;
+  } saved_inputs_;  // save_step_inputs()
 };
 
 }  // namespace sph

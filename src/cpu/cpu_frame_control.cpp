@@ -43,6 +43,7 @@ void CpuBackend::diagnose_non_finite(const FluidConstants& fluid, const SceneFra
   const uint32_t i = first;
   Vec3 a = acceleration(acceleration_function(), fluid, grid_.view(), columns_.view(), scene, i);
   if (spring_acceleration_) a += xyz(spring_acceleration_[i]);
+  a += wall_acceleration(i);
   const ParticleState current{xyz(pos[i]), xyz(vel[i])};
   ParticleState integrated;
   if (rk4_stage < 0) {

@@ -10,6 +10,18 @@
 
 namespace sph {
 
+void CpuBackend::bind_boundary_maps(const FluidConstants& fluid, SceneFrame& scene) {
+  collider_views_.clear();
+  if (!boundary_) return;
+  boundary_maps_.begin_frame();
+  for (ColliderFrame& c : scene.colliders) {
+    const float level = BoundaryDensity::map_level(fluid.methods.boundary, c.view.sign);
+    c.view.boundary_map = boundary_maps_.bind(*c.sdf, config_.kernel_radius, level, workers_);
+    collider_views_.push_back(c.view);
+  }
+  boundary_maps_.end_frame();
+}
+
 FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& params,
                                          const SceneFrame& scene_in) {
   FrameReport report;
@@ -17,6 +29,7 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
   const StepLimits limits = make_step_limits(config_, params);
   SceneFrame scene = scene_in;
   bind_scene_views(scene, [](const SdfAsset& a) { return a.host_view(); });
+  bind_boundary_maps(fluid, scene);
   report.removed_by_sink.assign(scene.sinks.size(), 0u);
   const uint32_t count_before = count_;
   const auto saved = store_.snapshot();

@@ -11,7 +11,8 @@
 namespace sph {
 
 // Hash, sort, reorder every attribute, then density and pressure (packed into the w slots).
-void CpuBackend::sort_and_density(const FluidConstants& fluid, FrameReport& report) {
+void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame& scene, StageTime at,
+                                  FrameReport& report) {
   auto t = Clock::now();
   grid_.build(position_.data(), count_, workers_);
   store_.permute(grid_.order().data(), count_);
@@ -24,9 +25,20 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, FrameReport& repo
   Float4* pos = position_.data();
   Float4* vel = velocity_.data();
   float* factor = density_factor_.data();
+  Float4* boundary = boundary_.data();
+  const ColliderView* colliders = collider_views_.data();
+  const uint32_t collider_count = static_cast<uint32_t>(collider_views_.size());
+  (void)scene;  // its colliders, with their maps bound, are collider_views_
 #pragma omp parallel for num_threads(threads()) schedule(static)
   for (int i = 0; i < n(); ++i) {
-    const DensitySample s = simd_.density(fluid, view, columns, static_cast<uint32_t>(i));
+    DensitySample s = simd_.density(fluid, view, columns, static_cast<uint32_t>(i));
+    if (boundary) {
+      // The walls' share is part of the summation (and so of a normalised density's kernel sum).
+      const BoundaryShare b =
+          boundary_share(fluid.methods.boundary, colliders, collider_count, xyz(pos[i]), at.s, at.tau);
+      s.density += b.density;
+      boundary[i] = pack_boundary(b);
+    }
     float rho = s.density;
     if (factor) {
       normalized_[i] = s.density;  // the summation, for the factor after the filter

@@ -31,7 +31,7 @@ void CpuBackend::collide(const SceneFrame& scene, const SubstepTime& time, OldPo
 
 uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame& scene,
                                    const SubstepTime& time, FrameReport& report) {
-  sort_and_density(fluid, report);
+  sort_and_density(fluid, scene, stage_time(time, 0.0f), report);
   spring_pass(time.dt, true, report);
   auto t = Clock::now();
   const GridView view = grid_.view();
@@ -48,6 +48,7 @@ uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame
   for (int i = 0; i < n(); ++i) {
     Vec3 a = acceleration(gather, fluid, view, columns, scene, static_cast<uint32_t>(i));
     if (spring) a += xyz(spring[i]);
+    a += wall_acceleration(static_cast<uint32_t>(i));
     a2max = std::max(a2max, length_squared(a));
     const ParticleState s = symplectic_euler({xyz(pos[i]), xyz(vel[i])}, a, dt);
     next_pos[i] = make_float4_record(s.position, pos[i].w);
@@ -75,7 +76,7 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
   const AccelerationFn gather = acceleration_function();
   float a2max = 0.0f;
   for (int stage = 0; stage < 4; ++stage) {
-    sort_and_density(fluid, report);
+    sort_and_density(fluid, scene, stage_time(time, rk4_stage_fraction(stage)), report);
     spring_pass(dt, stage == 0, report);
     auto t = Clock::now();
     const GridView view = grid_.view();
@@ -91,6 +92,7 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
     for (int i = 0; i < n(); ++i) {
       Vec3 a = acceleration(gather, fluid, view, columns, scene, static_cast<uint32_t>(i));
       if (spring) a += xyz(spring[i]);
+      a += wall_acceleration(static_cast<uint32_t>(i));
       a2max = std::max(a2max, length_squared(a));
       const ParticleState s = rk4_advance(stage, start[i], {xyz(pos[i]), xyz(vel[i])}, a, dt, sums[i]);
       next_pos[i] = make_float4_record(s.position, pos[i].w);

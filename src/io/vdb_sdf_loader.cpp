@@ -1,7 +1,9 @@
 // Loads an OpenVDB level set into a dense SDF asset through the public C API. OpenVDB stays in
 // this library (libsph_vdb); libsph never sees it.
 #include <openvdb/openvdb.h>
+#include <sys/stat.h>
 
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -63,6 +65,15 @@ SPH_API sph_result SPH_CALL sph_vdb_load_sdf(sph_context* context, const char* p
   if (!context) return fail(SPH_ERROR_INVALID_HANDLE, "context: is NULL");
   if (!path) return fail(SPH_ERROR_INVALID_ARGUMENT, "path: is NULL");
   if (!out) return fail(SPH_ERROR_INVALID_ARGUMENT, "out: is NULL");
+  struct stat st;
+  if (::stat(path, &st) != 0)
+    return fail(SPH_ERROR_INVALID_ARGUMENT,
+                std::string("path: cannot open '") + path + "' (" + std::strerror(errno) + ")");
+  if (!S_ISREG(st.st_mode))
+    return fail(SPH_ERROR_INVALID_ARGUMENT,
+                std::string("path: '") + path +
+                    "' is not a regular file (OpenVDB would read a FIFO or device "
+                    "without end)");
   try {
     initialize_openvdb();
     openvdb::io::File file(path);

@@ -4,6 +4,7 @@
 
 #include <stdint.h>
 
+#include "float4_types.h"
 #include "host_device.h"
 #include "rigid_transform.h"
 #include "sdf_sampling.h"
@@ -23,6 +24,9 @@ struct ColliderView {
   float sign;                 // +1: solid where the SDF is negative; -1 (inverted): a container
   uint32_t moving;            // 0 for a static collider: one pose, no collider velocity
   uint32_t deforming;         // the SDF carries a velocity field
+  // The asset's boundary-density correction for the world's h (boundary_map.h), one Float4 per
+  // SDF voxel in the memory the SDF view points to; null without SPH_FEATURE_BOUNDARY_DENSITY.
+  const Float4* boundary_map;
 };
 
 struct SubstepTime {

@@ -8,6 +8,7 @@
 
 #include <type_traits>
 
+#include "boundary_density.h"
 #include "density_normalization.h"
 #include "eos_ideal_gas.h"
 #include "eos_tait.h"
@@ -27,7 +28,9 @@ enum FeatureBits : uint32_t {
   kFeatureSurfaceTension = 1u << 0,
   kFeatureNormalizedDensity = 1u << 1,
   kFeatureSprings = 1u << 2,
-  kFeatureAll = kFeatureSurfaceTension | kFeatureNormalizedDensity | kFeatureSprings,
+  kFeatureBoundaryDensity = 1u << 3,
+  kFeatureAll =
+      kFeatureSurfaceTension | kFeatureNormalizedDensity | kFeatureSprings | kFeatureBoundaryDensity,
 };
 
 enum class ViscosityMethod : uint32_t { Mueller = 0, Clavet = 1 };
@@ -96,6 +99,9 @@ constexpr MethodSwitch switch_of(Tag<NormalizedDensity>) {
   return {SwitchKind::Feature, kFeatureNormalizedDensity};
 }
 constexpr MethodSwitch switch_of(Tag<Springs>) { return {SwitchKind::Feature, kFeatureSprings}; }
+constexpr MethodSwitch switch_of(Tag<BoundaryDensity>) {
+  return {SwitchKind::Feature, kFeatureBoundaryDensity};
+}
 
 // Calls visit(Tag<Method>{}) for every method a world can choose, in the list's order.
 template <class Visit>
@@ -107,6 +113,7 @@ void for_each_method(Visit&& visit) {
   visit(Tag<SurfaceTension>{});
   visit(Tag<NormalizedDensity>{});
   visit(Tag<Springs>{});
+  visit(Tag<BoundaryDensity>{});
 }
 
 // Whether a value of a sph_world_def method field (or a feature bit) names a method of the list,
@@ -161,6 +168,7 @@ struct MethodConstants {
   ClavetViscosity::Constants clavet;
   SurfaceTension::Constants surface_tension;
   Springs::Constants springs;
+  BoundaryDensity::Constants boundary;
 };
 
 inline EosConstants make_eos_constants(const MethodParams& p, const MethodSelection& s,
@@ -182,6 +190,7 @@ inline MethodConstants make_method_constants(const MethodParams& p, const Method
   if (runs(s, Tag<SurfaceTension>{}))
     m.surface_tension = SurfaceTension::make_constants(p.surface_tension, shape, lattice);
   if (runs(s, Tag<Springs>{})) m.springs = Springs::make_constants(p.springs, shape);
+  if (runs(s, Tag<BoundaryDensity>{})) m.boundary = BoundaryDensity::make_constants(shape, lattice);
   return m;
 }
 

@@ -16,6 +16,9 @@ struct WorldShape {
 struct LatticeSums {
   double (*surface_delta_integral)(float spacing, float kernel_radius, float threshold);
   double (*cohesion_surface_energy)(float spacing, float kernel_radius);
+  // The boundary density's scale (1/m^3; times the particle mass, K) and its wall offset (m)
+  // (fcc_boundary_calibration).
+  void (*boundary_calibration)(float spacing, float kernel_radius, double* scale, double* offset);
 };
 
 }  // namespace sph

@@ -588,11 +588,17 @@ static void test_copy_errors(void** state) {
                     "dst_size");
   EXPECT_COPY_FAILS(f, SPH_ATTRIBUTE_ID, THE_BUFFER, 5 * 4, 0, n - 6, 100, SPH_ERROR_BUFFER_TOO_SMALL,
                     "dst_size");
-  /* A stride so large that (count - 1) * stride overflows 64 bits must not pass the check. */
+  /* A stride so large that (count - 1) * stride overflows 64 bits is no array: refused even
+   * with a dst_size of UINT64_MAX (a saturated size would pass that check). */
   EXPECT_COPY_FAILS(f, SPH_ATTRIBUTE_POSITION, THE_BUFFER, 4096, (uint64_t)1 << 63, 0, 3,
-                    SPH_ERROR_BUFFER_TOO_SMALL, "dst_size");
+                    SPH_ERROR_INVALID_ARGUMENT, "dst_stride");
   EXPECT_COPY_FAILS(f, SPH_ATTRIBUTE_DENSITY, THE_BUFFER, 4096, UINT64_MAX / 2 + 1, 0, 5,
-                    SPH_ERROR_BUFFER_TOO_SMALL, "dst_size");
+                    SPH_ERROR_INVALID_ARGUMENT, "dst_stride");
+  EXPECT_COPY_FAILS(f, SPH_ATTRIBUTE_DENSITY, THE_BUFFER, UINT64_MAX, UINT64_MAX / 2 + 1, 0, 5,
+                    SPH_ERROR_INVALID_ARGUMENT, "dst_stride");
+  /* A span that fits 64 bits but runs past the end of the address space from dst. */
+  EXPECT_COPY_FAILS(f, SPH_ATTRIBUTE_DENSITY, (void*)(UINTPTR_MAX - 15), UINT64_MAX, 8, 0, 3,
+                    SPH_ERROR_INVALID_ARGUMENT, "dst_stride");
 }
 
 static void test_copy_success(void** state) {

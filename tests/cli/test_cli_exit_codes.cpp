@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <thread>
 
@@ -162,7 +163,7 @@ void test_interrupt_keeps_only_complete_frames(void**) {
   std::sort(names.begin(), names.end());
   size_t frames = 0;
   for (const std::string& name : names) {
-    assert_true(name.find(".tmp") == std::string::npos);
+    assert_true(name.find(".tmp") == std::string::npos && name.find(".sph-run-") == std::string::npos);
     if (name.size() > 4 && name.compare(name.size() - 4, 4, ".ply") == 0) {
       char expected[32];
       std::snprintf(expected, sizeof expected, "fluid_%04zu.ply", frames);
@@ -180,7 +181,22 @@ void test_interrupt_keeps_only_complete_frames(void**) {
     }
   }
   assert_true(frames >= 6);
-  assert_int_equal(names.size(), 2 * frames);  // a .ply and a .csv of every frame, nothing else
+  // A .ply and a .csv of every frame and the manifest, nothing else (no staging directory).
+  assert_int_equal(names.size(), 2 * frames + 1);
+  // The manifest says the same: frames 0..k complete, and how the run ended.
+  const std::string manifest = cli_test::read_text(dir + "/sph-run-manifest.jsonl");
+  char last[64];
+  std::snprintf(last, sizeof last, "{\"end\":\"interrupted\",\"last_frame\":%zu}\n", frames - 1);
+  assert_true(manifest.size() > std::strlen(last) &&
+              manifest.compare(manifest.size() - std::strlen(last), std::strlen(last), last) == 0);
+  size_t complete = 0;
+  for (size_t at = 0, end; (end = manifest.find('\n', at)) != std::string::npos; at = end + 1) {
+    const std::string line = manifest.substr(at, end - at);
+    char head[48];
+    std::snprintf(head, sizeof head, "{\"frame\":%zu,", complete);
+    if (line.compare(0, std::strlen(head), head) == 0 && contains(line, "\"state\":\"complete\"")) ++complete;
+  }
+  assert_int_equal(complete, frames);
 }
 
 }  // namespace

@@ -70,6 +70,8 @@ class Program {
   void run() {
     int ops = 0;
     while (!in_.empty() && ops++ < 64) step_op();
+    for (int i = 0; i < kWorlds; ++i)
+      if (worlds_[i].ptr) round_trip(i);
   }
 
  private:
@@ -181,6 +183,40 @@ class Program {
     p.id.resize(n);
     return p;
   }
+  // The world's whole state as a checkpoint (a live world's save must succeed).
+  std::vector<uint8_t> checkpoint(sph_world* w) {
+    uint64_t size = 0;
+    if (FUZZ_CALL(sph_world_save(w, nullptr, 0, &size)) != SPH_OK)
+      violation("saving a live world failed: %s", sph_get_last_error());
+    std::vector<uint8_t> bytes(static_cast<size_t>(size));
+    if (FUZZ_CALL(sph_world_save(w, bytes.data(), size, &size)) != SPH_OK || size != bytes.size())
+      violation("saving a live world failed: %s", sph_get_last_error());
+    return bytes;
+  }
+
+  // Whatever a world accepted, its own save restores (issue 23, item 6): the checkpoint loads
+  // into a new world and restores into the world itself, both save the same bytes again, and
+  // the loaded world steps as the original does.
+  void round_trip(int slot) {
+    WorldSlot& ws = worlds_[slot];
+    const std::vector<uint8_t> bytes = checkpoint(ws.ptr);
+    sph_world* loaded = nullptr;
+    if (FUZZ_CALL(sph_world_load(contexts_[ws.context].ptr, bytes.data(), bytes.size(), &loaded)) != SPH_OK)
+      violation("a world's own checkpoint does not load: %s", sph_get_last_error());
+    if (checkpoint(loaded) != bytes) violation("a loaded world saves other bytes than it was loaded from");
+    if (FUZZ_CALL(sph_world_restore(ws.ptr, bytes.data(), bytes.size())) != SPH_OK)
+      violation("a world's own checkpoint does not restore: %s", sph_get_last_error());
+    if (checkpoint(ws.ptr) != bytes) violation("a restored world saves other bytes than it was restored from");
+    const float dt = 1.0f / 600.0f;
+    const sph_result a = FUZZ_CALL(sph_world_step(ws.ptr, dt));
+    const sph_result b = FUZZ_CALL(sph_world_step(loaded, dt));
+    if (a != b) violation("the world's step answered %d, its loaded copy's %d", a, b);
+    const Particles pa = snapshot(ws.ptr), pb = snapshot(loaded);
+    if (!(pa == pb)) violation("a loaded world stepped to other particles than the original");
+    if (a == SPH_OK || a == SPH_INCOMPLETE) check_particles(ws, pa);
+    if (FUZZ_CALL(sph_world_destroy(loaded)) != SPH_OK) violation("destroying a loaded world failed");
+  }
+
   void check_particles(const WorldSlot& slot, const Particles& p) {
     if (p.id.size() > slot.capacity)
       violation("%zu particles in a world of capacity %u", p.id.size(), slot.capacity);
@@ -205,6 +241,24 @@ class Program {
                           in_.maybe_hostile(-1, 1)};
     return t;
   }
+  // An enum value: usually one of [0, count) (the last ones may be invalid on purpose); with
+  // chance invalid_in_256 an invalid one, half of those with the top bits set (0x80000000 + v,
+  // 0xffffffff, raw bits): the library must read caller enums as integers, since loading such a
+  // value as the enum type in C++ is undefined behaviour (UBSan: "not a valid value for type").
+  uint32_t enum_value(uint32_t count, uint8_t invalid_in_256 = 32) {
+    if (!in_.chance(invalid_in_256)) return in_.u8() % count;
+    switch (in_.u8() % 4) {
+      case 0:
+        return 0x80000000u | (in_.u8() % count);
+      case 1:
+        return 0xffffffffu;
+      case 2:
+        return count + in_.u8();
+      default:
+        return in_.u32();
+    }
+  }
+
   // struct_size: nearly always right; sometimes too small, too large or zero.
   uint32_t struct_size(uint32_t right) {
     if (!in_.chance(16)) return right;
@@ -643,6 +697,7 @@ class Program {
       return;
     }
     const Particles before = snapshot(w);
+    const std::vector<uint8_t> saved = checkpoint(w);
     const sph_result r = FUZZ_CALL(sph_world_step(w, dt));
     const Particles after = snapshot(w);
     if (r == SPH_OK || r == SPH_INCOMPLETE) {
@@ -655,14 +710,16 @@ class Program {
         violation("stats count %u != %zu", s.particle_count, after.id.size());
     } else if (!(before == after)) {
       violation("sph_world_step failed with %d and changed the particles", r);
+    } else if (checkpoint(w) != saved) {
+      // Every carried field (max speed, max acceleration, events, sources' budgets) too.
+      violation("sph_world_step failed with %d and changed the world's checkpoint", r);
     }
   }
 
   void op_copy_attribute() {
     int slot;
     sph_world* w = world_arg(&slot);
-    uint32_t attribute = in_.u8() % 6;
-    if (in_.chance(8)) attribute = in_.u32();
+    uint32_t attribute = enum_value(6);
     const uint64_t dst_size = in_.chance(16) ? in_.u64() % (1u << 16) : in_.u32() % 8192;
     const uint64_t stride = in_.chance(128) ? 0 : (in_.chance(224) ? in_.u8() % 40 : in_.u64());
     const uint32_t first = in_.chance(200) ? in_.u8() % 16 : in_.u32();
@@ -711,7 +768,7 @@ class Program {
     if (in_.chance(16)) g.index_to_local[in_.u8() % 12] = in_.hostile();
     g.components = in_.chance(240) ? components : in_.u32() % 5;
     if (in_.chance(8)) {
-      const uint32_t memory = in_.u32() % 3;
+      const uint32_t memory = enum_value(3, 128);
       std::memcpy(&g.memory, &memory, 4);
     }
     // components 0 means the channel's own count (sph_grid_desc): size the data for that.
@@ -789,8 +846,7 @@ class Program {
     Padded<sph_shape_desc> buf;
     sph_shape_desc& d = buf.value;
     sph_shape_desc_init(&d);
-    uint32_t shape = in_.u8() % 6;
-    if (in_.chance(8)) shape = in_.u32();
+    uint32_t shape = enum_value(6);
     std::memcpy(&d.shape, &shape, 4);
     d.half_extents = vec3(0.0f, 0.3f);
     d.radius = in_.maybe_hostile(0.0f, 0.3f);
@@ -828,8 +884,7 @@ class Program {
     sph_sdf* s = sdf_arg(&slot);
     uint32_t dims[3] = {1, 1, 1};
     if (slot >= 0 && s) FUZZ_CALL(sph_sdf_get_dims(s, dims));
-    uint32_t channel = in_.u8() % 3;
-    if (in_.chance(8)) channel = in_.u32();
+    uint32_t channel = enum_value(3);
     uint32_t origin[3], size[3];
     bool inside = true;
     for (int a = 0; a < 3; ++a) {
@@ -841,7 +896,7 @@ class Program {
     const size_t floats = inside ? components * size[0] * size[1] * size[2] : 16;
     std::vector<float> data(floats + 1, -0.01f);
     if (in_.chance(32)) data[in_.u16() % data.size()] = in_.hostile();
-    uint32_t memory = in_.chance(240) ? 0 : in_.u32() % 3;
+    uint32_t memory = in_.chance(240) ? 0 : enum_value(3, 128);
     sph_memory_kind m;
     std::memcpy(&m, &memory, 4);
     sph_sdf_channel ch;
@@ -969,8 +1024,7 @@ class Program {
     Padded<sph_source_def> buf;
     sph_source_def& d = buf.value;
     sph_source_def_init(&d);
-    uint32_t mode = in_.u8() % 2;
-    if (in_.chance(8)) mode = in_.u32();
+    uint32_t mode = enum_value(2);
     std::memcpy(&d.mode, &mode, 4);
     d.region = sdf_arg(&sslot);
     d.transform = transform();
@@ -1022,8 +1076,7 @@ class Program {
     Padded<sph_sink_def> buf;
     sph_sink_def& d = buf.value;
     sph_sink_def_init(&d);
-    uint32_t mode = in_.u8() % 2;
-    if (in_.chance(8)) mode = in_.u32();
+    uint32_t mode = enum_value(2);
     std::memcpy(&d.mode, &mode, 4);
     d.region = sdf_arg(&sslot);
     d.transform = transform();
@@ -1048,8 +1101,7 @@ class Program {
     Padded<sph_force_field_def> buf;
     sph_force_field_def& d = buf.value;
     sph_force_field_def_init(&d);
-    uint32_t kind = in_.u8() % 4;
-    if (in_.chance(8)) kind = in_.u32();
+    uint32_t kind = enum_value(4);
     std::memcpy(&d.kind, &kind, 4);
     d.region = in_.chance(128) ? nullptr : sdf_arg(&sslot);
     Padded<sph_grid_desc> gbuf;  // a fuzzed struct_size up to 255 stays inside

@@ -75,22 +75,33 @@ void check_world(sph_world* w) {
   std::sort(ids.begin(), ids.end());
   if (std::adjacent_find(ids.begin(), ids.end()) != ids.end()) violation("a loaded world with a repeated id");
 
-  // Save, load again: a checkpoint the library wrote must load.
-  const std::vector<unsigned char> again = save(w);
-  sph_world* copy = nullptr;
-  if (FUZZ_CALL(sph_world_load(shared_context(), again.data(), again.size(), &copy)) != SPH_OK)
-    violation("the library's own checkpoint does not load: %s", sph_get_last_error());
-  FUZZ_CALL(sph_world_destroy(copy));
-
+  // Save, load again: a checkpoint the library wrote must load, and save the same bytes.
   sph_world_params p;
   sph_world_params_init(&p);
   FUZZ_CALL(sph_world_get_params(w, &p));
   p.max_substeps = 4;
-  if (FUZZ_CALL(sph_world_set_params(w, &p)) == SPH_OK) {
-    const sph_result r = FUZZ_CALL(sph_world_step(w, 1.0f / 60.0f));
-    if (r == SPH_ERROR_INTERNAL)
-      violation("stepping a loaded world failed internally: %s", sph_get_last_error());
-  }
+  if (FUZZ_CALL(sph_world_set_params(w, &p)) != SPH_OK) return;
+  const std::vector<unsigned char> again = save(w);
+  sph_world* copy = nullptr;
+  if (FUZZ_CALL(sph_world_load(shared_context(), again.data(), again.size(), &copy)) != SPH_OK)
+    violation("the library's own checkpoint does not load: %s", sph_get_last_error());
+  if (save(copy) != again) violation("a world loaded from the library's own checkpoint saves other bytes");
+
+  // Step the loaded world and its copy: the same answer; a failed step changes no carried
+  // field (the checkpoint is the same byte for byte), a successful one leaves the two alike.
+  const sph_result r = FUZZ_CALL(sph_world_step(w, 1.0f / 60.0f));
+  if (r == SPH_ERROR_INTERNAL) violation("stepping a loaded world failed internally: %s", sph_get_last_error());
+  if (r < 0 && save(w) != again) violation("a failed step (%d) of a loaded world changed its checkpoint", r);
+  const sph_result rc = FUZZ_CALL(sph_world_step(copy, 1.0f / 60.0f));
+  if (rc != r) violation("a loaded world's step answered %d, its reloaded copy's %d", r, rc);
+  std::vector<float> xa(3 * static_cast<size_t>(def.capacity) + 3), xb(xa.size());
+  uint32_t na = 0, nb = 0;
+  FUZZ_CALL(sph_world_copy_attribute(w, SPH_ATTRIBUTE_POSITION, xa.data(), xa.size() * 4, 0, 0, def.capacity, &na));
+  FUZZ_CALL(sph_world_copy_attribute(copy, SPH_ATTRIBUTE_POSITION, xb.data(), xb.size() * 4, 0, 0, def.capacity,
+                                     &nb));
+  if (na != nb || std::memcmp(xa.data(), xb.data(), 3 * static_cast<size_t>(na) * sizeof(float)) != 0)
+    violation("a loaded world and its reloaded copy stepped apart");
+  FUZZ_CALL(sph_world_destroy(copy));
 }
 
 }  // namespace

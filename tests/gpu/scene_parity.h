@@ -368,6 +368,25 @@ inline void run_scene_parity() {
   spring_source.name = "springs_continuous_source_euler";
   spring_source.spec.features = SPH_FEATURE_SPRINGS;
   compare_scene(spring_source);
+
+  // Walls in the density: the maps computed on the device against the host's, sampled for a
+  // static inverted tank (both integrators), a kinematic paddle with a floor, and a deforming
+  // collider (its field advected at the stage's time).
+  SceneHooks boundary_tank = tank;
+  boundary_tank.name = "boundary_density_tank_euler";
+  boundary_tank.spec.features = SPH_FEATURE_BOUNDARY_DENSITY;
+  compare_scene(boundary_tank);
+  SceneHooks boundary_tank_rk4 = tank_rk4;
+  boundary_tank_rk4.name = "boundary_density_tank_rk4";
+  boundary_tank_rk4.spec.features = SPH_FEATURE_BOUNDARY_DENSITY;
+  compare_scene(boundary_tank_rk4);
+  SceneHooks boundary_paddle{"boundary_density_moving_paddle_floor_euler", base, build_paddle};
+  boundary_paddle.spec.features = SPH_FEATURE_BOUNDARY_DENSITY;
+  compare_scene(boundary_paddle);
+  SceneHooks boundary_deforming = deforming;
+  boundary_deforming.name = "boundary_density_deforming_euler";
+  boundary_deforming.spec.features = SPH_FEATURE_BOUNDARY_DENSITY;
+  compare_scene(boundary_deforming);
 }
 
 }  // namespace gpu_check

@@ -3,7 +3,9 @@
 #include <chrono>
 #include <cstdio>
 
-#include "atomic_file.h"
+#include "new_file.h"
+#include "staging.h"
+#include "video.h"
 #include "writers.h"
 
 namespace sph_tools {
@@ -13,6 +15,35 @@ namespace {
 double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
+
+// A frame's files in the staging directory: removed unless committed.
+class StagedFrame {
+ public:
+  explicit StagedFrame(const StagingDirectory& staging) : staging_(staging) {}
+  ~StagedFrame() {
+    for (const std::string& name : names_) staging_.discard(name);
+  }
+  StagedFrame(const StagedFrame&) = delete;
+  StagedFrame& operator=(const StagedFrame&) = delete;
+  // Registers an output and returns its staged path.
+  std::string add(const std::string& name) {
+    names_.push_back(name);
+    return staging_.file(name);
+  }
+  const std::vector<std::string>& names() const { return names_; }
+  // Moves every staged file into the output directory, between the manifest's two lines.
+  void commit(FrameManifest& manifest, uint32_t frame, double time) {
+    manifest.writing(frame, time, names_);
+    for (const std::string& name : names_) staging_.commit(name);
+    const std::vector<std::string> committed = std::move(names_);
+    names_.clear();
+    manifest.complete(frame, time, committed);
+  }
+
+ private:
+  const StagingDirectory& staging_;
+  std::vector<std::string> names_;
+};
 
 }  // namespace
 
@@ -44,34 +75,42 @@ const char* format_extension(OutputFormat format) {
   }
 }
 
-FrameWriter::FrameWriter(const FrameWriterOptions& options, const SceneRuntime& runtime) : options_(options) {
+FrameWriter::FrameWriter(const FrameWriterOptions& options, const SceneRuntime& runtime,
+                         const ManifestHeader& header)
+    : options_(options) {
   make_directories(options_.directory);
   remove_stale_temporaries(options_.directory);
+  staging_ = std::make_unique<StagingDirectory>(options_.directory);
+  manifest_ = std::make_unique<FrameManifest>(options_.directory, *staging_, header);
   if (options_.preview) preview_ = std::make_unique<PreviewRenderer>(runtime);
 }
 
+std::string FrameWriter::name(const char* prefix, uint32_t frame, const char* extension) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%s_%04u.%s", prefix, frame, extension);
+  return text;
+}
+
 std::string FrameWriter::path(const char* prefix, uint32_t frame, const char* extension) const {
-  char name[64];
-  std::snprintf(name, sizeof name, "%s_%04u.%s", prefix, frame, extension);
-  return options_.directory + "/" + name;
+  return options_.directory + "/" + name(prefix, frame, extension);
 }
 
 void FrameWriter::write(const SceneRuntime& runtime, const ParticleFrame& frame) {
-  FrameCommit commit;
+  StagedFrame staged(*staging_);
   times_ = FrameWriteTimes{};
   auto start = std::chrono::steady_clock::now();
   for (OutputFormat format : options_.formats) {
-    const std::string temp = commit.add(path("fluid", frame.frame, format_extension(format)));
+    const std::string file = staged.add(name("fluid", frame.frame, format_extension(format)));
     switch (format) {
       case OutputFormat::kCsv:
-        write_csv(frame, temp);
+        write_csv(frame, file);
         break;
       case OutputFormat::kPly:
-        write_ply(frame, temp);
+        write_ply(frame, file);
         break;
       case OutputFormat::kVdb:
 #ifdef SPH_TOOLS_HAVE_OPENVDB
-        write_vdb_points(frame, temp);
+        write_vdb_points(frame, file);
 #endif
         break;
     }
@@ -80,8 +119,8 @@ void FrameWriter::write(const SceneRuntime& runtime, const ParticleFrame& frame)
   start = std::chrono::steady_clock::now();
   if (options_.surface) {
 #ifdef SPH_TOOLS_HAVE_OPENVDB
-    const std::string vdb = commit.add(path("surface", frame.frame, "vdb"));
-    const std::string obj = commit.add(path("surface", frame.frame, "obj"));
+    const std::string vdb = staged.add(name("surface", frame.frame, "vdb"));
+    const std::string obj = staged.add(name("surface", frame.frame, "obj"));
     write_surface(frame, options_.surface_radius, options_.surface_voxel, vdb, obj, &mesh_);
 #endif
   }
@@ -91,10 +130,26 @@ void FrameWriter::write(const SceneRuntime& runtime, const ParticleFrame& frame)
     const bool draw_surface = options_.surface && options_.preview_surface;
     preview_->render(runtime, frame.position.data(), frame.velocity.data(), frame.count,
                      draw_surface ? &mesh_ : nullptr, &image_);
-    write_png(image_, commit.add(path("preview", frame.frame, "png")));
+    NewFile png(staged.add(name("preview", frame.frame, "png")));
+    write_png(image_, png.get(), png.path());
+    png.close();
   }
   times_.preview_ms = ms_since(start);
-  commit.commit();
+  staged.commit(*manifest_, frame.frame, frame.time);
+}
+
+std::string FrameWriter::write_preview_video(float fps) {
+  const std::string video = "preview.mp4";
+  const std::string problem =
+      encode_mp4(options_.directory + "/preview_%04d.png", 0, fps, staging_->file(video));
+  if (!problem.empty()) {
+    staging_->discard(video);
+    return problem;
+  }
+  manifest_->writing_video(video);
+  staging_->commit(video);
+  manifest_->complete_video(video);
+  return "";
 }
 
 }  // namespace sph_tools

@@ -13,6 +13,8 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "new_file.h"
+#include "vdb_file.h"
 #include "writers.h"
 
 namespace sph_tools {
@@ -39,8 +41,7 @@ class ParticleList {
 };
 
 void write_obj(const SurfaceMesh& mesh, const ParticleFrame& f, const std::string& path) {
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "w"), std::fclose);
-  if (!file) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  NewFile file(path);
   std::FILE* out = file.get();
   std::fprintf(out, "# sph-run fluid surface, frame %u, time %.9g s, %zu vertices, %zu triangles\n", f.frame,
                f.time, mesh.vertices.size() / 3, mesh.triangles.size() / 3);
@@ -49,8 +50,7 @@ void write_obj(const SurfaceMesh& mesh, const ParticleFrame& f, const std::strin
   for (size_t i = 0; i < mesh.triangles.size(); i += 3)
     std::fprintf(out, "f %u %u %u\n", mesh.triangles[i] + 1, mesh.triangles[i + 1] + 1,
                  mesh.triangles[i + 2] + 1);
-  if (std::ferror(out) || std::fclose(file.release()) != 0)
-    throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  file.close();
 }
 
 }  // namespace
@@ -78,13 +78,7 @@ void write_surface(const ParticleFrame& f, float radius, float voxel, const std:
   grid->setName("surface");
   grid->insertMeta("frame", openvdb::Int32Metadata(static_cast<int32_t>(f.frame)));
   grid->insertMeta("time", openvdb::DoubleMetadata(f.time));
-  try {
-    openvdb::io::File file(vdb_path);
-    file.write(openvdb::GridCPtrVec{grid});
-    file.close();
-  } catch (const openvdb::Exception& e) {
-    throw std::runtime_error("cannot write " + vdb_path + ": " + e.what());
-  }
+  write_vdb_file(vdb_path, openvdb::GridCPtrVec{grid});
 
   std::vector<openvdb::Vec3s> points;
   std::vector<openvdb::Vec3I> triangles;

@@ -2,6 +2,7 @@
 
 #ifdef SPH_TOOLS_HAVE_OPENVDB
 #include <openvdb/openvdb.h>
+#include <sys/stat.h>
 
 #include <cmath>
 #include <mutex>
@@ -14,6 +15,9 @@ namespace {
 
 void fill_one(ShapeDesc* shape) {
   if (shape->kind != ShapeDesc::Kind::kVdb) return;
+  // Only regular files: OpenVDB would wait forever on a FIFO (building the world says why).
+  struct stat st;
+  if (::stat(shape->vdb_file.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return;
   static std::once_flag once;
   std::call_once(once, [] { openvdb::initialize(); });
   try {
@@ -49,8 +53,9 @@ void fill_one(ShapeDesc* shape) {
       first = false;
     }
     shape->has_vdb_bounds = true;
-  } catch (const openvdb::Exception&) {
-    // Unreadable: building the world says why.
+  } catch (const std::exception&) {
+    // Unreadable (OpenVDB's exceptions, or an allocation a damaged file asked for): building
+    // the world says why.
   }
 }
 

@@ -5,13 +5,13 @@
 #include <memory>
 #include <stdexcept>
 
+#include "new_file.h"
 #include "writers.h"
 
 namespace sph_tools {
 
 void write_csv(const ParticleFrame& f, const std::string& path) {
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "w"), std::fclose);
-  if (!file) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  NewFile file(path);
   std::FILE* out = file.get();
   std::fputs("id,x,y,z,vx,vy,vz,density,pressure\n", out);
   for (uint32_t i = 0; i < f.count; ++i) {
@@ -20,8 +20,7 @@ void write_csv(const ParticleFrame& f, const std::string& path) {
     std::fprintf(out, "%u,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", f.id[i], x[0], x[1], x[2], v[0], v[1],
                  v[2], f.density[i], f.pressure[i]);
   }
-  if (std::ferror(out) || std::fclose(file.release()) != 0)
-    throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  file.close();
 }
 
 }  // namespace sph_tools

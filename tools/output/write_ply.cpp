@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "new_file.h"
 #include "writers.h"
 
 #if !defined(__BYTE_ORDER__) || __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
@@ -15,8 +16,7 @@
 namespace sph_tools {
 
 void write_ply(const ParticleFrame& f, const std::string& path) {
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "wb"), std::fclose);
-  if (!file) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  NewFile file(path);
   std::FILE* out = file.get();
   std::fprintf(out,
                "ply\nformat binary_little_endian 1.0\ncomment sph-run frame %u time %.9g\n"
@@ -38,8 +38,7 @@ void write_ply(const ParticleFrame& f, const std::string& path) {
     }
     if (std::fwrite(buffer.data(), kRecord, n, out) != n) break;
   }
-  if (std::ferror(out) || std::fclose(file.release()) != 0)
-    throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  file.close();
 }
 
 }  // namespace sph_tools

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "vdb_file.h"
 #include "writers.h"
 
 namespace sph_tools {
@@ -57,13 +58,7 @@ void write_vdb_points(const ParticleFrame& f, const std::string& path) {
   grid->insertMeta("frame", openvdb::Int32Metadata(static_cast<int32_t>(f.frame)));
   grid->insertMeta("time", openvdb::DoubleMetadata(f.time));
   grid->insertMeta("particle_spacing", openvdb::FloatMetadata(f.particle_spacing));
-  try {
-    openvdb::io::File file(path);
-    file.write(openvdb::GridCPtrVec{grid});
-    file.close();
-  } catch (const openvdb::Exception& e) {
-    throw std::runtime_error("cannot write " + path + ": " + e.what());
-  }
+  write_vdb_file(path, openvdb::GridCPtrVec{grid});
 }
 
 }  // namespace sph_tools

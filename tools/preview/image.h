@@ -3,6 +3,7 @@
 #define SPH_TOOLS_IMAGE_H
 
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <string>
 #include <vector>
@@ -22,8 +23,9 @@ struct Image {
   }
 };
 
-// Writes an 8-bit RGB PNG (sRGB-encoded) with libpng. Throws std::runtime_error.
-void write_png(const Image& image, const std::string& path);
+// Writes an 8-bit RGB PNG (sRGB-encoded) with libpng to `out` (the caller opened it and closes
+// it; `name` is for messages). Throws std::runtime_error.
+void write_png(const Image& image, std::FILE* out, const std::string& name);
 // Whether this build has libpng (write_png throws without it).
 bool png_available();
 

@@ -60,21 +60,19 @@ bool encode(std::FILE* file, const unsigned char* pixels, uint32_t width, uint32
 
 }  // namespace
 
-void write_png(const Image& image, const std::string& path) {
+void write_png(const Image& image, std::FILE* out, const std::string& name) {
   std::vector<unsigned char> pixels(image.rgb.size());
   for (size_t i = 0; i < pixels.size(); ++i) pixels[i] = encode_srgb(image.rgb[i]);
-  std::FILE* file = std::fopen(path.c_str(), "wb");
-  if (!file) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
-  const bool ok = encode(file, pixels.data(), image.width, image.height);
-  if (std::fclose(file) != 0 || !ok)
-    throw std::runtime_error("cannot write " + path + ": libpng or the file failed");
+  if (!encode(out, pixels.data(), image.width, image.height) || std::fflush(out) != 0 || std::ferror(out))
+    throw std::runtime_error("cannot write " + name + ": libpng or the file failed (" + std::strerror(errno) +
+                             ")");
 }
 
 #else
 bool png_available() { return false; }
 
-void write_png(const Image&, const std::string& path) {
-  throw std::runtime_error("cannot write " + path + ": this build has no libpng");
+void write_png(const Image&, std::FILE*, const std::string& name) {
+  throw std::runtime_error("cannot write " + name + ": this build has no libpng");
 }
 #endif
 

@@ -1,6 +1,8 @@
 // sph-run: runs a scene file and writes its frames (docs/cli.md).
+#include <csignal>
 #include <cstdio>
 #include <exception>
+#include <new>
 #include <string>
 
 #include "cli_options.h"
@@ -96,6 +98,14 @@ int run(int argc, char** argv) {
   if (out.surface && out.surface_radius < 1.5f * out.surface_voxel)
     return fail(kExitScene, cli.scene + ": output.surface.particle_radius: expected at least 1.5 voxels (" +
                                 number_text(1.5f * out.surface_voxel) + " m)");
+  // Each particle is rasterised as a sphere of radius/voxel voxels: past 16 the level set's size
+  // (and its time) grows as the cube of that ratio with nothing to gain for a fluid surface (a
+  // 1e-5 m voxel under a 0.02 m particle asked for 2000 voxels a radius and ran out of memory).
+  if (out.surface && out.surface_radius > 16.0f * out.surface_voxel)
+    return fail(kExitScene, cli.scene +
+                                ": output.surface.voxel_size: expected at least 1/16 of the particle "
+                                "radius (" +
+                                number_text(out.surface_radius / 16.0f) + " m)");
 
   // ---- the backend and the world ---------------------------------------------------------------
   ContextOwner owner;
@@ -136,4 +146,19 @@ int run(int argc, char** argv) {
 }  // namespace
 }  // namespace sph_tools
 
-int main(int argc, char** argv) { return sph_tools::run(argc, argv); }
+// Nothing escapes: every failure is a message and an exit code of docs/cli.md.
+int main(int argc, char** argv) {
+  // A write past the file size limit (ulimit -f) fails with EFBIG, which the writers report,
+  // instead of killing the process with SIGXFSZ halfway through a frame.
+  std::signal(SIGXFSZ, SIG_IGN);
+  try {
+    return sph_tools::run(argc, argv);
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "sph-run: out of memory\n");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "sph-run: %s\n", e.what());
+  } catch (...) {
+    std::fprintf(stderr, "sph-run: an unknown error\n");
+  }
+  return sph_tools::kExitRuntime;
+}

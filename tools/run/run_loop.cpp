@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <exception>
+#include <new>
 
 #include "exit_codes.h"
 #include "frame_writer.h"
@@ -41,7 +42,11 @@ int run_scene(sph_context* context, const std::string& backend_name, const Scene
   uint32_t stepped = 0;
   try {
     SceneRuntime runtime(scene, context);
-    FrameWriter writer(out, runtime);
+    ManifestHeader header;
+    header.scene = cli.scene;
+    header.fps = scene.fps;
+    header.frames = scene.frames;
+    FrameWriter writer(out, runtime, header);
     if (!cli.quiet) {
       std::string formats;
       for (OutputFormat f : out.formats)
@@ -97,21 +102,25 @@ int run_scene(sph_context* context, const std::string& backend_name, const Scene
         if (!cli.quiet)
           std::fprintf(stderr, "sph-run: no ffmpeg on PATH: no preview.mp4 (the PNGs are there)\n");
       } else {
-        const std::string problem = encode_mp4(out.directory + "/preview_%04d.png", 0, scene.fps, mp4);
+        const std::string problem = writer.write_preview_video(scene.fps);
         if (!problem.empty())
           std::fprintf(stderr, "sph-run: warning: preview.mp4: %s\n", problem.c_str());
         else if (!cli.quiet)
           std::fprintf(stderr, "sph-run: wrote %s\n", mp4.c_str());
       }
     }
+    writer.end(signal ? "interrupted" : "complete", written - 1);
     const double wall_s = std::chrono::duration<double>(Clock::now() - run_start).count();
     stats.print(stdout,
                 cli.scene + ": " + std::to_string(stats.frames()) + " frames (" + std::to_string(written) +
                     " written to " + out.directory + "/)",
                 backend_name, wall_s);
     std::fflush(stdout);
-    if (cli.stats_json && !stats.write_json(*cli.stats_json, cli.scene, backend_name, wall_s))
-      std::fprintf(stderr, "sph-run: warning: cannot write %s\n", cli.stats_json->c_str());
+    if (cli.stats_json) {
+      const std::string problem = stats.write_json(*cli.stats_json, cli.scene, backend_name, wall_s);
+      if (!problem.empty())
+        return fail(kExitRuntime, "--stats-json: cannot write " + *cli.stats_json + ": " + problem);
+    }
     return signal ? kExitInterrupted + signal : kExitOk;
   } catch (const SceneError& e) {
     return fail(kExitScene, cli.scene + ": " + e.what());
@@ -125,8 +134,12 @@ int run_scene(sph_context* context, const std::string& backend_name, const Scene
       return kExitBackend;
     }
     return fail(kExitRuntime, e.what());
+  } catch (const std::bad_alloc&) {
+    return fail(kExitRuntime, "out of memory");
   } catch (const std::exception& e) {
     return fail(kExitRuntime, e.what());
+  } catch (...) {
+    return fail(kExitRuntime, "an unknown error");
   }
 }
 

@@ -1,6 +1,8 @@
 #include "run_stats.h"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 
 namespace sph_tools {
 
@@ -53,10 +55,10 @@ void RunStats::print(std::FILE* out, const std::string& what, const std::string&
                static_cast<double>(last_.memory_bytes) / (1024.0 * 1024.0));
 }
 
-bool RunStats::write_json(const std::string& path, const std::string& scene, const std::string& backend,
-                          double wall_s) const {
+std::string RunStats::write_json(const std::string& path, const std::string& scene,
+                                 const std::string& backend, double wall_s) const {
   std::FILE* f = std::fopen(path.c_str(), "w");
-  if (!f) return false;
+  if (!f) return std::strerror(errno);
   static const char* kStages[SPH_STAGE_COUNT] = {"hash_sort", "cell_ranges", "density", "forces",
                                                  "integrate", "collide",     "emit",    "other"};
   const double frames = frames_ > 0 ? frames_ : 1.0;
@@ -77,7 +79,10 @@ bool RunStats::write_json(const std::string& path, const std::string& scene, con
   for (int i = 0; i < SPH_STAGE_COUNT; ++i)
     std::fprintf(f, "\"%s\": %.6g%s", kStages[i], stage_ms_[i], i + 1 < SPH_STAGE_COUNT ? ", " : "");
   std::fprintf(f, "}}\n");
-  return std::fclose(f) == 0;
+  const bool failed = std::ferror(f) != 0;
+  const int error = errno;
+  if (std::fclose(f) != 0) return std::strerror(errno);
+  return failed ? std::strerror(error) : "";
 }
 
 }  // namespace sph_tools

@@ -23,9 +23,10 @@ class RunStats {
   // Prints the summary. `what` heads it ("dam_break.json: 120 frames").
   void print(std::FILE* out, const std::string& what, const std::string& backend, double wall_s) const;
   uint32_t frames() const { return frames_; }
-  // Writes the same figures as print() as one JSON object; false when the file cannot be written.
-  bool write_json(const std::string& path, const std::string& scene, const std::string& backend,
-                  double wall_s) const;
+  // Writes the same figures as print() as one JSON object; returns "" or why the file could not
+  // be written.
+  std::string write_json(const std::string& path, const std::string& scene, const std::string& backend,
+                         double wall_s) const;
 
  private:
   uint32_t frames_ = 0;

@@ -42,7 +42,9 @@ void parse_time(const JsonNode& node, SceneDesc* scene) {
   if (node.missing()) return;
   node.expect_object("time", {"fps", "frames"});
   scene->fps = node["fps"].opt_positive(scene->fps);
-  if (scene->fps > 100000.0f) node["fps"].fail("a frame rate in (0, 100000]");
+  // A frame of 1 / fps seconds: below 0.001 fps (a frame of more than 1000 s) the frame time
+  // leaves what the library's step takes (1 / 1e-40 is +Inf in float32).
+  if (scene->fps > 100000.0f || scene->fps < 0.001f) node["fps"].fail("a frame rate in [0.001, 100000]");
   scene->frames = node["frames"].opt_count(scene->frames, 0, 10000000);
 }
 

@@ -1,12 +1,12 @@
 #include "scene_parser.h"
 
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
-#include <fstream>
 #include <set>
-#include <sstream>
 
 #include "json_node.h"
 #include "parse_parts.h"
@@ -115,17 +115,47 @@ SceneDesc parse_scene(const std::string& text, const std::string& base_dir) {
   return scene;
 }
 
-SceneDesc load_scene_file(const std::string& file) {
+namespace {
+
+// A scene file is JSON of a few kilobytes; its large data (level sets) lives in other files.
+constexpr off_t kMaxSceneFileBytes = 64 << 20;
+
+// Reads a scene file: a regular file of at most 64 MiB, never beyond the size it had when
+// opened (/dev/zero or a FIFO would otherwise be read until memory runs out, or block).
+std::string read_scene_text(const std::string& file) {
+  const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) throw SceneError("", "cannot open " + file + ": " + std::strerror(errno));
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
   struct stat st;
-  if (stat(file.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
-    throw SceneError("", "cannot open " + file + ": a directory, not a scene file");
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw SceneError("", "cannot open " + file + ": " + std::strerror(errno));
-  std::stringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw SceneError("", "cannot read " + file);
+  if (::fstat(fd, &st) != 0) throw SceneError("", "cannot read " + file + ": " + std::strerror(errno));
+  if (S_ISDIR(st.st_mode)) throw SceneError("", "cannot open " + file + ": a directory, not a scene file");
+  if (!S_ISREG(st.st_mode))
+    throw SceneError("", "cannot open " + file + ": not a regular file (a device, FIFO or socket)");
+  if (st.st_size > kMaxSceneFileBytes)
+    throw SceneError("", "cannot open " + file + ": " + std::to_string(st.st_size) +
+                             " bytes, more than a scene file may have (64 MiB)");
+  std::string text(static_cast<size_t>(st.st_size), '\0');
+  size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::read(fd, &text[done], text.size() - done);
+    if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
+    if (n < 0) throw SceneError("", "cannot read " + file + ": " + std::strerror(errno));
+    if (n == 0) break;
+    done += static_cast<size_t>(n);
+  }
+  text.resize(done);
+  return text;
+}
+
+}  // namespace
+
+SceneDesc load_scene_file(const std::string& file) {
+  const std::string text = read_scene_text(file);
   const size_t slash = file.find_last_of('/');
-  SceneDesc scene = parse_scene(text.str(), slash == std::string::npos ? "." : file.substr(0, slash));
+  SceneDesc scene = parse_scene(text, slash == std::string::npos ? "." : file.substr(0, slash));
   scene.file = file;
   return scene;
 }

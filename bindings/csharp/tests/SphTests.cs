@@ -682,6 +682,44 @@ static class Tests
         return t;
     }
 
+    static void ThrowsArgument(Action action, string what)
+    {
+        try
+        {
+            action();
+        }
+        catch (ArgumentException)
+        {
+            return;
+        }
+        throw new Exception(what + ": expected ArgumentException, nothing was thrown");
+    }
+
+    // Issue 23, item 2 (the hostile-input suite): arrays the library would read past never
+    // reach it; velocity needs 3 floats per voxel, origin and size exactly 3 indices.
+    public static void TestSdfUpdateChecksArrays()
+    {
+        using (var ctx = Cpu())
+        using (var ball = Ball(ctx, 0.2f))
+        {
+            var three = new uint[] { 0, 0, 0 };
+            var box = new uint[] { 2, 2, 2 };
+            ThrowsArgument(() => ball.Update(SdfChannel.Velocity, three, box, new float[8]), "velocity with 1 float per voxel");
+            ThrowsArgument(() => ball.Update(SdfChannel.Distance, three, box, new float[7]), "too few floats");
+            ThrowsArgument(() => ball.Update(SdfChannel.Distance, three, box, new float[24]), "too many floats");
+            ThrowsArgument(() => ball.Update(SdfChannel.Distance, new uint[] { 0 }, box, new float[8]), "origin of 1");
+            ThrowsArgument(() => ball.Update(SdfChannel.Distance, three, new uint[] { 2, 2 }, new float[4]), "size of 2");
+            ThrowsArgument(() => ball.Update(SdfChannel.Distance, three, new uint[] { 0, 2, 2 }, new float[0]), "empty box");
+            ThrowsArgument(() => ball.Update(SdfChannel.Distance, three, new uint[] { 65536, 65536, 2 }, new float[8]),
+                           "a box of 2^33 floats");
+            ThrowsArgument(() => ball.Update(SdfChannel.Velocity, three, new uint[] { uint.MaxValue, uint.MaxValue, uint.MaxValue },
+                                             new float[8]), "a box whose float count overflows 64 bits");
+            ball.Update(SdfChannel.Velocity, three, box, new float[24]);
+            ball.Update(SdfChannel.Distance, three, box, new float[8]);
+            AssertEqual(3, ball.Dims.Length, "dims");
+        }
+    }
+
     public static void TestSdfAssets()
     {
         using (var ctx = Cpu())
@@ -715,8 +753,10 @@ static class Tests
                 grid.Update(SdfChannel.Distance, new uint[] { 4, 4, 4 }, new uint[] { 1, 1, 1 }, new float[] { 0.5f });
                 Assert(Math.Abs(grid.Sample(new Vec3(0, 0, 0)) - 0.5f) < 1e-4f, "updated");
                 Throws(Result.ErrorInvalidArgument, () => grid.Update(SdfChannel.Distance, new uint[] { 8, 8, 8 }, new uint[] { 2, 2, 2 }, new float[8]));
-                Throws(Result.ErrorUnsupported, () => SphException.Check(Native.sph_sdf_update(grid.Handle, SdfChannel.Distance, new uint[] { 0, 0, 0 },
-                    new uint[] { 1, 1, 1 }, new float[1], MemoryKind.CudaDevice), "sph_sdf_update"));
+                var zero = FixedUint3.From(new uint[] { 0, 0, 0 });
+                var one = FixedUint3.From(new uint[] { 1, 1, 1 });
+                Throws(Result.ErrorUnsupported, () => SphException.Check(Native.sph_sdf_update(grid.Handle, SdfChannel.Distance, ref zero,
+                    ref one, new float[1], MemoryKind.CudaDevice), "sph_sdf_update"));
             }
             dist[0] = float.NaN;
             Throws(Result.ErrorInvalidArgument, () => Sdf.Create(ctx, dist, n, n, n, map));

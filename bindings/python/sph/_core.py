@@ -13,6 +13,7 @@ from ._errors import SphError, check
 from ._loader import library
 from ._options import WorldOptionsMixin
 from ._scene import Sdf, WorldSceneMixin
+from ._struct import check_int
 
 __all__ = ["Context", "World", "attribute_format", "version", "abi_version", "build_info", "result_string",
            "live_object_count", "make_version"]
@@ -381,6 +382,9 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
         """
         attribute = _g.Attribute(attribute)
         dtype, comps = attribute_format(attribute)
+        check_int(ctypes.c_uint32, first, "first")
+        if count is not None:
+            check_int(ctypes.c_uint32, count, "count")
         if count is None:
             count = max(self.particle_count - first, 0) if out is None else len(out)
         if out is None:

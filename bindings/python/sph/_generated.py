@@ -10,7 +10,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '436aef93b798522d5d9f86d7855b4fc1320ded56fc8114b24e33b5f43a5ab6b2', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
+HEADERS = {'include/sph_c.h': '3d2ae0c225ce462edc20d2f0301161896a5b2834da3d4aa80fd9a6bbb39c0b46', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -44,6 +44,17 @@ SPH_FEATURE_NORMALIZED_DENSITY = 2
 #: spawn shape), with rest lengths that yield and creep; sph_spring_params. Costs 128 bytes per
 #: particle (host) or 256 (device) and a spring pass per force evaluation.
 SPH_FEATURE_SPRINGS = 4
+#: Walls in the density: every collider's solid counts in the particles' density sums (a density
+#: map per SDF asset, Koschier & Bender 2017, calibrated on the particle lattice), and the wall
+#: pushes back through the pressure force, so particles at a wall no longer read low density: a
+#: resting FCC block from sph_world_fill_box reads rho0 at axis-aligned walls (77 % without), a
+#: settled tank's pressure near its walls is within 19-26 % of rho0 g d at the default stiffness
+#: (40-72 % low without). Edges and corners read high when a lattice is placed into them
+#: (docs/physics.md). The maps are computed per asset and kernel radius when a collider first steps
+#: with the asset and after sph_sdf_update (16 bytes per SDF voxel; on the device for CUDA). The
+#: collision response stays the no-penetration safeguard. Costs one SDF sample per particle and
+#: collider in each density pass.
+SPH_FEATURE_BOUNDARY_DENSITY = 8
 #: Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt <= step_factor h / c, c the
 #: EOS's speed of sound
 SPH_STEP_LIMIT_ACOUSTIC = 1
@@ -1580,7 +1591,7 @@ FUNCTIONS = {
     'sph_context_create': (sph_result, (_c.POINTER(sph_context_def), _c.POINTER(_c.POINTER(sph_context))), ('def', 'out'),
         'Creates a context: a backend (CPU or one CUDA device) that worlds are created on. Errors: INVALID_ARGUMENT (NULL, bad field: a cuda_*_block that is not 0 or a power of two from 32 to 1024, say), VERSION_MISMATCH (struct_size or a newer-major header), UNSUPPORTED (CUDA asked for but not built or no device; an unknown backend or cuda_frames value), OUT_OF_HOST_MEMORY. *out is written only on success. Thread-safe.', 'sph'),
     'sph_context_destroy': (sph_result, (_c.POINTER(sph_context),), ('context',),
-        'Destroys a context. NULL is a no-op. BUSY while worlds created on it are alive.', 'sph'),
+        'Destroys a context. NULL is a no-op. BUSY while worlds or SDF assets created on it are alive, or while another thread is creating one on it.', 'sph'),
     'sph_context_get_backend': (sph_result, (_c.POINTER(sph_context), _c.POINTER(sph_backend)), ('context', 'out_backend'),
         'The backend the context resolved to (CPU or CUDA; never AUTO).', 'sph'),
     'sph_world_def_init_sized': (sph_result, (_c.POINTER(sph_world_def), _c.c_uint32), ('def', 'size'),
@@ -1588,7 +1599,7 @@ FUNCTIONS = {
     'sph_world_create': (sph_result, (_c.POINTER(sph_context), _c.POINTER(sph_world_def), _c.POINTER(_c.POINTER(sph_world))), ('context', 'def', 'out'),
         'Creates an empty world on a context. The particle mass is derived here: the mass at which an FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass). Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range: capacity above 2^30, spacing < 0 or non-finite, kernel_radius < spacing, rest_density < 0), UNSUPPORTED (unknown integrator or feature bit), VERSION_MISMATCH, OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY. *out is written only on success.', 'sph'),
     'sph_world_destroy': (sph_result, (_c.POINTER(sph_world),), ('world',),
-        'Destroys a world and everything in it. NULL is a no-op.', 'sph'),
+        "Destroys a world and everything in it. NULL is a no-op. It takes the world like every call that takes a world: WORLD_LOCKED while another thread's call is inside it (destroy again once that call returned); a call that races a destroy that won gets INVALID_HANDLE. Memory a call is using is never freed.", 'sph'),
     'sph_world_get_def': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_world_def)), ('world', 'out_def'),
         'The def the world was created with, with defaults resolved (zeros and kernel_radius filled in).', 'sph'),
     'sph_world_get_particle_mass': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_float)), ('world', 'out_mass'),
@@ -1642,7 +1653,7 @@ FUNCTIONS = {
     'sph_spawn_desc_init_sized': (sph_result, (_c.POINTER(sph_spawn_desc), _c.c_uint32), ('desc', 'size'),
         '', 'sph'),
     'sph_world_spawn': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_spawn_desc), _c.POINTER(_c.c_uint32)), ('world', 'desc', 'out_first_id'),
-        'Adds particles from caller arrays (copied before return). All-or-nothing: on any error (non-finite value, count above the free capacity: SPH_ERROR_CAPACITY) nothing is added. out_first_id (optional) receives the id of the first new particle; ids are consecutive.', 'sph'),
+        'Adds particles from caller arrays (copied before return). All-or-nothing: on any error (non-finite value, a speed of 1.8e19 m/s or more, whose square float32 cannot hold; strides whose span overflows 64 bits; count above the free capacity: SPH_ERROR_CAPACITY) nothing is added. out_first_id (optional) receives the id of the first new particle; ids are consecutive.', 'sph'),
     'sph_fill_box_desc_init_sized': (sph_result, (_c.POINTER(sph_fill_box_desc), _c.c_uint32), ('desc', 'size'),
         '', 'sph'),
     'sph_world_fill_box': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_fill_box_desc), _c.POINTER(_c.c_uint32)), ('world', 'desc', 'out_count'),
@@ -1656,7 +1667,7 @@ FUNCTIONS = {
     'sph_world_get_particle_count': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_uint32)), ('world', 'out_count'),
         'Number of particles in the world.', 'sph'),
     'sph_world_copy_attribute': (sph_result, (_c.POINTER(sph_world), sph_attribute, _c.c_void_p, _c.c_uint64, _c.c_uint64, _c.c_uint32, _c.c_uint32, _c.POINTER(_c.c_uint32)), ('world', 'attribute', 'dst', 'dst_size', 'dst_stride', 'first', 'count', 'out_written'),
-        "Copies particles [first, first + count) of one attribute into caller memory. Particles come in the world's current order (cell order after the last step): use SPH_ATTRIBUTE_ID to match particles between calls. Each element is written at dst + i * dst_stride (dst_stride 0 = the element's size: 12 bytes for vectors, 4 for scalars); dst_size is the size of the buffer at dst in bytes. count is clamped to the particles available; out_written (optional) receives how many were written. Blocks until the data is ready. Errors: INVALID_ARGUMENT (NULL dst, stride smaller than the element, first > particle count), BUFFER_TOO_SMALL (dst_size cannot hold count elements), UNSUPPORTED (unknown attribute). Nothing is written on error.", 'sph'),
+        "Copies particles [first, first + count) of one attribute into caller memory. Particles come in the world's current order (cell order after the last step): use SPH_ATTRIBUTE_ID to match particles between calls. Each element is written at dst + i * dst_stride (dst_stride 0 = the element's size: 12 bytes for vectors, 4 for scalars); dst_size is the size of the buffer at dst in bytes. count is clamped to the particles available; out_written (optional) receives how many were written. Blocks until the data is ready. Errors: INVALID_ARGUMENT (NULL dst, stride smaller than the element, first > particle count, a span (n - 1) * dst_stride + element that overflows 64 bits or exceeds PTRDIFF_MAX), BUFFER_TOO_SMALL (dst_size cannot hold count elements), UNSUPPORTED (unknown attribute). Nothing is written on error.", 'sph'),
     'sph_stats_init_sized': (sph_result, (_c.POINTER(sph_stats), _c.c_uint32), ('stats', 'size'),
         '', 'sph'),
     'sph_world_get_stats': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_stats)), ('world', 'out'),
@@ -1678,7 +1689,7 @@ FUNCTIONS = {
     'sph_sdf_sample': (sph_result, (_c.POINTER(sph_sdf), sph_vec3, _c.POINTER(_c.c_float)), ('sdf', 'local_point', 'out_distance'),
         "Samples the signed distance at a point of the asset's local frame (for tools and tests).", 'sph'),
     'sph_sdf_destroy': (sph_result, (_c.POINTER(sph_sdf),), ('sdf',),
-        "Releases the caller's reference; colliders and the like keep the asset alive. NULL: no-op.", 'sph'),
+        "Releases the caller's reference; colliders and the like keep the asset alive, and so do calls on the handle that other threads are in. NULL: no-op.", 'sph'),
     'sph_transform_identity': (sph_transform, (), (),
         'The identity transform (exported twin of a constant, for bindings).', 'sph'),
     'sph_collider_def_init_sized': (sph_result, (_c.POINTER(sph_collider_def), _c.c_uint32), ('def', 'size'),
@@ -1728,11 +1739,11 @@ FUNCTIONS = {
     'sph_world_save': (sph_result, (_c.POINTER(sph_world), _c.c_void_p, _c.c_uint64, _c.POINTER(_c.c_uint64)), ('world', 'buffer', 'buffer_size', 'out_size'),
         'Saves a world into caller memory. Size query: buffer NULL and buffer_size 0 set *out_size to the bytes needed and return SPH_OK. Otherwise the checkpoint is written when it fits (*out_size: the bytes written), else SPH_ERROR_BUFFER_TOO_SMALL with *out_size the bytes needed and nothing written. The size can change whenever the world does. Blocks (a CUDA world copies its particles to the host). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL out_size, NULL buffer with a non-zero size), BUFFER_TOO_SMALL, WORLD_LOCKED, OUT_OF_HOST_MEMORY, DEVICE.', 'sph'),
     'sph_world_save_file': (sph_result, (_c.POINTER(sph_world), _c.c_char_p), ('world', 'path'),
-        'Saves a world into a file, atomically: the checkpoint goes to a new file next to `path` (path + ".tmp-" + a unique suffix), is flushed to the disk (fsync), and is then renamed to `path`, replacing any file there. A crash leaves either the old file or the new one, never a partial one; on any error the temporary file is removed and a file at `path` is untouched. path is UTF-8 (a narrow path on POSIX). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL or empty path; the file cannot be created, written or renamed: the message says why), WORLD_LOCKED, OUT_OF_HOST_MEMORY, DEVICE.', 'sph'),
+        'Saves a world into a file, atomically: the checkpoint goes to a new file next to `path` (path + ".tmp-" + a unique suffix), is flushed to the disk (fsync), and is then renamed to `path`, replacing any file there. A crash leaves either the old file or the new one, never a partial one; on any error the temporary file is removed and a file at `path` is untouched. Each save first removes the temporary files of killed saves to `path` on this host (those whose process is gone; docs/checkpoint.md). path is UTF-8 (a narrow path on POSIX). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL or empty path; the file cannot be created, written or renamed: the message says why), WORLD_LOCKED, OUT_OF_HOST_MEMORY, DEVICE.', 'sph'),
     'sph_world_load': (sph_result, (_c.POINTER(sph_context), _c.c_void_p, _c.c_uint64, _c.POINTER(_c.POINTER(sph_world))), ('context', 'data', 'size', 'out'),
         'Creates a new world on `context` from a checkpoint in memory (data is read only during the call). The context decides the backend, whichever backend saved it. The whole checkpoint is validated before anything is created: on any error no world is created and *out is not written. Errors: INVALID_HANDLE (context), INVALID_ARGUMENT (NULL data or out), CORRUPT_DATA (truncated, damaged or inconsistent data; the message names the section and what is wrong), VERSION_MISMATCH (a checkpoint format this library does not read), OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY.', 'sph'),
     'sph_world_load_file': (sph_result, (_c.POINTER(sph_context), _c.c_char_p, _c.POINTER(_c.POINTER(sph_world))), ('context', 'path', 'out'),
-        'sph_world_load from a file. INVALID_ARGUMENT also when the file cannot be opened or read.', 'sph'),
+        'sph_world_load from a file. INVALID_ARGUMENT also when the file cannot be opened or read, is not a regular file (a FIFO, a device such as /dev/zero, a directory: refused without reading) or is larger than 256 GiB.', 'sph'),
     'sph_world_restore': (sph_result, (_c.POINTER(sph_world), _c.c_void_p, _c.c_uint64), ('world', 'data', 'size'),
         "Replaces a world's whole state with a checkpoint's (undo, retry): afterwards the world is as a world loaded from it on the same context, and keeps its handle. All-or-nothing: on any error the world is unchanged. Errors: as sph_world_load, and WORLD_LOCKED.", 'sph'),
     'sph_cuda_attribute_view_init_sized': (sph_result, (_c.POINTER(sph_cuda_attribute_view), _c.c_uint32), ('view', 'size'),

@@ -63,6 +63,16 @@ def check_layouts(structs=_g.STRUCTS, pointer_size=_g.POINTER_SIZE):
         raise SphLoadError("struct layouts differ from the C library's: " + "; ".join(problems))
 
 
+def check_integer_arguments(lib, library_name="sph"):
+    """Integer arguments refuse values that do not fit their C type (ctypes would pass them
+    modulo 2^bits: first=2**32 + 5 as 5): OverflowError, reported as ctypes.ArgumentError."""
+    from ._struct import checked_argtype
+
+    for name, (_restype, argtypes, _names, _doc, lib_name) in _g.FUNCTIONS.items():
+        if lib_name == library_name and hasattr(lib, name):
+            getattr(lib, name).argtypes = tuple(checked_argtype(t) for t in argtypes)
+
+
 def load(path=None):
     """Loads and checks a library (path, or the search order above). Returns the CDLL; does
     not replace the library the package uses (see library())."""
@@ -93,6 +103,7 @@ def load(path=None):
     if missing:
         raise SphLoadError(f"{path} does not export {', '.join(missing)}: it is older than the header these "
                            f"bindings were generated from (sph {'.'.join(map(str, _g.VERSION))})")
+    check_integer_arguments(lib)
     check_layouts()
     lib._sph_path = path
     return lib
@@ -149,6 +160,7 @@ def helper_library(name="sph_vdb"):
         missing = _g.bind(lib, name)
         if missing:
             raise SphLoadError(f"{p} does not export {', '.join(missing)}")
+        check_integer_arguments(lib, name)
         lib._sph_path = p
         with _lock:
             _helpers.setdefault(name, lib)

@@ -7,6 +7,7 @@ import numpy as np
 from . import _generated as _g
 from ._errors import check
 from ._loader import library
+from ._struct import check_int
 
 __all__ = ["Sdf", "Collider", "Source", "Sink", "ForceField", "as_transform", "grid_transform", "WorldSceneMixin"]
 
@@ -146,14 +147,21 @@ class Sdf:
         Updating a channel the asset lacks creates it."""
         channel = _g.SdfChannel[channel.upper()] if isinstance(channel, str) else _g.SdfChannel(channel)
         a = np.ascontiguousarray(data, dtype=np.float32)
-        if a.ndim == 4:
-            a3 = a.shape[:3]
-        elif a.ndim == 3:
-            a3 = a.shape
-        else:
-            raise ValueError(f"data: expected (sk, sj, si) or (sk, sj, si, 3), got {a.shape}")
-        size = (ctypes.c_uint32 * 3)(a3[2], a3[1], a3[0])
-        at = (ctypes.c_uint32 * 3)(*origin)
+        # The library reads size[0] * size[1] * size[2] * components floats: the array's shape
+        # must be exactly the channel's (a 3-D array for the velocity channel was read three
+        # times its size).
+        if channel == _g.SdfChannel.VELOCITY:
+            if a.ndim != 4 or a.shape[3] != 3:
+                raise ValueError(f"data: the velocity channel needs shape (sk, sj, si, 3), got {a.shape}")
+        elif a.ndim != 3:
+            raise ValueError(f"data: the {channel.name.lower()} channel needs shape (sk, sj, si), got {a.shape}")
+        if 0 in a.shape:
+            raise ValueError(f"data: the box is empty (shape {a.shape})")
+        origin = tuple(origin)
+        if len(origin) != 3:
+            raise ValueError(f"origin: expected 3 grid indices (i, j, k), got {len(origin)}")
+        size = (ctypes.c_uint32 * 3)(*(check_int(ctypes.c_uint32, n, "data shape") for n in a.shape[2::-1]))
+        at = (ctypes.c_uint32 * 3)(*(check_int(ctypes.c_uint32, v, f"origin[{i}]") for i, v in enumerate(origin)))
         check(library().sph_sdf_update(self.handle, int(channel), at, size,
                                        a.ctypes.data_as(ctypes.POINTER(ctypes.c_float)), _g.SPH_MEMORY_HOST),
               "sph_sdf_update")

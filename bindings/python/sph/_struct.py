@@ -10,6 +10,51 @@ class Opaque(ctypes.Structure):
     _sph_destroy_ = None
 
 
+# ctypes stores an int into an integer field or argument modulo 2^bits, silently (a capacity of
+# 2^32 + 5 became 5). Every integer the bindings hand to C goes through check_int first.
+_INTEGER_CODES = "bBhHiIlLqQ"
+
+
+def int_range(ctype):
+    """(lo, hi) of a ctypes integer type, or None for any other type."""
+    code = getattr(ctype, "_type_", None)
+    if not isinstance(code, str) or code not in _INTEGER_CODES:
+        return None
+    bits = 8 * ctypes.sizeof(ctype)
+    return (-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if code.islower() else (0, (1 << bits) - 1)
+
+
+def check_int(ctype, value, what):
+    """Raises OverflowError when `value` (an int, or anything with __index__) does not fit the
+    ctypes integer type `ctype`; returns the value. Other values pass unchanged (ctypes decides)."""
+    bounds = int_range(ctype)
+    if bounds is None or isinstance(value, bool) or not hasattr(value, "__index__"):
+        return value
+    v = value.__index__()
+    if not bounds[0] <= v <= bounds[1]:
+        kind = ("int" if bounds[0] < 0 else "uint") + str(8 * ctypes.sizeof(ctype))
+        raise OverflowError(f"{what}: {v} does not fit {kind} ({bounds[0]}..{bounds[1]})")
+    return value
+
+
+_checked_types = {}
+
+
+def checked_argtype(ctype):
+    """ctype for a function argument, with a from_param that refuses integers that do not fit
+    (OverflowError, which ctypes reports as ArgumentError naming the argument's position)."""
+    if int_range(ctype) is None:
+        return ctype
+    checked = _checked_types.get(ctype)
+    if checked is None:
+        def from_param(cls, value, _base=ctype):
+            return _base.from_param(check_int(_base, value, "value"))
+
+        checked = type("Checked_" + ctype.__name__, (ctype,), {"from_param": classmethod(from_param)})
+        _checked_types[ctype] = checked
+    return checked
+
+
 def _field_types(cls):
     cached = cls.__dict__.get("_sph_field_types_")
     if cached is None:
@@ -18,8 +63,8 @@ def _field_types(cls):
     return cached
 
 
-def _convert(ftype, value):
-    """Accepts tuples/lists/arrays for struct and fixed-array fields."""
+def _convert(ftype, value, what="value"):
+    """Accepts tuples/lists/arrays for struct and fixed-array fields; range-checks integers."""
     if isinstance(value, ftype):
         return value
     if isinstance(ftype, type) and issubclass(ftype, SphStruct):
@@ -29,9 +74,9 @@ def _convert(ftype, value):
     if isinstance(ftype, type) and issubclass(ftype, ctypes.Array):
         values = list(value)
         if len(values) != ftype._length_:
-            raise ValueError(f"expected {ftype._length_} values, got {len(values)}")
-        return ftype(*values)
-    return value
+            raise ValueError(f"{what}: expected {ftype._length_} values, got {len(values)}")
+        return ftype(*(check_int(ftype._type_, v, f"{what}[{i}]") for i, v in enumerate(values)))
+    return check_int(ftype, value, what)
 
 
 def _enum_value(enum_cls, value, what):
@@ -111,7 +156,7 @@ class SphStruct(ctypes.Structure):
         enums = type(self)._sph_enums_
         if enums and name in enums:
             value = _enum_value(enums[name], value, f"{type(self).__name__}.{name}")
-        super().__setattr__(name, _convert(ftype, value))
+        super().__setattr__(name, _convert(ftype, value, f"{type(self).__name__}.{name}"))
 
     def __getattribute__(self, name):
         value = super().__getattribute__(name)

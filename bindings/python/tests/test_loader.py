@@ -9,6 +9,7 @@ import sys
 import pytest
 
 import sph
+from sph._struct import checked_argtype
 from sph import _generated as g
 from sph import _loader
 
@@ -63,7 +64,9 @@ def test_every_function_is_bound_with_its_prototype(api):
         if library != "sph":
             continue
         fn = getattr(lib._lib, name)
-        assert fn.restype is restype and tuple(fn.argtypes) == tuple(argtypes), name
+        # Integer parameters carry a range check (checked_argtype); each is its C type still.
+        assert fn.restype is restype and tuple(fn.argtypes) == tuple(checked_argtype(t) for t in argtypes), name
+        assert all(issubclass(got, want) for got, want in zip(fn.argtypes, argtypes)), name
         assert fn.__doc__ == doc
 
 

@@ -1,0 +1,21 @@
+// Checkpoint files: written atomically (a temporary file next to the target, flushed and
+// renamed), read only from regular files of bounded size, and the temporary files of saves
+// that were killed removed by the next save to the same path (docs/checkpoint.md).
+#pragma once
+
+#include <stdint.h>
+
+#include <string>
+#include <vector>
+
+namespace sph {
+
+// Writes `bytes` to `path` atomically: a crash leaves the old file or the new one. Throws
+// Error(InvalidArgument) naming the step that failed; the temporary file is removed then.
+void write_file_atomically(const std::string& path, const std::vector<uint8_t>& bytes);
+
+// Reads a whole regular file of at most 256 GiB; anything else (a directory, device, FIFO,
+// socket, or a larger file) is refused with Error(InvalidArgument) before it is read.
+std::vector<uint8_t> read_checkpoint_file(const char* path);
+
+}  // namespace sph

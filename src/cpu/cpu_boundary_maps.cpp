@@ -1,0 +1,52 @@
+#include "cpu_boundary_maps.h"
+
+#include "../physics/boundary_map.h"
+
+namespace sph {
+
+std::vector<Float4> compute_boundary_map(const SdfAsset& asset, float h, float level, unsigned workers) {
+  std::vector<Float4> map(asset.voxel_count(), Float4{0.0f, 0.0f, 0.0f, 0.0f});
+  const SdfGridView g = asset.host_view();
+  const Affine3x4 index_to_local = asset.index_to_local();
+  const int64_t planes = static_cast<int64_t>(asset.ny()) * asset.nz();
+  // One (j, k) row of voxels per iteration; the band's rows cost far more than the rest, so the
+  // rows are dealt out dynamically.
+#pragma omp parallel for num_threads(workers == 0 ? 1u : workers) schedule(dynamic, 4)
+  for (int64_t row = 0; row < planes; ++row) {
+    const int32_t j = static_cast<int32_t>(row % asset.ny()), k = static_cast<int32_t>(row / asset.ny());
+    for (int32_t i = 0; i < asset.nx(); ++i)
+      map[static_cast<size_t>(i) + static_cast<size_t>(asset.nx()) * static_cast<size_t>(row)] =
+          boundary_map_correction(g, index_to_local, i, j, k, h, level);
+  }
+  return map;
+}
+
+const Float4* CpuBoundaryMaps::bind(const SdfAsset& asset, float h, float level, unsigned workers) {
+  Entry& e = entries_[std::make_pair(asset.uid(), level)];
+  e.last_frame = frame_;
+  if (e.version != asset.version() || e.kernel_radius != h || e.correction.size() != asset.voxel_count()) {
+    e.version = 0;  // until the map below is complete
+    e.correction = compute_boundary_map(asset, h, level, workers);
+    e.kernel_radius = h;
+    e.version = asset.version();
+    ++builds_;
+  }
+  return e.correction.data();
+}
+
+void CpuBoundaryMaps::end_frame() {
+  for (auto it = entries_.begin(); it != entries_.end();) {
+    if (it->second.last_frame != frame_)
+      it = entries_.erase(it);
+    else
+      ++it;
+  }
+}
+
+uint64_t CpuBoundaryMaps::bytes() const {
+  uint64_t total = 0;
+  for (const auto& kv : entries_) total += kv.second.correction.size() * sizeof(Float4);
+  return total;
+}
+
+}  // namespace sph

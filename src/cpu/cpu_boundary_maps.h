@@ -1,0 +1,50 @@
+// The CPU backend's boundary-density maps (SPH_FEATURE_BOUNDARY_DENSITY; the physics is
+// src/physics/boundary_map.h): one map per SDF asset the world's colliders use, computed on host
+// threads for the world's kernel radius when a collider first steps with the asset and again
+// after every change of it (SdfAsset::version: sph_sdf_update), and dropped when no collider uses
+// the asset any more (the twin of cuda/device_boundary_maps.h).
+#pragma once
+
+#include <stdint.h>
+
+#include <map>
+#include <utility>
+#include <vector>
+
+#include "../core/sdf_asset.h"
+#include "../physics/float4_types.h"
+
+namespace sph {
+
+class CpuBoundaryMaps {
+ public:
+  // Marks the start of a frame's binding: maps not bound again until end_frame() are dropped.
+  void begin_frame() { ++frame_; }
+  // The map of an asset for kernel radius h and SDF level `level` (boundary_map.h), computed on
+  // `workers` threads when new or stale.
+  const Float4* bind(const SdfAsset& asset, float h, float level, unsigned workers);
+  void end_frame();
+  // 16 bytes per voxel of every map held.
+  uint64_t bytes() const;
+  // Maps computed since the backend was made (tests: a changed asset recomputes, an unchanged
+  // one does not).
+  uint64_t builds() const { return builds_; }
+
+ private:
+  struct Entry {
+    uint64_t version = 0;
+    float kernel_radius = 0.0f;
+    uint64_t last_frame = 0;
+    std::vector<Float4> correction;
+  };
+  std::map<std::pair<uint64_t, float>, Entry> entries_;  // by asset uid and level
+  uint64_t frame_ = 0;
+  uint64_t builds_ = 0;
+};
+
+// The map of an asset for kernel radius h and SDF level `level` (every voxel; zero outside the band
+// |phi - level| < h), on `workers` threads. Exposed for tests, which compare it with a brute-force
+// integral.
+std::vector<Float4> compute_boundary_map(const SdfAsset& asset, float h, float level, unsigned workers);
+
+}  // namespace sph

@@ -1,0 +1,241 @@
+// Walls in the density (SPH_FEATURE_BOUNDARY_DENSITY): a collider's solid counts in every
+// particle's density sum, as a density map (Koschier & Bender 2017, "Density maps for improved
+// SPH boundary handling"), so particles at a wall read the bulk's density instead of 70-80 % of
+// it, and the wall pushes back through the pressure force.
+//
+// The boundary's share of particle i's density is
+//     rho_b(x_i) = K Phi(x_i),   Phi(x) = int over the solid moved back by delta of W_spiky(|x - y|, h) dy,
+// Phi in [0, 1] the share of the kernel's unit mass inside the solid whose surface is moved delta
+// into it (the level set sigma phi = -delta of the collider's SDF). K (kg/m^3) and delta (m) are
+// calibrated on the FCC lattice (core/fcc_lattice.h, fcc_boundary_calibration): the fluid's
+// density is a discrete sum, rho_i = m (w0 + sum_{j != i} s W_spiky(r_ij)), and at a wall along
+// the lattice's (100) plane the first layer (spacing/2 from the wall) misses the sum over the half
+// lattice beyond it; K and delta make rho_b equal that sum there and its slope twice the sum's
+// (the fluid's pairs, each counted by both its particles, push the layer towards the wall by
+// that much at uniform pressure). 12.0 rho0 and 0.49 spacings at h = 1.8 spacings; docs/physics.md.
+//
+// Phi is sampled, per collider, as the flat-wall value of the collider's own signed distance
+// plus a correction stored per SDF voxel (boundary_map.h):
+//     Phi(x) = Phi_flat(sigma (phi(x) - L)) + sigma dPhi_L(x),   L = -sigma delta,
+//     grad Phi = Phi_flat'(...) sigma grad phi + sigma d(grad Phi)_L(x),
+// phi the SDF (trilinear), sigma the collider's sign (-1 for an inverted collider, whose solid is
+// the complement: Phi = 1 - the share of {phi < L}), Phi_flat the closed-form half-space share
+// (boundary_integrals.h), and the correction (trilinear) for the level L what curvature, corners
+// and thin walls add, computed per asset, kernel radius and level by a quadrature over the solid.
+// A flat wall is exact at any voxel size (the trilinear SDF of a plane is the plane).
+//
+// The pressure force of the wall (Akinci et al. 2012 with the wall's share as the boundary
+// "particles"): a_i = -(p_i / rho_i^2) grad rho_b(x_i). It is minus the gradient of the fluid's
+// internal energy sum_i m e(rho_i) through rho_b (de/drho = p / rho^2), as the symmetric pair force
+// is through the pairs, so a static wall does no net work on the fluid (a mirrored pressure,
+// 2 p_i / rho_i^2, is not a gradient: measured, it kept a tank at rest sloshing at 0.3-0.8 J where
+// this one settles). Its reaction on the collider is +m (p_i / rho_i^2) grad rho_b(x_i) per
+// particle and collider (collider_boundary_share keeps each collider's share apart for a
+// reduction of loads).
+//
+// Interface for the solvers (the density pass and DFSPH): per particle, boundary_share() sums the
+// colliders' shares at the particle's position and the stage's time; the density pass adds
+// .density to rho_i and stores pack_boundary() in the per-particle array kArrayBoundaryGradient
+// (Scratch, sorted order, one Float4: grad rho_b and the wall's velocity flux), which the force
+// pass and the DFSPH solves read:
+//   - WCSPH force:        a_i += boundary_pressure_acceleration(record, p_i, 1 / rho_i)
+//   - DFSPH alpha:        sum_j m grad W_ij + boundary_gradient(record) in the squared sum
+//   - DFSPH density rate: d rho_i / dt += boundary_density_rate(record, v_i)
+//                         (sum over colliders of (v_i - v_b) . grad rho_b)
+//   - DFSPH velocity:     v_i -= dt (kappa_i / rho_i) boundary_gradient(record)
+//                         (the wall's share with kappa_i alone, as the boundary has no kappa)
+#pragma once
+
+#include <stdint.h>
+
+#include "boundary_integrals.h"
+#include "collider_response.h"
+#include "float4_types.h"
+#include "particle_array_spec.h"
+#include "world_shape.h"
+
+namespace sph {
+
+constexpr const char* kArrayBoundaryGradient = "boundary_gradient";  // boundary density, Float4
+
+struct BoundaryDensity {
+  static constexpr const char* kName = "boundary_density";
+  // (grad rho_b, v_b . grad rho_b) of the last density pass, in sorted order.
+  static constexpr ParticleArraySpec kArrays[] = {
+      {kArrayBoundaryGradient, sizeof(Float4), ParticleArrayRole::Scratch, 1, nullptr, nullptr}};
+
+  struct Constants {
+    float density_scale;   // K, kg/m^3: rho_b = K Phi
+    float kernel_radius;   // h, m (the maps are made for it)
+    float surface_offset;  // delta, m: Phi is the share of the solid moved this far into it
+  };
+
+  static Constants make_constants(const WorldShape& shape, const LatticeSums& lattice) {
+    double scale = 0.0, offset = 0.0;
+    lattice.boundary_calibration(shape.particle_spacing, shape.kernel_radius, &scale, &offset);
+    Constants c;
+    c.density_scale = static_cast<float>(scale * static_cast<double>(shape.particle_mass));
+    c.kernel_radius = shape.kernel_radius;
+    c.surface_offset = static_cast<float>(offset);
+    return c;
+  }
+
+  // The SDF level whose solid a collider of this sign counts (the map is made for it).
+  SPH_HD static float map_level(const Constants& c, float sign) { return -sign * c.surface_offset; }
+};
+
+// One collider's share of a particle's density, or the sum of several.
+struct BoundaryShare {
+  float density;        // rho_b(x), kg/m^3
+  Vec3 gradient;        // grad rho_b(x), kg/m^4, world frame (points into the solid)
+  float velocity_flux;  // v_b(x) . grad rho_b(x), kg/(m^3 s): the wall's motion (0 when static)
+};
+
+// Float4 arithmetic for the trilinear interpolation of the map (sdf_sampling.h's lerp_value).
+SPH_HD Float4 operator+(const Float4& a, const Float4& b) {
+  return Float4{a.x + b.x, a.y + b.y, a.z + b.z, a.w + b.w};
+}
+SPH_HD Float4 operator-(const Float4& a, const Float4& b) {
+  return Float4{a.x - b.x, a.y - b.y, a.z - b.z, a.w - b.w};
+}
+SPH_HD Float4 operator*(const Float4& a, float s) { return Float4{a.x * s, a.y * s, a.z * s, a.w * s}; }
+
+SPH_HD BoundaryShare no_boundary_share() { return BoundaryShare{0.0f, Vec3{0.0f, 0.0f, 0.0f}, 0.0f}; }
+
+// The SDF's trilinear value and its gradient (index space) in one cell, from the 8 corners.
+struct TrilinearGradient {
+  float value;
+  Vec3 gradient;  // d/d(index)
+};
+
+SPH_HD TrilinearGradient trilinear_with_gradient(const float* data, const SdfGridView& g,
+                                                 const TrilinearCell& c) {
+  const int32_t di = g.nx > 1 ? 1 : 0, dj = g.ny > 1 ? g.nx : 0, dk = g.nz > 1 ? g.nx * g.ny : 0;
+  const float* p = data + (static_cast<int64_t>(c.i) +
+                           static_cast<int64_t>(g.nx) * (c.j + static_cast<int64_t>(g.ny) * c.k));
+  const float c000 = p[0], c100 = p[di], c010 = p[dj], c110 = p[dj + di];
+  const float c001 = p[dk], c101 = p[dk + di], c011 = p[dk + dj], c111 = p[dk + dj + di];
+  const float x00 = lerp_value(c000, c100, c.fx), x10 = lerp_value(c010, c110, c.fx);
+  const float x01 = lerp_value(c001, c101, c.fx), x11 = lerp_value(c011, c111, c.fx);
+  const float y0 = lerp_value(x00, x10, c.fy), y1 = lerp_value(x01, x11, c.fy);
+  TrilinearGradient out;
+  out.value = lerp_value(y0, y1, c.fz);
+  out.gradient.z = g.nz > 1 ? y1 - y0 : 0.0f;
+  const float dy0 = x10 - x00, dy1 = x11 - x01;
+  out.gradient.y = g.ny > 1 ? lerp_value(dy0, dy1, c.fz) : 0.0f;
+  const float dx00 = c100 - c000, dx10 = c110 - c010, dx01 = c101 - c001, dx11 = c111 - c011;
+  out.gradient.x =
+      g.nx > 1 ? lerp_value(lerp_value(dx00, dx10, c.fy), lerp_value(dx01, dx11, c.fy), c.fz) : 0.0f;
+  return out;
+}
+
+// Phi and grad Phi (local frame) of the solid where sigma (phi - level) < 0, at a local point: the
+// flat-wall share of the trilinear SDF plus the map's correction for that level (null map: the
+// flat-wall share alone).
+struct LocalBoundaryShare {
+  float share;    // Phi in [0, 1] (up to the correction's error)
+  Vec3 gradient;  // grad Phi, 1/m, local frame
+};
+
+SPH_HD LocalBoundaryShare local_boundary_share(const SdfGridView& g, const Float4* correction, float sign,
+                                               float level, float h, Vec3 local) {
+  const Vec3 idx = apply_affine(g.local_to_index, local);
+  const TrilinearCell cell = locate(g, local);
+  const TrilinearGradient phi = trilinear_with_gradient(g.distance, g, cell);
+  // Beyond the grid the SDF grows by the distance to its box (sample_distance); so does phi here,
+  // with that distance's gradient.
+  float distance = phi.value + cell.outside;
+  Vec3 gradient_index = phi.gradient;
+  if (cell.outside > 0.0f) {
+    const Vec3 away{idx.x - (static_cast<float>(cell.i) + cell.fx),
+                    idx.y - (static_cast<float>(cell.j) + cell.fy),
+                    idx.z - (static_cast<float>(cell.k) + cell.fz)};
+    const float n = length(away);
+    if (n > 0.0f) gradient_index += away * (g.min_voxel_size / n);
+  }
+  distance = sign * (distance - level);
+  LocalBoundaryShare out;
+  out.share = spiky_half_space(distance, h);
+  out.gradient = apply_linear_transposed(g.local_to_index, gradient_index) *
+                 (spiky_half_space_slope(distance, h) * sign);
+  // Away from the surface by h or more the kernel sees one side only: the correction is zero
+  // there (boundary_map.h), so it is not read.
+  if (correction && distance > -h && distance < h) {
+    const Float4 d = trilinear(correction, g, cell);
+    out.share += sign * d.x;
+    out.gradient += Vec3{d.y, d.z, d.w} * sign;
+  }
+  return out;
+}
+
+// One collider's share at a world point, at frame fraction s and time tau since the frame's start
+// (the pose interpolated as the collider response does; a deforming collider's field advected).
+SPH_HD BoundaryShare collider_boundary_share(const BoundaryDensity::Constants& b, const ColliderView& c,
+                                             Vec3 world, float s, float tau) {
+  RigidTransform pose = c.moving ? interpolate(c.pose_start, c.pose_end, s) : c.pose_start;
+  Vec3 local = to_local(pose, world);
+  if (c.deforming) local = local - sample_velocity(c.sdf, local) * tau;
+  const LocalBoundaryShare l = local_boundary_share(
+      c.sdf, c.boundary_map, c.sign, BoundaryDensity::map_level(b, c.sign), b.kernel_radius, local);
+  BoundaryShare out;
+  out.density = b.density_scale * l.share;
+  out.gradient = direction_to_world(pose, l.gradient) * b.density_scale;
+  out.velocity_flux = 0.0f;
+  if ((c.moving || c.deforming) && out.density > 0.0f) {
+    ColliderSample at;
+    at.pose = pose;
+    at.local = local;
+    at.distance = 0.0f;  // collider_velocity reads the pose and the local point only
+    out.velocity_flux = dot(collider_velocity(c, at, world), out.gradient);
+  }
+  return out;
+}
+
+// The sum over a scene's colliders. Colliders without a map (boundary_map null) count as flat
+// walls of their SDF (their share is still the SDF's half-space value).
+SPH_HD BoundaryShare boundary_share(const BoundaryDensity::Constants& b, const ColliderView* colliders,
+                                    uint32_t count, Vec3 world, float s, float tau) {
+  BoundaryShare sum = no_boundary_share();
+  for (uint32_t k = 0; k < count; ++k) {
+    const BoundaryShare one = collider_boundary_share(b, colliders[k], world, s, tau);
+    sum.density += one.density;
+    sum.gradient += one.gradient;
+    sum.velocity_flux += one.velocity_flux;
+  }
+  return sum;
+}
+
+// The per-particle record of kArrayBoundaryGradient.
+SPH_HD Float4 pack_boundary(const BoundaryShare& s) {
+  return make_float4_record(s.gradient, s.velocity_flux);
+}
+SPH_HD Vec3 boundary_gradient(const Float4& record) { return xyz(record); }
+
+// The wall's share of d rho_i / dt: sum over colliders of (v_i - v_b) . grad rho_b.
+SPH_HD float boundary_density_rate(const Float4& record, Vec3 velocity) {
+  return dot(velocity, xyz(record)) - record.w;
+}
+
+// The wall's pressure acceleration of a particle of pressure p and inverse density inv_rho.
+SPH_HD Vec3 boundary_pressure_acceleration(const Float4& record, float pressure, float inv_rho) {
+  return xyz(record) * (-pressure * inv_rho * inv_rho);
+}
+
+// The force (N) of one particle on one collider: minus the wall's force on the particle
+// (momentum is exchanged, not made), for a reduction of loads per collider.
+SPH_HD Vec3 boundary_reaction_force(const BoundaryShare& collider_share, float mass, float pressure,
+                                    float inv_rho) {
+  return collider_share.gradient * (mass * pressure * inv_rho * inv_rho);
+}
+
+// The frame fraction and time of an integration stage: the substep's start for symplectic Euler
+// and RK4's first stage, its middle for stages 1 and 2, its end for stage 3.
+struct StageTime {
+  float s, tau;
+};
+SPH_HD StageTime stage_time(const SubstepTime& t, float fraction) {
+  return StageTime{t.s0 + (t.s1 - t.s0) * fraction, t.tau0 + (t.tau1 - t.tau0) * fraction};
+}
+SPH_HD float rk4_stage_fraction(int stage) { return stage == 0 ? 0.0f : (stage == 3 ? 1.0f : 0.5f); }
+
+}  // namespace sph
