@@ -10,7 +10,7 @@ namespace sph {
 float CpuBackend::compute_max_speed() const {
   const Float4* vel = velocity_.data();
   float v2max = 0.0f;
-#pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : v2max)
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk) reduction(max : v2max)
   for (int i = 0; i < n(); ++i) v2max = std::max(v2max, length_squared(xyz(vel[i])));
   return std::sqrt(v2max);
 }
@@ -21,7 +21,10 @@ uint32_t CpuBackend::scan_next_state(float& v2max) const {
   const Float4* next_vel = next_velocity_.data();
   float m = 0.0f;
   uint32_t bad_index = kAllFinite;
-#pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : m) reduction(min : bad_index)
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk) reduction(max  \
+                                                                                            : m) \
+    reduction(min                                                                                \
+              : bad_index)
   for (int i = 0; i < n(); ++i) {
     const float v2 = length_squared(xyz(next_vel[i]));
     m = std::max(m, v2);

@@ -1,5 +1,7 @@
 #include "cpu_neighbor_columns.h"
 
+#include "cpu_neighbor_grid.h"
+
 namespace sph {
 
 namespace {
@@ -27,7 +29,7 @@ void CpuNeighborColumns::fill_state(const Float4* positions, const Float4* veloc
   for (std::vector<float>* c : {&normal_x_, &normal_y_, &normal_z_, &normal_length_})
     size_column(*c, n, normals_);
   const int count = static_cast<int>(n);
-#pragma omp parallel for num_threads(threads) schedule(static)
+#pragma omp parallel for num_threads(threads) schedule(dynamic, kParticleChunk)
   for (int i = 0; i < count; ++i) {
     x_[i] = positions[i].x;
     y_[i] = positions[i].y;

@@ -29,7 +29,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
   const ColliderView* colliders = collider_views_.data();
   const uint32_t collider_count = static_cast<uint32_t>(collider_views_.size());
   (void)scene;  // its colliders, with their maps bound, are collider_views_
-#pragma omp parallel for num_threads(threads()) schedule(static)
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
   for (int i = 0; i < n(); ++i) {
     DensitySample s = simd_.density(fluid, view, columns, static_cast<uint32_t>(i));
     if (boundary) {
@@ -55,13 +55,13 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
   if (factor) {
     // Eq. 31 over every carried rho_j: each particle writes only its own factor and side
     // slot (the first pass is done reading the factors), then the filtered values are published.
-#pragma omp parallel for num_threads(threads()) schedule(static)
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
     for (int i = 0; i < n(); ++i) {
       const float filtered = simd_.normalized_density(fluid, view, columns, static_cast<uint32_t>(i));
       factor[i] = filtered / normalized_[i];
       normalized_[i] = filtered;
     }
-#pragma omp parallel for num_threads(threads()) schedule(static)
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
     for (int i = 0; i < n(); ++i) {
       density_[i] = normalized_[i];
       pos[i].w = pressure_from_density(fluid.methods.eos, normalized_[i]);
@@ -71,7 +71,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
   }
   if (config_.features & kFeatureSurfaceTension) {
     // Colour-field normals of every particle, which the force gather reads for neighbours.
-#pragma omp parallel for num_threads(threads()) schedule(static)
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
     for (int i = 0; i < n(); ++i) {
       normals_[i] = simd_.colour_normal(fluid, view, columns, static_cast<uint32_t>(i));
       columns_.set_normal(static_cast<uint32_t>(i), normals_[i]);

@@ -17,7 +17,7 @@ void CpuBackend::collide(const SceneFrame& scene, const SubstepTime& time, OldPo
   const float h = config_.kernel_radius;
   Float4* next_pos = next_position_.data();
   Float4* next_vel = next_velocity_.data();
-#pragma omp parallel for num_threads(threads()) schedule(static)
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
   for (int i = 0; i < n(); ++i) {
     Vec3 x = xyz(next_pos[i]);
     Vec3 v = xyz(next_vel[i]);
@@ -44,7 +44,7 @@ uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame
   const AccelerationFn gather = acceleration_function();
   const NeighborColumns columns = columns_.view();
   float a2max = 0.0f;
-#pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk) reduction(max : a2max)
   for (int i = 0; i < n(); ++i) {
     Vec3 a = acceleration(gather, fluid, view, columns, scene, static_cast<uint32_t>(i));
     if (spring) a += xyz(spring[i]);
@@ -88,7 +88,7 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
     const NeighborColumns columns = columns_.view();
     const ParticleState* start = rk4_start_.data();
     Rk4Accumulator* sums = rk4_sum_.data();
-#pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk) reduction(max : a2max)
     for (int i = 0; i < n(); ++i) {
       Vec3 a = acceleration(gather, fluid, view, columns, scene, static_cast<uint32_t>(i));
       if (spring) a += xyz(spring[i]);
