@@ -41,6 +41,7 @@ struct DeviceResources {
   PipelineSetup graph_setup;
   DeviceSdfCache sdf_cache;
   DeviceBoundaryMaps boundary_maps;
+  DeviceColliderLoads loads;
   DeviceSceneBuffer scene_buffer;
   DeviceSinkCompactor sinks;
 

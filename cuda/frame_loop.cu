@@ -23,7 +23,9 @@ bool same_setup(const PipelineSetup& a, const PipelineSetup& b) {
          std::memcmp(&a.springs, &b.springs, sizeof a.springs) == 0 &&
          a.scene.colliders == b.scene.colliders && a.scene.fields == b.scene.fields &&
          a.scene.collider_count == b.scene.collider_count && a.scene.field_count == b.scene.field_count &&
-         a.scene.kernel_radius == b.scene.kernel_radius;
+         a.scene.kernel_radius == b.scene.kernel_radius && a.loads.partials == b.loads.partials &&
+         a.loads.sums == b.loads.sums && a.loads.output == b.loads.output &&
+         a.loads.colliders == b.loads.colliders;
 }
 
 }  // namespace
@@ -66,6 +68,8 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
           r_->boundary_maps.end_frame();
         }
         setup.scene = r_->scene_buffer.upload(scene, config_.kernel_radius, r_->stream);
+        if ((config_.features & kFeatureColliderLoads) && !scene.colliders.empty())
+          setup.loads = r_->loads.reserve(static_cast<uint32_t>(scene.colliders.size()), config_.capacity);
         if (with_sinks) r_->sinks.reserve(config_.capacity, *r_->store);
         cuda_check(cudaStreamSynchronize(r_->stream), "upload of the scene");
       }
@@ -111,6 +115,12 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
   FrameReport report;
   report.removed_ids = std::move(removed_ids);
   report.removed_by_sink = std::move(removed_by_sink);
+  if (config_.features & kFeatureColliderLoads) {
+    // Every collider gets its sums, zero for a frame without colliders' loads (none in the scene).
+    report.collider_loads.assign(scene_in.colliders.size(), ColliderLoadSums{});
+    if (setup.loads.on())
+      for (uint32_t c = 0; c < setup.loads.colliders; ++c) report.collider_loads[c] = setup.loads.output[c];
+  }
   report_clock(s.clock, report);
   report.max_speed = s.max_speed;
   report_density(s.density, report);

@@ -154,7 +154,7 @@ __global__ void colour_normal_kernel(FluidConstants fluid, GridView grid, Partic
 
 template <class Terms, bool kScene>
 __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
-                                    DeviceScene scene, FrameState* state) {
+                                    DeviceScene scene, bool collide_here, FrameState* state) {
   mark_stage(state, kStageForces);
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   float v2 = 0.0f, a2 = 0.0f;
@@ -171,7 +171,7 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
     a2 = length_squared(acc);
     ParticleState next = symplectic_euler(ParticleState{xyz(p), xyz(v)}, acc, f.dt);
     const ParticleState integrated = next;
-    if (kScene) collide_all(scene, state->clock.time, xyz(p), next);
+    if (kScene && collide_here) collide_all(scene, state->clock.time, xyz(p), next);
     const uint32_t id = a.sorted_id[i];
     a.position[i] = make_float4_record(next.position, p.w);
     a.velocity[i] = make_float4_record(next.velocity, v.w);
@@ -181,6 +181,7 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
       flag_non_finite(state, 0, i, id, classify_non_finite(a.density[i], p, v, acc, integrated));
       v2 = 0.0f;
     }
+    if (!collide_here) v2 = 0.0f;  // the loads pass collides and takes the speed (device_collider_loads.h)
   }
   block_max_to(&state->v2max_bits, v2);
   __syncthreads();  // block_max_to's shared slots are reused
@@ -189,7 +190,7 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
 
 template <class Terms, bool kScene>
 __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
-                                  int stage, DeviceScene scene, FrameState* state) {
+                                  int stage, DeviceScene scene, bool collide_here, FrameState* state) {
   mark_stage(state, kStageForces);
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   float v2 = 0.0f, a2 = 0.0f;
@@ -213,7 +214,8 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
     ParticleState next = rk4_advance(stage, from, ParticleState{xyz(p), xyz(v)}, acc, f.dt, sum);
     sums[i] = sum;
     const ParticleState integrated = next;
-    if (kScene && stage == kRk4Stages - 1) collide_all(scene, state->clock.time, from.position, next);
+    if (kScene && collide_here && stage == kRk4Stages - 1)
+      collide_all(scene, state->clock.time, from.position, next);
     const uint32_t id = a.sorted_id[i];
     a.position[i] = make_float4_record(next.position, p.w);
     a.velocity[i] = make_float4_record(next.velocity, v.w);
@@ -224,6 +226,7 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
       v2 = 0.0f;
     }
     if (stage != kRk4Stages - 1) v2 = 0.0f;  // the speed that counts is the final state's
+    if (!collide_here) v2 = 0.0f;            // the loads pass collides and takes the speed
   }
   if (stage == kRk4Stages - 1) {
     block_max_to(&state->v2max_bits, v2);
@@ -302,28 +305,33 @@ void enqueue_density(const FluidConstants& fluid, const GridView& grid, const Pa
 
 void enqueue_forces_euler(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                           uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
-                          const DeviceScene& scene, FrameState* state, cudaStream_t stream) {
+                          const DeviceScene& scene, bool collide_here, FrameState* state,
+                          cudaStream_t stream) {
   const unsigned threads = tuning.force_block, blocks = blocks_for(n, threads);
   with_force_terms(options.methods, [&](auto terms) {
     using Terms = decltype(terms);
     if (scene.active())
-      forces_euler_kernel<Terms, true><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
+      forces_euler_kernel<Terms, true>
+          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, collide_here, state);
     else
-      forces_euler_kernel<Terms, false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
+      forces_euler_kernel<Terms, false>
+          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, true, state);
   });
   check_launch("forces_euler_kernel");
 }
 
 void enqueue_forces_rk4(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                         uint32_t n, int stage, const SubstepOptions& options, const KernelTuning& tuning,
-                        const DeviceScene& scene, FrameState* state, cudaStream_t stream) {
+                        const DeviceScene& scene, bool collide_here, FrameState* state, cudaStream_t stream) {
   const unsigned threads = tuning.force_block, blocks = blocks_for(n, threads);
   with_force_terms(options.methods, [&](auto terms) {
     using Terms = decltype(terms);
     if (scene.active())
-      forces_rk4_kernel<Terms, true><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, scene, state);
+      forces_rk4_kernel<Terms, true>
+          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, scene, collide_here, state);
     else
-      forces_rk4_kernel<Terms, false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, scene, state);
+      forces_rk4_kernel<Terms, false>
+          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, scene, true, state);
   });
   check_launch("forces_rk4_kernel");
 }

@@ -11,6 +11,7 @@
 #include <cuda_runtime.h>
 
 #include "../src/core/config.h"
+#include "device_collider_loads.h"
 #include "device_neighbor_grid.h"
 #include "device_particle_store.h"
 #include "device_springs.h"
@@ -30,6 +31,7 @@ struct PipelineSetup {
   KernelTuning tuning{};
   DeviceScene scene{};        // colliders and force fields inside the substep (none: all zero)
   SpringConstants springs{};  // used when options.springs
+  DeviceLoads loads{};        // loads on colliders (off: all null)
 };
 
 struct PipelineBuffers {

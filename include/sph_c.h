@@ -186,6 +186,13 @@ typedef uint32_t sph_feature_flags;
  *  CUDA). The collision response stays the no-penetration safeguard. Costs one SDF sample per
  *  particle and collider in each density pass. */
 #define SPH_FEATURE_BOUNDARY_DENSITY 0x8u
+/** Loads on colliders: the force and torque of the fluid on each collider over every step
+ *  (sph_collider_get_loads): the collision response's contact impulses and, with
+ *  SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions, summed on the device per substep
+ *  in a fixed order (bitwise deterministic) and averaged over the step's time. Costs, per
+ *  substep, a reduction over the particles per collider (and with the boundary density one SDF
+ *  sample per particle and collider per force evaluation); no host round trip inside a step. */
+#define SPH_FEATURE_COLLIDER_LOADS 0x10u
 
 typedef enum sph_viscosity_method {
   SPH_VISCOSITY_MUELLER = 0, /* Laplacian viscosity (eq. 17), coefficient sph_world_params.viscosity */
@@ -798,6 +805,47 @@ static inline sph_result sph_shape_desc_init(sph_shape_desc* desc) {
 SPH_API sph_result SPH_CALL sph_sdf_create_shape(sph_context* context, const sph_shape_desc* desc,
                                                  sph_sdf** out);
 
+/** A triangle mesh to turn into an SDF asset (sph_sdf_create_from_mesh). Triangles are
+ *  counter-clockwise seen from outside (clockwise throughout works too: the inside is where the
+ *  winding number is at least 1/2 in magnitude). The mesh need not be closed or manifold: holes
+ *  narrower than about twice band_width voxels still leave a signed inside. Zero means default,
+ *  except that the arrays and their counts are required (the error names the first missing). */
+typedef struct sph_mesh_desc {
+  uint32_t struct_size;    /* set by sph_mesh_desc_init */
+  uint32_t vertex_count;   /* required, >= 3 */
+  uint32_t vertex_stride;  /* bytes from one vertex to the next; 0 (default) = 12 (packed
+                              x, y, z floats); otherwise >= 12 */
+  uint32_t index_count;    /* three per triangle; required, a multiple of 3 */
+  const float* vertices;   /* x, y, z (m, the asset's local frame) per vertex; finite; copied */
+  const uint32_t* indices; /* vertex indices, each < vertex_count; copied */
+  float voxel_size;        /* m; 0 (default) = 0.01 */
+  float band_width;        /* voxels of exact point-triangle distance on each side of the
+                              surface, in [1, 64]; 0 (default) = 3. Beyond it the closest
+                              triangle is swept outward (distances within a voxel or so) */
+  uint32_t padding_voxels; /* grid margin around the mesh's bounds, <= 1024; 0 (default) = 4 */
+  uint32_t reserved0;      /* must be 0 */
+} sph_mesh_desc;
+SPH_STATIC_ASSERT(sizeof(sph_mesh_desc) == 32 + 2 * sizeof(void*), sph_mesh_desc_size);
+
+SPH_API sph_result SPH_CALL sph_mesh_desc_init_sized(sph_mesh_desc* desc, uint32_t size);
+static inline sph_result sph_mesh_desc_init(sph_mesh_desc* desc) {
+  return sph_mesh_desc_init_sized(desc, (uint32_t)sizeof(*desc));
+}
+/**
+ * Builds an SDF asset from a triangle mesh (the arrays are read during the call, not kept): a
+ * grid of voxel_size over the mesh's bounds plus padding, axis-aligned, voxel (0, 0, 0) centred
+ * at the bounds' minimum corner less padding_voxels voxels (index_to_local is a scale by
+ * voxel_size and that translation); exact distances to the nearest triangle within band_width
+ * voxels of the surface, the nearest triangle swept outward beyond; negative inside by the
+ * generalised winding number. Host memory only; no OpenVDB needed.
+ * Blocking; costs about (triangles * (2 band_width + 1)^3 + voxels) distance evaluations.
+ * Thread-safe with respect to other SDF calls on the context. Errors: INVALID_ARGUMENT (NULL
+ * arrays, counts, an index out of range, a non-finite vertex, a size out of range, reserved0),
+ * CAPACITY (more than 2^31 voxels: a larger voxel_size is needed), OUT_OF_HOST_MEMORY.
+ */
+SPH_API sph_result SPH_CALL sph_sdf_create_from_mesh(sph_context* context, const sph_mesh_desc* desc,
+                                                     sph_sdf** out);
+
 typedef enum sph_sdf_channel {
   SPH_SDF_CHANNEL_DISTANCE = 0,
   SPH_SDF_CHANNEL_VELOCITY = 1, /* 3 floats per voxel */
@@ -933,6 +981,46 @@ SPH_API sph_result SPH_CALL sph_collider_set_material(sph_world* world, sph_coll
  */
 SPH_API sph_result SPH_CALL sph_collider_get_material(const sph_world* world, sph_collider_id id,
                                                       sph_collider_material* out);
+
+/**
+ * The fluid's loads on a collider over the last sph_world_step (SPH_FEATURE_COLLIDER_LOADS):
+ * the time averages over the step's substeps of the force and of the torque about the collider's
+ * load point, in world coordinates. What counts: the momentum the collision response took from
+ * particles (contacts, friction, stickiness) and, with SPH_FEATURE_BOUNDARY_DENSITY, the walls'
+ * pressure reactions; force times frame_time is the impulse the fluid gave the collider. The
+ * torque of each impulse is taken about the load point posed at the impulse's time (it moves
+ * with the collider). Zero before the first step (frame_time 0). docs/physics.md "Loads".
+ */
+typedef struct sph_collider_loads {
+  uint32_t struct_size; /* set by sph_collider_loads_init */
+  uint32_t reserved0;   /* written as 0 */
+  sph_vec3 force;       /* N, world frame */
+  sph_vec3 torque;      /* N m, world frame, about point */
+  sph_vec3 point;       /* the load point in the world at the end of the step, m */
+  double frame_time;    /* s: the time the step advanced, over which force and torque are averaged */
+} sph_collider_loads;
+SPH_STATIC_ASSERT(sizeof(sph_collider_loads) == 56, sph_collider_loads_size);
+
+SPH_API sph_result SPH_CALL sph_collider_loads_init_sized(sph_collider_loads* loads, uint32_t size);
+static inline sph_result sph_collider_loads_init(sph_collider_loads* loads) {
+  return sph_collider_loads_init_sized(loads, (uint32_t)sizeof(*loads));
+}
+/**
+ * Reads a collider's loads of the last step. Non-blocking (the step brought them to the host).
+ * out->struct_size must be set (sph_collider_loads_init); only that many bytes are written.
+ * Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (NULL out),
+ * VERSION_MISMATCH, FEATURE_DISABLED (the world lacks SPH_FEATURE_COLLIDER_LOADS), WORLD_LOCKED.
+ */
+SPH_API sph_result SPH_CALL sph_collider_get_loads(const sph_world* world, sph_collider_id id,
+                                                   sph_collider_loads* out);
+/**
+ * Sets the point, in the collider's own frame, that its loads' torque is taken about (default
+ * its origin; an engine passes the body's centre of mass). Acts from the next step. Errors:
+ * INVALID_HANDLE, INVALID_ARGUMENT (NULL point; a non-finite component, named),
+ * FEATURE_DISABLED, WORLD_LOCKED. Nothing changes on error.
+ */
+SPH_API sph_result SPH_CALL sph_collider_set_load_point(sph_world* world, sph_collider_id id,
+                                                        const sph_vec3* point);
 
 /* ---- sources ----------------------------------------------------------------------------- */
 typedef struct sph_source_id {

@@ -58,6 +58,16 @@ namespace Sph
         /// </summary>
         public const uint SPH_FEATURE_BOUNDARY_DENSITY = 8u;
         /// <summary>
+        /// Loads on colliders: the force and torque of the fluid on each collider over every step
+        /// (sph_collider_get_loads): the collision response's contact impulses and, with
+        /// SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions, summed on the device per
+        /// substep in a fixed order (bitwise deterministic) and averaged over the step's time. Costs,
+        /// per substep, a reduction over the particles per collider (and with the boundary density one
+        /// SDF sample per particle and collider per force evaluation); no host round trip inside a
+        /// step.
+        /// </summary>
+        public const uint SPH_FEATURE_COLLIDER_LOADS = 16u;
+        /// <summary>
         /// Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt &lt;= step_factor h /
         /// c, c the EOS's speed of sound
         /// </summary>
@@ -1217,6 +1227,55 @@ namespace Sph
         }
     }
 
+    /// <summary>
+    /// sph_mesh_desc (48 bytes): A triangle mesh to turn into an SDF asset (sph_sdf_create_from_mesh).
+    /// Triangles are counter-clockwise seen from outside (clockwise throughout works too: the inside is
+    /// where the winding number is at least 1/2 in magnitude). The mesh need not be closed or manifold:
+    /// holes narrower than about twice band_width voxels still leave a signed inside. Zero means
+    /// default, except that the arrays and their counts are required (the error names the first
+    /// missing).
+    /// </summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public partial struct MeshDesc
+    {
+        /// <summary>uint32_t struct_size: set by sph_mesh_desc_init</summary>
+        public uint StructSize;
+        /// <summary>uint32_t vertex_count: required, &gt;= 3</summary>
+        public uint VertexCount;
+        /// <summary>
+        /// uint32_t vertex_stride: bytes from one vertex to the next; 0 (default) = 12 (packed x, y, z
+        /// floats); otherwise &gt;= 12
+        /// </summary>
+        public uint VertexStride;
+        /// <summary>uint32_t index_count: three per triangle; required, a multiple of 3</summary>
+        public uint IndexCount;
+        /// <summary>const float* vertices: x, y, z (m, the asset's local frame) per vertex; finite; copied</summary>
+        public IntPtr Vertices;
+        /// <summary>const uint32_t* indices: vertex indices, each &lt; vertex_count; copied</summary>
+        public IntPtr Indices;
+        /// <summary>float voxel_size: m; 0 (default) = 0.01</summary>
+        public float VoxelSize;
+        /// <summary>
+        /// float band_width: voxels of exact point-triangle distance on each side of the surface, in
+        /// [1, 64]; 0 (default) = 3. Beyond it the closest triangle is swept outward (distances within
+        /// a voxel or so)
+        /// </summary>
+        public float BandWidth;
+        /// <summary>uint32_t padding_voxels: grid margin around the mesh's bounds, &lt;= 1024; 0 (default) = 4</summary>
+        public uint PaddingVoxels;
+        /// <summary>uint32_t reserved0: must be 0</summary>
+        public uint Reserved0;
+
+        /// <summary>A MeshDesc with the library's defaults (sph_mesh_desc_init_sized).</summary>
+        public static MeshDesc Default()
+        {
+            var value = new MeshDesc();
+            uint size = (uint)Marshal.SizeOf(typeof(MeshDesc));
+            SphException.Check(Native.sph_mesh_desc_init_sized(ref value, size), "sph_mesh_desc_init_sized");
+            return value;
+        }
+    }
+
     /// <summary>sph_quat (16 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct Quat
@@ -1352,6 +1411,42 @@ namespace Sph
             var value = new ColliderMaterial();
             uint size = (uint)Marshal.SizeOf(typeof(ColliderMaterial));
             SphException.Check(Native.sph_collider_material_init_sized(ref value, size), "sph_collider_material_init_sized");
+            return value;
+        }
+    }
+
+    /// <summary>
+    /// sph_collider_loads (56 bytes): The fluid's loads on a collider over the last sph_world_step
+    /// (SPH_FEATURE_COLLIDER_LOADS): the time averages over the step's substeps of the force and of the
+    /// torque about the collider's load point, in world coordinates. What counts: the momentum the
+    /// collision response took from particles (contacts, friction, stickiness) and, with
+    /// SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions; force times frame_time is the
+    /// impulse the fluid gave the collider. The torque of each impulse is taken about the load point
+    /// posed at the impulse's time (it moves with the collider). Zero before the first step (frame_time
+    /// 0). docs/physics.md "Loads".
+    /// </summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public partial struct ColliderLoads
+    {
+        /// <summary>uint32_t struct_size: set by sph_collider_loads_init</summary>
+        public uint StructSize;
+        /// <summary>uint32_t reserved0: written as 0</summary>
+        public uint Reserved0;
+        /// <summary>sph_vec3 force: N, world frame</summary>
+        public Vec3 Force;
+        /// <summary>sph_vec3 torque: N m, world frame, about point</summary>
+        public Vec3 Torque;
+        /// <summary>sph_vec3 point: the load point in the world at the end of the step, m</summary>
+        public Vec3 Point;
+        /// <summary>double frame_time: s: the time the step advanced, over which force and torque are averaged</summary>
+        public double FrameTime;
+
+        /// <summary>A ColliderLoads with the library's defaults (sph_collider_loads_init_sized).</summary>
+        public static ColliderLoads Default()
+        {
+            var value = new ColliderLoads();
+            uint size = (uint)Marshal.SizeOf(typeof(ColliderLoads));
+            SphException.Check(Native.sph_collider_loads_init_sized(ref value, size), "sph_collider_loads_init_sized");
             return value;
         }
     }
@@ -2066,6 +2161,29 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_sdf_create_shape")]
         public static extern Result sph_sdf_create_shape(IntPtr context, IntPtr desc, IntPtr @out);
 
+        /// <summary>sph_mesh_desc_init_sized</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_mesh_desc_init_sized(ref MeshDesc desc, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_mesh_desc_init_sized")]
+        public static extern Result sph_mesh_desc_init_sized(IntPtr desc, uint size);
+
+        /// <summary>
+        /// Builds an SDF asset from a triangle mesh (the arrays are read during the call, not kept): a
+        /// grid of voxel_size over the mesh's bounds plus padding, axis-aligned, voxel (0, 0, 0)
+        /// centred at the bounds' minimum corner less padding_voxels voxels (index_to_local is a scale
+        /// by voxel_size and that translation); exact distances to the nearest triangle within
+        /// band_width voxels of the surface, the nearest triangle swept outward beyond; negative inside
+        /// by the generalised winding number. Host memory only; no OpenVDB needed. Blocking; costs
+        /// about (triangles * (2 band_width + 1)^3 + voxels) distance evaluations. Thread-safe with
+        /// respect to other SDF calls on the context. Errors: INVALID_ARGUMENT (NULL arrays, counts, an
+        /// index out of range, a non-finite vertex, a size out of range, reserved0), CAPACITY (more
+        /// than 2^31 voxels: a larger voxel_size is needed), OUT_OF_HOST_MEMORY.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_sdf_create_from_mesh(ContextHandle context, ref MeshDesc desc, out SdfHandle @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_sdf_create_from_mesh")]
+        public static extern Result sph_sdf_create_from_mesh(IntPtr context, IntPtr desc, IntPtr @out);
+
         /// <summary>
         /// Overwrites the box [origin, origin + size) of one channel with data (size[0] * size[1] *
         /// size[2] * components floats, i fastest, copied). Updating the velocity or friction channel
@@ -2171,6 +2289,35 @@ namespace Sph
         public static extern Result sph_collider_get_material(WorldHandle world, ColliderId id, ref ColliderMaterial @out);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_get_material")]
         public static extern Result sph_collider_get_material(IntPtr world, ColliderId id, IntPtr @out);
+
+        /// <summary>sph_collider_loads_init_sized</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_collider_loads_init_sized(ref ColliderLoads loads, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_loads_init_sized")]
+        public static extern Result sph_collider_loads_init_sized(IntPtr loads, uint size);
+
+        /// <summary>
+        /// Reads a collider's loads of the last step. Non-blocking (the step brought them to the host).
+        /// out-&gt;struct_size must be set (sph_collider_loads_init); only that many bytes are written.
+        /// Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (NULL out),
+        /// VERSION_MISMATCH, FEATURE_DISABLED (the world lacks SPH_FEATURE_COLLIDER_LOADS),
+        /// WORLD_LOCKED.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_collider_get_loads(WorldHandle world, ColliderId id, ref ColliderLoads @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_get_loads")]
+        public static extern Result sph_collider_get_loads(IntPtr world, ColliderId id, IntPtr @out);
+
+        /// <summary>
+        /// Sets the point, in the collider's own frame, that its loads' torque is taken about (default
+        /// its origin; an engine passes the body's centre of mass). Acts from the next step. Errors:
+        /// INVALID_HANDLE, INVALID_ARGUMENT (NULL point; a non-finite component, named),
+        /// FEATURE_DISABLED, WORLD_LOCKED. Nothing changes on error.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_collider_set_load_point(WorldHandle world, ColliderId id, ref Vec3 point);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_set_load_point")]
+        public static extern Result sph_collider_set_load_point(IntPtr world, ColliderId id, IntPtr point);
 
         /// <summary>sph_source_def_init_sized</summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
@@ -2439,11 +2586,13 @@ namespace Sph
             typeof(GridDesc),
             typeof(SdfDesc),
             typeof(ShapeDesc),
+            typeof(MeshDesc),
             typeof(Quat),
             typeof(Transform),
             typeof(ColliderId),
             typeof(ColliderDef),
             typeof(ColliderMaterial),
+            typeof(ColliderLoads),
             typeof(SourceId),
             typeof(SourceDef),
             typeof(SinkId),
@@ -2472,11 +2621,13 @@ namespace Sph
             "sph_grid_desc",
             "sph_sdf_desc",
             "sph_shape_desc",
+            "sph_mesh_desc",
             "sph_quat",
             "sph_transform",
             "sph_collider_id",
             "sph_collider_def",
             "sph_collider_material",
+            "sph_collider_loads",
             "sph_source_id",
             "sph_source_def",
             "sph_sink_id",
@@ -2505,11 +2656,13 @@ namespace Sph
             80,
             104,
             44,
+            48,
             16,
             28,
             8,
             64,
             16,
+            56,
             8,
             80,
             8,
@@ -2652,6 +2805,16 @@ namespace Sph
             typeof(ShapeDesc),
             typeof(ShapeDesc),
             typeof(ShapeDesc),
+            typeof(MeshDesc),
+            typeof(MeshDesc),
+            typeof(MeshDesc),
+            typeof(MeshDesc),
+            typeof(MeshDesc),
+            typeof(MeshDesc),
+            typeof(MeshDesc),
+            typeof(MeshDesc),
+            typeof(MeshDesc),
+            typeof(MeshDesc),
             typeof(Quat),
             typeof(Quat),
             typeof(Quat),
@@ -2672,6 +2835,12 @@ namespace Sph
             typeof(ColliderMaterial),
             typeof(ColliderMaterial),
             typeof(ColliderMaterial),
+            typeof(ColliderLoads),
+            typeof(ColliderLoads),
+            typeof(ColliderLoads),
+            typeof(ColliderLoads),
+            typeof(ColliderLoads),
+            typeof(ColliderLoads),
             typeof(SourceId),
             typeof(SourceDef),
             typeof(SourceDef),
@@ -2847,6 +3016,16 @@ namespace Sph
             "VoxelSize",
             "Flags",
             "PaddingVoxels",
+            "StructSize",
+            "VertexCount",
+            "VertexStride",
+            "IndexCount",
+            "Vertices",
+            "Indices",
+            "VoxelSize",
+            "BandWidth",
+            "PaddingVoxels",
+            "Reserved0",
             "X",
             "Y",
             "Z",
@@ -2867,6 +3046,12 @@ namespace Sph
             "Restitution",
             "Friction",
             "Stickiness",
+            "StructSize",
+            "Reserved0",
+            "Force",
+            "Torque",
+            "Point",
+            "FrameTime",
             "Bits",
             "StructSize",
             "Mode",
@@ -3046,6 +3231,16 @@ namespace Sph
             4,
             8,
             12,
+            16,
+            24,
+            32,
+            36,
+            40,
+            44,
+            0,
+            4,
+            8,
+            12,
             0,
             12,
             0,
@@ -3062,6 +3257,12 @@ namespace Sph
             4,
             8,
             12,
+            0,
+            4,
+            8,
+            20,
+            32,
+            48,
             0,
             0,
             4,
@@ -3163,6 +3364,8 @@ namespace Sph
             "sph_sdf_create",
             "sph_shape_desc_init_sized",
             "sph_sdf_create_shape",
+            "sph_mesh_desc_init_sized",
+            "sph_sdf_create_from_mesh",
             "sph_sdf_update",
             "sph_sdf_get_dims",
             "sph_sdf_sample",
@@ -3177,6 +3380,9 @@ namespace Sph
             "sph_collider_material_init_sized",
             "sph_collider_set_material",
             "sph_collider_get_material",
+            "sph_collider_loads_init_sized",
+            "sph_collider_get_loads",
+            "sph_collider_set_load_point",
             "sph_source_def_init_sized",
             "sph_source_create",
             "sph_source_destroy",
@@ -3207,6 +3413,11 @@ namespace Sph
         };
         /// <summary>The shared library of each function ("sph", or an optional helper).</summary>
         public static readonly string[] FunctionLibraries = {
+            "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
             "sph",
             "sph",
             "sph",

@@ -230,6 +230,9 @@ namespace Sph
         /// <summary>Walls in the density: colliders count in the density sums and push back through
         /// the pressure force (a density map per SDF asset; docs/physics.md).</summary>
         BoundaryDensity = Constants.SPH_FEATURE_BOUNDARY_DENSITY,
+        /// <summary>Loads on colliders: the fluid's force and torque on each collider over every
+        /// step (<see cref="Collider.Loads"/>; docs/physics.md).</summary>
+        ColliderLoads = Constants.SPH_FEATURE_COLLIDER_LOADS,
     }
 
     /// <summary>Step-size limits beyond eq. 32 (SPH_STEP_LIMIT_*): set them with
@@ -1000,6 +1003,34 @@ namespace Sph
             return new Sdf(context, h);
         }
 
+        /// <summary>An asset from a triangle mesh (copied): vertices holds x, y, z per vertex
+        /// (m, the asset's local frame), indices three vertex indices per triangle,
+        /// counter-clockwise seen from outside (clockwise throughout works too; small holes are
+        /// fine). desc (MeshDesc.Default() when null) gives voxel size, band width and padding;
+        /// its array fields are filled here.</summary>
+        public static Sdf CreateFromMesh(Context context, float[] vertices, uint[] indices, MeshDesc? desc = null)
+        {
+            if (vertices == null || vertices.Length % 3 != 0) throw new ArgumentException("vertices: x, y, z per vertex");
+            if (indices == null || indices.Length % 3 != 0) throw new ArgumentException("indices: three per triangle");
+            var d = desc ?? MeshDesc.Default();
+            var pins = new List<GCHandle>();
+            try
+            {
+                d.Vertices = Pin(vertices, pins);
+                d.VertexCount = (uint)(vertices.Length / 3);
+                d.VertexStride = 0;
+                d.Indices = Pin(indices, pins);
+                d.IndexCount = (uint)indices.Length;
+                SdfHandle h;
+                SphException.Check(Native.sph_sdf_create_from_mesh(context.Handle, ref d, out h), "sph_sdf_create_from_mesh");
+                return new Sdf(context, h);
+            }
+            finally
+            {
+                foreach (var p in pins) p.Free();
+            }
+        }
+
         /// <summary>An asset from sampled grids (copied): distance has ni*nj*nk floats, i
         /// fastest; velocity (3 floats per voxel) and friction are optional.</summary>
         public static Sdf Create(Context context, float[] distance, uint ni, uint nj, uint nk, FixedFloat12 indexToLocal,
@@ -1170,6 +1201,26 @@ namespace Sph
             m.Friction = friction;
             m.Stickiness = stickiness;
             Material = m;
+        }
+
+        /// <summary>The fluid's loads on the collider over the last Step (time averages of the force
+        /// and of the torque about the load point, world frame); needs
+        /// <see cref="FeatureFlags.ColliderLoads"/>.</summary>
+        public ColliderLoads Loads
+        {
+            get
+            {
+                var l = ColliderLoads.Default();
+                SphException.Check(Native.sph_collider_get_loads(World.Handle, Id, ref l), "sph_collider_get_loads");
+                return l;
+            }
+        }
+
+        /// <summary>The point, in the collider's own frame, that the loads' torque is taken about
+        /// (default its origin; pass the body's centre of mass).</summary>
+        public void SetLoadPoint(Vec3 point)
+        {
+            SphException.Check(Native.sph_collider_set_load_point(World.Handle, Id, ref point), "sph_collider_set_load_point");
         }
 
         /// <summary>Removes the collider (idempotent).</summary>

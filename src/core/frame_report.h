@@ -19,6 +19,13 @@ enum StageIndex : int {
   kStageCount = 8,
 };
 
+// One collider's impulses over a frame (SPH_FEATURE_COLLIDER_LOADS, physics/collider_loads.h),
+// summed in double in a fixed order.
+struct ColliderLoadSums {
+  double linear[3] = {0.0, 0.0, 0.0};   // N s, world frame
+  double angular[3] = {0.0, 0.0, 0.0};  // N m s, about the load point
+};
+
 struct FrameReport {
   uint32_t substeps = 0;
   bool completed = true;       // false when max_substeps ran out before the frame's end
@@ -32,8 +39,9 @@ struct FrameReport {
   float neighbors_mean = 0.0f;
   uint32_t neighbors_max = 0;
   float stage_ms[kStageCount] = {};
-  std::vector<uint32_t> removed_ids;      // ids sinks removed during the frame
-  std::vector<uint32_t> removed_by_sink;  // count per sink, in SceneFrame::sinks order
+  std::vector<uint32_t> removed_ids;             // ids sinks removed during the frame
+  std::vector<uint32_t> removed_by_sink;         // count per sink, in SceneFrame::sinks order
+  std::vector<ColliderLoadSums> collider_loads;  // per collider in SceneFrame::colliders order (loads on)
 };
 
 }  // namespace sph

@@ -127,6 +127,7 @@ SceneFrame World::build_scene_frame(double frame_dt) const {
     v.sign = c.inverted ? -1.0f : 1.0f;
     v.deforming = c.sdf->has_moving_surface() ? 1u : 0u;
     v.boundary_map = nullptr;  // the backend binds its map (SPH_FEATURE_BOUNDARY_DENSITY)
+    v.load_point = c.load_point;
     float speed = 0.0f;
     if (v.moving) speed += length(v.linear_velocity) + length(v.angular_velocity) * bounding_radius(*c.sdf);
     if (v.deforming) speed += max_field_speed(*c.sdf);
@@ -160,6 +161,21 @@ SceneFrame World::build_scene_frame(double frame_dt) const {
   });
   return scene;
 }
+
+namespace {
+// A frame's impulses as time averages (zero for a frame that advanced no time).
+ColliderLoadResult load_result(const ColliderLoadSums& sums, const Collider& c, const FrameReport& report) {
+  ColliderLoadResult r;
+  const double inv_t = report.time_advanced > 0.0 ? 1.0 / report.time_advanced : 0.0;
+  r.force = Vec3{static_cast<float>(sums.linear[0] * inv_t), static_cast<float>(sums.linear[1] * inv_t),
+                 static_cast<float>(sums.linear[2] * inv_t)};
+  r.torque = Vec3{static_cast<float>(sums.angular[0] * inv_t), static_cast<float>(sums.angular[1] * inv_t),
+                  static_cast<float>(sums.angular[2] * inv_t)};
+  r.point = to_world(c.pose, c.load_point);  // c.pose is the end of the frame's pose here
+  r.time = report.time_advanced;
+  return r;
+}
+}  // namespace
 
 bool World::step(double frame_dt) {
   const auto start = std::chrono::steady_clock::now();
@@ -200,10 +216,12 @@ bool World::step(double frame_dt) {
     events_.swap(events_before);
     throw;
   }
-  // Colliders arrive where they were sent.
-  colliders_.for_each([&](uint64_t, Collider& c) {
+  // Colliders arrive where they were sent; their loads are the frame's impulses over its time.
+  colliders_.for_each([&, index = size_t{0}](uint64_t, Collider& c) mutable {
     if (c.target) c.pose = *c.target;
     c.target.reset();
+    if (index < report.collider_loads.size()) c.loads = load_result(report.collider_loads[index], c, report);
+    ++index;
   });
   sinks_.for_each([&, index = size_t{0}](uint64_t id, const Sink&) mutable {
     const uint32_t removed = index < report.removed_by_sink.size() ? report.removed_by_sink[index] : 0u;

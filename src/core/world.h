@@ -102,6 +102,8 @@ class World {
   void set_collider_target(uint64_t id, const RigidTransform& target);
   void teleport_collider(uint64_t id, const RigidTransform& pose);
   void set_collider_material(uint64_t id, const ColliderMaterial& material);
+  // The point (collider frame) its loads' torque is taken about; InvalidArgument if not finite.
+  void set_collider_load_point(uint64_t id, Vec3 point);
   void set_source_pose(uint64_t id, const RigidTransform& pose);
   void set_force_field_pose(uint64_t id, const RigidTransform& pose);
   // A live collider; Error(InvalidHandle) otherwise.

@@ -16,6 +16,7 @@
 #include "../core/backend.h"
 #include "../core/non_finite.h"
 #include "../core/particle_arrays.h"
+#include "../physics/collider_loads.h"
 #include "../physics/forces.h"
 #include "../physics/integrate.h"
 #include "../physics/springs.h"
@@ -104,6 +105,22 @@ class CpuBackend final : public Backend {
   template <class OldPosition>
   void collide(const SceneFrame& scene, const SubstepTime& time, OldPosition&& x_old, FrameReport& report);
 
+  // Loads (SPH_FEATURE_COLLIDER_LOADS, cpu_collider_loads.cpp): the frame's sums start at zero.
+  void begin_loads(const SceneFrame& scene);
+  bool loads_on() const { return (config_.features & kFeatureColliderLoads) != 0; }
+  // Where a substep's particles started, for the collision response: one of the two (none: no
+  // collision response in this pass).
+  struct OldPositions {
+    const Float4* records = nullptr;
+    const ParticleState* states = nullptr;
+  };
+  // One force evaluation's loads: the walls' pressure reactions (boundary density) over
+  // wall_seconds (its share of the substep; 0: none) at the stage's time `at`, then, when `old`
+  // names the start positions, the collision response of the state in next_* with its contact
+  // impulses. Adds to load_sums_.
+  void collide_with_loads(const FluidConstants& fluid, const SceneFrame& scene, const SubstepTime& time,
+                          StageTime at, float wall_seconds, OldPositions old, FrameReport& report);
+
   // Max speed and the first non-finite particle of the state in next_*.
   uint32_t scan_next_state(float& v2max) const;
 
@@ -159,6 +176,9 @@ class CpuBackend final : public Backend {
   CpuArrayRef<Float4> boundary_;  // boundary density: (grad rho_b, v_b . grad rho_b) per particle
   CpuBoundaryMaps boundary_maps_;
   std::vector<ColliderView> collider_views_;  // the frame's colliders, for the density pass
+  std::vector<ColliderLoadSums> load_sums_;   // the frame's impulses per collider (loads on)
+  std::vector<LoadImpulse> load_blocks_;      // per block of kLoadBlock particles and collider
+  std::vector<Vec3> load_points_;             // per collider: at the wall pass's time, at the end
   std::vector<uint32_t> keep_order_;
   SpringConstants spring_constants_{};
   uint32_t count_ = 0;

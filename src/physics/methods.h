@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include "boundary_density.h"
+#include "collider_loads.h"
 #include "density_normalization.h"
 #include "eos_ideal_gas.h"
 #include "eos_tait.h"
@@ -29,8 +30,9 @@ enum FeatureBits : uint32_t {
   kFeatureNormalizedDensity = 1u << 1,
   kFeatureSprings = 1u << 2,
   kFeatureBoundaryDensity = 1u << 3,
-  kFeatureAll =
-      kFeatureSurfaceTension | kFeatureNormalizedDensity | kFeatureSprings | kFeatureBoundaryDensity,
+  kFeatureColliderLoads = 1u << 4,
+  kFeatureAll = kFeatureSurfaceTension | kFeatureNormalizedDensity | kFeatureSprings |
+                kFeatureBoundaryDensity | kFeatureColliderLoads,
 };
 
 enum class ViscosityMethod : uint32_t { Mueller = 0, Clavet = 1 };
@@ -102,6 +104,7 @@ constexpr MethodSwitch switch_of(Tag<Springs>) { return {SwitchKind::Feature, kF
 constexpr MethodSwitch switch_of(Tag<BoundaryDensity>) {
   return {SwitchKind::Feature, kFeatureBoundaryDensity};
 }
+constexpr MethodSwitch switch_of(Tag<ColliderLoads>) { return {SwitchKind::Feature, kFeatureColliderLoads}; }
 
 // Calls visit(Tag<Method>{}) for every method a world can choose, in the list's order.
 template <class Visit>
@@ -114,6 +117,7 @@ void for_each_method(Visit&& visit) {
   visit(Tag<NormalizedDensity>{});
   visit(Tag<Springs>{});
   visit(Tag<BoundaryDensity>{});
+  visit(Tag<ColliderLoads>{});
 }
 
 // Whether a value of a sph_world_def method field (or a feature bit) names a method of the list,

@@ -478,6 +478,8 @@ static void test_methods_are_listed_with_their_switches(void** state) {
        SPH_PARAMS_SURFACE_TENSION},
       {"normalized_density", SPH_METHOD_SWITCH_FEATURE, SPH_FEATURE_NORMALIZED_DENSITY, 0, SPH_PARAMS_WORLD},
       {"springs", SPH_METHOD_SWITCH_FEATURE, SPH_FEATURE_SPRINGS, 1, SPH_PARAMS_SPRINGS},
+      {"boundary_density", SPH_METHOD_SWITCH_FEATURE, SPH_FEATURE_BOUNDARY_DENSITY, 0, SPH_PARAMS_WORLD},
+      {"collider_loads", SPH_METHOD_SWITCH_FEATURE, SPH_FEATURE_COLLIDER_LOADS, 0, SPH_PARAMS_WORLD},
   };
   const uint32_t n = (uint32_t)(sizeof expected / sizeof expected[0]);
   sph_physics_method_info info;

@@ -156,7 +156,7 @@ void non_finite_rollback() {
          "errors/non_finite_names_a_particle", "CPU names particle id %s, GPU names particle id %s",
          ids[0].c_str(), ids[1].c_str());
 
-  // The same particle on both backends: one particle thrown at 1e20 m/s, far from the others,
+  // The same particle on both backends: one particle thrown at 1.84e19 m/s, far from the others,
   // whose squared speed overflows in the integration of the first substep; nothing else fails.
   std::string named[2];
   uint32_t thrown_id[2] = {0, 0};
@@ -175,12 +175,27 @@ void non_finite_rollback() {
     require_ok(sph_world_spawn(world, &spawn, nullptr), "spawn");
     require_ok(sph_world_step(world, 0.002f), "first step");
     const float thrown_position[3] = {0.0f, 0.5f, 0.0f};
-    const float thrown_velocity[3] = {1e20f, 0.0f, 0.0f};
+    // Spawning refuses a speed whose square overflows float32 (1.8e19 m/s), so the thrown
+    // particle starts just inside that limit and a uniform field of 1e20 m/s^2 over one fixed
+    // 2 ms substep pushes it past: its |v|^2 overflows in the integration while every other
+    // particle's speed (2e17 m/s) stays finite.
+    const float thrown_velocity[3] = {1.84e19f, 0.0f, 0.0f};
     sph_spawn_desc_init(&spawn);
     spawn.count = 1;
     spawn.positions = thrown_position;
     spawn.velocities = thrown_velocity;
     require_ok(sph_world_spawn(world, &spawn, &thrown_id[b]), "spawn the thrown particle");
+    sph_world_params params;
+    sph_world_params_init(&params);
+    require_ok(sph_world_get_params(world, &params), "get params");
+    params.dt_min = params.dt_max = 0.002f;
+    require_ok(sph_world_set_params(world, &params), "one 2 ms substep");
+    sph_force_field_def field;
+    sph_force_field_def_init(&field);
+    field.kind = SPH_FORCE_FIELD_UNIFORM;
+    field.vector.x = 1e20f;
+    sph_force_field_id field_id;
+    require_ok(sph_force_field_create(world, &field, &field_id), "the pushing field");
     const sph_result r = sph_world_step(world, 0.002f);
     named[b] = r == SPH_ERROR_NON_FINITE ? message_id(sph_get_last_error())
                                          : std::string("(step: ") + sph_result_string(r) + ")";

@@ -238,6 +238,7 @@ static void test_world_destroy_races_calls(void** state) {
 typedef struct context_intruder {
   sph_context* context;
   int* slow;
+  int started; /* set just before the first sph_world_create */
   volatile int* go;
   pthread_mutex_t* go_mutex;
   tally creates, destroys;
@@ -249,6 +250,7 @@ static void* context_intruder_thread(void* arg) {
   sph_world_def_init(&def);
   def.capacity = 16;
   wait_go(in->go_mutex, in->go);
+  __atomic_store_n(&in->started, 1, __ATOMIC_RELEASE);
   for (;;) {
     sph_world* world = NULL;
     const sph_result r = sph_world_create(in->context, &def, &world);
@@ -286,6 +288,10 @@ static void test_context_destroy_races_world_create(void** state) {
     pthread_mutex_lock(&go_mutex);
     go = 1;
     pthread_mutex_unlock(&go_mutex);
+    /* Wait until the creator is about to create: where thread start-up is slower than a few
+     * yields (CUDA's context), the destroyer otherwise always came first and the race was never
+     * run (0 BUSY, 0 worlds in 500 rounds on an H200 host). */
+    while (!__atomic_load_n(&in.started, __ATOMIC_ACQUIRE)) sched_yield();
     for (int spin = 0; spin < round % 5; ++spin) sched_yield();
     for (;;) {
       const sph_result r = sph_context_destroy(context);

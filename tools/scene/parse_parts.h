@@ -17,7 +17,8 @@ sph_transform parse_transform(const JsonNode& node);
 // {"keyframes": [{"time": t, "position": ..., "rotation": ...}, ...], "interpolation": ...,
 // "loop": ...}; a key's missing position or rotation is `base`'s.
 Motion parse_motion(const JsonNode& node, const sph_transform& base);
-// An analytic shape or {"type": "vdb", "file": ..., "grid": ...} (relative to base_dir).
+// An analytic shape, {"type": "vdb", "file": ..., "grid": ...} or {"type": "mesh", "file":
+// ..., ...} (files relative to base_dir; mesh files are read here).
 ShapeDesc parse_shape(const JsonNode& node, const std::string& base_dir);
 
 void parse_world(const JsonNode& node, sph_world_def* def);

@@ -1,4 +1,6 @@
-// Shapes of a scene file: the library's analytic shapes, or a level set from a .vdb file.
+// Shapes of a scene file: the library's analytic shapes, a level set from a .vdb file, or a
+// triangle mesh from an .obj or .stl file.
+#include "mesh_file.h"
 #include "parse_parts.h"
 #include "scene_error.h"
 
@@ -17,7 +19,30 @@ ShapeDesc parse_shape(const JsonNode& node, const std::string& base_dir) {
   ShapeDesc shape;
   shape.path = node.path();
   if (node.missing() || !node.json().is_object()) node.fail("a shape (an object with a \"type\")");
-  const size_t type = node["type"].choice({"plane", "box", "sphere", "capsule", "cylinder", "cup", "vdb"});
+  const size_t type =
+      node["type"].choice({"plane", "box", "sphere", "capsule", "cylinder", "cup", "vdb", "mesh"});
+  if (type == 7) {
+    node.expect_object("a mesh shape",
+                       {"type", "file", "scale", "voxel_size", "band_width", "padding_voxels"});
+    shape.kind = ShapeDesc::Kind::kMesh;
+    const std::string file = node["file"].string();
+    if (file.empty()) node["file"].fail("a file name (.obj or .stl)");
+    shape.mesh_file = resolve(base_dir, file);
+    const float scale = node["scale"].opt_positive(1.0f);
+    try {
+      MeshData data = read_mesh_file(shape.mesh_file, scale);
+      shape.mesh_vertices = std::move(data.vertices);
+      shape.mesh_indices = std::move(data.indices);
+    } catch (const std::runtime_error& e) {
+      throw SceneError(node["file"].path(), e.what());
+    }
+    sph_mesh_desc& m = shape.mesh;
+    sph_mesh_desc_init(&m);
+    m.voxel_size = node["voxel_size"].opt_positive(m.voxel_size);
+    m.band_width = node["band_width"].opt_positive(m.band_width);
+    m.padding_voxels = node["padding_voxels"].opt_count(m.padding_voxels, 1, 1024);
+    return shape;
+  }
   if (type == 6) {
     node.expect_object("a vdb shape", {"type", "file", "grid"});
     shape.kind = ShapeDesc::Kind::kVdb;

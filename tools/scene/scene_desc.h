@@ -13,14 +13,21 @@
 
 namespace sph_tools {
 
-// An SDF asset: an analytic shape of the library, or a level set from a .vdb file.
+// An SDF asset: an analytic shape of the library, a level set from a .vdb file, or a
+// triangle mesh from an .obj or .stl file (read when the scene is parsed).
 struct ShapeDesc {
-  enum class Kind { kAnalytic, kVdb };
+  enum class Kind { kAnalytic, kVdb, kMesh };
   Kind kind = Kind::kAnalytic;
   sph_shape_desc analytic{};  // kAnalytic: filled by sph_shape_desc_init, then the file's fields
   std::string vdb_file;       // kVdb: absolute path
   std::string vdb_grid;       // kVdb: grid name, "" = the first float level set
   std::string path;           // where in the file, for errors ("colliders[1].shape")
+  // kMesh: the file's triangles (scaled) and the sizes; mesh.vertices and mesh.indices are
+  // pointed at mesh_vertices and mesh_indices when the asset is made.
+  std::string mesh_file;
+  std::vector<float> mesh_vertices;
+  std::vector<uint32_t> mesh_indices;
+  sph_mesh_desc mesh{};
   // kVdb: the box of the level set's active voxels in its local frame, when a tool that reads
   // OpenVDB files has filled it in (sph-run does, for the preview's camera and silhouettes).
   bool has_vdb_bounds = false;
@@ -49,6 +56,8 @@ struct ColliderDesc {
   Motion motion;
   bool inverted = false;
   float restitution = 0.0f, friction = 0.0f, stickiness = 0.0f;
+  bool loads = false;     // "loads": its force and torque are written per frame (a CSV)
+  sph_vec3 load_point{};  // the torque's point, in the collider's frame
   std::string path;
 };
 

@@ -1,5 +1,7 @@
 #include "sdf_factory.h"
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "scene_error.h"
@@ -35,6 +37,18 @@ sph_sdf* create_sdf(sph_context* context, const ShapeDesc& shape) {
                      "\"vdb\" shapes need tools built with OpenVDB (this build has none)");
 #endif
   }
+  if (shape.kind == ShapeDesc::Kind::kMesh) {
+    sph_mesh_desc d = shape.mesh;
+    d.vertices = shape.mesh_vertices.data();
+    d.vertex_count = static_cast<uint32_t>(shape.mesh_vertices.size() / 3);
+    d.indices = shape.mesh_indices.data();
+    d.index_count = static_cast<uint32_t>(shape.mesh_indices.size());
+    const sph_result r = sph_sdf_create_from_mesh(context, &d, &sdf);
+    if (r < 0)
+      throw SceneError(shape.path,
+                       "the library rejected the mesh from " + shape.mesh_file + ": " + sph_get_last_error());
+    return sdf;
+  }
   const sph_result r = sph_sdf_create_shape(context, &shape.analytic, &sdf);
   if (r < 0)
     throw SceneError(shape.path, std::string("the library rejected the shape: ") + sph_get_last_error());
@@ -46,6 +60,17 @@ bool shape_local_bounds(const ShapeDesc& shape, sph_vec3* min, sph_vec3* max) {
     *min = shape.vdb_bounds_min;
     *max = shape.vdb_bounds_max;
     return shape.has_vdb_bounds;
+  }
+  if (shape.kind == ShapeDesc::Kind::kMesh) {
+    if (shape.mesh_vertices.empty()) return false;
+    *min = sph_vec3{INFINITY, INFINITY, INFINITY};
+    *max = sph_vec3{-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i + 2 < shape.mesh_vertices.size(); i += 3) {
+      const float* v = &shape.mesh_vertices[i];
+      *min = sph_vec3{std::min(min->x, v[0]), std::min(min->y, v[1]), std::min(min->z, v[2])};
+      *max = sph_vec3{std::max(max->x, v[0]), std::max(max->y, v[1]), std::max(max->z, v[2])};
+    }
+    return true;
   }
   const sph_shape_desc& d = shape.analytic;
   const float w = d.wall_thickness;

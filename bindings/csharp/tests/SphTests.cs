@@ -484,7 +484,7 @@ static class Tests
         AssertEqual(ParamZero.Default, speed.Zero, "speed of sound: 0 is the default");
         AssertEqual(ParamBound.Exclusive, speed.LowerBound, "speed of sound > 0");
         PhysicsMethodInfo[] methods = Library.PhysicsMethods();
-        AssertEqual(7, methods.Length, "methods");
+        AssertEqual(9, methods.Length, "methods");  // through boundary_density and collider_loads
         AssertEqual("clavet", Utf8.FromNative(methods[3].Name), "the fourth method");
         AssertEqual(MethodSwitch.Viscosity, methods[3].SwitchBy, "Clavet is a viscosity method");
         AssertEqual(ParamsKind.ClavetViscosity, methods[3].ParamsKind, "its params");
@@ -734,6 +734,26 @@ static class Tests
                 Throws(Result.ErrorInvalidArgument, () => Sdf.CreateShape(ctx, bad));
                 Throws(Result.ErrorBusy, () => SphException.Check(Native.sph_context_destroy(ctx.Handle.DangerousGetHandle()), "sph_context_destroy"));
             }
+            // A mesh: a cube of side 0.2 m as 12 triangles; at its centre the distance is -0.1 m
+            // (within half a 2 cm voxel).
+            var corners = new float[24];
+            for (int c = 0; c < 8; ++c)
+            {
+                corners[3 * c] = (c & 1) != 0 ? 0.1f : -0.1f;
+                corners[3 * c + 1] = (c & 2) != 0 ? 0.1f : -0.1f;
+                corners[3 * c + 2] = (c & 4) != 0 ? 0.1f : -0.1f;
+            }
+            var cube = new uint[] { 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4,
+                                    2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5 };
+            var meshDesc = MeshDesc.Default();
+            meshDesc.VoxelSize = 0.02f;
+            using (var mesh = Sdf.CreateFromMesh(ctx, corners, cube, meshDesc))
+            {
+                Assert(Math.Abs(mesh.Sample(new Vec3(0, 0, 0)) + 0.1f) < 0.01f, "mesh inside");
+                Assert(Math.Abs(mesh.Sample(new Vec3(0.2f, 0, 0)) - 0.1f) < 0.01f, "mesh outside");
+            }
+            cube[5] = 8;  // past the last vertex
+            Throws(Result.ErrorInvalidArgument, () => Sdf.CreateFromMesh(ctx, corners, cube));
             // A grid: the distance to a sphere of radius 0.1 on 9^3 samples, centre at a sample.
             const int n = 9;
             float voxel = 0.05f, origin = -(n - 1) / 2f * voxel;
@@ -760,6 +780,41 @@ static class Tests
             }
             dist[0] = float.NaN;
             Throws(Result.ErrorInvalidArgument, () => Sdf.Create(ctx, dist, n, n, n, map));
+        }
+    }
+
+    // Loads on colliders (issue 17): refused without the feature; with it, water resting on a
+    // floor presses it with about its weight, the torque about the load point.
+    public static void TestColliderLoads()
+    {
+        var plane = ShapeDesc.Default();
+        plane.Shape = Shape.Plane;
+        plane.HalfExtents = new Vec3(1, 0.1f, 1);
+        plane.VoxelSize = 0.03f;
+        using (var ctx = Cpu())
+        using (var floor = Sdf.CreateShape(ctx, plane))
+        {
+            using (var world = ctx.CreateWorld(SmallWorld()))
+            {
+                var c = world.CreateCollider(floor, Transform.Default());
+                Throws(Result.ErrorFeatureDisabled, () => { var l = c.Loads; });
+                Throws(Result.ErrorFeatureDisabled, () => c.SetLoadPoint(new Vec3(0, 0, 0)));
+            }
+            var d = SmallWorld();
+            d.FeatureFlags = FeatureFlags.ColliderLoads;
+            using (var world = ctx.CreateWorld(d))
+            {
+                var c = world.CreateCollider(floor, Transform.Default());
+                AssertEqual(0.0, c.Loads.FrameTime, "no loads before a step");
+                c.SetLoadPoint(new Vec3(0.1f, 0, 0));
+                uint n = world.FillBox(new Vec3(-0.08f, 0.0f, -0.08f), new Vec3(0.08f, 0.06f, 0.08f));
+                for (int i = 0; i < 10; ++i) world.Step(1f / 60f);
+                var loads = c.Loads;
+                float weight = n * world.ParticleMass * 9.81f;
+                Assert(Math.Abs(loads.Force.Y + weight) < 0.3f * weight, "the floor carries the weight: " + loads.Force.Y);
+                Assert(Math.Abs(loads.Torque.Z + 0.1f * loads.Force.Y) < 0.2f * Math.Abs(0.1f * loads.Force.Y),
+                       "torque about the load point: " + loads.Torque.Z);
+            }
         }
     }
 

@@ -10,7 +10,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '3d2ae0c225ce462edc20d2f0301161896a5b2834da3d4aa80fd9a6bbb39c0b46', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
+HEADERS = {'include/sph_c.h': 'b3ef67d9166b01d7869f10a7c14ab5642a2f4b8e57ac1909c1ee49542b4db020', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -55,6 +55,13 @@ SPH_FEATURE_SPRINGS = 4
 #: collision response stays the no-penetration safeguard. Costs one SDF sample per particle and
 #: collider in each density pass.
 SPH_FEATURE_BOUNDARY_DENSITY = 8
+#: Loads on colliders: the force and torque of the fluid on each collider over every step
+#: (sph_collider_get_loads): the collision response's contact impulses and, with
+#: SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions, summed on the device per substep in
+#: a fixed order (bitwise deterministic) and averaged over the step's time. Costs, per substep, a
+#: reduction over the particles per collider (and with the boundary density one SDF sample per
+#: particle and collider per force evaluation); no host round trip inside a step.
+SPH_FEATURE_COLLIDER_LOADS = 16
 #: Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt <= step_factor h / c, c the
 #: EOS's speed of sound
 SPH_STEP_LIMIT_ACOUSTIC = 1
@@ -1196,6 +1203,47 @@ class ShapeDesc(_SphStruct):
 sph_shape_desc = ShapeDesc
 
 
+class MeshDesc(_SphStruct):
+    """
+    A triangle mesh to turn into an SDF asset (sph_sdf_create_from_mesh). Triangles are counter-
+    clockwise seen from outside (clockwise throughout works too: the inside is where the winding
+    number is at least 1/2 in magnitude). The mesh need not be closed or manifold: holes
+    narrower than about twice band_width voxels still leave a signed inside. Zero means default,
+    except that the arrays and their counts are required (the error names the first missing).
+
+    Fields:
+        struct_size (uint32_t): set by sph_mesh_desc_init
+        vertex_count (uint32_t): required, >= 3
+        vertex_stride (uint32_t): bytes from one vertex to the next; 0 (default) = 12 (packed x, y, z floats); otherwise >= 12
+        index_count (uint32_t): three per triangle; required, a multiple of 3
+        vertices (const float*): x, y, z (m, the asset's local frame) per vertex; finite; copied
+        indices (const uint32_t*): vertex indices, each < vertex_count; copied
+        voxel_size (float): m; 0 (default) = 0.01
+        band_width (float): voxels of exact point-triangle distance on each side of the surface, in [1, 64]; 0 (default) = 3. Beyond it the closest triangle is swept outward (distances within a voxel or so)
+        padding_voxels (uint32_t): grid margin around the mesh's bounds, <= 1024; 0 (default) = 4
+        reserved0 (uint32_t): must be 0
+    """
+    _fields_ = [
+        ('struct_size', _c.c_uint32),
+        ('vertex_count', _c.c_uint32),
+        ('vertex_stride', _c.c_uint32),
+        ('index_count', _c.c_uint32),
+        ('vertices', _c.POINTER(_c.c_float)),
+        ('indices', _c.POINTER(_c.c_uint32)),
+        ('voxel_size', _c.c_float),
+        ('band_width', _c.c_float),
+        ('padding_voxels', _c.c_uint32),
+        ('reserved0', _c.c_uint32),
+    ]
+    _sph_c_name_ = 'sph_mesh_desc'
+    _sph_size_ = 48
+    _sph_offsets_ = (('struct_size', 0), ('vertex_count', 4), ('vertex_stride', 8), ('index_count', 12), ('vertices', 16), ('indices', 24), ('voxel_size', 32), ('band_width', 36), ('padding_voxels', 40), ('reserved0', 44))
+    _sph_init_ = 'sph_mesh_desc_init_sized'
+
+
+sph_mesh_desc = MeshDesc
+
+
 class Quat(_SphStruct):
     """
     sph_quat.
@@ -1324,6 +1372,42 @@ class ColliderMaterial(_SphStruct):
 
 
 sph_collider_material = ColliderMaterial
+
+
+class ColliderLoads(_SphStruct):
+    """
+    The fluid's loads on a collider over the last sph_world_step (SPH_FEATURE_COLLIDER_LOADS):
+    the time averages over the step's substeps of the force and of the torque about the
+    collider's load point, in world coordinates. What counts: the momentum the collision
+    response took from particles (contacts, friction, stickiness) and, with
+    SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions; force times frame_time is the
+    impulse the fluid gave the collider. The torque of each impulse is taken about the load
+    point posed at the impulse's time (it moves with the collider). Zero before the first step
+    (frame_time 0). docs/physics.md "Loads".
+
+    Fields:
+        struct_size (uint32_t): set by sph_collider_loads_init
+        reserved0 (uint32_t): written as 0
+        force (sph_vec3): N, world frame
+        torque (sph_vec3): N m, world frame, about point
+        point (sph_vec3): the load point in the world at the end of the step, m
+        frame_time (double): s: the time the step advanced, over which force and torque are averaged
+    """
+    _fields_ = [
+        ('struct_size', _c.c_uint32),
+        ('reserved0', _c.c_uint32),
+        ('force', sph_vec3),
+        ('torque', sph_vec3),
+        ('point', sph_vec3),
+        ('frame_time', _c.c_double),
+    ]
+    _sph_c_name_ = 'sph_collider_loads'
+    _sph_size_ = 56
+    _sph_offsets_ = (('struct_size', 0), ('reserved0', 4), ('force', 8), ('torque', 20), ('point', 32), ('frame_time', 48))
+    _sph_init_ = 'sph_collider_loads_init_sized'
+
+
+sph_collider_loads = ColliderLoads
 
 
 class SourceId(_SphStruct):
@@ -1568,7 +1652,7 @@ class CudaAttributeView(_SphStruct):
 sph_cuda_attribute_view = CudaAttributeView
 
 
-STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpringParams, ParamsInfo, ParamFieldInfo, PhysicsMethodInfo, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, Quat, Transform, ColliderId, ColliderDef, ColliderMaterial, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, Event, CudaAttributeView, )
+STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpringParams, ParamsInfo, ParamFieldInfo, PhysicsMethodInfo, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, MeshDesc, Quat, Transform, ColliderId, ColliderDef, ColliderMaterial, ColliderLoads, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, Event, CudaAttributeView, )
 
 # ---- functions --------------------------------------------------------------------------------
 
@@ -1682,6 +1766,10 @@ FUNCTIONS = {
         '', 'sph'),
     'sph_sdf_create_shape': (sph_result, (_c.POINTER(sph_context), _c.POINTER(sph_shape_desc), _c.POINTER(_c.POINTER(sph_sdf))), ('context', 'desc', 'out'),
         'Samples an analytic shape (centred at its local origin, y up) into an SDF asset.', 'sph'),
+    'sph_mesh_desc_init_sized': (sph_result, (_c.POINTER(sph_mesh_desc), _c.c_uint32), ('desc', 'size'),
+        '', 'sph'),
+    'sph_sdf_create_from_mesh': (sph_result, (_c.POINTER(sph_context), _c.POINTER(sph_mesh_desc), _c.POINTER(_c.POINTER(sph_sdf))), ('context', 'desc', 'out'),
+        "Builds an SDF asset from a triangle mesh (the arrays are read during the call, not kept): a grid of voxel_size over the mesh's bounds plus padding, axis-aligned, voxel (0, 0, 0) centred at the bounds' minimum corner less padding_voxels voxels (index_to_local is a scale by voxel_size and that translation); exact distances to the nearest triangle within band_width voxels of the surface, the nearest triangle swept outward beyond; negative inside by the generalised winding number. Host memory only; no OpenVDB needed. Blocking; costs about (triangles * (2 band_width + 1)^3 + voxels) distance evaluations. Thread-safe with respect to other SDF calls on the context. Errors: INVALID_ARGUMENT (NULL arrays, counts, an index out of range, a non-finite vertex, a size out of range, reserved0), CAPACITY (more than 2^31 voxels: a larger voxel_size is needed), OUT_OF_HOST_MEMORY.", 'sph'),
     'sph_sdf_update': (sph_result, (_c.POINTER(sph_sdf), sph_sdf_channel, _c.POINTER(_c.c_uint32), _c.POINTER(_c.c_uint32), _c.POINTER(_c.c_float), sph_memory_kind), ('sdf', 'channel', 'origin', 'size', 'data', 'memory'),
         'Overwrites the box [origin, origin + size) of one channel with data (size[0] * size[1] * size[2] * components floats, i fastest, copied). Updating the velocity or friction channel of an asset created without it creates it (zero elsewhere). Do not update an asset while a world that uses it is inside sph_world_step on another thread. Errors: INVALID_ARGUMENT (box outside the grid, NULL or non-finite data), UNSUPPORTED (unknown channel or memory).', 'sph'),
     'sph_sdf_get_dims': (sph_result, (_c.POINTER(sph_sdf), _c.POINTER(_c.c_uint32)), ('sdf', 'out_dims'),
@@ -1710,6 +1798,12 @@ FUNCTIONS = {
         "Replaces a collider's material; acts from the next substep. Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (NULL material; a coefficient out of range or not finite, named), VERSION_MISMATCH (struct_size), WORLD_LOCKED. Nothing changes on error.", 'sph'),
     'sph_collider_get_material': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_collider_material)), ('world', 'id', 'out'),
         "Reads a collider's material (as the def or the last set call gave it). out->struct_size must be set (sph_collider_material_init); only that many bytes are written. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL out), VERSION_MISMATCH, WORLD_LOCKED.", 'sph'),
+    'sph_collider_loads_init_sized': (sph_result, (_c.POINTER(sph_collider_loads), _c.c_uint32), ('loads', 'size'),
+        '', 'sph'),
+    'sph_collider_get_loads': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_collider_loads)), ('world', 'id', 'out'),
+        "Reads a collider's loads of the last step. Non-blocking (the step brought them to the host). out->struct_size must be set (sph_collider_loads_init); only that many bytes are written. Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (NULL out), VERSION_MISMATCH, FEATURE_DISABLED (the world lacks SPH_FEATURE_COLLIDER_LOADS), WORLD_LOCKED.", 'sph'),
+    'sph_collider_set_load_point': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_vec3)), ('world', 'id', 'point'),
+        "Sets the point, in the collider's own frame, that its loads' torque is taken about (default its origin; an engine passes the body's centre of mass). Acts from the next step. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL point; a non-finite component, named), FEATURE_DISABLED, WORLD_LOCKED. Nothing changes on error.", 'sph'),
     'sph_source_def_init_sized': (sph_result, (_c.POINTER(sph_source_def), _c.c_uint32), ('def', 'size'),
         '', 'sph'),
     'sph_source_create': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_source_def), _c.POINTER(sph_source_id)), ('world', 'def', 'out_id'),

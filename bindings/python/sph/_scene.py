@@ -108,6 +108,38 @@ class Sdf:
         return cls(context, out)
 
     @classmethod
+    def from_mesh(cls, context, vertices, indices, *, voxel_size=None, band_width=None, padding_voxels=None):
+        """An asset from a triangle mesh (sph_sdf_create_from_mesh; the arrays are copied).
+
+        vertices: (n, 3) positions in the asset's local frame, m; indices: (m, 3) or a flat
+        sequence of vertex indices, three per triangle, counter-clockwise seen from outside
+        (clockwise throughout works too). The mesh may have small holes. voxel_size (m),
+        band_width (voxels of exact distance around the surface) and padding_voxels (grid
+        margin) default as in MeshDesc. Voxel (0, 0, 0) sits at the vertices' minimum corner
+        less padding_voxels voxels.
+        """
+        v = np.ascontiguousarray(vertices, dtype=np.float32)
+        if v.ndim != 2 or v.shape[1] != 3:
+            raise ValueError(f"vertices: expected an array of shape (n, 3), got {v.shape}")
+        i = np.asarray(indices)
+        if i.size and (not np.issubdtype(i.dtype, np.integer) or i.min() < 0 or i.max() > 0xFFFFFFFF):
+            raise ValueError("indices: expected integers in [0, 2^32)")
+        i = np.ascontiguousarray(i, dtype=np.uint32).reshape(-1)
+        if len(v) > 0xFFFFFFFF or len(i) > 0xFFFFFFFF:
+            raise ValueError("vertices, indices: at most 2^32 - 1 of each")
+        desc = _g.MeshDesc(vertex_count=len(v), index_count=len(i),
+                           vertices=v.ctypes.data_as(ctypes.POINTER(ctypes.c_float)),
+                           indices=i.ctypes.data_as(ctypes.POINTER(ctypes.c_uint32)))
+        for name, value in (("voxel_size", voxel_size), ("band_width", band_width),
+                            ("padding_voxels", padding_voxels)):
+            if value is not None:
+                setattr(desc, name, value)
+        out = ctypes.POINTER(_g.sph_sdf)()
+        check(library().sph_sdf_create_from_mesh(context.handle, ctypes.byref(desc), ctypes.byref(out)),
+              "sph_sdf_create_from_mesh")
+        return cls(context, out)
+
+    @classmethod
     def from_vdb(cls, context, path, grid_name=None):
         """Loads a level-set FloatGrid from a .vdb file (sph_vdb_load_sdf, in the optional
         helper library libsph_vdb; SphLoadError when it is not built). The asset's local frame
@@ -269,6 +301,23 @@ class Collider(_WorldObject):
         """Changes restitution [0, 1], friction >= 0 and stickiness >= 0: the same as setting
         ``material`` to a ColliderMaterial of these three."""
         self.material = _g.ColliderMaterial(restitution=restitution, friction=friction, stickiness=stickiness)
+
+    @property
+    def loads(self):
+        """The fluid's loads over the last step, a ColliderLoads: force (N) and torque (N m) about
+        ``point``, world frame, time averages over ``frame_time`` (sph_collider_get_loads; needs
+        the world feature "collider_loads")."""
+        l = _g.ColliderLoads()
+        check(library().sph_collider_get_loads(self.world.handle, self.id, ctypes.byref(l)),
+              "sph_collider_get_loads")
+        return l
+
+    def set_load_point(self, point):
+        """The point, in the collider's own frame, that the loads' torque is about (default the
+        origin; pass the body's centre of mass) (sph_collider_set_load_point)."""
+        p = _g.Vec3(*point)
+        check(library().sph_collider_set_load_point(self.world.handle, self.id, ctypes.byref(p)),
+              "sph_collider_set_load_point")
 
 
 class Source(_WorldObject):

@@ -169,7 +169,7 @@ def test_params_are_described_for_tools():
     assert tuple(gravity.default_value) == pytest.approx((0, -9.81, 0))
     methods = {m.name: m for m in sph.methods()}
     assert list(methods) == [b"ideal_gas", b"tait", b"mueller", b"clavet", b"surface_tension",
-                             b"normalized_density", b"springs"]
+                             b"normalized_density", b"springs", b"boundary_density", b"collider_loads"]
     assert methods[b"springs"].switch_by == sph.MethodSwitch.FEATURE
     assert methods[b"springs"].value == sph.Feature.SPRINGS and methods[b"springs"].has_params
     assert methods[b"tait"].params_kind == sph.ParamsKind.TAIT
