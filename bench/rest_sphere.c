@@ -9,7 +9,10 @@
  *
  *   rest_sphere [--particles N|largest] [--frames F] [--warmup W] [--backend cpu|cuda|auto]
  *               [--case rest|moving|both] [--option NAME] [--json FILE] [--csv FILE] [--label TEXT]
- *               [--cuda-frames graph|stream] [--density-block N] [--force-block N]
+ *               [--cuda-frames graph|stream] [--density-block N] [--force-block N] [--threads N]
+ *
+ * --threads sets the CPU backend's workers (sph_context_def.cpu_worker_count), so that a run on a
+ * larger host can measure two workers (issue 18's CPU goal); pin them with taskset to two cores.
  *
  * --option turns one optional piece of physics on, to measure what it costs (BENCHMARK.md,
  * issue 5): none (default), surface_tension, normalized_density, clavet (viscosity), tait
@@ -56,6 +59,7 @@ typedef struct options {
   sph_cuda_frames cuda_frames;
   uint32_t density_block; /* 0: the library's default */
   uint32_t force_block;
+  uint32_t threads; /* CPU workers; 0: the library's default, one per processor */
 } options;
 
 typedef struct result {
@@ -174,6 +178,7 @@ static result run_case(const options* o, int moving) {
   cdef.cuda_frames = o->cuda_frames;
   cdef.cuda_density_block = o->density_block;
   cdef.cuda_force_block = o->force_block;
+  cdef.cpu_worker_count = o->threads;
   sph_context* context = NULL;
   check(sph_context_create(&cdef, &context), "sph_context_create");
   sph_backend resolved;
@@ -334,13 +339,13 @@ static void usage(void) {
           "                   [--case rest|moving|both] [--option none|surface_tension|normalized_density|\n"
           "                   clavet|tait|rk4|acoustic_limit|springs] [--json FILE] [--csv FILE]\n"
           "                   [--label TEXT] [--cuda-frames graph|stream] [--density-block N]\n"
-          "                   [--force-block N]\n");
+          "                   [--force-block N] [--threads N]\n");
   exit(2);
 }
 
 int main(int argc, char** argv) {
   options o = {100000, 0, "none", 100, 3, SPH_BACKEND_AUTO, "both", NULL, NULL, NULL, SPH_CUDA_FRAMES_GRAPH,
-               0,      0};
+               0,      0, 0};
   for (int i = 1; i < argc; ++i) {
     const char* a = argv[i];
     const char* v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -371,6 +376,8 @@ int main(int argc, char** argv) {
       o.density_block = (uint32_t)strtoul(v, NULL, 10);
     } else if (strcmp(a, "--force-block") == 0) {
       o.force_block = (uint32_t)strtoul(v, NULL, 10);
+    } else if (strcmp(a, "--threads") == 0) {
+      o.threads = (uint32_t)strtoul(v, NULL, 10);
     } else {
       usage();
     }

@@ -18,7 +18,7 @@ SPH_SCRIPT_NAME="$(basename "${0}")"
 
 # The Debian 12 packages the build, the tests and the tools need. libclang-rt-14-dev is what
 # clang's Recommends would bring in; it holds libFuzzer and the sanitizer runtimes for clang;
-# libomp-dev is OpenMP for clang (the fuzz build).
+# libomp-dev is OpenMP for clang (the fuzz build). libxsimd-dev: the CPU backend's SIMD passes.
 # Python (numpy, pytest, matplotlib) and mono run the binding tests; libpng-dev gives sph-run
 # its preview images. python3-vtk9 reads sph-run's .vtp frames back, python3-jsonschema checks
 # the scene files against docs/scene.schema.json, python3-cffi parses bindings/cffi/sph_cdef.h;
@@ -26,7 +26,7 @@ SPH_SCRIPT_NAME="$(basename "${0}")"
 # virtual environment offline (scripts/build-wheel, scripts/test).
 SPH_PACKAGES=(
   cmake ninja-build g++ pkg-config git
-  libcmocka-dev libeigen3-dev
+  libcmocka-dev libeigen3-dev libxsimd-dev
   libopenvdb-dev libboost-iostreams-dev libtbb-dev nlohmann-json3-dev
   clang libclang-rt-14-dev libomp-dev clang-format
   python3 python3-numpy python3-pytest python3-matplotlib mono-mcs mono-runtime

@@ -34,7 +34,7 @@ void describe_field(const char* name, ParamType type, ZeroMeans zero, const Para
 }  // namespace binding_detail
 
 static_assert(static_cast<uint32_t>(ParamType::Float) == SPH_PARAM_FLOAT &&
-                  static_cast<uint32_t>(ParamType::Vec3) == SPH_PARAM_VEC3 &&
+                  static_cast<uint32_t>(ParamType::Vector) == SPH_PARAM_VEC3 &&
                   static_cast<uint32_t>(ParamType::Count) == SPH_PARAM_UINT32 &&
                   static_cast<uint32_t>(ParamType::Bits) == SPH_PARAM_FLAGS,
               "ParamType equals sph_param_type");

@@ -56,7 +56,7 @@ void read(const PartBinding& b, const unsigned char* in, RuntimeParams& into) {
     constexpr ParamField<typename Method::Params> f = Method::kFields[decltype(k)::value];
     const unsigned char* at = in + b.offsets[decltype(k)::value];
     if constexpr (f.type == ParamType::Float) std::memcpy(&(p.*f.real), at, sizeof(float));
-    if constexpr (f.type == ParamType::Vec3) std::memcpy(&(p.*f.vector), at, sizeof(Vec3));
+    if constexpr (f.type == ParamType::Vector) std::memcpy(&(p.*f.vector), at, sizeof(Vec3));
     if constexpr (f.type == ParamType::Count || f.type == ParamType::Bits)
       std::memcpy(&(p.*f.integer), at, sizeof(uint32_t));
   });
@@ -75,7 +75,7 @@ void write(const PartBinding& b, const RuntimeParams& r, unsigned char* out) {
     constexpr ParamField<typename Method::Params> f = Method::kFields[decltype(k)::value];
     unsigned char* at = out + b.offsets[decltype(k)::value];
     if constexpr (f.type == ParamType::Float) std::memcpy(at, &(p.*f.real), sizeof(float));
-    if constexpr (f.type == ParamType::Vec3) std::memcpy(at, &(p.*f.vector), sizeof(Vec3));
+    if constexpr (f.type == ParamType::Vector) std::memcpy(at, &(p.*f.vector), sizeof(Vec3));
     if constexpr (f.type == ParamType::Count || f.type == ParamType::Bits)
       std::memcpy(at, &(p.*f.integer), sizeof(uint32_t));
   });
@@ -93,7 +93,7 @@ void describe(const PartBinding& b, uint32_t field, sph_param_field_info& out) {
     if (decltype(k)::value != field) return;
     float values[3] = {0.0f, 0.0f, 0.0f};
     if constexpr (f.type == ParamType::Float) values[0] = defaults.*f.real;
-    if constexpr (f.type == ParamType::Vec3) {
+    if constexpr (f.type == ParamType::Vector) {
       const Vec3 v = defaults.*f.vector;
       values[0] = v.x, values[1] = v.y, values[2] = v.z;
     }

@@ -21,7 +21,7 @@ void write_block(ByteWriter& w, const typename Method::Params& p) {
   for_each_field<Method>([&](auto k) {
     constexpr ParamField<typename Method::Params> f = Method::kFields[decltype(k)::value];
     if constexpr (f.type == ParamType::Float) w.f32(p.*f.real);
-    if constexpr (f.type == ParamType::Vec3) {
+    if constexpr (f.type == ParamType::Vector) {
       w.f32((p.*f.vector).x);
       w.f32((p.*f.vector).y);
       w.f32((p.*f.vector).z);
@@ -38,7 +38,7 @@ void read_fields(ByteReader& r, uint32_t count, typename Method::Params& p) {
     constexpr ParamField<typename Method::Params> f = Method::kFields[decltype(k)::value];
     if (decltype(k)::value >= count) return;
     if constexpr (f.type == ParamType::Float) p.*f.real = r.f32();
-    if constexpr (f.type == ParamType::Vec3) {
+    if constexpr (f.type == ParamType::Vector) {
       (p.*f.vector).x = r.f32();
       (p.*f.vector).y = r.f32();
       (p.*f.vector).z = r.f32();

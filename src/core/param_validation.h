@@ -44,7 +44,7 @@ void validate(const typename Method::Params& p, const WorldShape& shape, const P
   for_each_field<Method>([&](auto k) {
     constexpr ParamField<typename Method::Params> f = Method::kFields[decltype(k)::value];
     if constexpr (f.type == ParamType::Float) check_real(p.*f.real, f.name, f.range, path);
-    if constexpr (f.type == ParamType::Vec3) check_vector(p.*f.vector, f.name, path);
+    if constexpr (f.type == ParamType::Vector) check_vector(p.*f.vector, f.name, path);
     if constexpr (f.type == ParamType::Count) check_count(p.*f.integer, f.name, f.range, path);
     if constexpr (f.type == ParamType::Bits) check_bits(p.*f.integer, f.name, f.known_bits, path);
   });

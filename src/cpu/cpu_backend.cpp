@@ -11,10 +11,27 @@
 
 namespace sph {
 
+namespace {
+
+// Which per-particle inputs a world's force terms read (forces.h), so only those columns exist.
+template <class... Terms>
+bool reads_neighbor_counts(ForceTerms<Terms...>) {
+  return TermList<Terms...>::kReadsNeighborCounts;
+}
+template <class... Terms>
+bool reads_colour_normals(ForceTerms<Terms...>) {
+  return TermList<Terms...>::kReadsColourNormals;
+}
+
+}  // namespace
+
 CpuBackend::CpuBackend(const WorldConfig& config, unsigned workers)
     : config_(config),
       workers_(workers == 0 ? 1u : workers),
       grid_(config.kernel_radius, max_particles_per_cell(config.particle_spacing, config.kernel_radius)),
+      simd_(best_simd_passes()),
+      columns_(with_force_terms(config.selection(), [](auto terms) { return reads_neighbor_counts(terms); }),
+               with_force_terms(config.selection(), [](auto terms) { return reads_colour_normals(terms); })),
       method_arrays_(method_particle_arrays(config)) {
   using Role = ParticleArrayRole;
   const auto array = [](const char* name, uint32_t size, Role role) {

@@ -2,8 +2,11 @@
 // The CPU backend's class, shared by the files of src/cpu/ that implement it (one per stage of a
 // frame, each the twin of a file of cuda/; see docs/architecture.md). Each substep sorts
 // particles into the wrapped grid, then loops the shared per-particle physics (src/physics) over
-// all particles on OpenMP threads. Results do not depend on the thread count: every particle is
-// a pure gather and the only reduction (max speed) is order-independent.
+// all particles on OpenMP threads, the neighbour gathers on SIMD lanes (cpu_simd_passes.h).
+// Results do not depend on the thread count nor on the processor's SIMD target: every particle
+// is a pure gather whose order of sums is fixed, and the only reductions (max speed and
+// acceleration) are order-independent. The loops hand out particles in chunks on demand, so a
+// core that something else keeps busy holds up only the chunk it is working on.
 #pragma once
 
 #include <chrono>
@@ -21,8 +24,10 @@
 #include "../physics/integrate.h"
 #include "../physics/springs.h"
 #include "cpu_boundary_maps.h"
+#include "cpu_neighbor_columns.h"
 #include "cpu_neighbor_grid.h"
 #include "cpu_particle_store.h"
+#include "cpu_simd_passes.h"
 
 namespace sph {
 
@@ -61,7 +66,9 @@ class CpuBackend final : public Backend {
 
   void import_particles(const ParticleSnapshot& s) override;
 
-  uint64_t memory_bytes() const override { return store_.bytes() + grid_.bytes() + boundary_maps_.bytes(); }
+  uint64_t memory_bytes() const override {
+    return store_.bytes() + grid_.bytes() + columns_.bytes() + boundary_maps_.bytes();
+  }
 
  private:
   static constexpr uint32_t kAllFinite = 0xffffffffu;
@@ -90,17 +97,22 @@ class CpuBackend final : public Backend {
                      : Vec3{0.0f, 0.0f, 0.0f};
   }
 
-  // Acceleration of particle i: the neighbour gather with the world's force terms compiled in
-  // (forces.h), plus the scene's force fields; with the pressure force (the weakly compressible
-  // scheme) or without it (DFSPH's non-pressure accelerations).
+  // The neighbour gather of the world's force terms (with_force_terms) on the SIMD target.
+  using AccelerationFn = SimdPasses::AccelerationFn;
+  AccelerationFn acceleration_function() const { return simd_.acceleration_for(config_.selection()); }
+  // Acceleration of particle i: the neighbour gather plus the scene's force fields.
+  Vec3 acceleration(AccelerationFn gather, const FluidConstants& fluid, const GridView& view,
+                    const NeighborColumns& columns, const SceneFrame& scene, uint32_t i) const;
+  // DFSPH's non-pressure accelerations: the scalar gather (forces.h) without the pressure force,
+  // plus the scene's force fields. (The SIMD passes gather the weakly compressible scheme's
+  // terms; DFSPH's pressure comes from its solves.)
   template <class Terms, bool kPressure>
   static Vec3 acceleration_with(const FluidConstants& fluid, const GridView& view, const ForceInputs& in,
                                 const SceneFrame& scene, uint32_t i);
-  using AccelerationFn = Vec3 (*)(const FluidConstants&, const GridView&, const ForceInputs&,
-                                  const SceneFrame&, uint32_t);
-  // The world's force pass: the solver's choice of the pressure force and the world's terms.
-  AccelerationFn acceleration_function() const;
-  // The arrays the force gather reads (normals and counts only where a term reads them).
+  using ScalarAccelerationFn = Vec3 (*)(const FluidConstants&, const GridView&, const ForceInputs&,
+                                        const SceneFrame&, uint32_t);
+  ScalarAccelerationFn scalar_acceleration_function() const;
+  // The arrays the scalar force gather reads (normals and counts only where a term reads them).
   ForceInputs force_inputs() const;
 
   // Resolves colliders for the state in next_position_/next_velocity_, moved from x_old(i).
@@ -184,6 +196,8 @@ class CpuBackend final : public Backend {
   WorldConfig config_;
   unsigned workers_;
   CpuNeighborGrid grid_;
+  const SimdPasses& simd_;      // the processor's SIMD target
+  CpuNeighborColumns columns_;  // the sorted records as columns, for the SIMD passes
   CpuParticleStore store_;
   std::vector<ParticleArraySpec> method_arrays_;  // method_particle_arrays(config_)
   CpuArrayRef<Float4> position_;                  // w: pressure after the density pass

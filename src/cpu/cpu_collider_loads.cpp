@@ -40,7 +40,10 @@ void CpuBackend::collide_with_loads(const FluidConstants& fluid, const SceneFram
   Float4* next_vel = next_velocity_.data();
   const Vec3* points = load_points_.data();
   LoadImpulse* partial = load_blocks_.data();
-#pragma omp parallel for num_threads(threads()) schedule(static)
+  // Blocks go out dynamically like every loop's particles (kParticleChunk); their sums are kept
+  // per block and added in block order below, so the split changes no bit.
+  constexpr int kBlocksPerChunk = kParticleChunk / static_cast<int>(kLoadBlock);
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kBlocksPerChunk)
   for (int b = 0; b < static_cast<int>(blocks); ++b) {
     LoadImpulse* sums = partial + static_cast<size_t>(b) * colliders;
     const uint32_t end = std::min(count_, (static_cast<uint32_t>(b) + 1) * kLoadBlock);

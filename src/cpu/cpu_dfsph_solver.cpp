@@ -119,13 +119,13 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
   Float4* next_pos = next_position_.data();
   Float4* next_vel = next_velocity_.data();
   const Float4* spring = spring_acceleration_.data();
-  const AccelerationFn acceleration = acceleration_function();
+  const ScalarAccelerationFn non_pressure = scalar_acceleration_function();
   const ForceInputs inputs = force_inputs();
   const Float4* contact = dfsph_contacts_ ? dfsph_contact_.data() : nullptr;
   float a2max = 0.0f;
 #pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
   for (int i = 0; i < n(); ++i) {
-    Vec3 a = acceleration(fluid, view, inputs, scene, static_cast<uint32_t>(i));
+    Vec3 a = non_pressure(fluid, view, inputs, scene, static_cast<uint32_t>(i));
     if (spring) a += xyz(spring[i]);
     a2max = std::max(a2max, length_squared(a));
     Vec3 v = xyz(vel[i]) + a * dt;

@@ -11,7 +11,7 @@ namespace sph {
 float CpuBackend::compute_max_speed() const {
   const Float4* vel = velocity_.data();
   float v2max = 0.0f;
-#pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : v2max)
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk) reduction(max : v2max)
   for (int i = 0; i < n(); ++i) v2max = std::max(v2max, length_squared(xyz(vel[i])));
   return std::sqrt(v2max);
 }
@@ -22,7 +22,10 @@ uint32_t CpuBackend::scan_next_state(float& v2max) const {
   const Float4* next_vel = next_velocity_.data();
   float m = 0.0f;
   uint32_t bad_index = kAllFinite;
-#pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : m) reduction(min : bad_index)
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk) reduction(max  \
+                                                                                            : m) \
+    reduction(min                                                                                \
+              : bad_index)
   for (int i = 0; i < n(); ++i) {
     const float v2 = length_squared(xyz(next_vel[i]));
     m = std::max(m, v2);
@@ -42,7 +45,9 @@ void CpuBackend::diagnose_non_finite(const FluidConstants& fluid, const SceneFra
   const Float4* pos = position_.data();
   const Float4* vel = velocity_.data();
   const uint32_t i = first;
-  Vec3 a = acceleration_function()(fluid, grid_.view(), force_inputs(), scene, i);
+  Vec3 a = config_.solver == Solver::Dfsph
+               ? scalar_acceleration_function()(fluid, grid_.view(), force_inputs(), scene, i)
+               : acceleration(acceleration_function(), fluid, grid_.view(), columns_.view(), scene, i);
   if (spring_acceleration_) a += xyz(spring_acceleration_[i]);
   a += wall_acceleration(i);
   const ParticleState current{xyz(pos[i]), xyz(vel[i])};

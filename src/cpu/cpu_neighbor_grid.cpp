@@ -69,7 +69,7 @@ void CpuNeighborGrid::build(const Float4* positions, uint32_t n, unsigned worker
   cell_start_.assign(static_cast<size_t>(shape_.cell_count) + 1, 0u);
   const int count = static_cast<int>(n);
   const GridShape shape = shape_;
-#pragma omp parallel for num_threads(n >= kParallelMinimum ? workers : 1u) schedule(static)
+#pragma omp parallel for num_threads(n >= kParallelMinimum ? workers : 1u) schedule(dynamic, kParticleChunk)
   for (int i = 0; i < count; ++i) hashes_[i] = cell_hash_of_position(shape, xyz(positions[i]));
 
   // Counting sort: histogram, exclusive prefix sum (the cell-start table), stable scatter.

@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: MIT
 // The CPU backend's per-particle passes of a substep: hash and sort, density and pressure (with
 // the normalised density and the colour-field normals when on), and the acceleration gather
-// with the world's options compiled in (the twin of cuda/substep_kernels.cu).
+// with the world's options compiled in (the twin of cuda/substep_kernels.cu). The neighbour
+// gathers run on the processor's SIMD target (cpu_simd_passes.h) and read the sorted records as
+// columns, which these passes keep up to date next to the records.
 #include "../physics/density.h"
 #include "../physics/density_normalization.h"
 #include "../physics/dfsph_passes.h"
-#include "../physics/surface_tension.h"
+#include "../physics/force_fields.h"
 #include "cpu_backend_impl.h"
 
 namespace sph {
@@ -16,10 +18,12 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
   auto t = Clock::now();
   grid_.build(position_.data(), count_, workers_);
   store_.permute(grid_.order().data(), count_);
+  columns_.fill_state(position_.data(), velocity_.data(), count_, threads());
   report.stage_ms[kStageHashSort] += static_cast<float>(elapsed_ms(t));
 
   t = Clock::now();
   const GridView view = grid_.view();
+  const NeighborColumns columns = columns_.view();
   Float4* pos = position_.data();
   Float4* vel = velocity_.data();
   float* factor = density_factor_.data();
@@ -37,10 +41,11 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
     return b;
   };
   if (config_.solver == Solver::Dfsph) {
-    // DFSPH: the density and the factor alpha / rho in one walk; no equation of state (w: the
-    // pressure, written when the density solve has found it).
+    // DFSPH: the density and the factor alpha / rho in one walk (the scalar gather: the SIMD
+    // passes serve the weakly compressible scheme); no equation of state (w: the pressure,
+    // written when the density solve has found it). Its solves read the records, not the columns.
     float* dfsph_factor = dfsph_factor_.data();
-#pragma omp parallel for num_threads(threads()) schedule(static)
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
     for (int i = 0; i < n(); ++i) {
       const DfsphDensitySample s =
           gather_density_and_factor(fluid, view, pos, wall(i), static_cast<uint32_t>(i));
@@ -51,11 +56,11 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
       vel[i].w = 1.0f / s.density;
     }
   } else {
-#pragma omp parallel for num_threads(threads()) schedule(static)
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
     for (int i = 0; i < n(); ++i) {
-      DensitySample s = gather_density(fluid, view, pos, static_cast<uint32_t>(i));
+      DensitySample s = simd_.density(fluid, view, columns, static_cast<uint32_t>(i));
       // The walls' share is part of the summation (and so of a normalised density's kernel sum).
-      s.density += wall(i).density;
+      if (boundary) s.density += wall(i).density;
       float rho = s.density;
       if (factor) {
         normalized_[i] = s.density;  // the summation, for the factor after the filter
@@ -66,35 +71,49 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
       // Only the w slots are written; neighbours read x, y, z alone.
       pos[i].w = pressure_from_density(fluid.methods.eos, rho);
       vel[i].w = 1.0f / rho;
+      columns_.set_density(static_cast<uint32_t>(i), pos[i].w, vel[i].w);
+      columns_.set_neighbor_count(static_cast<uint32_t>(i), s.neighbor_count);
     }
   }
   if (factor) {
     // Eq. 31 over every carried rho_j: each particle writes only its own factor and side
     // slot (the first pass is done reading the factors), then the filtered values are published.
-#pragma omp parallel for num_threads(threads()) schedule(static)
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
     for (int i = 0; i < n(); ++i) {
-      const float filtered = gather_normalized_density(fluid, view, pos, vel, static_cast<uint32_t>(i));
+      const float filtered = simd_.normalized_density(fluid, view, columns, static_cast<uint32_t>(i));
       factor[i] = filtered / normalized_[i];
       normalized_[i] = filtered;
     }
-#pragma omp parallel for num_threads(threads()) schedule(static)
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
     for (int i = 0; i < n(); ++i) {
       density_[i] = normalized_[i];
       pos[i].w = pressure_from_density(fluid.methods.eos, normalized_[i]);
       vel[i].w = 1.0f / normalized_[i];
+      columns_.set_density(static_cast<uint32_t>(i), pos[i].w, vel[i].w);
     }
   }
   if (config_.features & kFeatureSurfaceTension) {
     // Colour-field normals of every particle, which the force gather reads for neighbours.
-#pragma omp parallel for num_threads(threads()) schedule(static)
-    for (int i = 0; i < n(); ++i)
-      normals_[i] = gather_colour_normal(fluid, view, pos, vel, static_cast<uint32_t>(i));
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
+    for (int i = 0; i < n(); ++i) {
+      normals_[i] = simd_.colour_normal(fluid, view, columns, static_cast<uint32_t>(i));
+      columns_.set_normal(static_cast<uint32_t>(i), normals_[i]);
+    }
   }
   report.stage_ms[kStageDensity] += static_cast<float>(elapsed_ms(t));
 }
 
 // Acceleration of particle i: the neighbour gather with the world's force terms compiled in
-// (forces.h), plus the scene's force fields.
+// (forces.h, on the SIMD target), plus the scene's force fields.
+Vec3 CpuBackend::acceleration(AccelerationFn gather, const FluidConstants& fluid, const GridView& view,
+                              const NeighborColumns& columns, const SceneFrame& scene, uint32_t i) const {
+  Vec3 a = gather(fluid, view, columns, i);
+  const Vec3 x = xyz(position_[i]);
+  for (const ForceFieldFrame& f : scene.fields) a += force_field_acceleration(f.view, x);
+  return a;
+}
+
+// The scalar gather (forces.h) with or without the pressure force, plus the scene's force fields.
 template <class Terms, bool kPressure>
 Vec3 CpuBackend::acceleration_with(const FluidConstants& fluid, const GridView& view, const ForceInputs& in,
                                    const SceneFrame& scene, uint32_t i) {
@@ -103,9 +122,9 @@ Vec3 CpuBackend::acceleration_with(const FluidConstants& fluid, const GridView& 
   return a;
 }
 
-CpuBackend::AccelerationFn CpuBackend::acceleration_function() const {
+CpuBackend::ScalarAccelerationFn CpuBackend::scalar_acceleration_function() const {
   const bool pressure = config_.solver == Solver::WeaklyCompressible;
-  return with_force_terms(config_.selection(), [pressure](auto terms) -> AccelerationFn {
+  return with_force_terms(config_.selection(), [pressure](auto terms) -> ScalarAccelerationFn {
     return pressure ? &acceleration_with<decltype(terms), true> : &acceleration_with<decltype(terms), false>;
   });
 }

@@ -18,7 +18,7 @@ void CpuBackend::collide(const SceneFrame& scene, const SubstepTime& time, OldPo
   const float h = config_.kernel_radius;
   Float4* next_pos = next_position_.data();
   Float4* next_vel = next_velocity_.data();
-#pragma omp parallel for num_threads(threads()) schedule(static)
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
   for (int i = 0; i < n(); ++i) {
     Vec3 x = xyz(next_pos[i]);
     Vec3 v = xyz(next_vel[i]);
@@ -48,12 +48,12 @@ uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame
   const Float4* vel = velocity_.data();
   const Float4* spring = spring_acceleration_.data();
   const float dt = time.dt;
-  const AccelerationFn acceleration = acceleration_function();
-  const ForceInputs inputs = force_inputs();
+  const AccelerationFn gather = acceleration_function();
+  const NeighborColumns columns = columns_.view();
   float a2max = 0.0f;
-#pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk) reduction(max : a2max)
   for (int i = 0; i < n(); ++i) {
-    Vec3 a = acceleration(fluid, view, inputs, scene, static_cast<uint32_t>(i));
+    Vec3 a = acceleration(gather, fluid, view, columns, scene, static_cast<uint32_t>(i));
     if (spring) a += xyz(spring[i]);
     a += wall_acceleration(static_cast<uint32_t>(i));
     a2max = std::max(a2max, length_squared(a));
@@ -86,7 +86,7 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
   for (int i = 0; i < n(); ++i)
     rk4_start_[i] = ParticleState{xyz(position_[i]), xyz(velocity_[i])};  // (not a hot loop)
   const float dt = time.dt;
-  const AccelerationFn acceleration = acceleration_function();
+  const AccelerationFn gather = acceleration_function();
   float a2max = 0.0f;
   for (int stage = 0; stage < 4; ++stage) {
     sort_and_density(fluid, scene, stage_time(time, rk4_stage_fraction(stage)), report);
@@ -98,12 +98,12 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
     const Float4* pos = position_.data();
     const Float4* vel = velocity_.data();
     const Float4* spring = spring_acceleration_.data();
-    const ForceInputs inputs = force_inputs();
+    const NeighborColumns columns = columns_.view();
     const ParticleState* start = rk4_start_.data();
     Rk4Accumulator* sums = rk4_sum_.data();
-#pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk) reduction(max : a2max)
     for (int i = 0; i < n(); ++i) {
-      Vec3 a = acceleration(fluid, view, inputs, scene, static_cast<uint32_t>(i));
+      Vec3 a = acceleration(gather, fluid, view, columns, scene, static_cast<uint32_t>(i));
       if (spring) a += xyz(spring[i]);
       a += wall_acceleration(static_cast<uint32_t>(i));
       a2max = std::max(a2max, length_squared(a));

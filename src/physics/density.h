@@ -28,6 +28,13 @@ struct DensitySample {
   uint32_t neighbor_count;  // particles with r < h, self excluded
 };
 
+// The pair term of the sum for a neighbour at squared distance r2 (< h^2, j != i): W_spiky(r).
+// T is float or a pack of lanes (lane_math.h; the CPU backend's SIMD density pass).
+template <class T>
+SPH_HD T density_pair_term(const FluidBase& f, T r2) {
+  return spiky_value(f.kernel, square_root(r2));
+}
+
 // positions: sorted particle records (xyz used, w ignored). Returns rho_i for particle i.
 SPH_HD DensitySample gather_density(const FluidBase& f, const GridView& grid, const Float4* positions,
                                     uint32_t i) {
@@ -38,7 +45,7 @@ SPH_HD DensitySample gather_density(const FluidBase& f, const GridView& grid, co
     const Vec3 d = xi - xyz(positions[j]);
     const float r2 = length_squared(d);
     if (r2 < f.kernel.h2 && j != i) {
-      sum += spiky_value(f.kernel, SPH_SQRTF(r2));
+      sum += density_pair_term(f, r2);
       ++neighbors;
     }
   });

@@ -69,6 +69,25 @@ SPH_HD float carried_density(const FluidBase& f, float summed, float& factor) {
   return summed * factor;
 }
 
+// Eq. 31's pair terms for a neighbour at squared distance r2 (< h^2, self included) with carried
+// 1 / rho_j: W_poly6 to the mass sum, W_poly6 / rho_j to the volume sum. T is float or a pack of
+// lanes (lane_math.h; the CPU backend's SIMD pass).
+template <class T>
+struct NormalizedDensityPair {
+  T mass;
+  T volume;
+};
+template <class T>
+SPH_HD NormalizedDensityPair<T> normalized_density_pair_term(const FluidBase& f, T r2, T inv_density) {
+  const T w = poly6(f.kernel, r2);
+  return NormalizedDensityPair<T>{w, w * inv_density};
+}
+
+// rho~_i from its sums: mass_sum / volume_sum (rho0 where no neighbour has volume).
+SPH_HD float normalized_density_from_sums(const FluidBase& f, float mass_sum, float volume_sum) {
+  return volume_sum > 0.0f ? mass_sum / volume_sum : f.rest_density;
+}
+
 // Eq. 31 over the carried densities (velocities[j].w = 1 / rho_j), self included.
 SPH_HD float gather_normalized_density(const FluidBase& f, const GridView& grid, const Float4* positions,
                                        const Float4* velocities, uint32_t i) {
@@ -78,11 +97,11 @@ SPH_HD float gather_normalized_density(const FluidBase& f, const GridView& grid,
   for_each_neighbor_candidate(grid, xi, [&](uint32_t j) {
     const float r2 = length_squared(xi - xyz(positions[j]));
     if (r2 >= f.kernel.h2) return;
-    const float w = poly6(f.kernel, r2);
-    mass_sum += w;
-    volume_sum += w * velocities[j].w;
+    const NormalizedDensityPair<float> term = normalized_density_pair_term(f, r2, velocities[j].w);
+    mass_sum += term.mass;
+    volume_sum += term.volume;
   });
-  return volume_sum > 0.0f ? mass_sum / volume_sum : f.rest_density;
+  return normalized_density_from_sums(f, mass_sum, volume_sum);
 }
 
 }  // namespace sph

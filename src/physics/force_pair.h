@@ -2,7 +2,12 @@
 // What a force term (a method's part of the acceleration, forces.h) sees of particle i and of
 // one neighbour j. The composer fills these once per particle and once per pair, so that every
 // term reads the same values and a term that is compiled out costs nothing.
-// Records as the density pass leaves them: position.w = p, velocity.w = 1 / rho.
+//
+// Both are templates on the value type T (lane_math.h): float for one pair at a time (the scalar
+// gather, the CUDA kernels), or a pack of lanes, one candidate j per lane (the CPU backend's SIMD
+// passes). A term adds its pair's contribution through j.only(...), which keeps the lanes that
+// hold a force neighbour and gives zero in the others; for a scalar pair (always a neighbour) it
+// is the value itself, so the scalar sums are those of the plain loop bit for bit.
 #pragma once
 
 #include "float4_types.h"
@@ -10,23 +15,40 @@
 
 namespace sph {
 
-struct ForceParticle {
-  Float4 position;       // x_i, p_i
-  Float4 velocity;       // v_i, 1 / rho_i
-  Vec3 x;                // x_i
-  Vec3 v;                // v_i
-  float neighbor_count;  // n_i, when a term reads neighbour counts (else 0)
-  const Float4* normal;  // i's colour-field record, when a term reads them (else null)
+template <class T>
+struct ForceParticleOf {
+  Vec3Of<T> x;       // x_i
+  T pressure;        // p_i
+  Vec3Of<T> v;       // v_i
+  T inv_density;     // 1 / rho_i
+  T neighbor_count;  // n_i, when a term reads neighbour counts (else 0)
+  Vec3Of<T> normal;  // i's colour-field normal n_i, when a term reads them (else 0)
+  T normal_length;   // |n_i| (else 0)
 };
+using ForceParticle = ForceParticleOf<float>;
 
-struct ForcePair {
-  Float4 position;       // x_j, p_j
-  Float4 velocity;       // v_j, 1 / rho_j
-  Vec3 d;                // x_i - x_j
-  float r2;              // |d|^2 < h^2, j != i
-  float r;               // |d|
-  float pair_neighbors;  // n_i + n_j, when a term reads neighbour counts (else 0)
-  const Float4* normal;  // j's colour-field record, when a term reads them (else null)
+template <class T>
+struct ForcePairOf {
+  using Mask = decltype(T() < T());
+  T pressure;        // p_j
+  Vec3Of<T> v;       // v_j
+  T inv_density;     // 1 / rho_j
+  Vec3Of<T> d;       // x_i - x_j
+  T r2;              // |d|^2 < h^2, j != i (in the lanes of `neighbor`)
+  T r;               // |d|
+  T pair_neighbors;  // n_i + n_j, when a term reads neighbour counts (else 0)
+  Vec3Of<T> normal;  // j's colour-field normal, when a term reads them (else 0)
+  T normal_length;   // |n_j| (else 0)
+  Mask neighbor;     // the lanes that hold a force neighbour (true for a scalar pair)
+
+  // A pair term as it enters a sum: the value where j is a force neighbour, else zero. Sums
+  // start at +0 and so are never -0, hence adding a lane's +0 leaves its sum's bits unchanged.
+  SPH_HD T only(T value) const { return select(neighbor, value, T(0)); }
+  SPH_HD Vec3Of<T> only(Vec3Of<T> value) const {
+    const T zero(0);
+    return select(neighbor, value, Vec3Of<T>{zero, zero, zero});
+  }
 };
+using ForcePair = ForcePairOf<float>;
 
 }  // namespace sph

@@ -44,62 +44,63 @@ SPH_HD KernelCoefficientsOf<T> make_kernel_coefficients(T h) {
   return c;
 }
 
+// The per-pair functions below take the coefficients' scalar S (float, or double for the
+// calibration) and a value type T that is S or a pack of lanes (lane_math.h): their conditions
+// are selects, so one text serves the scalar gathers, the CUDA kernels and the CPU's SIMD passes.
+
 // W_poly6 from the squared distance: no square root needed for density.
-template <class T>
-SPH_HD T poly6(const KernelCoefficientsOf<T>& c, T r2) {
-  if (r2 >= c.h2) return T(0);
+template <class S, class T>
+SPH_HD T poly6(const KernelCoefficientsOf<S>& c, T r2) {
   const T d = c.h2 - r2;
-  return c.poly6 * d * d * d;
+  return select(r2 >= c.h2, T(0), c.poly6 * d * d * d);
 }
 
 // W_spiky(r) = 15 / (pi h^6) (h - r)^3, whose gradient the pressure force uses.
-template <class T>
-SPH_HD T spiky_value(const KernelCoefficientsOf<T>& c, T r) {
-  if (r >= c.h) return T(0);
+template <class S, class T>
+SPH_HD T spiky_value(const KernelCoefficientsOf<S>& c, T r) {
   const T d = c.h - r;
-  return c.spiky * d * d * d;
+  return select(r >= c.h, T(0), c.spiky * d * d * d);
 }
 
 // Magnitude factor of grad W_spiky: grad W = spiky_grad_scalar(r) * (r_vec / r).
-template <class T>
-SPH_HD T spiky_gradient_magnitude(const KernelCoefficientsOf<T>& c, T r) {
-  if (r >= c.h) return T(0);
+template <class S, class T>
+SPH_HD T spiky_gradient_magnitude(const KernelCoefficientsOf<S>& c, T r) {
   const T d = c.h - r;
-  return c.spiky_grad * d * d;
+  return select(r >= c.h, T(0), c.spiky_grad * d * d);
 }
 
 // grad W_spiky(r_vec, h) with r_vec = x_i - x_j; zero at r = 0 (direction undefined there).
-SPH_HD Vec3 spiky_gradient(const KernelCoefficients& c, Vec3 r_vec, float r) {
-  if (r <= 0.0f || r >= c.h) return Vec3{0.0f, 0.0f, 0.0f};
-  return r_vec * (spiky_gradient_magnitude(c, r) / r);
+template <class S, class T>
+SPH_HD Vec3Of<T> spiky_gradient(const KernelCoefficientsOf<S>& c, Vec3Of<T> r_vec, T r) {
+  const T zero(0);
+  return select((r <= zero) || (r >= c.h), Vec3Of<T>{zero, zero, zero},
+                r_vec * (spiky_gradient_magnitude(c, r) / r));
 }
 
 // Laplacian of W_viscosity.
-template <class T>
-SPH_HD T viscosity_laplacian(const KernelCoefficientsOf<T>& c, T r) {
-  if (r >= c.h) return T(0);
-  return c.visc_lap * (c.h - r);
+template <class S, class T>
+SPH_HD T viscosity_laplacian(const KernelCoefficientsOf<S>& c, T r) {
+  return select(r >= c.h, T(0), c.visc_lap * (c.h - r));
 }
 
 // The scalar of grad W_poly6 = poly6_gradient_factor(r^2) r_vec.
-template <class T>
-SPH_HD T poly6_gradient_factor(const KernelCoefficientsOf<T>& c, T r2) {
-  if (r2 >= c.h2) return T(0);
+template <class S, class T>
+SPH_HD T poly6_gradient_factor(const KernelCoefficientsOf<S>& c, T r2) {
   const T d = c.h2 - r2;
-  return c.poly6_grad * d * d;
+  return select(r2 >= c.h2, T(0), c.poly6_grad * d * d);
 }
 
 // grad W_poly6(r_vec) for the colour field of surface tension.
-SPH_HD Vec3 poly6_gradient(const KernelCoefficients& c, Vec3 r_vec, float r2) {
-  if (r2 >= c.h2) return Vec3{0.0f, 0.0f, 0.0f};
-  return r_vec * poly6_gradient_factor(c, r2);
+template <class S, class T>
+SPH_HD Vec3Of<T> poly6_gradient(const KernelCoefficientsOf<S>& c, Vec3Of<T> r_vec, T r2) {
+  const T zero(0);
+  return select(r2 >= c.h2, Vec3Of<T>{zero, zero, zero}, r_vec * poly6_gradient_factor(c, r2));
 }
 
 // lap W_poly6(r) = -945 / (32 pi h^9) (h^2 - r^2) (3 h^2 - 7 r^2).
-template <class T>
-SPH_HD T poly6_laplacian(const KernelCoefficientsOf<T>& c, T r2) {
-  if (r2 >= c.h2) return T(0);
-  return c.poly6_grad * (c.h2 - r2) * (T(3) * c.h2 - T(7) * r2);
+template <class S, class T>
+SPH_HD T poly6_laplacian(const KernelCoefficientsOf<S>& c, T r2) {
+  return select(r2 >= c.h2, T(0), c.poly6_grad * (c.h2 - r2) * (T(3) * c.h2 - T(7) * r2));
 }
 
 // The kernels themselves (not only their derivatives), for normalisation tests and tools.

@@ -35,7 +35,7 @@ enum class ZeroMeans : uint32_t {
 };
 
 // The kind of a field (values equal to sph_param_type).
-enum class ParamType : uint32_t { Float = 0, Vec3 = 1, Count = 2, Bits = 3 };
+enum class ParamType : uint32_t { Float = 0, Vector = 1, Count = 2, Bits = 3 };
 
 struct ParamRange {
   double lower;
@@ -76,7 +76,7 @@ constexpr ParamField<P> real_field(const char* name, float P::*member, ParamRang
 }
 template <class P>
 constexpr ParamField<P> vector_field(const char* name, Vec3 P::*member, ZeroMeans zero, const char* unit) {
-  return ParamField<P>{name, ParamType::Vec3, nullptr, member, nullptr, kAnyFinite, 0u, zero, unit};
+  return ParamField<P>{name, ParamType::Vector, nullptr, member, nullptr, kAnyFinite, 0u, zero, unit};
 }
 template <class P>
 constexpr ParamField<P> count_field(const char* name, uint32_t P::*member, ParamRange range, ZeroMeans zero) {

@@ -21,23 +21,30 @@ namespace sph {
 struct SymmetricPressure {
   static constexpr const char* kName = "pressure";
 
-  struct Sums {
-    Vec3 pressure;      // sum -(p_j / rho_j^2) grad W_spiky
-    Vec3 own_pressure;  // sum -p_i grad W_spiky (times 1 / rho_i^2 in acceleration())
+  template <class T>
+  struct SumsOf {
+    Vec3Of<T> pressure;      // sum -(p_j / rho_j^2) grad W_spiky
+    Vec3Of<T> own_pressure;  // sum -p_i grad W_spiky (times 1 / rho_i^2 in acceleration())
   };
-  SPH_HD static Sums zero_sums() { return Sums{Vec3{0.0f, 0.0f, 0.0f}, Vec3{0.0f, 0.0f, 0.0f}}; }
-
-  SPH_HD static void add_pair(const FluidBase& f, const ForceParticle& i, const ForcePair& j, Sums& s) {
-    const float inv_rho_j = j.velocity.w;
-    // -(p_i / rho_i^2 + p_j / rho_j^2) grad W_spiky; m and 1 / rho_i^2 are applied once below.
-    const Vec3 grad = spiky_gradient(f.kernel, j.d, j.r);
-    s.pressure += grad * (-j.position.w * inv_rho_j * inv_rho_j);
-    s.own_pressure += grad * (-i.position.w);
+  using Sums = SumsOf<float>;
+  template <class T = float>
+  SPH_HD static SumsOf<T> zero_sums() {
+    const T zero(0);
+    return SumsOf<T>{{zero, zero, zero}, {zero, zero, zero}};
   }
 
-  // The pressure acceleration, the first part of a_i (1 / rho_i = i.velocity.w).
+  template <class T>
+  SPH_HD static void add_pair(const FluidBase& f, const ForceParticleOf<T>& i, const ForcePairOf<T>& j,
+                              SumsOf<T>& s) {
+    // -(p_i / rho_i^2 + p_j / rho_j^2) grad W_spiky; m and 1 / rho_i^2 are applied once below.
+    const Vec3Of<T> grad = spiky_gradient(f.kernel, j.d, j.r);
+    s.pressure += j.only(grad * (-j.pressure * j.inv_density * j.inv_density));
+    s.own_pressure += j.only(grad * (-i.pressure));
+  }
+
+  // The pressure acceleration, the first part of a_i.
   SPH_HD static Vec3 acceleration(const FluidBase& f, const ForceParticle& i, const Sums& s) {
-    return (s.pressure + s.own_pressure * (i.velocity.w * i.velocity.w)) * f.particle_mass;
+    return (s.pressure + s.own_pressure * (i.inv_density * i.inv_density)) * f.particle_mass;
   }
 
   // The explicit scheme's acoustic limit, which holds whatever dt_max and lambda are:

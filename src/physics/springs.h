@@ -54,8 +54,8 @@ struct SpringConstants {
   float inv_kernel_radius;  // 1 / h
 };
 
-SPH_HD SpringList empty_spring_list() {
-  SpringList s;
+SPH_HD constexpr SpringList empty_spring_list() {
+  SpringList s{};
   for (uint32_t k = 0; k < kSpringSlots; ++k) {
     s.partner[k] = kNoSpring;
     s.rest[k] = 0.0f;
@@ -266,7 +266,9 @@ struct Springs {
     SpringList* list = static_cast<SpringList*>(element);
     *list = remap_spring_list(*list, new_index_of_old);
   }
-  inline static const SpringList kEmptyList = empty_spring_list();
+  // constexpr: no file that includes this runs code to initialise it at load (the CPU's SIMD
+  // target files must not run code before the processor is known to have their instructions).
+  inline static constexpr SpringList kEmptyList = empty_spring_list();
   static constexpr uint32_t kNoLinksPending = kNoPendingLinks;
   inline static const ParticleArraySpec kArrays[] = {
       {kArraySprings, sizeof(SpringList), ParticleArrayRole::Carried, 1, &kEmptyList, &rewrite_partners},

@@ -49,13 +49,12 @@
 namespace sph {
 
 // C(r) without its 32 / (pi h^9) (cohesion_coefficient), for 0 < r < h.
-template <class T>
-SPH_HD T cohesion_spline(T h, T r) {
+template <class S, class T>
+SPH_HD T cohesion_spline(S h, T r) {
   const T d = h - r;
   const T p = d * d * d * r * r * r;
-  if (T(2) * r > h) return p;
-  const T h3 = h * h * h;
-  return T(2) * p - h3 * h3 * (T(1) / T(64));
+  const S h3 = h * h * h;
+  return select(T(2) * r > h, p, T(2) * p - T(h3 * h3 * (S(1) / S(64))));
 }
 
 // The spline's coefficient 32 / (pi h^9) times `scale`.
@@ -110,43 +109,57 @@ struct SurfaceTension {
   static constexpr ParticleArraySpec kArrays[] = {
       {kArrayColourNormal, sizeof(Float4), ParticleArrayRole::Scratch, 1, nullptr, nullptr}};
 
-  // The capillary stress of a colour-field record applied to a vector g, without sigma:
+  // The capillary stress of a colour-field record (n, |n|) applied to a vector g, without sigma:
   // T . g = t (g - n^ (n^ . g)) with t = |n| less the threshold (zero below it): the threshold
   // keeps the noisy normals of interior particles out, and the ramp (not a switch) keeps the
   // stress continuous as a particle crosses it.
-  SPH_HD static Vec3 stress_times(const Constants& c, const Float4& normal, Vec3 g) {
-    const float t = normal.w - c.threshold;
-    if (t <= 0.0f) return Vec3{0.0f, 0.0f, 0.0f};
-    const Vec3 unit = xyz(normal) * (1.0f / normal.w);
-    return (g - unit * dot(unit, g)) * t;
+  template <class T>
+  SPH_HD static Vec3Of<T> stress_times(const Constants& c, Vec3Of<T> normal, T normal_length, Vec3Of<T> g) {
+    const T zero(0);
+    const T t = normal_length - c.threshold;
+    const Vec3Of<T> unit = normal * (T(1.0f) / normal_length);
+    return select(t <= zero, Vec3Of<T>{zero, zero, zero}, (g - unit * dot(unit, g)) * t);
   }
 
   static constexpr bool kReadsNeighborCounts = false;
   static constexpr bool kReadsColourNormals = true;
-  struct Sums {
-    Vec3 tension;   // sum T_j . grad W_poly6 over neighbours j
-    Vec3 gradient;  // sum grad W_poly6 (T_i . it in finish)
-    Vec3 cohesion;  // sum C(r) (x_i - x_j) / r (without C's coefficient)
+  template <class T>
+  struct SumsOf {
+    Vec3Of<T> tension;   // sum T_j . grad W_poly6 over neighbours j
+    Vec3Of<T> gradient;  // sum grad W_poly6 (T_i . it in finish)
+    Vec3Of<T> cohesion;  // sum C(r) (x_i - x_j) / r (without C's coefficient)
   };
-  SPH_HD static Sums zero_sums() {
-    const Vec3 zero{0.0f, 0.0f, 0.0f};
-    return Sums{zero, zero, zero};
+  using Sums = SumsOf<float>;
+  template <class T = float>
+  SPH_HD static SumsOf<T> zero_sums() {
+    const T zero(0);
+    const Vec3Of<T> zero3{zero, zero, zero};
+    return SumsOf<T>{zero3, zero3, zero3};
   }
-  SPH_HD static void add_pair(const FluidBase& f, const Constants& c, const ForceParticle&,
-                              const ForcePair& j, Sums& s) {
-    const Vec3 g = poly6_gradient(f.kernel, j.d, j.r2);
-    s.tension += stress_times(c, *j.normal, g);
-    s.gradient += g;
-    if (j.r > 0.0f) s.cohesion += j.d * (cohesion_spline(f.kernel.h, j.r) / j.r);
+  template <class T>
+  SPH_HD static void add_pair(const FluidBase& f, const Constants& c, const ForceParticleOf<T>&,
+                              const ForcePairOf<T>& j, SumsOf<T>& s) {
+    const T zero(0);
+    const Vec3Of<T> g = poly6_gradient(f.kernel, j.d, j.r2);
+    s.tension += j.only(stress_times(c, j.normal, j.normal_length, g));
+    s.gradient += j.only(g);
+    const Vec3Of<T> pull = j.d * (cohesion_spline(f.kernel.h, j.r) / j.r);
+    s.cohesion += j.only(select(j.r > zero, pull, Vec3Of<T>{zero, zero, zero}));
   }
   SPH_HD static void finish(const FluidBase& f, const Constants& c, const ForceParticle& i, const Sums& s,
                             Vec3& a) {
-    const Vec3 own = stress_times(c, *i.normal, s.gradient);
+    const Vec3 own = stress_times(c, i.normal, i.normal_length, s.gradient);
     const float scale = c.coefficient * c.delta_scale * f.particle_mass / (f.rest_density * f.rest_density);
     a += (s.tension + own) * scale;
     a += s.cohesion * (-c.cohesion);
   }
 };
+
+// The colour normal's pair term for a neighbour at d = x_i - x_j, r2 = |d|^2 (< h^2, j != i).
+template <class T>
+SPH_HD Vec3Of<T> colour_normal_pair_term(const FluidBase& f, Vec3Of<T> d, T r2) {
+  return poly6_gradient(f.kernel, d, r2) * (1.0f / f.rest_density);
+}
 
 // The colour-field record (n_i, |n_i|) of particle i.
 SPH_HD Float4 gather_colour_normal(const FluidBase& f, const GridView& grid, const Float4* positions,
@@ -157,7 +170,7 @@ SPH_HD Float4 gather_colour_normal(const FluidBase& f, const GridView& grid, con
     const Vec3 d = xi - xyz(positions[j]);
     const float r2 = length_squared(d);
     if (r2 >= f.kernel.h2 || j == i) return;
-    n += poly6_gradient(f.kernel, d, r2) * (1.0f / f.rest_density);
+    n += colour_normal_pair_term(f, d, r2);
   });
   n = n * f.particle_mass;
   return make_float4_record(n, length(n));

@@ -39,33 +39,39 @@ struct ClavetViscosity {
 
   static constexpr bool kReadsNeighborCounts = true;
   static constexpr bool kReadsColourNormals = false;
-  struct Sums {
-    Vec3 viscosity;  // sum of i's velocity changes
+  template <class T>
+  struct SumsOf {
+    Vec3Of<T> viscosity;  // sum of i's velocity changes
   };
-  SPH_HD static Sums zero_sums() { return Sums{Vec3{0.0f, 0.0f, 0.0f}}; }
+  using Sums = SumsOf<float>;
+  template <class T = float>
+  SPH_HD static SumsOf<T> zero_sums() {
+    const T zero(0);
+    return SumsOf<T>{{zero, zero, zero}};
+  }
 
   // The impulses are bounded by the pair's neighbour counts, I_ij <= 4 u_ij / (n_i + n_j), so
   // the simultaneous pairwise exchange can only remove kinetic energy (the gain from the squared
   // velocity changes stays below the loss); and I_ij <= u_ij, so a pair's impulse never
   // reverses its approach.
-  SPH_HD static void add_pair(const FluidBase& f, const Constants& c, const ForceParticle& i,
-                              const ForcePair& j, Sums& s) {
-    if (!(j.r > 0.0f)) return;
-    // Approaching pairs (u > 0 along i -> j) exchange I = dt (1 - q)(sigma u + beta u^2);
+  template <class T>
+  SPH_HD static void add_pair(const FluidBase& f, const Constants& c, const ForceParticleOf<T>& i,
+                              const ForcePairOf<T>& j, SumsOf<T>& s) {
+    // Approaching pairs (u > 0 along i -> j, r > 0) exchange I = dt (1 - q)(sigma u + beta u^2);
     // i takes half of it, pointing away from j.
-    const Vec3 unit = j.d * (-1.0f / j.r);
-    const float u = dot(i.v - xyz(j.velocity), unit);
-    if (u > 0.0f) {
-      const float q = j.r / f.kernel.h;
-      float impulse = f.dt * (1.0f - q) * (c.linear * u + c.quadratic * u * u);
-      // At most u: the pair's own impulse may stop its approach but never reverse it (with
-      // few neighbours the energy bound alone, up to 2u, would let a large coefficient turn
-      // an inelastic collision into an elastic bounce).
-      const float energy_bound = 4.0f * u / j.pair_neighbors;
-      const float bound = energy_bound < u ? energy_bound : u;
-      if (impulse > bound) impulse = bound;
-      s.viscosity += unit * (-0.5f * impulse);
-    }
+    const T zero(0);
+    const Vec3Of<T> unit = j.d * (T(-1.0f) / j.r);
+    const T u = dot(i.v - j.v, unit);
+    const T q = j.r / f.kernel.h;
+    const T impulse = f.dt * (T(1.0f) - q) * (c.linear * u + c.quadratic * u * u);
+    // At most u: the pair's own impulse may stop its approach but never reverse it (with
+    // few neighbours the energy bound alone, up to 2u, would let a large coefficient turn
+    // an inelastic collision into an elastic bounce).
+    const T energy_bound = T(4.0f) * u / j.pair_neighbors;
+    const T bound = select(energy_bound < u, energy_bound, u);
+    const T capped = select(impulse > bound, bound, impulse);
+    const Vec3Of<T> change = unit * (T(-0.5f) * capped);
+    s.viscosity += j.only(select(!(j.r > zero) || !(u > zero), Vec3Of<T>{zero, zero, zero}, change));
   }
   SPH_HD static void finish(const FluidBase& f, const Constants&, const ForceParticle&, const Sums& s,
                             Vec3& a) {

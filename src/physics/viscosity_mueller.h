@@ -39,17 +39,24 @@ struct MuellerViscosity {
 
   static constexpr bool kReadsNeighborCounts = false;
   static constexpr bool kReadsColourNormals = false;
-  struct Sums {
-    Vec3 viscosity;  // sum (v_j - v_i) / rho_j lap W
+  template <class T>
+  struct SumsOf {
+    Vec3Of<T> viscosity;  // sum (v_j - v_i) / rho_j lap W
   };
-  SPH_HD static Sums zero_sums() { return Sums{Vec3{0.0f, 0.0f, 0.0f}}; }
-  SPH_HD static void add_pair(const FluidBase& f, const Constants&, const ForceParticle& i,
-                              const ForcePair& j, Sums& s) {
-    s.viscosity += (xyz(j.velocity) - i.v) * (viscosity_laplacian(f.kernel, j.r) * j.velocity.w);
+  using Sums = SumsOf<float>;
+  template <class T = float>
+  SPH_HD static SumsOf<T> zero_sums() {
+    const T zero(0);
+    return SumsOf<T>{{zero, zero, zero}};
+  }
+  template <class T>
+  SPH_HD static void add_pair(const FluidBase& f, const Constants&, const ForceParticleOf<T>& i,
+                              const ForcePairOf<T>& j, SumsOf<T>& s) {
+    s.viscosity += j.only((j.v - i.v) * (viscosity_laplacian(f.kernel, j.r) * j.inv_density));
   }
   SPH_HD static void finish(const FluidBase& f, const Constants& c, const ForceParticle& i, const Sums& s,
                             Vec3& a) {
-    const float m_over_rho_i = f.particle_mass * i.velocity.w;
+    const float m_over_rho_i = f.particle_mass * i.inv_density;
     a += s.viscosity * (c.viscosity * m_over_rho_i);
   }
 };

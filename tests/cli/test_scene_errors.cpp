@@ -63,7 +63,8 @@ const Case kCases[] = {
     {R"({"physics": {"springs": {}}})",
      "physics.springs: the world does not use springs (add \"springs\" to world.features)"},
     {R"({"physics": {"foam": {}}})",
-     "physics.foam: unknown field; physics takes surface_tension, clavet, tait, springs (and \"comment\")"},
+     "physics.foam: unknown field; physics takes surface_tension, clavet, tait, springs, dfsph (and "
+     "\"comment\")"},
     {R"({"world": {"equation_of_state": "tait"}, "physics": {"tait": {"speed": 20}}})",
      "physics.tait.speed: unknown field; tait takes speed_of_sound (and \"comment\")"},
     {R"({"world": {"features": ["springs"]}, "physics": {"springs": {"stiffness": "hard"}}})",

@@ -9,6 +9,13 @@
  *    SPH_OK or SPH_ERROR_WORLD_LOCKED (never anything else), a locked call changes nothing,
  *    the lock is observed, and the world ends bitwise where an undisturbed copy ends.
  *
+ * 3. The worker count changes no bit: a dam break of about 9,000 particles (above the CPU backend's
+ *    one-thread limit of 4,096) with surface tension, the normalised density and the walls'
+ *    density share ends bitwise alike on 1, 2 and 3 workers. Every particle's result depends
+ *    on its index alone and the reductions are max/min, so neither the split of the loops
+ *    (dynamic chunks, handed out in whatever order the threads come) nor their count may
+ *    change a result.
+ *
  * Run under ThreadSanitizer in scripts/test (build-tsan/), where any data race fails the run.
  * Worker threads never call cmocka (its failure path longjmps); they record results and the
  * main thread checks them. */
@@ -295,11 +302,76 @@ static void test_world_used_from_two_threads(void** state) {
   EXPECT_OK(sph_context_destroy(context));
 }
 
+/* ---- 3. the worker count changes no bit ----------------------------------------------------- */
+typedef struct worker_run {
+  float* positions;
+  float* velocities;
+  uint32_t count;
+} worker_run;
+
+static sph_result run_with_workers(unsigned workers, worker_run* out) {
+  const support_tank tank = {{0.0f, 0.0f, 0.0f}, {0.3f, 0.3f, 0.15f}, 0.02f, 0.0f};
+  const sph_vec3 column_min = {-0.28f, -0.28f, -0.13f}, column_max = {-0.08f, 0.08f, 0.13f};
+  sph_context_def context_def;
+  sph_context* context = NULL;
+  sph_world_def def;
+  sph_world_params params;
+  sph_world* world = NULL;
+  uint32_t count = 0;
+  sph_result r = sph_test_context_def_init(&context_def);
+  if (r != SPH_OK) return r;
+  context_def.cpu_worker_count = workers;
+  if ((r = sph_context_create(&context_def, &context)) != SPH_OK) return r;
+  sph_world_def_init(&def);
+  def.capacity = 12000;
+  def.particle_spacing = 0.014f;
+  def.features = SPH_FEATURE_SURFACE_TENSION | SPH_FEATURE_NORMALIZED_DENSITY | SPH_FEATURE_BOUNDARY_DENSITY;
+  if ((r = sph_world_create(context, &def, &world)) != SPH_OK) goto done;
+  sph_world_params_init(&params);
+  params.max_substeps = 200;
+  if ((r = sph_world_set_params(world, &params)) != SPH_OK) goto done;
+  if ((r = support_dam_break(context, world, &tank, column_min, column_max, NULL, NULL, &count)) != SPH_OK)
+    goto done;
+  if (count <= 4096u) {
+    fail_msg("the dam break has %u particles: the CPU backend would run it on one thread", count);
+  }
+  for (int frame = 0; r == SPH_OK && frame < 3; ++frame) r = sph_world_step(world, kFrameDt);
+  if (r == SPH_OK) r = support_copy(world, SPH_ATTRIBUTE_POSITION, (void**)&out->positions, &out->count);
+  if (r == SPH_OK) r = support_copy(world, SPH_ATTRIBUTE_VELOCITY, (void**)&out->velocities, &out->count);
+done:
+  if (r != SPH_OK) print_error("run_with_workers: %s\n", sph_get_last_error());
+  sph_world_destroy(world);
+  sph_context_destroy(context);
+  return r;
+}
+
+static void test_worker_count_changes_no_bit(void** state) {
+  (void)state;
+#ifdef SPH_TEST_TSAN_BUILD
+  skip(); /* one worker under ThreadSanitizer (create_context) */
+#endif
+  if (sph_test_backend() == SPH_BACKEND_CUDA) skip(); /* the CPU backend's workers */
+  worker_run runs[3] = {{0}};
+  for (unsigned w = 0; w < 3; ++w) EXPECT_OK(run_with_workers(w + 1u, &runs[w]));
+  for (unsigned w = 1; w < 3; ++w) {
+    assert_int_equal(runs[w].count, runs[0].count);
+    const size_t bytes = sizeof(float) * 3u * runs[0].count;
+    if (memcmp(runs[w].positions, runs[0].positions, bytes) != 0 ||
+        memcmp(runs[w].velocities, runs[0].velocities, bytes) != 0)
+      fail_msg("%u workers ended differently from one worker", w + 1u);
+  }
+  for (unsigned w = 0; w < 3; ++w) {
+    free(runs[w].positions);
+    free(runs[w].velocities);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_worlds_on_threads_shared_context),
       cmocka_unit_test(test_worlds_on_threads_own_contexts),
       cmocka_unit_test(test_world_used_from_two_threads),
+      cmocka_unit_test(test_worker_count_changes_no_bit),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,321 @@
+// SPDX-License-Identifier: MIT
+// The CPU backend's SIMD passes (src/cpu/cpu_simd_passes.h) against the scalar gathers of the
+// shared physics (density.h, density_normalization.h, surface_tension.h, forces.h), on random
+// neighbourhoods: uniform clouds with about 40 neighbours per particle, one that folds onto a
+// small wrapped table (far candidates in every run), coincident particles (r = 0 between two
+// different particles) and a dense knot (runs longer than 16 candidates).
+//
+// 1. Every target this processor runs (AVX-512, AVX2, generic) gives the same bits as the
+//    generic target: the lanes' sums and their tree are fixed, so the results may not depend
+//    on the instruction set.
+// 2. Each SIMD result is the scalar gather's within float rounding: both add the same terms,
+//    bit for bit, only in another order. Recursive summation of n terms in any order is within
+//    (n - 1) u sum |t_k| of the exact sum (u = 2^-24; Higham, "Accuracy and Stability of
+//    Numerical Algorithms", 2nd ed., eq. 4.4), so two orders differ by at most 2 (n - 1) u
+//    sum |t_k|; the bound used is 4 (n + 1) u sum |t_k| for the rounding of the final scaling
+//    (finish) as well. The neighbour counts are equal.
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+extern "C" {
+#include <cmocka.h>
+}
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "core/config.h"
+#include "core/grid_layout.h"
+#include "cpu/cpu_neighbor_columns.h"
+#include "cpu/cpu_neighbor_grid.h"
+#include "cpu/cpu_simd_passes.h"
+#include "physics/density.h"
+#include "physics/density_normalization.h"
+#include "physics/forces.h"
+#include "physics/surface_tension.h"
+
+namespace {
+
+using sph::Float4;
+using sph::Vec3;
+
+constexpr float kH = 0.036f;                        // 1.8 x the default 2 cm spacing
+constexpr double kUnitRoundoff = 1.0 / 16777216.0;  // 2^-24
+
+// A sorted random neighbourhood with every input of the passes, as records and as columns.
+struct Scene {
+  sph::WorldConfig config;
+  sph::CpuNeighborGrid grid;
+  std::vector<Float4> positions, velocities, normals;
+  std::vector<uint32_t> counts;
+  sph::CpuNeighborColumns columns{true, true};
+  uint32_t n = 0;
+
+  // The grid sizes its table by the particles' extent at each build; no crowded-cell cap here.
+  Scene(const std::vector<Vec3>& points, uint32_t capacity, uint32_t seed) : grid(kH, UINT32_MAX) {
+    (void)capacity;
+    config.kernel_radius = kH;
+    config.rest_density = 1000.0f;
+    config.particle_spacing = kH / 1.8f;
+    config.particle_mass = 0.0056569f;
+    config.density_self_weight = 60000.0f;
+    n = static_cast<uint32_t>(points.size());
+    std::vector<Float4> records(n);
+    for (uint32_t i = 0; i < n; ++i) records[i] = sph::make_float4_record(points[i], 0.0f);
+    grid.build(records.data(), n, 1);
+    // Inputs the passes only read: pressures, densities, velocities, counts and colour normals
+    // in the ranges a fluid has (some normals below the stress threshold of 0.2 / h).
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> pressure(0.0f, 200.0f), density(900.0f, 1100.0f),
+        speed(-0.2f, 0.2f), normal(-20.0f, 20.0f);
+    std::uniform_int_distribution<uint32_t> count(1, 60);
+    positions.resize(n);
+    velocities.resize(n);
+    normals.resize(n);
+    counts.resize(n);
+    for (uint32_t i = 0; i < n; ++i) {
+      positions[i] = records[grid.order()[i]];
+      positions[i].w = pressure(rng);
+      velocities[i] = Float4{speed(rng), speed(rng), speed(rng), 1.0f / density(rng)};
+      const Vec3 nv{normal(rng), normal(rng), normal(rng)};
+      normals[i] = sph::make_float4_record(nv, sph::length(nv));
+      counts[i] = count(rng);
+    }
+    columns.fill_state(positions.data(), velocities.data(), n, 1);
+    for (uint32_t i = 0; i < n; ++i) {
+      columns.set_density(i, positions[i].w, velocities[i].w);
+      columns.set_neighbor_count(i, counts[i]);
+      columns.set_normal(i, normals[i]);
+    }
+  }
+
+  sph::FluidConstants fluid(const sph::MethodSelection& s) {
+    config.features = s.features;
+    config.viscosity_method = s.viscosity;
+    sph::RuntimeParams params;
+    params.stepping.gravity = Vec3{0.0f, 0.0f, 0.0f};  // so that a particle without neighbours has a = 0
+    params.methods.clavet.quadratic = 0.5f;
+    sph::FluidConstants f = sph::make_fluid_constants(config, params);
+    f.dt = 1e-3f;
+    return f;
+  }
+
+  sph::GridView view() const { return grid.view(); }
+  sph::ForceInputs inputs() const {
+    return sph::ForceInputs{positions.data(), velocities.data(), counts.data(), normals.data()};
+  }
+};
+
+std::vector<Vec3> uniform_cloud(uint32_t count, Vec3 center, float half, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-half, half);
+  std::vector<Vec3> p(count);
+  for (Vec3& v : p) v = Vec3{center.x + u(rng), center.y + u(rng), center.z + u(rng)};
+  return p;
+}
+
+// The clouds: about 40 neighbours inside (n / V = 40 / (4/3 pi h^3)).
+std::vector<std::vector<Vec3>> clouds(std::vector<uint32_t>& capacities) {
+  std::vector<std::vector<Vec3>> out;
+  const float half = 0.5f * std::cbrt(3000.0f * 4.18879f * kH * kH * kH / 40.0f);
+  out.push_back(uniform_cloud(3000, Vec3{0.0f, 0.0f, 0.0f}, half, 1));
+  capacities.push_back(3000);
+  out.push_back(uniform_cloud(3000, Vec3{-3.1f, 2.7f, 1e3f}, half, 2));  // folds onto a 3^3 table
+  capacities.push_back(8);
+  std::vector<Vec3> knot = uniform_cloud(1500, Vec3{0.5f, 0.5f, 0.5f}, half, 3);
+  std::vector<Vec3> dense = uniform_cloud(300, Vec3{0.5f, 0.5f, 0.5f}, 0.3f * kH, 4);
+  knot.insert(knot.end(), dense.begin(), dense.end());
+  for (int k = 0; k < 40; ++k) knot.push_back(knot[static_cast<size_t>(k) * 7]);  // coincident pairs
+  out.push_back(knot);
+  capacities.push_back(2000);
+  return out;
+}
+
+std::vector<const sph::SimdPasses*> runnable_targets() {
+  std::vector<const sph::SimdPasses*> t;
+  for (sph::SimdTarget target : {sph::SimdTarget::Generic, sph::SimdTarget::Avx2, sph::SimdTarget::Avx512}) {
+    if (sph::simd_target_runs(target))
+      t.push_back(sph::simd_passes_built(target));
+    else if (sph::simd_passes_built(target))
+      std::printf("  target %u built, not run by this processor\n", static_cast<unsigned>(target));
+  }
+  return t;
+}
+
+// |a - b| within 4 (n + 1) u scale, printing the first failures.
+bool within_rounding(double a, double b, double scale, uint32_t n, const char* what, uint32_t i) {
+  const double bound = 4.0 * (n + 1) * kUnitRoundoff * scale;
+  if (std::fabs(a - b) <= bound) return true;
+  std::printf("  %s of particle %u: SIMD %.9g, scalar %.9g, bound %.3g (%u neighbours)\n", what, i, a, b,
+              bound, n);
+  return false;
+}
+
+template <class T>
+bool same_bits(const T& a, const T& b) {
+  return std::memcmp(&a, &b, sizeof(T)) == 0;
+}
+
+void test_density_passes(void**) {
+  std::vector<uint32_t> capacities;
+  const std::vector<std::vector<Vec3>> all = clouds(capacities);
+  const std::vector<const sph::SimdPasses*> targets = runnable_targets();
+  for (size_t c = 0; c < all.size(); ++c) {
+    Scene s(all[c], capacities[c], static_cast<uint32_t>(10 + c));
+    const sph::FluidConstants f = s.fluid(sph::MethodSelection{});
+    const sph::GridView view = s.view();
+    const sph::NeighborColumns columns = s.columns.view();
+    size_t failures = 0, pairs = 0;
+    for (uint32_t i = 0; i < s.n; ++i) {
+      const sph::DensitySample scalar = sph::gather_density(f, view, s.positions.data(), i);
+      const float normalized_scalar =
+          sph::gather_normalized_density(f, view, s.positions.data(), s.velocities.data(), i);
+      const Float4 normal_scalar =
+          sph::gather_colour_normal(f, view, s.positions.data(), s.velocities.data(), i);
+      // sum |t| of the colour normal's terms, per component, in the scalar's own float terms.
+      double scale[3] = {0.0, 0.0, 0.0};
+      const Vec3 xi = sph::xyz(s.positions[i]);
+      sph::for_each_neighbor_candidate(view, xi, [&](uint32_t j) {
+        const Vec3 d = xi - sph::xyz(s.positions[j]);
+        const float r2 = sph::length_squared(d);
+        if (r2 >= f.kernel.h2 || j == i) return;
+        const Vec3 t = sph::colour_normal_pair_term(f, d, r2) * f.particle_mass;
+        scale[0] += std::fabs(t.x);
+        scale[1] += std::fabs(t.y);
+        scale[2] += std::fabs(t.z);
+      });
+      pairs += scalar.neighbor_count;
+      const sph::SimdPasses& generic = *targets.front();
+      const sph::DensitySample simd = generic.density(f, view, columns, i);
+      const float normalized = generic.normalized_density(f, view, columns, i);
+      const Float4 normal = generic.colour_normal(f, view, columns, i);
+      const uint32_t nb = scalar.neighbor_count;
+      bool ok = simd.neighbor_count == nb;
+      // Positive terms: sum |t| is the sum itself (self weight included in the scaling).
+      ok = within_rounding(simd.density, scalar.density, scalar.density, nb, "density", i) && ok;
+      // A ratio of two positive sums over n + 1 terms each: twice the bound of one.
+      ok = within_rounding(normalized, normalized_scalar, 2.0 * normalized_scalar, nb + 1, "eq. 31", i) && ok;
+      ok = within_rounding(normal.x, normal_scalar.x, scale[0], nb, "normal x", i) && ok;
+      ok = within_rounding(normal.y, normal_scalar.y, scale[1], nb, "normal y", i) && ok;
+      ok = within_rounding(normal.z, normal_scalar.z, scale[2], nb, "normal z", i) && ok;
+      ok =
+          within_rounding(normal.w, normal_scalar.w, scale[0] + scale[1] + scale[2], nb, "|normal|", i) && ok;
+      for (const sph::SimdPasses* t : targets) {
+        const bool same = same_bits(t->density(f, view, columns, i), simd) &&
+                          same_bits(t->normalized_density(f, view, columns, i), normalized) &&
+                          same_bits(t->colour_normal(f, view, columns, i), normal);
+        if (!same && failures < 5) std::printf("  %s differs from generic at particle %u\n", t->name, i);
+        ok = ok && same;
+      }
+      if (!ok) ++failures;
+    }
+    std::printf("cloud %zu: %u particles, %.1f neighbours each, %zu targets, %zu mismatches\n", c, s.n,
+                static_cast<double>(pairs) / s.n, targets.size(), failures);
+    assert_true(pairs > 20u * s.n);  // dense enough that runs have many neighbours
+    assert_int_equal(failures, 0);
+  }
+}
+
+// Particle i's acceleration from neighbour j alone (A_0 = 0: no gravity, no neighbour).
+template <class Terms>
+Vec3 single_pair_acceleration(const sph::FluidConstants& f, const sph::ForceInputs& in, uint32_t i,
+                              uint32_t j) {
+  sph::AccelerationGather<Terms> gather(in, i);
+  const Float4 pj = in.positions[j];
+  const Vec3 d = gather.position() - sph::xyz(pj);
+  gather.add(f, j, pj, d, sph::length_squared(d));
+  return gather.finish(f);
+}
+
+void check_forces(const sph::MethodSelection& selection, const char* name) {
+  std::vector<uint32_t> capacities;
+  const std::vector<std::vector<Vec3>> all = clouds(capacities);
+  const std::vector<const sph::SimdPasses*> targets = runnable_targets();
+  for (size_t c = 0; c < all.size(); ++c) {
+    Scene s(all[c], capacities[c], static_cast<uint32_t>(20 + c));
+    const sph::FluidConstants f = s.fluid(selection);
+    const sph::GridView view = s.view();
+    const sph::NeighborColumns columns = s.columns.view();
+    const sph::ForceInputs in = s.inputs();
+    std::vector<sph::SimdPasses::AccelerationFn> simd;
+    for (const sph::SimdPasses* t : targets) simd.push_back(t->acceleration_for(selection));
+    size_t failures = 0;
+    for (uint32_t i = 0; i < s.n; ++i) {
+      Vec3 scalar{0.0f, 0.0f, 0.0f};
+      double scale[3] = {0.0, 0.0, 0.0};
+      uint32_t nb = 0;
+      sph::with_force_terms(selection, [&](auto terms) {
+        using Terms = decltype(terms);
+        scalar = sph::gather_acceleration<Terms>(f, view, in, i);
+        const Vec3 xi = sph::xyz(s.positions[i]);
+        sph::for_each_neighbor_candidate(view, xi, [&](uint32_t j) {
+          if (!sph::is_force_neighbor(f, sph::length_squared(xi - sph::xyz(s.positions[j])), i, j)) return;
+          const Vec3 a = single_pair_acceleration<Terms>(f, in, i, j);
+          scale[0] += std::fabs(a.x);
+          scale[1] += std::fabs(a.y);
+          scale[2] += std::fabs(a.z);
+          ++nb;
+        });
+      });
+      const Vec3 a = simd.front()(f, view, columns, i);
+      bool ok = within_rounding(a.x, scalar.x, scale[0], nb, "a.x", i);
+      ok = within_rounding(a.y, scalar.y, scale[1], nb, "a.y", i) && ok;
+      ok = within_rounding(a.z, scalar.z, scale[2], nb, "a.z", i) && ok;
+      for (size_t t = 1; t < simd.size(); ++t) {
+        const bool same = same_bits(simd[t](f, view, columns, i), a);
+        if (!same && failures < 5)
+          std::printf("  %s differs from generic at particle %u\n", targets[t]->name, i);
+        ok = ok && same;
+      }
+      if (!ok) ++failures;
+    }
+    std::printf("%s, cloud %zu: %u particles, %zu targets, %zu mismatches\n", name, c, s.n, targets.size(),
+                failures);
+    assert_int_equal(failures, 0);
+  }
+}
+
+void test_forces_mueller(void**) { check_forces(sph::MethodSelection{}, "pressure + Mueller"); }
+
+void test_forces_clavet(void**) {
+  sph::MethodSelection s;
+  s.viscosity = sph::ViscosityMethod::Clavet;
+  check_forces(s, "pressure + Clavet");
+}
+
+void test_forces_surface_tension(void**) {
+  sph::MethodSelection s;
+  s.features = sph::kFeatureSurfaceTension;
+  check_forces(s, "pressure + Mueller + surface tension");
+  s.viscosity = sph::ViscosityMethod::Clavet;
+  check_forces(s, "pressure + Clavet + surface tension");
+}
+
+// The best target is one this processor runs, and the x86 targets are built on x86-64.
+void test_dispatch(void**) {
+  const sph::SimdPasses& best = sph::best_simd_passes();
+  std::printf("best SIMD target here: %s\n", best.name);
+  assert_true(sph::simd_target_runs(best.target));
+  assert_true(sph::simd_target_runs(sph::SimdTarget::Generic));
+#if defined(__x86_64__)
+  assert_non_null(sph::simd_passes_built(sph::SimdTarget::Avx2));
+  assert_non_null(sph::simd_passes_built(sph::SimdTarget::Avx512));
+#endif
+}
+
+}  // namespace
+
+int main() {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_dispatch),
+      cmocka_unit_test(test_density_passes),
+      cmocka_unit_test(test_forces_mueller),
+      cmocka_unit_test(test_forces_clavet),
+      cmocka_unit_test(test_forces_surface_tension),
+  };
+  return cmocka_run_group_tests(tests, nullptr, nullptr);
+}
