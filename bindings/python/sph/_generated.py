@@ -10,7 +10,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '19b0fec5231cc3a564c2a07c2ad6f3104c2e8b2d75b93f0f8d8057a15e0395c7', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
+HEADERS = {'include/sph_c.h': 'dd572196e8becf7f8c76274a52bb674dc7159e0f3c448c2a4b372ec0e21fd1e8', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -48,8 +48,8 @@ SPH_FEATURE_SPRINGS = 4
 #: map per SDF asset, Koschier & Bender 2017, calibrated on the particle lattice), and the wall
 #: pushes back through the pressure force, so particles at a wall no longer read low density: a
 #: resting FCC block from sph_world_fill_box reads rho0 at axis-aligned walls (77 % without), a
-#: settled tank's pressure near its walls is within 19-26 % of rho0 g d at the default stiffness
-#: (40-72 % low without). Edges and corners read high when a lattice is placed into them
+#: settled tank's pressure near its walls is within 3-5 % of rho0 g d at the default stiffness
+#: (48-77 % low without). Edges and corners read high when a lattice is placed into them
 #: (docs/physics.md). The maps are computed per asset and kernel radius when a collider first steps
 #: with the asset and after sph_sdf_update (16 bytes per SDF voxel; on the device for CUDA). The
 #: collision response stays the no-penetration safeguard. Costs one SDF sample per particle and
