@@ -24,6 +24,7 @@ CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBacken
   options_.normalized_density = (config.features & kFeatureNormalizedDensity) != 0;
   options_.viscosity = config.viscosity_method;
   options_.springs = (config.features & kFeatureSprings) != 0;
+  options_.dfsph = config.solver == Solver::Dfsph;
   options_.boundary_density = (config.features & kFeatureBoundaryDensity) != 0;
   // The methods' arrays (particle_arrays.h), and this backend's working arrays for springs.
   std::vector<ParticleArraySpec> arrays = method_particle_arrays(config);
@@ -36,6 +37,7 @@ CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBacken
       r->store->arrays().sorted_position, sizeof(Float4) * static_cast<size_t>(config.capacity));
   r->statistics = std::make_unique<FrameStatistics>(config.capacity);
   r->state.allocate(1, "frame state");
+  if (options_.dfsph) r->solve_partials.allocate(dfsph_partial_count(config.capacity), "DFSPH solve sums");
   cuda_check(cudaMemsetAsync(r->state.get(), 0, sizeof(FrameState), r->stream), "frame state reset");
   r->store->enqueue_initial_world_words(r->stream);
   r->input.allocate(1, "frame input");
@@ -256,7 +258,8 @@ void CudaBackend::import_particles(const ParticleSnapshot& s) {
 
 uint64_t CudaBackend::memory_bytes() const {
   return r_->store->bytes() + r_->grid->bytes() + r_->statistics->bytes() + r_->state.bytes() +
-         r_->sdf_cache.bytes() + r_->scene_buffer.bytes() + r_->sinks.bytes() + r_->boundary_maps.bytes();
+         r_->sdf_cache.bytes() + r_->scene_buffer.bytes() + r_->sinks.bytes() + r_->solve_partials.bytes() +
+         r_->boundary_maps.bytes() + r_->loads.bytes();
 }
 
 DeviceAttributeView CudaBackend::device_attribute(AttributeKind kind) const {

@@ -34,6 +34,7 @@ struct DeviceResources {
   std::unique_ptr<DeviceNeighborGrid> grid;
   std::unique_ptr<FrameStatistics> statistics;
   DeviceArray<FrameState> state;
+  DeviceArray<double> solve_partials;  // DFSPH only: the block sums of a solve's error
   PinnedArray<FrameInput> input;
   PinnedArray<FrameState> state_output;
   PinnedArray<uint32_t> sink_kept;
@@ -41,6 +42,7 @@ struct DeviceResources {
   PipelineSetup graph_setup;
   DeviceSdfCache sdf_cache;
   DeviceBoundaryMaps boundary_maps;
+  DeviceColliderLoads loads;
   DeviceSceneBuffer scene_buffer;
   DeviceSinkCompactor sinks;
 
@@ -54,8 +56,8 @@ struct DeviceResources {
   }
 
   PipelineBuffers buffers() {
-    return PipelineBuffers{store.get(), grid.get(),  statistics.get(),
-                           state.get(), input.get(), state_output.get()};
+    return PipelineBuffers{store.get(), grid.get(),         statistics.get(),    state.get(),
+                           input.get(), state_output.get(), solve_partials.get()};
   }
 };
 
@@ -152,7 +154,8 @@ class CudaBackend final : public Backend {
 
   // The stream driver (frame_loop.cu): frames with sinks, and every frame without graphs.
   uint32_t run_frame_on_stream(PipelineSetup setup, uint32_t sink_count, std::vector<uint32_t>& removed_ids,
-                               std::vector<uint32_t>& removed_by_sink);
+                               std::vector<uint32_t>& removed_by_sink, const StepInterrupt& interrupt,
+                               bool& interrupted);
 
   WorldConfig config_;
   int device_;

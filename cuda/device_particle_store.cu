@@ -49,6 +49,12 @@ DeviceParticleStore::DeviceParticleStore(uint32_t capacity,
   arrays_.spring_candidates = static_cast<uint32_t*>(find(kArraySpringCandidates));
   arrays_.spring_acceleration = static_cast<Float4*>(find(kArraySpringAcceleration));
   arrays_.link_from = static_cast<uint32_t*>(find(kArraySpringLinkFrom));
+  arrays_.dfsph_pressure = static_cast<float*>(find(kArrayDfsphPressure));
+  arrays_.dfsph_divergence = static_cast<float*>(find(kArrayDfsphDivergencePressure));
+  arrays_.dfsph_factor = static_cast<float*>(find(kArrayDfsphFactor));
+  arrays_.dfsph_step = static_cast<float*>(find(kArrayDfsphStep));
+  arrays_.dfsph_warm_pressure = static_cast<float*>(find(kArrayDfsphWarmPressure));
+  arrays_.dfsph_contact = static_cast<Float4*>(find(kArrayDfsphContact));
   arrays_.boundary_gradient = static_cast<Float4*>(find(kArrayBoundaryGradient));
   for (int side = 0; side < 2; ++side) {
     arrays_.rk4_start[side] = static_cast<ParticleState*>(find(kArrayRk4Start, side));

@@ -37,6 +37,11 @@ __global__ void begin_frame_kernel(FrameState* s, StepLimits limits, uint32_t ma
     s->bad_counts[k] = 0;
   }
   s->saved_max_speed = s->max_speed;
+  s->pressure_tally = empty_solve_tally();
+  s->divergence_tally = empty_solve_tally();
+  s->solve_run = 0;
+  s->solve_iterations = 0;
+  s->solve_error = 0.0f;
   const uint32_t run = clock_running(s->clock, max_substeps) ? 1u : 0u;
   if (run) pick_step(s, limits);
   set_run(s, run, cond);

@@ -18,12 +18,14 @@ bool same_setup(const PipelineSetup& a, const PipelineSetup& b) {
          a.options.surface_tension == b.options.surface_tension &&
          a.options.normalized_density == b.options.normalized_density &&
          a.options.viscosity == b.options.viscosity && a.options.springs == b.options.springs &&
-         a.options.boundary_density == b.options.boundary_density &&
+         a.options.dfsph == b.options.dfsph && a.options.boundary_density == b.options.boundary_density &&
          std::memcmp(&a.options.methods, &b.options.methods, sizeof a.options.methods) == 0 &&
          std::memcmp(&a.springs, &b.springs, sizeof a.springs) == 0 &&
          a.scene.colliders == b.scene.colliders && a.scene.fields == b.scene.fields &&
          a.scene.collider_count == b.scene.collider_count && a.scene.field_count == b.scene.field_count &&
-         a.scene.kernel_radius == b.scene.kernel_radius;
+         a.scene.kernel_radius == b.scene.kernel_radius && a.loads.partials == b.loads.partials &&
+         a.loads.sums == b.loads.sums && a.loads.output == b.loads.output &&
+         a.loads.colliders == b.loads.colliders;
 }
 
 }  // namespace
@@ -50,6 +52,7 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
   uint32_t count_after = count_;
   std::vector<uint32_t> removed_ids, removed_by_sink(scene_in.sinks.size(), 0u);
   bool frame_enqueued = false;  // the frame's first work (the rollback snapshot) is on the stream
+  bool interrupted = false;     // the stream driver stopped at a substep boundary (StepInterrupt)
   try {
     guarded([&] {
       if (!scene_in.empty()) {
@@ -66,6 +69,8 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
           r_->boundary_maps.end_frame();
         }
         setup.scene = r_->scene_buffer.upload(scene, config_.kernel_radius, r_->stream);
+        if ((config_.features & kFeatureColliderLoads) && !scene.colliders.empty())
+          setup.loads = r_->loads.reserve(static_cast<uint32_t>(scene.colliders.size()), config_.capacity);
         if (with_sinks) r_->sinks.reserve(config_.capacity, *r_->store);
         cuda_check(cudaStreamSynchronize(r_->stream), "upload of the scene");
       }
@@ -73,14 +78,17 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
       input->frame_dt = frame_dt;
       input->max_collider_speed = scene_in.max_collider_speed;
       input->pad = 0;
-      const bool on_graph = use_graphs_ && !with_sinks && prepare_graph(setup);
+      // A step budget needs the stream driver, which checks it between substeps (the graph
+      // runs the whole frame on the device).
+      const bool on_graph =
+          use_graphs_ && !with_sinks && !scene_in.interrupt.has_deadline() && prepare_graph(setup);
       cuda_check(cudaEventRecord(r_->frame_start, r_->stream), "cudaEventRecord");
       frame_enqueued = true;
       if (on_graph)
         r_->graph.launch(r_->stream);
       else
         count_after = run_frame_on_stream(setup, static_cast<uint32_t>(scene_in.sinks.size()), removed_ids,
-                                          removed_by_sink);
+                                          removed_by_sink, scene_in.interrupt, interrupted);
       cuda_check(cudaEventRecord(r_->frame_stop, r_->stream), "cudaEventRecord");
       cuda_check(cudaStreamSynchronize(r_->stream), "frame");
       cuda_check(cudaEventElapsedTime(&frame_ms, r_->frame_start, r_->frame_stop), "cudaEventElapsedTime");
@@ -111,9 +119,18 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
   FrameReport report;
   report.removed_ids = std::move(removed_ids);
   report.removed_by_sink = std::move(removed_by_sink);
+  if (config_.features & kFeatureColliderLoads) {
+    // Every collider gets its sums, zero for a frame without colliders' loads (none in the scene).
+    report.collider_loads.assign(scene_in.colliders.size(), ColliderLoadSums{});
+    if (setup.loads.on())
+      for (uint32_t c = 0; c < setup.loads.colliders; ++c) report.collider_loads[c] = setup.loads.output[c];
+  }
   report_clock(s.clock, report);
+  report.interrupted = interrupted;
   report.max_speed = s.max_speed;
   report_density(s.density, report);
+  report.pressure_solve = finish_solve(s.pressure_tally);
+  report.divergence_solve = finish_solve(s.divergence_tally);
   double staged_ms = 0.0;
   for (int k = 0; k < kStageCount; ++k) {
     report.stage_ms[k] = static_cast<float>(static_cast<double>(s.stage_ns[k]) * 1e-6);
@@ -159,9 +176,12 @@ bool CudaBackend::prepare_graph(const PipelineSetup& setup) {
 // them. With sinks, the survivor count comes back with the loop condition (one synchronisation
 // per substep, a second one only when particles were removed). Returns the particle count after
 // the frame; the removed ids, in the CPU backend's order, and the per-sink counts are appended.
+// `interrupt` is checked after every substep that removed no particle (so the statistics read
+// what a frame's natural end leaves); when it stops the frame, `interrupted` is set.
 uint32_t CudaBackend::run_frame_on_stream(PipelineSetup setup, uint32_t sink_count,
                                           std::vector<uint32_t>& removed_ids,
-                                          std::vector<uint32_t>& removed_by_sink) {
+                                          std::vector<uint32_t>& removed_by_sink,
+                                          const StepInterrupt& interrupt, bool& interrupted) {
   const PipelineBuffers b = r_->buffers();
   const ParticleArrays& a = b.store->arrays();
   cudaStream_t s = r_->stream;
@@ -190,11 +210,18 @@ uint32_t CudaBackend::run_frame_on_stream(PipelineSetup setup, uint32_t sink_cou
           "copy of the sink survivor count");
     }
     cuda_check(cudaStreamSynchronize(s), "substep");
-    if (sink_count == 0) continue;
+    const auto stop_here = [&] { return out->run && (interrupted = interrupt.requested()); };
+    if (sink_count == 0) {
+      if (stop_here()) break;
+      continue;
+    }
     counts_after_sinks = nullptr;
     if (out->non_finite) break;  // as on the CPU: no sinks after a failed substep
     const uint32_t kept = *kept_out;
-    if (kept == n) continue;
+    if (kept == n) {
+      if (stop_here()) break;
+      continue;
+    }
     // After the last substep the statistics need the neighbour counts of its density pass,
     // which the compaction carries along (the sorted copy it reads becomes scratch).
     uint32_t* counts = nullptr;

@@ -8,6 +8,7 @@
 #include "../src/core/density_record.h"
 #include "../src/core/frame_report.h"
 #include "../src/core/non_finite.h"
+#include "../src/core/solver_record.h"
 #include "../src/core/substep_clock.h"
 
 namespace sph {
@@ -51,6 +52,13 @@ struct FrameState {
   uint32_t bad_counts[kRk4Stages];  // non-finite particles flagged per stage
 
   DensityRecord density;  // of the last density evaluation, computed once at the end of the frame
+
+  // DFSPH (dfsph_solver.cu): the frame's record of its two solves, and the solve that runs now.
+  SolveTally pressure_tally;
+  SolveTally divergence_tally;
+  uint32_t solve_run;         // 1 while the current solve iterates (the stream driver reads it)
+  uint32_t solve_iterations;  // of the current solve, after its initial residual
+  float solve_error;          // the current solve's mean error
 
   // Stage timing: the first thread of each stage's first kernel reads the GPU's global
   // nanosecond timer and charges the time since the previous mark to the previous stage.

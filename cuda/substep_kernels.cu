@@ -5,69 +5,12 @@
 #include "../src/physics/integrate.h"
 #include "../src/physics/surface_tension.h"
 #include "block_reduce.cuh"
+#include "force_gather.cuh"
 #include "kernel_launch.h"
 #include "substep_kernels.h"
 
 namespace sph {
 namespace {
-
-// gather_acceleration (src/physics/forces.h) for SIMT: the same neighbours in the same order
-// and the same per-neighbour arithmetic (the composer's AccelerationGather), in two phases per
-// run of up to 32 candidates. First every candidate is only tested (a tight loop: load,
-// distance, compare) into a bit mask; then the costly pair terms run for the set bits in
-// ascending order. In one pass a warp would run the pair terms whenever any of its 32 threads
-// had a neighbour, i.e. for almost every candidate, since only about a fifth of the 27-cell
-// candidates are within h. (Collecting a whole particle's neighbours in a shared-memory list
-// first, for one longer second phase, measured slower: occupancy and latency.)
-// Terms: the world's force terms (methods.h); neighbor_counts and normals may be null unless a
-// term reads them.
-template <class Terms>
-__device__ __forceinline__ Vec3 gather_acceleration_masked(const FluidConstants& f, const GridView& grid,
-                                                           const Float4* __restrict__ positions,
-                                                           const Float4* __restrict__ velocities,
-                                                           const uint32_t* __restrict__ neighbor_counts,
-                                                           const Float4* __restrict__ normals, uint32_t i) {
-  AccelerationGather<Terms> gather(ForceInputs{positions, velocities, neighbor_counts, normals}, i);
-  const Vec3 xi = gather.position();
-  for_each_neighbor_range(grid, xi, [&](uint32_t begin, uint32_t end) {
-    for (uint32_t base = begin; base < end; base += 32u) {
-      const uint32_t count = min(32u, end - base);
-      uint32_t hits = 0;
-#pragma unroll 4
-      for (uint32_t k = 0; k < count; ++k) {
-        const float r2 = length_squared(xi - xyz(positions[base + k]));
-        hits |= (is_force_neighbor(f, r2, i, base + k) ? 1u : 0u) << k;
-      }
-      while (hits != 0u) {
-        const uint32_t j = base + static_cast<uint32_t>(__ffs(hits) - 1);
-        hits &= hits - 1u;
-        const Float4 pj = positions[j];
-        const Vec3 d = xi - xyz(pj);
-        gather.add(f, j, pj, d, length_squared(d));
-      }
-    }
-  });
-  return gather.finish(f);
-}
-
-__device__ __forceinline__ void flag_non_finite(FrameState* s, int stage, uint32_t index, uint32_t id,
-                                                uint32_t where) {
-  atomicMin(&s->bad_key[stage], ((static_cast<unsigned long long>(index) << 2 | where) << 32) | id);
-  atomicAdd(&s->bad_counts[stage], 1u);
-}
-
-// The scene's force fields at a particle (after the neighbour gather, as the CPU backend).
-__device__ __forceinline__ Vec3 add_force_fields(const DeviceScene& scene, Vec3 acc, Vec3 x) {
-  for (uint32_t f = 0; f < scene.field_count; ++f) acc += force_field_acceleration(scene.fields[f], x);
-  return acc;
-}
-
-// Every collider against the integrated state, moved from x_old during the substep.
-__device__ __forceinline__ void collide_all(const DeviceScene& scene, const SubstepTime& time, Vec3 x_old,
-                                            ParticleState& s) {
-  for (uint32_t c = 0; c < scene.collider_count; ++c)
-    collide_particle(scene.colliders[c], time, scene.kernel_radius, x_old, s.position, s.velocity);
-}
 
 template <Rk4Carry Carry>
 __global__ void reorder_kernel(ParticleArrays a, const uint32_t* __restrict__ order, uint32_t n, int from,
@@ -154,7 +97,7 @@ __global__ void colour_normal_kernel(FluidConstants fluid, GridView grid, Partic
 
 template <class Terms, bool kScene>
 __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
-                                    DeviceScene scene, FrameState* state) {
+                                    DeviceScene scene, bool collide_here, FrameState* state) {
   mark_stage(state, kStageForces);
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   float v2 = 0.0f, a2 = 0.0f;
@@ -171,7 +114,7 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
     a2 = length_squared(acc);
     ParticleState next = symplectic_euler(ParticleState{xyz(p), xyz(v)}, acc, f.dt);
     const ParticleState integrated = next;
-    if (kScene) collide_all(scene, state->clock.time, xyz(p), next);
+    if (kScene && collide_here) collide_all(scene, state->clock.time, xyz(p), next);
     const uint32_t id = a.sorted_id[i];
     a.position[i] = make_float4_record(next.position, p.w);
     a.velocity[i] = make_float4_record(next.velocity, v.w);
@@ -181,6 +124,7 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
       flag_non_finite(state, 0, i, id, classify_non_finite(a.density[i], p, v, acc, integrated));
       v2 = 0.0f;
     }
+    if (!collide_here) v2 = 0.0f;  // the loads pass collides and takes the speed (device_collider_loads.h)
   }
   block_max_to(&state->v2max_bits, v2);
   __syncthreads();  // block_max_to's shared slots are reused
@@ -189,7 +133,7 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
 
 template <class Terms, bool kScene>
 __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
-                                  int stage, DeviceScene scene, FrameState* state) {
+                                  int stage, DeviceScene scene, bool collide_here, FrameState* state) {
   mark_stage(state, kStageForces);
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   float v2 = 0.0f, a2 = 0.0f;
@@ -213,7 +157,8 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
     ParticleState next = rk4_advance(stage, from, ParticleState{xyz(p), xyz(v)}, acc, f.dt, sum);
     sums[i] = sum;
     const ParticleState integrated = next;
-    if (kScene && stage == kRk4Stages - 1) collide_all(scene, state->clock.time, from.position, next);
+    if (kScene && collide_here && stage == kRk4Stages - 1)
+      collide_all(scene, state->clock.time, from.position, next);
     const uint32_t id = a.sorted_id[i];
     a.position[i] = make_float4_record(next.position, p.w);
     a.velocity[i] = make_float4_record(next.velocity, v.w);
@@ -224,6 +169,7 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
       v2 = 0.0f;
     }
     if (stage != kRk4Stages - 1) v2 = 0.0f;  // the speed that counts is the final state's
+    if (!collide_here) v2 = 0.0f;            // the loads pass collides and takes the speed
   }
   if (stage == kRk4Stages - 1) {
     block_max_to(&state->v2max_bits, v2);
@@ -294,36 +240,45 @@ void enqueue_density(const FluidConstants& fluid, const GridView& grid, const Pa
     publish_normalized_density_kernel<<<blocks, threads, 0, stream>>>(fluid, a, n);
     check_launch("publish_normalized_density_kernel");
   }
-  if (options.surface_tension) {
-    colour_normal_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n);
-    check_launch("colour_normal_kernel");
-  }
+  if (options.surface_tension) enqueue_colour_normals(fluid, grid, a, n, tuning, stream);
+}
+
+void enqueue_colour_normals(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                            uint32_t n, const KernelTuning& tuning, cudaStream_t stream) {
+  const unsigned threads = tuning.density_block, blocks = blocks_for(n, threads);
+  colour_normal_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n);
+  check_launch("colour_normal_kernel");
 }
 
 void enqueue_forces_euler(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                           uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
-                          const DeviceScene& scene, FrameState* state, cudaStream_t stream) {
+                          const DeviceScene& scene, bool collide_here, FrameState* state,
+                          cudaStream_t stream) {
   const unsigned threads = tuning.force_block, blocks = blocks_for(n, threads);
   with_force_terms(options.methods, [&](auto terms) {
     using Terms = decltype(terms);
     if (scene.active())
-      forces_euler_kernel<Terms, true><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
+      forces_euler_kernel<Terms, true>
+          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, collide_here, state);
     else
-      forces_euler_kernel<Terms, false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
+      forces_euler_kernel<Terms, false>
+          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, true, state);
   });
   check_launch("forces_euler_kernel");
 }
 
 void enqueue_forces_rk4(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                         uint32_t n, int stage, const SubstepOptions& options, const KernelTuning& tuning,
-                        const DeviceScene& scene, FrameState* state, cudaStream_t stream) {
+                        const DeviceScene& scene, bool collide_here, FrameState* state, cudaStream_t stream) {
   const unsigned threads = tuning.force_block, blocks = blocks_for(n, threads);
   with_force_terms(options.methods, [&](auto terms) {
     using Terms = decltype(terms);
     if (scene.active())
-      forces_rk4_kernel<Terms, true><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, scene, state);
+      forces_rk4_kernel<Terms, true>
+          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, scene, collide_here, state);
     else
-      forces_rk4_kernel<Terms, false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, scene, state);
+      forces_rk4_kernel<Terms, false>
+          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, scene, true, state);
   });
   check_launch("forces_rk4_kernel");
 }

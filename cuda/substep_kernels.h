@@ -50,7 +50,8 @@ struct SubstepOptions {
   bool surface_tension = false;
   bool normalized_density = false;
   ViscosityMethod viscosity = ViscosityMethod::Mueller;
-  bool springs = false;           // a.spring_acceleration adds to the force pass
+  bool springs = false;  // a.spring_acceleration adds to the force pass
+  bool dfsph = false;    // the DFSPH solver (dfsph_solver.h) instead of the weakly compressible passes
   bool boundary_density = false;  // the colliders' share joins the density; the walls' pressure the forces
 };
 
@@ -63,18 +64,25 @@ void enqueue_density(const FluidConstants& fluid, const GridView& grid, const Pa
                      const SubstepOptions& options, const KernelTuning& tuning, const DeviceScene& scene,
                      float stage_fraction, FrameState* state, cudaStream_t stream);
 
+// colour_normal[i] for surface tension, after the density pass (enqueue_density calls it).
+void enqueue_colour_normals(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                            uint32_t n, const KernelTuning& tuning, cudaStream_t stream);
+
 // Symplectic Euler from the sorted copy into the state, with the max-speed and
 // max-acceleration reductions and the non-finite check.
 // With a scene: the force fields add to the gathered acceleration, and the colliders resolve
-// the integrated state from the particle's position before the step (FrameState::time).
+// the integrated state from the particle's position before the step (FrameState::time), unless
+// collide_here is false: then the loads pass (device_collider_loads.h) resolves them and takes
+// the state's max speed.
 void enqueue_forces_euler(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                           uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
-                          const DeviceScene& scene, FrameState* state, cudaStream_t stream);
+                          const DeviceScene& scene, bool collide_here, FrameState* state,
+                          cudaStream_t stream);
 
 // One RK4 stage (0..3); its start state and slope sums are on side (stage + 1) % 2. The
-// colliders act after the last stage, from the start position.
+// colliders act after the last stage, from the start position (collide_here as for Euler).
 void enqueue_forces_rk4(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                         uint32_t n, int stage, const SubstepOptions& options, const KernelTuning& tuning,
-                        const DeviceScene& scene, FrameState* state, cudaStream_t stream);
+                        const DeviceScene& scene, bool collide_here, FrameState* state, cudaStream_t stream);
 
 }  // namespace sph

@@ -8,6 +8,7 @@ void enqueue_frame_begin(const PipelineSetup& setup, const PipelineBuffers& b, L
              "copy of the frame input");
   enqueue_begin_frame(b.state, setup.limits, setup.max_substeps, cond, stream);
   b.store->enqueue_snapshot(setup.count, stream);
+  if (setup.loads.on()) enqueue_loads_begin(setup.loads, stream);
 }
 
 void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
@@ -16,6 +17,21 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
   const uint32_t n = setup.count;
   const bool rk4 = setup.integrator == Integrator::Rk4;
   const int stages = rk4 ? kRk4Stages : 1;
+  if (setup.options.dfsph) {
+    b.grid->enqueue_sort(a.position, n, b.state, stream);
+    b.grid->enqueue_cell_starts(n, b.state, stream);
+    enqueue_reorder(a, b.grid->order(), n, Rk4Carry::None, 0, b.state, stream);
+    if (setup.options.springs) enqueue_spring_reorder(a, b.grid->order(), n, stream);
+    enqueue_dfsph_density(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene,
+                          b.state, stream);
+    if (setup.options.springs)
+      enqueue_spring_pass(setup.springs, b.grid->view(), a, n, true, b.state, stream);
+    const DfsphLoops loops{cond.in_graph, b.solve_partials, b.state_output};
+    enqueue_dfsph_step(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene, loops,
+                       b.state, stream);
+    enqueue_end_substep(b.state, setup.limits, setup.max_substeps, 1, cond, stream);
+    return;
+  }
   for (int stage = 0; stage < stages; ++stage) {
     b.grid->enqueue_sort(a.position, n, b.state, stream);
     b.grid->enqueue_cell_starts(n, b.state, stream);
@@ -26,12 +42,19 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
                     rk4 ? rk4_stage_fraction(stage) : 0.0f, b.state, stream);
     if (setup.options.springs)
       enqueue_spring_pass(setup.springs, b.grid->view(), a, n, stage == 0, b.state, stream);
+    const bool loads = setup.loads.on();
     if (rk4)
       enqueue_forces_rk4(setup.fluid, b.grid->view(), a, n, stage, setup.options, setup.tuning, setup.scene,
-                         b.state, stream);
+                         !loads, b.state, stream);
     else
       enqueue_forces_euler(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene,
-                           b.state, stream);
+                           !loads, b.state, stream);
+    // Loads: the walls' reactions of every force evaluation, the contacts after the last.
+    const bool last = stage == stages - 1;
+    if (loads && (setup.options.boundary_density || last))
+      enqueue_loads(setup.fluid, a, n, setup.scene, setup.loads, setup.options.boundary_density,
+                    rk4 ? rk4_stage_fraction(stage) : 0.0f, rk4 ? rk4_weight(stage) : 1.0f, last, rk4,
+                    b.state, stream);
   }
   enqueue_end_substep(b.state, setup.limits, setup.max_substeps, stages, cond, stream);
 }
@@ -39,6 +62,7 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
 void enqueue_frame_end(const PipelineSetup& setup, const PipelineBuffers& b, cudaStream_t stream,
                        const uint32_t* counts) {
   b.statistics->enqueue(setup.fluid, b.grid->view(), b.store->arrays(), setup.count, b.state, stream, counts);
+  if (setup.loads.on()) enqueue_loads_end(setup.loads, stream);
   cuda_check(cudaMemcpyAsync(b.state_output, b.state, sizeof(FrameState), cudaMemcpyDeviceToHost, stream),
              "copy of the frame state");
 }

@@ -2,7 +2,9 @@
 // graph (frame_graph.h) or launched directly on the stream (the fallback). A frame is
 //   begin:    frame_dt in, counters reset, first step chosen, state snapshot
 //   substep:  (hash, sort, cell starts, reorder, density, forces + integrate) x 1 or 4 stages,
-//             then the end-of-substep kernel (max speed, non-finite check, clock, next step)
+//             or DFSPH's (hash, sort, cell starts, reorder, density and factor, its solves and the
+//             step: dfsph_solver.h), then the end-of-substep kernel (max speed, non-finite
+//             check, clock, next step)
 //   end:      statistics, FrameState out to pinned host memory
 #pragma once
 
@@ -11,9 +13,11 @@
 #include <cuda_runtime.h>
 
 #include "../src/core/config.h"
+#include "device_collider_loads.h"
 #include "device_neighbor_grid.h"
 #include "device_particle_store.h"
 #include "device_springs.h"
+#include "dfsph_solver.h"
 #include "frame_control.h"
 #include "frame_statistics.h"
 #include "substep_kernels.h"
@@ -30,6 +34,7 @@ struct PipelineSetup {
   KernelTuning tuning{};
   DeviceScene scene{};        // colliders and force fields inside the substep (none: all zero)
   SpringConstants springs{};  // used when options.springs
+  DeviceLoads loads{};        // loads on colliders (off: all null)
 };
 
 struct PipelineBuffers {
@@ -39,6 +44,7 @@ struct PipelineBuffers {
   FrameState* state;         // device
   const FrameInput* input;   // pinned host, copied into the head of *state
   FrameState* state_output;  // pinned host, receives the state at the end
+  double* solve_partials;    // DFSPH: the block sums of a solve's error (null otherwise)
 };
 
 void enqueue_frame_begin(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,

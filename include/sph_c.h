@@ -126,7 +126,8 @@ typedef enum sph_attribute {
   SPH_ATTRIBUTE_POSITION = 0, /* 3 x float32, metres */
   SPH_ATTRIBUTE_VELOCITY = 1, /* 3 x float32, metres per second */
   SPH_ATTRIBUTE_DENSITY = 2,  /* float32, kg/m^3, from the last density evaluation */
-  SPH_ATTRIBUTE_PRESSURE = 3, /* float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation */
+  SPH_ATTRIBUTE_PRESSURE = 3, /* float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation;
+                                 DFSPH: the pressure its density solve found in the last substep */
   SPH_ATTRIBUTE_ID = 4,       /* uint32, persistent particle id, unique within a world */
   SPH_ATTRIBUTE_COUNT = 5,
   SPH_ATTRIBUTE_FORCE32 = 0x7fffffff
@@ -137,7 +138,7 @@ typedef enum sph_stage {
   SPH_STAGE_HASH_SORT = 0,   /* cell hash, stable sort, reorder of every attribute */
   SPH_STAGE_CELL_RANGES = 1, /* start/end of each cell */
   SPH_STAGE_DENSITY = 2,     /* density and pressure */
-  SPH_STAGE_FORCES = 3,      /* pressure, viscosity and external forces */
+  SPH_STAGE_FORCES = 3,      /* pressure, viscosity and external forces (DFSPH: and its two solves) */
   SPH_STAGE_INTEGRATE = 4,   /* time integration, max-speed reduction, next step size */
   SPH_STAGE_COLLIDE = 5,     /* particles against colliders (CPU; the CUDA backend does it inside
                                 the forces kernel, so it counts under SPH_STAGE_FORCES there) */
@@ -186,6 +187,13 @@ typedef uint32_t sph_feature_flags;
  *  CUDA). The collision response stays the no-penetration safeguard. Costs one SDF sample per
  *  particle and collider in each density pass. */
 #define SPH_FEATURE_BOUNDARY_DENSITY 0x8u
+/** Loads on colliders: the force and torque of the fluid on each collider over every step
+ *  (sph_collider_get_loads): the collision response's contact impulses and, with
+ *  SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions, summed on the device per substep
+ *  in a fixed order (bitwise deterministic) and averaged over the step's time. Costs, per
+ *  substep, a reduction over the particles per collider (and with the boundary density one SDF
+ *  sample per particle and collider per force evaluation); no host round trip inside a step. */
+#define SPH_FEATURE_COLLIDER_LOADS 0x10u
 
 typedef enum sph_viscosity_method {
   SPH_VISCOSITY_MUELLER = 0, /* Laplacian viscosity (eq. 17), coefficient sph_world_params.viscosity */
@@ -200,9 +208,24 @@ typedef enum sph_equation_of_state {
   SPH_EOS_FORCE32 = 0x7fffffff
 } sph_equation_of_state;
 
+/** The pressure solver, fixed at world creation (docs/physics.md, "Solvers"). */
+typedef enum sph_solver {
+  SPH_SOLVER_WCSPH = 0, /* the thesis's weakly compressible SPH: pressure from the equation of
+                           state, explicit steps under the acoustic ceiling 0.4 h / c */
+  SPH_SOLVER_DFSPH = 1, /* divergence-free SPH (Bender & Koschier 2015, 2017): pressure from two
+                           iterative solves that hold the density error below a bound
+                           (sph_dfsph_params); steps bounded by the flow speed alone. No equation
+                           of state: the stiffness, Tait's parameters and SPH_STEP_LIMIT_ACOUSTIC
+                           have no effect. Not with SPH_INTEGRATOR_RK4, SPH_EOS_TAIT or
+                           SPH_FEATURE_NORMALIZED_DENSITY (SPH_ERROR_UNSUPPORTED at creation) */
+  SPH_SOLVER_FORCE32 = 0x7fffffff
+} sph_solver;
+
 /** Step-size limits beyond eq. 32, for sph_world_params.step_limits. */
-#define SPH_STEP_LIMIT_ACOUSTIC 0x1u /* dt <= step_factor h / c, c the EOS's speed of sound */
-#define SPH_STEP_LIMIT_FORCE 0x2u    /* dt <= step_factor sqrt(h / |a|_max) */
+#define SPH_STEP_LIMIT_ACOUSTIC                                                          \
+  0x1u                            /* dt <= step_factor h / c, c the EOS's speed of sound \
+                                     (weakly compressible worlds only) */
+#define SPH_STEP_LIMIT_FORCE 0x2u /* dt <= step_factor sqrt(h / |a|_max) */
 
 /* ---- version and diagnostics (always thread-safe) ---------------------------------------- */
 
@@ -295,8 +318,9 @@ typedef struct sph_world_def {
   float kernel_radius;                   /* h, m; 0 (default) = 1.8 * particle_spacing; must be >= spacing */
   float rest_density;                    /* rho0, kg/m^3; 0 (default) = 1000 (water) */
   sph_equation_of_state equation_of_state; /* default SPH_EOS_IDEAL_GAS */
+  sph_solver solver;                       /* default SPH_SOLVER_WCSPH */
 } sph_world_def;
-SPH_STATIC_ASSERT(sizeof(sph_world_def) == 40, sph_world_def_size);
+SPH_STATIC_ASSERT(sizeof(sph_world_def) == 44, sph_world_def_size);
 
 SPH_API sph_result SPH_CALL sph_world_def_init_sized(sph_world_def* def, uint32_t size);
 static inline sph_result sph_world_def_init(sph_world_def* def) {
@@ -310,7 +334,8 @@ static inline sph_result sph_world_def_init(sph_world_def* def) {
  * an FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass).
  * Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range:
  * capacity above 2^30, spacing < 0 or non-finite, kernel_radius < spacing, rest_density < 0),
- * UNSUPPORTED (unknown integrator or feature bit), VERSION_MISMATCH, OUT_OF_HOST_MEMORY,
+ * UNSUPPORTED (unknown integrator, feature bit, method or solver; a combination a solver does
+ * not support, see sph_solver), VERSION_MISMATCH, OUT_OF_HOST_MEMORY,
  * OUT_OF_DEVICE_MEMORY. *out is written only on success.
  */
 SPH_API sph_result SPH_CALL sph_world_create(sph_context* context, const sph_world_def* def, sph_world** out);
@@ -334,7 +359,8 @@ SPH_API sph_result SPH_CALL sph_world_get_particle_mass(const sph_world* world, 
  * (a 0 that took a default reads back as the default). */
 typedef struct sph_world_params {
   uint32_t struct_size;  /* sizeof(sph_world_params), set by sph_world_params_init */
-  uint32_t max_substeps; /* most substeps one sph_world_step may take; default 10000; 0 = default */
+  uint32_t max_substeps; /* most substeps one sph_world_step may take; default 10000; 0 = default;
+                            at most 1000000 (a bound on one call's cost; see also the step budget) */
   sph_vec3 gravity;      /* m/s^2; default (0, -9.81, 0); finite; 0 is no gravity */
   float stiffness;       /* k of p = k (rho - rho0), m^2/s^2 (the squared numerical sound speed);
                             default 100; > 0; 0 = default. Keep sqrt(k) * dt_max below about 0.4 h. */
@@ -444,6 +470,34 @@ static inline sph_result sph_spring_params_init(sph_spring_params* params) {
 SPH_API sph_result SPH_CALL sph_world_set_spring_params(sph_world* world, const sph_spring_params* params);
 SPH_API sph_result SPH_CALL sph_world_get_spring_params(const sph_world* world, sph_spring_params* out);
 
+/** sph_dfsph_params.flags */
+#define SPH_DFSPH_SKIP_DIVERGENCE_SOLVE 0x1u /* no divergence solve (cheaper; a noisier pressure) */
+
+typedef struct sph_dfsph_params {
+  uint32_t struct_size;               /* set by sph_dfsph_params_init */
+  float density_error;                /* bound on the density solve's mean error, the mean over the
+                                         particles of max(rho* - rho0, 0) / rho0 (rho*: the density
+                                         the step would give); dimensionless; default 0.001
+                                         (0.1 %); in (0, 1]; 0 = default */
+  float divergence_error;             /* bound on the divergence solve's mean of
+                                         max(D rho / Dt, 0) / rho0, 1/s; default 1; > 0; 0 = default */
+  uint32_t max_iterations;            /* cap of the density solve per substep; default 100; >= 2;
+                                         0 = default. A solve that stops here above its bound is
+                                         counted in sph_stats and reported as an event */
+  uint32_t max_divergence_iterations; /* cap of the divergence solve; default 100; >= 1; 0 = default */
+  uint32_t flags;                     /* SPH_DFSPH_* bits; default 0 */
+} sph_dfsph_params;
+SPH_STATIC_ASSERT(sizeof(sph_dfsph_params) == 24, sph_dfsph_params_size);
+
+SPH_API sph_result SPH_CALL sph_dfsph_params_init_sized(sph_dfsph_params* params, uint32_t size);
+static inline sph_result sph_dfsph_params_init(sph_dfsph_params* params) {
+  return sph_dfsph_params_init_sized(params, (uint32_t)sizeof(*params));
+}
+/** FEATURE_DISABLED unless the world's solver is SPH_SOLVER_DFSPH. INVALID_ARGUMENT for a value
+ *  out of range (the message names it); nothing changes on error. Acts from the next substep. */
+SPH_API sph_result SPH_CALL sph_world_set_dfsph_params(sph_world* world, const sph_dfsph_params* params);
+SPH_API sph_result SPH_CALL sph_world_get_dfsph_params(const sph_world* world, sph_dfsph_params* out);
+
 /* ---- every params struct by kind, and what tools need to know about them ----------------
  * The physics methods and their parameters described as data (after SPlisHSPlasH's parameter
  * objects), so that a tool (a scene format, an editor, a binding) can list, read, range-check
@@ -456,7 +510,8 @@ typedef enum sph_params_kind {
   SPH_PARAMS_CLAVET_VISCOSITY = 2, /* sph_clavet_viscosity_params */
   SPH_PARAMS_TAIT = 3,             /* sph_tait_params */
   SPH_PARAMS_SPRINGS = 4,          /* sph_spring_params */
-  SPH_PARAMS_KIND_COUNT = 5,
+  SPH_PARAMS_DFSPH = 5,            /* sph_dfsph_params */
+  SPH_PARAMS_KIND_COUNT = 6,
   SPH_PARAMS_KIND_FORCE32 = 0x7fffffff
 } sph_params_kind;
 
@@ -545,6 +600,7 @@ typedef enum sph_method_switch {
   SPH_METHOD_SWITCH_FEATURE = 1,           /* a bit of sph_world_def.features (value) */
   SPH_METHOD_SWITCH_VISCOSITY = 2,         /* sph_world_def.viscosity_method == value */
   SPH_METHOD_SWITCH_EQUATION_OF_STATE = 3, /* sph_world_def.equation_of_state == value */
+  SPH_METHOD_SWITCH_SOLVER = 4,            /* sph_world_def.solver == value */
   SPH_METHOD_SWITCH_FORCE32 = 0x7fffffff
 } sph_method_switch;
 
@@ -552,7 +608,8 @@ typedef struct sph_physics_method_info {
   uint32_t struct_size;        /* set by sph_physics_method_info_init */
   uint32_t method_count;       /* how many methods this library has (index runs below it) */
   sph_method_switch switch_by; /* the sph_world_def field that selects it */
-  uint32_t value;              /* the SPH_FEATURE_* bit, sph_viscosity_method or sph_equation_of_state */
+  uint32_t value;              /* the SPH_FEATURE_* bit, sph_viscosity_method, sph_equation_of_state or
+                                  sph_solver */
   uint32_t has_params;         /* 1 when its parameters are in the struct of params_kind */
   sph_params_kind params_kind; /* SPH_PARAMS_WORLD for the thesis's defaults (stiffness, viscosity) */
   const char* name;            /* "clavet", "surface_tension": a scene file's name; static */
@@ -642,11 +699,38 @@ SPH_API sph_result SPH_CALL sph_world_fill_sphere(sph_world* world, const sph_fi
  * Advances the world by frame_dt seconds (> 0, finite) in adaptive substeps: each substep's
  * dt = step_factor * h / v_max clamped to [dt_min, dt_max], shortened at the end so that the
  * substeps add up to frame_dt exactly (the last one or two may be shorter than dt_min).
- * Blocks until the frame is done. Returns SPH_INCOMPLETE if max_substeps ran out first
- * (sph_stats.frame_time says how far it got). SPH_ERROR_NON_FINITE if a substep produced a
- * NaN/Inf: the world is restored to its state before this call.
+ * Blocks until the frame is done. Returns SPH_INCOMPLETE if max_substeps ran out first, or
+ * the step budget (sph_world_set_step_budget) or a cancel (sph_world_cancel_step) stopped it:
+ * the world is then as after its last whole substep, consistent and ready to step again
+ * (sph_stats.frame_time and substeps say how far it got). SPH_ERROR_NON_FINITE if a substep
+ * produced a NaN/Inf, SPH_ERROR_CAPACITY if more particles than 64 times the rest density
+ * allows piled into one cell of side h (the neighbour work would grow with their square; the
+ * message says where): the world is restored to its state before this call.
  */
 SPH_API sph_result SPH_CALL sph_world_step(sph_world* world, float frame_dt);
+
+/**
+ * Bounds the wall-clock time of each later sph_world_step of this world: a step still running
+ * max_seconds after it began stops at its next substep boundary and returns SPH_INCOMPLETE
+ * (one substep may overrun the budget). Both backends check it between substeps: the CUDA
+ * backend runs a frame with a budget on its stream driver instead of its device graph (one host
+ * synchronisation a substep). 0 (the default) is no budget. Not saved in checkpoints. Errors: INVALID_HANDLE, INVALID_ARGUMENT
+ * (NaN, negative or above 86400), WORLD_LOCKED.
+ */
+SPH_API sph_result SPH_CALL sph_world_set_step_budget(sph_world* world, double max_seconds);
+/** The step budget in seconds (0: none). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL). */
+SPH_API sph_result SPH_CALL sph_world_get_step_budget(const sph_world* world, double* out_seconds);
+
+/**
+ * Asks the world's step to stop at its next substep boundary (it returns SPH_INCOMPLETE with
+ * the world consistent; on the CUDA backend a frame on the device graph, which is every frame
+ * without a step budget or sinks, sees it only at its end). The one call that may run on another thread while a step holds the
+ * world: it never blocks and never answers WORLD_LOCKED. A request made while no step runs
+ * stops the next step before its first substep (that step changes nothing and reports 0
+ * substeps); a step that stops for it clears it. Errors: INVALID_HANDLE (NULL or destroyed:
+ * safe to call racing sph_world_destroy).
+ */
+SPH_API sph_result SPH_CALL sph_world_cancel_step(sph_world* world);
 
 /* ---- particles out ----------------------------------------------------------------------- */
 
@@ -689,8 +773,23 @@ typedef struct sph_stats {
   uint32_t reserved0;
   uint64_t memory_bytes; /* bytes the world holds for particles and grids (device memory on
                             the CUDA backend) */
+  /* DFSPH's two solves over the substeps of the last step (all zero on a WCSPH world). An
+     iteration is one velocity update and one new residual, after the warm start's. */
+  uint32_t pressure_iterations;       /* the density solve's iterations, summed */
+  uint32_t pressure_iterations_max;   /* most in one substep */
+  uint32_t divergence_iterations;     /* the divergence solve's iterations, summed */
+  uint32_t divergence_iterations_max; /* most in one substep */
+  float density_error_mean;           /* the density solve's achieved mean error (see
+                                         sph_dfsph_params.density_error), averaged over the
+                                         substeps */
+  float density_error_max;            /* the largest of any substep */
+  float divergence_error_mean;        /* the divergence solve's achieved mean error, 1/s */
+  float divergence_error_max;         /* the largest of any substep */
+  uint32_t pressure_solves_capped;    /* substeps whose density solve stopped at its cap above
+                                         its bound (also SPH_EVENT_PRESSURE_SOLVE_CAPPED) */
+  uint32_t divergence_solves_capped;  /* likewise (SPH_EVENT_DIVERGENCE_SOLVE_CAPPED) */
 } sph_stats;
-SPH_STATIC_ASSERT(sizeof(sph_stats) == 104, sph_stats_size);
+SPH_STATIC_ASSERT(sizeof(sph_stats) == 144, sph_stats_size);
 
 SPH_API sph_result SPH_CALL sph_stats_init_sized(sph_stats* stats, uint32_t size);
 static inline sph_result sph_stats_init(sph_stats* stats) {
@@ -975,6 +1074,46 @@ SPH_API sph_result SPH_CALL sph_collider_set_material(sph_world* world, sph_coll
 SPH_API sph_result SPH_CALL sph_collider_get_material(const sph_world* world, sph_collider_id id,
                                                       sph_collider_material* out);
 
+/**
+ * The fluid's loads on a collider over the last sph_world_step (SPH_FEATURE_COLLIDER_LOADS):
+ * the time averages over the step's substeps of the force and of the torque about the collider's
+ * load point, in world coordinates. What counts: the momentum the collision response took from
+ * particles (contacts, friction, stickiness) and, with SPH_FEATURE_BOUNDARY_DENSITY, the walls'
+ * pressure reactions; force times frame_time is the impulse the fluid gave the collider. The
+ * torque of each impulse is taken about the load point posed at the impulse's time (it moves
+ * with the collider). Zero before the first step (frame_time 0). docs/physics.md "Loads".
+ */
+typedef struct sph_collider_loads {
+  uint32_t struct_size; /* set by sph_collider_loads_init */
+  uint32_t reserved0;   /* written as 0 */
+  sph_vec3 force;       /* N, world frame */
+  sph_vec3 torque;      /* N m, world frame, about point */
+  sph_vec3 point;       /* the load point in the world at the end of the step, m */
+  double frame_time;    /* s: the time the step advanced, over which force and torque are averaged */
+} sph_collider_loads;
+SPH_STATIC_ASSERT(sizeof(sph_collider_loads) == 56, sph_collider_loads_size);
+
+SPH_API sph_result SPH_CALL sph_collider_loads_init_sized(sph_collider_loads* loads, uint32_t size);
+static inline sph_result sph_collider_loads_init(sph_collider_loads* loads) {
+  return sph_collider_loads_init_sized(loads, (uint32_t)sizeof(*loads));
+}
+/**
+ * Reads a collider's loads of the last step. Non-blocking (the step brought them to the host).
+ * out->struct_size must be set (sph_collider_loads_init); only that many bytes are written.
+ * Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (NULL out),
+ * VERSION_MISMATCH, FEATURE_DISABLED (the world lacks SPH_FEATURE_COLLIDER_LOADS), WORLD_LOCKED.
+ */
+SPH_API sph_result SPH_CALL sph_collider_get_loads(const sph_world* world, sph_collider_id id,
+                                                   sph_collider_loads* out);
+/**
+ * Sets the point, in the collider's own frame, that its loads' torque is taken about (default
+ * its origin; an engine passes the body's centre of mass). Acts from the next step. Errors:
+ * INVALID_HANDLE, INVALID_ARGUMENT (NULL point; a non-finite component, named),
+ * FEATURE_DISABLED, WORLD_LOCKED. Nothing changes on error.
+ */
+SPH_API sph_result SPH_CALL sph_collider_set_load_point(sph_world* world, sph_collider_id id,
+                                                        const sph_vec3* point);
+
 /* ---- sources ----------------------------------------------------------------------------- */
 typedef struct sph_source_id {
   uint64_t bits; /* {0} is null (SPH_ID_IS_NULL) */
@@ -1101,6 +1240,10 @@ SPH_API sph_result SPH_CALL sph_force_field_set_transform(sph_world* world, sph_
 typedef enum sph_event_type {
   SPH_EVENT_SOURCE_CAPACITY_REACHED = 1, /* object: the source; count: particles not emitted */
   SPH_EVENT_SINK_REMOVED = 2,            /* object: the sink; count: particles removed */
+  SPH_EVENT_PRESSURE_SOLVE_CAPPED = 3,   /* DFSPH; object: none (0); count: substeps whose density
+                                            solve stopped at max_iterations above its bound */
+  SPH_EVENT_DIVERGENCE_SOLVE_CAPPED = 4, /* DFSPH; object: none (0); count: substeps whose
+                                            divergence solve stopped at its cap above its bound */
   SPH_EVENT_TYPE_FORCE32 = 0x7fffffff
 } sph_event_type;
 

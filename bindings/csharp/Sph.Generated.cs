@@ -58,12 +58,24 @@ namespace Sph
         /// </summary>
         public const uint SPH_FEATURE_BOUNDARY_DENSITY = 8u;
         /// <summary>
+        /// Loads on colliders: the force and torque of the fluid on each collider over every step
+        /// (sph_collider_get_loads): the collision response's contact impulses and, with
+        /// SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions, summed on the device per
+        /// substep in a fixed order (bitwise deterministic) and averaged over the step's time. Costs,
+        /// per substep, a reduction over the particles per collider (and with the boundary density one
+        /// SDF sample per particle and collider per force evaluation); no host round trip inside a
+        /// step.
+        /// </summary>
+        public const uint SPH_FEATURE_COLLIDER_LOADS = 16u;
+        /// <summary>
         /// Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt &lt;= step_factor h /
-        /// c, c the EOS's speed of sound
+        /// c, c the EOS's speed of sound \ (weakly compressible worlds only)
         /// </summary>
         public const uint SPH_STEP_LIMIT_ACOUSTIC = 1u;
         /// <summary>dt &lt;= step_factor sqrt(h / |a|_max)</summary>
         public const uint SPH_STEP_LIMIT_FORCE = 2u;
+        /// <summary>sph_dfsph_params.flags no divergence solve (cheaper; a noisier pressure)</summary>
+        public const uint SPH_DFSPH_SKIP_DIVERGENCE_SOLVE = 1u;
         /// <summary>hollow box: no lid (a tank open at +y)</summary>
         public const uint SPH_SHAPE_FLAG_OPEN_TOP = 1u;
         /// <summary>solid where the SDF is positive: a container</summary>
@@ -81,7 +93,8 @@ namespace Sph
         public const int SPH_STAGE_FORCE32 = 2147483647;
         public const int SPH_VISCOSITY_METHOD_FORCE32 = 2147483647;
         public const int SPH_EOS_FORCE32 = 2147483647;
-        public const int SPH_PARAMS_KIND_COUNT = 5;
+        public const int SPH_SOLVER_FORCE32 = 2147483647;
+        public const int SPH_PARAMS_KIND_COUNT = 6;
         public const int SPH_PARAMS_KIND_FORCE32 = 2147483647;
         public const int SPH_PARAM_TYPE_FORCE32 = 2147483647;
         public const int SPH_BOUND_FORCE32 = 2147483647;
@@ -186,7 +199,10 @@ namespace Sph
         Velocity = 1,
         /// <summary>float32, kg/m^3, from the last density evaluation</summary>
         Density = 2,
-        /// <summary>float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation</summary>
+        /// <summary>
+        /// float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure its
+        /// density solve found in the last substep
+        /// </summary>
         Pressure = 3,
         /// <summary>uint32, persistent particle id, unique within a world</summary>
         Id = 4,
@@ -201,7 +217,7 @@ namespace Sph
         CellRanges = 1,
         /// <summary>density and pressure</summary>
         Density = 2,
-        /// <summary>pressure, viscosity and external forces</summary>
+        /// <summary>pressure, viscosity and external forces (DFSPH: and its two solves)</summary>
         Forces = 3,
         /// <summary>time integration, max-speed reduction, next step size</summary>
         Integrate = 4,
@@ -237,6 +253,24 @@ namespace Sph
         Tait = 1,
     }
 
+    /// <summary>sph_solver: The pressure solver, fixed at world creation (docs/physics.md, "Solvers").</summary>
+    public enum Solver : int
+    {
+        /// <summary>
+        /// the thesis's weakly compressible SPH: pressure from the equation of state, explicit steps
+        /// under the acoustic ceiling 0.4 h / c
+        /// </summary>
+        Wcsph = 0,
+        /// <summary>
+        /// divergence-free SPH (Bender &amp; Koschier 2015, 2017): pressure from two iterative solves
+        /// that hold the density error below a bound (sph_dfsph_params); steps bounded by the flow
+        /// speed alone. No equation of state: the stiffness, Tait's parameters and
+        /// SPH_STEP_LIMIT_ACOUSTIC have no effect. Not with SPH_INTEGRATOR_RK4, SPH_EOS_TAIT or
+        /// SPH_FEATURE_NORMALIZED_DENSITY (SPH_ERROR_UNSUPPORTED at creation)
+        /// </summary>
+        Dfsph = 1,
+    }
+
     /// <summary>sph_params_kind</summary>
     public enum ParamsKind : int
     {
@@ -250,6 +284,8 @@ namespace Sph
         Tait = 3,
         /// <summary>sph_spring_params</summary>
         Springs = 4,
+        /// <summary>sph_dfsph_params</summary>
+        Dfsph = 5,
     }
 
     /// <summary>sph_param_type</summary>
@@ -296,6 +332,8 @@ namespace Sph
         Viscosity = 2,
         /// <summary>sph_world_def.equation_of_state == value</summary>
         EquationOfState = 3,
+        /// <summary>sph_world_def.solver == value</summary>
+        Solver = 4,
     }
 
     /// <summary>sph_memory_kind</summary>
@@ -377,6 +415,16 @@ namespace Sph
         SourceCapacityReached = 1,
         /// <summary>object: the sink; count: particles removed</summary>
         SinkRemoved = 2,
+        /// <summary>
+        /// DFSPH; object: none (0); count: substeps whose density solve stopped at max_iterations above
+        /// its bound
+        /// </summary>
+        PressureSolveCapped = 3,
+        /// <summary>
+        /// DFSPH; object: none (0); count: substeps whose divergence solve stopped at its cap above its
+        /// bound
+        /// </summary>
+        DivergenceSolveCapped = 4,
     }
 
     /// <summary>
@@ -674,7 +722,7 @@ namespace Sph
     }
 
     /// <summary>
-    /// sph_world_def (40 bytes): Creation-time description of a world; fixed for the world's life. Zero
+    /// sph_world_def (44 bytes): Creation-time description of a world; fixed for the world's life. Zero
     /// means default for every field: a zeroed def is the def sph_world_def_init gives.
     /// </summary>
     [StructLayout(LayoutKind.Sequential)]
@@ -700,6 +748,8 @@ namespace Sph
         public float RestDensity;
         /// <summary>sph_equation_of_state equation_of_state: default SPH_EOS_IDEAL_GAS</summary>
         public EquationOfState EquationOfState;
+        /// <summary>sph_solver solver: default SPH_SOLVER_WCSPH</summary>
+        public Solver Solver;
 
         /// <summary>A WorldDef with the library's defaults (sph_world_def_init_sized).</summary>
         public static WorldDef Default()
@@ -718,7 +768,10 @@ namespace Sph
     {
         /// <summary>uint32_t struct_size: sizeof(sph_world_params), set by sph_world_params_init</summary>
         public uint StructSize;
-        /// <summary>uint32_t max_substeps: most substeps one sph_world_step may take; default 10000; 0 = default</summary>
+        /// <summary>
+        /// uint32_t max_substeps: most substeps one sph_world_step may take; default 10000; 0 =
+        /// default; at most 1000000 (a bound on one call's cost; see also the step budget)
+        /// </summary>
         public uint MaxSubsteps;
         /// <summary>sph_vec3 gravity: m/s^2; default (0, -9.81, 0); finite; 0 is no gravity</summary>
         public Vec3 Gravity;
@@ -876,6 +929,47 @@ namespace Sph
         }
     }
 
+    /// <summary>sph_dfsph_params (24 bytes)</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public partial struct DfsphParams
+    {
+        /// <summary>uint32_t struct_size: set by sph_dfsph_params_init</summary>
+        public uint StructSize;
+        /// <summary>
+        /// float density_error: bound on the density solve's mean error, the mean over the particles of
+        /// max(rho* - rho0, 0) / rho0 (rho*: the density the step would give); dimensionless; default
+        /// 0.001 (0.1 %); in (0, 1]; 0 = default
+        /// </summary>
+        public float DensityError;
+        /// <summary>
+        /// float divergence_error: bound on the divergence solve's mean of max(D rho / Dt, 0) / rho0,
+        /// 1/s; default 1; &gt; 0; 0 = default
+        /// </summary>
+        public float DivergenceError;
+        /// <summary>
+        /// uint32_t max_iterations: cap of the density solve per substep; default 100; &gt;= 2; 0 =
+        /// default. A solve that stops here above its bound is counted in sph_stats and reported as an
+        /// event
+        /// </summary>
+        public uint MaxIterations;
+        /// <summary>
+        /// uint32_t max_divergence_iterations: cap of the divergence solve; default 100; &gt;= 1; 0 =
+        /// default
+        /// </summary>
+        public uint MaxDivergenceIterations;
+        /// <summary>uint32_t flags: SPH_DFSPH_* bits; default 0</summary>
+        public uint Flags;
+
+        /// <summary>A DfsphParams with the library's defaults (sph_dfsph_params_init_sized).</summary>
+        public static DfsphParams Default()
+        {
+            var value = new DfsphParams();
+            uint size = (uint)Marshal.SizeOf(typeof(DfsphParams));
+            SphException.Check(Native.sph_dfsph_params_init_sized(ref value, size), "sph_dfsph_params_init_sized");
+            return value;
+        }
+    }
+
     /// <summary>sph_params_info (32 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct ParamsInfo
@@ -952,7 +1046,10 @@ namespace Sph
         public uint MethodCount;
         /// <summary>sph_method_switch switch_by: the sph_world_def field that selects it</summary>
         public MethodSwitch SwitchBy;
-        /// <summary>uint32_t value: the SPH_FEATURE_* bit, sph_viscosity_method or sph_equation_of_state</summary>
+        /// <summary>
+        /// uint32_t value: the SPH_FEATURE_* bit, sph_viscosity_method, sph_equation_of_state or
+        /// sph_solver
+        /// </summary>
         public uint Value;
         /// <summary>uint32_t has_params: 1 when its parameters are in the struct of params_kind</summary>
         public uint HasParams;
@@ -1060,7 +1157,7 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_stats (104 bytes)</summary>
+    /// <summary>sph_stats (144 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct Stats
     {
@@ -1101,6 +1198,36 @@ namespace Sph
         /// CUDA backend)
         /// </summary>
         public ulong MemoryBytes;
+        /// <summary>
+        /// uint32_t pressure_iterations: DFSPH's two solves over the substeps of the last step (all
+        /// zero on a WCSPH world). An iteration is one velocity update and one new residual, after the
+        /// warm start's.
+        /// </summary>
+        public uint PressureIterations;
+        /// <summary>uint32_t pressure_iterations_max: most in one substep</summary>
+        public uint PressureIterationsMax;
+        /// <summary>uint32_t divergence_iterations: the divergence solve's iterations, summed</summary>
+        public uint DivergenceIterations;
+        /// <summary>uint32_t divergence_iterations_max: most in one substep</summary>
+        public uint DivergenceIterationsMax;
+        /// <summary>
+        /// float density_error_mean: the density solve's achieved mean error (see
+        /// sph_dfsph_params.density_error), averaged over the substeps
+        /// </summary>
+        public float DensityErrorMean;
+        /// <summary>float density_error_max: the largest of any substep</summary>
+        public float DensityErrorMax;
+        /// <summary>float divergence_error_mean: the divergence solve's achieved mean error, 1/s</summary>
+        public float DivergenceErrorMean;
+        /// <summary>float divergence_error_max: the largest of any substep</summary>
+        public float DivergenceErrorMax;
+        /// <summary>
+        /// uint32_t pressure_solves_capped: substeps whose density solve stopped at its cap above its
+        /// bound (also SPH_EVENT_PRESSURE_SOLVE_CAPPED)
+        /// </summary>
+        public uint PressureSolvesCapped;
+        /// <summary>uint32_t divergence_solves_capped: likewise (SPH_EVENT_DIVERGENCE_SOLVE_CAPPED)</summary>
+        public uint DivergenceSolvesCapped;
 
         /// <summary>A Stats with the library's defaults (sph_stats_init_sized).</summary>
         public static Stats Default()
@@ -1401,6 +1528,42 @@ namespace Sph
             var value = new ColliderMaterial();
             uint size = (uint)Marshal.SizeOf(typeof(ColliderMaterial));
             SphException.Check(Native.sph_collider_material_init_sized(ref value, size), "sph_collider_material_init_sized");
+            return value;
+        }
+    }
+
+    /// <summary>
+    /// sph_collider_loads (56 bytes): The fluid's loads on a collider over the last sph_world_step
+    /// (SPH_FEATURE_COLLIDER_LOADS): the time averages over the step's substeps of the force and of the
+    /// torque about the collider's load point, in world coordinates. What counts: the momentum the
+    /// collision response took from particles (contacts, friction, stickiness) and, with
+    /// SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions; force times frame_time is the
+    /// impulse the fluid gave the collider. The torque of each impulse is taken about the load point
+    /// posed at the impulse's time (it moves with the collider). Zero before the first step (frame_time
+    /// 0). docs/physics.md "Loads".
+    /// </summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public partial struct ColliderLoads
+    {
+        /// <summary>uint32_t struct_size: set by sph_collider_loads_init</summary>
+        public uint StructSize;
+        /// <summary>uint32_t reserved0: written as 0</summary>
+        public uint Reserved0;
+        /// <summary>sph_vec3 force: N, world frame</summary>
+        public Vec3 Force;
+        /// <summary>sph_vec3 torque: N m, world frame, about point</summary>
+        public Vec3 Torque;
+        /// <summary>sph_vec3 point: the load point in the world at the end of the step, m</summary>
+        public Vec3 Point;
+        /// <summary>double frame_time: s: the time the step advanced, over which force and torque are averaged</summary>
+        public double FrameTime;
+
+        /// <summary>A ColliderLoads with the library's defaults (sph_collider_loads_init_sized).</summary>
+        public static ColliderLoads Default()
+        {
+            var value = new ColliderLoads();
+            uint size = (uint)Marshal.SizeOf(typeof(ColliderLoads));
+            SphException.Check(Native.sph_collider_loads_init_sized(ref value, size), "sph_collider_loads_init_sized");
             return value;
         }
     }
@@ -1794,8 +1957,9 @@ namespace Sph
         /// FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass).
         /// Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range:
         /// capacity above 2^30, spacing &lt; 0 or non-finite, kernel_radius &lt; spacing, rest_density
-        /// &lt; 0), UNSUPPORTED (unknown integrator or feature bit), VERSION_MISMATCH,
-        /// OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY. *out is written only on success.
+        /// &lt; 0), UNSUPPORTED (unknown integrator, feature bit, method or solver; a combination a
+        /// solver does not support, see sph_solver), VERSION_MISMATCH, OUT_OF_HOST_MEMORY,
+        /// OUT_OF_DEVICE_MEMORY. *out is written only on success.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_create(ContextHandle context, ref WorldDef def, out WorldHandle @out);
@@ -1920,6 +2084,27 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_spring_params")]
         public static extern Result sph_world_get_spring_params(IntPtr world, IntPtr @out);
 
+        /// <summary>sph_dfsph_params_init_sized</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_dfsph_params_init_sized(ref DfsphParams @params, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_dfsph_params_init_sized")]
+        public static extern Result sph_dfsph_params_init_sized(IntPtr @params, uint size);
+
+        /// <summary>
+        /// FEATURE_DISABLED unless the world's solver is SPH_SOLVER_DFSPH. INVALID_ARGUMENT for a value
+        /// out of range (the message names it); nothing changes on error. Acts from the next substep.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_set_dfsph_params(WorldHandle world, ref DfsphParams @params);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_set_dfsph_params")]
+        public static extern Result sph_world_set_dfsph_params(IntPtr world, IntPtr @params);
+
+        /// <summary>sph_world_get_dfsph_params</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_get_dfsph_params(WorldHandle world, ref DfsphParams @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_dfsph_params")]
+        public static extern Result sph_world_get_dfsph_params(IntPtr world, IntPtr @out);
+
         /// <summary>
         /// Replaces the params struct of `kind` at once, as its typed set call does
         /// (sph_world_set_params, sph_world_set_tait_params, ...): params points to that struct,
@@ -2032,14 +2217,51 @@ namespace Sph
         /// Advances the world by frame_dt seconds (&gt; 0, finite) in adaptive substeps: each substep's
         /// dt = step_factor * h / v_max clamped to [dt_min, dt_max], shortened at the end so that the
         /// substeps add up to frame_dt exactly (the last one or two may be shorter than dt_min). Blocks
-        /// until the frame is done. Returns SPH_INCOMPLETE if max_substeps ran out first
-        /// (sph_stats.frame_time says how far it got). SPH_ERROR_NON_FINITE if a substep produced a
-        /// NaN/Inf: the world is restored to its state before this call.
+        /// until the frame is done. Returns SPH_INCOMPLETE if max_substeps ran out first, or the step
+        /// budget (sph_world_set_step_budget) or a cancel (sph_world_cancel_step) stopped it: the world
+        /// is then as after its last whole substep, consistent and ready to step again
+        /// (sph_stats.frame_time and substeps say how far it got). SPH_ERROR_NON_FINITE if a substep
+        /// produced a NaN/Inf, SPH_ERROR_CAPACITY if more particles than 64 times the rest density
+        /// allows piled into one cell of side h (the neighbour work would grow with their square; the
+        /// message says where): the world is restored to its state before this call.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_step(WorldHandle world, float frameDt);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_step")]
         public static extern Result sph_world_step(IntPtr world, float frameDt);
+
+        /// <summary>
+        /// Bounds the wall-clock time of each later sph_world_step of this world: a step still running
+        /// max_seconds after it began stops at its next substep boundary and returns SPH_INCOMPLETE
+        /// (one substep may overrun the budget). Both backends check it between substeps: the CUDA
+        /// backend runs a frame with a budget on its stream driver instead of its device graph (one
+        /// host synchronisation a substep). 0 (the default) is no budget. Not saved in checkpoints.
+        /// Errors: INVALID_HANDLE, INVALID_ARGUMENT (NaN, negative or above 86400), WORLD_LOCKED.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_set_step_budget(WorldHandle world, double maxSeconds);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_set_step_budget")]
+        public static extern Result sph_world_set_step_budget(IntPtr world, double maxSeconds);
+
+        /// <summary>The step budget in seconds (0: none). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL).</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_get_step_budget(WorldHandle world, out double outSeconds);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_step_budget")]
+        public static extern Result sph_world_get_step_budget(IntPtr world, IntPtr outSeconds);
+
+        /// <summary>
+        /// Asks the world's step to stop at its next substep boundary (it returns SPH_INCOMPLETE with
+        /// the world consistent; on the CUDA backend a frame on the device graph, which is every frame
+        /// without a step budget or sinks, sees it only at its end). The one call that may run on
+        /// another thread while a step holds the world: it never blocks and never answers WORLD_LOCKED.
+        /// A request made while no step runs stops the next step before its first substep (that step
+        /// changes nothing and reports 0 substeps); a step that stops for it clears it. Errors:
+        /// INVALID_HANDLE (NULL or destroyed: safe to call racing sph_world_destroy).
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_cancel_step(WorldHandle world);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_cancel_step")]
+        public static extern Result sph_world_cancel_step(IntPtr world);
 
         /// <summary>Number of particles in the world.</summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
@@ -2243,6 +2465,35 @@ namespace Sph
         public static extern Result sph_collider_get_material(WorldHandle world, ColliderId id, ref ColliderMaterial @out);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_get_material")]
         public static extern Result sph_collider_get_material(IntPtr world, ColliderId id, IntPtr @out);
+
+        /// <summary>sph_collider_loads_init_sized</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_collider_loads_init_sized(ref ColliderLoads loads, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_loads_init_sized")]
+        public static extern Result sph_collider_loads_init_sized(IntPtr loads, uint size);
+
+        /// <summary>
+        /// Reads a collider's loads of the last step. Non-blocking (the step brought them to the host).
+        /// out-&gt;struct_size must be set (sph_collider_loads_init); only that many bytes are written.
+        /// Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (NULL out),
+        /// VERSION_MISMATCH, FEATURE_DISABLED (the world lacks SPH_FEATURE_COLLIDER_LOADS),
+        /// WORLD_LOCKED.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_collider_get_loads(WorldHandle world, ColliderId id, ref ColliderLoads @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_get_loads")]
+        public static extern Result sph_collider_get_loads(IntPtr world, ColliderId id, IntPtr @out);
+
+        /// <summary>
+        /// Sets the point, in the collider's own frame, that its loads' torque is taken about (default
+        /// its origin; an engine passes the body's centre of mass). Acts from the next step. Errors:
+        /// INVALID_HANDLE, INVALID_ARGUMENT (NULL point; a non-finite component, named),
+        /// FEATURE_DISABLED, WORLD_LOCKED. Nothing changes on error.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_collider_set_load_point(WorldHandle world, ColliderId id, ref Vec3 point);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_set_load_point")]
+        public static extern Result sph_collider_set_load_point(IntPtr world, ColliderId id, IntPtr point);
 
         /// <summary>sph_source_def_init_sized</summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
@@ -2501,6 +2752,7 @@ namespace Sph
             typeof(ClavetViscosityParams),
             typeof(TaitParams),
             typeof(SpringParams),
+            typeof(DfsphParams),
             typeof(ParamsInfo),
             typeof(ParamFieldInfo),
             typeof(PhysicsMethodInfo),
@@ -2517,6 +2769,7 @@ namespace Sph
             typeof(ColliderId),
             typeof(ColliderDef),
             typeof(ColliderMaterial),
+            typeof(ColliderLoads),
             typeof(SourceId),
             typeof(SourceDef),
             typeof(SinkId),
@@ -2535,6 +2788,7 @@ namespace Sph
             "sph_clavet_viscosity_params",
             "sph_tait_params",
             "sph_spring_params",
+            "sph_dfsph_params",
             "sph_params_info",
             "sph_param_field_info",
             "sph_physics_method_info",
@@ -2551,6 +2805,7 @@ namespace Sph
             "sph_collider_id",
             "sph_collider_def",
             "sph_collider_material",
+            "sph_collider_loads",
             "sph_source_id",
             "sph_source_def",
             "sph_sink_id",
@@ -2563,19 +2818,20 @@ namespace Sph
         public static readonly int[] StructSizes = {
             12,
             56,
-            40,
+            44,
             48,
             16,
             16,
             8,
             28,
+            24,
             32,
             72,
             32,
             40,
             44,
             36,
-            104,
+            144,
             80,
             104,
             44,
@@ -2585,6 +2841,7 @@ namespace Sph
             8,
             64,
             16,
+            56,
             8,
             80,
             8,
@@ -2622,6 +2879,7 @@ namespace Sph
             typeof(WorldDef),
             typeof(WorldDef),
             typeof(WorldDef),
+            typeof(WorldDef),
             typeof(WorldParams),
             typeof(WorldParams),
             typeof(WorldParams),
@@ -2649,6 +2907,12 @@ namespace Sph
             typeof(SpringParams),
             typeof(SpringParams),
             typeof(SpringParams),
+            typeof(DfsphParams),
+            typeof(DfsphParams),
+            typeof(DfsphParams),
+            typeof(DfsphParams),
+            typeof(DfsphParams),
+            typeof(DfsphParams),
             typeof(ParamsInfo),
             typeof(ParamsInfo),
             typeof(ParamsInfo),
@@ -2690,6 +2954,16 @@ namespace Sph
             typeof(FillSphereDesc),
             typeof(FillSphereDesc),
             typeof(FillSphereDesc),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
             typeof(Stats),
             typeof(Stats),
             typeof(Stats),
@@ -2757,6 +3031,12 @@ namespace Sph
             typeof(ColliderMaterial),
             typeof(ColliderMaterial),
             typeof(ColliderMaterial),
+            typeof(ColliderLoads),
+            typeof(ColliderLoads),
+            typeof(ColliderLoads),
+            typeof(ColliderLoads),
+            typeof(ColliderLoads),
+            typeof(ColliderLoads),
             typeof(SourceId),
             typeof(SourceDef),
             typeof(SourceDef),
@@ -2827,6 +3107,7 @@ namespace Sph
             "KernelRadius",
             "RestDensity",
             "EquationOfState",
+            "Solver",
             "StructSize",
             "MaxSubsteps",
             "Gravity",
@@ -2854,6 +3135,12 @@ namespace Sph
             "Plasticity",
             "Damping",
             "Reserved0",
+            "StructSize",
+            "DensityError",
+            "DivergenceError",
+            "MaxIterations",
+            "MaxDivergenceIterations",
+            "Flags",
             "StructSize",
             "ParamsSize",
             "FieldCount",
@@ -2912,6 +3199,16 @@ namespace Sph
             "StepMs",
             "Reserved0",
             "MemoryBytes",
+            "PressureIterations",
+            "PressureIterationsMax",
+            "DivergenceIterations",
+            "DivergenceIterationsMax",
+            "DensityErrorMean",
+            "DensityErrorMax",
+            "DivergenceErrorMean",
+            "DivergenceErrorMax",
+            "PressureSolvesCapped",
+            "DivergenceSolvesCapped",
             "StructSize",
             "Dims",
             "IndexToLocal",
@@ -2962,6 +3259,12 @@ namespace Sph
             "Restitution",
             "Friction",
             "Stickiness",
+            "StructSize",
+            "Reserved0",
+            "Force",
+            "Torque",
+            "Point",
+            "FrameTime",
             "Bits",
             "StructSize",
             "Mode",
@@ -3032,6 +3335,7 @@ namespace Sph
             28,
             32,
             36,
+            40,
             0,
             4,
             8,
@@ -3059,6 +3363,12 @@ namespace Sph
             16,
             20,
             24,
+            0,
+            4,
+            8,
+            12,
+            16,
+            20,
             0,
             4,
             8,
@@ -3117,6 +3427,16 @@ namespace Sph
             88,
             92,
             96,
+            104,
+            108,
+            112,
+            116,
+            120,
+            124,
+            128,
+            132,
+            136,
+            140,
             0,
             4,
             16,
@@ -3167,6 +3487,12 @@ namespace Sph
             4,
             8,
             12,
+            0,
+            4,
+            8,
+            20,
+            32,
+            48,
             0,
             0,
             4,
@@ -3244,6 +3570,9 @@ namespace Sph
             "sph_spring_params_init_sized",
             "sph_world_set_spring_params",
             "sph_world_get_spring_params",
+            "sph_dfsph_params_init_sized",
+            "sph_world_set_dfsph_params",
+            "sph_world_get_dfsph_params",
             "sph_world_set_physics_params",
             "sph_world_get_physics_params",
             "sph_params_info_init_sized",
@@ -3259,6 +3588,9 @@ namespace Sph
             "sph_fill_sphere_desc_init_sized",
             "sph_world_fill_sphere",
             "sph_world_step",
+            "sph_world_set_step_budget",
+            "sph_world_get_step_budget",
+            "sph_world_cancel_step",
             "sph_world_get_particle_count",
             "sph_world_copy_attribute",
             "sph_stats_init_sized",
@@ -3284,6 +3616,9 @@ namespace Sph
             "sph_collider_material_init_sized",
             "sph_collider_set_material",
             "sph_collider_get_material",
+            "sph_collider_loads_init_sized",
+            "sph_collider_get_loads",
+            "sph_collider_set_load_point",
             "sph_source_def_init_sized",
             "sph_source_create",
             "sph_source_destroy",
@@ -3314,6 +3649,15 @@ namespace Sph
         };
         /// <summary>The shared library of each function ("sph", or an optional helper).</summary>
         public static readonly string[] FunctionLibraries = {
+            "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
             "sph",
             "sph",
             "sph",
@@ -3444,12 +3788,12 @@ namespace Sph
             { "SPH_ATTRIBUTE_POSITION", "3 x float32, metres" },
             { "SPH_ATTRIBUTE_VELOCITY", "3 x float32, metres per second" },
             { "SPH_ATTRIBUTE_DENSITY", "float32, kg/m^3, from the last density evaluation" },
-            { "SPH_ATTRIBUTE_PRESSURE", "float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation" },
+            { "SPH_ATTRIBUTE_PRESSURE", "float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure its density solve found in the last substep" },
             { "SPH_ATTRIBUTE_ID", "uint32, persistent particle id, unique within a world" },
             { "SPH_STAGE_HASH_SORT", "cell hash, stable sort, reorder of every attribute" },
             { "SPH_STAGE_CELL_RANGES", "start/end of each cell" },
             { "SPH_STAGE_DENSITY", "density and pressure" },
-            { "SPH_STAGE_FORCES", "pressure, viscosity and external forces" },
+            { "SPH_STAGE_FORCES", "pressure, viscosity and external forces (DFSPH: and its two solves)" },
             { "SPH_STAGE_INTEGRATE", "time integration, max-speed reduction, next step size" },
             { "SPH_STAGE_COLLIDE", "particles against colliders (CPU; the CUDA backend does it inside the forces kernel, so it counts under SPH_STAGE_FORCES there)" },
             { "SPH_STAGE_EMIT", "sinks removing particles; sources emit before the substeps and count only in sph_stats.step_ms" },
@@ -3458,11 +3802,14 @@ namespace Sph
             { "SPH_VISCOSITY_CLAVET", "radial impulses between approaching pairs (eq. 18-19), sph_clavet_viscosity_params" },
             { "SPH_EOS_IDEAL_GAS", "the thesis's modified ideal gas p = k (rho - rho0) (eq. 15)" },
             { "SPH_EOS_TAIT", "p = B ((rho / rho0)^7 - 1), B = rho0 c^2 / 7, sph_tait_params" },
+            { "SPH_SOLVER_WCSPH", "the thesis's weakly compressible SPH: pressure from the equation of state, explicit steps under the acoustic ceiling 0.4 h / c" },
+            { "SPH_SOLVER_DFSPH", "divergence-free SPH (Bender & Koschier 2015, 2017): pressure from two iterative solves that hold the density error below a bound (sph_dfsph_params); steps bounded by the flow speed alone. No equation of state: the stiffness, Tait's parameters and SPH_STEP_LIMIT_ACOUSTIC have no effect. Not with SPH_INTEGRATOR_RK4, SPH_EOS_TAIT or SPH_FEATURE_NORMALIZED_DENSITY (SPH_ERROR_UNSUPPORTED at creation)" },
             { "SPH_PARAMS_WORLD", "sph_world_params" },
             { "SPH_PARAMS_SURFACE_TENSION", "sph_surface_tension_params" },
             { "SPH_PARAMS_CLAVET_VISCOSITY", "sph_clavet_viscosity_params" },
             { "SPH_PARAMS_TAIT", "sph_tait_params" },
             { "SPH_PARAMS_SPRINGS", "sph_spring_params" },
+            { "SPH_PARAMS_DFSPH", "sph_dfsph_params" },
             { "SPH_PARAM_FLOAT", "float, finite" },
             { "SPH_PARAM_VEC3", "sph_vec3, every component finite" },
             { "SPH_PARAM_UINT32", "uint32_t count" },
@@ -3476,6 +3823,7 @@ namespace Sph
             { "SPH_METHOD_SWITCH_FEATURE", "a bit of sph_world_def.features (value)" },
             { "SPH_METHOD_SWITCH_VISCOSITY", "sph_world_def.viscosity_method == value" },
             { "SPH_METHOD_SWITCH_EQUATION_OF_STATE", "sph_world_def.equation_of_state == value" },
+            { "SPH_METHOD_SWITCH_SOLVER", "sph_world_def.solver == value" },
             { "SPH_MEMORY_HOST", "ordinary host memory" },
             { "SPH_MEMORY_CUDA_DEVICE", "device memory of the context's CUDA device (CUDA contexts only)" },
             { "SPH_SHAPE_PLANE", "solid below y = 0; half_extents.x/.z its size, .y its thickness" },
@@ -3495,6 +3843,8 @@ namespace Sph
             { "SPH_FORCE_FIELD_GRID", "accelerations from a user grid (3 components, field frame)" },
             { "SPH_EVENT_SOURCE_CAPACITY_REACHED", "object: the source; count: particles not emitted" },
             { "SPH_EVENT_SINK_REMOVED", "object: the sink; count: particles removed" },
+            { "SPH_EVENT_PRESSURE_SOLVE_CAPPED", "DFSPH; object: none (0); count: substeps whose density solve stopped at max_iterations above its bound" },
+            { "SPH_EVENT_DIVERGENCE_SOLVE_CAPPED", "DFSPH; object: none (0); count: substeps whose divergence solve stopped at its cap above its bound" },
         };
     }
 }

@@ -230,6 +230,9 @@ namespace Sph
         /// <summary>Walls in the density: colliders count in the density sums and push back through
         /// the pressure force (a density map per SDF asset; docs/physics.md).</summary>
         BoundaryDensity = Constants.SPH_FEATURE_BOUNDARY_DENSITY,
+        /// <summary>Loads on colliders: the fluid's force and torque on each collider over every
+        /// step (<see cref="Collider.Loads"/>; docs/physics.md).</summary>
+        ColliderLoads = Constants.SPH_FEATURE_COLLIDER_LOADS,
     }
 
     /// <summary>Step-size limits beyond eq. 32 (SPH_STEP_LIMIT_*): set them with
@@ -579,6 +582,24 @@ namespace Sph
             set { SphException.Check(Native.sph_world_set_spring_params(Handle, ref value), "sph_world_set_spring_params"); }
         }
 
+        /// <summary>DFSPH's parameters (the bound on the density solve's mean error, that of the
+        /// divergence solve in 1/s, the two iteration caps, flags) of a world created with
+        /// <c>Solver.Dfsph</c>; setting replaces them whole. Throws SphException
+        /// (<c>Result.ErrorFeatureDisabled</c>) on a weakly compressible world.</summary>
+        public DfsphParams DfsphParams
+        {
+            get
+            {
+                var p = DfsphParams.Default();
+                SphException.Check(Native.sph_world_get_dfsph_params(Handle, ref p), "sph_world_get_dfsph_params");
+                return p;
+            }
+            set { SphException.Check(Native.sph_world_set_dfsph_params(Handle, ref value), "sph_world_set_dfsph_params"); }
+        }
+
+        /// <summary>The solver the world was created with (WorldDef.Solver).</summary>
+        public Solver Solver { get { return Def.Solver; } }
+
         /// <summary>The params struct of <paramref name="kind"/> (T must be its struct:
         /// WorldParams for ParamsKind.World, TaitParams for ParamsKind.Tait, ...), read from the
         /// world (sph_world_get_physics_params).</summary>
@@ -694,6 +715,26 @@ namespace Sph
         public Result Step(float frameDt)
         {
             return SphException.Check(Native.sph_world_step(Handle, frameDt), "sph_world_step");
+        }
+
+        /// <summary>Wall-clock seconds one Step may take before it stops at a substep boundary
+        /// and returns Incomplete; 0 is no budget (sph_world_set/get_step_budget).</summary>
+        public double StepBudget
+        {
+            get
+            {
+                double seconds;
+                SphException.Check(Native.sph_world_get_step_budget(Handle, out seconds), "sph_world_get_step_budget");
+                return seconds;
+            }
+            set { SphException.Check(Native.sph_world_set_step_budget(Handle, value), "sph_world_set_step_budget"); }
+        }
+
+        /// <summary>Asks the Step running on another thread (or else the next one) to stop at its
+        /// next substep boundary, returning Incomplete. Safe from any thread while the world steps.</summary>
+        public void CancelStep()
+        {
+            SphException.Check(Native.sph_world_cancel_step(Handle), "sph_world_cancel_step");
         }
 
         // ---- particles out --------------------------------------------------------------------
@@ -1198,6 +1239,26 @@ namespace Sph
             m.Friction = friction;
             m.Stickiness = stickiness;
             Material = m;
+        }
+
+        /// <summary>The fluid's loads on the collider over the last Step (time averages of the force
+        /// and of the torque about the load point, world frame); needs
+        /// <see cref="FeatureFlags.ColliderLoads"/>.</summary>
+        public ColliderLoads Loads
+        {
+            get
+            {
+                var l = ColliderLoads.Default();
+                SphException.Check(Native.sph_collider_get_loads(World.Handle, Id, ref l), "sph_collider_get_loads");
+                return l;
+            }
+        }
+
+        /// <summary>The point, in the collider's own frame, that the loads' torque is taken about
+        /// (default its origin; pass the body's centre of mass).</summary>
+        public void SetLoadPoint(Vec3 point)
+        {
+            SphException.Check(Native.sph_collider_set_load_point(World.Handle, Id, ref point), "sph_collider_set_load_point");
         }
 
         /// <summary>Removes the collider (idempotent).</summary>

@@ -99,6 +99,7 @@ SPH_API sph_result SPH_CALL sph_get_physics_method_info(uint32_t index, sph_phys
 
 static_assert(static_cast<uint32_t>(sph::SwitchKind::Feature) == SPH_METHOD_SWITCH_FEATURE &&
                   static_cast<uint32_t>(sph::SwitchKind::Viscosity) == SPH_METHOD_SWITCH_VISCOSITY &&
+                  static_cast<uint32_t>(sph::SwitchKind::Solver) == SPH_METHOD_SWITCH_SOLVER &&
                   static_cast<uint32_t>(sph::SwitchKind::EquationOfState) ==
                       SPH_METHOD_SWITCH_EQUATION_OF_STATE,
               "SwitchKind equals sph_method_switch");

@@ -51,6 +51,12 @@ const std::vector<ParamsBinding>& params_bindings() {
            SPH_AT(sph_spring_params, yield_ratio), SPH_AT(sph_spring_params, plasticity),
            SPH_AT(sph_spring_params, damping)},
           {{"reserved0", SPH_AT(sph_spring_params, reserved0)}}),
+      option<Dfsph, sph_dfsph_params>(
+          SPH_PARAMS_DFSPH, "sph_dfsph_params", "SPH_SOLVER_DFSPH",
+          {SPH_AT(sph_dfsph_params, density_error), SPH_AT(sph_dfsph_params, divergence_error),
+           SPH_AT(sph_dfsph_params, max_iterations), SPH_AT(sph_dfsph_params, max_divergence_iterations),
+           SPH_AT(sph_dfsph_params, flags)},
+          {}),
   };
 #undef SPH_AT
   for (const ParamsBinding& b : table)
@@ -185,6 +191,16 @@ SPH_API sph_result SPH_CALL sph_world_set_spring_params(sph_world* world, const 
 }
 SPH_API sph_result SPH_CALL sph_world_get_spring_params(const sph_world* world, sph_spring_params* out) {
   return get_params("sph_world_get_spring_params", world, SPH_PARAMS_SPRINGS, out);
+}
+
+SPH_API sph_result SPH_CALL sph_dfsph_params_init_sized(sph_dfsph_params* params, uint32_t size) {
+  return init_params("sph_dfsph_params_init", SPH_PARAMS_DFSPH, params, size);
+}
+SPH_API sph_result SPH_CALL sph_world_set_dfsph_params(sph_world* world, const sph_dfsph_params* params) {
+  return set_params("sph_world_set_dfsph_params", world, SPH_PARAMS_DFSPH, params);
+}
+SPH_API sph_result SPH_CALL sph_world_get_dfsph_params(const sph_world* world, sph_dfsph_params* out) {
+  return get_params("sph_world_get_dfsph_params", world, SPH_PARAMS_DFSPH, out);
 }
 
 }  // extern "C"

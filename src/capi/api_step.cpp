@@ -1,4 +1,7 @@
-// Stepping and statistics.
+// Stepping (with its budget and cancel) and statistics.
+#include <chrono>
+#include <string>
+
 #include "guard.h"
 #include "handles.h"
 #include "init_struct.h"
@@ -8,6 +11,11 @@
 using sph::Error;
 using sph::Status;
 
+namespace sph {
+// A budget longer than a day is a mistake, not a bound.
+constexpr double kMaxStepBudgetSeconds = 86400.0;
+}  // namespace sph
+
 extern "C" {
 
 SPH_API sph_result SPH_CALL sph_world_step(sph_world* world, float frame_dt) {
@@ -15,12 +23,51 @@ SPH_API sph_result SPH_CALL sph_world_step(sph_world* world, float frame_dt) {
     sph::require_world(world);
     sph::WorldLock lock(world);
     sph::require_positive(frame_dt, "frame_dt");
+    sph::StepInterrupt interrupt;
+    interrupt.cancel = &world->cancel_requested;
+    if (world->step_budget_seconds > 0.0)
+      interrupt.deadline =
+          sph::StepInterrupt::Clock::now() + std::chrono::duration_cast<sph::StepInterrupt::Clock::duration>(
+                                                 std::chrono::duration<double>(world->step_budget_seconds));
     try {
-      return world->world->step(frame_dt) ? SPH_OK : SPH_INCOMPLETE;
+      const bool completed = world->world->step(frame_dt, interrupt);
+      if (world->world->last_report().interrupted) world->cancel_requested.store(0);
+      return completed ? SPH_OK : SPH_INCOMPLETE;
     } catch (const Error& e) {
       if (e.status() == Status::DeviceLost) world->device_lost = true;
       throw;
     }
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_world_set_step_budget(sph_world* world, double max_seconds) {
+  return sph::guarded("sph_world_set_step_budget", sph::context_of(world), [&] {
+    sph::require_world(world);
+    sph::WorldLock lock(world);
+    if (!(max_seconds >= 0.0 && max_seconds <= sph::kMaxStepBudgetSeconds))
+      sph::fail(Status::InvalidArgument,
+                "max_seconds: must be in [0, 86400] (0: no budget), got " + std::to_string(max_seconds));
+    world->step_budget_seconds = max_seconds;
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_world_get_step_budget(const sph_world* world, double* out_seconds) {
+  return sph::guarded("sph_world_get_step_budget", sph::context_of(world), [&] {
+    sph::require_world(world);
+    sph::WorldLock lock(world);
+    if (!out_seconds) sph::fail(Status::InvalidArgument, "out_seconds: is NULL");
+    *out_seconds = world->step_budget_seconds;
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_world_cancel_step(sph_world* world) {
+  return sph::guarded("sph_world_cancel_step", sph::context_of(world), [&] {
+    if (!world) sph::fail(Status::InvalidHandle, "world: is NULL");
+    if (!sph::raise_cancel(world))
+      sph::fail(Status::InvalidHandle, "world: is not a live sph_world (destroyed or foreign pointer)");
+    return SPH_OK;
   });
 }
 
@@ -52,6 +99,16 @@ SPH_API sph_result SPH_CALL sph_world_get_stats(const sph_world* world, sph_stat
     for (int i = 0; i < SPH_STAGE_COUNT; ++i) s.stage_ms[i] = r.stage_ms[i];
     s.step_ms = w.last_step_ms();
     s.memory_bytes = w.backend().memory_bytes();
+    s.pressure_iterations = r.pressure_solve.iterations;
+    s.pressure_iterations_max = r.pressure_solve.iterations_max;
+    s.divergence_iterations = r.divergence_solve.iterations;
+    s.divergence_iterations_max = r.divergence_solve.iterations_max;
+    s.density_error_mean = r.pressure_solve.error_mean;
+    s.density_error_max = r.pressure_solve.error_max;
+    s.divergence_error_mean = r.divergence_solve.error_mean;
+    s.divergence_error_max = r.divergence_solve.error_max;
+    s.pressure_solves_capped = r.pressure_solve.capped;
+    s.divergence_solves_capped = r.divergence_solve.capped;
     sph::write_output_struct(out, s, "out");
     return SPH_OK;
   });

@@ -25,7 +25,33 @@ sph_world_def default_world_def() {
   d.particle_spacing = 0.02f;
   d.kernel_radius = 0.0f;
   d.rest_density = 1000.0f;
+  d.solver = SPH_SOLVER_WCSPH;
   return d;
+}
+
+// DFSPH's combinations (docs/physics.md, "Solvers"): what it does not support is refused here,
+// naming the field, rather than run with a meaning the caller did not ask for.
+void require_dfsph_combination(const sph_world_def& d, uint32_t integrator, uint32_t eos) {
+  if (integrator == SPH_INTEGRATOR_RK4)
+    throw Error(Status::Unsupported,
+                "def->integrator: SPH_INTEGRATOR_RK4 with def->solver SPH_SOLVER_DFSPH; DFSPH is its own "
+                "time integration (a velocity update per solve, then positions), use "
+                "SPH_INTEGRATOR_SYMPLECTIC_EULER");
+  if (eos != SPH_EOS_IDEAL_GAS)
+    throw Error(Status::Unsupported,
+                "def->equation_of_state: SPH_SOLVER_DFSPH has no equation of state (its pressure comes from "
+                "its solves); leave it at SPH_EOS_IDEAL_GAS (unused)");
+  if (d.features & SPH_FEATURE_NORMALIZED_DENSITY)
+    throw Error(
+        Status::Unsupported,
+        "def->features: SPH_FEATURE_NORMALIZED_DENSITY with def->solver SPH_SOLVER_DFSPH; the carried "
+        "density factor corrects a weakly compressible surface, while DFSPH's density solve acts only "
+        "on compression, which a surface deficit never reads");
+  if (d.features & SPH_FEATURE_COLLIDER_LOADS)
+    throw Error(Status::Unsupported,
+                "def->features: SPH_FEATURE_COLLIDER_LOADS with def->solver SPH_SOLVER_DFSPH; the loads are "
+                "gathered from the weakly compressible pressure force and the collision response, which "
+                "DFSPH's solves do not yet report (issue 16/17)");
 }
 
 // Validates a def and resolves defaults into the internal configuration. Zero means default
@@ -60,6 +86,11 @@ sph::WorldConfig config_from_def(const sph_world_def& def) {
   if (!sph::selects_a_method(sph::SwitchKind::EquationOfState, eos))
     throw Error(Status::Unsupported, "def->equation_of_state: " + std::to_string(static_cast<int32_t>(eos)) +
                                          " is not an sph_equation_of_state value");
+  const uint32_t solver = sph::enum_bits(d.solver);
+  if (!sph::selects_a_method(sph::SwitchKind::Solver, solver))
+    throw Error(Status::Unsupported, "def->solver: " + std::to_string(static_cast<int32_t>(solver)) +
+                                         " is not an sph_solver value");
+  if (solver == SPH_SOLVER_DFSPH) require_dfsph_combination(d, integrator, eos);
   sph::require_positive(d.particle_spacing, "def->particle_spacing");
   sph::require_positive(d.rest_density, "def->rest_density");
   float h = d.kernel_radius;
@@ -90,6 +121,7 @@ sph::WorldConfig config_from_def(const sph_world_def& def) {
   c.integrator = static_cast<sph::Integrator>(integrator);
   c.viscosity_method = static_cast<sph::ViscosityMethod>(viscosity);
   c.equation_of_state = static_cast<sph::EquationOfState>(eos);
+  c.solver = static_cast<sph::Solver>(solver);
   c.particle_spacing = d.particle_spacing;
   c.kernel_radius = h;
   c.rest_density = d.rest_density;
@@ -161,6 +193,7 @@ SPH_API sph_result SPH_CALL sph_world_get_def(const sph_world* world, sph_world_
     d.integrator = static_cast<sph_integrator>(c.integrator);
     d.viscosity_method = static_cast<sph_viscosity_method>(c.viscosity_method);
     d.equation_of_state = static_cast<sph_equation_of_state>(c.equation_of_state);
+    d.solver = static_cast<sph_solver>(c.solver);
     d.particle_spacing = c.particle_spacing;
     d.kernel_radius = c.kernel_radius;
     d.rest_density = c.rest_density;

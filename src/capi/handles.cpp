@@ -78,6 +78,13 @@ Take try_take_world(const sph_world* world) {
 
 void release_world(const sph_world* world) { const_cast<sph_world*>(world)->busy.store(false); }
 
+bool raise_cancel(const sph_world* world) {
+  std::lock_guard<std::mutex> lock(registry_mutex());
+  if (!world || !live_locked(world, HandleKind::World)) return false;
+  const_cast<sph_world*>(world)->cancel_requested.store(1);
+  return true;
+}
+
 Take try_retire_world(sph_world* world) {
   std::lock_guard<std::mutex> lock(registry_mutex());
   if (!world || !live_locked(world, HandleKind::World)) return Take::NotLive;

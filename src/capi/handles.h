@@ -40,8 +40,12 @@ struct sph_sdf {
 struct sph_world {
   sph_context* context;
   std::unique_ptr<sph::World> world;
-  std::atomic<bool> busy{false};  // taken under the registry's mutex (WorldLock, destroy)
-  bool device_lost = false;       // read and written only while busy is held
+  std::atomic<bool> busy{false};     // taken under the registry's mutex (WorldLock, destroy)
+  bool device_lost = false;          // read and written only while busy is held
+  double step_budget_seconds = 0.0;  // 0: none (sph_world_set_step_budget); read while busy is held
+  // Raised by sph_world_cancel_step from any thread (under the registry's mutex, so never on a
+  // freed world), lowered by the step that it stopped.
+  std::atomic<uint32_t> cancel_requested{0};
 };
 
 namespace sph {
@@ -70,6 +74,8 @@ LogTarget log_target_of(const sph_sdf* sdf);
 enum class Take { Taken, NotLive, Busy };
 Take try_take_world(const sph_world* world);
 void release_world(const sph_world* world);
+// Raises a live world's cancel flag whether or not another call holds it; false if not live.
+bool raise_cancel(const sph_world* world);
 // Takes a world for destruction: as try_take_world, and on Taken the handle has left the
 // registry (and its context's count) in the same critical section; the caller deletes it.
 Take try_retire_world(sph_world* world);

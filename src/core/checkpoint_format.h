@@ -1,6 +1,7 @@
 // The checkpoint layout shared by the writer and the reader (docs/checkpoint.md). All numbers
-// little-endian; floats IEEE 754. Version 2 (version 1 differs only in the parameters section,
-// checkpoint_params.h; both load):
+// little-endian; floats IEEE 754. Version 3 (version 2 lacks the solver in CONF, the solves'
+// report in TIME and DFSPH's warm starts in PART; version 1 differs from 2 only in the
+// parameters section, checkpoint_params.h; all load):
 //   header (48 bytes): magic[8] "SPHCKPT\x1a", u32 format version, u32 flags (0), u32 writer
 //     backend, u32 writer library version, u64 payload size, u64 checksum, u32 section count,
 //     u32 reserved (0). The checksum is FNV-1a 64 over the header with the checksum field
@@ -16,7 +17,8 @@ namespace sph {
 namespace checkpoint {
 
 constexpr uint8_t kMagic[8] = {'S', 'P', 'H', 'C', 'K', 'P', 'T', 0x1a};
-constexpr uint32_t kFormatVersion = 2;          // what the writer writes
+constexpr uint32_t kFormatVersion = 3;          // what the writer writes
+constexpr uint32_t kFirstSolverVersion = 3;     // the first with the solver, its report and warm starts
 constexpr uint32_t kOldestReadableVersion = 1;  // the oldest the reader still loads
 constexpr size_t kHeaderSize = 48;
 constexpr size_t kChecksumOffset = 32;

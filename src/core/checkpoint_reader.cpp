@@ -12,8 +12,10 @@
 #include "../physics/kernels.h"
 #include "byte_io.h"
 #include "checkpoint.h"
+#include "checkpoint_fields.h"
 #include "checkpoint_format.h"
 #include "checkpoint_params.h"
+#include "checkpoint_scene_reader.h"
 #include "fcc_lattice.h"
 #include "field_error.h"
 #include "pose_rules.h"
@@ -23,117 +25,9 @@ namespace sph {
 namespace {
 
 using namespace checkpoint;
+using namespace checkpoint_read;
 
-[[noreturn]] void corrupt(const std::string& message) {
-  throw Error(Status::CorruptData, "checkpoint: " + message);
-}
-
-std::string hex32(uint32_t v) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "0x%08x", v);
-  return buf;
-}
-
-// Field readers that validate as they go; `name` is the field's path in messages.
-float finite(ByteReader& r, const std::string& name) {
-  const float v = r.f32();
-  if (!std::isfinite(v)) corrupt(r.what() + ": " + name + " is not finite");
-  return v;
-}
-
-float non_negative(ByteReader& r, const std::string& name) {
-  const float v = finite(r, name);
-  if (v < 0.0f) corrupt(r.what() + ": " + name + " is negative (" + std::to_string(v) + ")");
-  return v;
-}
-
-// A maximum of |v| or |a| over finite vectors: non-negative, and +infinity when a squared
-// length overflows float32 (a particle spawned at 2e19 m/s has finite components but an
-// infinite |v|^2); never NaN. The writer saves what the world carries, so this accepts
-// exactly that.
-float magnitude_max(ByteReader& r, const std::string& name) {
-  const float v = r.f32();
-  if (std::isnan(v) || v < 0.0f) corrupt(r.what() + ": " + name + " is negative or not a number");
-  return v;
-}
-
-float positive(ByteReader& r, const std::string& name) {
-  const float v = finite(r, name);
-  if (!(v > 0.0f)) corrupt(r.what() + ": " + name + " must be > 0, is " + std::to_string(v));
-  return v;
-}
-
-uint32_t flag(ByteReader& r, const std::string& name) {
-  const uint32_t v = r.u32();
-  if (v > 1) corrupt(r.what() + ": " + name + " is " + std::to_string(v) + ", not 0 or 1");
-  return v;
-}
-
-uint32_t below(ByteReader& r, uint32_t limit, const std::string& name) {
-  const uint32_t v = r.u32();
-  if (v >= limit)
-    corrupt(r.what() + ": " + name + " is " + std::to_string(v) + ", not below " + std::to_string(limit));
-  return v;
-}
-
-// A value of a world-def field that selects one method of the list (physics/methods.h).
-uint32_t method(ByteReader& r, SwitchKind kind, const std::string& name) {
-  const uint32_t v = r.u32();
-  if (!selects_a_method(kind, v))
-    corrupt(r.what() + ": " + name + " is " + std::to_string(v) + ", no method of this library");
-  return v;
-}
-
-void zero(ByteReader& r, const std::string& name) {
-  if (r.u32() != 0) corrupt(r.what() + ": " + name + " is reserved and must be 0");
-}
-
-// A pose as stored; the scene's rules (pose_rules.h) check it where the object is made.
-RigidTransform raw_pose(ByteReader& r) {
-  RigidTransform t;
-  t.position.x = r.f32();
-  t.position.y = r.f32();
-  t.position.z = r.f32();
-  t.rotation.x = r.f32();
-  t.rotation.y = r.f32();
-  t.rotation.z = r.f32();
-  t.rotation.w = r.f32();
-  return t;
-}
-
-Vec3 raw_vec3(ByteReader& r) {
-  Vec3 v;
-  v.x = r.f32();
-  v.y = r.f32();
-  v.z = r.f32();
-  return v;
-}
-
-// Bulk floats: the message is built only on failure (a checkpoint may hold millions).
-float bulk_finite(ByteReader& r, const char* what, uint32_t index) {
-  const float v = r.f32();
-  if (!std::isfinite(v)) corrupt(r.what() + ": " + what + " " + std::to_string(index) + " is not finite");
-  return v;
-}
-
-Float4 float4(ByteReader& r, const char* what, uint32_t index) {
-  Float4 v;
-  v.x = bulk_finite(r, what, index);
-  v.y = bulk_finite(r, what, index);
-  v.z = bulk_finite(r, what, index);
-  v.w = bulk_finite(r, what, index);
-  return v;
-}
-
-Vec3 bulk_vec3(ByteReader& r, const char* what, uint32_t index) {
-  Vec3 v;
-  v.x = bulk_finite(r, what, index);
-  v.y = bulk_finite(r, what, index);
-  v.z = bulk_finite(r, what, index);
-  return v;
-}
-
-WorldConfig read_config(ByteReader& r) {
+WorldConfig read_config(ByteReader& r, uint32_t version) {
   WorldConfig c;
   c.capacity = r.u32();
   if (c.capacity == 0 || c.capacity > (1u << 30))
@@ -149,6 +43,15 @@ WorldConfig read_config(ByteReader& r) {
   c.kernel_radius = positive(r, "kernel radius");
   c.rest_density = positive(r, "rest density");
   c.particle_mass = positive(r, "particle mass");
+  if (version >= kFirstSolverVersion) {
+    c.solver = static_cast<Solver>(method(r, SwitchKind::Solver, "solver"));
+    if (c.solver == Solver::Dfsph &&
+        (c.integrator == Integrator::Rk4 || c.equation_of_state != EquationOfState::IdealGas ||
+         (c.features & kFeatureNormalizedDensity)))
+      corrupt(r.what() +
+              ": the DFSPH solver with RK4, an equation of state other than the ideal gas, or "
+              "the normalised density (no world can be made so)");
+  }
   if (c.kernel_radius < c.particle_spacing || c.kernel_radius > 5.0f * c.particle_spacing)
     corrupt(r.what() + ": kernel radius is outside [1, 5] x the particle spacing");
   const KernelCoefficients k = make_kernel_coefficients(c.kernel_radius);
@@ -223,7 +126,19 @@ struct Clock {
   std::vector<Event> events;
 };
 
-Clock read_clock(ByteReader& r) {
+SolveReport read_solve(ByteReader& r, const std::string& name) {
+  SolveReport s;
+  s.iterations = r.u32();
+  s.iterations_max = r.u32();
+  s.capped = r.u32();
+  s.error_mean = non_negative(r, name + " mean error");
+  s.error_max = non_negative(r, name + " largest error");
+  if (s.iterations_max > s.iterations || s.capped > s.iterations)
+    corrupt(r.what() + ": " + name + " counts more in one substep or more capped solves than iterations");
+  return s;
+}
+
+Clock read_clock(ByteReader& r, uint32_t version) {
   Clock c;
   c.next_id = r.u32();
   zero(r, "reserved");
@@ -246,13 +161,19 @@ Clock read_clock(ByteReader& r) {
   f.neighbors_mean = non_negative(r, "neighbours mean");
   f.neighbors_max = r.u32();
   for (int k = 0; k < kStageCount; ++k) f.stage_ms[k] = non_negative(r, "stage time");
+  if (version >= kFirstSolverVersion) {
+    f.pressure_solve = read_solve(r, "density solve");
+    f.divergence_solve = read_solve(r, "divergence solve");
+  }
   const uint32_t events = r.u32();
   r.need_elements(events, 16, "events");
   c.events.resize(events);
   for (Event& e : c.events) {
     const uint32_t type = r.u32();
     if (type != static_cast<uint32_t>(EventType::SourceCapacityReached) &&
-        type != static_cast<uint32_t>(EventType::SinkRemoved))
+        type != static_cast<uint32_t>(EventType::SinkRemoved) &&
+        type != static_cast<uint32_t>(EventType::PressureSolveCapped) &&
+        type != static_cast<uint32_t>(EventType::DivergenceSolveCapped))
       corrupt(r.what() + ": unknown event type " + std::to_string(type));
     e.type = static_cast<EventType>(type);
     e.count = r.u32();
@@ -303,6 +224,21 @@ ParticleSnapshot read_particles(ByteReader& r, const WorldConfig& config, uint32
     }
     s.set_carried(kArrayDensityFactor, factors);
   }
+  // DFSPH: the warm starts of its two solves (finite; the density solve's pressure is never
+  // negative). Every DFSPH checkpoint has them (DFSPH came with version 3).
+  if (config.solver == Solver::Dfsph) {
+    r.need_elements(n, 2 * sizeof(float), "DFSPH warm starts");
+    std::vector<float> pressure(n), divergence(n);
+    for (uint32_t i = 0; i < n; ++i) {
+      pressure[i] = bulk_finite(r, "DFSPH pressure of particle", i);
+      if (pressure[i] < 0.0f)
+        corrupt(r.what() + ": DFSPH pressure of particle " + std::to_string(i) + " is negative");
+    }
+    for (uint32_t i = 0; i < n; ++i)
+      divergence[i] = bulk_finite(r, "DFSPH divergence pressure of particle", i);
+    s.set_carried(kArrayDfsphPressure, pressure);
+    s.set_carried(kArrayDfsphDivergencePressure, divergence);
+  }
   std::vector<uint32_t> sorted(s.id);
   std::sort(sorted.begin(), sorted.end());
   const auto dup = std::adjacent_find(sorted.begin(), sorted.end());
@@ -310,173 +246,10 @@ ParticleSnapshot read_particles(ByteReader& r, const WorldConfig& config, uint32
   return s;
 }
 
-std::shared_ptr<SdfAsset> read_asset(ByteReader& r, uint32_t index) {
-  const std::string name = "asset " + std::to_string(index);
-  uint32_t dims[3];
-  for (uint32_t& d : dims) {
-    d = r.u32();
-    if (d == 0 || d > kMaxAssetDim)
-      corrupt(r.what() + ": " + name + " has a dimension of " + std::to_string(d));
-  }
-  const uint64_t n = uint64_t{dims[0]} * dims[1] * dims[2];
-  if (n > kMaxAssetVoxels) corrupt(r.what() + ": " + name + " has more than 2^31 voxels");
-  const uint32_t channels = r.u32();
-  if (channels & ~(kAssetHasVelocity | kAssetHasFriction))
-    corrupt(r.what() + ": " + name + " has unknown channel bits " + hex32(channels));
-  Affine3x4 affine;
-  for (float& m : affine.m) m = finite(r, name + " index_to_local");
-  const uint64_t floats_per_voxel =
-      1 + ((channels & kAssetHasVelocity) ? 3 : 0) + ((channels & kAssetHasFriction) ? 1 : 0);
-  r.need_elements(n, floats_per_voxel * sizeof(float), "voxels");  // before any allocation
-  std::shared_ptr<SdfAsset> asset;
-  try {
-    asset = std::make_shared<SdfAsset>(static_cast<int32_t>(dims[0]), static_cast<int32_t>(dims[1]),
-                                       static_cast<int32_t>(dims[2]), affine);
-  } catch (const Error& e) {
-    corrupt(r.what() + ": " + name + ": " + e.what());
-  }
-  const std::string where = name + ": voxel";
-  std::vector<float>& distance = asset->distance();
-  for (uint64_t i = 0; i < n; ++i) distance[i] = bulk_finite(r, where.c_str(), static_cast<uint32_t>(i));
-  if (channels & kAssetHasVelocity) {
-    asset->velocity().resize(n);
-    std::vector<Vec3>& velocity = asset->velocity();
-    for (uint64_t i = 0; i < n; ++i) velocity[i] = bulk_vec3(r, where.c_str(), static_cast<uint32_t>(i));
-  }
-  if (channels & kAssetHasFriction) {
-    asset->friction().resize(n);
-    std::vector<float>& friction = asset->friction();
-    for (uint64_t i = 0; i < n; ++i) {
-      friction[i] = bulk_finite(r, where.c_str(), static_cast<uint32_t>(i));
-      if (friction[i] < 0.0f)
-        corrupt(r.what() + ": " + where + " " + std::to_string(i) + " has a negative friction");
-    }
-  }
-  return asset;
-}
-
-using Assets = std::vector<std::shared_ptr<SdfAsset>>;
-
-// An asset of the table, or none; whether the object needs one is the scene's rule.
-std::shared_ptr<const SdfAsset> asset_ref(ByteReader& r, const Assets& assets, const std::string& name) {
-  const uint32_t k = r.u32();
-  if (k == kNoAsset) return nullptr;
-  if (k >= assets.size())
-    corrupt(r.what() + ": " + name + " refers to asset " + std::to_string(k) + " of " +
-            std::to_string(assets.size()));
-  return assets[k];
-}
-
-// The slot table of one kind of object (see write_slots); read_value reads one live body.
-template <class T, class ReadValue>
-SlotTable<T> read_slots(ByteReader& r, ReadValue&& read_value) {
-  SlotTable<T> t;
-  const uint32_t slots = r.u32();
-  if (slots > kMaxObjectSlots) corrupt(r.what() + ": " + std::to_string(slots) + " slots, more than 65536");
-  r.need_elements(slots, 2 * sizeof(uint32_t), "slots");
-  t.generations.resize(slots);
-  t.values.resize(slots);
-  uint32_t dead = 0;
-  for (uint32_t i = 0; i < slots; ++i) {
-    const std::string name = "slot " + std::to_string(i);
-    t.generations[i] = r.u32();
-    if (t.generations[i] == 0 || t.generations[i] > 0xffffffu)
-      corrupt(r.what() + ": " + name + " has generation " + std::to_string(t.generations[i]));
-    if (flag(r, name + " live"))
-      t.values[i] = read_value(name);
-    else
-      ++dead;
-  }
-  const uint32_t free_count = r.u32();
-  if (free_count != dead)
-    corrupt(r.what() + ": the free list has " + std::to_string(free_count) + " slots, but " +
-            std::to_string(dead) + " slots are empty");
-  std::vector<char> seen(slots, 0);
-  t.free_list.resize(free_count);
-  for (uint32_t& slot : t.free_list) {
-    slot = r.u32();
-    if (slot >= slots || t.values[slot] || seen[slot])
-      corrupt(r.what() + ": the free list names slot " + std::to_string(slot) +
-              ", which is not a distinct empty slot");
-    seen[slot] = 1;
-  }
-  return t;
-}
-
-// Runs one of the scene's rules (scene_build.h, pose_rules.h: the same the world's entry
-// points apply to callers) on what the file holds; a violation is corrupt data, named by slot.
-template <class Check>
-auto by_scene_rules(ByteReader& r, const std::string& name, Check&& check) -> decltype(check()) {
-  try {
-    return with_field_prefix(name + " ", std::forward<Check>(check));
-  } catch (const Error& e) {
-    corrupt(r.what() + ": " + e.what());
-  }
-}
-
-Collider read_collider(ByteReader& r, const Assets& assets, const std::string& name) {
-  ColliderSpec spec;
-  spec.sdf = asset_ref(r, assets, name + " SDF");
-  spec.pose = raw_pose(r);
-  std::optional<RigidTransform> target;
-  if (flag(r, name + " has target")) target = raw_pose(r);
-  spec.material.restitution = r.f32();
-  spec.material.friction = r.f32();
-  spec.material.stickiness = r.f32();
-  spec.inverted = flag(r, name + " inverted") != 0;
-  Collider c = by_scene_rules(r, name, [&] { return make_collider(spec); });
-  if (target) by_scene_rules(r, name, [&] { require_pose(*target, "target"); });
-  c.target = target;
-  return c;
-}
-
-Source read_source(ByteReader& r, const Assets& assets, const WorldConfig& config, const std::string& name) {
-  SourceSpec spec;
-  spec.region = asset_ref(r, assets, name + " region");
-  spec.pose = raw_pose(r);
-  spec.mode = static_cast<SourceMode>(below(r, 2, name + " mode"));
-  spec.spacing = r.f32();
-  spec.min_distance = r.f32();
-  spec.velocity = raw_vec3(r);
-  spec.velocity_from_field = flag(r, name + " velocity from field") != 0;
-  spec.rate = r.f32();
-  // Stored values are resolved: a zero here would be read as "the default" by the rules.
-  if (spec.spacing == 0.0f || spec.min_distance == 0.0f)
-    corrupt(r.what() + ": " + name + " spacing or min distance is 0 (never written)");
-  Source s = by_scene_rules(r, name, [&] { return make_source(spec, config); });
-  s.rate_budget = r.f64();
-  // A budget grows by at most rate x frame time per step; far below the size_t range.
-  if (!std::isfinite(s.rate_budget) || s.rate_budget < 0.0 || s.rate_budget > 1e15)
-    corrupt(r.what() + ": " + name + " rate budget is outside [0, 1e15]");
-  s.done = flag(r, name + " done") != 0;
-  const uint32_t points = r.u32();
-  r.need_elements(points, 3 * sizeof(float), "lattice points");
-  s.lattice.resize(points);
-  const std::string where = name + " lattice point";
-  for (uint32_t i = 0; i < points; ++i) s.lattice[i] = bulk_vec3(r, where.c_str(), i);
-  return s;
-}
-
-Sink read_sink(ByteReader& r, const Assets& assets, const std::string& name) {
-  SinkSpec spec;
-  spec.mode = static_cast<SinkMode>(below(r, 2, name + " mode"));
-  spec.region = asset_ref(r, assets, name + " region");
-  spec.pose = raw_pose(r);
-  spec.bounds_min = raw_vec3(r);
-  spec.bounds_max = raw_vec3(r);
-  return by_scene_rules(r, name, [&] { return make_sink(spec); });
-}
-
-ForceField read_force_field(ByteReader& r, const Assets& assets, const std::string& name) {
-  ForceFieldSpec spec;
-  spec.kind = static_cast<ForceFieldKind>(below(r, 4, name + " kind"));
-  spec.region = asset_ref(r, assets, name + " region");
-  spec.grid = asset_ref(r, assets, name + " grid");
-  spec.pose = raw_pose(r);
-  spec.vector = raw_vec3(r);
-  spec.strength = r.f32();
-  spec.falloff_radius = r.f32();
-  return by_scene_rules(r, name, [&] { return make_force_field(spec); });
+// SPH_MAKE_VERSION's packing: (major << 22) | (minor << 12) | patch.
+std::string library_version_text(uint32_t packed) {
+  return std::to_string(packed >> 22) + "." + std::to_string((packed >> 12) & 0x3ffu) + "." +
+         std::to_string(packed & 0xfffu);
 }
 
 }  // namespace
@@ -490,13 +263,19 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   if (std::memcmp(data, kMagic, sizeof kMagic) != 0) corrupt("not a checkpoint (wrong magic bytes)");
   ByteReader h(data + sizeof kMagic, kHeaderSize - sizeof kMagic, "header");
   const uint32_t version = h.u32();
-  if (version < kOldestReadableVersion || version > kFormatVersion)
-    throw Error(Status::VersionMismatch,
-                "checkpoint: format version " + std::to_string(version) + "; this library reads versions " +
-                    std::to_string(kOldestReadableVersion) + " to " + std::to_string(kFormatVersion));
   const uint32_t flags = h.u32();
-  h.u32();  // writer backend: informational
-  h.u32();  // writer library version: informational
+  h.u32();                                  // writer backend: informational
+  const uint32_t writer_library = h.u32();  // informational, but named when refusing a version
+  if (version > kFormatVersion)
+    throw Error(Status::VersionMismatch,
+                "checkpoint: format version " + std::to_string(version) +
+                    " is newer than this library reads (versions " + std::to_string(kOldestReadableVersion) +
+                    " to " + std::to_string(kFormatVersion) + "); it was written by sph " +
+                    library_version_text(writer_library) + ": load it with that library or a later one");
+  if (version < kOldestReadableVersion)
+    throw Error(Status::VersionMismatch, "checkpoint: format version " + std::to_string(version) +
+                                             " is older than the oldest this library reads (" +
+                                             std::to_string(kOldestReadableVersion) + ")");
   const uint64_t payload_size = h.u64();
   const uint64_t checksum = h.u64();
   const uint32_t section_count = h.u32();
@@ -534,7 +313,7 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   };
 
   ByteReader conf = next_section(0);
-  const WorldConfig config = read_config(conf);
+  const WorldConfig config = read_config(conf, version);
   conf.expect_end();
   ByteReader parm = next_section(1);
   const RuntimeParams params = version == 1 ? read_params_v1(parm, config) : read_params(parm, config);
@@ -542,7 +321,7 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   // A dt_min above the stability ceiling is accepted, as sph_world_set_params accepts it (the
   // caller's fixed step wins over the ceiling; a step that then fails says so and rolls back).
   ByteReader time = next_section(2);
-  const Clock clock = read_clock(time);
+  const Clock clock = read_clock(time, version);
   time.expect_end();
   ByteReader part = next_section(3);
   ParticleSnapshot particles = read_particles(part, config, clock.next_id);
@@ -550,27 +329,19 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   part.expect_end();
 
   ByteReader sdfa = next_section(4);
-  const uint32_t asset_count = sdfa.u32();
-  sdfa.need_elements(asset_count, 16 + 12 * sizeof(float) + sizeof(float), "assets");
-  Assets assets;
-  for (uint32_t k = 0; k < asset_count; ++k) assets.push_back(read_asset(sdfa, k));
+  const CheckpointAssets assets = read_checkpoint_assets(sdfa);
   sdfa.expect_end();
-
   ByteReader coll = next_section(5);
-  auto colliders = read_slots<Collider>(
-      coll, [&](const std::string& n) { return read_collider(coll, assets, "collider " + n); });
+  auto colliders = read_checkpoint_colliders(coll, assets);
   coll.expect_end();
   ByteReader srce = next_section(6);
-  auto sources = read_slots<Source>(
-      srce, [&](const std::string& n) { return read_source(srce, assets, config, "source " + n); });
+  auto sources = read_checkpoint_sources(srce, assets, config);
   srce.expect_end();
   ByteReader sink = next_section(7);
-  auto sinks =
-      read_slots<Sink>(sink, [&](const std::string& n) { return read_sink(sink, assets, "sink " + n); });
+  auto sinks = read_checkpoint_sinks(sink, assets);
   sink.expect_end();
   ByteReader ffld = next_section(8);
-  auto fields = read_slots<ForceField>(
-      ffld, [&](const std::string& n) { return read_force_field(ffld, assets, "force field " + n); });
+  auto fields = read_checkpoint_force_fields(ffld, assets);
   ffld.expect_end();
   payload.expect_end();
 

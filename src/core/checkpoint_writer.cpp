@@ -66,6 +66,15 @@ void write_config(ByteWriter& w, const WorldConfig& c) {
   w.f32(c.kernel_radius);
   w.f32(c.rest_density);
   w.f32(c.particle_mass);
+  w.u32(static_cast<uint32_t>(c.solver));
+}
+
+void write_solve(ByteWriter& w, const SolveReport& s) {
+  w.u32(s.iterations);
+  w.u32(s.iterations_max);
+  w.u32(s.capped);
+  w.f32(s.error_mean);
+  w.f32(s.error_max);
 }
 
 // SPH_FEATURE_SPRINGS worlds only, after the particles: the lowest id still waiting for springs
@@ -99,6 +108,8 @@ void write_clock(ByteWriter& w, const World& world) {
   w.f32(r.neighbors_mean);
   w.u32(r.neighbors_max);
   for (float ms : r.stage_ms) w.f32(ms);
+  write_solve(w, r.pressure_solve);
+  write_solve(w, r.divergence_solve);
   // What the last step reported, so a loaded world answers the same queries.
   w.u32(static_cast<uint32_t>(world.events().size()));
   for (const Event& e : world.events()) {
@@ -131,6 +142,9 @@ void write_particles(ByteWriter& w, const ParticleSnapshot& s) {
   for (float d : s.density) w.f32(d);
   // Normalised density only: each particle's carried factor (NaN: not resolved yet).
   for (float d : s.carried_as<float>(kArrayDensityFactor)) w.f32(d);
+  // DFSPH only: the warm starts of its two solves.
+  for (float k : s.carried_as<float>(kArrayDfsphPressure)) w.f32(k);
+  for (float k : s.carried_as<float>(kArrayDfsphDivergencePressure)) w.f32(k);
 }
 
 void write_asset(ByteWriter& w, const SdfAsset& a) {

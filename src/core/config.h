@@ -22,6 +22,7 @@ struct WorldConfig {
   Integrator integrator = Integrator::SymplecticEuler;
   ViscosityMethod viscosity_method = ViscosityMethod::Mueller;
   EquationOfState equation_of_state = EquationOfState::IdealGas;
+  Solver solver = Solver::WeaklyCompressible;
   float particle_spacing = 0.0f;
   float kernel_radius = 0.0f;
   float rest_density = 0.0f;
@@ -32,7 +33,9 @@ struct WorldConfig {
   // The lattice normalisation of W_spiky (fcc_spiky_scale), derived like density_self_weight.
   float spiky_scale = 1.0f;
 
-  MethodSelection selection() const { return MethodSelection{features, viscosity_method, equation_of_state}; }
+  MethodSelection selection() const {
+    return MethodSelection{features, viscosity_method, equation_of_state, solver};
+  }
   WorldShape shape() const {
     return WorldShape{particle_spacing, kernel_radius, rest_density, particle_mass};
   }
@@ -69,6 +72,7 @@ auto& params_of(Params& p) {
 inline LatticeSums fcc_lattice_sums() {
   return LatticeSums{&fcc_surface_delta_integral,
                      [](float spacing, float h) { return fcc_cohesion_lattice(spacing, h).surface_energy; },
+                     &fcc_neighbor_count,
                      [](float spacing, float h, double* scale, double* offset) {
                        const BoundaryCalibration c = fcc_boundary_calibration(spacing, h);
                        *scale = c.scale;
@@ -97,7 +101,8 @@ inline StepLimits make_step_limits(const WorldConfig& c, const RuntimeParams& p)
   s.dt_min = p.stepping.dt_min;
   s.dt_max = p.stepping.dt_max;
   s.sound_speed = 0.0f;
-  if (p.stepping.step_limits & kStepLimitAcoustic)
+  // DFSPH has no equation of state and no sound speed: its step is the CFL number alone.
+  if ((p.stepping.step_limits & kStepLimitAcoustic) && c.solver == Solver::WeaklyCompressible)
     s.sound_speed = speed_of_sound(make_eos_constants(p.methods, c.selection(), c.shape()));
   s.use_force_limit = (p.stepping.step_limits & kStepLimitForce) ? 1u : 0u;
   s.stability_dt = method_stability_ceiling(p.methods, c.selection(), c.shape());

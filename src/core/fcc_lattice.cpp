@@ -173,6 +173,14 @@ float fcc_density_self_weight(float spacing, float kernel_radius, float rest_den
   return static_cast<float>(static_cast<double>(rest_density) / mass - sum);
 }
 
+uint32_t fcc_neighbor_count(float spacing, float kernel_radius) {
+  uint32_t count = 0;
+  for_each_lattice_point_within(half_cell(spacing), kernel_radius, [&](int64_t, int64_t, int64_t, double r2) {
+    if (r2 > 0.0) ++count;
+  });
+  return count;
+}
+
 BoundaryCalibration fcc_boundary_calibration(float spacing, float kernel_radius) {
   const double step = half_cell(spacing);
   KernelCoefficientsOf<double> k = make_kernel_coefficients<double>(kernel_radius);

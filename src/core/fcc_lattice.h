@@ -44,6 +44,10 @@ float fcc_density_self_weight(float spacing, float kernel_radius, float rest_den
 // 1.113 at 1.8 spacings, 1.054 at 2, 1.016 at 2.5.
 float fcc_spiky_scale(float spacing, float kernel_radius);
 
+// The neighbours of a particle of the infinite lattice: points closer than kernel_radius, the
+// particle itself excluded (42 at the default 1.8 spacings).
+uint32_t fcc_neighbor_count(float spacing, float kernel_radius);
+
 // The surface integral of the particle-sampled colour gradient (surface tension's smoothed delta
 // function): sum over the particles of a flat free surface of the FCC lattice of (m / rho0)
 // (|grad c_i| - threshold) per unit area, over the particles where that is positive, with

@@ -19,9 +19,27 @@ enum StageIndex : int {
   kStageCount = 8,
 };
 
+// One DFSPH solve (the density solve or the divergence solve) over the substeps of a frame
+// (solver_record.h tallies it; zero on a weakly compressible world).
+struct SolveReport {
+  uint32_t iterations = 0;      // summed over the frame's substeps
+  uint32_t iterations_max = 0;  // most in one substep
+  uint32_t capped = 0;          // substeps whose solve stopped at its iteration cap above its bound
+  float error_mean = 0.0f;      // the achieved mean error, averaged over the substeps
+  float error_max = 0.0f;       // the largest of any substep
+};
+
+// One collider's impulses over a frame (SPH_FEATURE_COLLIDER_LOADS, physics/collider_loads.h),
+// summed in double in a fixed order.
+struct ColliderLoadSums {
+  double linear[3] = {0.0, 0.0, 0.0};   // N s, world frame
+  double angular[3] = {0.0, 0.0, 0.0};  // N m s, about the load point
+};
+
 struct FrameReport {
   uint32_t substeps = 0;
   bool completed = true;       // false when max_substeps ran out before the frame's end
+  bool interrupted = false;    // the step budget or a cancel stopped the frame (completed is false)
   double time_advanced = 0.0;  // seconds
   float dt_min = 0.0f;
   float dt_max = 0.0f;
@@ -32,8 +50,11 @@ struct FrameReport {
   float neighbors_mean = 0.0f;
   uint32_t neighbors_max = 0;
   float stage_ms[kStageCount] = {};
+  SolveReport pressure_solve;             // DFSPH's density solve: error dimensionless, (rho* - rho0)+ / rho0
+  SolveReport divergence_solve;           // DFSPH's divergence solve: error in 1/s, (D rho / Dt)+ / rho0
   std::vector<uint32_t> removed_ids;      // ids sinks removed during the frame
   std::vector<uint32_t> removed_by_sink;  // count per sink, in SceneFrame::sinks order
+  std::vector<ColliderLoadSums> collider_loads;  // per collider in SceneFrame::colliders order (loads on)
 };
 
 }  // namespace sph

@@ -12,6 +12,7 @@
 #include "../physics/force_fields.h"
 #include "../physics/sink_region.h"
 #include "sdf_asset.h"
+#include "step_interrupt.h"
 
 namespace sph {
 
@@ -37,6 +38,7 @@ struct SceneFrame {
   std::vector<ForceFieldFrame> fields;
   std::vector<SinkFrame> sinks;
   float max_collider_speed = 0.0f;  // fastest collider surface point, m/s (for the step size)
+  StepInterrupt interrupt;          // checked between substeps (CUDA: on its stream driver only)
 
   bool empty() const { return colliders.empty() && fields.empty() && sinks.empty(); }
 };

@@ -12,12 +12,22 @@
 
 namespace sph {
 
+// A collider's loads over the last step: the time averages of the fluid's force and torque.
+struct ColliderLoadResult {
+  Vec3 force{0.0f, 0.0f, 0.0f};   // N, world frame
+  Vec3 torque{0.0f, 0.0f, 0.0f};  // N m, about point
+  Vec3 point{0.0f, 0.0f, 0.0f};   // the load point in the world at the end of the step
+  double time = 0.0;              // the span of the average (the step's time advanced), s
+};
+
 struct Collider {
   std::shared_ptr<const SdfAsset> sdf;
   RigidTransform pose = identity_pose();  // where the collider is now (start of the next frame)
   std::optional<RigidTransform> target;   // where it must be at the end of the next frame
   ColliderMaterial material;
   bool inverted = false;
+  Vec3 load_point{0.0f, 0.0f, 0.0f};  // collider frame: the torque of its loads is about it
+  ColliderLoadResult loads;           // of the last step (SPH_FEATURE_COLLIDER_LOADS)
 };
 
 struct Source {
@@ -52,7 +62,13 @@ struct ForceField {
   float falloff_radius = 0.0f;
 };
 
-enum class EventType : uint32_t { SourceCapacityReached = 1, SinkRemoved = 2 };
+// Values equal to sph_event_type. The solver's events name no object (object_id 0).
+enum class EventType : uint32_t {
+  SourceCapacityReached = 1,
+  SinkRemoved = 2,
+  PressureSolveCapped = 3,
+  DivergenceSolveCapped = 4,
+};
 
 struct Event {
   EventType type;

@@ -127,6 +127,7 @@ SceneFrame World::build_scene_frame(double frame_dt) const {
     v.sign = c.inverted ? -1.0f : 1.0f;
     v.deforming = c.sdf->has_moving_surface() ? 1u : 0u;
     v.boundary_map = nullptr;  // the backend binds its map (SPH_FEATURE_BOUNDARY_DENSITY)
+    v.load_point = c.load_point;
     float speed = 0.0f;
     if (v.moving) speed += length(v.linear_velocity) + length(v.angular_velocity) * bounding_radius(*c.sdf);
     if (v.deforming) speed += max_field_speed(*c.sdf);
@@ -161,8 +162,31 @@ SceneFrame World::build_scene_frame(double frame_dt) const {
   return scene;
 }
 
-bool World::step(double frame_dt) {
+namespace {
+// A frame's impulses as time averages (zero for a frame that advanced no time).
+ColliderLoadResult load_result(const ColliderLoadSums& sums, const Collider& c, const FrameReport& report) {
+  ColliderLoadResult r;
+  const double inv_t = report.time_advanced > 0.0 ? 1.0 / report.time_advanced : 0.0;
+  r.force = Vec3{static_cast<float>(sums.linear[0] * inv_t), static_cast<float>(sums.linear[1] * inv_t),
+                 static_cast<float>(sums.linear[2] * inv_t)};
+  r.torque = Vec3{static_cast<float>(sums.angular[0] * inv_t), static_cast<float>(sums.angular[1] * inv_t),
+                  static_cast<float>(sums.angular[2] * inv_t)};
+  r.point = to_world(c.pose, c.load_point);  // c.pose is the end of the frame's pose here
+  r.time = report.time_advanced;
+  return r;
+}
+}  // namespace
+
+bool World::step(double frame_dt, const StepInterrupt& interrupt) {
   const auto start = std::chrono::steady_clock::now();
+  if (interrupt.requested()) {
+    report_ = FrameReport{};
+    report_.completed = false;
+    report_.interrupted = true;
+    events_.clear();
+    last_step_ms_ = 0.0f;
+    return false;
+  }
   // Everything a failed step must put back.
   const uint32_t count_before = particle_count();
   const uint32_t next_id_before = next_id_;
@@ -182,10 +206,12 @@ bool World::step(double frame_dt) {
   try {
     // Reserved up front, so that nothing after the backend's frame can fail on an allocation:
     // once the particles have moved, the rest of the step must not throw.
-    events_.reserve(sources_.size() + sinks_.size());
+    events_.reserve(sources_.size() + sinks_.size() + 2);  // + the solves' capped events
     if (sources_.size() > 0) backend_->save_step_inputs();
     emit_sources(frame_dt);
-    report = backend_->step_scene_frame(frame_dt, params_, build_scene_frame(frame_dt));
+    SceneFrame scene = build_scene_frame(frame_dt);
+    scene.interrupt = interrupt;
+    report = backend_->step_scene_frame(frame_dt, params_, scene);
   } catch (...) {
     if (particle_count() > count_before) {
       backend_->truncate(count_before);
@@ -200,16 +226,23 @@ bool World::step(double frame_dt) {
     events_.swap(events_before);
     throw;
   }
-  // Colliders arrive where they were sent.
-  colliders_.for_each([&](uint64_t, Collider& c) {
+  // Colliders arrive where they were sent; their loads are the frame's impulses over its time.
+  colliders_.for_each([&, index = size_t{0}](uint64_t, Collider& c) mutable {
     if (c.target) c.pose = *c.target;
     c.target.reset();
+    if (index < report.collider_loads.size()) c.loads = load_result(report.collider_loads[index], c, report);
+    ++index;
   });
   sinks_.for_each([&, index = size_t{0}](uint64_t id, const Sink&) mutable {
     const uint32_t removed = index < report.removed_by_sink.size() ? report.removed_by_sink[index] : 0u;
     if (removed > 0) events_.push_back(Event{EventType::SinkRemoved, id, removed});
     ++index;
   });
+  // A DFSPH solve that stopped at its cap is never silent.
+  if (report.pressure_solve.capped > 0)
+    events_.push_back(Event{EventType::PressureSolveCapped, 0, report.pressure_solve.capped});
+  if (report.divergence_solve.capped > 0)
+    events_.push_back(Event{EventType::DivergenceSolveCapped, 0, report.divergence_solve.capped});
   report_ = std::move(report);
   simulated_time_ += report_.time_advanced;
   last_step_ms_ = static_cast<float>(

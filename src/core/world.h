@@ -57,9 +57,11 @@ class World {
   uint32_t fill_sphere(const FillSphereSpec& spec);
 
   // Runs one frame: sources emit, then substeps with colliders, fields and sinks. Returns
-  // false when max_substeps ran out before frame_dt. On an exception the world (particles,
-  // ids, sources, collider poses) is as it was before the call.
-  bool step(double frame_dt);
+  // false when max_substeps ran out before frame_dt, or `interrupt` stopped it at a substep
+  // boundary (raised before the step starts: nothing changes but the report, which says no
+  // substep ran). On an exception the world (particles, ids, sources, collider poses) is as it
+  // was before the call.
+  bool step(double frame_dt, const StepInterrupt& interrupt = StepInterrupt{});
 
   const FrameReport& last_report() const { return report_; }
   double simulated_time() const { return simulated_time_; }
@@ -102,6 +104,8 @@ class World {
   void set_collider_target(uint64_t id, const RigidTransform& target);
   void teleport_collider(uint64_t id, const RigidTransform& pose);
   void set_collider_material(uint64_t id, const ColliderMaterial& material);
+  // The point (collider frame) its loads' torque is taken about; InvalidArgument if not finite.
+  void set_collider_load_point(uint64_t id, Vec3 point);
   void set_source_pose(uint64_t id, const RigidTransform& pose);
   void set_force_field_pose(uint64_t id, const RigidTransform& pose);
   // A live collider; Error(InvalidHandle) otherwise.

@@ -2,6 +2,7 @@
 // specs (rules in scene_build.h), their setters, and the restore of a saved scene.
 #include <string>
 
+#include "field_checks.h"
 #include "field_error.h"
 #include "pose_rules.h"
 #include "scene_build.h"
@@ -82,6 +83,12 @@ void World::set_collider_material(uint64_t id, const ColliderMaterial& material)
   Collider& c = live(colliders_, id);
   check_collider_material(material);
   c.material = material;
+}
+
+void World::set_collider_load_point(uint64_t id, Vec3 point) {
+  Collider& c = live(colliders_, id);
+  require_finite_vec3_field(point, "point");
+  c.load_point = point;
 }
 
 void World::set_source_pose(uint64_t id, const RigidTransform& pose) {

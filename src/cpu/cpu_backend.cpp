@@ -5,7 +5,6 @@
 #include <memory>
 #include <utility>
 
-#include "../core/grid_layout.h"
 #include "cpu_backend.h"
 #include "cpu_backend_impl.h"
 
@@ -14,7 +13,7 @@ namespace sph {
 CpuBackend::CpuBackend(const WorldConfig& config, unsigned workers)
     : config_(config),
       workers_(workers == 0 ? 1u : workers),
-      grid_(make_grid_shape(config.kernel_radius, config.capacity)),
+      grid_(config.kernel_radius, max_particles_per_cell(config.particle_spacing, config.kernel_radius)),
       method_arrays_(method_particle_arrays(config)) {
   using Role = ParticleArrayRole;
   const auto array = [](const char* name, uint32_t size, Role role) {
@@ -39,6 +38,12 @@ CpuBackend::CpuBackend(const WorldConfig& config, unsigned workers)
   link_from_ = store_.find_typed<uint32_t>(kArraySpringLinkFrom);
   spring_candidates_ = store_.find_typed<uint32_t>(kArraySpringCandidates);
   spring_acceleration_ = store_.find_typed<Float4>(kArraySpringAcceleration);
+  dfsph_pressure_ = store_.find_typed<float>(kArrayDfsphPressure);
+  dfsph_divergence_ = store_.find_typed<float>(kArrayDfsphDivergencePressure);
+  dfsph_factor_ = store_.find_typed<float>(kArrayDfsphFactor);
+  dfsph_step_ = store_.find_typed<float>(kArrayDfsphStep);
+  dfsph_residual_ = store_.find_typed<float>(kArrayDfsphResidual);
+  dfsph_contact_ = store_.find_typed<Float4>(kArrayDfsphContact);
   boundary_ = store_.find_typed<Float4>(kArrayBoundaryGradient);
 }
 

@@ -13,6 +13,9 @@
 #include "../core/backend.h"
 #include "../core/non_finite.h"
 #include "../core/particle_arrays.h"
+#include "../core/solver_record.h"
+#include "../physics/collider_loads.h"
+#include "../physics/dfsph_passes.h"
 #include "../physics/forces.h"
 #include "../physics/integrate.h"
 #include "../physics/springs.h"
@@ -87,12 +90,14 @@ class CpuBackend final : public Backend {
   }
 
   // Acceleration of particle i: the neighbour gather with the world's force terms compiled in
-  // (forces.h), plus the scene's force fields.
-  template <class Terms>
+  // (forces.h), plus the scene's force fields; with the pressure force (the weakly compressible
+  // scheme) or without it (DFSPH's non-pressure accelerations).
+  template <class Terms, bool kPressure>
   static Vec3 acceleration_with(const FluidConstants& fluid, const GridView& view, const ForceInputs& in,
                                 const SceneFrame& scene, uint32_t i);
   using AccelerationFn = Vec3 (*)(const FluidConstants&, const GridView&, const ForceInputs&,
                                   const SceneFrame&, uint32_t);
+  // The world's force pass: the solver's choice of the pressure force and the world's terms.
   AccelerationFn acceleration_function() const;
   // The arrays the force gather reads (normals and counts only where a term reads them).
   ForceInputs force_inputs() const;
@@ -100,6 +105,24 @@ class CpuBackend final : public Backend {
   // Resolves colliders for the state in next_position_/next_velocity_, moved from x_old(i).
   template <class OldPosition>
   void collide(const SceneFrame& scene, const SubstepTime& time, OldPosition&& x_old, FrameReport& report);
+  // The same from the positions `old` (xyz), for the files that do not see the template.
+  void collide_from(const SceneFrame& scene, const SubstepTime& time, const Float4* old, FrameReport& report);
+
+  // Loads (SPH_FEATURE_COLLIDER_LOADS, cpu_collider_loads.cpp): the frame's sums start at zero.
+  void begin_loads(const SceneFrame& scene);
+  bool loads_on() const { return (config_.features & kFeatureColliderLoads) != 0; }
+  // Where a substep's particles started, for the collision response: one of the two (none: no
+  // collision response in this pass).
+  struct OldPositions {
+    const Float4* records = nullptr;
+    const ParticleState* states = nullptr;
+  };
+  // One force evaluation's loads: the walls' pressure reactions (boundary density) over
+  // wall_seconds (its share of the substep; 0: none) at the stage's time `at`, then, when `old`
+  // names the start positions, the collision response of the state in next_* with its contact
+  // impulses. Adds to load_sums_.
+  void collide_with_loads(const FluidConstants& fluid, const SceneFrame& scene, const SubstepTime& time,
+                          StageTime at, float wall_seconds, OldPositions old, FrameReport& report);
 
   // Max speed and the first non-finite particle of the state in next_*.
   uint32_t scan_next_state(float& v2max) const;
@@ -115,6 +138,35 @@ class CpuBackend final : public Backend {
 
   uint32_t substep_rk4(const FluidConstants& fluid, const SceneFrame& scene, const SubstepTime& time,
                        FrameReport& report);
+
+  // DFSPH's substep (cpu_dfsph_solver.cpp; physics/dfsph.h): density and factor, the divergence
+  // solve, the non-pressure accelerations, the density solve, positions, colliders. The two
+  // solves add to the frame's tallies.
+  struct DfsphTallies {
+    SolveTally pressure = empty_solve_tally();
+    SolveTally divergence = empty_solve_tally();
+  };
+  uint32_t substep_dfsph(const FluidConstants& fluid, const SceneFrame& scene, const SubstepTime& time,
+                         FrameReport& report, DfsphTallies& tallies);
+  enum class DfsphSolve { Divergence, Density };
+  struct SolveOutcome {
+    uint32_t iterations;
+    float error;
+    bool capped;
+  };
+  // One solve over the velocities v (xyz; w: 1 / rho), from the warm start in `carried` (k,
+  // times carry_scale: dt for the divergence solve's impulse, 1 for the density solve's
+  // pressure), which it replaces with its own.
+  SolveOutcome dfsph_solve(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls, float dt,
+                           Float4* v, float* carried, float carry_scale);
+  // Each particle's contact with the scene's colliders (dfsph_contact_), for the solves.
+  void dfsph_find_contacts(const SceneFrame& scene, const SubstepTime& time);
+  // Applies the pressures of dfsph_step_ to v and adds them (times carry_scale) to carried.
+  void dfsph_correct(const FluidConstants& fluid, const DfsphWalls& walls, float dt, Float4* v,
+                     float* carried, float carry_scale);
+  // New pressures and errors from the rates over v; returns the mean error.
+  float dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls, float dt,
+                        const Float4* v);
 
   // Springs (SPH_FEATURE_SPRINGS), after the sort: the particles that wait for springs make
   // them (two passes, springs.h), then every particle gathers its spring acceleration into a
@@ -151,9 +203,20 @@ class CpuBackend final : public Backend {
   CpuArrayRef<uint32_t> link_from_;    // one word: the lowest id that waits for its springs
   CpuArrayRef<uint32_t> spring_candidates_;
   CpuArrayRef<Float4> spring_acceleration_;
+  CpuArrayRef<float> dfsph_pressure_;          // DFSPH: the density solve's p / rho^2 (warm start)
+  CpuArrayRef<float> dfsph_divergence_;        // DFSPH: the divergence solve's p / rho^2 times dt
+  CpuArrayRef<float> dfsph_factor_;            // DFSPH: alpha / rho of the density pass
+  CpuArrayRef<float> dfsph_step_;              // DFSPH: the iteration's p / rho^2
+  CpuArrayRef<float> dfsph_residual_;          // DFSPH: each particle's share of the solve's error
+  CpuArrayRef<Float4> dfsph_contact_;          // DFSPH: each particle's contact with the colliders
+  bool dfsph_contacts_ = false;                // DFSPH: the substep has colliders (contacts to respect)
+  std::vector<ColliderView> dfsph_colliders_;  // DFSPH: the substep's colliders, for the contacts
   CpuArrayRef<Float4> boundary_;  // boundary density: (grad rho_b, v_b . grad rho_b) per particle
   CpuBoundaryMaps boundary_maps_;
   std::vector<ColliderView> collider_views_;  // the frame's colliders, for the density pass
+  std::vector<ColliderLoadSums> load_sums_;   // the frame's impulses per collider (loads on)
+  std::vector<LoadImpulse> load_blocks_;      // per block of kLoadBlock particles and collider
+  std::vector<Vec3> load_points_;             // per collider: at the wall pass's time, at the end
   std::vector<uint32_t> keep_order_;
   SpringConstants spring_constants_{};
   uint32_t count_ = 0;

@@ -46,7 +46,13 @@ void CpuBackend::diagnose_non_finite(const FluidConstants& fluid, const SceneFra
   a += wall_acceleration(i);
   const ParticleState current{xyz(pos[i]), xyz(vel[i])};
   ParticleState integrated;
-  if (rk4_stage < 0) {
+  if (config_.solver == Solver::Dfsph) {
+    // DFSPH's velocity comes from its solves, which a recomputation here would repeat: its
+    // failure is classified from the density pass and the new state itself, so the solves and
+    // the non-pressure accelerations count as the integration (as on the CUDA backend).
+    a = Vec3{0.0f, 0.0f, 0.0f};
+    integrated = ParticleState{xyz(next_position_[i]), xyz(next_velocity_[i])};
+  } else if (rk4_stage < 0) {
     integrated = symplectic_euler(current, a, fluid.dt);
   } else if (rk4_stage < 3) {
     Rk4Accumulator sums = rk4_sum_[i];  // a copy: the stage has updated the sums already

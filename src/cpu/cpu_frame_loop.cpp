@@ -30,6 +30,7 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
   SceneFrame scene = scene_in;
   bind_scene_views(scene, [](const SdfAsset& a) { return a.host_view(); });
   bind_boundary_maps(fluid, scene);
+  begin_loads(scene);
   report.removed_by_sink.assign(scene.sinks.size(), 0u);
   const uint32_t count_before = count_;
   const auto saved = store_.snapshot();
@@ -52,14 +53,20 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
   };
   SubstepClock clock;
   start_clock(clock, frame_dt);
+  DfsphTallies tallies;
   try {
     while (clock_running(clock, params.stepping.max_substeps)) {
+      if (scene.interrupt.requested()) {
+        report.interrupted = true;
+        break;
+      }
       pick_next_step(clock, frame_dt, limits, std::max(max_speed_, scene.max_collider_speed),
                      max_acceleration_);
       fluid.dt = clock.dt_float;
-      const uint32_t bad = config_.integrator == Integrator::Rk4
-                               ? substep_rk4(fluid, scene, clock.time, report)
-                               : substep_euler(fluid, scene, clock.time, report);
+      const uint32_t bad =
+          config_.solver == Solver::Dfsph         ? substep_dfsph(fluid, scene, clock.time, report, tallies)
+          : config_.integrator == Integrator::Rk4 ? substep_rk4(fluid, scene, clock.time, report)
+                                                  : substep_euler(fluid, scene, clock.time, report);
       if (bad != kAllFinite) {
         roll_back();
         non_finite_.substep = clock.substeps + 1;
@@ -77,7 +84,10 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
     throw;
   }
   report_clock(clock, report);
+  report.pressure_solve = finish_solve(tallies.pressure);
+  report.divergence_solve = finish_solve(tallies.divergence);
   report.max_speed = max_speed_;
+  report.collider_loads = load_sums_;
   const auto t = Clock::now();
   summarize(report);
   report.stage_ms[kStageOther] += static_cast<float>(elapsed_ms(t));

@@ -1,5 +1,8 @@
 // The CPU backend's neighbour structure: a stable counting sort of particles by wrapped cell
-// hash, which yields the permutation and the dense cell-start table in one pass.
+// hash, which yields the permutation and the dense cell-start table in one pass. The table is
+// sized at every build from the particles' extent and count (core/grid_layout.h), and a build
+// that finds more than max_per_cell particles in one slot is refused (docs/reliability.md,
+// "What one call may cost").
 #pragma once
 
 #include <stdint.h>
@@ -14,24 +17,45 @@ namespace sph {
 // Below this many particles the CPU backend's loops run on one thread.
 constexpr uint32_t kParallelMinimum = 4096;
 
+// A cell may hold this many times the particles a cell of fluid at rest holds (sqrt(2) h^3 /
+// spacing^3, the FCC lattice's number density) before a step is refused: 64 times the rest
+// density is far beyond any state of the weakly compressible fluids (a few per cent) or the
+// gases the solver models, and it bounds the candidates one particle visits to 27 times the
+// cap (64 times a fluid at rest's), whatever the particles do.
+constexpr double kMaxCellDensityRatio = 64.0;
+constexpr uint32_t kMinCellCap = 64;
+
+// The most particles one grid slot may hold for a world of this spacing and kernel radius.
+uint32_t max_particles_per_cell(float particle_spacing, float kernel_radius);
+
 class CpuNeighborGrid {
  public:
-  explicit CpuNeighborGrid(const GridShape& shape) : shape_(shape) {}
+  CpuNeighborGrid(float kernel_radius, uint32_t max_per_cell)
+      : inv_cell_size_(1.0f / kernel_radius), kernel_radius_(kernel_radius), max_per_cell_(max_per_cell) {}
 
   // Hashes positions[0..n) and computes the stable order by cell (order()[i] is the old index
   // of the particle that goes to place i). Fills the cell-start table for the sorted order.
+  // Throws Error(Capacity) when a slot holds more than max_per_cell particles (nothing the
+  // caller owns has changed: the world's frame rolls back).
   void build(const Float4* positions, uint32_t n, unsigned workers);
 
   const std::vector<uint32_t>& order() const { return order_; }
   GridView view() const { return GridView{shape_, cell_start_.data()}; }
   const GridShape& shape() const { return shape_; }
+  uint32_t max_per_cell() const { return max_per_cell_; }
   size_t bytes() const {
     return (hashes_.capacity() + order_.capacity() + cell_start_.capacity() + cursor_.capacity()) *
            sizeof(uint32_t);
   }
 
  private:
-  GridShape shape_;
+  void choose_shape(const Float4* positions, uint32_t n, unsigned workers);
+  void refuse_crowded_slot(const Float4* positions, uint32_t n, uint32_t slot, uint32_t held) const;
+
+  float inv_cell_size_;
+  float kernel_radius_;
+  uint32_t max_per_cell_;
+  GridShape shape_{1.0f, 3, 3, 3, 27};
   std::vector<uint32_t> hashes_;
   std::vector<uint32_t> order_;
   std::vector<uint32_t> cell_start_;

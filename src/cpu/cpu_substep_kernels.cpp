@@ -3,6 +3,7 @@
 // with the world's options compiled in (the twin of cuda/substep_kernels.cu).
 #include "../physics/density.h"
 #include "../physics/density_normalization.h"
+#include "../physics/dfsph_passes.h"
 #include "../physics/surface_tension.h"
 #include "cpu_backend_impl.h"
 
@@ -25,26 +26,46 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
   const ColliderView* colliders = collider_views_.data();
   const uint32_t collider_count = static_cast<uint32_t>(collider_views_.size());
   (void)scene;  // its colliders, with their maps bound, are collider_views_
+  // The walls' share at particle i (SPH_FEATURE_BOUNDARY_DENSITY), its record kept for the force
+  // pass and DFSPH's solves; none without the feature.
+  auto wall = [&](int i) {
+    if (!boundary) return no_boundary_share();
+    const BoundaryShare b =
+        boundary_share(fluid.methods.boundary, colliders, collider_count, xyz(pos[i]), at.s, at.tau);
+    boundary[i] = pack_boundary(b);
+    return b;
+  };
+  if (config_.solver == Solver::Dfsph) {
+    // DFSPH: the density and the factor alpha / rho in one walk; no equation of state (w: the
+    // pressure, written when the density solve has found it).
+    float* dfsph_factor = dfsph_factor_.data();
 #pragma omp parallel for num_threads(threads()) schedule(static)
-  for (int i = 0; i < n(); ++i) {
-    DensitySample s = gather_density(fluid, view, pos, static_cast<uint32_t>(i));
-    if (boundary) {
+    for (int i = 0; i < n(); ++i) {
+      const DfsphDensitySample s =
+          gather_density_and_factor(fluid, view, pos, wall(i), static_cast<uint32_t>(i));
+      density_[i] = s.density;
+      neighbors_[i] = s.neighbor_count;
+      dfsph_factor[i] = s.factor;
+      pos[i].w = 0.0f;
+      vel[i].w = 1.0f / s.density;
+    }
+  } else {
+#pragma omp parallel for num_threads(threads()) schedule(static)
+    for (int i = 0; i < n(); ++i) {
+      DensitySample s = gather_density(fluid, view, pos, static_cast<uint32_t>(i));
       // The walls' share is part of the summation (and so of a normalised density's kernel sum).
-      const BoundaryShare b =
-          boundary_share(fluid.methods.boundary, colliders, collider_count, xyz(pos[i]), at.s, at.tau);
-      s.density += b.density;
-      boundary[i] = pack_boundary(b);
+      s.density += wall(i).density;
+      float rho = s.density;
+      if (factor) {
+        normalized_[i] = s.density;  // the summation, for the factor after the filter
+        rho = carried_density(fluid, s.density, factor[i]);
+      }
+      density_[i] = rho;
+      neighbors_[i] = s.neighbor_count;
+      // Only the w slots are written; neighbours read x, y, z alone.
+      pos[i].w = pressure_from_density(fluid.methods.eos, rho);
+      vel[i].w = 1.0f / rho;
     }
-    float rho = s.density;
-    if (factor) {
-      normalized_[i] = s.density;  // the summation, for the factor after the filter
-      rho = carried_density(fluid, s.density, factor[i]);
-    }
-    density_[i] = rho;
-    neighbors_[i] = s.neighbor_count;
-    // Only the w slots are written; neighbours read x, y, z alone.
-    pos[i].w = pressure_from_density(fluid.methods.eos, rho);
-    vel[i].w = 1.0f / rho;
   }
   if (factor) {
     // Eq. 31 over every carried rho_j: each particle writes only its own factor and side
@@ -73,17 +94,19 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
 
 // Acceleration of particle i: the neighbour gather with the world's force terms compiled in
 // (forces.h), plus the scene's force fields.
-template <class Terms>
+template <class Terms, bool kPressure>
 Vec3 CpuBackend::acceleration_with(const FluidConstants& fluid, const GridView& view, const ForceInputs& in,
                                    const SceneFrame& scene, uint32_t i) {
-  Vec3 a = gather_acceleration<Terms>(fluid, view, in, i);
+  Vec3 a = gather_acceleration<Terms, kPressure>(fluid, view, in, i);
   for (const ForceFieldFrame& f : scene.fields) a += force_field_acceleration(f.view, xyz(in.positions[i]));
   return a;
 }
 
 CpuBackend::AccelerationFn CpuBackend::acceleration_function() const {
-  return with_force_terms(config_.selection(),
-                          [](auto terms) -> AccelerationFn { return &acceleration_with<decltype(terms)>; });
+  const bool pressure = config_.solver == Solver::WeaklyCompressible;
+  return with_force_terms(config_.selection(), [pressure](auto terms) -> AccelerationFn {
+    return pressure ? &acceleration_with<decltype(terms), true> : &acceleration_with<decltype(terms), false>;
+  });
 }
 
 ForceInputs CpuBackend::force_inputs() const {

@@ -29,6 +29,12 @@ void CpuBackend::collide(const SceneFrame& scene, const SubstepTime& time, OldPo
   report.stage_ms[kStageCollide] += static_cast<float>(elapsed_ms(t));
 }
 
+void CpuBackend::collide_from(const SceneFrame& scene, const SubstepTime& time, const Float4* old,
+                              FrameReport& report) {
+  collide(
+      scene, time, [old](uint32_t i) { return xyz(old[i]); }, report);
+}
+
 uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame& scene,
                                    const SubstepTime& time, FrameReport& report) {
   sort_and_density(fluid, scene, stage_time(time, 0.0f), report);
@@ -56,8 +62,14 @@ uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame
   }
   max_acceleration_ = std::sqrt(a2max);
   report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
-  collide(
-      scene, time, [&](uint32_t i) { return xyz(pos[i]); }, report);
+  if (loads_on()) {
+    OldPositions old;
+    old.records = pos;
+    collide_with_loads(fluid, scene, time, stage_time(time, 0.0f), dt, old, report);
+  } else {
+    collide(
+        scene, time, [&](uint32_t i) { return xyz(pos[i]); }, report);
+  }
   t = Clock::now();
   float v2max = 0.0f;
   const uint32_t bad_index = scan_next_state(v2max);
@@ -99,9 +111,15 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
       next_vel[i] = make_float4_record(s.velocity, vel[i].w);
     }
     report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
-    if (stage == 3)
+    if (loads_on() && (boundary_ || stage == 3)) {  // the walls' reactions, the contacts after the last
+      OldPositions old;
+      if (stage == 3) old.states = start;
+      collide_with_loads(fluid, scene, time, stage_time(time, rk4_stage_fraction(stage)),
+                         rk4_weight(stage) * dt, old, report);
+    } else if (stage == 3) {
       collide(
           scene, time, [start](uint32_t i) { return start[i].position; }, report);
+    }
     t = Clock::now();
     float v2max = 0.0f;
     const uint32_t bad_index = scan_next_state(v2max);

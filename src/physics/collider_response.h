@@ -27,6 +27,8 @@ struct ColliderView {
   // The asset's boundary-density correction for the world's h (boundary_map.h), one Float4 per
   // SDF voxel in the memory the SDF view points to; null without SPH_FEATURE_BOUNDARY_DENSITY.
   const Float4* boundary_map;
+  // The point the loads' torque is taken about, in the collider's frame (collider_loads.h).
+  Vec3 load_point;
 };
 
 struct SubstepTime {

@@ -76,11 +76,13 @@ SPH_HD bool is_force_neighbor(const FluidConstants& f, float r2, uint32_t i, uin
 }
 
 // One particle's gather: construct, add() every force neighbour j (in the order of the
-// neighbour walk), then finish().
-template <class Terms>
+// neighbour walk), then finish(). kPressure: whether the symmetric pressure force is part of it
+// (the weakly compressible scheme); DFSPH gathers the other terms alone (its pressure comes
+// from its solves, dfsph.h), and its records' position.w holds no pressure.
+template <class Terms, bool kPressure = true>
 class AccelerationGather;
-template <class... Terms>
-class AccelerationGather<ForceTerms<Terms...>> {
+template <class... Terms, bool kPressure>
+class AccelerationGather<ForceTerms<Terms...>, kPressure> {
  public:
   using List = TermList<Terms...>;
 
@@ -108,12 +110,12 @@ class AccelerationGather<ForceTerms<Terms...>> {
     pair.pair_neighbors =
         List::kReadsNeighborCounts ? self_.neighbor_count + static_cast<float>(in_.neighbor_counts[j]) : 0.0f;
     pair.normal = List::kReadsColourNormals ? in_.colour_normals + j : nullptr;
-    SymmetricPressure::add_pair(f, self_, pair, pressure_);
+    if (kPressure) SymmetricPressure::add_pair(f, self_, pair, pressure_);
     List::add(f, self_, pair, sums_);
   }
 
   SPH_HD Vec3 finish(const FluidConstants& f) const {
-    Vec3 a = SymmetricPressure::acceleration(f, self_, pressure_) + f.gravity;
+    Vec3 a = kPressure ? SymmetricPressure::acceleration(f, self_, pressure_) + f.gravity : f.gravity;
     List::finish(f, self_, sums_, a);
     return a;
   }
@@ -126,10 +128,10 @@ class AccelerationGather<ForceTerms<Terms...>> {
 };
 
 // The whole gather for particle i, walking the neighbour cells in order.
-template <class Terms>
+template <class Terms, bool kPressure = true>
 SPH_HD Vec3 gather_acceleration(const FluidConstants& f, const GridView& grid, const ForceInputs& in,
                                 uint32_t i) {
-  AccelerationGather<Terms> gather(in, i);
+  AccelerationGather<Terms, kPressure> gather(in, i);
   const Vec3 xi = gather.position();
   for_each_neighbor_candidate(grid, xi, [&](uint32_t j) {
     const Float4 pj = in.positions[j];

@@ -9,7 +9,9 @@
 #include <type_traits>
 
 #include "boundary_density.h"
+#include "collider_loads.h"
 #include "density_normalization.h"
+#include "dfsph.h"
 #include "eos_ideal_gas.h"
 #include "eos_tait.h"
 #include "pressure_force.h"
@@ -18,6 +20,7 @@
 #include "surface_tension.h"
 #include "viscosity_clavet.h"
 #include "viscosity_mueller.h"
+#include "weakly_compressible.h"
 #include "world_shape.h"
 
 namespace sph {
@@ -29,8 +32,9 @@ enum FeatureBits : uint32_t {
   kFeatureNormalizedDensity = 1u << 1,
   kFeatureSprings = 1u << 2,
   kFeatureBoundaryDensity = 1u << 3,
-  kFeatureAll =
-      kFeatureSurfaceTension | kFeatureNormalizedDensity | kFeatureSprings | kFeatureBoundaryDensity,
+  kFeatureColliderLoads = 1u << 4,
+  kFeatureAll = kFeatureSurfaceTension | kFeatureNormalizedDensity | kFeatureSprings |
+                kFeatureBoundaryDensity | kFeatureColliderLoads,
 };
 
 enum class ViscosityMethod : uint32_t { Mueller = 0, Clavet = 1 };
@@ -39,6 +43,9 @@ enum class ViscosityMethod : uint32_t { Mueller = 0, Clavet = 1 };
 // The choice is made at run time, per density evaluation: a branch on a value every thread
 // shares, cheaper than another template dimension.
 enum class EquationOfState : uint32_t { IdealGas = 0, Tait = 1 };
+
+// The solver: the thesis's weakly compressible scheme, or DFSPH (dfsph.h). Equal to sph_solver.
+enum class Solver : uint32_t { WeaklyCompressible = 0, Dfsph = 1 };
 
 struct EosConstants {
   EquationOfState kind;
@@ -70,11 +77,12 @@ struct MethodSelection {
   uint32_t features = 0;  // FeatureBits
   ViscosityMethod viscosity = ViscosityMethod::Mueller;
   EquationOfState equation_of_state = EquationOfState::IdealGas;
+  Solver solver = Solver::WeaklyCompressible;
 };
 
 // How a world turns a method on (values equal to sph_method_switch): a feature bit, or a value
 // of one of sph_world_def's method fields.
-enum class SwitchKind : uint32_t { Feature = 1, Viscosity = 2, EquationOfState = 3 };
+enum class SwitchKind : uint32_t { Feature = 1, Viscosity = 2, EquationOfState = 3, Solver = 4 };
 struct MethodSwitch {
   SwitchKind kind;
   uint32_t value;
@@ -99,9 +107,16 @@ constexpr MethodSwitch switch_of(Tag<NormalizedDensity>) {
   return {SwitchKind::Feature, kFeatureNormalizedDensity};
 }
 constexpr MethodSwitch switch_of(Tag<Springs>) { return {SwitchKind::Feature, kFeatureSprings}; }
+constexpr MethodSwitch switch_of(Tag<WeaklyCompressible>) {
+  return {SwitchKind::Solver, static_cast<uint32_t>(Solver::WeaklyCompressible)};
+}
+constexpr MethodSwitch switch_of(Tag<Dfsph>) {
+  return {SwitchKind::Solver, static_cast<uint32_t>(Solver::Dfsph)};
+}
 constexpr MethodSwitch switch_of(Tag<BoundaryDensity>) {
   return {SwitchKind::Feature, kFeatureBoundaryDensity};
 }
+constexpr MethodSwitch switch_of(Tag<ColliderLoads>) { return {SwitchKind::Feature, kFeatureColliderLoads}; }
 
 // Calls visit(Tag<Method>{}) for every method a world can choose, in the list's order.
 template <class Visit>
@@ -113,7 +128,10 @@ void for_each_method(Visit&& visit) {
   visit(Tag<SurfaceTension>{});
   visit(Tag<NormalizedDensity>{});
   visit(Tag<Springs>{});
+  visit(Tag<WeaklyCompressible>{});
+  visit(Tag<Dfsph>{});
   visit(Tag<BoundaryDensity>{});
+  visit(Tag<ColliderLoads>{});
 }
 
 // Whether a value of a sph_world_def method field (or a feature bit) names a method of the list,
@@ -128,11 +146,13 @@ inline bool selects_a_method(SwitchKind kind, uint32_t value) {
 }
 
 constexpr bool selects(const MethodSelection& s, MethodSwitch m) {
-  return m.kind == SwitchKind::Feature     ? (s.features & m.value) != 0
-         : m.kind == SwitchKind::Viscosity ? static_cast<uint32_t>(s.viscosity) == m.value
-                                           : static_cast<uint32_t>(s.equation_of_state) == m.value;
+  return m.kind == SwitchKind::Feature           ? (s.features & m.value) != 0
+         : m.kind == SwitchKind::Viscosity       ? static_cast<uint32_t>(s.viscosity) == m.value
+         : m.kind == SwitchKind::EquationOfState ? static_cast<uint32_t>(s.equation_of_state) == m.value
+                                                 : static_cast<uint32_t>(s.solver) == m.value;
 }
-// Whether a world runs a method (the pressure force and the world's stepping always run).
+// Whether a world runs a method (the world's stepping always runs; the symmetric pressure force
+// with the weakly compressible solver).
 template <class Method>
 bool runs(const MethodSelection& s, Tag<Method> method) {
   return selects(s, switch_of(method));
@@ -146,6 +166,7 @@ struct MethodParams {
   ClavetViscosity::Params clavet;
   SurfaceTension::Params surface_tension;
   Springs::Params springs;
+  Dfsph::Params dfsph;
 };
 
 // Calls visit(Tag<Method>{}, params) for each method with parameters, in the list's order (the
@@ -158,6 +179,7 @@ void for_each_method_params(Params& p, Visit&& visit) {
   visit(Tag<ClavetViscosity>{}, p.clavet);
   visit(Tag<SurfaceTension>{}, p.surface_tension);
   visit(Tag<Springs>{}, p.springs);
+  visit(Tag<Dfsph>{}, p.dfsph);
 }
 
 // ---- constants: derived per frame from the Params and the world's shape ---------------------
@@ -168,6 +190,7 @@ struct MethodConstants {
   ClavetViscosity::Constants clavet;
   SurfaceTension::Constants surface_tension;
   Springs::Constants springs;
+  Dfsph::Constants dfsph;
   BoundaryDensity::Constants boundary;
 };
 
@@ -190,6 +213,7 @@ inline MethodConstants make_method_constants(const MethodParams& p, const Method
   if (runs(s, Tag<SurfaceTension>{}))
     m.surface_tension = SurfaceTension::make_constants(p.surface_tension, shape, lattice);
   if (runs(s, Tag<Springs>{})) m.springs = Springs::make_constants(p.springs, shape);
+  if (runs(s, Tag<Dfsph>{})) m.dfsph = Dfsph::make_constants(p.dfsph, shape, lattice);
   if (runs(s, Tag<BoundaryDensity>{})) m.boundary = BoundaryDensity::make_constants(shape, lattice);
   return m;
 }
@@ -206,6 +230,7 @@ SPH_HD const SurfaceTension::Constants& constants_of(const MethodConstants& m, T
 }
 
 // ---- the stability ceiling: the smallest of the running methods' ceilings (0: none) ---------
+// The acoustic ceiling is the weakly compressible scheme's: DFSPH has no equation of state.
 inline float method_stability_ceiling(const MethodParams& p, const MethodSelection& s,
                                       const WorldShape& shape) {
   const EosConstants eos = make_eos_constants(p, s, shape);
@@ -213,7 +238,8 @@ inline float method_stability_ceiling(const MethodParams& p, const MethodSelecti
   auto take = [&dt](float ceiling) {
     if (ceiling > 0.0f && (dt == 0.0f || ceiling < dt)) dt = ceiling;
   };
-  take(SymmetricPressure::stability_ceiling(shape.kernel_radius, speed_of_sound(eos)));
+  if (runs(s, Tag<WeaklyCompressible>{}))
+    take(SymmetricPressure::stability_ceiling(shape.kernel_radius, speed_of_sound(eos)));
   if (runs(s, Tag<MuellerViscosity>{})) take(MuellerViscosity::stability_ceiling(p.mueller, shape));
   if (runs(s, Tag<Springs>{})) take(Springs::stability_ceiling(p.springs));
   return dt;

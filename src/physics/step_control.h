@@ -16,6 +16,11 @@ enum StepLimitBits : uint32_t { kStepLimitAcoustic = 1u << 0, kStepLimitForce = 
 
 // The world's own runtime parameters (the rest of sph_world_params belongs to the equation of
 // state and the viscosity): gravity, and how substeps are chosen.
+// The most substeps one frame may be allowed: 100 times the default, so that max_substeps alone
+// cannot let one sph_world_step run for hours (issue 23 item 9; the step budget bounds the
+// wall-clock time itself).
+constexpr double kMaxSubstepsBound = 1000000.0;
+
 struct Stepping {
   static constexpr const char* kName = "stepping";
 
@@ -28,7 +33,7 @@ struct Stepping {
     uint32_t step_limits = 0;          // StepLimitBits
   };
   static constexpr ParamField<Params> kFields[] = {
-      count_field("max_substeps", &Params::max_substeps, at_least(1.0), ZeroMeans::Default),
+      count_field("max_substeps", &Params::max_substeps, within(1.0, kMaxSubstepsBound), ZeroMeans::Default),
       vector_field("gravity", &Params::gravity, ZeroMeans::Value, "m/s^2"),
       real_field("step_factor", &Params::step_factor, above_up_to(0.0, 10.0), ZeroMeans::Default, ""),
       real_field("dt_min", &Params::dt_min, above(0.0), ZeroMeans::Default, "s"),

@@ -3,6 +3,8 @@
 // fcc_lattice.cpp); the physics layer only names them, so it includes nothing from core.
 #pragma once
 
+#include <stdint.h>
+
 namespace sph {
 
 struct WorldShape {
@@ -16,6 +18,7 @@ struct WorldShape {
 struct LatticeSums {
   double (*surface_delta_integral)(float spacing, float kernel_radius, float threshold);
   double (*cohesion_surface_energy)(float spacing, float kernel_radius);
+  uint32_t (*neighbor_count)(float spacing, float kernel_radius);  // lattice points within h, self excluded
   // The boundary density's scale (1/m^3; times the particle mass, K) and its wall offset (m)
   // (fcc_boundary_calibration).
   void (*boundary_calibration)(float spacing, float kernel_radius, double* scale, double* offset);

@@ -17,9 +17,16 @@
 typedef struct world_fixture {
   sph_context* context;
   sph_world* world;
+  sph_world* dfsph; /* the DFSPH solver's world: its params (it excludes Tait) */
 } world_fixture;
 
-/* A world that runs every method with parameters, so every params struct is accepted. */
+/* The fixture's world that runs the method whose params are of `kind`. */
+static sph_world* world_of(const world_fixture* f, uint32_t kind) {
+  return kind == SPH_PARAMS_DFSPH ? f->dfsph : f->world;
+}
+
+/* A world that runs every method with parameters but DFSPH, and a DFSPH world, so every params
+ * struct is accepted by one of them. */
 static int open_all_options(void** state) {
   static world_fixture f;
   sph_world_def def;
@@ -31,6 +38,11 @@ static int open_all_options(void** state) {
   def.viscosity_method = SPH_VISCOSITY_CLAVET;
   def.equation_of_state = SPH_EOS_TAIT;
   assert_int_equal(sph_world_create(f.context, &def, &f.world), SPH_OK);
+  sph_world_def_init(&def);
+  def.capacity = 256;
+  def.particle_spacing = SPACING;
+  def.solver = SPH_SOLVER_DFSPH;
+  assert_int_equal(sph_world_create(f.context, &def, &f.dfsph), SPH_OK);
   *state = &f;
   return 0;
 }
@@ -38,6 +50,7 @@ static int open_all_options(void** state) {
 static int close_world(void** state) {
   world_fixture* f = (world_fixture*)*state;
   sph_world_destroy(f->world);
+  sph_world_destroy(f->dfsph);
   sph_context_destroy(f->context);
   return 0;
 }
@@ -162,8 +175,8 @@ static void test_zero_rule_matches_the_descriptions(void** state) {
     params_buffer got;
     sph_params_info info;
     uint32_t k;
-    EXPECT_OK(sph_world_set_physics_params(f->world, (sph_params_kind)kind, zero.u.bytes));
-    got = read_back(f->world, (sph_params_kind)kind);
+    EXPECT_OK(sph_world_set_physics_params(world_of(f, kind), (sph_params_kind)kind, zero.u.bytes));
+    got = read_back(world_of(f, kind), (sph_params_kind)kind);
     sph_params_info_init(&info);
     EXPECT_OK(sph_params_get_info((sph_params_kind)kind, &info));
     for (k = 0; k < info.field_count; ++k) {
@@ -211,13 +224,13 @@ static void shortest(float v, char* out, size_t size) {
 static void expect_rule(world_fixture* f, const rule_case* c, const params_buffer* base) {
   params_buffer p = *base, before, after;
   char expected[256];
-  before = read_back(f->world, c->kind);
+  before = read_back(world_of(f, c->kind), c->kind);
   memcpy(p.u.bytes + c->offset, &c->value, sizeof c->value);
-  assert_int_equal(sph_world_set_physics_params(f->world, c->kind, p.u.bytes), c->code);
+  assert_int_equal(sph_world_set_physics_params(world_of(f, c->kind), c->kind, p.u.bytes), c->code);
   snprintf(expected, sizeof expected, "sph_world_set_physics_params: %s", c->message);
   if (strcmp(sph_get_last_error(), expected) != 0)
     fail_msg("message \"%s\", expected \"%s\"", sph_get_last_error(), expected);
-  after = read_back(f->world, c->kind);
+  after = read_back(world_of(f, c->kind), c->kind);
   assert_memory_equal(before.u.bytes, after.u.bytes, sizeof before.u.bytes);
 }
 
@@ -262,10 +275,14 @@ static void test_each_rule_fires_with_its_message(void** state) {
        "params->plasticity: must be >= 0, got -3"},
       {SPH_PARAMS_SPRINGS, offsetof(sph_spring_params, damping), -0.25f, SPH_ERROR_INVALID_ARGUMENT,
        "params->damping: must be >= 0, got -0.25"},
+      {SPH_PARAMS_DFSPH, offsetof(sph_dfsph_params, density_error), 1.5f, SPH_ERROR_INVALID_ARGUMENT,
+       "params->density_error: must be in (0, 1], got 1.5"},
+      {SPH_PARAMS_DFSPH, offsetof(sph_dfsph_params, divergence_error), -1.0f, SPH_ERROR_INVALID_ARGUMENT,
+       "params->divergence_error: must be > 0, got -1"},
   };
   size_t i;
   for (i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
-    const params_buffer base = read_back(f->world, cases[i].kind);
+    const params_buffer base = read_back(world_of(f, cases[i].kind), cases[i].kind);
     expect_rule(f, &cases[i], &base);
   }
   /* Words that are not floats: unknown step-limit bits and the reserved words. */
@@ -281,7 +298,7 @@ static void test_each_rule_fires_with_its_message(void** state) {
          "params->reserved0: is reserved and must be 0"},
     };
     for (i = 0; i < sizeof words / sizeof words[0]; ++i) {
-      const params_buffer base = read_back(f->world, words[i].kind);
+      const params_buffer base = read_back(world_of(f, words[i].kind), words[i].kind);
       expect_rule(f, &words[i], &base);
     }
   }
@@ -320,7 +337,7 @@ static void test_described_ranges_are_enforced(void** state) {
     EXPECT_OK(sph_params_get_info((sph_params_kind)kind, &info));
     for (k = 0; k < info.field_count; ++k) {
       sph_param_field_info field;
-      const params_buffer base = read_back(f->world, (sph_params_kind)kind);
+      const params_buffer base = read_back(world_of(f, kind), (sph_params_kind)kind);
       params_buffer p;
       char name[64];
       float bad;
@@ -332,7 +349,7 @@ static void test_described_ranges_are_enforced(void** state) {
       bad = NAN;
       memcpy(p.u.bytes + field.offset, &bad, sizeof bad);
       EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, name,
-                   sph_world_set_physics_params(f->world, (sph_params_kind)kind, p.u.bytes));
+                   sph_world_set_physics_params(world_of(f, kind), (sph_params_kind)kind, p.u.bytes));
       if (field.lower_bound != SPH_BOUND_NONE) {
         const float lower = (float)field.lower;
         p = base;
@@ -341,12 +358,12 @@ static void test_described_ranges_are_enforced(void** state) {
         if (!(bad == 0.0f && field.zero == SPH_PARAM_ZERO_IS_DEFAULT)) {
           memcpy(p.u.bytes + field.offset, &bad, sizeof bad);
           EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, name,
-                       sph_world_set_physics_params(f->world, (sph_params_kind)kind, p.u.bytes));
+                       sph_world_set_physics_params(world_of(f, kind), (sph_params_kind)kind, p.u.bytes));
         }
         if (field.lower_bound == SPH_BOUND_INCLUSIVE) {
           p = base;
           memcpy(p.u.bytes + field.offset, &lower, sizeof lower);
-          EXPECT_OK(sph_world_set_physics_params(f->world, (sph_params_kind)kind, p.u.bytes));
+          EXPECT_OK(sph_world_set_physics_params(world_of(f, kind), (sph_params_kind)kind, p.u.bytes));
         }
       }
       if (field.upper_bound != SPH_BOUND_NONE) {
@@ -355,12 +372,12 @@ static void test_described_ranges_are_enforced(void** state) {
         bad = field.upper_bound == SPH_BOUND_EXCLUSIVE ? upper : nextafterf(upper, INFINITY);
         memcpy(p.u.bytes + field.offset, &bad, sizeof bad);
         EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, name,
-                     sph_world_set_physics_params(f->world, (sph_params_kind)kind, p.u.bytes));
+                     sph_world_set_physics_params(world_of(f, kind), (sph_params_kind)kind, p.u.bytes));
         p = base;
         memcpy(p.u.bytes + field.offset, &upper, sizeof upper);
-        EXPECT_OK(sph_world_set_physics_params(f->world, (sph_params_kind)kind, p.u.bytes));
+        EXPECT_OK(sph_world_set_physics_params(world_of(f, kind), (sph_params_kind)kind, p.u.bytes));
       }
-      EXPECT_OK(sph_world_set_physics_params(f->world, (sph_params_kind)kind, base.u.bytes));
+      EXPECT_OK(sph_world_set_physics_params(world_of(f, kind), (sph_params_kind)kind, base.u.bytes));
     }
   }
 }
@@ -411,6 +428,16 @@ static void test_descriptions_match_the_header(void** state) {
        SPH_PARAM_ZERO_IS_VALUE},
       {SPH_PARAMS_SPRINGS, "damping", offsetof(sph_spring_params, damping), SPH_PARAM_FLOAT,
        SPH_PARAM_ZERO_IS_VALUE},
+      {SPH_PARAMS_DFSPH, "density_error", offsetof(sph_dfsph_params, density_error), SPH_PARAM_FLOAT,
+       SPH_PARAM_ZERO_IS_DEFAULT},
+      {SPH_PARAMS_DFSPH, "divergence_error", offsetof(sph_dfsph_params, divergence_error), SPH_PARAM_FLOAT,
+       SPH_PARAM_ZERO_IS_DEFAULT},
+      {SPH_PARAMS_DFSPH, "max_iterations", offsetof(sph_dfsph_params, max_iterations), SPH_PARAM_UINT32,
+       SPH_PARAM_ZERO_IS_DEFAULT},
+      {SPH_PARAMS_DFSPH, "max_divergence_iterations", offsetof(sph_dfsph_params, max_divergence_iterations),
+       SPH_PARAM_UINT32, SPH_PARAM_ZERO_IS_DEFAULT},
+      {SPH_PARAMS_DFSPH, "flags", offsetof(sph_dfsph_params, flags), SPH_PARAM_FLAGS,
+       SPH_PARAM_ZERO_IS_VALUE},
   };
   const struct {
     const char* name;
@@ -422,6 +449,7 @@ static void test_descriptions_match_the_header(void** state) {
       {"clavet", "sph_clavet_viscosity_params", sizeof(sph_clavet_viscosity_params), 2},
       {"tait", "sph_tait_params", sizeof(sph_tait_params), 1},
       {"springs", "sph_spring_params", sizeof(sph_spring_params), 5},
+      {"dfsph", "sph_dfsph_params", sizeof(sph_dfsph_params), 5},
   };
   size_t i, seen[SPH_PARAMS_KIND_COUNT] = {0};
   sph_params_info info;
@@ -478,7 +506,10 @@ static void test_methods_are_listed_with_their_switches(void** state) {
        SPH_PARAMS_SURFACE_TENSION},
       {"normalized_density", SPH_METHOD_SWITCH_FEATURE, SPH_FEATURE_NORMALIZED_DENSITY, 0, SPH_PARAMS_WORLD},
       {"springs", SPH_METHOD_SWITCH_FEATURE, SPH_FEATURE_SPRINGS, 1, SPH_PARAMS_SPRINGS},
+      {"wcsph", SPH_METHOD_SWITCH_SOLVER, SPH_SOLVER_WCSPH, 0, SPH_PARAMS_WORLD},
+      {"dfsph", SPH_METHOD_SWITCH_SOLVER, SPH_SOLVER_DFSPH, 1, SPH_PARAMS_DFSPH},
       {"boundary_density", SPH_METHOD_SWITCH_FEATURE, SPH_FEATURE_BOUNDARY_DENSITY, 0, SPH_PARAMS_WORLD},
+      {"collider_loads", SPH_METHOD_SWITCH_FEATURE, SPH_FEATURE_COLLIDER_LOADS, 0, SPH_PARAMS_WORLD},
   };
   const uint32_t n = (uint32_t)(sizeof expected / sizeof expected[0]);
   sph_physics_method_info info;

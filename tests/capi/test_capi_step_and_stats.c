@@ -42,7 +42,15 @@ static void test_stats_errors(void** state) {
   assert_int_equal(s.struct_size, 4);
   assert_int_equal(s.particle_count, 0xababababu);
   EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "stats", sph_stats_init_sized(NULL, sizeof s));
-  EXPECT_ERROR(SPH_ERROR_VERSION_MISMATCH, "stats", sph_stats_init_sized(&s, sizeof s - 8));
+  /* Below the first released size (0.1.0: 104 bytes, before DFSPH's solve statistics). */
+  EXPECT_ERROR(SPH_ERROR_VERSION_MISMATCH, "stats", sph_stats_init_sized(&s, 104 - 8));
+  /* A 0.1.0 caller's size: accepted, its prefix written, nothing past it. */
+  memset(&s, 0xab, sizeof s);
+  EXPECT_OK(sph_stats_init_sized(&s, 104));
+  assert_int_equal(s.struct_size, 104);
+  assert_int_equal(s.pressure_iterations, 0xababababu);
+  EXPECT_OK(sph_world_get_stats(f->world, &s));
+  assert_int_equal(s.pressure_iterations, 0xababababu);
   /* An older caller's shorter struct: only its prefix is written. */
   memset(&s, 0xab, sizeof s);
   s.struct_size = (uint32_t)offsetof(sph_stats, simulated_time);

@@ -64,8 +64,16 @@ static void test_def_init(void** state) {
   (void)state;
   EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "def", sph_world_def_init_sized(NULL, sizeof def));
   memset(&def, 0xab, sizeof def);
-  EXPECT_ERROR(SPH_ERROR_VERSION_MISMATCH, "def", sph_world_def_init_sized(&def, sizeof def - 1));
+  /* Below the struct's first released size (0.1.0: 40 bytes, before the solver): refused. */
+  EXPECT_ERROR(SPH_ERROR_VERSION_MISMATCH, "def", sph_world_def_init_sized(&def, 40 - 1));
   assert_int_equal(def.struct_size, 0xababababu);
+  /* A 0.1.0 caller's size: its prefix is filled, nothing past it. */
+  EXPECT_OK(sph_world_def_init_sized(&def, 40));
+  assert_int_equal(def.struct_size, 40);
+  assert_int_equal(def.capacity, 65536);
+  assert_int_equal((uint32_t)def.solver, 0xababababu);
+  EXPECT_OK(sph_world_def_init(&def));
+  assert_int_equal(def.solver, SPH_SOLVER_WCSPH);
   EXPECT_OK(sph_world_def_init(&def));
   assert_int_equal(def.struct_size, sizeof def);
   assert_int_equal(def.header_version, SPH_VERSION);
@@ -119,8 +127,14 @@ static void test_create_struct_size(void** state) {
   (void)state;
   memset(&grown, 0, sizeof grown);
   small_world_def(&grown.def);
-  grown.def.struct_size = sizeof grown.def - 4;
+  grown.def.struct_size = 40 - 4;
   EXPECT_CREATE_FAILS(context, &grown.def, SPH_ERROR_VERSION_MISMATCH, "struct_size");
+  /* A 0.1.0 caller's def, without the solver: accepted, the solver reads as zero (WCSPH),
+     whatever the bytes after its struct hold. */
+  grown.def.struct_size = 40;
+  grown.def.solver = (sph_solver)77;
+  expect_create_ok(context, &grown.def);
+  grown.def.solver = SPH_SOLVER_WCSPH;
   grown.def.struct_size = 0;
   EXPECT_CREATE_FAILS(context, &grown.def, SPH_ERROR_VERSION_MISMATCH, "struct_size");
   grown.def.struct_size = sizeof grown;

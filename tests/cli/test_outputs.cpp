@@ -297,6 +297,46 @@ void test_vdb_level_set_collider(void**) {
 }
 #endif
 
+// Loads per collider (issue 17): a collider with "loads" gets loads_<index>_<name>.csv, a row per
+// frame; water resting in a tank presses its floor with about its weight, and each row covers
+// one frame's time.
+void test_loads_csv(void**) {
+  const std::string dir = cli_test::make_temp_dir("loads_csv");
+  const std::string scene_file = dir + "/loads.json";
+  cli_test::write_text(scene_file, R"({
+    "world": { "capacity": 4000, "particle_spacing": 0.02 },
+    "time": { "fps": 50, "frames": 3 },
+    "fluids": [ { "type": "box", "min": [-0.1, 0.0, -0.1], "max": [0.1, 0.06, 0.1] } ],
+    "colliders": [ { "name": "the tank", "inverted": true, "loads": { "point": [0.1, 0, 0] },
+                     "shape": { "type": "box", "half_extents": [0.1, 0.1, 0.1], "voxel_size": 0.02 },
+                     "transform": { "position": [0, 0.1, 0] } } ],
+    "output": { "format": "csv" } })");
+  std::string log;
+  const int status = cli_test::run(
+      {g_sph_run, scene_file, "--backend", "cpu", "--threads", "2", "--out", dir + "/out", "--quiet"}, &log);
+  std::printf("%s", log.c_str());
+  assert_int_equal(status, 0);
+  const std::string text = cli_test::read_text(dir + "/out/loads_0_the_tank.csv");
+  std::vector<std::string> lines;
+  for (size_t start = 0, end; start < text.size(); start = end + 1) {
+    end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    lines.push_back(text.substr(start, end - start));
+  }
+  assert_int_equal(lines.size(), 4);
+  assert_true(lines[0].rfind("frame,time_s,force_x_N,force_y_N,force_z_N,torque_x_Nm", 0) == 0);
+  int frame = 0;
+  double time = 0, f[3], t[3], p[3], frame_time = 0;
+  assert_int_equal(
+      std::sscanf(lines[3].c_str(), "%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &frame, &time, &f[0],
+                  &f[1], &f[2], &t[0], &t[1], &t[2], &p[0], &p[1], &p[2], &frame_time),
+      12);
+  assert_int_equal(frame, 3);
+  assert_true(std::fabs(frame_time - 0.02) < 1e-6 && std::fabs(time - 0.06) < 1e-6);
+  assert_true(std::fabs(p[0] - 0.1) < 1e-6 && std::fabs(p[1] - 0.1) < 1e-6);  // the point, posed
+  assert_true(f[1] < 0.0);                                                    // pressed down
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -309,6 +349,7 @@ int main(int argc, char** argv) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_writers_round_trip),
       cmocka_unit_test(test_run_outputs_equal_world),
+      cmocka_unit_test(test_loads_csv),
 #ifdef SPH_TOOLS_HAVE_OPENVDB
       cmocka_unit_test(test_surface_encloses_fluid),
       cmocka_unit_test(test_vdb_level_set_collider),

@@ -49,8 +49,9 @@ const Case kCases[] = {
      "step_factor, "
      "dt_min, dt_max, step_limits"},
     {R"({"world": {"features": ["surface_tension", "foam"]}})",
-     "world.features[1]: expected \"surface_tension\", \"normalized_density\" or \"springs\", got the string "
-     "\"foam\""},
+     "world.features[1]: expected \"surface_tension\", \"normalized_density\", \"springs\", "
+     "\"boundary_density\" "
+     "or \"collider_loads\", got the string \"foam\""},
     {R"({"world": {"features": "springs"}})", "world.features: expected a list of feature names (an array)"},
     {R"({"world": {"viscosity_method": "xsph"}})",
      "world.viscosity_method: expected \"mueller\" or \"clavet\""},

@@ -126,6 +126,14 @@ int main(int argc, char** argv) {
   SceneSpec springs_rk4 = springs;
   springs_rk4.integrator = SPH_INTEGRATOR_RK4;
   add("options_springs_plastic_rk4", springs_rk4, 0.010f);
+  SceneSpec dfsph = moving;
+  dfsph.solver = SPH_SOLVER_DFSPH;
+  add("dfsph_moving_sphere_gravity_euler", dfsph, 0.010f);
+  SceneSpec dfsph_options = dfsph;
+  dfsph_options.random_speed = 0.5f;
+  dfsph_options.viscosity_method = SPH_VISCOSITY_CLAVET;
+  dfsph_options.features = SPH_FEATURE_SURFACE_TENSION | SPH_FEATURE_SPRINGS;
+  add("dfsph_options_surface_tension_clavet_springs_euler", dfsph_options, 0.010f);
 
   // The scene cases of tests/gpu/scene_parity.h.
   SceneSpec base;
@@ -164,6 +172,14 @@ int main(int argc, char** argv) {
   spring_source.name = "springs_continuous_source_euler";
   spring_source.spec.features = SPH_FEATURE_SPRINGS;
   cases.push_back(spring_source);
+  SceneHooks dfsph_tank = tank;
+  dfsph_tank.name = "dfsph_tank_euler";
+  dfsph_tank.spec.solver = SPH_SOLVER_DFSPH;
+  cases.push_back(dfsph_tank);
+  SceneHooks dfsph_boundary_tank = dfsph_tank;
+  dfsph_boundary_tank.name = "dfsph_boundary_density_tank_euler";
+  dfsph_boundary_tank.spec.features = SPH_FEATURE_BOUNDARY_DENSITY;
+  cases.push_back(dfsph_boundary_tank);
 
   for (const SceneHooks& h : cases) digest_scene(backend, h);
   return 0;

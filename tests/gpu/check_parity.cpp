@@ -134,6 +134,25 @@ int main() {
   springs_rk4.integrator = SPH_INTEGRATOR_RK4;
   compare(springs_rk4, 0.010f);
 
+  // DFSPH (issue 16): its density and factor pass, both solves (the iteration counts must match:
+  // the CPU sums each solve's error in storage order in double, the GPU in fixed-shape block
+  // trees, and both stop on the same mean to within rounding) and the non-pressure terms.
+  SceneSpec dfsph = moving;
+  dfsph.name = "dfsph_moving_sphere_gravity_euler";
+  dfsph.solver = SPH_SOLVER_DFSPH;
+  compare(dfsph, 0.010f);
+  SceneSpec dfsph_fast = fast;
+  dfsph_fast.name = "dfsph_fast_sphere_adaptive_dt_euler";
+  dfsph_fast.solver = SPH_SOLVER_DFSPH;
+  compare(dfsph_fast, 0.006f);
+  SceneSpec dfsph_options = moving;
+  dfsph_options.name = "dfsph_options_surface_tension_clavet_springs_euler";
+  dfsph_options.solver = SPH_SOLVER_DFSPH;
+  dfsph_options.random_speed = 0.5f;
+  dfsph_options.viscosity_method = SPH_VISCOSITY_CLAVET;
+  dfsph_options.features = SPH_FEATURE_SURFACE_TENSION | SPH_FEATURE_SPRINGS;
+  compare(dfsph_options, 0.010f);
+
   // Scenes: colliders, force fields, sinks and a source on both backends.
   run_scene_parity();
   return finish();

@@ -136,6 +136,7 @@ struct SceneSpec {
   sph_viscosity_method viscosity_method = SPH_VISCOSITY_MUELLER;
   sph_equation_of_state equation_of_state = SPH_EOS_IDEAL_GAS;
   uint32_t step_limits = 0;
+  sph_solver solver = SPH_SOLVER_WCSPH;  // SPH_SOLVER_DFSPH: symplectic Euler, ideal gas (unused)
   // SPH_FEATURE_SPRINGS: stiff, damped and plastic, so linking, the force, the rest-length flow
   // and the dropping of springs all run.
   float spring_stiffness = 1e5f;
@@ -173,6 +174,7 @@ inline Loaded load_scene(sph_backend backend, const SceneSpec& s) {
   def.features = s.features;
   def.viscosity_method = s.viscosity_method;
   def.equation_of_state = s.equation_of_state;
+  def.solver = s.solver;
   require_ok(sph_world_create(l.context, &def, &l.world), "sph_world_create");
   sph_world_params params;
   sph_world_params_init(&params);

@@ -387,6 +387,24 @@ inline void run_scene_parity() {
   boundary_deforming.name = "boundary_density_deforming_euler";
   boundary_deforming.spec.features = SPH_FEATURE_BOUNDARY_DENSITY;
   compare_scene(boundary_deforming);
+
+  // DFSPH (issue 16) with colliders: the solves' contacts (walls by collision only) and the
+  // walls in its density, factor and solves (SPH_FEATURE_BOUNDARY_DENSITY), a static tank, a
+  // kinematic paddle, a deforming collider and sinks. Three GPU runs must agree bit for bit
+  // (the solves' error reductions and their device-side loop).
+  const auto dfsph = [](SceneHooks h, const char* name, sph_feature_flags features) {
+    h.name = name;
+    h.spec.solver = SPH_SOLVER_DFSPH;
+    h.spec.integrator = SPH_INTEGRATOR_SYMPLECTIC_EULER;
+    h.spec.features = features;
+    return h;
+  };
+  compare_scene(dfsph(tank, "dfsph_tank_euler", SPH_FEATURE_NONE));
+  compare_scene(dfsph(tank, "dfsph_boundary_density_tank_euler", SPH_FEATURE_BOUNDARY_DENSITY));
+  compare_scene(dfsph(boundary_paddle, "dfsph_boundary_density_moving_paddle_floor_euler",
+                      SPH_FEATURE_BOUNDARY_DENSITY));
+  compare_scene(dfsph(deforming, "dfsph_deforming_sdf_velocity_field_euler", SPH_FEATURE_NONE));
+  compare_scene(dfsph(sinks, "dfsph_sinks_region_and_bounds_euler", SPH_FEATURE_NONE));
 }
 
 }  // namespace gpu_check

@@ -106,7 +106,10 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
   def.capacity = n;
   def.particle_spacing = (float)spacing;
   def.integrator = config->integrator;
-  def.equation_of_state = SPH_EOS_TAIT;
+  def.solver = config->solver;
+  def.features |= config->features;
+  /* DFSPH has no equation of state (Tait is refused with it). */
+  def.equation_of_state = config->solver == SPH_SOLVER_DFSPH ? SPH_EOS_IDEAL_GAS : SPH_EOS_TAIT;
   r = sph_world_create(context, &def, &world);
   if (r != SPH_OK) goto done;
   sph_world_params_init(&params);
@@ -120,9 +123,19 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
   /* Only lambda limits the step (its speed and acoustic limits), not dt_max. */
   params.dt_max = 0.01f;
   if ((r = sph_world_set_params(world, &params)) != SPH_OK) goto done;
-  sph_tait_params_init(&tait);
-  tait.speed_of_sound = config->speed_of_sound;
-  if ((r = sph_world_set_tait_params(world, &tait)) != SPH_OK) goto done;
+  if (config->solver == SPH_SOLVER_DFSPH) {
+    sph_dfsph_params dfsph;
+    sph_dfsph_params_init(&dfsph);
+    if (config->density_error > 0.0f) dfsph.density_error = config->density_error;
+    if (config->divergence_error > 0.0f) dfsph.divergence_error = config->divergence_error;
+    if (config->max_iterations > 0) dfsph.max_iterations = config->max_iterations;
+    dfsph.flags = config->dfsph_flags;
+    if ((r = sph_world_set_dfsph_params(world, &dfsph)) != SPH_OK) goto done;
+  } else {
+    sph_tait_params_init(&tait);
+    tait.speed_of_sound = config->speed_of_sound;
+    if ((r = sph_world_set_tait_params(world, &tait)) != SPH_OK) goto done;
+  }
 
   /* The tank: closed on every side (nothing leaves), long enough that the front never reaches
    * the end. */
@@ -147,6 +160,22 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
         result->simulated_seconds += stats.frame_time;
         if (stats.density_max / rest - 1.0 > result->max_compression)
           result->max_compression = stats.density_max / rest - 1.0;
+        result->pressure_iterations += stats.pressure_iterations;
+        result->divergence_iterations += stats.divergence_iterations;
+        if (stats.pressure_iterations_max > result->pressure_iterations_max)
+          result->pressure_iterations_max = stats.pressure_iterations_max;
+        result->density_error_mean += (double)stats.density_error_mean * stats.substeps;
+        if (stats.density_error_max > result->density_error_max)
+          result->density_error_max = stats.density_error_max;
+        result->capped_substeps += stats.pressure_solves_capped;
+        {
+          sph_event events[8];
+          uint32_t event_count = 0;
+          if ((r = sph_world_get_events(world, events, 8, &event_count)) != SPH_OK && r != SPH_INCOMPLETE)
+            goto done;
+          for (uint32_t e = 0; e < event_count && e < 8; ++e)
+            if (events[e].type == SPH_EVENT_PRESSURE_SOLVE_CAPPED) result->capped_events += events[e].count;
+        }
       }
       if ((r = sph_world_get_particle_count(world, &count)) != SPH_OK) goto done;
       if ((r = sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, positions, sizeof(float) * 3 * n, 0, 0,
@@ -180,6 +209,7 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
       }
     }
     result->mean_compression = frames ? compression_sum / frames : 0.0;
+    if (result->substeps > 0) result->density_error_mean /= (double)result->substeps;
   }
 
   /* The one allowed shift, fitted by minimising the mean error on a 0.005 grid. */

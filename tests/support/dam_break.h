@@ -39,6 +39,15 @@ typedef struct dam_break_config {
   float friction;            /* Coulomb coefficient of the tank walls (0: free slip) */
   double end_T;              /* simulate until this T */
   double sample_T;           /* sample the front every sample_T */
+  /* The solver (0: SPH_SOLVER_WCSPH, the validation's). With SPH_SOLVER_DFSPH the world has no
+   * equation of state (speed_of_sound and the acoustic limit are not used) and these are its
+   * sph_dfsph_params (0: the library's default): */
+  sph_solver solver;
+  float density_error;
+  float divergence_error;
+  uint32_t max_iterations;
+  uint32_t dfsph_flags;
+  uint32_t features; /* sph_world_def.features added to the world's (e.g. SPH_FEATURE_BOUNDARY_DENSITY) */
 } dam_break_config;
 
 /* The configuration the validation uses (docs/validation.md says why each value). */
@@ -66,7 +75,15 @@ typedef struct dam_break_result {
   double max_error_unshifted;
   uint32_t compared; /* measured points in the window */
   uint32_t escaped;  /* particles outside the tank at the end */
-  char message[256]; /* the failing call's message when the run failed */
+  /* DFSPH's solves over the run (sph_stats), zero for WCSPH: */
+  uint64_t pressure_iterations;   /* density-solve iterations, summed over the substeps */
+  uint64_t divergence_iterations; /* divergence-solve iterations, summed */
+  uint32_t pressure_iterations_max;
+  double density_error_mean; /* the density solve's achieved mean error, averaged over substeps */
+  double density_error_max;  /* the largest of any substep */
+  uint32_t capped_substeps;  /* substeps whose density solve stopped at its cap (sph_stats) */
+  uint32_t capped_events;    /* the counts of SPH_EVENT_PRESSURE_SOLVE_CAPPED events, summed */
+  char message[256];         /* the failing call's message when the run failed */
 } dam_break_result;
 
 /* Runs the case on `context`. Returns SPH_OK or the first failing call's result (its message

@@ -1,8 +1,10 @@
 // The CPU neighbour grid (src/cpu/cpu_neighbor_grid.h) walked by the shared 27-cell search
 // (src/physics/neighbor_walk.h) finds, for every particle, exactly the particles a brute-force
 // O(n^2) search finds within the kernel radius: around the origin, at negative coordinates,
-// 10 km away, and in clouds many times wider than the wrapped table, where distant cells
-// share table slots.
+// 10 km away, and in clouds of blobs far apart, where the table (sized by the particles' count
+// and extent at every build) is narrower than the cloud and distant cells share table slots.
+// The table never has many more slots than particles, whatever their extent, and a build that
+// finds more particles in one slot than the grid's cap is refused.
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -17,6 +19,7 @@ extern "C" {
 #include <vector>
 
 #include "core/grid_layout.h"
+#include "core/status.h"
 #include "cpu/cpu_neighbor_grid.h"
 #include "physics/neighbor_walk.h"
 
@@ -32,17 +35,21 @@ struct Cloud {
   Vec3 center;
   float half_extent;  // points uniform in center +- half_extent per axis
   uint32_t count;
-  uint32_t capacity;  // sets the table size: about one slot per unit of capacity, >= 3^3
+  uint32_t blobs = 1;  // >1: that many copies of the cloud, `blob_step` apart along each axis
+  float blob_step = 0.0f;
 };
 
 std::vector<Vec3> random_points(const Cloud& cloud, uint32_t seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::vector<Vec3> points(cloud.count);
-  for (Vec3& p : points)
-    p = Vec3{static_cast<float>(cloud.center.x + cloud.half_extent * u(rng)),
-             static_cast<float>(cloud.center.y + cloud.half_extent * u(rng)),
-             static_cast<float>(cloud.center.z + cloud.half_extent * u(rng))};
+  uint32_t k = 0;
+  for (Vec3& p : points) {
+    const float offset = cloud.blob_step * static_cast<float>(k++ % cloud.blobs);
+    p = Vec3{static_cast<float>(cloud.center.x + offset + cloud.half_extent * u(rng)),
+             static_cast<float>(cloud.center.y - offset + cloud.half_extent * u(rng)),
+             static_cast<float>(cloud.center.z + 0.5f * offset + cloud.half_extent * u(rng))};
+  }
   return points;
 }
 
@@ -56,13 +63,18 @@ struct SearchResult {
   size_t wrapped_far = 0;  // candidates beyond the 3x3x3 block (> 2 sqrt 3 h): from a folded slot
 };
 
-SearchResult search_and_compare(const std::vector<Vec3>& points, uint32_t capacity, float h) {
+SearchResult search_and_compare(const std::vector<Vec3>& points, float h,
+                                sph::GridShape* shape_out = nullptr) {
   const uint32_t n = static_cast<uint32_t>(points.size());
-  const sph::GridShape shape = sph::make_grid_shape(h, capacity);
-  sph::CpuNeighborGrid grid(shape);
+  sph::CpuNeighborGrid grid(h, UINT32_MAX);
   std::vector<Float4> records(n);
   for (uint32_t i = 0; i < n; ++i) records[i] = sph::make_float4_record(points[i], static_cast<float>(i));
   grid.build(records.data(), n, 2);
+  const sph::GridShape shape = grid.shape();
+  if (shape_out) *shape_out = shape;
+  // At most two slots per particle (64 for a handful), whatever the particles' extent.
+  assert_true(shape.cell_count <= std::max<uint32_t>(2u * n, 64u));
+  assert_true(shape.nx >= 3 && shape.ny >= 3 && shape.nz >= 3);
 
   // order() is a permutation; the sort is by cell hash and stable (original order within a cell).
   const std::vector<uint32_t>& order = grid.order();
@@ -116,9 +128,9 @@ SearchResult search_and_compare(const std::vector<Vec3>& points, uint32_t capaci
 
 // wraps: whether the cloud is wider than the table, so distant cells share slots.
 void run_cloud(const Cloud& cloud, uint32_t seed, bool wraps) {
-  const sph::GridShape shape = sph::make_grid_shape(kH, cloud.capacity);
-  const SearchResult r = search_and_compare(random_points(cloud, seed), cloud.capacity, kH);
-  const double cells_across = 2.0 * cloud.half_extent / kH;
+  sph::GridShape shape{};
+  const SearchResult r = search_and_compare(random_points(cloud, seed), kH, &shape);
+  const double cells_across = (2.0 * cloud.half_extent + cloud.blob_step * (cloud.blobs - 1)) / kH;
   std::printf(
       "%s: %u points, table %dx%dx%d, cloud %.0f cells across, %.1f neighbours per point, "
       "%zu far candidates from wrapped slots, %zu mismatches\n",
@@ -135,31 +147,30 @@ void run_cloud(const Cloud& cloud, uint32_t seed, bool wraps) {
 
 void test_cloud_at_origin(void**) {
   // Straddles 0, where floor() of negative coordinates matters; fits the table (no wrap).
-  run_cloud(Cloud{"origin", Vec3{0.0f, 0.0f, 0.0f}, 0.2f, 2000, 2000}, 1, false);
+  run_cloud(Cloud{"origin", Vec3{0.0f, 0.0f, 0.0f}, 0.2f, 2000}, 1, false);
 }
 
 void test_cloud_negative(void**) {
-  run_cloud(Cloud{"negative", Vec3{-3.3f, -7.1f, -0.5f}, 0.2f, 2000, 2000}, 2, false);
+  run_cloud(Cloud{"negative", Vec3{-3.3f, -7.1f, -0.5f}, 0.2f, 2000}, 2, false);
 }
 
 void test_cloud_far_away(void**) {
   // 10 km out, float positions are spaced ~1 mm: still far finer than h.
-  run_cloud(Cloud{"far +1e4", Vec3{1e4f, 1e4f, 1e4f}, 0.2f, 2000, 2000}, 3, false);
-  run_cloud(Cloud{"far mixed", Vec3{-1e4f, 1e4f, -1e4f}, 0.2f, 2000, 2000}, 4, false);
+  run_cloud(Cloud{"far +1e4", Vec3{1e4f, 1e4f, 1e4f}, 0.2f, 2000}, 3, false);
+  run_cloud(Cloud{"far mixed", Vec3{-1e4f, 1e4f, -1e4f}, 0.2f, 2000}, 4, false);
 }
 
 void test_cloud_wraps_table(void**) {
-  // Capacity 8 gives the smallest table, 3x3x3: a cloud 14 cells across folds onto it almost
-  // 5 times per axis, so every slot holds particles from many distant cells.
-  run_cloud(Cloud{"wrap 3^3", Vec3{0.0f, 0.0f, 0.0f}, 0.25f, 3000, 8}, 5, true);
-  // A 4x4x4 table (not a multiple of 3) and a 7x7x7 one, at negative and far coordinates.
-  run_cloud(Cloud{"wrap 4^3", Vec3{-20.0f, 5.0f, -3.0f}, 0.25f, 3000, 64}, 6, true);
-  run_cloud(Cloud{"wrap far", Vec3{-1e4f, 1e4f, 5e3f}, 0.25f, 3000, 343}, 7, true);
+  // Blobs metres apart: the particles span thousands of cells per axis, the table has about
+  // one slot per particle, so the blobs fold onto each other and slots hold distant cells.
+  run_cloud(Cloud{"wrap 3 blobs", Vec3{0.0f, 0.0f, 0.0f}, 0.1f, 3000, 3, 5.0f}, 5, true);
+  run_cloud(Cloud{"wrap 7 blobs", Vec3{-20.0f, 5.0f, -3.0f}, 0.08f, 3000, 7, 1.3f}, 6, true);
+  run_cloud(Cloud{"wrap far", Vec3{-1e4f, 1e4f, 5e3f}, 0.1f, 3000, 4, 40.0f}, 7, true);
 }
 
 void test_dense_cluster(void**) {
   // Hundreds of particles per cell.
-  run_cloud(Cloud{"dense", Vec3{0.01f, 0.01f, 0.01f}, 0.03f, 1500, 1500}, 8, false);
+  run_cloud(Cloud{"dense", Vec3{0.01f, 0.01f, 0.01f}, 0.03f, 1500}, 8, false);
 }
 
 // Points on and within a few float steps of cell boundaries (multiples of h), where the
@@ -179,7 +190,7 @@ void test_points_on_cell_boundaries(void**) {
     }
     p = Vec3{c[0], c[1], c[2]};
   }
-  const SearchResult r = search_and_compare(points, 2000, kH);
+  const SearchResult r = search_and_compare(points, kH);
   std::printf("cell boundaries: %.1f neighbours per point, %zu mismatches\n",
               static_cast<double>(r.pairs) / points.size(), r.mismatches);
   assert_int_equal(r.duplicates, 0);
@@ -203,7 +214,7 @@ size_t straddle_pairs(double base, float h, size_t* mismatches) {
         const std::vector<Vec3> pair = {Vec3{a, 0.25f * h, 0.25f * h}, Vec3{b, 0.25f * h, 0.25f * h}};
         if (!within(pair[0], pair[1], h * h)) continue;
         ++cases;
-        *mismatches += search_and_compare(pair, 2000, h).mismatches;
+        *mismatches += search_and_compare(pair, h).mismatches;
       }
   return cases;
 }
@@ -223,6 +234,48 @@ void test_pairs_straddling_boundaries(void**) {
     }
 }
 
+// 100 particles a kilometre apart along each axis (the case of a world of capacity 2^30 with
+// 100 particles, issue 23 item 9): the table has at most 200 slots, where the capacity-sized
+// table had 2^30 (4 GiB). A long thin column keeps its length.
+void test_table_follows_the_particles(void**) {
+  std::vector<Vec3> sparse(100);
+  for (uint32_t i = 0; i < 100; ++i)
+    sparse[i] = Vec3{1000.0f * static_cast<float>(i % 5), -1000.0f * static_cast<float>(i / 20), 7.0f * i};
+  sph::GridShape shape{};
+  search_and_compare(sparse, kH, &shape);
+  std::printf("sparse: 100 points, table %dx%dx%d = %u slots\n", shape.nx, shape.ny, shape.nz,
+              shape.cell_count);
+  assert_true(shape.cell_count <= 200u);
+  std::vector<Vec3> column(3000);
+  for (uint32_t i = 0; i < 3000; ++i)
+    column[i] = Vec3{0.001f * (i % 3), 0.5f * kH * static_cast<float>(i), 0.0f};
+  const SearchResult r = search_and_compare(column, kH, &shape);
+  std::printf("column: 3000 points, table %dx%dx%d\n", shape.nx, shape.ny, shape.nz);
+  assert_int_equal(shape.nx, 3);
+  assert_int_equal(shape.nz, 3);
+  assert_true(shape.ny >= 600);  // 1500 cells tall: folded at most 2.5 times
+  assert_int_equal(r.mismatches, 0);
+}
+
+// More particles in one cell than the grid's cap: the build is refused (Error(Capacity), which
+// the world turns into a failed, rolled-back step), and exactly the cap is accepted.
+void test_crowded_cell_is_refused(void**) {
+  std::vector<Float4> records(201, sph::make_float4_record(Vec3{0.5f, 0.5f, 0.5f}, 0.0f));
+  sph::CpuNeighborGrid grid(kH, 200);
+  bool refused = false;
+  try {
+    grid.build(records.data(), 201, 1);
+  } catch (const sph::Error& e) {
+    refused = e.status() == sph::Status::Capacity;
+    std::printf("refused: %s\n", e.what());
+  }
+  assert_true(refused);
+  grid.build(records.data(), 200, 1);
+  assert_int_equal(grid.view().cell_start[grid.shape().cell_count], 200);
+  // The default cap: 64 times the particles of a cell of fluid at rest (sqrt(2) (h/s)^3).
+  assert_int_equal(sph::max_particles_per_cell(0.02f, 0.036f), 528u);
+}
+
 }  // namespace
 
 int main() {
@@ -234,6 +287,8 @@ int main() {
       cmocka_unit_test(test_dense_cluster),
       cmocka_unit_test(test_points_on_cell_boundaries),
       cmocka_unit_test(test_pairs_straddling_boundaries),
+      cmocka_unit_test(test_table_follows_the_particles),
+      cmocka_unit_test(test_crowded_cell_is_refused),
   };
   return cmocka_run_group_tests_name("neighbor_search", tests, nullptr, nullptr);
 }

@@ -41,7 +41,10 @@
 
 typedef struct tank_case {
   const char* name;
-  sph_equation_of_state eos;
+  sph_equation_of_state eos; /* the weakly compressible solver's; unused by DFSPH */
+  sph_solver solver;
+  uint32_t features;     /* added to the world's (SPH_FEATURE_BOUNDARY_DENSITY) */
+  double bound;          /* the interior's worst relative pressure error */
   uint32_t width_layers; /* lattice layers across the tank in x and z */
   uint32_t depth_layers; /* lattice layers of water */
   double step;           /* lattice step (spacing / sqrt 2), m */
@@ -53,8 +56,12 @@ static int ascending(const void* a, const void* b) {
   return (x > y) - (x < y);
 }
 
+/* DFSPH (incompressible): p(d) = rho0 g d. */
+#define EOS_INCOMPRESSIBLE ((sph_equation_of_state)0x7fff)
+
 static double exact_pressure(sph_equation_of_state eos, double k, double c, double rho0, double d) {
   if (d <= 0.0) return 0.0;
+  if (eos == EOS_INCOMPRESSIBLE) return rho0 * GRAVITY * d;
   if (eos == SPH_EOS_TAIT) {
     const double b = rho0 * c * c / 7.0;
     return b * (pow(1.0 + 6.0 * GRAVITY * d / (c * c), 7.0 / 6.0) - 1.0);
@@ -83,6 +90,8 @@ static void run_tank(const tank_case* tc) {
   uint32_t* layer_count;
   double k, c = 0.0, h, rho0, lowest = 1e30, top_layer = -1e30;
   uint32_t n = 0;
+  /* The profile compared: the solver's own equilibrium. */
+  const sph_equation_of_state profile = tc->solver == SPH_SOLVER_DFSPH ? EOS_INCOMPRESSIBLE : tc->eos;
   const int frames = (int)(tc->seconds * 50.0 + 0.5);
   double bin, window_ke = 0.0;
   int window_frames = 0;
@@ -92,6 +101,8 @@ static void run_tank(const tank_case* tc) {
   def.capacity = n;
   def.particle_spacing = (float)(step * sqrt(2.0));
   def.equation_of_state = tc->eos;
+  def.solver = tc->solver;
+  def.features |= tc->features;
   EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
   world = w.world;
   def = w.def;
@@ -105,7 +116,7 @@ static void run_tank(const tank_case* tc) {
   sph_world_params_init(&params);
   /* Viscosity at its default (1 Pa s) damps the start-up sloshing within the first half; the
    * acoustic limit keeps c dt below 0.4 h whatever the speeds. */
-  params.step_limits = SPH_STEP_LIMIT_ACOUSTIC;
+  if (tc->solver != SPH_SOLVER_DFSPH) params.step_limits = SPH_STEP_LIMIT_ACOUSTIC;
   EXPECT_OK(sph_world_set_params(world, &params));
   k = params.stiffness;
   if (tc->eos == SPH_EOS_TAIT) {
@@ -115,6 +126,7 @@ static void run_tank(const tank_case* tc) {
     c = tait.speed_of_sound;
   }
   EXPECT_OK(support_tank_between(w.context, world, tank_min, tank_max, 0.5 * step, 0.0f, &sdf, NULL));
+
   EXPECT_OK(support_spawn(world, lattice_points, NULL, n));
   EXPECT_OK(sph_world_get_particle_mass(world, &mass));
   free(lattice_points);
@@ -182,7 +194,7 @@ static void run_tank(const tank_case* tc) {
       for (uint32_t l = 0; l < nl; ++l) {
         double e;
         if (layer_count[l] == 0 || layer_y[l] < h || ys - layer_y[l] < 2.0 * h) continue;
-        e = layer_sum[l] / exact_pressure(tc->eos, k, c, rho0, ys - layer_y[l]) - 1.0;
+        e = layer_sum[l] / exact_pressure(profile, k, c, rho0, ys - layer_y[l]) - 1.0;
         cost += e * e;
       }
       if (cost < best_cost) {
@@ -199,7 +211,7 @@ static void run_tank(const tank_case* tc) {
     for (uint32_t l = 0; l < nl; ++l) {
       double exact, e;
       if (layer_count[l] == 0) continue;
-      exact = exact_pressure(tc->eos, k, c, rho0, best_s - layer_y[l]);
+      exact = exact_pressure(profile, k, c, rho0, best_s - layer_y[l]);
       e = exact > 0.0 ? layer_sum[l] / exact - 1.0 : 0.0;
       {
         const int interior = layer_y[l] >= h && best_s - layer_y[l] >= 2.0 * h;
@@ -220,12 +232,16 @@ static void run_tank(const tank_case* tc) {
              sqrt(v2), 100.0 * rest_share);
     }
     printf(
-        "  interior layers %u: mean |error| %.2f %%, worst %.2f %% (bound 3 %%); lowest particle y = %.2e m "
+        "  interior layers %u: mean |error| %.2f %%, worst %.2f %% (bound %.1f %%); lowest particle y = %.2e "
+        "m "
         "(%.3f spacings)\n",
-        used, 100.0 * mean, 100.0 * worst, lowest, lowest / def.particle_spacing);
+        used, 100.0 * mean, 100.0 * worst, 100.0 * tc->bound, lowest, lowest / def.particle_spacing);
     {
-      FILE* out = validation_open_output(tc->eos == SPH_EOS_TAIT ? "hydrostatic_tait.txt"
-                                                                 : "hydrostatic_ideal_gas.txt");
+      FILE* out = validation_open_output(
+          tc->solver == SPH_SOLVER_DFSPH
+              ? (tc->features ? "hydrostatic_dfsph_boundary.txt" : "hydrostatic_dfsph.txt")
+          : tc->eos == SPH_EOS_TAIT ? "hydrostatic_tait.txt"
+                                    : "hydrostatic_ideal_gas.txt");
       if (out) {
         fprintf(out, "%s %u %.3f %.3f %.2f %.3e %.4f\n", tc->name, n, 100.0 * mean, 100.0 * worst,
                 (best_s - top_layer) / h, lowest / def.particle_spacing, 100.0 * rest_share);
@@ -234,7 +250,7 @@ static void run_tank(const tank_case* tc) {
     }
     assert_true(used >= 5);
     assert_true(rest_share <= 0.01);
-    assert_true(worst <= 0.03);
+    assert_true(worst <= tc->bound);
     /* The fitted surface lies where the fluid is: within 2 h of the top particle layer. */
     assert_true(fabs(best_s - top_layer) <= 2.0 * h);
     /* Nothing crosses the floor: the collider puts particles back on the trilinear SDF's zero
@@ -252,7 +268,7 @@ static void run_tank(const tank_case* tc) {
 /* The tank of the case's equation of state at the resolution asked for: 16 x 30 x 16 layers for
  * 1 s in CI, 32 x 60 x 32 for 4 s at full resolution. */
 static void run_tank_at_resolution(const char* name, sph_equation_of_state eos) {
-  tank_case tc = {name, eos, 16, 30, 0.01, 1.0};
+  tank_case tc = {name, eos, SPH_SOLVER_WCSPH, 0u, 0.03, 16, 30, 0.01, 1.0};
   if (validation_full()) {
     tc.width_layers = 32;
     tc.depth_layers = 60;
@@ -271,6 +287,32 @@ static void test_hydrostatic_ideal_gas(void** state) {
   run_tank_at_resolution("ideal gas p = k (rho - rho0), k = 100", SPH_EOS_IDEAL_GAS);
 }
 
+/* DFSPH (issue 16 item 4): the interior within 0.5 % of rho0 g d (the issue's bound) with the
+ * walls in the density and the solves (SPH_FEATURE_BOUNDARY_DENSITY); without them, the walls
+ * only stop particles (the collision response and the solves' contacts) and the particles
+ * within h of them read low densities: `dfsph_walls_unmodelled` runs that case and reports it
+ * against the weakly compressible scheme's 3 %. A 12 x 24 x 12 tank for 2 s in CI (DFSPH's step
+ * is its CFL step, not the acoustic one), 24 x 48 x 24 for 3 s at full resolution. */
+static void run_dfsph_tank(const char* name, uint32_t features, double bound) {
+  tank_case tc = {name, SPH_EOS_IDEAL_GAS, SPH_SOLVER_DFSPH, features, bound, 12, 24, 0.01, 2.0};
+  if (validation_full()) {
+    tc.width_layers = 24;
+    tc.depth_layers = 48;
+    tc.seconds = 3.0;
+  }
+  run_tank(&tc);
+}
+
+static void test_hydrostatic_dfsph(void** state) {
+  (void)state;
+  run_dfsph_tank("DFSPH, boundary density, p = rho0 g d", SPH_FEATURE_BOUNDARY_DENSITY, 0.005);
+}
+
+static void test_hydrostatic_dfsph_walls_unmodelled(void** state) {
+  (void)state;
+  run_dfsph_tank("DFSPH, walls by collision only, p = rho0 g d", 0u, 0.03);
+}
+
 static void test_hydrostatic_tait(void** state) {
   (void)state;
   run_tank_at_resolution("Tait, c = 10 m/s", SPH_EOS_TAIT);
@@ -280,10 +322,16 @@ static void test_hydrostatic_tait(void** state) {
 int main(int argc, char** argv) {
   const struct CMUnitTest tait[] = {cmocka_unit_test(test_hydrostatic_tait)};
   const struct CMUnitTest ideal_gas[] = {cmocka_unit_test(test_hydrostatic_ideal_gas)};
+  const struct CMUnitTest dfsph[] = {cmocka_unit_test(test_hydrostatic_dfsph)};
+  const struct CMUnitTest dfsph_walls[] = {cmocka_unit_test(test_hydrostatic_dfsph_walls_unmodelled)};
   int failed = 0;
   if (argc < 2 || strcmp(argv[1], "tait") == 0)
     failed += cmocka_run_group_tests_name("hydrostatic_tait", tait, NULL, NULL);
   if (argc < 2 || strcmp(argv[1], "ideal_gas") == 0)
     failed += cmocka_run_group_tests_name("hydrostatic_ideal_gas", ideal_gas, NULL, NULL);
+  if (argc >= 2 && strcmp(argv[1], "dfsph") == 0)
+    failed += cmocka_run_group_tests_name("hydrostatic_dfsph", dfsph, NULL, NULL);
+  if (argc >= 2 && strcmp(argv[1], "dfsph_walls_unmodelled") == 0)
+    failed += cmocka_run_group_tests_name("hydrostatic_dfsph_walls_unmodelled", dfsph_walls, NULL, NULL);
   return failed;
 }

@@ -41,6 +41,7 @@ typedef struct sphere_case {
   const char* name;
   double disturbance; /* start speeds uniform in [-d, d] per component, m/s */
   int check_density;  /* assert the interior density bounds */
+  sph_solver solver;  /* 0: the weakly compressible scheme */
 } sphere_case;
 
 static void run_sphere(const sphere_case* sc) {
@@ -61,6 +62,7 @@ static void run_sphere(const sphere_case* sc) {
   sph_world_def_init(&def);
   def.particle_spacing = spacing;
   def.capacity = 0; /* the ball's particles */
+  def.solver = sc->solver;
   EXPECT_OK(support_params_gravity_and_steps(&params, 0.0f, 0.0f, 0.0f, 1e-6f, 1e-3f));
   ball.radius = radius;
   ball.speed = disturbance;
@@ -182,29 +184,49 @@ static void run_sphere(const sphere_case* sc) {
 }
 
 static void test_rest(void** state) {
-  const sphere_case sc = {"rest", 0.0, 1};
+  const sphere_case sc = {"rest", 0.0, 1, SPH_SOLVER_WCSPH};
   (void)state;
   run_sphere(&sc);
 }
 
 static void test_disturbed(void** state) {
-  const sphere_case sc = {"disturbed", 1e-3, 0};
+  const sphere_case sc = {"disturbed", 1e-3, 0, SPH_SOLVER_WCSPH};
   (void)state;
   run_sphere(&sc);
 }
 
 static void test_disturbed_density(void** state) {
-  const sphere_case sc = {"disturbed_density", 1e-3, 1};
+  const sphere_case sc = {"disturbed_density", 1e-3, 1, SPH_SOLVER_WCSPH};
   (void)state;
   run_sphere(&sc);
 }
 
-/* argv[1] picks one run (rest | disturbed | disturbed_density); none runs rest and disturbed. */
+/* DFSPH (issue 16 item 4): the same sphere and bounds with the incompressible solver. */
+static void test_dfsph_rest(void** state) {
+  const sphere_case sc = {"dfsph_rest", 0.0, 1, SPH_SOLVER_DFSPH};
+  (void)state;
+  run_sphere(&sc);
+}
+
+static void test_dfsph_disturbed(void** state) {
+  const sphere_case sc = {"dfsph_disturbed", 1e-3, 1, SPH_SOLVER_DFSPH};
+  (void)state;
+  run_sphere(&sc);
+}
+
+/* argv[1] picks one run (rest | disturbed | disturbed_density | dfsph_rest | dfsph_disturbed);
+ * none runs rest and disturbed. */
 int main(int argc, char** argv) {
   const struct CMUnitTest rest[] = {cmocka_unit_test(test_rest)};
   const struct CMUnitTest disturbed[] = {cmocka_unit_test(test_disturbed)};
   const struct CMUnitTest disturbed_density[] = {cmocka_unit_test(test_disturbed_density)};
+  const struct CMUnitTest dfsph_rest[] = {cmocka_unit_test(test_dfsph_rest)};
+  const struct CMUnitTest dfsph_disturbed[] = {cmocka_unit_test(test_dfsph_disturbed)};
   int failed = 0;
+  if (argc >= 2 && strcmp(argv[1], "dfsph_rest") == 0)
+    failed += cmocka_run_group_tests_name("rest_sphere_dfsph", dfsph_rest, NULL, NULL);
+  if (argc >= 2 && strcmp(argv[1], "dfsph_disturbed") == 0)
+    failed += cmocka_run_group_tests_name("rest_sphere_dfsph_disturbed", dfsph_disturbed, NULL, NULL);
   if (argc < 2 || strcmp(argv[1], "rest") == 0)
     failed += cmocka_run_group_tests_name("rest_sphere", rest, NULL, NULL);
   if (argc < 2 || strcmp(argv[1], "disturbed") == 0)

@@ -11,6 +11,7 @@
 #include "frame_writer.h"
 #include "interrupt.h"
 #include "library_error.h"
+#include "load_csv.h"
 #include "particle_frame.h"
 #include "progress.h"
 #include "run_stats.h"
@@ -68,6 +69,9 @@ int run_scene(sph_context* context, const std::string& backend_name, const Scene
     stats.add_output(ms_since(t));
     stats.add_output_kinds(writer.times().particles_ms, writer.times().surface_ms, writer.times().preview_ms);
     uint32_t written = 1;
+    LoadCsv loads;  // the colliders that ask for their loads (scene file "loads")
+    const std::string loads_problem = loads.open(out.directory, runtime);
+    if (!loads_problem.empty()) return fail(kExitRuntime, "loads: cannot write " + loads_problem);
     for (uint32_t i = 1; i <= scene.frames && !interrupt_signal(); ++i) {
       t = Clock::now();
       const sph_result step = runtime.step_frame();
@@ -84,6 +88,8 @@ int run_scene(sph_context* context, const std::string& backend_name, const Scene
       t = Clock::now();
       read_particles(runtime.world(), i, runtime.time(), &frame);
       writer.write(runtime, frame);
+      const std::string load_problem = loads.write(runtime, i, runtime.time());
+      if (!load_problem.empty()) return fail(kExitRuntime, "loads: cannot write " + load_problem);
       const double output_ms = ms_since(t);
       ++written;
       stats.add_frame(s, step_ms, output_ms);

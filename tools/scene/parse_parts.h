@@ -30,7 +30,7 @@ std::vector<PhysicsDesc> parse_physics(const JsonNode& node, const sph_world_def
 // ranges when the world is built.
 void parse_params_fields(const JsonNode& node, sph_params_kind kind, const char* what, unsigned char* bytes);
 // A method's name for a sph_world_def field that selects one (world.viscosity_method,
-// world.equation_of_state), and a list of feature names (world.features).
+// world.equation_of_state, world.solver), and a list of feature names (world.features).
 uint32_t parse_method(const JsonNode& node, sph_method_switch field);
 uint32_t parse_features(const JsonNode& node);
 void parse_time(const JsonNode& node, SceneDesc* scene);

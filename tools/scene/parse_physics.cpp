@@ -45,6 +45,8 @@ bool world_runs(const sph_world_def& world, const sph_physics_method_info& m) {
       return static_cast<uint32_t>(world.viscosity_method) == m.value;
     case SPH_METHOD_SWITCH_EQUATION_OF_STATE:
       return static_cast<uint32_t>(world.equation_of_state) == m.value;
+    case SPH_METHOD_SWITCH_SOLVER:
+      return static_cast<uint32_t>(world.solver) == m.value;
     default:
       return true;
   }
@@ -59,6 +61,8 @@ std::string how_to_turn_on(const sph_physics_method_info& m) {
       return "set world.viscosity_method to " + name;
     case SPH_METHOD_SWITCH_EQUATION_OF_STATE:
       return "set world.equation_of_state to " + name;
+    case SPH_METHOD_SWITCH_SOLVER:
+      return "set world.solver to " + name;
     default:
       return "";
   }

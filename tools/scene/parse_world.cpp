@@ -10,7 +10,7 @@ void parse_world(const JsonNode& node, sph_world_def* def) {
   sph_world_def_init(def);
   if (node.missing()) return;
   node.expect_object("world", {"capacity", "particle_spacing", "kernel_radius", "rest_density", "integrator",
-                               "features", "viscosity_method", "equation_of_state"});
+                               "features", "viscosity_method", "equation_of_state", "solver"});
   def->capacity = node["capacity"].opt_count(def->capacity, 1, std::numeric_limits<uint32_t>::max());
   def->particle_spacing = node["particle_spacing"].opt_positive(def->particle_spacing);
   def->kernel_radius = node["kernel_radius"].opt_positive(def->kernel_radius);
@@ -28,6 +28,8 @@ void parse_world(const JsonNode& node, sph_world_def* def) {
   if (!node["equation_of_state"].missing())
     def->equation_of_state = static_cast<sph_equation_of_state>(
         parse_method(node["equation_of_state"], SPH_METHOD_SWITCH_EQUATION_OF_STATE));
+  if (!node["solver"].missing())
+    def->solver = static_cast<sph_solver>(parse_method(node["solver"], SPH_METHOD_SWITCH_SOLVER));
 }
 
 // The world's runtime parameters: the fields of sph_world_params by the library's description

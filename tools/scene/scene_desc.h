@@ -56,6 +56,8 @@ struct ColliderDesc {
   Motion motion;
   bool inverted = false;
   float restitution = 0.0f, friction = 0.0f, stickiness = 0.0f;
+  bool loads = false;     // "loads": its force and torque are written per frame (a CSV)
+  sph_vec3 load_point{};  // the torque's point, in the collider's frame
   std::string path;
 };
 

@@ -105,6 +105,8 @@ SceneDesc parse_scene(const std::string& text, const std::string& base_dir) {
   parse_list(top["fluids"], "a list of fluid bodies", &scene.fluids, parse_fluid);
   parse_list(top["colliders"], "a list of colliders", &scene.colliders,
              [&](const JsonNode& n) { return parse_collider(n, base_dir); });
+  for (const ColliderDesc& c : scene.colliders)
+    if (c.loads) scene.world.features |= SPH_FEATURE_COLLIDER_LOADS;
   parse_list(top["sources"], "a list of sources", &scene.sources,
              [&](const JsonNode& n) { return parse_source(n, base_dir); });
   parse_list(top["sinks"], "a list of sinks", &scene.sinks,

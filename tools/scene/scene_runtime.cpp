@@ -62,6 +62,9 @@ SceneRuntime::SceneRuntime(const SceneDesc& scene, sph_context* context) : scene
       def.friction = c.friction;
       def.stickiness = c.stickiness;
       check_object(sph_collider_create(world_, &def, &colliders_.back().id), c.path, "collider");
+      if (c.loads)
+        check_object(sph_collider_set_load_point(world_, colliders_.back().id, &c.load_point),
+                     c.path + ".loads", "load point");
     }
     for (const SinkDesc& s : scene.sinks) {
       sph_sink_def def;

@@ -325,6 +325,20 @@ static class Tests
             AssertEqual(Result.Incomplete, world.Step(0.1f), "max_substeps ran out");
             Throws(Result.ErrorInvalidArgument, () => world.Step(-1));
             Throws(Result.ErrorInvalidArgument, () => world.Step(float.NaN));
+            // What one call may cost (issue 23 item 9): the budget, a cancel, max_substeps' bound.
+            AssertEqual(0.0, world.StepBudget, "no budget by default");
+            world.StepBudget = 0.25;
+            AssertEqual(0.25, world.StepBudget, "budget read back");
+            Throws(Result.ErrorInvalidArgument, () => world.StepBudget = -1);
+            Throws(Result.ErrorInvalidArgument, () => world.StepBudget = double.NaN);
+            world.StepBudget = 0;
+            p.MaxSubsteps = 1000;
+            world.Params = p;
+            world.CancelStep();
+            AssertEqual(Result.Incomplete, world.Step(0.01f), "a cancel before the step stops it");
+            AssertEqual(0u, world.GetStats().Substeps, "no substep after a cancel");
+            p.MaxSubsteps = 1000001;
+            Throws(Result.ErrorInvalidArgument, () => world.Params = p);
         }
     }
 
@@ -471,6 +485,29 @@ static class Tests
         }
     }
 
+    public static void TestDfsphSolverAndItsParams()
+    {
+        using (var context = Cpu())
+        {
+            WorldDef d = WorldDef.Default();
+            d.Capacity = 64;
+            d.Solver = Solver.Dfsph;
+            using (var world = new World(context, d))
+            {
+                AssertEqual(Solver.Dfsph, world.Solver, "World.Solver");
+                DfsphParams p = world.DfsphParams;
+                AssertEqual(100u, p.MaxIterations, "default cap");
+                p.DensityError = 1e-4f;
+                world.DfsphParams = p;
+                AssertEqual(1e-4f, world.DfsphParams.DensityError, "set and read back");
+                p.MaxIterations = 1;
+                Throws(Result.ErrorInvalidArgument, () => world.DfsphParams = p);
+            }
+            d.Integrator = Integrator.Rk4;
+            Throws(Result.ErrorUnsupported, () => new World(context, d));
+        }
+    }
+
     public static void TestPhysicsParamsByKindAndTheirDescriptions()
     {
         AssertEqual("tait", Utf8.FromNative(Library.ParamsInfo(ParamsKind.Tait).Name), "params name");
@@ -484,7 +521,10 @@ static class Tests
         AssertEqual(ParamZero.Default, speed.Zero, "speed of sound: 0 is the default");
         AssertEqual(ParamBound.Exclusive, speed.LowerBound, "speed of sound > 0");
         PhysicsMethodInfo[] methods = Library.PhysicsMethods();
-        AssertEqual(7, methods.Length, "methods");
+        AssertEqual(11, methods.Length, "methods");  // through boundary_density and collider_loads
+        AssertEqual("dfsph", Utf8.FromNative(methods[8].Name), "the last method");
+        AssertEqual(MethodSwitch.Solver, methods[8].SwitchBy, "DFSPH is a solver");
+        AssertEqual(ParamsKind.Dfsph, methods[8].ParamsKind, "its params");
         AssertEqual("clavet", Utf8.FromNative(methods[3].Name), "the fourth method");
         AssertEqual(MethodSwitch.Viscosity, methods[3].SwitchBy, "Clavet is a viscosity method");
         AssertEqual(ParamsKind.ClavetViscosity, methods[3].ParamsKind, "its params");
@@ -780,6 +820,41 @@ static class Tests
             }
             dist[0] = float.NaN;
             Throws(Result.ErrorInvalidArgument, () => Sdf.Create(ctx, dist, n, n, n, map));
+        }
+    }
+
+    // Loads on colliders (issue 17): refused without the feature; with it, water resting on a
+    // floor presses it with about its weight, the torque about the load point.
+    public static void TestColliderLoads()
+    {
+        var plane = ShapeDesc.Default();
+        plane.Shape = Shape.Plane;
+        plane.HalfExtents = new Vec3(1, 0.1f, 1);
+        plane.VoxelSize = 0.03f;
+        using (var ctx = Cpu())
+        using (var floor = Sdf.CreateShape(ctx, plane))
+        {
+            using (var world = ctx.CreateWorld(SmallWorld()))
+            {
+                var c = world.CreateCollider(floor, Transform.Default());
+                Throws(Result.ErrorFeatureDisabled, () => { var l = c.Loads; });
+                Throws(Result.ErrorFeatureDisabled, () => c.SetLoadPoint(new Vec3(0, 0, 0)));
+            }
+            var d = SmallWorld();
+            d.FeatureFlags = FeatureFlags.ColliderLoads;
+            using (var world = ctx.CreateWorld(d))
+            {
+                var c = world.CreateCollider(floor, Transform.Default());
+                AssertEqual(0.0, c.Loads.FrameTime, "no loads before a step");
+                c.SetLoadPoint(new Vec3(0.1f, 0, 0));
+                uint n = world.FillBox(new Vec3(-0.08f, 0.0f, -0.08f), new Vec3(0.08f, 0.06f, 0.08f));
+                for (int i = 0; i < 10; ++i) world.Step(1f / 60f);
+                var loads = c.Loads;
+                float weight = n * world.ParticleMass * 9.81f;
+                Assert(Math.Abs(loads.Force.Y + weight) < 0.3f * weight, "the floor carries the weight: " + loads.Force.Y);
+                Assert(Math.Abs(loads.Torque.Z + 0.1f * loads.Force.Y) < 0.2f * Math.Abs(0.1f * loads.Force.Y),
+                       "torque about the load point: " + loads.Torque.Z);
+            }
         }
     }
 

@@ -42,4 +42,4 @@ __all__ = ["Context", "World", "SphError", "SphLoadError", "Result", "Backend", 
            "Attribute", "Stage", "version", "abi_version", "build_info", "result_string", "last_error",
            "live_object_count", "make_version", "attribute_format", "stage_times", "library", "library_path", "helper_library",
            "ABI_VERSION", "BINDINGS_VERSION", "raw", "Sdf", "Collider", "Source", "Sink", "ForceField", "CudaArray",
-           "as_transform", "grid_transform", "Feature", "StepLimit", "params_info", "param_fields", "methods", "params_kind", "ViscosityMethod", "EquationOfState"] + [cls.__name__ for cls in STRUCTS]
+           "as_transform", "grid_transform", "Feature", "StepLimit", "params_info", "param_fields", "methods", "params_kind", "ViscosityMethod", "EquationOfState", "Solver"] + [cls.__name__ for cls in STRUCTS]

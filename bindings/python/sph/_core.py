@@ -360,6 +360,24 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
         """
         return check(library().sph_world_step(self.handle, float(frame_dt)), "sph_world_step")
 
+    @property
+    def step_budget(self):
+        """Wall-clock seconds one step may take before it stops at a substep boundary and
+        returns Result.INCOMPLETE (sph_world_get_step_budget); 0 is no budget."""
+        seconds = ctypes.c_double()
+        check(library().sph_world_get_step_budget(self.handle, ctypes.byref(seconds)), "sph_world_get_step_budget")
+        return seconds.value
+
+    @step_budget.setter
+    def step_budget(self, seconds):
+        check(library().sph_world_set_step_budget(self.handle, float(seconds)), "sph_world_set_step_budget")
+
+    def cancel_step(self):
+        """Asks the step running on another thread (or else the next step) to stop at its next
+        substep boundary; that step returns Result.INCOMPLETE (sph_world_cancel_step). Safe to
+        call from any thread while the world steps."""
+        check(library().sph_world_cancel_step(self.handle), "sph_world_cancel_step")
+
     # -- particles out
     @property
     def particle_count(self):

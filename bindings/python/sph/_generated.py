@@ -10,7 +10,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'dd572196e8becf7f8c76274a52bb674dc7159e0f3c448c2a4b372ec0e21fd1e8', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
+HEADERS = {'include/sph_c.h': '682f6803dadec41d2ee4c9ac4b91c9f4bf1e94855acfd7116aaea96cc714e6ad', 'include/sph_cuda.h': 'aa1e0cf00152e578eb9ba28b77f029be4aa8a1e7817c08f15df546ad679d6660', 'include/sph_vdb.h': '137519e13bcc00e5318091faa5b90123d9edb7d1d668f98ef10daf2f58b97a66'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -55,11 +55,20 @@ SPH_FEATURE_SPRINGS = 4
 #: collision response stays the no-penetration safeguard. Costs one SDF sample per particle and
 #: collider in each density pass.
 SPH_FEATURE_BOUNDARY_DENSITY = 8
+#: Loads on colliders: the force and torque of the fluid on each collider over every step
+#: (sph_collider_get_loads): the collision response's contact impulses and, with
+#: SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions, summed on the device per substep in
+#: a fixed order (bitwise deterministic) and averaged over the step's time. Costs, per substep, a
+#: reduction over the particles per collider (and with the boundary density one SDF sample per
+#: particle and collider per force evaluation); no host round trip inside a step.
+SPH_FEATURE_COLLIDER_LOADS = 16
 #: Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt <= step_factor h / c, c the
-#: EOS's speed of sound
+#: EOS's speed of sound \ (weakly compressible worlds only)
 SPH_STEP_LIMIT_ACOUSTIC = 1
 #: dt <= step_factor sqrt(h / |a|_max)
 SPH_STEP_LIMIT_FORCE = 2
+#: sph_dfsph_params.flags no divergence solve (cheaper; a noisier pressure)
+SPH_DFSPH_SKIP_DIVERGENCE_SOLVE = 1
 #: hollow box: no lid (a tank open at +y)
 SPH_SHAPE_FLAG_OPEN_TOP = 1
 #: solid where the SDF is positive: a container
@@ -201,7 +210,7 @@ sph_attribute = _c.c_int32
 SPH_ATTRIBUTE_POSITION = 0  # 3 x float32, metres
 SPH_ATTRIBUTE_VELOCITY = 1  # 3 x float32, metres per second
 SPH_ATTRIBUTE_DENSITY = 2  # float32, kg/m^3, from the last density evaluation
-SPH_ATTRIBUTE_PRESSURE = 3  # float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation
+SPH_ATTRIBUTE_PRESSURE = 3  # float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure its density solve found in the last substep
 SPH_ATTRIBUTE_ID = 4  # uint32, persistent particle id, unique within a world
 SPH_ATTRIBUTE_COUNT = 5
 SPH_ATTRIBUTE_FORCE32 = 2147483647
@@ -215,7 +224,8 @@ class Attribute(_enum.IntEnum):
     VELOCITY = 1
     #: float32, kg/m^3, from the last density evaluation
     DENSITY = 2
-    #: float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation
+    #: float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure its
+    #: density solve found in the last substep
     PRESSURE = 3
     #: uint32, persistent particle id, unique within a world
     ID = 4
@@ -225,7 +235,7 @@ sph_stage = _c.c_int32
 SPH_STAGE_HASH_SORT = 0  # cell hash, stable sort, reorder of every attribute
 SPH_STAGE_CELL_RANGES = 1  # start/end of each cell
 SPH_STAGE_DENSITY = 2  # density and pressure
-SPH_STAGE_FORCES = 3  # pressure, viscosity and external forces
+SPH_STAGE_FORCES = 3  # pressure, viscosity and external forces (DFSPH: and its two solves)
 SPH_STAGE_INTEGRATE = 4  # time integration, max-speed reduction, next step size
 SPH_STAGE_COLLIDE = 5  # particles against colliders (CPU; the CUDA backend does it inside the forces kernel, so it counts under SPH_STAGE_FORCES there)
 SPH_STAGE_EMIT = 6  # sinks removing particles; sources emit before the substeps and count only in sph_stats.step_ms
@@ -242,7 +252,7 @@ class Stage(_enum.IntEnum):
     CELL_RANGES = 1
     #: density and pressure
     DENSITY = 2
-    #: pressure, viscosity and external forces
+    #: pressure, viscosity and external forces (DFSPH: and its two solves)
     FORCES = 3
     #: time integration, max-speed reduction, next step size
     INTEGRATE = 4
@@ -284,13 +294,33 @@ class EquationOfState(_enum.IntEnum):
     TAIT = 1
 
 
+sph_solver = _c.c_int32
+SPH_SOLVER_WCSPH = 0  # the thesis's weakly compressible SPH: pressure from the equation of state, explicit steps under the acoustic ceiling 0.4 h / c
+SPH_SOLVER_DFSPH = 1  # divergence-free SPH (Bender & Koschier 2015, 2017): pressure from two iterative solves that hold the density error below a bound (sph_dfsph_params); steps bounded by the flow speed alone. No equation of state: the stiffness, Tait's parameters and SPH_STEP_LIMIT_ACOUSTIC have no effect. Not with SPH_INTEGRATOR_RK4, SPH_EOS_TAIT or SPH_FEATURE_NORMALIZED_DENSITY (SPH_ERROR_UNSUPPORTED at creation)
+SPH_SOLVER_FORCE32 = 2147483647
+
+
+class Solver(_enum.IntEnum):
+    """sph_solver: The pressure solver, fixed at world creation (docs/physics.md, "Solvers")."""
+    #: the thesis's weakly compressible SPH: pressure from the equation of state, explicit steps
+    #: under the acoustic ceiling 0.4 h / c
+    WCSPH = 0
+    #: divergence-free SPH (Bender & Koschier 2015, 2017): pressure from two iterative solves that
+    #: hold the density error below a bound (sph_dfsph_params); steps bounded by the flow speed
+    #: alone. No equation of state: the stiffness, Tait's parameters and SPH_STEP_LIMIT_ACOUSTIC
+    #: have no effect. Not with SPH_INTEGRATOR_RK4, SPH_EOS_TAIT or SPH_FEATURE_NORMALIZED_DENSITY
+    #: (SPH_ERROR_UNSUPPORTED at creation)
+    DFSPH = 1
+
+
 sph_params_kind = _c.c_int32
 SPH_PARAMS_WORLD = 0  # sph_world_params
 SPH_PARAMS_SURFACE_TENSION = 1  # sph_surface_tension_params
 SPH_PARAMS_CLAVET_VISCOSITY = 2  # sph_clavet_viscosity_params
 SPH_PARAMS_TAIT = 3  # sph_tait_params
 SPH_PARAMS_SPRINGS = 4  # sph_spring_params
-SPH_PARAMS_KIND_COUNT = 5
+SPH_PARAMS_DFSPH = 5  # sph_dfsph_params
+SPH_PARAMS_KIND_COUNT = 6
 SPH_PARAMS_KIND_FORCE32 = 2147483647
 
 
@@ -306,6 +336,8 @@ class ParamsKind(_enum.IntEnum):
     TAIT = 3
     #: sph_spring_params
     SPRINGS = 4
+    #: sph_dfsph_params
+    DFSPH = 5
 
 
 sph_param_type = _c.c_int32
@@ -368,6 +400,7 @@ sph_method_switch = _c.c_int32
 SPH_METHOD_SWITCH_FEATURE = 1  # a bit of sph_world_def.features (value)
 SPH_METHOD_SWITCH_VISCOSITY = 2  # sph_world_def.viscosity_method == value
 SPH_METHOD_SWITCH_EQUATION_OF_STATE = 3  # sph_world_def.equation_of_state == value
+SPH_METHOD_SWITCH_SOLVER = 4  # sph_world_def.solver == value
 SPH_METHOD_SWITCH_FORCE32 = 2147483647
 
 
@@ -379,6 +412,8 @@ class MethodSwitch(_enum.IntEnum):
     VISCOSITY = 2
     #: sph_world_def.equation_of_state == value
     EQUATION_OF_STATE = 3
+    #: sph_world_def.solver == value
+    SOLVER = 4
 
 
 sph_memory_kind = _c.c_int32
@@ -489,6 +524,8 @@ class ForceFieldKind(_enum.IntEnum):
 sph_event_type = _c.c_int32
 SPH_EVENT_SOURCE_CAPACITY_REACHED = 1  # object: the source; count: particles not emitted
 SPH_EVENT_SINK_REMOVED = 2  # object: the sink; count: particles removed
+SPH_EVENT_PRESSURE_SOLVE_CAPPED = 3  # DFSPH; object: none (0); count: substeps whose density solve stopped at max_iterations above its bound
+SPH_EVENT_DIVERGENCE_SOLVE_CAPPED = 4  # DFSPH; object: none (0); count: substeps whose divergence solve stopped at its cap above its bound
 SPH_EVENT_TYPE_FORCE32 = 2147483647
 
 
@@ -498,6 +535,12 @@ class EventType(_enum.IntEnum):
     SOURCE_CAPACITY_REACHED = 1
     #: object: the sink; count: particles removed
     SINK_REMOVED = 2
+    #: DFSPH; object: none (0); count: substeps whose density solve stopped at max_iterations above
+    #: its bound
+    PRESSURE_SOLVE_CAPPED = 3
+    #: DFSPH; object: none (0); count: substeps whose divergence solve stopped at its cap above its
+    #: bound
+    DIVERGENCE_SOLVE_CAPPED = 4
 
 
 #: Doc text of every enum member, by C name (e.g. the element format of an attribute).
@@ -530,12 +573,12 @@ ENUM_MEMBER_DOCS = {
     'SPH_ATTRIBUTE_POSITION': '3 x float32, metres',
     'SPH_ATTRIBUTE_VELOCITY': '3 x float32, metres per second',
     'SPH_ATTRIBUTE_DENSITY': 'float32, kg/m^3, from the last density evaluation',
-    'SPH_ATTRIBUTE_PRESSURE': 'float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation',
+    'SPH_ATTRIBUTE_PRESSURE': 'float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure its density solve found in the last substep',
     'SPH_ATTRIBUTE_ID': 'uint32, persistent particle id, unique within a world',
     'SPH_STAGE_HASH_SORT': 'cell hash, stable sort, reorder of every attribute',
     'SPH_STAGE_CELL_RANGES': 'start/end of each cell',
     'SPH_STAGE_DENSITY': 'density and pressure',
-    'SPH_STAGE_FORCES': 'pressure, viscosity and external forces',
+    'SPH_STAGE_FORCES': 'pressure, viscosity and external forces (DFSPH: and its two solves)',
     'SPH_STAGE_INTEGRATE': 'time integration, max-speed reduction, next step size',
     'SPH_STAGE_COLLIDE': 'particles against colliders (CPU; the CUDA backend does it inside the forces kernel, so it counts under SPH_STAGE_FORCES there)',
     'SPH_STAGE_EMIT': 'sinks removing particles; sources emit before the substeps and count only in sph_stats.step_ms',
@@ -544,11 +587,14 @@ ENUM_MEMBER_DOCS = {
     'SPH_VISCOSITY_CLAVET': 'radial impulses between approaching pairs (eq. 18-19), sph_clavet_viscosity_params',
     'SPH_EOS_IDEAL_GAS': "the thesis's modified ideal gas p = k (rho - rho0) (eq. 15)",
     'SPH_EOS_TAIT': 'p = B ((rho / rho0)^7 - 1), B = rho0 c^2 / 7, sph_tait_params',
+    'SPH_SOLVER_WCSPH': "the thesis's weakly compressible SPH: pressure from the equation of state, explicit steps under the acoustic ceiling 0.4 h / c",
+    'SPH_SOLVER_DFSPH': "divergence-free SPH (Bender & Koschier 2015, 2017): pressure from two iterative solves that hold the density error below a bound (sph_dfsph_params); steps bounded by the flow speed alone. No equation of state: the stiffness, Tait's parameters and SPH_STEP_LIMIT_ACOUSTIC have no effect. Not with SPH_INTEGRATOR_RK4, SPH_EOS_TAIT or SPH_FEATURE_NORMALIZED_DENSITY (SPH_ERROR_UNSUPPORTED at creation)",
     'SPH_PARAMS_WORLD': 'sph_world_params',
     'SPH_PARAMS_SURFACE_TENSION': 'sph_surface_tension_params',
     'SPH_PARAMS_CLAVET_VISCOSITY': 'sph_clavet_viscosity_params',
     'SPH_PARAMS_TAIT': 'sph_tait_params',
     'SPH_PARAMS_SPRINGS': 'sph_spring_params',
+    'SPH_PARAMS_DFSPH': 'sph_dfsph_params',
     'SPH_PARAM_FLOAT': 'float, finite',
     'SPH_PARAM_VEC3': 'sph_vec3, every component finite',
     'SPH_PARAM_UINT32': 'uint32_t count',
@@ -562,6 +608,7 @@ ENUM_MEMBER_DOCS = {
     'SPH_METHOD_SWITCH_FEATURE': 'a bit of sph_world_def.features (value)',
     'SPH_METHOD_SWITCH_VISCOSITY': 'sph_world_def.viscosity_method == value',
     'SPH_METHOD_SWITCH_EQUATION_OF_STATE': 'sph_world_def.equation_of_state == value',
+    'SPH_METHOD_SWITCH_SOLVER': 'sph_world_def.solver == value',
     'SPH_MEMORY_HOST': 'ordinary host memory',
     'SPH_MEMORY_CUDA_DEVICE': "device memory of the context's CUDA device (CUDA contexts only)",
     'SPH_SHAPE_PLANE': 'solid below y = 0; half_extents.x/.z its size, .y its thickness',
@@ -581,6 +628,8 @@ ENUM_MEMBER_DOCS = {
     'SPH_FORCE_FIELD_GRID': 'accelerations from a user grid (3 components, field frame)',
     'SPH_EVENT_SOURCE_CAPACITY_REACHED': 'object: the source; count: particles not emitted',
     'SPH_EVENT_SINK_REMOVED': 'object: the sink; count: particles removed',
+    'SPH_EVENT_PRESSURE_SOLVE_CAPPED': 'DFSPH; object: none (0); count: substeps whose density solve stopped at max_iterations above its bound',
+    'SPH_EVENT_DIVERGENCE_SOLVE_CAPPED': 'DFSPH; object: none (0); count: substeps whose divergence solve stopped at its cap above its bound',
 }
 
 # ---- type aliases -----------------------------------------------------------------------------
@@ -699,6 +748,7 @@ class WorldDef(_SphStruct):
         kernel_radius (float): h, m; 0 (default) = 1.8 * particle_spacing; must be >= spacing
         rest_density (float): rho0, kg/m^3; 0 (default) = 1000 (water)
         equation_of_state (sph_equation_of_state): default SPH_EOS_IDEAL_GAS
+        solver (sph_solver): default SPH_SOLVER_WCSPH
     """
     _fields_ = [
         ('struct_size', _c.c_uint32),
@@ -711,13 +761,14 @@ class WorldDef(_SphStruct):
         ('kernel_radius', _c.c_float),
         ('rest_density', _c.c_float),
         ('equation_of_state', sph_equation_of_state),
+        ('solver', sph_solver),
     ]
     _sph_c_name_ = 'sph_world_def'
-    _sph_size_ = 40
-    _sph_offsets_ = (('struct_size', 0), ('header_version', 4), ('capacity', 8), ('features', 12), ('integrator', 16), ('viscosity_method', 20), ('particle_spacing', 24), ('kernel_radius', 28), ('rest_density', 32), ('equation_of_state', 36))
+    _sph_size_ = 44
+    _sph_offsets_ = (('struct_size', 0), ('header_version', 4), ('capacity', 8), ('features', 12), ('integrator', 16), ('viscosity_method', 20), ('particle_spacing', 24), ('kernel_radius', 28), ('rest_density', 32), ('equation_of_state', 36), ('solver', 40))
     _sph_init_ = 'sph_world_def_init_sized'
     _sph_assigns_ = {'header_version': SPH_VERSION}
-    _sph_enums_ = {'integrator': Integrator, 'viscosity_method': ViscosityMethod, 'equation_of_state': EquationOfState}
+    _sph_enums_ = {'integrator': Integrator, 'viscosity_method': ViscosityMethod, 'equation_of_state': EquationOfState, 'solver': Solver}
 
 
 sph_world_def = WorldDef
@@ -729,7 +780,7 @@ class WorldParams(_SphStruct):
 
     Fields:
         struct_size (uint32_t): sizeof(sph_world_params), set by sph_world_params_init
-        max_substeps (uint32_t): most substeps one sph_world_step may take; default 10000; 0 = default
+        max_substeps (uint32_t): most substeps one sph_world_step may take; default 10000; 0 = default; at most 1000000 (a bound on one call's cost; see also the step budget)
         gravity (sph_vec3): m/s^2; default (0, -9.81, 0); finite; 0 is no gravity
         stiffness (float): k of p = k (rho - rho0), m^2/s^2 (the squared numerical sound speed); default 100; > 0; 0 = default. Keep sqrt(k) * dt_max below about 0.4 h.
         viscosity (float): mu of Mueller's Laplacian viscosity (a numerical viscosity, not water's 0.001 Pa s); default 1; >= 0; 0 is an inviscid fluid
@@ -862,6 +913,35 @@ class SpringParams(_SphStruct):
 sph_spring_params = SpringParams
 
 
+class DfsphParams(_SphStruct):
+    """
+    sph_dfsph_params.
+
+    Fields:
+        struct_size (uint32_t): set by sph_dfsph_params_init
+        density_error (float): bound on the density solve's mean error, the mean over the particles of max(rho* - rho0, 0) / rho0 (rho*: the density the step would give); dimensionless; default 0.001 (0.1 %); in (0, 1]; 0 = default
+        divergence_error (float): bound on the divergence solve's mean of max(D rho / Dt, 0) / rho0, 1/s; default 1; > 0; 0 = default
+        max_iterations (uint32_t): cap of the density solve per substep; default 100; >= 2; 0 = default. A solve that stops here above its bound is counted in sph_stats and reported as an event
+        max_divergence_iterations (uint32_t): cap of the divergence solve; default 100; >= 1; 0 = default
+        flags (uint32_t): SPH_DFSPH_* bits; default 0
+    """
+    _fields_ = [
+        ('struct_size', _c.c_uint32),
+        ('density_error', _c.c_float),
+        ('divergence_error', _c.c_float),
+        ('max_iterations', _c.c_uint32),
+        ('max_divergence_iterations', _c.c_uint32),
+        ('flags', _c.c_uint32),
+    ]
+    _sph_c_name_ = 'sph_dfsph_params'
+    _sph_size_ = 24
+    _sph_offsets_ = (('struct_size', 0), ('density_error', 4), ('divergence_error', 8), ('max_iterations', 12), ('max_divergence_iterations', 16), ('flags', 20))
+    _sph_init_ = 'sph_dfsph_params_init_sized'
+
+
+sph_dfsph_params = DfsphParams
+
+
 class ParamsInfo(_SphStruct):
     """
     sph_params_info.
@@ -941,7 +1021,7 @@ class PhysicsMethodInfo(_SphStruct):
         struct_size (uint32_t): set by sph_physics_method_info_init
         method_count (uint32_t): how many methods this library has (index runs below it)
         switch_by (sph_method_switch): the sph_world_def field that selects it
-        value (uint32_t): the SPH_FEATURE_* bit, sph_viscosity_method or sph_equation_of_state
+        value (uint32_t): the SPH_FEATURE_* bit, sph_viscosity_method, sph_equation_of_state or sph_solver
         has_params (uint32_t): 1 when its parameters are in the struct of params_kind
         params_kind (sph_params_kind): SPH_PARAMS_WORLD for the thesis's defaults (stiffness, viscosity)
         name (const char*): "clavet", "surface_tension": a scene file's name; static
@@ -1071,6 +1151,16 @@ class Stats(_SphStruct):
         step_ms (float): wall milliseconds of the whole last sph_world_step
         reserved0 (uint32_t)
         memory_bytes (uint64_t): bytes the world holds for particles and grids (device memory on the CUDA backend)
+        pressure_iterations (uint32_t): DFSPH's two solves over the substeps of the last step (all zero on a WCSPH world). An iteration is one velocity update and one new residual, after the warm start's.
+        pressure_iterations_max (uint32_t): most in one substep
+        divergence_iterations (uint32_t): the divergence solve's iterations, summed
+        divergence_iterations_max (uint32_t): most in one substep
+        density_error_mean (float): the density solve's achieved mean error (see sph_dfsph_params.density_error), averaged over the substeps
+        density_error_max (float): the largest of any substep
+        divergence_error_mean (float): the divergence solve's achieved mean error, 1/s
+        divergence_error_max (float): the largest of any substep
+        pressure_solves_capped (uint32_t): substeps whose density solve stopped at its cap above its bound (also SPH_EVENT_PRESSURE_SOLVE_CAPPED)
+        divergence_solves_capped (uint32_t): likewise (SPH_EVENT_DIVERGENCE_SOLVE_CAPPED)
     """
     _fields_ = [
         ('struct_size', _c.c_uint32),
@@ -1090,10 +1180,20 @@ class Stats(_SphStruct):
         ('step_ms', _c.c_float),
         ('reserved0', _c.c_uint32),
         ('memory_bytes', _c.c_uint64),
+        ('pressure_iterations', _c.c_uint32),
+        ('pressure_iterations_max', _c.c_uint32),
+        ('divergence_iterations', _c.c_uint32),
+        ('divergence_iterations_max', _c.c_uint32),
+        ('density_error_mean', _c.c_float),
+        ('density_error_max', _c.c_float),
+        ('divergence_error_mean', _c.c_float),
+        ('divergence_error_max', _c.c_float),
+        ('pressure_solves_capped', _c.c_uint32),
+        ('divergence_solves_capped', _c.c_uint32),
     ]
     _sph_c_name_ = 'sph_stats'
-    _sph_size_ = 104
-    _sph_offsets_ = (('struct_size', 0), ('particle_count', 4), ('substeps', 8), ('neighbors_max', 12), ('simulated_time', 16), ('frame_time', 24), ('dt_min', 28), ('dt_max', 32), ('max_speed', 36), ('density_min', 40), ('density_mean', 44), ('density_max', 48), ('neighbors_mean', 52), ('stage_ms', 56), ('step_ms', 88), ('reserved0', 92), ('memory_bytes', 96))
+    _sph_size_ = 144
+    _sph_offsets_ = (('struct_size', 0), ('particle_count', 4), ('substeps', 8), ('neighbors_max', 12), ('simulated_time', 16), ('frame_time', 24), ('dt_min', 28), ('dt_max', 32), ('max_speed', 36), ('density_min', 40), ('density_mean', 44), ('density_max', 48), ('neighbors_mean', 52), ('stage_ms', 56), ('step_ms', 88), ('reserved0', 92), ('memory_bytes', 96), ('pressure_iterations', 104), ('pressure_iterations_max', 108), ('divergence_iterations', 112), ('divergence_iterations_max', 116), ('density_error_mean', 120), ('density_error_max', 124), ('divergence_error_mean', 128), ('divergence_error_max', 132), ('pressure_solves_capped', 136), ('divergence_solves_capped', 140))
     _sph_init_ = 'sph_stats_init_sized'
 
 
@@ -1367,6 +1467,42 @@ class ColliderMaterial(_SphStruct):
 sph_collider_material = ColliderMaterial
 
 
+class ColliderLoads(_SphStruct):
+    """
+    The fluid's loads on a collider over the last sph_world_step (SPH_FEATURE_COLLIDER_LOADS):
+    the time averages over the step's substeps of the force and of the torque about the
+    collider's load point, in world coordinates. What counts: the momentum the collision
+    response took from particles (contacts, friction, stickiness) and, with
+    SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions; force times frame_time is the
+    impulse the fluid gave the collider. The torque of each impulse is taken about the load
+    point posed at the impulse's time (it moves with the collider). Zero before the first step
+    (frame_time 0). docs/physics.md "Loads".
+
+    Fields:
+        struct_size (uint32_t): set by sph_collider_loads_init
+        reserved0 (uint32_t): written as 0
+        force (sph_vec3): N, world frame
+        torque (sph_vec3): N m, world frame, about point
+        point (sph_vec3): the load point in the world at the end of the step, m
+        frame_time (double): s: the time the step advanced, over which force and torque are averaged
+    """
+    _fields_ = [
+        ('struct_size', _c.c_uint32),
+        ('reserved0', _c.c_uint32),
+        ('force', sph_vec3),
+        ('torque', sph_vec3),
+        ('point', sph_vec3),
+        ('frame_time', _c.c_double),
+    ]
+    _sph_c_name_ = 'sph_collider_loads'
+    _sph_size_ = 56
+    _sph_offsets_ = (('struct_size', 0), ('reserved0', 4), ('force', 8), ('torque', 20), ('point', 32), ('frame_time', 48))
+    _sph_init_ = 'sph_collider_loads_init_sized'
+
+
+sph_collider_loads = ColliderLoads
+
+
 class SourceId(_SphStruct):
     """
     sph_source_id.
@@ -1609,7 +1745,7 @@ class CudaAttributeView(_SphStruct):
 sph_cuda_attribute_view = CudaAttributeView
 
 
-STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpringParams, ParamsInfo, ParamFieldInfo, PhysicsMethodInfo, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, MeshDesc, Quat, Transform, ColliderId, ColliderDef, ColliderMaterial, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, Event, CudaAttributeView, )
+STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpringParams, DfsphParams, ParamsInfo, ParamFieldInfo, PhysicsMethodInfo, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, MeshDesc, Quat, Transform, ColliderId, ColliderDef, ColliderMaterial, ColliderLoads, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, Event, CudaAttributeView, )
 
 # ---- functions --------------------------------------------------------------------------------
 
@@ -1638,7 +1774,7 @@ FUNCTIONS = {
     'sph_world_def_init_sized': (sph_result, (_c.POINTER(sph_world_def), _c.c_uint32), ('def', 'size'),
         '', 'sph'),
     'sph_world_create': (sph_result, (_c.POINTER(sph_context), _c.POINTER(sph_world_def), _c.POINTER(_c.POINTER(sph_world))), ('context', 'def', 'out'),
-        'Creates an empty world on a context. The particle mass is derived here: the mass at which an FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass). Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range: capacity above 2^30, spacing < 0 or non-finite, kernel_radius < spacing, rest_density < 0), UNSUPPORTED (unknown integrator or feature bit), VERSION_MISMATCH, OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY. *out is written only on success.', 'sph'),
+        'Creates an empty world on a context. The particle mass is derived here: the mass at which an FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass). Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range: capacity above 2^30, spacing < 0 or non-finite, kernel_radius < spacing, rest_density < 0), UNSUPPORTED (unknown integrator, feature bit, method or solver; a combination a solver does not support, see sph_solver), VERSION_MISMATCH, OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY. *out is written only on success.', 'sph'),
     'sph_world_destroy': (sph_result, (_c.POINTER(sph_world),), ('world',),
         "Destroys a world and everything in it. NULL is a no-op. It takes the world like every call that takes a world: WORLD_LOCKED while another thread's call is inside it (destroy again once that call returned); a call that races a destroy that won gets INVALID_HANDLE. Memory a call is using is never freed.", 'sph'),
     'sph_world_get_def': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_world_def)), ('world', 'out_def'),
@@ -1675,6 +1811,12 @@ FUNCTIONS = {
         'FEATURE_DISABLED unless the world has SPH_FEATURE_SPRINGS. INVALID_ARGUMENT for a value out of range (the message names it); nothing changes on error. Springs already made keep their rest lengths; the new stiffness, damping and plasticity act from the next substep.', 'sph'),
     'sph_world_get_spring_params': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_spring_params)), ('world', 'out'),
         '', 'sph'),
+    'sph_dfsph_params_init_sized': (sph_result, (_c.POINTER(sph_dfsph_params), _c.c_uint32), ('params', 'size'),
+        '', 'sph'),
+    'sph_world_set_dfsph_params': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_dfsph_params)), ('world', 'params'),
+        "FEATURE_DISABLED unless the world's solver is SPH_SOLVER_DFSPH. INVALID_ARGUMENT for a value out of range (the message names it); nothing changes on error. Acts from the next substep.", 'sph'),
+    'sph_world_get_dfsph_params': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_dfsph_params)), ('world', 'out'),
+        '', 'sph'),
     'sph_world_set_physics_params': (sph_result, (_c.POINTER(sph_world), sph_params_kind, _c.c_void_p), ('world', 'kind', 'params'),
         'Replaces the params struct of `kind` at once, as its typed set call does (sph_world_set_params, sph_world_set_tait_params, ...): params points to that struct, struct_size first. Errors: those of the typed call; UNSUPPORTED for an unknown kind.', 'sph'),
     'sph_world_get_physics_params': (sph_result, (_c.POINTER(sph_world), sph_params_kind, _c.c_void_p), ('world', 'kind', 'out'),
@@ -1704,7 +1846,13 @@ FUNCTIONS = {
     'sph_world_fill_sphere': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_fill_sphere_desc), _c.POINTER(_c.c_uint32)), ('world', 'desc', 'out_count'),
         'Fills a sphere on an FCC lattice; as sph_world_fill_box otherwise.', 'sph'),
     'sph_world_step': (sph_result, (_c.POINTER(sph_world), _c.c_float), ('world', 'frame_dt'),
-        "Advances the world by frame_dt seconds (> 0, finite) in adaptive substeps: each substep's dt = step_factor * h / v_max clamped to [dt_min, dt_max], shortened at the end so that the substeps add up to frame_dt exactly (the last one or two may be shorter than dt_min). Blocks until the frame is done. Returns SPH_INCOMPLETE if max_substeps ran out first (sph_stats.frame_time says how far it got). SPH_ERROR_NON_FINITE if a substep produced a NaN/Inf: the world is restored to its state before this call.", 'sph'),
+        "Advances the world by frame_dt seconds (> 0, finite) in adaptive substeps: each substep's dt = step_factor * h / v_max clamped to [dt_min, dt_max], shortened at the end so that the substeps add up to frame_dt exactly (the last one or two may be shorter than dt_min). Blocks until the frame is done. Returns SPH_INCOMPLETE if max_substeps ran out first, or the step budget (sph_world_set_step_budget) or a cancel (sph_world_cancel_step) stopped it: the world is then as after its last whole substep, consistent and ready to step again (sph_stats.frame_time and substeps say how far it got). SPH_ERROR_NON_FINITE if a substep produced a NaN/Inf, SPH_ERROR_CAPACITY if more particles than 64 times the rest density allows piled into one cell of side h (the neighbour work would grow with their square; the message says where): the world is restored to its state before this call.", 'sph'),
+    'sph_world_set_step_budget': (sph_result, (_c.POINTER(sph_world), _c.c_double), ('world', 'max_seconds'),
+        'Bounds the wall-clock time of each later sph_world_step of this world: a step still running max_seconds after it began stops at its next substep boundary and returns SPH_INCOMPLETE (one substep may overrun the budget). Both backends check it between substeps: the CUDA backend runs a frame with a budget on its stream driver instead of its device graph (one host synchronisation a substep). 0 (the default) is no budget. Not saved in checkpoints. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NaN, negative or above 86400), WORLD_LOCKED.', 'sph'),
+    'sph_world_get_step_budget': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_double)), ('world', 'out_seconds'),
+        'The step budget in seconds (0: none). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL).', 'sph'),
+    'sph_world_cancel_step': (sph_result, (_c.POINTER(sph_world),), ('world',),
+        "Asks the world's step to stop at its next substep boundary (it returns SPH_INCOMPLETE with the world consistent; on the CUDA backend a frame on the device graph, which is every frame without a step budget or sinks, sees it only at its end). The one call that may run on another thread while a step holds the world: it never blocks and never answers WORLD_LOCKED. A request made while no step runs stops the next step before its first substep (that step changes nothing and reports 0 substeps); a step that stops for it clears it. Errors: INVALID_HANDLE (NULL or destroyed: safe to call racing sph_world_destroy).", 'sph'),
     'sph_world_get_particle_count': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_uint32)), ('world', 'out_count'),
         'Number of particles in the world.', 'sph'),
     'sph_world_copy_attribute': (sph_result, (_c.POINTER(sph_world), sph_attribute, _c.c_void_p, _c.c_uint64, _c.c_uint64, _c.c_uint32, _c.c_uint32, _c.POINTER(_c.c_uint32)), ('world', 'attribute', 'dst', 'dst_size', 'dst_stride', 'first', 'count', 'out_written'),
@@ -1755,6 +1903,12 @@ FUNCTIONS = {
         "Replaces a collider's material; acts from the next substep. Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (NULL material; a coefficient out of range or not finite, named), VERSION_MISMATCH (struct_size), WORLD_LOCKED. Nothing changes on error.", 'sph'),
     'sph_collider_get_material': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_collider_material)), ('world', 'id', 'out'),
         "Reads a collider's material (as the def or the last set call gave it). out->struct_size must be set (sph_collider_material_init); only that many bytes are written. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL out), VERSION_MISMATCH, WORLD_LOCKED.", 'sph'),
+    'sph_collider_loads_init_sized': (sph_result, (_c.POINTER(sph_collider_loads), _c.c_uint32), ('loads', 'size'),
+        '', 'sph'),
+    'sph_collider_get_loads': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_collider_loads)), ('world', 'id', 'out'),
+        "Reads a collider's loads of the last step. Non-blocking (the step brought them to the host). out->struct_size must be set (sph_collider_loads_init); only that many bytes are written. Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (NULL out), VERSION_MISMATCH, FEATURE_DISABLED (the world lacks SPH_FEATURE_COLLIDER_LOADS), WORLD_LOCKED.", 'sph'),
+    'sph_collider_set_load_point': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_vec3)), ('world', 'id', 'point'),
+        "Sets the point, in the collider's own frame, that its loads' torque is taken about (default its origin; an engine passes the body's centre of mass). Acts from the next step. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL point; a non-finite component, named), FEATURE_DISABLED, WORLD_LOCKED. Nothing changes on error.", 'sph'),
     'sph_source_def_init_sized': (sph_result, (_c.POINTER(sph_source_def), _c.c_uint32), ('def', 'size'),
         '', 'sph'),
     'sph_source_create': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_source_def), _c.POINTER(sph_source_id)), ('world', 'def', 'out_id'),

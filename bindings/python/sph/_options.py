@@ -6,6 +6,7 @@ Options are chosen when the world is created, through fields of its WorldDef::
     ctx.world(viscosity_method="clavet",                          # ViscosityMethod.CLAVET
               equation_of_state="tait",                           # EquationOfState.TAIT
               features="surface_tension|normalized_density")      # or Feature.X | Feature.Y
+    ctx.world(solver="dfsph")                                     # Solver.DFSPH: world.dfsph_params
 
 Their parameters are structs of their own, read and replaced whole (world.tait_params, ...)
 or changed field by field (world.set_tait_params(speed_of_sound=40)). Reading or setting the
@@ -191,6 +192,31 @@ class WorldOptionsMixin:
         Returns the parameters now set."""
         p = _changed(self.spring_params, fields)
         self.spring_params = p
+        return p
+
+    # -- DFSPH (solver=Solver.DFSPH)
+    @property
+    def dfsph_params(self):
+        """DfsphParams of a world created with solver=Solver.DFSPH (sph_world_get_dfsph_params):
+        density_error (the bound on the density solve's mean (rho* - rho0)+ / rho0, default
+        0.001), divergence_error (1/s, default 1), max_iterations, max_divergence_iterations and
+        flags (SPH_DFSPH_SKIP_DIVERGENCE_SOLVE). Assign a DfsphParams (or a dict of its fields)
+        to replace them (sph_world_set_dfsph_params; validated, unchanged on error). Raises
+        SphError(ERROR_FEATURE_DISABLED) on a weakly compressible world."""
+        p = _g.DfsphParams()
+        check(library().sph_world_get_dfsph_params(self.handle, ctypes.byref(p)), "sph_world_get_dfsph_params")
+        return p
+
+    @dfsph_params.setter
+    def dfsph_params(self, params):
+        p = _as_struct(_g.DfsphParams, params)
+        check(library().sph_world_set_dfsph_params(self.handle, ctypes.byref(p)), "sph_world_set_dfsph_params")
+
+    def set_dfsph_params(self, **fields):
+        """Changes some DFSPH parameters, keeping the others: ``w.set_dfsph_params(density_error=1e-4)``.
+        Returns the parameters now set."""
+        p = _changed(self.dfsph_params, fields)
+        self.dfsph_params = p
         return p
 
     # -- any params struct by kind (the generic calls, for tools that read the descriptions)

@@ -302,6 +302,23 @@ class Collider(_WorldObject):
         ``material`` to a ColliderMaterial of these three."""
         self.material = _g.ColliderMaterial(restitution=restitution, friction=friction, stickiness=stickiness)
 
+    @property
+    def loads(self):
+        """The fluid's loads over the last step, a ColliderLoads: force (N) and torque (N m) about
+        ``point``, world frame, time averages over ``frame_time`` (sph_collider_get_loads; needs
+        the world feature "collider_loads")."""
+        l = _g.ColliderLoads()
+        check(library().sph_collider_get_loads(self.world.handle, self.id, ctypes.byref(l)),
+              "sph_collider_get_loads")
+        return l
+
+    def set_load_point(self, point):
+        """The point, in the collider's own frame, that the loads' torque is about (default the
+        origin; pass the body's centre of mass) (sph_collider_set_load_point)."""
+        p = _g.Vec3(*point)
+        check(library().sph_collider_set_load_point(self.world.handle, self.id, ctypes.byref(p)),
+              "sph_collider_set_load_point")
+
 
 class Source(_WorldObject):
     """Emits particles where its region SDF is negative (World.add_source)."""

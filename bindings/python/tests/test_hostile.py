@@ -94,3 +94,33 @@ def test_spawn_and_copy_shapes_are_checked(world):
         world.copy_attribute(sph.Attribute.POSITION, out=np.empty((4, 2), np.float32))
     with pytest.raises(ValueError, match="stride"):
         world.copy_attribute(sph.Attribute.POSITION, out=np.empty((4, 3), np.float32)[::-1])
+
+
+def test_step_budget_and_cancel_bound_a_step(world):
+    # What one call may cost (issue 23 item 9): a frame of 10,000 fixed substeps stops early,
+    # consistent, under a budget or a cancel; bad budgets and max_substeps beyond 10^6 are refused.
+    import threading
+    import time
+    world.fill_box((0.0, 0.0, 0.0), (0.16, 0.16, 0.16))
+    world.set_params(dt_min=1e-4, dt_max=1e-4)
+    assert world.step_budget == 0.0
+    world.step_budget = 0.05
+    assert world.step_budget == 0.05
+    assert world.step(1.0) == sph.Result.INCOMPLETE
+    assert 1 <= world.stats().substeps < 10000
+    world.step_budget = 0.0
+    for bad in (-1.0, float("nan"), 1e9):
+        with pytest.raises(sph.SphError, match="max_seconds"):
+            world.step_budget = bad
+    world.cancel_step()  # no step running: the next one stops before its first substep
+    assert world.step(1.0) == sph.Result.INCOMPLETE
+    assert world.stats().substeps == 0
+    timer = threading.Timer(0.05, world.cancel_step)
+    timer.start()
+    started = time.monotonic()
+    assert world.step(1.0) == sph.Result.INCOMPLETE
+    timer.join()
+    assert 1 <= world.stats().substeps < 10000, time.monotonic() - started
+    assert world.step(2e-4) == sph.Result.OK
+    with pytest.raises(sph.SphError, match="max_substeps"):
+        world.set_params(max_substeps=1_000_001)

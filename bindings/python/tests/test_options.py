@@ -154,7 +154,7 @@ def test_tait_speed_of_sound_must_be_positive(full):
 # ---- every params struct by kind, and the descriptions tools read -------------------------------
 def test_params_are_described_for_tools():
     assert [sph.params_info(k).name for k in sph.ParamsKind] == [
-        b"world", b"surface_tension", b"clavet", b"tait", b"springs"]
+        b"world", b"surface_tension", b"clavet", b"tait", b"springs", b"dfsph"]
     assert sph.params_info("tait").type_name == b"sph_tait_params"
     assert sph.params_info("clavet").params_size == ctypes.sizeof(sph.ClavetViscosityParams)
     names = [f.name for f in sph.param_fields(sph.ParamsKind.WORLD)]
@@ -169,7 +169,10 @@ def test_params_are_described_for_tools():
     assert tuple(gravity.default_value) == pytest.approx((0, -9.81, 0))
     methods = {m.name: m for m in sph.methods()}
     assert list(methods) == [b"ideal_gas", b"tait", b"mueller", b"clavet", b"surface_tension",
-                             b"normalized_density", b"springs"]
+                             b"normalized_density", b"springs", b"wcsph", b"dfsph",
+                             b"boundary_density", b"collider_loads"]
+    assert methods[b"dfsph"].switch_by == sph.MethodSwitch.SOLVER and methods[b"dfsph"].value == sph.Solver.DFSPH
+    assert methods[b"dfsph"].params_kind == sph.ParamsKind.DFSPH and not methods[b"wcsph"].has_params
     assert methods[b"springs"].switch_by == sph.MethodSwitch.FEATURE
     assert methods[b"springs"].value == sph.Feature.SPRINGS and methods[b"springs"].has_params
     assert methods[b"tait"].params_kind == sph.ParamsKind.TAIT
@@ -269,3 +272,27 @@ def test_spring_params_round_trip_validation_and_feature(ctx):
         assert w.spring_params.yield_ratio == pytest.approx(0.1)
         w.spring_params = {"damping": 3.0}
         assert w.spring_params.damping == 3.0 and w.spring_params.plasticity == 0.0
+
+
+# ---- the solver (WorldDef.solver) -------------------------------------------------------------------
+def test_dfsph_world_has_its_params_and_refuses_what_it_does_not_support(ctx):
+    with ctx.world(capacity=256, solver="dfsph") as w:
+        assert w.definition.solver is sph.Solver.DFSPH
+        p = w.dfsph_params
+        assert (p.density_error, p.divergence_error, p.max_iterations, p.max_divergence_iterations, p.flags) == (
+            pytest.approx(0.001), 1.0, 100, 100, 0)
+        w.set_dfsph_params(density_error=1e-4, flags=sph.raw.SPH_DFSPH_SKIP_DIVERGENCE_SOLVE)
+        assert w.dfsph_params.density_error == pytest.approx(1e-4)
+        assert w.physics_params("dfsph").flags == sph.raw.SPH_DFSPH_SKIP_DIVERGENCE_SOLVE
+        e = error(w.set_dfsph_params, max_iterations=1)
+        assert "params->max_iterations" in e.message and w.dfsph_params.max_iterations == 100
+        w.fill_box((0, 0, 0), (0.1, 0.1, 0.1))
+        w.step(1 / 60)
+        s = w.stats()
+        assert s.pressure_iterations >= 2 * s.substeps and s.density_error_max <= 1e-4
+    with ctx.world(capacity=16) as w:
+        assert w.definition.solver is sph.Solver.WCSPH
+        assert error(_get, w, "dfsph_params").result == sph.Result.ERROR_FEATURE_DISABLED
+    for refused in ({"integrator": "rk4"}, {"equation_of_state": "tait"}, {"features": "normalized_density"}):
+        e = error(ctx.world, capacity=16, solver="dfsph", **refused)
+        assert e.result == sph.Result.ERROR_UNSUPPORTED and "SPH_SOLVER_DFSPH" in e.message

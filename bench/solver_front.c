@@ -1,0 +1,168 @@
+/* The solver trade (issue 16 item 5): the dam break of Martin & Moyce (tests/support/dam_break.c)
+ * for the weakly compressible scheme at several stiffnesses (Tait's speed of sound as a multiple
+ * of the column's free-fall speed sqrt(2 g 2a) = 1.50 m/s) and DFSPH at several density error
+ * bounds, at each resolution asked for, on the chosen backend. Per run: wall seconds per
+ * simulated second, substeps, neighbour passes, the mean and largest compression (density
+ * error) of the particles above rest density, the front's mean error against the measurements
+ * (one fitted shift, as the validation), and DFSPH's solve iterations.
+ *
+ *   solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1]
+ *                [--out solver_front.csv]
+ *
+ * --sample-T: the front's sampling interval in T (0.1 = 5.4 ms). Each sample ends a frame, and a
+ * frame's landing step caps the substep, so a fine sampling (the validation's 0.025 = 1.35 ms)
+ * would cap DFSPH's CFL step, which is several times the weakly compressible one, and hide the
+ * trade. 0.1 is fine enough for the front: the measurements are 0.2-0.3 apart in T.
+ * --seconds: the simulated time (1 s is T = 18.5; the front's comparison window ends at T = 3.3,
+ * 0.18 s, so a shorter run, >= 0.2 s, still measures the front). Neighbour passes count the
+ * walks over every particle's neighbours: two per substep for the weakly compressible scheme
+ * (density, forces), and for DFSPH the density and the forces plus, per solve, the warm start's
+ * velocity update and first residual and two per iteration. The plot is
+ * bench/solver_front_plot.py. A run that fails is a row with status "failed". */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dam_break.h"
+#include "sph_c.h"
+#include "support.h"
+
+#define MAX_RESOLUTIONS 8
+#define GRAVITY 9.81
+
+static int parse_layers(const char* text, uint32_t* layers) {
+  int count = 0;
+  const char* p = text;
+  while (*p && count < MAX_RESOLUTIONS) {
+    char* end = NULL;
+    const long v = strtol(p, &end, 10);
+    if (end == p || v < 4 || v > 1000) return 0;
+    layers[count++] = (uint32_t)v;
+    p = (*end == ',') ? end + 1 : end;
+    if (*end != ',' && *end != '\0') return 0;
+  }
+  return count;
+}
+
+typedef struct solver_run {
+  sph_solver solver;
+  double value; /* WCSPH: c / free-fall speed; DFSPH: the density error bound */
+} solver_run;
+
+int main(int argc, char** argv) {
+  const solver_run runs[] = {{SPH_SOLVER_WCSPH, 5.0},  {SPH_SOLVER_WCSPH, 10.0},  {SPH_SOLVER_WCSPH, 20.0},
+                             {SPH_SOLVER_DFSPH, 0.01}, {SPH_SOLVER_DFSPH, 0.001}, {SPH_SOLVER_DFSPH, 0.0001}};
+  const int run_count = (int)(sizeof runs / sizeof runs[0]);
+  uint32_t layers[MAX_RESOLUTIONS] = {8, 12, 16};
+  int resolutions = 3;
+  double seconds = 1.0, sample_T = 0.1;
+  const char* out_path = "solver_front.csv";
+  sph_backend backend = SPH_BACKEND_AUTO, resolved = SPH_BACKEND_CPU;
+  sph_context* context = NULL;
+  dam_break_result* result = (dam_break_result*)malloc(sizeof(dam_break_result));
+  const double a = DAM_BREAK_COLUMN_WIDTH;
+  const double free_fall = sqrt(2.0 * GRAVITY * 2.0 * a);
+  const double time_scale = sqrt(2.0 * GRAVITY / a);
+  FILE* csv;
+  if (!result) return 1;
+  for (int i = 1; i < argc; ++i) {
+    if (strcmp(argv[i], "--backend") == 0 && i + 1 < argc) {
+      backend = support_backend_from_name(argv[++i], SPH_BACKEND_AUTO);
+    } else if (strcmp(argv[i], "--layers") == 0 && i + 1 < argc) {
+      resolutions = parse_layers(argv[++i], layers);
+      if (resolutions == 0) {
+        fprintf(stderr, "solver_front: --layers takes a comma-separated list of integers in [4, 1000]\n");
+        return 2;
+      }
+    } else if (strcmp(argv[i], "--seconds") == 0 && i + 1 < argc) {
+      seconds = atof(argv[++i]);
+      if (!(seconds >= 0.2 && seconds <= 100.0)) {
+        fprintf(stderr, "solver_front: --seconds takes a simulated time in [0.2, 100] s\n");
+        return 2;
+      }
+    } else if (strcmp(argv[i], "--sample-T") == 0 && i + 1 < argc) {
+      sample_T = atof(argv[++i]);
+      if (!(sample_T >= 0.005 && sample_T <= 0.2)) {
+        fprintf(stderr, "solver_front: --sample-T takes an interval in [0.005, 0.2]\n");
+        return 2;
+      }
+    } else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
+      out_path = argv[++i];
+    } else {
+      fprintf(
+          stderr,
+          "usage: solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1] "
+          "[--out solver_front.csv]\n");
+      return 2;
+    }
+  }
+  if (support_context_create(backend, &context) != SPH_OK) {
+    fprintf(stderr, "solver_front: no context for the backend asked for\n");
+    return 1;
+  }
+  sph_context_get_backend(context, &resolved);
+  csv = fopen(out_path, "w");
+  if (!csv) {
+    fprintf(stderr, "solver_front: cannot write %s\n", out_path);
+    return 1;
+  }
+  fprintf(csv,
+          "backend,solver,parameter,layers,particles,simulated_s,wall_s,wall_s_per_simulated_s,substeps,"
+          "neighbor_passes,pressure_iterations,divergence_iterations,density_error_mean,density_error_max,"
+          "solve_error_max,front_shift_T,front_error_mean,front_error_max,status\n");
+  printf(
+      "%s backend; dam break of Martin & Moyce for %.2f simulated s; front errors over T in [%.1f, %.1f]\n",
+      resolved == SPH_BACKEND_CUDA ? "CUDA" : "CPU", seconds, DAM_BREAK_T_FIRST, DAM_BREAK_T_LAST);
+  printf("%-6s %-9s %6s %9s %10s %9s %10s %8s %8s %8s %8s\n", "solver", "parameter", "layers", "particles",
+         "wall/sim", "substeps", "nb passes", "rho err", "rho max", "front", "it/step");
+  for (int l = 0; l < resolutions; ++l) {
+    for (int r = 0; r < run_count; ++r) {
+      dam_break_config config;
+      sph_result status;
+      double passes = 0.0;
+      const int dfsph = runs[r].solver == SPH_SOLVER_DFSPH;
+      dam_break_config_default(&config, layers[l]);
+      config.end_T = seconds * time_scale;
+      config.sample_T = sample_T;
+      config.solver = runs[r].solver;
+      if (dfsph)
+        config.density_error = (float)runs[r].value;
+      else
+        config.speed_of_sound = (float)(runs[r].value * free_fall);
+      status = dam_break_run(context, &config, result, NULL, NULL);
+      if (status != SPH_OK) {
+        fprintf(csv, "%s,%s,%g,%u,%u,,,,,,,,,,,,,,failed\n", resolved == SPH_BACKEND_CUDA ? "cuda" : "cpu",
+                dfsph ? "dfsph" : "wcsph", runs[r].value, layers[l], result->particles);
+        printf("%-6s %-9g %6u failed: %s\n", dfsph ? "DFSPH" : "WCSPH", runs[r].value, layers[l],
+               result->message);
+        continue;
+      }
+      passes = 2.0 * (double)result->substeps;
+      if (dfsph) {
+        /* Per solve: the warm start's update and the first residual, then two per iteration. */
+        const double solves = (double)result->substeps * (config.dfsph_flags ? 1.0 : 2.0);
+        passes += 2.0 * solves + 2.0 * (double)(result->pressure_iterations + result->divergence_iterations);
+      }
+      fprintf(csv, "%s,%s,%g,%u,%u,%.4f,%.3f,%.3f,%llu,%.0f,%llu,%llu,%.6f,%.6f,%.6f,%.4f,%.5f,%.5f,ok\n",
+              resolved == SPH_BACKEND_CUDA ? "cuda" : "cpu", dfsph ? "dfsph" : "wcsph", runs[r].value,
+              layers[l], result->particles, result->simulated_seconds, result->wall_seconds,
+              result->wall_seconds / result->simulated_seconds, (unsigned long long)result->substeps, passes,
+              (unsigned long long)result->pressure_iterations,
+              (unsigned long long)result->divergence_iterations, result->mean_compression,
+              result->max_compression, result->density_error_max, result->shift_T, result->mean_error,
+              result->max_error);
+      fflush(csv);
+      printf("%-6s %-9g %6u %9u %10.2f %9llu %10.0f %7.2f%% %7.2f%% %7.2f%% %8.2f\n",
+             dfsph ? "DFSPH" : "WCSPH", runs[r].value, layers[l], result->particles,
+             result->wall_seconds / result->simulated_seconds, (unsigned long long)result->substeps, passes,
+             100.0 * result->mean_compression, 100.0 * result->max_compression, 100.0 * result->mean_error,
+             dfsph ? (double)result->pressure_iterations / (double)result->substeps : 0.0);
+      fflush(stdout);
+    }
+  }
+  fclose(csv);
+  free(result);
+  sph_context_destroy(context);
+  return 0;
+}

@@ -1,0 +1,331 @@
+#include <vector>
+
+#include "../src/physics/dfsph_passes.h"
+#include "block_reduce.cuh"
+#include "dfsph_solver.h"
+#include "force_gather.cuh"
+#include "kernel_launch.h"
+
+namespace sph {
+namespace {
+
+constexpr unsigned kCheckBlock = 256;
+constexpr cudaStreamCaptureMode kCaptureMode = cudaStreamCaptureModeThreadLocal;
+
+// Fixed-shape tree over a block's shared slots: the same additions in the same order every run.
+template <unsigned kBlock>
+__device__ void tree_sum(double* slots) {
+  for (unsigned stride = kBlock / 2; stride > 0; stride >>= 1) {
+    __syncthreads();
+    if (threadIdx.x < stride) slots[threadIdx.x] += slots[threadIdx.x + stride];
+  }
+  __syncthreads();
+}
+
+// kBoundary: SPH_FEATURE_BOUNDARY_DENSITY, the walls' share (dfsph_boundary.h, place 1) at the
+// substep's start, its record kept for the solves.
+template <bool kBoundary>
+__global__ void dfsph_density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
+                                     DeviceScene scene, FrameState* state) {
+  mark_stage(state, kStageDensity);
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  // The reorder left this particle's old index in w; the carried pressures are still in the
+  // old order (nothing writes them in this kernel), their sorted copies go to scratch arrays.
+  const Float4 p = a.sorted_position[i];
+  const uint32_t k = __float_as_uint(p.w);
+  BoundaryShare wall = no_boundary_share();
+  if (kBoundary) {
+    const StageTime at = stage_time(state->clock.time, 0.0f);
+    wall =
+        boundary_share(fluid.methods.boundary, scene.colliders, scene.collider_count, xyz(p), at.s, at.tau);
+    a.boundary_gradient[i] = pack_boundary(wall);
+  }
+  const DfsphDensitySample s = gather_density_and_factor(fluid, grid, a.sorted_position, wall, i);
+  a.density[i] = s.density;
+  a.neighbor_count[i] = s.neighbor_count;
+  a.dfsph_factor[i] = s.factor;
+  // The warm starts, as the CPU backend's solve computes them (k = share * carried / scale).
+  const float dt = state->clock.dt_float;
+  a.dfsph_step[i] = Dfsph::kWarmStart * a.dfsph_divergence[k] / dt;
+  a.dfsph_warm_pressure[i] = Dfsph::kWarmStart * a.dfsph_pressure[k] / 1.0f;
+  if (scene.collider_count != 0)
+    a.dfsph_contact[i] =
+        wall_contact(scene.colliders, scene.collider_count, state->clock.time, scene.kernel_radius, xyz(p));
+  a.sorted_position[i].w = 0.0f;  // no equation of state: the pressure is written after the solves
+  a.sorted_velocity[i] = make_float4_record(xyz(a.velocity[k]), 1.0f / s.density);
+}
+
+__global__ void dfsph_begin_solve_kernel(FrameState* state) {
+  state->solve_run = 1;
+  state->solve_iterations = 0;
+}
+
+// v += the pressures k's velocity change (held to the contacts); carried gets k times the
+// solve's scale (dt for the divergence solve's impulse), added, or replacing the state-order
+// values on the warm start's pass.
+template <bool kWarm>
+__global__ void dfsph_correct_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
+                                     Float4* v, const float* k, float* carried, bool divergence,
+                                     bool contacts, FrameState* state) {
+  if (state->solve_run == 0) return;
+  mark_stage(state, kStageForces);
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const float dt = state->clock.dt_float;
+  const float scale = divergence ? dt : 1.0f;
+  Vec3 vi = xyz(v[i]) + pressure_velocity_change(fluid, grid, a.sorted_position, k,
+                                                 DfsphWalls{a.boundary_gradient}, i, dt);
+  if (contacts) vi = respect_contact(a.dfsph_contact[i], vi);
+  v[i] = make_float4_record(vi, v[i].w);
+  carried[i] = (kWarm ? 0.0f : carried[i]) + k[i] * scale;
+}
+
+// New pressures from the rates over v; each block's error sum to partials[block].
+template <bool kDivergence>
+__global__ void __launch_bounds__(kDfsphSolveBlock)
+    dfsph_residual_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n, const Float4* v,
+                          double* partials, FrameState* state) {
+  if (state->solve_run == 0) return;  // the same for every thread of the grid
+  __shared__ double slots[kDfsphSolveBlock];
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  double error = 0.0;
+  if (i < n) {
+    const float dt = state->clock.dt_float;
+    const float rate = density_rate(fluid, grid, a.sorted_position, v, DfsphWalls{a.boundary_gradient}, i);
+    const DfsphResidual r =
+        kDivergence ? divergence_residual(fluid.methods.dfsph, rate, a.neighbor_count[i], a.dfsph_factor[i],
+                                          fluid.rest_density, dt)
+                    : density_residual(rate, a.density[i], a.dfsph_factor[i], fluid.rest_density, dt);
+    a.dfsph_step[i] = r.k;
+    error = r.error;
+  }
+  slots[threadIdx.x] = error;
+  tree_sum<kDfsphSolveBlock>(slots);
+  if (threadIdx.x == 0) partials[blockIdx.x] = slots[0];
+}
+
+// The solve's mean error from the block sums; whether it goes on; its record when it stops.
+__global__ void __launch_bounds__(kCheckBlock)
+    dfsph_check_kernel(const double* partials, uint32_t blocks, uint32_t n, float bound,
+                       uint32_t min_iterations, uint32_t max_iterations, bool divergence, bool first,
+                       LoopCondition cond, FrameState* state) {
+  if (state->solve_run == 0) return;
+  __shared__ double slots[kCheckBlock];
+  double sum = 0.0;
+  for (uint32_t b = threadIdx.x; b < blocks; b += kCheckBlock) sum += partials[b];
+  slots[threadIdx.x] = sum;
+  tree_sum<kCheckBlock>(slots);
+  if (threadIdx.x != 0) return;
+  const float error = n > 0 ? static_cast<float>(slots[0] / n) : 0.0f;
+  const uint32_t iterations = first ? 0u : state->solve_iterations + 1u;
+  state->solve_iterations = iterations;
+  state->solve_error = error;
+  const bool more = (error > bound || iterations < min_iterations) && iterations < max_iterations;
+  if (!more) {
+    record_solve(divergence ? state->divergence_tally : state->pressure_tally, iterations, error,
+                 error > bound);
+    state->solve_run = 0;
+  }
+  if (cond.in_graph) cudaGraphSetConditional(cond.handle, more ? 1u : 0u);
+}
+
+// v* = v + dt a with the non-pressure accelerations, into the state's velocity array (free
+// since the density pass gathered it), held to the contacts.
+template <class Terms, bool kScene>
+__global__ void dfsph_forces_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
+                                    DeviceScene scene, bool divergence_solve, FrameState* state) {
+  mark_stage(state, kStageForces);
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  float a2 = 0.0f;
+  if (i < n) {
+    FluidConstants f = fluid;
+    f.dt = state->clock.dt_float;
+    Vec3 acc = gather_acceleration_masked<Terms, false>(f, grid, a.sorted_position, a.sorted_velocity,
+                                                        a.neighbor_count, a.colour_normal, i);
+    const Float4 p = a.sorted_position[i];
+    const Float4 v = a.sorted_velocity[i];
+    if (kScene) acc = add_force_fields(scene, acc, xyz(p));
+    if (a.spring_acceleration) acc += xyz(a.spring_acceleration[i]);
+    a2 = length_squared(acc);
+    Vec3 next = xyz(v) + acc * f.dt;
+    if (kScene && scene.collider_count != 0) next = respect_contact(a.dfsph_contact[i], next);
+    a.velocity[i] = make_float4_record(next, v.w);
+    if (!divergence_solve) a.dfsph_divergence[i] = 0.0f;  // no warm start to keep
+  }
+  block_max_to(&state->a2max_bits, a2);
+}
+
+// x += dt v*, the colliders, the pressure both solves applied, the state in the sorted order.
+template <bool kScene>
+__global__ void dfsph_integrate_kernel(ParticleArrays a, uint32_t n, DeviceScene scene, bool divergence_solve,
+                                       FrameState* state) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  float v2 = 0.0f;
+  if (i < n) {
+    const float dt = state->clock.dt_float;
+    const Float4 p = a.sorted_position[i];
+    const Float4 v = a.velocity[i];
+    ParticleState next{xyz(p) + xyz(v) * dt, xyz(v)};
+    if (kScene) collide_all(scene, state->clock.time, xyz(p), next);
+    const float rho = a.density[i];
+    const float divergence = divergence_solve ? 1.0f / dt : 0.0f;
+    const uint32_t id = a.sorted_id[i];
+    a.position[i] = make_float4_record(
+        next.position, dfsph_pressure(a.dfsph_pressure[i], a.dfsph_divergence[i] * divergence, rho));
+    a.velocity[i] = make_float4_record(next.velocity, v.w);
+    a.id[i] = id;
+    v2 = length_squared(next.velocity);
+    if (!finite3(next.position) || !isfinite(v2)) {
+      // As the CPU backend: the solves count as the integration (no acceleration to blame).
+      flag_non_finite(state, 0, i, id,
+                      classify_non_finite(rho, p, a.sorted_velocity[i], Vec3{0.0f, 0.0f, 0.0f}, next));
+      v2 = 0.0f;
+    }
+  }
+  block_max_to(&state->v2max_bits, v2);
+}
+
+// A conditional handle on the graph the stream is being captured into.
+LoopCondition open_solve_loop(bool in_graph, cudaStream_t stream) {
+  LoopCondition cond;
+  if (!in_graph) return cond;
+  cudaStreamCaptureStatus status = cudaStreamCaptureStatusNone;
+  cudaGraph_t graph = nullptr;
+  cuda_check(cudaStreamGetCaptureInfo(stream, &status, nullptr, &graph, nullptr, nullptr, nullptr),
+             "cudaStreamGetCaptureInfo");
+  cuda_check(cudaGraphConditionalHandleCreate(&cond.handle, graph, 0, cudaGraphCondAssignDefault),
+             "cudaGraphConditionalHandleCreate");
+  cond.in_graph = true;
+  return cond;
+}
+
+// Runs iteration() while the check says so: a WHILE node in the graph being captured (the capture
+// is ended, the node added after what was captured, its body captured, and the capture resumed
+// after it), or chunks on the stream with one read of the flag per chunk.
+template <class Iteration>
+void run_solve_loop(const LoopCondition& cond, FrameState* state, FrameState* host_state, cudaStream_t stream,
+                    Iteration&& iteration) {
+  if (!cond.in_graph) {
+    for (;;) {
+      cuda_check(cudaMemcpyAsync(&host_state->solve_run, &state->solve_run, sizeof(uint32_t),
+                                 cudaMemcpyDeviceToHost, stream),
+                 "copy of the solve's flag");
+      cuda_check(cudaStreamSynchronize(stream), "solve");
+      if (!host_state->solve_run) return;
+      for (uint32_t k = 0; k < kDfsphSolveChunk; ++k) iteration();
+    }
+  }
+  cudaStreamCaptureStatus status = cudaStreamCaptureStatusNone;
+  cudaGraph_t graph = nullptr;
+  const cudaGraphNode_t* leaves = nullptr;
+  size_t leaf_count = 0;
+  cuda_check(cudaStreamGetCaptureInfo(stream, &status, nullptr, &graph, &leaves, nullptr, &leaf_count),
+             "cudaStreamGetCaptureInfo");
+  const std::vector<cudaGraphNode_t> after(leaves, leaves + leaf_count);
+  cuda_check(cudaStreamEndCapture(stream, &graph), "capture before a solve");
+  cudaGraphNodeParams params = {};
+  params.type = cudaGraphNodeTypeConditional;
+  params.conditional.handle = cond.handle;
+  params.conditional.type = cudaGraphCondTypeWhile;
+  params.conditional.size = 1;
+  cudaGraphNode_t loop = nullptr;
+  cuda_check(cudaGraphAddNode(&loop, graph, after.data(), nullptr, after.size(), &params),
+             "conditional WHILE node of a solve");
+  cudaGraph_t body = params.conditional.phGraph_out[0];
+  cuda_check(cudaStreamBeginCaptureToGraph(stream, body, nullptr, nullptr, 0, kCaptureMode),
+             "capture of a solve's iteration");
+  iteration();
+  cuda_check(cudaStreamEndCapture(stream, &body), "capture of a solve's iteration");
+  cuda_check(cudaStreamBeginCaptureToGraph(stream, graph, &loop, nullptr, 1, kCaptureMode),
+             "capture after a solve");
+}
+
+enum class Solve { Divergence, Density };
+
+// One solve: the warm start's pass, the initial residual and check, then the loop.
+void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                   uint32_t n, bool contacts, const DfsphLoops& loops, FrameState* state,
+                   cudaStream_t stream) {
+  const bool divergence = kind == Solve::Divergence;
+  const Dfsph::Constants& c = fluid.methods.dfsph;
+  Float4* v = divergence ? a.sorted_velocity : a.velocity;
+  float* carried = divergence ? a.dfsph_divergence : a.dfsph_pressure;
+  const float* warm = divergence ? a.dfsph_step : a.dfsph_warm_pressure;
+  const float bound = divergence ? c.divergence_error : c.density_error;
+  const uint32_t min_iterations = divergence ? Dfsph::kMinDivergenceIterations : Dfsph::kMinIterations;
+  const uint32_t max_iterations = divergence ? c.max_divergence_iterations : c.max_iterations;
+  const unsigned threads = kDfsphSolveBlock, blocks = blocks_for(n, threads);
+  const uint32_t partial_count = blocks;
+  dfsph_begin_solve_kernel<<<1, 1, 0, stream>>>(state);
+  check_launch("dfsph_begin_solve_kernel");
+  const LoopCondition cond = open_solve_loop(loops.in_graph, stream);
+  auto residual = [&] {
+    if (divergence)
+      dfsph_residual_kernel<true>
+          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, loops.partials, state);
+    else
+      dfsph_residual_kernel<false>
+          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, loops.partials, state);
+    check_launch("dfsph_residual_kernel");
+  };
+  auto check = [&](bool first) {
+    dfsph_check_kernel<<<1, kCheckBlock, 0, stream>>>(loops.partials, partial_count, n, bound, min_iterations,
+                                                      max_iterations, divergence, first, cond, state);
+    check_launch("dfsph_check_kernel");
+  };
+  dfsph_correct_kernel<true>
+      <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, warm, carried, divergence, contacts, state);
+  check_launch("dfsph_correct_kernel");
+  residual();
+  check(true);
+  run_solve_loop(cond, state, loops.host_state, stream, [&] {
+    dfsph_correct_kernel<false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, a.dfsph_step, carried,
+                                                                divergence, contacts, state);
+    check_launch("dfsph_correct_kernel");
+    residual();
+    check(false);
+  });
+}
+
+}  // namespace
+
+void enqueue_dfsph_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                           uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
+                           const DeviceScene& scene, FrameState* state, cudaStream_t stream) {
+  const unsigned threads = tuning.density_block, blocks = blocks_for(n, threads);
+  if (options.boundary_density)
+    dfsph_density_kernel<true><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
+  else
+    dfsph_density_kernel<false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
+  check_launch("dfsph_density_kernel");
+  if (options.surface_tension) enqueue_colour_normals(fluid, grid, a, n, tuning, stream);
+}
+
+void enqueue_dfsph_step(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                        uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
+                        const DeviceScene& scene, const DfsphLoops& loops, FrameState* state,
+                        cudaStream_t stream) {
+  const bool contacts = scene.collider_count != 0;
+  const bool divergence_solve = fluid.methods.dfsph.divergence_solve != 0;
+  if (divergence_solve) enqueue_solve(Solve::Divergence, fluid, grid, a, n, contacts, loops, state, stream);
+  const unsigned threads = tuning.force_block, blocks = blocks_for(n, threads);
+  with_force_terms(options.methods, [&](auto terms) {
+    using Terms = decltype(terms);
+    if (scene.active())
+      dfsph_forces_kernel<Terms, true>
+          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, divergence_solve, state);
+    else
+      dfsph_forces_kernel<Terms, false>
+          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, divergence_solve, state);
+  });
+  check_launch("dfsph_forces_kernel");
+  enqueue_solve(Solve::Density, fluid, grid, a, n, contacts, loops, state, stream);
+  if (scene.active())
+    dfsph_integrate_kernel<true><<<blocks, threads, 0, stream>>>(a, n, scene, divergence_solve, state);
+  else
+    dfsph_integrate_kernel<false><<<blocks, threads, 0, stream>>>(a, n, scene, divergence_solve, state);
+  check_launch("dfsph_integrate_kernel");
+}
+
+}  // namespace sph

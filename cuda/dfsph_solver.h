@@ -1,0 +1,59 @@
+// DFSPH on the device (physics/dfsph.h; the twin of src/cpu/cpu_dfsph_solver.cpp): the density
+// and factor pass, then the divergence solve, the non-pressure accelerations, the density solve
+// and the step. Each solve is a Jacobi loop of three kernels, the velocity update, the new rates
+// and pressures (with each block's error sum in a fixed tree) and a one-block convergence check
+// (the block sums in a fixed order) that decides whether the loop goes on, so the iteration
+// counts and every result are the same bits on every run. The loop never waits for the host per
+// iteration: in the frame graph it is a conditional WHILE node nested in the substep's, whose
+// condition the check kernel sets; on the stream (the stream driver) the kernels run in chunks of
+// kSolveChunk iterations, each of which does nothing once the check has stopped the solve, and the
+// host reads the flag once per chunk.
+#pragma once
+
+#include <stdint.h>
+
+#include <cuda_runtime.h>
+
+#include "../src/physics/fluid_constants.h"
+#include "../src/physics/neighbor_walk.h"
+#include "device_particle_store.h"
+#include "frame_control.h"
+#include "frame_state.cuh"
+#include "substep_kernels.h"
+
+namespace sph {
+
+// Threads per block of the residual kernel: fixed, since its block sums are the reduction's
+// tree (the tuning knobs must not change results).
+constexpr unsigned kDfsphSolveBlock = 128;
+// Iterations the stream driver launches between two reads of the convergence flag.
+constexpr uint32_t kDfsphSolveChunk = 4;
+
+// Doubles the residual kernel's block sums need for `capacity` particles.
+inline uint32_t dfsph_partial_count(uint32_t capacity) {
+  return capacity == 0 ? 1u : (capacity + kDfsphSolveBlock - 1) / kDfsphSolveBlock;
+}
+
+// DFSPH's density pass: rho_i, the neighbour counts, the factor, each particle's contact with the
+// colliders, the warm starts gathered from the state order into the sorted order, and the
+// sorted velocities (w: 1 / rho); the colour normals when the world has surface tension.
+void enqueue_dfsph_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                           uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
+                           const DeviceScene& scene, FrameState* state, cudaStream_t stream);
+
+// Where a solve's loop runs and what it needs beyond the particles.
+struct DfsphLoops {
+  bool in_graph;           // capturing a substep into the frame graph
+  double* partials;        // dfsph_partial_count(capacity) doubles
+  FrameState* host_state;  // pinned: the stream driver reads solve_run here
+};
+
+// After the density pass (and the spring pass): the divergence solve (unless skipped), the
+// non-pressure accelerations, the density solve, positions, colliders and the reductions of the
+// step's end (max speed, max acceleration, the non-finite check), into the state arrays.
+void enqueue_dfsph_step(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                        uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
+                        const DeviceScene& scene, const DfsphLoops& loops, FrameState* state,
+                        cudaStream_t stream);
+
+}  // namespace sph

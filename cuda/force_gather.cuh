@@ -1,0 +1,78 @@
+// The force pass's device pieces that the weakly compressible kernels (substep_kernels.cu) and
+// DFSPH's (dfsph_solver.cu) share: the masked neighbour gather, the scene's force fields and
+// colliders, and the non-finite flag.
+#pragma once
+
+#include <stdint.h>
+
+#include "../src/core/non_finite.h"
+#include "../src/physics/collider_response.h"
+#include "../src/physics/force_fields.h"
+#include "../src/physics/forces.h"
+#include "../src/physics/integrate.h"
+#include "frame_state.cuh"
+#include "substep_kernels.h"
+
+namespace sph {
+
+// gather_acceleration (src/physics/forces.h) for SIMT: the same neighbours in the same order
+// and the same per-neighbour arithmetic (the composer's AccelerationGather), in two phases per
+// run of up to 32 candidates. First every candidate is only tested (a tight loop: load,
+// distance, compare) into a bit mask; then the costly pair terms run for the set bits in
+// ascending order. In one pass a warp would run the pair terms whenever any of its 32 threads
+// had a neighbour, i.e. for almost every candidate, since only about a fifth of the 27-cell
+// candidates are within h. (Collecting a whole particle's neighbours in a shared-memory list
+// first, for one longer second phase, measured slower: occupancy and latency.)
+// Terms: the world's force terms (methods.h); neighbor_counts and normals may be null unless a
+// term reads them. kPressure: with the symmetric pressure force (the weakly compressible
+// scheme), or without it (DFSPH's non-pressure accelerations, dfsph_solver.cu).
+template <class Terms, bool kPressure = true>
+__device__ __forceinline__ Vec3 gather_acceleration_masked(const FluidConstants& f, const GridView& grid,
+                                                           const Float4* __restrict__ positions,
+                                                           const Float4* __restrict__ velocities,
+                                                           const uint32_t* __restrict__ neighbor_counts,
+                                                           const Float4* __restrict__ normals, uint32_t i) {
+  AccelerationGather<Terms, kPressure> gather(ForceInputs{positions, velocities, neighbor_counts, normals},
+                                              i);
+  const Vec3 xi = gather.position();
+  for_each_neighbor_range(grid, xi, [&](uint32_t begin, uint32_t end) {
+    for (uint32_t base = begin; base < end; base += 32u) {
+      const uint32_t count = min(32u, end - base);
+      uint32_t hits = 0;
+#pragma unroll 4
+      for (uint32_t k = 0; k < count; ++k) {
+        const float r2 = length_squared(xi - xyz(positions[base + k]));
+        hits |= (is_force_neighbor(f, r2, i, base + k) ? 1u : 0u) << k;
+      }
+      while (hits != 0u) {
+        const uint32_t j = base + static_cast<uint32_t>(__ffs(hits) - 1);
+        hits &= hits - 1u;
+        const Float4 pj = positions[j];
+        const Vec3 d = xi - xyz(pj);
+        gather.add(f, j, pj, d, length_squared(d));
+      }
+    }
+  });
+  return gather.finish(f);
+}
+
+__device__ __forceinline__ void flag_non_finite(FrameState* s, int stage, uint32_t index, uint32_t id,
+                                                uint32_t where) {
+  atomicMin(&s->bad_key[stage], ((static_cast<unsigned long long>(index) << 2 | where) << 32) | id);
+  atomicAdd(&s->bad_counts[stage], 1u);
+}
+
+// The scene's force fields at a particle (after the neighbour gather, as the CPU backend).
+__device__ __forceinline__ Vec3 add_force_fields(const DeviceScene& scene, Vec3 acc, Vec3 x) {
+  for (uint32_t f = 0; f < scene.field_count; ++f) acc += force_field_acceleration(scene.fields[f], x);
+  return acc;
+}
+
+// Every collider against the integrated state, moved from x_old during the substep.
+__device__ __forceinline__ void collide_all(const DeviceScene& scene, const SubstepTime& time, Vec3 x_old,
+                                            ParticleState& s) {
+  for (uint32_t c = 0; c < scene.collider_count; ++c)
+    collide_particle(scene.colliders[c], time, scene.kernel_radius, x_old, s.position, s.velocity);
+}
+
+}  // namespace sph

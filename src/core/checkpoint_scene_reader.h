@@ -1,0 +1,26 @@
+// The scene sections of a checkpoint (SDF assets, colliders, sources, sinks, force fields):
+// each object is made by the same rules as a caller's (scene_build.h), its slot layout
+// restored as saved so ids stay valid.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "byte_io.h"
+#include "config.h"
+#include "scene_objects.h"
+#include "sdf_asset.h"
+#include "slot_map.h"
+
+namespace sph {
+
+using CheckpointAssets = std::vector<std::shared_ptr<SdfAsset>>;
+
+CheckpointAssets read_checkpoint_assets(ByteReader& r);
+SlotTable<Collider> read_checkpoint_colliders(ByteReader& r, const CheckpointAssets& assets);
+SlotTable<Source> read_checkpoint_sources(ByteReader& r, const CheckpointAssets& assets,
+                                          const WorldConfig& config);
+SlotTable<Sink> read_checkpoint_sinks(ByteReader& r, const CheckpointAssets& assets);
+SlotTable<ForceField> read_checkpoint_force_fields(ByteReader& r, const CheckpointAssets& assets);
+
+}  // namespace sph

@@ -1,0 +1,159 @@
+// The CPU backend's DFSPH substep (physics/dfsph.h; the twin of cuda/dfsph_solver.cu): density and
+// factor, the divergence solve on the current velocities, the non-pressure accelerations into
+// v*, the density solve on v*, then positions and colliders. Each solve is a Jacobi iteration of
+// two passes, the velocity update (dfsph_correct) and the new rates and pressures
+// (dfsph_residuals), until its mean error is below its bound or its cap. The mean is summed in
+// storage order in double, so it, the iteration count and every result do not depend on the
+// thread count.
+#include <algorithm>
+#include <cmath>
+
+#include "cpu_backend_impl.h"
+
+namespace sph {
+
+void CpuBackend::dfsph_find_contacts(const SceneFrame& scene, const SubstepTime& time) {
+  dfsph_colliders_.clear();
+  for (const ColliderFrame& c : scene.colliders) dfsph_colliders_.push_back(c.view);
+  dfsph_contacts_ = !dfsph_colliders_.empty();
+  if (!dfsph_contacts_) return;
+  const Float4* pos = position_.data();
+  Float4* contact = dfsph_contact_.data();
+  const ColliderView* views = dfsph_colliders_.data();
+  const uint32_t count = static_cast<uint32_t>(dfsph_colliders_.size());
+  const float h = config_.kernel_radius;
+#pragma omp parallel for num_threads(threads()) schedule(static)
+  for (int i = 0; i < n(); ++i) contact[i] = wall_contact(views, count, time, h, xyz(pos[i]));
+}
+
+void CpuBackend::dfsph_correct(const FluidConstants& fluid, const DfsphWalls& walls, float dt, Float4* v,
+                               float* carried, float carry_scale) {
+  const GridView view = grid_.view();
+  const Float4* pos = position_.data();
+  const float* k = dfsph_step_.data();
+  const Float4* contact = dfsph_contacts_ ? dfsph_contact_.data() : nullptr;
+#pragma omp parallel for num_threads(threads()) schedule(static)
+  for (int i = 0; i < n(); ++i) {
+    const uint32_t p = static_cast<uint32_t>(i);
+    Vec3 vi = xyz(v[i]) + pressure_velocity_change(fluid, view, pos, k, walls, p, dt);
+    if (contact) vi = respect_contact(contact[i], vi);
+    v[i] = make_float4_record(vi, v[i].w);
+    carried[i] += k[i] * carry_scale;
+  }
+}
+
+float CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls,
+                                  float dt, const Float4* v) {
+  const GridView view = grid_.view();
+  const Float4* pos = position_.data();
+  const float* factor = dfsph_factor_.data();
+  const float* density = density_.data();
+  const uint32_t* neighbors = neighbors_.data();
+  float* k = dfsph_step_.data();
+  float* error = dfsph_residual_.data();
+  const Dfsph::Constants& c = fluid.methods.dfsph;
+  const float rho0 = fluid.rest_density;
+#pragma omp parallel for num_threads(threads()) schedule(static)
+  for (int i = 0; i < n(); ++i) {
+    const float rate = density_rate(fluid, view, pos, v, walls, static_cast<uint32_t>(i));
+    const DfsphResidual r = kind == DfsphSolve::Divergence
+                                ? divergence_residual(c, rate, neighbors[i], factor[i], rho0, dt)
+                                : density_residual(rate, density[i], factor[i], rho0, dt);
+    k[i] = r.k;
+    error[i] = r.error;
+  }
+  double sum = 0.0;
+  for (uint32_t i = 0; i < count_; ++i) sum += error[i];
+  return count_ > 0 ? static_cast<float>(sum / count_) : 0.0f;
+}
+
+CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidConstants& fluid,
+                                                 const DfsphWalls& walls, float dt, Float4* v, float* carried,
+                                                 float carry_scale) {
+  const Dfsph::Constants& c = fluid.methods.dfsph;
+  const bool divergence = kind == DfsphSolve::Divergence;
+  const float bound = divergence ? c.divergence_error : c.density_error;
+  const uint32_t min_iterations = divergence ? Dfsph::kMinDivergenceIterations : Dfsph::kMinIterations;
+  const uint32_t max_iterations = divergence ? c.max_divergence_iterations : c.max_iterations;
+  // The warm start: half the last substep's pressure, applied once; the solve's own
+  // pressures add to it.
+  float* k = dfsph_step_.data();
+#pragma omp parallel for num_threads(threads()) schedule(static)
+  for (int i = 0; i < n(); ++i) {
+    k[i] = Dfsph::kWarmStart * carried[i] / carry_scale;
+    carried[i] = 0.0f;
+  }
+  dfsph_correct(fluid, walls, dt, v, carried, carry_scale);
+  float error = dfsph_residuals(kind, fluid, walls, dt, v);
+  uint32_t iterations = 0;
+  while ((error > bound || iterations < min_iterations) && iterations < max_iterations) {
+    dfsph_correct(fluid, walls, dt, v, carried, carry_scale);
+    error = dfsph_residuals(kind, fluid, walls, dt, v);
+    ++iterations;
+  }
+  return SolveOutcome{iterations, error, error > bound};
+}
+
+uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame& scene,
+                                   const SubstepTime& time, FrameReport& report, DfsphTallies& tallies) {
+  sort_and_density(fluid, scene, stage_time(time, 0.0f), report);
+  spring_pass(time.dt, true, report);
+  auto t = Clock::now();
+  const float dt = time.dt;
+  const DfsphWalls walls{boundary_.data()};  // the walls' share (dfsph_boundary.h), null without it
+  dfsph_find_contacts(scene, time);
+  // 2. The divergence solve corrects the current velocities in place (a failed frame restores
+  // them from the snapshot).
+  if (fluid.methods.dfsph.divergence_solve) {
+    const SolveOutcome o =
+        dfsph_solve(DfsphSolve::Divergence, fluid, walls, dt, velocity_.data(), dfsph_divergence_.data(), dt);
+    record_solve(tallies.divergence, o.iterations, o.error, o.capped);
+  } else {
+    std::fill(dfsph_divergence_.data(), dfsph_divergence_.data() + count_, 0.0f);  // no warm start to keep
+  }
+  // 3. The non-pressure accelerations: v* = v + dt a, into next_velocity_ (w: 1 / rho).
+  const GridView view = grid_.view();
+  const Float4* pos = position_.data();
+  const Float4* vel = velocity_.data();
+  Float4* next_pos = next_position_.data();
+  Float4* next_vel = next_velocity_.data();
+  const Float4* spring = spring_acceleration_.data();
+  const AccelerationFn acceleration = acceleration_function();
+  const ForceInputs inputs = force_inputs();
+  const Float4* contact = dfsph_contacts_ ? dfsph_contact_.data() : nullptr;
+  float a2max = 0.0f;
+#pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
+  for (int i = 0; i < n(); ++i) {
+    Vec3 a = acceleration(fluid, view, inputs, scene, static_cast<uint32_t>(i));
+    if (spring) a += xyz(spring[i]);
+    a2max = std::max(a2max, length_squared(a));
+    Vec3 v = xyz(vel[i]) + a * dt;
+    if (contact) v = respect_contact(contact[i], v);
+    next_vel[i] = make_float4_record(v, vel[i].w);
+  }
+  max_acceleration_ = std::sqrt(a2max);
+  // 4. The density solve on v*.
+  const SolveOutcome o =
+      dfsph_solve(DfsphSolve::Density, fluid, walls, dt, next_vel, dfsph_pressure_.data(), 1.0f);
+  record_solve(tallies.pressure, o.iterations, o.error, o.capped);
+  // 5. x += dt v*; w: the pressure both solves applied in this substep, p = (k + k_v) rho^2.
+  const float* k = dfsph_pressure_.data();
+  const float* k_v = dfsph_divergence_.data();
+  const float* density = density_.data();
+  const float divergence = fluid.methods.dfsph.divergence_solve ? 1.0f / dt : 0.0f;
+#pragma omp parallel for num_threads(threads()) schedule(static)
+  for (int i = 0; i < n(); ++i)
+    next_pos[i] = make_float4_record(xyz(pos[i]) + xyz(next_vel[i]) * dt,
+                                     dfsph_pressure(k[i], k_v[i] * divergence, density[i]));
+  report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
+  collide_from(scene, time, pos, report);
+  t = Clock::now();
+  float v2max = 0.0f;
+  const uint32_t bad_index = scan_next_state(v2max);
+  if (bad_index != kAllFinite) diagnose_non_finite(fluid, scene, -1, bad_index);
+  const uint32_t bad = finish_substep(v2max, bad_index);
+  report.stage_ms[kStageIntegrate] += static_cast<float>(elapsed_ms(t));
+  return bad;
+}
+
+}  // namespace sph

@@ -1,0 +1,131 @@
+// Divergence-free SPH (Bender & Koschier 2015, "Divergence-free smoothed particle
+// hydrodynamics"; 2017, "Divergence-Free SPH for Incompressible and Viscous Fluids"), the
+// incompressible solver a world chooses instead of the thesis's weakly compressible scheme
+// (sph_world_def.solver = SPH_SOLVER_DFSPH; sph_dfsph_params). Its per-particle passes are
+// dfsph_passes.h; the order of a substep is each backend's (src/cpu/cpu_dfsph_solver.cpp,
+// cuda/dfsph_solver.cu), written as Bender & Koschier's Algorithm 1:
+//   1. density rho_i = m (w0 + sum_j W_ij) (density.h) and the factor
+//      alpha_i = rho_i / (|sum_j m grad W_ij|^2 + sum_j |m grad W_ij|^2);
+//   2. the divergence solve: iterate D rho_i / Dt = sum_j m (v_i - v_j) . grad W_ij (clamped
+//      at 0, and 0 for a particle with too few neighbours), k_i = (D rho_i / Dt) alpha_i /
+//      (dt rho_i), v_i -= dt sum_j m (k_i + k_j) grad W_ij, until the mean of
+//      (D rho / Dt) / rho0 is below divergence_error (per second) or the cap;
+//   3. v* = v + dt a with the non-pressure accelerations of the world's methods (gravity,
+//      viscosity, surface tension, springs, force fields);
+//   4. the density solve: rho*_i = rho_i + dt sum_j m (v*_i - v*_j) . grad W_ij,
+//      k_i = max(rho*_i - rho0, 0) alpha_i / (dt^2 rho_i), v*_i -= dt sum_j m (k_i + k_j)
+//      grad W_ij, until the mean of max(rho* - rho0, 0) / rho0 is below density_error, with
+//      at least two iterations, or the cap;
+//   5. x += dt v*, then the colliders, sinks and the max-speed reduction for the next step.
+// k = kappa / rho = p / rho^2 (the symmetric pressure force of pressure_force.h with
+// p_i = kappa_i rho_i), so the passes read one float per neighbour and no density. The kernel
+// is the world's lattice-scaled W_spiky, the density's own, so the discrete divergence and
+// gradient are those of the density sum (the energy argument of density.h holds).
+//
+// Warm starts: each solve starts from half the pressure it ended the previous substep with (the
+// reference implementation's choice: the solves only ever add pressure, so a stale pressure
+// that a full warm start re-applied could never be taken back; halved, it fades within a few
+// substeps unless the solve renews it). The carried values are made independent of the step:
+// the density solve's p / rho^2 is a pressure, the same whatever dt; the divergence solve's is
+// an impulse, carried times dt.
+//
+// Not used by DFSPH: the equation of state (its stiffness and Tait's speed of sound) and the
+// acoustic step limit; the step is dt = step_factor h / v_max (a CFL number on the particle
+// speed), clamped by dt_max and by the viscous, spring and force limits of the methods.
+#pragma once
+
+#include <stdint.h>
+
+#include "host_device.h"
+#include "param_table.h"
+#include "particle_array_spec.h"
+#include "world_shape.h"
+
+namespace sph {
+
+// sph_dfsph_params.flags (SPH_DFSPH_*).
+enum DfsphFlags : uint32_t { kDfsphSkipDivergenceSolve = 1u << 0, kDfsphFlagsAll = 1u };
+
+// The names of DFSPH's per-particle arrays.
+constexpr const char* kArrayDfsphPressure = "dfsph_pressure";              // p / rho^2 of the density solve
+constexpr const char* kArrayDfsphDivergencePressure = "dfsph_divergence";  // p_v / rho^2 times dt
+constexpr const char* kArrayDfsphFactor = "dfsph_factor";                  // alpha_i / rho_i
+constexpr const char* kArrayDfsphStep = "dfsph_step";                      // this iteration's k_i
+constexpr const char* kArrayDfsphResidual = "dfsph_residual";              // the particle's error
+constexpr const char* kArrayDfsphWarmPressure = "dfsph_warm_pressure";     // warm start, sorted order
+constexpr const char* kArrayDfsphContact = "dfsph_contact";                // Float4: wall normal, speed
+
+struct Dfsph {
+  static constexpr const char* kName = "dfsph";
+
+  struct Params {
+    float density_error = 0.001f;   // bound on the mean max(rho* - rho0, 0) / rho0
+    float divergence_error = 1.0f;  // bound on the mean max(D rho / Dt, 0) / rho0, 1/s
+    uint32_t max_iterations = 100;  // of the density solve, per substep
+    uint32_t max_divergence_iterations = 100;
+    uint32_t flags = 0;  // DfsphFlags
+  };
+  static constexpr ParamField<Params> kFields[] = {
+      real_field("density_error", &Params::density_error, above_up_to(0.0, 1.0), ZeroMeans::Default, ""),
+      real_field("divergence_error", &Params::divergence_error, above(0.0), ZeroMeans::Default, "1/s"),
+      count_field("max_iterations", &Params::max_iterations, at_least(2.0), ZeroMeans::Default),
+      count_field("max_divergence_iterations", &Params::max_divergence_iterations, at_least(1.0),
+                  ZeroMeans::Default),
+      bits_field("flags", &Params::flags, kDfsphFlagsAll),
+  };
+  static bool check(const Params&, const WorldShape&, ParamConflict&) { return true; }
+
+  // The density solve runs at least this many iterations (the reference's minimum: a first
+  // iteration alone, from a warm start, can stop on an error it has not looked at since).
+  static constexpr uint32_t kMinIterations = 2;
+  static constexpr uint32_t kMinDivergenceIterations = 1;
+  // The share of the last substep's pressure a solve starts from (see above).
+  static constexpr float kWarmStart = 0.5f;
+  // A particle with fewer neighbours than this share of the full lattice's (42 at h = 1.8
+  // spacings) gets no divergence correction: at a free surface or a splash the divergence of
+  // a half-empty neighbourhood is not the fluid's (the reference uses 20 of about 45).
+  static constexpr float kDivergenceNeighborShare = 0.45f;
+  // alpha_i is 0 (no pressure) where its denominator is below this share of one pair's largest
+  // term (m |grad W(0)|)^2: an isolated particle, whose alpha would be infinite.
+  static constexpr float kFactorFloor = 1e-6f;
+
+  struct Constants {
+    float density_error;
+    float divergence_error;  // 1/s
+    uint32_t max_iterations;
+    uint32_t max_divergence_iterations;
+    uint32_t divergence_solve;  // 1 unless kDfsphSkipDivergenceSolve
+    uint32_t min_divergence_neighbors;
+  };
+  static Constants make_constants(const Params& p, const WorldShape& shape, const LatticeSums& lattice) {
+    Constants c;
+    c.density_error = p.density_error;
+    c.divergence_error = p.divergence_error;
+    c.max_iterations = p.max_iterations < kMinIterations ? kMinIterations : p.max_iterations;
+    c.max_divergence_iterations = p.max_divergence_iterations < kMinDivergenceIterations
+                                      ? kMinDivergenceIterations
+                                      : p.max_divergence_iterations;
+    c.divergence_solve = (p.flags & kDfsphSkipDivergenceSolve) ? 0u : 1u;
+    const double full =
+        static_cast<double>(lattice.neighbor_count(shape.particle_spacing, shape.kernel_radius));
+    c.min_divergence_neighbors = static_cast<uint32_t>(kDivergenceNeighborShare * full + 0.5);
+    return c;
+  }
+
+  // Carried: the two solves' pressures (warm starts; sorted, rolled back, saved). Scratch: the
+  // factor, the pressure of the iteration that neighbours read, each particle's error for the
+  // solve's mean (CPU), the density solve's warm start gathered into the sorted order (CUDA), the
+  // particle's contact with the colliders (dfsph_passes.h, wall_contact), and the density pass's
+  // neighbour counts (the divergence solve skips particles with too few).
+  static constexpr ParticleArraySpec kArrays[] = {
+      {kArrayDfsphPressure, sizeof(float), ParticleArrayRole::Carried, 1, nullptr, nullptr},
+      {kArrayDfsphDivergencePressure, sizeof(float), ParticleArrayRole::Carried, 1, nullptr, nullptr},
+      {kArrayDfsphFactor, sizeof(float), ParticleArrayRole::Scratch, 1, nullptr, nullptr},
+      {kArrayDfsphStep, sizeof(float), ParticleArrayRole::Scratch, 1, nullptr, nullptr},
+      {kArrayDfsphResidual, sizeof(float), ParticleArrayRole::Scratch, 1, nullptr, nullptr},
+      {kArrayDfsphWarmPressure, sizeof(float), ParticleArrayRole::Scratch, 1, nullptr, nullptr},
+      {kArrayDfsphContact, 4 * sizeof(float), ParticleArrayRole::Scratch, 1, nullptr, nullptr},
+      {kArrayNeighborCount, sizeof(uint32_t), ParticleArrayRole::Scratch, 1, nullptr, nullptr}};
+};
+
+}  // namespace sph

@@ -1,0 +1,178 @@
+// DFSPH's per-particle passes (the method is dfsph.h; the order of a substep is each backend's).
+// Three gathers over the neighbours, each written once for both backends:
+//   gather_density_and_factor  rho_i and the factor alpha_i / rho_i = 1 / D_i,
+//                              D_i = |sum_j m grad W_ij|^2 + sum_j |m grad W_ij|^2
+//   density_rate               D rho_i / Dt = sum_j m (v_i - v_j) . grad W_ij
+//   pressure_velocity_change   -dt sum_j m (k_i + k_j) grad W_ij,  k = kappa / rho = p / rho^2
+// and the per-particle step between them (divergence_residual, density_residual) that turns a
+// rate into the particle's pressure k_i and its share of the solve's mean error. The walls enter
+// each gather through one call (dfsph_boundary.h).
+//
+// With k_i = e_i alpha_i / (dt rho_i) (divergence, e = D rho / Dt) or e_i alpha_i / (dt^2 rho_i)
+// (density, e = rho* - rho0), a particle's own k_i alone, applied by the velocity update to it and
+// its neighbours, changes its rate by -e_i / dt (density: its predicted density by -e_i): the
+// Jacobi step of Bender & Koschier 2017, eq. 9-11. alpha_i / rho_i = 1 / D_i, so the passes need
+// no density.
+//
+// The gradient is the world's grad W_spiky (lattice-scaled, as the density and the weakly
+// compressible pressure force use it) with the particle mass folded into its coefficient, so
+// that m grad W is one product per pair and stays within float range at any spacing the world
+// accepts (grad W alone reaches 1e24 at micrometre spacings; its square would overflow).
+#pragma once
+
+#include <stdint.h>
+
+#include "collider_response.h"
+#include "dfsph.h"
+#include "dfsph_boundary.h"
+#include "float4_types.h"
+#include "fluid_base.h"
+#include "kernels.h"
+#include "neighbor_walk.h"
+
+namespace sph {
+
+// grad W_spiky times the particle mass: m grad W = spiky_gradient(mass_gradient(f), d, r).
+SPH_HD KernelCoefficients mass_gradient_kernel(const FluidBase& f) {
+  KernelCoefficients k = f.kernel;
+  k.spiky_grad *= f.particle_mass;
+  return k;
+}
+
+struct DfsphDensitySample {
+  float density;            // rho_i = m (w0 + sum_{j != i} W_ij) + the walls' share
+  uint32_t neighbor_count;  // particles with r < h, self excluded
+  float factor;             // alpha_i / rho_i = 1 / D_i, or 0 where D_i is too small
+};
+
+// The density of density.h (the same sum in the same order) and the factor, in one walk.
+// wall: the walls' share at x_i (boundary_share; no_boundary_share() without the feature).
+SPH_HD DfsphDensitySample gather_density_and_factor(const FluidBase& f, const GridView& grid,
+                                                    const Float4* positions, const BoundaryShare& wall,
+                                                    uint32_t i) {
+  const KernelCoefficients mk = mass_gradient_kernel(f);
+  const Vec3 xi = xyz(positions[i]);
+  float sum = 0.0f;
+  uint32_t neighbors = 0;
+  Vec3 gradient{0.0f, 0.0f, 0.0f};  // sum_j m grad W_ij
+  float squares = 0.0f;             // sum_j |m grad W_ij|^2
+  for_each_neighbor_candidate(grid, xi, [&](uint32_t j) {
+    const Vec3 d = xi - xyz(positions[j]);
+    const float r2 = length_squared(d);
+    if (r2 < f.kernel.h2 && j != i) {
+      const float r = SPH_SQRTF(r2);
+      sum += spiky_value(f.kernel, r);
+      ++neighbors;
+      const Vec3 g = spiky_gradient(mk, d, r);
+      gradient += g;
+      squares += length_squared(g);
+    }
+  });
+  // Boundary place 1: the walls' density and their gradient in alpha (dfsph_boundary.h).
+  const float density = f.particle_mass * (f.density_self_weight + sum) + wall.density;
+  gradient += wall.gradient;
+  const float denominator = length_squared(gradient) + squares;
+  // One pair's largest term, (m |grad W(0)|)^2: the scale below which alpha would blow up.
+  const float pair_max = -mk.spiky_grad * f.kernel.h2;
+  const float smallest = Dfsph::kFactorFloor * pair_max * pair_max;
+  return DfsphDensitySample{density, neighbors, denominator > smallest ? 1.0f / denominator : 0.0f};
+}
+
+// D rho_i / Dt = sum_j m (v_i - v_j) . grad W_ij over the velocities `velocities` (xyz).
+SPH_HD float density_rate(const FluidBase& f, const GridView& grid, const Float4* positions,
+                          const Float4* velocities, const DfsphWalls& walls, uint32_t i) {
+  const KernelCoefficients mk = mass_gradient_kernel(f);
+  const Vec3 xi = xyz(positions[i]);
+  const Vec3 vi = xyz(velocities[i]);
+  float rate = 0.0f;
+  for_each_neighbor_candidate(grid, xi, [&](uint32_t j) {
+    const Vec3 d = xi - xyz(positions[j]);
+    const float r2 = length_squared(d);
+    if (r2 < f.kernel.h2 && j != i)
+      rate += dot(vi - xyz(velocities[j]), spiky_gradient(mk, d, SPH_SQRTF(r2)));
+  });
+  return rate + wall_density_rate(walls, i, vi);  // boundary place 2: the walls' relative motion
+}
+
+// The velocity change of particle i from the pressures k (k_j = p_j / rho_j^2 of this
+// iteration): -dt sum_j m (k_i + k_j) grad W_ij, which pushes compressed neighbours apart.
+SPH_HD Vec3 pressure_velocity_change(const FluidBase& f, const GridView& grid, const Float4* positions,
+                                     const float* k, const DfsphWalls& walls, uint32_t i, float dt) {
+  const KernelCoefficients mk = mass_gradient_kernel(f);
+  const Vec3 xi = xyz(positions[i]);
+  const float ki = k[i];
+  Vec3 sum{0.0f, 0.0f, 0.0f};
+  for_each_neighbor_candidate(grid, xi, [&](uint32_t j) {
+    const Vec3 d = xi - xyz(positions[j]);
+    const float r2 = length_squared(d);
+    if (r2 < f.kernel.h2 && j != i) sum += spiky_gradient(mk, d, SPH_SQRTF(r2)) * (ki + k[j]);
+  });
+  sum += wall_pressure_gradient(walls, i) * ki;  // boundary place 3: the walls' share, k_i alone
+  return sum * (-dt);
+}
+
+// One particle's result of a residual pass.
+struct DfsphResidual {
+  float k;      // its pressure p / rho^2 for the next velocity update
+  float error;  // its share of the solve's mean error: e_i / rho0
+};
+
+// The divergence solve: e = D rho / Dt, clamped at 0 (only compression is corrected), and 0 for
+// a particle with fewer neighbours than the constants allow (a free surface, a splash).
+// error in 1/s.
+SPH_HD DfsphResidual divergence_residual(const Dfsph::Constants& c, float rate, uint32_t neighbors,
+                                         float factor, float rest_density, float dt) {
+  const float e = (neighbors >= c.min_divergence_neighbors && rate > 0.0f) ? rate : 0.0f;
+  return DfsphResidual{e * factor / dt, e / rest_density};
+}
+
+// The density solve: e = max(rho* - rho0, 0), rho* = rho_i + dt D rho_i / Dt the density the
+// velocities would give after the step. error dimensionless.
+SPH_HD DfsphResidual density_residual(float rate, float density, float factor, float rest_density, float dt) {
+  const float predicted = density + dt * rate;
+  const float e = predicted > rest_density ? predicted - rest_density : 0.0f;
+  return DfsphResidual{e * factor / (dt * dt), e / rest_density};
+}
+
+// The colliders' no-penetration inside the solves. The collision response after the step stops a
+// particle at a wall whatever velocity the solves gave it; a solve that does not know this
+// relieves the compression of a particle pressed against a wall by moving it into the wall,
+// which the response then undoes, and the fluid at walls and corners ends up compressed by tens
+// of percent (measured: a dam break's corner at 1.28 rho0, a quarter of its particles above
+// 1.05 rho0, where the weakly compressible scheme stays below 1.03). So each particle within h
+// of a collider carries its contact, (n, c): n the wall's normal (into the fluid) and c the
+// smallest normal velocity it can have, c = v_wall . n - d / dt with d its distance from the
+// wall (it can approach by d within the step), and every velocity the solves make is held to
+// v . n >= c. The nearest collider wins where several are near. A boundary model that puts the
+// walls into the density (dfsph_boundary.h) makes the solves see the approach as compression,
+// and this becomes a safeguard.
+SPH_HD Float4 wall_contact(const ColliderView* colliders, uint32_t collider_count, const SubstepTime& t,
+                           float kernel_radius, Vec3 x) {
+  Float4 contact{0.0f, 0.0f, 0.0f, 0.0f};  // no contact: n = 0 holds nothing
+  float nearest = kernel_radius;
+  for (uint32_t c = 0; c < collider_count; ++c) {
+    const ColliderSample s = sample_collider(colliders[c], x, t.s0, t.tau0);
+    if (!(s.distance < nearest)) continue;
+    nearest = s.distance;
+    const Vec3 n = collider_normal(colliders[c], s);
+    const float d = s.distance > 0.0f ? s.distance : 0.0f;
+    contact = make_float4_record(n, dot(collider_velocity(colliders[c], s, x), n) - d / t.dt);
+  }
+  return contact;
+}
+
+// v held to its contact: v . n >= c.
+SPH_HD Vec3 respect_contact(const Float4& contact, Vec3 v) {
+  const Vec3 n = xyz(contact);
+  const float vn = dot(v, n);
+  return vn < contact.w ? v + n * (contact.w - vn) : v;
+}
+
+// The pressure a substep applied (the attribute SPH_ATTRIBUTE_PRESSURE): both solves' p / rho^2
+// act in the same substep with the same dt, so p = (k + k_v) rho^2 (k_v: the divergence solve's
+// p / rho^2, its carried impulse over dt).
+SPH_HD float dfsph_pressure(float k, float k_divergence, float density) {
+  return (k + k_divergence) * density * density;
+}
+
+}  // namespace sph
