@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /*
  * dam_break - BENCHMARK.md case 2, the realistic load: a water column of width a, height 2a and
  * depth a at one end of a tank 5a long, gravity, the tank a collider (an inverted hollow-box

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // device_ceilings - the physical limits of the GPU the benchmarks run on (BENCHMARK.md, issue
 // 10 item 3), measured, not taken from a data sheet:
 //   - copy bandwidth: cudaMemcpyAsync device-to-device of a 1 GiB buffer (bytes read + written)

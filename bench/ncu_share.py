@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """What share of the device's bandwidth and FP32 rate the substep achieves (issue 10, item 3).
 
     bench/ncu_share.py NCU_CSV PARTICLES OUT_JSON

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Neighbour-search variants for the two gather passes, measured alone on the GPU (issue 18):
 // how many candidates each cell layout makes a particle test, and what a density pass and a
 // force-like pass cost with each, on the benchmark's rest sphere (FCC lattice, h = 1.8

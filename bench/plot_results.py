@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Plots and tables from a scripts/bench-gpu results folder (BENCHMARK.md, issue 10).
 
     bench/plot_results.py RESULTS_DIR

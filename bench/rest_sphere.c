@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /*
  * rest_sphere - BENCHMARK.md case 1, the thesis benchmark: particles on an FCC lattice in a
  * sphere at rest density, no gravity, no colliders, dt_max = 1 ms (40 substeps in a 25 fps

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* The solver trade (issue 16 item 5): the dam break of Martin & Moyce (tests/support/dam_break.c)
  * for the weakly compressible scheme at several stiffnesses (Tait's speed of sound as a multiple
  * of the column's free-fall speed sqrt(2 g 2a) = 1.50 m/s) and DFSPH at several density error

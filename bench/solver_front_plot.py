@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Plots bench/solver_front's CSV: the front's mean error and the mean compression against wall
 seconds per simulated second, one marker per solver and parameter, one point per resolution.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* The speed-accuracy trade (../shared/BENCHMARK.md case 4): the dam break of Martin & Moyce
  * (tests/support/dam_break.c) for integrator (symplectic Euler, RK4) x step factor lambda
  * (0.1, 0.2, 0.4, 0.8) x three resolutions. For each run: the surge front's error against the

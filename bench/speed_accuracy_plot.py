@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Plots bench/speed_accuracy's CSV: the surge front's mean error against the cost (wall seconds
 per simulated second), one marker per integrator, one colour per resolution, lambda written
 next to each point. The lower-left envelope is the Pareto front a user picks from.

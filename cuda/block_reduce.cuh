@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Block-wide reductions used by several kernels. Every one gives the same bits whatever the
 // order in which blocks run: maxima are exact, and sums are combined in a fixed tree.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CUDA backend's particles: creation, appends, truncation, copies out, checkpoints and the
 // interop tier of sph_cuda.h (the twin of src/cpu/cpu_backend.cpp; frames are frame_loop.cu).
 #include <cstring>

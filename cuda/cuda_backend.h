@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Entry points of the CUDA backend, seen by the backend factory (src/factory) only.
 #pragma once
 

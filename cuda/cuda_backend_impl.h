@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CUDA backend's class, shared by cuda_backend.cu (particles, copies out, checkpoints, the
 // interop tier) and frame_loop.cu (frames and their rollback). Device-resident particles,
 // every substep stage on the world's own stream, and the frame loop on the device

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // CUDA errors as the library's Status codes, and the guard that keeps the caller's current
 // device unchanged across every call into the backend.
 #pragma once

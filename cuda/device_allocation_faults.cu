@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "device_allocation_faults.h"
 
 #include <atomic>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A test hook for device and pinned-host allocation failures (issue 9, item 6). Armed with n,
 // the n-th DeviceArray/PinnedArray allocation from then on fails once, exactly as a real
 // cudaErrorMemoryAllocation would. Off unless a test arms it; the check costs one relaxed

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Owning handles of device and pinned host memory. Allocation failures throw
 // Error(OutOfDeviceMemory / OutOfHostMemory) and leave nothing allocated; release never throws.
 #pragma once

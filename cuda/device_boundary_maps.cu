@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "../src/physics/boundary_map.h"
 #include "device_boundary_maps.h"
 #include "kernel_launch.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CUDA backend's boundary-density maps (SPH_FEATURE_BOUNDARY_DENSITY; the physics is
 // src/physics/boundary_map.h): one map per SDF asset the world's colliders use, computed on the
 // device from the asset's device copy (DeviceSdfCache) for the world's kernel radius, one thread

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "../src/physics/boundary_density.h"
 #include "../src/physics/integrate.h"
 #include "block_reduce.cuh"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Loads on colliders (SPH_FEATURE_COLLIDER_LOADS) on the device: the buffers of a frame's sums and
 // the passes that fill them (the twin of src/cpu/cpu_collider_loads.cpp; the physics is
 // src/physics/collider_loads.h). Per force evaluation, one kernel of kLoadBlock threads a block

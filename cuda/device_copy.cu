@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Copies caller data that lives in device memory (SDF grids given as SPH_MEMORY_CUDA_DEVICE)
 // to the host, on the context's device, restoring the caller's current device.
 #include <cuda_runtime.h>

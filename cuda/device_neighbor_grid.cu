@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include <cub/device/device_radix_sort.cuh>
 
 #include "../src/physics/grid_hash.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CUDA backend's neighbour structure: each particle's wrapped cell hash, a stable radix
 // sort of (hash, index) pairs (CUB), and the dense cell-start table the shared neighbour walk
 // reads. The sort is stable over the current order, so the permutation is the CPU backend's.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The device-resident particle state of one world, as a structure of arrays, allocated once
 // for the world's capacity. The core state has fixed arrays:
 //   position/velocity/id/density  the state in the current order (what callers read)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The scene on the device, per world: device copies of the SDF assets the scene uses (one
 // copy per asset, shared by every collider, field and sink that uses it), and the per-frame
 // arrays of collider, force-field and sink views whose SdfGridViews point at those copies.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include <cub/device/device_scan.cuh>
 
 #include "device_sinks.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Sinks on the device: after a substep, every particle inside a sink (or outside its bounds)
 // is removed with a stable compaction, so the survivors keep their relative order exactly as
 // in the CPU backend's apply_sinks; the removed ids come out in the same order, each with the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "device_springs.h"
 #include "kernel_launch.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Springs on the device (SPH_FEATURE_SPRINGS; the physics is src/physics/springs.h, shared
 // with the CPU backend). Per sort: the lists follow the permutation with their partners
 // rewritten (enqueue_spring_reorder); per force evaluation, after the density pass: the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // DFSPH on the device (physics/dfsph.h; the twin of src/cpu/cpu_dfsph_solver.cpp): the density
 // and factor pass, then the divergence solve, the non-pressure accelerations, the density solve
 // and the step. Each solve is a Jacobi loop of three kernels, the velocity update, the new rates

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The force pass's device pieces that the weakly compressible kernels (substep_kernels.cu) and
 // DFSPH's (dfsph_solver.cu) share: the masked neighbour gather, the scene's force fields and
 // colliders, and the non-finite flag.

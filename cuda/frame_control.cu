@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "block_reduce.cuh"
 #include "frame_control.h"
 #include "kernel_launch.h"

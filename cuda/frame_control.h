@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The single-thread kernels that run the frame loop on the device: start a frame, and after
 // each substep take the max-speed reduction, check for non-finite values, advance the clock
 // and pick the next step with the shared step control (controller_dt, landing_dt). In a CUDA

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // One frame as one CUDA graph: the begin segment, a conditional WHILE node whose body is one
 // substep (captured from the stream, CUB's sort included) and whose condition the
 // end-of-substep kernel sets, then the end segment. Launching it runs the whole adaptive frame

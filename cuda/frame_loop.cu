@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CUDA backend's frame: the scene uploaded, the frame run by one of its drivers (the frame
 // graph, or the stream), the report read back, and the rollback that puts the particles back
 // when a substep fails (the twin of src/cpu/cpu_frame_loop.cpp).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The frame's bookkeeping, kept on the device so that the substep loop decides its own next
 // step size and its own end without a round trip to the host. One per world.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "../src/physics/density.h"
 #include "frame_statistics.h"
 #include "kernel_launch.h"

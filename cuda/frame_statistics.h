@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The frame's statistics, computed once at its end on the device: the density record
 // (src/core/density_record.h) of the last density evaluation, and the neighbour counts of that evaluation
 // (recounted here over the sorted copy it read, which is still intact, instead of being stored every

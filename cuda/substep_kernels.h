@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The per-particle passes of a substep on the device: reorder into the sorted working copy,
 // density and pressure, then forces with integration. Each kernel is one thread per particle
 // calling the shared physics of src/physics; the host functions here only launch them.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "substep_pipeline.h"
 
 namespace sph {

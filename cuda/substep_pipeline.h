@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The order of device work in a frame, written once and used two ways: captured into a CUDA
 // graph (frame_graph.h) or launched directly on the stream (the fallback). A frame is
 //   begin:    frame_dt in, counters reset, first step chosen, state snapshot

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * sph_c.h - the C ABI of the sph fluid-simulation library.
  *
@@ -714,8 +715,8 @@ SPH_API sph_result SPH_CALL sph_world_step(sph_world* world, float frame_dt);
  * max_seconds after it began stops at its next substep boundary and returns SPH_INCOMPLETE
  * (one substep may overrun the budget). Both backends check it between substeps: the CUDA
  * backend runs a frame with a budget on its stream driver instead of its device graph (one host
- * synchronisation a substep). 0 (the default) is no budget. Not saved in checkpoints. Errors: INVALID_HANDLE, INVALID_ARGUMENT
- * (NaN, negative or above 86400), WORLD_LOCKED.
+ * synchronisation a substep). 0 (the default) is no budget. Not saved in checkpoints. Errors: INVALID_HANDLE,
+ * INVALID_ARGUMENT (NaN, negative or above 86400), WORLD_LOCKED.
  */
 SPH_API sph_result SPH_CALL sph_world_set_step_budget(sph_world* world, double max_seconds);
 /** The step budget in seconds (0: none). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL). */
@@ -724,8 +725,8 @@ SPH_API sph_result SPH_CALL sph_world_get_step_budget(const sph_world* world, do
 /**
  * Asks the world's step to stop at its next substep boundary (it returns SPH_INCOMPLETE with
  * the world consistent; on the CUDA backend a frame on the device graph, which is every frame
- * without a step budget or sinks, sees it only at its end). The one call that may run on another thread while a step holds the
- * world: it never blocks and never answers WORLD_LOCKED. A request made while no step runs
+ * without a step budget or sinks, sees it only at its end). The one call that may run on another thread while
+ * a step holds the world: it never blocks and never answers WORLD_LOCKED. A request made while no step runs
  * stops the next step before its first substep (that step changes nothing and reports 0
  * substeps); a step that stops for it clears it. Errors: INVALID_HANDLE (NULL or destroyed:
  * safe to call racing sph_world_destroy).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * sph_cuda.h - the zero-copy tier of the sph library for worlds on the CUDA backend.
  *

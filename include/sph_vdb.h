@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * sph_vdb.h - optional OpenVDB helpers for sph (library libsph_vdb, target sph::sph_vdb).
  *

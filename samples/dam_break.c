@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* The default demo scene, a dam break, built through the C API alone as an engine would
  * (the same scene as samples/scenes/dam_break.json, which sph-run plays): a column of water
  * collapses in a closed tank, an inverted box collider. The tank and the column come from

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* The default demo scene: two droplets of water, 12 cm across, collide head-on at 1.5 m/s
  * in zero gravity and splash. Every frame's particles are written as CSV
  * (id, x, y, z, vx, vy, vz, density, pressure) to the output directory, built through the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Thesis figure 6 through the C API alone (the scene of samples/scenes/fig6_pour_into_cup.json):
  * a continuous source pours liquid into a cup standing on a ground plane for 2.5 s; then the cup
  * tips over about its bottom edge and pours the liquid out onto the ground. The cup is a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Thesis figure 7 through the C API alone (the scene of samples/scenes/fig7_drop_into_tank.json):
  * a big sphere of liquid falls into an open tank, a hollow box collider; 2.5 s later, with the
  * pool near rest, a second sphere is added above it and falls in. About 58,000 particles at

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Two-way coupling through the C API (issue 17): a wooden box (500 kg/m^3) dropped onto water
  * floats. The box is a collider the fluid cannot enter; a small rigid-body integrator, standing in
  * for a game engine's, owns its motion: every frame it reads the fluid's force and torque on the

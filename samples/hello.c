@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* The smallest useful program: create a world, fill a box with water, step 100 frames and
  * print what happened. Build: cc hello.c $(pkg-config --cflags --libs sph) */
 #include <stdio.h>

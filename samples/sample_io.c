@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "sample_io.h"
 
 #include <errno.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* What the scene samples share and a user would write once: reporting a failed call, the
  * command line (OUTPUT_DIR --frames N --backend auto|cpu|cuda), and writing each frame's
  * particles as CSV (id, x, y, z, vx, vy, vz, density) through a temporary name, so an

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* A wave tank through the C API alone (the scene of samples/scenes/wave_tank.json): a paddle
  * at one end of a long tank swings back and forth and sends waves down it. The paddle is a
  * kinematic collider: every frame it gets the pose it must reach by the frame's end

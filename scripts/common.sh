@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # shellcheck shell=bash
 # Shared set-up for scripts/demo and scripts/test (sourced, not run).
 #
@@ -19,7 +20,10 @@ SPH_SCRIPT_NAME="$(basename "${0}")"
 # clang's Recommends would bring in; it holds libFuzzer and the sanitizer runtimes for clang;
 # libomp-dev is OpenMP for clang (the fuzz build).
 # Python (numpy, pytest, matplotlib) and mono run the binding tests; libpng-dev gives sph-run
-# its preview images.
+# its preview images. python3-vtk9 reads sph-run's .vtp frames back, python3-jsonschema checks
+# the scene files against docs/scene.schema.json, python3-cffi parses bindings/cffi/sph_cdef.h;
+# python3-setuptools, -wheel and -venv build the Python wheel and install it into a clean
+# virtual environment offline (scripts/build-wheel, scripts/test).
 SPH_PACKAGES=(
   cmake ninja-build g++ pkg-config git
   libcmocka-dev libeigen3-dev
@@ -27,6 +31,7 @@ SPH_PACKAGES=(
   clang libclang-rt-14-dev libomp-dev clang-format
   python3 python3-numpy python3-pytest python3-matplotlib mono-mcs mono-runtime
   libpng-dev
+  python3-vtk9 python3-jsonschema python3-cffi python3-setuptools python3-wheel python3-venv
 )
 
 sph_log() { printf '[%s] %s\n' "${SPH_SCRIPT_NAME}" "$*" >&2; }

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # The exported-symbol allowlist of one shared library: every dynamic symbol it defines starts
 # with sph_ (the version-script node SPH_<n> aside), every function its public headers
 # declare with SPH_API is exported, nothing else is, and the SONAME is <name>.so.<ABI>.

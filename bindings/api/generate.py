@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Regenerates everything derived from include/sph_c.h, or checks that it is up to date.
 
     python3 bindings/api/generate.py            # rewrite the generated files in place
@@ -9,6 +10,7 @@ Generated files (all committed):
                                              needs a C compiler)
     bindings/python/sph/_generated.py     <- sph_api.json    (generate_python.py)
     bindings/csharp/Sph.Generated.cs      <- sph_api.json    (generate_csharp.py)
+    bindings/cffi/sph_cdef.h              <- sph_api.json    (generate_cdef.py; for cffi's cdef)
 
 --check exits 1 and prints a unified diff when any committed file differs from what the
 current header produces: run this script without --check and commit the result.
@@ -25,6 +27,7 @@ import tempfile
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import generate_api  # noqa: E402
+import generate_cdef  # noqa: E402
 import generate_csharp  # noqa: E402
 import generate_python  # noqa: E402
 
@@ -33,6 +36,7 @@ TARGETS = {
     "json": os.path.join("bindings", "api", "sph_api.json"),
     "python": os.path.join("bindings", "python", "sph", "_generated.py"),
     "csharp": os.path.join("bindings", "csharp", "Sph.Generated.cs"),
+    "cdef": os.path.join("bindings", "cffi", "sph_cdef.h"),
 }
 
 
@@ -45,6 +49,7 @@ def generate_into(out_root: str, headers: list[str], cc: str) -> None:
         raise SystemExit(rc)
     generate_python.main(["--api", paths["json"], "--out", paths["python"]])
     generate_csharp.main(["--api", paths["json"], "--out", paths["csharp"]])
+    generate_cdef.main(["--api", paths["json"], "--out", paths["cdef"]])
 
 
 def main(argv=None) -> int:

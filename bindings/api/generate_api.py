@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Generates bindings/api/sph_api.json, the machine-readable description of include/sph_c.h.
 
     python3 bindings/api/generate_api.py [--header H ...] [--out FILE] [--cc CC]

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Generates bindings/csharp/Sph.Generated.cs (P/Invoke declarations) from sph_api.json.
 
     python3 bindings/api/generate_csharp.py [--api sph_api.json] [--out FILE]

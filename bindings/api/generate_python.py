@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Generates bindings/python/sph/_generated.py (ctypes declarations) from sph_api.json.
 
     python3 bindings/api/generate_python.py [--api sph_api.json] [--out FILE]

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Sph.cs - the idiomatic C# layer over Sph.Generated.cs: Context, World, SphException.
 //
 // Unity-friendly: no unsafe code, blittable structs, Cdecl, SafeHandles for the heavy objects,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Checkpoints: saving a world to memory or a file (atomically), loading one into a new world,
 // restoring one into an existing world. The format itself lives in src/core/checkpoint*.
 #include <cstring>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Loads on colliders (SPH_FEATURE_COLLIDER_LOADS): the last step's force and torque of the fluid
 // on a collider, and the point the torque is about. The backends sum the impulses
 // (physics/collider_loads.h); the world keeps each collider's averages (core/world.cpp).

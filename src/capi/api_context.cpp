@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Contexts: backend choice, device, CPU workers, CUDA tuning and logging.
 #include <thread>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The zero-copy tier (include/sph_cuda.h): device addresses of attributes, the data epoch, the
 // world's stream and event ordering. The backend answers; a CPU backend (and every backend of
 // a build without CUDA) refuses with Unsupported.

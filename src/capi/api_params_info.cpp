@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Parameters and methods described as data, for tools: read from the same tables the set calls
 // validate against (params_binding.h, physics/methods.h), so a tool sees the library's rules.
 #include "guard.h"

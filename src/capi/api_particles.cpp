@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Particles in (spawn, lattice fills) and out (count, attribute copies).
 #include <vector>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Runtime parameters: the world's (sph_world_params) and each optional method's own struct, all
 // set and read whole through one path (params_binding.h): read the caller's struct, apply the
 // zero rule, validate against the methods' tables, install; and described to tools from the same

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Colliders, sources, sinks and force fields inside a world, and the events of a step. The
 // calls here convert public defs to specs (scene_specs.h) and hand them to the world's entry
 // points, which validate them and name the field; "def->" goes in front of that name.

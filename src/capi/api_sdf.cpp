@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // SDF assets: grids from the caller, analytic shapes, sub-box updates.
 #include <vector>
 
@@ -81,7 +82,8 @@ std::shared_ptr<sph::SdfAsset> asset_from_desc(const sph_context* context, const
     same_dims(v, "desc->velocity");
     if (sph::grid_components(v, 3) != 3)
       throw Error(Status::InvalidArgument, "desc->velocity->components: must be 3 (or 0, meaning 3)");
-    const std::vector<float> raw = read_floats(context, v.data, 3 * n, sph::enum_bits(v.memory), "desc->velocity->");
+    const std::vector<float> raw =
+        read_floats(context, v.data, 3 * n, sph::enum_bits(v.memory), "desc->velocity->");
     asset->velocity().resize(n);
     std::memcpy(asset->velocity().data(), raw.data(), raw.size() * sizeof(float));
   }

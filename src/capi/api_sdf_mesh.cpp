@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // SDF assets from triangle meshes: the C layer over core/mesh_sdf.
 #include <algorithm>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Stepping (with its budget and cancel) and statistics.
 #include <chrono>
 #include <string>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Version queries, result strings and the last-error accessor: always thread-safe.
 #include "guard.h"
 #include "handles.h"

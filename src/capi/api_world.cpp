@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Worlds: creation from a def (runtime parameters: api_physics_options.cpp).
 #include "../core/fcc_lattice.h"
 #include "../physics/kernels.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Checkpoint files: written atomically (a temporary file next to the target, flushed and
 // renamed), read only from regular files of bounded size, and the temporary files of saves
 // that were killed removed by the next save to the same path (docs/checkpoint.md).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The zero rules of sph_grid_desc, shared by every call that reads one (SDF assets, their
 // optional channels, force-field grids): an all-zero index_to_local is the identity (1 m
 // voxels), and components 0 means the channel's own count.

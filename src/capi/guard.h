@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Every exported function runs its body through guarded(): it clears the thread's last error,
 // turns exceptions into result codes and messages, tells the context's log callback, and
 // makes sure nothing escapes across the C boundary.

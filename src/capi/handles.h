@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The opaque objects of the C ABI and the registry that tells a live handle from a dangling
 // or foreign pointer in every build.
 //

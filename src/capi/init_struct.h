@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The body of every *_init_sized function: check the caller's size, start from a struct with
 // every byte zero and struct_size set, let `fill` write the defaults, and copy it out.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The thread-local message behind sph_get_last_error(). A plain char array, so the library
 // can be unloaded without thread-exit destructors.
 #pragma once

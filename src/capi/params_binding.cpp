@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "params_binding.h"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Public params structs bound to the methods' Params they carry, so that one code path reads,
 // validates (core/param_validation.h), installs, writes back and describes every params struct:
 // a binding names, for each method whose fields the struct holds, the byte offset of each field

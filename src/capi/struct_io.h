@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Reading caller structs by their struct_size (the kernel's copy_struct_from_user rule):
 // smaller than the struct's first released size is a version mismatch; between that and ours
 // (a caller built against an older header) the fields it does not have read as zero, which

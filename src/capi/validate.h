@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Argument checks shared by the C entry points; each throws Error with the argument's name.
 #pragma once
 

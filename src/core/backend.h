@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The interface the core drives a backend through. A backend owns the particle state (in host
 // or device memory) and runs whole frames; the core validates input, assigns ids and keeps
 // parameters. The core never names a backend: src/factory makes them.

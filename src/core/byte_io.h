@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Little-endian byte streams for checkpoints: a growing writer, and a reader that checks every
 // read against the bytes that remain, so hostile input can never make it read out of bounds
 // or allocate more than the input could possibly describe.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Checkpoints: a world's whole state as a self-contained, versioned and checksummed byte
 // string (docs/checkpoint.md has the layout). The C layer adds files and handles.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The checkpoint layout shared by the writer and the reader (docs/checkpoint.md). All numbers
 // little-endian; floats IEEE 754. Version 3 (version 2 lacks the solver in CONF, the solves'
 // report in TIME and DFSPH's warm starts in PART; version 1 differs from 2 only in the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The parameters section of a checkpoint (PARM), written and read generically from the methods'
 // tables: one block per method (its name, its field count, its fields in table order), each
 // checked on reading by the same validate() as the C layer's set calls (param_validation.h).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Reads a checkpoint into a new world. Everything is parsed and validated before the backend
 // is created, so a damaged file allocates nothing beyond what its own bytes describe and
 // leaves nothing behind. Scene objects are made by the same rules as a caller's

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "checkpoint_scene_reader.h"
 
 #include <string>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The scene sections of a checkpoint (SDF assets, colliders, sources, sinks, force fields):
 // each object is made by the same rules as a caller's (scene_build.h), its slot layout
 // restored as saved so ids stay valid.

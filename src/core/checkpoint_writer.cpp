@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Writes a world as a checkpoint (layout: checkpoint_format.h, docs/checkpoint.md).
 #include <map>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Internal descriptions of a world: what is fixed at creation and what can change per step,
 // and the per-frame constants both derive (the physics layer's method list composes them).
 #pragma once

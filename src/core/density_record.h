@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The density record of a frame, written once for both backends: density min/mean/max and the
 // neighbour counts of its last density evaluation (sph_stats). Each particle contributes a tally;
 // tallies combine in any grouping (the CPU backend adds them in storage order, the CUDA backend

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fcc_lattice.h"
 
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Face-centred cubic lattice points (the thesis's "tetrahedral lattice"): the points of a
 // cubic grid of step spacing/sqrt(2) whose integer coordinates sum to an even number, so
 // every point has 12 nearest neighbours at exactly `spacing`.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Range checks of spec fields for the world's entry points; each throws a FieldError that
 // names the field (field_error.h).
 #pragma once

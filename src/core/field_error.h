@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Errors about one field of a spec handed to a world's entry point. The core names the field
 // relative to the spec ("restitution", "pose.rotation", "positions[3]"); a caller that knows
 // where the spec came from puts that path in front: the C layer "def->", the checkpoint

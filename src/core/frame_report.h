@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // What a backend reports about one frame (one sph_world_step).
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Chooses the wrapped grid's table size. The CUDA backend sizes its table once from the
 // world's capacity (its particle arrays are capacity-sized too, so the table, 4 bytes a slot,
 // is a small share of what the world already holds). The CPU backend sizes it at every sort

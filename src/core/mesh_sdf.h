@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // SDF assets built from triangle meshes (vertices and indices), with no OpenVDB: exact
 // point-triangle distances in a narrow band around the surface, the closest triangle swept
 // outward from the band for the far field, and the sign from the generalised winding number,

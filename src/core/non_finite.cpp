@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "non_finite.h"
 
 namespace sph {

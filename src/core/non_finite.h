@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A substep that produced a non-finite state, written once for both backends: which stage of a
 // particle went non-finite first (classify_non_finite, on the device too) and the error message
 // (non_finite_message). Both backends name the particle with the lowest storage index whose new

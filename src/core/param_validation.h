@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The one check of a method's runtime parameters against its table (physics/param_table.h)
 // and its cross-field rule, for every path that sets them: the C layer (set calls, and through
 // it scene files) and the checkpoint reader. A failure throws Error with the caller's status

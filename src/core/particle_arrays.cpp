@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "particle_arrays.h"
 
 #include <cstring>

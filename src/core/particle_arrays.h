@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The per-particle arrays a world needs: the core state, each running method's own (declared by
 // the method's module as ParticleArraySpec records, physics/particle_array_spec.h) and the
 // integrator's. Both backends' particle stores allocate from this list.

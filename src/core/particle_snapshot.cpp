@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "particle_snapshot.h"
 
 #include "status.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Everything a backend carries from one frame to the next, in storage order (the order of the
 // last sort, which fixes the summation order of the next one): loading it into a fresh backend
 // of the same kind continues bit for bit (checkpoints). The core state has fields; the methods'

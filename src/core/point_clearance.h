@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Which candidate points keep a minimum distance from a set of existing points: sources use it
 // to skip lattice points where fluid already is.
 #pragma once

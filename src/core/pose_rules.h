@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Rotations from callers and the rule every pose inside a world obeys. The public structs take
 // any non-zero quaternion (the library normalises it) and read the all-zero quaternion of a
 // zeroed struct as the identity; inside, a pose has a finite position and a unit rotation.

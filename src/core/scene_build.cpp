@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "scene_build.h"
 
 #include "field_checks.h"

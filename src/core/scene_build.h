@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The rules of a world's scene objects, written once for every way in: the world's entry
 // points (World::add_collider and the like, which the C layer calls) and the checkpoint
 // reader. Each make_* validates a spec, resolves its zero defaults (against the world's

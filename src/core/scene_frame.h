@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // What a backend needs to know about a world's scene for one frame: colliders with their
 // start and end poses, force fields and sinks. Assets are held by reference; each backend
 // turns them into grid views over its own memory.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The small objects a world holds besides particles: colliders, sources, sinks and force
 // fields, as the core keeps them between frames (made from specs by scene_build.h).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // What a world's entry points take to make its scene objects and fills: plain values, as the C
 // layer converts them from the public defs and the checkpoint reader reads them from a file.
 // The entry points (World::add_collider and the like) validate every field through

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "sdf_asset.h"
 
 #include <Eigen/Dense>

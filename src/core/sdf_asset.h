@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A signed-distance grid asset: distances (negative inside) at voxel centres with an
 // index-to-local affine map, and optional per-voxel surface velocity and friction. Assets are
 // shared: colliders, sources, sinks and fields in any world of a context hold references.

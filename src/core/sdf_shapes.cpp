@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "sdf_shapes.h"
 
 #include <Eigen/Dense>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Analytic shapes sampled into SDF assets: plane, box (solid or a hollow tank), sphere,
 // capsule, cylinder and an open cup. Each shape is centred at its local origin with Y up.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Generational ids for the small objects inside a world (colliders, sources, sinks, fields):
 // a 32-bit slot, a 24-bit generation and an 8-bit kind tag, so a stale or foreign id is
 // recognised in every build. Id 0 is never issued.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The record of DFSPH's solves over a frame, written once for both backends: each substep adds
 // one solve's iterations, achieved error and whether it stopped at its cap (the CPU backend on
 // the stack of its frame, the CUDA backend in FrameState from its convergence kernel), and the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Internal error codes and the exception that carries them to the C layer. The values match
 // sph_result one for one (checked in src/capi), but the core never sees sph_* types.
 #pragma once

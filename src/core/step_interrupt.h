@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // What may stop a step early: a wall-clock deadline and a cancel flag that another thread can
 // raise (sph_world_set_step_budget, sph_world_cancel_step). A backend checks it at substep
 // boundaries only, so a step it stops leaves the world as after its last whole substep, like a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The substep clock of a frame, written once for both backends: the CPU backend keeps it in its
 // frame loop, the CUDA backend in FrameState on the device (frame_control.cu), and both advance
 // it with the functions below, so they take the very same steps (the step control itself is

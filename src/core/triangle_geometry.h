@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Host geometry of one triangle for building SDFs from meshes: the exact distance from a point
 // and the signed solid angle it subtends (the generalised winding number's term).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "winding_number.h"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The generalised winding number of a triangle soup (Jacobson, Kavan & Sorkine-Hornung 2013):
 // w(p) = sum of the triangles' solid angles / 4 pi, 1 inside a closed outward mesh, 0 outside,
 // and near 1/2 only close to the surface or across a hole, so thresholding it at 1/2 signs

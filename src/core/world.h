@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A simulation world: its fixed configuration, runtime parameters, particle ids and time,
 // its scene (colliders, sources, sinks, force fields), and the backend that holds and steps
 // the particles.

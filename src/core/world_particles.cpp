@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The world's entry points for particles from callers: spawns and lattice fills, validated
 // whole before anything is added.
 #include <algorithm>

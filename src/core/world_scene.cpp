@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The world's entry points for its scene: colliders, sources, sinks and force fields made from
 // specs (rules in scene_build.h), their setters, and the restore of a saved scene.
 #include <string>

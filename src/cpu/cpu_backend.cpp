@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CPU backend's particles: creation, appends, truncation, copies out, checkpoints (the twin
 // of cuda/cuda_backend.cu).
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Entry point of the CPU backend, seen by the backend factory (src/factory) only.
 #pragma once
 

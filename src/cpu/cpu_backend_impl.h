@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CPU backend's class, shared by the files of src/cpu/ that implement it (one per stage of a
 // frame, each the twin of a file of cuda/; see docs/architecture.md). Each substep sorts
 // particles into the wrapped grid, then loops the shared per-particle physics (src/physics) over

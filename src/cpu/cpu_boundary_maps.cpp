@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "cpu_boundary_maps.h"
 
 #include "../physics/boundary_map.h"

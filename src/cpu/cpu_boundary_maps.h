@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CPU backend's boundary-density maps (SPH_FEATURE_BOUNDARY_DENSITY; the physics is
 // src/physics/boundary_map.h): one map per SDF asset the world's colliders use, computed on host
 // threads for the world's kernel radius when a collider first steps with the asset and again

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Loads on colliders (SPH_FEATURE_COLLIDER_LOADS) on the CPU: the walls' pressure reactions of a
 // force evaluation and the collision response with its contact impulses, summed per collider in
 // blocks of kLoadBlock particles in storage order, then the blocks in order into the frame's

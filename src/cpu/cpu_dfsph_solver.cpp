@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CPU backend's DFSPH substep (physics/dfsph.h; the twin of cuda/dfsph_solver.cu): density and
 // factor, the divergence solve on the current velocities, the non-pressure accelerations into
 // v*, the density solve on v*, then positions and colliders. Each solve is a Jacobi iteration of

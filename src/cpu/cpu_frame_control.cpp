@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CPU backend's end of a substep: the max-speed reduction, the non-finite check and its
 // diagnosis, and the swap to the new state (the twin of cuda/frame_control.cu).
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CPU backend's frame: adaptive substeps until the frame time is reached, sinks after each,
 // and the rollback that puts the particles back when a substep fails (the twin of
 // cuda/frame_loop.cu).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CPU backend's frame statistics: the density record (src/core/density_record.h) of the
 // last density evaluation, tallied in storage order. The twin of cuda/frame_statistics.cu.
 #include "../core/density_record.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "cpu_neighbor_grid.h"
 
 #include <algorithm>

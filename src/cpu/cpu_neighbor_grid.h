@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CPU backend's neighbour structure: a stable counting sort of particles by wrapped cell
 // hash, which yields the permutation and the dense cell-start table in one pass. The table is
 // sized at every build from the particles' extent and count (core/grid_layout.h), and a build

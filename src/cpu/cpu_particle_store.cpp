@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "cpu_particle_store.h"
 
 #include <cstring>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CPU backend's per-particle arrays, each allocated from a registration
 // (src/core/particle_arrays.h: name, element size, role) and given its role's bookkeeping: after
 // the neighbour sort or a sink's removal, permute() reorders every Sorted and Carried array in

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CPU backend's sinks: the twin of cuda/device_sinks.cu.
 #include "cpu_backend_impl.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CPU backend's springs (SPH_FEATURE_SPRINGS; the physics is src/physics/springs.h): the
 // twin of cuda/device_springs.cu.
 #include "cpu_backend_impl.h"

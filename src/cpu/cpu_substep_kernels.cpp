@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CPU backend's per-particle passes of a substep: hash and sort, density and pressure (with
 // the normalised density and the colour-field normals when on), and the acceleration gather
 // with the world's options compiled in (the twin of cuda/substep_kernels.cu).

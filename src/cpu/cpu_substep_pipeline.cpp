@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The order of the CPU backend's passes in one substep: symplectic Euler (sort, density,
 // springs, forces + integration, colliders) or the four stages of RK4 (the twin of
 // cuda/substep_pipeline.cu).

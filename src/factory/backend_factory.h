@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The one place that knows which backends exist: picks the CPU or CUDA implementation. It sits
 // above the core (which knows a backend only as the interface of core/backend.h) and below the C
 // layer, which calls it to make a world's backend; nothing else includes a backend.

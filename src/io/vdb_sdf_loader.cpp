@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Loads an OpenVDB level set into a dense SDF asset through the public C API. OpenVDB stays in
 // this library (libsph_vdb); libsph never sees it.
 #include <openvdb/openvdb.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Walls in the density (SPH_FEATURE_BOUNDARY_DENSITY): a collider's solid counts in every
 // particle's density sum, as a density map (Koschier & Bender 2017, "Density maps for improved
 // SPH boundary handling"), so particles at a wall read the bulk's density instead of 70-80 % of

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Integrals of W_spiky over a solid, in closed form where the solid is simple: the radial
 // antiderivatives a quadrature along rays needs (boundary_map.h), and the integral over a half
 // space, which is the whole boundary share of a flat wall (boundary_density.h) and the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The boundary density's map of an SDF asset for a kernel radius h and an SDF level L (the solid
 // {phi < L}; boundary_density.h: L = -sigma delta): per voxel, what the solid's true kernel share
 // Phi differs by from the flat-wall share of the SDF, which the sampling adds back,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Loads (SPH_FEATURE_COLLIDER_LOADS): the force and torque of the fluid on each collider, as
 // the momentum the fluid gives it. Per substep, every particle adds per collider
 //   - the wall's pressure reaction (SPH_FEATURE_BOUNDARY_DENSITY): the wall accelerates the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Particles against one SDF collider (thesis 3.4.2, eq. 33-37), for static, kinematic (a
 // pose interpolated inside the frame) and deforming (a surface velocity field) colliders.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Density by summation (thesis eq. 9) and the pressure it implies.
 //
 // The pair terms use W_spiky, the kernel whose gradient the pressure force uses (forces.h), not

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Normalised density (thesis eq. 31) over densities carried per particle.
 //
 // Near a free surface (and near a collider wall: there are no wall particles) the plain sum

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Divergence-free SPH (Bender & Koschier 2015, "Divergence-free smoothed particle
 // hydrodynamics"; 2017, "Divergence-Free SPH for Incompressible and Viscous Fluids"), the
 // incompressible solver a world chooses instead of the thesis's weakly compressible scheme

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The walls' share in DFSPH's sums: where the boundary density (SPH_FEATURE_BOUNDARY_DENSITY,
 // boundary_density.h: the colliders' solids as density maps) enters the incompressible solver.
 // DFSPH takes it at exactly three places (dfsph_passes.h):

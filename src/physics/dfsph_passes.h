@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // DFSPH's per-particle passes (the method is dfsph.h; the order of a substep is each backend's).
 // Three gathers over the neighbours, each written once for both backends:
 //   gather_density_and_factor  rho_i and the factor alpha_i / rho_i = 1 / D_i,

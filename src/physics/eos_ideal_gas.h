@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The thesis's modified ideal-gas law (eq. 15, Desbrun & Cani): p = k (rho - rho0), clamped at
 // zero below rest density (methods.h, pressure_from_density, says why). k is the squared numerical speed of
 // sound. Its parameter is sph_world_params.stiffness.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Tait's law (gamma = 7) from a chosen speed of sound c: p = B ((rho / rho0)^7 - 1),
 // B = rho0 c^2 / 7, clamped at zero below rest density (methods.h, pressure_from_density, says why).
 #pragma once

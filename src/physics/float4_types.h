@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Packed 16-byte particle records shared by both backends. The w slot carries a second
 // quantity so that one 16-byte load brings everything a neighbour contributes.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The part of the per-particle constants that every method reads: the kernel, the particle
 // mass, rest density, gravity and the substep's length. FluidConstants (fluid_constants.h)
 // adds each method's own constants; a method's terms take this part and their own.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Everything the per-particle physics needs, passed by value to every kernel and loop
 // (no globals: two worlds in one process, even on two devices, keep their own): the part every
 // method reads (fluid_base.h) and each method's own constants (methods.h).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // External force fields inside a region (thesis 4.4.2.4): uniform, radial, vortex and a grid
 // of accelerations. Each yields an acceleration in m/s^2.
 #pragma once

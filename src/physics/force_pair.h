@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // What a force term (a method's part of the acceleration, forces.h) sees of particle i and of
 // one neighbour j. The composer fills these once per particle and once per pair, so that every
 // term reads the same values and a term that is compiled out costs nothing.

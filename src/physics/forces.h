@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The force composer: the acceleration of a particle from its neighbours, as the sum of the
 // world's force terms in a fixed order: the pressure force (pressure_force.h) and gravity, then
 // each term of the world's ForceTerms list (methods.h: the viscosity method, surface tension).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The wrapped hashed uniform grid (thesis eq. 27-30): cell = floor(x / cell_size) per axis,
 // folded into an nx * ny * nz table in linear x-fastest order so neighbouring cells stay
 // close in memory. An unbounded domain maps onto a table sized by particle count.

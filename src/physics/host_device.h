@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Marks a function callable from host and device code: one formula for both backends.
 #pragma once
 

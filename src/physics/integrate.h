@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Time integration of one particle: symplectic Euler and the classic RK4 stage updates.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Smoothing kernels of Mueller et al. 2003 (thesis eq. 10-13). Each is zero for r >= h.
 // Coefficients depend only on h, so callers compute them once per step (KernelCoefficients)
 // and the per-pair functions do no division.

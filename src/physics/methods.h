@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The method list: every physics method of the library and the one order in which everything
 // that visits them does (constants, validation, checkpoints, the force composer). Each method is
 // a module of its own header (Params with its table, Constants, terms, step ceiling, arrays);

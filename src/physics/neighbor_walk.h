@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Visits every particle in the 27 cells around a position, in a fixed order, using a dense
 // cell-start table: cell_start[c] is the index of the first particle whose hash is >= c, and
 // cell_start[cell_count] is the particle count. Because the table is dense, the three cells of

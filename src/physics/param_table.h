@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // How a physics method describes itself as data (host only): its runtime parameters with their
 // ranges and the meaning of a zero, and its per-particle arrays. Each method's table is the one
 // copy of its rules: core/param_validation.h checks a method's Params against it for the C

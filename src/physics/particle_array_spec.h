@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The per-particle arrays of a physics method, declared as data by the method's module (its
 // kArrays). Both backends' particle stores allocate them from these records and give each the
 // bookkeeping of its role, and checkpoints carry the carried ones by name, so a method's arrays

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The pressure force: Monaghan's symmetric form a_i = -sum_j m (p_i / rho_i^2 + p_j / rho_j^2)
 // grad W_spiky(x_i - x_j) (Monaghan 1992), not the thesis's eq. 14 (Mueller 2003),
 // -sum_j m (p_i + p_j) / (2 rho_j) grad W_ij / rho_i. Both are antisymmetric in i and j

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Rigid placement of colliders, sources and fields: a rotation (unit quaternion) and a
 // translation, with interpolation between two poses for substeps inside a frame.
 #pragma once

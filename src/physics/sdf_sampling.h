@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Sampling a dense signed-distance grid: trilinear values, the gradient of the trilinear
 // field, and a conservative extension outside the grid. Samples sit at voxel centres with
 // integer indices (OpenVDB's convention); local = index_to_local * (i, j, k, 1).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Sinks (thesis 4.4.2.3): the test that removes a particle, inside an SDF region or outside an
 // axis-aligned box of the world.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Elasticity and plasticity (thesis 4.4.2.1): springs between neighbouring particles whose
 // rest lengths yield and creep, after Clavet, Beaudoin & Poulin 2005, "Particle-based
 // viscoelastic fluid simulation", section 5, written as accelerations for this solver's

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The adaptive step size (thesis eq. 32) and the rule that lands substeps exactly on the end
 // of a frame. Shared so both backends take the very same steps.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Surface tension (SPH_FEATURE_SURFACE_TENSION): the thesis's colour field (eq. 20-23) turned
 // into a capillary stress, plus a short-range cohesion, both calibrated on the FCC lattice so
 // that sigma is the physical N/m (docs/physics.md, Surface tension; sph_surface_tension_params).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A plain 3-vector of floats shared by the CPU and CUDA backends.
 #pragma once
 

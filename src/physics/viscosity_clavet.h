@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Clavet's viscosity (thesis eq. 18-19; Clavet, Beaudoin & Poulin 2005): radial impulses
 // between approaching pairs, q = r / h, u = (v_i - v_j) . r^ > 0,
 // I = dt (1 - q)(sigma u + beta u^2), applied half to each particle (sph_clavet_viscosity_params).

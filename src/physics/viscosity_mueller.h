@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Mueller's viscosity (thesis eq. 17): a_i = (mu / rho_i) sum_j m (v_j - v_i) / rho_j
 // lap W_viscosity(|x_i - x_j|), a numerical viscosity whose coefficient is
 // sph_world_params.viscosity. The default viscosity method.

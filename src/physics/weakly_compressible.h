@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The thesis's weakly compressible scheme, the default solver (sph_world_def.solver =
 // SPH_SOLVER_WCSPH): the pressure from the equation of state (eos_ideal_gas.h, eos_tait.h) and
 // the symmetric pressure force (pressure_force.h), integrated explicitly under the acoustic step

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // What a method derives its constants from and checks its parameters against (host only): the
 // world's fixed shape, and the lattice sums it may calibrate on. Core fills both (config.h and
 // fcc_lattice.cpp); the physics layer only names them, so it includes nothing from core.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "capi_test.h"
 
 #include <math.h>

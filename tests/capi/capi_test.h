@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* What the C-API tests share: result/message expectations, a populated world fixture and a
  * snapshot that proves a failed call left the world unchanged. */
 #ifndef SPH_CAPI_TEST_H

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Contexts through the C API: every bad input to the context functions returns its code, names
  * the argument in sph_get_last_error(), writes no output and creates nothing. */
 #include <string.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* A thousand create/destroy cycles in one process leak nothing: the live-object count returns
  * to 0 after every cycle, and the process does not grow. (LeakSanitizer checks every byte in
  * the sanitizer build.) */

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Version queries, result strings, the thread-local last error and the log callback. */
 #include <pthread.h>
 #include <stdio.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Runtime parameters through the one validation path (issue 15, items 1-2 and 6):
  * - a params struct that is all zeros but for struct_size is valid and yields exactly the
  *   values sph_c.h documents, for every params struct;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Particles in and out through the C API: spawn, the lattice fills, the particle count and
  * attribute copies. Every bad input returns its code, names the argument, writes nothing and
  * leaves the world unchanged; the successful paths do exactly what the header says. */

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Stepping and statistics through the C API: bad frame lengths, SPH_INCOMPLETE when the
  * substep budget runs out, SPH_ERROR_NON_FINITE with the world rolled back, and the values
  * sph_world_get_stats reports after a step. */

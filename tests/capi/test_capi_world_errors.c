@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Worlds and their parameters through the C API: every bad def, handle and parameter returns
  * its code, names the argument, writes no output and leaves the world as it was. */
 #include <math.h>

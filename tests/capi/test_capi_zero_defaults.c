@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* "Zero means default" (STYLE.md) for every def and desc of sph_c.h: a struct that is all zeros
  * except struct_size is accepted and gives the documented defaults (read back through the
  * getters, or compared with the struct its init function fills), or is refused with the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "cli_test_support.h"
 
 #include <dirent.h>

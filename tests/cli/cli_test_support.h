@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Helpers of the sph-run tests: running a program, temporary directories, and readers for the
 // PLY and CSV frames written independently of the writers under test.
 #ifndef SPH_CLI_TEST_SUPPORT_H

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sph-run under hostile conditions (issue 23, items 3, 5 and 8): links planted in the output
 // directory, other programs' files there, kills at any moment, frames of an earlier run,
 // special files as input, an unwritable --stats-json, a file size limit, and scene values that

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Mesh shapes in scene files (issue 21, item 4): OBJ and STL (ASCII and binary) read to the
 // same triangles, bad files reported at the shape's path with the line or triangle, and a
 // scene with a mesh collider builds an asset whose inside is negative.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Keyframed motion (issue 7, item 1): the pose a collider is sent each frame. Linear and smooth
 // interpolation pass through their keys, hold before the first and after the last, loop, and
 // turn rotations along the shorter arc; axis-angle and quaternion rotations of a scene file

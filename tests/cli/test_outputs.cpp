@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Outputs read back equal the particle arrays (issue 7, items 3 and 6): the CSV, PLY and VDB
 // points writers round-trip a frame exactly (VDB positions to float precision), sph-run's frame
 // files hold what the world held after the same frames, and the surface encloses the fluid.
@@ -70,6 +71,50 @@ void expect_equal(const sph_tools::ParticleFrame& f, const cli_test::Particles& 
   assert_true(same_floats(p.velocity, f.velocity));
   assert_true(same_floats(p.density, f.density));
   if (with_pressure) assert_true(same_floats(p.pressure, f.pressure));
+}
+
+// The OBJ writer's vertex normals on a regular octahedron: by symmetry the area-weighted mean of
+// the four faces around a corner points along that corner's axis, so each normal is the unit
+// vector of its vertex (to float rounding), and the file names that normal at each corner.
+void test_obj_vertex_normals(void** /*state*/) {
+  sph_tools::SurfaceMesh mesh;
+  mesh.vertices = {1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1};
+  // Counter-clockwise seen from outside: (a, b, c) with (b - a) x (c - a) pointing out.
+  const uint32_t px = 0, nx = 1, py = 2, ny = 3, pz = 4, nz = 5;
+  mesh.triangles = {px, py, pz, py, nx, pz, nx, ny, pz, ny, px, pz,
+                    py, px, nz, nx, py, nz, ny, nx, nz, px, ny, nz};
+  std::vector<float> normals;
+  sph_tools::vertex_normals(mesh, &normals);
+  assert_int_equal(normals.size(), mesh.vertices.size());
+  for (size_t i = 0; i < normals.size(); ++i) assert_true(std::fabs(normals[i] - mesh.vertices[i]) < 1e-6f);
+
+  const std::string dir = cli_test::make_temp_dir("obj");
+  const std::string path = dir + "/surface.obj";
+  sph_tools::write_obj(mesh, 3, 0.25, path);
+  std::FILE* in = std::fopen(path.c_str(), "r");
+  assert_non_null(in);
+  char line[256];
+  int v = 0, vn = 0, f = 0;
+  while (std::fgets(line, sizeof line, in)) {
+    float x, y, z;
+    unsigned a, a_n, b, b_n, c, c_n;
+    if (std::sscanf(line, "vn %f %f %f", &x, &y, &z) == 3) {
+      assert_true(std::fabs(x - mesh.vertices[3 * vn]) < 1e-6f &&
+                  std::fabs(y - mesh.vertices[3 * vn + 1]) < 1e-6f &&
+                  std::fabs(z - mesh.vertices[3 * vn + 2]) < 1e-6f);
+      ++vn;
+    } else if (std::sscanf(line, "v %f %f %f", &x, &y, &z) == 3) {
+      ++v;
+    } else if (std::sscanf(line, "f %u//%u %u//%u %u//%u", &a, &a_n, &b, &b_n, &c, &c_n) == 6) {
+      assert_true(a == a_n && b == b_n && c == c_n);
+      assert_int_equal(a, mesh.triangles[3 * static_cast<size_t>(f)] + 1);
+      ++f;
+    }
+  }
+  std::fclose(in);
+  assert_int_equal(v, 6);
+  assert_int_equal(vn, 6);
+  assert_int_equal(f, 8);
 }
 
 #ifdef SPH_TOOLS_HAVE_OPENVDB
@@ -350,6 +395,7 @@ int main(int argc, char** argv) {
       cmocka_unit_test(test_writers_round_trip),
       cmocka_unit_test(test_run_outputs_equal_world),
       cmocka_unit_test(test_loads_csv),
+      cmocka_unit_test(test_obj_vertex_normals),
 #ifdef SPH_TOOLS_HAVE_OPENVDB
       cmocka_unit_test(test_surface_encloses_fluid),
       cmocka_unit_test(test_vdb_level_set_collider),

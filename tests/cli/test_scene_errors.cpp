@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Scene-file errors (issue 7, item 6): every bad field is reported with its path and what was
 // expected there; unknown fields (physics options of later issues among them) are rejected;
 // scene objects the library refuses are reported at their path too.
@@ -116,7 +117,7 @@ const Case kCases[] = {
     {R"({"force_fields": [{"type": "grid"}]})",
      "force_fields[0].type: expected \"uniform\", \"radial\" or \"vortex\", got the string \"grid\""},
     {R"({"output": {"format": "exr"}})",
-     "output.format: expected \"vdb\", \"ply\" or \"csv\", got the string \"exr\""},
+     "output.format: expected \"vdb\", \"ply\", \"csv\" or \"vtp\", got the string \"exr\""},
     {R"({"output": {"preview": {"camera": {"position": [1, 1, 1], "target": [1, 1, 1]}}}})",
      "output.preview.camera.target: expected a point other than the position"},
     {R"({"output": {"preview": {"width": 4}}})",

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Writes tests/data/checkpoint_v1_options.sphckpt: a checkpoint of format version 1, the layout
  * before the physics methods became modules (issue 15), for the test that old files still load
  * (tests/reliability/test_checkpoint_formats.c).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "extremes_util.h"
 
 #include <math.h>

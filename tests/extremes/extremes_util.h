@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Helpers of the extremes tests (issue 6 item 3): a world on the test backend, a small dam
  * break in a closed tank (both tests/support's), and the measurements that define a "stable
  * state" (finite values, particle count, speed and mechanical energy bounded by the drop, density

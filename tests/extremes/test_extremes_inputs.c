@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Extremes of the input: 0, 1 and 2 particles; all particles at one point; particles 1e6 m
  * from the origin and at 1e30 m; 1x1x1 and very large SDFs; spacings near float precision;
  * capacity exhausted. Each ends in a specific error with a message that names the problem (and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Physical extremes: stiffness over six decades, viscosity from 0 to very high, dt_max far
  * above the stable limit, velocities of 1e4 m/s, and the bound on the work of one call. */
 #include <math.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* A step that produces non-finite values (issue 9 item 3): SPH_ERROR_NON_FINITE with a message
  * that names the stage and the particles, the world bitwise as it was before the step (every
  * attribute copied out before and after and compared with memcmp), the same failure again on a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // libFuzzer harness: the input is a program of C-API calls with hostile arguments. Each op
 // picks a function and its arguments (fuzzed defs and descs, NaN/Inf/huge floats, wrong struct
 // sizes, stale and foreign handles and ids); after each call the harness checks the contract
@@ -206,7 +207,8 @@ class Program {
     if (checkpoint(loaded) != bytes) violation("a loaded world saves other bytes than it was loaded from");
     if (FUZZ_CALL(sph_world_restore(ws.ptr, bytes.data(), bytes.size())) != SPH_OK)
       violation("a world's own checkpoint does not restore: %s", sph_get_last_error());
-    if (checkpoint(ws.ptr) != bytes) violation("a restored world saves other bytes than it was restored from");
+    if (checkpoint(ws.ptr) != bytes)
+      violation("a restored world saves other bytes than it was restored from");
     const float dt = 1.0f / 600.0f;
     const sph_result a = FUZZ_CALL(sph_world_step(ws.ptr, dt));
     const sph_result b = FUZZ_CALL(sph_world_step(loaded, dt));

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // What every harness checks after a library call: the result is a known code, a failure comes
 // with a message, a success clears it. A violated invariant aborts, which libFuzzer (and the
 // replay driver) reports as a crash with the input that caused it.

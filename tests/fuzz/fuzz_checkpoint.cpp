@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // libFuzzer harness: the input is a checkpoint given to sph_world_load (and to
 // sph_world_restore of a live world). The loader validates the whole checkpoint before it
 // creates anything (sph_c.h): it must return a world or an error with a message, and on error
@@ -90,15 +91,17 @@ void check_world(sph_world* w) {
   // Step the loaded world and its copy: the same answer; a failed step changes no carried
   // field (the checkpoint is the same byte for byte), a successful one leaves the two alike.
   const sph_result r = FUZZ_CALL(sph_world_step(w, 1.0f / 60.0f));
-  if (r == SPH_ERROR_INTERNAL) violation("stepping a loaded world failed internally: %s", sph_get_last_error());
+  if (r == SPH_ERROR_INTERNAL)
+    violation("stepping a loaded world failed internally: %s", sph_get_last_error());
   if (r < 0 && save(w) != again) violation("a failed step (%d) of a loaded world changed its checkpoint", r);
   const sph_result rc = FUZZ_CALL(sph_world_step(copy, 1.0f / 60.0f));
   if (rc != r) violation("a loaded world's step answered %d, its reloaded copy's %d", r, rc);
   std::vector<float> xa(3 * static_cast<size_t>(def.capacity) + 3), xb(xa.size());
   uint32_t na = 0, nb = 0;
-  FUZZ_CALL(sph_world_copy_attribute(w, SPH_ATTRIBUTE_POSITION, xa.data(), xa.size() * 4, 0, 0, def.capacity, &na));
-  FUZZ_CALL(sph_world_copy_attribute(copy, SPH_ATTRIBUTE_POSITION, xb.data(), xb.size() * 4, 0, 0, def.capacity,
-                                     &nb));
+  FUZZ_CALL(
+      sph_world_copy_attribute(w, SPH_ATTRIBUTE_POSITION, xa.data(), xa.size() * 4, 0, 0, def.capacity, &na));
+  FUZZ_CALL(sph_world_copy_attribute(copy, SPH_ATTRIBUTE_POSITION, xb.data(), xb.size() * 4, 0, 0,
+                                     def.capacity, &nb));
   if (na != nb || std::memcmp(xa.data(), xb.data(), 3 * static_cast<size_t>(na) * sizeof(float)) != 0)
     violation("a loaded world and its reloaded copy stepped apart");
   FUZZ_CALL(sph_world_destroy(copy));

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // FuzzInput: the fuzzer's bytes read as a stream of small decisions. Once the bytes run out every
 // read returns zero, so a harness never reads past its input and short inputs stay meaningful.
 #ifndef SPH_FUZZ_INPUT_H

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // libFuzzer harness: the input is the text of a scene file (tools/scene, read by sph-run). The
 // parser must either return a scene or throw SceneError (a path and a message); anything else
 // (another exception, a crash, undefined behaviour) is a bug. A scene that parses is then

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // libFuzzer harness: the input is a .vdb file given to sph_vdb_load_sdf (libsph_vdb,
 // src/io/vdb_sdf_loader.cpp). The loader must return SPH_OK with an asset or an error code with
 // a message from sph_vdb_get_last_error(), and leave no object behind on failure. The first

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Writes the seed corpus of fuzz_checkpoint (tests/fuzz/corpus/checkpoint/): checkpoints of
 // small worlds saved by the library, one with every kind of scene object. Run by hand when the
 // format changes: fuzz_make_checkpoint_seeds <folder>.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Writes the seed corpus of fuzz_vdb (tests/fuzz/corpus/vdb/): small .vdb files made by OpenVDB,
 // each behind the harness's first byte (the grid-name choice, fuzz_vdb.cpp). Run by hand when the
 // seeds need remaking: fuzz_make_vdb_seeds <folder>.

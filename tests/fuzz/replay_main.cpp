@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A main() for builds without libFuzzer (gcc, the ordinary Release build): runs the harness's
 // LLVMFuzzerTestOneInput over every file named on the command line, or every file in a named
 // folder (options that start with '-' are libFuzzer's and skipped), so the saved crash inputs

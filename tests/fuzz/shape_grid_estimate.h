@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The number of voxels sph_sdf_create_shape samples for a shape desc, computed as the library
 // does (src/core/sdf_shapes.cpp: the shape's half bounds per kind, 2 ceil(half / voxel) +
 // 2 padding + 1 per axis). The harnesses use it to skip grids that are legal but too slow to

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Prints a digest of the particle state after a fixed set of scenes, one line per scene, for one
 // backend: `state_digest cpu` or `state_digest cuda`. Two builds whose digests match produce
 // bit-for-bit the same particles (positions, velocities, densities, pressures, ids in storage

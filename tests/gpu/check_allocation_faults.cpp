@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Device and pinned-host allocation failures on the CUDA backend (issue 9, item 6), injected
 // at every device allocation point of every call in turn through the hook in
 // cuda/device_allocation_faults.h (linked from sph_internal; libsph does not export it).

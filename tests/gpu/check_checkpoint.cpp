@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Checkpoints on the CUDA backend (docs/checkpoint.md): a CUDA world saved mid-run and loaded
 // into a new CUDA world continues bit for bit, on the CUDA-graph path and on the stream
 // fallback, with and without a scene (collider, sink, force field); restoring in place does the

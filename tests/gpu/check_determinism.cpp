@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Bitwise determinism: two GPU runs of the same scene give identical arrays (compared by id)
 // and identical statistics; the graph path and the stream fallback agree bit for bit; two
 // worlds stepped at once from two threads give the same bits as one at a time.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A sticky CUDA error (here an illegal address in a kernel of the caller's, which poisons the
 // whole process's context) puts a CUDA world in the device-lost state: every later call says
 // SPH_ERROR_DEVICE_LOST, destroy still works, and nothing aborts. Run as its own process.

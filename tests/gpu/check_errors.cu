@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Error paths and the zero-copy tier of the CUDA backend: device allocation failure, the
 // caller's current device, an out-of-range device, the non-finite rollback (bitwise, and the
 // same particle named as on the CPU), and sph_cuda.h (views, epoch, stream, events).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Loads on colliders on the GPU (issue 17): a column collapsing in a tank with a fixed box in
 // its way, on the CUDA backend:
 //   - two runs give bitwise-identical loads (the fixed-order block sums) and states; the graph

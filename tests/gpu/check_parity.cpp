@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // CPU against GPU on the same scenes: after 10 substeps the positions (matched by id) agree
 // within 1e-4 relative, and so do the density statistics. The scene cases (scene_parity.h) add
 // colliders, force fields, sinks and sources, and check that three GPU runs agree bit for bit.

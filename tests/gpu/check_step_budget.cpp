@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // What one call may cost on the CUDA backend (issue 23 item 9; the CPU side is ctest
 // hostile_cost): a frame with a step budget runs on the stream driver and stops at a substep
 // boundary when the budget runs out or another thread cancels it (INCOMPLETE, the world

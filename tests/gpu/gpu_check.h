@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Shared helpers of the GPU check programs (run by scripts/gpu-test on a machine with an
 // NVIDIA GPU; never by ctest, so CI without a GPU does not see them). Each program prints one
 // "PASS <name>: <detail>" or "FAIL <name>: <detail>" line per check and exits non-zero if any

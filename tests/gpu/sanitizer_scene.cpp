@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A small scene for compute-sanitizer (memcheck, racecheck, synccheck): Euler and RK4 frames,
 // a spawn between frames, a rollback, and the copy-out of every attribute; then the scene
 // kernels: colliders (tank, paddle, deforming ball), every force field, sinks and a source.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Scene cases of the CPU/GPU parity check: colliders (an inverted-box tank, a moving paddle, a
 // deforming SDF with a velocity field), sinks, a source and every force-field kind, built the
 // same way on both backends. compare_scene() steps one frame (10 substeps) and compares the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* sph_c.h compiled as strict C99 with -Wall -Wextra -pedantic -Werror (and a few more
  * warnings engines enable); the build fails if the header is not real C. Run as a test, it
  * also checks that the declarations it uses link and agree with the library. */

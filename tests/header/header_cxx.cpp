@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sph_c.h compiled as C++ with -Wall -Wextra -pedantic -Werror (and a few more warnings
 // engines enable); the build fails if the header does not compile cleanly as C++. Run as a
 // test, it checks that the extern "C" declarations link and agree with the library.

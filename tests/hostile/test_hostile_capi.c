@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Hostile use of the C API (issue 23, items 4, 5, 6 and 8): each test replays one class of
  * input that once crashed, over-read, lost a message or made a world its own save could not
  * restore, and checks the clear error (or the round trip) that replaced it.

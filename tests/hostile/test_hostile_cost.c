@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* What one call may cost (issue 23 item 9), on the CPU backend: a world of capacity 2^30 with
  * 100 particles does not allocate a capacity-sized cell table; particles piled into one cell
  * are refused at once instead of costing time quadratic in their number; a step budget and a

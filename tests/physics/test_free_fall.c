@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* A single particle (no neighbours, so no pressure or viscosity) falls freely: after time t
  * its height is y = -g t^2 / 2 up to each integrator's error. Symplectic Euler is first order
  * (x_n = -g t^2/2 - g t dt/2, so halving dt halves the error); RK4 is exact for a constant

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Linear momentum is conserved with no external force: the pressure and viscosity pair forces
  * are antisymmetric (equal and opposite for each pair), so sum(m a) = 0 at every force
  * evaluation, for symplectic Euler and for each RK4 stage alike. */

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* An FCC sphere at rest density with no gravity stays at rest: the particle mass is chosen so
  * the lattice sits exactly at rest density, so pressure and viscosity leave it alone. 100
  * frames of 1/25 s with dt_max 1 ms (4,000 substeps).

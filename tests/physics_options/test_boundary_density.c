@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Walls in the density (SPH_FEATURE_BOUNDARY_DENSITY; src/physics/boundary_density.h), against
  * what it is for: particles at a wall read rest density instead of the summation's deficit, and
  * the wall holds the fluid with the pressure it should. Spacing s = 2 cm, h = 1.8 s.

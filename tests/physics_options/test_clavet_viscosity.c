@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Clavet viscosity (SPH_VISCOSITY_CLAVET, thesis eq. 18-19): radial impulses between
  * approaching pairs, I = dt (1 - q)(sigma u + beta u^2), half to each particle. Issue 5: it
  * "damps relative motion and never adds energy". test_physics_options.c already checks, per

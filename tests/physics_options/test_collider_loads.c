@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Loads on colliders (SPH_FEATURE_COLLIDER_LOADS; src/physics/collider_loads.h), against what
  * they must equal. Lattice step 1 cm (spacing 1.41 cm, h = 2.5 cm), ideal gas k = 100.
  *   - momentum balance: a column collapsing in a closed tank; over the run the fluid's momentum

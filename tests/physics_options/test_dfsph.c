@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* DFSPH (issue 16 item 4): the state a checkpoint carries and a failed step puts back.
  * - checkpoint: a ball falling into a closed tank (its solves warm-started from the last
  *   substep's pressures, which the checkpoint carries), saved mid-run: the loaded world and the

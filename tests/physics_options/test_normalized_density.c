@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Normalised density (SPH_FEATURE_NORMALIZED_DENSITY; thesis eq. 31 as a Shepard filter over
  * densities carried per particle, src/physics/density_normalization.h), against what it is for
  * (issue 5: "normalised density brings surface particles' density within 5 % of the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Optional physics (issue 5), each against an analytic expectation (surface tension has its
  * own file, test_surface_tension.c): Clavet's viscosity damps relative motion and never adds
  * energy; normalised density brings surface particles closer to the interior's density; Tait's

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Springs (SPH_FEATURE_SPRINGS; thesis 4.4.2.1, Clavet et al. 2005): an elastic blob dropped
  * on a plane comes back to its spawn shape and a plastic one keeps its dent; the spring forces
  * conserve momentum; the parameters are validated and refused on a world without the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Surface tension (issue 5 items 1 and 7) against the physics of a free droplet, with the
  * physical sigma the caller gives (water's 0.0728 N/m) and no gravity:
  * - a resting droplet holds the Laplace pressure 2 sigma / R inside;

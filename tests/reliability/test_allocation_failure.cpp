@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Host allocation failures (issue 9, item 6), injected at every allocation point of every
 // call in turn.
 //

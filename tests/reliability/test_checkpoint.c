@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Checkpoints (issue 9, item 4): a world saved and loaded continues bit for bit as the saved
  * one does (same backend); ids of scene objects stay valid; every truncation and corruption is
  * refused with a clear error and creates nothing; a file is replaced only by a complete one.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Checkpoint formats (issue 15): parameters are written per method from the methods' tables
  * (format version 2), version 1 files still load, and both go through the one validate() of the
  * set calls. tests/data/checkpoint_v1_options.sphckpt was written by the library of commit

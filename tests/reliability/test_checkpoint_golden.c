@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Checkpoint format versions (issue 23 item 7). A fixed small world, built here from explicit
  * values and never stepped (so physics changes do not move its bytes), is saved and compared
  * byte for byte with tests/data/checkpoint_v<N>_world.sphckpt, N the version the writer writes:

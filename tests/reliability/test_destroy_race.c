@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Destroying an object while another thread's call uses it (issue 23, item 1).
  *
  * 1. sph_world_destroy racing sph_world_step, sph_world_copy_attribute, sph_world_get_stats and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Worlds on threads (issue 9, item 5).
  *
  * 1. Several worlds stepped on several threads at once give bitwise the particles they give

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "scene_test.h"
 
 #include <stdio.h>

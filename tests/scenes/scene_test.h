@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Helpers shared by the scene tests: a world on the test backend with chosen parameters, a
  * particle's state by id, and shape assets, over tests/support's worlds and readers. */
 #ifndef SPH_SCENE_TEST_H

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Colliders against analytic expectations (issue 4, item 6): restitution, Coulomb friction,
  * no penetration of a static tank, no tunnelling through a fast paddle, a rotating cup that
  * holds its water, and a deforming floor that carries a particle with its surface. */

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Error paths of the scene API: every bad argument gets its code and a message naming it,
  * and the world keeps its objects (a failed create adds nothing; a stale id stays stale). */
 #include <math.h>

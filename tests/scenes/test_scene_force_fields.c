@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Force fields (issue 4, item 5) on single particles in zero gravity, where the motion is
  * known in closed form: uniform, radial (push and pull, with falloff), vortex, a user grid,
  * a region that limits a field, and a rotated field frame. */

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* SDF assets from triangle meshes (issue 21, item 4): a meshed sphere and box against their
  * analytic distances within half a voxel, a sphere with a hole still signed inside, bad input
  * refused with the field named, and a small dam break around a mesh obstacle. */

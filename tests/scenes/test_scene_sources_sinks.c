@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Sources and sinks (issue 4, items 3, 4 and 6): a source's count and spacing match its FCC
  * lattice, it never emits on top of fluid, it stops cleanly at capacity with an event; a sink
  * removes exactly the particles inside it and reports their ids. Zero gravity and tiny steps

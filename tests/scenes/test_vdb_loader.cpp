@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A level set written with OpenVDB loads back through sph_vdb_load_sdf with the same
 // distances (issue 4, item 6): at every voxel centre of the narrow band the asset returns the
 // file's value to float round-off, and between voxels it agrees with OpenVDB's own trilinear

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Reading one attribute of every particle, in storage order or by particle id. */
 #include <stdlib.h>
 #include <string.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "dam_break.h"
 
 #include <math.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* The dam-break case of Martin & Moyce (1952), shared by the validation test
  * (tests/validation/test_dam_break.c) and the speed-accuracy benchmark (bench/speed_accuracy.c).
  * Plain C on the public API only, no test framework, so a benchmark can link it (part of

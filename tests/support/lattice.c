@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* FCC lattices: the points of a ball (those of sph_world_fill_sphere) and a box tiled exactly. */
 #include <math.h>
 #include <stdlib.h>

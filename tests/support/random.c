@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* xorshift64* (Vigna 2016): a small generator whose sequence is the same on every platform, so
  * that every run builds the same scene. */
 #include "support.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* The rest sphere: an FCC ball at rest density in a world of its own, with random velocities. */
 #include <stdlib.h>
 

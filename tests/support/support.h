@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* tests/support: the scenes and helpers that the tests, the benchmarks and the samples share, so
  * each is written once: the test backend switch, a deterministic random generator, FCC lattices
  * (a ball, a box tiled exactly), a world from a def and params, spawning, reading attributes in

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* The closed tank (an inverted box collider) and the dam break: a column of water in it. */
 #include "support.h"
 

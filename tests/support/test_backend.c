@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* The backend of the tests' contexts (SPH_TEST_BACKEND) and backends named on a command line. */
 #include <stdio.h>
 #include <stdlib.h>

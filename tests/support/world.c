@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* A context and a world from a def and params, and particles spawned into it. */
 #include <stdlib.h>
 #include <string.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The boundary density's map (src/physics/boundary_map.h) and sampling (boundary_density.h)
 // against brute force: the share Phi(x) = int over the solid of W_spiky(|x - y|, h) dy of a ball
 // and of a plane, by a 1D integral over r of W(r) times the solid's share of the sphere of

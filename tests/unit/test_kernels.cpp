@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The smoothing kernels of src/physics/kernels.h: each W integrates to 1 over the ball of
 // radius h, vanishes outside it, and the gradient and Laplacian functions the solver uses are
 // the derivatives of the kernel value functions (central finite differences).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CPU neighbour grid (src/cpu/cpu_neighbor_grid.h) walked by the shared 27-cell search
 // (src/physics/neighbor_walk.h) finds, for every particle, exactly the particles a brute-force
 // O(n^2) search finds within the kernel radius: around the origin, at negative coordinates,

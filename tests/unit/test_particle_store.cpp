@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The per-particle array registry (src/core/particle_arrays.h) as the CPU backend's store
 // (src/cpu/cpu_particle_store.h) applies it: each role gets its bookkeeping and nothing more
 // (a permutation moves Sorted and Carried arrays and leaves Scratch ones; the rollback snapshot

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Closed box: the total energy of water sloshing in a closed tank never grows by more than
  * 0.5 %, and, without gravity, momentum drifts only at float round-off.
  *

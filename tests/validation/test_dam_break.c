@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Dam break against Martin & Moyce (1952): the surge front's mean error <= 8 % and worst point
  * <= 15 % over T in [0.8, 3.3], after at most one fitted time shift |dT| <= 0.2, which the
  * test reports. The case itself (tank, slab, equation of state, front) is dam_break.c; why each

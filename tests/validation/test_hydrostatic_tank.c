@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Hydrostatic tank: water at rest in a closed box under gravity. The interior pressure must
  * follow the exact equilibrium of the equation of state in use within 3 %, and no particle may
  * cross the floor.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* The thesis's rest sphere (its Figure 8 benchmark; ../shared/BENCHMARK.md case 1): an FCC ball
  * at rest density, no gravity, no colliders, water defaults, the default kernel radius, 100
  * frames at 25 frames/s with dt_max = 1 ms.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "validation_util.h"
 
 #include <stdio.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Helpers of the validation cases (tests/validation): the resolution switch between CI and the
  * full run and where results go. Their scenes (lattices, the tank, the rest sphere, the
  * Martin & Moyce dam break) are tests/support's. They drive the library through the C API only. */

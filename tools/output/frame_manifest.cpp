@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "frame_manifest.h"
 
 #include <fcntl.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The manifest: what a run committed to its output directory, "sph-run-manifest.jsonl"
 // (docs/cli.md). JSON Lines: a header line, then for every frame a "writing" line before its
 // files are moved into place and a "complete" line once all of them are; readers trust a

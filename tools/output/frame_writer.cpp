@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "frame_writer.h"
 
 #include <chrono>
@@ -70,6 +71,8 @@ const char* format_extension(OutputFormat format) {
       return "vdb";
     case OutputFormat::kPly:
       return "ply";
+    case OutputFormat::kVtp:
+      return "vtp";
     default:
       return "csv";
   }
@@ -98,6 +101,7 @@ std::string FrameWriter::path(const char* prefix, uint32_t frame, const char* ex
 void FrameWriter::write(const SceneRuntime& runtime, const ParticleFrame& frame) {
   StagedFrame staged(*staging_);
   times_ = FrameWriteTimes{};
+  std::vector<SeriesEntry> series = vtp_series_;  // kept only if the frame is committed
   auto start = std::chrono::steady_clock::now();
   for (OutputFormat format : options_.formats) {
     const std::string file = staged.add(name("fluid", frame.frame, format_extension(format)));
@@ -107,6 +111,12 @@ void FrameWriter::write(const SceneRuntime& runtime, const ParticleFrame& frame)
         break;
       case OutputFormat::kPly:
         write_ply(frame, file);
+        break;
+      case OutputFormat::kVtp:
+        write_vtp(frame, file);
+        // The series so far, this frame included, committed with the frame.
+        series.push_back({name("fluid", frame.frame, "vtp"), frame.time});
+        write_pvd(series, staged.add(kSeriesName));
         break;
       case OutputFormat::kVdb:
 #ifdef SPH_TOOLS_HAVE_OPENVDB
@@ -129,13 +139,14 @@ void FrameWriter::write(const SceneRuntime& runtime, const ParticleFrame& frame)
   if (preview_) {
     const bool draw_surface = options_.surface && options_.preview_surface;
     preview_->render(runtime, frame.position.data(), frame.velocity.data(), frame.count,
-                     draw_surface ? &mesh_ : nullptr, &image_);
+                     draw_surface ? &mesh_ : nullptr, frame.frame, frame.time, &image_);
     NewFile png(staged.add(name("preview", frame.frame, "png")));
     write_png(image_, png.get(), png.path());
     png.close();
   }
   times_.preview_ms = ms_since(start);
   staged.commit(*manifest_, frame.frame, frame.time);
+  vtp_series_ = std::move(series);
 }
 
 std::string FrameWriter::write_preview_video(float fps) {

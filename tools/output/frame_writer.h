@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // FrameWriter: every file of one frame (particles in the chosen formats, the surface, the
 // preview image), written in the run's private staging directory, then moved into the output
 // directory between a "writing" and a "complete" line of the run's manifest, which is what
@@ -15,6 +16,7 @@
 #include "scene_desc.h"
 #include "scene_runtime.h"
 #include "surface_mesh.h"
+#include "writers.h"
 
 namespace sph_tools {
 
@@ -66,6 +68,7 @@ class FrameWriter {
   SurfaceMesh mesh_;
   Image image_;
   FrameWriteTimes times_;
+  std::vector<SeriesEntry> vtp_series_;  // the committed .vtp frames, for fluid.pvd
 };
 
 }  // namespace sph_tools

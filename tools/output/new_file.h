@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // NewFile: a file that must not exist yet, for one of a frame's outputs. Created with
 // O_CREAT | O_EXCL | O_NOFOLLOW, so it is never an existing file nor the target of a link that
 // someone planted, and closed with its write errors reported (a full disk, or a file size

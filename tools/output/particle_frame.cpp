@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "particle_frame.h"
 
 #include "library_error.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // ParticleFrame: one frame's particle arrays, copied out of a world with
 // sph_world_copy_attribute, in the world's order (match particles by id between frames).
 #ifndef SPH_TOOLS_PARTICLE_FRAME_H

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "staging.h"
 
 #include <dirent.h>
@@ -56,13 +57,13 @@ bool empty_and_remove(const std::string& dir) {
 }  // namespace
 
 bool is_output_name(const std::string& name) {
-  if (name == "preview.mp4") return true;
+  if (name == "preview.mp4" || name == kSeriesName) return true;
   struct Kind {
     const char* prefix;
     std::vector<const char*> extensions;
   };
   static const Kind kinds[] = {
-      {"fluid_", {".vdb", ".ply", ".csv"}}, {"surface_", {".vdb", ".obj"}}, {"preview_", {".png"}}};
+      {"fluid_", {".vdb", ".ply", ".csv", ".vtp"}}, {"surface_", {".vdb", ".obj"}}, {"preview_", {".png"}}};
   for (const Kind& kind : kinds) {
     const size_t p = std::strlen(kind.prefix);
     if (name.compare(0, p, kind.prefix) != 0) continue;

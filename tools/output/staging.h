@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Where a frame's files are written before they are committed: a private directory inside the
 // output directory, made by mkdtemp (".sph-run-XXXXXX": an unpredictable name, created
 // exclusively with mode 0700, so nobody else can plant a file or a link in it), locked with
@@ -11,12 +12,14 @@
 namespace sph_tools {
 
 // Whether `name` is one of sph-run's own output file names: "fluid_NNNN.vdb|ply|csv",
-// "surface_NNNN.vdb|obj", "preview_NNNN.png" (at least four digits) or "preview.mp4". Nothing
-// else in an output directory is ever removed or replaced by sph-run but its manifest.
+// "surface_NNNN.vdb|obj", "preview_NNNN.png" (at least four digits), "fluid_NNNN.vtp", "fluid.pvd" or
+// "preview.mp4". Nothing else in an output directory is ever removed or replaced by sph-run but its manifest.
 bool is_output_name(const std::string& name);
 
 // The manifest of the run that last wrote to an output directory (frame_manifest.h).
 constexpr const char* kManifestName = "sph-run-manifest.jsonl";
+// The ParaView time series of the .vtp frames, rewritten with each frame.
+constexpr const char* kSeriesName = "fluid.pvd";
 
 class StagingDirectory {
  public:

@@ -1,5 +1,7 @@
+// SPDX-License-Identifier: MIT
 // The fluid surface: particles rasterised into a narrow-band level set with OpenVDB's
-// ParticlesToLevelSet, smoothed, written as .vdb, and meshed with volumeToMesh into an OBJ.
+// ParticlesToLevelSet, smoothed, written as .vdb, and meshed with volumeToMesh into an OBJ
+// (write_obj.cpp).
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetFilter.h>
 #include <openvdb/tools/ParticlesToLevelSet.h>
@@ -39,19 +41,6 @@ class ParticleList {
   const ParticleFrame& f_;
   double radius_;
 };
-
-void write_obj(const SurfaceMesh& mesh, const ParticleFrame& f, const std::string& path) {
-  NewFile file(path);
-  std::FILE* out = file.get();
-  std::fprintf(out, "# sph-run fluid surface, frame %u, time %.9g s, %zu vertices, %zu triangles\n", f.frame,
-               f.time, mesh.vertices.size() / 3, mesh.triangles.size() / 3);
-  for (size_t i = 0; i < mesh.vertices.size(); i += 3)
-    std::fprintf(out, "v %.7g %.7g %.7g\n", mesh.vertices[i], mesh.vertices[i + 1], mesh.vertices[i + 2]);
-  for (size_t i = 0; i < mesh.triangles.size(); i += 3)
-    std::fprintf(out, "f %u %u %u\n", mesh.triangles[i] + 1, mesh.triangles[i + 1] + 1,
-                 mesh.triangles[i + 2] + 1);
-  file.close();
-}
 
 }  // namespace
 
@@ -94,7 +83,7 @@ void write_surface(const ParticleFrame& f, float radius, float voxel, const std:
   for (const openvdb::Vec3I& t : triangles) mesh->triangles.insert(mesh->triangles.end(), {t[2], t[1], t[0]});
   for (const openvdb::Vec4I& q : quads)
     mesh->triangles.insert(mesh->triangles.end(), {q[2], q[1], q[0], q[3], q[2], q[0]});
-  write_obj(*mesh, f, obj_path);
+  write_obj(*mesh, f.frame, f.time, obj_path);
 }
 
 }  // namespace sph_tools

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "vdb_bounds.h"
 
 #ifdef SPH_TOOLS_HAVE_OPENVDB

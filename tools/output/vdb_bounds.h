@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The extent of the level sets that scene files load from .vdb files, read with OpenVDB, for
 // the preview (the C API's SDF assets do not tell their extent).
 #ifndef SPH_TOOLS_VDB_BOUNDS_H

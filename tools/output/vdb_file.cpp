@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "vdb_file.h"
 
 #include <cerrno>

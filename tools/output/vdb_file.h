@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Writing a .vdb file whose every byte is checked. openvdb::io::File::write() does not look at
 // its stream after writing: a full disk or a file size limit (EFBIG) left a truncated file
 // that it reported as written. This writes the same file (OpenVDB's seekable archive format,

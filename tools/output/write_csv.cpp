@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // CSV frames: a header line and one particle per line.
 #include <cerrno>
 #include <cstdio>

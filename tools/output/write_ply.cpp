@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // PLY frames: binary little-endian, one vertex element per particle.
 #include <cerrno>
 #include <cstdio>

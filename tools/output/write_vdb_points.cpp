@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // VDB points frames through OpenVDB's point data grids.
 #include <openvdb/openvdb.h>
 #include <openvdb/points/PointAttribute.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A pinhole camera for the preview: world points to pixels and pixels to rays.
 #ifndef SPH_TOOLS_CAMERA_H
 #define SPH_TOOLS_CAMERA_H

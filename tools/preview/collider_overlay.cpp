@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "collider_overlay.h"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Colliders drawn as faint glass: each collider's SDF is sampled once into a local grid
 // (through sph_sdf_sample), and every pixel's ray records where it crosses the zero level set.
 // Crossings in front of the fluid are blended over it, brighter where the surface is seen

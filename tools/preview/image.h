@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The preview's frame buffer: linear RGB in [0, 1] and a depth per pixel.
 #ifndef SPH_TOOLS_IMAGE_H
 #define SPH_TOOLS_IMAGE_H

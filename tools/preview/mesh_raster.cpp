@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "mesh_raster.h"
 
 #include <algorithm>

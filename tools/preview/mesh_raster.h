@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A triangle mesh (the fluid surface) drawn with a depth buffer and smooth normals.
 #ifndef SPH_TOOLS_MESH_RASTER_H
 #define SPH_TOOLS_MESH_RASTER_H

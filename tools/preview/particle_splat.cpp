@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "particle_splat.h"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Particles drawn as shaded spheres (screen-space splats with a per-pixel sphere depth),
 // coloured by speed and faded with depth.
 #ifndef SPH_TOOLS_PARTICLE_SPLAT_H

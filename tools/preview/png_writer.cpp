@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // PNG files through libpng (in builds that found it).
 #ifdef SPH_TOOLS_HAVE_PNG
 #include <png.h>

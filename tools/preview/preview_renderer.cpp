@@ -1,8 +1,10 @@
+// SPDX-License-Identifier: MIT
 #include "preview_renderer.h"
 
 #include <algorithm>
 #include <cmath>
 
+#include "frame_caption.h"
 #include "geometry.h"
 #include "mesh_raster.h"
 #include "particle_splat.h"
@@ -55,7 +57,8 @@ void PreviewRenderer::setup_camera(const float* positions, uint32_t count) {
 }
 
 void PreviewRenderer::render(const SceneRuntime& runtime, const float* positions, const float* velocities,
-                             uint32_t count, const SurfaceMesh* mesh, Image* image) {
+                             uint32_t count, const SurfaceMesh* mesh, uint32_t frame, double time,
+                             Image* image) {
   if (!camera_ready_) setup_camera(positions, count);
   const auto& colliders = runtime.colliders();
   if (!overlay_ready_) {
@@ -98,6 +101,13 @@ void PreviewRenderer::render(const SceneRuntime& runtime, const float* positions
     overlay_.trace(camera_, poses);
     overlay_.composite(image);
   }
+  FrameCaption caption;
+  caption.frame = frame;
+  caption.time = time;
+  caption.particles = count;
+  caption.speed_legend = mesh == nullptr;
+  caption.speed_max = speed_max_;
+  draw_caption(caption, image);
 }
 
 }  // namespace sph_tools

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The headless preview: each frame's particles (or the fluid surface) drawn on the CPU with
 // the colliders as faint glass, from the scene's camera or one that frames the scene.
 #ifndef SPH_TOOLS_PREVIEW_RENDERER_H
@@ -20,9 +21,10 @@ class PreviewRenderer {
   explicit PreviewRenderer(const SceneRuntime& runtime);
 
   // Draws one frame. positions/velocities: 3 floats per particle. With a mesh, the surface is
-  // drawn instead of the particles.
+  // drawn instead of the particles. The caption gives the frame's number and time (s), the
+  // particle count and, for particles, the speed legend.
   void render(const SceneRuntime& runtime, const float* positions, const float* velocities, uint32_t count,
-              const SurfaceMesh* mesh, Image* image);
+              const SurfaceMesh* mesh, uint32_t frame, double time, Image* image);
 
   const Camera& camera() const { return camera_; }
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The box a preview frames: what the scene file places, before any particle moves.
 #include "geometry.h"
 #include "preview_renderer.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Colours and lighting of the preview: the speed colour ramp, the light, the background and
 // the depth fade shared by particles and surfaces.
 #ifndef SPH_TOOLS_SHADING_H

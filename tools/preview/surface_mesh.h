@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A triangle mesh of the fluid surface (from the level set), shared by the OBJ writer and the
 // preview renderer.
 #ifndef SPH_TOOLS_SURFACE_MESH_H

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "video.h"
 
 #include <spawn.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // An MP4 of the preview frames through the ffmpeg program, when it is on PATH.
 #ifndef SPH_TOOLS_VIDEO_H
 #define SPH_TOOLS_VIDEO_H

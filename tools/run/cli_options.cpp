@@ -1,5 +1,7 @@
+// SPDX-License-Identifier: MIT
 #include "cli_options.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -17,10 +19,11 @@ const char* usage_text() {
          "  --backend B         auto | cpu | cuda (default auto: CUDA when a GPU is present)\n"
          "  --out DIR           output directory (default: the scene's output.directory,\n"
          "                      else out/<scene file name>)\n"
-         "  --format F          vdb | ply | csv | none; several as vdb,ply (default: the scene's,\n"
+         "  --format F          vdb | ply | csv | vtp | none; several as vdb,vtp (default: the scene's,\n"
          "                      else vdb; ply in builds without OpenVDB)\n"
          "  --surface           also write the fluid surface: level set (.vdb) and mesh (.obj)\n"
          "  --preview           draw every frame to PNG, and an MP4 when ffmpeg is on PATH\n"
+         "  --preview-style S   particles | surface (implies --preview; surface needs --surface)\n"
          "  --threads N         CPU backend threads (default: all)\n"
          "  --quiet             no progress, only warnings, errors and the summary\n"
          "  --stats-json FILE   also write the summary's figures to FILE as JSON (benchmarks)\n"
@@ -33,6 +36,44 @@ const char* usage_text() {
 }
 
 namespace {
+
+const char* const kOptions[] = {"--frames",  "--backend",    "--out",           "--format",
+                                "--surface", "--preview",    "--preview-style", "--threads",
+                                "--quiet",   "--stats-json", "--version",       "--help"};
+
+// Levenshtein distance: the number of single-character edits between a and b.
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// "unknown option --frame (did you mean --frames?)": the closest option within a third of its
+// length (at least two edits), so a typo is named and a wholly foreign word is not matched.
+std::string unknown_option_message(const std::string& arg) {
+  std::string best;
+  size_t best_distance = std::numeric_limits<size_t>::max();
+  const std::string dashed = arg.rfind("--", 0) == 0 ? arg : "-" + arg;
+  for (const char* option : kOptions) {
+    const size_t d = edit_distance(dashed, option);
+    if (d < best_distance) {
+      best_distance = d;
+      best = option;
+    }
+  }
+  std::string message = "unknown option " + arg;
+  if (best_distance <= std::max<size_t>(2, best.size() / 3)) message += " (did you mean " + best + "?)";
+  return message;
+}
 
 uint32_t parse_count(const std::string& option, const char* text, uint32_t lo, uint32_t hi) {
   char* end = nullptr;
@@ -58,8 +99,11 @@ std::vector<OutputFormat> parse_formats(const char* text) {
       formats.push_back(OutputFormat::kPly);
     else if (f == "csv")
       formats.push_back(OutputFormat::kCsv);
+    else if (f == "vtp")
+      formats.push_back(OutputFormat::kVtp);
     else
-      throw UsageError("--format: expected vdb, ply, csv or none (several as vdb,ply), got \"" + all + "\"");
+      throw UsageError("--format: expected vdb, ply, csv, vtp or none (several as vtp,ply), got \"" + all +
+                       "\"");
     if (comma == std::string::npos) break;
     start = comma + 1;
   }
@@ -119,6 +163,12 @@ CliOptions parse_cli(int argc, char** argv) {
     } else if (arg == "--preview") {
       no_value();
       o.preview = true;
+    } else if (arg == "--preview-style") {
+      const std::string style = next();
+      if (style != "particles" && style != "surface")
+        throw UsageError("--preview-style: expected particles or surface, got \"" + style + "\"");
+      o.preview = true;
+      o.preview_surface = style == "surface";
     } else if (arg == "--threads") {
       o.threads = parse_count(arg, next(), 1, 4096);
     } else if (arg == "--quiet") {
@@ -128,7 +178,7 @@ CliOptions parse_cli(int argc, char** argv) {
       o.stats_json = next();
       if (o.stats_json->empty()) throw UsageError("--stats-json: expected a file name");
     } else if (arg.size() > 1 && arg[0] == '-') {
-      throw UsageError("unknown option " + arg);
+      throw UsageError(unknown_option_message(arg));
     } else if (o.scene.empty()) {
       o.scene = arg;
     } else {

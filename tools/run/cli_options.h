@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sph-run's command line.
 #ifndef SPH_TOOLS_CLI_OPTIONS_H
 #define SPH_TOOLS_CLI_OPTIONS_H
@@ -20,6 +21,7 @@ struct CliOptions {
   std::optional<std::vector<OutputFormat>> formats;  // set and empty: "--format none"
   bool surface = false;
   bool preview = false;
+  std::optional<bool> preview_surface;  // --preview-style: true for surface, false for particles
   uint32_t threads = 0;
   bool quiet = false;
   std::optional<std::string> stats_json;  // --stats-json FILE: the run's figures, machine-readable
@@ -32,7 +34,8 @@ class UsageError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Throws UsageError naming the offending argument.
+// Throws UsageError naming the offending argument (and, for an unknown option, the nearest
+// known one).
 CliOptions parse_cli(int argc, char** argv);
 const char* usage_text();
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sph-run's exit codes (docs/cli.md lists them for users).
 #ifndef SPH_TOOLS_EXIT_CODES_H
 #define SPH_TOOLS_EXIT_CODES_H

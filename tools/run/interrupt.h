@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Ctrl-C and SIGTERM: the first asks the run to stop after the frame in progress is complete
 // (or discarded); the second ends the process at once.
 #ifndef SPH_TOOLS_INTERRUPT_H

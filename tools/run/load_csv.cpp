@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "load_csv.h"
 
 #include <cctype>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The colliders' loads as CSV files, one per collider that asks for them in the scene file
 // ("loads": {...}): <output>/loads_<index>[_<name>].csv, a row per frame (docs/cli.md).
 #ifndef SPH_TOOLS_RUN_LOAD_CSV_H

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sph-run: runs a scene file and writes its frames (docs/cli.md).
 #include <csignal>
 #include <cstdio>
@@ -42,7 +43,7 @@ int run(int argc, char** argv) {
   try {
     cli = parse_cli(argc, argv);
   } catch (const UsageError& e) {
-    std::fprintf(stderr, "sph-run: %s\n\n%s", e.what(), usage_text());
+    std::fprintf(stderr, "sph-run: %s\n  (sph-run --help lists the options)\n", e.what());
     return kExitUsage;
   }
   if (cli.help) {
@@ -51,9 +52,9 @@ int run(int argc, char** argv) {
   }
   if (cli.version) {
     std::printf("sph-run, %s\n", sph_get_build_info());
-    std::printf("outputs: csv, ply%s%s%s\n", format_available(OutputFormat::kVdb) ? ", vdb" : "",
-                surface_available() ? ", surfaces (vdb + obj)" : "",
-                png_available() ? ", preview (png)" : "");
+    std::printf(
+        "outputs: csv, ply, vtp (+ fluid.pvd)%s%s%s\n", format_available(OutputFormat::kVdb) ? ", vdb" : "",
+        surface_available() ? ", surfaces (vdb + obj)" : "", png_available() ? ", preview (png)" : "");
     return kExitOk;
   }
 
@@ -91,7 +92,10 @@ int run(int argc, char** argv) {
     return fail(kExitUnavailable,
                 std::string(cli.preview ? "--preview" : "output.preview") +
                     ": preview images need libpng, which this build lacks (install libpng-dev)");
-  out.preview_surface = scene.output.preview_surface;
+  out.preview_surface = cli.preview_surface ? *cli.preview_surface : scene.output.preview_surface;
+  if (cli.preview_surface.value_or(false) && !out.surface)
+    return fail(kExitUsage,
+                "--preview-style surface: draws the surface mesh, so it needs --surface (or output.surface)");
   const float spacing = scene.world.particle_spacing;
   out.surface_radius = scene.output.surface_radius > 0.0f ? scene.output.surface_radius : spacing;
   out.surface_voxel = scene.output.surface_voxel > 0.0f ? scene.output.surface_voxel : 0.5f * spacing;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Progress of a run: a one-line bar redrawn in place on a terminal, plain lines otherwise.
 #ifndef SPH_TOOLS_PROGRESS_H
 #define SPH_TOOLS_PROGRESS_H

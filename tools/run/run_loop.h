@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The run itself: a built scene stepped frame by frame, every frame written, progress shown,
 // the summary printed at the end.
 #ifndef SPH_TOOLS_RUN_LOOP_H

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // What a run did, gathered frame by frame from sph_stats and printed when it ends.
 #ifndef SPH_TOOLS_RUN_STATS_H
 #define SPH_TOOLS_RUN_STATS_H

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Small vector and quaternion helpers on the C API's types (sph_vec3, sph_quat, sph_transform).
 #ifndef SPH_TOOLS_GEOMETRY_H
 #define SPH_TOOLS_GEOMETRY_H

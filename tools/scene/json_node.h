@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // JsonNode: one value of a scene file together with its path, and the checks every field of
 // the schema goes through. A failed check throws SceneError naming the path and what was
 // expected ("colliders[2].shape.radius: expected a positive number, got -1").

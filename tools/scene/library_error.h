@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // LibraryError: a call of the sph C API that failed outside any one scene object (creating the
 // context or world, stepping), with its result code and the library's message.
 #ifndef SPH_TOOLS_LIBRARY_ERROR_H

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "mesh_file.h"
 
 #include <sys/stat.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Triangle meshes from files for mesh shapes: Wavefront OBJ (v and f records; polygons are
 // fanned into triangles; other records ignored) and STL (binary, or ASCII "solid ... facet
 // ... vertex"), chosen by the file's extension.

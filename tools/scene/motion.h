@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Motion: a pose over time from keyframes, sampled once per frame and handed to the library
 // as the next target transform (sph_collider_set_target_transform).
 #ifndef SPH_TOOLS_MOTION_H

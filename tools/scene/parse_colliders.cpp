@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Colliders: a shape placed in the world, its material and its keyframed motion.
 #include "parse_parts.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Fluid bodies: boxes and spheres filled on the lattice, or explicit particles, each added at
 // its time.
 #include "parse_parts.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Force fields: uniform, radial and vortex accelerations, optionally within a region.
 #include "parse_parts.h"
 

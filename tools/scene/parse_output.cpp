@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Output settings: where frames go, in which formats, the surface and the preview images.
 #include "parse_parts.h"
 #include "scene_error.h"
@@ -7,11 +8,13 @@ namespace sph_tools {
 namespace {
 
 OutputFormat parse_format(const JsonNode& node) {
-  switch (node.choice({"vdb", "ply", "csv"})) {
+  switch (node.choice({"vdb", "ply", "csv", "vtp"})) {
     case 0:
       return OutputFormat::kVdb;
     case 1:
       return OutputFormat::kPly;
+    case 3:
+      return OutputFormat::kVtp;
     default:
       return OutputFormat::kCsv;
   }

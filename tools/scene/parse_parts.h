@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The parsers of each part of a scene file (one file each). Every parser validates what it
 // reads and throws SceneError with the field's path; scene_parser.cpp puts them together.
 #ifndef SPH_TOOLS_PARSE_PARTS_H

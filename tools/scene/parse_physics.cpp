@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The physics methods and their parameters, read through the library's description of them
 // (sph_get_physics_method_info, sph_params_get_info, sph_params_get_field_info): a method the
 // library adds needs no code here. Values are checked for their JSON type only; their ranges

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Shapes of a scene file: the library's analytic shapes, a level set from a .vdb file, or a
 // triangle mesh from an .obj or .stl file.
 #include "mesh_file.h"

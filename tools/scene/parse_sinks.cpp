@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Sinks: a region, or everything outside a box, where particles are removed.
 #include "parse_parts.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Sources: a region filled with particles once or continuously, between start and stop.
 #include "parse_parts.h"
 

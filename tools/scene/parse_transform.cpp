@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Rotations, transforms and keyframed motion of a scene file.
 #include <cmath>
 

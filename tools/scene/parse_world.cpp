@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The world (creation-time settings and the methods it runs), its runtime parameters and the
 // run's timing.
 #include <limits>

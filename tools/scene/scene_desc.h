@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The scene a scene file describes, parsed and validated but not yet built: plain values that
 // map one to one onto the public C API's descriptions (see docs/scenes.md for the file format).
 #ifndef SPH_TOOLS_SCENE_DESC_H
@@ -105,7 +106,7 @@ struct PhysicsDesc {
   std::string path;                  // "physics.tait"
 };
 
-enum class OutputFormat { kVdb, kPly, kCsv };
+enum class OutputFormat { kVdb, kPly, kCsv, kVtp };
 
 struct CameraDesc {
   bool automatic = true;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // SceneError: a scene file that cannot be used, with the path of the offending field
 // ("colliders[2].shape.radius") and what was expected there.
 #ifndef SPH_TOOLS_SCENE_ERROR_H

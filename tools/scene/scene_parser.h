@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Reading a scene file: JSON text to a validated SceneDesc (docs/scenes.md is the schema).
 #ifndef SPH_TOOLS_SCENE_PARSER_H
 #define SPH_TOOLS_SCENE_PARSER_H

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "scene_runtime.h"
 
 #include "library_error.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // SceneRuntime: a SceneDesc built into a world through the public C API, and stepped frame by
 // frame with its schedule (fluid bodies and sources that start later, sources and fields that
 // stop, keyframed motion sent as target transforms).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "sdf_factory.h"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Turning a ShapeDesc into an SDF asset of a context: sph_sdf_create_shape for analytic shapes,
 // sph_vdb_load_sdf for .vdb level sets (when the tools are built with OpenVDB),
 // sph_sdf_create_from_mesh for .obj and .stl meshes.

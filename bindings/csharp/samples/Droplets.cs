@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Droplets.cs - two water droplets collide head-on in zero gravity (the scene of samples/demo.c),
 // driven from C# through the sph bindings. Prints a line every 10 frames.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // SphTests.cs - tests of the C# bindings, with a tiny runner (no NuGet: mcs + mono only).
 //
 //   mcs -target:library -out:Sph.dll ../Sph.Generated.cs ../Sph.cs

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """A dam break in a tank, simulated with sph from Python and plotted with matplotlib.
 
     SPH_LIBRARY=build/libsph.so python3 bindings/python/examples/dam_break.py [--out dam_break.png]
@@ -22,8 +23,11 @@ import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-import sph  # noqa: E402
+try:
+    import sph  # an installed package (pip install bindings/python, or the wheel)
+except ImportError:  # else the checkout's, beside this folder
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+    import sph  # noqa: E402
 
 TANK = (0.8, 0.6, 0.1)  # inside: x in [0, 0.8], y in [0, 0.6] (open top), z in [0, 0.1]
 COLUMN = ((0.0, 0.0, 0.0), (0.2, 0.35, 0.1))

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Two-way coupling from Python: a wooden box (500 kg/m^3) dropped onto water floats.
 
     SPH_LIBRARY=build/libsph.so python3 bindings/python/examples/floating_box.py [--seconds 3]

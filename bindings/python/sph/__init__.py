@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """sph: Python bindings of the sph SPH fluid library (ctypes + numpy, no compiler needed).
 
     import sph

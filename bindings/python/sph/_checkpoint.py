@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Checkpoints: a world's whole state as bytes or a file (sph_world_save, _save_file,
 sph_world_load, _load_file, sph_world_restore). docs/checkpoint.md describes the format."""
 import ctypes

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Context and World: the Pythonic layer over the generated ctypes declarations."""
 import ctypes
 import re

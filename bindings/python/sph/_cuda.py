@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """The zero-copy CUDA tier (sph_cuda.h): a CUDA world's particles where they live on the GPU."""
 import ctypes
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """SphError: a failed sph_ call, with its sph_result code and the library's message."""
 from . import _generated as _g
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Finding and loading the sph shared library, and checking that it matches these bindings.
 
 Search order:

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Optional physics (docs/physics.md): feature bits, step limits, and the parameters of the
 options a world turned on at creation.
 

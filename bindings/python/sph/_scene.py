@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """SDF assets and the objects placed in a world: colliders, sources, sinks, force fields."""
 import ctypes
 import os

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Base classes of the generated ctypes structs and opaque types."""
 import ctypes
 import enum

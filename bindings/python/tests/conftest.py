@@ -1,7 +1,10 @@
+# SPDX-License-Identifier: MIT
 """Test set-up: imports the package from this checkout, counts the C functions the tests reach.
 
 Run from the repository root with the library to test in SPH_LIBRARY:
     SPH_LIBRARY=build/libsph.so python3 -m pytest -q bindings/python/tests
+With SPH_TEST_INSTALLED=1 the tests import the installed package instead (the wheel check,
+bindings/python/check_wheel.sh) and test_installed.py checks that they did.
 """
 import collections
 import os
@@ -10,7 +13,8 @@ import sys
 import pytest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(HERE))  # bindings/python
+if os.environ.get("SPH_TEST_INSTALLED") != "1":
+    sys.path.insert(0, os.path.dirname(HERE))  # bindings/python
 
 import sph  # noqa: E402
 from sph import _loader  # noqa: E402

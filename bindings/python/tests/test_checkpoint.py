@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Checkpoints: save/load through bytes and files, bitwise continuation, restore, refusals."""
 import ctypes
 import os

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Contexts: creation, backend, errors with the right sph_result, closing, logging."""
 import pytest
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """The zero-copy CUDA tier on a real GPU (skipped without a CUDA build and device).
 
 Device memory is read back through the CUDA runtime (libcudart, loaded with ctypes) and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """The example runs (coarse and short) and writes its plot."""
 import os
 import subprocess

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Hostile use of the Python binding (issue 23, item 2): array shapes the library would read
 past, and integers ctypes would wrap silently into C's fixed-width types. Part of the
 hostile-input suite (the C side is ctest label `hostile`; this file is collected by name)."""

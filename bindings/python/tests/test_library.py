@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Library-wide calls: versions, result strings, the last error, live objects."""
 import pytest
 

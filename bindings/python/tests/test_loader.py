@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Loading the library: search order, ABI version, exported functions, struct layouts."""
 import ctypes
 import ctypes.util

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Optional physics: world def options, feature and step-limit flags, the option parameter
 structs (round trips, validation, ERROR_FEATURE_DISABLED when the option is off)."""
 import ctypes

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """SDF assets, colliders, sources, sinks, force fields and events."""
 import ctypes
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """The generated structs: defaults from the library, keyword construction, conversions."""
 import ctypes
 

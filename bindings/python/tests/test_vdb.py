@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """SDF assets from OpenVDB files (the optional helper library libsph_vdb)."""
 import pytest
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Worlds: defs, params, spawning from numpy, fills, stepping, reading back, stats, errors."""
 import ctypes
 

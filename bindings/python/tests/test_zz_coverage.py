@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """The bindings cover the whole C API: every exported function is wrapped and was called."""
 import glob
 import os
