@@ -14,7 +14,23 @@ __global__ void boundary_map_kernel(SdfGridView sdf, Affine3x4 index_to_local, f
   const int32_t i = static_cast<int32_t>(v % static_cast<uint64_t>(sdf.nx));
   const int32_t j = static_cast<int32_t>(row % static_cast<uint64_t>(sdf.ny));
   const int32_t k = static_cast<int32_t>(row / static_cast<uint64_t>(sdf.ny));
-  map[v] = boundary_map_correction(sdf, index_to_local, i, j, k, h, level);
+  map[v] = Float4{boundary_map_correction(sdf, index_to_local, i, j, k, h, level), 0.0f, 0.0f, 0.0f};
+}
+
+// After boundary_map_kernel (every value in place): each voxel's slopes from its neighbours'
+// values, written to its own gradient channels only.
+__global__ void boundary_map_slope_kernel(SdfGridView sdf, float h, float level, Float4* map,
+                                          uint64_t voxels) {
+  const uint64_t v = static_cast<uint64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (v >= voxels) return;
+  const uint64_t row = v / static_cast<uint64_t>(sdf.nx);
+  const int32_t i = static_cast<int32_t>(v % static_cast<uint64_t>(sdf.nx));
+  const int32_t j = static_cast<int32_t>(row % static_cast<uint64_t>(sdf.ny));
+  const int32_t k = static_cast<int32_t>(row / static_cast<uint64_t>(sdf.ny));
+  const Vec3 s = boundary_map_slope(sdf, map, i, j, k, h, level);
+  map[v].y = s.x;
+  map[v].z = s.y;
+  map[v].w = s.z;
 }
 
 }  // namespace
@@ -32,6 +48,8 @@ const Float4* DeviceBoundaryMaps::bind(const SdfAsset& asset, const SdfGridView&
     boundary_map_kernel<<<blocks, threads, 0, stream>>>(sdf, asset.index_to_local(), h, level,
                                                         e.correction.get(), voxels);
     check_launch("boundary_map_kernel");
+    boundary_map_slope_kernel<<<blocks, threads, 0, stream>>>(sdf, h, level, e.correction.get(), voxels);
+    check_launch("boundary_map_slope_kernel");
     e.kernel_radius = h;
     e.version = asset.version();
   }

@@ -181,8 +181,8 @@ typedef uint32_t sph_feature_flags;
  *  density map per SDF asset, Koschier & Bender 2017, calibrated on the particle lattice), and
  *  the wall pushes back through the pressure force, so particles at a wall no longer read low
  *  density: a resting FCC block from sph_world_fill_box reads rho0 at axis-aligned walls
- *  (77 % without), a settled tank's pressure near its walls is within 19-26 % of rho0 g d at the
- *  default stiffness (40-72 % low without). Edges and corners read high when a lattice is placed
+ *  (77 % without), a settled tank's pressure near its walls is within 3-5 % of rho0 g d at the
+ *  default stiffness (48-77 % low without). Edges and corners read high when a lattice is placed
  *  into them (docs/physics.md). The maps are computed per asset and kernel radius when a collider
  *  first steps with the asset and after sph_sdf_update (16 bytes per SDF voxel; on the device for
  *  CUDA). The collision response stays the no-penetration safeguard. Costs one SDF sample per

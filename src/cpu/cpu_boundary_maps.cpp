@@ -16,8 +16,19 @@ std::vector<Float4> compute_boundary_map(const SdfAsset& asset, float h, float l
   for (int64_t row = 0; row < planes; ++row) {
     const int32_t j = static_cast<int32_t>(row % asset.ny()), k = static_cast<int32_t>(row / asset.ny());
     for (int32_t i = 0; i < asset.nx(); ++i)
-      map[static_cast<size_t>(i) + static_cast<size_t>(asset.nx()) * static_cast<size_t>(row)] =
+      map[static_cast<size_t>(i) + static_cast<size_t>(asset.nx()) * static_cast<size_t>(row)].x =
           boundary_map_correction(g, index_to_local, i, j, k, h, level);
+  }
+  // The slopes from the values: all values are in place before any slope is written, and a slope
+  // writes only its own voxel's gradient channels.
+#pragma omp parallel for num_threads(workers == 0 ? 1u : workers) schedule(static)
+  for (int64_t row = 0; row < planes; ++row) {
+    const int32_t j = static_cast<int32_t>(row % asset.ny()), k = static_cast<int32_t>(row / asset.ny());
+    for (int32_t i = 0; i < asset.nx(); ++i) {
+      const Vec3 s = boundary_map_slope(g, map.data(), i, j, k, h, level);
+      Float4& m = map[static_cast<size_t>(i) + static_cast<size_t>(asset.nx()) * static_cast<size_t>(row)];
+      m.y = s.x, m.z = s.y, m.w = s.z;
+    }
   }
   return map;
 }

@@ -18,12 +18,14 @@
 // Phi is sampled, per collider, as the flat-wall value of the collider's own signed distance
 // plus a correction stored per SDF voxel (boundary_map.h):
 //     Phi(x) = Phi_flat(sigma (phi(x) - L)) + sigma dPhi_L(x),   L = -sigma delta,
-//     grad Phi = Phi_flat'(...) sigma grad phi + sigma d(grad Phi)_L(x),
+//     grad Phi = the exact gradient of that sampled Phi,
 // phi the SDF (trilinear), sigma the collider's sign (-1 for an inverted collider, whose solid is
 // the complement: Phi = 1 - the share of {phi < L}), Phi_flat the closed-form half-space share
-// (boundary_integrals.h), and the correction (trilinear) for the level L what curvature, corners
-// and thin walls add, computed per asset, kernel radius and level by a quadrature over the solid.
-// A flat wall is exact at any voxel size (the trilinear SDF of a plane is the plane).
+// (boundary_integrals.h), and the correction for the level L what curvature, corners and thin
+// walls add, computed per asset, kernel radius and level by a quadrature over the solid (value
+// and gradient per voxel) and interpolated as a cubic Hermite of both. The gradient being that
+// of the sampled value makes the wall's force conservative (local_boundary_share). A flat wall
+// is exact at any voxel size (the trilinear SDF of a plane is the plane).
 //
 // The pressure force of the wall (Akinci et al. 2012 with the wall's share as the boundary
 // "particles"): a_i = -(p_i / rho_i^2) grad rho_b(x_i). It is minus the gradient of the fluid's
@@ -103,10 +105,12 @@ SPH_HD Float4 operator*(const Float4& a, float s) { return Float4{a.x * s, a.y *
 
 SPH_HD BoundaryShare no_boundary_share() { return BoundaryShare{0.0f, Vec3{0.0f, 0.0f, 0.0f}, 0.0f}; }
 
-// The SDF's trilinear value and its gradient (index space) in one cell, from the 8 corners.
+// The trilinear interpolant's value and its exact gradient (index space) in one cell, from the 8
+// corners, with the corners' range.
 struct TrilinearGradient {
   float value;
   Vec3 gradient;  // d/d(index)
+  float lo, hi;   // the smallest and largest corner
 };
 
 SPH_HD TrilinearGradient trilinear_with_gradient(const float* data, const SdfGridView& g,
@@ -127,6 +131,70 @@ SPH_HD TrilinearGradient trilinear_with_gradient(const float* data, const SdfGri
   const float dx00 = c100 - c000, dx10 = c110 - c010, dx01 = c101 - c001, dx11 = c111 - c011;
   out.gradient.x =
       g.nx > 1 ? lerp_value(lerp_value(dx00, dx10, c.fy), lerp_value(dx01, dx11, c.fy), c.fz) : 0.0f;
+  const float corners[8] = {c000, c100, c010, c110, c001, c101, c011, c111};
+  out.lo = out.hi = c000;
+  for (int q = 1; q < 8; ++q) {
+    out.lo = corners[q] < out.lo ? corners[q] : out.lo;
+    out.hi = corners[q] > out.hi ? corners[q] : out.hi;
+  }
+  return out;
+}
+
+// Beyond the grid a sample is the nearest boundary cell's (locate clamps the index): along a
+// clamped axis the interpolant does not change, so its gradient there is zero.
+SPH_HD Vec3 without_clamped_axes(Vec3 gradient_index, const SdfGridView& g, Vec3 idx) {
+  if (!(idx.x >= 0.0f && idx.x <= static_cast<float>(g.nx - 1))) gradient_index.x = 0.0f;
+  if (!(idx.y >= 0.0f && idx.y <= static_cast<float>(g.ny - 1))) gradient_index.y = 0.0f;
+  if (!(idx.z >= 0.0f && idx.z <= static_cast<float>(g.nz - 1))) gradient_index.z = 0.0f;
+  return gradient_index;
+}
+
+// The map's correction in one cell: the tensor-product cubic Hermite interpolant of the corners'
+// values C_o and gradients G_o (index space, as boundary_map.h stores them; the cross derivatives
+// taken as zero),
+//     C(f) = sum_o [prod_a phi_{o_a}(f_a)] C_o + sum_o sum_a psi_{o_a}(f_a) [prod_{b != a} phi_{o_b}(f_b)]
+//     G_o,a
+// with phi_0(t) = 1 - 3t^2 + 2t^3, phi_1 = 1 - phi_0, psi_0(t) = t (1 - t)^2, psi_1(t) = -t^2 (1 - t),
+// and the exact gradient of that. It takes the corners' values and gradients at the corners, is
+// continuous with its gradient across cells (a face's values and normal slopes depend on that
+// face's corners alone), and its gradient is the gradient of its value (local_boundary_share says
+// why that matters). hermite_basis gives phi_o, psi_o and their derivatives at t.
+SPH_HD void hermite_basis(float t, int o, float& phi, float& dphi, float& psi, float& dpsi) {
+  const float t2 = t * t, u = 1.0f - t;
+  const float p0 = 1.0f - 3.0f * t2 + 2.0f * t2 * t, dp0 = 6.0f * t2 - 6.0f * t;
+  phi = o ? 1.0f - p0 : p0;
+  dphi = o ? -dp0 : dp0;
+  psi = o ? -t2 * u : t * u * u;
+  dpsi = o ? 3.0f * t2 - 2.0f * t : u * u - 2.0f * t * u;
+}
+
+struct InterpolatedCorrection {
+  float value;
+  Vec3 gradient;  // d/d(index)
+};
+
+SPH_HD InterpolatedCorrection hermite_correction(const Float4* data, const SdfGridView& g,
+                                                 const TrilinearCell& c) {
+  const int32_t di = g.nx > 1 ? 1 : 0, dj = g.ny > 1 ? g.nx : 0, dk = g.nz > 1 ? g.nx * g.ny : 0;
+  const Float4* p = data + (static_cast<int64_t>(c.i) +
+                            static_cast<int64_t>(g.nx) * (c.j + static_cast<int64_t>(g.ny) * c.k));
+  InterpolatedCorrection out{0.0f, Vec3{0.0f, 0.0f, 0.0f}};
+  for (int o = 0; o < 8; ++o) {
+    const int ox = o & 1, oy = (o >> 1) & 1, oz = (o >> 2) & 1;
+    const Float4 q = p[ox * di + oy * dj + oz * dk];
+    float ax, dax, bx, dbx, ay, day, by, dby, az, daz, bz, dbz;
+    hermite_basis(c.fx, ox, ax, dax, bx, dbx);
+    hermite_basis(c.fy, oy, ay, day, by, dby);
+    hermite_basis(c.fz, oz, az, daz, bz, dbz);
+    out.value += ax * ay * az * q.x + bx * ay * az * q.y + ax * by * az * q.z + ax * ay * bz * q.w;
+    out.gradient +=
+        Vec3{dax * ay * az * q.x + dbx * ay * az * q.y + dax * by * az * q.z + dax * ay * bz * q.w,
+             ax * day * az * q.x + bx * day * az * q.y + ax * dby * az * q.z + ax * day * bz * q.w,
+             ax * ay * daz * q.x + bx * ay * daz * q.y + ax * by * daz * q.z + ax * ay * dbz * q.w};
+  }
+  if (g.nx <= 1) out.gradient.x = 0.0f;
+  if (g.ny <= 1) out.gradient.y = 0.0f;
+  if (g.nz <= 1) out.gradient.z = 0.0f;
   return out;
 }
 
@@ -148,6 +216,7 @@ SPH_HD LocalBoundaryShare local_boundary_share(const SdfGridView& g, const Float
   float distance = phi.value + cell.outside;
   Vec3 gradient_index = phi.gradient;
   if (cell.outside > 0.0f) {
+    gradient_index = without_clamped_axes(gradient_index, g, idx);
     const Vec3 away{idx.x - (static_cast<float>(cell.i) + cell.fx),
                     idx.y - (static_cast<float>(cell.j) + cell.fy),
                     idx.z - (static_cast<float>(cell.k) + cell.fz)};
@@ -157,15 +226,24 @@ SPH_HD LocalBoundaryShare local_boundary_share(const SdfGridView& g, const Float
   distance = sign * (distance - level);
   LocalBoundaryShare out;
   out.share = spiky_half_space(distance, h);
-  out.gradient = apply_linear_transposed(g.local_to_index, gradient_index) *
-                 (spiky_half_space_slope(distance, h) * sign);
-  // Away from the surface by h or more the kernel sees one side only: the correction is zero
-  // there (boundary_map.h), so it is not read.
-  if (correction && distance > -h && distance < h) {
-    const Float4 d = trilinear(correction, g, cell);
-    out.share += sign * d.x;
-    out.gradient += Vec3{d.y, d.z, d.w} * sign;
+  // The gradient is that of the sampled share itself (the flat share's through the trilinear
+  // SDF's, plus the correction's Hermite interpolant's), not an interpolation of gradients: the
+  // wall's force is then minus the gradient of the energy the density pass sees, so a static wall
+  // does no net work on a particle that comes back to where it was. Trilinear interpolation of
+  // the map's value and gradient channels separately did not hold that: where the SDF has a kink
+  // (a box's edges) the two disagree by up to 10 % of the slope, and a closed tank at rest gained
+  // 0.5-0.9 J/s without viscosity (docs/physics.md, "Energy").
+  Vec3 share_gradient = gradient_index * (spiky_half_space_slope(distance, h) * sign);
+  // A map node is nonzero only where |phi - level| < h (boundary_map.h); a cell none of whose
+  // corners is there interpolates zero, so it is not read. (The test is on the corners rather
+  // than on the sample's distance so that the sampled share has no step at the band's edge.)
+  if (correction && phi.lo - level < h && phi.hi - level > -h) {
+    InterpolatedCorrection d = hermite_correction(correction, g, cell);
+    if (cell.outside > 0.0f) d.gradient = without_clamped_axes(d.gradient, g, idx);
+    out.share += sign * d.value;
+    share_gradient += d.gradient * sign;
   }
+  out.gradient = apply_linear_transposed(g.local_to_index, share_gradient);
   return out;
 }
 

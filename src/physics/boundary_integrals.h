@@ -8,9 +8,6 @@
 // With W(r) = 15 / (pi h^6) (h - r)^3 (unit integral over the ball of radius h):
 //   radial_volume(r) = int_0^r W(t) t^2 dt, so int over a cone of solid angle dOmega between
 //     radii r0 and r1 of W dV is dOmega (radial_volume(r1) - radial_volume(r0));
-//   radial_gradient(r) = int_0^r -W'(t) t^2 dt, the same for |grad W| (grad_x W(|x - y|) =
-//     -W'(r) w for y = x + r w points from x to y: the integral of grad_x W over the solid is the
-//     sum over directions w of w dOmega (radial_gradient(r1) - radial_gradient(r0)));
 //   half_space(d) = int over {z > d} of W(|x|) dV = a^5 (1.5 h - a) / h^6 with a = h - d, for
 //     0 <= d <= h (1/2 at d = 0, 0 at d >= h), and 1 - half_space(-d) for d < 0: the share of
 //     the kernel's unit mass that lies beyond a plane at signed distance d.
@@ -30,16 +27,6 @@ SPH_HD T spiky_radial_volume(T r, T h) {
   // 15 / (pi h^6) int_0^r (h^3 t^2 - 3 h^2 t^3 + 3 h t^4 - t^5) dt
   return T(15) / (kPiOf<T> * h6) *
          (h * h * h * r3 / T(3) - T(3) * h * h * r2 * r2 / T(4) + T(3) * h * r3 * r2 / T(5) - r3 * r3 / T(6));
-}
-
-template <class T>
-SPH_HD T spiky_radial_gradient(T r, T h) {
-  if (r <= T(0)) return T(0);
-  if (r > h) r = h;
-  const T r2 = r * r, r3 = r2 * r;
-  const T h6 = h * h * h * h * h * h;
-  // 45 / (pi h^6) int_0^r (h^2 t^2 - 2 h t^3 + t^4) dt
-  return T(45) / (kPiOf<T> * h6) * (h * h * r3 / T(3) - h * r2 * r2 / T(2) + r3 * r2 / T(5));
 }
 
 // The share of W_spiky's unit mass beyond a plane at signed distance d from the kernel's centre

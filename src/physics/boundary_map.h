@@ -1,13 +1,16 @@
 // SPDX-License-Identifier: MIT
 // The boundary density's map of an SDF asset for a kernel radius h and an SDF level L (the solid
 // {phi < L}; boundary_density.h: L = -sigma delta): per voxel, what the solid's true kernel share
-// Phi and its gradient differ by from the flat-wall share of the SDF, which the sampling adds back:
-//     correction(node) = (Phi(x) - Phi_flat, grad Phi(x) - grad Phi_flat)
-// with Phi_flat and its gradient exactly as local_boundary_share computes them at the node (so a
-// sample at a node returns the quadrature's values). Zero where |phi - L| >= h: the kernel sees one
-// side only there (for an SDF that is a distance), so the voxels to compute are a band of 2 h
-// around the surface; the rest of the map is zero. Both backends call boundary_map_correction
-// per band voxel: the CPU backend on host threads, the CUDA backend one thread per voxel.
+// Phi differs by from the flat-wall share of the SDF, which the sampling adds back,
+//     correction(node) = Phi(x) - Phi_flat(x)
+// with Phi_flat exactly as local_boundary_share computes it at the node (so a sample at a node
+// returns the quadrature's value), and the correction's slopes (d/d index) by central differences
+// of those values, which the sampling's cubic Hermite interpolation takes at the voxels: one
+// Float4 (correction, slope x, slope y, slope z) per voxel. Zero where |phi - L| >= h: the kernel
+// sees one side only there (for an SDF that is a distance), so the voxels to compute are a band
+// of 2 h around the surface; the rest of the map is zero. Both backends call
+// boundary_map_correction per band voxel, then, with every value in place, boundary_map_slope:
+// the CPU backend on host threads, the CUDA backend one thread per voxel.
 //
 // The quadrature, in spherical coordinates about the node x: Phi(x) = int over directions w of
 // int_0^h W(r) r^2 [x + r w in the solid] dr. The polar axis is the SDF's normal at x, and the
@@ -64,15 +67,10 @@ SPH_HD void gauss_legendre8(int q, float& x, float& w) {
 
 constexpr int kBoundaryMapAzimuths = 8;
 
-// The radial integrals of W r^2 and -W' r^2 over the solid's part of the ray x + r w, r in [0, h].
-struct RayIntegral {
-  float volume;    // sum of spiky_radial_volume differences
-  float gradient;  // sum of spiky_radial_gradient differences
-};
-
-SPH_HD RayIntegral integrate_ray(const SdfGridView& g, Vec3 x, Vec3 w, float h, float level, int steps,
-                                 float phi0) {
-  RayIntegral out{0.0f, 0.0f};
+// The radial integral of W r^2 over the solid's part of the ray x + r w, r in [0, h].
+SPH_HD float integrate_ray(const SdfGridView& g, Vec3 x, Vec3 w, float h, float level, int steps,
+                           float phi0) {
+  float out = 0.0f;
   float r0 = 0.0f, a = phi0;
   for (int k = 1; k <= steps; ++k) {
     const float r1 = h * static_cast<float>(k) / static_cast<float>(steps);
@@ -85,10 +83,7 @@ SPH_HD RayIntegral integrate_ray(const SdfGridView& g, Vec3 x, Vec3 w, float h, 
     } else if (b < 0.0f) {
       lo = r0 + (r1 - r0) * (a / (a - b)), hi = r1;
     }
-    if (hi > lo) {
-      out.volume += spiky_radial_volume(hi, h) - spiky_radial_volume(lo, h);
-      out.gradient += spiky_radial_gradient(hi, h) - spiky_radial_gradient(lo, h);
-    }
+    if (hi > lo) out += spiky_radial_volume(hi, h) - spiky_radial_volume(lo, h);
     r0 = r1, a = b;
   }
   return out;
@@ -102,12 +97,12 @@ SPH_HD int boundary_map_ray_steps(const SdfGridView& g, float h) {
 
 // The correction of voxel (i, j, k) for the solid {phi < level}; index_to_local is the inverse of
 // g.local_to_index.
-SPH_HD Float4 boundary_map_correction(const SdfGridView& g, const Affine3x4& index_to_local, int32_t i,
-                                      int32_t j, int32_t k, float h, float level) {
+SPH_HD float boundary_map_correction(const SdfGridView& g, const Affine3x4& index_to_local, int32_t i,
+                                     int32_t j, int32_t k, float h, float level) {
   const float phi =
       -level +
       g.distance[static_cast<int64_t>(i) + static_cast<int64_t>(g.nx) * (j + static_cast<int64_t>(g.ny) * k)];
-  if (!(phi > -h && phi < h)) return Float4{0.0f, 0.0f, 0.0f, 0.0f};
+  if (!(phi > -h && phi < h)) return 0.0f;
   const Vec3 x =
       apply_affine(index_to_local, Vec3{static_cast<float>(i), static_cast<float>(j), static_cast<float>(k)});
   Vec3 n = sample_normal(g, x);
@@ -121,7 +116,6 @@ SPH_HD Float4 boundary_map_correction(const SdfGridView& g, const Affine3x4& ind
   float kink = -phi / h;
   kink = kink < -1.0f ? -1.0f : (kink > 1.0f ? 1.0f : kink);
   float share = 0.0f;
-  Vec3 gradient{0.0f, 0.0f, 0.0f};
   const float azimuth_weight = 2.0f * kPi / static_cast<float>(kBoundaryMapAzimuths);
   for (int part = 0; part < 2; ++part) {
     const float lo = part == 0 ? -1.0f : kink, hi = part == 0 ? kink : 1.0f;
@@ -135,15 +129,36 @@ SPH_HD Float4 boundary_map_correction(const SdfGridView& g, const Affine3x4& ind
       for (int p = 0; p < kBoundaryMapAzimuths; ++p) {
         const float angle = azimuth_weight * (static_cast<float>(p) + 0.5f);
         const Vec3 w = n * mu + (t1 * SPH_COSF(angle) + t2 * SPH_SINF(angle)) * sin_theta;
-        const RayIntegral ray = integrate_ray(g, x, w, h, level, steps, phi);
-        share += w_mu * ray.volume;
-        gradient += w * (w_mu * ray.gradient);
+        share += w_mu * integrate_ray(g, x, w, h, level, steps, phi);
       }
     }
   }
-  const LocalBoundaryShare flat = local_boundary_share(g, nullptr, 1.0f, level, h, x);
-  const Vec3 dg = gradient - flat.gradient;
-  return Float4{share - flat.share, dg.x, dg.y, dg.z};
+  return share - local_boundary_share(g, nullptr, 1.0f, level, h, x).share;
+}
+
+// The slopes (d/d index) the sampling's Hermite interpolation takes at voxel (i, j, k): central
+// differences of the map's values (one-sided at the grid's faces). Zero outside the band, where
+// the value is zero, so that the interpolant is zero in a cell of such voxels (the sampling does
+// not read those). Differences rather than the quadrature's own gradient: at a kink of the SDF
+// (a box's edges) the flat share's gradient at a voxel is one-sided, and a correction's gradient
+// taken against it made the interpolant lopsided (a box's corners read 1.43-1.56 rho0 by which
+// corner; with differences all read alike).
+SPH_HD Vec3 boundary_map_slope(const SdfGridView& g, const Float4* map, int32_t i, int32_t j, int32_t k,
+                               float h, float level) {
+  const int64_t v =
+      static_cast<int64_t>(i) + static_cast<int64_t>(g.nx) * (j + static_cast<int64_t>(g.ny) * k);
+  const float phi = g.distance[v] - level;
+  if (!(phi > -h && phi < h)) return Vec3{0.0f, 0.0f, 0.0f};
+  const int32_t n[3] = {g.nx, g.ny, g.nz}, at[3] = {i, j, k};
+  const int64_t stride[3] = {1, static_cast<int64_t>(g.nx), static_cast<int64_t>(g.nx) * g.ny};
+  float slope[3];
+  for (int a = 0; a < 3; ++a) {
+    const int32_t lo = at[a] > 0 ? at[a] - 1 : at[a], hi = at[a] < n[a] - 1 ? at[a] + 1 : at[a];
+    slope[a] = hi > lo ? (map[v + (hi - at[a]) * stride[a]].x - map[v + (lo - at[a]) * stride[a]].x) /
+                             static_cast<float>(hi - lo)
+                       : 0.0f;
+  }
+  return Vec3{slope[0], slope[1], slope[2]};
 }
 
 }  // namespace sph

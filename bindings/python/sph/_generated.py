@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '6d2e0443c63f45d869e01146dd2d2c77045b512358062557e2e764d0da3c66b4', 'include/sph_cuda.h': '8fe2c1988d9c8456a91fb26b7863765759ab8ad17bd1ff44b457c77af0bc7985', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '9ef8a5508f3bedd20a0c2223355d754fbca8c301ed98ee6951b5b4302855b6c3', 'include/sph_cuda.h': '8fe2c1988d9c8456a91fb26b7863765759ab8ad17bd1ff44b457c77af0bc7985', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -49,8 +49,8 @@ SPH_FEATURE_SPRINGS = 4
 #: map per SDF asset, Koschier & Bender 2017, calibrated on the particle lattice), and the wall
 #: pushes back through the pressure force, so particles at a wall no longer read low density: a
 #: resting FCC block from sph_world_fill_box reads rho0 at axis-aligned walls (77 % without), a
-#: settled tank's pressure near its walls is within 19-26 % of rho0 g d at the default stiffness
-#: (40-72 % low without). Edges and corners read high when a lattice is placed into them
+#: settled tank's pressure near its walls is within 3-5 % of rho0 g d at the default stiffness
+#: (48-77 % low without). Edges and corners read high when a lattice is placed into them
 #: (docs/physics.md). The maps are computed per asset and kernel radius when a collider first steps
 #: with the asset and after sph_sdf_update (16 bytes per SDF voxel; on the device for CUDA). The
 #: collision response stays the no-penetration safeguard. Costs one SDF sample per particle and
