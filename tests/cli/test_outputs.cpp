@@ -283,9 +283,11 @@ void test_surface_encloses_fluid(void**) {
   char line[256];
   while (std::fgets(line, sizeof line, obj)) {
     double x, y, z;
-    unsigned a, b, c;
+    unsigned a, b, c, na, nb, nc;
     if (std::sscanf(line, "v %lf %lf %lf", &x, &y, &z) == 3) v.push_back({x, y, z});
-    if (std::sscanf(line, "f %u %u %u", &a, &b, &c) == 3) {
+    // Faces name their vertex normals ("f a//na b//nb c//nc", write_obj.cpp).
+    if (std::sscanf(line, "f %u//%u %u//%u %u//%u", &a, &na, &b, &nb, &c, &nc) == 6) {
+      assert_true(na == a && nb == b && nc == c);  // one normal per vertex
       const auto &p0 = v.at(a - 1), &p1 = v.at(b - 1), &p2 = v.at(c - 1);
       volume += (p0[0] * (p1[1] * p2[2] - p1[2] * p2[1]) + p0[1] * (p1[2] * p2[0] - p1[0] * p2[2]) +
                  p0[2] * (p1[0] * p2[1] - p1[1] * p2[0])) /
