@@ -288,7 +288,7 @@ class Program {
 
   // ---- ops --------------------------------------------------------------------------------------
   void step_op() {
-    switch (in_.u8() % 27) {
+    switch (in_.u8() % 29) {
       case 0:
         return op_context_create();
       case 1:
@@ -341,6 +341,10 @@ class Program {
         return op_physics_params();
       case 25:
         return op_init_sized();
+      case 26:
+        return op_step_budget();
+      case 27:
+        return op_sdf_create_from_mesh();
       default:
         return op_misc();
     }
@@ -879,6 +883,105 @@ class Program {
     }
     const double v = d.voxel_size;
     sdfs_[slot] = SdfSlot{out, cslot, got * v * v * v, false};
+  }
+
+  // A small random triangle mesh (sometimes with an index out of range, a non-finite vertex, an
+  // odd stride or hostile sizes); the arrays always hold what the description claims, since the
+  // library cannot check a caller's lie about their length. Grids past the harness's voxel cap
+  // and wide bands are skipped when the library would accept them (too slow to build here).
+  void op_sdf_create_from_mesh() {
+    const int slot = free_sdf_slot();
+    int cslot;
+    sph_context* c = context_arg(&cslot);
+    Padded<sph_mesh_desc> buf;
+    sph_mesh_desc& d = buf.value;
+    sph_mesh_desc_init(&d);
+    d.vertex_count = in_.u8() % 12u;
+    d.vertex_stride = in_.chance(192) ? 12u + 4u * (in_.u8() % 2u) : in_.u8() % 40u;
+    const uint32_t stride_bytes = d.vertex_stride == 0u ? 12u : d.vertex_stride;
+    std::vector<float> vertices((d.vertex_count * std::max(stride_bytes, 12u) + 3u) / 4u + 3u);
+    for (float& x : vertices) x = in_.chance(4) ? in_.hostile() : in_.unit(-0.3f, 0.3f);
+    const uint32_t triangles = in_.u8() % 9u;
+    std::vector<uint32_t> indices(triangles * 3u + 2u);
+    for (uint32_t& i : indices) i = in_.chance(4) ? in_.u32() : in_.u8() % std::max(d.vertex_count, 1u);
+    d.index_count = triangles * 3u + (in_.chance(16) ? 1u + in_.u8() % 2u : 0u);
+    d.vertices = in_.chance(8) ? nullptr : vertices.data();
+    d.indices = in_.chance(8) ? nullptr : indices.data();
+    d.voxel_size = in_.chance(16) ? in_.hostile() : in_.unit(0.04f, 0.1f);
+    d.band_width = in_.chance(16) ? in_.hostile() : in_.unit(0.0f, 4.0f);
+    d.padding_voxels = in_.chance(224) ? in_.u8() % 6u : in_.u32();
+    d.reserved0 = in_.chance(248) ? 0u : in_.u32();
+    d.struct_size = struct_size(sizeof d);
+    // The grid: the vertices' bounds over the voxel size plus the padding on both sides, per axis.
+    float lo[3] = {0.0f, 0.0f, 0.0f}, hi[3] = {0.0f, 0.0f, 0.0f};
+    bool finite = true;
+    for (uint32_t v = 0; v < d.vertex_count; ++v) {
+      for (int k = 0; k < 3; ++k) {
+        float x;
+        std::memcpy(&x, reinterpret_cast<const unsigned char*>(vertices.data()) + v * stride_bytes + 4u * k,
+                    4);
+        finite = finite && std::isfinite(x);
+        lo[k] = v == 0 ? x : std::min(lo[k], x);
+        hi[k] = v == 0 ? x : std::max(hi[k], x);
+      }
+    }
+    const double voxel = d.voxel_size == 0.0f ? 0.01 : static_cast<double>(d.voxel_size);
+    const double padding = d.padding_voxels == 0u ? 4.0 : static_cast<double>(d.padding_voxels);
+    double voxels = 1.0;
+    for (int k = 0; k < 3; ++k) voxels *= (static_cast<double>(hi[k]) - lo[k]) / voxel + 2.0 * padding + 2.0;
+    const double band = d.band_width == 0.0f ? 3.0 : static_cast<double>(d.band_width);
+    // Skip (as op_sdf_create_shape does) what the library may accept but is too slow here; pass
+    // grids far past its 2^31-voxel limit, which it must refuse.
+    const bool accepted_sizes = finite && d.padding_voxels <= 1024u && band >= 1.0 && band <= 64.0 &&
+                                voxel > 0.0 && std::isfinite(voxel);
+    if (accepted_sizes && ((voxels > kMaxVoxels && voxels <= 4.0 * kLibraryVoxelLimit) || band > 8.0)) return;
+    sph_sdf* out = nullptr;
+    const sph_result r = FUZZ_CALL(sph_sdf_create_from_mesh(c, in_.chance(8) ? nullptr : &d, &out));
+    if (r != SPH_OK) {
+      if (out) violation("sph_sdf_create_from_mesh wrote *out on failure");
+      return;
+    }
+    if (cslot < 0) violation("sph_sdf_create_from_mesh succeeded on a dead context");
+    uint32_t dims[3];
+    FUZZ_CALL(sph_sdf_get_dims(out, dims));
+    const double got = static_cast<double>(dims[0]) * dims[1] * dims[2];
+    if (got > kMaxVoxels) violation("mesh grid of %g voxels, estimated %g", got, voxels);
+    if (slot < 0) {
+      FUZZ_CALL(sph_sdf_destroy(out));
+      return;
+    }
+    sdfs_[slot] = SdfSlot{out, cslot, got * voxel * voxel * voxel, false};
+  }
+
+  // The step budget (refused: NaN, negative, above a day; the old one kept) and a cancel request
+  // before a step (that step stops before its first substep and changes no particle).
+  void op_step_budget() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    const bool live = slot >= 0 && w;
+    double old_budget = 0.0;
+    if (live) FUZZ_CALL(sph_world_get_step_budget(w, &old_budget));
+    const double budget = in_.chance(64) ? static_cast<double>(in_.hostile()) : in_.unit(0.0f, 0.05f);
+    const sph_result r = FUZZ_CALL(sph_world_set_step_budget(w, budget));
+    if (!live) {
+      if (r == SPH_OK) violation("sph_world_set_step_budget succeeded on a dead world");
+      if (FUZZ_CALL(sph_world_cancel_step(w)) == SPH_OK)
+        violation("sph_world_cancel_step succeeded on a dead world");
+      return;
+    }
+    const bool valid = std::isfinite(budget) && budget >= 0.0 && budget <= 86400.0;
+    if ((r == SPH_OK) != valid) violation("sph_world_set_step_budget(%g) answered %d", budget, r);
+    double got = -1.0;
+    FUZZ_CALL(sph_world_get_step_budget(w, &got));
+    if (got != (valid ? budget : old_budget))
+      violation("step budget %g after setting %g (was %g)", got, budget, old_budget);
+    if (!in_.chance(128)) return;
+    if (FUZZ_CALL(sph_world_cancel_step(w)) != SPH_OK)
+      violation("sph_world_cancel_step failed on a live world");
+    const Particles before = snapshot(w);
+    const sph_result s = FUZZ_CALL(sph_world_step(w, in_.unit(1e-4f, 0.01f)));
+    if (s != SPH_INCOMPLETE) violation("a step after a cancel request answered %d, not SPH_INCOMPLETE", s);
+    if (!(snapshot(w) == before)) violation("a cancelled step changed the particles");
   }
 
   void op_sdf_update() {
