@@ -2264,6 +2264,45 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_cancel_step")]
         public static extern Result sph_world_cancel_step(IntPtr world);
 
+        /// <summary>
+        /// Asynchronous steps: sph_world_step_begin starts the frame that sph_world_step would run and
+        /// returns at once; the frame runs on the world's own thread (started by its first asynchronous
+        /// step and kept until sph_world_destroy; on the CPU backend it leads the OpenMP workers), so
+        /// the caller's frame overlaps the simulation. Until sph_world_step_wait collects it, the world
+        /// is held by that step: every other call on the world answers SPH_ERROR_WORLD_LOCKED (destroy
+        /// included), except sph_world_cancel_step and sph_world_step_poll. Each begin needs one wait,
+        /// also before the process exits; the wait may come from any thread. Errors of begin:
+        /// INVALID_HANDLE, INVALID_ARGUMENT (frame_dt not &gt; 0 and finite), WORLD_LOCKED,
+        /// OUT_OF_HOST_MEMORY (no thread could be started). Nothing runs when begin fails.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_step_begin(WorldHandle world, float frameDt);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_step_begin")]
+        public static extern Result sph_world_step_begin(IntPtr world, float frameDt);
+
+        /// <summary>
+        /// Waits for the step that sph_world_step_begin started and returns what sph_world_step would
+        /// have returned for it (SPH_OK, SPH_INCOMPLETE, or its error, with its message in this
+        /// thread's sph_get_last_error and the world rolled back as sph_world_step does); the world is
+        /// free again. Errors of the call itself: INVALID_HANDLE, INVALID_ARGUMENT (no step begun, or
+        /// it was already waited for), WORLD_LOCKED (another call holds the world, e.g. another
+        /// thread's wait).
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_step_wait(WorldHandle world);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_step_wait")]
+        public static extern Result sph_world_step_wait(IntPtr world);
+
+        /// <summary>
+        /// Whether the step sph_world_step_begin started has finished (*out_done 1: sph_world_step_wait
+        /// will not block). Never blocks. Errors: INVALID_HANDLE, INVALID_ARGUMENT (out_done NULL, or
+        /// no step begun), WORLD_LOCKED (a synchronous call holds the world).
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_step_poll(WorldHandle world, out uint outDone);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_step_poll")]
+        public static extern Result sph_world_step_poll(IntPtr world, IntPtr outDone);
+
         /// <summary>Number of particles in the world.</summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_get_particle_count(WorldHandle world, out uint outCount);
@@ -3592,6 +3631,9 @@ namespace Sph
             "sph_world_set_step_budget",
             "sph_world_get_step_budget",
             "sph_world_cancel_step",
+            "sph_world_step_begin",
+            "sph_world_step_wait",
+            "sph_world_step_poll",
             "sph_world_get_particle_count",
             "sph_world_copy_attribute",
             "sph_stats_init_sized",
@@ -3650,6 +3692,9 @@ namespace Sph
         };
         /// <summary>The shared library of each function ("sph", or an optional helper).</summary>
         public static readonly string[] FunctionLibraries = {
+            "sph",
+            "sph",
+            "sph",
             "sph",
             "sph",
             "sph",

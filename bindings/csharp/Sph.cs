@@ -731,6 +731,30 @@ namespace Sph
             set { SphException.Check(Native.sph_world_set_step_budget(Handle, value), "sph_world_set_step_budget"); }
         }
 
+        /// <summary>Starts the frame Step would run on the world's own thread and returns at once
+        /// (sph_world_step_begin). Until StepWait collects it every other call on the world throws
+        /// ErrorWorldLocked, except CancelStep and StepDone.</summary>
+        public void StepBegin(float frameDt)
+        {
+            SphException.Check(Native.sph_world_step_begin(Handle, frameDt), "sph_world_step_begin");
+        }
+
+        /// <summary>Waits for the frame StepBegin started and returns what Step would have returned
+        /// (Ok or Incomplete), or throws its error (sph_world_step_wait).</summary>
+        public Result StepWait()
+        {
+            return SphException.Check(Native.sph_world_step_wait(Handle), "sph_world_step_wait");
+        }
+
+        /// <summary>True once the frame StepBegin started has ended, so StepWait will not block
+        /// (sph_world_step_poll; never blocks).</summary>
+        public bool StepDone()
+        {
+            uint done;
+            SphException.Check(Native.sph_world_step_poll(Handle, out done), "sph_world_step_poll");
+            return done != 0;
+        }
+
         /// <summary>Asks the Step running on another thread (or else the next one) to stop at its
         /// next substep boundary, returning Incomplete. Safe from any thread while the world steps.</summary>
         public void CancelStep()

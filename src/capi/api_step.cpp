@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
 // Stepping (with its budget and cancel) and statistics.
 #include <chrono>
+#include <new>
 #include <string>
+#include <system_error>
 
 #include "guard.h"
 #include "handles.h"
@@ -13,8 +15,50 @@ using sph::Error;
 using sph::Status;
 
 namespace sph {
+namespace {
 // A budget longer than a day is a mistake, not a bound.
 constexpr double kMaxStepBudgetSeconds = 86400.0;
+
+// One frame of a world whose lock the caller holds: true if it completed, false if its budget,
+// a cancel or max_substeps stopped it; throws on failure (the world then as before the call).
+bool run_frame(sph_world* world, float frame_dt) {
+  StepInterrupt interrupt;
+  interrupt.cancel = &world->cancel_requested;
+  if (world->step_budget_seconds > 0.0)
+    interrupt.deadline =
+        StepInterrupt::Clock::now() + std::chrono::duration_cast<StepInterrupt::Clock::duration>(
+                                          std::chrono::duration<double>(world->step_budget_seconds));
+  try {
+    const bool completed = world->world->step(frame_dt, interrupt);
+    if (world->world->last_report().interrupted) world->cancel_requested.store(0);
+    return completed;
+  } catch (const Error& e) {
+    if (e.status() == Status::DeviceLost) world->device_lost = true;
+    throw;
+  }
+}
+
+// run_frame on the world's step thread: errors become an outcome for sph_world_step_wait.
+StepOutcome run_frame_outcome(sph_world* world, float frame_dt) noexcept {
+  StepOutcome outcome;
+  try {
+    outcome.status = run_frame(world, frame_dt) ? Status::Ok : Status::Incomplete;
+  } catch (const Error& e) {
+    outcome.status = e.status();
+    outcome.message = e.what();
+  } catch (const std::bad_alloc&) {
+    outcome.status = Status::OutOfHostMemory;
+    outcome.message = "a host allocation failed";
+  } catch (const std::exception& e) {
+    outcome.status = Status::Internal;
+    outcome.message = e.what();
+  } catch (...) {
+    outcome.status = Status::Internal;
+    outcome.message = "unknown internal exception";
+  }
+  return outcome;
+}
+}  // namespace
 }  // namespace sph
 
 extern "C" {
@@ -24,20 +68,68 @@ SPH_API sph_result SPH_CALL sph_world_step(sph_world* world, float frame_dt) {
     sph::require_world(world);
     sph::WorldLock lock(world);
     sph::require_positive(frame_dt, "frame_dt");
-    sph::StepInterrupt interrupt;
-    interrupt.cancel = &world->cancel_requested;
-    if (world->step_budget_seconds > 0.0)
-      interrupt.deadline =
-          sph::StepInterrupt::Clock::now() + std::chrono::duration_cast<sph::StepInterrupt::Clock::duration>(
-                                                 std::chrono::duration<double>(world->step_budget_seconds));
+    return sph::run_frame(world, frame_dt) ? SPH_OK : SPH_INCOMPLETE;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_world_step_begin(sph_world* world, float frame_dt) {
+  return sph::guarded("sph_world_step_begin", sph::context_of(world), [&] {
+    sph::require_world(world);
+    sph::WorldLock lock(world);
+    sph::require_positive(frame_dt, "frame_dt");
     try {
-      const bool completed = world->world->step(frame_dt, interrupt);
-      if (world->world->last_report().interrupted) world->cancel_requested.store(0);
-      return completed ? SPH_OK : SPH_INCOMPLETE;
-    } catch (const Error& e) {
-      if (e.status() == Status::DeviceLost) world->device_lost = true;
-      throw;
+      world->async_step.start([world, frame_dt] { return sph::run_frame_outcome(world, frame_dt); });
+    } catch (const std::system_error& e) {
+      throw Error(Status::OutOfHostMemory,
+                  std::string("the step's thread could not be started: ") + e.what());
     }
+    world->async_step.pending.store(true);
+    lock.hand_over();
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_world_step_wait(sph_world* world) {
+  return sph::guarded("sph_world_step_wait", sph::context_of(world), [&] {
+    sph::require_world(world);
+    switch (sph::try_collect_async_step(world)) {
+      case sph::Collect::NotLive:
+        throw Error(Status::InvalidHandle, "world: is not a live sph_world (destroyed or foreign pointer)");
+      case sph::Collect::Busy:
+        throw Error(Status::WorldLocked,
+                    "world: it is in use by another call (another thread may be waiting for its step)");
+      case sph::Collect::NoStep:
+        throw Error(Status::InvalidArgument,
+                    "world: no step was begun (sph_world_step_begin) or it was already waited for");
+      case sph::Collect::Taken:
+        break;
+    }
+    sph::StepOutcome outcome = world->async_step.collect();
+    sph::release_world(world);
+    if (outcome.status == Status::Ok) return SPH_OK;
+    if (outcome.status == Status::Incomplete) return SPH_INCOMPLETE;
+    throw Error(outcome.status, outcome.message);
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_world_step_poll(const sph_world* world, sph_bool32* out_done) {
+  return sph::guarded("sph_world_step_poll", sph::context_of(world), [&] {
+    sph::require_world(world);
+    if (!out_done) throw Error(Status::InvalidArgument, "out_done: is NULL");
+    bool finished = false;
+    switch (sph::poll_async_step(world, &finished)) {
+      case sph::Collect::NotLive:
+        throw Error(Status::InvalidHandle, "world: is not a live sph_world (destroyed or foreign pointer)");
+      case sph::Collect::Busy:
+        throw Error(Status::WorldLocked, "world: it is in use by another call");
+      case sph::Collect::NoStep:
+        throw Error(Status::InvalidArgument,
+                    "world: no step was begun (sph_world_step_begin) or it was already waited for");
+      case sph::Collect::Taken:
+        break;
+    }
+    *out_done = finished ? 1u : 0u;
+    return SPH_OK;
   });
 }
 

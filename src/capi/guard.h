@@ -76,7 +76,11 @@ class WorldLock {
       throw Error(Status::DeviceLost, "world: its device was lost after a sticky device error; destroy it");
     }
   }
-  ~WorldLock() { release_world(world_); }
+  ~WorldLock() {
+    if (world_) release_world(world_);
+  }
+  // Hands the lock to an asynchronous step, which keeps it until sph_world_step_wait.
+  void hand_over() { world_ = nullptr; }
   WorldLock(const WorldLock&) = delete;
   WorldLock& operator=(const WorldLock&) = delete;
 

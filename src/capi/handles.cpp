@@ -86,6 +86,23 @@ bool raise_cancel(const sph_world* world) {
   return true;
 }
 
+Collect try_collect_async_step(sph_world* world) {
+  std::lock_guard<std::mutex> lock(registry_mutex());
+  if (!world || !live_locked(world, HandleKind::World)) return Collect::NotLive;
+  if (world->async_step.pending.exchange(false)) return Collect::Taken;
+  return world->busy.load() ? Collect::Busy : Collect::NoStep;
+}
+
+Collect poll_async_step(const sph_world* world, bool* finished) {
+  std::lock_guard<std::mutex> lock(registry_mutex());
+  if (!world || !live_locked(world, HandleKind::World)) return Collect::NotLive;
+  if (world->async_step.pending.load()) {
+    *finished = world->async_step.finished();
+    return Collect::Taken;
+  }
+  return world->busy.load() ? Collect::Busy : Collect::NoStep;
+}
+
 Take try_retire_world(sph_world* world) {
   std::lock_guard<std::mutex> lock(registry_mutex());
   if (!world || !live_locked(world, HandleKind::World)) return Take::NotLive;

@@ -18,6 +18,7 @@
 #include "../core/status.h"
 #include "../core/world.h"
 #include "../factory/backend_factory.h"
+#include "async_stepper.h"
 #include "sph_c.h"
 
 struct sph_context {
@@ -47,6 +48,8 @@ struct sph_world {
   // Raised by sph_world_cancel_step from any thread (under the registry's mutex, so never on a
   // freed world), lowered by the step that it stopped.
   std::atomic<uint32_t> cancel_requested{0};
+  // sph_world_step_begin's thread; declared last, so it stops before the world goes away.
+  sph::AsyncStepper async_step;
 };
 
 namespace sph {
@@ -77,6 +80,14 @@ Take try_take_world(const sph_world* world);
 void release_world(const sph_world* world);
 // Raises a live world's cancel flag whether or not another call holds it; false if not live.
 bool raise_cancel(const sph_world* world);
+// For sph_world_step_wait: under the registry's mutex, a live world whose asynchronous step is
+// pending passes to the caller (Taken: the caller now holds the world's lock the step held, and
+// no other waiter can take it); Busy if another call holds the world; NoStep if nothing does.
+enum class Collect { Taken, NotLive, Busy, NoStep };
+Collect try_collect_async_step(sph_world* world);
+// For sph_world_step_poll: as above without taking anything; *finished says whether the pending
+// step has ended.
+Collect poll_async_step(const sph_world* world, bool* finished);
 // Takes a world for destruction: as try_take_world, and on Taken the handle has left the
 // registry (and its context's count) in the same critical section; the caller deletes it.
 Take try_retire_world(sph_world* world);

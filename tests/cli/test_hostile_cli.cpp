@@ -170,12 +170,28 @@ void test_foreign_files_survive(void**) {
 void test_killed_runs_leave_whole_frames(void**) {
   const std::string out = cli_test::make_temp_dir("killed");
   size_t trusted = 0;
+  const std::string manifest = out + "/sph-run-manifest.jsonl";
   for (int trial = 0; trial < 8; ++trial) {
+    struct stat before;
+    const ino_t last_inode = stat(manifest.c_str(), &before) == 0 ? before.st_ino : 0;
     const pid_t pid =
         cli_test::start({g_sph_run, g_scenes + "/tiny.json", "--frames", "100000", "--backend", "cpu",
                          "--format", "ply,csv", "--out", out, "--threads", "1", "--quiet"},
                         out + ".log");
     // Kills at different moments of a frame: start-up, writing, moving files, the manifest.
+    // The first two trials kill at fixed times (start-up on a slow machine); the others wait
+    // for this run's first complete frame (its manifest replaced the last run's: a new inode),
+    // so that a loaded machine or a sanitizer build still kills mid-run, never only at start-up.
+    if (trial >= 2) {
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+      while (std::chrono::steady_clock::now() < deadline) {
+        struct stat now;
+        if (stat(manifest.c_str(), &now) == 0 && now.st_ino != last_inode &&
+            !read_manifest(out).complete.empty())
+          break;
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+    }
     std::this_thread::sleep_for(std::chrono::milliseconds(150 + 37 * trial));
     kill(pid, SIGKILL);
     assert_int_equal(cli_test::wait_for(pid, 60), 128 + SIGKILL);

@@ -56,8 +56,7 @@ struct Scene {
   uint32_t n = 0;
 
   // The grid sizes its table by the particles' extent at each build; no crowded-cell cap here.
-  Scene(const std::vector<Vec3>& points, uint32_t capacity, uint32_t seed) : grid(kH, UINT32_MAX) {
-    (void)capacity;
+  Scene(const std::vector<Vec3>& points, uint32_t seed) : grid(kH, UINT32_MAX) {
     config.kernel_radius = kH;
     config.rest_density = 1000.0f;
     config.particle_spacing = kH / 1.8f;
@@ -119,19 +118,16 @@ std::vector<Vec3> uniform_cloud(uint32_t count, Vec3 center, float half, uint32_
 }
 
 // The clouds: about 40 neighbours inside (n / V = 40 / (4/3 pi h^3)).
-std::vector<std::vector<Vec3>> clouds(std::vector<uint32_t>& capacities) {
+std::vector<std::vector<Vec3>> clouds() {
   std::vector<std::vector<Vec3>> out;
   const float half = 0.5f * std::cbrt(3000.0f * 4.18879f * kH * kH * kH / 40.0f);
   out.push_back(uniform_cloud(3000, Vec3{0.0f, 0.0f, 0.0f}, half, 1));
-  capacities.push_back(3000);
-  out.push_back(uniform_cloud(3000, Vec3{-3.1f, 2.7f, 1e3f}, half, 2));  // folds onto a 3^3 table
-  capacities.push_back(8);
+  out.push_back(uniform_cloud(3000, Vec3{-3.1f, 2.7f, 1e3f}, half, 2));  // far from the origin
   std::vector<Vec3> knot = uniform_cloud(1500, Vec3{0.5f, 0.5f, 0.5f}, half, 3);
   std::vector<Vec3> dense = uniform_cloud(300, Vec3{0.5f, 0.5f, 0.5f}, 0.3f * kH, 4);
   knot.insert(knot.end(), dense.begin(), dense.end());
   for (int k = 0; k < 40; ++k) knot.push_back(knot[static_cast<size_t>(k) * 7]);  // coincident pairs
   out.push_back(knot);
-  capacities.push_back(2000);
   return out;
 }
 
@@ -161,11 +157,10 @@ bool same_bits(const T& a, const T& b) {
 }
 
 void test_density_passes(void**) {
-  std::vector<uint32_t> capacities;
-  const std::vector<std::vector<Vec3>> all = clouds(capacities);
+  const std::vector<std::vector<Vec3>> all = clouds();
   const std::vector<const sph::SimdPasses*> targets = runnable_targets();
   for (size_t c = 0; c < all.size(); ++c) {
-    Scene s(all[c], capacities[c], static_cast<uint32_t>(10 + c));
+    Scene s(all[c], static_cast<uint32_t>(10 + c));
     const sph::FluidConstants f = s.fluid(sph::MethodSelection{});
     const sph::GridView view = s.view();
     const sph::NeighborColumns columns = s.columns.view();
@@ -232,11 +227,10 @@ Vec3 single_pair_acceleration(const sph::FluidConstants& f, const sph::ForceInpu
 }
 
 void check_forces(const sph::MethodSelection& selection, const char* name) {
-  std::vector<uint32_t> capacities;
-  const std::vector<std::vector<Vec3>> all = clouds(capacities);
+  const std::vector<std::vector<Vec3>> all = clouds();
   const std::vector<const sph::SimdPasses*> targets = runnable_targets();
   for (size_t c = 0; c < all.size(); ++c) {
-    Scene s(all[c], capacities[c], static_cast<uint32_t>(20 + c));
+    Scene s(all[c], static_cast<uint32_t>(20 + c));
     const sph::FluidConstants f = s.fluid(selection);
     const sph::GridView view = s.view();
     const sph::NeighborColumns columns = s.columns.view();

@@ -340,6 +340,12 @@ static class Tests
             AssertEqual(0u, world.GetStats().Substeps, "no substep after a cancel");
             p.MaxSubsteps = 1000001;
             Throws(Result.ErrorInvalidArgument, () => world.Params = p);
+            // Asynchronous steps (issue 21 item 1): the world is held until StepWait collects.
+            world.StepBegin(0.01f);
+            Throws(Result.ErrorWorldLocked, () => world.Step(0.01f));
+            while (!world.StepDone()) { }
+            AssertEqual(Result.Ok, world.StepWait(), "an asynchronous frame");
+            Throws(Result.ErrorInvalidArgument, () => world.StepWait());
         }
     }
 

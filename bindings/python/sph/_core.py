@@ -373,6 +373,24 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
     def step_budget(self, seconds):
         check(library().sph_world_set_step_budget(self.handle, float(seconds)), "sph_world_set_step_budget")
 
+    def step_begin(self, frame_dt):
+        """Starts the frame step() would run on the world's own thread and returns at once
+        (sph_world_step_begin). Until step_wait() collects it every other call on the world
+        raises SphError(WORLD_LOCKED), except cancel_step() and step_done()."""
+        check(library().sph_world_step_begin(self.handle, float(frame_dt)), "sph_world_step_begin")
+
+    def step_wait(self):
+        """Waits for the frame step_begin() started and returns what step() would have
+        returned (Result.OK or Result.INCOMPLETE), or raises its error (sph_world_step_wait)."""
+        return check(library().sph_world_step_wait(self.handle), "sph_world_step_wait")
+
+    def step_done(self):
+        """True once the frame step_begin() started has ended, so step_wait() will not block
+        (sph_world_step_poll; never blocks)."""
+        done = ctypes.c_uint32()
+        check(library().sph_world_step_poll(self.handle, ctypes.byref(done)), "sph_world_step_poll")
+        return bool(done.value)
+
     def cancel_step(self):
         """Asks the step running on another thread (or else the next step) to stop at its next
         substep boundary; that step returns Result.INCOMPLETE (sph_world_cancel_step). Safe to

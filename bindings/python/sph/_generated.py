@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '9ef8a5508f3bedd20a0c2223355d754fbca8c301ed98ee6951b5b4302855b6c3', 'include/sph_cuda.h': '8fe2c1988d9c8456a91fb26b7863765759ab8ad17bd1ff44b457c77af0bc7985', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': 'e6c52b58999e75cee3695c453301421bb899dac60d8f96025467a4ffdb70db76', 'include/sph_cuda.h': '8fe2c1988d9c8456a91fb26b7863765759ab8ad17bd1ff44b457c77af0bc7985', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -1854,6 +1854,12 @@ FUNCTIONS = {
         'The step budget in seconds (0: none). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL).', 'sph'),
     'sph_world_cancel_step': (sph_result, (_c.POINTER(sph_world),), ('world',),
         "Asks the world's step to stop at its next substep boundary (it returns SPH_INCOMPLETE with the world consistent; on the CUDA backend a frame on the device graph, which is every frame without a step budget or sinks, sees it only at its end). The one call that may run on another thread while a step holds the world: it never blocks and never answers WORLD_LOCKED. A request made while no step runs stops the next step before its first substep (that step changes nothing and reports 0 substeps); a step that stops for it clears it. Errors: INVALID_HANDLE (NULL or destroyed: safe to call racing sph_world_destroy).", 'sph'),
+    'sph_world_step_begin': (sph_result, (_c.POINTER(sph_world), _c.c_float), ('world', 'frame_dt'),
+        "Asynchronous steps: sph_world_step_begin starts the frame that sph_world_step would run and returns at once; the frame runs on the world's own thread (started by its first asynchronous step and kept until sph_world_destroy; on the CPU backend it leads the OpenMP workers), so the caller's frame overlaps the simulation. Until sph_world_step_wait collects it, the world is held by that step: every other call on the world answers SPH_ERROR_WORLD_LOCKED (destroy included), except sph_world_cancel_step and sph_world_step_poll. Each begin needs one wait, also before the process exits; the wait may come from any thread. Errors of begin: INVALID_HANDLE, INVALID_ARGUMENT (frame_dt not > 0 and finite), WORLD_LOCKED, OUT_OF_HOST_MEMORY (no thread could be started). Nothing runs when begin fails.", 'sph'),
+    'sph_world_step_wait': (sph_result, (_c.POINTER(sph_world),), ('world',),
+        "Waits for the step that sph_world_step_begin started and returns what sph_world_step would have returned for it (SPH_OK, SPH_INCOMPLETE, or its error, with its message in this thread's sph_get_last_error and the world rolled back as sph_world_step does); the world is free again. Errors of the call itself: INVALID_HANDLE, INVALID_ARGUMENT (no step begun, or it was already waited for), WORLD_LOCKED (another call holds the world, e.g. another thread's wait).", 'sph'),
+    'sph_world_step_poll': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_bool32)), ('world', 'out_done'),
+        'Whether the step sph_world_step_begin started has finished (*out_done 1: sph_world_step_wait will not block). Never blocks. Errors: INVALID_HANDLE, INVALID_ARGUMENT (out_done NULL, or no step begun), WORLD_LOCKED (a synchronous call holds the world).', 'sph'),
     'sph_world_get_particle_count': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_uint32)), ('world', 'out_count'),
         'Number of particles in the world.', 'sph'),
     'sph_world_copy_attribute': (sph_result, (_c.POINTER(sph_world), sph_attribute, _c.c_void_p, _c.c_uint64, _c.c_uint64, _c.c_uint32, _c.c_uint32, _c.POINTER(_c.c_uint32)), ('world', 'attribute', 'dst', 'dst_size', 'dst_stride', 'first', 'count', 'out_written'),

@@ -272,3 +272,27 @@ def test_two_worlds_are_independent(ctx):
         b.step(0.01)
         assert a.velocities()[:, 1].mean() < -0.05
         assert abs(b.velocities()[:, 1].mean()) < 1e-3
+
+
+def test_asynchronous_step_matches_step(ctx):
+    # sph_world_step_begin / _wait / _poll (issue 21 item 1): the same frames as step(), the
+    # world held meanwhile (WORLD_LOCKED), misuse refused.
+    with ctx.world(capacity=4096, particle_spacing=0.02) as a, ctx.world(capacity=4096, particle_spacing=0.02) as b:
+        for w in (a, b):
+            w.fill_box((0.0, 0.0, 0.0), (0.16, 0.16, 0.16))
+        for _ in range(2):
+            assert a.step(1.0 / 60.0) == sph.Result.OK
+            b.step_begin(1.0 / 60.0)
+            with pytest.raises(sph.SphError) as locked:
+                b.particle_count
+            assert locked.value.result == sph.Result.ERROR_WORLD_LOCKED
+            while not b.step_done():
+                pass
+            assert b.step_wait() == sph.Result.OK
+            assert np.array_equal(a.positions(), b.positions())
+        with pytest.raises(sph.SphError, match="no step was begun"):
+            b.step_wait()
+        with pytest.raises(sph.SphError, match="no step was begun"):
+            b.step_done()
+        with pytest.raises(sph.SphError, match="frame_dt"):
+            b.step_begin(float("nan"))

@@ -1,0 +1,56 @@
+// SPDX-License-Identifier: MIT
+// The thread behind sph_world_step_begin / sph_world_step_wait: one per world, started by the
+// world's first asynchronous step and kept until the world is destroyed, so its OpenMP team
+// (the CPU backend's workers) and the CUDA backend's host thread stay warm from frame to frame.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <functional>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "../core/status.h"
+
+namespace sph {
+
+// How a step ended: Ok, Incomplete, or an error with the message the synchronous call gives.
+struct StepOutcome {
+  Status status = Status::Ok;
+  std::string message;
+};
+
+class AsyncStepper {
+ public:
+  AsyncStepper() = default;
+  ~AsyncStepper();  // stops the thread (no step may be running: the world's lock says so)
+  AsyncStepper(const AsyncStepper&) = delete;
+  AsyncStepper& operator=(const AsyncStepper&) = delete;
+
+  // Runs `step` on the world's thread (started here the first time; std::system_error if the
+  // system has no thread to give). The caller holds the world's lock and hands it to the step.
+  void start(std::function<StepOutcome()> step);
+  // Waits for the step that start() began and returns how it ended.
+  StepOutcome collect();
+  bool finished() const { return finished_.load(std::memory_order_acquire); }
+
+  // Raised by sph_world_step_begin once the step runs, lowered (under the handle registry's
+  // mutex) by the one sph_world_step_wait that collects it: the world's lock belongs to the
+  // step meanwhile.
+  std::atomic<bool> pending{false};
+
+ private:
+  void run();
+
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::thread thread_;
+  std::function<StepOutcome()> step_;  // set: a step to run
+  bool stop_ = false;
+  bool done_ = false;
+  StepOutcome outcome_;
+  std::atomic<bool> finished_{false};
+};
+
+}  // namespace sph

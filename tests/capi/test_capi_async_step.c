@@ -1,0 +1,282 @@
+// SPDX-License-Identifier: MIT
+/* Asynchronous steps (issue 21, item 1): sph_world_step_begin / _wait / _poll.
+ *
+ * 1. A frame begun and waited for ends bitwise where sph_world_step ends it (same world, same
+ *    backend: a step is deterministic), three frames in a row, waited from another thread once.
+ * 2. While a step is pending, every other call on the world answers WORLD_LOCKED and changes
+ *    nothing (destroy included); poll answers and turns to done; cancel reaches the step.
+ * 3. A step that fails (particles piled into one cell: SPH_ERROR_CAPACITY) reports its error and
+ *    message through wait on the waiting thread, and the world is as before the begin.
+ * 4. Misuse: wait or poll without a begin, a second wait, a second begin, bad arguments, dead
+ *    handles: each a clear error, nothing started.
+ * Runs in the TSan stage (label threads) with one worker: libgomp is not instrumented. */
+#include <pthread.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "capi_test.h"
+
+static const float kFrameDt = 1.0f / 60.0f;
+
+static sph_context* make_context(void) {
+  sph_context_def def;
+  sph_context* context = NULL;
+  EXPECT_OK(sph_test_context_def_init(&def));
+#ifdef SPH_TEST_TSAN_BUILD
+  def.cpu_worker_count = 1;
+#endif
+  EXPECT_OK(sph_context_create(&def, &context));
+  return context;
+}
+
+/* A block of fluid falling in a box: about 1,000 particles, a few substeps a frame. */
+static sph_world* make_world(sph_context* context) {
+  sph_world_def def;
+  sph_world* world = NULL;
+  sph_fill_box_desc box;
+  uint32_t added = 0;
+  sph_world_def_init(&def);
+  def.capacity = 4096;
+  EXPECT_OK(sph_world_create(context, &def, &world));
+  sph_fill_box_desc_init(&box);
+  box.max.x = box.max.y = box.max.z = 0.2f;
+  EXPECT_OK(sph_world_fill_box(world, &box, &added));
+  assert_true(added > 500);
+  return world;
+}
+
+static sph_world* copy_of(sph_context* context, const sph_world* world) {
+  uint8_t* bytes;
+  uint64_t size = 0;
+  sph_world* copy = NULL;
+  EXPECT_OK(sph_world_save(world, NULL, 0, &size));
+  bytes = (uint8_t*)malloc((size_t)size);
+  assert_non_null(bytes);
+  EXPECT_OK(sph_world_save(world, bytes, size, &size));
+  EXPECT_OK(sph_world_load(context, bytes, size, &copy));
+  free(bytes);
+  return copy;
+}
+
+/* Every attribute of every particle, bit for bit. */
+static void expect_same_particles(const sph_world* world, const sph_world* copy) {
+  uint32_t n = 0, m = 0;
+  int a;
+  EXPECT_OK(sph_world_get_particle_count(world, &n));
+  EXPECT_OK(sph_world_get_particle_count(copy, &m));
+  assert_int_equal(n, m);
+  for (a = 0; a < SPH_ATTRIBUTE_COUNT; ++a) {
+    float* x = (float*)calloc(3u * n + 1u, sizeof(float));
+    float* y = (float*)calloc(3u * n + 1u, sizeof(float));
+    assert_true(x && y);
+    EXPECT_OK(sph_world_copy_attribute(world, (sph_attribute)a, x, 12ull * n + 4, 0, 0, n, NULL));
+    EXPECT_OK(sph_world_copy_attribute(copy, (sph_attribute)a, y, 12ull * n + 4, 0, 0, n, NULL));
+    assert_memory_equal(x, y, 12u * n);
+    free(x);
+    free(y);
+  }
+}
+
+typedef struct waiter {
+  sph_world* world;
+  sph_result result;
+  char error[256];
+} waiter;
+
+static void* wait_on_thread(void* arg) {
+  waiter* w = (waiter*)arg;
+  w->result = sph_world_step_wait(w->world);
+  snprintf(w->error, sizeof w->error, "%s", sph_get_last_error());
+  return NULL;
+}
+
+/* Polls until the pending step is done (at most about 60 s). */
+static void poll_until_done(const sph_world* world) {
+  const struct timespec pause = {0, 1000000};
+  sph_bool32 done = 0;
+  int i;
+  for (i = 0; i < 60000 && !done; ++i) {
+    EXPECT_OK(sph_world_step_poll(world, &done));
+    if (!done) nanosleep(&pause, NULL);
+  }
+  assert_int_equal(done, 1);
+}
+
+static void test_same_frames_as_step(void** state) {
+  sph_context* context = make_context();
+  sph_world* world = make_world(context);
+  sph_world* reference = copy_of(context, world);
+  waiter w;
+  pthread_t thread;
+  int frame;
+  (void)state;
+  for (frame = 0; frame < 3; ++frame) {
+    EXPECT_OK(sph_world_step(reference, kFrameDt));
+    EXPECT_OK(sph_world_step_begin(world, kFrameDt));
+    if (frame == 1) {
+      /* Collected by another thread than the one that began it. */
+      w.world = world;
+      w.result = SPH_ERROR_INTERNAL;
+      assert_int_equal(pthread_create(&thread, NULL, wait_on_thread, &w), 0);
+      assert_int_equal(pthread_join(thread, NULL), 0);
+      assert_int_equal(w.result, SPH_OK);
+      assert_string_equal(w.error, "");
+    } else {
+      EXPECT_OK(sph_world_step_wait(world));
+    }
+    expect_same_particles(world, reference);
+  }
+  {
+    sph_stats a, b;
+    sph_stats_init(&a);
+    sph_stats_init(&b);
+    EXPECT_OK(sph_world_get_stats(world, &a));
+    EXPECT_OK(sph_world_get_stats(reference, &b));
+    assert_int_equal(a.substeps, b.substeps);
+    assert_true(a.substeps > 0);
+    assert_true(a.simulated_time == b.simulated_time);
+  }
+  EXPECT_OK(sph_world_destroy(reference));
+  EXPECT_OK(sph_world_destroy(world));
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+static void test_pending_step_holds_the_world(void** state) {
+  sph_context* context = make_context();
+  sph_world* world = make_world(context);
+  sph_world_params params;
+  sph_stats stats;
+  uint32_t count = 0;
+  float position[3];
+  sph_bool32 done = 2;
+  (void)state;
+  /* Many short substeps: the frame is still running while the calls below are made, although
+   * the answers must not depend on it (the world stays held until the wait). */
+  sph_world_params_init(&params);
+  EXPECT_OK(sph_world_get_params(world, &params));
+  params.dt_min = params.dt_max = 1e-4f;
+  params.max_substeps = 10000;
+  EXPECT_OK(sph_world_set_params(world, &params));
+
+  EXPECT_OK(sph_world_step_begin(world, 0.5f));
+  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_step(world, kFrameDt));
+  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_step_begin(world, kFrameDt));
+  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_get_particle_count(world, &count));
+  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_get_params(world, &params));
+  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_set_params(world, &params));
+  sph_stats_init(&stats);
+  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_get_stats(world, &stats));
+  EXPECT_ERROR(
+      SPH_ERROR_WORLD_LOCKED, "world",
+      sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, position, sizeof position, 0, 0, 1, NULL));
+  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_destroy(world));
+  EXPECT_ERROR(SPH_ERROR_BUSY, "context", sph_context_destroy(context));
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "out_done", sph_world_step_poll(world, NULL));
+  EXPECT_OK(sph_world_step_poll(world, &done));
+  assert_true(done == 0 || done == 1);
+
+  /* 5,000 substeps of 1e-4 s: the cancel stops the frame early (or, if the frame already ran
+   * out, the cancel waits for the next step, which then stops at once). */
+  EXPECT_OK(sph_world_cancel_step(world));
+  poll_until_done(world);
+  {
+    const sph_result r = sph_world_step_wait(world);
+    assert_true(r == SPH_INCOMPLETE || r == SPH_OK);
+    EXPECT_OK(sph_world_get_stats(world, &stats));
+    if (r == SPH_INCOMPLETE) {
+      assert_true(stats.substeps < 5000);
+    } else {
+      assert_int_equal(stats.substeps, 5000);
+      assert_int_equal(sph_world_step(world, kFrameDt), SPH_INCOMPLETE); /* uses up the cancel */
+    }
+    printf("cancelled asynchronous frame: %s after %u substeps\n", sph_result_string(r), stats.substeps);
+  }
+  /* Free again. */
+  EXPECT_OK(sph_world_get_particle_count(world, &count));
+  assert_true(count > 500);
+  EXPECT_OK(sph_world_destroy(world));
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+static void test_failed_step_reports_through_wait(void** state) {
+  sph_context* context = make_context();
+  sph_world_def def;
+  sph_world* world = NULL;
+  sph_world* before;
+  sph_spawn_desc spawn;
+  float* p;
+  uint32_t i, first = 0;
+  const uint32_t n = 8000;
+  (void)state;
+  sph_world_def_init(&def);
+  def.capacity = n;
+  EXPECT_OK(sph_world_create(context, &def, &world));
+  p = (float*)calloc(3u * n, sizeof(float));
+  assert_non_null(p);
+  for (i = 0; i < n; ++i) {
+    p[3 * i] = 0.25f;
+    p[3 * i + 1] = 0.5f;
+    p[3 * i + 2] = 0.125f;
+  }
+  sph_spawn_desc_init(&spawn);
+  spawn.count = n;
+  spawn.positions = p;
+  EXPECT_OK(sph_world_spawn(world, &spawn, &first));
+  free(p);
+  before = copy_of(context, world);
+
+  EXPECT_OK(sph_world_step_begin(world, kFrameDt));
+  assert_int_equal(sph_world_step_wait(world), SPH_ERROR_CAPACITY);
+  assert_non_null(strstr(sph_get_last_error(), "particles share one cell"));
+  expect_same_particles(world, before);
+  /* The failure was collected: the world is free and no step is pending. */
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "no step was begun", sph_world_step_wait(world));
+  EXPECT_OK(sph_world_destroy(before));
+  EXPECT_OK(sph_world_destroy(world));
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+static void test_misuse(void** state) {
+  sph_context* context = make_context();
+  sph_world* world = make_world(context);
+  sph_world* dead = make_world(context);
+  sph_bool32 done = 7;
+  (void)state;
+  EXPECT_OK(sph_world_destroy(dead));
+
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "no step was begun", sph_world_step_wait(world));
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "no step was begun", sph_world_step_poll(world, &done));
+  assert_int_equal(done, 7);
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "frame_dt", sph_world_step_begin(world, 0.0f));
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "frame_dt", sph_world_step_begin(world, -1.0f));
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "frame_dt", sph_world_step_begin(world, capi_non_finite(0)));
+  /* Nothing was started by the refused begins. */
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "no step was begun", sph_world_step_wait(world));
+
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world", sph_world_step_begin(NULL, kFrameDt));
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world", sph_world_step_wait(NULL));
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world", sph_world_step_poll(NULL, &done));
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world", sph_world_step_begin(dead, kFrameDt));
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world", sph_world_step_wait(dead));
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world", sph_world_step_poll(dead, &done));
+
+  /* One wait per begin. */
+  EXPECT_OK(sph_world_step_begin(world, kFrameDt));
+  EXPECT_OK(sph_world_step_wait(world));
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "already waited for", sph_world_step_wait(world));
+  EXPECT_OK(sph_world_destroy(world));
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_same_frames_as_step),
+      cmocka_unit_test(test_pending_step_holds_the_world),
+      cmocka_unit_test(test_failed_step_reports_through_wait),
+      cmocka_unit_test(test_misuse),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
