@@ -23,6 +23,7 @@ __global__ void reorder_kernel(ParticleArrays a, const uint32_t* __restrict__ or
   const Float4 p = a.position[k];
   a.sorted_position[i] = Float4{p.x, p.y, p.z, __uint_as_float(k)};
   a.sorted_id[i] = a.id[k];
+  if (a.user_attribute) a.sorted_user_attribute[i] = a.user_attribute[k];
   if (Carry == Rk4Carry::BuildStart) {
     a.rk4_start[1][i] = ParticleState{xyz(p), xyz(a.velocity[k])};
   } else if (Carry == Rk4Carry::Gather) {
@@ -214,6 +215,12 @@ void enqueue_reorder(const ParticleArrays& a, const uint32_t* order, uint32_t n,
       break;
   }
   check_launch("reorder_kernel");
+  // The user attribute is no kernel's input: it takes the new order at once (every later pass
+  // writes the state in the sorted order, so the two stay matched).
+  if (a.user_attribute && n > 0)
+    cuda_check(cudaMemcpyAsync(a.user_attribute, a.sorted_user_attribute, sizeof(uint32_t) * n,
+                               cudaMemcpyDeviceToDevice, stream),
+               "reorder of the user attributes");
 }
 
 void enqueue_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a, uint32_t n,

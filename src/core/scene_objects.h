@@ -43,6 +43,7 @@ struct Source {
   double rate_budget = 0.0;   // fractional particles carried between frames
   bool done = false;          // FillOnce: already emitted
   std::vector<Vec3> lattice;  // FCC points inside the region, in the region's frame
+  uint32_t user_attribute = 0;  // its particles' (SPH_FEATURE_USER_ATTRIBUTE)
 };
 
 struct Sink {
