@@ -32,8 +32,8 @@ CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBacken
   if (options_.springs)
     for (const ParticleArraySpec& spec : spring_device_arrays()) arrays.push_back(spec);
   if (config.features & kFeatureUserAttribute)
-    arrays.push_back(ParticleArraySpec{kArraySortedUserAttribute, sizeof(uint32_t), ParticleArrayRole::Scratch,
-                                       1, nullptr, nullptr});
+    arrays.push_back(ParticleArraySpec{kArraySortedUserAttribute, sizeof(uint32_t),
+                                       ParticleArrayRole::Scratch, 1, nullptr, nullptr});
   r->store = std::make_unique<DeviceParticleStore>(config.capacity, arrays);
   // The sorted positions are free while the sort runs: its temporary storage goes there.
   r->grid = std::make_unique<DeviceNeighborGrid>(

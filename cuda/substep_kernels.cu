@@ -38,6 +38,13 @@ __global__ void reorder_kernel(ParticleArrays a, const uint32_t* __restrict__ or
   }
 }
 
+// The user attribute back into the state arrays after its gather (a kernel rather than a memcpy:
+// the substep is the body of the frame graph's conditional WHILE node, which takes kernels).
+__global__ void user_attribute_copy_kernel(const uint32_t* __restrict__ sorted, uint32_t n, uint32_t* state) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i < n) state[i] = sorted[i];
+}
+
 template <bool kCounts, bool kNormalized, bool kBoundary>
 __global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
                                DeviceScene scene, float stage_fraction, FrameState* state) {
@@ -217,10 +224,11 @@ void enqueue_reorder(const ParticleArrays& a, const uint32_t* order, uint32_t n,
   check_launch("reorder_kernel");
   // The user attribute is no kernel's input: it takes the new order at once (every later pass
   // writes the state in the sorted order, so the two stay matched).
-  if (a.user_attribute && n > 0)
-    cuda_check(cudaMemcpyAsync(a.user_attribute, a.sorted_user_attribute, sizeof(uint32_t) * n,
-                               cudaMemcpyDeviceToDevice, stream),
-               "reorder of the user attributes");
+  if (a.user_attribute) {
+    user_attribute_copy_kernel<<<blocks, kDefaultBlockSize, 0, stream>>>(a.sorted_user_attribute, n,
+                                                                         a.user_attribute);
+    check_launch("user_attribute_copy_kernel");
+  }
 }
 
 void enqueue_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a, uint32_t n,

@@ -20,7 +20,14 @@
 
 namespace sph {
 
-enum class AttributeKind : uint32_t { Position = 0, Velocity = 1, Density = 2, Pressure = 3, Id = 4, User = 5 };
+enum class AttributeKind : uint32_t {
+  Position = 0,
+  Velocity = 1,
+  Density = 2,
+  Pressure = 3,
+  Id = 4,
+  User = 5
+};
 
 // A device-resident attribute: element k of particle i is at address + i * stride.
 struct DeviceAttributeView {

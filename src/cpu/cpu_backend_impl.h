@@ -227,7 +227,7 @@ class CpuBackend final : public Backend {
   CpuArrayRef<Float4> dfsph_contact_;          // DFSPH: each particle's contact with the colliders
   bool dfsph_contacts_ = false;                // DFSPH: the substep has colliders (contacts to respect)
   std::vector<ColliderView> dfsph_colliders_;  // DFSPH: the substep's colliders, for the contacts
-  CpuArrayRef<Float4> boundary_;  // boundary density: (grad rho_b, v_b . grad rho_b) per particle
+  CpuArrayRef<Float4> boundary_;          // boundary density: (grad rho_b, v_b . grad rho_b) per particle
   CpuArrayRef<uint32_t> user_attribute_;  // SPH_FEATURE_USER_ATTRIBUTE: the caller's value
   CpuBoundaryMaps boundary_maps_;
   std::vector<ColliderView> collider_views_;  // the frame's colliders, for the density pass

@@ -57,9 +57,8 @@ void write_vtp(const ParticleFrame& f, const std::string& path) {
   const uint64_t n = f.count;
   const Array velocity{"velocity", "Float32", 3, 12 * n}, density{"density", "Float32", 1, 4 * n},
       pressure{"pressure", "Float32", 1, 4 * n}, id{"id", "UInt32", 1, 4 * n},
-      user{"user", "UInt32", 1, 4 * n},
-      points{nullptr, "Float32", 3, 12 * n}, connectivity{"connectivity", "Int64", 1, 8 * n},
-      offsets{"offsets", "Int64", 1, 8 * n};
+      user{"user", "UInt32", 1, 4 * n}, points{nullptr, "Float32", 3, 12 * n},
+      connectivity{"connectivity", "Int64", 1, 8 * n}, offsets{"offsets", "Int64", 1, 8 * n};
   std::fprintf(
       out,
       "<?xml version=\"1.0\"?>\n"
