@@ -755,8 +755,9 @@ SPH_API sph_result SPH_CALL sph_world_get_particle_count(const sph_world* world,
  * out_written (optional) receives how many were written. Blocks until the data is ready.
  * Errors: INVALID_ARGUMENT (NULL dst, stride smaller than the element, first > particle
  * count, a span (n - 1) * dst_stride + element that overflows 64 bits or exceeds PTRDIFF_MAX),
- * BUFFER_TOO_SMALL (dst_size cannot hold count elements), UNSUPPORTED (unknown attribute).
- * Nothing is written on error.
+ * BUFFER_TOO_SMALL (dst_size cannot hold count elements), UNSUPPORTED (unknown attribute),
+ * FEATURE_DISABLED (SPH_ATTRIBUTE_USER without SPH_FEATURE_USER_ATTRIBUTE). Nothing is written
+ * on error.
  */
 SPH_API sph_result SPH_CALL sph_world_copy_attribute(const sph_world* world, sph_attribute attribute,
                                                      void* dst, uint64_t dst_size, uint64_t dst_stride,

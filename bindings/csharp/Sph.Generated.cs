@@ -2293,7 +2293,8 @@ namespace Sph
         /// how many were written. Blocks until the data is ready. Errors: INVALID_ARGUMENT (NULL dst,
         /// stride smaller than the element, first &gt; particle count, a span (n - 1) * dst_stride +
         /// element that overflows 64 bits or exceeds PTRDIFF_MAX), BUFFER_TOO_SMALL (dst_size cannot
-        /// hold count elements), UNSUPPORTED (unknown attribute). Nothing is written on error.
+        /// hold count elements), UNSUPPORTED (unknown attribute), FEATURE_DISABLED (SPH_ATTRIBUTE_USER
+        /// without SPH_FEATURE_USER_ATTRIBUTE). Nothing is written on error.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_copy_attribute(WorldHandle world, SphAttribute attribute, IntPtr dst, ulong dstSize, ulong dstStride, uint first, uint count, out uint outWritten);
