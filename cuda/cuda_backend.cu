@@ -31,6 +31,9 @@ CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBacken
   std::vector<ParticleArraySpec> arrays = method_particle_arrays(config);
   if (options_.springs)
     for (const ParticleArraySpec& spec : spring_device_arrays()) arrays.push_back(spec);
+  if (config.features & kFeatureUserAttribute)
+    arrays.push_back(ParticleArraySpec{kArraySortedUserAttribute, sizeof(uint32_t),
+                                       ParticleArrayRole::Scratch, 1, nullptr, nullptr});
   r->store = std::make_unique<DeviceParticleStore>(config.capacity, arrays);
   // The sorted positions are free while the sort runs: its temporary storage goes there.
   r->grid = std::make_unique<DeviceNeighborGrid>(
@@ -61,7 +64,8 @@ CudaBackend::~CudaBackend() {
   delete guard;
 }
 
-void CudaBackend::append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id) {
+void CudaBackend::append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id,
+                         uint32_t user_attribute) {
   require_alive();
   DeviceGuard guard(device_);
   std::vector<Float4> pos(n), vel(n);
@@ -73,6 +77,17 @@ void CudaBackend::append(const Vec3* positions, const Vec3* velocities, uint32_t
   for (const auto& m : r_->store->method_arrays())
     if (m->spec.role == ParticleArrayRole::Carried && m->spec.elements_per_particle != 0)
       initial.push_back(carried_bytes(ParticleSnapshot{}, m->spec, n));
+  // The user attribute starts at the caller's value instead.
+  {
+    size_t k = 0;
+    for (const auto& m : r_->store->method_arrays()) {
+      if (m->spec.role != ParticleArrayRole::Carried || m->spec.elements_per_particle == 0) continue;
+      if (std::strcmp(m->spec.name, kArrayUserAttribute) == 0)
+        for (uint32_t e = 0; e < n; ++e)
+          std::memcpy(initial[k].data() + sizeof(uint32_t) * e, &user_attribute, sizeof(uint32_t));
+      ++k;
+    }
+  }
   for (uint32_t k = 0; k < n; ++k) {
     const Vec3 v = velocities ? velocities[k] : Vec3{0.0f, 0.0f, 0.0f};
     pos[k] = make_float4_record(positions[k], 0.0f);
@@ -178,6 +193,9 @@ void CudaBackend::copy_attribute(AttributeKind kind, uint32_t first, uint32_t co
       break;
     case AttributeKind::Id:
       scatter(download(a.id + first, count), out, stride);
+      break;
+    case AttributeKind::User:
+      scatter(download(a.user_attribute + first, count), out, stride);
       break;
   }
 }
@@ -285,6 +303,9 @@ DeviceAttributeView CudaBackend::device_attribute(AttributeKind kind) const {
       break;
     case AttributeKind::Id:
       v = with(v, reinterpret_cast<uintptr_t>(a.id), sizeof(uint32_t), 4);
+      break;
+    case AttributeKind::User:
+      v = with(v, reinterpret_cast<uintptr_t>(a.user_attribute), sizeof(uint32_t), 4);
       break;
   }
   return v;

@@ -69,7 +69,8 @@ class CudaBackend final : public Backend {
 
   uint32_t particle_count() const override { return count_; }
 
-  void append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id) override;
+  void append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id,
+              uint32_t user_attribute) override;
 
   // Drops particles [count, particle_count()) (an emission undone after a failed step).
   void truncate(uint32_t count) override;

@@ -68,7 +68,14 @@ struct ParticleArrays {
   Float4* dfsph_contact;       // the particle's contact with the colliders (n, smallest normal speed)
   // Null unless SPH_FEATURE_BOUNDARY_DENSITY: (grad rho_b, v_b . grad rho_b) of the density pass.
   Float4* boundary_gradient;
+  // Null unless SPH_FEATURE_USER_ATTRIBUTE: the caller's value in the state order, and the
+  // reorder's gather target, copied back over it right after (substep_kernels.cu).
+  uint32_t* user_attribute;
+  uint32_t* sorted_user_attribute;
 };
+
+// This backend's working array for the user attribute's reorder (SPH_FEATURE_USER_ATTRIBUTE).
+constexpr const char* kArraySortedUserAttribute = "sorted_user_attribute";
 
 // A method's array on the device: its elements (two sides for a Sorted array) and, for a
 // Carried one, the snapshot of the frame's start.

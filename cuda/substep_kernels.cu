@@ -23,6 +23,7 @@ __global__ void reorder_kernel(ParticleArrays a, const uint32_t* __restrict__ or
   const Float4 p = a.position[k];
   a.sorted_position[i] = Float4{p.x, p.y, p.z, __uint_as_float(k)};
   a.sorted_id[i] = a.id[k];
+  if (a.user_attribute) a.sorted_user_attribute[i] = a.user_attribute[k];
   if (Carry == Rk4Carry::BuildStart) {
     a.rk4_start[1][i] = ParticleState{xyz(p), xyz(a.velocity[k])};
   } else if (Carry == Rk4Carry::Gather) {
@@ -35,6 +36,13 @@ __global__ void reorder_kernel(ParticleArrays a, const uint32_t* __restrict__ or
       a.rk4_sum[0][i] = a.rk4_sum[1][k];
     }
   }
+}
+
+// The user attribute back into the state arrays after its gather (a kernel rather than a memcpy:
+// the substep is the body of the frame graph's conditional WHILE node, which takes kernels).
+__global__ void user_attribute_copy_kernel(const uint32_t* __restrict__ sorted, uint32_t n, uint32_t* state) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i < n) state[i] = sorted[i];
 }
 
 template <bool kCounts, bool kNormalized, bool kBoundary>
@@ -214,6 +222,13 @@ void enqueue_reorder(const ParticleArrays& a, const uint32_t* order, uint32_t n,
       break;
   }
   check_launch("reorder_kernel");
+  // The user attribute is no kernel's input: it takes the new order at once (every later pass
+  // writes the state in the sorted order, so the two stay matched).
+  if (a.user_attribute) {
+    user_attribute_copy_kernel<<<blocks, kDefaultBlockSize, 0, stream>>>(a.sorted_user_attribute, n,
+                                                                         a.user_attribute);
+    check_launch("user_attribute_copy_kernel");
+  }
 }
 
 void enqueue_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a, uint32_t n,

@@ -130,7 +130,8 @@ typedef enum sph_attribute {
   SPH_ATTRIBUTE_PRESSURE = 3, /* float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation;
                                  DFSPH: the pressure its density solve found in the last substep */
   SPH_ATTRIBUTE_ID = 4,       /* uint32, persistent particle id, unique within a world */
-  SPH_ATTRIBUTE_COUNT = 5,
+  SPH_ATTRIBUTE_USER = 5,     /* uint32, the caller's value (SPH_FEATURE_USER_ATTRIBUTE) */
+  SPH_ATTRIBUTE_COUNT = 6,
   SPH_ATTRIBUTE_FORCE32 = 0x7fffffff
 } sph_attribute;
 
@@ -195,6 +196,13 @@ typedef uint32_t sph_feature_flags;
  *  substep, a reduction over the particles per collider (and with the boundary density one SDF
  *  sample per particle and collider per force evaluation); no host round trip inside a step. */
 #define SPH_FEATURE_COLLIDER_LOADS 0x10u
+/** A user attribute: one uint32 per particle that the caller sets and the library never reads (a
+ *  colour, a phase or material id): written with sph_world_set_attribute and read with
+ *  sph_world_copy_attribute (SPH_ATTRIBUTE_USER), it follows its particle through every sort,
+ *  sink and checkpoint. Particles from sph_world_spawn and the fills start at 0; a source's get
+ *  its sph_source_def.user_attribute. Costs 4 bytes per particle (and its copy in the rollback
+ *  snapshot) and one gather per sort. */
+#define SPH_FEATURE_USER_ATTRIBUTE 0x20u
 
 typedef enum sph_viscosity_method {
   SPH_VISCOSITY_MUELLER = 0, /* Laplacian viscosity (eq. 17), coefficient sph_world_params.viscosity */
@@ -774,12 +782,52 @@ SPH_API sph_result SPH_CALL sph_world_get_particle_count(const sph_world* world,
  * out_written (optional) receives how many were written. Blocks until the data is ready.
  * Errors: INVALID_ARGUMENT (NULL dst, stride smaller than the element, first > particle
  * count, a span (n - 1) * dst_stride + element that overflows 64 bits or exceeds PTRDIFF_MAX),
- * BUFFER_TOO_SMALL (dst_size cannot hold count elements), UNSUPPORTED (unknown attribute).
- * Nothing is written on error.
+ * BUFFER_TOO_SMALL (dst_size cannot hold count elements), UNSUPPORTED (unknown attribute),
+ * FEATURE_DISABLED (SPH_ATTRIBUTE_USER without SPH_FEATURE_USER_ATTRIBUTE). Nothing is written
+ * on error.
  */
 SPH_API sph_result SPH_CALL sph_world_copy_attribute(const sph_world* world, sph_attribute attribute,
                                                      void* dst, uint64_t dst_size, uint64_t dst_stride,
                                                      uint32_t first, uint32_t count, uint32_t* out_written);
+
+/* ---- writing particles ------------------------------------------------------------------- */
+
+/**
+ * Overwrites particles [first, first + count) of one attribute from caller memory (copied
+ * before return), in the order sph_world_copy_attribute reads them (the world's current order:
+ * read SPH_ATTRIBUTE_ID over the same range to know which particles they are). Writable:
+ * SPH_ATTRIBUTE_POSITION and SPH_ATTRIBUTE_VELOCITY (3 x float32) and SPH_ATTRIBUTE_USER
+ * (uint32, needs SPH_FEATURE_USER_ATTRIBUTE). Element i is read at src + i * src_stride
+ * (src_stride 0 = the element's size); src_size is the size of the buffer at src in bytes.
+ * Positions must be finite and within 65536 particle spacings of the origin (as spawned ones);
+ * velocities finite with a speed below 1.8e19 m/s. A written particle keeps everything else
+ * (its id, density, the methods' state); the next step starts from the written values, its
+ * first substep sized from the new speeds. All-or-nothing: every element is checked before
+ * anything is written; on any error the world is unchanged. Blocks; O(particle count) work and,
+ * on a CUDA world, a copy of the particle state to the host and back (batch writes into one call).
+ * Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL src with count > 0, stride smaller than the
+ * element, first + count beyond the particle count, a span that overflows, a value out of range:
+ * the message names the element, e.g. "src[3]"; DENSITY, PRESSURE or ID, which are not writable),
+ * BUFFER_TOO_SMALL (src_size cannot hold count elements), UNSUPPORTED (unknown attribute),
+ * FEATURE_DISABLED (SPH_ATTRIBUTE_USER without SPH_FEATURE_USER_ATTRIBUTE), WORLD_LOCKED,
+ * OUT_OF_HOST_MEMORY, DEVICE.
+ */
+SPH_API sph_result SPH_CALL sph_world_set_attribute(sph_world* world, sph_attribute attribute,
+                                                    const void* src, uint64_t src_size, uint64_t src_stride,
+                                                    uint32_t first, uint32_t count);
+
+/**
+ * Removes the particles with the given ids (SPH_ATTRIBUTE_ID; caller array, read during the
+ * call). The particles left keep their relative order and their ids. The removed ids are added,
+ * in the order given, to those sph_world_get_removed_ids reports (which the next sph_world_step
+ * clears), as if a sink had removed them; no event is added. count 0 removes nothing (ids may
+ * then be NULL). All-or-nothing: on any error nothing is removed. Blocks; O(particle count) work
+ * and, on a CUDA world, a copy of the particle state to the host and back.
+ * Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL ids with count > 0; an id that names no
+ * particle of the world or appears twice: the message names the first such, e.g. "ids[4]: 17
+ * appears twice (first at ids[1])"), WORLD_LOCKED, OUT_OF_HOST_MEMORY, DEVICE.
+ */
+SPH_API sph_result SPH_CALL sph_world_remove_particles(sph_world* world, const uint32_t* ids, uint32_t count);
 
 /* ---- statistics -------------------------------------------------------------------------- */
 typedef struct sph_stats {
@@ -1169,7 +1217,8 @@ typedef struct sph_source_def {
   sph_vec3 velocity;       /* initial velocity (unless VELOCITY_FROM_FIELD); default 0 */
   uint32_t flags;          /* SPH_SOURCE_FLAG_* */
   float rate;              /* CONTINUOUS: most particles per second; 0 (default) = no limit */
-  uint32_t reserved0;      /* must be 0 */
+  uint32_t user_attribute; /* the user attribute of the particles it emits; default 0; non-zero
+                              needs SPH_FEATURE_USER_ATTRIBUTE (else FEATURE_DISABLED) */
   uint32_t reserved1;      /* must be 0 */
 } sph_source_def;
 SPH_STATIC_ASSERT(sizeof(sph_source_def) == 72 + sizeof(void*), sph_source_def_size);
@@ -1289,7 +1338,8 @@ SPH_STATIC_ASSERT(sizeof(sph_event) == 16, sph_event_size);
  */
 SPH_API sph_result SPH_CALL sph_world_get_events(const sph_world* world, sph_event* events, uint32_t capacity,
                                                  uint32_t* out_count);
-/** Ids of the particles sinks removed during the last sph_world_step (two-call pattern). */
+/** Ids of the particles sinks removed during the last sph_world_step, then those
+ *  sph_world_remove_particles removed since (two-call pattern). */
 SPH_API sph_result SPH_CALL sph_world_get_removed_ids(const sph_world* world, uint32_t* ids,
                                                       uint32_t capacity, uint32_t* out_count);
 

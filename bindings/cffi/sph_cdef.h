@@ -19,6 +19,7 @@
 #define SPH_FEATURE_SPRINGS 4
 #define SPH_FEATURE_BOUNDARY_DENSITY 8
 #define SPH_FEATURE_COLLIDER_LOADS 16
+#define SPH_FEATURE_USER_ATTRIBUTE 32
 #define SPH_STEP_LIMIT_ACOUSTIC 1
 #define SPH_STEP_LIMIT_FORCE 2
 #define SPH_DFSPH_SKIP_DIVERGENCE_SOLVE 1
@@ -83,7 +84,8 @@ typedef enum {
   SPH_ATTRIBUTE_DENSITY = 2,
   SPH_ATTRIBUTE_PRESSURE = 3,
   SPH_ATTRIBUTE_ID = 4,
-  SPH_ATTRIBUTE_COUNT = 5,
+  SPH_ATTRIBUTE_USER = 5,
+  SPH_ATTRIBUTE_COUNT = 6,
   SPH_ATTRIBUTE_FORCE32 = 2147483647,
 } sph_attribute;
 typedef enum {
@@ -444,7 +446,7 @@ typedef struct sph_source_def {
   sph_vec3 velocity;
   uint32_t flags;
   float rate;
-  uint32_t reserved0;
+  uint32_t user_attribute;
   uint32_t reserved1;
 } sph_source_def;
 typedef struct sph_sink_id {
@@ -548,6 +550,8 @@ sph_result sph_world_step_wait(sph_world* world);
 sph_result sph_world_step_poll(const sph_world* world, sph_bool32* out_done);
 sph_result sph_world_get_particle_count(const sph_world* world, uint32_t* out_count);
 sph_result sph_world_copy_attribute(const sph_world* world, sph_attribute attribute, void* dst, uint64_t dst_size, uint64_t dst_stride, uint32_t first, uint32_t count, uint32_t* out_written);
+sph_result sph_world_set_attribute(sph_world* world, sph_attribute attribute, const void* src, uint64_t src_size, uint64_t src_stride, uint32_t first, uint32_t count);
+sph_result sph_world_remove_particles(sph_world* world, const uint32_t* ids, uint32_t count);
 sph_result sph_stats_init_sized(sph_stats* stats, uint32_t size);
 sph_result sph_world_get_stats(const sph_world* world, sph_stats* out);
 sph_result sph_grid_desc_init_sized(sph_grid_desc* desc, uint32_t size);

@@ -69,6 +69,15 @@ namespace Sph
         /// </summary>
         public const uint SPH_FEATURE_COLLIDER_LOADS = 16u;
         /// <summary>
+        /// A user attribute: one uint32 per particle that the caller sets and the library never reads
+        /// (a colour, a phase or material id): written with sph_world_set_attribute and read with
+        /// sph_world_copy_attribute (SPH_ATTRIBUTE_USER), it follows its particle through every sort,
+        /// sink and checkpoint. Particles from sph_world_spawn and the fills start at 0; a source's get
+        /// its sph_source_def.user_attribute. Costs 4 bytes per particle (and its copy in the rollback
+        /// snapshot) and one gather per sort.
+        /// </summary>
+        public const uint SPH_FEATURE_USER_ATTRIBUTE = 32u;
+        /// <summary>
         /// Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt &lt;= step_factor h /
         /// c, c the EOS's speed of sound \ (weakly compressible worlds only)
         /// </summary>
@@ -88,7 +97,7 @@ namespace Sph
         public const int SPH_CUDA_FRAMES_FORCE32 = 2147483647;
         public const int SPH_INTEGRATOR_FORCE32 = 2147483647;
         public const int SPH_LOG_LEVEL_FORCE32 = 2147483647;
-        public const int SPH_ATTRIBUTE_COUNT = 5;
+        public const int SPH_ATTRIBUTE_COUNT = 6;
         public const int SPH_ATTRIBUTE_FORCE32 = 2147483647;
         public const int SPH_STAGE_COUNT = 8;
         public const int SPH_STAGE_FORCE32 = 2147483647;
@@ -207,6 +216,8 @@ namespace Sph
         Pressure = 3,
         /// <summary>uint32, persistent particle id, unique within a world</summary>
         Id = 4,
+        /// <summary>uint32, the caller's value (SPH_FEATURE_USER_ATTRIBUTE)</summary>
+        User = 5,
     }
 
     /// <summary>sph_stage: Stages of a substep, indices into sph_stats.stage_ms.</summary>
@@ -1611,8 +1622,11 @@ namespace Sph
         public uint Flags;
         /// <summary>float rate: CONTINUOUS: most particles per second; 0 (default) = no limit</summary>
         public float Rate;
-        /// <summary>uint32_t reserved0: must be 0</summary>
-        public uint Reserved0;
+        /// <summary>
+        /// uint32_t user_attribute: the user attribute of the particles it emits; default 0; non-zero
+        /// needs SPH_FEATURE_USER_ATTRIBUTE (else FEATURE_DISABLED)
+        /// </summary>
+        public uint UserAttribute;
         /// <summary>uint32_t reserved1: must be 0</summary>
         public uint Reserved1;
 
@@ -2318,12 +2332,54 @@ namespace Sph
         /// how many were written. Blocks until the data is ready. Errors: INVALID_ARGUMENT (NULL dst,
         /// stride smaller than the element, first &gt; particle count, a span (n - 1) * dst_stride +
         /// element that overflows 64 bits or exceeds PTRDIFF_MAX), BUFFER_TOO_SMALL (dst_size cannot
-        /// hold count elements), UNSUPPORTED (unknown attribute). Nothing is written on error.
+        /// hold count elements), UNSUPPORTED (unknown attribute), FEATURE_DISABLED (SPH_ATTRIBUTE_USER
+        /// without SPH_FEATURE_USER_ATTRIBUTE). Nothing is written on error.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_copy_attribute(WorldHandle world, SphAttribute attribute, IntPtr dst, ulong dstSize, ulong dstStride, uint first, uint count, out uint outWritten);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_copy_attribute")]
         public static extern Result sph_world_copy_attribute(IntPtr world, SphAttribute attribute, IntPtr dst, ulong dstSize, ulong dstStride, uint first, uint count, IntPtr outWritten);
+
+        /// <summary>
+        /// Overwrites particles [first, first + count) of one attribute from caller memory (copied
+        /// before return), in the order sph_world_copy_attribute reads them (the world's current order:
+        /// read SPH_ATTRIBUTE_ID over the same range to know which particles they are). Writable:
+        /// SPH_ATTRIBUTE_POSITION and SPH_ATTRIBUTE_VELOCITY (3 x float32) and SPH_ATTRIBUTE_USER
+        /// (uint32, needs SPH_FEATURE_USER_ATTRIBUTE). Element i is read at src + i * src_stride
+        /// (src_stride 0 = the element's size); src_size is the size of the buffer at src in bytes.
+        /// Positions must be finite and within 65536 particle spacings of the origin (as spawned ones);
+        /// velocities finite with a speed below 1.8e19 m/s. A written particle keeps everything else
+        /// (its id, density, the methods' state); the next step starts from the written values, its
+        /// first substep sized from the new speeds. All-or-nothing: every element is checked before
+        /// anything is written; on any error the world is unchanged. Blocks; O(particle count) work
+        /// and, on a CUDA world, a copy of the particle state to the host and back (batch writes into
+        /// one call). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL src with count &gt; 0, stride
+        /// smaller than the element, first + count beyond the particle count, a span that overflows, a
+        /// value out of range: the message names the element, e.g. "src[3]"; DENSITY, PRESSURE or ID,
+        /// which are not writable), BUFFER_TOO_SMALL (src_size cannot hold count elements), UNSUPPORTED
+        /// (unknown attribute), FEATURE_DISABLED (SPH_ATTRIBUTE_USER without
+        /// SPH_FEATURE_USER_ATTRIBUTE), WORLD_LOCKED, OUT_OF_HOST_MEMORY, DEVICE.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_set_attribute(WorldHandle world, SphAttribute attribute, IntPtr src, ulong srcSize, ulong srcStride, uint first, uint count);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_set_attribute")]
+        public static extern Result sph_world_set_attribute(IntPtr world, SphAttribute attribute, IntPtr src, ulong srcSize, ulong srcStride, uint first, uint count);
+
+        /// <summary>
+        /// Removes the particles with the given ids (SPH_ATTRIBUTE_ID; caller array, read during the
+        /// call). The particles left keep their relative order and their ids. The removed ids are
+        /// added, in the order given, to those sph_world_get_removed_ids reports (which the next
+        /// sph_world_step clears), as if a sink had removed them; no event is added. count 0 removes
+        /// nothing (ids may then be NULL). All-or-nothing: on any error nothing is removed. Blocks;
+        /// O(particle count) work and, on a CUDA world, a copy of the particle state to the host and
+        /// back. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL ids with count &gt; 0; an id that names
+        /// no particle of the world or appears twice: the message names the first such, e.g. "ids[4]:
+        /// 17 appears twice (first at ids[1])"), WORLD_LOCKED, OUT_OF_HOST_MEMORY, DEVICE.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_remove_particles(WorldHandle world, [In] uint[] ids, uint count);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_remove_particles")]
+        public static extern Result sph_world_remove_particles(IntPtr world, IntPtr ids, uint count);
 
         /// <summary>sph_stats_init_sized</summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
@@ -2616,7 +2672,10 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_events")]
         public static extern Result sph_world_get_events(IntPtr world, IntPtr events, uint capacity, IntPtr outCount);
 
-        /// <summary>Ids of the particles sinks removed during the last sph_world_step (two-call pattern).</summary>
+        /// <summary>
+        /// Ids of the particles sinks removed during the last sph_world_step, then those
+        /// sph_world_remove_particles removed since (two-call pattern).
+        /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_get_removed_ids(WorldHandle world, [In, Out] uint[] ids, uint capacity, out uint outCount);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_removed_ids")]
@@ -3315,7 +3374,7 @@ namespace Sph
             "Velocity",
             "Flags",
             "Rate",
-            "Reserved0",
+            "UserAttribute",
             "Reserved1",
             "Bits",
             "StructSize",
@@ -3636,6 +3695,8 @@ namespace Sph
             "sph_world_step_poll",
             "sph_world_get_particle_count",
             "sph_world_copy_attribute",
+            "sph_world_set_attribute",
+            "sph_world_remove_particles",
             "sph_stats_init_sized",
             "sph_world_get_stats",
             "sph_grid_desc_init_sized",
@@ -3799,6 +3860,8 @@ namespace Sph
             "sph",
             "sph",
             "sph",
+            "sph",
+            "sph",
             "sph_vdb",
             "sph_vdb",
         };
@@ -3836,6 +3899,7 @@ namespace Sph
             { "SPH_ATTRIBUTE_DENSITY", "float32, kg/m^3, from the last density evaluation" },
             { "SPH_ATTRIBUTE_PRESSURE", "float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure its density solve found in the last substep" },
             { "SPH_ATTRIBUTE_ID", "uint32, persistent particle id, unique within a world" },
+            { "SPH_ATTRIBUTE_USER", "uint32, the caller's value (SPH_FEATURE_USER_ATTRIBUTE)" },
             { "SPH_STAGE_HASH_SORT", "cell hash, stable sort, reorder of every attribute" },
             { "SPH_STAGE_CELL_RANGES", "start/end of each cell" },
             { "SPH_STAGE_DENSITY", "density and pressure" },

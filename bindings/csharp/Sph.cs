@@ -234,6 +234,10 @@ namespace Sph
         /// <summary>Loads on colliders: the fluid's force and torque on each collider over every
         /// step (<see cref="Collider.Loads"/>; docs/physics.md).</summary>
         ColliderLoads = Constants.SPH_FEATURE_COLLIDER_LOADS,
+        /// <summary>A user attribute: one uint per particle the caller sets (a colour, a phase id),
+        /// carried through sorts, sinks and checkpoints (<see cref="World.SetAttribute"/>,
+        /// <see cref="SphAttribute.User"/>).</summary>
+        UserAttribute = Constants.SPH_FEATURE_USER_ATTRIBUTE,
     }
 
     /// <summary>Step-size limits beyond eq. 32 (SPH_STEP_LIMIT_*): set them with
@@ -837,6 +841,53 @@ namespace Sph
             var a = new uint[ParticleCount];
             CopyAttribute(SphAttribute.Id, a);
             return a;
+        }
+
+        // ---- writing particles ----------------------------------------------------------------
+
+        /// <summary>Overwrites particles [first, first + count) of Position, Velocity or User from
+        /// raw memory: element i at src + i * stride (0 = packed); srcSize is the buffer's size in
+        /// bytes. All-or-nothing: every value is checked first (sph_world_set_attribute).</summary>
+        public void SetAttribute(SphAttribute attribute, IntPtr src, ulong srcSize, ulong srcStride, uint first, uint count)
+        {
+            SphException.Check(Native.sph_world_set_attribute(Handle, attribute, src, srcSize, srcStride, first, count),
+                "sph_world_set_attribute");
+        }
+
+        /// <summary>Writes from an array of blittable elements, one per particle, the attribute
+        /// read at the start of each (stride = the element's size): Vec3 or UnityEngine.Vector3
+        /// for positions and velocities, uint for the user attribute, or an interleaved particle
+        /// struct. Particles [first, first + src.Length).</summary>
+        public void SetAttribute<T>(SphAttribute attribute, T[] src, uint first = 0) where T : struct
+        {
+            if (src == null) throw new ArgumentNullException("src");
+            ulong stride = (ulong)Marshal.SizeOf(typeof(T));
+            GCHandle h = GCHandle.Alloc(src, GCHandleType.Pinned);
+            try
+            {
+                SetAttribute(attribute, h.AddrOfPinnedObject(), stride * (ulong)src.LongLength, stride, first, (uint)src.Length);
+            }
+            finally
+            {
+                h.Free();
+            }
+        }
+
+        /// <summary>User attributes (<see cref="FeatureFlags.UserAttribute"/>), in the same order.</summary>
+        public uint[] UserAttributes()
+        {
+            var a = new uint[ParticleCount];
+            CopyAttribute(SphAttribute.User, a);
+            return a;
+        }
+
+        /// <summary>Removes the particles with these ids (sph_world_remove_particles): an unknown
+        /// or repeated id throws, naming the first, and removes nothing. The ids join
+        /// <see cref="GetRemovedIds"/>.</summary>
+        public void RemoveParticles(uint[] ids)
+        {
+            if (ids == null) throw new ArgumentNullException("ids");
+            SphException.Check(Native.sph_world_remove_particles(Handle, ids, (uint)ids.Length), "sph_world_remove_particles");
         }
 
         // ---- statistics -----------------------------------------------------------------------

@@ -48,6 +48,7 @@ SPH_API sph_result SPH_CALL sph_cuda_world_get_attribute(const sph_world* world,
       if (static_cast<uint32_t>(attribute) >= SPH_ATTRIBUTE_COUNT)
         throw Error(Status::Unsupported, "attribute: " + std::to_string(static_cast<int>(attribute)) +
                                              " is not an sph_attribute value");
+      if (attribute == SPH_ATTRIBUTE_USER) sph::require_user_attribute(world);
       const sph::DeviceAttributeView d = backend.device_attribute(static_cast<sph::AttributeKind>(attribute));
       sph_cuda_attribute_view v;
       std::memset(&v, 0, sizeof v);

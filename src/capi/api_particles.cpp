@@ -129,6 +129,7 @@ SPH_API sph_result SPH_CALL sph_world_copy_attribute(const sph_world* world, sph
       throw Error(Status::Unsupported,
                   "attribute: " + std::to_string(static_cast<int32_t>(sph::enum_bits(attribute))) +
                       " is not an sph_attribute value");
+    if (attribute == SPH_ATTRIBUTE_USER) sph::require_user_attribute(world);
     if (!dst) throw Error(Status::InvalidArgument, "dst: is NULL");
     const uint64_t element = element_size(attribute);
     const uint64_t stride = dst_stride == 0 ? element : dst_stride;

@@ -214,10 +214,10 @@ SPH_API sph_result SPH_CALL sph_source_create(sph_world* world, const sph_source
                                            " is not an sph_source_mode value");
     if (d.flags & ~SPH_SOURCE_FLAG_VELOCITY_FROM_FIELD)
       throw Error(Status::Unsupported, "def->flags: unknown bits");
-    sph::require_zero(d.reserved0, "def->reserved0");
     sph::require_zero(d.reserved1, "def->reserved1");
     out_id->bits = sph::with_field_prefix("def->", [&] {
       sph::SourceSpec spec;
+      spec.user_attribute = d.user_attribute;
       spec.region = world_sdf_or_null(world, d.region, "def->region");
       spec.pose = pose_from_public(d.transform, "transform");
       spec.mode = static_cast<sph::SourceMode>(mode);

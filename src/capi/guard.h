@@ -98,4 +98,11 @@ inline void require_world(const sph_world* world) {
 
 inline LogTarget context_of(const sph_world* world) { return log_target_of(world); }
 
+// SPH_ATTRIBUTE_USER needs SPH_FEATURE_USER_ATTRIBUTE (the caller holds the world's lock).
+inline void require_user_attribute(const sph_world* world) {
+  if (!(world->world->config().features & kFeatureUserAttribute))
+    throw Error(Status::FeatureDisabled,
+                "world: SPH_FEATURE_USER_ATTRIBUTE is not enabled in its sph_world_def (SPH_ATTRIBUTE_USER)");
+}
+
 }  // namespace sph

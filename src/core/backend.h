@@ -20,7 +20,14 @@
 
 namespace sph {
 
-enum class AttributeKind : uint32_t { Position = 0, Velocity = 1, Density = 2, Pressure = 3, Id = 4 };
+enum class AttributeKind : uint32_t {
+  Position = 0,
+  Velocity = 1,
+  Density = 2,
+  Pressure = 3,
+  Id = 4,
+  User = 5
+};
 
 // A device-resident attribute: element k of particle i is at address + i * stride.
 struct DeviceAttributeView {
@@ -38,10 +45,12 @@ class Backend {
 
   virtual uint32_t particle_count() const = 0;
 
-  // Appends n particles (velocities may be null = zero) with ids first_id, first_id + 1, ...
+  // Appends n particles (velocities may be null = zero) with ids first_id, first_id + 1, ...,
+  // and user_attribute as their user attribute (when the world carries one; else ignored).
   // The caller has checked capacity and finiteness. All-or-nothing: throws on failure and
   // leaves the particles as they were.
-  virtual void append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id) = 0;
+  virtual void append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id,
+                      uint32_t user_attribute) = 0;
 
   // Runs adaptive substeps until frame_dt is reached or params.max_substeps is spent, with the
   // scene's colliders, force fields and sinks. On a non-finite state it restores the particles
@@ -63,7 +72,8 @@ class Backend {
   virtual void truncate(uint32_t count) = 0;
 
   // Writes particles [first, first + count) of one attribute to dst with a byte stride, as
-  // float32 x3 (position, velocity), float32 (density, pressure) or uint32 (id).
+  // float32 x3 (position, velocity), float32 (density, pressure) or uint32 (id, user; the caller
+  // has checked that the world carries a user attribute).
   virtual void copy_attribute(AttributeKind kind, uint32_t first, uint32_t count, void* dst,
                               size_t stride) const = 0;
 

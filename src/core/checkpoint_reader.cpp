@@ -240,6 +240,14 @@ ParticleSnapshot read_particles(ByteReader& r, const WorldConfig& config, uint32
     s.set_carried(kArrayDfsphPressure, pressure);
     s.set_carried(kArrayDfsphDivergencePressure, divergence);
   }
+  // The user attribute: any uint32 (the library never reads it). Every checkpoint of a world
+  // with the feature has it (the feature came with it, in version 3).
+  if (config.features & kFeatureUserAttribute) {
+    r.need_elements(n, sizeof(uint32_t), "user attributes");
+    std::vector<uint32_t> attribute(n);
+    for (uint32_t& a : attribute) a = r.u32();
+    s.set_carried(kArrayUserAttribute, attribute);
+  }
   std::vector<uint32_t> sorted(s.id);
   std::sort(sorted.begin(), sorted.end());
   const auto dup = std::adjacent_find(sorted.begin(), sorted.end());

@@ -144,6 +144,7 @@ Source read_source(ByteReader& r, const Assets& assets, const WorldConfig& confi
   spec.velocity = raw_vec3(r);
   spec.velocity_from_field = flag(r, name + " velocity from field") != 0;
   spec.rate = r.f32();
+  if (config.features & kFeatureUserAttribute) spec.user_attribute = r.u32();
   // Stored values are resolved: a zero here would be read as "the default" by the rules.
   if (spec.spacing == 0.0f || spec.min_distance == 0.0f)
     corrupt(r.what() + ": " + name + " spacing or min distance is 0 (never written)");

@@ -146,6 +146,8 @@ void write_particles(ByteWriter& w, const ParticleSnapshot& s) {
   // DFSPH only: the warm starts of its two solves.
   for (float k : s.carried_as<float>(kArrayDfsphPressure)) w.f32(k);
   for (float k : s.carried_as<float>(kArrayDfsphDivergencePressure)) w.f32(k);
+  // SPH_FEATURE_USER_ATTRIBUTE only: each particle's value.
+  for (uint32_t a : s.carried_as<uint32_t>(kArrayUserAttribute)) w.u32(a);
 }
 
 void write_asset(ByteWriter& w, const SdfAsset& a) {
@@ -234,6 +236,7 @@ std::vector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin
       write_vec3(w, s.velocity);
       w.u32(s.velocity_from_field ? 1u : 0u);
       w.f32(s.rate);
+      if (world.config().features & kFeatureUserAttribute) w.u32(s.user_attribute);
       w.f64(s.rate_budget);
       w.u32(s.done ? 1u : 0u);
       w.u32(static_cast<uint32_t>(s.lattice.size()));

@@ -37,6 +37,9 @@ std::vector<ParticleArraySpec> method_particle_arrays(const WorldConfig& config)
     arrays.push_back(ParticleArraySpec{kArrayRk4Sum, sizeof(Rk4Accumulator), ParticleArrayRole::Sorted, 1,
                                        nullptr, nullptr});
   }
+  if (config.features & kFeatureUserAttribute)
+    arrays.push_back(ParticleArraySpec{kArrayUserAttribute, sizeof(uint32_t), ParticleArrayRole::Carried, 1,
+                                       nullptr, nullptr});
   return arrays;
 }
 

@@ -18,6 +18,9 @@ constexpr const char* kArrayPosition = "position";  // Float4, w: pressure after
 constexpr const char* kArrayVelocity = "velocity";  // Float4, w: 1 / density after the density pass
 constexpr const char* kArrayId = "id";              // uint32
 constexpr const char* kArrayDensity = "density";    // float
+// SPH_FEATURE_USER_ATTRIBUTE: the caller's uint32 per particle, carried (0 for a new particle
+// unless its source gives another).
+constexpr const char* kArrayUserAttribute = "user_attribute";
 
 // Names of the integrator's arrays (the methods' own are in physics/particle_array_spec.h).
 constexpr const char* kArrayRk4Start = "rk4_start";  // RK4, ParticleState
@@ -25,7 +28,7 @@ constexpr const char* kArrayRk4Sum = "rk4_sum";      // RK4, Rk4Accumulator
 
 // The arrays the world's methods need beyond the core state (position, velocity, id, density):
 // each running method's kArrays in the method list's order (physics/methods.h), then the
-// integrator's.
+// integrator's, then the user attribute's.
 std::vector<ParticleArraySpec> method_particle_arrays(const WorldConfig& config);
 
 // The spec of that name in specs, or null.

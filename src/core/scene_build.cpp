@@ -65,6 +65,10 @@ Source make_source(const SourceSpec& spec, const WorldConfig& config) {
   s.velocity = spec.velocity;
   s.velocity_from_field = spec.velocity_from_field;
   s.rate = spec.rate;
+  if (spec.user_attribute != 0 && !(config.features & kFeatureUserAttribute))
+    throw FieldError(Status::FeatureDisabled, "user_attribute",
+                     "is not 0 but SPH_FEATURE_USER_ATTRIBUTE is not enabled in the world's def");
+  s.user_attribute = spec.user_attribute;
   return s;
 }
 

@@ -39,10 +39,11 @@ struct Source {
   float min_distance = 0.0f;
   Vec3 velocity{0.0f, 0.0f, 0.0f};
   bool velocity_from_field = false;
-  float rate = 0.0f;          // Continuous: particles per second at most; 0 = no limit
-  double rate_budget = 0.0;   // fractional particles carried between frames
-  bool done = false;          // FillOnce: already emitted
-  std::vector<Vec3> lattice;  // FCC points inside the region, in the region's frame
+  float rate = 0.0f;            // Continuous: particles per second at most; 0 = no limit
+  double rate_budget = 0.0;     // fractional particles carried between frames
+  bool done = false;            // FillOnce: already emitted
+  std::vector<Vec3> lattice;    // FCC points inside the region, in the region's frame
+  uint32_t user_attribute = 0;  // its particles' (SPH_FEATURE_USER_ATTRIBUTE)
 };
 
 struct Sink {

@@ -42,6 +42,7 @@ struct SourceSpec {
   Vec3 velocity{0.0f, 0.0f, 0.0f};
   bool velocity_from_field = false;  // the region's velocity channel instead of `velocity`
   float rate = 0.0f;                 // Continuous: particles per second at most; 0 = no limit
+  uint32_t user_attribute = 0;       // its particles'; non-zero needs kFeatureUserAttribute
 };
 
 struct SinkSpec {

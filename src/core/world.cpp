@@ -52,7 +52,8 @@ float max_field_speed(const SdfAsset& a) {
 World::World(const WorldConfig& config, std::unique_ptr<Backend> backend)
     : config_(config), backend_(std::move(backend)) {}
 
-uint32_t World::spawn(const std::vector<Vec3>& positions, const std::vector<Vec3>* velocities) {
+uint32_t World::spawn(const std::vector<Vec3>& positions, const std::vector<Vec3>* velocities,
+                      uint32_t user_attribute) {
   const uint64_t n = positions.size();
   if (n > free_capacity())
     throw Error(Status::Capacity, "spawn: " + std::to_string(n) + " particles do not fit; the world holds " +
@@ -63,7 +64,7 @@ uint32_t World::spawn(const std::vector<Vec3>& positions, const std::vector<Vec3
   const uint32_t first = next_id_;
   if (n == 0) return first;
   backend_->append(positions.data(), velocities ? velocities->data() : nullptr, static_cast<uint32_t>(n),
-                   first);
+                   first, user_attribute);
   next_id_ += static_cast<uint32_t>(n);
   return first;
 }
@@ -103,7 +104,7 @@ void World::emit_sources(double frame_dt) {
     velocities.resize(fits);
     if (s.mode == SourceMode::Continuous && s.rate > 0.0f) s.rate_budget -= static_cast<double>(fits);
     if (!accepted.empty()) {
-      spawn(accepted, &velocities);
+      spawn(accepted, &velocities, s.user_attribute);
       existing.insert(existing.end(), accepted.begin(), accepted.end());
     }
     s.done = true;

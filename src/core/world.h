@@ -7,6 +7,7 @@
 #include <stdint.h>
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "backend.h"
@@ -56,6 +57,24 @@ class World {
   // radius 0 fills nothing. Error(Capacity) when the lattice does not fit. Returns the count.
   uint32_t fill_box(const FillBoxSpec& spec);
   uint32_t fill_sphere(const FillSphereSpec& spec);
+
+  // ---- particles written (world_particle_writes.cpp) ----
+  // Each checks everything first and changes nothing on error. Particles are addressed as
+  // Backend::copy_attribute reads them: [first, first + n) in the current storage order,
+  // InvalidArgument "first/count" when the range passes the particle count. Value errors are
+  // FieldErrors naming "src[i]" (the i-th value given) or "ids[k]".
+  //
+  // Positions (finite, within 65536 spacings of the origin) or velocities (finite, speed below
+  // 1.8e19 m/s) of particles [first, first + values.size()); kind is Position or Velocity.
+  // Error(InvalidArgument) "first/count" unless [first, first + count) lies in the particles.
+  void require_particle_range(uint32_t first, uint64_t count) const;
+  void set_vectors(AttributeKind kind, uint32_t first, const std::vector<Vec3>& values);
+  // The user attribute of particles [first, first + values.size()); Error(FeatureDisabled)
+  // without kFeatureUserAttribute.
+  void set_user_attributes(uint32_t first, const std::vector<uint32_t>& values);
+  // Removes the particles with these ids (each a live particle's, none twice); the rest keep
+  // their order. The ids join removed_ids() (cleared by the next step).
+  void remove_particles(const std::vector<uint32_t>& ids);
 
   // Runs one frame: sources emit, then substeps with colliders, fields and sinks. Returns
   // false when max_substeps ran out before frame_dt, or `interrupt` stopped it at a substep
@@ -121,8 +140,12 @@ class World {
   const SlotMap<ForceField>& force_fields() const { return force_fields_; }
 
  private:
-  // Adds particles without the entry point's checks (sources emit inside their region).
-  uint32_t spawn(const std::vector<Vec3>& positions, const std::vector<Vec3>* velocities);
+  // Adds particles without the entry point's checks (sources emit inside their region), with
+  // user_attribute as their user attribute where the world carries one.
+  uint32_t spawn(const std::vector<Vec3>& positions, const std::vector<Vec3>* velocities,
+                 uint32_t user_attribute = 0);
+  // Why a position is refused (world_particles.cpp), or empty when it is fine.
+  std::string position_problem(const Vec3& p) const;
   // The end of fill_box and fill_sphere: checks the points (errors name region_fields) and
   // adds them at one velocity.
   uint32_t fill(const std::vector<Vec3>& points, const Vec3& velocity, const char* region_fields);

@@ -30,6 +30,11 @@ std::string resolution_problem(const Vec3& p, float spacing) {
 
 }  // namespace
 
+std::string World::position_problem(const Vec3& p) const {
+  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return "is not finite";
+  return resolution_problem(p, config_.particle_spacing);
+}
+
 void World::require_room_for_particles(uint64_t count) const {
   if (count > free_capacity())
     throw FieldError(Status::Capacity, "count",

@@ -63,9 +63,11 @@ CpuBackend::CpuBackend(const WorldConfig& config, unsigned workers)
   dfsph_residual_ = store_.find_typed<float>(kArrayDfsphResidual);
   dfsph_contact_ = store_.find_typed<Float4>(kArrayDfsphContact);
   boundary_ = store_.find_typed<Float4>(kArrayBoundaryGradient);
+  user_attribute_ = store_.find_typed<uint32_t>(kArrayUserAttribute);
 }
 
-void CpuBackend::append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id) {
+void CpuBackend::append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id,
+                        uint32_t user_attribute) {
   const uint32_t total = count_ + n;
   // New elements of the methods' arrays take their initial values (a fresh density factor, an
   // empty spring list). std::bad_alloc leaves count_ unchanged; the C layer maps it.
@@ -80,6 +82,7 @@ void CpuBackend::append(const Vec3* positions, const Vec3* velocities, uint32_t 
     id_[i] = first_id + k;
     density_[i] = config_.rest_density;
     neighbors_[i] = 0;
+    if (user_attribute_) user_attribute_[i] = user_attribute;
   }
   count_ = total;
   max_speed_valid_ = false;
@@ -119,6 +122,9 @@ void CpuBackend::copy_attribute(AttributeKind kind, uint32_t first, uint32_t cou
         break;
       case AttributeKind::Id:
         std::memcpy(p, &id_[i], sizeof(uint32_t));
+        break;
+      case AttributeKind::User:
+        std::memcpy(p, &user_attribute_[i], sizeof(uint32_t));
         break;
     }
   }

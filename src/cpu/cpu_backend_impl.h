@@ -43,7 +43,8 @@ class CpuBackend final : public Backend {
 
   uint32_t particle_count() const override { return count_; }
 
-  void append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id) override;
+  void append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id,
+              uint32_t user_attribute) override;
 
   FrameReport step_scene_frame(double frame_dt, const RuntimeParams& params,
                                const SceneFrame& scene_in) override;
@@ -226,7 +227,8 @@ class CpuBackend final : public Backend {
   CpuArrayRef<Float4> dfsph_contact_;          // DFSPH: each particle's contact with the colliders
   bool dfsph_contacts_ = false;                // DFSPH: the substep has colliders (contacts to respect)
   std::vector<ColliderView> dfsph_colliders_;  // DFSPH: the substep's colliders, for the contacts
-  CpuArrayRef<Float4> boundary_;  // boundary density: (grad rho_b, v_b . grad rho_b) per particle
+  CpuArrayRef<Float4> boundary_;          // boundary density: (grad rho_b, v_b . grad rho_b) per particle
+  CpuArrayRef<uint32_t> user_attribute_;  // SPH_FEATURE_USER_ATTRIBUTE: the caller's value
   CpuBoundaryMaps boundary_maps_;
   std::vector<ColliderView> collider_views_;  // the frame's colliders, for the density pass
   std::vector<ColliderLoadSums> load_sums_;   // the frame's impulses per collider (loads on)

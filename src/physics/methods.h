@@ -34,8 +34,9 @@ enum FeatureBits : uint32_t {
   kFeatureSprings = 1u << 2,
   kFeatureBoundaryDensity = 1u << 3,
   kFeatureColliderLoads = 1u << 4,
+  kFeatureUserAttribute = 1u << 5,  // no physics: a carried uint32 (core/particle_arrays.h)
   kFeatureAll = kFeatureSurfaceTension | kFeatureNormalizedDensity | kFeatureSprings |
-                kFeatureBoundaryDensity | kFeatureColliderLoads,
+                kFeatureBoundaryDensity | kFeatureColliderLoads | kFeatureUserAttribute,
 };
 
 enum class ViscosityMethod : uint32_t { Mueller = 0, Clavet = 1 };

@@ -16,6 +16,7 @@ usage: test_interchange.py SPH_RUN SCENES_DIR
   the nearest real one.
 Tests needing a module the machine lacks are skipped, and say so; the run fails on any failure.
 """
+import json
 import os
 import subprocess
 import sys
@@ -177,6 +178,42 @@ with tempfile.TemporaryDirectory() as tmp:
     p = run("--xyzzyplugh", expect=2)
     check("a foreign word gets no guess", "did you mean" not in p.stderr and "--help" in p.stderr, p.stderr)
     check("a usage error does not reprint the usage", "exit codes:" not in p.stderr, p.stderr)
+
+# ---- the user attribute: a source's value in every format, 0 for the other particles ----
+with tempfile.TemporaryDirectory() as tmp:
+    with open(SCENE) as f:
+        scene = json.load(f)
+    scene["sources"][0]["user_attribute"] = 9
+    path = os.path.join(tmp, "tagged.json")
+    with open(path, "w") as f:
+        json.dump(scene, f)
+    out = os.path.join(tmp, "out")
+    p = subprocess.run([SPH_RUN, path, "--backend", "cpu", "--quiet", "--frames", "3", "--format", "vtp,ply,csv",
+                        "--out", out], capture_output=True, text=True)
+    check("a scene whose source has a user_attribute runs", p.returncode == 0, p.stderr)
+    if p.returncode == 0:
+        with open(os.path.join(out, "fluid_0003.ply"), "rb") as f:
+            data = f.read()
+        end = data.index(b"end_header\n") + len(b"end_header\n")
+        check("ply: a uint user property after the id", b"property uint id\nproperty uint user\nend_header" in data)
+        n = int(data[:end].decode().split("element vertex ")[1].split()[0])
+        rec = np.dtype([("p", "<f4", 3), ("v", "<f4", 3), ("density", "<f4"), ("id", "<u4"), ("user", "<u4")])
+        ply = np.frombuffer(data[end:], dtype=rec, count=n)
+        # tiny.json: the source emits from 0.02 s on, after the first fluids took their ids.
+        check("ply: the source's particles carry 9, the others 0",
+              set(np.unique(ply["user"]).tolist()) == {0, 9}, np.unique(ply["user"]))
+        csv = np.loadtxt(os.path.join(out, "fluid_0003.csv"), delimiter=",", skiprows=1, ndmin=2)
+        check("csv: the user column equals the PLY's", np.array_equal(csv[:, 9].astype(np.uint32), ply["user"]))
+        try:
+            from vtkmodules.util.numpy_support import vtk_to_numpy
+            from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
+            reader = vtkXMLPolyDataReader()
+            reader.SetFileName(os.path.join(out, "fluid_0003.vtp"))
+            reader.Update()
+            user = vtk_to_numpy(reader.GetOutput().GetPointData().GetArray("user"))
+            check("vtp: the user array equals the PLY's", np.array_equal(user, ply["user"]))
+        except ImportError as e:
+            skip("vtp user array", f"no VTK Python module ({e})")
 
 print(f"{passed} passed, {len(failures)} failed, {skipped} skipped")
 sys.exit(1 if failures else 0)

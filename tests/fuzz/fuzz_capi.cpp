@@ -1138,7 +1138,7 @@ class Program {
     d.velocity = vec3(-1.0f, 1.0f);
     d.flags = in_.chance(224) ? in_.u8() % 2 : in_.u32();
     d.rate = in_.chance(128) ? 0.0f : in_.maybe_hostile(0.0f, 1e5f);
-    if (in_.chance(8)) d.reserved0 = in_.u32();
+    if (in_.chance(8)) d.user_attribute = in_.u32();  // FEATURE_DISABLED unless the world has the feature
     if (in_.chance(8)) d.reserved1 = in_.u32();
     d.struct_size = struct_size(sizeof d);
     // The library keeps the region's lattice (up to 2^28 points, legitimately); skip regions

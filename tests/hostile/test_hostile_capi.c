@@ -59,7 +59,7 @@ static void expect_same_particles(const sph_world* a, const sph_world* b) {
   EXPECT_OK(sph_world_get_particle_count(a, &count_a));
   EXPECT_OK(sph_world_get_particle_count(b, &count_b));
   assert_int_equal(count_a, count_b);
-  for (int k = 0; k < SPH_ATTRIBUTE_COUNT; ++k) {
+  for (int k = 0; k <= SPH_ATTRIBUTE_ID; ++k) {
     const size_t bytes = 12u * count_a + 4u;
     void* va = malloc(bytes);
     void* vb = malloc(bytes);

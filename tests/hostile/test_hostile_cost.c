@@ -178,7 +178,7 @@ static void expect_same_particles(const sph_world* world, const sph_world* copy)
   EXPECT_OK(sph_world_get_particle_count(world, &n));
   EXPECT_OK(sph_world_get_particle_count(copy, &m));
   assert_int_equal(n, m);
-  for (a = 0; a < SPH_ATTRIBUTE_COUNT; ++a) {
+  for (a = 0; a <= SPH_ATTRIBUTE_ID; ++a) {
     float* x = (float*)calloc(3u * n + 1u, sizeof(float));
     float* y = (float*)calloc(3u * n + 1u, sizeof(float));
     EXPECT_OK(sph_world_copy_attribute(world, (sph_attribute)a, x, 12ull * n + 4, 0, 0, n, NULL));

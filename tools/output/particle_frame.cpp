@@ -39,6 +39,9 @@ void read_particles(const sph_world* world, uint32_t frame, double time, Particl
   copy(world, SPH_ATTRIBUTE_DENSITY, out->density.data(), 4ull * n, n);
   copy(world, SPH_ATTRIBUTE_PRESSURE, out->pressure.data(), 4ull * n, n);
   copy(world, SPH_ATTRIBUTE_ID, out->id.data(), 4ull * n, n);
+  out->has_user = (def.features & SPH_FEATURE_USER_ATTRIBUTE) != 0;
+  out->user.resize(out->has_user ? n : 0);
+  if (out->has_user) copy(world, SPH_ATTRIBUTE_USER, out->user.data(), 4ull * n, n);
 }
 
 }  // namespace sph_tools

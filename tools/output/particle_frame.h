@@ -21,6 +21,8 @@ struct ParticleFrame {
   std::vector<float> density;   // count, kg/m^3
   std::vector<float> pressure;  // count
   std::vector<uint32_t> id;     // count
+  bool has_user = false;        // the world carries a user attribute (SPH_FEATURE_USER_ATTRIBUTE)
+  std::vector<uint32_t> user;   // count when has_user, else empty
 };
 
 // Copies every attribute of `world` into `out` (arrays are reused). Throws LibraryError.

@@ -14,12 +14,15 @@ namespace sph_tools {
 void write_csv(const ParticleFrame& f, const std::string& path) {
   NewFile file(path);
   std::FILE* out = file.get();
-  std::fputs("id,x,y,z,vx,vy,vz,density,pressure\n", out);
+  std::fputs(
+      f.has_user ? "id,x,y,z,vx,vy,vz,density,pressure,user\n" : "id,x,y,z,vx,vy,vz,density,pressure\n", out);
   for (uint32_t i = 0; i < f.count; ++i) {
     const float* x = &f.position[3 * static_cast<size_t>(i)];
     const float* v = &f.velocity[3 * static_cast<size_t>(i)];
-    std::fprintf(out, "%u,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", f.id[i], x[0], x[1], x[2], v[0], v[1],
+    std::fprintf(out, "%u,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g", f.id[i], x[0], x[1], x[2], v[0], v[1],
                  v[2], f.density[i], f.pressure[i]);
+    if (f.has_user) std::fprintf(out, ",%u", f.user[i]);
+    std::fputc('\n', out);
   }
   file.close();
 }

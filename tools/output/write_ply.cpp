@@ -23,9 +23,10 @@ void write_ply(const ParticleFrame& f, const std::string& path) {
                "ply\nformat binary_little_endian 1.0\ncomment sph-run frame %u time %.9g\n"
                "element vertex %u\nproperty float x\nproperty float y\nproperty float z\n"
                "property float vx\nproperty float vy\nproperty float vz\nproperty float density\n"
-               "property uint id\nend_header\n",
-               f.frame, f.time, f.count);
-  constexpr size_t kRecord = 32, kBatch = 4096;
+               "property uint id\n%send_header\n",
+               f.frame, f.time, f.count, f.has_user ? "property uint user\n" : "");
+  constexpr size_t kBatch = 4096;
+  const size_t kRecord = f.has_user ? 36 : 32;
   std::vector<unsigned char> buffer(kRecord * kBatch);
   for (uint32_t first = 0; first < f.count; first += kBatch) {
     const uint32_t n = f.count - first < kBatch ? f.count - first : static_cast<uint32_t>(kBatch);
@@ -36,6 +37,7 @@ void write_ply(const ParticleFrame& f, const std::string& path) {
       std::memcpy(r + 12, &f.velocity[3 * i], 12);
       std::memcpy(r + 24, &f.density[i], 4);
       std::memcpy(r + 28, &f.id[i], 4);
+      if (f.has_user) std::memcpy(r + 32, &f.user[i], 4);
     }
     if (std::fwrite(buffer.data(), kRecord, n, out) != n) break;
   }

@@ -57,8 +57,8 @@ void write_vtp(const ParticleFrame& f, const std::string& path) {
   const uint64_t n = f.count;
   const Array velocity{"velocity", "Float32", 3, 12 * n}, density{"density", "Float32", 1, 4 * n},
       pressure{"pressure", "Float32", 1, 4 * n}, id{"id", "UInt32", 1, 4 * n},
-      points{nullptr, "Float32", 3, 12 * n}, connectivity{"connectivity", "Int64", 1, 8 * n},
-      offsets{"offsets", "Int64", 1, 8 * n};
+      user{"user", "UInt32", 1, 4 * n}, points{nullptr, "Float32", 3, 12 * n},
+      connectivity{"connectivity", "Int64", 1, 8 * n}, offsets{"offsets", "Int64", 1, 8 * n};
   std::fprintf(
       out,
       "<?xml version=\"1.0\"?>\n"
@@ -76,6 +76,7 @@ void write_vtp(const ParticleFrame& f, const std::string& path) {
       f.frame, f.time, f.time, f.frame, f.count, f.count);
   uint64_t offset = 0;
   for (const Array* a : {&velocity, &density, &pressure, &id}) declare(out, *a, &offset);
+  if (f.has_user) declare(out, user, &offset);  // SPH_FEATURE_USER_ATTRIBUTE
   std::fputs("      </PointData>\n      <Points>\n", out);
   declare(out, points, &offset);
   // One vertex cell per particle, so ParaView draws the points without a Glyph filter.
@@ -87,6 +88,7 @@ void write_vtp(const ParticleFrame& f, const std::string& path) {
   write_block(out, f.density.data(), density.bytes);
   write_block(out, f.pressure.data(), pressure.bytes);
   write_block(out, f.id.data(), id.bytes);
+  if (f.has_user) write_block(out, f.user.data(), user.bytes);
   write_block(out, f.position.data(), points.bytes);
   write_index_block(out, f.count, 0);
   write_index_block(out, f.count, 1);

@@ -70,7 +70,9 @@ struct SourceDesc {
   sph_source_mode mode = SPH_SOURCE_FILL_ONCE;
   sph_vec3 velocity{};
   float spacing = 0.0f, min_distance = 0.0f, rate = 0.0f;
-  double start = 0.0;                                     // s: created before the step at start
+  uint32_t user_attribute = 0;      // its particles' user attribute
+  bool has_user_attribute = false;  // given in the scene: the world gets SPH_FEATURE_USER_ATTRIBUTE
+  double start = 0.0;               // s: created before the step at start
   double stop = std::numeric_limits<double>::infinity();  // s: removed from then on
   std::string path;
 };

@@ -110,6 +110,8 @@ SceneDesc parse_scene(const std::string& text, const std::string& base_dir) {
     if (c.loads) scene.world.features |= SPH_FEATURE_COLLIDER_LOADS;
   parse_list(top["sources"], "a list of sources", &scene.sources,
              [&](const JsonNode& n) { return parse_source(n, base_dir); });
+  for (const SourceDesc& s : scene.sources)
+    if (s.has_user_attribute) scene.world.features |= SPH_FEATURE_USER_ATTRIBUTE;
   parse_list(top["sinks"], "a list of sinks", &scene.sinks,
              [&](const JsonNode& n) { return parse_sink(n, base_dir); });
   parse_list(top["force_fields"], "a list of force fields", &scene.force_fields,

@@ -166,6 +166,7 @@ void SceneRuntime::start_source(size_t i) {
   def.min_distance = s.min_distance;
   def.velocity = s.velocity;
   def.rate = s.rate;
+  def.user_attribute = s.user_attribute;
   check_object(sph_source_create(world_, &def, &state.id), s.path, "source");
   state.started = true;
 }

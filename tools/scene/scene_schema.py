@@ -178,7 +178,8 @@ def build():
             "sources": {"type": "array", "items": obj({
                 "name": STRING, "shape": {"$ref": "#/definitions/shape"}, **placed,
                 "mode": {"enum": ["once", "continuous"]}, "velocity": VEC3, "spacing": POSITIVE,
-                "min_distance": POSITIVE, "rate": POSITIVE, **span}, ["shape"])},
+                "min_distance": POSITIVE, "rate": POSITIVE, "user_attribute": COUNT, **span},
+                ["shape"])},
             "sinks": {"type": "array", "items": tagged(sink, "A sink (docs/scenes.md, sinks).")},
             "force_fields": {"type": "array", "items": tagged(force_field, "A force field.")},
             "output": output,

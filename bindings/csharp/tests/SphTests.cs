@@ -274,6 +274,43 @@ static class Tests
         }
     }
 
+    public static void TestWriteParticlesAndRemoveById()
+    {
+        var def = SmallWorld();
+        def.FeatureFlags = FeatureFlags.UserAttribute;
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(def))
+        {
+            var particles = new Particle[10];
+            for (int i = 0; i < particles.Length; ++i) particles[i].Position = new Vec3(0.1f * i, 0, 0);
+            world.Spawn(particles);
+            world.Step(0.01f);
+            var write = new Particle[4];
+            for (int k = 0; k < write.Length; ++k) write[k].Position = new Vec3(0.3f * k, 0.125f, -0.5f);
+            world.SetAttribute(SphAttribute.Position, write, 3);  // strided: the interleaved structs
+            var tags = new uint[10];
+            for (int k = 0; k < tags.Length; ++k) tags[k] = 0xC0100000u + (uint)k;
+            world.SetAttribute(SphAttribute.User, tags);
+            var pos = world.Positions();
+            for (int k = 0; k < write.Length; ++k)
+            {
+                AssertEqual(write[k].Position.X, pos[3 + k].X, "written x");
+                AssertEqual(0.125f, pos[3 + k].Y, "written y");
+            }
+            var back = world.UserAttributes();
+            for (int k = 0; k < tags.Length; ++k) AssertEqual(tags[k], back[k], "user attribute");
+            var ids = world.Ids();
+            world.RemoveParticles(new uint[] { ids[2], ids[7] });
+            AssertEqual(8u, world.ParticleCount, "two removed");
+            AssertEqual(2, world.GetRemovedIds().Length, "reported as removed");
+            Throws(Result.ErrorInvalidArgument, () => world.RemoveParticles(new uint[] { ids[2] }));
+            var nan = new Vec3[] { new Vec3(0, float.NaN, 0) };
+            Throws(Result.ErrorInvalidArgument, () => world.SetAttribute(SphAttribute.Velocity, nan));
+            Throws(Result.ErrorInvalidArgument, () => world.SetAttribute(SphAttribute.Position, new Vec3[9]));
+            AssertEqual(8u, world.ParticleCount, "nothing changed");
+        }
+    }
+
     public static void TestSpawnErrorsLeaveWorldUnchanged()
     {
         using (var ctx = Cpu())

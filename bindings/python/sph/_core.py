@@ -466,6 +466,56 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
         """(n,) uint32 persistent particle ids, in the same order as the other attributes."""
         return self.copy_attribute(_g.Attribute.ID, out)
 
+    def user_attributes(self, out=None):
+        """(n,) uint32 user attributes (Feature.USER_ATTRIBUTE), in the same order."""
+        return self.copy_attribute(_g.Attribute.USER, out)
+
+    # -- writing particles
+    def set_attribute(self, attribute, values, first=0):
+        """Overwrites particles [first, first + len(values)) of POSITION, VELOCITY ((n, 3)
+        float32) or USER ((n,) uint32) in the world's current order (sph_world_set_attribute:
+        all-or-nothing, every value checked first). Strided numpy rows pass without a copy."""
+        attribute = _g.Attribute(attribute)
+        dtype, comps = attribute_format(attribute)
+        check_int(ctypes.c_uint32, first, "first")
+        if comps == 3:
+            a = _vec3_rows(values, "values")
+        else:
+            a = np.asarray(values)
+            if a.ndim != 1:
+                raise ValueError(f"values: expected an array of shape (n,), got {a.shape}")
+            if a.dtype != dtype or a.strides[0] < dtype.itemsize:
+                a = np.ascontiguousarray(a, dtype=dtype)
+        elem = comps * dtype.itemsize
+        stride = a.strides[0] if len(a) > 1 else elem
+        size = 0 if len(a) == 0 else (len(a) - 1) * stride + elem
+        check(library().sph_world_set_attribute(self.handle, int(attribute), ctypes.c_void_p(a.ctypes.data), size,
+                                                stride, first, len(a)),
+              "sph_world_set_attribute")
+
+    def set_positions(self, values, first=0):
+        """(n, 3) positions, m, for particles [first, first + n) (set_attribute)."""
+        self.set_attribute(_g.Attribute.POSITION, values, first)
+
+    def set_velocities(self, values, first=0):
+        """(n, 3) velocities, m/s, for particles [first, first + n) (set_attribute)."""
+        self.set_attribute(_g.Attribute.VELOCITY, values, first)
+
+    def set_user_attributes(self, values, first=0):
+        """(n,) uint32 user attributes for particles [first, first + n) (set_attribute)."""
+        self.set_attribute(_g.Attribute.USER, values, first)
+
+    def remove_particles(self, ids):
+        """Removes the particles with these ids (sph_world_remove_particles; all-or-nothing: an
+        unknown or repeated id raises, naming the first). The ids join removed_ids()."""
+        a = np.ascontiguousarray(np.asarray(ids, dtype=np.int64).reshape(-1))
+        if len(a) and (a.min() < 0 or a.max() > 0xFFFFFFFF):
+            raise ValueError("ids: every id must be in [0, 2^32)")
+        a = a.astype(np.uint32)
+        check(library().sph_world_remove_particles(self.handle, a.ctypes.data_as(ctypes.POINTER(ctypes.c_uint32)),
+                                                   len(a)),
+              "sph_world_remove_particles")
+
     # -- statistics
     def stats(self):
         """Statistics of the last step as a Stats struct (sph_world_get_stats): attribute

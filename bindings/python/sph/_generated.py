@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'e6c52b58999e75cee3695c453301421bb899dac60d8f96025467a4ffdb70db76', 'include/sph_cuda.h': '8fe2c1988d9c8456a91fb26b7863765759ab8ad17bd1ff44b457c77af0bc7985', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '9ddf8c1008182f568b6aca0f6f369681f70aa5f3f72c43656abb7c86c960c0d7', 'include/sph_cuda.h': '8fe2c1988d9c8456a91fb26b7863765759ab8ad17bd1ff44b457c77af0bc7985', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -63,6 +63,13 @@ SPH_FEATURE_BOUNDARY_DENSITY = 8
 #: reduction over the particles per collider (and with the boundary density one SDF sample per
 #: particle and collider per force evaluation); no host round trip inside a step.
 SPH_FEATURE_COLLIDER_LOADS = 16
+#: A user attribute: one uint32 per particle that the caller sets and the library never reads (a
+#: colour, a phase or material id): written with sph_world_set_attribute and read with
+#: sph_world_copy_attribute (SPH_ATTRIBUTE_USER), it follows its particle through every sort, sink
+#: and checkpoint. Particles from sph_world_spawn and the fills start at 0; a source's get its
+#: sph_source_def.user_attribute. Costs 4 bytes per particle (and its copy in the rollback
+#: snapshot) and one gather per sort.
+SPH_FEATURE_USER_ATTRIBUTE = 32
 #: Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt <= step_factor h / c, c the
 #: EOS's speed of sound \ (weakly compressible worlds only)
 SPH_STEP_LIMIT_ACOUSTIC = 1
@@ -213,7 +220,8 @@ SPH_ATTRIBUTE_VELOCITY = 1  # 3 x float32, metres per second
 SPH_ATTRIBUTE_DENSITY = 2  # float32, kg/m^3, from the last density evaluation
 SPH_ATTRIBUTE_PRESSURE = 3  # float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure its density solve found in the last substep
 SPH_ATTRIBUTE_ID = 4  # uint32, persistent particle id, unique within a world
-SPH_ATTRIBUTE_COUNT = 5
+SPH_ATTRIBUTE_USER = 5  # uint32, the caller's value (SPH_FEATURE_USER_ATTRIBUTE)
+SPH_ATTRIBUTE_COUNT = 6
 SPH_ATTRIBUTE_FORCE32 = 2147483647
 
 
@@ -230,6 +238,8 @@ class Attribute(_enum.IntEnum):
     PRESSURE = 3
     #: uint32, persistent particle id, unique within a world
     ID = 4
+    #: uint32, the caller's value (SPH_FEATURE_USER_ATTRIBUTE)
+    USER = 5
 
 
 sph_stage = _c.c_int32
@@ -576,6 +586,7 @@ ENUM_MEMBER_DOCS = {
     'SPH_ATTRIBUTE_DENSITY': 'float32, kg/m^3, from the last density evaluation',
     'SPH_ATTRIBUTE_PRESSURE': 'float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure its density solve found in the last substep',
     'SPH_ATTRIBUTE_ID': 'uint32, persistent particle id, unique within a world',
+    'SPH_ATTRIBUTE_USER': "uint32, the caller's value (SPH_FEATURE_USER_ATTRIBUTE)",
     'SPH_STAGE_HASH_SORT': 'cell hash, stable sort, reorder of every attribute',
     'SPH_STAGE_CELL_RANGES': 'start/end of each cell',
     'SPH_STAGE_DENSITY': 'density and pressure',
@@ -1539,7 +1550,7 @@ class SourceDef(_SphStruct):
         velocity (sph_vec3): initial velocity (unless VELOCITY_FROM_FIELD); default 0
         flags (uint32_t): SPH_SOURCE_FLAG_*
         rate (float): CONTINUOUS: most particles per second; 0 (default) = no limit
-        reserved0 (uint32_t): must be 0
+        user_attribute (uint32_t): the user attribute of the particles it emits; default 0; non-zero needs SPH_FEATURE_USER_ATTRIBUTE (else FEATURE_DISABLED)
         reserved1 (uint32_t): must be 0
     """
     _fields_ = [
@@ -1552,12 +1563,12 @@ class SourceDef(_SphStruct):
         ('velocity', sph_vec3),
         ('flags', _c.c_uint32),
         ('rate', _c.c_float),
-        ('reserved0', _c.c_uint32),
+        ('user_attribute', _c.c_uint32),
         ('reserved1', _c.c_uint32),
     ]
     _sph_c_name_ = 'sph_source_def'
     _sph_size_ = 80
-    _sph_offsets_ = (('struct_size', 0), ('mode', 4), ('region', 8), ('transform', 16), ('spacing', 44), ('min_distance', 48), ('velocity', 52), ('flags', 64), ('rate', 68), ('reserved0', 72), ('reserved1', 76))
+    _sph_offsets_ = (('struct_size', 0), ('mode', 4), ('region', 8), ('transform', 16), ('spacing', 44), ('min_distance', 48), ('velocity', 52), ('flags', 64), ('rate', 68), ('user_attribute', 72), ('reserved1', 76))
     _sph_init_ = 'sph_source_def_init_sized'
     _sph_enums_ = {'mode': SourceMode}
 
@@ -1863,7 +1874,11 @@ FUNCTIONS = {
     'sph_world_get_particle_count': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_uint32)), ('world', 'out_count'),
         'Number of particles in the world.', 'sph'),
     'sph_world_copy_attribute': (sph_result, (_c.POINTER(sph_world), sph_attribute, _c.c_void_p, _c.c_uint64, _c.c_uint64, _c.c_uint32, _c.c_uint32, _c.POINTER(_c.c_uint32)), ('world', 'attribute', 'dst', 'dst_size', 'dst_stride', 'first', 'count', 'out_written'),
-        "Copies particles [first, first + count) of one attribute into caller memory. Particles come in the world's current order (cell order after the last step): use SPH_ATTRIBUTE_ID to match particles between calls. Each element is written at dst + i * dst_stride (dst_stride 0 = the element's size: 12 bytes for vectors, 4 for scalars); dst_size is the size of the buffer at dst in bytes. count is clamped to the particles available; out_written (optional) receives how many were written. Blocks until the data is ready. Errors: INVALID_ARGUMENT (NULL dst, stride smaller than the element, first > particle count, a span (n - 1) * dst_stride + element that overflows 64 bits or exceeds PTRDIFF_MAX), BUFFER_TOO_SMALL (dst_size cannot hold count elements), UNSUPPORTED (unknown attribute). Nothing is written on error.", 'sph'),
+        "Copies particles [first, first + count) of one attribute into caller memory. Particles come in the world's current order (cell order after the last step): use SPH_ATTRIBUTE_ID to match particles between calls. Each element is written at dst + i * dst_stride (dst_stride 0 = the element's size: 12 bytes for vectors, 4 for scalars); dst_size is the size of the buffer at dst in bytes. count is clamped to the particles available; out_written (optional) receives how many were written. Blocks until the data is ready. Errors: INVALID_ARGUMENT (NULL dst, stride smaller than the element, first > particle count, a span (n - 1) * dst_stride + element that overflows 64 bits or exceeds PTRDIFF_MAX), BUFFER_TOO_SMALL (dst_size cannot hold count elements), UNSUPPORTED (unknown attribute), FEATURE_DISABLED (SPH_ATTRIBUTE_USER without SPH_FEATURE_USER_ATTRIBUTE). Nothing is written on error.", 'sph'),
+    'sph_world_set_attribute': (sph_result, (_c.POINTER(sph_world), sph_attribute, _c.c_void_p, _c.c_uint64, _c.c_uint64, _c.c_uint32, _c.c_uint32), ('world', 'attribute', 'src', 'src_size', 'src_stride', 'first', 'count'),
+        'Overwrites particles [first, first + count) of one attribute from caller memory (copied before return), in the order sph_world_copy_attribute reads them (the world\'s current order: read SPH_ATTRIBUTE_ID over the same range to know which particles they are). Writable: SPH_ATTRIBUTE_POSITION and SPH_ATTRIBUTE_VELOCITY (3 x float32) and SPH_ATTRIBUTE_USER (uint32, needs SPH_FEATURE_USER_ATTRIBUTE). Element i is read at src + i * src_stride (src_stride 0 = the element\'s size); src_size is the size of the buffer at src in bytes. Positions must be finite and within 65536 particle spacings of the origin (as spawned ones); velocities finite with a speed below 1.8e19 m/s. A written particle keeps everything else (its id, density, the methods\' state); the next step starts from the written values, its first substep sized from the new speeds. All-or-nothing: every element is checked before anything is written; on any error the world is unchanged. Blocks; O(particle count) work and, on a CUDA world, a copy of the particle state to the host and back (batch writes into one call). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL src with count > 0, stride smaller than the element, first + count beyond the particle count, a span that overflows, a value out of range: the message names the element, e.g. "src[3]"; DENSITY, PRESSURE or ID, which are not writable), BUFFER_TOO_SMALL (src_size cannot hold count elements), UNSUPPORTED (unknown attribute), FEATURE_DISABLED (SPH_ATTRIBUTE_USER without SPH_FEATURE_USER_ATTRIBUTE), WORLD_LOCKED, OUT_OF_HOST_MEMORY, DEVICE.', 'sph'),
+    'sph_world_remove_particles': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_uint32), _c.c_uint32), ('world', 'ids', 'count'),
+        'Removes the particles with the given ids (SPH_ATTRIBUTE_ID; caller array, read during the call). The particles left keep their relative order and their ids. The removed ids are added, in the order given, to those sph_world_get_removed_ids reports (which the next sph_world_step clears), as if a sink had removed them; no event is added. count 0 removes nothing (ids may then be NULL). All-or-nothing: on any error nothing is removed. Blocks; O(particle count) work and, on a CUDA world, a copy of the particle state to the host and back. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL ids with count > 0; an id that names no particle of the world or appears twice: the message names the first such, e.g. "ids[4]: 17 appears twice (first at ids[1])"), WORLD_LOCKED, OUT_OF_HOST_MEMORY, DEVICE.', 'sph'),
     'sph_stats_init_sized': (sph_result, (_c.POINTER(sph_stats), _c.c_uint32), ('stats', 'size'),
         '', 'sph'),
     'sph_world_get_stats': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_stats)), ('world', 'out'),
@@ -1941,7 +1956,7 @@ FUNCTIONS = {
     'sph_world_get_events': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_event), _c.c_uint32, _c.POINTER(_c.c_uint32)), ('world', 'events', 'capacity', 'out_count'),
         'Events of the last sph_world_step (two-call pattern): writes up to `capacity` events and sets *out_count to the number there are; SPH_INCOMPLETE when capacity was too small. events may be NULL when capacity is 0.', 'sph'),
     'sph_world_get_removed_ids': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_uint32), _c.c_uint32, _c.POINTER(_c.c_uint32)), ('world', 'ids', 'capacity', 'out_count'),
-        'Ids of the particles sinks removed during the last sph_world_step (two-call pattern).', 'sph'),
+        'Ids of the particles sinks removed during the last sph_world_step, then those sph_world_remove_particles removed since (two-call pattern).', 'sph'),
     'sph_world_save': (sph_result, (_c.POINTER(sph_world), _c.c_void_p, _c.c_uint64, _c.POINTER(_c.c_uint64)), ('world', 'buffer', 'buffer_size', 'out_size'),
         'Saves a world into caller memory. Size query: buffer NULL and buffer_size 0 set *out_size to the bytes needed and return SPH_OK. Otherwise the checkpoint is written when it fits (*out_size: the bytes written), else SPH_ERROR_BUFFER_TOO_SMALL with *out_size the bytes needed and nothing written. The size can change whenever the world does. Blocks (a CUDA world copies its particles to the host). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL out_size, NULL buffer with a non-zero size), BUFFER_TOO_SMALL, WORLD_LOCKED, OUT_OF_HOST_MEMORY, DEVICE.', 'sph'),
     'sph_world_save_file': (sph_result, (_c.POINTER(sph_world), _c.c_char_p), ('world', 'path'),

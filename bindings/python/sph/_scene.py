@@ -377,7 +377,7 @@ class WorldSceneMixin:
     def add_source(self, region, transform=None, *, mode=_g.SourceMode.FILL_ONCE, **fields):
         """Adds a source that fills `region` (an Sdf, negative inside) with particles
         (sph_source_create). mode: SourceMode or "fill_once" / "continuous"; other fields are
-        those of SourceDef (spacing, min_distance, velocity, flags, rate)."""
+        those of SourceDef (spacing, min_distance, velocity, flags, rate, user_attribute)."""
         d = _g.SourceDef(transform=as_transform(transform), mode=_enum(_g.SourceMode, mode), **fields)
         d.region = region.handle
         out = _g.SourceId()

@@ -296,3 +296,56 @@ def test_asynchronous_step_matches_step(ctx):
             b.step_done()
         with pytest.raises(sph.SphError, match="frame_dt"):
             b.step_begin(float("nan"))
+
+
+# ---- writing particles -------------------------------------------------------------------------
+def test_set_attributes_read_back_bitwise(ctx):
+    with ctx.world(capacity=2048, features="user_attribute") as w:
+        n = w.fill_box((0, 0.2, 0), (0.1, 0.3, 0.1))
+        w.step(0.01)
+        table = np.zeros((n, 8), np.float32)  # interleaved rows: the writes read strided views
+        table[:, 0:3] = w.positions() + np.float32(1e-3) / 3
+        table[:, 4:7] = np.arange(3 * n, dtype=np.float32).reshape(n, 3) / 7
+        ids = w.ids()
+        w.set_positions(table[5:25, 0:3], first=5)
+        w.set_velocities(table[5:25, 4:7], first=5)
+        tags = (ids.astype(np.uint64) * 2654435761 % 2**32).astype(np.uint32)
+        w.set_user_attributes(tags)
+        np.testing.assert_array_equal(w.positions()[5:25].view(np.uint32), table[5:25, 0:3].view(np.uint32))
+        np.testing.assert_array_equal(w.velocities()[5:25].view(np.uint32), table[5:25, 4:7].view(np.uint32))
+        np.testing.assert_array_equal(w.user_attributes(), tags)
+        np.testing.assert_array_equal(w.ids(), ids)
+        for _ in range(10):
+            w.step(0.01)
+        by_id = dict(zip(ids.tolist(), tags.tolist()))
+        assert [by_id[i] for i in w.ids().tolist()] == w.user_attributes().tolist()  # sorted along
+
+
+def test_remove_particles_by_id(ctx):
+    with ctx.world(capacity=2048) as w:
+        w.fill_box((0, 0.2, 0), (0.1, 0.3, 0.1))
+        w.step(0.01)
+        ids = w.ids()
+        gone = [int(ids[3]), int(ids[0]), int(ids[-1])]
+        w.remove_particles(gone)
+        np.testing.assert_array_equal(w.ids(), np.delete(ids, [0, 3, len(ids) - 1]))
+        np.testing.assert_array_equal(w.removed_ids(), gone)
+        w.remove_particles([])
+
+
+def test_particle_write_errors_change_nothing(ctx):
+    with ctx.world(capacity=2048) as w:
+        n = w.fill_box((0, 0.2, 0), (0.1, 0.3, 0.1))
+        before = w.save()
+        bad = w.positions()[:4].copy()
+        bad[3, 1] = np.nan
+        assert error(w.set_positions, bad) == sph.Result.ERROR_INVALID_ARGUMENT
+        assert error(w.set_velocities, np.zeros((2, 3)), first=n - 1) == sph.Result.ERROR_INVALID_ARGUMENT
+        assert error(w.set_user_attributes, [1, 2]) == sph.Result.ERROR_FEATURE_DISABLED
+        assert error(w.set_attribute, sph.Attribute.DENSITY, [1.0]) == sph.Result.ERROR_INVALID_ARGUMENT
+        ids = w.ids()
+        assert error(w.remove_particles, [int(ids[1]), 10**6]) == sph.Result.ERROR_INVALID_ARGUMENT
+        assert error(w.remove_particles, [int(ids[1]), int(ids[1])]) == sph.Result.ERROR_INVALID_ARGUMENT
+        with pytest.raises(ValueError):
+            w.remove_particles([-1])
+        assert w.save() == before
