@@ -282,6 +282,35 @@ def test_cuda_array_interface_shape():
 
 
 # ---- loads on colliders -----------------------------------------------------------------------------
+def test_probes(ctx):
+    """World.add_probe / Probe.reading: a point in water resting in a tank reads about rho0 and the
+    water's stillness; a gauge through it reads the fill height (within 10 %: a few frames of
+    settling); bad input names the field."""
+    with ctx.shape("box", half_extents=(0.05, 0.1, 0.05), voxel_size=0.01) as box:
+        with ctx.world(capacity=512, particle_spacing=0.02) as world:
+            tank = world.add_collider(box, (0.05, 0.1, 0.05), inverted=True)
+            n = world.fill_box((0.0, 0.0, 0.0), (0.1, 0.06, 0.1))
+            point = world.add_probe((0.05, 0.02, 0.05), sampling="substep")
+            gauge = world.add_probe((0.05, -0.03, 0.05), gauge_length=0.2)
+            assert point.reading.samples == 0
+            for _ in range(10):
+                world.step(0.02)
+            r = point.reading
+            assert r.samples == world.stats().substeps
+            assert r.density == pytest.approx(1000.0, rel=0.05)
+            assert abs(r.velocity.y) < 0.2
+            fill = n * world.particle_mass / 1000.0 / (0.1 * 0.1)
+            assert gauge.reading.water_height == pytest.approx(fill, rel=0.1)
+            assert gauge.reading.samples == 1
+            assert error(world.add_probe, (0.0, float("nan"), 0.0)) == sph.Result.ERROR_INVALID_ARGUMENT
+            assert "def->position" in sph.last_error()
+            assert error(world.add_probe, (0.0, 0.0, 0.0), gauge_length=-1.0) == sph.Result.ERROR_INVALID_ARGUMENT
+            assert "def->length" in sph.last_error()
+            gauge.destroy()
+            assert point.reading.samples > 0
+            tank.destroy()
+
+
 def test_collider_loads(ctx):
     """Collider.loads / set_load_point (SPH_FEATURE_COLLIDER_LOADS): refused without the feature;
     with it, water resting on a tank's floor presses it with about its weight, and the torque is
