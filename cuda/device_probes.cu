@@ -35,7 +35,7 @@ __global__ void probe_sums_kernel(DeviceProbes probes, const FrameState* state) 
   const ProbeView p = probes.views[k];
   ProbeGather g = zero_probe_gather();
   for (uint32_t q = 0; q < p.point_count; ++q) g = g + probes.points[p.first_point + q];
-  add_probe_sample(probes.sums[k], p, probe_sample(p, g), state->clock.time.dt);
+  add_probe_sample(probes.sums[k], p, probe_sample(probes.constants, p, g), state->clock.time.dt);
 }
 
 }  // namespace

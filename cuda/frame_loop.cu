@@ -83,6 +83,7 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
         ProbeConstants constants;
         constants.kernel = make_kernel_coefficients(config_.kernel_radius);
         constants.particle_mass = config_.particle_mass;
+        constants.rest_density = config_.rest_density;
         setup.probes = r_->probes.upload(scene_in, constants, r_->stream);
       }
       FrameInput* input = r_->input.get();

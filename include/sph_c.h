@@ -1309,7 +1309,8 @@ typedef struct sph_probe_reading {
   float pressure_max;   /* Pa: the largest pressure of the samples (the peak of an impact) */
   float kernel_sum;     /* sum_j V_j W: the fluid fraction, about 1 inside water, 0 in air;
                            GAUGE: its mean over the line */
-  float water_height;   /* GAUGE: the column integral of the fluid fraction along the line, m;
+  float water_height;   /* GAUGE: the column integral along the line of the mass interpolant over
+                           the rest density (the mass per unit area as a height at rho0), m;
                            POINT: 0 */
   double time;          /* s: the span of the reading (the last substep's length, or the step's) */
 } sph_probe_reading;

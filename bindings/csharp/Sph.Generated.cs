@@ -1831,8 +1831,8 @@ namespace Sph
         /// </summary>
         public float KernelSum;
         /// <summary>
-        /// float water_height: GAUGE: the column integral of the fluid fraction along the line, m;
-        /// POINT: 0
+        /// float water_height: GAUGE: the column integral along the line of the mass interpolant over
+        /// the rest density (the mass per unit area as a height at rho0), m; POINT: 0
         /// </summary>
         public float WaterHeight;
         /// <summary>double time: s: the span of the reading (the last substep's length, or the step's)</summary>

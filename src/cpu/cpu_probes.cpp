@@ -20,6 +20,7 @@ void CpuBackend::sample_probes(const SceneFrame& scene, float dt, FrameReport& r
   ProbeConstants constants;
   constants.kernel = make_kernel_coefficients(config_.kernel_radius);
   constants.particle_mass = config_.particle_mass;
+  constants.rest_density = config_.rest_density;
   const GridView view = grid_.view();
   const Float4* pos = position_.data();
   const Float4* vel = velocity_.data();
@@ -37,7 +38,7 @@ void CpuBackend::sample_probes(const SceneFrame& scene, float dt, FrameReport& r
     const ProbeView& p = probes[k];
     ProbeGather g = zero_probe_gather();
     for (uint32_t q = 0; q < p.point_count; ++q) g = g + points[p.first_point + q];
-    add_probe_sample(probe_sums_[static_cast<size_t>(k)], p, probe_sample(p, g), dt);
+    add_probe_sample(probe_sums_[static_cast<size_t>(k)], p, probe_sample(constants, p, g), dt);
   }
   report.stage_ms[kStageDensity] += static_cast<float>(elapsed_ms(t));
 }

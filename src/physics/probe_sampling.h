@@ -8,10 +8,14 @@
 //   field       A(x) = sum_j V_j A_j W(|x - x_j|) / S(x)   (Shepard-normalised, A = rho, p, v)
 // The density needs no division by rho_j: sum_j V_j rho_j W = sum_j m W. A gauge is a line of
 // points x_k = origin + (k + 1/2) step, k < count; its water height is the column integral of the
-// fluid fraction by the midpoint rule, H = sum_k S(x_k) |step|, which counts the volume of the
-// particles the line passes through per unit area: a line that starts below the floor (inside a
-// wall, where S = 0) and ends above the surface reads the depth. Its density, pressure and
-// velocity are the Shepard means over the whole line: sum_k sum_j V_j A_j W / sum_k S(x_k).
+// mass interpolant over the rest density by the midpoint rule, H = sum_k sum_j m W(x_k) |step| /
+// rho0: the mass per unit area the line passes through, as the height it stands at rest density.
+// A line that starts below the floor (inside a wall, where no particle is) and ends above the
+// surface reads the depth. m / rho0 rather than V_j = m / rho_j: the particles of a free surface
+// read a density deficit (their kernels reach into air), so V_j overstates their volume; a block
+// of 10 layers read +5.5 % with V_j and within the quadrature's error with m / rho0
+// (tests/physics_options/test_probes.c). Its density, pressure and velocity are the Shepard means
+// over the whole line: sum_k sum_j V_j A_j W / sum_k S(x_k).
 //
 // W is W_poly6 at the world's kernel radius, not the density's lattice-scaled W_spiky: the
 // interpolant then is a plain normalised kernel (S -> 1 in the bulk), and poly6 is the smoothest
@@ -51,6 +55,7 @@ struct ProbeView {
 struct ProbeConstants {
   KernelCoefficients kernel;  // make_kernel_coefficients(h): unscaled poly6
   float particle_mass;
+  float rest_density;
 };
 
 // The sums of one sample point (or of a gauge's points).
@@ -104,11 +109,11 @@ struct ProbeSample {
 };
 
 // The sample from the sums of a probe's points (in point order); zero where no particle is near.
-SPH_HD ProbeSample probe_sample(const ProbeView& p, const ProbeGather& g) {
+SPH_HD ProbeSample probe_sample(const ProbeConstants& c, const ProbeView& p, const ProbeGather& g) {
   ProbeSample s{0.0f, 0.0f, 0.0f, Vec3{0.0f, 0.0f, 0.0f}, 0.0f};
   const float count = static_cast<float>(p.point_count);
   s.kernel_sum = g.kernel_sum / count;
-  if (p.gauge) s.water_height = g.kernel_sum * length(p.step);
+  if (p.gauge) s.water_height = g.mass_sum * length(p.step) / c.rest_density;
   if (g.kernel_sum > 0.0f) {
     const float inv = 1.0f / g.kernel_sum;
     s.density = g.mass_sum * inv;

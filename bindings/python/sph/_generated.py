@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'fe6af1922a7de6784551812034d70f3819151650b4d8023cf6fc09ae92f4f185', 'include/sph_cuda.h': '8fe2c1988d9c8456a91fb26b7863765759ab8ad17bd1ff44b457c77af0bc7985', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': 'b9bba4a9dd28dbd89c1e6599f0e10ed40961c2d3f05245c4c6f79b52cb937a68', 'include/sph_cuda.h': '8fe2c1988d9c8456a91fb26b7863765759ab8ad17bd1ff44b457c77af0bc7985', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -1782,7 +1782,7 @@ class ProbeReading(_SphStruct):
         velocity (sph_vec3): m/s
         pressure_max (float): Pa: the largest pressure of the samples (the peak of an impact)
         kernel_sum (float): sum_j V_j W: the fluid fraction, about 1 inside water, 0 in air; GAUGE: its mean over the line
-        water_height (float): GAUGE: the column integral of the fluid fraction along the line, m; POINT: 0
+        water_height (float): GAUGE: the column integral along the line of the mass interpolant over the rest density (the mass per unit area as a height at rho0), m; POINT: 0
         time (double): s: the span of the reading (the last substep's length, or the step's)
     """
     _fields_ = [
