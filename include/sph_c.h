@@ -1285,7 +1285,8 @@ static inline sph_result sph_probe_def_init(sph_probe_def* def) {
  * length not > 0 or too many steps, a negative sample_spacing, non-zero reserved0, each named),
  * UNSUPPORTED (an unknown kind or sampling; a world of the DFSPH solver, whose substep does not
  * sample probes), VERSION_MISMATCH, CAPACITY (65536 probes), WORLD_LOCKED. Nothing changes on
- * error. Probes are not carried by checkpoints (docs/api.md).
+ * error. Probes are not carried by checkpoints: sph_world_restore keeps the world's own, a world
+ * made by sph_world_load has none (docs/api.md).
  */
 SPH_API sph_result SPH_CALL sph_probe_create(sph_world* world, const sph_probe_def* def,
                                              sph_probe_id* out_id);

@@ -2704,7 +2704,8 @@ namespace Sph
         /// length not &gt; 0 or too many steps, a negative sample_spacing, non-zero reserved0, each
         /// named), UNSUPPORTED (an unknown kind or sampling; a world of the DFSPH solver, whose substep
         /// does not sample probes), VERSION_MISMATCH, CAPACITY (65536 probes), WORLD_LOCKED. Nothing
-        /// changes on error. Probes are not carried by checkpoints (docs/api.md).
+        /// changes on error. Probes are not carried by checkpoints: sph_world_restore keeps the world's
+        /// own, a world made by sph_world_load has none (docs/api.md).
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_probe_create(WorldHandle world, ref ProbeDef def, out ProbeId outId);

@@ -126,6 +126,9 @@ class World {
   // A live probe; Error(InvalidHandle) otherwise.
   const Probe& probe(uint64_t id) const;
   const SlotMap<Probe>& probes() const { return probes_; }
+  // Takes over another world's probes with their ids, readings cleared (a restore keeps the
+  // world's probes: they are instruments, not state). None on a DFSPH world (add_probe's rule).
+  void adopt_probes(const World& from);
 
   // Replaces the whole scene (checkpoints; see SceneTables).
   void restore_scene(SceneTables tables);

@@ -81,6 +81,13 @@ void World::remove_probe(uint64_t id) {
   if (!probes_.erase(id)) throw Error(Status::InvalidHandle, "id: is stale or not of this world");
 }
 
+void World::adopt_probes(const World& from) {
+  if (config_.solver == Solver::Dfsph) return;
+  SlotMap<Probe> probes = from.probes_;
+  probes.for_each([](uint64_t, Probe& p) { p.reading = ProbeReading{}; });
+  probes_ = std::move(probes);
+}
+
 const Probe& World::probe(uint64_t id) const {
   const Probe* p = probes_.find(id);
   if (!p) throw Error(Status::InvalidHandle, "id: is null, stale or not of this world");

@@ -11,7 +11,8 @@
  *     the test);
  *   - a body of water moving at a uniform velocity without gravity: a probe it passes reads that
  *     velocity and rho0, a gauge through it the block's height (its fill height);
- *   - sampling: EVERY_SUBSTEP averages the step's substeps, EVERY_FRAME reads the last;
+ *   - sampling: EVERY_SUBSTEP averages the step's substeps, EVERY_FRAME reads the last; a
+ *     restore keeps the probes;
  *   - bad input: each field named, the world unchanged (no slot taken), handles checked.
  * PROBES_MEASURE=1 prints the measurements without asserting the bounds. */
 #include <math.h>
@@ -373,6 +374,24 @@ static void test_sampling(void** state) {
   assert_true(a.pressure_max >= a.pressure);
   assert_true(b.kernel_sum > 0.5);
   assert_true(c.samples == 1 && c.kernel_sum == 0.0f && c.density == 0.0f && c.pressure == 0.0f);
+  {
+    /* A restore keeps the world's probes and their ids (checkpoints hold no probes); their
+     * readings start again. */
+    uint64_t size = 0;
+    void* saved;
+    EXPECT_OK(sph_world_save(w.world, NULL, 0, &size));
+    saved = malloc(size);
+    assert_non_null(saved);
+    EXPECT_OK(sph_world_save(w.world, saved, size, &size));
+    EXPECT_OK(sph_world_step(w.world, 0.02f));
+    EXPECT_OK(sph_world_restore(w.world, saved, size));
+    free(saved);
+    a = reading_of(w.world, every);
+    assert_int_equal(a.samples, 0);
+    EXPECT_OK(sph_world_step(w.world, 0.02f));
+    a = reading_of(w.world, every);
+    assert_true(a.samples > 1 && a.kernel_sum > 0.5f);
+  }
   EXPECT_OK(support_world_close(&w));
 }
 

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'b9bba4a9dd28dbd89c1e6599f0e10ed40961c2d3f05245c4c6f79b52cb937a68', 'include/sph_cuda.h': '8fe2c1988d9c8456a91fb26b7863765759ab8ad17bd1ff44b457c77af0bc7985', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '361710117077e19a2453ec1565e24977ceeb952c6f6135531dabff4fd8090b39', 'include/sph_cuda.h': '8fe2c1988d9c8456a91fb26b7863765759ab8ad17bd1ff44b457c77af0bc7985', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -2063,7 +2063,7 @@ FUNCTIONS = {
     'sph_probe_def_init_sized': (sph_result, (_c.POINTER(sph_probe_def), _c.c_uint32), ('def', 'size'),
         '', 'sph'),
     'sph_probe_create': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_probe_def), _c.POINTER(sph_probe_id)), ('world', 'def', 'out_id'),
-        "Adds a probe or gauge; it is sampled inside every following sph_world_step on the world's backend (on the device for CUDA, with no host copy per substep). Errors: INVALID_HANDLE (world), INVALID_ARGUMENT (NULL def or out_id; a non-finite position or direction, a gauge's length not > 0 or too many steps, a negative sample_spacing, non-zero reserved0, each named), UNSUPPORTED (an unknown kind or sampling; a world of the DFSPH solver, whose substep does not sample probes), VERSION_MISMATCH, CAPACITY (65536 probes), WORLD_LOCKED. Nothing changes on error. Probes are not carried by checkpoints (docs/api.md).", 'sph'),
+        "Adds a probe or gauge; it is sampled inside every following sph_world_step on the world's backend (on the device for CUDA, with no host copy per substep). Errors: INVALID_HANDLE (world), INVALID_ARGUMENT (NULL def or out_id; a non-finite position or direction, a gauge's length not > 0 or too many steps, a negative sample_spacing, non-zero reserved0, each named), UNSUPPORTED (an unknown kind or sampling; a world of the DFSPH solver, whose substep does not sample probes), VERSION_MISMATCH, CAPACITY (65536 probes), WORLD_LOCKED. Nothing changes on error. Probes are not carried by checkpoints: sph_world_restore keeps the world's own, a world made by sph_world_load has none (docs/api.md).", 'sph'),
     'sph_probe_destroy': (sph_result, (_c.POINTER(sph_world), sph_probe_id), ('world', 'id'),
         'Removes a probe; id {0} is a no-op. Errors: INVALID_HANDLE (world; stale or foreign id), WORLD_LOCKED.', 'sph'),
     'sph_probe_reading_init_sized': (sph_result, (_c.POINTER(sph_probe_reading), _c.c_uint32), ('reading', 'size'),
