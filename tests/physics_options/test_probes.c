@@ -213,7 +213,9 @@ static void test_resting_tank(void** state) {
   sph_sdf* sdf = NULL;
   sph_world_def def;
   sph_world_params params;
-  sph_probe_id probes[4], gauge;
+  sph_probe_id probes[4], gauge, snapshot;
+  double snapshot_sum = 0.0, snapshot_sum2 = 0.0;
+  int snapshots = 0;
   double pressure[4] = {0.0, 0.0, 0.0, 0.0}, height = 0.0, time = 0.0, probe_time = 0.0, fill, rho0;
   (void)state;
   assert_int_equal(support_fcc_box(layers, kStep, NULL, &lattice, &n), SPH_OK);
@@ -228,11 +230,18 @@ static void test_resting_tank(void** state) {
   for (int k = 0; k < 4; ++k)
     probes[k] = add_point(w.world, width / 2, heights[k], width / 2, SPH_PROBE_EVERY_SUBSTEP);
   gauge = add_gauge(w.world, width / 2, -0.03, width / 2, 0.48, 0.0);
+  /* One substep's pressure per frame at 8 cm: its spread over time is the solver's pressure noise
+   * (reported for the density diffusion of issue 17 item 3 to compare against). */
+  snapshot = add_point(w.world, width / 2, heights[1], width / 2, SPH_PROBE_EVERY_FRAME);
   for (int frame = 0; frame < 80; ++frame) {
     EXPECT_OK(sph_world_step(w.world, 0.02f));
     if (frame < 60) continue;
     {
       const sph_probe_reading g = reading_of(w.world, gauge);
+      const sph_probe_reading one = reading_of(w.world, snapshot);
+      snapshot_sum += one.pressure;
+      snapshot_sum2 += (double)one.pressure * one.pressure;
+      ++snapshots;
       height += g.water_height * g.time;
       time += g.time;
       for (int k = 0; k < 4; ++k) {
@@ -262,6 +271,14 @@ static void test_resting_tank(void** state) {
         "  probe at y = %.2f m: p = %.2f Pa, rho0 g d = %.2f Pa (d = %.4f m below the gauge's "
         "surface; %+.2f %%)\n",
         heights[k], pressure[k], rho0 * kGravity * d, d, 100.0 * (pressure[k] / (rho0 * kGravity * d) - 1.0));
+  }
+  {
+    const double mean = snapshot_sum / snapshots;
+    print_message(
+        "  pressure noise at 8 cm (one substep per frame, %d frames): mean %.1f Pa, standard deviation "
+        "%.1f Pa (%.1f %% of the mean; k = %.0f, no density diffusion)\n",
+        snapshots, mean, sqrt(fmax(0.0, snapshot_sum2 / snapshots - mean * mean)),
+        100.0 * sqrt(fmax(0.0, snapshot_sum2 / snapshots - mean * mean)) / mean, w.params.stiffness);
   }
   {
     const double gradient = (pressure[0] - pressure[3]) / (heights[3] - heights[0]);
