@@ -278,7 +278,7 @@ void CudaBackend::import_particles(const ParticleSnapshot& s) {
 uint64_t CudaBackend::memory_bytes() const {
   return r_->store->bytes() + r_->grid->bytes() + r_->statistics->bytes() + r_->state.bytes() +
          r_->sdf_cache.bytes() + r_->scene_buffer.bytes() + r_->sinks.bytes() + r_->solve_partials.bytes() +
-         r_->boundary_maps.bytes() + r_->loads.bytes();
+         r_->boundary_maps.bytes() + r_->loads.bytes() + r_->probes.bytes();
 }
 
 DeviceAttributeView CudaBackend::device_attribute(AttributeKind kind) const {

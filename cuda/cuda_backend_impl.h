@@ -44,6 +44,7 @@ struct DeviceResources {
   DeviceSdfCache sdf_cache;
   DeviceBoundaryMaps boundary_maps;
   DeviceColliderLoads loads;
+  DeviceProbeBuffers probes;
   DeviceSceneBuffer scene_buffer;
   DeviceSinkCompactor sinks;
 

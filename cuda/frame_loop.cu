@@ -26,7 +26,11 @@ bool same_setup(const PipelineSetup& a, const PipelineSetup& b) {
          a.scene.collider_count == b.scene.collider_count && a.scene.field_count == b.scene.field_count &&
          a.scene.kernel_radius == b.scene.kernel_radius && a.loads.partials == b.loads.partials &&
          a.loads.sums == b.loads.sums && a.loads.output == b.loads.output &&
-         a.loads.colliders == b.loads.colliders;
+         a.loads.colliders == b.loads.colliders && a.probes.views == b.probes.views &&
+         a.probes.points == b.probes.points && a.probes.sums == b.probes.sums &&
+         a.probes.output == b.probes.output && a.probes.probe_count == b.probes.probe_count &&
+         a.probes.point_count == b.probes.point_count &&
+         std::memcmp(&a.probes.constants, &b.probes.constants, sizeof a.probes.constants) == 0;
 }
 
 }  // namespace
@@ -74,6 +78,13 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
           setup.loads = r_->loads.reserve(static_cast<uint32_t>(scene.colliders.size()), config_.capacity);
         if (with_sinks) r_->sinks.reserve(config_.capacity, *r_->store);
         cuda_check(cudaStreamSynchronize(r_->stream), "upload of the scene");
+      }
+      if (!scene_in.probes.empty()) {
+        ProbeConstants constants;
+        constants.kernel = make_kernel_coefficients(config_.kernel_radius);
+        constants.particle_mass = config_.particle_mass;
+        constants.rest_density = config_.rest_density;
+        setup.probes = r_->probes.upload(scene_in, constants, r_->stream);
       }
       FrameInput* input = r_->input.get();
       input->frame_dt = frame_dt;
@@ -126,6 +137,8 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
     if (setup.loads.on())
       for (uint32_t c = 0; c < setup.loads.colliders; ++c) report.collider_loads[c] = setup.loads.output[c];
   }
+  report.probes.assign(scene_in.probes.size(), ProbeSums{});
+  for (uint32_t k = 0; k < setup.probes.probe_count; ++k) report.probes[k] = setup.probes.output[k];
   report_clock(s.clock, report);
   report.interrupted = interrupted;
   report.max_speed = s.max_speed;

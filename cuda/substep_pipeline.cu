@@ -10,6 +10,7 @@ void enqueue_frame_begin(const PipelineSetup& setup, const PipelineBuffers& b, L
   enqueue_begin_frame(b.state, setup.limits, setup.max_substeps, cond, stream);
   b.store->enqueue_snapshot(setup.count, stream);
   if (setup.loads.on()) enqueue_loads_begin(setup.loads, stream);
+  if (setup.probes.on()) enqueue_probes_begin(setup.probes, stream);
 }
 
 void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
@@ -41,6 +42,9 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
     if (setup.options.springs) enqueue_spring_reorder(a, b.grid->order(), n, stream);
     enqueue_density(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene,
                     rk4 ? rk4_stage_fraction(stage) : 0.0f, b.state, stream);
+    // Probes sample the substep's start (RK4: its first stage), as on the CPU.
+    if (stage == 0 && setup.probes.on())
+      enqueue_probe_samples(setup.probes, b.grid->view(), a, b.state, stream);
     if (setup.options.springs)
       enqueue_spring_pass(setup.springs, b.grid->view(), a, n, stage == 0, b.state, stream);
     const bool loads = setup.loads.on();
@@ -64,6 +68,7 @@ void enqueue_frame_end(const PipelineSetup& setup, const PipelineBuffers& b, cud
                        const uint32_t* counts) {
   b.statistics->enqueue(setup.fluid, b.grid->view(), b.store->arrays(), setup.count, b.state, stream, counts);
   if (setup.loads.on()) enqueue_loads_end(setup.loads, stream);
+  if (setup.probes.on()) enqueue_probes_end(setup.probes, stream);
   cuda_check(cudaMemcpyAsync(b.state_output, b.state, sizeof(FrameState), cudaMemcpyDeviceToHost, stream),
              "copy of the frame state");
 }

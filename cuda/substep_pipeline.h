@@ -17,6 +17,7 @@
 #include "device_collider_loads.h"
 #include "device_neighbor_grid.h"
 #include "device_particle_store.h"
+#include "device_probes.h"
 #include "device_springs.h"
 #include "dfsph_solver.h"
 #include "frame_control.h"
@@ -36,6 +37,7 @@ struct PipelineSetup {
   DeviceScene scene{};        // colliders and force fields inside the substep (none: all zero)
   SpringConstants springs{};  // used when options.springs
   DeviceLoads loads{};        // loads on colliders (off: all null)
+  DeviceProbes probes{};      // probes and gauges (none: all null)
 };
 
 struct PipelineBuffers {

@@ -1313,6 +1313,99 @@ SPH_API sph_result SPH_CALL sph_force_field_destroy(sph_world* world, sph_force_
 SPH_API sph_result SPH_CALL sph_force_field_set_transform(sph_world* world, sph_force_field_id id,
                                                           const sph_transform* transform);
 
+/* ---- probes and gauges ------------------------------------------------------------------- */
+typedef struct sph_probe_id {
+  uint64_t bits; /* {0} is null (SPH_ID_IS_NULL) */
+} sph_probe_id;
+
+typedef enum sph_probe_kind {
+  SPH_PROBE_POINT = 0, /* samples density, pressure and velocity at `position` */
+  SPH_PROBE_GAUGE = 1, /* a line from `position` along `direction`, `length` long: the water height
+                          (column integral) and the column's mean density, pressure and velocity */
+  SPH_PROBE_KIND_FORCE32 = 0x7fffffff
+} sph_probe_kind;
+
+typedef enum sph_probe_sampling {
+  SPH_PROBE_EVERY_FRAME = 0,   /* the last substep of each step is sampled */
+  SPH_PROBE_EVERY_SUBSTEP = 1, /* every substep is sampled; the reading is the time average */
+  SPH_PROBE_SAMPLING_FORCE32 = 0x7fffffff
+} sph_probe_sampling;
+
+/** Zero means default: a zeroed def (after sph_probe_def_init) is a point probe at the origin
+ *  sampled once a frame. The values are the SPH interpolant (docs/physics.md "Probes and
+ *  gauges"): A(x) = sum_j V_j A_j W(|x - x_j|) / sum_j V_j W(|x - x_j|), V_j = m / rho_j, with
+ *  W_poly6 at the world's kernel radius, over the particles of the substep's density pass. */
+typedef struct sph_probe_def {
+  uint32_t struct_size;        /* set by sph_probe_def_init */
+  sph_probe_kind kind;         /* default SPH_PROBE_POINT */
+  sph_probe_sampling sampling; /* default SPH_PROBE_EVERY_FRAME */
+  sph_vec3 position;           /* POINT: where; GAUGE: the line's start (put it below the floor), m */
+  sph_vec3 direction;          /* GAUGE: the line's direction (normalised by the library);
+                                  {0,0,0} = up, against the world's gravity at each step (+y
+                                  without gravity) */
+  float length;                /* GAUGE: the line's length, m; > 0 */
+  float sample_spacing;        /* GAUGE: the column integral's step, m; 0 = kernel radius / 8; at
+                                  most 65536 steps along the line */
+  uint32_t reserved0;          /* must be 0 */
+} sph_probe_def;
+SPH_STATIC_ASSERT(sizeof(sph_probe_def) == 48, sph_probe_def_size);
+
+SPH_API sph_result SPH_CALL sph_probe_def_init_sized(sph_probe_def* def, uint32_t size);
+static inline sph_result sph_probe_def_init(sph_probe_def* def) {
+  return sph_probe_def_init_sized(def, (uint32_t)sizeof(*def));
+}
+/**
+ * Adds a probe or gauge; it is sampled inside every following sph_world_step on the world's
+ * backend (on the device for CUDA, with no host copy per substep). Errors: INVALID_HANDLE
+ * (world), INVALID_ARGUMENT (NULL def or out_id; a non-finite position or direction, a gauge's
+ * length not > 0 or too many steps, a negative sample_spacing, non-zero reserved0, each named),
+ * UNSUPPORTED (an unknown kind or sampling; a world of the DFSPH solver, whose substep does not
+ * sample probes), VERSION_MISMATCH, CAPACITY (65536 probes), WORLD_LOCKED. Nothing changes on
+ * error. Probes are not carried by checkpoints: sph_world_restore keeps the world's own, a world
+ * made by sph_world_load has none (docs/api.md).
+ */
+SPH_API sph_result SPH_CALL sph_probe_create(sph_world* world, const sph_probe_def* def,
+                                             sph_probe_id* out_id);
+/** Removes a probe; id {0} is a no-op. Errors: INVALID_HANDLE (world; stale or foreign id),
+ *  WORLD_LOCKED. */
+SPH_API sph_result SPH_CALL sph_probe_destroy(sph_world* world, sph_probe_id id);
+
+/**
+ * A probe's reading of the last sph_world_step. EVERY_FRAME: the sample of the step's last
+ * substep; EVERY_SUBSTEP: the average of the step's substeps, each weighted by its length. A
+ * sample is taken at the substep's density pass (the positions and velocities the substep starts
+ * from, the densities and pressures its forces use). Where no particle is within the kernel
+ * radius (kernel_sum 0) a sample reads 0.
+ */
+typedef struct sph_probe_reading {
+  uint32_t struct_size; /* set by sph_probe_reading_init */
+  uint32_t samples;     /* samples in the reading; 0 before the first step */
+  float density;        /* kg/m^3, Shepard-normalised */
+  float pressure;       /* Pa (the equation of state's, relative to the free surface) */
+  sph_vec3 velocity;    /* m/s */
+  float pressure_max;   /* Pa: the largest pressure of the samples (the peak of an impact) */
+  float kernel_sum;     /* sum_j V_j W: the fluid fraction, about 1 inside water, 0 in air;
+                           GAUGE: its mean over the line */
+  float water_height;   /* GAUGE: the column integral along the line of the mass interpolant over
+                           the rest density (the mass per unit area as a height at rho0), m;
+                           POINT: 0 */
+  double time;          /* s: the span of the reading (the last substep's length, or the step's) */
+} sph_probe_reading;
+SPH_STATIC_ASSERT(sizeof(sph_probe_reading) == 48, sph_probe_reading_size);
+
+SPH_API sph_result SPH_CALL sph_probe_reading_init_sized(sph_probe_reading* reading, uint32_t size);
+static inline sph_result sph_probe_reading_init(sph_probe_reading* reading) {
+  return sph_probe_reading_init_sized(reading, (uint32_t)sizeof(*reading));
+}
+/**
+ * Reads a probe's reading of the last step. Non-blocking (the step brought it to the host).
+ * out->struct_size must be set (sph_probe_reading_init); only that many bytes are written.
+ * Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (NULL out),
+ * VERSION_MISMATCH, WORLD_LOCKED.
+ */
+SPH_API sph_result SPH_CALL sph_probe_get_reading(const sph_world* world, sph_probe_id id,
+                                                  sph_probe_reading* out);
+
 /* ---- events of the last step ------------------------------------------------------------- */
 typedef enum sph_event_type {
   SPH_EVENT_SOURCE_CAPACITY_REACHED = 1, /* object: the source; count: particles not emitted */

@@ -189,6 +189,16 @@ typedef enum {
   SPH_FORCE_FIELD_KIND_FORCE32 = 2147483647,
 } sph_force_field_kind;
 typedef enum {
+  SPH_PROBE_POINT = 0,
+  SPH_PROBE_GAUGE = 1,
+  SPH_PROBE_KIND_FORCE32 = 2147483647,
+} sph_probe_kind;
+typedef enum {
+  SPH_PROBE_EVERY_FRAME = 0,
+  SPH_PROBE_EVERY_SUBSTEP = 1,
+  SPH_PROBE_SAMPLING_FORCE32 = 2147483647,
+} sph_probe_sampling;
+typedef enum {
   SPH_EVENT_SOURCE_CAPACITY_REACHED = 1,
   SPH_EVENT_SINK_REMOVED = 2,
   SPH_EVENT_PRESSURE_SOLVE_CAPPED = 3,
@@ -476,6 +486,30 @@ typedef struct sph_force_field_def {
   uint32_t reserved0;
   uint32_t reserved1;
 } sph_force_field_def;
+typedef struct sph_probe_id {
+  uint64_t bits;
+} sph_probe_id;
+typedef struct sph_probe_def {
+  uint32_t struct_size;
+  sph_probe_kind kind;
+  sph_probe_sampling sampling;
+  sph_vec3 position;
+  sph_vec3 direction;
+  float length;
+  float sample_spacing;
+  uint32_t reserved0;
+} sph_probe_def;
+typedef struct sph_probe_reading {
+  uint32_t struct_size;
+  uint32_t samples;
+  float density;
+  float pressure;
+  sph_vec3 velocity;
+  float pressure_max;
+  float kernel_sum;
+  float water_height;
+  double time;
+} sph_probe_reading;
 typedef struct sph_event {
   sph_event_type type;
   uint32_t count;
@@ -589,6 +623,11 @@ sph_result sph_force_field_def_init_sized(sph_force_field_def* def, uint32_t siz
 sph_result sph_force_field_create(sph_world* world, const sph_force_field_def* def, sph_force_field_id* out_id);
 sph_result sph_force_field_destroy(sph_world* world, sph_force_field_id id);
 sph_result sph_force_field_set_transform(sph_world* world, sph_force_field_id id, const sph_transform* transform);
+sph_result sph_probe_def_init_sized(sph_probe_def* def, uint32_t size);
+sph_result sph_probe_create(sph_world* world, const sph_probe_def* def, sph_probe_id* out_id);
+sph_result sph_probe_destroy(sph_world* world, sph_probe_id id);
+sph_result sph_probe_reading_init_sized(sph_probe_reading* reading, uint32_t size);
+sph_result sph_probe_get_reading(const sph_world* world, sph_probe_id id, sph_probe_reading* out);
 sph_result sph_world_get_events(const sph_world* world, sph_event* events, uint32_t capacity, uint32_t* out_count);
 sph_result sph_world_get_removed_ids(const sph_world* world, uint32_t* ids, uint32_t capacity, uint32_t* out_count);
 sph_result sph_world_save(const sph_world* world, void* buffer, uint64_t buffer_size, uint64_t* out_size);

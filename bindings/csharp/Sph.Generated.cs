@@ -116,6 +116,8 @@ namespace Sph
         public const int SPH_SOURCE_MODE_FORCE32 = 2147483647;
         public const int SPH_SINK_MODE_FORCE32 = 2147483647;
         public const int SPH_FORCE_FIELD_KIND_FORCE32 = 2147483647;
+        public const int SPH_PROBE_KIND_FORCE32 = 2147483647;
+        public const int SPH_PROBE_SAMPLING_FORCE32 = 2147483647;
         public const int SPH_EVENT_TYPE_FORCE32 = 2147483647;
         // SPH_MAKE_VERSION(major, minor, patch) is a function-like macro: not generated.
         // SPH_ID_IS_NULL(id) is a function-like macro: not generated.
@@ -418,6 +420,27 @@ namespace Sph
         Vortex = 2,
         /// <summary>accelerations from a user grid (3 components, field frame)</summary>
         Grid = 3,
+    }
+
+    /// <summary>sph_probe_kind</summary>
+    public enum ProbeKind : int
+    {
+        /// <summary>samples density, pressure and velocity at `position`</summary>
+        Point = 0,
+        /// <summary>
+        /// a line from `position` along `direction`, `length` long: the water height (column integral)
+        /// and the column's mean density, pressure and velocity
+        /// </summary>
+        Gauge = 1,
+    }
+
+    /// <summary>sph_probe_sampling</summary>
+    public enum ProbeSampling : int
+    {
+        /// <summary>the last substep of each step is sampled</summary>
+        Frame = 0,
+        /// <summary>every substep is sampled; the reading is the time average</summary>
+        Substep = 1,
     }
 
     /// <summary>sph_event_type</summary>
@@ -1738,6 +1761,107 @@ namespace Sph
         }
     }
 
+    /// <summary>sph_probe_id (8 bytes)</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public partial struct ProbeId
+    {
+        /// <summary>uint64_t bits: {0} is null (SPH_ID_IS_NULL)</summary>
+        public ulong Bits;
+
+        public ProbeId(ulong bits)
+        {
+            Bits = bits;
+        }
+    }
+
+    /// <summary>
+    /// sph_probe_def (48 bytes): Zero means default: a zeroed def (after sph_probe_def_init) is a point
+    /// probe at the origin sampled once a frame. The values are the SPH interpolant (docs/physics.md
+    /// "Probes and gauges"): A(x) = sum_j V_j A_j W(|x - x_j|) / sum_j V_j W(|x - x_j|), V_j = m /
+    /// rho_j, with W_poly6 at the world's kernel radius, over the particles of the substep's density
+    /// pass.
+    /// </summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public partial struct ProbeDef
+    {
+        /// <summary>uint32_t struct_size: set by sph_probe_def_init</summary>
+        public uint StructSize;
+        /// <summary>sph_probe_kind kind: default SPH_PROBE_POINT</summary>
+        public ProbeKind Kind;
+        /// <summary>sph_probe_sampling sampling: default SPH_PROBE_EVERY_FRAME</summary>
+        public ProbeSampling Sampling;
+        /// <summary>sph_vec3 position: POINT: where; GAUGE: the line's start (put it below the floor), m</summary>
+        public Vec3 Position;
+        /// <summary>
+        /// sph_vec3 direction: GAUGE: the line's direction (normalised by the library); {0,0,0} = up,
+        /// against the world's gravity at each step (+y without gravity)
+        /// </summary>
+        public Vec3 Direction;
+        /// <summary>float length: GAUGE: the line's length, m; &gt; 0</summary>
+        public float Length;
+        /// <summary>
+        /// float sample_spacing: GAUGE: the column integral's step, m; 0 = kernel radius / 8; at most
+        /// 65536 steps along the line
+        /// </summary>
+        public float SampleSpacing;
+        /// <summary>uint32_t reserved0: must be 0</summary>
+        public uint Reserved0;
+
+        /// <summary>A ProbeDef with the library's defaults (sph_probe_def_init_sized).</summary>
+        public static ProbeDef Default()
+        {
+            var value = new ProbeDef();
+            uint size = (uint)Marshal.SizeOf(typeof(ProbeDef));
+            SphException.Check(Native.sph_probe_def_init_sized(ref value, size), "sph_probe_def_init_sized");
+            return value;
+        }
+    }
+
+    /// <summary>
+    /// sph_probe_reading (48 bytes): A probe's reading of the last sph_world_step. EVERY_FRAME: the
+    /// sample of the step's last substep; EVERY_SUBSTEP: the average of the step's substeps, each
+    /// weighted by its length. A sample is taken at the substep's density pass (the positions and
+    /// velocities the substep starts from, the densities and pressures its forces use). Where no
+    /// particle is within the kernel radius (kernel_sum 0) a sample reads 0.
+    /// </summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public partial struct ProbeReading
+    {
+        /// <summary>uint32_t struct_size: set by sph_probe_reading_init</summary>
+        public uint StructSize;
+        /// <summary>uint32_t samples: samples in the reading; 0 before the first step</summary>
+        public uint Samples;
+        /// <summary>float density: kg/m^3, Shepard-normalised</summary>
+        public float Density;
+        /// <summary>float pressure: Pa (the equation of state's, relative to the free surface)</summary>
+        public float Pressure;
+        /// <summary>sph_vec3 velocity: m/s</summary>
+        public Vec3 Velocity;
+        /// <summary>float pressure_max: Pa: the largest pressure of the samples (the peak of an impact)</summary>
+        public float PressureMax;
+        /// <summary>
+        /// float kernel_sum: sum_j V_j W: the fluid fraction, about 1 inside water, 0 in air; GAUGE:
+        /// its mean over the line
+        /// </summary>
+        public float KernelSum;
+        /// <summary>
+        /// float water_height: GAUGE: the column integral along the line of the mass interpolant over
+        /// the rest density (the mass per unit area as a height at rho0), m; POINT: 0
+        /// </summary>
+        public float WaterHeight;
+        /// <summary>double time: s: the span of the reading (the last substep's length, or the step's)</summary>
+        public double Time;
+
+        /// <summary>A ProbeReading with the library's defaults (sph_probe_reading_init_sized).</summary>
+        public static ProbeReading Default()
+        {
+            var value = new ProbeReading();
+            uint size = (uint)Marshal.SizeOf(typeof(ProbeReading));
+            SphException.Check(Native.sph_probe_reading_init_sized(ref value, size), "sph_probe_reading_init_sized");
+            return value;
+        }
+    }
+
     /// <summary>sph_event (16 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct Event
@@ -2662,6 +2786,53 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_force_field_set_transform")]
         public static extern Result sph_force_field_set_transform(IntPtr world, ForceFieldId id, IntPtr transform);
 
+        /// <summary>sph_probe_def_init_sized</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_probe_def_init_sized(ref ProbeDef def, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_probe_def_init_sized")]
+        public static extern Result sph_probe_def_init_sized(IntPtr def, uint size);
+
+        /// <summary>
+        /// Adds a probe or gauge; it is sampled inside every following sph_world_step on the world's
+        /// backend (on the device for CUDA, with no host copy per substep). Errors: INVALID_HANDLE
+        /// (world), INVALID_ARGUMENT (NULL def or out_id; a non-finite position or direction, a gauge's
+        /// length not &gt; 0 or too many steps, a negative sample_spacing, non-zero reserved0, each
+        /// named), UNSUPPORTED (an unknown kind or sampling; a world of the DFSPH solver, whose substep
+        /// does not sample probes), VERSION_MISMATCH, CAPACITY (65536 probes), WORLD_LOCKED. Nothing
+        /// changes on error. Probes are not carried by checkpoints: sph_world_restore keeps the world's
+        /// own, a world made by sph_world_load has none (docs/api.md).
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_probe_create(WorldHandle world, ref ProbeDef def, out ProbeId outId);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_probe_create")]
+        public static extern Result sph_probe_create(IntPtr world, IntPtr def, IntPtr outId);
+
+        /// <summary>
+        /// Removes a probe; id {0} is a no-op. Errors: INVALID_HANDLE (world; stale or foreign id),
+        /// WORLD_LOCKED.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_probe_destroy(WorldHandle world, ProbeId id);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_probe_destroy")]
+        public static extern Result sph_probe_destroy(IntPtr world, ProbeId id);
+
+        /// <summary>sph_probe_reading_init_sized</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_probe_reading_init_sized(ref ProbeReading reading, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_probe_reading_init_sized")]
+        public static extern Result sph_probe_reading_init_sized(IntPtr reading, uint size);
+
+        /// <summary>
+        /// Reads a probe's reading of the last step. Non-blocking (the step brought it to the host).
+        /// out-&gt;struct_size must be set (sph_probe_reading_init); only that many bytes are written.
+        /// Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (NULL out),
+        /// VERSION_MISMATCH, WORLD_LOCKED.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_probe_get_reading(WorldHandle world, ProbeId id, ref ProbeReading @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_probe_get_reading")]
+        public static extern Result sph_probe_get_reading(IntPtr world, ProbeId id, IntPtr @out);
+
         /// <summary>
         /// Events of the last sph_world_step (two-call pattern): writes up to `capacity` events and
         /// sets *out_count to the number there are; SPH_INCOMPLETE when capacity was too small. events
@@ -2875,6 +3046,9 @@ namespace Sph
             typeof(SinkDef),
             typeof(ForceFieldId),
             typeof(ForceFieldDef),
+            typeof(ProbeId),
+            typeof(ProbeDef),
+            typeof(ProbeReading),
             typeof(Event),
             typeof(CudaAttributeView),
         };
@@ -2911,6 +3085,9 @@ namespace Sph
             "sph_sink_def",
             "sph_force_field_id",
             "sph_force_field_def",
+            "sph_probe_id",
+            "sph_probe_def",
+            "sph_probe_reading",
             "sph_event",
             "sph_cuda_attribute_view",
         };
@@ -2947,6 +3124,9 @@ namespace Sph
             72,
             8,
             80,
+            8,
+            48,
+            48,
             16,
             48,
         };
@@ -3167,6 +3347,24 @@ namespace Sph
             typeof(ForceFieldDef),
             typeof(ForceFieldDef),
             typeof(ForceFieldDef),
+            typeof(ProbeId),
+            typeof(ProbeDef),
+            typeof(ProbeDef),
+            typeof(ProbeDef),
+            typeof(ProbeDef),
+            typeof(ProbeDef),
+            typeof(ProbeDef),
+            typeof(ProbeDef),
+            typeof(ProbeDef),
+            typeof(ProbeReading),
+            typeof(ProbeReading),
+            typeof(ProbeReading),
+            typeof(ProbeReading),
+            typeof(ProbeReading),
+            typeof(ProbeReading),
+            typeof(ProbeReading),
+            typeof(ProbeReading),
+            typeof(ProbeReading),
             typeof(Event),
             typeof(Event),
             typeof(Event),
@@ -3395,6 +3593,24 @@ namespace Sph
             "FalloffRadius",
             "Reserved0",
             "Reserved1",
+            "Bits",
+            "StructSize",
+            "Kind",
+            "Sampling",
+            "Position",
+            "Direction",
+            "Length",
+            "SampleSpacing",
+            "Reserved0",
+            "StructSize",
+            "Samples",
+            "Density",
+            "Pressure",
+            "Velocity",
+            "PressureMax",
+            "KernelSum",
+            "WaterHeight",
+            "Time",
             "Type",
             "Count",
             "ObjectBits",
@@ -3624,6 +3840,24 @@ namespace Sph
             72,
             76,
             0,
+            0,
+            4,
+            8,
+            12,
+            24,
+            36,
+            40,
+            44,
+            0,
+            4,
+            8,
+            12,
+            16,
+            28,
+            32,
+            36,
+            40,
+            0,
             4,
             8,
             0,
@@ -3734,6 +3968,11 @@ namespace Sph
             "sph_force_field_create",
             "sph_force_field_destroy",
             "sph_force_field_set_transform",
+            "sph_probe_def_init_sized",
+            "sph_probe_create",
+            "sph_probe_destroy",
+            "sph_probe_reading_init_sized",
+            "sph_probe_get_reading",
             "sph_world_get_events",
             "sph_world_get_removed_ids",
             "sph_world_save",
@@ -3753,6 +3992,11 @@ namespace Sph
         };
         /// <summary>The shared library of each function ("sph", or an optional helper).</summary>
         public static readonly string[] FunctionLibraries = {
+            "sph",
+            "sph",
+            "sph",
+            "sph",
+            "sph",
             "sph",
             "sph",
             "sph",
@@ -3951,6 +4195,10 @@ namespace Sph
             { "SPH_FORCE_FIELD_RADIAL", "`strength` m/s^2 away from the origin (negative attracts)" },
             { "SPH_FORCE_FIELD_VORTEX", "`strength` m/s^2 around the axis `vector` through the origin" },
             { "SPH_FORCE_FIELD_GRID", "accelerations from a user grid (3 components, field frame)" },
+            { "SPH_PROBE_POINT", "samples density, pressure and velocity at `position`" },
+            { "SPH_PROBE_GAUGE", "a line from `position` along `direction`, `length` long: the water height (column integral) and the column's mean density, pressure and velocity" },
+            { "SPH_PROBE_EVERY_FRAME", "the last substep of each step is sampled" },
+            { "SPH_PROBE_EVERY_SUBSTEP", "every substep is sampled; the reading is the time average" },
             { "SPH_EVENT_SOURCE_CAPACITY_REACHED", "object: the source; count: particles not emitted" },
             { "SPH_EVENT_SINK_REMOVED", "object: the sink; count: particles removed" },
             { "SPH_EVENT_PRESSURE_SOLVE_CAPPED", "DFSPH; object: none (0); count: substeps whose density solve stopped at max_iterations above its bound" },

@@ -949,6 +949,14 @@ namespace Sph
             return new Sink(this, id);
         }
 
+        /// <summary>Adds a probe or a gauge (ProbeDef.Kind), sampled inside every Step.</summary>
+        public Probe CreateProbe(ProbeDef def)
+        {
+            ProbeId id;
+            SphException.Check(Native.sph_probe_create(Handle, ref def, out id), "sph_probe_create");
+            return new Probe(this, id);
+        }
+
         /// <summary>Adds a force field; `region` (optional) limits it to where that SDF is negative.</summary>
         public ForceField CreateForceField(ForceFieldDef def, Sdf region = null)
         {
@@ -1380,6 +1388,34 @@ namespace Sph
             if (Id.Bits == 0) return;
             SphException.Check(Native.sph_sink_destroy(World.Handle, Id), "sph_sink_destroy");
             Id = default(SinkId);
+        }
+    }
+
+    /// <summary>A point probe or a gauge line, sampled inside every Step (docs/physics.md).</summary>
+    public sealed class Probe : IDisposable
+    {
+        public World World { get; private set; }
+        public ProbeId Id { get; private set; }
+
+        internal Probe(World world, ProbeId id) { World = world; Id = id; }
+
+        /// <summary>The reading of the last Step: density, pressure (and its maximum), velocity,
+        /// the fluid fraction and, for a gauge, the water height.</summary>
+        public ProbeReading Reading
+        {
+            get
+            {
+                var r = ProbeReading.Default();
+                SphException.Check(Native.sph_probe_get_reading(World.Handle, Id, ref r), "sph_probe_get_reading");
+                return r;
+            }
+        }
+
+        public void Dispose()
+        {
+            if (Id.Bits == 0) return;
+            SphException.Check(Native.sph_probe_destroy(World.Handle, Id), "sph_probe_destroy");
+            Id = default(ProbeId);
         }
     }
 

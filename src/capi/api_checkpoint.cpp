@@ -118,6 +118,7 @@ SPH_API sph_result SPH_CALL sph_world_restore(sph_world* world, const void* data
     sph::WorldLock lock(world);
     // The new state is built whole beside the old one, then swapped in.
     std::unique_ptr<sph::World> loaded = load_world(world->context, data, size);
+    loaded->adopt_probes(*world->world);  // probes are not in checkpoints; the world keeps its own
     world->world.swap(loaded);
     return SPH_OK;
   });

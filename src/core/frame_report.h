@@ -6,6 +6,8 @@
 
 #include <vector>
 
+#include "../physics/probe_sampling.h"
+
 namespace sph {
 
 enum StageIndex : int {
@@ -56,6 +58,7 @@ struct FrameReport {
   std::vector<uint32_t> removed_ids;      // ids sinks removed during the frame
   std::vector<uint32_t> removed_by_sink;  // count per sink, in SceneFrame::sinks order
   std::vector<ColliderLoadSums> collider_loads;  // per collider in SceneFrame::colliders order (loads on)
+  std::vector<ProbeSums> probes;                 // per probe in SceneFrame::probes order
 };
 
 }  // namespace sph

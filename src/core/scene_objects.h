@@ -64,6 +64,24 @@ struct ForceField {
   float falloff_radius = 0.0f;
 };
 
+// A probe or gauge (physics/probe_sampling.h) and its reading of the last step.
+struct ProbeReading {
+  uint32_t samples = 0;
+  float density = 0.0f, pressure = 0.0f, pressure_max = 0.0f, kernel_sum = 0.0f, water_height = 0.0f;
+  Vec3 velocity{0.0f, 0.0f, 0.0f};
+  double time = 0.0;
+};
+
+struct Probe {
+  bool gauge = false;
+  bool every_substep = false;
+  Vec3 position{0.0f, 0.0f, 0.0f};
+  Vec3 direction{0.0f, 0.0f, 0.0f};  // gauges: unit, or zero for "against gravity"
+  float length = 0.0f;               // gauges
+  uint32_t sample_count = 1;         // gauges: the column integral's steps
+  ProbeReading reading;
+};
+
 // Values equal to sph_event_type. The solver's events name no object (object_id 0).
 enum class EventType : uint32_t {
   SourceCapacityReached = 1,

@@ -53,6 +53,16 @@ struct SinkSpec {
   Vec3 bounds_max{0.0f, 0.0f, 0.0f};
 };
 
+// A probe or gauge (sph_probe_def; world_probes.cpp checks it).
+struct ProbeSpec {
+  bool gauge = false;
+  bool every_substep = false;
+  Vec3 position{0.0f, 0.0f, 0.0f};
+  Vec3 direction{0.0f, 0.0f, 0.0f};  // gauges; zero: against gravity
+  float length = 0.0f;               // gauges: > 0
+  float sample_spacing = 0.0f;       // gauges: >= 0; 0 = kernel radius / 8
+};
+
 struct ForceFieldSpec {
   ForceFieldKind kind = ForceFieldKind::Uniform;
   std::shared_ptr<const SdfAsset> region;  // optional: acts only where it is negative

@@ -161,6 +161,7 @@ SceneFrame World::build_scene_frame(double frame_dt) const {
     frame.view.bounds_max = s.bounds_max;
     scene.sinks.push_back(std::move(frame));
   });
+  add_probe_frames(scene);
   return scene;
 }
 
@@ -235,6 +236,7 @@ bool World::step(double frame_dt, const StepInterrupt& interrupt) {
     if (index < report.collider_loads.size()) c.loads = load_result(report.collider_loads[index], c, report);
     ++index;
   });
+  store_probe_readings(report);
   sinks_.for_each([&, index = size_t{0}](uint64_t id, const Sink&) mutable {
     const uint32_t removed = index < report.removed_by_sink.size() ? report.removed_by_sink[index] : 0u;
     if (removed > 0) events_.push_back(Event{EventType::SinkRemoved, id, removed});

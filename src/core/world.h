@@ -19,7 +19,13 @@
 
 namespace sph {
 
-enum ObjectTag : uint8_t { kTagCollider = 1, kTagSource = 2, kTagSink = 3, kTagForceField = 4 };
+enum ObjectTag : uint8_t {
+  kTagCollider = 1,
+  kTagSource = 2,
+  kTagSink = 3,
+  kTagForceField = 4,
+  kTagProbe = 5
+};
 
 // A world's whole scene as slot tables (checkpoints): objects made by scene_build.h's make_*,
 // slot layouts the caller has validated (generations in [1, 2^24), the free list naming every
@@ -130,6 +136,19 @@ class World {
   void set_force_field_pose(uint64_t id, const RigidTransform& pose);
   // A live collider; Error(InvalidHandle) otherwise.
   const Collider& collider(uint64_t id) const;
+  // ---- probes and gauges (world_probes.cpp; physics/probe_sampling.h) ----
+  // add_probe: FieldError naming the field for a bad spec, Error(Unsupported) on a DFSPH world,
+  // Error(Capacity) past 65536 probes; the world is unchanged on error. Probes are not part of
+  // SceneTables: a restore keeps the world's own.
+  uint64_t add_probe(const ProbeSpec& spec);
+  void remove_probe(uint64_t id);
+  // A live probe; Error(InvalidHandle) otherwise.
+  const Probe& probe(uint64_t id) const;
+  const SlotMap<Probe>& probes() const { return probes_; }
+  // Takes over another world's probes with their ids, readings cleared (a restore keeps the
+  // world's probes: they are instruments, not state). None on a DFSPH world (add_probe's rule).
+  void adopt_probes(const World& from);
+
   // Replaces the whole scene (checkpoints; see SceneTables).
   void restore_scene(SceneTables tables);
 
@@ -151,6 +170,8 @@ class World {
   uint32_t fill(const std::vector<Vec3>& points, const Vec3& velocity, const char* region_fields);
   void emit_sources(double frame_dt);
   SceneFrame build_scene_frame(double frame_dt) const;
+  void add_probe_frames(SceneFrame& scene) const;
+  void store_probe_readings(const FrameReport& report);
 
   WorldConfig config_;
   RuntimeParams params_;
@@ -164,6 +185,7 @@ class World {
   SlotMap<Source> sources_{kTagSource};
   SlotMap<Sink> sinks_{kTagSink};
   SlotMap<ForceField> force_fields_{kTagForceField};
+  SlotMap<Probe> probes_{kTagProbe};
 };
 
 }  // namespace sph

@@ -22,6 +22,7 @@
 #include "../physics/dfsph_passes.h"
 #include "../physics/forces.h"
 #include "../physics/integrate.h"
+#include "../physics/probe_sampling.h"
 #include "../physics/springs.h"
 #include "cpu_boundary_maps.h"
 #include "cpu_neighbor_columns.h"
@@ -138,6 +139,12 @@ class CpuBackend final : public Backend {
   void collide_with_loads(const FluidConstants& fluid, const SceneFrame& scene, const SubstepTime& time,
                           StageTime at, float wall_seconds, OldPositions old, FrameReport& report);
 
+  // Probes and gauges (cpu_probes.cpp; physics/probe_sampling.h): each sample point's sums over
+  // the sorted particles of the density pass just run, then each probe's sample in point order,
+  // weighted by the substep's dt into probe_sums_. No-op without probes.
+  void begin_probes(const SceneFrame& scene);
+  void sample_probes(const SceneFrame& scene, float dt, FrameReport& report);
+
   // Max speed and the first non-finite particle of the state in next_*.
   uint32_t scan_next_state(float& v2max) const;
 
@@ -234,6 +241,8 @@ class CpuBackend final : public Backend {
   std::vector<ColliderLoadSums> load_sums_;   // the frame's impulses per collider (loads on)
   std::vector<LoadImpulse> load_blocks_;      // per block of kLoadBlock particles and collider
   std::vector<Vec3> load_points_;             // per collider: at the wall pass's time, at the end
+  std::vector<ProbeGather> probe_points_;     // per sample point of the frame's probes
+  std::vector<ProbeSums> probe_sums_;         // per probe: the frame's samples
   std::vector<uint32_t> keep_order_;
   SpringConstants spring_constants_{};
   uint32_t count_ = 0;

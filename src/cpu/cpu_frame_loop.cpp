@@ -32,6 +32,7 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
   bind_scene_views(scene, [](const SdfAsset& a) { return a.host_view(); });
   bind_boundary_maps(fluid, scene);
   begin_loads(scene);
+  begin_probes(scene);
   report.removed_by_sink.assign(scene.sinks.size(), 0u);
   const uint32_t count_before = count_;
   const auto saved = store_.snapshot();
@@ -89,6 +90,7 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
   report.divergence_solve = finish_solve(tallies.divergence);
   report.max_speed = max_speed_;
   report.collider_loads = load_sums_;
+  report.probes = probe_sums_;
   const auto t = Clock::now();
   summarize(report);
   report.stage_ms[kStageOther] += static_cast<float>(elapsed_ms(t));

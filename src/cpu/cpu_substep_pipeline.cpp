@@ -39,6 +39,7 @@ void CpuBackend::collide_from(const SceneFrame& scene, const SubstepTime& time, 
 uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame& scene,
                                    const SubstepTime& time, FrameReport& report) {
   sort_and_density(fluid, scene, stage_time(time, 0.0f), report);
+  sample_probes(scene, time.dt, report);
   spring_pass(time.dt, true, report);
   auto t = Clock::now();
   const GridView view = grid_.view();
@@ -90,6 +91,7 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
   float a2max = 0.0f;
   for (int stage = 0; stage < 4; ++stage) {
     sort_and_density(fluid, scene, stage_time(time, rk4_stage_fraction(stage)), report);
+    if (stage == 0) sample_probes(scene, dt, report);  // the substep's start, as with Euler
     spring_pass(dt, stage == 0, report);
     auto t = Clock::now();
     const GridView view = grid_.view();

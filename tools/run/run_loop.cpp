@@ -14,6 +14,7 @@
 #include "library_error.h"
 #include "load_csv.h"
 #include "particle_frame.h"
+#include "probe_csv.h"
 #include "progress.h"
 #include "run_stats.h"
 #include "scene_error.h"
@@ -73,6 +74,9 @@ int run_scene(sph_context* context, const std::string& backend_name, const Scene
     LoadCsv loads;  // the colliders that ask for their loads (scene file "loads")
     const std::string loads_problem = loads.open(out.directory, runtime);
     if (!loads_problem.empty()) return fail(kExitRuntime, "loads: cannot write " + loads_problem);
+    ProbeCsv probes;  // the scene file's "probes"
+    const std::string probes_problem = probes.open(out.directory, runtime);
+    if (!probes_problem.empty()) return fail(kExitRuntime, "probes: cannot write " + probes_problem);
     for (uint32_t i = 1; i <= scene.frames && !interrupt_signal(); ++i) {
       t = Clock::now();
       const sph_result step = runtime.step_frame();
@@ -91,6 +95,8 @@ int run_scene(sph_context* context, const std::string& backend_name, const Scene
       writer.write(runtime, frame);
       const std::string load_problem = loads.write(runtime, i, runtime.time());
       if (!load_problem.empty()) return fail(kExitRuntime, "loads: cannot write " + load_problem);
+      const std::string probe_problem = probes.write(runtime, i, runtime.time());
+      if (!probe_problem.empty()) return fail(kExitRuntime, "probes: cannot write " + probe_problem);
       const double output_ms = ms_since(t);
       ++written;
       stats.add_frame(s, step_ms, output_ms);

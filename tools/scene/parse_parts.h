@@ -40,6 +40,7 @@ ColliderDesc parse_collider(const JsonNode& node, const std::string& base_dir);
 SourceDesc parse_source(const JsonNode& node, const std::string& base_dir);
 SinkDesc parse_sink(const JsonNode& node, const std::string& base_dir);
 ForceFieldDesc parse_force_field(const JsonNode& node, const std::string& base_dir);
+ProbeDesc parse_probe(const JsonNode& node);
 OutputDesc parse_output(const JsonNode& node);
 
 // Times of optional start/stop fields: start >= 0, stop > start.

@@ -86,6 +86,18 @@ struct SinkDesc {
   std::string path;
 };
 
+// A probe or gauge ("probes": [...]); sph-run writes its reading per frame to a CSV.
+struct ProbeDesc {
+  std::string name;
+  sph_probe_kind kind = SPH_PROBE_POINT;
+  sph_probe_sampling sampling = SPH_PROBE_EVERY_FRAME;
+  sph_vec3 position{};
+  sph_vec3 direction{};  // gauge; zero = up (against gravity)
+  float length = 0.0f;   // gauge
+  float sample_spacing = 0.0f;
+  std::string path;
+};
+
 struct ForceFieldDesc {
   std::string name;
   sph_force_field_kind kind = SPH_FORCE_FIELD_UNIFORM;
@@ -143,6 +155,7 @@ struct SceneDesc {
   std::vector<SourceDesc> sources;
   std::vector<SinkDesc> sinks;
   std::vector<ForceFieldDesc> force_fields;
+  std::vector<ProbeDesc> probes;
   OutputDesc output;
 };
 

@@ -94,8 +94,9 @@ SceneDesc parse_scene(const std::string& text, const std::string& base_dir) {
   SceneDesc scene;
   scene.base_dir = base_dir;
   const JsonNode top(&root, "");
-  top.expect_object("a scene", {"version", "name", "description", "world", "params", "physics", "time",
-                                "fluids", "colliders", "sources", "sinks", "force_fields", "output"});
+  top.expect_object("a scene",
+                    {"version", "name", "description", "world", "params", "physics", "time", "fluids",
+                     "colliders", "sources", "sinks", "force_fields", "probes", "output"});
   if (!top["version"].missing()) top["version"].count(1, 1);
   scene.name = top["name"].opt_string("");
   scene.description = top["description"].opt_string("");
@@ -116,6 +117,7 @@ SceneDesc parse_scene(const std::string& text, const std::string& base_dir) {
              [&](const JsonNode& n) { return parse_sink(n, base_dir); });
   parse_list(top["force_fields"], "a list of force fields", &scene.force_fields,
              [&](const JsonNode& n) { return parse_force_field(n, base_dir); });
+  parse_list(top["probes"], "a list of probes", &scene.probes, parse_probe);
   scene.output = parse_output(top["output"]);
   return scene;
 }

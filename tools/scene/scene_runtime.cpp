@@ -82,6 +82,18 @@ SceneRuntime::SceneRuntime(const SceneDesc& scene, sph_context* context) : scene
       sph_sink_id id;
       check_object(sph_sink_create(world_, &def, &id), s.path, "sink");
     }
+    for (const ProbeDesc& p : scene.probes) {
+      sph_probe_def def;
+      sph_probe_def_init(&def);
+      def.kind = p.kind;
+      def.sampling = p.sampling;
+      def.position = p.position;
+      def.direction = p.direction;
+      def.length = p.length;
+      def.sample_spacing = p.sample_spacing;
+      probes_.push_back(sph_probe_id{0});
+      check_object(sph_probe_create(world_, &def, &probes_.back()), p.path, "probe");
+    }
     sources_.resize(scene.sources.size());
     fields_.resize(scene.force_fields.size());
     fluid_added_.assign(scene.fluids.size(), false);
@@ -100,6 +112,7 @@ void SceneRuntime::destroy_all() {
   world_ = nullptr;
   for (Collider& c : colliders_) sph_sdf_destroy(c.sdf);
   colliders_.clear();
+  probes_.clear();
   for (Source& s : sources_) sph_sdf_destroy(s.sdf);
   sources_.clear();
   for (sph_sdf* sdf : sink_sdfs_) sph_sdf_destroy(sdf);

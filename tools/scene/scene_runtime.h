@@ -34,6 +34,8 @@ class SceneRuntime {
   uint32_t frame() const { return frame_; }
   double time() const { return frame_ / static_cast<double>(scene_.fps); }
   const std::vector<Collider>& colliders() const { return colliders_; }
+  // The probes, in the scene file's order (scene().probes).
+  const std::vector<sph_probe_id>& probes() const { return probes_; }
   // The current pose of colliders()[i].
   sph_transform collider_pose(size_t i) const;
 
@@ -57,6 +59,7 @@ class SceneRuntime {
   sph_world* world_ = nullptr;
   uint32_t frame_ = 0;
   std::vector<Collider> colliders_;
+  std::vector<sph_probe_id> probes_;
   std::vector<bool> fluid_added_;
   struct Source {
     sph_sdf* sdf = nullptr;

@@ -115,6 +115,13 @@ def build():
         obj({"type": const_type("outside_bounds"), "name": STRING, "min": VEC3, "max": VEC3},
             ["type", "min", "max"]),
     ]
+    sampling = {"enum": ["frame", "substep"]}
+    probe = [
+        obj({"type": const_type("point"), "name": STRING, "position": VEC3, "sampling": sampling},
+            ["type", "position"]),
+        obj({"type": const_type("gauge"), "name": STRING, "position": VEC3, "direction": VEC3, "length": POSITIVE,
+             "sample_spacing": POSITIVE, "sampling": sampling}, ["type", "position", "length"]),
+    ]
     tagged = lambda variants, what: {  # noqa: E731
         "type": "object", "required": ["type"], "description": what,
         "properties": {"type": {"enum": [v["properties"]["type"]["const"] for v in variants]}},
@@ -182,6 +189,7 @@ def build():
                 ["shape"])},
             "sinks": {"type": "array", "items": tagged(sink, "A sink (docs/scenes.md, sinks).")},
             "force_fields": {"type": "array", "items": tagged(force_field, "A force field.")},
+            "probes": {"type": "array", "items": tagged(probe, "A probe or gauge (docs/scenes.md, probes).")},
             "output": output,
         }),
     }

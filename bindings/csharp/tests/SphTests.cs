@@ -902,6 +902,45 @@ static class Tests
         }
     }
 
+    // Probes (issue 17 item 2): a point in water resting on a floor reads near rho0; a gauge
+    // through it starting below the floor reads the water's few centimetres; bad input is refused.
+    public static void TestProbes()
+    {
+        var plane = ShapeDesc.Default();
+        plane.Shape = Shape.Plane;
+        plane.HalfExtents = new Vec3(1, 0.1f, 1);
+        plane.VoxelSize = 0.03f;
+        using (var ctx = Cpu())
+        using (var floor = Sdf.CreateShape(ctx, plane))
+        using (var world = ctx.CreateWorld(SmallWorld()))
+        {
+            world.CreateCollider(floor, Transform.Default());
+            world.FillBox(new Vec3(-0.08f, 0.0f, -0.08f), new Vec3(0.08f, 0.06f, 0.08f));
+            var def = ProbeDef.Default();
+            def.Position = new Vec3(0, 0.02f, 0);
+            def.Sampling = ProbeSampling.Substep;
+            var point = world.CreateProbe(def);
+            AssertEqual(0u, point.Reading.Samples, "no reading before a step");
+            var g = ProbeDef.Default();
+            g.Kind = ProbeKind.Gauge;
+            g.Position = new Vec3(0, -0.05f, 0);
+            g.Length = 0.2f;
+            var gauge = world.CreateProbe(g);
+            for (int i = 0; i < 3; ++i) world.Step(1f / 60f);
+            var r = point.Reading;
+            // The whole 6 cm layer lies within h of the floor or the surface, where the summed
+            // densities the interpolant averages read a deficit (measured 864).
+            Assert(r.Samples >= 1 && r.Density > 700f && r.Density < 1100f, "a point in water reads near rho0: " + r.Density);
+            // The lattice fills the 6 cm box from spacing/2 inside its faces: three or four layers.
+            float h = gauge.Reading.WaterHeight;
+            Assert(h > 0.03f && h < 0.07f, "the gauge reads the depth: " + h);
+            g.Length = -1f;
+            Throws(Result.ErrorInvalidArgument, () => world.CreateProbe(g));
+            gauge.Dispose();
+            point.Dispose();
+        }
+    }
+
     public static void TestCollidersHoldWater()
     {
         using (var ctx = Cpu())

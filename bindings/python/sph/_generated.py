@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '9ddf8c1008182f568b6aca0f6f369681f70aa5f3f72c43656abb7c86c960c0d7', 'include/sph_cuda.h': '8fe2c1988d9c8456a91fb26b7863765759ab8ad17bd1ff44b457c77af0bc7985', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': 'bf273bd221a1a69cee88249e5a9722146de0c0bca4841f6c9e8ee8ca51b67edc', 'include/sph_cuda.h': '8fe2c1988d9c8456a91fb26b7863765759ab8ad17bd1ff44b457c77af0bc7985', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -532,6 +532,35 @@ class ForceFieldKind(_enum.IntEnum):
     GRID = 3
 
 
+sph_probe_kind = _c.c_int32
+SPH_PROBE_POINT = 0  # samples density, pressure and velocity at `position`
+SPH_PROBE_GAUGE = 1  # a line from `position` along `direction`, `length` long: the water height (column integral) and the column's mean density, pressure and velocity
+SPH_PROBE_KIND_FORCE32 = 2147483647
+
+
+class ProbeKind(_enum.IntEnum):
+    """sph_probe_kind"""
+    #: samples density, pressure and velocity at `position`
+    POINT = 0
+    #: a line from `position` along `direction`, `length` long: the water height (column integral)
+    #: and the column's mean density, pressure and velocity
+    GAUGE = 1
+
+
+sph_probe_sampling = _c.c_int32
+SPH_PROBE_EVERY_FRAME = 0  # the last substep of each step is sampled
+SPH_PROBE_EVERY_SUBSTEP = 1  # every substep is sampled; the reading is the time average
+SPH_PROBE_SAMPLING_FORCE32 = 2147483647
+
+
+class ProbeSampling(_enum.IntEnum):
+    """sph_probe_sampling"""
+    #: the last substep of each step is sampled
+    FRAME = 0
+    #: every substep is sampled; the reading is the time average
+    SUBSTEP = 1
+
+
 sph_event_type = _c.c_int32
 SPH_EVENT_SOURCE_CAPACITY_REACHED = 1  # object: the source; count: particles not emitted
 SPH_EVENT_SINK_REMOVED = 2  # object: the sink; count: particles removed
@@ -638,6 +667,10 @@ ENUM_MEMBER_DOCS = {
     'SPH_FORCE_FIELD_RADIAL': '`strength` m/s^2 away from the origin (negative attracts)',
     'SPH_FORCE_FIELD_VORTEX': '`strength` m/s^2 around the axis `vector` through the origin',
     'SPH_FORCE_FIELD_GRID': 'accelerations from a user grid (3 components, field frame)',
+    'SPH_PROBE_POINT': 'samples density, pressure and velocity at `position`',
+    'SPH_PROBE_GAUGE': "a line from `position` along `direction`, `length` long: the water height (column integral) and the column's mean density, pressure and velocity",
+    'SPH_PROBE_EVERY_FRAME': 'the last substep of each step is sampled',
+    'SPH_PROBE_EVERY_SUBSTEP': 'every substep is sampled; the reading is the time average',
     'SPH_EVENT_SOURCE_CAPACITY_REACHED': 'object: the source; count: particles not emitted',
     'SPH_EVENT_SINK_REMOVED': 'object: the sink; count: particles removed',
     'SPH_EVENT_PRESSURE_SOLVE_CAPPED': 'DFSPH; object: none (0); count: substeps whose density solve stopped at max_iterations above its bound',
@@ -1688,6 +1721,101 @@ class ForceFieldDef(_SphStruct):
 sph_force_field_def = ForceFieldDef
 
 
+class ProbeId(_SphStruct):
+    """
+    sph_probe_id.
+
+    Fields:
+        bits (uint64_t): {0} is null (SPH_ID_IS_NULL)
+    """
+    _fields_ = [
+        ('bits', _c.c_uint64),
+    ]
+    _sph_c_name_ = 'sph_probe_id'
+    _sph_size_ = 8
+    _sph_offsets_ = (('bits', 0),)
+    _sph_init_ = None
+
+
+sph_probe_id = ProbeId
+
+
+class ProbeDef(_SphStruct):
+    """
+    Zero means default: a zeroed def (after sph_probe_def_init) is a point probe at the origin
+    sampled once a frame. The values are the SPH interpolant (docs/physics.md "Probes and
+    gauges"): A(x) = sum_j V_j A_j W(|x - x_j|) / sum_j V_j W(|x - x_j|), V_j = m / rho_j, with
+    W_poly6 at the world's kernel radius, over the particles of the substep's density pass.
+
+    Fields:
+        struct_size (uint32_t): set by sph_probe_def_init
+        kind (sph_probe_kind): default SPH_PROBE_POINT
+        sampling (sph_probe_sampling): default SPH_PROBE_EVERY_FRAME
+        position (sph_vec3): POINT: where; GAUGE: the line's start (put it below the floor), m
+        direction (sph_vec3): GAUGE: the line's direction (normalised by the library); {0,0,0} = up, against the world's gravity at each step (+y without gravity)
+        length (float): GAUGE: the line's length, m; > 0
+        sample_spacing (float): GAUGE: the column integral's step, m; 0 = kernel radius / 8; at most 65536 steps along the line
+        reserved0 (uint32_t): must be 0
+    """
+    _fields_ = [
+        ('struct_size', _c.c_uint32),
+        ('kind', sph_probe_kind),
+        ('sampling', sph_probe_sampling),
+        ('position', sph_vec3),
+        ('direction', sph_vec3),
+        ('length', _c.c_float),
+        ('sample_spacing', _c.c_float),
+        ('reserved0', _c.c_uint32),
+    ]
+    _sph_c_name_ = 'sph_probe_def'
+    _sph_size_ = 48
+    _sph_offsets_ = (('struct_size', 0), ('kind', 4), ('sampling', 8), ('position', 12), ('direction', 24), ('length', 36), ('sample_spacing', 40), ('reserved0', 44))
+    _sph_init_ = 'sph_probe_def_init_sized'
+    _sph_enums_ = {'kind': ProbeKind, 'sampling': ProbeSampling}
+
+
+sph_probe_def = ProbeDef
+
+
+class ProbeReading(_SphStruct):
+    """
+    A probe's reading of the last sph_world_step. EVERY_FRAME: the sample of the step's last
+    substep; EVERY_SUBSTEP: the average of the step's substeps, each weighted by its length. A
+    sample is taken at the substep's density pass (the positions and velocities the substep
+    starts from, the densities and pressures its forces use). Where no particle is within the
+    kernel radius (kernel_sum 0) a sample reads 0.
+
+    Fields:
+        struct_size (uint32_t): set by sph_probe_reading_init
+        samples (uint32_t): samples in the reading; 0 before the first step
+        density (float): kg/m^3, Shepard-normalised
+        pressure (float): Pa (the equation of state's, relative to the free surface)
+        velocity (sph_vec3): m/s
+        pressure_max (float): Pa: the largest pressure of the samples (the peak of an impact)
+        kernel_sum (float): sum_j V_j W: the fluid fraction, about 1 inside water, 0 in air; GAUGE: its mean over the line
+        water_height (float): GAUGE: the column integral along the line of the mass interpolant over the rest density (the mass per unit area as a height at rho0), m; POINT: 0
+        time (double): s: the span of the reading (the last substep's length, or the step's)
+    """
+    _fields_ = [
+        ('struct_size', _c.c_uint32),
+        ('samples', _c.c_uint32),
+        ('density', _c.c_float),
+        ('pressure', _c.c_float),
+        ('velocity', sph_vec3),
+        ('pressure_max', _c.c_float),
+        ('kernel_sum', _c.c_float),
+        ('water_height', _c.c_float),
+        ('time', _c.c_double),
+    ]
+    _sph_c_name_ = 'sph_probe_reading'
+    _sph_size_ = 48
+    _sph_offsets_ = (('struct_size', 0), ('samples', 4), ('density', 8), ('pressure', 12), ('velocity', 16), ('pressure_max', 28), ('kernel_sum', 32), ('water_height', 36), ('time', 40))
+    _sph_init_ = 'sph_probe_reading_init_sized'
+
+
+sph_probe_reading = ProbeReading
+
+
 class Event(_SphStruct):
     """
     sph_event.
@@ -1757,7 +1885,7 @@ class CudaAttributeView(_SphStruct):
 sph_cuda_attribute_view = CudaAttributeView
 
 
-STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpringParams, DfsphParams, ParamsInfo, ParamFieldInfo, PhysicsMethodInfo, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, MeshDesc, Quat, Transform, ColliderId, ColliderDef, ColliderMaterial, ColliderLoads, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, Event, CudaAttributeView, )
+STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpringParams, DfsphParams, ParamsInfo, ParamFieldInfo, PhysicsMethodInfo, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, MeshDesc, Quat, Transform, ColliderId, ColliderDef, ColliderMaterial, ColliderLoads, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, ProbeId, ProbeDef, ProbeReading, Event, CudaAttributeView, )
 
 # ---- functions --------------------------------------------------------------------------------
 
@@ -1953,6 +2081,16 @@ FUNCTIONS = {
         '', 'sph'),
     'sph_force_field_set_transform': (sph_result, (_c.POINTER(sph_world), sph_force_field_id, _c.POINTER(sph_transform)), ('world', 'id', 'transform'),
         '', 'sph'),
+    'sph_probe_def_init_sized': (sph_result, (_c.POINTER(sph_probe_def), _c.c_uint32), ('def', 'size'),
+        '', 'sph'),
+    'sph_probe_create': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_probe_def), _c.POINTER(sph_probe_id)), ('world', 'def', 'out_id'),
+        "Adds a probe or gauge; it is sampled inside every following sph_world_step on the world's backend (on the device for CUDA, with no host copy per substep). Errors: INVALID_HANDLE (world), INVALID_ARGUMENT (NULL def or out_id; a non-finite position or direction, a gauge's length not > 0 or too many steps, a negative sample_spacing, non-zero reserved0, each named), UNSUPPORTED (an unknown kind or sampling; a world of the DFSPH solver, whose substep does not sample probes), VERSION_MISMATCH, CAPACITY (65536 probes), WORLD_LOCKED. Nothing changes on error. Probes are not carried by checkpoints: sph_world_restore keeps the world's own, a world made by sph_world_load has none (docs/api.md).", 'sph'),
+    'sph_probe_destroy': (sph_result, (_c.POINTER(sph_world), sph_probe_id), ('world', 'id'),
+        'Removes a probe; id {0} is a no-op. Errors: INVALID_HANDLE (world; stale or foreign id), WORLD_LOCKED.', 'sph'),
+    'sph_probe_reading_init_sized': (sph_result, (_c.POINTER(sph_probe_reading), _c.c_uint32), ('reading', 'size'),
+        '', 'sph'),
+    'sph_probe_get_reading': (sph_result, (_c.POINTER(sph_world), sph_probe_id, _c.POINTER(sph_probe_reading)), ('world', 'id', 'out'),
+        "Reads a probe's reading of the last step. Non-blocking (the step brought it to the host). out->struct_size must be set (sph_probe_reading_init); only that many bytes are written. Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (NULL out), VERSION_MISMATCH, WORLD_LOCKED.", 'sph'),
     'sph_world_get_events': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_event), _c.c_uint32, _c.POINTER(_c.c_uint32)), ('world', 'events', 'capacity', 'out_count'),
         'Events of the last sph_world_step (two-call pattern): writes up to `capacity` events and sets *out_count to the number there are; SPH_INCOMPLETE when capacity was too small. events may be NULL when capacity is 0.', 'sph'),
     'sph_world_get_removed_ids': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_uint32), _c.c_uint32, _c.POINTER(_c.c_uint32)), ('world', 'ids', 'capacity', 'out_count'),

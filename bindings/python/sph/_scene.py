@@ -352,6 +352,23 @@ class ForceField(_WorldObject):
               "sph_force_field_set_transform")
 
 
+class Probe(_WorldObject):
+    """A point probe or a gauge line sampled inside every step (World.add_probe)."""
+
+    def _destroy(self):
+        check(library().sph_probe_destroy(self.world.handle, self.id), "sph_probe_destroy")
+
+    @property
+    def reading(self):
+        """The reading of the last step, a ProbeReading: density (kg/m^3), pressure and
+        pressure_max (Pa), velocity (m/s), kernel_sum (the fluid fraction), water_height (m,
+        gauges), samples and time (s) (sph_probe_get_reading)."""
+        r = _g.ProbeReading()
+        check(library().sph_probe_get_reading(self.world.handle, self.id, ctypes.byref(r)),
+              "sph_probe_get_reading")
+        return r
+
+
 # ---- World methods --------------------------------------------------------------------------------
 def _enum(cls, value):
     return cls[value.upper()] if isinstance(value, str) else cls(value)
@@ -398,6 +415,20 @@ class WorldSceneMixin:
         out = _g.SinkId()
         check(library().sph_sink_create(self.handle, ctypes.byref(d), ctypes.byref(out)), "sph_sink_create")
         return Sink(self, out)
+
+    def add_probe(self, position, *, gauge_length=None, sampling="frame", **fields):
+        """Adds a probe at `position` (sph_probe_create); with ``gauge_length`` a gauge: the line
+        from `position` that long along ``direction`` (default up, against gravity), reading the
+        water height by a column integral. sampling: ProbeSampling or "frame" (the step's last
+        substep), "substep" (every substep, averaged); other fields of ProbeDef: direction, sample_spacing."""
+        d = _g.ProbeDef(sampling=_enum(_g.ProbeSampling, sampling), **fields)
+        d.position = _g.Vec3(*position)
+        if gauge_length is not None:
+            d.kind = _g.ProbeKind.GAUGE
+            d.length = gauge_length
+        out = _g.ProbeId()
+        check(library().sph_probe_create(self.handle, ctypes.byref(d), ctypes.byref(out)), "sph_probe_create")
+        return Probe(self, out)
 
     def add_force_field(self, kind=_g.ForceFieldKind.UNIFORM, transform=None, *, region=None, grid=None,
                         grid_index_to_local=None, **fields):

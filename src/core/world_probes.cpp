@@ -1,0 +1,138 @@
+// SPDX-License-Identifier: MIT
+// The world's probes and gauges: their checks, their sample points in a frame, and their
+// readings of the last step (the sampling itself is physics/probe_sampling.h, run by the
+// backends inside the substep).
+#include <cmath>
+#include <string>
+
+#include "field_checks.h"
+#include "field_error.h"
+#include "status.h"
+#include "world.h"
+
+namespace sph {
+namespace {
+
+constexpr size_t kMaxProbes = 65536;
+// The particles' bound (world_particles.cpp): beyond 2^16 spacings float32 positions no longer
+// resolve the spacing, and far points would only ever read air.
+constexpr float kMaxProbeCoordinateInSpacings = 65536.0f;
+
+void require_resolved(const Vec3& p, float spacing, const char* field) {
+  const float limit = kMaxProbeCoordinateInSpacings * spacing;
+  if (!(std::fabs(p.x) <= limit && std::fabs(p.y) <= limit && std::fabs(p.z) <= limit))
+    throw FieldError(Status::InvalidArgument, field,
+                     "lies farther than " + describe_value(limit) +
+                         " m (65536 particle spacings) from the origin, where no particle may be");
+}
+
+// The gauge's direction, or the world's up (against gravity; +y without gravity).
+Vec3 gauge_axis(const Probe& p, const Vec3& gravity) {
+  const Vec3 d = length_squared(p.direction) > 0.0f ? p.direction : gravity * -1.0f;
+  const float n = length(d);
+  return n > 0.0f ? d * (1.0f / n) : Vec3{0.0f, 1.0f, 0.0f};
+}
+
+}  // namespace
+
+uint64_t World::add_probe(const ProbeSpec& spec) {
+  if (config_.solver == Solver::Dfsph)
+    throw Error(Status::Unsupported,
+                "world: probes sample the weakly compressible solver's density pass; a DFSPH world has "
+                "none that carries its pressures (not supported yet)");
+  require_finite_vec3_field(spec.position, "position");
+  require_resolved(spec.position, config_.particle_spacing, "position");
+  Probe p;
+  p.gauge = spec.gauge;
+  p.every_substep = spec.every_substep;
+  p.position = spec.position;
+  if (spec.gauge) {
+    require_finite_vec3_field(spec.direction, "direction");
+    const float n = length(spec.direction);
+    if (!std::isfinite(n))
+      throw FieldError(Status::InvalidArgument, "direction", "its length overflows float32");
+    require_finite_field(spec.length, "length");
+    if (!(spec.length > 0.0f))
+      throw FieldError(Status::InvalidArgument, "length",
+                       "a gauge's length must be > 0, got " + describe_value(spec.length));
+    require_non_negative_field(spec.sample_spacing, "sample_spacing");
+    const float spacing = spec.sample_spacing > 0.0f ? spec.sample_spacing : config_.kernel_radius / 8.0f;
+    const double steps = std::ceil(static_cast<double>(spec.length) / static_cast<double>(spacing));
+    if (!(steps <= static_cast<double>(kMaxGaugeSamples)))
+      throw FieldError(Status::InvalidArgument, "sample_spacing",
+                       "gives " + describe_value(static_cast<float>(steps)) +
+                           " steps along the gauge's length " + describe_value(spec.length) +
+                           " m; at most 65536 (raise sample_spacing)");
+    // The far end, whichever way gravity points later.
+    const float reach = spec.length;
+    require_resolved(Vec3{std::fabs(spec.position.x) + reach, std::fabs(spec.position.y) + reach,
+                          std::fabs(spec.position.z) + reach},
+                     config_.particle_spacing, "length");
+    p.direction = n > 0.0f ? spec.direction * (1.0f / n) : Vec3{0.0f, 0.0f, 0.0f};
+    p.length = spec.length;
+    p.sample_count = steps < 1.0 ? 1u : static_cast<uint32_t>(steps);
+  }
+  if (probes_.size() >= kMaxProbes) throw Error(Status::Capacity, "a world holds at most 65536 probes");
+  return probes_.insert(std::move(p));
+}
+
+void World::remove_probe(uint64_t id) {
+  if (id == 0) return;
+  if (!probes_.erase(id)) throw Error(Status::InvalidHandle, "id: is stale or not of this world");
+}
+
+void World::adopt_probes(const World& from) {
+  if (config_.solver == Solver::Dfsph) return;
+  SlotMap<Probe> probes = from.probes_;
+  probes.for_each([](uint64_t, Probe& p) { p.reading = ProbeReading{}; });
+  probes_ = std::move(probes);
+}
+
+const Probe& World::probe(uint64_t id) const {
+  const Probe* p = probes_.find(id);
+  if (!p) throw Error(Status::InvalidHandle, "id: is null, stale or not of this world");
+  return *p;
+}
+
+void World::add_probe_frames(SceneFrame& scene) const {
+  scene.probes.reserve(probes_.size());
+  uint32_t points = 0;
+  probes_.for_each([&](uint64_t, const Probe& p) {
+    ProbeView v;
+    v.origin = p.position;
+    v.step = Vec3{0.0f, 0.0f, 0.0f};
+    if (p.gauge)
+      v.step = gauge_axis(p, params_.stepping.gravity) * (p.length / static_cast<float>(p.sample_count));
+    v.first_point = points;
+    v.point_count = p.gauge ? p.sample_count : 1u;
+    v.gauge = p.gauge ? 1u : 0u;
+    v.every_substep = p.every_substep ? 1u : 0u;
+    points += v.point_count;
+    scene.probes.push_back(v);
+  });
+  scene.probe_points = points;
+}
+
+// The frame's sums as readings (a probe added after the step's scene was built has none yet).
+void World::store_probe_readings(const FrameReport& report) {
+  probes_.for_each([&, index = size_t{0}](uint64_t, Probe& p) mutable {
+    ProbeReading r;
+    if (index < report.probes.size()) {
+      const ProbeSums& s = report.probes[index];
+      const double inv = s.time > 0.0 ? 1.0 / s.time : 0.0;
+      r.samples = s.samples;
+      r.density = static_cast<float>(s.density * inv);
+      r.pressure = static_cast<float>(s.pressure * inv);
+      r.velocity = Vec3{static_cast<float>(s.velocity[0] * inv), static_cast<float>(s.velocity[1] * inv),
+                        static_cast<float>(s.velocity[2] * inv)};
+      r.kernel_sum = static_cast<float>(s.kernel_sum * inv);
+      r.water_height = static_cast<float>(s.water_height * inv);
+      r.pressure_max = s.samples > 0 ? s.pressure_max : 0.0f;
+      r.time = s.time;
+    }
+    p.reading = r;
+    ++index;
+  });
+}
+
+}  // namespace sph

@@ -1,0 +1,46 @@
+// SPDX-License-Identifier: MIT
+// Probes and gauges on the CPU: after a substep's density pass, each sample point gathers the
+// SPH interpolant's sums over the sorted particles (one point per loop iteration, its neighbours
+// in the grid's fixed walk order), then each probe adds its points in order and its sample to the
+// frame's sums (the twin of cuda/device_probes.cu; the physics is physics/probe_sampling.h). The
+// result depends on neither the thread count nor the scheduling.
+#include "../physics/probe_sampling.h"
+#include "cpu_backend_impl.h"
+
+namespace sph {
+
+void CpuBackend::begin_probes(const SceneFrame& scene) {
+  probe_sums_.assign(scene.probes.size(), ProbeSums{});
+  probe_points_.resize(scene.probe_points);
+}
+
+void CpuBackend::sample_probes(const SceneFrame& scene, float dt, FrameReport& report) {
+  if (scene.probes.empty()) return;
+  const auto t = Clock::now();
+  ProbeConstants constants;
+  constants.kernel = make_kernel_coefficients(config_.kernel_radius);
+  constants.particle_mass = config_.particle_mass;
+  constants.rest_density = config_.rest_density;
+  const GridView view = grid_.view();
+  const Float4* pos = position_.data();
+  const Float4* vel = velocity_.data();
+  const ProbeView* probes = scene.probes.data();
+  ProbeGather* points = probe_points_.data();
+  const int probe_count = static_cast<int>(scene.probes.size());
+  // One probe per iteration: a gauge's points are many, a point probe's one.
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, 1)
+  for (int k = 0; k < probe_count; ++k) {
+    const ProbeView& p = probes[k];
+    for (uint32_t q = 0; q < p.point_count; ++q)
+      points[p.first_point + q] = gather_probe_point(constants, view, pos, vel, probe_point(p, q));
+  }
+  for (int k = 0; k < probe_count; ++k) {
+    const ProbeView& p = probes[k];
+    ProbeGather g = zero_probe_gather();
+    for (uint32_t q = 0; q < p.point_count; ++q) g = g + points[p.first_point + q];
+    add_probe_sample(probe_sums_[static_cast<size_t>(k)], p, probe_sample(constants, p, g), dt);
+  }
+  report.stage_ms[kStageDensity] += static_cast<float>(elapsed_ms(t));
+}
+
+}  // namespace sph

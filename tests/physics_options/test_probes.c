@@ -1,0 +1,498 @@
+// SPDX-License-Identifier: MIT
+/* Probes and gauges (sph_probe_*; src/physics/probe_sampling.h), against what they must read.
+ * Lattice step 1 cm (spacing 1.41 cm, h = 2.5 cm), ideal gas k = 100 (the defaults).
+ *   - brute force: after a sloshing start, one step of a single substep; the probe's sample is
+ *     the interpolant over the state that substep started from (the positions and velocities
+ *     read before the step, the densities and pressures of its density pass read after it),
+ *     evaluated here in double over every particle: within 1e-4 relative (float sums of ~100
+ *     terms against double; measured below 1e-5), a gauge's column integral likewise;
+ *   - a resting tank: the pressure difference of two probes against rho0 g (d2 - d1), and (reported)
+ *     each probe's pressure against rho0 g d below the surface the gauge finds (bounds and why at
+ *     the test);
+ *   - a body of water moving at a uniform velocity without gravity: a probe it passes reads that
+ *     velocity and rho0, a gauge through it the block's height (its fill height);
+ *   - sampling: EVERY_SUBSTEP averages the step's substeps, EVERY_FRAME reads the last; a
+ *     restore keeps the probes;
+ *   - bad input: each field named, the world unchanged (no slot taken), handles checked.
+ * PROBES_MEASURE=1 prints the measurements without asserting the bounds. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "capi_test.h"
+
+static const double kStep = 0.01; /* support_fcc_box's step; the world's spacing is step sqrt 2 */
+static const double kGravity = 9.81;
+static const double kPi = 3.14159265358979323846;
+
+static int measuring(void) { return getenv("PROBES_MEASURE") != NULL; }
+
+static sph_world_def probe_world_def(uint32_t capacity) {
+  sph_world_def def;
+  sph_world_def_init(&def);
+  def.particle_spacing = (float)(kStep * sqrt(2.0));
+  def.capacity = capacity;
+  return def;
+}
+
+static sph_probe_id add_point(sph_world* world, double x, double y, double z, sph_probe_sampling sampling) {
+  sph_probe_def def;
+  sph_probe_id id = {0};
+  EXPECT_OK(sph_probe_def_init(&def));
+  def.position.x = (float)x, def.position.y = (float)y, def.position.z = (float)z;
+  def.sampling = sampling;
+  EXPECT_OK(sph_probe_create(world, &def, &id));
+  return id;
+}
+
+/* A vertical gauge (up: against gravity) from (x, y0, z), `length` long. */
+static sph_probe_id add_gauge(sph_world* world, double x, double y0, double z, double length,
+                              double spacing) {
+  sph_probe_def def;
+  sph_probe_id id = {0};
+  EXPECT_OK(sph_probe_def_init(&def));
+  def.kind = SPH_PROBE_GAUGE;
+  def.position.x = (float)x, def.position.y = (float)y0, def.position.z = (float)z;
+  def.length = (float)length;
+  def.sample_spacing = (float)spacing;
+  EXPECT_OK(sph_probe_create(world, &def, &id));
+  return id;
+}
+
+static sph_probe_reading reading_of(const sph_world* world, sph_probe_id id) {
+  sph_probe_reading r;
+  EXPECT_OK(sph_probe_reading_init(&r));
+  EXPECT_OK(sph_probe_get_reading(world, id, &r));
+  return r;
+}
+
+/* ---- brute force ---------------------------------------------------------------------------- */
+
+/* W_poly6 (Mueller et al. 2003) in double. */
+static double poly6(double r2, double h) {
+  if (r2 >= h * h) return 0.0;
+  return 315.0 / (64.0 * kPi * pow(h, 9.0)) * pow(h * h - r2, 3.0);
+}
+
+typedef struct brute_sums {
+  double kernel, mass, pressure, velocity[3];
+} brute_sums;
+
+/* The interpolant's sums at x over n particles (positions and velocities of the substep's start,
+ * densities and pressures of its density pass, all by particle id). */
+static void brute_gather(const double x[3], uint32_t n, const float* pos, const float* vel, const float* rho,
+                         const float* p, double mass, double h, brute_sums* s) {
+  for (uint32_t j = 0; j < n; ++j) {
+    const double dx = x[0] - pos[3 * j], dy = x[1] - pos[3 * j + 1], dz = x[2] - pos[3 * j + 2];
+    const double w = poly6(dx * dx + dy * dy + dz * dz, h);
+    const double vw = mass / rho[j] * w;
+    s->kernel += vw;
+    s->mass += mass * w;
+    s->pressure += vw * p[j];
+    for (int k = 0; k < 3; ++k) s->velocity[k] += vw * vel[3 * j + k];
+  }
+}
+
+/* Copies an attribute and re-orders it by particle id (ids are 0..n-1 here). */
+static float* by_id(const sph_world* world, sph_attribute attribute, int components, uint32_t* count) {
+  float* raw = NULL;
+  uint32_t* ids = NULL;
+  uint32_t n = 0, m = 0;
+  float* out;
+  EXPECT_OK(support_copy(world, attribute, (void**)&raw, &n));
+  EXPECT_OK(support_copy(world, SPH_ATTRIBUTE_ID, (void**)&ids, &m));
+  assert_int_equal(n, m);
+  out = (float*)malloc(sizeof(float) * components * (n ? n : 1));
+  assert_non_null(out);
+  for (uint32_t i = 0; i < n; ++i) {
+    assert_true(ids[i] < n);
+    memcpy(out + (size_t)components * ids[i], raw + (size_t)components * i, sizeof(float) * components);
+  }
+  free(raw);
+  free(ids);
+  *count = n;
+  return out;
+}
+
+static double relative(double got, double want, double scale) { return fabs(got - want) / scale; }
+
+static void test_brute_force(void** state) {
+  const uint32_t layers[3] = {8, 12, 8};
+  const double tank_min[3] = {0.0, 0.0, 0.0}, tank_max[3] = {0.16, 0.24, 0.08};
+  float *lattice = NULL, *pos, *vel, *rho, *p;
+  uint32_t n = 0, count = 0;
+  support_world w;
+  sph_sdf* sdf = NULL;
+  sph_world_def def;
+  sph_probe_id points[3], gauge;
+  const double where[3][3] = {{0.04, 0.03, 0.04}, {0.02, 0.06, 0.03}, {0.10, 0.01, 0.04}};
+  double worst = 0.0, h, mass;
+  sph_stats stats;
+  (void)state;
+  assert_int_equal(support_fcc_box(layers, kStep, NULL, &lattice, &n), SPH_OK);
+  def = probe_world_def(n);
+  EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
+  EXPECT_OK(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * kStep, 0.0f, &sdf, NULL));
+  EXPECT_OK(support_spawn(w.world, lattice, NULL, n));
+  free(lattice);
+  h = w.def.kernel_radius;
+  mass = w.mass;
+  for (int k = 0; k < 3; ++k)
+    points[k] = add_point(w.world, where[k][0], where[k][1], where[k][2], SPH_PROBE_EVERY_FRAME);
+  gauge = add_gauge(w.world, 0.05, -0.03, 0.04, 0.25, 0.0);
+  /* The column collapses: a flow with velocity and pressure gradients. */
+  for (int frame = 0; frame < 8; ++frame) EXPECT_OK(sph_world_step(w.world, 0.02f));
+  pos = by_id(w.world, SPH_ATTRIBUTE_POSITION, 3, &count);
+  vel = by_id(w.world, SPH_ATTRIBUTE_VELOCITY, 3, &count);
+  /* One substep: a frame shorter than any step the controller picks. */
+  EXPECT_OK(sph_world_step(w.world, 1e-5f));
+  EXPECT_OK(sph_stats_init(&stats));
+  EXPECT_OK(sph_world_get_stats(w.world, &stats));
+  assert_int_equal(stats.substeps, 1);
+  rho = by_id(w.world, SPH_ATTRIBUTE_DENSITY, 1, &count);
+  p = by_id(w.world, SPH_ATTRIBUTE_PRESSURE, 1, &count);
+  for (int k = 0; k < 3; ++k) {
+    const sph_probe_reading r = reading_of(w.world, points[k]);
+    brute_sums s = {0.0, 0.0, 0.0, {0.0, 0.0, 0.0}};
+    double e[6];
+    const double pressure_scale = w.def.rest_density * kGravity * 0.12; /* rho0 g H of the column */
+    brute_gather(where[k], count, pos, vel, rho, p, mass, h, &s);
+    assert_true(s.kernel > 0.1); /* the points are in the water */
+    assert_int_equal(r.samples, 1);
+    e[0] = relative(r.kernel_sum, s.kernel, 1.0);
+    e[1] = relative(r.density, s.mass / s.kernel, w.def.rest_density);
+    e[2] = relative(r.pressure, s.pressure / s.kernel, pressure_scale);
+    for (int c = 0; c < 3; ++c) e[3 + c] = relative((&r.velocity.x)[c], s.velocity[c] / s.kernel, 1.0);
+    for (int c = 0; c < 6; ++c) worst = e[c] > worst ? e[c] : worst;
+    print_message(
+        "probe %d: kernel sum %.6f (brute %.6f), density %.3f (%.3f), pressure %.3f (%.3f), "
+        "v_y %.5f (%.5f)\n",
+        k, r.kernel_sum, s.kernel, r.density, s.mass / s.kernel, r.pressure, s.pressure / s.kernel,
+        r.velocity.y, s.velocity[1] / s.kernel);
+  }
+  {
+    /* The gauge: the midpoint rule over the same points, 0.25 m / (h / 8) steps, of sum m W / rho0. */
+    const sph_probe_reading r = reading_of(w.world, gauge);
+    const uint32_t steps = (uint32_t)ceil(0.25 / ((float)h / 8.0f));
+    const double dz = 0.25 / steps;
+    double height = 0.0;
+    for (uint32_t q = 0; q < steps; ++q) {
+      const double x[3] = {0.05, -0.03 + (q + 0.5) * dz, 0.04};
+      brute_sums s = {0.0, 0.0, 0.0, {0.0, 0.0, 0.0}};
+      brute_gather(x, count, pos, vel, rho, p, mass, h, &s);
+      height += s.mass * dz / w.def.rest_density;
+    }
+    print_message("gauge: water height %.6f m (brute force %.6f m)\n", r.water_height, height);
+    worst = fmax(worst, relative(r.water_height, height, height));
+  }
+  print_message("brute force: worst relative difference %.2e (bound 1e-4)\n", worst);
+  assert_true(worst <= 1e-4 || measuring());
+  free(pos);
+  free(vel);
+  free(rho);
+  free(p);
+  EXPECT_OK(sph_sdf_destroy(sdf));
+  EXPECT_OK(support_world_close(&w));
+}
+
+/* ---- a resting tank ------------------------------------------------------------------------- */
+
+/* Water 12 x 24 x 12 layers (12 cm wide, H = 24 cm deep) settled in a closed tank for 1.2 s (the
+ * acoustic step limit; the default viscosity damps the start-up waves), then read over 0.4 s:
+ * a gauge through the centre from 3 cm below the floor to 0.45 m, point probes on the centre line
+ * at y = 4, 8, 12 and 16 cm, every substep averaged. */
+static void test_resting_tank(void** state) {
+  const uint32_t layers[3] = {12, 24, 12};
+  const double width = 0.12, depth = 0.24;
+  const double tank_min[3] = {0.0, 0.0, 0.0}, tank_max[3] = {width, 2.0 * depth, width};
+  const double heights[4] = {0.04, 0.08, 0.12, 0.16};
+  float* lattice = NULL;
+  uint32_t n = 0;
+  support_world w;
+  sph_sdf* sdf = NULL;
+  sph_world_def def;
+  sph_world_params params;
+  sph_probe_id probes[4], gauge, snapshot;
+  double snapshot_sum = 0.0, snapshot_sum2 = 0.0;
+  int snapshots = 0;
+  double pressure[4] = {0.0, 0.0, 0.0, 0.0}, height = 0.0, time = 0.0, probe_time = 0.0, fill, rho0;
+  (void)state;
+  assert_int_equal(support_fcc_box(layers, kStep, NULL, &lattice, &n), SPH_OK);
+  def = probe_world_def(n);
+  sph_world_params_init(&params);
+  params.step_limits = SPH_STEP_LIMIT_ACOUSTIC;
+  EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, &params));
+  EXPECT_OK(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * kStep, 0.0f, &sdf, NULL));
+  EXPECT_OK(support_spawn(w.world, lattice, NULL, n));
+  free(lattice);
+  rho0 = w.def.rest_density;
+  for (int k = 0; k < 4; ++k)
+    probes[k] = add_point(w.world, width / 2, heights[k], width / 2, SPH_PROBE_EVERY_SUBSTEP);
+  gauge = add_gauge(w.world, width / 2, -0.03, width / 2, 0.48, 0.0);
+  /* One substep's pressure per frame at 8 cm: its spread over time is the solver's pressure noise
+   * (reported for the density diffusion of issue 17 item 3 to compare against). */
+  snapshot = add_point(w.world, width / 2, heights[1], width / 2, SPH_PROBE_EVERY_FRAME);
+  for (int frame = 0; frame < 80; ++frame) {
+    EXPECT_OK(sph_world_step(w.world, 0.02f));
+    if (frame < 60) continue;
+    {
+      const sph_probe_reading g = reading_of(w.world, gauge);
+      const sph_probe_reading one = reading_of(w.world, snapshot);
+      snapshot_sum += one.pressure;
+      snapshot_sum2 += (double)one.pressure * one.pressure;
+      ++snapshots;
+      height += g.water_height * g.time;
+      time += g.time;
+      for (int k = 0; k < 4; ++k) {
+        const sph_probe_reading r = reading_of(w.world, probes[k]);
+        assert_true(r.samples >= 1);
+        pressure[k] += r.pressure * r.time;
+        if (k == 0) probe_time += r.time;
+      }
+    }
+  }
+  height /= time;
+  for (int k = 0; k < 4; ++k) pressure[k] /= probe_time;
+  {
+    sph_stats st;
+    EXPECT_OK(sph_stats_init(&st));
+    EXPECT_OK(sph_world_get_stats(w.world, &st));
+    print_message("  particles: density min %.2f mean %.2f max %.2f, max speed %.4f m/s, k = %.1f\n",
+                  st.density_min, st.density_mean, st.density_max, st.max_speed, w.params.stiffness);
+  }
+  /* The fill height: the particles' volume at rest density over the tank's floor. */
+  fill = n * (double)w.mass / rho0 / (width * width);
+  print_message("resting tank: gauge height %.5f m, fill height %.5f m (%+.2f %%)\n", height, fill,
+                100.0 * (height / fill - 1.0));
+  for (int k = 0; k < 4; ++k) {
+    const double d = height - heights[k];
+    print_message(
+        "  probe at y = %.2f m: p = %.2f Pa, rho0 g d = %.2f Pa (d = %.4f m below the gauge's "
+        "surface; %+.2f %%)\n",
+        heights[k], pressure[k], rho0 * kGravity * d, d, 100.0 * (pressure[k] / (rho0 * kGravity * d) - 1.0));
+  }
+  {
+    const double mean = snapshot_sum / snapshots;
+    print_message(
+        "  pressure noise at 8 cm (one substep per frame, %d frames): mean %.1f Pa, standard deviation "
+        "%.1f Pa (%.1f %% of the mean; k = %.0f, no density diffusion)\n",
+        snapshots, mean, sqrt(fmax(0.0, snapshot_sum2 / snapshots - mean * mean)),
+        100.0 * sqrt(fmax(0.0, snapshot_sum2 / snapshots - mean * mean)) / mean, w.params.stiffness);
+  }
+  {
+    const double gradient = (pressure[0] - pressure[3]) / (heights[3] - heights[0]);
+    print_message("  (p(4 cm) - p(16 cm)) / 12 cm = %.2f Pa/m against rho0 g = %.2f Pa/m (%+.2f %%)\n",
+                  gradient, rho0 * kGravity, 100.0 * (gradient / (rho0 * kGravity) - 1.0));
+    /* The bound: the pressure gradient within 1 % of rho0 g (the issue's bound for a probe's
+     * pressure; measured -0.53 %). The difference takes out where the surface is: an SPH free
+     * surface is diffuse, its outer particles read a density deficit and so no pressure, and the
+     * level where the pressure extrapolates to zero lies about 1 cm (0.4 h) below the
+     * height the gauge finds (measured, the absolute comparisons printed above: -7 % at 14 cm,
+     * -44 % at 2 cm, a constant offset of about 95 Pa). The gauge is not held to the fill height
+     * here: without walls in the density the particles within h of the tank's walls read low
+     * densities and pack tighter, so the middle of the tank stands lower than n m / (rho0 A)
+     * (printed; test_uniform_flow holds the gauge to a known height instead). */
+    assert_true(fabs(gradient / (rho0 * kGravity) - 1.0) <= 0.01 || measuring());
+  }
+  EXPECT_OK(sph_sdf_destroy(sdf));
+  EXPECT_OK(support_world_close(&w));
+}
+
+/* ---- a uniform flow ------------------------------------------------------------------------- */
+
+/* A block of 10 x 10 x 10 layers moving at U = (0.5, 0, 0.2) m/s without gravity, through a
+ * probe fixed where the block's centre is after 0.1 s. The velocity field is uniform: a probe
+ * must read U (within 1 % of |U|: the free surface's pressure pulls the outer layers inwards, by
+ * symmetry not at the centre) and the rest density (within 1 %: the lattice is at rest density in
+ * its interior by construction of the particle mass). */
+static void test_uniform_flow(void** state) {
+  const uint32_t layers[3] = {10, 10, 10};
+  const float u[3] = {0.5f, 0.0f, 0.2f};
+  float *lattice = NULL, *velocities;
+  uint32_t n = 0;
+  support_world w;
+  sph_world_def def;
+  sph_world_params params;
+  sph_probe_id probe, gauge;
+  sph_probe_reading r, g;
+  double speed, error;
+  (void)state;
+  assert_int_equal(support_fcc_box(layers, kStep, NULL, &lattice, &n), SPH_OK);
+  velocities = (float*)malloc(sizeof(float) * 3 * n);
+  assert_non_null(velocities);
+  for (uint32_t i = 0; i < n; ++i) memcpy(velocities + 3 * i, u, sizeof u);
+  def = probe_world_def(n);
+  EXPECT_OK(support_params_gravity_and_steps(&params, 0.0f, 0.0f, 0.0f, 1e-6f, 2e-3f));
+  EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, &params));
+  EXPECT_OK(support_spawn(w.world, lattice, velocities, n));
+  free(lattice);
+  free(velocities);
+  probe = add_point(w.world, 0.05 + 0.1 * u[0], 0.05 + 0.1 * u[1], 0.05 + 0.1 * u[2], SPH_PROBE_EVERY_FRAME);
+  gauge = add_gauge(w.world, 0.05 + 0.1 * u[0], -0.05, 0.05 + 0.1 * u[2], 0.2, 0.0);
+  for (int frame = 0; frame < 5; ++frame) EXPECT_OK(sph_world_step(w.world, 0.02f));
+  r = reading_of(w.world, probe);
+  speed = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+  error =
+      sqrt(pow(r.velocity.x - u[0], 2) + pow(r.velocity.y - u[1], 2) + pow(r.velocity.z - u[2], 2)) / speed;
+  print_message(
+      "uniform flow: probe reads v = (%.5f, %.5f, %.5f), U = (%.2f, %.2f, %.2f): %.2e of |U|; "
+      "density %.2f (rho0 %.2f), kernel sum %.4f\n",
+      r.velocity.x, r.velocity.y, r.velocity.z, u[0], u[1], u[2], error, r.density, w.def.rest_density,
+      r.kernel_sum);
+  g = reading_of(w.world, gauge);
+  print_message("uniform flow: a gauge through the block reads %.5f m of its 0.10000 m (%+.2f %%)\n",
+                g.water_height, 100.0 * (g.water_height / 0.1 - 1.0));
+  /* The gauge: the block's 10 layers are 0.1 m of water at rest density (support_fcc_box tiles
+   * the box with the lattice's volume per point); within 1 %: the poly6 column integral's
+   * quadrature error on the lattice is 0.13 % (probe_sampling.h), the rest is the block's
+   * surface layers relaxing over the 0.1 s. */
+  assert_true((error <= 0.01 && fabs(r.density / w.def.rest_density - 1.0) <= 0.01 &&
+               fabs(g.water_height / 0.1 - 1.0) <= 0.01) ||
+              measuring());
+  EXPECT_OK(support_world_close(&w));
+}
+
+/* ---- sampling ------------------------------------------------------------------------------- */
+
+/* EVERY_SUBSTEP: one sample per substep, the span the step's time; EVERY_FRAME: one sample, the
+ * span its substep's. A probe in air reads zeros and a kernel sum of 0. */
+static void test_sampling(void** state) {
+  const uint32_t layers[3] = {6, 6, 6};
+  float* lattice = NULL;
+  uint32_t n = 0;
+  support_world w;
+  sph_world_def def;
+  sph_probe_id every, last, air;
+  sph_probe_reading a, b, c;
+  sph_stats stats;
+  (void)state;
+  assert_int_equal(support_fcc_box(layers, kStep, NULL, &lattice, &n), SPH_OK);
+  def = probe_world_def(n);
+  EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
+  EXPECT_OK(support_spawn(w.world, lattice, NULL, n));
+  free(lattice);
+  every = add_point(w.world, 0.03, 0.03, 0.03, SPH_PROBE_EVERY_SUBSTEP);
+  last = add_point(w.world, 0.03, 0.03, 0.03, SPH_PROBE_EVERY_FRAME);
+  air = add_point(w.world, 1.0, 1.0, 1.0, SPH_PROBE_EVERY_FRAME);
+  a = reading_of(w.world, every);
+  assert_int_equal(a.samples, 0); /* before the first step */
+  EXPECT_OK(sph_world_step(w.world, 0.02f));
+  EXPECT_OK(sph_stats_init(&stats));
+  EXPECT_OK(sph_world_get_stats(w.world, &stats));
+  a = reading_of(w.world, every);
+  b = reading_of(w.world, last);
+  c = reading_of(w.world, air);
+  assert_true(stats.substeps > 1);
+  assert_int_equal(a.samples, stats.substeps);
+  assert_true(fabs(a.time - stats.frame_time) <= 1e-6 * stats.frame_time);
+  assert_int_equal(b.samples, 1);
+  assert_true(b.time > 0.0 && b.time < a.time);
+  assert_true(a.pressure_max >= a.pressure);
+  assert_true(b.kernel_sum > 0.5);
+  assert_true(c.samples == 1 && c.kernel_sum == 0.0f && c.density == 0.0f && c.pressure == 0.0f);
+  {
+    /* A restore keeps the world's probes and their ids (checkpoints hold no probes); their
+     * readings start again. */
+    uint64_t size = 0;
+    void* saved;
+    EXPECT_OK(sph_world_save(w.world, NULL, 0, &size));
+    saved = malloc(size);
+    assert_non_null(saved);
+    EXPECT_OK(sph_world_save(w.world, saved, size, &size));
+    EXPECT_OK(sph_world_step(w.world, 0.02f));
+    EXPECT_OK(sph_world_restore(w.world, saved, size));
+    free(saved);
+    a = reading_of(w.world, every);
+    assert_int_equal(a.samples, 0);
+    EXPECT_OK(sph_world_step(w.world, 0.02f));
+    a = reading_of(w.world, every);
+    assert_true(a.samples > 1 && a.kernel_sum > 0.5f);
+  }
+  EXPECT_OK(support_world_close(&w));
+}
+
+/* ---- bad input ------------------------------------------------------------------------------ */
+
+static void test_bad_input(void** state) {
+  support_world w, dfsph;
+  sph_world_def def;
+  sph_probe_def good, bad;
+  sph_probe_id id = {0}, untouched = {0x1234}, first, stale;
+  sph_probe_reading r;
+  (void)state;
+  def = probe_world_def(64);
+  EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
+  EXPECT_OK(sph_probe_def_init(&good));
+  good.kind = SPH_PROBE_GAUGE;
+  good.length = 0.5f;
+
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "def", sph_probe_create(w.world, NULL, &id));
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "out_id", sph_probe_create(w.world, &good, NULL));
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world", sph_probe_create(NULL, &good, &id));
+#define EXPECT_BAD(result, field, change)                              \
+  do {                                                                 \
+    bad = good;                                                        \
+    change;                                                            \
+    id = untouched;                                                    \
+    EXPECT_ERROR(result, field, sph_probe_create(w.world, &bad, &id)); \
+    assert_true(id.bits == untouched.bits);                            \
+  } while (0)
+  EXPECT_BAD(SPH_ERROR_UNSUPPORTED, "def->kind", bad.kind = (sph_probe_kind)7);
+  EXPECT_BAD(SPH_ERROR_UNSUPPORTED, "def->sampling", bad.sampling = (sph_probe_sampling)2);
+  EXPECT_BAD(SPH_ERROR_INVALID_ARGUMENT, "def->reserved0", bad.reserved0 = 1);
+  EXPECT_BAD(SPH_ERROR_VERSION_MISMATCH, "def->struct_size", bad.struct_size = 8);
+  for (int i = 0; i < CAPI_NON_FINITE_COUNT; ++i) {
+    EXPECT_BAD(SPH_ERROR_INVALID_ARGUMENT, "def->position", bad.position.y = capi_non_finite(i));
+    EXPECT_BAD(SPH_ERROR_INVALID_ARGUMENT, "def->direction", bad.direction.x = capi_non_finite(i));
+    EXPECT_BAD(SPH_ERROR_INVALID_ARGUMENT, "def->length", bad.length = capi_non_finite(i));
+    EXPECT_BAD(SPH_ERROR_INVALID_ARGUMENT, "def->sample_spacing", bad.sample_spacing = capi_non_finite(i));
+  }
+  EXPECT_BAD(SPH_ERROR_INVALID_ARGUMENT, "def->position", bad.position.x = 1e9f);
+  EXPECT_BAD(SPH_ERROR_INVALID_ARGUMENT, "def->length", bad.length = 0.0f);
+  EXPECT_BAD(SPH_ERROR_INVALID_ARGUMENT, "def->length", bad.length = -1.0f);
+  EXPECT_BAD(SPH_ERROR_INVALID_ARGUMENT, "def->sample_spacing", bad.sample_spacing = -0.1f);
+  EXPECT_BAD(SPH_ERROR_INVALID_ARGUMENT, "def->sample_spacing", bad.sample_spacing = 1e-6f);
+#undef EXPECT_BAD
+  /* A point reads only its position: the gauge's fields do not matter. */
+  bad = good;
+  bad.kind = SPH_PROBE_POINT;
+  bad.length = -1.0f;
+  EXPECT_OK(sph_probe_create(w.world, &bad, &first));
+  /* No failed call took a slot: the first probe has the first id a world gives. */
+  {
+    support_world fresh;
+    sph_probe_id other;
+    EXPECT_OK(support_world_open(&fresh, sph_test_backend(), &def, NULL));
+    EXPECT_OK(sph_probe_create(fresh.world, &good, &other));
+    assert_true(other.bits == first.bits);
+    EXPECT_OK(support_world_close(&fresh));
+  }
+  /* Handles: destroy, then the id is stale everywhere; {0} is a no-op for destroy. */
+  stale = first;
+  EXPECT_OK(sph_probe_destroy(w.world, first));
+  EXPECT_OK(sph_probe_reading_init(&r));
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "id", sph_probe_get_reading(w.world, stale, &r));
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "id", sph_probe_destroy(w.world, stale));
+  EXPECT_OK(sph_probe_destroy(w.world, (sph_probe_id){0}));
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "id", sph_probe_get_reading(w.world, (sph_probe_id){0}, &r));
+  EXPECT_OK(sph_probe_create(w.world, &good, &id));
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "out", sph_probe_get_reading(w.world, id, NULL));
+  /* DFSPH has no sampled substep yet. */
+  def.solver = SPH_SOLVER_DFSPH;
+  EXPECT_OK(support_world_open(&dfsph, sph_test_backend(), &def, NULL));
+  EXPECT_ERROR(SPH_ERROR_UNSUPPORTED, "DFSPH", sph_probe_create(dfsph.world, &good, &id));
+  EXPECT_OK(support_world_close(&dfsph));
+  EXPECT_OK(support_world_close(&w));
+}
+
+int main(int argc, char** argv) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_bad_input),    cmocka_unit_test(test_sampling),
+      cmocka_unit_test(test_brute_force),  cmocka_unit_test(test_uniform_flow),
+      cmocka_unit_test(test_resting_tank),
+  };
+  (void)argc;
+  (void)argv;
+  return cmocka_run_group_tests_name("physics_probes", tests, NULL, NULL);
+}

@@ -1,0 +1,37 @@
+// SPDX-License-Identifier: MIT
+// The probes' readings as CSV files, one per probe of the scene file ("probes": [...]):
+// <output>/probe_<index>[_<name>].csv, a row per frame (docs/cli.md).
+#ifndef SPH_TOOLS_RUN_PROBE_CSV_H
+#define SPH_TOOLS_RUN_PROBE_CSV_H
+
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "scene_runtime.h"
+
+namespace sph_tools {
+
+class ProbeCsv {
+ public:
+  // Opens (truncates) the files and writes their headers. Returns "" or what went wrong.
+  std::string open(const std::string& directory, const SceneRuntime& runtime);
+  // Appends frame `frame` (time in s) of every file. Returns "" or what went wrong.
+  std::string write(const SceneRuntime& runtime, uint32_t frame, double time);
+  // Closes the files (also on destruction). Returns "" or what went wrong.
+  std::string close();
+  ~ProbeCsv() { close(); }
+
+ private:
+  struct File {
+    size_t probe;
+    std::string path;
+    std::FILE* file;
+  };
+  std::vector<File> files_;
+};
+
+}  // namespace sph_tools
+
+#endif
