@@ -67,8 +67,9 @@ class CpuParticleStore {
   // Every per-particle array to n particles; new elements start as their record's initial value.
   void resize(size_t n);
   // Sorted and Carried arrays: new[i] = old[order[i]] for i < n (the rest is dropped by the
-  // next resize); elements with stored indices rewrite them to the new order.
-  void permute(const uint32_t* order, size_t n);
+  // next resize); elements with stored indices rewrite them to the new order. Runs on `workers`
+  // OpenMP threads; the result does not depend on their number.
+  void permute(const uint32_t* order, size_t n, unsigned workers = 1);
   // Swaps the elements of two arrays of one size (the integration's double buffer).
   void swap_contents(CpuParticleArray& a, CpuParticleArray& b) { a.bytes.swap(b.bytes); }
 

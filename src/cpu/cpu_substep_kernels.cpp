@@ -17,7 +17,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
                                   FrameReport& report) {
   auto t = Clock::now();
   grid_.build(position_.data(), count_, workers_);
-  store_.permute(grid_.order().data(), count_);
+  store_.permute(grid_.order().data(), count_, threads());
   columns_.fill_state(position_.data(), velocity_.data(), count_, threads());
   report.stage_ms[kStageHashSort] += static_cast<float>(elapsed_ms(t));
 
