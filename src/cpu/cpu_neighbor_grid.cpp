@@ -64,14 +64,14 @@ void CpuNeighborGrid::refuse_crowded_slot(const Float4* positions, uint32_t n, u
                   "remove or spread the piled-up particles");
 }
 
-// A stable counting sort on the worker team, in three phases with a barrier between each. The
-// particles are cut into one contiguous block per worker. 1: each worker hashes its block and
-// counts it into its own row of block_counts_ (one slot per cell). 2: each worker takes a range of
-// cells and turns the rows into where each block's run of each cell starts, in cell order and
-// then block order; the cell-start table is the first block's start. 3: each worker scatters its
-// block from its own starts, in particle order. Within a cell the particles of block 0 come first,
-// then those of block 1, each block in particle order: exactly the order of the one-pass stable
-// sort, whatever the number of workers.
+// A stable counting sort on the worker team. The particles are cut into one contiguous block per
+// worker. Each worker hashes its block and counts it into its own row of block_counts_ (one slot
+// per cell); one worker turns the rows into where each block's run of each cell starts, in cell
+// order and then block order (the cell-start table is the first block's start); each worker
+// scatters its block from its own starts, in particle order. Within a cell the particles of block
+// 0 come first, then those of block 1, each block in particle order: exactly the order of the
+// one-pass stable sort, whatever the number of workers. The workers meet twice (after the counts,
+// after the starts): on a machine whose cores are shared, every meeting can cost a time slice.
 void CpuNeighborGrid::build(const Float4* positions, uint32_t n, unsigned workers) {
   choose_shape(positions, n, workers);
   const unsigned team = n >= kParallelMinimum ? std::min(std::max(workers, 1u), kMaxSortWorkers) : 1u;
@@ -80,11 +80,9 @@ void CpuNeighborGrid::build(const Float4* positions, uint32_t n, unsigned worker
   order_.resize(n);
   cell_start_.resize(cells + 1);
   block_counts_.resize(cells * team);  // (every slot is written before it is read)
-  cell_sums_.assign(team + 1, 0u);
-  first_crowded_.assign(team, UINT32_MAX);
   const GridShape shape = shape_;
   const uint32_t cap = max_per_cell_;
-  bool crowded = false;
+  uint32_t crowded = UINT32_MAX;  // the lowest slot holding more than the cap
 #pragma omp parallel num_threads(team)
   {
     // The team may be smaller than asked for: blocks follow the team that runs.
@@ -100,38 +98,27 @@ void CpuNeighborGrid::build(const Float4* positions, uint32_t n, unsigned worker
       ++counts[h];
     }
 #pragma omp barrier
-    const size_t cell_lo = cells * b / blocks, cell_hi = cells * (b + 1) / blocks;
-    uint32_t held = 0;
-    for (size_t c = cell_lo; c < cell_hi; ++c)
-      for (unsigned k = 0; k < blocks; ++k) held += block_counts_[cells * k + c];
-    cell_sums_[b + 1] = held;
-#pragma omp barrier
-    uint32_t running = 0;
-    for (unsigned k = 0; k <= b; ++k) running += cell_sums_[k];
-    for (size_t c = cell_lo; c < cell_hi; ++c) {
-      cell_start_[c] = running;
-      const uint32_t before = running;
-      for (unsigned k = 0; k < blocks; ++k) {
-        uint32_t& slot = block_counts_[cells * k + c];
-        const uint32_t count = slot;
-        slot = running;
-        running += count;
-      }
-      if (running - before > cap && first_crowded_[b] == UINT32_MAX)
-        first_crowded_[b] = static_cast<uint32_t>(c);
-    }
-#pragma omp barrier
 #pragma omp single
     {
-      cell_start_[cells] = n;
-      for (unsigned k = 0; k < blocks; ++k) crowded = crowded || first_crowded_[k] != UINT32_MAX;
-    }  // (the single's barrier publishes `crowded`)
-    if (!crowded)
+      uint32_t running = 0;
+      for (size_t c = 0; c < cells; ++c) {
+        cell_start_[c] = running;
+        const uint32_t before = running;
+        for (unsigned k = 0; k < blocks; ++k) {
+          uint32_t& slot = block_counts_[cells * k + c];
+          const uint32_t count = slot;
+          slot = running;
+          running += count;
+        }
+        if (running - before > cap && crowded == UINT32_MAX) crowded = static_cast<uint32_t>(c);
+      }
+      cell_start_[cells] = running;
+    }  // (the single's barrier publishes the starts and `crowded`)
+    if (crowded == UINT32_MAX)
       for (uint32_t i = first; i < last; ++i) order_[counts[hashes_[i]]++] = i;
   }
-  if (crowded)
-    for (const uint32_t c : first_crowded_)  // the lowest crowded cell, as a serial scan finds it
-      if (c != UINT32_MAX) refuse_crowded_slot(positions, n, c, cell_start_[c + 1] - cell_start_[c]);
+  if (crowded != UINT32_MAX)
+    refuse_crowded_slot(positions, n, crowded, cell_start_[crowded + 1] - cell_start_[crowded]);
 }
 
 }  // namespace sph

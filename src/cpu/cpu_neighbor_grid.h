@@ -55,8 +55,7 @@ class CpuNeighborGrid {
   const GridShape& shape() const { return shape_; }
   uint32_t max_per_cell() const { return max_per_cell_; }
   size_t bytes() const {
-    return (hashes_.capacity() + order_.capacity() + cell_start_.capacity() + block_counts_.capacity() +
-            cell_sums_.capacity() + first_crowded_.capacity()) *
+    return (hashes_.capacity() + order_.capacity() + cell_start_.capacity() + block_counts_.capacity()) *
            sizeof(uint32_t);
   }
 
@@ -71,11 +70,8 @@ class CpuNeighborGrid {
   std::vector<uint32_t> hashes_;
   std::vector<uint32_t> order_;
   std::vector<uint32_t> cell_start_;
-  // The parallel counting sort's scratch: a row of cell counts (then starts) per block, the
-  // blocks' sums over their ranges of cells, and each block's first crowded cell.
+  // The parallel counting sort's rows of cell counts (then starts), one per block of particles.
   std::vector<uint32_t> block_counts_;
-  std::vector<uint32_t> cell_sums_;
-  std::vector<uint32_t> first_crowded_;
 };
 
 }  // namespace sph

@@ -99,14 +99,17 @@ void CpuParticleStore::resize(size_t n) {
   particles_ = n;
 }
 
-// One parallel region for every array: the workers share each array's particles in blocks and go
-// on to the next array without waiting (the arrays are independent); the inverse order, which a
-// rewritten index may look up anywhere, is complete before any array is gathered.
-void CpuParticleStore::permute(const uint32_t* order, size_t n, unsigned workers) {
+// One parallel region: the workers share the particles in blocks, and each gathers its block of
+// every array (the old elements were swapped into scratch first, so data() is the new order
+// throughout) and then hands the block to after_block. The inverse order, which a rewritten index
+// may look up anywhere, is complete before any block is gathered.
+void CpuParticleStore::permute(const uint32_t* order, size_t n, unsigned workers,
+                               const BlockHook& after_block) {
   bool rewrites = false;
   for (auto& a : arrays_) {
     if (!reordered(*a)) continue;
     a->scratch.resize(a->bytes.size());  // (allocations before the parallel region, which must not throw)
+    a->bytes.swap(a->scratch);
     rewrites = rewrites || a->spec.rewrite_indices != nullptr;
   }
   if (rewrites) inverse_.assign(particles_, 0xffffffffu);
@@ -117,24 +120,22 @@ void CpuParticleStore::permute(const uint32_t* order, size_t n, unsigned workers
 #pragma omp for schedule(static)
       for (long i = 0; i < count; ++i) inverse_[order[i]] = static_cast<uint32_t>(i);
     }  // (the loop's barrier: the inverse is complete before any index is rewritten)
-    for (auto& a : arrays_) {
-      if (!reordered(*a)) continue;
-      const size_t size = a->spec.element_size;
-      const size_t per = a->spec.elements_per_particle;
-      // Each array's share of particles is independent of the others': no barrier between them.
-#pragma omp for schedule(static) nowait
-      for (long block = 0; block < (count + kPermuteBlock - 1) / kPermuteBlock; ++block) {
-        const size_t first = static_cast<size_t>(block) * kPermuteBlock;
-        const size_t last = std::min(first + kPermuteBlock, n);
-        gather(a->scratch.data(), a->bytes.data(), order, first, last, per, size);
+#pragma omp for schedule(static)
+    for (long block = 0; block < (count + kPermuteBlock - 1) / kPermuteBlock; ++block) {
+      const size_t first = static_cast<size_t>(block) * kPermuteBlock;
+      const size_t last = std::min(first + kPermuteBlock, n);
+      for (auto& a : arrays_) {
+        if (!reordered(*a)) continue;
+        const size_t size = a->spec.element_size;
+        const size_t per = a->spec.elements_per_particle;
+        gather(a->bytes.data(), a->scratch.data(), order, first, last, per, size);
         if (a->spec.rewrite_indices)
           for (size_t e = first * per; e < last * per; ++e)
-            a->spec.rewrite_indices(a->scratch.data() + e * size, inverse_.data());
+            a->spec.rewrite_indices(a->bytes.data() + e * size, inverse_.data());
       }
+      if (after_block) after_block(first, last);
     }
   }
-  for (auto& a : arrays_)
-    if (reordered(*a)) a->bytes.swap(a->scratch);
 }
 
 std::vector<std::vector<unsigned char>> CpuParticleStore::snapshot() const {
