@@ -5,8 +5,6 @@
 #include <cmath>
 #include <string>
 
-#include <omp.h>
-
 #include "../core/grid_layout.h"
 #include "../core/status.h"
 
@@ -64,61 +62,23 @@ void CpuNeighborGrid::refuse_crowded_slot(const Float4* positions, uint32_t n, u
                   "remove or spread the piled-up particles");
 }
 
-// A stable counting sort on the worker team. The particles are cut into one contiguous block per
-// worker. Each worker hashes its block and counts it into its own row of block_counts_ (one slot
-// per cell); one worker turns the rows into where each block's run of each cell starts, in cell
-// order and then block order (the cell-start table is the first block's start); each worker
-// scatters its block from its own starts, in particle order. Within a cell the particles of block
-// 0 come first, then those of block 1, each block in particle order: exactly the order of the
-// one-pass stable sort, whatever the number of workers. The workers meet twice (after the counts,
-// after the starts): on a machine whose cores are shared, every meeting can cost a time slice.
 void CpuNeighborGrid::build(const Float4* positions, uint32_t n, unsigned workers) {
   choose_shape(positions, n, workers);
-  const unsigned team = n >= kParallelMinimum ? std::min(std::max(workers, 1u), kMaxSortWorkers) : 1u;
-  const size_t cells = shape_.cell_count;
   hashes_.resize(n);
   order_.resize(n);
-  cell_start_.resize(cells + 1);
-  block_counts_.resize(cells * team);  // (every slot is written before it is read)
+  cell_start_.assign(static_cast<size_t>(shape_.cell_count) + 1, 0u);
+  const int count = static_cast<int>(n);
   const GridShape shape = shape_;
-  const uint32_t cap = max_per_cell_;
-  uint32_t crowded = UINT32_MAX;  // the lowest slot holding more than the cap
-#pragma omp parallel num_threads(team)
-  {
-    // The team may be smaller than asked for: blocks follow the team that runs.
-    const unsigned blocks = static_cast<unsigned>(omp_get_num_threads());
-    const unsigned b = static_cast<unsigned>(omp_get_thread_num());
-    const uint32_t first = static_cast<uint32_t>(static_cast<uint64_t>(n) * b / blocks);
-    const uint32_t last = static_cast<uint32_t>(static_cast<uint64_t>(n) * (b + 1) / blocks);
-    uint32_t* counts = block_counts_.data() + cells * b;
-    std::fill(counts, counts + cells, 0u);
-    for (uint32_t i = first; i < last; ++i) {
-      const uint32_t h = cell_hash_of_position(shape, xyz(positions[i]));
-      hashes_[i] = h;
-      ++counts[h];
-    }
-#pragma omp barrier
-#pragma omp single
-    {
-      uint32_t running = 0;
-      for (size_t c = 0; c < cells; ++c) {
-        cell_start_[c] = running;
-        const uint32_t before = running;
-        for (unsigned k = 0; k < blocks; ++k) {
-          uint32_t& slot = block_counts_[cells * k + c];
-          const uint32_t count = slot;
-          slot = running;
-          running += count;
-        }
-        if (running - before > cap && crowded == UINT32_MAX) crowded = static_cast<uint32_t>(c);
-      }
-      cell_start_[cells] = running;
-    }  // (the single's barrier publishes the starts and `crowded`)
-    if (crowded == UINT32_MAX)
-      for (uint32_t i = first; i < last; ++i) order_[counts[hashes_[i]]++] = i;
-  }
-  if (crowded != UINT32_MAX)
-    refuse_crowded_slot(positions, n, crowded, cell_start_[crowded + 1] - cell_start_[crowded]);
+#pragma omp parallel for num_threads(n >= kParallelMinimum ? workers : 1u) schedule(dynamic, kParticleChunk)
+  for (int i = 0; i < count; ++i) hashes_[i] = cell_hash_of_position(shape, xyz(positions[i]));
+
+  // Counting sort: histogram, exclusive prefix sum (the cell-start table), stable scatter.
+  for (uint32_t i = 0; i < n; ++i) ++cell_start_[hashes_[i] + 1];
+  for (uint32_t c = 0; c < shape_.cell_count; ++c)
+    if (cell_start_[c + 1] > max_per_cell_) refuse_crowded_slot(positions, n, c, cell_start_[c + 1]);
+  for (uint32_t c = 0; c < shape_.cell_count; ++c) cell_start_[c + 1] += cell_start_[c];
+  cursor_.assign(cell_start_.begin(), cell_start_.end() - 1);
+  for (uint32_t i = 0; i < n; ++i) order_[cursor_[hashes_[i]]++] = i;
 }
 
 }  // namespace sph

@@ -34,9 +34,6 @@ uint32_t max_particles_per_cell(float particle_spacing, float kernel_radius);
 // slices. Each particle's result depends on nothing but its index, so the split changes no bit.
 // 1024 particles are about 0.1-0.3 ms of a gather, large against the cost of taking a chunk.
 constexpr int kParticleChunk = 1024;
-// The neighbour sort runs on at most this many workers: each keeps a count per table slot (4
-// bytes, up to two slots a particle), so 4 workers hold up to 32 bytes a particle of counts.
-constexpr unsigned kMaxSortWorkers = 4;
 
 class CpuNeighborGrid {
  public:
@@ -44,8 +41,7 @@ class CpuNeighborGrid {
       : inv_cell_size_(1.0f / kernel_radius), kernel_radius_(kernel_radius), max_per_cell_(max_per_cell) {}
 
   // Hashes positions[0..n) and computes the stable order by cell (order()[i] is the old index
-  // of the particle that goes to place i), on up to kMaxSortWorkers of `workers`; the order is
-  // the same on any number. Fills the cell-start table for the sorted order.
+  // of the particle that goes to place i). Fills the cell-start table for the sorted order.
   // Throws Error(Capacity) when a slot holds more than max_per_cell particles (nothing the
   // caller owns has changed: the world's frame rolls back).
   void build(const Float4* positions, uint32_t n, unsigned workers);
@@ -55,7 +51,7 @@ class CpuNeighborGrid {
   const GridShape& shape() const { return shape_; }
   uint32_t max_per_cell() const { return max_per_cell_; }
   size_t bytes() const {
-    return (hashes_.capacity() + order_.capacity() + cell_start_.capacity() + block_counts_.capacity()) *
+    return (hashes_.capacity() + order_.capacity() + cell_start_.capacity() + cursor_.capacity()) *
            sizeof(uint32_t);
   }
 
@@ -70,8 +66,7 @@ class CpuNeighborGrid {
   std::vector<uint32_t> hashes_;
   std::vector<uint32_t> order_;
   std::vector<uint32_t> cell_start_;
-  // The parallel counting sort's rows of cell counts (then starts), one per block of particles.
-  std::vector<uint32_t> block_counts_;
+  std::vector<uint32_t> cursor_;
 };
 
 }  // namespace sph

@@ -120,7 +120,8 @@ void CpuParticleStore::permute(const uint32_t* order, size_t n, unsigned workers
 #pragma omp for schedule(static)
       for (long i = 0; i < count; ++i) inverse_[order[i]] = static_cast<uint32_t>(i);
     }  // (the loop's barrier: the inverse is complete before any index is rewritten)
-#pragma omp for schedule(static)
+       // Blocks on demand: a worker that something else keeps off its core holds up one block.
+#pragma omp for schedule(dynamic, 1)
     for (long block = 0; block < (count + kPermuteBlock - 1) / kPermuteBlock; ++block) {
       const size_t first = static_cast<size_t>(block) * kPermuteBlock;
       const size_t last = std::min(first + kPermuteBlock, n);

@@ -279,11 +279,9 @@ void test_crowded_cell_is_refused(void**) {
   assert_int_equal(sph::max_particles_per_cell(0.02f, 0.036f), 528u);
 }
 
-// The sort runs on up to kMaxSortWorkers workers, each counting and scattering its own block of
-// particles: on 1, 2, 3, 4 and 7 workers the order and the cell-start table are exactly those of
-// a stable sort by cell hash (std::stable_sort), for a cloud above the parallel minimum whose
-// blocks share cells (it wraps the table). A crowded cell is refused on 2 workers as on one,
-// with the lowest crowded slot named.
+// The sort's order and cell-start table are exactly those of a stable sort by cell hash
+// (std::stable_sort), on 1, 2, 3, 4 and 7 workers, for a cloud above the parallel minimum that
+// wraps the table. A crowded cell is refused on 2 workers as on one, with the same slot named.
 void test_sort_same_on_any_workers(void**) {
   const Cloud cloud{"wide", Vec3{0.1f, -0.2f, 0.3f}, 40.0f * kH, 20000, 3, 30.0f * kH};
   const std::vector<Vec3> points = random_points(cloud, 11u);
@@ -305,7 +303,7 @@ void test_sort_same_on_any_workers(void**) {
     for (uint32_t c = 0; c < shape.cell_count; ++c) starts[c + 1] += starts[c];
     for (uint32_t c = 0; c <= shape.cell_count; ++c) assert_int_equal(grid.view().cell_start[c], starts[c]);
   }
-  // Two crowded cells, one in each worker's block of particles: the lower slot is named.
+  // Two crowded cells, at the two ends of the particles: the lower slot is named.
   std::vector<Float4> crowded(records);
   for (uint32_t i = 0; i < 300; ++i) {
     crowded[i] = sph::make_float4_record(Vec3{0.5f, 0.5f, 0.5f}, 0.0f);
