@@ -1,8 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "cpu_neighbor_columns.h"
 
-#include "cpu_neighbor_grid.h"
-
 namespace sph {
 
 namespace {
@@ -22,23 +20,12 @@ const float* data_or_null(const std::vector<float>& column) {
 
 }  // namespace
 
-void CpuNeighborColumns::fill_state(const Float4* positions, const Float4* velocities, uint32_t n,
-                                    unsigned threads) {
+void CpuNeighborColumns::resize(uint32_t n) {
   for (std::vector<float>* c : {&x_, &y_, &z_, &vx_, &vy_, &vz_, &pressure_, &inv_density_})
     size_column(*c, n, true);
   size_column(neighbor_count_, n, counts_);
   for (std::vector<float>* c : {&normal_x_, &normal_y_, &normal_z_, &normal_length_})
     size_column(*c, n, normals_);
-  const int count = static_cast<int>(n);
-#pragma omp parallel for num_threads(threads) schedule(dynamic, kParticleChunk)
-  for (int i = 0; i < count; ++i) {
-    x_[i] = positions[i].x;
-    y_[i] = positions[i].y;
-    z_[i] = positions[i].z;
-    vx_[i] = velocities[i].x;
-    vy_[i] = velocities[i].y;
-    vz_[i] = velocities[i].z;
-  }
 }
 
 NeighborColumns CpuNeighborColumns::view() const {

@@ -40,8 +40,19 @@ class CpuNeighborColumns {
   // Keeps the count and normal columns only where a pass reads them.
   CpuNeighborColumns(bool keep_counts, bool keep_normals) : counts_(keep_counts), normals_(keep_normals) {}
 
-  // Sizes every column for n particles and copies positions and velocities (after the sort).
-  void fill_state(const Float4* positions, const Float4* velocities, uint32_t n, unsigned threads);
+  // Sizes every column for n particles (before the sort's reorder), then copies positions and
+  // velocities of particles [first, last) (after it, on the worker that reordered them).
+  void resize(uint32_t n);
+  void copy_state(const Float4* positions, const Float4* velocities, size_t first, size_t last) {
+    for (size_t i = first; i < last; ++i) {
+      x_[i] = positions[i].x;
+      y_[i] = positions[i].y;
+      z_[i] = positions[i].z;
+      vx_[i] = velocities[i].x;
+      vy_[i] = velocities[i].y;
+      vz_[i] = velocities[i].z;
+    }
+  }
 
   // One particle's results of the density pass, and of the colour-field pass.
   void set_density(uint32_t i, float pressure, float inv_density) {

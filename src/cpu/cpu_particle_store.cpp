@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "cpu_particle_store.h"
 
+#include <algorithm>
 #include <cstring>
 #include <string>
 
@@ -9,32 +10,40 @@
 namespace sph {
 namespace {
 
-// new[i] = old[order[i]] for elements of `size` bytes, `per` elements per particle.
+// new[i] = old[order[i]] for i in [first, last), elements of `size` bytes, `per` per particle.
 template <size_t kSize>
-void gather_fixed(unsigned char* out, const unsigned char* in, const uint32_t* order, size_t n, size_t per) {
+void gather_fixed(unsigned char* out, const unsigned char* in, const uint32_t* order, size_t first,
+                  size_t last, size_t per) {
   struct Element {
     unsigned char b[kSize];
   };
   Element* o = reinterpret_cast<Element*>(out);
   const Element* s = reinterpret_cast<const Element*>(in);
-  for (size_t i = 0; i < n; ++i)
+  for (size_t i = first; i < last; ++i)
     for (size_t k = 0; k < per; ++k) o[i * per + k] = s[static_cast<size_t>(order[i]) * per + k];
 }
 
-void gather(unsigned char* out, const unsigned char* in, const uint32_t* order, size_t n, size_t per,
-            size_t size) {
+void gather(unsigned char* out, const unsigned char* in, const uint32_t* order, size_t first, size_t last,
+            size_t per, size_t size) {
   switch (size) {
     case 4:
-      return gather_fixed<4>(out, in, order, n, per);
+      return gather_fixed<4>(out, in, order, first, last, per);
     case 16:
-      return gather_fixed<16>(out, in, order, n, per);
+      return gather_fixed<16>(out, in, order, first, last, per);
     case 24:
-      return gather_fixed<24>(out, in, order, n, per);
+      return gather_fixed<24>(out, in, order, first, last, per);
     default: {
       const size_t stride = per * size;
-      for (size_t i = 0; i < n; ++i) std::memcpy(out + i * stride, in + order[i] * stride, stride);
+      for (size_t i = first; i < last; ++i) std::memcpy(out + i * stride, in + order[i] * stride, stride);
     }
   }
+}
+
+// Particles per share of the reorder: 4096 records are 16-64 KiB of each array.
+constexpr long kPermuteBlock = 4096;
+
+bool reordered(const CpuParticleArray& a) {
+  return a.spec.role != ParticleArrayRole::Scratch && a.spec.elements_per_particle != 0;
 }
 
 }  // namespace
@@ -90,23 +99,43 @@ void CpuParticleStore::resize(size_t n) {
   particles_ = n;
 }
 
-void CpuParticleStore::permute(const uint32_t* order, size_t n) {
-  bool inverse_ready = false;
+// One parallel region: the workers share the particles in blocks, and each gathers its block of
+// every array (the old elements were swapped into scratch first, so data() is the new order
+// throughout) and then hands the block to after_block. The inverse order, which a rewritten index
+// may look up anywhere, is complete before any block is gathered.
+void CpuParticleStore::permute(const uint32_t* order, size_t n, unsigned workers,
+                               const BlockHook& after_block) {
+  bool rewrites = false;
   for (auto& a : arrays_) {
-    if (a->spec.role == ParticleArrayRole::Scratch || a->spec.elements_per_particle == 0) continue;
-    const size_t size = a->spec.element_size;
-    a->scratch.resize(a->bytes.size());
-    gather(a->scratch.data(), a->bytes.data(), order, n, a->spec.elements_per_particle, size);
-    if (a->spec.rewrite_indices) {
-      if (!inverse_ready) {
-        inverse_.assign(particles_, 0xffffffffu);
-        for (size_t i = 0; i < n; ++i) inverse_[order[i]] = static_cast<uint32_t>(i);
-        inverse_ready = true;
-      }
-      for (size_t e = 0; e < a->elements(n); ++e)
-        a->spec.rewrite_indices(a->scratch.data() + e * size, inverse_.data());
-    }
+    if (!reordered(*a)) continue;
+    a->scratch.resize(a->bytes.size());  // (allocations before the parallel region, which must not throw)
     a->bytes.swap(a->scratch);
+    rewrites = rewrites || a->spec.rewrite_indices != nullptr;
+  }
+  if (rewrites) inverse_.assign(particles_, 0xffffffffu);
+  const long count = static_cast<long>(n);
+#pragma omp parallel num_threads(std::max(workers, 1u))
+  {
+    if (rewrites) {
+#pragma omp for schedule(static)
+      for (long i = 0; i < count; ++i) inverse_[order[i]] = static_cast<uint32_t>(i);
+    }  // (the loop's barrier: the inverse is complete before any index is rewritten)
+       // Blocks on demand: a worker that something else keeps off its core holds up one block.
+#pragma omp for schedule(dynamic, 1)
+    for (long block = 0; block < (count + kPermuteBlock - 1) / kPermuteBlock; ++block) {
+      const size_t first = static_cast<size_t>(block) * kPermuteBlock;
+      const size_t last = std::min(first + kPermuteBlock, n);
+      for (auto& a : arrays_) {
+        if (!reordered(*a)) continue;
+        const size_t size = a->spec.element_size;
+        const size_t per = a->spec.elements_per_particle;
+        gather(a->bytes.data(), a->scratch.data(), order, first, last, per, size);
+        if (a->spec.rewrite_indices)
+          for (size_t e = first * per; e < last * per; ++e)
+            a->spec.rewrite_indices(a->bytes.data() + e * size, inverse_.data());
+      }
+      if (after_block) after_block(first, last);
+    }
   }
 }
 

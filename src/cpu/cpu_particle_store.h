@@ -10,6 +10,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -67,8 +68,13 @@ class CpuParticleStore {
   // Every per-particle array to n particles; new elements start as their record's initial value.
   void resize(size_t n);
   // Sorted and Carried arrays: new[i] = old[order[i]] for i < n (the rest is dropped by the
-  // next resize); elements with stored indices rewrite them to the new order.
-  void permute(const uint32_t* order, size_t n);
+  // next resize); elements with stored indices rewrite them to the new order. Runs on `workers`
+  // OpenMP threads; the result does not depend on their number. after_block(first, last), when
+  // given, runs on the worker that has just reordered particles [first, last) of every array (it
+  // may read them through data(), and must not throw), so a copy of the new order needs no
+  // pass, and no meeting of the workers, of its own.
+  using BlockHook = std::function<void(size_t first, size_t last)>;
+  void permute(const uint32_t* order, size_t n, unsigned workers = 1, const BlockHook& after_block = {});
   // Swaps the elements of two arrays of one size (the integration's double buffer).
   void swap_contents(CpuParticleArray& a, CpuParticleArray& b) { a.bytes.swap(b.bytes); }
 

@@ -17,8 +17,12 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
                                   FrameReport& report) {
   auto t = Clock::now();
   grid_.build(position_.data(), count_, workers_);
-  store_.permute(grid_.order().data(), count_);
-  columns_.fill_state(position_.data(), velocity_.data(), count_, threads());
+  columns_.resize(count_);
+  // The columns copy each block of the new order as soon as it is reordered (data() is the new
+  // order inside the reorder).
+  store_.permute(grid_.order().data(), count_, threads(), [this](size_t first, size_t last) {
+    columns_.copy_state(position_.data(), velocity_.data(), first, last);
+  });
   report.stage_ms[kStageHashSort] += static_cast<float>(elapsed_ms(t));
 
   t = Clock::now();

@@ -16,8 +16,12 @@
 #else
 #include <cmath>
 #define SPH_FLOORF std::floor
-#define SPH_FMINF std::fmin
-#define SPH_FMAXF std::fmax
+// fmax and fmin by comparison: GCC calls libm for std::fmax / std::fmin (without
+// -ffinite-math-only), twice per axis per particle in every sort and walk. With the finite
+// bounds of cell_coordinate they give fmax's and fmin's value for every input, NaN included
+// (fmax(NaN, lo) = lo).
+#define SPH_FMINF(a, b) ((a) <= (b) ? (a) : (b))
+#define SPH_FMAXF(a, b) ((a) >= (b) ? (a) : (b))
 #endif
 
 namespace sph {

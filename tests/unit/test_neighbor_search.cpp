@@ -5,7 +5,8 @@
 // 10 km away, and in clouds of blobs far apart, where the table (sized by the particles' count
 // and extent at every build) is narrower than the cloud and distant cells share table slots.
 // The table never has many more slots than particles, whatever their extent, and a build that
-// finds more particles in one slot than the grid's cap is refused.
+// finds more particles in one slot than the grid's cap is refused. The sort gives the same order
+// on any number of workers.
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -17,6 +18,7 @@ extern "C" {
 #include <algorithm>
 #include <cstdio>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "core/grid_layout.h"
@@ -277,6 +279,51 @@ void test_crowded_cell_is_refused(void**) {
   assert_int_equal(sph::max_particles_per_cell(0.02f, 0.036f), 528u);
 }
 
+// The sort's order and cell-start table are exactly those of a stable sort by cell hash
+// (std::stable_sort), on 1, 2, 3, 4 and 7 workers, for a cloud above the parallel minimum that
+// wraps the table. A crowded cell is refused on 2 workers as on one, with the same slot named.
+void test_sort_same_on_any_workers(void**) {
+  const Cloud cloud{"wide", Vec3{0.1f, -0.2f, 0.3f}, 40.0f * kH, 20000, 3, 30.0f * kH};
+  const std::vector<Vec3> points = random_points(cloud, 11u);
+  const uint32_t n = cloud.count;
+  std::vector<Float4> records(n);
+  for (uint32_t i = 0; i < n; ++i) records[i] = sph::make_float4_record(points[i], 0.0f);
+  for (unsigned workers : {1u, 2u, 3u, 4u, 7u}) {
+    sph::CpuNeighborGrid grid(kH, UINT32_MAX);
+    grid.build(records.data(), n, workers);
+    const sph::GridShape shape = grid.shape();
+    std::vector<uint32_t> expected(n);
+    for (uint32_t i = 0; i < n; ++i) expected[i] = i;
+    std::stable_sort(expected.begin(), expected.end(), [&](uint32_t a, uint32_t b) {
+      return sph::cell_hash_of_position(shape, points[a]) < sph::cell_hash_of_position(shape, points[b]);
+    });
+    assert_true(grid.order() == expected);
+    std::vector<uint32_t> starts(shape.cell_count + 1, 0u);
+    for (uint32_t i = 0; i < n; ++i) ++starts[sph::cell_hash_of_position(shape, points[i]) + 1];
+    for (uint32_t c = 0; c < shape.cell_count; ++c) starts[c + 1] += starts[c];
+    for (uint32_t c = 0; c <= shape.cell_count; ++c) assert_int_equal(grid.view().cell_start[c], starts[c]);
+  }
+  // Two crowded cells, at the two ends of the particles: the lower slot is named.
+  std::vector<Float4> crowded(records);
+  for (uint32_t i = 0; i < 300; ++i) {
+    crowded[i] = sph::make_float4_record(Vec3{0.5f, 0.5f, 0.5f}, 0.0f);
+    crowded[n - 1 - i] = sph::make_float4_record(Vec3{-0.5f, 0.5f, 0.5f}, 0.0f);
+  }
+  std::string messages[2];
+  for (unsigned workers : {1u, 2u}) {
+    sph::CpuNeighborGrid grid(kH, 200);
+    try {
+      grid.build(crowded.data(), n, workers);
+    } catch (const sph::Error& e) {
+      assert_int_equal(static_cast<int>(e.status()), static_cast<int>(sph::Status::Capacity));
+      messages[workers - 1] = e.what();
+    }
+  }
+  std::printf("crowded on 2 workers: %s\n", messages[1].c_str());
+  assert_false(messages[0].empty());
+  assert_true(messages[0] == messages[1]);
+}
+
 }  // namespace
 
 int main() {
@@ -290,6 +337,7 @@ int main() {
       cmocka_unit_test(test_pairs_straddling_boundaries),
       cmocka_unit_test(test_table_follows_the_particles),
       cmocka_unit_test(test_crowded_cell_is_refused),
+      cmocka_unit_test(test_sort_same_on_any_workers),
   };
   return cmocka_run_group_tests_name("neighbor_search", tests, nullptr, nullptr);
 }

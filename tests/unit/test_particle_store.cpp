@@ -4,7 +4,8 @@
 // (a permutation moves Sorted and Carried arrays and leaves Scratch ones; the rollback snapshot
 // holds the Carried ones; new particles start at the record's initial value; spring partners
 // follow the permutation through the record's index rewrite), and a snapshot's carried arrays
-// round-trip by name (src/core/particle_snapshot.h). Every expected value is written out by hand
+// round-trip by name (src/core/particle_snapshot.h). The reorder gives the same bytes on any
+// number of workers. Every expected value is written out by hand
 // from the permutation.
 #include <setjmp.h>
 #include <stdarg.h>
@@ -181,6 +182,38 @@ void test_snapshot_arrays_by_name(void**) {
   }
 }
 
+// The reorder runs on several workers, in blocks of particles: with more particles than one
+// block, 1 and 3 workers move every element to where the order says (a value that names its old
+// index lands at its new place) and rewrite the spring partners alike, byte for byte.
+void test_permute_on_workers(void**) {
+  const uint32_t n = 10007;  // a few blocks and a ragged end
+  std::vector<uint32_t> order(n);
+  for (uint32_t i = 0; i < n; ++i) order[i] = (i * 7919u) % n;  // 7919 is prime: a permutation
+  sph::WorldConfig config;
+  config.features = sph::kFeatureSprings;
+  std::vector<std::vector<unsigned char>> results[2];
+  const unsigned workers[2] = {1u, 3u};
+  for (int run = 0; run < 2; ++run) {
+    CpuParticleStore store;
+    for (const ParticleArraySpec& sp : sph::method_particle_arrays(config)) store.add(sp);
+    CpuArrayRef<uint32_t> carried = store.add_typed<uint32_t>(spec("carried", ParticleArrayRole::Carried));
+    CpuArrayRef<sph::SpringList> springs = store.find_typed<sph::SpringList>(sph::kArraySprings);
+    store.resize(n);
+    for (uint32_t i = 0; i < n; ++i) {
+      carried[i] = 1000000u + i;
+      springs[i].partner[0] = (i + 1) % n;  // each old particle links to the next one
+    }
+    store.permute(order.data(), n, workers[run]);
+    for (uint32_t i = 0; i < n; ++i) {
+      assert_int_equal(carried[i], 1000000u + order[i]);
+      // New place i holds old particle order[i]; its partner is the new place of old order[i] + 1.
+      assert_int_equal(order[springs[i].partner[0]], (order[i] + 1) % n);
+    }
+    for (const auto& a : store.arrays()) results[run].push_back(a->bytes);
+  }
+  assert_true(results[0] == results[1]);
+}
+
 }  // namespace
 
 int main() {
@@ -191,6 +224,7 @@ int main() {
       cmocka_unit_test(test_same_name_is_one_array),
       cmocka_unit_test(test_spring_partners_follow),
       cmocka_unit_test(test_snapshot_arrays_by_name),
+      cmocka_unit_test(test_permute_on_workers),
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
