@@ -75,13 +75,21 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
   const double slab = step * config->slab_layers;
   const double tank_length = 6.0 * a, tank_height = 3.0 * a;
   const uint32_t layers[3] = {config->layers_across, 2 * config->layers_across, config->slab_layers};
-  const double tank_min[3] = {0.0, 0.0, 0.0};
-  const double tank_max[3] = {tank_length, tank_height, slab};
+  /* With the walls in the density they stand spacing/2 (step/sqrt 2) beyond the lattice's outer
+   * layers, where the boundary calibration puts a first layer at rest (physics_boundary_density's
+   * tank); at step/2 (0.35 spacings) the walls' share over-reads and the slab starts compressed
+   * against them. The column still spans x in [0, a] and the front is still measured from x = 0:
+   * the gap, 0.21 steps, is 1 % of a at 20 layers. Without the walls in the density the walls
+   * stand at the lattice's faces. */
+  const double gap = (config->features & SPH_FEATURE_BOUNDARY_DENSITY) ? 0.5 * step * (sqrt(2.0) - 1.0) : 0.0;
+  const double tank_min[3] = {-gap, -gap, -gap};
+  const double tank_max[3] = {tank_length, tank_height, slab + gap};
   sph_world_def def;
   sph_world_params params;
   sph_tait_params tait;
   sph_world* world = NULL;
   sph_sdf* tank = NULL;
+  sph_sdf* gate = NULL;
   float* positions = NULL;
   float* density = NULL;
   float* scratch = NULL;
@@ -143,6 +151,34 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
   r = support_tank_between(context, world, tank_min, tank_max, 0.5 * step, config->friction, &tank, NULL);
   if (r != SPH_OK) goto done;
   if ((r = support_spawn(world, positions, NULL, n)) != SPH_OK) goto done;
+  if (config->settle_seconds > 0.0) {
+    /* The gate: a solid box a column wide whose face stands where a tank wall would (the gap
+     * beyond the column's last layer), reaching past the tank's floor, roof and sides. */
+    sph_shape_desc shape;
+    sph_collider_def gate_def;
+    sph_collider_id gate_id;
+    double settled = 0.0;
+    if ((r = sph_shape_desc_init(&shape)) != SPH_OK) goto done;
+    shape.shape = SPH_SHAPE_BOX;
+    shape.half_extents.x = (float)(0.5 * a);
+    shape.half_extents.y = (float)(0.5 * tank_height + a);
+    shape.half_extents.z = (float)(0.5 * slab + a);
+    shape.voxel_size = (float)(0.5 * step);
+    if ((r = sph_sdf_create_shape(context, &shape, &gate)) != SPH_OK) goto done;
+    if ((r = sph_collider_def_init(&gate_def)) != SPH_OK) goto done;
+    gate_def.sdf = gate;
+    gate_def.transform = sph_transform_identity();
+    gate_def.transform.position.x = (float)(a + gap + 0.5 * a);
+    gate_def.transform.position.y = (float)(0.5 * tank_height);
+    gate_def.transform.position.z = (float)(0.5 * slab);
+    if ((r = sph_collider_create(world, &gate_def, &gate_id)) != SPH_OK) goto done;
+    while (settled < config->settle_seconds - 1e-9) {
+      const double frame = fmin(0.01, config->settle_seconds - settled);
+      if ((r = sph_world_step(world, (float)frame)) != SPH_OK) goto done;
+      settled += frame;
+    }
+    if ((r = sph_collider_destroy(world, gate_id)) != SPH_OK) goto done;
+  }
 
   {
     const double scale = time_scale();
@@ -203,8 +239,8 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
         const float tol = (float)(0.5 * step);
         for (uint32_t i = 0; i < count; ++i) {
           const float* p = positions + 3 * i;
-          if (p[0] < -tol || p[0] > tank_length + tol || p[1] < -tol || p[1] > tank_height + tol ||
-              p[2] < -tol || p[2] > slab + tol)
+          if (p[0] < tank_min[0] - tol || p[0] > tank_max[0] + tol || p[1] < tank_min[1] - tol ||
+              p[1] > tank_max[1] + tol || p[2] < tank_min[2] - tol || p[2] > tank_max[2] + tol)
             ++result->escaped;
         }
       }
@@ -240,6 +276,7 @@ done:
   }
   if (world) sph_world_destroy(world);
   if (tank) sph_sdf_destroy(tank);
+  if (gate) sph_sdf_destroy(gate);
   free(positions);
   free(density);
   free(scratch);

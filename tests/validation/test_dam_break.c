@@ -106,6 +106,7 @@ static void run_dfsph(uint32_t features) {
   dam_break_config_default(&config, validation_full() ? 40 : 20);
   config.solver = SPH_SOLVER_DFSPH;
   config.features = features;
+  if (getenv("SPH_DAM_SETTLE")) config.settle_seconds = atof(getenv("SPH_DAM_SETTLE"));
   r = dam_break_run(context, &config, result, trace_line, getenv("SPH_TRACE") ? stdout : NULL);
   if (r != SPH_OK) printf("dam break failed: %s: %s\n", sph_result_string(r), result->message);
   assert_int_equal(r, SPH_OK);
