@@ -89,7 +89,6 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
   sph_tait_params tait;
   sph_world* world = NULL;
   sph_sdf* tank = NULL;
-  sph_sdf* gate = NULL;
   float* positions = NULL;
   float* density = NULL;
   float* scratch = NULL;
@@ -151,34 +150,6 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
   r = support_tank_between(context, world, tank_min, tank_max, 0.5 * step, config->friction, &tank, NULL);
   if (r != SPH_OK) goto done;
   if ((r = support_spawn(world, positions, NULL, n)) != SPH_OK) goto done;
-  if (config->settle_seconds > 0.0) {
-    /* The gate: a solid box a column wide whose face stands where a tank wall would (the gap
-     * beyond the column's last layer), reaching past the tank's floor, roof and sides. */
-    sph_shape_desc shape;
-    sph_collider_def gate_def;
-    sph_collider_id gate_id;
-    double settled = 0.0;
-    if ((r = sph_shape_desc_init(&shape)) != SPH_OK) goto done;
-    shape.shape = SPH_SHAPE_BOX;
-    shape.half_extents.x = (float)(0.5 * a);
-    shape.half_extents.y = (float)(0.5 * tank_height + a);
-    shape.half_extents.z = (float)(0.5 * slab + a);
-    shape.voxel_size = (float)(0.5 * step);
-    if ((r = sph_sdf_create_shape(context, &shape, &gate)) != SPH_OK) goto done;
-    if ((r = sph_collider_def_init(&gate_def)) != SPH_OK) goto done;
-    gate_def.sdf = gate;
-    gate_def.transform = sph_transform_identity();
-    gate_def.transform.position.x = (float)(a + gap + 0.5 * a);
-    gate_def.transform.position.y = (float)(0.5 * tank_height);
-    gate_def.transform.position.z = (float)(0.5 * slab);
-    if ((r = sph_collider_create(world, &gate_def, &gate_id)) != SPH_OK) goto done;
-    while (settled < config->settle_seconds - 1e-9) {
-      const double frame = fmin(0.01, config->settle_seconds - settled);
-      if ((r = sph_world_step(world, (float)frame)) != SPH_OK) goto done;
-      settled += frame;
-    }
-    if ((r = sph_collider_destroy(world, gate_id)) != SPH_OK) goto done;
-  }
 
   {
     const double scale = time_scale();
@@ -276,7 +247,6 @@ done:
   }
   if (world) sph_world_destroy(world);
   if (tank) sph_sdf_destroy(tank);
-  if (gate) sph_sdf_destroy(gate);
   free(positions);
   free(density);
   free(scratch);

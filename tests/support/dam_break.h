@@ -49,10 +49,6 @@ typedef struct dam_break_config {
   uint32_t max_iterations;
   uint32_t dfsph_flags;
   uint32_t features; /* sph_world_def.features added to the world's (e.g. SPH_FEATURE_BOUNDARY_DENSITY) */
-  /* 0: the column is released at once from its lattice. > 0: it first rests this many seconds
-   * behind a gate (a solid box spacing/2 beyond the column's face, as the tank's walls), which is
-   * then removed; T counts from the removal (the experiment's water was at rest behind a gate). */
-  double settle_seconds;
 } dam_break_config;
 
 /* The configuration the validation uses (docs/validation.md says why each value). */
