@@ -3,11 +3,11 @@
  * density solves either converged within the user's bound (sph_stats.density_error_max <= the
  * bound) or stopped at their cap and said so: sph_stats.pressure_solves_capped substeps and as
  * many SPH_EVENT_PRESSURE_SOLVE_CAPPED counts (never silently); likewise the divergence solve.
- * Every position stays finite and inside the tank. The cases:
+ * Every position stays finite and inside the tank (but at step_factor 10, below). The cases:
  *   - cfl: a dam-break column at the largest step_factor the API accepts (10: a particle may move
  *     ten kernel radii a step) and at 1 (one kernel radius, the neighbour search's reach);
- *   - fine: a falling block at 0.1 mm spacing (m grad W reaches 1e9 there: dfsph_passes.h folds
- *     the mass into the gradient so that its square stays in float range);
+ *   - fine: a collapsing column at 0.1 mm steps (grad W about 1e15 m^-4 there, m about 2e-9 kg:
+ *     dfsph_passes.h folds the mass into the gradient so that the sums stay in float range);
  *   - sheet: a sheet two lattice layers thick thrown onto the floor (no particle has a full
  *     neighbourhood: the factor and the divergence solve's neighbour floor at work);
  *   - kinematic: a paddle driven at 5 m/s through water, with the walls in the density: no
