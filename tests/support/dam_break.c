@@ -75,8 +75,15 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
   const double slab = step * config->slab_layers;
   const double tank_length = 6.0 * a, tank_height = 3.0 * a;
   const uint32_t layers[3] = {config->layers_across, 2 * config->layers_across, config->slab_layers};
-  const double tank_min[3] = {0.0, 0.0, 0.0};
-  const double tank_max[3] = {tank_length, tank_height, slab};
+  /* With the walls in the density they stand spacing/2 (step/sqrt 2) beyond the lattice's outer
+   * layers, where the boundary calibration puts a first layer at rest (physics_boundary_density's
+   * tank); at step/2 (0.35 spacings) the walls' share over-reads and the slab starts compressed
+   * against them. The column still spans x in [0, a] and the front is still measured from x = 0:
+   * the gap, 0.21 steps, is 1 % of a at 20 layers. Without the walls in the density the walls
+   * stand at the lattice's faces. */
+  const double gap = (config->features & SPH_FEATURE_BOUNDARY_DENSITY) ? 0.5 * step * (sqrt(2.0) - 1.0) : 0.0;
+  const double tank_min[3] = {-gap, -gap, -gap};
+  const double tank_max[3] = {tank_length, tank_height, slab + gap};
   sph_world_def def;
   sph_world_params params;
   sph_tait_params tait;
@@ -203,8 +210,8 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
         const float tol = (float)(0.5 * step);
         for (uint32_t i = 0; i < count; ++i) {
           const float* p = positions + 3 * i;
-          if (p[0] < -tol || p[0] > tank_length + tol || p[1] < -tol || p[1] > tank_height + tol ||
-              p[2] < -tol || p[2] > slab + tol)
+          if (p[0] < tank_min[0] - tol || p[0] > tank_max[0] + tol || p[1] < tank_min[1] - tol ||
+              p[1] > tank_max[1] + tol || p[2] < tank_min[2] - tol || p[2] > tank_max[2] + tol)
             ++result->escaped;
         }
       }
