@@ -84,7 +84,8 @@ struct Scene {
       normals[i] = sph::make_float4_record(nv, sph::length(nv));
       counts[i] = count(rng);
     }
-    columns.fill_state(positions.data(), velocities.data(), n, 1);
+    columns.resize(n);
+    columns.copy_state(positions.data(), velocities.data(), 0, n);
     for (uint32_t i = 0; i < n; ++i) {
       columns.set_density(i, positions[i].w, velocities[i].w);
       columns.set_neighbor_count(i, counts[i]);
