@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "../src/physics/boundary_density.h"
 #include "../src/physics/density.h"
+#include "../src/physics/density_diffusion.h"
 #include "../src/physics/density_normalization.h"
 #include "../src/physics/forces.h"
 #include "../src/physics/integrate.h"
@@ -88,6 +89,20 @@ __global__ void publish_normalized_density_kernel(FluidConstants fluid, Particle
   a.density[i] = rho;
   a.sorted_position[i].w = pressure_from_density(fluid.methods.eos, rho);
   a.sorted_velocity[i].w = 1.0f / rho;
+}
+
+// The delta-SPH rate over every published rho_j: the diffused density goes to the side array
+// (free once the filtered densities are published) and the factor that carries it is written;
+// publish_normalized_density_kernel then publishes them.
+__global__ void density_diffusion_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
+                                         const FrameState* state) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const float rate = gather_density_diffusion(fluid, fluid.methods.density_diffusion, grid, a.sorted_position,
+                                              a.sorted_velocity, i);
+  const DiffusedDensity d = diffused_density(a.density[i], a.density_factor[i], rate, state->clock.dt_float);
+  a.density_factor[i] = d.factor;
+  a.normalized_density[i] = d.density;
 }
 
 __global__ void colour_normal_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n) {
@@ -218,7 +233,7 @@ void enqueue_reorder(const ParticleArrays& a, const uint32_t* order, uint32_t n,
 
 void enqueue_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a, uint32_t n,
                      const SubstepOptions& options, const KernelTuning& tuning, const DeviceScene& scene,
-                     float stage_fraction, FrameState* state, cudaStream_t stream) {
+                     float stage_fraction, bool first_of_substep, FrameState* state, cudaStream_t stream) {
   const unsigned threads = tuning.density_block, blocks = blocks_for(n, threads);
   const bool counts = options.viscosity == ViscosityMethod::Clavet;
   const bool boundary = options.boundary_density;
@@ -241,7 +256,19 @@ void enqueue_density(const FluidConstants& fluid, const GridView& grid, const Pa
     publish_normalized_density_kernel<<<blocks, threads, 0, stream>>>(fluid, a, n);
     check_launch("publish_normalized_density_kernel");
   }
+  if (options.density_diffusion && first_of_substep)  // once per substep, for its whole dt
+    enqueue_density_diffusion(fluid, grid, a, n, tuning, state, stream);
   if (options.surface_tension) enqueue_colour_normals(fluid, grid, a, n, tuning, stream);
+}
+
+void enqueue_density_diffusion(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                               uint32_t n, const KernelTuning& tuning, FrameState* state,
+                               cudaStream_t stream) {
+  const unsigned threads = tuning.density_block, blocks = blocks_for(n, threads);
+  density_diffusion_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n, state);
+  check_launch("density_diffusion_kernel");
+  publish_normalized_density_kernel<<<blocks, threads, 0, stream>>>(fluid, a, n);
+  check_launch("publish_normalized_density_kernel");
 }
 
 void enqueue_colour_normals(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,

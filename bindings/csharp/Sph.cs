@@ -234,6 +234,9 @@ namespace Sph
         /// <summary>Loads on colliders: the fluid's force and torque on each collider over every
         /// step (<see cref="Collider.Loads"/>; docs/physics.md).</summary>
         ColliderLoads = Constants.SPH_FEATURE_COLLIDER_LOADS,
+        /// <summary>Density diffusion (delta-SPH with the Fourtakas correction) on the carried
+        /// density; needs <see cref="NormalizedDensity"/> (docs/physics.md).</summary>
+        DensityDiffusion = Constants.SPH_FEATURE_DENSITY_DIFFUSION,
     }
 
     /// <summary>Step-size limits beyond eq. 32 (SPH_STEP_LIMIT_*): set them with
