@@ -38,9 +38,13 @@ __global__ void reorder_kernel(ParticleArrays a, const uint32_t* __restrict__ or
   }
 }
 
+// With kNormalized the side array receives the kernel sum (for the filter's factor) or, with
+// factor_to_side (the density diffusion, which has no filter), the resolved factor itself, so
+// that a later kernel writes the factors in the new order without a division's rounding.
 template <bool kCounts, bool kNormalized, bool kBoundary>
 __global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
-                               DeviceScene scene, float stage_fraction, FrameState* state) {
+                               DeviceScene scene, float stage_fraction, bool factor_to_side,
+                               FrameState* state) {
   mark_stage(state, kStageDensity);
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
@@ -62,7 +66,7 @@ __global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArra
     // kernel sum goes to the side array for the factor after the filter.
     float factor = a.density_factor[k];
     rho = carried_density(fluid, s.density, factor);
-    a.normalized_density[i] = s.density;
+    a.normalized_density[i] = factor_to_side ? factor : s.density;
   }
   a.density[i] = rho;
   if (kCounts) a.neighbor_count[i] = s.neighbor_count;
@@ -100,9 +104,18 @@ __global__ void density_diffusion_kernel(FluidConstants fluid, GridView grid, Pa
   if (i >= n) return;
   const float rate = gather_density_diffusion(fluid, fluid.methods.density_diffusion, grid, a.sorted_position,
                                               a.sorted_velocity, i);
-  const DiffusedDensity d = diffused_density(a.density[i], a.density_factor[i], rate, state->clock.dt_float);
+  // The side array holds this particle's resolved factor (density_kernel's factor_to_side).
+  const DiffusedDensity d =
+      diffused_density(a.density[i], a.normalized_density[i], rate, state->clock.dt_float);
   a.density_factor[i] = d.factor;
   a.normalized_density[i] = d.density;
+}
+
+// Without diffusion in this pass: the resolved factors, from the side array, in the new order.
+__global__ void carry_density_factor_kernel(ParticleArrays a, uint32_t n) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  a.density_factor[i] = a.normalized_density[i];
 }
 
 __global__ void colour_normal_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n) {
@@ -202,13 +215,13 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
 template <bool kCounts, bool kNormalized>
 void launch_density(bool boundary, unsigned blocks, unsigned threads, const FluidConstants& fluid,
                     const GridView& grid, const ParticleArrays& a, uint32_t n, const DeviceScene& scene,
-                    float stage_fraction, FrameState* state, cudaStream_t stream) {
+                    float stage_fraction, bool factor_to_side, FrameState* state, cudaStream_t stream) {
   if (boundary)
     density_kernel<kCounts, kNormalized, true>
-        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, stage_fraction, state);
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, stage_fraction, factor_to_side, state);
   else
     density_kernel<kCounts, kNormalized, false>
-        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, stage_fraction, state);
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, stage_fraction, factor_to_side, state);
 }
 
 }  // namespace
@@ -238,26 +251,32 @@ void enqueue_density(const FluidConstants& fluid, const GridView& grid, const Pa
   const bool counts = options.viscosity == ViscosityMethod::Clavet;
   const bool boundary = options.boundary_density;
   if (counts && options.normalized_density)
-    launch_density<true, true>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction, state,
-                               stream);
+    launch_density<true, true>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction,
+                               options.density_diffusion, state, stream);
   else if (counts)
-    launch_density<true, false>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction, state,
-                                stream);
+    launch_density<true, false>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction,
+                                options.density_diffusion, state, stream);
   else if (options.normalized_density)
-    launch_density<false, true>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction, state,
-                                stream);
+    launch_density<false, true>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction,
+                                options.density_diffusion, state, stream);
   else
-    launch_density<false, false>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction, state,
-                                 stream);
+    launch_density<false, false>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction,
+                                 options.density_diffusion, state, stream);
   check_launch("density_kernel");
-  if (options.normalized_density) {
+  if (options.density_diffusion) {
+    // The diffusion keeps the carried density instead of the filter (density_diffusion.h).
+    if (first_of_substep) {  // once per substep, for its whole dt
+      enqueue_density_diffusion(fluid, grid, a, n, tuning, state, stream);
+    } else {
+      carry_density_factor_kernel<<<blocks, threads, 0, stream>>>(a, n);
+      check_launch("carry_density_factor_kernel");
+    }
+  } else if (options.normalized_density) {
     normalized_density_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n);
     check_launch("normalized_density_kernel");
     publish_normalized_density_kernel<<<blocks, threads, 0, stream>>>(fluid, a, n);
     check_launch("publish_normalized_density_kernel");
   }
-  if (options.density_diffusion && first_of_substep)  // once per substep, for its whole dt
-    enqueue_density_diffusion(fluid, grid, a, n, tuning, state, stream);
   if (options.surface_tension) enqueue_colour_normals(fluid, grid, a, n, tuning, stream);
 }
 

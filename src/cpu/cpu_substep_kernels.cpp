@@ -76,7 +76,9 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
       columns_.set_neighbor_count(static_cast<uint32_t>(i), s.neighbor_count);
     }
   }
-  if (factor) {
+  // The Shepard filter, unless the density diffusion keeps the carried density instead
+  // (density_diffusion.h says why one or the other).
+  if (factor && !(config_.features & kFeatureDensityDiffusion)) {
     // Eq. 31 over every carried rho_j: each particle writes only its own factor and side
     // slot (the first pass is done reading the factors), then the filtered values are published.
 #pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
