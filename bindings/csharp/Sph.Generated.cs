@@ -70,12 +70,15 @@ namespace Sph
         public const uint SPH_FEATURE_COLLIDER_LOADS = 16u;
         /// <summary>
         /// Density diffusion (delta-SPH, Molteni &amp; Colagrossi 2009, with the dynamic-density
-        /// correction of Fourtakas et al. 2019): a diffusive term in the carried density's rate that
-        /// damps the weakly compressible solver's density and pressure noise without pulling a tank's
-        /// hydrostatic stratification towards uniform; sph_density_diffusion_params. Needs
-        /// SPH_FEATURE_NORMALIZED_DENSITY (its carried density is the one integrated in time; the plain
-        /// summation has no history to diffuse) and SPH_SOLVER_WCSPH (SPH_ERROR_UNSUPPORTED at creation
-        /// otherwise). Costs one gather per substep (docs/physics.md).
+        /// correction of Fourtakas et al. 2019): a diffusive, conservative term in the carried
+        /// density's rate that damps the weakly compressible solver's density and pressure noise
+        /// without pulling a tank's hydrostatic stratification towards uniform;
+        /// sph_density_diffusion_params. Needs SPH_FEATURE_NORMALIZED_DENSITY (its carried density is
+        /// the one integrated in time; the plain summation has no history to diffuse) and
+        /// SPH_SOLVER_WCSPH (SPH_ERROR_UNSUPPORTED at creation otherwise); it replaces that feature's
+        /// Shepard filter (eq. 31 is not applied). A settled tank's pressure noise within a layer: 65
+        /// Pa summed, 12 Pa with the diffusion, 10 Pa with the filter alone. Costs one gather per
+        /// substep instead of one per density pass (docs/physics.md).
         /// </summary>
         public const uint SPH_FEATURE_DENSITY_DIFFUSION = 32u;
         /// <summary>

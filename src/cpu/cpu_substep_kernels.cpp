@@ -110,15 +110,15 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
 void CpuBackend::diffuse_density(const FluidConstants& fluid, float dt) {
   if (!(config_.features & kFeatureDensityDiffusion)) return;
   const GridView view = grid_.view();
+  const NeighborColumns columns = columns_.view();
   Float4* pos = position_.data();
   Float4* vel = velocity_.data();
   float* factor = density_factor_.data();
-  const DensityDiffusion::Constants& c = fluid.methods.density_diffusion;
   // The gather reads every published rho_j; each particle writes only its own factor and side
   // slot (free once the filtered densities are published), then the diffused values are published.
 #pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
   for (int i = 0; i < n(); ++i) {
-    const float rate = gather_density_diffusion(fluid, c, view, pos, vel, static_cast<uint32_t>(i));
+    const float rate = simd_.density_diffusion(fluid, view, columns, static_cast<uint32_t>(i));
     const DiffusedDensity d = diffused_density(density_[i], factor[i], rate, dt);
     factor[i] = d.factor;
     normalized_[i] = d.density;

@@ -16,6 +16,8 @@
 //    (K the largest neighbour count; Higham's recursive-summation bound, one extra for the
 //    products) on a random density field with gravity on.
 // 4. Sign: a single particle denser than its uniform neighbours loses density, they gain.
+// 5. The CPU backend's SIMD gather (every target this processor runs) against the scalar one:
+//    the same terms in another order, within 2 (K + 1) u sum_j |t_ij| (as test_simd_passes).
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -30,7 +32,9 @@ extern "C" {
 #include <vector>
 
 #include "core/config.h"
+#include "cpu/cpu_neighbor_columns.h"
 #include "cpu/cpu_neighbor_grid.h"
+#include "cpu/cpu_simd_passes.h"
 #include "physics/density_diffusion.h"
 
 namespace {
@@ -185,6 +189,29 @@ void test_volume_weighted_sum_is_zero(void**) {
   assert_true(std::fabs(sum) <= bound);
 }
 
+void test_simd_gather_matches_the_scalar_one(void**) {
+  Cloud c(5);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> density(950.0f, 1050.0f);
+  c.set_density([&](uint32_t, Vec3) { return density(rng); });
+  const sph::FluidConstants f = c.fluid(Vec3{0.0f, -9.81f, 0.0f});
+  sph::CpuNeighborColumns columns{false, false};
+  columns.fill_state(c.positions.data(), c.velocities.data(), c.n, 1);
+  for (uint32_t i = 0; i < c.n; ++i) columns.set_density(i, 0.0f, c.velocities[i].w);
+  uint32_t targets = 0;
+  for (sph::SimdTarget t : {sph::SimdTarget::Generic, sph::SimdTarget::Avx2, sph::SimdTarget::Avx512}) {
+    const sph::SimdPasses* passes = sph::simd_passes_built(t);
+    if (!passes || !sph::simd_target_runs(t)) continue;
+    ++targets;
+    for (uint32_t i = 0; i < c.n; ++i) {
+      const Cloud::Brute b = c.brute(f, i);
+      const float lanes = passes->density_diffusion(f, c.grid.view(), columns.view(), i);
+      assert_true(std::fabs(lanes - c.gather(f, i)) <= 2.0 * (b.neighbors + 1) * kUnitRoundoff * b.abs_terms);
+    }
+  }
+  assert_true(targets >= 1);
+}
+
 void test_a_dense_particle_spreads_its_excess(void**) {
   Cloud c(4);
   const uint32_t centre = c.n / 2;
@@ -212,6 +239,7 @@ int main() {
       cmocka_unit_test(test_hydrostatic_profile_is_left_alone),
       cmocka_unit_test(test_volume_weighted_sum_is_zero),
       cmocka_unit_test(test_a_dense_particle_spreads_its_excess),
+      cmocka_unit_test(test_simd_gather_matches_the_scalar_one),
   };
   return cmocka_run_group_tests_name("density_diffusion", tests, nullptr, nullptr);
 }
