@@ -4,7 +4,8 @@
  * 1. The switch and its parameters: the feature needs the normalised density and the weakly
  *    compressible solver (SPH_ERROR_UNSUPPORTED naming def->features otherwise); delta has its
  *    default 0.1, 0 takes the default, a value outside (0, 1] or not finite is refused naming
- *    the field and changes nothing; a world without the feature refuses the struct.
+ *    the field and changes nothing; a world without the feature refuses the struct; a
+ *    checkpoint keeps the feature and delta.
  * 2. A settled tank's pressure noise: the same tank (the normalised density, collision walls,
  *    ideal-gas law at the default k = 100, i.e. c0 = 10 m/s) with and without the diffusion.
  *    In the averaging window (the second half of the run) every interior particle's residual
@@ -65,7 +66,27 @@ static void test_switch_and_params(void** state) {
   EXPECT_OK(sph_density_diffusion_params_init(&p));
   EXPECT_OK(sph_world_get_density_diffusion_params(world, &p));
   assert_true(p.delta == 0.25f); /* the refused calls changed nothing */
-  p.delta = 0.0f;                /* 0 = the default */
+  {
+    /* A checkpoint keeps delta (its own parameter block) and the feature. */
+    uint64_t size = 0;
+    void* buffer = NULL;
+    sph_world* loaded = NULL;
+    sph_world_def loaded_def;
+    EXPECT_OK(sph_world_save(world, NULL, 0, &size));
+    buffer = malloc((size_t)size);
+    assert_non_null(buffer);
+    EXPECT_OK(sph_world_save(world, buffer, size, &size));
+    EXPECT_OK(sph_world_load(context, buffer, size, &loaded));
+    free(buffer);
+    sph_world_def_init(&loaded_def);
+    EXPECT_OK(sph_world_get_def(loaded, &loaded_def));
+    assert_true(loaded_def.features & SPH_FEATURE_DENSITY_DIFFUSION);
+    EXPECT_OK(sph_density_diffusion_params_init(&p));
+    EXPECT_OK(sph_world_get_density_diffusion_params(loaded, &p));
+    assert_true(p.delta == 0.25f);
+    EXPECT_OK(sph_world_destroy(loaded));
+  }
+  p.delta = 0.0f; /* 0 = the default */
   EXPECT_OK(sph_world_set_density_diffusion_params(world, &p));
   EXPECT_OK(sph_world_get_density_diffusion_params(world, &p));
   assert_true(p.delta == 0.1f);
