@@ -205,7 +205,7 @@ typedef uint32_t sph_feature_flags;
  *  settled tank's pressure noise within a layer: 65 Pa summed, 12 Pa with the diffusion, 10 Pa
  *  with the filter alone. Costs one gather per substep instead of one per density pass
  *  (docs/physics.md). */
-#define SPH_FEATURE_DENSITY_DIFFUSION 0x20u
+#define SPH_FEATURE_DENSITY_DIFFUSION 0x40u
 
 typedef enum sph_viscosity_method {
   SPH_VISCOSITY_MUELLER = 0, /* Laplacian viscosity (eq. 17), coefficient sph_world_params.viscosity */

@@ -80,7 +80,7 @@ namespace Sph
         /// Pa summed, 12 Pa with the diffusion, 10 Pa with the filter alone. Costs one gather per
         /// substep instead of one per density pass (docs/physics.md).
         /// </summary>
-        public const uint SPH_FEATURE_DENSITY_DIFFUSION = 32u;
+        public const uint SPH_FEATURE_DENSITY_DIFFUSION = 64u;
         /// <summary>
         /// Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt &lt;= step_factor h /
         /// c, c the EOS's speed of sound \ (weakly compressible worlds only)

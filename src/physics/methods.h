@@ -35,7 +35,7 @@ enum FeatureBits : uint32_t {
   kFeatureSprings = 1u << 2,
   kFeatureBoundaryDensity = 1u << 3,
   kFeatureColliderLoads = 1u << 4,
-  kFeatureDensityDiffusion = 1u << 5,
+  kFeatureDensityDiffusion = 1u << 6,  // (1u << 5 is main's SPH_FEATURE_USER_ATTRIBUTE)
   kFeatureAll = kFeatureSurfaceTension | kFeatureNormalizedDensity | kFeatureSprings |
                 kFeatureBoundaryDensity | kFeatureColliderLoads | kFeatureDensityDiffusion,
 };

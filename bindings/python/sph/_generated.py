@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '283491b073586c665df74c426971875574bd25bf89f9d69d9a0ecb04a52bd61f', 'include/sph_cuda.h': '8fe2c1988d9c8456a91fb26b7863765759ab8ad17bd1ff44b457c77af0bc7985', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': 'ac6acd187f98124d537583f2ec37b92911bcc9cd43273e23979b8cd71b998338', 'include/sph_cuda.h': '8fe2c1988d9c8456a91fb26b7863765759ab8ad17bd1ff44b457c77af0bc7985', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -72,7 +72,7 @@ SPH_FEATURE_COLLIDER_LOADS = 16
 #: otherwise); it replaces that feature's Shepard filter (eq. 31 is not applied). A settled tank's
 #: pressure noise within a layer: 65 Pa summed, 12 Pa with the diffusion, 10 Pa with the filter
 #: alone. Costs one gather per substep instead of one per density pass (docs/physics.md).
-SPH_FEATURE_DENSITY_DIFFUSION = 32
+SPH_FEATURE_DENSITY_DIFFUSION = 64
 #: Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt <= step_factor h / c, c the
 #: EOS's speed of sound \ (weakly compressible worlds only)
 SPH_STEP_LIMIT_ACOUSTIC = 1
