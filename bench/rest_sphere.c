@@ -15,7 +15,8 @@
  * larger host can measure two workers (issue 18's CPU goal); pin them with taskset to two cores.
  *
  * --option turns one optional piece of physics on, to measure what it costs (BENCHMARK.md,
- * issue 5): none (default), surface_tension, normalized_density, clavet (viscosity), tait
+ * issue 5): none (default), surface_tension, normalized_density, density_diffusion (with the
+ * normalised density it needs: compare with normalized_density), clavet (viscosity), tait
  * (equation of state), rk4 (integrator), acoustic_limit (step limit), springs (elasticity with
  * the default sph_spring_params, whose step ceiling, 1.25 ms, is above dt_max: the same
  * substeps, so the cost is the spring work; the springs are made in the first warm-up
@@ -120,6 +121,9 @@ static void describe_world(const options* o, uint32_t capacity, sph_world_def* d
     def->features |= SPH_FEATURE_SURFACE_TENSION;
   } else if (strcmp(o->option, "normalized_density") == 0) {
     def->features |= SPH_FEATURE_NORMALIZED_DENSITY;
+  } else if (strcmp(o->option, "density_diffusion") == 0) {
+    /* The diffusion needs the normalised density: compare with --option normalized_density. */
+    def->features |= SPH_FEATURE_NORMALIZED_DENSITY | SPH_FEATURE_DENSITY_DIFFUSION;
   } else if (strcmp(o->option, "clavet") == 0) {
     def->viscosity_method = SPH_VISCOSITY_CLAVET;
   } else if (strcmp(o->option, "tait") == 0) {
@@ -336,7 +340,8 @@ static void append_csv(const char* path, const result* rs, int n, const options*
 static void usage(void) {
   fprintf(stderr,
           "usage: rest_sphere [--particles N|largest] [--frames F] [--warmup W] [--backend cpu|cuda|auto]\n"
-          "                   [--case rest|moving|both] [--option none|surface_tension|normalized_density|\n"
+          "                   [--case rest|moving|both] [--option "
+          "none|surface_tension|normalized_density|density_diffusion|\n"
           "                   clavet|tait|rk4|acoustic_limit|springs] [--json FILE] [--csv FILE]\n"
           "                   [--label TEXT] [--cuda-frames graph|stream] [--density-block N]\n"
           "                   [--force-block N] [--threads N]\n");

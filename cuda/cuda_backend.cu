@@ -23,6 +23,7 @@ CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBacken
   options_.methods = config.selection();
   options_.surface_tension = (config.features & kFeatureSurfaceTension) != 0;
   options_.normalized_density = (config.features & kFeatureNormalizedDensity) != 0;
+  options_.density_diffusion = (config.features & kFeatureDensityDiffusion) != 0;
   options_.viscosity = config.viscosity_method;
   options_.springs = (config.features & kFeatureSprings) != 0;
   options_.dfsph = config.solver == Solver::Dfsph;

@@ -18,6 +18,7 @@ bool same_setup(const PipelineSetup& a, const PipelineSetup& b) {
          a.tuning.density_block == b.tuning.density_block && a.tuning.force_block == b.tuning.force_block &&
          a.options.surface_tension == b.options.surface_tension &&
          a.options.normalized_density == b.options.normalized_density &&
+         a.options.density_diffusion == b.options.density_diffusion &&
          a.options.viscosity == b.options.viscosity && a.options.springs == b.options.springs &&
          a.options.dfsph == b.options.dfsph && a.options.boundary_density == b.options.boundary_density &&
          std::memcmp(&a.options.methods, &b.options.methods, sizeof a.options.methods) == 0 &&

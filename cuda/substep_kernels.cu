@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "../src/physics/boundary_density.h"
 #include "../src/physics/density.h"
+#include "../src/physics/density_diffusion.h"
 #include "../src/physics/density_normalization.h"
 #include "../src/physics/forces.h"
 #include "../src/physics/integrate.h"
@@ -45,9 +46,13 @@ __global__ void user_attribute_copy_kernel(const uint32_t* __restrict__ sorted, 
   if (i < n) state[i] = sorted[i];
 }
 
+// With kNormalized the side array receives the kernel sum (for the filter's factor) or, with
+// factor_to_side (the density diffusion, which has no filter), the resolved factor itself, so
+// that a later kernel writes the factors in the new order without a division's rounding.
 template <bool kCounts, bool kNormalized, bool kBoundary>
 __global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
-                               DeviceScene scene, float stage_fraction, FrameState* state) {
+                               DeviceScene scene, float stage_fraction, bool factor_to_side,
+                               FrameState* state) {
   mark_stage(state, kStageDensity);
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
@@ -69,7 +74,7 @@ __global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArra
     // kernel sum goes to the side array for the factor after the filter.
     float factor = a.density_factor[k];
     rho = carried_density(fluid, s.density, factor);
-    a.normalized_density[i] = s.density;
+    a.normalized_density[i] = factor_to_side ? factor : s.density;
   }
   a.density[i] = rho;
   if (kCounts) a.neighbor_count[i] = s.neighbor_count;
@@ -96,6 +101,29 @@ __global__ void publish_normalized_density_kernel(FluidConstants fluid, Particle
   a.density[i] = rho;
   a.sorted_position[i].w = pressure_from_density(fluid.methods.eos, rho);
   a.sorted_velocity[i].w = 1.0f / rho;
+}
+
+// The delta-SPH rate over every published rho_j: the diffused density goes to the side array
+// (free once the filtered densities are published) and the factor that carries it is written;
+// publish_normalized_density_kernel then publishes them.
+__global__ void density_diffusion_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
+                                         const FrameState* state) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const float rate = gather_density_diffusion(fluid, fluid.methods.density_diffusion, grid, a.sorted_position,
+                                              a.sorted_velocity, i);
+  // The side array holds this particle's resolved factor (density_kernel's factor_to_side).
+  const DiffusedDensity d =
+      diffused_density(a.density[i], a.normalized_density[i], rate, state->clock.dt_float);
+  a.density_factor[i] = d.factor;
+  a.normalized_density[i] = d.density;
+}
+
+// Without diffusion in this pass: the resolved factors, from the side array, in the new order.
+__global__ void carry_density_factor_kernel(ParticleArrays a, uint32_t n) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  a.density_factor[i] = a.normalized_density[i];
 }
 
 __global__ void colour_normal_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n) {
@@ -195,13 +223,13 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
 template <bool kCounts, bool kNormalized>
 void launch_density(bool boundary, unsigned blocks, unsigned threads, const FluidConstants& fluid,
                     const GridView& grid, const ParticleArrays& a, uint32_t n, const DeviceScene& scene,
-                    float stage_fraction, FrameState* state, cudaStream_t stream) {
+                    float stage_fraction, bool factor_to_side, FrameState* state, cudaStream_t stream) {
   if (boundary)
     density_kernel<kCounts, kNormalized, true>
-        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, stage_fraction, state);
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, stage_fraction, factor_to_side, state);
   else
     density_kernel<kCounts, kNormalized, false>
-        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, stage_fraction, state);
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, stage_fraction, factor_to_side, state);
 }
 
 }  // namespace
@@ -233,30 +261,48 @@ void enqueue_reorder(const ParticleArrays& a, const uint32_t* order, uint32_t n,
 
 void enqueue_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a, uint32_t n,
                      const SubstepOptions& options, const KernelTuning& tuning, const DeviceScene& scene,
-                     float stage_fraction, FrameState* state, cudaStream_t stream) {
+                     float stage_fraction, bool first_of_substep, FrameState* state, cudaStream_t stream) {
   const unsigned threads = tuning.density_block, blocks = blocks_for(n, threads);
   const bool counts = options.viscosity == ViscosityMethod::Clavet;
   const bool boundary = options.boundary_density;
   if (counts && options.normalized_density)
-    launch_density<true, true>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction, state,
-                               stream);
+    launch_density<true, true>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction,
+                               options.density_diffusion, state, stream);
   else if (counts)
-    launch_density<true, false>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction, state,
-                                stream);
+    launch_density<true, false>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction,
+                                options.density_diffusion, state, stream);
   else if (options.normalized_density)
-    launch_density<false, true>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction, state,
-                                stream);
+    launch_density<false, true>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction,
+                                options.density_diffusion, state, stream);
   else
-    launch_density<false, false>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction, state,
-                                 stream);
+    launch_density<false, false>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction,
+                                 options.density_diffusion, state, stream);
   check_launch("density_kernel");
-  if (options.normalized_density) {
+  if (options.density_diffusion) {
+    // The diffusion keeps the carried density instead of the filter (density_diffusion.h).
+    if (first_of_substep) {  // once per substep, for its whole dt
+      enqueue_density_diffusion(fluid, grid, a, n, tuning, state, stream);
+    } else {
+      carry_density_factor_kernel<<<blocks, threads, 0, stream>>>(a, n);
+      check_launch("carry_density_factor_kernel");
+    }
+  } else if (options.normalized_density) {
     normalized_density_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n);
     check_launch("normalized_density_kernel");
     publish_normalized_density_kernel<<<blocks, threads, 0, stream>>>(fluid, a, n);
     check_launch("publish_normalized_density_kernel");
   }
   if (options.surface_tension) enqueue_colour_normals(fluid, grid, a, n, tuning, stream);
+}
+
+void enqueue_density_diffusion(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                               uint32_t n, const KernelTuning& tuning, FrameState* state,
+                               cudaStream_t stream) {
+  const unsigned threads = tuning.density_block, blocks = blocks_for(n, threads);
+  density_diffusion_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n, state);
+  check_launch("density_diffusion_kernel");
+  publish_normalized_density_kernel<<<blocks, threads, 0, stream>>>(fluid, a, n);
+  check_launch("publish_normalized_density_kernel");
 }
 
 void enqueue_colour_normals(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,

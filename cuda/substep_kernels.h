@@ -50,6 +50,7 @@ struct SubstepOptions {
   MethodSelection methods{};  // every method the world runs; the force pass dispatches on it
   bool surface_tension = false;
   bool normalized_density = false;
+  bool density_diffusion = false;  // with normalized_density: delta-SPH on the carried density
   ViscosityMethod viscosity = ViscosityMethod::Mueller;
   bool springs = false;  // a.spring_acceleration adds to the force pass
   bool dfsph = false;    // the DFSPH solver (dfsph_solver.h) instead of the weakly compressible passes
@@ -61,9 +62,18 @@ struct SubstepOptions {
 // same three places) and the colour-field normals, in the CPU backend's order. With
 // options.boundary_density the scene's colliders add their share (posed at the substep's time
 // at `stage_fraction` of it, boundary_density.h's stage_time) and a.boundary_gradient is written.
+// With options.density_diffusion and first_of_substep the density diffusion follows the
+// normalised density (enqueue_density_diffusion), before the colour-field normals.
 void enqueue_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a, uint32_t n,
                      const SubstepOptions& options, const KernelTuning& tuning, const DeviceScene& scene,
-                     float stage_fraction, FrameState* state, cudaStream_t stream);
+                     float stage_fraction, bool first_of_substep, FrameState* state, cudaStream_t stream);
+
+// SPH_FEATURE_DENSITY_DIFFUSION (density_diffusion.h): the delta-SPH term over the published
+// densities, applied for the substep's dt (read from the state) through the carried factors and
+// republished into the same three places. Once per substep, after its first density pass.
+void enqueue_density_diffusion(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                               uint32_t n, const KernelTuning& tuning, FrameState* state,
+                               cudaStream_t stream);
 
 // colour_normal[i] for surface tension, after the density pass (enqueue_density calls it).
 void enqueue_colour_normals(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,

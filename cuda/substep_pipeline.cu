@@ -41,7 +41,7 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
     enqueue_reorder(a, b.grid->order(), n, carry, stage & 1, b.state, stream);
     if (setup.options.springs) enqueue_spring_reorder(a, b.grid->order(), n, stream);
     enqueue_density(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene,
-                    rk4 ? rk4_stage_fraction(stage) : 0.0f, b.state, stream);
+                    rk4 ? rk4_stage_fraction(stage) : 0.0f, stage == 0, b.state, stream);
     // Probes sample the substep's start (RK4: its first stage), as on the CPU.
     if (stage == 0 && setup.probes.on())
       enqueue_probe_samples(setup.probes, b.grid->view(), a, b.state, stream);

@@ -20,6 +20,7 @@
 #define SPH_FEATURE_BOUNDARY_DENSITY 8
 #define SPH_FEATURE_COLLIDER_LOADS 16
 #define SPH_FEATURE_USER_ATTRIBUTE 32
+#define SPH_FEATURE_DENSITY_DIFFUSION 64
 #define SPH_STEP_LIMIT_ACOUSTIC 1
 #define SPH_STEP_LIMIT_FORCE 2
 #define SPH_DFSPH_SKIP_DIVERGENCE_SOLVE 1
@@ -122,7 +123,8 @@ typedef enum {
   SPH_PARAMS_TAIT = 3,
   SPH_PARAMS_SPRINGS = 4,
   SPH_PARAMS_DFSPH = 5,
-  SPH_PARAMS_KIND_COUNT = 6,
+  SPH_PARAMS_DENSITY_DIFFUSION = 6,
+  SPH_PARAMS_KIND_COUNT = 7,
   SPH_PARAMS_KIND_FORCE32 = 2147483647,
 } sph_params_kind;
 typedef enum {
@@ -277,6 +279,10 @@ typedef struct sph_spring_params {
   float damping;
   uint32_t reserved0;
 } sph_spring_params;
+typedef struct sph_density_diffusion_params {
+  uint32_t struct_size;
+  float delta;
+} sph_density_diffusion_params;
 typedef struct sph_dfsph_params {
   uint32_t struct_size;
   float density_error;
@@ -558,6 +564,9 @@ sph_result sph_world_get_tait_params(const sph_world* world, sph_tait_params* ou
 sph_result sph_spring_params_init_sized(sph_spring_params* params, uint32_t size);
 sph_result sph_world_set_spring_params(sph_world* world, const sph_spring_params* params);
 sph_result sph_world_get_spring_params(const sph_world* world, sph_spring_params* out);
+sph_result sph_density_diffusion_params_init_sized(sph_density_diffusion_params* params, uint32_t size);
+sph_result sph_world_set_density_diffusion_params(sph_world* world, const sph_density_diffusion_params* params);
+sph_result sph_world_get_density_diffusion_params(const sph_world* world, sph_density_diffusion_params* out);
 sph_result sph_dfsph_params_init_sized(sph_dfsph_params* params, uint32_t size);
 sph_result sph_world_set_dfsph_params(sph_world* world, const sph_dfsph_params* params);
 sph_result sph_world_get_dfsph_params(const sph_world* world, sph_dfsph_params* out);

@@ -78,6 +78,19 @@ namespace Sph
         /// </summary>
         public const uint SPH_FEATURE_USER_ATTRIBUTE = 32u;
         /// <summary>
+        /// Density diffusion (delta-SPH, Molteni &amp; Colagrossi 2009, with the dynamic-density
+        /// correction of Fourtakas et al. 2019): a diffusive, conservative term in the carried
+        /// density's rate that damps the weakly compressible solver's density and pressure noise
+        /// without pulling a tank's hydrostatic stratification towards uniform;
+        /// sph_density_diffusion_params. Needs SPH_FEATURE_NORMALIZED_DENSITY (its carried density is
+        /// the one integrated in time; the plain summation has no history to diffuse) and
+        /// SPH_SOLVER_WCSPH (SPH_ERROR_UNSUPPORTED at creation otherwise); it replaces that feature's
+        /// Shepard filter (eq. 31 is not applied). A settled tank's pressure noise within a layer: 65
+        /// Pa summed, 12 Pa with the diffusion, 10 Pa with the filter alone. Costs one gather per
+        /// substep instead of one per density pass (docs/physics.md).
+        /// </summary>
+        public const uint SPH_FEATURE_DENSITY_DIFFUSION = 64u;
+        /// <summary>
         /// Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt &lt;= step_factor h /
         /// c, c the EOS's speed of sound \ (weakly compressible worlds only)
         /// </summary>
@@ -104,7 +117,7 @@ namespace Sph
         public const int SPH_VISCOSITY_METHOD_FORCE32 = 2147483647;
         public const int SPH_EOS_FORCE32 = 2147483647;
         public const int SPH_SOLVER_FORCE32 = 2147483647;
-        public const int SPH_PARAMS_KIND_COUNT = 6;
+        public const int SPH_PARAMS_KIND_COUNT = 7;
         public const int SPH_PARAMS_KIND_FORCE32 = 2147483647;
         public const int SPH_PARAM_TYPE_FORCE32 = 2147483647;
         public const int SPH_BOUND_FORCE32 = 2147483647;
@@ -300,6 +313,8 @@ namespace Sph
         Springs = 4,
         /// <summary>sph_dfsph_params</summary>
         Dfsph = 5,
+        /// <summary>sph_density_diffusion_params</summary>
+        DensityDiffusion = 6,
     }
 
     /// <summary>sph_param_type</summary>
@@ -960,6 +975,28 @@ namespace Sph
             var value = new SpringParams();
             uint size = (uint)Marshal.SizeOf(typeof(SpringParams));
             SphException.Check(Native.sph_spring_params_init_sized(ref value, size), "sph_spring_params_init_sized");
+            return value;
+        }
+    }
+
+    /// <summary>sph_density_diffusion_params (8 bytes)</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public partial struct DensityDiffusionParams
+    {
+        /// <summary>uint32_t struct_size: set by sph_density_diffusion_params_init</summary>
+        public uint StructSize;
+        /// <summary>
+        /// float delta: delta of the delta-SPH term D_i = delta h c0 sum_j psi_ij . grad W_ij V_j (c0
+        /// the equation of state's speed of sound); dimensionless; default 0.1; in (0, 1]; 0 = default
+        /// </summary>
+        public float Delta;
+
+        /// <summary>A DensityDiffusionParams with the library's defaults (sph_density_diffusion_params_init_sized).</summary>
+        public static DensityDiffusionParams Default()
+        {
+            var value = new DensityDiffusionParams();
+            uint size = (uint)Marshal.SizeOf(typeof(DensityDiffusionParams));
+            SphException.Check(Native.sph_density_diffusion_params_init_sized(ref value, size), "sph_density_diffusion_params_init_sized");
             return value;
         }
     }
@@ -2223,6 +2260,28 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_spring_params")]
         public static extern Result sph_world_get_spring_params(IntPtr world, IntPtr @out);
 
+        /// <summary>sph_density_diffusion_params_init_sized</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_density_diffusion_params_init_sized(ref DensityDiffusionParams @params, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_density_diffusion_params_init_sized")]
+        public static extern Result sph_density_diffusion_params_init_sized(IntPtr @params, uint size);
+
+        /// <summary>
+        /// FEATURE_DISABLED unless the world has SPH_FEATURE_DENSITY_DIFFUSION. INVALID_ARGUMENT for a
+        /// value out of range (the message names it); nothing changes on error. Acts from the next
+        /// substep.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_set_density_diffusion_params(WorldHandle world, ref DensityDiffusionParams @params);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_set_density_diffusion_params")]
+        public static extern Result sph_world_set_density_diffusion_params(IntPtr world, IntPtr @params);
+
+        /// <summary>sph_world_get_density_diffusion_params</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_get_density_diffusion_params(WorldHandle world, ref DensityDiffusionParams @out);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_get_density_diffusion_params")]
+        public static extern Result sph_world_get_density_diffusion_params(IntPtr world, IntPtr @out);
+
         /// <summary>sph_dfsph_params_init_sized</summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_dfsph_params_init_sized(ref DfsphParams @params, uint size);
@@ -3022,6 +3081,7 @@ namespace Sph
             typeof(ClavetViscosityParams),
             typeof(TaitParams),
             typeof(SpringParams),
+            typeof(DensityDiffusionParams),
             typeof(DfsphParams),
             typeof(ParamsInfo),
             typeof(ParamFieldInfo),
@@ -3061,6 +3121,7 @@ namespace Sph
             "sph_clavet_viscosity_params",
             "sph_tait_params",
             "sph_spring_params",
+            "sph_density_diffusion_params",
             "sph_dfsph_params",
             "sph_params_info",
             "sph_param_field_info",
@@ -3100,6 +3161,7 @@ namespace Sph
             16,
             8,
             28,
+            8,
             24,
             32,
             72,
@@ -3186,6 +3248,8 @@ namespace Sph
             typeof(SpringParams),
             typeof(SpringParams),
             typeof(SpringParams),
+            typeof(DensityDiffusionParams),
+            typeof(DensityDiffusionParams),
             typeof(DfsphParams),
             typeof(DfsphParams),
             typeof(DfsphParams),
@@ -3432,6 +3496,8 @@ namespace Sph
             "Plasticity",
             "Damping",
             "Reserved0",
+            "StructSize",
+            "Delta",
             "StructSize",
             "DensityError",
             "DivergenceError",
@@ -3680,6 +3746,8 @@ namespace Sph
             24,
             0,
             4,
+            0,
+            4,
             8,
             12,
             16,
@@ -3903,6 +3971,9 @@ namespace Sph
             "sph_spring_params_init_sized",
             "sph_world_set_spring_params",
             "sph_world_get_spring_params",
+            "sph_density_diffusion_params_init_sized",
+            "sph_world_set_density_diffusion_params",
+            "sph_world_get_density_diffusion_params",
             "sph_dfsph_params_init_sized",
             "sph_world_set_dfsph_params",
             "sph_world_get_dfsph_params",
@@ -4106,6 +4177,9 @@ namespace Sph
             "sph",
             "sph",
             "sph",
+            "sph",
+            "sph",
+            "sph",
             "sph_vdb",
             "sph_vdb",
         };
@@ -4164,6 +4238,7 @@ namespace Sph
             { "SPH_PARAMS_TAIT", "sph_tait_params" },
             { "SPH_PARAMS_SPRINGS", "sph_spring_params" },
             { "SPH_PARAMS_DFSPH", "sph_dfsph_params" },
+            { "SPH_PARAMS_DENSITY_DIFFUSION", "sph_density_diffusion_params" },
             { "SPH_PARAM_FLOAT", "float, finite" },
             { "SPH_PARAM_VEC3", "sph_vec3, every component finite" },
             { "SPH_PARAM_UINT32", "uint32_t count" },

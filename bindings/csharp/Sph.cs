@@ -238,6 +238,9 @@ namespace Sph
         /// carried through sorts, sinks and checkpoints (<see cref="World.SetAttribute"/>,
         /// <see cref="SphAttribute.User"/>).</summary>
         UserAttribute = Constants.SPH_FEATURE_USER_ATTRIBUTE,
+        /// <summary>Density diffusion (delta-SPH with the Fourtakas correction) on the carried
+        /// density; needs <see cref="NormalizedDensity"/> (docs/physics.md).</summary>
+        DensityDiffusion = Constants.SPH_FEATURE_DENSITY_DIFFUSION,
     }
 
     /// <summary>Step-size limits beyond eq. 32 (SPH_STEP_LIMIT_*): set them with

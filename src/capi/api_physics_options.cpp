@@ -58,6 +58,9 @@ const std::vector<ParamsBinding>& params_bindings() {
            SPH_AT(sph_dfsph_params, max_iterations), SPH_AT(sph_dfsph_params, max_divergence_iterations),
            SPH_AT(sph_dfsph_params, flags)},
           {}),
+      option<DensityDiffusion, sph_density_diffusion_params>(
+          SPH_PARAMS_DENSITY_DIFFUSION, "sph_density_diffusion_params", "SPH_FEATURE_DENSITY_DIFFUSION",
+          {SPH_AT(sph_density_diffusion_params, delta)}, {}),
   };
 #undef SPH_AT
   for (const ParamsBinding& b : table)
@@ -202,6 +205,19 @@ SPH_API sph_result SPH_CALL sph_world_set_dfsph_params(sph_world* world, const s
 }
 SPH_API sph_result SPH_CALL sph_world_get_dfsph_params(const sph_world* world, sph_dfsph_params* out) {
   return get_params("sph_world_get_dfsph_params", world, SPH_PARAMS_DFSPH, out);
+}
+
+SPH_API sph_result SPH_CALL sph_density_diffusion_params_init_sized(sph_density_diffusion_params* params,
+                                                                    uint32_t size) {
+  return init_params("sph_density_diffusion_params_init", SPH_PARAMS_DENSITY_DIFFUSION, params, size);
+}
+SPH_API sph_result SPH_CALL
+sph_world_set_density_diffusion_params(sph_world* world, const sph_density_diffusion_params* params) {
+  return set_params("sph_world_set_density_diffusion_params", world, SPH_PARAMS_DENSITY_DIFFUSION, params);
+}
+SPH_API sph_result SPH_CALL sph_world_get_density_diffusion_params(const sph_world* world,
+                                                                   sph_density_diffusion_params* out) {
+  return get_params("sph_world_get_density_diffusion_params", world, SPH_PARAMS_DENSITY_DIFFUSION, out);
 }
 
 }  // extern "C"

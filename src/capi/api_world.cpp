@@ -48,6 +48,11 @@ void require_dfsph_combination(const sph_world_def& d, uint32_t integrator, uint
         "def->features: SPH_FEATURE_NORMALIZED_DENSITY with def->solver SPH_SOLVER_DFSPH; the carried "
         "density factor corrects a weakly compressible surface, while DFSPH's density solve acts only "
         "on compression, which a surface deficit never reads");
+  if (d.features & SPH_FEATURE_DENSITY_DIFFUSION)
+    throw Error(Status::Unsupported,
+                "def->features: SPH_FEATURE_DENSITY_DIFFUSION with def->solver SPH_SOLVER_DFSPH; the "
+                "diffusion acts on the weakly compressible solver's carried density, DFSPH's density "
+                "solve has none");
   if (d.features & SPH_FEATURE_COLLIDER_LOADS)
     throw Error(Status::Unsupported,
                 "def->features: SPH_FEATURE_COLLIDER_LOADS with def->solver SPH_SOLVER_DFSPH; the loads are "
@@ -92,6 +97,11 @@ sph::WorldConfig config_from_def(const sph_world_def& def) {
     throw Error(Status::Unsupported, "def->solver: " + std::to_string(static_cast<int32_t>(solver)) +
                                          " is not an sph_solver value");
   if (solver == SPH_SOLVER_DFSPH) require_dfsph_combination(d, integrator, eos);
+  if ((d.features & SPH_FEATURE_DENSITY_DIFFUSION) && !(d.features & SPH_FEATURE_NORMALIZED_DENSITY))
+    throw Error(Status::Unsupported,
+                "def->features: SPH_FEATURE_DENSITY_DIFFUSION needs SPH_FEATURE_NORMALIZED_DENSITY; the "
+                "diffusion is a term of the continuity equation and acts on the carried density, while the "
+                "plain summation is recomputed from the positions every substep");
   sph::require_positive(d.particle_spacing, "def->particle_spacing");
   sph::require_positive(d.rest_density, "def->rest_density");
   float h = d.kernel_radius;

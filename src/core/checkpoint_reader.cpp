@@ -53,6 +53,10 @@ WorldConfig read_config(ByteReader& r, uint32_t version) {
               ": the DFSPH solver with RK4, an equation of state other than the ideal gas, or "
               "the normalised density (no world can be made so)");
   }
+  if ((c.features & kFeatureDensityDiffusion) &&
+      (!(c.features & kFeatureNormalizedDensity) || c.solver == Solver::Dfsph))
+    corrupt(r.what() +
+            ": density diffusion without the normalised density, or with DFSPH (no world can be made so)");
   if (c.kernel_radius < c.particle_spacing || c.kernel_radius > 5.0f * c.particle_spacing)
     corrupt(r.what() + ": kernel radius is outside [1, 5] x the particle spacing");
   const KernelCoefficients k = make_kernel_coefficients(c.kernel_radius);

@@ -91,7 +91,7 @@ inline FluidConstants make_fluid_constants(const WorldConfig& c, const RuntimePa
   f.rest_density = c.rest_density;
   f.gravity = p.stepping.gravity;
   f.dt = 0.0f;  // set by the backend for each substep
-  f.methods = make_method_constants(p.methods, c.selection(), c.shape(), fcc_lattice_sums());
+  f.methods = make_method_constants(p.methods, c.selection(), c.shape(), fcc_lattice_sums(), f.gravity);
   return f;
 }
 

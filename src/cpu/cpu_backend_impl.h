@@ -86,8 +86,15 @@ class CpuBackend final : public Backend {
   // Hash, sort, reorder every attribute, then density and pressure (packed into the w slots).
   // With SPH_FEATURE_BOUNDARY_DENSITY the colliders' share joins the density, their poses at
   // the stage's time `at`.
+  // With SPH_FEATURE_DENSITY_DIFFUSION and diffusion_dt > 0 the diffusion (diffuse_density)
+  // follows the normalised density, before the colour-field normals.
   void sort_and_density(const FluidConstants& fluid, const SceneFrame& scene, StageTime at,
-                        FrameReport& report);
+                        FrameReport& report, float diffusion_dt = 0.0f);
+
+  // SPH_FEATURE_DENSITY_DIFFUSION (density_diffusion.h): the delta-SPH term over the published
+  // densities, applied for dt through the carried factors and republished. Once per substep,
+  // after its first density pass (sort_and_density calls it); nothing without the feature.
+  void diffuse_density(const FluidConstants& fluid, float dt);
 
   // Binds the world's boundary-density maps into the scene's collider views (computing those
   // that are new or stale) and lists the views for the density pass.

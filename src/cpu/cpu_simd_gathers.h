@@ -18,6 +18,7 @@
 #include <type_traits>
 
 #include "../physics/density.h"
+#include "../physics/density_diffusion.h"
 #include "../physics/density_normalization.h"
 #include "../physics/forces.h"
 #include "../physics/surface_tension.h"
@@ -127,6 +128,26 @@ SPH_SIMD_GATHER float normalized_density(const FluidBase& f, const GridView& gri
 }
 
 template <class L>
+SPH_SIMD_GATHER float density_diffusion(const FluidConstants& f, const GridView& grid,
+                                        const NeighborColumns& c, uint32_t i) {
+  const Vec3 xi{c.x[i], c.y[i], c.z[i]};
+  const Vec3Of<L> x = broadcast<L>(xi);
+  const L h2(f.kernel.h2), zero(0.0f), one(1.0f), rho_i(1.0f / c.inv_density[i]);
+  L rate(0.0f);
+  for_each_candidate_run<L>(grid, xi, i, true, [&](uint32_t base, const typename L::Mask& valid) {
+    const Vec3Of<L> x_ji = load3<L>(c.x, c.y, c.z, base) - x;
+    const L r2 = length_squared(x_ji);
+    const typename L::Mask neighbor = valid && r2 < h2;
+    if (!any(neighbor)) return;
+    const L inv_rho_j = L::load(c.inv_density + base);
+    const L term = density_diffusion_pair_term(f, f.methods.density_diffusion, x_ji, square_root(r2),
+                                               one / inv_rho_j - rho_i, inv_rho_j);
+    rate += select(neighbor, term, zero);
+  });
+  return reduce_sum(rate);
+}
+
+template <class L>
 SPH_SIMD_GATHER Float4 colour_normal(const FluidBase& f, const GridView& grid, const NeighborColumns& c,
                                      uint32_t i) {
   const Vec3 xi{c.x[i], c.y[i], c.z[i]};
@@ -218,8 +239,13 @@ SimdPasses::AccelerationFn acceleration_for(const MethodSelection& s) {
 
 template <class L>
 constexpr SimdPasses make_simd_passes(SimdTarget target, const char* name) {
-  return SimdPasses{
-      target, name, &density<L>, &normalized_density<L>, &colour_normal<L>, &acceleration_for<L>};
+  return SimdPasses{target,
+                    name,
+                    &density<L>,
+                    &normalized_density<L>,
+                    &density_diffusion<L>,
+                    &colour_normal<L>,
+                    &acceleration_for<L>};
 }
 
 }  // namespace simd

@@ -24,6 +24,9 @@ struct SimdPasses {
   using DensityFn = DensitySample (*)(const FluidBase&, const GridView&, const NeighborColumns&, uint32_t);
   // Eq. 31 over the carried densities (gather_normalized_density).
   using NormalizedDensityFn = float (*)(const FluidBase&, const GridView&, const NeighborColumns&, uint32_t);
+  // The density diffusion's rate D_i over the published densities (gather_density_diffusion).
+  using DensityDiffusionFn = float (*)(const FluidConstants&, const GridView&, const NeighborColumns&,
+                                       uint32_t);
   // The colour-field record (n_i, |n_i|) (gather_colour_normal).
   using ColourNormalFn = Float4 (*)(const FluidBase&, const GridView&, const NeighborColumns&, uint32_t);
   // The acceleration of the neighbour terms and gravity (gather_acceleration), for one
@@ -34,6 +37,7 @@ struct SimdPasses {
   const char* name;  // "generic", "avx2", "avx512"
   DensityFn density;
   NormalizedDensityFn normalized_density;
+  DensityDiffusionFn density_diffusion;
   ColourNormalFn colour_normal;
   // The acceleration function for the force terms a world runs (methods.h, with_force_terms).
   AccelerationFn (*acceleration_for)(const MethodSelection&);

@@ -5,6 +5,7 @@
 // gathers run on the processor's SIMD target (cpu_simd_passes.h) and read the sorted records as
 // columns, which these passes keep up to date next to the records.
 #include "../physics/density.h"
+#include "../physics/density_diffusion.h"
 #include "../physics/density_normalization.h"
 #include "../physics/dfsph_passes.h"
 #include "../physics/force_fields.h"
@@ -14,7 +15,7 @@ namespace sph {
 
 // Hash, sort, reorder every attribute, then density and pressure (packed into the w slots).
 void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame& scene, StageTime at,
-                                  FrameReport& report) {
+                                  FrameReport& report, float diffusion_dt) {
   auto t = Clock::now();
   grid_.build(position_.data(), count_, workers_);
   columns_.resize(count_);
@@ -79,7 +80,9 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
       columns_.set_neighbor_count(static_cast<uint32_t>(i), s.neighbor_count);
     }
   }
-  if (factor) {
+  // The Shepard filter, unless the density diffusion keeps the carried density instead
+  // (density_diffusion.h says why one or the other).
+  if (factor && !(config_.features & kFeatureDensityDiffusion)) {
     // Eq. 31 over every carried rho_j: each particle writes only its own factor and side
     // slot (the first pass is done reading the factors), then the filtered values are published.
 #pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
@@ -96,6 +99,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
       columns_.set_density(static_cast<uint32_t>(i), pos[i].w, vel[i].w);
     }
   }
+  if (diffusion_dt > 0.0f) diffuse_density(fluid, diffusion_dt);
   if (config_.features & kFeatureSurfaceTension) {
     // Colour-field normals of every particle, which the force gather reads for neighbours.
 #pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
@@ -105,6 +109,31 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
     }
   }
   report.stage_ms[kStageDensity] += static_cast<float>(elapsed_ms(t));
+}
+
+void CpuBackend::diffuse_density(const FluidConstants& fluid, float dt) {
+  if (!(config_.features & kFeatureDensityDiffusion)) return;
+  const GridView view = grid_.view();
+  const NeighborColumns columns = columns_.view();
+  Float4* pos = position_.data();
+  Float4* vel = velocity_.data();
+  float* factor = density_factor_.data();
+  // The gather reads every published rho_j; each particle writes only its own factor and side
+  // slot (free once the filtered densities are published), then the diffused values are published.
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
+  for (int i = 0; i < n(); ++i) {
+    const float rate = simd_.density_diffusion(fluid, view, columns, static_cast<uint32_t>(i));
+    const DiffusedDensity d = diffused_density(density_[i], factor[i], rate, dt);
+    factor[i] = d.factor;
+    normalized_[i] = d.density;
+  }
+#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
+  for (int i = 0; i < n(); ++i) {
+    density_[i] = normalized_[i];
+    pos[i].w = pressure_from_density(fluid.methods.eos, normalized_[i]);
+    vel[i].w = 1.0f / normalized_[i];
+    columns_.set_density(static_cast<uint32_t>(i), pos[i].w, vel[i].w);
+  }
 }
 
 // Acceleration of particle i: the neighbour gather with the world's force terms compiled in

@@ -38,7 +38,7 @@ void CpuBackend::collide_from(const SceneFrame& scene, const SubstepTime& time, 
 
 uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame& scene,
                                    const SubstepTime& time, FrameReport& report) {
-  sort_and_density(fluid, scene, stage_time(time, 0.0f), report);
+  sort_and_density(fluid, scene, stage_time(time, 0.0f), report, time.dt);
   sample_probes(scene, time.dt, report);
   spring_pass(time.dt, true, report);
   auto t = Clock::now();
@@ -104,7 +104,9 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
   const AccelerationFn gather = acceleration_function();
   float a2max = 0.0f;
   for (int stage = 0; stage < 4; ++stage) {
-    sort_and_density(fluid, scene, stage_time(time, rk4_stage_fraction(stage)), report);
+    // The density diffusion once per substep, for its whole dt.
+    sort_and_density(fluid, scene, stage_time(time, rk4_stage_fraction(stage)), report,
+                     stage == 0 ? dt : 0.0f);
     if (stage == 0) sample_probes(scene, dt, report);  // the substep's start, as with Euler
     spring_pass(dt, stage == 0, report);
     auto t = Clock::now();

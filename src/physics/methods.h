@@ -11,6 +11,7 @@
 
 #include "boundary_density.h"
 #include "collider_loads.h"
+#include "density_diffusion.h"
 #include "density_normalization.h"
 #include "dfsph.h"
 #include "eos_ideal_gas.h"
@@ -35,8 +36,9 @@ enum FeatureBits : uint32_t {
   kFeatureBoundaryDensity = 1u << 3,
   kFeatureColliderLoads = 1u << 4,
   kFeatureUserAttribute = 1u << 5,  // no physics: a carried uint32 (core/particle_arrays.h)
-  kFeatureAll = kFeatureSurfaceTension | kFeatureNormalizedDensity | kFeatureSprings |
-                kFeatureBoundaryDensity | kFeatureColliderLoads | kFeatureUserAttribute,
+  kFeatureDensityDiffusion = 1u << 6,
+  kFeatureAll = kFeatureSurfaceTension | kFeatureNormalizedDensity | kFeatureSprings | kFeatureBoundaryDensity |
+                kFeatureColliderLoads | kFeatureUserAttribute | kFeatureDensityDiffusion,
 };
 
 enum class ViscosityMethod : uint32_t { Mueller = 0, Clavet = 1 };
@@ -119,6 +121,9 @@ constexpr MethodSwitch switch_of(Tag<BoundaryDensity>) {
   return {SwitchKind::Feature, kFeatureBoundaryDensity};
 }
 constexpr MethodSwitch switch_of(Tag<ColliderLoads>) { return {SwitchKind::Feature, kFeatureColliderLoads}; }
+constexpr MethodSwitch switch_of(Tag<DensityDiffusion>) {
+  return {SwitchKind::Feature, kFeatureDensityDiffusion};
+}
 
 // Calls visit(Tag<Method>{}) for every method a world can choose, in the list's order.
 template <class Visit>
@@ -134,6 +139,7 @@ void for_each_method(Visit&& visit) {
   visit(Tag<Dfsph>{});
   visit(Tag<BoundaryDensity>{});
   visit(Tag<ColliderLoads>{});
+  visit(Tag<DensityDiffusion>{});
 }
 
 // Whether a value of a sph_world_def method field (or a feature bit) names a method of the list,
@@ -169,6 +175,7 @@ struct MethodParams {
   SurfaceTension::Params surface_tension;
   Springs::Params springs;
   Dfsph::Params dfsph;
+  DensityDiffusion::Params density_diffusion;
 };
 
 // Calls visit(Tag<Method>{}, params) for each method with parameters, in the list's order (the
@@ -182,6 +189,7 @@ void for_each_method_params(Params& p, Visit&& visit) {
   visit(Tag<SurfaceTension>{}, p.surface_tension);
   visit(Tag<Springs>{}, p.springs);
   visit(Tag<Dfsph>{}, p.dfsph);
+  visit(Tag<DensityDiffusion>{}, p.density_diffusion);  // last: checkpoints before it lack its block
 }
 
 // ---- constants: derived per frame from the Params and the world's shape ---------------------
@@ -194,6 +202,7 @@ struct MethodConstants {
   Springs::Constants springs;
   Dfsph::Constants dfsph;
   BoundaryDensity::Constants boundary;
+  DensityDiffusion::Constants density_diffusion;
 };
 
 inline EosConstants make_eos_constants(const MethodParams& p, const MethodSelection& s,
@@ -207,7 +216,8 @@ inline EosConstants make_eos_constants(const MethodParams& p, const MethodSelect
 }
 
 inline MethodConstants make_method_constants(const MethodParams& p, const MethodSelection& s,
-                                             const WorldShape& shape, const LatticeSums& lattice) {
+                                             const WorldShape& shape, const LatticeSums& lattice,
+                                             Vec3 gravity) {
   MethodConstants m{};
   m.eos = make_eos_constants(p, s, shape);
   if (runs(s, Tag<MuellerViscosity>{})) m.mueller = MuellerViscosity::make_constants(p.mueller);
@@ -217,6 +227,9 @@ inline MethodConstants make_method_constants(const MethodParams& p, const Method
   if (runs(s, Tag<Springs>{})) m.springs = Springs::make_constants(p.springs, shape);
   if (runs(s, Tag<Dfsph>{})) m.dfsph = Dfsph::make_constants(p.dfsph, shape, lattice);
   if (runs(s, Tag<BoundaryDensity>{})) m.boundary = BoundaryDensity::make_constants(shape, lattice);
+  if (runs(s, Tag<DensityDiffusion>{}))
+    m.density_diffusion =
+        DensityDiffusion::make_constants(p.density_diffusion, shape, speed_of_sound(m.eos), gravity);
   return m;
 }
 

@@ -35,7 +35,8 @@ static int open_all_options(void** state) {
   sph_world_def_init(&def);
   def.capacity = 256;
   def.particle_spacing = SPACING;
-  def.features = SPH_FEATURE_SURFACE_TENSION | SPH_FEATURE_SPRINGS;
+  def.features = SPH_FEATURE_SURFACE_TENSION | SPH_FEATURE_SPRINGS | SPH_FEATURE_NORMALIZED_DENSITY |
+                 SPH_FEATURE_DENSITY_DIFFUSION;
   def.viscosity_method = SPH_VISCOSITY_CLAVET;
   def.equation_of_state = SPH_EOS_TAIT;
   assert_int_equal(sph_world_create(f.context, &def, &f.world), SPH_OK);
@@ -280,6 +281,8 @@ static void test_each_rule_fires_with_its_message(void** state) {
        "params->density_error: must be in (0, 1], got 1.5"},
       {SPH_PARAMS_DFSPH, offsetof(sph_dfsph_params, divergence_error), -1.0f, SPH_ERROR_INVALID_ARGUMENT,
        "params->divergence_error: must be > 0, got -1"},
+      {SPH_PARAMS_DENSITY_DIFFUSION, offsetof(sph_density_diffusion_params, delta), 1.5f,
+       SPH_ERROR_INVALID_ARGUMENT, "params->delta: must be in (0, 1], got 1.5"},
   };
   size_t i;
   for (i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
@@ -439,6 +442,8 @@ static void test_descriptions_match_the_header(void** state) {
        SPH_PARAM_UINT32, SPH_PARAM_ZERO_IS_DEFAULT},
       {SPH_PARAMS_DFSPH, "flags", offsetof(sph_dfsph_params, flags), SPH_PARAM_FLAGS,
        SPH_PARAM_ZERO_IS_VALUE},
+      {SPH_PARAMS_DENSITY_DIFFUSION, "delta", offsetof(sph_density_diffusion_params, delta), SPH_PARAM_FLOAT,
+       SPH_PARAM_ZERO_IS_DEFAULT},
   };
   const struct {
     const char* name;
@@ -451,6 +456,7 @@ static void test_descriptions_match_the_header(void** state) {
       {"tait", "sph_tait_params", sizeof(sph_tait_params), 1},
       {"springs", "sph_spring_params", sizeof(sph_spring_params), 5},
       {"dfsph", "sph_dfsph_params", sizeof(sph_dfsph_params), 5},
+      {"density_diffusion", "sph_density_diffusion_params", sizeof(sph_density_diffusion_params), 1},
   };
   size_t i, seen[SPH_PARAMS_KIND_COUNT] = {0};
   sph_params_info info;
@@ -511,6 +517,8 @@ static void test_methods_are_listed_with_their_switches(void** state) {
       {"dfsph", SPH_METHOD_SWITCH_SOLVER, SPH_SOLVER_DFSPH, 1, SPH_PARAMS_DFSPH},
       {"boundary_density", SPH_METHOD_SWITCH_FEATURE, SPH_FEATURE_BOUNDARY_DENSITY, 0, SPH_PARAMS_WORLD},
       {"collider_loads", SPH_METHOD_SWITCH_FEATURE, SPH_FEATURE_COLLIDER_LOADS, 0, SPH_PARAMS_WORLD},
+      {"density_diffusion", SPH_METHOD_SWITCH_FEATURE, SPH_FEATURE_DENSITY_DIFFUSION, 1,
+       SPH_PARAMS_DENSITY_DIFFUSION},
   };
   const uint32_t n = (uint32_t)(sizeof expected / sizeof expected[0]);
   sph_physics_method_info info;

@@ -173,7 +173,7 @@ static void test_create_capacity(void** state) {
 }
 
 static void test_create_unknown_enums_and_bits(void** state) {
-  const uint32_t features[] = {0x40u, 0x80u, 0x100u, 0x80000000u, 0xffffffffu};
+  const uint32_t features[] = {0x80u, 0x100u, 0x200u, 0x80000000u, 0xffffffffu};
   const int32_t integrators[] = {2, 3, 1000, 0x7fffffff, -1};
   sph_context* context = make_context();
   sph_world_def def;

@@ -22,27 +22,34 @@ static void trace_line(void* user, double T, double Z) {
   if (user) fprintf((FILE*)user, "%.4f,%.4f\n", T, Z);
 }
 
+/* The features the weakly compressible case adds (argv[1] = diffusion: the normalised density
+ * with the density diffusion, SPH_FEATURE_DENSITY_DIFFUSION, under the same bounds). */
+static uint32_t wcsph_features = 0;
+
 static void test_dam_break(void** state) {
   sph_context* context = NULL;
   dam_break_config config;
   dam_break_result* result = (dam_break_result*)malloc(sizeof(dam_break_result));
-  FILE* trace = validation_open_output("dam_break_front.csv");
+  FILE* trace =
+      validation_open_output(wcsph_features ? "dam_break_diffusion_front.csv" : "dam_break_front.csv");
   sph_result r;
   (void)state;
   assert_non_null(result);
   EXPECT_OK(sph_test_context_create(&context));
   dam_break_config_default(&config, validation_full() ? 40 : 20);
+  config.features = wcsph_features;
   if (trace) fprintf(trace, "T,Z\n");
   r = dam_break_run(context, &config, result, trace_line, trace);
   if (trace) fclose(trace);
   if (r != SPH_OK) printf("dam break failed: %s: %s\n", sph_result_string(r), result->message);
   assert_int_equal(r, SPH_OK);
   printf(
-      "dam break: %u lattice layers across the column, %u particles, spacing %.2f mm, c = %.1f m/s, mu = "
+      "dam break%s: %u lattice layers across the column, %u particles, spacing %.2f mm, c = %.1f m/s, mu = "
       "%.3f Pa s, "
       "%llu substeps, %.2f s wall for %.3f s simulated\n",
-      config.layers_across, result->particles, 1e3 * result->spacing, config.speed_of_sound, config.viscosity,
-      (unsigned long long)result->substeps, result->wall_seconds, result->simulated_seconds);
+      wcsph_features ? " (density diffusion)" : "", config.layers_across, result->particles,
+      1e3 * result->spacing, config.speed_of_sound, config.viscosity, (unsigned long long)result->substeps,
+      result->wall_seconds, result->simulated_seconds);
   printf(
       "  fitted time shift dT = %+.3f (bound |dT| <= %.1f): mean error %.2f %% (bound 8 %%), worst %.2f %% "
       "(bound 15 "
@@ -69,7 +76,7 @@ static void test_dam_break(void** state) {
     }
   }
   {
-    FILE* out = validation_open_output("dam_break.txt");
+    FILE* out = validation_open_output(wcsph_features ? "dam_break_diffusion.txt" : "dam_break.txt");
     if (out) {
       fprintf(out, "%u %u %.4f %.3f %.3f %.3f %.3f %.3f %u\n", config.layers_across, result->particles,
               result->shift_T, 100.0 * result->mean_error, 100.0 * result->max_error,
@@ -197,7 +204,7 @@ static void test_dfsph_capped(void** state) {
   EXPECT_OK(sph_context_destroy(context));
 }
 
-/* argv[1] picks one case (wcsph | dfsph | dfsph_boundary | dfsph_capped); none runs wcsph. */
+/* argv[1] picks one case (wcsph | diffusion | dfsph | dfsph_boundary | dfsph_capped); none runs wcsph. */
 int main(int argc, char** argv) {
   const char* which = argc >= 2 ? argv[1] : "wcsph";
   const struct CMUnitTest wcsph[] = {cmocka_unit_test(test_dam_break)};
@@ -209,5 +216,9 @@ int main(int argc, char** argv) {
     return cmocka_run_group_tests_name("dam_break_dfsph_boundary", dfsph_boundary, NULL, NULL);
   if (strcmp(which, "dfsph_capped") == 0)
     return cmocka_run_group_tests_name("dam_break_dfsph_capped", dfsph_capped, NULL, NULL);
+  if (strcmp(which, "diffusion") == 0) {
+    wcsph_features = SPH_FEATURE_NORMALIZED_DENSITY | SPH_FEATURE_DENSITY_DIFFUSION;
+    return cmocka_run_group_tests_name("validation_dam_break_diffusion", wcsph, NULL, NULL);
+  }
   return cmocka_run_group_tests_name("validation_dam_break", wcsph, NULL, NULL);
 }

@@ -39,8 +39,10 @@ PHYSICS_PARAMS = {
                 "damping": "float"},
     "dfsph": {"density_error": "float", "divergence_error": "float", "max_iterations": "uint",
               "max_divergence_iterations": "uint", "flags": "uint"},
+    "density_diffusion": {"delta": "float"},
 }
-FEATURES = ["surface_tension", "normalized_density", "springs", "boundary_density", "collider_loads"]
+FEATURES = ["surface_tension", "normalized_density", "springs", "boundary_density", "collider_loads",
+            "density_diffusion"]
 VISCOSITY_METHODS = ["mueller", "clavet"]
 EQUATIONS_OF_STATE = ["ideal_gas", "tait"]
 SOLVERS = ["wcsph", "dfsph"]

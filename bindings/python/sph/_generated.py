@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'bf273bd221a1a69cee88249e5a9722146de0c0bca4841f6c9e8ee8ca51b67edc', 'include/sph_cuda.h': '8fe2c1988d9c8456a91fb26b7863765759ab8ad17bd1ff44b457c77af0bc7985', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': 'dd3c4e011aaa8b2a66a03330b00d44d37bf680ef19d8f58aebae8d886b886e15', 'include/sph_cuda.h': '8fe2c1988d9c8456a91fb26b7863765759ab8ad17bd1ff44b457c77af0bc7985', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -70,6 +70,16 @@ SPH_FEATURE_COLLIDER_LOADS = 16
 #: sph_source_def.user_attribute. Costs 4 bytes per particle (and its copy in the rollback
 #: snapshot) and one gather per sort.
 SPH_FEATURE_USER_ATTRIBUTE = 32
+#: Density diffusion (delta-SPH, Molteni & Colagrossi 2009, with the dynamic-density correction of
+#: Fourtakas et al. 2019): a diffusive, conservative term in the carried density's rate that damps
+#: the weakly compressible solver's density and pressure noise without pulling a tank's hydrostatic
+#: stratification towards uniform; sph_density_diffusion_params. Needs
+#: SPH_FEATURE_NORMALIZED_DENSITY (its carried density is the one integrated in time; the plain
+#: summation has no history to diffuse) and SPH_SOLVER_WCSPH (SPH_ERROR_UNSUPPORTED at creation
+#: otherwise); it replaces that feature's Shepard filter (eq. 31 is not applied). A settled tank's
+#: pressure noise within a layer: 65 Pa summed, 12 Pa with the diffusion, 10 Pa with the filter
+#: alone. Costs one gather per substep instead of one per density pass (docs/physics.md).
+SPH_FEATURE_DENSITY_DIFFUSION = 64
 #: Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt <= step_factor h / c, c the
 #: EOS's speed of sound \ (weakly compressible worlds only)
 SPH_STEP_LIMIT_ACOUSTIC = 1
@@ -331,7 +341,8 @@ SPH_PARAMS_CLAVET_VISCOSITY = 2  # sph_clavet_viscosity_params
 SPH_PARAMS_TAIT = 3  # sph_tait_params
 SPH_PARAMS_SPRINGS = 4  # sph_spring_params
 SPH_PARAMS_DFSPH = 5  # sph_dfsph_params
-SPH_PARAMS_KIND_COUNT = 6
+SPH_PARAMS_DENSITY_DIFFUSION = 6  # sph_density_diffusion_params
+SPH_PARAMS_KIND_COUNT = 7
 SPH_PARAMS_KIND_FORCE32 = 2147483647
 
 
@@ -349,6 +360,8 @@ class ParamsKind(_enum.IntEnum):
     SPRINGS = 4
     #: sph_dfsph_params
     DFSPH = 5
+    #: sph_density_diffusion_params
+    DENSITY_DIFFUSION = 6
 
 
 sph_param_type = _c.c_int32
@@ -636,6 +649,7 @@ ENUM_MEMBER_DOCS = {
     'SPH_PARAMS_TAIT': 'sph_tait_params',
     'SPH_PARAMS_SPRINGS': 'sph_spring_params',
     'SPH_PARAMS_DFSPH': 'sph_dfsph_params',
+    'SPH_PARAMS_DENSITY_DIFFUSION': 'sph_density_diffusion_params',
     'SPH_PARAM_FLOAT': 'float, finite',
     'SPH_PARAM_VEC3': 'sph_vec3, every component finite',
     'SPH_PARAM_UINT32': 'uint32_t count',
@@ -956,6 +970,27 @@ class SpringParams(_SphStruct):
 
 
 sph_spring_params = SpringParams
+
+
+class DensityDiffusionParams(_SphStruct):
+    """
+    sph_density_diffusion_params.
+
+    Fields:
+        struct_size (uint32_t): set by sph_density_diffusion_params_init
+        delta (float): delta of the delta-SPH term D_i = delta h c0 sum_j psi_ij . grad W_ij V_j (c0 the equation of state's speed of sound); dimensionless; default 0.1; in (0, 1]; 0 = default
+    """
+    _fields_ = [
+        ('struct_size', _c.c_uint32),
+        ('delta', _c.c_float),
+    ]
+    _sph_c_name_ = 'sph_density_diffusion_params'
+    _sph_size_ = 8
+    _sph_offsets_ = (('struct_size', 0), ('delta', 4))
+    _sph_init_ = 'sph_density_diffusion_params_init_sized'
+
+
+sph_density_diffusion_params = DensityDiffusionParams
 
 
 class DfsphParams(_SphStruct):
@@ -1885,7 +1920,7 @@ class CudaAttributeView(_SphStruct):
 sph_cuda_attribute_view = CudaAttributeView
 
 
-STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpringParams, DfsphParams, ParamsInfo, ParamFieldInfo, PhysicsMethodInfo, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, MeshDesc, Quat, Transform, ColliderId, ColliderDef, ColliderMaterial, ColliderLoads, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, ProbeId, ProbeDef, ProbeReading, Event, CudaAttributeView, )
+STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpringParams, DensityDiffusionParams, DfsphParams, ParamsInfo, ParamFieldInfo, PhysicsMethodInfo, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, MeshDesc, Quat, Transform, ColliderId, ColliderDef, ColliderMaterial, ColliderLoads, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, ProbeId, ProbeDef, ProbeReading, Event, CudaAttributeView, )
 
 # ---- functions --------------------------------------------------------------------------------
 
@@ -1950,6 +1985,12 @@ FUNCTIONS = {
     'sph_world_set_spring_params': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_spring_params)), ('world', 'params'),
         'FEATURE_DISABLED unless the world has SPH_FEATURE_SPRINGS. INVALID_ARGUMENT for a value out of range (the message names it); nothing changes on error. Springs already made keep their rest lengths; the new stiffness, damping and plasticity act from the next substep.', 'sph'),
     'sph_world_get_spring_params': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_spring_params)), ('world', 'out'),
+        '', 'sph'),
+    'sph_density_diffusion_params_init_sized': (sph_result, (_c.POINTER(sph_density_diffusion_params), _c.c_uint32), ('params', 'size'),
+        '', 'sph'),
+    'sph_world_set_density_diffusion_params': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_density_diffusion_params)), ('world', 'params'),
+        'FEATURE_DISABLED unless the world has SPH_FEATURE_DENSITY_DIFFUSION. INVALID_ARGUMENT for a value out of range (the message names it); nothing changes on error. Acts from the next substep.', 'sph'),
+    'sph_world_get_density_diffusion_params': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_density_diffusion_params)), ('world', 'out'),
         '', 'sph'),
     'sph_dfsph_params_init_sized': (sph_result, (_c.POINTER(sph_dfsph_params), _c.c_uint32), ('params', 'size'),
         '', 'sph'),

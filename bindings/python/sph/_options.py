@@ -220,6 +220,32 @@ class WorldOptionsMixin:
         self.dfsph_params = p
         return p
 
+    # -- density diffusion (features normalized_density|density_diffusion)
+    @property
+    def density_diffusion_params(self):
+        """DensityDiffusionParams of a world created with Feature.DENSITY_DIFFUSION
+        (sph_world_get_density_diffusion_params): delta, the delta-SPH coefficient (default 0.1,
+        in (0, 1]). Assign a DensityDiffusionParams (or a dict of its fields) to replace them
+        (sph_world_set_density_diffusion_params; validated, unchanged on error). Raises
+        SphError(ERROR_FEATURE_DISABLED) on a world without the feature."""
+        p = _g.DensityDiffusionParams()
+        check(library().sph_world_get_density_diffusion_params(self.handle, ctypes.byref(p)),
+              "sph_world_get_density_diffusion_params")
+        return p
+
+    @density_diffusion_params.setter
+    def density_diffusion_params(self, params):
+        p = _as_struct(_g.DensityDiffusionParams, params)
+        check(library().sph_world_set_density_diffusion_params(self.handle, ctypes.byref(p)),
+              "sph_world_set_density_diffusion_params")
+
+    def set_density_diffusion_params(self, **fields):
+        """Changes some density-diffusion parameters, keeping the others:
+        ``w.set_density_diffusion_params(delta=0.2)``. Returns the parameters now set."""
+        p = _changed(self.density_diffusion_params, fields)
+        self.density_diffusion_params = p
+        return p
+
     # -- any params struct by kind (the generic calls, for tools that read the descriptions)
     def physics_params(self, kind):
         """The params struct of `kind` (a ParamsKind or its name, "world", "tait", ...), read

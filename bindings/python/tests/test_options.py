@@ -155,7 +155,7 @@ def test_tait_speed_of_sound_must_be_positive(full):
 # ---- every params struct by kind, and the descriptions tools read -------------------------------
 def test_params_are_described_for_tools():
     assert [sph.params_info(k).name for k in sph.ParamsKind] == [
-        b"world", b"surface_tension", b"clavet", b"tait", b"springs", b"dfsph"]
+        b"world", b"surface_tension", b"clavet", b"tait", b"springs", b"dfsph", b"density_diffusion"]
     assert sph.params_info("tait").type_name == b"sph_tait_params"
     assert sph.params_info("clavet").params_size == ctypes.sizeof(sph.ClavetViscosityParams)
     names = [f.name for f in sph.param_fields(sph.ParamsKind.WORLD)]
@@ -171,7 +171,8 @@ def test_params_are_described_for_tools():
     methods = {m.name: m for m in sph.methods()}
     assert list(methods) == [b"ideal_gas", b"tait", b"mueller", b"clavet", b"surface_tension",
                              b"normalized_density", b"springs", b"wcsph", b"dfsph",
-                             b"boundary_density", b"collider_loads"]
+                             b"boundary_density", b"collider_loads", b"density_diffusion"]
+    assert methods[b"density_diffusion"].params_kind == sph.ParamsKind.DENSITY_DIFFUSION
     assert methods[b"dfsph"].switch_by == sph.MethodSwitch.SOLVER and methods[b"dfsph"].value == sph.Solver.DFSPH
     assert methods[b"dfsph"].params_kind == sph.ParamsKind.DFSPH and not methods[b"wcsph"].has_params
     assert methods[b"springs"].switch_by == sph.MethodSwitch.FEATURE
@@ -273,6 +274,24 @@ def test_spring_params_round_trip_validation_and_feature(ctx):
         assert w.spring_params.yield_ratio == pytest.approx(0.1)
         w.spring_params = {"damping": 3.0}
         assert w.spring_params.damping == 3.0 and w.spring_params.plasticity == 0.0
+
+
+# ---- density diffusion (Feature.DENSITY_DIFFUSION, with the normalised density) ----------------------
+def test_density_diffusion_params_and_its_requirement(ctx):
+    e = error(ctx.world, capacity=16, features="density_diffusion")
+    assert e.result == sph.Result.ERROR_UNSUPPORTED and "SPH_FEATURE_NORMALIZED_DENSITY" in e.message
+    with ctx.world(capacity=256, features="normalized_density|density_diffusion") as w:
+        assert w.density_diffusion_params.delta == pytest.approx(0.1)
+        w.set_density_diffusion_params(delta=0.2)
+        assert w.physics_params("density_diffusion").delta == pytest.approx(0.2)
+        e = error(w.set_density_diffusion_params, delta=2.0)
+        assert "params->delta" in e.message and w.density_diffusion_params.delta == pytest.approx(0.2)
+        w.density_diffusion_params = {"delta": 0.0}  # 0 = the default
+        assert w.density_diffusion_params.delta == pytest.approx(0.1)
+        w.fill_box((0, 0, 0), (0.1, 0.1, 0.1))
+        w.step(1 / 60)
+    with ctx.world(capacity=16, features="normalized_density") as w:
+        assert error(lambda: w.density_diffusion_params).result == sph.Result.ERROR_FEATURE_DISABLED
 
 
 # ---- the solver (WorldDef.solver) -------------------------------------------------------------------
