@@ -37,8 +37,9 @@ enum FeatureBits : uint32_t {
   kFeatureColliderLoads = 1u << 4,
   kFeatureUserAttribute = 1u << 5,  // no physics: a carried uint32 (core/particle_arrays.h)
   kFeatureDensityDiffusion = 1u << 6,
-  kFeatureAll = kFeatureSurfaceTension | kFeatureNormalizedDensity | kFeatureSprings | kFeatureBoundaryDensity |
-                kFeatureColliderLoads | kFeatureUserAttribute | kFeatureDensityDiffusion,
+  kFeatureAll = kFeatureSurfaceTension | kFeatureNormalizedDensity | kFeatureSprings |
+                kFeatureBoundaryDensity | kFeatureColliderLoads | kFeatureUserAttribute |
+                kFeatureDensityDiffusion,
 };
 
 enum class ViscosityMethod : uint32_t { Mueller = 0, Clavet = 1 };
