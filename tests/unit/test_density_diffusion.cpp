@@ -196,7 +196,8 @@ void test_simd_gather_matches_the_scalar_one(void**) {
   c.set_density([&](uint32_t, Vec3) { return density(rng); });
   const sph::FluidConstants f = c.fluid(Vec3{0.0f, -9.81f, 0.0f});
   sph::CpuNeighborColumns columns{false, false};
-  columns.fill_state(c.positions.data(), c.velocities.data(), c.n, 1);
+  columns.resize(c.n);
+  columns.copy_state(c.positions.data(), c.velocities.data(), 0, c.n);
   for (uint32_t i = 0; i < c.n; ++i) columns.set_density(i, 0.0f, c.velocities[i].w);
   uint32_t targets = 0;
   for (sph::SimdTarget t : {sph::SimdTarget::Generic, sph::SimdTarget::Avx2, sph::SimdTarget::Avx512}) {
