@@ -590,6 +590,25 @@ namespace Sph
             set { SphException.Check(Native.sph_world_set_spring_params(Handle, ref value), "sph_world_set_spring_params"); }
         }
 
+        /// <summary>The density diffusion's parameters (delta, dimensionless) of a world created
+        /// with <see cref="FeatureFlags.DensityDiffusion"/>; setting replaces them whole. Throws
+        /// SphException (<c>Result.ErrorFeatureDisabled</c>) on a world without the feature.</summary>
+        public DensityDiffusionParams DensityDiffusionParams
+        {
+            get
+            {
+                var p = DensityDiffusionParams.Default();
+                SphException.Check(Native.sph_world_get_density_diffusion_params(Handle, ref p),
+                                   "sph_world_get_density_diffusion_params");
+                return p;
+            }
+            set
+            {
+                SphException.Check(Native.sph_world_set_density_diffusion_params(Handle, ref value),
+                                   "sph_world_set_density_diffusion_params");
+            }
+        }
+
         /// <summary>DFSPH's parameters (the bound on the density solve's mean error, that of the
         /// divergence solve in 1/s, the two iteration caps, flags) of a world created with
         /// <c>Solver.Dfsph</c>; setting replaces them whole. Throws SphException

@@ -51,8 +51,7 @@ const Case kCases[] = {
      "dt_min, dt_max, step_limits"},
     {R"({"world": {"features": ["surface_tension", "foam"]}})",
      "world.features[1]: expected \"surface_tension\", \"normalized_density\", \"springs\", "
-     "\"boundary_density\" "
-     "or \"collider_loads\", got the string \"foam\""},
+     "\"boundary_density\", \"collider_loads\" or \"density_diffusion\", got the string \"foam\""},
     {R"({"world": {"features": "springs"}})", "world.features: expected a list of feature names (an array)"},
     {R"({"world": {"viscosity_method": "xsph"}})",
      "world.viscosity_method: expected \"mueller\" or \"clavet\""},
@@ -63,7 +62,8 @@ const Case kCases[] = {
     {R"({"physics": {"springs": {}}})",
      "physics.springs: the world does not use springs (add \"springs\" to world.features)"},
     {R"({"physics": {"foam": {}}})",
-     "physics.foam: unknown field; physics takes surface_tension, clavet, tait, springs, dfsph (and "
+     "physics.foam: unknown field; physics takes surface_tension, clavet, tait, springs, dfsph, "
+     "density_diffusion (and "
      "\"comment\")"},
     {R"({"world": {"equation_of_state": "tait"}, "physics": {"tait": {"speed": 20}}})",
      "physics.tait.speed: unknown field; tait takes speed_of_sound (and \"comment\")"},

@@ -565,7 +565,7 @@ static class Tests
         AssertEqual(ParamZero.Default, speed.Zero, "speed of sound: 0 is the default");
         AssertEqual(ParamBound.Exclusive, speed.LowerBound, "speed of sound > 0");
         PhysicsMethodInfo[] methods = Library.PhysicsMethods();
-        AssertEqual(11, methods.Length, "methods");  // through boundary_density and collider_loads
+        AssertEqual(12, methods.Length, "methods");  // through collider_loads, probes and density_diffusion
         AssertEqual("dfsph", Utf8.FromNative(methods[8].Name), "the last method");
         AssertEqual(MethodSwitch.Solver, methods[8].SwitchBy, "DFSPH is a solver");
         AssertEqual(ParamsKind.Dfsph, methods[8].ParamsKind, "its params");
@@ -587,6 +587,31 @@ static class Tests
             zero.StructSize = (uint)Marshal.SizeOf(typeof(TaitParams));
             world.TaitParams = zero;
             AssertEqual(10f, world.TaitParams.SpeedOfSound, "a zeroed struct takes the defaults");
+        }
+    }
+
+    public static void TestDensityDiffusionParams()
+    {
+        using (var ctx = Cpu())
+        {
+            using (var plain = ctx.CreateWorld(SmallWorld()))
+            {
+                Throws(Result.ErrorFeatureDisabled, () => { var p = plain.DensityDiffusionParams; });
+            }
+            var d = SmallWorld();
+            d.FeatureFlags = FeatureFlags.NormalizedDensity | FeatureFlags.DensityDiffusion;
+            using (var world = ctx.CreateWorld(d))
+            {
+                DensityDiffusionParams dp = world.DensityDiffusionParams;
+                AssertEqual(0.1f, dp.Delta, "delta default");
+                dp.Delta = 0.25f;
+                world.DensityDiffusionParams = dp;
+                AssertEqual(0.25f, world.DensityDiffusionParams.Delta, "delta round trip");
+                var bad = dp;
+                bad.Delta = 2f;
+                Throws(Result.ErrorInvalidArgument, () => world.DensityDiffusionParams = bad);
+                AssertEqual(0.25f, world.DensityDiffusionParams.Delta, "delta unchanged after an error");
+            }
         }
     }
 
