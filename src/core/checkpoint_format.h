@@ -3,9 +3,9 @@
 // little-endian; floats IEEE 754. Version 4 (version 3 lacks the density diffusion's block in
 // PARM, read by name like every block, so a version 3 file loads with its defaults; version 2
 // lacks the solver in CONF, the solves' report in TIME and DFSPH's warm starts in PART; version 1
-// differs from 2 only in the parameters section, checkpoint_params.h; all load). A world with SPH_FEATURE_USER_ATTRIBUTE
-// adds its values to PART and each source's to SRCE: a layout only that feature bit in CONF
-// selects, so it needed no new version (a library without the feature refuses the bit):
+// differs from 2 only in the parameters section, checkpoint_params.h; all load). A world with
+// SPH_FEATURE_USER_ATTRIBUTE adds its values to PART and each source's to SRCE: a layout only that feature
+// bit in CONF selects, so it needed no new version (a library without the feature refuses the bit):
 //   header (48 bytes): magic[8] "SPHCKPT\x1a", u32 format version, u32 flags (0), u32 writer
 //     backend, u32 writer library version, u64 payload size, u64 checksum, u32 section count,
 //     u32 reserved (0). The checksum is FNV-1a 64 over the header with the checksum field
