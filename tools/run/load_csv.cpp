@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "load_csv.h"
 
-#include <cctype>
 #include <cerrno>
 #include <cstring>
 
@@ -11,26 +10,20 @@ std::string LoadCsv::open(const std::string& directory, const SceneRuntime& runt
   const std::vector<SceneRuntime::Collider>& colliders = runtime.colliders();
   for (size_t k = 0; k < colliders.size(); ++k) {
     if (!colliders[k].desc->loads) continue;
-    const std::string& name = colliders[k].desc->name;
-    std::string path = directory + "/loads_" + std::to_string(k);
-    for (char ch : name) path += (std::isalnum(static_cast<unsigned char>(ch)) || ch == '-') ? ch : '_';
-    if (!name.empty()) path.insert(path.size() - name.size(), "_");
-    path += ".csv";
-    std::FILE* f = std::fopen(path.c_str(), "w");
-    if (!f) return path + ": " + std::strerror(errno);
-    files_.push_back(File{k, path, f});
-    std::fprintf(f,
-                 "frame,time_s,force_x_N,force_y_N,force_z_N,torque_x_Nm,torque_y_Nm,torque_z_Nm,"
-                 "point_x_m,point_y_m,point_z_m,frame_time_s\n");
+    const std::string problem =
+        files_.open(directory, "loads", k, colliders[k].desc->name,
+                    "frame,time_s,force_x_N,force_y_N,force_z_N,torque_x_Nm,torque_y_Nm,torque_z_Nm,"
+                    "point_x_m,point_y_m,point_z_m,frame_time_s\n");
+    if (!problem.empty()) return problem;
   }
   return "";
 }
 
 std::string LoadCsv::write(const SceneRuntime& runtime, uint32_t frame, double time) {
-  for (const File& f : files_) {
+  for (const ObjectCsvFiles::File& f : files_.files()) {
     sph_collider_loads l;
     sph_collider_loads_init(&l);
-    if (sph_collider_get_loads(runtime.world(), runtime.colliders()[f.collider].id, &l) != SPH_OK)
+    if (sph_collider_get_loads(runtime.world(), runtime.colliders()[f.object].id, &l) != SPH_OK)
       return f.path + ": " + sph_get_last_error();
     if (std::fprintf(f.file, "%u,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", frame, time,
                      static_cast<double>(l.force.x), static_cast<double>(l.force.y),
@@ -41,14 +34,6 @@ std::string LoadCsv::write(const SceneRuntime& runtime, uint32_t frame, double t
       return f.path + ": " + std::strerror(errno);
   }
   return "";
-}
-
-std::string LoadCsv::close() {
-  std::string problem;
-  for (File& f : files_)
-    if (f.file && std::fclose(f.file) != 0 && problem.empty()) problem = f.path + ": " + std::strerror(errno);
-  files_.clear();
-  return problem;
 }
 
 }  // namespace sph_tools

@@ -5,10 +5,9 @@
 #define SPH_TOOLS_RUN_LOAD_CSV_H
 
 #include <cstdint>
-#include <cstdio>
 #include <string>
-#include <vector>
 
+#include "object_csv_files.h"
 #include "scene_runtime.h"
 
 namespace sph_tools {
@@ -20,16 +19,10 @@ class LoadCsv {
   // Appends frame `frame` (time in s) of every file. Returns "" or what went wrong.
   std::string write(const SceneRuntime& runtime, uint32_t frame, double time);
   // Closes the files (also on destruction). Returns "" or what went wrong.
-  std::string close();
-  ~LoadCsv() { close(); }
+  std::string close() { return files_.close(); }
 
  private:
-  struct File {
-    size_t collider;
-    std::string path;
-    std::FILE* file;
-  };
-  std::vector<File> files_;
+  ObjectCsvFiles files_;
 };
 
 }  // namespace sph_tools

@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "probe_csv.h"
 
-#include <cctype>
 #include <cerrno>
 #include <cstring>
 
@@ -10,26 +9,20 @@ namespace sph_tools {
 std::string ProbeCsv::open(const std::string& directory, const SceneRuntime& runtime) {
   const std::vector<ProbeDesc>& probes = runtime.scene().probes;
   for (size_t k = 0; k < probes.size(); ++k) {
-    const std::string& name = probes[k].name;
-    std::string path = directory + "/probe_" + std::to_string(k);
-    if (!name.empty()) path += "_";
-    for (char ch : name) path += (std::isalnum(static_cast<unsigned char>(ch)) || ch == '-') ? ch : '_';
-    path += ".csv";
-    std::FILE* f = std::fopen(path.c_str(), "w");
-    if (!f) return path + ": " + std::strerror(errno);
-    files_.push_back(File{k, path, f});
-    std::fprintf(f,
-                 "frame,time_s,density_kg_m3,pressure_Pa,velocity_x_m_s,velocity_y_m_s,velocity_z_m_s,"
-                 "pressure_max_Pa,kernel_sum,water_height_m,samples,span_s\n");
+    const std::string problem =
+        files_.open(directory, "probe", k, probes[k].name,
+                    "frame,time_s,density_kg_m3,pressure_Pa,velocity_x_m_s,velocity_y_m_s,velocity_z_m_s,"
+                    "pressure_max_Pa,kernel_sum,water_height_m,samples,span_s\n");
+    if (!problem.empty()) return problem;
   }
   return "";
 }
 
 std::string ProbeCsv::write(const SceneRuntime& runtime, uint32_t frame, double time) {
-  for (const File& f : files_) {
+  for (const ObjectCsvFiles::File& f : files_.files()) {
     sph_probe_reading r;
     sph_probe_reading_init(&r);
-    if (sph_probe_get_reading(runtime.world(), runtime.probes()[f.probe], &r) != SPH_OK)
+    if (sph_probe_get_reading(runtime.world(), runtime.probes()[f.object], &r) != SPH_OK)
       return f.path + ": " + sph_get_last_error();
     if (std::fprintf(f.file, "%u,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%u,%.9g\n", frame, time,
                      static_cast<double>(r.density), static_cast<double>(r.pressure),
@@ -40,14 +33,6 @@ std::string ProbeCsv::write(const SceneRuntime& runtime, uint32_t frame, double 
       return f.path + ": " + std::strerror(errno);
   }
   return "";
-}
-
-std::string ProbeCsv::close() {
-  std::string problem;
-  for (File& f : files_)
-    if (f.file && std::fclose(f.file) != 0 && problem.empty()) problem = f.path + ": " + std::strerror(errno);
-  files_.clear();
-  return problem;
 }
 
 }  // namespace sph_tools
