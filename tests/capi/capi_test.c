@@ -135,3 +135,34 @@ void capi_expect_unchanged(const sph_world* world, const capi_snapshot* before, 
     _fail(file, line);
   }
 }
+
+sph_world* capi_world_copy(sph_context* context, const sph_world* world) {
+  uint8_t* bytes;
+  uint64_t size = 0;
+  sph_world* copy = NULL;
+  EXPECT_OK(sph_world_save(world, NULL, 0, &size));
+  bytes = (uint8_t*)malloc((size_t)size);
+  assert_non_null(bytes);
+  EXPECT_OK(sph_world_save(world, bytes, size, &size));
+  EXPECT_OK(sph_world_load(context, bytes, size, &copy));
+  free(bytes);
+  return copy;
+}
+
+void capi_expect_same_particles(const sph_world* a, const sph_world* b) {
+  uint32_t na = 0, nb = 0;
+  int attribute;
+  EXPECT_OK(sph_world_get_particle_count(a, &na));
+  EXPECT_OK(sph_world_get_particle_count(b, &nb));
+  assert_int_equal(na, nb);
+  for (attribute = 0; attribute <= SPH_ATTRIBUTE_ID; ++attribute) {
+    float* x = (float*)calloc(3u * na + 1u, sizeof(float));
+    float* y = (float*)calloc(3u * na + 1u, sizeof(float));
+    assert_true(x && y);
+    EXPECT_OK(sph_world_copy_attribute(a, (sph_attribute)attribute, x, 12ull * na + 4, 0, 0, na, NULL));
+    EXPECT_OK(sph_world_copy_attribute(b, (sph_attribute)attribute, y, 12ull * na + 4, 0, 0, na, NULL));
+    assert_memory_equal(x, y, 12u * na);
+    free(x);
+    free(y);
+  }
+}

@@ -64,4 +64,11 @@ void capi_snapshot_take(const sph_world* world, capi_snapshot* out);
   capi_expect_unchanged((world), (snapshot), __FILE__, (line))
 void capi_expect_unchanged(const sph_world* world, const capi_snapshot* before, const char* file, int line);
 
+/* ---- copies and bitwise comparisons ------------------------------------------------------- */
+/* A copy of the world through its checkpoint (save, then load on `context`). */
+sph_world* capi_world_copy(sph_context* context, const sph_world* world);
+/* The same particle count and every attribute up to the ids bit for bit (the user attribute is
+ * left out: it needs SPH_FEATURE_USER_ATTRIBUTE). */
+void capi_expect_same_particles(const sph_world* a, const sph_world* b);
+
 #endif /* SPH_CAPI_TEST_H */

@@ -48,39 +48,6 @@ static sph_world* make_world(sph_context* context) {
   return world;
 }
 
-static sph_world* copy_of(sph_context* context, const sph_world* world) {
-  uint8_t* bytes;
-  uint64_t size = 0;
-  sph_world* copy = NULL;
-  EXPECT_OK(sph_world_save(world, NULL, 0, &size));
-  bytes = (uint8_t*)malloc((size_t)size);
-  assert_non_null(bytes);
-  EXPECT_OK(sph_world_save(world, bytes, size, &size));
-  EXPECT_OK(sph_world_load(context, bytes, size, &copy));
-  free(bytes);
-  return copy;
-}
-
-/* Every attribute of every particle, bit for bit. */
-static void expect_same_particles(const sph_world* world, const sph_world* copy) {
-  uint32_t n = 0, m = 0;
-  int a;
-  EXPECT_OK(sph_world_get_particle_count(world, &n));
-  EXPECT_OK(sph_world_get_particle_count(copy, &m));
-  assert_int_equal(n, m);
-  for (a = 0; a < SPH_ATTRIBUTE_COUNT; ++a) {
-    if (a == SPH_ATTRIBUTE_USER) continue; /* a feature these worlds do not enable */
-    float* x = (float*)calloc(3u * n + 1u, sizeof(float));
-    float* y = (float*)calloc(3u * n + 1u, sizeof(float));
-    assert_true(x && y);
-    EXPECT_OK(sph_world_copy_attribute(world, (sph_attribute)a, x, 12ull * n + 4, 0, 0, n, NULL));
-    EXPECT_OK(sph_world_copy_attribute(copy, (sph_attribute)a, y, 12ull * n + 4, 0, 0, n, NULL));
-    assert_memory_equal(x, y, 12u * n);
-    free(x);
-    free(y);
-  }
-}
-
 typedef struct waiter {
   sph_world* world;
   sph_result result;
@@ -109,7 +76,7 @@ static void poll_until_done(const sph_world* world) {
 static void test_same_frames_as_step(void** state) {
   sph_context* context = make_context();
   sph_world* world = make_world(context);
-  sph_world* reference = copy_of(context, world);
+  sph_world* reference = capi_world_copy(context, world);
   waiter w;
   pthread_t thread;
   int frame;
@@ -128,7 +95,7 @@ static void test_same_frames_as_step(void** state) {
     } else {
       EXPECT_OK(sph_world_step_wait(world));
     }
-    expect_same_particles(world, reference);
+    capi_expect_same_particles(world, reference);
   }
   {
     sph_stats a, b;
@@ -227,12 +194,12 @@ static void test_failed_step_reports_through_wait(void** state) {
   spawn.positions = p;
   EXPECT_OK(sph_world_spawn(world, &spawn, &first));
   free(p);
-  before = copy_of(context, world);
+  before = capi_world_copy(context, world);
 
   EXPECT_OK(sph_world_step_begin(world, kFrameDt));
   assert_int_equal(sph_world_step_wait(world), SPH_ERROR_CAPACITY);
   assert_non_null(strstr(sph_get_last_error(), "particles share one cell"));
-  expect_same_particles(world, before);
+  capi_expect_same_particles(world, before);
   /* The failure was collected: the world is free and no step is pending. */
   EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "no step was begun", sph_world_step_wait(world));
   EXPECT_OK(sph_world_destroy(before));

@@ -82,9 +82,6 @@ static void test_huge_capacity_few_particles(void** state) {
   EXPECT_OK(sph_context_destroy(context));
 }
 
-static sph_world* copy_of(sph_context* context, const sph_world* world);
-static void expect_same_particles(const sph_world* world, const sph_world* copy);
-
 /* The cap of one cell: 64 times a cell of fluid at rest, sqrt(2) (h/s)^3 (cpu_neighbor_grid.h). */
 static uint32_t cell_cap(const sph_world* world) {
   sph_world_def def;
@@ -106,7 +103,7 @@ static void test_coincident_particles_are_refused(void** state) {
   double t;
   (void)state;
   spawn(world, 16000, 0);
-  before = copy_of(context, world);
+  before = capi_world_copy(context, world);
   t = now_seconds();
   assert_int_equal(sph_world_step(world, 1.0f / 60.0f), SPH_ERROR_CAPACITY);
   t = now_seconds() - t;
@@ -114,7 +111,7 @@ static void test_coincident_particles_are_refused(void** state) {
   assert_true(t < 1.0);
   assert_non_null(strstr(sph_get_last_error(), "16000 particles share one cell"));
   assert_non_null(strstr(sph_get_last_error(), "(0.25"));
-  expect_same_particles(world, before);
+  capi_expect_same_particles(world, before);
   EXPECT_OK(sph_world_destroy(before));
   EXPECT_OK(sph_world_destroy(world));
 
@@ -158,44 +155,13 @@ static uint32_t substeps_of(const sph_world* world, float* frame_time) {
   return stats.substeps;
 }
 
-/* A copy of the world through its checkpoint. */
-static sph_world* copy_of(sph_context* context, const sph_world* world) {
-  uint8_t* bytes;
-  uint64_t size = 0;
-  sph_world* copy = NULL;
-  EXPECT_OK(sph_world_save(world, NULL, 0, &size));
-  bytes = (uint8_t*)malloc((size_t)size);
-  EXPECT_OK(sph_world_save(world, bytes, size, &size));
-  EXPECT_OK(sph_world_load(context, bytes, size, &copy));
-  free(bytes);
-  return copy;
-}
-
-/* Every attribute of every particle, bit for bit. */
-static void expect_same_particles(const sph_world* world, const sph_world* copy) {
-  uint32_t n = 0, m = 0;
-  int a;
-  EXPECT_OK(sph_world_get_particle_count(world, &n));
-  EXPECT_OK(sph_world_get_particle_count(copy, &m));
-  assert_int_equal(n, m);
-  for (a = 0; a <= SPH_ATTRIBUTE_ID; ++a) {
-    float* x = (float*)calloc(3u * n + 1u, sizeof(float));
-    float* y = (float*)calloc(3u * n + 1u, sizeof(float));
-    EXPECT_OK(sph_world_copy_attribute(world, (sph_attribute)a, x, 12ull * n + 4, 0, 0, n, NULL));
-    EXPECT_OK(sph_world_copy_attribute(copy, (sph_attribute)a, y, 12ull * n + 4, 0, 0, n, NULL));
-    assert_memory_equal(x, y, 12u * n);
-    free(x);
-    free(y);
-  }
-}
-
 /* After an interrupted step the world is consistent: it saves, the save loads, and both step
  * on to the same particles, bit for bit. */
 static void expect_consistent(sph_context* context, sph_world* world) {
-  sph_world* copy = copy_of(context, world);
+  sph_world* copy = capi_world_copy(context, world);
   EXPECT_OK(sph_world_step(world, 2e-4f));
   EXPECT_OK(sph_world_step(copy, 2e-4f));
-  expect_same_particles(world, copy);
+  capi_expect_same_particles(world, copy);
   EXPECT_OK(sph_world_destroy(copy));
 }
 
@@ -260,11 +226,11 @@ static void test_cancel(void** state) {
   double t;
   uint32_t substeps;
   (void)state;
-  before = copy_of(context, world);
+  before = capi_world_copy(context, world);
   EXPECT_OK(sph_world_cancel_step(world));
   assert_int_equal(sph_world_step(world, 1.0f), SPH_INCOMPLETE);
   assert_int_equal(substeps_of(world, NULL), 0);
-  expect_same_particles(world, before);
+  capi_expect_same_particles(world, before);
   EXPECT_OK(sph_world_destroy(before));
   EXPECT_OK(sph_world_step(world, 2e-4f));
   assert_int_equal(substeps_of(world, NULL), 2);
