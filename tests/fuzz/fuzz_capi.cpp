@@ -922,15 +922,21 @@ class Program {
     // The grid: the vertices' bounds over the voxel size plus the padding on both sides, per axis.
     float lo[3] = {0.0f, 0.0f, 0.0f}, hi[3] = {0.0f, 0.0f, 0.0f};
     bool finite = true;
-    for (uint32_t v = 0; v < d.vertex_count; ++v) {
+    // Over the vertices the triangles use (the library bounds those; an index out of range is
+    // refused anyway).
+    bool first = true;
+    for (uint32_t t = 0; t < d.index_count && t < indices.size(); ++t) {
+      const uint32_t v = indices[t];
+      if (v >= d.vertex_count) continue;
       for (int k = 0; k < 3; ++k) {
         float x;
         std::memcpy(&x, reinterpret_cast<const unsigned char*>(vertices.data()) + v * stride_bytes + 4u * k,
                     4);
         finite = finite && std::isfinite(x);
-        lo[k] = v == 0 ? x : std::min(lo[k], x);
-        hi[k] = v == 0 ? x : std::max(hi[k], x);
+        lo[k] = first ? x : std::min(lo[k], x);
+        hi[k] = first ? x : std::max(hi[k], x);
       }
+      first = false;
     }
     const double voxel = d.voxel_size == 0.0f ? 0.01 : static_cast<double>(d.voxel_size);
     const double padding = d.padding_voxels == 0u ? 4.0 : static_cast<double>(d.padding_voxels);
