@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "../src/core/crowded_cell.h"
 #include "../src/core/grid_layout.h"
 #include "cuda_backend.h"
 #include "cuda_backend_impl.h"
@@ -38,7 +39,8 @@ CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBacken
   r->store = std::make_unique<DeviceParticleStore>(config.capacity, arrays);
   // The sorted positions are free while the sort runs: its temporary storage goes there.
   r->grid = std::make_unique<DeviceNeighborGrid>(
-      make_grid_shape(config.kernel_radius, config.capacity), config.capacity, r->store->sort_scratch(),
+      make_grid_shape(config.kernel_radius, config.capacity), config.capacity,
+      max_particles_per_cell(config.particle_spacing, config.kernel_radius), r->store->sort_scratch(),
       r->store->arrays().sorted_position, sizeof(Float4) * static_cast<size_t>(config.capacity));
   r->statistics = std::make_unique<FrameStatistics>(config.capacity);
   r->state.allocate(1, "frame state");

@@ -31,11 +31,14 @@ __device__ uint32_t lower_bound(const uint32_t* __restrict__ keys, uint32_t lo, 
 
 // One thread per table entry c in [0, cell_count]: cell_start[c] = first sorted index whose
 // key is >= c. Each block first bounds its cells' answers by two searches over all keys, so
-// the per-thread search runs over the few particles of the block's cells.
-__global__ void cell_start_kernel(const uint32_t* __restrict__ sorted_keys, uint32_t n, uint32_t cell_count,
-                                  uint32_t* __restrict__ cell_start, FrameState* state) {
+// the per-thread search runs over the few particles of the block's cells. The block's starts
+// then give each cell's crowd, checked against the cap (src/core/crowded_cell.h).
+__global__ void __launch_bounds__(kDefaultBlockSize)
+    cell_start_kernel(const uint32_t* __restrict__ sorted_keys, uint32_t n, uint32_t cell_count,
+                      uint32_t max_per_cell, uint32_t* __restrict__ cell_start, FrameState* state) {
   mark_stage(state, kStageCellRanges);
   __shared__ uint32_t bounds[2];
+  __shared__ uint32_t starts[kDefaultBlockSize + 1];
   const uint32_t first_cell = blockIdx.x * blockDim.x;
   if (threadIdx.x < 2) {
     const uint64_t cell = static_cast<uint64_t>(first_cell) + (threadIdx.x == 0 ? 0u : blockDim.x);
@@ -43,8 +46,15 @@ __global__ void cell_start_kernel(const uint32_t* __restrict__ sorted_keys, uint
   }
   __syncthreads();
   const uint32_t c = first_cell + threadIdx.x;
+  const uint32_t start = c > cell_count ? n : lower_bound(sorted_keys, bounds[0], bounds[1], c);
+  starts[threadIdx.x] = start;
+  if (threadIdx.x == 0) starts[blockDim.x] = bounds[1];
+  __syncthreads();
   if (c > cell_count) return;
-  cell_start[c] = lower_bound(sorted_keys, bounds[0], bounds[1], c);
+  cell_start[c] = start;
+  const uint32_t held = starts[threadIdx.x + 1] - start;
+  if (c < cell_count && held > max_per_cell)
+    atomicMax(&state->crowded_key, static_cast<unsigned long long>(held) << 32 | c);
 }
 
 int bits_for(uint32_t max_value) {
@@ -55,9 +65,13 @@ int bits_for(uint32_t max_value) {
 
 }  // namespace
 
-DeviceNeighborGrid::DeviceNeighborGrid(const GridShape& shape, uint32_t capacity, SortScratch scratch,
-                                       void* spare, size_t spare_bytes)
-    : shape_(shape), capacity_(capacity), key_bits_(bits_for(shape.cell_count - 1)), scratch_(scratch) {
+DeviceNeighborGrid::DeviceNeighborGrid(const GridShape& shape, uint32_t capacity, uint32_t max_per_cell,
+                                       SortScratch scratch, void* spare, size_t spare_bytes)
+    : shape_(shape),
+      capacity_(capacity),
+      max_per_cell_(max_per_cell),
+      key_bits_(bits_for(shape.cell_count - 1)),
+      scratch_(scratch) {
   cell_start_.allocate(static_cast<size_t>(shape.cell_count) + 1, "cell-start table");
   cub::DoubleBuffer<uint32_t> keys(scratch_.keys[0], scratch_.keys[1]);
   cub::DoubleBuffer<uint32_t> values(scratch_.values[0], scratch_.values[1]);
@@ -99,7 +113,7 @@ void DeviceNeighborGrid::enqueue_sort(const Float4* positions, uint32_t n, Frame
 void DeviceNeighborGrid::enqueue_cell_starts(uint32_t n, FrameState* state, cudaStream_t stream) {
   const uint32_t entries = shape_.cell_count + 1;
   cell_start_kernel<<<blocks_for(entries, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
-      sorted_keys_, n, shape_.cell_count, cell_start_.get(), state);
+      sorted_keys_, n, shape_.cell_count, max_per_cell_, cell_start_.get(), state);
   check_launch("cell_start_kernel");
 }
 

@@ -15,12 +15,21 @@
 
 namespace sph {
 
+// What the reorder needs to disarm a crowded table (enqueue_reorder): the table to empty and the
+// sorted keys that name the crowded slot's first particle.
+struct CrowdGuard {
+  uint32_t* cell_start;
+  uint32_t entries;  // cell_count + 1
+  const uint32_t* sorted_keys;
+};
+
 class DeviceNeighborGrid {
  public:
   // scratch: the key/value buffers (capacity entries each). spare/spare_bytes: memory that is
   // free while the sort runs, reused for the sort's temporary storage when large enough.
-  DeviceNeighborGrid(const GridShape& shape, uint32_t capacity, SortScratch scratch, void* spare,
-                     size_t spare_bytes);
+  // max_per_cell: the crowd cap of one slot (src/core/crowded_cell.h).
+  DeviceNeighborGrid(const GridShape& shape, uint32_t capacity, uint32_t max_per_cell, SortScratch scratch,
+                     void* spare, size_t spare_bytes);
 
   // Hashes positions[0, n) and sorts. Afterwards order() gives, for each sorted place, the
   // particle's index before the sort. The buffers order() and sorted_keys() point to are
@@ -28,16 +37,22 @@ class DeviceNeighborGrid {
   // launches can be captured in a graph).
   void enqueue_sort(const Float4* positions, uint32_t n, FrameState* state, cudaStream_t stream);
   // Fills the dense cell-start table from the sorted keys: every one of cell_count + 1 entries
-  // is written once, without clearing the table first.
+  // is written once, without clearing the table first. A slot holding more than max_per_cell
+  // particles sets FrameState::crowded_key; the reorder that follows then empties the table
+  // (crowd_guard) so that no walk of the failing substep visits the pile.
   void enqueue_cell_starts(uint32_t n, FrameState* state, cudaStream_t stream);
 
   const uint32_t* order() const { return order_; }
   GridView view() const { return GridView{shape_, cell_start_.get()}; }
+  CrowdGuard crowd_guard() const {
+    return CrowdGuard{cell_start_.get(), shape_.cell_count + 1, sorted_keys_};
+  }
   uint64_t bytes() const { return cell_start_.bytes() + temp_.bytes(); }
 
  private:
   GridShape shape_;
   uint32_t capacity_;
+  uint32_t max_per_cell_;
   int key_bits_;
   SortScratch scratch_;
   DeviceArray<uint32_t> cell_start_;

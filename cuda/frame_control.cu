@@ -37,6 +37,7 @@ __global__ void begin_frame_kernel(FrameState* s, StepLimits limits, uint32_t ma
     s->bad_key[k] = kNoBadParticle;
     s->bad_counts[k] = 0;
   }
+  s->crowded_key = 0;
   s->saved_max_speed = s->max_speed;
   s->pressure_tally = empty_solve_tally();
   s->divergence_tally = empty_solve_tally();
@@ -58,6 +59,13 @@ __global__ void end_substep_kernel(FrameState* s, StepLimits limits, uint32_t ma
   // As the CPU backend: symplectic Euler keeps the force pass's |a|max even when the substep
   // then fails; RK4 keeps the max over its four stages only when all of them succeeded.
   if (stages == 1) s->max_acceleration = sqrtf(a2max);
+  if (s->crowded_key != 0) {
+    // The walks of this substep saw an emptied table (enqueue_reorder); the frame is refused.
+    // non_finite stops the stream driver's sinks as for a failed substep.
+    s->non_finite = 1;
+    set_run(s, 0, cond);
+    return;
+  }
   for (int k = 0; k < stages; ++k) {
     if (s->bad_key[k] != kNoBadParticle) {
       s->non_finite = 1;

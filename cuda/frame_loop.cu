@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "../src/core/crowded_cell.h"
 #include "cuda_backend_impl.h"
 
 namespace sph {
@@ -118,6 +119,13 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
   }
   const FrameState s = *r_->state_output.get();
   ++epoch_;
+  if (s.crowded_key != 0) {
+    roll_back_frame();
+    const Vec3 where{s.crowded_where[0], s.crowded_where[1], s.crowded_where[2]};
+    throw Error(Status::Capacity, crowded_cell_message(static_cast<uint32_t>(s.crowded_key >> 32), where,
+                                                       max_particles_per_cell(config_.particle_spacing,
+                                                                              config_.kernel_radius)));
+  }
   if (s.non_finite) {
     roll_back_frame();
     NonFiniteFailure failure;

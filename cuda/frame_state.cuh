@@ -51,6 +51,10 @@ struct FrameState {
   // the minimum wins, which is the particle the CPU backend names (indices < 2^30 = capacity).
   unsigned long long bad_key[kRk4Stages];
   uint32_t bad_counts[kRk4Stages];  // non-finite particles flagged per stage
+  // A grid slot over the crowd cap (src/core/crowded_cell.h): (held << 32 | slot) of the most
+  // crowded one, the largest key winning; 0 when none. The substep that finds it ends the frame.
+  unsigned long long crowded_key;
+  float crowded_where[3];  // the position of that slot's first sorted particle, for the message
 
   DensityRecord density;  // of the last density evaluation, computed once at the end of the frame
 

@@ -16,9 +16,20 @@ namespace {
 
 template <Rk4Carry Carry>
 __global__ void reorder_kernel(ParticleArrays a, const uint32_t* __restrict__ order, uint32_t n, int from,
-                               FrameState* state) {
+                               CrowdGuard guard, FrameState* state) {
   mark_stage(state, kStageHashSort);
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  const unsigned long long crowded = state->crowded_key;
+  if (crowded != 0) {
+    // Every range empty: the failing substep's walks cost nothing, whatever the pile.
+    for (uint64_t e = i; e < guard.entries; e += static_cast<uint64_t>(gridDim.x) * blockDim.x)
+      guard.cell_start[e] = 0;
+    const uint32_t slot = static_cast<uint32_t>(crowded & 0xffffffffu);
+    if (i < n && guard.sorted_keys[i] == slot && (i == 0 || guard.sorted_keys[i - 1] != slot)) {
+      const Float4 p = a.position[order[i]];
+      state->crowded_where[0] = p.x, state->crowded_where[1] = p.y, state->crowded_where[2] = p.z;
+    }
+  }
   if (i >= n) return;
   const uint32_t k = order[i];
   const Float4 p = a.position[k];
@@ -235,18 +246,20 @@ void launch_density(bool boundary, unsigned blocks, unsigned threads, const Flui
 }  // namespace
 
 void enqueue_reorder(const ParticleArrays& a, const uint32_t* order, uint32_t n, Rk4Carry carry, int from,
-                     FrameState* state, cudaStream_t stream) {
+                     const CrowdGuard& guard, FrameState* state, cudaStream_t stream) {
   const unsigned blocks = blocks_for(n, kDefaultBlockSize);
   switch (carry) {
     case Rk4Carry::None:
-      reorder_kernel<Rk4Carry::None><<<blocks, kDefaultBlockSize, 0, stream>>>(a, order, n, from, state);
+      reorder_kernel<Rk4Carry::None>
+          <<<blocks, kDefaultBlockSize, 0, stream>>>(a, order, n, from, guard, state);
       break;
     case Rk4Carry::BuildStart:
       reorder_kernel<Rk4Carry::BuildStart>
-          <<<blocks, kDefaultBlockSize, 0, stream>>>(a, order, n, from, state);
+          <<<blocks, kDefaultBlockSize, 0, stream>>>(a, order, n, from, guard, state);
       break;
     case Rk4Carry::Gather:
-      reorder_kernel<Rk4Carry::Gather><<<blocks, kDefaultBlockSize, 0, stream>>>(a, order, n, from, state);
+      reorder_kernel<Rk4Carry::Gather>
+          <<<blocks, kDefaultBlockSize, 0, stream>>>(a, order, n, from, guard, state);
       break;
   }
   check_launch("reorder_kernel");

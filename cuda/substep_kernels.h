@@ -13,6 +13,7 @@
 #include "../src/physics/force_fields.h"
 #include "../src/physics/forces.h"
 #include "../src/physics/neighbor_walk.h"
+#include "device_neighbor_grid.h"
 #include "device_particle_store.h"
 #include "frame_state.cuh"
 
@@ -41,9 +42,11 @@ struct DeviceScene {
 enum class Rk4Carry { None, BuildStart, Gather };
 
 // sorted_position[i] = position[order[i]] (w = order[i] as bits, read back by the density
-// pass), sorted_id likewise; RK4 state from side `from` to side 1 - from.
+// pass), sorted_id likewise; RK4 state from side `from` to side 1 - from. When the cell-start
+// pass found a crowded slot, the table is emptied instead of walked (guard) and the slot's first
+// particle's position recorded for the message.
 void enqueue_reorder(const ParticleArrays& a, const uint32_t* order, uint32_t n, Rk4Carry carry, int from,
-                     FrameState* state, cudaStream_t stream);
+                     const CrowdGuard& guard, FrameState* state, cudaStream_t stream);
 
 // The physics options a world was created with (methods: src/physics/methods.h).
 struct SubstepOptions {

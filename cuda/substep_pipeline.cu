@@ -22,7 +22,7 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
   if (setup.options.dfsph) {
     b.grid->enqueue_sort(a.position, n, b.state, stream);
     b.grid->enqueue_cell_starts(n, b.state, stream);
-    enqueue_reorder(a, b.grid->order(), n, Rk4Carry::None, 0, b.state, stream);
+    enqueue_reorder(a, b.grid->order(), n, Rk4Carry::None, 0, b.grid->crowd_guard(), b.state, stream);
     if (setup.options.springs) enqueue_spring_reorder(a, b.grid->order(), n, stream);
     enqueue_dfsph_density(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene,
                           b.state, stream);
@@ -38,7 +38,7 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
     b.grid->enqueue_sort(a.position, n, b.state, stream);
     b.grid->enqueue_cell_starts(n, b.state, stream);
     const Rk4Carry carry = !rk4 ? Rk4Carry::None : (stage == 0 ? Rk4Carry::BuildStart : Rk4Carry::Gather);
-    enqueue_reorder(a, b.grid->order(), n, carry, stage & 1, b.state, stream);
+    enqueue_reorder(a, b.grid->order(), n, carry, stage & 1, b.grid->crowd_guard(), b.state, stream);
     if (setup.options.springs) enqueue_spring_reorder(a, b.grid->order(), n, stream);
     enqueue_density(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene,
                     rk4 ? rk4_stage_fraction(stage) : 0.0f, stage == 0, b.state, stream);

@@ -2,20 +2,11 @@
 #include "cpu_neighbor_grid.h"
 
 #include <algorithm>
-#include <cmath>
-#include <string>
 
 #include "../core/grid_layout.h"
 #include "../core/status.h"
 
 namespace sph {
-
-uint32_t max_particles_per_cell(float particle_spacing, float kernel_radius) {
-  const double per_axis = static_cast<double>(kernel_radius) / static_cast<double>(particle_spacing);
-  const double rest = std::sqrt(2.0) * per_axis * per_axis * per_axis;
-  const double cap = std::ceil(kMaxCellDensityRatio * rest);
-  return static_cast<uint32_t>(std::min(std::max(cap, static_cast<double>(kMinCellCap)), 1e9));
-}
 
 // The cells the particles span, then the table for them (make_grid_shape_for_extent). Exact
 // (a min and max of integers), so the shape is the same for the same positions on any thread
@@ -54,12 +45,7 @@ void CpuNeighborGrid::refuse_crowded_slot(const Float4* positions, uint32_t n, u
       where = xyz(positions[i]);
       break;
     }
-  throw Error(Status::Capacity,
-              "neighbour grid: " + std::to_string(held) + " particles share one cell (near (" +
-                  std::to_string(where.x) + ", " + std::to_string(where.y) + ", " + std::to_string(where.z) +
-                  ")); at most " + std::to_string(max_per_cell_) +
-                  " may (64 times the rest density), so the step was refused and rolled back: "
-                  "remove or spread the piled-up particles");
+  throw Error(Status::Capacity, crowded_cell_message(held, where, max_per_cell_));
 }
 
 void CpuNeighborGrid::build(const Float4* positions, uint32_t n, unsigned workers) {

@@ -10,6 +10,7 @@
 
 #include <vector>
 
+#include "../core/crowded_cell.h"
 #include "../physics/float4_types.h"
 #include "../physics/neighbor_walk.h"
 
@@ -18,16 +19,6 @@ namespace sph {
 // Below this many particles the CPU backend's loops run on one thread.
 constexpr uint32_t kParallelMinimum = 4096;
 
-// A cell may hold this many times the particles a cell of fluid at rest holds (sqrt(2) h^3 /
-// spacing^3, the FCC lattice's number density) before a step is refused: 64 times the rest
-// density is far beyond any state of the weakly compressible fluids (a few per cent) or the
-// gases the solver models, and it bounds the candidates one particle visits to 27 times the
-// cap (64 times a fluid at rest's), whatever the particles do.
-constexpr double kMaxCellDensityRatio = 64.0;
-constexpr uint32_t kMinCellCap = 64;
-
-// The most particles one grid slot may hold for a world of this spacing and kernel radius.
-uint32_t max_particles_per_cell(float particle_spacing, float kernel_radius);
 // The CPU backend's parallel loops hand out particles in chunks of this many to whichever thread
 // is free (schedule(dynamic)): a static split makes every pass wait for its slowest thread, and on
 // a machine where another process holds a core that thread is off the core for whole time

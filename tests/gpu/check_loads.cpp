@@ -22,6 +22,8 @@ namespace {
 
 struct LoadsRun {
   State state;
+  std::vector<State> frame_states;        // after every frame, to name the first that differs
+  std::vector<uint32_t> substeps;         // of every frame
   std::vector<sph_collider_loads> loads;  // per collider, the last frame's
   double momentum[3] = {0, 0, 0}, impulse[3] = {0, 0, 0}, start[3] = {0, 0, 0}, time = 0, mass = 0;
 };
@@ -48,6 +50,7 @@ LoadsRun run(sph_backend backend, uint32_t features, sph_integrator integrator, 
   def.integrator = integrator;
   sph_world* world = nullptr;
   require_ok(sph_world_create(context, &def, &world), "sph_world_create");
+  const bool diag_no_box = std::getenv("LOADS_DIAG_NO_BOX") != nullptr;
   const double lo[3] = {0.0, 0.0, 0.0}, hi[3] = {0.6, 0.4, 0.2};
   sph_sdf *tank = nullptr, *box = nullptr;
   std::vector<sph_collider_id> ids(2);
@@ -64,7 +67,10 @@ LoadsRun run(sph_backend backend, uint32_t features, sph_integrator integrator, 
   c.sdf = box;
   c.transform = sph_transform_identity();
   c.transform.position = sph_vec3{0.4f, 0.04f, 0.1f};
-  require_ok(sph_collider_create(world, &c, &ids[1]), "box collider");
+  if (diag_no_box)
+    ids.pop_back();
+  else
+    require_ok(sph_collider_create(world, &c, &ids[1]), "box collider");
   sph_fill_box_desc column;
   sph_fill_box_desc_init(&column);
   column.max = sph_vec3{0.2f, 0.3f, 0.2f};
@@ -75,6 +81,8 @@ LoadsRun run(sph_backend backend, uint32_t features, sph_integrator integrator, 
   const bool loads = (features & SPH_FEATURE_COLLIDER_LOADS) != 0;
   for (int f = 0; f < frames; ++f) {
     require_ok(sph_world_step(world, 1.0f / 60.0f), "sph_world_step");
+    r.frame_states.push_back(read_state(world));
+    r.substeps.push_back(get_stats(world).substeps);
     if (!loads) continue;
     r.loads.clear();
     for (sph_collider_id id : ids) {
@@ -127,8 +135,19 @@ void check(uint32_t extra, sph_integrator integrator, const char* label) {
 
   const LoadsRun off = run(SPH_BACKEND_CUDA, extra, integrator, frames);
   std::snprintf(name, sizeof name, "loads/trajectory_unchanged/%s", label);
-  report(states_identical(a.state, off.state), name, "with loads against without: states %s",
-         states_identical(a.state, off.state) ? "bitwise identical" : "DIFFER");
+  size_t first = 0;
+  while (first < a.frame_states.size() && states_identical(a.frame_states[first], off.frame_states[first]))
+    ++first;
+  std::string where = "bitwise identical";
+  if (first < a.frame_states.size()) {
+    const State &x = a.frame_states[first], &y = off.frame_states[first];
+    where = "DIFFER from frame " + std::to_string(first + 1) + " (substeps " +
+            std::to_string(a.substeps[first]) + " with loads, " + std::to_string(off.substeps[first]) +
+            " without; positions " + (bitwise_equal(x.position, y.position) ? "same" : "differ") +
+            ", velocities " + (bitwise_equal(x.velocity, y.velocity) ? "same" : "differ") + ", densities " +
+            (bitwise_equal(x.density, y.density) ? "same" : "differ") + ")";
+  }
+  report(states_identical(a.state, off.state), name, "with loads against without: states %s", where.c_str());
 
   const double weight = a.mass * 9.81;
   const double residual[3] = {a.momentum[0] - a.start[0] + a.impulse[0],

@@ -3,10 +3,14 @@
 // hostile_cost): a frame with a step budget runs on the stream driver and stops at a substep
 // boundary when the budget runs out or another thread cancels it (INCOMPLETE, the world
 // consistent: it steps on); a cancel before the step stops it before its first substep; a
-// budget that is not reached changes nothing (100 substeps, OK); max_substeps is bounded.
+// budget that is not reached changes nothing (100 substeps, OK); max_substeps is bounded; a pile
+// of a million coincident particles is refused at once (CAPACITY, the crowded-cell cap of
+// src/core/crowded_cell.h) instead of costing 10^12 pair tests, and the world is unchanged.
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <thread>
+#include <vector>
 
 #include "gpu_check.h"
 
@@ -103,6 +107,38 @@ int main() {
   report(r == SPH_ERROR_INVALID_ARGUMENT, "max_substeps_bounded", "1,000,001 substeps: result %d",
          static_cast<int>(r));
   require_ok(sph_world_destroy(world), "sph_world_destroy");
+
+  // A million particles at one point, on the frame graph (no budget) and on the stream driver.
+  for (int driver = 0; driver < 2; ++driver) {
+    const uint32_t pile = 1000000;
+    sph_world_def_init(&def);
+    def.capacity = pile;
+    require_ok(sph_world_create(context, &def, &world), "sph_world_create (pile)");
+    std::vector<float> at(3u * pile, 0.25f);
+    sph_spawn_desc spawn;
+    sph_spawn_desc_init(&spawn);
+    spawn.count = pile;
+    spawn.positions = at.data();
+    uint32_t first = 0;
+    require_ok(sph_world_spawn(world, &spawn, &first), "sph_world_spawn (pile)");
+    if (driver == 1) require_ok(sph_world_set_step_budget(world, 100.0), "sph_world_set_step_budget");
+    t = std::chrono::steady_clock::now();
+    r = sph_world_step(world, 1.0f / 60.0f);
+    took = seconds_since(t);
+    const bool named = std::strstr(sph_get_last_error(), "1000000 particles share one cell") != nullptr;
+    std::vector<float> after(3u * pile, -1.0f);
+    uint32_t copied = 0, count = 0;
+    require_ok(sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, after.data(),
+                                        sizeof(float) * after.size(), 0, 0, pile, &copied),
+               "sph_world_copy_attribute");
+    require_ok(sph_world_get_particle_count(world, &count), "sph_world_get_particle_count");
+    const bool unchanged = count == pile && copied == pile && after == at;
+    report(r == SPH_ERROR_CAPACITY && named && unchanged && took < 2.0,
+           driver == 0 ? "crowded_cell_refused/graph" : "crowded_cell_refused/stream",
+           "1,000,000 particles at one point: result %d in %.3f s, message %s, world %s", static_cast<int>(r),
+           took, named ? "names the pile" : sph_get_last_error(), unchanged ? "unchanged" : "CHANGED");
+    require_ok(sph_world_destroy(world), "sph_world_destroy (pile)");
+  }
   sph_context_destroy(context);
   return gpu_check::finish();
 }
