@@ -50,7 +50,6 @@ LoadsRun run(sph_backend backend, uint32_t features, sph_integrator integrator, 
   def.integrator = integrator;
   sph_world* world = nullptr;
   require_ok(sph_world_create(context, &def, &world), "sph_world_create");
-  const bool diag_no_box = std::getenv("LOADS_DIAG_NO_BOX") != nullptr;
   const double lo[3] = {0.0, 0.0, 0.0}, hi[3] = {0.6, 0.4, 0.2};
   sph_sdf *tank = nullptr, *box = nullptr;
   std::vector<sph_collider_id> ids(2);
@@ -67,10 +66,7 @@ LoadsRun run(sph_backend backend, uint32_t features, sph_integrator integrator, 
   c.sdf = box;
   c.transform = sph_transform_identity();
   c.transform.position = sph_vec3{0.4f, 0.04f, 0.1f};
-  if (diag_no_box)
-    ids.pop_back();
-  else
-    require_ok(sph_collider_create(world, &c, &ids[1]), "box collider");
+  require_ok(sph_collider_create(world, &c, &ids[1]), "box collider");
   sph_fill_box_desc column;
   sph_fill_box_desc_init(&column);
   column.max = sph_vec3{0.2f, 0.3f, 0.2f};
