@@ -21,6 +21,7 @@ CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBacken
   cuda_check(cudaStreamCreateWithFlags(&r->stream, cudaStreamNonBlocking), "cudaStreamCreate");
   cuda_check(cudaEventCreate(&r->frame_start), "cudaEventCreate");
   cuda_check(cudaEventCreate(&r->frame_stop), "cudaEventCreate");
+  cuda_check(cudaEventCreateWithFlags(&r->order_event, cudaEventDisableTiming), "cudaEventCreate");
   options_.methods = config.selection();
   options_.surface_tension = (config.features & kFeatureSurfaceTension) != 0;
   options_.normalized_density = (config.features & kFeatureNormalizedDensity) != 0;
@@ -326,6 +327,28 @@ void CudaBackend::wait_device_event(void* event) const {
   DeviceGuard guard(device_);
   guarded([&] {
     cuda_check(cudaStreamWaitEvent(r_->stream, static_cast<cudaEvent_t>(event), 0), "cudaStreamWaitEvent");
+  });
+}
+
+// One event serves both directions: a stream wait takes the event's state when it is enqueued,
+// so the event may be recorded again at once.
+void CudaBackend::order_after_stream(void* stream) const {
+  require_alive();
+  DeviceGuard guard(device_);
+  guarded([&] {
+    cuda_check(cudaEventRecord(r_->order_event, static_cast<cudaStream_t>(stream)),
+               "cudaEventRecord on the caller's stream");
+    cuda_check(cudaStreamWaitEvent(r_->stream, r_->order_event, 0), "cudaStreamWaitEvent");
+  });
+}
+
+void CudaBackend::order_stream_after(void* stream) const {
+  require_alive();
+  DeviceGuard guard(device_);
+  guarded([&] {
+    cuda_check(cudaEventRecord(r_->order_event, r_->stream), "cudaEventRecord");
+    cuda_check(cudaStreamWaitEvent(static_cast<cudaStream_t>(stream), r_->order_event, 0),
+               "cudaStreamWaitEvent on the caller's stream");
   });
 }
 

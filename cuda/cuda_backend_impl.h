@@ -31,6 +31,7 @@ struct DeviceResources {
   cudaStream_t stream = nullptr;
   cudaEvent_t frame_start = nullptr;
   cudaEvent_t frame_stop = nullptr;
+  cudaEvent_t order_event = nullptr;  // for ordering against a caller's stream (sph_cuda.h)
   std::unique_ptr<DeviceParticleStore> store;
   std::unique_ptr<DeviceNeighborGrid> grid;
   std::unique_ptr<FrameStatistics> statistics;
@@ -53,6 +54,7 @@ struct DeviceResources {
     graph.reset();
     if (frame_start) cudaEventDestroy(frame_start);
     if (frame_stop) cudaEventDestroy(frame_stop);
+    if (order_event) cudaEventDestroy(order_event);
     if (stream) cudaStreamDestroy(stream);
     (void)cudaGetLastError();
   }
@@ -104,6 +106,8 @@ class CudaBackend final : public Backend {
   void record_device_event(void* event) const override;
 
   void wait_device_event(void* event) const override;
+  void order_after_stream(void* stream) const override;
+  void order_stream_after(void* stream) const override;
 
  private:
   static DeviceAttributeView with(DeviceAttributeView v, uintptr_t address, uint64_t stride,

@@ -104,6 +104,7 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
         count_after = run_frame_on_stream(setup, static_cast<uint32_t>(scene_in.sinks.size()), removed_ids,
                                           removed_by_sink, scene_in.interrupt, interrupted);
       cuda_check(cudaEventRecord(r_->frame_stop, r_->stream), "cudaEventRecord");
+      if (scene_in.enqueued) scene_in.enqueued();  // e.g. a caller's stream waits for the frame
       cuda_check(cudaStreamSynchronize(r_->stream), "frame");
       cuda_check(cudaEventElapsedTime(&frame_ms, r_->frame_start, r_->frame_stop), "cudaEventElapsedTime");
     });

@@ -15,7 +15,8 @@
  * Ordering: sph_world_step and the particle calls of sph_c.h return once their device work
  * is done, so data read after they return is complete. To overlap with the world's work, or
  * to make the world wait for yours, use sph_cuda_world_record_event and
- * sph_cuda_world_wait_event with events you create on the world's device.
+ * sph_cuda_world_wait_event with events you create on the world's device, or begin a step on
+ * your own stream (sph_cuda_world_step_begin_on_stream).
  */
 #ifndef SPH_CUDA_H
 #define SPH_CUDA_H
@@ -102,6 +103,28 @@ SPH_API sph_result SPH_CALL sph_cuda_world_record_event(sph_world* world, void* 
  * Non-blocking. Errors: as sph_cuda_world_record_event.
  */
 SPH_API sph_result SPH_CALL sph_cuda_world_wait_event(sph_world* world, void* event);
+
+/**
+ * sph_world_step_begin ordered on the caller's CUDA stream `stream` (a cudaStream_t on the
+ * world's device; NULL: the legacy default stream): the frame's device work runs after the work
+ * enqueued on `stream` before this call, and work the caller enqueues on `stream` after this
+ * call returns runs after the frame's device work. So an engine can enqueue its own kernels
+ * that read the world's device buffers (sph_cuda_world_get_attribute) right behind the step,
+ * and draw them, without the host waiting for the GPU.
+ *
+ * Returns once the frame's device work is enqueued: at once for a frame the world runs as one
+ * device graph, but only after the frame has run for a frame the host drives substep by substep
+ * (frames with sinks or a step budget). As after sph_world_step_begin, the world is held
+ * until sph_world_step_wait, which must be called and reports the step's result. If the step
+ * fails (non-finite state, a crowded cell), the caller's stream may already have read the
+ * failed frame's particles: the world then rolls back, sph_world_step_wait reports the error,
+ * and the data epoch tells (sph_cuda_world_get_epoch).
+ * Errors: INVALID_HANDLE, INVALID_ARGUMENT (frame_dt not positive and finite), UNSUPPORTED (CPU
+ * world, no CUDA build), DEVICE (CUDA refused the stream, e.g. one of another device),
+ * DEVICE_LOST, WORLD_LOCKED (a step is pending or another call holds the world), OUT_OF_HOST_MEMORY
+ * (no thread for the step). On error nothing was started.
+ */
+SPH_API sph_result SPH_CALL sph_cuda_world_step_begin_on_stream(sph_world* world, float frame_dt, void* stream);
 
 #ifdef __cplusplus
 }

@@ -651,6 +651,7 @@ sph_result sph_cuda_world_get_device(const sph_world* world, int32_t* out_device
 sph_result sph_cuda_world_get_stream(const sph_world* world, void** out_stream);
 sph_result sph_cuda_world_record_event(sph_world* world, void* event);
 sph_result sph_cuda_world_wait_event(sph_world* world, void* event);
+sph_result sph_cuda_world_step_begin_on_stream(sph_world* world, float frame_dt, void* stream);
 // libsph_vdb
 sph_result sph_vdb_load_sdf(sph_context* context, const char* path, const char* grid_name, sph_sdf** out);
 const char* sph_vdb_get_last_error(void);

@@ -3043,6 +3043,31 @@ namespace Sph
         public static extern Result sph_cuda_world_wait_event(IntPtr world, IntPtr @event);
 
         /// <summary>
+        /// sph_world_step_begin ordered on the caller's CUDA stream `stream` (a cudaStream_t on the
+        /// world's device; NULL: the legacy default stream): the frame's device work runs after the
+        /// work enqueued on `stream` before this call, and work the caller enqueues on `stream` after
+        /// this call returns runs after the frame's device work. So an engine can enqueue its own
+        /// kernels that read the world's device buffers (sph_cuda_world_get_attribute) right behind the
+        /// step, and draw them, without the host waiting for the GPU.
+        /// <para/>
+        /// Returns once the frame's device work is enqueued: at once for a frame the world runs as one
+        /// device graph, but only after the frame has run for a frame the host drives substep by
+        /// substep (frames with sinks or a step budget). As after sph_world_step_begin, the world is
+        /// held until sph_world_step_wait, which must be called and reports the step's result. If the
+        /// step fails (non-finite state, a crowded cell), the caller's stream may already have read the
+        /// failed frame's particles: the world then rolls back, sph_world_step_wait reports the error,
+        /// and the data epoch tells (sph_cuda_world_get_epoch). Errors: INVALID_HANDLE,
+        /// INVALID_ARGUMENT (frame_dt not positive and finite), UNSUPPORTED (CPU world, no CUDA build),
+        /// DEVICE (CUDA refused the stream, e.g. one of another device), DEVICE_LOST, WORLD_LOCKED (a
+        /// step is pending or another call holds the world), OUT_OF_HOST_MEMORY (no thread for the
+        /// step). On error nothing was started.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_cuda_world_step_begin_on_stream(WorldHandle world, float frameDt, IntPtr stream);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_cuda_world_step_begin_on_stream")]
+        public static extern Result sph_cuda_world_step_begin_on_stream(IntPtr world, float frameDt, IntPtr stream);
+
+        /// <summary>
         /// Loads a level-set FloatGrid from a .vdb file into a new SDF asset of `context`: the grid's
         /// active voxels (plus one voxel of margin) become a dense grid whose index_to_local is the
         /// grid's linear index-to-world transform, so the asset's local frame is the file's world
@@ -4058,11 +4083,13 @@ namespace Sph
             "sph_cuda_world_get_stream",
             "sph_cuda_world_record_event",
             "sph_cuda_world_wait_event",
+            "sph_cuda_world_step_begin_on_stream",
             "sph_vdb_load_sdf",
             "sph_vdb_get_last_error",
         };
         /// <summary>The shared library of each function ("sph", or an optional helper).</summary>
         public static readonly string[] FunctionLibraries = {
+            "sph",
             "sph",
             "sph",
             "sph",

@@ -1099,6 +1099,15 @@ namespace Sph
         {
             SphException.Check(Native.sph_cuda_world_wait_event(Handle, cudaEvent), "sph_cuda_world_wait_event");
         }
+
+        /// <summary>StepBegin ordered on your cudaStream_t (IntPtr.Zero: the legacy default stream):
+        /// the frame runs after your stream's earlier work and your stream's later work after the
+        /// frame (sph_cuda_world_step_begin_on_stream). Collect it with StepWait.</summary>
+        public void CudaStepBeginOnStream(float frameDt, IntPtr cudaStream)
+        {
+            SphException.Check(Native.sph_cuda_world_step_begin_on_stream(Handle, frameDt, cudaStream),
+                               "sph_cuda_world_step_begin_on_stream");
+        }
     }
 
     /// <summary>A SafeHandle's pointer, kept alive (AddRef) while a call uses it; null gives IntPtr.Zero.</summary>

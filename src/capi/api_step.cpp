@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Stepping (with its budget and cancel) and statistics.
 #include <chrono>
+#include <functional>
+#include <memory>
 #include <new>
 #include <string>
 #include <system_error>
@@ -8,6 +10,7 @@
 #include "guard.h"
 #include "handles.h"
 #include "init_struct.h"
+#include "sph_cuda.h"
 #include "struct_io.h"
 #include "validate.h"
 
@@ -21,7 +24,7 @@ constexpr double kMaxStepBudgetSeconds = 86400.0;
 
 // One frame of a world whose lock the caller holds: true if it completed, false if its budget,
 // a cancel or max_substeps stopped it; throws on failure (the world then as before the call).
-bool run_frame(sph_world* world, float frame_dt) {
+bool run_frame(sph_world* world, float frame_dt, const FrameEnqueuedHook& enqueued = FrameEnqueuedHook{}) {
   StepInterrupt interrupt;
   interrupt.cancel = &world->cancel_requested;
   if (world->step_budget_seconds > 0.0)
@@ -29,7 +32,7 @@ bool run_frame(sph_world* world, float frame_dt) {
         StepInterrupt::Clock::now() + std::chrono::duration_cast<StepInterrupt::Clock::duration>(
                                           std::chrono::duration<double>(world->step_budget_seconds));
   try {
-    const bool completed = world->world->step(frame_dt, interrupt);
+    const bool completed = world->world->step(frame_dt, interrupt, enqueued);
     if (world->world->last_report().interrupted) world->cancel_requested.store(0);
     return completed;
   } catch (const Error& e) {
@@ -39,10 +42,11 @@ bool run_frame(sph_world* world, float frame_dt) {
 }
 
 // run_frame on the world's step thread: errors become an outcome for sph_world_step_wait.
-StepOutcome run_frame_outcome(sph_world* world, float frame_dt) noexcept {
+StepOutcome run_frame_outcome(sph_world* world, float frame_dt,
+                              const FrameEnqueuedHook& enqueued = FrameEnqueuedHook{}) noexcept {
   StepOutcome outcome;
   try {
-    outcome.status = run_frame(world, frame_dt) ? Status::Ok : Status::Incomplete;
+    outcome.status = run_frame(world, frame_dt, enqueued) ? Status::Ok : Status::Incomplete;
   } catch (const Error& e) {
     outcome.status = e.status();
     outcome.message = e.what();
@@ -57,6 +61,15 @@ StepOutcome run_frame_outcome(sph_world* world, float frame_dt) noexcept {
     outcome.message = "unknown internal exception";
   }
   return outcome;
+}
+
+// Starts `step` on the world's step thread (the caller holds the world's lock).
+void start_async_step(sph_world* world, std::function<StepOutcome()> step) {
+  try {
+    world->async_step.start(std::move(step));
+  } catch (const std::system_error& e) {
+    throw Error(Status::OutOfHostMemory, std::string("the step's thread could not be started: ") + e.what());
+  }
 }
 }  // namespace
 }  // namespace sph
@@ -77,14 +90,39 @@ SPH_API sph_result SPH_CALL sph_world_step_begin(sph_world* world, float frame_d
     sph::require_world(world);
     sph::WorldLock lock(world);
     sph::require_positive(frame_dt, "frame_dt");
-    try {
-      world->async_step.start([world, frame_dt] { return sph::run_frame_outcome(world, frame_dt); });
-    } catch (const std::system_error& e) {
-      throw Error(Status::OutOfHostMemory,
-                  std::string("the step's thread could not be started: ") + e.what());
-    }
+    sph::start_async_step(world, [world, frame_dt] { return sph::run_frame_outcome(world, frame_dt); });
     world->async_step.pending.store(true);
     lock.hand_over();
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_cuda_world_step_begin_on_stream(sph_world* world, float frame_dt,
+                                                                void* stream) {
+  return sph::guarded("sph_cuda_world_step_begin_on_stream", sph::context_of(world), [&] {
+    sph::require_world(world);
+    sph::WorldLock lock(world);
+    sph::require_positive(frame_dt, "frame_dt");
+    const sph::Backend& backend = world->world->backend();
+    try {
+      backend.order_after_stream(stream);  // refuses a CPU world and a stream CUDA refuses
+    } catch (const Error& e) {
+      if (e.status() == Status::DeviceLost) world->device_lost = true;
+      throw;
+    }
+    auto enqueued = std::make_shared<sph::StepSignal>();
+    sph::FrameEnqueuedHook hook = [&backend, stream, enqueued] {
+      backend.order_stream_after(stream);
+      enqueued->raise();
+    };
+    sph::start_async_step(world, [world, frame_dt, hook, enqueued] {
+      sph::StepOutcome outcome = sph::run_frame_outcome(world, frame_dt, hook);
+      enqueued->raise();  // a frame that failed before its work was enqueued
+      return outcome;
+    });
+    world->async_step.pending.store(true);
+    lock.hand_over();
+    enqueued->wait();
     return SPH_OK;
   });
 }

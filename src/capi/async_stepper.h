@@ -21,6 +21,26 @@ struct StepOutcome {
   std::string message;
 };
 
+// Raised once, by whichever comes first: a step's device work is enqueued, or the step ended
+// (sph_cuda_world_step_begin_on_stream returns when it is raised).
+class StepSignal {
+ public:
+  void raise() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    raised_ = true;
+    raised_changed_.notify_all();
+  }
+  void wait() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    raised_changed_.wait(lock, [this] { return raised_; });
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable raised_changed_;
+  bool raised_ = false;
+};
+
 class AsyncStepper {
  public:
   AsyncStepper() = default;

@@ -97,6 +97,10 @@ class Backend {
   // Records a caller-owned cudaEvent_t on the backend's stream / makes the stream wait for one.
   virtual void record_device_event(void* /*event*/) const { throw unsupported_interop(); }
   virtual void wait_device_event(void* /*event*/) const { throw unsupported_interop(); }
+  // The backend's later work waits for what the caller's stream (a cudaStream_t; null: the
+  // legacy default stream) holds now / the caller's stream waits for the backend's work so far.
+  virtual void order_after_stream(void* /*stream*/) const { throw unsupported_interop(); }
+  virtual void order_stream_after(void* /*stream*/) const { throw unsupported_interop(); }
 
  protected:
   static Error unsupported_interop() {

@@ -13,6 +13,7 @@
 #include "../physics/force_fields.h"
 #include "../physics/probe_sampling.h"
 #include "../physics/sink_region.h"
+#include "frame_enqueued.h"
 #include "sdf_asset.h"
 #include "step_interrupt.h"
 
@@ -45,6 +46,7 @@ struct SceneFrame {
   uint32_t probe_points = 0;
   float max_collider_speed = 0.0f;  // fastest collider surface point, m/s (for the step size)
   StepInterrupt interrupt;          // checked between substeps (CUDA: on its stream driver only)
+  FrameEnqueuedHook enqueued;       // optional (frame_enqueued.h)
 
   bool empty() const { return colliders.empty() && fields.empty() && sinks.empty(); }
 };

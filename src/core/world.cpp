@@ -180,7 +180,7 @@ ColliderLoadResult load_result(const ColliderLoadSums& sums, const Collider& c, 
 }
 }  // namespace
 
-bool World::step(double frame_dt, const StepInterrupt& interrupt) {
+bool World::step(double frame_dt, const StepInterrupt& interrupt, const FrameEnqueuedHook& enqueued) {
   const auto start = std::chrono::steady_clock::now();
   if (interrupt.requested()) {
     report_ = FrameReport{};
@@ -214,6 +214,7 @@ bool World::step(double frame_dt, const StepInterrupt& interrupt) {
     emit_sources(frame_dt);
     SceneFrame scene = build_scene_frame(frame_dt);
     scene.interrupt = interrupt;
+    scene.enqueued = enqueued;
     report = backend_->step_scene_frame(frame_dt, params_, scene);
   } catch (...) {
     if (particle_count() > count_before) {

@@ -87,7 +87,9 @@ class World {
   // boundary (raised before the step starts: nothing changes but the report, which says no
   // substep ran). On an exception the world (particles, ids, sources, collider poses) is as it
   // was before the call.
-  bool step(double frame_dt, const StepInterrupt& interrupt = StepInterrupt{});
+  // `enqueued`, when set, is called once the frame's device work is enqueued (frame_enqueued.h).
+  bool step(double frame_dt, const StepInterrupt& interrupt = StepInterrupt{},
+            const FrameEnqueuedHook& enqueued = FrameEnqueuedHook{});
 
   const FrameReport& last_report() const { return report_; }
   double simulated_time() const { return simulated_time_; }

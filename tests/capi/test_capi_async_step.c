@@ -9,6 +9,9 @@
  *    message through wait on the waiting thread, and the world is as before the begin.
  * 4. Misuse: wait or poll without a begin, a second wait, a second begin, bad arguments, dead
  *    handles: each a clear error, nothing started.
+ * 5. sph_cuda_world_step_begin_on_stream (the legacy default stream): on a CUDA world the frames
+ *    end where sph_world_step ends them; on a CPU world UNSUPPORTED and nothing started. (The
+ *    stream ordering itself is checked on the GPU: tests/gpu/check_stream_step.cu.)
  * Runs in the TSan stage (label threads) with one worker: libgomp is not instrumented. */
 #include <pthread.h>
 #include <stdint.h>
@@ -18,6 +21,7 @@
 #include <time.h>
 
 #include "capi_test.h"
+#include "sph_cuda.h"
 
 static const float kFrameDt = 1.0f / 60.0f;
 
@@ -212,6 +216,33 @@ static void test_failed_step_reports_through_wait(void** state) {
   EXPECT_OK(sph_context_destroy(context));
 }
 
+static void test_begin_on_stream(void** state) {
+  sph_context* context = make_context();
+  sph_world* world = make_world(context);
+  sph_world* reference = capi_world_copy(context, world);
+  int frame;
+  (void)state;
+  if (sph_test_backend() == SPH_BACKEND_CPU) {
+    EXPECT_ERROR(SPH_ERROR_UNSUPPORTED, "CUDA", sph_cuda_world_step_begin_on_stream(world, kFrameDt, NULL));
+    EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "no step was begun", sph_world_step_wait(world));
+  } else {
+    EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "frame_dt",
+                 sph_cuda_world_step_begin_on_stream(world, 0.0f, NULL));
+    for (frame = 0; frame < 3; ++frame) {
+      EXPECT_OK(sph_world_step(reference, kFrameDt));
+      EXPECT_OK(sph_cuda_world_step_begin_on_stream(world, kFrameDt, NULL));
+      EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world",
+                   sph_cuda_world_step_begin_on_stream(world, kFrameDt, NULL));
+      EXPECT_OK(sph_world_step_wait(world));
+      capi_expect_same_particles(world, reference);
+    }
+  }
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world", sph_cuda_world_step_begin_on_stream(NULL, kFrameDt, NULL));
+  EXPECT_OK(sph_world_destroy(reference));
+  EXPECT_OK(sph_world_destroy(world));
+  EXPECT_OK(sph_context_destroy(context));
+}
+
 static void test_misuse(void** state) {
   sph_context* context = make_context();
   sph_world* world = make_world(context);
@@ -250,6 +281,7 @@ int main(void) {
       cmocka_unit_test(test_pending_step_holds_the_world),
       cmocka_unit_test(test_failed_step_reports_through_wait),
       cmocka_unit_test(test_misuse),
+      cmocka_unit_test(test_begin_on_stream),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

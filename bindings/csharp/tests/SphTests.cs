@@ -1105,6 +1105,8 @@ static class Tests
             Throws(Result.ErrorUnsupported, () => { var s = world.CudaStream; });
             Throws(Result.ErrorUnsupported, () => world.CudaRecordEvent(new IntPtr(1)));
             Throws(Result.ErrorUnsupported, () => world.CudaWaitEvent(new IntPtr(1)));
+            Throws(Result.ErrorUnsupported, () => world.CudaStepBeginOnStream(1.0f / 60.0f, IntPtr.Zero));
+            Throws(Result.ErrorInvalidArgument, () => world.StepWait());  // nothing was started
         }
     }
 

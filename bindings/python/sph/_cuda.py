@@ -97,3 +97,10 @@ class WorldCudaMixin:
     def cuda_wait_event(self, event):
         """Makes the world's later device work wait for a cudaEvent_t (sph_cuda_world_wait_event)."""
         check(library().sph_cuda_world_wait_event(self.handle, ctypes.c_void_p(event)), "sph_cuda_world_wait_event")
+
+    def cuda_step_begin_on_stream(self, frame_dt, stream):
+        """step_begin() ordered on your cudaStream_t (an int; 0: the legacy default stream): the
+        frame runs after your stream's earlier work, and your stream's later work after the
+        frame (sph_cuda_world_step_begin_on_stream). Collect it with step_wait()."""
+        check(library().sph_cuda_world_step_begin_on_stream(self.handle, float(frame_dt), ctypes.c_void_p(stream)),
+              "sph_cuda_world_step_begin_on_stream")

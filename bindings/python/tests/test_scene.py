@@ -267,8 +267,10 @@ def test_events_two_call_pattern_raw(world):
 def test_cuda_tier_on_a_cpu_world_is_unsupported(world):
     for call in (lambda: world.cuda_attribute(sph.Attribute.POSITION), lambda: world.cuda_array(sph.Attribute.ID),
                  lambda: world.cuda_epoch, lambda: world.cuda_device, lambda: world.cuda_stream,
-                 lambda: world.cuda_record_event(1), lambda: world.cuda_wait_event(1)):
+                 lambda: world.cuda_record_event(1), lambda: world.cuda_wait_event(1),
+                 lambda: world.cuda_step_begin_on_stream(1.0 / 60.0, 0)):
         assert error(call) == sph.Result.ERROR_UNSUPPORTED
+    assert error(world.step_wait) == sph.Result.ERROR_INVALID_ARGUMENT  # nothing was started
 
 
 def test_cuda_array_interface_shape():
