@@ -20,9 +20,9 @@ int draw_scene_open(sph_backend backend, float spacing, draw_scene* s) {
   context_def.backend = backend;
   if (sample_failed(sph_context_create(&context_def, &s->context), "sph_context_create")) return 1;
   sph_world_def_init(&world_def);
-  /* The column's lattice with room to spare: (0.35 / h + 1)(0.5 / h + 1)(0.3 / h + 1). */
-  world_def.capacity =
-      (uint32_t)((0.35f / spacing + 2.0f) * (0.5f / spacing + 2.0f) * (0.3f / spacing + 2.0f));
+  /* The fill's lattice puts 1.24 particles in a spacing cube of the column (8160 at 2 cm): room
+   * for 1.5 and a few more. */
+  world_def.capacity = (uint32_t)(1.5f * 0.35f * 0.5f * 0.3f / (spacing * spacing * spacing)) + 1000u;
   world_def.particle_spacing = spacing;
   if (sample_failed(sph_world_create(s->context, &world_def, &s->world), "sph_world_create")) return 1;
   s->capacity = world_def.capacity;
