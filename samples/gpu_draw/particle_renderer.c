@@ -1,20 +1,16 @@
 // SPDX-License-Identifier: MIT
-/* The headless renderer of particle_renderer.h: EGL display and context, the GL functions it
- * uses loaded through eglGetProcAddress, a framebuffer object, and the sprite shaders. */
+/* The renderer of particle_renderer.h on a headless EGL context (headless_egl.c): the GL
+ * functions it uses loaded through eglGetProcAddress, a framebuffer object, the sprite shaders. */
 #include "particle_renderer.h"
 
-#include <EGL/egl.h>
-#include <EGL/eglext.h>
+#include "headless_egl.h"
+
 #include <GL/glcorearb.h> /* types, enums and PFN typedefs only: no prototypes are used */
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#ifndef EGL_PLATFORM_SURFACELESS_MESA
-#define EGL_PLATFORM_SURFACELESS_MESA 0x31DD
-#endif
 
 /* Every GL function the renderer calls: X(type, name) becomes a member gl.name loaded from
  * "gl" #name. All are in OpenGL 3.3 core and OpenGL ES 3.0. */
@@ -71,120 +67,13 @@ typedef struct gl_functions {
 
 struct particle_renderer {
   particle_renderer_def def;
-  EGLDisplay display;
-  EGLContext context;
-  int es; /* 1: an OpenGL ES 3.0 context */
-  char api[32];
+  headless_egl egl;
+  int es; /* 1: an OpenGL ES 3.0 context (a copy of egl.es) */
   char device[128];
   gl_functions gl;
   GLuint framebuffer, colour_buffer, depth_buffer, vertex_array, vertex_buffer, program;
   GLint view_projection_location, point_scale_location;
 };
-
-static int has_extension(const char* list, const char* name) {
-  const size_t n = strlen(name);
-  const char* p = list;
-  while (p && (p = strstr(p, name)) != NULL) {
-    if ((p == list || p[-1] == ' ') && (p[n] == ' ' || p[n] == '\0')) return 1;
-    p += n;
-  }
-  return 0;
-}
-
-/* The EGL device whose CUDA ordinal is cuda_device (or the first that initialises when
- * cuda_device < 0), through EGL_EXT_device_enumeration and EGL_EXT_platform_device; with
- * cuda_device < 0 and no device, Mesa's surfaceless platform. */
-static EGLDisplay open_display(int cuda_device) {
-  const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
-  if (client && has_extension(client, "EGL_EXT_device_enumeration") &&
-      has_extension(client, "EGL_EXT_platform_device")) {
-    PFNEGLQUERYDEVICESEXTPROC query_devices =
-        (PFNEGLQUERYDEVICESEXTPROC)eglGetProcAddress("eglQueryDevicesEXT");
-    PFNEGLQUERYDEVICEATTRIBEXTPROC query_attribute =
-        (PFNEGLQUERYDEVICEATTRIBEXTPROC)eglGetProcAddress("eglQueryDeviceAttribEXT");
-    PFNEGLQUERYDEVICESTRINGEXTPROC query_string =
-        (PFNEGLQUERYDEVICESTRINGEXTPROC)eglGetProcAddress("eglQueryDeviceStringEXT");
-    EGLDeviceEXT devices[32];
-    EGLint count = 0, i;
-    if (query_devices && query_devices(32, devices, &count)) {
-      for (i = 0; i < count; ++i) {
-        EGLDisplay display;
-        if (cuda_device >= 0) {
-          EGLAttrib ordinal = -1;
-          const char* extensions = query_string ? query_string(devices[i], EGL_EXTENSIONS) : NULL;
-          if (!extensions || !has_extension(extensions, "EGL_NV_device_cuda") || !query_attribute ||
-              !query_attribute(devices[i], EGL_CUDA_DEVICE_NV, &ordinal) || ordinal != cuda_device)
-            continue;
-        }
-        display = eglGetPlatformDisplay(EGL_PLATFORM_DEVICE_EXT, devices[i], NULL);
-        if (display != EGL_NO_DISPLAY && eglInitialize(display, NULL, NULL)) return display;
-      }
-    }
-    if (cuda_device >= 0) {
-      fprintf(stderr,
-              "particle_renderer: none of the %d EGL devices is CUDA device %d (EGL_NV_device_cuda)\n",
-              (int)count, cuda_device);
-      return EGL_NO_DISPLAY;
-    }
-  } else if (cuda_device >= 0) {
-    fprintf(stderr,
-            "particle_renderer: EGL has no device enumeration (EGL_EXT_device_enumeration, "
-            "EGL_EXT_platform_device): cannot find the GL device of CUDA device %d\n",
-            cuda_device);
-    return EGL_NO_DISPLAY;
-  }
-  if (client && has_extension(client, "EGL_MESA_platform_surfaceless")) {
-    EGLDisplay display = eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
-    if (display != EGL_NO_DISPLAY && eglInitialize(display, NULL, NULL)) return display;
-  }
-  fprintf(stderr, "particle_renderer: no EGL display (no device platform, no surfaceless platform)\n");
-  return EGL_NO_DISPLAY;
-}
-
-/* Desktop OpenGL 3.3 core first, then OpenGL ES 3.0; surfaceless (EGL_KHR_surfaceless_context:
- * everything is drawn into the framebuffer object). */
-static int create_context(particle_renderer* r) {
-  /* EGL_SURFACE_TYPE defaults to EGL_WINDOW_BIT, which no headless config has. */
-  static const EGLint gl_config[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT,
-                                     EGL_NONE};
-  static const EGLint es_config[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE,
-                                     EGL_OPENGL_ES3_BIT, EGL_NONE};
-  static const EGLint gl_attributes[] = {EGL_CONTEXT_MAJOR_VERSION,
-                                         3,
-                                         EGL_CONTEXT_MINOR_VERSION,
-                                         3,
-                                         EGL_CONTEXT_OPENGL_PROFILE_MASK,
-                                         EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                                         EGL_NONE};
-  static const EGLint es_attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 0,
-                                         EGL_NONE};
-  int es;
-  if (!has_extension(eglQueryString(r->display, EGL_EXTENSIONS), "EGL_KHR_surfaceless_context")) {
-    fprintf(stderr, "particle_renderer: the EGL display has no EGL_KHR_surfaceless_context\n");
-    return 1;
-  }
-  for (es = 0; es < 2; ++es) {
-    EGLConfig config;
-    EGLint configs = 0;
-    if (!eglBindAPI(es ? EGL_OPENGL_ES_API : EGL_OPENGL_API)) continue;
-    if (!eglChooseConfig(r->display, es ? es_config : gl_config, &config, 1, &configs) || configs < 1)
-      continue;
-    r->context = eglCreateContext(r->display, config, EGL_NO_CONTEXT, es ? es_attributes : gl_attributes);
-    if (r->context == EGL_NO_CONTEXT) continue;
-    if (!eglMakeCurrent(r->display, EGL_NO_SURFACE, EGL_NO_SURFACE, r->context)) {
-      eglDestroyContext(r->display, r->context);
-      r->context = EGL_NO_CONTEXT;
-      continue;
-    }
-    r->es = es;
-    snprintf(r->api, sizeof r->api, "%s", es ? "OpenGL ES 3.0" : "OpenGL 3.3 core");
-    return 0;
-  }
-  fprintf(stderr,
-          "particle_renderer: neither an OpenGL 3.3 core nor an OpenGL ES 3.0 context (EGL error 0x%x)\n",
-          (unsigned)eglGetError());
-  return 1;
-}
 
 static int load_functions(particle_renderer* r) {
 #define RENDERER_GL_LOAD(type, name)                                                         \
@@ -338,6 +227,7 @@ static void view_projection(const particle_renderer_def* d, float m[16]) {
 int particle_renderer_create(const particle_renderer_def* def, particle_renderer** out) {
   particle_renderer* r;
   const char* renderer_name;
+  int status;
   *out = NULL;
   if (def->width <= 0 || def->height <= 0 || def->capacity == 0) {
     fprintf(stderr, "particle_renderer: width, height and capacity must be positive\n");
@@ -346,12 +236,13 @@ int particle_renderer_create(const particle_renderer_def* def, particle_renderer
   r = (particle_renderer*)calloc(1, sizeof *r);
   if (!r) return 1;
   r->def = *def;
-  r->display = open_display(def->cuda_device);
-  if (r->display == EGL_NO_DISPLAY) {
+  status = headless_egl_open(def->cuda_device, &r->egl);
+  if (status != 0) {
     free(r);
-    return 77;
+    return status;
   }
-  if (create_context(r) || load_functions(r) || build_program(r) || build_buffers(r)) {
+  r->es = r->egl.es;
+  if (load_functions(r) || build_program(r) || build_buffers(r)) {
     particle_renderer_destroy(r);
     return 1;
   }
@@ -364,7 +255,9 @@ int particle_renderer_create(const particle_renderer_def* def, particle_renderer
 unsigned particle_renderer_vertex_buffer(const particle_renderer* renderer) {
   return renderer->vertex_buffer;
 }
-const char* particle_renderer_api(const particle_renderer* renderer) { return renderer->api; }
+const char* particle_renderer_api(const particle_renderer* renderer) {
+  return renderer->es ? "OpenGL ES 3.0" : "OpenGL 3.3 core";
+}
 const char* particle_renderer_device(const particle_renderer* renderer) { return renderer->device; }
 
 int particle_renderer_upload(particle_renderer* r, const particle_vertex* vertices, uint32_t count) {
@@ -409,7 +302,7 @@ int particle_renderer_draw(particle_renderer* r, uint32_t count, uint8_t* rgba) 
 
 void particle_renderer_destroy(particle_renderer* r) {
   if (!r) return;
-  if (r->context != EGL_NO_CONTEXT && r->gl.DeleteBuffers) {
+  if (r->gl.DeleteBuffers) { /* the functions are loaded: the context is current */
     r->gl.DeleteBuffers(1, &r->vertex_buffer);
     r->gl.DeleteVertexArrays(1, &r->vertex_array);
     r->gl.DeleteFramebuffers(1, &r->framebuffer);
@@ -417,10 +310,6 @@ void particle_renderer_destroy(particle_renderer* r) {
     r->gl.DeleteRenderbuffers(1, &r->depth_buffer);
     r->gl.DeleteProgram(r->program);
   }
-  if (r->display != EGL_NO_DISPLAY) {
-    eglMakeCurrent(r->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-    if (r->context != EGL_NO_CONTEXT) eglDestroyContext(r->display, r->context);
-    eglTerminate(r->display);
-  }
+  headless_egl_close(&r->egl);
   free(r);
 }

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
-/* A headless particle renderer: an EGL context with no window system (EGL_EXT_platform_device,
- * or Mesa's surfaceless platform when no device is asked for), an OpenGL 3.3 core context (an
- * OpenGL ES 3.0 one where desktop GL is refused), a framebuffer object of the image size, and
+/* A headless particle renderer: an EGL context with no window system (headless_egl.h: the EGL
+ * device of a CUDA device, or Mesa's surfaceless platform when no device is asked for), OpenGL
+ * 3.3 core (OpenGL ES 3.0 where desktop GL is refused), a framebuffer object of the image size, and
  * a vertex buffer of particle_vertex that a CUDA kernel (through cudaGraphicsGLRegisterBuffer)
  * or the host fills. Each draw renders the particles as point sprites shaded as spheres and
  * reads the image back.
