@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: MIT
 #include "gpu_draw_interop.h"
 
+// clang-format off
+#include <GL/gl.h> /* before cuda_gl_interop.h, which on aarch64 asks for GL's types first */
 #include <cuda_gl_interop.h>
+// clang-format on
 #include <cuda_runtime.h>
 
 #include <cstdio>
