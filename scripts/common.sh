@@ -23,14 +23,17 @@ SPH_SCRIPT_NAME="$(basename "${0}")"
 # its preview images. python3-vtk9 reads sph-run's .vtp frames back, python3-jsonschema checks
 # the scene files against docs/scene.schema.json, python3-cffi parses bindings/cffi/sph_cdef.h;
 # python3-setuptools, -wheel and -venv build the Python wheel and install it into a clean
-# virtual environment offline (scripts/build-wheel, scripts/test).
+# virtual environment offline (scripts/build-wheel, scripts/test). libegl-dev, libgl-dev and
+# libgles-dev (EGL and glvnd, the EGL/GL/GLES headers) build samples/gpu_draw; libegl-mesa0 and
+# libgl1-mesa-dri (Mesa's EGL driver and llvmpipe) let gl_draw_host draw without a GPU; the
+# kit for a GPU machine without them comes from scripts/devkit-interop.
 SPH_PACKAGES=(
   cmake ninja-build g++ pkg-config git
   libcmocka-dev libeigen3-dev libxsimd-dev
   libopenvdb-dev libboost-iostreams-dev libtbb-dev nlohmann-json3-dev
   clang libclang-rt-14-dev libomp-dev clang-format
   python3 python3-numpy python3-pytest python3-matplotlib mono-mcs mono-runtime
-  libpng-dev
+  libpng-dev libegl-dev libgl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
   python3-vtk9 python3-jsonschema python3-cffi python3-setuptools python3-wheel python3-venv
 )
 
