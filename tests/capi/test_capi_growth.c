@@ -352,7 +352,8 @@ static void test_rollback_on_grown_world(void** state) {
   EXPECT_OK(sph_world_get_particle_count(world, &after_count));
   assert_int_equal(after_count, before_count);
   capi_expect_same_particles(world, copy);
-  assert_true(stats_of(world).capacity >= stats_of(copy).capacity);
+  /* The source grew the world for its emission before the substep failed: the capacity stays. */
+  assert_true(stats_of(world).capacity > stats_of(copy).capacity);
   /* Without the overflow both emit the same particles and step alike. */
   EXPECT_OK(sph_world_set_params(world, &params));
   EXPECT_OK(sph_world_step(world, 0.001f));
