@@ -4,6 +4,7 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "../src/core/crowded_cell.h"
@@ -141,6 +142,35 @@ void CudaBackend::truncate(uint32_t count) {
     cuda_check(cudaStreamSynchronize(r_->stream), "truncate");
   });
   count_ = count;
+  ++epoch_;
+}
+
+void CudaBackend::reserve(uint32_t capacity) {
+  require_alive();
+  if (capacity <= config_.capacity) return;
+  DeviceGuard guard(device_);
+  guarded([&] {
+    std::vector<ParticleArraySpec> specs;
+    for (const auto& m : r_->store->method_arrays()) specs.push_back(m->spec);
+    auto store = std::make_unique<DeviceParticleStore>(capacity, specs);
+    // The grid is sized from the capacity, as a world created at this capacity sizes it, so a
+    // grown world sorts (and computes) exactly as that world would.
+    auto grid = std::make_unique<DeviceNeighborGrid>(
+        make_grid_shape(config_.kernel_radius, capacity), capacity, store->sort_scratch(),
+        store->arrays().sorted_position, sizeof(Float4) * static_cast<size_t>(capacity));
+    auto statistics = std::make_unique<FrameStatistics>(capacity);
+    DeviceArray<double> partials;
+    if (options_.dfsph) partials.allocate(dfsph_partial_count(capacity), "DFSPH solve sums");
+    store->enqueue_copy_from(*r_->store, count_, r_->stream);
+    cuda_check(cudaStreamSynchronize(r_->stream), "growth of the particle storage");
+    // Nothing below throws: the new buffers replace the old ones (freed at the end of scope).
+    r_->graph.reset();
+    r_->grid.swap(grid);
+    r_->store.swap(store);
+    r_->statistics.swap(statistics);
+    std::swap(r_->solve_partials, partials);
+  });
+  config_.capacity = capacity;
   ++epoch_;
 }
 

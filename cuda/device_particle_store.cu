@@ -120,6 +120,23 @@ void DeviceParticleStore::enqueue_initial_world_words(cudaStream_t stream) const
   }
 }
 
+void DeviceParticleStore::enqueue_copy_from(const DeviceParticleStore& from, uint32_t n,
+                                            cudaStream_t stream) const {
+  if (n > capacity_ || n > from.capacity_ || methods_.size() != from.methods_.size())
+    throw Error(Status::Internal, "copy of the particle store: the stores do not match");
+  copy_async(position_.get(), from.position_.get(), n, stream, "growth: positions");
+  copy_async(velocity_.get(), from.velocity_.get(), n, stream, "growth: velocities");
+  copy_async(id_.get(), from.id_.get(), n, stream, "growth: ids");
+  copy_async(density_.get(), from.density_.get(), n, stream, "growth: densities");
+  for (size_t k = 0; k < methods_.size(); ++k) {
+    const DeviceMethodArray& to = *methods_[k];
+    const DeviceMethodArray& old = *from.methods_[k];
+    if (to.spec.role != ParticleArrayRole::Carried) continue;
+    copy_async(to.side[0].get(), old.side[0].get(), to.bytes_for(n), stream, to.spec.name);
+    copy_async(to.snapshot.get(), old.snapshot.get(), to.bytes_for(n), stream, to.spec.name);
+  }
+}
+
 uint64_t DeviceParticleStore::bytes() const {
   uint64_t total = position_.bytes() + velocity_.bytes() + id_.bytes() + density_.bytes() +
                    sorted_position_.bytes() + sorted_velocity_.bytes() + sorted_id_.bytes() +

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
-// The device-resident particle state of one world, as a structure of arrays, allocated once
-// for the world's capacity. The core state has fixed arrays:
+// The device-resident particle state of one world, as a structure of arrays, allocated for the
+// world's capacity (a world that grows makes a larger store and copies the state over). The core state has
+// fixed arrays:
 //   position/velocity/id/density  the state in the current order (what callers read)
 //   sorted_*                      the working copy in the order of the last sort; the density
 //                                 pass reads it and the force pass writes the state from it.
@@ -115,6 +116,10 @@ class DeviceParticleStore {
   void enqueue_restore(uint32_t n, cudaStream_t stream) const;
   // Sets the methods' world words (and their snapshots) to their initial values (a new world).
   void enqueue_initial_world_words(cudaStream_t stream) const;
+  // Copies the state of particles [0, n) of `from` (a smaller store of the same arrays: a world
+  // that grows), the core's and the Carried arrays' with their snapshots, world words
+  // included. What is not carried is rebuilt by every substep, as after a checkpoint load.
+  void enqueue_copy_from(const DeviceParticleStore& from, uint32_t n, cudaStream_t stream) const;
 
   uint64_t bytes() const;
 

@@ -78,7 +78,8 @@ void copy_back(T* dst, const T* src, uint32_t n, cudaStream_t stream, const char
 }  // namespace
 
 void DeviceSinkCompactor::reserve(uint32_t capacity, const DeviceParticleStore& store) {
-  if (capacity_ != 0 || capacity == 0) return;
+  if (capacity <= capacity_) return;
+  capacity_ = 0;  // a failure half-way leaves the compactor unreserved, so the next frame retries
   const size_t n = capacity;
   words_per_particle_ = 1;  // the densities
   for (const auto& m : store.method_arrays())

@@ -19,7 +19,8 @@ namespace sph {
 
 class DeviceSinkCompactor {
  public:
-  // Allocates the buffers for `capacity` particles (once; throws OUT_OF_DEVICE_MEMORY), with room
+  // Allocates the buffers for `capacity` particles (again when a grown world asks for more;
+  // throws OUT_OF_DEVICE_MEMORY), with room
   // for the widest of the store's carried arrays.
   void reserve(uint32_t capacity, const DeviceParticleStore& store);
   bool ready() const { return capacity_ != 0; }

@@ -74,7 +74,7 @@ typedef enum sph_result {
   SPH_ERROR_VERSION_MISMATCH = -3,     /* struct_size or header_version not accepted */
   SPH_ERROR_UNSUPPORTED = -4,          /* not compiled in, no such device, unknown enum value */
   SPH_ERROR_FEATURE_DISABLED = -5,     /* the feature was not enabled in the world's def */
-  SPH_ERROR_CAPACITY = -6,             /* more particles than the world's capacity */
+  SPH_ERROR_CAPACITY = -6,             /* more particles than the world may hold (max_capacity) */
   SPH_ERROR_OUT_OF_HOST_MEMORY = -7,   /* a host allocation failed */
   SPH_ERROR_OUT_OF_DEVICE_MEMORY = -8, /* a device allocation failed */
   SPH_ERROR_WORLD_LOCKED = -9,         /* the world is in use by another call */
@@ -328,8 +328,9 @@ typedef struct sph_world sph_world;
 typedef struct sph_world_def {
   uint32_t struct_size;                  /* sizeof(sph_world_def), set by sph_world_def_init */
   uint32_t header_version;               /* SPH_VERSION of the caller's header; 0 = unchecked */
-  uint32_t capacity;                     /* most particles the world holds; 0 (default) = 65536;
-                                            at most 2^30 */
+  uint32_t capacity;                     /* particles the world has room for at creation; 0
+                                            (default) = 65536; at most 2^30. A world whose
+                                            max_capacity is larger grows past it on demand. */
   sph_feature_flags features;            /* SPH_FEATURE_* bits; default SPH_FEATURE_NONE */
   sph_integrator integrator;             /* default SPH_INTEGRATOR_SYMPLECTIC_EULER */
   sph_viscosity_method viscosity_method; /* default SPH_VISCOSITY_MUELLER */
@@ -339,8 +340,14 @@ typedef struct sph_world_def {
   float rest_density;                    /* rho0, kg/m^3; 0 (default) = 1000 (water) */
   sph_equation_of_state equation_of_state; /* default SPH_EOS_IDEAL_GAS */
   sph_solver solver;                       /* default SPH_SOLVER_WCSPH */
+  /* Most particles the world may grow to (docs/api.md, "Growable worlds"); 0 (default) =
+     capacity: a fixed world, as before growable worlds. Otherwise >= capacity and at most 2^30.
+     A spawn, fill or source emission that needs more room than the world has reallocates its
+     particle storage to max(needed, 2 x capacity), clamped to max_capacity (amortised: a world
+     grown one particle at a time reallocates O(log n) times). Checkpoints keep both. */
+  uint32_t max_capacity;
 } sph_world_def;
-SPH_STATIC_ASSERT(sizeof(sph_world_def) == 44, sph_world_def_size);
+SPH_STATIC_ASSERT(sizeof(sph_world_def) == 48, sph_world_def_size);
 
 SPH_API sph_result SPH_CALL sph_world_def_init_sized(sph_world_def* def, uint32_t size);
 static inline sph_result sph_world_def_init(sph_world_def* def) {
@@ -353,7 +360,8 @@ static inline sph_result sph_world_def_init(sph_world_def* def) {
  * Creates an empty world on a context. The particle mass is derived here: the mass at which
  * an FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass).
  * Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range:
- * capacity above 2^30, spacing < 0 or non-finite, kernel_radius < spacing, rest_density < 0),
+ * capacity above 2^30, max_capacity non-zero and below capacity or above 2^30, spacing < 0 or
+ * non-finite, kernel_radius < spacing, rest_density < 0),
  * UNSUPPORTED (unknown integrator, feature bit, method or solver; a combination a solver does
  * not support, see sph_solver), VERSION_MISMATCH, OUT_OF_HOST_MEMORY,
  * OUT_OF_DEVICE_MEMORY. *out is written only on success.
@@ -366,7 +374,9 @@ SPH_API sph_result SPH_CALL sph_world_create(sph_context* context, const sph_wor
  * call is using is never freed.
  */
 SPH_API sph_result SPH_CALL sph_world_destroy(sph_world* world);
-/** The def the world was created with, with defaults resolved (zeros and kernel_radius filled in). */
+/** The def the world was created with, with defaults resolved (zeros and kernel_radius filled in),
+ *  except capacity, which reads the world's current capacity (larger than the def's once the
+ *  world grew; never more than max_capacity). */
 SPH_API sph_result SPH_CALL sph_world_get_def(const sph_world* world, sph_world_def* out_def);
 /** Mass of every particle, kg. */
 SPH_API sph_result SPH_CALL sph_world_get_particle_mass(const sph_world* world, float* out_mass);
@@ -687,8 +697,10 @@ static inline sph_result sph_spawn_desc_init(sph_spawn_desc* desc) {
 /**
  * Adds particles from caller arrays (copied before return). All-or-nothing: on any error
  * (non-finite value, a speed of 1.8e19 m/s or more, whose square float32 cannot hold; strides
- * whose span overflows 64 bits; count above the free capacity: SPH_ERROR_CAPACITY) nothing is
- * added.
+ * whose span overflows 64 bits; more particles than max_capacity leaves room for:
+ * SPH_ERROR_CAPACITY, naming the limit; a growth the host or device cannot allocate:
+ * OUT_OF_HOST_MEMORY / OUT_OF_DEVICE_MEMORY) nothing is added and the capacity is as it was.
+ * A world with room up to its max_capacity grows first (sph_world_def.max_capacity).
  * out_first_id (optional) receives the id of the first new particle; ids are consecutive.
  */
 SPH_API sph_result SPH_CALL sph_world_spawn(sph_world* world, const sph_spawn_desc* desc,
@@ -712,7 +724,8 @@ static inline sph_result sph_fill_box_desc_init(sph_fill_box_desc* desc) {
 /**
  * Fills an axis-aligned box with particles on an FCC lattice at the world's particle_spacing
  * (points at least spacing/2 inside each face), at rest density. All-or-nothing:
- * SPH_ERROR_CAPACITY if they do not fit. out_count (optional) receives the number added.
+ * SPH_ERROR_CAPACITY if they do not fit in max_capacity (the world grows as a spawn does).
+ * out_count (optional) receives the number added.
  */
 SPH_API sph_result SPH_CALL sph_world_fill_box(sph_world* world, const sph_fill_box_desc* desc,
                                                uint32_t* out_count);
@@ -897,8 +910,13 @@ typedef struct sph_stats {
   uint32_t pressure_solves_capped;    /* substeps whose density solve stopped at its cap above
                                          its bound (also SPH_EVENT_PRESSURE_SOLVE_CAPPED) */
   uint32_t divergence_solves_capped;  /* likewise (SPH_EVENT_DIVERGENCE_SOLVE_CAPPED) */
+  uint32_t capacity;                  /* particles the world has room for now (always current) */
+  uint32_t max_capacity;              /* most it may grow to (always current) */
+  uint32_t capacity_growths;          /* times the world reallocated its particle storage since
+                                         it was created or loaded (always current) */
+  uint32_t reserved1;
 } sph_stats;
-SPH_STATIC_ASSERT(sizeof(sph_stats) == 144, sph_stats_size);
+SPH_STATIC_ASSERT(sizeof(sph_stats) == 160, sph_stats_size);
 
 SPH_API sph_result SPH_CALL sph_stats_init_sized(sph_stats* stats, uint32_t size);
 static inline sph_result sph_stats_init(sph_stats* stats) {
@@ -1261,9 +1279,11 @@ static inline sph_result sph_source_def_init(sph_source_def* def) {
   return sph_source_def_init_sized(def, (uint32_t)sizeof(*def));
 }
 /**
- * Adds a source (thesis 3.3). Emission happens at the start of each sph_world_step. When the
- * world's capacity runs out, the source emits what fits and the step reports an
- * SPH_EVENT_SOURCE_CAPACITY_REACHED event; nothing else changes. Errors: INVALID_ARGUMENT,
+ * Adds a source (thesis 3.3). Emission happens at the start of each sph_world_step. A growable
+ * world grows for it (SPH_EVENT_CAPACITY_GROWN; a growth that cannot be allocated fails the
+ * step with OUT_OF_*_MEMORY, world unchanged). When max_capacity runs out, the source emits
+ * what fits and the step reports an SPH_EVENT_SOURCE_CAPACITY_REACHED event; nothing else
+ * changes. Errors: INVALID_ARGUMENT,
  * CAPACITY (the region holds more than 2^28 lattice points).
  */
 SPH_API sph_result SPH_CALL sph_source_create(sph_world* world, const sph_source_def* def,
@@ -1447,6 +1467,8 @@ typedef enum sph_event_type {
                                             solve stopped at max_iterations above its bound */
   SPH_EVENT_DIVERGENCE_SOLVE_CAPPED = 4, /* DFSPH; object: none (0); count: substeps whose
                                             divergence solve stopped at its cap above its bound */
+  SPH_EVENT_CAPACITY_GROWN = 5,          /* a source's emission grew the world; object: the
+                                            source; count: the new capacity */
   SPH_EVENT_TYPE_FORCE32 = 0x7fffffff
 } sph_event_type;
 

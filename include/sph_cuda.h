@@ -38,10 +38,13 @@ extern "C" {
  *                       the fourth float of the record is internal and may change.
  *   PRESSURE:           float32 (element_size 4), stride 16.
  *   DENSITY:            float32, stride 4.       ID: uint32, stride 4.
- * The address and layout stay valid for the world's life. The contents are those of data
- * epoch `epoch`: every call that changes particles (spawn, fill, step, also a step that
- * failed and rolled back) increments the world's epoch and rewrites them in place; compare
- * with sph_cuda_world_get_epoch. The memory is the world's: read it, never write or free it.
+ * The address and layout stay valid until the world's capacity grows (a world with
+ * sph_world_def.max_capacity above its capacity reallocates its particles when a spawn, fill or
+ * source needs room: sph_stats.capacity_growths counts it, and the epoch changes; a fixed world
+ * never moves them): take the view again after any call that may add particles. The
+ * contents are those of data epoch `epoch`: every call that changes particles (spawn, fill, step, also a step
+ * that failed and rolled back) increments the world's epoch and rewrites them in place; compare with
+ * sph_cuda_world_get_epoch. The memory is the world's: read it, never write or free it.
  */
 typedef struct sph_cuda_attribute_view {
   uint32_t struct_size;    /* sizeof(sph_cuda_attribute_view), set by the init function */

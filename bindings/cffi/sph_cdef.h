@@ -205,6 +205,7 @@ typedef enum {
   SPH_EVENT_SINK_REMOVED = 2,
   SPH_EVENT_PRESSURE_SOLVE_CAPPED = 3,
   SPH_EVENT_DIVERGENCE_SOLVE_CAPPED = 4,
+  SPH_EVENT_CAPACITY_GROWN = 5,
   SPH_EVENT_TYPE_FORCE32 = 2147483647,
 } sph_event_type;
 
@@ -241,6 +242,7 @@ typedef struct sph_world_def {
   float rest_density;
   sph_equation_of_state equation_of_state;
   sph_solver solver;
+  uint32_t max_capacity;
 } sph_world_def;
 typedef struct sph_world_params {
   uint32_t struct_size;
@@ -372,6 +374,10 @@ typedef struct sph_stats {
   float divergence_error_max;
   uint32_t pressure_solves_capped;
   uint32_t divergence_solves_capped;
+  uint32_t capacity;
+  uint32_t max_capacity;
+  uint32_t capacity_growths;
+  uint32_t reserved1;
 } sph_stats;
 typedef struct sph_grid_desc {
   uint32_t struct_size;

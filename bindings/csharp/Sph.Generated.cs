@@ -153,7 +153,7 @@ namespace Sph
         ErrorUnsupported = -4,
         /// <summary>the feature was not enabled in the world's def</summary>
         ErrorFeatureDisabled = -5,
-        /// <summary>more particles than the world's capacity</summary>
+        /// <summary>more particles than the world may hold (max_capacity)</summary>
         ErrorCapacity = -6,
         /// <summary>a host allocation failed</summary>
         ErrorOutOfHostMemory = -7,
@@ -475,6 +475,8 @@ namespace Sph
         /// bound
         /// </summary>
         DivergenceSolveCapped = 4,
+        /// <summary>a source's emission grew the world; object: the source; count: the new capacity</summary>
+        CapacityGrown = 5,
     }
 
     /// <summary>
@@ -772,7 +774,7 @@ namespace Sph
     }
 
     /// <summary>
-    /// sph_world_def (44 bytes): Creation-time description of a world; fixed for the world's life. Zero
+    /// sph_world_def (48 bytes): Creation-time description of a world; fixed for the world's life. Zero
     /// means default for every field: a zeroed def is the def sph_world_def_init gives.
     /// </summary>
     [StructLayout(LayoutKind.Sequential)]
@@ -782,7 +784,10 @@ namespace Sph
         public uint StructSize;
         /// <summary>uint32_t header_version: SPH_VERSION of the caller's header; 0 = unchecked</summary>
         public uint HeaderVersion;
-        /// <summary>uint32_t capacity: most particles the world holds; 0 (default) = 65536; at most 2^30</summary>
+        /// <summary>
+        /// uint32_t capacity: particles the world has room for at creation; 0 (default) = 65536; at
+        /// most 2^30. A world whose max_capacity is larger grows past it on demand.
+        /// </summary>
         public uint Capacity;
         /// <summary>sph_feature_flags features: SPH_FEATURE_* bits; default SPH_FEATURE_NONE</summary>
         public uint Features;
@@ -800,6 +805,15 @@ namespace Sph
         public EquationOfState EquationOfState;
         /// <summary>sph_solver solver: default SPH_SOLVER_WCSPH</summary>
         public Solver Solver;
+        /// <summary>
+        /// uint32_t max_capacity: Most particles the world may grow to (docs/api.md, "Growable
+        /// worlds"); 0 (default) = capacity: a fixed world, as before growable worlds. Otherwise &gt;=
+        /// capacity and at most 2^30. A spawn, fill or source emission that needs more room than the
+        /// world has reallocates its particle storage to max(needed, 2 x capacity), clamped to
+        /// max_capacity (amortised: a world grown one particle at a time reallocates O(log n) times).
+        /// Checkpoints keep both.
+        /// </summary>
+        public uint MaxCapacity;
 
         /// <summary>A WorldDef with the library's defaults (sph_world_def_init_sized).</summary>
         public static WorldDef Default()
@@ -1229,7 +1243,7 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_stats (144 bytes)</summary>
+    /// <summary>sph_stats (160 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct Stats
     {
@@ -1300,6 +1314,17 @@ namespace Sph
         public uint PressureSolvesCapped;
         /// <summary>uint32_t divergence_solves_capped: likewise (SPH_EVENT_DIVERGENCE_SOLVE_CAPPED)</summary>
         public uint DivergenceSolvesCapped;
+        /// <summary>uint32_t capacity: particles the world has room for now (always current)</summary>
+        public uint Capacity;
+        /// <summary>uint32_t max_capacity: most it may grow to (always current)</summary>
+        public uint MaxCapacity;
+        /// <summary>
+        /// uint32_t capacity_growths: times the world reallocated its particle storage since it was
+        /// created or loaded (always current)
+        /// </summary>
+        public uint CapacityGrowths;
+        /// <summary>uint32_t reserved1</summary>
+        public uint Reserved1;
 
         /// <summary>A Stats with the library's defaults (sph_stats_init_sized).</summary>
         public static Stats Default()
@@ -1918,10 +1943,13 @@ namespace Sph
     /// particle's id). POSITION, VELOCITY: 3 x float32 (element_size 12) inside 16-byte records (stride
     /// 16); the fourth float of the record is internal and may change. PRESSURE:           float32
     /// (element_size 4), stride 16. DENSITY:            float32, stride 4.       ID: uint32, stride 4.
-    /// The address and layout stay valid for the world's life. The contents are those of data epoch
-    /// `epoch`: every call that changes particles (spawn, fill, step, also a step that failed and
-    /// rolled back) increments the world's epoch and rewrites them in place; compare with
-    /// sph_cuda_world_get_epoch. The memory is the world's: read it, never write or free it.
+    /// The address and layout stay valid until the world's capacity grows (a world with
+    /// sph_world_def.max_capacity above its capacity reallocates its particles when a spawn, fill or
+    /// source needs room: sph_stats.capacity_growths counts it, and the epoch changes; a fixed world
+    /// never moves them): take the view again after any call that may add particles. The contents are
+    /// those of data epoch `epoch`: every call that changes particles (spawn, fill, step, also a step
+    /// that failed and rolled back) increments the world's epoch and rewrites them in place; compare
+    /// with sph_cuda_world_get_epoch. The memory is the world's: read it, never write or free it.
     /// </summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct CudaAttributeView
@@ -2132,10 +2160,11 @@ namespace Sph
         /// Creates an empty world on a context. The particle mass is derived here: the mass at which an
         /// FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass).
         /// Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range:
-        /// capacity above 2^30, spacing &lt; 0 or non-finite, kernel_radius &lt; spacing, rest_density
-        /// &lt; 0), UNSUPPORTED (unknown integrator, feature bit, method or solver; a combination a
-        /// solver does not support, see sph_solver), VERSION_MISMATCH, OUT_OF_HOST_MEMORY,
-        /// OUT_OF_DEVICE_MEMORY. *out is written only on success.
+        /// capacity above 2^30, max_capacity non-zero and below capacity or above 2^30, spacing &lt; 0
+        /// or non-finite, kernel_radius &lt; spacing, rest_density &lt; 0), UNSUPPORTED (unknown
+        /// integrator, feature bit, method or solver; a combination a solver does not support, see
+        /// sph_solver), VERSION_MISMATCH, OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY. *out is written
+        /// only on success.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_create(ContextHandle context, ref WorldDef def, out WorldHandle @out);
@@ -2153,7 +2182,8 @@ namespace Sph
 
         /// <summary>
         /// The def the world was created with, with defaults resolved (zeros and kernel_radius filled
-        /// in).
+        /// in), except capacity, which reads the world's current capacity (larger than the def's once
+        /// the world grew; never more than max_capacity).
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_get_def(WorldHandle world, ref WorldDef outDef);
@@ -2375,7 +2405,10 @@ namespace Sph
         /// <summary>
         /// Adds particles from caller arrays (copied before return). All-or-nothing: on any error (non-
         /// finite value, a speed of 1.8e19 m/s or more, whose square float32 cannot hold; strides whose
-        /// span overflows 64 bits; count above the free capacity: SPH_ERROR_CAPACITY) nothing is added.
+        /// span overflows 64 bits; more particles than max_capacity leaves room for:
+        /// SPH_ERROR_CAPACITY, naming the limit; a growth the host or device cannot allocate:
+        /// OUT_OF_HOST_MEMORY / OUT_OF_DEVICE_MEMORY) nothing is added and the capacity is as it was. A
+        /// world with room up to its max_capacity grows first (sph_world_def.max_capacity).
         /// out_first_id (optional) receives the id of the first new particle; ids are consecutive.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
@@ -2392,7 +2425,8 @@ namespace Sph
         /// <summary>
         /// Fills an axis-aligned box with particles on an FCC lattice at the world's particle_spacing
         /// (points at least spacing/2 inside each face), at rest density. All-or-nothing:
-        /// SPH_ERROR_CAPACITY if they do not fit. out_count (optional) receives the number added.
+        /// SPH_ERROR_CAPACITY if they do not fit in max_capacity (the world grows as a spawn does).
+        /// out_count (optional) receives the number added.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_fill_box(WorldHandle world, ref FillBoxDesc desc, out uint outCount);
@@ -2781,10 +2815,12 @@ namespace Sph
         public static extern Result sph_source_def_init_sized(IntPtr def, uint size);
 
         /// <summary>
-        /// Adds a source (thesis 3.3). Emission happens at the start of each sph_world_step. When the
-        /// world's capacity runs out, the source emits what fits and the step reports an
-        /// SPH_EVENT_SOURCE_CAPACITY_REACHED event; nothing else changes. Errors: INVALID_ARGUMENT,
-        /// CAPACITY (the region holds more than 2^28 lattice points).
+        /// Adds a source (thesis 3.3). Emission happens at the start of each sph_world_step. A growable
+        /// world grows for it (SPH_EVENT_CAPACITY_GROWN; a growth that cannot be allocated fails the
+        /// step with OUT_OF_*_MEMORY, world unchanged). When max_capacity runs out, the source emits
+        /// what fits and the step reports an SPH_EVENT_SOURCE_CAPACITY_REACHED event; nothing else
+        /// changes. Errors: INVALID_ARGUMENT, CAPACITY (the region holds more than 2^28 lattice
+        /// points).
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_source_create(WorldHandle world, ref SourceDef def, out SourceId outId);
@@ -3180,7 +3216,7 @@ namespace Sph
         public static readonly int[] StructSizes = {
             12,
             56,
-            44,
+            48,
             48,
             16,
             16,
@@ -3194,7 +3230,7 @@ namespace Sph
             40,
             44,
             36,
-            144,
+            160,
             80,
             104,
             44,
@@ -3246,6 +3282,7 @@ namespace Sph
             typeof(WorldDef),
             typeof(WorldDef),
             typeof(WorldDef),
+            typeof(WorldDef),
             typeof(WorldParams),
             typeof(WorldParams),
             typeof(WorldParams),
@@ -3322,6 +3359,10 @@ namespace Sph
             typeof(FillSphereDesc),
             typeof(FillSphereDesc),
             typeof(FillSphereDesc),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
+            typeof(Stats),
             typeof(Stats),
             typeof(Stats),
             typeof(Stats),
@@ -3494,6 +3535,7 @@ namespace Sph
             "RestDensity",
             "EquationOfState",
             "Solver",
+            "MaxCapacity",
             "StructSize",
             "MaxSubsteps",
             "Gravity",
@@ -3597,6 +3639,10 @@ namespace Sph
             "DivergenceErrorMax",
             "PressureSolvesCapped",
             "DivergenceSolvesCapped",
+            "Capacity",
+            "MaxCapacity",
+            "CapacityGrowths",
+            "Reserved1",
             "StructSize",
             "Dims",
             "IndexToLocal",
@@ -3742,6 +3788,7 @@ namespace Sph
             32,
             36,
             40,
+            44,
             0,
             4,
             8,
@@ -3845,6 +3892,10 @@ namespace Sph
             132,
             136,
             140,
+            144,
+            148,
+            152,
+            156,
             0,
             4,
             16,
@@ -4221,7 +4272,7 @@ namespace Sph
             { "SPH_ERROR_VERSION_MISMATCH", "struct_size or header_version not accepted" },
             { "SPH_ERROR_UNSUPPORTED", "not compiled in, no such device, unknown enum value" },
             { "SPH_ERROR_FEATURE_DISABLED", "the feature was not enabled in the world's def" },
-            { "SPH_ERROR_CAPACITY", "more particles than the world's capacity" },
+            { "SPH_ERROR_CAPACITY", "more particles than the world may hold (max_capacity)" },
             { "SPH_ERROR_OUT_OF_HOST_MEMORY", "a host allocation failed" },
             { "SPH_ERROR_OUT_OF_DEVICE_MEMORY", "a device allocation failed" },
             { "SPH_ERROR_WORLD_LOCKED", "the world is in use by another call" },
@@ -4305,6 +4356,7 @@ namespace Sph
             { "SPH_EVENT_SINK_REMOVED", "object: the sink; count: particles removed" },
             { "SPH_EVENT_PRESSURE_SOLVE_CAPPED", "DFSPH; object: none (0); count: substeps whose density solve stopped at max_iterations above its bound" },
             { "SPH_EVENT_DIVERGENCE_SOLVE_CAPPED", "DFSPH; object: none (0); count: substeps whose divergence solve stopped at its cap above its bound" },
+            { "SPH_EVENT_CAPACITY_GROWN", "a source's emission grew the world; object: the source; count: the new capacity" },
         };
     }
 }

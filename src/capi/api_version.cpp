@@ -57,7 +57,7 @@ SPH_API const char* SPH_CALL sph_result_string(sph_result result) {
     case SPH_ERROR_FEATURE_DISABLED:
       return "SPH_ERROR_FEATURE_DISABLED: the feature is off in the world's def";
     case SPH_ERROR_CAPACITY:
-      return "SPH_ERROR_CAPACITY: more particles than the world's capacity";
+      return "SPH_ERROR_CAPACITY: more particles than the world may hold (max_capacity)";
     case SPH_ERROR_OUT_OF_HOST_MEMORY:
       return "SPH_ERROR_OUT_OF_HOST_MEMORY: a host allocation failed";
     case SPH_ERROR_OUT_OF_DEVICE_MEMORY:

@@ -12,7 +12,7 @@ using sph::Status;
 
 namespace {
 
-constexpr uint32_t kMaxCapacity = 1u << 30;
+constexpr uint32_t kMaxCapacity = sph::kMaxWorldCapacity;
 constexpr float kDefaultKernelRadiusFactor = 1.8f;  // between the 3rd (sqrt 3) and 4th (2) FCC shell
 constexpr float kMaxKernelRadiusFactor = 5.0f;
 
@@ -74,6 +74,10 @@ sph::WorldConfig config_from_def(const sph_world_def& def) {
   if (d.capacity > kMaxCapacity)
     throw Error(Status::InvalidArgument, "def->capacity: must be at most 2^30 (0 = the default 65536), got " +
                                              std::to_string(d.capacity));
+  if (d.max_capacity != 0 && (d.max_capacity < d.capacity || d.max_capacity > kMaxCapacity))
+    throw Error(Status::InvalidArgument,
+                "def->max_capacity: must be 0 (a fixed world) or in [def->capacity " +
+                    std::to_string(d.capacity) + ", 2^30], got " + std::to_string(d.max_capacity));
   if (d.features & ~static_cast<uint32_t>(sph::kFeatureAll)) {
     char buf[16];
     std::snprintf(buf, sizeof buf, "%x", d.features & ~static_cast<uint32_t>(sph::kFeatureAll));
@@ -128,6 +132,7 @@ sph::WorldConfig config_from_def(const sph_world_def& def) {
                                              "cannot represent; choose other units or spacing");
   sph::WorldConfig c;
   c.capacity = d.capacity;
+  c.max_capacity = d.max_capacity == 0 ? d.capacity : d.max_capacity;
   c.features = d.features;
   c.integrator = static_cast<sph::Integrator>(integrator);
   c.viscosity_method = static_cast<sph::ViscosityMethod>(viscosity);
@@ -200,6 +205,7 @@ SPH_API sph_result SPH_CALL sph_world_get_def(const sph_world* world, sph_world_
     sph_world_def d = default_world_def();
     d.header_version = SPH_VERSION;
     d.capacity = c.capacity;
+    d.max_capacity = c.max_capacity;
     d.features = c.features;
     d.integrator = static_cast<sph_integrator>(c.integrator);
     d.viscosity_method = static_cast<sph_viscosity_method>(c.viscosity_method);

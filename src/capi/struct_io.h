@@ -28,9 +28,11 @@ template <>
 inline constexpr uint32_t kFirstStructSize<sph_context_def> =
     24 + 2 * sizeof(void*);  // 0.1.0; 0.2.0 adds the CUDA tuning
 template <>
-inline constexpr uint32_t kFirstStructSize<sph_world_def> = 40;  // 0.1.0; 0.2.0 adds the solver
+inline constexpr uint32_t kFirstStructSize<sph_world_def> =
+    40;  // 0.1.0; 0.2.0 adds the solver, then max_capacity (44 and 48)
 template <>
-inline constexpr uint32_t kFirstStructSize<sph_stats> = 104;  // 0.1.0; 0.2.0 adds DFSPH's solves
+inline constexpr uint32_t kFirstStructSize<sph_stats> =
+    104;  // 0.1.0; 0.2.0 adds DFSPH's solves, then the capacity (144 and 160)
 
 // No public struct comes near this size. A larger struct_size is garbage, not a newer header:
 // it is refused rather than read (its bytes past ours are checked to be zero one by one, and

@@ -52,6 +52,12 @@ class Backend {
   virtual void append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id,
                       uint32_t user_attribute) = 0;
 
+  // Makes room for `capacity` particles (more than config.capacity; the caller has checked
+  // it against max_capacity): every per-particle buffer is reallocated and the particles are
+  // kept. All-or-nothing: throws Error(OutOfHostMemory / OutOfDeviceMemory) and leaves the
+  // backend as it was. Device pointers taken before (device_attribute) are stale after.
+  virtual void reserve(uint32_t capacity) = 0;
+
   // Runs adaptive substeps until frame_dt is reached or params.max_substeps is spent, with the
   // scene's colliders, force fields and sinks. On a non-finite state it restores the particles
   // as they were before the call and throws Error(Status::NonFinite).
@@ -88,7 +94,8 @@ class Backend {
 
   // ---- the device interop tier (include/sph_cuda.h); a backend whose particles live in host
   // memory refuses it with the defaults below ---------------------------------------------------
-  // Where an attribute lives in device memory; the pointer stays valid for the backend's life.
+  // Where an attribute lives in device memory; the pointer stays valid until reserve() grows
+  // the backend (the view's epoch changes then too).
   virtual DeviceAttributeView device_attribute(AttributeKind) const { throw unsupported_interop(); }
   // Increments on every call that changes particle data (append, frames, rollbacks).
   virtual uint64_t data_epoch() const { throw unsupported_interop(); }

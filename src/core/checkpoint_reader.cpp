@@ -31,7 +31,7 @@ using namespace checkpoint_read;
 WorldConfig read_config(ByteReader& r, uint32_t version) {
   WorldConfig c;
   c.capacity = r.u32();
-  if (c.capacity == 0 || c.capacity > (1u << 30))
+  if (c.capacity == 0 || c.capacity > kMaxWorldCapacity)
     corrupt(r.what() + ": capacity " + std::to_string(c.capacity) + " is outside [1, 2^30]");
   c.features = r.u32();
   if (c.features & ~static_cast<uint32_t>(kFeatureAll))
@@ -52,6 +52,13 @@ WorldConfig read_config(ByteReader& r, uint32_t version) {
       corrupt(r.what() +
               ": the DFSPH solver with RK4, an equation of state other than the ideal gas, or "
               "the normalised density (no world can be made so)");
+  }
+  c.max_capacity = c.capacity;  // before version 5 every world was fixed
+  if (version >= kFirstGrowableVersion) {
+    c.max_capacity = r.u32();
+    if (c.max_capacity < c.capacity || c.max_capacity > kMaxWorldCapacity)
+      corrupt(r.what() + ": max_capacity " + std::to_string(c.max_capacity) + " is outside [capacity " +
+              std::to_string(c.capacity) + ", 2^30]");
   }
   if ((c.features & kFeatureDensityDiffusion) &&
       (!(c.features & kFeatureNormalizedDensity) || c.solver == Solver::Dfsph))
@@ -178,7 +185,8 @@ Clock read_clock(ByteReader& r, uint32_t version) {
     if (type != static_cast<uint32_t>(EventType::SourceCapacityReached) &&
         type != static_cast<uint32_t>(EventType::SinkRemoved) &&
         type != static_cast<uint32_t>(EventType::PressureSolveCapped) &&
-        type != static_cast<uint32_t>(EventType::DivergenceSolveCapped))
+        type != static_cast<uint32_t>(EventType::DivergenceSolveCapped) &&
+        (type != static_cast<uint32_t>(EventType::CapacityGrown) || version < kFirstGrowableVersion))
       corrupt(r.what() + ": unknown event type " + std::to_string(type));
     e.type = static_cast<EventType>(type);
     e.count = r.u32();

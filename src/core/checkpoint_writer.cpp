@@ -68,6 +68,7 @@ void write_config(ByteWriter& w, const WorldConfig& c) {
   w.f32(c.rest_density);
   w.f32(c.particle_mass);
   w.u32(static_cast<uint32_t>(c.solver));
+  w.u32(c.max_capacity);  // version 5
 }
 
 void write_solve(ByteWriter& w, const SolveReport& s) {

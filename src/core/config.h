@@ -17,8 +17,17 @@ namespace sph {
 
 enum class Integrator : uint32_t { SymplecticEuler = 0, Rk4 = 1 };
 
+// The hard limit of a world's particle count. Particle indices are uint32 everywhere, the
+// CUDA backend's sort and scans take int counts, and the radix sort's scratch (four uint32
+// arrays of capacity each) lives in one Float4 array of capacity: 2^30 keeps every index,
+// every capacity * 4 and every block count inside 32 bits with room to spare.
+constexpr uint32_t kMaxWorldCapacity = 1u << 30;
+
 struct WorldConfig {
+  // Particles the backend has room for now; grows (World::reserve_particles) up to
+  // max_capacity, never past it, and never shrinks.
   uint32_t capacity = 0;
+  uint32_t max_capacity = 0;  // resolved: >= capacity, <= kMaxWorldCapacity
   uint32_t features = 0;
   Integrator integrator = Integrator::SymplecticEuler;
   ViscosityMethod viscosity_method = ViscosityMethod::Mueller;

@@ -88,6 +88,7 @@ enum class EventType : uint32_t {
   SinkRemoved = 2,
   PressureSolveCapped = 3,
   DivergenceSolveCapped = 4,
+  CapacityGrown = 5,  // object: the source whose emission grew the world; count: the new capacity
 };
 
 struct Event {

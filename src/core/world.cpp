@@ -2,6 +2,7 @@
 #include "world.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -50,19 +51,46 @@ float max_field_speed(const SdfAsset& a) {
 }  // namespace
 
 World::World(const WorldConfig& config, std::unique_ptr<Backend> backend)
-    : config_(config), backend_(std::move(backend)) {}
+    : config_(config), backend_(std::move(backend)) {
+  config_.max_capacity = std::max(config_.max_capacity, config_.capacity);  // 0: a fixed world
+}
+
+std::string World::capacity_limit() const {
+  std::string text = "the world's max_capacity " + std::to_string(config_.max_capacity);
+  if (config_.max_capacity == config_.capacity && config_.capacity < kMaxWorldCapacity)
+    text += " (a fixed world: a larger sph_world_def.max_capacity lets it grow)";
+  return text;
+}
+
+bool World::reserve_particles(uint64_t total) {
+  if (total <= config_.capacity) return false;
+  if (total > config_.max_capacity)
+    throw Error(Status::Capacity, std::to_string(total) + " particles do not fit in " + capacity_limit());
+  const uint64_t doubled = 2ull * config_.capacity;
+  const uint32_t grown =
+      static_cast<uint32_t>(std::min<uint64_t>(std::max(total, doubled), config_.max_capacity));
+  backend_->reserve(grown);  // all-or-nothing
+  config_.capacity = grown;
+  ++capacity_growths_;
+  return true;
+}
 
 uint32_t World::spawn(const std::vector<Vec3>& positions, const std::vector<Vec3>* velocities,
                       uint32_t user_attribute) {
   const uint64_t n = positions.size();
-  if (n > free_capacity())
-    throw Error(Status::Capacity, "spawn: " + std::to_string(n) + " particles do not fit; the world holds " +
-                                      std::to_string(particle_count()) + " of its capacity " +
-                                      std::to_string(config_.capacity));
   if (static_cast<uint64_t>(next_id_) + n > UINT32_MAX)
     throw Error(Status::Capacity, "spawn: the world has used up its 2^32 particle ids");
   const uint32_t first = next_id_;
   if (n == 0) return first;
+  // Grown before the append: a failed append leaves the larger storage, which holds the same
+  // particles (growth changes no particle, and capacity never shrinks).
+  try {
+    reserve_particles(particle_count() + n);
+  } catch (const Error& e) {
+    throw Error(e.status(), "spawn: " + std::string(e.what()) + "; the world holds " +
+                                std::to_string(particle_count()) + " of its capacity " +
+                                std::to_string(config_.capacity));
+  }
   backend_->append(positions.data(), velocities ? velocities->data() : nullptr, static_cast<uint32_t>(n),
                    first, user_attribute);
   next_id_ += static_cast<uint32_t>(n);
@@ -97,9 +125,11 @@ void World::emit_sources(double frame_dt) {
       s.rate_budget += static_cast<double>(s.rate) * frame_dt;
       allowed = std::min(allowed, static_cast<size_t>(s.rate_budget));
     }
-    const size_t fits = std::min<size_t>(allowed, free_capacity());
+    const size_t fits = std::min<size_t>(allowed, room());
     if (fits < allowed)
       events_.push_back(Event{EventType::SourceCapacityReached, id, static_cast<uint32_t>(allowed - fits)});
+    if (reserve_particles(static_cast<uint64_t>(particle_count()) + fits))
+      events_.push_back(Event{EventType::CapacityGrown, id, config_.capacity});
     accepted.resize(fits);
     velocities.resize(fits);
     if (s.mode == SourceMode::Continuous && s.rate > 0.0f) s.rate_budget -= static_cast<double>(fits);
@@ -209,7 +239,8 @@ bool World::step(double frame_dt, const StepInterrupt& interrupt, const FrameEnq
   try {
     // Reserved up front, so that nothing after the backend's frame can fail on an allocation:
     // once the particles have moved, the rest of the step must not throw.
-    events_.reserve(sources_.size() + sinks_.size() + 2);  // + the solves' capped events
+    // + each source's growth + the solves' capped events
+    events_.reserve(2 * sources_.size() + sinks_.size() + 2);
     if (sources_.size() > 0) backend_->save_step_inputs();
     emit_sources(frame_dt);
     SceneFrame scene = build_scene_frame(frame_dt);

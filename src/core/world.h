@@ -46,21 +46,34 @@ class World {
   void set_params(const RuntimeParams& params) { params_ = params; }
 
   uint32_t particle_count() const { return backend_->particle_count(); }
-  uint32_t free_capacity() const { return config_.capacity - particle_count(); }
+  // Particles that may still be added: up to max_capacity (the world grows on demand).
+  uint32_t room() const { return config_.max_capacity - particle_count(); }
+  // Times reserve_particles reallocated the backend since the world was made (or loaded).
+  uint32_t capacity_growths() const { return capacity_growths_; }
+
+  // Makes the backend hold room for `total` particles: nothing when it has; otherwise grows
+  // it to max(total, 2 x capacity), clamped to max_capacity (geometric, so n single spawns
+  // cost O(log n) reallocations). Error(Capacity) naming max_capacity when total exceeds it;
+  // the backend's OutOf*Memory when it cannot allocate. Either way the world is as it was.
+  // Returns whether it grew.
+  bool reserve_particles(uint64_t total);
+  // "the world's max_capacity N", for the messages of every refusal past it.
+  std::string capacity_limit() const;
 
   // ---- particles in (world_particles.cpp) ----
   // The entry points validate everything before they change anything: on any error the world
   // is as it was. Field errors are FieldErrors named as the public descs name them
   // ("positions[3]", "max"); the C layer puts "desc->" in front.
   //
-  // FieldError(Capacity) "count" unless `count` more particles fit (callers check before
-  // they copy a large input).
+  // FieldError(Capacity) "count" unless `count` more particles fit under max_capacity
+  // (callers check before they copy a large input).
   void require_room_for_particles(uint64_t count) const;
   // Adds particles at finite positions within 65536 particle spacings of the origin, with
   // finite velocities (or none: at rest). Returns the first new id; ids are consecutive.
   uint32_t add_particles(const std::vector<Vec3>& positions, const std::vector<Vec3>* velocities);
   // FCC lattices at the world's spacing in a box or a sphere (fcc_lattice.h); an empty box or
-  // radius 0 fills nothing. Error(Capacity) when the lattice does not fit. Returns the count.
+  // radius 0 fills nothing. Error(Capacity) when the lattice does not fit under max_capacity.
+  // Returns the count.
   uint32_t fill_box(const FillBoxSpec& spec);
   uint32_t fill_sphere(const FillSphereSpec& spec);
 
@@ -182,6 +195,7 @@ class World {
   double simulated_time_ = 0.0;
   FrameReport report_;
   float last_step_ms_ = 0.0f;
+  uint32_t capacity_growths_ = 0;
   std::vector<Event> events_;
   SlotMap<Collider> colliders_{kTagCollider};
   SlotMap<Source> sources_{kTagSource};

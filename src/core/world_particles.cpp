@@ -36,10 +36,10 @@ std::string World::position_problem(const Vec3& p) const {
 }
 
 void World::require_room_for_particles(uint64_t count) const {
-  if (count > free_capacity())
+  if (count > room())
     throw FieldError(Status::Capacity, "count",
-                     std::to_string(count) + " particles do not fit; " + std::to_string(free_capacity()) +
-                         " of the capacity " + std::to_string(config_.capacity) + " are free");
+                     std::to_string(count) + " particles do not fit; " + std::to_string(room()) + " of " +
+                         capacity_limit() + " are free");
 }
 
 uint32_t World::add_particles(const std::vector<Vec3>& positions, const std::vector<Vec3>* velocities) {
@@ -67,11 +67,10 @@ uint32_t World::add_particles(const std::vector<Vec3>& positions, const std::vec
 
 namespace {
 
-void require_fill_fits(uint64_t count, uint32_t free, uint32_t capacity) {
+void require_fill_fits(uint64_t count, uint32_t free, const std::string& limit) {
   if (count > free)
     throw Error(Status::Capacity, "the fill makes " + std::to_string(count) + " particles but only " +
-                                      std::to_string(free) + " of the world's capacity " +
-                                      std::to_string(capacity) + " are free");
+                                      std::to_string(free) + " of " + limit + " are free");
 }
 
 }  // namespace
@@ -83,7 +82,7 @@ uint32_t World::fill_box(const FillBoxSpec& spec) {
   if (!(spec.max.x >= spec.min.x && spec.max.y >= spec.min.y && spec.max.z >= spec.min.z))
     throw FieldError(Status::InvalidArgument, "max", "every component must be >= min's");
   const float s = config_.particle_spacing;
-  require_fill_fits(fcc_box_point_count(spec.min, spec.max, s), free_capacity(), config_.capacity);
+  require_fill_fits(fcc_box_point_count(spec.min, spec.max, s), room(), capacity_limit());
   const std::vector<Vec3> points = fcc_points_in_box(spec.min, spec.max, s);
   return fill(points, spec.velocity, "min/max");
 }
@@ -97,13 +96,13 @@ uint32_t World::fill_sphere(const FillSphereSpec& spec) {
   // Refuse before generating anything when the lattice cannot possibly fit (the estimate
   // is within a few percent of the exact count for any sphere larger than a few spacings).
   const double estimate = fcc_sphere_point_estimate(spec.radius, s);
-  if (estimate > 2.0 * free_capacity() + 4096.0)
-    require_fill_fits(static_cast<uint64_t>(std::min(estimate, 1.8e19)), free_capacity(), config_.capacity);
+  if (estimate > 2.0 * room() + 4096.0)
+    require_fill_fits(static_cast<uint64_t>(std::min(estimate, 1.8e19)), room(), capacity_limit());
   return fill(fcc_points_in_sphere(spec.center, spec.radius, s), spec.velocity, "center/radius");
 }
 
 uint32_t World::fill(const std::vector<Vec3>& points, const Vec3& velocity, const char* region_fields) {
-  require_fill_fits(points.size(), free_capacity(), config_.capacity);
+  require_fill_fits(points.size(), room(), capacity_limit());
   for (const Vec3& p : points) {
     const std::string problem = resolution_problem(p, config_.particle_spacing);
     if (!problem.empty())

@@ -181,6 +181,13 @@ void test_library_rejections_name_the_object(void**) {
   expect_build_error(
       R"({"world": {"capacity": 100}, "fluids": [{"type": "box", "min": [0, 0, 0], "max": [1, 1, 1]}]})",
       "fluids[0]: the fluid body does not fit: the world holds 0 of 100 particles (raise world.capacity)");
+  // A growable world grows for a body up to its max_capacity, and names that limit past it.
+  expect_build_error(
+      R"({"world": {"capacity": 10, "max_capacity": 200}, "fluids": [{"type": "box", "min": [0, 0, 0], "max": [1, 1, 1]}]})",
+      "fluids[0]: the fluid body does not fit: the world holds 0 of 200 particles (raise "
+      "world.max_capacity)");
+  expect_build_error(R"({"world": {"capacity": 10, "max_capacity": 5}})",
+                     "world: the library rejected the world: sph_world_create: def->max_capacity");
   // A later body that does not fit is reported when its time comes.
   expect_build_error(R"({"world": {"capacity": 1000}, "time": {"fps": 60},
                          "fluids": [{"type": "sphere", "center": [0, 0, 0], "radius": 0.1},

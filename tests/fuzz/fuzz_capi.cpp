@@ -9,6 +9,7 @@
 // library must refuse them before it allocates or reads anything.
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <vector>
@@ -36,7 +37,7 @@ struct ContextSlot {
 struct WorldSlot {
   sph_world* ptr = nullptr;
   int context = -1;
-  uint32_t capacity = 0;
+  uint32_t capacity = 0;  // the most particles it may hold: its max_capacity (it grows on demand)
   uint32_t features = 0;
   uint32_t integrator = 0, viscosity = 0, eos = 0;
   float spacing = 0.0f;
@@ -428,7 +429,25 @@ class Program {
       // large); invalid ones (> 2^30) must be refused; 0 is the default, 65536.
       if (raw == 0 || raw > (1u << 30)) d.capacity = raw;
     }
-    d.features = in_.chance(224) ? in_.u8() % 4 : in_.u32();
+    // The features byte's spare bits choose max_capacity, so that inputs written before the
+    // field (the regressions) keep their byte stream.
+    uint32_t growth = 0;
+    if (in_.chance(224)) {
+      const uint8_t bits = in_.u8();
+      d.features = bits % 4;
+      growth = bits >> 2;
+    } else {
+      d.features = in_.u32();
+    }
+    const uint64_t resolved = d.capacity == 0 ? 65536u : d.capacity;
+    if (growth >= 32 && growth < 62)  // a growable world, up to 31 x its capacity
+      d.max_capacity = static_cast<uint32_t>(std::min<uint64_t>(resolved * (growth - 30), 0xffffffffu));
+    else if (growth == 62)
+      d.max_capacity = static_cast<uint32_t>(resolved - 1);  // below the capacity: refused (unless 0)
+    else if (growth == 63)
+      d.max_capacity = (1u << 30) + 1u;  // past the hard limit: refused
+    const bool max_refused =
+        d.max_capacity != 0 && (d.max_capacity < resolved || d.max_capacity > (1u << 30));
     const uint32_t integrator = in_.chance(224) ? in_.u8() % 2 : in_.u32();
     const uint32_t viscosity = in_.chance(224) ? in_.u8() % 2 : in_.u32();
     const uint32_t eos = in_.chance(224) ? in_.u8() % 2 : in_.u32();
@@ -449,20 +468,25 @@ class Program {
       return;
     }
     if (cslot < 0) violation("sph_world_create succeeded on a dead or foreign context");
+    const bool read_max = d.struct_size >= offsetof(sph_world_def, max_capacity) + sizeof(uint32_t);
+    if (read_max && max_refused) violation("sph_world_create accepted max_capacity %u", d.max_capacity);
     WorldSlot& w = worlds_[slot];
     w.ptr = out;
     w.context = cslot;
     sph_world_def got;
     sph_world_def_init(&got);
     FUZZ_CALL(sph_world_get_def(out, &got));
-    w.capacity = got.capacity;
+    w.capacity = got.max_capacity;
     w.features = got.features;
     w.integrator = static_cast<uint32_t>(got.integrator);
     w.viscosity = static_cast<uint32_t>(got.viscosity_method);
     w.eos = static_cast<uint32_t>(got.equation_of_state);
     w.spacing = got.particle_spacing;
-    if (w.capacity != (d.capacity == 0 ? 65536u : d.capacity))
-      violation("the world's capacity %u is not the def's %u", w.capacity, d.capacity);
+    if (got.capacity != resolved)
+      violation("the world's capacity %u is not the def's %u", got.capacity, d.capacity);
+    const uint32_t max_expected = read_max && d.max_capacity != 0 ? d.max_capacity : got.capacity;
+    if (got.max_capacity != max_expected)
+      violation("the world's max_capacity %u is not the def's %u", got.max_capacity, max_expected);
     if (!(got.kernel_radius >= got.particle_spacing)) violation("kernel radius below the spacing");
     if (w.capacity > kMaxCapacity) {
       // Valid but beyond what the harness steps through: drop the world again.

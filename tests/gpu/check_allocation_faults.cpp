@@ -7,7 +7,10 @@
 // allocation. Every injected failure must come back as SPH_ERROR_OUT_OF_DEVICE_MEMORY (or
 // OUT_OF_HOST_MEMORY for pinned memory) with a message, leave the world bitwise as it was, and
 // the world must then step bitwise like an undisturbed copy (the CUDA backend is
-// deterministic: gpu_check_determinism).
+// deterministic: gpu_check_determinism). The growable-world calls (issue 19 item 1) start from
+// a world whose capacity its particles fill exactly, so the call must grow it first: every
+// allocation of the growth fails in turn and must leave the world, its capacity included, as
+// it was.
 #include <functional>
 
 #include "../../cuda/device_allocation_faults.h"
@@ -36,12 +39,14 @@ sph_transform at(float x, float y, float z) {
 enum class Objects { None, BeforeFirstStep, AfterFirstStep };
 
 // A tank with water and one frame behind it; with a tank collider, a continuous source and a
-// sink added before that frame, or after it (so the next step is their first).
-void build_scene(Scene* s, Objects objects) {
+// sink added before that frame, or after it (so the next step is their first). A growable
+// world starts at capacity 16 and grows to exactly its water's count with the fill.
+void build_scene(Scene* s, Objects objects, bool growable = false) {
   s->context = make_context(SPH_BACKEND_CUDA);
   sph_world_def def;
   sph_world_def_init(&def);
-  def.capacity = 4000;
+  def.capacity = growable ? 16 : 4000;
+  def.max_capacity = growable ? 100000 : 0;
   def.particle_spacing = 0.02f;
   require_ok(sph_world_create(s->context, &def, &s->world), "sph_world_create");
   sph_shape_desc shape;
@@ -96,12 +101,13 @@ void destroy_scene(Scene* s) {
 
 struct Snapshot {
   uint32_t count = 0;
+  uint32_t capacity = 0;
   double time = 0.0;
   std::vector<float> position, velocity, density;
   std::vector<uint32_t> id;
   bool operator==(const Snapshot& o) const {
-    return count == o.count && time == o.time && position == o.position && velocity == o.velocity &&
-           density == o.density && id == o.id;
+    return count == o.count && capacity == o.capacity && time == o.time && position == o.position &&
+           velocity == o.velocity && density == o.density && id == o.id;
   }
 };
 
@@ -112,6 +118,7 @@ Snapshot take(const sph_world* world) {
   sph_stats_init(&stats);
   require_ok(sph_world_get_stats(world, &stats), "stats");
   s.time = stats.simulated_time;
+  s.capacity = stats.capacity;
   s.position.resize(3 * size_t{s.count});
   s.velocity.resize(3 * size_t{s.count});
   s.density.resize(s.count);
@@ -137,11 +144,12 @@ struct Call {
   std::function<sph_result(Scene&)> run;
   std::function<void(Scene&)> undo;  // releases what a successful call made (not the world's)
   bool changes_world;
+  bool growable = false;  // the scene's world is full and may grow (build_scene)
 };
 
 void check_call(const Call& call) {
   Scene scene;
-  build_scene(&scene, call.objects);
+  build_scene(&scene, call.objects, call.growable);
   long faults_injected = 0;
   bool ok = true;
   std::string problem;
@@ -165,7 +173,7 @@ void check_call(const Call& call) {
     if (r == SPH_OK) {  // absorbed (a fallback path): start again from a fresh scene
       if (call.undo) call.undo(scene);
       destroy_scene(&scene);
-      build_scene(&scene, call.objects);
+      build_scene(&scene, call.objects, call.growable);
       continue;
     }
     uint32_t objects_after = 0;
@@ -187,7 +195,7 @@ void check_call(const Call& call) {
   }
   if (ok && call.changes_world) {
     Scene reference;
-    build_scene(&reference, call.objects);
+    build_scene(&reference, call.objects, call.growable);
     require_ok(call.run(reference), call.name);
     require_ok(sph_world_step(scene.world, kFrameDt), "step after the faults");
     require_ok(sph_world_step(reference.world, kFrameDt), "reference step");
@@ -251,6 +259,18 @@ int main() {
        [](Scene& s) { return sph_world_step(s.world, kFrameDt); }, nullptr, true},
       {"sph_world_step (plain)", Objects::None, [](Scene& s) { return sph_world_step(s.world, kFrameDt); },
        nullptr, true},
+      {"sph_world_fill_box (growing a full world)", Objects::None,
+       [](Scene& s) {
+         sph_fill_box_desc box;
+         sph_fill_box_desc_init(&box);
+         box.min = sph_vec3{0.05f, -0.18f, -0.08f};
+         box.max = sph_vec3{0.15f, -0.1f, 0.08f};
+         return sph_world_fill_box(s.world, &box, nullptr);
+       },
+       nullptr, true, true},
+      {"sph_world_step (a source growing a full world; a sink reserving for the new capacity)",
+       Objects::AfterFirstStep, [](Scene& s) { return sph_world_step(s.world, kFrameDt); }, nullptr, true,
+       true},
   };
   for (const Call& call : calls) check_call(call);
   return finish();

@@ -10,9 +10,13 @@ namespace sph_tools {
 void parse_world(const JsonNode& node, sph_world_def* def) {
   sph_world_def_init(def);
   if (node.missing()) return;
-  node.expect_object("world", {"capacity", "particle_spacing", "kernel_radius", "rest_density", "integrator",
-                               "features", "viscosity_method", "equation_of_state", "solver"});
+  node.expect_object(
+      "world", {"capacity", "particle_spacing", "kernel_radius", "rest_density", "integrator", "features",
+                "viscosity_method", "equation_of_state", "solver", "max_capacity"});
   def->capacity = node["capacity"].opt_count(def->capacity, 1, std::numeric_limits<uint32_t>::max());
+  // A growable world (docs/api.md, "Growable worlds"); the library checks it against capacity.
+  def->max_capacity =
+      node["max_capacity"].opt_count(def->max_capacity, 1, std::numeric_limits<uint32_t>::max());
   def->particle_spacing = node["particle_spacing"].opt_positive(def->particle_spacing);
   def->kernel_radius = node["kernel_radius"].opt_positive(def->kernel_radius);
   if (def->kernel_radius != 0.0f && def->kernel_radius < def->particle_spacing)

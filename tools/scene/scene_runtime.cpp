@@ -160,8 +160,8 @@ void SceneRuntime::add_fluid(const FluidDesc& f) {
     uint32_t count = 0;
     sph_world_get_particle_count(world_, &count);
     throw SceneError(f.path, "the fluid body does not fit: the world holds " + std::to_string(count) +
-                                 " of " + std::to_string(scene_.world.capacity) +
-                                 " particles (raise world.capacity)");
+                                 " of " + std::to_string(world_limit()) + " particles (" + raise_hint() +
+                                 ")");
   }
   check_object(r, f.path, "fluid body");
 }
@@ -253,9 +253,8 @@ void SceneRuntime::collect_events() {
     std::string path = "sources";
     for (size_t i = 0; i < sources_.size(); ++i)
       if (sources_[i].id.bits == e.object_bits) path = scene_.sources[i].path;
-    warnings_.push_back(path + ": the world's capacity (" + std::to_string(scene_.world.capacity) +
-                        ") is reached; " + std::to_string(e.count) +
-                        " particles were not emitted (raise world.capacity)");
+    warnings_.push_back(path + ": the world's capacity (" + std::to_string(world_limit()) + ") is reached; " +
+                        std::to_string(e.count) + " particles were not emitted (" + raise_hint() + ")");
   }
 }
 

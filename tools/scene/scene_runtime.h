@@ -53,6 +53,16 @@ class SceneRuntime {
   void start_source(size_t i);
   void start_force_field(size_t i);
   void collect_events();
+  // The most particles the world may hold, and what to raise for more (a growable world's
+  // max_capacity, or a fixed world's capacity).
+  uint32_t world_limit() const {
+    return scene_.world.max_capacity > scene_.world.capacity ? scene_.world.max_capacity
+                                                             : scene_.world.capacity;
+  }
+  const char* raise_hint() const {
+    return scene_.world.max_capacity > scene_.world.capacity ? "raise world.max_capacity"
+                                                             : "raise world.capacity";
+  }
 
   const SceneDesc& scene_;
   sph_context* context_ = nullptr;

@@ -169,6 +169,7 @@ def build():
             "description": STRING,
             "world": obj({
                 "capacity": {"type": "integer", "minimum": 1, "maximum": 4294967295},
+                "max_capacity": {"type": "integer", "minimum": 1, "maximum": 4294967295},
                 "particle_spacing": POSITIVE, "kernel_radius": POSITIVE, "rest_density": POSITIVE,
                 "integrator": {"enum": ["symplectic_euler", "rk4"]},
                 "features": {"type": "array", "items": {"enum": FEATURES}},

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'dd3c4e011aaa8b2a66a03330b00d44d37bf680ef19d8f58aebae8d886b886e15', 'include/sph_cuda.h': '9dfeaac87d033150d96782c34a29b248b5139133ee901b11953c2d157e47363f', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': 'bc147262e5027a71c84f65a5c440f81cc642615a35a5c07f4c3e1fb9483f2392', 'include/sph_cuda.h': 'c684e65602dfd8308b1fc6a37541e8372192d22a76cc8d370b7db2bb126a15f8', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -106,7 +106,7 @@ SPH_ERROR_INVALID_HANDLE = -2  # a NULL, destroyed or foreign object
 SPH_ERROR_VERSION_MISMATCH = -3  # struct_size or header_version not accepted
 SPH_ERROR_UNSUPPORTED = -4  # not compiled in, no such device, unknown enum value
 SPH_ERROR_FEATURE_DISABLED = -5  # the feature was not enabled in the world's def
-SPH_ERROR_CAPACITY = -6  # more particles than the world's capacity
+SPH_ERROR_CAPACITY = -6  # more particles than the world may hold (max_capacity)
 SPH_ERROR_OUT_OF_HOST_MEMORY = -7  # a host allocation failed
 SPH_ERROR_OUT_OF_DEVICE_MEMORY = -8  # a device allocation failed
 SPH_ERROR_WORLD_LOCKED = -9  # the world is in use by another call
@@ -136,7 +136,7 @@ class Result(_enum.IntEnum):
     ERROR_UNSUPPORTED = -4
     #: the feature was not enabled in the world's def
     ERROR_FEATURE_DISABLED = -5
-    #: more particles than the world's capacity
+    #: more particles than the world may hold (max_capacity)
     ERROR_CAPACITY = -6
     #: a host allocation failed
     ERROR_OUT_OF_HOST_MEMORY = -7
@@ -579,6 +579,7 @@ SPH_EVENT_SOURCE_CAPACITY_REACHED = 1  # object: the source; count: particles no
 SPH_EVENT_SINK_REMOVED = 2  # object: the sink; count: particles removed
 SPH_EVENT_PRESSURE_SOLVE_CAPPED = 3  # DFSPH; object: none (0); count: substeps whose density solve stopped at max_iterations above its bound
 SPH_EVENT_DIVERGENCE_SOLVE_CAPPED = 4  # DFSPH; object: none (0); count: substeps whose divergence solve stopped at its cap above its bound
+SPH_EVENT_CAPACITY_GROWN = 5  # a source's emission grew the world; object: the source; count: the new capacity
 SPH_EVENT_TYPE_FORCE32 = 2147483647
 
 
@@ -594,6 +595,8 @@ class EventType(_enum.IntEnum):
     #: DFSPH; object: none (0); count: substeps whose divergence solve stopped at its cap above its
     #: bound
     DIVERGENCE_SOLVE_CAPPED = 4
+    #: a source's emission grew the world; object: the source; count: the new capacity
+    CAPACITY_GROWN = 5
 
 
 #: Doc text of every enum member, by C name (e.g. the element format of an attribute).
@@ -605,7 +608,7 @@ ENUM_MEMBER_DOCS = {
     'SPH_ERROR_VERSION_MISMATCH': 'struct_size or header_version not accepted',
     'SPH_ERROR_UNSUPPORTED': 'not compiled in, no such device, unknown enum value',
     'SPH_ERROR_FEATURE_DISABLED': "the feature was not enabled in the world's def",
-    'SPH_ERROR_CAPACITY': "more particles than the world's capacity",
+    'SPH_ERROR_CAPACITY': 'more particles than the world may hold (max_capacity)',
     'SPH_ERROR_OUT_OF_HOST_MEMORY': 'a host allocation failed',
     'SPH_ERROR_OUT_OF_DEVICE_MEMORY': 'a device allocation failed',
     'SPH_ERROR_WORLD_LOCKED': 'the world is in use by another call',
@@ -689,6 +692,7 @@ ENUM_MEMBER_DOCS = {
     'SPH_EVENT_SINK_REMOVED': 'object: the sink; count: particles removed',
     'SPH_EVENT_PRESSURE_SOLVE_CAPPED': 'DFSPH; object: none (0); count: substeps whose density solve stopped at max_iterations above its bound',
     'SPH_EVENT_DIVERGENCE_SOLVE_CAPPED': 'DFSPH; object: none (0); count: substeps whose divergence solve stopped at its cap above its bound',
+    'SPH_EVENT_CAPACITY_GROWN': "a source's emission grew the world; object: the source; count: the new capacity",
 }
 
 # ---- type aliases -----------------------------------------------------------------------------
@@ -799,7 +803,7 @@ class WorldDef(_SphStruct):
     Fields:
         struct_size (uint32_t): sizeof(sph_world_def), set by sph_world_def_init
         header_version (uint32_t): SPH_VERSION of the caller's header; 0 = unchecked
-        capacity (uint32_t): most particles the world holds; 0 (default) = 65536; at most 2^30
+        capacity (uint32_t): particles the world has room for at creation; 0 (default) = 65536; at most 2^30. A world whose max_capacity is larger grows past it on demand.
         features (sph_feature_flags): SPH_FEATURE_* bits; default SPH_FEATURE_NONE
         integrator (sph_integrator): default SPH_INTEGRATOR_SYMPLECTIC_EULER
         viscosity_method (sph_viscosity_method): default SPH_VISCOSITY_MUELLER
@@ -808,6 +812,7 @@ class WorldDef(_SphStruct):
         rest_density (float): rho0, kg/m^3; 0 (default) = 1000 (water)
         equation_of_state (sph_equation_of_state): default SPH_EOS_IDEAL_GAS
         solver (sph_solver): default SPH_SOLVER_WCSPH
+        max_capacity (uint32_t): Most particles the world may grow to (docs/api.md, "Growable worlds"); 0 (default) = capacity: a fixed world, as before growable worlds. Otherwise >= capacity and at most 2^30. A spawn, fill or source emission that needs more room than the world has reallocates its particle storage to max(needed, 2 x capacity), clamped to max_capacity (amortised: a world grown one particle at a time reallocates O(log n) times). Checkpoints keep both.
     """
     _fields_ = [
         ('struct_size', _c.c_uint32),
@@ -821,10 +826,11 @@ class WorldDef(_SphStruct):
         ('rest_density', _c.c_float),
         ('equation_of_state', sph_equation_of_state),
         ('solver', sph_solver),
+        ('max_capacity', _c.c_uint32),
     ]
     _sph_c_name_ = 'sph_world_def'
-    _sph_size_ = 44
-    _sph_offsets_ = (('struct_size', 0), ('header_version', 4), ('capacity', 8), ('features', 12), ('integrator', 16), ('viscosity_method', 20), ('particle_spacing', 24), ('kernel_radius', 28), ('rest_density', 32), ('equation_of_state', 36), ('solver', 40))
+    _sph_size_ = 48
+    _sph_offsets_ = (('struct_size', 0), ('header_version', 4), ('capacity', 8), ('features', 12), ('integrator', 16), ('viscosity_method', 20), ('particle_spacing', 24), ('kernel_radius', 28), ('rest_density', 32), ('equation_of_state', 36), ('solver', 40), ('max_capacity', 44))
     _sph_init_ = 'sph_world_def_init_sized'
     _sph_assigns_ = {'header_version': SPH_VERSION}
     _sph_enums_ = {'integrator': Integrator, 'viscosity_method': ViscosityMethod, 'equation_of_state': EquationOfState, 'solver': Solver}
@@ -1241,6 +1247,10 @@ class Stats(_SphStruct):
         divergence_error_max (float): the largest of any substep
         pressure_solves_capped (uint32_t): substeps whose density solve stopped at its cap above its bound (also SPH_EVENT_PRESSURE_SOLVE_CAPPED)
         divergence_solves_capped (uint32_t): likewise (SPH_EVENT_DIVERGENCE_SOLVE_CAPPED)
+        capacity (uint32_t): particles the world has room for now (always current)
+        max_capacity (uint32_t): most it may grow to (always current)
+        capacity_growths (uint32_t): times the world reallocated its particle storage since it was created or loaded (always current)
+        reserved1 (uint32_t)
     """
     _fields_ = [
         ('struct_size', _c.c_uint32),
@@ -1270,10 +1280,14 @@ class Stats(_SphStruct):
         ('divergence_error_max', _c.c_float),
         ('pressure_solves_capped', _c.c_uint32),
         ('divergence_solves_capped', _c.c_uint32),
+        ('capacity', _c.c_uint32),
+        ('max_capacity', _c.c_uint32),
+        ('capacity_growths', _c.c_uint32),
+        ('reserved1', _c.c_uint32),
     ]
     _sph_c_name_ = 'sph_stats'
-    _sph_size_ = 144
-    _sph_offsets_ = (('struct_size', 0), ('particle_count', 4), ('substeps', 8), ('neighbors_max', 12), ('simulated_time', 16), ('frame_time', 24), ('dt_min', 28), ('dt_max', 32), ('max_speed', 36), ('density_min', 40), ('density_mean', 44), ('density_max', 48), ('neighbors_mean', 52), ('stage_ms', 56), ('step_ms', 88), ('reserved0', 92), ('memory_bytes', 96), ('pressure_iterations', 104), ('pressure_iterations_max', 108), ('divergence_iterations', 112), ('divergence_iterations_max', 116), ('density_error_mean', 120), ('density_error_max', 124), ('divergence_error_mean', 128), ('divergence_error_max', 132), ('pressure_solves_capped', 136), ('divergence_solves_capped', 140))
+    _sph_size_ = 160
+    _sph_offsets_ = (('struct_size', 0), ('particle_count', 4), ('substeps', 8), ('neighbors_max', 12), ('simulated_time', 16), ('frame_time', 24), ('dt_min', 28), ('dt_max', 32), ('max_speed', 36), ('density_min', 40), ('density_mean', 44), ('density_max', 48), ('neighbors_mean', 52), ('stage_ms', 56), ('step_ms', 88), ('reserved0', 92), ('memory_bytes', 96), ('pressure_iterations', 104), ('pressure_iterations_max', 108), ('divergence_iterations', 112), ('divergence_iterations_max', 116), ('density_error_mean', 120), ('density_error_max', 124), ('divergence_error_mean', 128), ('divergence_error_max', 132), ('pressure_solves_capped', 136), ('divergence_solves_capped', 140), ('capacity', 144), ('max_capacity', 148), ('capacity_growths', 152), ('reserved1', 156))
     _sph_init_ = 'sph_stats_init_sized'
 
 
@@ -1883,10 +1897,14 @@ class CudaAttributeView(_SphStruct):
     VELOCITY: 3 x float32 (element_size 12) inside 16-byte records (stride 16); the fourth float
     of the record is internal and may change. PRESSURE:           float32 (element_size 4),
     stride 16. DENSITY:            float32, stride 4.       ID: uint32, stride 4. The address
-    and layout stay valid for the world's life. The contents are those of data epoch `epoch`:
-    every call that changes particles (spawn, fill, step, also a step that failed and rolled
-    back) increments the world's epoch and rewrites them in place; compare with
-    sph_cuda_world_get_epoch. The memory is the world's: read it, never write or free it.
+    and layout stay valid until the world's capacity grows (a world with
+    sph_world_def.max_capacity above its capacity reallocates its particles when a spawn, fill
+    or source needs room: sph_stats.capacity_growths counts it, and the epoch changes; a fixed
+    world never moves them): take the view again after any call that may add particles. The
+    contents are those of data epoch `epoch`: every call that changes particles (spawn, fill,
+    step, also a step that failed and rolled back) increments the world's epoch and rewrites
+    them in place; compare with sph_cuda_world_get_epoch. The memory is the world's: read it,
+    never write or free it.
 
     Fields:
         struct_size (uint32_t): sizeof(sph_cuda_attribute_view), set by the init function
@@ -1949,11 +1967,11 @@ FUNCTIONS = {
     'sph_world_def_init_sized': (sph_result, (_c.POINTER(sph_world_def), _c.c_uint32), ('def', 'size'),
         '', 'sph'),
     'sph_world_create': (sph_result, (_c.POINTER(sph_context), _c.POINTER(sph_world_def), _c.POINTER(_c.POINTER(sph_world))), ('context', 'def', 'out'),
-        'Creates an empty world on a context. The particle mass is derived here: the mass at which an FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass). Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range: capacity above 2^30, spacing < 0 or non-finite, kernel_radius < spacing, rest_density < 0), UNSUPPORTED (unknown integrator, feature bit, method or solver; a combination a solver does not support, see sph_solver), VERSION_MISMATCH, OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY. *out is written only on success.', 'sph'),
+        'Creates an empty world on a context. The particle mass is derived here: the mass at which an FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass). Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range: capacity above 2^30, max_capacity non-zero and below capacity or above 2^30, spacing < 0 or non-finite, kernel_radius < spacing, rest_density < 0), UNSUPPORTED (unknown integrator, feature bit, method or solver; a combination a solver does not support, see sph_solver), VERSION_MISMATCH, OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY. *out is written only on success.', 'sph'),
     'sph_world_destroy': (sph_result, (_c.POINTER(sph_world),), ('world',),
         "Destroys a world and everything in it. NULL is a no-op. It takes the world like every call that takes a world: WORLD_LOCKED while another thread's call is inside it (destroy again once that call returned); a call that races a destroy that won gets INVALID_HANDLE. Memory a call is using is never freed.", 'sph'),
     'sph_world_get_def': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_world_def)), ('world', 'out_def'),
-        'The def the world was created with, with defaults resolved (zeros and kernel_radius filled in).', 'sph'),
+        "The def the world was created with, with defaults resolved (zeros and kernel_radius filled in), except capacity, which reads the world's current capacity (larger than the def's once the world grew; never more than max_capacity).", 'sph'),
     'sph_world_get_particle_mass': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_float)), ('world', 'out_mass'),
         'Mass of every particle, kg.', 'sph'),
     'sph_world_params_init_sized': (sph_result, (_c.POINTER(sph_world_params), _c.c_uint32), ('params', 'size'),
@@ -2017,11 +2035,11 @@ FUNCTIONS = {
     'sph_spawn_desc_init_sized': (sph_result, (_c.POINTER(sph_spawn_desc), _c.c_uint32), ('desc', 'size'),
         '', 'sph'),
     'sph_world_spawn': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_spawn_desc), _c.POINTER(_c.c_uint32)), ('world', 'desc', 'out_first_id'),
-        'Adds particles from caller arrays (copied before return). All-or-nothing: on any error (non-finite value, a speed of 1.8e19 m/s or more, whose square float32 cannot hold; strides whose span overflows 64 bits; count above the free capacity: SPH_ERROR_CAPACITY) nothing is added. out_first_id (optional) receives the id of the first new particle; ids are consecutive.', 'sph'),
+        'Adds particles from caller arrays (copied before return). All-or-nothing: on any error (non-finite value, a speed of 1.8e19 m/s or more, whose square float32 cannot hold; strides whose span overflows 64 bits; more particles than max_capacity leaves room for: SPH_ERROR_CAPACITY, naming the limit; a growth the host or device cannot allocate: OUT_OF_HOST_MEMORY / OUT_OF_DEVICE_MEMORY) nothing is added and the capacity is as it was. A world with room up to its max_capacity grows first (sph_world_def.max_capacity). out_first_id (optional) receives the id of the first new particle; ids are consecutive.', 'sph'),
     'sph_fill_box_desc_init_sized': (sph_result, (_c.POINTER(sph_fill_box_desc), _c.c_uint32), ('desc', 'size'),
         '', 'sph'),
     'sph_world_fill_box': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_fill_box_desc), _c.POINTER(_c.c_uint32)), ('world', 'desc', 'out_count'),
-        "Fills an axis-aligned box with particles on an FCC lattice at the world's particle_spacing (points at least spacing/2 inside each face), at rest density. All-or-nothing: SPH_ERROR_CAPACITY if they do not fit. out_count (optional) receives the number added.", 'sph'),
+        "Fills an axis-aligned box with particles on an FCC lattice at the world's particle_spacing (points at least spacing/2 inside each face), at rest density. All-or-nothing: SPH_ERROR_CAPACITY if they do not fit in max_capacity (the world grows as a spawn does). out_count (optional) receives the number added.", 'sph'),
     'sph_fill_sphere_desc_init_sized': (sph_result, (_c.POINTER(sph_fill_sphere_desc), _c.c_uint32), ('desc', 'size'),
         '', 'sph'),
     'sph_world_fill_sphere': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_fill_sphere_desc), _c.POINTER(_c.c_uint32)), ('world', 'desc', 'out_count'),
@@ -2103,7 +2121,7 @@ FUNCTIONS = {
     'sph_source_def_init_sized': (sph_result, (_c.POINTER(sph_source_def), _c.c_uint32), ('def', 'size'),
         '', 'sph'),
     'sph_source_create': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_source_def), _c.POINTER(sph_source_id)), ('world', 'def', 'out_id'),
-        "Adds a source (thesis 3.3). Emission happens at the start of each sph_world_step. When the world's capacity runs out, the source emits what fits and the step reports an SPH_EVENT_SOURCE_CAPACITY_REACHED event; nothing else changes. Errors: INVALID_ARGUMENT, CAPACITY (the region holds more than 2^28 lattice points).", 'sph'),
+        'Adds a source (thesis 3.3). Emission happens at the start of each sph_world_step. A growable world grows for it (SPH_EVENT_CAPACITY_GROWN; a growth that cannot be allocated fails the step with OUT_OF_*_MEMORY, world unchanged). When max_capacity runs out, the source emits what fits and the step reports an SPH_EVENT_SOURCE_CAPACITY_REACHED event; nothing else changes. Errors: INVALID_ARGUMENT, CAPACITY (the region holds more than 2^28 lattice points).', 'sph'),
     'sph_source_destroy': (sph_result, (_c.POINTER(sph_world), sph_source_id), ('world', 'id'),
         '', 'sph'),
     'sph_source_set_transform': (sph_result, (_c.POINTER(sph_world), sph_source_id, _c.POINTER(sph_transform)), ('world', 'id', 'transform'),

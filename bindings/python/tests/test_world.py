@@ -153,6 +153,28 @@ def test_spawn_errors_leave_the_world_unchanged(ctx):
             w.spawn(np.zeros((2, 3)), np.zeros((3, 3)))
 
 
+def test_growable_world_grows_on_demand_up_to_its_maximum(ctx):
+    # max_capacity lets the capacity grow: to max(needed, 2 x capacity), up to the maximum.
+    with ctx.world(capacity=10, max_capacity=100, particle_spacing=0.05) as w:
+        assert w.definition.max_capacity == 100
+        row = np.array([[0.05 * i, 0.0, 0.0] for i in range(100)], dtype=np.float32)
+        w.spawn(row[:25])
+        s = w.stats()
+        assert (s.capacity, s.max_capacity, s.capacity_growths) == (25, 100, 1)
+        w.spawn(row[25:26])
+        assert (w.stats().capacity, w.definition.capacity) == (50, 50)
+        with pytest.raises(sph.SphError) as e:
+            w.spawn(row[26:] + np.float32(1.0))  # 26 + 74 = 100 fits, 101 would not
+            w.spawn(row[:1] + np.float32(2.0))
+        assert e.value.result == sph.Result.ERROR_CAPACITY
+        assert "max_capacity 100" in e.value.message
+        assert w.particle_count == 100 and w.stats().capacity == 100
+    # The default is a fixed world.
+    with ctx.world(capacity=10) as w:
+        assert w.definition.max_capacity == 10
+        assert error(w.spawn, np.zeros((11, 3), dtype=np.float32)) == sph.Result.ERROR_CAPACITY
+
+
 def test_raw_spawn_desc_errors(world):
     d = sph.SpawnDesc(count=1)  # positions NULL
     assert error(raw, "sph_world_spawn", world.handle, ctypes.byref(d), None) == sph.Result.ERROR_INVALID_ARGUMENT
