@@ -5,14 +5,15 @@
  *     change plus the impulses the colliders received equals gravity's impulse (the pair forces
  *     cancel in pairs, tests/physics/test_momentum.c), with and without the walls in the density,
  *     both integrators: within 1 % of gravity's impulse;
- *   - a hydrostatic tank: the force on its side wall against rho0 g H^2 W / 2;
+ *   - a hydrostatic tank: the force on its side wall against the resting compressible column's
+ *     (rho0 g H^2 W / 2 less 1.07 % at k = 100);
  *   - a fixed box submerged in a tank: its force against rho0 g V upwards once settled.
- *     These two measure the solver's pressure at walls more than the accounting: measured +8.1 %
- *     and +13.4 % with the walls in the density (WCSPH, k = 100: the pressure near walls reads
- *     high, docs/physics.md), -41 % and -64 % without. The issue's bound, 2 %, is asserted with
- *     LOADS_STRICT=1 (for the solver that should meet it, DFSPH, when it merges); by default the
- *     bound is the solver's accuracy now, 10 % and 15 %, with the walls in the density closer
- *     than without (a regression guard, not the goal);
+ *     These two measure the solver's pressure at walls more than the accounting. With the walls in
+ *     the density: the side wall +11.0 % (a film the walls' calibration keeps free of water, an
+ *     error of the order of the spacing; measured against resolution at the test), the box
+ *     -2.2 %; without them -41 % and -63 %. The issue's bound, 2 %, is asserted with
+ *     LOADS_STRICT=1; by default the bounds are the measurements with room for rounding, 12 %
+ *     and 3 %, and the walls in the density must do better than the collision response alone;
  *   - the loads pass leaves the trajectory alone (bit for bit, friction on);
  *   - the C API: FEATURE_DISABLED without the bit, a handle check, the load point's torque.
  * LOADS_MEASURE=1 prints the measurements without asserting the bounds. */
@@ -186,67 +187,116 @@ static void test_loads_leave_the_trajectory_alone(void** state) {
 
 /* ---- a hydrostatic tank's side wall ------------------------------------------------------------ */
 
-/* Water 10 x 14 x 10 layers (W = 10 cm wide, H = 14 cm deep) at rest in a tank whose face at x = 0
- * is a collider of its own (a plane, solid x < 0; the tank's box reaches 5 cm beyond it, out of
- * the fluid's reach). Settled for 1.2 s; the plane's force averaged over the last 0.4 s against
- * rho0 g H^2 W / 2 (H = layers * step: the lattice holds its volume at rest density). */
-static double side_wall_force(uint32_t features, double* expected) {
-  const uint32_t layers[3] = {10, 14, 10};
-  const double width = layers[0] * kStep, depth = layers[1] * kStep;
+/* The force per unit width on a side wall of a resting ideal-gas column holding H of water (its
+ * mass per unit area rho0 H): with p = k (rho - rho0), dp/dd = rho g gives rho = rho0 e^(a d),
+ * a = g / k; the column's depth D has (e^(a D) - 1) / a = H, and the force is
+ * int_0^D p dd = k rho0 (H - D). Below rho0 g H^2 / 2 (its k -> infinity limit) by 1.07 % at
+ * H = 14 cm, k = 100: the weakly compressible fluid's column is 0.7 % shorter. */
+static double compressible_wall_force(double rho0, double k, double height) {
+  const double a = kGravity / k, depth = log1p(a * height) / a;
+  return k * rho0 * (height - depth);
+}
+
+typedef struct side_wall_result {
+  double force;          /* N, the fluid's push on the wall, averaged */
+  double expected;       /* N, the compressible column's (above) over the wall's width */
+  double incompressible; /* N, rho0 g H^2 W / 2 */
+  double gauge_height;   /* m, a gauge's water height in the middle of the tank, averaged */
+} side_wall_result;
+
+/* Water of 10 x 14 x 10 lattice layers of `step` (W = 10 step wide, H = 14 step deep, its volume
+ * exactly the tank's: support_fcc_box's lattice reaches step / 2 beyond its outer points) at rest
+ * in a tank whose face at x = 0 is a collider of its own (a plane, solid x < 0; the tank's box
+ * reaches 5 cm beyond it, out of the fluid's reach). Settled for 0.8 s, then the plane's force
+ * and a gauge in the middle averaged over 0.4 s. */
+static side_wall_result side_wall_force(uint32_t features, double step) {
+  const double scale = kStep / step;
+  const uint32_t layers[3] = {(uint32_t)lround(10 * scale), (uint32_t)lround(14 * scale),
+                              (uint32_t)lround(10 * scale)};
+  const double width = layers[0] * step, depth = layers[1] * step;
   const double tank_min[3] = {-0.05, 0.0, 0.0}, tank_max[3] = {width, 2.0 * depth, width};
+  const double stiffness = 100.0;
   float* lattice = NULL;
   uint32_t n = 0;
   support_world w;
   sph_sdf *tank_sdf = NULL, *wall_sdf = NULL;
   sph_collider_id wall;
+  sph_probe_id gauge;
+  sph_probe_def gauge_def;
   sph_world_def def;
   sph_world_params params;
-  double sum = 0.0, time = 0.0;
-  assert_int_equal(support_fcc_box(layers, kStep, NULL, &lattice, &n), SPH_OK);
+  side_wall_result out = {0.0, 0.0, 0.0, 0.0};
+  double sum = 0.0, height = 0.0, time = 0.0;
+  assert_int_equal(support_fcc_box(layers, step, NULL, &lattice, &n), SPH_OK);
   def = loads_def(SPH_FEATURE_COLLIDER_LOADS | features, n, SPH_INTEGRATOR_SYMPLECTIC_EULER);
+  def.particle_spacing = (float)(step * sqrt(2.0));
   EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
   sph_world_params_init(&params);
+  params.stiffness = (float)stiffness;
   params.step_limits = SPH_STEP_LIMIT_ACOUSTIC;
   EXPECT_OK(sph_world_set_params(w.world, &params));
-  EXPECT_OK(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * kStep, 0.0f, &tank_sdf, NULL));
+  EXPECT_OK(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * step, 0.0f, &tank_sdf, NULL));
   wall = add_axis_wall(&w, 0, -1.0, 0.0, &wall_sdf);
   EXPECT_OK(support_spawn(w.world, lattice, NULL, n));
+  EXPECT_OK(sph_probe_def_init(&gauge_def));
+  gauge_def.kind = SPH_PROBE_GAUGE;
+  gauge_def.sampling = SPH_PROBE_EVERY_SUBSTEP;
+  gauge_def.position.x = gauge_def.position.z = (float)(0.5 * width);
+  gauge_def.position.y = -0.05f; /* from inside the floor to above the surface */
+  gauge_def.length = (float)(0.05 + 2.0 * depth);
+  EXPECT_OK(sph_probe_create(w.world, &gauge_def, &gauge));
   for (int frame = 0; frame < 60; ++frame) {
     EXPECT_OK(sph_world_step(w.world, 0.02f));
     if (frame < 40) continue;
     {
       const sph_collider_loads l = loads_of(w.world, wall);
+      sph_probe_reading r;
+      EXPECT_OK(sph_probe_reading_init(&r));
+      EXPECT_OK(sph_probe_get_reading(w.world, gauge, &r));
       sum += l.force.x * l.frame_time;
+      height += r.water_height * l.frame_time;
       time += l.frame_time;
     }
   }
-  *expected = w.def.rest_density * kGravity * depth * depth * width / 2.0;
+  out.force = -sum / time; /* the fluid pushes the wall towards -x */
+  out.gauge_height = height / time;
+  out.expected = compressible_wall_force(w.def.rest_density, stiffness, depth) * width;
+  out.incompressible = w.def.rest_density * kGravity * depth * depth * width / 2.0;
   free(lattice);
   EXPECT_OK(sph_sdf_destroy(tank_sdf));
   EXPECT_OK(sph_sdf_destroy(wall_sdf));
   EXPECT_OK(support_world_close(&w));
-  return -sum / time; /* the fluid pushes the wall towards -x */
+  return out;
 }
 
 static void test_hydrostatic_side_wall(void** state) {
-  double expected = 0.0;
-  const double on = side_wall_force(SPH_FEATURE_BOUNDARY_DENSITY, &expected);
-  const double off = side_wall_force(SPH_FEATURE_NONE, &expected);
+  /* LOADS_SIDE_WALL_STEP=0.00707 (with LOADS_MEASURE=1) measures at a finer lattice. */
+  const double step = getenv("LOADS_SIDE_WALL_STEP") ? atof(getenv("LOADS_SIDE_WALL_STEP")) : kStep;
+  const side_wall_result on = side_wall_force(SPH_FEATURE_BOUNDARY_DENSITY, step);
+  const side_wall_result off = side_wall_force(SPH_FEATURE_NONE, step);
+  const double error = on.force / on.expected - 1.0;
   (void)state;
   print_message(
-      "hydrostatic side wall: %.4f N with walls in the density (%+.2f %%), %.4f N without "
-      "(%+.2f %%), rho0 g H^2 W / 2 = %.4f N\n",
-      on, 100.0 * (on / expected - 1.0), off, 100.0 * (off / expected - 1.0), expected);
-  /* The issue's 2 % holds only under LOADS_STRICT=1 and fails today: +10.0 % since the boundary
-   * density's wall force became the gradient of the sampled share (it was +8.1 % before, when a
-   * 10 % guard stood here; the buoyancy case below went from +13.4 % to -2.2 % with the same
-   * change). The lattice starts 0.35 spacings from the walls, where the calibration puts a
-   * resting layer at 0.5 (docs/physics.md), which may account for the rest. By default the check
-   * is the comparison that the accounting must pass whatever the wall model's accuracy: the walls
-   * in the density bring the force closer to rho0 g H^2 W / 2 than the collision response alone. */
-  assert_true((fabs(on - expected) < fabs(off - expected) &&
-               (!getenv("LOADS_STRICT") || fabs(on / expected - 1.0) <= wall_bound(0.02))) ||
-              measuring());
+      "hydrostatic side wall, step %.4f m: %.4f N with walls in the density (%+.2f %%; gauge %.4f m), "
+      "%.4f N without (%+.2f %%; gauge %.4f m); the compressible column's %.4f N, rho0 g H^2 W / 2 = "
+      "%.4f N, H = %.4f m\n",
+      step, on.force, 100.0 * error, on.gauge_height, off.force, 100.0 * (off.force / off.expected - 1.0),
+      off.gauge_height, on.expected, on.incompressible, 14.0 * step * lround(kStep / step * 14.0) / 14.0);
+  /* The issue asks 2 % (asserted under LOADS_STRICT=1); not met by the walls in the density as
+   * calibrated (docs/validation.md, "Loads on a hydrostatic tank's side wall"). Their calibration
+   * holds a resting layer spacing / 2 from a wall, while a lattice plane's share of the volume
+   * reaches only half the plane gap, step / 2, towards it: every wall keeps a film of
+   * (spacing - step) / 2 = 0.21 step free of water, the tank holds its water as a tank 0.41 step
+   * narrower would, and the water stands higher (the gauge: +7.1 % at step 1 cm, +4.0 % at
+   * 0.71 cm). That film is an error of the order of the spacing over the tank's width: the force
+   * is +11.0 % at 1 cm and +6.8 % at 0.71 cm. With the calibration moved to the lattice's
+   * mid-plane (an experiment, not committed: every fill_box scene would then start 0.15 spacings
+   * off its walls, so fill_box's margin has to move with it) it is -3.4 % and -3.1 %, and the
+   * gauge -1.5 % and -0.9 %. The bound is the measurement at this resolution with room for
+   * rounding: 12 %; and the walls in the density must beat the collision response alone (-41 %). */
+  assert_true(
+      (fabs(on.force - on.expected) < fabs(off.force - off.expected) && fabs(error) <= wall_bound(0.12)) ||
+      measuring());
 }
 
 /* ---- buoyancy of a fixed submerged box ---------------------------------------------------------- */
@@ -326,7 +376,7 @@ static void test_submerged_box_buoyancy(void** state) {
       "submerged box: buoyancy %.4f N with walls in the density (%+.2f %%), %.4f N without "
       "(%+.2f %%), rho0 g V = %.4f N\n",
       on, 100.0 * (on / expected - 1.0), off, 100.0 * (off / expected - 1.0), expected);
-  assert_true((fabs(on / expected - 1.0) <= wall_bound(0.15) && fabs(on - expected) < fabs(off - expected)) ||
+  assert_true((fabs(on / expected - 1.0) <= wall_bound(0.03) && fabs(on - expected) < fabs(off - expected)) ||
               measuring());
 }
 
