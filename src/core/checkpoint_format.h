@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The checkpoint layout shared by the writer and the reader (docs/checkpoint.md). All numbers
-// little-endian; floats IEEE 754. Version 4 (version 3 lacks the density diffusion's block in
+// little-endian; floats IEEE 754. Version 5 (version 4 lacks the probes' section PROB and the
+// colliders' load points, which load as none and the origin; version 3 lacks the density diffusion's block in
 // PARM, read by name like every block, so a version 3 file loads with its defaults; version 2
 // lacks the solver in CONF, the solves' report in TIME and DFSPH's warm starts in PART; version 1
 // differs from 2 only in the parameters section, checkpoint_params.h; all load). A world with
@@ -21,7 +22,8 @@ namespace sph {
 namespace checkpoint {
 
 constexpr uint8_t kMagic[8] = {'S', 'P', 'H', 'C', 'K', 'P', 'T', 0x1a};
-constexpr uint32_t kFormatVersion = 4;          // what the writer writes
+constexpr uint32_t kFormatVersion = 5;          // what the writer writes
+constexpr uint32_t kFirstProbeVersion = 5;      // the first with probes (PROB) and load points
 constexpr uint32_t kFirstSolverVersion = 3;     // the first with the solver, its report and warm starts
 constexpr uint32_t kOldestReadableVersion = 1;  // the oldest the reader still loads
 constexpr size_t kHeaderSize = 48;
