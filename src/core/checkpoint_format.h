@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The checkpoint layout shared by the writer and the reader (docs/checkpoint.md). All numbers
 // little-endian; floats IEEE 754. Version 5 (version 4 lacks the probes' section PROB and the
-// colliders' load points, which load as none and the origin; version 3 lacks the density diffusion's block in
+// colliders' load points: such a file loads with no probes, sph_world_restore keeps the world's
+// own, and load points at the colliders' origins; version 3 lacks the density diffusion's block in
 // PARM, read by name like every block, so a version 3 file loads with its defaults; version 2
 // lacks the solver in CONF, the solves' report in TIME and DFSPH's warm starts in PART; version 1
 // differs from 2 only in the parameters section, checkpoint_params.h; all load). A world with
@@ -53,8 +54,19 @@ constexpr SectionInfo kSectionOrder[] = {
     {tag('S', 'R', 'C', 'E'), "sources"},
     {tag('S', 'I', 'N', 'K'), "sinks"},
     {tag('F', 'F', 'L', 'D'), "force fields"},
+    {tag('P', 'R', 'O', 'B'), "probes"},  // from version 5
 };
 constexpr uint32_t kSectionCount = sizeof(kSectionOrder) / sizeof(kSectionOrder[0]);
+// The format version of a checkpoint that loaded (its header's bytes 8-11, little-endian).
+inline uint32_t format_version_of(const void* data) {
+  const uint8_t* b = static_cast<const uint8_t*>(data);
+  return static_cast<uint32_t>(b[8]) | (static_cast<uint32_t>(b[9]) << 8) |
+         (static_cast<uint32_t>(b[10]) << 16) | (static_cast<uint32_t>(b[11]) << 24);
+}
+// The sections a file of `version` has: all but PROB before version 5.
+constexpr uint32_t section_count_of(uint32_t version) {
+  return version >= kFirstProbeVersion ? kSectionCount : kSectionCount - 1;
+}
 
 constexpr uint32_t kNoAsset = 0xffffffffu;       // an object without this asset
 constexpr uint32_t kAssetHasVelocity = 1u << 0;  // SDF asset channel bits

@@ -526,13 +526,13 @@ static void test_floating_box(void** state) {
   /* The issue asks 5 % of Archimedes' draft (asserted under LOADS_STRICT=1); measured +11.6 % at
    * the sample's 2 cm (h = 3.6 cm) and +7.1 % at 1.41 cm (h = 2.5 cm, 2.8 times the particles, too
    * slow for CI): it rides deeper, by 0.58 cm and 0.36 cm, 0.16 h and 0.14 h, an error that
-   * shrinks with the spacing (the summation's density deficit in the diffuse layer at the free
-   * surface around the box, whose pressure the clamped equation of state drops, takes some of
-   * the buoyancy; at a wall the walls in the density make up for it, at the free surface nothing
-   * does). Measured against the level a gauge reads, not the fill height (the sample's 6.5-7 cm
-   * "draft" was below y = 20 cm, where the water did not stand). The heave decays from 2.3 cm to
-   * 0.1 cm. Bounds: 15 % (the measurement with room for rounding and a GPU's different sums), and
-   * the last second's heave under a tenth of the first's. */
+   * shrinks with the spacing (not isolated; probably the summation's density deficit in the
+   * diffuse layer at the free surface around the box, whose pressure the clamped equation of
+   * state drops: the box's bottom lies 1.4 h below the surface, where test_probes.c's 1 %
+   * agreement, from 3.7 h down, is not measured). Measured against the level a gauge reads, not the fill
+   * height (the sample's 6.5-7 cm "draft" was below y = 20 cm, where the water did not stand). The heave
+   * decays from 2.3 cm to 0.1 cm. Bounds: 15 % (the measurement with room for rounding and a GPU's different
+   * sums), and the last second's heave under a tenth of the first's. */
   assert_true((fabs(draft / archimedes - 1.0) <= wall_bound(0.15) && late < 0.1 * early) || measuring());
 }
 
@@ -593,6 +593,29 @@ static void test_loads_api(void** state) {
     /* tau_z = (x - p)_x F_y - (x - p)_y F_x ~ (-0.05) F_y > 0 (the weight's line is at x = 0.05). */
     assert_true(l.torque.z > 0.0f &&
                 fabs(l.torque.z - (-0.05f * l.force.y)) <= 0.2f * fabs(0.05f * l.force.y));
+    /* A checkpoint carries the load point (format 5): a loaded copy steps to the same loads. */
+    {
+      uint64_t size = 0;
+      void* saved;
+      sph_world* copy = NULL;
+      sph_collider_loads a, b;
+      EXPECT_OK(sph_world_save(w.world, NULL, 0, &size));
+      saved = malloc(size);
+      assert_non_null(saved);
+      EXPECT_OK(sph_world_save(w.world, saved, size, &size));
+      EXPECT_OK(sph_world_load(w.context, saved, size, &copy));
+      free(saved);
+      EXPECT_OK(sph_world_step(w.world, 0.02f));
+      EXPECT_OK(sph_world_step(copy, 0.02f));
+      a = loads_of(w.world, tank);
+      b = loads_of(copy, tank);
+      assert_true(fabs(b.point.x - 0.10f) < 1e-6f);
+      assert_memory_equal(&a.force, &b.force, sizeof a.force);
+      assert_memory_equal(&a.torque, &b.torque, sizeof a.torque);
+      assert_memory_equal(&a.point, &b.point, sizeof a.point);
+      assert_true(a.frame_time == b.frame_time);
+      EXPECT_OK(sph_world_destroy(copy));
+    }
   }
   EXPECT_OK(sph_sdf_destroy(sdf));
   EXPECT_OK(support_world_close(&w));

@@ -12,7 +12,7 @@
  *   - a body of water moving at a uniform velocity without gravity: a probe it passes reads that
  *     velocity and rho0, a gauge through it the block's height (its fill height);
  *   - sampling: EVERY_SUBSTEP averages the step's substeps, EVERY_FRAME reads the last; a
- *     restore keeps the probes;
+ *     checkpoint carries the probes (a restore and a load);
  *   - bad input: each field named, the world unchanged (no slot taken), handles checked.
  * PROBES_MEASURE=1 prints the measurements without asserting the bounds. */
 #include <math.h>
@@ -424,22 +424,38 @@ static void test_sampling(void** state) {
   assert_true(b.kernel_sum > 0.5);
   assert_true(c.samples == 1 && c.kernel_sum == 0.0f && c.density == 0.0f && c.pressure == 0.0f);
   {
-    /* A restore keeps the world's probes and their ids (checkpoints hold no probes); their
-     * readings start again. */
+    /* Checkpoints carry the probes (format 5): a restore brings back the saved probes with their
+     * ids (one removed after the save returns, one added after it is gone), their readings start
+     * again; a world loaded from the checkpoint has them too and reads what the original reads. */
     uint64_t size = 0;
     void* saved;
+    sph_world* loaded = NULL;
+    sph_probe_id later;
+    sph_probe_reading r;
     EXPECT_OK(sph_world_save(w.world, NULL, 0, &size));
     saved = malloc(size);
     assert_non_null(saved);
     EXPECT_OK(sph_world_save(w.world, saved, size, &size));
     EXPECT_OK(sph_world_step(w.world, 0.02f));
+    EXPECT_OK(sph_probe_destroy(w.world, air));
+    later = add_gauge(w.world, 0.03, -0.02, 0.03, 0.1, 0.0);
     EXPECT_OK(sph_world_restore(w.world, saved, size));
+    EXPECT_OK(sph_probe_reading_init(&r));
+    EXPECT_OK(sph_probe_get_reading(w.world, air, &r));
+    EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, NULL, sph_probe_get_reading(w.world, later, &r));
+    EXPECT_OK(sph_world_load(w.context, saved, size, &loaded));
     free(saved);
+    EXPECT_OK(sph_world_step(loaded, 0.02f));
+    EXPECT_OK(sph_probe_get_reading(loaded, every, &r));
     a = reading_of(w.world, every);
     assert_int_equal(a.samples, 0);
     EXPECT_OK(sph_world_step(w.world, 0.02f));
     a = reading_of(w.world, every);
     assert_true(a.samples > 1 && a.kernel_sum > 0.5f);
+    /* the same state, the same step: the same reading */
+    assert_true(a.samples == r.samples && a.density == r.density && a.pressure == r.pressure &&
+                a.kernel_sum == r.kernel_sum && a.time == r.time);
+    EXPECT_OK(sph_world_destroy(loaded));
   }
   EXPECT_OK(support_world_close(&w));
 }
