@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "../core/checkpoint.h"
+#include "../core/checkpoint_format.h"
 #include "checkpoint_files.h"
 #include "guard.h"
 #include "handles.h"
@@ -118,7 +119,10 @@ SPH_API sph_result SPH_CALL sph_world_restore(sph_world* world, const void* data
     sph::WorldLock lock(world);
     // The new state is built whole beside the old one, then swapped in.
     std::unique_ptr<sph::World> loaded = load_world(world->context, data, size);
-    loaded->adopt_probes(*world->world);  // probes are not in checkpoints; the world keeps its own
+    // A file of format 5 or later carries its probes; an older one has none, and the world
+    // keeps its own (the rule before probes were in checkpoints).
+    if (sph::checkpoint::format_version_of(data) < sph::checkpoint::kFirstProbeVersion)
+      loaded->adopt_probes(*world->world);
     world->world.swap(loaded);
     return SPH_OK;
   });

@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: MIT
 // The checkpoint layout shared by the writer and the reader (docs/checkpoint.md). All numbers
-// little-endian; floats IEEE 754. Version 5 (version 4 lacks max_capacity at the end of CONF,
-// which then equals the capacity: a fixed world, and SPH_EVENT_CAPACITY_GROWN; version 3 lacks the density
-// diffusion's block in PARM, read by name like every block, so a version 3 file loads with its defaults;
-// version 2 lacks the solver in CONF, the solves' report in TIME and DFSPH's warm starts in PART; version 1
+// little-endian; floats IEEE 754. Version 6 (version 5 lacks the probes' section PROB and the
+// colliders' load points: such a file loads with no probes, sph_world_restore keeps the world's
+// own, and load points at the colliders' origins; version 4 also lacks max_capacity at the end of
+// CONF, which then equals the capacity: a fixed world, and SPH_EVENT_CAPACITY_GROWN; version 3 lacks
+// the density diffusion's block in PARM, read by name like every block, so a version 3 file loads with
+// its defaults; version 2 lacks the solver in CONF, the solves' report in TIME and DFSPH's warm starts in
+// PART; version 1
 // differs from 2 only in the parameters section, checkpoint_params.h; all load). A world with
 // SPH_FEATURE_USER_ATTRIBUTE adds its values to PART and each source's to SRCE: a layout only that feature
 // bit in CONF selects, so it needed no new version (a library without the feature refuses the bit):
@@ -22,7 +25,8 @@ namespace sph {
 namespace checkpoint {
 
 constexpr uint8_t kMagic[8] = {'S', 'P', 'H', 'C', 'K', 'P', 'T', 0x1a};
-constexpr uint32_t kFormatVersion = 5;          // what the writer writes
+constexpr uint32_t kFormatVersion = 6;          // what the writer writes
+constexpr uint32_t kFirstProbeVersion = 6;      // the first with probes (PROB) and load points
 constexpr uint32_t kFirstSolverVersion = 3;     // the first with the solver, its report and warm starts
 constexpr uint32_t kFirstGrowableVersion = 5;   // the first with max_capacity in CONF
 constexpr uint32_t kOldestReadableVersion = 1;  // the oldest the reader still loads
@@ -53,8 +57,19 @@ constexpr SectionInfo kSectionOrder[] = {
     {tag('S', 'R', 'C', 'E'), "sources"},
     {tag('S', 'I', 'N', 'K'), "sinks"},
     {tag('F', 'F', 'L', 'D'), "force fields"},
+    {tag('P', 'R', 'O', 'B'), "probes"},  // from version 5
 };
 constexpr uint32_t kSectionCount = sizeof(kSectionOrder) / sizeof(kSectionOrder[0]);
+// The format version of a checkpoint that loaded (its header's bytes 8-11, little-endian).
+inline uint32_t format_version_of(const void* data) {
+  const uint8_t* b = static_cast<const uint8_t*>(data);
+  return static_cast<uint32_t>(b[8]) | (static_cast<uint32_t>(b[9]) << 8) |
+         (static_cast<uint32_t>(b[10]) << 16) | (static_cast<uint32_t>(b[11]) << 24);
+}
+// The sections a file of `version` has: all but PROB before version 5.
+constexpr uint32_t section_count_of(uint32_t version) {
+  return version >= kFirstProbeVersion ? kSectionCount : kSectionCount - 1;
+}
 
 constexpr uint32_t kNoAsset = 0xffffffffu;       // an object without this asset
 constexpr uint32_t kAssetHasVelocity = 1u << 0;  // SDF asset channel bits

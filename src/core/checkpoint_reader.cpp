@@ -313,9 +313,9 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   if (sum.value() != checksum) corrupt("checksum mismatch: the data is damaged");
   if (flags != 0) corrupt("unknown flags " + hex32(flags));
   if (reserved != 0) corrupt("a reserved header field is not 0");
-  if (section_count != kSectionCount)
+  if (section_count != section_count_of(version))
     corrupt(std::to_string(section_count) + " sections; version " + std::to_string(version) + " has " +
-            std::to_string(kSectionCount));
+            std::to_string(section_count_of(version)));
 
   ByteReader payload(data + kHeaderSize, static_cast<size_t>(payload_size), "payload");
   auto next_section = [&](uint32_t k) {
@@ -353,7 +353,7 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   const CheckpointAssets assets = read_checkpoint_assets(sdfa);
   sdfa.expect_end();
   ByteReader coll = next_section(5);
-  auto colliders = read_checkpoint_colliders(coll, assets);
+  auto colliders = read_checkpoint_colliders(coll, assets, version);
   coll.expect_end();
   ByteReader srce = next_section(6);
   auto sources = read_checkpoint_sources(srce, assets, config);
@@ -364,6 +364,12 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   ByteReader ffld = next_section(8);
   auto fields = read_checkpoint_force_fields(ffld, assets);
   ffld.expect_end();
+  SlotTable<Probe> probes;
+  if (version >= kFirstProbeVersion) {
+    ByteReader prob = next_section(9);
+    probes = read_checkpoint_probes(prob, config);
+    prob.expect_end();
+  }
   payload.expect_end();
 
   // Everything is valid: build the world.
@@ -375,6 +381,7 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
                           clock.events);
   world->restore_scene(
       SceneTables{std::move(colliders), std::move(sources), std::move(sinks), std::move(fields)});
+  world->restore_probes(std::move(probes));
   return world;
 }
 

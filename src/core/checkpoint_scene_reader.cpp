@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: MIT
 #include "checkpoint_scene_reader.h"
 
+#include <cmath>
 #include <string>
 #include <utility>
 
+#include "../physics/probe_sampling.h"
 #include "checkpoint_fields.h"
 #include "field_error.h"
 #include "pose_rules.h"
@@ -118,7 +120,15 @@ auto by_scene_rules(ByteReader& r, const std::string& name, Check&& check) -> de
   }
 }
 
-Collider read_collider(ByteReader& r, const Assets& assets, const std::string& name) {
+Vec3 finite_vec3(ByteReader& r, const std::string& name) {
+  Vec3 v;
+  v.x = finite(r, name);
+  v.y = finite(r, name);
+  v.z = finite(r, name);
+  return v;
+}
+
+Collider read_collider(ByteReader& r, const Assets& assets, uint32_t version, const std::string& name) {
   ColliderSpec spec;
   spec.sdf = asset_ref(r, assets, name + " SDF");
   spec.pose = raw_pose(r);
@@ -128,10 +138,31 @@ Collider read_collider(ByteReader& r, const Assets& assets, const std::string& n
   spec.material.friction = r.f32();
   spec.material.stickiness = r.f32();
   spec.inverted = flag(r, name + " inverted") != 0;
+  Vec3 load_point{0.0f, 0.0f, 0.0f};
+  if (version >= kFirstProbeVersion) load_point = finite_vec3(r, name + " load point");
   Collider c = by_scene_rules(r, name, [&] { return make_collider(spec); });
   if (target) by_scene_rules(r, name, [&] { require_pose(*target, "target"); });
   c.target = target;
+  c.load_point = load_point;
   return c;
+}
+
+// The rules of World::add_probe (world_probes.cpp) on what the file holds.
+Probe read_probe(ByteReader& r, const std::string& name) {
+  Probe p;
+  p.gauge = flag(r, name + " gauge") != 0;
+  p.every_substep = flag(r, name + " every substep") != 0;
+  p.position = finite_vec3(r, name + " position");
+  p.direction = finite_vec3(r, name + " direction");
+  p.length = finite(r, name + " length");
+  p.sample_count = r.u32();
+  const float d2 = length_squared(p.direction);
+  if (!(d2 == 0.0f || std::fabs(d2 - 1.0f) < 1e-3f))
+    corrupt(r.what() + ": " + name + " has a direction neither zero nor of unit length");
+  if (p.gauge ? !(p.length > 0.0f) || p.sample_count == 0 || p.sample_count > kMaxGaugeSamples
+              : p.length != 0.0f || p.sample_count != 1u || d2 != 0.0f)
+    corrupt(r.what() + ": " + name + " has a length or sample count its kind does not allow");
+  return p;
 }
 
 Source read_source(ByteReader& r, const Assets& assets, const WorldConfig& config, const std::string& name) {
@@ -194,9 +225,10 @@ CheckpointAssets read_checkpoint_assets(ByteReader& r) {
   return assets;
 }
 
-SlotTable<Collider> read_checkpoint_colliders(ByteReader& r, const CheckpointAssets& assets) {
+SlotTable<Collider> read_checkpoint_colliders(ByteReader& r, const CheckpointAssets& assets,
+                                              uint32_t version) {
   return read_slots<Collider>(
-      r, [&](const std::string& n) { return read_collider(r, assets, "collider " + n); });
+      r, [&](const std::string& n) { return read_collider(r, assets, version, "collider " + n); });
 }
 
 SlotTable<Source> read_checkpoint_sources(ByteReader& r, const CheckpointAssets& assets,
@@ -212,6 +244,15 @@ SlotTable<Sink> read_checkpoint_sinks(ByteReader& r, const CheckpointAssets& ass
 SlotTable<ForceField> read_checkpoint_force_fields(ByteReader& r, const CheckpointAssets& assets) {
   return read_slots<ForceField>(
       r, [&](const std::string& n) { return read_force_field(r, assets, "force field " + n); });
+}
+
+SlotTable<Probe> read_checkpoint_probes(ByteReader& r, const WorldConfig& config) {
+  SlotTable<Probe> t =
+      read_slots<Probe>(r, [&](const std::string& n) { return read_probe(r, "probe " + n); });
+  if (config.solver == Solver::Dfsph)
+    for (const auto& value : t.values)
+      if (value) corrupt(r.what() + ": a DFSPH world has no probes (World::add_probe refuses them)");
+  return t;
 }
 
 }  // namespace sph

@@ -18,10 +18,14 @@ namespace sph {
 using CheckpointAssets = std::vector<std::shared_ptr<SdfAsset>>;
 
 CheckpointAssets read_checkpoint_assets(ByteReader& r);
-SlotTable<Collider> read_checkpoint_colliders(ByteReader& r, const CheckpointAssets& assets);
+// version: the file's (load points from kFirstProbeVersion on).
+SlotTable<Collider> read_checkpoint_colliders(ByteReader& r, const CheckpointAssets& assets,
+                                              uint32_t version);
 SlotTable<Source> read_checkpoint_sources(ByteReader& r, const CheckpointAssets& assets,
                                           const WorldConfig& config);
 SlotTable<Sink> read_checkpoint_sinks(ByteReader& r, const CheckpointAssets& assets);
 SlotTable<ForceField> read_checkpoint_force_fields(ByteReader& r, const CheckpointAssets& assets);
+// The probes as World::add_probe would have made them; readings cleared. None on a DFSPH world.
+SlotTable<Probe> read_checkpoint_probes(ByteReader& r, const WorldConfig& config);
 
 }  // namespace sph

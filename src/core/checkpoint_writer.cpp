@@ -225,6 +225,7 @@ std::vector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin
       w.f32(c.material.friction);
       w.f32(c.material.stickiness);
       w.u32(c.inverted ? 1u : 0u);
+      write_vec3(w, c.load_point);
     });
   });
   section(w, kSectionOrder[6].tag, [&] {
@@ -262,6 +263,17 @@ std::vector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin
       write_vec3(w, f.vector);
       w.f32(f.strength);
       w.f32(f.falloff_radius);
+    });
+  });
+  section(w, kSectionOrder[9].tag, [&] {
+    // The probes as placed (their readings are the last step's output, not state).
+    write_slots(w, world.probes(), [&](const Probe& p) {
+      w.u32(p.gauge ? 1u : 0u);
+      w.u32(p.every_substep ? 1u : 0u);
+      write_vec3(w, p.position);
+      write_vec3(w, p.direction);
+      w.f32(p.length);
+      w.u32(p.sample_count);
     });
   });
 

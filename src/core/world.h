@@ -154,15 +154,18 @@ class World {
   // ---- probes and gauges (world_probes.cpp; physics/probe_sampling.h) ----
   // add_probe: FieldError naming the field for a bad spec, Error(Unsupported) on a DFSPH world,
   // Error(Capacity) past 65536 probes; the world is unchanged on error. Probes are not part of
-  // SceneTables: a restore keeps the world's own.
+  // SceneTables: a checkpoint of format 5 or later carries them (restore_probes), an older one
+  // has none and sph_world_restore keeps the world's own (adopt_probes).
   uint64_t add_probe(const ProbeSpec& spec);
   void remove_probe(uint64_t id);
   // A live probe; Error(InvalidHandle) otherwise.
   const Probe& probe(uint64_t id) const;
   const SlotMap<Probe>& probes() const { return probes_; }
-  // Takes over another world's probes with their ids, readings cleared (a restore keeps the
-  // world's probes: they are instruments, not state). None on a DFSPH world (add_probe's rule).
+  // Takes over another world's probes with their ids, readings cleared (a restore from a file
+  // before format 5 keeps the world's probes). None on a DFSPH world (add_probe's rule).
   void adopt_probes(const World& from);
+  // A checkpoint's probes (checkpoint_reader.cpp), readings cleared.
+  void restore_probes(SlotTable<Probe> table);
 
   // Replaces the whole scene (checkpoints; see SceneTables).
   void restore_scene(SceneTables tables);

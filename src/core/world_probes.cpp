@@ -88,6 +88,8 @@ void World::adopt_probes(const World& from) {
   probes_ = std::move(probes);
 }
 
+void World::restore_probes(SlotTable<Probe> table) { probes_.restore(std::move(table)); }
+
 const Probe& World::probe(uint64_t id) const {
   const Probe* p = probes_.find(id);
   if (!p) throw Error(Status::InvalidHandle, "id: is null, stale or not of this world");

@@ -5,14 +5,18 @@
  *     change plus the impulses the colliders received equals gravity's impulse (the pair forces
  *     cancel in pairs, tests/physics/test_momentum.c), with and without the walls in the density,
  *     both integrators: within 1 % of gravity's impulse;
- *   - a hydrostatic tank: the force on its side wall against rho0 g H^2 W / 2;
+ *   - a hydrostatic tank: the force on its side wall against the resting compressible column's
+ *     (rho0 g H^2 W / 2 less 1.07 % at k = 100);
  *   - a fixed box submerged in a tank: its force against rho0 g V upwards once settled.
- *     These two measure the solver's pressure at walls more than the accounting: measured +8.1 %
- *     and +13.4 % with the walls in the density (WCSPH, k = 100: the pressure near walls reads
- *     high, docs/physics.md), -41 % and -64 % without. The issue's bound, 2 %, is asserted with
- *     LOADS_STRICT=1 (for the solver that should meet it, DFSPH, when it merges); by default the
- *     bound is the solver's accuracy now, 10 % and 15 %, with the walls in the density closer
- *     than without (a regression guard, not the goal);
+ *     These two measure the solver's pressure at walls more than the accounting. With the walls in
+ *     the density: the side wall +11.0 % (a film the walls' calibration keeps free of water, an
+ *     error of the order of the spacing; measured against resolution at the test), the box
+ *     -2.2 %; without them -41 % and -63 %. The issue's bound, 2 %, is asserted with
+ *     LOADS_STRICT=1; by default the bounds are the measurements with room for rounding, 12 %
+ *     and 3 %, and the walls in the density must do better than the collision response alone;
+ *   - two-way coupling: a floating box (the integrator of samples/floating_box.c) settles at
+ *     Archimedes' draft (issue: 5 %; measured +11.6 % at 2 cm, +7.1 % at 1.41 cm; bound 15 %,
+ *     why at the test) and its heave decays;
  *   - the loads pass leaves the trajectory alone (bit for bit, friction on);
  *   - the C API: FEATURE_DISABLED without the bit, a handle check, the load point's torque.
  * LOADS_MEASURE=1 prints the measurements without asserting the bounds. */
@@ -186,67 +190,116 @@ static void test_loads_leave_the_trajectory_alone(void** state) {
 
 /* ---- a hydrostatic tank's side wall ------------------------------------------------------------ */
 
-/* Water 10 x 14 x 10 layers (W = 10 cm wide, H = 14 cm deep) at rest in a tank whose face at x = 0
- * is a collider of its own (a plane, solid x < 0; the tank's box reaches 5 cm beyond it, out of
- * the fluid's reach). Settled for 1.2 s; the plane's force averaged over the last 0.4 s against
- * rho0 g H^2 W / 2 (H = layers * step: the lattice holds its volume at rest density). */
-static double side_wall_force(uint32_t features, double* expected) {
-  const uint32_t layers[3] = {10, 14, 10};
-  const double width = layers[0] * kStep, depth = layers[1] * kStep;
+/* The force per unit width on a side wall of a resting ideal-gas column holding H of water (its
+ * mass per unit area rho0 H): with p = k (rho - rho0), dp/dd = rho g gives rho = rho0 e^(a d),
+ * a = g / k; the column's depth D has (e^(a D) - 1) / a = H, and the force is
+ * int_0^D p dd = k rho0 (H - D). Below rho0 g H^2 / 2 (its k -> infinity limit) by 1.07 % at
+ * H = 14 cm, k = 100: the weakly compressible fluid's column is 0.7 % shorter. */
+static double compressible_wall_force(double rho0, double k, double height) {
+  const double a = kGravity / k, depth = log1p(a * height) / a;
+  return k * rho0 * (height - depth);
+}
+
+typedef struct side_wall_result {
+  double force;          /* N, the fluid's push on the wall, averaged */
+  double expected;       /* N, the compressible column's (above) over the wall's width */
+  double incompressible; /* N, rho0 g H^2 W / 2 */
+  double gauge_height;   /* m, a gauge's water height in the middle of the tank, averaged */
+} side_wall_result;
+
+/* Water of 10 x 14 x 10 lattice layers of `step` (W = 10 step wide, H = 14 step deep, its volume
+ * exactly the tank's: support_fcc_box's lattice reaches step / 2 beyond its outer points) at rest
+ * in a tank whose face at x = 0 is a collider of its own (a plane, solid x < 0; the tank's box
+ * reaches 5 cm beyond it, out of the fluid's reach). Settled for 0.8 s, then the plane's force
+ * and a gauge in the middle averaged over 0.4 s. */
+static side_wall_result side_wall_force(uint32_t features, double step) {
+  const double scale = kStep / step;
+  const uint32_t layers[3] = {(uint32_t)lround(10 * scale), (uint32_t)lround(14 * scale),
+                              (uint32_t)lround(10 * scale)};
+  const double width = layers[0] * step, depth = layers[1] * step;
   const double tank_min[3] = {-0.05, 0.0, 0.0}, tank_max[3] = {width, 2.0 * depth, width};
+  const double stiffness = 100.0;
   float* lattice = NULL;
   uint32_t n = 0;
   support_world w;
   sph_sdf *tank_sdf = NULL, *wall_sdf = NULL;
   sph_collider_id wall;
+  sph_probe_id gauge;
+  sph_probe_def gauge_def;
   sph_world_def def;
   sph_world_params params;
-  double sum = 0.0, time = 0.0;
-  assert_int_equal(support_fcc_box(layers, kStep, NULL, &lattice, &n), SPH_OK);
+  side_wall_result out = {0.0, 0.0, 0.0, 0.0};
+  double sum = 0.0, height = 0.0, time = 0.0;
+  assert_int_equal(support_fcc_box(layers, step, NULL, &lattice, &n), SPH_OK);
   def = loads_def(SPH_FEATURE_COLLIDER_LOADS | features, n, SPH_INTEGRATOR_SYMPLECTIC_EULER);
+  def.particle_spacing = (float)(step * sqrt(2.0));
   EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
   sph_world_params_init(&params);
+  params.stiffness = (float)stiffness;
   params.step_limits = SPH_STEP_LIMIT_ACOUSTIC;
   EXPECT_OK(sph_world_set_params(w.world, &params));
-  EXPECT_OK(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * kStep, 0.0f, &tank_sdf, NULL));
+  EXPECT_OK(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * step, 0.0f, &tank_sdf, NULL));
   wall = add_axis_wall(&w, 0, -1.0, 0.0, &wall_sdf);
   EXPECT_OK(support_spawn(w.world, lattice, NULL, n));
+  EXPECT_OK(sph_probe_def_init(&gauge_def));
+  gauge_def.kind = SPH_PROBE_GAUGE;
+  gauge_def.sampling = SPH_PROBE_EVERY_SUBSTEP;
+  gauge_def.position.x = gauge_def.position.z = (float)(0.5 * width);
+  gauge_def.position.y = -0.05f; /* from inside the floor to above the surface */
+  gauge_def.length = (float)(0.05 + 2.0 * depth);
+  EXPECT_OK(sph_probe_create(w.world, &gauge_def, &gauge));
   for (int frame = 0; frame < 60; ++frame) {
     EXPECT_OK(sph_world_step(w.world, 0.02f));
     if (frame < 40) continue;
     {
       const sph_collider_loads l = loads_of(w.world, wall);
+      sph_probe_reading r;
+      EXPECT_OK(sph_probe_reading_init(&r));
+      EXPECT_OK(sph_probe_get_reading(w.world, gauge, &r));
       sum += l.force.x * l.frame_time;
+      height += r.water_height * l.frame_time;
       time += l.frame_time;
     }
   }
-  *expected = w.def.rest_density * kGravity * depth * depth * width / 2.0;
+  out.force = -sum / time; /* the fluid pushes the wall towards -x */
+  out.gauge_height = height / time;
+  out.expected = compressible_wall_force(w.def.rest_density, stiffness, depth) * width;
+  out.incompressible = w.def.rest_density * kGravity * depth * depth * width / 2.0;
   free(lattice);
   EXPECT_OK(sph_sdf_destroy(tank_sdf));
   EXPECT_OK(sph_sdf_destroy(wall_sdf));
   EXPECT_OK(support_world_close(&w));
-  return -sum / time; /* the fluid pushes the wall towards -x */
+  return out;
 }
 
 static void test_hydrostatic_side_wall(void** state) {
-  double expected = 0.0;
-  const double on = side_wall_force(SPH_FEATURE_BOUNDARY_DENSITY, &expected);
-  const double off = side_wall_force(SPH_FEATURE_NONE, &expected);
+  /* LOADS_SIDE_WALL_STEP=0.00707 (with LOADS_MEASURE=1) measures at a finer lattice. */
+  const double step = getenv("LOADS_SIDE_WALL_STEP") ? atof(getenv("LOADS_SIDE_WALL_STEP")) : kStep;
+  const side_wall_result on = side_wall_force(SPH_FEATURE_BOUNDARY_DENSITY, step);
+  const side_wall_result off = side_wall_force(SPH_FEATURE_NONE, step);
+  const double error = on.force / on.expected - 1.0;
   (void)state;
   print_message(
-      "hydrostatic side wall: %.4f N with walls in the density (%+.2f %%), %.4f N without "
-      "(%+.2f %%), rho0 g H^2 W / 2 = %.4f N\n",
-      on, 100.0 * (on / expected - 1.0), off, 100.0 * (off / expected - 1.0), expected);
-  /* The issue's 2 % holds only under LOADS_STRICT=1 and fails today: +10.0 % since the boundary
-   * density's wall force became the gradient of the sampled share (it was +8.1 % before, when a
-   * 10 % guard stood here; the buoyancy case below went from +13.4 % to -2.2 % with the same
-   * change). The lattice starts 0.35 spacings from the walls, where the calibration puts a
-   * resting layer at 0.5 (docs/physics.md), which may account for the rest. By default the check
-   * is the comparison that the accounting must pass whatever the wall model's accuracy: the walls
-   * in the density bring the force closer to rho0 g H^2 W / 2 than the collision response alone. */
-  assert_true((fabs(on - expected) < fabs(off - expected) &&
-               (!getenv("LOADS_STRICT") || fabs(on / expected - 1.0) <= wall_bound(0.02))) ||
-              measuring());
+      "hydrostatic side wall, step %.4f m: %.4f N with walls in the density (%+.2f %%; gauge %.4f m), "
+      "%.4f N without (%+.2f %%; gauge %.4f m); the compressible column's %.4f N, rho0 g H^2 W / 2 = "
+      "%.4f N, H = %.4f m\n",
+      step, on.force, 100.0 * error, on.gauge_height, off.force, 100.0 * (off.force / off.expected - 1.0),
+      off.gauge_height, on.expected, on.incompressible, 14.0 * step * lround(kStep / step * 14.0) / 14.0);
+  /* The issue asks 2 % (asserted under LOADS_STRICT=1); not met by the walls in the density as
+   * calibrated (docs/validation.md, "Loads on a hydrostatic tank's side wall"). Their calibration
+   * holds a resting layer spacing / 2 from a wall, while a lattice plane's share of the volume
+   * reaches only half the plane gap, step / 2, towards it: every wall keeps a film of
+   * (spacing - step) / 2 = 0.21 step free of water, the tank holds its water as a tank 0.41 step
+   * narrower would, and the water stands higher (the gauge: +7.1 % at step 1 cm, +4.0 % at
+   * 0.71 cm). That film is an error of the order of the spacing over the tank's width: the force
+   * is +11.0 % at 1 cm and +6.8 % at 0.71 cm. With the calibration moved to the lattice's
+   * mid-plane (an experiment, not committed: every fill_box scene would then start 0.15 spacings
+   * off its walls, so fill_box's margin has to move with it) it is -3.4 % and -3.1 %, and the
+   * gauge -1.5 % and -0.9 %. The bound is the measurement at this resolution with room for
+   * rounding: 12 %; and the walls in the density must beat the collision response alone (-41 %). */
+  assert_true(
+      (fabs(on.force - on.expected) < fabs(off.force - off.expected) && fabs(error) <= wall_bound(0.12)) ||
+      measuring());
 }
 
 /* ---- buoyancy of a fixed submerged box ---------------------------------------------------------- */
@@ -326,8 +379,161 @@ static void test_submerged_box_buoyancy(void** state) {
       "submerged box: buoyancy %.4f N with walls in the density (%+.2f %%), %.4f N without "
       "(%+.2f %%), rho0 g V = %.4f N\n",
       on, 100.0 * (on / expected - 1.0), off, 100.0 * (off / expected - 1.0), expected);
-  assert_true((fabs(on / expected - 1.0) <= wall_bound(0.15) && fabs(on - expected) < fabs(off - expected)) ||
+  assert_true((fabs(on / expected - 1.0) <= wall_bound(0.03) && fabs(on - expected) < fabs(off - expected)) ||
               measuring());
+}
+
+/* ---- two-way coupling: a floating box ---------------------------------------------------------- */
+
+/* The engine's side, as samples/floating_box.c: a rigid body stepped by symplectic Euler from the
+ * fluid's loads plus its weight, its pose sent as the collider's target every frame. */
+typedef struct float_body {
+  double mass, inertia, position[3], velocity[3], rotation[4], angular[3];
+} float_body;
+
+static void float_body_step(float_body* b, const sph_collider_loads* l, double dt) {
+  const double force[3] = {l->force.x, l->force.y - b->mass * kGravity, l->force.z};
+  const double torque[3] = {l->torque.x, l->torque.y, l->torque.z};
+  double* q = b->rotation;
+  double dq[4], norm;
+  for (int k = 0; k < 3; ++k) {
+    b->velocity[k] += force[k] / b->mass * dt;
+    b->position[k] += b->velocity[k] * dt;
+    b->angular[k] += torque[k] / b->inertia * dt;
+  }
+  dq[0] = 0.5 * dt * (b->angular[0] * q[3] + b->angular[1] * q[2] - b->angular[2] * q[1]);
+  dq[1] = 0.5 * dt * (-b->angular[0] * q[2] + b->angular[1] * q[3] + b->angular[2] * q[0]);
+  dq[2] = 0.5 * dt * (b->angular[0] * q[1] - b->angular[1] * q[0] + b->angular[2] * q[3]);
+  dq[3] = 0.5 * dt * (-b->angular[0] * q[0] - b->angular[1] * q[1] - b->angular[2] * q[2]);
+  norm = 0.0;
+  for (int k = 0; k < 4; ++k) q[k] += dq[k], norm += q[k] * q[k];
+  for (int k = 0; k < 4; ++k) q[k] /= sqrt(norm);
+}
+
+static sph_transform float_body_pose(const float_body* b) {
+  sph_transform t = sph_transform_identity();
+  t.position.x = (float)b->position[0], t.position.y = (float)b->position[1],
+  t.position.z = (float)b->position[2];
+  t.rotation.x = (float)b->rotation[0], t.rotation.y = (float)b->rotation[1];
+  t.rotation.z = (float)b->rotation[2], t.rotation.w = (float)b->rotation[3];
+  return t;
+}
+
+/* A 10 cm cube of 500 kg/m^3 dropped from 1 cm above water 20 cm deep in a tank 30 x 30 cm,
+ * lattice spacing `spacing` (the sample's 2 cm: h = 3.6 cm), walls in the density, frames of
+ * 1/120 s for 3 s. The draft is the water level a gauge reads in a corner of the tank (the level
+ * the box's displacement raised) less the box's bottom, averaged over the last second, against
+ * Archimedes' m / (rho0 A) = 5 cm; the heave is the largest distance of the box's centre from
+ * that mean, over 0.25-0.75 s and over the last second. */
+static void floating_box(double spacing, double* draft, double* archimedes, double* heave_early,
+                         double* heave_late) {
+  const double half = 0.05, density = 500.0, depth = 0.2, dt = 1.0 / 120.0;
+  const support_tank tank = {{0.0f, 0.25f, 0.0f}, {0.15f, 0.25f, 0.15f}, 0.01f, 0.0f};
+  const sph_vec3 centre_of_mass = {0.0f, 0.0f, 0.0f};
+  const int frames = 360;
+  sph_context_def context_def;
+  sph_context* context = NULL;
+  sph_world* world = NULL;
+  sph_world_def def = loads_def(SPH_FEATURE_COLLIDER_LOADS | SPH_FEATURE_BOUNDARY_DENSITY, 8000,
+                                SPH_INTEGRATOR_SYMPLECTIC_EULER);
+  sph_world_params params;
+  sph_shape_desc shape;
+  sph_collider_def collider;
+  sph_collider_id box;
+  sph_fill_box_desc water;
+  sph_probe_def gauge_def;
+  sph_probe_id gauge;
+  sph_sdf *tank_sdf = NULL, *box_sdf = NULL;
+  float_body body;
+  double heights[360], level = 0.0, mean = 0.0, late_time = 0.0;
+  memset(&body, 0, sizeof(body));
+  body.mass = density * 8.0 * half * half * half;
+  body.inertia = body.mass * (2.0 * half) * (2.0 * half) / 6.0;
+  body.position[1] = depth + half + 0.01;
+  body.rotation[3] = 1.0;
+  *archimedes = body.mass / (1000.0 * 4.0 * half * half);
+  sph_context_def_init(&context_def);
+  context_def.backend = sph_test_backend();
+  EXPECT_OK(sph_context_create(&context_def, &context));
+  def.particle_spacing = (float)spacing;
+  EXPECT_OK(sph_world_create(context, &def, &world));
+  sph_world_params_init(&params);
+  EXPECT_OK(sph_world_set_params(world, &params));
+  EXPECT_OK(support_tank_create(context, world, &tank, &tank_sdf, NULL));
+  EXPECT_OK(sph_shape_desc_init(&shape));
+  shape.shape = SPH_SHAPE_BOX;
+  shape.half_extents.x = shape.half_extents.y = shape.half_extents.z = (float)half;
+  shape.voxel_size = 0.01f;
+  shape.padding_voxels = 8; /* beyond h + the walls' offset, as the boundary density needs */
+  EXPECT_OK(sph_sdf_create_shape(context, &shape, &box_sdf));
+  EXPECT_OK(sph_collider_def_init(&collider));
+  collider.sdf = box_sdf;
+  collider.transform = float_body_pose(&body);
+  EXPECT_OK(sph_collider_create(world, &collider, &box));
+  EXPECT_OK(sph_collider_set_load_point(world, box, &centre_of_mass));
+  sph_fill_box_desc_init(&water);
+  water.min.x = -0.15f, water.min.y = 0.0f, water.min.z = -0.15f;
+  water.max.x = 0.15f, water.max.y = (float)depth, water.max.z = 0.15f;
+  EXPECT_OK(sph_world_fill_box(world, &water, NULL));
+  EXPECT_OK(sph_probe_def_init(&gauge_def));
+  gauge_def.kind = SPH_PROBE_GAUGE;
+  gauge_def.position.x = gauge_def.position.z = -0.11f; /* 6 cm off the box's faces at rest */
+  gauge_def.position.y = -0.05f;
+  gauge_def.length = 0.45f;
+  EXPECT_OK(sph_probe_create(world, &gauge_def, &gauge));
+  for (int frame = 0; frame < frames; ++frame) {
+    sph_collider_loads l;
+    sph_transform target;
+    EXPECT_OK(sph_world_step(world, (float)dt));
+    EXPECT_OK(sph_collider_loads_init(&l));
+    EXPECT_OK(sph_collider_get_loads(world, box, &l));
+    float_body_step(&body, &l, dt);
+    target = float_body_pose(&body);
+    EXPECT_OK(sph_collider_set_target_transform(world, box, &target));
+    heights[frame] = body.position[1];
+    if (frame >= frames - 120) {
+      sph_probe_reading r;
+      EXPECT_OK(sph_probe_reading_init(&r));
+      EXPECT_OK(sph_probe_get_reading(world, gauge, &r));
+      level += r.water_height * dt;
+      mean += body.position[1] * dt;
+      late_time += dt;
+    }
+  }
+  level /= late_time, mean /= late_time;
+  *draft = level - (mean - half);
+  *heave_early = *heave_late = 0.0;
+  for (int frame = 30; frame < 90; ++frame) *heave_early = fmax(*heave_early, fabs(heights[frame] - mean));
+  for (int frame = frames - 120; frame < frames; ++frame)
+    *heave_late = fmax(*heave_late, fabs(heights[frame] - mean));
+  print_message(
+      "floating box, spacing %.3f m: centre %.4f m, water level %.4f m (gauge), draft %.2f cm "
+      "(Archimedes %.2f cm, %+.1f %%), heave %.2f cm at 0.25-0.75 s, %.2f cm over the last second\n",
+      spacing, mean, level, 100.0 * *draft, 100.0 * *archimedes, 100.0 * (*draft / *archimedes - 1.0),
+      100.0 * *heave_early, 100.0 * *heave_late);
+  EXPECT_OK(sph_sdf_destroy(tank_sdf));
+  EXPECT_OK(sph_sdf_destroy(box_sdf));
+  EXPECT_OK(sph_world_destroy(world));
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+static void test_floating_box(void** state) {
+  /* LOADS_FLOAT_SPACING=0.01414 (with LOADS_MEASURE=1) measures at a finer lattice. */
+  const double spacing = getenv("LOADS_FLOAT_SPACING") ? atof(getenv("LOADS_FLOAT_SPACING")) : 0.02;
+  double draft = 0.0, archimedes = 0.0, early = 0.0, late = 0.0;
+  (void)state;
+  floating_box(spacing, &draft, &archimedes, &early, &late);
+  /* The issue asks 5 % of Archimedes' draft (asserted under LOADS_STRICT=1); measured +11.6 % at
+   * the sample's 2 cm (h = 3.6 cm) and +7.1 % at 1.41 cm (h = 2.5 cm, 2.8 times the particles, too
+   * slow for CI): it rides deeper, by 0.58 cm and 0.36 cm, 0.16 h and 0.14 h, an error that
+   * shrinks with the spacing (not isolated; probably the summation's density deficit in the
+   * diffuse layer at the free surface around the box, whose pressure the clamped equation of
+   * state drops: the box's bottom lies 1.4 h below the surface, where test_probes.c's 1 %
+   * agreement, from 3.7 h down, is not measured). Measured against the level a gauge reads, not the fill
+   * height (the sample's 6.5-7 cm "draft" was below y = 20 cm, where the water did not stand). The heave
+   * decays from 2.3 cm to 0.1 cm. Bounds: 15 % (the measurement with room for rounding and a GPU's different
+   * sums), and the last second's heave under a tenth of the first's. */
+  assert_true((fabs(draft / archimedes - 1.0) <= wall_bound(0.15) && late < 0.1 * early) || measuring());
 }
 
 /* ---- the C API ------------------------------------------------------------------------------------ */
@@ -387,6 +593,29 @@ static void test_loads_api(void** state) {
     /* tau_z = (x - p)_x F_y - (x - p)_y F_x ~ (-0.05) F_y > 0 (the weight's line is at x = 0.05). */
     assert_true(l.torque.z > 0.0f &&
                 fabs(l.torque.z - (-0.05f * l.force.y)) <= 0.2f * fabs(0.05f * l.force.y));
+    /* A checkpoint carries the load point (format 6): a loaded copy steps to the same loads. */
+    {
+      uint64_t size = 0;
+      void* saved;
+      sph_world* copy = NULL;
+      sph_collider_loads a, b;
+      EXPECT_OK(sph_world_save(w.world, NULL, 0, &size));
+      saved = malloc(size);
+      assert_non_null(saved);
+      EXPECT_OK(sph_world_save(w.world, saved, size, &size));
+      EXPECT_OK(sph_world_load(w.context, saved, size, &copy));
+      free(saved);
+      EXPECT_OK(sph_world_step(w.world, 0.02f));
+      EXPECT_OK(sph_world_step(copy, 0.02f));
+      a = loads_of(w.world, tank);
+      b = loads_of(copy, tank);
+      assert_true(fabs(b.point.x - 0.10f) < 1e-6f);
+      assert_memory_equal(&a.force, &b.force, sizeof a.force);
+      assert_memory_equal(&a.torque, &b.torque, sizeof a.torque);
+      assert_memory_equal(&a.point, &b.point, sizeof a.point);
+      assert_true(a.frame_time == b.frame_time);
+      EXPECT_OK(sph_world_destroy(copy));
+    }
   }
   EXPECT_OK(sph_sdf_destroy(sdf));
   EXPECT_OK(support_world_close(&w));
@@ -400,7 +629,13 @@ int main(int argc, char** argv) {
       cmocka_unit_test(test_momentum_balance_boundary_density),
       cmocka_unit_test(test_hydrostatic_side_wall),
       cmocka_unit_test(test_submerged_box_buoyancy),
+      cmocka_unit_test(test_floating_box),
   };
-  if (argc > 1) cmocka_set_test_filter(argv[1]); /* one case by name (measuring) */
+  /* One case by name (measuring; the floating box's ctest), or "--skip NAME" (the main ctest leaves
+   * the floating box to its own, so that neither runs near the timeout in a sanitizer build). */
+  if (argc > 2 && strcmp(argv[1], "--skip") == 0)
+    cmocka_set_skip_filter(argv[2]);
+  else if (argc > 1)
+    cmocka_set_test_filter(argv[1]);
   return cmocka_run_group_tests_name("collider_loads", tests, NULL, NULL);
 }

@@ -6,13 +6,13 @@
  *     read before the step, the densities and pressures of its density pass read after it),
  *     evaluated here in double over every particle: within 1e-4 relative (float sums of ~100
  *     terms against double; measured below 1e-5), a gauge's column integral likewise;
- *   - a resting tank: the pressure difference of two probes against rho0 g (d2 - d1), and (reported)
- *     each probe's pressure against rho0 g d below the surface the gauge finds (bounds and why at
- *     the test);
+ *   - a resting tank: the pressure difference of two probes against rho0 g (d2 - d1); with the
+ *     walls in the density, each probe's pressure against the resting compressible column's
+ *     below the height the gauge finds, within 1 % of rho0 g d (bounds and why at the test);
  *   - a body of water moving at a uniform velocity without gravity: a probe it passes reads that
  *     velocity and rho0, a gauge through it the block's height (its fill height);
  *   - sampling: EVERY_SUBSTEP averages the step's substeps, EVERY_FRAME reads the last; a
- *     restore keeps the probes;
+ *     checkpoint carries the probes (a restore and a load);
  *   - bad input: each field named, the world unchanged (no slot taken), handles checked.
  * PROBES_MEASURE=1 prints the measurements without asserting the bounds. */
 #include <math.h>
@@ -202,7 +202,7 @@ static void test_brute_force(void** state) {
  * acoustic step limit; the default viscosity damps the start-up waves), then read over 0.4 s:
  * a gauge through the centre from 3 cm below the floor to 0.45 m, point probes on the centre line
  * at y = 4, 8, 12 and 16 cm, every substep averaged. */
-static void test_resting_tank(void** state) {
+static void resting_tank(uint32_t features) {
   const uint32_t layers[3] = {12, 24, 12};
   const double width = 0.12, depth = 0.24;
   const double tank_min[3] = {0.0, 0.0, 0.0}, tank_max[3] = {width, 2.0 * depth, width};
@@ -217,9 +217,9 @@ static void test_resting_tank(void** state) {
   double snapshot_sum = 0.0, snapshot_sum2 = 0.0;
   int snapshots = 0;
   double pressure[4] = {0.0, 0.0, 0.0, 0.0}, height = 0.0, time = 0.0, probe_time = 0.0, fill, rho0;
-  (void)state;
   assert_int_equal(support_fcc_box(layers, kStep, NULL, &lattice, &n), SPH_OK);
   def = probe_world_def(n);
+  def.features = features;
   sph_world_params_init(&params);
   params.step_limits = SPH_STEP_LIMIT_ACOUSTIC;
   EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, &params));
@@ -284,19 +284,51 @@ static void test_resting_tank(void** state) {
     const double gradient = (pressure[0] - pressure[3]) / (heights[3] - heights[0]);
     print_message("  (p(4 cm) - p(16 cm)) / 12 cm = %.2f Pa/m against rho0 g = %.2f Pa/m (%+.2f %%)\n",
                   gradient, rho0 * kGravity, 100.0 * (gradient / (rho0 * kGravity) - 1.0));
-    /* The bound: the pressure gradient within 1 % of rho0 g (the issue's bound for a probe's
-     * pressure; measured -0.53 %). The difference takes out where the surface is: an SPH free
-     * surface is diffuse, its outer particles read a density deficit and so no pressure, and the
-     * level where the pressure extrapolates to zero lies about 1 cm (0.4 h) below the
-     * height the gauge finds (measured, the absolute comparisons printed above: -7 % at 14 cm,
-     * -44 % at 2 cm, a constant offset of about 95 Pa). The gauge is not held to the fill height
-     * here: without walls in the density the particles within h of the tank's walls read low
-     * densities and pack tighter, so the middle of the tank stands lower than n m / (rho0 A)
-     * (printed; test_uniform_flow holds the gauge to a known height instead). */
-    assert_true(fabs(gradient / (rho0 * kGravity) - 1.0) <= 0.01 || measuring());
+    /* Without the walls in the density: the pressure gradient within 1 % of rho0 g (the issue's
+     * bound for a probe's pressure; measured -0.53 %), and the absolute pressure only printed:
+     * it reads a near constant 95 Pa below rho0 g d (-7 % at 14 cm, -44 % at 2 cm). That is the
+     * tank's walls, not the probe: the particles within h of the walls read low densities and
+     * pack tighter, the middle of the tank stands 24 % below n m / (rho0 A) and its pressure does
+     * not follow its own column. With the walls in the density (the second case) the same
+     * probes read within 0.6 % of the resting column's pressure below the gauge's height, so
+     * neither the interpolant, nor its Shepard normalisation, nor the clamped equation of
+     * state's zero at the surface is the cause. */
+    if (features == SPH_FEATURE_NONE)
+      assert_true(fabs(gradient / (rho0 * kGravity) - 1.0) <= 0.01 || measuring());
+  }
+  if (features & SPH_FEATURE_BOUNDARY_DENSITY) {
+    /* The absolute pressure against the resting compressible column (test_collider_loads.c): with
+     * p = k (rho - rho0) and dp/dd = rho g, p(y) = k rho0 ((1 + a H) e^(-a (y - f)) - 1), a = g / k,
+     * H the gauge's water height (the mass per unit area over rho0) and f the floor the walls in
+     * the density hold the water on: the calibration keeps a film of (spacing - step) / 2 free of
+     * water at every wall (docs/validation.md, "Loads on a hydrostatic tank's side wall"). */
+    const double k = w.params.stiffness, a = kGravity / k, film = 0.5 * (sqrt(2.0) - 1.0) * kStep;
+    const double surface = film + log1p(a * height) / a;
+    for (int j = 0; j < 4; ++j) {
+      const double want = k * rho0 * ((1.0 + a * height) * exp(-a * (heights[j] - film)) - 1.0);
+      const double d = surface - heights[j];
+      print_message(
+          "  walls in the density: probe at y = %.2f m (d = %.4f m): p = %.2f Pa, the column's %.2f Pa "
+          "(%+.2f Pa, %+.2f %% of rho0 g d)\n",
+          heights[j], d, pressure[j], want, pressure[j] - want,
+          100.0 * (pressure[j] - want) / (rho0 * kGravity * d));
+      /* The issue's 1 % of rho0 g d, at depths of 9-21 cm (3.7-8.5 h: below the diffuse surface
+       * layer, the top h, where a kernel reaches into air); measured -0.2 % to -0.6 %. */
+      assert_true(fabs(pressure[j] - want) <= 0.01 * rho0 * kGravity * d || measuring());
+    }
   }
   EXPECT_OK(sph_sdf_destroy(sdf));
   EXPECT_OK(support_world_close(&w));
+}
+
+static void test_resting_tank(void** state) {
+  (void)state;
+  resting_tank(SPH_FEATURE_NONE);
+}
+
+static void test_resting_tank_walls_in_density(void** state) {
+  (void)state;
+  resting_tank(SPH_FEATURE_BOUNDARY_DENSITY);
 }
 
 /* ---- a uniform flow ------------------------------------------------------------------------- */
@@ -392,22 +424,38 @@ static void test_sampling(void** state) {
   assert_true(b.kernel_sum > 0.5);
   assert_true(c.samples == 1 && c.kernel_sum == 0.0f && c.density == 0.0f && c.pressure == 0.0f);
   {
-    /* A restore keeps the world's probes and their ids (checkpoints hold no probes); their
-     * readings start again. */
+    /* Checkpoints carry the probes (format 6): a restore brings back the saved probes with their
+     * ids (one removed after the save returns, one added after it is gone), their readings start
+     * again; a world loaded from the checkpoint has them too and reads what the original reads. */
     uint64_t size = 0;
     void* saved;
+    sph_world* loaded = NULL;
+    sph_probe_id later;
+    sph_probe_reading r;
     EXPECT_OK(sph_world_save(w.world, NULL, 0, &size));
     saved = malloc(size);
     assert_non_null(saved);
     EXPECT_OK(sph_world_save(w.world, saved, size, &size));
     EXPECT_OK(sph_world_step(w.world, 0.02f));
+    EXPECT_OK(sph_probe_destroy(w.world, air));
+    later = add_gauge(w.world, 0.03, -0.02, 0.03, 0.1, 0.0);
     EXPECT_OK(sph_world_restore(w.world, saved, size));
+    EXPECT_OK(sph_probe_reading_init(&r));
+    EXPECT_OK(sph_probe_get_reading(w.world, air, &r));
+    EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, NULL, sph_probe_get_reading(w.world, later, &r));
+    EXPECT_OK(sph_world_load(w.context, saved, size, &loaded));
     free(saved);
+    EXPECT_OK(sph_world_step(loaded, 0.02f));
+    EXPECT_OK(sph_probe_get_reading(loaded, every, &r));
     a = reading_of(w.world, every);
     assert_int_equal(a.samples, 0);
     EXPECT_OK(sph_world_step(w.world, 0.02f));
     a = reading_of(w.world, every);
     assert_true(a.samples > 1 && a.kernel_sum > 0.5f);
+    /* the same state, the same step: the same reading */
+    assert_true(a.samples == r.samples && a.density == r.density && a.pressure == r.pressure &&
+                a.kernel_sum == r.kernel_sum && a.time == r.time);
+    EXPECT_OK(sph_world_destroy(loaded));
   }
   EXPECT_OK(support_world_close(&w));
 }
@@ -490,7 +538,7 @@ int main(int argc, char** argv) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_bad_input),    cmocka_unit_test(test_sampling),
       cmocka_unit_test(test_brute_force),  cmocka_unit_test(test_uniform_flow),
-      cmocka_unit_test(test_resting_tank),
+      cmocka_unit_test(test_resting_tank), cmocka_unit_test(test_resting_tank_walls_in_density),
   };
   (void)argc;
   (void)argv;

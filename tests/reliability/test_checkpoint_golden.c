@@ -178,13 +178,13 @@ static void golden_path(char* out, size_t size, const char* dir, uint32_t versio
 
 /* The section that holds byte `at` of a checkpoint (for the message), by walking the headers. */
 static const char* section_of(const uint8_t* data, uint64_t size, uint64_t at) {
-  static const char* names[] = {"world definition", "parameters", "clock and statistics",
-                                "particles",        "SDF assets", "colliders",
-                                "sources",          "sinks",      "force fields"};
+  static const char* names[] = {
+      "world definition", "parameters", "clock and statistics", "particles", "SDF assets", "colliders",
+      "sources",          "sinks",      "force fields",         "probes"};
   uint64_t offset = 48;
   uint32_t k;
   if (at < 48) return "header";
-  for (k = 0; k < 9 && offset + 16 <= size; ++k) {
+  for (k = 0; k < sizeof names / sizeof names[0] && offset + 16 <= size; ++k) {
     uint64_t length = 0;
     int b;
     for (b = 0; b < 8; ++b) length |= (uint64_t)data[offset + 8 + b] << (8 * b);
