@@ -107,11 +107,15 @@ void launch_loads(unsigned blocks, const FluidConstants& fluid, const ParticleAr
 
 DeviceLoads DeviceColliderLoads::reserve(uint32_t colliders, uint32_t capacity) {
   const size_t partials = static_cast<size_t>(blocks_for(capacity, kLoadBlock)) * colliders;
+  // allocate() frees the old buffer first: the slot counts drop to 0 until the new one is there,
+  // so a failed allocation cannot leave a count that a later, smaller frame trusts.
   if (partials > partial_slots_) {
+    partial_slots_ = 0;
     partials_.allocate(partials, "the loads' block sums");
     partial_slots_ = partials;
   }
   if (colliders > sum_slots_) {
+    sum_slots_ = 0;
     sums_.allocate(colliders, "the loads' frame sums");
     output_.allocate(colliders, "the loads' host copy");
     sum_slots_ = colliders;
