@@ -52,7 +52,7 @@ float max_field_speed(const SdfAsset& a) {
 World::World(const WorldConfig& config, std::unique_ptr<Backend> backend)
     : config_(config), backend_(std::move(backend)) {}
 
-uint32_t World::spawn(const std::vector<Vec3>& positions, const std::vector<Vec3>* velocities,
+uint32_t World::spawn(const HostVector<Vec3>& positions, const HostVector<Vec3>* velocities,
                       uint32_t user_attribute) {
   const uint64_t n = positions.size();
   if (n > free_capacity())
@@ -70,7 +70,7 @@ uint32_t World::spawn(const std::vector<Vec3>& positions, const std::vector<Vec3
 }
 
 void World::emit_sources(double frame_dt) {
-  std::vector<Vec3> existing;
+  HostVector<Vec3> existing;
   bool have_existing = false;
   sources_.for_each([&](uint64_t id, Source& s) {
     if (s.mode == SourceMode::FillOnce && s.done) return;
@@ -81,10 +81,10 @@ void World::emit_sources(double frame_dt) {
       have_existing = true;
     }
     const SdfGridView region = s.region->host_view();
-    std::vector<Vec3> points(s.lattice.size());
+    HostVector<Vec3> points(s.lattice.size());
     for (size_t i = 0; i < points.size(); ++i) points[i] = to_world(s.pose, s.lattice[i]);
-    const std::vector<char> keep = clear_of_points(existing, points, s.min_distance);
-    std::vector<Vec3> accepted, velocities;
+    const HostVector<char> keep = clear_of_points(existing, points, s.min_distance);
+    HostVector<Vec3> accepted, velocities;
     for (size_t i = 0; i < points.size(); ++i) {
       if (!keep[i]) continue;
       accepted.push_back(points[i]);
@@ -198,12 +198,12 @@ bool World::step(double frame_dt, const StepInterrupt& interrupt) {
     bool done;
     double rate_budget;
   };
-  std::vector<SourceState> sources_before;
+  HostVector<SourceState> sources_before;
   sources_.for_each([&](uint64_t id, const Source& s) {
     sources_before.push_back({id, s.done, s.rate_budget});
   });
   // The last step's events, kept aside (no allocation: nothing can fail from here to the try).
-  std::vector<Event> events_before;
+  HostVector<Event> events_before;
   events_before.swap(events_);
   FrameReport report;
   try {

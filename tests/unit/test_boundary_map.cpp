@@ -91,7 +91,7 @@ void test_ball_against_brute_force(void**) {
   spec.voxel_size = 0.01f;
   const auto asset = sph::build_shape_sdf(spec, 1u << 24);
   const double h = 0.036, R = 0.1;
-  const std::vector<sph::Float4> map = sph::compute_boundary_map(*asset, static_cast<float>(h), 0.0f, 2);
+  const auto map = sph::compute_boundary_map(*asset, static_cast<float>(h), 0.0f, 2);
   const std::vector<sph::Float4> none(map.size(), sph::Float4{0.0f, 0.0f, 0.0f, 0.0f});
   double worst = 0.0, worst_flat = 0.0, worst_slope = 0.0;
   for (double d = -h; d <= h + 1e-9; d += h / 7.0) {
