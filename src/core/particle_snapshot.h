@@ -49,8 +49,8 @@ struct ParticleSnapshot {
     if (!out.empty()) std::memcpy(out.data(), a->bytes.data(), out.size() * sizeof(T));
     return out;
   }
-  template <class T>
-  void set_carried(const char* name, const HostVector<T>& values) {
+  template <class T, class Allocator>
+  void set_carried(const char* name, const std::vector<T, Allocator>& values) {
     CarriedArray a;
     a.name = name;
     a.element_size = sizeof(T);
