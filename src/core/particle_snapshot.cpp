@@ -12,7 +12,8 @@ uint64_t elements_of(const ParticleArraySpec& spec, uint32_t n) {
 
 }  // namespace
 
-void check_carried_arrays(const ParticleSnapshot& s, const std::vector<ParticleArraySpec>& specs, uint32_t n) {
+void check_carried_arrays(const ParticleSnapshot& s, const std::vector<ParticleArraySpec>& specs,
+                          uint32_t n) {
   for (const CarriedArray& a : s.carried) {
     const ParticleArraySpec* spec = find_array_spec(specs, a.name.c_str());
     if (!spec || spec->role != ParticleArrayRole::Carried)
