@@ -839,9 +839,10 @@ namespace Sph
         /// = the system heap. Every host allocation for the context's worlds and SDF assets goes
         /// through it (particle arrays, neighbour grids, scratch, rollback snapshots, checkpoint
         /// buffers, colliders, sources, sinks, probes, SDF grids and assets, boundary maps, per-frame
-        /// lists) except: the context object, each world's handle record, World and backend objects (a
-        /// few KB a world) and step thread, error messages and the last-error text, and on CUDA the
-        /// page-locked staging buffers (cudaMallocHost). Device memory: sph_cuda_context_set_allocator.
+        /// lists) except: the context object, each world's handle record, World and backend objects and
+        /// their array records (15 allocations, 3.4 KB, for a plain CPU world; none in a step) and step
+        /// thread, error messages and the last-error text, and on CUDA the page-locked staging buffers
+        /// (cudaMallocHost). Device memory: sph_cuda_context_set_allocator.
         /// </summary>
         public IntPtr AllocFn;
         /// <summary>sph_free_fn free_fn</summary>

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '5bb2b69b717c007b64cde106bffaeb4b51aefa14d4b0f4af9f24cfb6af0585be', 'include/sph_cuda.h': 'bc45fdd19760b5f7836b35e85fab855a08fb42a1fee6c5be4a9099ef47174560', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '20c1d0226face5f4ec556f6f15ab9a9ab1fced4a0a521cb093c75772ed65d249', 'include/sph_cuda.h': 'bc45fdd19760b5f7836b35e85fab855a08fb42a1fee6c5be4a9099ef47174560', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -806,7 +806,7 @@ class ContextDef(_SphStruct):
         enqueue_task (sph_enqueue_task_fn): The engine's task system (0.2.0): both or neither; NULL (default) = the library's OpenMP workers. A CPU context uses it for every parallel loop of its worlds; cpu_worker_count then only decides whether a loop runs in parallel (1: every loop on the calling thread). A CUDA context checks and ignores it.
         finish_task (sph_finish_task_fn)
         task_user_context (void*): passed to enqueue_task and finish_task
-        alloc_fn (sph_alloc_fn): The engine's host allocator (0.2.0): both or neither; NULL (default) = the system heap. Every host allocation for the context's worlds and SDF assets goes through it (particle arrays, neighbour grids, scratch, rollback snapshots, checkpoint buffers, colliders, sources, sinks, probes, SDF grids and assets, boundary maps, per-frame lists) except: the context object, each world's handle record, World and backend objects (a few KB a world) and step thread, error messages and the last-error text, and on CUDA the page-locked staging buffers (cudaMallocHost). Device memory: sph_cuda_context_set_allocator.
+        alloc_fn (sph_alloc_fn): The engine's host allocator (0.2.0): both or neither; NULL (default) = the system heap. Every host allocation for the context's worlds and SDF assets goes through it (particle arrays, neighbour grids, scratch, rollback snapshots, checkpoint buffers, colliders, sources, sinks, probes, SDF grids and assets, boundary maps, per-frame lists) except: the context object, each world's handle record, World and backend objects and their array records (15 allocations, 3.4 KB, for a plain CPU world; none in a step) and step thread, error messages and the last-error text, and on CUDA the page-locked staging buffers (cudaMallocHost). Device memory: sph_cuda_context_set_allocator.
         free_fn (sph_free_fn)
         alloc_user_context (void*): passed to alloc_fn and free_fn
     """
