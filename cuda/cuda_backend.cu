@@ -73,12 +73,12 @@ void CudaBackend::append(const Vec3* positions, const Vec3* velocities, uint32_t
                          uint32_t user_attribute) {
   require_alive();
   DeviceGuard guard(device_);
-  std::vector<Float4> pos(n), vel(n);
-  std::vector<uint32_t> ids(n);
-  const std::vector<float> density(n, config_.rest_density);
+  HostVector<Float4> pos(n), vel(n);
+  HostVector<uint32_t> ids(n);
+  const HostVector<float> density(n, config_.rest_density);
   // The methods' carried arrays start at their initial values (a fresh density factor, which
   // the first density pass resolves; an empty spring list).
-  std::vector<std::vector<unsigned char>> initial;
+  HostVector<HostVector<unsigned char>> initial;
   for (const auto& m : r_->store->method_arrays())
     if (m->spec.role == ParticleArrayRole::Carried && m->spec.elements_per_particle != 0)
       initial.push_back(carried_bytes(ParticleSnapshot{}, m->spec, n));
@@ -210,7 +210,7 @@ void CudaBackend::copy_attribute(AttributeKind kind, uint32_t first, uint32_t co
     case AttributeKind::Velocity:
     case AttributeKind::Pressure: {
       const Float4* src = (kind == AttributeKind::Velocity ? a.velocity : a.position) + first;
-      const std::vector<Float4> host = download(src, count);
+      const HostVector<Float4> host = download(src, count);
       for (uint32_t k = 0; k < count; ++k) {
         unsigned char* p = out + static_cast<size_t>(k) * stride;
         if (kind == AttributeKind::Pressure) {
@@ -245,7 +245,7 @@ ParticleSnapshot CudaBackend::export_particles() const {
   s.velocity = download(a.velocity, count_);
   s.id = download(a.id, count_);
   s.density = download(a.density, count_);
-  const std::vector<FrameState> state = download(static_cast<const FrameState*>(r_->state.get()), 1u);
+  const HostVector<FrameState> state = download(static_cast<const FrameState*>(r_->state.get()), 1u);
   s.max_speed = state[0].max_speed;
   s.max_acceleration = state[0].max_acceleration;
   for (const auto& m : r_->store->method_arrays()) {
@@ -269,7 +269,7 @@ void CudaBackend::import_particles(const ParticleSnapshot& s) {
   check_carried_arrays(s, specs, n);
   // A carried array the snapshot lacks (a checkpoint written before the method carried it)
   // starts every particle fresh, as if it had just been spawned.
-  std::vector<std::vector<unsigned char>> carried;
+  HostVector<HostVector<unsigned char>> carried;
   for (const auto& m : r_->store->method_arrays())
     if (m->spec.role == ParticleArrayRole::Carried) carried.push_back(carried_bytes(s, m->spec, n));
   DeviceGuard guard(device_);

@@ -146,8 +146,8 @@ class CudaBackend final : public Backend {
   }
 
   template <class T>
-  std::vector<T> download(const T* src, size_t count) const {
-    std::vector<T> host(count);
+  HostVector<T> download(const T* src, size_t count) const {
+    HostVector<T> host(count);
     guarded([&] {
       cuda_check(cudaMemcpyAsync(host.data(), src, sizeof(T) * count, cudaMemcpyDeviceToHost, r_->stream),
                  "copy of particle data to the host");
@@ -157,7 +157,7 @@ class CudaBackend final : public Backend {
   }
 
   template <class T>
-  static void scatter(const std::vector<T>& host, unsigned char* out, size_t stride) {
+  static void scatter(const HostVector<T>& host, unsigned char* out, size_t stride) {
     for (size_t k = 0; k < host.size(); ++k) std::memcpy(out + k * stride, &host[k], sizeof(T));
   }
 
@@ -165,8 +165,8 @@ class CudaBackend final : public Backend {
   bool prepare_graph(const PipelineSetup& setup);
 
   // The stream driver (frame_loop.cu): frames with sinks, and every frame without graphs.
-  uint32_t run_frame_on_stream(PipelineSetup setup, uint32_t sink_count, std::vector<uint32_t>& removed_ids,
-                               std::vector<uint32_t>& removed_by_sink, const StepInterrupt& interrupt,
+  uint32_t run_frame_on_stream(PipelineSetup setup, uint32_t sink_count, HostVector<uint32_t>& removed_ids,
+                               HostVector<uint32_t>& removed_by_sink, const StepInterrupt& interrupt,
                                bool& interrupted);
 
   WorldConfig config_;

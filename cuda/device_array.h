@@ -1,18 +1,24 @@
 // SPDX-License-Identifier: MIT
-// Owning handles of device and pinned host memory. Allocation failures throw
+// Owning handles of device and pinned host memory (every device allocation of the CUDA backend
+// is a DeviceArray). Allocation failures throw
 // Error(OutOfDeviceMemory / OutOfHostMemory) and leave nothing allocated; release never throws.
 #pragma once
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include <string>
 #include <utility>
 
+#include "../src/core/host_memory.h"
 #include "cuda_status.h"
 #include "device_allocation_faults.h"
 
 namespace sph {
 
+// Device memory comes from the engine's device allocator when its context has one
+// (sph_cuda_context_set_allocator; core/host_memory.h), cudaMalloc otherwise: the hooks current
+// when the array is allocated, kept with it so it frees there.
 template <class T>
 class DeviceArray {
  public:
@@ -20,12 +26,17 @@ class DeviceArray {
   DeviceArray(size_t count, const char* name) { allocate(count, name); }
   ~DeviceArray() { release(); }
   DeviceArray(DeviceArray&& other) noexcept
-      : data_(std::exchange(other.data_, nullptr)), count_(std::exchange(other.count_, 0)) {}
+      : data_(std::exchange(other.data_, nullptr)),
+        count_(std::exchange(other.count_, 0)),
+        hooks_(std::exchange(other.hooks_, nullptr)),
+        device_(other.device_) {}
   DeviceArray& operator=(DeviceArray&& other) noexcept {
     if (this != &other) {
       release();
       data_ = std::exchange(other.data_, nullptr);
       count_ = std::exchange(other.count_, 0);
+      hooks_ = std::exchange(other.hooks_, nullptr);
+      device_ = other.device_;
     }
     return *this;
   }
@@ -35,24 +46,50 @@ class DeviceArray {
   void allocate(size_t count, const char* name) {
     release();
     if (count == 0) return;
+    const size_t bytes = count * sizeof(T);
+    const MemoryHooks* current = current_memory_hooks();
+    const DeviceMemoryHooks* engine = current && current->device.alloc ? &current->device : nullptr;
     void* p = nullptr;
-    const cudaError_t e = testing::device_allocation_fault_due() ? cudaErrorMemoryAllocation
-                                                                 : cudaMalloc(&p, count * sizeof(T));
+    cudaError_t e = cudaSuccess;
+    int device = 0;
+    if (testing::device_allocation_fault_due()) {
+      e = cudaErrorMemoryAllocation;
+    } else if (engine) {
+      cuda_check(cudaGetDevice(&device), name);
+      p = engine->alloc(bytes, device, engine->user_context);
+      if (!p) e = cudaErrorMemoryAllocation;
+      if (p && reinterpret_cast<uintptr_t>(p) % 256 != 0) {
+        engine->free(p, bytes, device, engine->user_context);
+        throw Error(Status::OutOfDeviceMemory, std::string("the engine's device allocator gave ") + name +
+                                                   " memory that is not 256-byte aligned");
+      }
+    } else {
+      e = cudaMalloc(&p, bytes);
+    }
     if (e != cudaSuccess) {
       (void)cudaGetLastError();
       if (e == cudaErrorMemoryAllocation)
-        throw Error(Status::OutOfDeviceMemory, std::string("cudaMalloc of ") + name + " (" +
-                                                   std::to_string(count * sizeof(T)) + " bytes) failed");
+        throw Error(Status::OutOfDeviceMemory,
+                    std::string(engine ? "the engine's device allocator" : "cudaMalloc") + " of " + name +
+                        " (" + std::to_string(bytes) + " bytes) failed");
       cuda_check(e, name);
     }
     data_ = static_cast<T*>(p);
     count_ = count;
+    hooks_ = engine ? current : nullptr;
+    device_ = device;
   }
 
   void release() noexcept {
-    if (data_ && cudaFree(data_) != cudaSuccess) (void)cudaGetLastError();
+    if (data_) {
+      if (hooks_)
+        hooks_->device.free(data_, count_ * sizeof(T), device_, hooks_->device.user_context);
+      else if (cudaFree(data_) != cudaSuccess)
+        (void)cudaGetLastError();
+    }
     data_ = nullptr;
     count_ = 0;
+    hooks_ = nullptr;
   }
 
   T* get() const { return data_; }
@@ -62,6 +99,8 @@ class DeviceArray {
  private:
   T* data_ = nullptr;
   size_t count_ = 0;
+  const MemoryHooks* hooks_ = nullptr;  // the engine's allocator that gave data_ (null: cudaMalloc)
+  int device_ = 0;
 };
 
 // Page-locked host memory: the only host memory a captured graph may copy to or from.

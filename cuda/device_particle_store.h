@@ -104,7 +104,7 @@ class DeviceParticleStore {
   DeviceParticleStore(uint32_t capacity, const std::vector<ParticleArraySpec>& method_arrays);
 
   const ParticleArrays& arrays() const { return arrays_; }
-  const std::vector<std::unique_ptr<DeviceMethodArray>>& method_arrays() const { return methods_; }
+  const HostVector<std::unique_ptr<DeviceMethodArray>>& method_arrays() const { return methods_; }
   // A method array's side (0 or 1) by name; null when the world has no such array.
   void* find(const char* name, int side = 0) const;
   SortScratch sort_scratch() const;
@@ -131,7 +131,7 @@ class DeviceParticleStore {
   DeviceArray<Float4> snapshot_position_, snapshot_velocity_;
   DeviceArray<uint32_t> snapshot_id_;
   DeviceArray<float> snapshot_density_;
-  std::vector<std::unique_ptr<DeviceMethodArray>> methods_;
+  HostVector<std::unique_ptr<DeviceMethodArray>> methods_;
   ParticleArrays arrays_{};
 };
 

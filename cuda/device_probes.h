@@ -49,7 +49,7 @@ class DeviceProbeBuffers {
   DeviceArray<ProbeSums> sums_;
   PinnedArray<ProbeSums> output_;
   size_t output_slots_ = 0;
-  std::vector<ProbeView> host_views_;
+  HostVector<ProbeView> host_views_;
 };
 
 // The frame's sums to zero (frame begin) / to the pinned output (frame end).

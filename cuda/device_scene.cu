@@ -5,7 +5,7 @@ namespace sph {
 namespace {
 
 template <class T>
-void upload_array(DeviceArray<T>& dst, const std::vector<T>& src, cudaStream_t stream, const char* what) {
+void upload_array(DeviceArray<T>& dst, const HostVector<T>& src, cudaStream_t stream, const char* what) {
   if (src.empty()) return;
   if (dst.size() < src.size()) dst.allocate(src.size(), what);
   cuda_check(cudaMemcpyAsync(dst.get(), src.data(), sizeof(T) * src.size(), cudaMemcpyHostToDevice, stream),

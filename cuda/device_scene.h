@@ -56,9 +56,9 @@ class DeviceSceneBuffer {
   DeviceArray<ColliderView> colliders_;
   DeviceArray<ForceFieldView> fields_;
   DeviceArray<SinkView> sinks_;
-  std::vector<ColliderView> host_colliders_;
-  std::vector<ForceFieldView> host_fields_;
-  std::vector<SinkView> host_sinks_;
+  HostVector<ColliderView> host_colliders_;
+  HostVector<ForceFieldView> host_fields_;
+  HostVector<SinkView> host_sinks_;
 };
 
 }  // namespace sph

@@ -223,7 +223,7 @@ void run_solve_loop(const LoopCondition& cond, FrameState* state, FrameState* ho
   size_t leaf_count = 0;
   cuda_check(cudaStreamGetCaptureInfo(stream, &status, nullptr, &graph, &leaves, nullptr, &leaf_count),
              "cudaStreamGetCaptureInfo");
-  const std::vector<cudaGraphNode_t> after(leaves, leaves + leaf_count);
+  const HostVector<cudaGraphNode_t> after(leaves, leaves + leaf_count);
   cuda_check(cudaStreamEndCapture(stream, &graph), "capture before a solve");
   cudaGraphNodeParams params = {};
   params.type = cudaGraphNodeTypeConditional;

@@ -45,7 +45,7 @@ void FrameGraph::build(const PipelineSetup& setup, const PipelineBuffers& buffer
     size_t leaf_count = 0;
     cuda_check(cudaStreamGetCaptureInfo(stream, &status, nullptr, nullptr, &leaves, nullptr, &leaf_count),
                "cudaStreamGetCaptureInfo");
-    const std::vector<cudaGraphNode_t> begin_leaves(leaves, leaves + leaf_count);
+    const HostVector<cudaGraphNode_t> begin_leaves(leaves, leaves + leaf_count);
     cuda_check(cudaStreamEndCapture(stream, &graph_), "capture of the frame begin");
 
     // 2. the WHILE node; its body is one substep.

@@ -57,7 +57,7 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
   float frame_ms = 0.0f;
   const bool with_sinks = !scene_in.sinks.empty();
   uint32_t count_after = count_;
-  std::vector<uint32_t> removed_ids, removed_by_sink(scene_in.sinks.size(), 0u);
+  HostVector<uint32_t> removed_ids, removed_by_sink(scene_in.sinks.size(), 0u);
   bool frame_enqueued = false;  // the frame's first work (the rollback snapshot) is on the stream
   bool interrupted = false;     // the stream driver stopped at a substep boundary (StepInterrupt)
   try {
@@ -203,8 +203,8 @@ bool CudaBackend::prepare_graph(const PipelineSetup& setup) {
 // `interrupt` is checked after every substep that removed no particle (so the statistics read
 // what a frame's natural end leaves); when it stops the frame, `interrupted` is set.
 uint32_t CudaBackend::run_frame_on_stream(PipelineSetup setup, uint32_t sink_count,
-                                          std::vector<uint32_t>& removed_ids,
-                                          std::vector<uint32_t>& removed_by_sink,
+                                          HostVector<uint32_t>& removed_ids,
+                                          HostVector<uint32_t>& removed_by_sink,
                                           const StepInterrupt& interrupt, bool& interrupted) {
   const PipelineBuffers b = r_->buffers();
   const ParticleArrays& a = b.store->arrays();
@@ -218,7 +218,7 @@ uint32_t CudaBackend::run_frame_on_stream(PipelineSetup setup, uint32_t sink_cou
              "copy of the loop condition");
   cuda_check(cudaStreamSynchronize(s), "frame begin");
   const uint32_t* counts_after_sinks = nullptr;
-  std::vector<uint32_t> ids, sinks;
+  HostVector<uint32_t> ids, sinks;
   while (out->run) {
     setup.count = n;
     enqueue_substep(setup, b, LoopCondition{}, s);

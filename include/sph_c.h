@@ -275,6 +275,42 @@ typedef struct sph_context sph_context;
 typedef void(SPH_CALL* sph_log_fn)(void* user_data, sph_log_level level, sph_result code,
                                    const char* message);
 
+/**
+ * The engine's task system (the shape of Box2D v3's b2EnqueueTaskCallback and
+ * b2FinishTaskCallback; docs/embedding.md, "Threads"). With one, a CPU context runs every
+ * parallel loop of its worlds through it and starts no thread of its own for them.
+ *
+ * sph_task_fn runs items [first, last) of a task on the calling thread; `worker` is the index
+ * of the task system's worker that runs them (the library does not read it; pass what you
+ * have). The library's task functions never block, never call back into the library and never
+ * throw; they may run on any thread, concurrently with each other.
+ *
+ * sph_enqueue_task_fn schedules `task` over the items [0, item_count), split into ranges of at
+ * least min_range items (the library passes 1), each range one call of task with task_context.
+ * It returns a handle that the library passes to finish_task, or NULL once it has run every
+ * item itself (then finish_task is not called). It is called only from the thread inside an
+ * sph_ call on the world (for sph_world_step_begin: the world's step thread), never from a task.
+ *
+ * sph_finish_task_fn returns once every item of the task behind user_task has run (it may run
+ * items itself meanwhile). Results are the same bits whatever the split or the worker count.
+ */
+typedef void(SPH_CALL* sph_task_fn)(uint32_t first, uint32_t last, uint32_t worker, void* task_context);
+typedef void*(SPH_CALL* sph_enqueue_task_fn)(sph_task_fn task, uint32_t item_count, uint32_t min_range,
+                                             void* task_context, void* user_context);
+typedef void(SPH_CALL* sph_finish_task_fn)(void* user_task, void* user_context);
+
+/**
+ * The engine's host allocator (docs/embedding.md, "Memory"). alloc returns `size` bytes (never
+ * 0) aligned to `alignment` (a power of two, at least 16), or NULL when it has none (the call
+ * then fails with SPH_ERROR_OUT_OF_HOST_MEMORY and the world is unchanged). free gives back
+ * memory that alloc returned, with the size that was asked for. Both may be called from any
+ * thread that runs the library's work for the context (the caller's, the world's step thread,
+ * a worker or the engine's tasks), concurrently: they must be thread-safe. user_context is
+ * passed unchanged.
+ */
+typedef void*(SPH_CALL* sph_alloc_fn)(size_t size, size_t alignment, void* user_context);
+typedef void(SPH_CALL* sph_free_fn)(void* memory, size_t size, void* user_context);
+
 /** Zero means default: a zeroed def is valid (AUTO backend, device 0, every hardware thread,
  *  no logging; header_version 0 skips the header check). */
 typedef struct sph_context_def {
@@ -293,8 +329,26 @@ typedef struct sph_context_def {
                                   32, 64, 128, 256, 512, 1024 */
   uint32_t cuda_force_block;   /* threads per block of the force kernels: 0 (default) = 128, or as above */
   uint32_t reserved1;          /* must be 0 */
+  /* The engine's task system (0.2.0): both or neither; NULL (default) = the library's OpenMP
+     workers. A CPU context uses it for every parallel loop of its worlds; cpu_worker_count
+     then only decides whether a loop runs in parallel (1: every loop on the calling thread). A
+     CUDA context checks and ignores it. */
+  sph_enqueue_task_fn enqueue_task;
+  sph_finish_task_fn finish_task;
+  void* task_user_context; /* passed to enqueue_task and finish_task */
+  /* The engine's host allocator (0.2.0): both or neither; NULL (default) = the system heap.
+     Every host allocation for the context's worlds and SDF assets goes through it (particle
+     arrays, neighbour grids, scratch, rollback snapshots, checkpoint buffers, colliders,
+     sources, sinks, probes, SDF grids and assets, boundary maps, per-frame lists) except: the
+     context object, each world's handle record, World and backend objects and their array
+     records (15 allocations, 3.4 KB, for a plain CPU world; none in a step) and step thread, error messages
+     and the last-error text, and on CUDA the page-locked staging buffers (cudaMallocHost). Device memory:
+     sph_cuda_context_set_allocator. */
+  sph_alloc_fn alloc_fn;
+  sph_free_fn free_fn;
+  void* alloc_user_context; /* passed to alloc_fn and free_fn */
 } sph_context_def;
-SPH_STATIC_ASSERT(sizeof(sph_context_def) == 40 + 2 * sizeof(void*), sph_context_def_size);
+SPH_STATIC_ASSERT(sizeof(sph_context_def) == 40 + 8 * sizeof(void*), sph_context_def_size);
 
 /** Fills def with defaults; size is sizeof(*def). Prefer sph_context_def_init. */
 SPH_API sph_result SPH_CALL sph_context_def_init_sized(sph_context_def* def, uint32_t size);

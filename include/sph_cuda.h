@@ -129,6 +129,51 @@ SPH_API sph_result SPH_CALL sph_cuda_world_wait_event(sph_world* world, void* ev
  */
 SPH_API sph_result SPH_CALL sph_cuda_world_step_begin_on_stream(sph_world* world, float frame_dt, void* stream);
 
+/* ---- the engine's device allocator --------------------------------------------------------- */
+
+/**
+ * The engine's device allocator (docs/embedding.md, "Memory"). alloc_fn returns `size` bytes
+ * (never 0) of device memory on device_ordinal, aligned to at least 256 bytes (as cudaMalloc
+ * gives), or NULL when it has none (the call then fails with SPH_ERROR_OUT_OF_DEVICE_MEMORY and
+ * the world is unchanged). free_fn gives back memory that alloc_fn returned, with its size and
+ * device. The library calls them with that device current, from the thread inside an sph_
+ * call on the context (for sph_world_step_begin: the world's step thread), so several worlds
+ * on several threads may call them at once: they must be thread-safe. The memory must stay
+ * valid until freed (stream-ordered pools: free it only after the device's work is done).
+ */
+typedef void*(SPH_CALL* sph_cuda_alloc_fn)(size_t size, int32_t device_ordinal, void* user_context);
+typedef void(SPH_CALL* sph_cuda_free_fn)(void* device_memory, size_t size, int32_t device_ordinal,
+                                         void* user_context);
+
+typedef struct sph_cuda_allocator {
+  uint32_t struct_size;       /* sizeof(sph_cuda_allocator), set by the init function */
+  uint32_t reserved0;         /* must be 0 */
+  sph_cuda_alloc_fn alloc_fn; /* both or neither; NULL (default): cudaMalloc / cudaFree */
+  sph_cuda_free_fn free_fn;
+  void* user_context; /* passed to alloc_fn and free_fn */
+} sph_cuda_allocator;
+SPH_STATIC_ASSERT(sizeof(sph_cuda_allocator) == 8 + 3 * sizeof(void*), sph_cuda_allocator_size);
+
+/** Zeroes *allocator and sets struct_size (size = sizeof(*allocator)). */
+SPH_API sph_result SPH_CALL sph_cuda_allocator_init_sized(sph_cuda_allocator* allocator, uint32_t size);
+static inline sph_result sph_cuda_allocator_init(sph_cuda_allocator* allocator) {
+  return sph_cuda_allocator_init_sized(allocator, (uint32_t)sizeof(*allocator));
+}
+
+/**
+ * Makes every device allocation of the context's worlds (particle arrays, grids, sort and
+ * reduction scratch, SDF grids and boundary maps, probes, loads) go through `allocator`; NULL
+ * or a zeroed allocator goes back to cudaMalloc. Set it before the context has any world or
+ * SDF asset: it cannot change under memory already taken. Page-locked host staging buffers
+ * (cudaMallocHost) and CUDA's own allocations (graphs, streams, events, the runtime's context)
+ * do not go through it. Thread-safe.
+ * Errors: INVALID_HANDLE, INVALID_ARGUMENT (one of alloc_fn / free_fn without the other,
+ * reserved0 not 0; the message names it), VERSION_MISMATCH, UNSUPPORTED (a CPU context or a
+ * build without CUDA), BUSY (the context has worlds or SDF assets).
+ */
+SPH_API sph_result SPH_CALL sph_cuda_context_set_allocator(sph_context* context,
+                                                           const sph_cuda_allocator* allocator);
+
 #ifdef __cplusplus
 }
 #endif

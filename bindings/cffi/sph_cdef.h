@@ -210,6 +210,13 @@ typedef enum {
 } sph_event_type;
 
 typedef void (*sph_log_fn)(void* user_data, sph_log_level level, sph_result code, const char* message);
+typedef void (*sph_task_fn)(uint32_t first, uint32_t last, uint32_t worker, void* task_context);
+typedef void* (*sph_enqueue_task_fn)(sph_task_fn task, uint32_t item_count, uint32_t min_range, void* task_context, void* user_context);
+typedef void (*sph_finish_task_fn)(void* user_task, void* user_context);
+typedef void* (*sph_alloc_fn)(size_t size, size_t alignment, void* user_context);
+typedef void (*sph_free_fn)(void* memory, size_t size, void* user_context);
+typedef void* (*sph_cuda_alloc_fn)(size_t size, int32_t device_ordinal, void* user_context);
+typedef void (*sph_cuda_free_fn)(void* device_memory, size_t size, int32_t device_ordinal, void* user_context);
 
 typedef struct sph_vec3 {
   float x;
@@ -229,6 +236,12 @@ typedef struct sph_context_def {
   uint32_t cuda_density_block;
   uint32_t cuda_force_block;
   uint32_t reserved1;
+  sph_enqueue_task_fn enqueue_task;
+  sph_finish_task_fn finish_task;
+  void* task_user_context;
+  sph_alloc_fn alloc_fn;
+  sph_free_fn free_fn;
+  void* alloc_user_context;
 } sph_context_def;
 typedef struct sph_world_def {
   uint32_t struct_size;
@@ -538,6 +551,13 @@ typedef struct sph_cuda_attribute_view {
   int32_t device_ordinal;
   uint32_t reserved0;
 } sph_cuda_attribute_view;
+typedef struct sph_cuda_allocator {
+  uint32_t struct_size;
+  uint32_t reserved0;
+  sph_cuda_alloc_fn alloc_fn;
+  sph_cuda_free_fn free_fn;
+  void* user_context;
+} sph_cuda_allocator;
 
 // libsph
 uint32_t sph_get_version(void);
@@ -658,6 +678,8 @@ sph_result sph_cuda_world_get_stream(const sph_world* world, void** out_stream);
 sph_result sph_cuda_world_record_event(sph_world* world, void* event);
 sph_result sph_cuda_world_wait_event(sph_world* world, void* event);
 sph_result sph_cuda_world_step_begin_on_stream(sph_world* world, float frame_dt, void* stream);
+sph_result sph_cuda_allocator_init_sized(sph_cuda_allocator* allocator, uint32_t size);
+sph_result sph_cuda_context_set_allocator(sph_context* context, const sph_cuda_allocator* allocator);
 // libsph_vdb
 sph_result sph_vdb_load_sdf(sph_context* context, const char* path, const char* grid_name, sph_sdf** out);
 const char* sph_vdb_get_last_error(void);

@@ -486,6 +486,70 @@ namespace Sph
     [UnmanagedFunctionPointer(CallingConvention.Cdecl)]
     public delegate void LogFn(IntPtr userData, LogLevel level, Result code, IntPtr message);
 
+    /// <summary>
+    /// sph_task_fn: The engine's task system (the shape of Box2D v3's b2EnqueueTaskCallback and
+    /// b2FinishTaskCallback; docs/embedding.md, "Threads"). With one, a CPU context runs every parallel
+    /// loop of its worlds through it and starts no thread of its own for them.
+    /// <para/>
+    /// sph_task_fn runs items [first, last) of a task on the calling thread; `worker` is the index of
+    /// the task system's worker that runs them (the library does not read it; pass what you have). The
+    /// library's task functions never block, never call back into the library and never throw; they may
+    /// run on any thread, concurrently with each other.
+    /// <para/>
+    /// sph_enqueue_task_fn schedules `task` over the items [0, item_count), split into ranges of at
+    /// least min_range items (the library passes 1), each range one call of task with task_context. It
+    /// returns a handle that the library passes to finish_task, or NULL once it has run every item
+    /// itself (then finish_task is not called). It is called only from the thread inside an sph_ call
+    /// on the world (for sph_world_step_begin: the world's step thread), never from a task.
+    /// <para/>
+    /// sph_finish_task_fn returns once every item of the task behind user_task has run (it may run
+    /// items itself meanwhile). Results are the same bits whatever the split or the worker count.
+    /// </summary>
+    [UnmanagedFunctionPointer(CallingConvention.Cdecl)]
+    public delegate void TaskFn(uint first, uint last, uint worker, IntPtr taskContext);
+
+    /// <summary>sph_enqueue_task_fn:</summary>
+    [UnmanagedFunctionPointer(CallingConvention.Cdecl)]
+    public delegate IntPtr EnqueueTaskFn(IntPtr task, uint itemCount, uint minRange, IntPtr taskContext, IntPtr userContext);
+
+    /// <summary>sph_finish_task_fn:</summary>
+    [UnmanagedFunctionPointer(CallingConvention.Cdecl)]
+    public delegate void FinishTaskFn(IntPtr userTask, IntPtr userContext);
+
+    /// <summary>
+    /// sph_alloc_fn: The engine's host allocator (docs/embedding.md, "Memory"). alloc returns `size`
+    /// bytes (never 0) aligned to `alignment` (a power of two, at least 16), or NULL when it has none
+    /// (the call then fails with SPH_ERROR_OUT_OF_HOST_MEMORY and the world is unchanged). free gives
+    /// back memory that alloc returned, with the size that was asked for. Both may be called from any
+    /// thread that runs the library's work for the context (the caller's, the world's step thread, a
+    /// worker or the engine's tasks), concurrently: they must be thread-safe. user_context is passed
+    /// unchanged.
+    /// </summary>
+    [UnmanagedFunctionPointer(CallingConvention.Cdecl)]
+    public delegate IntPtr AllocFn(UIntPtr size, UIntPtr alignment, IntPtr userContext);
+
+    /// <summary>sph_free_fn:</summary>
+    [UnmanagedFunctionPointer(CallingConvention.Cdecl)]
+    public delegate void FreeFn(IntPtr memory, UIntPtr size, IntPtr userContext);
+
+    /// <summary>
+    /// sph_cuda_alloc_fn: The engine's device allocator (docs/embedding.md, "Memory"). alloc_fn returns
+    /// `size` bytes (never 0) of device memory on device_ordinal, aligned to at least 256 bytes (as
+    /// cudaMalloc gives), or NULL when it has none (the call then fails with
+    /// SPH_ERROR_OUT_OF_DEVICE_MEMORY and the world is unchanged). free_fn gives back memory that
+    /// alloc_fn returned, with its size and device. The library calls them with that device current,
+    /// from the thread inside an sph_ call on the context (for sph_world_step_begin: the world's step
+    /// thread), so several worlds on several threads may call them at once: they must be thread-safe.
+    /// The memory must stay valid until freed (stream-ordered pools: free it only after the device's
+    /// work is done).
+    /// </summary>
+    [UnmanagedFunctionPointer(CallingConvention.Cdecl)]
+    public delegate IntPtr CudaAllocFn(UIntPtr size, int deviceOrdinal, IntPtr userContext);
+
+    /// <summary>sph_cuda_free_fn:</summary>
+    [UnmanagedFunctionPointer(CallingConvention.Cdecl)]
+    public delegate void CudaFreeFn(IntPtr deviceMemory, UIntPtr size, int deviceOrdinal, IntPtr userContext);
+
     /// <summary>A C array float[3], blittable (no unsafe fixed buffer).</summary>
     [StructLayout(LayoutKind.Sequential)]
     public struct FixedFloat3
@@ -718,7 +782,7 @@ namespace Sph
     }
 
     /// <summary>
-    /// sph_context_def (56 bytes): Zero means default: a zeroed def is valid (AUTO backend, device 0,
+    /// sph_context_def (104 bytes): Zero means default: a zeroed def is valid (AUTO backend, device 0,
     /// every hardware thread, no logging; header_version 0 skips the header check).
     /// </summary>
     [StructLayout(LayoutKind.Sequential)]
@@ -761,6 +825,32 @@ namespace Sph
         public uint CudaForceBlock;
         /// <summary>uint32_t reserved1: must be 0</summary>
         public uint Reserved1;
+        /// <summary>
+        /// sph_enqueue_task_fn enqueue_task: The engine's task system (0.2.0): both or neither; NULL
+        /// (default) = the library's OpenMP workers. A CPU context uses it for every parallel loop of
+        /// its worlds; cpu_worker_count then only decides whether a loop runs in parallel (1: every
+        /// loop on the calling thread). A CUDA context checks and ignores it.
+        /// </summary>
+        public IntPtr EnqueueTask;
+        /// <summary>sph_finish_task_fn finish_task</summary>
+        public IntPtr FinishTask;
+        /// <summary>void* task_user_context: passed to enqueue_task and finish_task</summary>
+        public IntPtr TaskUserContext;
+        /// <summary>
+        /// sph_alloc_fn alloc_fn: The engine's host allocator (0.2.0): both or neither; NULL (default)
+        /// = the system heap. Every host allocation for the context's worlds and SDF assets goes
+        /// through it (particle arrays, neighbour grids, scratch, rollback snapshots, checkpoint
+        /// buffers, colliders, sources, sinks, probes, SDF grids and assets, boundary maps, per-frame
+        /// lists) except: the context object, each world's handle record, World and backend objects and
+        /// their array records (15 allocations, 3.4 KB, for a plain CPU world; none in a step) and step
+        /// thread, error messages and the last-error text, and on CUDA the page-locked staging buffers
+        /// (cudaMallocHost). Device memory: sph_cuda_context_set_allocator.
+        /// </summary>
+        public IntPtr AllocFn;
+        /// <summary>sph_free_fn free_fn</summary>
+        public IntPtr FreeFn;
+        /// <summary>void* alloc_user_context: passed to alloc_fn and free_fn</summary>
+        public IntPtr AllocUserContext;
 
         /// <summary>A ContextDef with the library's defaults (sph_context_def_init_sized).</summary>
         public static ContextDef Default()
@@ -1983,6 +2073,31 @@ namespace Sph
         }
     }
 
+    /// <summary>sph_cuda_allocator (32 bytes)</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public partial struct CudaAllocator
+    {
+        /// <summary>uint32_t struct_size: sizeof(sph_cuda_allocator), set by the init function</summary>
+        public uint StructSize;
+        /// <summary>uint32_t reserved0: must be 0</summary>
+        public uint Reserved0;
+        /// <summary>sph_cuda_alloc_fn alloc_fn: both or neither; NULL (default): cudaMalloc / cudaFree</summary>
+        public IntPtr AllocFn;
+        /// <summary>sph_cuda_free_fn free_fn</summary>
+        public IntPtr FreeFn;
+        /// <summary>void* user_context: passed to alloc_fn and free_fn</summary>
+        public IntPtr UserContext;
+
+        /// <summary>A CudaAllocator with the library's defaults (sph_cuda_allocator_init_sized).</summary>
+        public static CudaAllocator Default()
+        {
+            var value = new CudaAllocator();
+            uint size = (uint)Marshal.SizeOf(typeof(CudaAllocator));
+            SphException.Check(Native.sph_cuda_allocator_init_sized(ref value, size), "sph_cuda_allocator_init_sized");
+            return value;
+        }
+    }
+
     /// <summary>Owns an sph_context*, released with sph_context_destroy.</summary>
     public sealed partial class ContextHandle : SafeHandle
     {
@@ -3103,6 +3218,28 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_cuda_world_step_begin_on_stream")]
         public static extern Result sph_cuda_world_step_begin_on_stream(IntPtr world, float frameDt, IntPtr stream);
 
+        /// <summary>Zeroes *allocator and sets struct_size (size = sizeof(*allocator)).</summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_cuda_allocator_init_sized(ref CudaAllocator allocator, uint size);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_cuda_allocator_init_sized")]
+        public static extern Result sph_cuda_allocator_init_sized(IntPtr allocator, uint size);
+
+        /// <summary>
+        /// Makes every device allocation of the context's worlds (particle arrays, grids, sort and
+        /// reduction scratch, SDF grids and boundary maps, probes, loads) go through `allocator`; NULL
+        /// or a zeroed allocator goes back to cudaMalloc. Set it before the context has any world or
+        /// SDF asset: it cannot change under memory already taken. Page-locked host staging buffers
+        /// (cudaMallocHost) and CUDA's own allocations (graphs, streams, events, the runtime's context)
+        /// do not go through it. Thread-safe. Errors: INVALID_HANDLE, INVALID_ARGUMENT (one of alloc_fn
+        /// / free_fn without the other, reserved0 not 0; the message names it), VERSION_MISMATCH,
+        /// UNSUPPORTED (a CPU context or a build without CUDA), BUSY (the context has worlds or SDF
+        /// assets).
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_cuda_context_set_allocator(ContextHandle context, ref CudaAllocator allocator);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_cuda_context_set_allocator")]
+        public static extern Result sph_cuda_context_set_allocator(IntPtr context, IntPtr allocator);
+
         /// <summary>
         /// Loads a level-set FloatGrid from a .vdb file into a new SDF asset of `context`: the grid's
         /// active voxels (plus one voxel of margin) become a dense grid whose index_to_local is the
@@ -3172,6 +3309,7 @@ namespace Sph
             typeof(ProbeReading),
             typeof(Event),
             typeof(CudaAttributeView),
+            typeof(CudaAllocator),
         };
         public static readonly string[] StructNames = {
             "sph_vec3",
@@ -3212,10 +3350,11 @@ namespace Sph
             "sph_probe_reading",
             "sph_event",
             "sph_cuda_attribute_view",
+            "sph_cuda_allocator",
         };
         public static readonly int[] StructSizes = {
             12,
-            56,
+            104,
             48,
             48,
             16,
@@ -3252,6 +3391,7 @@ namespace Sph
             48,
             16,
             48,
+            32,
         };
 
         // One entry per field: struct type, C# field name, C offset.
@@ -3259,6 +3399,12 @@ namespace Sph
             typeof(Vec3),
             typeof(Vec3),
             typeof(Vec3),
+            typeof(ContextDef),
+            typeof(ContextDef),
+            typeof(ContextDef),
+            typeof(ContextDef),
+            typeof(ContextDef),
+            typeof(ContextDef),
             typeof(ContextDef),
             typeof(ContextDef),
             typeof(ContextDef),
@@ -3507,6 +3653,11 @@ namespace Sph
             typeof(CudaAttributeView),
             typeof(CudaAttributeView),
             typeof(CudaAttributeView),
+            typeof(CudaAllocator),
+            typeof(CudaAllocator),
+            typeof(CudaAllocator),
+            typeof(CudaAllocator),
+            typeof(CudaAllocator),
         };
         public static readonly string[] FieldNames = {
             "X",
@@ -3524,6 +3675,12 @@ namespace Sph
             "CudaDensityBlock",
             "CudaForceBlock",
             "Reserved1",
+            "EnqueueTask",
+            "FinishTask",
+            "TaskUserContext",
+            "AllocFn",
+            "FreeFn",
+            "AllocUserContext",
             "StructSize",
             "HeaderVersion",
             "Capacity",
@@ -3760,6 +3917,11 @@ namespace Sph
             "Epoch",
             "DeviceOrdinal",
             "Reserved0",
+            "StructSize",
+            "Reserved0",
+            "AllocFn",
+            "FreeFn",
+            "UserContext",
         };
         public static readonly int[] FieldOffsets = {
             0,
@@ -3777,6 +3939,12 @@ namespace Sph
             44,
             48,
             52,
+            56,
+            64,
+            72,
+            80,
+            88,
+            96,
             0,
             4,
             8,
@@ -4013,6 +4181,11 @@ namespace Sph
             32,
             40,
             44,
+            0,
+            4,
+            8,
+            16,
+            24,
         };
 
         /// <summary>Every exported function of the header.</summary>
@@ -4135,11 +4308,15 @@ namespace Sph
             "sph_cuda_world_record_event",
             "sph_cuda_world_wait_event",
             "sph_cuda_world_step_begin_on_stream",
+            "sph_cuda_allocator_init_sized",
+            "sph_cuda_context_set_allocator",
             "sph_vdb_load_sdf",
             "sph_vdb_get_last_error",
         };
         /// <summary>The shared library of each function ("sph", or an optional helper).</summary>
         public static readonly string[] FunctionLibraries = {
+            "sph",
+            "sph",
             "sph",
             "sph",
             "sph",

@@ -361,6 +361,16 @@ namespace Sph
             }
         }
 
+        /// <summary>The engine's device allocator for this CUDA context's worlds
+        /// (sph_cuda_context_set_allocator): both function pointers or neither (neither: back to
+        /// cudaMalloc), set before the first world or SDF asset. A CPU context throws
+        /// SphException(ErrorUnsupported).</summary>
+        public void SetCudaAllocator(CudaAllocator allocator)
+        {
+            SphException.Check(Native.sph_cuda_context_set_allocator(Handle, ref allocator),
+                               "sph_cuda_context_set_allocator");
+        }
+
         public World CreateWorld(WorldDef def) { return new World(this, def); }
 
         public World CreateWorld() { return new World(this, WorldDef.Default()); }

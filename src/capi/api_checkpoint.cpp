@@ -17,7 +17,7 @@ using sph::Status;
 
 namespace {
 
-std::vector<uint8_t> save_world(const sph_world* world) {
+sph::HostVector<uint8_t> save_world(const sph_world* world) {
   sph::CheckpointOrigin origin;
   origin.backend = static_cast<uint32_t>(world->context->backend);
   origin.library_version = SPH_VERSION;
@@ -35,7 +35,8 @@ std::unique_ptr<sph::World> load_world(sph_context* context, const void* data, u
   return sph::read_checkpoint(static_cast<const uint8_t*>(data), static_cast<size_t>(size),
                               [context](const sph::WorldConfig& config) {
                                 return sph::make_backend(context->backend, config, context->device_ordinal,
-                                                         context->cpu_workers, context->cuda_tuning);
+                                                         context->cpu_workers, context->cpu_tasks,
+                                                         context->cuda_tuning);
                               });
 }
 
@@ -66,7 +67,7 @@ SPH_API sph_result SPH_CALL sph_world_save(const sph_world* world, void* buffer,
     if (!buffer && buffer_size != 0)
       throw Error(Status::InvalidArgument, "buffer: is NULL but buffer_size is " +
                                                std::to_string(buffer_size) + " (pass 0 to ask the size)");
-    const std::vector<uint8_t> bytes = save_world(world);
+    const sph::HostVector<uint8_t> bytes = save_world(world);
     *out_size = bytes.size();
     if (!buffer) return SPH_OK;
     if (buffer_size < bytes.size())
@@ -102,7 +103,7 @@ SPH_API sph_result SPH_CALL sph_world_load_file(sph_context* context, const char
     const sph::ContextHold hold(context);
     require_path(path);
     if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
-    const std::vector<uint8_t> bytes = sph::read_checkpoint_file(path);
+    const sph::HostVector<uint8_t> bytes = sph::read_checkpoint_file(path);
     try {
       static const uint8_t nothing = 0;  // an empty file is a truncated checkpoint, not NULL data
       return publish(hold, load_world(hold.get(), bytes.empty() ? &nothing : bytes.data(), bytes.size()),

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Contexts: backend choice, device, CPU workers, CUDA tuning and logging.
 #include <thread>
+#include <type_traits>
 
 #include "guard.h"
 #include "handles.h"
@@ -41,6 +42,50 @@ sph::CudaTuning cuda_tuning_from_def(const sph_context_def& d) {
   t.density_block = block(d.cuda_density_block, "cuda_density_block");
   t.force_block = block(d.cuda_force_block, "cuda_force_block");
   return t;
+}
+
+static_assert(std::is_same<sph_task_fn, sph::TaskFn>::value, "the task hook types match core's");
+static_assert(std::is_same<sph_enqueue_task_fn, sph::EnqueueTaskFn>::value,
+              "the task hook types match core's");
+static_assert(std::is_same<sph_finish_task_fn, sph::FinishTaskFn>::value, "the task hook types match core's");
+static_assert(std::is_same<sph_alloc_fn, decltype(sph::HostMemoryHooks::alloc)>::value,
+              "the allocator types match");
+static_assert(std::is_same<sph_free_fn, decltype(sph::HostMemoryHooks::free)>::value,
+              "the allocator types match");
+
+// A hook without its other half would leave the library unable to wait for its tasks or to
+// give memory back: refused, whichever half is missing.
+sph::TaskSystem task_system_from_def(const sph_context_def& d) {
+  if ((d.enqueue_task == nullptr) != (d.finish_task == nullptr))
+    throw Error(Status::InvalidArgument, d.enqueue_task
+                                             ? "def->finish_task: is NULL while enqueue_task is set; "
+                                               "give both (the engine's task system) or neither"
+                                             : "def->enqueue_task: is NULL while finish_task is set; "
+                                               "give both (the engine's task system) or neither");
+  if (!d.enqueue_task && d.task_user_context)
+    throw Error(Status::InvalidArgument,
+                "def->task_user_context: is set without enqueue_task and finish_task");
+  sph::TaskSystem t;
+  t.enqueue = d.enqueue_task;
+  t.finish = d.finish_task;
+  t.user_context = d.task_user_context;
+  return t;
+}
+
+sph::HostMemoryHooks host_memory_from_def(const sph_context_def& d) {
+  if ((d.alloc_fn == nullptr) != (d.free_fn == nullptr))
+    throw Error(Status::InvalidArgument, d.alloc_fn
+                                             ? "def->free_fn: is NULL while alloc_fn is set; give both "
+                                               "(the engine's allocator) or neither"
+                                             : "def->alloc_fn: is NULL while free_fn is set; give both "
+                                               "(the engine's allocator) or neither");
+  if (!d.alloc_fn && d.alloc_user_context)
+    throw Error(Status::InvalidArgument, "def->alloc_user_context: is set without alloc_fn and free_fn");
+  sph::HostMemoryHooks h;
+  h.alloc = d.alloc_fn;
+  h.free = d.free_fn;
+  h.user_context = d.alloc_user_context;
+  return h;
 }
 
 }  // namespace
@@ -87,6 +132,8 @@ SPH_API sph_result SPH_CALL sph_context_create(const sph_context_def* def, sph_c
     context->cuda_tuning = cuda_tuning;
     context->log_fn = d.log_fn;
     context->log_user_data = d.log_user_data;
+    context->cpu_tasks = task_system_from_def(d);
+    context->memory.host = host_memory_from_def(d);
     sph::register_handle(context.get(), sph::HandleKind::Context);
     *out = context.release();
     return SPH_OK;

@@ -2,6 +2,8 @@
 // The zero-copy tier (include/sph_cuda.h): device addresses of attributes, the data epoch, the
 // world's stream and event ordering. The backend answers; a CPU backend (and every backend of
 // a build without CUDA) refuses with Unsupported.
+#include <type_traits>
+
 #include "guard.h"
 #include "handles.h"
 #include "sph_cuda.h"
@@ -115,5 +117,55 @@ SPH_API sph_result SPH_CALL sph_cuda_world_wait_event(sph_world* world, void* ev
     });
   });
 }
+
+SPH_API sph_result SPH_CALL sph_cuda_allocator_init_sized(sph_cuda_allocator* allocator, uint32_t size) {
+  return sph::guarded("sph_cuda_allocator_init", nullptr, [&] {
+    sph::require_init_size(allocator, size, "allocator");
+    sph_cuda_allocator a;
+    std::memset(&a, 0, sizeof a);
+    a.struct_size = sizeof a;
+    sph::write_user_struct(allocator, size, a);
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_cuda_context_set_allocator(sph_context* context,
+                                                           const sph_cuda_allocator* allocator) {
+  return sph::guarded("sph_cuda_context_set_allocator", context, [&] {
+    sph::DeviceMemoryHooks hooks;
+    if (allocator) {
+      const sph_cuda_allocator a = sph::read_user_struct(allocator, "allocator");
+      if (a.reserved0 != 0) throw Error(Status::InvalidArgument, "allocator->reserved0: must be 0");
+      if ((a.alloc_fn == nullptr) != (a.free_fn == nullptr))
+        throw Error(Status::InvalidArgument, a.alloc_fn
+                                                 ? "allocator->free_fn: is NULL while alloc_fn is set; "
+                                                   "give both (the engine's allocator) or neither"
+                                                 : "allocator->alloc_fn: is NULL while free_fn is set; "
+                                                   "give both (the engine's allocator) or neither");
+      if (!a.alloc_fn && a.user_context)
+        throw Error(Status::InvalidArgument, "allocator->user_context: is set without alloc_fn and free_fn");
+      hooks.alloc = a.alloc_fn;
+      hooks.free = a.free_fn;
+      hooks.user_context = a.user_context;
+    }
+    {
+      const sph::ContextHold hold(context);
+      if (hold.get()->backend != sph::BackendKind::Cuda)
+        throw Error(Status::Unsupported,
+                    "context: is not a CUDA context (device allocators are for CUDA worlds)");
+    }
+    std::string why;
+    const sph::Take take = sph::try_set_device_memory(context, hooks, &why);
+    if (take == sph::Take::NotLive)
+      throw Error(Status::InvalidHandle, "context: is not a live sph_context (destroyed or foreign pointer)");
+    if (take == sph::Take::Busy) throw Error(Status::Busy, "context: " + why);
+    return SPH_OK;
+  });
+}
+
+static_assert(std::is_same<sph_cuda_alloc_fn, decltype(sph::DeviceMemoryHooks::alloc)>::value,
+              "the device allocator types match");
+static_assert(std::is_same<sph_cuda_free_fn, decltype(sph::DeviceMemoryHooks::free)>::value,
+              "the device allocator types match");
 
 }  // extern "C"

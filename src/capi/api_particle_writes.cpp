@@ -9,14 +9,16 @@
 #include "handles.h"
 #include "validate.h"
 
+using sph::HostVector;
+
 using sph::Error;
 using sph::Status;
 
 namespace {
 
 template <class T>
-std::vector<T> read_elements(const void* src, uint64_t stride, uint32_t count) {
-  std::vector<T> out(count);
+HostVector<T> read_elements(const void* src, uint64_t stride, uint32_t count) {
+  HostVector<T> out(count);
   const unsigned char* base = static_cast<const unsigned char*>(src);
   for (uint32_t i = 0; i < count; ++i) std::memcpy(&out[i], base + stride * i, sizeof(T));
   return out;
@@ -59,7 +61,7 @@ SPH_API sph_result SPH_CALL sph_world_set_attribute(sph_world* world, sph_attrib
                                               std::to_string(stride) + " (" + std::to_string(needed) +
                                               " bytes needed)");
     if (vector) {
-      const std::vector<sph::Vec3> values = read_elements<sph::Vec3>(src, stride, count);
+      const HostVector<sph::Vec3> values = read_elements<sph::Vec3>(src, stride, count);
       w.set_vectors(static_cast<sph::AttributeKind>(attribute), first, values);
     } else {
       w.set_user_attributes(first, read_elements<uint32_t>(src, stride, count));
@@ -75,7 +77,7 @@ SPH_API sph_result SPH_CALL sph_world_remove_particles(sph_world* world, const u
     sph::WorldLock lock(world);
     if (count == 0) return SPH_OK;
     if (!ids) throw Error(Status::InvalidArgument, "ids: is NULL but count is " + std::to_string(count));
-    world->world->remove_particles(std::vector<uint32_t>(ids, ids + count));
+    world->world->remove_particles(HostVector<uint32_t>(ids, ids + count));
     return SPH_OK;
   });
 }

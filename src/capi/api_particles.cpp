@@ -9,6 +9,8 @@
 #include "struct_io.h"
 #include "validate.h"
 
+using sph::HostVector;
+
 using sph::Error;
 using sph::Status;
 
@@ -61,9 +63,9 @@ SPH_API sph_result SPH_CALL sph_world_spawn(sph_world* world, const sph_spawn_de
     if (d.velocities) sph::require_array_span(d.velocities, d.count, vstride, 12, "desc->velocity_stride");
     const uint32_t first = sph::with_field_prefix("desc->", [&] {
       world->world->require_room_for_particles(d.count);  // before copying a large input
-      std::vector<sph::Vec3> positions(d.count);
+      HostVector<sph::Vec3> positions(d.count);
       for (uint32_t i = 0; i < d.count; ++i) positions[i] = read_vec3(d.positions, pstride, i);
-      std::vector<sph::Vec3> velocities;
+      HostVector<sph::Vec3> velocities;
       if (d.velocities) {
         velocities.resize(d.count);
         for (uint32_t i = 0; i < d.count; ++i) velocities[i] = read_vec3(d.velocities, vstride, i);

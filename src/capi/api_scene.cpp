@@ -11,6 +11,8 @@
 #include "struct_io.h"
 #include "validate.h"
 
+using sph::HostVector;
+
 using sph::Error;
 using sph::Status;
 
@@ -66,9 +68,8 @@ std::shared_ptr<const sph::SdfAsset> acceleration_grid(const sph_grid_desc* desc
   for (uint64_t i = 0; i < 3 * n; ++i)
     if (!std::isfinite(g.data[i]))
       throw Error(Status::InvalidArgument, "def->grid->data[" + std::to_string(i) + "]: is not finite");
-  auto grid =
-      std::make_shared<sph::SdfAsset>(static_cast<int32_t>(g.dims[0]), static_cast<int32_t>(g.dims[1]),
-                                      static_cast<int32_t>(g.dims[2]), sph::index_to_local_from_public(g));
+  auto grid = sph::make_sdf_asset(static_cast<int32_t>(g.dims[0]), static_cast<int32_t>(g.dims[1]),
+                                  static_cast<int32_t>(g.dims[2]), sph::index_to_local_from_public(g));
   grid->velocity().resize(n);
   std::memcpy(grid->velocity().data(), g.data, 3 * n * sizeof(float));
   return grid;
@@ -347,7 +348,7 @@ SPH_API sph_result SPH_CALL sph_world_get_events(const sph_world* world, sph_eve
   return sph::guarded("sph_world_get_events", sph::context_of(world), [&] {
     sph::require_world(world);
     sph::WorldLock lock(world);
-    std::vector<sph_event> list;
+    HostVector<sph_event> list;
     for (const sph::Event& e : world->world->events()) {
       sph_event out;
       out.type = static_cast<sph_event_type>(e.type);
@@ -364,7 +365,7 @@ SPH_API sph_result SPH_CALL sph_world_get_removed_ids(const sph_world* world, ui
   return sph::guarded("sph_world_get_removed_ids", sph::context_of(world), [&] {
     sph::require_world(world);
     sph::WorldLock lock(world);
-    const std::vector<uint32_t>& removed = world->world->removed_ids();
+    const auto& removed = world->world->removed_ids();
     return copy_list(removed.data(), removed.size(), ids, capacity, out_count, "ids");
   });
 }

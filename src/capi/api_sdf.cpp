@@ -23,10 +23,10 @@ sph::LogTarget context_of_sdf(const sph_sdf* sdf) { return sph::log_target_of(sd
 // `name` is the grid's path with its separator ("desc->distance.", "desc->velocity->");
 // `memory_bits` is the caller's sph_memory_kind read as an integer (sph::enum_bits): loading an
 // out-of-range value as the enum type is undefined behaviour.
-std::vector<float> read_floats(const sph_context* context, const float* data, uint64_t count,
-                               uint32_t memory_bits, const std::string& name) {
+sph::HostVector<float> read_floats(const sph_context* context, const float* data, uint64_t count,
+                                   uint32_t memory_bits, const std::string& name) {
   if (!data) throw Error(Status::InvalidArgument, name + "data: is NULL (required)");
-  std::vector<float> out(count);
+  sph::HostVector<float> out(count);
   if (memory_bits == SPH_MEMORY_HOST) {
     std::memcpy(out.data(), data, count * sizeof(float));
   } else if (memory_bits == SPH_MEMORY_CUDA_DEVICE) {
@@ -69,9 +69,8 @@ std::shared_ptr<sph::SdfAsset> asset_from_desc(const sph_context* context, const
     throw Error(Status::InvalidArgument, "desc->distance.components: must be 1 (or 0, meaning 1)");
   const uint64_t n = voxel_count(g.dims, "desc->distance.");
   if (!g.data) throw Error(Status::InvalidArgument, "desc->distance.data: is NULL (required)");
-  auto asset =
-      std::make_shared<sph::SdfAsset>(static_cast<int32_t>(g.dims[0]), static_cast<int32_t>(g.dims[1]),
-                                      static_cast<int32_t>(g.dims[2]), sph::index_to_local_from_public(g));
+  auto asset = sph::make_sdf_asset(static_cast<int32_t>(g.dims[0]), static_cast<int32_t>(g.dims[1]),
+                                   static_cast<int32_t>(g.dims[2]), sph::index_to_local_from_public(g));
   asset->distance() = read_floats(context, g.data, n, sph::enum_bits(g.memory), "desc->distance.");
   auto same_dims = [&](const sph_grid_desc& o, const char* name) {
     if (o.dims[0] != g.dims[0] || o.dims[1] != g.dims[1] || o.dims[2] != g.dims[2])
@@ -82,7 +81,7 @@ std::shared_ptr<sph::SdfAsset> asset_from_desc(const sph_context* context, const
     same_dims(v, "desc->velocity");
     if (sph::grid_components(v, 3) != 3)
       throw Error(Status::InvalidArgument, "desc->velocity->components: must be 3 (or 0, meaning 3)");
-    const std::vector<float> raw =
+    const sph::HostVector<float> raw =
         read_floats(context, v.data, 3 * n, sph::enum_bits(v.memory), "desc->velocity->");
     asset->velocity().resize(n);
     std::memcpy(asset->velocity().data(), raw.data(), raw.size() * sizeof(float));
@@ -227,7 +226,7 @@ SPH_API sph_result SPH_CALL sph_sdf_update(sph_sdf* sdf, sph_sdf_channel channel
                         ") leaves the grid along axis " + std::to_string(axis) + " (dimension " +
                         std::to_string(dims[axis]) + ")");
     const uint64_t n = static_cast<uint64_t>(size[0]) * size[1] * size[2];
-    const std::vector<float> values =
+    const sph::HostVector<float> values =
         read_floats(use.context.get(), data, n * components, sph::enum_bits(memory), "");
     if (channel_bits == SPH_SDF_CHANNEL_FRICTION)
       for (float mu : values)

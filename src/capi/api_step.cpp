@@ -25,6 +25,7 @@ constexpr double kMaxStepBudgetSeconds = 86400.0;
 // One frame of a world whose lock the caller holds: true if it completed, false if its budget,
 // a cancel or max_substeps stopped it; throws on failure (the world then as before the call).
 bool run_frame(sph_world* world, float frame_dt, const FrameEnqueuedHook& enqueued = FrameEnqueuedHook{}) {
+  const MemoryScope memory(&world->context->memory);  // (the step thread's too)
   StepInterrupt interrupt;
   interrupt.cancel = &world->cancel_requested;
   if (world->step_budget_seconds > 0.0)

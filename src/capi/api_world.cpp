@@ -168,7 +168,7 @@ SPH_API sph_result SPH_CALL sph_world_create(sph_context* context, const sph_wor
     const sph_world_def d = sph::read_user_struct(def, "def");
     const sph::WorldConfig config = config_from_def(d);
     auto backend = sph::make_backend(context->backend, config, context->device_ordinal, context->cpu_workers,
-                                     context->cuda_tuning);
+                                     context->cpu_tasks, context->cuda_tuning);
     auto world = std::make_unique<sph_world>();
     world->context = context;
     world->world = std::make_unique<sph::World>(config, std::move(backend));

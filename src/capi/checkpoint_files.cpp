@@ -62,7 +62,7 @@ std::string temporary_name(const std::string& path) {
 }
 
 #if defined(_WIN32)
-void write_atomically(const std::string& path, const std::vector<uint8_t>& bytes) {
+void write_atomically(const std::string& path, const HostVector<uint8_t>& bytes) {
   for (int attempt = 0;; ++attempt) {
     const std::string temp = temporary_name(path);
     HANDLE file =
@@ -131,7 +131,7 @@ void remove_stale_temporaries(const std::string& path) {
   ::closedir(listing);
 }
 
-void write_atomically(const std::string& path, const std::vector<uint8_t>& bytes) {
+void write_atomically(const std::string& path, const HostVector<uint8_t>& bytes) {
   remove_stale_temporaries(path);
   std::string temp;
   int fd = -1;
@@ -178,7 +178,7 @@ void write_atomically(const std::string& path, const std::vector<uint8_t>& bytes
 // when it was opened (at most kMaxCheckpointFileBytes): /dev/zero, a FIFO or a device would
 // otherwise be read until memory runs out, or block forever.
 #if defined(_WIN32)
-std::vector<uint8_t> read_file(const char* path) {
+HostVector<uint8_t> read_file(const char* path) {
   struct Closer {
     void operator()(std::FILE* f) const { std::fclose(f); }
   };
@@ -186,7 +186,7 @@ std::vector<uint8_t> read_file(const char* path) {
   if (!file)
     throw Error(Status::InvalidArgument,
                 std::string("path: cannot open '") + path + "' (" + system_error() + ")");
-  std::vector<uint8_t> bytes;
+  HostVector<uint8_t> bytes;
   uint8_t chunk[1 << 16];
   for (;;) {
     const size_t n = std::fread(chunk, 1, sizeof chunk, file.get());
@@ -200,7 +200,7 @@ std::vector<uint8_t> read_file(const char* path) {
   return bytes;
 }
 #else
-std::vector<uint8_t> read_file(const char* path) {
+HostVector<uint8_t> read_file(const char* path) {
   // O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer.
   const int fd = ::open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0)
@@ -222,7 +222,7 @@ std::vector<uint8_t> read_file(const char* path) {
   if (size > kMaxCheckpointFileBytes || size > SIZE_MAX)
     throw Error(Status::InvalidArgument, std::string("path: '") + path + "' is " + std::to_string(size) +
                                              " bytes, more than the 256 GiB a checkpoint may have");
-  std::vector<uint8_t> bytes(static_cast<size_t>(size));
+  HostVector<uint8_t> bytes(static_cast<size_t>(size));
   size_t done = 0;
   while (done < bytes.size()) {
     const ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
@@ -240,10 +240,10 @@ std::vector<uint8_t> read_file(const char* path) {
 
 }  // namespace
 
-void write_file_atomically(const std::string& path, const std::vector<uint8_t>& bytes) {
+void write_file_atomically(const std::string& path, const HostVector<uint8_t>& bytes) {
   write_atomically(path, bytes);
 }
 
-std::vector<uint8_t> read_checkpoint_file(const char* path) { return read_file(path); }
+HostVector<uint8_t> read_checkpoint_file(const char* path) { return read_file(path); }
 
 }  // namespace sph

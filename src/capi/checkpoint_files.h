@@ -9,14 +9,16 @@
 #include <string>
 #include <vector>
 
+#include "../core/host_memory.h"
+
 namespace sph {
 
 // Writes `bytes` to `path` atomically: a crash leaves the old file or the new one. Throws
 // Error(InvalidArgument) naming the step that failed; the temporary file is removed then.
-void write_file_atomically(const std::string& path, const std::vector<uint8_t>& bytes);
+void write_file_atomically(const std::string& path, const HostVector<uint8_t>& bytes);
 
 // Reads a whole regular file of at most 256 GiB; anything else (a directory, device, FIFO,
 // socket, or a larger file) is refused with Error(InvalidArgument) before it is read.
-std::vector<uint8_t> read_checkpoint_file(const char* path);
+HostVector<uint8_t> read_checkpoint_file(const char* path);
 
 }  // namespace sph

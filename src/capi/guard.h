@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Every exported function runs its body through guarded(): it clears the thread's last error,
-// turns exceptions into result codes and messages, tells the context's log callback, and
-// makes sure nothing escapes across the C boundary.
+// makes the context's allocators current (core/host_memory.h), turns exceptions into result
+// codes and messages, tells the context's log callback, and makes sure nothing escapes across
+// the C boundary.
 #pragma once
 
 #include <cstdio>
@@ -39,6 +40,7 @@ inline void report_failure(const LogTarget& log, const char* function, sph_resul
 template <class Body>
 sph_result guarded(const char* function, const LogTarget& log, Body&& body) noexcept {
   clear_last_error();
+  const MemoryScope memory(log.memory);
   try {
     return body();
   } catch (const Error& e) {

@@ -45,6 +45,7 @@ LogTarget::LogTarget(const sph_context* context) {
   if (context && live_locked(context, HandleKind::Context)) {
     fn = context->log_fn;
     user_data = context->log_user_data;
+    memory = &context->memory;
   }
 }
 
@@ -55,6 +56,7 @@ LogTarget log_target_of(const sph_world* world) {
   if (world && live_locked(world, HandleKind::World)) {
     target.fn = world->context->log_fn;
     target.user_data = world->context->log_user_data;
+    target.memory = &world->context->memory;
   }
   return target;
 }
@@ -65,6 +67,7 @@ LogTarget log_target_of(const sph_sdf* sdf) {
   if (sdf && live_locked(sdf, HandleKind::Sdf)) {
     target.fn = sdf->context->log_fn;
     target.user_data = sdf->context->log_user_data;
+    target.memory = &sdf->context->memory;
   }
   return target;
 }
@@ -166,6 +169,20 @@ Take try_retire_context(sph_context* context, std::string* why) {
     return Take::Busy;
   }
   registry().erase(context);
+  return Take::Taken;
+}
+
+Take try_set_device_memory(sph_context* context, const DeviceMemoryHooks& hooks, std::string* why) {
+  std::lock_guard<std::mutex> lock(registry_mutex());
+  if (!context || !live_locked(context, HandleKind::Context)) return Take::NotLive;
+  if (context->world_count != 0 || context->sdf_count != 0 || context->held_by_calls != 0) {
+    *why = std::to_string(context->world_count) + " world(s) and " + std::to_string(context->sdf_count) +
+           " SDF asset(s) use it" +
+           (context->held_by_calls != 0 ? ", and another thread's call holds it" : "") +
+           "; set the allocator before creating any";
+    return Take::Busy;
+  }
+  context->memory.device = hooks;
   return Take::Taken;
 }
 

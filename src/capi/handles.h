@@ -14,8 +14,10 @@
 #include <memory>
 #include <string>
 
+#include "../core/host_memory.h"
 #include "../core/sdf_asset.h"
 #include "../core/status.h"
+#include "../core/task_system.h"
 #include "../core/world.h"
 #include "../factory/backend_factory.h"
 #include "async_stepper.h"
@@ -28,6 +30,10 @@ struct sph_context {
   sph::CudaTuning cuda_tuning;
   sph_log_fn log_fn;
   void* log_user_data;
+  sph::TaskSystem cpu_tasks;  // the engine's task system (none: OpenMP)
+  // The engine's allocators (none: the heap, cudaMalloc); the context outlives every world and
+  // SDF asset whose memory came from them.
+  sph::MemoryHooks memory;
   // What keeps the context alive; changed and read only under the registry's mutex.
   uint32_t world_count = 0;    // worlds created on it
   uint32_t sdf_count = 0;      // SDF assets created on it
@@ -66,6 +72,7 @@ uint32_t live_handle_count();
 struct LogTarget {
   sph_log_fn fn = nullptr;
   void* user_data = nullptr;
+  const MemoryHooks* memory = nullptr;  // the context's allocators, current for the call (guarded)
   LogTarget() = default;
   LogTarget(std::nullptr_t) {}            // NOLINT: guarded(name, nullptr, ...) for calls without a context
   LogTarget(const sph_context* context);  // NOLINT: a live context's callback, else none
@@ -120,6 +127,9 @@ sph_sdf* publish_sdf(std::unique_ptr<sph_sdf> sdf);
 // Takes a context for destruction: Taken means it left the registry and the caller deletes
 // it; otherwise *why says what still uses it (Busy) or that it is not live (NotLive).
 Take try_retire_context(sph_context* context, std::string* why);
+// Replaces a live context's device allocator while nothing uses the context (no world, no SDF
+// asset, no call holding it); otherwise Busy with *why, or NotLive.
+Take try_set_device_memory(sph_context* context, const DeviceMemoryHooks& hooks, std::string* why);
 // Takes an SDF handle out of the registry (its context's count drops with it); the caller
 // deletes it. Calls in flight on it keep their own reference to the asset and hold the context.
 bool try_retire_sdf(sph_sdf* sdf);

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "host_memory.h"
 #include "status.h"
 
 namespace sph {
@@ -62,10 +63,10 @@ class ByteWriter {
     for (int k = 0; k < 8; ++k) bytes_[at + k] = static_cast<uint8_t>(v >> (8 * k));
   }
   size_t size() const { return bytes_.size(); }
-  std::vector<uint8_t>& buffer() { return bytes_; }
+  HostVector<uint8_t>& buffer() { return bytes_; }
 
  private:
-  std::vector<uint8_t> bytes_;
+  HostVector<uint8_t> bytes_;
 };
 
 class ByteReader {

@@ -21,7 +21,7 @@ struct CheckpointOrigin {
 };
 
 // Serialises a world. Throws only on allocation or backend (device) failures.
-std::vector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin& origin);
+HostVector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin& origin);
 
 using BackendMaker = std::function<std::unique_ptr<Backend>(const WorldConfig&)>;
 

@@ -91,7 +91,7 @@ void read_springs(ByteReader& r, const WorldConfig& config, uint32_t next_id, Pa
   if (r.u32() != kSpringSlots)
     corrupt(r.what() + ": spring lists do not have " + std::to_string(kSpringSlots) + " slots");
   r.need_elements(n, kSpringSlots * 8, "spring lists");
-  std::vector<SpringList> springs(n);
+  HostVector<SpringList> springs(n);
   for (uint32_t i = 0; i < n; ++i) {
     SpringList& list = springs[i];
     for (uint32_t k = 0; k < kSpringSlots; ++k) {
@@ -127,7 +127,7 @@ void read_springs(ByteReader& r, const WorldConfig& config, uint32_t next_id, Pa
                 std::to_string(j) + " is not stored once at each end with one rest length");
     }
   s.set_carried(kArraySprings, springs);
-  s.set_carried(kArraySpringLinkFrom, std::vector<uint32_t>{link_from});
+  s.set_carried(kArraySpringLinkFrom, HostVector<uint32_t>{link_from});
 }
 
 struct Clock {
@@ -135,7 +135,7 @@ struct Clock {
   double simulated_time = 0.0;
   float last_step_ms = 0.0f;
   FrameReport report;
-  std::vector<Event> events;
+  HostVector<Event> events;
 };
 
 SolveReport read_solve(ByteReader& r, const std::string& name) {
@@ -227,7 +227,7 @@ ParticleSnapshot read_particles(ByteReader& r, const WorldConfig& config, uint32
   // its particles start fresh.
   if ((config.features & kFeatureNormalizedDensity) && r.remaining() != 0) {
     r.need_elements(n, sizeof(float), "density factors");
-    std::vector<float> factors(n);
+    HostVector<float> factors(n);
     for (uint32_t i = 0; i < n; ++i) {
       const float d = r.f32();
       if (!std::isnan(d) && !(d > 0.0f && std::isfinite(d)))
@@ -241,7 +241,7 @@ ParticleSnapshot read_particles(ByteReader& r, const WorldConfig& config, uint32
   // negative). Every DFSPH checkpoint has them (DFSPH came with version 3).
   if (config.solver == Solver::Dfsph) {
     r.need_elements(n, 2 * sizeof(float), "DFSPH warm starts");
-    std::vector<float> pressure(n), divergence(n);
+    HostVector<float> pressure(n), divergence(n);
     for (uint32_t i = 0; i < n; ++i) {
       pressure[i] = bulk_finite(r, "DFSPH pressure of particle", i);
       if (pressure[i] < 0.0f)
@@ -256,11 +256,11 @@ ParticleSnapshot read_particles(ByteReader& r, const WorldConfig& config, uint32
   // with the feature has it (the feature came with it, in version 3).
   if (config.features & kFeatureUserAttribute) {
     r.need_elements(n, sizeof(uint32_t), "user attributes");
-    std::vector<uint32_t> attribute(n);
+    HostVector<uint32_t> attribute(n);
     for (uint32_t& a : attribute) a = r.u32();
     s.set_carried(kArrayUserAttribute, attribute);
   }
-  std::vector<uint32_t> sorted(s.id);
+  HostVector<uint32_t> sorted(s.id);
   std::sort(sorted.begin(), sorted.end());
   const auto dup = std::adjacent_find(sorted.begin(), sorted.end());
   if (dup != sorted.end()) corrupt(r.what() + ": particle id " + std::to_string(*dup) + " appears twice");

@@ -36,22 +36,22 @@ std::shared_ptr<SdfAsset> read_asset(ByteReader& r, uint32_t index) {
   r.need_elements(n, floats_per_voxel * sizeof(float), "voxels");  // before any allocation
   std::shared_ptr<SdfAsset> asset;
   try {
-    asset = std::make_shared<SdfAsset>(static_cast<int32_t>(dims[0]), static_cast<int32_t>(dims[1]),
-                                       static_cast<int32_t>(dims[2]), affine);
+    asset = make_sdf_asset(static_cast<int32_t>(dims[0]), static_cast<int32_t>(dims[1]),
+                           static_cast<int32_t>(dims[2]), affine);
   } catch (const Error& e) {
     corrupt(r.what() + ": " + name + ": " + e.what());
   }
   const std::string where = name + ": voxel";
-  std::vector<float>& distance = asset->distance();
+  HostVector<float>& distance = asset->distance();
   for (uint64_t i = 0; i < n; ++i) distance[i] = bulk_finite(r, where.c_str(), static_cast<uint32_t>(i));
   if (channels & kAssetHasVelocity) {
     asset->velocity().resize(n);
-    std::vector<Vec3>& velocity = asset->velocity();
+    HostVector<Vec3>& velocity = asset->velocity();
     for (uint64_t i = 0; i < n; ++i) velocity[i] = bulk_vec3(r, where.c_str(), static_cast<uint32_t>(i));
   }
   if (channels & kAssetHasFriction) {
     asset->friction().resize(n);
-    std::vector<float>& friction = asset->friction();
+    HostVector<float>& friction = asset->friction();
     for (uint64_t i = 0; i < n; ++i) {
       friction[i] = bulk_finite(r, where.c_str(), static_cast<uint32_t>(i));
       if (friction[i] < 0.0f)
@@ -97,7 +97,7 @@ SlotTable<T> read_slots(ByteReader& r, ReadValue&& read_value) {
   if (free_count != dead)
     corrupt(r.what() + ": the free list has " + std::to_string(free_count) + " slots, but " +
             std::to_string(dead) + " slots are empty");
-  std::vector<char> seen(slots, 0);
+  HostVector<char> seen(slots, 0);
   t.free_list.resize(free_count);
   for (uint32_t& slot : t.free_list) {
     slot = r.u32();

@@ -9,13 +9,14 @@
 
 #include "byte_io.h"
 #include "config.h"
+#include "host_memory.h"
 #include "scene_objects.h"
 #include "sdf_asset.h"
 #include "slot_map.h"
 
 namespace sph {
 
-using CheckpointAssets = std::vector<std::shared_ptr<SdfAsset>>;
+using CheckpointAssets = HostVector<std::shared_ptr<SdfAsset>>;
 
 CheckpointAssets read_checkpoint_assets(ByteReader& r);
 // version: the file's (load points from kFirstProbeVersion on).

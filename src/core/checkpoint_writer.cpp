@@ -38,11 +38,11 @@ class AssetTable {
     assets_.push_back(asset.get());
     return k;
   }
-  const std::vector<const SdfAsset*>& assets() const { return assets_; }
+  const HostVector<const SdfAsset*>& assets() const { return assets_; }
 
  private:
   std::map<const SdfAsset*, uint32_t> index_;
-  std::vector<const SdfAsset*> assets_;
+  HostVector<const SdfAsset*> assets_;
 };
 
 // A section: tag, reserved, length (patched when the body is done), body.
@@ -82,7 +82,7 @@ void write_solve(ByteWriter& w, const SolveReport& s) {
 // SPH_FEATURE_SPRINGS worlds only, after the particles: the lowest id still waiting for springs
 // and each particle's spring slots (partner storage index or 0xffffffff, rest length).
 void write_springs(ByteWriter& w, const ParticleSnapshot& s) {
-  const std::vector<uint32_t> link_from = s.carried_as<uint32_t>(kArraySpringLinkFrom);
+  const HostVector<uint32_t> link_from = s.carried_as<uint32_t>(kArraySpringLinkFrom);
   w.u32(link_from.empty() ? kNoPendingLinks : link_from[0]);
   w.u32(kSpringSlots);
   for (const SpringList& list : s.carried_as<SpringList>(kArraySprings))
@@ -184,7 +184,7 @@ void write_particle_section(ByteWriter& w, const World& world, const ParticleSna
 
 }  // namespace
 
-std::vector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin& origin) {
+HostVector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin& origin) {
   // Asset indices first: the asset section precedes the objects that refer to it.
   AssetTable assets;
   world.colliders().for_each([&](uint64_t, const Collider& c) { assets.index(c.sdf); });
@@ -277,7 +277,7 @@ std::vector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin
     });
   });
 
-  std::vector<uint8_t>& bytes = w.buffer();
+  HostVector<uint8_t>& bytes = w.buffer();
   w.patch_u64(24, bytes.size() - kHeaderSize);
   Fnv1a64 sum;
   sum.add(bytes.data(), kChecksumOffset);

@@ -104,9 +104,9 @@ double fcc_sphere_point_estimate(float radius, float spacing) {
   return 4.0 / 3.0 * 3.14159265358979323846 * r * r * r * std::sqrt(2.0) / (s * s * s);
 }
 
-std::vector<Vec3> fcc_points_in_box(Vec3 min, Vec3 max, float spacing) {
+HostVector<Vec3> fcc_points_in_box(Vec3 min, Vec3 max, float spacing) {
   const BoxLattice b = box_lattice(min, max, spacing);
-  std::vector<Vec3> points;
+  HostVector<Vec3> points;
   points.reserve(static_cast<size_t>(fcc_box_point_count(min, max, spacing)));
   for (int64_t k = 0; k < b.n[2]; ++k)
     for (int64_t j = 0; j < b.n[1]; ++j)
@@ -119,11 +119,11 @@ std::vector<Vec3> fcc_points_in_box(Vec3 min, Vec3 max, float spacing) {
   return points;
 }
 
-std::vector<Vec3> fcc_points_in_sphere(Vec3 center, float radius, float spacing) {
+HostVector<Vec3> fcc_points_in_sphere(Vec3 center, float radius, float spacing) {
   const double step = half_cell(spacing);
   const int64_t n = static_cast<int64_t>(std::floor(radius / step));
   const double r2 = static_cast<double>(radius) * radius;
-  std::vector<Vec3> points;
+  HostVector<Vec3> points;
   for (int64_t k = -n; k <= n; ++k)
     for (int64_t j = -n; j <= n; ++j)
       for (int64_t i = -n; i <= n; ++i) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "../physics/vec3.h"
+#include "host_memory.h"
 
 namespace sph {
 
@@ -19,9 +20,9 @@ uint64_t fcc_box_point_count(Vec3 min, Vec3 max, float spacing);
 double fcc_sphere_point_estimate(float radius, float spacing);
 
 // Points at least spacing/2 inside each face of [min, max].
-std::vector<Vec3> fcc_points_in_box(Vec3 min, Vec3 max, float spacing);
+HostVector<Vec3> fcc_points_in_box(Vec3 min, Vec3 max, float spacing);
 // Points with |p - center| <= radius; the centre is a lattice point.
-std::vector<Vec3> fcc_points_in_sphere(Vec3 center, float radius, float spacing);
+HostVector<Vec3> fcc_points_in_sphere(Vec3 center, float radius, float spacing);
 
 // The particle mass at which an infinite FCC lattice at `spacing` has density rest_density
 // under W_poly6 with radius kernel_radius (sum over the lattice computed in double).

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "../physics/probe_sampling.h"
+#include "host_memory.h"
 
 namespace sph {
 
@@ -53,12 +54,12 @@ struct FrameReport {
   float neighbors_mean = 0.0f;
   uint32_t neighbors_max = 0;
   float stage_ms[kStageCount] = {};
-  SolveReport pressure_solve;             // DFSPH's density solve: error dimensionless, (rho* - rho0)+ / rho0
-  SolveReport divergence_solve;           // DFSPH's divergence solve: error in 1/s, (D rho / Dt)+ / rho0
-  std::vector<uint32_t> removed_ids;      // ids sinks removed during the frame
-  std::vector<uint32_t> removed_by_sink;  // count per sink, in SceneFrame::sinks order
-  std::vector<ColliderLoadSums> collider_loads;  // per collider in SceneFrame::colliders order (loads on)
-  std::vector<ProbeSums> probes;                 // per probe in SceneFrame::probes order
+  SolveReport pressure_solve;            // DFSPH's density solve: error dimensionless, (rho* - rho0)+ / rho0
+  SolveReport divergence_solve;          // DFSPH's divergence solve: error in 1/s, (D rho / Dt)+ / rho0
+  HostVector<uint32_t> removed_ids;      // ids sinks removed during the frame
+  HostVector<uint32_t> removed_by_sink;  // count per sink, in SceneFrame::sinks order
+  HostVector<ColliderLoadSums> collider_loads;  // per collider in SceneFrame::colliders order (loads on)
+  HostVector<ProbeSums> probes;                 // per probe in SceneFrame::probes order
 };
 
 }  // namespace sph

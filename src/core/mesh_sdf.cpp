@@ -21,7 +21,7 @@ void require(bool ok, const std::string& message) {
   if (!ok) throw Error(Status::InvalidArgument, message);
 }
 
-std::vector<MeshTriangle> read_triangles(const MeshSpec& s, V3* low, V3* high) {
+HostVector<MeshTriangle> read_triangles(const MeshSpec& s, V3* low, V3* high) {
   require(s.vertices != nullptr, "desc->vertices: is NULL (required)");
   require(s.indices != nullptr, "desc->indices: is NULL (required)");
   require(s.vertex_count >= 3, "desc->vertex_count: " + std::to_string(s.vertex_count) + " is below 3");
@@ -29,7 +29,7 @@ std::vector<MeshTriangle> read_triangles(const MeshSpec& s, V3* low, V3* high) {
           "desc->index_count: " + std::to_string(s.index_count) + " is not a positive multiple of 3");
   require(s.vertex_stride >= 3 * sizeof(float),
           "desc->vertex_stride: " + std::to_string(s.vertex_stride) + " is below 12 bytes (three floats)");
-  std::vector<V3> points(s.vertex_count);
+  HostVector<V3> points(s.vertex_count);
   const unsigned char* bytes = reinterpret_cast<const unsigned char*>(s.vertices);
   for (uint32_t i = 0; i < s.vertex_count; ++i) {
     float xyz[3];
@@ -40,7 +40,7 @@ std::vector<MeshTriangle> read_triangles(const MeshSpec& s, V3* low, V3* high) {
   }
   *low = V3::Constant(INFINITY);
   *high = V3::Constant(-INFINITY);
-  std::vector<MeshTriangle> triangles;
+  HostVector<MeshTriangle> triangles;
   triangles.reserve(s.index_count / 3);
   for (uint32_t t = 0; t < s.index_count / 3; ++t) {
     uint32_t corner[3];
@@ -69,8 +69,8 @@ struct Grid {
 };
 
 // Exact distances (and the closest triangle) for every voxel within `band` of a triangle.
-void fill_band(const Grid& g, const std::vector<MeshTriangle>& triangles, double band,
-               std::vector<float>& distance, std::vector<int32_t>& closest) {
+void fill_band(const Grid& g, const HostVector<MeshTriangle>& triangles, double band,
+               HostVector<float>& distance, HostVector<int32_t>& closest) {
   for (size_t t = 0; t < triangles.size(); ++t) {
     const MeshTriangle& tri = triangles[t];
     const V3 low = (tri.a.cwiseMin(tri.b).cwiseMin(tri.c) - g.origin).array() - band;
@@ -101,8 +101,8 @@ void fill_band(const Grid& g, const std::vector<MeshTriangle>& triangles, double
 // The far field: two rounds of sweeps in the eight diagonal orders (Bridson's makelevelset3),
 // each voxel taking the closest of its upwind neighbours' closest triangles. Distances stay
 // exact point-triangle distances; only the triangle may be a near-best one far from the band.
-void sweep_far_field(const Grid& g, const std::vector<MeshTriangle>& triangles, double band,
-                     std::vector<float>& distance, std::vector<int32_t>& closest) {
+void sweep_far_field(const Grid& g, const HostVector<MeshTriangle>& triangles, double band,
+                     HostVector<float>& distance, HostVector<int32_t>& closest) {
   for (int round = 0; round < 2; ++round)
     for (int order = 0; order < 8; ++order) {
       const int di = (order & 1) ? -1 : 1, dj = (order & 2) ? -1 : 1, dk = (order & 4) ? -1 : 1;
@@ -139,14 +139,14 @@ void sweep_far_field(const Grid& g, const std::vector<MeshTriangle>& triangles, 
 // Negates the distance of every voxel inside. Voxels in the band get their own winding number;
 // beyond the band no voxel edge crosses the surface (both ends lie farther than band >= one
 // voxel from it), so each connected region outside the band takes the sign of its first voxel.
-void apply_sign(const Grid& g, const std::vector<MeshTriangle>& triangles, double band,
-                std::vector<float>& distance) {
+void apply_sign(const Grid& g, const HostVector<MeshTriangle>& triangles, double band,
+                HostVector<float>& distance) {
   const WindingNumber winding(triangles);
   auto inside = [&](int32_t i, int32_t j, int32_t k) {
     return std::fabs(winding.at(g.centre(i, j, k))) >= 0.5;
   };
-  std::vector<uint8_t> done(distance.size(), 0);
-  std::vector<size_t> queue;
+  HostVector<uint8_t> done(distance.size(), 0);
+  HostVector<size_t> queue;
   for (int32_t k = 0; k < g.n[2]; ++k)
     for (int32_t j = 0; j < g.n[1]; ++j)
       for (int32_t i = 0; i < g.n[0]; ++i) {
@@ -186,7 +186,7 @@ std::shared_ptr<SdfAsset> build_mesh_sdf(const MeshSpec& s, uint64_t max_voxels)
           "desc->band_width: must be in [1, 64] voxels");
   require(s.padding_voxels >= 1 && s.padding_voxels <= 1024, "desc->padding_voxels: must be in [1, 1024]");
   V3 low, high;
-  const std::vector<MeshTriangle> triangles = read_triangles(s, &low, &high);
+  const HostVector<MeshTriangle> triangles = read_triangles(s, &low, &high);
   Grid g;
   g.voxel = s.voxel_size;
   double dims[3];
@@ -207,14 +207,14 @@ std::shared_ptr<SdfAsset> build_mesh_sdf(const MeshSpec& s, uint64_t max_voxels)
     index_to_local.m[a * 4 + a] = static_cast<float>(g.voxel);
     index_to_local.m[a * 4 + 3] = static_cast<float>(g.origin[a]);
   }
-  auto asset = std::make_shared<SdfAsset>(g.n[0], g.n[1], g.n[2], index_to_local);
-  std::vector<float>& distance = asset->distance();
+  auto asset = make_sdf_asset(g.n[0], g.n[1], g.n[2], index_to_local);
+  HostVector<float>& distance = asset->distance();
   distance.assign(asset->voxel_count(), INFINITY);
-  std::vector<int32_t> closest(asset->voxel_count(), -1);
+  HostVector<int32_t> closest(asset->voxel_count(), -1);
   const double band = s.band_width * g.voxel;
   fill_band(g, triangles, band, distance, closest);
   sweep_far_field(g, triangles, band, distance, closest);
-  closest = std::vector<int32_t>();
+  closest = HostVector<int32_t>();
   apply_sign(g, triangles, band, distance);
   return asset;
 }

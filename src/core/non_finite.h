@@ -15,6 +15,7 @@
 #include "../physics/integrate.h"
 #include "../physics/step_control.h"
 #include "../physics/vec3.h"
+#include "host_memory.h"
 
 #if defined(__CUDACC__)
 #define SPH_ISFINITE isfinite
@@ -53,7 +54,7 @@ struct NonFiniteFailure {
   uint32_t substep = 0;                // 1 for the frame's first substep
   float dt = 0.0f;                     // the failed substep's step, s
   uint32_t count = 0;                  // particles whose new state is not finite
-  std::vector<uint32_t> ids;           // some of their ids, the first particle's first
+  HostVector<uint32_t> ids;            // some of their ids, the first particle's first
 };
 
 // "the step produced non-finite values in the forces stage (SPH_STAGE_FORCES) of substep 3 (dt

@@ -24,11 +24,11 @@ void check_carried_arrays(const ParticleSnapshot& s, const std::vector<ParticleA
   }
 }
 
-std::vector<unsigned char> carried_bytes(const ParticleSnapshot& s, const ParticleArraySpec& spec,
-                                         uint32_t n) {
+HostVector<unsigned char> carried_bytes(const ParticleSnapshot& s, const ParticleArraySpec& spec,
+                                        uint32_t n) {
   if (const CarriedArray* a = s.find(spec.name)) return a->bytes;
   const uint64_t elements = elements_of(spec, n);
-  std::vector<unsigned char> bytes(elements * spec.element_size, 0);
+  HostVector<unsigned char> bytes(elements * spec.element_size, 0);
   if (spec.initial)
     for (uint64_t e = 0; e < elements; ++e)
       std::memcpy(bytes.data() + e * spec.element_size, spec.initial, spec.element_size);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "../physics/float4_types.h"
+#include "host_memory.h"
 #include "particle_arrays.h"
 
 namespace sph {
@@ -21,17 +22,17 @@ namespace sph {
 struct CarriedArray {
   std::string name;
   uint32_t element_size = 0;
-  std::vector<unsigned char> bytes;
+  HostVector<unsigned char> bytes;
 };
 
 struct ParticleSnapshot {
-  std::vector<Float4> position;  // w: pressure of the last density pass
-  std::vector<Float4> velocity;  // w: 1 / density of the last density pass
-  std::vector<uint32_t> id;
-  std::vector<float> density;
+  HostVector<Float4> position;  // w: pressure of the last density pass
+  HostVector<Float4> velocity;  // w: 1 / density of the last density pass
+  HostVector<uint32_t> id;
+  HostVector<float> density;
   float max_speed = 0.0f;         // |v|max the next frame's first step is chosen from
   float max_acceleration = 0.0f;  // |a|max of the last force evaluation (the force step limit)
-  std::vector<CarriedArray> carried;
+  HostVector<CarriedArray> carried;
 
   const CarriedArray* find(const char* name) const {
     for (const CarriedArray& a : carried)
@@ -40,16 +41,16 @@ struct ParticleSnapshot {
   }
   // The elements of a carried array; empty when the snapshot has none of that name.
   template <class T>
-  std::vector<T> carried_as(const char* name) const {
+  HostVector<T> carried_as(const char* name) const {
     const CarriedArray* a = find(name);
-    std::vector<T> out;
+    HostVector<T> out;
     if (!a || a->element_size != sizeof(T)) return out;
     out.resize(a->bytes.size() / sizeof(T));
     if (!out.empty()) std::memcpy(out.data(), a->bytes.data(), out.size() * sizeof(T));
     return out;
   }
-  template <class T>
-  void set_carried(const char* name, const std::vector<T>& values) {
+  template <class T, class Allocator>
+  void set_carried(const char* name, const std::vector<T, Allocator>& values) {
     CarriedArray a;
     a.name = name;
     a.element_size = sizeof(T);
@@ -71,7 +72,6 @@ void check_carried_arrays(const ParticleSnapshot& s, const std::vector<ParticleA
 // The bytes of a carried array for n particles from a checked snapshot; the record's initial
 // value for every element when the snapshot has none (a checkpoint written before the method
 // carried it starts its particles fresh).
-std::vector<unsigned char> carried_bytes(const ParticleSnapshot& s, const ParticleArraySpec& spec,
-                                         uint32_t n);
+HostVector<unsigned char> carried_bytes(const ParticleSnapshot& s, const ParticleArraySpec& spec, uint32_t n);
 
 }  // namespace sph

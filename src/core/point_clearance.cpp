@@ -22,12 +22,12 @@ uint64_t cell_key(Vec3 p, float inv) {
 
 }  // namespace
 
-std::vector<char> clear_of_points(const std::vector<Vec3>& existing, const std::vector<Vec3>& candidates,
-                                  float min_distance) {
-  std::vector<char> keep(candidates.size(), 1);
+HostVector<char> clear_of_points(const HostVector<Vec3>& existing, const HostVector<Vec3>& candidates,
+                                 float min_distance) {
+  HostVector<char> keep(candidates.size(), 1);
   if (existing.empty() || !(min_distance > 0.0f)) return keep;
   const float inv = 1.0f / min_distance;
-  std::vector<std::pair<uint64_t, uint32_t>> cells(existing.size());
+  HostVector<std::pair<uint64_t, uint32_t>> cells(existing.size());
   for (size_t i = 0; i < existing.size(); ++i)
     cells[i] = {cell_key(existing[i], inv), static_cast<uint32_t>(i)};
   std::sort(cells.begin(), cells.end());

@@ -6,11 +6,12 @@
 #include <vector>
 
 #include "../physics/vec3.h"
+#include "host_memory.h"
 
 namespace sph {
 
 // keep[i] is 1 when no existing point lies closer than min_distance to candidates[i].
-std::vector<char> clear_of_points(const std::vector<Vec3>& existing, const std::vector<Vec3>& candidates,
-                                  float min_distance);
+HostVector<char> clear_of_points(const HostVector<Vec3>& existing, const HostVector<Vec3>& candidates,
+                                 float min_distance);
 
 }  // namespace sph

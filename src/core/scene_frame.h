@@ -14,6 +14,7 @@
 #include "../physics/probe_sampling.h"
 #include "../physics/sink_region.h"
 #include "frame_enqueued.h"
+#include "host_memory.h"
 #include "sdf_asset.h"
 #include "step_interrupt.h"
 
@@ -37,12 +38,12 @@ struct SinkFrame {
 };
 
 struct SceneFrame {
-  std::vector<ColliderFrame> colliders;
-  std::vector<ForceFieldFrame> fields;
-  std::vector<SinkFrame> sinks;
+  HostVector<ColliderFrame> colliders;
+  HostVector<ForceFieldFrame> fields;
+  HostVector<SinkFrame> sinks;
   // Probes and gauges (probe_sampling.h), sampled at each substep's density pass; their sample
   // points number probe_points (a probe's are [first_point, first_point + point_count)).
-  std::vector<ProbeView> probes;
+  HostVector<ProbeView> probes;
   uint32_t probe_points = 0;
   float max_collider_speed = 0.0f;  // fastest collider surface point, m/s (for the step size)
   StepInterrupt interrupt;          // checked between substeps (CUDA: on its stream driver only)

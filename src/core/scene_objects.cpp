@@ -11,7 +11,7 @@
 
 namespace sph {
 
-std::vector<Vec3> lattice_inside(const SdfAsset& region, float spacing, uint64_t max_points) {
+HostVector<Vec3> lattice_inside(const SdfAsset& region, float spacing, uint64_t max_points) {
   // The grid's box in the local frame: the bounding box of its eight index-space corners.
   Vec3 lo{std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
           std::numeric_limits<float>::max()};
@@ -31,9 +31,9 @@ std::vector<Vec3> lattice_inside(const SdfAsset& region, float spacing, uint64_t
     throw Error(Status::Capacity, "the region's box holds " + std::to_string(candidates) +
                                       " lattice points at this spacing, more than the limit of " +
                                       std::to_string(max_points));
-  const std::vector<Vec3> box = fcc_points_in_box(lo - Vec3{m, m, m}, hi + Vec3{m, m, m}, spacing);
+  const HostVector<Vec3> box = fcc_points_in_box(lo - Vec3{m, m, m}, hi + Vec3{m, m, m}, spacing);
   const SdfGridView view = region.host_view();
-  std::vector<Vec3> inside;
+  HostVector<Vec3> inside;
   for (const Vec3& p : box)
     if (sample_distance(view, p) < 0.0f) inside.push_back(p);
   return inside;

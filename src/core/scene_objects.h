@@ -9,6 +9,7 @@
 #include <optional>
 #include <vector>
 
+#include "host_memory.h"
 #include "scene_specs.h"
 
 namespace sph {
@@ -42,7 +43,7 @@ struct Source {
   float rate = 0.0f;            // Continuous: particles per second at most; 0 = no limit
   double rate_budget = 0.0;     // fractional particles carried between frames
   bool done = false;            // FillOnce: already emitted
-  std::vector<Vec3> lattice;    // FCC points inside the region, in the region's frame
+  HostVector<Vec3> lattice;     // FCC points inside the region, in the region's frame
   uint32_t user_attribute = 0;  // its particles' (SPH_FEATURE_USER_ATTRIBUTE)
 };
 
@@ -99,6 +100,6 @@ struct Event {
 
 // FCC lattice points at `spacing` inside an asset's negative region, in the asset's frame.
 // Throws Error(Capacity) when the region's box holds more than max_points lattice points.
-std::vector<Vec3> lattice_inside(const SdfAsset& region, float spacing, uint64_t max_points);
+HostVector<Vec3> lattice_inside(const SdfAsset& region, float spacing, uint64_t max_points);
 
 }  // namespace sph

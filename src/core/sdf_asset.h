@@ -7,9 +7,12 @@
 #include <stdint.h>
 
 #include <atomic>
+#include <memory>
+#include <utility>
 #include <vector>
 
 #include "../physics/sdf_sampling.h"
+#include "host_memory.h"
 
 namespace sph {
 
@@ -24,12 +27,12 @@ class SdfAsset {
   uint64_t voxel_count() const { return static_cast<uint64_t>(nx_) * ny_ * nz_; }
   const Affine3x4& index_to_local() const { return index_to_local_; }
 
-  std::vector<float>& distance() { return distance_; }
-  std::vector<Vec3>& velocity() { return velocity_; }   // empty when the asset has none
-  std::vector<float>& friction() { return friction_; }  // empty when the asset has none
-  const std::vector<float>& distance() const { return distance_; }
-  const std::vector<Vec3>& velocity() const { return velocity_; }
-  const std::vector<float>& friction() const { return friction_; }
+  HostVector<float>& distance() { return distance_; }
+  HostVector<Vec3>& velocity() { return velocity_; }   // empty when the asset has none
+  HostVector<float>& friction() { return friction_; }  // empty when the asset has none
+  const HostVector<float>& distance() const { return distance_; }
+  const HostVector<Vec3>& velocity() const { return velocity_; }
+  const HostVector<float>& friction() const { return friction_; }
 
   bool has_velocity() const { return !velocity_.empty(); }
   // True when a velocity field exists and any of it is non-zero.
@@ -53,11 +56,18 @@ class SdfAsset {
   Affine3x4 index_to_local_;
   Affine3x4 local_to_index_;
   float min_voxel_size_;
-  std::vector<float> distance_;
-  std::vector<Vec3> velocity_;
-  std::vector<float> friction_;
+  HostVector<float> distance_;
+  HostVector<Vec3> velocity_;
+  HostVector<float> friction_;
   std::atomic<uint64_t> version_{1};
   uint64_t uid_;
 };
+
+// A new asset, the object and its grids from the allocator current on this thread (the engine's,
+// when its context has one: core/host_memory.h).
+template <class... Args>
+std::shared_ptr<SdfAsset> make_sdf_asset(Args&&... args) {
+  return std::allocate_shared<SdfAsset>(HostAllocator<SdfAsset>(), std::forward<Args>(args)...);
+}
 
 }  // namespace sph

@@ -116,8 +116,8 @@ std::shared_ptr<SdfAsset> build_shape_sdf(const ShapeSpec& s, uint64_t max_voxel
     index_to_local.m[a * 4 + a] = static_cast<float>(voxel);
     index_to_local.m[a * 4 + 3] = static_cast<float>(-0.5 * (n[a] - 1) * voxel);
   }
-  auto asset = std::make_shared<SdfAsset>(n[0], n[1], n[2], index_to_local);
-  std::vector<float>& d = asset->distance();
+  auto asset = make_sdf_asset(n[0], n[1], n[2], index_to_local);
+  HostVector<float>& d = asset->distance();
   for (int32_t k = 0; k < n[2]; ++k)
     for (int32_t j = 0; j < n[1]; ++j)
       for (int32_t i = 0; i < n[0]; ++i) {

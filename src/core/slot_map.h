@@ -9,15 +9,17 @@
 #include <optional>
 #include <vector>
 
+#include "host_memory.h"
+
 namespace sph {
 
 // The raw table of a SlotMap (checkpoints): one generation and an optional value per slot,
 // and the free slots in the order they will be reused.
 template <class T>
 struct SlotTable {
-  std::vector<uint32_t> generations;
-  std::vector<std::optional<T>> values;
-  std::vector<uint32_t> free_list;
+  HostVector<uint32_t> generations;
+  HostVector<std::optional<T>> values;
+  HostVector<uint32_t> free_list;
 };
 
 template <class T>
@@ -68,11 +70,11 @@ class SlotMap {
   uint32_t slot_count() const { return static_cast<uint32_t>(slots_.size()); }
   uint32_t generation_at(uint32_t slot) const { return slots_[slot].generation; }
   const T* value_at(uint32_t slot) const { return slots_[slot].value ? &*slots_[slot].value : nullptr; }
-  const std::vector<uint32_t>& free_slots() const { return free_; }
+  const HostVector<uint32_t>& free_slots() const { return free_; }
   // Replaces the whole table. The caller has validated it: generations in [1, 2^24), and
   // the free list names every empty slot exactly once.
   void restore(SlotTable<T> table) {
-    std::vector<Slot> slots(table.generations.size());
+    HostVector<Slot> slots(table.generations.size());
     size_t count = 0;
     for (size_t i = 0; i < slots.size(); ++i) {
       slots[i].generation = table.generations[i];
@@ -105,8 +107,8 @@ class SlotMap {
     return (static_cast<uint64_t>(tag_) << 56) | (static_cast<uint64_t>(generation) << 32) | slot;
   }
   uint8_t tag_;
-  std::vector<Slot> slots_;
-  std::vector<uint32_t> free_;
+  HostVector<Slot> slots_;
+  HostVector<uint32_t> free_;
   size_t count_ = 0;
 };
 

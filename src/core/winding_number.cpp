@@ -19,7 +19,7 @@ V3 centroid(const MeshTriangle& t) { return (t.a + t.b + t.c) / 3.0; }
 
 }  // namespace
 
-WindingNumber::WindingNumber(const std::vector<MeshTriangle>& triangles) : triangles_(triangles) {
+WindingNumber::WindingNumber(const HostVector<MeshTriangle>& triangles) : triangles_(triangles) {
   order_.resize(triangles.size());
   for (uint32_t i = 0; i < order_.size(); ++i) order_[i] = i;
   nodes_.reserve(2 * (triangles.size() / kLeafTriangles + 1));
@@ -72,7 +72,7 @@ int32_t WindingNumber::build(uint32_t first, uint32_t count) {
 double WindingNumber::at(const V3& p) const {
   if (nodes_.empty()) return 0.0;
   double solid_angle = 0.0;
-  std::vector<int32_t> stack{0};
+  HostVector<int32_t> stack{0};
   while (!stack.empty()) {
     const Node& node = nodes_[stack.back()];
     stack.pop_back();

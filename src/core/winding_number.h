@@ -11,6 +11,7 @@
 
 #include <vector>
 
+#include "host_memory.h"
 #include "triangle_geometry.h"
 
 namespace sph {
@@ -18,7 +19,7 @@ namespace sph {
 class WindingNumber {
  public:
   // Keeps a reference to `triangles`, which must outlive this object.
-  explicit WindingNumber(const std::vector<MeshTriangle>& triangles);
+  explicit WindingNumber(const HostVector<MeshTriangle>& triangles);
 
   double at(const Eigen::Vector3d& p) const;
 
@@ -32,9 +33,9 @@ class WindingNumber {
   };
   int32_t build(uint32_t first, uint32_t count);
 
-  const std::vector<MeshTriangle>& triangles_;
-  std::vector<uint32_t> order_;
-  std::vector<Node> nodes_;
+  const HostVector<MeshTriangle>& triangles_;
+  HostVector<uint32_t> order_;
+  HostVector<Node> nodes_;
 };
 
 }  // namespace sph

@@ -75,7 +75,7 @@ bool World::reserve_particles(uint64_t total) {
   return true;
 }
 
-uint32_t World::spawn(const std::vector<Vec3>& positions, const std::vector<Vec3>* velocities,
+uint32_t World::spawn(const HostVector<Vec3>& positions, const HostVector<Vec3>* velocities,
                       uint32_t user_attribute) {
   const uint64_t n = positions.size();
   if (static_cast<uint64_t>(next_id_) + n > UINT32_MAX)
@@ -98,7 +98,7 @@ uint32_t World::spawn(const std::vector<Vec3>& positions, const std::vector<Vec3
 }
 
 void World::emit_sources(double frame_dt) {
-  std::vector<Vec3> existing;
+  HostVector<Vec3> existing;
   bool have_existing = false;
   sources_.for_each([&](uint64_t id, Source& s) {
     if (s.mode == SourceMode::FillOnce && s.done) return;
@@ -109,10 +109,10 @@ void World::emit_sources(double frame_dt) {
       have_existing = true;
     }
     const SdfGridView region = s.region->host_view();
-    std::vector<Vec3> points(s.lattice.size());
+    HostVector<Vec3> points(s.lattice.size());
     for (size_t i = 0; i < points.size(); ++i) points[i] = to_world(s.pose, s.lattice[i]);
-    const std::vector<char> keep = clear_of_points(existing, points, s.min_distance);
-    std::vector<Vec3> accepted, velocities;
+    const HostVector<char> keep = clear_of_points(existing, points, s.min_distance);
+    HostVector<Vec3> accepted, velocities;
     for (size_t i = 0; i < points.size(); ++i) {
       if (!keep[i]) continue;
       accepted.push_back(points[i]);
@@ -228,12 +228,12 @@ bool World::step(double frame_dt, const StepInterrupt& interrupt, const FrameEnq
     bool done;
     double rate_budget;
   };
-  std::vector<SourceState> sources_before;
+  HostVector<SourceState> sources_before;
   sources_.for_each([&](uint64_t id, const Source& s) {
     sources_before.push_back({id, s.done, s.rate_budget});
   });
   // The last step's events, kept aside (no allocation: nothing can fail from here to the try).
-  std::vector<Event> events_before;
+  HostVector<Event> events_before;
   events_before.swap(events_);
   FrameReport report;
   try {

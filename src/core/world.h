@@ -13,6 +13,7 @@
 #include "backend.h"
 #include "config.h"
 #include "frame_report.h"
+#include "host_memory.h"
 #include "scene_objects.h"
 #include "scene_specs.h"
 #include "slot_map.h"
@@ -70,7 +71,7 @@ class World {
   void require_room_for_particles(uint64_t count) const;
   // Adds particles at finite positions within 65536 particle spacings of the origin, with
   // finite velocities (or none: at rest). Returns the first new id; ids are consecutive.
-  uint32_t add_particles(const std::vector<Vec3>& positions, const std::vector<Vec3>* velocities);
+  uint32_t add_particles(const HostVector<Vec3>& positions, const HostVector<Vec3>* velocities);
   // FCC lattices at the world's spacing in a box or a sphere (fcc_lattice.h); an empty box or
   // radius 0 fills nothing. Error(Capacity) when the lattice does not fit under max_capacity.
   // Returns the count.
@@ -87,13 +88,13 @@ class World {
   // 1.8e19 m/s) of particles [first, first + values.size()); kind is Position or Velocity.
   // Error(InvalidArgument) "first/count" unless [first, first + count) lies in the particles.
   void require_particle_range(uint32_t first, uint64_t count) const;
-  void set_vectors(AttributeKind kind, uint32_t first, const std::vector<Vec3>& values);
+  void set_vectors(AttributeKind kind, uint32_t first, const HostVector<Vec3>& values);
   // The user attribute of particles [first, first + values.size()); Error(FeatureDisabled)
   // without kFeatureUserAttribute.
-  void set_user_attributes(uint32_t first, const std::vector<uint32_t>& values);
+  void set_user_attributes(uint32_t first, const HostVector<uint32_t>& values);
   // Removes the particles with these ids (each a live particle's, none twice); the rest keep
   // their order. The ids join removed_ids() (cleared by the next step).
-  void remove_particles(const std::vector<uint32_t>& ids);
+  void remove_particles(const HostVector<uint32_t>& ids);
 
   // Runs one frame: sources emit, then substeps with colliders, fields and sinks. Returns
   // false when max_substeps ran out before frame_dt, or `interrupt` stopped it at a substep
@@ -107,8 +108,8 @@ class World {
   const FrameReport& last_report() const { return report_; }
   double simulated_time() const { return simulated_time_; }
   float last_step_ms() const { return last_step_ms_; }
-  const std::vector<Event>& events() const { return events_; }
-  const std::vector<uint32_t>& removed_ids() const { return report_.removed_ids; }
+  const HostVector<Event>& events() const { return events_; }
+  const HostVector<uint32_t>& removed_ids() const { return report_.removed_ids; }
 
   const Backend& backend() const { return *backend_; }
   Backend& backend() { return *backend_; }
@@ -117,7 +118,7 @@ class World {
   uint32_t next_id() const { return next_id_; }
   // Puts back the bookkeeping of a saved world (checkpoints); the caller has validated it.
   void restore_counters(uint32_t next_id, double simulated_time, const FrameReport& report,
-                        float last_step_ms, const std::vector<Event>& events) {
+                        float last_step_ms, const HostVector<Event>& events) {
     next_id_ = next_id;
     simulated_time_ = simulated_time;
     report_ = report;
@@ -179,13 +180,13 @@ class World {
  private:
   // Adds particles without the entry point's checks (sources emit inside their region), with
   // user_attribute as their user attribute where the world carries one.
-  uint32_t spawn(const std::vector<Vec3>& positions, const std::vector<Vec3>* velocities,
+  uint32_t spawn(const HostVector<Vec3>& positions, const HostVector<Vec3>* velocities,
                  uint32_t user_attribute = 0);
   // Why a position is refused (world_particles.cpp), or empty when it is fine.
   std::string position_problem(const Vec3& p) const;
   // The end of fill_box and fill_sphere: checks the points (errors name region_fields) and
   // adds them at one velocity.
-  uint32_t fill(const std::vector<Vec3>& points, const Vec3& velocity, const char* region_fields);
+  uint32_t fill(const HostVector<Vec3>& points, const Vec3& velocity, const char* region_fields);
   void emit_sources(double frame_dt);
   SceneFrame build_scene_frame(double frame_dt) const;
   void add_probe_frames(SceneFrame& scene) const;
@@ -199,7 +200,7 @@ class World {
   FrameReport report_;
   float last_step_ms_ = 0.0f;
   uint32_t capacity_growths_ = 0;
-  std::vector<Event> events_;
+  HostVector<Event> events_;
   SlotMap<Collider> colliders_{kTagCollider};
   SlotMap<Source> sources_{kTagSource};
   SlotMap<Sink> sinks_{kTagSink};

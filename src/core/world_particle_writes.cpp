@@ -16,7 +16,7 @@ namespace {
 
 // What the step controller carries as the max speed: sqrt of the largest |v|^2, as a backend
 // computes it when the velocities change under it (the max is order-free, so this is exact).
-float max_speed_of(const std::vector<Float4>& velocity) {
+float max_speed_of(const HostVector<Float4>& velocity) {
   float v2max = 0.0f;
   for (const Float4& v : velocity) v2max = std::max(v2max, length_squared(xyz(v)));
   return std::sqrt(v2max);
@@ -24,9 +24,9 @@ float max_speed_of(const std::vector<Float4>& velocity) {
 
 // The bytes of the particles that stay (kept[i] for particle i) of an array of
 // per_particle_bytes per particle.
-std::vector<unsigned char> kept_bytes(const std::vector<unsigned char>& bytes, const std::vector<char>& kept,
-                                      size_t per_particle_bytes) {
-  std::vector<unsigned char> out;
+HostVector<unsigned char> kept_bytes(const HostVector<unsigned char>& bytes, const HostVector<char>& kept,
+                                     size_t per_particle_bytes) {
+  HostVector<unsigned char> out;
   out.reserve(bytes.size());
   for (size_t i = 0; i < kept.size(); ++i)
     if (kept[i])
@@ -36,8 +36,8 @@ std::vector<unsigned char> kept_bytes(const std::vector<unsigned char>& bytes, c
 }
 
 template <class T>
-std::vector<T> kept_values(const std::vector<T>& values, const std::vector<char>& kept) {
-  std::vector<T> out;
+HostVector<T> kept_values(const HostVector<T>& values, const HostVector<char>& kept) {
+  HostVector<T> out;
   out.reserve(values.size());
   for (size_t i = 0; i < kept.size(); ++i)
     if (kept[i]) out.push_back(values[i]);
@@ -54,7 +54,7 @@ void World::require_particle_range(uint32_t first, uint64_t count) const {
                                              std::to_string(total));
 }
 
-void World::set_vectors(AttributeKind kind, uint32_t first, const std::vector<Vec3>& values) {
+void World::set_vectors(AttributeKind kind, uint32_t first, const HostVector<Vec3>& values) {
   if (kind != AttributeKind::Position && kind != AttributeKind::Velocity)
     throw Error(Status::Internal, "set_vectors: not a position or velocity");
   require_particle_range(first, values.size());
@@ -69,7 +69,7 @@ void World::set_vectors(AttributeKind kind, uint32_t first, const std::vector<Ve
   }
   if (values.empty()) return;
   ParticleSnapshot s = backend_->export_particles();
-  std::vector<Float4>& target = kind == AttributeKind::Position ? s.position : s.velocity;
+  HostVector<Float4>& target = kind == AttributeKind::Position ? s.position : s.velocity;
   for (size_t i = 0; i < values.size(); ++i) {
     Float4& record = target[first + i];
     record = make_float4_record(values[i], record.w);  // w (pressure, 1/density) stays
@@ -78,14 +78,14 @@ void World::set_vectors(AttributeKind kind, uint32_t first, const std::vector<Ve
   backend_->import_particles(s);
 }
 
-void World::set_user_attributes(uint32_t first, const std::vector<uint32_t>& values) {
+void World::set_user_attributes(uint32_t first, const HostVector<uint32_t>& values) {
   if (!(config_.features & kFeatureUserAttribute))
     throw Error(Status::FeatureDisabled,
                 "world: SPH_FEATURE_USER_ATTRIBUTE is not enabled in its sph_world_def (SPH_ATTRIBUTE_USER)");
   require_particle_range(first, values.size());
   if (values.empty()) return;
   ParticleSnapshot s = backend_->export_particles();
-  std::vector<uint32_t> attribute = s.carried_as<uint32_t>(kArrayUserAttribute);
+  HostVector<uint32_t> attribute = s.carried_as<uint32_t>(kArrayUserAttribute);
   if (attribute.size() != s.id.size())
     throw Error(Status::Internal, "set_user_attributes: the backend exported no user attributes");
   std::copy(values.begin(), values.end(), attribute.begin() + first);
@@ -93,17 +93,17 @@ void World::set_user_attributes(uint32_t first, const std::vector<uint32_t>& val
   backend_->import_particles(s);
 }
 
-void World::remove_particles(const std::vector<uint32_t>& ids) {
+void World::remove_particles(const HostVector<uint32_t>& ids) {
   if (ids.empty()) return;
   ParticleSnapshot s = backend_->export_particles();
   const size_t n = s.id.size();
   // Index of each id (ids are unique within a world), then every requested id checked in the
   // order given, so the error names the first bad one.
-  std::vector<std::pair<uint32_t, uint32_t>> by_id(n);
+  HostVector<std::pair<uint32_t, uint32_t>> by_id(n);
   for (size_t i = 0; i < n; ++i) by_id[i] = {s.id[i], static_cast<uint32_t>(i)};
   std::sort(by_id.begin(), by_id.end());
   constexpr uint32_t kNotAsked = 0xffffffffu;
-  std::vector<uint32_t> asked_at(n, kNotAsked);  // per particle: where in ids it was asked for
+  HostVector<uint32_t> asked_at(n, kNotAsked);  // per particle: where in ids it was asked for
   for (size_t k = 0; k < ids.size(); ++k) {
     const std::string field = "ids[" + std::to_string(k) + "]";
     const auto it = std::lower_bound(by_id.begin(), by_id.end(), std::make_pair(ids[k], 0u));
@@ -116,8 +116,8 @@ void World::remove_particles(const std::vector<uint32_t>& ids) {
                        std::to_string(ids[k]) + " appears twice (first at ids[" + std::to_string(at) + "])");
     at = static_cast<uint32_t>(k);
   }
-  std::vector<char> kept(n);
-  std::vector<uint32_t> new_index_of_old(n, 0xffffffffu);  // ParticleArraySpec::rewrite_indices
+  HostVector<char> kept(n);
+  HostVector<uint32_t> new_index_of_old(n, 0xffffffffu);  // ParticleArraySpec::rewrite_indices
   uint32_t next = 0;
   for (size_t i = 0; i < n; ++i) {
     kept[i] = asked_at[i] == kNotAsked;
@@ -147,7 +147,7 @@ void World::remove_particles(const std::vector<uint32_t>& ids) {
     }
     out.carried.push_back(std::move(c));
   }
-  std::vector<uint32_t> removed = report_.removed_ids;
+  HostVector<uint32_t> removed = report_.removed_ids;
   removed.insert(removed.end(), ids.begin(), ids.end());
   backend_->import_particles(out);
   report_.removed_ids.swap(removed);  // no throw after the import

@@ -42,7 +42,7 @@ void World::require_room_for_particles(uint64_t count) const {
                          capacity_limit() + " are free");
 }
 
-uint32_t World::add_particles(const std::vector<Vec3>& positions, const std::vector<Vec3>* velocities) {
+uint32_t World::add_particles(const HostVector<Vec3>& positions, const HostVector<Vec3>* velocities) {
   require_room_for_particles(positions.size());
   for (size_t i = 0; i < positions.size(); ++i) {
     const std::string field = "positions[" + std::to_string(i) + "]";
@@ -83,7 +83,7 @@ uint32_t World::fill_box(const FillBoxSpec& spec) {
     throw FieldError(Status::InvalidArgument, "max", "every component must be >= min's");
   const float s = config_.particle_spacing;
   require_fill_fits(fcc_box_point_count(spec.min, spec.max, s), room(), capacity_limit());
-  const std::vector<Vec3> points = fcc_points_in_box(spec.min, spec.max, s);
+  const HostVector<Vec3> points = fcc_points_in_box(spec.min, spec.max, s);
   return fill(points, spec.velocity, "min/max");
 }
 
@@ -101,14 +101,14 @@ uint32_t World::fill_sphere(const FillSphereSpec& spec) {
   return fill(fcc_points_in_sphere(spec.center, spec.radius, s), spec.velocity, "center/radius");
 }
 
-uint32_t World::fill(const std::vector<Vec3>& points, const Vec3& velocity, const char* region_fields) {
+uint32_t World::fill(const HostVector<Vec3>& points, const Vec3& velocity, const char* region_fields) {
   require_fill_fits(points.size(), room(), capacity_limit());
   for (const Vec3& p : points) {
     const std::string problem = resolution_problem(p, config_.particle_spacing);
     if (!problem.empty())
       throw FieldError(Status::InvalidArgument, region_fields, "a lattice point " + problem);
   }
-  const std::vector<Vec3> velocities(points.size(), velocity);
+  const HostVector<Vec3> velocities(points.size(), velocity);
   spawn(points, &velocities);
   return static_cast<uint32_t>(points.size());
 }

@@ -25,9 +25,9 @@ bool reads_colour_normals(ForceTerms<Terms...>) {
 
 }  // namespace
 
-CpuBackend::CpuBackend(const WorldConfig& config, unsigned workers)
+CpuBackend::CpuBackend(const WorldConfig& config, unsigned workers, const TaskSystem& tasks)
     : config_(config),
-      workers_(workers == 0 ? 1u : workers),
+      workers_(workers == 0 ? 1u : workers, tasks),
       grid_(config.kernel_radius, max_particles_per_cell(config.particle_spacing, config.kernel_radius)),
       simd_(best_simd_passes()),
       columns_(with_force_terms(config.selection(), [](auto terms) { return reads_neighbor_counts(terms); }),
@@ -158,7 +158,7 @@ void CpuBackend::import_particles(const ParticleSnapshot& s) {
     throw Error(Status::Internal, "import_particles: inconsistent snapshot");
   check_carried_arrays(s, method_arrays_, n);
   // Copies first (they may throw), then the store, so a failure leaves the state as it was.
-  std::vector<std::pair<CpuParticleArray*, std::vector<unsigned char>>> carried;
+  HostVector<std::pair<CpuParticleArray*, HostVector<unsigned char>>> carried;
   for (const ParticleArraySpec& spec : method_arrays_)
     if (spec.role == ParticleArrayRole::Carried)
       carried.emplace_back(store_.find(spec.name), carried_bytes(s, spec, n));
@@ -175,8 +175,9 @@ void CpuBackend::import_particles(const ParticleSnapshot& s) {
   max_acceleration_ = s.max_acceleration;
 }
 
-std::unique_ptr<Backend> make_cpu_backend(const WorldConfig& config, unsigned worker_count) {
-  return std::make_unique<CpuBackend>(config, worker_count);
+std::unique_ptr<Backend> make_cpu_backend(const WorldConfig& config, unsigned worker_count,
+                                          const TaskSystem& tasks) {
+  return std::make_unique<CpuBackend>(config, worker_count, tasks);
 }
 
 }  // namespace sph

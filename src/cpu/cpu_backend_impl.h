@@ -2,13 +2,15 @@
 // The CPU backend's class, shared by the files of src/cpu/ that implement it (one per stage of a
 // frame, each the twin of a file of cuda/; see docs/architecture.md). Each substep sorts
 // particles into the wrapped grid, then loops the shared per-particle physics (src/physics) over
-// all particles on OpenMP threads, the neighbour gathers on SIMD lanes (cpu_simd_passes.h).
-// Results do not depend on the thread count nor on the processor's SIMD target: every particle
-// is a pure gather whose order of sums is fixed, and the only reductions (max speed and
-// acceleration) are order-independent. The loops hand out particles in chunks on demand, so a
-// core that something else keeps busy holds up only the chunk it is working on.
+// all particles on OpenMP threads or the engine's task system (cpu_parallel.h), the neighbour
+// gathers on SIMD lanes (cpu_simd_passes.h). Results do not depend on the thread count, the
+// task system nor the processor's SIMD target: every particle is a pure gather whose order of
+// sums is fixed, and reductions are combined per block in block order. The loops hand out
+// particles in blocks on demand, so a core that something else keeps busy holds up only the
+// block it is working on.
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -27,6 +29,7 @@
 #include "cpu_boundary_maps.h"
 #include "cpu_neighbor_columns.h"
 #include "cpu_neighbor_grid.h"
+#include "cpu_parallel.h"
 #include "cpu_particle_store.h"
 #include "cpu_simd_passes.h"
 
@@ -40,7 +43,7 @@ inline double elapsed_ms(Clock::time_point since) {
 
 class CpuBackend final : public Backend {
  public:
-  CpuBackend(const WorldConfig& config, unsigned workers);
+  CpuBackend(const WorldConfig& config, unsigned workers, const TaskSystem& tasks);
 
   uint32_t particle_count() const override { return count_; }
 
@@ -77,9 +80,9 @@ class CpuBackend final : public Backend {
  private:
   static constexpr uint32_t kAllFinite = 0xffffffffu;
 
-  // Threads for a loop over the particles: small worlds run on the calling thread alone, where
+  // The workers of a loop over the particles: small worlds run on the calling thread alone, where
   // waking a team (and its spinning idle threads) would cost more than the work.
-  unsigned threads() const { return count_ >= kParallelMinimum ? workers_ : 1u; }
+  CpuParallel parallel() const { return workers_.for_items(count_); }
 
   int n() const { return static_cast<int>(count_); }
 
@@ -211,7 +214,7 @@ class CpuBackend final : public Backend {
   void summarize(FrameReport& report) const;
 
   WorldConfig config_;
-  unsigned workers_;
+  CpuParallel workers_;  // OpenMP's, or the engine's task system (cpu_parallel.h)
   CpuNeighborGrid grid_;
   const SimdPasses& simd_;      // the processor's SIMD target
   CpuNeighborColumns columns_;  // the sorted records as columns, for the SIMD passes
@@ -235,24 +238,35 @@ class CpuBackend final : public Backend {
   CpuArrayRef<uint32_t> link_from_;    // one word: the lowest id that waits for its springs
   CpuArrayRef<uint32_t> spring_candidates_;
   CpuArrayRef<Float4> spring_acceleration_;
-  CpuArrayRef<float> dfsph_pressure_;          // DFSPH: the density solve's p / rho^2 (warm start)
-  CpuArrayRef<float> dfsph_divergence_;        // DFSPH: the divergence solve's p / rho^2 times dt
-  CpuArrayRef<float> dfsph_factor_;            // DFSPH: alpha / rho of the density pass
-  CpuArrayRef<float> dfsph_step_;              // DFSPH: the iteration's p / rho^2
-  CpuArrayRef<float> dfsph_residual_;          // DFSPH: each particle's share of the solve's error
-  CpuArrayRef<Float4> dfsph_contact_;          // DFSPH: each particle's contact with the colliders
-  bool dfsph_contacts_ = false;                // DFSPH: the substep has colliders (contacts to respect)
-  std::vector<ColliderView> dfsph_colliders_;  // DFSPH: the substep's colliders, for the contacts
-  CpuArrayRef<Float4> boundary_;          // boundary density: (grad rho_b, v_b . grad rho_b) per particle
-  CpuArrayRef<uint32_t> user_attribute_;  // SPH_FEATURE_USER_ATTRIBUTE: the caller's value
+  CpuArrayRef<float> dfsph_pressure_;         // DFSPH: the density solve's p / rho^2 (warm start)
+  CpuArrayRef<float> dfsph_divergence_;       // DFSPH: the divergence solve's p / rho^2 times dt
+  CpuArrayRef<float> dfsph_factor_;           // DFSPH: alpha / rho of the density pass
+  CpuArrayRef<float> dfsph_step_;             // DFSPH: the iteration's p / rho^2
+  CpuArrayRef<float> dfsph_residual_;         // DFSPH: each particle's share of the solve's error
+  CpuArrayRef<Float4> dfsph_contact_;         // DFSPH: each particle's contact with the colliders
+  bool dfsph_contacts_ = false;               // DFSPH: the substep has colliders (contacts to respect)
+  HostVector<ColliderView> dfsph_colliders_;  // DFSPH: the substep's colliders, for the contacts
+  CpuArrayRef<Float4> boundary_;              // boundary density: (grad rho_b, v_b . grad rho_b) per particle
+  CpuArrayRef<uint32_t> user_attribute_;      // SPH_FEATURE_USER_ATTRIBUTE: the caller's value
   CpuBoundaryMaps boundary_maps_;
-  std::vector<ColliderView> collider_views_;  // the frame's colliders, for the density pass
-  std::vector<ColliderLoadSums> load_sums_;   // the frame's impulses per collider (loads on)
-  std::vector<LoadImpulse> load_blocks_;      // per block of kLoadBlock particles and collider
-  std::vector<Vec3> load_points_;             // per collider: at the wall pass's time, at the end
-  std::vector<ProbeGather> probe_points_;     // per sample point of the frame's probes
-  std::vector<ProbeSums> probe_sums_;         // per probe: the frame's samples
-  std::vector<uint32_t> keep_order_;
+  HostVector<ColliderView> collider_views_;  // the frame's colliders, for the density pass
+  HostVector<ColliderLoadSums> load_sums_;   // the frame's impulses per collider (loads on)
+  HostVector<LoadImpulse> load_blocks_;      // per block of kLoadBlock particles and collider
+  HostVector<Vec3> load_points_;             // per collider: at the wall pass's time, at the end
+  HostVector<ProbeGather> probe_points_;     // per sample point of the frame's probes
+  HostVector<ProbeSums> probe_sums_;         // per probe: the frame's samples
+  HostVector<uint32_t> keep_order_;
+  // The three maxima an integration pass reduces, and the first non-finite particle.
+  struct StateScan {
+    float a2max = 0.0f, v2max = 0.0f;
+    uint32_t bad_index = kAllFinite;
+  };
+  static StateScan combine_scans(StateScan a, const StateScan& b) {
+    a.a2max = std::max(a.a2max, b.a2max);
+    a.v2max = std::max(a.v2max, b.v2max);
+    a.bad_index = std::min(a.bad_index, b.bad_index);
+    return a;
+  }
   SpringConstants spring_constants_{};
   uint32_t count_ = 0;
   float max_speed_ = 0.0f;

@@ -8,12 +8,15 @@
 
 #include <stdint.h>
 
+#include <functional>
 #include <map>
 #include <utility>
 #include <vector>
 
+#include "../core/host_memory.h"
 #include "../core/sdf_asset.h"
 #include "../physics/float4_types.h"
+#include "cpu_parallel.h"
 
 namespace sph {
 
@@ -22,8 +25,8 @@ class CpuBoundaryMaps {
   // Marks the start of a frame's binding: maps not bound again until end_frame() are dropped.
   void begin_frame() { ++frame_; }
   // The map of an asset for kernel radius h and SDF level `level` (boundary_map.h), computed on
-  // `workers` threads when new or stale.
-  const Float4* bind(const SdfAsset& asset, float h, float level, unsigned workers);
+  // `parallel`'s workers when new or stale.
+  const Float4* bind(const SdfAsset& asset, float h, float level, const CpuParallel& parallel);
   void end_frame();
   // 16 bytes per voxel of every map held.
   uint64_t bytes() const;
@@ -36,16 +39,19 @@ class CpuBoundaryMaps {
     uint64_t version = 0;
     float kernel_radius = 0.0f;
     uint64_t last_frame = 0;
-    std::vector<Float4> correction;
+    HostVector<Float4> correction;
   };
-  std::map<std::pair<uint64_t, float>, Entry> entries_;  // by asset uid and level
+  using Key = std::pair<uint64_t, float>;
+  std::map<Key, Entry, std::less<Key>, HostAllocator<std::pair<const Key, Entry>>>
+      entries_;  // by asset uid and level
   uint64_t frame_ = 0;
   uint64_t builds_ = 0;
 };
 
 // The map of an asset for kernel radius h and SDF level `level` (every voxel; zero outside the band
-// |phi - level| < h), on `workers` threads. Exposed for tests, which compare it with a brute-force
-// integral.
-std::vector<Float4> compute_boundary_map(const SdfAsset& asset, float h, float level, unsigned workers);
+// |phi - level| < h), on `parallel`'s workers. Exposed for tests, which compare it with a
+// brute-force integral.
+HostVector<Float4> compute_boundary_map(const SdfAsset& asset, float h, float level,
+                                        const CpuParallel& parallel);
 
 }  // namespace sph

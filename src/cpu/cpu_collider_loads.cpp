@@ -42,35 +42,36 @@ void CpuBackend::collide_with_loads(const FluidConstants& fluid, const SceneFram
   LoadImpulse* partial = load_blocks_.data();
   // Blocks go out dynamically like every loop's particles (kParticleChunk); their sums are kept
   // per block and added in block order below, so the split changes no bit.
-  constexpr int kBlocksPerChunk = kParticleChunk / static_cast<int>(kLoadBlock);
-#pragma omp parallel for num_threads(threads()) schedule(dynamic, kBlocksPerChunk)
-  for (int b = 0; b < static_cast<int>(blocks); ++b) {
-    LoadImpulse* sums = partial + static_cast<size_t>(b) * colliders;
-    const uint32_t end = std::min(count_, (static_cast<uint32_t>(b) + 1) * kLoadBlock);
-    for (uint32_t i = static_cast<uint32_t>(b) * kLoadBlock; i < end; ++i) {
-      if (walls) {
-        const Vec3 x = xyz(pos[i]);
-        const float coefficient_dt = pos[i].w * vel[i].w * vel[i].w * wall_seconds;
-        for (uint32_t c = 0; c < colliders; ++c) {
-          const BoundaryShare share =
-              collider_boundary_share(fluid.methods.boundary, collider_views_[c], x, at.s, at.tau);
-          add_load(sums[c], wall_reaction_impulse(share.gradient, mass, coefficient_dt), x, points[2 * c]);
+  constexpr size_t kBlocksPerChunk = kParticleChunk / kLoadBlock;
+  parallel().for_blocks(blocks, kBlocksPerChunk, [&](size_t first_block, size_t last_block) {
+    for (size_t b = first_block; b < last_block; ++b) {
+      LoadImpulse* sums = partial + static_cast<size_t>(b) * colliders;
+      const uint32_t end = std::min(count_, (static_cast<uint32_t>(b) + 1) * kLoadBlock);
+      for (uint32_t i = static_cast<uint32_t>(b) * kLoadBlock; i < end; ++i) {
+        if (walls) {
+          const Vec3 x = xyz(pos[i]);
+          const float coefficient_dt = pos[i].w * vel[i].w * vel[i].w * wall_seconds;
+          for (uint32_t c = 0; c < colliders; ++c) {
+            const BoundaryShare share =
+                collider_boundary_share(fluid.methods.boundary, collider_views_[c], x, at.s, at.tau);
+            add_load(sums[c], wall_reaction_impulse(share.gradient, mass, coefficient_dt), x, points[2 * c]);
+          }
         }
-      }
-      if (contacts) {
-        Vec3 x = xyz(next_pos[i]);
-        Vec3 v = xyz(next_vel[i]);
-        const Vec3 from = old.records ? xyz(old.records[i]) : old.states[i].position;
-        for (uint32_t c = 0; c < colliders; ++c) {
-          const Vec3 before = v;
-          collide_particle(scene.colliders[c].view, time, h, from, x, v);
-          add_load(sums[c], contact_impulse(mass, before, v), x, points[2 * c + 1]);
+        if (contacts) {
+          Vec3 x = xyz(next_pos[i]);
+          Vec3 v = xyz(next_vel[i]);
+          const Vec3 from = old.records ? xyz(old.records[i]) : old.states[i].position;
+          for (uint32_t c = 0; c < colliders; ++c) {
+            const Vec3 before = v;
+            collide_particle(scene.colliders[c].view, time, h, from, x, v);
+            add_load(sums[c], contact_impulse(mass, before, v), x, points[2 * c + 1]);
+          }
+          next_pos[i] = make_float4_record(x, next_pos[i].w);
+          next_vel[i] = make_float4_record(v, next_vel[i].w);
         }
-        next_pos[i] = make_float4_record(x, next_pos[i].w);
-        next_vel[i] = make_float4_record(v, next_vel[i].w);
       }
     }
-  }
+  });
   for (uint32_t b = 0; b < blocks; ++b)
     for (uint32_t c = 0; c < colliders; ++c) {
       const LoadImpulse& s = partial[static_cast<size_t>(b) * colliders + c];

@@ -23,8 +23,8 @@ void CpuBackend::dfsph_find_contacts(const SceneFrame& scene, const SubstepTime&
   const ColliderView* views = dfsph_colliders_.data();
   const uint32_t count = static_cast<uint32_t>(dfsph_colliders_.size());
   const float h = config_.kernel_radius;
-#pragma omp parallel for num_threads(threads()) schedule(static)
-  for (int i = 0; i < n(); ++i) contact[i] = wall_contact(views, count, time, h, xyz(pos[i]));
+  parallel().for_each(count_,
+                      [&](uint32_t i) { contact[i] = wall_contact(views, count, time, h, xyz(pos[i])); });
 }
 
 void CpuBackend::dfsph_correct(const FluidConstants& fluid, const DfsphWalls& walls, float dt, Float4* v,
@@ -33,14 +33,13 @@ void CpuBackend::dfsph_correct(const FluidConstants& fluid, const DfsphWalls& wa
   const Float4* pos = position_.data();
   const float* k = dfsph_step_.data();
   const Float4* contact = dfsph_contacts_ ? dfsph_contact_.data() : nullptr;
-#pragma omp parallel for num_threads(threads()) schedule(static)
-  for (int i = 0; i < n(); ++i) {
+  parallel().for_each(count_, [&](uint32_t i) {
     const uint32_t p = static_cast<uint32_t>(i);
     Vec3 vi = xyz(v[i]) + pressure_velocity_change(fluid, view, pos, k, walls, p, dt);
     if (contact) vi = respect_contact(contact[i], vi);
     v[i] = make_float4_record(vi, v[i].w);
     carried[i] += k[i] * carry_scale;
-  }
+  });
 }
 
 float CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls,
@@ -54,15 +53,14 @@ float CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, 
   float* error = dfsph_residual_.data();
   const Dfsph::Constants& c = fluid.methods.dfsph;
   const float rho0 = fluid.rest_density;
-#pragma omp parallel for num_threads(threads()) schedule(static)
-  for (int i = 0; i < n(); ++i) {
+  parallel().for_each(count_, [&](uint32_t i) {
     const float rate = density_rate(fluid, view, pos, v, walls, static_cast<uint32_t>(i));
     const DfsphResidual r = kind == DfsphSolve::Divergence
                                 ? divergence_residual(c, rate, neighbors[i], factor[i], rho0, dt)
                                 : density_residual(rate, density[i], factor[i], rho0, dt);
     k[i] = r.k;
     error[i] = r.error;
-  }
+  });
   double sum = 0.0;
   for (uint32_t i = 0; i < count_; ++i) sum += error[i];
   return count_ > 0 ? static_cast<float>(sum / count_) : 0.0f;
@@ -79,11 +77,10 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
   // The warm start: half the last substep's pressure, applied once; the solve's own
   // pressures add to it.
   float* k = dfsph_step_.data();
-#pragma omp parallel for num_threads(threads()) schedule(static)
-  for (int i = 0; i < n(); ++i) {
+  parallel().for_each(count_, [&](uint32_t i) {
     k[i] = Dfsph::kWarmStart * carried[i] / carry_scale;
     carried[i] = 0.0f;
-  }
+  });
   dfsph_correct(fluid, walls, dt, v, carried, carry_scale);
   float error = dfsph_residuals(kind, fluid, walls, dt, v);
   uint32_t iterations = 0;
@@ -122,16 +119,17 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
   const ScalarAccelerationFn non_pressure = scalar_acceleration_function();
   const ForceInputs inputs = force_inputs();
   const Float4* contact = dfsph_contacts_ ? dfsph_contact_.data() : nullptr;
-  float a2max = 0.0f;
-#pragma omp parallel for num_threads(threads()) schedule(static) reduction(max : a2max)
-  for (int i = 0; i < n(); ++i) {
-    Vec3 a = non_pressure(fluid, view, inputs, scene, static_cast<uint32_t>(i));
-    if (spring) a += xyz(spring[i]);
-    a2max = std::max(a2max, length_squared(a));
-    Vec3 v = xyz(vel[i]) + a * dt;
-    if (contact) v = respect_contact(contact[i], v);
-    next_vel[i] = make_float4_record(v, vel[i].w);
-  }
+  const float a2max = parallel().reduce(
+      count_, 0.0f,
+      [&](uint32_t i, float& m) {
+        Vec3 a = non_pressure(fluid, view, inputs, scene, i);
+        if (spring) a += xyz(spring[i]);
+        m = std::max(m, length_squared(a));
+        Vec3 v = xyz(vel[i]) + a * dt;
+        if (contact) v = respect_contact(contact[i], v);
+        next_vel[i] = make_float4_record(v, vel[i].w);
+      },
+      [](float a, float b) { return std::max(a, b); });
   max_acceleration_ = std::sqrt(a2max);
   // 4. The density solve on v*.
   const SolveOutcome o =
@@ -142,10 +140,10 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
   const float* k_v = dfsph_divergence_.data();
   const float* density = density_.data();
   const float divergence = fluid.methods.dfsph.divergence_solve ? 1.0f / dt : 0.0f;
-#pragma omp parallel for num_threads(threads()) schedule(static)
-  for (int i = 0; i < n(); ++i)
+  parallel().for_each(count_, [&](uint32_t i) {
     next_pos[i] = make_float4_record(xyz(pos[i]) + xyz(next_vel[i]) * dt,
                                      dfsph_pressure(k[i], k_v[i] * divergence, density[i]));
+  });
   report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
   collide_from(scene, time, pos, report);
   t = Clock::now();

@@ -10,9 +10,9 @@ namespace sph {
 
 float CpuBackend::compute_max_speed() const {
   const Float4* vel = velocity_.data();
-  float v2max = 0.0f;
-#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk) reduction(max : v2max)
-  for (int i = 0; i < n(); ++i) v2max = std::max(v2max, length_squared(xyz(vel[i])));
+  const float v2max = parallel().reduce(
+      count_, 0.0f, [&](uint32_t i, float& m) { m = std::max(m, length_squared(xyz(vel[i]))); },
+      [](float a, float b) { return std::max(a, b); });
   return std::sqrt(v2max);
 }
 
@@ -20,20 +20,16 @@ float CpuBackend::compute_max_speed() const {
 uint32_t CpuBackend::scan_next_state(float& v2max) const {
   const Float4* next_pos = next_position_.data();
   const Float4* next_vel = next_velocity_.data();
-  float m = 0.0f;
-  uint32_t bad_index = kAllFinite;
-#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk) reduction(max  \
-                                                                                            : m) \
-    reduction(min                                                                                \
-              : bad_index)
-  for (int i = 0; i < n(); ++i) {
-    const float v2 = length_squared(xyz(next_vel[i]));
-    m = std::max(m, v2);
-    if (!finite3(xyz(next_pos[i])) || !std::isfinite(v2))
-      bad_index = std::min(bad_index, static_cast<uint32_t>(i));
-  }
-  v2max = m;
-  return bad_index;
+  const StateScan scan = parallel().reduce(
+      count_, StateScan{},
+      [&](uint32_t i, StateScan& s) {
+        const float v2 = length_squared(xyz(next_vel[i]));
+        s.v2max = std::max(s.v2max, v2);
+        if (!finite3(xyz(next_pos[i])) || !std::isfinite(v2)) s.bad_index = std::min(s.bad_index, i);
+      },
+      combine_scans);
+  v2max = scan.v2max;
+  return scan.bad_index;
 }
 
 // Where a failed substep went non-finite, worked out on the failure path only, before the new

@@ -7,24 +7,24 @@ namespace {
 
 // Sizes a column for n particles plus the padding, which is zero (finite, and masked off). The
 // first n elements are written by the passes before anything reads them.
-void size_column(std::vector<float>& column, uint32_t n, bool keep) {
+void size_column(HostVector<float>& column, uint32_t n, bool keep) {
   if (!keep) return column.clear();
   column.reserve(n + kLanePadding);
   column.resize(n);
   column.resize(n + kLanePadding, 0.0f);
 }
 
-const float* data_or_null(const std::vector<float>& column) {
+const float* data_or_null(const HostVector<float>& column) {
   return column.empty() ? nullptr : column.data();
 }
 
 }  // namespace
 
 void CpuNeighborColumns::resize(uint32_t n) {
-  for (std::vector<float>* c : {&x_, &y_, &z_, &vx_, &vy_, &vz_, &pressure_, &inv_density_})
+  for (HostVector<float>* c : {&x_, &y_, &z_, &vx_, &vy_, &vz_, &pressure_, &inv_density_})
     size_column(*c, n, true);
   size_column(neighbor_count_, n, counts_);
-  for (std::vector<float>* c : {&normal_x_, &normal_y_, &normal_z_, &normal_length_})
+  for (HostVector<float>* c : {&normal_x_, &normal_y_, &normal_z_, &normal_length_})
     size_column(*c, n, normals_);
 }
 
@@ -46,8 +46,8 @@ NeighborColumns CpuNeighborColumns::view() const {
 
 size_t CpuNeighborColumns::bytes() const {
   size_t total = 0;
-  for (const std::vector<float>* c : {&x_, &y_, &z_, &vx_, &vy_, &vz_, &pressure_, &inv_density_,
-                                      &neighbor_count_, &normal_x_, &normal_y_, &normal_z_, &normal_length_})
+  for (const HostVector<float>* c : {&x_, &y_, &z_, &vx_, &vy_, &vz_, &pressure_, &inv_density_,
+                                     &neighbor_count_, &normal_x_, &normal_y_, &normal_z_, &normal_length_})
     total += c->capacity() * sizeof(float);
   return total;
 }

@@ -12,6 +12,7 @@
 
 #include <vector>
 
+#include "../core/host_memory.h"
 #include "../physics/float4_types.h"
 
 namespace sph {
@@ -75,8 +76,8 @@ class CpuNeighborColumns {
  private:
   bool counts_;
   bool normals_;
-  std::vector<float> x_, y_, z_, vx_, vy_, vz_, pressure_, inv_density_, neighbor_count_;
-  std::vector<float> normal_x_, normal_y_, normal_z_, normal_length_;
+  HostVector<float> x_, y_, z_, vx_, vy_, vz_, pressure_, inv_density_, neighbor_count_;
+  HostVector<float> normal_x_, normal_y_, normal_z_, normal_length_;
 };
 
 }  // namespace sph

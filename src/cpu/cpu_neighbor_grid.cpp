@@ -11,30 +11,32 @@ namespace sph {
 // The cells the particles span, then the table for them (make_grid_shape_for_extent). Exact
 // (a min and max of integers), so the shape is the same for the same positions on any thread
 // count.
-void CpuNeighborGrid::choose_shape(const Float4* positions, uint32_t n, unsigned workers) {
-  int32_t lo_x = 0, lo_y = 0, lo_z = 0, hi_x = 0, hi_y = 0, hi_z = 0;
-  if (n > 0) {
-    lo_x = lo_y = lo_z = INT32_MAX;
-    hi_x = hi_y = hi_z = INT32_MIN;
-  }
-  const int count = static_cast<int>(n);
+void CpuNeighborGrid::choose_shape(const Float4* positions, uint32_t n, const CpuParallel& parallel) {
+  struct Extent {
+    int32_t lo[3], hi[3];
+  };
+  const Extent none{{INT32_MAX, INT32_MAX, INT32_MAX}, {INT32_MIN, INT32_MIN, INT32_MIN}};
   const float inv = inv_cell_size_;
-#pragma omp parallel for num_threads(n >= kParallelMinimum ? workers : 1u) schedule(static) \
-    reduction(min                                                                           \
-              : lo_x, lo_y, lo_z) reduction(max                                             \
-                                            : hi_x, hi_y, hi_z)
-  for (int i = 0; i < count; ++i) {
-    const int32_t x = cell_coordinate(positions[i].x, inv), y = cell_coordinate(positions[i].y, inv),
-                  z = cell_coordinate(positions[i].z, inv);
-    lo_x = std::min(lo_x, x);
-    lo_y = std::min(lo_y, y);
-    lo_z = std::min(lo_z, z);
-    hi_x = std::max(hi_x, x);
-    hi_y = std::max(hi_y, y);
-    hi_z = std::max(hi_z, z);
-  }
-  shape_ =
-      make_grid_shape_for_extent(kernel_radius_, CellCoord{lo_x, lo_y, lo_z}, CellCoord{hi_x, hi_y, hi_z}, n);
+  const Extent e = parallel.for_items(n).reduce(
+      n, none,
+      [&](uint32_t i, Extent& acc) {
+        const int32_t c[3] = {cell_coordinate(positions[i].x, inv), cell_coordinate(positions[i].y, inv),
+                              cell_coordinate(positions[i].z, inv)};
+        for (int a = 0; a < 3; ++a) {
+          acc.lo[a] = std::min(acc.lo[a], c[a]);
+          acc.hi[a] = std::max(acc.hi[a], c[a]);
+        }
+      },
+      [](Extent a, const Extent& b) {
+        for (int k = 0; k < 3; ++k) {
+          a.lo[k] = std::min(a.lo[k], b.lo[k]);
+          a.hi[k] = std::max(a.hi[k], b.hi[k]);
+        }
+        return a;
+      });
+  const CellCoord lo = n > 0 ? CellCoord{e.lo[0], e.lo[1], e.lo[2]} : CellCoord{0, 0, 0};
+  const CellCoord hi = n > 0 ? CellCoord{e.hi[0], e.hi[1], e.hi[2]} : CellCoord{0, 0, 0};
+  shape_ = make_grid_shape_for_extent(kernel_radius_, lo, hi, n);
 }
 
 void CpuNeighborGrid::refuse_crowded_slot(const Float4* positions, uint32_t n, uint32_t slot,
@@ -48,15 +50,15 @@ void CpuNeighborGrid::refuse_crowded_slot(const Float4* positions, uint32_t n, u
   throw Error(Status::Capacity, crowded_cell_message(held, where, max_per_cell_));
 }
 
-void CpuNeighborGrid::build(const Float4* positions, uint32_t n, unsigned workers) {
-  choose_shape(positions, n, workers);
+void CpuNeighborGrid::build(const Float4* positions, uint32_t n, const CpuParallel& parallel) {
+  choose_shape(positions, n, parallel);
   hashes_.resize(n);
   order_.resize(n);
   cell_start_.assign(static_cast<size_t>(shape_.cell_count) + 1, 0u);
-  const int count = static_cast<int>(n);
   const GridShape shape = shape_;
-#pragma omp parallel for num_threads(n >= kParallelMinimum ? workers : 1u) schedule(dynamic, kParticleChunk)
-  for (int i = 0; i < count; ++i) hashes_[i] = cell_hash_of_position(shape, xyz(positions[i]));
+  uint32_t* hashes = hashes_.data();
+  parallel.for_items(n).for_each(
+      n, [&](uint32_t i) { hashes[i] = cell_hash_of_position(shape, xyz(positions[i])); });
 
   // Counting sort: histogram, exclusive prefix sum (the cell-start table), stable scatter.
   for (uint32_t i = 0; i < n; ++i) ++cell_start_[hashes_[i] + 1];

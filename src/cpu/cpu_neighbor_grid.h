@@ -13,18 +13,9 @@
 #include "../core/crowded_cell.h"
 #include "../physics/float4_types.h"
 #include "../physics/neighbor_walk.h"
+#include "cpu_parallel.h"
 
 namespace sph {
-
-// Below this many particles the CPU backend's loops run on one thread.
-constexpr uint32_t kParallelMinimum = 4096;
-
-// The CPU backend's parallel loops hand out particles in chunks of this many to whichever thread
-// is free (schedule(dynamic)): a static split makes every pass wait for its slowest thread, and on
-// a machine where another process holds a core that thread is off the core for whole time
-// slices. Each particle's result depends on nothing but its index, so the split changes no bit.
-// 1024 particles are about 0.1-0.3 ms of a gather, large against the cost of taking a chunk.
-constexpr int kParticleChunk = 1024;
 
 class CpuNeighborGrid {
  public:
@@ -35,9 +26,9 @@ class CpuNeighborGrid {
   // of the particle that goes to place i). Fills the cell-start table for the sorted order.
   // Throws Error(Capacity) when a slot holds more than max_per_cell particles (nothing the
   // caller owns has changed: the world's frame rolls back).
-  void build(const Float4* positions, uint32_t n, unsigned workers);
+  void build(const Float4* positions, uint32_t n, const CpuParallel& parallel);
 
-  const std::vector<uint32_t>& order() const { return order_; }
+  const HostVector<uint32_t>& order() const { return order_; }
   GridView view() const { return GridView{shape_, cell_start_.data()}; }
   const GridShape& shape() const { return shape_; }
   uint32_t max_per_cell() const { return max_per_cell_; }
@@ -47,17 +38,17 @@ class CpuNeighborGrid {
   }
 
  private:
-  void choose_shape(const Float4* positions, uint32_t n, unsigned workers);
+  void choose_shape(const Float4* positions, uint32_t n, const CpuParallel& parallel);
   void refuse_crowded_slot(const Float4* positions, uint32_t n, uint32_t slot, uint32_t held) const;
 
   float inv_cell_size_;
   float kernel_radius_;
   uint32_t max_per_cell_;
   GridShape shape_{1.0f, 3, 3, 3, 27};
-  std::vector<uint32_t> hashes_;
-  std::vector<uint32_t> order_;
-  std::vector<uint32_t> cell_start_;
-  std::vector<uint32_t> cursor_;
+  HostVector<uint32_t> hashes_;
+  HostVector<uint32_t> order_;
+  HostVector<uint32_t> cell_start_;
+  HostVector<uint32_t> cursor_;
 };
 
 }  // namespace sph

@@ -40,7 +40,7 @@ void gather(unsigned char* out, const unsigned char* in, const uint32_t* order, 
 }
 
 // Particles per share of the reorder: 4096 records are 16-64 KiB of each array.
-constexpr long kPermuteBlock = 4096;
+constexpr size_t kPermuteBlock = 4096;
 
 bool reordered(const CpuParticleArray& a) {
   return a.spec.role != ParticleArrayRole::Scratch && a.spec.elements_per_particle != 0;
@@ -99,54 +99,48 @@ void CpuParticleStore::resize(size_t n) {
   particles_ = n;
 }
 
-// One parallel region: the workers share the particles in blocks, and each gathers its block of
-// every array (the old elements were swapped into scratch first, so data() is the new order
-// throughout) and then hands the block to after_block. The inverse order, which a rewritten index
-// may look up anywhere, is complete before any block is gathered.
-void CpuParticleStore::permute(const uint32_t* order, size_t n, unsigned workers,
+// The workers share the particles in blocks, and each gathers its block of every array (the old
+// elements were swapped into scratch first, so data() is the new order throughout) and then hands
+// the block to after_block. The inverse order, which a rewritten index may look up anywhere, is
+// complete before any block is gathered (its own loop, when some array rewrites indices).
+void CpuParticleStore::permute(const uint32_t* order, size_t n, const CpuParallel& parallel,
                                const BlockHook& after_block) {
   bool rewrites = false;
   for (auto& a : arrays_) {
     if (!reordered(*a)) continue;
-    a->scratch.resize(a->bytes.size());  // (allocations before the parallel region, which must not throw)
+    a->scratch.resize(a->bytes.size());  // (allocations before the parallel loops, which must not throw)
     a->bytes.swap(a->scratch);
     rewrites = rewrites || a->spec.rewrite_indices != nullptr;
   }
-  if (rewrites) inverse_.assign(particles_, 0xffffffffu);
-  const long count = static_cast<long>(n);
-#pragma omp parallel num_threads(std::max(workers, 1u))
-  {
-    if (rewrites) {
-#pragma omp for schedule(static)
-      for (long i = 0; i < count; ++i) inverse_[order[i]] = static_cast<uint32_t>(i);
-    }  // (the loop's barrier: the inverse is complete before any index is rewritten)
-       // Blocks on demand: a worker that something else keeps off its core holds up one block.
-#pragma omp for schedule(dynamic, 1)
-    for (long block = 0; block < (count + kPermuteBlock - 1) / kPermuteBlock; ++block) {
-      const size_t first = static_cast<size_t>(block) * kPermuteBlock;
-      const size_t last = std::min(first + kPermuteBlock, n);
-      for (auto& a : arrays_) {
-        if (!reordered(*a)) continue;
-        const size_t size = a->spec.element_size;
-        const size_t per = a->spec.elements_per_particle;
-        gather(a->bytes.data(), a->scratch.data(), order, first, last, per, size);
-        if (a->spec.rewrite_indices)
-          for (size_t e = first * per; e < last * per; ++e)
-            a->spec.rewrite_indices(a->bytes.data() + e * size, inverse_.data());
-      }
-      if (after_block) after_block(first, last);
-    }
+  if (rewrites) {
+    inverse_.assign(particles_, 0xffffffffu);
+    uint32_t* inverse = inverse_.data();
+    parallel.for_blocks(n, kPermuteBlock, [&](size_t first, size_t last) {
+      for (size_t i = first; i < last; ++i) inverse[order[i]] = static_cast<uint32_t>(i);
+    });
   }
+  parallel.for_blocks(n, kPermuteBlock, [&](size_t first, size_t last) {
+    for (auto& a : arrays_) {
+      if (!reordered(*a)) continue;
+      const size_t size = a->spec.element_size;
+      const size_t per = a->spec.elements_per_particle;
+      gather(a->bytes.data(), a->scratch.data(), order, first, last, per, size);
+      if (a->spec.rewrite_indices)
+        for (size_t e = first * per; e < last * per; ++e)
+          a->spec.rewrite_indices(a->bytes.data() + e * size, inverse_.data());
+    }
+    if (after_block) after_block(first, last);
+  });
 }
 
-std::vector<std::vector<unsigned char>> CpuParticleStore::snapshot() const {
-  std::vector<std::vector<unsigned char>> copy;
+HostVector<HostVector<unsigned char>> CpuParticleStore::snapshot() const {
+  HostVector<HostVector<unsigned char>> copy;
   for (const auto& a : arrays_)
     if (a->spec.role == ParticleArrayRole::Carried) copy.push_back(a->bytes);
   return copy;
 }
 
-void CpuParticleStore::restore(const std::vector<std::vector<unsigned char>>& copy) {
+void CpuParticleStore::restore(const HostVector<HostVector<unsigned char>>& copy) {
   size_t k = 0;
   for (auto& a : arrays_) {
     if (a->spec.role != ParticleArrayRole::Carried) continue;

@@ -15,14 +15,15 @@
 #include <vector>
 
 #include "../core/particle_arrays.h"
+#include "cpu_parallel.h"
 
 namespace sph {
 
 // One registered array: raw elements (16-byte aligned storage), element_size bytes each.
 struct CpuParticleArray {
   ParticleArraySpec spec;
-  std::vector<unsigned char> bytes;
-  std::vector<unsigned char> scratch;  // the reorder's target, swapped in
+  HostVector<unsigned char> bytes;
+  HostVector<unsigned char> scratch;  // the reorder's target, swapped in
 
   size_t elements(size_t particles) const {
     return spec.elements_per_particle == 0 ? 1 : particles * spec.elements_per_particle;
@@ -68,20 +69,21 @@ class CpuParticleStore {
   // Every per-particle array to n particles; new elements start as their record's initial value.
   void resize(size_t n);
   // Sorted and Carried arrays: new[i] = old[order[i]] for i < n (the rest is dropped by the
-  // next resize); elements with stored indices rewrite them to the new order. Runs on `workers`
-  // OpenMP threads; the result does not depend on their number. after_block(first, last), when
+  // next resize); elements with stored indices rewrite them to the new order. Runs on
+  // `parallel`'s workers; the result does not depend on their number. after_block(first, last), when
   // given, runs on the worker that has just reordered particles [first, last) of every array (it
   // may read them through data(), and must not throw), so a copy of the new order needs no
   // pass, and no meeting of the workers, of its own.
   using BlockHook = std::function<void(size_t first, size_t last)>;
-  void permute(const uint32_t* order, size_t n, unsigned workers = 1, const BlockHook& after_block = {});
+  void permute(const uint32_t* order, size_t n, const CpuParallel& parallel = {},
+               const BlockHook& after_block = {});
   // Swaps the elements of two arrays of one size (the integration's double buffer).
   void swap_contents(CpuParticleArray& a, CpuParticleArray& b) { a.bytes.swap(b.bytes); }
 
   // Copies of the Carried arrays, to roll a failed frame back; restore() copies them back (the
   // arrays keep their capacity, so a restore does not allocate).
-  std::vector<std::vector<unsigned char>> snapshot() const;
-  void restore(const std::vector<std::vector<unsigned char>>& copy);
+  HostVector<HostVector<unsigned char>> snapshot() const;
+  void restore(const HostVector<HostVector<unsigned char>>& copy);
 
   const std::vector<std::unique_ptr<CpuParticleArray>>& arrays() const { return arrays_; }
   size_t particles() const { return particles_; }
@@ -91,7 +93,7 @@ class CpuParticleStore {
   static void check_element_size(const CpuParticleArray& a, size_t size);
 
   std::vector<std::unique_ptr<CpuParticleArray>> arrays_;
-  std::vector<uint32_t> inverse_;  // new index of each old one, for the index rewrite
+  HostVector<uint32_t> inverse_;  // new index of each old one, for the index rewrite
   size_t particles_ = 0;
 };
 

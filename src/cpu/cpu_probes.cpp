@@ -27,13 +27,12 @@ void CpuBackend::sample_probes(const SceneFrame& scene, float dt, FrameReport& r
   const ProbeView* probes = scene.probes.data();
   ProbeGather* points = probe_points_.data();
   const int probe_count = static_cast<int>(scene.probes.size());
-  // One probe per iteration: a gauge's points are many, a point probe's one.
-#pragma omp parallel for num_threads(threads()) schedule(dynamic, 1)
-  for (int k = 0; k < probe_count; ++k) {
+  // One probe a block: a gauge's points are many, a point probe's one.
+  parallel().for_blocks(scene.probes.size(), 1, [&](size_t k, size_t) {
     const ProbeView& p = probes[k];
     for (uint32_t q = 0; q < p.point_count; ++q)
       points[p.first_point + q] = gather_probe_point(constants, view, pos, vel, probe_point(p, q));
-  }
+  });
   for (int k = 0; k < probe_count; ++k) {
     const ProbeView& p = probes[k];
     ProbeGather g = zero_probe_gather();

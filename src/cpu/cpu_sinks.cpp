@@ -21,7 +21,7 @@ void CpuBackend::apply_sinks(const SceneFrame& scene, FrameReport& report) {
     if (!removed) keep_order_.push_back(i);
   }
   if (keep_order_.size() != count_) {
-    store_.permute(keep_order_.data(), keep_order_.size(), threads());
+    store_.permute(keep_order_.data(), keep_order_.size(), parallel());
     count_ = static_cast<uint32_t>(keep_order_.size());
     store_.resize(count_);
   }

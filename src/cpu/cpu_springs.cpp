@@ -21,25 +21,25 @@ void CpuBackend::spring_pass(float dt, bool first_evaluation, FrameReport& repor
     const uint32_t* ids = id_.data();
     const uint32_t from = link_from_[0];
     uint32_t* candidates = spring_candidates_.data();
-#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
-    for (int i = 0; i < n(); ++i)
+    parallel().for_each(count_, [&](uint32_t i) {
       spring_candidates(c, view, pos, ids, from, lists[i], static_cast<uint32_t>(i),
                         candidates + static_cast<size_t>(i) * kSpringSlots);
-#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
-    for (int i = 0; i < n(); ++i) spring_link(pos, candidates, static_cast<uint32_t>(i), lists[i]);
+    });
+    parallel().for_each(
+        count_, [&](uint32_t i) { spring_link(pos, candidates, static_cast<uint32_t>(i), lists[i]); });
     link_from_[0] = kNoPendingLinks;
   }
   Float4* out = spring_acceleration_.data();  // w unused
   if (first_evaluation) {
-#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
-    for (int i = 0; i < n(); ++i)
+    parallel().for_each(count_, [&](uint32_t i) {
       out[i] = make_float4_record(
           spring_acceleration<true>(c, pos, vel, static_cast<uint32_t>(i), lists[i], dt), 0.0f);
+    });
   } else {
-#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
-    for (int i = 0; i < n(); ++i)
+    parallel().for_each(count_, [&](uint32_t i) {
       out[i] = make_float4_record(
           spring_acceleration<false>(c, pos, vel, static_cast<uint32_t>(i), lists[i], dt), 0.0f);
+    });
   }
   report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
 }

@@ -21,7 +21,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
   columns_.resize(count_);
   // The columns copy each block of the new order as soon as it is reordered (data() is the new
   // order inside the reorder).
-  store_.permute(grid_.order().data(), count_, threads(), [this](size_t first, size_t last) {
+  store_.permute(grid_.order().data(), count_, parallel(), [this](size_t first, size_t last) {
     columns_.copy_state(position_.data(), velocity_.data(), first, last);
   });
   report.stage_ms[kStageHashSort] += static_cast<float>(elapsed_ms(t));
@@ -50,8 +50,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
     // passes serve the weakly compressible scheme); no equation of state (w: the pressure,
     // written when the density solve has found it). Its solves read the records, not the columns.
     float* dfsph_factor = dfsph_factor_.data();
-#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
-    for (int i = 0; i < n(); ++i) {
+    parallel().for_each(count_, [&](uint32_t i) {
       const DfsphDensitySample s =
           gather_density_and_factor(fluid, view, pos, wall(i), static_cast<uint32_t>(i));
       density_[i] = s.density;
@@ -59,10 +58,9 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
       dfsph_factor[i] = s.factor;
       pos[i].w = 0.0f;
       vel[i].w = 1.0f / s.density;
-    }
+    });
   } else {
-#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
-    for (int i = 0; i < n(); ++i) {
+    parallel().for_each(count_, [&](uint32_t i) {
       DensitySample s = simd_.density(fluid, view, columns, static_cast<uint32_t>(i));
       // The walls' share is part of the summation (and so of a normalised density's kernel sum).
       if (boundary) s.density += wall(i).density;
@@ -78,35 +76,32 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
       vel[i].w = 1.0f / rho;
       columns_.set_density(static_cast<uint32_t>(i), pos[i].w, vel[i].w);
       columns_.set_neighbor_count(static_cast<uint32_t>(i), s.neighbor_count);
-    }
+    });
   }
   // The Shepard filter, unless the density diffusion keeps the carried density instead
   // (density_diffusion.h says why one or the other).
   if (factor && !(config_.features & kFeatureDensityDiffusion)) {
     // Eq. 31 over every carried rho_j: each particle writes only its own factor and side
     // slot (the first pass is done reading the factors), then the filtered values are published.
-#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
-    for (int i = 0; i < n(); ++i) {
+    parallel().for_each(count_, [&](uint32_t i) {
       const float filtered = simd_.normalized_density(fluid, view, columns, static_cast<uint32_t>(i));
       factor[i] = filtered / normalized_[i];
       normalized_[i] = filtered;
-    }
-#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
-    for (int i = 0; i < n(); ++i) {
+    });
+    parallel().for_each(count_, [&](uint32_t i) {
       density_[i] = normalized_[i];
       pos[i].w = pressure_from_density(fluid.methods.eos, normalized_[i]);
       vel[i].w = 1.0f / normalized_[i];
       columns_.set_density(static_cast<uint32_t>(i), pos[i].w, vel[i].w);
-    }
+    });
   }
   if (diffusion_dt > 0.0f) diffuse_density(fluid, diffusion_dt);
   if (config_.features & kFeatureSurfaceTension) {
     // Colour-field normals of every particle, which the force gather reads for neighbours.
-#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
-    for (int i = 0; i < n(); ++i) {
+    parallel().for_each(count_, [&](uint32_t i) {
       normals_[i] = simd_.colour_normal(fluid, view, columns, static_cast<uint32_t>(i));
       columns_.set_normal(static_cast<uint32_t>(i), normals_[i]);
-    }
+    });
   }
   report.stage_ms[kStageDensity] += static_cast<float>(elapsed_ms(t));
 }
@@ -120,20 +115,18 @@ void CpuBackend::diffuse_density(const FluidConstants& fluid, float dt) {
   float* factor = density_factor_.data();
   // The gather reads every published rho_j; each particle writes only its own factor and side
   // slot (free once the filtered densities are published), then the diffused values are published.
-#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
-  for (int i = 0; i < n(); ++i) {
+  parallel().for_each(count_, [&](uint32_t i) {
     const float rate = simd_.density_diffusion(fluid, view, columns, static_cast<uint32_t>(i));
     const DiffusedDensity d = diffused_density(density_[i], factor[i], rate, dt);
     factor[i] = d.factor;
     normalized_[i] = d.density;
-  }
-#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
-  for (int i = 0; i < n(); ++i) {
+  });
+  parallel().for_each(count_, [&](uint32_t i) {
     density_[i] = normalized_[i];
     pos[i].w = pressure_from_density(fluid.methods.eos, normalized_[i]);
     vel[i].w = 1.0f / normalized_[i];
     columns_.set_density(static_cast<uint32_t>(i), pos[i].w, vel[i].w);
-  }
+  });
 }
 
 // Acceleration of particle i: the neighbour gather with the world's force terms compiled in

@@ -18,15 +18,14 @@ void CpuBackend::collide(const SceneFrame& scene, const SubstepTime& time, OldPo
   const float h = config_.kernel_radius;
   Float4* next_pos = next_position_.data();
   Float4* next_vel = next_velocity_.data();
-#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk)
-  for (int i = 0; i < n(); ++i) {
+  parallel().for_each(count_, [&](uint32_t i) {
     Vec3 x = xyz(next_pos[i]);
     Vec3 v = xyz(next_vel[i]);
     const Vec3 from = x_old(static_cast<uint32_t>(i));
     for (const ColliderFrame& c : scene.colliders) collide_particle(c.view, time, h, from, x, v);
     next_pos[i] = make_float4_record(x, next_pos[i].w);
     next_vel[i] = make_float4_record(v, next_vel[i].w);
-  }
+  });
   report.stage_ms[kStageCollide] += static_cast<float>(elapsed_ms(t));
 }
 
@@ -55,29 +54,26 @@ uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame
   // end-of-substep scan (max speed, first non-finite particle) rides in the force loop: one pass
   // over the particles less. Both reductions are order-independent, so the bits are the scan's.
   const bool scan_in_loop = scene.colliders.empty() && !loads_on();
-  float a2max = 0.0f;
-  float v2max = 0.0f;
-  uint32_t bad_index = kAllFinite;
-#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk) reduction(max             \
-                                                                                            : a2max, v2max) \
-    reduction(min                                                                                           \
-              : bad_index)
-  for (int i = 0; i < n(); ++i) {
-    Vec3 a = acceleration(gather, fluid, view, columns, scene, static_cast<uint32_t>(i));
-    if (spring) a += xyz(spring[i]);
-    a += wall_acceleration(static_cast<uint32_t>(i));
-    a2max = std::max(a2max, length_squared(a));
-    const ParticleState s = symplectic_euler({xyz(pos[i]), xyz(vel[i])}, a, dt);
-    next_pos[i] = make_float4_record(s.position, pos[i].w);
-    next_vel[i] = make_float4_record(s.velocity, vel[i].w);
-    if (scan_in_loop) {
-      const float v2 = length_squared(s.velocity);
-      v2max = std::max(v2max, v2);
-      if (!finite3(s.position) || !std::isfinite(v2))
-        bad_index = std::min(bad_index, static_cast<uint32_t>(i));
-    }
-  }
-  max_acceleration_ = std::sqrt(a2max);
+  const StateScan forces = parallel().reduce(
+      count_, StateScan{},
+      [&](uint32_t i, StateScan& r) {
+        Vec3 a = acceleration(gather, fluid, view, columns, scene, i);
+        if (spring) a += xyz(spring[i]);
+        a += wall_acceleration(i);
+        r.a2max = std::max(r.a2max, length_squared(a));
+        const ParticleState s = symplectic_euler({xyz(pos[i]), xyz(vel[i])}, a, dt);
+        next_pos[i] = make_float4_record(s.position, pos[i].w);
+        next_vel[i] = make_float4_record(s.velocity, vel[i].w);
+        if (scan_in_loop) {
+          const float v2 = length_squared(s.velocity);
+          r.v2max = std::max(r.v2max, v2);
+          if (!finite3(s.position) || !std::isfinite(v2)) r.bad_index = std::min(r.bad_index, i);
+        }
+      },
+      combine_scans);
+  float v2max = forces.v2max;
+  uint32_t bad_index = forces.bad_index;
+  max_acceleration_ = std::sqrt(forces.a2max);
   report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
   if (loads_on()) {
     OldPositions old;
@@ -119,16 +115,19 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
     const NeighborColumns columns = columns_.view();
     const ParticleState* start = rk4_start_.data();
     Rk4Accumulator* sums = rk4_sum_.data();
-#pragma omp parallel for num_threads(threads()) schedule(dynamic, kParticleChunk) reduction(max : a2max)
-    for (int i = 0; i < n(); ++i) {
-      Vec3 a = acceleration(gather, fluid, view, columns, scene, static_cast<uint32_t>(i));
-      if (spring) a += xyz(spring[i]);
-      a += wall_acceleration(static_cast<uint32_t>(i));
-      a2max = std::max(a2max, length_squared(a));
-      const ParticleState s = rk4_advance(stage, start[i], {xyz(pos[i]), xyz(vel[i])}, a, dt, sums[i]);
-      next_pos[i] = make_float4_record(s.position, pos[i].w);
-      next_vel[i] = make_float4_record(s.velocity, vel[i].w);
-    }
+    const float stage_a2max = parallel().reduce(
+        count_, 0.0f,
+        [&](uint32_t i, float& m) {
+          Vec3 a = acceleration(gather, fluid, view, columns, scene, i);
+          if (spring) a += xyz(spring[i]);
+          a += wall_acceleration(i);
+          m = std::max(m, length_squared(a));
+          const ParticleState s = rk4_advance(stage, start[i], {xyz(pos[i]), xyz(vel[i])}, a, dt, sums[i]);
+          next_pos[i] = make_float4_record(s.position, pos[i].w);
+          next_vel[i] = make_float4_record(s.velocity, vel[i].w);
+        },
+        [](float a, float b) { return std::max(a, b); });
+    a2max = std::max(a2max, stage_a2max);
     report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
     if (loads_on() && (boundary_ || stage == 3)) {  // the walls' reactions, the contacts after the last
       OldPositions old;

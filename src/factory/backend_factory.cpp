@@ -58,7 +58,8 @@ void copy_device_to_host(void* host_dst, const void* device_src, size_t bytes, i
 }
 
 std::unique_ptr<Backend> make_backend(BackendKind kind, const WorldConfig& config, int device_ordinal,
-                                      unsigned cpu_workers, const CudaTuning& cuda_tuning) {
+                                      unsigned cpu_workers, const TaskSystem& cpu_tasks,
+                                      const CudaTuning& cuda_tuning) {
 #if defined(SPH_HAVE_CUDA)
   if (kind == BackendKind::Cuda) {
     CudaBackendOptions options;
@@ -73,7 +74,7 @@ std::unique_ptr<Backend> make_backend(BackendKind kind, const WorldConfig& confi
 #endif
   if (kind == BackendKind::Cuda)
     throw Error(Status::Unsupported, "backend: CUDA is not available in this build");
-  return make_cpu_backend(config, cpu_workers);
+  return make_cpu_backend(config, cpu_workers, cpu_tasks);
 }
 
 }  // namespace sph

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "../core/backend.h"
+#include "../core/task_system.h"
 
 namespace sph {
 
@@ -30,7 +31,9 @@ struct CudaTuning {
   uint32_t force_block = 0;    // threads per block of the force kernels
 };
 
+// cpu_tasks: the engine's task system for a CPU backend's loops (none: OpenMP's cpu_workers).
 std::unique_ptr<Backend> make_backend(BackendKind kind, const WorldConfig& config, int device_ordinal,
-                                      unsigned cpu_workers, const CudaTuning& cuda_tuning);
+                                      unsigned cpu_workers, const TaskSystem& cpu_tasks,
+                                      const CudaTuning& cuda_tuning);
 
 }  // namespace sph

@@ -160,7 +160,7 @@ void test_snapshot_arrays_by_name(void**) {
   assert_int_equal(s.carried_as<float>(sph::kArrayDensityFactor).size(), 2);
   // Missing arrays start fresh: the factor NaN, the link word "none waits".
   const ParticleArraySpec* link = sph::find_array_spec(specs, sph::kArraySpringLinkFrom);
-  const std::vector<unsigned char> word = sph::carried_bytes(s, *link, 2);
+  const auto word = sph::carried_bytes(s, *link, 2);
   uint32_t value = 0;
   assert_int_equal(word.size(), 4);
   std::memcpy(&value, word.data(), 4);
@@ -209,7 +209,7 @@ void test_permute_on_workers(void**) {
       // New place i holds old particle order[i]; its partner is the new place of old order[i] + 1.
       assert_int_equal(order[springs[i].partner[0]], (order[i] + 1) % n);
     }
-    for (const auto& a : store.arrays()) results[run].push_back(a->bytes);
+    for (const auto& a : store.arrays()) results[run].emplace_back(a->bytes.begin(), a->bytes.end());
   }
   assert_true(results[0] == results[1]);
 }

@@ -130,6 +130,19 @@ static class Tests
         Throws(Result.ErrorInvalidHandle, () => SphException.Check(Native.sph_context_get_backend(IntPtr.Zero, IntPtr.Zero), "sph_context_get_backend"));
     }
 
+    public static void TestCudaAllocatorOnCpuContext()
+    {
+        var def = ContextDef.Default();
+        def.Backend = Backend.Cpu;
+        using (var ctx = new Context(def))
+        {
+            var allocator = CudaAllocator.Default();
+            allocator.AllocFn = new IntPtr(1);  // half an allocator: refused before anything else
+            Throws(Result.ErrorInvalidArgument, () => ctx.SetCudaAllocator(allocator));
+            Throws(Result.ErrorUnsupported, () => ctx.SetCudaAllocator(CudaAllocator.Default()));
+        }
+    }
+
     public static void TestLogCallback()
     {
         int calls = 0;

@@ -145,6 +145,23 @@ class Context:
         check(library().sph_context_get_backend(self.handle, ctypes.byref(out)), "sph_context_get_backend")
         return _g.Backend(out.value)
 
+    def set_cuda_allocator(self, alloc_fn=None, free_fn=None, user_context=None):
+        """The engine's device allocator for this CUDA context's worlds
+        (sph_cuda_context_set_allocator): ctypes function pointers of the types
+        sph_cuda_alloc_fn and sph_cuda_free_fn (usually from the engine's own C library), both
+        or neither (neither: back to cudaMalloc). Set it before the first world or SDF asset
+        (else ERROR_BUSY). A CPU context raises SphError(ERROR_UNSUPPORTED)."""
+        a = _g.CudaAllocator()
+        if alloc_fn is not None:
+            a.alloc_fn = alloc_fn
+        if free_fn is not None:
+            a.free_fn = free_fn
+        if user_context is not None:
+            a.user_context = user_context
+        check(library().sph_cuda_context_set_allocator(self.handle, ctypes.byref(a)),
+              "sph_cuda_context_set_allocator")
+        self._cuda_allocator = (alloc_fn, free_fn)  # the library keeps calling them
+
     def world(self, definition=None, **fields):
         """A new World on this context; see World."""
         return World(self, definition, **fields)

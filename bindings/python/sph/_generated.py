@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'bc147262e5027a71c84f65a5c440f81cc642615a35a5c07f4c3e1fb9483f2392', 'include/sph_cuda.h': 'c684e65602dfd8308b1fc6a37541e8372192d22a76cc8d370b7db2bb126a15f8', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '36d518451bcbab0bd257cee1b31d9725affdbb094e8340a601fc802b4cfbbe50', 'include/sph_cuda.h': 'b5e0ec658cb73b06ce44db49a20d0fae88f579b9df3e65c4d6e1b93b72cdccd8', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -724,6 +724,44 @@ class sph_sdf(_Opaque):
 #: Log callback. Called only on a thread that is inside an sph_ call on this context (never from
 #: internal worker threads). message is valid for the duration of the call.
 sph_log_fn = _c.CFUNCTYPE(None, _c.c_void_p, sph_log_level, sph_result, _c.c_char_p)
+#: The engine's task system (the shape of Box2D v3's b2EnqueueTaskCallback and
+#: b2FinishTaskCallback; docs/embedding.md, "Threads"). With one, a CPU context runs every parallel
+#: loop of its worlds through it and starts no thread of its own for them.
+#: 
+#: sph_task_fn runs items [first, last) of a task on the calling thread; `worker` is the index of
+#: the task system's worker that runs them (the library does not read it; pass what you have). The
+#: library's task functions never block, never call back into the library and never throw; they may
+#: run on any thread, concurrently with each other.
+#: 
+#: sph_enqueue_task_fn schedules `task` over the items [0, item_count), split into ranges of at
+#: least min_range items (the library passes 1), each range one call of task with task_context. It
+#: returns a handle that the library passes to finish_task, or NULL once it has run every item
+#: itself (then finish_task is not called). It is called only from the thread inside an sph_ call
+#: on the world (for sph_world_step_begin: the world's step thread), never from a task.
+#: 
+#: sph_finish_task_fn returns once every item of the task behind user_task has run (it may run
+#: items itself meanwhile). Results are the same bits whatever the split or the worker count.
+sph_task_fn = _c.CFUNCTYPE(None, _c.c_uint32, _c.c_uint32, _c.c_uint32, _c.c_void_p)
+sph_enqueue_task_fn = _c.CFUNCTYPE(_c.c_void_p, sph_task_fn, _c.c_uint32, _c.c_uint32, _c.c_void_p, _c.c_void_p)
+sph_finish_task_fn = _c.CFUNCTYPE(None, _c.c_void_p, _c.c_void_p)
+#: The engine's host allocator (docs/embedding.md, "Memory"). alloc returns `size` bytes (never 0)
+#: aligned to `alignment` (a power of two, at least 16), or NULL when it has none (the call then
+#: fails with SPH_ERROR_OUT_OF_HOST_MEMORY and the world is unchanged). free gives back memory that
+#: alloc returned, with the size that was asked for. Both may be called from any thread that runs
+#: the library's work for the context (the caller's, the world's step thread, a worker or the
+#: engine's tasks), concurrently: they must be thread-safe. user_context is passed unchanged.
+sph_alloc_fn = _c.CFUNCTYPE(_c.c_void_p, _c.c_size_t, _c.c_size_t, _c.c_void_p)
+sph_free_fn = _c.CFUNCTYPE(None, _c.c_void_p, _c.c_size_t, _c.c_void_p)
+#: The engine's device allocator (docs/embedding.md, "Memory"). alloc_fn returns `size` bytes
+#: (never 0) of device memory on device_ordinal, aligned to at least 256 bytes (as cudaMalloc
+#: gives), or NULL when it has none (the call then fails with SPH_ERROR_OUT_OF_DEVICE_MEMORY and
+#: the world is unchanged). free_fn gives back memory that alloc_fn returned, with its size and
+#: device. The library calls them with that device current, from the thread inside an sph_ call on
+#: the context (for sph_world_step_begin: the world's step thread), so several worlds on several
+#: threads may call them at once: they must be thread-safe. The memory must stay valid until freed
+#: (stream-ordered pools: free it only after the device's work is done).
+sph_cuda_alloc_fn = _c.CFUNCTYPE(_c.c_void_p, _c.c_size_t, _c.c_int32, _c.c_void_p)
+sph_cuda_free_fn = _c.CFUNCTYPE(None, _c.c_void_p, _c.c_size_t, _c.c_int32, _c.c_void_p)
 
 # ---- structs ----------------------------------------------------------------------------------
 
@@ -769,6 +807,12 @@ class ContextDef(_SphStruct):
         cuda_density_block (uint32_t): threads per block of the density kernels: 0 (default) = 128, or 32, 64, 128, 256, 512, 1024
         cuda_force_block (uint32_t): threads per block of the force kernels: 0 (default) = 128, or as above
         reserved1 (uint32_t): must be 0
+        enqueue_task (sph_enqueue_task_fn): The engine's task system (0.2.0): both or neither; NULL (default) = the library's OpenMP workers. A CPU context uses it for every parallel loop of its worlds; cpu_worker_count then only decides whether a loop runs in parallel (1: every loop on the calling thread). A CUDA context checks and ignores it.
+        finish_task (sph_finish_task_fn)
+        task_user_context (void*): passed to enqueue_task and finish_task
+        alloc_fn (sph_alloc_fn): The engine's host allocator (0.2.0): both or neither; NULL (default) = the system heap. Every host allocation for the context's worlds and SDF assets goes through it (particle arrays, neighbour grids, scratch, rollback snapshots, checkpoint buffers, colliders, sources, sinks, probes, SDF grids and assets, boundary maps, per-frame lists) except: the context object, each world's handle record, World and backend objects and their array records (15 allocations, 3.4 KB, for a plain CPU world; none in a step) and step thread, error messages and the last-error text, and on CUDA the page-locked staging buffers (cudaMallocHost). Device memory: sph_cuda_context_set_allocator.
+        free_fn (sph_free_fn)
+        alloc_user_context (void*): passed to alloc_fn and free_fn
     """
     _fields_ = [
         ('struct_size', _c.c_uint32),
@@ -783,10 +827,16 @@ class ContextDef(_SphStruct):
         ('cuda_density_block', _c.c_uint32),
         ('cuda_force_block', _c.c_uint32),
         ('reserved1', _c.c_uint32),
+        ('enqueue_task', sph_enqueue_task_fn),
+        ('finish_task', sph_finish_task_fn),
+        ('task_user_context', _c.c_void_p),
+        ('alloc_fn', sph_alloc_fn),
+        ('free_fn', sph_free_fn),
+        ('alloc_user_context', _c.c_void_p),
     ]
     _sph_c_name_ = 'sph_context_def'
-    _sph_size_ = 56
-    _sph_offsets_ = (('struct_size', 0), ('header_version', 4), ('backend', 8), ('device_ordinal', 12), ('cpu_worker_count', 16), ('reserved0', 20), ('log_fn', 24), ('log_user_data', 32), ('cuda_frames', 40), ('cuda_density_block', 44), ('cuda_force_block', 48), ('reserved1', 52))
+    _sph_size_ = 104
+    _sph_offsets_ = (('struct_size', 0), ('header_version', 4), ('backend', 8), ('device_ordinal', 12), ('cpu_worker_count', 16), ('reserved0', 20), ('log_fn', 24), ('log_user_data', 32), ('cuda_frames', 40), ('cuda_density_block', 44), ('cuda_force_block', 48), ('reserved1', 52), ('enqueue_task', 56), ('finish_task', 64), ('task_user_context', 72), ('alloc_fn', 80), ('free_fn', 88), ('alloc_user_context', 96))
     _sph_init_ = 'sph_context_def_init_sized'
     _sph_assigns_ = {'header_version': SPH_VERSION}
     _sph_enums_ = {'backend': Backend, 'cuda_frames': CudaFrames}
@@ -1938,7 +1988,34 @@ class CudaAttributeView(_SphStruct):
 sph_cuda_attribute_view = CudaAttributeView
 
 
-STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpringParams, DensityDiffusionParams, DfsphParams, ParamsInfo, ParamFieldInfo, PhysicsMethodInfo, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, MeshDesc, Quat, Transform, ColliderId, ColliderDef, ColliderMaterial, ColliderLoads, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, ProbeId, ProbeDef, ProbeReading, Event, CudaAttributeView, )
+class CudaAllocator(_SphStruct):
+    """
+    sph_cuda_allocator.
+
+    Fields:
+        struct_size (uint32_t): sizeof(sph_cuda_allocator), set by the init function
+        reserved0 (uint32_t): must be 0
+        alloc_fn (sph_cuda_alloc_fn): both or neither; NULL (default): cudaMalloc / cudaFree
+        free_fn (sph_cuda_free_fn)
+        user_context (void*): passed to alloc_fn and free_fn
+    """
+    _fields_ = [
+        ('struct_size', _c.c_uint32),
+        ('reserved0', _c.c_uint32),
+        ('alloc_fn', sph_cuda_alloc_fn),
+        ('free_fn', sph_cuda_free_fn),
+        ('user_context', _c.c_void_p),
+    ]
+    _sph_c_name_ = 'sph_cuda_allocator'
+    _sph_size_ = 32
+    _sph_offsets_ = (('struct_size', 0), ('reserved0', 4), ('alloc_fn', 8), ('free_fn', 16), ('user_context', 24))
+    _sph_init_ = 'sph_cuda_allocator_init_sized'
+
+
+sph_cuda_allocator = CudaAllocator
+
+
+STRUCTS = (Vec3, ContextDef, WorldDef, WorldParams, SurfaceTensionParams, ClavetViscosityParams, TaitParams, SpringParams, DensityDiffusionParams, DfsphParams, ParamsInfo, ParamFieldInfo, PhysicsMethodInfo, SpawnDesc, FillBoxDesc, FillSphereDesc, Stats, GridDesc, SdfDesc, ShapeDesc, MeshDesc, Quat, Transform, ColliderId, ColliderDef, ColliderMaterial, ColliderLoads, SourceId, SourceDef, SinkId, SinkDef, ForceFieldId, ForceFieldDef, ProbeId, ProbeDef, ProbeReading, Event, CudaAttributeView, CudaAllocator, )
 
 # ---- functions --------------------------------------------------------------------------------
 
@@ -2180,6 +2257,10 @@ FUNCTIONS = {
         "Makes the world's later device work wait for `event` (a cudaEvent_t the caller recorded on its own stream): e.g. a kernel of the caller that must finish before the next step. Non-blocking. Errors: as sph_cuda_world_record_event.", 'sph'),
     'sph_cuda_world_step_begin_on_stream': (sph_result, (_c.POINTER(sph_world), _c.c_float, _c.c_void_p), ('world', 'frame_dt', 'stream'),
         "sph_world_step_begin ordered on the caller's CUDA stream `stream` (a cudaStream_t on the world's device; NULL: the legacy default stream): the frame's device work runs after the work enqueued on `stream` before this call, and work the caller enqueues on `stream` after this call returns runs after the frame's device work. So an engine can enqueue its own kernels that read the world's device buffers (sph_cuda_world_get_attribute) right behind the step, and draw them, without the host waiting for the GPU.\n\nReturns once the frame's device work is enqueued: at once for a frame the world runs as one device graph, but only after the frame has run for a frame the host drives substep by substep (frames with sinks or a step budget). As after sph_world_step_begin, the world is held until sph_world_step_wait, which must be called and reports the step's result. If the step fails (non-finite state, a crowded cell), the caller's stream may already have read the failed frame's particles: the world then rolls back, sph_world_step_wait reports the error, and the data epoch tells (sph_cuda_world_get_epoch). Errors: INVALID_HANDLE, INVALID_ARGUMENT (frame_dt not positive and finite), UNSUPPORTED (CPU world, no CUDA build), DEVICE (CUDA refused the stream, e.g. one of another device), DEVICE_LOST, WORLD_LOCKED (a step is pending or another call holds the world), OUT_OF_HOST_MEMORY (no thread for the step). On error nothing was started.", 'sph'),
+    'sph_cuda_allocator_init_sized': (sph_result, (_c.POINTER(sph_cuda_allocator), _c.c_uint32), ('allocator', 'size'),
+        'Zeroes *allocator and sets struct_size (size = sizeof(*allocator)).', 'sph'),
+    'sph_cuda_context_set_allocator': (sph_result, (_c.POINTER(sph_context), _c.POINTER(sph_cuda_allocator)), ('context', 'allocator'),
+        "Makes every device allocation of the context's worlds (particle arrays, grids, sort and reduction scratch, SDF grids and boundary maps, probes, loads) go through `allocator`; NULL or a zeroed allocator goes back to cudaMalloc. Set it before the context has any world or SDF asset: it cannot change under memory already taken. Page-locked host staging buffers (cudaMallocHost) and CUDA's own allocations (graphs, streams, events, the runtime's context) do not go through it. Thread-safe. Errors: INVALID_HANDLE, INVALID_ARGUMENT (one of alloc_fn / free_fn without the other, reserved0 not 0; the message names it), VERSION_MISMATCH, UNSUPPORTED (a CPU context or a build without CUDA), BUSY (the context has worlds or SDF assets).", 'sph'),
     'sph_vdb_load_sdf': (sph_result, (_c.POINTER(sph_context), _c.c_char_p, _c.c_char_p, _c.POINTER(_c.POINTER(sph_sdf))), ('context', 'path', 'grid_name', 'out'),
         'Loads a level-set FloatGrid from a .vdb file into a new SDF asset of `context`: the grid\'s active voxels (plus one voxel of margin) become a dense grid whose index_to_local is the grid\'s linear index-to-world transform, so the asset\'s local frame is the file\'s world frame. Voxels outside the narrow band take the grid\'s values there (plus or minus the band width). grid_name selects a grid; NULL or "" takes the first float level set in the file. Errors: INVALID_ARGUMENT (NULL arguments; the file cannot be opened or is not a VDB file; no such grid; the grid is not a float level set; a non-linear transform), CAPACITY (the dense grid would exceed 2^31 voxels), and those of sph_sdf_create. On failure *out is unchanged and sph_vdb_get_last_error() explains. Thread-safe.', 'sph_vdb'),
     'sph_vdb_get_last_error': (_c.c_char_p, (), (),

@@ -3,6 +3,7 @@
 import pytest
 
 import sph
+from sph import _generated as _g
 
 
 def test_cpu_context(ctx):
@@ -29,6 +30,19 @@ def test_cuda_without_cuda_is_unsupported():
     assert e.value.result == sph.Result.ERROR_UNSUPPORTED
     assert e.value.function == "sph_context_create"
     assert e.value.message and e.value.message in str(e.value)
+
+
+def test_cuda_allocator_rules():
+    """Half a device allocator is refused naming the missing half; a CPU context has none."""
+    with sph.Context("cpu") as c:
+        alloc = _g.sph_cuda_alloc_fn(lambda size, device, user: None)
+        with pytest.raises(sph.SphError) as e:
+            c.set_cuda_allocator(alloc_fn=alloc)
+        assert e.value.result == sph.Result.ERROR_INVALID_ARGUMENT
+        assert "allocator->free_fn" in e.value.message
+        with pytest.raises(sph.SphError) as e:
+            c.set_cuda_allocator()
+        assert e.value.result == sph.Result.ERROR_UNSUPPORTED
 
 
 @pytest.mark.parametrize("field, value, result", [
