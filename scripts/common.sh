@@ -7,6 +7,7 @@
 #   sph_log / sph_warn / sph_die  messages on stderr, prefixed with the calling script's name
 #   sph_install_packages          apt-get installs whatever of SPH_PACKAGES is missing
 #   sph_configure DIR [ARGS...]   cmake -G Ninja into DIR (Release unless ARGS say otherwise)
+#   sph_configure_sanitizer_tree DIR   the clang ASan + UBSan + libFuzzer tree (build-sanitize/)
 #   sph_build DIR [TARGETS...]    ninja in DIR
 #
 # Environment knobs:
@@ -114,6 +115,29 @@ sph_configure() {
   fi
   sph_log "configuring ${dir}: cmake -G Ninja -DCMAKE_BUILD_TYPE=Release $*"
   cmake -S "${SPH_ROOT}" -B "${dir}" -G Ninja -DCMAKE_BUILD_TYPE=Release "$@"
+}
+
+# sph_configure_sanitizer_tree DIR: the one sanitizer tree of scripts/test and scripts/fuzz.
+# clang with ASan + UBSan (SPH_SANITIZE: the tests' sanitizer settings) and libFuzzer's coverage
+# instrumentation in every library object (SPH_FUZZ): the sanitizer ctest stage and the fuzz
+# harnesses share one build instead of compiling the library twice (once with GCC for the tests,
+# once with clang for libFuzzer). -O2 with line tables: the tests run at the speed of the former
+# GCC -O2 build and the reports keep function names and line numbers. Without CUDA, the
+# benchmarks and sph-run's OpenVDB outputs (the slowest code to compile; the Release build tests
+# them); with libsph_vdb, which fuzz_vdb needs. Warnings are not errors here: build/ enforces them.
+sph_configure_sanitizer_tree() {
+  local dir="$1"
+  command -v clang++ >/dev/null 2>&1 || sph_die "clang++ not found (Debian: apt-get install clang libclang-rt-14-dev)"
+  # A tree configured with another compiler (GCC, before the two trees became one) starts afresh.
+  if [[ -f "${dir}/CMakeCache.txt" ]] && ! grep -q '^CMAKE_CXX_COMPILER:[A-Z]*=.*clang++' "${dir}/CMakeCache.txt"; then
+    sph_log "${dir} was configured with another compiler: starting it afresh"
+    rm -rf "${dir}/CMakeCache.txt" "${dir}/CMakeFiles"
+  fi
+  sph_configure "${dir}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
+    "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O2 -gline-tables-only -DNDEBUG" \
+    "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -gline-tables-only -DNDEBUG" \
+    -DSPH_SANITIZE=ON -DSPH_FUZZ=ON -DSPH_WITH_CUDA=OFF -DSPH_RUN_WITH_OPENVDB=OFF -DSPH_BUILD_BENCH=OFF \
+    -DSPH_WARNINGS_AS_ERRORS=OFF
 }
 
 # sph_build DIR [TARGETS...]
