@@ -156,7 +156,8 @@ void CudaBackend::reserve(uint32_t capacity) {
     // The grid is sized from the capacity, as a world created at this capacity sizes it, so a
     // grown world sorts (and computes) exactly as that world would.
     auto grid = std::make_unique<DeviceNeighborGrid>(
-        make_grid_shape(config_.kernel_radius, capacity), capacity, store->sort_scratch(),
+        make_grid_shape(config_.kernel_radius, capacity), capacity,
+        max_particles_per_cell(config_.particle_spacing, config_.kernel_radius), store->sort_scratch(),
         store->arrays().sorted_position, sizeof(Float4) * static_cast<size_t>(capacity));
     auto statistics = std::make_unique<FrameStatistics>(capacity);
     DeviceArray<double> partials;
