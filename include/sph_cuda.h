@@ -127,7 +127,8 @@ SPH_API sph_result SPH_CALL sph_cuda_world_wait_event(sph_world* world, void* ev
  * DEVICE_LOST, WORLD_LOCKED (a step is pending or another call holds the world), OUT_OF_HOST_MEMORY
  * (no thread for the step). On error nothing was started.
  */
-SPH_API sph_result SPH_CALL sph_cuda_world_step_begin_on_stream(sph_world* world, float frame_dt, void* stream);
+SPH_API sph_result SPH_CALL sph_cuda_world_step_begin_on_stream(sph_world* world, float frame_dt,
+                                                                void* stream);
 
 /* ---- the engine's device allocator --------------------------------------------------------- */
 
