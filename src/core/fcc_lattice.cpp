@@ -107,6 +107,9 @@ double fcc_sphere_point_estimate(float radius, float spacing) {
 HostVector<Vec3> fcc_points_in_box(Vec3 min, Vec3 max, float spacing) {
   const BoxLattice b = box_lattice(min, max, spacing);
   HostVector<Vec3> points;
+  // A box without a lattice row along one axis holds no point, however long it is along the
+  // others: return before the outer loops spin through them (a fuzzer found 1e9 empty turns).
+  if (b.n[0] <= 0 || b.n[1] <= 0 || b.n[2] <= 0) return points;
   points.reserve(static_cast<size_t>(fcc_box_point_count(min, max, spacing)));
   for (int64_t k = 0; k < b.n[2]; ++k)
     for (int64_t j = 0; j < b.n[1]; ++j)
