@@ -8,7 +8,10 @@
  * (one fitted shift, as the validation), and DFSPH's solve iterations.
  *
  *   solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1]
- *                [--out solver_front.csv]
+ *                [--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--out solver_front.csv]
+ *
+ * --wcsph: the weakly compressible runs' speeds of sound, as multiples of the free-fall speed;
+ * --dfsph: the DFSPH runs' density error bounds (0.001 = 0.1 %); `none` leaves a solver out.
  *
  * --sample-T: the front's sampling interval in T (0.1 = 5.4 ms). Each sample ends a frame, and a
  * frame's landing step caps the substep, so a fine sampling (the validation's 0.025 = 1.35 ms)
@@ -30,6 +33,7 @@
 #include "support.h"
 
 #define MAX_RESOLUTIONS 8
+#define MAX_RUNS 8
 #define GRAVITY 9.81
 
 static int parse_layers(const char* text, uint32_t* layers) {
@@ -46,15 +50,30 @@ static int parse_layers(const char* text, uint32_t* layers) {
   return count;
 }
 
+/* A comma-separated list of positive numbers; 0 on a malformed list. */
+static int parse_values(const char* text, double* values, int most) {
+  int count = 0;
+  const char* p = text;
+  while (*p && count < most) {
+    char* end = NULL;
+    const double v = strtod(p, &end);
+    if (end == p || !(v > 0.0 && v < 1e6)) return 0;
+    values[count++] = v;
+    if (*end != ',' && *end != '\0') return 0;
+    p = (*end == ',') ? end + 1 : end;
+  }
+  return *p ? 0 : count;
+}
+
 typedef struct solver_run {
   sph_solver solver;
   double value; /* WCSPH: c / free-fall speed; DFSPH: the density error bound */
 } solver_run;
 
 int main(int argc, char** argv) {
-  const solver_run runs[] = {{SPH_SOLVER_WCSPH, 5.0},  {SPH_SOLVER_WCSPH, 10.0},  {SPH_SOLVER_WCSPH, 20.0},
-                             {SPH_SOLVER_DFSPH, 0.01}, {SPH_SOLVER_DFSPH, 0.001}, {SPH_SOLVER_DFSPH, 0.0001}};
-  const int run_count = (int)(sizeof runs / sizeof runs[0]);
+  double wcsph_values[MAX_RUNS] = {5.0, 10.0, 20.0}, dfsph_values[MAX_RUNS] = {0.01, 0.001, 0.0001};
+  int wcsph_count = 3, dfsph_count = 3, run_count = 0;
+  solver_run runs[2 * MAX_RUNS];
   uint32_t layers[MAX_RESOLUTIONS] = {8, 12, 16};
   int resolutions = 3;
   double seconds = 1.0, sample_T = 0.1;
@@ -88,16 +107,35 @@ int main(int argc, char** argv) {
         fprintf(stderr, "solver_front: --sample-T takes an interval in [0.005, 0.2]\n");
         return 2;
       }
+    } else if (strcmp(argv[i], "--wcsph") == 0 && i + 1 < argc) {
+      wcsph_count = strcmp(argv[i + 1], "none") == 0 ? -1 : parse_values(argv[i + 1], wcsph_values, MAX_RUNS);
+      ++i;
+      if (wcsph_count == 0) {
+        fprintf(stderr,
+                "solver_front: --wcsph takes up to 8 speeds of sound (multiples of the free-fall speed) or "
+                "none\n");
+        return 2;
+      }
+    } else if (strcmp(argv[i], "--dfsph") == 0 && i + 1 < argc) {
+      dfsph_count = strcmp(argv[i + 1], "none") == 0 ? -1 : parse_values(argv[i + 1], dfsph_values, MAX_RUNS);
+      ++i;
+      if (dfsph_count == 0) {
+        fprintf(stderr,
+                "solver_front: --dfsph takes up to 8 density error bounds (0.001 = 0.1 %%) or none\n");
+        return 2;
+      }
     } else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
       out_path = argv[++i];
     } else {
       fprintf(
           stderr,
           "usage: solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1] "
-          "[--out solver_front.csv]\n");
+          "[--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--out solver_front.csv]\n");
       return 2;
     }
   }
+  for (int k = 0; k < wcsph_count; ++k) runs[run_count++] = (solver_run){SPH_SOLVER_WCSPH, wcsph_values[k]};
+  for (int k = 0; k < dfsph_count; ++k) runs[run_count++] = (solver_run){SPH_SOLVER_DFSPH, dfsph_values[k]};
   if (support_context_create(backend, &context) != SPH_OK) {
     fprintf(stderr, "solver_front: no context for the backend asked for\n");
     return 1;

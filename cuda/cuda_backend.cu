@@ -145,7 +145,7 @@ void CudaBackend::truncate(uint32_t count) {
   ++epoch_;
 }
 
-void CudaBackend::reserve(uint32_t capacity) {
+void CudaBackend::reserve(uint32_t capacity, const GrowthNeeds& needs) {
   require_alive();
   if (capacity <= config_.capacity) return;
   DeviceGuard guard(device_);
@@ -162,6 +162,13 @@ void CudaBackend::reserve(uint32_t capacity) {
     auto statistics = std::make_unique<FrameStatistics>(capacity);
     DeviceArray<double> partials;
     if (options_.dfsph) partials.allocate(dfsph_partial_count(capacity), "DFSPH solve sums");
+    // The frame's capacity-sized buffers grow with the storage, inside the all-or-nothing
+    // growth: the frame that grew the world then allocates none of them, so it cannot fail with
+    // the world grown (gpu_check_allocation_faults).
+    DeviceSinkCompactor sinks;
+    if (needs.sinks) sinks.reserve(capacity, *store);
+    DeviceColliderLoads loads;
+    if (needs.load_colliders != 0) loads.reserve(needs.load_colliders, capacity);
     store->enqueue_copy_from(*r_->store, count_, r_->stream);
     cuda_check(cudaStreamSynchronize(r_->stream), "growth of the particle storage");
     // Nothing below throws: the new buffers replace the old ones (freed at the end of scope).
@@ -170,6 +177,8 @@ void CudaBackend::reserve(uint32_t capacity) {
     r_->store.swap(store);
     r_->statistics.swap(statistics);
     std::swap(r_->solve_partials, partials);
+    if (needs.sinks) std::swap(r_->sinks, sinks);
+    if (needs.load_colliders != 0) std::swap(r_->loads, loads);
   });
   config_.capacity = capacity;
   ++epoch_;

@@ -81,7 +81,7 @@ class CudaBackend final : public Backend {
   // A larger store, grid, statistics and solve sums are made and the particles copied before
   // anything is swapped in (so a failed allocation leaves the world as it was); the frame graph,
   // which holds the old buffers' addresses, is dropped and captured again by the next frame.
-  void reserve(uint32_t capacity) override;
+  void reserve(uint32_t capacity, const GrowthNeeds& needs) override;
 
   // Device-to-device copies of the carried max speed and max acceleration on the stream (no
   // wait for the host when saving).

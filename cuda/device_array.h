@@ -111,6 +111,15 @@ class PinnedArray {
   ~PinnedArray() { release(); }
   PinnedArray(const PinnedArray&) = delete;
   PinnedArray& operator=(const PinnedArray&) = delete;
+  PinnedArray(PinnedArray&& other) noexcept : data_(other.data_) { other.data_ = nullptr; }
+  PinnedArray& operator=(PinnedArray&& other) noexcept {
+    if (this != &other) {
+      release();
+      data_ = other.data_;
+      other.data_ = nullptr;
+    }
+    return *this;
+  }
 
   void allocate(size_t count, const char* name) {
     release();

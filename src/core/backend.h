@@ -52,11 +52,19 @@ class Backend {
   virtual void append(const Vec3* positions, const Vec3* velocities, uint32_t n, uint32_t first_id,
                       uint32_t user_attribute) = 0;
 
+  // What the next frames need beside the particle storage, so that a growth reserves their
+  // capacity-sized buffers too (a frame that grows its world can then fail only before the
+  // growth or after every buffer it needs exists: never with a grown world and a step rolled
+  // back).
+  struct GrowthNeeds {
+    bool sinks = false;           // the world has sinks (the sink compaction's buffers)
+    uint32_t load_colliders = 0;  // colliders whose loads a frame sums (their block sums)
+  };
   // Makes room for `capacity` particles (more than config.capacity; the caller has checked
   // it against max_capacity): every per-particle buffer is reallocated and the particles are
   // kept. All-or-nothing: throws Error(OutOfHostMemory / OutOfDeviceMemory) and leaves the
   // backend as it was. Device pointers taken before (device_attribute) are stale after.
-  virtual void reserve(uint32_t capacity) = 0;
+  virtual void reserve(uint32_t capacity, const GrowthNeeds& needs) = 0;
 
   // Runs adaptive substeps until frame_dt is reached or params.max_substeps is spent, with the
   // scene's colliders, force fields and sinks. On a non-finite state it restores the particles

@@ -69,7 +69,11 @@ bool World::reserve_particles(uint64_t total) {
   const uint64_t doubled = 2ull * config_.capacity;
   const uint32_t grown =
       static_cast<uint32_t>(std::min<uint64_t>(std::max(total, doubled), config_.max_capacity));
-  backend_->reserve(grown);  // all-or-nothing
+  Backend::GrowthNeeds needs;
+  needs.sinks = sinks_.size() != 0;
+  if (config_.features & kFeatureColliderLoads)
+    needs.load_colliders = static_cast<uint32_t>(colliders_.size());
+  backend_->reserve(grown, needs);  // all-or-nothing
   config_.capacity = grown;
   ++capacity_growths_;
   return true;

@@ -55,7 +55,7 @@ class CpuBackend final : public Backend {
 
   void truncate(uint32_t count) override;
   // The host arrays grow with the particles (append), so a new capacity is only a new limit.
-  void reserve(uint32_t capacity) override { config_.capacity = capacity; }
+  void reserve(uint32_t capacity, const GrowthNeeds&) override { config_.capacity = capacity; }
 
   void save_step_inputs() override {
     saved_inputs_ = StepInputs{max_speed_, max_acceleration_, max_speed_valid_};
