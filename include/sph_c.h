@@ -1294,6 +1294,17 @@ SPH_API sph_result SPH_CALL sph_collider_get_loads(const sph_world* world, sph_c
  */
 SPH_API sph_result SPH_CALL sph_collider_set_load_point(sph_world* world, sph_collider_id id,
                                                         const sph_vec3* point);
+/**
+ * A threshold on a collider's loads, for engines that react to a hit rather than poll: after
+ * every sph_world_step whose mean force on the collider (sph_collider_loads.force) has a
+ * magnitude of at least `force` newtons, the step reports SPH_EVENT_COLLIDER_LOAD_EXCEEDED
+ * (object: the collider; count: the magnitude in N, rounded down). 0 (the default) = no event.
+ * Acts from the next step; checkpoints carry it (format 7). Errors: INVALID_HANDLE,
+ * INVALID_ARGUMENT (negative or not finite), FEATURE_DISABLED, WORLD_LOCKED. Nothing changes on
+ * error.
+ */
+SPH_API sph_result SPH_CALL sph_collider_set_load_threshold(sph_world* world, sph_collider_id id,
+                                                            float force);
 
 /* ---- sources ----------------------------------------------------------------------------- */
 typedef struct sph_source_id {
@@ -1468,8 +1479,8 @@ static inline sph_result sph_probe_def_init(sph_probe_def* def) {
  * length not > 0 or too many steps, a negative sample_spacing, non-zero reserved0, each named),
  * UNSUPPORTED (an unknown kind or sampling; a world of the DFSPH solver, whose substep does not
  * sample probes), VERSION_MISMATCH, CAPACITY (65536 probes), WORLD_LOCKED. Nothing changes on
- * error. Probes are not carried by checkpoints: sph_world_restore keeps the world's own, a world
- * made by sph_world_load has none (docs/api.md).
+ * error. Checkpoints of format 6 and later carry the probes (readings start again); restoring an
+ * older one keeps the world's own (docs/api.md).
  */
 SPH_API sph_result SPH_CALL sph_probe_create(sph_world* world, const sph_probe_def* def,
                                              sph_probe_id* out_id);
@@ -1512,6 +1523,16 @@ static inline sph_result sph_probe_reading_init(sph_probe_reading* reading) {
  */
 SPH_API sph_result SPH_CALL sph_probe_get_reading(const sph_world* world, sph_probe_id id,
                                                   sph_probe_reading* out);
+/**
+ * A threshold on a probe's pressure (an impact alarm): after every sph_world_step whose reading
+ * has a pressure_max of at least `pressure` Pa, the step reports SPH_EVENT_PROBE_PRESSURE_EXCEEDED
+ * (object: the probe; count: pressure_max in Pa, rounded down). 0 (the default) = no event. Acts
+ * from the next step; checkpoints carry it (format 7). Errors: INVALID_HANDLE (world; a null,
+ * stale or foreign id), INVALID_ARGUMENT (negative or not finite), WORLD_LOCKED. Nothing changes
+ * on error.
+ */
+SPH_API sph_result SPH_CALL sph_probe_set_pressure_threshold(sph_world* world, sph_probe_id id,
+                                                             float pressure);
 
 /* ---- events of the last step ------------------------------------------------------------- */
 typedef enum sph_event_type {
@@ -1523,13 +1544,19 @@ typedef enum sph_event_type {
                                             divergence solve stopped at its cap above its bound */
   SPH_EVENT_CAPACITY_GROWN = 5,          /* a source's emission grew the world; object: the
                                             source; count: the new capacity */
+  SPH_EVENT_COLLIDER_LOAD_EXCEEDED = 6,  /* the step's mean force on a collider reached its
+                                            threshold (sph_collider_set_load_threshold); object:
+                                            the collider; count: the force's magnitude, N */
+  SPH_EVENT_PROBE_PRESSURE_EXCEEDED = 7, /* a probe's peak pressure of the step reached its
+                                            threshold (sph_probe_set_pressure_threshold); object:
+                                            the probe; count: the peak pressure, Pa */
   SPH_EVENT_TYPE_FORCE32 = 0x7fffffff
 } sph_event_type;
 
 typedef struct sph_event {
   sph_event_type type;
   uint32_t count;
-  uint64_t object_bits; /* the bits of the source/sink id */
+  uint64_t object_bits; /* the bits of the source/sink/collider/probe id */
 } sph_event;
 SPH_STATIC_ASSERT(sizeof(sph_event) == 16, sph_event_size);
 

@@ -206,6 +206,8 @@ typedef enum {
   SPH_EVENT_PRESSURE_SOLVE_CAPPED = 3,
   SPH_EVENT_DIVERGENCE_SOLVE_CAPPED = 4,
   SPH_EVENT_CAPACITY_GROWN = 5,
+  SPH_EVENT_COLLIDER_LOAD_EXCEEDED = 6,
+  SPH_EVENT_PROBE_PRESSURE_EXCEEDED = 7,
   SPH_EVENT_TYPE_FORCE32 = 2147483647,
 } sph_event_type;
 
@@ -647,6 +649,7 @@ sph_result sph_collider_get_material(const sph_world* world, sph_collider_id id,
 sph_result sph_collider_loads_init_sized(sph_collider_loads* loads, uint32_t size);
 sph_result sph_collider_get_loads(const sph_world* world, sph_collider_id id, sph_collider_loads* out);
 sph_result sph_collider_set_load_point(sph_world* world, sph_collider_id id, const sph_vec3* point);
+sph_result sph_collider_set_load_threshold(sph_world* world, sph_collider_id id, float force);
 sph_result sph_source_def_init_sized(sph_source_def* def, uint32_t size);
 sph_result sph_source_create(sph_world* world, const sph_source_def* def, sph_source_id* out_id);
 sph_result sph_source_destroy(sph_world* world, sph_source_id id);
@@ -663,6 +666,7 @@ sph_result sph_probe_create(sph_world* world, const sph_probe_def* def, sph_prob
 sph_result sph_probe_destroy(sph_world* world, sph_probe_id id);
 sph_result sph_probe_reading_init_sized(sph_probe_reading* reading, uint32_t size);
 sph_result sph_probe_get_reading(const sph_world* world, sph_probe_id id, sph_probe_reading* out);
+sph_result sph_probe_set_pressure_threshold(sph_world* world, sph_probe_id id, float pressure);
 sph_result sph_world_get_events(const sph_world* world, sph_event* events, uint32_t capacity, uint32_t* out_count);
 sph_result sph_world_get_removed_ids(const sph_world* world, uint32_t* ids, uint32_t capacity, uint32_t* out_count);
 sph_result sph_world_save(const sph_world* world, void* buffer, uint64_t buffer_size, uint64_t* out_size);

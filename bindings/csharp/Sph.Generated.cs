@@ -477,6 +477,16 @@ namespace Sph
         DivergenceSolveCapped = 4,
         /// <summary>a source's emission grew the world; object: the source; count: the new capacity</summary>
         CapacityGrown = 5,
+        /// <summary>
+        /// the step's mean force on a collider reached its threshold (sph_collider_set_load_threshold);
+        /// object: the collider; count: the force's magnitude, N
+        /// </summary>
+        ColliderLoadExceeded = 6,
+        /// <summary>
+        /// a probe's peak pressure of the step reached its threshold
+        /// (sph_probe_set_pressure_threshold); object: the probe; count: the peak pressure, Pa
+        /// </summary>
+        ProbePressureExceeded = 7,
     }
 
     /// <summary>
@@ -2022,7 +2032,7 @@ namespace Sph
         public EventType Type;
         /// <summary>uint32_t count</summary>
         public uint Count;
-        /// <summary>uint64_t object_bits: the bits of the source/sink id</summary>
+        /// <summary>uint64_t object_bits: the bits of the source/sink/collider/probe id</summary>
         public ulong ObjectBits;
     }
 
@@ -2923,6 +2933,20 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_set_load_point")]
         public static extern Result sph_collider_set_load_point(IntPtr world, ColliderId id, IntPtr point);
 
+        /// <summary>
+        /// A threshold on a collider's loads, for engines that react to a hit rather than poll: after
+        /// every sph_world_step whose mean force on the collider (sph_collider_loads.force) has a
+        /// magnitude of at least `force` newtons, the step reports SPH_EVENT_COLLIDER_LOAD_EXCEEDED
+        /// (object: the collider; count: the magnitude in N, rounded down). 0 (the default) = no event.
+        /// Acts from the next step; checkpoints carry it (format 7). Errors: INVALID_HANDLE,
+        /// INVALID_ARGUMENT (negative or not finite), FEATURE_DISABLED, WORLD_LOCKED. Nothing changes
+        /// on error.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_collider_set_load_threshold(WorldHandle world, ColliderId id, float force);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_set_load_threshold")]
+        public static extern Result sph_collider_set_load_threshold(IntPtr world, ColliderId id, float force);
+
         /// <summary>sph_source_def_init_sized</summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_source_def_init_sized(ref SourceDef def, uint size);
@@ -3009,8 +3033,8 @@ namespace Sph
         /// length not &gt; 0 or too many steps, a negative sample_spacing, non-zero reserved0, each
         /// named), UNSUPPORTED (an unknown kind or sampling; a world of the DFSPH solver, whose substep
         /// does not sample probes), VERSION_MISMATCH, CAPACITY (65536 probes), WORLD_LOCKED. Nothing
-        /// changes on error. Probes are not carried by checkpoints: sph_world_restore keeps the world's
-        /// own, a world made by sph_world_load has none (docs/api.md).
+        /// changes on error. Checkpoints of format 6 and later carry the probes (readings start again);
+        /// restoring an older one keeps the world's own (docs/api.md).
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_probe_create(WorldHandle world, ref ProbeDef def, out ProbeId outId);
@@ -3042,6 +3066,19 @@ namespace Sph
         public static extern Result sph_probe_get_reading(WorldHandle world, ProbeId id, ref ProbeReading @out);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_probe_get_reading")]
         public static extern Result sph_probe_get_reading(IntPtr world, ProbeId id, IntPtr @out);
+
+        /// <summary>
+        /// A threshold on a probe's pressure (an impact alarm): after every sph_world_step whose
+        /// reading has a pressure_max of at least `pressure` Pa, the step reports
+        /// SPH_EVENT_PROBE_PRESSURE_EXCEEDED (object: the probe; count: pressure_max in Pa, rounded
+        /// down). 0 (the default) = no event. Acts from the next step; checkpoints carry it (format 7).
+        /// Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (negative or
+        /// not finite), WORLD_LOCKED. Nothing changes on error.
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_probe_set_pressure_threshold(WorldHandle world, ProbeId id, float pressure);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_probe_set_pressure_threshold")]
+        public static extern Result sph_probe_set_pressure_threshold(IntPtr world, ProbeId id, float pressure);
 
         /// <summary>
         /// Events of the last sph_world_step (two-call pattern): writes up to `capacity` events and
@@ -4277,6 +4314,7 @@ namespace Sph
             "sph_collider_loads_init_sized",
             "sph_collider_get_loads",
             "sph_collider_set_load_point",
+            "sph_collider_set_load_threshold",
             "sph_source_def_init_sized",
             "sph_source_create",
             "sph_source_destroy",
@@ -4293,6 +4331,7 @@ namespace Sph
             "sph_probe_destroy",
             "sph_probe_reading_init_sized",
             "sph_probe_get_reading",
+            "sph_probe_set_pressure_threshold",
             "sph_world_get_events",
             "sph_world_get_removed_ids",
             "sph_world_save",
@@ -4315,6 +4354,8 @@ namespace Sph
         };
         /// <summary>The shared library of each function ("sph", or an optional helper).</summary>
         public static readonly string[] FunctionLibraries = {
+            "sph",
+            "sph",
             "sph",
             "sph",
             "sph",
@@ -4534,6 +4575,8 @@ namespace Sph
             { "SPH_EVENT_PRESSURE_SOLVE_CAPPED", "DFSPH; object: none (0); count: substeps whose density solve stopped at max_iterations above its bound" },
             { "SPH_EVENT_DIVERGENCE_SOLVE_CAPPED", "DFSPH; object: none (0); count: substeps whose divergence solve stopped at its cap above its bound" },
             { "SPH_EVENT_CAPACITY_GROWN", "a source's emission grew the world; object: the source; count: the new capacity" },
+            { "SPH_EVENT_COLLIDER_LOAD_EXCEEDED", "the step's mean force on a collider reached its threshold (sph_collider_set_load_threshold); object: the collider; count: the force's magnitude, N" },
+            { "SPH_EVENT_PROBE_PRESSURE_EXCEEDED", "a probe's peak pressure of the step reached its threshold (sph_probe_set_pressure_threshold); object: the probe; count: the peak pressure, Pa" },
         };
     }
 }

@@ -1030,7 +1030,7 @@ namespace Sph
             return new ForceField(this, id);
         }
 
-        /// <summary>Events of the last Step (source capacity reached, particles removed by sinks).</summary>
+        /// <summary>Events of the last Step (sources at capacity, sink removals, growths, capped solves, load and pressure thresholds).</summary>
         public Event[] GetEvents()
         {
             uint n;
@@ -1386,6 +1386,14 @@ namespace Sph
             SphException.Check(Native.sph_collider_set_load_point(World.Handle, Id, ref point), "sph_collider_set_load_point");
         }
 
+        /// <summary>After each Step whose mean force on the collider reaches <paramref name="force"/>
+        /// newtons, the step reports an EventType.ColliderLoadExceeded event (count: the force in N);
+        /// 0 = none.</summary>
+        public void SetLoadThreshold(float force)
+        {
+            SphException.Check(Native.sph_collider_set_load_threshold(World.Handle, Id, force), "sph_collider_set_load_threshold");
+        }
+
         /// <summary>Removes the collider (idempotent).</summary>
         public void Dispose()
         {
@@ -1450,6 +1458,13 @@ namespace Sph
                 SphException.Check(Native.sph_probe_get_reading(World.Handle, Id, ref r), "sph_probe_get_reading");
                 return r;
             }
+        }
+
+        /// <summary>After each Step whose reading's PressureMax reaches <paramref name="pressure"/> Pa,
+        /// the step reports an EventType.ProbePressureExceeded event (count: the peak in Pa); 0 = none.</summary>
+        public void SetPressureThreshold(float pressure)
+        {
+            SphException.Check(Native.sph_probe_set_pressure_threshold(World.Handle, Id, pressure), "sph_probe_set_pressure_threshold");
         }
 
         public void Dispose()

@@ -59,4 +59,16 @@ SPH_API sph_result SPH_CALL sph_collider_set_load_point(sph_world* world, sph_co
   });
 }
 
+SPH_API sph_result SPH_CALL sph_collider_set_load_threshold(sph_world* world, sph_collider_id id,
+                                                            float force) {
+  return sph::guarded("sph_collider_set_load_threshold", sph::context_of(world), [&] {
+    sph::require_world(world);
+    sph::WorldLock lock(world);
+    world->world->collider(id.bits);  // the handle first: a stale id is INVALID_HANDLE
+    require_loads(world);
+    world->world->set_collider_load_threshold(id.bits, force);
+    return SPH_OK;
+  });
+}
+
 }  // extern "C"

@@ -94,4 +94,14 @@ SPH_API sph_result SPH_CALL sph_probe_get_reading(const sph_world* world, sph_pr
   });
 }
 
+SPH_API sph_result SPH_CALL sph_probe_set_pressure_threshold(sph_world* world, sph_probe_id id,
+                                                             float pressure) {
+  return sph::guarded("sph_probe_set_pressure_threshold", sph::context_of(world), [&] {
+    sph::require_world(world);
+    sph::WorldLock lock(world);
+    world->world->set_probe_pressure_threshold(id.bits, pressure);
+    return SPH_OK;
+  });
+}
+
 }  // extern "C"

@@ -28,6 +28,23 @@ namespace {
 using namespace checkpoint;
 using namespace checkpoint_read;
 
+// The event types a library of checkpoint format `version` could report.
+bool event_type_known(uint32_t type, uint32_t version) {
+  switch (static_cast<EventType>(type)) {
+    case EventType::SourceCapacityReached:
+    case EventType::SinkRemoved:
+    case EventType::PressureSolveCapped:
+    case EventType::DivergenceSolveCapped:
+      return true;
+    case EventType::CapacityGrown:
+      return version >= kFirstGrowableVersion;
+    case EventType::ColliderLoadExceeded:
+    case EventType::ProbePressureExceeded:
+      return version >= kFirstThresholdVersion;
+  }
+  return false;
+}
+
 WorldConfig read_config(ByteReader& r, uint32_t version) {
   WorldConfig c;
   c.capacity = r.u32();
@@ -182,12 +199,7 @@ Clock read_clock(ByteReader& r, uint32_t version) {
   c.events.resize(events);
   for (Event& e : c.events) {
     const uint32_t type = r.u32();
-    if (type != static_cast<uint32_t>(EventType::SourceCapacityReached) &&
-        type != static_cast<uint32_t>(EventType::SinkRemoved) &&
-        type != static_cast<uint32_t>(EventType::PressureSolveCapped) &&
-        type != static_cast<uint32_t>(EventType::DivergenceSolveCapped) &&
-        (type != static_cast<uint32_t>(EventType::CapacityGrown) || version < kFirstGrowableVersion))
-      corrupt(r.what() + ": unknown event type " + std::to_string(type));
+    if (!event_type_known(type, version)) corrupt(r.what() + ": unknown event type " + std::to_string(type));
     e.type = static_cast<EventType>(type);
     e.count = r.u32();
     e.object_id = r.u64();
@@ -367,7 +379,7 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   SlotTable<Probe> probes;
   if (version >= kFirstProbeVersion) {
     ByteReader prob = next_section(9);
-    probes = read_checkpoint_probes(prob, config);
+    probes = read_checkpoint_probes(prob, config, version);
     prob.expect_end();
   }
   payload.expect_end();

@@ -140,15 +140,18 @@ Collider read_collider(ByteReader& r, const Assets& assets, uint32_t version, co
   spec.inverted = flag(r, name + " inverted") != 0;
   Vec3 load_point{0.0f, 0.0f, 0.0f};
   if (version >= kFirstProbeVersion) load_point = finite_vec3(r, name + " load point");
+  const float load_threshold =
+      version >= kFirstThresholdVersion ? non_negative(r, name + " load threshold") : 0.0f;
   Collider c = by_scene_rules(r, name, [&] { return make_collider(spec); });
   if (target) by_scene_rules(r, name, [&] { require_pose(*target, "target"); });
   c.target = target;
   c.load_point = load_point;
+  c.load_threshold = load_threshold;
   return c;
 }
 
 // The rules of World::add_probe (world_probes.cpp) on what the file holds.
-Probe read_probe(ByteReader& r, const std::string& name) {
+Probe read_probe(ByteReader& r, uint32_t version, const std::string& name) {
   Probe p;
   p.gauge = flag(r, name + " gauge") != 0;
   p.every_substep = flag(r, name + " every substep") != 0;
@@ -162,6 +165,7 @@ Probe read_probe(ByteReader& r, const std::string& name) {
   if (p.gauge ? !(p.length > 0.0f) || p.sample_count == 0 || p.sample_count > kMaxGaugeSamples
               : p.length != 0.0f || p.sample_count != 1u || d2 != 0.0f)
     corrupt(r.what() + ": " + name + " has a length or sample count its kind does not allow");
+  if (version >= kFirstThresholdVersion) p.pressure_threshold = non_negative(r, name + " pressure threshold");
   return p;
 }
 
@@ -246,9 +250,9 @@ SlotTable<ForceField> read_checkpoint_force_fields(ByteReader& r, const Checkpoi
       r, [&](const std::string& n) { return read_force_field(r, assets, "force field " + n); });
 }
 
-SlotTable<Probe> read_checkpoint_probes(ByteReader& r, const WorldConfig& config) {
+SlotTable<Probe> read_checkpoint_probes(ByteReader& r, const WorldConfig& config, uint32_t version) {
   SlotTable<Probe> t =
-      read_slots<Probe>(r, [&](const std::string& n) { return read_probe(r, "probe " + n); });
+      read_slots<Probe>(r, [&](const std::string& n) { return read_probe(r, version, "probe " + n); });
   if (config.solver == Solver::Dfsph)
     for (const auto& value : t.values)
       if (value) corrupt(r.what() + ": a DFSPH world has no probes (World::add_probe refuses them)");

@@ -226,6 +226,7 @@ HostVector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin&
       w.f32(c.material.stickiness);
       w.u32(c.inverted ? 1u : 0u);
       write_vec3(w, c.load_point);
+      w.f32(c.load_threshold);
     });
   });
   section(w, kSectionOrder[6].tag, [&] {
@@ -274,6 +275,7 @@ HostVector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin&
       write_vec3(w, p.direction);
       w.f32(p.length);
       w.u32(p.sample_count);
+      w.f32(p.pressure_threshold);
     });
   });
 

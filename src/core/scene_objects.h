@@ -29,6 +29,7 @@ struct Collider {
   ColliderMaterial material;
   bool inverted = false;
   Vec3 load_point{0.0f, 0.0f, 0.0f};  // collider frame: the torque of its loads is about it
+  float load_threshold = 0.0f;        // N: a step whose mean force reaches it reports an event; 0 = none
   ColliderLoadResult loads;           // of the last step (SPH_FEATURE_COLLIDER_LOADS)
 };
 
@@ -80,6 +81,7 @@ struct Probe {
   Vec3 direction{0.0f, 0.0f, 0.0f};  // gauges: unit, or zero for "against gravity"
   float length = 0.0f;               // gauges
   uint32_t sample_count = 1;         // gauges: the column integral's steps
+  float pressure_threshold = 0.0f;   // Pa: a step whose peak pressure reaches it reports an event; 0 = none
   ProbeReading reading;
 };
 
@@ -89,7 +91,9 @@ enum class EventType : uint32_t {
   SinkRemoved = 2,
   PressureSolveCapped = 3,
   DivergenceSolveCapped = 4,
-  CapacityGrown = 5,  // object: the source whose emission grew the world; count: the new capacity
+  CapacityGrown = 5,          // object: the source whose emission grew the world; count: the new capacity
+  ColliderLoadExceeded = 6,   // object: the collider; count: its mean force's magnitude, N
+  ProbePressureExceeded = 7,  // object: the probe; count: its reading's peak pressure, Pa
 };
 
 struct Event {

@@ -200,6 +200,11 @@ SceneFrame World::build_scene_frame(double frame_dt) const {
 }
 
 namespace {
+// A threshold event's count: the magnitude rounded down, saturated at the largest count.
+uint32_t event_magnitude(float value) {
+  return value >= 4294967040.0f ? UINT32_MAX : static_cast<uint32_t>(value);
+}
+
 // A frame's impulses as time averages (zero for a frame that advanced no time).
 ColliderLoadResult load_result(const ColliderLoadSums& sums, const Collider& c, const FrameReport& report) {
   ColliderLoadResult r;
@@ -243,8 +248,8 @@ bool World::step(double frame_dt, const StepInterrupt& interrupt, const FrameEnq
   try {
     // Reserved up front, so that nothing after the backend's frame can fail on an allocation:
     // once the particles have moved, the rest of the step must not throw.
-    // + each source's growth + the solves' capped events
-    events_.reserve(2 * sources_.size() + sinks_.size() + 2);
+    // + each source's growth + the solves' capped events + the colliders' and probes' thresholds
+    events_.reserve(2 * sources_.size() + sinks_.size() + 2 + colliders_.size() + probes_.size());
     if (sources_.size() > 0) backend_->save_step_inputs();
     emit_sources(frame_dt);
     SceneFrame scene = build_scene_frame(frame_dt);
@@ -266,13 +271,23 @@ bool World::step(double frame_dt, const StepInterrupt& interrupt, const FrameEnq
     throw;
   }
   // Colliders arrive where they were sent; their loads are the frame's impulses over its time.
-  colliders_.for_each([&, index = size_t{0}](uint64_t, Collider& c) mutable {
+  colliders_.for_each([&, index = size_t{0}](uint64_t id, Collider& c) mutable {
     if (c.target) c.pose = *c.target;
     c.target.reset();
-    if (index < report.collider_loads.size()) c.loads = load_result(report.collider_loads[index], c, report);
+    if (index < report.collider_loads.size()) {
+      c.loads = load_result(report.collider_loads[index], c, report);
+      const float force = length(c.loads.force);
+      if (c.load_threshold > 0.0f && force >= c.load_threshold)
+        events_.push_back(Event{EventType::ColliderLoadExceeded, id, event_magnitude(force)});
+    }
     ++index;
   });
   store_probe_readings(report);
+  probes_.for_each([&](uint64_t id, const Probe& p) {
+    if (p.pressure_threshold > 0.0f && p.reading.samples > 0 &&
+        p.reading.pressure_max >= p.pressure_threshold)
+      events_.push_back(Event{EventType::ProbePressureExceeded, id, event_magnitude(p.reading.pressure_max)});
+  });
   sinks_.for_each([&, index = size_t{0}](uint64_t id, const Sink&) mutable {
     const uint32_t removed = index < report.removed_by_sink.size() ? report.removed_by_sink[index] : 0u;
     if (removed > 0) events_.push_back(Event{EventType::SinkRemoved, id, removed});

@@ -148,6 +148,9 @@ class World {
   void set_collider_material(uint64_t id, const ColliderMaterial& material);
   // The point (collider frame) its loads' torque is taken about; InvalidArgument if not finite.
   void set_collider_load_point(uint64_t id, Vec3 point);
+  // The force (N) whose reaching makes a step report ColliderLoadExceeded; 0 = none;
+  // InvalidArgument if negative or not finite.
+  void set_collider_load_threshold(uint64_t id, float threshold);
   void set_source_pose(uint64_t id, const RigidTransform& pose);
   void set_force_field_pose(uint64_t id, const RigidTransform& pose);
   // A live collider; Error(InvalidHandle) otherwise.
@@ -159,6 +162,9 @@ class World {
   // has none and sph_world_restore keeps the world's own (adopt_probes).
   uint64_t add_probe(const ProbeSpec& spec);
   void remove_probe(uint64_t id);
+  // The peak pressure (Pa) whose reaching makes a step report ProbePressureExceeded; 0 = none;
+  // InvalidArgument if negative or not finite.
+  void set_probe_pressure_threshold(uint64_t id, float threshold);
   // A live probe; Error(InvalidHandle) otherwise.
   const Probe& probe(uint64_t id) const;
   const SlotMap<Probe>& probes() const { return probes_; }

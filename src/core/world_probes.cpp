@@ -81,6 +81,13 @@ void World::remove_probe(uint64_t id) {
   if (!probes_.erase(id)) throw Error(Status::InvalidHandle, "id: is stale or not of this world");
 }
 
+void World::set_probe_pressure_threshold(uint64_t id, float threshold) {
+  Probe* p = probes_.find(id);
+  if (!p) throw Error(Status::InvalidHandle, "id: is null, stale or not of this world");
+  require_non_negative_field(threshold, "pressure");
+  p->pressure_threshold = threshold;
+}
+
 void World::adopt_probes(const World& from) {
   if (config_.solver == Solver::Dfsph) return;
   SlotMap<Probe> probes = from.probes_;

@@ -92,6 +92,12 @@ void World::set_collider_load_point(uint64_t id, Vec3 point) {
   c.load_point = point;
 }
 
+void World::set_collider_load_threshold(uint64_t id, float threshold) {
+  Collider& c = live(colliders_, id);
+  require_non_negative_field(threshold, "force");
+  c.load_threshold = threshold;
+}
+
 void World::set_source_pose(uint64_t id, const RigidTransform& pose) {
   Source& s = live(sources_, id);
   require_pose(pose, "transform");

@@ -384,6 +384,42 @@ void test_loads_csv(void**) {
   assert_true(f[1] < 0.0);                                                    // pressed down
 }
 
+// Threshold events (issue 17): a collider's "loads.threshold" below the water's weight and a
+// probe's "pressure_threshold" below its pressure make sph-run print a line for each frame that
+// reaches them ("sph-run: frame N: colliders[0]: ..."); thresholds no reading reaches print
+// nothing.
+void test_threshold_notices(void**) {
+  const std::string dir = cli_test::make_temp_dir("threshold_notices");
+  const std::string scene_file = dir + "/thresholds.json";
+  // 0.2 x 0.06 x 0.2 m of water weighs about 24 N and stands 6 cm: 1 N and 1 Pa are reached
+  // once it rests; 1e6 N and 1e6 Pa never.
+  const char* scene = R"({
+    "world": { "capacity": 4000, "particle_spacing": 0.02 },
+    "time": { "fps": 50, "frames": 6 },
+    "fluids": [ { "type": "box", "min": [-0.1, 0.0, -0.1], "max": [0.1, 0.06, 0.1] } ],
+    "colliders": [ { "name": "tank", "inverted": true, "loads": { "threshold": THRESHOLD },
+                     "shape": { "type": "box", "half_extents": [0.1, 0.1, 0.1], "voxel_size": 0.02 },
+                     "transform": { "position": [0, 0.1, 0] } } ],
+    "probes": [ { "type": "point", "name": "floor", "position": [0, 0.01, 0], "pressure_threshold": THRESHOLD } ],
+    "output": { "format": "csv" } })";
+  for (const char* threshold : {"1", "1e6"}) {
+    std::string text = scene;
+    for (size_t at; (at = text.find("THRESHOLD")) != std::string::npos;) text.replace(at, 9, threshold);
+    cli_test::write_text(scene_file, text);
+    std::string log;
+    const int status = cli_test::run(
+        {g_sph_run, scene_file, "--backend", "cpu", "--threads", "2", "--out", dir + "/out", "--quiet"},
+        &log);
+    std::printf("%s", log.c_str());
+    assert_int_equal(status, 0);
+    const bool low = std::string(threshold) == "1";
+    assert_true((log.find(": colliders[0]: the fluid's force ") != std::string::npos) == low);
+    assert_true((log.find(" N reached its loads.threshold") != std::string::npos) == low);
+    assert_true((log.find(": probes[0]: the peak pressure ") != std::string::npos) == low);
+    assert_true((log.find(" Pa reached its pressure_threshold") != std::string::npos) == low);
+  }
+}
+
 // Probes (issue 17 item 2): each probe of "probes" gets probe_<index>[_<name>].csv, a row per
 // frame; a point in water resting in a tank reads a density near rho0, a gauge through it the few
 // centimetres of water (the 6 cm fluid box holds three lattice layers, 4.2 cm, before it spreads
@@ -450,6 +486,7 @@ int main(int argc, char** argv) {
       cmocka_unit_test(test_writers_round_trip),
       cmocka_unit_test(test_run_outputs_equal_world),
       cmocka_unit_test(test_loads_csv),
+      cmocka_unit_test(test_threshold_notices),
       cmocka_unit_test(test_probe_csv),
       cmocka_unit_test(test_obj_vertex_normals),
 #ifdef SPH_TOOLS_HAVE_OPENVDB

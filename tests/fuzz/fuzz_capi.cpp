@@ -1119,10 +1119,19 @@ class Program {
     const sph_collider_id id{id_arg(colliders_)};
     sph_transform t = transform();
     sph_result r;
-    switch (in_.u8() % 5) {
+    switch (in_.u8() % 6) {
       case 0:
         r = FUZZ_CALL(sph_collider_destroy(w, id));
         break;
+      case 4: {
+        // A load threshold (any world: FEATURE_DISABLED without the loads bit), then a step
+        // reports it or not; negative and non-finite values must be refused.
+        const float force = in_.maybe_hostile(0.0f, 100.0f);
+        r = FUZZ_CALL(sph_collider_set_load_threshold(w, id, force));
+        if (r == SPH_OK && !(force >= 0.0f && std::isfinite(force)))
+          violation("sph_collider_set_load_threshold accepted a negative or non-finite threshold");
+        break;
+      }
       case 1:
         r = FUZZ_CALL(sph_collider_set_target_transform(w, id, in_.chance(8) ? nullptr : &t));
         break;

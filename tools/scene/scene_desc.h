@@ -59,6 +59,7 @@ struct ColliderDesc {
   float restitution = 0.0f, friction = 0.0f, stickiness = 0.0f;
   bool loads = false;     // "loads": its force and torque are written per frame (a CSV)
   sph_vec3 load_point{};  // the torque's point, in the collider's frame
+  float load_threshold = 0.0f;  // N: a frame whose force reaches it is reported; 0 = never
   std::string path;
 };
 
@@ -95,6 +96,7 @@ struct ProbeDesc {
   sph_vec3 direction{};  // gauge; zero = up (against gravity)
   float length = 0.0f;   // gauge
   float sample_spacing = 0.0f;
+  float pressure_threshold = 0.0f;  // Pa: a frame whose peak pressure reaches it is reported; 0 = never
   std::string path;
 };
 

@@ -63,9 +63,12 @@ SceneRuntime::SceneRuntime(const SceneDesc& scene, sph_context* context) : scene
       def.friction = c.friction;
       def.stickiness = c.stickiness;
       check_object(sph_collider_create(world_, &def, &colliders_.back().id), c.path, "collider");
-      if (c.loads)
+      if (c.loads) {
         check_object(sph_collider_set_load_point(world_, colliders_.back().id, &c.load_point),
                      c.path + ".loads", "load point");
+        check_object(sph_collider_set_load_threshold(world_, colliders_.back().id, c.load_threshold),
+                     c.path + ".loads.threshold", "load threshold");
+      }
     }
     for (const SinkDesc& s : scene.sinks) {
       sph_sink_def def;
@@ -93,6 +96,8 @@ SceneRuntime::SceneRuntime(const SceneDesc& scene, sph_context* context) : scene
       def.sample_spacing = p.sample_spacing;
       probes_.push_back(sph_probe_id{0});
       check_object(sph_probe_create(world_, &def, &probes_.back()), p.path, "probe");
+      check_object(sph_probe_set_pressure_threshold(world_, probes_.back(), p.pressure_threshold),
+                   p.path + ".pressure_threshold", "pressure threshold");
     }
     sources_.resize(scene.sources.size());
     fields_.resize(scene.force_fields.size());
@@ -244,11 +249,26 @@ void SceneRuntime::apply_schedule(double t, double next_t) {
 
 void SceneRuntime::collect_events() {
   warnings_.clear();
+  notices_.clear();
   uint32_t count = 0;
   if (sph_world_get_events(world_, nullptr, 0, &count) < 0 || count == 0) return;
   std::vector<sph_event> events(count);
   sph_world_get_events(world_, events.data(), count, &count);
   for (const sph_event& e : events) {
+    if (e.type == SPH_EVENT_COLLIDER_LOAD_EXCEEDED) {
+      for (size_t i = 0; i < colliders_.size(); ++i)
+        if (colliders_[i].id.bits == e.object_bits)
+          notices_.push_back(colliders_[i].desc->path + ": the fluid's force " + std::to_string(e.count) +
+                             " N reached its loads.threshold");
+      continue;
+    }
+    if (e.type == SPH_EVENT_PROBE_PRESSURE_EXCEEDED) {
+      for (size_t i = 0; i < probes_.size(); ++i)
+        if (probes_[i].bits == e.object_bits)
+          notices_.push_back(scene_.probes[i].path + ": the peak pressure " + std::to_string(e.count) +
+                             " Pa reached its pressure_threshold");
+      continue;
+    }
     if (e.type != SPH_EVENT_SOURCE_CAPACITY_REACHED) continue;
     std::string path = "sources";
     for (size_t i = 0; i < sources_.size(); ++i)

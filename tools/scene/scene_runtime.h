@@ -45,6 +45,8 @@ class SceneRuntime {
 
   // Warnings of the last step_frame (a source that reached the capacity), for the user.
   const std::vector<std::string>& warnings() const { return warnings_; }
+  // The last frame's threshold events (colliders' loads, probes' pressure), as sentences.
+  const std::vector<std::string>& notices() const { return notices_; }
 
  private:
   void destroy_all();
@@ -85,6 +87,7 @@ class SceneRuntime {
   };
   std::vector<ForceField> fields_;
   std::vector<std::string> warnings_;
+  std::vector<std::string> notices_;
 };
 
 }  // namespace sph_tools

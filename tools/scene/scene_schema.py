@@ -119,10 +119,11 @@ def build():
     ]
     sampling = {"enum": ["frame", "substep"]}
     probe = [
-        obj({"type": const_type("point"), "name": STRING, "position": VEC3, "sampling": sampling},
-            ["type", "position"]),
+        obj({"type": const_type("point"), "name": STRING, "position": VEC3, "sampling": sampling,
+             "pressure_threshold": NON_NEGATIVE}, ["type", "position"]),
         obj({"type": const_type("gauge"), "name": STRING, "position": VEC3, "direction": VEC3, "length": POSITIVE,
-             "sample_spacing": POSITIVE, "sampling": sampling}, ["type", "position", "length"]),
+             "sample_spacing": POSITIVE, "sampling": sampling, "pressure_threshold": NON_NEGATIVE},
+            ["type", "position", "length"]),
     ]
     tagged = lambda variants, what: {  # noqa: E731
         "type": "object", "required": ["type"], "description": what,
@@ -184,7 +185,7 @@ def build():
             "colliders": {"type": "array", "items": obj({
                 "name": STRING, "shape": {"$ref": "#/definitions/shape"}, **placed, "inverted": BOOLEAN,
                 "restitution": {"type": "number", "minimum": 0, "maximum": 1}, "friction": NON_NEGATIVE,
-                "stickiness": NON_NEGATIVE, "loads": obj({"point": VEC3})}, ["shape"])},
+                "stickiness": NON_NEGATIVE, "loads": obj({"point": VEC3, "threshold": NON_NEGATIVE})}, ["shape"])},
             "sources": {"type": "array", "items": obj({
                 "name": STRING, "shape": {"$ref": "#/definitions/shape"}, **placed,
                 "mode": {"enum": ["once", "continuous"]}, "velocity": VEC3, "spacing": POSITIVE,

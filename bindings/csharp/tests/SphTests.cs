@@ -921,6 +921,7 @@ static class Tests
                 var c = world.CreateCollider(floor, Transform.Default());
                 Throws(Result.ErrorFeatureDisabled, () => { var l = c.Loads; });
                 Throws(Result.ErrorFeatureDisabled, () => c.SetLoadPoint(new Vec3(0, 0, 0)));
+                Throws(Result.ErrorFeatureDisabled, () => c.SetLoadThreshold(1.0f));
             }
             var d = SmallWorld();
             d.FeatureFlags = FeatureFlags.ColliderLoads;
@@ -936,6 +937,16 @@ static class Tests
                 Assert(Math.Abs(loads.Force.Y + weight) < 0.3f * weight, "the floor carries the weight: " + loads.Force.Y);
                 Assert(Math.Abs(loads.Torque.Z + 0.1f * loads.Force.Y) < 0.2f * Math.Abs(0.1f * loads.Force.Y),
                        "torque about the load point: " + loads.Torque.Z);
+                // A threshold below the force reports the step, one above it nothing.
+                Throws(Result.ErrorInvalidArgument, () => c.SetLoadThreshold(-1.0f));
+                c.SetLoadThreshold(0.5f * weight);
+                world.Step(1f / 60f);
+                var hits = Array.FindAll(world.GetEvents(), e => e.Type == EventType.ColliderLoadExceeded);
+                Assert(hits.Length == 1 && hits[0].ObjectBits == c.Id.Bits && hits[0].Count > 0, "load threshold event");
+                c.SetLoadThreshold(10.0f * weight);
+                world.Step(1f / 60f);
+                Assert(Array.FindAll(world.GetEvents(), e => e.Type == EventType.ColliderLoadExceeded).Length == 0,
+                       "no event above the force");
             }
         }
     }

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '36d518451bcbab0bd257cee1b31d9725affdbb094e8340a601fc802b4cfbbe50', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '9512829c65c6746f57aba9cfc3d0436e66516e348e2b3a814c7aa7f931b16aad', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -580,6 +580,8 @@ SPH_EVENT_SINK_REMOVED = 2  # object: the sink; count: particles removed
 SPH_EVENT_PRESSURE_SOLVE_CAPPED = 3  # DFSPH; object: none (0); count: substeps whose density solve stopped at max_iterations above its bound
 SPH_EVENT_DIVERGENCE_SOLVE_CAPPED = 4  # DFSPH; object: none (0); count: substeps whose divergence solve stopped at its cap above its bound
 SPH_EVENT_CAPACITY_GROWN = 5  # a source's emission grew the world; object: the source; count: the new capacity
+SPH_EVENT_COLLIDER_LOAD_EXCEEDED = 6  # the step's mean force on a collider reached its threshold (sph_collider_set_load_threshold); object: the collider; count: the force's magnitude, N
+SPH_EVENT_PROBE_PRESSURE_EXCEEDED = 7  # a probe's peak pressure of the step reached its threshold (sph_probe_set_pressure_threshold); object: the probe; count: the peak pressure, Pa
 SPH_EVENT_TYPE_FORCE32 = 2147483647
 
 
@@ -597,6 +599,12 @@ class EventType(_enum.IntEnum):
     DIVERGENCE_SOLVE_CAPPED = 4
     #: a source's emission grew the world; object: the source; count: the new capacity
     CAPACITY_GROWN = 5
+    #: the step's mean force on a collider reached its threshold (sph_collider_set_load_threshold);
+    #: object: the collider; count: the force's magnitude, N
+    COLLIDER_LOAD_EXCEEDED = 6
+    #: a probe's peak pressure of the step reached its threshold
+    #: (sph_probe_set_pressure_threshold); object: the probe; count: the peak pressure, Pa
+    PROBE_PRESSURE_EXCEEDED = 7
 
 
 #: Doc text of every enum member, by C name (e.g. the element format of an attribute).
@@ -693,6 +701,8 @@ ENUM_MEMBER_DOCS = {
     'SPH_EVENT_PRESSURE_SOLVE_CAPPED': 'DFSPH; object: none (0); count: substeps whose density solve stopped at max_iterations above its bound',
     'SPH_EVENT_DIVERGENCE_SOLVE_CAPPED': 'DFSPH; object: none (0); count: substeps whose divergence solve stopped at its cap above its bound',
     'SPH_EVENT_CAPACITY_GROWN': "a source's emission grew the world; object: the source; count: the new capacity",
+    'SPH_EVENT_COLLIDER_LOAD_EXCEEDED': "the step's mean force on a collider reached its threshold (sph_collider_set_load_threshold); object: the collider; count: the force's magnitude, N",
+    'SPH_EVENT_PROBE_PRESSURE_EXCEEDED': "a probe's peak pressure of the step reached its threshold (sph_probe_set_pressure_threshold); object: the probe; count: the peak pressure, Pa",
 }
 
 # ---- type aliases -----------------------------------------------------------------------------
@@ -1922,7 +1932,7 @@ class Event(_SphStruct):
     Fields:
         type (sph_event_type)
         count (uint32_t)
-        object_bits (uint64_t): the bits of the source/sink id
+        object_bits (uint64_t): the bits of the source/sink/collider/probe id
     """
     _fields_ = [
         ('type', sph_event_type),
@@ -2195,6 +2205,8 @@ FUNCTIONS = {
         "Reads a collider's loads of the last step. Non-blocking (the step brought them to the host). out->struct_size must be set (sph_collider_loads_init); only that many bytes are written. Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (NULL out), VERSION_MISMATCH, FEATURE_DISABLED (the world lacks SPH_FEATURE_COLLIDER_LOADS), WORLD_LOCKED.", 'sph'),
     'sph_collider_set_load_point': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_vec3)), ('world', 'id', 'point'),
         "Sets the point, in the collider's own frame, that its loads' torque is taken about (default its origin; an engine passes the body's centre of mass). Acts from the next step. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL point; a non-finite component, named), FEATURE_DISABLED, WORLD_LOCKED. Nothing changes on error.", 'sph'),
+    'sph_collider_set_load_threshold': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.c_float), ('world', 'id', 'force'),
+        "A threshold on a collider's loads, for engines that react to a hit rather than poll: after every sph_world_step whose mean force on the collider (sph_collider_loads.force) has a magnitude of at least `force` newtons, the step reports SPH_EVENT_COLLIDER_LOAD_EXCEEDED (object: the collider; count: the magnitude in N, rounded down). 0 (the default) = no event. Acts from the next step; checkpoints carry it (format 7). Errors: INVALID_HANDLE, INVALID_ARGUMENT (negative or not finite), FEATURE_DISABLED, WORLD_LOCKED. Nothing changes on error.", 'sph'),
     'sph_source_def_init_sized': (sph_result, (_c.POINTER(sph_source_def), _c.c_uint32), ('def', 'size'),
         '', 'sph'),
     'sph_source_create': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_source_def), _c.POINTER(sph_source_id)), ('world', 'def', 'out_id'),
@@ -2220,13 +2232,15 @@ FUNCTIONS = {
     'sph_probe_def_init_sized': (sph_result, (_c.POINTER(sph_probe_def), _c.c_uint32), ('def', 'size'),
         '', 'sph'),
     'sph_probe_create': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_probe_def), _c.POINTER(sph_probe_id)), ('world', 'def', 'out_id'),
-        "Adds a probe or gauge; it is sampled inside every following sph_world_step on the world's backend (on the device for CUDA, with no host copy per substep). Errors: INVALID_HANDLE (world), INVALID_ARGUMENT (NULL def or out_id; a non-finite position or direction, a gauge's length not > 0 or too many steps, a negative sample_spacing, non-zero reserved0, each named), UNSUPPORTED (an unknown kind or sampling; a world of the DFSPH solver, whose substep does not sample probes), VERSION_MISMATCH, CAPACITY (65536 probes), WORLD_LOCKED. Nothing changes on error. Probes are not carried by checkpoints: sph_world_restore keeps the world's own, a world made by sph_world_load has none (docs/api.md).", 'sph'),
+        "Adds a probe or gauge; it is sampled inside every following sph_world_step on the world's backend (on the device for CUDA, with no host copy per substep). Errors: INVALID_HANDLE (world), INVALID_ARGUMENT (NULL def or out_id; a non-finite position or direction, a gauge's length not > 0 or too many steps, a negative sample_spacing, non-zero reserved0, each named), UNSUPPORTED (an unknown kind or sampling; a world of the DFSPH solver, whose substep does not sample probes), VERSION_MISMATCH, CAPACITY (65536 probes), WORLD_LOCKED. Nothing changes on error. Checkpoints of format 6 and later carry the probes (readings start again); restoring an older one keeps the world's own (docs/api.md).", 'sph'),
     'sph_probe_destroy': (sph_result, (_c.POINTER(sph_world), sph_probe_id), ('world', 'id'),
         'Removes a probe; id {0} is a no-op. Errors: INVALID_HANDLE (world; stale or foreign id), WORLD_LOCKED.', 'sph'),
     'sph_probe_reading_init_sized': (sph_result, (_c.POINTER(sph_probe_reading), _c.c_uint32), ('reading', 'size'),
         '', 'sph'),
     'sph_probe_get_reading': (sph_result, (_c.POINTER(sph_world), sph_probe_id, _c.POINTER(sph_probe_reading)), ('world', 'id', 'out'),
         "Reads a probe's reading of the last step. Non-blocking (the step brought it to the host). out->struct_size must be set (sph_probe_reading_init); only that many bytes are written. Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (NULL out), VERSION_MISMATCH, WORLD_LOCKED.", 'sph'),
+    'sph_probe_set_pressure_threshold': (sph_result, (_c.POINTER(sph_world), sph_probe_id, _c.c_float), ('world', 'id', 'pressure'),
+        "A threshold on a probe's pressure (an impact alarm): after every sph_world_step whose reading has a pressure_max of at least `pressure` Pa, the step reports SPH_EVENT_PROBE_PRESSURE_EXCEEDED (object: the probe; count: pressure_max in Pa, rounded down). 0 (the default) = no event. Acts from the next step; checkpoints carry it (format 7). Errors: INVALID_HANDLE (world; a null, stale or foreign id), INVALID_ARGUMENT (negative or not finite), WORLD_LOCKED. Nothing changes on error.", 'sph'),
     'sph_world_get_events': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_event), _c.c_uint32, _c.POINTER(_c.c_uint32)), ('world', 'events', 'capacity', 'out_count'),
         'Events of the last sph_world_step (two-call pattern): writes up to `capacity` events and sets *out_count to the number there are; SPH_INCOMPLETE when capacity was too small. events may be NULL when capacity is 0.', 'sph'),
     'sph_world_get_removed_ids': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_uint32), _c.c_uint32, _c.POINTER(_c.c_uint32)), ('world', 'ids', 'capacity', 'out_count'),

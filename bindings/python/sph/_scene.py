@@ -320,6 +320,13 @@ class Collider(_WorldObject):
         check(library().sph_collider_set_load_point(self.world.handle, self.id, ctypes.byref(p)),
               "sph_collider_set_load_point")
 
+    def set_load_threshold(self, force):
+        """After each step whose mean force on the collider reaches ``force`` newtons, the step
+        reports a COLLIDER_LOAD_EXCEEDED event (count: the force in N); 0 = none
+        (sph_collider_set_load_threshold)."""
+        check(library().sph_collider_set_load_threshold(self.world.handle, self.id, float(force)),
+              "sph_collider_set_load_threshold")
+
 
 class Source(_WorldObject):
     """Emits particles where its region SDF is negative (World.add_source)."""
@@ -367,6 +374,13 @@ class Probe(_WorldObject):
         check(library().sph_probe_get_reading(self.world.handle, self.id, ctypes.byref(r)),
               "sph_probe_get_reading")
         return r
+
+    def set_pressure_threshold(self, pressure):
+        """After each step whose reading's pressure_max reaches ``pressure`` Pa, the step reports a
+        PROBE_PRESSURE_EXCEEDED event (count: the peak in Pa); 0 = none
+        (sph_probe_set_pressure_threshold)."""
+        check(library().sph_probe_set_pressure_threshold(self.world.handle, self.id, float(pressure)),
+              "sph_probe_set_pressure_threshold")
 
 
 # ---- World methods --------------------------------------------------------------------------------
@@ -451,7 +465,7 @@ class WorldSceneMixin:
 
     def events(self):
         """Events of the last step as a list of Event (type: EventType, count, object_bits;
-        compare object_bits with a Source's or Sink's .bits) (sph_world_get_events)."""
+        compare object_bits with a Source's, Sink's, Collider's or Probe's .bits) (sph_world_get_events)."""
         n = ctypes.c_uint32()
         lib = library()
         check(lib.sph_world_get_events(self.handle, None, 0, ctypes.byref(n)), "sph_world_get_events")

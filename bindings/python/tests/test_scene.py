@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: MIT
 """SDF assets, colliders, sources, sinks, force fields and events."""
 import ctypes
+import math
 
 import numpy as np
 import pytest
@@ -327,6 +328,7 @@ def test_collider_loads(ctx):
             tank = plain.add_collider(box, (0.05, 0.05, 0.05), inverted=True)
             assert error(lambda: tank.loads) == sph.Result.ERROR_FEATURE_DISABLED
             assert error(tank.set_load_point, (0, 0, 0)) == sph.Result.ERROR_FEATURE_DISABLED
+            assert error(tank.set_load_threshold, 1.0) == sph.Result.ERROR_FEATURE_DISABLED
         with ctx.world(capacity=256, particle_spacing=0.02, features="collider_loads") as world:
             tank = world.add_collider(box, (0.05, 0.05, 0.05), inverted=True)
             assert tank.loads.frame_time == 0.0
@@ -341,3 +343,14 @@ def test_collider_loads(ctx):
             assert loads.force.y == pytest.approx(-weight, rel=0.3)  # settling: within 30 % per frame
             # The weight's line is at x = 0.05, 5 cm to -x of the point: tau_z = -0.05 * F_y.
             assert loads.torque.z == pytest.approx(-0.05 * loads.force.y, rel=0.2)
+            # A threshold below the force reports the step; above it, nothing; bad values refused.
+            assert error(tank.set_load_threshold, -1.0) == sph.Result.ERROR_INVALID_ARGUMENT
+            tank.set_load_threshold(0.5 * weight)
+            world.step(0.02)
+            force = math.sqrt(tank.loads.force.x ** 2 + tank.loads.force.y ** 2 + tank.loads.force.z ** 2)
+            hits = [e for e in world.events() if e.type == sph.EventType.COLLIDER_LOAD_EXCEEDED]
+            assert len(hits) == 1 and hits[0].object_bits == tank.bits
+            assert math.floor(force) - 1 <= hits[0].count <= math.floor(force)
+            tank.set_load_threshold(10.0 * weight)
+            world.step(0.02)
+            assert not [e for e in world.events() if e.type == sph.EventType.COLLIDER_LOAD_EXCEEDED]
