@@ -355,7 +355,7 @@ static void usage(void) {
 
 int main(int argc, char** argv) {
   options o = {100000, 0, "none", 100, 3, SPH_BACKEND_AUTO, "both", NULL, NULL, NULL, SPH_CUDA_FRAMES_GRAPH,
-               0,      0, 0};
+               0,      0, 0,      0};
   for (int i = 1; i < argc; ++i) {
     const char* a = argv[i];
     const char* v = i + 1 < argc ? argv[i + 1] : NULL;
