@@ -59,9 +59,6 @@ __global__ void user_attribute_copy_kernel(const uint32_t* __restrict__ sorted, 
   if (i < n) state[i] = sorted[i];
 }
 
-// With kNormalized the side array receives the kernel sum (for the filter's factor) or, with
-// factor_to_side (the density diffusion, which has no filter), the resolved factor itself, so
-// that a later kernel writes the factors in the new order without a division's rounding.
 // The thread's index in the grid (64 bits: n particles of G lanes can pass 2^32 threads).
 __device__ __forceinline__ unsigned long long grid_thread() {
   return static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
@@ -90,6 +87,10 @@ __device__ __forceinline__ DensitySample gather_density_lanes(const FluidBase& f
   return density_from_sum(f, group.sum(sum), group.sum(neighbors));
 }
 
+// With kNormalized the side array receives the kernel sum (for the filter's factor) or, with
+// factor_to_side (the density diffusion, which has no filter), the resolved factor itself, so
+// that a later kernel writes the factors in the new order without a division's rounding.
+// G: the lane group (LaneGroup); lane 0 of each group writes the particle.
 template <bool kCounts, bool kNormalized, bool kBoundary, unsigned G>
 __global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
                                DeviceScene scene, float stage_fraction, bool factor_to_side,
@@ -176,6 +177,8 @@ __global__ void colour_normal_kernel(FluidConstants fluid, GridView grid, Partic
   a.colour_normal[i] = gather_colour_normal(fluid, grid, a.sorted_position, a.sorted_velocity, i);
 }
 
+// G: the lane group (LaneGroup); every lane gathers, lane 0 integrates and writes the particle,
+// and every thread of the block joins the block maxima.
 template <class Terms, bool kScene, unsigned G>
 __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
                                     DeviceScene scene, bool collide_here, FrameState* state) {
