@@ -9,7 +9,8 @@
  *
  *   rest_sphere [--particles N|largest] [--frames F] [--warmup W] [--backend cpu|cuda|auto]
  *               [--case rest|moving|both] [--option NAME] [--json FILE] [--csv FILE] [--label TEXT]
- *               [--cuda-frames graph|stream] [--density-block N] [--force-block N] [--threads N]
+ *               [--cuda-frames graph|stream] [--density-block N] [--force-block N]
+ *               [--particle-lanes N] [--threads N]
  *
  * --threads sets the CPU backend's workers (sph_context_def.cpu_worker_count), so that a run on a
  * larger host can measure two workers (issue 18's CPU goal); pin them with taskset to two cores.
@@ -27,6 +28,8 @@
  * --cuda-frames, --density-block and --force-block set the CUDA tuning of sph_context_def
  * (cuda_frames, cuda_density_block, cuda_force_block; docs/cuda.md): the stream driver launches
  * kernel by kernel, which is what a profiler such as ncu needs (scripts/bench-gpu).
+ * --particle-lanes sets cuda_particle_lanes (threads per particle of the neighbour passes: 1, 2,
+ * 4 or 8; scripts/bench-lanes compares them).
  *
  * Prints a table per case; --json writes the results as a JSON array, --csv appends rows
  * (with a header when the file is new). Times are the wall time of sph_world_step (which
@@ -60,7 +63,8 @@ typedef struct options {
   sph_cuda_frames cuda_frames;
   uint32_t density_block; /* 0: the library's default */
   uint32_t force_block;
-  uint32_t threads; /* CPU workers; 0: the library's default, one per processor */
+  uint32_t particle_lanes; /* 0: the library's choice */
+  uint32_t threads;        /* CPU workers; 0: the library's default, one per processor */
 } options;
 
 typedef struct result {
@@ -182,6 +186,7 @@ static result run_case(const options* o, int moving) {
   cdef.cuda_frames = o->cuda_frames;
   cdef.cuda_density_block = o->density_block;
   cdef.cuda_force_block = o->force_block;
+  cdef.cuda_particle_lanes = o->particle_lanes;
   cdef.cpu_worker_count = o->threads;
   sph_context* context = NULL;
   check(sph_context_create(&cdef, &context), "sph_context_create");
@@ -344,13 +349,13 @@ static void usage(void) {
           "none|surface_tension|normalized_density|density_diffusion|\n"
           "                   clavet|tait|rk4|acoustic_limit|springs] [--json FILE] [--csv FILE]\n"
           "                   [--label TEXT] [--cuda-frames graph|stream] [--density-block N]\n"
-          "                   [--force-block N] [--threads N]\n");
+          "                   [--force-block N] [--particle-lanes N] [--threads N]\n");
   exit(2);
 }
 
 int main(int argc, char** argv) {
   options o = {100000, 0, "none", 100, 3, SPH_BACKEND_AUTO, "both", NULL, NULL, NULL, SPH_CUDA_FRAMES_GRAPH,
-               0,      0, 0};
+               0,      0, 0,      0};
   for (int i = 1; i < argc; ++i) {
     const char* a = argv[i];
     const char* v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -381,6 +386,8 @@ int main(int argc, char** argv) {
       o.density_block = (uint32_t)strtoul(v, NULL, 10);
     } else if (strcmp(a, "--force-block") == 0) {
       o.force_block = (uint32_t)strtoul(v, NULL, 10);
+    } else if (strcmp(a, "--particle-lanes") == 0) {
+      o.particle_lanes = (uint32_t)strtoul(v, NULL, 10);
     } else if (strcmp(a, "--threads") == 0) {
       o.threads = (uint32_t)strtoul(v, NULL, 10);
     } else {

@@ -55,6 +55,7 @@ CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBacken
   cuda_check(cudaStreamSynchronize(r->stream), "backend set-up");
   tuning_.density_block = options.density_block;
   tuning_.force_block = options.force_block;
+  tuning_.particle_lanes = options.particle_lanes;
   use_graphs_ = !options.stream_frames;
   r_ = std::move(r);
 }

@@ -12,11 +12,12 @@ namespace sph {
 int cuda_usable_device_count();
 
 // The backend's tuning (sph_context_def's cuda_* fields, checked by the C layer; docs/cuda.md).
-// No choice changes results.
+// No choice changes results but particle_lanes (the order of the neighbour sums).
 struct CudaBackendOptions {
   bool stream_frames = false;    // every frame on the stream driver (profilers, sanitizers)
   unsigned density_block = 128;  // threads per block of the density kernels (32..1024, powers of two)
   unsigned force_block = 128;    // threads per block of the force kernels
+  unsigned particle_lanes = 0;   // lane groups (KernelTuning::particle_lanes): 0 = by particle count
 };
 
 std::unique_ptr<Backend> make_cuda_backend(const WorldConfig& config, int device_ordinal,

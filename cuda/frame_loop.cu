@@ -17,6 +17,7 @@ bool same_setup(const PipelineSetup& a, const PipelineSetup& b) {
          std::memcmp(&a.fluid, &b.fluid, sizeof a.fluid) == 0 &&
          std::memcmp(&a.limits, &b.limits, sizeof a.limits) == 0 &&
          a.tuning.density_block == b.tuning.density_block && a.tuning.force_block == b.tuning.force_block &&
+         a.tuning.particle_lanes == b.tuning.particle_lanes &&
          a.options.surface_tension == b.options.surface_tension &&
          a.options.normalized_density == b.options.normalized_density &&
          a.options.density_diffusion == b.options.density_diffusion &&

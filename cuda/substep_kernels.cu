@@ -1,4 +1,6 @@
 // SPDX-License-Identifier: MIT
+#include <type_traits>
+
 #include "../src/physics/boundary_density.h"
 #include "../src/physics/density.h"
 #include "../src/physics/density_diffusion.h"
@@ -57,20 +59,52 @@ __global__ void user_attribute_copy_kernel(const uint32_t* __restrict__ sorted, 
   if (i < n) state[i] = sorted[i];
 }
 
+// The thread's index in the grid (64 bits: n particles of G lanes can pass 2^32 threads).
+__device__ __forceinline__ unsigned long long grid_thread() {
+  return static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
+}
+
+// gather_density (src/physics/density.h) over a lane group: each lane sums every G-th candidate
+// of a run, and the group adds the sums (LaneGroup). G = 1 is gather_density itself.
+template <unsigned G>
+__device__ __forceinline__ DensitySample gather_density_lanes(const FluidBase& f, const GridView& grid,
+                                                              const Float4* __restrict__ positions,
+                                                              uint32_t i, LaneGroup<G> group) {
+  if (G == 1) return gather_density(f, grid, positions, i);
+  const Vec3 xi = xyz(positions[i]);
+  float sum = 0.0f;
+  uint32_t neighbors = 0;
+  for_each_neighbor_range(grid, xi, [&](uint32_t begin, uint32_t end) {
+#pragma unroll 2
+    for (uint32_t j = begin + group.lane; j < end; j += G) {
+      const float r2 = length_squared(xi - xyz(positions[j]));
+      if (r2 < f.kernel.h2 && j != i) {
+        sum += density_pair_term(f, r2);
+        ++neighbors;
+      }
+    }
+  });
+  return density_from_sum(f, group.sum(sum), group.sum(neighbors));
+}
+
 // With kNormalized the side array receives the kernel sum (for the filter's factor) or, with
 // factor_to_side (the density diffusion, which has no filter), the resolved factor itself, so
 // that a later kernel writes the factors in the new order without a division's rounding.
-template <bool kCounts, bool kNormalized, bool kBoundary>
+// G: the lane group (LaneGroup); lane 0 of each group writes the particle.
+template <bool kCounts, bool kNormalized, bool kBoundary, unsigned G>
 __global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
                                DeviceScene scene, float stage_fraction, bool factor_to_side,
                                FrameState* state) {
   mark_stage(state, kStageDensity);
-  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i >= n) return;
+  const unsigned long long t = grid_thread();
+  if (t / G >= n) return;  // whole groups: n * G threads are lanes of particles
+  const uint32_t i = static_cast<uint32_t>(t / G);
+  const LaneGroup<G> group = LaneGroup<G>::of_thread(t);
+  DensitySample s = gather_density_lanes<G>(fluid, grid, a.sorted_position, i, group);
+  if (group.lane != 0) return;
   // The reorder left this particle's old index in w; read it before w becomes the pressure.
   // Other threads read only x, y, z of this record.
   const uint32_t k = __float_as_uint(a.sorted_position[i].w);
-  DensitySample s = gather_density(fluid, grid, a.sorted_position, i);
   if (kBoundary) {
     // The walls' share is part of the summation (and so of a normalised density's kernel sum).
     const StageTime at = stage_time(state->clock.time, stage_fraction);
@@ -143,17 +177,24 @@ __global__ void colour_normal_kernel(FluidConstants fluid, GridView grid, Partic
   a.colour_normal[i] = gather_colour_normal(fluid, grid, a.sorted_position, a.sorted_velocity, i);
 }
 
-template <class Terms, bool kScene>
+// G: the lane group (LaneGroup); every lane gathers, lane 0 integrates and writes the particle,
+// and every thread of the block joins the block maxima.
+template <class Terms, bool kScene, unsigned G>
 __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
                                     DeviceScene scene, bool collide_here, FrameState* state) {
   mark_stage(state, kStageForces);
-  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  const unsigned long long t = grid_thread();
+  const uint32_t i = t / G < n ? static_cast<uint32_t>(t / G) : n;  // whole groups past the end
+  const LaneGroup<G> group = LaneGroup<G>::of_thread(t);
   float v2 = 0.0f, a2 = 0.0f;
+  Vec3 acc{0.0f, 0.0f, 0.0f};
+  FluidConstants f = fluid;
   if (i < n) {
-    FluidConstants f = fluid;
     f.dt = state->clock.dt_float;  // impulse-based terms need the substep's length
-    Vec3 acc = gather_acceleration_masked<Terms>(f, grid, a.sorted_position, a.sorted_velocity,
-                                                 a.neighbor_count, a.colour_normal, i);
+    acc = gather_acceleration_masked<Terms, true, G>(f, grid, a.sorted_position, a.sorted_velocity,
+                                                     a.neighbor_count, a.colour_normal, i, group);
+  }
+  if (i < n && group.lane == 0) {
     const Float4 p = a.sorted_position[i];
     const Float4 v = a.sorted_velocity[i];
     if (kScene) acc = add_force_fields(scene, acc, xyz(p));
@@ -179,20 +220,25 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
   block_max_to(&state->a2max_bits, a2);
 }
 
-template <class Terms, bool kScene>
+template <class Terms, bool kScene, unsigned G>
 __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
                                   int stage, DeviceScene scene, bool collide_here, FrameState* state) {
   mark_stage(state, kStageForces);
-  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  const unsigned long long t = grid_thread();
+  const uint32_t i = t / G < n ? static_cast<uint32_t>(t / G) : n;  // whole groups past the end
+  const LaneGroup<G> group = LaneGroup<G>::of_thread(t);
   float v2 = 0.0f, a2 = 0.0f;
+  Vec3 acc{0.0f, 0.0f, 0.0f};
+  FluidConstants f = fluid;
   if (i < n) {
+    f.dt = state->clock.dt_float;
+    acc = gather_acceleration_masked<Terms, true, G>(f, grid, a.sorted_position, a.sorted_velocity,
+                                                     a.neighbor_count, a.colour_normal, i, group);
+  }
+  if (i < n && group.lane == 0) {
     // This stage's side, (stage + 1) % 2, picked without a run-time index into the struct.
     ParticleState* start = (stage & 1) ? a.rk4_start[0] : a.rk4_start[1];
     Rk4Accumulator* sums = (stage & 1) ? a.rk4_sum[0] : a.rk4_sum[1];
-    FluidConstants f = fluid;
-    f.dt = state->clock.dt_float;
-    Vec3 acc = gather_acceleration_masked<Terms>(f, grid, a.sorted_position, a.sorted_velocity,
-                                                 a.neighbor_count, a.colour_normal, i);
     const Float4 p = a.sorted_position[i];
     const Float4 v = a.sorted_velocity[i];
     if (kScene) acc = add_force_fields(scene, acc, xyz(p));
@@ -230,20 +276,57 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
 // does not use a method runs code without it. A frame without colliders and force fields runs
 // kernels without the scene code.
 
+// Calls launch(std::integral_constant<unsigned, G>) for the lane group G = lanes (1, 2, 4, 8).
+template <class Launch>
+void with_lanes(unsigned lanes, Launch&& launch) {
+  switch (lanes) {
+    case 2:
+      launch(std::integral_constant<unsigned, 2>{});
+      break;
+    case 4:
+      launch(std::integral_constant<unsigned, 4>{});
+      break;
+    case 8:
+      launch(std::integral_constant<unsigned, 8>{});
+      break;
+    default:
+      launch(std::integral_constant<unsigned, 1>{});
+      break;
+  }
+}
+
+// Blocks for n particles of `lanes` threads each.
+unsigned blocks_for_lanes(uint32_t n, unsigned lanes, unsigned threads) {
+  const uint64_t items = static_cast<uint64_t>(n) * lanes;
+  return items == 0 ? 1u : static_cast<unsigned>((items + threads - 1) / threads);
+}
+
 // One launch of the density kernel with its options as template arguments.
 template <bool kCounts, bool kNormalized>
-void launch_density(bool boundary, unsigned blocks, unsigned threads, const FluidConstants& fluid,
+void launch_density(bool boundary, unsigned lanes, unsigned threads, const FluidConstants& fluid,
                     const GridView& grid, const ParticleArrays& a, uint32_t n, const DeviceScene& scene,
                     float stage_fraction, bool factor_to_side, FrameState* state, cudaStream_t stream) {
-  if (boundary)
-    density_kernel<kCounts, kNormalized, true>
-        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, stage_fraction, factor_to_side, state);
-  else
-    density_kernel<kCounts, kNormalized, false>
-        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, stage_fraction, factor_to_side, state);
+  const unsigned blocks = blocks_for_lanes(n, lanes, threads);
+  with_lanes(lanes, [&](auto g) {
+    constexpr unsigned G = decltype(g)::value;
+    if (boundary)
+      density_kernel<kCounts, kNormalized, true, G>
+          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, stage_fraction, factor_to_side, state);
+    else
+      density_kernel<kCounts, kNormalized, false, G>
+          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, stage_fraction, factor_to_side, state);
+  });
 }
 
 }  // namespace
+
+unsigned lanes_per_particle(const KernelTuning& tuning, uint32_t n) {
+  if (tuning.particle_lanes != 0) return tuning.particle_lanes;
+  // Not yet chosen by n: the lane groups have not been timed on a device (docs/performance.md,
+  // session 8), so the default stays one thread per particle, the kernels of before.
+  (void)n;
+  return 1u;
+}
 
 void enqueue_reorder(const ParticleArrays& a, const uint32_t* order, uint32_t n, Rk4Carry carry, int from,
                      const CrowdGuard& guard, FrameState* state, cudaStream_t stream) {
@@ -276,19 +359,20 @@ void enqueue_density(const FluidConstants& fluid, const GridView& grid, const Pa
                      const SubstepOptions& options, const KernelTuning& tuning, const DeviceScene& scene,
                      float stage_fraction, bool first_of_substep, FrameState* state, cudaStream_t stream) {
   const unsigned threads = tuning.density_block, blocks = blocks_for(n, threads);
+  const unsigned lanes = lanes_per_particle(tuning, n);
   const bool counts = options.viscosity == ViscosityMethod::Clavet;
   const bool boundary = options.boundary_density;
   if (counts && options.normalized_density)
-    launch_density<true, true>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction,
+    launch_density<true, true>(boundary, lanes, threads, fluid, grid, a, n, scene, stage_fraction,
                                options.density_diffusion, state, stream);
   else if (counts)
-    launch_density<true, false>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction,
+    launch_density<true, false>(boundary, lanes, threads, fluid, grid, a, n, scene, stage_fraction,
                                 options.density_diffusion, state, stream);
   else if (options.normalized_density)
-    launch_density<false, true>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction,
+    launch_density<false, true>(boundary, lanes, threads, fluid, grid, a, n, scene, stage_fraction,
                                 options.density_diffusion, state, stream);
   else
-    launch_density<false, false>(boundary, blocks, threads, fluid, grid, a, n, scene, stage_fraction,
+    launch_density<false, false>(boundary, lanes, threads, fluid, grid, a, n, scene, stage_fraction,
                                  options.density_diffusion, state, stream);
   check_launch("density_kernel");
   if (options.density_diffusion) {
@@ -329,15 +413,19 @@ void enqueue_forces_euler(const FluidConstants& fluid, const GridView& grid, con
                           uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
                           const DeviceScene& scene, bool collide_here, FrameState* state,
                           cudaStream_t stream) {
-  const unsigned threads = tuning.force_block, blocks = blocks_for(n, threads);
+  const unsigned threads = tuning.force_block, lanes = lanes_per_particle(tuning, n);
+  const unsigned blocks = blocks_for_lanes(n, lanes, threads);
   with_force_terms(options.methods, [&](auto terms) {
     using Terms = decltype(terms);
-    if (scene.active())
-      forces_euler_kernel<Terms, true>
-          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, collide_here, state);
-    else
-      forces_euler_kernel<Terms, false>
-          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, true, state);
+    with_lanes(lanes, [&](auto g) {
+      constexpr unsigned G = decltype(g)::value;
+      if (scene.active())
+        forces_euler_kernel<Terms, true, G>
+            <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, collide_here, state);
+      else
+        forces_euler_kernel<Terms, false, G>
+            <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, true, state);
+    });
   });
   check_launch("forces_euler_kernel");
 }
@@ -345,15 +433,19 @@ void enqueue_forces_euler(const FluidConstants& fluid, const GridView& grid, con
 void enqueue_forces_rk4(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                         uint32_t n, int stage, const SubstepOptions& options, const KernelTuning& tuning,
                         const DeviceScene& scene, bool collide_here, FrameState* state, cudaStream_t stream) {
-  const unsigned threads = tuning.force_block, blocks = blocks_for(n, threads);
+  const unsigned threads = tuning.force_block, lanes = lanes_per_particle(tuning, n);
+  const unsigned blocks = blocks_for_lanes(n, lanes, threads);
   with_force_terms(options.methods, [&](auto terms) {
     using Terms = decltype(terms);
-    if (scene.active())
-      forces_rk4_kernel<Terms, true>
-          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, scene, collide_here, state);
-    else
-      forces_rk4_kernel<Terms, false>
-          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, scene, true, state);
+    with_lanes(lanes, [&](auto g) {
+      constexpr unsigned G = decltype(g)::value;
+      if (scene.active())
+        forces_rk4_kernel<Terms, true, G>
+            <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, scene, collide_here, state);
+      else
+        forces_rk4_kernel<Terms, false, G>
+            <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, scene, true, state);
+    });
   });
   check_launch("forces_rk4_kernel");
 }

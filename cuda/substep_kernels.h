@@ -22,7 +22,17 @@ namespace sph {
 struct KernelTuning {
   unsigned density_block = 128;
   unsigned force_block = 128;
+  // Threads per particle of the density pass and the weakly compressible force passes (a lane
+  // group, force_gather.cuh): 1, 2, 4 or 8, or 0 to choose by the particle count
+  // (lanes_per_particle). The lanes split each run of candidates and add their sums in a fixed
+  // order, so a result depends on this count (the last bits of the sums), never on timing.
+  unsigned particle_lanes = 0;
 };
+
+// The lane group of the neighbour passes for n particles: tuning.particle_lanes if set, else
+// one (until the lane groups are timed; the aim is more lanes for fewer particles, so that
+// small worlds still fill the device's thread slots).
+unsigned lanes_per_particle(const KernelTuning& tuning, uint32_t n);
 
 // The scene inside a substep, as the kernels see it: the views live in a per-world device
 // buffer uploaded before each frame (their SdfGridViews point at the world's device copies of

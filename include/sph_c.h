@@ -323,12 +323,15 @@ typedef struct sph_context_def {
   sph_log_fn log_fn;         /* optional; NULL = no logging */
   void* log_user_data;       /* passed to log_fn */
   /* Tuning of the CUDA backend (a CPU context checks and ignores it; docs/cuda.md). Results do
-     not depend on it: every choice computes the same particles bit for bit. */
-  sph_cuda_frames cuda_frames; /* default SPH_CUDA_FRAMES_GRAPH */
-  uint32_t cuda_density_block; /* threads per block of the density kernels: 0 (default) = 128, or
-                                  32, 64, 128, 256, 512, 1024 */
-  uint32_t cuda_force_block;   /* threads per block of the force kernels: 0 (default) = 128, or as above */
-  uint32_t reserved1;          /* must be 0 */
+     not depend on it: every choice computes the same particles bit for bit, except
+     cuda_particle_lanes (the order of the neighbour sums: the last bits). */
+  sph_cuda_frames cuda_frames;  /* default SPH_CUDA_FRAMES_GRAPH */
+  uint32_t cuda_density_block;  /* threads per block of the density kernels: 0 (default) = 128, or
+                                   32, 64, 128, 256, 512, 1024 */
+  uint32_t cuda_force_block;    /* threads per block of the force kernels: 0 (default) = 128, or as above */
+  uint32_t cuda_particle_lanes; /* threads per particle of the density and force passes (0.2.0): 0
+                                   (default) = chosen by the library (1 today), or 1, 2, 4, 8 (a
+                                   measurement knob: each sums neighbours in its own fixed order) */
   /* The engine's task system (0.2.0): both or neither; NULL (default) = the library's OpenMP
      workers. A CPU context uses it for every parallel loop of its worlds; cpu_worker_count
      then only decides whether a loop runs in parallel (1: every loop on the calling thread). A

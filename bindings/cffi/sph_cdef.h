@@ -237,7 +237,7 @@ typedef struct sph_context_def {
   sph_cuda_frames cuda_frames;
   uint32_t cuda_density_block;
   uint32_t cuda_force_block;
-  uint32_t reserved1;
+  uint32_t cuda_particle_lanes;
   sph_enqueue_task_fn enqueue_task;
   sph_finish_task_fn finish_task;
   void* task_user_context;

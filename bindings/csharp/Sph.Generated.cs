@@ -820,7 +820,7 @@ namespace Sph
         /// <summary>
         /// sph_cuda_frames cuda_frames: Tuning of the CUDA backend (a CPU context checks and ignores
         /// it; docs/cuda.md). Results do not depend on it: every choice computes the same particles bit
-        /// for bit.
+        /// for bit, except cuda_particle_lanes (the order of the neighbour sums: the last bits).
         /// </summary>
         public CudaFrames CudaFrames;
         /// <summary>
@@ -833,8 +833,12 @@ namespace Sph
         /// above
         /// </summary>
         public uint CudaForceBlock;
-        /// <summary>uint32_t reserved1: must be 0</summary>
-        public uint Reserved1;
+        /// <summary>
+        /// uint32_t cuda_particle_lanes: threads per particle of the density and force passes (0.2.0):
+        /// 0 (default) = chosen by the library (1 today), or 1, 2, 4, 8 (a measurement knob: each sums
+        /// neighbours in its own fixed order)
+        /// </summary>
+        public uint CudaParticleLanes;
         /// <summary>
         /// sph_enqueue_task_fn enqueue_task: The engine's task system (0.2.0): both or neither; NULL
         /// (default) = the library's OpenMP workers. A CPU context uses it for every parallel loop of
@@ -3711,7 +3715,7 @@ namespace Sph
             "CudaFrames",
             "CudaDensityBlock",
             "CudaForceBlock",
-            "Reserved1",
+            "CudaParticleLanes",
             "EnqueueTask",
             "FinishTask",
             "TaskUserContext",

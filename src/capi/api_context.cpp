@@ -36,11 +36,16 @@ sph::CudaTuning cuda_tuning_from_def(const sph_context_def& d) {
                                                "from 32 to 1024");
     return value;
   };
-  if (d.reserved1 != 0) throw Error(Status::InvalidArgument, "def->reserved1: must be 0");
+  const uint32_t lanes = d.cuda_particle_lanes;
+  if (lanes != 0 && lanes != 1 && lanes != 2 && lanes != 4 && lanes != 8)
+    throw Error(Status::InvalidArgument,
+                "def->cuda_particle_lanes: " + std::to_string(lanes) +
+                    " threads per particle; use 0 (the library's choice), 1, 2, 4 or 8");
   sph::CudaTuning t;
   t.stream_frames = frames == SPH_CUDA_FRAMES_STREAM;
   t.density_block = block(d.cuda_density_block, "cuda_density_block");
   t.force_block = block(d.cuda_force_block, "cuda_force_block");
+  t.particle_lanes = lanes;
   return t;
 }
 

@@ -66,6 +66,7 @@ std::unique_ptr<Backend> make_backend(BackendKind kind, const WorldConfig& confi
     options.stream_frames = cuda_tuning.stream_frames;
     if (cuda_tuning.density_block != 0) options.density_block = cuda_tuning.density_block;
     if (cuda_tuning.force_block != 0) options.force_block = cuda_tuning.force_block;
+    options.particle_lanes = cuda_tuning.particle_lanes;
     return make_cuda_backend(config, device_ordinal < 0 ? 0 : device_ordinal, options);
   }
 #else

@@ -29,6 +29,8 @@ struct CudaTuning {
   bool stream_frames = false;  // every frame on the stream driver, never as a graph
   uint32_t density_block = 0;  // threads per block of the density kernels (a power of two, 32..1024)
   uint32_t force_block = 0;    // threads per block of the force kernels
+  uint32_t particle_lanes =
+      0;  // threads per particle of the neighbour passes: 0 (the backend's choice), 1, 2, 4, 8
 };
 
 // cpu_tasks: the engine's task system for a CPU backend's loops (none: OpenMP's cpu_workers).

@@ -35,6 +35,11 @@ SPH_HD T density_pair_term(const FluidBase& f, T r2) {
   return spiky_value(f.kernel, square_root(r2));
 }
 
+// The sample from the sum of the pair terms and the neighbour count.
+SPH_HD DensitySample density_from_sum(const FluidBase& f, float sum, uint32_t neighbors) {
+  return DensitySample{f.particle_mass * (f.density_self_weight + sum), neighbors};
+}
+
 // positions: sorted particle records (xyz used, w ignored). Returns rho_i for particle i.
 SPH_HD DensitySample gather_density(const FluidBase& f, const GridView& grid, const Float4* positions,
                                     uint32_t i) {
@@ -49,7 +54,7 @@ SPH_HD DensitySample gather_density(const FluidBase& f, const GridView& grid, co
       ++neighbors;
     }
   });
-  return DensitySample{f.particle_mass * (f.density_self_weight + sum), neighbors};
+  return density_from_sum(f, sum, neighbors);
 }
 
 }  // namespace sph

@@ -150,6 +150,15 @@ class AccelerationGather<ForceTerms<Terms...>, kPressure> {
     List::add(f, self_, pair, sums_);
   }
 
+  // Calls combine(sums) on the symmetric pressure's sums, then on the terms' (a TermSums), so
+  // that a backend splitting one particle's neighbours over several lanes can add the lanes'
+  // partial sums before finish() (the CUDA backend's lane groups, cuda/force_gather.cuh).
+  template <class Combine>
+  SPH_HD void combine_sums(Combine&& combine) {
+    combine(pressure_);
+    combine(sums_);
+  }
+
   SPH_HD Vec3 finish(const FluidConstants& f) const {
     return finish_acceleration<List, TermSums<float, Terms...>, kPressure>(f, self_, pressure_, sums_);
   }

@@ -57,7 +57,7 @@ static void test_def_init(void** state) {
   assert_int_equal(def.cuda_frames, SPH_CUDA_FRAMES_GRAPH);
   assert_int_equal(def.cuda_density_block, 0);
   assert_int_equal(def.cuda_force_block, 0);
-  assert_int_equal(def.reserved1, 0);
+  assert_int_equal(def.cuda_particle_lanes, 0);
   /* Larger (a newer caller): accepted, struct_size kept, the unknown tail zeroed. */
   memset(&grown, 0xab, sizeof grown);
   EXPECT_OK(sph_context_def_init_sized(&grown.def, sizeof grown));
@@ -146,16 +146,16 @@ static void test_create_bad_fields(void** state) {
   sph_test_context_def_init(&def);
   def.cpu_worker_count = 0xffffffffu;
   EXPECT_CREATE_FAILS(&def, SPH_ERROR_INVALID_ARGUMENT, "cpu_worker_count");
-  sph_test_context_def_init(&def);
-  def.reserved1 = 1;
-  EXPECT_CREATE_FAILS(&def, SPH_ERROR_INVALID_ARGUMENT, "reserved1");
 }
 
 /* The CUDA tuning fields are checked on every context (a CPU context ignores valid values): block
- * sizes are 0 or a power of two from 32 to 1024, cuda_frames one of its two values. */
+ * sizes are 0 or a power of two from 32 to 1024, cuda_frames one of its two values, the threads
+ * per particle 0, 1, 2, 4 or 8. */
 static void test_create_cuda_tuning(void** state) {
   static const uint32_t bad_blocks[] = {1, 16, 31, 33, 96, 100, 2048, 0x80000000u, 0xffffffffu};
   static const uint32_t good_blocks[] = {0, 32, 64, 128, 256, 512, 1024};
+  static const uint32_t bad_lanes[] = {3, 5, 6, 7, 16, 32, 0x80000000u, 0xffffffffu};
+  static const uint32_t good_lanes[] = {0, 1, 2, 4, 8};
   static const uint32_t bad_frames[] = {2, 0x7fffffffu, 0x80000000u};
   sph_context_def def;
   sph_context* context = NULL;
@@ -173,6 +173,17 @@ static void test_create_cuda_tuning(void** state) {
     sph_test_context_def_init(&def);
     def.cuda_frames = (sph_cuda_frames)bad_frames[i];
     EXPECT_CREATE_FAILS(&def, SPH_ERROR_UNSUPPORTED, "cuda_frames");
+  }
+  for (i = 0; i < sizeof bad_lanes / sizeof bad_lanes[0]; ++i) {
+    sph_test_context_def_init(&def);
+    def.cuda_particle_lanes = bad_lanes[i];
+    EXPECT_CREATE_FAILS(&def, SPH_ERROR_INVALID_ARGUMENT, "cuda_particle_lanes");
+  }
+  for (i = 0; i < sizeof good_lanes / sizeof good_lanes[0]; ++i) {
+    sph_test_context_def_init(&def);
+    def.cuda_particle_lanes = good_lanes[i];
+    EXPECT_OK(sph_context_create(&def, &context));
+    EXPECT_OK(sph_context_destroy(context));
   }
   for (i = 0; i < sizeof good_blocks / sizeof good_blocks[0]; ++i) {
     sph_test_context_def_init(&def);

@@ -55,7 +55,8 @@ void twice(const SceneSpec& spec, int frames, float frame_dt) {
   context_tuning().density_block = 256;
   context_tuning().force_block = 64;
   const Run d = run(spec, frames, frame_dt);
-  context_tuning() = ContextTuning{};
+  context_tuning().density_block = 0;
+  context_tuning().force_block = 0;
   const std::string name3 = std::string("block_sizes/") + spec.name;
   report(
       states_identical(a.state, d.state) && same_stats(a.stats, d.stats), name3.c_str(),
@@ -110,6 +111,34 @@ int main() {
   springs.name = "moving_sphere_springs_euler";
   springs.features = SPH_FEATURE_SPRINGS;
   twice(springs, 3, 0.02f);
+
+  // Eight threads per particle in the neighbour passes (lane groups, cuda/force_gather.cuh;
+  // sph_context_def.cuda_particle_lanes): the groups' fixed-order sums keep every run's bits
+  // (twice: two runs, graph against stream, other block sizes).
+  SceneSpec lanes = moving;
+  lanes.name = "moving_sphere_euler_lanes8";
+  context_tuning().particle_lanes = 8;
+  twice(lanes, 5, 0.04f);
+  {
+    // The field reaches the kernels: eight lanes sum in another order than one, so some bits
+    // differ after 200 substeps of 47k moving particles.
+    context_tuning().particle_lanes = 8;
+    const Run eight = run(lanes, 5, 0.04f);
+    context_tuning().particle_lanes = 1;
+    const Run one = run(lanes, 5, 0.04f);
+    const bool same = states_identical(eight.state, one.state);
+    report(!same, "lane_groups/moving_sphere_euler", "eight lanes per particle against one: %s",
+           same ? "IDENTICAL (the field did not reach the kernels)" : "different last bits, as expected");
+  }
+  SceneSpec lanes_options = options;
+  lanes_options.name = "moving_sphere_all_options_euler_lanes8";
+  context_tuning().particle_lanes = 8;
+  twice(lanes_options, 3, 0.02f);
+  SceneSpec lanes_rk4 = rk4;
+  lanes_rk4.name = "moving_sphere_rk4_lanes4";
+  context_tuning().particle_lanes = 4;
+  twice(lanes_rk4, 2, 0.04f);
+  context_tuning() = ContextTuning{};
 
   SceneSpec small = moving;
   small.radius = 0.25f;

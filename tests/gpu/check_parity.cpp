@@ -154,6 +154,20 @@ int main() {
   dfsph_options.features = SPH_FEATURE_SURFACE_TENSION | SPH_FEATURE_SPRINGS;
   compare(dfsph_options, 0.010f);
 
+  // Lane groups (cuda/force_gather.cuh): 2, 4 or 8 threads per particle in the density and
+  // weakly compressible force passes (sph_context_def.cuda_particle_lanes). Each sums the
+  // candidates in another order than the CPU, within the same limits.
+  for (uint32_t lanes : {2u, 4u, 8u}) {
+    context_tuning().particle_lanes = lanes;
+    const std::string suffix = "_lanes" + std::to_string(lanes);
+    for (SceneSpec spec : {moving, moving_rk4, tait, surface, springs}) {
+      const std::string name = spec.name + suffix;
+      spec.name = name.c_str();
+      compare(spec, 0.010f);
+    }
+  }
+  context_tuning() = ContextTuning{};
+
   // Scenes: colliders, force fields, sinks and a source on both backends.
   run_scene_parity();
   return finish();

@@ -72,6 +72,7 @@ struct ContextTuning {
   bool stream_frames = false;
   uint32_t density_block = 0;  // 0: the library's default
   uint32_t force_block = 0;
+  uint32_t particle_lanes = 0;  // cuda_particle_lanes; 0: the library's choice
 };
 inline ContextTuning& context_tuning() {
   static ContextTuning tuning;
@@ -91,12 +92,19 @@ auto apply_context_tuning(Def& def, int) -> decltype(def.cuda_frames, def.cuda_d
 }
 template <class Def>
 void apply_context_tuning(Def&, long) {}
+template <class Def>
+auto apply_particle_lanes(Def& def, int) -> decltype(def.cuda_particle_lanes, void()) {
+  def.cuda_particle_lanes = context_tuning().particle_lanes;
+}
+template <class Def>
+void apply_particle_lanes(Def&, long) {}
 
 inline sph_context* make_context(sph_backend backend) {
   sph_context_def def;
   sph_context_def_init(&def);
   def.backend = backend;
   apply_context_tuning(def, 0);
+  apply_particle_lanes(def, 0);
   sph_context* context = nullptr;
   require_ok(sph_context_create(&def, &context), "sph_context_create");
   return context;

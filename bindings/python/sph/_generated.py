@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '9512829c65c6746f57aba9cfc3d0436e66516e348e2b3a814c7aa7f931b16aad', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '08488d8562283b51c72c63a66ad8a4df4b67710733b9802dbe574a8a1f2ca7dc', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -813,10 +813,10 @@ class ContextDef(_SphStruct):
         reserved0 (uint32_t): must be 0
         log_fn (sph_log_fn): optional; NULL = no logging
         log_user_data (void*): passed to log_fn
-        cuda_frames (sph_cuda_frames): Tuning of the CUDA backend (a CPU context checks and ignores it; docs/cuda.md). Results do not depend on it: every choice computes the same particles bit for bit.
+        cuda_frames (sph_cuda_frames): Tuning of the CUDA backend (a CPU context checks and ignores it; docs/cuda.md). Results do not depend on it: every choice computes the same particles bit for bit, except cuda_particle_lanes (the order of the neighbour sums: the last bits).
         cuda_density_block (uint32_t): threads per block of the density kernels: 0 (default) = 128, or 32, 64, 128, 256, 512, 1024
         cuda_force_block (uint32_t): threads per block of the force kernels: 0 (default) = 128, or as above
-        reserved1 (uint32_t): must be 0
+        cuda_particle_lanes (uint32_t): threads per particle of the density and force passes (0.2.0): 0 (default) = chosen by the library (1 today), or 1, 2, 4, 8 (a measurement knob: each sums neighbours in its own fixed order)
         enqueue_task (sph_enqueue_task_fn): The engine's task system (0.2.0): both or neither; NULL (default) = the library's OpenMP workers. A CPU context uses it for every parallel loop of its worlds; cpu_worker_count then only decides whether a loop runs in parallel (1: every loop on the calling thread). A CUDA context checks and ignores it.
         finish_task (sph_finish_task_fn)
         task_user_context (void*): passed to enqueue_task and finish_task
@@ -836,7 +836,7 @@ class ContextDef(_SphStruct):
         ('cuda_frames', sph_cuda_frames),
         ('cuda_density_block', _c.c_uint32),
         ('cuda_force_block', _c.c_uint32),
-        ('reserved1', _c.c_uint32),
+        ('cuda_particle_lanes', _c.c_uint32),
         ('enqueue_task', sph_enqueue_task_fn),
         ('finish_task', sph_finish_task_fn),
         ('task_user_context', _c.c_void_p),
@@ -846,7 +846,7 @@ class ContextDef(_SphStruct):
     ]
     _sph_c_name_ = 'sph_context_def'
     _sph_size_ = 104
-    _sph_offsets_ = (('struct_size', 0), ('header_version', 4), ('backend', 8), ('device_ordinal', 12), ('cpu_worker_count', 16), ('reserved0', 20), ('log_fn', 24), ('log_user_data', 32), ('cuda_frames', 40), ('cuda_density_block', 44), ('cuda_force_block', 48), ('reserved1', 52), ('enqueue_task', 56), ('finish_task', 64), ('task_user_context', 72), ('alloc_fn', 80), ('free_fn', 88), ('alloc_user_context', 96))
+    _sph_offsets_ = (('struct_size', 0), ('header_version', 4), ('backend', 8), ('device_ordinal', 12), ('cpu_worker_count', 16), ('reserved0', 20), ('log_fn', 24), ('log_user_data', 32), ('cuda_frames', 40), ('cuda_density_block', 44), ('cuda_force_block', 48), ('cuda_particle_lanes', 52), ('enqueue_task', 56), ('finish_task', 64), ('task_user_context', 72), ('alloc_fn', 80), ('free_fn', 88), ('alloc_user_context', 96))
     _sph_init_ = 'sph_context_def_init_sized'
     _sph_assigns_ = {'header_version': SPH_VERSION}
     _sph_enums_ = {'backend': Backend, 'cuda_frames': CudaFrames}
