@@ -278,21 +278,31 @@ typedef void(SPH_CALL* sph_log_fn)(void* user_data, sph_log_level level, sph_res
 /**
  * The engine's task system (the shape of Box2D v3's b2EnqueueTaskCallback and
  * b2FinishTaskCallback; docs/embedding.md, "Threads"). With one, a CPU context runs every
- * parallel loop of its worlds through it and starts no thread of its own for them.
+ * parallel loop of its worlds through it, and each asynchronous step (sph_world_step_begin) as
+ * one task of it, and starts no thread of its own.
  *
  * sph_task_fn runs items [first, last) of a task on the calling thread; `worker` is the index
  * of the task system's worker that runs them (the library does not read it; pass what you
- * have). The library's task functions never block, never call back into the library and never
- * throw; they may run on any thread, concurrently with each other.
+ * have). The library's task functions never call back into the library and never throw; they
+ * may run on any thread, concurrently with each other. A loop's task never blocks; an
+ * asynchronous step's task (one item: the whole frame) enqueues the frame's loops as tasks of
+ * their own and waits for each with finish_task, from inside the task (nested tasks).
  *
  * sph_enqueue_task_fn schedules `task` over the items [0, item_count), split into ranges of at
  * least min_range items (the library passes 1), each range one call of task with task_context.
  * It returns a handle that the library passes to finish_task, or NULL once it has run every
- * item itself (then finish_task is not called). It is called only from the thread inside an
- * sph_ call on the world (for sph_world_step_begin: the world's step thread), never from a task.
+ * item itself (then finish_task is not called; for an asynchronous step sph_world_step_begin
+ * then returns after the frame). It is called from the thread inside an sph_ call on the world
+ * (sph_world_step_begin enqueues its step from the caller's thread) and from inside an
+ * asynchronous step's task, on whichever worker runs it: the task system must take tasks from
+ * several threads and from its own tasks.
  *
  * sph_finish_task_fn returns once every item of the task behind user_task has run (it may run
- * items itself meanwhile). Results are the same bits whatever the split or the worker count.
+ * items itself meanwhile). For an asynchronous step's task it is called by sph_world_step_wait,
+ * on the waiting thread (not always the one that began); for a loop, on the thread that enqueued
+ * it, which may be a worker inside the step's task: there it must not wait for a worker that
+ * cannot come free (run items itself meanwhile, as enkiTS and Jolt's job system do, or keep a
+ * worker to spare). Results are the same bits whatever the split or the worker count.
  */
 typedef void(SPH_CALL* sph_task_fn)(uint32_t first, uint32_t last, uint32_t worker, void* task_context);
 typedef void*(SPH_CALL* sph_enqueue_task_fn)(sph_task_fn task, uint32_t item_count, uint32_t min_range,
@@ -333,9 +343,9 @@ typedef struct sph_context_def {
                                    (default) = chosen by the library (1 today), or 1, 2, 4, 8 (a
                                    measurement knob: each sums neighbours in its own fixed order) */
   /* The engine's task system (0.2.0): both or neither; NULL (default) = the library's OpenMP
-     workers. A CPU context uses it for every parallel loop of its worlds; cpu_worker_count
-     then only decides whether a loop runs in parallel (1: every loop on the calling thread). A
-     CUDA context checks and ignores it. */
+     workers. A CPU context uses it for every parallel loop of its worlds and runs each
+     asynchronous step as one task of it; cpu_worker_count then only decides whether a loop runs
+     in parallel (1: every loop on the calling thread). A CUDA context checks and ignores it. */
   sph_enqueue_task_fn enqueue_task;
   sph_finish_task_fn finish_task;
   void* task_user_context; /* passed to enqueue_task and finish_task */
@@ -847,21 +857,25 @@ SPH_API sph_result SPH_CALL sph_world_cancel_step(sph_world* world);
 /**
  * Asynchronous steps: sph_world_step_begin starts the frame that sph_world_step would run and
  * returns at once; the frame runs on the world's own thread (started by its first asynchronous
- * step and kept until sph_world_destroy; on the CPU backend it leads the OpenMP workers), so the
- * caller's frame overlaps the simulation. Until sph_world_step_wait collects it, the world is
- * held by that step: every other call on the world answers SPH_ERROR_WORLD_LOCKED (destroy
- * included), except sph_world_cancel_step and sph_world_step_poll. Each begin needs one wait,
- * also before the process exits; the wait may come from any thread.
+ * step and kept until sph_world_destroy; on the CPU backend it leads the OpenMP workers), or, on
+ * a CPU context with the engine's task system, as one task of it, enqueued by begin (no thread
+ * is started; if enqueue_task runs it at once and returns NULL, begin returns after the frame),
+ * so the caller's frame overlaps the simulation. Until sph_world_step_wait collects it, the
+ * world is held by that step: every other call on the world answers SPH_ERROR_WORLD_LOCKED
+ * (destroy included), except sph_world_cancel_step and sph_world_step_poll. Each begin needs
+ * one wait, also before the process exits; the wait may come from any thread.
  * Errors of begin: INVALID_HANDLE, INVALID_ARGUMENT (frame_dt not > 0 and finite), WORLD_LOCKED,
- * OUT_OF_HOST_MEMORY (no thread could be started). Nothing runs when begin fails.
+ * OUT_OF_HOST_MEMORY (no thread could be started, or a host allocation failed). Nothing runs
+ * when begin fails.
  */
 SPH_API sph_result SPH_CALL sph_world_step_begin(sph_world* world, float frame_dt);
 /**
- * Waits for the step that sph_world_step_begin started and returns what sph_world_step would
- * have returned for it (SPH_OK, SPH_INCOMPLETE, or its error, with its message in this thread's
- * sph_get_last_error and the world rolled back as sph_world_step does); the world is free again.
- * Errors of the call itself: INVALID_HANDLE, INVALID_ARGUMENT (no step begun, or it was already
- * waited for), WORLD_LOCKED (another call holds the world, e.g. another thread's wait).
+ * Waits for the step that sph_world_step_begin started (through the task system's finish_task
+ * when it runs as a task) and returns what sph_world_step would have returned for it (SPH_OK,
+ * SPH_INCOMPLETE, or its error, with its message in this thread's sph_get_last_error and the
+ * world rolled back as sph_world_step does); the world is free again. Errors of the call itself:
+ * INVALID_HANDLE, INVALID_ARGUMENT (no step begun, or it was already waited for), WORLD_LOCKED
+ * (another call holds the world, e.g. another thread's wait).
  */
 SPH_API sph_result SPH_CALL sph_world_step_wait(sph_world* world);
 /**

@@ -16,52 +16,12 @@
  *
  * Usage: floating_box [OUTPUT_DIR] [--frames N] [--backend auto|cpu|cuda]
  *        (default out/floating_box_c, 360 frames, 3 s) */
-#include <math.h>
 #include <stdio.h>
 
+#include "rigid_body.h" /* the engine's side: the body, its step and its pose */
 #include "sample_io.h"
 #include "sph_c.h"
 #include "support.h"
-
-/* The engine's side: a rigid body with its state and a symplectic Euler step. */
-typedef struct rigid_body {
-  double mass;        /* kg */
-  double inertia;     /* kg m^2 (a cube: m a^2 / 6 about every axis through its centre) */
-  double position[3]; /* centre of mass, m */
-  double velocity[3]; /* m/s */
-  double rotation[4]; /* x, y, z, w */
-  double angular[3];  /* rad/s, world frame */
-} rigid_body;
-
-static void body_step(rigid_body* b, const sph_collider_loads* loads, double g, double dt) {
-  const double force[3] = {loads->force.x, loads->force.y - b->mass * g, loads->force.z};
-  const double torque[3] = {loads->torque.x, loads->torque.y, loads->torque.z};
-  double* q = b->rotation;
-  double dq[4], n;
-  int k;
-  for (k = 0; k < 3; ++k) {
-    b->velocity[k] += force[k] / b->mass * dt;
-    b->position[k] += b->velocity[k] * dt;
-    b->angular[k] += torque[k] / b->inertia * dt;
-  }
-  /* q += dt/2 (omega, 0) q, renormalised */
-  dq[0] = 0.5 * dt * (b->angular[0] * q[3] + b->angular[1] * q[2] - b->angular[2] * q[1]);
-  dq[1] = 0.5 * dt * (-b->angular[0] * q[2] + b->angular[1] * q[3] + b->angular[2] * q[0]);
-  dq[2] = 0.5 * dt * (b->angular[0] * q[1] - b->angular[1] * q[0] + b->angular[2] * q[3]);
-  dq[3] = 0.5 * dt * (-b->angular[0] * q[0] - b->angular[1] * q[1] - b->angular[2] * q[2]);
-  for (k = 0; k < 4; ++k) q[k] += dq[k];
-  n = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-  for (k = 0; k < 4; ++k) q[k] /= n;
-}
-
-static sph_transform body_pose(const rigid_body* b) {
-  sph_transform t;
-  t.position.x = (float)b->position[0], t.position.y = (float)b->position[1],
-  t.position.z = (float)b->position[2];
-  t.rotation.x = (float)b->rotation[0], t.rotation.y = (float)b->rotation[1];
-  t.rotation.z = (float)b->rotation[2], t.rotation.w = (float)b->rotation[3];
-  return t;
-}
 
 int main(int argc, char** argv) {
   const char* out_dir = "out/floating_box_c";
@@ -113,7 +73,7 @@ int main(int argc, char** argv) {
   if (sample_failed(sph_sdf_create_shape(context, &shape, &box_sdf), "sph_sdf_create_shape")) goto done;
   sph_collider_def_init(&def);
   def.sdf = box_sdf;
-  def.transform = body_pose(&body);
+  def.transform = rigid_body_pose(&body);
   if (sample_failed(sph_collider_create(world, &def, &box_id), "sph_collider_create")) goto done;
   if (sample_failed(sph_collider_set_load_point(world, box_id, &centre_of_mass),
                     "sph_collider_set_load_point"))
@@ -133,8 +93,8 @@ int main(int argc, char** argv) {
     if (sample_failed(sph_world_step(world, (float)dt), "sph_world_step")) goto done;
     sph_collider_loads_init(&loads);
     if (sample_failed(sph_collider_get_loads(world, box_id, &loads), "sph_collider_get_loads")) goto done;
-    body_step(&body, &loads, g, dt);
-    target = body_pose(&body);
+    rigid_body_step(&body, &loads, g, dt);
+    target = rigid_body_pose(&body);
     if (sample_failed(sph_collider_set_target_transform(world, box_id, &target),
                       "sph_collider_set_target_transform"))
       goto done;

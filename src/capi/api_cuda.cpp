@@ -19,12 +19,7 @@ template <class Body>
 sph_result with_backend(const sph_world* world, Body&& body) {
   sph::require_world(world);
   sph::WorldLock lock(world);
-  try {
-    return body(world->world->backend());
-  } catch (const Error& e) {
-    if (e.status() == Status::DeviceLost) const_cast<sph_world*>(world)->device_lost = true;
-    throw;
-  }
+  return sph::marking_device_lost(world, [&] { return body(world->world->backend()); });
 }
 
 }  // namespace

@@ -25,24 +25,21 @@ constexpr double kMaxStepBudgetSeconds = 86400.0;
 // One frame of a world whose lock the caller holds: true if it completed, false if its budget,
 // a cancel or max_substeps stopped it; throws on failure (the world then as before the call).
 bool run_frame(sph_world* world, float frame_dt, const FrameEnqueuedHook& enqueued = FrameEnqueuedHook{}) {
-  const MemoryScope memory(&world->context->memory);  // (the step thread's too)
+  const MemoryScope memory(&world->context->memory);  // (the step thread's or task's too)
   StepInterrupt interrupt;
   interrupt.cancel = &world->cancel_requested;
   if (world->step_budget_seconds > 0.0)
     interrupt.deadline =
         StepInterrupt::Clock::now() + std::chrono::duration_cast<StepInterrupt::Clock::duration>(
                                           std::chrono::duration<double>(world->step_budget_seconds));
-  try {
+  return marking_device_lost(world, [&] {
     const bool completed = world->world->step(frame_dt, interrupt, enqueued);
     if (world->world->last_report().interrupted) world->cancel_requested.store(0);
     return completed;
-  } catch (const Error& e) {
-    if (e.status() == Status::DeviceLost) world->device_lost = true;
-    throw;
-  }
+  });
 }
 
-// run_frame on the world's step thread: errors become an outcome for sph_world_step_wait.
+// run_frame on the world's step thread or as a task: errors become an outcome for sph_world_step_wait.
 StepOutcome run_frame_outcome(sph_world* world, float frame_dt,
                               const FrameEnqueuedHook& enqueued = FrameEnqueuedHook{}) noexcept {
   StepOutcome outcome;
@@ -64,10 +61,12 @@ StepOutcome run_frame_outcome(sph_world* world, float frame_dt,
   return outcome;
 }
 
-// Starts `step` on the world's step thread (the caller holds the world's lock).
-void start_async_step(sph_world* world, std::function<StepOutcome()> step) {
+// Starts `step` on the world's step thread, or as one task of `tasks` when it is a task system
+// (the caller holds the world's lock).
+void start_async_step(sph_world* world, std::function<StepOutcome()> step,
+                      const TaskSystem& tasks = TaskSystem{}) {
   try {
-    world->async_step.start(std::move(step));
+    world->async_step.start(std::move(step), tasks);
   } catch (const std::system_error& e) {
     throw Error(Status::OutOfHostMemory, std::string("the step's thread could not be started: ") + e.what());
   }
@@ -91,7 +90,13 @@ SPH_API sph_result SPH_CALL sph_world_step_begin(sph_world* world, float frame_d
     sph::require_world(world);
     sph::WorldLock lock(world);
     sph::require_positive(frame_dt, "frame_dt");
-    sph::start_async_step(world, [world, frame_dt] { return sph::run_frame_outcome(world, frame_dt); });
+    // A CPU context with the engine's task system runs the frame as one task of it (the frame's
+    // loops then enqueue from inside that task); a CUDA context ignores the task system.
+    const sph_context& context = *world->context;
+    const sph::TaskSystem tasks =
+        context.backend == sph::BackendKind::Cpu ? context.cpu_tasks : sph::TaskSystem{};
+    sph::start_async_step(
+        world, [world, frame_dt] { return sph::run_frame_outcome(world, frame_dt); }, tasks);
     world->async_step.pending.store(true);
     lock.hand_over();
     return SPH_OK;
@@ -105,12 +110,8 @@ SPH_API sph_result SPH_CALL sph_cuda_world_step_begin_on_stream(sph_world* world
     sph::WorldLock lock(world);
     sph::require_positive(frame_dt, "frame_dt");
     const sph::Backend& backend = world->world->backend();
-    try {
-      backend.order_after_stream(stream);  // refuses a CPU world and a stream CUDA refuses
-    } catch (const Error& e) {
-      if (e.status() == Status::DeviceLost) world->device_lost = true;
-      throw;
-    }
+    // Refuses a CPU world and a stream CUDA refuses.
+    sph::marking_device_lost(world, [&] { backend.order_after_stream(stream); });
     auto enqueued = std::make_shared<sph::StepSignal>();
     sph::FrameEnqueuedHook hook = [&backend, stream, enqueued] {
       backend.order_stream_after(stream);

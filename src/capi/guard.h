@@ -90,6 +90,19 @@ class WorldLock {
   const sph_world* world_;
 };
 
+// Runs body() on a world whose lock the caller holds and passes on whatever it throws; a
+// DEVICE_LOST error first marks the world lost, so that every later call on it answers
+// DEVICE_LOST (WorldLock) until it is destroyed.
+template <class Body>
+auto marking_device_lost(const sph_world* world, Body&& body) -> decltype(body()) {
+  try {
+    return body();
+  } catch (const Error& e) {
+    if (e.status() == Status::DeviceLost) const_cast<sph_world*>(world)->device_lost = true;
+    throw;
+  }
+}
+
 // Validates a world handle without touching the world's memory (WorldLock checks the rest:
 // it must follow before the world is used).
 inline void require_world(const sph_world* world) {

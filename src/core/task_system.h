@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
 // The engine's task system, when it gives one (sph_context_def's enqueue_task / finish_task, the
 // shape of Box2D v3's b2EnqueueTaskCallback / b2FinishTaskCallback): the CPU backend hands its
-// parallel loops to it instead of starting threads of its own. The C layer checks the pair and
-// passes it down unchanged; the types are the public ones (the C layer asserts they match).
+// parallel loops to it instead of starting threads of its own, and the C layer runs each
+// asynchronous step as one task of it (capi/async_stepper.h), whose loops are then tasks
+// enqueued from inside a task. The C layer checks the pair and passes it down unchanged; the
+// types are the public ones (the C layer asserts they match).
 #pragma once
 
 #include <stdint.h>

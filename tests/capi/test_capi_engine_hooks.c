@@ -2,12 +2,13 @@
 /* The engine's threads and memory (issue 21, item 2): sph_context_def's task-system and
  * allocator hooks, on the CPU backend.
  *
- * 1. With a task system of the test's own (three threads it starts itself), a world of about
- *    5,800 particles (past the 4,096 where the loops go parallel) steps, and the library starts
- *    no thread: /proc/self/task lists as many threads after the frames as before the context,
- *    and the loops did run on the test's threads. The particles are bit for bit those of the
- *    same frames on the library's own OpenMP workers (run after, so no OpenMP thread existed
- *    during the first part).
+ * 1. With a task system of the test's own (task_pool.c: three threads it starts itself), a
+ *    world of about 5,800 particles (past the 4,096 where the loops go parallel) steps, and the
+ *    library starts no thread: /proc/self/task lists as many threads after the frames as
+ *    before the context, and the loops did run on the test's threads. The particles are bit for
+ *    bit those of the same frames on the library's own OpenMP workers (run after, so no OpenMP
+ *    thread existed during the first part). (Asynchronous steps on the task system:
+ *    test_capi_async_task_step.c.)
  * 2. With a counting allocator, a world with a collider spawns, steps, saves and loads a
  *    checkpoint; the allocator holds at least the bytes sph_stats.memory_bytes reports, and none
  *    once the worlds and the SDF asset are destroyed.
@@ -26,118 +27,10 @@
 
 #include "capi_test.h"
 #include "sph_cuda.h"
+#include "task_pool.h"
 
 static const float kFrameDt = 1.0f / 60.0f;
-enum { kFrames = 2, kPoolThreads = 3, kSlots = 16, kWorldThreads = 3 };
-
-/* ---- a task system of the test's own ------------------------------------------------------- */
-
-typedef struct task_slot {
-  sph_task_fn fn;
-  void* context;
-  uint32_t count, next, done;
-  int in_use;
-} task_slot;
-
-static struct {
-  pthread_mutex_t mutex;
-  pthread_cond_t work, finished;
-  task_slot slots[kSlots];
-  pthread_t threads[kPoolThreads];
-  int stop;
-  atomic_uint items_on_pool; /* items the pool's own threads ran */
-  atomic_uint tasks;         /* tasks enqueued */
-} pool;
-
-/* Runs one item of slot s; called and returns with the mutex held. */
-static void run_item_locked(task_slot* s, uint32_t worker) {
-  const uint32_t item = s->next++;
-  pthread_mutex_unlock(&pool.mutex);
-  s->fn(item, item + 1, worker, s->context);
-  pthread_mutex_lock(&pool.mutex);
-  if (++s->done == s->count) pthread_cond_broadcast(&pool.finished);
-}
-
-static task_slot* slot_with_work_locked(void) {
-  int k;
-  for (k = 0; k < kSlots; ++k)
-    if (pool.slots[k].in_use && pool.slots[k].next < pool.slots[k].count) return &pool.slots[k];
-  return NULL;
-}
-
-static void* pool_thread(void* arg) {
-  const uint32_t worker = (uint32_t)(uintptr_t)arg;
-  pthread_mutex_lock(&pool.mutex);
-  while (!pool.stop) {
-    task_slot* s = slot_with_work_locked();
-    if (!s) {
-      pthread_cond_wait(&pool.work, &pool.mutex);
-      continue;
-    }
-    run_item_locked(s, worker);
-    atomic_fetch_add(&pool.items_on_pool, 1u);
-  }
-  pthread_mutex_unlock(&pool.mutex);
-  return NULL;
-}
-
-static void* SPH_CALL enqueue_task(sph_task_fn task, uint32_t item_count, uint32_t min_range,
-                                   void* task_context, void* user_context) {
-  task_slot* s = NULL;
-  int k;
-  assert_ptr_equal(user_context, &pool);
-  assert_true(min_range >= 1u && item_count >= 1u);
-  pthread_mutex_lock(&pool.mutex);
-  for (k = 0; k < kSlots && !s; ++k)
-    if (!pool.slots[k].in_use) s = &pool.slots[k];
-  if (!s) { /* every slot busy: run it here, as Box2D allows (finish is then not called) */
-    pthread_mutex_unlock(&pool.mutex);
-    task(0, item_count, kPoolThreads, task_context);
-    return NULL;
-  }
-  s->fn = task;
-  s->context = task_context;
-  s->count = item_count;
-  s->next = s->done = 0;
-  s->in_use = 1;
-  atomic_fetch_add(&pool.tasks, 1u);
-  pthread_cond_broadcast(&pool.work);
-  pthread_mutex_unlock(&pool.mutex);
-  return s;
-}
-
-/* The caller helps with its own task's items, then waits for the pool's. */
-static void SPH_CALL finish_task(void* user_task, void* user_context) {
-  task_slot* s = (task_slot*)user_task;
-  assert_ptr_equal(user_context, &pool);
-  pthread_mutex_lock(&pool.mutex);
-  while (s->next < s->count) run_item_locked(s, kPoolThreads);
-  while (s->done < s->count) pthread_cond_wait(&pool.finished, &pool.mutex);
-  s->in_use = 0;
-  pthread_mutex_unlock(&pool.mutex);
-}
-
-static void pool_start(void) {
-  int k;
-  assert_int_equal(pthread_mutex_init(&pool.mutex, NULL), 0);
-  assert_int_equal(pthread_cond_init(&pool.work, NULL), 0);
-  assert_int_equal(pthread_cond_init(&pool.finished, NULL), 0);
-  pool.stop = 0;
-  for (k = 0; k < kPoolThreads; ++k)
-    assert_int_equal(pthread_create(&pool.threads[k], NULL, pool_thread, (void*)(uintptr_t)k), 0);
-}
-
-static void pool_stop(void) {
-  int k;
-  pthread_mutex_lock(&pool.mutex);
-  pool.stop = 1;
-  pthread_cond_broadcast(&pool.work);
-  pthread_mutex_unlock(&pool.mutex);
-  for (k = 0; k < kPoolThreads; ++k) pthread_join(pool.threads[k], NULL);
-  pthread_cond_destroy(&pool.finished);
-  pthread_cond_destroy(&pool.work);
-  pthread_mutex_destroy(&pool.mutex);
-}
+enum { kFrames = 2, kWorldThreads = 3 };
 
 /* ---- a counting allocator ---------------------------------------------------------------- */
 
@@ -185,11 +78,7 @@ static sph_context* make_context(int tasks, int allocator) {
   EXPECT_OK(sph_context_def_init(&def));
   def.backend = SPH_BACKEND_CPU;
   def.cpu_worker_count = 4;
-  if (tasks) {
-    def.enqueue_task = enqueue_task;
-    def.finish_task = finish_task;
-    def.task_user_context = &pool;
-  }
+  if (tasks) task_pool_use(&def);
   if (allocator) {
     def.alloc_fn = counting_alloc;
     def.free_fn = counting_free;
@@ -249,14 +138,14 @@ static void test_task_hook_starts_no_thread_and_matches_openmp(void** state) {
   sph_world *a, *b;
   int before;
   (void)state;
-  pool_start();
+  task_pool_start();
   before = thread_count();
   hooked = make_context(1, 0);
   a = make_world(hooked, NULL);
   step_frames(a);
   assert_int_equal(thread_count(), before);
-  assert_true(atomic_load(&pool.tasks) > 10u);
-  assert_true(atomic_load(&pool.items_on_pool) > 0u);
+  assert_true(task_pool_tasks() > 10u);
+  assert_true(task_pool_items_on_pool() > 0u);
 
   openmp = make_context(0, 0);
   b = make_world(openmp, NULL);
@@ -266,7 +155,7 @@ static void test_task_hook_starts_no_thread_and_matches_openmp(void** state) {
   EXPECT_OK(sph_world_destroy(a));
   EXPECT_OK(sph_context_destroy(openmp));
   EXPECT_OK(sph_context_destroy(hooked));
-  pool_stop();
+  task_pool_stop();
 }
 
 /* 2. Every allocation of the worlds and the SDF asset comes back. */
@@ -346,7 +235,7 @@ static void test_hooks_from_several_threads(void** state) {
   world_job jobs[kWorldThreads];
   int k;
   (void)state;
-  pool_start();
+  task_pool_start();
   context = make_context(1, 1);
   for (k = 0; k < kWorldThreads; ++k) {
     jobs[k].context = context;
@@ -358,7 +247,7 @@ static void test_hooks_from_several_threads(void** state) {
   for (k = 0; k < kWorldThreads; ++k) EXPECT_OK(sph_world_destroy(jobs[k].world));
   assert_int_equal(atomic_load(&heap.live_bytes), 0);
   EXPECT_OK(sph_context_destroy(context));
-  pool_stop();
+  task_pool_stop();
 }
 
 /* 5. Half a hook is refused, naming the missing half. */
@@ -367,10 +256,12 @@ static void test_half_set_hooks_are_refused(void** state) {
   sph_context* context = NULL;
   (void)state;
   EXPECT_OK(sph_context_def_init(&def));
-  def.enqueue_task = enqueue_task;
+  task_pool_use(&def);
+  def.finish_task = NULL;
   EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "def->finish_task", sph_context_create(&def, &context));
   EXPECT_OK(sph_context_def_init(&def));
-  def.finish_task = finish_task;
+  task_pool_use(&def);
+  def.enqueue_task = NULL;
   EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "def->enqueue_task", sph_context_create(&def, &context));
   EXPECT_OK(sph_context_def_init(&def));
   def.alloc_fn = counting_alloc;

@@ -14,9 +14,9 @@
  *     -2.2 %; without them -41 % and -63 %. The issue's bound, 2 %, is asserted with
  *     LOADS_STRICT=1; by default the bounds are the measurements with room for rounding, 12 %
  *     and 3 %, and the walls in the density must do better than the collision response alone;
- *   - two-way coupling: a floating box (the integrator of samples/floating_box.c) settles at
- *     Archimedes' draft (issue: 5 %; measured +11.6 % at 2 cm, +7.1 % at 1.41 cm; bound 15 %,
- *     why at the test) and its heave decays;
+ *   - two-way coupling: a floating box (stepped by samples/rigid_body.h, as in
+ *     samples/floating_box.c) settles at Archimedes' draft (issue: 5 %; measured +11.6 % at 2 cm,
+ *     +7.1 % at 1.41 cm; bound 15 %, why at the test) and its heave decays;
  *   - the loads pass leaves the trajectory alone (bit for bit, friction on);
  *   - the C API: FEATURE_DISABLED without the bit, a handle check, the load point's torque.
  * LOADS_MEASURE=1 prints the measurements without asserting the bounds. */
@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "capi_test.h"
+#include "rigid_body.h" /* the engine's side of samples/floating_box.c: a rigid body, stepped */
 
 static const double kStep = 0.01; /* support_fcc_box's step; the world's spacing is step sqrt 2 */
 static const double kGravity = 9.81;
@@ -385,40 +386,6 @@ static void test_submerged_box_buoyancy(void** state) {
 
 /* ---- two-way coupling: a floating box ---------------------------------------------------------- */
 
-/* The engine's side, as samples/floating_box.c: a rigid body stepped by symplectic Euler from the
- * fluid's loads plus its weight, its pose sent as the collider's target every frame. */
-typedef struct float_body {
-  double mass, inertia, position[3], velocity[3], rotation[4], angular[3];
-} float_body;
-
-static void float_body_step(float_body* b, const sph_collider_loads* l, double dt) {
-  const double force[3] = {l->force.x, l->force.y - b->mass * kGravity, l->force.z};
-  const double torque[3] = {l->torque.x, l->torque.y, l->torque.z};
-  double* q = b->rotation;
-  double dq[4], norm;
-  for (int k = 0; k < 3; ++k) {
-    b->velocity[k] += force[k] / b->mass * dt;
-    b->position[k] += b->velocity[k] * dt;
-    b->angular[k] += torque[k] / b->inertia * dt;
-  }
-  dq[0] = 0.5 * dt * (b->angular[0] * q[3] + b->angular[1] * q[2] - b->angular[2] * q[1]);
-  dq[1] = 0.5 * dt * (-b->angular[0] * q[2] + b->angular[1] * q[3] + b->angular[2] * q[0]);
-  dq[2] = 0.5 * dt * (b->angular[0] * q[1] - b->angular[1] * q[0] + b->angular[2] * q[3]);
-  dq[3] = 0.5 * dt * (-b->angular[0] * q[0] - b->angular[1] * q[1] - b->angular[2] * q[2]);
-  norm = 0.0;
-  for (int k = 0; k < 4; ++k) q[k] += dq[k], norm += q[k] * q[k];
-  for (int k = 0; k < 4; ++k) q[k] /= sqrt(norm);
-}
-
-static sph_transform float_body_pose(const float_body* b) {
-  sph_transform t = sph_transform_identity();
-  t.position.x = (float)b->position[0], t.position.y = (float)b->position[1],
-  t.position.z = (float)b->position[2];
-  t.rotation.x = (float)b->rotation[0], t.rotation.y = (float)b->rotation[1];
-  t.rotation.z = (float)b->rotation[2], t.rotation.w = (float)b->rotation[3];
-  return t;
-}
-
 /* A 10 cm cube of 500 kg/m^3 dropped from 1 cm above water 20 cm deep in a tank 30 x 30 cm,
  * lattice spacing `spacing` (the sample's 2 cm: h = 3.6 cm), walls in the density, frames of
  * 1/120 s for 3 s. The draft is the water level a gauge reads in a corner of the tank (the level
@@ -444,7 +411,7 @@ static void floating_box(double spacing, double* draft, double* archimedes, doub
   sph_probe_def gauge_def;
   sph_probe_id gauge;
   sph_sdf *tank_sdf = NULL, *box_sdf = NULL;
-  float_body body;
+  rigid_body body;
   double heights[360], level = 0.0, mean = 0.0, late_time = 0.0;
   memset(&body, 0, sizeof(body));
   body.mass = density * 8.0 * half * half * half;
@@ -468,7 +435,7 @@ static void floating_box(double spacing, double* draft, double* archimedes, doub
   EXPECT_OK(sph_sdf_create_shape(context, &shape, &box_sdf));
   EXPECT_OK(sph_collider_def_init(&collider));
   collider.sdf = box_sdf;
-  collider.transform = float_body_pose(&body);
+  collider.transform = rigid_body_pose(&body);
   EXPECT_OK(sph_collider_create(world, &collider, &box));
   EXPECT_OK(sph_collider_set_load_point(world, box, &centre_of_mass));
   sph_fill_box_desc_init(&water);
@@ -487,8 +454,8 @@ static void floating_box(double spacing, double* draft, double* archimedes, doub
     EXPECT_OK(sph_world_step(world, (float)dt));
     EXPECT_OK(sph_collider_loads_init(&l));
     EXPECT_OK(sph_collider_get_loads(world, box, &l));
-    float_body_step(&body, &l, dt);
-    target = float_body_pose(&body);
+    rigid_body_step(&body, &l, kGravity, dt);
+    target = rigid_body_pose(&body);
     EXPECT_OK(sph_collider_set_target_transform(world, box, &target));
     heights[frame] = body.position[1];
     if (frame >= frames - 120) {

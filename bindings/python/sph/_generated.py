@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '08488d8562283b51c72c63a66ad8a4df4b67710733b9802dbe574a8a1f2ca7dc', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': 'dd36d2a921befe00a3a9f00f765d29e12a962f72045fddfd022c5be53ea8ea8d', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -736,21 +736,31 @@ class sph_sdf(_Opaque):
 sph_log_fn = _c.CFUNCTYPE(None, _c.c_void_p, sph_log_level, sph_result, _c.c_char_p)
 #: The engine's task system (the shape of Box2D v3's b2EnqueueTaskCallback and
 #: b2FinishTaskCallback; docs/embedding.md, "Threads"). With one, a CPU context runs every parallel
-#: loop of its worlds through it and starts no thread of its own for them.
+#: loop of its worlds through it, and each asynchronous step (sph_world_step_begin) as one task of
+#: it, and starts no thread of its own.
 #: 
 #: sph_task_fn runs items [first, last) of a task on the calling thread; `worker` is the index of
 #: the task system's worker that runs them (the library does not read it; pass what you have). The
-#: library's task functions never block, never call back into the library and never throw; they may
-#: run on any thread, concurrently with each other.
+#: library's task functions never call back into the library and never throw; they may run on any
+#: thread, concurrently with each other. A loop's task never blocks; an asynchronous step's task
+#: (one item: the whole frame) enqueues the frame's loops as tasks of their own and waits for each
+#: with finish_task, from inside the task (nested tasks).
 #: 
 #: sph_enqueue_task_fn schedules `task` over the items [0, item_count), split into ranges of at
 #: least min_range items (the library passes 1), each range one call of task with task_context. It
 #: returns a handle that the library passes to finish_task, or NULL once it has run every item
-#: itself (then finish_task is not called). It is called only from the thread inside an sph_ call
-#: on the world (for sph_world_step_begin: the world's step thread), never from a task.
+#: itself (then finish_task is not called; for an asynchronous step sph_world_step_begin then
+#: returns after the frame). It is called from the thread inside an sph_ call on the world
+#: (sph_world_step_begin enqueues its step from the caller's thread) and from inside an
+#: asynchronous step's task, on whichever worker runs it: the task system must take tasks from
+#: several threads and from its own tasks.
 #: 
 #: sph_finish_task_fn returns once every item of the task behind user_task has run (it may run
-#: items itself meanwhile). Results are the same bits whatever the split or the worker count.
+#: items itself meanwhile). For an asynchronous step's task it is called by sph_world_step_wait, on
+#: the waiting thread (not always the one that began); for a loop, on the thread that enqueued it,
+#: which may be a worker inside the step's task: there it must not wait for a worker that cannot
+#: come free (run items itself meanwhile, as enkiTS and Jolt's job system do, or keep a worker to
+#: spare). Results are the same bits whatever the split or the worker count.
 sph_task_fn = _c.CFUNCTYPE(None, _c.c_uint32, _c.c_uint32, _c.c_uint32, _c.c_void_p)
 sph_enqueue_task_fn = _c.CFUNCTYPE(_c.c_void_p, sph_task_fn, _c.c_uint32, _c.c_uint32, _c.c_void_p, _c.c_void_p)
 sph_finish_task_fn = _c.CFUNCTYPE(None, _c.c_void_p, _c.c_void_p)
@@ -817,7 +827,7 @@ class ContextDef(_SphStruct):
         cuda_density_block (uint32_t): threads per block of the density kernels: 0 (default) = 128, or 32, 64, 128, 256, 512, 1024
         cuda_force_block (uint32_t): threads per block of the force kernels: 0 (default) = 128, or as above
         cuda_particle_lanes (uint32_t): threads per particle of the density and force passes (0.2.0): 0 (default) = chosen by the library (1 today), or 1, 2, 4, 8 (a measurement knob: each sums neighbours in its own fixed order)
-        enqueue_task (sph_enqueue_task_fn): The engine's task system (0.2.0): both or neither; NULL (default) = the library's OpenMP workers. A CPU context uses it for every parallel loop of its worlds; cpu_worker_count then only decides whether a loop runs in parallel (1: every loop on the calling thread). A CUDA context checks and ignores it.
+        enqueue_task (sph_enqueue_task_fn): The engine's task system (0.2.0): both or neither; NULL (default) = the library's OpenMP workers. A CPU context uses it for every parallel loop of its worlds and runs each asynchronous step as one task of it; cpu_worker_count then only decides whether a loop runs in parallel (1: every loop on the calling thread). A CUDA context checks and ignores it.
         finish_task (sph_finish_task_fn)
         task_user_context (void*): passed to enqueue_task and finish_task
         alloc_fn (sph_alloc_fn): The engine's host allocator (0.2.0): both or neither; NULL (default) = the system heap. Every host allocation for the context's worlds and SDF assets goes through it (particle arrays, neighbour grids, scratch, rollback snapshots, checkpoint buffers, colliders, sources, sinks, probes, SDF grids and assets, boundary maps, per-frame lists) except: the context object, each world's handle record, World and backend objects and their array records (15 allocations, 3.4 KB, for a plain CPU world; none in a step) and step thread, error messages and the last-error text, and on CUDA the page-locked staging buffers (cudaMallocHost). Device memory: sph_cuda_context_set_allocator.
@@ -2140,9 +2150,9 @@ FUNCTIONS = {
     'sph_world_cancel_step': (sph_result, (_c.POINTER(sph_world),), ('world',),
         "Asks the world's step to stop at its next substep boundary (it returns SPH_INCOMPLETE with the world consistent; on the CUDA backend a frame on the device graph, which is every frame without a step budget or sinks, sees it only at its end). The one call that may run on another thread while a step holds the world: it never blocks and never answers WORLD_LOCKED. A request made while no step runs stops the next step before its first substep (that step changes nothing and reports 0 substeps); a step that stops for it clears it. Errors: INVALID_HANDLE (NULL or destroyed: safe to call racing sph_world_destroy).", 'sph'),
     'sph_world_step_begin': (sph_result, (_c.POINTER(sph_world), _c.c_float), ('world', 'frame_dt'),
-        "Asynchronous steps: sph_world_step_begin starts the frame that sph_world_step would run and returns at once; the frame runs on the world's own thread (started by its first asynchronous step and kept until sph_world_destroy; on the CPU backend it leads the OpenMP workers), so the caller's frame overlaps the simulation. Until sph_world_step_wait collects it, the world is held by that step: every other call on the world answers SPH_ERROR_WORLD_LOCKED (destroy included), except sph_world_cancel_step and sph_world_step_poll. Each begin needs one wait, also before the process exits; the wait may come from any thread. Errors of begin: INVALID_HANDLE, INVALID_ARGUMENT (frame_dt not > 0 and finite), WORLD_LOCKED, OUT_OF_HOST_MEMORY (no thread could be started). Nothing runs when begin fails.", 'sph'),
+        "Asynchronous steps: sph_world_step_begin starts the frame that sph_world_step would run and returns at once; the frame runs on the world's own thread (started by its first asynchronous step and kept until sph_world_destroy; on the CPU backend it leads the OpenMP workers), or, on a CPU context with the engine's task system, as one task of it, enqueued by begin (no thread is started; if enqueue_task runs it at once and returns NULL, begin returns after the frame), so the caller's frame overlaps the simulation. Until sph_world_step_wait collects it, the world is held by that step: every other call on the world answers SPH_ERROR_WORLD_LOCKED (destroy included), except sph_world_cancel_step and sph_world_step_poll. Each begin needs one wait, also before the process exits; the wait may come from any thread. Errors of begin: INVALID_HANDLE, INVALID_ARGUMENT (frame_dt not > 0 and finite), WORLD_LOCKED, OUT_OF_HOST_MEMORY (no thread could be started, or a host allocation failed). Nothing runs when begin fails.", 'sph'),
     'sph_world_step_wait': (sph_result, (_c.POINTER(sph_world),), ('world',),
-        "Waits for the step that sph_world_step_begin started and returns what sph_world_step would have returned for it (SPH_OK, SPH_INCOMPLETE, or its error, with its message in this thread's sph_get_last_error and the world rolled back as sph_world_step does); the world is free again. Errors of the call itself: INVALID_HANDLE, INVALID_ARGUMENT (no step begun, or it was already waited for), WORLD_LOCKED (another call holds the world, e.g. another thread's wait).", 'sph'),
+        "Waits for the step that sph_world_step_begin started (through the task system's finish_task when it runs as a task) and returns what sph_world_step would have returned for it (SPH_OK, SPH_INCOMPLETE, or its error, with its message in this thread's sph_get_last_error and the world rolled back as sph_world_step does); the world is free again. Errors of the call itself: INVALID_HANDLE, INVALID_ARGUMENT (no step begun, or it was already waited for), WORLD_LOCKED (another call holds the world, e.g. another thread's wait).", 'sph'),
     'sph_world_step_poll': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_bool32)), ('world', 'out_done'),
         'Whether the step sph_world_step_begin started has finished (*out_done 1: sph_world_step_wait will not block). Never blocks. Errors: INVALID_HANDLE, INVALID_ARGUMENT (out_done NULL, or no step begun), WORLD_LOCKED (a synchronous call holds the world).', 'sph'),
     'sph_world_get_particle_count': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_uint32)), ('world', 'out_count'),
