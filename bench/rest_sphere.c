@@ -20,7 +20,9 @@
  * (equation of state), rk4 (integrator), acoustic_limit (step limit), springs (elasticity with
  * the default sph_spring_params, whose step ceiling, 1.25 ms, is above dt_max: the same
  * substeps, so the cost is the spring work; the springs are made in the first warm-up
- * substep). --particles largest
+ * substep), dfsph (the incompressible solver, SPH_SOLVER_DFSPH, with its default bounds: at rest
+ * its cost is the factor pass and the solves' minimum iterations, all neighbour passes).
+ * --particles largest
  * finds the largest world the device holds (world creation refused with OUT_OF_*_MEMORY
  * above it) and runs 95 % of that.
  *
@@ -134,6 +136,8 @@ static void describe_world(const options* o, uint32_t capacity, sph_world_def* d
     params->step_limits = SPH_STEP_LIMIT_ACOUSTIC;
   } else if (strcmp(o->option, "springs") == 0) {
     def->features |= SPH_FEATURE_SPRINGS;
+  } else if (strcmp(o->option, "dfsph") == 0) {
+    def->solver = SPH_SOLVER_DFSPH;
   } else if (strcmp(o->option, "none") != 0) {
     fprintf(stderr, "rest_sphere: unknown --option '%s'\n", o->option);
     exit(2);
@@ -342,7 +346,7 @@ static void usage(void) {
           "usage: rest_sphere [--particles N|largest] [--frames F] [--warmup W] [--backend cpu|cuda|auto]\n"
           "                   [--case rest|moving|both] [--option "
           "none|surface_tension|normalized_density|density_diffusion|\n"
-          "                   clavet|tait|rk4|acoustic_limit|springs] [--json FILE] [--csv FILE]\n"
+          "                   clavet|tait|rk4|acoustic_limit|springs|dfsph] [--json FILE] [--csv FILE]\n"
           "                   [--label TEXT] [--cuda-frames graph|stream] [--density-block N]\n"
           "                   [--force-block N] [--threads N]\n");
   exit(2);
