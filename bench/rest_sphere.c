@@ -79,6 +79,8 @@ typedef struct result {
   double bytes_per_particle;
   double stage_ms_per_substep[SPH_STAGE_COUNT]; /* mean over the timed frames */
   double density_error_mean;                    /* (mean density - rho0) / rho0 at the end */
+  double pressure_iterations;                   /* DFSPH: density solve iterations per substep */
+  double divergence_iterations;                 /* DFSPH: divergence solve iterations per substep */
   double density_min, density_max;
   double max_speed;
   double setup_s;
@@ -230,7 +232,7 @@ static result run_case(const options* o, int moving) {
   double* frame_ms = malloc(sizeof(double) * (size_t)o->frames);
   double* substep_ms = malloc(sizeof(double) * (size_t)o->frames);
   double stage_sum[SPH_STAGE_COUNT] = {0};
-  uint64_t substeps_total = 0;
+  uint64_t substeps_total = 0, pressure_iterations = 0, divergence_iterations = 0;
   sph_stats s;
   sph_stats_init(&s);
   for (int f = 0; f < o->frames; ++f) {
@@ -239,6 +241,8 @@ static result run_case(const options* o, int moving) {
     frame_ms[f] = s.step_ms;
     substep_ms[f] = s.substeps ? s.step_ms / s.substeps : 0.0;
     substeps_total += s.substeps;
+    pressure_iterations += s.pressure_iterations;
+    divergence_iterations += s.divergence_iterations;
     for (int k = 0; k < SPH_STAGE_COUNT; ++k) stage_sum[k] += s.stage_ms[k];
   }
   r.substeps_per_frame = s.substeps;
@@ -252,6 +256,8 @@ static result run_case(const options* o, int moving) {
     r.stage_ms_per_substep[k] = substeps_total ? stage_sum[k] / (double)substeps_total : 0.0;
   r.density_error_mean = (s.density_mean - def.rest_density) / def.rest_density;
   r.density_min = s.density_min;
+  r.pressure_iterations = substeps_total ? (double)pressure_iterations / (double)substeps_total : 0.0;
+  r.divergence_iterations = substeps_total ? (double)divergence_iterations / (double)substeps_total : 0.0;
   r.density_max = s.density_max;
   r.max_speed = s.max_speed;
   free(frame_ms);
@@ -275,6 +281,14 @@ static void print_result(const result* r, const options* o) {
   printf("  %-28s %12.3g (min %.2f, max %.2f kg/m^3)\n", "end mean density error", r->density_error_mean,
          r->density_min, r->density_max);
   printf("  %-28s %12.4g m/s\n", "end max speed", r->max_speed);
+  if (strcmp(r->option, "dfsph") == 0) {
+    /* Neighbour passes: density and factor, the non-pressure forces, and per solve the warm
+       start's velocity update and residual plus two per iteration (as bench/solver_front). */
+    printf("  %-28s %12.2f density, %.2f divergence\n", "DFSPH iterations/substep", r->pressure_iterations,
+           r->divergence_iterations);
+    printf("  %-28s %12.2f\n", "neighbour passes/substep",
+           6.0 + 2.0 * (r->pressure_iterations + r->divergence_iterations));
+  }
   printf("  stage breakdown (ms per substep, share):\n");
   for (int k = 0; k < SPH_STAGE_COUNT; ++k)
     printf("    %-14s %10.4f  %5.1f%%\n", stage_names[k], r->stage_ms_per_substep[k],
