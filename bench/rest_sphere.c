@@ -21,7 +21,9 @@
  * (equation of state), rk4 (integrator), acoustic_limit (step limit), springs (elasticity with
  * the default sph_spring_params, whose step ceiling, 1.25 ms, is above dt_max: the same
  * substeps, so the cost is the spring work; the springs are made in the first warm-up
- * substep). --particles largest
+ * substep), dfsph (the incompressible solver, SPH_SOLVER_DFSPH, with its default bounds: at rest
+ * its cost is the factor pass and the solves' minimum iterations, all neighbour passes).
+ * --particles largest
  * finds the largest world the device holds (world creation refused with OUT_OF_*_MEMORY
  * above it) and runs 95 % of that.
  *
@@ -81,6 +83,8 @@ typedef struct result {
   double bytes_per_particle;
   double stage_ms_per_substep[SPH_STAGE_COUNT]; /* mean over the timed frames */
   double density_error_mean;                    /* (mean density - rho0) / rho0 at the end */
+  double pressure_iterations;                   /* DFSPH: density solve iterations per substep */
+  double divergence_iterations;                 /* DFSPH: divergence solve iterations per substep */
   double density_min, density_max;
   double max_speed;
   double setup_s;
@@ -138,6 +142,8 @@ static void describe_world(const options* o, uint32_t capacity, sph_world_def* d
     params->step_limits = SPH_STEP_LIMIT_ACOUSTIC;
   } else if (strcmp(o->option, "springs") == 0) {
     def->features |= SPH_FEATURE_SPRINGS;
+  } else if (strcmp(o->option, "dfsph") == 0) {
+    def->solver = SPH_SOLVER_DFSPH;
   } else if (strcmp(o->option, "none") != 0) {
     fprintf(stderr, "rest_sphere: unknown --option '%s'\n", o->option);
     exit(2);
@@ -231,7 +237,7 @@ static result run_case(const options* o, int moving) {
   double* frame_ms = malloc(sizeof(double) * (size_t)o->frames);
   double* substep_ms = malloc(sizeof(double) * (size_t)o->frames);
   double stage_sum[SPH_STAGE_COUNT] = {0};
-  uint64_t substeps_total = 0;
+  uint64_t substeps_total = 0, pressure_iterations = 0, divergence_iterations = 0;
   sph_stats s;
   sph_stats_init(&s);
   for (int f = 0; f < o->frames; ++f) {
@@ -240,6 +246,8 @@ static result run_case(const options* o, int moving) {
     frame_ms[f] = s.step_ms;
     substep_ms[f] = s.substeps ? s.step_ms / s.substeps : 0.0;
     substeps_total += s.substeps;
+    pressure_iterations += s.pressure_iterations;
+    divergence_iterations += s.divergence_iterations;
     for (int k = 0; k < SPH_STAGE_COUNT; ++k) stage_sum[k] += s.stage_ms[k];
   }
   r.substeps_per_frame = s.substeps;
@@ -253,6 +261,8 @@ static result run_case(const options* o, int moving) {
     r.stage_ms_per_substep[k] = substeps_total ? stage_sum[k] / (double)substeps_total : 0.0;
   r.density_error_mean = (s.density_mean - def.rest_density) / def.rest_density;
   r.density_min = s.density_min;
+  r.pressure_iterations = substeps_total ? (double)pressure_iterations / (double)substeps_total : 0.0;
+  r.divergence_iterations = substeps_total ? (double)divergence_iterations / (double)substeps_total : 0.0;
   r.density_max = s.density_max;
   r.max_speed = s.max_speed;
   free(frame_ms);
@@ -276,6 +286,14 @@ static void print_result(const result* r, const options* o) {
   printf("  %-28s %12.3g (min %.2f, max %.2f kg/m^3)\n", "end mean density error", r->density_error_mean,
          r->density_min, r->density_max);
   printf("  %-28s %12.4g m/s\n", "end max speed", r->max_speed);
+  if (strcmp(r->option, "dfsph") == 0) {
+    /* Neighbour passes: density and factor, the non-pressure forces, and per solve the warm
+       start's velocity update and residual plus two per iteration (as bench/solver_front). */
+    printf("  %-28s %12.2f density, %.2f divergence\n", "DFSPH iterations/substep", r->pressure_iterations,
+           r->divergence_iterations);
+    printf("  %-28s %12.2f\n", "neighbour passes/substep",
+           6.0 + 2.0 * (r->pressure_iterations + r->divergence_iterations));
+  }
   printf("  stage breakdown (ms per substep, share):\n");
   for (int k = 0; k < SPH_STAGE_COUNT; ++k)
     printf("    %-14s %10.4f  %5.1f%%\n", stage_names[k], r->stage_ms_per_substep[k],
@@ -347,7 +365,7 @@ static void usage(void) {
           "usage: rest_sphere [--particles N|largest] [--frames F] [--warmup W] [--backend cpu|cuda|auto]\n"
           "                   [--case rest|moving|both] [--option "
           "none|surface_tension|normalized_density|density_diffusion|\n"
-          "                   clavet|tait|rk4|acoustic_limit|springs] [--json FILE] [--csv FILE]\n"
+          "                   clavet|tait|rk4|acoustic_limit|springs|dfsph] [--json FILE] [--csv FILE]\n"
           "                   [--label TEXT] [--cuda-frames graph|stream] [--density-block N]\n"
           "                   [--force-block N] [--particle-lanes N] [--threads N]\n");
   exit(2);

@@ -59,7 +59,6 @@ CpuBackend::CpuBackend(const WorldConfig& config, unsigned workers, const TaskSy
   dfsph_pressure_ = store_.find_typed<float>(kArrayDfsphPressure);
   dfsph_divergence_ = store_.find_typed<float>(kArrayDfsphDivergencePressure);
   dfsph_factor_ = store_.find_typed<float>(kArrayDfsphFactor);
-  dfsph_step_ = store_.find_typed<float>(kArrayDfsphStep);
   dfsph_residual_ = store_.find_typed<float>(kArrayDfsphResidual);
   dfsph_contact_ = store_.find_typed<Float4>(kArrayDfsphContact);
   boundary_ = store_.find_typed<Float4>(kArrayBoundaryGradient);

@@ -194,12 +194,13 @@ class CpuBackend final : public Backend {
                            Float4* v, float* carried, float carry_scale);
   // Each particle's contact with the scene's colliders (dfsph_contact_), for the solves.
   void dfsph_find_contacts(const SceneFrame& scene, const SubstepTime& time);
-  // Applies the pressures of dfsph_step_ to v and adds them (times carry_scale) to carried.
+  // Applies the iteration's pressures (columns_.dfsph_step()) to v (records and columns) and adds
+  // them (times carry_scale) to carried.
   void dfsph_correct(const FluidConstants& fluid, const DfsphWalls& walls, float dt, Float4* v,
                      float* carried, float carry_scale);
-  // New pressures and errors from the rates over v; returns the mean error.
-  float dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls, float dt,
-                        const Float4* v);
+  // New pressures and errors from the rates over the velocities the last dfsph_correct wrote (the
+  // columns); returns the mean error.
+  float dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls, float dt);
 
   // Springs (SPH_FEATURE_SPRINGS), after the sort: the particles that wait for springs make
   // them (two passes, springs.h), then every particle gathers its spring acceleration into a
@@ -241,7 +242,6 @@ class CpuBackend final : public Backend {
   CpuArrayRef<float> dfsph_pressure_;         // DFSPH: the density solve's p / rho^2 (warm start)
   CpuArrayRef<float> dfsph_divergence_;       // DFSPH: the divergence solve's p / rho^2 times dt
   CpuArrayRef<float> dfsph_factor_;           // DFSPH: alpha / rho of the density pass
-  CpuArrayRef<float> dfsph_step_;             // DFSPH: the iteration's p / rho^2
   CpuArrayRef<float> dfsph_residual_;         // DFSPH: each particle's share of the solve's error
   CpuArrayRef<Float4> dfsph_contact_;         // DFSPH: each particle's contact with the colliders
   bool dfsph_contacts_ = false;               // DFSPH: the substep has colliders (contacts to respect)

@@ -6,6 +6,11 @@
 // (dfsph_residuals), until its mean error is below its bound or its cap. The mean is summed in
 // storage order in double, so it, the iteration count and every result do not depend on the
 // thread count.
+//
+// The neighbour passes run on the processor's SIMD target (cpu_simd_passes.h: the factor pass in
+// sort_and_density, the velocity updates, the rates and the non-pressure accelerations here) and
+// read the columns: positions, the velocities each velocity update writes next to the records,
+// the density pass's 1 / rho and counts, and the iteration's k in the pressure column.
 #include <algorithm>
 #include <cmath>
 
@@ -30,31 +35,36 @@ void CpuBackend::dfsph_find_contacts(const SceneFrame& scene, const SubstepTime&
 void CpuBackend::dfsph_correct(const FluidConstants& fluid, const DfsphWalls& walls, float dt, Float4* v,
                                float* carried, float carry_scale) {
   const GridView view = grid_.view();
-  const Float4* pos = position_.data();
-  const float* k = dfsph_step_.data();
+  const NeighborColumns columns = columns_.view();
+  const float* k = columns_.dfsph_step();
   const Float4* contact = dfsph_contacts_ ? dfsph_contact_.data() : nullptr;
+  const SimdPasses::DfsphVelocityChangeFn change = simd_.dfsph_velocity_change;
+  // The gather reads positions and k; each particle writes only its own velocity (record and
+  // column), which the next rate pass reads.
   parallel().for_each(count_, [&](uint32_t i) {
-    const uint32_t p = static_cast<uint32_t>(i);
-    Vec3 vi = xyz(v[i]) + pressure_velocity_change(fluid, view, pos, k, walls, p, dt);
+    Vec3 vi = xyz(v[i]) + change(fluid, view, columns, k, walls, i, dt);
     if (contact) vi = respect_contact(contact[i], vi);
     v[i] = make_float4_record(vi, v[i].w);
+    columns_.set_velocity(i, vi);
     carried[i] += k[i] * carry_scale;
   });
 }
 
 float CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls,
-                                  float dt, const Float4* v) {
+                                  float dt) {
   const GridView view = grid_.view();
-  const Float4* pos = position_.data();
+  const NeighborColumns columns = columns_.view();
   const float* factor = dfsph_factor_.data();
   const float* density = density_.data();
   const uint32_t* neighbors = neighbors_.data();
-  float* k = dfsph_step_.data();
+  float* k = columns_.dfsph_step();
   float* error = dfsph_residual_.data();
   const Dfsph::Constants& c = fluid.methods.dfsph;
   const float rho0 = fluid.rest_density;
+  const SimdPasses::DfsphRateFn density_rate_of = simd_.dfsph_density_rate;
+  // The gather reads positions and the velocities' columns; each particle writes only its k.
   parallel().for_each(count_, [&](uint32_t i) {
-    const float rate = density_rate(fluid, view, pos, v, walls, static_cast<uint32_t>(i));
+    const float rate = density_rate_of(fluid, view, columns, walls, i);
     const DfsphResidual r = kind == DfsphSolve::Divergence
                                 ? divergence_residual(c, rate, neighbors[i], factor[i], rho0, dt)
                                 : density_residual(rate, density[i], factor[i], rho0, dt);
@@ -76,17 +86,17 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
   const uint32_t max_iterations = divergence ? c.max_divergence_iterations : c.max_iterations;
   // The warm start: half the last substep's pressure, applied once; the solve's own
   // pressures add to it.
-  float* k = dfsph_step_.data();
+  float* k = columns_.dfsph_step();
   parallel().for_each(count_, [&](uint32_t i) {
     k[i] = Dfsph::kWarmStart * carried[i] / carry_scale;
     carried[i] = 0.0f;
   });
   dfsph_correct(fluid, walls, dt, v, carried, carry_scale);
-  float error = dfsph_residuals(kind, fluid, walls, dt, v);
+  float error = dfsph_residuals(kind, fluid, walls, dt);
   uint32_t iterations = 0;
   while ((error > bound || iterations < min_iterations) && iterations < max_iterations) {
     dfsph_correct(fluid, walls, dt, v, carried, carry_scale);
-    error = dfsph_residuals(kind, fluid, walls, dt, v);
+    error = dfsph_residuals(kind, fluid, walls, dt);
     ++iterations;
   }
   return SolveOutcome{iterations, error, error > bound};
@@ -116,13 +126,15 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
   Float4* next_pos = next_position_.data();
   Float4* next_vel = next_velocity_.data();
   const Float4* spring = spring_acceleration_.data();
-  const ScalarAccelerationFn non_pressure = scalar_acceleration_function();
-  const ForceInputs inputs = force_inputs();
+  // The gather without the pressure force on the SIMD target, over the columns: the velocities
+  // the divergence solve left (or the sorted ones without it), the density pass's 1 / rho.
+  const AccelerationFn non_pressure = simd_.acceleration_without_pressure_for(config_.selection());
+  const NeighborColumns columns = columns_.view();
   const Float4* contact = dfsph_contacts_ ? dfsph_contact_.data() : nullptr;
   const float a2max = parallel().reduce(
       count_, 0.0f,
       [&](uint32_t i, float& m) {
-        Vec3 a = non_pressure(fluid, view, inputs, scene, i);
+        Vec3 a = acceleration(non_pressure, fluid, view, columns, scene, i);
         if (spring) a += xyz(spring[i]);
         m = std::max(m, length_squared(a));
         Vec3 v = xyz(vel[i]) + a * dt;

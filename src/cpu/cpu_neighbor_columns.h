@@ -24,10 +24,10 @@ struct NeighborColumns {
   const float* x;
   const float* y;
   const float* z;
-  const float* vx;
+  const float* vx;  // velocities; DFSPH: those its solve's last velocity update wrote
   const float* vy;
   const float* vz;
-  const float* pressure;        // p, after the density pass
+  const float* pressure;        // p, after the density pass; DFSPH: its solve's k = p / rho^2
   const float* inv_density;     // 1 / rho, after the density pass
   const float* neighbor_count;  // n (exact in a float), after the density pass; Clavet only
   const float* normal_x;        // colour-field normal and its length; surface tension only
@@ -63,6 +63,15 @@ class CpuNeighborColumns {
   void set_neighbor_count(uint32_t i, uint32_t count) {
     if (counts_) neighbor_count_[i] = static_cast<float>(count);
   }
+  // DFSPH's solves (src/cpu/cpu_dfsph_solver.cpp): the velocity a velocity update gave particle
+  // i (the rate passes read it for neighbours), and the pressures k = p / rho^2 of the iteration,
+  // kept in the pressure column (a weakly compressible p is not used by DFSPH).
+  void set_velocity(uint32_t i, Vec3 v) {
+    vx_[i] = v.x;
+    vy_[i] = v.y;
+    vz_[i] = v.z;
+  }
+  float* dfsph_step() { return pressure_.data(); }
   void set_normal(uint32_t i, const Float4& n) {
     normal_x_[i] = n.x;
     normal_y_[i] = n.y;

@@ -20,6 +20,7 @@
 #include "../physics/density.h"
 #include "../physics/density_diffusion.h"
 #include "../physics/density_normalization.h"
+#include "../physics/dfsph_passes.h"
 #include "../physics/forces.h"
 #include "../physics/surface_tension.h"
 #include "cpu_simd_lanes.h"
@@ -166,6 +167,76 @@ SPH_SIMD_GATHER Float4 colour_normal(const FluidBase& f, const GridView& grid, c
   return make_float4_record(normal, length(normal));
 }
 
+// DFSPH's density and factor (gather_density_and_factor of dfsph_passes.h).
+template <class L>
+SPH_SIMD_GATHER DfsphDensitySample dfsph_density_and_factor(const FluidBase& f, const GridView& grid,
+                                                            const NeighborColumns& c,
+                                                            const BoundaryShare& wall, uint32_t i) {
+  const KernelCoefficients mk = mass_gradient_kernel(f);
+  const Vec3 xi{c.x[i], c.y[i], c.z[i]};
+  const Vec3Of<L> x = broadcast<L>(xi);
+  const L h2(f.kernel.h2), zero(0.0f), one(1.0f);
+  const Vec3Of<L> zero3{zero, zero, zero};
+  L kernel(0.0f), squares(0.0f), count(0.0f);
+  Vec3Of<L> gradient = zero3;
+  for_each_candidate_run<L>(grid, xi, i, true, [&](uint32_t base, const typename L::Mask& valid) {
+    const Vec3Of<L> d = x - load3<L>(c.x, c.y, c.z, base);
+    const L r2 = length_squared(d);
+    const typename L::Mask neighbor = valid && r2 < h2;
+    if (!any(neighbor)) return;
+    const DfsphFactorTermsOf<L> t = dfsph_factor_pair_terms(f, mk, d, r2);
+    kernel += select(neighbor, t.kernel, zero);
+    gradient += select(neighbor, t.gradient, zero3);
+    squares += select(neighbor, t.square, zero);
+    count += select(neighbor, one, zero);
+  });
+  return sph::dfsph_density_and_factor(f, reduce_sum(kernel), static_cast<uint32_t>(reduce_sum(count)),
+                                       reduce_vec3(gradient), reduce_sum(squares), wall);
+}
+
+// DFSPH's D rho_i / Dt (density_rate) over the velocities of the columns vx, vy, vz.
+template <class L>
+SPH_SIMD_GATHER float dfsph_density_rate(const FluidBase& f, const GridView& grid, const NeighborColumns& c,
+                                         const DfsphWalls& walls, uint32_t i) {
+  const KernelCoefficients mk = mass_gradient_kernel(f);
+  const Vec3 xi{c.x[i], c.y[i], c.z[i]};
+  const Vec3 vi{c.vx[i], c.vy[i], c.vz[i]};
+  const Vec3Of<L> x = broadcast<L>(xi);
+  const Vec3Of<L> v = broadcast<L>(vi);
+  const L h2(f.kernel.h2), zero(0.0f);
+  L rate(0.0f);
+  for_each_candidate_run<L>(grid, xi, i, true, [&](uint32_t base, const typename L::Mask& valid) {
+    const Vec3Of<L> d = x - load3<L>(c.x, c.y, c.z, base);
+    const L r2 = length_squared(d);
+    const typename L::Mask neighbor = valid && r2 < h2;
+    if (!any(neighbor)) return;
+    const Vec3Of<L> v_ij = v - load3<L>(c.vx, c.vy, c.vz, base);
+    rate += select(neighbor, density_rate_pair_term(mk, d, r2, v_ij), zero);
+  });
+  return sph::dfsph_density_rate(reduce_sum(rate), walls, i, vi);
+}
+
+// DFSPH's velocity change (pressure_velocity_change) from the pressures k (a column: padded).
+template <class L>
+SPH_SIMD_GATHER Vec3 dfsph_velocity_change(const FluidBase& f, const GridView& grid, const NeighborColumns& c,
+                                           const float* k, const DfsphWalls& walls, uint32_t i, float dt) {
+  const KernelCoefficients mk = mass_gradient_kernel(f);
+  const Vec3 xi{c.x[i], c.y[i], c.z[i]};
+  const Vec3Of<L> x = broadcast<L>(xi);
+  const float ki = k[i];
+  const L h2(f.kernel.h2), zero(0.0f), k_i(ki);
+  const Vec3Of<L> zero3{zero, zero, zero};
+  Vec3Of<L> sum = zero3;
+  for_each_candidate_run<L>(grid, xi, i, true, [&](uint32_t base, const typename L::Mask& valid) {
+    const Vec3Of<L> d = x - load3<L>(c.x, c.y, c.z, base);
+    const L r2 = length_squared(d);
+    const typename L::Mask neighbor = valid && r2 < h2;
+    if (!any(neighbor)) return;
+    sum += select(neighbor, pressure_velocity_pair_term(mk, d, r2, k_i + L::load(k + base)), zero3);
+  });
+  return sph::dfsph_velocity_change(reduce_vec3(sum), walls, i, ki, dt);
+}
+
 // Particle i as the force terms see it (force_particle in forces.h), from the columns.
 template <class List>
 ForceParticle force_particle_from_columns(const NeighborColumns& c, uint32_t i) {
@@ -181,7 +252,10 @@ ForceParticle force_particle_from_columns(const NeighborColumns& c, uint32_t i) 
   return p;
 }
 
-template <class L, class... Terms>
+// kPressure: with the symmetric pressure force (the weakly compressible scheme), or without it
+// (DFSPH's non-pressure accelerations: its pressure comes from its solves, and the pressure
+// column then holds their k, which this gather does not read).
+template <class L, bool kPressure, class... Terms>
 SPH_SIMD_GATHER Vec3 acceleration(const FluidConstants& f, const GridView& grid, const NeighborColumns& c,
                                   uint32_t i) {
   using List = TermList<Terms...>;
@@ -204,7 +278,7 @@ SPH_SIMD_GATHER Vec3 acceleration(const FluidConstants& f, const GridView& grid,
     pair.r2 = length_squared(pair.d);
     pair.neighbor = valid && pair.r2 < h2;
     if (!any(pair.neighbor)) return;
-    pair.pressure = L::load(c.pressure + base);
+    pair.pressure = kPressure ? L::load(c.pressure + base) : zero;
     pair.v = load3<L>(c.vx, c.vy, c.vz, base);
     pair.inv_density = L::load(c.inv_density + base);
     pair.r = square_root(pair.r2);
@@ -217,24 +291,29 @@ SPH_SIMD_GATHER Vec3 acceleration(const FluidConstants& f, const GridView& grid,
       pair.normal = Vec3Of<L>{zero, zero, zero};
       pair.normal_length = zero;
     }
-    SymmetricPressure::add_pair(f, lanes_self, pair, pressure);
+    if (kPressure) SymmetricPressure::add_pair(f, lanes_self, pair, pressure);
     List::add(f, lanes_self, pair, sums);
   });
   const SymmetricPressure::Sums pressure_sums =
       reduce_term_sums<SymmetricPressure::Sums, SymmetricPressure::SumsOf<L>, L>(pressure);
   TermSums<float, Terms...> term_sums;
   reduce_term_list(sums, term_sums);
-  return finish_acceleration<List>(f, self, pressure_sums, term_sums);
+  return finish_acceleration<List, TermSums<float, Terms...>, kPressure>(f, self, pressure_sums, term_sums);
 }
 
-template <class L, class... Terms>
+template <class L, bool kPressure, class... Terms>
 SimdPasses::AccelerationFn acceleration_of(ForceTerms<Terms...>) {
-  return &acceleration<L, Terms...>;
+  return &acceleration<L, kPressure, Terms...>;
 }
 
 template <class L>
 SimdPasses::AccelerationFn acceleration_for(const MethodSelection& s) {
-  return with_force_terms(s, [](auto terms) { return acceleration_of<L>(terms); });
+  return with_force_terms(s, [](auto terms) { return acceleration_of<L, true>(terms); });
+}
+
+template <class L>
+SimdPasses::AccelerationFn acceleration_without_pressure_for(const MethodSelection& s) {
+  return with_force_terms(s, [](auto terms) { return acceleration_of<L, false>(terms); });
 }
 
 template <class L>
@@ -245,7 +324,11 @@ constexpr SimdPasses make_simd_passes(SimdTarget target, const char* name) {
                     &normalized_density<L>,
                     &density_diffusion<L>,
                     &colour_normal<L>,
-                    &acceleration_for<L>};
+                    &acceleration_for<L>,
+                    &acceleration_without_pressure_for<L>,
+                    &dfsph_density_and_factor<L>,
+                    &dfsph_density_rate<L>,
+                    &dfsph_velocity_change<L>};
 }
 
 }  // namespace simd

@@ -11,6 +11,7 @@
 #include <stdint.h>
 
 #include "../physics/density.h"
+#include "../physics/dfsph_passes.h"
 #include "../physics/fluid_constants.h"
 #include "../physics/methods.h"
 #include "../physics/neighbor_walk.h"
@@ -33,6 +34,13 @@ struct SimdPasses {
   // combination of force terms.
   using AccelerationFn = Vec3 (*)(const FluidConstants&, const GridView&, const NeighborColumns&, uint32_t);
 
+  using DfsphFactorFn = DfsphDensitySample (*)(const FluidBase&, const GridView&, const NeighborColumns&,
+                                               const BoundaryShare&, uint32_t);
+  using DfsphRateFn = float (*)(const FluidBase&, const GridView&, const NeighborColumns&, const DfsphWalls&,
+                                uint32_t);
+  using DfsphVelocityChangeFn = Vec3 (*)(const FluidBase&, const GridView&, const NeighborColumns&,
+                                         const float*, const DfsphWalls&, uint32_t, float);
+
   SimdTarget target;
   const char* name;  // "generic", "avx2", "avx512"
   DensityFn density;
@@ -41,6 +49,16 @@ struct SimdPasses {
   ColourNormalFn colour_normal;
   // The acceleration function for the force terms a world runs (methods.h, with_force_terms).
   AccelerationFn (*acceleration_for)(const MethodSelection&);
+  // The same without the pressure force (gather_acceleration<Terms, false>): DFSPH's
+  // non-pressure accelerations.
+  AccelerationFn (*acceleration_without_pressure_for)(const MethodSelection&);
+  // DFSPH's three gathers (dfsph_passes.h): the density and factor (gather_density_and_factor,
+  // wall: the walls' share at x_i), D rho_i / Dt over the columns' velocities (density_rate),
+  // and the velocity change from the pressures k (pressure_velocity_change; k padded as a
+  // column, kLanePadding elements past the particles).
+  DfsphFactorFn dfsph_density_and_factor;
+  DfsphRateFn dfsph_density_rate;
+  DfsphVelocityChangeFn dfsph_velocity_change;
 };
 
 // The passes of a target, or null when this build does not have it.

@@ -46,18 +46,20 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
     return b;
   };
   if (config_.solver == Solver::Dfsph) {
-    // DFSPH: the density and the factor alpha / rho in one walk (the scalar gather: the SIMD
-    // passes serve the weakly compressible scheme); no equation of state (w: the pressure,
-    // written when the density solve has found it). Its solves read the records, not the columns.
+    // DFSPH: the density and the factor alpha / rho in one walk (on the SIMD target); no equation
+    // of state (w: the pressure, written when the density solve has found it). Its solves read
+    // the columns' positions and write their velocities and pressures into the columns
+    // (cpu_dfsph_solver.cpp).
     float* dfsph_factor = dfsph_factor_.data();
     parallel().for_each(count_, [&](uint32_t i) {
-      const DfsphDensitySample s =
-          gather_density_and_factor(fluid, view, pos, wall(i), static_cast<uint32_t>(i));
+      const DfsphDensitySample s = simd_.dfsph_density_and_factor(fluid, view, columns, wall(i), i);
       density_[i] = s.density;
       neighbors_[i] = s.neighbor_count;
       dfsph_factor[i] = s.factor;
       pos[i].w = 0.0f;
       vel[i].w = 1.0f / s.density;
+      columns_.set_density(i, 0.0f, vel[i].w);
+      columns_.set_neighbor_count(i, s.neighbor_count);
     });
   } else {
     parallel().for_each(count_, [&](uint32_t i) {

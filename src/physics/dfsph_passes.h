@@ -46,6 +46,62 @@ struct DfsphDensitySample {
   float factor;             // alpha_i / rho_i = 1 / D_i, or 0 where D_i is too small
 };
 
+// The pair terms of the three gathers, for a neighbour j of i (r2 < h^2, j != i) at
+// d = x_i - x_j, r = |d|. T is float or a pack of lanes (lane_math.h): the scalar gathers below
+// (both backends) and the CPU backend's SIMD passes (src/cpu/cpu_simd_gathers.h) add the same
+// terms, so only the order of the sums can differ between them.
+//
+// The density and factor pass: W_ij, m grad W_ij and |m grad W_ij|^2 (mk: mass_gradient_kernel).
+template <class T>
+struct DfsphFactorTermsOf {
+  T kernel;
+  Vec3Of<T> gradient;
+  T square;
+};
+template <class T>
+SPH_HD DfsphFactorTermsOf<T> dfsph_factor_pair_terms(const FluidBase& f, const KernelCoefficients& mk,
+                                                     Vec3Of<T> d, T r2) {
+  const T r = square_root(r2);
+  const Vec3Of<T> g = spiky_gradient(mk, d, r);
+  return DfsphFactorTermsOf<T>{spiky_value(f.kernel, r), g, length_squared(g)};
+}
+
+// The density rate: m (v_i - v_j) . grad W_ij (v_ij = v_i - v_j).
+template <class T>
+SPH_HD T density_rate_pair_term(const KernelCoefficients& mk, Vec3Of<T> d, T r2, Vec3Of<T> v_ij) {
+  return dot(v_ij, spiky_gradient(mk, d, square_root(r2)));
+}
+
+// The velocity update: m (k_i + k_j) grad W_ij (k_ij = k_i + k_j).
+template <class T>
+SPH_HD Vec3Of<T> pressure_velocity_pair_term(const KernelCoefficients& mk, Vec3Of<T> d, T r2, T k_ij) {
+  return spiky_gradient(mk, d, square_root(r2)) * k_ij;
+}
+
+// What each gather makes of its sums and the walls' share (one text for every path).
+// kernel_sum = sum_j W_ij, gradient = sum_j m grad W_ij, squares = sum_j |m grad W_ij|^2.
+SPH_HD DfsphDensitySample dfsph_density_and_factor(const FluidBase& f, float kernel_sum, uint32_t neighbors,
+                                                   Vec3 gradient, float squares, const BoundaryShare& wall) {
+  const KernelCoefficients mk = mass_gradient_kernel(f);
+  // Boundary place 1: the walls' density and their gradient in alpha (dfsph_boundary.h).
+  const float density = f.particle_mass * (f.density_self_weight + kernel_sum) + wall.density;
+  gradient += wall.gradient;
+  const float denominator = length_squared(gradient) + squares;
+  // One pair's largest term, (m |grad W(0)|)^2: the scale below which alpha would blow up.
+  const float pair_max = -mk.spiky_grad * f.kernel.h2;
+  const float smallest = Dfsph::kFactorFloor * pair_max * pair_max;
+  return DfsphDensitySample{density, neighbors, denominator > smallest ? 1.0f / denominator : 0.0f};
+}
+// sum = sum_j m (v_i - v_j) . grad W_ij.
+SPH_HD float dfsph_density_rate(float sum, const DfsphWalls& walls, uint32_t i, Vec3 vi) {
+  return sum + wall_density_rate(walls, i, vi);  // boundary place 2: the walls' relative motion
+}
+// sum = sum_j m (k_i + k_j) grad W_ij.
+SPH_HD Vec3 dfsph_velocity_change(Vec3 sum, const DfsphWalls& walls, uint32_t i, float ki, float dt) {
+  sum += wall_pressure_gradient(walls, i) * ki;  // boundary place 3: the walls' share, k_i alone
+  return sum * (-dt);
+}
+
 // The density of density.h (the same sum in the same order) and the factor, in one walk.
 // wall: the walls' share at x_i (boundary_share; no_boundary_share() without the feature).
 SPH_HD DfsphDensitySample gather_density_and_factor(const FluidBase& f, const GridView& grid,
@@ -61,22 +117,14 @@ SPH_HD DfsphDensitySample gather_density_and_factor(const FluidBase& f, const Gr
     const Vec3 d = xi - xyz(positions[j]);
     const float r2 = length_squared(d);
     if (r2 < f.kernel.h2 && j != i) {
-      const float r = SPH_SQRTF(r2);
-      sum += spiky_value(f.kernel, r);
+      const DfsphFactorTermsOf<float> t = dfsph_factor_pair_terms(f, mk, d, r2);
+      sum += t.kernel;
       ++neighbors;
-      const Vec3 g = spiky_gradient(mk, d, r);
-      gradient += g;
-      squares += length_squared(g);
+      gradient += t.gradient;
+      squares += t.square;
     }
   });
-  // Boundary place 1: the walls' density and their gradient in alpha (dfsph_boundary.h).
-  const float density = f.particle_mass * (f.density_self_weight + sum) + wall.density;
-  gradient += wall.gradient;
-  const float denominator = length_squared(gradient) + squares;
-  // One pair's largest term, (m |grad W(0)|)^2: the scale below which alpha would blow up.
-  const float pair_max = -mk.spiky_grad * f.kernel.h2;
-  const float smallest = Dfsph::kFactorFloor * pair_max * pair_max;
-  return DfsphDensitySample{density, neighbors, denominator > smallest ? 1.0f / denominator : 0.0f};
+  return dfsph_density_and_factor(f, sum, neighbors, gradient, squares, wall);
 }
 
 // D rho_i / Dt = sum_j m (v_i - v_j) . grad W_ij over the velocities `velocities` (xyz).
@@ -89,10 +137,9 @@ SPH_HD float density_rate(const FluidBase& f, const GridView& grid, const Float4
   for_each_neighbor_candidate(grid, xi, [&](uint32_t j) {
     const Vec3 d = xi - xyz(positions[j]);
     const float r2 = length_squared(d);
-    if (r2 < f.kernel.h2 && j != i)
-      rate += dot(vi - xyz(velocities[j]), spiky_gradient(mk, d, SPH_SQRTF(r2)));
+    if (r2 < f.kernel.h2 && j != i) rate += density_rate_pair_term(mk, d, r2, vi - xyz(velocities[j]));
   });
-  return rate + wall_density_rate(walls, i, vi);  // boundary place 2: the walls' relative motion
+  return dfsph_density_rate(rate, walls, i, vi);
 }
 
 // The velocity change of particle i from the pressures k (k_j = p_j / rho_j^2 of this
@@ -106,10 +153,9 @@ SPH_HD Vec3 pressure_velocity_change(const FluidBase& f, const GridView& grid, c
   for_each_neighbor_candidate(grid, xi, [&](uint32_t j) {
     const Vec3 d = xi - xyz(positions[j]);
     const float r2 = length_squared(d);
-    if (r2 < f.kernel.h2 && j != i) sum += spiky_gradient(mk, d, SPH_SQRTF(r2)) * (ki + k[j]);
+    if (r2 < f.kernel.h2 && j != i) sum += pressure_velocity_pair_term(mk, d, r2, ki + k[j]);
   });
-  sum += wall_pressure_gradient(walls, i) * ki;  // boundary place 3: the walls' share, k_i alone
-  return sum * (-dt);
+  return dfsph_velocity_change(sum, walls, i, ki, dt);
 }
 
 // One particle's result of a residual pass.

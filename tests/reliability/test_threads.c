@@ -14,7 +14,9 @@
  *    density share ends bitwise alike on 1, 2 and 3 workers. Every particle's result depends
  *    on its index alone and the reductions are max/min, so neither the split of the loops
  *    (dynamic chunks, handed out in whatever order the threads come) nor their count may
- *    change a result.
+ *    change a result. The same for DFSPH (with surface tension, Clavet's viscosity and the walls'
+ *    density share): its solves' mean errors are summed in storage order, so the iteration
+ *    counts, and with them every result, may not depend on the workers either.
  *
  * Run under ThreadSanitizer in scripts/test (build-tsan/), where any data race fails the run.
  * Worker threads never call cmocka (its failure path longjmps); they record results and the
@@ -309,7 +311,7 @@ typedef struct worker_run {
   uint32_t count;
 } worker_run;
 
-static sph_result run_with_workers(unsigned workers, worker_run* out) {
+static sph_result run_with_workers(unsigned workers, sph_solver solver, worker_run* out) {
   const support_tank tank = {{0.0f, 0.0f, 0.0f}, {0.3f, 0.3f, 0.15f}, 0.02f, 0.0f};
   const sph_vec3 column_min = {-0.28f, -0.28f, -0.13f}, column_max = {-0.08f, 0.08f, 0.13f};
   sph_context_def context_def;
@@ -326,6 +328,11 @@ static sph_result run_with_workers(unsigned workers, worker_run* out) {
   def.capacity = 12000;
   def.particle_spacing = 0.014f;
   def.features = SPH_FEATURE_SURFACE_TENSION | SPH_FEATURE_NORMALIZED_DENSITY | SPH_FEATURE_BOUNDARY_DENSITY;
+  if (solver == SPH_SOLVER_DFSPH) { /* DFSPH refuses the normalised density */
+    def.solver = SPH_SOLVER_DFSPH;
+    def.features = SPH_FEATURE_SURFACE_TENSION | SPH_FEATURE_BOUNDARY_DENSITY;
+    def.viscosity_method = SPH_VISCOSITY_CLAVET;
+  }
   if ((r = sph_world_create(context, &def, &world)) != SPH_OK) goto done;
   sph_world_params_init(&params);
   params.max_substeps = 200;
@@ -345,14 +352,13 @@ done:
   return r;
 }
 
-static void test_worker_count_changes_no_bit(void** state) {
-  (void)state;
+static void check_worker_count_changes_no_bit(sph_solver solver) {
 #ifdef SPH_TEST_TSAN_BUILD
   skip(); /* one worker under ThreadSanitizer (create_context) */
 #endif
   if (sph_test_backend() == SPH_BACKEND_CUDA) skip(); /* the CPU backend's workers */
   worker_run runs[3] = {{0}};
-  for (unsigned w = 0; w < 3; ++w) EXPECT_OK(run_with_workers(w + 1u, &runs[w]));
+  for (unsigned w = 0; w < 3; ++w) EXPECT_OK(run_with_workers(w + 1u, solver, &runs[w]));
   for (unsigned w = 1; w < 3; ++w) {
     assert_int_equal(runs[w].count, runs[0].count);
     const size_t bytes = sizeof(float) * 3u * runs[0].count;
@@ -366,12 +372,23 @@ static void test_worker_count_changes_no_bit(void** state) {
   }
 }
 
+static void test_worker_count_changes_no_bit(void** state) {
+  (void)state;
+  check_worker_count_changes_no_bit(SPH_SOLVER_WCSPH);
+}
+
+static void test_dfsph_worker_count_changes_no_bit(void** state) {
+  (void)state;
+  check_worker_count_changes_no_bit(SPH_SOLVER_DFSPH);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_worlds_on_threads_shared_context),
       cmocka_unit_test(test_worlds_on_threads_own_contexts),
       cmocka_unit_test(test_world_used_from_two_threads),
       cmocka_unit_test(test_worker_count_changes_no_bit),
+      cmocka_unit_test(test_dfsph_worker_count_changes_no_bit),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

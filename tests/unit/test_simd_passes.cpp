@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The CPU backend's SIMD passes (src/cpu/cpu_simd_passes.h) against the scalar gathers of the
-// shared physics (density.h, density_normalization.h, surface_tension.h, forces.h), on random
+// shared physics (density.h, density_normalization.h, surface_tension.h, forces.h, and DFSPH's
+// dfsph_passes.h with and without the walls' share), on random
 // neighbourhoods: uniform clouds with about 40 neighbours per particle, one that folds onto a
 // small wrapped table (far candidates in every run), coincident particles (r = 0 between two
 // different particles) and a dense knot (runs longer than 16 candidates).
@@ -13,7 +14,8 @@
 //    (n - 1) u sum |t_k| of the exact sum (u = 2^-24; Higham, "Accuracy and Stability of
 //    Numerical Algorithms", 2nd ed., eq. 4.4), so two orders differ by at most 2 (n - 1) u
 //    sum |t_k|; the bound used is 4 (n + 1) u sum |t_k| for the rounding of the final scaling
-//    (finish) as well. The neighbour counts are equal.
+//    (finish) as well. The neighbour counts are equal. DFSPH's factor 1 / D, D = |sum_j g_j|^2 +
+//    sum_j |g_j|^2 (g_j = m grad W_ij), is bounded through its sums (test_dfsph_passes).
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -35,6 +37,7 @@ extern "C" {
 #include "cpu/cpu_simd_passes.h"
 #include "physics/density.h"
 #include "physics/density_normalization.h"
+#include "physics/dfsph_passes.h"
 #include "physics/forces.h"
 #include "physics/surface_tension.h"
 
@@ -217,16 +220,18 @@ void test_density_passes(void**) {
 }
 
 // Particle i's acceleration from neighbour j alone (A_0 = 0: no gravity, no neighbour).
-template <class Terms>
+template <class Terms, bool kPressure>
 Vec3 single_pair_acceleration(const sph::FluidConstants& f, const sph::ForceInputs& in, uint32_t i,
                               uint32_t j) {
-  sph::AccelerationGather<Terms> gather(in, i);
+  sph::AccelerationGather<Terms, kPressure> gather(in, i);
   const Float4 pj = in.positions[j];
   const Vec3 d = gather.position() - sph::xyz(pj);
   gather.add(f, j, pj, d, sph::length_squared(d));
   return gather.finish(f);
 }
 
+// pressure: the weakly compressible gather, or DFSPH's without the pressure force.
+template <bool kPressure>
 void check_forces(const sph::MethodSelection& selection, const char* name) {
   const std::vector<std::vector<Vec3>> all = clouds();
   const std::vector<const sph::SimdPasses*> targets = runnable_targets();
@@ -237,7 +242,9 @@ void check_forces(const sph::MethodSelection& selection, const char* name) {
     const sph::NeighborColumns columns = s.columns.view();
     const sph::ForceInputs in = s.inputs();
     std::vector<sph::SimdPasses::AccelerationFn> simd;
-    for (const sph::SimdPasses* t : targets) simd.push_back(t->acceleration_for(selection));
+    for (const sph::SimdPasses* t : targets)
+      simd.push_back(kPressure ? t->acceleration_for(selection)
+                               : t->acceleration_without_pressure_for(selection));
     size_t failures = 0;
     for (uint32_t i = 0; i < s.n; ++i) {
       Vec3 scalar{0.0f, 0.0f, 0.0f};
@@ -245,11 +252,11 @@ void check_forces(const sph::MethodSelection& selection, const char* name) {
       uint32_t nb = 0;
       sph::with_force_terms(selection, [&](auto terms) {
         using Terms = decltype(terms);
-        scalar = sph::gather_acceleration<Terms>(f, view, in, i);
+        scalar = sph::gather_acceleration<Terms, kPressure>(f, view, in, i);
         const Vec3 xi = sph::xyz(s.positions[i]);
         sph::for_each_neighbor_candidate(view, xi, [&](uint32_t j) {
           if (!sph::is_force_neighbor(f, sph::length_squared(xi - sph::xyz(s.positions[j])), i, j)) return;
-          const Vec3 a = single_pair_acceleration<Terms>(f, in, i, j);
+          const Vec3 a = single_pair_acceleration<Terms, kPressure>(f, in, i, j);
           scale[0] += std::fabs(a.x);
           scale[1] += std::fabs(a.y);
           scale[2] += std::fabs(a.z);
@@ -268,27 +275,156 @@ void check_forces(const sph::MethodSelection& selection, const char* name) {
       }
       if (!ok) ++failures;
     }
-    std::printf("%s, cloud %zu: %u particles, %zu targets, %zu mismatches\n", name, c, s.n, targets.size(),
-                failures);
+    std::printf("%s%s, cloud %zu: %u particles, %zu targets, %zu mismatches\n", name,
+                kPressure ? "" : " (DFSPH: no pressure force)", c, s.n, targets.size(), failures);
     assert_int_equal(failures, 0);
   }
 }
 
-void test_forces_mueller(void**) { check_forces(sph::MethodSelection{}, "pressure + Mueller"); }
+void test_forces_mueller(void**) {
+  check_forces<true>(sph::MethodSelection{}, "pressure + Mueller");
+  check_forces<false>(sph::MethodSelection{}, "Mueller");
+}
 
 void test_forces_clavet(void**) {
   sph::MethodSelection s;
   s.viscosity = sph::ViscosityMethod::Clavet;
-  check_forces(s, "pressure + Clavet");
+  check_forces<true>(s, "pressure + Clavet");
+  check_forces<false>(s, "Clavet");
 }
 
 void test_forces_surface_tension(void**) {
   sph::MethodSelection s;
   s.features = sph::kFeatureSurfaceTension;
-  check_forces(s, "pressure + Mueller + surface tension");
+  check_forces<true>(s, "pressure + Mueller + surface tension");
+  check_forces<false>(s, "Mueller + surface tension");
   s.viscosity = sph::ViscosityMethod::Clavet;
-  check_forces(s, "pressure + Clavet + surface tension");
+  check_forces<true>(s, "pressure + Clavet + surface tension");
+  check_forces<false>(s, "Clavet + surface tension");
 }
+
+// DFSPH's three gathers (dfsph_passes.h) against their scalar twins, without walls and with a
+// random walls' share (density, gradient and flux in the ranges a density map gives at 2 cm:
+// |grad rho_b| up to rho0 / h, about m |grad W| of one close pair).
+//
+// The density, the rate and the velocity change are sums of the same float terms: the bound of
+// the file's header. The factor 1 / D: each component G_c of G = sum_j g_j + grad rho_b is off
+// by at most e_c = 4 (n + 1) u sum_j |g_jc| and the sum of squares S by e_S = 4 (n + 1) u S, so
+// D = |G|^2 + S by at most sum_c (2 |G_c| + e_c) e_c + e_S, plus 8 u D for the rounding of
+// |G|^2 + S on each side; 1 / D then within that share of D (and 2 u for the division).
+void check_dfsph(bool walls) {
+  const std::vector<std::vector<Vec3>> all = clouds();
+  const std::vector<const sph::SimdPasses*> targets = runnable_targets();
+  const float dt = 1e-3f;
+  for (size_t c = 0; c < all.size(); ++c) {
+    Scene s(all[c], static_cast<uint32_t>(30 + c));
+    const sph::FluidConstants f = s.fluid(sph::MethodSelection{});
+    const sph::KernelCoefficients mk = sph::mass_gradient_kernel(f);
+    const sph::GridView view = s.view();
+    const sph::NeighborColumns columns = s.columns.view();
+    // k = p / rho^2 of an iteration (0 to a few 1e-4 in a dam break at 2 cm), padded as a column.
+    std::mt19937 rng(static_cast<uint32_t>(40 + c));
+    std::uniform_real_distribution<float> k_of(0.0f, 1e-3f), density(0.0f, 500.0f), gradient(-3e4f, 3e4f),
+        flux(-50.0f, 50.0f);
+    std::vector<float> k(s.n + sph::kLanePadding, 0.0f);
+    for (uint32_t i = 0; i < s.n; ++i) k[i] = k_of(rng);
+    std::vector<sph::BoundaryShare> shares(s.n, sph::no_boundary_share());
+    std::vector<Float4> records(s.n);
+    for (uint32_t i = 0; i < s.n; ++i) {
+      if (walls && i % 3 != 0)
+        shares[i] =
+            sph::BoundaryShare{density(rng), Vec3{gradient(rng), gradient(rng), gradient(rng)}, flux(rng)};
+      records[i] = sph::pack_boundary(shares[i]);
+    }
+    const sph::DfsphWalls dfsph_walls{walls ? records.data() : nullptr};
+    size_t failures = 0, pairs = 0;
+    for (uint32_t i = 0; i < s.n; ++i) {
+      const sph::DfsphDensitySample scalar =
+          sph::gather_density_and_factor(f, view, s.positions.data(), shares[i], i);
+      const float rate_scalar =
+          sph::density_rate(f, view, s.positions.data(), s.velocities.data(), dfsph_walls, i);
+      const Vec3 change_scalar =
+          sph::pressure_velocity_change(f, view, s.positions.data(), k.data(), dfsph_walls, i, dt);
+      // The terms' magnitudes, from the scalar's own float terms.
+      double g_abs[3] = {0.0, 0.0, 0.0}, g_sum[3] = {0.0, 0.0, 0.0}, squares = 0.0, rate_abs = 0.0;
+      double change_abs[3] = {0.0, 0.0, 0.0};
+      const Vec3 xi = sph::xyz(s.positions[i]);
+      const Vec3 vi = sph::xyz(s.velocities[i]);
+      sph::for_each_neighbor_candidate(view, xi, [&](uint32_t j) {
+        const Vec3 d = xi - sph::xyz(s.positions[j]);
+        const float r2 = sph::length_squared(d);
+        if (r2 >= f.kernel.h2 || j == i) return;
+        const sph::DfsphFactorTermsOf<float> t = sph::dfsph_factor_pair_terms(f, mk, d, r2);
+        const float g[3] = {t.gradient.x, t.gradient.y, t.gradient.z};
+        for (int a = 0; a < 3; ++a) {
+          g_abs[a] += std::fabs(g[a]);
+          g_sum[a] += g[a];
+        }
+        squares += t.square;
+        rate_abs += std::fabs(sph::density_rate_pair_term(mk, d, r2, vi - sph::xyz(s.velocities[j])));
+        const Vec3 dv = sph::pressure_velocity_pair_term(mk, d, r2, k[i] + k[j]);
+        change_abs[0] += std::fabs(dv.x);
+        change_abs[1] += std::fabs(dv.y);
+        change_abs[2] += std::fabs(dv.z);
+      });
+      const Vec3 wg = shares[i].gradient;
+      const double wall_g[3] = {wg.x, wg.y, wg.z};
+      if (walls) {
+        rate_abs += std::fabs(sph::wall_density_rate(dfsph_walls, i, vi));
+        for (int a = 0; a < 3; ++a) change_abs[a] += std::fabs(wall_g[a] * k[i]);
+      }
+      const uint32_t nb = scalar.neighbor_count;
+      pairs += nb;
+      const sph::SimdPasses& generic = *targets.front();
+      const sph::DfsphDensitySample simd = generic.dfsph_density_and_factor(f, view, columns, shares[i], i);
+      const float rate = generic.dfsph_density_rate(f, view, columns, dfsph_walls, i);
+      const Vec3 change = generic.dfsph_velocity_change(f, view, columns, k.data(), dfsph_walls, i, dt);
+      bool ok = simd.neighbor_count == nb;
+      ok = within_rounding(simd.density, scalar.density, scalar.density, nb, "DFSPH density", i) && ok;
+      // The factor, through D (module comment above).
+      const double e = 4.0 * (nb + 1) * kUnitRoundoff;
+      double d_exact = squares, d_error = e * squares;
+      for (int a = 0; a < 3; ++a) {
+        const double g = g_sum[a] + wall_g[a];
+        const double e_c = e * (g_abs[a] + std::fabs(wall_g[a]));
+        d_exact += g * g;
+        d_error += (2.0 * std::fabs(g) + e_c) * e_c;
+      }
+      d_error += 8.0 * kUnitRoundoff * d_exact;
+      if (scalar.factor == 0.0f || simd.factor == 0.0f) {
+        ok = ok && scalar.factor == simd.factor;  // no particle here sits at the floor
+      } else {
+        const double bound = scalar.factor * (d_error / (d_exact - d_error) + 2.0 * kUnitRoundoff);
+        if (std::fabs(simd.factor - scalar.factor) > bound) {
+          std::printf("  factor of particle %u: SIMD %.9g, scalar %.9g, bound %.3g\n", i, simd.factor,
+                      scalar.factor, bound);
+          ok = false;
+        }
+      }
+      ok = within_rounding(rate, rate_scalar, rate_abs, nb + 1, "rate", i) && ok;
+      ok = within_rounding(change.x, change_scalar.x, change_abs[0] * dt, nb + 1, "dv.x", i) && ok;
+      ok = within_rounding(change.y, change_scalar.y, change_abs[1] * dt, nb + 1, "dv.y", i) && ok;
+      ok = within_rounding(change.z, change_scalar.z, change_abs[2] * dt, nb + 1, "dv.z", i) && ok;
+      for (const sph::SimdPasses* t : targets) {
+        const bool same =
+            same_bits(t->dfsph_density_and_factor(f, view, columns, shares[i], i), simd) &&
+            same_bits(t->dfsph_density_rate(f, view, columns, dfsph_walls, i), rate) &&
+            same_bits(t->dfsph_velocity_change(f, view, columns, k.data(), dfsph_walls, i, dt), change);
+        if (!same && failures < 5) std::printf("  %s differs from generic at particle %u\n", t->name, i);
+        ok = ok && same;
+      }
+      if (!ok) ++failures;
+    }
+    std::printf("DFSPH%s, cloud %zu: %u particles, %.1f neighbours each, %zu targets, %zu mismatches\n",
+                walls ? " with walls" : "", c, s.n, static_cast<double>(pairs) / s.n, targets.size(),
+                failures);
+    assert_true(pairs > 20u * s.n);
+    assert_int_equal(failures, 0);
+  }
+}
+
+void test_dfsph_passes(void**) { check_dfsph(false); }
+void test_dfsph_passes_walls(void**) { check_dfsph(true); }
 
 // The best target is one this processor runs, and the x86 targets are built on x86-64.
 void test_dispatch(void**) {
@@ -311,6 +447,8 @@ int main() {
       cmocka_unit_test(test_forces_mueller),
       cmocka_unit_test(test_forces_clavet),
       cmocka_unit_test(test_forces_surface_tension),
+      cmocka_unit_test(test_dfsph_passes),
+      cmocka_unit_test(test_dfsph_passes_walls),
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
