@@ -17,13 +17,16 @@ namespace sph {
 void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame& scene, StageTime at,
                                   FrameReport& report, float diffusion_dt) {
   auto t = Clock::now();
-  grid_.build(position_.data(), count_, workers_);
+  if (ranks_) halo_gather();
+  grid_.build(position_.data(), count_, workers_, ranks_ ? &halo_shape_ : nullptr,
+              ranks_ ? halo_visit_.data() : nullptr);
   columns_.resize(count_);
   // The columns copy each block of the new order as soon as it is reordered (data() is the new
   // order inside the reorder).
   store_.permute(grid_.order().data(), count_, parallel(), [this](size_t first, size_t last) {
     columns_.copy_state(position_.data(), velocity_.data(), first, last);
   });
+  if (ranks_) halo_keys();
   report.stage_ms[kStageHashSort] += static_cast<float>(elapsed_ms(t));
 
   t = Clock::now();
@@ -77,6 +80,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
       columns_.set_density(static_cast<uint32_t>(i), pos[i].w, vel[i].w);
       columns_.set_neighbor_count(static_cast<uint32_t>(i), s.neighbor_count);
     });
+    if (ranks_) halo_share_density();
   }
   // The Shepard filter, unless the density diffusion keeps the carried density instead
   // (density_diffusion.h says why one or the other).

@@ -19,6 +19,7 @@ void CpuBackend::collide(const SceneFrame& scene, const SubstepTime& time, OldPo
   Float4* next_pos = next_position_.data();
   Float4* next_vel = next_velocity_.data();
   parallel().for_each(count_, [&](uint32_t i) {
+    if (ghost(i)) return;  // (a distributed world's halo: its owner moves it)
     Vec3 x = xyz(next_pos[i]);
     Vec3 v = xyz(next_vel[i]);
     const Vec3 from = x_old(static_cast<uint32_t>(i));
@@ -57,6 +58,7 @@ uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame
   const StateScan forces = parallel().reduce(
       count_, StateScan{},
       [&](uint32_t i, StateScan& r) {
+        if (ghost(i)) return;  // (a distributed world's halo: its owner moves it)
         Vec3 a = acceleration(gather, fluid, view, columns, scene, i);
         if (spring) a += xyz(spring[i]);
         a += wall_acceleration(i);
