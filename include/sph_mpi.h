@@ -54,7 +54,8 @@ static inline sph_result sph_mpi_world_def_init(sph_mpi_world_def* def) {
 /**
  * COLLECTIVE. Creates this rank's part of a world spread over the communicator whose Fortran
  * handle is `comm` (MPI_Comm_c2f). MPI must be initialised (MPI_Init) and stay so until every
- * distributed world is destroyed (sph_world_destroy, not collective). The library duplicates
+ * distributed world is destroyed (sph_world_destroy on every rank: it frees the duplicated
+ * communicator, which MPI counts as collective). The library duplicates
  * the communicator, so its messages never meet the caller's. `def` as sph_world_create's (the
  * same on every rank); `mpi_def` may be NULL (defaults). `context` must be a CPU context.
  * Errors: INVALID_ARGUMENT (NULL out, a bad def, a bad communicator), UNSUPPORTED (a CUDA

@@ -91,6 +91,11 @@ SPH_API sph_result SPH_CALL sph_world_step_begin(sph_world* world, float frame_d
     sph::require_world(world);
     sph::WorldLock lock(world);
     sph::require_positive(frame_dt, "frame_dt");
+    // Its MPI calls would run on the step's thread, which MPI_Init's thread level does not allow.
+    if (world->world->backend().distributed())
+      throw Error(Status::Unsupported,
+                  "world: a distributed world (sph_mpi.h) steps on the calling thread only; use "
+                  "sph_mpi_world_step");
     sph::start_async_step(world, [world, frame_dt] { return sph::run_frame_outcome(world, frame_dt); });
     world->async_step.pending.store(true);
     lock.hand_over();

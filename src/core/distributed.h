@@ -13,12 +13,12 @@ struct DistributedOptions {
 };
 
 struct DistributedCounters {
-  uint32_t ghosts = 0;          // halo particles this rank held in its last substep
-  uint32_t migrated_in = 0;     // particles this rank received from others, summed over substeps
-  uint32_t migrated_out = 0;    // particles this rank sent to others, summed over substeps
-  uint32_t rebalances = 0;      // times the slabs were cut anew (the first cut counts)
-  int32_t axis = 0;             // the slabs' axis (0 x, 1 y, 2 z)
-  int32_t slab_first = 0;       // this rank's cell layers [slab_first, slab_last] (empty: first > last)
+  uint32_t ghosts = 0;        // halo particles this rank held in its last substep
+  uint32_t migrated_in = 0;   // particles this rank received from others, summed over substeps
+  uint32_t migrated_out = 0;  // particles this rank sent to others, summed over substeps
+  uint32_t rebalances = 0;    // times the slabs were cut anew (the first cut counts)
+  int32_t axis = 0;           // the slabs' axis (0 x, 1 y, 2 z)
+  int32_t slab_first = 0;     // this rank's cell layers [slab_first, slab_last] (empty: first > last)
   int32_t slab_last = 0;
 };
 

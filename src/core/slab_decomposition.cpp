@@ -46,7 +46,8 @@ void SlabDecomposition::rebalance(int axis, int32_t first_layer, const std::vect
     // The smallest layer whose running count (layers before it) reaches r * total / n.
     const int64_t target = (total * r + n - 1) / n;
     while (k < histogram.size() && running < target) running += histogram[k++];
-    cuts[static_cast<size_t>(r - 1)] = k < histogram.size() ? first_layer + static_cast<int32_t>(k) : INT32_MAX;
+    cuts[static_cast<size_t>(r - 1)] =
+        k < histogram.size() ? first_layer + static_cast<int32_t>(k) : INT32_MAX;
   }
   cuts_ = cuts;
 }

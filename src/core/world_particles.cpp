@@ -66,8 +66,9 @@ uint32_t World::add_particles(const HostVector<Vec3>& positions, const HostVecto
 }
 
 uint32_t World::add_rank_particles(const HostVector<Vec3>& positions, const HostVector<Vec3>* velocities,
-                                  uint32_t first_id, uint32_t next_id_after) {
-  if (!backend_->distributed()) throw Error(Status::Internal, "add_rank_particles: the world is not distributed");
+                                   uint32_t first_id, uint32_t next_id_after) {
+  if (!backend_->distributed())
+    throw Error(Status::Internal, "add_rank_particles: the world is not distributed");
   const uint32_t next_id_before = next_id_;
   next_id_ = first_id;
   rank_add_ = true;

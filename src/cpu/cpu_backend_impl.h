@@ -239,6 +239,8 @@ class CpuBackend final : public Backend {
   // The substep's end: ghosts dropped, the step size's inputs and any failure agreed by all
   // ranks. Returns the world's first non-finite particle id (kAllFinite: none).
   uint32_t halo_end_substep(uint32_t bad_id);
+  // Whether `flag` is raised on any rank.
+  bool halo_any(bool flag) const;
   // Cell layer of particle i along the slabs' axis.
   int32_t halo_layer(uint32_t i) const;
   // Appends particle i's carried arrays to `out` / appends the records of `in` as particles

@@ -59,7 +59,8 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
   DfsphTallies tallies;
   try {
     while (clock_running(clock, params.stepping.max_substeps)) {
-      if (scene.interrupt.requested()) {
+      // A distributed world's ranks stop together: a cancel or budget seen by any rank stops all.
+      if (ranks_ ? halo_any(scene.interrupt.requested()) : scene.interrupt.requested()) {
         report.interrupted = true;
         break;
       }

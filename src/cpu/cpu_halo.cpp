@@ -39,17 +39,20 @@ void refuse(const std::string& what) {
 
 void CpuBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks, const DistributedOptions& options) {
   if (!ranks) throw Error(Status::Internal, "attach_ranks: no transport");
-  if (count_ != 0 || ranks_) throw Error(Status::Internal, "attach_ranks: the backend already holds particles");
-  if (config_.solver == Solver::Dfsph) refuse("the DFSPH solver (SPH_SOLVER_DFSPH: its pressure solves need a halo per iteration)");
+  if (count_ != 0 || ranks_)
+    throw Error(Status::Internal, "attach_ranks: the backend already holds particles");
+  if (config_.solver == Solver::Dfsph)
+    refuse("the DFSPH solver (SPH_SOLVER_DFSPH: its pressure solves need a halo per iteration)");
   if (config_.integrator == Integrator::Rk4) refuse("the RK4 integrator (SPH_INTEGRATOR_RK4)");
   const struct {
     uint32_t bit;
     const char* name;
-  } features[] = {{kFeatureSurfaceTension, "SPH_FEATURE_SURFACE_TENSION (its colour normals need a second halo)"},
-                  {kFeatureNormalizedDensity, "SPH_FEATURE_NORMALIZED_DENSITY (its filter needs a second halo)"},
-                  {kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks)"},
-                  {kFeatureColliderLoads, "SPH_FEATURE_COLLIDER_LOADS (loads summed over ranks)"},
-                  {kFeatureDensityDiffusion, "SPH_FEATURE_DENSITY_DIFFUSION (its diffusion needs a second halo)"}};
+  } features[] = {
+      {kFeatureSurfaceTension, "SPH_FEATURE_SURFACE_TENSION (its colour normals need a second halo)"},
+      {kFeatureNormalizedDensity, "SPH_FEATURE_NORMALIZED_DENSITY (its filter needs a second halo)"},
+      {kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks)"},
+      {kFeatureColliderLoads, "SPH_FEATURE_COLLIDER_LOADS (loads summed over ranks)"},
+      {kFeatureDensityDiffusion, "SPH_FEATURE_DENSITY_DIFFUSION (its diffusion needs a second halo)"}};
   for (const auto& f : features)
     if (config_.features & f.bit) refuse(f.name);
   const auto array = [](const char* name, uint32_t size, ParticleArrayRole role) {
@@ -70,6 +73,12 @@ DistributedCounters CpuBackend::distributed_counters() const {
   c.slab_first = me == 0 ? INT32_MIN : cuts[static_cast<size_t>(me - 1)];
   c.slab_last = me == static_cast<int>(cuts.size()) ? INT32_MAX : cuts[static_cast<size_t>(me)] - 1;
   return c;
+}
+
+bool CpuBackend::halo_any(bool flag) const {
+  int64_t raised = flag ? 1 : 0;
+  ranks_->all_max(&raised, 1);
+  return raised != 0;
 }
 
 int32_t CpuBackend::halo_layer(uint32_t i) const {
@@ -202,21 +211,20 @@ void CpuBackend::halo_gather() {
   t.all_max(hi, 3);
   t.all_sum(&total, 1);
   const bool any = total > 0;
-  const CellCoord clo = any ? CellCoord{static_cast<int32_t>(lo[0]), static_cast<int32_t>(lo[1]),
-                                        static_cast<int32_t>(lo[2])}
-                            : CellCoord{0, 0, 0};
-  const CellCoord chi = any ? CellCoord{static_cast<int32_t>(hi[0]), static_cast<int32_t>(hi[1]),
-                                        static_cast<int32_t>(hi[2])}
-                            : CellCoord{0, 0, 0};
+  const CellCoord clo =
+      any ? CellCoord{static_cast<int32_t>(lo[0]), static_cast<int32_t>(lo[1]), static_cast<int32_t>(lo[2])}
+          : CellCoord{0, 0, 0};
+  const CellCoord chi =
+      any ? CellCoord{static_cast<int32_t>(hi[0]), static_cast<int32_t>(hi[1]), static_cast<int32_t>(hi[2])}
+          : CellCoord{0, 0, 0};
   halo_shape_ = make_grid_shape_for_extent(config_.kernel_radius, clo, chi, static_cast<uint32_t>(total));
   // The sort's order: by key, then id (two keys are equal only where the table folds).
   halo_visit_.resize(count_);
   for (uint32_t i = 0; i < count_; ++i) halo_visit_[i] = i;
   const uint64_t* key = sort_key_.data();
   const uint32_t* id = id_.data();
-  std::sort(halo_visit_.begin(), halo_visit_.end(), [key, id](uint32_t a, uint32_t b) {
-    return key[a] != key[b] ? key[a] < key[b] : id[a] < id[b];
-  });
+  std::sort(halo_visit_.begin(), halo_visit_.end(),
+            [key, id](uint32_t a, uint32_t b) { return key[a] != key[b] ? key[a] < key[b] : id[a] < id[b]; });
 }
 
 void CpuBackend::halo_keys() {
@@ -245,8 +253,8 @@ void CpuBackend::halo_share_density() {
     const int n = slabs_.ghost_destinations(halo_layer(i), me, to);
     const Record r{id_[i], density_[i], position_[i].w, velocity_[i].w, neighbors_[i]};
     const unsigned char* from = reinterpret_cast<const unsigned char*>(&r);
-    for (int k = 0; k < n; ++k) out[static_cast<size_t>(to[k])].insert(out[static_cast<size_t>(to[k])].end(), from,
-                                                                       from + sizeof r);
+    for (int k = 0; k < n; ++k)
+      out[static_cast<size_t>(to[k])].insert(out[static_cast<size_t>(to[k])].end(), from, from + sizeof r);
   }
   const std::vector<RankBytes> in = t.exchange(out);
   std::vector<size_t> read(static_cast<size_t>(size), 0);
@@ -255,7 +263,8 @@ void CpuBackend::halo_share_density() {
     const size_t from = origin_[i] - 1u;
     Record r;
     if ((read[from] + 1) * sizeof r > in[from].size())
-      throw Error(Status::Internal, "halo: rank " + std::to_string(from) + " sent fewer densities than ghosts");
+      throw Error(Status::Internal,
+                  "halo: rank " + std::to_string(from) + " sent fewer densities than ghosts");
     std::memcpy(&r, in[from].data() + read[from]++ * sizeof r, sizeof r);
     if (r.id != id_[i])
       throw Error(Status::Internal, "halo: the densities of rank " + std::to_string(from) +

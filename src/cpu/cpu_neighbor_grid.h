@@ -29,8 +29,8 @@ class CpuNeighborGrid {
   // A distributed world's rank (cpu_halo.cpp) passes the world's shape (`shape`, else it is
   // chosen from these positions) and the order in which the sort takes the particles
   // (`visit`, n indices; else 0 .. n-1): within a slot they keep that order.
-  void build(const Float4* positions, uint32_t n, const CpuParallel& parallel, const GridShape* shape = nullptr,
-             const uint32_t* visit = nullptr);
+  void build(const Float4* positions, uint32_t n, const CpuParallel& parallel,
+             const GridShape* shape = nullptr, const uint32_t* visit = nullptr);
 
   const HostVector<uint32_t>& order() const { return order_; }
   GridView view() const { return GridView{shape_, cell_start_.data()}; }

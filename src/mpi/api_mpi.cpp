@@ -55,11 +55,12 @@ SPH_API sph_result SPH_CALL sph_mpi_world_create(sph_context* context, const sph
     } else {
       m = sph::zeroed_struct<sph_mpi_world_def>();
     }
-    const uint32_t percent = m.rebalance_threshold_percent == 0 ? sph::kDefaultRebalancePercent
-                                                                 : m.rebalance_threshold_percent;
+    const uint32_t percent =
+        m.rebalance_threshold_percent == 0 ? sph::kDefaultRebalancePercent : m.rebalance_threshold_percent;
     if (percent > sph::kMaxRebalancePercent)
-      throw Error(Status::InvalidArgument, "mpi_def->rebalance_threshold_percent: must be in [0, 10000], got " +
-                                               std::to_string(percent));
+      throw Error(
+          Status::InvalidArgument,
+          "mpi_def->rebalance_threshold_percent: must be in [0, 10000], got " + std::to_string(percent));
     const sph_world_def d = sph::read_user_struct(def, "def");
     // Everything above is the same on every rank; from here on the ranks meet.
     auto transport = std::make_shared<sph::MpiTransport>(MPI_Comm_f2c(static_cast<MPI_Fint>(comm)));
@@ -111,7 +112,8 @@ SPH_API sph_result SPH_CALL sph_mpi_world_add_particles(sph_world* world, const 
     if (refused) throw Error(status, message);
     if (any_refused) {
       w.undo_rank_particles(count_before, next_id_before);
-      throw Error(Status::InvalidArgument, "another rank's particles were refused (its error says why); no rank added any");
+      throw Error(Status::InvalidArgument,
+                  "another rank's particles were refused (its error says why); no rank added any");
     }
     if (out_first_id) *out_first_id = next_id_before + static_cast<uint32_t>(below);
     return SPH_OK;
@@ -156,8 +158,8 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t
     sph::WorldLock lock(world);
     const sph::RankTransport& ranks = sph::ranks_of(world);
     if (root < 0 || root >= ranks.size())
-      throw Error(Status::InvalidArgument, "root: must be a rank of the world's communicator, got " +
-                                               std::to_string(root));
+      throw Error(Status::InvalidArgument,
+                  "root: must be a rank of the world's communicator, got " + std::to_string(root));
     struct Record {
       uint32_t id;
       float x[3], v[3];
@@ -171,7 +173,8 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t
       b.copy_attribute(sph::AttributeKind::Velocity, 0, n, mine[0].v, sizeof(Record));
     }
     const unsigned char* bytes = reinterpret_cast<const unsigned char*>(mine.data());
-    const std::vector<sph::RankBytes> all = ranks.gather(sph::RankBytes(bytes, bytes + n * sizeof(Record)), root);
+    const std::vector<sph::RankBytes> all =
+        ranks.gather(sph::RankBytes(bytes, bytes + n * sizeof(Record)), root);
     if (out_count) *out_count = 0;
     if (ranks.rank() != root) return SPH_OK;
     sph::HostVector<Record> records;
@@ -184,8 +187,9 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t
     std::sort(records.begin(), records.end(), [](const Record& a, const Record& c) { return a.id < c.id; });
     if (out_count) *out_count = records.size();
     if (capacity < records.size())
-      throw Error(Status::InvalidArgument, "capacity: " + std::to_string(capacity) + " is below the world's " +
-                                               std::to_string(records.size()) + " particles");
+      throw Error(Status::InvalidArgument, "capacity: " + std::to_string(capacity) +
+                                               " is below the world's " + std::to_string(records.size()) +
+                                               " particles");
     for (size_t i = 0; i < records.size(); ++i) {
       if (positions) std::memcpy(positions + 3 * i, records[i].x, sizeof records[i].x);
       if (velocities) std::memcpy(velocities + 3 * i, records[i].v, sizeof records[i].v);

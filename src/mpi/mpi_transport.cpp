@@ -15,7 +15,8 @@ void check(int code, const char* what) {
   char text[MPI_MAX_ERROR_STRING];
   int length = 0;
   MPI_Error_string(code, text, &length);
-  throw Error(Status::Internal, std::string("MPI: ") + what + " failed: " + std::string(text, static_cast<size_t>(length)));
+  throw Error(Status::Internal,
+              std::string("MPI: ") + what + " failed: " + std::string(text, static_cast<size_t>(length)));
 }
 
 int as_count(size_t n) {
@@ -28,7 +29,8 @@ int as_count(size_t n) {
 MpiTransport::MpiTransport(MPI_Comm comm) {
   int initialized = 0;
   MPI_Initialized(&initialized);
-  if (!initialized) throw Error(Status::InvalidArgument, "comm: MPI is not initialised (call MPI_Init first)");
+  if (!initialized)
+    throw Error(Status::InvalidArgument, "comm: MPI is not initialised (call MPI_Init first)");
   if (comm == MPI_COMM_NULL) throw Error(Status::InvalidArgument, "comm: is MPI_COMM_NULL");
   // Errors come back as codes (check() turns them into Errors), not as an abort.
   check(MPI_Comm_dup(comm, &comm_), "MPI_Comm_dup");
@@ -103,12 +105,14 @@ std::vector<RankBytes> MpiTransport::gather(const RankBytes& mine, int root) con
       total += static_cast<size_t>(counts[r]);
     }
   RankBytes all(total);
-  check(MPI_Gatherv(mine.data(), count, MPI_BYTE, all.data(), counts.data(), offsets.data(), MPI_BYTE, root, comm_),
+  check(MPI_Gatherv(mine.data(), count, MPI_BYTE, all.data(), counts.data(), offsets.data(), MPI_BYTE, root,
+                    comm_),
         "MPI_Gatherv");
   std::vector<RankBytes> out;
   if (rank_ == root) {
     out.resize(n);
-    for (size_t r = 0; r < n; ++r) out[r].assign(all.begin() + offsets[r], all.begin() + offsets[r] + counts[r]);
+    for (size_t r = 0; r < n; ++r)
+      out[r].assign(all.begin() + offsets[r], all.begin() + offsets[r] + counts[r]);
   }
   return out;
 }

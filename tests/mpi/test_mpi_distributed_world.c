@@ -1,14 +1,17 @@
 /* SPDX-License-Identifier: MIT */
 /* A distributed world (include/sph_mpi.h) against one undivided world, run under mpirun on 1-4
- * ranks (tests/mpi/CMakeLists.txt). Two scenes: a small dam break (a column in a closed tank,
- * gravity) and the same column stirred with random velocities of up to 2 m/s, so that particles
- * cross the slab boundaries every few substeps. For each, after 20 substeps (19 + 1 frames):
+ * ranks (tests/mpi/CMakeLists.txt). Three scenes: a small dam break (a column in a closed tank,
+ * gravity), the same column stirred with random velocities of up to 2 m/s, so that particles
+ * cross the slab boundaries every few substeps, and the column joined by a second block after
+ * 10 substeps. For each, after 20 substeps (frames of 19 and 1 substeps):
  *   - the gathered particles equal the undivided world's bit for bit: every sum of the
  *     distributed world runs in the undivided world's order (the sort keys of cpu_halo.cpp), so
  *     no tolerance is needed, and a difference of one rounding fails;
  *   - the particle count is the world's on every rank, each id 0 .. n-1 held once (count and
  *     mass, n times the particle mass, conserved across the migrations), and particles did
  *     migrate where there are several ranks;
+ *   - with a block added after 10 substeps off to one side, the ranks rebalance along the new
+ *     longest axis (x) and the equality still holds;
  *   - each rank's halo of the last substep holds exactly the particles of the cell layers on
  *     each side of its slab, counted by brute force over the gathered positions that substep
  *     started from. (That the halo's densities came in the order of its particles is checked by
@@ -29,22 +32,22 @@
 
 static int g_rank = 0, g_size = 1, g_failures = 0;
 
-#define CHECK(cond, ...)                                                 \
-  do {                                                                   \
-    if (!(cond)) {                                                       \
-      fprintf(stderr, "rank %d: %s:%d: ", g_rank, __FILE__, __LINE__);   \
-      fprintf(stderr, __VA_ARGS__);                                      \
-      fprintf(stderr, " (last error: %s)\n", sph_get_last_error());      \
-      ++g_failures;                                                      \
-    }                                                                    \
+#define CHECK(cond, ...)                                               \
+  do {                                                                 \
+    if (!(cond)) {                                                     \
+      fprintf(stderr, "rank %d: %s:%d: ", g_rank, __FILE__, __LINE__); \
+      fprintf(stderr, __VA_ARGS__);                                    \
+      fprintf(stderr, " (last error: %s)\n", sph_get_last_error());    \
+      ++g_failures;                                                    \
+    }                                                                  \
   } while (0)
 
-#define REQUIRE(cond, ...)               \
-  do {                                   \
-    if (!(cond)) {                       \
-      CHECK(cond, __VA_ARGS__);          \
-      MPI_Abort(MPI_COMM_WORLD, 1);      \
-    }                                    \
+#define REQUIRE(cond, ...)          \
+  do {                              \
+    if (!(cond)) {                  \
+      CHECK(cond, __VA_ARGS__);     \
+      MPI_Abort(MPI_COMM_WORLD, 1); \
+    }                               \
   } while (0)
 
 static void world_def(sph_world_def* def) {
@@ -92,17 +95,47 @@ static void check_halo(const sph_mpi_counts* counts, const float* start, uint64_
       uint32_t expected = 0;
       for (uint64_t i = 0; i < n && first <= last; ++i) {
         const int32_t layer = layer_of(start[3 * i + axis]);
-        if ((first != INT32_MIN && layer == first - 1) || (last != INT32_MAX && layer == last + 1)) ++expected;
+        if ((first != INT32_MIN && layer == first - 1) || (last != INT32_MAX && layer == last + 1))
+          ++expected;
       }
-      CHECK((uint32_t)ghosts == expected, "rank %d (layers %d..%d along axis %d) held %d ghosts, brute force %u", r,
-            first, last, axis, ghosts, expected);
+      CHECK((uint32_t)ghosts == expected,
+            "rank %d (layers %d..%d along axis %d) held %d ghosts, brute force %u", r, first, last, axis,
+            ghosts, expected);
     }
   }
   free(all);
 }
 
-/* One scene: the undivided world (rank 0) and the distributed one (every rank). */
-static void run_scene(sph_context* context, const char* name, float stir_speed) {
+/* A second block, [0.25, 0.35] x [0, 0.1] x [0, 0.06], filled into the undivided world (rank 0)
+ * and added from rank 0 to the distributed one; *n grows by its count on every rank. */
+static void add_block(sph_world* single, sph_world* world, uint32_t* n) {
+  float* positions = NULL;
+  uint32_t total = 0, added = 0;
+  if (g_rank == 0) {
+    sph_fill_box_desc box;
+    REQUIRE(sph_fill_box_desc_init(&box) == SPH_OK, "fill init");
+    box.min.x = 0.25f;
+    box.min.y = 0.0f;
+    box.min.z = 0.0f;
+    box.max.x = 0.35f;
+    box.max.y = 0.1f;
+    box.max.z = 0.06f;
+    REQUIRE(sph_world_fill_box(single, &box, &added) == SPH_OK, "fill");
+    REQUIRE(support_copy_by_id(single, SPH_ATTRIBUTE_POSITION, (void**)&positions, &total) == SPH_OK, "read");
+    REQUIRE(total == *n + added, "%u particles after the block", total);
+  }
+  REQUIRE(sph_mpi_world_add_particles(world, positions ? positions + 3 * (size_t)*n : NULL, NULL, added,
+                                      NULL) == SPH_OK,
+          "add the block");
+  MPI_Bcast(&added, 1, MPI_UINT32_T, 0, MPI_COMM_WORLD);
+  *n += added;
+  free(positions);
+}
+
+/* One scene: the undivided world (rank 0) and the distributed one (every rank). With `block`,
+ * a second block joins after 10 substeps, off to one side: the ranks are out of balance, and
+ * the world's longest axis changes from y to x, so the next frame cuts new slabs. */
+static void run_scene(sph_context* context, const char* name, float stir_speed, int block) {
   const sph_vec3 column_min = {0.0f, 0.0f, 0.0f}, column_max = {0.1f, 0.2f, 0.06f};
   sph_world_def def;
   sph_world* single = NULL;
@@ -121,15 +154,18 @@ static void run_scene(sph_context* context, const char* name, float stir_speed) 
   /* The undivided world and its particles, in id order. */
   if (g_rank == 0) {
     REQUIRE(sph_world_create(context, &def, &single) == SPH_OK, "single world");
-    REQUIRE(support_dam_break(context, single, &kTank, column_min, column_max, NULL, NULL, &n) == SPH_OK, "dam");
-    REQUIRE(support_copy_by_id(single, SPH_ATTRIBUTE_POSITION, (void**)&positions, &n) == SPH_OK, "positions");
+    REQUIRE(support_dam_break(context, single, &kTank, column_min, column_max, NULL, NULL, &n) == SPH_OK,
+            "dam");
+    REQUIRE(support_copy_by_id(single, SPH_ATTRIBUTE_POSITION, (void**)&positions, &n) == SPH_OK,
+            "positions");
     velocities = (float*)calloc(3 * (size_t)n + 3, sizeof(float));
     REQUIRE(velocities != NULL, "calloc");
     if (stir_speed > 0.0f) {
       uint64_t state = 12345;
       support_random_velocities(velocities, n, stir_speed, NULL, &state);
-      REQUIRE(sph_world_set_attribute(single, SPH_ATTRIBUTE_VELOCITY, velocities, 12ull * n, 12, 0, n) == SPH_OK,
-              "stir");
+      REQUIRE(
+          sph_world_set_attribute(single, SPH_ATTRIBUTE_VELOCITY, velocities, 12ull * n, 12, 0, n) == SPH_OK,
+          "stir");
     }
   }
   MPI_Bcast(&n, 1, MPI_UINT32_T, 0, MPI_COMM_WORLD);
@@ -140,14 +176,20 @@ static void run_scene(sph_context* context, const char* name, float stir_speed) 
   REQUIRE(support_tank_create(context, world, &kTank, NULL, NULL) == SPH_OK, "tank");
   {
     uint32_t first = 99;
-    const sph_result r = sph_mpi_world_add_particles(world, positions, velocities, g_rank == 0 ? n : 0, &first);
+    const sph_result r =
+        sph_mpi_world_add_particles(world, positions, velocities, g_rank == 0 ? n : 0, &first);
     REQUIRE(r == SPH_OK, "add particles: %d", (int)r);
     CHECK(first == (g_rank == 0 ? 0u : n), "first id %u", first);
   }
 
-  /* 19 substeps, the positions the 20th starts from, the 20th. */
-  if (g_rank == 0) step_substeps(single, 19, 0);
-  step_substeps(world, 19, 1);
+  /* 19 substeps (10, the block, 9), the positions the 20th starts from, the 20th. */
+  if (block) {
+    if (g_rank == 0) step_substeps(single, 10, 0);
+    step_substeps(world, 10, 1);
+    add_block(single, world, &n);
+  }
+  if (g_rank == 0) step_substeps(single, block ? 9 : 19, 0);
+  step_substeps(world, block ? 9 : 19, 1);
   if (g_rank == 0) {
     mid = (float*)malloc(sizeof(float) * 3 * ((size_t)n + 1));
     REQUIRE(mid != NULL, "malloc");
@@ -160,9 +202,12 @@ static void run_scene(sph_context* context, const char* name, float stir_speed) 
   REQUIRE(sph_mpi_world_get_counts(world, &counts) == SPH_OK, "counts");
   CHECK(counts.global_count == n, "%s: %llu particles in the world, %u added", name,
         (unsigned long long)counts.global_count, n);
-  CHECK(counts.rank == g_rank && counts.rank_count == g_size, "rank %d of %d", counts.rank, counts.rank_count);
+  CHECK(counts.rank == g_rank && counts.rank_count == g_size, "rank %d of %d", counts.rank,
+        counts.rank_count);
   CHECK(g_size == 1 || counts.migrated > 0, "%s: no particle migrated", name);
   CHECK(g_size == 1 || counts.global_ghosts > 0, "%s: no ghosts", name);
+  CHECK(!block || g_size == 1 || (counts.rebalances >= 2 && counts.axis == 0),
+        "%s: %u rebalances, axis %d; expected a second cut, along x", name, counts.rebalances, counts.axis);
   check_halo(&counts, mid, gathered);
 
   if (g_rank == 0) {
@@ -191,12 +236,15 @@ static void run_scene(sph_context* context, const char* name, float stir_speed) 
         }
       }
     }
-    CHECK(differ == 0, "%s on %d ranks: %u of %u particles differ from the undivided world (worst position %g m)",
-          name, g_size, differ, n, worst);
-    printf("%s on %d ranks: %u particles, 20 substeps, %u differ; %llu ghosts in the last substep, %llu migrations, "
-           "%u rebalances, axis %d\n",
-           name, g_size, n, differ, (unsigned long long)counts.global_ghosts, (unsigned long long)counts.migrated,
-           counts.rebalances, counts.axis);
+    CHECK(differ == 0,
+          "%s on %d ranks: %u of %u particles differ from the undivided world (worst position %g m)", name,
+          g_size, differ, n, worst);
+    printf(
+        "%s on %d ranks: %u particles, 20 substeps, %u differ; %llu ghosts in the last substep, %llu "
+        "migrations, "
+        "%u rebalances, axis %d\n",
+        name, g_size, n, differ, (unsigned long long)counts.global_ghosts,
+        (unsigned long long)counts.migrated, counts.rebalances, counts.axis);
     free(want_x);
     free(want_v);
   }
@@ -219,7 +267,8 @@ static void check_refusals(sph_context* context) {
   const int32_t comm = (int32_t)MPI_Comm_c2f(MPI_COMM_WORLD);
   world_def(&def);
   def.solver = SPH_SOLVER_DFSPH;
-  CHECK(sph_mpi_world_create(context, &def, comm, NULL, &world) == SPH_ERROR_UNSUPPORTED && world == NULL, "DFSPH");
+  CHECK(sph_mpi_world_create(context, &def, comm, NULL, &world) == SPH_ERROR_UNSUPPORTED && world == NULL,
+        "DFSPH");
   CHECK(strstr(sph_get_last_error(), "DFSPH") != NULL, "the message names DFSPH: %s", sph_get_last_error());
   world_def(&def);
   def.features = SPH_FEATURE_SURFACE_TENSION;
@@ -233,7 +282,8 @@ static void check_refusals(sph_context* context) {
   REQUIRE(sph_spawn_desc_init(&spawn) == SPH_OK, "spawn init");
   spawn.count = 1;
   spawn.positions = p;
-  CHECK(sph_world_spawn(world, &spawn, NULL) == SPH_ERROR_UNSUPPORTED, "sph_world_spawn on a distributed world");
+  CHECK(sph_world_spawn(world, &spawn, NULL) == SPH_ERROR_UNSUPPORTED,
+        "sph_world_spawn on a distributed world");
   {
     /* A refused particle on one rank: no rank adds any. */
     const float bad[3] = {NAN, 0.0f, 0.0f};
@@ -242,7 +292,8 @@ static void check_refusals(sph_context* context) {
     CHECK(r == SPH_ERROR_INVALID_ARGUMENT, "a NaN position on the last rank: %d", (int)r);
     REQUIRE(sph_mpi_counts_init(&counts) == SPH_OK, "counts init");
     REQUIRE(sph_mpi_world_get_counts(world, &counts) == SPH_OK, "counts");
-    CHECK(counts.global_count == 0, "%llu particles after a refused add", (unsigned long long)counts.global_count);
+    CHECK(counts.global_count == 0, "%llu particles after a refused add",
+          (unsigned long long)counts.global_count);
   }
   REQUIRE(sph_world_destroy(world) == SPH_OK, "destroy");
 }
@@ -254,8 +305,9 @@ int main(int argc, char** argv) {
   MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
   MPI_Comm_size(MPI_COMM_WORLD, &g_size);
   REQUIRE(support_context_create(SPH_BACKEND_CPU, &context) == SPH_OK, "context");
-  run_scene(context, "dam break", 0.0f);
-  run_scene(context, "stirred column", 2.0f);
+  run_scene(context, "dam break", 0.0f, 0);
+  run_scene(context, "stirred column", 2.0f, 0);
+  run_scene(context, "column and a late block", 0.0f, 1);
   check_refusals(context);
   REQUIRE(sph_context_destroy(context) == SPH_OK, "context destroy");
   MPI_Allreduce(&g_failures, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
