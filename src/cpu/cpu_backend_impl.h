@@ -234,8 +234,12 @@ class CpuBackend final : public Backend {
   void halo_gather();
   // After the sort: the keys of the new order.
   void halo_keys();
-  // After the density pass: the ghosts take their owners' densities and pressures.
+  // After the density pass: the ghosts take their owners' densities and pressures; after the
+  // colour-field pass (surface tension), their normals.
   void halo_share_density();
+  void halo_share_normals();
+  template <class Record, class Make, class Apply>
+  void halo_share(const char* what, Make&& make, Apply&& apply);
   // The substep's end: ghosts dropped, the step size's inputs and any failure agreed by all
   // ranks. Returns the world's first non-finite particle id (kAllFinite: none).
   uint32_t halo_end_substep(uint32_t bad_id);

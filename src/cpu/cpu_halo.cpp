@@ -48,7 +48,6 @@ void CpuBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks, const 
     uint32_t bit;
     const char* name;
   } features[] = {
-      {kFeatureSurfaceTension, "SPH_FEATURE_SURFACE_TENSION (its colour normals need a second halo)"},
       {kFeatureNormalizedDensity, "SPH_FEATURE_NORMALIZED_DENSITY (its filter needs a second halo)"},
       {kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks)"},
       {kFeatureColliderLoads, "SPH_FEATURE_COLLIDER_LOADS (loads summed over ranks)"},
@@ -235,23 +234,22 @@ void CpuBackend::halo_keys() {
       key[i] = (static_cast<uint64_t>(c) << 32) | (i - view.cell_start[c]);
 }
 
-void CpuBackend::halo_share_density() {
+// Each owned particle beside another rank's slab sends make(i) (a Record, which starts with the
+// particle's id) to that rank; each ghost takes apply(i, record) from its owner's. Both sides
+// list the particles in the sorted order, which is the same on every rank for the particles
+// they share: the receiver reads them in its own order (the ids check it).
+template <class Record, class Make, class Apply>
+void CpuBackend::halo_share(const char* what, Make&& make, Apply&& apply) {
   const RankTransport& t = *ranks_;
   const int me = t.rank();
   const int size = t.size();
-  // Both sides list the particles in the sorted order, which is the same on every rank for the
-  // particles they share: the receiver reads them in its own order (the id checks it).
-  struct Record {
-    uint32_t id;
-    float density, pressure, inv_density;
-    uint32_t neighbors;
-  };
   std::vector<RankBytes> out(static_cast<size_t>(size));
   for (uint32_t i = 0; i < count_; ++i) {
     if (ghost(i)) continue;
     int to[2];
     const int n = slabs_.ghost_destinations(halo_layer(i), me, to);
-    const Record r{id_[i], density_[i], position_[i].w, velocity_[i].w, neighbors_[i]};
+    if (n == 0) continue;
+    const Record r = make(i);
     const unsigned char* from = reinterpret_cast<const unsigned char*>(&r);
     for (int k = 0; k < n; ++k)
       out[static_cast<size_t>(to[k])].insert(out[static_cast<size_t>(to[k])].end(), from, from + sizeof r);
@@ -264,22 +262,55 @@ void CpuBackend::halo_share_density() {
     Record r;
     if ((read[from] + 1) * sizeof r > in[from].size())
       throw Error(Status::Internal,
-                  "halo: rank " + std::to_string(from) + " sent fewer densities than ghosts");
+                  std::string("halo: rank ") + std::to_string(from) + " sent fewer " + what + " than ghosts");
     std::memcpy(&r, in[from].data() + read[from]++ * sizeof r, sizeof r);
     if (r.id != id_[i])
-      throw Error(Status::Internal, "halo: the densities of rank " + std::to_string(from) +
+      throw Error(Status::Internal, std::string("halo: the ") + what + " of rank " + std::to_string(from) +
                                         " came in another order than its ghosts (id " + std::to_string(r.id) +
                                         " for ghost " + std::to_string(id_[i]) + ")");
-    density_[i] = r.density;
-    position_[i].w = r.pressure;
-    velocity_[i].w = r.inv_density;
-    neighbors_[i] = r.neighbors;
-    columns_.set_density(i, r.pressure, r.inv_density);
-    columns_.set_neighbor_count(i, r.neighbors);
+    apply(i, r);
   }
   for (int r = 0; r < size; ++r)
     if (read[static_cast<size_t>(r)] * sizeof(Record) != in[static_cast<size_t>(r)].size())
-      throw Error(Status::Internal, "halo: rank " + std::to_string(r) + " sent more densities than ghosts");
+      throw Error(Status::Internal,
+                  std::string("halo: rank ") + std::to_string(r) + " sent more " + what + " than ghosts");
+}
+
+void CpuBackend::halo_share_density() {
+  struct Record {
+    uint32_t id;
+    float density, pressure, inv_density;
+    uint32_t neighbors;
+  };
+  halo_share<Record>(
+      "densities",
+      [this](uint32_t i) {
+        return Record{id_[i], density_[i], position_[i].w, velocity_[i].w, neighbors_[i]};
+      },
+      [this](uint32_t i, const Record& r) {
+        density_[i] = r.density;
+        position_[i].w = r.pressure;
+        velocity_[i].w = r.inv_density;
+        neighbors_[i] = r.neighbors;
+        columns_.set_density(i, r.pressure, r.inv_density);
+        columns_.set_neighbor_count(i, r.neighbors);
+      });
+}
+
+void CpuBackend::halo_share_normals() {
+  struct Record {
+    uint32_t id;
+    Float4 normal;
+  };
+  halo_share<Record>(
+      "colour normals",
+      [this](uint32_t i) {
+        return Record{id_[i], normals_[i]};
+      },
+      [this](uint32_t i, const Record& r) {
+        normals_[i] = r.normal;
+        columns_.set_normal(i, r.normal);
+      });
 }
 
 uint32_t CpuBackend::halo_end_substep(uint32_t bad_id) {

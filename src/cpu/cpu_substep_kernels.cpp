@@ -106,6 +106,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
       normals_[i] = simd_.colour_normal(fluid, view, columns, static_cast<uint32_t>(i));
       columns_.set_normal(static_cast<uint32_t>(i), normals_[i]);
     });
+    if (ranks_) halo_share_normals();
   }
   report.stage_ms[kStageDensity] += static_cast<float>(elapsed_ms(t));
 }
