@@ -47,11 +47,8 @@ void CpuBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks, const 
   const struct {
     uint32_t bit;
     const char* name;
-  } features[] = {
-      {kFeatureNormalizedDensity, "SPH_FEATURE_NORMALIZED_DENSITY (its filter needs a second halo)"},
-      {kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks)"},
-      {kFeatureColliderLoads, "SPH_FEATURE_COLLIDER_LOADS (loads summed over ranks)"},
-      {kFeatureDensityDiffusion, "SPH_FEATURE_DENSITY_DIFFUSION (its diffusion needs a second halo)"}};
+  } features[] = {{kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks)"},
+                  {kFeatureColliderLoads, "SPH_FEATURE_COLLIDER_LOADS (loads summed over ranks)"}};
   for (const auto& f : features)
     if (config_.features & f.bit) refuse(f.name);
   const auto array = [](const char* name, uint32_t size, ParticleArrayRole role) {

@@ -98,6 +98,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
       vel[i].w = 1.0f / normalized_[i];
       columns_.set_density(static_cast<uint32_t>(i), pos[i].w, vel[i].w);
     });
+    if (ranks_) halo_share_density();  // the ghosts' filtered densities are their owners'
   }
   if (diffusion_dt > 0.0f) diffuse_density(fluid, diffusion_dt);
   if (config_.features & kFeatureSurfaceTension) {
@@ -132,6 +133,7 @@ void CpuBackend::diffuse_density(const FluidConstants& fluid, float dt) {
     vel[i].w = 1.0f / normalized_[i];
     columns_.set_density(static_cast<uint32_t>(i), pos[i].w, vel[i].w);
   });
+  if (ranks_) halo_share_density();  // the ghosts' diffused densities are their owners'
 }
 
 // Acceleration of particle i: the neighbour gather with the world's force terms compiled in
