@@ -129,10 +129,10 @@ SPH_API sph_result SPH_CALL sph_mpi_world_get_counts(const sph_world* world, sph
     sph::require_world(world);
     sph::WorldLock lock(world);
     const sph::RankTransport& ranks = sph::ranks_of(world);
-    if (!out) throw Error(Status::InvalidArgument, "out: is NULL");  // (the same on every rank, or a misuse)
     const sph::DistributedCounters c = world->world->backend().distributed_counters();
     int64_t sums[3] = {world->world->particle_count(), c.ghosts, c.migrated_out};
-    ranks.all_sum(sums, 3);
+    ranks.all_sum(sums, 3);  // (before any check of this rank's arguments: the other ranks wait for it)
+    if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
     sph_mpi_counts r = sph::zeroed_struct<sph_mpi_counts>();
     r.rank = ranks.rank();
     r.rank_count = ranks.size();
