@@ -7,7 +7,8 @@
 //                     the slab), the world's grid shape is reduced from every rank's extent;
 //   after the sort    each particle's key becomes its slot and place in the slot;
 //   after density     the ghosts take their owners' density, pressure and neighbour count
-//                     (the force pass reads them);
+//                     (the force pass reads them), again after the normalised density's filter
+//                     and the diffusion, and their colour normals after that pass;
 //   the substep's end ghosts are dropped, the max speed and acceleration (the next step size)
 //                     and the first non-finite particle are reduced over the ranks.
 // The sort takes particles in key order, so each cell's particles come in the order the
