@@ -31,7 +31,7 @@ SPH_SCRIPT_NAME="$(basename "${0}")"
 SPH_PACKAGES=(
   cmake ninja-build g++ pkg-config git
   libcmocka-dev libeigen3-dev libxsimd-dev
-  libopenvdb-dev libboost-iostreams-dev libtbb-dev nlohmann-json3-dev
+  libopenvdb-dev libboost-iostreams-dev libtbb-dev nlohmann-json3-dev libopenmpi-dev openmpi-bin
   clang libclang-rt-14-dev libomp-dev clang-format
   python3 python3-numpy python3-pytest python3-matplotlib mono-mcs mono-runtime
   libpng-dev libegl-dev libgl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri

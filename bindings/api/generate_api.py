@@ -828,9 +828,15 @@ def rel_path(header: str) -> str:
     return rel.replace(os.sep, "/")
 
 
+# Headers the bindings do not cover: sph_mpi.h's distributed worlds live in libsph_mpi, which a
+# program links instead of libsph, and need MPI in the caller (Python through mpi4py: issue 19).
+NOT_BOUND = {"sph_mpi.h"}
+
+
 def default_headers() -> list[str]:
     inc = os.path.dirname(DEFAULT_HEADER)
-    others = sorted(f for f in os.listdir(inc) if f.startswith("sph_") and f.endswith(".h") and f != "sph_c.h")
+    others = sorted(f for f in os.listdir(inc)
+                    if f.startswith("sph_") and f.endswith(".h") and f != "sph_c.h" and f not in NOT_BOUND)
     return [DEFAULT_HEADER] + [os.path.join(inc, f) for f in others]
 
 

@@ -90,6 +90,11 @@ SPH_API sph_result SPH_CALL sph_world_step_begin(sph_world* world, float frame_d
     sph::require_world(world);
     sph::WorldLock lock(world);
     sph::require_positive(frame_dt, "frame_dt");
+    // Its MPI calls would run on the step's thread, which MPI_Init's thread level does not allow.
+    if (world->world->backend().distributed())
+      throw Error(Status::Unsupported,
+                  "world: a distributed world (sph_mpi.h) steps on the calling thread only; use "
+                  "sph_mpi_world_step");
     // A CPU context with the engine's task system runs the frame as one task of it (the frame's
     // loops then enqueue from inside that task); a CUDA context ignores the task system.
     const sph_context& context = *world->context;

@@ -150,6 +150,18 @@ sph::WorldConfig config_from_def(const sph_world_def& def) {
 
 }  // namespace
 
+// (handles.h) The world that sph_world_create makes, unpublished: libsph_mpi's
+// sph_mpi_world_create makes its rank's world with it.
+std::unique_ptr<sph_world> sph::make_world(sph_context* context, const sph_world_def& def) {
+  const sph::WorldConfig config = config_from_def(def);
+  auto backend = sph::make_backend(context->backend, config, context->device_ordinal, context->cpu_workers,
+                                   context->cpu_tasks, context->cuda_tuning);
+  auto world = std::make_unique<sph_world>();
+  world->context = context;
+  world->world = std::make_unique<sph::World>(config, std::move(backend));
+  return world;
+}
+
 extern "C" {
 
 SPH_API sph_result SPH_CALL sph_world_def_init_sized(sph_world_def* def, uint32_t size) {
@@ -166,13 +178,7 @@ SPH_API sph_result SPH_CALL sph_world_create(sph_context* context, const sph_wor
     const sph::ContextHold hold(context);
     if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
     const sph_world_def d = sph::read_user_struct(def, "def");
-    const sph::WorldConfig config = config_from_def(d);
-    auto backend = sph::make_backend(context->backend, config, context->device_ordinal, context->cpu_workers,
-                                     context->cpu_tasks, context->cuda_tuning);
-    auto world = std::make_unique<sph_world>();
-    world->context = context;
-    world->world = std::make_unique<sph::World>(config, std::move(backend));
-    *out = sph::publish_world(std::move(world));
+    *out = sph::publish_world(sph::make_world(context, d));
     return SPH_OK;
   });
 }

@@ -122,6 +122,8 @@ class ContextHold {
 // Publishes a new object made on a held context: registers the handle and counts it on the
 // context in one critical section. Returns the handle (ownership passes to the caller's caller).
 sph_world* publish_world(std::unique_ptr<sph_world> world);
+// A new world from a def (validated here; Errors name its fields "def->..."), not yet published.
+std::unique_ptr<sph_world> make_world(sph_context* context, const sph_world_def& def);
 sph_sdf* publish_sdf(std::unique_ptr<sph_sdf> sdf);
 
 // Takes a context for destruction: Taken means it left the registry and the caller deletes

@@ -13,8 +13,10 @@
 #include "../physics/float4_types.h"
 #include "../physics/vec3.h"
 #include "config.h"
+#include "distributed.h"
 #include "frame_report.h"
 #include "particle_snapshot.h"
+#include "rank_transport.h"
 #include "scene_frame.h"
 #include "status.h"
 
@@ -99,6 +101,22 @@ class Backend {
 
   // Bytes held for particles and grids (device bytes on a GPU backend).
   virtual uint64_t memory_bytes() const = 0;
+
+  // ---- distributed worlds (include/sph_mpi.h): one backend per rank ---------------------------
+  // Makes this backend one rank of a world spread over `ranks` (before it holds particles):
+  // every frame becomes collective (all ranks step together), particles migrate to the rank
+  // whose slab holds them, halos are exchanged before each neighbour pass. Error(Unsupported)
+  // naming the feature when the world uses one that does not work distributed yet (or this
+  // backend has no distributed path).
+  virtual void attach_ranks(std::shared_ptr<const RankTransport> /*ranks*/, const DistributedOptions&) {
+    throw Error(Status::Unsupported,
+                "world: distributed worlds (sph_mpi.h) run on the CPU backend only for now; the CUDA "
+                "backend's host-staged path is not built yet");
+  }
+  // The ranks attach_ranks gave (null: not a distributed world).
+  virtual const RankTransport* rank_transport() const { return nullptr; }
+  bool distributed() const { return rank_transport() != nullptr; }
+  virtual DistributedCounters distributed_counters() const { return DistributedCounters{}; }
 
   // ---- the device interop tier (include/sph_cuda.h); a backend whose particles live in host
   // memory refuses it with the defaults below ---------------------------------------------------

@@ -185,6 +185,10 @@ void write_particle_section(ByteWriter& w, const World& world, const ParticleSna
 }  // namespace
 
 HostVector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin& origin) {
+  if (world.backend().distributed())
+    throw Error(Status::Unsupported,
+                "world: checkpoints of a distributed world (one per rank with a manifest) are not built yet "
+                "(docs/distributed.md)");
   // Asset indices first: the asset section precedes the objects that refer to it.
   AssetTable assets;
   world.colliders().for_each([&](uint64_t, const Collider& c) { assets.index(c.sdf); });

@@ -72,6 +72,13 @@ class World {
   // Adds particles at finite positions within 65536 particle spacings of the origin, with
   // finite velocities (or none: at rest). Returns the first new id; ids are consecutive.
   uint32_t add_particles(const HostVector<Vec3>& positions, const HostVector<Vec3>* velocities);
+  // A distributed world's collective add (src/mpi): this rank's particles, validated as
+  // add_particles does, take ids first_id, first_id + 1, ...; the world's next id is then
+  // next_id_after (the same on every rank). On error the world is as it was.
+  uint32_t add_rank_particles(const HostVector<Vec3>& positions, const HostVector<Vec3>* velocities,
+                              uint32_t first_id, uint32_t next_id_after);
+  // Undoes the last add_rank_particles (another rank refused its particles).
+  void undo_rank_particles(uint32_t count_before, uint32_t next_id_before);
   // FCC lattices at the world's spacing in a box or a sphere (fcc_lattice.h); an empty box or
   // radius 0 fills nothing. Error(Capacity) when the lattice does not fit under max_capacity.
   // Returns the count.
@@ -206,6 +213,7 @@ class World {
   FrameReport report_;
   float last_step_ms_ = 0.0f;
   uint32_t capacity_growths_ = 0;
+  bool rank_add_ = false;  // inside add_rank_particles (a distributed world's only spawn)
   HostVector<Event> events_;
   SlotMap<Collider> colliders_{kTagCollider};
   SlotMap<Source> sources_{kTagSource};

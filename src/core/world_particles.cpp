@@ -65,6 +65,30 @@ uint32_t World::add_particles(const HostVector<Vec3>& positions, const HostVecto
   return spawn(positions, velocities);
 }
 
+uint32_t World::add_rank_particles(const HostVector<Vec3>& positions, const HostVector<Vec3>* velocities,
+                                   uint32_t first_id, uint32_t next_id_after) {
+  if (!backend_->distributed())
+    throw Error(Status::Internal, "add_rank_particles: the world is not distributed");
+  const uint32_t next_id_before = next_id_;
+  next_id_ = first_id;
+  rank_add_ = true;
+  try {
+    add_particles(positions, velocities);
+  } catch (...) {
+    next_id_ = next_id_before;
+    rank_add_ = false;
+    throw;
+  }
+  rank_add_ = false;
+  next_id_ = next_id_after;
+  return first_id;
+}
+
+void World::undo_rank_particles(uint32_t count_before, uint32_t next_id_before) {
+  if (particle_count() > count_before) backend_->truncate(count_before);
+  next_id_ = next_id_before;
+}
+
 namespace {
 
 void require_fill_fits(uint64_t count, uint32_t free, const std::string& limit) {

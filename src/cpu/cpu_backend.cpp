@@ -82,6 +82,7 @@ void CpuBackend::append(const Vec3* positions, const Vec3* velocities, uint32_t 
     density_[i] = config_.rest_density;
     neighbors_[i] = 0;
     if (user_attribute_) user_attribute_[i] = user_attribute;
+    if (sort_key_) sort_key_[i] = kAppendedSortKey | (first_id + k);
   }
   count_ = total;
   max_speed_valid_ = false;
@@ -156,6 +157,12 @@ void CpuBackend::import_particles(const ParticleSnapshot& s) {
   if (n > config_.capacity || s.position.size() != n || s.velocity.size() != n || s.density.size() != n)
     throw Error(Status::Internal, "import_particles: inconsistent snapshot");
   check_carried_arrays(s, method_arrays_, n);
+  // A distributed rank's sort keys follow its particles; a snapshot that drops or reorders
+  // them (sph_world_remove_particles, a restore) would leave them behind.
+  if (ranks_ && n != count_)
+    throw Error(Status::Unsupported,
+                "world: removing or restoring particles does not work in a distributed world yet "
+                "(docs/distributed.md)");
   // Copies first (they may throw), then the store, so a failure leaves the state as it was.
   HostVector<std::pair<CpuParticleArray*, HostVector<unsigned char>>> carried;
   for (const ParticleArraySpec& spec : method_arrays_)

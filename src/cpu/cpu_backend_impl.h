@@ -19,6 +19,7 @@
 #include "../core/backend.h"
 #include "../core/non_finite.h"
 #include "../core/particle_arrays.h"
+#include "../core/slab_decomposition.h"
 #include "../core/solver_record.h"
 #include "../physics/collider_loads.h"
 #include "../physics/dfsph_passes.h"
@@ -72,6 +73,11 @@ class CpuBackend final : public Backend {
   ParticleSnapshot export_particles() const override;
 
   void import_particles(const ParticleSnapshot& s) override;
+
+  // Distributed worlds (cpu_halo.cpp).
+  void attach_ranks(std::shared_ptr<const RankTransport> ranks, const DistributedOptions& options) override;
+  const RankTransport* rank_transport() const override { return ranks_.get(); }
+  DistributedCounters distributed_counters() const override;
 
   uint64_t memory_bytes() const override {
     return store_.bytes() + grid_.bytes() + columns_.bytes() + boundary_maps_.bytes();
@@ -213,6 +219,54 @@ class CpuBackend final : public Backend {
 
   // Density and neighbour statistics of the last density evaluation.
   void summarize(FrameReport& report) const;
+
+  // ---- a distributed world's rank (cpu_halo.cpp; include/sph_mpi.h). Between substeps a rank
+  // holds the particles it owns; during one it also holds ghosts (origin_ != 0), the owned
+  // particles of the cell layer beside its slab. The sort takes the particles in the order of
+  // their keys (sort_key_: slot and place in it at the last sort, the same on every rank), so
+  // each cell lists its particles in the order one undivided world would, and every sum runs
+  // in the same order. Each step is collective.
+  // A ghost of this substep (never in a world that is not distributed).
+  bool ghost(uint32_t i) const { return origin_ && origin_[i] != 0u; }
+  // The frame's start: the world's max speed, and new slabs when the ranks are out of balance.
+  void halo_begin_frame();
+  // Before the sort: owned particles that left the slab migrate, ghosts arrive; the world's
+  // grid shape and this rank's sort order go to halo_shape_ and halo_visit_.
+  void halo_gather();
+  // After the sort: the keys of the new order.
+  void halo_keys();
+  // After the density pass: the ghosts take their owners' densities and pressures; after the
+  // colour-field pass (surface tension), their normals.
+  void halo_share_density();
+  void halo_share_normals();
+  template <class Record, class Make, class Apply>
+  void halo_share(const char* what, Make&& make, Apply&& apply);
+  // The substep's end: ghosts dropped, the step size's inputs and any failure agreed by all
+  // ranks. Returns the world's first non-finite particle id (kAllFinite: none).
+  uint32_t halo_end_substep(uint32_t bad_id);
+  // Whether `flag` is raised on any rank.
+  bool halo_any(bool flag) const;
+  // Cell layer of particle i along the slabs' axis.
+  int32_t halo_layer(uint32_t i) const;
+  // Appends particle i's carried arrays to `out` / appends the records of `in` as particles
+  // whose origin_ is `origin`; returns how many.
+  void halo_pack(uint32_t i, RankBytes& out) const;
+  uint32_t halo_unpack(const RankBytes& in, uint32_t origin);
+  // Keeps the particles keep_order_ lists (ascending), in that order.
+  void halo_keep(size_t kept);
+
+  // The key of a particle appended since the last sort: after every sorted one, in id order
+  // (the undivided world appends at the end, ids ascending).
+  static constexpr uint64_t kAppendedSortKey = 0xffffffff00000000ull;
+  std::shared_ptr<const RankTransport> ranks_;
+  DistributedOptions distributed_options_;
+  SlabDecomposition slabs_;
+  bool slabs_cut_ = false;
+  DistributedCounters halo_counters_;
+  GridShape halo_shape_{};
+  HostVector<uint32_t> halo_visit_;
+  CpuArrayRef<uint64_t> sort_key_;  // Carried
+  CpuArrayRef<uint32_t> origin_;    // Sorted: 0 owned, else 1 + the rank the ghost came from
 
   WorldConfig config_;
   CpuParallel workers_;  // OpenMP's, or the engine's task system (cpu_parallel.h)

@@ -20,9 +20,11 @@ float CpuBackend::compute_max_speed() const {
 uint32_t CpuBackend::scan_next_state(float& v2max) const {
   const Float4* next_pos = next_position_.data();
   const Float4* next_vel = next_velocity_.data();
+  const uint32_t* origin = origin_.data();  // null unless distributed
   const StateScan scan = parallel().reduce(
       count_, StateScan{},
       [&](uint32_t i, StateScan& s) {
+        if (origin && origin[i]) return;  // (a distributed world's halo)
         const float v2 = length_squared(xyz(next_vel[i]));
         s.v2max = std::max(s.v2max, v2);
         if (!finite3(xyz(next_pos[i])) || !std::isfinite(v2)) s.bad_index = std::min(s.bad_index, i);

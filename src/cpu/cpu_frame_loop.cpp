@@ -41,6 +41,7 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
   const float saved_max_acceleration = max_acceleration_;
   spring_constants_ = fluid.methods.springs;
   if (!max_speed_valid_) max_speed_ = compute_max_speed();
+  if (ranks_) halo_begin_frame();
 
   // Puts the particles back as they were before the frame: on a non-finite state and on any
   // exception (an allocation that fails halfway through a frame), so a failed step changes
@@ -58,17 +59,19 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
   DfsphTallies tallies;
   try {
     while (clock_running(clock, params.stepping.max_substeps)) {
-      if (scene.interrupt.requested()) {
+      // A distributed world's ranks stop together: a cancel or budget seen by any rank stops all.
+      if (ranks_ ? halo_any(scene.interrupt.requested()) : scene.interrupt.requested()) {
         report.interrupted = true;
         break;
       }
       pick_next_step(clock, frame_dt, limits, std::max(max_speed_, scene.max_collider_speed),
                      max_acceleration_);
       fluid.dt = clock.dt_float;
-      const uint32_t bad =
+      uint32_t bad =
           config_.solver == Solver::Dfsph         ? substep_dfsph(fluid, scene, clock.time, report, tallies)
           : config_.integrator == Integrator::Rk4 ? substep_rk4(fluid, scene, clock.time, report)
                                                   : substep_euler(fluid, scene, clock.time, report);
+      if (ranks_) bad = halo_end_substep(bad);
       if (bad != kAllFinite) {
         roll_back();
         non_finite_.substep = clock.substeps + 1;

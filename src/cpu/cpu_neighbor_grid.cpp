@@ -50,15 +50,19 @@ void CpuNeighborGrid::refuse_crowded_slot(const Float4* positions, uint32_t n, u
   throw Error(Status::Capacity, crowded_cell_message(held, where, max_per_cell_));
 }
 
-void CpuNeighborGrid::build(const Float4* positions, uint32_t n, const CpuParallel& parallel) {
-  choose_shape(positions, n, parallel);
+void CpuNeighborGrid::build(const Float4* positions, uint32_t n, const CpuParallel& parallel,
+                            const GridShape* shape, const uint32_t* visit) {
+  if (shape)
+    shape_ = *shape;
+  else
+    choose_shape(positions, n, parallel);
   hashes_.resize(n);
   order_.resize(n);
   cell_start_.assign(static_cast<size_t>(shape_.cell_count) + 1, 0u);
-  const GridShape shape = shape_;
+  const GridShape table = shape_;
   uint32_t* hashes = hashes_.data();
   parallel.for_items(n).for_each(
-      n, [&](uint32_t i) { hashes[i] = cell_hash_of_position(shape, xyz(positions[i])); });
+      n, [&](uint32_t i) { hashes[i] = cell_hash_of_position(table, xyz(positions[i])); });
 
   // Counting sort: histogram, exclusive prefix sum (the cell-start table), stable scatter.
   for (uint32_t i = 0; i < n; ++i) ++cell_start_[hashes_[i] + 1];
@@ -66,7 +70,11 @@ void CpuNeighborGrid::build(const Float4* positions, uint32_t n, const CpuParall
     if (cell_start_[c + 1] > max_per_cell_) refuse_crowded_slot(positions, n, c, cell_start_[c + 1]);
   for (uint32_t c = 0; c < shape_.cell_count; ++c) cell_start_[c + 1] += cell_start_[c];
   cursor_.assign(cell_start_.begin(), cell_start_.end() - 1);
-  for (uint32_t i = 0; i < n; ++i) order_[cursor_[hashes_[i]]++] = i;
+  if (visit) {
+    for (uint32_t k = 0; k < n; ++k) order_[cursor_[hashes_[visit[k]]]++] = visit[k];
+  } else {
+    for (uint32_t i = 0; i < n; ++i) order_[cursor_[hashes_[i]]++] = i;
+  }
 }
 
 }  // namespace sph

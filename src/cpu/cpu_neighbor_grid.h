@@ -26,7 +26,11 @@ class CpuNeighborGrid {
   // of the particle that goes to place i). Fills the cell-start table for the sorted order.
   // Throws Error(Capacity) when a slot holds more than max_per_cell particles (nothing the
   // caller owns has changed: the world's frame rolls back).
-  void build(const Float4* positions, uint32_t n, const CpuParallel& parallel);
+  // A distributed world's rank (cpu_halo.cpp) passes the world's shape (`shape`, else it is
+  // chosen from these positions) and the order in which the sort takes the particles
+  // (`visit`, n indices; else 0 .. n-1): within a slot they keep that order.
+  void build(const Float4* positions, uint32_t n, const CpuParallel& parallel,
+             const GridShape* shape = nullptr, const uint32_t* visit = nullptr);
 
   const HostVector<uint32_t>& order() const { return order_; }
   GridView view() const { return GridView{shape_, cell_start_.data()}; }

@@ -18,7 +18,9 @@ void CpuBackend::collide(const SceneFrame& scene, const SubstepTime& time, OldPo
   const float h = config_.kernel_radius;
   Float4* next_pos = next_position_.data();
   Float4* next_vel = next_velocity_.data();
+  const uint32_t* origin = origin_.data();  // null unless distributed
   parallel().for_each(count_, [&](uint32_t i) {
+    if (origin && origin[i]) return;  // (a distributed world's halo: its owner moves it)
     Vec3 x = xyz(next_pos[i]);
     Vec3 v = xyz(next_vel[i]);
     const Vec3 from = x_old(static_cast<uint32_t>(i));
@@ -54,9 +56,11 @@ uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame
   // end-of-substep scan (max speed, first non-finite particle) rides in the force loop: one pass
   // over the particles less. Both reductions are order-independent, so the bits are the scan's.
   const bool scan_in_loop = scene.colliders.empty() && !loads_on();
+  const uint32_t* origin = origin_.data();  // null unless distributed
   const StateScan forces = parallel().reduce(
       count_, StateScan{},
       [&](uint32_t i, StateScan& r) {
+        if (origin && origin[i]) return;  // (a distributed world's halo: its owner moves it)
         Vec3 a = acceleration(gather, fluid, view, columns, scene, i);
         if (spring) a += xyz(spring[i]);
         a += wall_acceleration(i);

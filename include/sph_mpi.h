@@ -1,0 +1,133 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * sph_mpi.h - distributed worlds: one world spread over the ranks of an MPI communicator.
+ *
+ * Optional, in its own library (libsph_mpi, built when CMake finds MPI: SPH_WITH_MPI). That
+ * library holds the whole of sph_c.h as well, so a program links libsph_mpi instead of libsph
+ * (not both). This header needs no mpi.h: the communicator crosses as its Fortran handle
+ * (MPI_Fint, from MPI_Comm_c2f(comm)) in an int32_t.
+ *
+ * A distributed world is an sph_world on every rank of the communicator; each rank holds the
+ * particles of its slab of space (cells of one kernel radius along the world's longest axis),
+ * plus, during a step, a halo one kernel radius deep from its neighbours. The calls marked
+ * COLLECTIVE must be made by every rank of the communicator, in the same order, with the same
+ * scalar arguments: sph_mpi_world_create, sph_mpi_world_add_particles, sph_mpi_world_step (and
+ * sph_world_step on a distributed world, which is the same call), sph_mpi_world_get_counts,
+ * sph_mpi_world_gather. The scene (colliders, force fields, sinks) is replicated: make the same
+ * calls of sph_c.h on every rank. The calls of sph_c.h that read particles (copy_attribute,
+ * get_stats) read the calling rank's own.
+ *
+ * What works and what is refused (SPH_ERROR_UNSUPPORTED, naming the feature): docs/distributed.md.
+ * A distributed world steps the same bits as one undivided world of the same particles (while
+ * the neighbour grid's table covers the particles' extent; docs/distributed.md says when).
+ *
+ * Thread rules: as sph_c.h, per rank. A failure other than bad input inside a collective step
+ * on one rank (an allocation, a crowded cell) is not yet agreed between the ranks: the others
+ * then wait in MPI; the world reports non-finite states on every rank and rolls every rank back.
+ */
+#ifndef SPH_MPI_H
+#define SPH_MPI_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sph_c.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Options of a distributed world. Zero-initialised fields mean the defaults. */
+typedef struct sph_mpi_world_def {
+  uint32_t struct_size; /* sizeof(sph_mpi_world_def), set by the init function */
+  /* Rebalance the slabs at a frame's start when the fullest rank holds more than
+   * (100 + this) percent of the mean particle count. 0: 20. Range [1, 10000]. */
+  uint32_t rebalance_threshold_percent;
+} sph_mpi_world_def;
+SPH_STATIC_ASSERT(sizeof(sph_mpi_world_def) == 8, sph_mpi_world_def_size);
+
+SPH_API sph_result SPH_CALL sph_mpi_world_def_init_sized(sph_mpi_world_def* def, uint32_t size);
+static inline sph_result sph_mpi_world_def_init(sph_mpi_world_def* def) {
+  return sph_mpi_world_def_init_sized(def, (uint32_t)sizeof(*def));
+}
+
+/**
+ * COLLECTIVE. Creates this rank's part of a world spread over the communicator whose Fortran
+ * handle is `comm` (MPI_Comm_c2f). MPI must be initialised (MPI_Init) and stay so until every
+ * distributed world is destroyed (sph_world_destroy on every rank: it frees the duplicated
+ * communicator, which MPI counts as collective). The library duplicates
+ * the communicator, so its messages never meet the caller's. `def` as sph_world_create's (the
+ * same on every rank); `mpi_def` may be NULL (defaults). `context` must be a CPU context.
+ * Errors: INVALID_ARGUMENT (NULL out, a bad def, a bad communicator), UNSUPPORTED (a CUDA
+ * context; a feature, solver or integrator that does not work distributed yet, named in the
+ * message), OUT_OF_HOST_MEMORY. *out is untouched on error.
+ */
+SPH_API sph_result SPH_CALL sph_mpi_world_create(sph_context* context, const sph_world_def* def, int32_t comm,
+                                                 const sph_mpi_world_def* mpi_def, sph_world** out);
+
+/**
+ * COLLECTIVE. Adds `count` particles from this rank (positions and, unless NULL, velocities:
+ * 3 x float32 each, packed; count may be 0). Ids are numbered across the ranks in rank order:
+ * rank 0's first, so a world whose rank 0 adds everything numbers them as an undivided world
+ * would. Particles may be anywhere: each moves to the rank that owns its slab in the next step.
+ * All-or-nothing over the ranks: if any rank's particles are refused (INVALID_ARGUMENT as
+ * sph_world_spawn's, CAPACITY), every rank returns SPH_ERROR_INVALID_ARGUMENT (the refusing
+ * rank its own code) and no rank adds any. *out_first_id (may be NULL): this rank's first id.
+ * sph_world_spawn and the fills of sph_c.h return UNSUPPORTED on a distributed world.
+ */
+SPH_API sph_result SPH_CALL sph_mpi_world_add_particles(sph_world* world, const float* positions,
+                                                        const float* velocities, uint32_t count,
+                                                        uint32_t* out_first_id);
+
+/** COLLECTIVE. Steps the world by frame_dt on every rank; the same codes as sph_world_step. */
+SPH_API sph_result SPH_CALL sph_mpi_world_step(sph_world* world, float frame_dt);
+
+/** Counts of a distributed world (sph_mpi_world_get_counts). */
+typedef struct sph_mpi_counts {
+  uint32_t struct_size;
+  int32_t rank;           /* this rank in the world's communicator */
+  int32_t rank_count;     /* ranks of the communicator */
+  uint32_t local_count;   /* particles this rank holds */
+  uint64_t global_count;  /* particles of the whole world */
+  uint64_t global_ghosts; /* halo particles of the last substep, summed over the ranks */
+  uint64_t migrated;      /* particles that moved between ranks so far, summed over the ranks */
+  uint32_t local_ghosts;  /* halo particles this rank held in the last substep */
+  uint32_t rebalances;    /* times the slabs were cut anew (the first cut counts) */
+  int32_t axis;           /* the slabs' axis: 0 x, 1 y, 2 z */
+  /* This rank's slab: the cell layers [slab_first, slab_last] along axis, cell k holding
+   * floor(x / kernel_radius) = k (INT32_MIN / INT32_MAX: open; first > last: empty). */
+  int32_t slab_first;
+  int32_t slab_last;
+  uint32_t reserved0;
+} sph_mpi_counts;
+SPH_STATIC_ASSERT(sizeof(sph_mpi_counts) == 64, sph_mpi_counts_size);
+
+SPH_API sph_result SPH_CALL sph_mpi_counts_init_sized(sph_mpi_counts* counts, uint32_t size);
+static inline sph_result sph_mpi_counts_init(sph_mpi_counts* counts) {
+  return sph_mpi_counts_init_sized(counts, (uint32_t)sizeof(*counts));
+}
+
+/**
+ * COLLECTIVE. Fills *out (initialised by sph_mpi_counts_init) with this rank's and the world's
+ * counts. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL out, a bad struct_size), UNSUPPORTED
+ * (not a distributed world).
+ */
+SPH_API sph_result SPH_CALL sph_mpi_world_get_counts(const sph_world* world, sph_mpi_counts* out);
+
+/**
+ * COLLECTIVE. Gathers every rank's particles onto rank `root`, ordered by id: positions and
+ * velocities (3 x float32 each, packed) and ids (uint32), each array NULL to skip it. On root
+ * the arrays hold `capacity` particles; *out_count (may be NULL) gets the world's count there
+ * (0 elsewhere); other ranks pass NULL arrays. Errors: INVALID_ARGUMENT (root out of range;
+ * on root, capacity below the world's count), UNSUPPORTED (not a distributed world). A rank's
+ * own particles read with sph_world_copy_attribute, without the others.
+ */
+SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t root, float* positions,
+                                                 float* velocities, uint32_t* ids, uint64_t capacity,
+                                                 uint64_t* out_count);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SPH_MPI_H */

@@ -1,0 +1,37 @@
+// SPDX-License-Identifier: MIT
+// What a distributed world (include/sph_mpi.h) needs from its ranks' transport: collective
+// reductions and one all-to-all of bytes. The core and the backends see only this interface;
+// src/mpi implements it with MPI (libsph_mpi), so libsph never links MPI. Every call is
+// collective: each rank of the world makes the same calls in the same order.
+#pragma once
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include <vector>
+
+#include "host_memory.h"
+
+namespace sph {
+
+using RankBytes = HostVector<unsigned char>;
+
+class RankTransport {
+ public:
+  virtual ~RankTransport() = default;
+  virtual int rank() const = 0;
+  virtual int size() const = 0;
+  // Element-wise reductions over the ranks, in place.
+  virtual void all_min(int64_t* values, int n) const = 0;
+  virtual void all_max(int64_t* values, int n) const = 0;
+  virtual void all_sum(int64_t* values, int n) const = 0;
+  virtual void all_max(float* values, int n) const = 0;
+  // The sum of `value` over the ranks below this one.
+  virtual int64_t exclusive_sum(int64_t value) const = 0;
+  // send[d] goes to rank d (size() entries); returns what each rank sent to this one.
+  virtual std::vector<RankBytes> exchange(const std::vector<RankBytes>& send) const = 0;
+  // Every rank's bytes on `root` (in rank order); other ranks get an empty list.
+  virtual std::vector<RankBytes> gather(const RankBytes& mine, int root) const = 0;
+};
+
+}  // namespace sph

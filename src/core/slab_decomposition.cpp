@@ -1,0 +1,55 @@
+// SPDX-License-Identifier: MIT
+#include "slab_decomposition.h"
+
+#include <algorithm>
+
+namespace sph {
+
+SlabDecomposition::SlabDecomposition(int ranks)
+    : cuts_(static_cast<size_t>(ranks > 1 ? ranks - 1 : 0), INT32_MAX) {}
+
+int SlabDecomposition::owner(int32_t layer) const {
+  // The first cut above the layer: rank r owns [cuts_[r-1], cuts_[r]).
+  return static_cast<int>(std::upper_bound(cuts_.begin(), cuts_.end(), layer) - cuts_.begin());
+}
+
+int SlabDecomposition::ghost_destinations(int32_t layer, int self, int out[2]) const {
+  int n = 0;
+  const int below = layer > INT32_MIN ? owner(layer - 1) : self;
+  const int above = layer < INT32_MAX ? owner(layer + 1) : self;
+  if (below != self) out[n++] = below;
+  if (above != self && above != below) out[n++] = above;
+  if (n == 2 && out[0] > out[1]) std::swap(out[0], out[1]);
+  return n;
+}
+
+bool SlabDecomposition::imbalanced(const std::vector<int64_t>& count, double threshold) {
+  if (count.empty()) return false;
+  int64_t total = 0, fullest = 0;
+  for (int64_t c : count) {
+    total += c;
+    fullest = std::max(fullest, c);
+  }
+  const double mean = static_cast<double>(total) / static_cast<double>(count.size());
+  return static_cast<double>(fullest) > (1.0 + threshold) * mean;
+}
+
+void SlabDecomposition::rebalance(int axis, int32_t first_layer, const std::vector<int64_t>& histogram) {
+  axis_ = axis;
+  const int n = ranks();
+  int64_t total = 0;
+  for (int64_t c : histogram) total += c;
+  std::vector<int32_t> cuts(static_cast<size_t>(n - 1), INT32_MAX);
+  int64_t running = 0;
+  size_t k = 0;
+  for (int r = 1; r < n; ++r) {
+    // The smallest layer whose running count (layers before it) reaches r * total / n.
+    const int64_t target = (total * r + n - 1) / n;
+    while (k < histogram.size() && running < target) running += histogram[k++];
+    cuts[static_cast<size_t>(r - 1)] =
+        k < histogram.size() ? first_layer + static_cast<int32_t>(k) : INT32_MAX;
+  }
+  cuts_ = cuts;
+}
+
+}  // namespace sph

@@ -1,0 +1,335 @@
+// SPDX-License-Identifier: MIT
+// The CPU backend as one rank of a distributed world (include/sph_mpi.h, docs/distributed.md):
+// host-staged halos over a RankTransport (MPI in libsph_mpi). A substep of a rank runs the
+// single world's passes over its own particles plus ghosts, with four steps of its own:
+//   before the sort   particles that left the slab migrate to their owner (every carried
+//                     array), the ghosts arrive (the owned particles of the cell layer beside
+//                     the slab), the world's grid shape is reduced from every rank's extent;
+//   after the sort    each particle's key becomes its slot and place in the slot;
+//   after density     the ghosts take their owners' density, pressure and neighbour count
+//                     (the force pass reads them), again after the normalised density's filter
+//                     and the diffusion, and their colour normals after that pass;
+//   the substep's end ghosts are dropped, the max speed and acceleration (the next step size)
+//                     and the first non-finite particle are reduced over the ranks.
+// The sort takes particles in key order, so each cell's particles come in the order the
+// undivided world's stable sort gives them: the neighbour sums add in the same order and a
+// distributed world steps the single world's bits (while the grid's table covers the
+// particles' extent without folding; docs/distributed.md).
+#include <algorithm>
+#include <cstring>
+#include <memory>
+#include <string>
+
+#include "../core/grid_layout.h"
+#include "cpu_backend_impl.h"
+
+namespace sph {
+
+namespace {
+
+constexpr const char* kArraySortKey = "distributed_sort_key";
+constexpr const char* kArrayOrigin = "distributed_origin";
+
+void refuse(const std::string& what) {
+  throw Error(Status::Unsupported, "world: " + what +
+                                       " does not work in a distributed world yet (docs/distributed.md lists "
+                                       "what does)");
+}
+
+}  // namespace
+
+void CpuBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks, const DistributedOptions& options) {
+  if (!ranks) throw Error(Status::Internal, "attach_ranks: no transport");
+  if (count_ != 0 || ranks_)
+    throw Error(Status::Internal, "attach_ranks: the backend already holds particles");
+  if (config_.solver == Solver::Dfsph)
+    refuse("the DFSPH solver (SPH_SOLVER_DFSPH: its pressure solves need a halo per iteration)");
+  if (config_.integrator == Integrator::Rk4) refuse("the RK4 integrator (SPH_INTEGRATOR_RK4)");
+  const struct {
+    uint32_t bit;
+    const char* name;
+  } features[] = {{kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks)"},
+                  {kFeatureColliderLoads, "SPH_FEATURE_COLLIDER_LOADS (loads summed over ranks)"}};
+  for (const auto& f : features)
+    if (config_.features & f.bit) refuse(f.name);
+  const auto array = [](const char* name, uint32_t size, ParticleArrayRole role) {
+    return ParticleArraySpec{name, size, role, 1, nullptr, nullptr};
+  };
+  sort_key_ = store_.add_typed<uint64_t>(array(kArraySortKey, sizeof(uint64_t), ParticleArrayRole::Carried));
+  origin_ = store_.add_typed<uint32_t>(array(kArrayOrigin, sizeof(uint32_t), ParticleArrayRole::Sorted));
+  distributed_options_ = options;
+  slabs_ = SlabDecomposition(ranks->size());
+  ranks_ = std::move(ranks);
+}
+
+DistributedCounters CpuBackend::distributed_counters() const {
+  DistributedCounters c = halo_counters_;
+  c.axis = slabs_.axis();
+  const int me = ranks_ ? ranks_->rank() : 0;
+  const std::vector<int32_t>& cuts = slabs_.cuts();
+  c.slab_first = me == 0 ? INT32_MIN : cuts[static_cast<size_t>(me - 1)];
+  c.slab_last = me == static_cast<int>(cuts.size()) ? INT32_MAX : cuts[static_cast<size_t>(me)] - 1;
+  return c;
+}
+
+bool CpuBackend::halo_any(bool flag) const {
+  int64_t raised = flag ? 1 : 0;
+  ranks_->all_max(&raised, 1);
+  return raised != 0;
+}
+
+int32_t CpuBackend::halo_layer(uint32_t i) const {
+  const Float4& p = position_[i];
+  const int axis = slabs_.axis();
+  return cell_coordinate(axis == 0 ? p.x : (axis == 1 ? p.y : p.z), 1.0f / config_.kernel_radius);
+}
+
+void CpuBackend::halo_pack(uint32_t i, RankBytes& out) const {
+  for (const auto& a : store_.arrays()) {
+    if (a->spec.role != ParticleArrayRole::Carried || a->spec.elements_per_particle == 0) continue;
+    const size_t bytes = particle_bytes(a->spec);
+    const unsigned char* from = a->bytes.data() + i * bytes;
+    out.insert(out.end(), from, from + bytes);
+  }
+}
+
+uint32_t CpuBackend::halo_unpack(const RankBytes& in, uint32_t origin) {
+  size_t record = 0;
+  for (const auto& a : store_.arrays())
+    if (a->spec.role == ParticleArrayRole::Carried && a->spec.elements_per_particle != 0)
+      record += particle_bytes(a->spec);
+  if (in.size() % record != 0) throw Error(Status::Internal, "halo: a rank sent a partial particle record");
+  const uint32_t n = static_cast<uint32_t>(in.size() / record);
+  if (n == 0) return 0;
+  const uint32_t first = count_;
+  store_.resize(static_cast<size_t>(first) + n);
+  const unsigned char* from = in.data();
+  for (uint32_t k = 0; k < n; ++k)
+    for (const auto& a : store_.arrays()) {
+      if (a->spec.role != ParticleArrayRole::Carried || a->spec.elements_per_particle == 0) continue;
+      const size_t bytes = particle_bytes(a->spec);
+      std::memcpy(a->bytes.data() + (first + k) * bytes, from, bytes);
+      from += bytes;
+    }
+  for (uint32_t k = 0; k < n; ++k) origin_[first + k] = origin;
+  count_ = first + n;
+  return n;
+}
+
+void CpuBackend::halo_keep(size_t kept) {
+  if (kept == count_) return;
+  store_.permute(keep_order_.data(), kept, parallel());
+  count_ = static_cast<uint32_t>(kept);
+  store_.resize(count_);
+}
+
+void CpuBackend::halo_begin_frame() {
+  const RankTransport& t = *ranks_;
+  float maxima[2] = {max_speed_, max_acceleration_};
+  t.all_max(maxima, 2);
+  max_speed_ = maxima[0];
+  max_acceleration_ = maxima[1];
+  // Particles per rank, and the world's extent in cells.
+  const int size = t.size();
+  std::vector<int64_t> held(static_cast<size_t>(size), 0);
+  held[static_cast<size_t>(t.rank())] = count_;
+  t.all_sum(held.data(), size);
+  if (slabs_cut_ && !SlabDecomposition::imbalanced(held, distributed_options_.rebalance_threshold)) return;
+  const float inv = 1.0f / config_.kernel_radius;
+  int64_t lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+  for (uint32_t i = 0; i < count_; ++i) {
+    const float x[3] = {position_[i].x, position_[i].y, position_[i].z};
+    for (int a = 0; a < 3; ++a) {
+      const int64_t c = cell_coordinate(x[a], inv);
+      lo[a] = std::min(lo[a], c);
+      hi[a] = std::max(hi[a], c);
+    }
+  }
+  t.all_min(lo, 3);
+  t.all_max(hi, 3);
+  if (lo[0] > hi[0]) return;  // no particles anywhere: nothing to cut
+  int axis = 0;
+  for (int a = 1; a < 3; ++a)
+    if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
+  std::vector<int64_t> histogram(static_cast<size_t>(hi[axis] - lo[axis] + 1), 0);
+  for (uint32_t i = 0; i < count_; ++i) {
+    const float x[3] = {position_[i].x, position_[i].y, position_[i].z};
+    ++histogram[static_cast<size_t>(cell_coordinate(x[axis], inv) - lo[axis])];
+  }
+  t.all_sum(histogram.data(), static_cast<int>(histogram.size()));
+  slabs_.rebalance(axis, static_cast<int32_t>(lo[axis]), histogram);
+  slabs_cut_ = true;
+  ++halo_counters_.rebalances;
+}
+
+void CpuBackend::halo_gather() {
+  const RankTransport& t = *ranks_;
+  const int me = t.rank();
+  const int size = t.size();
+  std::vector<RankBytes> out(static_cast<size_t>(size));
+  // Migration: what another rank's slab holds goes there with every carried array.
+  keep_order_.clear();
+  for (uint32_t i = 0; i < count_; ++i) {
+    const int owner = slabs_.owner(halo_layer(i));
+    if (owner == me)
+      keep_order_.push_back(i);
+    else
+      halo_pack(i, out[static_cast<size_t>(owner)]);
+  }
+  std::vector<RankBytes> in = t.exchange(out);
+  halo_counters_.migrated_out += count_ - static_cast<uint32_t>(keep_order_.size());
+  halo_keep(keep_order_.size());
+  for (int r = 0; r < size; ++r) halo_counters_.migrated_in += halo_unpack(in[static_cast<size_t>(r)], 0u);
+  const uint32_t owned = count_;
+  // Ghosts: each owned particle of a layer beside another rank's slab goes to that rank.
+  for (RankBytes& b : out) b.clear();
+  for (uint32_t i = 0; i < owned; ++i) {
+    int to[2];
+    const int n = slabs_.ghost_destinations(halo_layer(i), me, to);
+    for (int k = 0; k < n; ++k) halo_pack(i, out[static_cast<size_t>(to[k])]);
+  }
+  in = t.exchange(out);
+  for (int r = 0; r < size; ++r) halo_unpack(in[static_cast<size_t>(r)], static_cast<uint32_t>(r) + 1u);
+  halo_counters_.ghosts = count_ - owned;
+  // The world's grid: the extent and count of every rank's owned particles (what the undivided
+  // world's grid sees).
+  const float inv = 1.0f / config_.kernel_radius;
+  int64_t lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+  for (uint32_t i = 0; i < owned; ++i) {
+    const float x[3] = {position_[i].x, position_[i].y, position_[i].z};
+    for (int a = 0; a < 3; ++a) {
+      const int64_t c = cell_coordinate(x[a], inv);
+      lo[a] = std::min(lo[a], c);
+      hi[a] = std::max(hi[a], c);
+    }
+  }
+  int64_t total = owned;
+  t.all_min(lo, 3);
+  t.all_max(hi, 3);
+  t.all_sum(&total, 1);
+  const bool any = total > 0;
+  const CellCoord clo =
+      any ? CellCoord{static_cast<int32_t>(lo[0]), static_cast<int32_t>(lo[1]), static_cast<int32_t>(lo[2])}
+          : CellCoord{0, 0, 0};
+  const CellCoord chi =
+      any ? CellCoord{static_cast<int32_t>(hi[0]), static_cast<int32_t>(hi[1]), static_cast<int32_t>(hi[2])}
+          : CellCoord{0, 0, 0};
+  halo_shape_ = make_grid_shape_for_extent(config_.kernel_radius, clo, chi, static_cast<uint32_t>(total));
+  // The sort's order: by key, then id (two keys are equal only where the table folds).
+  halo_visit_.resize(count_);
+  for (uint32_t i = 0; i < count_; ++i) halo_visit_[i] = i;
+  const uint64_t* key = sort_key_.data();
+  const uint32_t* id = id_.data();
+  std::sort(halo_visit_.begin(), halo_visit_.end(),
+            [key, id](uint32_t a, uint32_t b) { return key[a] != key[b] ? key[a] < key[b] : id[a] < id[b]; });
+}
+
+void CpuBackend::halo_keys() {
+  const GridView view = grid_.view();
+  uint64_t* key = sort_key_.data();
+  for (uint32_t c = 0; c < view.shape.cell_count; ++c)
+    for (uint32_t i = view.cell_start[c]; i < view.cell_start[c + 1]; ++i)
+      key[i] = (static_cast<uint64_t>(c) << 32) | (i - view.cell_start[c]);
+}
+
+// Each owned particle beside another rank's slab sends make(i) (a Record, which starts with the
+// particle's id) to that rank; each ghost takes apply(i, record) from its owner's. Both sides
+// list the particles in the sorted order, which is the same on every rank for the particles
+// they share: the receiver reads them in its own order (the ids check it).
+template <class Record, class Make, class Apply>
+void CpuBackend::halo_share(const char* what, Make&& make, Apply&& apply) {
+  const RankTransport& t = *ranks_;
+  const int me = t.rank();
+  const int size = t.size();
+  std::vector<RankBytes> out(static_cast<size_t>(size));
+  for (uint32_t i = 0; i < count_; ++i) {
+    if (ghost(i)) continue;
+    int to[2];
+    const int n = slabs_.ghost_destinations(halo_layer(i), me, to);
+    if (n == 0) continue;
+    const Record r = make(i);
+    const unsigned char* from = reinterpret_cast<const unsigned char*>(&r);
+    for (int k = 0; k < n; ++k)
+      out[static_cast<size_t>(to[k])].insert(out[static_cast<size_t>(to[k])].end(), from, from + sizeof r);
+  }
+  const std::vector<RankBytes> in = t.exchange(out);
+  std::vector<size_t> read(static_cast<size_t>(size), 0);
+  for (uint32_t i = 0; i < count_; ++i) {
+    if (!ghost(i)) continue;
+    const size_t from = origin_[i] - 1u;
+    Record r;
+    if ((read[from] + 1) * sizeof r > in[from].size())
+      throw Error(Status::Internal,
+                  std::string("halo: rank ") + std::to_string(from) + " sent fewer " + what + " than ghosts");
+    std::memcpy(&r, in[from].data() + read[from]++ * sizeof r, sizeof r);
+    if (r.id != id_[i])
+      throw Error(Status::Internal, std::string("halo: the ") + what + " of rank " + std::to_string(from) +
+                                        " came in another order than its ghosts (id " + std::to_string(r.id) +
+                                        " for ghost " + std::to_string(id_[i]) + ")");
+    apply(i, r);
+  }
+  for (int r = 0; r < size; ++r)
+    if (read[static_cast<size_t>(r)] * sizeof(Record) != in[static_cast<size_t>(r)].size())
+      throw Error(Status::Internal,
+                  std::string("halo: rank ") + std::to_string(r) + " sent more " + what + " than ghosts");
+}
+
+void CpuBackend::halo_share_density() {
+  struct Record {
+    uint32_t id;
+    float density, pressure, inv_density;
+    uint32_t neighbors;
+  };
+  halo_share<Record>(
+      "densities",
+      [this](uint32_t i) {
+        return Record{id_[i], density_[i], position_[i].w, velocity_[i].w, neighbors_[i]};
+      },
+      [this](uint32_t i, const Record& r) {
+        density_[i] = r.density;
+        position_[i].w = r.pressure;
+        velocity_[i].w = r.inv_density;
+        neighbors_[i] = r.neighbors;
+        columns_.set_density(i, r.pressure, r.inv_density);
+        columns_.set_neighbor_count(i, r.neighbors);
+      });
+}
+
+void CpuBackend::halo_share_normals() {
+  struct Record {
+    uint32_t id;
+    Float4 normal;
+  };
+  halo_share<Record>(
+      "colour normals",
+      [this](uint32_t i) {
+        return Record{id_[i], normals_[i]};
+      },
+      [this](uint32_t i, const Record& r) {
+        normals_[i] = r.normal;
+        columns_.set_normal(i, r.normal);
+      });
+}
+
+uint32_t CpuBackend::halo_end_substep(uint32_t bad_id) {
+  keep_order_.clear();
+  for (uint32_t i = 0; i < count_; ++i)
+    if (!ghost(i)) keep_order_.push_back(i);
+  halo_keep(keep_order_.size());
+  const RankTransport& t = *ranks_;
+  int64_t bad = bad_id;
+  t.all_min(&bad, 1);
+  float maxima[2] = {max_speed_, max_acceleration_};
+  t.all_max(maxima, 2);
+  max_speed_ = maxima[0];
+  max_acceleration_ = maxima[1];
+  if (bad != static_cast<int64_t>(kAllFinite) && bad_id == kAllFinite) {
+    // Another rank's particle: that rank's message classifies it.
+    non_finite_ = NonFiniteFailure{};
+    non_finite_.count = 1;
+    non_finite_.ids.push_back(static_cast<uint32_t>(bad));
+  }
+  return static_cast<uint32_t>(bad);
+}
+
+}  // namespace sph

@@ -1,0 +1,202 @@
+// SPDX-License-Identifier: MIT
+// The C layer of include/sph_mpi.h (libsph_mpi only): a world per rank, its backend attached
+// to an MpiTransport; the collective calls agree on their outcome over the ranks.
+#include <algorithm>
+#include <cstring>
+#include <memory>
+#include <string>
+
+#include "../capi/guard.h"
+#include "../capi/handles.h"
+#include "../capi/init_struct.h"
+#include "../capi/struct_io.h"
+#include "mpi_transport.h"
+#include "sph_mpi.h"
+
+using sph::Error;
+using sph::Status;
+
+namespace sph {
+namespace {
+
+constexpr uint32_t kDefaultRebalancePercent = 20;
+constexpr uint32_t kMaxRebalancePercent = 10000;
+
+// The world's ranks (the caller holds its lock); Unsupported for a world of sph_world_create.
+const RankTransport& ranks_of(const sph_world* world) {
+  const RankTransport* t = world->world->backend().rank_transport();
+  if (!t)
+    throw Error(Status::Unsupported,
+                "world: is not a distributed world (make it with sph_mpi_world_create on every rank)");
+  return *t;
+}
+
+}  // namespace
+}  // namespace sph
+
+extern "C" {
+
+SPH_API sph_result SPH_CALL sph_mpi_world_def_init_sized(sph_mpi_world_def* def, uint32_t size) {
+  return sph::init_user_struct("sph_mpi_world_def_init", "def", def, size);
+}
+
+SPH_API sph_result SPH_CALL sph_mpi_counts_init_sized(sph_mpi_counts* counts, uint32_t size) {
+  return sph::init_user_struct("sph_mpi_counts_init", "counts", counts, size);
+}
+
+SPH_API sph_result SPH_CALL sph_mpi_world_create(sph_context* context, const sph_world_def* def, int32_t comm,
+                                                 const sph_mpi_world_def* mpi_def, sph_world** out) {
+  return sph::guarded("sph_mpi_world_create", context, [&] {
+    const sph::ContextHold hold(context);
+    if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
+    sph_mpi_world_def m;
+    if (mpi_def) {
+      m = sph::read_user_struct(mpi_def, "mpi_def");
+    } else {
+      m = sph::zeroed_struct<sph_mpi_world_def>();
+    }
+    const uint32_t percent =
+        m.rebalance_threshold_percent == 0 ? sph::kDefaultRebalancePercent : m.rebalance_threshold_percent;
+    if (percent > sph::kMaxRebalancePercent)
+      throw Error(
+          Status::InvalidArgument,
+          "mpi_def->rebalance_threshold_percent: must be in [0, 10000], got " + std::to_string(percent));
+    const sph_world_def d = sph::read_user_struct(def, "def");
+    // Everything above is the same on every rank; from here on the ranks meet.
+    auto transport = std::make_shared<sph::MpiTransport>(MPI_Comm_f2c(static_cast<MPI_Fint>(comm)));
+    std::unique_ptr<sph_world> world = sph::make_world(context, d);
+    sph::DistributedOptions options;
+    options.rebalance_threshold = percent / 100.0;
+    world->world->backend().attach_ranks(std::move(transport), options);
+    *out = sph::publish_world(std::move(world));
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_mpi_world_add_particles(sph_world* world, const float* positions,
+                                                        const float* velocities, uint32_t count,
+                                                        uint32_t* out_first_id) {
+  return sph::guarded("sph_mpi_world_add_particles", sph::context_of(world), [&] {
+    sph::require_world(world);
+    sph::WorldLock lock(world);
+    sph::World& w = *world->world;
+    const sph::RankTransport& ranks = sph::ranks_of(world);
+    // The ids: rank order, after what the world has numbered.
+    const int64_t below = ranks.exclusive_sum(count);
+    int64_t total = count;
+    ranks.all_sum(&total, 1);
+    const uint32_t next_id_before = w.next_id();
+    const uint32_t count_before = w.particle_count();
+    bool refused = false;
+    Status status = Status::Ok;
+    std::string message;
+    try {
+      if (static_cast<uint64_t>(next_id_before) + static_cast<uint64_t>(total) > UINT32_MAX)
+        throw Error(Status::Capacity, "count: the world's ranks add " + std::to_string(total) +
+                                          " particles, past its 2^32 particle ids");
+      if (count > 0 && !positions) throw Error(Status::InvalidArgument, "positions: is NULL");
+      sph::HostVector<sph::Vec3> p(count), v(velocities ? count : 0u);
+      for (uint32_t i = 0; i < count; ++i) {
+        p[i] = sph::Vec3{positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]};
+        if (velocities) v[i] = sph::Vec3{velocities[3 * i], velocities[3 * i + 1], velocities[3 * i + 2]};
+      }
+      w.add_rank_particles(p, velocities ? &v : nullptr, next_id_before + static_cast<uint32_t>(below),
+                           next_id_before + static_cast<uint32_t>(total));
+    } catch (const Error& e) {
+      refused = true;
+      status = e.status();
+      message = e.what();
+    }
+    int64_t any_refused = refused ? 1 : 0;
+    ranks.all_max(&any_refused, 1);
+    if (refused) throw Error(status, message);
+    if (any_refused) {
+      w.undo_rank_particles(count_before, next_id_before);
+      throw Error(Status::InvalidArgument,
+                  "another rank's particles were refused (its error says why); no rank added any");
+    }
+    if (out_first_id) *out_first_id = next_id_before + static_cast<uint32_t>(below);
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_mpi_world_step(sph_world* world, float frame_dt) {
+  return sph_world_step(world, frame_dt);
+}
+
+SPH_API sph_result SPH_CALL sph_mpi_world_get_counts(const sph_world* world, sph_mpi_counts* out) {
+  return sph::guarded("sph_mpi_world_get_counts", sph::context_of(world), [&] {
+    sph::require_world(world);
+    sph::WorldLock lock(world);
+    const sph::RankTransport& ranks = sph::ranks_of(world);
+    const sph::DistributedCounters c = world->world->backend().distributed_counters();
+    int64_t sums[3] = {world->world->particle_count(), c.ghosts, c.migrated_out};
+    ranks.all_sum(sums, 3);  // (before any check of this rank's arguments: the other ranks wait for it)
+    if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
+    sph_mpi_counts r = sph::zeroed_struct<sph_mpi_counts>();
+    r.rank = ranks.rank();
+    r.rank_count = ranks.size();
+    r.local_count = world->world->particle_count();
+    r.global_count = static_cast<uint64_t>(sums[0]);
+    r.global_ghosts = static_cast<uint64_t>(sums[1]);
+    r.migrated = static_cast<uint64_t>(sums[2]);
+    r.local_ghosts = c.ghosts;
+    r.rebalances = c.rebalances;
+    r.axis = c.axis;
+    r.slab_first = c.slab_first;
+    r.slab_last = c.slab_last;
+    sph::write_output_struct(out, r, "out");
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t root, float* positions,
+                                                 float* velocities, uint32_t* ids, uint64_t capacity,
+                                                 uint64_t* out_count) {
+  return sph::guarded("sph_mpi_world_gather", sph::context_of(world), [&] {
+    sph::require_world(world);
+    sph::WorldLock lock(world);
+    const sph::RankTransport& ranks = sph::ranks_of(world);
+    if (root < 0 || root >= ranks.size())
+      throw Error(Status::InvalidArgument,
+                  "root: must be a rank of the world's communicator, got " + std::to_string(root));
+    struct Record {
+      uint32_t id;
+      float x[3], v[3];
+    };
+    const sph::Backend& b = world->world->backend();
+    const uint32_t n = world->world->particle_count();
+    sph::HostVector<Record> mine(n);
+    if (n > 0) {
+      b.copy_attribute(sph::AttributeKind::Id, 0, n, &mine[0].id, sizeof(Record));
+      b.copy_attribute(sph::AttributeKind::Position, 0, n, mine[0].x, sizeof(Record));
+      b.copy_attribute(sph::AttributeKind::Velocity, 0, n, mine[0].v, sizeof(Record));
+    }
+    const unsigned char* bytes = reinterpret_cast<const unsigned char*>(mine.data());
+    const std::vector<sph::RankBytes> all =
+        ranks.gather(sph::RankBytes(bytes, bytes + n * sizeof(Record)), root);
+    if (out_count) *out_count = 0;
+    if (ranks.rank() != root) return SPH_OK;
+    sph::HostVector<Record> records;
+    for (const sph::RankBytes& r : all) {
+      const size_t k = r.size() / sizeof(Record);
+      const size_t at = records.size();
+      records.resize(at + k);
+      if (k > 0) std::memcpy(&records[at], r.data(), k * sizeof(Record));
+    }
+    std::sort(records.begin(), records.end(), [](const Record& a, const Record& c) { return a.id < c.id; });
+    if (out_count) *out_count = records.size();
+    if (capacity < records.size())
+      throw Error(Status::InvalidArgument, "capacity: " + std::to_string(capacity) +
+                                               " is below the world's " + std::to_string(records.size()) +
+                                               " particles");
+    for (size_t i = 0; i < records.size(); ++i) {
+      if (positions) std::memcpy(positions + 3 * i, records[i].x, sizeof records[i].x);
+      if (velocities) std::memcpy(velocities + 3 * i, records[i].v, sizeof records[i].v);
+      if (ids) ids[i] = records[i].id;
+    }
+    return SPH_OK;
+  });
+}
+
+}  // extern "C"

@@ -1,0 +1,120 @@
+// SPDX-License-Identifier: MIT
+#include "mpi_transport.h"
+
+#include <climits>
+#include <string>
+
+#include "../core/status.h"
+
+namespace sph {
+
+namespace {
+
+void check(int code, const char* what) {
+  if (code == MPI_SUCCESS) return;
+  char text[MPI_MAX_ERROR_STRING];
+  int length = 0;
+  MPI_Error_string(code, text, &length);
+  throw Error(Status::Internal,
+              std::string("MPI: ") + what + " failed: " + std::string(text, static_cast<size_t>(length)));
+}
+
+int as_count(size_t n) {
+  if (n > static_cast<size_t>(INT_MAX)) throw Error(Status::Capacity, "MPI: a message of more than 2 GiB");
+  return static_cast<int>(n);
+}
+
+}  // namespace
+
+MpiTransport::MpiTransport(MPI_Comm comm) {
+  int initialized = 0;
+  MPI_Initialized(&initialized);
+  if (!initialized)
+    throw Error(Status::InvalidArgument, "comm: MPI is not initialised (call MPI_Init first)");
+  if (comm == MPI_COMM_NULL) throw Error(Status::InvalidArgument, "comm: is MPI_COMM_NULL");
+  // Errors come back as codes (check() turns them into Errors), not as an abort.
+  check(MPI_Comm_dup(comm, &comm_), "MPI_Comm_dup");
+  MPI_Comm_set_errhandler(comm_, MPI_ERRORS_RETURN);
+  MPI_Comm_rank(comm_, &rank_);
+  MPI_Comm_size(comm_, &size_);
+}
+
+MpiTransport::~MpiTransport() {
+  int finalized = 0;
+  MPI_Finalized(&finalized);
+  if (!finalized && comm_ != MPI_COMM_NULL) MPI_Comm_free(&comm_);
+}
+
+void MpiTransport::all_min(int64_t* values, int n) const {
+  check(MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_INT64_T, MPI_MIN, comm_), "MPI_Allreduce");
+}
+void MpiTransport::all_max(int64_t* values, int n) const {
+  check(MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_INT64_T, MPI_MAX, comm_), "MPI_Allreduce");
+}
+void MpiTransport::all_sum(int64_t* values, int n) const {
+  check(MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_INT64_T, MPI_SUM, comm_), "MPI_Allreduce");
+}
+void MpiTransport::all_max(float* values, int n) const {
+  check(MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_FLOAT, MPI_MAX, comm_), "MPI_Allreduce");
+}
+
+int64_t MpiTransport::exclusive_sum(int64_t value) const {
+  int64_t below = 0;
+  check(MPI_Exscan(&value, &below, 1, MPI_INT64_T, MPI_SUM, comm_), "MPI_Exscan");
+  return rank_ == 0 ? 0 : below;  // (MPI leaves rank 0's result undefined)
+}
+
+std::vector<RankBytes> MpiTransport::exchange(const std::vector<RankBytes>& send) const {
+  const size_t n = static_cast<size_t>(size_);
+  if (send.size() != n) throw Error(Status::Internal, "exchange: one buffer per rank");
+  std::vector<int> send_counts(n), recv_counts(n), send_offsets(n), recv_offsets(n);
+  size_t total = 0;
+  for (size_t r = 0; r < n; ++r) {
+    send_counts[r] = as_count(send[r].size());
+    send_offsets[r] = as_count(total);
+    total += send[r].size();
+  }
+  RankBytes packed;
+  packed.reserve(total);
+  for (const RankBytes& b : send) packed.insert(packed.end(), b.begin(), b.end());
+  check(MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm_), "MPI_Alltoall");
+  size_t received = 0;
+  for (size_t r = 0; r < n; ++r) {
+    recv_offsets[r] = as_count(received);
+    received += static_cast<size_t>(recv_counts[r]);
+  }
+  RankBytes in(received);
+  check(MPI_Alltoallv(packed.data(), send_counts.data(), send_offsets.data(), MPI_BYTE, in.data(),
+                      recv_counts.data(), recv_offsets.data(), MPI_BYTE, comm_),
+        "MPI_Alltoallv");
+  std::vector<RankBytes> out(n);
+  for (size_t r = 0; r < n; ++r)
+    out[r].assign(in.begin() + recv_offsets[r], in.begin() + recv_offsets[r] + recv_counts[r]);
+  return out;
+}
+
+std::vector<RankBytes> MpiTransport::gather(const RankBytes& mine, int root) const {
+  const size_t n = static_cast<size_t>(size_);
+  int count = as_count(mine.size());
+  std::vector<int> counts(rank_ == root ? n : 0), offsets(rank_ == root ? n : 0);
+  check(MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, root, comm_), "MPI_Gather");
+  size_t total = 0;
+  if (rank_ == root)
+    for (size_t r = 0; r < n; ++r) {
+      offsets[r] = as_count(total);
+      total += static_cast<size_t>(counts[r]);
+    }
+  RankBytes all(total);
+  check(MPI_Gatherv(mine.data(), count, MPI_BYTE, all.data(), counts.data(), offsets.data(), MPI_BYTE, root,
+                    comm_),
+        "MPI_Gatherv");
+  std::vector<RankBytes> out;
+  if (rank_ == root) {
+    out.resize(n);
+    for (size_t r = 0; r < n; ++r)
+      out[r].assign(all.begin() + offsets[r], all.begin() + offsets[r] + counts[r]);
+  }
+  return out;
+}
+
+}  // namespace sph
