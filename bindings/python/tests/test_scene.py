@@ -316,6 +316,18 @@ def test_probes(ctx):
             assert "def->length" in sph.last_error()
             gauge.destroy()
             assert point.reading.samples > 0
+            # A pressure threshold below the point's peak reports the step; a bad one is refused.
+            assert error(point.set_pressure_threshold, float("nan")) == sph.Result.ERROR_INVALID_ARGUMENT
+            point.set_pressure_threshold(1.0)
+            world.step(0.02)
+            peak = point.reading.pressure_max  # about 700 Pa, 4 cm under the surface
+            hits = [e for e in world.events() if e.type == sph.EventType.PROBE_PRESSURE_EXCEEDED]
+            assert peak >= 1.0
+            assert len(hits) == 1 and hits[0].object_bits == point.bits
+            assert math.floor(peak) - 1 <= hits[0].count <= math.floor(peak)
+            point.set_pressure_threshold(0.0)
+            world.step(0.02)
+            assert not [e for e in world.events() if e.type == sph.EventType.PROBE_PRESSURE_EXCEEDED]
             tank.destroy()
 
 
