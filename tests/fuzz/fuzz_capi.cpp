@@ -601,10 +601,13 @@ class Program {
         sph_stats_init(&s.value);
         s.value.struct_size = struct_size(sizeof(sph_stats));
         const uint32_t size = s.value.struct_size;
-        std::memset(s.bytes + std::min<uint32_t>(size, 256), 0xAB, 256 - std::min<uint32_t>(size, 256));
+        // The canary starts after the struct_size field even when struct_size is below 4: painting
+        // over the field would hand the library a struct_size of 0xABABABAB instead of `size`.
+        const uint32_t canary = std::min<uint32_t>(std::max<uint32_t>(size, sizeof(uint32_t)), 256);
+        std::memset(s.bytes + canary, 0xAB, 256 - canary);
         const sph_result r = FUZZ_CALL(sph_world_get_stats(w, in_.chance(16) ? nullptr : &s.value));
         // "only that many bytes are written"
-        for (uint32_t i = std::max<uint32_t>(size, 0); i < 256; ++i)
+        for (uint32_t i = canary; i < 256; ++i)
           if (s.bytes[i] != 0xAB) violation("sph_world_get_stats wrote past struct_size %u (r=%d)", size, r);
         break;
       }

@@ -13,9 +13,8 @@ ProbeDesc parse_probe(const JsonNode& node) {
     node.expect_object("a point probe", {"name", "type", "position", "sampling", "pressure_threshold"});
     p.kind = SPH_PROBE_POINT;
   } else {
-    node.expect_object("a gauge",
-                       {"name", "type", "position", "direction", "length", "sample_spacing", "sampling",
-                        "pressure_threshold"});
+    node.expect_object("a gauge", {"name", "type", "position", "direction", "length", "sample_spacing",
+                                   "sampling", "pressure_threshold"});
     p.kind = SPH_PROBE_GAUGE;
     if (!node["direction"].missing()) p.direction = node["direction"].direction();
     p.length = node["length"].positive();

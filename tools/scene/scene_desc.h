@@ -57,8 +57,8 @@ struct ColliderDesc {
   Motion motion;
   bool inverted = false;
   float restitution = 0.0f, friction = 0.0f, stickiness = 0.0f;
-  bool loads = false;     // "loads": its force and torque are written per frame (a CSV)
-  sph_vec3 load_point{};  // the torque's point, in the collider's frame
+  bool loads = false;           // "loads": its force and torque are written per frame (a CSV)
+  sph_vec3 load_point{};        // the torque's point, in the collider's frame
   float load_threshold = 0.0f;  // N: a frame whose force reaches it is reported; 0 = never
   std::string path;
 };
