@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "host_memory.h"
+#include "status.h"
 
 namespace sph {
 
@@ -54,6 +55,13 @@ class SlotMap {
     return &*s.value;
   }
   const T* find(uint64_t id) const { return const_cast<SlotMap*>(this)->find(id); }
+  // The live object `id` names; Error(InvalidHandle) "id: ..." for a null, stale or foreign id.
+  T& at(uint64_t id) {
+    T* object = find(id);
+    if (!object) throw Error(Status::InvalidHandle, "id: is null, stale or not of this world");
+    return *object;
+  }
+  const T& at(uint64_t id) const { return const_cast<SlotMap*>(this)->at(id); }
 
   bool erase(uint64_t id) {
     if (!find(id)) return false;

@@ -86,10 +86,9 @@ void World::remove_probe(uint64_t id) {
 }
 
 void World::set_probe_pressure_threshold(uint64_t id, float threshold) {
-  Probe* p = probes_.find(id);
-  if (!p) throw Error(Status::InvalidHandle, "id: is null, stale or not of this world");
+  Probe& p = probes_.at(id);
   require_non_negative_field(threshold, "pressure");
-  p->pressure_threshold = threshold;
+  p.pressure_threshold = threshold;
 }
 
 void World::adopt_probes(const World& from) {
@@ -101,11 +100,7 @@ void World::adopt_probes(const World& from) {
 
 void World::restore_probes(SlotTable<Probe> table) { probes_.restore(std::move(table)); }
 
-const Probe& World::probe(uint64_t id) const {
-  const Probe* p = probes_.find(id);
-  if (!p) throw Error(Status::InvalidHandle, "id: is null, stale or not of this world");
-  return *p;
-}
+const Probe& World::probe(uint64_t id) const { return probes_.at(id); }
 
 void World::add_probe_frames(SceneFrame& scene) const {
   scene.probes.reserve(probes_.size());

@@ -23,13 +23,6 @@ void require_room(const SlotMap<T>& map, const char* kind) {
 }
 
 template <class T>
-T& live(SlotMap<T>& map, uint64_t id) {
-  T* object = map.find(id);
-  if (!object) throw Error(Status::InvalidHandle, "id: is null, stale or not of this world");
-  return *object;
-}
-
-template <class T>
 void remove(SlotMap<T>& map, uint64_t id) {
   if (id == 0) return;
   if (!map.erase(id)) throw Error(Status::InvalidHandle, "id: is stale or not of this world");
@@ -72,53 +65,49 @@ void World::remove_sink(uint64_t id) { remove(sinks_, id); }
 void World::remove_force_field(uint64_t id) { remove(force_fields_, id); }
 
 void World::set_collider_target(uint64_t id, const RigidTransform& target) {
-  Collider& c = live(colliders_, id);
+  Collider& c = colliders_.at(id);
   require_pose(target, "target");
   c.target = target;
 }
 
 void World::teleport_collider(uint64_t id, const RigidTransform& pose) {
-  Collider& c = live(colliders_, id);
+  Collider& c = colliders_.at(id);
   require_pose(pose, "transform");
   c.pose = pose;
   c.target.reset();
 }
 
 void World::set_collider_material(uint64_t id, const ColliderMaterial& material) {
-  Collider& c = live(colliders_, id);
+  Collider& c = colliders_.at(id);
   check_collider_material(material);
   c.material = material;
 }
 
 void World::set_collider_load_point(uint64_t id, Vec3 point) {
-  Collider& c = live(colliders_, id);
+  Collider& c = colliders_.at(id);
   require_finite_vec3_field(point, "point");
   c.load_point = point;
 }
 
 void World::set_collider_load_threshold(uint64_t id, float threshold) {
-  Collider& c = live(colliders_, id);
+  Collider& c = colliders_.at(id);
   require_non_negative_field(threshold, "force");
   c.load_threshold = threshold;
 }
 
 void World::set_source_pose(uint64_t id, const RigidTransform& pose) {
-  Source& s = live(sources_, id);
+  Source& s = sources_.at(id);
   require_pose(pose, "transform");
   s.pose = pose;
 }
 
 void World::set_force_field_pose(uint64_t id, const RigidTransform& pose) {
-  ForceField& f = live(force_fields_, id);
+  ForceField& f = force_fields_.at(id);
   require_pose(pose, "transform");
   f.pose = pose;
 }
 
-const Collider& World::collider(uint64_t id) const {
-  const Collider* c = colliders_.find(id);
-  if (!c) throw Error(Status::InvalidHandle, "id: is null, stale or not of this world");
-  return *c;
-}
+const Collider& World::collider(uint64_t id) const { return colliders_.at(id); }
 
 void World::restore_scene(SceneTables tables) {
   colliders_.restore(std::move(tables.colliders));
