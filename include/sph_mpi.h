@@ -13,7 +13,8 @@
  * COLLECTIVE must be made by every rank of the communicator, in the same order, with the same
  * scalar arguments: sph_mpi_world_create, sph_mpi_world_add_particles, sph_mpi_world_step (and
  * sph_world_step on a distributed world, which is the same call), sph_mpi_world_get_counts,
- * sph_mpi_world_gather. The scene (colliders, force fields, sinks) is replicated: make the same
+ * sph_mpi_world_gather, sph_mpi_world_save_file, sph_mpi_world_load_file,
+ * sph_mpi_world_restore_file. The scene (colliders, force fields, sinks) is replicated: make the same
  * calls of sph_c.h on every rank. The calls of sph_c.h that read particles (copy_attribute,
  * get_stats) read the calling rank's own.
  *
@@ -21,9 +22,11 @@
  * A distributed world steps the same bits as one undivided world of the same particles (while
  * the neighbour grid's table covers the particles' extent; docs/distributed.md says when).
  *
- * Thread rules: as sph_c.h, per rank. A failure other than bad input inside a collective step
- * on one rank (an allocation, a crowded cell) is not yet agreed between the ranks: the others
- * then wait in MPI; the world reports non-finite states on every rank and rolls every rank back.
+ * Thread rules: as sph_c.h, per rank. Failures are agreed between the ranks: when a step, save,
+ * load or restore fails on one rank (an allocation, a crowded cell, a non-finite state, a file),
+ * every rank returns an error and rolls back (the failing rank its own code and message, the
+ * others the first failing rank's code, the message naming that rank), rather than waiting in
+ * MPI for it.
  */
 #ifndef SPH_MPI_H
 #define SPH_MPI_H
@@ -125,6 +128,53 @@ SPH_API sph_result SPH_CALL sph_mpi_world_get_counts(const sph_world* world, sph
 SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t root, float* positions,
                                                  float* velocities, uint32_t* ids, uint64_t capacity,
                                                  uint64_t* out_count);
+
+/* ---- checkpoints ---------------------------------------------------------------------------
+ * A distributed world saves as one checkpoint file per rank (sph_c.h's format, marked as one
+ * rank's part: its particles, their sort keys, its copy of the scene) plus a manifest that
+ * rank 0 writes last: the rank count, the slabs and counters, the world's particle count, and
+ * each rank file's name, size and hash. It loads and restores on the same number of ranks only,
+ * each rank taking its own file back, and then steps on bit for bit as the saved world would
+ * have. The files are found beside the manifest (the same directory), so the set moves together;
+ * every rank must see the manifest and its own file (a shared file system, or copies). A rank's
+ * file alone is not a world: sph_world_load refuses it (INVALID_ARGUMENT), and sph_world_save and
+ * sph_world_restore refuse a distributed world (UNSUPPORTED). */
+
+/**
+ * COLLECTIVE. Saves the world at `path` (the same on every rank): each rank writes its file,
+ * path + ".rank" + its rank, atomically as sph_world_save_file does, then rank 0 writes the
+ * manifest at `path`, atomically. Succeeds or fails on every rank. Each file is replaced only
+ * by a whole new one, but the set is not replaced atomically: after a failed (or killed) save,
+ * the manifest at `path` may be the previous save's while some rank files are new, and a load
+ * then refuses the set (their hashes do not match) rather than mixing two saves.
+ * Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL or empty path; a file that cannot be written:
+ * the message says which and why), UNSUPPORTED (not a distributed world), WORLD_LOCKED,
+ * OUT_OF_HOST_MEMORY; a rank whose own save succeeded returns the failing rank's code.
+ */
+SPH_API sph_result SPH_CALL sph_mpi_world_save_file(const sph_world* world, const char* path);
+
+/**
+ * COLLECTIVE. Creates a distributed world over the communicator `comm` (as sph_mpi_world_create)
+ * from the manifest at `path` and this rank's file named in it. The communicator must have the
+ * rank count that saved it. The rebalance threshold is the saved world's. On any error on any
+ * rank, no rank creates a world and *out is untouched. Errors: INVALID_HANDLE (context),
+ * INVALID_ARGUMENT (NULL path or out; a file that cannot be read; a communicator of another rank
+ * count than the manifest's, or a bad one), CORRUPT_DATA (a damaged manifest or rank file, or a
+ * rank file whose size or hash is not the manifest's: the message names the file),
+ * VERSION_MISMATCH, UNSUPPORTED (a CUDA context), OUT_OF_HOST_MEMORY; a rank that found nothing
+ * wrong returns the first failing rank's code.
+ */
+SPH_API sph_result SPH_CALL sph_mpi_world_load_file(sph_context* context, int32_t comm, const char* path,
+                                                    sph_world** out);
+
+/**
+ * COLLECTIVE. Replaces the world's whole state with the one saved at `path`, keeping its handle
+ * and communicator: afterwards it is as a world sph_mpi_world_load_file made from `path`.
+ * All-or-nothing over the ranks: on any error on any rank, every rank's world is unchanged.
+ * Errors: as sph_mpi_world_load_file, and INVALID_HANDLE, UNSUPPORTED (not a distributed world),
+ * WORLD_LOCKED.
+ */
+SPH_API sph_result SPH_CALL sph_mpi_world_restore_file(sph_world* world, const char* path);
 
 #ifdef __cplusplus
 }

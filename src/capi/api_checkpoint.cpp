@@ -118,6 +118,10 @@ SPH_API sph_result SPH_CALL sph_world_restore(sph_world* world, const void* data
   return sph::guarded("sph_world_restore", sph::context_of(world), [&] {
     sph::require_world(world);
     sph::WorldLock lock(world);
+    if (world->world->backend().distributed())
+      throw Error(Status::Unsupported,
+                  "world: a distributed world restores from its ranks' checkpoints and their manifest: "
+                  "sph_mpi_world_restore_file on every rank (sph_mpi.h)");
     // The new state is built whole beside the old one, then swapped in.
     std::unique_ptr<sph::World> loaded = load_world(world->context, data, size);
     // A file of format 5 or later carries its probes; an older one has none, and the world

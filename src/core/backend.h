@@ -117,6 +117,18 @@ class Backend {
   virtual const RankTransport* rank_transport() const { return nullptr; }
   bool distributed() const { return rank_transport() != nullptr; }
   virtual DistributedCounters distributed_counters() const { return DistributedCounters{}; }
+  // The ranks as attach_ranks took them (a restore attaches them to the state it builds).
+  virtual std::shared_ptr<const RankTransport> shared_rank_transport() const { return nullptr; }
+  // A distributed world's decomposition and counters (a rank's checkpoint); the restore takes a
+  // state whose cuts are valid for the ranks (SlabDecomposition::valid).
+  virtual DistributedState distributed_state() const { return DistributedState{}; }
+  virtual void restore_distributed_state(const DistributedState&) {
+    throw Error(Status::Internal, "restore_distributed_state: not a distributed world");
+  }
+  // Call at the end of the catch block of a step: rethrows the exception being handled. In a
+  // distributed world, a failure of this rank alone first meets the other ranks at their next
+  // agreement, so that they fail too instead of waiting for it (core/rank_agreement.h).
+  virtual void rethrow_step_failure() const { throw; }
 
   // ---- the device interop tier (include/sph_cuda.h); a backend whose particles live in host
   // memory refuses it with the defaults below ---------------------------------------------------

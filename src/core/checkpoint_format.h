@@ -10,12 +10,16 @@
 // differs from 2 only in the parameters section, checkpoint_params.h; all load). A world with
 // SPH_FEATURE_USER_ATTRIBUTE adds its values to PART and each source's to SRCE: a layout only that feature
 // bit in CONF selects, so it needed no new version (a library without the feature refuses the bit):
-//   header (48 bytes): magic[8] "SPHCKPT\x1a", u32 format version, u32 flags (0), u32 writer
+//   header (48 bytes): magic[8] "SPHCKPT\x1a", u32 format version, u32 flags, u32 writer
 //     backend, u32 writer library version, u64 payload size, u64 checksum, u32 section count,
 //     u32 reserved (0). The checksum is FNV-1a 64 over the header with the checksum field
 //     left out, then the payload.
 //   payload: sections in the order of kSectionOrder, each u32 tag, u32 reserved (0), u64 body
 //     length, body.
+// Flags: 0 for a world's checkpoint; kFlagRankPart for one rank's part of a distributed world
+// (include/sph_mpi.h: one such file per rank and a manifest, src/mpi/rank_manifest.h): PART then
+// ends with each particle's u64 sort key (the order of the next sort; docs/distributed.md). A
+// reader before that flag refuses such a file as unknown flags, as it should: it cannot resume it.
 #pragma once
 
 #include <stddef.h>
@@ -31,6 +35,7 @@ constexpr uint32_t kFirstThresholdVersion = 7;  // the first with load and press
 constexpr uint32_t kFirstSolverVersion = 3;     // the first with the solver, its report and warm starts
 constexpr uint32_t kFirstGrowableVersion = 5;   // the first with max_capacity in CONF
 constexpr uint32_t kOldestReadableVersion = 1;  // the oldest the reader still loads
+constexpr uint32_t kFlagRankPart = 1u << 0;
 constexpr size_t kHeaderSize = 48;
 constexpr size_t kChecksumOffset = 32;
 constexpr size_t kSectionHeaderSize = 16;

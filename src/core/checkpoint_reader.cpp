@@ -287,7 +287,8 @@ std::string library_version_text(uint32_t packed) {
 
 }  // namespace
 
-std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const BackendMaker& make_backend) {
+std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const BackendMaker& make_backend,
+                                       bool rank_part) {
   // Header: magic and version first (a later version may lay out the rest differently), then
   // the sizes, then the checksum over everything.
   if (size < kHeaderSize)
@@ -323,7 +324,14 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   sum.add(data, kChecksumOffset);
   sum.add(data + kChecksumOffset + 8, size - kChecksumOffset - 8);
   if (sum.value() != checksum) corrupt("checksum mismatch: the data is damaged");
-  if (flags != 0) corrupt("unknown flags " + hex32(flags));
+  if ((flags & ~kFlagRankPart) != 0) corrupt("unknown flags " + hex32(flags));
+  if ((flags & kFlagRankPart) && !rank_part)
+    throw Error(
+        Status::InvalidArgument,
+        "checkpoint: it is one rank's part of a distributed world; load it on its ranks with its manifest "
+        "(sph_mpi_world_load_file)");
+  if (rank_part && !(flags & kFlagRankPart))
+    corrupt("not one rank's part of a distributed world (the manifest names a world's checkpoint)");
   if (reserved != 0) corrupt("a reserved header field is not 0");
   if (section_count != section_count_of(version))
     corrupt(std::to_string(section_count) + " sections; version " + std::to_string(version) + " has " +
@@ -359,6 +367,13 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   ByteReader part = next_section(3);
   ParticleSnapshot particles = read_particles(part, config, clock.next_id);
   if (config.features & kFeatureSprings) read_springs(part, config, clock.next_id, particles);
+  if (rank_part) {
+    // Any value is a valid order (keys only order the next sort); the count is checked first.
+    part.need_elements(particles.id.size(), sizeof(uint64_t), "sort keys");
+    HostVector<uint64_t> keys(particles.id.size());
+    for (uint64_t& key : keys) key = part.u64();
+    particles.set_carried(kArrayDistributedSortKey, keys);
+  }
   part.expect_end();
 
   ByteReader sdfa = next_section(4);

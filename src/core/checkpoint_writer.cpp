@@ -177,18 +177,22 @@ void write_slots(ByteWriter& w, const SlotMap<T>& map, Body&& body) {
   for (uint32_t slot : map.free_slots()) w.u32(slot);
 }
 
-void write_particle_section(ByteWriter& w, const World& world, const ParticleSnapshot& particles) {
+void write_particle_section(ByteWriter& w, const World& world, const ParticleSnapshot& particles,
+                            bool rank_part) {
   write_particles(w, particles);
   if (world.config().features & kFeatureSprings) write_springs(w, particles);
+  if (rank_part)
+    for (uint64_t key : particles.carried_as<uint64_t>(kArrayDistributedSortKey)) w.u64(key);
 }
 
 }  // namespace
 
 HostVector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin& origin) {
-  if (world.backend().distributed())
-    throw Error(Status::Unsupported,
-                "world: checkpoints of a distributed world (one per rank with a manifest) are not built yet "
-                "(docs/distributed.md)");
+  if (world.backend().distributed() != origin.rank_part)
+    throw Error(origin.rank_part ? Status::Internal : Status::Unsupported,
+                origin.rank_part ? "write_checkpoint: a rank's part of a world that is not distributed"
+                                 : "world: a distributed world saves one checkpoint per rank and a manifest: "
+                                   "sph_mpi_world_save_file on every rank (sph_mpi.h)");
   // Asset indices first: the asset section precedes the objects that refer to it.
   AssetTable assets;
   world.colliders().for_each([&](uint64_t, const Collider& c) { assets.index(c.sdf); });
@@ -203,7 +207,7 @@ HostVector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin&
   ByteWriter w;
   for (uint8_t b : kMagic) w.u8(b);  // (not bytes(): GCC 12 flags its insert into an empty vector here)
   w.u32(kFormatVersion);
-  w.u32(0);  // flags
+  w.u32(origin.rank_part ? kFlagRankPart : 0u);
   w.u32(origin.backend);
   w.u32(origin.library_version);
   w.u64(0);  // payload size, patched below
@@ -214,7 +218,7 @@ HostVector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin&
   section(w, kSectionOrder[0].tag, [&] { write_config(w, world.config()); });
   section(w, kSectionOrder[1].tag, [&] { write_params(w, world.params()); });
   section(w, kSectionOrder[2].tag, [&] { write_clock(w, world); });
-  section(w, kSectionOrder[3].tag, [&] { write_particle_section(w, world, particles); });
+  section(w, kSectionOrder[3].tag, [&] { write_particle_section(w, world, particles, origin.rank_part); });
   section(w, kSectionOrder[4].tag, [&] {
     w.u32(static_cast<uint32_t>(assets.assets().size()));
     for (const SdfAsset* a : assets.assets()) write_asset(w, *a);

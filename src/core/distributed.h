@@ -5,7 +5,13 @@
 
 #include <stdint.h>
 
+#include <vector>
+
 namespace sph {
+
+// Each particle's sort key in a distributed world (cpu_halo.cpp): a carried array that a rank's
+// checkpoint saves with its particles.
+constexpr const char* kArrayDistributedSortKey = "distributed_sort_key";
 
 struct DistributedOptions {
   // Rebalance when the fullest rank holds more than (1 + threshold) times the mean.
@@ -20,6 +26,16 @@ struct DistributedCounters {
   int32_t axis = 0;           // the slabs' axis (0 x, 1 y, 2 z)
   int32_t slab_first = 0;     // this rank's cell layers [slab_first, slab_last] (empty: first > last)
   int32_t slab_last = 0;
+};
+
+// What a rank's checkpoint carries beside its particles: the decomposition and the counters, so
+// that a restored world cuts, migrates and counts as the saved one would have.
+struct DistributedState {
+  int32_t axis = 0;                  // the slabs' axis
+  std::vector<int32_t> cuts;         // ranks - 1 non-decreasing cuts (SlabDecomposition::cuts)
+  bool cut = false;                  // whether the first frame's cut was made
+  DistributedCounters counters;      // ghosts, migrated_in, migrated_out, rebalances (axis and slab: above)
+  double rebalance_threshold = 0.2;  // DistributedOptions' (reported; attach_ranks sets it)
 };
 
 }  // namespace sph

@@ -2,7 +2,9 @@
 // What a distributed world (include/sph_mpi.h) needs from its ranks' transport: collective
 // reductions and one all-to-all of bytes. The core and the backends see only this interface;
 // src/mpi implements it with MPI (libsph_mpi), so libsph never links MPI. Every call is
-// collective: each rank of the world makes the same calls in the same order.
+// collective: each rank of the world makes the same calls in the same order. exchange and
+// gather are agreements too (core/rank_agreement.h): a rank that failed before one, or fails
+// in its own buffers, makes every rank throw instead of leaving them in MPI.
 #pragma once
 
 #include <stddef.h>
@@ -32,6 +34,8 @@ class RankTransport {
   virtual std::vector<RankBytes> exchange(const std::vector<RankBytes>& send) const = 0;
   // Every rank's bytes on `root` (in rank order); other ranks get an empty list.
   virtual std::vector<RankBytes> gather(const RankBytes& mine, int root) const = 0;
+  // Root's bytes on every rank (no agreement: the agreements' own failure path).
+  virtual RankBytes broadcast(const RankBytes& bytes, int root) const = 0;
 };
 
 }  // namespace sph

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 
+#include "status.h"
+
 namespace sph {
 
 SlabDecomposition::SlabDecomposition(int ranks)
@@ -49,6 +51,18 @@ void SlabDecomposition::rebalance(int axis, int32_t first_layer, const std::vect
     cuts[static_cast<size_t>(r - 1)] =
         k < histogram.size() ? first_layer + static_cast<int32_t>(k) : INT32_MAX;
   }
+  cuts_ = cuts;
+}
+
+bool SlabDecomposition::valid(int ranks, int axis, const std::vector<int32_t>& cuts) {
+  if (ranks < 1 || axis < 0 || axis > 2) return false;
+  if (cuts.size() != static_cast<size_t>(ranks - 1)) return false;
+  return std::is_sorted(cuts.begin(), cuts.end());
+}
+
+void SlabDecomposition::restore(int axis, const std::vector<int32_t>& cuts) {
+  if (!valid(ranks(), axis, cuts)) throw Error(Status::Internal, "slabs: an invalid decomposition");
+  axis_ = axis;
   cuts_ = cuts;
 }
 

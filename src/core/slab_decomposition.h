@@ -33,6 +33,11 @@ class SlabDecomposition {
   // r / ranks of the total.
   void rebalance(int axis, int32_t first_layer, const std::vector<int64_t>& histogram);
   const std::vector<int32_t>& cuts() const { return cuts_; }
+  // Cuts as cuts() gave them (a checkpoint's): ranks() - 1 of them, non-decreasing, axis 0-2.
+  // Whether `axis` and `cuts` are such a decomposition for `ranks` ranks.
+  static bool valid(int ranks, int axis, const std::vector<int32_t>& cuts);
+  // Takes a valid decomposition (Internal otherwise).
+  void restore(int axis, const std::vector<int32_t>& cuts);
 
  private:
   int axis_ = 0;

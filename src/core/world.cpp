@@ -273,6 +273,8 @@ bool World::step(double frame_dt, const StepInterrupt& interrupt, const FrameEnq
       s->rate_budget = saved.rate_budget;
     }
     events_.swap(events_before);
+    // (A distributed world's other ranks fail too, rather than wait for this one.)
+    backend_->rethrow_step_failure();
     throw;
   }
   // Colliders arrive where they were sent; their loads are the frame's impulses over its time.

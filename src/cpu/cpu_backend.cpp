@@ -149,6 +149,10 @@ ParticleSnapshot CpuBackend::export_particles() const {
     c.bytes.assign(a.bytes.begin(), a.bytes.begin() + a.elements(count_) * spec.element_size);
     s.carried.push_back(std::move(c));
   }
+  // A distributed rank's sort keys (its checkpoint carries them: they order the next sort).
+  if (ranks_)
+    s.set_carried(kArrayDistributedSortKey,
+                  HostVector<uint64_t>(sort_key_.data(), sort_key_.data() + count_));
   return s;
 }
 
@@ -156,13 +160,21 @@ void CpuBackend::import_particles(const ParticleSnapshot& s) {
   const uint32_t n = static_cast<uint32_t>(s.id.size());
   if (n > config_.capacity || s.position.size() != n || s.velocity.size() != n || s.density.size() != n)
     throw Error(Status::Internal, "import_particles: inconsistent snapshot");
-  check_carried_arrays(s, method_arrays_, n);
-  // A distributed rank's sort keys follow its particles; a snapshot that drops or reorders
-  // them (sph_world_remove_particles, a restore) would leave them behind.
-  if (ranks_ && n != count_)
-    throw Error(Status::Unsupported,
-                "world: removing or restoring particles does not work in a distributed world yet "
-                "(docs/distributed.md)");
+  // A distributed rank's sort keys follow its particles: a snapshot that drops or reorders them
+  // (sph_world_remove_particles) would leave them behind, unless it carries them (a rank's
+  // checkpoint, into a fresh backend).
+  std::vector<ParticleArraySpec> carried_specs = method_arrays_;
+  HostVector<uint64_t> keys;
+  if (ranks_) {
+    keys = s.carried_as<uint64_t>(kArrayDistributedSortKey);
+    if (n != count_ && !(count_ == 0 && keys.size() == n))
+      throw Error(Status::Unsupported,
+                  "world: removing or restoring particles does not work in a distributed world yet "
+                  "(docs/distributed.md)");
+    carried_specs.push_back(ParticleArraySpec{kArrayDistributedSortKey, sizeof(uint64_t),
+                                              ParticleArrayRole::Carried, 1, nullptr, nullptr});
+  }
+  check_carried_arrays(s, carried_specs, n);
   // Copies first (they may throw), then the store, so a failure leaves the state as it was.
   HostVector<std::pair<CpuParticleArray*, HostVector<unsigned char>>> carried;
   for (const ParticleArraySpec& spec : method_arrays_)
@@ -175,6 +187,7 @@ void CpuBackend::import_particles(const ParticleSnapshot& s) {
   std::copy(s.density.begin(), s.density.end(), density_.data());
   std::fill(neighbors_.data(), neighbors_.data() + n, 0u);
   for (auto& c : carried) c.first->bytes.swap(c.second);
+  if (keys.size() == n) std::copy(keys.begin(), keys.end(), sort_key_.data());
   count_ = n;
   max_speed_ = s.max_speed;
   max_speed_valid_ = true;

@@ -78,6 +78,10 @@ class CpuBackend final : public Backend {
   void attach_ranks(std::shared_ptr<const RankTransport> ranks, const DistributedOptions& options) override;
   const RankTransport* rank_transport() const override { return ranks_.get(); }
   DistributedCounters distributed_counters() const override;
+  std::shared_ptr<const RankTransport> shared_rank_transport() const override { return ranks_; }
+  DistributedState distributed_state() const override;
+  void restore_distributed_state(const DistributedState& state) override;
+  void rethrow_step_failure() const override;
 
   uint64_t memory_bytes() const override {
     return store_.bytes() + grid_.bytes() + columns_.bytes() + boundary_maps_.bytes();
@@ -244,8 +248,11 @@ class CpuBackend final : public Backend {
   // The substep's end: ghosts dropped, the step size's inputs and any failure agreed by all
   // ranks. Returns the world's first non-finite particle id (kAllFinite: none).
   uint32_t halo_end_substep(uint32_t bad_id);
-  // Whether `flag` is raised on any rank.
+  // Whether `flag` is raised on any rank; an agreement (rank_agreement.h), as every collective
+  // step below is: it throws on every rank when one failed since the last.
   bool halo_any(bool flag) const;
+  // An agreement of its own, before ranks meet after code that can fail.
+  void halo_agree() const;
   // Cell layer of particle i along the slabs' axis.
   int32_t halo_layer(uint32_t i) const;
   // Appends particle i's carried arrays to `out` / appends the records of `in` as particles

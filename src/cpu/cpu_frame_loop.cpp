@@ -4,6 +4,7 @@
 // cuda/frame_loop.cu).
 #include <algorithm>
 
+#include "../core/rank_agreement.h"
 #include "../core/scene_frame.h"
 #include "../core/status.h"
 #include "../core/substep_clock.h"
@@ -76,11 +77,16 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
         roll_back();
         non_finite_.substep = clock.substeps + 1;
         non_finite_.dt = clock.dt_float;
+        // (Every rank of a distributed world has found it in halo_end_substep's agreement.)
+        if (ranks_) throw AgreedRankFailure(Status::NonFinite, non_finite_message(non_finite_, limits));
         throw Error(Status::NonFinite, non_finite_message(non_finite_, limits));
       }
       if (!scene.sinks.empty()) apply_sinks(scene, report);
       advance_clock(clock);
     }
+    // The frame's end: a rank that failed after the last substep's agreement (its sinks) fails
+    // every rank; nothing after this can fail.
+    if (ranks_) halo_agree();
   } catch (const Error& e) {
     if (e.status() != Status::NonFinite) roll_back();  // NonFinite has rolled back already
     throw;

@@ -11,6 +11,9 @@
 //                     and the diffusion, and their colour normals after that pass;
 //   the substep's end ghosts are dropped, the max speed and acceleration (the next step size)
 //                     and the first non-finite particle are reduced over the ranks.
+// Each place where the ranks meet after code that can fail (an allocation, a crowded cell) is
+// an agreement (core/rank_agreement.h): a rank that failed joins the others' next one from its
+// catch block (rethrow_step_failure), and every rank returns the error instead of waiting.
 // The sort takes particles in key order, so each cell's particles come in the order the
 // undivided world's stable sort gives them: the neighbour sums add in the same order and a
 // distributed world steps the single world's bits (while the grid's table covers the
@@ -21,13 +24,13 @@
 #include <string>
 
 #include "../core/grid_layout.h"
+#include "../core/rank_agreement.h"
 #include "cpu_backend_impl.h"
 
 namespace sph {
 
 namespace {
 
-constexpr const char* kArraySortKey = "distributed_sort_key";
 constexpr const char* kArrayOrigin = "distributed_origin";
 
 void refuse(const std::string& what) {
@@ -55,7 +58,8 @@ void CpuBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks, const 
   const auto array = [](const char* name, uint32_t size, ParticleArrayRole role) {
     return ParticleArraySpec{name, size, role, 1, nullptr, nullptr};
   };
-  sort_key_ = store_.add_typed<uint64_t>(array(kArraySortKey, sizeof(uint64_t), ParticleArrayRole::Carried));
+  sort_key_ = store_.add_typed<uint64_t>(
+      array(kArrayDistributedSortKey, sizeof(uint64_t), ParticleArrayRole::Carried));
   origin_ = store_.add_typed<uint32_t>(array(kArrayOrigin, sizeof(uint32_t), ParticleArrayRole::Sorted));
   distributed_options_ = options;
   slabs_ = SlabDecomposition(ranks->size());
@@ -73,9 +77,16 @@ DistributedCounters CpuBackend::distributed_counters() const {
 }
 
 bool CpuBackend::halo_any(bool flag) const {
-  int64_t raised = flag ? 1 : 0;
-  ranks_->all_max(&raised, 1);
-  return raised != 0;
+  int64_t lowered = flag ? 0 : 1;  // (an agreement reduces by min)
+  agree(*ranks_, &lowered);
+  return lowered == 0;
+}
+
+void CpuBackend::halo_agree() const { agree(*ranks_); }
+
+void CpuBackend::rethrow_step_failure() const {
+  if (ranks_) rethrow_agreed(*ranks_);
+  throw;
 }
 
 int32_t CpuBackend::halo_layer(uint32_t i) const {
@@ -125,13 +136,14 @@ void CpuBackend::halo_keep(size_t kept) {
 
 void CpuBackend::halo_begin_frame() {
   const RankTransport& t = *ranks_;
+  const int size = t.size();
+  std::vector<int64_t> held(static_cast<size_t>(size), 0);
+  halo_agree();  // (the frame's start: the step's code before it ran on each rank alone)
   float maxima[2] = {max_speed_, max_acceleration_};
   t.all_max(maxima, 2);
   max_speed_ = maxima[0];
   max_acceleration_ = maxima[1];
   // Particles per rank, and the world's extent in cells.
-  const int size = t.size();
-  std::vector<int64_t> held(static_cast<size_t>(size), 0);
   held[static_cast<size_t>(t.rank())] = count_;
   t.all_sum(held.data(), size);
   if (slabs_cut_ && !SlabDecomposition::imbalanced(held, distributed_options_.rebalance_threshold)) return;
@@ -156,6 +168,7 @@ void CpuBackend::halo_begin_frame() {
     const float x[3] = {position_[i].x, position_[i].y, position_[i].z};
     ++histogram[static_cast<size_t>(cell_coordinate(x[axis], inv) - lo[axis])];
   }
+  halo_agree();  // (the histogram's allocation)
   t.all_sum(histogram.data(), static_cast<int>(histogram.size()));
   slabs_.rebalance(axis, static_cast<int32_t>(lo[axis]), histogram);
   slabs_cut_ = true;
@@ -167,6 +180,9 @@ void CpuBackend::halo_gather() {
   const int me = t.rank();
   const int size = t.size();
   std::vector<RankBytes> out(static_cast<size_t>(size));
+  // Every particle held between substeps is owned; a substep that failed after the ghosts came
+  // and was rolled back leaves their marks in this (not carried) array.
+  std::fill(origin_.data(), origin_.data() + count_, 0u);
   // Migration: what another rank's slab holds goes there with every carried array.
   keep_order_.clear();
   for (uint32_t i = 0; i < count_; ++i) {
@@ -176,7 +192,7 @@ void CpuBackend::halo_gather() {
     else
       halo_pack(i, out[static_cast<size_t>(owner)]);
   }
-  std::vector<RankBytes> in = t.exchange(out);
+  std::vector<RankBytes> in = t.exchange(out);  // (an agreement: the substep so far, the packing)
   halo_counters_.migrated_out += count_ - static_cast<uint32_t>(keep_order_.size());
   halo_keep(keep_order_.size());
   for (int r = 0; r < size; ++r) halo_counters_.migrated_in += halo_unpack(in[static_cast<size_t>(r)], 0u);
@@ -188,7 +204,7 @@ void CpuBackend::halo_gather() {
     const int n = slabs_.ghost_destinations(halo_layer(i), me, to);
     for (int k = 0; k < n; ++k) halo_pack(i, out[static_cast<size_t>(to[k])]);
   }
-  in = t.exchange(out);
+  in = t.exchange(out);  // (an agreement: the migrants' arrival, the ghosts' packing)
   for (int r = 0; r < size; ++r) halo_unpack(in[static_cast<size_t>(r)], static_cast<uint32_t>(r) + 1u);
   halo_counters_.ghosts = count_ - owned;
   // The world's grid: the extent and count of every rank's owned particles (what the undivided
@@ -204,6 +220,7 @@ void CpuBackend::halo_gather() {
     }
   }
   int64_t total = owned;
+  halo_agree();  // (the ghosts' arrival)
   t.all_min(lo, 3);
   t.all_max(hi, 3);
   t.all_sum(&total, 1);
@@ -252,8 +269,9 @@ void CpuBackend::halo_share(const char* what, Make&& make, Apply&& apply) {
     for (int k = 0; k < n; ++k)
       out[static_cast<size_t>(to[k])].insert(out[static_cast<size_t>(to[k])].end(), from, from + sizeof r);
   }
-  const std::vector<RankBytes> in = t.exchange(out);
   std::vector<size_t> read(static_cast<size_t>(size), 0);
+  // (An agreement: the passes since the last exchange, the sort, a crowded cell, the records.)
+  const std::vector<RankBytes> in = t.exchange(out);
   for (uint32_t i = 0; i < count_; ++i) {
     if (!ghost(i)) continue;
     const size_t from = origin_[i] - 1u;
@@ -318,7 +336,7 @@ uint32_t CpuBackend::halo_end_substep(uint32_t bad_id) {
   halo_keep(keep_order_.size());
   const RankTransport& t = *ranks_;
   int64_t bad = bad_id;
-  t.all_min(&bad, 1);
+  agree(t, &bad);  // (the force and integration passes)
   float maxima[2] = {max_speed_, max_acceleration_};
   t.all_max(maxima, 2);
   max_speed_ = maxima[0];

@@ -11,6 +11,7 @@
 #include "../capi/init_struct.h"
 #include "../capi/struct_io.h"
 #include "mpi_transport.h"
+#include "mpi_world.h"
 #include "sph_mpi.h"
 
 using sph::Error;
@@ -21,15 +22,6 @@ namespace {
 
 constexpr uint32_t kDefaultRebalancePercent = 20;
 constexpr uint32_t kMaxRebalancePercent = 10000;
-
-// The world's ranks (the caller holds its lock); Unsupported for a world of sph_world_create.
-const RankTransport& ranks_of(const sph_world* world) {
-  const RankTransport* t = world->world->backend().rank_transport();
-  if (!t)
-    throw Error(Status::Unsupported,
-                "world: is not a distributed world (make it with sph_mpi_world_create on every rank)");
-  return *t;
-}
 
 }  // namespace
 }  // namespace sph

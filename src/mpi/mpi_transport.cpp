@@ -4,6 +4,7 @@
 #include <climits>
 #include <string>
 
+#include "../core/rank_agreement.h"
 #include "../core/status.h"
 
 namespace sph {
@@ -64,29 +65,46 @@ int64_t MpiTransport::exclusive_sum(int64_t value) const {
   return rank_ == 0 ? 0 : below;  // (MPI leaves rank 0's result undefined)
 }
 
+// The buffers are made between agreements (core/rank_agreement.h): a rank whose allocation
+// fails meets the others at the next one, before they enter the MPI call it would miss.
 std::vector<RankBytes> MpiTransport::exchange(const std::vector<RankBytes>& send) const {
   const size_t n = static_cast<size_t>(size_);
   if (send.size() != n) throw Error(Status::Internal, "exchange: one buffer per rank");
-  std::vector<int> send_counts(n), recv_counts(n), send_offsets(n), recv_offsets(n);
-  size_t total = 0;
-  for (size_t r = 0; r < n; ++r) {
-    send_counts[r] = as_count(send[r].size());
-    send_offsets[r] = as_count(total);
-    total += send[r].size();
+  std::vector<int> send_counts, recv_counts, send_offsets, recv_offsets;
+  RankBytes packed, in;
+  try {
+    send_counts.resize(n);
+    recv_counts.resize(n);
+    send_offsets.resize(n);
+    recv_offsets.resize(n);
+    size_t total = 0;
+    for (size_t r = 0; r < n; ++r) {
+      send_counts[r] = as_count(send[r].size());
+      send_offsets[r] = as_count(total);
+      total += send[r].size();
+    }
+    packed.reserve(total);
+    for (const RankBytes& b : send) packed.insert(packed.end(), b.begin(), b.end());
+  } catch (...) {
+    rethrow_agreed(*this);
   }
-  RankBytes packed;
-  packed.reserve(total);
-  for (const RankBytes& b : send) packed.insert(packed.end(), b.begin(), b.end());
+  agree(*this);
   check(MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm_), "MPI_Alltoall");
-  size_t received = 0;
-  for (size_t r = 0; r < n; ++r) {
-    recv_offsets[r] = as_count(received);
-    received += static_cast<size_t>(recv_counts[r]);
+  try {
+    size_t received = 0;
+    for (size_t r = 0; r < n; ++r) {
+      recv_offsets[r] = as_count(received);
+      received += static_cast<size_t>(recv_counts[r]);
+    }
+    in.resize(received);
+  } catch (...) {
+    rethrow_agreed(*this);
   }
-  RankBytes in(received);
+  agree(*this);
   check(MPI_Alltoallv(packed.data(), send_counts.data(), send_offsets.data(), MPI_BYTE, in.data(),
                       recv_counts.data(), recv_offsets.data(), MPI_BYTE, comm_),
         "MPI_Alltoallv");
+  // (A failure from here on is met by the caller's next agreement.)
   std::vector<RankBytes> out(n);
   for (size_t r = 0; r < n; ++r)
     out[r].assign(in.begin() + recv_offsets[r], in.begin() + recv_offsets[r] + recv_counts[r]);
@@ -95,16 +113,30 @@ std::vector<RankBytes> MpiTransport::exchange(const std::vector<RankBytes>& send
 
 std::vector<RankBytes> MpiTransport::gather(const RankBytes& mine, int root) const {
   const size_t n = static_cast<size_t>(size_);
-  int count = as_count(mine.size());
-  std::vector<int> counts(rank_ == root ? n : 0), offsets(rank_ == root ? n : 0);
+  int count = 0;
+  std::vector<int> counts, offsets;
+  RankBytes all;
+  try {
+    count = as_count(mine.size());
+    counts.resize(rank_ == root ? n : 0);
+    offsets.resize(rank_ == root ? n : 0);
+  } catch (...) {
+    rethrow_agreed(*this);
+  }
+  agree(*this);
   check(MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, root, comm_), "MPI_Gather");
-  size_t total = 0;
-  if (rank_ == root)
-    for (size_t r = 0; r < n; ++r) {
-      offsets[r] = as_count(total);
-      total += static_cast<size_t>(counts[r]);
-    }
-  RankBytes all(total);
+  try {
+    size_t total = 0;
+    if (rank_ == root)
+      for (size_t r = 0; r < n; ++r) {
+        offsets[r] = as_count(total);
+        total += static_cast<size_t>(counts[r]);
+      }
+    all.resize(total);
+  } catch (...) {
+    rethrow_agreed(*this);
+  }
+  agree(*this);
   check(MPI_Gatherv(mine.data(), count, MPI_BYTE, all.data(), counts.data(), offsets.data(), MPI_BYTE, root,
                     comm_),
         "MPI_Gatherv");
@@ -114,6 +146,14 @@ std::vector<RankBytes> MpiTransport::gather(const RankBytes& mine, int root) con
     for (size_t r = 0; r < n; ++r)
       out[r].assign(all.begin() + offsets[r], all.begin() + offsets[r] + counts[r]);
   }
+  return out;
+}
+
+RankBytes MpiTransport::broadcast(const RankBytes& bytes, int root) const {
+  uint64_t size = bytes.size();
+  check(MPI_Bcast(&size, 1, MPI_UINT64_T, root, comm_), "MPI_Bcast");
+  RankBytes out(rank_ == root ? bytes : RankBytes(static_cast<size_t>(size)));
+  check(MPI_Bcast(out.data(), as_count(out.size()), MPI_BYTE, root, comm_), "MPI_Bcast");
   return out;
 }
 

@@ -26,6 +26,7 @@ class MpiTransport final : public RankTransport {
   int64_t exclusive_sum(int64_t value) const override;
   std::vector<RankBytes> exchange(const std::vector<RankBytes>& send) const override;
   std::vector<RankBytes> gather(const RankBytes& mine, int root) const override;
+  RankBytes broadcast(const RankBytes& bytes, int root) const override;
 
  private:
   MPI_Comm comm_ = MPI_COMM_NULL;

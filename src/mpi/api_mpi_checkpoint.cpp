@@ -1,0 +1,196 @@
+// SPDX-License-Identifier: MIT
+// Checkpoints of a distributed world (include/sph_mpi.h): one file per rank in the checkpoint
+// format (a rank's part: its particles with their sort keys, its copy of the scene) and a
+// manifest rank 0 writes last (rank_manifest.h). Every step where one rank can fail on its own
+// (a file, an allocation, a damaged or mismatched file) is agreed between the ranks
+// (core/rank_agreement.h): each call succeeds on every rank or fails on every rank, a load
+// creates no world and a restore leaves the world as it was.
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include "../capi/checkpoint_files.h"
+#include "../capi/guard.h"
+#include "../capi/handles.h"
+#include "../core/byte_io.h"
+#include "../core/checkpoint.h"
+#include "../core/rank_agreement.h"
+#include "../factory/backend_factory.h"
+#include "mpi_transport.h"
+#include "mpi_world.h"
+#include "rank_manifest.h"
+#include "sph_mpi.h"
+
+using sph::Error;
+using sph::Status;
+
+namespace sph {
+namespace {
+
+void require_path(const char* path) {
+  if (!path) throw Error(Status::InvalidArgument, "path: is NULL");
+  if (!*path) throw Error(Status::InvalidArgument, "path: is empty");
+}
+
+// A rank's entry as it travels to rank 0.
+RankBytes pack_entry(const RankFileEntry& e) {
+  ByteWriter w;
+  w.u32(e.particles);
+  w.u32(e.counters.ghosts);
+  w.u32(e.counters.migrated_in);
+  w.u32(e.counters.migrated_out);
+  w.u64(e.size);
+  w.u64(e.hash);
+  w.bytes(e.name.data(), e.name.size());
+  return RankBytes(w.buffer().begin(), w.buffer().end());
+}
+
+RankFileEntry unpack_entry(const RankBytes& b) {
+  ByteReader r(b.data(), b.size(), "a rank's manifest entry");
+  RankFileEntry e;
+  e.particles = r.u32();
+  e.counters.ghosts = r.u32();
+  e.counters.migrated_in = r.u32();
+  e.counters.migrated_out = r.u32();
+  e.size = r.u64();
+  e.hash = r.u64();
+  while (r.remaining() > 0) e.name.push_back(static_cast<char>(r.u8()));
+  return e;
+}
+
+// Writes this rank's file; returns its manifest entry.
+RankFileEntry save_rank(const sph_world* world, const RankTransport& ranks, const std::string& path) {
+  CheckpointOrigin origin;
+  origin.backend = static_cast<uint32_t>(world->context->backend);
+  origin.library_version = SPH_VERSION;
+  origin.rank_part = true;
+  const HostVector<uint8_t> bytes = write_checkpoint(*world->world, origin);
+  RankFileEntry e;
+  e.name = rank_file_name(path, ranks.rank());
+  write_file_atomically(rank_file_path(path, e.name), bytes);
+  e.particles = world->world->particle_count();
+  e.counters = world->world->backend().distributed_state().counters;
+  e.size = bytes.size();
+  e.hash = file_hash(bytes);
+  return e;
+}
+
+// This rank's part of the world saved at `path`, attached to `ranks`; nothing else changes.
+std::unique_ptr<World> load_rank(sph_context* context, const std::shared_ptr<const RankTransport>& ranks,
+                                 const char* path) {
+  require_path(path);
+  const std::string manifest_path = path;
+  const HostVector<uint8_t> manifest_bytes = read_checkpoint_file(path);
+  RankManifest m;
+  try {
+    m = read_rank_manifest(manifest_bytes.data(), manifest_bytes.size());
+  } catch (const Error& e) {
+    throw Error(e.status(), std::string(e.what()) + " (file '" + manifest_path + "')");
+  }
+  if (m.ranks.size() != static_cast<size_t>(ranks->size()))
+    throw Error(Status::InvalidArgument,
+                "comm: '" + manifest_path + "' is a world saved on " + std::to_string(m.ranks.size()) +
+                    " ranks; this communicator has " + std::to_string(ranks->size()) +
+                    " (a distributed world loads on the rank count that saved it)");
+  const RankFileEntry& mine = m.ranks[static_cast<size_t>(ranks->rank())];
+  const std::string file = rank_file_path(manifest_path, mine.name);
+  const HostVector<uint8_t> bytes = read_checkpoint_file(file.c_str());
+  if (bytes.size() != mine.size || file_hash(bytes) != mine.hash)
+    throw Error(Status::CorruptData, "manifest: rank " + std::to_string(ranks->rank()) + "'s file '" + file +
+                                         "' has " + std::to_string(bytes.size()) + " bytes" +
+                                         (bytes.size() == mine.size ? " and another hash" : "") +
+                                         "; the manifest '" + manifest_path + "' lists " +
+                                         std::to_string(mine.size) +
+                                         " bytes and its hash (a file of another save, or damaged)");
+  DistributedOptions options;
+  options.rebalance_threshold = m.rebalance_percent / 100.0;
+  std::unique_ptr<World> world;
+  try {
+    world = read_checkpoint(
+        bytes.data(), bytes.size(),
+        [&](const WorldConfig& config) {
+          std::unique_ptr<Backend> b =
+              make_backend(context->backend, config, context->device_ordinal, context->cpu_workers,
+                           context->cpu_tasks, context->cuda_tuning);
+          b->attach_ranks(ranks, options);
+          return b;
+        },
+        true);
+  } catch (const Error& e) {
+    throw Error(e.status(), std::string(e.what()) + " (file '" + file + "')");
+  }
+  if (world->particle_count() != mine.particles)
+    throw Error(Status::CorruptData, "manifest: rank " + std::to_string(ranks->rank()) + "'s file '" + file +
+                                         "' holds " + std::to_string(world->particle_count()) +
+                                         " particles, the manifest " + std::to_string(mine.particles));
+  DistributedState state = m.state;
+  state.counters.ghosts = mine.counters.ghosts;
+  state.counters.migrated_in = mine.counters.migrated_in;
+  state.counters.migrated_out = mine.counters.migrated_out;
+  world->backend().restore_distributed_state(state);
+  return world;
+}
+
+}  // namespace
+}  // namespace sph
+
+extern "C" {
+
+SPH_API sph_result SPH_CALL sph_mpi_world_save_file(const sph_world* world, const char* path) {
+  return sph::guarded("sph_mpi_world_save_file", sph::context_of(world), [&] {
+    sph::require_world(world);
+    sph::WorldLock lock(world);
+    const sph::RankTransport& ranks = sph::ranks_of(world);
+    sph::RankBytes mine;
+    sph::agreed(ranks, [&] {
+      sph::require_path(path);
+      mine = sph::pack_entry(sph::save_rank(world, ranks, path));
+    });
+    const std::vector<sph::RankBytes> entries = ranks.gather(mine, 0);
+    // The manifest last: it names files that are all written.
+    sph::agreed(ranks, [&] {
+      if (ranks.rank() != 0) return;
+      sph::RankManifest m;
+      m.state = world->world->backend().distributed_state();
+      m.rebalance_percent = static_cast<uint32_t>(std::lround(m.state.rebalance_threshold * 100.0));
+      for (const sph::RankBytes& b : entries) {
+        m.ranks.push_back(sph::unpack_entry(b));
+        m.particles += m.ranks.back().particles;
+      }
+      sph::write_file_atomically(path, sph::write_rank_manifest(m));
+    });
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_mpi_world_load_file(sph_context* context, int32_t comm, const char* path,
+                                                    sph_world** out) {
+  return sph::guarded("sph_mpi_world_load_file", context, [&] {
+    const sph::ContextHold hold(context);
+    if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
+    auto ranks = std::make_shared<sph::MpiTransport>(MPI_Comm_f2c(static_cast<MPI_Fint>(comm)));
+    std::unique_ptr<sph::World> loaded;
+    sph::agreed(*ranks, [&] { loaded = sph::load_rank(hold.get(), ranks, path); });
+    auto world = std::make_unique<sph_world>();
+    world->context = hold.get();
+    world->world = std::move(loaded);
+    *out = sph::publish_world(std::move(world));
+    return SPH_OK;
+  });
+}
+
+SPH_API sph_result SPH_CALL sph_mpi_world_restore_file(sph_world* world, const char* path) {
+  return sph::guarded("sph_mpi_world_restore_file", sph::context_of(world), [&] {
+    sph::require_world(world);
+    sph::WorldLock lock(world);
+    const sph::RankTransport& ranks = sph::ranks_of(world);
+    const std::shared_ptr<const sph::RankTransport> shared = world->world->backend().shared_rank_transport();
+    std::unique_ptr<sph::World> loaded;
+    // Built whole beside the world's state, swapped in once every rank has built its own.
+    sph::agreed(ranks, [&] { loaded = sph::load_rank(world->context, shared, path); });
+    world->world.swap(loaded);
+    return SPH_OK;
+  });
+}
+
+}  // extern "C"

@@ -1,0 +1,227 @@
+/* SPDX-License-Identifier: MIT */
+/* Checkpoints of a distributed world (sph_mpi_world_save_file, _load_file, _restore_file) under
+ * mpirun on 1-4 ranks. A stirred dam break (particles cross the slabs every few substeps) steps
+ * 10 substeps and is saved; then:
+ *   - it steps 10 more (A); restored from the save, it steps the same 10 again (B); a new world
+ *     loaded from the save steps them too (C): A, B and C are equal bit for bit (a restored rank
+ *     holds its particles in their saved order with their sort keys, and the slabs and counters
+ *     as saved, so every sum adds in the same order: no tolerance);
+ *   - the counts (global count, rebalances, migrations) after a restore are the saved world's;
+ *   - a set with a missing rank file, a rank file of another save, a damaged manifest, or a
+ *     communicator of another rank count fails on every rank (each rank returns an error; the
+ *     failing rank's code, the others the same code with the message naming the rank), and the
+ *     world is unchanged after each (its gathered state equal bit for bit);
+ *   - a rank's file is not a world (sph_world_load_file refuses it), and sph_world_save_file and
+ *     sph_world_restore refuse a distributed world. */
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "mpi_test_world.h"
+
+#define N_SUBSTEPS 10
+#define M_SUBSTEPS 10
+
+static char g_dir[200];
+
+static void path_of(char* out, size_t size, const char* name) { snprintf(out, size, "%s/%s", g_dir, name); }
+
+static void counts_of(sph_world* world, sph_mpi_counts* c) {
+  REQUIRE(sph_mpi_counts_init(c) == SPH_OK, "counts init");
+  REQUIRE(sph_mpi_world_get_counts(world, c) == SPH_OK, "counts");
+}
+
+static int copy_file(const char* from, const char* to) {
+  char buf[65536];
+  size_t k;
+  FILE* in = fopen(from, "rb");
+  FILE* out = in ? fopen(to, "wb") : NULL;
+  int ok = in && out;
+  while (ok && (k = fread(buf, 1, sizeof buf, in)) > 0) ok = fwrite(buf, 1, k, out) == k;
+  if (in) fclose(in);
+  if (out) fclose(out);
+  return ok;
+}
+
+/* A restore of `path` that must fail on every rank with `code`, naming `needle` on the rank that
+ * failed (`culprit`, or every rank when -1) and the culprit on the others; the world unchanged. */
+static void expect_failed_restore(sph_world* world, uint32_t n, const char* path, sph_result code,
+                                  int culprit, const char* needle, const char* what) {
+  float* x0 = NULL;
+  float* v0 = NULL;
+  float* x1 = NULL;
+  float* v1 = NULL;
+  sph_mpi_counts before, after;
+  sph_result r;
+  char rank_text[32];
+  mpi_test_gather(world, n, &x0, &v0);
+  counts_of(world, &before);
+  r = sph_mpi_world_restore_file(world, path);
+  CHECK(r == code, "%s: restore returned %d, expected %d", what, (int)r, (int)code);
+  if (culprit < 0 || g_rank == culprit) {
+    CHECK(strstr(sph_get_last_error(), needle) != NULL, "%s: the message names '%s': %s", what, needle,
+          sph_get_last_error());
+  } else {
+    snprintf(rank_text, sizeof rank_text, "rank %d", culprit);
+    CHECK(strstr(sph_get_last_error(), rank_text) != NULL, "%s: the message names %s: %s", what, rank_text,
+          sph_get_last_error());
+  }
+  mpi_test_gather(world, n, &x1, &v1);
+  counts_of(world, &after);
+  CHECK(g_rank != 0 || mpi_test_differ(x0, v0, x1, v1, n) == 0, "%s: the world changed", what);
+  CHECK(before.local_count == after.local_count && before.rebalances == after.rebalances &&
+            before.migrated == after.migrated && before.slab_first == after.slab_first,
+        "%s: the counts changed", what);
+  free(x0);
+  free(v0);
+  free(x1);
+  free(v1);
+}
+
+int main(int argc, char** argv) {
+  sph_context* context = NULL;
+  sph_world_def def;
+  sph_world* world = NULL;
+  sph_world* loaded = NULL;
+  sph_world* plain = NULL;
+  sph_mpi_counts saved, restored;
+  uint32_t n = 0;
+  float *ax = NULL, *av = NULL, *bx = NULL, *bv = NULL, *cx = NULL, *cv = NULL;
+  char ck[256], ck2[256], file[300], other[300], aside[400];
+  sph_result r;
+  mpi_test_init(&argc, &argv, &context);
+  if (g_rank == 0) {
+    snprintf(g_dir, sizeof g_dir, "%s/sph_mpi_checkpoint_XXXXXX",
+             getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
+    REQUIRE(mkdtemp(g_dir) != NULL, "mkdtemp");
+  }
+  MPI_Bcast(g_dir, sizeof g_dir, MPI_CHAR, 0, MPI_COMM_WORLD);
+  path_of(ck, sizeof ck, "dam.sphck");
+  path_of(ck2, sizeof ck2, "later.sphck");
+
+  mpi_test_world_def(&def);
+  mpi_test_dam(context, &def, 2.0f, NULL, NULL, &world, &n);
+  mpi_test_step(world, N_SUBSTEPS, 1);
+  r = sph_mpi_world_save_file(world, ck);
+  REQUIRE(r == SPH_OK, "save: %d", (int)r);
+  counts_of(world, &saved);
+
+  /* A: on from the live world; B: on from the restored one; C: on from a loaded one. */
+  mpi_test_step(world, M_SUBSTEPS, 1);
+  mpi_test_gather(world, n, &ax, &av);
+  r = sph_mpi_world_restore_file(world, ck);
+  REQUIRE(r == SPH_OK, "restore: %d", (int)r);
+  counts_of(world, &restored);
+  CHECK(restored.global_count == n && restored.local_count == saved.local_count &&
+            restored.rebalances == saved.rebalances && restored.migrated == saved.migrated &&
+            restored.axis == saved.axis && restored.slab_first == saved.slab_first &&
+            restored.slab_last == saved.slab_last,
+        "the restored counts are not the saved ones");
+  mpi_test_step(world, M_SUBSTEPS, 1);
+  mpi_test_gather(world, n, &bx, &bv);
+  r = sph_mpi_world_load_file(context, MPI_TEST_COMM, ck, &loaded);
+  REQUIRE(r == SPH_OK && loaded != NULL, "load: %d", (int)r);
+  mpi_test_step(loaded, M_SUBSTEPS, 1);
+  mpi_test_gather(loaded, n, &cx, &cv);
+  if (g_rank == 0) {
+    const uint32_t restored_differ = mpi_test_differ(ax, av, bx, bv, n);
+    const uint32_t loaded_differ = mpi_test_differ(ax, av, cx, cv, n);
+    CHECK(restored_differ == 0, "restored and stepped %u substeps: %u of %u particles differ", M_SUBSTEPS,
+          restored_differ, n);
+    CHECK(loaded_differ == 0, "loaded and stepped %u substeps: %u of %u particles differ", M_SUBSTEPS,
+          loaded_differ, n);
+    printf(
+        "checkpoint on %d ranks: %u particles, saved after %u substeps, %u more: restored %u differ, loaded "
+        "%u differ (%llu migrations, %u rebalances at the save)\n",
+        g_size, n, N_SUBSTEPS, M_SUBSTEPS, restored_differ, loaded_differ, (unsigned long long)saved.migrated,
+        saved.rebalances);
+  }
+  CHECK(saved.rebalances >= 1 && (g_size == 1 || saved.migrated > 0), "no migration before the save");
+  /* A later state's set, for a rank file of another save. */
+  REQUIRE(sph_mpi_world_save_file(loaded, ck2) == SPH_OK, "second save");
+  REQUIRE(sph_world_destroy(loaded) == SPH_OK, "destroy");
+
+  /* Failures, each on one rank (the last), agreed by every rank. */
+  snprintf(file, sizeof file, "%s.rank%d", ck, g_size - 1);
+  snprintf(other, sizeof other, "%s.rank%d", ck2, g_size - 1);
+  snprintf(aside, sizeof aside, "%s.aside", file);
+  if (g_rank == g_size - 1) REQUIRE(rename(file, aside) == 0, "rename");
+  MPI_Barrier(MPI_COMM_WORLD);
+  expect_failed_restore(world, n, ck, SPH_ERROR_INVALID_ARGUMENT, g_size - 1, "rank", "a missing rank file");
+  if (g_rank == g_size - 1) REQUIRE(copy_file(other, file), "copy");
+  MPI_Barrier(MPI_COMM_WORLD);
+  expect_failed_restore(world, n, ck, SPH_ERROR_CORRUPT_DATA, g_size - 1, "another save",
+                        "a rank file of another save");
+  if (g_rank == g_size - 1) REQUIRE(rename(aside, file) == 0, "rename back");
+  if (g_rank == 0) {
+    /* The manifest cut short by one byte (a later copy of it is kept aside). */
+    FILE* f = fopen(ck, "rb");
+    char buf[4096];
+    size_t k;
+    REQUIRE(f != NULL, "open manifest");
+    k = fread(buf, 1, sizeof buf, f);
+    fclose(f);
+    snprintf(aside, sizeof aside, "%s.aside", ck);
+    REQUIRE(copy_file(ck, aside), "copy manifest");
+    f = fopen(ck, "wb");
+    REQUIRE(f != NULL && fwrite(buf, 1, k - 1, f) == k - 1, "write manifest");
+    fclose(f);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  expect_failed_restore(world, n, ck, SPH_ERROR_CORRUPT_DATA, -1, "manifest", "a damaged manifest");
+  if (g_rank == 0) REQUIRE(rename(aside, ck) == 0, "manifest back");
+  MPI_Barrier(MPI_COMM_WORLD);
+  expect_failed_restore(world, n, NULL, SPH_ERROR_INVALID_ARGUMENT, -1, "path", "a NULL path");
+  if (g_size > 1) {
+    /* Another rank count: rank 0 alone, and the others together, load the set. */
+    MPI_Comm half;
+    sph_world* w = NULL;
+    MPI_Comm_split(MPI_COMM_WORLD, g_rank == 0 ? 0 : 1, g_rank, &half);
+    r = sph_mpi_world_load_file(context, (int32_t)MPI_Comm_c2f(half), ck, &w);
+    CHECK(r == SPH_ERROR_INVALID_ARGUMENT && w == NULL, "a load on another rank count: %d", (int)r);
+    CHECK(strstr(sph_get_last_error(), "ranks") != NULL, "the message names the rank counts: %s",
+          sph_get_last_error());
+    MPI_Comm_free(&half);
+  }
+  /* The set is whole again: it restores. */
+  REQUIRE(sph_mpi_world_restore_file(world, ck) == SPH_OK, "restore of the repaired set");
+
+  /* The single-world calls. */
+  r = sph_world_load_file(context, file, &plain);
+  CHECK(r == SPH_ERROR_INVALID_ARGUMENT && plain == NULL, "sph_world_load_file of a rank's file: %d", (int)r);
+  CHECK(strstr(sph_get_last_error(), "manifest") != NULL, "the message points to the manifest: %s",
+        sph_get_last_error());
+  snprintf(aside, sizeof aside, "%s/plain.sphck.%d", g_dir, g_rank);
+  CHECK(sph_world_save_file(world, aside) == SPH_ERROR_UNSUPPORTED,
+        "sph_world_save_file of a distributed world");
+  {
+    const char junk[64] = {0};
+    CHECK(sph_world_restore(world, junk, sizeof junk) == SPH_ERROR_UNSUPPORTED,
+          "sph_world_restore of a distributed world");
+  }
+
+  REQUIRE(sph_world_destroy(world) == SPH_OK, "destroy");
+  MPI_Barrier(MPI_COMM_WORLD);
+  {
+    char name[300];
+    for (int k = 0; k < g_size; ++k) {
+      snprintf(name, sizeof name, "%s.rank%d", ck, k);
+      if (g_rank == k) remove(name);
+      snprintf(name, sizeof name, "%s.rank%d", ck2, k);
+      if (g_rank == k) remove(name);
+    }
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (g_rank == 0) {
+      remove(ck);
+      remove(ck2);
+      rmdir(g_dir);
+    }
+  }
+  free(ax);
+  free(av);
+  free(bx);
+  free(bv);
+  free(cx);
+  free(cv);
+  return mpi_test_finish(context, "mpi checkpoint");
+}

@@ -1,0 +1,242 @@
+// SPDX-License-Identifier: MIT
+// Failures that are not input errors, on one rank of a distributed world, agreed by every rank
+// (core/rank_agreement.h), under mpirun on 1-4 ranks:
+//   - a host allocation failure injected on the last rank at each allocation of a step in turn
+//     (the replaced operator new of tests/reliability/test_allocation_failure.cpp, armed on that
+//     rank only): every rank returns SPH_ERROR_OUT_OF_HOST_MEMORY (the others' messages name the
+//     failing rank) instead of waiting in MPI for it, every rank's world is as before the step
+//     (gathered bit for bit), and the world then steps on exactly as an undisturbed copy;
+//   - a crowded cell (700 particles in one cell, more than the 528 one may hold) on whichever
+//     rank owns it, and the ranks holding it as ghosts: every rank returns SPH_ERROR_CAPACITY and
+//     the world is unchanged.
+// A rank that waited forever would hang the test into ctest's timeout.
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <atomic>
+#include <cstddef>
+#include <new>
+
+#include "mpi_test_world.h"
+#include "support.h"
+
+// ---- the injector ---------------------------------------------------------------------------
+// The replacements below pair malloc with free themselves; GCC cannot see that through
+// inlining and warns that free() meets a pointer from operator new.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+#endif
+namespace {
+
+std::atomic<long> g_countdown{-1};  // allocations to let through before one fails; -1 = off
+std::atomic<long> g_injected{0};    // failures injected since the last arm()
+
+bool allocation_fault_due() {
+  long left = g_countdown.load(std::memory_order_relaxed);
+  while (left >= 0) {
+    if (g_countdown.compare_exchange_weak(left, left - 1, std::memory_order_relaxed)) {
+      if (left == 0) {
+        g_injected.fetch_add(1, std::memory_order_relaxed);
+        return true;
+      }
+      return false;
+    }
+  }
+  return false;
+}
+
+void arm(long n) {
+  g_injected.store(0);
+  g_countdown.store(n);
+}
+
+// Returns whether a failure was injected since arm().
+bool disarm() {
+  g_countdown.store(-1);
+  return g_injected.load() != 0;
+}
+
+void* checked_malloc(std::size_t size) { return std::malloc(size ? size : 1); }
+
+void* checked_aligned(std::size_t size, std::align_val_t alignment) {
+  const std::size_t a = static_cast<std::size_t>(alignment);
+  void* p = nullptr;
+  if (posix_memalign(&p, a < sizeof(void*) ? sizeof(void*) : a, size ? size : 1) != 0) return nullptr;
+  return p;
+}
+
+}  // namespace
+
+void* operator new(std::size_t size) {
+  if (allocation_fault_due()) throw std::bad_alloc();
+  void* p = checked_malloc(size);
+  if (!p) throw std::bad_alloc();
+  return p;
+}
+void* operator new[](std::size_t size) { return operator new(size); }
+void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
+  return allocation_fault_due() ? nullptr : checked_malloc(size);
+}
+void* operator new[](std::size_t size, const std::nothrow_t&) noexcept {
+  return allocation_fault_due() ? nullptr : checked_malloc(size);
+}
+void* operator new(std::size_t size, std::align_val_t alignment) {
+  if (allocation_fault_due()) throw std::bad_alloc();
+  void* p = checked_aligned(size, alignment);
+  if (!p) throw std::bad_alloc();
+  return p;
+}
+void* operator new[](std::size_t size, std::align_val_t alignment) { return operator new(size, alignment); }
+void* operator new(std::size_t size, std::align_val_t alignment, const std::nothrow_t&) noexcept {
+  return allocation_fault_due() ? nullptr : checked_aligned(size, alignment);
+}
+void* operator new[](std::size_t size, std::align_val_t alignment, const std::nothrow_t&) noexcept {
+  return allocation_fault_due() ? nullptr : checked_aligned(size, alignment);
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
+
+namespace {
+
+constexpr uint32_t kSubsteps = 2;
+
+sph_result step(sph_world* world) { return sph_mpi_world_step(world, 1.0f); }
+
+void set_substeps(sph_world* world) {
+  sph_world_params p;
+  REQUIRE(support_params_gravity_and_steps(&p, 0.0f, -9.81f, 0.0f, 1e-5f, 1e-3f) == SPH_OK, "params");
+  p.max_substeps = kSubsteps;
+  REQUIRE(sph_world_set_params(world, &p) == SPH_OK, "set params");
+}
+
+void check_rank_named(int culprit, const char* what) {
+  char text[32];
+  if (g_rank == culprit) return;
+  snprintf(text, sizeof text, "rank %d", culprit);
+  CHECK(strstr(sph_get_last_error(), text) != NULL, "%s: the message names %s: %s", what, text,
+        sph_get_last_error());
+}
+
+// An allocation failure at each allocation of the last rank's step in turn.
+void allocation_failures(sph_context* context) {
+  sph_world_def def;
+  sph_world* world = NULL;
+  sph_world* undisturbed = NULL;
+  uint32_t n = 0;
+  long k = 0;
+  const int victim = g_size - 1;
+  mpi_test_world_def(&def);
+  def.particle_spacing = 0.02f;  // 150 particles: a step per allocation point
+  def.kernel_radius = 0.036f;
+  mpi_test_dam(context, &def, 2.0f, NULL, NULL, &world, &n);
+  mpi_test_dam(context, &def, 2.0f, NULL, NULL, &undisturbed, &n);
+  set_substeps(world);
+  set_substeps(undisturbed);
+  for (k = 0; k < 100000; ++k) {
+    float *x0 = NULL, *v0 = NULL, *x1 = NULL, *v1 = NULL;
+    bool injected = false;
+    sph_result r;
+    mpi_test_gather(world, n, &x0, &v0);
+    if (g_rank == victim) arm(k);
+    r = step(world);
+    if (g_rank == victim) injected = disarm();
+    if (r == SPH_INCOMPLETE) {
+      CHECK(!injected, "allocation %ld failed, yet the step succeeded", k);
+      free(x0);
+      free(v0);
+      break;
+    }
+    CHECK(r == SPH_ERROR_OUT_OF_HOST_MEMORY, "allocation %ld of rank %d failed: the step returned %d", k,
+          victim, (int)r);
+    CHECK(g_rank != victim || injected, "the step failed (%d) without an injected failure", (int)r);
+    check_rank_named(victim, "an allocation failure");
+    mpi_test_gather(world, n, &x1, &v1);
+    CHECK(g_rank != 0 || mpi_test_differ(x0, v0, x1, v1, n) == 0, "allocation %ld: the world changed", k);
+    free(x0);
+    free(v0);
+    free(x1);
+    free(v1);
+  }
+  REQUIRE(step(undisturbed) == SPH_INCOMPLETE, "undisturbed step");
+  {
+    float *x0 = NULL, *v0 = NULL, *x1 = NULL, *v1 = NULL;
+    mpi_test_gather(world, n, &x0, &v0);
+    mpi_test_gather(undisturbed, n, &x1, &v1);
+    if (g_rank == 0) {
+      const uint32_t differ = mpi_test_differ(x0, v0, x1, v1, n);
+      CHECK(differ == 0, "after the failures, %u of %u particles differ from the undisturbed world", differ,
+            n);
+      printf(
+          "allocation failures on rank %d of %d: %ld allocation points of a %u-substep step failed in turn, "
+          "each on every rank; then %u particles differ from the undisturbed world\n",
+          victim, g_size, k, kSubsteps, differ);
+    }
+    free(x0);
+    free(v0);
+    free(x1);
+    free(v1);
+  }
+  CHECK(k > 10, "only %ld allocations in a step", k);
+  REQUIRE(sph_world_destroy(world) == SPH_OK && sph_world_destroy(undisturbed) == SPH_OK, "destroy");
+}
+
+// 700 particles in one cell of the far end of the tank, beside the column.
+void crowded_cell(sph_context* context) {
+  sph_world_def def;
+  sph_world* world = NULL;
+  uint32_t n = 0;
+  float *x0 = NULL, *v0 = NULL, *x1 = NULL, *v1 = NULL;
+  float clump[3 * 700];
+  uint64_t state = 99;
+  sph_mpi_counts counts;
+  sph_result r;
+  mpi_test_world_def(&def);
+  mpi_test_dam(context, &def, 0.0f, NULL, NULL, &world, &n);
+  for (int i = 0; i < 700; ++i) {
+    // Inside the cell [0.360, 0.378) x [0, 0.018) x [0.018, 0.036).
+    clump[3 * i] = 0.362f + 0.014f * (float)support_random(&state);
+    clump[3 * i + 1] = 0.002f + 0.014f * (float)support_random(&state);
+    clump[3 * i + 2] = 0.020f + 0.014f * (float)support_random(&state);
+  }
+  REQUIRE(sph_mpi_world_add_particles(world, clump, NULL, g_rank == 0 ? 700u : 0u, NULL) == SPH_OK, "clump");
+  n += 700;
+  set_substeps(world);
+  mpi_test_gather(world, n, &x0, &v0);
+  r = step(world);
+  CHECK(r == SPH_ERROR_CAPACITY, "a crowded cell: the step returned %d", (int)r);
+  CHECK(strstr(sph_get_last_error(), "particles share one cell") != NULL, "the message: %s",
+        sph_get_last_error());
+  mpi_test_gather(world, n, &x1, &v1);
+  CHECK(g_rank != 0 || mpi_test_differ(x0, v0, x1, v1, n) == 0, "a crowded cell: the world changed");
+  REQUIRE(sph_mpi_counts_init(&counts) == SPH_OK && sph_mpi_world_get_counts(world, &counts) == SPH_OK,
+          "counts");
+  CHECK(counts.global_count == n, "%llu particles after a refused step, %u before",
+        (unsigned long long)counts.global_count, n);
+  if (g_rank == 0) printf("a crowded cell on %d ranks: every rank returned %d\n", g_size, (int)r);
+  free(x0);
+  free(v0);
+  free(x1);
+  free(v1);
+  REQUIRE(sph_world_destroy(world) == SPH_OK, "destroy");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  sph_context* context = NULL;
+  mpi_test_init(&argc, &argv, &context);
+  allocation_failures(context);
+  crowded_cell(context);
+  return mpi_test_finish(context, "mpi rank failures");
+}
