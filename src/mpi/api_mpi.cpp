@@ -10,6 +10,7 @@
 #include "../capi/handles.h"
 #include "../capi/init_struct.h"
 #include "../capi/struct_io.h"
+#include "../core/rank_agreement.h"
 #include "mpi_transport.h"
 #include "mpi_world.h"
 #include "sph_mpi.h"
@@ -94,7 +95,9 @@ SPH_API sph_result SPH_CALL sph_mpi_world_add_particles(sph_world* world, const 
       }
       w.add_rank_particles(p, velocities ? &v : nullptr, next_id_before + static_cast<uint32_t>(below),
                            next_id_before + static_cast<uint32_t>(total));
-    } catch (const Error& e) {
+    } catch (...) {
+      // (An allocation too: the other ranks wait in the reduction below for this one.)
+      const Error e = sph::current_error();
       refused = true;
       status = e.status();
       message = e.what();
