@@ -2,8 +2,8 @@
 // Failures that are not input errors, on one rank of a distributed world, agreed by every rank
 // (core/rank_agreement.h), under mpirun on 1-4 ranks:
 //   - a host allocation failure injected on the last rank at each allocation of a step in turn
-//     (the replaced operator new of tests/reliability/test_allocation_failure.cpp, armed on that
-//     rank only): every rank returns SPH_ERROR_OUT_OF_HOST_MEMORY (the others' messages name the
+//     (the replaced operator new of tests/support/allocation_injector.h, armed on that rank
+//     only): every rank returns SPH_ERROR_OUT_OF_HOST_MEMORY (the others' messages name the
 //     failing rank) instead of waiting in MPI for it, every rank's world is as before the step
 //     (gathered bit for bit), and the world then steps on exactly as an undisturbed copy;
 //   - a crowded cell (700 particles in one cell, more than the 528 one may hold) on whichever
@@ -22,90 +22,10 @@
 #include "mpi_test_world.h"
 #include "support.h"
 
-// ---- the injector ---------------------------------------------------------------------------
-// The replacements below pair malloc with free themselves; GCC cannot see that through
-// inlining and warns that free() meets a pointer from operator new.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-#endif
-namespace {
+#include "allocation_injector.h"
 
-std::atomic<long> g_countdown{-1};  // allocations to let through before one fails; -1 = off
-std::atomic<long> g_injected{0};    // failures injected since the last arm()
-
-bool allocation_fault_due() {
-  long left = g_countdown.load(std::memory_order_relaxed);
-  while (left >= 0) {
-    if (g_countdown.compare_exchange_weak(left, left - 1, std::memory_order_relaxed)) {
-      if (left == 0) {
-        g_injected.fetch_add(1, std::memory_order_relaxed);
-        return true;
-      }
-      return false;
-    }
-  }
-  return false;
-}
-
-void arm(long n) {
-  g_injected.store(0);
-  g_countdown.store(n);
-}
-
-// Returns whether a failure was injected since arm().
-bool disarm() {
-  g_countdown.store(-1);
-  return g_injected.load() != 0;
-}
-
-void* checked_malloc(std::size_t size) { return std::malloc(size ? size : 1); }
-
-void* checked_aligned(std::size_t size, std::align_val_t alignment) {
-  const std::size_t a = static_cast<std::size_t>(alignment);
-  void* p = nullptr;
-  if (posix_memalign(&p, a < sizeof(void*) ? sizeof(void*) : a, size ? size : 1) != 0) return nullptr;
-  return p;
-}
-
-}  // namespace
-
-void* operator new(std::size_t size) {
-  if (allocation_fault_due()) throw std::bad_alloc();
-  void* p = checked_malloc(size);
-  if (!p) throw std::bad_alloc();
-  return p;
-}
-void* operator new[](std::size_t size) { return operator new(size); }
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
-  return allocation_fault_due() ? nullptr : checked_malloc(size);
-}
-void* operator new[](std::size_t size, const std::nothrow_t&) noexcept {
-  return allocation_fault_due() ? nullptr : checked_malloc(size);
-}
-void* operator new(std::size_t size, std::align_val_t alignment) {
-  if (allocation_fault_due()) throw std::bad_alloc();
-  void* p = checked_aligned(size, alignment);
-  if (!p) throw std::bad_alloc();
-  return p;
-}
-void* operator new[](std::size_t size, std::align_val_t alignment) { return operator new(size, alignment); }
-void* operator new(std::size_t size, std::align_val_t alignment, const std::nothrow_t&) noexcept {
-  return allocation_fault_due() ? nullptr : checked_aligned(size, alignment);
-}
-void* operator new[](std::size_t size, std::align_val_t alignment, const std::nothrow_t&) noexcept {
-  return allocation_fault_due() ? nullptr : checked_aligned(size, alignment);
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
+using alloc_fault::arm;
+using alloc_fault::disarm;
 
 namespace {
 

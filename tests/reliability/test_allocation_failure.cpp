@@ -2,10 +2,10 @@
 // Host allocation failures (issue 9, item 6), injected at every allocation point of every
 // call in turn.
 //
-// This executable replaces the global operator new (libsph resolves it from the executable,
-// since the library exports nothing but sph_*). Armed with n, the n-th allocation from then on
-// throws std::bad_alloc (or returns null for the nothrow forms), once. For each call below, n
-// runs 0, 1, 2, ... until the call completes without reaching the n-th allocation, so every
+// This executable replaces the global operator new (tests/support/allocation_injector.h; libsph
+// resolves it from the executable, since the library exports nothing but sph_*). Armed with n, the n-th
+// allocation from then on throws std::bad_alloc (or returns null for the nothrow forms), once. For each call
+// below, n runs 0, 1, 2, ... until the call completes without reaching the n-th allocation, so every
 // allocation the call makes fails once. Each failure must come back as
 // SPH_ERROR_OUT_OF_HOST_MEMORY with a message, leave the world bitwise as it was and the live
 // object count unchanged, and the world must then go on exactly as an undisturbed copy.
@@ -24,92 +24,10 @@
 extern "C" {
 #include "capi_test.h"
 }
+#include "allocation_injector.h"
 
-// ---- the injector ---------------------------------------------------------------------------
-// The replacements below pair malloc with free themselves; GCC cannot see that through
-// inlining and warns that free() meets a pointer from operator new.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-#endif
-namespace {
-
-std::atomic<long> g_countdown{-1};  // allocations to let through before one fails; -1 = off
-std::atomic<long> g_injected{0};    // failures injected since the last arm()
-
-bool allocation_fault_due() {
-  long left = g_countdown.load(std::memory_order_relaxed);
-  while (left >= 0) {
-    if (g_countdown.compare_exchange_weak(left, left - 1, std::memory_order_relaxed)) {
-      if (left == 0) {
-        g_injected.fetch_add(1, std::memory_order_relaxed);
-        return true;
-      }
-      return false;
-    }
-  }
-  return false;
-}
-
-void arm(long n) {
-  g_injected.store(0);
-  g_countdown.store(n);
-}
-
-// Returns whether a failure was injected since arm().
-bool disarm() {
-  g_countdown.store(-1);
-  return g_injected.load() != 0;
-}
-
-void* checked_malloc(std::size_t size) { return std::malloc(size ? size : 1); }
-
-void* checked_aligned(std::size_t size, std::align_val_t alignment) {
-  const std::size_t a = static_cast<std::size_t>(alignment);
-  void* p = nullptr;
-  if (posix_memalign(&p, a < sizeof(void*) ? sizeof(void*) : a, size ? size : 1) != 0) return nullptr;
-  return p;
-}
-
-}  // namespace
-
-void* operator new(std::size_t size) {
-  if (allocation_fault_due()) throw std::bad_alloc();
-  void* p = checked_malloc(size);
-  if (!p) throw std::bad_alloc();
-  return p;
-}
-void* operator new[](std::size_t size) { return operator new(size); }
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
-  return allocation_fault_due() ? nullptr : checked_malloc(size);
-}
-void* operator new[](std::size_t size, const std::nothrow_t&) noexcept {
-  return allocation_fault_due() ? nullptr : checked_malloc(size);
-}
-void* operator new(std::size_t size, std::align_val_t alignment) {
-  if (allocation_fault_due()) throw std::bad_alloc();
-  void* p = checked_aligned(size, alignment);
-  if (!p) throw std::bad_alloc();
-  return p;
-}
-void* operator new[](std::size_t size, std::align_val_t alignment) { return operator new(size, alignment); }
-void* operator new(std::size_t size, std::align_val_t alignment, const std::nothrow_t&) noexcept {
-  return allocation_fault_due() ? nullptr : checked_aligned(size, alignment);
-}
-void* operator new[](std::size_t size, std::align_val_t alignment, const std::nothrow_t&) noexcept {
-  return allocation_fault_due() ? nullptr : checked_aligned(size, alignment);
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
+using alloc_fault::arm;
+using alloc_fault::disarm;
 
 // ---- the scene every call runs against ----------------------------------------------------------
 namespace {
