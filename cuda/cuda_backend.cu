@@ -56,6 +56,11 @@ CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBacken
   tuning_.density_block = options.density_block;
   tuning_.force_block = options.force_block;
   tuning_.particle_lanes = options.particle_lanes;
+  int sms = 0, threads_per_sm = 0;
+  cuda_check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device_), "cudaDeviceGetAttribute");
+  cuda_check(cudaDeviceGetAttribute(&threads_per_sm, cudaDevAttrMaxThreadsPerMultiProcessor, device_),
+             "cudaDeviceGetAttribute");
+  tuning_.thread_slots = static_cast<unsigned>(sms) * static_cast<unsigned>(threads_per_sm);
   use_graphs_ = !options.stream_frames;
   r_ = std::move(r);
 }

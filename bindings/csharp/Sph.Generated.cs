@@ -845,8 +845,9 @@ namespace Sph
         public uint CudaForceBlock;
         /// <summary>
         /// uint32_t cuda_particle_lanes: threads per particle of the density and force passes (0.2.0):
-        /// 0 (default) = chosen by the library (1 today), or 1, 2, 4, 8 (a measurement knob: each sums
-        /// neighbours in its own fixed order)
+        /// 0 (default) = chosen by the library from the particle count (more lanes for small worlds,
+        /// docs/cuda.md), or 1, 2, 4, 8 (a measurement knob: each sums neighbours in its own fixed
+        /// order)
         /// </summary>
         public uint CudaParticleLanes;
         /// <summary>

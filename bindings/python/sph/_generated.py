@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'dd36d2a921befe00a3a9f00f765d29e12a962f72045fddfd022c5be53ea8ea8d', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': 'acc80be4ac6bc8c74a52fe7115fe978f313c800c117dd8293d8674b1c244edbd', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -826,7 +826,7 @@ class ContextDef(_SphStruct):
         cuda_frames (sph_cuda_frames): Tuning of the CUDA backend (a CPU context checks and ignores it; docs/cuda.md). Results do not depend on it: every choice computes the same particles bit for bit, except cuda_particle_lanes (the order of the neighbour sums: the last bits).
         cuda_density_block (uint32_t): threads per block of the density kernels: 0 (default) = 128, or 32, 64, 128, 256, 512, 1024
         cuda_force_block (uint32_t): threads per block of the force kernels: 0 (default) = 128, or as above
-        cuda_particle_lanes (uint32_t): threads per particle of the density and force passes (0.2.0): 0 (default) = chosen by the library (1 today), or 1, 2, 4, 8 (a measurement knob: each sums neighbours in its own fixed order)
+        cuda_particle_lanes (uint32_t): threads per particle of the density and force passes (0.2.0): 0 (default) = chosen by the library from the particle count (more lanes for small worlds, docs/cuda.md), or 1, 2, 4, 8 (a measurement knob: each sums neighbours in its own fixed order)
         enqueue_task (sph_enqueue_task_fn): The engine's task system (0.2.0): both or neither; NULL (default) = the library's OpenMP workers. A CPU context uses it for every parallel loop of its worlds and runs each asynchronous step as one task of it; cpu_worker_count then only decides whether a loop runs in parallel (1: every loop on the calling thread). A CUDA context checks and ignores it.
         finish_task (sph_finish_task_fn)
         task_user_context (void*): passed to enqueue_task and finish_task
