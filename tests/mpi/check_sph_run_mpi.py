@@ -6,11 +6,12 @@
 
 Runs SCENE with sph-run (libsph, one undivided world) and with RANKS ranks of sph-run-mpi
 (libsph_mpi), both as CSV frames, and asserts that every frame of the merged output equals
-sph-run's particle for particle, every column to the printed bit (%.9g round-trips a float):
+sph-run's particle for particle, every column to the printed bit (%.9g round-trips a float),
+with every rank holding particles after the first step:
 docs/distributed.md promises the same bits while the neighbour grid covers the particles'
 extent, which a closed tank keeps. Also that the --per-rank files of each frame hold every
 particle once, each as the merged frame has it, and that sph-run-mpi refuses a scene with a
-source, naming it.
+source or RK4, naming it.
 """
 import glob
 import os
@@ -71,6 +72,8 @@ def main(argv):
         for d in sorted(glob.glob(os.path.join(merged, "rank*"))):
             _, r = rows(os.path.join(d, name))
             assert not (union.keys() & r.keys()), f"{name}: a particle on two ranks"
+            # After the first step every rank holds a slab's particles: the run was divided.
+            assert r or name == frames[0], f"{name}: {os.path.basename(d)} holds no particle"
             union.update(r)
         assert union == b, f"{name}: the ranks' files hold {len(union)} particles, the merged {len(b)}"
     assert len(glob.glob(os.path.join(merged, "rank*"))) == int(ranks), "one folder per rank"
@@ -90,6 +93,16 @@ def main(argv):
     assert "sources[0]" in p.stderr and "distributed world" in p.stderr, p.stderr
     assert p.stderr.count("sph-run-mpi:") == 1, f"one message, from rank 0:\n{p.stderr}"
     print("refused:", p.stderr.strip())
+
+    # RK4: the library refuses the world (sph_mpi_world_create) and names the integrator.
+    bad_scene = os.path.join(work, "with_rk4.json")
+    with open(bad_scene, "w", encoding="utf-8") as f:
+        f.write(text.replace('"capacity": 4000', '"capacity": 4000, "integrator": "rk4"', 1))
+    p = run([mpiexec, "--oversubscribe", "-np", ranks, sph_run_mpi, bad_scene, "--quiet", "--out",
+             os.path.join(work, "refused")], expect=3)
+    assert "world" in p.stderr and "RK4" in p.stderr.upper(), p.stderr
+    assert p.stderr.count("sph-run-mpi:") == 1, f"one message, from rank 0:\n{p.stderr}"
+    print("refused:", p.stderr.strip().splitlines()[0])
     return 0
 
 

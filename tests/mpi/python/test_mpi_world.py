@@ -38,43 +38,59 @@ def test_a_dam_break_equals_the_undivided_world(ctx, comm):
         world = sph.mpi.DistributedWorld(ctx, comm.py2f(), capacity=4000, particle_spacing=SPACING)
         try:
             tank_scene(ctx, world)
-            # Rank 0 adds every particle, so the ids are the undivided world's.
+            # Every collective call first, then the checks: a failing assertion on one rank then
+            # cannot leave the others waiting in a collective. Rank 0 adds every particle, so the
+            # ids are the undivided world's.
             first = world.add_particles(x0 if comm.rank == 0 else None, v0 if comm.rank == 0 else None)
-            assert first == (0 if comm.rank == 0 else len(x0))
+            steps = []
             for _ in range(FRAMES):
-                assert ref.step(1 / 50) == sph.Result.OK
-                assert world.step(1 / 50) == sph.Result.OK
+                steps.append((ref.step(1 / 50), world.step(1 / 50)))
             c = world.counts()
-            assert (c.rank, c.rank_count) == (comm.rank, comm.size)
-            assert c.global_count == len(x0) == comm.allreduce(world.particle_count)
-            assert c.local_count == world.particle_count
-            assert c.rebalances >= 1  # the first frame always cuts
-            if comm.size > 1:
-                assert comm.allreduce(int(world.particle_count > 0)) == comm.size, "every rank holds a slab"
+            local_sum = comm.allreduce(world.particle_count)
+            ranks_holding = comm.allreduce(int(world.particle_count > 0))
             merged = world.gather(root=0)
-            order = np.argsort(ref.ids())
-            if comm.rank == 0:
-                assert np.array_equal(merged["ids"], np.arange(len(x0), dtype=np.uint32))
-                x, v = ref.positions()[order], ref.velocities()[order]
-                moved = np.abs(x - x0).max()
-                assert moved > 0.5 * SPACING, f"the column moved {moved} m in {FRAMES} frames"
-                differ = int(np.count_nonzero(np.any(merged["positions"] != x, axis=1) |
-                                              np.any(merged["velocities"] != v, axis=1)))
-                assert differ == 0, f"{differ} of {len(x)} particles differ from the undivided world on {comm.size} ranks"
-            else:
-                assert merged is None
-            # Only the positions, onto the last rank: the others pass nothing.
             last = comm.size - 1
-            only = world.gather(root=last, velocities=False, ids=False)
-            if comm.rank == last:
-                assert set(only) == {"positions"} and only["positions"].shape == (len(x0), 3)
-            # Each rank's own particles, together, are the world's.
+            only = world.gather(root=last, velocities=False, ids=False)  # the others pass nothing
             own = comm.gather((world.ids(), world.positions()), root=0)
+            problems = []
+            if first != (0 if comm.rank == 0 else len(x0)):  # ids in rank order: rank 0 added all
+                problems.append(f"rank {comm.rank}: first id {first}")
+            if any(s != (sph.Result.OK, sph.Result.OK) for s in steps):
+                problems.append(f"rank {comm.rank}: steps returned {steps}")
+            if (c.rank, c.rank_count, c.local_count) != (comm.rank, comm.size, world.particle_count):
+                problems.append(f"rank {comm.rank}: counts {c.rank}, {c.rank_count}, {c.local_count}")
+            if not c.global_count == len(x0) == local_sum:
+                problems.append(f"global count {c.global_count}, ranks' sum {local_sum}, added {len(x0)}")
+            if c.rebalances < 1:  # the first frame always cuts
+                problems.append(f"rebalances {c.rebalances}")
+            if ranks_holding != comm.size:
+                problems.append(f"{ranks_holding} of {comm.size} ranks hold particles")
             if comm.rank == 0:
+                order = np.argsort(ref.ids())
+                x, v = ref.positions()[order], ref.velocities()[order]
+                moved = float(np.abs(x - x0).max())
+                if moved < 0.5 * SPACING:
+                    problems.append(f"the column moved {moved} m in {FRAMES} frames")
+                if not np.array_equal(merged["ids"], np.arange(len(x0), dtype=np.uint32)):
+                    problems.append("the gather's ids are not 0..n-1")
+                else:
+                    differ = int(np.count_nonzero(np.any(merged["positions"] != x, axis=1) |
+                                                  np.any(merged["velocities"] != v, axis=1)))
+                    if differ:
+                        problems.append(f"{differ} of {len(x)} particles differ from the undivided world on "
+                                        f"{comm.size} ranks")
+                # Each rank's own particles, together, are the world's.
                 ids = np.concatenate([i for i, _ in own])
                 xs = np.concatenate([p for _, p in own])
                 k = np.argsort(ids)
-                assert np.array_equal(ids[k], merged["ids"]) and np.array_equal(xs[k], merged["positions"])
+                if not (np.array_equal(ids[k], merged["ids"]) and np.array_equal(xs[k], merged["positions"])):
+                    problems.append("the ranks' own particles are not the gathered ones")
+            elif merged is not None:
+                problems.append(f"rank {comm.rank} got a gather for root 0")
+            if comm.rank == last and not (set(only) == {"positions"} and only["positions"].shape == (len(x0), 3)):
+                problems.append(f"the gather onto rank {last}: {only}")
+            problems = sum(comm.allgather(problems), [])
+            assert not problems, problems
         finally:
             world.close()
 
@@ -85,7 +101,7 @@ def test_bad_input_is_refused(ctx, comm):
     # Refused features name themselves, on every rank (the same def everywhere).
     with pytest.raises(sph.SphError, match="(?i)rk4") as e:
         sph.mpi.DistributedWorld(ctx, comm, integrator=sph.Integrator.RK4)
-    assert e.value.code == sph.Result.ERROR_UNSUPPORTED
+    assert e.value.result == sph.Result.ERROR_UNSUPPORTED
     world = sph.mpi.DistributedWorld(ctx, comm, rebalance_threshold_percent=50, particle_spacing=SPACING)
     try:
         with pytest.raises(ValueError, match="velocities"):
@@ -93,10 +109,10 @@ def test_bad_input_is_refused(ctx, comm):
         # The fills number ids on one rank: refused, pointing at add_particles.
         with pytest.raises(sph.SphError) as e:
             world.fill_box((0, 0, 0), (0.1, 0.1, 0.1))
-        assert e.value.code == sph.Result.ERROR_UNSUPPORTED
+        assert e.value.result == sph.Result.ERROR_UNSUPPORTED
         with pytest.raises(sph.SphError) as e:
             world.gather(root=comm.size)
-        assert e.value.code == sph.Result.ERROR_INVALID_ARGUMENT
+        assert e.value.result == sph.Result.ERROR_INVALID_ARGUMENT
         assert world.global_count == 0
         empty = world.gather()
         if comm.rank == 0:
@@ -109,7 +125,7 @@ def test_an_undivided_world_is_not_a_distributed_one(ctx):
     with ctx.world(particle_spacing=SPACING) as plain:
         with pytest.raises(sph.SphError) as e:
             sph.mpi.DistributedWorld.counts(plain)
-        assert e.value.code == sph.Result.ERROR_UNSUPPORTED
+        assert e.value.result == sph.Result.ERROR_UNSUPPORTED
 
 
 def test_zz_every_sph_mpi_function_was_called():
