@@ -29,6 +29,7 @@
 #include "scene_error.h"
 #include "scene_parser.h"
 #include "sph_mpi.h"
+#include "video.h"
 
 namespace sph_tools {
 namespace {
@@ -154,6 +155,15 @@ int run_frames(const Ranks& ranks, const CliOptions& cli, const SceneDesc& scene
     if (i > 0) progress.frame_done(FrameReport{i, all.count, s.substeps, step_ms, output_ms});
   }
   progress.finish();
+  if (merged && out.preview) {
+    if (!ffmpeg_on_path()) {
+      if (!cli.quiet)
+        std::fprintf(stderr, "sph-run-mpi: no ffmpeg on PATH: no preview.mp4 (the PNGs are there)\n");
+    } else {
+      const std::string problem = merged->write_preview_video(scene.fps);
+      if (!problem.empty()) std::fprintf(stderr, "sph-run-mpi: warning: preview.mp4: %s\n", problem.c_str());
+    }
+  }
   if (merged) merged->end("complete", scene.frames);
   if (own_writer) own_writer->end("complete", scene.frames);
   sph_mpi_counts counts;
@@ -194,6 +204,8 @@ int run(const Ranks& ranks, int argc, char** argv) {
     if (ranks.rank == 0 && cli.version) std::printf("sph-run-mpi, %s\n", sph_get_build_info());
     return kExitOk;
   }
+  if (cli.stats_json)
+    return fail(ranks, kExitUsage, "--stats-json: not in sph-run-mpi yet (its summary line is on stdout)");
   if (cli.backend == SPH_BACKEND_CUDA)
     return fail(ranks, kExitBackend,
                 "--backend cuda: distributed worlds run on the CPU backend only (docs/distributed.md)");
