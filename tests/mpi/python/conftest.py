@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: MIT
 """Set-up of the Python tests of distributed worlds, run on every rank under mpirun:
 
-    SPH_LIBRARY=build/libsph_mpi.so mpirun --oversubscribe -np 2 python3 -m pytest -q -p no:cacheprovider tests/mpi/python
+    SPH_LIBRARY=build/libsph_mpi.so mpirun --oversubscribe -np 2 \
+        python3 -m pytest -q -p no:cacheprovider tests/mpi/python
 
 Imports mpi4py first (MPI_Init), the package from this checkout, and counts the sph_* calls
 that go through the package (as bindings/python/tests/conftest.py does for libsph), so the last
