@@ -88,6 +88,10 @@ class CudaBackend final : public Backend {
   void save_step_inputs() override;
   void restore_step_inputs() override;
 
+  // Binds the scene's SDFs and boundary maps and uploads its views (a frame that follows binds
+  // the same copies again without allocating).
+  void prepare_scene(const SceneFrame& scene, const RuntimeParams& params) override;
+
   FrameReport step_scene_frame(double frame_dt, const RuntimeParams& params,
                                const SceneFrame& scene_in) override;
 
@@ -126,6 +130,9 @@ class CudaBackend final : public Backend {
   // Restores the particles (and the cached max speed) from the snapshot taken at the start of
   // the frame; count_ is still the count before the frame.
   void roll_back_frame();
+  // The device side of a frame's scene: SDF copies, boundary maps, the scene's views, the
+  // loads' and sinks' buffers, the probes. Sets setup.scene, setup.loads and setup.probes.
+  void bind_frame_scene(const SceneFrame& scene_in, PipelineSetup& setup);
   void copy_step_inputs(bool save);
 
   void require_alive() const {

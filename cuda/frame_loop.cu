@@ -38,6 +38,43 @@ bool same_setup(const PipelineSetup& a, const PipelineSetup& b) {
 
 }  // namespace
 
+void CudaBackend::bind_frame_scene(const SceneFrame& scene_in, PipelineSetup& setup) {
+  if (!scene_in.empty()) {
+    SceneFrame scene = scene_in;
+    r_->sdf_cache.begin_frame();
+    bind_scene_views(scene, [&](const SdfAsset& a) { return r_->sdf_cache.bind(a, r_->stream); });
+    r_->sdf_cache.end_frame();
+    if (options_.boundary_density) {
+      r_->boundary_maps.begin_frame();
+      for (ColliderFrame& c : scene.colliders)
+        c.view.boundary_map = r_->boundary_maps.bind(
+            *c.sdf, c.view.sdf, config_.kernel_radius,
+            BoundaryDensity::map_level(setup.fluid.methods.boundary, c.view.sign), r_->stream);
+      r_->boundary_maps.end_frame();
+    }
+    setup.scene = r_->scene_buffer.upload(scene, config_.kernel_radius, r_->stream);
+    if ((config_.features & kFeatureColliderLoads) && !scene.colliders.empty())
+      setup.loads = r_->loads.reserve(static_cast<uint32_t>(scene.colliders.size()), config_.capacity);
+    if (!scene_in.sinks.empty()) r_->sinks.reserve(config_.capacity, *r_->store);
+    cuda_check(cudaStreamSynchronize(r_->stream), "upload of the scene");
+  }
+  if (!scene_in.probes.empty()) {
+    ProbeConstants constants;
+    constants.kernel = make_kernel_coefficients(config_.kernel_radius);
+    constants.particle_mass = config_.particle_mass;
+    constants.rest_density = config_.rest_density;
+    setup.probes = r_->probes.upload(scene_in, constants, r_->stream);
+  }
+}
+
+void CudaBackend::prepare_scene(const SceneFrame& scene, const RuntimeParams& params) {
+  require_alive();
+  DeviceGuard guard(device_);
+  PipelineSetup setup;
+  setup.fluid = make_fluid_constants(config_, params);
+  guarded([&] { bind_frame_scene(scene, setup); });
+}
+
 // One frame, run by one of two drivers (docs/cuda.md): the frame graph (frame_graph.h), or the
 // stream driver (run_frame_on_stream) for frames with sinks and when graphs are off. A frame
 // with colliders and force fields runs in the frame graph like any other: the scene's assets
@@ -63,32 +100,7 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
   bool interrupted = false;     // the stream driver stopped at a substep boundary (StepInterrupt)
   try {
     guarded([&] {
-      if (!scene_in.empty()) {
-        SceneFrame scene = scene_in;
-        r_->sdf_cache.begin_frame();
-        bind_scene_views(scene, [&](const SdfAsset& a) { return r_->sdf_cache.bind(a, r_->stream); });
-        r_->sdf_cache.end_frame();
-        if (options_.boundary_density) {
-          r_->boundary_maps.begin_frame();
-          for (ColliderFrame& c : scene.colliders)
-            c.view.boundary_map = r_->boundary_maps.bind(
-                *c.sdf, c.view.sdf, config_.kernel_radius,
-                BoundaryDensity::map_level(setup.fluid.methods.boundary, c.view.sign), r_->stream);
-          r_->boundary_maps.end_frame();
-        }
-        setup.scene = r_->scene_buffer.upload(scene, config_.kernel_radius, r_->stream);
-        if ((config_.features & kFeatureColliderLoads) && !scene.colliders.empty())
-          setup.loads = r_->loads.reserve(static_cast<uint32_t>(scene.colliders.size()), config_.capacity);
-        if (with_sinks) r_->sinks.reserve(config_.capacity, *r_->store);
-        cuda_check(cudaStreamSynchronize(r_->stream), "upload of the scene");
-      }
-      if (!scene_in.probes.empty()) {
-        ProbeConstants constants;
-        constants.kernel = make_kernel_coefficients(config_.kernel_radius);
-        constants.particle_mass = config_.particle_mass;
-        constants.rest_density = config_.rest_density;
-        setup.probes = r_->probes.upload(scene_in, constants, r_->stream);
-      }
+      bind_frame_scene(scene_in, setup);
       FrameInput* input = r_->input.get();
       input->frame_dt = frame_dt;
       input->max_collider_speed = scene_in.max_collider_speed;

@@ -27,11 +27,13 @@ struct KernelTuning {
   // (lanes_per_particle). The lanes split each run of candidates and add their sums in a fixed
   // order, so a result depends on this count (the last bits of the sums), never on timing.
   unsigned particle_lanes = 0;
+  // Threads the device keeps resident at once (SMs x threads per SM), for the choice by count;
+  // 0 = unknown (one lane).
+  unsigned thread_slots = 0;
 };
 
 // The lane group of the neighbour passes for n particles: tuning.particle_lanes if set, else
-// one (until the lane groups are timed; the aim is more lanes for fewer particles, so that
-// small worlds still fill the device's thread slots).
+// the fewest lanes (1, 2 or 4) with which n particles fill the device's thread slots.
 unsigned lanes_per_particle(const KernelTuning& tuning, uint32_t n);
 
 // The scene inside a substep, as the kernels see it: the views live in a per-world device

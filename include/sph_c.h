@@ -340,7 +340,8 @@ typedef struct sph_context_def {
                                    32, 64, 128, 256, 512, 1024 */
   uint32_t cuda_force_block;    /* threads per block of the force kernels: 0 (default) = 128, or as above */
   uint32_t cuda_particle_lanes; /* threads per particle of the density and force passes (0.2.0): 0
-                                   (default) = chosen by the library (1 today), or 1, 2, 4, 8 (a
+                                   (default) = chosen by the library from the particle count (more
+                                   lanes for small worlds, docs/cuda.md), or 1, 2, 4, 8 (a
                                    measurement knob: each sums neighbours in its own fixed order) */
   /* The engine's task system (0.2.0): both or neither; NULL (default) = the library's OpenMP
      workers. A CPU context uses it for every parallel loop of its worlds and runs each

@@ -27,11 +27,12 @@ SPH_SCRIPT_NAME="$(basename "${0}")"
 # virtual environment offline (scripts/build-wheel, scripts/test). libegl-dev, libgl-dev and
 # libgles-dev (EGL and glvnd, the EGL/GL/GLES headers) build samples/gpu_draw; libegl-mesa0 and
 # libgl1-mesa-dri (Mesa's EGL driver and llvmpipe) let gl_draw_host draw without a GPU; the
-# kit for a GPU machine without them comes from scripts/devkit-interop.
+# kit for a GPU machine without them comes from scripts/devkit-interop. libopenmpi-dev and
+# openmpi-bin build libsph_mpi and run the mpi tests; python3-mpi4py drives it from Python.
 SPH_PACKAGES=(
   cmake ninja-build g++ pkg-config git
   libcmocka-dev libeigen3-dev libxsimd-dev
-  libopenvdb-dev libboost-iostreams-dev libtbb-dev nlohmann-json3-dev libopenmpi-dev openmpi-bin
+  libopenvdb-dev libboost-iostreams-dev libtbb-dev nlohmann-json3-dev libopenmpi-dev openmpi-bin python3-mpi4py
   clang libclang-rt-14-dev libomp-dev clang-format
   python3 python3-numpy python3-pytest python3-matplotlib mono-mcs mono-runtime
   libpng-dev libegl-dev libgl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri

@@ -6,8 +6,8 @@
     python3 bindings/api/generate.py --check    # regenerate into a temporary folder and diff
 
 Generated files (all committed):
-    bindings/api/sph_api.json             <- include/sph_c.h, include/sph_cuda.h (generate_api.py;
-                                             needs a C compiler)
+    bindings/api/sph_api.json             <- include/sph_c.h, then the other include/sph_*.h
+                                             (generate_api.py; needs a C compiler)
     bindings/python/sph/_generated.py     <- sph_api.json    (generate_python.py)
     bindings/csharp/Sph.Generated.cs      <- sph_api.json    (generate_csharp.py)
     bindings/cffi/sph_cdef.h              <- sph_api.json    (generate_cdef.py; for cffi's cdef)

@@ -5,8 +5,9 @@
     python3 bindings/api/generate_api.py [--header H ...] [--out FILE] [--cc CC]
 
 The headers are include/sph_c.h and then every other include/sph_*.h (the CUDA interop tier
-sph_cuda.h; sph_vdb.h, whose functions live in the optional helper library libsph_vdb),
-unless --header names them. Every declaration records its header, every function its library.
+sph_cuda.h; sph_vdb.h, whose functions live in the optional helper library libsph_vdb;
+sph_mpi.h, whose functions live in libsph_mpi, loaded in place of libsph), unless --header
+names them. Every declaration records its header, every function its library.
 
 Two passes:
 
@@ -49,8 +50,9 @@ DEFAULT_HEADER = os.path.join(ROOT, "include", "sph_c.h")
 DEFAULT_OUT = os.path.join(HERE, "sph_api.json")
 
 # The shared library that exports a header's functions, when it is not libsph itself.
-# (sph_vdb.h belongs to the optional OpenVDB helper library libsph_vdb.)
-LIBRARY_OF_HEADER = {"sph_vdb.h": "sph_vdb"}
+# (sph_vdb.h belongs to the optional OpenVDB helper library libsph_vdb; sph_mpi.h to libsph_mpi,
+# which holds the whole of sph_c.h too and is loaded instead of libsph, never beside it.)
+LIBRARY_OF_HEADER = {"sph_vdb.h": "sph_vdb", "sph_mpi.h": "sph_mpi"}
 
 # C types the header may use directly (B2: fixed-width types only; the rest for robustness).
 BUILTIN_TYPES = {
@@ -828,9 +830,9 @@ def rel_path(header: str) -> str:
     return rel.replace(os.sep, "/")
 
 
-# Headers the bindings do not cover: sph_mpi.h's distributed worlds live in libsph_mpi, which a
-# program links instead of libsph, and need MPI in the caller (Python through mpi4py: issue 19).
-NOT_BOUND = {"sph_mpi.h"}
+# Headers the bindings do not cover (none now: sph_mpi.h's functions are recorded with their
+# library, sph_mpi, and Python reaches them through sph.mpi with mpi4py).
+NOT_BOUND: set[str] = set()
 
 
 def default_headers() -> list[str]:

@@ -54,10 +54,13 @@ static EGLDisplay open_display(int cuda_device) {
       return EGL_NO_DISPLAY;
     }
   } else if (cuda_device >= 0) {
+    /* The client extensions say which vendor libraries EGL loaded: none at all (a null list,
+     * or only the loader's own) means the driver's EGL library was not found or failed. */
     fprintf(stderr,
             "headless_egl: EGL has no device enumeration (EGL_EXT_device_enumeration, "
-            "EGL_EXT_platform_device): cannot find the GL device of CUDA device %d\n",
-            cuda_device);
+            "EGL_EXT_platform_device): cannot find the GL device of CUDA device %d; client extensions: "
+            "%s (eglGetError 0x%x)\n",
+            cuda_device, client ? client : "(none)", (unsigned)eglGetError());
     return EGL_NO_DISPLAY;
   }
   if (client && has_extension(client, "EGL_MESA_platform_surfaceless")) {

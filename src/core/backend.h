@@ -68,6 +68,13 @@ class Backend {
   // backend as it was. Device pointers taken before (device_attribute) are stale after.
   virtual void reserve(uint32_t capacity, const GrowthNeeds& needs) = 0;
 
+  // Makes the device copies a frame of `scene` needs (collider SDFs, boundary maps, scene and
+  // probe buffers) ahead of the frame. The world calls it before a step's sources may grow the
+  // storage, so that the step cannot fail on one of these allocations with the world already
+  // grown (a grown world and a rolled-back step would differ from the world before the call).
+  // Throws like step_scene_frame; a backend without such copies does nothing.
+  virtual void prepare_scene(const SceneFrame& /*scene*/, const RuntimeParams& /*params*/) {}
+
   // Runs adaptive substeps until frame_dt is reached or params.max_substeps is spent, with the
   // scene's colliders, force fields and sinks. On a non-finite state it restores the particles
   // as they were before the call and throws Error(Status::NonFinite).

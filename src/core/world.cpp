@@ -255,9 +255,12 @@ bool World::step(double frame_dt, const StepInterrupt& interrupt, const FrameEnq
     // once the particles have moved, the rest of the step must not throw.
     // + each source's growth + the solves' capped events + the colliders' and probes' thresholds
     events_.reserve(2 * sources_.size() + sinks_.size() + 2 + colliders_.size() + probes_.size());
-    if (sources_.size() > 0) backend_->save_step_inputs();
-    emit_sources(frame_dt);
     SceneFrame scene = build_scene_frame(frame_dt);
+    if (sources_.size() > 0) {
+      backend_->prepare_scene(scene, params_);  // before emission can grow the world
+      backend_->save_step_inputs();
+    }
+    emit_sources(frame_dt);
     scene.interrupt = interrupt;
     scene.enqueued = enqueued;
     report = backend_->step_scene_frame(frame_dt, params_, scene);

@@ -2,6 +2,8 @@
 // Bitwise determinism: two GPU runs of the same scene give identical arrays (compared by id)
 // and identical statistics; the graph path and the stream fallback agree bit for bit; two
 // worlds stepped at once from two threads give the same bits as one at a time.
+#include <cuda_runtime.h>
+
 #include <cstdlib>
 #include <thread>
 
@@ -129,6 +131,25 @@ int main() {
     const bool same = states_identical(eight.state, one.state);
     report(!same, "lane_groups/moving_sphere_euler", "eight lanes per particle against one: %s",
            same ? "IDENTICAL (the field did not reach the kernels)" : "different last bits, as expected");
+  }
+  {
+    // The library's choice (cuda_particle_lanes 0) is the fewest lanes, up to 4, with which the
+    // particles fill the device's resident thread slots (lanes_per_particle): here the same
+    // bits as that explicit count, and on a device of 270k slots (an H200) 4 lanes for 47k.
+    int sms = 0, per_sm = 0;
+    cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, 0);
+    cudaDeviceGetAttribute(&per_sm, cudaDevAttrMaxThreadsPerMultiProcessor, 0);
+    context_tuning().particle_lanes = 0;
+    const Run chosen = run(lanes, 5, 0.04f);
+    const uint64_t slots = static_cast<uint64_t>(sms) * static_cast<uint64_t>(per_sm);
+    uint32_t expected = 1;
+    while (expected < 4 && static_cast<uint64_t>(chosen.stats.particle_count) * expected < slots)
+      expected *= 2;
+    context_tuning().particle_lanes = expected;
+    const Run explicit_count = run(lanes, 5, 0.04f);
+    report(states_identical(chosen.state, explicit_count.state), "lane_groups/default_choice",
+           "%u particles, %llu thread slots: the library's choice computes the bits of %u lanes",
+           chosen.stats.particle_count, static_cast<unsigned long long>(slots), expected);
   }
   SceneSpec lanes_options = options;
   lanes_options.name = "moving_sphere_all_options_euler_lanes8";

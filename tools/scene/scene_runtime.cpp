@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "scene_runtime.h"
 
+#include "lattice_fill.h"
 #include "library_error.h"
 #include "scene_error.h"
 #include "sdf_factory.h"
@@ -39,9 +40,11 @@ void check_object(sph_result r, const std::string& path, const char* what) {
 
 }  // namespace
 
-SceneRuntime::SceneRuntime(const SceneDesc& scene, sph_context* context) : scene_(scene), context_(context) {
+SceneRuntime::SceneRuntime(const SceneDesc& scene, sph_context* context, WorldMaker* maker)
+    : scene_(scene), context_(context), maker_(maker) {
   try {
-    sph_result r = sph_world_create(context, &scene.world, &world_);
+    sph_result r = maker ? maker->create_world(context, &scene.world, &world_)
+                         : sph_world_create(context, &scene.world, &world_);
     if (r < 0) {
       if (r == SPH_ERROR_INVALID_ARGUMENT || r == SPH_ERROR_UNSUPPORTED)
         throw SceneError("world", std::string("the library rejected the world: ") + sph_get_last_error());
@@ -135,7 +138,13 @@ sph_transform SceneRuntime::collider_pose(size_t i) const {
 void SceneRuntime::add_fluid(const FluidDesc& f) {
   sph_result r;
   uint32_t added = 0;
-  if (f.kind == FluidDesc::Kind::kBox) {
+  if (maker_) {
+    std::vector<float> positions, velocities;
+    r = lattice_fill(context_, scene_.world, f, &positions, &velocities);
+    if (r >= 0)
+      r = maker_->add_particles(world_, positions.data(), velocities.data(),
+                                static_cast<uint32_t>(positions.size() / 3));
+  } else if (f.kind == FluidDesc::Kind::kBox) {
     sph_fill_box_desc d;
     sph_fill_box_desc_init(&d);
     d.min = f.min;

@@ -15,6 +15,20 @@ namespace sph_tools {
 
 class SceneRuntime {
  public:
+  // How the runtime makes its world and adds a fluid body's particles. Without one, an undivided
+  // world (sph_world_create) filled by the library's fills and spawn; sph-run-mpi passes a
+  // distributed world's (tools/mpi/distributed_maker.h), whose fills are refused, so the
+  // runtime then takes a fill's particles from a scratch world (lattice_fill.h) and adds them
+  // through add_particles, on every rank at the same frame.
+  class WorldMaker {
+   public:
+    virtual ~WorldMaker() = default;
+    virtual sph_result create_world(sph_context* context, const sph_world_def* def, sph_world** out) = 0;
+    // `count` particles, 3 floats each (velocities too).
+    virtual sph_result add_particles(sph_world* world, const float* positions, const float* velocities,
+                                     uint32_t count) = 0;
+  };
+
   struct Collider {
     const ColliderDesc* desc;
     sph_sdf* sdf;  // owned by the runtime (one reference)
@@ -24,7 +38,7 @@ class SceneRuntime {
   // Creates a world on `context` (which must outlive the runtime) holding the scene's objects
   // and the fluid bodies of time 0. Throws SceneError (the object's path and the library's
   // message) when the library rejects a scene object, LibraryError for other failures.
-  SceneRuntime(const SceneDesc& scene, sph_context* context);
+  SceneRuntime(const SceneDesc& scene, sph_context* context, WorldMaker* maker = nullptr);
   ~SceneRuntime();
   SceneRuntime(const SceneRuntime&) = delete;
   SceneRuntime& operator=(const SceneRuntime&) = delete;
@@ -68,6 +82,7 @@ class SceneRuntime {
 
   const SceneDesc& scene_;
   sph_context* context_ = nullptr;
+  WorldMaker* maker_ = nullptr;
   sph_world* world_ = nullptr;
   uint32_t frame_ = 0;
   std::vector<Collider> colliders_;

@@ -1215,8 +1215,12 @@ static class Tests
         string wrapper = File.ReadAllText(Path.Combine(SourceDir, "Sph.cs"));
         string generated = File.ReadAllText(Path.Combine(SourceDir, "Sph.Generated.cs"));
         var missing = new System.Collections.Generic.List<string>();
-        foreach (string fn in Layout.Functions)
+        for (int i = 0; i < Layout.Functions.Length; ++i)
         {
+            string fn = Layout.Functions[i];
+            // sph_mpi.h (libsph_mpi, loaded instead of libsph) is bound in Python only (sph.mpi,
+            // with mpi4py's communicators); C# has its declarations but no wrapper yet.
+            if (Layout.FunctionLibraries[i] == "sph_mpi") continue;
             bool used = wrapper.Contains("Native." + fn + "(") ||
                         (fn.EndsWith("_init_sized") && generated.Contains("SphException.Check(Native." + fn + "(")) ||
                         (fn.EndsWith("_destroy") && generated.Contains("Native." + fn + "(handle)")) ||

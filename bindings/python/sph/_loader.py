@@ -25,6 +25,11 @@ _PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
 _LOCAL_NAMES = {"win32": ["sph.dll"], "darwin": ["libsph.0.dylib", "libsph.dylib"]}.get(
     sys.platform, ["libsph.so.0", "libsph.so"])
 
+#: Libraries that hold the whole of sph_c.h and more, loaded as the core library in place of
+#: libsph (SPH_LIBRARY=.../libsph_mpi.so), never beside it: each keeps its own registry of
+#: worlds. Their own functions are bound on the core library when it exports them (sph.mpi).
+CORE_VARIANTS = ("sph_mpi",)
+
 _lock = threading.Lock()
 _library = None
 _library_path = None
@@ -105,6 +110,11 @@ def load(path=None):
         raise SphLoadError(f"{path} does not export {', '.join(missing)}: it is older than the header these "
                            f"bindings were generated from (sph {'.'.join(map(str, _g.VERSION))})")
     check_integer_arguments(lib)
+    for variant in CORE_VARIANTS:
+        own = [name for name, entry in _g.FUNCTIONS.items() if entry[4] == variant]
+        if own and all(hasattr(lib, name) for name in own):
+            _g.bind(lib, variant)
+            check_integer_arguments(lib, variant)
     check_layouts()
     lib._sph_path = path
     return lib

@@ -46,6 +46,8 @@ _loader._library = _CountingLibrary(_loader.library())
 #: Optional helper libraries (libsph_vdb) this run can load; their functions are counted too.
 HELPERS = []
 for _name in sph.raw.LIBRARIES[1:]:
+    if _name in _loader.CORE_VARIANTS:  # libsph_mpi: the core library itself under mpirun (tests/mpi)
+        continue
     try:
         _loader._helpers[_name] = _CountingLibrary(_loader.helper_library(_name))
         HELPERS.append(_name)

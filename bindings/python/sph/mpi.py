@@ -1,0 +1,159 @@
+# SPDX-License-Identifier: MIT
+"""Distributed worlds (include/sph_mpi.h) with mpi4py: one world spread over the ranks of an
+MPI communicator (docs/distributed.md).
+
+The package must load libsph_mpi, which holds the whole of sph_c.h as well, instead of libsph
+(never both: each keeps its own registry of worlds)::
+
+    SPH_LIBRARY=build/libsph_mpi.so mpirun -np 2 python3 script.py
+
+    from mpi4py import MPI          # initialises MPI (MPI_Init) before any world is made
+    import sph, sph.mpi
+
+    comm = MPI.COMM_WORLD
+    with sph.Context("cpu") as ctx:
+        world = sph.mpi.DistributedWorld(ctx, comm, particle_spacing=0.02)
+        world.add_particles(xyz if comm.rank == 0 else None)   # (n, 3); ids in rank order
+        for _ in range(10):
+            world.step(1 / 60)
+        merged = world.gather()     # on rank 0: positions, velocities, ids of every rank, by id
+        world.close()               # collective, before MPI_Finalize (mpi4py's, at exit)
+
+The communicator crosses as its Fortran handle (``comm.py2f()``, an MPI_Fint), so the library
+needs nothing of mpi4py but that MPI is initialised; a plain int handle is taken as well.
+Calls marked COLLECTIVE must be made by every rank, in the same order, with the same scalar
+arguments. The rest of World's methods (colliders, sinks, force fields, copy_attribute, stats)
+work per rank: positions() and ids() read this rank's own particles.
+
+Each function of sph_mpi.h is one method below, named after it. A function added to the header
+gets its method here, its call in tests/mpi/python/test_mpi_world.py, and is then covered: the
+package-wide check (bindings/python/tests/test_zz_coverage.py) wants a wrapper for every
+generated function, and the mpirun test wants every sph_mpi_* function called.
+"""
+import ctypes
+
+import numpy as np
+
+from . import _generated as _g
+from ._core import World, _float_ptr, _vec3_rows
+from ._errors import SphLoadError, check
+from ._loader import library
+
+__all__ = ["DistributedWorld", "comm_handle", "library_has_mpi"]
+
+
+def library_has_mpi():
+    """True when the package's library is libsph_mpi (it exports sph_mpi.h's functions)."""
+    return hasattr(library(), "sph_mpi_world_create")
+
+
+def _mpi_library():
+    lib = library()
+    if not hasattr(lib, "sph_mpi_world_create"):
+        raise SphLoadError("distributed worlds need libsph_mpi as the package's library: set SPH_LIBRARY to the "
+                           "full path of libsph_mpi.so (built where CMake finds MPI: SPH_WITH_MPI), not libsph.so")
+    return lib
+
+
+def comm_handle(comm):
+    """The Fortran handle (MPI_Fint) of an mpi4py communicator (comm.py2f()), or an int as it is."""
+    if isinstance(comm, (int, np.integer)):
+        return int(comm)
+    try:
+        return int(comm.py2f())
+    except AttributeError:
+        raise TypeError(f"comm: expected an mpi4py communicator or its Fortran handle (int), got "
+                        f"{type(comm).__name__}") from None
+
+
+class DistributedWorld(World):
+    """This rank's part of a world spread over ``comm``'s ranks (sph_mpi_world_create;
+    COLLECTIVE). ``definition`` and keyword fields as World's (a WorldDef, the same on every
+    rank); ``rebalance_threshold_percent`` (1-10000, default 20) is the sph_mpi_world_def field.
+    The context must be a CPU context. close() (sph_world_destroy) is collective here: close
+    every rank's world, before MPI is finalised.
+    """
+
+    def __init__(self, context, comm, definition=None, *, rebalance_threshold_percent=None, **fields):
+        lib = _mpi_library()
+        d = definition.copy() if definition is not None else _g.WorldDef()
+        for name, value in fields.items():
+            setattr(d, name, value)
+        md = _g.MpiWorldDef()
+        if rebalance_threshold_percent is not None:
+            md.rebalance_threshold_percent = rebalance_threshold_percent
+        out = ctypes.POINTER(_g.sph_world)()
+        check(lib.sph_mpi_world_create(context.handle, ctypes.byref(d), comm_handle(comm), ctypes.byref(md),
+                                       ctypes.byref(out)), "sph_mpi_world_create")
+        self._ptr = out
+        self.context = context
+        self.comm = comm
+        context._children.add(self)
+
+    def add_particles(self, positions=None, velocities=None):
+        """COLLECTIVE. Adds this rank's particles ((n, 3) arrays; None or n = 0 adds none here)
+        (sph_mpi_world_add_particles). Ids are numbered across the ranks in rank order; each
+        particle moves to the rank of its slab in the next step. All-or-nothing over the ranks.
+        Returns this rank's first id."""
+        pos = _vec3_rows(np.zeros((0, 3), np.float32) if positions is None else positions, "positions")
+        vel = None
+        if velocities is not None:
+            vel = np.ascontiguousarray(_vec3_rows(velocities, "velocities"))
+            if vel.shape[0] != pos.shape[0]:
+                raise ValueError(f"velocities: {vel.shape[0]} rows for {pos.shape[0]} positions")
+        pos = np.ascontiguousarray(pos)  # the call takes packed triples, without a stride
+        first = ctypes.c_uint32()
+        check(_mpi_library().sph_mpi_world_add_particles(self.handle, _float_ptr(pos),
+                                                         None if vel is None else _float_ptr(vel), pos.shape[0],
+                                                         ctypes.byref(first)), "sph_mpi_world_add_particles")
+        return first.value
+
+    def step(self, frame_dt):
+        """COLLECTIVE. Advances every rank's part by frame_dt (sph_mpi_world_step); as World.step."""
+        return check(_mpi_library().sph_mpi_world_step(self.handle, float(frame_dt)), "sph_mpi_world_step")
+
+    def counts(self):
+        """COLLECTIVE. This rank's and the world's counts (sph_mpi_world_get_counts): an
+        MpiCounts (rank, rank_count, local_count, global_count, ghosts, migrated, rebalances,
+        the slab's axis and cell layers)."""
+        c = _g.MpiCounts()
+        check(_mpi_library().sph_mpi_world_get_counts(self.handle, ctypes.byref(c)), "sph_mpi_world_get_counts")
+        return c
+
+    @property
+    def global_count(self):
+        """COLLECTIVE. Particles of the whole world."""
+        return self.counts().global_count
+
+    def gather(self, root=0, positions=True, velocities=True, ids=True):
+        """COLLECTIVE. Every rank's particles on ``root``, ordered by id (sph_mpi_world_gather).
+
+        On root: a dict with "positions" and "velocities" ((n, 3) float32) and "ids" ((n,)
+        uint32), each only if asked for. Elsewhere: None.
+        """
+        lib = _mpi_library()
+        c = self.counts()
+        rank = c.rank
+        n = c.global_count if rank == root else 0
+        arrays = {}
+        if rank == root:
+            if positions:
+                arrays["positions"] = np.empty((n, 3), np.float32)
+            if velocities:
+                arrays["velocities"] = np.empty((n, 3), np.float32)
+            if ids:
+                arrays["ids"] = np.empty(n, np.uint32)
+
+        def ptr(name, ctype):
+            return arrays[name].ctypes.data_as(ctypes.POINTER(ctype)) if name in arrays else None
+
+        count = ctypes.c_uint64()
+        check(lib.sph_mpi_world_gather(self.handle, int(root), ptr("positions", ctypes.c_float),
+                                       ptr("velocities", ctypes.c_float), ptr("ids", ctypes.c_uint32), n,
+                                       ctypes.byref(count)), "sph_mpi_world_gather")
+        return arrays if rank == root else None
+
+    def __repr__(self):
+        if self._ptr is None:
+            return "<sph.mpi.DistributedWorld closed>"
+        return f"<sph.mpi.DistributedWorld {self.particle_count} particles on this rank>"

@@ -1,0 +1,136 @@
+# SPDX-License-Identifier: MIT
+"""sph.mpi (bindings/python/sph/mpi.py) on every rank of MPI.COMM_WORLD, against one undivided
+world of the same particles in the same process: docs/distributed.md promises the same bits
+(the CPU backend sums in the same order on any rank count while the neighbour grid covers the
+particles' extent, which the closed tank keeps), so positions and velocities are compared
+exactly. Every test runs on every rank in the same order: the collective calls then match.
+"""
+import numpy as np
+import pytest
+
+import sph
+import sph.mpi
+from sph import _generated as g
+
+from conftest import CALLS
+
+SPACING = 0.02
+FRAMES = 6
+
+
+def tank_scene(ctx, world):
+    """A closed tank, the same on every rank (the scene is replicated)."""
+    tank = ctx.shape("box", half_extents=(0.2, 0.15, 0.07), voxel_size=0.01)
+    world.add_collider(tank, transform=(0.0, 0.15, 0.0), inverted=True)
+    world.set_params(gravity=(0.0, -9.81, 0.0), stiffness=100.0, viscosity=1.0, dt_max=0.002)
+
+
+def test_the_library_is_libsph_mpi():
+    assert sph.mpi.library_has_mpi(), "run with SPH_LIBRARY=.../libsph_mpi.so"
+
+
+def test_a_dam_break_equals_the_undivided_world(ctx, comm):
+    with ctx.world(capacity=4000, particle_spacing=SPACING) as ref:
+        tank_scene(ctx, ref)
+        ref.fill_box((-0.2, 0.0, -0.06), (0.0, 0.14, 0.06), velocity=(0.1, 0.0, 0.0))
+        order = np.argsort(ref.ids())
+        x0, v0 = ref.positions()[order], ref.velocities()[order]
+        world = sph.mpi.DistributedWorld(ctx, comm.py2f(), capacity=4000, particle_spacing=SPACING)
+        try:
+            tank_scene(ctx, world)
+            # Every collective call first, then the checks: a failing assertion on one rank then
+            # cannot leave the others waiting in a collective. Rank 0 adds every particle, so the
+            # ids are the undivided world's.
+            first = world.add_particles(x0 if comm.rank == 0 else None, v0 if comm.rank == 0 else None)
+            steps = []
+            for _ in range(FRAMES):
+                steps.append((ref.step(1 / 50), world.step(1 / 50)))
+            c = world.counts()
+            local_sum = comm.allreduce(world.particle_count)
+            ranks_holding = comm.allreduce(int(world.particle_count > 0))
+            merged = world.gather(root=0)
+            last = comm.size - 1
+            only = world.gather(root=last, velocities=False, ids=False)  # the others pass nothing
+            own = comm.gather((world.ids(), world.positions()), root=0)
+            problems = []
+            if first != (0 if comm.rank == 0 else len(x0)):  # ids in rank order: rank 0 added all
+                problems.append(f"rank {comm.rank}: first id {first}")
+            if any(s != (sph.Result.OK, sph.Result.OK) for s in steps):
+                problems.append(f"rank {comm.rank}: steps returned {steps}")
+            if (c.rank, c.rank_count, c.local_count) != (comm.rank, comm.size, world.particle_count):
+                problems.append(f"rank {comm.rank}: counts {c.rank}, {c.rank_count}, {c.local_count}")
+            if not c.global_count == len(x0) == local_sum:
+                problems.append(f"global count {c.global_count}, ranks' sum {local_sum}, added {len(x0)}")
+            if c.rebalances < 1:  # the first frame always cuts
+                problems.append(f"rebalances {c.rebalances}")
+            if ranks_holding != comm.size:
+                problems.append(f"{ranks_holding} of {comm.size} ranks hold particles")
+            if comm.rank == 0:
+                order = np.argsort(ref.ids())
+                x, v = ref.positions()[order], ref.velocities()[order]
+                moved = float(np.abs(x - x0).max())
+                if moved < 0.5 * SPACING:
+                    problems.append(f"the column moved {moved} m in {FRAMES} frames")
+                if not np.array_equal(merged["ids"], np.arange(len(x0), dtype=np.uint32)):
+                    problems.append("the gather's ids are not 0..n-1")
+                else:
+                    differ = int(np.count_nonzero(np.any(merged["positions"] != x, axis=1) |
+                                                  np.any(merged["velocities"] != v, axis=1)))
+                    if differ:
+                        problems.append(f"{differ} of {len(x)} particles differ from the undivided world on "
+                                        f"{comm.size} ranks")
+                # Each rank's own particles, together, are the world's.
+                ids = np.concatenate([i for i, _ in own])
+                xs = np.concatenate([p for _, p in own])
+                k = np.argsort(ids)
+                if not (np.array_equal(ids[k], merged["ids"]) and np.array_equal(xs[k], merged["positions"])):
+                    problems.append("the ranks' own particles are not the gathered ones")
+            elif merged is not None:
+                problems.append(f"rank {comm.rank} got a gather for root 0")
+            if comm.rank == last and not (set(only) == {"positions"} and only["positions"].shape == (len(x0), 3)):
+                problems.append(f"the gather onto rank {last}: {only}")
+            problems = sum(comm.allgather(problems), [])
+            assert not problems, problems
+        finally:
+            world.close()
+
+
+def test_bad_input_is_refused(ctx, comm):
+    with pytest.raises(TypeError, match="mpi4py communicator"):
+        sph.mpi.DistributedWorld(ctx, object())
+    # Refused features name themselves, on every rank (the same def everywhere).
+    with pytest.raises(sph.SphError, match="(?i)rk4") as e:
+        sph.mpi.DistributedWorld(ctx, comm, integrator=sph.Integrator.RK4)
+    assert e.value.result == sph.Result.ERROR_UNSUPPORTED
+    world = sph.mpi.DistributedWorld(ctx, comm, rebalance_threshold_percent=50, particle_spacing=SPACING)
+    try:
+        with pytest.raises(ValueError, match="velocities"):
+            world.add_particles(np.zeros((2, 3)), np.zeros((3, 3)))
+        # The fills number ids on one rank: refused, pointing at add_particles.
+        with pytest.raises(sph.SphError) as e:
+            world.fill_box((0, 0, 0), (0.1, 0.1, 0.1))
+        assert e.value.result == sph.Result.ERROR_UNSUPPORTED
+        with pytest.raises(sph.SphError) as e:
+            world.gather(root=comm.size)
+        assert e.value.result == sph.Result.ERROR_INVALID_ARGUMENT
+        assert world.global_count == 0
+        empty = world.gather()
+        if comm.rank == 0:
+            assert empty["positions"].shape == (0, 3) and empty["ids"].shape == (0,)
+    finally:
+        world.close()
+
+
+def test_an_undivided_world_is_not_a_distributed_one(ctx):
+    with ctx.world(particle_spacing=SPACING) as plain:
+        with pytest.raises(sph.SphError) as e:
+            sph.mpi.DistributedWorld.counts(plain)
+        assert e.value.result == sph.Result.ERROR_UNSUPPORTED
+
+
+def test_zz_every_sph_mpi_function_was_called():
+    """Runs last (file order): every function of sph_mpi.h went through the package."""
+    expected = {name for name, entry in g.FUNCTIONS.items() if entry[4] == "sph_mpi"}
+    assert expected, "sph_mpi.h is in the generated bindings"
+    missing = sorted(expected - set(CALLS))
+    assert not missing, f"sph_mpi.h functions no test reached through sph.mpi: {missing}"
