@@ -3442,6 +3442,50 @@ namespace Sph
         public static extern Result sph_mpi_world_gather(IntPtr world, int root, IntPtr positions, IntPtr velocities, IntPtr ids, ulong capacity, IntPtr outCount);
 
         /// <summary>
+        /// COLLECTIVE. Saves the world at `path` (the same on every rank): each rank writes its file,
+        /// path + ".rank" + its rank, atomically as sph_world_save_file does, then rank 0 writes the
+        /// manifest at `path`, atomically. Succeeds or fails on every rank. Each file is replaced only
+        /// by a whole new one, but the set is not replaced atomically: after a failed (or killed) save,
+        /// the manifest at `path` may be the previous save's while some rank files are new, and a load
+        /// then refuses the set (their hashes do not match) rather than mixing two saves. Errors:
+        /// INVALID_HANDLE, INVALID_ARGUMENT (NULL or empty path; a file that cannot be written: the
+        /// message says which and why), UNSUPPORTED (not a distributed world), WORLD_LOCKED,
+        /// OUT_OF_HOST_MEMORY; a rank whose own save succeeded returns the failing rank's code.
+        /// </summary>
+        [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_mpi_world_save_file(WorldHandle world, byte[] path);
+        [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_mpi_world_save_file")]
+        public static extern Result sph_mpi_world_save_file(IntPtr world, IntPtr path);
+
+        /// <summary>
+        /// COLLECTIVE. Creates a distributed world over the communicator `comm` (as
+        /// sph_mpi_world_create) from the manifest at `path` and this rank's file named in it. The
+        /// communicator must have the rank count that saved it. The rebalance threshold is the saved
+        /// world's. On any error on any rank, no rank creates a world and *out is untouched. Errors:
+        /// INVALID_HANDLE (context), INVALID_ARGUMENT (NULL path or out; a file that cannot be read; a
+        /// communicator of another rank count than the manifest's, or a bad one), CORRUPT_DATA (a
+        /// damaged manifest or rank file, or a rank file whose size or hash is not the manifest's: the
+        /// message names the file), VERSION_MISMATCH, UNSUPPORTED (a CUDA context), OUT_OF_HOST_MEMORY;
+        /// a rank that found nothing wrong returns the first failing rank's code.
+        /// </summary>
+        [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_mpi_world_load_file(ContextHandle context, int comm, byte[] path, out WorldHandle @out);
+        [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_mpi_world_load_file")]
+        public static extern Result sph_mpi_world_load_file(IntPtr context, int comm, IntPtr path, IntPtr @out);
+
+        /// <summary>
+        /// COLLECTIVE. Replaces the world's whole state with the one saved at `path`, keeping its
+        /// handle and communicator: afterwards it is as a world sph_mpi_world_load_file made from
+        /// `path`. All-or-nothing over the ranks: on any error on any rank, every rank's world is
+        /// unchanged. Errors: as sph_mpi_world_load_file, and INVALID_HANDLE, UNSUPPORTED (not a
+        /// distributed world), WORLD_LOCKED.
+        /// </summary>
+        [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_mpi_world_restore_file(WorldHandle world, byte[] path);
+        [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_mpi_world_restore_file")]
+        public static extern Result sph_mpi_world_restore_file(IntPtr world, IntPtr path);
+
+        /// <summary>
         /// Loads a level-set FloatGrid from a .vdb file into a new SDF asset of `context`: the grid's
         /// active voxels (plus one voxel of margin) become a dense grid whose index_to_local is the
         /// grid's linear index-to-world transform, so the asset's local frame is the file's world
@@ -4571,6 +4615,9 @@ namespace Sph
             "sph_mpi_counts_init_sized",
             "sph_mpi_world_get_counts",
             "sph_mpi_world_gather",
+            "sph_mpi_world_save_file",
+            "sph_mpi_world_load_file",
+            "sph_mpi_world_restore_file",
             "sph_vdb_load_sdf",
             "sph_vdb_get_last_error",
         };
@@ -4698,6 +4745,9 @@ namespace Sph
             "sph",
             "sph",
             "sph",
+            "sph_mpi",
+            "sph_mpi",
+            "sph_mpi",
             "sph_mpi",
             "sph_mpi",
             "sph_mpi",

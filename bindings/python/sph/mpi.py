@@ -35,6 +35,7 @@ import ctypes
 import numpy as np
 
 from . import _generated as _g
+from ._checkpoint import _path_bytes
 from ._core import World, _float_ptr, _vec3_rows
 from ._errors import SphLoadError, check
 from ._loader import library
@@ -152,6 +153,30 @@ class DistributedWorld(World):
                                        ptr("velocities", ctypes.c_float), ptr("ids", ctypes.c_uint32), n,
                                        ctypes.byref(count)), "sph_mpi_world_gather")
         return arrays if rank == root else None
+
+    def save_file(self, path):
+        """COLLECTIVE. Saves the world at ``path`` (the same on every rank): each rank's checkpoint
+        at path + ".rank<r>", then rank 0's manifest at path (sph_mpi_world_save_file). Succeeds
+        or raises on every rank."""
+        check(_mpi_library().sph_mpi_world_save_file(self.handle, _path_bytes(path)), "sph_mpi_world_save_file")
+
+    def restore_file(self, path):
+        """COLLECTIVE. Replaces the world's state with the one saved at ``path``, on the rank count
+        that saved it (sph_mpi_world_restore_file); on an error on any rank, every rank raises and
+        keeps its state."""
+        check(_mpi_library().sph_mpi_world_restore_file(self.handle, _path_bytes(path)),
+              "sph_mpi_world_restore_file")
+
+    @classmethod
+    def load_file(cls, context, comm, path):
+        """COLLECTIVE. A new distributed world over ``comm`` from the save at ``path`` (its rank
+        count; sph_mpi_world_load_file). On an error on any rank, every rank raises."""
+        out = ctypes.POINTER(_g.sph_world)()
+        check(_mpi_library().sph_mpi_world_load_file(context.handle, comm_handle(comm), _path_bytes(path),
+                                                     ctypes.byref(out)), "sph_mpi_world_load_file")
+        world = cls._adopt(context, out)
+        world.comm = comm
+        return world
 
     def __repr__(self):
         if self._ptr is None:

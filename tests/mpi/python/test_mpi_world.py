@@ -121,6 +121,52 @@ def test_bad_input_is_refused(ctx, comm):
         world.close()
 
 
+def test_a_checkpoint_continues_bit_for_bit(ctx, comm, tmp_path_factory):
+    """Saved after 3 frames, 3 more frames from the live world, from the restored one and from a
+    loaded one: the same bits (tests/mpi/test_mpi_checkpoint.c checks the failures too)."""
+    base = comm.bcast(str(tmp_path_factory.mktemp("ck")) if comm.rank == 0 else None, root=0)
+    path = base + "/dam.sphck"
+    with ctx.world(capacity=4000, particle_spacing=SPACING) as ref:
+        ref.fill_box((-0.2, 0.0, -0.06), (0.0, 0.14, 0.06))
+        order = np.argsort(ref.ids())
+        x0 = ref.positions()[order]
+    world = sph.mpi.DistributedWorld(ctx, comm, capacity=4000, particle_spacing=SPACING)
+    loaded = None
+    try:
+        tank_scene(ctx, world)
+        world.add_particles(x0 if comm.rank == 0 else None)
+        for _ in range(3):
+            world.step(1 / 50)
+        world.save_file(path)
+        for _ in range(3):
+            world.step(1 / 50)
+        live = world.gather()
+        world.restore_file(path)
+        for _ in range(3):
+            world.step(1 / 50)
+        restored = world.gather()
+        loaded = sph.mpi.DistributedWorld.load_file(ctx, comm, path)
+        for _ in range(3):
+            loaded.step(1 / 50)
+        again = loaded.gather()
+        problems = []
+        if comm.rank == 0:
+            for name, got in (("restored", restored), ("loaded", again)):
+                if not (np.array_equal(got["positions"], live["positions"]) and
+                        np.array_equal(got["velocities"], live["velocities"])):
+                    problems.append(f"the {name} world differs from the live one on {comm.size} ranks")
+        with pytest.raises(sph.SphError) as e:  # a missing manifest: every rank raises
+            world.restore_file(base + "/missing.sphck")
+        if e.value.result != sph.Result.ERROR_INVALID_ARGUMENT:
+            problems.append(f"rank {comm.rank}: a missing manifest gave {e.value.result}")
+        problems = sum(comm.allgather(problems), [])
+        assert not problems, problems
+    finally:
+        if loaded is not None:
+            loaded.close()
+        world.close()
+
+
 def test_an_undivided_world_is_not_a_distributed_one(ctx):
     with ctx.world(particle_spacing=SPACING) as plain:
         with pytest.raises(sph.SphError) as e:
