@@ -13,9 +13,10 @@
  * COLLECTIVE must be made by every rank of the communicator, in the same order, with the same
  * scalar arguments: sph_mpi_world_create, sph_mpi_world_add_particles, sph_mpi_world_step (and
  * sph_world_step on a distributed world, which is the same call), sph_mpi_world_get_counts,
- * sph_mpi_world_gather. The scene (colliders, force fields, sinks) is replicated: make the same
- * calls of sph_c.h on every rank. The calls of sph_c.h that read particles (copy_attribute,
- * get_stats) read the calling rank's own.
+ * sph_mpi_world_gather. The scene (colliders, force fields, sources, sinks, probes) is replicated:
+ * make the same calls of sph_c.h on every rank. The calls of sph_c.h that read particles
+ * (copy_attribute, get_stats, get_removed_ids) read the calling rank's own; collider loads and
+ * probe readings are the world's, the same on every rank.
  *
  * What works and what is refused (SPH_ERROR_UNSUPPORTED, naming the feature): docs/distributed.md.
  * A distributed world steps the same bits as one undivided world of the same particles (while

@@ -48,6 +48,7 @@ void CpuBackend::dfsph_correct(const FluidConstants& fluid, const DfsphWalls& wa
     columns_.set_velocity(i, vi);
     carried[i] += k[i] * carry_scale;
   });
+  if (ranks_) halo_share_velocities(v);  // the next rate pass reads the ghosts' velocities
 }
 
 float CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls,
@@ -72,8 +73,11 @@ float CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, 
     error[i] = r.error;
   });
   double sum = 0.0;
-  for (uint32_t i = 0; i < count_; ++i) sum += error[i];
-  return count_ > 0 ? static_cast<float>(sum / count_) : 0.0f;
+  for (uint32_t i = 0; i < count_; ++i)
+    if (!ghost(i)) sum += error[i];
+  if (!ranks_) return count_ > 0 ? static_cast<float>(sum / count_) : 0.0f;
+  halo_share_dfsph_step();  // the next velocity update reads the ghosts' k
+  return halo_mean(sum);
 }
 
 CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidConstants& fluid,
@@ -131,12 +135,15 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
   const AccelerationFn non_pressure = simd_.acceleration_without_pressure_for(config_.selection());
   const NeighborColumns columns = columns_.view();
   const Float4* contact = dfsph_contacts_ ? dfsph_contact_.data() : nullptr;
+  const uint32_t* origin = origin_.data();  // null unless distributed
   const float a2max = parallel().reduce(
       count_, 0.0f,
       [&](uint32_t i, float& m) {
         Vec3 a = acceleration(non_pressure, fluid, view, columns, scene, i);
         if (spring) a += xyz(spring[i]);
-        m = std::max(m, length_squared(a));
+        // (a distributed world's halo: its owner's acceleration counts; its v* is replaced by its
+        // owner's after the density solve's first velocity update)
+        if (!(origin && origin[i])) m = std::max(m, length_squared(a));
         Vec3 v = xyz(vel[i]) + a * dt;
         if (contact) v = respect_contact(contact[i], v);
         next_vel[i] = make_float4_record(v, vel[i].w);
