@@ -6,14 +6,19 @@
  * and pressure steps, which cross the halo after each pass, and its convergence test reads the
  * world's mean error, summed over the ranks in rank order. Scenes: the dam break and the stirred
  * column (particles crossing the slab boundaries every few substeps), with the divergence solve
- * (the default) and without it, 12 substeps each (frames of 7 and 5). Checked:
+ * (the default) and without it, and RK4's stirred column, 12 substeps each (frames of 7 and 5).
+ * Checked:
  *   - the gathered particles equal the undivided world's bit for bit: every sum of a pass runs in
- *     the undivided world's order (the halo's sort keys), and the mean error's partial sums are
- *     doubles of at most a few thousand float errors of one sign (each float error has 24
- *     significant bits: the double sums of this size round nowhere, so their order does not
- *     matter; a solve that stopped one iteration apart would move every particle);
- *   - the solves' iteration counts and achieved errors (sph_stats) are the undivided world's, on
- *     every rank. */
+ *     the undivided world's order (the halo's sort keys). The mean error is the one sum whose
+ *     grouping differs (each rank's double partial sum, added in rank order): equal by
+ *     measurement, not by construction (docs/distributed.md says when it could round apart);
+ *     a solve that stopped one iteration apart would move every particle;
+ *   - the solves' iteration counts and achieved mean errors (sph_stats) are the undivided world's,
+ *     and the same on every rank.
+ * The bounds are 100 (density) and 10 (divergence) times tighter than the defaults, so the convergence test
+ * rather than the minimum ends the stirred column's solves (19 density and 12 divergence iterations over the
+ * last 5 substeps). Without the velocities' or the pressure steps' exchange, 1278-1404 of the 1404 particles
+ * differ on 2 ranks. */
 #include "mpi_compare.h"
 
 static void run_scene(sph_context* context, const char* name, float stir, sph_solver solver,
@@ -32,8 +37,8 @@ static void run_scene(sph_context* context, const char* name, float stir, sph_so
     sph_dfsph_params dfsph;
     REQUIRE(sph_dfsph_params_init(&dfsph) == SPH_OK, "dfsph params init");
     if (!divergence_solve) dfsph.flags |= SPH_DFSPH_SKIP_DIVERGENCE_SOLVE;
-    /* Bounds a hundred and ten times tighter than the defaults: the solves iterate well past their
-     * minimum, so the convergence test, not the minimum, ends them. */
+    /* Bounds 100 (density) and 10 (divergence) times tighter than the defaults (the header says
+     * why). */
     dfsph.density_error = 1e-5f;
     dfsph.divergence_error = 0.1f;
     REQUIRE(sph_world_set_dfsph_params(world, &dfsph) == SPH_OK, "dfsph params");
