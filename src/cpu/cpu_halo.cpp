@@ -10,7 +10,9 @@
 //                     (the force pass reads them), again after the normalised density's filter
 //                     and the diffusion, and their colour normals after that pass;
 //   the substep's end ghosts are dropped, the max speed and acceleration (the next step size)
-//                     and the first non-finite particle are reduced over the ranks.
+//                     and the first non-finite particle are reduced over the ranks (RK4: at
+//                     each stage's end, as each stage sorts and gathers anew).
+// DFSPH's per-iteration exchanges, the probes' and the loads' sums: cpu_halo_solvers.cpp.
 // The sort takes particles in key order, so each cell's particles come in the order the
 // undivided world's stable sort gives them: the neighbour sums add in the same order and a
 // distributed world steps the single world's bits (while the grid's table covers the
