@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Sums over the ranks of a distributed world in a fixed order: every rank receives every rank's
 // values and adds them in rank order, so each rank holds the same bits, whatever order the MPI
-// implementation would reduce in (MPI_Allreduce fixes none). For the DFSPH solves' mean error,
-// the colliders' loads and the probes' kernel sums (docs/distributed.md).
+// implementation would reduce in (MPI_Allreduce fixes none). For the colliders' loads
+// (docs/distributed.md).
 #pragma once
 
 #include <string.h>

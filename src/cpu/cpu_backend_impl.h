@@ -241,11 +241,10 @@ class CpuBackend final : public Backend {
   void halo_share_normals();
   // DFSPH (cpu_halo_solvers.cpp): the ghosts' density, factor and neighbour count after the
   // density pass, their velocities v after each velocity update, their pressure steps after each
-  // rate pass; the world's mean of a solve's errors from this rank's sum over its own particles.
+  // rate pass.
   void halo_share_dfsph_density();
   void halo_share_velocities(Float4* v);
   void halo_share_dfsph_step();
-  float halo_mean(double owned_sum) const;
   // Each probe point's sums from the rank whose slab holds it; the colliders' load sums of the
   // frame added over the ranks in rank order.
   void halo_pick_probe_points(const SceneFrame& scene);

@@ -3,9 +3,9 @@
 // factor, the divergence solve on the current velocities, the non-pressure accelerations into
 // v*, the density solve on v*, then positions and colliders. Each solve is a Jacobi iteration of
 // two passes, the velocity update (dfsph_correct) and the new rates and pressures
-// (dfsph_residuals), until its mean error is below its bound or its cap. The mean is summed in
-// storage order in double, so it, the iteration count and every result do not depend on the
-// thread count.
+// (dfsph_residuals), until its mean error is below its bound or its cap. The mean is an exact
+// sum (exact_float_sum.h), so it, the iteration count and every result depend on neither the
+// thread count nor, in a distributed world, the ranks.
 //
 // The neighbour passes run on the processor's SIMD target (cpu_simd_passes.h: the factor pass in
 // sort_and_density, the velocity updates, the rates and the non-pressure accelerations here) and
@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "../core/exact_float_sum.h"
 #include "cpu_backend_impl.h"
 
 namespace sph {
@@ -72,12 +73,17 @@ float CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, 
     k[i] = r.k;
     error[i] = r.error;
   });
-  double sum = 0.0;
+  // Exact, so the mean is the same bits whichever particles a rank holds (exact_float_sum.h).
+  ExactFloatSum sum;
   for (uint32_t i = 0; i < count_; ++i)
-    if (!ghost(i)) sum += error[i];
-  if (!ranks_) return count_ > 0 ? static_cast<float>(sum / count_) : 0.0f;
-  halo_share_dfsph_step();  // the next velocity update reads the ghosts' k
-  return halo_mean(sum);
+    if (!ghost(i)) sum.add(error[i]);
+  int64_t particles = count_;
+  if (ranks_) {
+    halo_share_dfsph_step();  // the next velocity update reads the ghosts' k
+    ranks_->all_sum(sum.terms(), ExactFloatSum::kTerms);
+    particles = halo_world_count_;
+  }
+  return particles > 0 ? static_cast<float>(sum.value() / static_cast<double>(particles)) : 0.0f;
 }
 
 CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidConstants& fluid,

@@ -3,8 +3,8 @@
 //   DFSPH      after its density pass the ghosts take their owners' density, factor and neighbour
 //              count; inside each solve iteration, their velocities after each velocity update
 //              and their pressure steps k after each rate pass (the next pass reads both of its
-//              neighbours); the solve's mean error is summed over the ranks in rank order, so
-//              every rank runs the same iterations;
+//              neighbours); the solve's mean error is an exact sum whose bins are added over
+//              the ranks (cpu_dfsph_solver.cpp): every rank runs the undivided world's iterations;
 //   probes     each sample point is gathered by the rank whose slab holds its cell layer (its
 //              neighbour cells are complete there, in the undivided world's order) and every
 //              rank takes that rank's sums: each rank reads the world's bits;
@@ -68,12 +68,6 @@ void CpuBackend::halo_share_dfsph_step() {
         return Record{id_[i], k[i]};
       },
       [&](uint32_t i, const Record& r) { k[i] = r.k; });
-}
-
-float CpuBackend::halo_mean(double owned_sum) const {
-  ordered_rank_sum(*ranks_, &owned_sum, 1);
-  return halo_world_count_ > 0 ? static_cast<float>(owned_sum / static_cast<double>(halo_world_count_))
-                               : 0.0f;
 }
 
 void CpuBackend::halo_pick_probe_points(const SceneFrame& scene) {

@@ -4,15 +4,14 @@
  * its halo, and the stage's state (rk4_start, rk4_sum) moves with a particle that changes ranks
  * between stages. DFSPH: each solve iteration's neighbour passes read the ghosts' velocities
  * and pressure steps, which cross the halo after each pass, and its convergence test reads the
- * world's mean error, summed over the ranks in rank order. Scenes: the dam break and the stirred
+ * world's mean error, an exact sum over the ranks. Scenes: the dam break and the stirred
  * column (particles crossing the slab boundaries every few substeps), with the divergence solve
  * (the default) and without it, and RK4's stirred column, 12 substeps each (frames of 7 and 5).
  * Checked:
  *   - the gathered particles equal the undivided world's bit for bit: every sum of a pass runs in
- *     the undivided world's order (the halo's sort keys). The mean error is the one sum whose
- *     grouping differs (each rank's double partial sum, added in rank order): equal by
- *     measurement, not by construction (docs/distributed.md says when it could round apart);
- *     a solve that stopped one iteration apart would move every particle;
+ *     the undivided world's order (the halo's sort keys), and the mean error is an exact sum
+ *     (exact_float_sum.h) whose bins the ranks add (a solve that stopped one iteration apart
+ *     would move every particle);
  *   - the solves' iteration counts and achieved mean errors (sph_stats) are the undivided world's,
  *     and the same on every rank.
  * The bounds are 100 (density) and 10 (divergence) times tighter than the defaults, so the convergence test
