@@ -20,6 +20,8 @@
  * differ on 2 ranks. */
 #include "mpi_compare.h"
 
+static uint32_t g_features = SPH_FEATURE_NONE; /* the def's features ("walls": the walls' density) */
+
 static void run_scene(sph_context* context, const char* name, float stir, sph_solver solver,
                       sph_integrator integrator, uint32_t divergence_solve) {
   const sph_vec3 column_min = {0.0f, 0.0f, 0.0f}, column_max = {0.1f, 0.2f, 0.06f};
@@ -31,6 +33,7 @@ static void run_scene(sph_context* context, const char* name, float stir, sph_so
   world_def(&def);
   def.solver = solver;
   def.integrator = integrator;
+  def.features = g_features;
   (void)make_worlds(context, &def, column_min, column_max, stir, &single, &world, &single_tank, &tank);
   if (solver == SPH_SOLVER_DFSPH) {
     sph_dfsph_params dfsph;
@@ -87,6 +90,18 @@ static void run_scene(sph_context* context, const char* name, float stir, sph_so
 int main(int argc, char** argv) {
   sph_context* context = NULL;
   mpi_test_begin(&argc, &argv, &context);
+  if (argc > 1 && strcmp(argv[1], "walls") == 0) {
+    /* scripts/validate (45 s a run on 2 cores, for the walls' boundary maps): the walls' share
+     * of the density (per particle, before the halo's exchanges) with DFSPH, and with RK4 and the
+     * loads' wall reactions. */
+    g_features = SPH_FEATURE_BOUNDARY_DENSITY;
+    run_scene(context, "DFSPH stirred column with walls", 2.0f, SPH_SOLVER_DFSPH,
+              SPH_INTEGRATOR_SYMPLECTIC_EULER, 1);
+    g_features = SPH_FEATURE_BOUNDARY_DENSITY | SPH_FEATURE_COLLIDER_LOADS;
+    run_scene(context, "RK4 stirred column with walls and loads", 2.0f, SPH_SOLVER_WCSPH, SPH_INTEGRATOR_RK4,
+              0);
+    return mpi_test_end(context);
+  }
   run_scene(context, "DFSPH dam break", 0.0f, SPH_SOLVER_DFSPH, SPH_INTEGRATOR_SYMPLECTIC_EULER, 1);
   run_scene(context, "DFSPH stirred column", 2.0f, SPH_SOLVER_DFSPH, SPH_INTEGRATOR_SYMPLECTIC_EULER, 1);
   run_scene(context, "DFSPH stirred column without the divergence solve", 2.0f, SPH_SOLVER_DFSPH,
