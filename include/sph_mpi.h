@@ -127,6 +127,19 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t
                                                  float* velocities, uint32_t* ids, uint64_t capacity,
                                                  uint64_t* out_count);
 
+/**
+ * COLLECTIVE. Gathers the ids every rank's sinks removed in the last step (each rank's
+ * sph_world_get_removed_ids, which holds only its own particles) onto rank `root`, in ascending
+ * order. On root: writes up to `capacity` ids, sets *out_count to the world's number of removed
+ * ids and returns SPH_INCOMPLETE when capacity was too small (call again, collectively, with a
+ * larger array); other ranks may pass NULL ids, capacity 0 and a NULL out_count. Errors:
+ * INVALID_ARGUMENT (root out of range; on root, a NULL out_count, or NULL ids with capacity > 0),
+ * UNSUPPORTED (not a distributed world).
+ */
+SPH_API sph_result SPH_CALL sph_mpi_world_gather_removed_ids(const sph_world* world, int32_t root,
+                                                             uint32_t* ids, uint32_t capacity,
+                                                             uint32_t* out_count);
+
 #ifdef __cplusplus
 }
 #endif

@@ -10,8 +10,9 @@
  *   - the gathered particles are the undivided world's bit for bit, by id, each id once: the
  *     emitted particles got the undivided world's ids;
  *   - where there are several ranks, more than one holds emitted particles;
- *   - the sink: the ranks' removed ids (per rank) together are the undivided world's, and their
- *     SPH_EVENT_SINK_REMOVED counts add up to its count.
+ *   - the sink: the ranks' removed ids (per rank) together are the undivided world's, as
+ *     sph_mpi_world_gather_removed_ids gives them on one rank, and their SPH_EVENT_SINK_REMOVED
+ *     counts add up to its count.
  * Then the capacity limit (run_capacity_limit). */
 #include "mpi_compare.h"
 
@@ -146,6 +147,8 @@ int main(int argc, char** argv) {
     int* sizes = (int*)malloc(sizeof(int) * (size_t)g_size);
     int* offsets = (int*)malloc(sizeof(int) * (size_t)g_size);
     uint32_t* all_ids = NULL;
+    uint32_t* gathered = NULL;
+    uint32_t gathered_n = 0;
     int total = 0;
     char name[64];
     REQUIRE(sizes && offsets, "malloc");
@@ -167,6 +170,25 @@ int main(int argc, char** argv) {
       MPI_Reduce(&mine_events, &events_sum, 1, MPI_UINT32_T, MPI_SUM, 0, MPI_COMM_WORLD);
       mine_events = events_sum;
     }
+    {
+      /* The library's gather: on rank 0 the ids of every rank, ascending; on the last rank, with
+       * no room, the count alone (SPH_INCOMPLETE when there are any). */
+      uint32_t world_removed = mine, on_last = 99;
+      sph_result r;
+      gathered = (uint32_t*)malloc(sizeof(uint32_t) * ((size_t)total + 1));
+      REQUIRE(gathered != NULL, "malloc");
+      r = sph_mpi_world_gather_removed_ids(world, 0, g_rank == 0 ? gathered : NULL,
+                                           g_rank == 0 ? (uint32_t)total : 0u,
+                                           g_rank == 0 ? &gathered_n : NULL);
+      CHECK(r == SPH_OK, "gather removed ids: %d", (int)r);
+      MPI_Allreduce(MPI_IN_PLACE, &world_removed, 1, MPI_UINT32_T, MPI_SUM, MPI_COMM_WORLD);
+      r = sph_mpi_world_gather_removed_ids(world, g_size - 1, NULL, 0, &on_last);
+      CHECK(g_rank != g_size - 1 ||
+                (on_last == world_removed && r == (world_removed > 0 ? SPH_INCOMPLETE : SPH_OK)),
+            "the count alone on the last rank: %u (%d), expected %u", on_last, (int)r, world_removed);
+      CHECK(sph_mpi_world_gather_removed_ids(world, g_size, NULL, 0, &on_last) == SPH_ERROR_INVALID_ARGUMENT,
+            "a root outside the communicator");
+    }
     if (g_rank == 0) {
       uint32_t want_events = 0;
       uint32_t* want_ids;
@@ -176,6 +198,9 @@ int main(int argc, char** argv) {
       qsort(all_ids, (size_t)total, sizeof(uint32_t), compare_ids);
       CHECK((uint32_t)total == want_n && memcmp(all_ids, want_ids, sizeof(uint32_t) * want_n) == 0,
             "frame %d: the ranks removed %d ids, the undivided world %u (or other ids)", f, total, want_n);
+      CHECK(gathered_n == want_n && memcmp(gathered, want_ids, sizeof(uint32_t) * want_n) == 0,
+            "frame %d: sph_mpi_world_gather_removed_ids gave %u ids, the undivided world %u (or other ids)",
+            f, gathered_n, want_n);
       CHECK(mine_events == want_events, "frame %d: sink events count %u, the undivided world %u", f,
             mine_events, want_events);
       removed_total += want_n;
@@ -200,6 +225,7 @@ int main(int argc, char** argv) {
     expect_same_particles(single, world, name);
     free(mine_ids);
     free(all_ids);
+    free(gathered);
     free(sizes);
     free(offsets);
   }
