@@ -711,6 +711,7 @@ sph_result sph_mpi_world_step(sph_world* world, float frame_dt);
 sph_result sph_mpi_counts_init_sized(sph_mpi_counts* counts, uint32_t size);
 sph_result sph_mpi_world_get_counts(const sph_world* world, sph_mpi_counts* out);
 sph_result sph_mpi_world_gather(const sph_world* world, int32_t root, float* positions, float* velocities, uint32_t* ids, uint64_t capacity, uint64_t* out_count);
+sph_result sph_mpi_world_gather_removed_ids(const sph_world* world, int32_t root, uint32_t* ids, uint32_t capacity, uint32_t* out_count);
 // libsph_vdb
 sph_result sph_vdb_load_sdf(sph_context* context, const char* path, const char* grid_name, sph_sdf** out);
 const char* sph_vdb_get_last_error(void);

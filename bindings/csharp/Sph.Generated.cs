@@ -3442,6 +3442,20 @@ namespace Sph
         public static extern Result sph_mpi_world_gather(IntPtr world, int root, IntPtr positions, IntPtr velocities, IntPtr ids, ulong capacity, IntPtr outCount);
 
         /// <summary>
+        /// COLLECTIVE. Gathers the ids every rank's sinks removed in the last step (each rank's
+        /// sph_world_get_removed_ids, which holds only its own particles) onto rank `root`, in
+        /// ascending order. On root: writes up to `capacity` ids, sets *out_count to the world's number
+        /// of removed ids and returns SPH_INCOMPLETE when capacity was too small (call again,
+        /// collectively, with a larger array); other ranks may pass NULL ids, capacity 0 and a NULL
+        /// out_count. Errors: INVALID_ARGUMENT (root out of range; on root, a NULL out_count, or NULL
+        /// ids with capacity &gt; 0), UNSUPPORTED (not a distributed world).
+        /// </summary>
+        [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_mpi_world_gather_removed_ids(WorldHandle world, int root, [In, Out] uint[] ids, uint capacity, out uint outCount);
+        [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_mpi_world_gather_removed_ids")]
+        public static extern Result sph_mpi_world_gather_removed_ids(IntPtr world, int root, IntPtr ids, uint capacity, IntPtr outCount);
+
+        /// <summary>
         /// Loads a level-set FloatGrid from a .vdb file into a new SDF asset of `context`: the grid's
         /// active voxels (plus one voxel of margin) become a dense grid whose index_to_local is the
         /// grid's linear index-to-world transform, so the asset's local frame is the file's world
@@ -4571,6 +4585,7 @@ namespace Sph
             "sph_mpi_counts_init_sized",
             "sph_mpi_world_get_counts",
             "sph_mpi_world_gather",
+            "sph_mpi_world_gather_removed_ids",
             "sph_vdb_load_sdf",
             "sph_vdb_get_last_error",
         };
@@ -4698,6 +4713,7 @@ namespace Sph
             "sph",
             "sph",
             "sph",
+            "sph_mpi",
             "sph_mpi",
             "sph_mpi",
             "sph_mpi",
