@@ -13,10 +13,11 @@
  * COLLECTIVE must be made by every rank of the communicator, in the same order, with the same
  * scalar arguments: sph_mpi_world_create, sph_mpi_world_add_particles, sph_mpi_world_step (and
  * sph_world_step on a distributed world, which is the same call), sph_mpi_world_get_counts,
- * sph_mpi_world_gather, sph_mpi_world_save_file, sph_mpi_world_load_file,
- * sph_mpi_world_restore_file. The scene (colliders, force fields, sinks) is replicated: make the same
- * calls of sph_c.h on every rank. The calls of sph_c.h that read particles (copy_attribute,
- * get_stats) read the calling rank's own.
+ * sph_mpi_world_gather, sph_mpi_world_gather_removed_ids, sph_mpi_world_save_file,
+ * sph_mpi_world_load_file, sph_mpi_world_restore_file. The scene (colliders, force fields,
+ * sources, sinks, probes) is replicated: make the same calls of sph_c.h on every rank. The calls
+ * of sph_c.h that read particles (copy_attribute, get_stats, get_removed_ids) read the calling
+ * rank's own; collider loads and probe readings are the world's, the same on every rank.
  *
  * What works and what is refused (SPH_ERROR_UNSUPPORTED, naming the feature): docs/distributed.md.
  * A distributed world steps the same bits as one undivided world of the same particles (while
@@ -128,6 +129,19 @@ SPH_API sph_result SPH_CALL sph_mpi_world_get_counts(const sph_world* world, sph
 SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t root, float* positions,
                                                  float* velocities, uint32_t* ids, uint64_t capacity,
                                                  uint64_t* out_count);
+
+/**
+ * COLLECTIVE. Gathers the ids every rank's sinks removed in the last step (each rank's
+ * sph_world_get_removed_ids, which holds only its own particles) onto rank `root`, in ascending
+ * order. On root: writes up to `capacity` ids, sets *out_count to the world's number of removed
+ * ids and returns SPH_INCOMPLETE when capacity was too small (call again, collectively, with a
+ * larger array); other ranks may pass NULL ids, capacity 0 and a NULL out_count. Errors:
+ * INVALID_ARGUMENT (root out of range; on root, a NULL out_count, or NULL ids with capacity > 0),
+ * UNSUPPORTED (not a distributed world).
+ */
+SPH_API sph_result SPH_CALL sph_mpi_world_gather_removed_ids(const sph_world* world, int32_t root,
+                                                             uint32_t* ids, uint32_t capacity,
+                                                             uint32_t* out_count);
 
 /* ---- checkpoints ---------------------------------------------------------------------------
  * A distributed world saves as one checkpoint file per rank (sph_c.h's format, marked as one

@@ -711,6 +711,7 @@ sph_result sph_mpi_world_step(sph_world* world, float frame_dt);
 sph_result sph_mpi_counts_init_sized(sph_mpi_counts* counts, uint32_t size);
 sph_result sph_mpi_world_get_counts(const sph_world* world, sph_mpi_counts* out);
 sph_result sph_mpi_world_gather(const sph_world* world, int32_t root, float* positions, float* velocities, uint32_t* ids, uint64_t capacity, uint64_t* out_count);
+sph_result sph_mpi_world_gather_removed_ids(const sph_world* world, int32_t root, uint32_t* ids, uint32_t capacity, uint32_t* out_count);
 sph_result sph_mpi_world_save_file(const sph_world* world, const char* path);
 sph_result sph_mpi_world_load_file(sph_context* context, int32_t comm, const char* path, sph_world** out);
 sph_result sph_mpi_world_restore_file(sph_world* world, const char* path);

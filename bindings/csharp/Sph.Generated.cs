@@ -3442,6 +3442,20 @@ namespace Sph
         public static extern Result sph_mpi_world_gather(IntPtr world, int root, IntPtr positions, IntPtr velocities, IntPtr ids, ulong capacity, IntPtr outCount);
 
         /// <summary>
+        /// COLLECTIVE. Gathers the ids every rank's sinks removed in the last step (each rank's
+        /// sph_world_get_removed_ids, which holds only its own particles) onto rank `root`, in
+        /// ascending order. On root: writes up to `capacity` ids, sets *out_count to the world's number
+        /// of removed ids and returns SPH_INCOMPLETE when capacity was too small (call again,
+        /// collectively, with a larger array); other ranks may pass NULL ids, capacity 0 and a NULL
+        /// out_count. Errors: INVALID_ARGUMENT (root out of range; on root, a NULL out_count, or NULL
+        /// ids with capacity &gt; 0), UNSUPPORTED (not a distributed world).
+        /// </summary>
+        [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_mpi_world_gather_removed_ids(WorldHandle world, int root, [In, Out] uint[] ids, uint capacity, out uint outCount);
+        [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_mpi_world_gather_removed_ids")]
+        public static extern Result sph_mpi_world_gather_removed_ids(IntPtr world, int root, IntPtr ids, uint capacity, IntPtr outCount);
+
+        /// <summary>
         /// COLLECTIVE. Saves the world at `path` (the same on every rank): each rank writes its file,
         /// path + ".rank" + its rank, atomically as sph_world_save_file does, then rank 0 writes the
         /// manifest at `path`, atomically. Succeeds or fails on every rank. Each file is replaced only
@@ -4615,6 +4629,7 @@ namespace Sph
             "sph_mpi_counts_init_sized",
             "sph_mpi_world_get_counts",
             "sph_mpi_world_gather",
+            "sph_mpi_world_gather_removed_ids",
             "sph_mpi_world_save_file",
             "sph_mpi_world_load_file",
             "sph_mpi_world_restore_file",
@@ -4745,6 +4760,7 @@ namespace Sph
             "sph",
             "sph",
             "sph",
+            "sph_mpi",
             "sph_mpi",
             "sph_mpi",
             "sph_mpi",

@@ -109,6 +109,7 @@ uint32_t World::spawn(const HostVector<Vec3>& positions, const HostVector<Vec3>*
 void World::emit_sources(double frame_dt) {
   HostVector<Vec3> existing;
   bool have_existing = false;
+  const bool distributed = backend_->distributed();
   sources_.for_each([&](uint64_t id, Source& s) {
     if (s.mode == SourceMode::FillOnce && s.done) return;
     if (!have_existing) {
@@ -120,7 +121,8 @@ void World::emit_sources(double frame_dt) {
     const SdfGridView region = s.region->host_view();
     HostVector<Vec3> points(s.lattice.size());
     for (size_t i = 0; i < points.size(); ++i) points[i] = to_world(s.pose, s.lattice[i]);
-    const HostVector<char> keep = clear_of_points(existing, points, s.min_distance);
+    HostVector<char> keep = clear_of_points(existing, points, s.min_distance);
+    if (distributed) agree_clear_points(keep);
     HostVector<Vec3> accepted, velocities;
     for (size_t i = 0; i < points.size(); ++i) {
       if (!keep[i]) continue;
@@ -134,15 +136,21 @@ void World::emit_sources(double frame_dt) {
       s.rate_budget += static_cast<double>(s.rate) * frame_dt;
       allowed = std::min(allowed, static_cast<size_t>(s.rate_budget));
     }
-    const size_t fits = std::min<size_t>(allowed, room());
+    HostVector<char> mine;
+    if (distributed) mine = points_of_this_rank(accepted);
+    const size_t fits = distributed ? rank_emission_fits(mine, allowed) : std::min<size_t>(allowed, room());
     if (fits < allowed)
       events_.push_back(Event{EventType::SourceCapacityReached, id, static_cast<uint32_t>(allowed - fits)});
-    if (reserve_particles(static_cast<uint64_t>(particle_count()) + fits))
-      events_.push_back(Event{EventType::CapacityGrown, id, config_.capacity});
     accepted.resize(fits);
     velocities.resize(fits);
+    mine.resize(distributed ? fits : 0);
+    const size_t kept = distributed ? static_cast<size_t>(std::count(mine.begin(), mine.end(), 1)) : fits;
+    if (reserve_particles(static_cast<uint64_t>(particle_count()) + kept))
+      events_.push_back(Event{EventType::CapacityGrown, id, config_.capacity});
     if (s.mode == SourceMode::Continuous && s.rate > 0.0f) s.rate_budget -= static_cast<double>(fits);
-    if (!accepted.empty()) {
+    if (distributed) {
+      emit_on_ranks(accepted, velocities, mine, s.user_attribute, existing);
+    } else if (!accepted.empty()) {
       spawn(accepted, &velocities, s.user_attribute);
       existing.insert(existing.end(), accepted.begin(), accepted.end());
     }

@@ -201,6 +201,15 @@ class World {
   // adds them at one velocity.
   uint32_t fill(const HostVector<Vec3>& points, const Vec3& velocity, const char* region_fields);
   void emit_sources(double frame_dt);
+  // A distributed world's emission (world_rank_sources.cpp), the same decision on every rank:
+  // keep[i] stays set where no rank's particle is too close; which points lie in this rank's
+  // slab; how many accepted points fit on every rank; then this rank's points appended with the
+  // world's ids (next_id_ grows by all of them) and added to `existing`.
+  void agree_clear_points(HostVector<char>& keep) const;
+  HostVector<char> points_of_this_rank(const HostVector<Vec3>& points) const;
+  size_t rank_emission_fits(const HostVector<char>& mine, size_t allowed) const;
+  void emit_on_ranks(const HostVector<Vec3>& points, const HostVector<Vec3>& velocities,
+                     const HostVector<char>& mine, uint32_t user_attribute, HostVector<Vec3>& existing);
   SceneFrame build_scene_frame(double frame_dt) const;
   void add_probe_frames(SceneFrame& scene) const;
   void store_probe_readings(const FrameReport& report);

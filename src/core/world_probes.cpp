@@ -36,10 +36,6 @@ Vec3 gauge_axis(const Probe& p, const Vec3& gravity) {
 }  // namespace
 
 uint64_t World::add_probe(const ProbeSpec& spec) {
-  if (backend_->distributed())
-    throw Error(Status::Unsupported,
-                "world: probes and gauges do not work in a distributed world yet (samples summed over ranks; "
-                "docs/distributed.md)");
   if (config_.solver == Solver::Dfsph)
     throw Error(Status::Unsupported,
                 "world: probes sample the weakly compressible solver's density pass; a DFSPH world has "

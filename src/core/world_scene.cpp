@@ -37,10 +37,6 @@ uint64_t World::add_collider(const ColliderSpec& spec) {
 }
 
 uint64_t World::add_source(const SourceSpec& spec) {
-  if (backend_->distributed())
-    throw Error(Status::Unsupported,
-                "world: sources do not work in a distributed world yet (emission across ranks; "
-                "docs/distributed.md)");
   Source s = make_source(spec, config_);
   s.lattice = lattice_inside(*s.region, s.spacing, kMaxSourceLatticePoints);
   require_room(sources_, "sources");

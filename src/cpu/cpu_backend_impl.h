@@ -243,6 +243,16 @@ class CpuBackend final : public Backend {
   // colour-field pass (surface tension), their normals.
   void halo_share_density();
   void halo_share_normals();
+  // DFSPH (cpu_halo_solvers.cpp): the ghosts' density, factor and neighbour count after the
+  // density pass, their velocities v after each velocity update, their pressure steps after each
+  // rate pass.
+  void halo_share_dfsph_density();
+  void halo_share_velocities(Float4* v);
+  void halo_share_dfsph_step();
+  // Each probe point's sums from the rank whose slab holds it; the colliders' load sums of the
+  // frame added over the ranks in rank order.
+  void halo_pick_probe_points(const SceneFrame& scene);
+  void halo_sum_loads();
   template <class Record, class Make, class Apply>
   void halo_share(const char* what, Make&& make, Apply&& apply);
   // The substep's end: ghosts dropped, the step size's inputs and any failure agreed by all
@@ -258,6 +268,8 @@ class CpuBackend final : public Backend {
   // Appends particle i's carried arrays to `out` / appends the records of `in` as particles
   // whose origin_ is `origin`; returns how many.
   void halo_pack(uint32_t i, RankBytes& out) const;
+  // Whether an array moves with its particle: the carried ones, and RK4's stage state.
+  static bool halo_travels(const ParticleArraySpec& spec);
   uint32_t halo_unpack(const RankBytes& in, uint32_t origin);
   // Keeps the particles keep_order_ lists (ascending), in that order.
   void halo_keep(size_t kept);
@@ -272,6 +284,7 @@ class CpuBackend final : public Backend {
   DistributedCounters halo_counters_;
   GridShape halo_shape_{};
   HostVector<uint32_t> halo_visit_;
+  int64_t halo_world_count_ = 0;    // the particles every rank owns, this substep
   CpuArrayRef<uint64_t> sort_key_;  // Carried
   CpuArrayRef<uint32_t> origin_;    // Sorted: 0 owned, else 1 + the rank the ghost came from
 

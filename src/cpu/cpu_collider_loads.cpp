@@ -40,6 +40,7 @@ void CpuBackend::collide_with_loads(const FluidConstants& fluid, const SceneFram
   Float4* next_vel = next_velocity_.data();
   const Vec3* points = load_points_.data();
   LoadImpulse* partial = load_blocks_.data();
+  const uint32_t* origin = origin_.data();  // null unless distributed
   // Blocks go out dynamically like every loop's particles (kParticleChunk); their sums are kept
   // per block and added in block order below, so the split changes no bit.
   constexpr size_t kBlocksPerChunk = kParticleChunk / kLoadBlock;
@@ -48,6 +49,7 @@ void CpuBackend::collide_with_loads(const FluidConstants& fluid, const SceneFram
       LoadImpulse* sums = partial + static_cast<size_t>(b) * colliders;
       const uint32_t end = std::min(count_, (static_cast<uint32_t>(b) + 1) * kLoadBlock);
       for (uint32_t i = static_cast<uint32_t>(b) * kLoadBlock; i < end; ++i) {
+        if (origin && origin[i]) continue;  // (a distributed world's halo: its owner's load)
         if (walls) {
           const Vec3 x = xyz(pos[i]);
           const float coefficient_dt = pos[i].w * vel[i].w * vel[i].w * wall_seconds;

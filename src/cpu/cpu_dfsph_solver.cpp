@@ -3,9 +3,9 @@
 // factor, the divergence solve on the current velocities, the non-pressure accelerations into
 // v*, the density solve on v*, then positions and colliders. Each solve is a Jacobi iteration of
 // two passes, the velocity update (dfsph_correct) and the new rates and pressures
-// (dfsph_residuals), until its mean error is below its bound or its cap. The mean is summed in
-// storage order in double, so it, the iteration count and every result do not depend on the
-// thread count.
+// (dfsph_residuals), until its mean error is below its bound or its cap. The mean is an exact
+// sum (exact_float_sum.h), so it, the iteration count and every result depend on neither the
+// thread count nor, in a distributed world, the ranks.
 //
 // The neighbour passes run on the processor's SIMD target (cpu_simd_passes.h: the factor pass in
 // sort_and_density, the velocity updates, the rates and the non-pressure accelerations here) and
@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "../core/exact_float_sum.h"
 #include "cpu_backend_impl.h"
 
 namespace sph {
@@ -48,6 +49,7 @@ void CpuBackend::dfsph_correct(const FluidConstants& fluid, const DfsphWalls& wa
     columns_.set_velocity(i, vi);
     carried[i] += k[i] * carry_scale;
   });
+  if (ranks_) halo_share_velocities(v);  // the next rate pass reads the ghosts' velocities
 }
 
 float CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls,
@@ -71,9 +73,17 @@ float CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, 
     k[i] = r.k;
     error[i] = r.error;
   });
-  double sum = 0.0;
-  for (uint32_t i = 0; i < count_; ++i) sum += error[i];
-  return count_ > 0 ? static_cast<float>(sum / count_) : 0.0f;
+  // Exact, so the mean is the same bits whichever particles a rank holds (exact_float_sum.h).
+  ExactFloatSum sum;
+  for (uint32_t i = 0; i < count_; ++i)
+    if (!ghost(i)) sum.add(error[i]);
+  int64_t particles = count_;
+  if (ranks_) {
+    halo_share_dfsph_step();  // the next velocity update reads the ghosts' k
+    ranks_->all_sum(sum.terms(), ExactFloatSum::kTerms);
+    particles = halo_world_count_;
+  }
+  return particles > 0 ? static_cast<float>(sum.value() / static_cast<double>(particles)) : 0.0f;
 }
 
 CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidConstants& fluid,
@@ -131,12 +141,15 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
   const AccelerationFn non_pressure = simd_.acceleration_without_pressure_for(config_.selection());
   const NeighborColumns columns = columns_.view();
   const Float4* contact = dfsph_contacts_ ? dfsph_contact_.data() : nullptr;
+  const uint32_t* origin = origin_.data();  // null unless distributed
   const float a2max = parallel().reduce(
       count_, 0.0f,
       [&](uint32_t i, float& m) {
         Vec3 a = acceleration(non_pressure, fluid, view, columns, scene, i);
         if (spring) a += xyz(spring[i]);
-        m = std::max(m, length_squared(a));
+        // (a distributed world's halo: its owner's acceleration counts; its v* is replaced by its
+        // owner's after the density solve's first velocity update)
+        if (!(origin && origin[i])) m = std::max(m, length_squared(a));
         Vec3 v = xyz(vel[i]) + a * dt;
         if (contact) v = respect_contact(contact[i], v);
         next_vel[i] = make_float4_record(v, vel[i].w);

@@ -95,6 +95,7 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
     throw;
   }
   report_clock(clock, report);
+  if (ranks_ && !load_sums_.empty()) halo_sum_loads();  // every rank reads the world's loads
   report.pressure_solve = finish_solve(tallies.pressure);
   report.divergence_solve = finish_solve(tallies.divergence);
   report.max_speed = max_speed_;

@@ -10,7 +10,9 @@
 //                     (the force pass reads them), again after the normalised density's filter
 //                     and the diffusion, and their colour normals after that pass;
 //   the substep's end ghosts are dropped, the max speed and acceleration (the next step size)
-//                     and the first non-finite particle are reduced over the ranks.
+//                     and the first non-finite particle are reduced over the ranks (RK4: at
+//                     each stage's end, as each stage sorts and gathers anew).
+// DFSPH's per-iteration exchanges, the probes' and the loads' sums: cpu_halo_solvers.cpp.
 // Each place where the ranks meet after code that can fail (an allocation, a crowded cell) is
 // an agreement (core/rank_agreement.h): a rank that failed joins the others' next one from its
 // catch block (rethrow_step_failure), and every rank returns the error instead of waiting.
@@ -25,7 +27,7 @@
 
 #include "../core/grid_layout.h"
 #include "../core/rank_agreement.h"
-#include "cpu_backend_impl.h"
+#include "cpu_halo_share.h"
 
 namespace sph {
 
@@ -45,14 +47,10 @@ void CpuBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks, const 
   if (!ranks) throw Error(Status::Internal, "attach_ranks: no transport");
   if (count_ != 0 || ranks_)
     throw Error(Status::Internal, "attach_ranks: the backend already holds particles");
-  if (config_.solver == Solver::Dfsph)
-    refuse("the DFSPH solver (SPH_SOLVER_DFSPH: its pressure solves need a halo per iteration)");
-  if (config_.integrator == Integrator::Rk4) refuse("the RK4 integrator (SPH_INTEGRATOR_RK4)");
   const struct {
     uint32_t bit;
     const char* name;
-  } features[] = {{kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks)"},
-                  {kFeatureColliderLoads, "SPH_FEATURE_COLLIDER_LOADS (loads summed over ranks)"}};
+  } features[] = {{kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks)"}};
   for (const auto& f : features)
     if (config_.features & f.bit) refuse(f.name);
   const auto array = [](const char* name, uint32_t size, ParticleArrayRole role) {
@@ -95,9 +93,16 @@ int32_t CpuBackend::halo_layer(uint32_t i) const {
   return cell_coordinate(axis == 0 ? p.x : (axis == 1 ? p.y : p.z), 1.0f / config_.kernel_radius);
 }
 
+bool CpuBackend::halo_travels(const ParticleArraySpec& spec) {
+  if (spec.elements_per_particle == 0) return false;
+  // RK4's stage state lives through a substep, and a particle may change ranks between its stages.
+  return spec.role == ParticleArrayRole::Carried || std::strcmp(spec.name, kArrayRk4Start) == 0 ||
+         std::strcmp(spec.name, kArrayRk4Sum) == 0;
+}
+
 void CpuBackend::halo_pack(uint32_t i, RankBytes& out) const {
   for (const auto& a : store_.arrays()) {
-    if (a->spec.role != ParticleArrayRole::Carried || a->spec.elements_per_particle == 0) continue;
+    if (!halo_travels(a->spec)) continue;
     const size_t bytes = particle_bytes(a->spec);
     const unsigned char* from = a->bytes.data() + i * bytes;
     out.insert(out.end(), from, from + bytes);
@@ -107,8 +112,7 @@ void CpuBackend::halo_pack(uint32_t i, RankBytes& out) const {
 uint32_t CpuBackend::halo_unpack(const RankBytes& in, uint32_t origin) {
   size_t record = 0;
   for (const auto& a : store_.arrays())
-    if (a->spec.role == ParticleArrayRole::Carried && a->spec.elements_per_particle != 0)
-      record += particle_bytes(a->spec);
+    if (halo_travels(a->spec)) record += particle_bytes(a->spec);
   if (in.size() % record != 0) throw Error(Status::Internal, "halo: a rank sent a partial particle record");
   const uint32_t n = static_cast<uint32_t>(in.size() / record);
   if (n == 0) return 0;
@@ -117,7 +121,7 @@ uint32_t CpuBackend::halo_unpack(const RankBytes& in, uint32_t origin) {
   const unsigned char* from = in.data();
   for (uint32_t k = 0; k < n; ++k)
     for (const auto& a : store_.arrays()) {
-      if (a->spec.role != ParticleArrayRole::Carried || a->spec.elements_per_particle == 0) continue;
+      if (!halo_travels(a->spec)) continue;
       const size_t bytes = particle_bytes(a->spec);
       std::memcpy(a->bytes.data() + (first + k) * bytes, from, bytes);
       from += bytes;
@@ -224,6 +228,7 @@ void CpuBackend::halo_gather() {
   t.all_min(lo, 3);
   t.all_max(hi, 3);
   t.all_sum(&total, 1);
+  halo_world_count_ = total;
   const bool any = total > 0;
   const CellCoord clo =
       any ? CellCoord{static_cast<int32_t>(lo[0]), static_cast<int32_t>(lo[1]), static_cast<int32_t>(lo[2])}
@@ -247,49 +252,6 @@ void CpuBackend::halo_keys() {
   for (uint32_t c = 0; c < view.shape.cell_count; ++c)
     for (uint32_t i = view.cell_start[c]; i < view.cell_start[c + 1]; ++i)
       key[i] = (static_cast<uint64_t>(c) << 32) | (i - view.cell_start[c]);
-}
-
-// Each owned particle beside another rank's slab sends make(i) (a Record, which starts with the
-// particle's id) to that rank; each ghost takes apply(i, record) from its owner's. Both sides
-// list the particles in the sorted order, which is the same on every rank for the particles
-// they share: the receiver reads them in its own order (the ids check it).
-template <class Record, class Make, class Apply>
-void CpuBackend::halo_share(const char* what, Make&& make, Apply&& apply) {
-  const RankTransport& t = *ranks_;
-  const int me = t.rank();
-  const int size = t.size();
-  std::vector<RankBytes> out(static_cast<size_t>(size));
-  for (uint32_t i = 0; i < count_; ++i) {
-    if (ghost(i)) continue;
-    int to[2];
-    const int n = slabs_.ghost_destinations(halo_layer(i), me, to);
-    if (n == 0) continue;
-    const Record r = make(i);
-    const unsigned char* from = reinterpret_cast<const unsigned char*>(&r);
-    for (int k = 0; k < n; ++k)
-      out[static_cast<size_t>(to[k])].insert(out[static_cast<size_t>(to[k])].end(), from, from + sizeof r);
-  }
-  std::vector<size_t> read(static_cast<size_t>(size), 0);
-  // (An agreement: the passes since the last exchange, the sort, a crowded cell, the records.)
-  const std::vector<RankBytes> in = t.exchange(out);
-  for (uint32_t i = 0; i < count_; ++i) {
-    if (!ghost(i)) continue;
-    const size_t from = origin_[i] - 1u;
-    Record r;
-    if ((read[from] + 1) * sizeof r > in[from].size())
-      throw Error(Status::Internal,
-                  std::string("halo: rank ") + std::to_string(from) + " sent fewer " + what + " than ghosts");
-    std::memcpy(&r, in[from].data() + read[from]++ * sizeof r, sizeof r);
-    if (r.id != id_[i])
-      throw Error(Status::Internal, std::string("halo: the ") + what + " of rank " + std::to_string(from) +
-                                        " came in another order than its ghosts (id " + std::to_string(r.id) +
-                                        " for ghost " + std::to_string(id_[i]) + ")");
-    apply(i, r);
-  }
-  for (int r = 0; r < size; ++r)
-    if (read[static_cast<size_t>(r)] * sizeof(Record) != in[static_cast<size_t>(r)].size())
-      throw Error(Status::Internal,
-                  std::string("halo: rank ") + std::to_string(r) + " sent more " + what + " than ghosts");
 }
 
 void CpuBackend::halo_share_density() {

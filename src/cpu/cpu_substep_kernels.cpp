@@ -64,6 +64,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
       columns_.set_density(i, 0.0f, vel[i].w);
       columns_.set_neighbor_count(i, s.neighbor_count);
     });
+    if (ranks_) halo_share_dfsph_density();
   } else {
     parallel().for_each(count_, [&](uint32_t i) {
       DensitySample s = simd_.density(fluid, view, columns, static_cast<uint32_t>(i));

@@ -119,9 +119,11 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
     const NeighborColumns columns = columns_.view();
     const ParticleState* start = rk4_start_.data();
     Rk4Accumulator* sums = rk4_sum_.data();
+    const uint32_t* origin = origin_.data();  // null unless distributed
     const float stage_a2max = parallel().reduce(
         count_, 0.0f,
         [&](uint32_t i, float& m) {
+          if (origin && origin[i]) return;  // (a distributed world's halo: its owner moves it)
           Vec3 a = acceleration(gather, fluid, view, columns, scene, i);
           if (spring) a += xyz(spring[i]);
           a += wall_acceleration(i);
@@ -146,7 +148,10 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
     float v2max = 0.0f;
     const uint32_t bad_index = scan_next_state(v2max);
     if (bad_index != kAllFinite) diagnose_non_finite(fluid, scene, stage, bad_index);
-    const uint32_t bad = finish_substep(v2max, bad_index);
+    uint32_t bad = finish_substep(v2max, bad_index);
+    // A distributed world's stage ends as a substep does: the ghosts go (the next stage's sort
+    // gathers them anew) and the ranks agree on a failure, so all stop at the same stage.
+    if (ranks_) bad = halo_end_substep(bad);
     report.stage_ms[kStageIntegrate] += static_cast<float>(elapsed_ms(t));
     if (bad != kAllFinite) return bad;
   }

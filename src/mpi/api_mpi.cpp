@@ -194,4 +194,38 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t
   });
 }
 
+SPH_API sph_result SPH_CALL sph_mpi_world_gather_removed_ids(const sph_world* world, int32_t root,
+                                                             uint32_t* ids, uint32_t capacity,
+                                                             uint32_t* out_count) {
+  return sph::guarded("sph_mpi_world_gather_removed_ids", sph::context_of(world), [&] {
+    sph::require_world(world);
+    sph::WorldLock lock(world);
+    const sph::RankTransport& ranks = sph::ranks_of(world);
+    if (root < 0 || root >= ranks.size())
+      throw Error(Status::InvalidArgument,
+                  "root: must be a rank of the world's communicator, got " + std::to_string(root));
+    const sph::HostVector<uint32_t>& mine = world->world->removed_ids();
+    const unsigned char* bytes = reinterpret_cast<const unsigned char*>(mine.data());
+    const std::vector<sph::RankBytes> all =
+        ranks.gather(sph::RankBytes(bytes, bytes + mine.size() * sizeof(uint32_t)), root);
+    if (ranks.rank() != root) {
+      if (out_count) *out_count = 0;
+      return SPH_OK;
+    }
+    if (!out_count) throw Error(Status::InvalidArgument, "out_count: is NULL");
+    if (capacity > 0 && !ids) throw Error(Status::InvalidArgument, "ids: is NULL but capacity > 0");
+    sph::HostVector<uint32_t> removed;
+    for (const sph::RankBytes& r : all) {
+      const size_t at = removed.size();
+      removed.resize(at + r.size() / sizeof(uint32_t));
+      if (r.size() > 0) std::memcpy(removed.data() + at, r.data(), r.size());
+    }
+    std::sort(removed.begin(), removed.end());
+    const size_t written = std::min<size_t>(removed.size(), capacity);
+    if (written > 0) std::memcpy(ids, removed.data(), written * sizeof(uint32_t));
+    *out_count = static_cast<uint32_t>(removed.size());
+    return written < removed.size() ? SPH_INCOMPLETE : SPH_OK;
+  });
+}
+
 }  // extern "C"

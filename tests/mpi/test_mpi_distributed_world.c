@@ -282,17 +282,8 @@ static void check_refusals(sph_context* context) {
   const float p[3] = {0.05f, 0.05f, 0.03f};
   const int32_t comm = (int32_t)MPI_Comm_c2f(MPI_COMM_WORLD);
   world_def(&def);
-  def.solver = SPH_SOLVER_DFSPH;
-  expect_refused(context, &def, "DFSPH");
-  world_def(&def);
   def.features = SPH_FEATURE_SPRINGS;
   expect_refused(context, &def, "SPH_FEATURE_SPRINGS");
-  world_def(&def);
-  def.features = SPH_FEATURE_COLLIDER_LOADS;
-  expect_refused(context, &def, "SPH_FEATURE_COLLIDER_LOADS");
-  world_def(&def);
-  def.integrator = SPH_INTEGRATOR_RK4;
-  expect_refused(context, &def, "RK4");
   world_def(&def);
   REQUIRE(sph_mpi_world_create(context, &def, comm, NULL, &world) == SPH_OK, "world");
   REQUIRE(sph_spawn_desc_init(&spawn) == SPH_OK, "spawn init");

@@ -178,6 +178,23 @@ class DistributedWorld(World):
         world.comm = comm
         return world
 
+    def gather_removed_ids(self, root=0):
+        """COLLECTIVE. The ids every rank's sinks removed in the last step, on ``root``, ascending
+        (sph_mpi_world_gather_removed_ids); None elsewhere (``removed_ids()`` is this rank's own). Two collective calls on every rank:
+        the first learns the count on root, the second fills an array of that size.
+        """
+        lib = _mpi_library()
+        rank = self.counts().rank
+        count = ctypes.c_uint32()
+        out = ctypes.byref(count) if rank == root else None
+        check(lib.sph_mpi_world_gather_removed_ids(self.handle, int(root), None, 0, out),
+              "sph_mpi_world_gather_removed_ids")
+        ids = np.empty(count.value if rank == root else 0, np.uint32)
+        pointer = ids.ctypes.data_as(ctypes.POINTER(ctypes.c_uint32)) if ids.size else None
+        check(lib.sph_mpi_world_gather_removed_ids(self.handle, int(root), pointer, ids.size, out),
+              "sph_mpi_world_gather_removed_ids")
+        return ids if rank == root else None
+
     def __repr__(self):
         if self._ptr is None:
             return "<sph.mpi.DistributedWorld closed>"

@@ -95,12 +95,41 @@ def test_a_dam_break_equals_the_undivided_world(ctx, comm):
             world.close()
 
 
+def test_removed_ids_are_gathered_from_every_rank(ctx, comm):
+    sink = ((-0.2, 0.0, -0.07), (-0.12, 0.05, 0.07))  # the column's lower left corner
+    with ctx.world(capacity=4000, particle_spacing=SPACING) as ref:
+        tank_scene(ctx, ref)
+        ref.add_sink(bounds=sink)
+        ref.fill_box((-0.2, 0.0, -0.06), (0.0, 0.14, 0.06))
+        order = np.argsort(ref.ids())
+        x0 = ref.positions()[order]
+        world = sph.mpi.DistributedWorld(ctx, comm.py2f(), capacity=4000, particle_spacing=SPACING)
+        try:
+            tank_scene(ctx, world)
+            world.add_sink(bounds=sink)
+            world.add_particles(x0 if comm.rank == 0 else None)
+            ref.step(1 / 50)
+            world.step(1 / 50)
+            gathered = world.gather_removed_ids(root=0)
+            own = comm.gather(world.removed_ids(), root=0)
+        finally:
+            world.close()
+        expected = np.sort(ref.removed_ids())
+        if comm.rank == 0:
+            assert expected.size > 0, "the sink removed particles"
+            assert np.array_equal(gathered, expected)
+            assert np.array_equal(np.sort(np.concatenate(own)), expected)  # each rank's own, once
+        else:
+            assert gathered is None
+
+
 def test_bad_input_is_refused(ctx, comm):
     with pytest.raises(TypeError, match="mpi4py communicator"):
         sph.mpi.DistributedWorld(ctx, object())
     # Refused features name themselves, on every rank (the same def everywhere).
-    with pytest.raises(sph.SphError, match="(?i)rk4") as e:
-        sph.mpi.DistributedWorld(ctx, comm, integrator=sph.Integrator.RK4)
+    # (RK4 works distributed since wt-mpisolve; springs do not.)
+    with pytest.raises(sph.SphError, match="SPH_FEATURE_SPRINGS") as e:
+        sph.mpi.DistributedWorld(ctx, comm, features=sph.Feature.SPRINGS)
     assert e.value.result == sph.Result.ERROR_UNSUPPORTED
     world = sph.mpi.DistributedWorld(ctx, comm, rebalance_threshold_percent=50, particle_spacing=SPACING)
     try:

@@ -1,0 +1,113 @@
+// SPDX-License-Identifier: MIT
+// A distributed rank's exchanges for what reads more than the density pass (docs/distributed.md):
+//   DFSPH      after its density pass the ghosts take their owners' density, factor and neighbour
+//              count; inside each solve iteration, their velocities after each velocity update
+//              and their pressure steps k after each rate pass (the next pass reads both of its
+//              neighbours); the solve's mean error is an exact sum whose bins are added over
+//              the ranks (cpu_dfsph_solver.cpp): every rank runs the undivided world's iterations;
+//   probes     each sample point is gathered by the rank whose slab holds its cell layer (its
+//              neighbour cells are complete there, in the undivided world's order) and every
+//              rank takes that rank's sums: each rank reads the world's bits;
+//   loads      each rank sums the impulses of its own particles; the frame's sums are added
+//              over the ranks in rank order, so every rank reads the same world's value.
+#include <string>
+
+#include "../core/grid_layout.h"
+#include "../core/rank_sums.h"
+#include "cpu_halo_share.h"
+
+namespace sph {
+
+void CpuBackend::halo_share_dfsph_density() {
+  struct Record {
+    uint32_t id;
+    float density, factor, inv_density;
+    uint32_t neighbors;
+  };
+  float* factor = dfsph_factor_.data();
+  halo_share<Record>(
+      "DFSPH densities",
+      [&](uint32_t i) {
+        return Record{id_[i], density_[i], factor[i], velocity_[i].w, neighbors_[i]};
+      },
+      [&](uint32_t i, const Record& r) {
+        density_[i] = r.density;
+        factor[i] = r.factor;
+        velocity_[i].w = r.inv_density;
+        neighbors_[i] = r.neighbors;
+        columns_.set_density(i, position_[i].w, r.inv_density);
+        columns_.set_neighbor_count(i, r.neighbors);
+      });
+}
+
+void CpuBackend::halo_share_velocities(Float4* v) {
+  struct Record {
+    uint32_t id;
+    Float4 velocity;
+  };
+  halo_share<Record>(
+      "DFSPH velocities",
+      [&](uint32_t i) {
+        return Record{id_[i], v[i]};
+      },
+      [&](uint32_t i, const Record& r) {
+        v[i] = r.velocity;
+        columns_.set_velocity(i, xyz(r.velocity));
+      });
+}
+
+void CpuBackend::halo_share_dfsph_step() {
+  struct Record {
+    uint32_t id;
+    float k;
+  };
+  float* k = columns_.dfsph_step();
+  halo_share<Record>(
+      "DFSPH pressure steps",
+      [&](uint32_t i) {
+        return Record{id_[i], k[i]};
+      },
+      [&](uint32_t i, const Record& r) { k[i] = r.k; });
+}
+
+void CpuBackend::halo_pick_probe_points(const SceneFrame& scene) {
+  static_assert(sizeof(ProbeGather) == 6 * sizeof(float), "a probe gather is six floats");
+  const RankTransport& t = *ranks_;
+  const size_t points = probe_points_.size();
+  if (t.size() == 1 || points == 0) return;
+  const size_t bytes = points * sizeof(ProbeGather);
+  RankBytes mine(bytes);
+  std::memcpy(mine.data(), probe_points_.data(), bytes);
+  const std::vector<RankBytes> in = t.exchange(std::vector<RankBytes>(static_cast<size_t>(t.size()), mine));
+  for (size_t r = 0; r < in.size(); ++r)
+    if (in[r].size() != bytes)
+      throw Error(Status::Internal,
+                  "halo: rank " + std::to_string(r) + " sampled another number of probe points");
+  const int axis = slabs_.axis();
+  const float inv = 1.0f / config_.kernel_radius;
+  for (const ProbeView& p : scene.probes)
+    for (uint32_t q = 0; q < p.point_count; ++q) {
+      const Vec3 x = probe_point(p, q);
+      const int owner = slabs_.owner(cell_coordinate(axis == 0 ? x.x : (axis == 1 ? x.y : x.z), inv));
+      const size_t k = p.first_point + q;
+      std::memcpy(&probe_points_[k], in[static_cast<size_t>(owner)].data() + k * sizeof(ProbeGather),
+                  sizeof(ProbeGather));
+    }
+}
+
+void CpuBackend::halo_sum_loads() {
+  HostVector<double> sums;
+  sums.reserve(6 * load_sums_.size());
+  for (const ColliderLoadSums& c : load_sums_) {
+    sums.insert(sums.end(), c.linear, c.linear + 3);
+    sums.insert(sums.end(), c.angular, c.angular + 3);
+  }
+  ordered_rank_sum(*ranks_, sums.data(), sums.size());
+  for (size_t c = 0; c < load_sums_.size(); ++c)
+    for (int k = 0; k < 3; ++k) {
+      load_sums_[c].linear[k] = sums[6 * c + static_cast<size_t>(k)];
+      load_sums_[c].angular[k] = sums[6 * c + 3 + static_cast<size_t>(k)];
+    }
+}
+
+}  // namespace sph
