@@ -11,7 +11,7 @@ with every rank holding particles after the first step:
 docs/distributed.md promises the same bits while the neighbour grid covers the particles'
 extent, which a closed tank keeps. Also that the --per-rank files of each frame hold every
 particle once, each as the merged frame has it, and (--refusals) that sph-run-mpi refuses a
-scene with a source or RK4, naming it.
+scene with a source or springs, naming it.
 """
 import glob
 import os
@@ -96,13 +96,14 @@ def main(argv):
     assert p.stderr.count("sph-run-mpi:") == 1, f"one message, from rank 0:\n{p.stderr}"
     print("refused:", p.stderr.strip())
 
-    # RK4: the library refuses the world (sph_mpi_world_create) and names the integrator.
-    bad_scene = os.path.join(work, "with_rk4.json")
+    # Springs: the library refuses the world (sph_mpi_world_create) and names the feature (RK4,
+    # refused here before, works distributed since wt-mpisolve).
+    bad_scene = os.path.join(work, "with_springs.json")
     with open(bad_scene, "w", encoding="utf-8") as f:
-        f.write(text.replace('"capacity": 4000', '"capacity": 4000, "integrator": "rk4"', 1))
+        f.write(text.replace('"capacity": 4000', '"capacity": 4000, "features": ["springs"]', 1))
     p = run([mpiexec, "--oversubscribe", "-np", ranks, sph_run_mpi, bad_scene, "--quiet", "--out",
              os.path.join(work, "refused")], expect=3)
-    assert "world" in p.stderr and "RK4" in p.stderr.upper(), p.stderr
+    assert "world" in p.stderr and "SPH_FEATURE_SPRINGS" in p.stderr, p.stderr
     assert p.stderr.count("sph-run-mpi:") == 1, f"one message, from rank 0:\n{p.stderr}"
     print("refused:", p.stderr.strip().splitlines()[0])
     return 0
