@@ -180,8 +180,9 @@ class DistributedWorld(World):
 
     def gather_removed_ids(self, root=0):
         """COLLECTIVE. The ids every rank's sinks removed in the last step, on ``root``, ascending
-        (sph_mpi_world_gather_removed_ids); None elsewhere (``removed_ids()`` is this rank's own). Two collective calls on every rank:
-        the first learns the count on root, the second fills an array of that size.
+        (sph_mpi_world_gather_removed_ids); None elsewhere (``removed_ids()`` is this rank's
+        own). Two collective calls on every rank: the first learns the count on root, the
+        second fills an array of that size.
         """
         lib = _mpi_library()
         rank = self.counts().rank
