@@ -24,7 +24,10 @@ static int has_extension(const char* list, const char* name) {
  * cuda_device < 0 and no device, Mesa's surfaceless platform. */
 static EGLDisplay open_display(int cuda_device) {
   const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
-  if (client && has_extension(client, "EGL_EXT_device_enumeration") &&
+  /* EGL_EXT_device_base is EGL_EXT_device_enumeration and _query together; libglvnd's loader
+   * lists only it. */
+  if (client &&
+      (has_extension(client, "EGL_EXT_device_enumeration") || has_extension(client, "EGL_EXT_device_base")) &&
       has_extension(client, "EGL_EXT_platform_device")) {
     PFNEGLQUERYDEVICESEXTPROC query_devices =
         (PFNEGLQUERYDEVICESEXTPROC)eglGetProcAddress("eglQueryDevicesEXT");
