@@ -95,16 +95,12 @@ SPH_HD int boundary_map_ray_steps(const SdfGridView& g, float h) {
   return n < 8.0f ? 8 : (n > 64.0f ? 64 : static_cast<int>(SPH_CEILF(n)));
 }
 
-// The correction of voxel (i, j, k) for the solid {phi < level}; index_to_local is the inverse of
-// g.local_to_index.
-SPH_HD float boundary_map_correction(const SdfGridView& g, const Affine3x4& index_to_local, int32_t i,
-                                     int32_t j, int32_t k, float h, float level) {
-  const float phi =
-      -level +
-      g.distance[static_cast<int64_t>(i) + static_cast<int64_t>(g.nx) * (j + static_cast<int64_t>(g.ny) * k)];
-  if (!(phi > -h && phi < h)) return 0.0f;
-  const Vec3 x =
-      apply_affine(index_to_local, Vec3{static_cast<float>(i), static_cast<float>(j), static_cast<float>(k)});
+// The share of the solid {phi < level} at local point x by the quadrature above, phi the SDF
+// there less level (a node's own value for the map; sample_distance elsewhere): no map and no
+// interpolation, what the map stores at a node and what tests compare the sampling with.
+SPH_HD float boundary_quadrature_share(const SdfGridView& g, Vec3 x, float phi, float h, float level) {
+  if (!(phi > -h)) return 1.0f;
+  if (!(phi < h)) return 0.0f;
   Vec3 n = sample_normal(g, x);
   if (length_squared(n) == 0.0f) n = Vec3{0.0f, 0.0f, 1.0f};
   // Two tangents completing n to an orthonormal frame.
@@ -133,7 +129,21 @@ SPH_HD float boundary_map_correction(const SdfGridView& g, const Affine3x4& inde
       }
     }
   }
-  return share - local_boundary_share(g, nullptr, 1.0f, level, h, x).share;
+  return share;
+}
+
+// The correction of voxel (i, j, k) for the solid {phi < level}; index_to_local is the inverse of
+// g.local_to_index.
+SPH_HD float boundary_map_correction(const SdfGridView& g, const Affine3x4& index_to_local, int32_t i,
+                                     int32_t j, int32_t k, float h, float level) {
+  const float phi =
+      -level +
+      g.distance[static_cast<int64_t>(i) + static_cast<int64_t>(g.nx) * (j + static_cast<int64_t>(g.ny) * k)];
+  if (!(phi > -h && phi < h)) return 0.0f;
+  const Vec3 x =
+      apply_affine(index_to_local, Vec3{static_cast<float>(i), static_cast<float>(j), static_cast<float>(k)});
+  return boundary_quadrature_share(g, x, phi, h, level) -
+         local_boundary_share(g, nullptr, 1.0f, level, h, x).share;
 }
 
 // The slopes (d/d index) the sampling's Hermite interpolation takes at voxel (i, j, k): central
