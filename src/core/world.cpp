@@ -8,6 +8,8 @@
 #include <string>
 
 #include "point_clearance.h"
+#include "rank_agreement.h"
+#include "rank_transport.h"
 #include "status.h"
 
 namespace sph {
@@ -234,7 +236,15 @@ ColliderLoadResult load_result(const ColliderLoadSums& sums, const Collider& c, 
 
 bool World::step(double frame_dt, const StepInterrupt& interrupt, const FrameEnqueuedHook& enqueued) {
   const auto start = std::chrono::steady_clock::now();
-  if (interrupt.requested()) {
+  bool stop_now = interrupt.requested();
+  // A distributed world's ranks decide together: a rank that returned here alone would leave
+  // the others waiting in the frame's first collective call.
+  if (const RankTransport* ranks = backend_->rank_transport()) {
+    int64_t none_asked = stop_now ? 0 : 1;
+    agree(*ranks, &none_asked);
+    stop_now = none_asked == 0;
+  }
+  if (stop_now) {
     report_ = FrameReport{};
     report_.completed = false;
     report_.interrupted = true;

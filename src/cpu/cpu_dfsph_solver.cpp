@@ -80,6 +80,7 @@ float CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, 
   int64_t particles = count_;
   if (ranks_) {
     halo_share_dfsph_step();  // the next velocity update reads the ghosts' k
+    halo_agree();             // (the share's buffers: a rank that failed there meets the others here)
     ranks_->all_sum(sum.terms(), ExactFloatSum::kTerms);
     particles = halo_world_count_;
   }
