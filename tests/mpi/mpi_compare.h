@@ -21,23 +21,7 @@
 
 static int g_rank = 0, g_size = 1, g_failures = 0;
 
-#define CHECK(cond, ...)                                               \
-  do {                                                                 \
-    if (!(cond)) {                                                     \
-      fprintf(stderr, "rank %d: %s:%d: ", g_rank, __FILE__, __LINE__); \
-      fprintf(stderr, __VA_ARGS__);                                    \
-      fprintf(stderr, " (last error: %s)\n", sph_get_last_error());    \
-      ++g_failures;                                                    \
-    }                                                                  \
-  } while (0)
-
-#define REQUIRE(cond, ...)          \
-  do {                              \
-    if (!(cond)) {                  \
-      CHECK(cond, __VA_ARGS__);     \
-      MPI_Abort(MPI_COMM_WORLD, 1); \
-    }                               \
-  } while (0)
+#include "mpi_check.h"
 
 static const support_tank kTank = {{0.2f, 0.1f, 0.03f}, {0.2f, 0.1f, 0.03f}, 0.005f, 0.0f};
 

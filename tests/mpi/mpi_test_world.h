@@ -18,23 +18,7 @@ extern "C" {
 
 extern int g_rank, g_size, g_failures;
 
-#define CHECK(cond, ...)                                               \
-  do {                                                                 \
-    if (!(cond)) {                                                     \
-      fprintf(stderr, "rank %d: %s:%d: ", g_rank, __FILE__, __LINE__); \
-      fprintf(stderr, __VA_ARGS__);                                    \
-      fprintf(stderr, " (last error: %s)\n", sph_get_last_error());    \
-      ++g_failures;                                                    \
-    }                                                                  \
-  } while (0)
-
-#define REQUIRE(cond, ...)          \
-  do {                              \
-    if (!(cond)) {                  \
-      CHECK(cond, __VA_ARGS__);     \
-      MPI_Abort(MPI_COMM_WORLD, 1); \
-    }                               \
-  } while (0)
+#include "mpi_check.h"
 
 #define MPI_TEST_SPACING 0.01f
 #define MPI_TEST_COMM ((int32_t)MPI_Comm_c2f(MPI_COMM_WORLD))

@@ -34,23 +34,7 @@
 
 static int g_rank = 0, g_size = 1, g_failures = 0;
 
-#define CHECK(cond, ...)                                               \
-  do {                                                                 \
-    if (!(cond)) {                                                     \
-      fprintf(stderr, "rank %d: %s:%d: ", g_rank, __FILE__, __LINE__); \
-      fprintf(stderr, __VA_ARGS__);                                    \
-      fprintf(stderr, " (last error: %s)\n", sph_get_last_error());    \
-      ++g_failures;                                                    \
-    }                                                                  \
-  } while (0)
-
-#define REQUIRE(cond, ...)          \
-  do {                              \
-    if (!(cond)) {                  \
-      CHECK(cond, __VA_ARGS__);     \
-      MPI_Abort(MPI_COMM_WORLD, 1); \
-    }                               \
-  } while (0)
+#include "mpi_check.h"
 
 static void world_def(sph_world_def* def) {
   REQUIRE(sph_world_def_init(def) == SPH_OK, "def init");
