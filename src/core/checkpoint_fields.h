@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Field readers of the checkpoint reader's files: each reads one value and refuses what the
 // format does not allow as corrupt data, naming the field (checkpoint_reader.cpp,
-// checkpoint_scene_reader.cpp).
+// checkpoint_scene_reader.cpp, checkpoint_particles_reader.cpp).
 #pragma once
 
 #include <cmath>
