@@ -146,20 +146,23 @@ int main(int argc, char** argv) {
     fprintf(stderr, "solver_front: cannot write %s\n", out_path);
     return 1;
   }
-  fprintf(csv,
-          "backend,solver,parameter,layers,particles,simulated_s,wall_s,wall_s_per_simulated_s,substeps,"
-          "neighbor_passes,pressure_iterations,divergence_iterations,density_error_mean,density_error_max,"
-          "solve_error_max,front_shift_T,front_error_mean,front_error_max,status\n");
+  fprintf(
+      csv,
+      "backend,solver,parameter,layers,particles,simulated_s,wall_s,wall_s_per_simulated_s,substeps,"
+      "neighbor_passes,pressure_iterations,divergence_iterations,density_error_mean,density_error_max,"
+      "solve_error_max,front_shift_T,front_error_mean,front_error_max,status,ms_per_substep,neighbors_mean,"
+      "ms_hash_sort,ms_cell_ranges,ms_density,ms_forces,ms_integrate,ms_collide,ms_emit,ms_other\n");
   printf(
       "%s backend; dam break of Martin & Moyce for %.2f simulated s; front errors over T in [%.1f, %.1f]\n",
       resolved == SPH_BACKEND_CUDA ? "CUDA" : "CPU", seconds, DAM_BREAK_T_FIRST, DAM_BREAK_T_LAST);
-  printf("%-6s %-9s %6s %9s %10s %9s %10s %8s %8s %8s %8s\n", "solver", "parameter", "layers", "particles",
-         "wall/sim", "substeps", "nb passes", "rho err", "rho max", "front", "it/step");
+  printf("%-6s %-9s %6s %9s %10s %9s %10s %8s %8s %8s %8s %9s %6s\n", "solver", "parameter", "layers",
+         "particles", "wall/sim", "substeps", "nb passes", "rho err", "rho max", "front", "it/step",
+         "ms/subst", "nbrs");
   for (int l = 0; l < resolutions; ++l) {
     for (int r = 0; r < run_count; ++r) {
       dam_break_config config;
       sph_result status;
-      double passes = 0.0;
+      double passes = 0.0, substep_ms = 0.0;
       const int dfsph = runs[r].solver == SPH_SOLVER_DFSPH;
       dam_break_config_default(&config, layers[l]);
       config.end_T = seconds * time_scale;
@@ -178,25 +181,34 @@ int main(int argc, char** argv) {
         continue;
       }
       passes = 2.0 * (double)result->substeps;
+      substep_ms = result->substeps ? 1e3 * result->wall_seconds / (double)result->substeps : 0.0;
       if (dfsph) {
         /* Per solve: the warm start's update and the first residual, then two per iteration. */
         const double solves = (double)result->substeps * (config.dfsph_flags ? 1.0 : 2.0);
         passes += 2.0 * solves + 2.0 * (double)(result->pressure_iterations + result->divergence_iterations);
       }
-      fprintf(csv, "%s,%s,%g,%u,%u,%.4f,%.3f,%.3f,%llu,%.0f,%llu,%llu,%.6f,%.6f,%.6f,%.4f,%.5f,%.5f,ok\n",
-              resolved == SPH_BACKEND_CUDA ? "cuda" : "cpu", dfsph ? "dfsph" : "wcsph", runs[r].value,
-              layers[l], result->particles, result->simulated_seconds, result->wall_seconds,
-              result->wall_seconds / result->simulated_seconds, (unsigned long long)result->substeps, passes,
-              (unsigned long long)result->pressure_iterations,
-              (unsigned long long)result->divergence_iterations, result->mean_compression,
-              result->max_compression, result->density_error_max, result->shift_T, result->mean_error,
-              result->max_error);
+      fprintf(
+          csv, "%s,%s,%g,%u,%u,%.4f,%.3f,%.3f,%llu,%.0f,%llu,%llu,%.6f,%.6f,%.6f,%.4f,%.5f,%.5f,ok,%.5f,%.2f",
+          resolved == SPH_BACKEND_CUDA ? "cuda" : "cpu", dfsph ? "dfsph" : "wcsph", runs[r].value, layers[l],
+          result->particles, result->simulated_seconds, result->wall_seconds,
+          result->wall_seconds / result->simulated_seconds, (unsigned long long)result->substeps, passes,
+          (unsigned long long)result->pressure_iterations, (unsigned long long)result->divergence_iterations,
+          result->mean_compression, result->max_compression, result->density_error_max, result->shift_T,
+          result->mean_error, result->max_error, substep_ms, result->neighbors_mean);
+      for (int k = 0; k < SPH_STAGE_COUNT; ++k)
+        fprintf(csv, ",%.5f", result->substeps ? result->stage_ms[k] / (double)result->substeps : 0.0);
+      fprintf(csv, "\n");
       fflush(csv);
-      printf("%-6s %-9g %6u %9u %10.2f %9llu %10.0f %7.2f%% %7.2f%% %7.2f%% %8.2f\n",
+      printf("%-6s %-9g %6u %9u %10.2f %9llu %10.0f %7.2f%% %7.2f%% %7.2f%% %8.2f %9.4f %6.1f\n",
              dfsph ? "DFSPH" : "WCSPH", runs[r].value, layers[l], result->particles,
              result->wall_seconds / result->simulated_seconds, (unsigned long long)result->substeps, passes,
              100.0 * result->mean_compression, 100.0 * result->max_compression, 100.0 * result->mean_error,
-             dfsph ? (double)result->pressure_iterations / (double)result->substeps : 0.0);
+             dfsph ? (double)result->pressure_iterations / (double)result->substeps : 0.0, substep_ms,
+             result->neighbors_mean);
+      printf("       stages, ms/substep:");
+      for (int k = 0; k < SPH_STAGE_COUNT; ++k)
+        printf(" %.4f", result->substeps ? result->stage_ms[k] / (double)result->substeps : 0.0);
+      printf(" (hash+sort, cell ranges, density, forces, integrate, collide, emit, other)\n");
       fflush(stdout);
     }
   }

@@ -176,6 +176,8 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
         if (stats.density_error_max > result->density_error_max)
           result->density_error_max = stats.density_error_max;
         result->capped_substeps += stats.pressure_solves_capped;
+        for (int k = 0; k < SPH_STAGE_COUNT; ++k) result->stage_ms[k] += stats.stage_ms[k];
+        result->neighbors_mean += (double)stats.neighbors_mean * stats.substeps;
         {
           sph_event events[8];
           uint32_t event_count = 0;
@@ -218,6 +220,7 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
     }
     result->mean_compression = frames ? compression_sum / frames : 0.0;
     if (result->substeps > 0) result->density_error_mean /= (double)result->substeps;
+    if (result->substeps > 0) result->neighbors_mean /= (double)result->substeps;
   }
 
   /* The one allowed shift, fitted by minimising the mean error on a 0.005 grid. */

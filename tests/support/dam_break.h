@@ -84,7 +84,12 @@ typedef struct dam_break_result {
   double density_error_max;  /* the largest of any substep */
   uint32_t capped_substeps;  /* substeps whose density solve stopped at its cap (sph_stats) */
   uint32_t capped_events;    /* the counts of SPH_EVENT_PRESSURE_SOLVE_CAPPED events, summed */
-  char message[256];         /* the failing call's message when the run failed */
+  /* Where the wall time went (sph_stats' stage_ms summed over the frames, ms) and the mean
+   * neighbour count (sph_stats' neighbors_mean, weighted by the frames' substeps): what tells
+   * two runs' substep costs apart (bench/solver_front prints them). */
+  double stage_ms[SPH_STAGE_COUNT];
+  double neighbors_mean;
+  char message[256]; /* the failing call's message when the run failed */
 } dam_break_result;
 
 /* Runs the case on `context`. Returns SPH_OK or the first failing call's result (its message
