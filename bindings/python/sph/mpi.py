@@ -19,6 +19,12 @@ The package must load libsph_mpi, which holds the whole of sph_c.h as well, inst
         merged = world.gather()     # on rank 0: positions, velocities, ids of every rank, by id
         world.close()               # collective, before MPI_Finalize (mpi4py's, at exit)
 
+A DistributedWorld dropped without close() is never destroyed by the garbage collector: its
+destroy is collective (it frees the world's communicator), and the collector runs at different
+times on different ranks, so a destroy from __del__ could wait for ranks that never come. It
+warns (ResourceWarning) and leaks the world, and its Context leaks too (sph_context_destroy would
+destroy the world): close() every DistributedWorld, on every rank.
+
 The communicator crosses as its Fortran handle (``comm.py2f()``, an MPI_Fint), so the library
 needs nothing of mpi4py but that MPI is initialised; a plain int handle is taken as well.
 Calls marked COLLECTIVE must be made by every rank, in the same order, with the same scalar
@@ -31,6 +37,7 @@ package-wide check (bindings/python/tests/test_zz_coverage.py) wants a wrapper f
 generated function, and the mpirun test wants every sph_mpi_* function called.
 """
 import ctypes
+import warnings
 
 import numpy as np
 
@@ -41,6 +48,9 @@ from ._errors import SphLoadError, check
 from ._loader import library
 
 __all__ = ["DistributedWorld", "comm_handle", "library_has_mpi"]
+
+#: The handles of distributed worlds dropped without close(), kept here (never destroyed).
+_LEAKED = []
 
 
 def library_has_mpi():
@@ -90,6 +100,23 @@ class DistributedWorld(World):
         self.context = context
         self.comm = comm
         context._children.add(self)
+
+    def __del__(self):
+        """Never the collective destroy: warns and leaks an open world (the module's docstring)."""
+        ptr = getattr(self, "_ptr", None)
+        if ptr is None:
+            return
+        _LEAKED.append(ptr)
+        self._ptr = None
+        context = getattr(self, "context", None)
+        if context is not None:
+            context._leaked_worlds = getattr(context, "_leaked_worlds", 0) + 1
+        try:
+            warnings.warn("sph.mpi.DistributedWorld dropped without close(): leaked (its destroy is collective, "
+                          "so the garbage collector does not run it); close() it on every rank", ResourceWarning,
+                          stacklevel=2)
+        except Exception:  # noqa: BLE001 - warnings turned into errors: nothing may leave __del__
+            pass
 
     def add_particles(self, positions=None, velocities=None):
         """COLLECTIVE. Adds this rank's particles ((n, 3) arrays; None or n = 0 adds none here)
