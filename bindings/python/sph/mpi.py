@@ -188,16 +188,16 @@ class DistributedWorld(World):
         check(_mpi_library().sph_mpi_world_save_file(self.handle, _path_bytes(path)), "sph_mpi_world_save_file")
 
     def restore_file(self, path):
-        """COLLECTIVE. Replaces the world's state with the one saved at ``path``, on the rank count
-        that saved it (sph_mpi_world_restore_file); on an error on any rank, every rank raises and
-        keeps its state."""
+        """COLLECTIVE. Replaces the world's state with the one saved at ``path``, saved on any rank
+        count (sph_mpi_world_restore_file); on an error on any rank, every rank raises and keeps
+        its state."""
         check(_mpi_library().sph_mpi_world_restore_file(self.handle, _path_bytes(path)),
               "sph_mpi_world_restore_file")
 
     @classmethod
     def load_file(cls, context, comm, path):
-        """COLLECTIVE. A new distributed world over ``comm`` from the save at ``path`` (its rank
-        count; sph_mpi_world_load_file). On an error on any rank, every rank raises."""
+        """COLLECTIVE. A new distributed world over ``comm`` from the save at ``path``, saved on any
+        rank count (sph_mpi_world_load_file). On an error on any rank, every rank raises."""
         out = ctypes.POINTER(_g.sph_world)()
         check(_mpi_library().sph_mpi_world_load_file(context.handle, comm_handle(comm), _path_bytes(path),
                                                      ctypes.byref(out)), "sph_mpi_world_load_file")
