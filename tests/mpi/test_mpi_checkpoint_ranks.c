@@ -9,6 +9,8 @@
  *     order; no tolerance;
  *   - after a load on another rank count each rank holds the particles of its block of the saved
  *     files (a rank without one holds none) until the first frame cuts the slabs anew;
+ *   - DFSPH's warm starts and the user attribute travel with the particles (a DFSPH world saved
+ *     on 2 ranks and loaded on 3: the undivided world's bits, every attribute kept);
  *   - a save that fails on one rank (its staged file's name taken by a directory) fails on every
  *     rank and leaves the old set byte for byte (manifest and every rank file) with no staged
  *     file beside it; the old set still loads and steps to the undivided world's state. */
@@ -62,6 +64,71 @@ static void expect_reference(sph_world* world, MPI_Comm comm, uint32_t n, const 
   free(v);
 }
 
+/* This rank's ids and user attributes (malloc'd), *n of them. */
+static void read_ids_and_users(sph_world* world, uint32_t** ids, uint32_t** users, uint32_t* n) {
+  sph_mpi_counts c;
+  uint32_t got = 0;
+  REQUIRE(sph_mpi_counts_init(&c) == SPH_OK, "counts init");
+  REQUIRE(sph_mpi_world_get_counts(world, &c) == SPH_OK, "counts");
+  *n = c.local_count;
+  *ids = (uint32_t*)malloc(4 * ((size_t)*n + 1));
+  *users = (uint32_t*)malloc(4 * ((size_t)*n + 1));
+  REQUIRE(*ids && *users, "malloc");
+  REQUIRE(sph_world_copy_attribute(world, SPH_ATTRIBUTE_ID, *ids, 4ull * *n, 4, 0, *n, &got) == SPH_OK &&
+              got == *n,
+          "ids");
+  REQUIRE(sph_world_copy_attribute(world, SPH_ATTRIBUTE_USER, *users, 4ull * *n, 4, 0, *n, &got) == SPH_OK &&
+              got == *n,
+          "user attributes");
+}
+
+/* DFSPH's warm starts (carried pressures) and the user attribute travel with the particles: a
+ * DFSPH world whose particles carry the attribute 3 id + 1, saved on 2 ranks after 5 + 5
+ * substeps and loaded on 3, steps 10 more to the undivided world's bits, each particle still
+ * carrying 3 id + 1. */
+static void carried_arrays(sph_context* context, MPI_Comm comm2, const char* path) {
+  sph_world_def def;
+  sph_world *single = NULL, *w2 = NULL, *loaded = NULL;
+  uint32_t n = 0, k, mine, *ids = NULL, *users = NULL, wrong = 0;
+  float *rx = NULL, *rv = NULL;
+  mpi_test_world_def(&def);
+  def.solver = SPH_SOLVER_DFSPH;
+  def.features = SPH_FEATURE_USER_ATTRIBUTE;
+  if (comm2 != MPI_COMM_NULL) {
+    mpi_test_dam_on(context, &def, 2.0f, comm2, NULL, &single, &w2, &n);
+    mpi_test_step(w2, 5, 1);
+    read_ids_and_users(w2, &ids, &users, &mine);
+    for (k = 0; k < mine; ++k) users[k] = 3u * ids[k] + 1u;
+    REQUIRE(sph_world_set_attribute(w2, SPH_ATTRIBUTE_USER, users, 4ull * mine, 4, 0, mine) == SPH_OK,
+            "set users");
+    free(ids);
+    free(users);
+    mpi_test_step(w2, 5, 1);
+    REQUIRE(sph_mpi_world_save_file(w2, path) == SPH_OK, "save the DFSPH world on 2 ranks");
+    REQUIRE(sph_world_destroy(w2) == SPH_OK, "destroy");
+  }
+  MPI_Bcast(&n, 1, MPI_UINT32_T, 0, MPI_COMM_WORLD);
+  if (g_rank == 0) {
+    mpi_test_step(single, 5, 0);
+    mpi_test_step(single, 5, 0);
+    mpi_test_step(single, M_SUBSTEPS, 0);
+    mpi_test_read(single, n, &rx, &rv);
+    sph_world_destroy(single);
+  }
+  REQUIRE(sph_mpi_world_load_file(context, MPI_TEST_COMM, path, &loaded) == SPH_OK,
+          "load the DFSPH world on 3: %s", sph_get_last_error());
+  expect_reference(loaded, MPI_COMM_WORLD, n, rx, rv,
+                   "DFSPH with the user attribute, saved on 2 ranks, loaded on 3");
+  read_ids_and_users(loaded, &ids, &users, &mine);
+  for (k = 0; k < mine; ++k) wrong += users[k] != 3u * ids[k] + 1u;
+  CHECK(wrong == 0, "rank %d: %u of %u particles lost their user attribute", g_rank, wrong, mine);
+  free(ids);
+  free(users);
+  free(rx);
+  free(rv);
+  REQUIRE(sph_world_destroy(loaded) == SPH_OK, "destroy");
+}
+
 static void local_count(sph_world* world, sph_mpi_counts* c) {
   REQUIRE(sph_mpi_counts_init(c) == SPH_OK, "counts init");
   REQUIRE(sph_mpi_world_get_counts(world, c) == SPH_OK, "counts");
@@ -75,7 +142,7 @@ int main(int argc, char** argv) {
   MPI_Comm comm1, comm2;
   uint32_t n = 0, n3 = 0;
   float *rx = NULL, *rv = NULL;
-  char ck2[256], ck3[256], name[300];
+  char ck2[256], ck3[256], ckd[256], name[300];
   sph_result r;
   mpi_test_init(&argc, &argv, &context);
   if (g_size != 3) {
@@ -90,6 +157,7 @@ int main(int argc, char** argv) {
   MPI_Bcast(g_dir, sizeof g_dir, MPI_CHAR, 0, MPI_COMM_WORLD);
   snprintf(ck2, sizeof ck2, "%s/two.sphck", g_dir);
   snprintf(ck3, sizeof ck3, "%s/three.sphck", g_dir);
+  snprintf(ckd, sizeof ckd, "%s/dfsph.sphck", g_dir);
   MPI_Comm_split(MPI_COMM_WORLD, g_rank == 0 ? 0 : MPI_UNDEFINED, g_rank, &comm1);
   MPI_Comm_split(MPI_COMM_WORLD, g_rank < 2 ? 0 : MPI_UNDEFINED, g_rank, &comm2);
   mpi_test_world_def(&def);
@@ -185,16 +253,21 @@ int main(int argc, char** argv) {
   expect_reference(w3, MPI_COMM_WORLD, n, rx, rv, "saved on 3 ranks, a failed save later, restored");
   REQUIRE(sph_world_destroy(w3) == SPH_OK, "destroy");
 
-  /* Clean up (each rank its own files; rank 1 rank 2's of the 2-rank set does not exist). */
+  carried_arrays(context, comm2, ckd);
+
+  /* Clean up (each rank its own files; rank 2's of the 2-rank sets does not exist). */
   MPI_Barrier(MPI_COMM_WORLD);
   snprintf(name, sizeof name, "%s.rank%d", ck3, g_rank);
   remove(name);
   snprintf(name, sizeof name, "%s.rank%d", ck2, g_rank);
   if (g_rank < 2) remove(name);
+  snprintf(name, sizeof name, "%s.rank%d", ckd, g_rank);
+  if (g_rank < 2) remove(name);
   MPI_Barrier(MPI_COMM_WORLD);
   if (g_rank == 0) {
     remove(ck2);
     remove(ck3);
+    remove(ckd);
     rmdir(g_dir);
     sph_world_destroy(single);
   }
