@@ -6,12 +6,11 @@
  * A water block of 0.8 x 0.4 x 0.2 m at rest in a closed tank (the slabs cut its 0.8 m axis),
  * stepped one warm-up frame (the first cut and its migration) and then timed over K substeps
  * (default 20). Prints, on rank 0: the ranks, the particles per rank, the ghosts (halo) per rank
- * in the last substep against the model's slab halo (one support radius of the block's
- * cross-section per neighbour, sqrt(2) particles per spacing^3), ms per substep (the slowest
+ * in the last substep against the model's slab halo (one support radius of the block per face
+ * beside another slab: h / L of its particles), ms per substep (the slowest
  * rank, MPI_Wtime around the step) and the step's stage times; and a ping-pong of MPI messages
  * of 8 B to 8 MB between ranks 0 and 1 (their latency and bandwidth, the model's alpha and beta
  * for this host's MPI). */
-#include <math.h>
 #include <mpi.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -29,7 +28,7 @@ static void need(sph_result r, const char* what) {
 }
 
 static void ping_pong(int rank) {
-  static const size_t kSizes[] = {8, 1024, 65536, 1u << 20, 8u << 20};
+  static const size_t kSizes[] = {8, 1024, 65536, 131072, 1u << 20, 8u << 20};
   char* buf = (char*)calloc(8u << 20, 1);
   if (!buf) MPI_Abort(MPI_COMM_WORLD, 1);
   for (size_t k = 0; k < sizeof kSizes / sizeof kSizes[0]; ++k) {
@@ -114,13 +113,15 @@ int main(int argc, char** argv) {
   owned_max = c.local_count;
   MPI_Allreduce(MPI_IN_PLACE, &owned_max, 1, MPI_INT64_T, MPI_MAX, MPI_COMM_WORLD);
   if (rank == 0) {
-    /* One support radius of the block's 0.4 x 0.2 m cross-section per neighbour of each slab. */
-    const double h = 1.8 * spacing, cross = 0.4 * 0.2;
-    const double model = size > 1 ? sqrt(2.0) * cross * h / pow(spacing, 3.0) * 2.0 * (size - 1) / size : 0.0;
+    /* docs/scaling.md's slab halo: one support radius of the block per face beside another
+     * slab, h / L of the block's particles (L = 0.8 m, the cut axis); 2 (R - 1) faces. */
+    const double h = 1.8 * spacing;
+    const double model = size > 1 ? n * h / 0.8 * 2.0 * (size - 1) / size : 0.0;
     printf("ranks %d, %u particles (%.0f per rank, the fullest %lld), %u substeps\n", size, n,
            (double)n / size, (long long)owned_max, stats.substeps);
-    printf("ghosts per rank (last substep): %.0f measured, %.0f model (slab faces, h = 1.8 spacings)\n",
-           (double)c.global_ghosts / size, model);
+    printf(
+        "ghosts per rank (last substep): %.0f measured, %.0f model (h / L per slab face, h = 1.8 spacings)\n",
+        (double)c.global_ghosts / size, model);
     printf("ms per substep (slowest rank): %.3f\n", 1e3 * slowest / stats.substeps);
     printf("rank 0 stage ms over the step:");
     for (int s = 0; s < SPH_STAGE_COUNT; ++s) printf(" %.1f", stats.stage_ms[s]);
