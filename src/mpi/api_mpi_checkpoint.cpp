@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: MIT
 // Checkpoints of a distributed world (include/sph_mpi.h): one file per rank in the checkpoint
-// format (a rank's part: its particles with their sort keys, its copy of the scene) and a
-// manifest rank 0 writes last (rank_manifest.h). Every step where one rank can fail on its own
-// (a file, an allocation, a damaged or mismatched file) is agreed between the ranks
-// (core/rank_agreement.h): each call succeeds on every rank or fails on every rank, a load
-// creates no world and a restore leaves the world as it was.
+// format (a rank's part: its particles with their sort keys, its copy of the scene), staged and
+// renamed in once every rank has written its own, and a manifest rank 0 writes last
+// (rank_manifest.h); loaded on the saved rank count or on another (rank_part_join.h). Every step
+// where one rank can fail on its own (a file, an allocation, a damaged or mismatched file) is
+// agreed between the ranks (core/rank_agreement.h): each call succeeds on every rank or fails on
+// every rank, a load creates no world and a restore leaves the world as it was.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
