@@ -82,7 +82,8 @@ class DistributedWorld(World):
     COLLECTIVE). ``definition`` and keyword fields as World's (a WorldDef, the same on every
     rank); ``rebalance_threshold_percent`` (1-10000, default 20) is the sph_mpi_world_def field.
     The context must be a CPU context. close() (sph_world_destroy) is collective here: close
-    every rank's world, before MPI is finalised.
+    every rank's world, before MPI is finalised. One dropped unclosed is leaked, with a
+    ResourceWarning, and so is its context (the module's docstring says why).
     """
 
     def __init__(self, context, comm, definition=None, *, rebalance_threshold_percent=None, **fields):
