@@ -13,7 +13,11 @@
 #include <string>
 #include <vector>
 
+#if defined(_WIN32)
+#include <windows.h>
+#else
 #include <sys/stat.h>
+#endif
 
 #include "../capi/checkpoint_files.h"
 #include "../capi/guard.h"
@@ -91,8 +95,12 @@ RankFileEntry stage_rank(const sph_world* world, const RankTransport& ranks, con
 void remove_staged(const std::string& path, int rank) {
   if (path.empty()) return;
   const std::string staged = staged_path(rank_file_path(path, rank_file_name(path, rank)));
+#if defined(_WIN32)
+  (void)DeleteFileA(staged.c_str());  // (files only)
+#else
   struct stat st;
   if (::lstat(staged.c_str(), &st) == 0 && S_ISREG(st.st_mode)) (void)std::remove(staged.c_str());
+#endif
 }
 
 // Rank k's file of the set at `manifest_path`, checked against the manifest's size and hash.
