@@ -11,6 +11,8 @@
  *     files (a rank without one holds none) until the first frame cuts the slabs anew;
  *   - DFSPH's warm starts and the user attribute travel with the particles (a DFSPH world saved
  *     on 2 ranks and loaded on 3: the undivided world's bits, every attribute kept);
+ *   - max_capacity is per rank: a set whose particles do not fit one rank's max_capacity fails
+ *     to load on 1 rank with SPH_ERROR_CAPACITY;
  *   - a save that fails on one rank (its staged file's name taken by a directory) fails on every
  *     rank and leaves the old set byte for byte (manifest and every rank file) with no staged
  *     file beside it; the old set still loads and steps to the undivided world's state. */
@@ -20,6 +22,7 @@
 #include <unistd.h>
 
 #include "mpi_test_world.h"
+#include "support.h"
 
 #define N_SUBSTEPS 10
 #define M_SUBSTEPS 10
@@ -129,6 +132,54 @@ static void carried_arrays(sph_context* context, MPI_Comm comm2, const char* pat
   REQUIRE(sph_world_destroy(loaded) == SPH_OK, "destroy");
 }
 
+/* max_capacity is per rank: a world of max_capacity 1000 whose 2 ranks each added half of the
+ * 1404-particle column saves fine, but its 1404 particles do not fit one rank: a load on 1 rank
+ * fails with SPH_ERROR_CAPACITY naming max_capacity, and creates no world. */
+static void capacity_refusal(sph_context* context, MPI_Comm comm1, MPI_Comm comm2, const char* path) {
+  static const support_tank kTank = {{0.2f, 0.1f, 0.03f}, {0.2f, 0.1f, 0.03f}, 0.005f, 0.0f};
+  const sph_vec3 column_min = {0.0f, 0.0f, 0.0f}, column_max = {0.1f, 0.2f, 0.06f};
+  sph_world_def def;
+  sph_world *scratch = NULL, *w2 = NULL, *loaded = NULL;
+  float* positions = NULL;
+  uint32_t n = 0, half;
+  int rank2;
+  sph_result r;
+  mpi_test_world_def(&def);
+  def.capacity = 1000;
+  def.max_capacity = 1000;
+  if (comm2 != MPI_COMM_NULL) {
+    sph_world_def big = def;
+    big.capacity = big.max_capacity = 4096;
+    MPI_Comm_rank(comm2, &rank2);
+    /* Every rank of comm2 makes the column and adds its half (ids in rank order). */
+    REQUIRE(sph_world_create(context, &big, &scratch) == SPH_OK, "scratch world");
+    REQUIRE(support_dam_break(context, scratch, &kTank, column_min, column_max, NULL, NULL, &n) == SPH_OK,
+            "dam");
+    REQUIRE(support_copy_by_id(scratch, SPH_ATTRIBUTE_POSITION, (void**)&positions, &n) == SPH_OK,
+            "positions");
+    sph_world_destroy(scratch);
+    half = n / 2;
+    REQUIRE(sph_mpi_world_create(context, &def, (int32_t)MPI_Comm_c2f(comm2), NULL, &w2) == SPH_OK, "world");
+    REQUIRE(support_tank_create(context, w2, &kTank, NULL, NULL) == SPH_OK, "tank");
+    REQUIRE(sph_mpi_world_add_particles(w2, positions + (rank2 == 0 ? 0 : 3 * (size_t)half), NULL,
+                                        rank2 == 0 ? half : n - half, NULL) == SPH_OK,
+            "add halves: %s", sph_get_last_error());
+    free(positions);
+    mpi_test_step(w2, 2, 1);
+    REQUIRE(sph_mpi_world_save_file(w2, path) == SPH_OK, "save: %s", sph_get_last_error());
+    REQUIRE(sph_world_destroy(w2) == SPH_OK, "destroy");
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (comm1 != MPI_COMM_NULL) {
+    r = sph_mpi_world_load_file(context, (int32_t)MPI_Comm_c2f(comm1), path, &loaded);
+    CHECK(r == SPH_ERROR_CAPACITY && loaded == NULL, "1404 particles on one rank of max_capacity 1000: %d",
+          (int)r);
+    CHECK(strstr(sph_get_last_error(), "max_capacity") != NULL, "the message names max_capacity: %s",
+          sph_get_last_error());
+    if (loaded) sph_world_destroy(loaded);
+  }
+}
+
 static void local_count(sph_world* world, sph_mpi_counts* c) {
   REQUIRE(sph_mpi_counts_init(c) == SPH_OK, "counts init");
   REQUIRE(sph_mpi_world_get_counts(world, c) == SPH_OK, "counts");
@@ -142,7 +193,7 @@ int main(int argc, char** argv) {
   MPI_Comm comm1, comm2;
   uint32_t n = 0, n3 = 0;
   float *rx = NULL, *rv = NULL;
-  char ck2[256], ck3[256], ckd[256], name[300];
+  char ck2[256], ck3[256], ckd[256], ckc[256], name[300];
   sph_result r;
   mpi_test_init(&argc, &argv, &context);
   if (g_size != 3) {
@@ -158,6 +209,7 @@ int main(int argc, char** argv) {
   snprintf(ck2, sizeof ck2, "%s/two.sphck", g_dir);
   snprintf(ck3, sizeof ck3, "%s/three.sphck", g_dir);
   snprintf(ckd, sizeof ckd, "%s/dfsph.sphck", g_dir);
+  snprintf(ckc, sizeof ckc, "%s/capacity.sphck", g_dir);
   MPI_Comm_split(MPI_COMM_WORLD, g_rank == 0 ? 0 : MPI_UNDEFINED, g_rank, &comm1);
   MPI_Comm_split(MPI_COMM_WORLD, g_rank < 2 ? 0 : MPI_UNDEFINED, g_rank, &comm2);
   mpi_test_world_def(&def);
@@ -254,6 +306,7 @@ int main(int argc, char** argv) {
   REQUIRE(sph_world_destroy(w3) == SPH_OK, "destroy");
 
   carried_arrays(context, comm2, ckd);
+  capacity_refusal(context, comm1, comm2, ckc);
 
   /* Clean up (each rank its own files; rank 2's of the 2-rank sets does not exist). */
   MPI_Barrier(MPI_COMM_WORLD);
@@ -263,11 +316,14 @@ int main(int argc, char** argv) {
   if (g_rank < 2) remove(name);
   snprintf(name, sizeof name, "%s.rank%d", ckd, g_rank);
   if (g_rank < 2) remove(name);
+  snprintf(name, sizeof name, "%s.rank%d", ckc, g_rank);
+  if (g_rank < 2) remove(name);
   MPI_Barrier(MPI_COMM_WORLD);
   if (g_rank == 0) {
     remove(ck2);
     remove(ck3);
     remove(ckd);
+    remove(ckc);
     rmdir(g_dir);
     sph_world_destroy(single);
   }
