@@ -147,20 +147,24 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather_removed_ids(const sph_world* wo
  * A distributed world saves as one checkpoint file per rank (sph_c.h's format, marked as one
  * rank's part: its particles, their sort keys, its copy of the scene) plus a manifest that
  * rank 0 writes last: the rank count, the slabs and counters, the world's particle count, and
- * each rank file's name, size and hash. It loads and restores on the same number of ranks only,
- * each rank taking its own file back, and then steps on bit for bit as the saved world would
- * have. The files are found beside the manifest (the same directory), so the set moves together;
- * every rank must see the manifest and its own file (a shared file system, or copies). A rank's
+ * each rank file's name, size and hash. On the same number of ranks each rank takes its own file
+ * back with the saved slabs; on another, each rank takes a block of the saved files (rank p of P
+ * the files [p N / P, (p + 1) N / P) of N) and the first frame cuts the slabs anew. Either way
+ * the world then steps on bit for bit as the saved world would have. The files are found beside
+ * the manifest (the same directory), so the set moves together; every rank must see the manifest
+ * and the files it takes (a shared file system, or copies). A rank's
  * file alone is not a world: sph_world_load refuses it (INVALID_ARGUMENT), and sph_world_save and
  * sph_world_restore refuse a distributed world (UNSUPPORTED). */
 
 /**
- * COLLECTIVE. Saves the world at `path` (the same on every rank): each rank writes its file,
- * path + ".rank" + its rank, atomically as sph_world_save_file does, then rank 0 writes the
- * manifest at `path`, atomically. Succeeds or fails on every rank. Each file is replaced only
- * by a whole new one, but the set is not replaced atomically: after a failed (or killed) save,
- * the manifest at `path` may be the previous save's while some rank files are new, and a load
- * then refuses the set (their hashes do not match) rather than mixing two saves.
+ * COLLECTIVE. Saves the world at `path` (the same on every rank): each rank writes its file
+ * under a staged name, path + ".rank" + its rank + ".staged", atomically as sph_world_save_file
+ * does; once every rank has, each renames its file to path + ".rank" + its rank, then rank 0
+ * writes the manifest at `path`, atomically. Succeeds or fails on every rank. A save that fails
+ * while writing (on any rank) leaves the previous set as it was, its staged files removed; only
+ * a crash (or a failed rename) between the renames and the manifest leaves new rank files beside
+ * the previous manifest, a set a load refuses (their hashes do not match) rather than mixing two
+ * saves.
  * Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL or empty path; a file that cannot be written:
  * the message says which and why), UNSUPPORTED (not a distributed world), WORLD_LOCKED,
  * OUT_OF_HOST_MEMORY; a rank whose own save succeeded returns the failing rank's code.
@@ -169,13 +173,14 @@ SPH_API sph_result SPH_CALL sph_mpi_world_save_file(const sph_world* world, cons
 
 /**
  * COLLECTIVE. Creates a distributed world over the communicator `comm` (as sph_mpi_world_create)
- * from the manifest at `path` and this rank's file named in it. The communicator must have the
- * rank count that saved it. The rebalance threshold is the saved world's. On any error on any
- * rank, no rank creates a world and *out is untouched. Errors: INVALID_HANDLE (context),
- * INVALID_ARGUMENT (NULL path or out; a file that cannot be read; a communicator of another rank
- * count than the manifest's, or a bad one), CORRUPT_DATA (a damaged manifest or rank file, or a
- * rank file whose size or hash is not the manifest's: the message names the file),
- * VERSION_MISMATCH, UNSUPPORTED (a CUDA context), OUT_OF_HOST_MEMORY; a rank that found nothing
+ * from the manifest at `path` and the rank files named in it, on any rank count (above). The
+ * rebalance threshold is the saved world's. On any error on any rank, no rank creates a world
+ * and *out is untouched. Errors: INVALID_HANDLE (context), INVALID_ARGUMENT (NULL path or out; a
+ * file that cannot be read; a bad communicator), CORRUPT_DATA (a damaged manifest or rank file,
+ * a rank file whose size or hash is not the manifest's, or files of different worlds: the
+ * message names the file), CAPACITY (on fewer ranks, the particles a rank takes exceed the
+ * world's max_capacity, which is per rank), VERSION_MISMATCH, UNSUPPORTED (a CUDA context),
+ * OUT_OF_HOST_MEMORY; a rank that found nothing
  * wrong returns the first failing rank's code.
  */
 SPH_API sph_result SPH_CALL sph_mpi_world_load_file(sph_context* context, int32_t comm, const char* path,

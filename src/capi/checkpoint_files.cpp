@@ -246,4 +246,16 @@ void write_file_atomically(const std::string& path, const HostVector<uint8_t>& b
 
 HostVector<uint8_t> read_checkpoint_file(const char* path) { return read_file(path); }
 
+void move_file(const std::string& from, const std::string& to) {
+#if defined(_WIN32)
+  const bool ok =
+      MoveFileExA(from.c_str(), to.c_str(), MOVEFILE_REPLACE_EXISTING | MOVEFILE_WRITE_THROUGH) != 0;
+#else
+  const bool ok = ::rename(from.c_str(), to.c_str()) == 0;
+#endif
+  if (!ok)
+    throw Error(Status::InvalidArgument,
+                "path: cannot rename '" + from + "' to '" + to + "' (" + system_error() + ")");
+}
+
 }  // namespace sph

@@ -167,10 +167,13 @@ std::string library_version_text(uint32_t packed) {
          std::to_string(packed & 0xfffu);
 }
 
-}  // namespace
+// The header checked (magic, version, sizes, checksum, flags): the payload and its version.
+struct Opened {
+  uint32_t version = 0;
+  ByteReader payload;
+};
 
-std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const BackendMaker& make_backend,
-                                       bool rank_part) {
+Opened open_checkpoint(const uint8_t* data, size_t size, bool rank_part) {
   // Header: magic and version first (a later version may lay out the rest differently), then
   // the sizes, then the checksum over everything.
   if (size < kHeaderSize)
@@ -218,36 +221,53 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   if (section_count != section_count_of(version))
     corrupt(std::to_string(section_count) + " sections; version " + std::to_string(version) + " has " +
             std::to_string(section_count_of(version)));
+  return Opened{version, ByteReader(data + kHeaderSize, static_cast<size_t>(payload_size), "payload")};
+}
 
-  ByteReader payload(data + kHeaderSize, static_cast<size_t>(payload_size), "payload");
-  auto next_section = [&](uint32_t k) {
-    const SectionInfo& info = kSectionOrder[k];
-    const std::string what = std::string("section '") + info.name + "'";
-    if (payload.remaining() < kSectionHeaderSize) payload.need(kSectionHeaderSize);
-    const uint32_t found = payload.u32();
-    if (found != info.tag)
-      corrupt("section " + std::to_string(k) + " has tag " + hex32(found) + ", expected " + what);
-    if (payload.u32() != 0) corrupt(what + ": a reserved field is not 0");
-    const uint64_t length = payload.u64();
-    if (length > payload.remaining())
-      corrupt("truncated in " + what + " (needs " + std::to_string(length) + " bytes, " +
-              std::to_string(payload.remaining()) + " left)");
-    return payload.sub(length, what);
-  };
+ByteReader next_section(ByteReader& payload, uint32_t k) {
+  const SectionInfo& info = kSectionOrder[k];
+  const std::string what = std::string("section '") + info.name + "'";
+  if (payload.remaining() < kSectionHeaderSize) payload.need(kSectionHeaderSize);
+  const uint32_t found = payload.u32();
+  if (found != info.tag)
+    corrupt("section " + std::to_string(k) + " has tag " + hex32(found) + ", expected " + what);
+  if (payload.u32() != 0) corrupt(what + ": a reserved field is not 0");
+  const uint64_t length = payload.u64();
+  if (length > payload.remaining())
+    corrupt("truncated in " + what + " (needs " + std::to_string(length) + " bytes, " +
+            std::to_string(payload.remaining()) + " left)");
+  return payload.sub(length, what);
+}
 
-  ByteReader conf = next_section(0);
-  const WorldConfig config = read_config(conf, version);
+// The sections before the scene: the config, the parameters, the clock and the particles.
+struct Front {
+  RuntimeParams params;
+  float last_step_ms = 0.0f;
+  CheckpointPart part;
+};
+
+Front read_front(ByteReader& payload, uint32_t version, bool rank_part) {
+  Front f;
+  ByteReader conf = next_section(payload, 0);
+  f.part.config = read_config(conf, version);
   conf.expect_end();
-  ByteReader parm = next_section(1);
-  const RuntimeParams params = version == 1 ? read_params_v1(parm, config) : read_params(parm, config);
+  const WorldConfig& config = f.part.config;
+  ByteReader parm = next_section(payload, 1);
+  f.params = version == 1 ? read_params_v1(parm, config) : read_params(parm, config);
   parm.expect_end();
   // A dt_min above the stability ceiling is accepted, as sph_world_set_params accepts it (the
   // caller's fixed step wins over the ceiling; a step that then fails says so and rolls back).
-  ByteReader time = next_section(2);
-  const Clock clock = read_clock(time, version);
+  ByteReader time = next_section(payload, 2);
+  Clock clock = read_clock(time, version);
   time.expect_end();
-  ByteReader part = next_section(3);
-  ParticleSnapshot particles = read_checkpoint_particles(part, config, clock.next_id);
+  f.part.next_id = clock.next_id;
+  f.part.simulated_time = clock.simulated_time;
+  f.part.report = std::move(clock.report);
+  f.part.events = std::move(clock.events);
+  f.last_step_ms = clock.last_step_ms;
+  ByteReader part = next_section(payload, 3);
+  ParticleSnapshot& particles = f.part.particles;
+  particles = read_checkpoint_particles(part, config, clock.next_id);
   if (config.features & kFeatureSprings) read_checkpoint_springs(part, config, clock.next_id, particles);
   if (rank_part) {
     // Any value is a valid order (keys only order the next sort); the count is checked first.
@@ -257,25 +277,44 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
     particles.set_carried(kArrayDistributedSortKey, keys);
   }
   part.expect_end();
+  return f;
+}
 
-  ByteReader sdfa = next_section(4);
+}  // namespace
+
+CheckpointPart read_checkpoint_part(const uint8_t* data, size_t size) {
+  Opened o = open_checkpoint(data, size, true);
+  return read_front(o.payload, o.version, true).part;
+}
+
+std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const BackendMaker& make_backend,
+                                       bool rank_part, const CheckpointAdjust& adjust) {
+  Opened o = open_checkpoint(data, size, rank_part);
+  const uint32_t version = o.version;
+  ByteReader& payload = o.payload;
+  Front front = read_front(payload, version, rank_part);
+  if (adjust) adjust(front.part);
+  const WorldConfig& config = front.part.config;
+  ParticleSnapshot& particles = front.part.particles;
+
+  ByteReader sdfa = next_section(payload, 4);
   const CheckpointAssets assets = read_checkpoint_assets(sdfa);
   sdfa.expect_end();
-  ByteReader coll = next_section(5);
+  ByteReader coll = next_section(payload, 5);
   auto colliders = read_checkpoint_colliders(coll, assets, version);
   coll.expect_end();
-  ByteReader srce = next_section(6);
+  ByteReader srce = next_section(payload, 6);
   auto sources = read_checkpoint_sources(srce, assets, config);
   srce.expect_end();
-  ByteReader sink = next_section(7);
+  ByteReader sink = next_section(payload, 7);
   auto sinks = read_checkpoint_sinks(sink, assets);
   sink.expect_end();
-  ByteReader ffld = next_section(8);
+  ByteReader ffld = next_section(payload, 8);
   auto fields = read_checkpoint_force_fields(ffld, assets);
   ffld.expect_end();
   SlotTable<Probe> probes;
   if (version >= kFirstProbeVersion) {
-    ByteReader prob = next_section(9);
+    ByteReader prob = next_section(payload, 9);
     probes = read_checkpoint_probes(prob, config, version);
     prob.expect_end();
   }
@@ -285,9 +324,9 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   std::unique_ptr<Backend> backend = make_backend(config);
   backend->import_particles(particles);
   auto world = std::make_unique<World>(config, std::move(backend));
-  world->set_params(params);
-  world->restore_counters(clock.next_id, clock.simulated_time, clock.report, clock.last_step_ms,
-                          clock.events);
+  world->set_params(front.params);
+  world->restore_counters(front.part.next_id, front.part.simulated_time, front.part.report,
+                          front.last_step_ms, front.part.events);
   world->restore_scene(
       SceneTables{std::move(colliders), std::move(sources), std::move(sinks), std::move(fields)});
   world->restore_probes(std::move(probes));

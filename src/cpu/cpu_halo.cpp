@@ -276,14 +276,18 @@ void CpuBackend::halo_share_density() {
 }
 
 void CpuBackend::halo_share_normals() {
+  // The padding is a member, zeroed: Float4's alignment would otherwise put 12 bytes of
+  // indeterminate stack on the wire.
   struct Record {
     uint32_t id;
+    uint32_t padding[3];
     Float4 normal;
   };
+  static_assert(sizeof(Record) == 32, "a colour normal's record has no implicit padding");
   halo_share<Record>(
       "colour normals",
       [this](uint32_t i) {
-        return Record{id_[i], normals_[i]};
+        return Record{id_[i], {0u, 0u, 0u}, normals_[i]};
       },
       [this](uint32_t i, const Record& r) {
         normals_[i] = r.normal;

@@ -41,14 +41,17 @@ void CpuBackend::halo_share_dfsph_density() {
 }
 
 void CpuBackend::halo_share_velocities(Float4* v) {
+  // The padding is a member, zeroed (as the colour normals' record, cpu_halo.cpp).
   struct Record {
     uint32_t id;
+    uint32_t padding[3];
     Float4 velocity;
   };
+  static_assert(sizeof(Record) == 32, "a velocity's record has no implicit padding");
   halo_share<Record>(
       "DFSPH velocities",
       [&](uint32_t i) {
-        return Record{id_[i], v[i]};
+        return Record{id_[i], {0u, 0u, 0u}, v[i]};
       },
       [&](uint32_t i, const Record& r) {
         v[i] = r.velocity;

@@ -1,13 +1,23 @@
 // SPDX-License-Identifier: MIT
 // Checkpoints of a distributed world (include/sph_mpi.h): one file per rank in the checkpoint
-// format (a rank's part: its particles with their sort keys, its copy of the scene) and a
-// manifest rank 0 writes last (rank_manifest.h). Every step where one rank can fail on its own
-// (a file, an allocation, a damaged or mismatched file) is agreed between the ranks
-// (core/rank_agreement.h): each call succeeds on every rank or fails on every rank, a load
-// creates no world and a restore leaves the world as it was.
+// format (a rank's part: its particles with their sort keys, its copy of the scene), staged and
+// renamed in once every rank has written its own, and a manifest rank 0 writes last
+// (rank_manifest.h); loaded on the saved rank count or on another (rank_part_join.h). Every step
+// where one rank can fail on its own (a file, an allocation, a damaged or mismatched file) is
+// agreed between the ranks (core/rank_agreement.h): each call succeeds on every rank or fails on
+// every rank, a load creates no world and a restore leaves the world as it was.
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
+
+#if defined(_WIN32)
+#include <windows.h>
+#else
+#include <sys/stat.h>
+#endif
 
 #include "../capi/checkpoint_files.h"
 #include "../capi/guard.h"
@@ -15,10 +25,12 @@
 #include "../core/byte_io.h"
 #include "../core/checkpoint.h"
 #include "../core/rank_agreement.h"
+#include "../core/slab_decomposition.h"
 #include "../factory/backend_factory.h"
 #include "mpi_transport.h"
 #include "mpi_world.h"
 #include "rank_manifest.h"
+#include "rank_part_join.h"
 #include "sph_mpi.h"
 
 using sph::Error;
@@ -58,8 +70,12 @@ RankFileEntry unpack_entry(const RankBytes& b) {
   return e;
 }
 
-// Writes this rank's file; returns its manifest entry.
-RankFileEntry save_rank(const sph_world* world, const RankTransport& ranks, const std::string& path) {
+// Where a rank's file waits until every rank has written its own: a set is replaced only once
+// all of its files are whole, so a failed save leaves the old set as it was.
+std::string staged_path(const std::string& file) { return file + ".staged"; }
+
+// Writes this rank's file under its staged name; returns its manifest entry.
+RankFileEntry stage_rank(const sph_world* world, const RankTransport& ranks, const std::string& path) {
   CheckpointOrigin origin;
   origin.backend = static_cast<uint32_t>(world->context->backend);
   origin.library_version = SPH_VERSION;
@@ -67,7 +83,7 @@ RankFileEntry save_rank(const sph_world* world, const RankTransport& ranks, cons
   const HostVector<uint8_t> bytes = write_checkpoint(*world->world, origin);
   RankFileEntry e;
   e.name = rank_file_name(path, ranks.rank());
-  write_file_atomically(rank_file_path(path, e.name), bytes);
+  write_file_atomically(staged_path(rank_file_path(path, e.name)), bytes);
   e.particles = world->world->particle_count();
   e.counters = world->world->backend().distributed_state().counters;
   e.size = bytes.size();
@@ -75,7 +91,44 @@ RankFileEntry save_rank(const sph_world* world, const RankTransport& ranks, cons
   return e;
 }
 
-// This rank's part of the world saved at `path`, attached to `ranks`; nothing else changes.
+// A failed save's staged file (best effort: a file only, never what a test or user put there).
+void remove_staged(const std::string& path, int rank) {
+  if (path.empty()) return;
+  const std::string staged = staged_path(rank_file_path(path, rank_file_name(path, rank)));
+#if defined(_WIN32)
+  (void)DeleteFileA(staged.c_str());  // (files only)
+#else
+  struct stat st;
+  if (::lstat(staged.c_str(), &st) == 0 && S_ISREG(st.st_mode)) (void)std::remove(staged.c_str());
+#endif
+}
+
+// Rank k's file of the set at `manifest_path`, checked against the manifest's size and hash.
+HostVector<uint8_t> read_rank_file(const std::string& manifest_path, const RankManifest& m, uint32_t k) {
+  const RankFileEntry& entry = m.ranks[k];
+  const std::string file = rank_file_path(manifest_path, entry.name);
+  HostVector<uint8_t> bytes = read_checkpoint_file(file.c_str());
+  if (bytes.size() != entry.size || file_hash(bytes) != entry.hash)
+    throw Error(Status::CorruptData, "manifest: rank " + std::to_string(k) + "'s file '" + file + "' has " +
+                                         std::to_string(bytes.size()) + " bytes" +
+                                         (bytes.size() == entry.size ? " and another hash" : "") +
+                                         "; the manifest '" + manifest_path + "' lists " +
+                                         std::to_string(entry.size) +
+                                         " bytes and its hash (a file of another save, or damaged)");
+  return bytes;
+}
+
+void check_part_count(const std::string& manifest_path, const RankManifest& m, uint32_t k, size_t count) {
+  if (count != m.ranks[k].particles)
+    throw Error(Status::CorruptData, "manifest: rank " + std::to_string(k) + "'s file '" +
+                                         rank_file_path(manifest_path, m.ranks[k].name) + "' holds " +
+                                         std::to_string(count) + " particles, the manifest " +
+                                         std::to_string(m.ranks[k].particles));
+}
+
+// This rank's part of the world saved at `path`, attached to `ranks`; nothing else changes. On
+// the rank count that saved it, each rank reads its own file and keeps the saved slabs; on
+// another, each reads a block of the files (rank_part_join.h) and the first frame cuts anew.
 std::unique_ptr<World> load_rank(sph_context* context, const std::shared_ptr<const RankTransport>& ranks,
                                  const char* path) {
   require_path(path);
@@ -87,21 +140,27 @@ std::unique_ptr<World> load_rank(sph_context* context, const std::shared_ptr<con
   } catch (const Error& e) {
     throw Error(e.status(), std::string(e.what()) + " (file '" + manifest_path + "')");
   }
-  if (m.ranks.size() != static_cast<size_t>(ranks->size()))
-    throw Error(Status::InvalidArgument,
-                "comm: '" + manifest_path + "' is a world saved on " + std::to_string(m.ranks.size()) +
-                    " ranks; this communicator has " + std::to_string(ranks->size()) +
-                    " (a distributed world loads on the rank count that saved it)");
-  const RankFileEntry& mine = m.ranks[static_cast<size_t>(ranks->rank())];
-  const std::string file = rank_file_path(manifest_path, mine.name);
-  const HostVector<uint8_t> bytes = read_checkpoint_file(file.c_str());
-  if (bytes.size() != mine.size || file_hash(bytes) != mine.hash)
-    throw Error(Status::CorruptData, "manifest: rank " + std::to_string(ranks->rank()) + "'s file '" + file +
-                                         "' has " + std::to_string(bytes.size()) + " bytes" +
-                                         (bytes.size() == mine.size ? " and another hash" : "") +
-                                         "; the manifest '" + manifest_path + "' lists " +
-                                         std::to_string(mine.size) +
-                                         " bytes and its hash (a file of another save, or damaged)");
+  const uint32_t saved = static_cast<uint32_t>(m.ranks.size());
+  const bool same_count = saved == static_cast<uint32_t>(ranks->size());
+  const RankFileBlock block = same_count ? RankFileBlock{static_cast<uint32_t>(ranks->rank()),
+                                                         static_cast<uint32_t>(ranks->rank()) + 1u}
+                                         : rank_file_block(saved, ranks->rank(), ranks->size());
+  // A rank that takes no file reads the next rank's for the scene (every file holds it alike).
+  const uint32_t base = std::min(block.first, saved - 1u);
+  const bool keep_own = block.first < block.last;
+  std::vector<CheckpointPart> others;
+  for (uint32_t k = block.first + 1u; k < block.last; ++k) {
+    const HostVector<uint8_t> bytes = read_rank_file(manifest_path, m, k);
+    try {
+      others.push_back(read_checkpoint_part(bytes.data(), bytes.size()));
+    } catch (const Error& e) {
+      throw Error(e.status(),
+                  std::string(e.what()) + " (file '" + rank_file_path(manifest_path, m.ranks[k].name) + "')");
+    }
+    check_part_count(manifest_path, m, k, others.back().particles.id.size());
+  }
+  const HostVector<uint8_t> bytes = read_rank_file(manifest_path, m, base);
+  const std::string file = rank_file_path(manifest_path, m.ranks[base].name);
   DistributedOptions options;
   options.rebalance_threshold = m.rebalance_percent / 100.0;
   std::unique_ptr<World> world;
@@ -115,18 +174,30 @@ std::unique_ptr<World> load_rank(sph_context* context, const std::shared_ptr<con
           b->attach_ranks(ranks, options);
           return b;
         },
-        true);
+        true,
+        [&](CheckpointPart& part) {
+          check_part_count(manifest_path, m, base, part.particles.id.size());
+          if (!same_count) join_rank_parts(part, keep_own, others);
+        });
   } catch (const Error& e) {
     throw Error(e.status(), std::string(e.what()) + " (file '" + file + "')");
   }
-  if (world->particle_count() != mine.particles)
-    throw Error(Status::CorruptData, "manifest: rank " + std::to_string(ranks->rank()) + "'s file '" + file +
-                                         "' holds " + std::to_string(world->particle_count()) +
-                                         " particles, the manifest " + std::to_string(mine.particles));
   DistributedState state = m.state;
-  state.counters.ghosts = mine.counters.ghosts;
-  state.counters.migrated_in = mine.counters.migrated_in;
-  state.counters.migrated_out = mine.counters.migrated_out;
+  if (same_count) {
+    const RankFileEntry& mine = m.ranks[base];
+    state.counters.ghosts = mine.counters.ghosts;
+    state.counters.migrated_in = mine.counters.migrated_in;
+    state.counters.migrated_out = mine.counters.migrated_out;
+  } else {
+    // The saved slabs do not fit this rank count: one slab until the first frame cuts (as a new
+    // world's first frame does); the rank's migration counters start at 0.
+    const SlabDecomposition whole(ranks->size());
+    state.cuts = whole.cuts();
+    state.cut = false;
+    state.counters.ghosts = 0;
+    state.counters.migrated_in = 0;
+    state.counters.migrated_out = 0;
+  }
   world->backend().restore_distributed_state(state);
   return world;
 }
@@ -141,13 +212,26 @@ SPH_API sph_result SPH_CALL sph_mpi_world_save_file(const sph_world* world, cons
     sph::require_world(world);
     sph::WorldLock lock(world);
     const sph::RankTransport& ranks = sph::ranks_of(world);
+    const std::string target = path ? path : "";
     sph::RankBytes mine;
+    std::vector<sph::RankBytes> entries;
+    // Three agreed phases: every rank stages its file; every rank moves its staged file in;
+    // rank 0 writes the manifest, which names files that are all in place. A failure in the
+    // first (a full disk, an unwritable directory, an allocation) leaves the old set whole.
+    try {
+      sph::agreed(ranks, [&] {
+        sph::require_path(path);
+        mine = sph::pack_entry(sph::stage_rank(world, ranks, target));
+      });
+      entries = ranks.gather(mine, 0);
+    } catch (...) {
+      sph::remove_staged(target, ranks.rank());
+      throw;
+    }
     sph::agreed(ranks, [&] {
-      sph::require_path(path);
-      mine = sph::pack_entry(sph::save_rank(world, ranks, path));
+      const std::string file = sph::rank_file_path(target, sph::rank_file_name(target, ranks.rank()));
+      sph::move_file(sph::staged_path(file), file);
     });
-    const std::vector<sph::RankBytes> entries = ranks.gather(mine, 0);
-    // The manifest last: it names files that are all written.
     sph::agreed(ranks, [&] {
       if (ranks.rank() != 0) return;
       sph::RankManifest m;
@@ -157,7 +241,7 @@ SPH_API sph_result SPH_CALL sph_mpi_world_save_file(const sph_world* world, cons
         m.ranks.push_back(sph::unpack_entry(b));
         m.particles += m.ranks.back().particles;
       }
-      sph::write_file_atomically(path, sph::write_rank_manifest(m));
+      sph::write_file_atomically(target, sph::write_rank_manifest(m));
     });
     return SPH_OK;
   });

@@ -37,12 +37,19 @@ void mpi_test_world_def(sph_world_def* def) {
 
 void mpi_test_dam(sph_context* context, const sph_world_def* def, float stir,
                   const sph_mpi_world_def* mpi_def, sph_world** single, sph_world** world, uint32_t* n) {
+  mpi_test_dam_on(context, def, stir, MPI_COMM_WORLD, mpi_def, single, world, n);
+}
+
+void mpi_test_dam_on(sph_context* context, const sph_world_def* def, float stir, MPI_Comm comm,
+                     const sph_mpi_world_def* mpi_def, sph_world** single, sph_world** world, uint32_t* n) {
+  int rank = 0;
   const sph_vec3 column_min = {0.0f, 0.0f, 0.0f}, column_max = {0.1f, 0.2f, 0.06f};
   sph_world* one = NULL;
   float* positions = NULL;
   float* velocities = NULL;
   *n = 0;
-  if (g_rank == 0) {
+  MPI_Comm_rank(comm, &rank);
+  if (rank == 0) {
     REQUIRE(sph_world_create(context, def, &one) == SPH_OK, "single world");
     REQUIRE(support_dam_break(context, one, &kTank, column_min, column_max, NULL, NULL, n) == SPH_OK, "dam");
     REQUIRE(support_copy_by_id(one, SPH_ATTRIBUTE_POSITION, (void**)&positions, n) == SPH_OK, "positions");
@@ -56,10 +63,11 @@ void mpi_test_dam(sph_context* context, const sph_world_def* def, float stir,
           "stir");
     }
   }
-  MPI_Bcast(n, 1, MPI_UINT32_T, 0, MPI_COMM_WORLD);
-  REQUIRE(sph_mpi_world_create(context, def, MPI_TEST_COMM, mpi_def, world) == SPH_OK, "distributed world");
+  MPI_Bcast(n, 1, MPI_UINT32_T, 0, comm);
+  REQUIRE(sph_mpi_world_create(context, def, (int32_t)MPI_Comm_c2f(comm), mpi_def, world) == SPH_OK,
+          "distributed world");
   REQUIRE(support_tank_create(context, *world, &kTank, NULL, NULL) == SPH_OK, "tank");
-  REQUIRE(sph_mpi_world_add_particles(*world, positions, velocities, g_rank == 0 ? *n : 0, NULL) == SPH_OK,
+  REQUIRE(sph_mpi_world_add_particles(*world, positions, velocities, rank == 0 ? *n : 0, NULL) == SPH_OK,
           "add particles");
   free(positions);
   free(velocities);
@@ -84,16 +92,22 @@ void mpi_test_step(sph_world* world, uint32_t substeps, int distributed) {
 }
 
 void mpi_test_gather(sph_world* world, uint32_t n, float** x, float** v) {
+  mpi_test_gather_on(world, MPI_COMM_WORLD, n, x, v);
+}
+
+void mpi_test_gather_on(sph_world* world, MPI_Comm comm, uint32_t n, float** x, float** v) {
   uint64_t got = 0;
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
   *x = NULL;
   *v = NULL;
-  if (g_rank == 0) {
+  if (rank == 0) {
     *x = (float*)malloc(sizeof(float) * 3 * ((size_t)n + 1));
     *v = (float*)malloc(sizeof(float) * 3 * ((size_t)n + 1));
     REQUIRE(*x && *v, "malloc");
   }
   REQUIRE(sph_mpi_world_gather(world, 0, *x, *v, NULL, n, &got) == SPH_OK, "gather");
-  CHECK(g_rank != 0 || got == n, "gathered %llu of %u", (unsigned long long)got, n);
+  CHECK(rank != 0 || got == n, "gathered %llu of %u", (unsigned long long)got, n);
 }
 
 void mpi_test_read(sph_world* single, uint32_t n, float** x, float** v) {

@@ -33,10 +33,15 @@ void mpi_test_world_def(sph_world_def* def);
  * undivided world, *world the distributed one (mpi_def may be NULL); *n the particles. */
 void mpi_test_dam(sph_context* context, const sph_world_def* def, float stir,
                   const sph_mpi_world_def* mpi_def, sph_world** single, sph_world** world, uint32_t* n);
+/* mpi_test_dam on the ranks of `comm` (rank 0 of it builds the undivided world). */
+void mpi_test_dam_on(sph_context* context, const sph_world_def* def, float stir, MPI_Comm comm,
+                     const sph_mpi_world_def* mpi_def, sph_world** single, sph_world** world, uint32_t* n);
 /* `substeps` substeps in one frame that max_substeps ends (collective when distributed). */
 void mpi_test_step(sph_world* world, uint32_t substeps, int distributed);
 /* The distributed world's positions and velocities by id on rank 0 (malloc'd; NULL elsewhere). */
 void mpi_test_gather(sph_world* world, uint32_t n, float** x, float** v);
+/* mpi_test_gather for a world on `comm`: onto its rank 0. */
+void mpi_test_gather_on(sph_world* world, MPI_Comm comm, uint32_t n, float** x, float** v);
 /* An undivided world's positions and velocities by id (malloc'd). */
 void mpi_test_read(sph_world* single, uint32_t n, float** x, float** v);
 /* Particles whose position or velocity differ in any bit. */

@@ -3,6 +3,7 @@
 import ctypes
 import re
 import sys
+import warnings
 import weakref
 
 import numpy as np
@@ -194,7 +195,13 @@ class Context:
             children = sorted(self._children, key=lambda c: not isinstance(c, World))
             for child in children:
                 child.close()
-            check(library().sph_context_destroy(self._ptr), "sph_context_destroy")
+            if getattr(self, "_leaked_worlds", 0):
+                # A distributed world dropped without close() is on it (sph.mpi): destroying the
+                # context would destroy that world, a collective call this rank alone would make.
+                warnings.warn(f"sph.Context: {self._leaked_worlds} distributed world(s) on it were dropped without "
+                              "close(); the context is leaked with them", ResourceWarning, stacklevel=2)
+            else:
+                check(library().sph_context_destroy(self._ptr), "sph_context_destroy")
             self._ptr = None
 
     def __enter__(self):
@@ -205,9 +212,9 @@ class Context:
 
     def __del__(self):
         try:
-            if getattr(self, "_ptr", None) is not None:
+            if getattr(self, "_ptr", None) is not None and not getattr(self, "_leaked_worlds", 0):
                 library().sph_context_destroy(self._ptr)
-                self._ptr = None
+            self._ptr = None
         except Exception:  # noqa: BLE001 - interpreter shutdown
             pass
 

@@ -19,6 +19,12 @@ The package must load libsph_mpi, which holds the whole of sph_c.h as well, inst
         merged = world.gather()     # on rank 0: positions, velocities, ids of every rank, by id
         world.close()               # collective, before MPI_Finalize (mpi4py's, at exit)
 
+A DistributedWorld dropped without close() is never destroyed by the garbage collector: its
+destroy is collective (it frees the world's communicator), and the collector runs at different
+times on different ranks, so a destroy from __del__ could wait for ranks that never come. It
+warns (ResourceWarning) and leaks the world, and its Context leaks too (sph_context_destroy would
+destroy the world): close() every DistributedWorld, on every rank.
+
 The communicator crosses as its Fortran handle (``comm.py2f()``, an MPI_Fint), so the library
 needs nothing of mpi4py but that MPI is initialised; a plain int handle is taken as well.
 Calls marked COLLECTIVE must be made by every rank, in the same order, with the same scalar
@@ -31,6 +37,7 @@ package-wide check (bindings/python/tests/test_zz_coverage.py) wants a wrapper f
 generated function, and the mpirun test wants every sph_mpi_* function called.
 """
 import ctypes
+import warnings
 
 import numpy as np
 
@@ -41,6 +48,9 @@ from ._errors import SphLoadError, check
 from ._loader import library
 
 __all__ = ["DistributedWorld", "comm_handle", "library_has_mpi"]
+
+#: The handles of distributed worlds dropped without close(), kept here (never destroyed).
+_LEAKED = []
 
 
 def library_has_mpi():
@@ -72,7 +82,8 @@ class DistributedWorld(World):
     COLLECTIVE). ``definition`` and keyword fields as World's (a WorldDef, the same on every
     rank); ``rebalance_threshold_percent`` (1-10000, default 20) is the sph_mpi_world_def field.
     The context must be a CPU context. close() (sph_world_destroy) is collective here: close
-    every rank's world, before MPI is finalised.
+    every rank's world, before MPI is finalised. One dropped unclosed is leaked, with a
+    ResourceWarning, and so is its context (the module's docstring says why).
     """
 
     def __init__(self, context, comm, definition=None, *, rebalance_threshold_percent=None, **fields):
@@ -90,6 +101,23 @@ class DistributedWorld(World):
         self.context = context
         self.comm = comm
         context._children.add(self)
+
+    def __del__(self):
+        """Never the collective destroy: warns and leaks an open world (the module's docstring)."""
+        ptr = getattr(self, "_ptr", None)
+        if ptr is None:
+            return
+        _LEAKED.append(ptr)
+        self._ptr = None
+        context = getattr(self, "context", None)
+        if context is not None:
+            context._leaked_worlds = getattr(context, "_leaked_worlds", 0) + 1
+        try:
+            warnings.warn("sph.mpi.DistributedWorld dropped without close(): leaked (its destroy is collective, "
+                          "so the garbage collector does not run it); close() it on every rank", ResourceWarning,
+                          stacklevel=2)
+        except Exception:  # noqa: BLE001 - warnings turned into errors: nothing may leave __del__
+            pass
 
     def add_particles(self, positions=None, velocities=None):
         """COLLECTIVE. Adds this rank's particles ((n, 3) arrays; None or n = 0 adds none here)
@@ -161,16 +189,16 @@ class DistributedWorld(World):
         check(_mpi_library().sph_mpi_world_save_file(self.handle, _path_bytes(path)), "sph_mpi_world_save_file")
 
     def restore_file(self, path):
-        """COLLECTIVE. Replaces the world's state with the one saved at ``path``, on the rank count
-        that saved it (sph_mpi_world_restore_file); on an error on any rank, every rank raises and
-        keeps its state."""
+        """COLLECTIVE. Replaces the world's state with the one saved at ``path``, saved on any rank
+        count (sph_mpi_world_restore_file); on an error on any rank, every rank raises and keeps
+        its state."""
         check(_mpi_library().sph_mpi_world_restore_file(self.handle, _path_bytes(path)),
               "sph_mpi_world_restore_file")
 
     @classmethod
     def load_file(cls, context, comm, path):
-        """COLLECTIVE. A new distributed world over ``comm`` from the save at ``path`` (its rank
-        count; sph_mpi_world_load_file). On an error on any rank, every rank raises."""
+        """COLLECTIVE. A new distributed world over ``comm`` from the save at ``path``, saved on any
+        rank count (sph_mpi_world_load_file). On an error on any rank, every rank raises."""
         out = ctypes.POINTER(_g.sph_world)()
         check(_mpi_library().sph_mpi_world_load_file(context.handle, comm_handle(comm), _path_bytes(path),
                                                      ctypes.byref(out)), "sph_mpi_world_load_file")

@@ -5,6 +5,9 @@ world of the same particles in the same process: docs/distributed.md promises th
 particles' extent, which the closed tank keeps), so positions and velocities are compared
 exactly. Every test runs on every rank in the same order: the collective calls then match.
 """
+import gc
+import warnings
+
 import numpy as np
 import pytest
 
@@ -201,6 +204,53 @@ def test_an_undivided_world_is_not_a_distributed_one(ctx):
         with pytest.raises(sph.SphError) as e:
             sph.mpi.DistributedWorld.counts(plain)
         assert e.value.result == sph.Result.ERROR_UNSUPPORTED
+
+
+def test_a_world_dropped_without_close_is_leaked_not_destroyed(comm):
+    """A DistributedWorld the garbage collector takes, at another time on each rank (rank 0 before
+    another world's collective step, the others after it): no sph_world_destroy runs for it (it
+    is collective, sph.mpi's docstring), a ResourceWarning says so, its context is then leaked
+    rather than destroyed (which would destroy the world), and every rank goes on."""
+    ctx = sph.Context("cpu", cpu_worker_count=1)
+    dropped = sph.mpi.DistributedWorld(ctx, comm, capacity=100, particle_spacing=SPACING)
+    kept = sph.mpi.DistributedWorld(ctx, comm, capacity=100, particle_spacing=SPACING)
+    kept.add_particles(np.array([[0.0, 0.1, 0.0]], np.float32) if comm.rank == 0 else None)
+    world_destroys = CALLS["sph_world_destroy"]
+    context_destroys = CALLS["sph_context_destroy"]
+    problems = []
+
+    def resource_warnings(action):
+        # Recorded rather than asserted with pytest.warns: a rank that failed here would leave the
+        # others waiting in the next collective call.
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            action()
+        return [str(w.message) for w in caught if issubclass(w.category, ResourceWarning)]
+
+    def drop():
+        nonlocal dropped
+        dropped = None
+        gc.collect()
+
+    dropped_warnings = resource_warnings(drop) if comm.rank == 0 else []
+    kept.step(1 / 50)  # COLLECTIVE, with the dropped world gone on rank 0 only
+    if comm.rank != 0:
+        dropped_warnings = resource_warnings(drop)
+    count = kept.global_count
+    kept.close()
+    context_warnings = resource_warnings(ctx.close)
+    if not any("without close" in w for w in dropped_warnings):
+        problems.append(f"rank {comm.rank}: no ResourceWarning for the dropped world: {dropped_warnings}")
+    if not any("leaked" in w for w in context_warnings):
+        problems.append(f"rank {comm.rank}: no ResourceWarning for the leaked context: {context_warnings}")
+    if count != 1:
+        problems.append(f"rank {comm.rank}: the kept world holds {count} particles")
+    if CALLS["sph_world_destroy"] != world_destroys + 1:  # the kept world's close() alone
+        problems.append(f"rank {comm.rank}: {CALLS['sph_world_destroy'] - world_destroys} world destroys")
+    if CALLS["sph_context_destroy"] != context_destroys:
+        problems.append(f"rank {comm.rank}: the context holding a leaked world was destroyed")
+    problems = sum(comm.allgather(problems), [])
+    assert not problems, problems
 
 
 def test_zz_every_sph_mpi_function_was_called():

@@ -1,0 +1,135 @@
+/* SPDX-License-Identifier: MIT */
+/* The two-rank calibration of docs/scaling.md's model on the CPU backend (issue 19 item 6):
+ *
+ *   mpirun -np R bench/mpi_halo [--spacing S] [--substeps K]
+ *
+ * A water block of 0.8 x 0.4 x 0.2 m at rest in a closed tank (the slabs cut its 0.8 m axis),
+ * stepped one warm-up frame (the first cut and its migration) and then timed over K substeps
+ * (default 20). Prints, on rank 0: the ranks, the particles per rank, the ghosts (halo) per rank
+ * in the last substep against the model's slab halo (one support radius of the block per face
+ * beside another slab: h / L of its particles), ms per substep (the slowest
+ * rank, MPI_Wtime around the step) and the step's stage times; and a ping-pong of MPI messages
+ * of 8 B to 8 MB between ranks 0 and 1 (their latency and bandwidth, the model's alpha and beta
+ * for this host's MPI). */
+#include <mpi.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sph_c.h"
+#include "sph_mpi.h"
+#include "support.h"
+
+static void need(sph_result r, const char* what) {
+  if (r != SPH_OK) {
+    fprintf(stderr, "mpi_halo: %s: %d %s\n", what, (int)r, sph_get_last_error());
+    MPI_Abort(MPI_COMM_WORLD, 1);
+  }
+}
+
+static void ping_pong(int rank) {
+  static const size_t kSizes[] = {8, 1024, 65536, 131072, 1u << 20, 8u << 20};
+  char* buf = (char*)calloc(8u << 20, 1);
+  if (!buf) MPI_Abort(MPI_COMM_WORLD, 1);
+  for (size_t k = 0; k < sizeof kSizes / sizeof kSizes[0]; ++k) {
+    const int n = (int)kSizes[k];
+    const int reps = n > 65536 ? 20 : 2000;
+    double t0;
+    MPI_Barrier(MPI_COMM_WORLD);
+    t0 = MPI_Wtime();
+    for (int i = 0; i < reps; ++i) {
+      if (rank == 0) {
+        MPI_Send(buf, n, MPI_CHAR, 1, 0, MPI_COMM_WORLD);
+        MPI_Recv(buf, n, MPI_CHAR, 1, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+      } else if (rank == 1) {
+        MPI_Recv(buf, n, MPI_CHAR, 0, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+        MPI_Send(buf, n, MPI_CHAR, 0, 0, MPI_COMM_WORLD);
+      }
+    }
+    if (rank == 0) {
+      const double one_way = (MPI_Wtime() - t0) / (2.0 * reps);
+      printf("ping-pong %8d B: %9.2f us one way, %8.3f GB/s\n", n, one_way * 1e6, n / one_way * 1e-9);
+    }
+  }
+  free(buf);
+}
+
+int main(int argc, char** argv) {
+  float spacing = 0.01f;
+  uint32_t substeps = 20;
+  int rank, size;
+  sph_context* context = NULL;
+  sph_world* scratch = NULL;
+  sph_world* world = NULL;
+  sph_world_def def;
+  sph_world_params params;
+  sph_mpi_counts c;
+  sph_stats stats;
+  float* positions = NULL;
+  uint32_t n = 0;
+  double t0, mine, slowest;
+  int64_t owned_max;
+  const support_tank tank = {{0.0f, 0.3f, 0.0f}, {0.45f, 0.3f, 0.15f}, 0.01f, 0.0f};
+  const sph_vec3 lo = {-0.4f, 0.0f, -0.1f}, hi = {0.4f, 0.4f, 0.1f};
+  MPI_Init(&argc, &argv);
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  for (int i = 1; i + 1 < argc; i += 2) {
+    if (strcmp(argv[i], "--spacing") == 0) spacing = (float)atof(argv[i + 1]);
+    if (strcmp(argv[i], "--substeps") == 0) substeps = (uint32_t)atoi(argv[i + 1]);
+  }
+  need(support_context_create(SPH_BACKEND_CPU, &context), "context");
+  need(sph_world_def_init(&def), "def");
+  def.particle_spacing = spacing;
+  def.kernel_radius = 1.8f * spacing;
+  def.capacity = 1u << 20;
+  if (rank == 0) {
+    /* The block filled on a scratch undivided world, its particles added from rank 0. */
+    need(sph_world_create(context, &def, &scratch), "scratch world");
+    need(support_dam_break(context, scratch, &tank, lo, hi, NULL, NULL, &n), "block");
+    need(support_copy_by_id(scratch, SPH_ATTRIBUTE_POSITION, (void**)&positions, &n), "positions");
+    sph_world_destroy(scratch);
+  }
+  MPI_Bcast(&n, 1, MPI_UINT32_T, 0, MPI_COMM_WORLD);
+  need(sph_mpi_world_create(context, &def, (int32_t)MPI_Comm_c2f(MPI_COMM_WORLD), NULL, &world), "world");
+  need(support_tank_create(context, world, &tank, NULL, NULL), "tank");
+  need(sph_mpi_world_add_particles(world, positions, NULL, rank == 0 ? n : 0, NULL), "particles");
+  free(positions);
+  need(support_params_gravity_and_steps(&params, 0.0f, -9.81f, 0.0f, 1e-5f, 1e-3f), "params");
+  params.max_substeps = 2;
+  need(sph_world_set_params(world, &params), "set params");
+  sph_mpi_world_step(world, 1.0f); /* warm-up: the first cut and its migration */
+  params.max_substeps = substeps;
+  need(sph_world_set_params(world, &params), "set params");
+  MPI_Barrier(MPI_COMM_WORLD);
+  t0 = MPI_Wtime();
+  sph_mpi_world_step(world, 1.0f);
+  mine = MPI_Wtime() - t0;
+  MPI_Reduce(&mine, &slowest, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+  need(sph_mpi_counts_init(&c), "counts init");
+  need(sph_mpi_world_get_counts(world, &c), "counts");
+  need(sph_stats_init(&stats), "stats init");
+  need(sph_world_get_stats(world, &stats), "stats");
+  owned_max = c.local_count;
+  MPI_Allreduce(MPI_IN_PLACE, &owned_max, 1, MPI_INT64_T, MPI_MAX, MPI_COMM_WORLD);
+  if (rank == 0) {
+    /* docs/scaling.md's slab halo: one support radius of the block per face beside another
+     * slab, h / L of the block's particles (L = 0.8 m, the cut axis); 2 (R - 1) faces. */
+    const double h = 1.8 * spacing;
+    const double model = size > 1 ? n * h / 0.8 * 2.0 * (size - 1) / size : 0.0;
+    printf("ranks %d, %u particles (%.0f per rank, the fullest %lld), %u substeps\n", size, n,
+           (double)n / size, (long long)owned_max, stats.substeps);
+    printf(
+        "ghosts per rank (last substep): %.0f measured, %.0f model (h / L per slab face, h = 1.8 spacings)\n",
+        (double)c.global_ghosts / size, model);
+    printf("ms per substep (slowest rank): %.3f\n", 1e3 * slowest / stats.substeps);
+    printf("rank 0 stage ms over the step:");
+    for (int s = 0; s < SPH_STAGE_COUNT; ++s) printf(" %.1f", stats.stage_ms[s]);
+    printf("\n");
+  }
+  sph_world_destroy(world);
+  sph_context_destroy(context);
+  if (size >= 2) ping_pong(rank);
+  MPI_Finalize();
+  return 0;
+}
