@@ -6,27 +6,36 @@
 // "The submerged box per region").
 //
 //   physics_loads_breakdown [--backend cpu|cuda] [--solver wcsph|dfsph] [--dt-max SECONDS]
+//                           [--settle SECONDS] [--self-check]
 //
 // The world is made and stepped through the C API as in the test (walls in the density; WCSPH:
-// ideal gas k = 100 with the acoustic step limit; DFSPH: its defaults, dt_max 1 ms unless given).
-// At each frame's end of the last 0.4 s the program reads back positions, densities and pressures
-// and evaluates on the host, per particle, the box's share of the wall's reaction,
+// ideal gas k = 100 with the acoustic step limit; DFSPH: its defaults, dt_max 1 ms unless given):
+// (--self-check: first one substep of 0.5 ms from the lattice, below), 0.8 s (--settle) in frames of 20 ms,
+// then 0.4 s in frames of 0.5 ms, one substep each. Around each of those the program reads back, by particle
+// id, the positions before it (the substep's start) and the densities and pressures after it (its density
+// pass's, at those positions), and evaluates on the host, per particle, the box's share of the wall's
+// reaction,
 //   F_i = m (p_i / rho_i^2) K grad Phi_box(x_i)         (boundary_density.h),
-// with the box's density map computed here from the same shape (cpu_boundary_maps.h), so the
-// breakdown does not depend on the backend's own map: a CPU/CUDA difference in it is a difference
-// of the particles' states (positions, densities, pressures), not of the sampling. A particle's
-// region is the set of the box's axes it lies beyond: one axis a face (top, bottom, sides), two an
-// edge (top, bottom, vertical), three a corner (top, bottom). The wall's reaction is the force the
-// solvers apply at the substep's start positions; read at the frame's end it is an instantaneous
-// sample, averaged over the frames. The collision response's contacts are not in it: with
-// SPH_FEATURE_COLLIDER_LOADS (WCSPH; DFSPH refuses it) the loads' time average is printed beside
-// it, and their difference is the contacts plus the sampling's noise.
+// the impulse the solvers' wall force gives the box over the substep, divided by dt; exact for
+// WCSPH (the loads pass's own sum), and for DFSPH the reaction of what both solves applied
+// (p = (k + k_v / dt) rho^2). The box's density map is computed here from the same shape
+// (cpu_boundary_maps.h). --self-check: in the first substep no particle touches the box yet, so with
+// SPH_FEATURE_COLLIDER_LOADS (WCSPH; DFSPH refuses it) the loads are the walls' reaction alone and
+// the two are printed side by side (on the CPU they agree to the last printed digit; on CUDA they
+// show whether the device's map is the host's). A particle's region is the set of the box's axes
+// it lies beyond at the substep's start: one axis a face (top, bottom, sides), two an edge (top,
+// bottom, vertical), three a corner (top, bottom), none "inside the box" (particles the collision
+// response holds on the SDF's zero level where the trilinear SDF rounds an edge). With the loads,
+// the contacts are the loads less the walls' reaction over the same substeps; "contacts" per region
+// counts the particles that end a substep on or in the box's surface (those the response touched).
 //
 // Also per region: the particles within h of the box, their mean rho / rho0 and their pressure
-// against rho0 g d, d their depth below the water level (the top lattice plane's mean height plus
-// half a step, over the tank's outer ring); and the interior's p / (rho0 g d) (particles more than
-// h from every wall), the hydrostatic profile the walls see. BREAKDOWN_DEBUG=1 first prints the host
-// map along the top face's normal (K Phi(spacing / 2) must be the calibration's 23.1 % of rho0).
+// against rho0 g d, d their depth below the hydrostatic level (y + p / (rho0 g) averaged over the
+// interior: particles more than h from every wall and 5 cm below the top lattice plane); and the
+// interior's p / (rho0 g d) from 3 cm below that plane down, the profile the walls see. Each face's
+// wall reaction is compared with rho0 g d A at the face's depth (the faces' regions alone, and with
+// the adjoining edges and corners). BREAKDOWN_DEBUG=1 first prints the host map along the top face's
+// normal (K Phi(spacing / 2) must be the calibration's 23.1 % of rho0).
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -84,13 +93,15 @@ struct Tally {
   double normal = 0.0;                // N, the side faces' inward push (sum of |F| along their normal)
   double density = 0.0, pressure_ratio = 0.0;
   double count = 0.0, near = 0.0;
+  double contacts = 0.0;  // particles on the box's surface after a substep (the collision response's)
 };
 
 }  // namespace
 
 int main(int argc, char** argv) {
   const char* backend_name = "cpu";
-  bool dfsph = false;
+  bool dfsph = false, self_check = false;
+  double settle_time = 0.8;
   double dt_max = 0.0;
   for (int k = 1; k < argc; ++k) {
     if (std::strcmp(argv[k], "--backend") == 0 && k + 1 < argc)
@@ -99,8 +110,14 @@ int main(int argc, char** argv) {
       dfsph = std::strcmp(argv[++k], "dfsph") == 0;
     else if (std::strcmp(argv[k], "--dt-max") == 0 && k + 1 < argc)
       dt_max = std::atof(argv[++k]);
+    else if (std::strcmp(argv[k], "--settle") == 0 && k + 1 < argc)
+      settle_time = std::atof(argv[++k]);
+    else if (std::strcmp(argv[k], "--self-check") == 0)
+      self_check = true;
     else {
-      std::fprintf(stderr, "usage: %s [--backend cpu|cuda] [--solver wcsph|dfsph] [--dt-max SECONDS]\n",
+      std::fprintf(stderr,
+                   "usage: %s [--backend cpu|cuda] [--solver wcsph|dfsph] [--dt-max SECONDS] [--settle "
+                   "SECONDS] [--self-check]\n",
                    argv[0]);
       return 2;
     }
@@ -193,17 +210,46 @@ int main(int argc, char** argv) {
   double interior_ratio = 0.0, interior_count = 0.0, level_sum = 0.0, plane_sum = 0.0;
   double api[3] = {0.0, 0.0, 0.0}, api_time = 0.0;
   int samples = 0;
-  std::vector<float> x(3 * static_cast<size_t>(kept)), rho(kept), p(kept);
-  // Settle 0.8 s in frames of 20 ms, then 0.4 s in frames of 0.5 ms: one substep each (the step
+  std::vector<float> x(3 * static_cast<size_t>(kept)), after(x.size()), rho(kept), p(kept);
+  // Settle 0.8 s (--settle) in frames of 20 ms, then 0.4 s in frames of 0.5 ms: one substep each (the step
   // limits allow 1 ms), so the positions read before a frame are its substep's start, where the
   // density pass put the pressures and densities read after it.
-  const int settle = 40, frames = 800;
+  const int settle = static_cast<int>(std::lround(settle_time / 0.02)), frames = 800;
   const float frame_time = 0.0005f;
-  for (int frame = 0; frame < settle; ++frame) check(sph_world_step(w.world, 0.02f), "sph_world_step");
-  for (int frame = 0; frame < frames; ++frame) {
-    uint32_t count = 0;
-    check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, x.data(), kept, &count), "read positions");
+  // The self-check: the first substep from the lattice has no contacts yet, so with the loads on its
+  // loads are the walls' reaction alone, which the host's map must reproduce.
+  if (self_check) {
+    uint32_t c0 = 0;
+    check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, x.data(), kept, &c0), "read positions");
     check(sph_world_step(w.world, frame_time), "sph_world_step");
+    check(support_read_by_id(w.world, SPH_ATTRIBUTE_DENSITY, rho.data(), kept, &c0), "read densities");
+    check(support_read_by_id(w.world, SPH_ATTRIBUTE_PRESSURE, p.data(), kept, &c0), "read pressures");
+    double f[3] = {0.0, 0.0, 0.0};
+    for (uint32_t i = 0; i < c0; ++i) {
+      const sph::Vec3 at{static_cast<float>(x[3 * i] - kCentre[0]),
+                         static_cast<float>(x[3 * i + 1] - kCentre[1]),
+                         static_cast<float>(x[3 * i + 2] - kCentre[2])};
+      const sph::LocalBoundaryShare s = sph::local_boundary_share(grid, map.data(), 1.0f, level, h, at);
+      const double c = static_cast<double>(w.mass) * p[i] / (static_cast<double>(rho[i]) * rho[i]) * K;
+      f[0] += c * s.gradient.x, f[1] += c * s.gradient.y, f[2] += c * s.gradient.z;
+    }
+    sph_collider_loads l;
+    check(sph_collider_loads_init(&l), "sph_collider_loads_init");
+    if (loads) {
+      check(sph_collider_get_loads(w.world, box, &l), "sph_collider_get_loads");
+      std::printf(
+          "self-check, the first substep (no contacts): the walls' reaction on the host (%+.5f %+.5f %+.5f) "
+          "N, the loads (%+.5f %+.5f %+.5f) N\n",
+          f[0], f[1], f[2], static_cast<double>(l.force.x), static_cast<double>(l.force.y),
+          static_cast<double>(l.force.z));
+    }
+  }
+  for (int frame = 0; frame < settle; ++frame) check(sph_world_step(w.world, 0.02f), "sph_world_step");
+  uint32_t count = 0;
+  check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, x.data(), kept, &count), "read positions");
+  for (int frame = 0; frame < frames; ++frame) {
+    check(sph_world_step(w.world, frame_time), "sph_world_step");
+    check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, after.data(), kept, &count), "read positions");
     check(support_read_by_id(w.world, SPH_ATTRIBUTE_DENSITY, rho.data(), kept, &count), "read densities");
     check(support_read_by_id(w.world, SPH_ATTRIBUTE_PRESSURE, p.data(), kept, &count), "read pressures");
     sph_stats stats;
@@ -265,10 +311,17 @@ int main(int argc, char** argv) {
       for (int k = 0; k < 3; ++k) t.force[k] += f[k];
       if (region_of(local) == kSides) t.normal += std::fabs(std::fabs(local[0]) > kHalf ? f[0] : f[2]);
       t.count += f[0] != 0.0 || f[1] != 0.0 || f[2] != 0.0;
+      {
+        const sph::Vec3 end{static_cast<float>(after[3 * i] - kCentre[0]),
+                            static_cast<float>(after[3 * i + 1] - kCentre[1]),
+                            static_cast<float>(after[3 * i + 2] - kCentre[2])};
+        t.contacts += sph::sample_distance(grid, end) < 1e-5f;
+      }
       if (distance < h) t.near += 1.0, t.density += rho[i] / rho0, t.pressure_ratio += ratio;
       if (interior(i, plane - 0.03)) interior_ratio += ratio, interior_count += 1.0;
     }
     ++samples;
+    x.swap(after);
   }
   const double mean_level = level_sum / samples;
   const double top_face = kCentre[1] + kHalf, bottom_face = kCentre[1] - kHalf;
@@ -284,16 +337,16 @@ int main(int argc, char** argv) {
       "interior (3 cm below the top plane and deeper) p / (rho0 g d) %.4f (%.0f particle samples)\n",
       mean_level, plane_sum / samples, mean_level - top_face, mean_level - bottom_face, expected,
       interior_count > 0.0 ? interior_ratio / interior_count : 0.0, interior_count);
-  std::printf("%-15s %9s %9s %9s %8s | %6s %8s %10s\n", "region", "Fy (N)", "Fy/rho0gV", "Fx,Fz (N)",
-              "particles", "near", "rho/rho0", "p/rho0gd");
+  std::printf("%-15s %9s %9s %9s %8s %8s | %6s %8s %10s\n", "region", "Fy (N)", "Fy/rho0gV", "Fx,Fz (N)",
+              "particles", "contacts", "near", "rho/rho0", "p/rho0gd");
   double total[3] = {0.0, 0.0, 0.0};
   for (int r = 0; r < kRegions; ++r) {
     const Tally& t = tally[r];
     const double fy = t.force[1] / samples;
     for (int k = 0; k < 3; ++k) total[k] += t.force[k] / samples;
-    std::printf("%-15s %+9.4f %+9.4f %+4.3f,%+4.3f %8.1f | %6.1f %8.4f %10.4f\n", kRegionNames[r], fy,
+    std::printf("%-15s %+9.4f %+9.4f %+4.3f,%+4.3f %8.1f %8.2f | %6.1f %8.4f %10.4f\n", kRegionNames[r], fy,
                 fy / expected, t.force[0] / samples, t.force[2] / samples, t.count / samples,
-                t.near / samples, t.near > 0.0 ? t.density / t.near : 0.0,
+                t.contacts / samples, t.near / samples, t.near > 0.0 ? t.density / t.near : 0.0,
                 t.near > 0.0 ? t.pressure_ratio / t.near : 0.0);
   }
   const double top_all =
@@ -315,12 +368,16 @@ int main(int argc, char** argv) {
       100.0 * (tally[kSides].normal / samples / 4.0 / side_expected - 1.0), side_expected);
   std::printf("walls' reaction, all regions: (%+.4f, %+.4f, %+.4f) N, buoyancy %+.2f %% of rho0 g V\n",
               total[0], total[1], total[2], 100.0 * (total[1] / expected - 1.0));
-  if (loads)
+  if (loads) {
+    const double l[3] = {api[0] / api_time, api[1] / api_time, api[2] / api_time};
     std::printf(
-        "the loads (SPH_FEATURE_COLLIDER_LOADS, time average, contacts included): (%+.4f, %+.4f, %+.4f) N, "
-        "buoyancy %+.2f %%\n",
-        api[0] / api_time, api[1] / api_time, api[2] / api_time,
-        100.0 * (api[1] / api_time / expected - 1.0));
+        "the loads (SPH_FEATURE_COLLIDER_LOADS, the same substeps, contacts included): (%+.4f, %+.4f, %+.4f) "
+        "N, buoyancy %+.2f %%\n",
+        l[0], l[1], l[2], 100.0 * (l[1] / expected - 1.0));
+    std::printf(
+        "the contacts (the loads less the walls' reaction): (%+.4f, %+.4f, %+.4f) N, %+.2f %% of rho0 g V\n",
+        l[0] - total[0], l[1] - total[1], l[2] - total[2], 100.0 * (l[1] - total[1]) / expected);
+  }
   std::free(lattice);
   check(sph_sdf_destroy(tank_sdf), "sph_sdf_destroy");
   check(sph_sdf_destroy(box_sdf), "sph_sdf_destroy");
