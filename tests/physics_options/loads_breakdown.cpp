@@ -6,7 +6,11 @@
 // "The submerged box per region").
 //
 //   physics_loads_breakdown [--backend cpu|cuda] [--solver wcsph|dfsph] [--dt-max SECONDS]
-//                           [--settle SECONDS] [--self-check]
+//                           [--settle SECONDS] [--perturb SEED] [--self-check]
+//
+// --perturb moves every lattice point by up to 1e-7 m (uniform per axis, a generator seeded with
+// SEED): a change of the size of a float's rounding, to see how far the box's settled state
+// depends on it (a CPU/CUDA difference is of that size).
 //
 // The world is made and stepped through the C API as in the test (walls in the density; WCSPH:
 // ideal gas k = 100 with the acoustic step limit; DFSPH: its defaults, dt_max 1 ms unless given):
@@ -37,6 +41,7 @@
 // the adjoining edges and corners). BREAKDOWN_DEBUG=1 first prints the host map along the top face's
 // normal (K Phi(spacing / 2) must be the calibration's 23.1 % of rho0).
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -102,6 +107,7 @@ int main(int argc, char** argv) {
   const char* backend_name = "cpu";
   bool dfsph = false, self_check = false;
   double settle_time = 0.8;
+  unsigned long perturb = 0;
   double dt_max = 0.0;
   for (int k = 1; k < argc; ++k) {
     if (std::strcmp(argv[k], "--backend") == 0 && k + 1 < argc)
@@ -112,6 +118,8 @@ int main(int argc, char** argv) {
       dt_max = std::atof(argv[++k]);
     else if (std::strcmp(argv[k], "--settle") == 0 && k + 1 < argc)
       settle_time = std::atof(argv[++k]);
+    else if (std::strcmp(argv[k], "--perturb") == 0 && k + 1 < argc)
+      perturb = std::strtoul(argv[++k], nullptr, 10);
     else if (std::strcmp(argv[k], "--self-check") == 0)
       self_check = true;
     else {
@@ -136,6 +144,13 @@ int main(int argc, char** argv) {
     if (inside) continue;
     std::memmove(lattice + 3 * kept, lattice + 3 * i, 3 * sizeof(float));
     ++kept;
+  }
+  if (perturb != 0) {
+    uint64_t state = perturb * 0x9E3779B97F4A7C15ull;
+    for (uint32_t i = 0; i < 3 * kept; ++i) {
+      state = state * 6364136223846793005ull + 1442695040888963407ull;
+      lattice[i] += static_cast<float>(((state >> 11) * (1.0 / 9007199254740992.0) * 2.0 - 1.0) * 1e-7);
+    }
   }
   sph_world_def def;
   sph_world_def_init(&def);
