@@ -32,6 +32,11 @@
 // response holds on the SDF's zero level where the trilinear SDF rounds an edge). With the loads,
 // the contacts are the loads less the walls' reaction over the same substeps; "contacts" per region
 // counts the particles that end a substep on or in the box's surface (those the response touched).
+// Momentum balance: the fluid's dP/dt = M g less the colliders' forces, so with the tank's walls'
+// reaction also summed on the host (its map computed here too), M g - dP/dt - both walls' reactions
+// is what the colliders receive besides the walls' reaction: the contacts, and for DFSPH the
+// impulses of its contact clamp (respect_contact), which no loads report. With the loads (WCSPH)
+// the same from the loads is printed as a check (they agree to the printed digits on the CPU).
 //
 // Also per region: the particles within h of the box, their mean rho / rho0 and their pressure
 // against rho0 g d, d their depth below the hydrostatic level (y + p / (rho0 g) averaged over the
@@ -174,7 +179,8 @@ int main(int argc, char** argv) {
   check(support_world_set_params(&w), "sph_world_set_params");
   const double tank_min[3] = {0.0, 0.0, 0.0}, tank_max[3] = {kSide, 0.4, kSide};
   sph_sdf *tank_sdf = nullptr, *box_sdf = nullptr;
-  check(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * kStep, 0.0f, &tank_sdf, nullptr),
+  sph_collider_id tank;
+  check(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * kStep, 0.0f, &tank_sdf, &tank),
         "support_tank_between");
   sph_shape_desc shape;
   check(sph_shape_desc_init(&shape), "sph_shape_desc_init");
@@ -209,6 +215,16 @@ int main(int argc, char** argv) {
   const float level = -static_cast<float>(calibration.offset);  // a solid (sign +1) counts {phi < -delta}
   const auto map = sph::compute_boundary_map(*asset, h, level, sph::CpuParallel(2));
   const sph::SdfGridView grid = asset->host_view();
+  // The tank's too (an inverted box, sign -1, its map at +delta), for the momentum balance below.
+  sph::ShapeSpec tank_spec;
+  tank_spec.kind = sph::ShapeKind::Box;
+  tank_spec.half_extents = sph::Vec3{static_cast<float>(0.5 * kSide), 0.2f, static_cast<float>(0.5 * kSide)};
+  tank_spec.voxel_size = static_cast<float>(0.5 * kStep);
+  const auto tank_asset = sph::build_shape_sdf(tank_spec, 1u << 24);
+  const float tank_level = static_cast<float>(calibration.offset);
+  const auto tank_map = sph::compute_boundary_map(*tank_asset, h, tank_level, sph::CpuParallel(2));
+  const sph::SdfGridView tank_grid = tank_asset->host_view();
+  double tank_walls[3] = {0.0, 0.0, 0.0}, tank_loads[3] = {0.0, 0.0, 0.0}, momentum[3] = {0.0, 0.0, 0.0};
 
   if (std::getenv("BREAKDOWN_DEBUG")) {
     for (double d : {0.0, 0.0035, 0.00707, 0.0141, 0.02}) {
@@ -261,6 +277,11 @@ int main(int argc, char** argv) {
   }
   for (int frame = 0; frame < settle; ++frame) check(sph_world_step(w.world, 0.02f), "sph_world_step");
   uint32_t count = 0;
+  std::vector<float> velocity(x.size());
+  check(support_read_by_id(w.world, SPH_ATTRIBUTE_VELOCITY, velocity.data(), kept, &count),
+        "read velocities");
+  for (uint32_t i = 0; i < count; ++i)
+    for (int k = 0; k < 3; ++k) momentum[k] -= static_cast<double>(w.mass) * velocity[3 * i + k];
   check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, x.data(), kept, &count), "read positions");
   for (int frame = 0; frame < frames; ++frame) {
     check(sph_world_step(w.world, frame_time), "sph_world_step");
@@ -281,6 +302,9 @@ int main(int argc, char** argv) {
       api[0] += l.force.x * l.frame_time, api[1] += l.force.y * l.frame_time,
           api[2] += l.force.z * l.frame_time;
       api_time += l.frame_time;
+      check(sph_collider_get_loads(w.world, tank, &l), "sph_collider_get_loads");
+      tank_loads[0] += l.force.x * l.frame_time, tank_loads[1] += l.force.y * l.frame_time;
+      tank_loads[2] += l.force.z * l.frame_time;
     }
     // The water level two ways: the hydrostatic level the interior's pressure gives (y + p / (rho0 g)
     // averaged over the particles more than h from every wall and 5 cm below the top plane), and the
@@ -321,6 +345,14 @@ int main(int argc, char** argv) {
       const sph::LocalBoundaryShare s = sph::local_boundary_share(grid, map.data(), 1.0f, level, h, at);
       const double distance = sph::sample_distance(grid, at);
       const double c = static_cast<double>(w.mass) * p[i] / (static_cast<double>(rho[i]) * rho[i]) * K;
+      {
+        const sph::Vec3 in_tank{static_cast<float>(x[3 * i] - 0.5 * kSide),
+                                static_cast<float>(x[3 * i + 1] - 0.2),
+                                static_cast<float>(x[3 * i + 2] - 0.5 * kSide)};
+        const sph::Vec3 g =
+            sph::local_boundary_share(tank_grid, tank_map.data(), -1.0f, tank_level, h, in_tank).gradient;
+        tank_walls[0] += c * g.x, tank_walls[1] += c * g.y, tank_walls[2] += c * g.z;
+      }
       Tally& t = tally[region_of(local)];
       const double f[3] = {c * s.gradient.x, c * s.gradient.y, c * s.gradient.z};
       for (int k = 0; k < 3; ++k) t.force[k] += f[k];
@@ -354,6 +386,10 @@ int main(int argc, char** argv) {
       interior_count > 0.0 ? interior_ratio / interior_count : 0.0, interior_count);
   std::printf("%-15s %9s %9s %9s %8s %8s | %6s %8s %10s\n", "region", "Fy (N)", "Fy/rho0gV", "Fx,Fz (N)",
               "particles", "contacts", "near", "rho/rho0", "p/rho0gd");
+  check(support_read_by_id(w.world, SPH_ATTRIBUTE_VELOCITY, velocity.data(), kept, &count),
+        "read velocities");
+  for (uint32_t i = 0; i < count; ++i)
+    for (int k = 0; k < 3; ++k) momentum[k] += static_cast<double>(w.mass) * velocity[3 * i + k];
   double total[3] = {0.0, 0.0, 0.0};
   for (int r = 0; r < kRegions; ++r) {
     const Tally& t = tally[r];
@@ -392,6 +428,26 @@ int main(int argc, char** argv) {
     std::printf(
         "the contacts (the loads less the walls' reaction): (%+.4f, %+.4f, %+.4f) N, %+.2f %% of rho0 g V\n",
         l[0] - total[0], l[1] - total[1], l[2] - total[2], 100.0 * (l[1] - total[1]) / expected);
+  }
+  {
+    // The fluid's momentum: dP/dt = M g - sum over colliders of their forces, so the forces that are
+    // neither wall's reaction (both colliders' contacts; DFSPH's contact clamp too) are
+    // M g - dP/dt - the walls' reactions. With the loads (WCSPH) the same from the loads, as a check.
+    const double seconds = static_cast<double>(frame_time) * frames,
+                 weight = kept * static_cast<double>(w.mass) * kGravity;
+    double rest[3];
+    for (int k = 0; k < 3; ++k)
+      rest[k] = -(k == 1 ? weight : 0.0) - momentum[k] / seconds - total[k] - tank_walls[k] / samples;
+    std::printf(
+        "momentum balance: weight %.4f N, fluid dP/dt (%+.4f, %+.4f, %+.4f) N, tank walls' reaction (%+.4f, "
+        "%+.4f, %+.4f) N; the colliders' other forces (contacts, DFSPH's clamp): (%+.4f, %+.4f, %+.4f) N\n",
+        weight, momentum[0] / seconds, momentum[1] / seconds, momentum[2] / seconds, tank_walls[0] / samples,
+        tank_walls[1] / samples, tank_walls[2] / samples, rest[0], rest[1], rest[2]);
+    if (loads)
+      std::printf("  the same from the loads, both colliders' contacts: (%+.4f, %+.4f, %+.4f) N\n",
+                  (api[0] + tank_loads[0]) / api_time - total[0] - tank_walls[0] / samples,
+                  (api[1] + tank_loads[1]) / api_time - total[1] - tank_walls[1] / samples,
+                  (api[2] + tank_loads[2]) / api_time - total[2] - tank_walls[2] / samples);
   }
   std::free(lattice);
   check(sph_sdf_destroy(tank_sdf), "sph_sdf_destroy");
