@@ -53,6 +53,7 @@
 #include <string>
 #include <vector>
 
+#include "box_regions.h"
 #include "core/fcc_lattice.h"
 #include "core/sdf_asset.h"
 #include "core/sdf_shapes.h"
@@ -63,39 +64,15 @@
 
 namespace {
 
-const double kStep = 0.01, kGravity = 9.81, kHalf = 0.03, kSide = 0.16;
+using namespace loads_breakdown;  // NOLINT: the regions' names (box_regions.h)
+
+const double kStep = 0.01, kGravity = 9.81, kSide = 0.16;
 const double kCentre[3] = {0.08, 0.08, 0.08};
 
 void check(sph_result r, const char* what) {
   if (r == SPH_OK) return;
   std::fprintf(stderr, "%s: %s (%s)\n", what, sph_result_string(r), sph_get_last_error());
   std::exit(1);
-}
-
-enum Region {
-  kTop,
-  kBottom,
-  kSides,
-  kEdgeTop,
-  kEdgeBottom,
-  kEdgeVertical,
-  kCornerTop,
-  kCornerBottom,
-  kInside,
-  kRegions
-};
-const char* const kRegionNames[kRegions] = {"top face",    "bottom face",    "side faces",
-                                            "top edges",   "bottom edges",   "vertical edges",
-                                            "top corners", "bottom corners", "inside the box"};
-
-Region region_of(const double local[3]) {
-  const bool out[3] = {std::fabs(local[0]) > kHalf, std::fabs(local[1]) > kHalf, std::fabs(local[2]) > kHalf};
-  const int count = out[0] + out[1] + out[2];
-  const bool up = local[1] > 0.0;
-  if (count == 0) return kInside;
-  if (count == 3) return up ? kCornerTop : kCornerBottom;
-  if (count == 2) return out[1] ? (up ? kEdgeTop : kEdgeBottom) : kEdgeVertical;
-  return out[1] ? (up ? kTop : kBottom) : kSides;
 }
 
 struct Tally {
