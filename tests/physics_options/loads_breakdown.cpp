@@ -6,7 +6,7 @@
 // "The submerged box per region").
 //
 //   physics_loads_breakdown [--backend cpu|cuda] [--solver wcsph|dfsph] [--dt-max SECONDS]
-//                           [--settle SECONDS] [--perturb SEED] [--self-check]
+//                           [--settle SECONDS] [--perturb SEED] [--self-check | --self-check-only]
 //
 // --perturb moves every lattice point by up to 1e-7 m (uniform per axis, a generator seeded with
 // SEED): a change of the size of a float's rounding, to see how far the box's settled state
@@ -26,9 +26,11 @@
 // (cpu_boundary_maps.h). --self-check: in the first substep no particle touches the box yet, so with
 // SPH_FEATURE_COLLIDER_LOADS (WCSPH; DFSPH refuses it) the loads are the walls' reaction alone and
 // the two are printed side by side (on the CPU they agree to the last printed digit; on CUDA they
-// show whether the device's map is the host's). A particle's region is the set of the box's axes
-// it lies beyond at the substep's start: one axis a face (top, bottom, sides), two an edge (top,
-// bottom, vertical), three a corner (top, bottom), none "inside the box" (particles the collision
+// show whether the device's map is the host's). --self-check-only stops there and fails unless
+// they agree within 1e-5 of the force (the ctest physics_loads_breakdown_self_check; the backend
+// defaults to SPH_TEST_BACKEND's, so the GPU test script runs it on CUDA). A particle's region is the set of
+// the box's axes it lies beyond at the substep's start: one axis a face (top, bottom, sides), two an edge
+// (top, bottom, vertical), three a corner (top, bottom), none "inside the box" (particles the collision
 // response holds on the SDF's zero level where the trilinear SDF rounds an edge). With the loads,
 // the contacts are the loads less the walls' reaction over the same substeps; "contacts" per region
 // counts the particles that end a substep on or in the box's surface (those the response touched).
@@ -86,8 +88,8 @@ struct Tally {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const char* backend_name = "cpu";
-  bool dfsph = false, self_check = false;
+  const char* backend_name = sph_test_backend_name();  // SPH_TEST_BACKEND, unset: cpu
+  bool dfsph = false, self_check = false, only = false;
   double settle_time = 0.8;
   unsigned long perturb = 0;
   double dt_max = 0.0;
@@ -104,10 +106,12 @@ int main(int argc, char** argv) {
       perturb = std::strtoul(argv[++k], nullptr, 10);
     else if (std::strcmp(argv[k], "--self-check") == 0)
       self_check = true;
+    else if (std::strcmp(argv[k], "--self-check-only") == 0)
+      self_check = only = true;
     else {
       std::fprintf(stderr,
                    "usage: %s [--backend cpu|cuda] [--solver wcsph|dfsph] [--dt-max SECONDS] [--settle "
-                   "SECONDS] [--self-check]\n",
+                   "SECONDS] [--perturb SEED] [--self-check | --self-check-only]\n",
                    argv[0]);
       return 2;
     }
@@ -192,15 +196,6 @@ int main(int argc, char** argv) {
   const float level = -static_cast<float>(calibration.offset);  // a solid (sign +1) counts {phi < -delta}
   const auto map = sph::compute_boundary_map(*asset, h, level, sph::CpuParallel(2));
   const sph::SdfGridView grid = asset->host_view();
-  // The tank's too (an inverted box, sign -1, its map at +delta), for the momentum balance below.
-  sph::ShapeSpec tank_spec;
-  tank_spec.kind = sph::ShapeKind::Box;
-  tank_spec.half_extents = sph::Vec3{static_cast<float>(0.5 * kSide), 0.2f, static_cast<float>(0.5 * kSide)};
-  tank_spec.voxel_size = static_cast<float>(0.5 * kStep);
-  const auto tank_asset = sph::build_shape_sdf(tank_spec, 1u << 24);
-  const float tank_level = static_cast<float>(calibration.offset);
-  const auto tank_map = sph::compute_boundary_map(*tank_asset, h, tank_level, sph::CpuParallel(2));
-  const sph::SdfGridView tank_grid = tank_asset->host_view();
   double tank_walls[3] = {0.0, 0.0, 0.0}, tank_loads[3] = {0.0, 0.0, 0.0}, momentum[3] = {0.0, 0.0, 0.0};
 
   if (std::getenv("BREAKDOWN_DEBUG")) {
@@ -251,7 +246,31 @@ int main(int argc, char** argv) {
           f[0], f[1], f[2], static_cast<double>(l.force.x), static_cast<double>(l.force.y),
           static_cast<double>(l.force.z));
     }
+    if (only) {
+      // The bound: the sums' rounding (float per particle, in another order on the host), 1e-5 of
+      // the force; on the CPU they agree bit for bit at the printed digits.
+      const double got[3] = {l.force.x, l.force.y, l.force.z};
+      double worst = 0.0, scale = 0.0;
+      for (int k = 0; k < 3; ++k)
+        worst = std::fmax(worst, std::fabs(f[k] - got[k])), scale += got[k] * got[k];
+      const bool pass = loads && scale > 0.0 && worst <= 1e-5 * std::sqrt(scale);
+      std::printf("self-check %s (largest difference %.3g N)\n", pass ? "passed" : "FAILED", worst);
+      std::free(lattice);
+      check(sph_sdf_destroy(tank_sdf), "sph_sdf_destroy");
+      check(sph_sdf_destroy(box_sdf), "sph_sdf_destroy");
+      check(support_world_close(&w), "support_world_close");
+      return pass ? 0 : 1;
+    }
   }
+  // The tank's too (an inverted box, sign -1, its map at +delta), for the momentum balance below.
+  sph::ShapeSpec tank_spec;
+  tank_spec.kind = sph::ShapeKind::Box;
+  tank_spec.half_extents = sph::Vec3{static_cast<float>(0.5 * kSide), 0.2f, static_cast<float>(0.5 * kSide)};
+  tank_spec.voxel_size = static_cast<float>(0.5 * kStep);
+  const auto tank_asset = sph::build_shape_sdf(tank_spec, 1u << 24);
+  const float tank_level = static_cast<float>(calibration.offset);
+  const auto tank_map = sph::compute_boundary_map(*tank_asset, h, tank_level, sph::CpuParallel(2));
+  const sph::SdfGridView tank_grid = tank_asset->host_view();
   for (int frame = 0; frame < settle; ++frame) check(sph_world_step(w.world, 0.02f), "sph_world_step");
   uint32_t count = 0;
   std::vector<float> velocity(x.size());
