@@ -1,0 +1,453 @@
+// SPDX-License-Identifier: MIT
+// The submerged box of test_collider_loads.c (a 6 cm cube fixed with its centre 8 cm above the floor
+// of a tank 16 x 16 cm filled to 20 cm, lattice step 1 cm, h = 2.5 cm), its walls' pressure
+// reaction broken down per face, edge and corner region, on either backend and either solver
+// (issue 17 item 5: which part of the buoyancy's error comes from where; docs/validation.md,
+// "The submerged box per region").
+//
+//   physics_loads_breakdown [--backend cpu|cuda] [--solver wcsph|dfsph] [--dt-max SECONDS]
+//                           [--settle SECONDS] [--perturb SEED] [--self-check | --self-check-only]
+//
+// --perturb moves every lattice point by up to 1e-7 m (uniform per axis, a generator seeded with
+// SEED): a change of the size of a float's rounding, to see how far the box's settled state
+// depends on it (a CPU/CUDA difference is of that size).
+//
+// The world is made and stepped through the C API as in the test (walls in the density; WCSPH:
+// ideal gas k = 100 with the acoustic step limit; DFSPH: its defaults, dt_max 1 ms unless given):
+// (--self-check: first one substep of 0.5 ms from the lattice, below), 0.8 s (--settle) in frames of 20 ms,
+// then 0.4 s in frames of 0.5 ms, one substep each. Around each of those the program reads back, by particle
+// id, the positions before it (the substep's start) and the densities and pressures after it (its density
+// pass's, at those positions), and evaluates on the host, per particle, the box's share of the wall's
+// reaction,
+//   F_i = m (p_i / rho_i^2) K grad Phi_box(x_i)         (boundary_density.h),
+// the impulse the solvers' wall force gives the box over the substep, divided by dt; exact for
+// WCSPH (the loads pass's own sum), and for DFSPH the reaction of what both solves applied
+// (p = (k + k_v / dt) rho^2). The box's density map is computed here from the same shape
+// (cpu_boundary_maps.h). --self-check: in the first substep no particle touches the box yet, so with
+// SPH_FEATURE_COLLIDER_LOADS (WCSPH; DFSPH refuses it) the loads are the walls' reaction alone and
+// the two are printed side by side (on the CPU they agree to the last printed digit; on CUDA they
+// show whether the device's map is the host's). --self-check-only stops there and fails unless
+// they agree within 1e-5 of the force (the ctest physics_loads_breakdown_self_check; the backend
+// defaults to SPH_TEST_BACKEND's, so the GPU test script runs it on CUDA). A particle's region is the set of
+// the box's axes it lies beyond at the substep's start: one axis a face (top, bottom, sides), two an edge
+// (top, bottom, vertical), three a corner (top, bottom), none "inside the box" (particles the collision
+// response holds on the SDF's zero level where the trilinear SDF rounds an edge). With the loads,
+// the contacts are the loads less the walls' reaction over the same substeps; "contacts" per region
+// counts the particles that end a substep on or in the box's surface (those the response touched).
+// Momentum balance: the fluid's dP/dt = M g less the colliders' forces, so with the tank's walls'
+// reaction also summed on the host (its map computed here too), M g - dP/dt - both walls' reactions
+// is what the colliders receive besides the walls' reaction: the contacts, and for DFSPH the
+// impulses of its contact clamp (respect_contact), which no loads report. With the loads (WCSPH)
+// the same from the loads is printed as a check (they agree to the printed digits on the CPU).
+//
+// Also per region: the particles within h of the box, their mean rho / rho0 and their pressure
+// against rho0 g d, d their depth below the hydrostatic level (y + p / (rho0 g) averaged over the
+// interior: particles more than h from every wall and 5 cm below the top lattice plane); and the
+// interior's p / (rho0 g d) from 3 cm below that plane down, the profile the walls see. Each face's
+// wall reaction is compared with rho0 g d A at the face's depth (the faces' regions alone, and with
+// the adjoining edges and corners). BREAKDOWN_DEBUG=1 first prints the host map along the top face's
+// normal (K Phi(spacing / 2) must be the calibration's 23.1 % of rho0).
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "box_regions.h"
+#include "core/fcc_lattice.h"
+#include "core/sdf_asset.h"
+#include "core/sdf_shapes.h"
+#include "cpu/cpu_boundary_maps.h"
+#include "cpu/cpu_parallel.h"
+#include "physics/boundary_density.h"
+#include "support.h"
+
+namespace {
+
+using namespace loads_breakdown;  // NOLINT: the regions' names (box_regions.h)
+
+const double kStep = 0.01, kGravity = 9.81, kSide = 0.16;
+const double kCentre[3] = {0.08, 0.08, 0.08};
+
+void check(sph_result r, const char* what) {
+  if (r == SPH_OK) return;
+  std::fprintf(stderr, "%s: %s (%s)\n", what, sph_result_string(r), sph_get_last_error());
+  std::exit(1);
+}
+
+struct Tally {
+  double force[3] = {0.0, 0.0, 0.0};  // N, summed over samples
+  double normal = 0.0;                // N, the side faces' inward push (sum of |F| along their normal)
+  double density = 0.0, pressure_ratio = 0.0;
+  double count = 0.0, near = 0.0;
+  double contacts = 0.0;  // particles on the box's surface after a substep (the collision response's)
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const char* backend_name = sph_test_backend_name();  // SPH_TEST_BACKEND, unset: cpu
+  bool dfsph = false, self_check = false, only = false;
+  double settle_time = 0.8;
+  unsigned long perturb = 0;
+  double dt_max = 0.0;
+  for (int k = 1; k < argc; ++k) {
+    if (std::strcmp(argv[k], "--backend") == 0 && k + 1 < argc)
+      backend_name = argv[++k];
+    else if (std::strcmp(argv[k], "--solver") == 0 && k + 1 < argc)
+      dfsph = std::strcmp(argv[++k], "dfsph") == 0;
+    else if (std::strcmp(argv[k], "--dt-max") == 0 && k + 1 < argc)
+      dt_max = std::atof(argv[++k]);
+    else if (std::strcmp(argv[k], "--settle") == 0 && k + 1 < argc)
+      settle_time = std::atof(argv[++k]);
+    else if (std::strcmp(argv[k], "--perturb") == 0 && k + 1 < argc)
+      perturb = std::strtoul(argv[++k], nullptr, 10);
+    else if (std::strcmp(argv[k], "--self-check") == 0)
+      self_check = true;
+    else if (std::strcmp(argv[k], "--self-check-only") == 0)
+      self_check = only = true;
+    else {
+      std::fprintf(stderr,
+                   "usage: %s [--backend cpu|cuda] [--solver wcsph|dfsph] [--dt-max SECONDS] [--settle "
+                   "SECONDS] [--perturb SEED] [--self-check | --self-check-only]\n",
+                   argv[0]);
+      return 2;
+    }
+  }
+  const sph_backend backend = support_backend_from_name(backend_name, SPH_BACKEND_CPU);
+
+  // The scene of test_collider_loads.c's submerged_box_force.
+  const uint32_t layers[3] = {16, 20, 16};
+  float* lattice = nullptr;
+  uint32_t n = 0, kept = 0;
+  check(support_fcc_box(layers, kStep, nullptr, &lattice, &n), "support_fcc_box");
+  for (uint32_t i = 0; i < n; ++i) {
+    bool inside = true;
+    for (int k = 0; k < 3; ++k)
+      inside = inside && std::fabs(lattice[3 * i + k] - kCentre[k]) < kHalf + 0.5 * kStep;
+    if (inside) continue;
+    std::memmove(lattice + 3 * kept, lattice + 3 * i, 3 * sizeof(float));
+    ++kept;
+  }
+  if (perturb != 0) {
+    uint64_t state = perturb * 0x9E3779B97F4A7C15ull;
+    for (uint32_t i = 0; i < 3 * kept; ++i) {
+      state = state * 6364136223846793005ull + 1442695040888963407ull;
+      lattice[i] += static_cast<float>(((state >> 11) * (1.0 / 9007199254740992.0) * 2.0 - 1.0) * 1e-7);
+    }
+  }
+  sph_world_def def;
+  sph_world_def_init(&def);
+  def.particle_spacing = static_cast<float>(kStep * std::sqrt(2.0));
+  def.capacity = kept;
+  def.features = SPH_FEATURE_BOUNDARY_DENSITY | SPH_FEATURE_COLLIDER_LOADS;
+  if (dfsph) def.solver = SPH_SOLVER_DFSPH;
+  support_world w;
+  std::memset(&w, 0, sizeof w);
+  bool loads = true;
+  if (support_world_open(&w, backend, &def, nullptr) != SPH_OK) {
+    support_world_close(&w);
+    def.features &= ~SPH_FEATURE_COLLIDER_LOADS;  // DFSPH refuses the loads (issue 16/17)
+    loads = false;
+    check(support_world_open(&w, backend, &def, nullptr), "support_world_open");
+  }
+  sph_world_params params = w.params;
+  if (!dfsph) params.step_limits = SPH_STEP_LIMIT_ACOUSTIC;
+  if (dt_max > 0.0) params.dt_max = static_cast<float>(dt_max);
+  w.params = params;
+  check(support_world_set_params(&w), "sph_world_set_params");
+  const double tank_min[3] = {0.0, 0.0, 0.0}, tank_max[3] = {kSide, 0.4, kSide};
+  sph_sdf *tank_sdf = nullptr, *box_sdf = nullptr;
+  sph_collider_id tank;
+  check(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * kStep, 0.0f, &tank_sdf, &tank),
+        "support_tank_between");
+  sph_shape_desc shape;
+  check(sph_shape_desc_init(&shape), "sph_shape_desc_init");
+  shape.shape = SPH_SHAPE_BOX;
+  shape.half_extents.x = shape.half_extents.y = shape.half_extents.z = static_cast<float>(kHalf);
+  shape.voxel_size = 0.005f;
+  shape.padding_voxels = 8;
+  check(sph_sdf_create_shape(w.context, &shape, &box_sdf), "sph_sdf_create_shape");
+  sph_collider_def collider;
+  check(sph_collider_def_init(&collider), "sph_collider_def_init");
+  collider.sdf = box_sdf;
+  collider.transform = sph_transform_identity();
+  collider.transform.position.x = static_cast<float>(kCentre[0]);
+  collider.transform.position.y = static_cast<float>(kCentre[1]);
+  collider.transform.position.z = static_cast<float>(kCentre[2]);
+  sph_collider_id box;
+  check(sph_collider_create(w.world, &collider, &box), "sph_collider_create");
+  check(support_spawn(w.world, lattice, nullptr, kept), "support_spawn");
+
+  // The box's map on the host, from the same shape (api_sdf.cpp's conversion) and the world's
+  // calibration (BoundaryDensity::make_constants): K = m scale, the solid moved delta into it.
+  const float h = w.def.kernel_radius, spacing = w.def.particle_spacing, rho0 = w.def.rest_density;
+  sph::ShapeSpec spec;
+  spec.kind = sph::ShapeKind::Box;
+  spec.half_extents =
+      sph::Vec3{static_cast<float>(kHalf), static_cast<float>(kHalf), static_cast<float>(kHalf)};
+  spec.voxel_size = 0.005f;
+  spec.padding_voxels = 8;
+  const auto asset = sph::build_shape_sdf(spec, 1u << 24);
+  const sph::BoundaryCalibration calibration = sph::fcc_boundary_calibration(spacing, h);
+  const float K = static_cast<float>(calibration.scale * w.mass);
+  const float level = -static_cast<float>(calibration.offset);  // a solid (sign +1) counts {phi < -delta}
+  const auto map = sph::compute_boundary_map(*asset, h, level, sph::CpuParallel(2));
+  const sph::SdfGridView grid = asset->host_view();
+  double tank_walls[3] = {0.0, 0.0, 0.0}, tank_loads[3] = {0.0, 0.0, 0.0}, momentum[3] = {0.0, 0.0, 0.0};
+
+  if (std::getenv("BREAKDOWN_DEBUG")) {
+    for (double d : {0.0, 0.0035, 0.00707, 0.0141, 0.02}) {
+      const sph::Vec3 at{0.0f, static_cast<float>(kHalf + d), 0.0f};
+      const sph::LocalBoundaryShare s = sph::local_boundary_share(grid, map.data(), 1.0f, level, h, at);
+      std::printf("debug: d %.4f distance %.5f K Phi %.2f K grad Phi (%.1f, %.1f, %.1f)\n", d,
+                  static_cast<double>(sph::sample_distance(grid, at)), static_cast<double>(K * s.share),
+                  static_cast<double>(K * s.gradient.x), static_cast<double>(K * s.gradient.y),
+                  static_cast<double>(K * s.gradient.z));
+    }
+  }
+  const double expected = rho0 * kGravity * 8.0 * kHalf * kHalf * kHalf, area = 4.0 * kHalf * kHalf;
+  Tally tally[kRegions];
+  double interior_ratio = 0.0, interior_count = 0.0, level_sum = 0.0, plane_sum = 0.0;
+  double api[3] = {0.0, 0.0, 0.0}, api_time = 0.0;
+  int samples = 0;
+  std::vector<float> x(3 * static_cast<size_t>(kept)), after(x.size()), rho(kept), p(kept);
+  // Settle 0.8 s (--settle) in frames of 20 ms, then 0.4 s in frames of 0.5 ms: one substep each (the step
+  // limits allow 1 ms), so the positions read before a frame are its substep's start, where the
+  // density pass put the pressures and densities read after it.
+  const int settle = static_cast<int>(std::lround(settle_time / 0.02)), frames = 800;
+  const float frame_time = 0.0005f;
+  // The self-check: the first substep from the lattice has no contacts yet, so with the loads on its
+  // loads are the walls' reaction alone, which the host's map must reproduce.
+  if (self_check) {
+    uint32_t c0 = 0;
+    check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, x.data(), kept, &c0), "read positions");
+    check(sph_world_step(w.world, frame_time), "sph_world_step");
+    check(support_read_by_id(w.world, SPH_ATTRIBUTE_DENSITY, rho.data(), kept, &c0), "read densities");
+    check(support_read_by_id(w.world, SPH_ATTRIBUTE_PRESSURE, p.data(), kept, &c0), "read pressures");
+    double f[3] = {0.0, 0.0, 0.0};
+    for (uint32_t i = 0; i < c0; ++i) {
+      const sph::Vec3 at{static_cast<float>(x[3 * i] - kCentre[0]),
+                         static_cast<float>(x[3 * i + 1] - kCentre[1]),
+                         static_cast<float>(x[3 * i + 2] - kCentre[2])};
+      const sph::LocalBoundaryShare s = sph::local_boundary_share(grid, map.data(), 1.0f, level, h, at);
+      const double c = static_cast<double>(w.mass) * p[i] / (static_cast<double>(rho[i]) * rho[i]) * K;
+      f[0] += c * s.gradient.x, f[1] += c * s.gradient.y, f[2] += c * s.gradient.z;
+    }
+    sph_collider_loads l;
+    check(sph_collider_loads_init(&l), "sph_collider_loads_init");
+    if (loads) {
+      check(sph_collider_get_loads(w.world, box, &l), "sph_collider_get_loads");
+      std::printf(
+          "self-check, the first substep (no contacts): the walls' reaction on the host (%+.5f %+.5f %+.5f) "
+          "N, the loads (%+.5f %+.5f %+.5f) N\n",
+          f[0], f[1], f[2], static_cast<double>(l.force.x), static_cast<double>(l.force.y),
+          static_cast<double>(l.force.z));
+    }
+    if (only) {
+      // The bound: the sums' rounding (float per particle, in another order on the host), 1e-5 of
+      // the force; on the CPU they agree bit for bit at the printed digits.
+      const double got[3] = {l.force.x, l.force.y, l.force.z};
+      double worst = 0.0, scale = 0.0;
+      for (int k = 0; k < 3; ++k)
+        worst = std::fmax(worst, std::fabs(f[k] - got[k])), scale += got[k] * got[k];
+      const bool pass = loads && scale > 0.0 && worst <= 1e-5 * std::sqrt(scale);
+      std::printf("self-check %s (largest difference %.3g N)\n", pass ? "passed" : "FAILED", worst);
+      std::free(lattice);
+      check(sph_sdf_destroy(tank_sdf), "sph_sdf_destroy");
+      check(sph_sdf_destroy(box_sdf), "sph_sdf_destroy");
+      check(support_world_close(&w), "support_world_close");
+      return pass ? 0 : 1;
+    }
+  }
+  // The tank's too (an inverted box, sign -1, its map at +delta), for the momentum balance below.
+  sph::ShapeSpec tank_spec;
+  tank_spec.kind = sph::ShapeKind::Box;
+  tank_spec.half_extents = sph::Vec3{static_cast<float>(0.5 * kSide), 0.2f, static_cast<float>(0.5 * kSide)};
+  tank_spec.voxel_size = static_cast<float>(0.5 * kStep);
+  const auto tank_asset = sph::build_shape_sdf(tank_spec, 1u << 24);
+  const float tank_level = static_cast<float>(calibration.offset);
+  const auto tank_map = sph::compute_boundary_map(*tank_asset, h, tank_level, sph::CpuParallel(2));
+  const sph::SdfGridView tank_grid = tank_asset->host_view();
+  for (int frame = 0; frame < settle; ++frame) check(sph_world_step(w.world, 0.02f), "sph_world_step");
+  uint32_t count = 0;
+  std::vector<float> velocity(x.size());
+  check(support_read_by_id(w.world, SPH_ATTRIBUTE_VELOCITY, velocity.data(), kept, &count),
+        "read velocities");
+  for (uint32_t i = 0; i < count; ++i)
+    for (int k = 0; k < 3; ++k) momentum[k] -= static_cast<double>(w.mass) * velocity[3 * i + k];
+  check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, x.data(), kept, &count), "read positions");
+  for (int frame = 0; frame < frames; ++frame) {
+    check(sph_world_step(w.world, frame_time), "sph_world_step");
+    check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, after.data(), kept, &count), "read positions");
+    check(support_read_by_id(w.world, SPH_ATTRIBUTE_DENSITY, rho.data(), kept, &count), "read densities");
+    check(support_read_by_id(w.world, SPH_ATTRIBUTE_PRESSURE, p.data(), kept, &count), "read pressures");
+    sph_stats stats;
+    check(sph_stats_init(&stats), "sph_stats_init");
+    check(sph_world_get_stats(w.world, &stats), "sph_world_get_stats");
+    if (stats.substeps != 1) {
+      std::fprintf(stderr, "frame %d took %u substeps, not 1: lower the frame time\n", frame, stats.substeps);
+      return 1;
+    }
+    if (loads) {
+      sph_collider_loads l;
+      check(sph_collider_loads_init(&l), "sph_collider_loads_init");
+      check(sph_collider_get_loads(w.world, box, &l), "sph_collider_get_loads");
+      api[0] += l.force.x * l.frame_time, api[1] += l.force.y * l.frame_time,
+          api[2] += l.force.z * l.frame_time;
+      api_time += l.frame_time;
+      check(sph_collider_get_loads(w.world, tank, &l), "sph_collider_get_loads");
+      tank_loads[0] += l.force.x * l.frame_time, tank_loads[1] += l.force.y * l.frame_time;
+      tank_loads[2] += l.force.z * l.frame_time;
+    }
+    // The water level two ways: the hydrostatic level the interior's pressure gives (y + p / (rho0 g)
+    // averaged over the particles more than h from every wall and 5 cm below the top plane), and the
+    // top lattice plane's mean height over the tank's outer ring plus half a step (a plane stands for
+    // half a step above it).
+    double plane = 0.0, hydrostatic = 0.0, deep = 0.0;
+    {
+      std::vector<double> column(64, -1.0);  // 8 x 8 columns of 2 cm
+      for (uint32_t i = 0; i < count; ++i) {
+        const double px = x[3 * i], pz = x[3 * i + 2];
+        const bool ring =
+            std::fabs(px - kCentre[0]) > kHalf + 0.02 || std::fabs(pz - kCentre[2]) > kHalf + 0.02;
+        if (!ring || px < h || pz < h || px > kSide - h || pz > kSide - h) continue;
+        const int c = std::min(7, static_cast<int>(px / 0.02)) * 8 + std::min(7, static_cast<int>(pz / 0.02));
+        column[c] = std::fmax(column[c], x[3 * i + 1]);
+      }
+      int used = 0;
+      for (double c : column)
+        if (c > 0.0) plane += c, ++used;
+      plane = plane / used + 0.5 * kStep;
+    }
+    auto interior = [&](uint32_t i, double below) {
+      const double px = x[3 * i], py = x[3 * i + 1], pz = x[3 * i + 2];
+      const sph::Vec3 at{static_cast<float>(px - kCentre[0]), static_cast<float>(py - kCentre[1]),
+                         static_cast<float>(pz - kCentre[2])};
+      return sph::sample_distance(grid, at) > h && px > h && pz > h && px < kSide - h && pz < kSide - h &&
+             py > h && py < below;
+    };
+    for (uint32_t i = 0; i < count; ++i)
+      if (interior(i, plane - 0.05)) hydrostatic += x[3 * i + 1] + p[i] / (rho0 * kGravity), deep += 1.0;
+    const double top = hydrostatic / deep;
+    level_sum += top, plane_sum += plane;
+    for (uint32_t i = 0; i < count; ++i) {
+      const double local[3] = {x[3 * i] - kCentre[0], x[3 * i + 1] - kCentre[1], x[3 * i + 2] - kCentre[2]};
+      const sph::Vec3 at{static_cast<float>(local[0]), static_cast<float>(local[1]),
+                         static_cast<float>(local[2])};
+      const double depth = top - x[3 * i + 1], ratio = p[i] / (rho0 * kGravity * depth);
+      const sph::LocalBoundaryShare s = sph::local_boundary_share(grid, map.data(), 1.0f, level, h, at);
+      const double distance = sph::sample_distance(grid, at);
+      const double c = static_cast<double>(w.mass) * p[i] / (static_cast<double>(rho[i]) * rho[i]) * K;
+      {
+        const sph::Vec3 in_tank{static_cast<float>(x[3 * i] - 0.5 * kSide),
+                                static_cast<float>(x[3 * i + 1] - 0.2),
+                                static_cast<float>(x[3 * i + 2] - 0.5 * kSide)};
+        const sph::Vec3 g =
+            sph::local_boundary_share(tank_grid, tank_map.data(), -1.0f, tank_level, h, in_tank).gradient;
+        tank_walls[0] += c * g.x, tank_walls[1] += c * g.y, tank_walls[2] += c * g.z;
+      }
+      Tally& t = tally[region_of(local)];
+      const double f[3] = {c * s.gradient.x, c * s.gradient.y, c * s.gradient.z};
+      for (int k = 0; k < 3; ++k) t.force[k] += f[k];
+      if (region_of(local) == kSides) t.normal += std::fabs(std::fabs(local[0]) > kHalf ? f[0] : f[2]);
+      t.count += f[0] != 0.0 || f[1] != 0.0 || f[2] != 0.0;
+      {
+        const sph::Vec3 end{static_cast<float>(after[3 * i] - kCentre[0]),
+                            static_cast<float>(after[3 * i + 1] - kCentre[1]),
+                            static_cast<float>(after[3 * i + 2] - kCentre[2])};
+        t.contacts += sph::sample_distance(grid, end) < 1e-5f;
+      }
+      if (distance < h) t.near += 1.0, t.density += rho[i] / rho0, t.pressure_ratio += ratio;
+      if (interior(i, plane - 0.03)) interior_ratio += ratio, interior_count += 1.0;
+    }
+    ++samples;
+    x.swap(after);
+  }
+  const double mean_level = level_sum / samples;
+  const double top_face = kCentre[1] + kHalf, bottom_face = kCentre[1] - kHalf;
+  std::printf(
+      "submerged box, backend %s, solver %s, dt_max %g s, walls in the density: %u particles, h %.4f m, "
+      "K %.1f kg/m^3, delta %.4f m; %d samples (substeps) over the last %.2f s\n",
+      backend_name, dfsph ? "dfsph" : "wcsph", static_cast<double>(w.params.dt_max), kept,
+      static_cast<double>(h), static_cast<double>(K), calibration.offset, samples,
+      static_cast<double>(frame_time) * frames);
+  std::printf(
+      "water level %.4f m hydrostatic (top plane %.4f m, fill 0.2000): top face %.4f m deep, bottom face "
+      "%.4f m; rho0 g V = %.4f N; "
+      "interior (3 cm below the top plane and deeper) p / (rho0 g d) %.4f (%.0f particle samples)\n",
+      mean_level, plane_sum / samples, mean_level - top_face, mean_level - bottom_face, expected,
+      interior_count > 0.0 ? interior_ratio / interior_count : 0.0, interior_count);
+  std::printf("%-15s %9s %9s %9s %8s %8s | %6s %8s %10s\n", "region", "Fy (N)", "Fy/rho0gV", "Fx,Fz (N)",
+              "particles", "contacts", "near", "rho/rho0", "p/rho0gd");
+  check(support_read_by_id(w.world, SPH_ATTRIBUTE_VELOCITY, velocity.data(), kept, &count),
+        "read velocities");
+  for (uint32_t i = 0; i < count; ++i)
+    for (int k = 0; k < 3; ++k) momentum[k] += static_cast<double>(w.mass) * velocity[3 * i + k];
+  double total[3] = {0.0, 0.0, 0.0};
+  for (int r = 0; r < kRegions; ++r) {
+    const Tally& t = tally[r];
+    const double fy = t.force[1] / samples;
+    for (int k = 0; k < 3; ++k) total[k] += t.force[k] / samples;
+    std::printf("%-15s %+9.4f %+9.4f %+4.3f,%+4.3f %8.1f %8.2f | %6.1f %8.4f %10.4f\n", kRegionNames[r], fy,
+                fy / expected, t.force[0] / samples, t.force[2] / samples, t.count / samples,
+                t.contacts / samples, t.near / samples, t.near > 0.0 ? t.density / t.near : 0.0,
+                t.near > 0.0 ? t.pressure_ratio / t.near : 0.0);
+  }
+  const double top_all =
+      (tally[kTop].force[1] + tally[kEdgeTop].force[1] + tally[kCornerTop].force[1]) / samples;
+  const double bottom_all =
+      (tally[kBottom].force[1] + tally[kEdgeBottom].force[1] + tally[kCornerBottom].force[1]) / samples;
+  const double top_expected = -rho0 * kGravity * (mean_level - top_face) * area;
+  const double bottom_expected = rho0 * kGravity * (mean_level - bottom_face) * area;
+  const double side_expected = rho0 * kGravity * (mean_level - kCentre[1]) * area;
+  std::printf(
+      "faces against rho0 g d A at the face's depth: top face %+.4f N (%+.2f %%), with its edges and "
+      "corners %+.4f N (%+.2f %%), expected %+.4f N; bottom face %+.4f N (%+.2f %%), with its edges and "
+      "corners %+.4f N (%+.2f %%), expected %+.4f N; each side face's push %.4f N (%+.2f %%), expected "
+      "%.4f N\n",
+      tally[kTop].force[1] / samples, 100.0 * (tally[kTop].force[1] / samples / top_expected - 1.0), top_all,
+      100.0 * (top_all / top_expected - 1.0), top_expected, tally[kBottom].force[1] / samples,
+      100.0 * (tally[kBottom].force[1] / samples / bottom_expected - 1.0), bottom_all,
+      100.0 * (bottom_all / bottom_expected - 1.0), bottom_expected, tally[kSides].normal / samples / 4.0,
+      100.0 * (tally[kSides].normal / samples / 4.0 / side_expected - 1.0), side_expected);
+  std::printf("walls' reaction, all regions: (%+.4f, %+.4f, %+.4f) N, buoyancy %+.2f %% of rho0 g V\n",
+              total[0], total[1], total[2], 100.0 * (total[1] / expected - 1.0));
+  if (loads) {
+    const double l[3] = {api[0] / api_time, api[1] / api_time, api[2] / api_time};
+    std::printf(
+        "the loads (SPH_FEATURE_COLLIDER_LOADS, the same substeps, contacts included): (%+.4f, %+.4f, %+.4f) "
+        "N, buoyancy %+.2f %%\n",
+        l[0], l[1], l[2], 100.0 * (l[1] / expected - 1.0));
+    std::printf(
+        "the contacts (the loads less the walls' reaction): (%+.4f, %+.4f, %+.4f) N, %+.2f %% of rho0 g V\n",
+        l[0] - total[0], l[1] - total[1], l[2] - total[2], 100.0 * (l[1] - total[1]) / expected);
+  }
+  {
+    // The fluid's momentum: dP/dt = M g - sum over colliders of their forces, so the forces that are
+    // neither wall's reaction (both colliders' contacts; DFSPH's contact clamp too) are
+    // M g - dP/dt - the walls' reactions. With the loads (WCSPH) the same from the loads, as a check.
+    const double seconds = static_cast<double>(frame_time) * frames,
+                 weight = kept * static_cast<double>(w.mass) * kGravity;
+    double rest[3];
+    for (int k = 0; k < 3; ++k)
+      rest[k] = -(k == 1 ? weight : 0.0) - momentum[k] / seconds - total[k] - tank_walls[k] / samples;
+    std::printf(
+        "momentum balance: weight %.4f N, fluid dP/dt (%+.4f, %+.4f, %+.4f) N, tank walls' reaction (%+.4f, "
+        "%+.4f, %+.4f) N; the colliders' other forces (contacts, DFSPH's clamp): (%+.4f, %+.4f, %+.4f) N\n",
+        weight, momentum[0] / seconds, momentum[1] / seconds, momentum[2] / seconds, tank_walls[0] / samples,
+        tank_walls[1] / samples, tank_walls[2] / samples, rest[0], rest[1], rest[2]);
+    if (loads)
+      std::printf("  the same from the loads, both colliders' contacts: (%+.4f, %+.4f, %+.4f) N\n",
+                  (api[0] + tank_loads[0]) / api_time - total[0] - tank_walls[0] / samples,
+                  (api[1] + tank_loads[1]) / api_time - total[1] - tank_walls[1] / samples,
+                  (api[2] + tank_loads[2]) / api_time - total[2] - tank_walls[2] / samples);
+  }
+  std::free(lattice);
+  check(sph_sdf_destroy(tank_sdf), "sph_sdf_destroy");
+  check(sph_sdf_destroy(box_sdf), "sph_sdf_destroy");
+  check(support_world_close(&w), "support_world_close");
+  return 0;
+}

@@ -1,0 +1,197 @@
+// SPDX-License-Identifier: MIT
+// The hydrostatic side wall of test_collider_loads.c (water of 10 x 14 x 10 lattice layers of 1 cm
+// at rest in a tank whose face at x = 0 is a plane collider of its own; walls in the density) on
+// either backend and either solver, the force measured without the loads feature, so that DFSPH,
+// whose worlds refuse SPH_FEATURE_COLLIDER_LOADS, can be measured too (issue 17 item 5;
+// docs/validation.md, "The submerged box per region").
+//
+//   physics_loads_side_wall [--backend cpu|cuda] [--solver wcsph|dfsph]
+//
+// As physics_loads_breakdown: settled 0.8 s in frames of 20 ms, then 0.4 s in frames of 0.5 ms,
+// one substep each; around each the positions before it and the densities and pressures after it,
+// by particle id, and on the host the plane's walls' reaction m (p / rho^2) K grad Phi(x): the
+// plane is flat over the tank, so Phi is the flat share of the solid x < -delta,
+// spiky_half_space(x + delta, h), and the reaction's x part is m (p / rho^2) K Phi'(x + delta).
+// The rest of the plane's force (its contacts; DFSPH's contact clamp) is bounded by the fluid's
+// momentum balance: M g - dP/dt less the plane's and the tank's walls' reactions (the tank's map
+// computed on the host) is what both colliders receive besides. With the loads (WCSPH) the plane's
+// loads over the same substeps are printed beside it. References: rho0 g H^2 W / 2, and for WCSPH
+// the resting compressible column's k rho0 (H - D) W (test_collider_loads.c).
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+#include "core/fcc_lattice.h"
+#include "core/sdf_asset.h"
+#include "core/sdf_shapes.h"
+#include "cpu/cpu_boundary_maps.h"
+#include "cpu/cpu_parallel.h"
+#include "physics/boundary_density.h"
+#include "physics/boundary_integrals.h"
+#include "support.h"
+
+namespace {
+
+const double kStep = 0.01, kGravity = 9.81, kStiffness = 100.0;
+
+void check(sph_result r, const char* what) {
+  if (r == SPH_OK) return;
+  std::fprintf(stderr, "%s: %s (%s)\n", what, sph_result_string(r), sph_get_last_error());
+  std::exit(1);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const char* backend_name = "cpu";
+  bool dfsph = false;
+  for (int k = 1; k < argc; ++k) {
+    if (std::strcmp(argv[k], "--backend") == 0 && k + 1 < argc)
+      backend_name = argv[++k];
+    else if (std::strcmp(argv[k], "--solver") == 0 && k + 1 < argc)
+      dfsph = std::strcmp(argv[++k], "dfsph") == 0;
+    else {
+      std::fprintf(stderr, "usage: %s [--backend cpu|cuda] [--solver wcsph|dfsph]\n", argv[0]);
+      return 2;
+    }
+  }
+  const uint32_t layers[3] = {10, 14, 10};
+  const double width = 10 * kStep, depth = 14 * kStep;
+  const double tank_min[3] = {-0.05, 0.0, 0.0}, tank_max[3] = {width, 2.0 * depth, width};
+  float* lattice = nullptr;
+  uint32_t n = 0;
+  check(support_fcc_box(layers, kStep, nullptr, &lattice, &n), "support_fcc_box");
+  sph_world_def def;
+  sph_world_def_init(&def);
+  def.particle_spacing = static_cast<float>(kStep * std::sqrt(2.0));
+  def.capacity = n;
+  def.features = SPH_FEATURE_BOUNDARY_DENSITY | SPH_FEATURE_COLLIDER_LOADS;
+  if (dfsph) def.solver = SPH_SOLVER_DFSPH;
+  support_world w;
+  std::memset(&w, 0, sizeof w);
+  bool loads = true;
+  if (support_world_open(&w, support_backend_from_name(backend_name, SPH_BACKEND_CPU), &def, nullptr) !=
+      SPH_OK) {
+    support_world_close(&w);
+    def.features &= ~SPH_FEATURE_COLLIDER_LOADS;  // DFSPH refuses the loads (issue 16/17)
+    loads = false;
+    check(support_world_open(&w, support_backend_from_name(backend_name, SPH_BACKEND_CPU), &def, nullptr),
+          "support_world_open");
+  }
+  if (!dfsph) {
+    w.params.stiffness = static_cast<float>(kStiffness);
+    w.params.step_limits = SPH_STEP_LIMIT_ACOUSTIC;
+    check(support_world_set_params(&w), "sph_world_set_params");
+  }
+  sph_sdf *tank_sdf = nullptr, *wall_sdf = nullptr;
+  check(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * kStep, 0.0f, &tank_sdf, nullptr),
+        "support_tank_between");
+  // The plane: the plane shape's solid y < 0 turned so that +y goes to +x (test_collider_loads.c's
+  // add_axis_wall(axis 0, sign -1)): solid x < 0.
+  sph_shape_desc shape;
+  check(sph_shape_desc_init(&shape), "sph_shape_desc_init");
+  shape.shape = SPH_SHAPE_PLANE;
+  shape.half_extents.x = 0.3f, shape.half_extents.y = 0.05f, shape.half_extents.z = 0.3f;
+  shape.voxel_size = 0.01f;
+  check(sph_sdf_create_shape(w.context, &shape, &wall_sdf), "sph_sdf_create_shape");
+  sph_collider_def collider;
+  check(sph_collider_def_init(&collider), "sph_collider_def_init");
+  collider.sdf = wall_sdf;
+  collider.transform = sph_transform_identity();
+  collider.transform.rotation.z = static_cast<float>(-std::sqrt(0.5));
+  collider.transform.rotation.w = static_cast<float>(std::sqrt(0.5));
+  sph_collider_id wall;
+  check(sph_collider_create(w.world, &collider, &wall), "sph_collider_create");
+  check(support_spawn(w.world, lattice, nullptr, n), "support_spawn");
+
+  const float h = w.def.kernel_radius, rho0 = w.def.rest_density;
+  const sph::BoundaryCalibration calibration = sph::fcc_boundary_calibration(w.def.particle_spacing, h);
+  const double K = calibration.scale * w.mass, delta = calibration.offset;
+  sph::ShapeSpec tank_spec;  // support_tank_between's inverted box, its map at +delta
+  tank_spec.kind = sph::ShapeKind::Box;
+  tank_spec.half_extents = sph::Vec3{static_cast<float>(0.5 * (tank_max[0] - tank_min[0])),
+                                     static_cast<float>(0.5 * (tank_max[1] - tank_min[1])),
+                                     static_cast<float>(0.5 * (tank_max[2] - tank_min[2]))};
+  tank_spec.voxel_size = static_cast<float>(0.5 * kStep);
+  const auto tank_asset = sph::build_shape_sdf(tank_spec, 1u << 24);
+  const auto tank_map =
+      sph::compute_boundary_map(*tank_asset, h, static_cast<float>(delta), sph::CpuParallel(2));
+  const sph::SdfGridView tank_grid = tank_asset->host_view();
+  const double tank_centre[3] = {0.5 * (tank_max[0] + tank_min[0]), 0.5 * (tank_max[1] + tank_min[1]),
+                                 0.5 * (tank_max[2] + tank_min[2])};
+
+  std::vector<float> x(3 * static_cast<size_t>(n)), after(x.size()), velocity(x.size()), rho(n), p(n);
+  for (int frame = 0; frame < 40; ++frame) check(sph_world_step(w.world, 0.02f), "sph_world_step");
+  const int frames = 800;
+  const float frame_time = 0.0005f;
+  uint32_t count = 0;
+  double plane = 0.0, tank[3] = {0.0, 0.0, 0.0}, api = 0.0, api_time = 0.0, momentum[3] = {0.0, 0.0, 0.0};
+  check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, x.data(), n, &count), "read positions");
+  check(support_read_by_id(w.world, SPH_ATTRIBUTE_VELOCITY, velocity.data(), n, &count), "read velocities");
+  for (uint32_t i = 0; i < count; ++i)
+    for (int k = 0; k < 3; ++k) momentum[k] -= static_cast<double>(w.mass) * velocity[3 * i + k];
+  for (int frame = 0; frame < frames; ++frame) {
+    check(sph_world_step(w.world, frame_time), "sph_world_step");
+    check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, after.data(), n, &count), "read positions");
+    check(support_read_by_id(w.world, SPH_ATTRIBUTE_DENSITY, rho.data(), n, &count), "read densities");
+    check(support_read_by_id(w.world, SPH_ATTRIBUTE_PRESSURE, p.data(), n, &count), "read pressures");
+    sph_stats stats;
+    check(sph_stats_init(&stats), "sph_stats_init");
+    check(sph_world_get_stats(w.world, &stats), "sph_world_get_stats");
+    if (stats.substeps != 1) {
+      std::fprintf(stderr, "frame %d took %u substeps, not 1\n", frame, stats.substeps);
+      return 1;
+    }
+    if (loads) {
+      sph_collider_loads l;
+      check(sph_collider_loads_init(&l), "sph_collider_loads_init");
+      check(sph_collider_get_loads(w.world, wall, &l), "sph_collider_get_loads");
+      api += l.force.x * l.frame_time, api_time += l.frame_time;
+    }
+    for (uint32_t i = 0; i < count; ++i) {
+      const double c = static_cast<double>(w.mass) * p[i] / (static_cast<double>(rho[i]) * rho[i]) * K;
+      plane += c * sph::spiky_half_space_slope<double>(x[3 * i] + delta, h);
+      const sph::Vec3 local{static_cast<float>(x[3 * i] - tank_centre[0]),
+                            static_cast<float>(x[3 * i + 1] - tank_centre[1]),
+                            static_cast<float>(x[3 * i + 2] - tank_centre[2])};
+      const sph::Vec3 g =
+          sph::local_boundary_share(tank_grid, tank_map.data(), -1.0f, static_cast<float>(delta), h, local)
+              .gradient;
+      tank[0] += c * g.x, tank[1] += c * g.y, tank[2] += c * g.z;
+    }
+    x.swap(after);
+  }
+  check(support_read_by_id(w.world, SPH_ATTRIBUTE_VELOCITY, velocity.data(), n, &count), "read velocities");
+  for (uint32_t i = 0; i < count; ++i)
+    for (int k = 0; k < 3; ++k) momentum[k] += static_cast<double>(w.mass) * velocity[3 * i + k];
+  const double seconds = static_cast<double>(frame_time) * frames,
+               weight = n * static_cast<double>(w.mass) * kGravity;
+  const double push = -plane / frames;  // the fluid pushes the plane towards -x
+  const double incompressible = rho0 * kGravity * depth * depth * width / 2.0;
+  const double a = kGravity / kStiffness, column = std::log1p(a * depth) / a;
+  const double compressible = kStiffness * rho0 * (depth - column) * width;
+  double rest[3];
+  const double walls[3] = {plane / frames + tank[0] / frames, tank[1] / frames, tank[2] / frames};
+  for (int k = 0; k < 3; ++k) rest[k] = -(k == 1 ? weight : 0.0) - momentum[k] / seconds - walls[k];
+  std::printf(
+      "hydrostatic side wall, backend %s, solver %s, %u particles, h %.4f m: the plane's walls' reaction "
+      "%.4f N: %+.2f %% of rho0 g H^2 W / 2 = %.4f N, %+.2f %% of the compressible column's %.4f N (k = "
+      "%g)\n",
+      backend_name, dfsph ? "dfsph" : "wcsph", n, static_cast<double>(h), push,
+      100.0 * (push / incompressible - 1.0), incompressible, 100.0 * (push / compressible - 1.0),
+      compressible, kStiffness);
+  std::printf(
+      "momentum balance: both colliders' forces besides the walls' reactions (contacts, DFSPH's clamp) "
+      "(%+.4f, %+.4f, %+.4f) N\n",
+      rest[0], rest[1], rest[2]);
+  if (loads)
+    std::printf("the plane's loads over the same substeps: %.4f N (%+.2f %% of the compressible column's)\n",
+                -api / api_time, 100.0 * (-api / api_time / compressible - 1.0));
+  std::free(lattice);
+  check(sph_sdf_destroy(tank_sdf), "sph_sdf_destroy");
+  check(sph_sdf_destroy(wall_sdf), "sph_sdf_destroy");
+  check(support_world_close(&w), "support_world_close");
+  return 0;
+}
