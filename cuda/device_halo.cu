@@ -74,13 +74,14 @@ __global__ void apply_density_kernel(ParticleArrays a, const uint32_t* __restric
 DeviceHalo::DeviceHalo(uint32_t capacity) : capacity_(capacity) {
   const size_t n = std::max<uint32_t>(capacity, 1u);
   layers_.allocate(n, "halo layers");
-  index_.allocate(n, "halo index list");
+  // An owned particle beside two other slabs (a slab one layer thick) is listed for both.
+  index_.allocate(2 * n, "halo index list");
   iota_.allocate(n, "halo sort values");
   visit_.allocate(n, "halo visit order");
   sorted_keys_.allocate(n, "halo sorted keys");
   mismatch_.allocate(1, "halo id check");
   host_layers_.allocate(n, "halo layers (host)");
-  host_index_.allocate(n, "halo index list (host)");
+  host_index_.allocate(2 * n, "halo index list (host)");
   host_order_.allocate(n, "halo sort order (host)");
   cuda_check(
       cub::DeviceRadixSort::SortPairs(nullptr, sort_temp_bytes_, static_cast<const uint64_t*>(nullptr),
@@ -121,7 +122,8 @@ void DeviceHalo::download_layers(const Float4* positions, uint32_t n, int axis, 
 }
 
 void DeviceHalo::upload_index(const uint32_t* idx, uint32_t m, cudaStream_t stream) {
-  if (m > capacity_) throw Error(Status::Internal, "halo: an index list longer than the capacity");
+  if (m > 2ull * capacity_)
+    throw Error(Status::Internal, "halo: an index list longer than twice the capacity");
   if (m == 0) return;
   std::copy(idx, idx + m, host_index_.get());
   cuda_check(
