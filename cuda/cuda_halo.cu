@@ -85,13 +85,11 @@ void CudaBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks,
                   {kFeatureSurfaceTension, "SPH_FEATURE_SURFACE_TENSION"},
                   {kFeatureNormalizedDensity, "SPH_FEATURE_NORMALIZED_DENSITY"},
                   {kFeatureDensityDiffusion, "SPH_FEATURE_DENSITY_DIFFUSION"},
-                  {kFeatureBoundaryDensity, "SPH_FEATURE_BOUNDARY_DENSITY"},
                   {kFeatureColliderLoads, "SPH_FEATURE_COLLIDER_LOADS"}};
   for (const auto& f : features)
     if (config_.features & f.bit) refuse(f.name);
   if (config_.solver == Solver::Dfsph) refuse("the DFSPH solver");
   if (config_.integrator == Integrator::Rk4) refuse("the RK4 integrator");
-  if (config_.viscosity_method == ViscosityMethod::Clavet) refuse("Clavet's viscosity");
   require_alive();
   DeviceGuard guard(device_);
   guarded([&] {

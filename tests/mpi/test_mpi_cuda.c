@@ -16,7 +16,8 @@
  *     tests/gpu's parity bound); after the collapse's 240 substeps the distance is only printed
  *     (the roundings grow with the flow's chaos).
  * Cases: the dam break (20 substeps), the stirred column whose particles cross the slab boundary
- * (20 substeps), the collapse that makes the ranks rebalance (12 frames of 20 substeps, spacing
+ * (20 substeps; again with Clavet's viscosity and the user attribute, and with the walls'
+ * density), the collapse that makes the ranks rebalance (12 frames of 20 substeps, spacing
  * 12.5 mm), and the refusals (DFSPH, RK4, surface tension: SPH_ERROR_UNSUPPORTED naming them).
  * With SPH_MPI_CUDA_QUICK set, the dam break and the refusals only (a run under compute-sanitizer). */
 #include <math.h>
@@ -119,6 +120,15 @@ int main(int argc, char** argv) {
   run_case("dam break", cuda, cpu, &def, 0.0f, 1, 20, 1);
   if (!quick) {
     run_case("stirred column", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    /* The neighbour counts cross in the density records (Clavet's viscosity reads them); the walls'
+     * density is each particle's own, inside the density its owner sends; the user attribute is a
+     * carried array that migrates. */
+    def.viscosity_method = SPH_VISCOSITY_CLAVET;
+    def.features = SPH_FEATURE_USER_ATTRIBUTE;
+    run_case("stirred column, Clavet's viscosity, user attribute", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    def.viscosity_method = SPH_VISCOSITY_MUELLER;
+    def.features = SPH_FEATURE_BOUNDARY_DENSITY;
+    run_case("stirred column, the walls' density", cuda, cpu, &def, 0.5f, 1, 20, 1);
     mpi_test_world_def(&def); /* capacity 4096: 16 slots an axis, folded along x */
     run_case("stirred column, folded table, one lane", cuda_one_lane, cpu, &def, 0.5f, 1, 20, 1);
     mpi_test_world_def(&def);
