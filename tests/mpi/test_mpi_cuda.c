@@ -78,8 +78,9 @@ static void run_case(const char* name, sph_context* cuda, sph_context* cpu, cons
     dx_cpu = max_abs_difference(cpu_x, x, n);
     printf(
         "%s on %d ranks: %u particles (mass %.6g kg), %u differ from the undivided CUDA world in any bit; "
-        "max |x_cuda - x_cpu| %.3g m; %u rebalances, %u ghosts and %u migrated in on rank 0\n",
-        name, g_size, n, mass, differ, (double)dx_cpu, counts.rebalances, counts.ghosts, counts.migrated_in);
+        "max |x_cuda - x_cpu| %.3g m; %u rebalances, %llu ghosts in the last substep, %llu migrations\n",
+        name, g_size, n, mass, differ, (double)dx_cpu, counts.rebalances,
+        (unsigned long long)counts.global_ghosts, (unsigned long long)counts.migrated);
     CHECK(differ == 0, "%s: %u of %u particles differ from the undivided CUDA world", name, differ, n);
     CHECK(!compare_cpu || dx_cpu <= 1e-4f * 0.4f,
           "%s: the CUDA and CPU distributed worlds %.3g m apart (bound 4e-5 m)", name, (double)dx_cpu);
