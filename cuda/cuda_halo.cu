@@ -42,6 +42,12 @@ void refuse(const std::string& what) {
                                        "(docs/distributed.md lists what does)");
 }
 
+// The rollback's point before the frame's first agreement (enqueue_frame_begin sets it again).
+__global__ void save_rollback_inputs_kernel(FrameState* s) {
+  s->saved_max_speed = s->max_speed;
+  s->saved_max_acceleration = s->max_acceleration;
+}
+
 __global__ void set_step_inputs_kernel(FrameState* s, float max_speed, float max_acceleration) {
   s->max_speed = max_speed;
   s->max_acceleration = max_acceleration;
@@ -414,6 +420,11 @@ uint32_t CudaBackend::run_frame_distributed(PipelineSetup setup, const StepInter
   FrameState* out = b.state_output;
   halo_owned_ = count_;
   halo_ghosts_ = 0;
+  // A failure agreed at the frame's start rolls back to here: the snapshot and the step inputs
+  // are taken before it (enqueue_frame_begin takes them again, after the reductions).
+  b.store->enqueue_snapshot(count_, s);
+  save_rollback_inputs_kernel<<<1, 1, 0, s>>>(b.state);
+  check_launch("save_rollback_inputs_kernel");
   halo_begin_frame();
   setup.count = count_;
   setup.ghosts = 0;
