@@ -142,6 +142,13 @@ void CudaBackend::import_particles(const ParticleSnapshot& s) {
     throw Error(Status::Internal, "import_particles: inconsistent snapshot");
   std::vector<ParticleArraySpec> specs;
   for (const auto& m : r_->store->method_arrays()) specs.push_back(m->spec);
+  // A distributed rank's sort keys follow its particles: a snapshot that drops or reorders them
+  // (sph_world_remove_particles) would leave them behind, unless it carries them (a rank's
+  // checkpoint, into a fresh backend).
+  if (ranks_ && n != count_ && !(count_ == 0 && s.carried_as<uint64_t>(kArrayDistributedSortKey).size() == n))
+    throw Error(Status::Unsupported,
+                "world: removing or restoring particles does not work in a distributed world yet "
+                "(docs/distributed.md)");
   check_carried_arrays(s, specs, n);
   // A carried array the snapshot lacks (a checkpoint written before the method carried it)
   // starts every particle fresh, as if it had just been spawned.
@@ -188,7 +195,8 @@ void CudaBackend::import_particles(const ParticleSnapshot& s) {
 uint64_t CudaBackend::memory_bytes() const {
   return r_->store->bytes() + r_->grid->bytes() + r_->statistics->bytes() + r_->state.bytes() +
          r_->sdf_cache.bytes() + r_->scene_buffer.bytes() + r_->sinks.bytes() + r_->solve_partials.bytes() +
-         r_->boundary_maps.bytes() + r_->loads.bytes() + r_->probes.bytes();
+         r_->boundary_maps.bytes() + r_->loads.bytes() + r_->probes.bytes() +
+         (r_->halo ? r_->halo->bytes() : 0);
 }
 
 DeviceAttributeView CudaBackend::device_attribute(AttributeKind kind) const {

@@ -68,6 +68,15 @@ void CudaBackend::append(const Vec3* positions, const Vec3* velocities, uint32_t
     }
     // New particles have no springs yet; they make them at their first substep.
     if (a.springs && n > 0) enqueue_springs_appended(a, first_id, s);
+    // A distributed rank's new particles sort after every sorted one, in id order (cuda_halo.cu).
+    HostVector<uint64_t> keys;
+    if (r_->halo && n > 0) {
+      keys.resize(n);
+      for (uint32_t k = 0; k < n; ++k) keys[k] = kAppendedSortKey | (first_id + k);
+      uint64_t* key = static_cast<uint64_t*>(r_->store->find(kArrayDistributedSortKey));
+      cuda_check(cudaMemcpyAsync(key + count_, keys.data(), sizeof(uint64_t) * n, cudaMemcpyHostToDevice, s),
+                 "copy of new sort keys");
+    }
     enqueue_recompute_max_speed(a.velocity, count_ + n, r_->state.get(), s);
     cuda_check(cudaStreamSynchronize(s), "append");
   });
@@ -113,6 +122,8 @@ void CudaBackend::reserve(uint32_t capacity, const GrowthNeeds& needs) {
     if (needs.sinks) sinks.reserve(capacity, *store);
     DeviceColliderLoads loads;
     if (needs.load_colliders != 0) loads.reserve(needs.load_colliders, capacity);
+    std::unique_ptr<DeviceHalo> halo;
+    if (r_->halo) halo = std::make_unique<DeviceHalo>(capacity);
     store->enqueue_copy_from(*r_->store, count_, r_->stream);
     cuda_check(cudaStreamSynchronize(r_->stream), "growth of the particle storage");
     // Nothing below throws: the new buffers replace the old ones (freed at the end of scope).
@@ -123,6 +134,7 @@ void CudaBackend::reserve(uint32_t capacity, const GrowthNeeds& needs) {
     std::swap(r_->solve_partials, partials);
     if (needs.sinks) std::swap(r_->sinks, sinks);
     if (needs.load_colliders != 0) std::swap(r_->loads, loads);
+    if (halo) r_->halo.swap(halo);
   });
   config_.capacity = capacity;
   ++epoch_;

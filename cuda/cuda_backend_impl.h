@@ -11,10 +11,12 @@
 #include <vector>
 
 #include "../src/core/backend.h"
+#include "../src/core/slab_decomposition.h"
 #include "cuda_backend.h"
 #include "cuda_status.h"
 #include "device_array.h"
 #include "device_boundary_maps.h"
+#include "device_halo.h"
 #include "device_neighbor_grid.h"
 #include "device_particle_store.h"
 #include "device_scene.h"
@@ -48,6 +50,7 @@ struct DeviceResources {
   DeviceProbeBuffers probes;
   DeviceSceneBuffer scene_buffer;
   DeviceSinkCompactor sinks;
+  std::unique_ptr<DeviceHalo> halo;  // a distributed world's rank only (cuda_halo.cu)
 
   ~DeviceResources() {
     if (stream && cudaStreamSynchronize(stream) != cudaSuccess) (void)cudaGetLastError();
@@ -118,6 +121,15 @@ class CudaBackend final : public Backend {
   void order_after_stream(void* stream) const override;
   void order_stream_after(void* stream) const override;
 
+  // ---- a distributed world's rank (cuda_halo.cu; include/sph_mpi.h, docs/distributed.md) ----
+  void attach_ranks(std::shared_ptr<const RankTransport> ranks, const DistributedOptions& options) override;
+  const RankTransport* rank_transport() const override { return ranks_.get(); }
+  DistributedCounters distributed_counters() const override;
+  std::shared_ptr<const RankTransport> shared_rank_transport() const override { return ranks_; }
+  DistributedState distributed_state() const override;
+  void restore_distributed_state(const DistributedState& state) override;
+  void rethrow_step_failure() const override;
+
  private:
   static DeviceAttributeView with(DeviceAttributeView v, uintptr_t address, uint64_t stride,
                                   uint32_t element) {
@@ -175,6 +187,35 @@ class CudaBackend final : public Backend {
   uint32_t run_frame_on_stream(PipelineSetup setup, uint32_t sink_count, HostVector<uint32_t>& removed_ids,
                                HostVector<uint32_t>& removed_by_sink, const StepInterrupt& interrupt,
                                bool& interrupted);
+
+  // A distributed rank's frames (cuda_halo.cu): the stream driver with the CPU rank's halo steps
+  // at the same points (src/cpu/cpu_halo.cpp), each a host synchronisation. Between substeps the
+  // rank holds the particles it owns; during one, also its ghosts, appended before the sort.
+  class HaloHooks;
+  uint32_t run_frame_distributed(PipelineSetup setup, const StepInterrupt& interrupt, bool& interrupted);
+  void halo_begin_frame();  // the world's max speed and acceleration; new slabs when out of balance
+  void halo_gather();       // migration, then ghosts; the visit order of the sort
+  void halo_after_sort(cudaStream_t stream);     // ghost mask and new keys; the order to the host
+  void halo_after_density(cudaStream_t stream);  // the ghosts take their owners' density records
+  void halo_before_end(cudaStream_t stream);     // maxima and failures reduced over the ranks
+  void halo_drop_ghosts();                       // the owned particles, in the sorted order
+  HostVector<HaloArray> halo_arrays() const;     // what travels with a particle
+  std::vector<RankBytes> halo_send(const std::vector<HostVector<uint32_t>>& to);
+  uint32_t halo_receive(const RankBytes& in, uint32_t first);
+  bool halo_any(bool flag) const;
+  void halo_agree() const;
+
+  std::shared_ptr<const RankTransport> ranks_;
+  DistributedOptions distributed_options_;
+  SlabDecomposition slabs_;
+  bool slabs_cut_ = false;
+  DistributedCounters halo_counters_;
+  int64_t halo_world_count_ = 0;      // the particles every rank owns, this substep
+  uint32_t halo_owned_ = 0;           // during a frame: the owned particles (count_: the frame's start)
+  uint32_t halo_ghosts_ = 0;          // and the ghosts after them
+  HostVector<int32_t> halo_layer_;    // before the sort: each owned particle's cell layer
+  HostVector<uint32_t> halo_origin_;  // before the sort: 0 owned, else 1 + the ghost's rank
+  HostVector<uint32_t> halo_keep_;    // the owned particles' places in the sorted order
 
   WorldConfig config_;
   int device_;

@@ -9,12 +9,14 @@ namespace sph {
 namespace {
 
 __global__ void hash_kernel(GridShape shape, const Float4* __restrict__ positions, uint32_t n,
-                            uint32_t* __restrict__ keys, uint32_t* __restrict__ values, FrameState* state) {
+                            const uint32_t* __restrict__ visit, uint32_t* __restrict__ keys,
+                            uint32_t* __restrict__ values, FrameState* state) {
   mark_stage(state, kStageHashSort);
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
-  keys[i] = cell_hash_of_position(shape, xyz(positions[i]));
-  values[i] = i;
+  const uint32_t k = visit ? visit[i] : i;
+  keys[i] = cell_hash_of_position(shape, xyz(positions[k]));
+  values[i] = k;
 }
 
 // First index in [lo, hi) whose key is >= cell, or hi.
@@ -87,9 +89,9 @@ DeviceNeighborGrid::DeviceNeighborGrid(const GridShape& shape, uint32_t capacity
 }
 
 void DeviceNeighborGrid::enqueue_sort(const Float4* positions, uint32_t n, FrameState* state,
-                                      cudaStream_t stream) {
+                                      cudaStream_t stream, const uint32_t* visit) {
   hash_kernel<<<blocks_for(n, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
-      shape_, positions, n, scratch_.keys[0], scratch_.values[0], state);
+      shape_, positions, n, visit, scratch_.keys[0], scratch_.values[0], state);
   check_launch("hash_kernel");
   cub::DoubleBuffer<uint32_t> keys(scratch_.keys[0], scratch_.keys[1]);
   cub::DoubleBuffer<uint32_t> values(scratch_.values[0], scratch_.values[1]);

@@ -34,8 +34,10 @@ class DeviceNeighborGrid {
   // Hashes positions[0, n) and sorts. Afterwards order() gives, for each sorted place, the
   // particle's index before the sort. The buffers order() and sorted_keys() point to are
   // decided here, on the host, and are the same on every call with the same n (so the
-  // launches can be captured in a graph).
-  void enqueue_sort(const Float4* positions, uint32_t n, FrameState* state, cudaStream_t stream);
+  // launches can be captured in a graph). visit (a distributed rank's key order, cuda_halo.cu):
+  // the particles are taken in this order, so a slot lists its particles in it; null: storage order.
+  void enqueue_sort(const Float4* positions, uint32_t n, FrameState* state, cudaStream_t stream,
+                    const uint32_t* visit = nullptr);
   // Fills the dense cell-start table from the sorted keys: every one of cell_count + 1 entries
   // is written once, without clearing the table first. A slot holding more than max_per_cell
   // particles sets FrameState::crowded_key; the reorder that follows then empties the table

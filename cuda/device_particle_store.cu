@@ -59,6 +59,7 @@ DeviceParticleStore::DeviceParticleStore(uint32_t capacity,
   arrays_.boundary_gradient = static_cast<Float4*>(find(kArrayBoundaryGradient));
   arrays_.user_attribute = static_cast<uint32_t*>(find(kArrayUserAttribute));
   arrays_.sorted_user_attribute = static_cast<uint32_t*>(find(kArraySortedUserAttribute));
+  arrays_.halo_ghost = static_cast<uint32_t*>(find(kArrayHaloGhost));
   for (int side = 0; side < 2; ++side) {
     arrays_.rk4_start[side] = static_cast<ParticleState*>(find(kArrayRk4Start, side));
     arrays_.rk4_sum[side] = static_cast<Rk4Accumulator*>(find(kArrayRk4Sum, side));

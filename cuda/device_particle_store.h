@@ -73,10 +73,15 @@ struct ParticleArrays {
   // reorder's gather target, copied back over it right after (substep_kernels.cu).
   uint32_t* user_attribute;
   uint32_t* sorted_user_attribute;
+  // Null unless a distributed world's rank (cuda_halo.cu): in the sorted order of the substep,
+  // non-zero for a ghost (a neighbour's particle, read by the neighbour passes, never moved).
+  uint32_t* halo_ghost;
 };
 
 // This backend's working array for the user attribute's reorder (SPH_FEATURE_USER_ATTRIBUTE).
 constexpr const char* kArraySortedUserAttribute = "sorted_user_attribute";
+// A distributed rank's ghost mask (ParticleArrays::halo_ghost; Scratch).
+constexpr const char* kArrayHaloGhost = "distributed_ghost";
 
 // A method's array on the device: its elements (two sides for a Sorted array) and, for a
 // Carried one, the snapshot of the frame's start.

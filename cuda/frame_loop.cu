@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "../src/core/crowded_cell.h"
+#include "../src/core/rank_agreement.h"
 #include "cuda_backend_impl.h"
 
 namespace sph {
@@ -82,6 +83,15 @@ void CudaBackend::prepare_scene(const SceneFrame& scene, const RuntimeParams& pa
 FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& params,
                                           const SceneFrame& scene_in) {
   require_alive();
+  // Every rank has the same scene, so every rank refuses it alike.
+  if (distributed() && !scene_in.sinks.empty())
+    throw Error(
+        Status::Unsupported,
+        "world: sinks do not work in a distributed world on the CUDA backend yet (docs/distributed.md)");
+  if (distributed() && !scene_in.probes.empty())
+    throw Error(Status::Unsupported,
+                "world: probes and gauges do not work in a distributed world on the CUDA backend yet "
+                "(docs/distributed.md)");
   DeviceGuard guard(device_);
   PipelineSetup setup;
   setup.count = count_;
@@ -107,12 +117,15 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
       input->pad = 0;
       // A step budget needs the stream driver, which checks it between substeps (the graph
       // runs the whole frame on the device).
-      const bool on_graph =
-          use_graphs_ && !with_sinks && !scene_in.interrupt.has_deadline() && prepare_graph(setup);
+      // A distributed rank waits for the stream at its halo steps: the stream driver.
+      const bool on_graph = use_graphs_ && !distributed() && !with_sinks &&
+                            !scene_in.interrupt.has_deadline() && prepare_graph(setup);
       cuda_check(cudaEventRecord(r_->frame_start, r_->stream), "cudaEventRecord");
       frame_enqueued = true;
       if (on_graph)
         r_->graph.launch(r_->stream);
+      else if (distributed())
+        count_after = run_frame_distributed(setup, scene_in.interrupt, interrupted);
       else
         count_after = run_frame_on_stream(setup, static_cast<uint32_t>(scene_in.sinks.size()), removed_ids,
                                           removed_by_sink, scene_in.interrupt, interrupted);
@@ -136,9 +149,12 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
   if (s.crowded_key != 0) {
     roll_back_frame();
     const Vec3 where{s.crowded_where[0], s.crowded_where[1], s.crowded_where[2]};
-    throw Error(Status::Capacity, crowded_cell_message(static_cast<uint32_t>(s.crowded_key >> 32), where,
-                                                       max_particles_per_cell(config_.particle_spacing,
-                                                                              config_.kernel_radius)));
+    const std::string message =
+        crowded_cell_message(static_cast<uint32_t>(s.crowded_key >> 32), where,
+                             max_particles_per_cell(config_.particle_spacing, config_.kernel_radius));
+    // (Every rank of a distributed world found it in the substep's reduction: no agreement left.)
+    if (distributed()) throw AgreedRankFailure(Status::Capacity, message);
+    throw Error(Status::Capacity, message);
   }
   if (s.non_finite) {
     roll_back_frame();
@@ -148,6 +164,7 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
     failure.dt = s.bad_dt;
     failure.count = s.bad_count;
     failure.ids.push_back(s.bad_id);  // the first; the device keeps no other ids
+    if (distributed()) throw AgreedRankFailure(Status::NonFinite, non_finite_message(failure, setup.limits));
     throw Error(Status::NonFinite, non_finite_message(failure, setup.limits));
   }
   count_ = count_after;

@@ -20,13 +20,14 @@ __device__ void tree_reduce(DensityTally* slots) {
 
 __global__ void __launch_bounds__(kStatsBlock)
     stats_partial_kernel(FluidConstants fluid, GridView grid, const Float4* sorted_position,
-                         const float* __restrict__ density, const uint32_t* __restrict__ counts, uint32_t n,
-                         DensityTally* partials, FrameState* state) {
+                         const float* __restrict__ density, const uint32_t* __restrict__ counts,
+                         const uint32_t* __restrict__ ghost, uint32_t n, DensityTally* partials,
+                         FrameState* state) {
   mark_stage(state, kStageOther);
   __shared__ DensityTally slots[kStatsBlock];
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   DensityTally p = empty_tally();
-  if (i < n) {
+  if (i < n && !(ghost && ghost[i])) {
     const float d = density[i];
     const uint32_t neighbors =
         counts ? counts[i] : gather_density(fluid, grid, sorted_position, i).neighbor_count;
@@ -63,13 +64,14 @@ FrameStatistics::FrameStatistics(uint32_t capacity) {
 }
 
 void FrameStatistics::enqueue(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
-                              uint32_t n, FrameState* state, cudaStream_t stream,
-                              const uint32_t* counts) const {
+                              uint32_t n, FrameState* state, cudaStream_t stream, const uint32_t* counts,
+                              uint32_t ghosts) const {
   const unsigned blocks = blocks_for(n, kStatsBlock);
   stats_partial_kernel<<<blocks, kStatsBlock, 0, stream>>>(fluid, grid, a.sorted_position, a.density, counts,
-                                                           n, partials_.get(), state);
+                                                           ghosts ? a.halo_ghost : nullptr, n,
+                                                           partials_.get(), state);
   check_launch("stats_partial_kernel");
-  stats_final_kernel<<<1, kStatsBlock, 0, stream>>>(partials_.get(), blocks, n, state);
+  stats_final_kernel<<<1, kStatsBlock, 0, stream>>>(partials_.get(), blocks, n - ghosts, state);
   check_launch("stats_final_kernel");
 }
 

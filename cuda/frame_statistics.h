@@ -23,9 +23,11 @@ class FrameStatistics {
   explicit FrameStatistics(uint32_t capacity);
   // Writes density_* and neighbors_* of *state for particles [0, n). The neighbour counts are
   // recounted over the sorted copy, or read from `counts` when given (after a sink compaction,
-  // which leaves the sorted copy behind).
+  // which leaves the sorted copy behind). A distributed rank's last substep still holds its
+  // `ghosts` (a.halo_ghost marks them): they are left out.
   void enqueue(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a, uint32_t n,
-               FrameState* state, cudaStream_t stream, const uint32_t* counts = nullptr) const;
+               FrameState* state, cudaStream_t stream, const uint32_t* counts = nullptr,
+               uint32_t ghosts = 0) const;
   // counts[i] = the neighbour count of the last density pass of particle i (for a compaction).
   void enqueue_neighbor_counts(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                                uint32_t n, uint32_t* counts, cudaStream_t stream) const;

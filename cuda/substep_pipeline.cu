@@ -14,7 +14,7 @@ void enqueue_frame_begin(const PipelineSetup& setup, const PipelineBuffers& b, L
 }
 
 void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
-                     cudaStream_t stream) {
+                     cudaStream_t stream, SubstepHooks* hooks) {
   const ParticleArrays& a = b.store->arrays();
   const uint32_t n = setup.count;
   const bool rk4 = setup.integrator == Integrator::Rk4;
@@ -34,14 +34,18 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
     enqueue_end_substep(b.state, setup.limits, setup.max_substeps, 1, cond, stream);
     return;
   }
+  if (hooks && (rk4 || setup.options.dfsph))
+    throw Error(Status::Internal, "substep: a distributed rank's steps are symplectic Euler's");
   for (int stage = 0; stage < stages; ++stage) {
-    b.grid->enqueue_sort(a.position, n, b.state, stream);
+    b.grid->enqueue_sort(a.position, n, b.state, stream, hooks ? hooks->visit : nullptr);
     b.grid->enqueue_cell_starts(n, b.state, stream);
+    if (hooks) hooks->after_sort(stream);
     const Rk4Carry carry = !rk4 ? Rk4Carry::None : (stage == 0 ? Rk4Carry::BuildStart : Rk4Carry::Gather);
     enqueue_reorder(a, b.grid->order(), n, carry, stage & 1, b.grid->crowd_guard(), b.state, stream);
     if (setup.options.springs) enqueue_spring_reorder(a, b.grid->order(), n, stream);
     enqueue_density(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene,
                     rk4 ? rk4_stage_fraction(stage) : 0.0f, stage == 0, b.state, stream);
+    if (hooks) hooks->after_density(stream);
     // Probes sample the substep's start (RK4: its first stage), as on the CPU.
     if (stage == 0 && setup.probes.on())
       enqueue_probe_samples(setup.probes, b.grid->view(), a, b.state, stream);
@@ -61,12 +65,14 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
                     rk4 ? rk4_stage_fraction(stage) : 0.0f, rk4 ? rk4_weight(stage) : 1.0f, last, rk4,
                     b.state, stream);
   }
+  if (hooks) hooks->before_end(stream);
   enqueue_end_substep(b.state, setup.limits, setup.max_substeps, stages, cond, stream);
 }
 
 void enqueue_frame_end(const PipelineSetup& setup, const PipelineBuffers& b, cudaStream_t stream,
                        const uint32_t* counts) {
-  b.statistics->enqueue(setup.fluid, b.grid->view(), b.store->arrays(), setup.count, b.state, stream, counts);
+  b.statistics->enqueue(setup.fluid, b.grid->view(), b.store->arrays(), setup.count, b.state, stream, counts,
+                        setup.ghosts);
   if (setup.loads.on()) enqueue_loads_end(setup.loads, stream);
   if (setup.probes.on()) enqueue_probes_end(setup.probes, stream);
   cuda_check(cudaMemcpyAsync(b.state_output, b.state, sizeof(FrameState), cudaMemcpyDeviceToHost, stream),

@@ -27,7 +27,8 @@
 namespace sph {
 
 struct PipelineSetup {
-  uint32_t count = 0;  // particles
+  uint32_t count = 0;   // particles
+  uint32_t ghosts = 0;  // of them, a distributed rank's ghosts (the statistics leave them out)
   Integrator integrator = Integrator::SymplecticEuler;
   FluidConstants fluid{};
   StepLimits limits{};
@@ -50,10 +51,23 @@ struct PipelineBuffers {
   double* solve_partials;    // DFSPH: the block sums of a solve's error (null otherwise)
 };
 
+// A distributed rank's host steps inside a substep (cuda_halo.cu; the stream driver only, as
+// each may wait for the stream): the sort's visit order, and calls after the sort (the grid's
+// order and cell starts are enqueued), after the density pass (the ghosts take their owners'
+// densities) and before the end-of-substep kernel (the maxima and failures reduced over ranks).
+struct SubstepHooks {
+  const uint32_t* visit = nullptr;
+  virtual ~SubstepHooks() = default;
+  virtual void after_sort(cudaStream_t stream) = 0;
+  virtual void after_density(cudaStream_t stream) = 0;
+  virtual void before_end(cudaStream_t stream) = 0;
+};
+
 void enqueue_frame_begin(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
                          cudaStream_t stream);
+// hooks: a distributed rank's (symplectic Euler only; null otherwise).
 void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
-                     cudaStream_t stream);
+                     cudaStream_t stream, SubstepHooks* hooks = nullptr);
 // counts: the neighbour counts of the last density pass when a sink compaction left the sorted
 // copy behind (FrameStatistics::enqueue); null otherwise.
 void enqueue_frame_end(const PipelineSetup& setup, const PipelineBuffers& b, cudaStream_t stream,

@@ -116,9 +116,7 @@ class Backend {
   // naming the feature when the world uses one that does not work distributed yet (or this
   // backend has no distributed path).
   virtual void attach_ranks(std::shared_ptr<const RankTransport> /*ranks*/, const DistributedOptions&) {
-    throw Error(Status::Unsupported,
-                "world: distributed worlds (sph_mpi.h) run on the CPU backend only for now; the CUDA "
-                "backend's host-staged path is not built yet");
+    throw Error(Status::Unsupported, "world: this backend has no distributed path (sph_mpi.h)");
   }
   // The ranks attach_ranks gave (null: not a distributed world).
   virtual const RankTransport* rank_transport() const { return nullptr; }

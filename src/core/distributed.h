@@ -12,6 +12,9 @@ namespace sph {
 // Each particle's sort key in a distributed world (cpu_halo.cpp): a carried array that a rank's
 // checkpoint saves with its particles.
 constexpr const char* kArrayDistributedSortKey = "distributed_sort_key";
+// The key of a particle appended since the last sort (ored with its id): after every sorted
+// one, in id order (the undivided world appends at the end, ids ascending).
+constexpr uint64_t kAppendedSortKey = 0xffffffff00000000ull;
 
 struct DistributedOptions {
   // Rebalance when the fullest rank holds more than (1 + threshold) times the mean.

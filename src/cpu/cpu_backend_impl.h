@@ -274,9 +274,6 @@ class CpuBackend final : public Backend {
   // Keeps the particles keep_order_ lists (ascending), in that order.
   void halo_keep(size_t kept);
 
-  // The key of a particle appended since the last sort: after every sorted one, in id order
-  // (the undivided world appends at the end, ids ascending).
-  static constexpr uint64_t kAppendedSortKey = 0xffffffff00000000ull;
   std::shared_ptr<const RankTransport> ranks_;
   DistributedOptions distributed_options_;
   SlabDecomposition slabs_;

@@ -26,7 +26,9 @@
 #include <string>
 
 #include "../core/grid_layout.h"
+#include "../core/halo_records.h"
 #include "../core/rank_agreement.h"
+#include "../core/slab_rebalance.h"
 #include "cpu_halo_share.h"
 
 namespace sph {
@@ -89,8 +91,7 @@ void CpuBackend::rethrow_step_failure() const {
 
 int32_t CpuBackend::halo_layer(uint32_t i) const {
   const Float4& p = position_[i];
-  const int axis = slabs_.axis();
-  return cell_coordinate(axis == 0 ? p.x : (axis == 1 ? p.y : p.z), 1.0f / config_.kernel_radius);
+  return slab_layer(p.x, p.y, p.z, slabs_.axis(), 1.0f / config_.kernel_radius);
 }
 
 bool CpuBackend::halo_travels(const ParticleArraySpec& spec) {
@@ -140,43 +141,18 @@ void CpuBackend::halo_keep(size_t kept) {
 
 void CpuBackend::halo_begin_frame() {
   const RankTransport& t = *ranks_;
-  const int size = t.size();
-  std::vector<int64_t> held(static_cast<size_t>(size), 0);
+  std::vector<int64_t> held(static_cast<size_t>(t.size()), 0);
   halo_agree();  // (the frame's start: the step's code before it ran on each rank alone)
   float maxima[2] = {max_speed_, max_acceleration_};
   t.all_max(maxima, 2);
   max_speed_ = maxima[0];
   max_acceleration_ = maxima[1];
-  // Particles per rank, and the world's extent in cells.
-  held[static_cast<size_t>(t.rank())] = count_;
-  t.all_sum(held.data(), size);
-  if (slabs_cut_ && !SlabDecomposition::imbalanced(held, distributed_options_.rebalance_threshold)) return;
-  const float inv = 1.0f / config_.kernel_radius;
-  int64_t lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
-  for (uint32_t i = 0; i < count_; ++i) {
-    const float x[3] = {position_[i].x, position_[i].y, position_[i].z};
-    for (int a = 0; a < 3; ++a) {
-      const int64_t c = cell_coordinate(x[a], inv);
-      lo[a] = std::min(lo[a], c);
-      hi[a] = std::max(hi[a], c);
-    }
+  // Particles per rank, and the world's extent in cells (core/slab_rebalance.h).
+  if (rebalance_slabs(t, slabs_, slabs_cut_, distributed_options_.rebalance_threshold, count_,
+                      1.0f / config_.kernel_radius, held, [this](uint32_t i) { return position_[i]; })) {
+    slabs_cut_ = true;
+    ++halo_counters_.rebalances;
   }
-  t.all_min(lo, 3);
-  t.all_max(hi, 3);
-  if (lo[0] > hi[0]) return;  // no particles anywhere: nothing to cut
-  int axis = 0;
-  for (int a = 1; a < 3; ++a)
-    if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
-  std::vector<int64_t> histogram(static_cast<size_t>(hi[axis] - lo[axis] + 1), 0);
-  for (uint32_t i = 0; i < count_; ++i) {
-    const float x[3] = {position_[i].x, position_[i].y, position_[i].z};
-    ++histogram[static_cast<size_t>(cell_coordinate(x[axis], inv) - lo[axis])];
-  }
-  halo_agree();  // (the histogram's allocation)
-  t.all_sum(histogram.data(), static_cast<int>(histogram.size()));
-  slabs_.rebalance(axis, static_cast<int32_t>(lo[axis]), histogram);
-  slabs_cut_ = true;
-  ++halo_counters_.rebalances;
 }
 
 void CpuBackend::halo_gather() {
@@ -255,11 +231,7 @@ void CpuBackend::halo_keys() {
 }
 
 void CpuBackend::halo_share_density() {
-  struct Record {
-    uint32_t id;
-    float density, pressure, inv_density;
-    uint32_t neighbors;
-  };
+  using Record = HaloDensityRecord;
   halo_share<Record>(
       "densities",
       [this](uint32_t i) {

@@ -208,7 +208,7 @@ int run(const Ranks& ranks, int argc, char** argv) {
     return fail(ranks, kExitUsage, "--stats-json: not in sph-run-mpi yet (its summary line is on stdout)");
   if (cli.backend == SPH_BACKEND_CUDA)
     return fail(ranks, kExitBackend,
-                "--backend cuda: distributed worlds run on the CPU backend only (docs/distributed.md)");
+                "--backend cuda: sph-run-mpi runs on the CPU backend only for now (docs/distributed.md)");
   SceneDesc scene;
   try {
     scene = load_scene_file(cli.scene);

@@ -1,0 +1,148 @@
+// SPDX-License-Identifier: MIT
+// A distributed CUDA rank's frame (cuda_halo.cu has the rank's arrays and its exchanges): the
+// stream driver with the halo's steps as hooks of the substep (SubstepHooks), the frame's start
+// (the world's max speed and acceleration, new slabs when out of balance) and the reduction of
+// each substep's maxima and failures over the ranks before the device's end-of-substep kernel,
+// which then picks the same next step on every rank (and fails on every rank together).
+#include <algorithm>
+#include <vector>
+
+#include "../src/core/rank_agreement.h"
+#include "../src/core/slab_rebalance.h"
+#include "cuda_backend_impl.h"
+#include "kernel_launch.h"
+
+namespace sph {
+namespace {
+
+constexpr uint32_t kAllFinite = 0xffffffffu;
+
+// The rollback's point before the frame's first agreement (enqueue_frame_begin sets it again).
+__global__ void save_rollback_inputs_kernel(FrameState* s) {
+  s->saved_max_speed = s->max_speed;
+  s->saved_max_acceleration = s->max_acceleration;
+}
+
+__global__ void set_step_inputs_kernel(FrameState* s, float max_speed, float max_acceleration) {
+  s->max_speed = max_speed;
+  s->max_acceleration = max_acceleration;
+}
+
+// The substep's maxima and failures as every rank found them; this rank's own failure keeps its
+// own particle (the message names it), another rank's is named by its id.
+__global__ void set_reduced_kernel(FrameState* s, uint32_t v2max_bits, uint32_t a2max_bits,
+                                   unsigned long long crowded, uint32_t bad_id) {
+  s->v2max_bits = v2max_bits;
+  s->a2max_bits = a2max_bits;
+  if (s->crowded_key == 0) s->crowded_key = crowded;
+  if (bad_id != kAllFinite && s->bad_key[0] == kNoBadParticle) {
+    s->bad_key[0] = bad_id;
+    s->bad_counts[0] = 1;
+  }
+}
+
+}  // namespace
+
+class CudaBackend::HaloHooks final : public SubstepHooks {
+ public:
+  explicit HaloHooks(CudaBackend& b) : b_(b) { visit = b.r_->halo->visit(); }
+  void after_sort(cudaStream_t stream) override { b_.halo_after_sort(stream); }
+  void after_density(cudaStream_t stream) override { b_.halo_after_density(stream); }
+  void before_end(cudaStream_t stream) override { b_.halo_before_end(stream); }
+
+ private:
+  CudaBackend& b_;
+};
+
+void CudaBackend::halo_begin_frame() {
+  const RankTransport& t = *ranks_;
+  std::vector<int64_t> held(static_cast<size_t>(t.size()), 0);
+  const HostVector<Float4> positions =
+      count_ > 0 ? download(static_cast<const Float4*>(r_->store->arrays().position), count_)
+                 : HostVector<Float4>{};
+  const HostVector<FrameState> state = download(static_cast<const FrameState*>(r_->state.get()), 1u);
+  halo_agree();  // (the frame's start: the step's code before it ran on each rank alone)
+  float maxima[2] = {state[0].max_speed, state[0].max_acceleration};
+  t.all_max(maxima, 2);
+  set_step_inputs_kernel<<<1, 1, 0, r_->stream>>>(r_->state.get(), maxima[0], maxima[1]);
+  check_launch("set_step_inputs_kernel");
+  if (rebalance_slabs(t, slabs_, slabs_cut_, distributed_options_.rebalance_threshold, count_,
+                      1.0f / config_.kernel_radius, held, [&](uint32_t i) { return positions[i]; })) {
+    slabs_cut_ = true;
+    ++halo_counters_.rebalances;
+  }
+}
+
+void CudaBackend::halo_before_end(cudaStream_t stream) {
+  const RankTransport& t = *ranks_;
+  DeviceHalo& h = *r_->halo;
+  FrameState* out = r_->state_output.get();
+  cuda_check(cudaMemcpyAsync(out, r_->state.get(), sizeof(FrameState), cudaMemcpyDeviceToHost, stream),
+             "copy of the substep's state");
+  uint32_t* mismatch = r_->sink_kept.get();  // (pinned; sinks are refused in a distributed world)
+  cuda_check(cudaMemcpyAsync(mismatch, h.mismatch_flag(), sizeof(uint32_t), cudaMemcpyDeviceToHost, stream),
+             "copy of the halo's id check");
+  cuda_check(cudaStreamSynchronize(stream), "the substep's state");
+  if (*mismatch != 0) {
+    cuda_check(cudaMemsetAsync(h.mismatch_flag(), 0, sizeof(uint32_t), stream), "halo id check reset");
+    throw Error(Status::Internal, "halo: a rank's density records came in another order than its ghosts");
+  }
+  const FrameState& f = *out;
+  int64_t bad =
+      f.bad_key[0] != kNoBadParticle ? static_cast<int64_t>(f.bad_key[0] & 0xffffffffu) : kAllFinite;
+  agree(t, &bad);  // (the substep's passes and the records' buffers)
+  int64_t maxima[3] = {f.v2max_bits, f.a2max_bits, static_cast<int64_t>(f.crowded_key)};
+  t.all_max(maxima, 3);
+  set_reduced_kernel<<<1, 1, 0, stream>>>(
+      r_->state.get(), static_cast<uint32_t>(maxima[0]), static_cast<uint32_t>(maxima[1]),
+      static_cast<unsigned long long>(maxima[2]), static_cast<uint32_t>(bad));
+  check_launch("set_reduced_kernel");
+}
+
+uint32_t CudaBackend::run_frame_distributed(PipelineSetup setup, const StepInterrupt& interrupt,
+                                            bool& interrupted) {
+  const PipelineBuffers b = r_->buffers();
+  cudaStream_t s = r_->stream;
+  FrameState* out = b.state_output;
+  halo_owned_ = count_;
+  halo_ghosts_ = 0;
+  // A failure agreed at the frame's start rolls back to here: the snapshot and the step inputs
+  // are taken before it (enqueue_frame_begin takes them again, after the reductions).
+  b.store->enqueue_snapshot(count_, s);
+  save_rollback_inputs_kernel<<<1, 1, 0, s>>>(b.state);
+  check_launch("save_rollback_inputs_kernel");
+  halo_begin_frame();
+  setup.count = count_;
+  setup.ghosts = 0;
+  enqueue_frame_begin(setup, b, LoopCondition{}, s);
+  cuda_check(cudaMemcpyAsync(&out->run, &b.state->run, sizeof(uint32_t), cudaMemcpyDeviceToHost, s),
+             "copy of the loop condition");
+  cuda_check(cudaStreamSynchronize(s), "frame begin");
+  HaloHooks hooks(*this);
+  while (out->run) {
+    halo_drop_ghosts();
+    halo_gather();
+    setup.count = halo_owned_ + halo_ghosts_;
+    setup.ghosts = halo_ghosts_;
+    // The lane groups as the undivided world picks them, from the world's count.
+    if (tuning_.particle_lanes == 0)
+      setup.tuning.particle_lanes = lanes_per_particle(
+          tuning_, static_cast<uint32_t>(std::min<int64_t>(halo_world_count_, UINT32_MAX)));
+    enqueue_substep(setup, b, LoopCondition{}, s, &hooks);
+    cuda_check(cudaMemcpyAsync(&out->run, &b.state->run, sizeof(uint32_t), cudaMemcpyDeviceToHost, s),
+               "copy of the loop condition");
+    cuda_check(cudaStreamSynchronize(s), "substep");
+    // A cancel or budget seen by any rank stops every rank at the same substep.
+    if (out->run && halo_any(interrupt.requested())) {
+      interrupted = true;
+      break;
+    }
+  }
+  enqueue_frame_end(setup, b, s);  // (the statistics leave the last substep's ghosts out)
+  halo_drop_ghosts();
+  cuda_check(cudaStreamSynchronize(s), "frame end");
+  halo_agree();  // (the frame's end: nothing after this can fail on one rank alone)
+  return halo_owned_;
+}
+
+}  // namespace sph

@@ -1,0 +1,253 @@
+// SPDX-License-Identifier: MIT
+#include <cub/device/device_radix_sort.cuh>
+
+#include <algorithm>
+#include <string>
+
+#include "../src/physics/grid_hash.h"
+#include "device_halo.h"
+#include "kernel_launch.h"
+
+namespace sph {
+namespace {
+
+__global__ void layer_kernel(const Float4* __restrict__ positions, uint32_t n, int axis, float inv,
+                             int32_t* __restrict__ layers) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const Float4 p = positions[i];
+  layers[i] = cell_coordinate(axis == 0 ? p.x : (axis == 1 ? p.y : p.z), inv);
+}
+
+// dst[k] = src[idx[k]] for k < m, `words` 32-bit words a particle.
+__global__ void gather_words_kernel(const uint32_t* __restrict__ src, uint32_t words,
+                                    const uint32_t* __restrict__ idx, uint32_t m,
+                                    uint32_t* __restrict__ dst) {
+  const uint64_t t = static_cast<uint64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (t >= static_cast<uint64_t>(m) * words) return;
+  const uint64_t k = t / words, w = t % words;
+  dst[t] = src[static_cast<uint64_t>(idx[k]) * words + w];
+}
+
+__global__ void iota_kernel(uint32_t* v, uint32_t n) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i < n) v[i] = i;
+}
+
+__global__ void mark_kernel(const uint32_t* __restrict__ order, const uint32_t* __restrict__ sorted_slots,
+                            const uint32_t* __restrict__ cell_start, uint32_t n, uint32_t owned,
+                            uint32_t* __restrict__ ghost, uint64_t* __restrict__ keys) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  ghost[i] = order[i] >= owned ? 1u : 0u;
+  const uint32_t slot = sorted_slots[i];
+  keys[i] = (static_cast<uint64_t>(slot) << 32) | (i - cell_start[slot]);
+}
+
+__global__ void pack_density_kernel(ParticleArrays a, const uint32_t* __restrict__ idx, uint32_t m,
+                                    HaloDensityRecord* __restrict__ out) {
+  const uint32_t k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k >= m) return;
+  const uint32_t i = idx[k];
+  out[k] = HaloDensityRecord{a.sorted_id[i], a.density[i], a.sorted_position[i].w, a.sorted_velocity[i].w,
+                             a.neighbor_count ? a.neighbor_count[i] : 0u};
+}
+
+__global__ void apply_density_kernel(ParticleArrays a, const uint32_t* __restrict__ idx, uint32_t m,
+                                     const HaloDensityRecord* __restrict__ in, uint32_t* mismatch) {
+  const uint32_t k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k >= m) return;
+  const uint32_t i = idx[k];
+  const HaloDensityRecord r = in[k];
+  if (r.id != a.sorted_id[i]) {
+    atomicExch(mismatch, 1u);
+    return;
+  }
+  a.density[i] = r.density;
+  a.sorted_position[i].w = r.pressure;
+  a.sorted_velocity[i].w = r.inv_density;
+  if (a.neighbor_count) a.neighbor_count[i] = r.neighbors;
+}
+
+}  // namespace
+
+DeviceHalo::DeviceHalo(uint32_t capacity) : capacity_(capacity) {
+  const size_t n = std::max<uint32_t>(capacity, 1u);
+  layers_.allocate(n, "halo layers");
+  // An owned particle beside two other slabs (a slab one layer thick) is listed for both.
+  index_.allocate(2 * n, "halo index list");
+  iota_.allocate(n, "halo sort values");
+  visit_.allocate(n, "halo visit order");
+  sorted_keys_.allocate(n, "halo sorted keys");
+  mismatch_.allocate(1, "halo id check");
+  host_layers_.allocate(n, "halo layers (host)");
+  host_index_.allocate(2 * n, "halo index list (host)");
+  host_order_.allocate(n, "halo sort order (host)");
+  cuda_check(
+      cub::DeviceRadixSort::SortPairs(nullptr, sort_temp_bytes_, static_cast<const uint64_t*>(nullptr),
+                                      static_cast<uint64_t*>(nullptr), static_cast<const uint32_t*>(nullptr),
+                                      static_cast<uint32_t*>(nullptr), static_cast<int>(n)),
+      "halo key sort size query");
+  sort_temp_.allocate(std::max<size_t>(sort_temp_bytes_, 1), "halo key sort temporary storage");
+  iota_kernel<<<blocks_for(static_cast<uint32_t>(n), kDefaultBlockSize), kDefaultBlockSize>>>(
+      iota_.get(), static_cast<uint32_t>(n));
+  check_launch("iota_kernel");
+  cuda_check(cudaMemset(mismatch_.get(), 0, sizeof(uint32_t)), "halo id check reset");
+  cuda_check(cudaDeviceSynchronize(), "halo set-up");
+}
+
+void DeviceHalo::ensure_device(size_t bytes) {
+  if (staging_.bytes() >= bytes) return;
+  staging_.allocate(bytes + bytes / 2 + 256, "halo staging");
+}
+
+void DeviceHalo::ensure_host(size_t bytes) {
+  if (host_staging_bytes_ >= bytes) return;
+  const size_t grown = bytes + bytes / 2 + 256;
+  host_staging_.allocate(grown, "halo staging (host)");
+  host_staging_bytes_ = grown;
+}
+
+void DeviceHalo::download_layers(const Float4* positions, uint32_t n, int axis, float inv_cell_size,
+                                 cudaStream_t stream) {
+  if (n > capacity_) throw Error(Status::Internal, "halo: more particles than the capacity");
+  if (n == 0) return;
+  layer_kernel<<<blocks_for(n, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
+      positions, n, axis, inv_cell_size, layers_.get());
+  check_launch("layer_kernel");
+  cuda_check(
+      cudaMemcpyAsync(host_layers_.get(), layers_.get(), sizeof(int32_t) * n, cudaMemcpyDeviceToHost, stream),
+      "copy of the halo layers");
+  cuda_check(cudaStreamSynchronize(stream), "halo layers");
+}
+
+void DeviceHalo::upload_index(const uint32_t* idx, uint32_t m, cudaStream_t stream) {
+  if (m > 2ull * capacity_)
+    throw Error(Status::Internal, "halo: an index list longer than twice the capacity");
+  if (m == 0) return;
+  std::copy(idx, idx + m, host_index_.get());
+  cuda_check(
+      cudaMemcpyAsync(index_.get(), host_index_.get(), sizeof(uint32_t) * m, cudaMemcpyHostToDevice, stream),
+      "copy of a halo index list");
+  cuda_check(cudaStreamSynchronize(stream), "halo index list");  // (the pinned list is reused)
+}
+
+const unsigned char* DeviceHalo::pack(const HaloArray* arrays, int count, uint32_t m, cudaStream_t stream) {
+  size_t record = 0;
+  for (int k = 0; k < count; ++k) record += arrays[k].bytes;
+  ensure_device(record * m);
+  ensure_host(record * m);
+  size_t offset = 0;
+  for (int k = 0; k < count && m > 0; ++k) {
+    const uint32_t words = arrays[k].bytes / 4u;
+    const uint64_t items = static_cast<uint64_t>(m) * words;
+    gather_words_kernel<<<static_cast<unsigned>((items + kDefaultBlockSize - 1) / kDefaultBlockSize),
+                          kDefaultBlockSize, 0, stream>>>(
+        reinterpret_cast<const uint32_t*>(arrays[k].data), words, index_.get(), m,
+        reinterpret_cast<uint32_t*>(staging_.get() + offset));
+    check_launch("gather_words_kernel");
+    offset += static_cast<size_t>(arrays[k].bytes) * m;
+  }
+  if (offset > 0)
+    cuda_check(cudaMemcpyAsync(host_staging_.get(), staging_.get(), offset, cudaMemcpyDeviceToHost, stream),
+               "copy of the halo's leaving particles");
+  cuda_check(cudaStreamSynchronize(stream), "halo pack");
+  return host_staging_.get();
+}
+
+void DeviceHalo::keep(const HaloArray* arrays, int count, uint32_t m, cudaStream_t stream) {
+  uint32_t widest = 0;
+  for (int k = 0; k < count; ++k) widest = std::max(widest, arrays[k].bytes);
+  ensure_device(static_cast<size_t>(widest) * m);
+  for (int k = 0; k < count && m > 0; ++k) {
+    const uint32_t words = arrays[k].bytes / 4u;
+    const uint64_t items = static_cast<uint64_t>(m) * words;
+    gather_words_kernel<<<static_cast<unsigned>((items + kDefaultBlockSize - 1) / kDefaultBlockSize),
+                          kDefaultBlockSize, 0, stream>>>(reinterpret_cast<const uint32_t*>(arrays[k].data),
+                                                          words, index_.get(), m,
+                                                          reinterpret_cast<uint32_t*>(staging_.get()));
+    check_launch("gather_words_kernel");
+    cuda_check(cudaMemcpyAsync(arrays[k].data, staging_.get(), static_cast<size_t>(arrays[k].bytes) * m,
+                               cudaMemcpyDeviceToDevice, stream),
+               "halo compaction");
+  }
+}
+
+void DeviceHalo::unpack(const HaloArray* arrays, int count, const unsigned char* bytes, uint32_t m,
+                        uint32_t first, cudaStream_t stream) {
+  if (m == 0) return;
+  if (static_cast<uint64_t>(first) + m > capacity_)
+    throw Error(Status::Internal, "halo: arriving particles past the capacity");
+  size_t record = 0;
+  for (int k = 0; k < count; ++k) record += arrays[k].bytes;
+  ensure_host(record * m);
+  std::copy(bytes, bytes + record * m, host_staging_.get());
+  size_t offset = 0;
+  for (int k = 0; k < count; ++k) {
+    const size_t b = arrays[k].bytes;
+    cuda_check(cudaMemcpyAsync(arrays[k].data + b * first, host_staging_.get() + offset, b * m,
+                               cudaMemcpyHostToDevice, stream),
+               "copy of the halo's arriving particles");
+    offset += b * m;
+  }
+  cuda_check(cudaStreamSynchronize(stream), "halo unpack");  // (the pinned staging is reused)
+}
+
+void DeviceHalo::enqueue_visit(const uint64_t* keys, uint32_t n, cudaStream_t stream) {
+  if (n > capacity_) throw Error(Status::Internal, "halo: more particles than the capacity");
+  if (n == 0) return;
+  size_t bytes = sort_temp_bytes_;
+  cuda_check(cub::DeviceRadixSort::SortPairs(sort_temp_.get(), bytes, keys, sorted_keys_.get(), iota_.get(),
+                                             visit_.get(), static_cast<int>(n), 0, 64, stream),
+             "halo key sort");
+}
+
+void DeviceHalo::enqueue_mark(const DeviceNeighborGrid& grid, uint32_t n, uint32_t owned, uint32_t* ghost,
+                              uint64_t* keys, cudaStream_t stream) {
+  if (n == 0) return;
+  const CrowdGuard g = grid.crowd_guard();
+  mark_kernel<<<blocks_for(n, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
+      grid.order(), g.sorted_keys, g.cell_start, n, owned, ghost, keys);
+  check_launch("mark_kernel");
+  // The order lives in the sort's scratch, which the density pass overwrites: copied now.
+  cuda_check(
+      cudaMemcpyAsync(host_order_.get(), grid.order(), sizeof(uint32_t) * n, cudaMemcpyDeviceToHost, stream),
+      "copy of the sort's order");
+}
+
+const HaloDensityRecord* DeviceHalo::pack_density(const ParticleArrays& a, uint32_t m, cudaStream_t stream) {
+  const size_t bytes = sizeof(HaloDensityRecord) * m;
+  ensure_device(bytes);
+  ensure_host(bytes);
+  if (m > 0) {
+    pack_density_kernel<<<blocks_for(m, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
+        a, index_.get(), m, reinterpret_cast<HaloDensityRecord*>(staging_.get()));
+    check_launch("pack_density_kernel");
+    cuda_check(cudaMemcpyAsync(host_staging_.get(), staging_.get(), bytes, cudaMemcpyDeviceToHost, stream),
+               "copy of the halo's density records");
+  }
+  cuda_check(cudaStreamSynchronize(stream), "halo density records");
+  return reinterpret_cast<const HaloDensityRecord*>(host_staging_.get());
+}
+
+void DeviceHalo::enqueue_apply_density(const ParticleArrays& a, const HaloDensityRecord* records, uint32_t m,
+                                       cudaStream_t stream) {
+  if (m == 0) return;
+  const size_t bytes = sizeof(HaloDensityRecord) * m;
+  ensure_device(bytes);
+  ensure_host(bytes);
+  std::copy(records, records + m, reinterpret_cast<HaloDensityRecord*>(host_staging_.get()));
+  cuda_check(cudaMemcpyAsync(staging_.get(), host_staging_.get(), bytes, cudaMemcpyHostToDevice, stream),
+             "copy of the ghosts' density records");
+  apply_density_kernel<<<blocks_for(m, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
+      a, index_.get(), m, reinterpret_cast<const HaloDensityRecord*>(staging_.get()), mismatch_.get());
+  check_launch("apply_density_kernel");
+  // (The pinned staging is not touched again before the stream's next wait.)
+}
+
+uint64_t DeviceHalo::bytes() const {
+  return layers_.bytes() + index_.bytes() + iota_.bytes() + visit_.bytes() + sorted_keys_.bytes() +
+         sort_temp_.bytes() + mismatch_.bytes() + staging_.bytes();
+}
+
+}  // namespace sph

@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: MIT
+// The frame's start of a distributed world's rank (include/sph_mpi.h), the same for every
+// backend (src/cpu/cpu_halo.cpp, cuda/cuda_halo.cu): when the slabs were never cut or the
+// fullest rank holds too many particles, new cuts along the longest axis of the world's extent
+// in cells, from a histogram of particles per cell layer (SlabDecomposition::rebalance). Also
+// the particles' cell layer along the slabs' axis, which every migration and ghost decision
+// reads (SlabDecomposition::owner, ghost_destinations).
+#pragma once
+
+#include <stdint.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "../physics/grid_hash.h"
+#include "rank_agreement.h"
+#include "slab_decomposition.h"
+
+namespace sph {
+
+// Cell layer of a point along `axis`.
+inline int32_t slab_layer(float x, float y, float z, int axis, float inv_cell_size) {
+  return cell_coordinate(axis == 0 ? x : (axis == 1 ? y : z), inv_cell_size);
+}
+
+// COLLECTIVE, after an agreement. held: ranks() entries, allocated by the caller before that
+// agreement (nothing here allocates before the first reduction, so a rank that fails cannot be
+// in another collective than the rest). position_of(i) gives a record with x, y, z for each of
+// the rank's `count` particles. Returns whether the slabs were cut anew.
+template <class PositionOf>
+bool rebalance_slabs(const RankTransport& t, SlabDecomposition& slabs, bool already_cut, double threshold,
+                     uint32_t count, float inv_cell_size, std::vector<int64_t>& held,
+                     PositionOf&& position_of) {
+  std::fill(held.begin(), held.end(), 0);
+  held[static_cast<size_t>(t.rank())] = count;
+  t.all_sum(held.data(), t.size());
+  if (already_cut && !SlabDecomposition::imbalanced(held, threshold)) return false;
+  int64_t lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+  for (uint32_t i = 0; i < count; ++i) {
+    const auto p = position_of(i);
+    const float x[3] = {p.x, p.y, p.z};
+    for (int a = 0; a < 3; ++a) {
+      const int64_t c = cell_coordinate(x[a], inv_cell_size);
+      lo[a] = std::min(lo[a], c);
+      hi[a] = std::max(hi[a], c);
+    }
+  }
+  t.all_min(lo, 3);
+  t.all_max(hi, 3);
+  if (lo[0] > hi[0]) return false;  // no particles anywhere: nothing to cut
+  int axis = 0;
+  for (int a = 1; a < 3; ++a)
+    if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
+  // (A failed allocation here meets the others at the agreement below, from the step's catch.)
+  std::vector<int64_t> histogram(static_cast<size_t>(hi[axis] - lo[axis] + 1), 0);
+  for (uint32_t i = 0; i < count; ++i) {
+    const auto p = position_of(i);
+    ++histogram[static_cast<size_t>(slab_layer(p.x, p.y, p.z, axis, inv_cell_size) - lo[axis])];
+  }
+  agree(t);  // (the histogram's allocation)
+  t.all_sum(histogram.data(), static_cast<int>(histogram.size()));
+  slabs.rebalance(axis, static_cast<int32_t>(lo[axis]), histogram);
+  return true;
+}
+
+}  // namespace sph

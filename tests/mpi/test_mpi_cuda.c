@@ -1,0 +1,154 @@
+/* SPDX-License-Identifier: MIT */
+/* The CUDA backend as a distributed world's rank (cuda/cuda_halo.cu, host-staged over MPI),
+ * under mpirun on 1 and 2 ranks that share one GPU (device 0). Not a ctest: scripts/gpu-mpi-test
+ * runs it on a machine with a GPU and MPI. Each case steps the distributed CUDA world and, on
+ * rank 0, an undivided CUDA world of the same particles, then compares them on rank 0:
+ *   - the particle count and mass (n times the particle mass: every id held once, by the gather);
+ *   - positions and velocities by id, BIT FOR BIT: each rank sorts its particles in the order of
+ *     their keys, so every slot lists its particles as the undivided world's stable sort does and
+ *     every neighbour sum adds the same terms in the same order; the lane groups are picked from
+ *     the world's count (docs/distributed.md). Two regimes: a table that covers the tank (capacity
+ *     32768: 32 slots an axis) with the default lane groups, and a folding table (capacity 4096:
+ *     16 slots an axis for a tank 23 cells long) with one lane a particle, where a slot's far
+ *     particles are skipped without changing the sum's order;
+ *   - the distributed CPU world of the same particles within 1e-4 of the tank's size after 20
+ *     substeps (CPU and GPU round differently: fused multiply-adds, the lanes' partial sums;
+ *     tests/gpu's parity bound); after the collapse's 240 substeps the distance is only printed
+ *     (the roundings grow with the flow's chaos).
+ * Cases: the dam break (20 substeps), the stirred column whose particles cross the slab boundary
+ * (20 substeps; again with Clavet's viscosity and the user attribute, and with the walls'
+ * density), the collapse that makes the ranks rebalance (12 frames of 20 substeps, spacing
+ * 12.5 mm), and the refusals (DFSPH, RK4, surface tension: SPH_ERROR_UNSUPPORTED naming them).
+ * With SPH_MPI_CUDA_QUICK set, the dam break and the refusals only (a run under compute-sanitizer). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpi_test_world.h"
+#include "support.h"
+
+static sph_context* cuda_context(uint32_t lanes) {
+  sph_context_def cdef;
+  sph_context* c = NULL;
+  REQUIRE(sph_context_def_init(&cdef) == SPH_OK, "context def");
+  cdef.backend = SPH_BACKEND_CUDA;
+  cdef.cuda_particle_lanes = lanes;
+  REQUIRE(sph_context_create(&cdef, &c) == SPH_OK, "CUDA context: %s", sph_get_last_error());
+  return c;
+}
+
+static float max_abs_difference(const float* a, const float* b, uint32_t n) {
+  float m = 0.0f;
+  for (uint32_t i = 0; i < 3 * n; ++i) m = fmaxf(m, fabsf(a[i] - b[i]));
+  return m;
+}
+
+/* One case: `frames` frames of `substeps` on the CUDA context `cuda` (distributed and undivided)
+ * and on the CPU context `cpu` (distributed), compared on rank 0. */
+static void run_case(const char* name, sph_context* cuda, sph_context* cpu, const sph_world_def* def,
+                     float stir, uint32_t frames, uint32_t substeps, int compare_cpu) {
+  sph_world* single = NULL;
+  sph_world* world = NULL;
+  sph_world* cpu_world = NULL;
+  sph_mpi_counts counts;
+  uint32_t n = 0, n_cpu = 0;
+  float *x = NULL, *v = NULL, *want_x = NULL, *want_v = NULL, *cpu_x = NULL, *cpu_v = NULL;
+  mpi_test_dam(cuda, def, stir, NULL, &single, &world, &n);
+  mpi_test_dam(cpu, def, stir, NULL, NULL, &cpu_world, &n_cpu);
+  for (uint32_t f = 0; f < frames; ++f) {
+    if (g_rank == 0) mpi_test_step(single, substeps, 0);
+    mpi_test_step(world, substeps, 1);
+    mpi_test_step(cpu_world, substeps, 1);
+  }
+  REQUIRE(sph_mpi_counts_init(&counts) == SPH_OK && sph_mpi_world_get_counts(world, &counts) == SPH_OK,
+          "counts");
+  CHECK(counts.global_count == n, "%s: %llu particles, %u added", name,
+        (unsigned long long)counts.global_count, n);
+  mpi_test_gather(world, n, &x, &v);
+  mpi_test_gather(cpu_world, n, &cpu_x, &cpu_v);
+  if (g_rank == 0) {
+    float particle_mass = 0.0f;
+    double mass;
+    uint32_t differ;
+    float dx_cpu;
+    REQUIRE(sph_world_get_particle_mass(single, &particle_mass) == SPH_OK, "particle mass");
+    mass = (double)n * (double)particle_mass;
+    mpi_test_read(single, n, &want_x, &want_v);
+    differ = mpi_test_differ(want_x, want_v, x, v, n);
+    dx_cpu = max_abs_difference(cpu_x, x, n);
+    printf(
+        "%s on %d ranks: %u particles (mass %.6g kg), %u differ from the undivided CUDA world in any bit; "
+        "max |x_cuda - x_cpu| %.3g m; %u rebalances, %llu ghosts in the last substep, %llu migrations\n",
+        name, g_size, n, mass, differ, (double)dx_cpu, counts.rebalances,
+        (unsigned long long)counts.global_ghosts, (unsigned long long)counts.migrated);
+    CHECK(differ == 0, "%s: %u of %u particles differ from the undivided CUDA world", name, differ, n);
+    CHECK(!compare_cpu || dx_cpu <= 1e-4f * 0.4f,
+          "%s: the CUDA and CPU distributed worlds %.3g m apart (bound 4e-5 m)", name, (double)dx_cpu);
+    CHECK(n == n_cpu, "%s: %u particles on the CPU world, %u on the CUDA world", name, n_cpu, n);
+    free(want_x);
+    free(want_v);
+    sph_world_destroy(single);
+  }
+  free(x);
+  free(v);
+  free(cpu_x);
+  free(cpu_v);
+  sph_world_destroy(world);
+  sph_world_destroy(cpu_world);
+}
+
+static void expect_refused(sph_context* cuda, const sph_world_def* def, const char* what) {
+  sph_world* world = NULL;
+  const sph_result r = sph_mpi_world_create(cuda, def, MPI_TEST_COMM, NULL, &world);
+  CHECK(r == SPH_ERROR_UNSUPPORTED && strstr(sph_get_last_error(), what) != NULL,
+        "a distributed CUDA world with %s: %d '%s'", what, (int)r, sph_get_last_error());
+  if (r == SPH_OK) sph_world_destroy(world);
+}
+
+int main(int argc, char** argv) {
+  sph_context* cpu = NULL;
+  sph_context* cuda = NULL;
+  sph_context* cuda_one_lane = NULL;
+  sph_world_def def;
+  /* The dam break alone (scripts/gpu-mpi-test's compute-sanitizer run). */
+  const int quick = getenv("SPH_MPI_CUDA_QUICK") != NULL;
+  mpi_test_init(&argc, &argv, &cpu);
+  cuda = cuda_context(0);
+  cuda_one_lane = cuda_context(1);
+
+  mpi_test_world_def(&def);
+  def.capacity = 32768; /* 32 slots an axis: the tank's 23 x 12 x 4 cells never fold */
+  run_case("dam break", cuda, cpu, &def, 0.0f, 1, 20, 1);
+  if (!quick) {
+    run_case("stirred column", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    /* The neighbour counts cross in the density records (Clavet's viscosity reads them); the walls'
+     * density is each particle's own, inside the density its owner sends; the user attribute is a
+     * carried array that migrates. */
+    def.viscosity_method = SPH_VISCOSITY_CLAVET;
+    def.features = SPH_FEATURE_USER_ATTRIBUTE;
+    run_case("stirred column, Clavet's viscosity, user attribute", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    def.viscosity_method = SPH_VISCOSITY_MUELLER;
+    def.features = SPH_FEATURE_BOUNDARY_DENSITY;
+    run_case("stirred column, the walls' density", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    mpi_test_world_def(&def); /* capacity 4096: 16 slots an axis, folded along x */
+    run_case("stirred column, folded table, one lane", cuda_one_lane, cpu, &def, 0.5f, 1, 20, 1);
+    mpi_test_world_def(&def);
+    def.capacity = 32768;
+    def.particle_spacing = 0.0125f;
+    def.kernel_radius = 1.8f * 0.0125f;
+    run_case("collapse with rebalancing", cuda, cpu, &def, 0.0f, 12, 20, 0);
+  }
+
+  mpi_test_world_def(&def);
+  def.solver = SPH_SOLVER_DFSPH;
+  expect_refused(cuda, &def, "DFSPH");
+  mpi_test_world_def(&def);
+  def.integrator = SPH_INTEGRATOR_RK4;
+  expect_refused(cuda, &def, "RK4");
+  mpi_test_world_def(&def);
+  def.features = SPH_FEATURE_SURFACE_TENSION;
+  expect_refused(cuda, &def, "SPH_FEATURE_SURFACE_TENSION");
+
+  REQUIRE(sph_context_destroy(cuda) == SPH_OK && sph_context_destroy(cuda_one_lane) == SPH_OK, "destroy");
+  return mpi_test_finish(cpu, "mpi_cuda");
+}
