@@ -146,16 +146,9 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
   }
   const FrameState s = *r_->state_output.get();
   ++epoch_;
-  if (s.crowded_key != 0) {
-    roll_back_frame();
-    const Vec3 where{s.crowded_where[0], s.crowded_where[1], s.crowded_where[2]};
-    const std::string message =
-        crowded_cell_message(static_cast<uint32_t>(s.crowded_key >> 32), where,
-                             max_particles_per_cell(config_.particle_spacing, config_.kernel_radius));
-    // (Every rank of a distributed world found it in the substep's reduction: no agreement left.)
-    if (distributed()) throw AgreedRankFailure(Status::Capacity, message);
-    throw Error(Status::Capacity, message);
-  }
+  // A non-finite particle first: its NaN position hashes into one cell with every other NaN,
+  // so a frame that went non-finite can also report that cell as crowded (RK4's next stage
+  // sorts the NaN positions), and the cause is the non-finite value, as the CPU reports it.
   if (s.non_finite) {
     roll_back_frame();
     NonFiniteFailure failure;
@@ -166,6 +159,16 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
     failure.ids.push_back(s.bad_id);  // the first; the device keeps no other ids
     if (distributed()) throw AgreedRankFailure(Status::NonFinite, non_finite_message(failure, setup.limits));
     throw Error(Status::NonFinite, non_finite_message(failure, setup.limits));
+  }
+  if (s.crowded_key != 0) {
+    roll_back_frame();
+    const Vec3 where{s.crowded_where[0], s.crowded_where[1], s.crowded_where[2]};
+    const std::string message =
+        crowded_cell_message(static_cast<uint32_t>(s.crowded_key >> 32), where,
+                             max_particles_per_cell(config_.particle_spacing, config_.kernel_radius));
+    // (Every rank of a distributed world found it in the substep's reduction: no agreement left.)
+    if (distributed()) throw AgreedRankFailure(Status::Capacity, message);
+    throw Error(Status::Capacity, message);
   }
   count_ = count_after;
   FrameReport report;
