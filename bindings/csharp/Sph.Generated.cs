@@ -1172,7 +1172,8 @@ namespace Sph
         /// uint32_t linear_solver: how the density solve iterates: SPH_DFSPH_JACOBI (the default) or
         /// SPH_DFSPH_CONJUGATE_GRADIENTS (the divergence solve is always Jacobi); 0 = default; any
         /// other value is INVALID_ARGUMENT. Conjugate gradients run on the CPU backend only: the CUDA
-        /// backend and a distributed world refuse a step with it (UNSUPPORTED, the world unchanged)
+        /// backend, a distributed world and SPH_FEATURE_BOUNDARY_DENSITY refuse a step with it
+        /// (UNSUPPORTED, the world unchanged)
         /// </summary>
         public uint LinearSolver;
 

@@ -23,7 +23,7 @@
 // velocities keep what it applied); the solve keeps its positive part (dfsph_cg_kept_pressure).
 //
 // Each iteration is one velocity update with the search direction p as k (dv_p = -dt G p) and one
-// rate pass on v + dv_p: change = value(v + dv_p) - value(v) = -dt^2 A p, so
+// rate pass over dv_p alone (dfsph_cg_change): change = -dt^2 A p, so
 // alpha = (value . z) / (p . (-change)) over the set, z the Jacobi step (the preconditioned
 // residual); then v += alpha dv_p, value += alpha change, the carried pressure += alpha p. Two
 // neighbour passes, as a Jacobi iteration, and three exact sums.
@@ -40,6 +40,7 @@
 #include <stdint.h>
 
 #include "dfsph.h"
+#include "dfsph_boundary.h"
 #include "float4_types.h"
 #include "host_device.h"
 #include "vec3.h"
@@ -49,6 +50,12 @@ namespace sph {
 // The value the solve drives to zero at particle i: rho* - rho0, rho* = rho_i + dt D rho_i / Dt.
 SPH_HD float dfsph_cg_value(float rate, float density, float rest_density, float dt) {
   return density + dt * rate - rest_density;
+}
+
+// The change of the value that a velocity change dv makes, from the rate pass over dv alone
+// (rate = D dv minus the walls' constant v_b . grad rho_b, which is put back: the change is linear).
+SPH_HD float dfsph_cg_change(float rate_of_dv, const DfsphWalls& walls, uint32_t i, float dt) {
+  return dt * (rate_of_dv - wall_density_rate(walls, i, Vec3{0.0f, 0.0f, 0.0f}));
 }
 
 // The particle's share of the solve's mean error (as density_residual: compression only).

@@ -209,13 +209,13 @@ static void test_dfsph_capped(void** state) {
   EXPECT_OK(sph_context_destroy(context));
 }
 
-/* argv[1] picks one case (wcsph | diffusion | dfsph | dfsph_boundary | dfsph_capped, and dfsph_cg,
- * dfsph_boundary_cg with the conjugate gradients' density solve); none runs wcsph. */
+/* argv[1] picks one case (wcsph | diffusion | dfsph | dfsph_boundary | dfsph_capped, and dfsph_cg
+ * with the conjugate gradients' density solve); none runs wcsph. */
 int main(int argc, char** argv) {
   const char* which = argc >= 2 ? argv[1] : "wcsph";
-  if (strcmp(which, "dfsph_cg") == 0 || strcmp(which, "dfsph_boundary_cg") == 0) {
+  if (strcmp(which, "dfsph_cg") == 0) {
     dfsph_linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS;
-    which = strcmp(which, "dfsph_cg") == 0 ? "dfsph" : "dfsph_boundary";
+    which = "dfsph";
   }
   const struct CMUnitTest wcsph[] = {cmocka_unit_test(test_dam_break)};
   const struct CMUnitTest dfsph[] = {cmocka_unit_test(test_dfsph)};
