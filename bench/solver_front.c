@@ -8,10 +8,13 @@
  * (one fitted shift, as the validation), and DFSPH's solve iterations.
  *
  *   solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1]
- *                [--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--out solver_front.csv]
+ *                [--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg]
+ *                [--out solver_front.csv]
  *
  * --wcsph: the weakly compressible runs' speeds of sound, as multiples of the free-fall speed;
  * --dfsph: the DFSPH runs' density error bounds (0.001 = 0.1 %); `none` leaves a solver out.
+ * --dfsph-solver: the DFSPH solves' linear solver (sph_dfsph_params.linear_solver; default: the
+ * library's).
  *
  * --sample-T: the front's sampling interval in T (0.1 = 5.4 ms). Each sample ends a frame, and a
  * frame's landing step caps the substep, so a fine sampling (the validation's 0.025 = 1.35 ms)
@@ -78,6 +81,7 @@ int main(int argc, char** argv) {
   int resolutions = 3;
   double seconds = 1.0, sample_T = 0.1;
   const char* out_path = "solver_front.csv";
+  uint32_t linear_solver = 0; /* the library's default */
   sph_backend backend = SPH_BACKEND_AUTO, resolved = SPH_BACKEND_CPU;
   sph_context* context = NULL;
   dam_break_result* result = (dam_break_result*)malloc(sizeof(dam_break_result));
@@ -126,11 +130,22 @@ int main(int argc, char** argv) {
       }
     } else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
       out_path = argv[++i];
+    } else if (strcmp(argv[i], "--dfsph-solver") == 0 && i + 1 < argc) {
+      ++i;
+      if (strcmp(argv[i], "jacobi") == 0) {
+        linear_solver = SPH_DFSPH_JACOBI;
+      } else if (strcmp(argv[i], "cg") == 0) {
+        linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS;
+      } else {
+        fprintf(stderr, "solver_front: --dfsph-solver takes jacobi or cg\n");
+        return 2;
+      }
     } else {
       fprintf(
           stderr,
           "usage: solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1] "
-          "[--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--out solver_front.csv]\n");
+          "[--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg] [--out "
+          "solver_front.csv]\n");
       return 2;
     }
   }
@@ -155,9 +170,9 @@ int main(int argc, char** argv) {
   printf(
       "%s backend; dam break of Martin & Moyce for %.2f simulated s; front errors over T in [%.1f, %.1f]\n",
       resolved == SPH_BACKEND_CUDA ? "CUDA" : "CPU", seconds, DAM_BREAK_T_FIRST, DAM_BREAK_T_LAST);
-  printf("%-6s %-9s %6s %9s %10s %9s %10s %8s %8s %8s %8s %9s %6s\n", "solver", "parameter", "layers",
-         "particles", "wall/sim", "substeps", "nb passes", "rho err", "rho max", "front", "it/step",
-         "ms/subst", "nbrs");
+  printf("%-6s %-9s %6s %9s %10s %9s %10s %8s %8s %8s %8s %8s %6s %9s %6s\n", "solver", "parameter", "layers",
+         "particles", "wall/sim", "substeps", "nb passes", "rho err", "rho max", "front", "it/step", "div it",
+         "capped", "ms/subst", "nbrs");
   for (int l = 0; l < resolutions; ++l) {
     for (int r = 0; r < run_count; ++r) {
       dam_break_config config;
@@ -168,6 +183,7 @@ int main(int argc, char** argv) {
       config.end_T = seconds * time_scale;
       config.sample_T = sample_T;
       config.solver = runs[r].solver;
+      config.dfsph_linear_solver = linear_solver;
       if (dfsph)
         config.density_error = (float)runs[r].value;
       else
@@ -199,12 +215,13 @@ int main(int argc, char** argv) {
         fprintf(csv, ",%.5f", result->substeps ? result->stage_ms[k] / (double)result->substeps : 0.0);
       fprintf(csv, "\n");
       fflush(csv);
-      printf("%-6s %-9g %6u %9u %10.2f %9llu %10.0f %7.2f%% %7.2f%% %7.2f%% %8.2f %9.4f %6.1f\n",
+      printf("%-6s %-9g %6u %9u %10.2f %9llu %10.0f %7.2f%% %7.2f%% %7.2f%% %8.2f %8.2f %6u %9.4f %6.1f\n",
              dfsph ? "DFSPH" : "WCSPH", runs[r].value, layers[l], result->particles,
              result->wall_seconds / result->simulated_seconds, (unsigned long long)result->substeps, passes,
              100.0 * result->mean_compression, 100.0 * result->max_compression, 100.0 * result->mean_error,
-             dfsph ? (double)result->pressure_iterations / (double)result->substeps : 0.0, substep_ms,
-             result->neighbors_mean);
+             dfsph ? (double)result->pressure_iterations / (double)result->substeps : 0.0,
+             dfsph ? (double)result->divergence_iterations / (double)result->substeps : 0.0,
+             result->capped_substeps, substep_ms, result->neighbors_mean);
       printf("       stages, ms/substep:");
       for (int k = 0; k < SPH_STAGE_COUNT; ++k)
         printf(" %.4f", result->substeps ? result->stage_ms[k] / (double)result->substeps : 0.0);

@@ -97,6 +97,10 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
   setup.count = count_;
   setup.integrator = config_.integrator;
   setup.fluid = make_fluid_constants(config_, params);
+  if (config_.solver == Solver::Dfsph && setup.fluid.methods.dfsph.linear_solver == kDfsphConjugateGradients)
+    throw Error(Status::Unsupported,
+                "step: DFSPH's conjugate gradients solve (sph_dfsph_params.linear_solver = "
+                "SPH_DFSPH_CONJUGATE_GRADIENTS) runs on the CPU backend only yet; use SPH_DFSPH_JACOBI");
   setup.limits = make_step_limits(config_, params);
   setup.max_substeps = params.stepping.max_substeps;
   setup.options = options_;

@@ -591,6 +591,11 @@ SPH_API sph_result SPH_CALL sph_world_get_density_diffusion_params(const sph_wor
 
 /** sph_dfsph_params.flags */
 #define SPH_DFSPH_SKIP_DIVERGENCE_SOLVE 0x1u /* no divergence solve (cheaper; a noisier pressure) */
+/** sph_dfsph_params.linear_solver (docs/physics.md, DFSPH) */
+#define SPH_DFSPH_JACOBI 1u /* the Jacobi step of Bender & Koschier (the default) */
+#define SPH_DFSPH_CONJUGATE_GRADIENTS                    \
+  2u /* Jacobi-preconditioned conjugate gradients on the \
+         compressed particles */
 
 typedef struct sph_dfsph_params {
   uint32_t struct_size;               /* set by sph_dfsph_params_init */
@@ -605,8 +610,15 @@ typedef struct sph_dfsph_params {
                                          counted in sph_stats and reported as an event */
   uint32_t max_divergence_iterations; /* cap of the divergence solve; default 100; >= 1; 0 = default */
   uint32_t flags;                     /* SPH_DFSPH_* bits; default 0 */
+  uint32_t linear_solver;             /* how the density solve iterates: SPH_DFSPH_JACOBI (the default)
+                                         or SPH_DFSPH_CONJUGATE_GRADIENTS (the divergence solve is
+                                         always Jacobi); 0 = default; any other value is
+                                         INVALID_ARGUMENT. Conjugate gradients run on the CPU backend
+                                         only: the CUDA backend, a distributed world and
+                                         SPH_FEATURE_BOUNDARY_DENSITY refuse a step with it
+                                         (UNSUPPORTED, the world unchanged) */
 } sph_dfsph_params;
-SPH_STATIC_ASSERT(sizeof(sph_dfsph_params) == 24, sph_dfsph_params_size);
+SPH_STATIC_ASSERT(sizeof(sph_dfsph_params) == 28, sph_dfsph_params_size);
 
 SPH_API sph_result SPH_CALL sph_dfsph_params_init_sized(sph_dfsph_params* params, uint32_t size);
 static inline sph_result sph_dfsph_params_init(sph_dfsph_params* params) {

@@ -24,6 +24,8 @@
 #define SPH_STEP_LIMIT_ACOUSTIC 1
 #define SPH_STEP_LIMIT_FORCE 2
 #define SPH_DFSPH_SKIP_DIVERGENCE_SOLVE 1
+#define SPH_DFSPH_JACOBI 1
+#define SPH_DFSPH_CONJUGATE_GRADIENTS 2
 #define SPH_SHAPE_FLAG_OPEN_TOP 1
 #define SPH_COLLIDER_FLAG_INVERTED 1
 #define SPH_SOURCE_FLAG_VELOCITY_FROM_FIELD 1
@@ -307,6 +309,7 @@ typedef struct sph_dfsph_params {
   uint32_t max_iterations;
   uint32_t max_divergence_iterations;
   uint32_t flags;
+  uint32_t linear_solver;
 } sph_dfsph_params;
 typedef struct sph_params_info {
   uint32_t struct_size;

@@ -99,6 +99,13 @@ namespace Sph
         public const uint SPH_STEP_LIMIT_FORCE = 2u;
         /// <summary>sph_dfsph_params.flags no divergence solve (cheaper; a noisier pressure)</summary>
         public const uint SPH_DFSPH_SKIP_DIVERGENCE_SOLVE = 1u;
+        /// <summary>
+        /// sph_dfsph_params.linear_solver (docs/physics.md, DFSPH) the Jacobi step of Bender &amp;
+        /// Koschier (the default)
+        /// </summary>
+        public const uint SPH_DFSPH_JACOBI = 1u;
+        /// <summary>Jacobi-preconditioned conjugate gradients on the \ compressed particles</summary>
+        public const uint SPH_DFSPH_CONJUGATE_GRADIENTS = 2u;
         /// <summary>hollow box: no lid (a tank open at +y)</summary>
         public const uint SPH_SHAPE_FLAG_OPEN_TOP = 1u;
         /// <summary>solid where the SDF is positive: a container</summary>
@@ -1131,7 +1138,7 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_dfsph_params (24 bytes)</summary>
+    /// <summary>sph_dfsph_params (28 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct DfsphParams
     {
@@ -1161,6 +1168,14 @@ namespace Sph
         public uint MaxDivergenceIterations;
         /// <summary>uint32_t flags: SPH_DFSPH_* bits; default 0</summary>
         public uint Flags;
+        /// <summary>
+        /// uint32_t linear_solver: how the density solve iterates: SPH_DFSPH_JACOBI (the default) or
+        /// SPH_DFSPH_CONJUGATE_GRADIENTS (the divergence solve is always Jacobi); 0 = default; any
+        /// other value is INVALID_ARGUMENT. Conjugate gradients run on the CPU backend only: the CUDA
+        /// backend, a distributed world and SPH_FEATURE_BOUNDARY_DENSITY refuse a step with it
+        /// (UNSUPPORTED, the world unchanged)
+        /// </summary>
+        public uint LinearSolver;
 
         /// <summary>A DfsphParams with the library's defaults (sph_dfsph_params_init_sized).</summary>
         public static DfsphParams Default()
@@ -3628,7 +3643,7 @@ namespace Sph
             8,
             28,
             8,
-            24,
+            28,
             32,
             72,
             32,
@@ -3726,6 +3741,7 @@ namespace Sph
             typeof(SpringParams),
             typeof(DensityDiffusionParams),
             typeof(DensityDiffusionParams),
+            typeof(DfsphParams),
             typeof(DfsphParams),
             typeof(DfsphParams),
             typeof(DfsphParams),
@@ -4011,6 +4027,7 @@ namespace Sph
             "MaxIterations",
             "MaxDivergenceIterations",
             "Flags",
+            "LinearSolver",
             "StructSize",
             "ParamsSize",
             "FieldCount",
@@ -4290,6 +4307,7 @@ namespace Sph
             12,
             16,
             20,
+            24,
             0,
             4,
             8,

@@ -211,6 +211,14 @@ class CpuBackend final : public Backend {
   // New pressures and errors from the rates over the velocities the last dfsph_correct wrote (the
   // columns); returns the mean error.
   float dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls, float dt);
+  // The density solve by conjugate gradients (cpu_dfsph_cg.cpp; sph_dfsph_params.linear_solver);
+  // its rate pass (each particle's value into cg_value_; returns the mean error); a contact held
+  // within an iteration (v_i changed by dv): the values of i and its neighbours.
+  SolveOutcome dfsph_solve_cg(const FluidConstants& fluid, const DfsphWalls& walls, float dt, Float4* v,
+                              float* carried);
+  float dfsph_cg_measure(const FluidConstants& fluid, const DfsphWalls& walls, float dt);
+  void dfsph_cg_hold_contact(const FluidConstants& fluid, const DfsphWalls& walls, float dt, uint32_t i,
+                             Vec3 dv);
 
   // Springs (SPH_FEATURE_SPRINGS), after the sort: the particles that wait for springs make
   // them (two passes, springs.h), then every particle gathers its spring acceleration into a
@@ -317,6 +325,10 @@ class CpuBackend final : public Backend {
   CpuArrayRef<Float4> dfsph_contact_;         // DFSPH: each particle's contact with the colliders
   bool dfsph_contacts_ = false;               // DFSPH: the substep has colliders (contacts to respect)
   HostVector<ColliderView> dfsph_colliders_;  // DFSPH: the substep's colliders, for the contacts
+  HostVector<float> cg_value_;                // DFSPH by conjugate gradients: rho* - rho0 per particle
+  HostVector<float> cg_change_;               // ... its change along the search direction
+  HostVector<Float4> cg_velocity_step_;       // ... the velocity change of the search direction
+  HostVector<uint8_t> cg_state_;              // ... in the active set; contact binds
   CpuArrayRef<Float4> boundary_;              // boundary density: (grad rho_b, v_b . grad rho_b) per particle
   CpuArrayRef<uint32_t> user_attribute_;      // SPH_FEATURE_USER_ATTRIBUTE: the caller's value
   CpuBoundaryMaps boundary_maps_;

@@ -3,7 +3,8 @@
 // factor, the divergence solve on the current velocities, the non-pressure accelerations into
 // v*, the density solve on v*, then positions and colliders. Each solve is a Jacobi iteration of
 // two passes, the velocity update (dfsph_correct) and the new rates and pressures
-// (dfsph_residuals), until its mean error is below its bound or its cap. The mean is an exact
+// (dfsph_residuals), until its mean error is below its bound or its cap; with
+// SPH_DFSPH_CONJUGATE_GRADIENTS the density solve is cpu_dfsph_cg.cpp's instead. The mean is an exact
 // sum (exact_float_sum.h), so it, the iteration count and every result depend on neither the
 // thread count nor, in a distributed world, the ranks.
 //
@@ -91,6 +92,8 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
                                                  const DfsphWalls& walls, float dt, Float4* v, float* carried,
                                                  float carry_scale) {
   const Dfsph::Constants& c = fluid.methods.dfsph;
+  if (c.linear_solver == kDfsphConjugateGradients && kind == DfsphSolve::Density)
+    return dfsph_solve_cg(fluid, walls, dt, v, carried);
   const bool divergence = kind == DfsphSolve::Divergence;
   const float bound = divergence ? c.divergence_error : c.density_error;
   const uint32_t min_iterations = divergence ? Dfsph::kMinDivergenceIterations : Dfsph::kMinIterations;

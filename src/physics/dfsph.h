@@ -46,6 +46,9 @@ namespace sph {
 
 // sph_dfsph_params.flags (SPH_DFSPH_*).
 enum DfsphFlags : uint32_t { kDfsphSkipDivergenceSolve = 1u << 0, kDfsphFlagsAll = 1u };
+// sph_dfsph_params.linear_solver (SPH_DFSPH_JACOBI, SPH_DFSPH_CONJUGATE_GRADIENTS): how the
+// density solve iterates (dfsph_cg.h has the conjugate gradients' method; CPU only).
+enum DfsphLinearSolver : uint32_t { kDfsphJacobi = 1, kDfsphConjugateGradients = 2 };
 
 // The names of DFSPH's per-particle arrays.
 constexpr const char* kArrayDfsphPressure = "dfsph_pressure";              // p / rho^2 of the density solve
@@ -64,7 +67,8 @@ struct Dfsph {
     float divergence_error = 1.0f;  // bound on the mean max(D rho / Dt, 0) / rho0, 1/s
     uint32_t max_iterations = 100;  // of the density solve, per substep
     uint32_t max_divergence_iterations = 100;
-    uint32_t flags = 0;  // DfsphFlags
+    uint32_t flags = 0;                     // DfsphFlags
+    uint32_t linear_solver = kDfsphJacobi;  // DfsphLinearSolver
   };
   static constexpr ParamField<Params> kFields[] = {
       real_field("density_error", &Params::density_error, above_up_to(0.0, 1.0), ZeroMeans::Default, ""),
@@ -73,6 +77,7 @@ struct Dfsph {
       count_field("max_divergence_iterations", &Params::max_divergence_iterations, at_least(1.0),
                   ZeroMeans::Default),
       bits_field("flags", &Params::flags, kDfsphFlagsAll),
+      count_field("linear_solver", &Params::linear_solver, within(1.0, 2.0), ZeroMeans::Default),
   };
   static bool check(const Params&, const WorldShape&, ParamConflict&) { return true; }
 
@@ -82,6 +87,9 @@ struct Dfsph {
   static constexpr uint32_t kMinDivergenceIterations = 1;
   // The share of the last substep's pressure a solve starts from (see above).
   static constexpr float kWarmStart = 0.5f;
+  // The conjugate gradients' density solve (dfsph_cg.h) starts a new cycle when the compression
+  // outside its active set reaches this share of the bound.
+  static constexpr float kCgRestartShare = 0.5f;
   // A particle with fewer neighbours than this share of the full lattice's (42 at h = 1.8
   // spacings) gets no divergence correction: at a free surface or a splash the divergence of
   // a half-empty neighbourhood is not the fluid's (the reference uses 20 of about 45).
@@ -97,6 +105,7 @@ struct Dfsph {
     uint32_t max_divergence_iterations;
     uint32_t divergence_solve;  // 1 unless kDfsphSkipDivergenceSolve
     uint32_t min_divergence_neighbors;
+    uint32_t linear_solver;  // DfsphLinearSolver
   };
   static Constants make_constants(const Params& p, const WorldShape& shape, const LatticeSums& lattice) {
     Constants c;
@@ -110,6 +119,7 @@ struct Dfsph {
     const double full =
         static_cast<double>(lattice.neighbor_count(shape.particle_spacing, shape.kernel_radius));
     c.min_divergence_neighbors = static_cast<uint32_t>(kDivergenceNeighborShare * full + 0.5);
+    c.linear_solver = p.linear_solver;
     return c;
   }
 

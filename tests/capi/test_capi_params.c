@@ -238,8 +238,8 @@ static void expect_rule(world_fixture* f, const rule_case* c, const params_buffe
 
 static void test_each_rule_fires_with_its_message(void** state) {
   world_fixture* f = (world_fixture*)*state;
-  const uint32_t unknown_bits = 0x10u, one = 1u;
-  float bits_as_float, one_as_float;
+  const uint32_t unknown_bits = 0x10u, one = 1u, three = 3u;
+  float bits_as_float, one_as_float, three_as_float;
   const rule_case cases[] = {
       {SPH_PARAMS_WORLD, offsetof(sph_world_params, stiffness), -1.0f, SPH_ERROR_INVALID_ARGUMENT,
        "params->stiffness: must be > 0, got -1"},
@@ -292,6 +292,7 @@ static void test_each_rule_fires_with_its_message(void** state) {
   /* Words that are not floats: unknown step-limit bits and the reserved words. */
   memcpy(&bits_as_float, &unknown_bits, sizeof bits_as_float);
   memcpy(&one_as_float, &one, sizeof one_as_float);
+  memcpy(&three_as_float, &three, sizeof three_as_float);
   {
     const rule_case words[] = {
         {SPH_PARAMS_WORLD, offsetof(sph_world_params, step_limits), bits_as_float, SPH_ERROR_UNSUPPORTED,
@@ -300,6 +301,9 @@ static void test_each_rule_fires_with_its_message(void** state) {
          "params->reserved0: is reserved and must be 0"},
         {SPH_PARAMS_SPRINGS, offsetof(sph_spring_params, reserved0), one_as_float, SPH_ERROR_INVALID_ARGUMENT,
          "params->reserved0: is reserved and must be 0"},
+        /* neither SPH_DFSPH_JACOBI nor SPH_DFSPH_CONJUGATE_GRADIENTS */
+        {SPH_PARAMS_DFSPH, offsetof(sph_dfsph_params, linear_solver), three_as_float,
+         SPH_ERROR_INVALID_ARGUMENT, "params->linear_solver: must be in [1, 2], got 3"},
     };
     for (i = 0; i < sizeof words / sizeof words[0]; ++i) {
       const params_buffer base = read_back(world_of(f, words[i].kind), words[i].kind);
@@ -442,6 +446,8 @@ static void test_descriptions_match_the_header(void** state) {
        SPH_PARAM_UINT32, SPH_PARAM_ZERO_IS_DEFAULT},
       {SPH_PARAMS_DFSPH, "flags", offsetof(sph_dfsph_params, flags), SPH_PARAM_FLAGS,
        SPH_PARAM_ZERO_IS_VALUE},
+      {SPH_PARAMS_DFSPH, "linear_solver", offsetof(sph_dfsph_params, linear_solver), SPH_PARAM_UINT32,
+       SPH_PARAM_ZERO_IS_DEFAULT},
       {SPH_PARAMS_DENSITY_DIFFUSION, "delta", offsetof(sph_density_diffusion_params, delta), SPH_PARAM_FLOAT,
        SPH_PARAM_ZERO_IS_DEFAULT},
   };
@@ -455,7 +461,7 @@ static void test_descriptions_match_the_header(void** state) {
       {"clavet", "sph_clavet_viscosity_params", sizeof(sph_clavet_viscosity_params), 2},
       {"tait", "sph_tait_params", sizeof(sph_tait_params), 1},
       {"springs", "sph_spring_params", sizeof(sph_spring_params), 5},
-      {"dfsph", "sph_dfsph_params", sizeof(sph_dfsph_params), 5},
+      {"dfsph", "sph_dfsph_params", sizeof(sph_dfsph_params), 6},
       {"density_diffusion", "sph_density_diffusion_params", sizeof(sph_density_diffusion_params), 1},
   };
   size_t i, seen[SPH_PARAMS_KIND_COUNT] = {0};

@@ -138,6 +138,7 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
     if (config->divergence_error > 0.0f) dfsph.divergence_error = config->divergence_error;
     if (config->max_iterations > 0) dfsph.max_iterations = config->max_iterations;
     dfsph.flags = config->dfsph_flags;
+    dfsph.linear_solver = config->dfsph_linear_solver;
     if ((r = sph_world_set_dfsph_params(world, &dfsph)) != SPH_OK) goto done;
   } else {
     sph_tait_params_init(&tait);

@@ -62,6 +62,9 @@ static double total_energy(const sph_world* world, float mass, double k, double 
  * (0.1 %) and store no energy, so its total is kinetic + potential, and a projection can only
  * remove kinetic energy (it makes the velocities' closest divergence-free field); what the bound
  * catches is a solve or a wall contact that adds energy. */
+/* SPH_DFSPH_JACOBI or SPH_DFSPH_CONJUGATE_GRADIENTS for the DFSPH runs (0: the default). */
+static uint32_t dfsph_linear_solver = 0;
+
 static void run_energy_never_grows(sph_solver solver) {
   const int full = validation_full();
   const double step = full ? 0.005 : 0.01;
@@ -93,6 +96,13 @@ static void run_energy_never_grows(sph_solver solver) {
   EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, &params));
   world = w.world;
   def = w.def;
+  if (solver == SPH_SOLVER_DFSPH && dfsph_linear_solver != 0) {
+    sph_dfsph_params dfsph;
+    EXPECT_OK(sph_dfsph_params_init(&dfsph));
+    EXPECT_OK(sph_world_get_dfsph_params(world, &dfsph));
+    dfsph.linear_solver = dfsph_linear_solver;
+    EXPECT_OK(sph_world_set_dfsph_params(world, &dfsph));
+  }
   EXPECT_OK(support_tank_between(w.context, world, box_min, box_max, 0.5 * step, 0.0f, &sdf, NULL));
   EXPECT_OK(support_spawn(world, points, NULL, n));
   EXPECT_OK(sph_world_get_particle_mass(world, &mass));
@@ -225,12 +235,18 @@ static void test_momentum_round_off(void** state) {
   EXPECT_OK(support_world_close(&w));
 }
 
-/* argv[1] picks one check (energy | energy_dfsph | momentum); none runs energy and momentum. */
+/* argv[1] picks one check (energy | energy_dfsph | energy_dfsph_cg | momentum); none runs energy and
+ * momentum. energy_dfsph_cg: DFSPH's density solve by conjugate gradients (the solve that may
+ * lower a particle's pressure within a substep, so the check that it adds no energy). */
 int main(int argc, char** argv) {
   const struct CMUnitTest energy[] = {cmocka_unit_test(test_energy_never_grows)};
   const struct CMUnitTest energy_dfsph[] = {cmocka_unit_test(test_energy_never_grows_dfsph)};
   const struct CMUnitTest momentum[] = {cmocka_unit_test(test_momentum_round_off)};
   int failed = 0;
+  if (argc >= 2 && strcmp(argv[1], "energy_dfsph_cg") == 0) {
+    dfsph_linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS;
+    return cmocka_run_group_tests_name("closed_box_energy_dfsph_cg", energy_dfsph, NULL, NULL);
+  }
   if (argc >= 2 && strcmp(argv[1], "energy_dfsph") == 0)
     return cmocka_run_group_tests_name("closed_box_energy_dfsph", energy_dfsph, NULL, NULL);
   if (argc < 2 || strcmp(argv[1], "energy") == 0)

@@ -108,6 +108,10 @@ static void test_dam_break(void** state) {
  * 4.92 % at dT = -0.200, the shift's bound (unshifted 10.5 % / 17.9 %): the front runs early, as
  * the floor's particles along the slab's side walls start over-read (the edges' +25 %,
  * docs/physics.md, "Walls in the density") and are pushed out at once. */
+/* SPH_DFSPH_JACOBI or SPH_DFSPH_CONJUGATE_GRADIENTS for the DFSPH cases (0: the default); the
+ * _cg cases hold the conjugate gradients' solve to the same bounds. */
+static uint32_t dfsph_linear_solver = 0;
+
 static void run_dfsph(uint32_t features) {
   sph_context* context = NULL;
   dam_break_config config;
@@ -118,6 +122,7 @@ static void run_dfsph(uint32_t features) {
   dam_break_config_default(&config, validation_full() ? 40 : 20);
   config.solver = SPH_SOLVER_DFSPH;
   config.features = features;
+  config.dfsph_linear_solver = dfsph_linear_solver;
   r = dam_break_run(context, &config, result, trace_line, getenv("SPH_TRACE") ? stdout : NULL);
   if (r != SPH_OK) printf("dam break failed: %s: %s\n", sph_result_string(r), result->message);
   assert_int_equal(r, SPH_OK);
@@ -204,9 +209,14 @@ static void test_dfsph_capped(void** state) {
   EXPECT_OK(sph_context_destroy(context));
 }
 
-/* argv[1] picks one case (wcsph | diffusion | dfsph | dfsph_boundary | dfsph_capped); none runs wcsph. */
+/* argv[1] picks one case (wcsph | diffusion | dfsph | dfsph_boundary | dfsph_capped, and dfsph_cg
+ * with the conjugate gradients' density solve); none runs wcsph. */
 int main(int argc, char** argv) {
   const char* which = argc >= 2 ? argv[1] : "wcsph";
+  if (strcmp(which, "dfsph_cg") == 0) {
+    dfsph_linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS;
+    which = "dfsph";
+  }
   const struct CMUnitTest wcsph[] = {cmocka_unit_test(test_dam_break)};
   const struct CMUnitTest dfsph[] = {cmocka_unit_test(test_dfsph)};
   const struct CMUnitTest dfsph_boundary[] = {cmocka_unit_test(test_dfsph_boundary)};

@@ -1,0 +1,191 @@
+// SPDX-License-Identifier: MIT
+// The CPU backend's DFSPH density solve by Jacobi-preconditioned conjugate gradients
+// (sph_dfsph_params.linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS; physics/dfsph_cg.h has the
+// method and why the system is symmetric). Each iteration is one velocity update with the search
+// direction as k and one rate pass over the velocities it would give, as a Jacobi iteration's
+// two passes. Every sum is exact (exact_float_sum.h) and taken in storage order, and the
+// contacts are held in storage order, so no result depends on the worker count.
+#include <cmath>
+#include <string>
+
+#include "../core/exact_float_sum.h"
+#include "../physics/dfsph_cg.h"
+#include "cpu_backend_impl.h"
+
+namespace sph {
+
+namespace {
+constexpr uint8_t kActive = 1, kBinds = 2;
+}  // namespace
+
+float CpuBackend::dfsph_cg_measure(const FluidConstants& fluid, const DfsphWalls& walls, float dt) {
+  const GridView view = grid_.view();
+  const NeighborColumns columns = columns_.view();
+  const float* density = density_.data();
+  const float rho0 = fluid.rest_density;
+  float* value = cg_value_.data();
+  float* error = dfsph_residual_.data();
+  const SimdPasses::DfsphRateFn rate_of = simd_.dfsph_density_rate;
+  parallel().for_each(count_, [&](uint32_t i) {
+    value[i] = dfsph_cg_value(rate_of(fluid, view, columns, walls, i), density[i], rho0, dt);
+    error[i] = dfsph_cg_error(value[i], rho0);
+  });
+  ExactFloatSum sum;
+  for (uint32_t i = 0; i < count_; ++i) sum.add(error[i]);
+  return count_ > 0 ? static_cast<float>(sum.value() / static_cast<double>(count_)) : 0.0f;
+}
+
+void CpuBackend::dfsph_cg_hold_contact(const FluidConstants& fluid, const DfsphWalls& walls, float dt,
+                                       uint32_t i, Vec3 dv) {
+  // D rho / Dt = sum_j m (v_i - v_j) . grad W_ij + v_i . grad rho_b: a change dv of v_i alone
+  // adds m dv . grad W_ij to the rate of i and of each neighbour j (grad W_ji = -grad W_ij).
+  const KernelCoefficients mk = mass_gradient_kernel(fluid);
+  const GridView view = grid_.view();
+  const Float4* x = position_.data();
+  const Vec3 xi = xyz(x[i]);
+  float* value = cg_value_.data();
+  float own = walls.records ? dot(boundary_gradient(walls.records[i]), dv) : 0.0f;
+  for_each_neighbor_candidate(view, xi, [&](uint32_t j) {
+    const Vec3 d = xi - xyz(x[j]);
+    const float r2 = length_squared(d);
+    if (!(r2 < fluid.kernel.h2) || j == i) return;
+    const float term = dot(dv, spiky_gradient(mk, d, std::sqrt(r2)));
+    own += term;
+    value[j] += dt * term;
+  });
+  value[i] += dt * own;
+}
+
+CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid, const DfsphWalls& walls,
+                                                    float dt, Float4* v, float* carried) {
+  const char* refused =
+      ranks_ ? "a distributed world" : (walls.records ? "SPH_FEATURE_BOUNDARY_DENSITY" : nullptr);
+  // With the walls in the density the solve did not converge (a falling ball in a tank: every
+  // iteration restarted, p . A p < 0 seen; docs/physics.md, DFSPH, Limits): refused until understood.
+  if (refused)
+    throw Error(Status::Unsupported,
+                std::string("step: DFSPH's conjugate gradients solve "
+                            "(sph_dfsph_params.linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS) "
+                            "does not work with ") +
+                    refused + " yet; use SPH_DFSPH_JACOBI");
+  const Dfsph::Constants& c = fluid.methods.dfsph;
+  const float bound = c.density_error;
+  const uint32_t n = count_;
+  cg_value_.resize(n);
+  cg_change_.resize(n);
+  cg_velocity_step_.resize(n);
+  cg_state_.resize(n);
+  float* p = columns_.dfsph_step();  // the search direction, read by the velocity update as k
+  float* value = cg_value_.data();
+  float* change = cg_change_.data();
+  float* z = dfsph_residual_.data();  // the preconditioned residual, or each particle's error
+  Float4* dv = cg_velocity_step_.data();
+  uint8_t* state = cg_state_.data();
+  const float* factor = dfsph_factor_.data();
+  const Float4* contact = dfsph_contacts_ ? dfsph_contact_.data() : nullptr;
+  const float rho0 = fluid.rest_density;
+  const GridView view = grid_.view();
+  const NeighborColumns columns = columns_.view();
+  const SimdPasses::DfsphVelocityChangeFn change_of = simd_.dfsph_velocity_change;
+  const SimdPasses::DfsphRateFn rate_of = simd_.dfsph_density_rate;
+
+  // The warm start, as the Jacobi solve's: half the last substep's pressure, applied once.
+  parallel().for_each(n, [&](uint32_t i) {
+    p[i] = Dfsph::kWarmStart * carried[i];
+    carried[i] = 0.0f;
+  });
+  dfsph_correct(fluid, walls, dt, v, carried, 1.0f);
+  float error = dfsph_cg_measure(fluid, walls, dt);
+
+  uint32_t iterations = 0;
+  bool restart = true;
+  double sz = 0.0;  // value . z over the active set
+  while ((error > bound || iterations < Dfsph::kMinIterations) && iterations < c.max_iterations) {
+    if (restart) {
+      // A new cycle: the set, the binding contacts and the steepest (preconditioned) direction.
+      parallel().for_each(n, [&](uint32_t i) {
+        const bool active = dfsph_cg_active(value[i], carried[i], factor[i]);
+        const bool binds = contact && dfsph_contact_binds(contact[i], xyz(v[i]));
+        state[i] = static_cast<uint8_t>((active ? kActive : 0) | (binds ? kBinds : 0));
+        p[i] = active ? dfsph_cg_step(value[i], factor[i], dt) : 0.0f;
+      });
+      ExactFloatSum s;
+      for (uint32_t i = 0; i < n; ++i)
+        if (state[i] & kActive) s.add(value[i] * p[i]);
+      sz = s.value();
+      restart = false;
+      // Nothing that pressure can reach is off its rest density: done, once the minimum ran (as
+      // the Jacobi solve's, whose iterations then apply no pressure either).
+      if (sz == 0.0 && iterations >= Dfsph::kMinIterations) break;
+    }
+    // The operator on p: the velocities p would give, and their rates.
+    parallel().for_each(n, [&](uint32_t i) {
+      Vec3 d = change_of(fluid, view, columns, p, walls, i, dt);
+      if (state[i] & kBinds) d = dfsph_contact_project(contact[i], d);
+      dv[i] = make_float4_record(d, 0.0f);
+      columns_.set_velocity(i, d);
+    });
+    // The rates of dv_p alone (linear, so the tracked values' rounding is never amplified by a
+    // long step, as it would be by value(v + dv_p) - value).
+    parallel().for_each(n, [&](uint32_t i) {
+      change[i] = dfsph_cg_change(rate_of(fluid, view, columns, walls, i), walls, i, dt);
+    });
+    ExactFloatSum pq_sum;  // p . A p (the value falls along p)
+    for (uint32_t i = 0; i < n; ++i)
+      if (state[i] & kActive) pq_sum.add(-p[i] * change[i]);
+    const double pq = pq_sum.value();
+    ++iterations;
+    if (!(pq > 0.0)) {  // no descent left along p (rounding): a new cycle from the same state
+      parallel().for_each(n, [&](uint32_t i) { columns_.set_velocity(i, xyz(v[i])); });
+      restart = true;
+      continue;
+    }
+    const float alpha = static_cast<float>(sz / pq);
+    parallel().for_each(n, [&](uint32_t i) {
+      const Vec3 vi = xyz(v[i]) + xyz(dv[i]) * alpha;
+      v[i] = make_float4_record(vi, v[i].w);
+      columns_.set_velocity(i, vi);
+      carried[i] += alpha * p[i];
+      value[i] += alpha * change[i];
+    });
+    // The contacts, held as the Jacobi solve holds them after each update; a held particle moves
+    // only along its wall for the rest of the solve.
+    if (contact)
+      for (uint32_t i = 0; i < n; ++i) {
+        const Vec3 vi = xyz(v[i]);
+        if (!dfsph_contact_moved(contact[i], vi)) continue;
+        const Vec3 held = respect_contact(contact[i], vi);
+        v[i] = make_float4_record(held, v[i].w);
+        columns_.set_velocity(i, held);
+        state[i] |= kBinds;
+        dfsph_cg_hold_contact(fluid, walls, dt, i, held - vi);
+      }
+    parallel().for_each(n, [&](uint32_t i) { z[i] = dfsph_cg_error(value[i], rho0); });
+    ExactFloatSum error_sum, outside_sum;
+    for (uint32_t i = 0; i < n; ++i) {
+      error_sum.add(z[i]);
+      if (!(state[i] & kActive)) outside_sum.add(z[i]);
+    }
+    error = static_cast<float>(error_sum.value() / static_cast<double>(n));
+    if (outside_sum.value() / static_cast<double>(n) >= Dfsph::kCgRestartShare * bound) {
+      restart = true;  // the compression outside the set needs a larger set
+      continue;
+    }
+    // z and the next direction p = z + beta p over the set.
+    parallel().for_each(
+        n, [&](uint32_t i) { z[i] = (state[i] & kActive) ? dfsph_cg_step(value[i], factor[i], dt) : 0.0f; });
+    ExactFloatSum s;
+    for (uint32_t i = 0; i < n; ++i)
+      if (state[i] & kActive) s.add(value[i] * z[i]);
+    const double sz_next = s.value();
+    const float beta = static_cast<float>(sz_next / sz);
+    sz = sz_next;
+    parallel().for_each(n, [&](uint32_t i) { p[i] = (state[i] & kActive) ? z[i] + beta * p[i] : 0.0f; });
+  }
+  // Kept for the warm start, the checkpoints and the pressure attribute: where it pushed
+  // (dfsph_cg.h).
+  parallel().for_each(n, [&](uint32_t i) { carried[i] = dfsph_cg_kept_pressure(carried[i]); });
+  return SolveOutcome{iterations, error, error > bound};
+}
+
+}  // namespace sph
