@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The checkpoint layout shared by the writer and the reader (docs/checkpoint.md). All numbers
-// little-endian; floats IEEE 754. Version 6 (version 5 lacks the probes' section PROB and the
+// little-endian; floats IEEE 754. Version 8 (version 7's DFSPH block in PARM lacks linear_solver,
+// read by field count, so it loads with the default solve). Version 6 (version 5 lacks the probes' section PROB and the
 // colliders' load points: such a file loads with no probes, sph_world_restore keeps the world's
 // own, and load points at the colliders' origins; version 4 also lacks max_capacity at the end of
 // CONF, which then equals the capacity: a fixed world, and SPH_EVENT_CAPACITY_GROWN; version 3 lacks
@@ -29,7 +30,7 @@ namespace sph {
 namespace checkpoint {
 
 constexpr uint8_t kMagic[8] = {'S', 'P', 'H', 'C', 'K', 'P', 'T', 0x1a};
-constexpr uint32_t kFormatVersion = 7;          // what the writer writes
+constexpr uint32_t kFormatVersion = 8;          // what the writer writes
 constexpr uint32_t kFirstProbeVersion = 6;      // the first with probes (PROB) and load points
 constexpr uint32_t kFirstThresholdVersion = 7;  // the first with load and pressure thresholds
 constexpr uint32_t kFirstSolverVersion = 3;     // the first with the solver, its report and warm starts
