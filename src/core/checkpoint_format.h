@@ -1,14 +1,14 @@
 // SPDX-License-Identifier: MIT
 // The checkpoint layout shared by the writer and the reader (docs/checkpoint.md). All numbers
-// little-endian; floats IEEE 754. Version 8 (version 7's DFSPH block in PARM lacks linear_solver,
-// read by field count, so it loads with the default solve). Version 6 (version 5 lacks the probes' section PROB and the
-// colliders' load points: such a file loads with no probes, sph_world_restore keeps the world's
-// own, and load points at the colliders' origins; version 4 also lacks max_capacity at the end of
-// CONF, which then equals the capacity: a fixed world, and SPH_EVENT_CAPACITY_GROWN; version 3 lacks
-// the density diffusion's block in PARM, read by name like every block, so a version 3 file loads with
-// its defaults; version 2 lacks the solver in CONF, the solves' report in TIME and DFSPH's warm starts in
-// PART; version 1
-// differs from 2 only in the parameters section, checkpoint_params.h; all load). A world with
+// little-endian; floats IEEE 754. Version 8 (version 7's DFSPH block in PARM lacks
+// linear_solver, read by field count, so it loads with the default solve). Version 6 (version 5
+// lacks the probes' section PROB and the colliders' load points: such a file loads with no probes,
+// sph_world_restore keeps the world's own, and load points at the colliders' origins; version 4
+// also lacks max_capacity at the end of CONF, which then equals the capacity: a fixed world, and
+// SPH_EVENT_CAPACITY_GROWN; version 3 lacks the density diffusion's block in PARM, read by name
+// like every block, so a version 3 file loads with its defaults; version 2 lacks the solver in
+// CONF, the solves' report in TIME and DFSPH's warm starts in PART; version 1 differs from 2 only
+// in the parameters section, checkpoint_params.h; all load). A world with
 // SPH_FEATURE_USER_ATTRIBUTE adds its values to PART and each source's to SRCE: a layout only that feature
 // bit in CONF selects, so it needed no new version (a library without the feature refuses the bit):
 //   header (48 bytes): magic[8] "SPHCKPT\x1a", u32 format version, u32 flags, u32 writer
