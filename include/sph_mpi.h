@@ -159,12 +159,14 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather_removed_ids(const sph_world* wo
 /**
  * COLLECTIVE. Saves the world at `path` (the same on every rank): each rank writes its file
  * under a staged name, path + ".rank" + its rank + ".staged", atomically as sph_world_save_file
- * does; once every rank has, each renames its file to path + ".rank" + its rank, then rank 0
- * writes the manifest at `path`, atomically. Succeeds or fails on every rank. A save that fails
- * while writing (on any rank) leaves the previous set as it was, its staged files removed; only
- * a crash (or a failed rename) between the renames and the manifest leaves new rank files beside
- * the previous manifest, a set a load refuses (their hashes do not match) rather than mixing two
- * saves.
+ * does; once every rank has, each renames its file to path + ".rank" + its rank + "." + the
+ * file's FNV-1a 64 hash in 16 hex digits (a name no file of the previous set has, unless its
+ * bytes are the same), then rank 0 writes the manifest at `path`, atomically: the one step that
+ * replaces the set. Then each rank removes its file of the previous set (only names of this
+ * form, or the plain path + ".rank" + r that earlier builds wrote). Succeeds or fails on every
+ * rank. A save that fails (on any rank), or a crash before the new manifest is in place, leaves
+ * the previous set as it was and named by its manifest; a failed save removes the files it
+ * wrote, a crash leaves them beside the set (files no manifest names).
  * Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL or empty path; a file that cannot be written:
  * the message says which and why), UNSUPPORTED (not a distributed world), WORLD_LOCKED,
  * OUT_OF_HOST_MEMORY; a rank whose own save succeeded returns the failing rank's code.

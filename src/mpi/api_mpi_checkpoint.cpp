@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: MIT
 // Checkpoints of a distributed world (include/sph_mpi.h): one file per rank in the checkpoint
 // format (a rank's part: its particles with their sort keys, its copy of the scene), staged and
-// renamed in once every rank has written its own, and a manifest rank 0 writes last
-// (rank_manifest.h); loaded on the saved rank count or on another (rank_part_join.h). Every step
-// where one rank can fail on its own (a file, an allocation, a damaged or mismatched file) is
-// agreed between the ranks (core/rank_agreement.h): each call succeeds on every rank or fails on
-// every rank, a load creates no world and a restore leaves the world as it was.
+// renamed to a name of its content once every rank has written its own, and a manifest rank 0
+// writes last, the one step that replaces a set (rank_manifest.h); loaded on the saved rank count or on
+// another (rank_part_join.h). Every step where one rank can fail on its own (a file, an allocation, a damaged
+// or mismatched file) is agreed between the ranks (core/rank_agreement.h): each call succeeds on every rank
+// or fails on every rank, a load creates no world and a restore leaves the world as it was.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -70,37 +70,63 @@ RankFileEntry unpack_entry(const RankBytes& b) {
   return e;
 }
 
-// Where a rank's file waits until every rank has written its own: a set is replaced only once
-// all of its files are whole, so a failed save leaves the old set as it was.
-std::string staged_path(const std::string& file) { return file + ".staged"; }
+// Where a rank's file waits until every rank has written its own.
+std::string staged_path(const std::string& path, int rank) {
+  return rank_file_path(path, staged_rank_file_name(path, rank));
+}
 
-// Writes this rank's file under its staged name; returns its manifest entry.
+// Writes this rank's file under its staged name; returns its manifest entry (the name the file
+// will have once every rank has staged its own).
 RankFileEntry stage_rank(const sph_world* world, const RankTransport& ranks, const std::string& path) {
   CheckpointOrigin origin;
   origin.backend = static_cast<uint32_t>(world->context->backend);
   origin.library_version = SPH_VERSION;
   origin.rank_part = true;
   const HostVector<uint8_t> bytes = write_checkpoint(*world->world, origin);
+  write_file_atomically(staged_path(path, ranks.rank()), bytes);
   RankFileEntry e;
-  e.name = rank_file_name(path, ranks.rank());
-  write_file_atomically(staged_path(rank_file_path(path, e.name)), bytes);
   e.particles = world->world->particle_count();
   e.counters = world->world->backend().distributed_state().counters;
   e.size = bytes.size();
   e.hash = file_hash(bytes);
+  e.name = rank_file_name(path, ranks.rank(), e.hash);
   return e;
 }
 
-// A failed save's staged file (best effort: a file only, never what a test or user put there).
-void remove_staged(const std::string& path, int rank) {
-  if (path.empty()) return;
-  const std::string staged = staged_path(rank_file_path(path, rank_file_name(path, rank)));
+// Removes `file` if it is a regular file (best effort: never a directory or link a test or user
+// put there).
+void remove_regular_file(const std::string& file) {
 #if defined(_WIN32)
-  (void)DeleteFileA(staged.c_str());  // (files only)
+  (void)DeleteFileA(file.c_str());  // (files only)
 #else
   struct stat st;
-  if (::lstat(staged.c_str(), &st) == 0 && S_ISREG(st.st_mode)) (void)std::remove(staged.c_str());
+  if (::lstat(file.c_str(), &st) == 0 && S_ISREG(st.st_mode)) (void)std::remove(file.c_str());
 #endif
+}
+
+// A failed save's staged file.
+void remove_staged(const std::string& path, int rank) {
+  if (!path.empty()) remove_regular_file(staged_path(path, rank));
+}
+
+// The files of the set a save to `path` replaces that this rank removes once the new manifest is
+// in place: its own rank's, and on rank 0 those of ranks past this rank count; only names this
+// library gives rank files (is_rank_file_name). Best effort: no manifest there, or a damaged or
+// foreign one, gives none and the save goes on (those files stay).
+std::vector<std::string> replaced_files(const std::string& path, int rank, int size) {
+  std::vector<std::string> files;
+  try {
+    const HostVector<uint8_t> bytes = read_checkpoint_file(path.c_str());
+    const RankManifest m = read_rank_manifest(bytes.data(), bytes.size());
+    for (size_t k = 0; k < m.ranks.size(); ++k) {
+      const int r = static_cast<int>(k);
+      if ((r == rank || (rank == 0 && r >= size)) && is_rank_file_name(path, r, m.ranks[k].name))
+        files.push_back(rank_file_path(path, m.ranks[k].name));
+    }
+  } catch (const Error&) {
+    files.clear();
+  }
+  return files;
 }
 
 // Rank k's file of the set at `manifest_path`, checked against the manifest's size and hash.
@@ -215,34 +241,53 @@ SPH_API sph_result SPH_CALL sph_mpi_world_save_file(const sph_world* world, cons
     const std::string target = path ? path : "";
     sph::RankBytes mine;
     std::vector<sph::RankBytes> entries;
-    // Three agreed phases: every rank stages its file; every rank moves its staged file in;
-    // rank 0 writes the manifest, which names files that are all in place. A failure in the
-    // first (a full disk, an unwritable directory, an allocation) leaves the old set whole.
+    std::vector<std::string> replaced;
+    std::string file;  // this rank's file of the new set
+    // Three agreed phases: every rank stages its file; every rank renames its staged file to its
+    // hashed name (a name the current manifest does not use unless the bytes are the same);
+    // rank 0 replaces the manifest, the one step that switches sets. Then each rank removes its
+    // file of the old set. A failure (or a crash) before the manifest is replaced leaves the
+    // old set whole and named by its manifest.
     try {
       sph::agreed(ranks, [&] {
         sph::require_path(path);
-        mine = sph::pack_entry(sph::stage_rank(world, ranks, target));
+        replaced = sph::replaced_files(target, ranks.rank(), ranks.size());
+        const sph::RankFileEntry e = sph::stage_rank(world, ranks, target);
+        file = sph::rank_file_path(target, e.name);
+        mine = sph::pack_entry(e);
       });
       entries = ranks.gather(mine, 0);
     } catch (...) {
       sph::remove_staged(target, ranks.rank());
       throw;
     }
-    sph::agreed(ranks, [&] {
-      const std::string file = sph::rank_file_path(target, sph::rank_file_name(target, ranks.rank()));
-      sph::move_file(sph::staged_path(file), file);
-    });
-    sph::agreed(ranks, [&] {
-      if (ranks.rank() != 0) return;
-      sph::RankManifest m;
-      m.state = world->world->backend().distributed_state();
-      m.rebalance_percent = static_cast<uint32_t>(std::lround(m.state.rebalance_threshold * 100.0));
-      for (const sph::RankBytes& b : entries) {
-        m.ranks.push_back(sph::unpack_entry(b));
-        m.particles += m.ranks.back().particles;
-      }
-      sph::write_file_atomically(target, sph::write_rank_manifest(m));
-    });
+    bool moved = false;
+    try {
+      sph::agreed(ranks, [&] {
+        sph::move_file(sph::staged_path(target, ranks.rank()), file);
+        moved = true;
+      });
+      sph::agreed(ranks, [&] {
+        if (ranks.rank() != 0) return;
+        sph::RankManifest m;
+        m.state = world->world->backend().distributed_state();
+        m.rebalance_percent = static_cast<uint32_t>(std::lround(m.state.rebalance_threshold * 100.0));
+        for (const sph::RankBytes& b : entries) {
+          m.ranks.push_back(sph::unpack_entry(b));
+          m.particles += m.ranks.back().particles;
+        }
+        sph::write_file_atomically(target, sph::write_rank_manifest(m));
+      });
+    } catch (...) {
+      // The old manifest still names the old set: take back what this save put beside it.
+      if (!moved)
+        sph::remove_staged(target, ranks.rank());
+      else if (std::find(replaced.begin(), replaced.end(), file) == replaced.end())
+        sph::remove_regular_file(file);
+      throw;
+    }
+    for (const std::string& old : replaced)
+      if (old != file) sph::remove_regular_file(old);
     return SPH_OK;
   });
 }

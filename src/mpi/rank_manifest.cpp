@@ -21,10 +21,38 @@ constexpr uint32_t kMaxRanks = 1u << 24;
 
 }  // namespace
 
-std::string rank_file_name(const std::string& manifest_path, int rank) {
-  const size_t slash = manifest_path.find_last_of('/');
-  const std::string base = slash == std::string::npos ? manifest_path : manifest_path.substr(slash + 1);
-  return base + ".rank" + std::to_string(rank);
+namespace {
+
+std::string last_component(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+std::string rank_stem(const std::string& manifest_path, int rank) {
+  return last_component(manifest_path) + ".rank" + std::to_string(rank);
+}
+
+}  // namespace
+
+std::string rank_file_name(const std::string& manifest_path, int rank, uint64_t hash) {
+  static const char digits[] = "0123456789abcdef";
+  std::string hex(16, '0');
+  for (int i = 15; i >= 0; --i, hash >>= 4) hex[static_cast<size_t>(i)] = digits[hash & 0xfu];
+  return rank_stem(manifest_path, rank) + "." + hex;
+}
+
+std::string staged_rank_file_name(const std::string& manifest_path, int rank) {
+  return rank_stem(manifest_path, rank) + ".staged";
+}
+
+bool is_rank_file_name(const std::string& manifest_path, int rank, const std::string& name) {
+  const std::string stem = rank_stem(manifest_path, rank);
+  if (name == stem) return true;
+  if (name.size() != stem.size() + 17 || name.compare(0, stem.size(), stem) != 0 || name[stem.size()] != '.')
+    return false;
+  for (size_t i = stem.size() + 1; i < name.size(); ++i)
+    if (!((name[i] >= '0' && name[i] <= '9') || (name[i] >= 'a' && name[i] <= 'f'))) return false;
+  return true;
 }
 
 std::string rank_file_path(const std::string& manifest_path, const std::string& name) {

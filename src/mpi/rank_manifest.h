@@ -37,8 +37,18 @@ struct RankManifest {
 
 constexpr uint32_t kMaxRankFileName = 4096;
 
-// The name of rank r's file beside a manifest at `manifest_path`: its last component + ".rank" r.
-std::string rank_file_name(const std::string& manifest_path, int rank);
+// The name of rank r's file beside a manifest at `manifest_path`: its last component + ".rank" r
+// + "." + the file's FNV-1a 64 in 16 lower-case hex digits. A save never writes over a file the
+// current manifest names (another content has another name), so a crash before the new manifest
+// is in place leaves the old set whole.
+std::string rank_file_name(const std::string& manifest_path, int rank, uint64_t hash);
+// Where rank r writes its file before every rank has: the last component + ".rank" r + ".staged".
+std::string staged_rank_file_name(const std::string& manifest_path, int rank);
+// Whether `name` is a name this library gives rank r's file beside `manifest_path`: the hashed
+// form above, or the plain last component + ".rank" r of libraries before it. A save removes
+// the files of the set it replaces only when their names pass this, never a file a damaged or
+// crafted manifest names otherwise.
+bool is_rank_file_name(const std::string& manifest_path, int rank, const std::string& name);
 // The path of a file named in a manifest: in the manifest's directory.
 std::string rank_file_path(const std::string& manifest_path, const std::string& name);
 

@@ -122,3 +122,36 @@ uint32_t mpi_test_differ(const float* x0, const float* v0, const float* x1, cons
     if (memcmp(x0 + 3 * i, x1 + 3 * i, 12) != 0 || memcmp(v0 + 3 * i, v1 + 3 * i, 12) != 0) ++differ;
   return differ;
 }
+
+/* Little-endian reads of the manifest (docs/checkpoint.md, "Distributed worlds"). */
+static uint32_t manifest_u32(const unsigned char* p) {
+  return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+int mpi_test_rank_file(const char* manifest, int rank, char* out, size_t size) {
+  unsigned char buf[1 << 16];
+  size_t n, at, k;
+  uint32_t ranks;
+  const char* slash;
+  FILE* f = fopen(manifest, "rb");
+  if (!f) return 0;
+  n = fread(buf, 1, sizeof buf, f);
+  fclose(f);
+  /* magic 8, version 4, rank count 4, particles 8, rebalance 4, axis 4, cut 4, rebalances 4 */
+  if (n < 40) return 0;
+  ranks = manifest_u32(buf + 12);
+  if (rank < 0 || (uint32_t)rank >= ranks) return 0;
+  at = 40 + 4 * ((size_t)ranks - 1); /* the cuts */
+  for (k = 0;; ++k) {
+    uint32_t length;
+    if (at + 36 > n) return 0;
+    length = manifest_u32(buf + at + 32); /* after 4 u32 counters, the size and the hash */
+    if (at + 36 + length > n) return 0;
+    if (k == (size_t)rank) {
+      const int dir = (slash = strrchr(manifest, '/')) ? (int)(slash - manifest + 1) : 0;
+      return snprintf(out, size, "%.*s%.*s", dir, manifest, (int)length, (const char*)buf + at + 36) <
+             (int)size;
+    }
+    at += 36 + length;
+  }
+}

@@ -143,8 +143,8 @@ int main(int argc, char** argv) {
   REQUIRE(sph_world_destroy(loaded) == SPH_OK, "destroy");
 
   /* Failures, each on one rank (the last), agreed by every rank. */
-  snprintf(file, sizeof file, "%s.rank%d", ck, g_size - 1);
-  snprintf(other, sizeof other, "%s.rank%d", ck2, g_size - 1);
+  REQUIRE(mpi_test_rank_file(ck, g_size - 1, file, sizeof file), "the manifest names the last rank's file");
+  REQUIRE(mpi_test_rank_file(ck2, g_size - 1, other, sizeof other), "the second manifest too");
   snprintf(aside, sizeof aside, "%s.aside", file);
   if (g_rank == g_size - 1) REQUIRE(rename(file, aside) == 0, "rename");
   MPI_Barrier(MPI_COMM_WORLD);
@@ -193,7 +193,38 @@ int main(int argc, char** argv) {
   /* The set is whole again: it restores. */
   REQUIRE(sph_mpi_world_restore_file(world, ck) == SPH_OK, "restore of the repaired set");
 
-  /* The single-world calls. */
+  /* A crash after the ranks renamed their files in and before rank 0 replaced the manifest
+   * leaves the new files beside the old manifest under names of their own (the file's hash in
+   * the name): emulated with the later set's files renamed to the names a save to `ck` would give
+   * them. The old set restores, with the saved counts. */
+  {
+    char later[300], orphan[400], mine[300];
+    const char* base = strrchr(ck2, '/') + 1;
+    REQUIRE(mpi_test_rank_file(ck2, g_rank, later, sizeof later), "the later set's file");
+    snprintf(orphan, sizeof orphan, "%s/dam.sphck%s", g_dir, strrchr(later, '/') + 1 + strlen(base));
+    REQUIRE(rename(later, orphan) == 0, "rename %s to %s", later, orphan);
+    MPI_Barrier(MPI_COMM_WORLD);
+    r = sph_mpi_world_restore_file(world, ck);
+    CHECK(r == SPH_OK, "restore beside a crashed save's files: %d %s", (int)r, sph_get_last_error());
+    counts_of(world, &restored);
+    CHECK(restored.global_count == n && restored.local_count == saved.local_count &&
+              restored.migrated == saved.migrated,
+          "the old set restored other counts beside a crashed save's files");
+    /* A save to the same path replaces the set: new names, the old set's files removed once the
+     * new manifest is in place (the crashed save's orphan is not the manifest's to remove). */
+    REQUIRE(mpi_test_rank_file(ck, g_rank, mine, sizeof mine), "this rank's file");
+    mpi_test_step(world, 1, 1);
+    REQUIRE(sph_mpi_world_save_file(world, ck) == SPH_OK, "save over a set: %s", sph_get_last_error());
+    REQUIRE(mpi_test_rank_file(ck, g_rank, later, sizeof later), "this rank's new file");
+    CHECK(strcmp(mine, later) != 0, "a later state's file has the old name %s", mine);
+    CHECK(access(mine, F_OK) != 0, "rank %d's file of the replaced set is left: %s", g_rank, mine);
+    CHECK(access(later, F_OK) == 0, "rank %d's new file is missing", g_rank);
+    REQUIRE(sph_mpi_world_restore_file(world, ck) == SPH_OK, "restore of the new set");
+    remove(orphan);
+  }
+
+  /* The single-world calls, on the last rank's file of the set now saved. */
+  REQUIRE(mpi_test_rank_file(ck, g_size - 1, file, sizeof file), "the last rank's file");
   r = sph_world_load_file(context, file, &plain);
   CHECK(r == SPH_ERROR_INVALID_ARGUMENT && plain == NULL, "sph_world_load_file of a rank's file: %d", (int)r);
   CHECK(strstr(sph_get_last_error(), "manifest") != NULL, "the message points to the manifest: %s",
@@ -211,12 +242,7 @@ int main(int argc, char** argv) {
   MPI_Barrier(MPI_COMM_WORLD);
   {
     char name[300];
-    for (int k = 0; k < g_size; ++k) {
-      snprintf(name, sizeof name, "%s.rank%d", ck, k);
-      if (g_rank == k) remove(name);
-      snprintf(name, sizeof name, "%s.rank%d", ck2, k);
-      if (g_rank == k) remove(name);
-    }
+    if (mpi_test_rank_file(ck, g_rank, name, sizeof name)) remove(name);
     MPI_Barrier(MPI_COMM_WORLD);
     if (g_rank == 0) {
       remove(ck);

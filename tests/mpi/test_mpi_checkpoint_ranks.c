@@ -274,8 +274,8 @@ int main(int argc, char** argv) {
     size_t bn, an, mbn = 0, man = 0;
     char rank_file[300], staged[320];
     struct stat st;
-    snprintf(rank_file, sizeof rank_file, "%s.rank%d", ck3, g_rank);
-    snprintf(staged, sizeof staged, "%s.staged", rank_file);
+    REQUIRE(mpi_test_rank_file(ck3, g_rank, rank_file, sizeof rank_file), "this rank's file");
+    snprintf(staged, sizeof staged, "%s.rank%d.staged", ck3, g_rank);
     before = slurp(rank_file, &bn);
     if (g_rank == 0) mb = slurp(ck3, &mbn);
     REQUIRE(before != NULL && (g_rank != 0 || mb != NULL), "read the set");
@@ -310,14 +310,10 @@ int main(int argc, char** argv) {
 
   /* Clean up (each rank its own files; rank 2's of the 2-rank sets does not exist). */
   MPI_Barrier(MPI_COMM_WORLD);
-  snprintf(name, sizeof name, "%s.rank%d", ck3, g_rank);
-  remove(name);
-  snprintf(name, sizeof name, "%s.rank%d", ck2, g_rank);
-  if (g_rank < 2) remove(name);
-  snprintf(name, sizeof name, "%s.rank%d", ckd, g_rank);
-  if (g_rank < 2) remove(name);
-  snprintf(name, sizeof name, "%s.rank%d", ckc, g_rank);
-  if (g_rank < 2) remove(name);
+  if (mpi_test_rank_file(ck3, g_rank, name, sizeof name)) remove(name);
+  if (mpi_test_rank_file(ck2, g_rank, name, sizeof name)) remove(name);
+  if (mpi_test_rank_file(ckd, g_rank, name, sizeof name)) remove(name);
+  if (mpi_test_rank_file(ckc, g_rank, name, sizeof name)) remove(name);
   MPI_Barrier(MPI_COMM_WORLD);
   if (g_rank == 0) {
     remove(ck2);

@@ -184,8 +184,8 @@ class DistributedWorld(World):
 
     def save_file(self, path):
         """COLLECTIVE. Saves the world at ``path`` (the same on every rank): each rank's checkpoint
-        at path + ".rank<r>", then rank 0's manifest at path (sph_mpi_world_save_file). Succeeds
-        or raises on every rank."""
+        at path + ".rank<r>.<its hash>", then rank 0's manifest at path, which replaces the set
+        (sph_mpi_world_save_file). Succeeds or raises on every rank."""
         check(_mpi_library().sph_mpi_world_save_file(self.handle, _path_bytes(path)), "sph_mpi_world_save_file")
 
     def restore_file(self, path):
