@@ -118,7 +118,8 @@ sph_configure() {
   cmake -S "${SPH_ROOT}" -B "${dir}" -G Ninja -DCMAKE_BUILD_TYPE=Release "$@"
 }
 
-# sph_configure_sanitizer_tree DIR: the one sanitizer tree of scripts/test and scripts/fuzz.
+# sph_configure_sanitizer_tree DIR [CMAKE ARGS...]: the one sanitizer tree of scripts/test and
+# scripts/fuzz (extra arguments go to CMake after the tree's own, so they can override them).
 # clang with ASan + UBSan (SPH_SANITIZE: the tests' sanitizer settings) and libFuzzer's coverage
 # instrumentation in every library object (SPH_FUZZ): the sanitizer ctest stage and the fuzz
 # harnesses share one build instead of compiling the library twice (once with GCC for the tests,
@@ -138,7 +139,7 @@ sph_configure_sanitizer_tree() {
     "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O2 -gline-tables-only -DNDEBUG" \
     "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -gline-tables-only -DNDEBUG" \
     -DSPH_SANITIZE=ON -DSPH_FUZZ=ON -DSPH_WITH_CUDA=OFF -DSPH_RUN_WITH_OPENVDB=OFF -DSPH_BUILD_BENCH=OFF \
-    -DSPH_WARNINGS_AS_ERRORS=OFF
+    -DSPH_WARNINGS_AS_ERRORS=OFF "${@:2}"
 }
 
 # sph_build DIR [TARGETS...]
