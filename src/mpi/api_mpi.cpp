@@ -21,6 +21,13 @@ using sph::Status;
 namespace sph {
 namespace {
 
+// A gather's root: a rank of the world's communicator.
+void require_root(const RankTransport& ranks, int32_t root) {
+  if (root < 0 || root >= ranks.size())
+    throw Error(Status::InvalidArgument,
+                "root: must be a rank of the world's communicator, got " + std::to_string(root));
+}
+
 constexpr uint32_t kDefaultRebalancePercent = 20;
 constexpr uint32_t kMaxRebalancePercent = 10000;
 
@@ -152,9 +159,7 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t
     sph::require_world(world);
     sph::WorldLock lock(world);
     const sph::RankTransport& ranks = sph::ranks_of(world);
-    if (root < 0 || root >= ranks.size())
-      throw Error(Status::InvalidArgument,
-                  "root: must be a rank of the world's communicator, got " + std::to_string(root));
+    sph::require_root(ranks, root);
     struct Record {
       uint32_t id;
       float x[3], v[3];
@@ -201,9 +206,7 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather_removed_ids(const sph_world* wo
     sph::require_world(world);
     sph::WorldLock lock(world);
     const sph::RankTransport& ranks = sph::ranks_of(world);
-    if (root < 0 || root >= ranks.size())
-      throw Error(Status::InvalidArgument,
-                  "root: must be a rank of the world's communicator, got " + std::to_string(root));
+    sph::require_root(ranks, root);
     const sph::HostVector<uint32_t>& mine = world->world->removed_ids();
     const unsigned char* bytes = reinterpret_cast<const unsigned char*>(mine.data());
     const std::vector<sph::RankBytes> all =
