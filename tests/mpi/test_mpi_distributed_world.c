@@ -185,6 +185,9 @@ static void run_scene(sph_context* context, const char* name, float stir_speed, 
     REQUIRE(mid != NULL, "malloc");
   }
   REQUIRE(sph_mpi_world_gather(world, 0, mid, NULL, NULL, n, &gathered) == SPH_OK, "gather");
+  CHECK(sph_mpi_world_gather(world, g_size, mid, NULL, NULL, n, &gathered) == SPH_ERROR_INVALID_ARGUMENT &&
+            sph_mpi_world_gather(world, -1, mid, NULL, NULL, n, &gathered) == SPH_ERROR_INVALID_ARGUMENT,
+        "a gather's root outside the communicator");
   if (g_rank == 0) step_substeps(single, 1, 0);
   step_substeps(world, 1, 1);
 
