@@ -53,10 +53,9 @@ typedef struct tank_case {
   float dt_max;          /* the step's ceiling, s (0: the library's default, 1 ms) */
   float density_error;   /* DFSPH's density-solve bound (0: the library's default, 0.1 %) */
   /* The settling experiments (docs/validation.md, "DFSPH: hydrostatic tank"); 0 = as before. */
-  float frame;            /* frame length, s (0: 0.02); one substep's (dt_max) samples every substep */
-  double window;          /* the averaged share of the run (0: the second half) */
-  double damp_until;      /* s: until then every velocity is zeroed each 0.1 s (kinetic damping) */
-  uint32_t linear_solver; /* DFSPH's density solve (0: the default, Jacobi) */
+  float frame;       /* frame length, s (0: 0.02); one substep's (dt_max) samples every substep */
+  double window;     /* the averaged share of the run (0: the second half) */
+  double damp_until; /* s: until then every velocity is zeroed each 0.1 s (kinetic damping) */
 } tank_case;
 
 static int ascending(const void* a, const void* b) {
@@ -137,11 +136,10 @@ static void run_tank(const tank_case* tc) {
   if (tc->solver != SPH_SOLVER_DFSPH) params.step_limits = SPH_STEP_LIMIT_ACOUSTIC;
   if (tc->dt_max > 0.0f) params.dt_max = tc->dt_max;
   EXPECT_OK(sph_world_set_params(world, &params));
-  if (tc->solver == SPH_SOLVER_DFSPH && (tc->density_error > 0.0f || tc->linear_solver)) {
+  if (tc->solver == SPH_SOLVER_DFSPH && tc->density_error > 0.0f) {
     sph_dfsph_params dp;
     sph_dfsph_params_init(&dp);
-    if (tc->density_error > 0.0f) dp.density_error = tc->density_error;
-    dp.linear_solver = tc->linear_solver;
+    dp.density_error = tc->density_error;
     dp.max_iterations = 1000;
     EXPECT_OK(sph_world_set_dfsph_params(world, &dp));
   }
@@ -312,8 +310,15 @@ static void run_tank(const tank_case* tc) {
  * 1 s in CI, 32 x 60 x 32 for 4 s at full resolution. */
 static void run_tank_at_resolution(const char* name, sph_equation_of_state eos, uint32_t features,
                                    double bound) {
-  tank_case tc = {name, eos, SPH_SOLVER_WCSPH, features, bound, 16, 30, 0.01, 1.0, 0.0f, 0.0f, 0.0f, 0.0,
-                  0.0,  0u};
+  tank_case tc = {.name = name,
+                  .eos = eos,
+                  .solver = SPH_SOLVER_WCSPH,
+                  .features = features,
+                  .bound = bound,
+                  .width_layers = 16,
+                  .depth_layers = 30,
+                  .step = 0.01,
+                  .seconds = 1.0};
   if (validation_full()) {
     tc.width_layers = 32;
     tc.depth_layers = 60;
@@ -349,21 +354,17 @@ static void test_hydrostatic_ideal_gas_boundary(void** state) {
  * 1e-4 (dfsph_tight) gives 0.55 % / 1.05 %: the solve's residual is not what limits it
  * (docs/validation.md, "DFSPH: hydrostatic tank"). */
 static tank_case dfsph_tank(const char* name, uint32_t features, double bound, float density_error) {
-  tank_case tc = {name,
-                  SPH_EOS_IDEAL_GAS,
-                  SPH_SOLVER_DFSPH,
-                  features,
-                  bound,
-                  12,
-                  24,
-                  0.01,
-                  4.0,
-                  0.004f,
-                  density_error,
-                  0.0f,
-                  0.0,
-                  0.0,
-                  0u};
+  tank_case tc = {.name = name,
+                  .eos = SPH_EOS_IDEAL_GAS,
+                  .solver = SPH_SOLVER_DFSPH,
+                  .features = features,
+                  .bound = bound,
+                  .width_layers = 12,
+                  .depth_layers = 24,
+                  .step = 0.01,
+                  .seconds = 4.0,
+                  .dt_max = 0.004f,
+                  .density_error = density_error};
   if (validation_full()) {
     tc.width_layers = 24;
     tc.depth_layers = 48;
