@@ -614,9 +614,9 @@ typedef struct sph_dfsph_params {
                                          or SPH_DFSPH_CONJUGATE_GRADIENTS (the divergence solve is
                                          always Jacobi); 0 = default; any other value is
                                          INVALID_ARGUMENT. Conjugate gradients run on the CPU backend
-                                         only: the CUDA backend, a distributed world and
-                                         SPH_FEATURE_BOUNDARY_DENSITY refuse a step with it
-                                         (UNSUPPORTED, the world unchanged) */
+                                         only: on the CUDA backend, a distributed world or with
+                                         SPH_FEATURE_BOUNDARY_DENSITY setting it (or loading a
+                                         checkpoint with it) is UNSUPPORTED, the world unchanged */
 } sph_dfsph_params;
 SPH_STATIC_ASSERT(sizeof(sph_dfsph_params) == 28, sph_dfsph_params_size);
 

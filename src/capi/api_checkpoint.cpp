@@ -9,6 +9,7 @@
 #include "../core/checkpoint.h"
 #include "../core/checkpoint_format.h"
 #include "checkpoint_files.h"
+#include "dfsph_solver_check.h"
 #include "guard.h"
 #include "handles.h"
 
@@ -32,12 +33,17 @@ sph::HostVector<uint8_t> save_world(const sph_world* world) {
 std::unique_ptr<sph::World> load_world(sph_context* context, const void* data, uint64_t size) {
   if (!data) throw Error(Status::InvalidArgument, "data: is NULL");
   if (size > SIZE_MAX) throw Error(Status::InvalidArgument, "size: does not fit in memory");
-  return sph::read_checkpoint(static_cast<const uint8_t*>(data), static_cast<size_t>(size),
-                              [context](const sph::WorldConfig& config) {
-                                return sph::make_backend(context->backend, config, context->device_ordinal,
-                                                         context->cpu_workers, context->cpu_tasks,
-                                                         context->cuda_tuning);
-                              });
+  std::unique_ptr<sph::World> world = sph::read_checkpoint(
+      static_cast<const uint8_t*>(data), static_cast<size_t>(size),
+      [context](const sph::WorldConfig& config) {
+        return sph::make_backend(context->backend, config, context->device_ordinal, context->cpu_workers,
+                                 context->cpu_tasks, context->cuda_tuning);
+      });
+  // A checkpoint's DFSPH parameters that this context cannot run (the state built beside any
+  // world it would replace, so nothing has changed).
+  sph::require_supported_dfsph_solver(context->backend, *world, world->params(),
+                                      "checkpoint: sph_dfsph_params.linear_solver");
+  return world;
 }
 
 // `hold` keeps the context alive from the start of the call to the new world's registration.

@@ -60,8 +60,12 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
                                                     float dt, Float4* v, float* carried) {
   const char* refused =
       ranks_ ? "a distributed world" : (walls.records ? "SPH_FEATURE_BOUNDARY_DENSITY" : nullptr);
-  // With the walls in the density the solve did not converge (a falling ball in a tank: every
-  // iteration restarted, p . A p < 0 seen; docs/physics.md, DFSPH, Limits): refused until understood.
+  // With the walls in the density the operator is symmetric and positive definite
+  // (tests/unit/test_dfsph_cg_operator.cpp) and the dam break converges, but a fluid ball started
+  // a third inside a tank's floor drives the solve to its cap every substep until the state fails
+  // (docs/validation.md, "DFSPH by conjugate gradients"): refused. Refused first when the
+  // parameters are set (capi/dfsph_solver_check.h); this holds for the paths that reach the step
+  // otherwise (a distributed world loaded from its ranks' checkpoints).
   if (refused)
     throw Error(Status::Unsupported,
                 std::string("step: DFSPH's conjugate gradients solve "
@@ -164,7 +168,9 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
     ExactFloatSum error_sum, outside_sum;
     for (uint32_t i = 0; i < n; ++i) {
       error_sum.add(z[i]);
-      if (!(state[i] & kActive)) outside_sum.add(z[i]);
+      // (only what a new set could take: a particle without a factor, which no pressure reaches,
+      // would restart every cycle)
+      if (!(state[i] & kActive) && factor[i] > 0.0f) outside_sum.add(z[i]);
     }
     error = static_cast<float>(error_sum.value() / static_cast<double>(n));
     if (outside_sum.value() / static_cast<double>(n) >= Dfsph::kCgRestartShare * bound) {

@@ -6,7 +6,11 @@
  *   of the checkpoint into the original gives the same state again;
  * - rollback: a gravity of 3e38 m/s^2 makes v* = v + dt g overflow in the first substep; the step
  *   fails with SPH_ERROR_NON_FINITE, the world is as before (particles and the solves' warm
- *   starts: the next steps equal those of a world that never failed). */
+ *   starts: the next steps equal those of a world that never failed);
+ * - the conjugate gradients' density solve refused where it does not run (the walls in the
+ *   density; on the CUDA backend any world) when the parameters are set, not at the step: both
+ *   setters return SPH_ERROR_UNSUPPORTED naming the reason, the parameters stay Jacobi and the
+ *   world steps. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -131,11 +135,35 @@ static void test_non_finite_rolls_back(void** state) {
   scene_close(&twin);
 }
 
+static void test_cg_refused_when_set(void** state) {
+  scene s;
+  sph_dfsph_params dp, now;
+  sph_backend backend = SPH_BACKEND_CPU;
+  (void)state;
+  open_dfsph_tank(&s, SPH_FEATURE_BOUNDARY_DENSITY, -9.81f);
+  SCENE_OK(sph_context_get_backend(s.context, &backend));
+  sph_dfsph_params_init(&dp);
+  dp.linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS;
+  dp.density_error = 0.002f; /* with the refused field: nothing of the struct is taken */
+  assert_int_equal(sph_world_set_dfsph_params(s.world, &dp), SPH_ERROR_UNSUPPORTED);
+  assert_non_null(strstr(sph_get_last_error(), "params->linear_solver"));
+  assert_non_null(
+      strstr(sph_get_last_error(), backend == SPH_BACKEND_CUDA ? "CUDA" : "SPH_FEATURE_BOUNDARY_DENSITY"));
+  assert_int_equal(sph_world_set_physics_params(s.world, SPH_PARAMS_DFSPH, &dp), SPH_ERROR_UNSUPPORTED);
+  sph_dfsph_params_init(&now);
+  SCENE_OK(sph_world_get_dfsph_params(s.world, &now));
+  assert_int_equal(now.linear_solver, SPH_DFSPH_JACOBI);
+  assert_true(now.density_error == 0.001f);
+  step_frames(&s, 1);
+  scene_close(&s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_checkpoint_bitwise),
       cmocka_unit_test(test_checkpoint_bitwise_boundary_density),
       cmocka_unit_test(test_non_finite_rolls_back),
+      cmocka_unit_test(test_cg_refused_when_set),
   };
   return cmocka_run_group_tests_name("physics_dfsph", tests, NULL, NULL);
 }
