@@ -24,10 +24,12 @@
 // WCSPH (the loads pass's own sum), and for DFSPH the reaction of what both solves applied
 // (p = (k + k_v / dt) rho^2). The box's density map is computed here from the same shape
 // (cpu_boundary_maps.h). --self-check: in the first substep no particle touches the box yet, so with
-// SPH_FEATURE_COLLIDER_LOADS (WCSPH; DFSPH refuses it) the loads are the walls' reaction alone and
+// SPH_FEATURE_COLLIDER_LOADS the loads are the walls' reaction alone (WCSPH; on DFSPH the contact
+// clamp already acts there, 54 N of the box's -1356 N along x and z, so the two differ by it; with
+// the clamp's impulses left out of the loads they agreed within 1.3e-4 N, docs/validation.md) and
 // the two are printed side by side (on the CPU they agree to the last printed digit; on CUDA they
 // show whether the device's map is the host's). --self-check-only stops there and fails unless
-// they agree within 1e-5 of the force (the ctest physics_loads_breakdown_self_check; the backend
+// they agree within 1e-5 of the force (the ctest physics_loads_breakdown_self_check, WCSPH; the backend
 // defaults to SPH_TEST_BACKEND's, so the GPU test script runs it on CUDA). A particle's region is the set of
 // the box's axes it lies beyond at the substep's start: one axis a face (top, bottom, sides), two an edge
 // (top, bottom, vertical), three a corner (top, bottom), none "inside the box" (particles the collision
@@ -37,8 +39,8 @@
 // Momentum balance: the fluid's dP/dt = M g less the colliders' forces, so with the tank's walls'
 // reaction also summed on the host (its map computed here too), M g - dP/dt - both walls' reactions
 // is what the colliders receive besides the walls' reaction: the contacts, and for DFSPH the
-// impulses of its contact clamp (respect_contact), which no loads report. With the loads (WCSPH)
-// the same from the loads is printed as a check (they agree to the printed digits on the CPU).
+// impulses of its contact clamp (respect_contact), which the loads include. With the loads the same
+// from the loads is printed as a check.
 //
 // Also per region: the particles within h of the box, their mean rho / rho0 and their pressure
 // against rho0 g d, d their depth below the hydrostatic level (y + p / (rho0 g) averaged over the
@@ -149,7 +151,7 @@ int main(int argc, char** argv) {
   bool loads = true;
   if (support_world_open(&w, backend, &def, nullptr) != SPH_OK) {
     support_world_close(&w);
-    def.features &= ~SPH_FEATURE_COLLIDER_LOADS;  // DFSPH refuses the loads (issue 16/17)
+    def.features &= ~SPH_FEATURE_COLLIDER_LOADS;  // a backend that refuses the loads on DFSPH
     loads = false;
     check(support_world_open(&w, backend, &def, nullptr), "support_world_open");
   }
