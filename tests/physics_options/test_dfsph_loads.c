@@ -15,6 +15,8 @@
  *     pressure (both solves', SPH_ATTRIBUTE_PRESSURE's) against rho0 g d below the gauge's
  *     surface: within 2 % (measured -0.4 to -1.6 %: the solver's hydrostatic pressure; the
  *     issue's 1 % with DFLOADS_STRICT=1), and their pressure gradient within 1 % of rho0 g;
+ *   - a checkpoint of a DFSPH world carries its probes: a loaded world reads the same probe and
+ *     loads after the same step, bit for bit;
  *   - refusals: the conjugate gradients' density solve with the loads is UNSUPPORTED at the step,
  *     the world unchanged.
  * DFLOADS_MEASURE=1 prints the measurements without asserting the bounds. */
@@ -289,6 +291,56 @@ static void test_resting_tank_probes(void** state) {
   EXPECT_OK(support_world_close(&w));
 }
 
+/* ---- checkpoints ------------------------------------------------------------------------------- */
+
+/* A DFSPH world's checkpoint carries its probes (it was refused as corrupt while DFSPH had none):
+ * a world loaded from it reads, after the same step, the same probe reading and loads bit for bit
+ * (the same state, the same step). */
+static void test_checkpoint_carries_probes(void** state) {
+  const uint32_t layers[3] = {5, 6, 5};
+  const double tank_min[3] = {0.0, 0.0, 0.0}, tank_max[3] = {0.1, 0.2, 0.1};
+  float* lattice = NULL;
+  uint32_t n = 0;
+  support_world w;
+  sph_sdf* sdf = NULL;
+  sph_collider_id tank;
+  sph_world_def def;
+  sph_probe_id probe;
+  sph_world* loaded = NULL;
+  uint64_t size = 0;
+  void* saved;
+  sph_probe_reading a, b;
+  sph_collider_loads la, lb;
+  (void)state;
+  assert_int_equal(support_fcc_box(layers, kStep, NULL, &lattice, &n), SPH_OK);
+  def = dfsph_def(SPH_FEATURE_COLLIDER_LOADS | SPH_FEATURE_BOUNDARY_DENSITY, n);
+  EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
+  EXPECT_OK(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * kStep, 0.0f, &sdf, &tank));
+  EXPECT_OK(support_spawn(w.world, lattice, NULL, n));
+  free(lattice);
+  probe = add_probe(w.world, 0.05, 0.02, 0.05, SPH_PROBE_POINT, 0.0);
+  EXPECT_OK(sph_world_step(w.world, 0.02f));
+  EXPECT_OK(sph_world_save(w.world, NULL, 0, &size));
+  saved = malloc(size);
+  assert_non_null(saved);
+  EXPECT_OK(sph_world_save(w.world, saved, size, &size));
+  EXPECT_OK(sph_world_load(w.context, saved, size, &loaded));
+  free(saved);
+  EXPECT_OK(sph_world_step(w.world, 0.02f));
+  EXPECT_OK(sph_world_step(loaded, 0.02f));
+  a = reading_of(w.world, probe);
+  b = reading_of(loaded, probe);
+  la = loads_of(w.world, tank);
+  lb = loads_of(loaded, tank);
+  assert_true(a.samples > 0 && a.pressure > 0.0f);
+  assert_true(a.samples == b.samples && a.density == b.density && a.pressure == b.pressure &&
+              a.velocity.y == b.velocity.y && a.time == b.time);
+  assert_true(la.force.x == lb.force.x && la.force.y == lb.force.y && la.force.z == lb.force.z);
+  EXPECT_OK(sph_world_destroy(loaded));
+  EXPECT_OK(sph_sdf_destroy(sdf));
+  EXPECT_OK(support_world_close(&w));
+}
+
 /* ---- refusals ---------------------------------------------------------------------------------- */
 
 static void test_conjugate_gradients_refused(void** state) {
@@ -328,6 +380,7 @@ static void test_conjugate_gradients_refused(void** state) {
 int main(int argc, char** argv) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_conjugate_gradients_refused),
+      cmocka_unit_test(test_checkpoint_carries_probes),
       cmocka_unit_test(test_momentum_balance_contacts),
       cmocka_unit_test(test_momentum_balance_boundary_density),
       cmocka_unit_test(test_resting_tank_probes),
