@@ -9,8 +9,9 @@
  *     with the clamp's impulses left out of the loads (a diagnostic build) it missed by 99 % and
  *     11 %: the clamp carries nearly all of the walls' force without the walls in the density;
  *   - a fixed box submerged in a tank: its force against rho0 g V upwards once settled (printed;
- *     bound and why at the test). The walls' part was checked against the host's sum of
- *     `physics_loads_breakdown --solver dfsph --self-check` (docs/validation.md);
+ *     bound and why at the test). That the loads are the walls' reaction of the solves' pressure
+ *     is checked against the host's sum by `physics_loads_breakdown --solver dfsph --check-loads`
+ *     (the ctest physics_loads_breakdown_dfsph: within 1e-3 N, measured 9e-6 N);
  *   - a resting tank with the walls in the density: probes on the centre line read DFSPH's
  *     pressure (both solves', SPH_ATTRIBUTE_PRESSURE's) against rho0 g d below the gauge's
  *     surface: within 2 % (measured -0.4 to -1.6 %: the solver's hydrostatic pressure; the
