@@ -208,7 +208,7 @@ class CpuBackend final : public Backend {
   // Each particle's contact with the scene's colliders (dfsph_contact_), for the solves.
   void dfsph_find_contacts(const SceneFrame& scene, const SubstepTime& time);
   // Holds v to particle i's contact (respect_contact); with the loads, adds the change to its
-  // clamp impulses (dfsph_contact_impulse_).
+  // clamp impulses (clamp_impulse_).
   void dfsph_clamp(uint32_t i, Vec3& v);
   // Applies the iteration's pressures (columns_.dfsph_step()) to v (records and columns) and adds
   // them (times carry_scale) to carried.
@@ -324,20 +324,20 @@ class CpuBackend final : public Backend {
   CpuArrayRef<uint32_t> link_from_;    // one word: the lowest id that waits for its springs
   CpuArrayRef<uint32_t> spring_candidates_;
   CpuArrayRef<Float4> spring_acceleration_;
-  CpuArrayRef<float> dfsph_pressure_;          // DFSPH: the density solve's p / rho^2 (warm start)
-  CpuArrayRef<float> dfsph_divergence_;        // DFSPH: the divergence solve's p / rho^2 times dt
-  CpuArrayRef<float> dfsph_factor_;            // DFSPH: alpha / rho of the density pass
-  CpuArrayRef<float> dfsph_residual_;          // DFSPH: each particle's share of the solve's error
-  CpuArrayRef<Float4> dfsph_contact_;          // DFSPH: each particle's contact with the colliders
-  CpuArrayRef<Float4> dfsph_contact_impulse_;  // DFSPH with the loads: the clamp's, per particle
-  bool dfsph_contacts_ = false;                // DFSPH: the substep has colliders (contacts to respect)
-  HostVector<ColliderView> dfsph_colliders_;   // DFSPH: the substep's colliders, for the contacts
-  HostVector<float> cg_value_;                 // DFSPH by conjugate gradients: rho* - rho0 per particle
-  HostVector<float> cg_change_;                // ... its change along the search direction
-  HostVector<Float4> cg_velocity_step_;        // ... the velocity change of the search direction
-  HostVector<uint8_t> cg_state_;               // ... in the active set; contact binds
-  CpuArrayRef<Float4> boundary_;          // boundary density: (grad rho_b, v_b . grad rho_b) per particle
-  CpuArrayRef<uint32_t> user_attribute_;  // SPH_FEATURE_USER_ATTRIBUTE: the caller's value
+  CpuArrayRef<float> dfsph_pressure_;         // DFSPH: the density solve's p / rho^2 (warm start)
+  CpuArrayRef<float> dfsph_divergence_;       // DFSPH: the divergence solve's p / rho^2 times dt
+  CpuArrayRef<float> dfsph_factor_;           // DFSPH: alpha / rho of the density pass
+  CpuArrayRef<float> dfsph_residual_;         // DFSPH: each particle's share of the solve's error
+  CpuArrayRef<Float4> dfsph_contact_;         // DFSPH: each particle's contact with the colliders
+  CpuArrayRef<Float4> clamp_impulse_;         // DFSPH with the loads: the clamp's, per particle
+  bool dfsph_contacts_ = false;               // DFSPH: the substep has colliders (contacts to respect)
+  HostVector<ColliderView> dfsph_colliders_;  // DFSPH: the substep's colliders, for the contacts
+  HostVector<float> cg_value_;                // DFSPH by conjugate gradients: rho* - rho0 per particle
+  HostVector<float> cg_change_;               // ... its change along the search direction
+  HostVector<Float4> cg_velocity_step_;       // ... the velocity change of the search direction
+  HostVector<uint8_t> cg_state_;              // ... in the active set; contact binds
+  CpuArrayRef<Float4> boundary_;              // boundary density: (grad rho_b, v_b . grad rho_b) per particle
+  CpuArrayRef<uint32_t> user_attribute_;      // SPH_FEATURE_USER_ATTRIBUTE: the caller's value
   CpuBoundaryMaps boundary_maps_;
   HostVector<ColliderView> collider_views_;  // the frame's colliders, for the density pass
   HostVector<ColliderLoadSums> load_sums_;   // the frame's impulses per collider (loads on)

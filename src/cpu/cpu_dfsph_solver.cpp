@@ -37,7 +37,7 @@ void CpuBackend::dfsph_find_contacts(const SceneFrame& scene, const SubstepTime&
   const float h = config_.kernel_radius;
   // With the loads, each particle's clamp impulses start at zero, named after its contact's
   // collider (collider_loads.h).
-  Float4* clamp = loads_on() ? dfsph_contact_impulse_.data() : nullptr;
+  Float4* clamp = loads_on() ? clamp_impulse_.data() : nullptr;
   parallel().for_each(count_, [&](uint32_t i) {
     uint32_t collider = count;
     contact[i] = wall_contact(views, count, time, h, xyz(pos[i]), collider);
@@ -47,7 +47,7 @@ void CpuBackend::dfsph_find_contacts(const SceneFrame& scene, const SubstepTime&
 
 void CpuBackend::dfsph_clamp(uint32_t i, Vec3& v) {
   const Vec3 held = respect_contact(dfsph_contact_[i], v);
-  if (loads_on()) add_clamp(dfsph_contact_impulse_[i], v, held);
+  if (loads_on()) add_clamp(clamp_impulse_[i], v, held);
   v = held;
 }
 
@@ -201,7 +201,7 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
     OldPositions old;
     old.records = pos;
     collide_with_loads(fluid, scene, time, stage_time(time, 0.0f), dt, old, report,
-                       dfsph_contacts_ ? dfsph_contact_impulse_.data() : nullptr);
+                       dfsph_contacts_ ? clamp_impulse_.data() : nullptr);
   } else {
     collide_from(scene, time, pos, report);
   }
