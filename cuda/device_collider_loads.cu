@@ -41,6 +41,16 @@ __global__ void __launch_bounds__(kLoadBlock)
   const float mass = fluid.particle_mass;
   Vec3 wall_x{0.0f, 0.0f, 0.0f}, x{0.0f, 0.0f, 0.0f}, v{0.0f, 0.0f, 0.0f}, from{0.0f, 0.0f, 0.0f};
   float coefficient_dt = 0.0f;
+  // DFSPH's contact clamp (collider_loads.h): its impulses at the substep's start.
+  const bool clamped = live && a.dfsph_contact_impulse != nullptr;
+  Float4 clamp{0.0f, 0.0f, 0.0f, 0.0f};
+  Vec3 clamp_x{0.0f, 0.0f, 0.0f};
+  uint32_t clamp_to = scene.collider_count;
+  if (clamped) {
+    clamp = a.dfsph_contact_impulse[i];
+    clamp_x = xyz(a.sorted_position[i]);
+    clamp_to = clamp_collider(clamp, scene.collider_count);
+  }
   if (live && kWalls) {
     const Float4 p = a.sorted_position[i];
     const float inv_rho = a.sorted_velocity[i].w;
@@ -60,6 +70,7 @@ __global__ void __launch_bounds__(kLoadBlock)
       add_load(mine, wall_reaction_impulse(share.gradient, mass, coefficient_dt), wall_x,
                load_point_at(view, at.s));
     }
+    if (clamp_to == c) add_load(mine, clamp_impulse(mass, clamp), clamp_x, load_point_at(view, at.s));
     if (live && kContacts) {
       const Vec3 before = v;
       collide_particle(view, time, scene.kernel_radius, from, x, v);

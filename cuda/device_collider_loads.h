@@ -54,7 +54,10 @@ void enqueue_loads_end(const DeviceLoads& loads, cudaStream_t stream);
 // One force evaluation's loads over n particles: the walls' pressure reactions (boundary density
 // on) over wall_weight times the substep's dt at stage fraction `stage_fraction`, and, with
 // contacts, the collision response of the integrated state (a.position / a.velocity) from its
-// start (Euler: the sorted copy's position; RK4: rk4_start[0]), its speed into the frame's max.
+// start (Euler and DFSPH: the sorted copy's position; RK4: rk4_start[0]), its speed into the
+// frame's max. On a DFSPH world (a.dfsph_contact_impulse set) also the contact clamp's impulses,
+// at the substep's start (collider_loads.h); its p is the one both solves applied, which
+// enqueue_dfsph_step wrote into the sorted records.
 void enqueue_loads(const FluidConstants& fluid, const ParticleArrays& a, uint32_t n, const DeviceScene& scene,
                    const DeviceLoads& loads, bool boundary_density, float stage_fraction, float wall_weight,
                    bool contacts, bool rk4, FrameState* state, cudaStream_t stream);

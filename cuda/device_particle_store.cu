@@ -3,6 +3,7 @@
 
 #include <cstring>
 
+#include "../src/physics/collider_loads.h"
 #include "device_springs.h"
 
 namespace sph {
@@ -56,6 +57,7 @@ DeviceParticleStore::DeviceParticleStore(uint32_t capacity,
   arrays_.dfsph_step = static_cast<float*>(find(kArrayDfsphStep));
   arrays_.dfsph_warm_pressure = static_cast<float*>(find(kArrayDfsphWarmPressure));
   arrays_.dfsph_contact = static_cast<Float4*>(find(kArrayDfsphContact));
+  arrays_.dfsph_contact_impulse = static_cast<Float4*>(find(kArrayDfsphContactImpulse));
   arrays_.boundary_gradient = static_cast<Float4*>(find(kArrayBoundaryGradient));
   arrays_.user_attribute = static_cast<uint32_t*>(find(kArrayUserAttribute));
   arrays_.sorted_user_attribute = static_cast<uint32_t*>(find(kArraySortedUserAttribute));

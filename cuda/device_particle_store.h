@@ -61,12 +61,13 @@ struct ParticleArrays {
   uint32_t* link_from;          // one word: the lowest id waiting for springs, or kNoPendingLinks
   // Null unless the DFSPH solver (physics/dfsph.h). The carried pressures are in the state
   // order until the solves of a substep rewrite them in the sorted order (dfsph_solver.cu).
-  float* dfsph_pressure;       // the density solve's p / rho^2 (carried)
-  float* dfsph_divergence;     // the divergence solve's p / rho^2 times dt (carried)
-  float* dfsph_factor;         // alpha / rho of the density pass
-  float* dfsph_step;           // the iteration's p / rho^2, which neighbours read
-  float* dfsph_warm_pressure;  // the density solve's warm start in the sorted order
-  Float4* dfsph_contact;       // the particle's contact with the colliders (n, smallest normal speed)
+  float* dfsph_pressure;          // the density solve's p / rho^2 (carried)
+  float* dfsph_divergence;        // the divergence solve's p / rho^2 times dt (carried)
+  float* dfsph_factor;            // alpha / rho of the density pass
+  float* dfsph_step;              // the iteration's p / rho^2, which neighbours read
+  float* dfsph_warm_pressure;     // the density solve's warm start in the sorted order
+  Float4* dfsph_contact;          // the particle's contact with the colliders (n, smallest normal speed)
+  Float4* dfsph_contact_impulse;  // null unless SPH_FEATURE_COLLIDER_LOADS: the clamp's (collider_loads.h)
   // Null unless SPH_FEATURE_BOUNDARY_DENSITY: (grad rho_b, v_b . grad rho_b) of the density pass.
   Float4* boundary_gradient;
   // Null unless SPH_FEATURE_USER_ATTRIBUTE: the caller's value in the state order, and the

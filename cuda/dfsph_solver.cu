@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include <vector>
 
+#include "../src/physics/collider_loads.h"
 #include "../src/physics/dfsph_passes.h"
 #include "block_reduce.cuh"
 #include "dfsph_solver.h"
@@ -50,11 +51,23 @@ __global__ void dfsph_density_kernel(FluidConstants fluid, GridView grid, Partic
   const float dt = state->clock.dt_float;
   a.dfsph_step[i] = Dfsph::kWarmStart * a.dfsph_divergence[k] / dt;
   a.dfsph_warm_pressure[i] = Dfsph::kWarmStart * a.dfsph_pressure[k] / 1.0f;
-  if (scene.collider_count != 0)
-    a.dfsph_contact[i] =
-        wall_contact(scene.colliders, scene.collider_count, state->clock.time, scene.kernel_radius, xyz(p));
+  if (scene.collider_count != 0) {
+    uint32_t collider = scene.collider_count;
+    a.dfsph_contact[i] = wall_contact(scene.colliders, scene.collider_count, state->clock.time,
+                                      scene.kernel_radius, xyz(p), collider);
+    // With the loads, the clamp's impulses start at zero, named after the contact's collider.
+    if (a.dfsph_contact_impulse) a.dfsph_contact_impulse[i] = no_clamp(collider);
+  }
   a.sorted_position[i].w = 0.0f;  // no equation of state: the pressure is written after the solves
   a.sorted_velocity[i] = make_float4_record(xyz(a.velocity[k]), 1.0f / s.density);
+}
+
+// v held to particle i's contact; with the loads, the change is added to its clamp impulses (the
+// CPU backend's CpuBackend::dfsph_clamp).
+__device__ Vec3 dfsph_clamp(const ParticleArrays& a, uint32_t i, Vec3 v) {
+  const Vec3 held = respect_contact(a.dfsph_contact[i], v);
+  if (a.dfsph_contact_impulse) add_clamp(a.dfsph_contact_impulse[i], v, held);
+  return held;
 }
 
 __global__ void dfsph_begin_solve_kernel(FrameState* state) {
@@ -77,7 +90,7 @@ __global__ void dfsph_correct_kernel(FluidConstants fluid, GridView grid, Partic
   const float scale = divergence ? dt : 1.0f;
   Vec3 vi = xyz(v[i]) + pressure_velocity_change(fluid, grid, a.sorted_position, k,
                                                  DfsphWalls{a.boundary_gradient}, i, dt);
-  if (contacts) vi = respect_contact(a.dfsph_contact[i], vi);
+  if (contacts) vi = dfsph_clamp(a, i, vi);
   v[i] = make_float4_record(vi, v[i].w);
   carried[i] = (kWarm ? 0.0f : carried[i]) + k[i] * scale;
 }
@@ -150,17 +163,19 @@ __global__ void dfsph_forces_kernel(FluidConstants fluid, GridView grid, Particl
     if (a.spring_acceleration) acc += xyz(a.spring_acceleration[i]);
     a2 = length_squared(acc);
     Vec3 next = xyz(v) + acc * f.dt;
-    if (kScene && scene.collider_count != 0) next = respect_contact(a.dfsph_contact[i], next);
+    if (kScene && scene.collider_count != 0) next = dfsph_clamp(a, i, next);
     a.velocity[i] = make_float4_record(next, v.w);
     if (!divergence_solve) a.dfsph_divergence[i] = 0.0f;  // no warm start to keep
   }
   block_max_to(&state->a2max_bits, a2);
 }
 
-// x += dt v*, the colliders, the pressure both solves applied, the state in the sorted order.
+// x += dt v*, the colliders (unless the loads pass takes them: collide_here false), the pressure
+// both solves applied (also into the sorted record's w, where the probes and the loads' walls read
+// it), the state in the sorted order.
 template <bool kScene>
 __global__ void dfsph_integrate_kernel(ParticleArrays a, uint32_t n, DeviceScene scene, bool divergence_solve,
-                                       FrameState* state) {
+                                       bool collide_here, FrameState* state) {
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   float v2 = 0.0f;
   if (i < n) {
@@ -168,12 +183,13 @@ __global__ void dfsph_integrate_kernel(ParticleArrays a, uint32_t n, DeviceScene
     const Float4 p = a.sorted_position[i];
     const Float4 v = a.velocity[i];
     ParticleState next{xyz(p) + xyz(v) * dt, xyz(v)};
-    if (kScene) collide_all(scene, state->clock.time, xyz(p), next);
+    if (kScene && collide_here) collide_all(scene, state->clock.time, xyz(p), next);
     const float rho = a.density[i];
     const float divergence = divergence_solve ? 1.0f / dt : 0.0f;
     const uint32_t id = a.sorted_id[i];
-    a.position[i] = make_float4_record(
-        next.position, dfsph_pressure(a.dfsph_pressure[i], a.dfsph_divergence[i] * divergence, rho));
+    const float pressure = dfsph_pressure(a.dfsph_pressure[i], a.dfsph_divergence[i] * divergence, rho);
+    a.sorted_position[i].w = pressure;
+    a.position[i] = make_float4_record(next.position, pressure);
     a.velocity[i] = make_float4_record(next.velocity, v.w);
     a.id[i] = id;
     v2 = length_squared(next.velocity);
@@ -183,6 +199,7 @@ __global__ void dfsph_integrate_kernel(ParticleArrays a, uint32_t n, DeviceScene
                       classify_non_finite(rho, p, a.sorted_velocity[i], Vec3{0.0f, 0.0f, 0.0f}, next));
       v2 = 0.0f;
     }
+    if (!collide_here) v2 = 0.0f;  // the loads pass collides and takes the speed (device_collider_loads.h)
   }
   block_max_to(&state->v2max_bits, v2);
 }
@@ -305,8 +322,8 @@ void enqueue_dfsph_density(const FluidConstants& fluid, const GridView& grid, co
 
 void enqueue_dfsph_step(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                         uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
-                        const DeviceScene& scene, const DfsphLoops& loops, FrameState* state,
-                        cudaStream_t stream) {
+                        const DeviceScene& scene, const DfsphLoops& loops, bool collide_here,
+                        FrameState* state, cudaStream_t stream) {
   const bool contacts = scene.collider_count != 0;
   const bool divergence_solve = fluid.methods.dfsph.divergence_solve != 0;
   if (divergence_solve) enqueue_solve(Solve::Divergence, fluid, grid, a, n, contacts, loops, state, stream);
@@ -323,9 +340,11 @@ void enqueue_dfsph_step(const FluidConstants& fluid, const GridView& grid, const
   check_launch("dfsph_forces_kernel");
   enqueue_solve(Solve::Density, fluid, grid, a, n, contacts, loops, state, stream);
   if (scene.active())
-    dfsph_integrate_kernel<true><<<blocks, threads, 0, stream>>>(a, n, scene, divergence_solve, state);
+    dfsph_integrate_kernel<true>
+        <<<blocks, threads, 0, stream>>>(a, n, scene, divergence_solve, collide_here, state);
   else
-    dfsph_integrate_kernel<false><<<blocks, threads, 0, stream>>>(a, n, scene, divergence_solve, state);
+    dfsph_integrate_kernel<false>
+        <<<blocks, threads, 0, stream>>>(a, n, scene, divergence_solve, collide_here, state);
   check_launch("dfsph_integrate_kernel");
 }
 

@@ -51,10 +51,13 @@ struct DfsphLoops {
 
 // After the density pass (and the spring pass): the divergence solve (unless skipped), the
 // non-pressure accelerations, the density solve, positions, colliders and the reductions of the
-// step's end (max speed, max acceleration, the non-finite check), into the state arrays.
+// step's end (max speed, max acceleration, the non-finite check), into the state arrays; the
+// pressure both solves applied also into the sorted records' w (the probes' and the loads' p).
+// collide_here false (the loads on): the collision response and the max speed are left to the
+// loads pass (enqueue_loads), which also gives the contact clamp's impulses to the colliders.
 void enqueue_dfsph_step(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                         uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
-                        const DeviceScene& scene, const DfsphLoops& loops, FrameState* state,
-                        cudaStream_t stream);
+                        const DeviceScene& scene, const DfsphLoops& loops, bool collide_here,
+                        FrameState* state, cudaStream_t stream);
 
 }  // namespace sph

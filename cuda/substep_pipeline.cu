@@ -29,8 +29,15 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
     if (setup.options.springs)
       enqueue_spring_pass(setup.springs, b.grid->view(), a, n, true, b.state, stream);
     const DfsphLoops loops{cond.in_graph, b.solve_partials, b.state_output};
+    const bool loads = setup.loads.on();
     enqueue_dfsph_step(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene, loops,
-                       b.state, stream);
+                       !loads, b.state, stream);
+    // Probes sample the substep's start once the solves have found its pressure, as on the CPU.
+    if (setup.probes.on()) enqueue_probe_samples(setup.probes, b.grid->view(), a, b.state, stream);
+    // Loads: the walls' reactions of both solves, the contact clamp's impulses, the contacts.
+    if (loads)
+      enqueue_loads(setup.fluid, a, n, setup.scene, setup.loads, setup.options.boundary_density, 0.0f, 1.0f,
+                    true, false, b.state, stream);
     enqueue_end_substep(b.state, setup.limits, setup.max_substeps, 1, cond, stream);
     return;
   }

@@ -128,7 +128,7 @@ typedef enum sph_attribute {
   SPH_ATTRIBUTE_VELOCITY = 1, /* 3 x float32, metres per second */
   SPH_ATTRIBUTE_DENSITY = 2,  /* float32, kg/m^3, from the last density evaluation */
   SPH_ATTRIBUTE_PRESSURE = 3, /* float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation;
-                                 DFSPH: the pressure its density solve found in the last substep */
+                                 DFSPH: the pressure both its solves applied in the last substep */
   SPH_ATTRIBUTE_ID = 4,       /* uint32, persistent particle id, unique within a world */
   SPH_ATTRIBUTE_USER = 5,     /* uint32, the caller's value (SPH_FEATURE_USER_ATTRIBUTE) */
   SPH_ATTRIBUTE_COUNT = 6,
@@ -1290,7 +1290,9 @@ SPH_API sph_result SPH_CALL sph_collider_get_material(const sph_world* world, sp
  * the time averages over the step's substeps of the force and of the torque about the collider's
  * load point, in world coordinates. What counts: the momentum the collision response took from
  * particles (contacts, friction, stickiness) and, with SPH_FEATURE_BOUNDARY_DENSITY, the walls'
- * pressure reactions; force times frame_time is the impulse the fluid gave the collider. The
+ * pressure reactions (on a DFSPH world: what both its solves applied, and the impulses of its
+ * solves' contact clamp; not with SPH_DFSPH_CONJUGATE_GRADIENTS, whose step is then UNSUPPORTED);
+ * force times frame_time is the impulse the fluid gave the collider. The
  * torque of each impulse is taken about the load point posed at the impulse's time (it moves
  * with the collider). Zero before the first step (frame_time 0). docs/physics.md "Loads".
  */
@@ -1507,8 +1509,9 @@ static inline sph_result sph_probe_def_init(sph_probe_def* def) {
  * backend (on the device for CUDA, with no host copy per substep). Errors: INVALID_HANDLE
  * (world), INVALID_ARGUMENT (NULL def or out_id; a non-finite position or direction, a gauge's
  * length not > 0 or too many steps, a negative sample_spacing, non-zero reserved0, each named),
- * UNSUPPORTED (an unknown kind or sampling; a world of the DFSPH solver, whose substep does not
- * sample probes), VERSION_MISMATCH, CAPACITY (65536 probes), WORLD_LOCKED. Nothing changes on
+ * UNSUPPORTED (an unknown kind or sampling), VERSION_MISMATCH, CAPACITY (65536 probes),
+ * WORLD_LOCKED. On a DFSPH world the pressure sampled is the one both its solves applied in the
+ * substep (SPH_ATTRIBUTE_PRESSURE's), at the substep's start positions. Nothing changes on
  * error. Checkpoints of format 6 and later carry the probes (readings start again); restoring an
  * older one keeps the world's own (docs/api.md).
  */

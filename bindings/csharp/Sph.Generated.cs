@@ -232,8 +232,8 @@ namespace Sph
         /// <summary>float32, kg/m^3, from the last density evaluation</summary>
         Density = 2,
         /// <summary>
-        /// float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure its
-        /// density solve found in the last substep
+        /// float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure both its
+        /// solves applied in the last substep
         /// </summary>
         Pressure = 3,
         /// <summary>uint32, persistent particle id, unique within a world</summary>
@@ -1765,7 +1765,9 @@ namespace Sph
     /// (SPH_FEATURE_COLLIDER_LOADS): the time averages over the step's substeps of the force and of the
     /// torque about the collider's load point, in world coordinates. What counts: the momentum the
     /// collision response took from particles (contacts, friction, stickiness) and, with
-    /// SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions; force times frame_time is the
+    /// SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions (on a DFSPH world: what both its
+    /// solves applied, and the impulses of its solves' contact clamp; not with
+    /// SPH_DFSPH_CONJUGATE_GRADIENTS, whose step is then UNSUPPORTED); force times frame_time is the
     /// impulse the fluid gave the collider. The torque of each impulse is taken about the load point
     /// posed at the impulse's time (it moves with the collider). Zero before the first step (frame_time
     /// 0). docs/physics.md "Loads".
@@ -3138,8 +3140,9 @@ namespace Sph
         /// backend (on the device for CUDA, with no host copy per substep). Errors: INVALID_HANDLE
         /// (world), INVALID_ARGUMENT (NULL def or out_id; a non-finite position or direction, a gauge's
         /// length not &gt; 0 or too many steps, a negative sample_spacing, non-zero reserved0, each
-        /// named), UNSUPPORTED (an unknown kind or sampling; a world of the DFSPH solver, whose substep
-        /// does not sample probes), VERSION_MISMATCH, CAPACITY (65536 probes), WORLD_LOCKED. Nothing
+        /// named), UNSUPPORTED (an unknown kind or sampling), VERSION_MISMATCH, CAPACITY (65536
+        /// probes), WORLD_LOCKED. On a DFSPH world the pressure sampled is the one both its solves
+        /// applied in the substep (SPH_ATTRIBUTE_PRESSURE's), at the substep's start positions. Nothing
         /// changes on error. Checkpoints of format 6 and later carry the probes (readings start again);
         /// restoring an older one keeps the world's own (docs/api.md).
         /// </summary>
@@ -4830,7 +4833,7 @@ namespace Sph
             { "SPH_ATTRIBUTE_POSITION", "3 x float32, metres" },
             { "SPH_ATTRIBUTE_VELOCITY", "3 x float32, metres per second" },
             { "SPH_ATTRIBUTE_DENSITY", "float32, kg/m^3, from the last density evaluation" },
-            { "SPH_ATTRIBUTE_PRESSURE", "float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure its density solve found in the last substep" },
+            { "SPH_ATTRIBUTE_PRESSURE", "float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure both its solves applied in the last substep" },
             { "SPH_ATTRIBUTE_ID", "uint32, persistent particle id, unique within a world" },
             { "SPH_ATTRIBUTE_USER", "uint32, the caller's value (SPH_FEATURE_USER_ATTRIBUTE)" },
             { "SPH_STAGE_HASH_SORT", "cell hash, stable sort, reorder of every attribute" },

@@ -53,11 +53,6 @@ void require_dfsph_combination(const sph_world_def& d, uint32_t integrator, uint
                 "def->features: SPH_FEATURE_DENSITY_DIFFUSION with def->solver SPH_SOLVER_DFSPH; the "
                 "diffusion acts on the weakly compressible solver's carried density, DFSPH's density "
                 "solve has none");
-  if (d.features & SPH_FEATURE_COLLIDER_LOADS)
-    throw Error(Status::Unsupported,
-                "def->features: SPH_FEATURE_COLLIDER_LOADS with def->solver SPH_SOLVER_DFSPH; the loads are "
-                "gathered from the weakly compressible pressure force and the collision response, which "
-                "DFSPH's solves do not yet report (issue 16/17)");
 }
 
 // Validates a def and resolves defaults into the internal configuration. Zero means default

@@ -315,7 +315,7 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   SlotTable<Probe> probes;
   if (version >= kFirstProbeVersion) {
     ByteReader prob = next_section(payload, 9);
-    probes = read_checkpoint_probes(prob, config, version);
+    probes = read_checkpoint_probes(prob, version);
     prob.expect_end();
   }
   payload.expect_end();

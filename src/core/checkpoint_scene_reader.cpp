@@ -250,13 +250,8 @@ SlotTable<ForceField> read_checkpoint_force_fields(ByteReader& r, const Checkpoi
       r, [&](const std::string& n) { return read_force_field(r, assets, "force field " + n); });
 }
 
-SlotTable<Probe> read_checkpoint_probes(ByteReader& r, const WorldConfig& config, uint32_t version) {
-  SlotTable<Probe> t =
-      read_slots<Probe>(r, [&](const std::string& n) { return read_probe(r, version, "probe " + n); });
-  if (config.solver == Solver::Dfsph)
-    for (const auto& value : t.values)
-      if (value) corrupt(r.what() + ": a DFSPH world has no probes (World::add_probe refuses them)");
-  return t;
+SlotTable<Probe> read_checkpoint_probes(ByteReader& r, uint32_t version) {
+  return read_slots<Probe>(r, [&](const std::string& n) { return read_probe(r, version, "probe " + n); });
 }
 
 }  // namespace sph

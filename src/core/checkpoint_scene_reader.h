@@ -26,7 +26,7 @@ SlotTable<Source> read_checkpoint_sources(ByteReader& r, const CheckpointAssets&
                                           const WorldConfig& config);
 SlotTable<Sink> read_checkpoint_sinks(ByteReader& r, const CheckpointAssets& assets);
 SlotTable<ForceField> read_checkpoint_force_fields(ByteReader& r, const CheckpointAssets& assets);
-// The probes as World::add_probe would have made them; readings cleared. None on a DFSPH world.
-SlotTable<Probe> read_checkpoint_probes(ByteReader& r, const WorldConfig& config, uint32_t version);
+// The probes as World::add_probe would have made them; readings cleared.
+SlotTable<Probe> read_checkpoint_probes(ByteReader& r, uint32_t version);
 
 }  // namespace sph

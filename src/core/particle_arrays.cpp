@@ -37,6 +37,10 @@ std::vector<ParticleArraySpec> method_particle_arrays(const WorldConfig& config)
     arrays.push_back(ParticleArraySpec{kArrayRk4Sum, sizeof(Rk4Accumulator), ParticleArrayRole::Sorted, 1,
                                        nullptr, nullptr});
   }
+  // DFSPH's loads: the impulses of its contact clamp, per particle and substep (collider_loads.h).
+  if (config.solver == Solver::Dfsph && (config.features & kFeatureColliderLoads))
+    arrays.push_back(ParticleArraySpec{kArrayDfsphContactImpulse, sizeof(Float4), ParticleArrayRole::Scratch,
+                                       1, nullptr, nullptr});
   if (config.features & kFeatureUserAttribute)
     arrays.push_back(ParticleArraySpec{kArrayUserAttribute, sizeof(uint32_t), ParticleArrayRole::Carried, 1,
                                        nullptr, nullptr});

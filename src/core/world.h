@@ -163,7 +163,7 @@ class World {
   // A live collider; Error(InvalidHandle) otherwise.
   const Collider& collider(uint64_t id) const;
   // ---- probes and gauges (world_probes.cpp; physics/probe_sampling.h) ----
-  // add_probe: FieldError naming the field for a bad spec, Error(Unsupported) on a DFSPH world,
+  // add_probe: FieldError naming the field for a bad spec,
   // Error(Capacity) past 65536 probes; the world is unchanged on error. Probes are not part of
   // SceneTables: a checkpoint of format 5 or later carries them (restore_probes), an older one
   // has none and sph_world_restore keeps the world's own (adopt_probes).
@@ -176,7 +176,7 @@ class World {
   const Probe& probe(uint64_t id) const;
   const SlotMap<Probe>& probes() const { return probes_; }
   // Takes over another world's probes with their ids, readings cleared (a restore from a file
-  // before format 5 keeps the world's probes). None on a DFSPH world (add_probe's rule).
+  // before format 5 keeps the world's probes).
   void adopt_probes(const World& from);
   // A checkpoint's probes (checkpoint_reader.cpp), readings cleared.
   void restore_probes(SlotTable<Probe> table);

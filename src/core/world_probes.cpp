@@ -36,10 +36,6 @@ Vec3 gauge_axis(const Probe& p, const Vec3& gravity) {
 }  // namespace
 
 uint64_t World::add_probe(const ProbeSpec& spec) {
-  if (config_.solver == Solver::Dfsph)
-    throw Error(Status::Unsupported,
-                "world: probes sample the weakly compressible solver's density pass; a DFSPH world has "
-                "none that carries its pressures (not supported yet)");
   require_finite_vec3_field(spec.position, "position");
   require_resolved(spec.position, config_.particle_spacing, "position");
   Probe p;
@@ -88,7 +84,6 @@ void World::set_probe_pressure_threshold(uint64_t id, float threshold) {
 }
 
 void World::adopt_probes(const World& from) {
-  if (config_.solver == Solver::Dfsph) return;
   SlotMap<Probe> probes = from.probes_;
   probes.for_each([](uint64_t, Probe& p) { p.reading = ProbeReading{}; });
   probes_ = std::move(probes);

@@ -61,6 +61,7 @@ CpuBackend::CpuBackend(const WorldConfig& config, unsigned workers, const TaskSy
   dfsph_factor_ = store_.find_typed<float>(kArrayDfsphFactor);
   dfsph_residual_ = store_.find_typed<float>(kArrayDfsphResidual);
   dfsph_contact_ = store_.find_typed<Float4>(kArrayDfsphContact);
+  clamp_impulse_ = store_.find_typed<Float4>(kArrayDfsphContactImpulse);
   boundary_ = store_.find_typed<Float4>(kArrayBoundaryGradient);
   user_attribute_ = store_.find_typed<uint32_t>(kArrayUserAttribute);
 }

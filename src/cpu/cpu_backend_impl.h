@@ -157,9 +157,12 @@ class CpuBackend final : public Backend {
   // One force evaluation's loads: the walls' pressure reactions (boundary density) over
   // wall_seconds (its share of the substep; 0: none) at the stage's time `at`, then, when `old`
   // names the start positions, the collision response of the state in next_* with its contact
-  // impulses. Adds to load_sums_.
+  // impulses. Adds to load_sums_. The walls' reactions read p (w of the start's records) and 1 / rho
+  // (w of the velocities'). clamp: DFSPH's contact clamp impulses (kArrayDfsphContactImpulse), or
+  // null.
   void collide_with_loads(const FluidConstants& fluid, const SceneFrame& scene, const SubstepTime& time,
-                          StageTime at, float wall_seconds, OldPositions old, FrameReport& report);
+                          StageTime at, float wall_seconds, OldPositions old, FrameReport& report,
+                          const Float4* clamp = nullptr);
 
   // Probes and gauges (cpu_probes.cpp; physics/probe_sampling.h): each sample point's sums over
   // the sorted particles of the density pass just run, then each probe's sample in point order,
@@ -204,6 +207,9 @@ class CpuBackend final : public Backend {
                            Float4* v, float* carried, float carry_scale);
   // Each particle's contact with the scene's colliders (dfsph_contact_), for the solves.
   void dfsph_find_contacts(const SceneFrame& scene, const SubstepTime& time);
+  // Holds v to particle i's contact (respect_contact); with the loads, adds the change to its
+  // clamp impulses (clamp_impulse_).
+  void dfsph_clamp(uint32_t i, Vec3& v);
   // Applies the iteration's pressures (columns_.dfsph_step()) to v (records and columns) and adds
   // them (times carry_scale) to carried.
   void dfsph_correct(const FluidConstants& fluid, const DfsphWalls& walls, float dt, Float4* v,
@@ -323,6 +329,7 @@ class CpuBackend final : public Backend {
   CpuArrayRef<float> dfsph_factor_;           // DFSPH: alpha / rho of the density pass
   CpuArrayRef<float> dfsph_residual_;         // DFSPH: each particle's share of the solve's error
   CpuArrayRef<Float4> dfsph_contact_;         // DFSPH: each particle's contact with the colliders
+  CpuArrayRef<Float4> clamp_impulse_;         // DFSPH with the loads: the clamp's, per particle
   bool dfsph_contacts_ = false;               // DFSPH: the substep has colliders (contacts to respect)
   HostVector<ColliderView> dfsph_colliders_;  // DFSPH: the substep's colliders, for the contacts
   HostVector<float> cg_value_;                // DFSPH by conjugate gradients: rho* - rho0 per particle

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Loads on colliders (SPH_FEATURE_COLLIDER_LOADS) on the CPU: the walls' pressure reactions of a
-// force evaluation and the collision response with its contact impulses, summed per collider in
+// force evaluation (or of DFSPH's solves, with its contact clamp's impulses) and the collision
+// response with its contact impulses, summed per collider in
 // blocks of kLoadBlock particles in storage order, then the blocks in order into the frame's
 // double sums, so the loads do not depend on the thread count (the twin of
 // cuda/device_collider_loads.cu; the physics is physics/collider_loads.h).
@@ -18,7 +19,7 @@ void CpuBackend::begin_loads(const SceneFrame& scene) {
 
 void CpuBackend::collide_with_loads(const FluidConstants& fluid, const SceneFrame& scene,
                                     const SubstepTime& time, StageTime at, float wall_seconds,
-                                    OldPositions old, FrameReport& report) {
+                                    OldPositions old, FrameReport& report, const Float4* clamp) {
   const uint32_t colliders = static_cast<uint32_t>(scene.colliders.size());
   if (colliders == 0) return;
   const auto t = Clock::now();
@@ -58,6 +59,11 @@ void CpuBackend::collide_with_loads(const FluidConstants& fluid, const SceneFram
                 collider_boundary_share(fluid.methods.boundary, collider_views_[c], x, at.s, at.tau);
             add_load(sums[c], wall_reaction_impulse(share.gradient, mass, coefficient_dt), x, points[2 * c]);
           }
+        }
+        if (clamp) {  // DFSPH's contact clamp, at the substep's start (where its solves work)
+          const Float4 j = clamp[i];
+          const uint32_t c = clamp_collider(j, colliders);
+          if (c < colliders) add_load(sums[c], clamp_impulse(mass, j), xyz(pos[i]), points[2 * c]);
         }
         if (contacts) {
           Vec3 x = xyz(next_pos[i]);

@@ -12,6 +12,11 @@
 // sort_and_density, the velocity updates, the rates and the non-pressure accelerations here) and
 // read the columns: positions, the velocities each velocity update writes next to the records,
 // the density pass's 1 / rho and counts, and the iteration's k in the pressure column.
+//
+// Loads and probes: the probes sample the substep's start once both solves have found its
+// pressure; with SPH_FEATURE_COLLIDER_LOADS each contact clamp's velocity change is summed per
+// particle (dfsph_clamp) and the loads pass adds it to the walls' reactions of both solves and
+// the collision response's contacts (physics/collider_loads.h).
 #include <algorithm>
 #include <cmath>
 
@@ -30,8 +35,20 @@ void CpuBackend::dfsph_find_contacts(const SceneFrame& scene, const SubstepTime&
   const ColliderView* views = dfsph_colliders_.data();
   const uint32_t count = static_cast<uint32_t>(dfsph_colliders_.size());
   const float h = config_.kernel_radius;
-  parallel().for_each(count_,
-                      [&](uint32_t i) { contact[i] = wall_contact(views, count, time, h, xyz(pos[i])); });
+  // With the loads, each particle's clamp impulses start at zero, named after its contact's
+  // collider (collider_loads.h).
+  Float4* clamp = loads_on() ? clamp_impulse_.data() : nullptr;
+  parallel().for_each(count_, [&](uint32_t i) {
+    uint32_t collider = count;
+    contact[i] = wall_contact(views, count, time, h, xyz(pos[i]), collider);
+    if (clamp) clamp[i] = no_clamp(collider);
+  });
+}
+
+void CpuBackend::dfsph_clamp(uint32_t i, Vec3& v) {
+  const Vec3 held = respect_contact(dfsph_contact_[i], v);
+  if (loads_on()) add_clamp(clamp_impulse_[i], v, held);
+  v = held;
 }
 
 void CpuBackend::dfsph_correct(const FluidConstants& fluid, const DfsphWalls& walls, float dt, Float4* v,
@@ -45,7 +62,7 @@ void CpuBackend::dfsph_correct(const FluidConstants& fluid, const DfsphWalls& wa
   // column), which the next rate pass reads.
   parallel().for_each(count_, [&](uint32_t i) {
     Vec3 vi = xyz(v[i]) + change(fluid, view, columns, k, walls, i, dt);
-    if (contact) vi = respect_contact(contact[i], vi);
+    if (contact) dfsph_clamp(i, vi);
     v[i] = make_float4_record(vi, v[i].w);
     columns_.set_velocity(i, vi);
     carried[i] += k[i] * carry_scale;
@@ -155,7 +172,7 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
         // owner's after the density solve's first velocity update)
         if (!(origin && origin[i])) m = std::max(m, length_squared(a));
         Vec3 v = xyz(vel[i]) + a * dt;
-        if (contact) v = respect_contact(contact[i], v);
+        if (contact) dfsph_clamp(i, v);
         next_vel[i] = make_float4_record(v, vel[i].w);
       },
       [](float a, float b) { return std::max(a, b); });
@@ -164,17 +181,30 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
   const SolveOutcome o =
       dfsph_solve(DfsphSolve::Density, fluid, walls, dt, next_vel, dfsph_pressure_.data(), 1.0f);
   record_solve(tallies.pressure, o.iterations, o.error, o.capped);
-  // 5. x += dt v*; w: the pressure both solves applied in this substep, p = (k + k_v) rho^2.
+  // 5. x += dt v*; w: the pressure both solves applied in this substep, p = (k + k_v) rho^2, also
+  // the start's record's (the probes sample it there, at the positions the solves worked on).
   const float* k = dfsph_pressure_.data();
   const float* k_v = dfsph_divergence_.data();
   const float* density = density_.data();
   const float divergence = fluid.methods.dfsph.divergence_solve ? 1.0f / dt : 0.0f;
+  Float4* start = position_.data();
   parallel().for_each(count_, [&](uint32_t i) {
-    next_pos[i] = make_float4_record(xyz(pos[i]) + xyz(next_vel[i]) * dt,
-                                     dfsph_pressure(k[i], k_v[i] * divergence, density[i]));
+    const float p = dfsph_pressure(k[i], k_v[i] * divergence, density[i]);
+    start[i].w = p;
+    next_pos[i] = make_float4_record(xyz(pos[i]) + xyz(next_vel[i]) * dt, p);
   });
   report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
-  collide_from(scene, time, pos, report);
+  sample_probes(scene, dt, report);
+  if (loads_on()) {
+    // The walls' reactions of both solves, the clamp's impulses, the collision response's contacts
+    // (collider_loads.h).
+    OldPositions old;
+    old.records = pos;
+    collide_with_loads(fluid, scene, time, stage_time(time, 0.0f), dt, old, report,
+                       dfsph_contacts_ ? clamp_impulse_.data() : nullptr);
+  } else {
+    collide_from(scene, time, pos, report);
+  }
   t = Clock::now();
   float v2max = 0.0f;
   const uint32_t bad_index = scan_next_state(v2max);

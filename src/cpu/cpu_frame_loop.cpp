@@ -28,6 +28,15 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
                                          const SceneFrame& scene_in) {
   FrameReport report;
   FluidConstants fluid = make_fluid_constants(config_, params);
+  // The conjugate gradients' density solve moves velocities outside dfsph_correct (its search
+  // directions and its own contact holds) and keeps only the positive part of what it applied, so
+  // the loads' sums (collider_loads.h) would not be the momentum it gave the walls.
+  if (config_.solver == Solver::Dfsph && loads_on() &&
+      fluid.methods.dfsph.linear_solver == kDfsphConjugateGradients)
+    throw Error(Status::Unsupported,
+                "step: SPH_FEATURE_COLLIDER_LOADS with DFSPH's conjugate gradients solve "
+                "(sph_dfsph_params.linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS) is not supported yet; the "
+                "loads follow the Jacobi solve's velocity updates, use SPH_DFSPH_JACOBI");
   const StepLimits limits = make_step_limits(config_, params);
   SceneFrame scene = scene_in;
   bind_scene_views(scene, [](const SdfAsset& a) { return a.host_view(); });

@@ -23,13 +23,20 @@
 //     m, p_i / rho_i^2 * weight * dt), weight 1 (Euler) or rk4_weight(stage);
 //   - the collision response pass: contact_impulse(m, v before, v after) per collider, in the
 //     order collide_particle() visits them;
-//   - DFSPH (its velocity update v_i -= dt (kappa_i / rho_i) grad rho_b): wall_reaction_impulse(
-//     collider gradient, m, dt kappa_i / rho_i), and its contacts as above.
+//   - DFSPH, once per substep after both solves: wall_reaction_impulse(collider gradient, m,
+//     p_i / rho_i^2 * dt) with p = (k + k_v / dt) rho^2 (dfsph_pressure: the sums both solves
+//     carry), which is the sum of what every velocity update of both solves applied
+//     (v_i -= dt k_i grad rho_b each, the warm start included), at the substep's start; the
+//     impulses of its contact clamp (respect_contact after each velocity update of both solves
+//     and after the non-pressure accelerations), summed per particle (add_clamp into
+//     kArrayDfsphContactImpulse) and given to the collider of the particle's contact at the
+//     substep's start; and its collision response's contacts as above.
 #pragma once
 
 #include <stdint.h>
 
 #include "collider_response.h"
+#include "float4_types.h"
 #include "host_device.h"
 #include "vec3.h"
 
@@ -38,6 +45,11 @@ namespace sph {
 struct ColliderLoads {
   static constexpr const char* kName = "collider_loads";
 };
+
+// DFSPH with the loads: per particle, xyz the velocity changes its contact clamps made in this
+// substep (the momentum it gave the wall, over m), w the index of its contact's collider (a
+// float: exact below 2^24 colliders). Scratch, found anew each substep (dfsph_passes.h).
+constexpr const char* kArrayDfsphContactImpulse = "dfsph_contact_impulse";
 
 // Particles per block of the loads reduction (both backends; the CUDA kernel's block size).
 constexpr uint32_t kLoadBlock = 256;
@@ -72,6 +84,21 @@ SPH_HD void add_load(LoadImpulse& sum, Vec3 j, Vec3 x, Vec3 p) {
 SPH_HD Vec3 wall_reaction_impulse(Vec3 collider_gradient, float mass, float coefficient_dt) {
   return collider_gradient * (mass * coefficient_dt);
 }
+
+// DFSPH's contact clamp (kArrayDfsphContactImpulse): a particle's record starts each substep as
+// no_clamp(its contact's collider); each clamp of a velocity from `before` to `after` adds the
+// change (add_clamp); the loads pass gives clamp_impulse to collider clamp_collider (none: the
+// count, for a particle without a contact, which no clamp changes).
+SPH_HD Float4 no_clamp(uint32_t collider) { return Float4{0.0f, 0.0f, 0.0f, static_cast<float>(collider)}; }
+SPH_HD void add_clamp(Float4& record, Vec3 before, Vec3 after) {
+  record = Float4{record.x + (before.x - after.x), record.y + (before.y - after.y),
+                  record.z + (before.z - after.z), record.w};
+}
+SPH_HD uint32_t clamp_collider(const Float4& record, uint32_t colliders) {
+  return record.w >= 0.0f && record.w < static_cast<float>(colliders) ? static_cast<uint32_t>(record.w)
+                                                                      : colliders;
+}
+SPH_HD Vec3 clamp_impulse(float mass, const Float4& record) { return xyz(record) * mass; }
 
 // The momentum a collision response took from a particle.
 SPH_HD Vec3 contact_impulse(float mass, Vec3 velocity_before, Vec3 velocity_after) {

@@ -193,19 +193,28 @@ SPH_HD DfsphResidual density_residual(float rate, float density, float factor, f
 // v . n >= c. The nearest collider wins where several are near. A boundary model that puts the
 // walls into the density (dfsph_boundary.h) makes the solves see the approach as compression,
 // and this becomes a safeguard.
+// collider: the nearest collider's index (whose wall receives the clamp's impulses, collider_loads.h),
+// or collider_count without a contact.
 SPH_HD Float4 wall_contact(const ColliderView* colliders, uint32_t collider_count, const SubstepTime& t,
-                           float kernel_radius, Vec3 x) {
+                           float kernel_radius, Vec3 x, uint32_t& collider) {
   Float4 contact{0.0f, 0.0f, 0.0f, 0.0f};  // no contact: n = 0 holds nothing
   float nearest = kernel_radius;
+  collider = collider_count;
   for (uint32_t c = 0; c < collider_count; ++c) {
     const ColliderSample s = sample_collider(colliders[c], x, t.s0, t.tau0);
     if (!(s.distance < nearest)) continue;
     nearest = s.distance;
+    collider = c;
     const Vec3 n = collider_normal(colliders[c], s);
     const float d = s.distance > 0.0f ? s.distance : 0.0f;
     contact = make_float4_record(n, dot(collider_velocity(colliders[c], s, x), n) - d / t.dt);
   }
   return contact;
+}
+SPH_HD Float4 wall_contact(const ColliderView* colliders, uint32_t collider_count, const SubstepTime& t,
+                           float kernel_radius, Vec3 x) {
+  uint32_t collider = 0;
+  return wall_contact(colliders, collider_count, t, kernel_radius, x, collider);
 }
 
 // v held to its contact: v . n >= c.

@@ -346,12 +346,13 @@ void test_vdb_level_set_collider(void**) {
 
 // Loads per collider (issue 17): a collider with "loads" gets loads_<index>_<name>.csv, a row per
 // frame; water resting in a tank presses its floor with about its weight, and each row covers
-// one frame's time.
-void test_loads_csv(void**) {
-  const std::string dir = cli_test::make_temp_dir("loads_csv");
+// one frame's time. On either solver (world.solver: "wcsph" or "dfsph").
+void loads_csv(const std::string& solver) {
+  const std::string dir = cli_test::make_temp_dir(("loads_csv_" + solver).c_str());
   const std::string scene_file = dir + "/loads.json";
   cli_test::write_text(scene_file, R"({
-    "world": { "capacity": 4000, "particle_spacing": 0.02 },
+    "world": { "capacity": 4000, "particle_spacing": 0.02, "solver": ")" +
+                                       solver + R"(" },
     "time": { "fps": 50, "frames": 3 },
     "fluids": [ { "type": "box", "min": [-0.1, 0.0, -0.1], "max": [0.1, 0.06, 0.1] } ],
     "colliders": [ { "name": "the tank", "inverted": true, "loads": { "point": [0.1, 0, 0] },
@@ -382,6 +383,11 @@ void test_loads_csv(void**) {
   assert_true(std::fabs(frame_time - 0.02) < 1e-6 && std::fabs(time - 0.06) < 1e-6);
   assert_true(std::fabs(p[0] - 0.1) < 1e-6 && std::fabs(p[1] - 0.1) < 1e-6);  // the point, posed
   assert_true(f[1] < 0.0);                                                    // pressed down
+}
+
+void test_loads_csv(void**) {
+  loads_csv("wcsph");
+  loads_csv("dfsph");
 }
 
 // Threshold events (issue 17): a collider's "loads.threshold" below the water's weight and a
@@ -423,12 +429,13 @@ void test_threshold_notices(void**) {
 // Probes (issue 17 item 2): each probe of "probes" gets probe_<index>[_<name>].csv, a row per
 // frame; a point in water resting in a tank reads a density near rho0, a gauge through it the few
 // centimetres of water (the 6 cm fluid box holds three lattice layers, 4.2 cm, before it spreads
-// over the tank's floor; test_probes.c holds the gauge to the fill height).
-void test_probe_csv(void**) {
-  const std::string dir = cli_test::make_temp_dir("probe_csv");
+// over the tank's floor; test_probes.c holds the gauge to the fill height). On either solver.
+void probe_csv(const std::string& solver) {
+  const std::string dir = cli_test::make_temp_dir(("probe_csv_" + solver).c_str());
   const std::string scene_file = dir + "/probes.json";
   cli_test::write_text(scene_file, R"({
-    "world": { "capacity": 4000, "particle_spacing": 0.02 },
+    "world": { "capacity": 4000, "particle_spacing": 0.02, "solver": ")" +
+                                       solver + R"(" },
     "time": { "fps": 50, "frames": 3 },
     "fluids": [ { "type": "box", "min": [-0.1, 0.0, -0.1], "max": [0.1, 0.06, 0.1] } ],
     "colliders": [ { "inverted": true,
@@ -471,6 +478,11 @@ void test_probe_csv(void**) {
       assert_true(samples == 1 && height > 0.03 && height < 0.065);
     }
   }
+}
+
+void test_probe_csv(void**) {
+  probe_csv("wcsph");
+  probe_csv("dfsph");
 }
 
 }  // namespace

@@ -8,7 +8,8 @@
 //   - CPU against GPU after one frame of 1/60 s: each collider's force within 1e-3 of the
 //     fluid's weight (the sums differ only in float rounding and summation order there);
 //   - momentum balance on the device over 10 frames: fluid dP + colliders' J = M g T within 1 %.
-// With and without SPH_FEATURE_BOUNDARY_DENSITY, symplectic Euler and RK4.
+// With and without SPH_FEATURE_BOUNDARY_DENSITY, symplectic Euler and RK4, and DFSPH (its loads add
+// the contact clamp's impulses, collider_loads.h) with and without the boundary density.
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -39,7 +40,8 @@ void momentum(const sph_world* w, float m, double out[3]) {
     for (int k = 0; k < 3; ++k) out[k] += static_cast<double>(m) * v[3 * i + k];
 }
 
-LoadsRun run(sph_backend backend, uint32_t features, sph_integrator integrator, int frames) {
+LoadsRun run(sph_backend backend, uint32_t features, sph_integrator integrator, int frames,
+             sph_solver solver) {
   LoadsRun r;
   sph_context* context = make_context(backend);
   sph_world_def def;
@@ -48,6 +50,7 @@ LoadsRun run(sph_backend backend, uint32_t features, sph_integrator integrator, 
   def.particle_spacing = 0.02f;
   def.features = features;
   def.integrator = integrator;
+  def.solver = solver;
   sph_world* world = nullptr;
   require_ok(sph_world_create(context, &def, &world), "sph_world_create");
   const double lo[3] = {0.0, 0.0, 0.0}, hi[3] = {0.6, 0.4, 0.2};
@@ -111,25 +114,26 @@ bool same_loads(const LoadsRun& a, const LoadsRun& b) {
   return true;
 }
 
-void check(uint32_t extra, sph_integrator integrator, const char* label) {
+void check(uint32_t extra, sph_integrator integrator, const char* label,
+           sph_solver solver = SPH_SOLVER_WCSPH) {
   const uint32_t features = SPH_FEATURE_COLLIDER_LOADS | extra;
   const int frames = integrator == SPH_INTEGRATOR_RK4 ? 4 : 10;
-  const LoadsRun a = run(SPH_BACKEND_CUDA, features, integrator, frames);
-  const LoadsRun b = run(SPH_BACKEND_CUDA, features, integrator, frames);
+  const LoadsRun a = run(SPH_BACKEND_CUDA, features, integrator, frames, solver);
+  const LoadsRun b = run(SPH_BACKEND_CUDA, features, integrator, frames, solver);
   char name[160];
   std::snprintf(name, sizeof name, "loads/determinism/%s", label);
   report(same_loads(a, b) && states_identical(a.state, b.state), name, "two GPU runs: loads and states %s",
          same_loads(a, b) && states_identical(a.state, b.state) ? "bitwise identical" : "DIFFER");
 
   context_tuning().stream_frames = true;
-  const LoadsRun s = run(SPH_BACKEND_CUDA, features, integrator, frames);
+  const LoadsRun s = run(SPH_BACKEND_CUDA, features, integrator, frames, solver);
   context_tuning().stream_frames = false;
   std::snprintf(name, sizeof name, "loads/graph_vs_stream/%s", label);
   report(same_loads(a, s) && states_identical(a.state, s.state), name,
          "graph frame against stream driver: %s",
          same_loads(a, s) && states_identical(a.state, s.state) ? "bitwise identical" : "DIFFERENT");
 
-  const LoadsRun off = run(SPH_BACKEND_CUDA, extra, integrator, frames);
+  const LoadsRun off = run(SPH_BACKEND_CUDA, extra, integrator, frames, solver);
   std::snprintf(name, sizeof name, "loads/trajectory_unchanged/%s", label);
   size_t first = 0;
   while (first < a.frame_states.size() && states_identical(a.frame_states[first], off.frame_states[first]))
@@ -155,8 +159,8 @@ void check(uint32_t extra, sph_integrator integrator, const char* label) {
   std::snprintf(name, sizeof name, "loads/momentum_balance/%s", label);
   report(error <= 0.01, name, "fluid dP + colliders' J - M g T over %.3f s: %.3g of M g T", a.time, error);
 
-  const LoadsRun gpu = run(SPH_BACKEND_CUDA, features, integrator, 1);
-  const LoadsRun cpu = run(SPH_BACKEND_CPU, features, integrator, 1);
+  const LoadsRun gpu = run(SPH_BACKEND_CUDA, features, integrator, 1, solver);
+  const LoadsRun cpu = run(SPH_BACKEND_CPU, features, integrator, 1, solver);
   double worst = 0.0;
   for (size_t k = 0; k < gpu.loads.size(); ++k) {
     const double d[3] = {gpu.loads[k].force.x - cpu.loads[k].force.x,
@@ -175,5 +179,8 @@ int main() {
   check(0u, SPH_INTEGRATOR_SYMPLECTIC_EULER, "contacts_euler");
   check(SPH_FEATURE_BOUNDARY_DENSITY, SPH_INTEGRATOR_SYMPLECTIC_EULER, "boundary_density_euler");
   check(SPH_FEATURE_BOUNDARY_DENSITY, SPH_INTEGRATOR_RK4, "boundary_density_rk4");
+  check(0u, SPH_INTEGRATOR_SYMPLECTIC_EULER, "contacts_dfsph", SPH_SOLVER_DFSPH);
+  check(SPH_FEATURE_BOUNDARY_DENSITY, SPH_INTEGRATOR_SYMPLECTIC_EULER, "boundary_density_dfsph",
+        SPH_SOLVER_DFSPH);
   return finish();
 }

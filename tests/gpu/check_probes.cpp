@@ -8,6 +8,7 @@
 //   - CPU against GPU after one frame of 1/60 s (the states differ only in float rounding there):
 //     densities within 1e-3 of rho0, pressures within 1e-3 of rho0 g H, velocities within 1e-3
 //     of sqrt(g H), the gauge's height within 1e-3 of H.
+// Symplectic Euler, RK4, and DFSPH (whose probes sample the substep's start after its solves).
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -27,7 +28,7 @@ struct ProbesRun {
   uint32_t substeps = 0;
 };
 
-ProbesRun run(sph_backend backend, sph_integrator integrator, int frames, bool probes) {
+ProbesRun run(sph_backend backend, sph_integrator integrator, int frames, bool probes, sph_solver solver) {
   ProbesRun r;
   sph_context* context = make_context(backend);
   sph_world_def def;
@@ -35,6 +36,7 @@ ProbesRun run(sph_backend backend, sph_integrator integrator, int frames, bool p
   def.capacity = 20000;
   def.particle_spacing = 0.02f;
   def.integrator = integrator;
+  def.solver = solver;
   sph_world* world = nullptr;
   require_ok(sph_world_create(context, &def, &world), "sph_world_create");
   const double lo[3] = {0.0, 0.0, 0.0}, hi[3] = {0.6, 0.4, 0.2};
@@ -88,24 +90,24 @@ bool same_readings(const ProbesRun& a, const ProbesRun& b) {
   return true;
 }
 
-void check(sph_integrator integrator, const char* label) {
+void check(sph_integrator integrator, const char* label, sph_solver solver = SPH_SOLVER_WCSPH) {
   const int frames = 6;
-  const ProbesRun a = run(SPH_BACKEND_CUDA, integrator, frames, true);
-  const ProbesRun b = run(SPH_BACKEND_CUDA, integrator, frames, true);
+  const ProbesRun a = run(SPH_BACKEND_CUDA, integrator, frames, true, solver);
+  const ProbesRun b = run(SPH_BACKEND_CUDA, integrator, frames, true, solver);
   char name[160];
   const bool same = same_readings(a, b) && states_identical(a.state, b.state);
   std::snprintf(name, sizeof name, "probes/determinism/%s", label);
   report(same, name, "two GPU runs: readings and states %s", same ? "bitwise identical" : "DIFFER");
 
   context_tuning().stream_frames = true;
-  const ProbesRun s = run(SPH_BACKEND_CUDA, integrator, frames, true);
+  const ProbesRun s = run(SPH_BACKEND_CUDA, integrator, frames, true, solver);
   context_tuning().stream_frames = false;
   const bool stream_same = same_readings(a, s) && states_identical(a.state, s.state);
   std::snprintf(name, sizeof name, "probes/graph_vs_stream/%s", label);
   report(stream_same, name, "graph frame against stream driver: %s",
          stream_same ? "bitwise identical" : "DIFFERENT");
 
-  const ProbesRun off = run(SPH_BACKEND_CUDA, integrator, frames, false);
+  const ProbesRun off = run(SPH_BACKEND_CUDA, integrator, frames, false, solver);
   std::snprintf(name, sizeof name, "probes/trajectory_unchanged/%s", label);
   report(states_identical(a.state, off.state), name, "with probes against without: states %s",
          states_identical(a.state, off.state) ? "bitwise identical" : "DIFFER");
@@ -115,8 +117,8 @@ void check(sph_integrator integrator, const char* label) {
          "EVERY_SUBSTEP: %u samples of %u substeps; EVERY_FRAME: %u", a.readings[0].samples, a.substeps,
          a.readings[1].samples);
 
-  const ProbesRun gpu = run(SPH_BACKEND_CUDA, integrator, 1, true);
-  const ProbesRun cpu = run(SPH_BACKEND_CPU, integrator, 1, true);
+  const ProbesRun gpu = run(SPH_BACKEND_CUDA, integrator, 1, true, solver);
+  const ProbesRun cpu = run(SPH_BACKEND_CPU, integrator, 1, true, solver);
   const double rho0 = 1000.0, pressure_scale = rho0 * 9.81 * kColumnHeight,
                speed = std::sqrt(9.81 * kColumnHeight);
   double worst = 0.0;
@@ -140,5 +142,6 @@ int main() {
   exit_if_no_cuda();
   check(SPH_INTEGRATOR_SYMPLECTIC_EULER, "euler");
   check(SPH_INTEGRATOR_RK4, "rk4");
+  check(SPH_INTEGRATOR_SYMPLECTIC_EULER, "dfsph", SPH_SOLVER_DFSPH);
   return finish();
 }

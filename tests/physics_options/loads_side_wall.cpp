@@ -75,7 +75,7 @@ int main(int argc, char** argv) {
   if (support_world_open(&w, support_backend_from_name(backend_name, SPH_BACKEND_CPU), &def, nullptr) !=
       SPH_OK) {
     support_world_close(&w);
-    def.features &= ~SPH_FEATURE_COLLIDER_LOADS;  // DFSPH refuses the loads (issue 16/17)
+    def.features &= ~SPH_FEATURE_COLLIDER_LOADS;  // a backend that refuses the loads on DFSPH
     loads = false;
     check(support_world_open(&w, support_backend_from_name(backend_name, SPH_BACKEND_CPU), &def, nullptr),
           "support_world_open");

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '788d297e48238b9c9beeb6fa21f8b44afb427d28fe47aa383feb9151261a753a', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '3b9a6e06bfeaffabf53d4891a8df4a61643e6b88f3d787b6e6d29a88d882171a', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -233,7 +233,7 @@ sph_attribute = _c.c_int32
 SPH_ATTRIBUTE_POSITION = 0  # 3 x float32, metres
 SPH_ATTRIBUTE_VELOCITY = 1  # 3 x float32, metres per second
 SPH_ATTRIBUTE_DENSITY = 2  # float32, kg/m^3, from the last density evaluation
-SPH_ATTRIBUTE_PRESSURE = 3  # float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure its density solve found in the last substep
+SPH_ATTRIBUTE_PRESSURE = 3  # float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure both its solves applied in the last substep
 SPH_ATTRIBUTE_ID = 4  # uint32, persistent particle id, unique within a world
 SPH_ATTRIBUTE_USER = 5  # uint32, the caller's value (SPH_FEATURE_USER_ATTRIBUTE)
 SPH_ATTRIBUTE_COUNT = 6
@@ -248,8 +248,8 @@ class Attribute(_enum.IntEnum):
     VELOCITY = 1
     #: float32, kg/m^3, from the last density evaluation
     DENSITY = 2
-    #: float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure its
-    #: density solve found in the last substep
+    #: float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure both its
+    #: solves applied in the last substep
     PRESSURE = 3
     #: uint32, persistent particle id, unique within a world
     ID = 4
@@ -642,7 +642,7 @@ ENUM_MEMBER_DOCS = {
     'SPH_ATTRIBUTE_POSITION': '3 x float32, metres',
     'SPH_ATTRIBUTE_VELOCITY': '3 x float32, metres per second',
     'SPH_ATTRIBUTE_DENSITY': 'float32, kg/m^3, from the last density evaluation',
-    'SPH_ATTRIBUTE_PRESSURE': 'float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure its density solve found in the last substep',
+    'SPH_ATTRIBUTE_PRESSURE': 'float32, Pa (kg m^-1 s^-2 scaled by the EOS), same evaluation; DFSPH: the pressure both its solves applied in the last substep',
     'SPH_ATTRIBUTE_ID': 'uint32, persistent particle id, unique within a world',
     'SPH_ATTRIBUTE_USER': "uint32, the caller's value (SPH_FEATURE_USER_ATTRIBUTE)",
     'SPH_STAGE_HASH_SORT': 'cell hash, stable sort, reorder of every attribute',
@@ -1644,8 +1644,10 @@ class ColliderLoads(_SphStruct):
     the time averages over the step's substeps of the force and of the torque about the
     collider's load point, in world coordinates. What counts: the momentum the collision
     response took from particles (contacts, friction, stickiness) and, with
-    SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions; force times frame_time is the
-    impulse the fluid gave the collider. The torque of each impulse is taken about the load
+    SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions (on a DFSPH world: what both its
+    solves applied, and the impulses of its solves' contact clamp; not with
+    SPH_DFSPH_CONJUGATE_GRADIENTS, whose step is then UNSUPPORTED); force times frame_time is
+    the impulse the fluid gave the collider. The torque of each impulse is taken about the load
     point posed at the impulse's time (it moves with the collider). Zero before the first step
     (frame_time 0). docs/physics.md "Loads".
 
@@ -2313,7 +2315,7 @@ FUNCTIONS = {
     'sph_probe_def_init_sized': (sph_result, (_c.POINTER(sph_probe_def), _c.c_uint32), ('def', 'size'),
         '', 'sph'),
     'sph_probe_create': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_probe_def), _c.POINTER(sph_probe_id)), ('world', 'def', 'out_id'),
-        "Adds a probe or gauge; it is sampled inside every following sph_world_step on the world's backend (on the device for CUDA, with no host copy per substep). Errors: INVALID_HANDLE (world), INVALID_ARGUMENT (NULL def or out_id; a non-finite position or direction, a gauge's length not > 0 or too many steps, a negative sample_spacing, non-zero reserved0, each named), UNSUPPORTED (an unknown kind or sampling; a world of the DFSPH solver, whose substep does not sample probes), VERSION_MISMATCH, CAPACITY (65536 probes), WORLD_LOCKED. Nothing changes on error. Checkpoints of format 6 and later carry the probes (readings start again); restoring an older one keeps the world's own (docs/api.md).", 'sph'),
+        "Adds a probe or gauge; it is sampled inside every following sph_world_step on the world's backend (on the device for CUDA, with no host copy per substep). Errors: INVALID_HANDLE (world), INVALID_ARGUMENT (NULL def or out_id; a non-finite position or direction, a gauge's length not > 0 or too many steps, a negative sample_spacing, non-zero reserved0, each named), UNSUPPORTED (an unknown kind or sampling), VERSION_MISMATCH, CAPACITY (65536 probes), WORLD_LOCKED. On a DFSPH world the pressure sampled is the one both its solves applied in the substep (SPH_ATTRIBUTE_PRESSURE's), at the substep's start positions. Nothing changes on error. Checkpoints of format 6 and later carry the probes (readings start again); restoring an older one keeps the world's own (docs/api.md).", 'sph'),
     'sph_probe_destroy': (sph_result, (_c.POINTER(sph_world), sph_probe_id), ('world', 'id'),
         'Removes a probe; id {0} is a no-op. Errors: INVALID_HANDLE (world; stale or foreign id), WORLD_LOCKED.', 'sph'),
     'sph_probe_reading_init_sized': (sph_result, (_c.POINTER(sph_probe_reading), _c.c_uint32), ('reading', 'size'),
