@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: MIT
 // Where DFSPH's density solve by conjugate gradients (sph_dfsph_params.linear_solver =
 // SPH_DFSPH_CONJUGATE_GRADIENTS; physics/dfsph_cg.h) cannot run yet: the CUDA backend, a
-// distributed world and the walls in the density (SPH_FEATURE_BOUNDARY_DENSITY; docs/physics.md,
-// DFSPH, Limits). Refused when the parameters are set (sph_world_set_dfsph_params and
-// sph_world_set_physics_params) and when a checkpoint that carries them is loaded or restored,
-// so that the user learns of it there, with the world unchanged, instead of at the next step.
-// The backends keep their own refusal at the step for the paths that reach them otherwise (a
+// distributed world, the walls in the density (SPH_FEATURE_BOUNDARY_DENSITY) and the collider
+// loads (SPH_FEATURE_COLLIDER_LOADS; docs/physics.md, DFSPH, Limits). Refused when the parameters are set
+// (sph_world_set_dfsph_params and sph_world_set_physics_params) and when a checkpoint that carries them is
+// loaded or restored, so that the user learns of it there, with the world unchanged, instead of at the next
+// step. The backends keep their own refusal at the step for the paths that reach them otherwise (a
 // distributed world loaded from its ranks' checkpoints).
 #pragma once
 
@@ -26,7 +26,10 @@ inline void require_supported_dfsph_solver(BackendKind backend, const World& wor
   const char* where = backend == BackendKind::Cuda    ? "the CUDA backend (it runs on the CPU backend only)"
                       : world.backend().distributed() ? "a distributed world"
                       : (world.config().features & kFeatureBoundaryDensity) ? "SPH_FEATURE_BOUNDARY_DENSITY"
-                                                                            : nullptr;
+                      // Its search directions and contact holds move velocities outside the
+                      // Jacobi update the loads' sums follow (physics/collider_loads.h).
+                      : (world.config().features & kFeatureColliderLoads) ? "SPH_FEATURE_COLLIDER_LOADS"
+                                                                          : nullptr;
   if (where)
     throw Error(Status::Unsupported, std::string(field) +
                                          ": SPH_DFSPH_CONJUGATE_GRADIENTS (DFSPH's conjugate gradients "
