@@ -97,7 +97,8 @@ void test_face(void**) {
   for (float d : kDepths) {
     float sampled = 0.0f;
     const double exact = resolve(c, spec, sph::Vec3{0.004f, kHalf - d, -0.007f}, &sampled);
-    if (std::fabs(exact) > 1e-6) std::printf("face, %.3g m deep: sampled %.3g m, exact %.3g m\n", d, sampled, exact);
+    if (std::fabs(exact) > 1e-6)
+      std::printf("face, %.3g m deep: sampled %.3g m, exact %.3g m\n", d, sampled, exact);
     assert_true(std::fabs(exact) <= 1e-6);
   }
 }
