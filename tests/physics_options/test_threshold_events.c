@@ -105,6 +105,7 @@ static void expect_event(const sph_world* world, sph_event_type type, uint64_t o
 static void test_events_follow_the_readings(void** state) {
   scene s;
   double force, peak;
+  int load_fired = 0, probe_fired = 0;
   (void)state;
   scene_open(&s, SPH_FEATURE_COLLIDER_LOADS);
   settle(&s);
@@ -119,8 +120,12 @@ static void test_events_follow_the_readings(void** state) {
   expect_event(s.w.world, SPH_EVENT_COLLIDER_LOAD_EXCEEDED, s.tank.bits, force, 0.0);
   expect_event(s.w.world, SPH_EVENT_PROBE_PRESSURE_EXCEEDED, s.probe.bits, peak, 0.0);
   for (int frame = 0; frame < 6; ++frame) {
-    /* Thresholds at half, then twice the last step's reading (the next step's reading moves by
-     * far less while the column settles), then cleared. */
+    /* Thresholds at half, then twice the last step's reading, then cleared. The next step's
+     * reading mostly moves by far less while the column settles, but not always: the probe's peak
+     * over a frame, on the contacts alone near the floor, fell from 285 to 104 Pa in one frame
+     * (session 11, after a change of the collision response's push-out moved the trajectory by
+     * rounding). So at half the last reading the event must fire in at least one of the two frames
+     * for each kind (below the loop), and every frame must match its reading (expect_event). */
     const double f = frame % 3 == 0 ? 0.5 : frame % 3 == 1 ? 2.0 : 0.0;
     const float load_threshold = (float)(f * force), pressure_threshold = (float)(f * peak);
     EXPECT_OK(sph_collider_set_load_threshold(s.w.world, s.tank, load_threshold));
@@ -132,10 +137,11 @@ static void test_events_follow_the_readings(void** state) {
     expect_event(s.w.world, SPH_EVENT_PROBE_PRESSURE_EXCEEDED, s.probe.bits, peak, pressure_threshold);
     if (f == 0.5) {
       uint32_t count = 0;
-      assert_int_equal(count_events(s.w.world, SPH_EVENT_COLLIDER_LOAD_EXCEEDED, s.tank.bits, &count), 1);
-      assert_int_equal(count_events(s.w.world, SPH_EVENT_PROBE_PRESSURE_EXCEEDED, s.probe.bits, &count), 1);
+      load_fired += (int)count_events(s.w.world, SPH_EVENT_COLLIDER_LOAD_EXCEEDED, s.tank.bits, &count);
+      probe_fired += (int)count_events(s.w.world, SPH_EVENT_PROBE_PRESSURE_EXCEEDED, s.probe.bits, &count);
     }
   }
+  assert_true(load_fired >= 1 && probe_fired >= 1);
   scene_close(&s);
 }
 
