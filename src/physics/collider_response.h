@@ -67,6 +67,58 @@ SPH_HD Vec3 collider_velocity(const ColliderView& c, const ColliderSample& s, Ve
   return v;
 }
 
+// The push-out's search (push_out): after the first step, the step jumps to at least a 64th of a
+// voxel and doubles (10 times reach 8 voxels; the flat cell is one voxel deep), then 16 halvings
+// of the bracket end within 1/65536 of it (a face's float rounding, the usual reason for a search
+// there, brackets the push's depth: 2 mm gives 3e-8 m).
+constexpr int kPushOutDoublings = 10;
+constexpr float kPushOutFirstJump = 1.0f / 64.0f;  // of the smallest voxel
+constexpr int kPushOutHalvings = 16;
+
+// Moves a particle that lies inside the solid (now.distance < 0) out along the field's normal to
+// its zero level; now becomes the sample there. One step of -distance is exact where the field is
+// a distance (unit gradient), but inside a solid's edge the trilinear field is flat (in the edge's
+// cell of a box whose faces lie on samples it is -voxel (1 - fx) (1 - fy): the product of the
+// depths below both faces over a voxel, far less than either depth). That step then left the
+// particle inside; the next substep it started inside, so the path's contact was skipped and it
+// was pushed out by as little again: it stayed caught in the solid (docs/validation.md, "The
+// submerged box: particles caught inside its edges"). So while the particle is still inside, the
+// step grows, and the last bracket [inside, outside] is bisected keeping the outside end: the
+// particle ends on the zero level or just outside it. Where the first step leaves the solid (a
+// flat face, the usual case) nothing changes; where the search finds no outside (a zero normal)
+// the particle is left where the first step put it, as before.
+SPH_HD Vec3 push_out(const ColliderView& c, const SubstepTime& t, Vec3 x, ColliderSample& now) {
+  const Vec3 n = collider_normal(c, now);
+  float inside = 0.0f, outside = -now.distance;
+  Vec3 y = x + n * outside;
+  ColliderSample out = sample_collider(c, y, t.s1, t.tau1);
+  for (int k = 0; k < kPushOutDoublings && out.distance < 0.0f; ++k) {
+    inside = outside;
+    outside = SPH_FMAXF(2.0f * outside, kPushOutFirstJump * c.sdf.min_voxel_size);
+    y = x + n * outside;
+    out = sample_collider(c, y, t.s1, t.tau1);
+  }
+  if (out.distance < 0.0f) {
+    y = x + n * -now.distance;
+    now = sample_collider(c, y, t.s1, t.tau1);
+    return y;
+  }
+  for (int k = 0; k < kPushOutHalvings && inside > 0.0f; ++k) {
+    const float mid = 0.5f * (inside + outside);
+    const Vec3 ym = x + n * mid;
+    const ColliderSample s = sample_collider(c, ym, t.s1, t.tau1);
+    if (s.distance < 0.0f) {
+      inside = mid;
+    } else {
+      outside = mid;
+      y = ym;
+      out = s;
+    }
+  }
+  now = out;
+  return y;
+}
+
 // Resolves one particle after integration moved it from x_old to x (velocity v) during the
 // substep. Returns true if it touched the collider.
 SPH_HD bool collide_particle(const ColliderView& c, const SubstepTime& t, float kernel_radius, Vec3 x_old,
@@ -91,11 +143,7 @@ SPH_HD bool collide_particle(const ColliderView& c, const SubstepTime& t, float 
     x = contact + (rest - n * dot(rest, n));
     now = sample_collider(c, x, t.s1, t.tau1);
   }
-  if (now.distance < 0.0f) {
-    // The object moved into the particle (or the slide ended inside): out along the gradient.
-    x = x - collider_normal(c, now) * now.distance;
-    now = sample_collider(c, x, t.s1, t.tau1);
-  }
+  if (now.distance < 0.0f) x = push_out(c, t, x, now);  // the object moved into it, or the slide ended inside
   const Vec3 n = collider_normal(c, now);
   const Vec3 vc = collider_velocity(c, now, x);
   const Vec3 rel = v - vc;

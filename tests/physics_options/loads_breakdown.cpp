@@ -38,8 +38,9 @@
 // defaults to SPH_TEST_BACKEND's, so the GPU test script runs it on CUDA). A particle's region is the set of
 // the box's axes it lies beyond at the substep's start: one axis a face (top, bottom, sides), two an edge
 // (top, bottom, vertical), three a corner (top, bottom), none "inside the box" (particles the collision
-// response holds on the SDF's zero level where the trilinear SDF rounds an edge). With the loads,
-// the contacts are the loads less the walls' reaction over the same substeps; "contacts" per region
+// response left caught inside an edge, where the trilinear SDF is flat; none since its push-out
+// reaches the surface, docs/validation.md "The submerged box: particles caught inside its edges"). With the
+// loads, the contacts are the loads less the walls' reaction over the same substeps; "contacts" per region
 // counts the particles that end a substep on or in the box's surface (those the response touched).
 // Momentum balance: the fluid's dP/dt = M g less the colliders' forces, so with the tank's walls'
 // reaction also summed on the host (its map computed here too), M g - dP/dt - both walls' reactions
