@@ -2,6 +2,7 @@
 #include "capi_test.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -165,4 +166,25 @@ void capi_expect_same_particles(const sph_world* a, const sph_world* b) {
     free(x);
     free(y);
   }
+}
+
+int capi_run_named_cases(const char* group, const struct CMUnitTest* tests, size_t count, int argc,
+                         char** argv) {
+  struct CMUnitTest chosen[64];
+  size_t n = 0, i;
+  if (argc < 2) return _cmocka_run_group_tests(group, tests, count, NULL, NULL);
+  if ((size_t)(argc - 1) > count || (size_t)(argc - 1) > sizeof chosen / sizeof chosen[0]) {
+    fprintf(stderr, "%s: at most %zu case names\n", group, count);
+    return 2;
+  }
+  for (int arg = 1; arg < argc; ++arg) {
+    for (i = 0; i < count; ++i)
+      if (strcmp(argv[arg], tests[i].name) == 0) break;
+    if (i == count) {
+      fprintf(stderr, "%s: no case named '%s'\n", group, argv[arg]);
+      return 2;
+    }
+    chosen[n++] = tests[i];
+  }
+  return _cmocka_run_group_tests(group, chosen, n, NULL, NULL);
 }

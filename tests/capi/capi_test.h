@@ -71,4 +71,11 @@ sph_world* capi_world_copy(sph_context* context, const sph_world* world);
  * left out: it needs SPH_FEATURE_USER_ATTRIBUTE). */
 void capi_expect_same_particles(const sph_world* a, const sph_world* b);
 
+/* ---- running some of a file's cases ---------------------------------------------------------- */
+/* Runs the cases of `tests` named in argv[1..] in that order, or all of them without names (a
+ * ctest per group of cases, e.g. so that the sanitizer stage can leave out the long settling
+ * runs). An unknown name, or more names than cases, prints why and returns 2. */
+int capi_run_named_cases(const char* group, const struct CMUnitTest* tests, size_t count, int argc,
+                         char** argv);
+
 #endif /* SPH_CAPI_TEST_H */

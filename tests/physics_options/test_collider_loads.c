@@ -610,24 +610,7 @@ int main(int argc, char** argv) {
       cmocka_unit_test(test_submerged_box_buoyancy),
       cmocka_unit_test(test_floating_box),
   };
-  /* With names, only those cases, in this order (the ctests split the cases so that the tanks'
-   * long settling runs can be left out of the sanitizer stage, scripts/test); without, all. */
-  struct CMUnitTest chosen[sizeof tests / sizeof tests[0]];
-  size_t count = 0, i;
-  int arg;
-  if (argc > (int)(sizeof tests / sizeof tests[0]) + 1) {
-    fprintf(stderr, "physics_collider_loads: at most %zu case names\n", sizeof tests / sizeof tests[0]);
-    return 2;
-  }
-  for (arg = 1; arg < argc; ++arg) {
-    for (i = 0; i < sizeof tests / sizeof tests[0]; ++i)
-      if (strcmp(argv[arg], tests[i].name) == 0) break;
-    if (i == sizeof tests / sizeof tests[0]) {
-      fprintf(stderr, "physics_collider_loads: no case named '%s'\n", argv[arg]);
-      return 2;
-    }
-    chosen[count++] = tests[i];
-  }
-  if (count > 0) return _cmocka_run_group_tests("collider_loads", chosen, count, NULL, NULL);
-  return cmocka_run_group_tests_name("collider_loads", tests, NULL, NULL);
+  /* With names, only those cases (the ctests split them so that the tanks' long settling runs
+   * can be left out of the sanitizer stage, scripts/test); without, all. */
+  return capi_run_named_cases("collider_loads", tests, sizeof tests / sizeof tests[0], argc, argv);
 }
