@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: MIT
 // The hydrostatic side wall of test_collider_loads.c (water of 10 x 14 x 10 lattice layers of 1 cm
 // at rest in a tank whose face at x = 0 is a plane collider of its own; walls in the density) on
-// either backend and either solver, the force measured without the loads feature, so that DFSPH,
-// whose worlds refuse SPH_FEATURE_COLLIDER_LOADS, can be measured too (issue 17 item 5;
-// docs/validation.md, "The submerged box per region").
+// either backend and either solver, the force summed on the host beside the loads feature (it
+// was written when DFSPH worlds refused SPH_FEATURE_COLLIDER_LOADS; a world that refuses them
+// is still measured without) (issue 17 item 5; docs/validation.md, "The submerged box per
+// region").
 //
 //   physics_loads_side_wall [--backend cpu|cuda] [--solver wcsph|dfsph]
 //
@@ -75,7 +76,7 @@ int main(int argc, char** argv) {
   if (support_world_open(&w, support_backend_from_name(backend_name, SPH_BACKEND_CPU), &def, nullptr) !=
       SPH_OK) {
     support_world_close(&w);
-    def.features &= ~SPH_FEATURE_COLLIDER_LOADS;  // a backend that refuses the loads on DFSPH
+    def.features &= ~SPH_FEATURE_COLLIDER_LOADS;  // a world that refuses the loads
     loads = false;
     check(support_world_open(&w, support_backend_from_name(backend_name, SPH_BACKEND_CPU), &def, nullptr),
           "support_world_open");
