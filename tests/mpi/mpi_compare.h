@@ -151,22 +151,17 @@ static inline void expect_same_particles(sph_world* single, sph_world* world, co
     float* want_x = NULL;
     float* want_v = NULL;
     uint32_t* want_id = NULL;
-    uint32_t differ = 0;
+    uint32_t differ, common;
     double worst = 0.0;
     const uint32_t m = read_in_id_order(single, &want_id, &want_x, &want_v);
     CHECK(gathered == n && m == n, "%s: gathered %llu, the world holds %u, the undivided world %u", name,
           (unsigned long long)gathered, n, m);
-    for (uint32_t i = 0; i < n && i < gathered && i < m; ++i) {
+    common = n < m ? n : m;
+    if (gathered < common) common = (uint32_t)gathered;
+    for (uint32_t i = 0; i < common; ++i)
       CHECK(got_id[i] == want_id[i], "%s: id %u at %u, the undivided world's %u", name, got_id[i], i,
             want_id[i]);
-      if (memcmp(got_x + 3 * i, want_x + 3 * i, 12) != 0 || memcmp(got_v + 3 * i, want_v + 3 * i, 12) != 0) {
-        ++differ;
-        for (int k = 0; k < 3; ++k) {
-          const double d = fabs((double)got_x[3 * i + k] - want_x[3 * i + k]);
-          if (d > worst) worst = d;
-        }
-      }
-    }
+    differ = mpi_differ(got_x, got_v, want_x, want_v, common, &worst);
     CHECK(differ == 0,
           "%s on %d ranks: %u of %u particles differ from the undivided world (worst position %g m)", name,
           g_size, differ, n, worst);

@@ -116,13 +116,6 @@ void mpi_test_read(sph_world* single, uint32_t n, float** x, float** v) {
   REQUIRE(support_copy_by_id(single, SPH_ATTRIBUTE_VELOCITY, (void**)v, &m) == SPH_OK && m == n, "read");
 }
 
-uint32_t mpi_test_differ(const float* x0, const float* v0, const float* x1, const float* v1, uint32_t n) {
-  uint32_t differ = 0;
-  for (uint32_t i = 0; i < n; ++i)
-    if (memcmp(x0 + 3 * i, x1 + 3 * i, 12) != 0 || memcmp(v0 + 3 * i, v1 + 3 * i, 12) != 0) ++differ;
-  return differ;
-}
-
 /* Little-endian reads of the manifest (docs/checkpoint.md, "Distributed worlds"). */
 static uint32_t manifest_u32(const unsigned char* p) {
   return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;

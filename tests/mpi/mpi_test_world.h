@@ -47,8 +47,6 @@ void mpi_test_read(sph_world* single, uint32_t n, float** x, float** v);
 /* The path of rank `rank`'s file named in the manifest at `manifest` (in its directory; the
  * names carry the file's hash, sph_mpi.h): 1, or 0 if the manifest cannot be read as one. */
 int mpi_test_rank_file(const char* manifest, int rank, char* out, size_t size);
-/* Particles whose position or velocity differ in any bit. */
-uint32_t mpi_test_differ(const float* x0, const float* v0, const float* x1, const float* v1, uint32_t n);
 
 #ifdef __cplusplus
 }

@@ -69,7 +69,7 @@ static void expect_failed_restore(sph_world* world, uint32_t n, const char* path
   }
   mpi_test_gather(world, n, &x1, &v1);
   counts_of(world, &after);
-  CHECK(g_rank != 0 || mpi_test_differ(x0, v0, x1, v1, n) == 0, "%s: the world changed", what);
+  CHECK(g_rank != 0 || mpi_differ(x0, v0, x1, v1, n, NULL) == 0, "%s: the world changed", what);
   CHECK(before.local_count == after.local_count && before.rebalances == after.rebalances &&
             before.migrated == after.migrated && before.slab_first == after.slab_first,
         "%s: the counts changed", what);
@@ -125,8 +125,8 @@ int main(int argc, char** argv) {
   mpi_test_step(loaded, M_SUBSTEPS, 1);
   mpi_test_gather(loaded, n, &cx, &cv);
   if (g_rank == 0) {
-    const uint32_t restored_differ = mpi_test_differ(ax, av, bx, bv, n);
-    const uint32_t loaded_differ = mpi_test_differ(ax, av, cx, cv, n);
+    const uint32_t restored_differ = mpi_differ(ax, av, bx, bv, n, NULL);
+    const uint32_t loaded_differ = mpi_differ(ax, av, cx, cv, n, NULL);
     CHECK(restored_differ == 0, "restored and stepped %u substeps: %u of %u particles differ", M_SUBSTEPS,
           restored_differ, n);
     CHECK(loaded_differ == 0, "loaded and stepped %u substeps: %u of %u particles differ", M_SUBSTEPS,

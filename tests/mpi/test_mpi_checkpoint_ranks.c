@@ -58,7 +58,7 @@ static void expect_reference(sph_world* world, MPI_Comm comm, uint32_t n, const 
   mpi_test_step(world, M_SUBSTEPS, 1);
   mpi_test_gather_on(world, comm, n, &x, &v);
   if (rank == 0) {
-    const uint32_t differ = mpi_test_differ(rx, rv, x, v, n);
+    const uint32_t differ = mpi_differ(rx, rv, x, v, n, NULL);
     CHECK(differ == 0, "%s: %u of %u particles differ from the undivided world", what, differ, n);
     printf("%s, %u more substeps: %u of %u particles differ from the undivided world\n", what, M_SUBSTEPS,
            differ, n);

@@ -214,21 +214,14 @@ static void run_scene(sph_context* context, const char* name, float stir_speed, 
     float* want_x = NULL;
     float* want_v = NULL;
     uint32_t m = 0;
-    uint32_t differ = 0;
+    uint32_t differ;
     double worst = 0.0;
+    const uint32_t common = gathered < n ? (uint32_t)gathered : n;
     CHECK(gathered == n, "gathered %llu of %u", (unsigned long long)gathered, n);
     REQUIRE(support_copy_by_id(single, SPH_ATTRIBUTE_POSITION, (void**)&want_x, &m) == SPH_OK, "read");
     REQUIRE(support_copy_by_id(single, SPH_ATTRIBUTE_VELOCITY, (void**)&want_v, &m) == SPH_OK, "read");
-    for (uint32_t i = 0; i < n && i < gathered; ++i) {
-      CHECK(got_id[i] == i, "id %u at %u: each id once", got_id[i], i);
-      if (memcmp(got_x + 3 * i, want_x + 3 * i, 12) != 0 || memcmp(got_v + 3 * i, want_v + 3 * i, 12) != 0) {
-        ++differ;
-        for (int k = 0; k < 3; ++k) {
-          const double d = fabs((double)got_x[3 * i + k] - want_x[3 * i + k]);
-          if (d > worst) worst = d;
-        }
-      }
-    }
+    for (uint32_t i = 0; i < common; ++i) CHECK(got_id[i] == i, "id %u at %u: each id once", got_id[i], i);
+    differ = mpi_differ(got_x, got_v, want_x, want_v, common, &worst);
     CHECK(differ == 0,
           "%s on %d ranks: %u of %u particles differ from the undivided world (worst position %g m)", name,
           g_size, differ, n, worst);

@@ -82,7 +82,7 @@ void allocation_failures(sph_context* context) {
     CHECK(g_rank != victim || injected, "the step failed (%d) without an injected failure", (int)r);
     check_rank_named(victim, "an allocation failure");
     mpi_test_gather(world, n, &x1, &v1);
-    CHECK(g_rank != 0 || mpi_test_differ(x0, v0, x1, v1, n) == 0, "allocation %ld: the world changed", k);
+    CHECK(g_rank != 0 || mpi_differ(x0, v0, x1, v1, n, nullptr) == 0, "allocation %ld: the world changed", k);
     free(x0);
     free(v0);
     free(x1);
@@ -94,7 +94,7 @@ void allocation_failures(sph_context* context) {
     mpi_test_gather(world, n, &x0, &v0);
     mpi_test_gather(undisturbed, n, &x1, &v1);
     if (g_rank == 0) {
-      const uint32_t differ = mpi_test_differ(x0, v0, x1, v1, n);
+      const uint32_t differ = mpi_differ(x0, v0, x1, v1, n, nullptr);
       CHECK(differ == 0, "after the failures, %u of %u particles differ from the undisturbed world", differ,
             n);
       printf(
@@ -138,7 +138,7 @@ void crowded_cell(sph_context* context) {
   CHECK(strstr(sph_get_last_error(), "particles share one cell") != NULL, "the message: %s",
         sph_get_last_error());
   mpi_test_gather(world, n, &x1, &v1);
-  CHECK(g_rank != 0 || mpi_test_differ(x0, v0, x1, v1, n) == 0, "a crowded cell: the world changed");
+  CHECK(g_rank != 0 || mpi_differ(x0, v0, x1, v1, n, nullptr) == 0, "a crowded cell: the world changed");
   REQUIRE(sph_mpi_counts_init(&counts) == SPH_OK && sph_mpi_world_get_counts(world, &counts) == SPH_OK,
           "counts");
   CHECK(counts.global_count == n, "%llu particles after a refused step, %u before",

@@ -70,7 +70,7 @@ int main(int argc, char** argv) {
     CHECK(got == n, "gathered %llu of %u", (unsigned long long)got, n);
     for (uint32_t i = 0; i < n; ++i) CHECK(ids[i] == i, "id %u at %u: each id once", ids[i], i);
     mpi_test_read(single, n, &want_x, &want_v);
-    differ = mpi_test_differ(x, v, want_x, want_v, n);
+    differ = mpi_differ(x, v, want_x, want_v, n, NULL);
     CHECK(differ == 0, "on %d ranks after %u substeps: %u of %u particles differ from the undivided world",
           g_size, FRAMES * FRAME_SUBSTEPS, differ, n);
     printf(
