@@ -97,7 +97,11 @@ static void dam_break_pressure(uint32_t features, const char* name, int check_pl
   const double length = kTankLength * kHeight - film; /* the far wall from the lattice's origin */
   const double tank_min[3] = {-film, -film, -film}, tank_max[3] = {length, 3.0 * kHeight, 4.0 * step + film};
   const double time_scale = sqrt(kHeight / kGravity), pressure_scale = 1000.0 * kGravity * kHeight;
-  const double frame = 0.02 * time_scale, end = 5.0;
+  /* The impact-only cases stop at t* = 3.2, after the latest impact their bound admits (1.15 x
+   * 2.478 = 2.85); the plateau's window ends at 4.5, so the whole cases, measuring runs and
+   * scripts/validate's series (SPH_VALIDATION_OUT) go on to 5. */
+  const int whole = check_plateau || measuring() || getenv("SPH_VALIDATION_OUT") != NULL;
+  const double frame = 0.02 * time_scale, end = whole ? 5.0 : 3.2;
   static double sim_t[MAX_FRAMES], sim_p[MAX_FRAMES], data_t[MAX_POINTS], data_p[MAX_POINTS];
   float* lattice = NULL;
   uint32_t n = 0;
@@ -165,10 +169,14 @@ static void dam_break_pressure(uint32_t features, const char* name, int check_pl
     double peak = 0.0;
     for (int i = 0; i < frames; ++i) peak = fmax(peak, sim_p[i]);
     print_message(
-        "dam break pressure (%s, %u particles, H = %u steps): impact t* = %.3f (Buchner %.3f, %+.1f %%), "
-        "plateau p* = %.3f (Buchner %.3f, %+.1f %%), peak of the frames' means %.3f\n",
-        name, n, across, t_sim, t_data, 100.0 * (t_sim / t_data - 1.0), plateau_sim, plateau_data,
-        100.0 * (plateau_sim / plateau_data - 1.0), peak);
+        "dam break pressure (%s, %u particles, H = %u steps): impact t* = %.3f (Buchner %.3f, %+.1f %%), ",
+        name, n, across, t_sim, t_data, 100.0 * (t_sim / t_data - 1.0));
+    if (end >= 4.5)
+      print_message("plateau p* = %.3f (Buchner %.3f, %+.1f %%), ", plateau_sim, plateau_data,
+                    100.0 * (plateau_sim / plateau_data - 1.0));
+    else
+      print_message("plateau not run (t* <= %.1f), ", end);
+    print_message("peak of the frames' means %.3f\n", peak);
   }
   {
     FILE* out =
