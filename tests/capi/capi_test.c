@@ -188,3 +188,20 @@ int capi_run_named_cases(const char* group, const struct CMUnitTest* tests, size
   }
   return _cmocka_run_group_tests(group, chosen, n, NULL, NULL);
 }
+
+sph_collider_loads capi_loads_of(const sph_world* world, sph_collider_id id) {
+  sph_collider_loads l;
+  EXPECT_OK(sph_collider_loads_init(&l));
+  EXPECT_OK(sph_collider_get_loads(world, id, &l));
+  return l;
+}
+
+void capi_fluid_momentum(const sph_world* world, float mass, double p[3]) {
+  float* v = NULL;
+  uint32_t n = 0;
+  EXPECT_OK(support_copy(world, SPH_ATTRIBUTE_VELOCITY, (void**)&v, &n));
+  p[0] = p[1] = p[2] = 0.0;
+  for (uint32_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) p[k] += (double)mass * v[3 * i + k];
+  free(v);
+}

@@ -71,6 +71,12 @@ sph_world* capi_world_copy(sph_context* context, const sph_world* world);
  * left out: it needs SPH_FEATURE_USER_ATTRIBUTE). */
 void capi_expect_same_particles(const sph_world* a, const sph_world* b);
 
+/* ---- loads ------------------------------------------------------------------------------------ */
+/* A collider's loads of the last step (sph_collider_get_loads, checked). */
+sph_collider_loads capi_loads_of(const sph_world* world, sph_collider_id id);
+/* The fluid's momentum, sum m v over the particles of mass `mass`, in double. */
+void capi_fluid_momentum(const sph_world* world, float mass, double p[3]);
+
 /* ---- running some of a file's cases ---------------------------------------------------------- */
 /* Runs the cases of `tests` named in argv[1..] in that order, or all of them without names (a
  * ctest per group of cases, e.g. so that the sanitizer stage can leave out the long settling

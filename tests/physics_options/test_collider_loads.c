@@ -50,24 +50,6 @@ static sph_world_def loads_def(uint32_t features, uint32_t capacity, sph_integra
   return def;
 }
 
-static sph_collider_loads loads_of(const sph_world* world, sph_collider_id id) {
-  sph_collider_loads l;
-  EXPECT_OK(sph_collider_loads_init(&l));
-  EXPECT_OK(sph_collider_get_loads(world, id, &l));
-  return l;
-}
-
-/* sum m v over the particles, in double. */
-static void fluid_momentum(const sph_world* world, float mass, double p[3]) {
-  float* v = NULL;
-  uint32_t n = 0;
-  EXPECT_OK(support_copy(world, SPH_ATTRIBUTE_VELOCITY, (void**)&v, &n));
-  p[0] = p[1] = p[2] = 0.0;
-  for (uint32_t i = 0; i < n; ++i)
-    for (int k = 0; k < 3; ++k) p[k] += (double)mass * v[3 * i + k];
-  free(v);
-}
-
 /* A plane collider whose solid is {x : u . x > offset} (the plane shape's solid y < 0, turned so
  * that its +y is -u; u an axis here). */
 static sph_collider_id add_axis_wall(support_world* w, int axis, double sign, double offset, sph_sdf** out) {
@@ -115,17 +97,17 @@ static void momentum_balance(uint32_t features, sph_integrator integrator) {
   EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
   EXPECT_OK(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * kStep, 0.0f, &sdf, &tank));
   EXPECT_OK(support_spawn(w.world, lattice, NULL, n));
-  fluid_momentum(w.world, w.mass, p0);
+  capi_fluid_momentum(w.world, w.mass, p0);
   for (int frame = 0; frame < 15; ++frame) {
     sph_collider_loads l;
     EXPECT_OK(sph_world_step(w.world, 0.02f));
-    l = loads_of(w.world, tank);
+    l = capi_loads_of(w.world, tank);
     impulse[0] += l.force.x * l.frame_time;
     impulse[1] += l.force.y * l.frame_time;
     impulse[2] += l.force.z * l.frame_time;
     time += l.frame_time;
   }
-  fluid_momentum(w.world, w.mass, p1);
+  capi_fluid_momentum(w.world, w.mass, p1);
   {
     const double weight_impulse = (double)n * w.mass * -kGravity * time;
     const double residual[3] = {p1[0] - p0[0] + impulse[0], p1[1] - p0[1] + impulse[1] - weight_impulse,
@@ -258,7 +240,7 @@ static side_wall_result side_wall_force(uint32_t features, double step) {
     EXPECT_OK(sph_world_step(w.world, 0.02f));
     if (frame < 40) continue;
     {
-      const sph_collider_loads l = loads_of(w.world, wall);
+      const sph_collider_loads l = capi_loads_of(w.world, wall);
       sph_probe_reading r;
       EXPECT_OK(sph_probe_reading_init(&r));
       EXPECT_OK(sph_probe_get_reading(w.world, gauge, &r));
@@ -359,7 +341,7 @@ static double submerged_box_force(uint32_t features, double* expected) {
     EXPECT_OK(sph_world_step(w.world, 0.02f));
     if (frame < 40) continue;
     {
-      const sph_collider_loads l = loads_of(w.world, box);
+      const sph_collider_loads l = capi_loads_of(w.world, box);
       sum[0] += l.force.x * l.frame_time;
       sum[1] += l.force.y * l.frame_time;
       sum[2] += l.force.z * l.frame_time;
@@ -540,7 +522,7 @@ static void test_loads_api(void** state) {
   def.features = SPH_FEATURE_COLLIDER_LOADS;
   EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
   EXPECT_OK(support_tank_between(w.context, w.world, lo, hi, 0.01, 0.0f, &sdf, &tank));
-  l = loads_of(w.world, tank);
+  l = capi_loads_of(w.world, tank);
   assert_true(l.frame_time == 0.0 && l.force.x == 0.0f && l.force.y == 0.0f && l.torque.z == 0.0f);
   EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "out", sph_collider_get_loads(w.world, tank, NULL));
   EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "point", sph_collider_set_load_point(w.world, tank, NULL));
@@ -560,7 +542,7 @@ static void test_loads_api(void** state) {
     free(lattice);
     EXPECT_OK(sph_collider_set_load_point(w.world, tank, &point));
     for (int frame = 0; frame < 2; ++frame) EXPECT_OK(sph_world_step(w.world, 0.02f));
-    l = loads_of(w.world, tank);
+    l = capi_loads_of(w.world, tank);
     assert_true(fabs(l.point.x - 0.10f) < 1e-6f && fabs(l.point.y - 0.05f) < 1e-6f);
     assert_true(l.frame_time > 0.0199 && l.frame_time < 0.0201);
     /* Torque about the point: the fluid presses down around x = 0.05, 0.05 to -x of the point. */
@@ -586,8 +568,8 @@ static void test_loads_api(void** state) {
       free(saved);
       EXPECT_OK(sph_world_step(w.world, 0.02f));
       EXPECT_OK(sph_world_step(copy, 0.02f));
-      a = loads_of(w.world, tank);
-      b = loads_of(copy, tank);
+      a = capi_loads_of(w.world, tank);
+      b = capi_loads_of(copy, tank);
       assert_true(fabs(b.point.x - 0.10f) < 1e-6f);
       assert_memory_equal(&a.force, &b.force, sizeof a.force);
       assert_memory_equal(&a.torque, &b.torque, sizeof a.torque);

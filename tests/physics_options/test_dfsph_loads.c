@@ -46,24 +46,6 @@ static sph_world_def dfsph_def(uint32_t features, uint32_t capacity) {
   return def;
 }
 
-static sph_collider_loads loads_of(const sph_world* world, sph_collider_id id) {
-  sph_collider_loads l;
-  EXPECT_OK(sph_collider_loads_init(&l));
-  EXPECT_OK(sph_collider_get_loads(world, id, &l));
-  return l;
-}
-
-/* sum m v over the particles, in double. */
-static void fluid_momentum(const sph_world* world, float mass, double p[3]) {
-  float* v = NULL;
-  uint32_t n = 0;
-  EXPECT_OK(support_copy(world, SPH_ATTRIBUTE_VELOCITY, (void**)&v, &n));
-  p[0] = p[1] = p[2] = 0.0;
-  for (uint32_t i = 0; i < n; ++i)
-    for (int k = 0; k < 3; ++k) p[k] += (double)mass * v[3 * i + k];
-  free(v);
-}
-
 /* ---- momentum balance ------------------------------------------------------------------------ */
 
 /* A column 6 x 14 x 8 layers collapsing in a tank 16 x 30 x 8 layers for 0.3 s (the fluid hits the
@@ -85,17 +67,17 @@ static void momentum_balance(uint32_t features) {
   EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
   EXPECT_OK(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * kStep, 0.0f, &sdf, &tank));
   EXPECT_OK(support_spawn(w.world, lattice, NULL, n));
-  fluid_momentum(w.world, w.mass, p0);
+  capi_fluid_momentum(w.world, w.mass, p0);
   for (int frame = 0; frame < 15; ++frame) {
     sph_collider_loads l;
     EXPECT_OK(sph_world_step(w.world, 0.02f));
-    l = loads_of(w.world, tank);
+    l = capi_loads_of(w.world, tank);
     impulse[0] += l.force.x * l.frame_time;
     impulse[1] += l.force.y * l.frame_time;
     impulse[2] += l.force.z * l.frame_time;
     time += l.frame_time;
   }
-  fluid_momentum(w.world, w.mass, p1);
+  capi_fluid_momentum(w.world, w.mass, p1);
   {
     const double weight_impulse = (double)n * w.mass * -kGravity * time;
     const double residual[3] = {p1[0] - p0[0] + impulse[0], p1[1] - p0[1] + impulse[1] - weight_impulse,
@@ -174,7 +156,7 @@ static void test_submerged_box_buoyancy(void** state) {
     EXPECT_OK(sph_world_step(w.world, 0.02f));
     if (frame < 40) continue;
     {
-      const sph_collider_loads l = loads_of(w.world, box);
+      const sph_collider_loads l = capi_loads_of(w.world, box);
       sum[0] += l.force.x * l.frame_time;
       sum[1] += l.force.y * l.frame_time;
       sum[2] += l.force.z * l.frame_time;
@@ -336,8 +318,8 @@ static void test_checkpoint_carries_probes(void** state) {
   EXPECT_OK(sph_world_step(loaded, 0.02f));
   a = reading_of(w.world, probe);
   b = reading_of(loaded, probe);
-  la = loads_of(w.world, tank);
-  lb = loads_of(loaded, tank);
+  la = capi_loads_of(w.world, tank);
+  lb = capi_loads_of(loaded, tank);
   assert_true(a.samples > 0 && a.pressure > 0.0f);
   assert_true(a.samples == b.samples && a.density == b.density && a.pressure == b.pressure &&
               a.velocity.y == b.velocity.y && a.time == b.time);
