@@ -59,13 +59,6 @@ __global__ void end_substep_kernel(FrameState* s, StepLimits limits, uint32_t ma
   // As the CPU backend: symplectic Euler keeps the force pass's |a|max even when the substep
   // then fails; RK4 keeps the max over its four stages only when all of them succeeded.
   if (stages == 1) s->max_acceleration = sqrtf(a2max);
-  if (s->crowded_key != 0) {
-    // The walks of this substep saw an emptied table (enqueue_reorder); the frame is refused.
-    // non_finite stops the stream driver's sinks as for a failed substep.
-    s->non_finite = 1;
-    set_run(s, 0, cond);
-    return;
-  }
   for (int k = 0; k < stages; ++k) {
     if (s->bad_key[k] != kNoBadParticle) {
       s->non_finite = 1;
@@ -77,6 +70,17 @@ __global__ void end_substep_kernel(FrameState* s, StepLimits limits, uint32_t ma
       set_run(s, 0, cond);
       return;
     }
+  }
+  // After the non-finite check: a NaN position of one RK4 stage hashes into one cell with every
+  // other NaN at the next stage's sort, and the cause to report is the NaN. A pile crowded from
+  // the start leaves every value finite (an emptied table gives each particle its self density).
+  if (s->crowded_key != 0) {
+    // The walks of this substep saw an emptied table (enqueue_reorder); the frame is refused.
+    // non_finite stops the stream driver's sinks as for a failed substep; bad_substep stays 0,
+    // which is how the host tells the two apart (frame_loop.cu).
+    s->non_finite = 1;
+    set_run(s, 0, cond);
+    return;
   }
   s->max_speed = sqrtf(v2max);
   if (stages != 1) s->max_acceleration = sqrtf(a2max);

@@ -153,7 +153,9 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
   // A non-finite particle first: its NaN position hashes into one cell with every other NaN,
   // so a frame that went non-finite can also report that cell as crowded (RK4's next stage
   // sorts the NaN positions), and the cause is the non-finite value, as the CPU reports it.
-  if (s.non_finite) {
+  // A crowded cell alone also raises non_finite (to stop the sinks) but records no bad
+  // particle: bad_substep stays 0 (end_substep_kernel, frame_control.cu).
+  if (s.non_finite && s.bad_substep != 0) {
     roll_back_frame();
     NonFiniteFailure failure;
     failure.stage = s.bad_stage;
