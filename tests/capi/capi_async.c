@@ -44,13 +44,23 @@ void capi_poll_until_done(const sph_world* world) {
   assert_int_equal(done, 1);
 }
 
-void capi_set_short_substeps(sph_world* world) {
+void capi_begin_long_frame_and_expect_held(sph_context* context, sph_world* world) {
+  const float frame_dt = 1.0f / 60.0f;
   sph_world_params params;
+  uint32_t count = 0;
   sph_world_params_init(&params);
   EXPECT_OK(sph_world_get_params(world, &params));
   params.dt_min = params.dt_max = 1e-4f;
   params.max_substeps = 10000;
   EXPECT_OK(sph_world_set_params(world, &params));
+
+  EXPECT_OK(sph_world_step_begin(world, 0.5f));
+  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_step(world, frame_dt));
+  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_step_begin(world, frame_dt));
+  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_get_particle_count(world, &count));
+  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_set_params(world, &params));
+  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_destroy(world));
+  EXPECT_ERROR(SPH_ERROR_BUSY, "context", sph_context_destroy(context));
 }
 
 void capi_expect_cancelled_frame(sph_world* world, const char* what) {

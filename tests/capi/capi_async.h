@@ -19,11 +19,14 @@ sph_world* capi_falling_block(sph_context* context, uint32_t capacity, float sid
 /* Polls until the pending step is done (at most about 60 s); poll never runs the step. */
 void capi_poll_until_done(const sph_world* world);
 
-/* Gives a world many short substeps (dt_min = dt_max = 1e-4 s, up to 10,000 a frame), so that a
- * begun frame of 0.5 s is likely still running while the test calls into the world. */
-void capi_set_short_substeps(sph_world* world);
+/* Gives the world many short substeps (dt_min = dt_max = 1e-4 s, up to 10,000 a frame) and begins
+ * a frame of 0.5 s, likely still running while the checks that follow call into the world (their
+ * answers must not depend on it: the world stays held until the wait): sph_world_step,
+ * sph_world_step_begin, sph_world_get_particle_count, sph_world_set_params and
+ * sph_world_destroy answer WORLD_LOCKED, destroying its context BUSY. */
+void capi_begin_long_frame_and_expect_held(sph_context* context, sph_world* world);
 
-/* With a frame of 0.5 s begun on `world` (capi_set_short_substeps): cancels it, waits, and checks
+/* With the frame of capi_begin_long_frame_and_expect_held pending: cancels it, waits, and checks
  * the result: SPH_INCOMPLETE before 5,000 substeps, or, if the frame already ran out (or, as a
  * CUDA frame on the device graph, cannot stop midway), the whole frame of 5,001 substeps and the
  * cancel waiting for the next step, which then stops at once. Prints "<what>: <result> after <n>

@@ -125,7 +125,6 @@ static void test_inline_enqueue_runs_the_frame_in_begin(void** state) {
 static void test_pending_task_holds_the_world(void** state) {
   sph_context* context;
   sph_world* world;
-  sph_world_params params;
   uint32_t count = 0;
   sph_bool32 done = 2;
   int before;
@@ -134,19 +133,7 @@ static void test_pending_task_holds_the_world(void** state) {
   before = capi_thread_count();
   context = make_context();
   world = make_world(context, 0.2f); /* about 1,000 particles */
-  /* Many short substeps, so the frame is likely still running below (the answers must not
-   * depend on it: the world stays held until the wait). */
-  capi_set_short_substeps(world);
-  sph_world_params_init(&params);
-  EXPECT_OK(sph_world_get_params(world, &params));
-
-  EXPECT_OK(sph_world_step_begin(world, 0.5f));
-  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_step(world, kFrameDt));
-  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_step_begin(world, kFrameDt));
-  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_get_particle_count(world, &count));
-  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_set_params(world, &params));
-  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_destroy(world));
-  EXPECT_ERROR(SPH_ERROR_BUSY, "context", sph_context_destroy(context));
+  capi_begin_long_frame_and_expect_held(context, world);
   EXPECT_OK(sph_world_step_poll(world, &done));
   assert_true(done == 0 || done == 1);
   assert_int_equal(capi_thread_count(), before);
