@@ -20,7 +20,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "capi_test.h"
+#include "capi_async.h"
 #include "sph_cuda.h"
 
 static const float kFrameDt = 1.0f / 60.0f;
@@ -38,16 +38,8 @@ static sph_context* make_context(void) {
 
 /* A block of fluid falling in a box: about 1,000 particles, a few substeps a frame. */
 static sph_world* make_world(sph_context* context) {
-  sph_world_def def;
-  sph_world* world = NULL;
-  sph_fill_box_desc box;
   uint32_t added = 0;
-  sph_world_def_init(&def);
-  def.capacity = 4096;
-  EXPECT_OK(sph_world_create(context, &def, &world));
-  sph_fill_box_desc_init(&box);
-  box.max.x = box.max.y = box.max.z = 0.2f;
-  EXPECT_OK(sph_world_fill_box(world, &box, &added));
+  sph_world* world = capi_falling_block(context, 4096, 0.2f, &added);
   assert_true(added > 500);
   return world;
 }
@@ -63,18 +55,6 @@ static void* wait_on_thread(void* arg) {
   w->result = sph_world_step_wait(w->world);
   snprintf(w->error, sizeof w->error, "%s", sph_get_last_error());
   return NULL;
-}
-
-/* Polls until the pending step is done (at most about 60 s). */
-static void poll_until_done(const sph_world* world) {
-  const struct timespec pause = {0, 1000000};
-  sph_bool32 done = 0;
-  int i;
-  for (i = 0; i < 60000 && !done; ++i) {
-    EXPECT_OK(sph_world_step_poll(world, &done));
-    if (!done) nanosleep(&pause, NULL);
-  }
-  assert_int_equal(done, 1);
 }
 
 static void test_same_frames_as_step(void** state) {
@@ -125,52 +105,20 @@ static void test_pending_step_holds_the_world(void** state) {
   float position[3];
   sph_bool32 done = 2;
   (void)state;
-  /* Many short substeps: the frame is still running while the calls below are made, although
-   * the answers must not depend on it (the world stays held until the wait). */
+  capi_begin_long_frame_and_expect_held(context, world);
   sph_world_params_init(&params);
-  EXPECT_OK(sph_world_get_params(world, &params));
-  params.dt_min = params.dt_max = 1e-4f;
-  params.max_substeps = 10000;
-  EXPECT_OK(sph_world_set_params(world, &params));
-
-  EXPECT_OK(sph_world_step_begin(world, 0.5f));
-  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_step(world, kFrameDt));
-  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_step_begin(world, kFrameDt));
-  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_get_particle_count(world, &count));
   EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_get_params(world, &params));
-  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_set_params(world, &params));
   sph_stats_init(&stats);
   EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_get_stats(world, &stats));
   EXPECT_ERROR(
       SPH_ERROR_WORLD_LOCKED, "world",
       sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, position, sizeof position, 0, 0, 1, NULL));
-  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_destroy(world));
-  EXPECT_ERROR(SPH_ERROR_BUSY, "context", sph_context_destroy(context));
   EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "out_done", sph_world_step_poll(world, NULL));
   EXPECT_OK(sph_world_step_poll(world, &done));
   assert_true(done == 0 || done == 1);
 
-  /* 5,001 substeps of about 1e-4 s: the cancel stops the frame early (or, if the frame already ran
-   * out or cannot stop midway, as a CUDA frame on the device graph, the cancel waits for the next
-   * step, which then stops at once). */
-  EXPECT_OK(sph_world_cancel_step(world));
-  poll_until_done(world);
-  {
-    const sph_result r = sph_world_step_wait(world);
-    assert_true(r == SPH_INCOMPLETE || r == SPH_OK);
-    EXPECT_OK(sph_world_get_stats(world, &stats));
-    if (r == SPH_INCOMPLETE) {
-      assert_true(stats.substeps < 5000);
-      assert_true(stats.frame_time < 0.5f);
-    } else {
-      /* The whole frame: 0.5 s in steps of 1e-4f (a little under 1e-4), which leaves a last step
-       * a little over 1e-4 that the clock splits in halves (landing_dt): 5,001 substeps. */
-      assert_true(stats.frame_time == 0.5f);
-      assert_int_equal(stats.substeps, 5001);
-      assert_int_equal(sph_world_step(world, kFrameDt), SPH_INCOMPLETE); /* uses up the cancel */
-    }
-    printf("cancelled asynchronous frame: %s after %u substeps\n", sph_result_string(r), stats.substeps);
-  }
+  /* 5,001 substeps of about 1e-4 s: the cancel stops the frame early (or waits for the next step). */
+  capi_expect_cancelled_frame(world, "cancelled asynchronous frame");
   /* Free again. */
   EXPECT_OK(sph_world_get_particle_count(world, &count));
   assert_true(count > 500);
@@ -180,39 +128,8 @@ static void test_pending_step_holds_the_world(void** state) {
 
 static void test_failed_step_reports_through_wait(void** state) {
   sph_context* context = make_context();
-  sph_world_def def;
-  sph_world* world = NULL;
-  sph_world* before;
-  sph_spawn_desc spawn;
-  float* p;
-  uint32_t i, first = 0;
-  const uint32_t n = 8000;
   (void)state;
-  sph_world_def_init(&def);
-  def.capacity = n;
-  EXPECT_OK(sph_world_create(context, &def, &world));
-  p = (float*)calloc(3u * n, sizeof(float));
-  assert_non_null(p);
-  for (i = 0; i < n; ++i) {
-    p[3 * i] = 0.25f;
-    p[3 * i + 1] = 0.5f;
-    p[3 * i + 2] = 0.125f;
-  }
-  sph_spawn_desc_init(&spawn);
-  spawn.count = n;
-  spawn.positions = p;
-  EXPECT_OK(sph_world_spawn(world, &spawn, &first));
-  free(p);
-  before = capi_world_copy(context, world);
-
-  EXPECT_OK(sph_world_step_begin(world, kFrameDt));
-  assert_int_equal(sph_world_step_wait(world), SPH_ERROR_CAPACITY);
-  assert_non_null(strstr(sph_get_last_error(), "particles share one cell"));
-  capi_expect_same_particles(world, before);
-  /* The failure was collected: the world is free and no step is pending. */
-  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "no step was begun", sph_world_step_wait(world));
-  EXPECT_OK(sph_world_destroy(before));
-  EXPECT_OK(sph_world_destroy(world));
+  capi_expect_failed_step_reported(context);
   EXPECT_OK(sph_context_destroy(context));
 }
 

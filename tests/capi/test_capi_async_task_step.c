@@ -17,29 +17,17 @@
  *    wait with its message, and the world is as before the begin.
  * In the TSan stage (label threads): with the task system no OpenMP runs, so TSan sees every
  * thread. */
-#include <dirent.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
-#include "capi_test.h"
+#include "capi_async.h"
 #include "task_pool.h"
 
 static const float kFrameDt = 1.0f / 60.0f;
 enum { kFrames = 2 };
-
-static int thread_count(void) {
-  int n = 0;
-  struct dirent* e;
-  DIR* d = opendir("/proc/self/task");
-  assert_non_null(d);
-  while ((e = readdir(d)) != NULL)
-    if (e->d_name[0] != '.') ++n;
-  closedir(d);
-  return n;
-}
 
 static sph_context* make_context(void) {
   sph_context_def def;
@@ -54,30 +42,10 @@ static sph_context* make_context(void) {
 
 /* A block of fluid of side `side` falling in open space: 0.32 m is about 5,800 particles. */
 static sph_world* make_world(sph_context* context, float side) {
-  sph_world_def def;
-  sph_world* world = NULL;
-  sph_fill_box_desc box;
   uint32_t added = 0;
-  sph_world_def_init(&def);
-  def.capacity = 8192;
-  EXPECT_OK(sph_world_create(context, &def, &world));
-  sph_fill_box_desc_init(&box);
-  box.max.x = box.max.y = box.max.z = side;
-  EXPECT_OK(sph_world_fill_box(world, &box, &added));
+  sph_world* world = capi_falling_block(context, 8192, side, &added);
   assert_true(side < 0.3f || added > 4096);
   return world;
-}
-
-/* Polls until the pending step is done (at most about 60 s); poll never runs the task. */
-static void poll_until_done(const sph_world* world) {
-  const struct timespec pause = {0, 1000000};
-  sph_bool32 done = 0;
-  int i;
-  for (i = 0; i < 60000 && !done; ++i) {
-    EXPECT_OK(sph_world_step_poll(world, &done));
-    if (!done) nanosleep(&pause, NULL);
-  }
-  assert_int_equal(done, 1);
 }
 
 /* 1. The frames are tasks of the pool: no thread, nested loops, sph_world_step's bits. */
@@ -87,7 +55,7 @@ static void test_frames_run_as_tasks_and_start_no_thread(void** state) {
   int before, frame;
   (void)state;
   task_pool_start();
-  before = thread_count();
+  before = capi_thread_count();
   context = make_context();
   a = make_world(context, 0.32f);
   b = capi_world_copy(context, a);
@@ -96,17 +64,17 @@ static void test_frames_run_as_tasks_and_start_no_thread(void** state) {
     EXPECT_OK(sph_world_step(reference, kFrameDt));
     EXPECT_OK(sph_world_step_begin(a, kFrameDt));
     EXPECT_OK(sph_world_step_begin(b, kFrameDt));
-    assert_int_equal(thread_count(), before);
+    assert_int_equal(capi_thread_count(), before);
     /* Done on the pool's threads (poll runs nothing), so the waits below only collect. */
-    poll_until_done(a);
-    poll_until_done(b);
-    assert_int_equal(thread_count(), before);
+    capi_poll_until_done(a);
+    capi_poll_until_done(b);
+    assert_int_equal(capi_thread_count(), before);
     EXPECT_OK(sph_world_step_wait(b));
     EXPECT_OK(sph_world_step_wait(a));
     capi_expect_same_particles(a, reference);
     capi_expect_same_particles(b, reference);
   }
-  assert_int_equal(thread_count(), before);
+  assert_int_equal(capi_thread_count(), before);
   /* Two steps a frame, and the loops of each frame enqueued from inside its task. */
   assert_true(task_pool_tasks() > 2u * kFrames);
   assert_true(task_pool_nested() > 2u * kFrames);
@@ -132,7 +100,7 @@ static void test_inline_enqueue_runs_the_frame_in_begin(void** state) {
   (void)state;
   task_pool_start();
   task_pool_set_inline(1);
-  before = thread_count();
+  before = capi_thread_count();
   context = make_context();
   world = make_world(context, 0.2f);
   reference = capi_world_copy(context, world);
@@ -144,7 +112,7 @@ static void test_inline_enqueue_runs_the_frame_in_begin(void** state) {
     EXPECT_OK(sph_world_step_wait(world));
     capi_expect_same_particles(world, reference);
   }
-  assert_int_equal(thread_count(), before);
+  assert_int_equal(capi_thread_count(), before);
   assert_int_equal(task_pool_tasks(), 0);
   assert_int_equal(task_pool_inline(), kFrames); /* one task a begin, run inside it */
   EXPECT_OK(sph_world_destroy(reference));
@@ -157,59 +125,26 @@ static void test_inline_enqueue_runs_the_frame_in_begin(void** state) {
 static void test_pending_task_holds_the_world(void** state) {
   sph_context* context;
   sph_world* world;
-  sph_world_params params;
-  sph_stats stats;
   uint32_t count = 0;
   sph_bool32 done = 2;
   int before;
   (void)state;
   task_pool_start();
-  before = thread_count();
+  before = capi_thread_count();
   context = make_context();
   world = make_world(context, 0.2f); /* about 1,000 particles */
-  /* Many short substeps, so the frame is likely still running below (the answers must not
-   * depend on it: the world stays held until the wait). */
-  sph_world_params_init(&params);
-  EXPECT_OK(sph_world_get_params(world, &params));
-  params.dt_min = params.dt_max = 1e-4f;
-  params.max_substeps = 10000;
-  EXPECT_OK(sph_world_set_params(world, &params));
-
-  EXPECT_OK(sph_world_step_begin(world, 0.5f));
-  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_step(world, kFrameDt));
-  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_step_begin(world, kFrameDt));
-  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_get_particle_count(world, &count));
-  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_set_params(world, &params));
-  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_destroy(world));
-  EXPECT_ERROR(SPH_ERROR_BUSY, "context", sph_context_destroy(context));
+  capi_begin_long_frame_and_expect_held(context, world);
   EXPECT_OK(sph_world_step_poll(world, &done));
   assert_true(done == 0 || done == 1);
-  assert_int_equal(thread_count(), before);
+  assert_int_equal(capi_thread_count(), before);
 
   /* 5,001 substeps of about 1e-4 s: the cancel stops the frame early, or, if the frame already
    * ran out, waits for the next step, which then stops at once. */
-  EXPECT_OK(sph_world_cancel_step(world));
-  poll_until_done(world);
-  {
-    const sph_result r = sph_world_step_wait(world);
-    assert_true(r == SPH_INCOMPLETE || r == SPH_OK);
-    sph_stats_init(&stats);
-    EXPECT_OK(sph_world_get_stats(world, &stats));
-    if (r == SPH_INCOMPLETE) {
-      assert_true(stats.substeps < 5000);
-      assert_true(stats.frame_time < 0.5f);
-    } else {
-      assert_true(stats.frame_time == 0.5f);
-      assert_int_equal(stats.substeps, 5001);
-      assert_int_equal(sph_world_step(world, kFrameDt), SPH_INCOMPLETE); /* uses up the cancel */
-    }
-    printf("cancelled frame on the task system: %s after %u substeps\n", sph_result_string(r),
-           stats.substeps);
-  }
+  capi_expect_cancelled_frame(world, "cancelled frame on the task system");
   EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "already waited for", sph_world_step_wait(world));
   EXPECT_OK(sph_world_get_particle_count(world, &count));
   assert_true(count > 500);
-  assert_int_equal(thread_count(), before);
+  assert_int_equal(capi_thread_count(), before);
   EXPECT_OK(sph_world_destroy(world));
   EXPECT_OK(sph_context_destroy(context));
   task_pool_stop();
@@ -218,39 +153,10 @@ static void test_pending_task_holds_the_world(void** state) {
 /* 4. A failed frame reports through the wait; the world is rolled back. */
 static void test_failed_task_reports_through_wait(void** state) {
   sph_context* context;
-  sph_world_def def;
-  sph_world *world = NULL, *before;
-  sph_spawn_desc spawn;
-  float* p;
-  uint32_t i, first = 0;
-  const uint32_t n = 8000;
   (void)state;
   task_pool_start();
   context = make_context();
-  sph_world_def_init(&def);
-  def.capacity = n;
-  EXPECT_OK(sph_world_create(context, &def, &world));
-  p = (float*)calloc(3u * n, sizeof(float));
-  assert_non_null(p);
-  for (i = 0; i < n; ++i) {
-    p[3 * i] = 0.25f;
-    p[3 * i + 1] = 0.5f;
-    p[3 * i + 2] = 0.125f;
-  }
-  sph_spawn_desc_init(&spawn);
-  spawn.count = n;
-  spawn.positions = p;
-  EXPECT_OK(sph_world_spawn(world, &spawn, &first));
-  free(p);
-  before = capi_world_copy(context, world);
-
-  EXPECT_OK(sph_world_step_begin(world, kFrameDt));
-  assert_int_equal(sph_world_step_wait(world), SPH_ERROR_CAPACITY);
-  assert_non_null(strstr(sph_get_last_error(), "particles share one cell"));
-  capi_expect_same_particles(world, before);
-  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "no step was begun", sph_world_step_wait(world));
-  EXPECT_OK(sph_world_destroy(before));
-  EXPECT_OK(sph_world_destroy(world));
+  capi_expect_failed_step_reported(context);
   EXPECT_OK(sph_context_destroy(context));
   task_pool_stop();
 }

@@ -17,7 +17,6 @@
  * 4. One context with both hooks used by three threads at once, each with its own world: every
  *    world ends bit for bit where the others do, and the allocator is empty after.
  * 5. Half-set hooks are refused with a message naming the missing field. */
-#include <dirent.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdint.h>
@@ -25,7 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "capi_test.h"
+#include "capi_async.h"
 #include "sph_cuda.h"
 #include "task_pool.h"
 
@@ -61,17 +60,6 @@ static void SPH_CALL counting_free(void* memory, size_t size, void* user_context
 
 /* ---- scenes -------------------------------------------------------------------------------- */
 
-static int thread_count(void) {
-  int n = 0;
-  struct dirent* e;
-  DIR* d = opendir("/proc/self/task");
-  assert_non_null(d);
-  while ((e = readdir(d)) != NULL)
-    if (e->d_name[0] != '.') ++n;
-  closedir(d);
-  return n;
-}
-
 static sph_context* make_context(int tasks, int allocator) {
   sph_context_def def;
   sph_context* context = NULL;
@@ -91,16 +79,8 @@ static sph_context* make_context(int tasks, int allocator) {
 /* A block of about 5,800 particles falling in a box (a collider), so the loops run in parallel
  * and the collision response runs too. */
 static sph_world* make_world_of(sph_context* context, float side, sph_sdf** box_sdf) {
-  sph_world_def def;
-  sph_world* world = NULL;
-  sph_fill_box_desc box;
   uint32_t added = 0;
-  sph_world_def_init(&def);
-  def.capacity = 8192;
-  EXPECT_OK(sph_world_create(context, &def, &world));
-  sph_fill_box_desc_init(&box);
-  box.max.x = box.max.y = box.max.z = side;
-  EXPECT_OK(sph_world_fill_box(world, &box, &added));
+  sph_world* world = capi_falling_block(context, 8192, side, &added);
   assert_true(side < 0.3f || added > 4096);
   if (box_sdf) {
     sph_shape_desc shape;
@@ -139,11 +119,11 @@ static void test_task_hook_starts_no_thread_and_matches_openmp(void** state) {
   int before;
   (void)state;
   task_pool_start();
-  before = thread_count();
+  before = capi_thread_count();
   hooked = make_context(1, 0);
   a = make_world(hooked, NULL);
   step_frames(a);
-  assert_int_equal(thread_count(), before);
+  assert_int_equal(capi_thread_count(), before);
   assert_true(task_pool_tasks() > 10u);
   assert_true(task_pool_items_on_pool() > 0u);
 

@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: MIT */
-/* What the mpi tests of the solvers and the scene's sums share (test_mpi_dfsph.c,
- * test_mpi_scene_sums.c): failure counting over the ranks, the column in its tank, stepping a
- * number of substeps, and the distributed world's particles against the undivided world's, bit
- * for bit, by id. Static functions: each test program includes it once. */
+/* What the mpi tests of the solvers, the scene's sums and the sources share (test_mpi_solvers.c,
+ * test_mpi_scene_sums.c, test_mpi_sources.c), beyond mpi_test_world.h (the ranks, the column in
+ * its tank, stepping a number of substeps): the distributed world's particles against the
+ * undivided world's, bit for bit, by id (the undivided world's ids need not be dense). Static
+ * functions: each test program includes it once. */
 #ifndef SPH_TESTS_MPI_COMPARE_H
 #define SPH_TESTS_MPI_COMPARE_H
 
@@ -12,81 +13,24 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mpi_test_world.h"
 #include "sph_c.h"
 #include "sph_mpi.h"
 #include "support.h"
 
-#define SPACING 0.01f
-#define KERNEL_RADIUS (1.8f * SPACING)
-
-static int g_rank = 0, g_size = 1, g_failures = 0;
-
-#include "mpi_check.h"
-
-static const support_tank kTank = {{0.2f, 0.1f, 0.03f}, {0.2f, 0.1f, 0.03f}, 0.005f, 0.0f};
-
-static inline void world_def(sph_world_def* def) {
-  REQUIRE(sph_world_def_init(def) == SPH_OK, "def init");
-  def->features = SPH_FEATURE_NONE;
-  def->capacity = 4096;
-  def->particle_spacing = SPACING;
-  def->kernel_radius = KERNEL_RADIUS;
-}
-
-/* Gravity, adaptive steps, at most `substeps` substeps per frame. */
-static inline void set_params(sph_world* world, uint32_t substeps) {
-  sph_world_params p;
-  REQUIRE(support_params_gravity_and_steps(&p, 0.0f, -9.81f, 0.0f, 1e-5f, 1e-3f) == SPH_OK, "params");
-  p.max_substeps = substeps;
-  REQUIRE(sph_world_set_params(world, &p) == SPH_OK, "set params");
-}
-
-/* One frame of `substeps` substeps (a long frame that max_substeps ends), collective when
- * distributed; the frame's stats in *stats. */
-static inline void step_substeps(sph_world* world, uint32_t substeps, int distributed, sph_stats* stats) {
-  sph_result r;
-  set_params(world, substeps);
-  r = distributed ? sph_mpi_world_step(world, 1.0f) : sph_world_step(world, 1.0f);
-  CHECK(r == SPH_INCOMPLETE, "step: %d, expected SPH_INCOMPLETE after %u substeps", (int)r, substeps);
-  REQUIRE(sph_stats_init(stats) == SPH_OK, "stats init");
-  REQUIRE(sph_world_get_stats(world, stats) == SPH_OK, "stats");
-  CHECK(stats->substeps == substeps, "%u substeps, expected %u", stats->substeps, substeps);
-}
-
 /* The undivided world (rank 0: the tank and the column [min, max], stirred at up to `stir` m/s)
- * and the distributed one (every rank: the tank, the particles added from rank 0). Returns the
+ * and the distributed one on every rank (mpi_test_make_worlds on MPI_COMM_WORLD). Returns the
  * particle count on every rank. */
 static inline uint32_t make_worlds(sph_context* context, const sph_world_def* def, sph_vec3 min, sph_vec3 max,
                                    float stir, sph_world** single, sph_world** world,
                                    sph_collider_id* single_tank, sph_collider_id* tank) {
-  float* positions = NULL;
-  float* velocities = NULL;
-  uint32_t n = 0;
-  *single = NULL;
-  if (g_rank == 0) {
-    REQUIRE(sph_world_create(context, def, single) == SPH_OK, "single world");
-    REQUIRE(support_dam_break(context, *single, &kTank, min, max, NULL, single_tank, &n) == SPH_OK, "dam");
-    REQUIRE(support_copy_by_id(*single, SPH_ATTRIBUTE_POSITION, (void**)&positions, &n) == SPH_OK,
-            "positions");
-    velocities = (float*)calloc(3 * (size_t)n + 3, sizeof(float));
-    REQUIRE(velocities != NULL, "calloc");
-    if (stir > 0.0f) {
-      uint64_t state = 12345;
-      support_random_velocities(velocities, n, stir, NULL, &state);
-      REQUIRE(
-          sph_world_set_attribute(*single, SPH_ATTRIBUTE_VELOCITY, velocities, 12ull * n, 12, 0, n) == SPH_OK,
-          "stir");
-    }
-  }
-  MPI_Bcast(&n, 1, MPI_UINT32_T, 0, MPI_COMM_WORLD);
-  REQUIRE(sph_mpi_world_create(context, def, (int32_t)MPI_Comm_c2f(MPI_COMM_WORLD), NULL, world) == SPH_OK,
-          "distributed world");
-  REQUIRE(support_tank_create(context, *world, &kTank, NULL, tank) == SPH_OK, "tank");
-  REQUIRE(sph_mpi_world_add_particles(*world, positions, velocities, g_rank == 0 ? n : 0, NULL) == SPH_OK,
-          "add particles");
-  free(positions);
-  free(velocities);
-  return n;
+  mpi_test_worlds w;
+  mpi_test_make_worlds(context, def, min, max, stir, MPI_COMM_WORLD, NULL, &w);
+  *single = w.single;
+  *world = w.world;
+  *single_tank = w.single_tank;
+  *tank = w.tank;
+  return w.n;
 }
 
 static const uint32_t* g_sort_ids; /* support_id_order's key (qsort takes no context) */
@@ -187,22 +131,6 @@ static inline int same_on_every_rank(const void* bytes, int size) {
     same = same && memcmp(all, all + (size_t)r * (size_t)size, (size_t)size) == 0;
   free(all);
   return same;
-}
-
-static inline void mpi_test_begin(int* argc, char*** argv, sph_context** context) {
-  MPI_Init(argc, argv);
-  MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &g_size);
-  REQUIRE(support_context_create(SPH_BACKEND_CPU, context) == SPH_OK, "context");
-}
-
-static inline int mpi_test_end(sph_context* context) {
-  int total = 0;
-  REQUIRE(sph_context_destroy(context) == SPH_OK, "context destroy");
-  MPI_Allreduce(&g_failures, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-  if (g_rank == 0) printf("%s: %d failures over %d ranks\n", total == 0 ? "PASS" : "FAIL", total, g_size);
-  MPI_Finalize();
-  return total == 0 ? 0 : 1;
 }
 
 #endif

@@ -32,7 +32,7 @@ void mpi_test_world_def(sph_world_def* def) {
   def->features = SPH_FEATURE_NONE;
   def->capacity = 4096;
   def->particle_spacing = MPI_TEST_SPACING;
-  def->kernel_radius = 1.8f * MPI_TEST_SPACING;
+  def->kernel_radius = MPI_TEST_KERNEL_RADIUS;
 }
 
 void mpi_test_dam(sph_context* context, const sph_world_def* def, float stir,
@@ -40,55 +40,71 @@ void mpi_test_dam(sph_context* context, const sph_world_def* def, float stir,
   mpi_test_dam_on(context, def, stir, MPI_COMM_WORLD, mpi_def, single, world, n);
 }
 
-void mpi_test_dam_on(sph_context* context, const sph_world_def* def, float stir, MPI_Comm comm,
-                     const sph_mpi_world_def* mpi_def, sph_world** single, sph_world** world, uint32_t* n) {
+void mpi_test_make_worlds(sph_context* context, const sph_world_def* def, sph_vec3 column_min,
+                          sph_vec3 column_max, float stir, MPI_Comm comm, const sph_mpi_world_def* mpi_def,
+                          mpi_test_worlds* out) {
   int rank = 0;
-  const sph_vec3 column_min = {0.0f, 0.0f, 0.0f}, column_max = {0.1f, 0.2f, 0.06f};
-  sph_world* one = NULL;
   float* positions = NULL;
   float* velocities = NULL;
-  *n = 0;
+  memset(out, 0, sizeof *out);
   MPI_Comm_rank(comm, &rank);
   if (rank == 0) {
-    REQUIRE(sph_world_create(context, def, &one) == SPH_OK, "single world");
-    REQUIRE(support_dam_break(context, one, &kTank, column_min, column_max, NULL, NULL, n) == SPH_OK, "dam");
-    REQUIRE(support_copy_by_id(one, SPH_ATTRIBUTE_POSITION, (void**)&positions, n) == SPH_OK, "positions");
-    velocities = (float*)calloc(3 * (size_t)*n + 3, sizeof(float));
+    REQUIRE(sph_world_create(context, def, &out->single) == SPH_OK, "single world");
+    REQUIRE(support_dam_break(context, out->single, &kTank, column_min, column_max, NULL, &out->single_tank,
+                              &out->n) == SPH_OK,
+            "dam");
+    REQUIRE(support_copy_by_id(out->single, SPH_ATTRIBUTE_POSITION, (void**)&positions, &out->n) == SPH_OK,
+            "positions");
+    velocities = (float*)calloc(3 * (size_t)out->n + 3, sizeof(float));
     REQUIRE(velocities != NULL, "calloc");
     if (stir > 0.0f) {
       uint64_t state = 12345;
-      support_random_velocities(velocities, *n, stir, NULL, &state);
-      REQUIRE(
-          sph_world_set_attribute(one, SPH_ATTRIBUTE_VELOCITY, velocities, 12ull * *n, 12, 0, *n) == SPH_OK,
-          "stir");
+      support_random_velocities(velocities, out->n, stir, NULL, &state);
+      REQUIRE(sph_world_set_attribute(out->single, SPH_ATTRIBUTE_VELOCITY, velocities, 12ull * out->n, 12, 0,
+                                      out->n) == SPH_OK,
+              "stir");
     }
   }
-  MPI_Bcast(n, 1, MPI_UINT32_T, 0, comm);
-  REQUIRE(sph_mpi_world_create(context, def, (int32_t)MPI_Comm_c2f(comm), mpi_def, world) == SPH_OK,
+  MPI_Bcast(&out->n, 1, MPI_UINT32_T, 0, comm);
+  REQUIRE(sph_mpi_world_create(context, def, (int32_t)MPI_Comm_c2f(comm), mpi_def, &out->world) == SPH_OK,
           "distributed world");
-  REQUIRE(support_tank_create(context, *world, &kTank, NULL, NULL) == SPH_OK, "tank");
-  REQUIRE(sph_mpi_world_add_particles(*world, positions, velocities, rank == 0 ? *n : 0, NULL) == SPH_OK,
+  REQUIRE(support_tank_create(context, out->world, &kTank, NULL, &out->tank) == SPH_OK, "tank");
+  REQUIRE(sph_mpi_world_add_particles(out->world, positions, velocities, rank == 0 ? out->n : 0,
+                                      &out->first) == SPH_OK,
           "add particles");
   free(positions);
   free(velocities);
+}
+
+void mpi_test_dam_on(sph_context* context, const sph_world_def* def, float stir, MPI_Comm comm,
+                     const sph_mpi_world_def* mpi_def, sph_world** single, sph_world** world, uint32_t* n) {
+  const sph_vec3 column_min = {0.0f, 0.0f, 0.0f}, column_max = {0.1f, 0.2f, 0.06f};
+  mpi_test_worlds w;
+  mpi_test_make_worlds(context, def, column_min, column_max, stir, comm, mpi_def, &w);
+  *world = w.world;
+  *n = w.n;
   if (single)
-    *single = one;
-  else if (one)
-    sph_world_destroy(one);
+    *single = w.single;
+  else if (w.single)
+    sph_world_destroy(w.single);
 }
 
 void mpi_test_step(sph_world* world, uint32_t substeps, int distributed) {
-  sph_world_params p;
   sph_stats stats;
+  mpi_test_step_stats(world, substeps, distributed, &stats);
+}
+
+void mpi_test_step_stats(sph_world* world, uint32_t substeps, int distributed, sph_stats* stats) {
+  sph_world_params p;
   sph_result r;
   REQUIRE(support_params_gravity_and_steps(&p, 0.0f, -9.81f, 0.0f, 1e-5f, 1e-3f) == SPH_OK, "params");
   p.max_substeps = substeps;
   REQUIRE(sph_world_set_params(world, &p) == SPH_OK, "set params");
   r = distributed ? sph_mpi_world_step(world, 1.0f) : sph_world_step(world, 1.0f);
   CHECK(r == SPH_INCOMPLETE, "step: %d, expected SPH_INCOMPLETE after %u substeps", (int)r, substeps);
-  REQUIRE(sph_stats_init(&stats) == SPH_OK, "stats init");
-  REQUIRE(sph_world_get_stats(world, &stats) == SPH_OK, "stats");
-  CHECK(stats.substeps == substeps, "%u substeps, expected %u", stats.substeps, substeps);
+  REQUIRE(sph_stats_init(stats) == SPH_OK, "stats init");
+  REQUIRE(sph_world_get_stats(world, stats) == SPH_OK, "stats");
+  CHECK(stats->substeps == substeps, "%u substeps, expected %u", stats->substeps, substeps);
 }
 
 void mpi_test_gather(sph_world* world, uint32_t n, float** x, float** v) {

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
-/* What the mpi tests of checkpoints, failures and rebalancing share: the ranks, the checks, the
- * dam break of test_mpi_distributed_world.c (a column in a closed tank, gravity) made on every
- * rank from rank 0's particles, stepping by substeps, and gathering onto rank 0. */
+/* What the mpi tests share: the ranks, the checks, the dam break (a column in a closed tank,
+ * gravity) built twice, undivided on rank 0 and distributed over the ranks from rank 0's
+ * particles, stepping by substeps, and gathering onto rank 0. */
 #ifndef SPH_MPI_TEST_WORLD_H
 #define SPH_MPI_TEST_WORLD_H
 
@@ -21,23 +21,45 @@ extern int g_rank, g_size, g_failures;
 #include "mpi_check.h"
 
 #define MPI_TEST_SPACING 0.01f
+#define MPI_TEST_KERNEL_RADIUS (1.8f * MPI_TEST_SPACING)
 #define MPI_TEST_COMM ((int32_t)MPI_Comm_c2f(MPI_COMM_WORLD))
 
 void mpi_test_init(int* argc, char*** argv, sph_context** context);
 /* Reduces the failures over the ranks, prints PASS or FAIL on rank 0, finalises MPI; the exit code. */
 int mpi_test_finish(sph_context* context, const char* name);
 
+/* No features, capacity 4096, spacing MPI_TEST_SPACING, kernel radius MPI_TEST_KERNEL_RADIUS. */
 void mpi_test_world_def(sph_world_def* def);
-/* The column [0, 0.1] x [0, 0.2] x [0, 0.06] in the tank [0, 0.4] x [0, 0.2] x [0, 0.06], stirred
- * with random velocities up to `stir` m/s: *single (rank 0 only, unless single is NULL) the
- * undivided world, *world the distributed one (mpi_def may be NULL); *n the particles. */
+
+/* The dam break's two worlds. */
+typedef struct mpi_test_worlds {
+  sph_world* single;           /* rank 0 of the communicator: the undivided world; NULL elsewhere */
+  sph_world* world;            /* the distributed world */
+  sph_collider_id single_tank; /* rank 0: the undivided world's tank */
+  sph_collider_id tank;        /* the distributed world's tank */
+  uint32_t n;                  /* the particles, on every rank */
+  uint32_t first;              /* the first id sph_mpi_world_add_particles gave on this rank */
+} mpi_test_worlds;
+
+/* The column [column_min, column_max] (sph_world_fill_box) in the tank [0, 0.4] x [0, 0.2] x
+ * [0, 0.06], stirred with random velocities up to `stir` m/s (support_random_velocities, seed
+ * 12345; 0: at rest): rank 0 of `comm` builds the undivided world, every rank of it the
+ * distributed one (mpi_def may be NULL) with the same tank and rank 0's particles, by id. */
+void mpi_test_make_worlds(sph_context* context, const sph_world_def* def, sph_vec3 column_min,
+                          sph_vec3 column_max, float stir, MPI_Comm comm, const sph_mpi_world_def* mpi_def,
+                          mpi_test_worlds* out);
+/* mpi_test_make_worlds with the column [0, 0.1] x [0, 0.2] x [0, 0.06]: *single (rank 0 only,
+ * unless single is NULL) the undivided world, *world the distributed one; *n the particles. */
 void mpi_test_dam(sph_context* context, const sph_world_def* def, float stir,
                   const sph_mpi_world_def* mpi_def, sph_world** single, sph_world** world, uint32_t* n);
 /* mpi_test_dam on the ranks of `comm` (rank 0 of it builds the undivided world). */
 void mpi_test_dam_on(sph_context* context, const sph_world_def* def, float stir, MPI_Comm comm,
                      const sph_mpi_world_def* mpi_def, sph_world** single, sph_world** world, uint32_t* n);
-/* `substeps` substeps in one frame that max_substeps ends (collective when distributed). */
+/* `substeps` substeps in one frame that max_substeps ends (collective when distributed), gravity
+ * and adaptive steps in [1e-5, 1e-3] s. */
 void mpi_test_step(sph_world* world, uint32_t substeps, int distributed);
+/* mpi_test_step, the frame's stats in *stats. */
+void mpi_test_step_stats(sph_world* world, uint32_t substeps, int distributed, sph_stats* stats);
 /* The distributed world's positions and velocities by id on rank 0 (malloc'd; NULL elsewhere). */
 void mpi_test_gather(sph_world* world, uint32_t n, float** x, float** v);
 /* mpi_test_gather for a world on `comm`: onto its rank 0. */

@@ -25,49 +25,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mpi_test_world.h"
 #include "sph_c.h"
 #include "sph_mpi.h"
 #include "support.h"
 
-#define SPACING 0.01f
-#define KERNEL_RADIUS (1.8f * SPACING)
-
-static int g_rank = 0, g_size = 1, g_failures = 0;
-
-#include "mpi_check.h"
-
-static void world_def(sph_world_def* def) {
-  REQUIRE(sph_world_def_init(def) == SPH_OK, "def init");
-  def->features = SPH_FEATURE_NONE;
-  def->capacity = 4096;
-  def->particle_spacing = SPACING;
-  def->kernel_radius = KERNEL_RADIUS;
-}
-
-static const support_tank kTank = {{0.2f, 0.1f, 0.03f}, {0.2f, 0.1f, 0.03f}, 0.005f, 0.0f};
-
-/* The scene's parameters: gravity, adaptive steps, at most `substeps` substeps per frame. */
-static void set_params(sph_world* world, uint32_t substeps) {
-  sph_world_params p;
-  REQUIRE(support_params_gravity_and_steps(&p, 0.0f, -9.81f, 0.0f, 1e-5f, 1e-3f) == SPH_OK, "params");
-  p.max_substeps = substeps;
-  REQUIRE(sph_world_set_params(world, &p) == SPH_OK, "set params");
-}
-
-/* Steps a world (collectively when distributed) through `substeps` substeps: a long frame that
- * max_substeps ends. */
-static void step_substeps(sph_world* world, uint32_t substeps, int distributed) {
-  sph_stats stats;
-  sph_result r;
-  set_params(world, substeps);
-  r = distributed ? sph_mpi_world_step(world, 1.0f) : sph_world_step(world, 1.0f);
-  CHECK(r == SPH_INCOMPLETE, "step: %d, expected SPH_INCOMPLETE after %u substeps", (int)r, substeps);
-  REQUIRE(sph_stats_init(&stats) == SPH_OK, "stats init");
-  REQUIRE(sph_world_get_stats(world, &stats) == SPH_OK, "stats");
-  CHECK(stats.substeps == substeps, "%u substeps, expected %u", stats.substeps, substeps);
-}
-
-static int32_t layer_of(float x) { return (int32_t)floorf(x * (1.0f / KERNEL_RADIUS)); }
+static int32_t layer_of(float x) { return (int32_t)floorf(x * (1.0f / MPI_TEST_KERNEL_RADIUS)); }
 
 /* Each rank's halo of the last substep against the particles of the layers beside its slab, in
  * the positions `start` (rank 0's gather) that substep started from. */
@@ -126,60 +89,36 @@ static void run_scene(sph_context* context, const char* name, float stir_speed, 
                       sph_viscosity_method viscosity) {
   const sph_vec3 column_min = {0.0f, 0.0f, 0.0f}, column_max = {0.1f, 0.2f, 0.06f};
   sph_world_def def;
-  sph_world* single = NULL;
-  sph_world* world = NULL;
-  float* positions = NULL;
-  float* velocities = NULL;
+  mpi_test_worlds worlds;
+  sph_world* single;
+  sph_world* world;
   float* mid = NULL;
   float* got_x = NULL;
   float* got_v = NULL;
   uint32_t* got_id = NULL;
-  uint32_t n = 0;
+  uint32_t n;
   uint64_t gathered = 0;
   sph_mpi_counts counts;
-  world_def(&def);
+  mpi_test_world_def(&def);
   def.features = features;
   def.viscosity_method = viscosity;
 
-  /* The undivided world and its particles, in id order. */
-  if (g_rank == 0) {
-    REQUIRE(sph_world_create(context, &def, &single) == SPH_OK, "single world");
-    REQUIRE(support_dam_break(context, single, &kTank, column_min, column_max, NULL, NULL, &n) == SPH_OK,
-            "dam");
-    REQUIRE(support_copy_by_id(single, SPH_ATTRIBUTE_POSITION, (void**)&positions, &n) == SPH_OK,
-            "positions");
-    velocities = (float*)calloc(3 * (size_t)n + 3, sizeof(float));
-    REQUIRE(velocities != NULL, "calloc");
-    if (stir_speed > 0.0f) {
-      uint64_t state = 12345;
-      support_random_velocities(velocities, n, stir_speed, NULL, &state);
-      REQUIRE(
-          sph_world_set_attribute(single, SPH_ATTRIBUTE_VELOCITY, velocities, 12ull * n, 12, 0, n) == SPH_OK,
-          "stir");
-    }
-  }
-  MPI_Bcast(&n, 1, MPI_UINT32_T, 0, MPI_COMM_WORLD);
-
-  /* The distributed world: the tank on every rank, the particles from rank 0. */
-  REQUIRE(sph_mpi_world_create(context, &def, (int32_t)MPI_Comm_c2f(MPI_COMM_WORLD), NULL, &world) == SPH_OK,
-          "distributed world");
-  REQUIRE(support_tank_create(context, world, &kTank, NULL, NULL) == SPH_OK, "tank");
-  {
-    uint32_t first = 99;
-    const sph_result r =
-        sph_mpi_world_add_particles(world, positions, velocities, g_rank == 0 ? n : 0, &first);
-    REQUIRE(r == SPH_OK, "add particles: %d", (int)r);
-    CHECK(first == (g_rank == 0 ? 0u : n), "first id %u", first);
-  }
+  /* The undivided world (rank 0) and the distributed one: the tank on every rank, the particles
+   * from rank 0, ids from 0 there. */
+  mpi_test_make_worlds(context, &def, column_min, column_max, stir_speed, MPI_COMM_WORLD, NULL, &worlds);
+  single = worlds.single;
+  world = worlds.world;
+  n = worlds.n;
+  CHECK(worlds.first == (g_rank == 0 ? 0u : n), "first id %u", worlds.first);
 
   /* 19 substeps (10, the block, 9), the positions the 20th starts from, the 20th. */
   if (block) {
-    if (g_rank == 0) step_substeps(single, 10, 0);
-    step_substeps(world, 10, 1);
+    if (g_rank == 0) mpi_test_step(single, 10, 0);
+    mpi_test_step(world, 10, 1);
     add_block(single, world, &n);
   }
-  if (g_rank == 0) step_substeps(single, block ? 9 : 19, 0);
-  step_substeps(world, block ? 9 : 19, 1);
+  if (g_rank == 0) mpi_test_step(single, block ? 9 : 19, 0);
+  mpi_test_step(world, block ? 9 : 19, 1);
   if (g_rank == 0) {
     mid = (float*)malloc(sizeof(float) * 3 * ((size_t)n + 1));
     REQUIRE(mid != NULL, "malloc");
@@ -188,8 +127,8 @@ static void run_scene(sph_context* context, const char* name, float stir_speed, 
   CHECK(sph_mpi_world_gather(world, g_size, mid, NULL, NULL, n, &gathered) == SPH_ERROR_INVALID_ARGUMENT &&
             sph_mpi_world_gather(world, -1, mid, NULL, NULL, n, &gathered) == SPH_ERROR_INVALID_ARGUMENT,
         "a gather's root outside the communicator");
-  if (g_rank == 0) step_substeps(single, 1, 0);
-  step_substeps(world, 1, 1);
+  if (g_rank == 0) mpi_test_step(single, 1, 0);
+  mpi_test_step(world, 1, 1);
 
   REQUIRE(sph_mpi_counts_init(&counts) == SPH_OK, "counts init");
   REQUIRE(sph_mpi_world_get_counts(world, &counts) == SPH_OK, "counts");
@@ -236,8 +175,6 @@ static void run_scene(sph_context* context, const char* name, float stir_speed, 
   }
   REQUIRE(sph_world_destroy(world) == SPH_OK, "destroy");
   if (single) REQUIRE(sph_world_destroy(single) == SPH_OK, "destroy");
-  free(positions);
-  free(velocities);
   free(mid);
   free(got_x);
   free(got_v);
@@ -261,10 +198,10 @@ static void check_refusals(sph_context* context) {
   sph_spawn_desc spawn;
   const float p[3] = {0.05f, 0.05f, 0.03f};
   const int32_t comm = (int32_t)MPI_Comm_c2f(MPI_COMM_WORLD);
-  world_def(&def);
+  mpi_test_world_def(&def);
   def.features = SPH_FEATURE_SPRINGS;
   expect_refused(context, &def, "SPH_FEATURE_SPRINGS");
-  world_def(&def);
+  mpi_test_world_def(&def);
   REQUIRE(sph_mpi_world_create(context, &def, comm, NULL, &world) == SPH_OK, "world");
   REQUIRE(sph_spawn_desc_init(&spawn) == SPH_OK, "spawn init");
   spawn.count = 1;
@@ -287,11 +224,7 @@ static void check_refusals(sph_context* context) {
 
 int main(int argc, char** argv) {
   sph_context* context = NULL;
-  int total = 0;
-  MPI_Init(&argc, &argv);
-  MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &g_size);
-  REQUIRE(support_context_create(SPH_BACKEND_CPU, &context) == SPH_OK, "context");
+  mpi_test_init(&argc, &argv, &context);
   run_scene(context, "dam break", 0.0f, 0, SPH_FEATURE_NONE, SPH_VISCOSITY_MUELLER);
   run_scene(context, "stirred column", 2.0f, 0, SPH_FEATURE_NONE, SPH_VISCOSITY_MUELLER);
   run_scene(context, "column and a late block", 0.0f, 1, SPH_FEATURE_NONE, SPH_VISCOSITY_MUELLER);
@@ -311,9 +244,5 @@ int main(int argc, char** argv) {
   run_scene(context, "stirred column with Clavet viscosity", 2.0f, 0, SPH_FEATURE_USER_ATTRIBUTE,
             SPH_VISCOSITY_CLAVET);
   check_refusals(context);
-  REQUIRE(sph_context_destroy(context) == SPH_OK, "context destroy");
-  MPI_Allreduce(&g_failures, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-  if (g_rank == 0) printf("%s: %d failures over %d ranks\n", total == 0 ? "PASS" : "FAIL", total, g_size);
-  MPI_Finalize();
-  return total == 0 ? 0 : 1;
+  return mpi_test_finish(context, "mpi_distributed_world");
 }

@@ -76,8 +76,8 @@ int main(int argc, char** argv) {
   sph_collider_id single_tank = {0}, tank = {0};
   sph_probe_id point, gauge, single_point = {0}, single_gauge = {0};
   float thresholds[2] = {0.0f, 0.0f};
-  mpi_test_begin(&argc, &argv, &context);
-  world_def(&def);
+  mpi_test_init(&argc, &argv, &context);
+  mpi_test_world_def(&def);
   def.features = SPH_FEATURE_COLLIDER_LOADS;
   (void)make_worlds(context, &def, column_min, column_max, 2.0f, &single, &world, &single_tank, &tank);
   add_probes(world, &point, &gauge);
@@ -85,12 +85,12 @@ int main(int argc, char** argv) {
   for (int f = 0; f < 2; ++f) {
     readings got, want;
     sph_stats stats;
-    step_substeps(world, 8, 1, &stats);
+    mpi_test_step_stats(world, 8, 1, &stats);
     read_world(world, tank, point, gauge, &got);
     CHECK(same_on_every_rank(&got, (int)sizeof got),
           "frame %d: the ranks read different loads, readings or events", f);
     if (g_rank == 0) {
-      step_substeps(single, 8, 0, &stats);
+      mpi_test_step_stats(single, 8, 0, &stats);
       read_world(single, single_tank, single_point, single_gauge, &want);
       CHECK(memcmp(&got.point, &want.point, sizeof got.point) == 0 &&
                 memcmp(&got.gauge, &want.gauge, sizeof got.gauge) == 0,
@@ -136,5 +136,5 @@ int main(int argc, char** argv) {
   expect_same_particles(single, world, "loads and probes");
   REQUIRE(sph_world_destroy(world) == SPH_OK, "destroy");
   if (single) REQUIRE(sph_world_destroy(single) == SPH_OK, "destroy");
-  return mpi_test_end(context);
+  return mpi_test_finish(context, "mpi_scene_sums");
 }

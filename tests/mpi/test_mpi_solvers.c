@@ -30,7 +30,7 @@ static void run_scene(sph_context* context, const char* name, float stir, sph_so
   sph_world* world = NULL;
   sph_collider_id single_tank, tank;
   const uint32_t frames[2] = {7, 5};
-  world_def(&def);
+  mpi_test_world_def(&def);
   def.solver = solver;
   def.integrator = integrator;
   def.features = g_features;
@@ -50,8 +50,8 @@ static void run_scene(sph_context* context, const char* name, float stir, sph_so
     sph_stats got, want;
     uint32_t solves[4];
     float errors[2];
-    step_substeps(world, frames[f], 1, &got);
-    if (g_rank == 0) step_substeps(single, frames[f], 0, &want);
+    mpi_test_step_stats(world, frames[f], 1, &got);
+    if (g_rank == 0) mpi_test_step_stats(single, frames[f], 0, &want);
     solves[0] = got.pressure_iterations;
     solves[1] = got.pressure_iterations_max;
     solves[2] = got.divergence_iterations;
@@ -89,7 +89,7 @@ static void run_scene(sph_context* context, const char* name, float stir, sph_so
 
 int main(int argc, char** argv) {
   sph_context* context = NULL;
-  mpi_test_begin(&argc, &argv, &context);
+  mpi_test_init(&argc, &argv, &context);
   if (argc > 1 && strcmp(argv[1], "walls") == 0) {
     /* scripts/validate (45 s a run on 2 cores, for the walls' boundary maps): the walls' share
      * of the density (per particle, before the halo's exchanges) with DFSPH, and with RK4 and the
@@ -100,12 +100,12 @@ int main(int argc, char** argv) {
     g_features = SPH_FEATURE_BOUNDARY_DENSITY | SPH_FEATURE_COLLIDER_LOADS;
     run_scene(context, "RK4 stirred column with walls and loads", 2.0f, SPH_SOLVER_WCSPH, SPH_INTEGRATOR_RK4,
               0);
-    return mpi_test_end(context);
+    return mpi_test_finish(context, "mpi_solvers");
   }
   run_scene(context, "DFSPH dam break", 0.0f, SPH_SOLVER_DFSPH, SPH_INTEGRATOR_SYMPLECTIC_EULER, 1);
   run_scene(context, "DFSPH stirred column", 2.0f, SPH_SOLVER_DFSPH, SPH_INTEGRATOR_SYMPLECTIC_EULER, 1);
   run_scene(context, "DFSPH stirred column without the divergence solve", 2.0f, SPH_SOLVER_DFSPH,
             SPH_INTEGRATOR_SYMPLECTIC_EULER, 0);
   run_scene(context, "RK4 stirred column", 2.0f, SPH_SOLVER_WCSPH, SPH_INTEGRATOR_RK4, 0);
-  return mpi_test_end(context);
+  return mpi_test_finish(context, "mpi_solvers");
 }

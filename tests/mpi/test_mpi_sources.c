@@ -93,7 +93,7 @@ static void run_capacity_limit(sph_context* context) {
   sph_world* single = NULL;
   sph_world* world = NULL;
   sph_collider_id single_tank, tank;
-  world_def(&def);
+  mpi_test_world_def(&def);
   def.capacity = 1700;
   (void)make_worlds(context, &def, column_min, column_max, 0.0f, &single, &world, &single_tank, &tank);
   add_source_and_sink(context, world);
@@ -102,7 +102,7 @@ static void run_capacity_limit(sph_context* context) {
     sph_stats stats;
     sph_mpi_counts counts;
     uint32_t missing;
-    step_substeps(world, 3, 1, &stats);
+    mpi_test_step_stats(world, 3, 1, &stats);
     missing = not_emitted(world);
     REQUIRE(sph_mpi_counts_init(&counts) == SPH_OK && sph_mpi_world_get_counts(world, &counts) == SPH_OK,
             "counts");
@@ -111,7 +111,7 @@ static void run_capacity_limit(sph_context* context) {
           "frame %d: the ranks disagree on the emission (%u not emitted here)", f, missing);
     if (f == 0) {
       if (g_rank == 0) {
-        step_substeps(single, 3, 0, &stats);
+        mpi_test_step_stats(single, 3, 0, &stats);
         CHECK(missing == not_emitted(single) && missing > 0,
               "the first frame left %u particles not emitted, the undivided world %u", missing,
               not_emitted(single));
@@ -133,8 +133,8 @@ int main(int argc, char** argv) {
   sph_world* world = NULL;
   sph_collider_id single_tank, tank;
   uint32_t removed_total = 0, column_count = 0;
-  mpi_test_begin(&argc, &argv, &context);
-  world_def(&def);
+  mpi_test_init(&argc, &argv, &context);
+  mpi_test_world_def(&def);
   column_count =
       make_worlds(context, &def, column_min, column_max, 0.0f, &single, &world, &single_tank, &tank);
   add_source_and_sink(context, world);
@@ -152,7 +152,7 @@ int main(int argc, char** argv) {
     int total = 0;
     char name[64];
     REQUIRE(sizes && offsets, "malloc");
-    step_substeps(world, 3, 1, &stats);
+    mpi_test_step_stats(world, 3, 1, &stats);
     REQUIRE(sph_mpi_counts_init(&counts) == SPH_OK && sph_mpi_world_get_counts(world, &counts) == SPH_OK,
             "counts");
     mine_ids = removed_ids(world, &mine, &mine_events);
@@ -192,7 +192,7 @@ int main(int argc, char** argv) {
     if (g_rank == 0) {
       uint32_t want_events = 0;
       uint32_t* want_ids;
-      step_substeps(single, 3, 0, &stats);
+      mpi_test_step_stats(single, 3, 0, &stats);
       want_ids = removed_ids(single, &want_n, &want_events);
       qsort(want_ids, want_n, sizeof(uint32_t), compare_ids);
       qsort(all_ids, (size_t)total, sizeof(uint32_t), compare_ids);
@@ -236,5 +236,5 @@ int main(int argc, char** argv) {
   REQUIRE(sph_world_destroy(world) == SPH_OK, "destroy");
   if (single) REQUIRE(sph_world_destroy(single) == SPH_OK, "destroy");
   run_capacity_limit(context);
-  return mpi_test_end(context);
+  return mpi_test_finish(context, "mpi_sources");
 }

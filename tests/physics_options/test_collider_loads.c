@@ -30,7 +30,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "capi_test.h"
+#include "capi_scenes.h"
 #include "rigid_body.h" /* the engine's side of samples/floating_box.c: a rigid body, stepped */
 
 static const double kStep = 0.01; /* support_fcc_box's step; the world's spacing is step sqrt 2 */
@@ -81,51 +81,17 @@ static sph_collider_id add_axis_wall(support_world* w, int axis, double sign, do
 /* ---- momentum balance ------------------------------------------------------------------------ */
 
 /* A column 6 x 14 x 8 layers collapsing in a tank 16 x 30 x 8 layers: 0.3 s of the dam break,
- * the fluid hitting the far wall. Bound 1 % (the issue's). */
+ * the fluid hitting the far wall (capi_collapse_momentum_balance). Bound 1 % (the issue's). */
 static void momentum_balance(uint32_t features, sph_integrator integrator) {
-  const uint32_t layers[3] = {6, 14, 8};
-  const double tank_min[3] = {0.0, 0.0, 0.0}, tank_max[3] = {0.16, 0.30, 0.08};
-  float* lattice = NULL;
-  uint32_t n = 0;
-  support_world w;
-  sph_sdf* sdf = NULL;
-  sph_collider_id tank;
-  sph_world_def def;
-  double p0[3], p1[3], impulse[3] = {0.0, 0.0, 0.0}, time = 0.0;
-  assert_int_equal(support_fcc_box(layers, kStep, NULL, &lattice, &n), SPH_OK);
-  def = loads_def(SPH_FEATURE_COLLIDER_LOADS | features, n, integrator);
-  EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
-  EXPECT_OK(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * kStep, 0.0f, &sdf, &tank));
-  EXPECT_OK(support_spawn(w.world, lattice, NULL, n));
-  capi_fluid_momentum(w.world, w.mass, p0);
-  for (int frame = 0; frame < 15; ++frame) {
-    sph_collider_loads l;
-    EXPECT_OK(sph_world_step(w.world, 0.02f));
-    l = capi_loads_of(w.world, tank);
-    impulse[0] += l.force.x * l.frame_time;
-    impulse[1] += l.force.y * l.frame_time;
-    impulse[2] += l.force.z * l.frame_time;
-    time += l.frame_time;
-  }
-  capi_fluid_momentum(w.world, w.mass, p1);
-  {
-    const double weight_impulse = (double)n * w.mass * -kGravity * time;
-    const double residual[3] = {p1[0] - p0[0] + impulse[0], p1[1] - p0[1] + impulse[1] - weight_impulse,
-                                p1[2] - p0[2] + impulse[2]};
-    const double error =
-        sqrt(residual[0] * residual[0] + residual[1] * residual[1] + residual[2] * residual[2]) /
-        fabs(weight_impulse);
-    print_message(
-        "momentum balance (features 0x%x, %s): fluid dP = (%.4g, %.4g, %.4g), colliders' J = "
-        "(%.4g, %.4g, %.4g), gravity %.4g N s over %.3f s: residual %.3g %%\n",
-        features, integrator == SPH_INTEGRATOR_RK4 ? "RK4" : "Euler", p1[0] - p0[0], p1[1] - p0[1],
-        p1[2] - p0[2], impulse[0], impulse[1], impulse[2], weight_impulse, time, 100.0 * error);
-    assert_true(fabs(time - 0.3) < 1e-6);
-    assert_true(error <= 0.01 || measuring());
-  }
-  free(lattice);
-  EXPECT_OK(sph_sdf_destroy(sdf));
-  EXPECT_OK(support_world_close(&w));
+  const sph_world_def def = loads_def(SPH_FEATURE_COLLIDER_LOADS | features, 0, integrator);
+  const capi_momentum_balance b = capi_collapse_momentum_balance(&def);
+  print_message(
+      "momentum balance (features 0x%x, %s): fluid dP = (%.4g, %.4g, %.4g), colliders' J = "
+      "(%.4g, %.4g, %.4g), gravity %.4g N s over %.3f s: residual %.3g %%\n",
+      features, integrator == SPH_INTEGRATOR_RK4 ? "RK4" : "Euler", b.fluid_change[0], b.fluid_change[1],
+      b.fluid_change[2], b.impulse[0], b.impulse[1], b.impulse[2], b.weight_impulse, b.time, 100.0 * b.error);
+  assert_true(fabs(b.time - 0.3) < 1e-6);
+  assert_true(b.error <= 0.01 || measuring());
 }
 
 static void test_momentum_balance_contacts(void** state) {
@@ -143,21 +109,14 @@ static void test_momentum_balance_boundary_density(void** state) {
 /* The loads pass applies the collision response the world would apply without it (the same calls
  * in the same order): with and without the feature, the particles end bit for bit the same. */
 static float* collapse_positions(uint32_t features, uint32_t* count) {
-  const uint32_t layers[3] = {6, 14, 8};
-  const double tank_min[3] = {0.0, 0.0, 0.0}, tank_max[3] = {0.16, 0.30, 0.08};
-  float *lattice = NULL, *x = NULL;
-  uint32_t n = 0;
+  const support_water_tank column = support_collapsing_column(0.2f);
+  const sph_world_def def = loads_def(features, 0, SPH_INTEGRATOR_SYMPLECTIC_EULER);
+  float* x = NULL;
   support_world w;
   sph_sdf* sdf = NULL;
-  sph_world_def def;
-  assert_int_equal(support_fcc_box(layers, kStep, NULL, &lattice, &n), SPH_OK);
-  def = loads_def(features, n, SPH_INTEGRATOR_SYMPLECTIC_EULER);
-  EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
-  EXPECT_OK(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * kStep, 0.2f, &sdf, NULL));
-  EXPECT_OK(support_spawn(w.world, lattice, NULL, n));
+  EXPECT_OK(support_water_tank_open(&w, sph_test_backend(), &def, NULL, &column, &sdf, NULL, NULL));
   for (int frame = 0; frame < 8; ++frame) EXPECT_OK(sph_world_step(w.world, 0.02f));
   EXPECT_OK(support_copy_by_id(w.world, SPH_ATTRIBUTE_POSITION, (void**)&x, count));
-  free(lattice);
   EXPECT_OK(sph_sdf_destroy(sdf));
   EXPECT_OK(support_world_close(&w));
   return x;
@@ -293,69 +252,25 @@ static void test_hydrostatic_side_wall(void** state) {
 /* ---- buoyancy of a fixed submerged box ---------------------------------------------------------- */
 
 /* A box of 6 x 6 x 6 cm fixed with its centre 8 cm above the floor of a tank 16 x 16 cm, water
- * filled around it (lattice points outside the box by at least step / 2) to 20 cm. Settled for
- * 1.2 s; the box's force averaged over the last 0.4 s against rho0 g V upwards. */
+ * filled around it (lattice points outside the box by at least step / 2) to 20 cm
+ * (capi_submerged_box_open). Settled for 0.8 s; the box's force averaged over the next 0.4 s
+ * against rho0 g V upwards. */
 static double submerged_box_force(uint32_t features, double* expected) {
-  const uint32_t layers[3] = {16, 20, 16};
-  const double side = 0.16, half = 0.03, centre[3] = {0.08, 0.08, 0.08};
-  const double tank_min[3] = {0.0, 0.0, 0.0}, tank_max[3] = {side, 0.4, side};
-  float* lattice = NULL;
-  uint32_t n = 0, kept = 0;
-  support_world w;
-  sph_sdf *tank_sdf = NULL, *box_sdf = NULL;
-  sph_collider_id box;
-  sph_world_def def;
+  const sph_world_def def =
+      loads_def(SPH_FEATURE_COLLIDER_LOADS | features, 0, SPH_INTEGRATOR_SYMPLECTIC_EULER);
+  const double half = CAPI_SUBMERGED_HALF;
+  capi_submerged_box s;
   sph_world_params params;
-  sph_shape_desc shape;
-  sph_collider_def collider;
-  double sum[3] = {0.0, 0.0, 0.0}, time = 0.0;
-  assert_int_equal(support_fcc_box(layers, kStep, NULL, &lattice, &n), SPH_OK);
-  for (uint32_t i = 0; i < n; ++i) {
-    int inside = 1;
-    for (int k = 0; k < 3; ++k) inside = inside && fabs(lattice[3 * i + k] - centre[k]) < half + 0.5 * kStep;
-    if (inside) continue;
-    memmove(lattice + 3 * kept, lattice + 3 * i, 3 * sizeof(float));
-    ++kept;
-  }
-  def = loads_def(SPH_FEATURE_COLLIDER_LOADS | features, kept, SPH_INTEGRATOR_SYMPLECTIC_EULER);
-  EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
+  double force[3];
   sph_world_params_init(&params);
   params.step_limits = SPH_STEP_LIMIT_ACOUSTIC;
-  EXPECT_OK(sph_world_set_params(w.world, &params));
-  EXPECT_OK(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * kStep, 0.0f, &tank_sdf, NULL));
-  EXPECT_OK(sph_shape_desc_init(&shape));
-  shape.shape = SPH_SHAPE_BOX;
-  shape.half_extents.x = shape.half_extents.y = shape.half_extents.z = (float)half;
-  shape.voxel_size = 0.005f;
-  shape.padding_voxels = 8; /* the grid reaches beyond the kernel radius plus the walls' offset */
-  EXPECT_OK(sph_sdf_create_shape(w.context, &shape, &box_sdf));
-  EXPECT_OK(sph_collider_def_init(&collider));
-  collider.sdf = box_sdf;
-  collider.transform = sph_transform_identity();
-  collider.transform.position.x = (float)centre[0];
-  collider.transform.position.y = (float)centre[1];
-  collider.transform.position.z = (float)centre[2];
-  EXPECT_OK(sph_collider_create(w.world, &collider, &box));
-  EXPECT_OK(support_spawn(w.world, lattice, NULL, kept));
-  for (int frame = 0; frame < 60; ++frame) {
-    EXPECT_OK(sph_world_step(w.world, 0.02f));
-    if (frame < 40) continue;
-    {
-      const sph_collider_loads l = capi_loads_of(w.world, box);
-      sum[0] += l.force.x * l.frame_time;
-      sum[1] += l.force.y * l.frame_time;
-      sum[2] += l.force.z * l.frame_time;
-      time += l.frame_time;
-    }
-  }
-  *expected = w.def.rest_density * kGravity * 8.0 * half * half * half;
-  print_message("submerged box (features 0x%x): force (%.4f, %.4f, %.4f) N\n", features, sum[0] / time,
-                sum[1] / time, sum[2] / time);
-  free(lattice);
-  EXPECT_OK(sph_sdf_destroy(tank_sdf));
-  EXPECT_OK(sph_sdf_destroy(box_sdf));
-  EXPECT_OK(support_world_close(&w));
-  return sum[1] / time;
+  capi_submerged_box_open(&s, &def, &params);
+  capi_mean_force(s.w.world, s.box, 60, 40, force);
+  *expected = s.w.def.rest_density * kGravity * 8.0 * half * half * half;
+  print_message("submerged box (features 0x%x): force (%.4f, %.4f, %.4f) N\n", features, force[0], force[1],
+                force[2]);
+  capi_submerged_box_close(&s);
+  return force[1];
 }
 
 static void test_submerged_box_buoyancy(void** state) {
@@ -556,16 +471,8 @@ static void test_loads_api(void** state) {
                 fabs(l.torque.z - (-0.05f * l.force.y)) <= 0.2f * fabs(0.05f * l.force.y));
     /* A checkpoint carries the load point (format 6): a loaded copy steps to the same loads. */
     {
-      uint64_t size = 0;
-      void* saved;
-      sph_world* copy = NULL;
+      sph_world* copy = capi_world_copy(w.context, w.world);
       sph_collider_loads a, b;
-      EXPECT_OK(sph_world_save(w.world, NULL, 0, &size));
-      saved = malloc(size);
-      assert_non_null(saved);
-      EXPECT_OK(sph_world_save(w.world, saved, size, &size));
-      EXPECT_OK(sph_world_load(w.context, saved, size, &copy));
-      free(saved);
       EXPECT_OK(sph_world_step(w.world, 0.02f));
       EXPECT_OK(sph_world_step(copy, 0.02f));
       a = capi_loads_of(w.world, tank);

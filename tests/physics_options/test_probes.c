@@ -20,7 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "capi_test.h"
+#include "capi_scenes.h"
 
 static const double kStep = 0.01; /* support_fcc_box's step; the world's spacing is step sqrt 2 */
 static const double kGravity = 9.81;
@@ -118,24 +118,18 @@ static float* by_id(const sph_world* world, sph_attribute attribute, int compone
 static double relative(double got, double want, double scale) { return fabs(got - want) / scale; }
 
 static void test_brute_force(void** state) {
-  const uint32_t layers[3] = {8, 12, 8};
-  const double tank_min[3] = {0.0, 0.0, 0.0}, tank_max[3] = {0.16, 0.24, 0.08};
-  float *lattice = NULL, *pos, *vel, *rho, *p;
-  uint32_t n = 0, count = 0;
+  const support_water_tank water = {{8, 12, 8}, kStep, {0.0, 0.0, 0.0}, {0.16, 0.24, 0.08}, 0.0f};
+  const sph_world_def def = probe_world_def(0);
+  float *pos, *vel, *rho, *p;
+  uint32_t count = 0;
   support_world w;
   sph_sdf* sdf = NULL;
-  sph_world_def def;
   sph_probe_id points[3], gauge;
   const double where[3][3] = {{0.04, 0.03, 0.04}, {0.02, 0.06, 0.03}, {0.10, 0.01, 0.04}};
   double worst = 0.0, h, mass;
   sph_stats stats;
   (void)state;
-  assert_int_equal(support_fcc_box(layers, kStep, NULL, &lattice, &n), SPH_OK);
-  def = probe_world_def(n);
-  EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
-  EXPECT_OK(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * kStep, 0.0f, &sdf, NULL));
-  EXPECT_OK(support_spawn(w.world, lattice, NULL, n));
-  free(lattice);
+  EXPECT_OK(support_water_tank_open(&w, sph_test_backend(), &def, NULL, &water, &sdf, NULL, NULL));
   h = w.def.kernel_radius;
   mass = w.mass;
   for (int k = 0; k < 3; ++k)
@@ -201,51 +195,39 @@ static void test_brute_force(void** state) {
 /* Water 12 x 24 x 12 layers (12 cm wide, H = 24 cm deep) settled in a closed tank for 1.2 s (the
  * acoustic step limit; the default viscosity damps the start-up waves), then read over 0.4 s:
  * a gauge through the centre from 3 cm below the floor to 0.45 m, point probes on the centre line
- * at y = 4, 8, 12 and 16 cm, every substep averaged. */
+ * at y = 4, 8, 12 and 16 cm, every substep averaged (capi_resting_tank_open). */
 static void resting_tank(uint32_t features) {
-  const uint32_t layers[3] = {12, 24, 12};
-  const double width = 0.12, depth = 0.24;
-  const double tank_min[3] = {0.0, 0.0, 0.0}, tank_max[3] = {width, 2.0 * depth, width};
-  const double heights[4] = {0.04, 0.08, 0.12, 0.16};
-  float* lattice = NULL;
-  uint32_t n = 0;
-  support_world w;
-  sph_sdf* sdf = NULL;
-  sph_world_def def;
+  const double width = CAPI_RESTING_WIDTH;
+  const double* heights = capi_resting_heights;
+  capi_resting_tank t;
+  support_world* w = &t.w;
+  sph_world_def def = probe_world_def(0);
   sph_world_params params;
-  sph_probe_id probes[4], gauge, snapshot;
+  sph_probe_id snapshot;
   double snapshot_sum = 0.0, snapshot_sum2 = 0.0;
   int snapshots = 0;
   double pressure[4] = {0.0, 0.0, 0.0, 0.0}, height = 0.0, time = 0.0, probe_time = 0.0, fill, rho0;
-  assert_int_equal(support_fcc_box(layers, kStep, NULL, &lattice, &n), SPH_OK);
-  def = probe_world_def(n);
   def.features = features;
   sph_world_params_init(&params);
   params.step_limits = SPH_STEP_LIMIT_ACOUSTIC;
-  EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, &params));
-  EXPECT_OK(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * kStep, 0.0f, &sdf, NULL));
-  EXPECT_OK(support_spawn(w.world, lattice, NULL, n));
-  free(lattice);
-  rho0 = w.def.rest_density;
-  for (int k = 0; k < 4; ++k)
-    probes[k] = add_point(w.world, width / 2, heights[k], width / 2, SPH_PROBE_EVERY_SUBSTEP);
-  gauge = add_gauge(w.world, width / 2, -0.03, width / 2, 0.48, 0.0);
+  capi_resting_tank_open(&t, &def, &params, SPH_PROBE_EVERY_FRAME);
+  rho0 = w->def.rest_density;
   /* One substep's pressure per frame at 8 cm: its spread over time is the solver's pressure noise
    * (reported for the density diffusion of issue 17 item 3 to compare against). */
-  snapshot = add_point(w.world, width / 2, heights[1], width / 2, SPH_PROBE_EVERY_FRAME);
+  snapshot = add_point(w->world, width / 2, heights[1], width / 2, SPH_PROBE_EVERY_FRAME);
   for (int frame = 0; frame < 80; ++frame) {
-    EXPECT_OK(sph_world_step(w.world, 0.02f));
+    EXPECT_OK(sph_world_step(w->world, 0.02f));
     if (frame < 60) continue;
     {
-      const sph_probe_reading g = reading_of(w.world, gauge);
-      const sph_probe_reading one = reading_of(w.world, snapshot);
+      const sph_probe_reading g = reading_of(w->world, t.gauge);
+      const sph_probe_reading one = reading_of(w->world, snapshot);
       snapshot_sum += one.pressure;
       snapshot_sum2 += (double)one.pressure * one.pressure;
       ++snapshots;
       height += g.water_height * g.time;
       time += g.time;
       for (int k = 0; k < 4; ++k) {
-        const sph_probe_reading r = reading_of(w.world, probes[k]);
+        const sph_probe_reading r = reading_of(w->world, t.probes[k]);
         assert_true(r.samples >= 1);
         pressure[k] += r.pressure * r.time;
         if (k == 0) probe_time += r.time;
@@ -257,12 +239,12 @@ static void resting_tank(uint32_t features) {
   {
     sph_stats st;
     EXPECT_OK(sph_stats_init(&st));
-    EXPECT_OK(sph_world_get_stats(w.world, &st));
+    EXPECT_OK(sph_world_get_stats(w->world, &st));
     print_message("  particles: density min %.2f mean %.2f max %.2f, max speed %.4f m/s, k = %.1f\n",
-                  st.density_min, st.density_mean, st.density_max, st.max_speed, w.params.stiffness);
+                  st.density_min, st.density_mean, st.density_max, st.max_speed, w->params.stiffness);
   }
   /* The fill height: the particles' volume at rest density over the tank's floor. */
-  fill = n * (double)w.mass / rho0 / (width * width);
+  fill = t.count * (double)w->mass / rho0 / (width * width);
   print_message("resting tank: gauge height %.5f m, fill height %.5f m (%+.2f %%)\n", height, fill,
                 100.0 * (height / fill - 1.0));
   for (int k = 0; k < 4; ++k) {
@@ -278,7 +260,7 @@ static void resting_tank(uint32_t features) {
         "  pressure noise at 8 cm (one substep per frame, %d frames): mean %.1f Pa, standard deviation "
         "%.1f Pa (%.1f %% of the mean; k = %.0f, no density diffusion)\n",
         snapshots, mean, sqrt(fmax(0.0, snapshot_sum2 / snapshots - mean * mean)),
-        100.0 * sqrt(fmax(0.0, snapshot_sum2 / snapshots - mean * mean)) / mean, w.params.stiffness);
+        100.0 * sqrt(fmax(0.0, snapshot_sum2 / snapshots - mean * mean)) / mean, w->params.stiffness);
   }
   {
     const double gradient = (pressure[0] - pressure[3]) / (heights[3] - heights[0]);
@@ -302,7 +284,7 @@ static void resting_tank(uint32_t features) {
      * H the gauge's water height (the mass per unit area over rho0) and f the floor the walls in
      * the density hold the water on: the calibration keeps a film of (spacing - step) / 2 free of
      * water at every wall (docs/validation.md, "Loads on a hydrostatic tank's side wall"). */
-    const double k = w.params.stiffness, a = kGravity / k, film = 0.5 * (sqrt(2.0) - 1.0) * kStep;
+    const double k = w->params.stiffness, a = kGravity / k, film = 0.5 * (sqrt(2.0) - 1.0) * kStep;
     const double surface = film + log1p(a * height) / a;
     for (int j = 0; j < 4; ++j) {
       const double want = k * rho0 * ((1.0 + a * height) * exp(-a * (heights[j] - film)) - 1.0);
@@ -317,8 +299,7 @@ static void resting_tank(uint32_t features) {
       assert_true(fabs(pressure[j] - want) <= 0.01 * rho0 * kGravity * d || measuring());
     }
   }
-  EXPECT_OK(sph_sdf_destroy(sdf));
-  EXPECT_OK(support_world_close(&w));
+  capi_resting_tank_close(&t);
 }
 
 static void test_resting_tank(void** state) {

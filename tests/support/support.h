@@ -196,6 +196,30 @@ sph_result support_dam_break(sph_context* context, sph_world* world, const suppo
                              sph_vec3 column_min, sph_vec3 column_max, sph_sdf** sdf,
                              sph_collider_id* collider, uint32_t* count);
 
+/** Water at rest in a closed tank: support_fcc_box's lattice of `layers` at `step` from the origin,
+ * in the tank whose cavity is [tank_min, tank_max] (support_tank_between, voxels of step / 2). */
+typedef struct support_water_tank {
+  uint32_t layers[3];
+  double step;        /* m */
+  double tank_min[3]; /* m */
+  double tank_max[3]; /* m */
+  float friction;     /* of the walls (Coulomb); 0: free slip */
+} support_water_tank;
+
+/** support_world_open (backend, def, params; a def->capacity of 0 becomes the lattice's count),
+ * the tank (*sdf and collider as support_tank_create's), then the lattice spawned at rest.
+ * *count (optional) receives the particle count. Errors: those of the calls, OUT_OF_HOST_MEMORY;
+ * on failure *w holds what was made. */
+sph_result support_water_tank_open(support_world* w, sph_backend backend, const sph_world_def* def,
+                                   const sph_world_params* params, const support_water_tank* scene,
+                                   sph_sdf** sdf, sph_collider_id* collider, uint32_t* count);
+/** The loads tests' collapsing column: 6 x 14 x 8 layers of 1 cm in a tank 16 x 30 x 8 cm, the
+ * column against the faces at x = 0, y = 0 and both z (test_collider_loads.c, test_dfsph_loads.c). */
+support_water_tank support_collapsing_column(float friction);
+/** The probes tests' resting tank: 12 x 24 x 12 layers of 1 cm (12 cm wide, 24 cm deep) in a tank
+ * as wide and twice as deep (test_probes.c, test_dfsph_loads.c). */
+support_water_tank support_resting_tank(void);
+
 #ifdef __cplusplus
 }
 #endif
