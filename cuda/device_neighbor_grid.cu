@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: MIT
+#include <algorithm>
+
 #include <cub/device/device_radix_sort.cuh>
 
+#include "../src/physics/grid_fit.h"
 #include "../src/physics/grid_hash.h"
 #include "device_neighbor_grid.h"
 #include "kernel_launch.h"
@@ -8,12 +11,73 @@
 namespace sph {
 namespace {
 
-__global__ void hash_kernel(GridShape shape, const Float4* __restrict__ positions, uint32_t n,
+constexpr unsigned kExtentBlocks = 1024;  // grid-stride: few blocks, so few atomics a sort
+
+__device__ __forceinline__ uint32_t cell_code(int32_t c) {
+  return static_cast<uint32_t>(static_cast<int64_t>(c) + 2147483648ll);
+}
+
+__device__ __forceinline__ uint32_t warp_max_u32(uint32_t v) {
+  for (int offset = 16; offset > 0; offset >>= 1) v = max(v, __shfl_xor_sync(0xffffffffu, v, offset));
+  return v;
+}
+
+// The particles' cell extent into live->lowest_code / highest_code (zeroed before): maxima only,
+// so any order of the blocks gives the same record.
+__global__ void __launch_bounds__(kDefaultBlockSize)
+    extent_kernel(float inv_cell_size, const Float4* __restrict__ positions, uint32_t n, LiveGridShape* live,
+                  FrameState* state) {
+  mark_stage(state, kStageHashSort);
+  __shared__ uint32_t warp_codes[kDefaultBlockSize / 32][6];
+  uint32_t codes[6] = {0, 0, 0, 0, 0, 0};
+  for (uint32_t i = blockIdx.x * blockDim.x + threadIdx.x; i < n; i += gridDim.x * blockDim.x) {
+    const Float4 p = positions[i];
+    const uint32_t c[3] = {cell_code(cell_coordinate(p.x, inv_cell_size)),
+                           cell_code(cell_coordinate(p.y, inv_cell_size)),
+                           cell_code(cell_coordinate(p.z, inv_cell_size))};
+    for (int a = 0; a < 3; ++a) {
+      codes[a] = max(codes[a], ~c[a]);
+      codes[3 + a] = max(codes[3 + a], c[a]);
+    }
+  }
+  const unsigned lane = threadIdx.x & 31u, warp = threadIdx.x >> 5;
+  for (int k = 0; k < 6; ++k) {
+    const uint32_t v = warp_max_u32(codes[k]);
+    if (lane == 0) warp_codes[warp][k] = v;
+  }
+  __syncthreads();
+  if (threadIdx.x < 6) {
+    uint32_t v = 0;
+    for (unsigned w = 0; w < (blockDim.x + 31u) / 32u; ++w) v = max(v, warp_codes[w][threadIdx.x]);
+    if (v != 0)
+      atomicMax(threadIdx.x < 3 ? &live->lowest_code[threadIdx.x] : &live->highest_code[threadIdx.x - 3], v);
+  }
+}
+
+// One thread: the dims for the extent within the table's slots; no particle: the table's own.
+__global__ void fit_shape_kernel(GridShape table, LiveGridShape* live) {
+  if (live->highest_code[0] == 0) {
+    live->shape = table;
+    return;
+  }
+  CellCoord lo, hi;
+  lo.x = static_cast<int32_t>(static_cast<int64_t>(~live->lowest_code[0]) - 2147483648ll);
+  lo.y = static_cast<int32_t>(static_cast<int64_t>(~live->lowest_code[1]) - 2147483648ll);
+  lo.z = static_cast<int32_t>(static_cast<int64_t>(~live->lowest_code[2]) - 2147483648ll);
+  hi.x = static_cast<int32_t>(static_cast<int64_t>(live->highest_code[0]) - 2147483648ll);
+  hi.y = static_cast<int32_t>(static_cast<int64_t>(live->highest_code[1]) - 2147483648ll);
+  hi.z = static_cast<int32_t>(static_cast<int64_t>(live->highest_code[2]) - 2147483648ll);
+  live->shape = fit_grid_shape(table.inv_cell_size, lo, hi, static_cast<double>(table.cell_count));
+}
+
+__global__ void hash_kernel(GridShape table, const LiveGridShape* __restrict__ live,
+                            const Float4* __restrict__ positions, uint32_t n,
                             const uint32_t* __restrict__ visit, uint32_t* __restrict__ keys,
                             uint32_t* __restrict__ values, FrameState* state) {
   mark_stage(state, kStageHashSort);
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
+  const GridShape shape = live ? live->shape : table;
   const uint32_t k = visit ? visit[i] : i;
   keys[i] = cell_hash_of_position(shape, xyz(positions[k]));
   values[i] = k;
@@ -68,13 +132,16 @@ int bits_for(uint32_t max_value) {
 }  // namespace
 
 DeviceNeighborGrid::DeviceNeighborGrid(const GridShape& shape, uint32_t capacity, uint32_t max_per_cell,
-                                       SortScratch scratch, void* spare, size_t spare_bytes)
+                                       SortScratch scratch, void* spare, size_t spare_bytes,
+                                       bool fit_to_extent)
     : shape_(shape),
+      fit_to_extent_(fit_to_extent),
       capacity_(capacity),
       max_per_cell_(max_per_cell),
       key_bits_(bits_for(shape.cell_count - 1)),
       scratch_(scratch) {
   cell_start_.allocate(static_cast<size_t>(shape.cell_count) + 1, "cell-start table");
+  if (fit_to_extent_) live_.allocate(1, "the grid's fitted shape");
   cub::DoubleBuffer<uint32_t> keys(scratch_.keys[0], scratch_.keys[1]);
   cub::DoubleBuffer<uint32_t> values(scratch_.values[0], scratch_.values[1]);
   cuda_check(cub::DeviceRadixSort::SortPairs(nullptr, temp_bytes_, keys, values, static_cast<int>(capacity),
@@ -90,8 +157,19 @@ DeviceNeighborGrid::DeviceNeighborGrid(const GridShape& shape, uint32_t capacity
 
 void DeviceNeighborGrid::enqueue_sort(const Float4* positions, uint32_t n, FrameState* state,
                                       cudaStream_t stream, const uint32_t* visit) {
+  if (fit_to_extent_) {
+    // The extent of the particles the hash takes (visit is a permutation of [0, n)).
+    cuda_check(cudaMemsetAsync(live_.get(), 0, sizeof(uint32_t) * 6, stream), "the grid's extent reset");
+    const unsigned blocks = std::min(blocks_for(n, kDefaultBlockSize), kExtentBlocks);
+    extent_kernel<<<blocks, kDefaultBlockSize, 0, stream>>>(shape_.inv_cell_size, positions, n, live_.get(),
+                                                            state);
+    check_launch("extent_kernel");
+    fit_shape_kernel<<<1, 1, 0, stream>>>(shape_, live_.get());
+    check_launch("fit_shape_kernel");
+  }
   hash_kernel<<<blocks_for(n, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
-      shape_, positions, n, visit, scratch_.keys[0], scratch_.values[0], state);
+      shape_, fit_to_extent_ ? live_.get() : nullptr, positions, n, visit, scratch_.keys[0],
+      scratch_.values[0], state);
   check_launch("hash_kernel");
   cub::DoubleBuffer<uint32_t> keys(scratch_.keys[0], scratch_.keys[1]);
   cub::DoubleBuffer<uint32_t> values(scratch_.values[0], scratch_.values[1]);

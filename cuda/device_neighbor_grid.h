@@ -23,13 +23,26 @@ struct CrowdGuard {
   const uint32_t* sorted_keys;
 };
 
+// The table shape of one sort, built on the device: the particles' cell extent, each bound as
+// the maximum of an unsigned code (so that a zeroed record is the identity of all six maxima, and
+// the order of the blocks' atomicMax calls cannot change it), then the dims fitted to it within
+// the table's slots (physics/grid_fit.h).
+struct LiveGridShape {
+  uint32_t lowest_code[3];   // max over the particles of ~(cell + 2^31): the lowest cell
+  uint32_t highest_code[3];  // max over the particles of cell + 2^31; 0: no particle
+  GridShape shape;
+};
+
 class DeviceNeighborGrid {
  public:
   // scratch: the key/value buffers (capacity entries each). spare/spare_bytes: memory that is
   // free while the sort runs, reused for the sort's temporary storage when large enough.
-  // max_per_cell: the crowd cap of one slot (src/core/crowded_cell.h).
+  // max_per_cell: the crowd cap of one slot (src/core/crowded_cell.h). fit_to_extent: every sort
+  // first fits the dims of the table's shape.cell_count slots to the particles' extent (a long
+  // flume or a thin slab then folds far fewer cells onto one slot: fewer far candidates in the
+  // walks); false keeps `shape` (a distributed rank's grid, whose slot order its halo follows).
   DeviceNeighborGrid(const GridShape& shape, uint32_t capacity, uint32_t max_per_cell, SortScratch scratch,
-                     void* spare, size_t spare_bytes);
+                     void* spare, size_t spare_bytes, bool fit_to_extent = true);
 
   // Hashes positions[0, n) and sorts. Afterwards order() gives, for each sorted place, the
   // particle's index before the sort. The buffers order() and sorted_keys() point to are
@@ -45,14 +58,18 @@ class DeviceNeighborGrid {
   void enqueue_cell_starts(uint32_t n, FrameState* state, cudaStream_t stream);
 
   const uint32_t* order() const { return order_; }
-  GridView view() const { return GridView{shape_, cell_start_.get()}; }
+  GridView view() const {
+    return GridView{shape_, cell_start_.get(), fit_to_extent_ ? &live_.get()->shape : nullptr};
+  }
   CrowdGuard crowd_guard() const {
     return CrowdGuard{cell_start_.get(), shape_.cell_count + 1, sorted_keys_};
   }
-  uint64_t bytes() const { return cell_start_.bytes() + temp_.bytes(); }
+  uint64_t bytes() const { return cell_start_.bytes() + temp_.bytes() + live_.bytes(); }
 
  private:
-  GridShape shape_;
+  GridShape shape_;  // the table's slots (cell_count) and, without the fit, its dims
+  bool fit_to_extent_;
+  DeviceArray<LiveGridShape> live_;  // one record, when fit_to_extent_
   uint32_t capacity_;
   uint32_t max_per_cell_;
   int key_bits_;

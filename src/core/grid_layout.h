@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Chooses the wrapped grid's table size. The CUDA backend sizes its table once from the
 // world's capacity (its particle arrays are capacity-sized too, so the table, 4 bytes a slot,
-// is a small share of what the world already holds). The CPU backend sizes it at every sort
+// is a small share of what the world already holds) and fits the dims of those slots to the
+// particles' extent on the device at every sort (physics/grid_fit.h). The CPU backend sizes it at every sort
 // from the particles it has: at most two slots per particle, and no more slots along an axis
 // than the particles span there, so a world of capacity 2^30 holding 100 particles has a table
 // of at most 200 slots, not 4 GiB (issue 23 item 9).
@@ -12,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "../physics/grid_fit.h"
 #include "../physics/grid_hash.h"
 
 namespace sph {
@@ -29,38 +31,15 @@ inline GridShape make_grid_shape(float kernel_radius, uint32_t capacity) {
   return g;
 }
 
-// A table for `count` particles whose cells span [lo, hi] (inclusive, per axis): each axis
-// gets the cells the particles span plus one on each side (so the 3x3x3 block around any
-// particle never folds onto particles at the far side), unless that makes more than
-// max(2 count, 64) slots (8 bytes a particle, a few per cent of what a particle holds); then the narrow axes
-// keep theirs and the wide ones share what is left, so a long thin column still gets one slot per particle
-// along its length. Where an axis keeps its span, no two cells along it share a slot.
+// A table for `count` particles whose cells span [lo, hi] (inclusive, per axis): the fit of
+// physics/grid_fit.h within max(2 count, 64) slots (8 bytes a particle, a few per cent of what a
+// particle holds), so a long thin column still gets one slot per particle along its length. Where
+// an axis keeps its span, no two cells along it share a slot.
 constexpr double kGridSlotsPerParticle = 2.0;
 
 inline GridShape make_grid_shape_for_extent(float kernel_radius, CellCoord lo, CellCoord hi, uint32_t count) {
   const double budget = std::max(kGridSlotsPerParticle * static_cast<double>(count), 64.0);
-  double span[3] = {static_cast<double>(hi.x) - lo.x + 3.0, static_cast<double>(hi.y) - lo.y + 3.0,
-                    static_cast<double>(hi.z) - lo.z + 3.0};
-  int axis_order[3] = {0, 1, 2};
-  std::sort(axis_order, axis_order + 3, [&](int a, int b) { return span[a] < span[b]; });
-  double used = 1.0;
-  int32_t dims[3] = {3, 3, 3};
-  for (int k = 0; k < 3; ++k) {
-    const int axis = axis_order[k];
-    // What the remaining axes may have each if they share the rest of the budget evenly.
-    const double fair = std::floor(std::pow(budget / used, 1.0 / (3 - k)) + 1e-9);
-    const double n = std::max(3.0, std::min(span[axis], fair));
-    dims[axis] = static_cast<int32_t>(n);
-    used *= n;
-  }
-  GridShape g;
-  g.inv_cell_size = 1.0f / kernel_radius;
-  g.nx = dims[0];
-  g.ny = dims[1];
-  g.nz = dims[2];
-  g.cell_count =
-      static_cast<uint32_t>(dims[0]) * static_cast<uint32_t>(dims[1]) * static_cast<uint32_t>(dims[2]);
-  return g;
+  return fit_grid_shape(1.0f / kernel_radius, lo, hi, budget);
 }
 
 }  // namespace sph

@@ -16,7 +16,18 @@ namespace sph {
 struct GridView {
   GridShape shape;
   const uint32_t* cell_start;  // cell_count + 1 entries
+  // The CUDA backend's table shape of this sort, fitted on the device to the particles' extent
+  // (cuda/device_neighbor_grid.h); null: `shape` is the table's. Device code only.
+  const GridShape* live_shape = nullptr;
 };
+
+// The shape the table was filled with.
+SPH_HD GridShape shape_of(const GridView& grid) {
+#if defined(__CUDA_ARCH__)
+  if (grid.live_shape) return *grid.live_shape;
+#endif
+  return grid.shape;
+}
 
 // Calls visit_range(begin, end) for each run of consecutive particle indices in the 3x3x3
 // block of cells around p: one run per row of three cells (two where the row wraps around the
@@ -24,7 +35,7 @@ struct GridView {
 // tests r < h (wrapped slots can hold far particles).
 template <class VisitRange>
 SPH_HD void for_each_neighbor_range(const GridView& grid, Vec3 p, VisitRange&& visit_range) {
-  const GridShape& g = grid.shape;
+  const GridShape g = shape_of(grid);
   const CellCoord c = cell_of(g, p);
   // One remainder per axis; the neighbouring slots follow by stepping (each n >= 3).
   const int32_t cx = wrap_index(c.x, g.nx), cy = wrap_index(c.y, g.ny), cz = wrap_index(c.z, g.nz);
