@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: MIT
 """sph-run-mpi under mpirun against sph-run (ctest label mpi; issue 19).
 
-    check_sph_run_mpi.py MPIEXEC SPH_RUN SPH_RUN_MPI SCENE WORKDIR RANKS [--refusals]
+    check_sph_run_mpi.py MPIEXEC SPH_RUN SPH_RUN_MPI SCENE WORKDIR RANKS [--refusals] [--backend cuda]
 
 Runs SCENE with sph-run (libsph, one undivided world) and with RANKS ranks of sph-run-mpi
 (libsph_mpi), both as CSV frames, and asserts that every frame of the merged output equals
@@ -11,8 +11,13 @@ with every rank holding particles after the first step:
 docs/distributed.md promises the same bits while the neighbour grid covers the particles'
 extent, which a closed tank keeps. Also that the --per-rank files of each frame hold every
 particle once, each as the merged frame has it, and (--refusals) that sph-run-mpi refuses a
-scene with a source or springs, naming it.
+scene with a source or springs, naming it, and that --backend cuda either runs (a GPU is there)
+or fails on every rank with exit code 4 and one message naming the option (CI: no GPU).
+--backend cuda: both programs on the CUDA backend (scripts/gpu-test), the scene without its sinks
+(a CUDA rank refuses sinks): the distributed CUDA world against the undivided CUDA world, bit for
+bit while the tables cover the tank (docs/distributed.md, "The CUDA backend as a rank").
 """
+import json
 import glob
 import os
 import shutil
@@ -45,12 +50,21 @@ def rows(path):
 
 def main(argv):
     mpiexec, sph_run, sph_run_mpi, scene, work, ranks = argv[1:7]
+    options = argv[7:]
+    backend = options[options.index("--backend") + 1] if "--backend" in options else "cpu"
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
+    if backend == "cuda":
+        with open(scene, encoding="utf-8") as f:
+            desc = json.load(f)
+        desc.pop("sinks", None)
+        scene = os.path.join(work, "no_sinks.json")
+        with open(scene, "w", encoding="utf-8") as f:
+            json.dump(desc, f)
     single, merged = os.path.join(work, "single"), os.path.join(work, "np" + ranks)
-    run([sph_run, scene, "--format", "csv", "--threads", "1", "--quiet", "--out", single])
-    p = run([mpiexec, "--oversubscribe", "-np", ranks, sph_run_mpi, scene, "--format", "csv", "--threads", "1",
-             "--quiet", "--per-rank", "--out", merged])
+    run([sph_run, scene, "--backend", backend, "--format", "csv", "--threads", "1", "--quiet", "--out", single])
+    p = run([mpiexec, "--oversubscribe", "-np", ranks, sph_run_mpi, scene, "--backend", backend, "--format", "csv",
+             "--threads", "1", "--quiet", "--per-rank", "--out", merged])
     print(p.stdout.strip())
 
     frames = sorted(os.path.basename(f) for f in glob.glob(os.path.join(single, "fluid_*.csv")))
@@ -79,9 +93,22 @@ def main(argv):
     assert len(glob.glob(os.path.join(merged, "rank*"))) == int(ranks), "one folder per rank"
     if differing:
         sys.exit(f"FAIL: {differing} of {len(frames)} frames differ between sph-run and sph-run-mpi -np {ranks}")
-    print(f"{len(frames)} frames of {len(a)} particles: sph-run-mpi on {ranks} ranks == sph-run, bit for bit")
-    if "--refusals" not in argv[7:]:
+    print(f"{len(frames)} frames of {len(a)} particles: sph-run-mpi on {ranks} ranks == sph-run, bit for bit"
+          f" ({backend} backend)")
+    if "--refusals" not in options:
         return 0
+
+    # --backend cuda: runs where a GPU is, else every rank fails alike, one message, exit code 4.
+    env = dict(os.environ, **MPI_ENV)
+    p = subprocess.run([mpiexec, "--oversubscribe", "-np", ranks, sph_run_mpi, scene, "--backend", "cuda",
+                        "--quiet", "--out", os.path.join(work, "cuda")], capture_output=True, text=True, env=env,
+                       timeout=100)
+    if p.returncode == 4:
+        assert "--backend cuda" in p.stderr and p.stderr.count("sph-run-mpi:") == 1, p.stderr
+        print("no GPU:", p.stderr.strip().splitlines()[0])
+    else:
+        assert p.returncode in (0, 3), f"--backend cuda exited {p.returncode}\n{p.stderr}"
+        print(f"--backend cuda: exit {p.returncode} (a GPU is here; 3 = the CUDA rank refused the scene's sinks)")
 
     # A source: refused before any world is made, naming the scene object and the feature.
     with open(scene, encoding="utf-8") as f:

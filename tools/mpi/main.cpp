@@ -40,7 +40,9 @@ const char* const kMpiUsage =
     "  mpirun -np 2 sph-run-mpi SCENE.json [options]\n"
     "Rank 0 writes the merged frames (every rank's particles, by id) to the output directory.\n"
     "  --per-rank          also write each rank's own particles to DIR/rank<R>/\n"
-    "The CPU backend only; no sources, probes or collider loads; no OpenVDB outputs.\n";
+    "  --backend cuda      every rank on the CUDA backend, on the GPU of its node-local rank (or GPU 0\n"
+    "                      where there is no such GPU; the host-staged halo); auto and cpu: the CPU\n"
+    "No sources, probes or collider loads (and on CUDA no sinks); no OpenVDB outputs.\n";
 
 struct Ranks {
   MPI_Comm comm = MPI_COMM_WORLD;
@@ -57,6 +59,36 @@ struct ContextOwner {
 int fail(const Ranks& r, int code, const std::string& message) {
   if (r.rank == 0) std::fprintf(stderr, "sph-run-mpi: %s\n", message.c_str());
   return code;
+}
+
+// The rank's context: the CPU backend for cpu and auto (a distributed world's ranks all need the
+// same backend, which auto cannot promise across nodes); for cuda the GPU of the node-local rank,
+// so that a node's ranks spread over its GPUs, or GPU 0 where the node has fewer GPUs than ranks
+// (ranks then share it, as the host-staged halo allows; docs/distributed.md).
+sph_result create_context(const Ranks& ranks, const CliOptions& cli, sph_context** out) {
+  sph_context_def def;
+  sph_context_def_init(&def);
+  def.cpu_worker_count = cli.threads;
+  if (cli.backend != SPH_BACKEND_CUDA) {
+    def.backend = SPH_BACKEND_CPU;
+    return sph_context_create(&def, out);
+  }
+  MPI_Comm node;
+  int local = 0;
+  MPI_Comm_split_type(ranks.comm, MPI_COMM_TYPE_SHARED, ranks.rank, MPI_INFO_NULL, &node);
+  MPI_Comm_rank(node, &local);
+  MPI_Comm_free(&node);
+  def.backend = SPH_BACKEND_CUDA;
+  def.device_ordinal = local;
+  sph_result r = sph_context_create(&def, out);
+  if (r < 0 && local != 0) {
+    def.device_ordinal = 0;
+    r = sph_context_create(&def, out);
+    if (r >= 0 && !cli.quiet)
+      std::fprintf(stderr, "sph-run-mpi: rank %d: no GPU %d on this node; sharing GPU 0\n", ranks.rank,
+                   local);
+  }
+  return r;
 }
 
 // A failure of this rank alone (its files): the others would wait for it in the next
@@ -121,9 +153,10 @@ int run_frames(const Ranks& ranks, const CliOptions& cli, const SceneDesc& scene
     abort_run(ranks, e.what());
   }
   if (ranks.rank == 0 && !cli.quiet)
-    std::fprintf(stderr, "sph-run-mpi: %s: %u frames at %g fps on %d ranks (CPU) -> %s/%s\n",
+    std::fprintf(stderr, "sph-run-mpi: %s: %u frames at %g fps on %d ranks (%s) -> %s/%s\n",
                  cli.scene.c_str(), scene.frames, static_cast<double>(scene.fps), ranks.count,
-                 out.directory.c_str(), per_rank ? " (+ rank<R>/)" : "");
+                 cli.backend == SPH_BACKEND_CUDA ? "CUDA" : "CPU", out.directory.c_str(),
+                 per_rank ? " (+ rank<R>/)" : "");
   Progress progress(scene.frames, isatty(STDERR_FILENO) != 0, cli.quiet || ranks.rank != 0);
   ParticleFrame own, all;
   uint64_t substeps = 0;
@@ -206,9 +239,6 @@ int run(const Ranks& ranks, int argc, char** argv) {
   }
   if (cli.stats_json)
     return fail(ranks, kExitUsage, "--stats-json: not in sph-run-mpi yet (its summary line is on stdout)");
-  if (cli.backend == SPH_BACKEND_CUDA)
-    return fail(ranks, kExitBackend,
-                "--backend cuda: sph-run-mpi runs on the CPU backend only for now (docs/distributed.md)");
   SceneDesc scene;
   try {
     scene = load_scene_file(cli.scene);
@@ -223,12 +253,18 @@ int run(const Ranks& ranks, int argc, char** argv) {
   if (!unavailable.empty()) return fail(ranks, kExitUnavailable, unavailable);
 
   ContextOwner owner;
-  sph_context_def context_def;
-  sph_context_def_init(&context_def);
-  context_def.backend = SPH_BACKEND_CPU;
-  context_def.cpu_worker_count = cli.threads;
-  const sph_result r = sph_context_create(&context_def, &owner.context);
-  if (r < 0) return fail(ranks, kExitRuntime, LibraryError(r, "creating the context").what());
+  const sph_result r = create_context(ranks, cli, &owner.context);
+  // Every rank learns whether every rank has its context before the world's collective creation.
+  int worst = r < 0 ? static_cast<int>(r) : 0;
+  MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_INT, MPI_MIN, ranks.comm);
+  if (worst < 0) {
+    if (cli.backend == SPH_BACKEND_CUDA)
+      return fail(ranks, kExitBackend,
+                  std::string("--backend cuda: the CUDA backend is not available on every rank (") +
+                      (r < 0 ? sph_get_last_error() : "another rank's") + ")\n  (use --backend cpu)");
+    return fail(ranks, kExitRuntime,
+                LibraryError(static_cast<sph_result>(worst), "creating the context").what());
+  }
   try {
     return run_frames(ranks, cli, scene, out, per_rank, owner.context);
   } catch (const SceneError& e) {
