@@ -141,8 +141,9 @@ SPH_SIMD_GATHER float density_diffusion(const FluidConstants& f, const GridView&
     const typename L::Mask neighbor = valid && r2 < h2;
     if (!any(neighbor)) return;
     const L inv_rho_j = L::load(c.inv_density + base);
-    const L term = density_diffusion_pair_term(f, f.methods.density_diffusion, x_ji, square_root(r2),
-                                               one / inv_rho_j - rho_i, inv_rho_j);
+    const L term =
+        density_diffusion_pair_term(f, f.methods.density_diffusion, x_ji, distance_from_squared(r2).r,
+                                    one / inv_rho_j - rho_i, inv_rho_j);
     rate += select(neighbor, term, zero);
   });
   return reduce_sum(rate);
@@ -281,7 +282,7 @@ SPH_SIMD_GATHER Vec3 acceleration(const FluidConstants& f, const GridView& grid,
     pair.pressure = kPressure ? L::load(c.pressure + base) : zero;
     pair.v = load3<L>(c.vx, c.vy, c.vz, base);
     pair.inv_density = L::load(c.inv_density + base);
-    pair.r = square_root(pair.r2);
+    pair.distance = distance_from_squared(pair.r2);
     pair.pair_neighbors =
         List::kReadsNeighborCounts ? lanes_self.neighbor_count + L::load(c.neighbor_count + base) : zero;
     if (List::kReadsColourNormals) {

@@ -32,7 +32,7 @@ struct DensitySample {
 // T is float or a pack of lanes (lane_math.h; the CPU backend's SIMD density pass).
 template <class T>
 SPH_HD T density_pair_term(const FluidBase& f, T r2) {
-  return spiky_value(f.kernel, square_root(r2));
+  return spiky_value(f.kernel, distance_from_squared(r2).r);
 }
 
 // The sample from the sum of the pair terms and the neighbour count.
