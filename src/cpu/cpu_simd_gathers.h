@@ -141,9 +141,8 @@ SPH_SIMD_GATHER float density_diffusion(const FluidConstants& f, const GridView&
     const typename L::Mask neighbor = valid && r2 < h2;
     if (!any(neighbor)) return;
     const L inv_rho_j = L::load(c.inv_density + base);
-    const L term =
-        density_diffusion_pair_term(f, f.methods.density_diffusion, x_ji, distance_from_squared(r2).r,
-                                    one / inv_rho_j - rho_i, inv_rho_j);
+    const L term = density_diffusion_pair_term(f, f.methods.density_diffusion, x_ji, square_root(r2),
+                                               one / inv_rho_j - rho_i, inv_rho_j);
     rate += select(neighbor, term, zero);
   });
   return reduce_sum(rate);

@@ -106,8 +106,7 @@ SPH_HD float gather_density_diffusion(const FluidBase& f, const DensityDiffusion
     const float r2 = length_squared(x_ji);
     if (r2 >= f.kernel.h2 || j == i) return;
     const float inv_rho_j = velocities[j].w;
-    rate += density_diffusion_pair_term(f, c, x_ji, distance_from_squared(r2).r, 1.0f / inv_rho_j - rho_i,
-                                        inv_rho_j);
+    rate += density_diffusion_pair_term(f, c, x_ji, square_root(r2), 1.0f / inv_rho_j - rho_i, inv_rho_j);
   });
   return rate;
 }

@@ -5,12 +5,14 @@
 //   - r within 4e-7 relative and 1 / r within 3e-7 (rsqrtf is within 2 ulp, 2.4e-7 relative, of
 //     the quotient, CUDA C Programming Guide, "Mathematical functions"; the product r2 (1 / r)
 //     adds half an ulp);
-//   - grad W_spiky (the pressure force's and DFSPH's pair gradient) and W_spiky (the density's
+//   - grad W_spiky (the pressure force's and DFSPH's pair gradient) and W_spiky (DFSPH's density
 //     pair term) within 2e-6 of their values at r = 0 (the error of r enters as 2 (h - r) dr and
 //     3 (h - r)^2 dr, the float formula's own roundings about as much again). The host's float
 //     formula is measured the same way, for the comparison.
 // And the guards: r2 = 0 (a coincident pair) gives r = 0, a zero gradient and W_spiky(0) bit for
 // bit as on the host; r2 below the smallest normal float gives finite values; a NaN r2 a NaN r.
+// Built with nvcc's default arithmetic, as cuda/dfsph_solver.cu is; the WCSPH force pass's file
+// adds -ftz=true, which changes only what a subnormal r2 gives (zero there, so r = 0).
 #include <cuda_runtime.h>
 
 #include <cfloat>
