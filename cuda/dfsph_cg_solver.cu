@@ -216,6 +216,7 @@ __global__ void __launch_bounds__(kDfsphCheckBlock) cg_error_check_kernel(CgSolv
   }
   if (threadIdx.x != 0) return;
   if (measured) {
+    // (n > 0 here: with no particles p . A p is 0 and every iteration skips its measurement)
     state->solve_error = static_cast<float>(error / static_cast<double>(s.n));
     if (outside / static_cast<double>(s.n) >= Dfsph::kCgRestartShare * c.density_error) {
       state->cg_restart = 1;
