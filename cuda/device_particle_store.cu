@@ -58,6 +58,11 @@ DeviceParticleStore::DeviceParticleStore(uint32_t capacity,
   arrays_.dfsph_warm_pressure = static_cast<float*>(find(kArrayDfsphWarmPressure));
   arrays_.dfsph_contact = static_cast<Float4*>(find(kArrayDfsphContact));
   arrays_.dfsph_contact_impulse = static_cast<Float4*>(find(kArrayDfsphContactImpulse));
+  arrays_.dfsph_residual = static_cast<float*>(find(kArrayDfsphResidual));
+  arrays_.dfsph_cg_value = static_cast<float*>(find(kArrayDfsphCgValue));
+  arrays_.dfsph_cg_change = static_cast<float*>(find(kArrayDfsphCgChange));
+  arrays_.dfsph_cg_velocity_step = static_cast<Float4*>(find(kArrayDfsphCgVelocityStep));
+  arrays_.dfsph_cg_state = static_cast<uint8_t*>(find(kArrayDfsphCgState));
   arrays_.boundary_gradient = static_cast<Float4*>(find(kArrayBoundaryGradient));
   arrays_.user_attribute = static_cast<uint32_t*>(find(kArrayUserAttribute));
   arrays_.sorted_user_attribute = static_cast<uint32_t*>(find(kArraySortedUserAttribute));

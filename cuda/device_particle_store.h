@@ -68,6 +68,13 @@ struct ParticleArrays {
   float* dfsph_warm_pressure;     // the density solve's warm start in the sorted order
   Float4* dfsph_contact;          // the particle's contact with the colliders (n, smallest normal speed)
   Float4* dfsph_contact_impulse;  // null unless SPH_FEATURE_COLLIDER_LOADS: the clamp's (collider_loads.h)
+  float* dfsph_residual;          // the conjugate gradients' preconditioned residual z
+  // Null where the conjugate gradients cannot run (particle_arrays.cpp): their density solve's
+  // rho* - rho0, its change along the search direction, that direction's velocity change, flags.
+  float* dfsph_cg_value;
+  float* dfsph_cg_change;
+  Float4* dfsph_cg_velocity_step;
+  uint8_t* dfsph_cg_state;
   // Null unless SPH_FEATURE_BOUNDARY_DENSITY: (grad rho_b, v_b . grad rho_b) of the density pass.
   Float4* boundary_gradient;
   // Null unless SPH_FEATURE_USER_ATTRIBUTE: the caller's value in the state order, and the

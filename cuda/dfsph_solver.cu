@@ -1,28 +1,14 @@
 // SPDX-License-Identifier: MIT
-#include <vector>
-
 #include "../src/physics/collider_loads.h"
 #include "../src/physics/dfsph_passes.h"
 #include "block_reduce.cuh"
+#include "dfsph_solve_loop.cuh"
 #include "dfsph_solver.h"
 #include "force_gather.cuh"
 #include "kernel_launch.h"
 
 namespace sph {
 namespace {
-
-constexpr unsigned kCheckBlock = 256;
-constexpr cudaStreamCaptureMode kCaptureMode = cudaStreamCaptureModeThreadLocal;
-
-// Fixed-shape tree over a block's shared slots: the same additions in the same order every run.
-template <unsigned kBlock>
-__device__ void tree_sum(double* slots) {
-  for (unsigned stride = kBlock / 2; stride > 0; stride >>= 1) {
-    __syncthreads();
-    if (threadIdx.x < stride) slots[threadIdx.x] += slots[threadIdx.x + stride];
-  }
-  __syncthreads();
-}
 
 // kBoundary: SPH_FEATURE_BOUNDARY_DENSITY, the walls' share (dfsph_boundary.h, place 1) at the
 // substep's start, its record kept for the solves.
@@ -101,7 +87,6 @@ __global__ void __launch_bounds__(kDfsphSolveBlock)
     dfsph_residual_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n, const Float4* v,
                           double* partials, FrameState* state) {
   if (state->solve_run == 0) return;  // the same for every thread of the grid
-  __shared__ double slots[kDfsphSolveBlock];
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   double error = 0.0;
   if (i < n) {
@@ -114,34 +99,21 @@ __global__ void __launch_bounds__(kDfsphSolveBlock)
     a.dfsph_step[i] = r.k;
     error = r.error;
   }
-  slots[threadIdx.x] = error;
-  tree_sum<kDfsphSolveBlock>(slots);
-  if (threadIdx.x == 0) partials[blockIdx.x] = slots[0];
+  dfsph_block_sum_to(partials, error);
 }
 
 // The solve's mean error from the block sums; whether it goes on; its record when it stops.
-__global__ void __launch_bounds__(kCheckBlock)
+__global__ void __launch_bounds__(kDfsphCheckBlock)
     dfsph_check_kernel(const double* partials, uint32_t blocks, uint32_t n, float bound,
                        uint32_t min_iterations, uint32_t max_iterations, bool divergence, bool first,
                        LoopCondition cond, FrameState* state) {
   if (state->solve_run == 0) return;
-  __shared__ double slots[kCheckBlock];
-  double sum = 0.0;
-  for (uint32_t b = threadIdx.x; b < blocks; b += kCheckBlock) sum += partials[b];
-  slots[threadIdx.x] = sum;
-  tree_sum<kCheckBlock>(slots);
+  const double sum = dfsph_sum_partials(partials, blocks);
   if (threadIdx.x != 0) return;
-  const float error = n > 0 ? static_cast<float>(slots[0] / n) : 0.0f;
-  const uint32_t iterations = first ? 0u : state->solve_iterations + 1u;
-  state->solve_iterations = iterations;
-  state->solve_error = error;
-  const bool more = (error > bound || iterations < min_iterations) && iterations < max_iterations;
-  if (!more) {
-    record_solve(divergence ? state->divergence_tally : state->pressure_tally, iterations, error,
-                 error > bound);
-    state->solve_run = 0;
-  }
-  if (cond.in_graph) cudaGraphSetConditional(cond.handle, more ? 1u : 0u);
+  state->solve_iterations = first ? 0u : state->solve_iterations + 1u;
+  state->solve_error = n > 0 ? static_cast<float>(sum / n) : 0.0f;
+  dfsph_continue_solve(state, divergence ? state->divergence_tally : state->pressure_tally, bound,
+                       min_iterations, max_iterations, cond);
 }
 
 // v* = v + dt a with the non-pressure accelerations, into the state's velocity array (free
@@ -204,61 +176,6 @@ __global__ void dfsph_integrate_kernel(ParticleArrays a, uint32_t n, DeviceScene
   block_max_to(&state->v2max_bits, v2);
 }
 
-// A conditional handle on the graph the stream is being captured into.
-LoopCondition open_solve_loop(bool in_graph, cudaStream_t stream) {
-  LoopCondition cond;
-  if (!in_graph) return cond;
-  cudaStreamCaptureStatus status = cudaStreamCaptureStatusNone;
-  cudaGraph_t graph = nullptr;
-  cuda_check(cudaStreamGetCaptureInfo(stream, &status, nullptr, &graph, nullptr, nullptr, nullptr),
-             "cudaStreamGetCaptureInfo");
-  cuda_check(cudaGraphConditionalHandleCreate(&cond.handle, graph, 0, cudaGraphCondAssignDefault),
-             "cudaGraphConditionalHandleCreate");
-  cond.in_graph = true;
-  return cond;
-}
-
-// Runs iteration() while the check says so: a WHILE node in the graph being captured (the capture
-// is ended, the node added after what was captured, its body captured, and the capture resumed
-// after it), or chunks on the stream with one read of the flag per chunk.
-template <class Iteration>
-void run_solve_loop(const LoopCondition& cond, FrameState* state, FrameState* host_state, cudaStream_t stream,
-                    Iteration&& iteration) {
-  if (!cond.in_graph) {
-    for (;;) {
-      cuda_check(cudaMemcpyAsync(&host_state->solve_run, &state->solve_run, sizeof(uint32_t),
-                                 cudaMemcpyDeviceToHost, stream),
-                 "copy of the solve's flag");
-      cuda_check(cudaStreamSynchronize(stream), "solve");
-      if (!host_state->solve_run) return;
-      for (uint32_t k = 0; k < kDfsphSolveChunk; ++k) iteration();
-    }
-  }
-  cudaStreamCaptureStatus status = cudaStreamCaptureStatusNone;
-  cudaGraph_t graph = nullptr;
-  const cudaGraphNode_t* leaves = nullptr;
-  size_t leaf_count = 0;
-  cuda_check(cudaStreamGetCaptureInfo(stream, &status, nullptr, &graph, &leaves, nullptr, &leaf_count),
-             "cudaStreamGetCaptureInfo");
-  const HostVector<cudaGraphNode_t> after(leaves, leaves + leaf_count);
-  cuda_check(cudaStreamEndCapture(stream, &graph), "capture before a solve");
-  cudaGraphNodeParams params = {};
-  params.type = cudaGraphNodeTypeConditional;
-  params.conditional.handle = cond.handle;
-  params.conditional.type = cudaGraphCondTypeWhile;
-  params.conditional.size = 1;
-  cudaGraphNode_t loop = nullptr;
-  cuda_check(cudaGraphAddNode(&loop, graph, after.data(), nullptr, after.size(), &params),
-             "conditional WHILE node of a solve");
-  cudaGraph_t body = params.conditional.phGraph_out[0];
-  cuda_check(cudaStreamBeginCaptureToGraph(stream, body, nullptr, nullptr, 0, kCaptureMode),
-             "capture of a solve's iteration");
-  iteration();
-  cuda_check(cudaStreamEndCapture(stream, &body), "capture of a solve's iteration");
-  cuda_check(cudaStreamBeginCaptureToGraph(stream, graph, &loop, nullptr, 1, kCaptureMode),
-             "capture after a solve");
-}
-
 enum class Solve { Divergence, Density };
 
 // One solve: the warm start's pass, the initial residual and check, then the loop.
@@ -288,13 +205,17 @@ void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid
     check_launch("dfsph_residual_kernel");
   };
   auto check = [&](bool first) {
-    dfsph_check_kernel<<<1, kCheckBlock, 0, stream>>>(loops.partials, partial_count, n, bound, min_iterations,
-                                                      max_iterations, divergence, first, cond, state);
+    dfsph_check_kernel<<<1, kDfsphCheckBlock, 0, stream>>>(loops.partials, partial_count, n, bound,
+                                                           min_iterations, max_iterations, divergence, first,
+                                                           cond, state);
     check_launch("dfsph_check_kernel");
   };
   dfsph_correct_kernel<true>
       <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, warm, carried, divergence, contacts, state);
   check_launch("dfsph_correct_kernel");
+  // The same warm start (as the CPU backend's), then the conjugate gradients' iterations.
+  if (!divergence && c.linear_solver == kDfsphConjugateGradients)
+    return enqueue_dfsph_cg_solve(fluid, grid, a, n, contacts, loops, cond, state, stream);
   residual();
   check(true);
   run_solve_loop(cond, state, loops.host_state, stream, [&] {

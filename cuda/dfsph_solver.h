@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // DFSPH on the device (physics/dfsph.h; the twin of src/cpu/cpu_dfsph_solver.cpp): the density
 // and factor pass, then the divergence solve, the non-pressure accelerations, the density solve
-// and the step. Each solve is a Jacobi loop of three kernels, the velocity update, the new rates
+// and the step. Each solve is a Jacobi loop (or, for the density solve, conjugate gradients:
+// dfsph_cg_solver.cu) of three kernels, the velocity update, the new rates
 // and pressures (with each block's error sum in a fixed tree) and a one-block convergence check
 // (the block sums in a fixed order) that decides whether the loop goes on, so the iteration
 // counts and every result are the same bits on every run. The loop never waits for the host per
@@ -30,9 +31,10 @@ constexpr unsigned kDfsphSolveBlock = 128;
 // Iterations the stream driver launches between two reads of the convergence flag.
 constexpr uint32_t kDfsphSolveChunk = 4;
 
-// Doubles the residual kernel's block sums need for `capacity` particles.
+// Doubles the solves' block sums need for `capacity` particles: two per block (the conjugate
+// gradients' error pass sums two quantities).
 inline uint32_t dfsph_partial_count(uint32_t capacity) {
-  return capacity == 0 ? 1u : (capacity + kDfsphSolveBlock - 1) / kDfsphSolveBlock;
+  return 2u * (capacity == 0 ? 1u : (capacity + kDfsphSolveBlock - 1) / kDfsphSolveBlock);
 }
 
 // DFSPH's density pass: rho_i, the neighbour counts, the factor, each particle's contact with the
@@ -48,6 +50,13 @@ struct DfsphLoops {
   double* partials;        // dfsph_partial_count(capacity) doubles
   FrameState* host_state;  // pinned: the stream driver reads solve_run here
 };
+
+// The density solve by conjugate gradients (sph_dfsph_params.linear_solver =
+// SPH_DFSPH_CONJUGATE_GRADIENTS; dfsph_cg_solver.cu), after the warm start's velocity update:
+// the initial values and check, the loop on `cond` (open_solve_loop), the kept pressures.
+void enqueue_dfsph_cg_solve(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                            uint32_t n, bool contacts, const DfsphLoops& loops, const LoopCondition& cond,
+                            FrameState* state, cudaStream_t stream);
 
 // After the density pass (and the spring pass): the divergence solve (unless skipped), the
 // non-pressure accelerations, the density solve, positions, colliders and the reductions of the

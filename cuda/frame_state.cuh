@@ -64,6 +64,16 @@ struct FrameState {
   uint32_t solve_run;         // 1 while the current solve iterates (the stream driver reads it)
   uint32_t solve_iterations;  // of the current solve, after its initial residual
   float solve_error;          // the current solve's mean error
+  // The conjugate gradients' density solve (dfsph_cg_solver.cu): a new cycle is due; the rest of
+  // this iteration is skipped (no descent along p, or a restart); a contact was held in it;
+  // value . z over the active set; the step along p and the next direction's share of p.
+  uint32_t cg_restart;
+  uint32_t cg_skip;
+  uint32_t cg_held;
+  uint32_t cg_pad;
+  double cg_sz;
+  float cg_alpha;
+  float cg_beta;
 
   // Stage timing: the first thread of each stage's first kernel reads the GPU's global
   // nanosecond timer and charges the time since the previous mark to the previous stage.

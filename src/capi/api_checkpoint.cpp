@@ -41,8 +41,7 @@ std::unique_ptr<sph::World> load_world(sph_context* context, const void* data, u
       });
   // A checkpoint's DFSPH parameters that this context cannot run (the state built beside any
   // world it would replace, so nothing has changed).
-  sph::require_supported_dfsph_solver(context->backend, *world, world->params(),
-                                      "checkpoint: sph_dfsph_params.linear_solver");
+  sph::require_supported_dfsph_solver(*world, world->params(), "checkpoint: sph_dfsph_params.linear_solver");
   return world;
 }
 

@@ -105,7 +105,7 @@ sph_result set_params(const char* function, sph_world* world, uint32_t kind, con
     const sph::PublicParams bytes = sph::read_public_params(b, params, "params");
     sph::RuntimeParams r = world->world->params();
     sph::apply_public_params(b, bytes, world->world->config().shape(), "params", r);
-    sph::require_supported_dfsph_solver(world->context->backend, *world->world, r, "params->linear_solver");
+    sph::require_supported_dfsph_solver(*world->world, r, "params->linear_solver");
     world->world->set_params(r);
     return SPH_OK;
   });

@@ -1,30 +1,28 @@
 // SPDX-License-Identifier: MIT
 // Where DFSPH's density solve by conjugate gradients (sph_dfsph_params.linear_solver =
-// SPH_DFSPH_CONJUGATE_GRADIENTS; physics/dfsph_cg.h) cannot run yet: the CUDA backend, a
-// distributed world, the walls in the density (SPH_FEATURE_BOUNDARY_DENSITY) and the collider
-// loads (SPH_FEATURE_COLLIDER_LOADS; docs/physics.md, DFSPH, Limits). Refused when the parameters are set
-// (sph_world_set_dfsph_params and sph_world_set_physics_params) and when a checkpoint that carries them is
-// loaded or restored, so that the user learns of it there, with the world unchanged, instead of at the next
-// step. The backends keep their own refusal at the step for the paths that reach them otherwise (a
-// distributed world loaded from its ranks' checkpoints).
+// SPH_DFSPH_CONJUGATE_GRADIENTS; physics/dfsph_cg.h) cannot run yet: a distributed world, the walls in the
+// density (SPH_FEATURE_BOUNDARY_DENSITY) and the collider loads (SPH_FEATURE_COLLIDER_LOADS; docs/physics.md,
+// DFSPH, Limits). Refused when the parameters are set (sph_world_set_dfsph_params and
+// sph_world_set_physics_params) and when a checkpoint that carries them is loaded or restored, so that the
+// user learns of it there, with the world unchanged, instead of at the next step. The backends keep their own
+// refusal at the step for the paths that reach them otherwise (a distributed world loaded from its ranks'
+// checkpoints).
 #pragma once
 
 #include <string>
 
 #include "../core/world.h"
-#include "../factory/backend_factory.h"
 #include "../physics/dfsph.h"
 
 namespace sph {
 
 // Error(Unsupported) naming the field when `params` ask for conjugate gradients where they do
 // not run; `field` is the field as the caller's message names it.
-inline void require_supported_dfsph_solver(BackendKind backend, const World& world,
-                                           const RuntimeParams& params, const char* field) {
+inline void require_supported_dfsph_solver(const World& world, const RuntimeParams& params,
+                                           const char* field) {
   if (world.config().solver != Solver::Dfsph) return;
   if (params_of<Dfsph>(params).linear_solver != kDfsphConjugateGradients) return;
-  const char* where = backend == BackendKind::Cuda    ? "the CUDA backend (it runs on the CPU backend only)"
-                      : world.backend().distributed() ? "a distributed world"
+  const char* where = world.backend().distributed()                         ? "a distributed world"
                       : (world.config().features & kFeatureBoundaryDensity) ? "SPH_FEATURE_BOUNDARY_DENSITY"
                       // Its search directions and contact holds move velocities outside the
                       // Jacobi update the loads' sums follow (physics/collider_loads.h).

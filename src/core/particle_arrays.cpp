@@ -41,6 +41,20 @@ std::vector<ParticleArraySpec> method_particle_arrays(const WorldConfig& config)
   if (config.solver == Solver::Dfsph && (config.features & kFeatureColliderLoads))
     arrays.push_back(ParticleArraySpec{kArrayDfsphContactImpulse, sizeof(Float4), ParticleArrayRole::Scratch,
                                        1, nullptr, nullptr});
+  // DFSPH's conjugate gradients (dfsph_cg.h): a runtime choice (sph_dfsph_params.linear_solver), so
+  // its arrays are there wherever it may be chosen, and only there (capi/dfsph_solver_check.h
+  // refuses it with the walls in the density or the loads). 25 bytes per particle.
+  if (config.solver == Solver::Dfsph &&
+      !(config.features & (kFeatureBoundaryDensity | kFeatureColliderLoads)))
+    for (const ParticleArraySpec& spec : {ParticleArraySpec{kArrayDfsphCgValue, sizeof(float),
+                                                            ParticleArrayRole::Scratch, 1, nullptr, nullptr},
+                                          ParticleArraySpec{kArrayDfsphCgChange, sizeof(float),
+                                                            ParticleArrayRole::Scratch, 1, nullptr, nullptr},
+                                          ParticleArraySpec{kArrayDfsphCgVelocityStep, sizeof(Float4),
+                                                            ParticleArrayRole::Scratch, 1, nullptr, nullptr},
+                                          ParticleArraySpec{kArrayDfsphCgState, sizeof(uint8_t),
+                                                            ParticleArrayRole::Scratch, 1, nullptr, nullptr}})
+      arrays.push_back(spec);
   if (config.features & kFeatureUserAttribute)
     arrays.push_back(ParticleArraySpec{kArrayUserAttribute, sizeof(uint32_t), ParticleArrayRole::Carried, 1,
                                        nullptr, nullptr});

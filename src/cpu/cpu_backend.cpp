@@ -62,6 +62,10 @@ CpuBackend::CpuBackend(const WorldConfig& config, unsigned workers, const TaskSy
   dfsph_residual_ = store_.find_typed<float>(kArrayDfsphResidual);
   dfsph_contact_ = store_.find_typed<Float4>(kArrayDfsphContact);
   clamp_impulse_ = store_.find_typed<Float4>(kArrayDfsphContactImpulse);
+  cg_value_ = store_.find_typed<float>(kArrayDfsphCgValue);
+  cg_change_ = store_.find_typed<float>(kArrayDfsphCgChange);
+  cg_velocity_step_ = store_.find_typed<Float4>(kArrayDfsphCgVelocityStep);
+  cg_state_ = store_.find_typed<uint8_t>(kArrayDfsphCgState);
   boundary_ = store_.find_typed<Float4>(kArrayBoundaryGradient);
   user_attribute_ = store_.find_typed<uint32_t>(kArrayUserAttribute);
 }

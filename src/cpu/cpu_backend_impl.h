@@ -332,10 +332,10 @@ class CpuBackend final : public Backend {
   CpuArrayRef<Float4> clamp_impulse_;         // DFSPH with the loads: the clamp's, per particle
   bool dfsph_contacts_ = false;               // DFSPH: the substep has colliders (contacts to respect)
   HostVector<ColliderView> dfsph_colliders_;  // DFSPH: the substep's colliders, for the contacts
-  HostVector<float> cg_value_;                // DFSPH by conjugate gradients: rho* - rho0 per particle
-  HostVector<float> cg_change_;               // ... its change along the search direction
-  HostVector<Float4> cg_velocity_step_;       // ... the velocity change of the search direction
-  HostVector<uint8_t> cg_state_;              // ... in the active set; contact binds
+  CpuArrayRef<float> cg_value_;               // DFSPH by conjugate gradients: rho* - rho0 per particle
+  CpuArrayRef<float> cg_change_;              // ... its change along the search direction
+  CpuArrayRef<Float4> cg_velocity_step_;      // ... the velocity change of the search direction
+  CpuArrayRef<uint8_t> cg_state_;             // ... in the active set; contact binds
   CpuArrayRef<Float4> boundary_;              // boundary density: (grad rho_b, v_b . grad rho_b) per particle
   CpuArrayRef<uint32_t> user_attribute_;      // SPH_FEATURE_USER_ATTRIBUTE: the caller's value
   CpuBoundaryMaps boundary_maps_;

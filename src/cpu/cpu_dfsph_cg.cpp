@@ -75,10 +75,6 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
   const Dfsph::Constants& c = fluid.methods.dfsph;
   const float bound = c.density_error;
   const uint32_t n = count_;
-  cg_value_.resize(n);
-  cg_change_.resize(n);
-  cg_velocity_step_.resize(n);
-  cg_state_.resize(n);
   float* p = columns_.dfsph_step();  // the search direction, read by the velocity update as k
   float* value = cg_value_.data();
   float* change = cg_change_.data();

@@ -47,7 +47,7 @@ namespace sph {
 // sph_dfsph_params.flags (SPH_DFSPH_*).
 enum DfsphFlags : uint32_t { kDfsphSkipDivergenceSolve = 1u << 0, kDfsphFlagsAll = 1u };
 // sph_dfsph_params.linear_solver (SPH_DFSPH_JACOBI, SPH_DFSPH_CONJUGATE_GRADIENTS): how the
-// density solve iterates (dfsph_cg.h has the conjugate gradients' method; CPU only).
+// density solve iterates (dfsph_cg.h has the conjugate gradients' method).
 enum DfsphLinearSolver : uint32_t { kDfsphJacobi = 1, kDfsphConjugateGradients = 2 };
 
 // The names of DFSPH's per-particle arrays.
@@ -58,6 +58,13 @@ constexpr const char* kArrayDfsphStep = "dfsph_step";                      // th
 constexpr const char* kArrayDfsphResidual = "dfsph_residual";              // the particle's error
 constexpr const char* kArrayDfsphWarmPressure = "dfsph_warm_pressure";     // warm start, sorted order
 constexpr const char* kArrayDfsphContact = "dfsph_contact";                // Float4: wall normal, speed
+// The conjugate gradients' density solve (dfsph_cg.h; registered by particle_arrays.cpp only where
+// it may run): rho* - rho0, its change along the search direction, the search direction's
+// velocity change, and the particle's flags (in the active set, contact binds).
+constexpr const char* kArrayDfsphCgValue = "dfsph_cg_value";
+constexpr const char* kArrayDfsphCgChange = "dfsph_cg_change";
+constexpr const char* kArrayDfsphCgVelocityStep = "dfsph_cg_velocity_step";  // Float4
+constexpr const char* kArrayDfsphCgState = "dfsph_cg_state";                 // uint8_t
 
 struct Dfsph {
   static constexpr const char* kName = "dfsph";

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '3b9a6e06bfeaffabf53d4891a8df4a61643e6b88f3d787b6e6d29a88d882171a', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '699639a0e819378dc6d733608aad948a6bf144150d1854f638cd4e59f377f358', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -1085,7 +1085,7 @@ class DfsphParams(_SphStruct):
         max_iterations (uint32_t): cap of the density solve per substep; default 100; >= 2; 0 = default. A solve that stops here above its bound is counted in sph_stats and reported as an event
         max_divergence_iterations (uint32_t): cap of the divergence solve; default 100; >= 1; 0 = default
         flags (uint32_t): SPH_DFSPH_* bits; default 0
-        linear_solver (uint32_t): how the density solve iterates: SPH_DFSPH_JACOBI (the default) or SPH_DFSPH_CONJUGATE_GRADIENTS (the divergence solve is always Jacobi); 0 = default; any other value is INVALID_ARGUMENT. Conjugate gradients run on the CPU backend only: on the CUDA backend, a distributed world or with SPH_FEATURE_BOUNDARY_DENSITY setting it (or loading a checkpoint with it) is UNSUPPORTED, the world unchanged
+        linear_solver (uint32_t): how the density solve iterates: SPH_DFSPH_JACOBI (the default) or SPH_DFSPH_CONJUGATE_GRADIENTS (the divergence solve is always Jacobi); 0 = default; any other value is INVALID_ARGUMENT. Conjugate gradients run on the CPU and CUDA backends; in a distributed world or with SPH_FEATURE_BOUNDARY_DENSITY or SPH_FEATURE_COLLIDER_LOADS setting it (or loading a checkpoint with it) is UNSUPPORTED, the world unchanged
     """
     _fields_ = [
         ('struct_size', _c.c_uint32),

@@ -310,11 +310,11 @@ def test_dfsph_world_has_its_params_and_refuses_what_it_does_not_support(ctx):
         w.step(1 / 60)
         s = w.stats()
         assert s.pressure_iterations >= 2 * s.substeps and s.density_error_max <= 1e-4
-        # The conjugate gradients' density solve: the same bound on the CPU; other values refused.
+        # The conjugate gradients' density solve: the same bound (either backend); other values refused.
         assert w.dfsph_params.linear_solver == sph.raw.SPH_DFSPH_JACOBI
         e = error(w.set_dfsph_params, linear_solver=3)
         assert "params->linear_solver" in e.message and w.dfsph_params.linear_solver == sph.raw.SPH_DFSPH_JACOBI
-        w.set_dfsph_params(linear_solver=sph.raw.SPH_DFSPH_CONJUGATE_GRADIENTS)  # ctx is a CPU context
+        w.set_dfsph_params(linear_solver=sph.raw.SPH_DFSPH_CONJUGATE_GRADIENTS)
         w.step(1 / 60)
         s = w.stats()
         assert s.pressure_iterations >= 2 * s.substeps and s.density_error_max <= 1e-4

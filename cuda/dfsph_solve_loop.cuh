@@ -1,0 +1,138 @@
+// SPDX-License-Identifier: MIT
+// What DFSPH's device solves share (dfsph_solver.cu's Jacobi solves, dfsph_cg_solver.cu's
+// conjugate gradients): the loop that runs an iteration's kernels while the device says so (a
+// conditional WHILE node of the graph being captured, or chunks on the stream with one read of
+// the flag per chunk), the sums in a fixed order (every block's tree, then the block sums in one
+// block: the same additions in the same order every run, so iteration counts and results are the
+// same bits), and the stopping rule with its record.
+#pragma once
+
+#include <stdint.h>
+
+#include <cuda_runtime.h>
+
+#include "../src/core/host_memory.h"
+#include "../src/core/solver_record.h"
+#include "cuda_status.h"
+#include "dfsph_solver.h"
+#include "frame_control.h"
+#include "frame_state.cuh"
+
+namespace sph {
+
+// Threads of the one-block kernels that sum the block sums and decide.
+constexpr unsigned kDfsphCheckBlock = 256;
+
+// Fixed-shape tree over a block's shared slots: the same additions in the same order every run.
+template <unsigned kBlock>
+__device__ void block_tree_sum(double* slots) {
+  for (unsigned stride = kBlock / 2; stride > 0; stride >>= 1) {
+    __syncthreads();
+    if (threadIdx.x < stride) slots[threadIdx.x] += slots[threadIdx.x + stride];
+  }
+  __syncthreads();
+}
+
+// The block's sum of `value` into partials[blockIdx.x]. Called by every thread of the block
+// (kDfsphSolveBlock threads); may be called more than once in a kernel.
+__device__ inline void dfsph_block_sum_to(double* partials, double value) {
+  __shared__ double slots[kDfsphSolveBlock];
+  __syncthreads();  // a previous call's slots are read
+  slots[threadIdx.x] = value;
+  block_tree_sum<kDfsphSolveBlock>(slots);
+  if (threadIdx.x == 0) partials[blockIdx.x] = slots[0];
+}
+
+// The sum of `blocks` block sums, in every thread of a kDfsphCheckBlock-thread block.
+__device__ inline double dfsph_sum_partials(const double* partials, uint32_t blocks) {
+  __shared__ double slots[kDfsphCheckBlock];
+  __syncthreads();  // a previous call's result is read
+  double sum = 0.0;
+  for (uint32_t b = threadIdx.x; b < blocks; b += kDfsphCheckBlock) sum += partials[b];
+  slots[threadIdx.x] = sum;
+  block_tree_sum<kDfsphCheckBlock>(slots);
+  return slots[0];
+}
+
+// Ends the current solve: its record (the iterations and error it reached; capped when the error
+// is above the bound) and the loop's flag and condition. One thread.
+__device__ inline void dfsph_stop_solve(FrameState* state, SolveTally& tally, float bound,
+                                        LoopCondition cond) {
+  record_solve(tally, state->solve_iterations, state->solve_error, state->solve_error > bound);
+  state->solve_run = 0;
+  if (cond.in_graph) cudaGraphSetConditional(cond.handle, 0u);
+}
+
+// The loop's test after an iteration (or the initial residual), as the CPU backend's: on while the
+// error is above the bound or the minimum has not run, and below the cap. One thread.
+__device__ inline void dfsph_continue_solve(FrameState* state, SolveTally& tally, float bound,
+                                            uint32_t min_iterations, uint32_t max_iterations,
+                                            LoopCondition cond) {
+  const uint32_t iterations = state->solve_iterations;
+  const bool more =
+      (state->solve_error > bound || iterations < min_iterations) && iterations < max_iterations;
+  if (!more) {
+    dfsph_stop_solve(state, tally, bound, cond);
+    return;
+  }
+  if (cond.in_graph) cudaGraphSetConditional(cond.handle, 1u);
+}
+
+// A conditional handle on the graph the stream is being captured into.
+inline LoopCondition open_solve_loop(bool in_graph, cudaStream_t stream) {
+  LoopCondition cond;
+  if (!in_graph) return cond;
+  cudaStreamCaptureStatus status = cudaStreamCaptureStatusNone;
+  cudaGraph_t graph = nullptr;
+  cuda_check(cudaStreamGetCaptureInfo(stream, &status, nullptr, &graph, nullptr, nullptr, nullptr),
+             "cudaStreamGetCaptureInfo");
+  cuda_check(cudaGraphConditionalHandleCreate(&cond.handle, graph, 0, cudaGraphCondAssignDefault),
+             "cudaGraphConditionalHandleCreate");
+  cond.in_graph = true;
+  return cond;
+}
+
+// Runs iteration() while the check says so: a WHILE node in the graph being captured (the capture
+// is ended, the node added after what was captured, its body captured, and the capture resumed
+// after it), or chunks on the stream with one read of the flag per chunk (each kernel does nothing
+// once the solve has stopped).
+template <class Iteration>
+void run_solve_loop(const LoopCondition& cond, FrameState* state, FrameState* host_state, cudaStream_t stream,
+                    Iteration&& iteration) {
+  constexpr cudaStreamCaptureMode kCaptureMode = cudaStreamCaptureModeThreadLocal;
+  if (!cond.in_graph) {
+    for (;;) {
+      cuda_check(cudaMemcpyAsync(&host_state->solve_run, &state->solve_run, sizeof(uint32_t),
+                                 cudaMemcpyDeviceToHost, stream),
+                 "copy of the solve's flag");
+      cuda_check(cudaStreamSynchronize(stream), "solve");
+      if (!host_state->solve_run) return;
+      for (uint32_t k = 0; k < kDfsphSolveChunk; ++k) iteration();
+    }
+  }
+  cudaStreamCaptureStatus status = cudaStreamCaptureStatusNone;
+  cudaGraph_t graph = nullptr;
+  const cudaGraphNode_t* leaves = nullptr;
+  size_t leaf_count = 0;
+  cuda_check(cudaStreamGetCaptureInfo(stream, &status, nullptr, &graph, &leaves, nullptr, &leaf_count),
+             "cudaStreamGetCaptureInfo");
+  const HostVector<cudaGraphNode_t> after(leaves, leaves + leaf_count);
+  cuda_check(cudaStreamEndCapture(stream, &graph), "capture before a solve");
+  cudaGraphNodeParams params = {};
+  params.type = cudaGraphNodeTypeConditional;
+  params.conditional.handle = cond.handle;
+  params.conditional.type = cudaGraphCondTypeWhile;
+  params.conditional.size = 1;
+  cudaGraphNode_t loop = nullptr;
+  cuda_check(cudaGraphAddNode(&loop, graph, after.data(), nullptr, after.size(), &params),
+             "conditional WHILE node of a solve");
+  cudaGraph_t body = params.conditional.phGraph_out[0];
+  cuda_check(cudaStreamBeginCaptureToGraph(stream, body, nullptr, nullptr, 0, kCaptureMode),
+             "capture of a solve's iteration");
+  iteration();
+  cuda_check(cudaStreamEndCapture(stream, &body), "capture of a solve's iteration");
+  cuda_check(cudaStreamBeginCaptureToGraph(stream, graph, &loop, nullptr, 1, kCaptureMode),
+             "capture after a solve");
+}
+
+}  // namespace sph
