@@ -244,6 +244,18 @@ int main() {
          return sph_world_create(s.context, &def, &made_world);
        },
        [&](Scene&) { sph_world_destroy(made_world); }, false},
+      // DFSPH's arrays, the conjugate gradients' among them (allocated with any DFSPH world that
+      // may choose them: src/core/particle_arrays.cpp), and its solves' block sums.
+      {"sph_world_create (DFSPH)", Objects::None,
+       [&](Scene& s) {
+         sph_world_def def;
+         sph_world_def_init(&def);
+         def.capacity = 20000;
+         def.solver = SPH_SOLVER_DFSPH;
+         def.equation_of_state = SPH_EOS_IDEAL_GAS;
+         return sph_world_create(s.context, &def, &made_world);
+       },
+       [&](Scene&) { sph_world_destroy(made_world); }, false},
       {"sph_world_fill_box", Objects::None,
        [](Scene& s) {
          sph_fill_box_desc box;
