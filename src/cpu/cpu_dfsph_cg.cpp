@@ -49,7 +49,7 @@ void CpuBackend::dfsph_cg_hold_contact(const FluidConstants& fluid, const DfsphW
     const Vec3 d = xi - xyz(x[j]);
     const float r2 = length_squared(d);
     if (!(r2 < fluid.kernel.h2) || j == i) return;
-    const float term = dot(dv, spiky_gradient(mk, d, distance_from_squared(r2)));
+    const float term = dot(dv, spiky_gradient(mk, d, std::sqrt(r2)));
     own += term;
     value[j] += dt * term;
   });

@@ -281,7 +281,7 @@ SPH_SIMD_GATHER Vec3 acceleration(const FluidConstants& f, const GridView& grid,
     pair.pressure = kPressure ? L::load(c.pressure + base) : zero;
     pair.v = load3<L>(c.vx, c.vy, c.vz, base);
     pair.inv_density = L::load(c.inv_density + base);
-    pair.distance = distance_from_squared(pair.r2);
+    pair.r = square_root(pair.r2);
     pair.pair_neighbors =
         List::kReadsNeighborCounts ? lanes_self.neighbor_count + L::load(c.neighbor_count + base) : zero;
     if (List::kReadsColourNormals) {

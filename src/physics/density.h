@@ -30,12 +30,6 @@ struct DensitySample {
 
 // The pair term of the sum for a neighbour at squared distance r2 (< h^2, j != i): W_spiky(r).
 // T is float or a pack of lanes (lane_math.h; the CPU backend's SIMD density pass).
-// It needs r and no 1 / r, so it takes the square root itself rather than the pair distance of
-// lane_math.h (r = r2 rsqrtf(r2)): the CUDA file of this pass (and of the density
-// diffusion, which needs r alone too) is built with -prec-sqrt=false, where sqrtf is one
-// hardware approximation already, and the rsqrtf form made its kernels 1-6 % longer in SASS
-// (ptxas sm_90, docs/performance.md, session 12). DFSPH's density pass takes both r and 1 / r
-// (dfsph_passes.h) and uses the pair distance.
 template <class T>
 SPH_HD T density_pair_term(const FluidBase& f, T r2) {
   return spiky_value(f.kernel, square_root(r2));

@@ -61,21 +61,21 @@ struct DfsphFactorTermsOf {
 template <class T>
 SPH_HD DfsphFactorTermsOf<T> dfsph_factor_pair_terms(const FluidBase& f, const KernelCoefficients& mk,
                                                      Vec3Of<T> d, T r2) {
-  const DistanceOf<T> r = distance_from_squared(r2);
+  const T r = square_root(r2);
   const Vec3Of<T> g = spiky_gradient(mk, d, r);
-  return DfsphFactorTermsOf<T>{spiky_value(f.kernel, r.r), g, length_squared(g)};
+  return DfsphFactorTermsOf<T>{spiky_value(f.kernel, r), g, length_squared(g)};
 }
 
 // The density rate: m (v_i - v_j) . grad W_ij (v_ij = v_i - v_j).
 template <class T>
 SPH_HD T density_rate_pair_term(const KernelCoefficients& mk, Vec3Of<T> d, T r2, Vec3Of<T> v_ij) {
-  return dot(v_ij, spiky_gradient(mk, d, distance_from_squared(r2)));
+  return dot(v_ij, spiky_gradient(mk, d, square_root(r2)));
 }
 
 // The velocity update: m (k_i + k_j) grad W_ij (k_ij = k_i + k_j).
 template <class T>
 SPH_HD Vec3Of<T> pressure_velocity_pair_term(const KernelCoefficients& mk, Vec3Of<T> d, T r2, T k_ij) {
-  return spiky_gradient(mk, d, distance_from_squared(r2)) * k_ij;
+  return spiky_gradient(mk, d, square_root(r2)) * k_ij;
 }
 
 // What each gather makes of its sums and the walls' share (one text for every path).

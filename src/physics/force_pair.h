@@ -30,16 +30,16 @@ using ForceParticle = ForceParticleOf<float>;
 template <class T>
 struct ForcePairOf {
   using Mask = decltype(T() < T());
-  T pressure;              // p_j
-  Vec3Of<T> v;             // v_j
-  T inv_density;           // 1 / rho_j
-  Vec3Of<T> d;             // x_i - x_j
-  T r2;                    // |d|^2 < h^2, j != i (in the lanes of `neighbor`)
-  DistanceOf<T> distance;  // r = |d| (distance.r) and the division by it (distance.over)
-  T pair_neighbors;        // n_i + n_j, when a term reads neighbour counts (else 0)
-  Vec3Of<T> normal;        // j's colour-field normal, when a term reads them (else 0)
-  T normal_length;         // |n_j| (else 0)
-  Mask neighbor;           // the lanes that hold a force neighbour (true for a scalar pair)
+  T pressure;        // p_j
+  Vec3Of<T> v;       // v_j
+  T inv_density;     // 1 / rho_j
+  Vec3Of<T> d;       // x_i - x_j
+  T r2;              // |d|^2 < h^2, j != i (in the lanes of `neighbor`)
+  T r;               // |d|
+  T pair_neighbors;  // n_i + n_j, when a term reads neighbour counts (else 0)
+  Vec3Of<T> normal;  // j's colour-field normal, when a term reads them (else 0)
+  T normal_length;   // |n_j| (else 0)
+  Mask neighbor;     // the lanes that hold a force neighbour (true for a scalar pair)
 
   // A pair term as it enters a sum: the value where j is a force neighbour, else zero. Sums
   // start at +0 and so are never -0, hence adding a lane's +0 leaves its sum's bits unchanged.

@@ -139,7 +139,7 @@ class AccelerationGather<ForceTerms<Terms...>, kPressure> {
     pair.inv_density = vj.w;
     pair.d = d;
     pair.r2 = r2;
-    pair.distance = distance_from_squared(r2);
+    pair.r = SPH_SQRTF(r2);
     pair.pair_neighbors =
         List::kReadsNeighborCounts ? self_.neighbor_count + static_cast<float>(in_.neighbor_counts[j]) : 0.0f;
     const Float4 normal = List::kReadsColourNormals ? in_.colour_normals[j] : Float4{0.0f, 0.0f, 0.0f, 0.0f};

@@ -69,13 +69,12 @@ SPH_HD T spiky_gradient_magnitude(const KernelCoefficientsOf<S>& c, T r) {
   return select(r >= c.h, T(0), c.spiky_grad * d * d);
 }
 
-// grad W_spiky(r_vec, h) with r_vec = x_i - x_j at distance r = |r_vec| (distance_from_squared,
-// lane_math.h: the device multiplies by its 1 / r); zero at r = 0 (direction undefined there).
+// grad W_spiky(r_vec, h) with r_vec = x_i - x_j; zero at r = 0 (direction undefined there).
 template <class S, class T>
-SPH_HD Vec3Of<T> spiky_gradient(const KernelCoefficientsOf<S>& c, Vec3Of<T> r_vec, const DistanceOf<T>& r) {
+SPH_HD Vec3Of<T> spiky_gradient(const KernelCoefficientsOf<S>& c, Vec3Of<T> r_vec, T r) {
   const T zero(0);
-  return select((r.r <= zero) || (r.r >= c.h), Vec3Of<T>{zero, zero, zero},
-                r_vec * r.over(spiky_gradient_magnitude(c, r.r)));
+  return select((r <= zero) || (r >= c.h), Vec3Of<T>{zero, zero, zero},
+                r_vec * (spiky_gradient_magnitude(c, r) / r));
 }
 
 // Laplacian of W_viscosity.

@@ -37,7 +37,7 @@ struct SymmetricPressure {
   SPH_HD static void add_pair(const FluidBase& f, const ForceParticleOf<T>& i, const ForcePairOf<T>& j,
                               SumsOf<T>& s) {
     // -(p_i / rho_i^2 + p_j / rho_j^2) grad W_spiky; m and 1 / rho_i^2 are applied once below.
-    const Vec3Of<T> grad = spiky_gradient(f.kernel, j.d, j.distance);
+    const Vec3Of<T> grad = spiky_gradient(f.kernel, j.d, j.r);
     s.pressure += j.only(grad * (-j.pressure * j.inv_density * j.inv_density));
     s.own_pressure += j.only(grad * (-i.pressure));
   }

@@ -143,8 +143,8 @@ struct SurfaceTension {
     const Vec3Of<T> g = poly6_gradient(f.kernel, j.d, j.r2);
     s.tension += j.only(stress_times(c, j.normal, j.normal_length, g));
     s.gradient += j.only(g);
-    const Vec3Of<T> pull = j.d * j.distance.over(cohesion_spline(f.kernel.h, j.distance.r));
-    s.cohesion += j.only(select(j.distance.r > zero, pull, Vec3Of<T>{zero, zero, zero}));
+    const Vec3Of<T> pull = j.d * (cohesion_spline(f.kernel.h, j.r) / j.r);
+    s.cohesion += j.only(select(j.r > zero, pull, Vec3Of<T>{zero, zero, zero}));
   }
   SPH_HD static void finish(const FluidBase& f, const Constants& c, const ForceParticle& i, const Sums& s,
                             Vec3& a) {

@@ -60,9 +60,9 @@ struct ClavetViscosity {
     // Approaching pairs (u > 0 along i -> j, r > 0) exchange I = dt (1 - q)(sigma u + beta u^2);
     // i takes half of it, pointing away from j.
     const T zero(0);
-    const Vec3Of<T> unit = j.d * j.distance.over(T(-1.0f));
+    const Vec3Of<T> unit = j.d * (T(-1.0f) / j.r);
     const T u = dot(i.v - j.v, unit);
-    const T q = j.distance.r / f.kernel.h;
+    const T q = j.r / f.kernel.h;
     const T impulse = f.dt * (T(1.0f) - q) * (c.linear * u + c.quadratic * u * u);
     // At most u: the pair's own impulse may stop its approach but never reverse it (with
     // few neighbours the energy bound alone, up to 2u, would let a large coefficient turn
@@ -71,7 +71,7 @@ struct ClavetViscosity {
     const T bound = select(energy_bound < u, energy_bound, u);
     const T capped = select(impulse > bound, bound, impulse);
     const Vec3Of<T> change = unit * (T(-0.5f) * capped);
-    s.viscosity += j.only(select(!(j.distance.r > zero) || !(u > zero), Vec3Of<T>{zero, zero, zero}, change));
+    s.viscosity += j.only(select(!(j.r > zero) || !(u > zero), Vec3Of<T>{zero, zero, zero}, change));
   }
   SPH_HD static void finish(const FluidBase& f, const Constants&, const ForceParticle&, const Sums& s,
                             Vec3& a) {

@@ -52,7 +52,7 @@ struct MuellerViscosity {
   template <class T>
   SPH_HD static void add_pair(const FluidBase& f, const Constants&, const ForceParticleOf<T>& i,
                               const ForcePairOf<T>& j, SumsOf<T>& s) {
-    s.viscosity += j.only((j.v - i.v) * (viscosity_laplacian(f.kernel, j.distance.r) * j.inv_density));
+    s.viscosity += j.only((j.v - i.v) * (viscosity_laplacian(f.kernel, j.r) * j.inv_density));
   }
   SPH_HD static void finish(const FluidBase& f, const Constants& c, const ForceParticle& i, const Sums& s,
                             Vec3& a) {
