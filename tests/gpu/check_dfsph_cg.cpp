@@ -124,23 +124,6 @@ bool same_stats(const Run& a, const Run& b) {
   return true;
 }
 
-double largest(const std::vector<float>& v) {
-  double m = 0.0;
-  for (size_t i = 0; i < v.size(); i += 3)
-    m = std::max(m,
-                 std::sqrt(double(v[i]) * v[i] + double(v[i + 1]) * v[i + 1] + double(v[i + 2]) * v[i + 2]));
-  return m;
-}
-
-double largest_difference(const std::vector<float>& a, const std::vector<float>& b) {
-  double m = 0.0;
-  for (size_t i = 0; i < a.size(); i += 3) {
-    const double dx = double(a[i]) - b[i], dy = double(a[i + 1]) - b[i + 1], dz = double(a[i + 2]) - b[i + 2];
-    m = std::max(m, std::sqrt(dx * dx + dy * dy + dz * dz));
-  }
-  return m;
-}
-
 // The solve within its bound on every substep, none capped.
 void check_bound(const Run& r, const char* backend) {
   uint32_t capped = 0, substeps = 0, iterations = 0, most = 0;
@@ -175,8 +158,8 @@ int main() {
   uint32_t close_frames = 0;
   while (close_frames < kFrames &&
          (close_frames == 0 ||
-          largest_difference(cpu.frames[close_frames - 1].position, gpu.frames[close_frames - 1].position) <=
-              1e-3 * largest(cpu.frames[close_frames - 1].position)))
+          max_diff(cpu.frames[close_frames - 1].position, gpu.frames[close_frames - 1].position) <=
+              1e-3 * max_abs(cpu.frames[close_frames - 1].position)))
     ++close_frames;
   uint32_t frames_equal = 0, frames_apart = 0, worst_frame = 0;
   for (uint32_t f = 0; f < close_frames; ++f) {
@@ -200,12 +183,12 @@ int main() {
       first_apart.iterations_max, first_apart_gpu.substeps, first_apart_gpu.iterations,
       first_apart_gpu.iterations_max);
 
-  const double scale = largest(cpu.early.position);
-  const double dx = largest_difference(cpu.early.position, gpu.early.position);
+  const double scale = max_abs(cpu.early.position);
+  const double dx = max_diff(cpu.early.position, gpu.early.position);
   report(cpu.early.count == gpu.early.count && dx <= 1e-4 * scale, "dfsph cg: positions after 5 frames",
          "max |x_gpu - x_cpu| = %.3g m, %.3g of max |x| = %.3g m (limit 1e-4)", dx, dx / scale, scale);
-  const double vscale = std::max(largest(cpu.early.velocity), 1e-2);
-  const double dv = largest_difference(cpu.early.velocity, gpu.early.velocity);
+  const double vscale = std::max(max_abs(cpu.early.velocity), 1e-2);
+  const double dv = max_diff(cpu.early.velocity, gpu.early.velocity);
   report(dv <= 1e-3 * vscale, "dfsph cg: velocities after 5 frames",
          "max |v_gpu - v_cpu| = %.3g m/s, %.3g of max |v| = %.3g m/s (limit 1e-3)", dv, dv / vscale, vscale);
   // SPH_CHECK_DFSPH_TRACE: each frame's substeps, iterations and the states' distance (a diagnosis).
@@ -216,12 +199,12 @@ int main() {
         "max |dv| %.3g m/s\n",
         f + 1, cpu.stats[f].substeps, gpu.stats[f].substeps, cpu.stats[f].iterations, gpu.stats[f].iterations,
         cpu.stats[f].iterations_max, gpu.stats[f].iterations_max,
-        largest_difference(cpu.frames[f].position, gpu.frames[f].position) / largest(cpu.frames[f].position),
-        largest_difference(cpu.frames[f].velocity, gpu.frames[f].velocity));
+        max_diff(cpu.frames[f].position, gpu.frames[f].position) / max_abs(cpu.frames[f].position),
+        max_diff(cpu.frames[f].velocity, gpu.frames[f].velocity));
   // Not a check: how far the two backends' rounding has carried the states apart by the end.
   std::printf("INFO dfsph cg: after %u frames max |x_gpu - x_cpu| = %.3g m (%.3g of max |x|)\n", kFrames,
-              largest_difference(cpu.late.position, gpu.late.position),
-              largest_difference(cpu.late.position, gpu.late.position) / largest(cpu.late.position));
+              max_diff(cpu.late.position, gpu.late.position),
+              max_diff(cpu.late.position, gpu.late.position) / max_abs(cpu.late.position));
 
   report(states_identical(gpu.late, gpu_again.late) && states_identical(gpu.early, gpu_again.early) &&
              same_stats(gpu, gpu_again),

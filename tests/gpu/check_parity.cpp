@@ -9,23 +9,6 @@ using namespace gpu_check;
 
 namespace {
 
-double max_abs(const std::vector<float>& v) {
-  double m = 0.0;
-  for (size_t i = 0; i < v.size(); i += 3)
-    m = std::max(m,
-                 std::sqrt(double(v[i]) * v[i] + double(v[i + 1]) * v[i + 1] + double(v[i + 2]) * v[i + 2]));
-  return m;
-}
-
-double max_diff(const std::vector<float>& a, const std::vector<float>& b) {
-  double m = 0.0;
-  for (size_t i = 0; i < a.size(); i += 3) {
-    const double dx = double(a[i]) - b[i], dy = double(a[i + 1]) - b[i + 1], dz = double(a[i + 2]) - b[i + 2];
-    m = std::max(m, std::sqrt(dx * dx + dy * dy + dz * dz));
-  }
-  return m;
-}
-
 double rel(double a, double b) { return std::fabs(a - b) / std::max(std::fabs(b), 1e-30); }
 
 void compare(const SceneSpec& spec, float frame_dt) {

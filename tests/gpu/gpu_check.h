@@ -247,6 +247,25 @@ inline bool states_identical(const State& a, const State& b) {
          bitwise_equal(a.pressure, b.pressure) && bitwise_equal(a.id, b.id);
 }
 
+// The largest length of the 3-vectors packed in v (x, y, z, x, ...).
+inline double max_abs(const std::vector<float>& v) {
+  double m = 0.0;
+  for (size_t i = 0; i < v.size(); i += 3)
+    m = std::max(m,
+                 std::sqrt(double(v[i]) * v[i] + double(v[i + 1]) * v[i + 1] + double(v[i + 2]) * v[i + 2]));
+  return m;
+}
+
+// The largest distance between the packed 3-vectors of a and b, element by element.
+inline double max_diff(const std::vector<float>& a, const std::vector<float>& b) {
+  double m = 0.0;
+  for (size_t i = 0; i < a.size(); i += 3) {
+    const double dx = double(a[i]) - b[i], dy = double(a[i + 1]) - b[i + 1], dz = double(a[i + 2]) - b[i + 2];
+    m = std::max(m, std::sqrt(dx * dx + dy * dy + dz * dz));
+  }
+  return m;
+}
+
 inline sph_stats get_stats(const sph_world* world) {
   sph_stats s;
   sph_stats_init(&s);
