@@ -22,8 +22,9 @@ __device__ __forceinline__ uint32_t warp_max_u32(uint32_t v) {
   return v;
 }
 
-// The particles' cell extent into live->lowest_code / highest_code (zeroed before): maxima only,
-// so any order of the blocks gives the same record.
+// The particles' cell extent into live->lowest_code / highest_code (zero on entry: zeroed at the
+// grid's creation and again by fit_shape_kernel after each read): maxima only, so any order of the
+// blocks gives the same record.
 __global__ void __launch_bounds__(kDefaultBlockSize)
     extent_kernel(float inv_cell_size, const Float4* __restrict__ positions, uint32_t n, LiveGridShape* live,
                   FrameState* state) {
@@ -54,19 +55,28 @@ __global__ void __launch_bounds__(kDefaultBlockSize)
   }
 }
 
-// One thread: the dims for the extent within the table's slots; no particle: the table's own.
+// One thread: the dims for the extent within the table's slots (no particle: the table's own),
+// then the extent zeroed for the next sort's extent_kernel (one graph node a substep less than a
+// memset before it).
 __global__ void fit_shape_kernel(GridShape table, LiveGridShape* live) {
-  if (live->highest_code[0] == 0) {
+  uint32_t lowest[3], highest[3];
+  for (int a = 0; a < 3; ++a) {
+    lowest[a] = live->lowest_code[a];
+    highest[a] = live->highest_code[a];
+    live->lowest_code[a] = 0;
+    live->highest_code[a] = 0;
+  }
+  if (highest[0] == 0) {
     live->shape = table;
     return;
   }
   CellCoord lo, hi;
-  lo.x = static_cast<int32_t>(static_cast<int64_t>(~live->lowest_code[0]) - 2147483648ll);
-  lo.y = static_cast<int32_t>(static_cast<int64_t>(~live->lowest_code[1]) - 2147483648ll);
-  lo.z = static_cast<int32_t>(static_cast<int64_t>(~live->lowest_code[2]) - 2147483648ll);
-  hi.x = static_cast<int32_t>(static_cast<int64_t>(live->highest_code[0]) - 2147483648ll);
-  hi.y = static_cast<int32_t>(static_cast<int64_t>(live->highest_code[1]) - 2147483648ll);
-  hi.z = static_cast<int32_t>(static_cast<int64_t>(live->highest_code[2]) - 2147483648ll);
+  lo.x = static_cast<int32_t>(static_cast<int64_t>(~lowest[0]) - 2147483648ll);
+  lo.y = static_cast<int32_t>(static_cast<int64_t>(~lowest[1]) - 2147483648ll);
+  lo.z = static_cast<int32_t>(static_cast<int64_t>(~lowest[2]) - 2147483648ll);
+  hi.x = static_cast<int32_t>(static_cast<int64_t>(highest[0]) - 2147483648ll);
+  hi.y = static_cast<int32_t>(static_cast<int64_t>(highest[1]) - 2147483648ll);
+  hi.z = static_cast<int32_t>(static_cast<int64_t>(highest[2]) - 2147483648ll);
   live->shape = fit_grid_shape(table.inv_cell_size, lo, hi, static_cast<double>(table.cell_count));
 }
 
@@ -141,7 +151,10 @@ DeviceNeighborGrid::DeviceNeighborGrid(const GridShape& shape, uint32_t capacity
       key_bits_(bits_for(shape.cell_count - 1)),
       scratch_(scratch) {
   cell_start_.allocate(static_cast<size_t>(shape.cell_count) + 1, "cell-start table");
-  if (fit_to_extent_) live_.allocate(1, "the grid's fitted shape");
+  if (fit_to_extent_) {
+    live_.allocate(1, "the grid's fitted shape");
+    cuda_check(cudaMemset(live_.get(), 0, sizeof(LiveGridShape)), "the grid's extent reset");
+  }
   cub::DoubleBuffer<uint32_t> keys(scratch_.keys[0], scratch_.keys[1]);
   cub::DoubleBuffer<uint32_t> values(scratch_.values[0], scratch_.values[1]);
   cuda_check(cub::DeviceRadixSort::SortPairs(nullptr, temp_bytes_, keys, values, static_cast<int>(capacity),
@@ -159,7 +172,6 @@ void DeviceNeighborGrid::enqueue_sort(const Float4* positions, uint32_t n, Frame
                                       cudaStream_t stream, const uint32_t* visit) {
   if (fit_to_extent_) {
     // The extent of the particles the hash takes (visit is a permutation of [0, n)).
-    cuda_check(cudaMemsetAsync(live_.get(), 0, sizeof(uint32_t) * 6, stream), "the grid's extent reset");
     const unsigned blocks = std::min(blocks_for(n, kDefaultBlockSize), kExtentBlocks);
     extent_kernel<<<blocks, kDefaultBlockSize, 0, stream>>>(shape_.inv_cell_size, positions, n, live_.get(),
                                                             state);

@@ -17,6 +17,7 @@
 #include "dfsph_solver.h"
 #include "frame_control.h"
 #include "frame_state.cuh"
+#include "graph_while_node.h"
 
 namespace sph {
 
@@ -92,14 +93,12 @@ inline LoopCondition open_solve_loop(bool in_graph, cudaStream_t stream) {
   return cond;
 }
 
-// Runs iteration() while the check says so: a WHILE node in the graph being captured (the capture
-// is ended, the node added after what was captured, its body captured, and the capture resumed
-// after it), or chunks on the stream with one read of the flag per chunk (each kernel does nothing
+// Runs iteration() while the check says so: a WHILE node in the graph being captured
+// (graph_while_node.h), or chunks on the stream with one read of the flag per chunk (each kernel does nothing
 // once the solve has stopped).
 template <class Iteration>
 void run_solve_loop(const LoopCondition& cond, FrameState* state, FrameState* host_state, cudaStream_t stream,
                     Iteration&& iteration) {
-  constexpr cudaStreamCaptureMode kCaptureMode = cudaStreamCaptureModeThreadLocal;
   if (!cond.in_graph) {
     for (;;) {
       cuda_check(cudaMemcpyAsync(&host_state->solve_run, &state->solve_run, sizeof(uint32_t),
@@ -110,29 +109,7 @@ void run_solve_loop(const LoopCondition& cond, FrameState* state, FrameState* ho
       for (uint32_t k = 0; k < kDfsphSolveChunk; ++k) iteration();
     }
   }
-  cudaStreamCaptureStatus status = cudaStreamCaptureStatusNone;
-  cudaGraph_t graph = nullptr;
-  const cudaGraphNode_t* leaves = nullptr;
-  size_t leaf_count = 0;
-  cuda_check(cudaStreamGetCaptureInfo(stream, &status, nullptr, &graph, &leaves, nullptr, &leaf_count),
-             "cudaStreamGetCaptureInfo");
-  const HostVector<cudaGraphNode_t> after(leaves, leaves + leaf_count);
-  cuda_check(cudaStreamEndCapture(stream, &graph), "capture before a solve");
-  cudaGraphNodeParams params = {};
-  params.type = cudaGraphNodeTypeConditional;
-  params.conditional.handle = cond.handle;
-  params.conditional.type = cudaGraphCondTypeWhile;
-  params.conditional.size = 1;
-  cudaGraphNode_t loop = nullptr;
-  cuda_check(cudaGraphAddNode(&loop, graph, after.data(), nullptr, after.size(), &params),
-             "conditional WHILE node of a solve");
-  cudaGraph_t body = params.conditional.phGraph_out[0];
-  cuda_check(cudaStreamBeginCaptureToGraph(stream, body, nullptr, nullptr, 0, kCaptureMode),
-             "capture of a solve's iteration");
-  iteration();
-  cuda_check(cudaStreamEndCapture(stream, &body), "capture of a solve's iteration");
-  cuda_check(cudaStreamBeginCaptureToGraph(stream, graph, &loop, nullptr, 1, kCaptureMode),
-             "capture after a solve");
+  capture_while_node(cond.handle, stream, iteration);
 }
 
 }  // namespace sph

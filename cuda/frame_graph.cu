@@ -2,6 +2,7 @@
 #include <vector>
 
 #include "frame_graph.h"
+#include "graph_while_node.h"
 
 namespace sph {
 namespace {
@@ -36,36 +37,15 @@ void FrameGraph::build(const PipelineSetup& setup, const PipelineBuffers& buffer
     cuda_check(cudaGraphConditionalHandleCreate(&cond.handle, graph_, 0, cudaGraphCondAssignDefault),
                "cudaGraphConditionalHandleCreate");
 
-    // 1. begin segment, captured into the frame graph; remember its last nodes.
+    // 1. begin segment, captured into the frame graph.
     cuda_check(cudaStreamBeginCaptureToGraph(stream, graph_, nullptr, nullptr, 0, kCaptureMode),
                "capture of the frame begin");
     enqueue_frame_begin(setup, buffers, cond, stream);
-    cudaStreamCaptureStatus status;
-    const cudaGraphNode_t* leaves = nullptr;
-    size_t leaf_count = 0;
-    cuda_check(cudaStreamGetCaptureInfo(stream, &status, nullptr, nullptr, &leaves, nullptr, &leaf_count),
-               "cudaStreamGetCaptureInfo");
-    const HostVector<cudaGraphNode_t> begin_leaves(leaves, leaves + leaf_count);
-    cuda_check(cudaStreamEndCapture(stream, &graph_), "capture of the frame begin");
 
-    // 2. the WHILE node; its body is one substep.
-    cudaGraphNodeParams params = {};
-    params.type = cudaGraphNodeTypeConditional;
-    params.conditional.handle = cond.handle;
-    params.conditional.type = cudaGraphCondTypeWhile;
-    params.conditional.size = 1;
-    cudaGraphNode_t loop = nullptr;
-    cuda_check(cudaGraphAddNode(&loop, graph_, begin_leaves.data(), nullptr, begin_leaves.size(), &params),
-               "conditional WHILE node");
-    cudaGraph_t body = params.conditional.phGraph_out[0];
-    cuda_check(cudaStreamBeginCaptureToGraph(stream, body, nullptr, nullptr, 0, kCaptureMode),
-               "capture of the substep");
-    enqueue_substep(setup, buffers, cond, stream);
-    cuda_check(cudaStreamEndCapture(stream, &body), "capture of the substep");
+    // 2. the WHILE node; its body is one substep. The capture resumes after it.
+    capture_while_node(cond.handle, stream, [&] { enqueue_substep(setup, buffers, cond, stream); });
 
     // 3. end segment after the loop.
-    cuda_check(cudaStreamBeginCaptureToGraph(stream, graph_, &loop, nullptr, 1, kCaptureMode),
-               "capture of the frame end");
     enqueue_frame_end(setup, buffers, stream);
     cuda_check(cudaStreamEndCapture(stream, &graph_), "capture of the frame end");
 
