@@ -9,12 +9,13 @@
  *
  *   solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1]
  *                [--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg]
- *                [--out solver_front.csv]
+ *                [--walls-in-density] [--out solver_front.csv]
  *
  * --wcsph: the weakly compressible runs' speeds of sound, as multiples of the free-fall speed;
  * --dfsph: the DFSPH runs' density error bounds (0.001 = 0.1 %); `none` leaves a solver out.
  * --dfsph-solver: the DFSPH solves' linear solver (sph_dfsph_params.linear_solver; default: the
- * library's).
+ * library's). --walls-in-density: the tank's walls count in the density and pressure
+ * (SPH_FEATURE_BOUNDARY_DENSITY) for both solvers; without it they are collision-only.
  *
  * --sample-T: the front's sampling interval in T (0.1 = 5.4 ms). Each sample ends a frame, and a
  * frame's landing step caps the substep, so a fine sampling (the validation's 0.025 = 1.35 ms)
@@ -82,6 +83,7 @@ int main(int argc, char** argv) {
   double seconds = 1.0, sample_T = 0.1;
   const char* out_path = "solver_front.csv";
   uint32_t linear_solver = 0; /* the library's default */
+  uint32_t features = 0;
   sph_backend backend = SPH_BACKEND_AUTO, resolved = SPH_BACKEND_CPU;
   sph_context* context = NULL;
   dam_break_result* result = (dam_break_result*)malloc(sizeof(dam_break_result));
@@ -130,6 +132,8 @@ int main(int argc, char** argv) {
       }
     } else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
       out_path = argv[++i];
+    } else if (strcmp(argv[i], "--walls-in-density") == 0) {
+      features |= SPH_FEATURE_BOUNDARY_DENSITY;
     } else if (strcmp(argv[i], "--dfsph-solver") == 0 && i + 1 < argc) {
       ++i;
       if (strcmp(argv[i], "jacobi") == 0) {
@@ -144,8 +148,8 @@ int main(int argc, char** argv) {
       fprintf(
           stderr,
           "usage: solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1] "
-          "[--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg] [--out "
-          "solver_front.csv]\n");
+          "[--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg] [--walls-in-density] "
+          "[--out solver_front.csv]\n");
       return 2;
     }
   }
@@ -184,6 +188,7 @@ int main(int argc, char** argv) {
       config.sample_T = sample_T;
       config.solver = runs[r].solver;
       config.dfsph_linear_solver = linear_solver;
+      config.features |= features;
       if (dfsph)
         config.density_error = (float)runs[r].value;
       else
