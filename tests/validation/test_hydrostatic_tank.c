@@ -3,6 +3,7 @@
  * the exact equilibrium of the equation of state in use within 3 % (DFSPH: 0.5 %), no particle
  * across the floor. The cases: the ideal gas and Tait's equation, the walls in the density, DFSPH;
  * what is compared and why: hydrostatic_tank.c. */
+#include <stdlib.h>
 #include <string.h>
 
 #include "hydrostatic_tank.h"
@@ -71,6 +72,17 @@ static tank_case dfsph_tank(const char* name, uint32_t features, double bound, f
     tc.width_layers = 24;
     tc.depth_layers = 48;
   }
+  /* HYDRO_LAYERS=N measures a tank N layers across and 2 N deep (the resolution study,
+   * docs/validation.md); HYDRO_SECONDS and HYDRO_DT_MAX (s) another length or step, HYDRO_KERNEL
+   * another kernel radius (in spacings). */
+  if (getenv("HYDRO_LAYERS")) {
+    tc.width_layers = (uint32_t)atoi(getenv("HYDRO_LAYERS"));
+    tc.depth_layers = 2u * tc.width_layers;
+  }
+  if (getenv("HYDRO_SECONDS")) tc.seconds = atof(getenv("HYDRO_SECONDS"));
+  if (getenv("HYDRO_DT_MAX")) tc.dt_max = (float)atof(getenv("HYDRO_DT_MAX"));
+  if (getenv("HYDRO_KERNEL")) tc.kernel_spacings = (float)atof(getenv("HYDRO_KERNEL"));
+  tc.gauges = 1;
   return tc;
 }
 
