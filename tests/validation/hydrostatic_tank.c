@@ -364,27 +364,7 @@ void run_tank(const tank_case* tc) {
         lowest / def.particle_spacing);
     if (tc->gauges) {
       particle_scatter(&model, &fit, n, nl, bin, particle_p, particle_y, inside, window_frames);
-      {
-        double* m_yy = (double*)calloc(nl, sizeof(double));
-        double* virial = (double*)calloc(nl, sizeof(double));
-        double* lift = (double*)calloc(nl, sizeof(double));
-        uint32_t* samples = (uint32_t*)calloc(nl, sizeof(uint32_t));
-        assert_true(m_yy && virial && lift && samples);
-        tank_moment_profile(moment, m_yy, virial, lift, samples);
-        printf("  the pressure force's moment M_yy per slice (1 on the lattice):");
-        for (uint32_t l = 0; l < nl; ++l)
-          if (samples[l]) printf(" %.4f", m_yy[l]);
-        printf("\n  the pairs' pressure acceleration / g per slice:");
-        for (uint32_t l = 0; l < nl; ++l)
-          if (samples[l]) printf(" %.4f", lift[l] / GRAVITY);
-        printf("\n");
-        (void)fit_profile(&model, top_layer, nl, virial, layer_y, NULL, samples,
-                          "diagnostic: the pairs' virial pressure (what crosses a plane), per slice");
-        free(m_yy);
-        free(virial);
-        free(lift);
-        free(samples);
-      }
+      tank_moment_print(moment, layer_y, fit.surface, rho0, GRAVITY, h);
       tank_gauges_profile(gauges, bin, layer_sum, layer_y, layer_count);
       (void)fit_profile(&model, top_layer, nl, layer_sum, layer_y, NULL, layer_count,
                         "the gauges' pressure (the SPH interpolant, horizontal lines), per slice");

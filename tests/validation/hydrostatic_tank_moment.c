@@ -1,28 +1,32 @@
 // SPDX-License-Identifier: MIT
 /* Why the particles' pressure reads off rho0 g d by a steady pattern (docs/validation.md, "DFSPH:
- * hydrostatic tank"): the pressure force's first moment. With the symmetric force
- * F_i = -m^2 sum_j (k_i + k_j) grad W_ij (k = p / rho^2, W_spiky, the library's), a pressure field
- * varying linearly, k_j = k_i + grad k . (x_j - x_i), pushes particle i by -m (M^T grad p) / rho0 plus
- * a term in k_i sum_j grad W_ij, where M = -sum_j (m / rho0) (x_i - x_j) (x) grad W_ij is the
- * packing's moment: the identity in the continuum, I on the FCC lattice (the library scales W_spiky so:
- * fcc_spiky_scale), something else on another packing. At rest the per-particle pressure is the multiplier
- * that balances the weight through that operator, so p ~ rho0 g d / M_yy: where the packing's M_yy differs
- * from one, the particles' pressure reads off by as much.
+ * hydrostatic tank"). With the symmetric force F_i = -m^2 sum_j (k_i + k_j) grad W_ij (k = p / rho^2,
+ * the library's scaled W_spiky), a pressure varying linearly, k_j = k_i + grad k . (x_j - x_i),
+ * accelerates particle i by -(M^T grad p) / rho0 - 2 k_i sum_j m grad W_ij, where
+ * M = -sum_j (m / rho0) (x_i - x_j) (x) grad W_ij is the packing's first moment: I in the continuum
+ * and on the FCC lattice (the library scales W_spiky so: fcc_spiky_scale), something else on
+ * another packing; the second, zeroth-order term vanishes only where the neighbourhood is
+ * symmetric. At rest the per-particle pressure is the multiplier that balances the weight through
+ * that operator, so where M_yy differs from one or the zeroth-order term is not zero, the
+ * pressure's gradient differs from rho0 g.
  *
- * Per slice this reports the particles' mean M_yy and their virial pressure, the force per area
- * the pairs carry across a horizontal plane (Irving-Kirkwood: P_i = -(rho0 m / 2) sum_j
- * (k_i + k_j) (y_i - y_j) dW_ij/dy, = p M_yy for a uniform pressure), which momentum balance
- * ties to the weight above: it is an explanation of the particles' reading, not a test of it. */
+ * Per slice (interior particles) this reports the mean M_yy, the pairs' pressure acceleration over
+ * g (1 at rest: the check that the pressure is an equilibrium), its zeroth-order part, and the
+ * virial pressure, the force per area the pairs carry across a horizontal plane (Irving-Kirkwood:
+ * P_i = -(rho0 m / 2) sum_j (k_i + k_j) (y_i - y_j) dW_ij/dy, = p M_yy for a uniform pressure),
+ * which momentum balance ties to the weight above: an explanation of the particles' reading, not
+ * a test of it. */
 #include "hydrostatic_tank_moment.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "validation_util.h"
 
 struct tank_moment {
   uint32_t bins;
-  double *moment, *virial, *lift;
+  double *moment, *virial, *lift, *zeroth;
   uint32_t* count;
 };
 
@@ -33,8 +37,9 @@ tank_moment* tank_moment_create(uint32_t bins) {
   t->moment = (double*)calloc(bins, sizeof(double));
   t->virial = (double*)calloc(bins, sizeof(double));
   t->lift = (double*)calloc(bins, sizeof(double));
+  t->zeroth = (double*)calloc(bins, sizeof(double));
   t->count = (uint32_t*)calloc(bins, sizeof(uint32_t));
-  assert_true(t->moment && t->virial && t->lift && t->count);
+  assert_true(t->moment && t->virial && t->lift && t->zeroth && t->count);
   return t;
 }
 
@@ -95,7 +100,7 @@ void tank_moment_add(tank_moment* t, uint32_t n, const float* x, const float* p,
     const double ki = p[i] / ((double)rho[i] * rho[i]);
     const int l = (int)floor(yi / bin);
     int c[3];
-    double moment = 0.0, virial = 0.0, lift = 0.0;
+    double moment = 0.0, virial = 0.0, lift = 0.0, zeroth = 0.0;
     if (xi < h || xi > width - h || zi < h || zi > width - h || l < 0 || l >= (int)t->bins) continue;
     for (int a = 0; a < 3; ++a) c[a] = (int)((x[3 * i + a] - lo[a]) / h);
     for (int dz = -1; dz <= 1; ++dz)
@@ -116,11 +121,13 @@ void tank_moment_add(tank_moment* t, uint32_t n, const float* x, const float* p,
             moment -= (mass / rho0) * d[1] * dwdy;
             virial -= 0.5 * rho0 * mass * (ki + kj) * d[1] * dwdy;
             lift -= mass * (ki + kj) * dwdy;
+            zeroth -= 2.0 * mass * ki * dwdy;
           }
         }
     t->moment[l] += moment;
     t->virial[l] += virial;
     t->lift[l] += lift;
+    t->zeroth[l] += zeroth;
     ++t->count[l];
   }
   free(start);
@@ -128,13 +135,19 @@ void tank_moment_add(tank_moment* t, uint32_t n, const float* x, const float* p,
   free(cell_of);
 }
 
-void tank_moment_profile(const tank_moment* t, double* moment, double* virial, double* lift,
-                         uint32_t* count) {
+void tank_moment_print(const tank_moment* t, const double* y, double surface, double rho0, double g,
+                       double h) {
+  printf(
+      "  per slice (interior particles, every 20 ms of the window): the pressure force's moment M_yy (1 on\n"
+      "  the lattice), the pairs' pressure acceleration / g (1 at rest), its zeroth-order part\n"
+      "  2 k_i sum_j m dW_ij/dy / g, the virial pressure against rho0 g (y_s - y) at the particles' y_s:\n");
+  printf("  %-9s %-7s %-8s %-8s %-8s\n", "y, m", "M_yy", "accel/g", "zeroth/g", "virial");
   for (uint32_t l = 0; l < t->bins; ++l) {
-    count[l] = t->count[l];
-    moment[l] = t->count[l] ? t->moment[l] / t->count[l] : 0.0;
-    virial[l] = t->count[l] ? t->virial[l] / t->count[l] : 0.0;
-    lift[l] = t->count[l] ? t->lift[l] / t->count[l] : 0.0;
+    const double c = t->count[l] ? 1.0 / t->count[l] : 0.0, exact = rho0 * g * (surface - y[l]);
+    if (!t->count[l]) continue;
+    printf("  %-9.4f %-7.4f %-8.4f %+-8.4f %+6.2f %%%s\n", y[l], t->moment[l] * c, t->lift[l] * c / g,
+           t->zeroth[l] * c / g, exact > 0.0 ? 100.0 * (t->virial[l] * c / exact - 1.0) : 0.0,
+           y[l] >= h && surface - y[l] >= 2.0 * h ? "" : "  (boundary layer)");
   }
 }
 
@@ -143,6 +156,7 @@ void tank_moment_destroy(tank_moment* t) {
   free(t->moment);
   free(t->virial);
   free(t->lift);
+  free(t->zeroth);
   free(t->count);
   free(t);
 }

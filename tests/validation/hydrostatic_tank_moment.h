@@ -14,9 +14,10 @@ tank_moment* tank_moment_create(uint32_t bins);
  * lattice's (the kernel's scale). */
 void tank_moment_add(tank_moment* t, uint32_t n, const float* x, const float* p, const float* rho,
                      double mass, double rho0, double h, double width, double bin, double step);
-/* Per slice: the mean M_yy, the mean virial pressure (Pa), the mean upward acceleration of the
- * pairs' pressure force (m/s^2; g at rest), the particle samples. */
-void tank_moment_profile(const tank_moment* t, double* moment, double* virial, double* lift, uint32_t* count);
+/* Prints per slice (y: the slices' mean heights) the mean M_yy, the pairs' pressure acceleration
+ * and its zeroth-order part over g, and the virial pressure against rho0 g (surface - y). */
+void tank_moment_print(const tank_moment* t, const double* y, double surface, double rho0, double g,
+                       double h);
 void tank_moment_destroy(tank_moment* t);
 
 #endif
