@@ -38,6 +38,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "hydrostatic_tank_gauges.h"
+#include "hydrostatic_tank_moment.h"
 #include "validation_util.h"
 
 #define GRAVITY 9.81
@@ -79,6 +81,7 @@ static void open_tank(const tank_case* tc, double gap, support_world* w, sph_sdf
   sph_world_def_init(&def);
   def.capacity = *n;
   def.particle_spacing = (float)(step * sqrt(2.0));
+  if (tc->kernel_spacings > 0.0f) def.kernel_radius = tc->kernel_spacings * def.particle_spacing;
   def.equation_of_state = tc->eos;
   def.solver = tc->solver;
   def.features |= tc->features;
@@ -111,6 +114,105 @@ static void open_tank(const tank_case* tc, double gap, support_world* w, sph_sdf
   free(lattice_points);
 }
 
+/* The interior slices' comparison of one pressure reading against the profile: the surface height
+ * y_s fitted (least squares of the relative error, within 2 h around the top particle layer's
+ * top), then each slice's error; the table printed under `label`. rho may be NULL. */
+typedef struct profile_fit {
+  double surface, mean, worst;
+  uint32_t used;
+} profile_fit;
+
+typedef struct profile_model {
+  sph_equation_of_state eos;
+  double k, c, rho0, h, step;
+} profile_model;
+
+static int interior_slice(const profile_model* m, double y, double ys) {
+  return y >= m->h && ys - y >= 2.0 * m->h;
+}
+
+static profile_fit fit_profile(const profile_model* m, double top_layer, uint32_t bins, const double* p,
+                               const double* y, const double* rho, const uint32_t* count, const char* label) {
+  profile_fit fit = {0.0, 0.0, 0.0, 0};
+  double best_cost = 1e30;
+  for (int s = -400; s <= 400; ++s) {
+    const double ys = top_layer + 0.5 * m->step + s * (2.0 * m->h / 400.0);
+    double cost = 0.0;
+    for (uint32_t l = 0; l < bins; ++l) {
+      double e;
+      if (count[l] == 0 || !interior_slice(m, y[l], ys)) continue;
+      e = p[l] / exact_pressure(m->eos, m->k, m->c, m->rho0, ys - y[l]) - 1.0;
+      cost += e * e;
+    }
+    if (cost < best_cost) {
+      best_cost = cost;
+      fit.surface = ys;
+    }
+  }
+  printf("  %s: fitted surface y_s = %.4f m (y_s - top = %.2f h)\n", label, fit.surface,
+         (fit.surface - top_layer) / m->h);
+  printf("  %-9s %-9s %-11s %-11s %-8s %-9s\n", "y, m", "depth, m", "p, Pa", "p exact, Pa", "error",
+         "rho/rho0-1");
+  for (uint32_t l = 0; l < bins; ++l) {
+    double exact, e;
+    int interior;
+    if (count[l] == 0) continue;
+    exact = exact_pressure(m->eos, m->k, m->c, m->rho0, fit.surface - y[l]);
+    e = exact > 0.0 ? p[l] / exact - 1.0 : 0.0;
+    interior = interior_slice(m, y[l], fit.surface);
+    printf("  %-9.4f %-9.4f %-11.1f %-11.1f %+6.2f %% ", y[l], fit.surface - y[l], p[l], exact, 100.0 * e);
+    if (rho)
+      printf("%+7.3f %%", 100.0 * (rho[l] / m->rho0 - 1.0));
+    else
+      printf("%9s", "");
+    printf("%s\n", interior ? "" : "  (boundary layer, not compared)");
+    if (!interior) continue;
+    if (fabs(e) > fit.worst) fit.worst = fabs(e);
+    fit.mean += fabs(e);
+    ++fit.used;
+  }
+  fit.mean /= fit.used ? fit.used : 1;
+  printf("  %s: interior slices %u: mean |error| %.2f %%, worst %.2f %%\n", label, fit.used, 100.0 * fit.mean,
+         100.0 * fit.worst);
+  return fit;
+}
+
+/* Each particle's pressure averaged over the window, against the profile at its mean height:
+ * per slice, the particles' mean error, their scatter and its standard error (scatter / sqrt N).
+ * A slice's error that matches its standard error is the sampling of a steady per-particle
+ * pattern by the slice's few particles, and falls as 1 / sqrt(particles per slice). */
+static void particle_scatter(const profile_model* m, const profile_fit* fit, uint32_t n, uint32_t bins,
+                             double bin, const double* p_sum, const double* y_sum, const uint8_t* inside,
+                             int frames) {
+  double* sum = (double*)calloc(bins, sizeof(double));
+  double* sum2 = (double*)calloc(bins, sizeof(double));
+  uint32_t* count = (uint32_t*)calloc(bins, sizeof(uint32_t));
+  assert_true(sum && sum2 && count && frames > 0);
+  for (uint32_t i = 0; i < n; ++i) {
+    const double y = y_sum[i] / frames, p = p_sum[i] / frames;
+    const int l = (int)floor(y / bin);
+    double e;
+    if (!inside[i] || l < 0 || l >= (int)bins || !interior_slice(m, y, fit->surface)) continue;
+    e = p / exact_pressure(m->eos, m->k, m->c, m->rho0, fit->surface - y) - 1.0;
+    sum[l] += e;
+    sum2[l] += e * e;
+    ++count[l];
+  }
+  printf("  per particle (its window mean, interior particles only):\n  %-6s %-5s %-9s %-9s %-9s\n", "slice",
+         "N", "mean", "scatter", "std err");
+  for (uint32_t l = 0; l < bins; ++l) {
+    double mean, sd;
+    if (count[l] < 2) continue;
+    mean = sum[l] / count[l];
+    sd = sqrt(fmax(sum2[l] / count[l] - mean * mean, 0.0) * count[l] / (count[l] - 1));
+    printf("  %-6u %-5u %+6.2f %%  %6.2f %%  %6.2f %%\n", l, count[l], 100.0 * mean, 100.0 * sd,
+           100.0 * sd / sqrt((double)count[l]));
+  }
+  free(sum);
+  free(sum2);
+  free(count);
+}
+
 void run_tank(const tank_case* tc) {
   const uint32_t nl = tc->depth_layers;
   const double step = tc->step;
@@ -125,12 +227,15 @@ void run_tank(const tank_case* tc) {
   sph_world* world;
   sph_world_def def;
   sph_sdf* sdf = NULL;
+  tank_gauges* gauges = NULL;
+  tank_moment* moment = NULL;
   float* x = NULL;
   float* p = NULL;
   float* rho = NULL;
   float mass = 0.0f;
-  double *layer_sum, *layer_y, *layer_rho;
+  double *layer_sum, *layer_y, *layer_rho, *particle_p, *particle_y;
   uint32_t* layer_count;
+  uint8_t* inside;
   double k, c, h, rho0, lowest = 1e30, top_layer = -1e30;
   uint32_t n = 0;
   /* The profile compared: the solver's own equilibrium. */
@@ -152,12 +257,20 @@ void run_tank(const tank_case* tc) {
    * of the pressure at 0.1 m depth), and a slice of several hundred particle samples brings that
    * below 1 %. */
   bin = h;
+  if (tc->gauges) {
+    gauges = tank_gauges_create(world, width, depth, h, bin, nl, step);
+    moment = tank_moment_create(nl);
+  }
 
   layer_sum = (double*)calloc(nl, sizeof(double));
   layer_rho = (double*)calloc(nl, sizeof(double));
   layer_y = (double*)calloc(nl, sizeof(double));
   layer_count = (uint32_t*)calloc(nl, sizeof(uint32_t));
-  assert_true(layer_sum && layer_rho && layer_y && layer_count);
+  particle_p = (double*)calloc(n, sizeof(double));
+  particle_y = (double*)calloc(n, sizeof(double));
+  inside = (uint8_t*)malloc(n);
+  assert_true(layer_sum && layer_rho && layer_y && layer_count && particle_p && particle_y && inside);
+  memset(inside, 1, n);
   for (int f = 0; f < frames; ++f) {
     EXPECT_OK(sph_world_step(world, (float)frame_dt));
     if ((f + 1) * frame_dt < tc->damp_until && f % damp_every == damp_every - 1) {
@@ -176,6 +289,7 @@ void run_tank(const tank_case* tc) {
       if ((f + 1) % (int)(0.2 / frame_dt + 0.5) == 0)
         printf("  t = %.1f s: kinetic energy %.3g J\n", frame_dt * (f + 1), ke);
     }
+    if (gauges && f >= window_start) tank_gauges_read(gauges, world);
     {
       uint32_t count = 0;
       EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_POSITION, (void**)&x, &count));
@@ -183,10 +297,18 @@ void run_tank(const tank_case* tc) {
       EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_PRESSURE, (void**)&p, &count));
       EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_DENSITY, (void**)&rho, &count));
     }
+    /* (the moment's neighbour sums once per 20 ms at most: they are the run's costliest host work) */
+    if (moment && f >= window_start && (f - window_start) % (int)(0.02 / frame_dt + 0.5) == 0)
+      tank_moment_add(moment, n, x, p, rho, mass, rho0, h, width, bin, step);
     for (uint32_t i = 0; i < n; ++i) {
       if (x[3 * i + 1] < lowest) lowest = x[3 * i + 1];
       if (f < window_start) continue;
-      if (x[3 * i] < h || x[3 * i] > width - h || x[3 * i + 2] < h || x[3 * i + 2] > width - h) continue;
+      particle_p[i] += p[i];
+      particle_y[i] += x[3 * i + 1];
+      if (x[3 * i] < h || x[3 * i] > width - h || x[3 * i + 2] < h || x[3 * i + 2] > width - h) {
+        inside[i] = 0; /* a particle counts per particle only if it stayed interior all window */
+        continue;
+      }
       {
         const int layer = (int)floor(x[3 * i + 1] / bin);
         if (layer < 0 || layer >= (int)nl) continue;
@@ -214,52 +336,19 @@ void run_tank(const tank_case* tc) {
 
   /* Fit the surface height y_s, then compare the interior layers. */
   {
-    double best_s = 0.0, best_cost = 1e30, worst = 0.0, mean = 0.0, rest_share = 0.0;
-    uint32_t used = 0;
+    const profile_model model = {profile, k, c, rho0, h, step};
+    profile_fit fit;
+    double rest_share = 0.0;
     for (uint32_t l = 0; l < nl; ++l)
       if (layer_count[l]) {
         layer_sum[l] /= layer_count[l];
         layer_rho[l] /= layer_count[l];
         layer_y[l] /= layer_count[l];
       }
-    for (int s = -400; s <= 400; ++s) {
-      const double ys = top_layer + 0.5 * step + s * (2.0 * h / 400.0);
-      double cost = 0.0;
-      for (uint32_t l = 0; l < nl; ++l) {
-        double e;
-        if (layer_count[l] == 0 || layer_y[l] < h || ys - layer_y[l] < 2.0 * h) continue;
-        e = layer_sum[l] / exact_pressure(profile, k, c, rho0, ys - layer_y[l]) - 1.0;
-        cost += e * e;
-      }
-      if (cost < best_cost) {
-        best_cost = cost;
-        best_s = ys;
-      }
-    }
-    printf(
-        "%s: %u particles, h = %.4f m, %u layers deep; fitted surface y_s = %.4f m, top particle layer %.4f "
-        "m "
-        "(y_s - top = %.2f h)\n",
-        tc->name, n, h, nl, best_s, top_layer, (best_s - top_layer) / h);
-    printf("  %-9s %-9s %-11s %-11s %-8s %-9s\n", "y, m", "depth, m", "p SPH, Pa", "p exact, Pa", "error",
-           "rho/rho0-1");
-    for (uint32_t l = 0; l < nl; ++l) {
-      double exact, e;
-      if (layer_count[l] == 0) continue;
-      exact = exact_pressure(profile, k, c, rho0, best_s - layer_y[l]);
-      e = exact > 0.0 ? layer_sum[l] / exact - 1.0 : 0.0;
-      {
-        const int interior = layer_y[l] >= h && best_s - layer_y[l] >= 2.0 * h;
-        printf("  %-9.4f %-9.4f %-11.1f %-11.1f %+6.2f %% %+7.3f %%%s\n", layer_y[l], best_s - layer_y[l],
-               layer_sum[l], exact, 100.0 * e, 100.0 * (layer_rho[l] / rho0 - 1.0),
-               interior ? "" : "  (boundary layer, not compared)");
-        if (!interior) continue;
-      }
-      if (fabs(e) > worst) worst = fabs(e);
-      mean += fabs(e);
-      ++used;
-    }
-    mean /= used ? used : 1;
+    printf("%s: %u particles, h = %.4f m, %u layers deep, top particle layer %.4f m\n", tc->name, n, h, nl,
+           top_layer);
+    fit = fit_profile(&model, top_layer, nl, layer_sum, layer_y, layer_rho, layer_count,
+                      "the particles' pressure (SPH_ATTRIBUTE_PRESSURE), per slice");
     {
       /* v_rms^2 / 2 over the window against g D: the dynamic pressure's share of the bottom's. */
       const double v2 = 2.0 * window_ke / (window_frames ? window_frames : 1) / ((double)mass * n);
@@ -271,7 +360,15 @@ void run_tank(const tank_case* tc) {
         "  interior layers %u: mean |error| %.2f %%, worst %.2f %% (bound %.1f %%); lowest particle y = %.2e "
         "m "
         "(%.3f spacings)\n",
-        used, 100.0 * mean, 100.0 * worst, 100.0 * tc->bound, lowest, lowest / def.particle_spacing);
+        fit.used, 100.0 * fit.mean, 100.0 * fit.worst, 100.0 * tc->bound, lowest,
+        lowest / def.particle_spacing);
+    if (tc->gauges) {
+      particle_scatter(&model, &fit, n, nl, bin, particle_p, particle_y, inside, window_frames);
+      tank_moment_print(moment, layer_y, fit.surface, rho0, GRAVITY, h);
+      tank_gauges_profile(gauges, bin, layer_sum, layer_y, layer_count);
+      (void)fit_profile(&model, top_layer, nl, layer_sum, layer_y, NULL, layer_count,
+                        "the gauges' pressure (the SPH interpolant, horizontal lines), per slice");
+    }
     {
       FILE* out = validation_open_output(
           tc->solver == SPH_SOLVER_DFSPH
@@ -280,25 +377,30 @@ void run_tank(const tank_case* tc) {
           : tc->features            ? "hydrostatic_ideal_gas_boundary.txt"
                                     : "hydrostatic_ideal_gas.txt");
       if (out) {
-        fprintf(out, "%s %u %.3f %.3f %.2f %.3e %.4f\n", tc->name, n, 100.0 * mean, 100.0 * worst,
-                (best_s - top_layer) / h, lowest / def.particle_spacing, 100.0 * rest_share);
+        fprintf(out, "%s %u %.3f %.3f %.2f %.3e %.4f\n", tc->name, n, 100.0 * fit.mean, 100.0 * fit.worst,
+                (fit.surface - top_layer) / h, lowest / def.particle_spacing, 100.0 * rest_share);
         fclose(out);
       }
     }
-    assert_true(used >= 5);
+    assert_true(fit.used >= 5);
     assert_true(rest_share <= 0.01);
-    assert_true(worst <= tc->bound);
+    assert_true(fit.worst <= tc->bound);
     /* The fitted surface lies where the fluid is: within 2 h of the top particle layer. */
-    assert_true(fabs(best_s - top_layer) <= 2.0 * h);
+    assert_true(fabs(fit.surface - top_layer) <= 2.0 * h);
     /* Nothing crosses the floor (at y = -gap): the collider puts particles back on the trilinear
      * SDF's zero level, which matches the box's floor to float rounding; 5 % of a spacing allows for that
      * and still catches any particle that leaks through (it would be a spacing or more out). */
     assert_true(lowest > -gap - 0.05 * def.particle_spacing);
   }
+  tank_gauges_destroy(gauges, world);
+  tank_moment_destroy(moment);
   free(layer_sum);
   free(layer_rho);
   free(layer_y);
   free(layer_count);
+  free(particle_p);
+  free(particle_y);
+  free(inside);
   EXPECT_OK(sph_sdf_destroy(sdf));
   EXPECT_OK(support_world_close(&w));
 }

@@ -22,9 +22,12 @@ typedef struct tank_case {
   float dt_max;          /* the step's ceiling, s (0: the library's default, 1 ms) */
   float density_error;   /* DFSPH's density-solve bound (0: the library's default, 0.1 %) */
   /* The settling experiments (docs/validation.md, "DFSPH: hydrostatic tank"); 0 = as before. */
-  float frame;       /* frame length, s (0: 0.02); one substep's (dt_max) samples every substep */
-  double window;     /* the averaged share of the run (0: the second half) */
-  double damp_until; /* s: until then every velocity is zeroed each 0.1 s (kinetic damping) */
+  float frame;           /* frame length, s (0: 0.02); one substep's (dt_max) samples every substep */
+  double window;         /* the averaged share of the run (0: the second half) */
+  double damp_until;     /* s: until then every velocity is zeroed each 0.1 s (kinetic damping) */
+  float kernel_spacings; /* the kernel radius in particle spacings (0: the library's default, 1.8) */
+  int gauges;            /* 1: also read the pressure through the library's gauges and report each
+                            particle's scatter (hydrostatic_tank_gauges.c) */
 } tank_case;
 
 /* Runs the case: the pressure profile, the rest and the floor asserted, one line of results
