@@ -9,7 +9,7 @@
  *   - the plateau, the mean of p* over t* in [3.3, 4.5] after the impact's peak (the data's 0.55).
  * One run's impact moves by several percent when the lattice moves by 1e-7 m, so the issue's
  * bounds (impact within 5 %, plateau within 20 %) are asserted on the mean of an ensemble of such
- * draws (test_plain_ensemble, ~1 min on 2 cores: scripts/validate runs it); the CI cases assert
+ * draws (test_plain_ensemble, ~50 s on 2 cores: scripts/validate runs it); the CI cases assert
  * one draw's impact within 15 % (the draws' spread; DAM_PRESSURE_STRICT=1: 5 %).
  * The experiment is 2D (a tank much wider than its water); here a slab 4 layers thick between
  * free-slip walls, H = 0.1 m (Froude scaling: t* and p* are the same at any H for an inviscid
