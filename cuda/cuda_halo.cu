@@ -21,7 +21,9 @@
 //                      which then picks the same step on every rank; ghosts dropped
 // A distributed world runs on the stream driver (each step waits for the stream; the frame,
 // the frame's start and the substep's reductions: cuda_halo_frame.cu). Symplectic Euler with the
-// weakly compressible solver only; attach_ranks refuses the rest by name.
+// weakly compressible solver only (with the normalised density and the density diffusion, whose
+// republished densities the ghosts take again: substep_pipeline.cu); attach_ranks refuses the
+// rest by name.
 #include <cstring>
 #include <memory>
 #include <string>
@@ -56,8 +58,6 @@ void CudaBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks,
     const char* name;
   } features[] = {{kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks)"},
                   {kFeatureSurfaceTension, "SPH_FEATURE_SURFACE_TENSION"},
-                  {kFeatureNormalizedDensity, "SPH_FEATURE_NORMALIZED_DENSITY"},
-                  {kFeatureDensityDiffusion, "SPH_FEATURE_DENSITY_DIFFUSION"},
                   {kFeatureColliderLoads, "SPH_FEATURE_COLLIDER_LOADS"}};
   for (const auto& f : features)
     if (config_.features & f.bit) refuse(f.name);

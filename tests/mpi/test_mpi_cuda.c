@@ -15,11 +15,12 @@
  *     substeps (CPU and GPU round differently: fused multiply-adds, the lanes' partial sums;
  *     tests/gpu's parity bound); after the collapse's 240 substeps the distance is only printed
  *     (the roundings grow with the flow's chaos).
- * Cases: the dam break (20 substeps), the stirred column whose particles cross the slab boundary
- * (20 substeps; again with Clavet's viscosity and the user attribute, and with the walls'
- * density), the collapse that makes the ranks rebalance (12 frames of 20 substeps, spacing
- * 12.5 mm), and the refusals (DFSPH, RK4, surface tension: SPH_ERROR_UNSUPPORTED naming them).
- * With SPH_MPI_CUDA_QUICK set, the dam break and the refusals only (a run under compute-sanitizer). */
+ * Cases: the dam break (20 substeps), the stirred column whose particles cross the slab
+ * boundary (20 substeps; again with Clavet's viscosity and the user attribute, with the walls'
+ * density, with the normalised density, and with it and the density diffusion), the collapse
+ * that makes the ranks rebalance (12 frames of 20 substeps, spacing 12.5 mm), and the refusals
+ * (DFSPH, RK4, surface tension: SPH_ERROR_UNSUPPORTED naming them). With SPH_MPI_CUDA_QUICK set,
+ * the dam break and the refusals only (a run under compute-sanitizer). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -130,6 +131,14 @@ int main(int argc, char** argv) {
     def.viscosity_method = SPH_VISCOSITY_MUELLER;
     def.features = SPH_FEATURE_BOUNDARY_DENSITY;
     run_case("stirred column, the walls' density", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    /* The normalised density's filter and the density diffusion publish the densities again after
+     * the summation: the ghosts take their owners' records after each publication (as on the CPU
+     * rank), so an owned particle's filter and forces read the undivided world's values. */
+    def.features = SPH_FEATURE_NORMALIZED_DENSITY;
+    run_case("stirred column, normalised density", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    def.features = SPH_FEATURE_NORMALIZED_DENSITY | SPH_FEATURE_DENSITY_DIFFUSION;
+    run_case("stirred column, normalised density and diffusion", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    def.features = 0;
     mpi_test_world_def(&def); /* capacity 4096: 16 slots an axis, folded along x */
     run_case("stirred column, folded table, one lane", cuda_one_lane, cpu, &def, 0.5f, 1, 20, 1);
     mpi_test_world_def(&def);
