@@ -197,9 +197,13 @@ class CudaBackend final : public Backend {
   void halo_gather();       // migration, then ghosts; the visit order of the sort
   void halo_after_sort(cudaStream_t stream);     // ghost mask, new keys, the lists of the records
   void halo_after_density(cudaStream_t stream);  // the ghosts take their owners' density records
-  void halo_before_end(cudaStream_t stream);     // maxima and failures reduced over the ranks
-  void halo_drop_ghosts();                       // the owned particles, in the sorted order
-  HostVector<HaloArray> halo_arrays() const;     // what travels with a particle
+  void halo_after_normals(cudaStream_t stream);  // and their colour normals (surface tension)
+  // The ghosts take their owners' records, made by pack(list, m) and applied by apply(list, got, m).
+  template <class Record, class Pack, class Apply>
+  void halo_refresh(cudaStream_t stream, const char* what, Pack&& pack, Apply&& apply);
+  void halo_before_end(cudaStream_t stream);  // maxima and failures reduced over the ranks
+  void halo_drop_ghosts();                    // the owned particles, in the sorted order
+  HostVector<HaloArray> halo_arrays() const;  // what travels with a particle
   std::vector<RankBytes> halo_send(const uint32_t* starts);
   uint32_t halo_receive(const RankBytes& in, uint32_t first);
   bool halo_any(bool flag) const;

@@ -22,8 +22,8 @@
 // A distributed world runs on the stream driver (each step waits for the stream; the frame,
 // the frame's start and the substep's reductions: cuda_halo_frame.cu). Symplectic Euler with the
 // weakly compressible solver only (with the normalised density and the density diffusion, whose
-// republished densities the ghosts take again: substep_pipeline.cu); attach_ranks refuses the
-// rest by name.
+// republished densities the ghosts take again, and surface tension, whose colour normals they
+// take: substep_pipeline.cu); attach_ranks refuses the rest by name.
 #include <cstring>
 #include <memory>
 #include <string>
@@ -57,7 +57,6 @@ void CudaBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks,
     uint32_t bit;
     const char* name;
   } features[] = {{kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks)"},
-                  {kFeatureSurfaceTension, "SPH_FEATURE_SURFACE_TENSION"},
                   {kFeatureColliderLoads, "SPH_FEATURE_COLLIDER_LOADS"}};
   for (const auto& f : features)
     if (config_.features & f.bit) refuse(f.name);
@@ -247,7 +246,8 @@ void CudaBackend::halo_after_sort(cudaStream_t stream) {
                          static_cast<uint64_t*>(r_->store->find(kArrayDistributedSortKey)), stream);
 }
 
-void CudaBackend::halo_after_density(cudaStream_t stream) {
+template <class Record, class Pack, class Apply>
+void CudaBackend::halo_refresh(cudaStream_t stream, const char* what, Pack&& pack, Apply&& apply) {
   const RankTransport& t = *ranks_;
   const size_t size = static_cast<size_t>(t.size());
   DeviceHalo& h = *r_->halo;
@@ -259,31 +259,52 @@ void CudaBackend::halo_after_density(cudaStream_t stream) {
   if (h.order_names_no_particle()) throw Error(Status::Internal, "halo: the sort's order names no particle");
   const uint32_t* starts = h.starts();
   const uint32_t sent = starts[size];
-  const ParticleArrays& a = r_->store->arrays();
   std::vector<RankBytes> out(size);
   if (sent > 0) {
-    const HaloDensityRecord* records = h.pack_density(a, h.list(), sent, stream);
+    const Record* records = pack(h.list(), sent);
     for (size_t d = 0; d < size; ++d) {
       const unsigned char* from = reinterpret_cast<const unsigned char*>(records + starts[d]);
-      out[d].assign(from, from + sizeof(HaloDensityRecord) * (starts[d + 1] - starts[d]));
+      out[d].assign(from, from + sizeof(Record) * (starts[d + 1] - starts[d]));
     }
   }
   // (starts is pinned memory the exchange leaves alone; the next lists come with the next substep)
   halo_kept_ = h.kept_count();
   const std::vector<RankBytes> in = t.exchange(out);
-  HostVector<HaloDensityRecord> got;
+  HostVector<Record> got;
   for (size_t r = 0; r < size; ++r) {
     const size_t ghosts = starts[size + r + 1] - starts[size + r];
-    if (in[r].size() != sizeof(HaloDensityRecord) * ghosts)
+    if (in[r].size() != sizeof(Record) * ghosts)
       throw Error(Status::Internal, "halo: rank " + std::to_string(r) + " sent " +
-                                        std::to_string(in[r].size() / sizeof(HaloDensityRecord)) +
-                                        " density records for " + std::to_string(ghosts) + " ghosts");
+                                        std::to_string(in[r].size() / sizeof(Record)) + " " + what + " for " +
+                                        std::to_string(ghosts) + " ghosts");
     const size_t first = got.size();
     got.resize(first + ghosts);
     if (ghosts > 0) std::memcpy(got.data() + first, in[r].data(), in[r].size());
   }
   if (got.empty()) return;
-  h.enqueue_apply_density(a, h.list() + sent, got.data(), static_cast<uint32_t>(got.size()), stream);
+  apply(h.list() + sent, got.data(), static_cast<uint32_t>(got.size()));
+}
+
+void CudaBackend::halo_after_density(cudaStream_t stream) {
+  DeviceHalo& h = *r_->halo;
+  const ParticleArrays& a = r_->store->arrays();
+  halo_refresh<HaloDensityRecord>(
+      stream, "density records",
+      [&](const uint32_t* idx, uint32_t m) { return h.pack_density(a, idx, m, stream); },
+      [&](const uint32_t* idx, const HaloDensityRecord* records, uint32_t m) {
+        h.enqueue_apply_density(a, idx, records, m, stream);
+      });
+}
+
+void CudaBackend::halo_after_normals(cudaStream_t stream) {
+  DeviceHalo& h = *r_->halo;
+  const ParticleArrays& a = r_->store->arrays();
+  halo_refresh<HaloNormalRecord>(
+      stream, "colour normals",
+      [&](const uint32_t* idx, uint32_t m) { return h.pack_normals(a, idx, m, stream); },
+      [&](const uint32_t* idx, const HaloNormalRecord* records, uint32_t m) {
+        h.enqueue_apply_normals(a, idx, records, m, stream);
+      });
 }
 
 void CudaBackend::halo_drop_ghosts() {

@@ -48,6 +48,7 @@ class CudaBackend::HaloHooks final : public SubstepHooks {
   explicit HaloHooks(CudaBackend& b) : b_(b) { visit = b.r_->halo->visit(); }
   void after_sort(cudaStream_t stream) override { b_.halo_after_sort(stream); }
   void after_density(cudaStream_t stream) override { b_.halo_after_density(stream); }
+  void after_normals(cudaStream_t stream) override { b_.halo_after_normals(stream); }
   void before_end(cudaStream_t stream) override { b_.halo_before_end(stream); }
 
  private:
@@ -85,7 +86,8 @@ void CudaBackend::halo_before_end(cudaStream_t stream) {
   cuda_check(cudaStreamSynchronize(stream), "the substep's state");
   if (*mismatch != 0) {
     cuda_check(cudaMemsetAsync(h.mismatch_flag(), 0, sizeof(uint32_t), stream), "halo id check reset");
-    throw Error(Status::Internal, "halo: a rank's density records came in another order than its ghosts");
+    throw Error(Status::Internal,
+                "halo: a rank's density records or colour normals came in another order than its ghosts");
   }
   const FrameState& f = *out;
   int64_t bad =

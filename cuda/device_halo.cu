@@ -35,6 +35,27 @@ __global__ void pack_density_kernel(ParticleArrays a, const uint32_t* __restrict
                              a.neighbor_count ? a.neighbor_count[i] : 0u};
 }
 
+__global__ void pack_normals_kernel(ParticleArrays a, const uint32_t* __restrict__ idx, uint32_t m,
+                                    HaloNormalRecord* __restrict__ out) {
+  const uint32_t k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k >= m) return;
+  const uint32_t i = idx[k];
+  out[k] = HaloNormalRecord{a.sorted_id[i], {0u, 0u, 0u}, a.colour_normal[i]};
+}
+
+__global__ void apply_normals_kernel(ParticleArrays a, const uint32_t* __restrict__ idx, uint32_t m,
+                                     const HaloNormalRecord* __restrict__ in, uint32_t* mismatch) {
+  const uint32_t k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k >= m) return;
+  const uint32_t i = idx[k];
+  const HaloNormalRecord r = in[k];
+  if (r.id != a.sorted_id[i]) {
+    atomicExch(mismatch, 1u);
+    return;
+  }
+  a.colour_normal[i] = r.normal;
+}
+
 __global__ void apply_density_kernel(ParticleArrays a, const uint32_t* __restrict__ idx, uint32_t m,
                                      const HaloDensityRecord* __restrict__ in, uint32_t* mismatch) {
   const uint32_t k = blockIdx.x * blockDim.x + threadIdx.x;
@@ -205,6 +226,36 @@ void DeviceHalo::enqueue_apply_density(const ParticleArrays& a, const uint32_t* 
       a, idx, m, reinterpret_cast<const HaloDensityRecord*>(staging_.get()), mismatch_.get());
   check_launch("apply_density_kernel");
   // (The pinned staging is not touched again before the stream's next wait.)
+}
+
+const HaloNormalRecord* DeviceHalo::pack_normals(const ParticleArrays& a, const uint32_t* idx, uint32_t m,
+                                                 cudaStream_t stream) {
+  const size_t bytes = sizeof(HaloNormalRecord) * m;
+  ensure_device(bytes);
+  ensure_host(bytes);
+  if (m > 0) {
+    pack_normals_kernel<<<blocks_for(m, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
+        a, idx, m, reinterpret_cast<HaloNormalRecord*>(staging_.get()));
+    check_launch("pack_normals_kernel");
+    cuda_check(cudaMemcpyAsync(host_staging_.get(), staging_.get(), bytes, cudaMemcpyDeviceToHost, stream),
+               "copy of the halo's colour normals");
+  }
+  cuda_check(cudaStreamSynchronize(stream), "halo colour normals");
+  return reinterpret_cast<const HaloNormalRecord*>(host_staging_.get());
+}
+
+void DeviceHalo::enqueue_apply_normals(const ParticleArrays& a, const uint32_t* idx,
+                                       const HaloNormalRecord* records, uint32_t m, cudaStream_t stream) {
+  if (m == 0) return;
+  const size_t bytes = sizeof(HaloNormalRecord) * m;
+  ensure_device(bytes);
+  ensure_host(bytes);
+  std::copy(records, records + m, reinterpret_cast<HaloNormalRecord*>(host_staging_.get()));
+  cuda_check(cudaMemcpyAsync(staging_.get(), host_staging_.get(), bytes, cudaMemcpyHostToDevice, stream),
+             "copy of the ghosts' colour normals");
+  apply_normals_kernel<<<blocks_for(m, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
+      a, idx, m, reinterpret_cast<const HaloNormalRecord*>(staging_.get()), mismatch_.get());
+  check_launch("apply_normals_kernel");
 }
 
 uint64_t DeviceHalo::bytes() const {

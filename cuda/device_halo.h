@@ -94,6 +94,11 @@ class DeviceHalo {
   // first). A record whose id is not its ghost's raises mismatch(), which the host reads later.
   void enqueue_apply_density(const ParticleArrays& a, const uint32_t* idx, const HaloDensityRecord* records,
                              uint32_t m, cudaStream_t stream);
+  // The same for the colour normals (surface tension), after their pass.
+  const HaloNormalRecord* pack_normals(const ParticleArrays& a, const uint32_t* idx, uint32_t m,
+                                       cudaStream_t stream);
+  void enqueue_apply_normals(const ParticleArrays& a, const uint32_t* idx, const HaloNormalRecord* records,
+                             uint32_t m, cudaStream_t stream);
   uint32_t* mismatch_flag() const { return mismatch_.get(); }
 
   uint64_t bytes() const;

@@ -62,8 +62,10 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
       if (enqueue_density_republish(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning,
                                     stage == 0, b.state, stream))
         hooks->after_density(stream);
-      if (setup.options.surface_tension)
-        throw Error(Status::Internal, "substep: a distributed rank does not share the colour normals");
+      if (setup.options.surface_tension) {
+        enqueue_colour_normals(setup.fluid, b.grid->view(), a, n, setup.tuning, stream);
+        hooks->after_normals(stream);
+      }
     }
     // Probes sample the substep's start (RK4: its first stage), as on the CPU.
     if (stage == 0 && setup.probes.on())

@@ -17,10 +17,10 @@
  *     (the roundings grow with the flow's chaos).
  * Cases: the dam break (20 substeps), the stirred column whose particles cross the slab
  * boundary (20 substeps; again with Clavet's viscosity and the user attribute, with the walls'
- * density, with the normalised density, and with it and the density diffusion), the collapse
- * that makes the ranks rebalance (12 frames of 20 substeps, spacing 12.5 mm), and the refusals
- * (DFSPH, RK4, surface tension: SPH_ERROR_UNSUPPORTED naming them). With SPH_MPI_CUDA_QUICK set,
- * the dam break and the refusals only (a run under compute-sanitizer). */
+ * density, with the normalised density, with it and the density diffusion, with surface
+ * tension), the collapse that makes the ranks rebalance (12 frames of 20 substeps, spacing
+ * 12.5 mm), and the refusals (DFSPH, RK4, collider loads: SPH_ERROR_UNSUPPORTED naming them). With
+ * SPH_MPI_CUDA_QUICK set, the dam break and the refusals only (a run under compute-sanitizer). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -138,6 +138,10 @@ int main(int argc, char** argv) {
     run_case("stirred column, normalised density", cuda, cpu, &def, 0.5f, 1, 20, 1);
     def.features = SPH_FEATURE_NORMALIZED_DENSITY | SPH_FEATURE_DENSITY_DIFFUSION;
     run_case("stirred column, normalised density and diffusion", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    /* Surface tension: the colour normals' pass reads the ghosts' densities (refreshed), and the
+     * ghosts take their owners' normals after it (the force pass reads them). */
+    def.features = SPH_FEATURE_SURFACE_TENSION;
+    run_case("stirred column, surface tension", cuda, cpu, &def, 0.5f, 1, 20, 1);
     def.features = 0;
     mpi_test_world_def(&def); /* capacity 4096: 16 slots an axis, folded along x */
     run_case("stirred column, folded table, one lane", cuda_one_lane, cpu, &def, 0.5f, 1, 20, 1);
@@ -155,8 +159,8 @@ int main(int argc, char** argv) {
   def.integrator = SPH_INTEGRATOR_RK4;
   expect_refused(cuda, &def, "RK4");
   mpi_test_world_def(&def);
-  def.features = SPH_FEATURE_SURFACE_TENSION;
-  expect_refused(cuda, &def, "SPH_FEATURE_SURFACE_TENSION");
+  def.features = SPH_FEATURE_COLLIDER_LOADS;
+  expect_refused(cuda, &def, "SPH_FEATURE_COLLIDER_LOADS");
 
   REQUIRE(sph_context_destroy(cuda) == SPH_OK && sph_context_destroy(cuda_one_lane) == SPH_OK, "destroy");
   return mpi_test_finish(cpu, "mpi_cuda");
