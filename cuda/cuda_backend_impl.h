@@ -202,6 +202,7 @@ class CudaBackend final : public Backend {
   template <class Record, class Pack, class Apply>
   void halo_refresh(cudaStream_t stream, const char* what, Pack&& pack, Apply&& apply);
   void halo_before_end(cudaStream_t stream);  // maxima and failures reduced over the ranks
+  void halo_sum_loads(ColliderLoadSums* sums, uint32_t colliders);  // the frame's loads over the ranks
   void halo_drop_ghosts();                    // the owned particles, in the sorted order
   HostVector<HaloArray> halo_arrays() const;  // what travels with a particle
   std::vector<RankBytes> halo_send(const uint32_t* starts);

@@ -22,8 +22,9 @@
 // A distributed world runs on the stream driver (each step waits for the stream; the frame,
 // the frame's start and the substep's reductions: cuda_halo_frame.cu). Symplectic Euler with the
 // weakly compressible solver only (with the normalised density and the density diffusion, whose
-// republished densities the ghosts take again, and surface tension, whose colour normals they
-// take: substep_pipeline.cu); attach_ranks refuses the rest by name.
+// republished densities the ghosts take again, surface tension, whose colour normals they take:
+// substep_pipeline.cu, and collider loads, each rank's own particles' impulses added over the
+// ranks at the frame's end: cuda_halo_frame.cu); attach_ranks refuses the rest by name.
 #include <cstring>
 #include <memory>
 #include <string>
@@ -56,8 +57,7 @@ void CudaBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks,
   const struct {
     uint32_t bit;
     const char* name;
-  } features[] = {{kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks)"},
-                  {kFeatureColliderLoads, "SPH_FEATURE_COLLIDER_LOADS"}};
+  } features[] = {{kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks)"}};
   for (const auto& f : features)
     if (config_.features & f.bit) refuse(f.name);
   if (config_.solver == Solver::Dfsph) refuse("the DFSPH solver");

@@ -5,9 +5,11 @@
 // each substep's maxima and failures over the ranks before the device's end-of-substep kernel,
 // which then picks the same next step on every rank (and fails on every rank together).
 #include <algorithm>
+#include <cstring>
 #include <vector>
 
 #include "../src/core/rank_agreement.h"
+#include "../src/core/rank_sums.h"
 #include "../src/core/slab_rebalance.h"
 #include "cuda_backend_impl.h"
 #include "kernel_launch.h"
@@ -72,6 +74,16 @@ void CudaBackend::halo_begin_frame() {
     slabs_cut_ = true;
     ++halo_counters_.rebalances;
   }
+}
+
+// Each rank summed its own particles' impulses; the frame's sums are added over the ranks in rank
+// order (core/rank_sums.h, as the CPU rank does), so every rank reads the same world's value.
+void CudaBackend::halo_sum_loads(ColliderLoadSums* sums, uint32_t colliders) {
+  static_assert(sizeof(ColliderLoadSums) == 6 * sizeof(double), "a collider's sums are six doubles");
+  HostVector<double> v(6 * static_cast<size_t>(colliders));
+  if (colliders > 0) std::memcpy(v.data(), sums, sizeof(double) * v.size());
+  ordered_rank_sum(*ranks_, v.data(), v.size());
+  if (colliders > 0) std::memcpy(sums, v.data(), sizeof(double) * v.size());
 }
 
 void CudaBackend::halo_before_end(cudaStream_t stream) {
@@ -144,6 +156,7 @@ uint32_t CudaBackend::run_frame_distributed(PipelineSetup setup, const StepInter
   halo_drop_ghosts();
   cuda_check(cudaStreamSynchronize(s), "frame end");
   halo_agree();  // (the frame's end: nothing after this can fail on one rank alone)
+  if (setup.loads.on()) halo_sum_loads(setup.loads.output, setup.loads.colliders);
   return halo_owned_;
 }
 
