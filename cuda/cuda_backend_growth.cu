@@ -123,7 +123,7 @@ void CudaBackend::reserve(uint32_t capacity, const GrowthNeeds& needs) {
     DeviceColliderLoads loads;
     if (needs.load_colliders != 0) loads.reserve(needs.load_colliders, capacity);
     std::unique_ptr<DeviceHalo> halo;
-    if (r_->halo) halo = std::make_unique<DeviceHalo>(capacity);
+    if (r_->halo) halo = std::make_unique<DeviceHalo>(capacity, ranks_->size());
     store->enqueue_copy_from(*r_->store, count_, r_->stream);
     cuda_check(cudaStreamSynchronize(r_->stream), "growth of the particle storage");
     // Nothing below throws: the new buffers replace the old ones (freed at the end of scope).

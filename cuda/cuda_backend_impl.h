@@ -195,12 +195,17 @@ class CudaBackend final : public Backend {
   uint32_t run_frame_distributed(PipelineSetup setup, const StepInterrupt& interrupt, bool& interrupted);
   void halo_begin_frame();  // the world's max speed and acceleration; new slabs when out of balance
   void halo_gather();       // migration, then ghosts; the visit order of the sort
-  void halo_after_sort(cudaStream_t stream);     // ghost mask and new keys; the order to the host
+  void halo_after_sort(cudaStream_t stream);     // ghost mask, new keys, the lists of the records
   void halo_after_density(cudaStream_t stream);  // the ghosts take their owners' density records
-  void halo_before_end(cudaStream_t stream);     // maxima and failures reduced over the ranks
-  void halo_drop_ghosts();                       // the owned particles, in the sorted order
-  HostVector<HaloArray> halo_arrays() const;     // what travels with a particle
-  std::vector<RankBytes> halo_send(const std::vector<HostVector<uint32_t>>& to);
+  void halo_after_normals(cudaStream_t stream);  // and their colour normals (surface tension)
+  // The ghosts take their owners' records, made by pack(list, m) and applied by apply(list, got, m).
+  template <class Record, class Pack, class Apply>
+  void halo_refresh(cudaStream_t stream, const char* what, Pack&& pack, Apply&& apply);
+  void halo_before_end(cudaStream_t stream);  // maxima and failures reduced over the ranks
+  void halo_sum_loads(ColliderLoadSums* sums, uint32_t colliders);  // the frame's loads over the ranks
+  void halo_drop_ghosts();                    // the owned particles, in the sorted order
+  HostVector<HaloArray> halo_arrays() const;  // what travels with a particle
+  std::vector<RankBytes> halo_send(const uint32_t* starts);
   uint32_t halo_receive(const RankBytes& in, uint32_t first);
   bool halo_any(bool flag) const;
   void halo_agree() const;
@@ -210,12 +215,13 @@ class CudaBackend final : public Backend {
   SlabDecomposition slabs_;
   bool slabs_cut_ = false;
   DistributedCounters halo_counters_;
-  int64_t halo_world_count_ = 0;      // the particles every rank owns, this substep
-  uint32_t halo_owned_ = 0;           // during a frame: the owned particles (count_: the frame's start)
-  uint32_t halo_ghosts_ = 0;          // and the ghosts after them
-  HostVector<int32_t> halo_layer_;    // before the sort: each owned particle's cell layer
-  HostVector<uint32_t> halo_origin_;  // before the sort: 0 owned, else 1 + the ghost's rank
-  HostVector<uint32_t> halo_keep_;    // the owned particles' places in the sorted order
+  int64_t halo_world_count_ = 0;  // the particles every rank owns, this substep
+  uint32_t halo_owned_ = 0;       // during a frame: the owned particles (count_: the frame's start)
+  uint32_t halo_ghosts_ = 0;      // and the ghosts after them
+  // After the density pass: how many owned particles the sorted order holds (the device's kept
+  // list, DeviceHalo::kept_list); kNoKeptList before it.
+  static constexpr uint32_t kNoKeptList = UINT32_MAX;
+  uint32_t halo_kept_ = kNoKeptList;
 
   WorldConfig config_;
   int device_;

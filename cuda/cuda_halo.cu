@@ -3,13 +3,16 @@
 // host-staged: what crosses to another rank is downloaded, sent over the RankTransport (MPI in
 // libsph_mpi; no CUDA-aware MPI) and uploaded where it arrives. The steps are the CPU rank's
 // (src/cpu/cpu_halo.cpp), at the same points of the substep, with the same decisions
-// (core/slab_decomposition.h, core/slab_rebalance.h) and the same agreements (core/rank_agreement.h):
+// (core/slab_rules.h, core/slab_rebalance.h) and the same agreements (core/rank_agreement.h).
+// Who goes where is decided on the device, per particle (DeviceHalo's lists, in the order the
+// CPU rank's loops list them); the host gets how many go to each rank and the bytes that leave:
 //   the frame's start  the world's max speed and acceleration; new slabs when out of balance
 //   before the sort    migrants leave with every carried array (the device compacts what stays),
 //                      ghosts arrive after the owned particles; the sort takes all of them in
 //                      the order of their keys (slot and place at the last sort), so each slot
 //                      lists its particles as the undivided world's stable sort does
-//   after the sort     the ghost mask, each particle's new key, the order to the host
+//   after the sort     the ghost mask, each particle's new key, and the lists of sorted places
+//                      that send and take density records (and the owned ones, kept later)
 //   after density      the ghosts take their owners' density, pressure, 1 / density and
 //                      neighbour count (the force pass reads them), checked by id
 //   forces             only owned particles are integrated and join the maxima (the mask)
@@ -18,7 +21,10 @@
 //                      which then picks the same step on every rank; ghosts dropped
 // A distributed world runs on the stream driver (each step waits for the stream; the frame,
 // the frame's start and the substep's reductions: cuda_halo_frame.cu). Symplectic Euler with the
-// weakly compressible solver only; attach_ranks refuses the rest by name.
+// weakly compressible solver only (with the normalised density and the density diffusion, whose
+// republished densities the ghosts take again, surface tension, whose colour normals they take:
+// substep_pipeline.cu, and collider loads, each rank's own particles' impulses added over the
+// ranks at the frame's end: cuda_halo_frame.cu); attach_ranks refuses the rest by name.
 #include <cstring>
 #include <memory>
 #include <string>
@@ -51,11 +57,7 @@ void CudaBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks,
   const struct {
     uint32_t bit;
     const char* name;
-  } features[] = {{kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks)"},
-                  {kFeatureSurfaceTension, "SPH_FEATURE_SURFACE_TENSION"},
-                  {kFeatureNormalizedDensity, "SPH_FEATURE_NORMALIZED_DENSITY"},
-                  {kFeatureDensityDiffusion, "SPH_FEATURE_DENSITY_DIFFUSION"},
-                  {kFeatureColliderLoads, "SPH_FEATURE_COLLIDER_LOADS"}};
+  } features[] = {{kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks)"}};
   for (const auto& f : features)
     if (config_.features & f.bit) refuse(f.name);
   if (config_.solver == Solver::Dfsph) refuse("the DFSPH solver");
@@ -78,7 +80,7 @@ void CudaBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks,
         max_particles_per_cell(config_.particle_spacing, config_.kernel_radius), store->sort_scratch(),
         store->arrays().sorted_position, sizeof(Float4) * static_cast<size_t>(capacity),
         /*fit_to_extent=*/false);
-    auto halo = std::make_unique<DeviceHalo>(capacity);
+    auto halo = std::make_unique<DeviceHalo>(capacity, ranks->size());
     store->enqueue_initial_world_words(r_->stream);
     cuda_check(cudaStreamSynchronize(r_->stream), "a distributed rank's arrays");
     r_->graph.reset();
@@ -151,28 +153,26 @@ HostVector<HaloArray> CudaBackend::halo_arrays() const {
   return v;
 }
 
-// to[d]: the indices of the particles for rank d. Each rank's bytes hold its particles' arrays
-// one after the other (DeviceHalo::pack's layout, for that rank's particles alone).
-std::vector<RankBytes> CudaBackend::halo_send(const std::vector<HostVector<uint32_t>>& to) {
-  std::vector<RankBytes> out(to.size());
-  HostVector<uint32_t> all;
-  for (const auto& list : to) all.insert(all.end(), list.begin(), list.end());
-  const uint32_t m = static_cast<uint32_t>(all.size());
+// The particles the device index list names at [starts[0], starts[size]) leave: rank d's are
+// [starts[d], starts[d + 1]). Each rank's bytes hold its particles' arrays one after the other
+// (DeviceHalo::pack's layout, for that rank's particles alone).
+std::vector<RankBytes> CudaBackend::halo_send(const uint32_t* starts) {
+  const size_t size = static_cast<size_t>(ranks_->size());
+  std::vector<RankBytes> out(size);
+  const uint32_t m = starts[size] - starts[0];
   if (m == 0) return out;
   const HostVector<HaloArray> arrays = halo_arrays();
   DeviceHalo& h = *r_->halo;
-  h.upload_index(all.data(), m, r_->stream);
-  const unsigned char* host = h.pack(arrays.data(), static_cast<int>(arrays.size()), m, r_->stream);
-  size_t start = 0;
-  for (size_t d = 0; d < to.size(); ++d) {
-    const size_t count = to[d].size();
+  const unsigned char* host =
+      h.pack(arrays.data(), static_cast<int>(arrays.size()), h.list() + starts[0], m, r_->stream);
+  for (size_t d = 0; d < size; ++d) {
+    const size_t start = starts[d] - starts[0], count = starts[d + 1] - starts[d];
     size_t offset = 0;
     for (const HaloArray& x : arrays) {
       const unsigned char* from = host + offset + x.bytes * start;
       out[d].insert(out[d].end(), from, from + x.bytes * count);
       offset += static_cast<size_t>(x.bytes) * m;
     }
-    start += count;
   }
   return out;
 }
@@ -201,54 +201,33 @@ void CudaBackend::halo_gather() {
   const float inv = 1.0f / config_.kernel_radius;
   cudaStream_t s = r_->stream;
   DeviceHalo& h = *r_->halo;
+  const Float4* position = r_->store->arrays().position;
   uint32_t owned = halo_owned_;
-  // Migration: what another rank's slab holds goes there with every carried array.
-  h.download_layers(r_->store->arrays().position, owned, axis, inv, s);
-  const int32_t* layer = h.host_layers();
-  std::vector<HostVector<uint32_t>> to(size);
-  halo_keep_.clear();
-  halo_layer_.clear();
-  for (uint32_t i = 0; i < owned; ++i) {
-    const int owner = slabs_.owner(layer[i]);
-    if (owner == me) {
-      halo_keep_.push_back(i);
-      halo_layer_.push_back(layer[i]);
-    } else {
-      to[static_cast<size_t>(owner)].push_back(i);
-    }
-  }
-  std::vector<RankBytes> in = t.exchange(halo_send(to));  // (an agreement: the substep so far, the packing)
-  const uint32_t kept = static_cast<uint32_t>(halo_keep_.size());
-  halo_counters_.migrated_out += owned - kept;
+  halo_kept_ = kNoKeptList;
+  // Migration: what another rank's slab holds goes there with every carried array (the lists and
+  // their order: DeviceHalo::list_migrants; what stays is listed last).
+  h.set_cuts(slabs_.cuts(), s);
+  const uint32_t* starts = h.list_migrants(position, owned, axis, inv, me, s);
+  std::vector<RankBytes> in =
+      t.exchange(halo_send(starts));  // (an agreement: the substep so far, the packing)
+  const uint32_t leaving = starts[size];
+  const uint32_t kept = owned - leaving;
+  halo_counters_.migrated_out += leaving;
   const HostVector<HaloArray> arrays = halo_arrays();
-  if (kept < owned) {
-    h.upload_index(halo_keep_.data(), kept, s);
-    h.keep(arrays.data(), static_cast<int>(arrays.size()), kept, s);
-  }
+  if (kept < owned) h.keep(arrays.data(), static_cast<int>(arrays.size()), h.list() + leaving, kept, s);
   owned = kept;
   for (const RankBytes& bytes : in) {
     const uint32_t m = halo_receive(bytes, owned);
-    for (uint32_t k = 0; k < m; ++k) {  // (the positions come first, DeviceHalo::pack)
-      Float4 p;
-      std::memcpy(&p, bytes.data() + sizeof(Float4) * k, sizeof p);
-      halo_layer_.push_back(slab_layer(p.x, p.y, p.z, axis, inv));
-    }
     owned += m;
     halo_counters_.migrated_in += m;
   }
   // Ghosts: each owned particle of a layer beside another rank's slab goes to that rank.
-  for (auto& list : to) list.clear();
-  for (uint32_t i = 0; i < owned; ++i) {
-    int dst[2];
-    const int n = slabs_.ghost_destinations(halo_layer_[i], me, dst);
-    for (int k = 0; k < n; ++k) to[static_cast<size_t>(dst[k])].push_back(i);
-  }
-  in = t.exchange(halo_send(to));  // (an agreement: the migrants' arrival, the ghosts' packing)
-  halo_origin_.assign(owned, 0u);
+  in = t.exchange(halo_send(h.list_ghosts(position, owned, axis, inv, me, s)));
+  // (an agreement: the migrants' arrival, the ghosts' packing)
   uint32_t n = owned;
   for (size_t r = 0; r < size; ++r) {
     const uint32_t m = halo_receive(in[r], n);
-    halo_origin_.insert(halo_origin_.end(), m, static_cast<uint32_t>(r) + 1u);
+    h.enqueue_origin(n, m, static_cast<uint32_t>(r), s);
     n += m;
   }
   halo_owned_ = owned;
@@ -262,74 +241,79 @@ void CudaBackend::halo_gather() {
 }
 
 void CudaBackend::halo_after_sort(cudaStream_t stream) {
-  r_->halo->enqueue_mark(*r_->grid, halo_owned_ + halo_ghosts_, halo_owned_, r_->store->arrays().halo_ghost,
+  r_->halo->enqueue_mark(*r_->grid, halo_owned_ + halo_ghosts_, halo_owned_, ranks_->rank(),
+                         r_->store->arrays().halo_ghost,
                          static_cast<uint64_t*>(r_->store->find(kArrayDistributedSortKey)), stream);
 }
 
-void CudaBackend::halo_after_density(cudaStream_t stream) {
+template <class Record, class Pack, class Apply>
+void CudaBackend::halo_refresh(cudaStream_t stream, const char* what, Pack&& pack, Apply&& apply) {
   const RankTransport& t = *ranks_;
-  const int me = t.rank();
   const size_t size = static_cast<size_t>(t.size());
-  const uint32_t n = halo_owned_ + halo_ghosts_;
   DeviceHalo& h = *r_->halo;
-  cuda_check(cudaStreamSynchronize(stream), "the sort's order");
+  cuda_check(cudaStreamSynchronize(stream), "the halo's lists");
   // Both sides list the particles they share in the sorted order, which is the same on every rank
-  // (the keys): the receiver reads its ghosts' records in its own order, checked by id.
-  const uint32_t* order = h.host_order();
-  std::vector<HostVector<uint32_t>> send(size), receive(size);
-  halo_keep_.clear();
-  for (uint32_t i = 0; i < n; ++i) {
-    const uint32_t k = order[i];
-    if (k >= n) throw Error(Status::Internal, "halo: the sort's order names no particle");
-    if (k < halo_owned_) {
-      halo_keep_.push_back(i);
-      int dst[2];
-      const int c = slabs_.ghost_destinations(halo_layer_[k], me, dst);
-      for (int e = 0; e < c; ++e) send[static_cast<size_t>(dst[e])].push_back(i);
-    } else {
-      receive[halo_origin_[k] - 1u].push_back(i);
-    }
-  }
-  HostVector<uint32_t> all;
-  for (const auto& list : send) all.insert(all.end(), list.begin(), list.end());
-  const ParticleArrays& a = r_->store->arrays();
+  // (the keys): the receiver reads its ghosts' records in its own order, checked by id. The lists
+  // (DeviceHalo::enqueue_mark): the records to send, rank by rank, then the ghosts that take
+  // them, rank by rank.
+  if (h.order_names_no_particle()) throw Error(Status::Internal, "halo: the sort's order names no particle");
+  const uint32_t* starts = h.starts();
+  const uint32_t sent = starts[size];
   std::vector<RankBytes> out(size);
-  if (!all.empty()) {
-    h.upload_index(all.data(), static_cast<uint32_t>(all.size()), stream);
-    const HaloDensityRecord* records = h.pack_density(a, static_cast<uint32_t>(all.size()), stream);
-    size_t start = 0;
+  if (sent > 0) {
+    const Record* records = pack(h.list(), sent);
     for (size_t d = 0; d < size; ++d) {
-      const unsigned char* from = reinterpret_cast<const unsigned char*>(records + start);
-      out[d].assign(from, from + sizeof(HaloDensityRecord) * send[d].size());
-      start += send[d].size();
+      const unsigned char* from = reinterpret_cast<const unsigned char*>(records + starts[d]);
+      out[d].assign(from, from + sizeof(Record) * (starts[d + 1] - starts[d]));
     }
   }
+  // (starts is pinned memory the exchange leaves alone; the next lists come with the next substep)
+  halo_kept_ = h.kept_count();
   const std::vector<RankBytes> in = t.exchange(out);
-  HostVector<HaloDensityRecord> got;
-  HostVector<uint32_t> ghosts;
+  HostVector<Record> got;
   for (size_t r = 0; r < size; ++r) {
-    if (in[r].size() != sizeof(HaloDensityRecord) * receive[r].size())
+    const size_t ghosts = starts[size + r + 1] - starts[size + r];
+    if (in[r].size() != sizeof(Record) * ghosts)
       throw Error(Status::Internal, "halo: rank " + std::to_string(r) + " sent " +
-                                        std::to_string(in[r].size() / sizeof(HaloDensityRecord)) +
-                                        " density records for " + std::to_string(receive[r].size()) +
-                                        " ghosts");
+                                        std::to_string(in[r].size() / sizeof(Record)) + " " + what + " for " +
+                                        std::to_string(ghosts) + " ghosts");
     const size_t first = got.size();
-    got.resize(first + receive[r].size());
-    if (!receive[r].empty()) std::memcpy(got.data() + first, in[r].data(), in[r].size());
-    ghosts.insert(ghosts.end(), receive[r].begin(), receive[r].end());
+    got.resize(first + ghosts);
+    if (ghosts > 0) std::memcpy(got.data() + first, in[r].data(), in[r].size());
   }
-  if (ghosts.empty()) return;
-  h.upload_index(ghosts.data(), static_cast<uint32_t>(ghosts.size()), stream);
-  h.enqueue_apply_density(a, got.data(), static_cast<uint32_t>(got.size()), stream);
+  if (got.empty()) return;
+  apply(h.list() + sent, got.data(), static_cast<uint32_t>(got.size()));
+}
+
+void CudaBackend::halo_after_density(cudaStream_t stream) {
+  DeviceHalo& h = *r_->halo;
+  const ParticleArrays& a = r_->store->arrays();
+  halo_refresh<HaloDensityRecord>(
+      stream, "density records",
+      [&](const uint32_t* idx, uint32_t m) { return h.pack_density(a, idx, m, stream); },
+      [&](const uint32_t* idx, const HaloDensityRecord* records, uint32_t m) {
+        h.enqueue_apply_density(a, idx, records, m, stream);
+      });
+}
+
+void CudaBackend::halo_after_normals(cudaStream_t stream) {
+  DeviceHalo& h = *r_->halo;
+  const ParticleArrays& a = r_->store->arrays();
+  halo_refresh<HaloNormalRecord>(
+      stream, "colour normals",
+      [&](const uint32_t* idx, uint32_t m) { return h.pack_normals(a, idx, m, stream); },
+      [&](const uint32_t* idx, const HaloNormalRecord* records, uint32_t m) {
+        h.enqueue_apply_normals(a, idx, records, m, stream);
+      });
 }
 
 void CudaBackend::halo_drop_ghosts() {
   if (halo_ghosts_ == 0) return;
   const HostVector<HaloArray> arrays = halo_arrays();
-  const uint32_t kept = static_cast<uint32_t>(halo_keep_.size());
-  if (kept != halo_owned_) throw Error(Status::Internal, "halo: the sorted order lost an owned particle");
-  r_->halo->upload_index(halo_keep_.data(), kept, r_->stream);
-  r_->halo->keep(arrays.data(), static_cast<int>(arrays.size()), kept, r_->stream);
+  if (halo_kept_ != halo_owned_)
+    throw Error(Status::Internal, "halo: the sorted order lost an owned particle");
+  r_->halo->keep(arrays.data(), static_cast<int>(arrays.size()), r_->halo->kept_list(), halo_kept_,
+                 r_->stream);
   halo_ghosts_ = 0;
 }
 

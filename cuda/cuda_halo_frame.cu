@@ -5,9 +5,11 @@
 // each substep's maxima and failures over the ranks before the device's end-of-substep kernel,
 // which then picks the same next step on every rank (and fails on every rank together).
 #include <algorithm>
+#include <cstring>
 #include <vector>
 
 #include "../src/core/rank_agreement.h"
+#include "../src/core/rank_sums.h"
 #include "../src/core/slab_rebalance.h"
 #include "cuda_backend_impl.h"
 #include "kernel_launch.h"
@@ -48,6 +50,7 @@ class CudaBackend::HaloHooks final : public SubstepHooks {
   explicit HaloHooks(CudaBackend& b) : b_(b) { visit = b.r_->halo->visit(); }
   void after_sort(cudaStream_t stream) override { b_.halo_after_sort(stream); }
   void after_density(cudaStream_t stream) override { b_.halo_after_density(stream); }
+  void after_normals(cudaStream_t stream) override { b_.halo_after_normals(stream); }
   void before_end(cudaStream_t stream) override { b_.halo_before_end(stream); }
 
  private:
@@ -73,6 +76,16 @@ void CudaBackend::halo_begin_frame() {
   }
 }
 
+// Each rank summed its own particles' impulses; the frame's sums are added over the ranks in rank
+// order (core/rank_sums.h, as the CPU rank does), so every rank reads the same world's value.
+void CudaBackend::halo_sum_loads(ColliderLoadSums* sums, uint32_t colliders) {
+  static_assert(sizeof(ColliderLoadSums) == 6 * sizeof(double), "a collider's sums are six doubles");
+  HostVector<double> v(6 * static_cast<size_t>(colliders));
+  if (colliders > 0) std::memcpy(v.data(), sums, sizeof(double) * v.size());
+  ordered_rank_sum(*ranks_, v.data(), v.size());
+  if (colliders > 0) std::memcpy(sums, v.data(), sizeof(double) * v.size());
+}
+
 void CudaBackend::halo_before_end(cudaStream_t stream) {
   const RankTransport& t = *ranks_;
   DeviceHalo& h = *r_->halo;
@@ -85,7 +98,8 @@ void CudaBackend::halo_before_end(cudaStream_t stream) {
   cuda_check(cudaStreamSynchronize(stream), "the substep's state");
   if (*mismatch != 0) {
     cuda_check(cudaMemsetAsync(h.mismatch_flag(), 0, sizeof(uint32_t), stream), "halo id check reset");
-    throw Error(Status::Internal, "halo: a rank's density records came in another order than its ghosts");
+    throw Error(Status::Internal,
+                "halo: a rank's density records or colour normals came in another order than its ghosts");
   }
   const FrameState& f = *out;
   int64_t bad =
@@ -142,6 +156,7 @@ uint32_t CudaBackend::run_frame_distributed(PipelineSetup setup, const StepInter
   halo_drop_ghosts();
   cuda_check(cudaStreamSynchronize(s), "frame end");
   halo_agree();  // (the frame's end: nothing after this can fail on one rank alone)
+  if (setup.loads.on()) halo_sum_loads(setup.loads.output, setup.loads.colliders);
   return halo_owned_;
 }
 

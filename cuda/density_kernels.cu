@@ -154,7 +154,16 @@ void launch_density(bool boundary, unsigned lanes, unsigned threads, const Fluid
 void enqueue_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a, uint32_t n,
                      const SubstepOptions& options, const KernelTuning& tuning, const DeviceScene& scene,
                      float stage_fraction, bool first_of_substep, FrameState* state, cudaStream_t stream) {
-  const unsigned threads = tuning.density_block, blocks = blocks_for(n, threads);
+  enqueue_density_summation(fluid, grid, a, n, options, tuning, scene, stage_fraction, state, stream);
+  enqueue_density_republish(fluid, grid, a, n, options, tuning, first_of_substep, state, stream);
+  if (options.surface_tension) enqueue_colour_normals(fluid, grid, a, n, tuning, stream);
+}
+
+void enqueue_density_summation(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                               uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
+                               const DeviceScene& scene, float stage_fraction, FrameState* state,
+                               cudaStream_t stream) {
+  const unsigned threads = tuning.density_block;
   const unsigned lanes = lanes_per_particle(tuning, n);
   const bool counts = options.viscosity == ViscosityMethod::Clavet;
   const bool boundary = options.boundary_density;
@@ -171,6 +180,12 @@ void enqueue_density(const FluidConstants& fluid, const GridView& grid, const Pa
     launch_density<false, false>(boundary, lanes, threads, fluid, grid, a, n, scene, stage_fraction,
                                  options.density_diffusion, state, stream);
   check_launch("density_kernel");
+}
+
+bool enqueue_density_republish(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                               uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
+                               bool first_of_substep, FrameState* state, cudaStream_t stream) {
+  const unsigned threads = tuning.density_block, blocks = blocks_for(n, threads);
   if (options.density_diffusion) {
     // The diffusion keeps the carried density instead of the filter (density_diffusion.h).
     if (first_of_substep) {  // once per substep, for its whole dt
@@ -184,8 +199,9 @@ void enqueue_density(const FluidConstants& fluid, const GridView& grid, const Pa
     check_launch("normalized_density_kernel");
     publish_normalized_density_kernel<<<blocks, threads, 0, stream>>>(fluid, a, n);
     check_launch("publish_normalized_density_kernel");
+    return true;
   }
-  if (options.surface_tension) enqueue_colour_normals(fluid, grid, a, n, tuning, stream);
+  return options.density_diffusion && first_of_substep;
 }
 
 void enqueue_density_diffusion(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,

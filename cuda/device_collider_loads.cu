@@ -35,7 +35,8 @@ __global__ void __launch_bounds__(kLoadBlock)
   __shared__ float slots[6][kLoadBlock];
   mark_stage(state, kStageCollide);
   const uint32_t i = blockIdx.x * kLoadBlock + threadIdx.x;
-  const bool live = i < n;
+  // A distributed rank's ghosts are another rank's particles: that rank adds their impulses.
+  const bool live = i < n && !(a.halo_ghost && a.halo_ghost[i]);
   const SubstepTime time = state->clock.time;
   const StageTime at = stage_time(time, stage_fraction);
   const float mass = fluid.particle_mass;

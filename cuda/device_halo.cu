@@ -11,14 +11,6 @@
 namespace sph {
 namespace {
 
-__global__ void layer_kernel(const Float4* __restrict__ positions, uint32_t n, int axis, float inv,
-                             int32_t* __restrict__ layers) {
-  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i >= n) return;
-  const Float4 p = positions[i];
-  layers[i] = cell_coordinate(axis == 0 ? p.x : (axis == 1 ? p.y : p.z), inv);
-}
-
 // dst[k] = src[idx[k]] for k < m, `words` 32-bit words a particle.
 __global__ void gather_words_kernel(const uint32_t* __restrict__ src, uint32_t words,
                                     const uint32_t* __restrict__ idx, uint32_t m,
@@ -34,16 +26,6 @@ __global__ void iota_kernel(uint32_t* v, uint32_t n) {
   if (i < n) v[i] = i;
 }
 
-__global__ void mark_kernel(const uint32_t* __restrict__ order, const uint32_t* __restrict__ sorted_slots,
-                            const uint32_t* __restrict__ cell_start, uint32_t n, uint32_t owned,
-                            uint32_t* __restrict__ ghost, uint64_t* __restrict__ keys) {
-  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i >= n) return;
-  ghost[i] = order[i] >= owned ? 1u : 0u;
-  const uint32_t slot = sorted_slots[i];
-  keys[i] = (static_cast<uint64_t>(slot) << 32) | (i - cell_start[slot]);
-}
-
 __global__ void pack_density_kernel(ParticleArrays a, const uint32_t* __restrict__ idx, uint32_t m,
                                     HaloDensityRecord* __restrict__ out) {
   const uint32_t k = blockIdx.x * blockDim.x + threadIdx.x;
@@ -51,6 +33,27 @@ __global__ void pack_density_kernel(ParticleArrays a, const uint32_t* __restrict
   const uint32_t i = idx[k];
   out[k] = HaloDensityRecord{a.sorted_id[i], a.density[i], a.sorted_position[i].w, a.sorted_velocity[i].w,
                              a.neighbor_count ? a.neighbor_count[i] : 0u};
+}
+
+__global__ void pack_normals_kernel(ParticleArrays a, const uint32_t* __restrict__ idx, uint32_t m,
+                                    HaloNormalRecord* __restrict__ out) {
+  const uint32_t k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k >= m) return;
+  const uint32_t i = idx[k];
+  out[k] = HaloNormalRecord{a.sorted_id[i], {0u, 0u, 0u}, a.colour_normal[i]};
+}
+
+__global__ void apply_normals_kernel(ParticleArrays a, const uint32_t* __restrict__ idx, uint32_t m,
+                                     const HaloNormalRecord* __restrict__ in, uint32_t* mismatch) {
+  const uint32_t k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k >= m) return;
+  const uint32_t i = idx[k];
+  const HaloNormalRecord r = in[k];
+  if (r.id != a.sorted_id[i]) {
+    atomicExch(mismatch, 1u);
+    return;
+  }
+  a.colour_normal[i] = r.normal;
 }
 
 __global__ void apply_density_kernel(ParticleArrays a, const uint32_t* __restrict__ idx, uint32_t m,
@@ -71,24 +74,38 @@ __global__ void apply_density_kernel(ParticleArrays a, const uint32_t* __restric
 
 }  // namespace
 
-DeviceHalo::DeviceHalo(uint32_t capacity) : capacity_(capacity) {
+DeviceHalo::DeviceHalo(uint32_t capacity, int ranks) : capacity_(capacity), ranks_(ranks) {
   const size_t n = std::max<uint32_t>(capacity, 1u);
+  key_bits_ = 1;
+  while ((1ull << key_bits_) <= 2ull * static_cast<uint64_t>(ranks)) ++key_bits_;
+  cuts_.allocate(static_cast<size_t>(std::max(ranks - 1, 1)), "halo slab cuts");
   layers_.allocate(n, "halo layers");
-  // An owned particle beside two other slabs (a slab one layer thick) is listed for both.
-  index_.allocate(2 * n, "halo index list");
+  origin_.allocate(n, "halo ghosts' ranks");
+  // Two entries a particle: an owned particle beside two other slabs (a slab one layer thick) is
+  // listed for both.
+  keys_in_.allocate(2 * n, "halo list keys");
+  keys_out_.allocate(2 * n, "halo sorted list keys");
+  values_.allocate(2 * n, "halo list values");
+  list_.allocate(2 * n, "halo index lists");
+  keep_.allocate(n, "halo kept list");
+  kept_flags_.allocate(n, "halo kept flags");
+  const size_t words = 2 * static_cast<size_t>(ranks) + 3;
+  words_.allocate(words, "halo list starts");
   iota_.allocate(n, "halo sort values");
   visit_.allocate(n, "halo visit order");
   sorted_keys_.allocate(n, "halo sorted keys");
   mismatch_.allocate(1, "halo id check");
-  host_layers_.allocate(n, "halo layers (host)");
-  host_index_.allocate(2 * n, "halo index list (host)");
-  host_order_.allocate(n, "halo sort order (host)");
+  host_cuts_.allocate(static_cast<size_t>(std::max(ranks - 1, 1)), "halo slab cuts (host)");
+  host_words_.allocate(words, "halo list starts (host)");
+  std::fill(host_words_.get(), host_words_.get() + words, 0u);
   cuda_check(
       cub::DeviceRadixSort::SortPairs(nullptr, sort_temp_bytes_, static_cast<const uint64_t*>(nullptr),
                                       static_cast<uint64_t*>(nullptr), static_cast<const uint32_t*>(nullptr),
                                       static_cast<uint32_t*>(nullptr), static_cast<int>(n)),
       "halo key sort size query");
   sort_temp_.allocate(std::max<size_t>(sort_temp_bytes_, 1), "halo key sort temporary storage");
+  lists_temp_bytes_ = lists_temp_bytes(static_cast<uint32_t>(2 * n));
+  lists_temp_.allocate(std::max<size_t>(lists_temp_bytes_, 1), "halo lists temporary storage");
   iota_kernel<<<blocks_for(static_cast<uint32_t>(n), kDefaultBlockSize), kDefaultBlockSize>>>(
       iota_.get(), static_cast<uint32_t>(n));
   check_launch("iota_kernel");
@@ -108,31 +125,8 @@ void DeviceHalo::ensure_host(size_t bytes) {
   host_staging_bytes_ = grown;
 }
 
-void DeviceHalo::download_layers(const Float4* positions, uint32_t n, int axis, float inv_cell_size,
-                                 cudaStream_t stream) {
-  if (n > capacity_) throw Error(Status::Internal, "halo: more particles than the capacity");
-  if (n == 0) return;
-  layer_kernel<<<blocks_for(n, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
-      positions, n, axis, inv_cell_size, layers_.get());
-  check_launch("layer_kernel");
-  cuda_check(
-      cudaMemcpyAsync(host_layers_.get(), layers_.get(), sizeof(int32_t) * n, cudaMemcpyDeviceToHost, stream),
-      "copy of the halo layers");
-  cuda_check(cudaStreamSynchronize(stream), "halo layers");
-}
-
-void DeviceHalo::upload_index(const uint32_t* idx, uint32_t m, cudaStream_t stream) {
-  if (m > 2ull * capacity_)
-    throw Error(Status::Internal, "halo: an index list longer than twice the capacity");
-  if (m == 0) return;
-  std::copy(idx, idx + m, host_index_.get());
-  cuda_check(
-      cudaMemcpyAsync(index_.get(), host_index_.get(), sizeof(uint32_t) * m, cudaMemcpyHostToDevice, stream),
-      "copy of a halo index list");
-  cuda_check(cudaStreamSynchronize(stream), "halo index list");  // (the pinned list is reused)
-}
-
-const unsigned char* DeviceHalo::pack(const HaloArray* arrays, int count, uint32_t m, cudaStream_t stream) {
+const unsigned char* DeviceHalo::pack(const HaloArray* arrays, int count, const uint32_t* idx, uint32_t m,
+                                      cudaStream_t stream) {
   size_t record = 0;
   for (int k = 0; k < count; ++k) record += arrays[k].bytes;
   ensure_device(record * m);
@@ -143,7 +137,7 @@ const unsigned char* DeviceHalo::pack(const HaloArray* arrays, int count, uint32
     const uint64_t items = static_cast<uint64_t>(m) * words;
     gather_words_kernel<<<static_cast<unsigned>((items + kDefaultBlockSize - 1) / kDefaultBlockSize),
                           kDefaultBlockSize, 0, stream>>>(
-        reinterpret_cast<const uint32_t*>(arrays[k].data), words, index_.get(), m,
+        reinterpret_cast<const uint32_t*>(arrays[k].data), words, idx, m,
         reinterpret_cast<uint32_t*>(staging_.get() + offset));
     check_launch("gather_words_kernel");
     offset += static_cast<size_t>(arrays[k].bytes) * m;
@@ -155,7 +149,8 @@ const unsigned char* DeviceHalo::pack(const HaloArray* arrays, int count, uint32
   return host_staging_.get();
 }
 
-void DeviceHalo::keep(const HaloArray* arrays, int count, uint32_t m, cudaStream_t stream) {
+void DeviceHalo::keep(const HaloArray* arrays, int count, const uint32_t* idx, uint32_t m,
+                      cudaStream_t stream) {
   uint32_t widest = 0;
   for (int k = 0; k < count; ++k) widest = std::max(widest, arrays[k].bytes);
   ensure_device(static_cast<size_t>(widest) * m);
@@ -164,7 +159,7 @@ void DeviceHalo::keep(const HaloArray* arrays, int count, uint32_t m, cudaStream
     const uint64_t items = static_cast<uint64_t>(m) * words;
     gather_words_kernel<<<static_cast<unsigned>((items + kDefaultBlockSize - 1) / kDefaultBlockSize),
                           kDefaultBlockSize, 0, stream>>>(reinterpret_cast<const uint32_t*>(arrays[k].data),
-                                                          words, index_.get(), m,
+                                                          words, idx, m,
                                                           reinterpret_cast<uint32_t*>(staging_.get()));
     check_launch("gather_words_kernel");
     cuda_check(cudaMemcpyAsync(arrays[k].data, staging_.get(), static_cast<size_t>(arrays[k].bytes) * m,
@@ -202,26 +197,14 @@ void DeviceHalo::enqueue_visit(const uint64_t* keys, uint32_t n, cudaStream_t st
              "halo key sort");
 }
 
-void DeviceHalo::enqueue_mark(const DeviceNeighborGrid& grid, uint32_t n, uint32_t owned, uint32_t* ghost,
-                              uint64_t* keys, cudaStream_t stream) {
-  if (n == 0) return;
-  const CrowdGuard g = grid.crowd_guard();
-  mark_kernel<<<blocks_for(n, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
-      grid.order(), g.sorted_keys, g.cell_start, n, owned, ghost, keys);
-  check_launch("mark_kernel");
-  // The order lives in the sort's scratch, which the density pass overwrites: copied now.
-  cuda_check(
-      cudaMemcpyAsync(host_order_.get(), grid.order(), sizeof(uint32_t) * n, cudaMemcpyDeviceToHost, stream),
-      "copy of the sort's order");
-}
-
-const HaloDensityRecord* DeviceHalo::pack_density(const ParticleArrays& a, uint32_t m, cudaStream_t stream) {
+const HaloDensityRecord* DeviceHalo::pack_density(const ParticleArrays& a, const uint32_t* idx, uint32_t m,
+                                                  cudaStream_t stream) {
   const size_t bytes = sizeof(HaloDensityRecord) * m;
   ensure_device(bytes);
   ensure_host(bytes);
   if (m > 0) {
     pack_density_kernel<<<blocks_for(m, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
-        a, index_.get(), m, reinterpret_cast<HaloDensityRecord*>(staging_.get()));
+        a, idx, m, reinterpret_cast<HaloDensityRecord*>(staging_.get()));
     check_launch("pack_density_kernel");
     cuda_check(cudaMemcpyAsync(host_staging_.get(), staging_.get(), bytes, cudaMemcpyDeviceToHost, stream),
                "copy of the halo's density records");
@@ -230,8 +213,8 @@ const HaloDensityRecord* DeviceHalo::pack_density(const ParticleArrays& a, uint3
   return reinterpret_cast<const HaloDensityRecord*>(host_staging_.get());
 }
 
-void DeviceHalo::enqueue_apply_density(const ParticleArrays& a, const HaloDensityRecord* records, uint32_t m,
-                                       cudaStream_t stream) {
+void DeviceHalo::enqueue_apply_density(const ParticleArrays& a, const uint32_t* idx,
+                                       const HaloDensityRecord* records, uint32_t m, cudaStream_t stream) {
   if (m == 0) return;
   const size_t bytes = sizeof(HaloDensityRecord) * m;
   ensure_device(bytes);
@@ -240,14 +223,46 @@ void DeviceHalo::enqueue_apply_density(const ParticleArrays& a, const HaloDensit
   cuda_check(cudaMemcpyAsync(staging_.get(), host_staging_.get(), bytes, cudaMemcpyHostToDevice, stream),
              "copy of the ghosts' density records");
   apply_density_kernel<<<blocks_for(m, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
-      a, index_.get(), m, reinterpret_cast<const HaloDensityRecord*>(staging_.get()), mismatch_.get());
+      a, idx, m, reinterpret_cast<const HaloDensityRecord*>(staging_.get()), mismatch_.get());
   check_launch("apply_density_kernel");
   // (The pinned staging is not touched again before the stream's next wait.)
 }
 
+const HaloNormalRecord* DeviceHalo::pack_normals(const ParticleArrays& a, const uint32_t* idx, uint32_t m,
+                                                 cudaStream_t stream) {
+  const size_t bytes = sizeof(HaloNormalRecord) * m;
+  ensure_device(bytes);
+  ensure_host(bytes);
+  if (m > 0) {
+    pack_normals_kernel<<<blocks_for(m, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
+        a, idx, m, reinterpret_cast<HaloNormalRecord*>(staging_.get()));
+    check_launch("pack_normals_kernel");
+    cuda_check(cudaMemcpyAsync(host_staging_.get(), staging_.get(), bytes, cudaMemcpyDeviceToHost, stream),
+               "copy of the halo's colour normals");
+  }
+  cuda_check(cudaStreamSynchronize(stream), "halo colour normals");
+  return reinterpret_cast<const HaloNormalRecord*>(host_staging_.get());
+}
+
+void DeviceHalo::enqueue_apply_normals(const ParticleArrays& a, const uint32_t* idx,
+                                       const HaloNormalRecord* records, uint32_t m, cudaStream_t stream) {
+  if (m == 0) return;
+  const size_t bytes = sizeof(HaloNormalRecord) * m;
+  ensure_device(bytes);
+  ensure_host(bytes);
+  std::copy(records, records + m, reinterpret_cast<HaloNormalRecord*>(host_staging_.get()));
+  cuda_check(cudaMemcpyAsync(staging_.get(), host_staging_.get(), bytes, cudaMemcpyHostToDevice, stream),
+             "copy of the ghosts' colour normals");
+  apply_normals_kernel<<<blocks_for(m, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
+      a, idx, m, reinterpret_cast<const HaloNormalRecord*>(staging_.get()), mismatch_.get());
+  check_launch("apply_normals_kernel");
+}
+
 uint64_t DeviceHalo::bytes() const {
-  return layers_.bytes() + index_.bytes() + iota_.bytes() + visit_.bytes() + sorted_keys_.bytes() +
-         sort_temp_.bytes() + mismatch_.bytes() + staging_.bytes();
+  return cuts_.bytes() + layers_.bytes() + origin_.bytes() + keys_in_.bytes() + keys_out_.bytes() +
+         values_.bytes() + list_.bytes() + keep_.bytes() + kept_flags_.bytes() + words_.bytes() +
+         lists_temp_.bytes() + iota_.bytes() + visit_.bytes() + sorted_keys_.bytes() + sort_temp_.bytes() +
+         mismatch_.bytes() + staging_.bytes();
 }
 
 }  // namespace sph

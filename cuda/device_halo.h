@@ -2,7 +2,10 @@
 // The device side of a distributed world's rank (cuda_halo.cu): the buffers and kernels that
 // stage what crosses to other ranks through the host. Nothing here talks to other ranks; the
 // backend downloads what leaves, exchanges it over the RankTransport and uploads what arrives.
-//   layers      each particle's cell layer along the slabs' axis (the host decides who owns it)
+//   lists       who goes where (core/slab_rules.h per particle, on the device): the migrants,
+//               the ghosts, and after the sort what the ghosts' density records are; per rank,
+//               in ascending order, by a stable radix sort on the destination. Only where each
+//               rank's list starts reaches the host, and the bytes that leave.
 //   pack/keep   particles' arrays gathered by an index list: into a staging buffer (what leaves),
 //               or back into the arrays' heads (what stays, in its order)
 //   visit       the particles in the order of their sort keys (a stable 64-bit radix sort), the
@@ -15,6 +18,8 @@
 #include <stdint.h>
 
 #include <cuda_runtime.h>
+
+#include <vector>
 
 #include "../src/core/halo_records.h"
 #include "device_array.h"
@@ -32,20 +37,35 @@ struct HaloArray {
 
 class DeviceHalo {
  public:
-  explicit DeviceHalo(uint32_t capacity);
+  // A rank of `ranks` ranks (their slabs' cuts come by set_cuts).
+  DeviceHalo(uint32_t capacity, int ranks);
 
-  // layers[i] for particles [0, n) into host_layers() (waits for the stream).
-  void download_layers(const Float4* positions, uint32_t n, int axis, float inv_cell_size,
-                       cudaStream_t stream);
-  const int32_t* host_layers() const { return host_layers_.get(); }
+  // The slabs' cuts (SlabDecomposition::cuts(), ranks - 1 of them) to the device (enqueued).
+  void set_cuts(const std::vector<int32_t>& cuts, cudaStream_t stream);
 
-  // Uploads idx[0, m) (ascending or not) as the device index list (waits for the stream).
-  void upload_index(const uint32_t* idx, uint32_t m, cudaStream_t stream);
-  // The arrays of the particles the index list names, one array after the other (each m x its
-  // bytes), into pinned host memory (waits for the stream); returns it.
-  const unsigned char* pack(const HaloArray* arrays, int count, uint32_t m, cudaStream_t stream);
-  // Keeps the particles the index list names (m of them), in that order, at the arrays' heads.
-  void keep(const HaloArray* arrays, int count, uint32_t m, cudaStream_t stream);
+  // Per-rank lists (device_halo_lists.cu): the device index list list() holds rank 0's list,
+  // then rank 1's, ..., each ascending (the order of the host loops these replace, which the
+  // receiver relies on); the host gets only where each list starts (pinned, read after the call
+  // or, for enqueue_mark, after the stream).
+  //   list_migrants  particles [0, n) by the rank that owns their layer; starts[0, ranks] and
+  //                  starts[ranks + 1] = n, with this rank's own list (what stays) last:
+  //                  [starts[ranks], n). Waits for the stream.
+  //   list_ghosts    particles [0, n) to the ranks beside their layer (their layers are kept
+  //                  for enqueue_mark); starts[0, ranks], starts[ranks] = the total. Waits.
+  const uint32_t* list_migrants(const Float4* positions, uint32_t n, int axis, float inv_cell_size, int me,
+                                cudaStream_t stream);
+  const uint32_t* list_ghosts(const Float4* positions, uint32_t n, int axis, float inv_cell_size, int me,
+                              cudaStream_t stream);
+  const uint32_t* list() const { return list_.get(); }
+  // Particles [first, first + m) are ghosts from rank `origin` (enqueued).
+  void enqueue_origin(uint32_t first, uint32_t m, uint32_t origin, cudaStream_t stream);
+
+  // The arrays of the particles idx[0, m) names (a device list), one array after the other (each
+  // m x its bytes), into pinned host memory (waits for the stream); returns it.
+  const unsigned char* pack(const HaloArray* arrays, int count, const uint32_t* idx, uint32_t m,
+                            cudaStream_t stream);
+  // Keeps the particles idx[0, m) names (a device list), in that order, at the arrays' heads.
+  void keep(const HaloArray* arrays, int count, const uint32_t* idx, uint32_t m, cudaStream_t stream);
   // Writes particles [first, first + m) of each array from `bytes` (pack's layout; waits).
   void unpack(const HaloArray* arrays, int count, const unsigned char* bytes, uint32_t m, uint32_t first,
               cudaStream_t stream);
@@ -53,19 +73,32 @@ class DeviceHalo {
   // visit() = [0, n) in ascending key order, ties in storage order.
   void enqueue_visit(const uint64_t* keys, uint32_t n, cudaStream_t stream);
   const uint32_t* visit() const { return visit_.get(); }
-  // After the grid's sort and cell starts: ghost[i] = (order[i] >= owned), keys[i] = the slot
-  // and place of sorted particle i; order[0, n) goes to host_order() (read after the stream).
-  void enqueue_mark(const DeviceNeighborGrid& grid, uint32_t n, uint32_t owned, uint32_t* ghost,
+  // After the grid's sort and cell starts (enqueued): ghost[i] = (order[i] >= owned), keys[i] =
+  // the slot and place of sorted particle i, and the lists of sorted positions, each ascending:
+  // in list(), the owned particles beside rank d's slab (what d's ghosts take) for each d, then
+  // the ghosts from rank r for each r; starts()[0, 2 ranks] (starts()[ranks] where the ghosts'
+  // lists begin, starts()[2 ranks] their end); kept_list() the owned particles (kept_count()).
+  void enqueue_mark(const DeviceNeighborGrid& grid, uint32_t n, uint32_t owned, int me, uint32_t* ghost,
                     uint64_t* keys, cudaStream_t stream);
-  const uint32_t* host_order() const { return host_order_.get(); }
+  // After the stream, of the last enqueue_mark.
+  const uint32_t* starts() const { return host_words_.get(); }
+  uint32_t kept_count() const { return host_words_.get()[2 * ranks_ + 1]; }
+  bool order_names_no_particle() const { return host_words_.get()[2 * ranks_ + 2] != 0; }
+  const uint32_t* kept_list() const { return keep_.get(); }
 
-  // The density records of the sorted particles the index list names (m), into pinned memory
-  // (waits for the stream).
-  const HaloDensityRecord* pack_density(const ParticleArrays& a, uint32_t m, cudaStream_t stream);
-  // The ghosts the index list names take records[0, m) (enqueued; records are copied first).
-  // A record whose id is not its ghost's raises mismatch(), which the host reads later.
-  void enqueue_apply_density(const ParticleArrays& a, const HaloDensityRecord* records, uint32_t m,
-                             cudaStream_t stream);
+  // The density records of the sorted particles idx[0, m) names (a device list), into pinned
+  // memory (waits for the stream).
+  const HaloDensityRecord* pack_density(const ParticleArrays& a, const uint32_t* idx, uint32_t m,
+                                        cudaStream_t stream);
+  // The ghosts idx[0, m) names (a device list) take records[0, m) (enqueued; records are copied
+  // first). A record whose id is not its ghost's raises mismatch(), which the host reads later.
+  void enqueue_apply_density(const ParticleArrays& a, const uint32_t* idx, const HaloDensityRecord* records,
+                             uint32_t m, cudaStream_t stream);
+  // The same for the colour normals (surface tension), after their pass.
+  const HaloNormalRecord* pack_normals(const ParticleArrays& a, const uint32_t* idx, uint32_t m,
+                                       cudaStream_t stream);
+  void enqueue_apply_normals(const ParticleArrays& a, const uint32_t* idx, const HaloNormalRecord* records,
+                             uint32_t m, cudaStream_t stream);
   uint32_t* mismatch_flag() const { return mismatch_.get(); }
 
   uint64_t bytes() const;
@@ -73,19 +106,33 @@ class DeviceHalo {
  private:
   void ensure_device(size_t bytes);
   void ensure_host(size_t bytes);
+  // Sorts keys_in_[0, m) with values [0, m) of `values` (stable) into list_, and writes where
+  // each key k <= last starts in the sorted keys to words_[k] (enqueued).
+  void enqueue_lists(const uint32_t* values, uint32_t m, uint32_t last, cudaStream_t stream);
+  void download_words(uint32_t count, cudaStream_t stream);
+  size_t lists_temp_bytes(
+      uint32_t items) const;  // CUB's temporary storage for enqueue_lists and the kept list
 
   uint32_t capacity_;
+  int ranks_;
+  int key_bits_;  // enough for every list key, 0 to 2 ranks
+  DeviceArray<int32_t> cuts_;
   DeviceArray<int32_t> layers_;
-  DeviceArray<uint32_t> index_;
+  DeviceArray<uint32_t> origin_;
+  DeviceArray<uint32_t> keys_in_, keys_out_, values_, list_;  // 2 x capacity: two entries a particle
+  DeviceArray<uint32_t> keep_;
+  DeviceArray<unsigned char> kept_flags_;
+  DeviceArray<uint32_t> words_;  // list starts, the kept count, the order's check (host_words_)
+  DeviceArray<unsigned char> lists_temp_;
+  size_t lists_temp_bytes_ = 0;
   DeviceArray<uint32_t> iota_, visit_;
   DeviceArray<uint64_t> sorted_keys_;
   DeviceArray<unsigned char> sort_temp_;
   size_t sort_temp_bytes_ = 0;
   DeviceArray<uint32_t> mismatch_;
   DeviceArray<unsigned char> staging_;  // grows on demand
-  PinnedArray<int32_t> host_layers_;
-  PinnedArray<uint32_t> host_index_;
-  PinnedArray<uint32_t> host_order_;
+  PinnedArray<int32_t> host_cuts_;
+  PinnedArray<uint32_t> host_words_;
   PinnedArray<unsigned char> host_staging_;  // grows on demand
   size_t host_staging_bytes_ = 0;
 };

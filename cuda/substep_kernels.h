@@ -83,6 +83,19 @@ void enqueue_density(const FluidConstants& fluid, const GridView& grid, const Pa
                      const SubstepOptions& options, const KernelTuning& tuning, const DeviceScene& scene,
                      float stage_fraction, bool first_of_substep, FrameState* state, cudaStream_t stream);
 
+// enqueue_density in its parts, for a distributed rank whose ghosts take their owners' records
+// after each publication of the densities (SubstepHooks::after_density): the summation (the
+// density kernel), then what publishes them again (the normalised density's filter, or the
+// diffusion where first_of_substep; without it the factors are carried): returns whether it
+// did. (The colour-field normals follow, enqueue_colour_normals.)
+void enqueue_density_summation(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                               uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
+                               const DeviceScene& scene, float stage_fraction, FrameState* state,
+                               cudaStream_t stream);
+bool enqueue_density_republish(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                               uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
+                               bool first_of_substep, FrameState* state, cudaStream_t stream);
+
 // SPH_FEATURE_DENSITY_DIFFUSION (density_diffusion.h): the delta-SPH term over the published
 // densities, applied for the substep's dt (read from the state) through the carried factors and
 // republished into the same three places. Once per substep, after its first density pass.

@@ -50,9 +50,23 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
     const Rk4Carry carry = !rk4 ? Rk4Carry::None : (stage == 0 ? Rk4Carry::BuildStart : Rk4Carry::Gather);
     enqueue_reorder(a, b.grid->order(), n, carry, stage & 1, b.grid->crowd_guard(), b.state, stream);
     if (setup.options.springs) enqueue_spring_reorder(a, b.grid->order(), n, stream);
-    enqueue_density(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene,
-                    rk4 ? rk4_stage_fraction(stage) : 0.0f, stage == 0, b.state, stream);
-    if (hooks) hooks->after_density(stream);
+    if (!hooks) {
+      enqueue_density(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene,
+                      rk4 ? rk4_stage_fraction(stage) : 0.0f, stage == 0, b.state, stream);
+    } else {
+      // A distributed rank: the ghosts take their owners' records after each publication of the
+      // densities, as on the CPU rank (cpu_substep_kernels.cpp), before anything reads them.
+      enqueue_density_summation(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene,
+                                rk4 ? rk4_stage_fraction(stage) : 0.0f, b.state, stream);
+      hooks->after_density(stream);
+      if (enqueue_density_republish(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning,
+                                    stage == 0, b.state, stream))
+        hooks->after_density(stream);
+      if (setup.options.surface_tension) {
+        enqueue_colour_normals(setup.fluid, b.grid->view(), a, n, setup.tuning, stream);
+        hooks->after_normals(stream);
+      }
+    }
     // Probes sample the substep's start (RK4: its first stage), as on the CPU.
     if (stage == 0 && setup.probes.on())
       enqueue_probe_samples(setup.probes, b.grid->view(), a, b.state, stream);

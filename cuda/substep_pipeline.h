@@ -60,6 +60,7 @@ struct SubstepHooks {
   virtual ~SubstepHooks() = default;
   virtual void after_sort(cudaStream_t stream) = 0;
   virtual void after_density(cudaStream_t stream) = 0;
+  virtual void after_normals(cudaStream_t stream) = 0;  // surface tension's colour normals
   virtual void before_end(cudaStream_t stream) = 0;
 };
 

@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: MIT
 // What a distributed world's ghosts take from their owners after a density pass (the CPU rank,
-// src/cpu/cpu_halo.cpp, and the CUDA rank, cuda/cuda_halo.cu, send the same record): the
-// density, pressure, 1 / density and neighbour count the force pass reads of a neighbour,
-// behind the particle's id, which the receiver checks against its ghost.
+// src/cpu/cpu_halo.cpp, and the CUDA rank, cuda/cuda_halo.cu, send the same records): the
+// density, pressure, 1 / density and neighbour count the force pass reads of a neighbour, and
+// with surface tension the colour normal, behind the particle's id, which the receiver checks
+// against its ghost.
 #pragma once
 
 #include <stdint.h>
+
+#include "../physics/float4_types.h"
 
 namespace sph {
 
@@ -16,5 +19,16 @@ struct HaloDensityRecord {
 };
 
 static_assert(sizeof(HaloDensityRecord) == 20, "a density record is five words");
+
+// With surface tension, after the colour normals' pass: each ghost takes its owner's normal
+// (the force pass reads it). The padding is a member, zeroed: Float4's alignment would otherwise
+// put 12 bytes of indeterminate memory on the wire.
+struct HaloNormalRecord {
+  uint32_t id;
+  uint32_t padding[3];
+  Float4 normal;
+};
+
+static_assert(sizeof(HaloNormalRecord) == 32, "a colour normal's record has no implicit padding");
 
 }  // namespace sph

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 
+#include "slab_rules.h"
 #include "status.h"
 
 namespace sph {
@@ -11,18 +12,11 @@ SlabDecomposition::SlabDecomposition(int ranks)
     : cuts_(static_cast<size_t>(ranks > 1 ? ranks - 1 : 0), INT32_MAX) {}
 
 int SlabDecomposition::owner(int32_t layer) const {
-  // The first cut above the layer: rank r owns [cuts_[r-1], cuts_[r]).
-  return static_cast<int>(std::upper_bound(cuts_.begin(), cuts_.end(), layer) - cuts_.begin());
+  return slab_owner(cuts_.data(), static_cast<int>(cuts_.size()), layer);
 }
 
 int SlabDecomposition::ghost_destinations(int32_t layer, int self, int out[2]) const {
-  int n = 0;
-  const int below = layer > INT32_MIN ? owner(layer - 1) : self;
-  const int above = layer < INT32_MAX ? owner(layer + 1) : self;
-  if (below != self) out[n++] = below;
-  if (above != self && above != below) out[n++] = above;
-  if (n == 2 && out[0] > out[1]) std::swap(out[0], out[1]);
-  return n;
+  return slab_ghost_destinations(cuts_.data(), static_cast<int>(cuts_.size()), layer, self, out);
 }
 
 bool SlabDecomposition::imbalanced(const std::vector<int64_t>& count, double threshold) {

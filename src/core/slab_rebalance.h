@@ -2,9 +2,9 @@
 // The frame's start of a distributed world's rank (include/sph_mpi.h), the same for every
 // backend (src/cpu/cpu_halo.cpp, cuda/cuda_halo.cu): when the slabs were never cut or the
 // fullest rank holds too many particles, new cuts along the longest axis of the world's extent
-// in cells, from a histogram of particles per cell layer (SlabDecomposition::rebalance). Also
-// the particles' cell layer along the slabs' axis, which every migration and ghost decision
-// reads (SlabDecomposition::owner, ghost_destinations).
+// in cells, from a histogram of particles per cell layer (SlabDecomposition::rebalance). The
+// particles' cell layer along the slabs' axis (slab_layer), which every migration and ghost
+// decision reads, is in slab_rules.h.
 #pragma once
 
 #include <stdint.h>
@@ -15,13 +15,9 @@
 #include "../physics/grid_hash.h"
 #include "rank_agreement.h"
 #include "slab_decomposition.h"
+#include "slab_rules.h"
 
 namespace sph {
-
-// Cell layer of a point along `axis`.
-inline int32_t slab_layer(float x, float y, float z, int axis, float inv_cell_size) {
-  return cell_coordinate(axis == 0 ? x : (axis == 1 ? y : z), inv_cell_size);
-}
 
 // COLLECTIVE, after an agreement. held: ranks() entries, allocated by the caller before that
 // agreement (nothing here allocates before the first reduction, so a rank that fails cannot be

@@ -248,14 +248,7 @@ void CpuBackend::halo_share_density() {
 }
 
 void CpuBackend::halo_share_normals() {
-  // The padding is a member, zeroed: Float4's alignment would otherwise put 12 bytes of
-  // indeterminate stack on the wire.
-  struct Record {
-    uint32_t id;
-    uint32_t padding[3];
-    Float4 normal;
-  };
-  static_assert(sizeof(Record) == 32, "a colour normal's record has no implicit padding");
+  using Record = HaloNormalRecord;
   halo_share<Record>(
       "colour normals",
       [this](uint32_t i) {

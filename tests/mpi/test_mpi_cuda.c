@@ -15,11 +15,12 @@
  *     substeps (CPU and GPU round differently: fused multiply-adds, the lanes' partial sums;
  *     tests/gpu's parity bound); after the collapse's 240 substeps the distance is only printed
  *     (the roundings grow with the flow's chaos).
- * Cases: the dam break (20 substeps), the stirred column whose particles cross the slab boundary
- * (20 substeps; again with Clavet's viscosity and the user attribute, and with the walls'
- * density), the collapse that makes the ranks rebalance (12 frames of 20 substeps, spacing
- * 12.5 mm), and the refusals (DFSPH, RK4, surface tension: SPH_ERROR_UNSUPPORTED naming them).
- * With SPH_MPI_CUDA_QUICK set, the dam break and the refusals only (a run under compute-sanitizer). */
+ * Cases: the dam break (20 substeps), the stirred column whose particles cross the slab
+ * boundary (20 substeps; again with Clavet's viscosity and the user attribute, with the walls'
+ * density, with the normalised density, with it and the density diffusion, with surface
+ * tension), the collider loads (run_loads_case), the collapse that makes the ranks rebalance (12 frames of 20
+ * substeps, spacing 12.5 mm), and the refusals (DFSPH, RK4, springs: SPH_ERROR_UNSUPPORTED naming them). With
+ * SPH_MPI_CUDA_QUICK set, the dam break and the refusals only (a run under compute-sanitizer). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -97,6 +98,69 @@ static void run_case(const char* name, sph_context* cuda, sph_context* cpu, cons
   sph_world_destroy(cpu_world);
 }
 
+static double norm3(const sph_vec3* v) {
+  return sqrt((double)v->x * v->x + (double)v->y * v->y + (double)v->z * v->z);
+}
+
+static double distance3(const sph_vec3* a, const sph_vec3* b) {
+  const sph_vec3 d = {a->x - b->x, a->y - b->y, a->z - b->z};
+  return norm3(&d);
+}
+
+/* Collider loads (tests/mpi/test_mpi_scene_sums.c's case on the CPU): the stirred column in its
+ * tank, two frames of 8 substeps. Every rank reads the same loads, bit for bit (added over the
+ * ranks in rank order); they are the undivided CUDA world's within 1e-6 of the force's (and
+ * torque's) magnitude: each rank sums its own particles' impulses in blocks of 256 in sorted
+ * order (float block sums, then doubles), other blocks than the undivided world's, so they round
+ * differently (the CPU case measured ~1e-8 relative: a few hundred impulses of one sign, 6e-8
+ * relative rounding each block); the particles stay the undivided world's bit for bit (the loads
+ * read the contacts and do not change them). */
+static void run_loads_case(sph_context* cuda, const sph_world_def* def) {
+  const sph_vec3 column_min = {0.0f, 0.0f, 0.0f}, column_max = {0.1f, 0.2f, 0.06f};
+  mpi_test_worlds w;
+  float *x = NULL, *v = NULL, *want_x = NULL, *want_v = NULL;
+  mpi_test_make_worlds(cuda, def, column_min, column_max, 0.5f, MPI_COMM_WORLD, NULL, &w);
+  for (int f = 0; f < 2; ++f) {
+    sph_collider_loads got, want, first;
+    mpi_test_step(w.world, 8, 1);
+    REQUIRE(
+        sph_collider_loads_init(&got) == SPH_OK && sph_collider_get_loads(w.world, w.tank, &got) == SPH_OK,
+        "loads");
+    first = got;
+    MPI_Bcast(&first, (int)sizeof first, MPI_BYTE, 0, MPI_COMM_WORLD);
+    CHECK(memcmp(&first, &got, sizeof got) == 0, "loads frame %d: rank %d reads other loads than rank 0", f,
+          g_rank);
+    if (g_rank == 0) {
+      double df, dt;
+      mpi_test_step(w.single, 8, 0);
+      REQUIRE(sph_collider_loads_init(&want) == SPH_OK &&
+                  sph_collider_get_loads(w.single, w.single_tank, &want) == SPH_OK,
+              "loads");
+      df = distance3(&got.force, &want.force) / norm3(&want.force);
+      dt = distance3(&got.torque, &want.torque) / norm3(&want.torque);
+      printf("collider loads frame %d on %d ranks: %.9g N (%.3g relative off), %.9g N m (%.3g)\n", f, g_size,
+             norm3(&got.force), df, norm3(&got.torque), dt);
+      CHECK(norm3(&want.force) > 0.0 && df <= 1e-6 && dt <= 1e-6,
+            "loads frame %d on %d ranks: %g N / %g N m off by %.3g / %.3g relative", f, g_size,
+            norm3(&want.force), norm3(&want.torque), df, dt);
+    }
+  }
+  mpi_test_gather(w.world, w.n, &x, &v);
+  if (g_rank == 0) {
+    uint32_t differ;
+    mpi_test_read(w.single, w.n, &want_x, &want_v);
+    differ = mpi_differ(want_x, want_v, x, v, w.n, NULL);
+    CHECK(differ == 0, "collider loads: %u of %u particles differ from the undivided CUDA world", differ,
+          w.n);
+    free(want_x);
+    free(want_v);
+    sph_world_destroy(w.single);
+  }
+  free(x);
+  free(v);
+  sph_world_destroy(w.world);
+}
+
 static void expect_refused(sph_context* cuda, const sph_world_def* def, const char* what) {
   sph_world* world = NULL;
   const sph_result r = sph_mpi_world_create(cuda, def, MPI_TEST_COMM, NULL, &world);
@@ -130,6 +194,20 @@ int main(int argc, char** argv) {
     def.viscosity_method = SPH_VISCOSITY_MUELLER;
     def.features = SPH_FEATURE_BOUNDARY_DENSITY;
     run_case("stirred column, the walls' density", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    /* The normalised density's filter and the density diffusion publish the densities again after
+     * the summation: the ghosts take their owners' records after each publication (as on the CPU
+     * rank), so an owned particle's filter and forces read the undivided world's values. */
+    def.features = SPH_FEATURE_NORMALIZED_DENSITY;
+    run_case("stirred column, normalised density", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    def.features = SPH_FEATURE_NORMALIZED_DENSITY | SPH_FEATURE_DENSITY_DIFFUSION;
+    run_case("stirred column, normalised density and diffusion", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    /* Surface tension: the colour normals' pass reads the ghosts' densities (refreshed), and the
+     * ghosts take their owners' normals after it (the force pass reads them). */
+    def.features = SPH_FEATURE_SURFACE_TENSION;
+    run_case("stirred column, surface tension", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    def.features = SPH_FEATURE_COLLIDER_LOADS;
+    run_loads_case(cuda, &def);
+    def.features = 0;
     mpi_test_world_def(&def); /* capacity 4096: 16 slots an axis, folded along x */
     run_case("stirred column, folded table, one lane", cuda_one_lane, cpu, &def, 0.5f, 1, 20, 1);
     mpi_test_world_def(&def);
@@ -146,8 +224,8 @@ int main(int argc, char** argv) {
   def.integrator = SPH_INTEGRATOR_RK4;
   expect_refused(cuda, &def, "RK4");
   mpi_test_world_def(&def);
-  def.features = SPH_FEATURE_SURFACE_TENSION;
-  expect_refused(cuda, &def, "SPH_FEATURE_SURFACE_TENSION");
+  def.features = SPH_FEATURE_SPRINGS;
+  expect_refused(cuda, &def, "SPH_FEATURE_SPRINGS");
 
   REQUIRE(sph_context_destroy(cuda) == SPH_OK && sph_context_destroy(cuda_one_lane) == SPH_OK, "destroy");
   return mpi_test_finish(cpu, "mpi_cuda");

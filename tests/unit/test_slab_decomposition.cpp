@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // A distributed world's slabs (src/core/slab_decomposition.h): who owns a cell layer, who needs
 // it as a ghost, when the ranks are out of balance, and where a rebalance cuts. Every expected
-// value is worked out by hand from the histogram.
+// value is worked out by hand from the histogram, or (the rules the CUDA rank runs per particle,
+// core/slab_rules.h) by brute force over every layer.
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -10,9 +11,12 @@ extern "C" {
 #include <cmocka.h>
 }
 
+#include <algorithm>
+#include <random>
 #include <vector>
 
 #include "core/slab_decomposition.h"
+#include "core/slab_rules.h"
 
 namespace {
 
@@ -73,6 +77,46 @@ void test_imbalance(void**) {
   assert_false(SlabDecomposition::imbalanced({0, 0}, 0.2));
 }
 
+// The rules as the device runs them (slab_owner's binary search) against their definitions by
+// brute force: the owner is the number of cuts at or below the layer (rank r owns [cut r-1,
+// cut r)); the ghosts' ranks are the other owners of the layers beside it, each once, ascending.
+// Random cuts with repeats (ranks owning nothing), 1 to 6 ranks, layers around and at the cuts
+// and at the int32 ends.
+void test_rules_brute_force(void**) {
+  std::mt19937 rng(12345);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const int ranks = 1 + static_cast<int>(rng() % 6);
+    std::vector<int32_t> cuts(static_cast<size_t>(ranks - 1));
+    for (int32_t& c : cuts) c = static_cast<int32_t>(rng() % 12) - 6;
+    if (!cuts.empty() && rng() % 4 == 0) cuts.back() = INT32_MAX;
+    std::sort(cuts.begin(), cuts.end());
+    const int count = static_cast<int>(cuts.size());
+    auto brute_owner = [&](int64_t layer) {
+      int o = 0;
+      for (int32_t c : cuts) o += c <= layer ? 1 : 0;
+      return o;
+    };
+    std::vector<int32_t> layers{INT32_MIN, INT32_MIN + 1, INT32_MAX - 1, INT32_MAX};
+    for (int32_t l = -9; l <= 9; ++l) layers.push_back(l);
+    for (int32_t layer : layers) {
+      assert_int_equal(sph::slab_owner(cuts.data(), count, layer), brute_owner(layer));
+      for (int self = 0; self < ranks; ++self) {
+        std::vector<int> want;
+        for (int64_t beside : {static_cast<int64_t>(layer) - 1, static_cast<int64_t>(layer) + 1}) {
+          if (beside < INT32_MIN || beside > INT32_MAX) continue;
+          const int o = brute_owner(beside);
+          if (o != self && std::find(want.begin(), want.end(), o) == want.end()) want.push_back(o);
+        }
+        std::sort(want.begin(), want.end());
+        int got[2] = {-1, -1};
+        const int n = sph::slab_ghost_destinations(cuts.data(), count, layer, self, got);
+        assert_int_equal(n, static_cast<int>(want.size()));
+        for (int k = 0; k < n; ++k) assert_int_equal(got[k], want[static_cast<size_t>(k)]);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 int main(void) {
@@ -81,6 +125,7 @@ int main(void) {
       cmocka_unit_test(test_rebalance_cuts),
       cmocka_unit_test(test_more_ranks_than_layers),
       cmocka_unit_test(test_imbalance),
+      cmocka_unit_test(test_rules_brute_force),
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
