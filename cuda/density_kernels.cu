@@ -86,12 +86,16 @@ __global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArra
 // Eq. 31 reads every carried rho_j: the factor is written in the new order
 // (the density kernel is done reading the old), the filtered density into the side array,
 // and both are published after every particle has been filtered.
-__global__ void normalized_density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n) {
+__global__ void normalized_density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
+                                          const FrameState* state) {
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
   const float filtered = gather_normalized_density(fluid, grid, a.sorted_position, a.sorted_velocity, i);
-  a.density_factor[i] = filtered / a.normalized_density[i];
-  a.normalized_density[i] = filtered;
+  const float share =
+      density_factor_relaxation(state->clock.dt_float, speed_of_sound(fluid.methods.eos), fluid.kernel.h);
+  const FilteredDensity d = filtered_density(fluid, filtered, a.normalized_density[i], share);
+  a.density_factor[i] = d.factor;
+  a.normalized_density[i] = d.density;
 }
 
 __global__ void publish_normalized_density_kernel(FluidConstants fluid, ParticleArrays a, uint32_t n) {
@@ -113,8 +117,8 @@ __global__ void density_diffusion_kernel(FluidConstants fluid, GridView grid, Pa
   const float rate = gather_density_diffusion(fluid, fluid.methods.density_diffusion, grid, a.sorted_position,
                                               a.sorted_velocity, i);
   // The side array holds this particle's resolved factor (density_kernel's factor_to_side).
-  const DiffusedDensity d =
-      diffused_density(a.density[i], a.normalized_density[i], rate, state->clock.dt_float);
+  const DiffusedDensity d = diffused_density(fluid, fluid.methods.density_diffusion, a.density[i],
+                                             a.normalized_density[i], rate, state->clock.dt_float);
   a.density_factor[i] = d.factor;
   a.normalized_density[i] = d.density;
 }
@@ -195,7 +199,7 @@ bool enqueue_density_republish(const FluidConstants& fluid, const GridView& grid
       check_launch("carry_density_factor_kernel");
     }
   } else if (options.normalized_density) {
-    normalized_density_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n);
+    normalized_density_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n, state);
     check_launch("normalized_density_kernel");
     publish_normalized_density_kernel<<<blocks, threads, 0, stream>>>(fluid, a, n);
     check_launch("publish_normalized_density_kernel");

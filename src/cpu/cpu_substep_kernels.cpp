@@ -90,10 +90,14 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
   if (factor && !(config_.features & kFeatureDensityDiffusion)) {
     // Eq. 31 over every carried rho_j: each particle writes only its own factor and side
     // slot (the first pass is done reading the factors), then the filtered values are published.
+    const float share =
+        density_factor_relaxation(fluid.dt, speed_of_sound(fluid.methods.eos), fluid.kernel.h);
     parallel().for_each(count_, [&](uint32_t i) {
-      const float filtered = simd_.normalized_density(fluid, view, columns, static_cast<uint32_t>(i));
-      factor[i] = filtered / normalized_[i];
-      normalized_[i] = filtered;
+      const FilteredDensity d =
+          filtered_density(fluid, simd_.normalized_density(fluid, view, columns, static_cast<uint32_t>(i)),
+                           normalized_[i], share);
+      factor[i] = d.factor;
+      normalized_[i] = d.density;
     });
     parallel().for_each(count_, [&](uint32_t i) {
       density_[i] = normalized_[i];
@@ -126,7 +130,8 @@ void CpuBackend::diffuse_density(const FluidConstants& fluid, float dt) {
   // slot (free once the filtered densities are published), then the diffused values are published.
   parallel().for_each(count_, [&](uint32_t i) {
     const float rate = simd_.density_diffusion(fluid, view, columns, static_cast<uint32_t>(i));
-    const DiffusedDensity d = diffused_density(density_[i], factor[i], rate, dt);
+    const DiffusedDensity d =
+        diffused_density(fluid, fluid.methods.density_diffusion, density_[i], factor[i], rate, dt);
     factor[i] = d.factor;
     normalized_[i] = d.density;
   });

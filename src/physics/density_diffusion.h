@@ -40,6 +40,7 @@
 
 #include <stdint.h>
 
+#include "density_normalization.h"
 #include "float4_types.h"
 #include "fluid_base.h"
 #include "host_device.h"
@@ -68,6 +69,7 @@ struct DensityDiffusion {
     float coefficient;  // 2 delta h c0 m, kg m^2/s (the pair term's prefactor)
     Vec3 hydrostatic;   // rho0 g / c0^2, kg/m^4: rho^H_ji = hydrostatic . x_ji
     float eta2;         // 0.01 h^2, m^2
+    float sound_speed;  // c0, m/s (the carried factor's relaxation, density_normalization.h)
   };
   // c0: the equation of state's speed of sound at rest density; gravity: the world's.
   static Constants make_constants(const Params& p, const WorldShape& shape, float sound_speed, Vec3 gravity) {
@@ -77,6 +79,7 @@ struct DensityDiffusion {
     const float c2 = sound_speed * sound_speed;
     c.hydrostatic = c2 > 0.0f ? gravity * (shape.rest_density / c2) : Vec3{0.0f, 0.0f, 0.0f};
     c.eta2 = 0.01f * h * h;
+    c.sound_speed = sound_speed;
     return c;
   }
   // No arrays of its own: the pass writes the diffused density into the normalised density's
@@ -111,14 +114,20 @@ SPH_HD float gather_density_diffusion(const FluidBase& f, const DensityDiffusion
   return rate;
 }
 
-// The diffused density and the factor that carries it (rho > 0, rate from the gather).
+// The diffused density and the factor that carries it (rho > 0, rate from the gather), the
+// factor then relaxed towards 1 where the neighbourhood is full (density_normalization.h:
+// without it the diffusion hides the compression it smooths away in the factors).
 struct DiffusedDensity {
   float density;
   float factor;
 };
-SPH_HD DiffusedDensity diffused_density(float density, float factor, float rate, float dt) {
-  const float diffused = density + dt * rate;
-  return DiffusedDensity{diffused, factor * (diffused / density)};
+SPH_HD DiffusedDensity diffused_density(const FluidBase& f, const DensityDiffusion::Constants& c,
+                                        float density, float factor, float rate, float dt) {
+  const float summed = density / factor;  // the kernel sum, walls' share included
+  const float diffused = factor * ((density + dt * rate) / density);
+  const float relaxed =
+      relaxed_density_factor(f, summed, diffused, density_factor_relaxation(dt, c.sound_speed, f.kernel.h));
+  return DiffusedDensity{relaxed * summed, relaxed};
 }
 
 }  // namespace sph

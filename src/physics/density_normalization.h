@@ -31,6 +31,16 @@
 //     interior's), which bends a hydrostatic profile near them (docs/physics.md has the
 //     numbers; a first-order, MLS, filter keeps linear fields but measured much worse in a
 //     dynamic tank: it amplifies particle noise at boundaries).
+// - where the kernel sum sees a full neighbourhood (sum_j m W_ij, walls' share included, at or
+//   above rho0) g_i relaxes towards 1 over kFactorRelaxationTimes acoustic times h / c0:
+//   g_i <- g_i + (1 - g_i) min(1, dt c0 / (N h)). There the summation reads the compression
+//   itself, and a factor away from 1 is either noise that the filter or the diffusion is
+//   smoothing (acoustic times, untouched) or a stale memory that they put in: both move density
+//   between neighbours as if it were real, so a compression they smoothed away (a dam break's
+//   impact on a wall, the walls' over-read along edges) stays hidden in g_i < 1 and the packed
+//   fluid reads rest density without pressure (the dam break's wall pressure read 37-52 % low,
+//   its particles at the wall 6 % denser in the kernel sum than in the carried density). Free
+//   surfaces and rarefied fluid (sum below rho0) keep their factor.
 // g_i is per-particle state: sorted, rolled back and checkpointed with the particles; a fresh
 // particle's factor is NaN until its first density pass.
 #pragma once
@@ -67,6 +77,34 @@ SPH_HD bool is_fresh_density_factor(float factor) { return factor != factor; }
 SPH_HD float carried_density(const FluidBase& f, float summed, float& factor) {
   if (is_fresh_density_factor(factor)) factor = summed < f.rest_density ? f.rest_density / summed : 1.0f;
   return summed * factor;
+}
+
+// The relaxation time of the carried factor, in acoustic times h / c0: long against the
+// acoustic noise that the filter and the diffusion damp, short against a flow's time
+// (docs/physics.md, "Normalised density", has the measured choice).
+constexpr float kFactorRelaxationTimes = 20.0f;
+
+// The share of the way to 1 a factor moves over dt: min(1, dt c0 / (N h)); 0 without a speed of
+// sound.
+SPH_HD float density_factor_relaxation(float dt, float sound_speed, float kernel_radius) {
+  const float a = dt * sound_speed / (kFactorRelaxationTimes * kernel_radius);
+  return a < 1.0f ? a : 1.0f;
+}
+
+// g_i relaxed by that share where the kernel sum (walls' share included) is at or above rho0.
+SPH_HD float relaxed_density_factor(const FluidBase& f, float summed, float factor, float share) {
+  return summed >= f.rest_density ? factor + (1.0f - factor) * share : factor;
+}
+
+// The Shepard filter's result for particle i (its filtered density and kernel sum): the factor
+// that carries it, relaxed by share, and the density that factor reads.
+struct FilteredDensity {
+  float density;
+  float factor;
+};
+SPH_HD FilteredDensity filtered_density(const FluidBase& f, float filtered, float summed, float share) {
+  const float factor = relaxed_density_factor(f, summed, filtered / summed, share);
+  return FilteredDensity{factor * summed, factor};
 }
 
 // Eq. 31's pair terms for a neighbour at squared distance r2 (< h^2, self included) with carried

@@ -17,7 +17,7 @@
  * ideal gas k = 225 (c = 15 m/s, kSoundSpeed), Mueller's viscosity 0.05 Pa s as the Martin & Moyce
  * validation (the default 1 Pa s slows a 10 cm flow: Reynolds number about 100). Cases: "plain" (the
  * summation density) and "diffusion" (SPH_FEATURE_NORMALIZED_DENSITY | SPH_FEATURE_DENSITY_DIFFUSION;
- * its plateau reads 37-40 % low, a KNOWN_ISSUE). CI: H = 16 lattice steps;
+ * both meet the issue's bounds on their six-draw ensembles). CI: H = 16 lattice steps;
  * SPH_VALIDATION_FULL=1 (scripts/validate --full): 32. Measuring knobs (docs/validation.md):
  * DAM_PRESSURE_MEASURE=1 prints without asserting (and reads probes half and a quarter kernel
  * radius off the wall and a gauge at it); DAM_PRESSURE_STEPS=N, DAM_PRESSURE_PERTURB=SEED,
@@ -341,9 +341,8 @@ static void test_diffusion_ensemble(void** state) {
 
 /* Each case is its own ctest (tests/validation/CMakeLists.txt): the impact cases run in CI with
  * the draws' spread as bound; the plain ensemble (the issue's bounds on the mean) is too long for
- * CI and runs from scripts/validate; the diffusion's plateau (one draw) is a KNOWN_ISSUE, its
- * ensemble (test_diffusion_ensemble) a measurement (docs/validation.md, "Dam break: the wall-pressure
- * sensor"). */
+ * CI and runs from scripts/validate, as the diffusion's (test_diffusion_ensemble) does
+ * (docs/validation.md, "Dam break: the wall-pressure sensor"). */
 int main(int argc, char** argv) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_plain_impact),   cmocka_unit_test(test_diffusion_impact),
