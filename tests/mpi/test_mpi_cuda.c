@@ -113,7 +113,8 @@ static double distance3(const sph_vec3* a, const sph_vec3* b) {
  * torque's) magnitude: each rank sums its own particles' impulses in blocks of 256 in sorted
  * order (float block sums, then doubles), other blocks than the undivided world's, so they round
  * differently (the CPU case measured ~1e-8 relative: a few hundred impulses of one sign, 6e-8
- * relative rounding each block); the particles stay the undivided world's bit for bit (the loads
+ * relative rounding each block; the H200 read 3.1e-8 on 2 ranks); a frame with no contact reads
+ * exactly zero on both; the particles stay the undivided world's bit for bit (the loads
  * read the contacts and do not change them). */
 static void run_loads_case(sph_context* cuda, const sph_world_def* def) {
   const sph_vec3 column_min = {0.0f, 0.0f, 0.0f}, column_max = {0.1f, 0.2f, 0.06f};
@@ -136,13 +137,19 @@ static void run_loads_case(sph_context* cuda, const sph_world_def* def) {
       REQUIRE(sph_collider_loads_init(&want) == SPH_OK &&
                   sph_collider_get_loads(w.single, w.single_tank, &want) == SPH_OK,
               "loads");
-      df = distance3(&got.force, &want.force) / norm3(&want.force);
-      dt = distance3(&got.torque, &want.torque) / norm3(&want.torque);
-      printf("collider loads frame %d on %d ranks: %.9g N (%.3g relative off), %.9g N m (%.3g)\n", f, g_size,
+      /* Before the water reaches a wall (frame 0 on the H200) both read exactly zero: compared
+       * exactly, since a relative difference is 0 / 0 there. The last frame must see water. */
+      df = norm3(&want.force) > 0.0 ? distance3(&got.force, &want.force) / norm3(&want.force)
+                                    : distance3(&got.force, &want.force);
+      dt = norm3(&want.torque) > 0.0 ? distance3(&got.torque, &want.torque) / norm3(&want.torque)
+                                     : distance3(&got.torque, &want.torque);
+      printf("collider loads frame %d on %d ranks: %.9g N (%.3g off), %.9g N m (%.3g)\n", f, g_size,
              norm3(&got.force), df, norm3(&got.torque), dt);
-      CHECK(norm3(&want.force) > 0.0 && df <= 1e-6 && dt <= 1e-6,
-            "loads frame %d on %d ranks: %g N / %g N m off by %.3g / %.3g relative", f, g_size,
-            norm3(&want.force), norm3(&want.torque), df, dt);
+      CHECK(df <= 1e-6 && dt <= 1e-6, "loads frame %d on %d ranks: %g N / %g N m off by %.3g / %.3g", f,
+            g_size, norm3(&want.force), norm3(&want.torque), df, dt);
+      if (f == 1)
+        CHECK(norm3(&want.force) > 0.0, "loads frame %d on %d ranks: the water never touched the tank", f,
+              g_size);
     }
   }
   mpi_test_gather(w.world, w.n, &x, &v);
