@@ -198,9 +198,9 @@ class CudaBackend final : public Backend {
   void halo_after_sort(cudaStream_t stream);     // ghost mask, new keys, the lists of the records
   void halo_after_density(cudaStream_t stream);  // the ghosts take their owners' density records
   void halo_after_normals(cudaStream_t stream);  // and their colour normals (surface tension)
-  // The ghosts take their owners' records, made by pack(list, m) and applied by apply(list, got, m).
-  template <class Record, class Pack, class Apply>
-  void halo_refresh(cudaStream_t stream, const char* what, Pack&& pack, Apply&& apply);
+  // The ghosts take their owners' records (DeviceHalo::pack_records / enqueue_apply_records).
+  template <class Record>
+  void halo_refresh(cudaStream_t stream, const char* what);
   void halo_before_end(cudaStream_t stream);  // maxima and failures reduced over the ranks
   void halo_sum_loads(ColliderLoadSums* sums, uint32_t colliders);  // the frame's loads over the ranks
   void halo_drop_ghosts();                    // the owned particles, in the sorted order

@@ -246,8 +246,8 @@ void CudaBackend::halo_after_sort(cudaStream_t stream) {
                          static_cast<uint64_t*>(r_->store->find(kArrayDistributedSortKey)), stream);
 }
 
-template <class Record, class Pack, class Apply>
-void CudaBackend::halo_refresh(cudaStream_t stream, const char* what, Pack&& pack, Apply&& apply) {
+template <class Record>
+void CudaBackend::halo_refresh(cudaStream_t stream, const char* what) {
   const RankTransport& t = *ranks_;
   const size_t size = static_cast<size_t>(t.size());
   DeviceHalo& h = *r_->halo;
@@ -261,7 +261,7 @@ void CudaBackend::halo_refresh(cudaStream_t stream, const char* what, Pack&& pac
   const uint32_t sent = starts[size];
   std::vector<RankBytes> out(size);
   if (sent > 0) {
-    const Record* records = pack(h.list(), sent);
+    const Record* records = h.pack_records<Record>(r_->store->arrays(), h.list(), sent, stream);
     for (size_t d = 0; d < size; ++d) {
       const unsigned char* from = reinterpret_cast<const unsigned char*>(records + starts[d]);
       out[d].assign(from, from + sizeof(Record) * (starts[d + 1] - starts[d]));
@@ -282,29 +282,16 @@ void CudaBackend::halo_refresh(cudaStream_t stream, const char* what, Pack&& pac
     if (ghosts > 0) std::memcpy(got.data() + first, in[r].data(), in[r].size());
   }
   if (got.empty()) return;
-  apply(h.list() + sent, got.data(), static_cast<uint32_t>(got.size()));
+  h.enqueue_apply_records(r_->store->arrays(), h.list() + sent, got.data(), static_cast<uint32_t>(got.size()),
+                          stream);
 }
 
 void CudaBackend::halo_after_density(cudaStream_t stream) {
-  DeviceHalo& h = *r_->halo;
-  const ParticleArrays& a = r_->store->arrays();
-  halo_refresh<HaloDensityRecord>(
-      stream, "density records",
-      [&](const uint32_t* idx, uint32_t m) { return h.pack_density(a, idx, m, stream); },
-      [&](const uint32_t* idx, const HaloDensityRecord* records, uint32_t m) {
-        h.enqueue_apply_density(a, idx, records, m, stream);
-      });
+  halo_refresh<HaloDensityRecord>(stream, "density records");
 }
 
 void CudaBackend::halo_after_normals(cudaStream_t stream) {
-  DeviceHalo& h = *r_->halo;
-  const ParticleArrays& a = r_->store->arrays();
-  halo_refresh<HaloNormalRecord>(
-      stream, "colour normals",
-      [&](const uint32_t* idx, uint32_t m) { return h.pack_normals(a, idx, m, stream); },
-      [&](const uint32_t* idx, const HaloNormalRecord* records, uint32_t m) {
-        h.enqueue_apply_normals(a, idx, records, m, stream);
-      });
+  halo_refresh<HaloNormalRecord>(stream, "colour normals");
 }
 
 void CudaBackend::halo_drop_ghosts() {

@@ -26,50 +26,58 @@ __global__ void iota_kernel(uint32_t* v, uint32_t n) {
   if (i < n) v[i] = i;
 }
 
-__global__ void pack_density_kernel(ParticleArrays a, const uint32_t* __restrict__ idx, uint32_t m,
-                                    HaloDensityRecord* __restrict__ out) {
-  const uint32_t k = blockIdx.x * blockDim.x + threadIdx.x;
-  if (k >= m) return;
-  const uint32_t i = idx[k];
-  out[k] = HaloDensityRecord{a.sorted_id[i], a.density[i], a.sorted_position[i].w, a.sorted_velocity[i].w,
+// What each record takes from a particle and gives back to its ghost (core/halo_records.h).
+template <class Record>
+struct HaloRecordFields;
+
+template <>
+struct HaloRecordFields<HaloDensityRecord> {
+  static constexpr const char* kCopyOut = "copy of the halo's density records";
+  static constexpr const char* kCopyIn = "copy of the ghosts' density records";
+  __device__ static HaloDensityRecord pack(const ParticleArrays& a, uint32_t i) {
+    return HaloDensityRecord{a.sorted_id[i], a.density[i], a.sorted_position[i].w, a.sorted_velocity[i].w,
                              a.neighbor_count ? a.neighbor_count[i] : 0u};
+  }
+  __device__ static void apply(const ParticleArrays& a, uint32_t i, const HaloDensityRecord& r) {
+    a.density[i] = r.density;
+    a.sorted_position[i].w = r.pressure;
+    a.sorted_velocity[i].w = r.inv_density;
+    if (a.neighbor_count) a.neighbor_count[i] = r.neighbors;
+  }
+};
+
+template <>
+struct HaloRecordFields<HaloNormalRecord> {
+  static constexpr const char* kCopyOut = "copy of the halo's colour normals";
+  static constexpr const char* kCopyIn = "copy of the ghosts' colour normals";
+  __device__ static HaloNormalRecord pack(const ParticleArrays& a, uint32_t i) {
+    return HaloNormalRecord{a.sorted_id[i], {0u, 0u, 0u}, a.colour_normal[i]};
+  }
+  __device__ static void apply(const ParticleArrays& a, uint32_t i, const HaloNormalRecord& r) {
+    a.colour_normal[i] = r.normal;
+  }
+};
+
+template <class Record>
+__global__ void pack_records_kernel(ParticleArrays a, const uint32_t* __restrict__ idx, uint32_t m,
+                                    Record* __restrict__ out) {
+  const uint32_t k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k >= m) return;
+  out[k] = HaloRecordFields<Record>::pack(a, idx[k]);
 }
 
-__global__ void pack_normals_kernel(ParticleArrays a, const uint32_t* __restrict__ idx, uint32_t m,
-                                    HaloNormalRecord* __restrict__ out) {
+template <class Record>
+__global__ void apply_records_kernel(ParticleArrays a, const uint32_t* __restrict__ idx, uint32_t m,
+                                     const Record* __restrict__ in, uint32_t* mismatch) {
   const uint32_t k = blockIdx.x * blockDim.x + threadIdx.x;
   if (k >= m) return;
   const uint32_t i = idx[k];
-  out[k] = HaloNormalRecord{a.sorted_id[i], {0u, 0u, 0u}, a.colour_normal[i]};
-}
-
-__global__ void apply_normals_kernel(ParticleArrays a, const uint32_t* __restrict__ idx, uint32_t m,
-                                     const HaloNormalRecord* __restrict__ in, uint32_t* mismatch) {
-  const uint32_t k = blockIdx.x * blockDim.x + threadIdx.x;
-  if (k >= m) return;
-  const uint32_t i = idx[k];
-  const HaloNormalRecord r = in[k];
+  const Record r = in[k];
   if (r.id != a.sorted_id[i]) {
     atomicExch(mismatch, 1u);
     return;
   }
-  a.colour_normal[i] = r.normal;
-}
-
-__global__ void apply_density_kernel(ParticleArrays a, const uint32_t* __restrict__ idx, uint32_t m,
-                                     const HaloDensityRecord* __restrict__ in, uint32_t* mismatch) {
-  const uint32_t k = blockIdx.x * blockDim.x + threadIdx.x;
-  if (k >= m) return;
-  const uint32_t i = idx[k];
-  const HaloDensityRecord r = in[k];
-  if (r.id != a.sorted_id[i]) {
-    atomicExch(mismatch, 1u);
-    return;
-  }
-  a.density[i] = r.density;
-  a.sorted_position[i].w = r.pressure;
-  a.sorted_velocity[i].w = r.inv_density;
-  if (a.neighbor_count) a.neighbor_count[i] = r.neighbors;
+  HaloRecordFields<Record>::apply(a, i, r);
 }
 
 }  // namespace
@@ -197,66 +205,51 @@ void DeviceHalo::enqueue_visit(const uint64_t* keys, uint32_t n, cudaStream_t st
              "halo key sort");
 }
 
-const HaloDensityRecord* DeviceHalo::pack_density(const ParticleArrays& a, const uint32_t* idx, uint32_t m,
-                                                  cudaStream_t stream) {
-  const size_t bytes = sizeof(HaloDensityRecord) * m;
+template <class Record>
+const Record* DeviceHalo::pack_records(const ParticleArrays& a, const uint32_t* idx, uint32_t m,
+                                       cudaStream_t stream) {
+  const size_t bytes = sizeof(Record) * m;
   ensure_device(bytes);
   ensure_host(bytes);
   if (m > 0) {
-    pack_density_kernel<<<blocks_for(m, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
-        a, idx, m, reinterpret_cast<HaloDensityRecord*>(staging_.get()));
-    check_launch("pack_density_kernel");
+    pack_records_kernel<Record><<<blocks_for(m, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
+        a, idx, m, reinterpret_cast<Record*>(staging_.get()));
+    check_launch("pack_records_kernel");
     cuda_check(cudaMemcpyAsync(host_staging_.get(), staging_.get(), bytes, cudaMemcpyDeviceToHost, stream),
-               "copy of the halo's density records");
+               HaloRecordFields<Record>::kCopyOut);
   }
-  cuda_check(cudaStreamSynchronize(stream), "halo density records");
-  return reinterpret_cast<const HaloDensityRecord*>(host_staging_.get());
+  cuda_check(cudaStreamSynchronize(stream), HaloRecordFields<Record>::kCopyOut);
+  return reinterpret_cast<const Record*>(host_staging_.get());
 }
 
-void DeviceHalo::enqueue_apply_density(const ParticleArrays& a, const uint32_t* idx,
-                                       const HaloDensityRecord* records, uint32_t m, cudaStream_t stream) {
+template <class Record>
+void DeviceHalo::enqueue_apply_records(const ParticleArrays& a, const uint32_t* idx, const Record* records,
+                                       uint32_t m, cudaStream_t stream) {
   if (m == 0) return;
-  const size_t bytes = sizeof(HaloDensityRecord) * m;
+  const size_t bytes = sizeof(Record) * m;
   ensure_device(bytes);
   ensure_host(bytes);
-  std::copy(records, records + m, reinterpret_cast<HaloDensityRecord*>(host_staging_.get()));
+  std::copy(records, records + m, reinterpret_cast<Record*>(host_staging_.get()));
   cuda_check(cudaMemcpyAsync(staging_.get(), host_staging_.get(), bytes, cudaMemcpyHostToDevice, stream),
-             "copy of the ghosts' density records");
-  apply_density_kernel<<<blocks_for(m, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
-      a, idx, m, reinterpret_cast<const HaloDensityRecord*>(staging_.get()), mismatch_.get());
-  check_launch("apply_density_kernel");
+             HaloRecordFields<Record>::kCopyIn);
+  apply_records_kernel<Record><<<blocks_for(m, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
+      a, idx, m, reinterpret_cast<const Record*>(staging_.get()), mismatch_.get());
+  check_launch("apply_records_kernel");
   // (The pinned staging is not touched again before the stream's next wait.)
 }
 
-const HaloNormalRecord* DeviceHalo::pack_normals(const ParticleArrays& a, const uint32_t* idx, uint32_t m,
-                                                 cudaStream_t stream) {
-  const size_t bytes = sizeof(HaloNormalRecord) * m;
-  ensure_device(bytes);
-  ensure_host(bytes);
-  if (m > 0) {
-    pack_normals_kernel<<<blocks_for(m, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
-        a, idx, m, reinterpret_cast<HaloNormalRecord*>(staging_.get()));
-    check_launch("pack_normals_kernel");
-    cuda_check(cudaMemcpyAsync(host_staging_.get(), staging_.get(), bytes, cudaMemcpyDeviceToHost, stream),
-               "copy of the halo's colour normals");
-  }
-  cuda_check(cudaStreamSynchronize(stream), "halo colour normals");
-  return reinterpret_cast<const HaloNormalRecord*>(host_staging_.get());
-}
-
-void DeviceHalo::enqueue_apply_normals(const ParticleArrays& a, const uint32_t* idx,
-                                       const HaloNormalRecord* records, uint32_t m, cudaStream_t stream) {
-  if (m == 0) return;
-  const size_t bytes = sizeof(HaloNormalRecord) * m;
-  ensure_device(bytes);
-  ensure_host(bytes);
-  std::copy(records, records + m, reinterpret_cast<HaloNormalRecord*>(host_staging_.get()));
-  cuda_check(cudaMemcpyAsync(staging_.get(), host_staging_.get(), bytes, cudaMemcpyHostToDevice, stream),
-             "copy of the ghosts' colour normals");
-  apply_normals_kernel<<<blocks_for(m, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
-      a, idx, m, reinterpret_cast<const HaloNormalRecord*>(staging_.get()), mismatch_.get());
-  check_launch("apply_normals_kernel");
-}
+template const HaloDensityRecord* DeviceHalo::pack_records<HaloDensityRecord>(const ParticleArrays&,
+                                                                              const uint32_t*, uint32_t,
+                                                                              cudaStream_t);
+template const HaloNormalRecord* DeviceHalo::pack_records<HaloNormalRecord>(const ParticleArrays&,
+                                                                            const uint32_t*, uint32_t,
+                                                                            cudaStream_t);
+template void DeviceHalo::enqueue_apply_records<HaloDensityRecord>(const ParticleArrays&, const uint32_t*,
+                                                                   const HaloDensityRecord*, uint32_t,
+                                                                   cudaStream_t);
+template void DeviceHalo::enqueue_apply_records<HaloNormalRecord>(const ParticleArrays&, const uint32_t*,
+                                                                  const HaloNormalRecord*, uint32_t,
+                                                                  cudaStream_t);
 
 uint64_t DeviceHalo::bytes() const {
   return cuts_.bytes() + layers_.bytes() + origin_.bytes() + keys_in_.bytes() + keys_out_.bytes() +

@@ -86,19 +86,16 @@ class DeviceHalo {
   bool order_names_no_particle() const { return host_words_.get()[2 * ranks_ + 2] != 0; }
   const uint32_t* kept_list() const { return keep_.get(); }
 
-  // The density records of the sorted particles idx[0, m) names (a device list), into pinned
-  // memory (waits for the stream).
-  const HaloDensityRecord* pack_density(const ParticleArrays& a, const uint32_t* idx, uint32_t m,
-                                        cudaStream_t stream);
+  // The records (core/halo_records.h: HaloDensityRecord after the density pass, HaloNormalRecord
+  // after the colour normals' pass) of the sorted particles idx[0, m) names (a device list), into
+  // pinned memory (waits for the stream).
+  template <class Record>
+  const Record* pack_records(const ParticleArrays& a, const uint32_t* idx, uint32_t m, cudaStream_t stream);
   // The ghosts idx[0, m) names (a device list) take records[0, m) (enqueued; records are copied
   // first). A record whose id is not its ghost's raises mismatch(), which the host reads later.
-  void enqueue_apply_density(const ParticleArrays& a, const uint32_t* idx, const HaloDensityRecord* records,
-                             uint32_t m, cudaStream_t stream);
-  // The same for the colour normals (surface tension), after their pass.
-  const HaloNormalRecord* pack_normals(const ParticleArrays& a, const uint32_t* idx, uint32_t m,
-                                       cudaStream_t stream);
-  void enqueue_apply_normals(const ParticleArrays& a, const uint32_t* idx, const HaloNormalRecord* records,
-                             uint32_t m, cudaStream_t stream);
+  template <class Record>
+  void enqueue_apply_records(const ParticleArrays& a, const uint32_t* idx, const Record* records, uint32_t m,
+                             cudaStream_t stream);
   uint32_t* mismatch_flag() const { return mismatch_.get(); }
 
   uint64_t bytes() const;

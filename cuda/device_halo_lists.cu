@@ -14,6 +14,7 @@
 
 #include "../src/core/slab_rules.h"
 #include "device_halo.h"
+#include "device_lower_bound.cuh"
 #include "kernel_launch.h"
 
 namespace sph {
@@ -92,15 +93,7 @@ __global__ void list_starts_kernel(const uint32_t* __restrict__ sorted, uint32_t
                                    uint32_t* __restrict__ starts) {
   const uint32_t k = blockIdx.x * blockDim.x + threadIdx.x;
   if (k > last) return;
-  uint32_t lo = 0, hi = m;
-  while (lo < hi) {
-    const uint32_t mid = lo + (hi - lo) / 2;
-    if (sorted[mid] < k)
-      lo = mid + 1;
-    else
-      hi = mid;
-  }
-  starts[k] = lo;
+  starts[k] = lower_bound_u32(sorted, 0, m, k);
 }
 
 __global__ void fill_kernel(uint32_t* __restrict__ v, uint32_t m, uint32_t value) {

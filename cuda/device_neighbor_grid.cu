@@ -5,6 +5,7 @@
 
 #include "../src/physics/grid_fit.h"
 #include "../src/physics/grid_hash.h"
+#include "device_lower_bound.cuh"
 #include "device_neighbor_grid.h"
 #include "kernel_launch.h"
 
@@ -93,18 +94,6 @@ __global__ void hash_kernel(GridShape table, const LiveGridShape* __restrict__ l
   values[i] = k;
 }
 
-// First index in [lo, hi) whose key is >= cell, or hi.
-__device__ uint32_t lower_bound(const uint32_t* __restrict__ keys, uint32_t lo, uint32_t hi, uint32_t cell) {
-  while (lo < hi) {
-    const uint32_t mid = lo + (hi - lo) / 2;
-    if (keys[mid] < cell)
-      lo = mid + 1;
-    else
-      hi = mid;
-  }
-  return lo;
-}
-
 // One thread per table entry c in [0, cell_count]: cell_start[c] = first sorted index whose
 // key is >= c. Each block first bounds its cells' answers by two searches over all keys, so
 // the per-thread search runs over the few particles of the block's cells. The block's starts
@@ -118,11 +107,12 @@ __global__ void __launch_bounds__(kDefaultBlockSize)
   const uint32_t first_cell = blockIdx.x * blockDim.x;
   if (threadIdx.x < 2) {
     const uint64_t cell = static_cast<uint64_t>(first_cell) + (threadIdx.x == 0 ? 0u : blockDim.x);
-    bounds[threadIdx.x] = cell > cell_count ? n : lower_bound(sorted_keys, 0, n, static_cast<uint32_t>(cell));
+    bounds[threadIdx.x] =
+        cell > cell_count ? n : lower_bound_u32(sorted_keys, 0, n, static_cast<uint32_t>(cell));
   }
   __syncthreads();
   const uint32_t c = first_cell + threadIdx.x;
-  const uint32_t start = c > cell_count ? n : lower_bound(sorted_keys, bounds[0], bounds[1], c);
+  const uint32_t start = c > cell_count ? n : lower_bound_u32(sorted_keys, bounds[0], bounds[1], c);
   starts[threadIdx.x] = start;
   if (threadIdx.x == 0) starts[blockDim.x] = bounds[1];
   __syncthreads();
