@@ -53,6 +53,7 @@ __global__ void __launch_bounds__(kDfsphSolveBlock) cg_measure_kernel(CgSolve s)
     error = dfsph_cg_error(value, s.fluid.rest_density);
   }
   dfsph_block_sum_to(s.partials, error);
+  dfsph_block_max_to(s.state, static_cast<float>(error));
 }
 
 __global__ void __launch_bounds__(kDfsphCheckBlock) cg_first_check_kernel(CgSolve s) {
@@ -63,10 +64,11 @@ __global__ void __launch_bounds__(kDfsphCheckBlock) cg_first_check_kernel(CgSolv
   const Dfsph::Constants& c = s.fluid.methods.dfsph;
   state->solve_iterations = 0;
   state->solve_error = s.n > 0 ? static_cast<float>(sum / s.n) : 0.0f;
+  dfsph_take_largest(state);
   state->cg_restart = 1;
   state->cg_skip = 0;
-  dfsph_continue_solve(state, state->pressure_tally, c.density_error, Dfsph::kMinIterations, c.max_iterations,
-                       s.cond);
+  dfsph_continue_solve(state, state->pressure_tally, dfsph_density_bounds(c), Dfsph::kMinIterations,
+                       c.max_iterations, s.cond);
 }
 
 // A new cycle (when one is due): the set, the binding contacts, the steepest (preconditioned)
@@ -98,7 +100,7 @@ __global__ void __launch_bounds__(kDfsphCheckBlock) cg_restart_check_kernel(CgSo
   state->cg_sz = sz;
   state->cg_restart = 0;
   if (sz == 0.0 && state->solve_iterations >= Dfsph::kMinIterations)
-    dfsph_stop_solve(state, state->pressure_tally, s.fluid.methods.dfsph.density_error, s.cond);
+    dfsph_stop_solve(state, state->pressure_tally, dfsph_density_bounds(s.fluid.methods.dfsph), s.cond);
 }
 
 // The operator on p, first half: the velocities p would give (a binding contact's normal part
@@ -200,6 +202,7 @@ __global__ void __launch_bounds__(kDfsphSolveBlock) cg_error_kernel(CgSolve s) {
   }
   dfsph_block_sum_to(s.partials, error);
   dfsph_block_sum_to(s.partials + s.blocks, outside);
+  dfsph_block_max_to(s.state, static_cast<float>(error));
 }
 
 // The mean error; a restart when the compression outside the set needs a larger set; the loop's
@@ -218,13 +221,14 @@ __global__ void __launch_bounds__(kDfsphCheckBlock) cg_error_check_kernel(CgSolv
   if (measured) {
     // (n > 0 here: with no particles p . A p is 0 and every iteration skips its measurement)
     state->solve_error = static_cast<float>(error / static_cast<double>(s.n));
+    dfsph_take_largest(state);
     if (outside / static_cast<double>(s.n) >= Dfsph::kCgRestartShare * c.density_error) {
       state->cg_restart = 1;
       state->cg_skip = 1;
     }
   }
-  dfsph_continue_solve(state, state->pressure_tally, c.density_error, Dfsph::kMinIterations, c.max_iterations,
-                       s.cond);
+  dfsph_continue_solve(state, state->pressure_tally, dfsph_density_bounds(c), Dfsph::kMinIterations,
+                       c.max_iterations, s.cond);
 }
 
 // z (the Jacobi step) over the set, and the block sums of value . z.

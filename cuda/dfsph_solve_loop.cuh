@@ -55,25 +55,50 @@ __device__ inline double dfsph_sum_partials(const double* partials, uint32_t blo
   return slots[0];
 }
 
-// Ends the current solve: its record (the iterations and error it reached; capped when the error
-// is above the bound) and the loop's flag and condition. One thread.
-__device__ inline void dfsph_stop_solve(FrameState* state, SolveTally& tally, float bound,
+// The block's largest particle error into state->solve_largest_bits (errors are >= 0, so their
+// float bits order as the floats; the maximum is the same whatever order the blocks run in). Called
+// by every thread of the block; a NaN counts as 0 here (the mean carries it).
+__device__ inline void dfsph_block_max_to(FrameState* state, float error) {
+  __shared__ unsigned block_largest;
+  const unsigned bits = __reduce_max_sync(0xffffffffu, __float_as_uint(error > 0.0f ? error : 0.0f));
+  if (threadIdx.x == 0) block_largest = 0u;
+  __syncthreads();
+  if ((threadIdx.x & 31u) == 0u && bits != 0u) atomicMax(&block_largest, bits);
+  __syncthreads();
+  if (threadIdx.x == 0 && block_largest != 0u) atomicMax(&state->solve_largest_bits, block_largest);
+}
+
+// The measurement's largest particle error into state->solve_largest, ready for the next. One thread.
+__device__ inline void dfsph_take_largest(FrameState* state) {
+  state->solve_largest = __uint_as_float(state->solve_largest_bits);
+  state->solve_largest_bits = 0u;
+}
+
+// The current solve's errors.
+__device__ inline DfsphErrors dfsph_solve_errors(const FrameState* state) {
+  return {state->solve_error, state->solve_largest};
+}
+
+// Ends the current solve: its record (the iterations and mean error it reached; capped when a
+// bound is unmet, dfsph.h) and the loop's flag and condition. One thread.
+__device__ inline void dfsph_stop_solve(FrameState* state, SolveTally& tally, const DfsphBounds& bounds,
                                         LoopCondition cond) {
-  record_solve(tally, state->solve_iterations, state->solve_error, state->solve_error > bound);
+  record_solve(tally, state->solve_iterations, state->solve_error, state->solve_largest,
+               dfsph_bounds_unmet(bounds, dfsph_solve_errors(state)));
   state->solve_run = 0;
   if (cond.in_graph) cudaGraphSetConditional(cond.handle, 0u);
 }
 
-// The loop's test after an iteration (or the initial residual), as the CPU backend's: on while the
-// error is above the bound or the minimum has not run, and below the cap. One thread.
-__device__ inline void dfsph_continue_solve(FrameState* state, SolveTally& tally, float bound,
+// The loop's test after an iteration (or the initial residual), as the CPU backend's: on while a
+// bound is unmet or the minimum has not run, and below the cap. One thread.
+__device__ inline void dfsph_continue_solve(FrameState* state, SolveTally& tally, const DfsphBounds& bounds,
                                             uint32_t min_iterations, uint32_t max_iterations,
                                             LoopCondition cond) {
   const uint32_t iterations = state->solve_iterations;
-  const bool more =
-      (state->solve_error > bound || iterations < min_iterations) && iterations < max_iterations;
+  const bool more = (dfsph_bounds_unmet(bounds, dfsph_solve_errors(state)) || iterations < min_iterations) &&
+                    iterations < max_iterations;
   if (!more) {
-    dfsph_stop_solve(state, tally, bound, cond);
+    dfsph_stop_solve(state, tally, bounds, cond);
     return;
   }
   if (cond.in_graph) cudaGraphSetConditional(cond.handle, 1u);

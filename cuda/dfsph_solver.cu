@@ -59,6 +59,8 @@ __device__ Vec3 dfsph_clamp(const ParticleArrays& a, uint32_t i, Vec3 v) {
 __global__ void dfsph_begin_solve_kernel(FrameState* state) {
   state->solve_run = 1;
   state->solve_iterations = 0;
+  state->solve_largest = 0.0f;
+  state->solve_largest_bits = 0u;
 }
 
 // v += the pressures k's velocity change (held to the contacts); carried gets k times the
@@ -100,11 +102,12 @@ __global__ void __launch_bounds__(kDfsphSolveBlock)
     error = r.error;
   }
   dfsph_block_sum_to(partials, error);
+  if (!kDivergence) dfsph_block_max_to(state, static_cast<float>(error));  // only the density solve bounds it
 }
 
 // The solve's mean error from the block sums; whether it goes on; its record when it stops.
 __global__ void __launch_bounds__(kDfsphCheckBlock)
-    dfsph_check_kernel(const double* partials, uint32_t blocks, uint32_t n, float bound,
+    dfsph_check_kernel(const double* partials, uint32_t blocks, uint32_t n, DfsphBounds bounds,
                        uint32_t min_iterations, uint32_t max_iterations, bool divergence, bool first,
                        LoopCondition cond, FrameState* state) {
   if (state->solve_run == 0) return;
@@ -112,7 +115,8 @@ __global__ void __launch_bounds__(kDfsphCheckBlock)
   if (threadIdx.x != 0) return;
   state->solve_iterations = first ? 0u : state->solve_iterations + 1u;
   state->solve_error = n > 0 ? static_cast<float>(sum / n) : 0.0f;
-  dfsph_continue_solve(state, divergence ? state->divergence_tally : state->pressure_tally, bound,
+  dfsph_take_largest(state);
+  dfsph_continue_solve(state, divergence ? state->divergence_tally : state->pressure_tally, bounds,
                        min_iterations, max_iterations, cond);
 }
 
@@ -187,7 +191,7 @@ void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid
   Float4* v = divergence ? a.sorted_velocity : a.velocity;
   float* carried = divergence ? a.dfsph_divergence : a.dfsph_pressure;
   const float* warm = divergence ? a.dfsph_step : a.dfsph_warm_pressure;
-  const float bound = divergence ? c.divergence_error : c.density_error;
+  const DfsphBounds bounds = divergence ? dfsph_divergence_bounds(c) : dfsph_density_bounds(c);
   const uint32_t min_iterations = divergence ? Dfsph::kMinDivergenceIterations : Dfsph::kMinIterations;
   const uint32_t max_iterations = divergence ? c.max_divergence_iterations : c.max_iterations;
   const unsigned threads = kDfsphSolveBlock, blocks = blocks_for(n, threads);
@@ -205,7 +209,7 @@ void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid
     check_launch("dfsph_residual_kernel");
   };
   auto check = [&](bool first) {
-    dfsph_check_kernel<<<1, kDfsphCheckBlock, 0, stream>>>(loops.partials, partial_count, n, bound,
+    dfsph_check_kernel<<<1, kDfsphCheckBlock, 0, stream>>>(loops.partials, partial_count, n, bounds,
                                                            min_iterations, max_iterations, divergence, first,
                                                            cond, state);
     check_launch("dfsph_check_kernel");

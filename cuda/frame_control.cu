@@ -44,6 +44,8 @@ __global__ void begin_frame_kernel(FrameState* s, StepLimits limits, uint32_t ma
   s->solve_run = 0;
   s->solve_iterations = 0;
   s->solve_error = 0.0f;
+  s->solve_largest = 0.0f;
+  s->solve_largest_bits = 0u;
   const uint32_t run = clock_running(s->clock, max_substeps) ? 1u : 0u;
   if (run) pick_step(s, limits);
   set_run(s, run, cond);

@@ -61,9 +61,11 @@ struct FrameState {
   // DFSPH (dfsph_solver.cu): the frame's record of its two solves, and the solve that runs now.
   SolveTally pressure_tally;
   SolveTally divergence_tally;
-  uint32_t solve_run;         // 1 while the current solve iterates (the stream driver reads it)
-  uint32_t solve_iterations;  // of the current solve, after its initial residual
-  float solve_error;          // the current solve's mean error
+  uint32_t solve_run;           // 1 while the current solve iterates (the stream driver reads it)
+  uint32_t solve_iterations;    // of the current solve, after its initial residual
+  float solve_error;            // the current solve's mean error
+  float solve_largest;          // and its largest particle error (the density solve's only)
+  uint32_t solve_largest_bits;  // the largest of the measurement in progress, as float bits (atomicMax)
   // The conjugate gradients' density solve (dfsph_cg_solver.cu): a new cycle is due; the rest of
   // this iteration is skipped (no descent along p, or a restart); a contact was held in it;
   // value . z over the active set; the step along p and the next direction's share of p.

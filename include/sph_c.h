@@ -618,8 +618,15 @@ typedef struct sph_dfsph_params {
                                          SPH_FEATURE_BOUNDARY_DENSITY or SPH_FEATURE_COLLIDER_LOADS
                                          setting it (or loading a checkpoint with it) is
                                          UNSUPPORTED, the world unchanged */
+  float density_error_max;            /* (0.2.0) bound on the density solve's largest error, max(rho* -
+                                         rho0, 0) / rho0 of any one particle: the solve iterates while
+                                         this or the mean is above its bound (then the cap); default
+                                         0.05 (5 %); in (0, 1]; 0 = default; a value below
+                                         density_error acts as density_error. Without it a small
+                                         violent region of a large world (a splash at a wall) stays
+                                         compressed by 50-100 %, as it barely moves the mean */
 } sph_dfsph_params;
-SPH_STATIC_ASSERT(sizeof(sph_dfsph_params) == 28, sph_dfsph_params_size);
+SPH_STATIC_ASSERT(sizeof(sph_dfsph_params) == 32, sph_dfsph_params_size);
 
 SPH_API sph_result SPH_CALL sph_dfsph_params_init_sized(sph_dfsph_params* params, uint32_t size);
 static inline sph_result sph_dfsph_params_init(sph_dfsph_params* params) {
@@ -999,7 +1006,10 @@ typedef struct sph_stats {
   uint32_t max_capacity;              /* most it may grow to (always current) */
   uint32_t capacity_growths;          /* times the world reallocated its particle storage since
                                          it was created or loaded (always current) */
-  uint32_t reserved1;
+  float density_error_largest;        /* (0.2.0) the largest error of one particle, max(rho* - rho0,
+                                         0) / rho0, that any density solve of the last step ended
+                                         with: within sph_dfsph_params.density_error_max unless the
+                                         solve was capped (before 0.2.0: reserved, 0) */
 } sph_stats;
 SPH_STATIC_ASSERT(sizeof(sph_stats) == 160, sph_stats_size);
 

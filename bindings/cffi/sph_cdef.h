@@ -310,6 +310,7 @@ typedef struct sph_dfsph_params {
   uint32_t max_divergence_iterations;
   uint32_t flags;
   uint32_t linear_solver;
+  float density_error_max;
 } sph_dfsph_params;
 typedef struct sph_params_info {
   uint32_t struct_size;
@@ -395,7 +396,7 @@ typedef struct sph_stats {
   uint32_t capacity;
   uint32_t max_capacity;
   uint32_t capacity_growths;
-  uint32_t reserved1;
+  float density_error_largest;
 } sph_stats;
 typedef struct sph_grid_desc {
   uint32_t struct_size;

@@ -1138,7 +1138,7 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_dfsph_params (28 bytes)</summary>
+    /// <summary>sph_dfsph_params (32 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct DfsphParams
     {
@@ -1176,6 +1176,14 @@ namespace Sph
         /// it (or loading a checkpoint with it) is UNSUPPORTED, the world unchanged
         /// </summary>
         public uint LinearSolver;
+        /// <summary>
+        /// float density_error_max: (0.2.0) bound on the density solve's largest error, max(rho* -
+        /// rho0, 0) / rho0 of any one particle: the solve iterates while this or the mean is above its
+        /// bound (then the cap); default 0.05 (5 %); in (0, 1]; 0 = default; a value below
+        /// density_error acts as density_error. Without it a small violent region of a large world (a
+        /// splash at a wall) stays compressed by 50-100 %, as it barely moves the mean
+        /// </summary>
+        public float DensityErrorMax;
 
         /// <summary>A DfsphParams with the library's defaults (sph_dfsph_params_init_sized).</summary>
         public static DfsphParams Default()
@@ -1454,8 +1462,12 @@ namespace Sph
         /// created or loaded (always current)
         /// </summary>
         public uint CapacityGrowths;
-        /// <summary>uint32_t reserved1</summary>
-        public uint Reserved1;
+        /// <summary>
+        /// float density_error_largest: (0.2.0) the largest error of one particle, max(rho* - rho0, 0)
+        /// / rho0, that any density solve of the last step ended with: within
+        /// sph_dfsph_params.density_error_max unless the solve was capped (before 0.2.0: reserved, 0)
+        /// </summary>
+        public float DensityErrorLargest;
 
         /// <summary>A Stats with the library's defaults (sph_stats_init_sized).</summary>
         public static Stats Default()
@@ -3649,7 +3661,7 @@ namespace Sph
             8,
             28,
             8,
-            28,
+            32,
             32,
             72,
             32,
@@ -3747,6 +3759,7 @@ namespace Sph
             typeof(SpringParams),
             typeof(DensityDiffusionParams),
             typeof(DensityDiffusionParams),
+            typeof(DfsphParams),
             typeof(DfsphParams),
             typeof(DfsphParams),
             typeof(DfsphParams),
@@ -4034,6 +4047,7 @@ namespace Sph
             "MaxDivergenceIterations",
             "Flags",
             "LinearSolver",
+            "DensityErrorMax",
             "StructSize",
             "ParamsSize",
             "FieldCount",
@@ -4105,7 +4119,7 @@ namespace Sph
             "Capacity",
             "MaxCapacity",
             "CapacityGrowths",
-            "Reserved1",
+            "DensityErrorLargest",
             "StructSize",
             "Dims",
             "IndexToLocal",
@@ -4314,6 +4328,7 @@ namespace Sph
             16,
             20,
             24,
+            28,
             0,
             4,
             8,

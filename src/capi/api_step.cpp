@@ -243,6 +243,7 @@ SPH_API sph_result SPH_CALL sph_world_get_stats(const sph_world* world, sph_stat
     s.divergence_iterations_max = r.divergence_solve.iterations_max;
     s.density_error_mean = r.pressure_solve.error_mean;
     s.density_error_max = r.pressure_solve.error_max;
+    s.density_error_largest = r.pressure_solve.largest_max;
     s.divergence_error_mean = r.divergence_solve.error_mean;
     s.divergence_error_max = r.divergence_solve.error_max;
     s.pressure_solves_capped = r.pressure_solve.capped;

@@ -105,13 +105,14 @@ struct Clock {
   HostVector<Event> events;
 };
 
-SolveReport read_solve(ByteReader& r, const std::string& name) {
+SolveReport read_solve(ByteReader& r, const std::string& name, uint32_t version) {
   SolveReport s;
   s.iterations = r.u32();
   s.iterations_max = r.u32();
   s.capped = r.u32();
   s.error_mean = non_negative(r, name + " mean error");
   s.error_max = non_negative(r, name + " largest error");
+  if (version >= kFirstLargestErrorVersion) s.largest_max = non_negative(r, name + " largest particle error");
   if (s.iterations_max > s.iterations || s.capped > s.iterations)
     corrupt(r.what() + ": " + name + " counts more in one substep or more capped solves than iterations");
   return s;
@@ -141,8 +142,8 @@ Clock read_clock(ByteReader& r, uint32_t version) {
   f.neighbors_max = r.u32();
   for (int k = 0; k < kStageCount; ++k) f.stage_ms[k] = non_negative(r, "stage time");
   if (version >= kFirstSolverVersion) {
-    f.pressure_solve = read_solve(r, "density solve");
-    f.divergence_solve = read_solve(r, "divergence solve");
+    f.pressure_solve = read_solve(r, "density solve", version);
+    f.divergence_solve = read_solve(r, "divergence solve", version);
   }
   const uint32_t events = r.u32();
   r.need_elements(events, 16, "events");

@@ -31,6 +31,7 @@ struct SolveReport {
   uint32_t capped = 0;          // substeps whose solve stopped at its iteration cap above its bound
   float error_mean = 0.0f;      // the achieved mean error, averaged over the substeps
   float error_max = 0.0f;       // the largest of any substep
+  float largest_max = 0.0f;     // the largest particle error any substep's solve ended with
 };
 
 // One collider's impulses over a frame (SPH_FEATURE_COLLIDER_LOADS, physics/collider_loads.h),

@@ -20,16 +20,17 @@ struct SolveTally {
   uint32_t iterations;
   uint32_t iterations_max;
   uint32_t capped;
-  uint32_t pad;
+  float largest_max;  // the largest particle error any of the solves ended with
 };
 
-SPH_HD SolveTally empty_solve_tally() { return SolveTally{0.0, 0.0f, 0u, 0u, 0u, 0u, 0u}; }
+SPH_HD SolveTally empty_solve_tally() { return SolveTally{0.0, 0.0f, 0u, 0u, 0u, 0u, 0.0f}; }
 
-// One substep's solve: `iterations` after the initial residual, the mean error it ended with,
-// and whether it stopped at the cap with the error still above the bound.
-SPH_HD void record_solve(SolveTally& t, uint32_t iterations, float error, bool capped) {
+// One substep's solve: `iterations` after the initial residual, the mean error and the largest
+// particle error it ended with, and whether it stopped at the cap with a bound unmet.
+SPH_HD void record_solve(SolveTally& t, uint32_t iterations, float error, float largest, bool capped) {
   t.error_sum += error;
   t.error_max = t.error_max < error ? error : t.error_max;
+  t.largest_max = t.largest_max < largest ? largest : t.largest_max;
   t.solves += 1;
   t.iterations += iterations;
   t.iterations_max = t.iterations_max < iterations ? iterations : t.iterations_max;
@@ -43,6 +44,7 @@ inline SolveReport finish_solve(const SolveTally& t) {
   r.capped = t.capped;
   r.error_mean = t.solves > 0 ? static_cast<float>(t.error_sum / t.solves) : 0.0f;
   r.error_max = t.error_max;
+  r.largest_max = t.largest_max;
   return r;
 }
 

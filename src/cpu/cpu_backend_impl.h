@@ -197,7 +197,8 @@ class CpuBackend final : public Backend {
   enum class DfsphSolve { Divergence, Density };
   struct SolveOutcome {
     uint32_t iterations;
-    float error;
+    float error;    // the mean
+    float largest;  // the largest particle error
     bool capped;
   };
   // One solve over the velocities v (xyz; w: 1 / rho), from the warm start in `carried` (k,
@@ -215,14 +216,15 @@ class CpuBackend final : public Backend {
   void dfsph_correct(const FluidConstants& fluid, const DfsphWalls& walls, float dt, Float4* v,
                      float* carried, float carry_scale);
   // New pressures and errors from the rates over the velocities the last dfsph_correct wrote (the
-  // columns); returns the mean error.
-  float dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls, float dt);
+  // columns); returns the mean and the largest error.
+  DfsphErrors dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls,
+                              float dt);
   // The density solve by conjugate gradients (cpu_dfsph_cg.cpp; sph_dfsph_params.linear_solver);
-  // its rate pass (each particle's value into cg_value_; returns the mean error); a contact held
+  // its rate pass (each particle's value into cg_value_; returns the mean and largest error); a contact held
   // within an iteration (v_i changed by dv): the values of i and its neighbours.
   SolveOutcome dfsph_solve_cg(const FluidConstants& fluid, const DfsphWalls& walls, float dt, Float4* v,
                               float* carried);
-  float dfsph_cg_measure(const FluidConstants& fluid, const DfsphWalls& walls, float dt);
+  DfsphErrors dfsph_cg_measure(const FluidConstants& fluid, const DfsphWalls& walls, float dt);
   void dfsph_cg_hold_contact(const FluidConstants& fluid, const DfsphWalls& walls, float dt, uint32_t i,
                              Vec3 dv);
 

@@ -18,7 +18,7 @@ namespace {
 constexpr uint8_t kActive = 1, kBinds = 2;
 }  // namespace
 
-float CpuBackend::dfsph_cg_measure(const FluidConstants& fluid, const DfsphWalls& walls, float dt) {
+DfsphErrors CpuBackend::dfsph_cg_measure(const FluidConstants& fluid, const DfsphWalls& walls, float dt) {
   const GridView view = grid_.view();
   const NeighborColumns columns = columns_.view();
   const float* density = density_.data();
@@ -31,8 +31,12 @@ float CpuBackend::dfsph_cg_measure(const FluidConstants& fluid, const DfsphWalls
     error[i] = dfsph_cg_error(value[i], rho0);
   });
   ExactFloatSum sum;
-  for (uint32_t i = 0; i < count_; ++i) sum.add(error[i]);
-  return count_ > 0 ? static_cast<float>(sum.value() / static_cast<double>(count_)) : 0.0f;
+  float largest = 0.0f;
+  for (uint32_t i = 0; i < count_; ++i) {
+    sum.add(error[i]);
+    largest = error[i] > largest ? error[i] : largest;
+  }
+  return {count_ > 0 ? static_cast<float>(sum.value() / static_cast<double>(count_)) : 0.0f, largest};
 }
 
 void CpuBackend::dfsph_cg_hold_contact(const FluidConstants& fluid, const DfsphWalls& walls, float dt,
@@ -73,7 +77,7 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
                             "does not work with ") +
                     refused + " yet; use SPH_DFSPH_JACOBI");
   const Dfsph::Constants& c = fluid.methods.dfsph;
-  const float bound = c.density_error;
+  const DfsphBounds bounds = dfsph_density_bounds(c);
   const uint32_t n = count_;
   float* p = columns_.dfsph_step();  // the search direction, read by the velocity update as k
   float* value = cg_value_.data();
@@ -95,12 +99,13 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
     carried[i] = 0.0f;
   });
   dfsph_correct(fluid, walls, dt, v, carried, 1.0f);
-  float error = dfsph_cg_measure(fluid, walls, dt);
+  DfsphErrors error = dfsph_cg_measure(fluid, walls, dt);
 
   uint32_t iterations = 0;
   bool restart = true;
   double sz = 0.0;  // value . z over the active set
-  while ((error > bound || iterations < Dfsph::kMinIterations) && iterations < c.max_iterations) {
+  while ((dfsph_bounds_unmet(bounds, error) || iterations < Dfsph::kMinIterations) &&
+         iterations < c.max_iterations) {
     if (restart) {
       // A new cycle: the set, the binding contacts and the steepest (preconditioned) direction.
       parallel().for_each(n, [&](uint32_t i) {
@@ -162,14 +167,16 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
       }
     parallel().for_each(n, [&](uint32_t i) { z[i] = dfsph_cg_error(value[i], rho0); });
     ExactFloatSum error_sum, outside_sum;
+    float largest = 0.0f;
     for (uint32_t i = 0; i < n; ++i) {
       error_sum.add(z[i]);
+      largest = z[i] > largest ? z[i] : largest;
       // (only what a new set could take: a particle without a factor, which no pressure reaches,
       // would restart every cycle)
       if (!(state[i] & kActive) && factor[i] > 0.0f) outside_sum.add(z[i]);
     }
-    error = static_cast<float>(error_sum.value() / static_cast<double>(n));
-    if (outside_sum.value() / static_cast<double>(n) >= Dfsph::kCgRestartShare * bound) {
+    error = {static_cast<float>(error_sum.value() / static_cast<double>(n)), largest};
+    if (outside_sum.value() / static_cast<double>(n) >= Dfsph::kCgRestartShare * bounds.mean) {
       restart = true;  // the compression outside the set needs a larger set
       continue;
     }
@@ -187,7 +194,7 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
   // Kept for the warm start, the checkpoints and the pressure attribute: where it pushed
   // (dfsph_cg.h).
   parallel().for_each(n, [&](uint32_t i) { carried[i] = dfsph_cg_kept_pressure(carried[i]); });
-  return SolveOutcome{iterations, error, error > bound};
+  return SolveOutcome{iterations, error.mean, error.largest, dfsph_bounds_unmet(bounds, error)};
 }
 
 }  // namespace sph

@@ -3,7 +3,7 @@
 // factor, the divergence solve on the current velocities, the non-pressure accelerations into
 // v*, the density solve on v*, then positions and colliders. Each solve is a Jacobi iteration of
 // two passes, the velocity update (dfsph_correct) and the new rates and pressures
-// (dfsph_residuals), until its mean error is below its bound or its cap; with
+// (dfsph_residuals), until its errors are within their bounds (dfsph.h) or its cap; with
 // SPH_DFSPH_CONJUGATE_GRADIENTS the density solve is cpu_dfsph_cg.cpp's instead. The mean is an exact
 // sum (exact_float_sum.h), so it, the iteration count and every result depend on neither the
 // thread count nor, in a distributed world, the ranks.
@@ -70,8 +70,8 @@ void CpuBackend::dfsph_correct(const FluidConstants& fluid, const DfsphWalls& wa
   if (ranks_) halo_share_velocities(v);  // the next rate pass reads the ghosts' velocities
 }
 
-float CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls,
-                                  float dt) {
+DfsphErrors CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls,
+                                        float dt) {
   const GridView view = grid_.view();
   const NeighborColumns columns = columns_.view();
   const float* factor = dfsph_factor_.data();
@@ -93,16 +93,21 @@ float CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, 
   });
   // Exact, so the mean is the same bits whichever particles a rank holds (exact_float_sum.h).
   ExactFloatSum sum;
+  float largest = 0.0f;
   for (uint32_t i = 0; i < count_; ++i)
-    if (!ghost(i)) sum.add(error[i]);
+    if (!ghost(i)) {
+      sum.add(error[i]);
+      largest = error[i] > largest ? error[i] : largest;
+    }
   int64_t particles = count_;
   if (ranks_) {
     halo_share_dfsph_step();  // the next velocity update reads the ghosts' k
     halo_agree();             // (the share's buffers: a rank that failed there meets the others here)
     ranks_->all_sum(sum.terms(), ExactFloatSum::kTerms);
+    if (kind == DfsphSolve::Density) ranks_->all_max(&largest, 1);  // only the density solve bounds it
     particles = halo_world_count_;
   }
-  return particles > 0 ? static_cast<float>(sum.value() / static_cast<double>(particles)) : 0.0f;
+  return {particles > 0 ? static_cast<float>(sum.value() / static_cast<double>(particles)) : 0.0f, largest};
 }
 
 CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidConstants& fluid,
@@ -112,7 +117,7 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
   if (c.linear_solver == kDfsphConjugateGradients && kind == DfsphSolve::Density)
     return dfsph_solve_cg(fluid, walls, dt, v, carried);
   const bool divergence = kind == DfsphSolve::Divergence;
-  const float bound = divergence ? c.divergence_error : c.density_error;
+  const DfsphBounds bounds = divergence ? dfsph_divergence_bounds(c) : dfsph_density_bounds(c);
   const uint32_t min_iterations = divergence ? Dfsph::kMinDivergenceIterations : Dfsph::kMinIterations;
   const uint32_t max_iterations = divergence ? c.max_divergence_iterations : c.max_iterations;
   // The warm start: half the last substep's pressure, applied once; the solve's own
@@ -123,14 +128,14 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
     carried[i] = 0.0f;
   });
   dfsph_correct(fluid, walls, dt, v, carried, carry_scale);
-  float error = dfsph_residuals(kind, fluid, walls, dt);
+  DfsphErrors error = dfsph_residuals(kind, fluid, walls, dt);
   uint32_t iterations = 0;
-  while ((error > bound || iterations < min_iterations) && iterations < max_iterations) {
+  while ((dfsph_bounds_unmet(bounds, error) || iterations < min_iterations) && iterations < max_iterations) {
     dfsph_correct(fluid, walls, dt, v, carried, carry_scale);
     error = dfsph_residuals(kind, fluid, walls, dt);
     ++iterations;
   }
-  return SolveOutcome{iterations, error, error > bound};
+  return SolveOutcome{iterations, error.mean, error.largest, dfsph_bounds_unmet(bounds, error)};
 }
 
 uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame& scene,
@@ -146,7 +151,7 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
   if (fluid.methods.dfsph.divergence_solve) {
     const SolveOutcome o =
         dfsph_solve(DfsphSolve::Divergence, fluid, walls, dt, velocity_.data(), dfsph_divergence_.data(), dt);
-    record_solve(tallies.divergence, o.iterations, o.error, o.capped);
+    record_solve(tallies.divergence, o.iterations, o.error, o.largest, o.capped);
   } else {
     std::fill(dfsph_divergence_.data(), dfsph_divergence_.data() + count_, 0.0f);  // no warm start to keep
   }
@@ -180,7 +185,7 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
   // 4. The density solve on v*.
   const SolveOutcome o =
       dfsph_solve(DfsphSolve::Density, fluid, walls, dt, next_vel, dfsph_pressure_.data(), 1.0f);
-  record_solve(tallies.pressure, o.iterations, o.error, o.capped);
+  record_solve(tallies.pressure, o.iterations, o.error, o.largest, o.capped);
   // 5. x += dt v*; w: the pressure both solves applied in this substep, p = (k + k_v) rho^2, also
   // the start's record's (the probes sample it there, at the positions the solves worked on).
   const float* k = dfsph_pressure_.data();

@@ -64,6 +64,25 @@ static double surge_front(const float* positions, uint32_t n, float* scratch, do
   }
 }
 
+/* One line of a frame's statistics and where its densest particle is (config->frame_log). */
+static void log_frame(FILE* log, const dam_break_result* result, const sph_stats* stats,
+                      const float* positions, const float* density, uint32_t count, double a) {
+  uint32_t densest = 0;
+  for (uint32_t i = 1; i < count; ++i)
+    if (density[i] > density[densest]) densest = i;
+  fprintf(log,
+          "frame T %.3f substeps %u dt %.2e..%.2e vmax %.3f rho %.1f..%.1f nbrs %.1f (max %u) it %u (max %u) "
+          "div %u (max %u) err %.5f (max %.5f) capped %u densest %u at (%.3f, %.3f, %.3f) a\n",
+          result->simulated_seconds * time_scale(), stats->substeps, stats->dt_min, stats->dt_max,
+          stats->max_speed, stats->density_min, stats->density_max, stats->neighbors_mean,
+          stats->neighbors_max, stats->pressure_iterations, stats->pressure_iterations_max,
+          stats->divergence_iterations, stats->divergence_iterations_max, stats->density_error_mean,
+          stats->density_error_max, stats->pressure_solves_capped, densest,
+          count ? positions[3 * densest] / a : 0.0, count ? positions[3 * densest + 1] / a : 0.0,
+          count ? positions[3 * densest + 2] / a : 0.0);
+  fflush(log);
+}
+
 sph_result dam_break_run(sph_context* context, const dam_break_config* config, dam_break_result* result,
                          void (*trace)(void* user, double T, double Z), void* trace_user) {
   const double a = DAM_BREAK_COLUMN_WIDTH;
@@ -135,6 +154,7 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
     sph_dfsph_params dfsph;
     sph_dfsph_params_init(&dfsph);
     if (config->density_error > 0.0f) dfsph.density_error = config->density_error;
+    if (config->density_error_max > 0.0f) dfsph.density_error_max = config->density_error_max;
     if (config->divergence_error > 0.0f) dfsph.divergence_error = config->divergence_error;
     if (config->max_iterations > 0) dfsph.max_iterations = config->max_iterations;
     dfsph.flags = config->dfsph_flags;
@@ -204,6 +224,7 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
             ++above;
           }
         compression_sum += above ? sum / above : 0.0;
+        if (config->frame_log) log_frame(config->frame_log, result, &stats, positions, density, count, a);
       }
       result->T[result->samples] = result->simulated_seconds * scale;
       result->Z[result->samples] = surge_front(positions, count, scratch, step, config->slab_layers) / a;

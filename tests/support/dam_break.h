@@ -13,6 +13,8 @@
 
 #include <stdint.h>
 
+#include <stdio.h>
+
 #include "sph_c.h"
 
 #ifdef __cplusplus
@@ -45,11 +47,14 @@ typedef struct dam_break_config {
    * sph_dfsph_params (0: the library's default): */
   sph_solver solver;
   float density_error;
+  float density_error_max; /* the bound on the largest particle error (0: the library's default) */
   float divergence_error;
   uint32_t max_iterations;
   uint32_t dfsph_flags;
   uint32_t dfsph_linear_solver; /* SPH_DFSPH_JACOBI or SPH_DFSPH_CONJUGATE_GRADIENTS (0: default) */
   uint32_t features; /* sph_world_def.features added to the world's (e.g. SPH_FEATURE_BOUNDARY_DENSITY) */
+  FILE* frame_log;   /* optional (NULL: none): one line a frame of the step's statistics and where the
+                        densest particle is, for diagnosing a run */
 } dam_break_config;
 
 /* The configuration the validation uses (docs/validation.md says why each value). */

@@ -38,7 +38,8 @@ PHYSICS_PARAMS = {
     "springs": {"stiffness": "float", "link_radius": "float", "yield_ratio": "float", "plasticity": "float",
                 "damping": "float"},
     "dfsph": {"density_error": "float", "divergence_error": "float", "max_iterations": "uint",
-              "max_divergence_iterations": "uint", "flags": "uint", "linear_solver": "uint"},
+              "max_divergence_iterations": "uint", "flags": "uint", "linear_solver": "uint",
+              "density_error_max": "float"},
     "density_diffusion": {"delta": "float"},
 }
 FEATURES = ["surface_tension", "normalized_density", "springs", "boundary_density", "collider_loads",

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '699639a0e819378dc6d733608aad948a6bf144150d1854f638cd4e59f377f358', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '0c7e6c4eaed9aa7e6325f7bd67c82878ef38c1a0c3a033c3625b240d6fd57c9b', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -1086,6 +1086,7 @@ class DfsphParams(_SphStruct):
         max_divergence_iterations (uint32_t): cap of the divergence solve; default 100; >= 1; 0 = default
         flags (uint32_t): SPH_DFSPH_* bits; default 0
         linear_solver (uint32_t): how the density solve iterates: SPH_DFSPH_JACOBI (the default) or SPH_DFSPH_CONJUGATE_GRADIENTS (the divergence solve is always Jacobi); 0 = default; any other value is INVALID_ARGUMENT. Conjugate gradients run on the CPU and CUDA backends; in a distributed world or with SPH_FEATURE_BOUNDARY_DENSITY or SPH_FEATURE_COLLIDER_LOADS setting it (or loading a checkpoint with it) is UNSUPPORTED, the world unchanged
+        density_error_max (float): (0.2.0) bound on the density solve's largest error, max(rho* - rho0, 0) / rho0 of any one particle: the solve iterates while this or the mean is above its bound (then the cap); default 0.05 (5 %); in (0, 1]; 0 = default; a value below density_error acts as density_error. Without it a small violent region of a large world (a splash at a wall) stays compressed by 50-100 %, as it barely moves the mean
     """
     _fields_ = [
         ('struct_size', _c.c_uint32),
@@ -1095,10 +1096,11 @@ class DfsphParams(_SphStruct):
         ('max_divergence_iterations', _c.c_uint32),
         ('flags', _c.c_uint32),
         ('linear_solver', _c.c_uint32),
+        ('density_error_max', _c.c_float),
     ]
     _sph_c_name_ = 'sph_dfsph_params'
-    _sph_size_ = 28
-    _sph_offsets_ = (('struct_size', 0), ('density_error', 4), ('divergence_error', 8), ('max_iterations', 12), ('max_divergence_iterations', 16), ('flags', 20), ('linear_solver', 24))
+    _sph_size_ = 32
+    _sph_offsets_ = (('struct_size', 0), ('density_error', 4), ('divergence_error', 8), ('max_iterations', 12), ('max_divergence_iterations', 16), ('flags', 20), ('linear_solver', 24), ('density_error_max', 28))
     _sph_init_ = 'sph_dfsph_params_init_sized'
 
 
@@ -1327,7 +1329,7 @@ class Stats(_SphStruct):
         capacity (uint32_t): particles the world has room for now (always current)
         max_capacity (uint32_t): most it may grow to (always current)
         capacity_growths (uint32_t): times the world reallocated its particle storage since it was created or loaded (always current)
-        reserved1 (uint32_t)
+        density_error_largest (float): (0.2.0) the largest error of one particle, max(rho* - rho0, 0) / rho0, that any density solve of the last step ended with: within sph_dfsph_params.density_error_max unless the solve was capped (before 0.2.0: reserved, 0)
     """
     _fields_ = [
         ('struct_size', _c.c_uint32),
@@ -1360,11 +1362,11 @@ class Stats(_SphStruct):
         ('capacity', _c.c_uint32),
         ('max_capacity', _c.c_uint32),
         ('capacity_growths', _c.c_uint32),
-        ('reserved1', _c.c_uint32),
+        ('density_error_largest', _c.c_float),
     ]
     _sph_c_name_ = 'sph_stats'
     _sph_size_ = 160
-    _sph_offsets_ = (('struct_size', 0), ('particle_count', 4), ('substeps', 8), ('neighbors_max', 12), ('simulated_time', 16), ('frame_time', 24), ('dt_min', 28), ('dt_max', 32), ('max_speed', 36), ('density_min', 40), ('density_mean', 44), ('density_max', 48), ('neighbors_mean', 52), ('stage_ms', 56), ('step_ms', 88), ('reserved0', 92), ('memory_bytes', 96), ('pressure_iterations', 104), ('pressure_iterations_max', 108), ('divergence_iterations', 112), ('divergence_iterations_max', 116), ('density_error_mean', 120), ('density_error_max', 124), ('divergence_error_mean', 128), ('divergence_error_max', 132), ('pressure_solves_capped', 136), ('divergence_solves_capped', 140), ('capacity', 144), ('max_capacity', 148), ('capacity_growths', 152), ('reserved1', 156))
+    _sph_offsets_ = (('struct_size', 0), ('particle_count', 4), ('substeps', 8), ('neighbors_max', 12), ('simulated_time', 16), ('frame_time', 24), ('dt_min', 28), ('dt_max', 32), ('max_speed', 36), ('density_min', 40), ('density_mean', 44), ('density_max', 48), ('neighbors_mean', 52), ('stage_ms', 56), ('step_ms', 88), ('reserved0', 92), ('memory_bytes', 96), ('pressure_iterations', 104), ('pressure_iterations_max', 108), ('divergence_iterations', 112), ('divergence_iterations_max', 116), ('density_error_mean', 120), ('density_error_max', 124), ('divergence_error_mean', 128), ('divergence_error_max', 132), ('pressure_solves_capped', 136), ('divergence_solves_capped', 140), ('capacity', 144), ('max_capacity', 148), ('capacity_growths', 152), ('density_error_largest', 156))
     _sph_init_ = 'sph_stats_init_sized'
 
 
