@@ -125,14 +125,8 @@ def manifest_end(directory):
     return (ends[-1] if ends else None), complete
 
 
-def check_interrupt(mpiexec, sph_run_mpi, scene, work, ranks, backend):
-    """SIGINT to one rank alone, once frame 1 is complete: every rank stops after the same frame."""
-    out = os.path.join(work, "interrupted")
-    env = dict(os.environ, **MPI_ENV)
-    proc = subprocess.Popen([mpiexec, "--oversubscribe", "-np", ranks, sph_run_mpi, scene, "--backend", backend,
-                             "--format", "csv", "--threads", "1", "--quiet", "--per-rank", "--frames", "5000",
-                             "--out", out, "--stats-json", out + ".json"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+def interrupt_one_rank(proc, out, ranks):
+    """Waits for frame 1 of the run `proc` (mpirun), sends SIGINT to one rank; its output."""
     deadline = time.monotonic() + 60
     while 1 not in manifest_end(out)[1]:
         assert proc.poll() is None and time.monotonic() < deadline, "sph-run-mpi never completed frame 1"
@@ -149,7 +143,26 @@ def check_interrupt(mpiexec, sph_run_mpi, scene, work, ranks, backend):
             children.append(int(os.path.basename(os.path.dirname(stat))))
     assert len(children) == int(ranks), f"mpirun's children: {children}"
     os.kill(max(children), signal.SIGINT)
-    stdout, stderr = proc.communicate(timeout=60)
+    return proc.communicate(timeout=60)
+
+
+def check_interrupt(mpiexec, sph_run_mpi, scene, work, ranks, backend):
+    """SIGINT to one rank alone, once frame 1 is complete: every rank stops after the same frame."""
+    out = os.path.join(work, "interrupted")
+    env = dict(os.environ, **MPI_ENV)
+    proc = subprocess.Popen([mpiexec, "--oversubscribe", "-np", ranks, sph_run_mpi, scene, "--backend", backend,
+                             "--format", "csv", "--threads", "1", "--quiet", "--per-rank", "--frames", "5000",
+                             "--out", out, "--stats-json", out + ".json"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        stdout, stderr = interrupt_one_rank(proc, out, ranks)
+    finally:
+        if proc.poll() is None:  # a failed check: no run of 5000 frames left behind
+            proc.terminate()  # mpirun ends its ranks (SIGTERM, then SIGKILL); a killed mpirun would not
+            try:
+                proc.communicate(timeout=30)
+            except subprocess.TimeoutExpired:
+                proc.kill()
     assert proc.returncode == 130, f"interrupted run exited {proc.returncode}\n{stdout}\n{stderr}"
     end, complete = manifest_end(out)
     assert end == {"end": "interrupted", "last_frame": end["last_frame"]}, end
