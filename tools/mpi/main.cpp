@@ -1,35 +1,29 @@
 // SPDX-License-Identifier: MIT
 // sph-run-mpi: sph-run's scene files on a distributed world (sph_mpi.h), one process per rank
 // under mpirun (docs/distributed.md, "sph-run under mpirun"). Every rank reads the scene and
-// builds the same colliders, sinks and force fields; rank 0 adds the fluid bodies; rank 0
-// writes the merged frames (every rank's particles, by id) and, with --per-rank, each rank its
-// own into DIR/rank<R>/.
+// builds the same colliders, sinks, sources, probes and force fields; rank 0 adds the fluid
+// bodies; rank 0 writes the merged frames (every rank's particles, by id), the probes' and
+// loads' files and, with --per-rank, each rank its own frames into DIR/rank<R>/ (run_frames).
 #include <mpi.h>
-#include <unistd.h>
 
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
-#include <memory>
 #include <new>
 #include <string>
 #include <vector>
 
 #include "cli_options.h"
-#include "distributed_maker.h"
 #include "exit_codes.h"
 #include "frame_writer.h"
 #include "image.h"
 #include "library_error.h"
-#include "merged_frame.h"
-#include "progress.h"
-#include "refusals.h"
+#include "ranks.h"
+#include "run_frames.h"
 #include "scene_error.h"
 #include "scene_parser.h"
 #include "sph_mpi.h"
-#include "video.h"
 
 namespace sph_tools {
 namespace {
@@ -42,12 +36,9 @@ const char* const kMpiUsage =
     "  --per-rank          also write each rank's own particles to DIR/rank<R>/\n"
     "  --backend cuda      every rank on the CUDA backend, on the GPU of its node-local rank (or GPU 0\n"
     "                      where there is no such GPU; the host-staged halo); auto and cpu: the CPU\n"
-    "No sources, probes or collider loads (and on CUDA no sinks); no OpenVDB outputs.\n";
-
-struct Ranks {
-  MPI_Comm comm = MPI_COMM_WORLD;
-  int rank = 0, count = 1;
-};
+    "Rank 0 writes the probes' and loads' CSV files and --stats-json (the world's figures).\n"
+    "Ctrl-C (SIGINT or SIGTERM on any rank) stops every rank after the same frame.\n"
+    "No OpenVDB outputs; a CUDA rank refuses what docs/distributed.md lists (sinks, probes).\n";
 
 struct ContextOwner {
   sph_context* context = nullptr;
@@ -91,15 +82,6 @@ sph_result create_context(const Ranks& ranks, const CliOptions& cli, sph_context
   return r;
 }
 
-// A failure of this rank alone (its files): the others would wait for it in the next
-// collective call, so the run ends here for all.
-[[noreturn]] void abort_run(const Ranks& r, const std::string& message) {
-  std::fprintf(stderr, "sph-run-mpi: rank %d: %s\n", r.rank, message.c_str());
-  std::fflush(stderr);
-  MPI_Abort(r.comm, kExitRuntime);
-  std::_Exit(kExitRuntime);
-}
-
 std::string file_stem(const std::string& path) {
   const size_t slash = path.find_last_of('/');
   std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
@@ -126,96 +108,6 @@ std::string output_options(const CliOptions& cli, const SceneDesc& scene, FrameW
   return "";
 }
 
-int run_frames(const Ranks& ranks, const CliOptions& cli, const SceneDesc& scene,
-               const FrameWriterOptions& out, bool per_rank, sph_context* context) {
-  DistributedMaker maker(static_cast<int32_t>(MPI_Comm_c2f(ranks.comm)), ranks.rank);
-  SceneRuntime runtime(scene, context, &maker);
-  ManifestHeader header;
-  header.scene = cli.scene;
-  header.fps = scene.fps;
-  header.frames = scene.frames;
-  // Rank 0 makes the output directory before the others make their folders in it.
-  std::unique_ptr<FrameWriter> merged, own_writer;
-  try {
-    if (ranks.rank == 0) merged = std::make_unique<FrameWriter>(out, runtime, header);
-  } catch (const std::exception& e) {
-    abort_run(ranks, e.what());
-  }
-  MPI_Barrier(ranks.comm);
-  try {
-    if (per_rank) {
-      FrameWriterOptions mine = out;
-      mine.directory = out.directory + "/rank" + std::to_string(ranks.rank);
-      mine.preview = false;
-      own_writer = std::make_unique<FrameWriter>(mine, runtime, header);
-    }
-  } catch (const std::exception& e) {
-    abort_run(ranks, e.what());
-  }
-  if (ranks.rank == 0 && !cli.quiet)
-    std::fprintf(stderr, "sph-run-mpi: %s: %u frames at %g fps on %d ranks (%s) -> %s/%s\n",
-                 cli.scene.c_str(), scene.frames, static_cast<double>(scene.fps), ranks.count,
-                 cli.backend == SPH_BACKEND_CUDA ? "CUDA" : "CPU", out.directory.c_str(),
-                 per_rank ? " (+ rank<R>/)" : "");
-  Progress progress(scene.frames, isatty(STDERR_FILENO) != 0, cli.quiet || ranks.rank != 0);
-  ParticleFrame own, all;
-  uint64_t substeps = 0;
-  const auto start = std::chrono::steady_clock::now();
-  for (uint32_t i = 0; i <= scene.frames; ++i) {
-    const auto t = std::chrono::steady_clock::now();
-    sph_stats s;
-    sph_stats_init(&s);
-    if (i > 0) {
-      if (runtime.step_frame() == SPH_INCOMPLETE && ranks.rank == 0)
-        progress.note("sph-run-mpi: warning: frame " + std::to_string(i) +
-                      ": max_substeps ran out before the frame's end (raise params.max_substeps or dt_min)");
-      sph_world_get_stats(runtime.world(), &s);
-      substeps += s.substeps;
-    }
-    const double step_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
-    const auto w = std::chrono::steady_clock::now();
-    read_particles(runtime.world(), i, runtime.time(), &own);
-    gather_frame(runtime.world(), ranks.comm, own, &all);
-    try {
-      if (merged) merged->write(runtime, all);
-      if (own_writer) own_writer->write(runtime, own);
-    } catch (const std::exception& e) {
-      abort_run(ranks, e.what());
-    }
-    const double output_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w).count();
-    if (i > 0) progress.frame_done(FrameReport{i, all.count, s.substeps, step_ms, output_ms});
-  }
-  progress.finish();
-  if (merged && out.preview) {
-    if (!ffmpeg_on_path()) {
-      if (!cli.quiet)
-        std::fprintf(stderr, "sph-run-mpi: no ffmpeg on PATH: no preview.mp4 (the PNGs are there)\n");
-    } else {
-      const std::string problem = merged->write_preview_video(scene.fps);
-      if (!problem.empty()) std::fprintf(stderr, "sph-run-mpi: warning: preview.mp4: %s\n", problem.c_str());
-    }
-  }
-  if (merged) merged->end("complete", scene.frames);
-  if (own_writer) own_writer->end("complete", scene.frames);
-  sph_mpi_counts counts;
-  sph_mpi_counts_init(&counts);
-  const sph_result r = sph_mpi_world_get_counts(runtime.world(), &counts);
-  if (r < 0) throw LibraryError(r, "reading the distributed world's counts");
-  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (ranks.rank == 0) {
-    std::printf(
-        "%s: %u frames on %d ranks (%u written to %s/): %llu particles, %llu substeps, %llu migrations, "
-        "%u rebalances, %.2f s\n",
-        cli.scene.c_str(), scene.frames, ranks.count, scene.frames + 1, out.directory.c_str(),
-        static_cast<unsigned long long>(counts.global_count), static_cast<unsigned long long>(substeps),
-        static_cast<unsigned long long>(counts.migrated), counts.rebalances, wall_s);
-    std::fflush(stdout);
-  }
-  return kExitOk;
-}
-
 int run(const Ranks& ranks, int argc, char** argv) {
   // --per-rank is sph-run-mpi's own; the rest is sph-run's command line.
   bool per_rank = false;
@@ -237,8 +129,6 @@ int run(const Ranks& ranks, int argc, char** argv) {
     if (ranks.rank == 0 && cli.version) std::printf("sph-run-mpi, %s\n", sph_get_build_info());
     return kExitOk;
   }
-  if (cli.stats_json)
-    return fail(ranks, kExitUsage, "--stats-json: not in sph-run-mpi yet (its summary line is on stdout)");
   SceneDesc scene;
   try {
     scene = load_scene_file(cli.scene);
@@ -246,8 +136,6 @@ int run(const Ranks& ranks, int argc, char** argv) {
     return fail(ranks, kExitScene, cli.scene + ": " + e.what());
   }
   if (cli.frames) scene.frames = *cli.frames;
-  const std::string refused = distributed_refusal(scene);
-  if (!refused.empty()) return fail(ranks, kExitScene, cli.scene + ": " + refused);
   FrameWriterOptions out;
   const std::string unavailable = output_options(cli, scene, &out);
   if (!unavailable.empty()) return fail(ranks, kExitUnavailable, unavailable);
@@ -270,7 +158,9 @@ int run(const Ranks& ranks, int argc, char** argv) {
   } catch (const SceneError& e) {
     return fail(ranks, kExitScene, cli.scene + ": " + e.what());
   } catch (const LibraryError& e) {
-    return fail(ranks, kExitRuntime, e.what());
+    // A feature the ranks' backend refuses (a CUDA rank's sinks or probes, at the first step,
+    // on every rank alike): a scene this program cannot run, as the world's own refusals are.
+    return fail(ranks, e.code() == SPH_ERROR_UNSUPPORTED ? kExitScene : kExitRuntime, e.what());
   }
 }
 

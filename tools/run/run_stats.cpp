@@ -57,7 +57,7 @@ void RunStats::print(std::FILE* out, const std::string& what, const std::string&
 }
 
 std::string RunStats::write_json(const std::string& path, const std::string& scene,
-                                 const std::string& backend, double wall_s) const {
+                                 const std::string& backend, double wall_s, const std::string& extra) const {
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (!f) return std::strerror(errno);
   static const char* kStages[SPH_STAGE_COUNT] = {"hash_sort", "cell_ranges", "density", "forces",
@@ -79,7 +79,7 @@ std::string RunStats::write_json(const std::string& path, const std::string& sce
                static_cast<unsigned long long>(last_.memory_bytes));
   for (int i = 0; i < SPH_STAGE_COUNT; ++i)
     std::fprintf(f, "\"%s\": %.6g%s", kStages[i], stage_ms_[i], i + 1 < SPH_STAGE_COUNT ? ", " : "");
-  std::fprintf(f, "}}\n");
+  std::fprintf(f, "}%s%s}\n", extra.empty() ? "" : ", ", extra.c_str());
   const bool failed = std::ferror(f) != 0;
   const int error = errno;
   if (std::fclose(f) != 0) return std::strerror(errno);

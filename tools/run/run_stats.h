@@ -24,10 +24,11 @@ class RunStats {
   // Prints the summary. `what` heads it ("dam_break.json: 120 frames").
   void print(std::FILE* out, const std::string& what, const std::string& backend, double wall_s) const;
   uint32_t frames() const { return frames_; }
+  uint64_t substeps() const { return substeps_; }
   // Writes the same figures as print() as one JSON object; returns "" or why the file could not
-  // be written.
+  // be written. `extra`: more members ("\"ranks\": 2"), written after sph-run's.
   std::string write_json(const std::string& path, const std::string& scene, const std::string& backend,
-                         double wall_s) const;
+                         double wall_s, const std::string& extra = "") const;
 
  private:
   uint32_t frames_ = 0;
