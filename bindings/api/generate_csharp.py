@@ -58,6 +58,10 @@ CS_KEYWORDS = {
 SYSTEM_TYPES = {"Action", "Activator", "Array", "Attribute", "Buffer", "Console", "Convert", "Delegate", "Enum",
                 "Environment", "Exception", "Func", "GC", "Guid", "Math", "Object", "Random", "Single",
                 "String", "Tuple", "Type", "Version", "TimeSpan", "DateTime", "Index", "Range", "Half"}
+# Libraries that hold the whole of sph_c.h and more, loaded in place of libsph, never beside it
+# (each keeps its own registry of worlds; bindings/python/sph/_loader.py's CORE_VARIANTS). The
+# bindings compiled with the define each names (-define:SPH_MPI) send every call to it.
+CORE_VARIANTS = {"sph_mpi": "SPH_MPI"}
 CONST_TYPES = {"int32": "int", "uint32": "uint", "int64": "long", "uint64": "ulong", "float": "float",
                "double": "double", "string": "string"}
 
@@ -366,12 +370,20 @@ class Gen:
                "#if (UNITY_IOS || UNITY_WEBGL) && !UNITY_EDITOR",
                "        public const string Library = \"__Internal\";"] + [
                f"        public const string Library{am.camel('sph_' + lib) if lib != 'sph' else ''} = \"__Internal\";"
-               for lib in self.libraries if lib != "sph"] + [
-               "#else",
-               "        public const string Library = \"sph\";"] + [
-               f"        public const string Library{am.camel('sph_' + lib)} = \"{lib}\";"
-               for lib in self.libraries if lib != "sph"] + [
-               "#endif", ""]
+               for lib in self.libraries if lib != "sph"]
+        for core, define in CORE_VARIANTS.items():
+            if core not in self.libraries:
+                continue
+            out += [f"#elif {define}",
+                    f"        // {define}: every function from lib{core}, which holds sph_c.h too (one registry).",
+                    f"        public const string Library = \"{core}\";"] + [
+                    f"        public const string Library{am.camel('sph_' + lib)} = \"{lib}\";"
+                    for lib in self.libraries if lib != "sph"]
+        out += ["#else",
+                "        public const string Library = \"sph\";"] + [
+                f"        public const string Library{am.camel('sph_' + lib)} = \"{lib}\";"
+                for lib in self.libraries if lib != "sph"] + [
+                "#endif", ""]
         for f in self.api["functions"]:
             ret = self.value_type(f["return"])
             doc = f["doc"] or f["name"]

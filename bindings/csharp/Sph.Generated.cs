@@ -2327,6 +2327,11 @@ namespace Sph
         public const string Library = "__Internal";
         public const string LibrarySphMpi = "__Internal";
         public const string LibrarySphVdb = "__Internal";
+#elif SPH_MPI
+        // SPH_MPI: every function from libsph_mpi, which holds sph_c.h too (one registry).
+        public const string Library = "sph_mpi";
+        public const string LibrarySphMpi = "sph_mpi";
+        public const string LibrarySphVdb = "sph_vdb";
 #else
         public const string Library = "sph";
         public const string LibrarySphMpi = "sph_mpi";

@@ -413,8 +413,9 @@ namespace Sph
         }
     }
 
-    /// <summary>A particle fluid on a context (sph_world). Not thread-safe: use one thread at a time.</summary>
-    public sealed class World : IDisposable
+    /// <summary>A particle fluid on a context (sph_world). Not thread-safe: use one thread at a time.
+    /// Not sealed for one subclass: DistributedWorld (SphMpi.cs), a world over MPI ranks.</summary>
+    public class World : IDisposable
     {
         public WorldHandle Handle { get; private set; }
         public Context Context { get; private set; }

@@ -5,41 +5,13 @@
 # Compiles the bindings into Sph.dll, the sample, the tests and README.md's snippet against it
 # (mcs, warnings as errors), then runs the snippet and the tests with mono. libsph.so must be
 # found by [DllImport("sph")]: LIBRARY_DIR is put first on LD_LIBRARY_PATH, else
-# LD_LIBRARY_PATH must name it. Relative paths (in the -D values and in LD_LIBRARY_PATH) are
-# taken from the folder cmake was started in (in -P mode, CMAKE_CURRENT_SOURCE_DIR): mcs and
-# mono run in WORK_DIR, where they would not resolve.
-foreach(var MCS MONO SOURCE_DIR WORK_DIR)
-  if(NOT DEFINED ${var})
-    message(FATAL_ERROR "run_tests.cmake: -D${var}=... is required")
-  endif()
-endforeach()
-foreach(var SOURCE_DIR WORK_DIR)
-  get_filename_component(${var} "${${var}}" ABSOLUTE)
-endforeach()
-set(_library_path "")
-if(DEFINED LIBRARY_DIR)
-  get_filename_component(LIBRARY_DIR "${LIBRARY_DIR}" ABSOLUTE)
-  list(APPEND _library_path "${LIBRARY_DIR}")
-endif()
-string(REPLACE ":" ";" _inherited "$ENV{LD_LIBRARY_PATH}")
-foreach(dir IN LISTS _inherited)
-  if(dir)
-    get_filename_component(dir "${dir}" ABSOLUTE)
-    list(APPEND _library_path "${dir}")
-  endif()
-endforeach()
-string(REPLACE ";" ":" _library_path "${_library_path}")
-set(ENV{LD_LIBRARY_PATH} "${_library_path}")
-file(MAKE_DIRECTORY "${WORK_DIR}")
+# LD_LIBRARY_PATH must name it (run_common.cmake; relative paths are taken from the folder cmake
+# was started in). Distributed worlds (SphMpi.cs) are compiled in and refused here: their tests,
+# on libsph_mpi, are run_mpi_tests.cmake's.
+include("${CMAKE_CURRENT_LIST_DIR}/run_common.cmake")
 
-function(sph_mcs)
-  execute_process(COMMAND "${MCS}" -nologo -warnaserror+ ${ARGN} WORKING_DIRECTORY "${WORK_DIR}" RESULT_VARIABLE rc)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "mcs ${ARGN} failed (${rc})")
-  endif()
-endfunction()
-
-sph_mcs(-target:library -doc:Sph.xml -nowarn:1591 -out:Sph.dll "${SOURCE_DIR}/Sph.Generated.cs" "${SOURCE_DIR}/Sph.cs")
+sph_mcs(-target:library -doc:Sph.xml -nowarn:1591 -out:Sph.dll "${SOURCE_DIR}/Sph.Generated.cs" "${SOURCE_DIR}/Sph.cs"
+        "${SOURCE_DIR}/SphMpi.cs")
 sph_mcs(-r:Sph.dll -out:Droplets.exe "${SOURCE_DIR}/samples/Droplets.cs")
 sph_mcs(-r:Sph.dll -out:SphTests.exe "${SOURCE_DIR}/tests/SphTests.cs")
 

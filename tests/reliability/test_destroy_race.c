@@ -13,130 +13,57 @@
  *    asset: every call answers OK or its not-live error, and a collider made in the race keeps
  *    the asset alive.
  *
+ * One round in kHeldEvery is held (destroy_race.h, handshake): the destroyer waits until an
+ * intruder holds the object, so that "destroy met a call in flight" is checked in every run,
+ * not left to the scheduler: a step begun and not yet collected (WORLD_LOCKED, then the step is
+ * collected OK), a world alive on the context (BUSY), a collider made before the SDF handle
+ * dies. The other rounds are free races: which interleavings they meet is printed, not asserted.
+ *
  * Under ThreadSanitizer (scripts/test, build-tsan/) and ASan (build-sanitize/) any data race or
  * use after free fails the run, so most of this test's force is there; in Release it checks
- * the results. Worker threads never call cmocka (its failure path longjmps): they record, the
- * main thread checks. Part of the hostile-input suite (ctest label `hostile`). */
+ * the results. Part of the hostile-input suite (ctest label `hostile`). */
 #include <pthread.h>
 #include <sched.h>
 #include <stdint.h>
-#include <stdio.h>
 #include <string.h>
 #include <time.h>
 
-#include "capi_test.h"
+#include "destroy_race.h"
 
 #ifdef SPH_TEST_TSAN_BUILD
 enum { kWorldRounds = 800, kContextRounds = 250, kSdfRounds = 800 };
 #else
 enum { kWorldRounds = 2000, kContextRounds = 500, kSdfRounds = 2000 };
 #endif
-enum { kParticles = 8, kIntruders = 4 };
-
-/* Results one thread saw, by kind. */
-typedef struct tally {
-  long ok, locked, invalid, busy, other;
-  sph_result first_other;
-  char first_other_message[200];
-} tally;
-
-static void tally_add(tally* t, sph_result r) {
-  if (r == SPH_OK || r == SPH_INCOMPLETE) {
-    ++t->ok;
-  } else if (r == SPH_ERROR_WORLD_LOCKED) {
-    ++t->locked;
-  } else if (r == SPH_ERROR_INVALID_HANDLE) {
-    ++t->invalid;
-  } else if (r == SPH_ERROR_BUSY) {
-    ++t->busy;
-  } else if (t->other++ == 0) {
-    t->first_other = r;
-    snprintf(t->first_other_message, sizeof t->first_other_message, "%s", sph_get_last_error());
-  }
-}
-
-static void tally_merge(tally* into, const tally* t) {
-  if (t->other != 0 && into->other == 0) {
-    into->first_other = t->first_other;
-    memcpy(into->first_other_message, t->first_other_message, sizeof into->first_other_message);
-  }
-  into->ok += t->ok;
-  into->locked += t->locked;
-  into->invalid += t->invalid;
-  into->busy += t->busy;
-  into->other += t->other;
-}
-
-static void expect_no_other(const char* who, const tally* t) {
-  if (t->other != 0)
-    fail_msg("%s: %ld calls answered something else than expected; first: %s (%s)", who, t->other,
-             sph_result_string(t->first_other), t->first_other_message);
-}
-
-static sph_context* create_context(void) {
-  sph_context_def def;
-  sph_context* context = NULL;
-  EXPECT_OK(sph_test_context_def_init(&def));
-  def.cpu_worker_count = 1; /* the race is between API calls, not inside a step */
-  EXPECT_OK(sph_context_create(&def, &context));
-  return context;
-}
-
-static sph_world* create_world(sph_context* context) {
-  sph_world_def def;
-  sph_spawn_desc spawn;
-  sph_world* world = NULL;
-  float positions[3 * kParticles];
-  sph_world_def_init(&def);
-  def.capacity = 64;
-  if (sph_world_create(context, &def, &world) != SPH_OK) return NULL;
-  for (int i = 0; i < kParticles; ++i) {
-    positions[3 * i + 0] = 0.02f * (float)(i % 2);
-    positions[3 * i + 1] = 0.02f * (float)((i / 2) % 2);
-    positions[3 * i + 2] = 0.02f * (float)(i / 4);
-  }
-  sph_spawn_desc_init(&spawn);
-  spawn.count = kParticles;
-  spawn.positions = positions;
-  if (sph_world_spawn(world, &spawn, NULL) != SPH_OK) {
-    sph_world_destroy(world);
-    return NULL;
-  }
-  return world;
-}
-
-/* Gaps between an intruder's calls, so the destroyer finds the object free now and then; wider
- * ones once it starved (threads calling back to back can hold an object for seconds on 2 busy
- * cores). `slow` is read relaxed: the flag must not order the intruders' calls after the
- * destroyer's (that would hide from ThreadSanitizer the very race under test). */
-static void pause_between_calls(int* slow) {
-  if (slow && __atomic_load_n(slow, __ATOMIC_RELAXED)) {
-    struct timespec pause = {0, 100000};
-    nanosleep(&pause, NULL);
-  } else {
-    sched_yield();
-  }
-}
+enum { kIntruders = 4 };
 
 /* ---- 1. world destroy against calls on the world -------------------------------------------- */
 typedef struct world_intruder {
   sph_world* world;
   int kind;
   int* slow;        /* set (relaxed) by the destroyer when it keeps finding the world busy */
+  handshake* hold;  /* a held round's stepping intruder: begins a step and posts */
   volatile int* go; /* guarded by go_mutex */
   pthread_mutex_t* go_mutex;
   tally seen;
+  sph_result held_step; /* what sph_world_step_wait returned for the held step */
 } world_intruder;
 
-static int wait_go(pthread_mutex_t* mutex, volatile int* go) {
+/* Until sph_world_step_wait collects it, a begun step holds the world (sph_c.h), running or
+ * not: a destroy meanwhile must answer WORLD_LOCKED, on any backend. */
+static void hold_world_in_a_step(world_intruder* in) {
+  sph_result r;
   for (;;) {
-    int v;
-    pthread_mutex_lock(mutex);
-    v = *go;
-    pthread_mutex_unlock(mutex);
-    if (v) return v;
-    sched_yield();
+    r = sph_world_step_begin(in->world, 1.0f / 600.0f);
+    tally_add(&in->seen, r);
+    if (r != SPH_ERROR_WORLD_LOCKED) break; /* another intruder's call is inside */
+    pause_between_calls(in->slow);
   }
+  handshake_post(in->hold, r);
+  if (r != SPH_OK) return;
+  handshake_wait_answer(in->hold);
+  in->held_step = sph_world_step_wait(in->world);
+  tally_add(&in->seen, in->held_step);
 }
 
 /* Calls into the world until it is gone (INVALID_HANDLE), then stops: the next round's world
@@ -145,6 +72,7 @@ static void* world_intruder_thread(void* arg) {
   world_intruder* in = (world_intruder*)arg;
   static __thread float scratch[3 * 64];
   wait_go(in->go_mutex, in->go);
+  if (in->hold) hold_world_in_a_step(in);
   for (;;) {
     sph_result r;
     switch (in->kind) {
@@ -174,17 +102,27 @@ static void* world_intruder_thread(void* arg) {
   }
 }
 
+/* One destroy, tallied; nonzero once it answered anything but WORLD_LOCKED (OK, or what the
+ * tally counts as "other"). */
+static int try_destroy_world(sph_world* world, tally* destroys) {
+  const sph_result r = sph_world_destroy(world);
+  tally_add(destroys, r);
+  return r != SPH_ERROR_WORLD_LOCKED;
+}
+
 static void test_world_destroy_races_calls(void** state) {
   sph_context* context = create_context();
   tally intruders = {0}, destroys = {0};
-  long rounds_with_locked_destroy = 0, rounds_with_call_before_destroy = 0;
+  long free_rounds_locked = 0, free_rounds_with_call = 0, held_refused = 0, held_collected = 0;
   (void)state;
   for (int round = 0; round < kWorldRounds; ++round) {
     world_intruder in[kIntruders];
     pthread_t threads[kIntruders];
     pthread_mutex_t go_mutex;
+    handshake hold = {SPH_OK, 0, 0};
     volatile int go = 0;
-    int slow = 0;
+    int slow = 0, gone = 0;
+    const int held = held_round(round);
     long locked_before = destroys.locked, ok_before = intruders.ok;
     sph_world* world = create_world(context);
     if (!world) fail_msg("round %d: creating the world: %s", round, sph_get_last_error());
@@ -194,6 +132,8 @@ static void test_world_destroy_races_calls(void** state) {
       in[i].world = world;
       in[i].kind = (i + round) % kIntruders;
       in[i].slow = &slow;
+      in[i].hold = held && in[i].kind == 0 ? &hold : NULL;
+      in[i].held_step = SPH_OK;
       in[i].go = &go;
       in[i].go_mutex = &go_mutex;
       assert_int_equal(pthread_create(&threads[i], NULL, world_intruder_thread, &in[i]), 0);
@@ -201,37 +141,44 @@ static void test_world_destroy_races_calls(void** state) {
     pthread_mutex_lock(&go_mutex);
     go = 1;
     pthread_mutex_unlock(&go_mutex);
-    /* A varying head start, so destroy meets the intruders at every point of their calls. */
-    for (int spin = 0; spin < round % 7; ++spin) sched_yield();
-    for (;;) {
-      const sph_result r = sph_world_destroy(world);
-      tally_add(&destroys, r);
-      if (r == SPH_OK) break;
-      if (r != SPH_ERROR_WORLD_LOCKED) break; /* counted as "other" above */
+    if (held) {
+      const sph_result begun = handshake_wait_post(&hold);
+      gone = try_destroy_world(world, &destroys);
+      if (begun == SPH_OK && destroys.locked > locked_before) ++held_refused;
+      handshake_answer(&hold);
+    } else {
+      /* A varying head start, so destroy meets the intruders at every point of their calls. */
+      for (int spin = 0; spin < round % 7; ++spin) sched_yield();
+    }
+    while (!gone) {
+      gone = try_destroy_world(world, &destroys);
       if (destroys.locked - locked_before == 100) __atomic_store_n(&slow, 1, __ATOMIC_RELAXED);
-      sched_yield();
+      if (!gone) sched_yield();
     }
     for (int i = 0; i < kIntruders; ++i) {
       assert_int_equal(pthread_join(threads[i], NULL), 0);
       tally_merge(&intruders, &in[i].seen);
+      if (in[i].hold && in[i].held_step == SPH_OK) ++held_collected;
     }
     pthread_mutex_destroy(&go_mutex);
-    if (destroys.locked > locked_before) ++rounds_with_locked_destroy;
-    if (intruders.ok > ok_before) ++rounds_with_call_before_destroy;
+    if (!held && destroys.locked > locked_before) ++free_rounds_locked;
+    if (!held && intruders.ok > ok_before) ++free_rounds_with_call;
     expect_no_other("destroy", &destroys);
   }
   print_message(
-      "world: %d rounds; destroy: %ld WORLD_LOCKED (in %ld rounds); intruders: %ld ok, %ld "
-      "WORLD_LOCKED, %ld INVALID_HANDLE (calls before destroy in %ld rounds)\n",
-      kWorldRounds, destroys.locked, rounds_with_locked_destroy, intruders.ok, intruders.locked,
-      intruders.invalid, rounds_with_call_before_destroy);
+      "world: %d rounds (%ld held: destroy refused %ld times, the step collected OK %ld times); free "
+      "rounds: destroy found a call inside in %ld, calls got in first in %ld; in all: destroy %ld "
+      "WORLD_LOCKED, intruders %ld ok, %ld WORLD_LOCKED, %ld INVALID_HANDLE\n",
+      kWorldRounds, held_rounds(kWorldRounds), held_refused, held_collected, free_rounds_locked,
+      free_rounds_with_call, destroys.locked, intruders.ok, intruders.locked, intruders.invalid);
   expect_no_other("intruders", &intruders);
   assert_int_equal(destroys.ok, kWorldRounds);
   /* Each intruder ends on INVALID_HANDLE, once per round. */
   assert_int_equal(intruders.invalid, (long)kWorldRounds * kIntruders);
-  /* The race was real: destroy found a call inside the world, and calls got in before it. */
-  assert_true(rounds_with_locked_destroy > 0);
-  assert_true(rounds_with_call_before_destroy > 0);
+  /* Every held round: destroy met the begun step and was refused, and the step, collected
+   * afterwards, ran as if nothing had happened. */
+  assert_int_equal(held_refused, held_rounds(kWorldRounds));
+  assert_int_equal(held_collected, held_rounds(kWorldRounds));
   EXPECT_OK(sph_context_destroy(context));
 }
 
@@ -239,7 +186,8 @@ static void test_world_destroy_races_calls(void** state) {
 typedef struct context_intruder {
   sph_context* context;
   int* slow;
-  int started; /* set just before the first sph_world_create */
+  int started;     /* set just before the first sph_world_create */
+  handshake* hold; /* a held round: posts with its first world alive, destroys it once answered */
   volatile int* go;
   pthread_mutex_t* go_mutex;
   tally creates, destroys;
@@ -256,6 +204,11 @@ static void* context_intruder_thread(void* arg) {
     sph_world* world = NULL;
     const sph_result r = sph_world_create(in->context, &def, &world);
     tally_add(&in->creates, r);
+    if (in->hold) {
+      handshake_post(in->hold, r);
+      if (r == SPH_OK) handshake_wait_answer(in->hold);
+      in->hold = NULL;
+    }
     if (r != SPH_OK) return NULL;
     if (in->creates.ok % 2 == 0) sched_yield(); /* a world alive meanwhile: destroy must say BUSY */
     tally_add(&in->destroys, sph_world_destroy(world));
@@ -270,32 +223,44 @@ static void* context_intruder_thread(void* arg) {
 
 static void test_context_destroy_races_world_create(void** state) {
   tally creates = {0}, world_destroys = {0}, context_destroys = {0};
+  long held_busy = 0;
   (void)state;
   for (int round = 0; round < kContextRounds; ++round) {
     context_intruder in;
     pthread_t thread;
     pthread_mutex_t go_mutex;
+    handshake hold = {SPH_OK, 0, 0};
     volatile int go = 0;
     int slow = 0;
+    sph_result r = SPH_ERROR_BUSY;
     long busy_before = context_destroys.busy;
     sph_context* context = create_context();
     assert_int_equal(pthread_mutex_init(&go_mutex, NULL), 0);
     memset(&in, 0, sizeof in);
     in.context = context;
     in.slow = &slow;
+    in.hold = held_round(round) ? &hold : NULL;
     in.go = &go;
     in.go_mutex = &go_mutex;
     assert_int_equal(pthread_create(&thread, NULL, context_intruder_thread, &in), 0);
     pthread_mutex_lock(&go_mutex);
     go = 1;
     pthread_mutex_unlock(&go_mutex);
-    /* Wait until the creator is about to create: where thread start-up is slower than a few
-     * yields (CUDA's context), the destroyer otherwise always came first and the race was never
-     * run (0 BUSY, 0 worlds in 500 rounds on an H200 host). */
-    while (!__atomic_load_n(&in.started, __ATOMIC_ACQUIRE)) sched_yield();
-    for (int spin = 0; spin < round % 5; ++spin) sched_yield();
-    for (;;) {
-      const sph_result r = sph_context_destroy(context);
+    if (held_round(round)) {
+      const sph_result created = handshake_wait_post(&hold);
+      r = sph_context_destroy(context);
+      tally_add(&context_destroys, r);
+      if (created == SPH_OK && r == SPH_ERROR_BUSY) ++held_busy;
+      handshake_answer(&hold);
+    } else {
+      /* Wait until the creator is about to create: where thread start-up is slower than a few
+       * yields (CUDA's context), the destroyer otherwise always came first and the race was
+       * never run (0 BUSY, 0 worlds in 500 rounds on an H200 host). */
+      while (!__atomic_load_n(&in.started, __ATOMIC_ACQUIRE)) sched_yield();
+      for (int spin = 0; spin < round % 5; ++spin) sched_yield();
+    }
+    while (r == SPH_ERROR_BUSY) {
+      r = sph_context_destroy(context);
       tally_add(&context_destroys, r);
       if (r != SPH_ERROR_BUSY) break;
       if (context_destroys.busy - busy_before == 10) __atomic_store_n(&slow, 1, __ATOMIC_RELAXED);
@@ -306,15 +271,19 @@ static void test_context_destroy_races_world_create(void** state) {
     tally_merge(&creates, &in.creates);
     tally_merge(&world_destroys, &in.destroys);
   }
-  print_message("context: %d rounds; context destroy: %ld BUSY; world create: %ld ok, %ld INVALID_HANDLE\n",
-                kContextRounds, context_destroys.busy, creates.ok, creates.invalid);
+  print_message(
+      "context: %d rounds (%ld held: BUSY %ld times); context destroy: %ld BUSY; world create: %ld ok, %ld "
+      "INVALID_HANDLE\n",
+      kContextRounds, held_rounds(kContextRounds), held_busy, context_destroys.busy, creates.ok,
+      creates.invalid);
   expect_no_other("context destroy", &context_destroys);
   expect_no_other("world create", &creates);
   expect_no_other("world destroy", &world_destroys);
   assert_int_equal(context_destroys.ok, kContextRounds);
   assert_int_equal(creates.invalid, kContextRounds); /* the creator stops on its first failure */
   assert_int_equal(world_destroys.ok, creates.ok);   /* every world made was destroyed */
-  assert_true(context_destroys.busy > 0);            /* destroy met a creation in flight */
+  /* Every held round: destroy met a world alive on the context. */
+  assert_int_equal(held_busy, held_rounds(kContextRounds));
 }
 
 /* ---- 3. SDF destroy against calls that use the asset ------------------------------------------ */
@@ -322,6 +291,7 @@ typedef struct sdf_intruder {
   sph_sdf* sdf;
   sph_world* world; /* kind 2 makes colliders on it */
   int kind;
+  handshake* hold; /* a held round's collider maker: posts after its first collider */
   volatile int* go;
   pthread_mutex_t* go_mutex;
   tally seen;
@@ -352,6 +322,10 @@ static void* sdf_intruder_thread(void* arg) {
       def.sdf = in->sdf;
       r = sph_collider_create(in->world, &def, &id);
       if (r == SPH_OK) ++in->colliders;
+      if (in->hold) {
+        handshake_post(in->hold, r);
+        in->hold = NULL;
+      }
     } else {
       uint32_t dims[3] = {0, 0, 0};
       r = sph_sdf_get_dims(in->sdf, dims);
@@ -367,7 +341,7 @@ static void test_sdf_destroy_races_users(void** state) {
   sph_context* context = create_context();
   sph_world* world = create_world(context);
   tally seen = {0};
-  long colliders = 0, users_started = 0;
+  long colliders = 0, users_started = 0, held_colliders = 0;
   sph_shape_desc shape;
   (void)state;
   assert_non_null(world);
@@ -382,6 +356,7 @@ static void test_sdf_destroy_races_users(void** state) {
     sdf_intruder in[3];
     pthread_t threads[3];
     pthread_mutex_t go_mutex;
+    handshake hold = {SPH_OK, 0, 0};
     volatile int go = 0;
     sph_sdf* sdf = NULL;
     EXPECT_OK(sph_sdf_create_shape(context, &shape, &sdf));
@@ -391,6 +366,7 @@ static void test_sdf_destroy_races_users(void** state) {
       in[i].sdf = sdf;
       in[i].world = world;
       in[i].kind = round_kinds[i];
+      in[i].hold = held_round(round) && round_kinds[i] == 2 ? &hold : NULL;
       in[i].go = &go;
       in[i].go_mutex = &go_mutex;
       assert_int_equal(pthread_create(&threads[i], NULL, sdf_intruder_thread, &in[i]), 0);
@@ -399,7 +375,11 @@ static void test_sdf_destroy_races_users(void** state) {
     pthread_mutex_lock(&go_mutex);
     go = 1;
     pthread_mutex_unlock(&go_mutex);
-    for (int spin = 0; spin < round % 7; ++spin) sched_yield();
+    if (held_round(round)) {
+      if (handshake_wait_post(&hold) == SPH_OK) ++held_colliders;
+    } else {
+      for (int spin = 0; spin < round % 7; ++spin) sched_yield();
+    }
     EXPECT_OK(sph_sdf_destroy(sdf));
     for (int i = 0; i < users; ++i) {
       assert_int_equal(pthread_join(threads[i], NULL), 0);
@@ -414,11 +394,13 @@ static void test_sdf_destroy_races_users(void** state) {
       assert_non_null(world);
     }
   }
-  print_message("sdf: %d rounds; users: %ld ok (%ld colliders), %ld INVALID_HANDLE; world locked %ld\n",
-                kSdfRounds, seen.ok, colliders, seen.invalid, seen.locked);
+  print_message(
+      "sdf: %d rounds (%ld held: a collider made first %ld times); users: %ld ok (%ld colliders), %ld "
+      "INVALID_HANDLE; world locked %ld\n",
+      kSdfRounds, held_rounds(kSdfRounds), held_colliders, seen.ok, colliders, seen.invalid, seen.locked);
   expect_no_other("sdf users", &seen);
   assert_int_equal(seen.invalid, users_started); /* each user ends on INVALID_HANDLE */
-  assert_true(colliders > 0);
+  assert_int_equal(held_colliders, held_rounds(kSdfRounds));
   EXPECT_OK(sph_world_step(world, 1.0f / 600.0f)); /* colliders whose handle died still work */
   EXPECT_OK(sph_world_destroy(world));
   EXPECT_OK(sph_context_destroy(context));

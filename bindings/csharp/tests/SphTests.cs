@@ -1210,24 +1210,48 @@ static class Tests
         }
     }
 
+    /// Built without -define:SPH_MPI, every call goes to libsph: a distributed world refuses to
+    /// start, saying why (tests/SphMpiTests.cs runs them on libsph_mpi). Through reflection: the
+    /// Unity package's Sph.dll, which these tests also run on, has no SphMpi.cs.
+    public static void TestDistributedWorldsNeedTheSphMpiBuild()
+    {
+        Type distributed = typeof(World).Assembly.GetType("Sph.DistributedWorld");
+        if (distributed == null) return;
+        AssertEqual(false, (bool)distributed.GetProperty("Available").GetValue(null, null), "DistributedWorld.Available");
+        using (var ctx = Cpu())
+        {
+            uint live = Library.LiveObjectCount;
+            try
+            {
+                Activator.CreateInstance(distributed, ctx, 0, SmallWorld());
+                throw new Exception("a DistributedWorld was made on libsph");
+            }
+            catch (TargetInvocationException e)
+            {
+                var refused = e.InnerException as SphException;
+                Assert(refused != null && refused.Result == Result.ErrorUnsupported, "refused: " + e.InnerException);
+                Assert(refused.LibraryMessage.Contains("SPH_MPI"), "the message names SPH_MPI: " + refused.LibraryMessage);
+            }
+            AssertEqual(live, Library.LiveObjectCount, "no world was made");
+        }
+    }
+
     public static void TestEveryFunctionIsWrapped()
     {
-        string wrapper = File.ReadAllText(Path.Combine(SourceDir, "Sph.cs"));
+        string wrapper = File.ReadAllText(Path.Combine(SourceDir, "Sph.cs")) +
+                         File.ReadAllText(Path.Combine(SourceDir, "SphMpi.cs"));
         string generated = File.ReadAllText(Path.Combine(SourceDir, "Sph.Generated.cs"));
         var missing = new System.Collections.Generic.List<string>();
         for (int i = 0; i < Layout.Functions.Length; ++i)
         {
             string fn = Layout.Functions[i];
-            // sph_mpi.h (libsph_mpi, loaded instead of libsph) is bound in Python only (sph.mpi,
-            // with mpi4py's communicators); C# has its declarations but no wrapper yet.
-            if (Layout.FunctionLibraries[i] == "sph_mpi") continue;
             bool used = wrapper.Contains("Native." + fn + "(") ||
                         (fn.EndsWith("_init_sized") && generated.Contains("SphException.Check(Native." + fn + "(")) ||
                         (fn.EndsWith("_destroy") && generated.Contains("Native." + fn + "(handle)")) ||
                         generated.Contains("return Native." + fn + "();");  // a struct's Default()
             if (!used) missing.Add(fn);
         }
-        Assert(missing.Count == 0, "not wrapped in Sph.cs: " + string.Join(", ", missing.ToArray()));
+        Assert(missing.Count == 0, "not wrapped in Sph.cs or SphMpi.cs: " + string.Join(", ", missing.ToArray()));
     }
 
     // ---- runner -----------------------------------------------------------------------------
