@@ -67,7 +67,7 @@ __global__ void __launch_bounds__(kDfsphCheckBlock) cg_first_check_kernel(CgSolv
   dfsph_take_largest(state);
   state->cg_restart = 1;
   state->cg_skip = 0;
-  dfsph_continue_solve(state, state->pressure_tally, dfsph_density_bounds(c), Dfsph::kMinIterations,
+  dfsph_continue_solve(state, state->pressure_tally, dfsph_cg_bounds(c), Dfsph::kMinIterations,
                        c.max_iterations, s.cond);
 }
 
@@ -100,7 +100,7 @@ __global__ void __launch_bounds__(kDfsphCheckBlock) cg_restart_check_kernel(CgSo
   state->cg_sz = sz;
   state->cg_restart = 0;
   if (sz == 0.0 && state->solve_iterations >= Dfsph::kMinIterations)
-    dfsph_stop_solve(state, state->pressure_tally, dfsph_density_bounds(s.fluid.methods.dfsph), s.cond);
+    dfsph_stop_solve(state, state->pressure_tally, dfsph_cg_bounds(s.fluid.methods.dfsph), s.cond);
 }
 
 // The operator on p, first half: the velocities p would give (a binding contact's normal part
@@ -227,7 +227,7 @@ __global__ void __launch_bounds__(kDfsphCheckBlock) cg_error_check_kernel(CgSolv
       state->cg_skip = 1;
     }
   }
-  dfsph_continue_solve(state, state->pressure_tally, dfsph_density_bounds(c), Dfsph::kMinIterations,
+  dfsph_continue_solve(state, state->pressure_tally, dfsph_cg_bounds(c), Dfsph::kMinIterations,
                        c.max_iterations, s.cond);
 }
 
