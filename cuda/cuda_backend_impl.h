@@ -198,9 +198,16 @@ class CudaBackend final : public Backend {
   void halo_after_sort(cudaStream_t stream);     // ghost mask, new keys, the lists of the records
   void halo_after_density(cudaStream_t stream);  // the ghosts take their owners' density records
   void halo_after_normals(cudaStream_t stream);  // and their colour normals (surface tension)
-  // The ghosts take their owners' records (DeviceHalo::pack_records / enqueue_apply_records).
+  // DFSPH (core/dfsph_jacobi_loop.h says when): the ghosts take their owners' densities and
+  // factors, a solve's velocities v, its pressure steps k; the solve's mean error over the world.
+  void halo_after_dfsph_density(cudaStream_t stream);
+  void halo_share_velocities(Float4* v, cudaStream_t stream);
+  void halo_share_dfsph_steps(cudaStream_t stream);
+  float halo_dfsph_mean_error(cudaStream_t stream);
+  // The ghosts take their owners' records (DeviceHalo::pack_records / enqueue_apply_records) of
+  // the arrays `a` (the store's, or a view of them).
   template <class Record>
-  void halo_refresh(cudaStream_t stream, const char* what);
+  void halo_refresh(cudaStream_t stream, const char* what, const ParticleArrays& a);
   void halo_before_end(cudaStream_t stream);  // maxima and failures reduced over the ranks
   void halo_sum_loads(ColliderLoadSums* sums, uint32_t colliders);  // the frame's loads over the ranks
   void halo_drop_ghosts();                    // the owned particles, in the sorted order

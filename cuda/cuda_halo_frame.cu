@@ -52,6 +52,11 @@ class CudaBackend::HaloHooks final : public SubstepHooks {
   void after_density(cudaStream_t stream) override { b_.halo_after_density(stream); }
   void after_normals(cudaStream_t stream) override { b_.halo_after_normals(stream); }
   void before_end(cudaStream_t stream) override { b_.halo_before_end(stream); }
+  void after_dfsph_density(cudaStream_t stream) override { b_.halo_after_dfsph_density(stream); }
+  void share_velocities(Float4* v, cudaStream_t stream) override { b_.halo_share_velocities(v, stream); }
+  void share_steps(cudaStream_t stream) override { b_.halo_share_dfsph_steps(stream); }
+  unsigned long long* error_bins() override { return b_.r_->halo->error_bins(); }
+  float mean_error(cudaStream_t stream) override { return b_.halo_dfsph_mean_error(stream); }
 
  private:
   CudaBackend& b_;
@@ -99,7 +104,8 @@ void CudaBackend::halo_before_end(cudaStream_t stream) {
   if (*mismatch != 0) {
     cuda_check(cudaMemsetAsync(h.mismatch_flag(), 0, sizeof(uint32_t), stream), "halo id check reset");
     throw Error(Status::Internal,
-                "halo: a rank's density records or colour normals came in another order than its ghosts");
+                "halo: a rank's records (densities, colour normals, DFSPH's velocities or steps) came in "
+                "another order than its ghosts");
   }
   const FrameState& f = *out;
   int64_t bad =

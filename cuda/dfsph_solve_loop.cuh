@@ -11,6 +11,7 @@
 
 #include <cuda_runtime.h>
 
+#include "../src/core/dfsph_jacobi_loop.h"
 #include "../src/core/host_memory.h"
 #include "../src/core/solver_record.h"
 #include "cuda_status.h"
@@ -64,14 +65,13 @@ __device__ inline void dfsph_stop_solve(FrameState* state, SolveTally& tally, fl
   if (cond.in_graph) cudaGraphSetConditional(cond.handle, 0u);
 }
 
-// The loop's test after an iteration (or the initial residual), as the CPU backend's: on while the
-// error is above the bound or the minimum has not run, and below the cap. One thread.
+// The loop's test after an iteration (or the initial residual), the rule the host-driven loops
+// share (core/dfsph_jacobi_loop.h). One thread.
 __device__ inline void dfsph_continue_solve(FrameState* state, SolveTally& tally, float bound,
                                             uint32_t min_iterations, uint32_t max_iterations,
                                             LoopCondition cond) {
-  const uint32_t iterations = state->solve_iterations;
   const bool more =
-      (state->solve_error > bound || iterations < min_iterations) && iterations < max_iterations;
+      dfsph_solve_goes_on(state->solve_error, state->solve_iterations, bound, min_iterations, max_iterations);
   if (!more) {
     dfsph_stop_solve(state, tally, bound, cond);
     return;

@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "../core/dfsph_jacobi_loop.h"
 #include "../core/exact_float_sum.h"
 #include "cpu_backend_impl.h"
 
@@ -67,11 +68,10 @@ void CpuBackend::dfsph_correct(const FluidConstants& fluid, const DfsphWalls& wa
     columns_.set_velocity(i, vi);
     carried[i] += k[i] * carry_scale;
   });
-  if (ranks_) halo_share_velocities(v);  // the next rate pass reads the ghosts' velocities
 }
 
-float CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls,
-                                  float dt) {
+void CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls,
+                                 float dt) {
   const GridView view = grid_.view();
   const NeighborColumns columns = columns_.view();
   const float* factor = dfsph_factor_.data();
@@ -91,14 +91,17 @@ float CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, 
     k[i] = r.k;
     error[i] = r.error;
   });
+}
+
+float CpuBackend::dfsph_mean_error() {
   // Exact, so the mean is the same bits whichever particles a rank holds (exact_float_sum.h).
+  const float* error = dfsph_residual_.data();
   ExactFloatSum sum;
   for (uint32_t i = 0; i < count_; ++i)
     if (!ghost(i)) sum.add(error[i]);
   int64_t particles = count_;
   if (ranks_) {
-    halo_share_dfsph_step();  // the next velocity update reads the ghosts' k
-    halo_agree();             // (the share's buffers: a rank that failed there meets the others here)
+    halo_agree();  // (the shares' buffers: a rank that failed there meets the others here)
     ranks_->all_sum(sum.terms(), ExactFloatSum::kTerms);
     particles = halo_world_count_;
   }
@@ -122,15 +125,29 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
     k[i] = Dfsph::kWarmStart * carried[i] / carry_scale;
     carried[i] = 0.0f;
   });
-  dfsph_correct(fluid, walls, dt, v, carried, carry_scale);
-  float error = dfsph_residuals(kind, fluid, walls, dt);
-  uint32_t iterations = 0;
-  while ((error > bound || iterations < min_iterations) && iterations < max_iterations) {
-    dfsph_correct(fluid, walls, dt, v, carried, carry_scale);
-    error = dfsph_residuals(kind, fluid, walls, dt);
-    ++iterations;
-  }
-  return SolveOutcome{iterations, error, error > bound};
+  // The loop and, on a rank, the ghosts' refreshes between its passes (core/dfsph_jacobi_loop.h).
+  struct Passes {
+    CpuBackend& b;
+    DfsphSolve kind;
+    const FluidConstants& fluid;
+    const DfsphWalls& walls;
+    float dt;
+    Float4* v;
+    float* carried;
+    float carry_scale;
+    void velocity_update(bool) { b.dfsph_correct(fluid, walls, dt, v, carried, carry_scale); }
+    void share_velocities() {
+      if (b.ranks_) b.halo_share_velocities(v);
+    }
+    void rates() { b.dfsph_residuals(kind, fluid, walls, dt); }
+    void share_steps() {
+      if (b.ranks_) b.halo_share_dfsph_step();
+    }
+    float mean_error() { return b.dfsph_mean_error(); }
+    void checked(uint32_t, float, bool) {}
+  } passes{*this, kind, fluid, walls, dt, v, carried, carry_scale};
+  const DfsphLoopOutcome o = run_dfsph_jacobi(passes, bound, min_iterations, max_iterations);
+  return SolveOutcome{o.iterations, o.error, o.capped};
 }
 
 uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame& scene,

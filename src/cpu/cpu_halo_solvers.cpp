@@ -3,8 +3,9 @@
 //   DFSPH      after its density pass the ghosts take their owners' density, factor and neighbour
 //              count; inside each solve iteration, their velocities after each velocity update
 //              and their pressure steps k after each rate pass (the next pass reads both of its
-//              neighbours); the solve's mean error is an exact sum whose bins are added over
-//              the ranks (cpu_dfsph_solver.cpp): every rank runs the undivided world's iterations;
+//              neighbours; core/dfsph_jacobi_loop.h, the loop the CUDA rank runs too); the
+//              solve's mean error is an exact sum whose bins are added over the ranks
+//              (cpu_dfsph_solver.cpp): every rank runs the undivided world's iterations;
 //   probes     each sample point is gathered by the rank whose slab holds its cell layer (its
 //              neighbour cells are complete there, in the undivided world's order) and every
 //              rank takes that rank's sums: each rank reads the world's bits;
@@ -13,17 +14,14 @@
 #include <string>
 
 #include "../core/grid_layout.h"
+#include "../core/halo_records.h"
 #include "../core/rank_sums.h"
 #include "cpu_halo_share.h"
 
 namespace sph {
 
 void CpuBackend::halo_share_dfsph_density() {
-  struct Record {
-    uint32_t id;
-    float density, factor, inv_density;
-    uint32_t neighbors;
-  };
+  using Record = HaloDfsphDensityRecord;
   float* factor = dfsph_factor_.data();
   halo_share<Record>(
       "DFSPH densities",
@@ -41,13 +39,7 @@ void CpuBackend::halo_share_dfsph_density() {
 }
 
 void CpuBackend::halo_share_velocities(Float4* v) {
-  // The padding is a member, zeroed (as the colour normals' record, cpu_halo.cpp).
-  struct Record {
-    uint32_t id;
-    uint32_t padding[3];
-    Float4 velocity;
-  };
-  static_assert(sizeof(Record) == 32, "a velocity's record has no implicit padding");
+  using Record = HaloVelocityRecord;  // (its padding a member, zeroed)
   halo_share<Record>(
       "DFSPH velocities",
       [&](uint32_t i) {
@@ -60,10 +52,7 @@ void CpuBackend::halo_share_velocities(Float4* v) {
 }
 
 void CpuBackend::halo_share_dfsph_step() {
-  struct Record {
-    uint32_t id;
-    float k;
-  };
+  using Record = HaloDfsphStepRecord;
   float* k = columns_.dfsph_step();
   halo_share<Record>(
       "DFSPH pressure steps",

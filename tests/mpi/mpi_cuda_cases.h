@@ -1,0 +1,15 @@
+/* SPDX-License-Identifier: MIT */
+/* The CUDA rank's DFSPH and conjugate-gradients refusal cases of gpu_check_mpi
+ * (tests/mpi/test_mpi_cuda.c runs them; test_mpi_cuda_cases.c says what each checks). */
+#pragma once
+
+#include <stdint.h>
+
+#include "sph_c.h"
+
+/* DFSPH's Jacobi solves on the distributed CUDA world against the undivided one (stir 0: the dam
+ * break); divergence_solve 0 skips the divergence solve. */
+void mpi_cuda_dfsph_case(const char* name, sph_context* cuda, sph_context* cpu, float stir,
+                         uint32_t divergence_solve);
+/* SPH_DFSPH_CONJUGATE_GRADIENTS refused on a distributed CUDA world. */
+void mpi_cuda_expect_cg_refused(sph_context* cuda);

@@ -1,0 +1,132 @@
+/* SPDX-License-Identifier: MIT */
+/* gpu_check_mpi's DFSPH cases (tests/mpi/test_mpi_cuda.c has the program and the
+ * weakly compressible cases): the distributed CUDA world against the undivided CUDA world. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpi_cuda_cases.h"
+#include "mpi_test_world.h"
+
+static float max_abs_difference(const float* a, const float* b, uint32_t n) {
+  float m = 0.0f;
+  for (uint32_t i = 0; i < 3 * n; ++i) m = fmaxf(m, fabsf(a[i] - b[i]));
+  return m;
+}
+
+/* DFSPH (Jacobi): the stirred column (or the dam break: stir 0) in two frames of 7 and 5 substeps
+ * with bounds 100 (density) and 10 (divergence) times tighter than the defaults, as
+ * tests/mpi/test_mpi_solvers.c does on the CPU, so the convergence test rather than the minimum ends
+ * the stirred column's solves. The rank drives each solve from the host: the ghosts take their
+ * owners' densities and factors, and in each iteration velocities and pressure steps; the mean error
+ * is an exact sum (int64 bins) added over the ranks. Checked on rank 0:
+ *   - the particles BIT FOR BIT against the undivided CUDA world (every pass sums in its order, and
+ *     a solve that ran one iteration more or less would move every particle);
+ *   - the iteration counts (sum and max, both solves, each frame) equal the undivided CUDA world's,
+ *     and are the same on every rank with the same mean errors (bit for bit); the stirred column's
+ *     density solves run more than the minimum (2 a substep), so the test decides;
+ *   - the mean errors within 1e-6 of the undivided CUDA world's: it sums the errors in doubles in a
+ *     fixed tree (dfsph_solve_loop.cuh), the rank exactly, so the float means may differ by an ulp
+ *     (an iteration count would differ only if a mean fell within that ulp of its bound).
+ * The two-rank CPU world's distance is printed only (the solves amplify CPU and GPU roundings). */
+void mpi_cuda_dfsph_case(const char* name, sph_context* cuda, sph_context* cpu, float stir,
+                         uint32_t divergence_solve) {
+  const uint32_t frames[2] = {7, 5};
+  sph_world_def def;
+  sph_dfsph_params dfsph;
+  sph_world* single = NULL;
+  sph_world* world = NULL;
+  sph_world* cpu_world = NULL;
+  uint32_t n = 0, n_cpu = 0;
+  float *x = NULL, *v = NULL, *want_x = NULL, *want_v = NULL, *cpu_x = NULL, *cpu_v = NULL;
+  mpi_test_world_def(&def);
+  def.capacity = 32768;
+  def.solver = SPH_SOLVER_DFSPH;
+  mpi_test_dam(cuda, &def, stir, NULL, &single, &world, &n);
+  mpi_test_dam(cpu, &def, stir, NULL, NULL, &cpu_world, &n_cpu);
+  REQUIRE(sph_dfsph_params_init(&dfsph) == SPH_OK, "dfsph params init");
+  if (!divergence_solve) dfsph.flags |= SPH_DFSPH_SKIP_DIVERGENCE_SOLVE;
+  dfsph.density_error = 1e-5f;
+  dfsph.divergence_error = 0.1f;
+  REQUIRE(sph_world_set_dfsph_params(world, &dfsph) == SPH_OK, "dfsph params: %s", sph_get_last_error());
+  REQUIRE(sph_world_set_dfsph_params(cpu_world, &dfsph) == SPH_OK, "dfsph params");
+  if (single) REQUIRE(sph_world_set_dfsph_params(single, &dfsph) == SPH_OK, "dfsph params");
+  for (int f = 0; f < 2; ++f) {
+    sph_stats got, want, first, cpu_stats;
+    mpi_test_step_stats(world, frames[f], 1, &got);
+    mpi_test_step_stats(cpu_world, frames[f], 1, &cpu_stats);
+    first = got;
+    MPI_Bcast(&first, (int)sizeof first, MPI_BYTE, 0, MPI_COMM_WORLD);
+    CHECK(first.pressure_iterations == got.pressure_iterations &&
+              first.divergence_iterations == got.divergence_iterations &&
+              memcmp(&first.density_error_mean, &got.density_error_mean, sizeof(float)) == 0 &&
+              memcmp(&first.divergence_error_mean, &got.divergence_error_mean, sizeof(float)) == 0,
+          "%s frame %d: rank %d ran other iterations than rank 0", name, f, g_rank);
+    CHECK(got.pressure_iterations >= 2 * frames[f] && (!divergence_solve || got.divergence_iterations > 0),
+          "%s frame %d: %u density, %u divergence iterations (the solves did not run)", name, f,
+          got.pressure_iterations, got.divergence_iterations);
+    if (g_rank != 0) continue;
+    mpi_test_step_stats(single, frames[f], 0, &want);
+    printf(
+        "%s frame %d on %d ranks: iterations %u/%u density, %u/%u divergence (undivided %u/%u, %u/%u; "
+        "CPU ranks %u, %u); mean errors %.9g, %.9g (undivided %.9g, %.9g)\n",
+        name, f, g_size, got.pressure_iterations, got.pressure_iterations_max, got.divergence_iterations,
+        got.divergence_iterations_max, want.pressure_iterations, want.pressure_iterations_max,
+        want.divergence_iterations, want.divergence_iterations_max, cpu_stats.pressure_iterations,
+        cpu_stats.divergence_iterations, (double)got.density_error_mean, (double)got.divergence_error_mean,
+        (double)want.density_error_mean, (double)want.divergence_error_mean);
+    CHECK(got.pressure_iterations == want.pressure_iterations &&
+              got.pressure_iterations_max == want.pressure_iterations_max &&
+              got.divergence_iterations == want.divergence_iterations &&
+              got.divergence_iterations_max == want.divergence_iterations_max,
+          "%s frame %d: the iterations differ from the undivided CUDA world's", name, f);
+    CHECK(fabsf(got.density_error_mean - want.density_error_mean) <= 1e-6f * fabsf(want.density_error_mean) &&
+              fabsf(got.divergence_error_mean - want.divergence_error_mean) <=
+                  1e-6f * fabsf(want.divergence_error_mean),
+          "%s frame %d: mean errors differ from the undivided CUDA world's by more than 1e-6", name, f);
+    if (stir > 0.0f && f == 1)
+      CHECK(want.pressure_iterations > 2 * frames[f],
+            "%s: the density solves stopped at the minimum (%u iterations): the test never decided", name,
+            want.pressure_iterations);
+  }
+  mpi_test_gather(world, n, &x, &v);
+  mpi_test_gather(cpu_world, n, &cpu_x, &cpu_v);
+  if (g_rank == 0) {
+    uint32_t differ;
+    mpi_test_read(single, n, &want_x, &want_v);
+    differ = mpi_differ(want_x, want_v, x, v, n, NULL);
+    printf(
+        "%s on %d ranks: %u of %u particles differ from the undivided CUDA world in any bit; "
+        "max |x_cuda - x_cpu| %.3g m (printed only)\n",
+        name, g_size, differ, n, (double)max_abs_difference(cpu_x, x, n));
+    CHECK(differ == 0, "%s: %u of %u particles differ from the undivided CUDA world", name, differ, n);
+    CHECK(n == n_cpu, "%s: %u particles on the CPU world, %u on the CUDA world", name, n_cpu, n);
+    free(want_x);
+    free(want_v);
+    sph_world_destroy(single);
+  }
+  free(x);
+  free(v);
+  free(cpu_x);
+  free(cpu_v);
+  sph_world_destroy(world);
+  sph_world_destroy(cpu_world);
+}
+
+/* DFSPH's conjugate gradients stay refused on a rank (both backends), when the parameters are set. */
+void mpi_cuda_expect_cg_refused(sph_context* cuda) {
+  sph_world_def def;
+  sph_dfsph_params dfsph;
+  sph_world* world = NULL;
+  sph_result r;
+  mpi_test_world_def(&def);
+  def.solver = SPH_SOLVER_DFSPH;
+  REQUIRE(sph_mpi_world_create(cuda, &def, MPI_TEST_COMM, NULL, &world) == SPH_OK, "a DFSPH rank: %s",
+          sph_get_last_error());
+  REQUIRE(sph_dfsph_params_init(&dfsph) == SPH_OK, "dfsph params init");
+  dfsph.linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS;
+  r = sph_world_set_dfsph_params(world, &dfsph);
+  CHECK(r == SPH_ERROR_UNSUPPORTED && strstr(sph_get_last_error(), "SPH_DFSPH_CONJUGATE_GRADIENTS") != NULL,
+        "conjugate gradients on a distributed CUDA world: %d '%s'", (int)r, sph_get_last_error());
+  sph_world_destroy(world);
+}
