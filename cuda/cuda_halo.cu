@@ -39,6 +39,7 @@
 #include "../src/core/exact_float_sum.h"
 #include "../src/core/grid_layout.h"
 #include "../src/core/rank_agreement.h"
+#include "../src/core/rank_probe_points.h"
 #include "../src/core/slab_rebalance.h"
 #include "cuda_backend_impl.h"
 #include "kernel_launch.h"
@@ -322,6 +323,24 @@ float CudaBackend::halo_dfsph_mean_error(cudaStream_t stream) {
   ranks_->all_sum(sum.terms(), ExactFloatSum::kTerms);
   const int64_t particles = halo_world_count_;
   return particles > 0 ? static_cast<float>(sum.value() / static_cast<double>(particles)) : 0.0f;
+}
+
+// The points' gathers through the host: down, the owners' picked (the CPU rank's rule), up.
+void CudaBackend::halo_pick_probe_points(const DeviceProbes& probes, cudaStream_t stream) {
+  HostVector<ProbeGather> points(probes.point_count);
+  if (probes.point_count > 0)
+    cuda_check(cudaMemcpyAsync(points.data(), probes.points, sizeof(ProbeGather) * points.size(),
+                               cudaMemcpyDeviceToHost, stream),
+               "copy of the probes' points");
+  cuda_check(cudaStreamSynchronize(stream), "the probes' points");
+  const HostVector<ProbeView>& views = r_->probes.host_views();
+  pick_rank_probe_points(*ranks_, slabs_, config_.kernel_radius, views.data(), views.size(), points.data(),
+                         points.size());
+  if (probes.point_count > 0)
+    cuda_check(cudaMemcpyAsync(probes.points, points.data(), sizeof(ProbeGather) * points.size(),
+                               cudaMemcpyHostToDevice, stream),
+               "copy of the probes' picked points");
+  cuda_check(cudaStreamSynchronize(stream), "the probes' picked points");  // (points is freed on return)
 }
 
 void CudaBackend::halo_drop_ghosts() {

@@ -53,6 +53,9 @@ class CudaBackend::HaloHooks final : public SubstepHooks {
   void after_normals(cudaStream_t stream) override { b_.halo_after_normals(stream); }
   void before_end(cudaStream_t stream) override { b_.halo_before_end(stream); }
   void after_dfsph_density(cudaStream_t stream) override { b_.halo_after_dfsph_density(stream); }
+  void after_probe_points(const DeviceProbes& probes, cudaStream_t stream) override {
+    b_.halo_pick_probe_points(probes, stream);
+  }
   void share_velocities(Float4* v, cudaStream_t stream) override { b_.halo_share_velocities(v, stream); }
   void share_steps(cudaStream_t stream) override { b_.halo_share_dfsph_steps(stream); }
   unsigned long long* error_bins() override { return b_.r_->halo->error_bins(); }

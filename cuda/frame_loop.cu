@@ -88,10 +88,6 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
     throw Error(
         Status::Unsupported,
         "world: sinks do not work in a distributed world on the CUDA backend yet (docs/distributed.md)");
-  if (distributed() && !scene_in.probes.empty())
-    throw Error(Status::Unsupported,
-                "world: probes and gauges do not work in a distributed world on the CUDA backend yet "
-                "(docs/distributed.md)");
   DeviceGuard guard(device_);
   PipelineSetup setup;
   setup.count = count_;

@@ -2,6 +2,18 @@
 #include "substep_pipeline.h"
 
 namespace sph {
+namespace {
+
+// The probes' samples; on a distributed rank every rank takes each point's owner's gather first.
+void enqueue_probes(const DeviceProbes& probes, const GridView& grid, const ParticleArrays& a,
+                    FrameState* state, cudaStream_t stream, SubstepHooks* hooks) {
+  if (!hooks) return enqueue_probe_samples(probes, grid, a, state, stream);
+  enqueue_probe_points(probes, grid, a, stream);
+  hooks->after_probe_points(probes, stream);
+  enqueue_probe_sums(probes, state, stream);
+}
+
+}  // namespace
 
 void enqueue_frame_begin(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
                          cudaStream_t stream) {
@@ -42,7 +54,7 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
     enqueue_dfsph_step(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene, loops,
                        !loads, b.state, stream);
     // Probes sample the substep's start once the solves have found its pressure, as on the CPU.
-    if (setup.probes.on()) enqueue_probe_samples(setup.probes, b.grid->view(), a, b.state, stream);
+    if (setup.probes.on()) enqueue_probes(setup.probes, b.grid->view(), a, b.state, stream, hooks);
     // Loads: the walls' reactions of both solves, the contact clamp's impulses, the contacts.
     if (loads)
       enqueue_loads(setup.fluid, a, n, setup.scene, setup.loads, setup.options.boundary_density, 0.0f, 1.0f,
@@ -79,7 +91,7 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
     }
     // Probes sample the substep's start (RK4: its first stage), as on the CPU.
     if (stage == 0 && setup.probes.on())
-      enqueue_probe_samples(setup.probes, b.grid->view(), a, b.state, stream);
+      enqueue_probes(setup.probes, b.grid->view(), a, b.state, stream, hooks);
     if (setup.options.springs)
       enqueue_spring_pass(setup.springs, b.grid->view(), a, n, stage == 0, b.state, stream);
     const bool loads = setup.loads.on();

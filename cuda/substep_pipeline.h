@@ -62,6 +62,8 @@ struct SubstepHooks : DfsphRankSteps {
   virtual void after_density(cudaStream_t stream) = 0;
   virtual void after_dfsph_density(cudaStream_t stream) = 0;  // DFSPH's density pass
   virtual void after_normals(cudaStream_t stream) = 0;        // surface tension's colour normals
+  // Probes: each sample point's gather (probes.points, device) replaced by its owner rank's.
+  virtual void after_probe_points(const DeviceProbes& probes, cudaStream_t stream) = 0;
   virtual void before_end(cudaStream_t stream) = 0;
 };
 

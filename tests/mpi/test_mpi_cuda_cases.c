@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* gpu_check_mpi's DFSPH cases (tests/mpi/test_mpi_cuda.c has the program and the
+/* gpu_check_mpi's DFSPH and probes cases (tests/mpi/test_mpi_cuda.c has the program and the
  * weakly compressible cases): the distributed CUDA world against the undivided CUDA world. */
 #include <math.h>
 #include <stdlib.h>
@@ -111,6 +111,84 @@ void mpi_cuda_dfsph_case(const char* name, sph_context* cuda, sph_context* cpu, 
   free(cpu_v);
   sph_world_destroy(world);
   sph_world_destroy(cpu_world);
+}
+
+static void add_probes(sph_world* w, sph_probe_id* point, sph_probe_id* gauge) {
+  sph_probe_def def;
+  REQUIRE(sph_probe_def_init(&def) == SPH_OK, "probe init");
+  def.sampling = SPH_PROBE_EVERY_SUBSTEP;
+  def.position.x = 0.05f;
+  def.position.y = 0.02f;
+  def.position.z = 0.03f;
+  REQUIRE(sph_probe_create(w, &def, point) == SPH_OK, "point probe: %s", sph_get_last_error());
+  def.kind = SPH_PROBE_GAUGE;
+  def.position.x = 0.031f;
+  def.position.y = -0.01f;
+  def.position.z = 0.027f;
+  def.length = 0.25f;
+  REQUIRE(sph_probe_create(w, &def, gauge) == SPH_OK, "gauge: %s", sph_get_last_error());
+}
+
+/* Probes and gauges (tests/mpi/test_mpi_scene_sums.c's probes on the CPU): the stirred column with a
+ * point probe inside it and a gauge along y (the slabs' axis, so its points lie in every rank's slab),
+ * sampled every substep, two frames of 8 substeps, with the weakly compressible solver or DFSPH.
+ * Each rank gathers every point; every rank takes, for each point, the gather of the rank whose slab
+ * holds the point's cell layer (its neighbour cells are complete there and list their particles in
+ * the undivided world's order), so the readings are the undivided CUDA world's BIT FOR BIT, the same
+ * on every rank; the point must read water (density > 0) and the gauge a water height > 0 (not two
+ * empty readings); the particles stay the undivided world's bit for bit. */
+void mpi_cuda_probes_case(const char* name, sph_context* cuda, sph_solver solver) {
+  const sph_vec3 column_min = {0.0f, 0.0f, 0.0f}, column_max = {0.1f, 0.2f, 0.06f};
+  sph_world_def def;
+  mpi_test_worlds w;
+  sph_probe_id point, gauge, single_point = {0}, single_gauge = {0};
+  float *x = NULL, *v = NULL, *want_x = NULL, *want_v = NULL;
+  mpi_test_world_def(&def);
+  def.capacity = 32768;
+  def.solver = solver;
+  mpi_test_make_worlds(cuda, &def, column_min, column_max, 0.5f, MPI_COMM_WORLD, NULL, &w);
+  add_probes(w.world, &point, &gauge);
+  if (w.single) add_probes(w.single, &single_point, &single_gauge);
+  for (int f = 0; f < 2; ++f) {
+    sph_probe_reading got[2], want[2], first[2];
+    mpi_test_step(w.world, 8, 1);
+    REQUIRE(sph_probe_reading_init(&got[0]) == SPH_OK && sph_probe_reading_init(&got[1]) == SPH_OK &&
+                sph_probe_get_reading(w.world, point, &got[0]) == SPH_OK &&
+                sph_probe_get_reading(w.world, gauge, &got[1]) == SPH_OK,
+            "%s: readings: %s", name, sph_get_last_error());
+    memcpy(first, got, sizeof got);
+    MPI_Bcast(first, (int)sizeof first, MPI_BYTE, 0, MPI_COMM_WORLD);
+    CHECK(memcmp(first, got, sizeof got) == 0, "%s frame %d: rank %d reads other probes than rank 0", name, f,
+          g_rank);
+    if (g_rank != 0) continue;
+    mpi_test_step(w.single, 8, 0);
+    REQUIRE(sph_probe_reading_init(&want[0]) == SPH_OK && sph_probe_reading_init(&want[1]) == SPH_OK &&
+                sph_probe_get_reading(w.single, single_point, &want[0]) == SPH_OK &&
+                sph_probe_get_reading(w.single, single_gauge, &want[1]) == SPH_OK,
+            "%s: readings", name);
+    printf(
+        "%s frame %d on %d ranks: point %.9g Pa %.9g kg/m3, gauge %.9g m (undivided %.9g Pa %.9g kg/m3, "
+        "%.9g m)\n",
+        name, f, g_size, (double)got[0].pressure, (double)got[0].density, (double)got[1].water_height,
+        (double)want[0].pressure, (double)want[0].density, (double)want[1].water_height);
+    CHECK(memcmp(got, want, sizeof got) == 0,
+          "%s frame %d: the readings differ from the undivided CUDA world's", name, f);
+    CHECK(want[0].density > 0.0f && want[1].water_height > 0.0f, "%s frame %d: the probes read no water",
+          name, f);
+  }
+  mpi_test_gather(w.world, w.n, &x, &v);
+  if (g_rank == 0) {
+    uint32_t differ;
+    mpi_test_read(w.single, w.n, &want_x, &want_v);
+    differ = mpi_differ(want_x, want_v, x, v, w.n, NULL);
+    CHECK(differ == 0, "%s: %u of %u particles differ from the undivided CUDA world", name, differ, w.n);
+    free(want_x);
+    free(want_v);
+    sph_world_destroy(w.single);
+  }
+  free(x);
+  free(v);
+  sph_world_destroy(w.world);
 }
 
 /* DFSPH's conjugate gradients stay refused on a rank (both backends), when the parameters are set. */
