@@ -343,9 +343,10 @@ void CudaBackend::halo_pick_probe_points(const DeviceProbes& probes, cudaStream_
   cuda_check(cudaStreamSynchronize(stream), "the probes' picked points");  // (points is freed on return)
 }
 
-void CudaBackend::halo_drop_ghosts() {
+void CudaBackend::halo_drop_ghosts(uint32_t* counts) {
   if (halo_ghosts_ == 0) return;
-  const HostVector<HaloArray> arrays = halo_arrays();
+  HostVector<HaloArray> arrays = halo_arrays();
+  if (counts) arrays.push_back(HaloArray{reinterpret_cast<unsigned char*>(counts), sizeof(uint32_t)});
   if (halo_kept_ != halo_owned_)
     throw Error(Status::Internal, "halo: the sorted order lost an owned particle");
   r_->halo->keep(arrays.data(), static_cast<int>(arrays.size()), r_->halo->kept_list(), halo_kept_,

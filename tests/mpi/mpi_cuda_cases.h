@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* The CUDA rank's DFSPH, probes and conjugate-gradients refusal cases of gpu_check_mpi
+/* The CUDA rank's DFSPH, probes, sinks and conjugate-gradients refusal cases of gpu_check_mpi
  * (tests/mpi/test_mpi_cuda.c runs them; test_mpi_cuda_cases.c says what each checks). */
 #pragma once
 
@@ -13,5 +13,7 @@ void mpi_cuda_dfsph_case(const char* name, sph_context* cuda, sph_context* cpu, 
                          uint32_t divergence_solve);
 /* A point probe and a gauge on the stirred column, with `solver`. */
 void mpi_cuda_probes_case(const char* name, sph_context* cuda, sph_solver solver);
+/* A sink over the stirred column's top, with `solver`. */
+void mpi_cuda_sinks_case(const char* name, sph_context* cuda, sph_solver solver);
 /* SPH_DFSPH_CONJUGATE_GRADIENTS refused on a distributed CUDA world. */
 void mpi_cuda_expect_cg_refused(sph_context* cuda);

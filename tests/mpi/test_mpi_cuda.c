@@ -20,7 +20,7 @@
  * density, with the normalised density, with it and the density diffusion, with surface
  * tension), the collider loads (run_loads_case), the collapse that makes the ranks rebalance (12 frames of 20
  * substeps, spacing 12.5 mm), DFSPH's Jacobi solves (test_mpi_cuda_cases.c: the dam break, the stirred
- * column with and without the divergence solve), probes and gauges (there too, both solvers), and
+ * column with and without the divergence solve), probes and gauges and sinks (there too, both solvers), and
  * the refusals (RK4, springs, DFSPH's conjugate gradients: SPH_ERROR_UNSUPPORTED naming them). With
  * SPH_MPI_CUDA_QUICK set, the dam breaks (WCSPH and DFSPH) and the refusals only (a run under
  * compute-sanitizer). */
@@ -236,6 +236,8 @@ int main(int argc, char** argv) {
   if (!quick) {
     mpi_cuda_probes_case("probes", cuda, SPH_SOLVER_WCSPH);
     mpi_cuda_probes_case("DFSPH probes", cuda, SPH_SOLVER_DFSPH);
+    mpi_cuda_sinks_case("sinks", cuda, SPH_SOLVER_WCSPH);
+    mpi_cuda_sinks_case("DFSPH sinks", cuda, SPH_SOLVER_DFSPH);
   }
   mpi_cuda_expect_cg_refused(cuda);
   mpi_test_world_def(&def);

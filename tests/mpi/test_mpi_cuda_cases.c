@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* gpu_check_mpi's DFSPH and probes cases (tests/mpi/test_mpi_cuda.c has the program and the
+/* gpu_check_mpi's DFSPH, probes and sinks cases (tests/mpi/test_mpi_cuda.c has the program and the
  * weakly compressible cases): the distributed CUDA world against the undivided CUDA world. */
 #include <math.h>
 #include <stdlib.h>
@@ -182,6 +182,123 @@ void mpi_cuda_probes_case(const char* name, sph_context* cuda, sph_solver solver
     mpi_test_read(w.single, w.n, &want_x, &want_v);
     differ = mpi_differ(want_x, want_v, x, v, w.n, NULL);
     CHECK(differ == 0, "%s: %u of %u particles differ from the undivided CUDA world", name, differ, w.n);
+    free(want_x);
+    free(want_v);
+    sph_world_destroy(w.single);
+  }
+  free(x);
+  free(v);
+  sph_world_destroy(w.world);
+}
+
+static void add_sink(sph_world* w) {
+  sph_sink_def sink;
+  sph_sink_id id;
+  REQUIRE(sph_sink_def_init(&sink) == SPH_OK, "sink init");
+  sink.mode = SPH_SINK_OUTSIDE_BOUNDS;
+  sink.bounds_min.x = -1.0f;
+  sink.bounds_min.y = -1.0f;
+  sink.bounds_min.z = -1.0f;
+  sink.bounds_max.x = 1.0f;
+  sink.bounds_max.y = 0.185f;
+  sink.bounds_max.z = 1.0f;
+  REQUIRE(sph_sink_create(w, &sink, &id) == SPH_OK, "sink: %s", sph_get_last_error());
+}
+
+static int compare_ids(const void* a, const void* b) {
+  const uint32_t x = *(const uint32_t*)a, y = *(const uint32_t*)b;
+  return (x > y) - (x < y);
+}
+
+/* The last step's removed ids (malloc'd, *count of them) and its SPH_EVENT_SINK_REMOVED count. */
+static uint32_t* last_removed(sph_world* w, uint32_t* count, uint32_t* events_count) {
+  sph_event events[8];
+  uint32_t n = 0, events_n = 0;
+  uint32_t* ids;
+  REQUIRE(sph_world_get_removed_ids(w, NULL, 0, &n) == SPH_OK || n > 0, "removed ids count");
+  ids = (uint32_t*)malloc(sizeof(uint32_t) * ((size_t)n + 1));
+  REQUIRE(ids != NULL, "malloc");
+  REQUIRE(sph_world_get_removed_ids(w, ids, n, count) == SPH_OK, "removed ids");
+  REQUIRE(sph_world_get_events(w, events, 8, &events_n) == SPH_OK, "events");
+  *events_count = 0;
+  for (uint32_t i = 0; i < events_n && i < 8; ++i)
+    if (events[i].type == SPH_EVENT_SINK_REMOVED) *events_count += events[i].count;
+  return ids;
+}
+
+/* Sinks (tests/mpi/test_mpi_sources.c's sink on the CPU): the stirred column with a sink that removes
+ * what lies above y = 0.185 m (the column is 0.2 m tall), two frames of 8 substeps, with `solver`.
+ * Each rank removes its own particles after each substep, its ghosts dropped first. Checked on rank 0,
+ * each frame: the ids all ranks removed (sph_mpi_world_gather_removed_ids: ascending) are the undivided
+ * CUDA world's (sorted), the ranks' SPH_EVENT_SINK_REMOVED counts add up to its count, and the world's
+ * count is its; the first frame must remove particles (not all of them). After the frames the
+ * survivors equal the undivided world's BIT FOR BIT (a removed particle is gone from both worlds'
+ * neighbour sums alike; the survivors' sort keys keep their order). */
+void mpi_cuda_sinks_case(const char* name, sph_context* cuda, sph_solver solver) {
+  const sph_vec3 column_min = {0.0f, 0.0f, 0.0f}, column_max = {0.1f, 0.2f, 0.06f};
+  sph_world_def def;
+  mpi_test_worlds w;
+  sph_mpi_counts counts;
+  uint32_t n = 0;
+  float *x = NULL, *v = NULL, *want_x = NULL, *want_v = NULL;
+  mpi_test_world_def(&def);
+  def.capacity = 32768;
+  def.solver = solver;
+  mpi_test_make_worlds(cuda, &def, column_min, column_max, 0.5f, MPI_COMM_WORLD, NULL, &w);
+  add_sink(w.world);
+  if (w.single) add_sink(w.single);
+  for (int f = 0; f < 2; ++f) {
+    uint32_t mine = 0, mine_events = 0, events = 0, world_removed = 0, gathered_n = 0;
+    uint32_t* mine_ids;
+    uint32_t* gathered = NULL;
+    sph_result r;
+    mpi_test_step(w.world, 8, 1);
+    mine_ids = last_removed(w.world, &mine, &mine_events);
+    MPI_Allreduce(&mine, &world_removed, 1, MPI_UINT32_T, MPI_SUM, MPI_COMM_WORLD);
+    MPI_Reduce(&mine_events, &events, 1, MPI_UINT32_T, MPI_SUM, 0, MPI_COMM_WORLD);
+    if (g_rank == 0) {
+      gathered = (uint32_t*)malloc(sizeof(uint32_t) * ((size_t)world_removed + 1));
+      REQUIRE(gathered != NULL, "malloc");
+    }
+    r = sph_mpi_world_gather_removed_ids(w.world, 0, gathered, g_rank == 0 ? world_removed : 0u,
+                                         g_rank == 0 ? &gathered_n : NULL);
+    CHECK(r == SPH_OK, "%s: gather removed ids: %d", name, (int)r);
+    REQUIRE(sph_mpi_counts_init(&counts) == SPH_OK && sph_mpi_world_get_counts(w.world, &counts) == SPH_OK,
+            "counts");
+    if (g_rank == 0) {
+      uint32_t want_n = 0, want_events = 0;
+      uint32_t* want_ids;
+      sph_stats stats;
+      mpi_test_step(w.single, 8, 0);
+      want_ids = last_removed(w.single, &want_n, &want_events);
+      qsort(want_ids, want_n, sizeof(uint32_t), compare_ids);
+      REQUIRE(sph_stats_init(&stats) == SPH_OK && sph_world_get_stats(w.single, &stats) == SPH_OK, "stats");
+      printf("%s frame %d on %d ranks: %u removed (%u events), %llu left; the undivided world %u (%u), %u\n",
+             name, f, g_size, gathered_n, events, (unsigned long long)counts.global_count, want_n,
+             want_events, stats.particle_count);
+      CHECK(gathered_n == want_n && memcmp(gathered, want_ids, sizeof(uint32_t) * want_n) == 0,
+            "%s frame %d: the ranks removed %u ids, the undivided CUDA world %u (or other ids)", name, f,
+            gathered_n, want_n);
+      CHECK(events == want_events, "%s frame %d: %u sink events, the undivided world %u", name, f, events,
+            want_events);
+      CHECK(counts.global_count == stats.particle_count,
+            "%s frame %d: %llu particles, the undivided world %u", name, f,
+            (unsigned long long)counts.global_count, stats.particle_count);
+      CHECK(f != 0 || (want_n > 0 && want_n < w.n), "%s: the first frame removed %u of %u particles", name,
+            want_n, w.n);
+      n = stats.particle_count;
+      free(want_ids);
+    }
+    free(mine_ids);
+    free(gathered);
+  }
+  MPI_Bcast(&n, 1, MPI_UINT32_T, 0, MPI_COMM_WORLD);
+  mpi_test_gather(w.world, n, &x, &v);
+  if (g_rank == 0) {
+    uint32_t differ;
+    mpi_test_read(w.single, n, &want_x, &want_v);
+    differ = mpi_differ(want_x, want_v, x, v, n, NULL);
+    CHECK(differ == 0, "%s: %u of %u survivors differ from the undivided CUDA world", name, differ, n);
     free(want_x);
     free(want_v);
     sph_world_destroy(w.single);
