@@ -228,10 +228,11 @@ int main(int argc, char** argv) {
     run_case("collapse with rebalancing", cuda, cpu, &def, 0.0f, 12, 20, 0);
   }
 
-  mpi_cuda_dfsph_case("DFSPH dam break", cuda, cpu, 0.0f, 1);
+  mpi_cuda_dfsph_case("DFSPH dam break", cuda, cpu, 0.0f, 1, 0);
   if (!quick) {
-    mpi_cuda_dfsph_case("DFSPH stirred column", cuda, cpu, 2.0f, 1);
-    mpi_cuda_dfsph_case("DFSPH stirred column without the divergence solve", cuda, cpu, 2.0f, 0);
+    mpi_cuda_dfsph_case("DFSPH stirred column", cuda, cpu, 2.0f, 1, 0);
+    mpi_cuda_dfsph_case("DFSPH stirred column without the divergence solve", cuda, cpu, 2.0f, 0, 0);
+    mpi_cuda_dfsph_case("DFSPH stirred column, capped solves", cuda, cpu, 2.0f, 1, 3);
   }
   if (!quick) {
     mpi_cuda_probes_case("probes", cuda, SPH_SOLVER_WCSPH);

@@ -24,13 +24,15 @@ static float max_abs_difference(const float* a, const float* b, uint32_t n) {
  *     a solve that ran one iteration more or less would move every particle);
  *   - the iteration counts (sum and max, both solves, each frame) equal the undivided CUDA world's,
  *     and are the same on every rank with the same mean errors (bit for bit); the stirred column's
- *     density solves run more than the minimum (2 a substep), so the test decides;
+ *     density solves run more than the minimum (2 a substep), so the test decides; the capped solves'
+ *     counts equal too, and the capped case (cap 3, bound 1e-8) caps every density solve (the cap,
+ *     the record and SPH_EVENT_PRESSURE_SOLVE_CAPPED's count come from the same device record);
  *   - the mean errors within 1e-6 of the undivided CUDA world's: it sums the errors in doubles in a
  *     fixed tree (dfsph_solve_loop.cuh), the rank exactly, so the float means may differ by an ulp
  *     (an iteration count would differ only if a mean fell within that ulp of its bound).
  * The two-rank CPU world's distance is printed only (the solves amplify CPU and GPU roundings). */
 void mpi_cuda_dfsph_case(const char* name, sph_context* cuda, sph_context* cpu, float stir,
-                         uint32_t divergence_solve) {
+                         uint32_t divergence_solve, uint32_t cap) {
   const uint32_t frames[2] = {7, 5};
   sph_world_def def;
   sph_dfsph_params dfsph;
@@ -48,6 +50,11 @@ void mpi_cuda_dfsph_case(const char* name, sph_context* cuda, sph_context* cpu, 
   if (!divergence_solve) dfsph.flags |= SPH_DFSPH_SKIP_DIVERGENCE_SOLVE;
   dfsph.density_error = 1e-5f;
   dfsph.divergence_error = 0.1f;
+  if (cap > 0) {
+    /* A bound no solve reaches in `cap` iterations: each substep's density solve stops at its cap. */
+    dfsph.density_error = 1e-8f;
+    dfsph.max_iterations = cap;
+  }
   REQUIRE(sph_world_set_dfsph_params(world, &dfsph) == SPH_OK, "dfsph params: %s", sph_get_last_error());
   REQUIRE(sph_world_set_dfsph_params(cpu_world, &dfsph) == SPH_OK, "dfsph params");
   if (single) REQUIRE(sph_world_set_dfsph_params(single, &dfsph) == SPH_OK, "dfsph params");
@@ -80,6 +87,14 @@ void mpi_cuda_dfsph_case(const char* name, sph_context* cuda, sph_context* cpu, 
               got.divergence_iterations == want.divergence_iterations &&
               got.divergence_iterations_max == want.divergence_iterations_max,
           "%s frame %d: the iterations differ from the undivided CUDA world's", name, f);
+    CHECK(got.pressure_solves_capped == want.pressure_solves_capped &&
+              got.divergence_solves_capped == want.divergence_solves_capped,
+          "%s frame %d: %u/%u capped solves (density/divergence), the undivided CUDA world %u/%u", name, f,
+          got.pressure_solves_capped, got.divergence_solves_capped, want.pressure_solves_capped,
+          want.divergence_solves_capped);
+    CHECK(cap == 0 || (want.pressure_solves_capped == frames[f] && got.pressure_iterations_max == cap),
+          "%s frame %d: %u of %u density solves capped, at most %u iterations (cap %u)", name, f,
+          want.pressure_solves_capped, frames[f], got.pressure_iterations_max, cap);
     CHECK(fabsf(got.density_error_mean - want.density_error_mean) <= 1e-6f * fabsf(want.density_error_mean) &&
               fabsf(got.divergence_error_mean - want.divergence_error_mean) <=
                   1e-6f * fabsf(want.divergence_error_mean),
