@@ -192,18 +192,35 @@ class CudaBackend final : public Backend {
   // at the same points (src/cpu/cpu_halo.cpp), each a host synchronisation. Between substeps the
   // rank holds the particles it owns; during one, also its ghosts, appended before the sort.
   class HaloHooks;
-  uint32_t run_frame_distributed(PipelineSetup setup, const StepInterrupt& interrupt, bool& interrupted);
+  uint32_t run_frame_distributed(PipelineSetup setup, uint32_t sink_count, HostVector<uint32_t>& removed_ids,
+                                 HostVector<uint32_t>& removed_by_sink, const StepInterrupt& interrupt,
+                                 bool& interrupted);
   void halo_begin_frame();  // the world's max speed and acceleration; new slabs when out of balance
   void halo_gather();       // migration, then ghosts; the visit order of the sort
   void halo_after_sort(cudaStream_t stream);     // ghost mask, new keys, the lists of the records
   void halo_after_density(cudaStream_t stream);  // the ghosts take their owners' density records
   void halo_after_normals(cudaStream_t stream);  // and their colour normals (surface tension)
-  // The ghosts take their owners' records (DeviceHalo::pack_records / enqueue_apply_records).
+  // DFSPH (core/dfsph_jacobi_loop.h says when): the ghosts take their owners' densities and
+  // factors, a solve's velocities v, its pressure steps k; the solve's mean error over the world.
+  void halo_after_dfsph_density(cudaStream_t stream);
+  void halo_share_velocities(Float4* v, cudaStream_t stream);
+  void halo_share_dfsph_steps(cudaStream_t stream);
+  DfsphErrors halo_dfsph_errors(cudaStream_t stream);
+  // Probes: each sample point's gather becomes its owner rank's (core/rank_probe_points.h).
+  void halo_pick_probe_points(const DeviceProbes& probes, cudaStream_t stream);
+  // The ghosts take their owners' records (DeviceHalo::pack_records / enqueue_apply_records) of
+  // the arrays `a` (the store's, or a view of them).
   template <class Record>
-  void halo_refresh(cudaStream_t stream, const char* what);
+  void halo_refresh(cudaStream_t stream, const char* what, const ParticleArrays& a);
   void halo_before_end(cudaStream_t stream);  // maxima and failures reduced over the ranks
   void halo_sum_loads(ColliderLoadSums* sums, uint32_t colliders);  // the frame's loads over the ranks
-  void halo_drop_ghosts();                    // the owned particles, in the sorted order
+  // Sinks after a substep, as on the CPU rank: the ghosts dropped, then the rank's own particles
+  // tested and compacted (its removed ids and counts appended); after the frame's last substep
+  // the neighbour counts of its density pass (returned; null otherwise) travel with them.
+  const uint32_t* halo_apply_sinks(const PipelineSetup& setup, uint32_t sink_count, bool last,
+                                   HostVector<uint32_t>& removed_ids, HostVector<uint32_t>& removed_by_sink);
+  // The owned particles, in the sorted order; `counts` (per particle, sorted order) kept with them.
+  void halo_drop_ghosts(uint32_t* counts = nullptr);
   HostVector<HaloArray> halo_arrays() const;  // what travels with a particle
   std::vector<RankBytes> halo_send(const uint32_t* starts);
   uint32_t halo_receive(const RankBytes& in, uint32_t first);

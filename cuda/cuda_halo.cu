@@ -21,10 +21,14 @@
 //                      which then picks the same step on every rank; ghosts dropped
 // A distributed world runs on the stream driver (each step waits for the stream; the frame,
 // the frame's start and the substep's reductions: cuda_halo_frame.cu). Symplectic Euler with the
-// weakly compressible solver only (with the normalised density and the density diffusion, whose
+// weakly compressible solver (with the normalised density and the density diffusion, whose
 // republished densities the ghosts take again, surface tension, whose colour normals they take:
 // substep_pipeline.cu, and collider loads, each rank's own particles' impulses added over the
-// ranks at the frame's end: cuda_halo_frame.cu); attach_ranks refuses the rest by name.
+// ranks at the frame's end: cuda_halo_frame.cu) or DFSPH's Jacobi solves (the host drives each
+// solve an iteration at a time, core/dfsph_jacobi_loop.h: the ghosts take their owners' densities
+// and factors after the density pass, velocities and pressure steps within each iteration, and
+// the mean error is an exact sum added over the ranks); attach_ranks refuses RK4 and springs by
+// name, the step DFSPH's conjugate gradients (frame_loop.cu).
 #include <cstring>
 #include <memory>
 #include <string>
@@ -32,8 +36,10 @@
 #include <vector>
 
 #include "../src/core/crowded_cell.h"
+#include "../src/core/exact_float_sum.h"
 #include "../src/core/grid_layout.h"
 #include "../src/core/rank_agreement.h"
+#include "../src/core/rank_probe_points.h"
 #include "../src/core/slab_rebalance.h"
 #include "cuda_backend_impl.h"
 #include "kernel_launch.h"
@@ -60,7 +66,6 @@ void CudaBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks,
   } features[] = {{kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks)"}};
   for (const auto& f : features)
     if (config_.features & f.bit) refuse(f.name);
-  if (config_.solver == Solver::Dfsph) refuse("the DFSPH solver");
   if (config_.integrator == Integrator::Rk4) refuse("the RK4 integrator");
   require_alive();
   DeviceGuard guard(device_);
@@ -247,7 +252,7 @@ void CudaBackend::halo_after_sort(cudaStream_t stream) {
 }
 
 template <class Record>
-void CudaBackend::halo_refresh(cudaStream_t stream, const char* what) {
+void CudaBackend::halo_refresh(cudaStream_t stream, const char* what, const ParticleArrays& a) {
   const RankTransport& t = *ranks_;
   const size_t size = static_cast<size_t>(t.size());
   DeviceHalo& h = *r_->halo;
@@ -261,7 +266,7 @@ void CudaBackend::halo_refresh(cudaStream_t stream, const char* what) {
   const uint32_t sent = starts[size];
   std::vector<RankBytes> out(size);
   if (sent > 0) {
-    const Record* records = h.pack_records<Record>(r_->store->arrays(), h.list(), sent, stream);
+    const Record* records = h.pack_records<Record>(a, h.list(), sent, stream);
     for (size_t d = 0; d < size; ++d) {
       const unsigned char* from = reinterpret_cast<const unsigned char*>(records + starts[d]);
       out[d].assign(from, from + sizeof(Record) * (starts[d + 1] - starts[d]));
@@ -282,21 +287,72 @@ void CudaBackend::halo_refresh(cudaStream_t stream, const char* what) {
     if (ghosts > 0) std::memcpy(got.data() + first, in[r].data(), in[r].size());
   }
   if (got.empty()) return;
-  h.enqueue_apply_records(r_->store->arrays(), h.list() + sent, got.data(), static_cast<uint32_t>(got.size()),
-                          stream);
+  h.enqueue_apply_records(a, h.list() + sent, got.data(), static_cast<uint32_t>(got.size()), stream);
 }
 
 void CudaBackend::halo_after_density(cudaStream_t stream) {
-  halo_refresh<HaloDensityRecord>(stream, "density records");
+  halo_refresh<HaloDensityRecord>(stream, "density records", r_->store->arrays());
 }
 
 void CudaBackend::halo_after_normals(cudaStream_t stream) {
-  halo_refresh<HaloNormalRecord>(stream, "colour normals");
+  halo_refresh<HaloNormalRecord>(stream, "colour normals", r_->store->arrays());
 }
 
-void CudaBackend::halo_drop_ghosts() {
+void CudaBackend::halo_after_dfsph_density(cudaStream_t stream) {
+  halo_refresh<HaloDfsphDensityRecord>(stream, "DFSPH density records", r_->store->arrays());
+}
+
+void CudaBackend::halo_share_velocities(Float4* v, cudaStream_t stream) {
+  // The velocity record carries the arrays' sorted_velocity: here the solve's (the divergence
+  // solve's are the sorted velocities, the density solve's v* the state array).
+  ParticleArrays view = r_->store->arrays();
+  view.sorted_velocity = v;
+  halo_refresh<HaloVelocityRecord>(stream, "DFSPH velocities", view);
+}
+
+void CudaBackend::halo_share_dfsph_steps(cudaStream_t stream) {
+  halo_refresh<HaloDfsphStepRecord>(stream, "DFSPH pressure steps", r_->store->arrays());
+}
+
+// As the CPU rank's (CpuBackend::dfsph_errors): the rank's exact bins, added over the ranks, over
+// the world's count, and the ranks' largest error; the same bits on every rank, whichever
+// particles each holds.
+DfsphErrors CudaBackend::halo_dfsph_errors(cudaStream_t stream) {
+  ExactFloatSum sum;
+  const int64_t* words = r_->halo->download_error_bins(stream);
+  std::memcpy(sum.terms(), words, sizeof(int64_t) * ExactFloatSum::kTerms);
+  const uint32_t largest_bits = static_cast<uint32_t>(static_cast<uint64_t>(words[ExactFloatSum::kTerms]));
+  float largest = 0.0f;
+  std::memcpy(&largest, &largest_bits, sizeof largest);
+  halo_agree();  // (the refreshes' buffers: a rank that failed there meets the others here)
+  ranks_->all_sum(sum.terms(), ExactFloatSum::kTerms);
+  ranks_->all_max(&largest, 1);
+  const int64_t particles = halo_world_count_;
+  return {particles > 0 ? static_cast<float>(sum.value() / static_cast<double>(particles)) : 0.0f, largest};
+}
+
+// The points' gathers through the host: down, the owners' picked (the CPU rank's rule), up.
+void CudaBackend::halo_pick_probe_points(const DeviceProbes& probes, cudaStream_t stream) {
+  HostVector<ProbeGather> points(probes.point_count);
+  if (probes.point_count > 0)
+    cuda_check(cudaMemcpyAsync(points.data(), probes.points, sizeof(ProbeGather) * points.size(),
+                               cudaMemcpyDeviceToHost, stream),
+               "copy of the probes' points");
+  cuda_check(cudaStreamSynchronize(stream), "the probes' points");
+  const HostVector<ProbeView>& views = r_->probes.host_views();
+  pick_rank_probe_points(*ranks_, slabs_, config_.kernel_radius, views.data(), views.size(), points.data(),
+                         points.size());
+  if (probes.point_count > 0)
+    cuda_check(cudaMemcpyAsync(probes.points, points.data(), sizeof(ProbeGather) * points.size(),
+                               cudaMemcpyHostToDevice, stream),
+               "copy of the probes' picked points");
+  cuda_check(cudaStreamSynchronize(stream), "the probes' picked points");  // (points is freed on return)
+}
+
+void CudaBackend::halo_drop_ghosts(uint32_t* counts) {
   if (halo_ghosts_ == 0) return;
-  const HostVector<HaloArray> arrays = halo_arrays();
+  HostVector<HaloArray> arrays = halo_arrays();
+  if (counts) arrays.push_back(HaloArray{reinterpret_cast<unsigned char*>(counts), sizeof(uint32_t)});
   if (halo_kept_ != halo_owned_)
     throw Error(Status::Internal, "halo: the sorted order lost an owned particle");
   r_->halo->keep(arrays.data(), static_cast<int>(arrays.size()), r_->halo->kept_list(), halo_kept_,

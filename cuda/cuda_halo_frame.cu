@@ -3,7 +3,9 @@
 // stream driver with the halo's steps as hooks of the substep (SubstepHooks), the frame's start
 // (the world's max speed and acceleration, new slabs when out of balance) and the reduction of
 // each substep's maxima and failures over the ranks before the device's end-of-substep kernel,
-// which then picks the same next step on every rank (and fails on every rank together).
+// which then picks the same next step on every rank (and fails on every rank together); the
+// sinks after each substep, on the rank's own particles (its removed ids are its own, as on the
+// CPU rank).
 #include <algorithm>
 #include <cstring>
 #include <vector>
@@ -52,6 +54,14 @@ class CudaBackend::HaloHooks final : public SubstepHooks {
   void after_density(cudaStream_t stream) override { b_.halo_after_density(stream); }
   void after_normals(cudaStream_t stream) override { b_.halo_after_normals(stream); }
   void before_end(cudaStream_t stream) override { b_.halo_before_end(stream); }
+  void after_dfsph_density(cudaStream_t stream) override { b_.halo_after_dfsph_density(stream); }
+  void after_probe_points(const DeviceProbes& probes, cudaStream_t stream) override {
+    b_.halo_pick_probe_points(probes, stream);
+  }
+  void share_velocities(Float4* v, cudaStream_t stream) override { b_.halo_share_velocities(v, stream); }
+  void share_steps(cudaStream_t stream) override { b_.halo_share_dfsph_steps(stream); }
+  unsigned long long* error_bins() override { return b_.r_->halo->error_bins(); }
+  DfsphErrors errors(cudaStream_t stream) override { return b_.halo_dfsph_errors(stream); }
 
  private:
   CudaBackend& b_;
@@ -92,14 +102,15 @@ void CudaBackend::halo_before_end(cudaStream_t stream) {
   FrameState* out = r_->state_output.get();
   cuda_check(cudaMemcpyAsync(out, r_->state.get(), sizeof(FrameState), cudaMemcpyDeviceToHost, stream),
              "copy of the substep's state");
-  uint32_t* mismatch = r_->sink_kept.get();  // (pinned; sinks are refused in a distributed world)
+  uint32_t* mismatch = r_->sink_kept.get();  // (pinned; the sinks read their count after the substep)
   cuda_check(cudaMemcpyAsync(mismatch, h.mismatch_flag(), sizeof(uint32_t), cudaMemcpyDeviceToHost, stream),
              "copy of the halo's id check");
   cuda_check(cudaStreamSynchronize(stream), "the substep's state");
   if (*mismatch != 0) {
     cuda_check(cudaMemsetAsync(h.mismatch_flag(), 0, sizeof(uint32_t), stream), "halo id check reset");
     throw Error(Status::Internal,
-                "halo: a rank's density records or colour normals came in another order than its ghosts");
+                "halo: a rank's records (densities, colour normals, DFSPH's velocities or steps) came in "
+                "another order than its ghosts");
   }
   const FrameState& f = *out;
   int64_t bad =
@@ -113,8 +124,50 @@ void CudaBackend::halo_before_end(cudaStream_t stream) {
   check_launch("set_reduced_kernel");
 }
 
-uint32_t CudaBackend::run_frame_distributed(PipelineSetup setup, const StepInterrupt& interrupt,
-                                            bool& interrupted) {
+const uint32_t* CudaBackend::halo_apply_sinks(const PipelineSetup& setup, uint32_t sink_count, bool last,
+                                              HostVector<uint32_t>& removed_ids,
+                                              HostVector<uint32_t>& removed_by_sink) {
+  const PipelineBuffers b = r_->buffers();
+  const ParticleArrays& a = b.store->arrays();
+  cudaStream_t s = r_->stream;
+  // The frame's statistics read the last density pass's neighbour counts, in the sorted order the
+  // ghosts' drop and the sinks' compaction change: counted for every particle, then carried along
+  // (as the undivided stream driver does for its compaction).
+  uint32_t* counts = nullptr;
+  if (last) {
+    counts = r_->sinks.counts();
+    b.statistics->enqueue_neighbor_counts(setup.fluid, b.grid->view(), a, halo_owned_ + halo_ghosts_, counts,
+                                          s);
+  }
+  halo_drop_ghosts(counts);
+  const uint32_t n = halo_owned_;
+  uint32_t* kept_out = r_->sink_kept.get();
+  r_->sinks.enqueue_flag(r_->scene_buffer.sinks(), sink_count, a, n, b.state, s);
+  cuda_check(cudaMemcpyAsync(kept_out, r_->sinks.kept_device(), sizeof(uint32_t), cudaMemcpyDeviceToHost, s),
+             "copy of the sink survivor count");
+  cuda_check(cudaStreamSynchronize(s), "sinks");
+  const uint32_t kept = *kept_out;
+  if (kept == n) return counts;
+  r_->sinks.enqueue_compact(*b.store, n, kept, counts, s);
+  const uint32_t removed = n - kept;
+  HostVector<uint32_t> ids(removed), sinks(removed);
+  cuda_check(cudaMemcpyAsync(ids.data(), r_->sinks.removed_ids(), sizeof(uint32_t) * removed,
+                             cudaMemcpyDeviceToHost, s),
+             "copy of the removed ids");
+  cuda_check(cudaMemcpyAsync(sinks.data(), r_->sinks.removed_sinks(), sizeof(uint32_t) * removed,
+                             cudaMemcpyDeviceToHost, s),
+             "copy of the removed ids' sinks");
+  cuda_check(cudaStreamSynchronize(s), "sinks");
+  removed_ids.insert(removed_ids.end(), ids.begin(), ids.end());
+  for (uint32_t k : sinks) ++removed_by_sink[k];
+  halo_owned_ = kept;
+  return counts;
+}
+
+uint32_t CudaBackend::run_frame_distributed(PipelineSetup setup, uint32_t sink_count,
+                                            HostVector<uint32_t>& removed_ids,
+                                            HostVector<uint32_t>& removed_by_sink,
+                                            const StepInterrupt& interrupt, bool& interrupted) {
   const PipelineBuffers b = r_->buffers();
   cudaStream_t s = r_->stream;
   FrameState* out = b.state_output;
@@ -133,6 +186,7 @@ uint32_t CudaBackend::run_frame_distributed(PipelineSetup setup, const StepInter
              "copy of the loop condition");
   cuda_check(cudaStreamSynchronize(s), "frame begin");
   HaloHooks hooks(*this);
+  const uint32_t* counts_after_sinks = nullptr;
   while (out->run) {
     halo_drop_ghosts();
     halo_gather();
@@ -145,14 +199,28 @@ uint32_t CudaBackend::run_frame_distributed(PipelineSetup setup, const StepInter
     enqueue_substep(setup, b, LoopCondition{}, s, &hooks);
     cuda_check(cudaMemcpyAsync(&out->run, &b.state->run, sizeof(uint32_t), cudaMemcpyDeviceToHost, s),
                "copy of the loop condition");
+    cuda_check(
+        cudaMemcpyAsync(&out->non_finite, &b.state->non_finite, sizeof(uint32_t), cudaMemcpyDeviceToHost, s),
+        "copy of the non-finite flag");
     cuda_check(cudaStreamSynchronize(s), "substep");
-    // A cancel or budget seen by any rank stops every rank at the same substep.
-    if (out->run && halo_any(interrupt.requested())) {
+    // A cancel or budget seen by any rank stops every rank at the same substep (after its sinks,
+    // as on the CPU rank).
+    const bool stop = out->run && halo_any(interrupt.requested());
+    // Sinks (not after a failed substep, which every rank found in the substep's reduction).
+    if (sink_count > 0 && !out->non_finite) {
+      counts_after_sinks =
+          halo_apply_sinks(setup, sink_count, !out->run || stop, removed_ids, removed_by_sink);
+      setup.count = halo_owned_;
+      setup.ghosts = 0;
+    }
+    if (stop) {
       interrupted = true;
       break;
     }
   }
-  enqueue_frame_end(setup, b, s);  // (the statistics leave the last substep's ghosts out)
+  // (The statistics leave the last substep's ghosts out; with sinks they are gone already, and the
+  // counts of its density pass came along.)
+  enqueue_frame_end(setup, b, s, counts_after_sinks);
   halo_drop_ghosts();
   cuda_check(cudaStreamSynchronize(s), "frame end");
   halo_agree();  // (the frame's end: nothing after this can fail on one rank alone)

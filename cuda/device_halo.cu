@@ -4,8 +4,10 @@
 #include <algorithm>
 #include <string>
 
+#include "../src/core/exact_float_sum.h"
 #include "../src/physics/grid_hash.h"
 #include "device_halo.h"
+#include "dfsph_solver.h"
 #include "kernel_launch.h"
 
 namespace sph {
@@ -58,6 +60,49 @@ struct HaloRecordFields<HaloNormalRecord> {
   }
 };
 
+// DFSPH (core/dfsph_jacobi_loop.h says when each crosses): after its density pass, the density,
+// factor, 1 / density and neighbour count; in a solve, the velocities of the solve (the arrays'
+// sorted_velocity: the caller points it at the density solve's v*) and the pressure steps k.
+template <>
+struct HaloRecordFields<HaloDfsphDensityRecord> {
+  static constexpr const char* kCopyOut = "copy of the halo's DFSPH density records";
+  static constexpr const char* kCopyIn = "copy of the ghosts' DFSPH density records";
+  __device__ static HaloDfsphDensityRecord pack(const ParticleArrays& a, uint32_t i) {
+    return HaloDfsphDensityRecord{a.sorted_id[i], a.density[i], a.dfsph_factor[i], a.sorted_velocity[i].w,
+                                  a.neighbor_count[i]};
+  }
+  __device__ static void apply(const ParticleArrays& a, uint32_t i, const HaloDfsphDensityRecord& r) {
+    a.density[i] = r.density;
+    a.dfsph_factor[i] = r.factor;
+    a.sorted_velocity[i].w = r.inv_density;
+    a.neighbor_count[i] = r.neighbors;
+  }
+};
+
+template <>
+struct HaloRecordFields<HaloVelocityRecord> {
+  static constexpr const char* kCopyOut = "copy of the halo's DFSPH velocities";
+  static constexpr const char* kCopyIn = "copy of the ghosts' DFSPH velocities";
+  __device__ static HaloVelocityRecord pack(const ParticleArrays& a, uint32_t i) {
+    return HaloVelocityRecord{a.sorted_id[i], {0u, 0u, 0u}, a.sorted_velocity[i]};
+  }
+  __device__ static void apply(const ParticleArrays& a, uint32_t i, const HaloVelocityRecord& r) {
+    a.sorted_velocity[i] = r.velocity;
+  }
+};
+
+template <>
+struct HaloRecordFields<HaloDfsphStepRecord> {
+  static constexpr const char* kCopyOut = "copy of the halo's DFSPH pressure steps";
+  static constexpr const char* kCopyIn = "copy of the ghosts' DFSPH pressure steps";
+  __device__ static HaloDfsphStepRecord pack(const ParticleArrays& a, uint32_t i) {
+    return HaloDfsphStepRecord{a.sorted_id[i], a.dfsph_step[i]};
+  }
+  __device__ static void apply(const ParticleArrays& a, uint32_t i, const HaloDfsphStepRecord& r) {
+    a.dfsph_step[i] = r.k;
+  }
+};
+
 template <class Record>
 __global__ void pack_records_kernel(ParticleArrays a, const uint32_t* __restrict__ idx, uint32_t m,
                                     Record* __restrict__ out) {
@@ -103,6 +148,8 @@ DeviceHalo::DeviceHalo(uint32_t capacity, int ranks) : capacity_(capacity), rank
   visit_.allocate(n, "halo visit order");
   sorted_keys_.allocate(n, "halo sorted keys");
   mismatch_.allocate(1, "halo id check");
+  error_bins_.allocate(kDfsphRankErrorWords, "halo DFSPH error bins");
+  host_error_bins_.allocate(kDfsphRankErrorWords, "halo DFSPH error bins (host)");
   host_cuts_.allocate(static_cast<size_t>(std::max(ranks - 1, 1)), "halo slab cuts (host)");
   host_words_.allocate(words, "halo list starts (host)");
   std::fill(host_words_.get(), host_words_.get() + words, 0u);
@@ -238,24 +285,32 @@ void DeviceHalo::enqueue_apply_records(const ParticleArrays& a, const uint32_t* 
   // (The pinned staging is not touched again before the stream's next wait.)
 }
 
-template const HaloDensityRecord* DeviceHalo::pack_records<HaloDensityRecord>(const ParticleArrays&,
-                                                                              const uint32_t*, uint32_t,
-                                                                              cudaStream_t);
-template const HaloNormalRecord* DeviceHalo::pack_records<HaloNormalRecord>(const ParticleArrays&,
-                                                                            const uint32_t*, uint32_t,
-                                                                            cudaStream_t);
-template void DeviceHalo::enqueue_apply_records<HaloDensityRecord>(const ParticleArrays&, const uint32_t*,
-                                                                   const HaloDensityRecord*, uint32_t,
-                                                                   cudaStream_t);
-template void DeviceHalo::enqueue_apply_records<HaloNormalRecord>(const ParticleArrays&, const uint32_t*,
-                                                                  const HaloNormalRecord*, uint32_t,
-                                                                  cudaStream_t);
+// Each record's pack and apply (HaloRecordFields above).
+#define SPH_HALO_RECORD(Record)                                                                             \
+  template const Record* DeviceHalo::pack_records<Record>(const ParticleArrays&, const uint32_t*, uint32_t, \
+                                                          cudaStream_t);                                    \
+  template void DeviceHalo::enqueue_apply_records<Record>(const ParticleArrays&, const uint32_t*,           \
+                                                          const Record*, uint32_t, cudaStream_t);
+SPH_HALO_RECORD(HaloDensityRecord)
+SPH_HALO_RECORD(HaloNormalRecord)
+SPH_HALO_RECORD(HaloDfsphDensityRecord)
+SPH_HALO_RECORD(HaloVelocityRecord)
+SPH_HALO_RECORD(HaloDfsphStepRecord)
+#undef SPH_HALO_RECORD
+
+const int64_t* DeviceHalo::download_error_bins(cudaStream_t stream) {
+  cuda_check(cudaMemcpyAsync(host_error_bins_.get(), error_bins_.get(),
+                             sizeof(int64_t) * kDfsphRankErrorWords, cudaMemcpyDeviceToHost, stream),
+             "copy of the DFSPH error bins");
+  cuda_check(cudaStreamSynchronize(stream), "the DFSPH error bins");
+  return host_error_bins_.get();
+}
 
 uint64_t DeviceHalo::bytes() const {
   return cuts_.bytes() + layers_.bytes() + origin_.bytes() + keys_in_.bytes() + keys_out_.bytes() +
          values_.bytes() + list_.bytes() + keep_.bytes() + kept_flags_.bytes() + words_.bytes() +
          lists_temp_.bytes() + iota_.bytes() + visit_.bytes() + sorted_keys_.bytes() + sort_temp_.bytes() +
-         mismatch_.bytes() + staging_.bytes();
+         mismatch_.bytes() + error_bins_.bytes() + staging_.bytes();
 }
 
 }  // namespace sph

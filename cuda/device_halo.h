@@ -12,7 +12,8 @@
 //               order in which the grid's sort takes them
 //   mark        after the sort: the ghost mask and each particle's new key (slot, place in it)
 //   records     the density records of the owned particles beside another slab, and the
-//               ghosts' update from their owners' records, checked by id
+//               ghosts' update from their owners' records, checked by id (and DFSPH's records and
+//               its solves' error bins)
 #pragma once
 
 #include <stdint.h>
@@ -98,6 +99,12 @@ class DeviceHalo {
                              cudaStream_t stream);
   uint32_t* mismatch_flag() const { return mismatch_.get(); }
 
+  // DFSPH's error words (dfsph_solver.h's kDfsphRankErrorWords: core/exact_float_sum.h's bins, int64
+  // as two's complement, then the largest error's float bits): the rate pass adds the rank's own
+  // particles' errors; the host reads them (waits).
+  unsigned long long* error_bins() const { return error_bins_.get(); }
+  const int64_t* download_error_bins(cudaStream_t stream);
+
   uint64_t bytes() const;
 
  private:
@@ -127,6 +134,8 @@ class DeviceHalo {
   DeviceArray<unsigned char> sort_temp_;
   size_t sort_temp_bytes_ = 0;
   DeviceArray<uint32_t> mismatch_;
+  DeviceArray<unsigned long long> error_bins_;
+  PinnedArray<int64_t> host_error_bins_;
   DeviceArray<unsigned char> staging_;  // grows on demand
   PinnedArray<int32_t> host_cuts_;
   PinnedArray<uint32_t> host_words_;

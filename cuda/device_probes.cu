@@ -77,13 +77,22 @@ void enqueue_probes_end(const DeviceProbes& probes, cudaStream_t stream) {
              "copy of the probes");
 }
 
-void enqueue_probe_samples(const DeviceProbes& probes, const GridView& grid, const ParticleArrays& a,
-                           const FrameState* state, cudaStream_t stream) {
+void enqueue_probe_points(const DeviceProbes& probes, const GridView& grid, const ParticleArrays& a,
+                          cudaStream_t stream) {
   probe_points_kernel<<<blocks_for(probes.point_count, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(
       probes, grid, a.sorted_position, a.sorted_velocity);
   check_launch("probe_points_kernel");
+}
+
+void enqueue_probe_sums(const DeviceProbes& probes, const FrameState* state, cudaStream_t stream) {
   probe_sums_kernel<<<blocks_for(probes.probe_count, 64), 64, 0, stream>>>(probes, state);
   check_launch("probe_sums_kernel");
+}
+
+void enqueue_probe_samples(const DeviceProbes& probes, const GridView& grid, const ParticleArrays& a,
+                           const FrameState* state, cudaStream_t stream) {
+  enqueue_probe_points(probes, grid, a, stream);
+  enqueue_probe_sums(probes, state, stream);
 }
 
 }  // namespace sph

@@ -42,6 +42,8 @@ class DeviceProbeBuffers {
   // Copies the frame's probe views to the device on `stream`.
   DeviceProbes upload(const SceneFrame& scene, const ProbeConstants& constants, cudaStream_t stream);
   uint64_t bytes() const { return views_.bytes() + points_.bytes() + sums_.bytes(); }
+  // The views of the last upload, on the host (a distributed rank picks each point's owner by them).
+  const HostVector<ProbeView>& host_views() const { return host_views_; }
 
  private:
   DeviceArray<ProbeView> views_;
@@ -56,8 +58,13 @@ class DeviceProbeBuffers {
 void enqueue_probes_begin(const DeviceProbes& probes, cudaStream_t stream);
 void enqueue_probes_end(const DeviceProbes& probes, cudaStream_t stream);
 
-// One substep's samples, after its density pass (the sorted records and the grid).
+// One substep's samples, after its density pass (the sorted records and the grid): the points'
+// gathers (enqueue_probe_points), then each probe's sample into the frame's sums
+// (enqueue_probe_sums); a distributed rank takes each point's owner's gather between the two.
 void enqueue_probe_samples(const DeviceProbes& probes, const GridView& grid, const ParticleArrays& a,
                            const FrameState* state, cudaStream_t stream);
+void enqueue_probe_points(const DeviceProbes& probes, const GridView& grid, const ParticleArrays& a,
+                          cudaStream_t stream);
+void enqueue_probe_sums(const DeviceProbes& probes, const FrameState* state, cudaStream_t stream);
 
 }  // namespace sph

@@ -11,6 +11,7 @@
 
 #include <cuda_runtime.h>
 
+#include "../src/core/dfsph_jacobi_loop.h"
 #include "../src/core/host_memory.h"
 #include "../src/core/solver_record.h"
 #include "cuda_status.h"
@@ -55,17 +56,19 @@ __device__ inline double dfsph_sum_partials(const double* partials, uint32_t blo
   return slots[0];
 }
 
-// The block's largest particle error into state->solve_largest_bits (errors are >= 0, so their
+// The block's largest particle error into *largest (errors are >= 0, so their
 // float bits order as the floats; the maximum is the same whatever order the blocks run in). Called
 // by every thread of the block; a NaN counts as 0 here (the mean carries it).
-__device__ inline void dfsph_block_max_to(FrameState* state, float error) {
+// `largest`: FrameState::solve_largest_bits, or a distributed rank's word after its exact bins.
+template <class Word>
+__device__ inline void dfsph_block_max_to(Word* largest, float error) {
   __shared__ unsigned block_largest;
   const unsigned bits = __reduce_max_sync(0xffffffffu, __float_as_uint(error > 0.0f ? error : 0.0f));
   if (threadIdx.x == 0) block_largest = 0u;
   __syncthreads();
   if ((threadIdx.x & 31u) == 0u && bits != 0u) atomicMax(&block_largest, bits);
   __syncthreads();
-  if (threadIdx.x == 0 && block_largest != 0u) atomicMax(&state->solve_largest_bits, block_largest);
+  if (threadIdx.x == 0 && block_largest != 0u) atomicMax(largest, static_cast<Word>(block_largest));
 }
 
 // The measurement's largest particle error into state->solve_largest, ready for the next. One thread.
@@ -89,14 +92,13 @@ __device__ inline void dfsph_stop_solve(FrameState* state, SolveTally& tally, co
   if (cond.in_graph) cudaGraphSetConditional(cond.handle, 0u);
 }
 
-// The loop's test after an iteration (or the initial residual), as the CPU backend's: on while a
-// bound is unmet or the minimum has not run, and below the cap. One thread.
+// The loop's test after an iteration (or the initial residual), the rule the host-driven loops
+// share (core/dfsph_jacobi_loop.h). One thread.
 __device__ inline void dfsph_continue_solve(FrameState* state, SolveTally& tally, const DfsphBounds& bounds,
                                             uint32_t min_iterations, uint32_t max_iterations,
                                             LoopCondition cond) {
-  const uint32_t iterations = state->solve_iterations;
-  const bool more = (dfsph_bounds_unmet(bounds, dfsph_solve_errors(state)) || iterations < min_iterations) &&
-                    iterations < max_iterations;
+  const bool more = dfsph_solve_goes_on(dfsph_solve_errors(state), state->solve_iterations, bounds,
+                                        min_iterations, max_iterations);
   if (!more) {
     dfsph_stop_solve(state, tally, bounds, cond);
     return;

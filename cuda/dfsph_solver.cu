@@ -1,4 +1,6 @@
 // SPDX-License-Identifier: MIT
+#include "../src/core/dfsph_jacobi_loop.h"
+#include "../src/core/exact_float_sum.h"
 #include "../src/physics/collider_loads.h"
 #include "../src/physics/dfsph_passes.h"
 #include "block_reduce.cuh"
@@ -83,11 +85,28 @@ __global__ void dfsph_correct_kernel(FluidConstants fluid, GridView grid, Partic
   carried[i] = (kWarm ? 0.0f : carried[i]) + k[i] * scale;
 }
 
-// New pressures from the rates over v; each block's error sum to partials[block].
-template <bool kDivergence>
+// Adds x (when `own`) into the exact sum's bins (core/exact_float_sum.h, int64 as two's
+// complement): the block's into shared bins, then its nonzero bins into the device's. Integer
+// additions, so any order of the threads and blocks gives the same bins. Every thread calls it.
+__device__ void exact_bins_add(unsigned long long* bins, bool own, float x) {
+  __shared__ unsigned long long local[ExactFloatSum::kTerms];
+  for (unsigned b = threadIdx.x; b < ExactFloatSum::kTerms; b += blockDim.x) local[b] = 0ull;
+  __syncthreads();
+  if (own) {
+    const ExactFloatTerm t = exact_float_term(__float_as_uint(x));
+    atomicAdd(&local[t.bin], static_cast<unsigned long long>(t.term));
+  }
+  __syncthreads();
+  for (unsigned b = threadIdx.x; b < ExactFloatSum::kTerms; b += blockDim.x)
+    if (local[b] != 0ull) atomicAdd(&bins[b], local[b]);
+}
+
+// New pressures from the rates over v; each block's error sum to partials[block], or (kExact, a
+// distributed rank) the errors of the rank's own particles into the exact sum's bins.
+template <bool kDivergence, bool kExact>
 __global__ void __launch_bounds__(kDfsphSolveBlock)
     dfsph_residual_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n, const Float4* v,
-                          double* partials, FrameState* state) {
+                          double* partials, unsigned long long* bins, FrameState* state) {
   if (state->solve_run == 0) return;  // the same for every thread of the grid
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   double error = 0.0;
@@ -101,8 +120,17 @@ __global__ void __launch_bounds__(kDfsphSolveBlock)
     a.dfsph_step[i] = r.k;
     error = r.error;
   }
-  dfsph_block_sum_to(partials, error);
-  if (!kDivergence) dfsph_block_max_to(state, static_cast<float>(error));  // only the density solve bounds it
+  // (if constexpr: the undivided world's kernel keeps its code and its shared memory). The largest
+  // error: the density solve's only (the divergence solve does not bound it).
+  if constexpr (kExact) {
+    const bool own = i < n && !(a.halo_ghost && a.halo_ghost[i]);
+    exact_bins_add(bins, own, static_cast<float>(error));
+    if (!kDivergence)
+      dfsph_block_max_to(bins + ExactFloatSum::kTerms, own ? static_cast<float>(error) : 0.0f);
+  } else {
+    dfsph_block_sum_to(partials, error);
+    if (!kDivergence) dfsph_block_max_to(&state->solve_largest_bits, static_cast<float>(error));
+  }
 }
 
 // The solve's mean error from the block sums; whether it goes on; its record when it stops.
@@ -118,6 +146,18 @@ __global__ void __launch_bounds__(kDfsphCheckBlock)
   dfsph_take_largest(state);
   dfsph_continue_solve(state, divergence ? state->divergence_tally : state->pressure_tally, bounds,
                        min_iterations, max_iterations, cond);
+}
+
+// A distributed rank's test, decided by the host (core/dfsph_jacobi_loop.h) on the world's
+// errors: the state and the record as dfsph_check_kernel leaves them, by the same rule.
+__global__ void dfsph_rank_check_kernel(uint32_t iterations, DfsphErrors errors, DfsphBounds bounds,
+                                        uint32_t min_iterations, uint32_t max_iterations, bool divergence,
+                                        FrameState* state) {
+  state->solve_iterations = iterations;
+  state->solve_error = errors.mean;
+  state->solve_largest = errors.largest;
+  dfsph_continue_solve(state, divergence ? state->divergence_tally : state->pressure_tally, bounds,
+                       min_iterations, max_iterations, LoopCondition{});
 }
 
 // v* = v + dt a with the non-pressure accelerations, into the state's velocity array (free
@@ -137,7 +177,9 @@ __global__ void dfsph_forces_kernel(FluidConstants fluid, GridView grid, Particl
     const Float4 v = a.sorted_velocity[i];
     if (kScene) acc = add_force_fields(scene, acc, xyz(p));
     if (a.spring_acceleration) acc += xyz(a.spring_acceleration[i]);
-    a2 = length_squared(acc);
+    // A distributed rank's ghost: its owner's acceleration counts; its v* is replaced by its
+    // owner's after the density solve's first velocity update.
+    if (!(a.halo_ghost && a.halo_ghost[i])) a2 = length_squared(acc);
     Vec3 next = xyz(v) + acc * f.dt;
     if (kScene && scene.collider_count != 0) next = dfsph_clamp(a, i, next);
     a.velocity[i] = make_float4_record(next, v.w);
@@ -169,7 +211,9 @@ __global__ void dfsph_integrate_kernel(ParticleArrays a, uint32_t n, DeviceScene
     a.velocity[i] = make_float4_record(next.velocity, v.w);
     a.id[i] = id;
     v2 = length_squared(next.velocity);
-    if (!finite3(next.position) || !isfinite(v2)) {
+    if (a.halo_ghost && a.halo_ghost[i])
+      v2 = 0.0f;  // a distributed rank's ghost: its owner's to move
+    else if (!finite3(next.position) || !isfinite(v2)) {
       // As the CPU backend: the solves count as the integration (no acceleration to blame).
       flag_non_finite(state, 0, i, id,
                       classify_non_finite(rho, p, a.sorted_velocity[i], Vec3{0.0f, 0.0f, 0.0f}, next));
@@ -201,11 +245,11 @@ void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid
   const LoopCondition cond = open_solve_loop(loops.in_graph, stream);
   auto residual = [&] {
     if (divergence)
-      dfsph_residual_kernel<true>
-          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, loops.partials, state);
+      dfsph_residual_kernel<true, false>
+          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, loops.partials, nullptr, state);
     else
-      dfsph_residual_kernel<false>
-          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, loops.partials, state);
+      dfsph_residual_kernel<false, false>
+          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, loops.partials, nullptr, state);
     check_launch("dfsph_residual_kernel");
   };
   auto check = [&](bool first) {
@@ -214,6 +258,61 @@ void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid
                                                            cond, state);
     check_launch("dfsph_check_kernel");
   };
+  if (loops.rank) {
+    // A distributed rank: the host drives the loop, the ghosts' refreshes and the world's error
+    // between the passes (core/dfsph_jacobi_loop.h, the CPU rank's loop); the conjugate gradients
+    // are refused before the step (frame_loop.cu).
+    struct Passes {
+      const FluidConstants& fluid;
+      const GridView& grid;
+      const ParticleArrays& a;
+      uint32_t n;
+      Float4* v;
+      const float* warm;
+      float* carried;
+      bool divergence, contacts;
+      DfsphBounds bounds;
+      uint32_t min_iterations, max_iterations;
+      DfsphRankSteps& rank;
+      FrameState* state;
+      cudaStream_t stream;
+      unsigned blocks, threads;
+      void velocity_update(bool first) {
+        if (first)
+          dfsph_correct_kernel<true><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, warm, carried,
+                                                                     divergence, contacts, state);
+        else
+          dfsph_correct_kernel<false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, a.dfsph_step,
+                                                                      carried, divergence, contacts, state);
+        check_launch("dfsph_correct_kernel");
+      }
+      void share_velocities() { rank.share_velocities(v, stream); }
+      void rates() {
+        unsigned long long* bins = rank.error_bins();
+        cuda_check(cudaMemsetAsync(bins, 0, sizeof(unsigned long long) * kDfsphRankErrorWords, stream),
+                   "DFSPH error bins reset");
+        if (divergence)
+          dfsph_residual_kernel<true, true>
+              <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, nullptr, bins, state);
+        else
+          dfsph_residual_kernel<false, true>
+              <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, nullptr, bins, state);
+        check_launch("dfsph_residual_kernel");
+      }
+      void share_steps() { rank.share_steps(stream); }
+      DfsphErrors errors() { return rank.errors(stream); }
+      void checked(uint32_t iterations, const DfsphErrors& errors, bool) {
+        dfsph_rank_check_kernel<<<1, 1, 0, stream>>>(iterations, errors, bounds, min_iterations,
+                                                     max_iterations, divergence, state);
+        check_launch("dfsph_rank_check_kernel");
+      }
+    } passes{fluid,          grid,           a,           n,        v,
+             warm,           carried,        divergence,  contacts, bounds,
+             min_iterations, max_iterations, *loops.rank, state,    stream,
+             blocks,         threads};
+    run_dfsph_jacobi(passes, bounds, min_iterations, max_iterations);
+    return;
+  }
   dfsph_correct_kernel<true>
       <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, warm, carried, divergence, contacts, state);
   check_launch("dfsph_correct_kernel");
@@ -242,7 +341,6 @@ void enqueue_dfsph_density(const FluidConstants& fluid, const GridView& grid, co
   else
     dfsph_density_kernel<false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
   check_launch("dfsph_density_kernel");
-  if (options.surface_tension) enqueue_colour_normals(fluid, grid, a, n, tuning, stream);
 }
 
 void enqueue_dfsph_step(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,

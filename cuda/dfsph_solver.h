@@ -16,6 +16,8 @@
 
 #include <cuda_runtime.h>
 
+#include "../src/core/exact_float_sum.h"
+#include "../src/physics/dfsph.h"
 #include "../src/physics/fluid_constants.h"
 #include "../src/physics/neighbor_walk.h"
 #include "device_particle_store.h"
@@ -39,16 +41,40 @@ inline uint32_t dfsph_partial_count(uint32_t capacity) {
 
 // DFSPH's density pass: rho_i, the neighbour counts, the factor, each particle's contact with the
 // colliders, the warm starts gathered from the state order into the sorted order, and the
-// sorted velocities (w: 1 / rho); the colour normals when the world has surface tension.
+// sorted velocities (w: 1 / rho). (The colour normals, with surface tension, come after it:
+// substep_pipeline.cu, where a distributed rank's ghosts first take their owners' densities.)
 void enqueue_dfsph_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                            uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
                            const DeviceScene& scene, FrameState* state, cudaStream_t stream);
 
+// A distributed rank's host steps inside DFSPH's solves (cuda_halo.cu; the stream driver only):
+// the host drives each Jacobi solve, an iteration at a time, by core/dfsph_jacobi_loop.h (the CPU
+// rank's loop), which says when the ghosts take their owners' velocities and pressure steps k
+// and reads the world's mean error.
+// A distributed rank's error words: the exact sum's bins, then the largest error's float bits.
+constexpr uint32_t kDfsphRankErrorWords = ExactFloatSum::kTerms + 1;
+
+struct DfsphRankSteps {
+  virtual ~DfsphRankSteps() = default;
+  // The ghosts take their owners' velocities of v (the solve's velocities, sorted order).
+  virtual void share_velocities(Float4* v, cudaStream_t stream) = 0;
+  // The ghosts take their owners' pressure steps k (ParticleArrays::dfsph_step).
+  virtual void share_steps(cudaStream_t stream) = 0;
+  // kDfsphRankErrorWords device words: ExactFloatSum::kTerms bins (int64 in two's complement), into
+  // which the rate pass adds the errors of the rank's own particles, then the float bits of the
+  // largest of them (the density solve's; atomicMax).
+  virtual unsigned long long* error_bins() = 0;
+  // The world's errors: the mean, the bins (after the rate pass) added over the ranks, over the
+  // world's particle count; the largest, the ranks' largest. Waits for the stream.
+  virtual DfsphErrors errors(cudaStream_t stream) = 0;
+};
+
 // Where a solve's loop runs and what it needs beyond the particles.
 struct DfsphLoops {
-  bool in_graph;           // capturing a substep into the frame graph
-  double* partials;        // dfsph_partial_count(capacity) doubles
-  FrameState* host_state;  // pinned: the stream driver reads solve_run here
+  bool in_graph;                   // capturing a substep into the frame graph
+  double* partials;                // dfsph_partial_count(capacity) doubles
+  FrameState* host_state;          // pinned: the stream driver reads solve_run here
+  DfsphRankSteps* rank = nullptr;  // a distributed rank's (the host drives the loop); null otherwise
 };
 
 // The density solve by conjugate gradients (sph_dfsph_params.linear_solver =

@@ -83,15 +83,6 @@ void CudaBackend::prepare_scene(const SceneFrame& scene, const RuntimeParams& pa
 FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& params,
                                           const SceneFrame& scene_in) {
   require_alive();
-  // Every rank has the same scene, so every rank refuses it alike.
-  if (distributed() && !scene_in.sinks.empty())
-    throw Error(
-        Status::Unsupported,
-        "world: sinks do not work in a distributed world on the CUDA backend yet (docs/distributed.md)");
-  if (distributed() && !scene_in.probes.empty())
-    throw Error(Status::Unsupported,
-                "world: probes and gauges do not work in a distributed world on the CUDA backend yet "
-                "(docs/distributed.md)");
   DeviceGuard guard(device_);
   PipelineSetup setup;
   setup.count = count_;
@@ -135,7 +126,8 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
       if (on_graph)
         r_->graph.launch(r_->stream);
       else if (distributed())
-        count_after = run_frame_distributed(setup, scene_in.interrupt, interrupted);
+        count_after = run_frame_distributed(setup, static_cast<uint32_t>(scene_in.sinks.size()), removed_ids,
+                                            removed_by_sink, scene_in.interrupt, interrupted);
       else
         count_after = run_frame_on_stream(setup, static_cast<uint32_t>(scene_in.sinks.size()), removed_ids,
                                           removed_by_sink, scene_in.interrupt, interrupted);

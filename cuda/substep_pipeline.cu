@@ -2,6 +2,18 @@
 #include "substep_pipeline.h"
 
 namespace sph {
+namespace {
+
+// The probes' samples; on a distributed rank every rank takes each point's owner's gather first.
+void enqueue_probes(const DeviceProbes& probes, const GridView& grid, const ParticleArrays& a,
+                    FrameState* state, cudaStream_t stream, SubstepHooks* hooks) {
+  if (!hooks) return enqueue_probe_samples(probes, grid, a, state, stream);
+  enqueue_probe_points(probes, grid, a, stream);
+  hooks->after_probe_points(probes, stream);
+  enqueue_probe_sums(probes, state, stream);
+}
+
+}  // namespace
 
 void enqueue_frame_begin(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
                          cudaStream_t stream) {
@@ -20,28 +32,38 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
   const bool rk4 = setup.integrator == Integrator::Rk4;
   const int stages = rk4 ? kRk4Stages : 1;
   if (setup.options.dfsph) {
-    b.grid->enqueue_sort(a.position, n, b.state, stream);
+    b.grid->enqueue_sort(a.position, n, b.state, stream, hooks ? hooks->visit : nullptr);
     b.grid->enqueue_cell_starts(n, b.state, stream);
+    if (hooks) hooks->after_sort(stream);
     enqueue_reorder(a, b.grid->order(), n, Rk4Carry::None, 0, b.grid->crowd_guard(), b.state, stream);
     if (setup.options.springs) enqueue_spring_reorder(a, b.grid->order(), n, stream);
     enqueue_dfsph_density(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene,
                           b.state, stream);
+    // A distributed rank: the ghosts take their owners' densities and factors, then their colour
+    // normals, before anything reads them (as on the CPU rank); the solves' own refreshes run
+    // inside them (DfsphLoops::rank).
+    if (hooks) hooks->after_dfsph_density(stream);
+    if (setup.options.surface_tension) {
+      enqueue_colour_normals(setup.fluid, b.grid->view(), a, n, setup.tuning, stream);
+      if (hooks) hooks->after_normals(stream);
+    }
     if (setup.options.springs)
       enqueue_spring_pass(setup.springs, b.grid->view(), a, n, true, b.state, stream);
-    const DfsphLoops loops{cond.in_graph, b.solve_partials, b.state_output};
+    const DfsphLoops loops{cond.in_graph, b.solve_partials, b.state_output, hooks};
     const bool loads = setup.loads.on();
     enqueue_dfsph_step(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene, loops,
                        !loads, b.state, stream);
     // Probes sample the substep's start once the solves have found its pressure, as on the CPU.
-    if (setup.probes.on()) enqueue_probe_samples(setup.probes, b.grid->view(), a, b.state, stream);
+    if (setup.probes.on()) enqueue_probes(setup.probes, b.grid->view(), a, b.state, stream, hooks);
     // Loads: the walls' reactions of both solves, the contact clamp's impulses, the contacts.
     if (loads)
       enqueue_loads(setup.fluid, a, n, setup.scene, setup.loads, setup.options.boundary_density, 0.0f, 1.0f,
                     true, false, b.state, stream);
+    if (hooks) hooks->before_end(stream);
     enqueue_end_substep(b.state, setup.limits, setup.max_substeps, 1, cond, stream);
     return;
   }
-  if (hooks && (rk4 || setup.options.dfsph))
+  if (hooks && rk4)
     throw Error(Status::Internal, "substep: a distributed rank's steps are symplectic Euler's");
   for (int stage = 0; stage < stages; ++stage) {
     b.grid->enqueue_sort(a.position, n, b.state, stream, hooks ? hooks->visit : nullptr);
@@ -69,7 +91,7 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
     }
     // Probes sample the substep's start (RK4: its first stage), as on the CPU.
     if (stage == 0 && setup.probes.on())
-      enqueue_probe_samples(setup.probes, b.grid->view(), a, b.state, stream);
+      enqueue_probes(setup.probes, b.grid->view(), a, b.state, stream, hooks);
     if (setup.options.springs)
       enqueue_spring_pass(setup.springs, b.grid->view(), a, n, stage == 0, b.state, stream);
     const bool loads = setup.loads.on();

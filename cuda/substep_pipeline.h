@@ -54,19 +54,22 @@ struct PipelineBuffers {
 // A distributed rank's host steps inside a substep (cuda_halo.cu; the stream driver only, as
 // each may wait for the stream): the sort's visit order, and calls after the sort (the grid's
 // order and cell starts are enqueued), after the density pass (the ghosts take their owners'
-// densities) and before the end-of-substep kernel (the maxima and failures reduced over ranks).
-struct SubstepHooks {
+// densities) and before the end-of-substep kernel (the maxima and failures reduced over ranks);
+// with DFSPH, after its density pass and inside its solves (DfsphRankSteps).
+struct SubstepHooks : DfsphRankSteps {
   const uint32_t* visit = nullptr;
-  virtual ~SubstepHooks() = default;
   virtual void after_sort(cudaStream_t stream) = 0;
   virtual void after_density(cudaStream_t stream) = 0;
-  virtual void after_normals(cudaStream_t stream) = 0;  // surface tension's colour normals
+  virtual void after_dfsph_density(cudaStream_t stream) = 0;  // DFSPH's density pass
+  virtual void after_normals(cudaStream_t stream) = 0;        // surface tension's colour normals
+  // Probes: each sample point's gather (probes.points, device) replaced by its owner rank's.
+  virtual void after_probe_points(const DeviceProbes& probes, cudaStream_t stream) = 0;
   virtual void before_end(cudaStream_t stream) = 0;
 };
 
 void enqueue_frame_begin(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
                          cudaStream_t stream);
-// hooks: a distributed rank's (symplectic Euler only; null otherwise).
+// hooks: a distributed rank's (symplectic Euler or DFSPH; null otherwise).
 void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
                      cudaStream_t stream, SubstepHooks* hooks = nullptr);
 // counts: the neighbour counts of the last density pass when a sink compaction left the sorted

@@ -14,7 +14,26 @@
 #include <cmath>
 #include <limits>
 
+#include "../physics/host_device.h"
+
 namespace sph {
+
+// Where a float (its bits) goes in an exact sum: the bin and the integer added there. Host and
+// device (a distributed CUDA rank adds its DFSPH errors into the same bins on the device).
+struct ExactFloatTerm {
+  int bin;
+  int64_t term;
+};
+
+SPH_HD ExactFloatTerm exact_float_term(uint32_t bits) {
+  const uint32_t exponent = (bits >> 23) & 0xffu;
+  const bool negative = (bits >> 31) != 0;
+  if (exponent == 0xffu)  // as IEEE sums them: NaN beats inf, +inf and -inf make NaN
+    return ExactFloatTerm{(bits & 0x7fffffu) != 0 ? 255 : (negative ? 257 : 256), 1};
+  int64_t significand = bits & 0x7fffffu;
+  if (exponent != 0) significand |= 0x800000;  // the implicit bit of a normal float
+  return ExactFloatTerm{static_cast<int>(exponent), negative ? -significand : significand};
+}
 
 class ExactFloatSum {
  public:
@@ -24,15 +43,8 @@ class ExactFloatSum {
   void add(float x) {
     uint32_t bits;
     memcpy(&bits, &x, sizeof bits);
-    const uint32_t exponent = (bits >> 23) & 0xffu;
-    const bool negative = (bits >> 31) != 0;
-    if (exponent == 0xffu) {  // as IEEE sums them: NaN beats inf, +inf and -inf make NaN
-      ++terms_[(bits & 0x7fffffu) != 0 ? kNan : (negative ? kMinusInf : kPlusInf)];
-      return;
-    }
-    int64_t significand = bits & 0x7fffffu;
-    if (exponent != 0) significand |= 0x800000;  // the implicit bit of a normal float
-    terms_[exponent] += negative ? -significand : significand;
+    const ExactFloatTerm t = exact_float_term(bits);
+    terms_[t.bin] += t.term;
   }
   int64_t* terms() { return terms_; }
 
@@ -48,7 +60,8 @@ class ExactFloatSum {
   }
 
  private:
-  static constexpr int kNan = 255, kPlusInf = 256, kMinusInf = 257;  // after the 255 exponents' bins
+  // After the 255 exponents' bins (exact_float_term's).
+  static constexpr int kNan = 255, kPlusInf = 256, kMinusInf = 257;
   int64_t terms_[kTerms] = {};
 };
 

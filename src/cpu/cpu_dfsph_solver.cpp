@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "../core/dfsph_jacobi_loop.h"
 #include "../core/exact_float_sum.h"
 #include "cpu_backend_impl.h"
 
@@ -67,11 +68,10 @@ void CpuBackend::dfsph_correct(const FluidConstants& fluid, const DfsphWalls& wa
     columns_.set_velocity(i, vi);
     carried[i] += k[i] * carry_scale;
   });
-  if (ranks_) halo_share_velocities(v);  // the next rate pass reads the ghosts' velocities
 }
 
-DfsphErrors CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls,
-                                        float dt) {
+void CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls,
+                                 float dt) {
   const GridView view = grid_.view();
   const NeighborColumns columns = columns_.view();
   const float* factor = dfsph_factor_.data();
@@ -91,7 +91,11 @@ DfsphErrors CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& f
     k[i] = r.k;
     error[i] = r.error;
   });
+}
+
+DfsphErrors CpuBackend::dfsph_errors() {
   // Exact, so the mean is the same bits whichever particles a rank holds (exact_float_sum.h).
+  const float* error = dfsph_residual_.data();
   ExactFloatSum sum;
   float largest = 0.0f;
   for (uint32_t i = 0; i < count_; ++i)
@@ -101,10 +105,9 @@ DfsphErrors CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& f
     }
   int64_t particles = count_;
   if (ranks_) {
-    halo_share_dfsph_step();  // the next velocity update reads the ghosts' k
-    halo_agree();             // (the share's buffers: a rank that failed there meets the others here)
+    halo_agree();  // (the shares' buffers: a rank that failed there meets the others here)
     ranks_->all_sum(sum.terms(), ExactFloatSum::kTerms);
-    if (kind == DfsphSolve::Density) ranks_->all_max(&largest, 1);  // only the density solve bounds it
+    ranks_->all_max(&largest, 1);
     particles = halo_world_count_;
   }
   return {particles > 0 ? static_cast<float>(sum.value() / static_cast<double>(particles)) : 0.0f, largest};
@@ -127,15 +130,29 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
     k[i] = Dfsph::kWarmStart * carried[i] / carry_scale;
     carried[i] = 0.0f;
   });
-  dfsph_correct(fluid, walls, dt, v, carried, carry_scale);
-  DfsphErrors error = dfsph_residuals(kind, fluid, walls, dt);
-  uint32_t iterations = 0;
-  while ((dfsph_bounds_unmet(bounds, error) || iterations < min_iterations) && iterations < max_iterations) {
-    dfsph_correct(fluid, walls, dt, v, carried, carry_scale);
-    error = dfsph_residuals(kind, fluid, walls, dt);
-    ++iterations;
-  }
-  return SolveOutcome{iterations, error.mean, error.largest, dfsph_bounds_unmet(bounds, error)};
+  // The loop and, on a rank, the ghosts' refreshes between its passes (core/dfsph_jacobi_loop.h).
+  struct Passes {
+    CpuBackend& b;
+    DfsphSolve kind;
+    const FluidConstants& fluid;
+    const DfsphWalls& walls;
+    float dt;
+    Float4* v;
+    float* carried;
+    float carry_scale;
+    void velocity_update(bool) { b.dfsph_correct(fluid, walls, dt, v, carried, carry_scale); }
+    void share_velocities() {
+      if (b.ranks_) b.halo_share_velocities(v);
+    }
+    void rates() { b.dfsph_residuals(kind, fluid, walls, dt); }
+    void share_steps() {
+      if (b.ranks_) b.halo_share_dfsph_step();
+    }
+    DfsphErrors errors() { return b.dfsph_errors(); }
+    void checked(uint32_t, const DfsphErrors&, bool) {}
+  } passes{*this, kind, fluid, walls, dt, v, carried, carry_scale};
+  const DfsphLoopOutcome o = run_dfsph_jacobi(passes, bounds, min_iterations, max_iterations);
+  return SolveOutcome{o.iterations, o.errors.mean, o.errors.largest, o.capped};
 }
 
 uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame& scene,

@@ -3,27 +3,26 @@
 //   DFSPH      after its density pass the ghosts take their owners' density, factor and neighbour
 //              count; inside each solve iteration, their velocities after each velocity update
 //              and their pressure steps k after each rate pass (the next pass reads both of its
-//              neighbours); the solve's mean error is an exact sum whose bins are added over
-//              the ranks (cpu_dfsph_solver.cpp): every rank runs the undivided world's iterations;
+//              neighbours; core/dfsph_jacobi_loop.h, the loop the CUDA rank runs too); the
+//              solve's mean error is an exact sum whose bins are added over the ranks
+//              (cpu_dfsph_solver.cpp): every rank runs the undivided world's iterations;
 //   probes     each sample point is gathered by the rank whose slab holds its cell layer (its
 //              neighbour cells are complete there, in the undivided world's order) and every
-//              rank takes that rank's sums: each rank reads the world's bits;
+//              rank takes that rank's sums (core/rank_probe_points.h, the CUDA rank's too):
+//              each rank reads the world's bits;
 //   loads      each rank sums the impulses of its own particles; the frame's sums are added
 //              over the ranks in rank order, so every rank reads the same world's value.
 #include <string>
 
-#include "../core/grid_layout.h"
+#include "../core/halo_records.h"
+#include "../core/rank_probe_points.h"
 #include "../core/rank_sums.h"
 #include "cpu_halo_share.h"
 
 namespace sph {
 
 void CpuBackend::halo_share_dfsph_density() {
-  struct Record {
-    uint32_t id;
-    float density, factor, inv_density;
-    uint32_t neighbors;
-  };
+  using Record = HaloDfsphDensityRecord;
   float* factor = dfsph_factor_.data();
   halo_share<Record>(
       "DFSPH densities",
@@ -41,13 +40,7 @@ void CpuBackend::halo_share_dfsph_density() {
 }
 
 void CpuBackend::halo_share_velocities(Float4* v) {
-  // The padding is a member, zeroed (as the colour normals' record, cpu_halo.cpp).
-  struct Record {
-    uint32_t id;
-    uint32_t padding[3];
-    Float4 velocity;
-  };
-  static_assert(sizeof(Record) == 32, "a velocity's record has no implicit padding");
+  using Record = HaloVelocityRecord;  // (its padding a member, zeroed)
   halo_share<Record>(
       "DFSPH velocities",
       [&](uint32_t i) {
@@ -60,10 +53,7 @@ void CpuBackend::halo_share_velocities(Float4* v) {
 }
 
 void CpuBackend::halo_share_dfsph_step() {
-  struct Record {
-    uint32_t id;
-    float k;
-  };
+  using Record = HaloDfsphStepRecord;
   float* k = columns_.dfsph_step();
   halo_share<Record>(
       "DFSPH pressure steps",
@@ -74,28 +64,8 @@ void CpuBackend::halo_share_dfsph_step() {
 }
 
 void CpuBackend::halo_pick_probe_points(const SceneFrame& scene) {
-  static_assert(sizeof(ProbeGather) == 6 * sizeof(float), "a probe gather is six floats");
-  const RankTransport& t = *ranks_;
-  const size_t points = probe_points_.size();
-  if (t.size() == 1 || points == 0) return;
-  const size_t bytes = points * sizeof(ProbeGather);
-  RankBytes mine(bytes);
-  std::memcpy(mine.data(), probe_points_.data(), bytes);
-  const std::vector<RankBytes> in = t.exchange(std::vector<RankBytes>(static_cast<size_t>(t.size()), mine));
-  for (size_t r = 0; r < in.size(); ++r)
-    if (in[r].size() != bytes)
-      throw Error(Status::Internal,
-                  "halo: rank " + std::to_string(r) + " sampled another number of probe points");
-  const int axis = slabs_.axis();
-  const float inv = 1.0f / config_.kernel_radius;
-  for (const ProbeView& p : scene.probes)
-    for (uint32_t q = 0; q < p.point_count; ++q) {
-      const Vec3 x = probe_point(p, q);
-      const int owner = slabs_.owner(cell_coordinate(axis == 0 ? x.x : (axis == 1 ? x.y : x.z), inv));
-      const size_t k = p.first_point + q;
-      std::memcpy(&probe_points_[k], in[static_cast<size_t>(owner)].data() + k * sizeof(ProbeGather),
-                  sizeof(ProbeGather));
-    }
+  pick_rank_probe_points(*ranks_, slabs_, config_.kernel_radius, scene.probes.data(), scene.probes.size(),
+                         probe_points_.data(), probe_points_.size());
 }
 
 void CpuBackend::halo_sum_loads() {

@@ -19,12 +19,16 @@
  * boundary (20 substeps; again with Clavet's viscosity and the user attribute, with the walls'
  * density, with the normalised density, with it and the density diffusion, with surface
  * tension), the collider loads (run_loads_case), the collapse that makes the ranks rebalance (12 frames of 20
- * substeps, spacing 12.5 mm), and the refusals (DFSPH, RK4, springs: SPH_ERROR_UNSUPPORTED naming them). With
- * SPH_MPI_CUDA_QUICK set, the dam break and the refusals only (a run under compute-sanitizer). */
+ * substeps, spacing 12.5 mm), DFSPH's Jacobi solves (test_mpi_cuda_cases.c: the dam break, the stirred
+ * column with and without the divergence solve), probes and gauges and sinks (there too, both solvers), and
+ * the refusals (RK4, springs, DFSPH's conjugate gradients: SPH_ERROR_UNSUPPORTED naming them). With
+ * SPH_MPI_CUDA_QUICK set, the dam breaks (WCSPH and DFSPH) and the refusals only (a run under
+ * compute-sanitizer). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "mpi_cuda_cases.h"
 #include "mpi_test_world.h"
 #include "support.h"
 
@@ -224,9 +228,19 @@ int main(int argc, char** argv) {
     run_case("collapse with rebalancing", cuda, cpu, &def, 0.0f, 12, 20, 0);
   }
 
-  mpi_test_world_def(&def);
-  def.solver = SPH_SOLVER_DFSPH;
-  expect_refused(cuda, &def, "DFSPH");
+  mpi_cuda_dfsph_case("DFSPH dam break", cuda, cpu, 0.0f, 1, 0);
+  if (!quick) {
+    mpi_cuda_dfsph_case("DFSPH stirred column", cuda, cpu, 2.0f, 1, 0);
+    mpi_cuda_dfsph_case("DFSPH stirred column without the divergence solve", cuda, cpu, 2.0f, 0, 0);
+    mpi_cuda_dfsph_case("DFSPH stirred column, capped solves", cuda, cpu, 2.0f, 1, 3);
+  }
+  if (!quick) {
+    mpi_cuda_probes_case("probes", cuda, SPH_SOLVER_WCSPH);
+    mpi_cuda_probes_case("DFSPH probes", cuda, SPH_SOLVER_DFSPH);
+    mpi_cuda_sinks_case("sinks", cuda, SPH_SOLVER_WCSPH);
+    mpi_cuda_sinks_case("DFSPH sinks", cuda, SPH_SOLVER_DFSPH);
+  }
+  mpi_cuda_expect_cg_refused(cuda);
   mpi_test_world_def(&def);
   def.integrator = SPH_INTEGRATOR_RK4;
   expect_refused(cuda, &def, "RK4");

@@ -1,0 +1,342 @@
+/* SPDX-License-Identifier: MIT */
+/* gpu_check_mpi's DFSPH, probes and sinks cases (tests/mpi/test_mpi_cuda.c has the program and the
+ * weakly compressible cases): the distributed CUDA world against the undivided CUDA world. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpi_cuda_cases.h"
+#include "mpi_test_world.h"
+
+static float max_abs_difference(const float* a, const float* b, uint32_t n) {
+  float m = 0.0f;
+  for (uint32_t i = 0; i < 3 * n; ++i) m = fmaxf(m, fabsf(a[i] - b[i]));
+  return m;
+}
+
+/* DFSPH (Jacobi): the stirred column (or the dam break: stir 0) in two frames of 7 and 5 substeps
+ * with bounds 100 (density) and 10 (divergence) times tighter than the defaults, as
+ * tests/mpi/test_mpi_solvers.c does on the CPU, so the convergence test rather than the minimum ends
+ * the stirred column's solves. The rank drives each solve from the host: the ghosts take their
+ * owners' densities and factors, and in each iteration velocities and pressure steps; the mean error
+ * is an exact sum (int64 bins) added over the ranks. Checked on rank 0:
+ *   - the particles BIT FOR BIT against the undivided CUDA world (every pass sums in its order, and
+ *     a solve that ran one iteration more or less would move every particle);
+ *   - the iteration counts (sum and max, both solves, each frame) equal the undivided CUDA world's,
+ *     and are the same on every rank with the same mean errors (bit for bit); the stirred column's
+ *     density solves run more than the minimum (2 a substep), so the test decides; the capped solves'
+ *     counts equal too, and the capped case (cap 3, bound 1e-8) caps every density solve (the cap,
+ *     the record and SPH_EVENT_PRESSURE_SOLVE_CAPPED's count come from the same device record);
+ *   - the mean errors within 1e-6 of the undivided CUDA world's: it sums the errors in doubles in a
+ *     fixed tree (dfsph_solve_loop.cuh), the rank exactly, so the float means may differ by an ulp
+ *     (an iteration count would differ only if a mean fell within that ulp of its bound).
+ * The two-rank CPU world's distance is printed only (the solves amplify CPU and GPU roundings). */
+void mpi_cuda_dfsph_case(const char* name, sph_context* cuda, sph_context* cpu, float stir,
+                         uint32_t divergence_solve, uint32_t cap) {
+  const uint32_t frames[2] = {7, 5};
+  sph_world_def def;
+  sph_dfsph_params dfsph;
+  sph_world* single = NULL;
+  sph_world* world = NULL;
+  sph_world* cpu_world = NULL;
+  uint32_t n = 0, n_cpu = 0;
+  float *x = NULL, *v = NULL, *want_x = NULL, *want_v = NULL, *cpu_x = NULL, *cpu_v = NULL;
+  mpi_test_world_def(&def);
+  def.capacity = 32768;
+  def.solver = SPH_SOLVER_DFSPH;
+  mpi_test_dam(cuda, &def, stir, NULL, &single, &world, &n);
+  mpi_test_dam(cpu, &def, stir, NULL, NULL, &cpu_world, &n_cpu);
+  REQUIRE(sph_dfsph_params_init(&dfsph) == SPH_OK, "dfsph params init");
+  if (!divergence_solve) dfsph.flags |= SPH_DFSPH_SKIP_DIVERGENCE_SOLVE;
+  dfsph.density_error = 1e-5f;
+  dfsph.divergence_error = 0.1f;
+  if (cap > 0) {
+    /* A bound no solve reaches in `cap` iterations: each substep's density solve stops at its cap. */
+    dfsph.density_error = 1e-8f;
+    dfsph.max_iterations = cap;
+  }
+  REQUIRE(sph_world_set_dfsph_params(world, &dfsph) == SPH_OK, "dfsph params: %s", sph_get_last_error());
+  REQUIRE(sph_world_set_dfsph_params(cpu_world, &dfsph) == SPH_OK, "dfsph params");
+  if (single) REQUIRE(sph_world_set_dfsph_params(single, &dfsph) == SPH_OK, "dfsph params");
+  for (int f = 0; f < 2; ++f) {
+    sph_stats got, want, first, cpu_stats;
+    mpi_test_step_stats(world, frames[f], 1, &got);
+    mpi_test_step_stats(cpu_world, frames[f], 1, &cpu_stats);
+    first = got;
+    MPI_Bcast(&first, (int)sizeof first, MPI_BYTE, 0, MPI_COMM_WORLD);
+    CHECK(first.pressure_iterations == got.pressure_iterations &&
+              first.divergence_iterations == got.divergence_iterations &&
+              memcmp(&first.density_error_mean, &got.density_error_mean, sizeof(float)) == 0 &&
+              memcmp(&first.divergence_error_mean, &got.divergence_error_mean, sizeof(float)) == 0,
+          "%s frame %d: rank %d ran other iterations than rank 0", name, f, g_rank);
+    CHECK(got.pressure_iterations >= 2 * frames[f] && (!divergence_solve || got.divergence_iterations > 0),
+          "%s frame %d: %u density, %u divergence iterations (the solves did not run)", name, f,
+          got.pressure_iterations, got.divergence_iterations);
+    if (g_rank != 0) continue;
+    mpi_test_step_stats(single, frames[f], 0, &want);
+    printf(
+        "%s frame %d on %d ranks: iterations %u/%u density, %u/%u divergence (undivided %u/%u, %u/%u; "
+        "CPU ranks %u, %u); mean errors %.9g, %.9g (undivided %.9g, %.9g)\n",
+        name, f, g_size, got.pressure_iterations, got.pressure_iterations_max, got.divergence_iterations,
+        got.divergence_iterations_max, want.pressure_iterations, want.pressure_iterations_max,
+        want.divergence_iterations, want.divergence_iterations_max, cpu_stats.pressure_iterations,
+        cpu_stats.divergence_iterations, (double)got.density_error_mean, (double)got.divergence_error_mean,
+        (double)want.density_error_mean, (double)want.divergence_error_mean);
+    CHECK(got.pressure_iterations == want.pressure_iterations &&
+              got.pressure_iterations_max == want.pressure_iterations_max &&
+              got.divergence_iterations == want.divergence_iterations &&
+              got.divergence_iterations_max == want.divergence_iterations_max,
+          "%s frame %d: the iterations differ from the undivided CUDA world's", name, f);
+    CHECK(got.pressure_solves_capped == want.pressure_solves_capped &&
+              got.divergence_solves_capped == want.divergence_solves_capped,
+          "%s frame %d: %u/%u capped solves (density/divergence), the undivided CUDA world %u/%u", name, f,
+          got.pressure_solves_capped, got.divergence_solves_capped, want.pressure_solves_capped,
+          want.divergence_solves_capped);
+    CHECK(cap == 0 || (want.pressure_solves_capped == frames[f] && got.pressure_iterations_max == cap),
+          "%s frame %d: %u of %u density solves capped, at most %u iterations (cap %u)", name, f,
+          want.pressure_solves_capped, frames[f], got.pressure_iterations_max, cap);
+    CHECK(fabsf(got.density_error_mean - want.density_error_mean) <= 1e-6f * fabsf(want.density_error_mean) &&
+              fabsf(got.divergence_error_mean - want.divergence_error_mean) <=
+                  1e-6f * fabsf(want.divergence_error_mean),
+          "%s frame %d: mean errors differ from the undivided CUDA world's by more than 1e-6", name, f);
+    if (stir > 0.0f && f == 1)
+      CHECK(want.pressure_iterations > 2 * frames[f],
+            "%s: the density solves stopped at the minimum (%u iterations): the test never decided", name,
+            want.pressure_iterations);
+  }
+  mpi_test_gather(world, n, &x, &v);
+  mpi_test_gather(cpu_world, n, &cpu_x, &cpu_v);
+  if (g_rank == 0) {
+    uint32_t differ;
+    mpi_test_read(single, n, &want_x, &want_v);
+    differ = mpi_differ(want_x, want_v, x, v, n, NULL);
+    printf(
+        "%s on %d ranks: %u of %u particles differ from the undivided CUDA world in any bit; "
+        "max |x_cuda - x_cpu| %.3g m (printed only)\n",
+        name, g_size, differ, n, (double)max_abs_difference(cpu_x, x, n));
+    CHECK(differ == 0, "%s: %u of %u particles differ from the undivided CUDA world", name, differ, n);
+    CHECK(n == n_cpu, "%s: %u particles on the CPU world, %u on the CUDA world", name, n_cpu, n);
+    free(want_x);
+    free(want_v);
+    sph_world_destroy(single);
+  }
+  free(x);
+  free(v);
+  free(cpu_x);
+  free(cpu_v);
+  sph_world_destroy(world);
+  sph_world_destroy(cpu_world);
+}
+
+static void add_probes(sph_world* w, sph_probe_id* point, sph_probe_id* gauge) {
+  sph_probe_def def;
+  REQUIRE(sph_probe_def_init(&def) == SPH_OK, "probe init");
+  def.sampling = SPH_PROBE_EVERY_SUBSTEP;
+  def.position.x = 0.05f;
+  def.position.y = 0.02f;
+  def.position.z = 0.03f;
+  REQUIRE(sph_probe_create(w, &def, point) == SPH_OK, "point probe: %s", sph_get_last_error());
+  def.kind = SPH_PROBE_GAUGE;
+  def.position.x = 0.031f;
+  def.position.y = -0.01f;
+  def.position.z = 0.027f;
+  def.length = 0.25f;
+  REQUIRE(sph_probe_create(w, &def, gauge) == SPH_OK, "gauge: %s", sph_get_last_error());
+}
+
+/* Probes and gauges (tests/mpi/test_mpi_scene_sums.c's probes on the CPU): the stirred column with a
+ * point probe inside it and a gauge along y (the slabs' axis, so its points lie in every rank's slab),
+ * sampled every substep, two frames of 8 substeps, with the weakly compressible solver or DFSPH.
+ * Each rank gathers every point; every rank takes, for each point, the gather of the rank whose slab
+ * holds the point's cell layer (its neighbour cells are complete there and list their particles in
+ * the undivided world's order), so the readings are the undivided CUDA world's BIT FOR BIT, the same
+ * on every rank; the point must read water (density > 0) and the gauge a water height > 0 (not two
+ * empty readings); the particles stay the undivided world's bit for bit. */
+void mpi_cuda_probes_case(const char* name, sph_context* cuda, sph_solver solver) {
+  const sph_vec3 column_min = {0.0f, 0.0f, 0.0f}, column_max = {0.1f, 0.2f, 0.06f};
+  sph_world_def def;
+  mpi_test_worlds w;
+  sph_probe_id point, gauge, single_point = {0}, single_gauge = {0};
+  float *x = NULL, *v = NULL, *want_x = NULL, *want_v = NULL;
+  mpi_test_world_def(&def);
+  def.capacity = 32768;
+  def.solver = solver;
+  mpi_test_make_worlds(cuda, &def, column_min, column_max, 0.5f, MPI_COMM_WORLD, NULL, &w);
+  add_probes(w.world, &point, &gauge);
+  if (w.single) add_probes(w.single, &single_point, &single_gauge);
+  for (int f = 0; f < 2; ++f) {
+    sph_probe_reading got[2], want[2], first[2];
+    mpi_test_step(w.world, 8, 1);
+    REQUIRE(sph_probe_reading_init(&got[0]) == SPH_OK && sph_probe_reading_init(&got[1]) == SPH_OK &&
+                sph_probe_get_reading(w.world, point, &got[0]) == SPH_OK &&
+                sph_probe_get_reading(w.world, gauge, &got[1]) == SPH_OK,
+            "%s: readings: %s", name, sph_get_last_error());
+    memcpy(first, got, sizeof got);
+    MPI_Bcast(first, (int)sizeof first, MPI_BYTE, 0, MPI_COMM_WORLD);
+    CHECK(memcmp(first, got, sizeof got) == 0, "%s frame %d: rank %d reads other probes than rank 0", name, f,
+          g_rank);
+    if (g_rank != 0) continue;
+    mpi_test_step(w.single, 8, 0);
+    REQUIRE(sph_probe_reading_init(&want[0]) == SPH_OK && sph_probe_reading_init(&want[1]) == SPH_OK &&
+                sph_probe_get_reading(w.single, single_point, &want[0]) == SPH_OK &&
+                sph_probe_get_reading(w.single, single_gauge, &want[1]) == SPH_OK,
+            "%s: readings", name);
+    printf(
+        "%s frame %d on %d ranks: point %.9g Pa %.9g kg/m3, gauge %.9g m (undivided %.9g Pa %.9g kg/m3, "
+        "%.9g m)\n",
+        name, f, g_size, (double)got[0].pressure, (double)got[0].density, (double)got[1].water_height,
+        (double)want[0].pressure, (double)want[0].density, (double)want[1].water_height);
+    CHECK(memcmp(got, want, sizeof got) == 0,
+          "%s frame %d: the readings differ from the undivided CUDA world's", name, f);
+    CHECK(want[0].density > 0.0f && want[1].water_height > 0.0f, "%s frame %d: the probes read no water",
+          name, f);
+  }
+  mpi_test_gather(w.world, w.n, &x, &v);
+  if (g_rank == 0) {
+    uint32_t differ;
+    mpi_test_read(w.single, w.n, &want_x, &want_v);
+    differ = mpi_differ(want_x, want_v, x, v, w.n, NULL);
+    CHECK(differ == 0, "%s: %u of %u particles differ from the undivided CUDA world", name, differ, w.n);
+    free(want_x);
+    free(want_v);
+    sph_world_destroy(w.single);
+  }
+  free(x);
+  free(v);
+  sph_world_destroy(w.world);
+}
+
+static void add_sink(sph_world* w) {
+  sph_sink_def sink;
+  sph_sink_id id;
+  REQUIRE(sph_sink_def_init(&sink) == SPH_OK, "sink init");
+  sink.mode = SPH_SINK_OUTSIDE_BOUNDS;
+  sink.bounds_min.x = -1.0f;
+  sink.bounds_min.y = -1.0f;
+  sink.bounds_min.z = -1.0f;
+  sink.bounds_max.x = 1.0f;
+  sink.bounds_max.y = 0.185f;
+  sink.bounds_max.z = 1.0f;
+  REQUIRE(sph_sink_create(w, &sink, &id) == SPH_OK, "sink: %s", sph_get_last_error());
+}
+
+static int compare_ids(const void* a, const void* b) {
+  const uint32_t x = *(const uint32_t*)a, y = *(const uint32_t*)b;
+  return (x > y) - (x < y);
+}
+
+/* The last step's removed ids (malloc'd, *count of them) and its SPH_EVENT_SINK_REMOVED count. */
+static uint32_t* last_removed(sph_world* w, uint32_t* count, uint32_t* events_count) {
+  sph_event events[8];
+  uint32_t n = 0, events_n = 0;
+  uint32_t* ids;
+  REQUIRE(sph_world_get_removed_ids(w, NULL, 0, &n) == SPH_OK || n > 0, "removed ids count");
+  ids = (uint32_t*)malloc(sizeof(uint32_t) * ((size_t)n + 1));
+  REQUIRE(ids != NULL, "malloc");
+  REQUIRE(sph_world_get_removed_ids(w, ids, n, count) == SPH_OK, "removed ids");
+  REQUIRE(sph_world_get_events(w, events, 8, &events_n) == SPH_OK, "events");
+  *events_count = 0;
+  for (uint32_t i = 0; i < events_n && i < 8; ++i)
+    if (events[i].type == SPH_EVENT_SINK_REMOVED) *events_count += events[i].count;
+  return ids;
+}
+
+/* Sinks (tests/mpi/test_mpi_sources.c's sink on the CPU): the stirred column with a sink that removes
+ * what lies above y = 0.185 m (the column is 0.2 m tall), two frames of 8 substeps, with `solver`.
+ * Each rank removes its own particles after each substep, its ghosts dropped first. Checked on rank 0,
+ * each frame: the ids all ranks removed (sph_mpi_world_gather_removed_ids: ascending) are the undivided
+ * CUDA world's (sorted), the ranks' SPH_EVENT_SINK_REMOVED counts add up to its count, and the world's
+ * count is its; the first frame must remove particles (not all of them). After the frames the
+ * survivors equal the undivided world's BIT FOR BIT (a removed particle is gone from both worlds'
+ * neighbour sums alike; the survivors' sort keys keep their order). */
+void mpi_cuda_sinks_case(const char* name, sph_context* cuda, sph_solver solver) {
+  const sph_vec3 column_min = {0.0f, 0.0f, 0.0f}, column_max = {0.1f, 0.2f, 0.06f};
+  sph_world_def def;
+  mpi_test_worlds w;
+  sph_mpi_counts counts;
+  uint32_t n = 0;
+  float *x = NULL, *v = NULL, *want_x = NULL, *want_v = NULL;
+  mpi_test_world_def(&def);
+  def.capacity = 32768;
+  def.solver = solver;
+  mpi_test_make_worlds(cuda, &def, column_min, column_max, 0.5f, MPI_COMM_WORLD, NULL, &w);
+  add_sink(w.world);
+  if (w.single) add_sink(w.single);
+  for (int f = 0; f < 2; ++f) {
+    uint32_t mine = 0, mine_events = 0, events = 0, world_removed = 0, gathered_n = 0;
+    uint32_t* mine_ids;
+    uint32_t* gathered = NULL;
+    sph_result r;
+    mpi_test_step(w.world, 8, 1);
+    mine_ids = last_removed(w.world, &mine, &mine_events);
+    MPI_Allreduce(&mine, &world_removed, 1, MPI_UINT32_T, MPI_SUM, MPI_COMM_WORLD);
+    MPI_Reduce(&mine_events, &events, 1, MPI_UINT32_T, MPI_SUM, 0, MPI_COMM_WORLD);
+    if (g_rank == 0) {
+      gathered = (uint32_t*)malloc(sizeof(uint32_t) * ((size_t)world_removed + 1));
+      REQUIRE(gathered != NULL, "malloc");
+    }
+    r = sph_mpi_world_gather_removed_ids(w.world, 0, gathered, g_rank == 0 ? world_removed : 0u,
+                                         g_rank == 0 ? &gathered_n : NULL);
+    CHECK(r == SPH_OK, "%s: gather removed ids: %d", name, (int)r);
+    REQUIRE(sph_mpi_counts_init(&counts) == SPH_OK && sph_mpi_world_get_counts(w.world, &counts) == SPH_OK,
+            "counts");
+    if (g_rank == 0) {
+      uint32_t want_n = 0, want_events = 0;
+      uint32_t* want_ids;
+      sph_stats stats;
+      mpi_test_step(w.single, 8, 0);
+      want_ids = last_removed(w.single, &want_n, &want_events);
+      qsort(want_ids, want_n, sizeof(uint32_t), compare_ids);
+      REQUIRE(sph_stats_init(&stats) == SPH_OK && sph_world_get_stats(w.single, &stats) == SPH_OK, "stats");
+      printf("%s frame %d on %d ranks: %u removed (%u events), %llu left; the undivided world %u (%u), %u\n",
+             name, f, g_size, gathered_n, events, (unsigned long long)counts.global_count, want_n,
+             want_events, stats.particle_count);
+      CHECK(gathered_n == want_n && memcmp(gathered, want_ids, sizeof(uint32_t) * want_n) == 0,
+            "%s frame %d: the ranks removed %u ids, the undivided CUDA world %u (or other ids)", name, f,
+            gathered_n, want_n);
+      CHECK(events == want_events, "%s frame %d: %u sink events, the undivided world %u", name, f, events,
+            want_events);
+      CHECK(counts.global_count == stats.particle_count,
+            "%s frame %d: %llu particles, the undivided world %u", name, f,
+            (unsigned long long)counts.global_count, stats.particle_count);
+      CHECK(f != 0 || (want_n > 0 && want_n < w.n), "%s: the first frame removed %u of %u particles", name,
+            want_n, w.n);
+      n = stats.particle_count;
+      free(want_ids);
+    }
+    free(mine_ids);
+    free(gathered);
+  }
+  MPI_Bcast(&n, 1, MPI_UINT32_T, 0, MPI_COMM_WORLD);
+  mpi_test_gather(w.world, n, &x, &v);
+  if (g_rank == 0) {
+    uint32_t differ;
+    mpi_test_read(w.single, n, &want_x, &want_v);
+    differ = mpi_differ(want_x, want_v, x, v, n, NULL);
+    CHECK(differ == 0, "%s: %u of %u survivors differ from the undivided CUDA world", name, differ, n);
+    free(want_x);
+    free(want_v);
+    sph_world_destroy(w.single);
+  }
+  free(x);
+  free(v);
+  sph_world_destroy(w.world);
+}
+
+/* DFSPH's conjugate gradients stay refused on a rank (both backends), when the parameters are set. */
+void mpi_cuda_expect_cg_refused(sph_context* cuda) {
+  sph_world_def def;
+  sph_dfsph_params dfsph;
+  sph_world* world = NULL;
+  sph_result r;
+  mpi_test_world_def(&def);
+  def.solver = SPH_SOLVER_DFSPH;
+  REQUIRE(sph_mpi_world_create(cuda, &def, MPI_TEST_COMM, NULL, &world) == SPH_OK, "a DFSPH rank: %s",
+          sph_get_last_error());
+  REQUIRE(sph_dfsph_params_init(&dfsph) == SPH_OK, "dfsph params init");
+  dfsph.linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS;
+  r = sph_world_set_dfsph_params(world, &dfsph);
+  CHECK(r == SPH_ERROR_UNSUPPORTED && strstr(sph_get_last_error(), "SPH_DFSPH_CONJUGATE_GRADIENTS") != NULL,
+        "conjugate gradients on a distributed CUDA world: %d '%s'", (int)r, sph_get_last_error());
+  sph_world_destroy(world);
+}
