@@ -53,7 +53,7 @@ __global__ void __launch_bounds__(kDfsphSolveBlock) cg_measure_kernel(CgSolve s)
     error = dfsph_cg_error(value, s.fluid.rest_density);
   }
   dfsph_block_sum_to(s.partials, error);
-  dfsph_block_max_to(s.state, static_cast<float>(error));
+  dfsph_block_max_to(&s.state->solve_largest_bits, static_cast<float>(error));
 }
 
 __global__ void __launch_bounds__(kDfsphCheckBlock) cg_first_check_kernel(CgSolve s) {
@@ -202,7 +202,7 @@ __global__ void __launch_bounds__(kDfsphSolveBlock) cg_error_kernel(CgSolve s) {
   }
   dfsph_block_sum_to(s.partials, error);
   dfsph_block_sum_to(s.partials + s.blocks, outside);
-  dfsph_block_max_to(s.state, static_cast<float>(error));
+  dfsph_block_max_to(&s.state->solve_largest_bits, static_cast<float>(error));
 }
 
 // The mean error; a restart when the compression outside the set needs a larger set; the loop's
