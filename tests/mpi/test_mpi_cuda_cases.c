@@ -7,6 +7,7 @@
 
 #include "mpi_cuda_cases.h"
 #include "mpi_test_world.h"
+#include "support.h"
 
 static float max_abs_difference(const float* a, const float* b, uint32_t n) {
   float m = 0.0f;
@@ -92,7 +93,9 @@ void mpi_cuda_dfsph_case(const char* name, sph_context* cuda, sph_context* cpu, 
           "%s frame %d: %u/%u capped solves (density/divergence), the undivided CUDA world %u/%u", name, f,
           got.pressure_solves_capped, got.divergence_solves_capped, want.pressure_solves_capped,
           want.divergence_solves_capped);
-    CHECK(cap == 0 || (want.pressure_solves_capped == frames[f] && got.pressure_iterations_max == cap),
+    /* (not every solve: one whose error is 0 to the last bit meets even a 1e-8 bound; measured on
+     * the H200, 6 of 7 capped in frame 0) */
+    CHECK(cap == 0 || (want.pressure_solves_capped > 0 && got.pressure_iterations_max == cap),
           "%s frame %d: %u of %u density solves capped, at most %u iterations (cap %u)", name, f,
           want.pressure_solves_capped, frames[f], got.pressure_iterations_max, cap);
     CHECK(fabsf(got.density_error_mean - want.density_error_mean) <= 1e-6f * fabsf(want.density_error_mean) &&
@@ -249,6 +252,36 @@ static uint32_t* last_removed(sph_world* w, uint32_t* count, uint32_t* events_co
  * count is its; the first frame must remove particles (not all of them). After the frames the
  * survivors equal the undivided world's BIT FOR BIT (a removed particle is gone from both worlds'
  * neighbour sums alike; the survivors' sort keys keep their order). */
+/* The undivided world's survivors in ascending id order (their ids are no longer 0..n-1 once the
+ * sinks took some, so mpi_test_read's by-id copy does not apply), as sph_mpi_world_gather orders
+ * the ranks' particles. */
+typedef struct id_index {
+  uint32_t id, index;
+} id_index;
+static int compare_id_index(const void* a, const void* b) {
+  const uint32_t x = ((const id_index*)a)->id, y = ((const id_index*)b)->id;
+  return (x > y) - (x < y);
+}
+static void read_by_ascending_id(sph_world* single, uint32_t n, float** x, float** v) {
+  float *raw_x = NULL, *raw_v = NULL;
+  uint32_t *ids = NULL, m = 0;
+  id_index* order = (id_index*)malloc(sizeof(id_index) * ((size_t)n + 1));
+  REQUIRE(order != NULL, "malloc");
+  REQUIRE(support_copy(single, SPH_ATTRIBUTE_POSITION, (void**)&raw_x, &m) == SPH_OK && m == n, "read");
+  REQUIRE(support_copy(single, SPH_ATTRIBUTE_VELOCITY, (void**)&raw_v, &m) == SPH_OK && m == n, "read");
+  REQUIRE(support_copy(single, SPH_ATTRIBUTE_ID, (void**)&ids, &m) == SPH_OK && m == n, "read");
+  for (uint32_t i = 0; i < n; ++i) order[i] = (id_index){ids[i], i};
+  qsort(order, n, sizeof(id_index), compare_id_index);
+  *x = (float*)malloc(sizeof(float) * 3 * ((size_t)n + 1));
+  *v = (float*)malloc(sizeof(float) * 3 * ((size_t)n + 1));
+  REQUIRE(*x && *v, "malloc");
+  for (uint32_t i = 0; i < n; ++i) {
+    memcpy(*x + 3 * (size_t)i, raw_x + 3 * (size_t)order[i].index, 3 * sizeof(float));
+    memcpy(*v + 3 * (size_t)i, raw_v + 3 * (size_t)order[i].index, 3 * sizeof(float));
+  }
+  free(raw_x), free(raw_v), free(ids), free(order);
+}
+
 void mpi_cuda_sinks_case(const char* name, sph_context* cuda, sph_solver solver) {
   const sph_vec3 column_min = {0.0f, 0.0f, 0.0f}, column_max = {0.1f, 0.2f, 0.06f};
   sph_world_def def;
@@ -311,7 +344,7 @@ void mpi_cuda_sinks_case(const char* name, sph_context* cuda, sph_solver solver)
   mpi_test_gather(w.world, n, &x, &v);
   if (g_rank == 0) {
     uint32_t differ;
-    mpi_test_read(w.single, n, &want_x, &want_v);
+    read_by_ascending_id(w.single, n, &want_x, &want_v);
     differ = mpi_differ(want_x, want_v, x, v, n, NULL);
     CHECK(differ == 0, "%s: %u of %u survivors differ from the undivided CUDA world", name, differ, n);
     free(want_x);
