@@ -281,6 +281,8 @@ static void test_each_rule_fires_with_its_message(void** state) {
        "params->density_error: must be in (0, 1], got 1.5"},
       {SPH_PARAMS_DFSPH, offsetof(sph_dfsph_params, divergence_error), -1.0f, SPH_ERROR_INVALID_ARGUMENT,
        "params->divergence_error: must be > 0, got -1"},
+      {SPH_PARAMS_DFSPH, offsetof(sph_dfsph_params, density_error_max), 1.5f, SPH_ERROR_INVALID_ARGUMENT,
+       "params->density_error_max: must be in (0, 1], got 1.5"},
       {SPH_PARAMS_DENSITY_DIFFUSION, offsetof(sph_density_diffusion_params, delta), 1.5f,
        SPH_ERROR_INVALID_ARGUMENT, "params->delta: must be in (0, 1], got 1.5"},
   };
@@ -448,6 +450,8 @@ static void test_descriptions_match_the_header(void** state) {
        SPH_PARAM_ZERO_IS_VALUE},
       {SPH_PARAMS_DFSPH, "linear_solver", offsetof(sph_dfsph_params, linear_solver), SPH_PARAM_UINT32,
        SPH_PARAM_ZERO_IS_DEFAULT},
+      {SPH_PARAMS_DFSPH, "density_error_max", offsetof(sph_dfsph_params, density_error_max), SPH_PARAM_FLOAT,
+       SPH_PARAM_ZERO_IS_DEFAULT},
       {SPH_PARAMS_DENSITY_DIFFUSION, "delta", offsetof(sph_density_diffusion_params, delta), SPH_PARAM_FLOAT,
        SPH_PARAM_ZERO_IS_DEFAULT},
   };
@@ -461,7 +465,7 @@ static void test_descriptions_match_the_header(void** state) {
       {"clavet", "sph_clavet_viscosity_params", sizeof(sph_clavet_viscosity_params), 2},
       {"tait", "sph_tait_params", sizeof(sph_tait_params), 1},
       {"springs", "sph_spring_params", sizeof(sph_spring_params), 5},
-      {"dfsph", "sph_dfsph_params", sizeof(sph_dfsph_params), 6},
+      {"dfsph", "sph_dfsph_params", sizeof(sph_dfsph_params), 7},
       {"density_diffusion", "sph_density_diffusion_params", sizeof(sph_density_diffusion_params), 1},
   };
   size_t i, seen[SPH_PARAMS_KIND_COUNT] = {0};
