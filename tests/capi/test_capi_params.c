@@ -281,8 +281,8 @@ static void test_each_rule_fires_with_its_message(void** state) {
        "params->density_error: must be in (0, 1], got 1.5"},
       {SPH_PARAMS_DFSPH, offsetof(sph_dfsph_params, divergence_error), -1.0f, SPH_ERROR_INVALID_ARGUMENT,
        "params->divergence_error: must be > 0, got -1"},
-      {SPH_PARAMS_DFSPH, offsetof(sph_dfsph_params, density_error_max), 2.0f, SPH_ERROR_INVALID_ARGUMENT,
-       "params->density_error_max: must be in (0, 1], got 2"},
+      {SPH_PARAMS_DFSPH, offsetof(sph_dfsph_params, density_error_max), 1.5f, SPH_ERROR_INVALID_ARGUMENT,
+       "params->density_error_max: must be in (0, 1], got 1.5"},
       {SPH_PARAMS_DENSITY_DIFFUSION, offsetof(sph_density_diffusion_params, delta), 1.5f,
        SPH_ERROR_INVALID_ARGUMENT, "params->delta: must be in (0, 1], got 1.5"},
   };
