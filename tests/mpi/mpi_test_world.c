@@ -132,6 +132,37 @@ void mpi_test_read(sph_world* single, uint32_t n, float** x, float** v) {
   REQUIRE(support_copy_by_id(single, SPH_ATTRIBUTE_VELOCITY, (void**)v, &m) == SPH_OK && m == n, "read");
 }
 
+void mpi_test_add_probes(sph_world* world, sph_probe_id* point, sph_probe_id* gauge) {
+  sph_probe_def def;
+  REQUIRE(sph_probe_def_init(&def) == SPH_OK, "probe init");
+  def.sampling = SPH_PROBE_EVERY_SUBSTEP;
+  def.position.x = 0.05f;
+  def.position.y = 0.02f;
+  def.position.z = 0.03f;
+  REQUIRE(sph_probe_create(world, &def, point) == SPH_OK, "point probe: %s", sph_get_last_error());
+  def.kind = SPH_PROBE_GAUGE;
+  def.position.x = 0.031f;
+  def.position.y = -0.01f;
+  def.position.z = 0.027f;
+  def.length = 0.25f;
+  REQUIRE(sph_probe_create(world, &def, gauge) == SPH_OK, "gauge: %s", sph_get_last_error());
+}
+
+uint32_t* mpi_test_removed_ids(sph_world* world, uint32_t* count, uint32_t* event_count) {
+  uint32_t n = 0, events_n = 0;
+  uint32_t* ids;
+  sph_event events[8];
+  REQUIRE(sph_world_get_removed_ids(world, NULL, 0, &n) == SPH_OK || n > 0, "removed ids count");
+  ids = (uint32_t*)malloc(sizeof(uint32_t) * ((size_t)n + 1));
+  REQUIRE(ids != NULL, "malloc");
+  REQUIRE(sph_world_get_removed_ids(world, ids, n, count) == SPH_OK, "removed ids");
+  REQUIRE(sph_world_get_events(world, events, 8, &events_n) == SPH_OK, "events");
+  *event_count = 0;
+  for (uint32_t i = 0; i < events_n && i < 8; ++i)
+    if (events[i].type == SPH_EVENT_SINK_REMOVED) *event_count += events[i].count;
+  return ids;
+}
+
 /* Little-endian reads of the manifest (docs/checkpoint.md, "Distributed worlds"). */
 static uint32_t manifest_u32(const unsigned char* p) {
   return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;

@@ -66,6 +66,11 @@ void mpi_test_gather(sph_world* world, uint32_t n, float** x, float** v);
 void mpi_test_gather_on(sph_world* world, MPI_Comm comm, uint32_t n, float** x, float** v);
 /* An undivided world's positions and velocities by id (malloc'd). */
 void mpi_test_read(sph_world* single, uint32_t n, float** x, float** v);
+/* A point probe at (0.05, 0.02, 0.03) m and a gauge 0.25 m long from (0.031, -0.01, 0.027) m against
+ * gravity, both sampled every substep (the stirred column's probes). */
+void mpi_test_add_probes(sph_world* world, sph_probe_id* point, sph_probe_id* gauge);
+/* The last step's removed ids (malloc'd, *count of them) and its SPH_EVENT_SINK_REMOVED count. */
+uint32_t* mpi_test_removed_ids(sph_world* world, uint32_t* count, uint32_t* event_count);
 /* The path of rank `rank`'s file named in the manifest at `manifest` (in its directory; the
  * names carry the file's hash, sph_mpi.h): 1, or 0 if the manifest cannot be read as one. */
 int mpi_test_rank_file(const char* manifest, int rank, char* out, size_t size);

@@ -131,22 +131,6 @@ void mpi_cuda_dfsph_case(const char* name, sph_context* cuda, sph_context* cpu, 
   sph_world_destroy(cpu_world);
 }
 
-static void add_probes(sph_world* w, sph_probe_id* point, sph_probe_id* gauge) {
-  sph_probe_def def;
-  REQUIRE(sph_probe_def_init(&def) == SPH_OK, "probe init");
-  def.sampling = SPH_PROBE_EVERY_SUBSTEP;
-  def.position.x = 0.05f;
-  def.position.y = 0.02f;
-  def.position.z = 0.03f;
-  REQUIRE(sph_probe_create(w, &def, point) == SPH_OK, "point probe: %s", sph_get_last_error());
-  def.kind = SPH_PROBE_GAUGE;
-  def.position.x = 0.031f;
-  def.position.y = -0.01f;
-  def.position.z = 0.027f;
-  def.length = 0.25f;
-  REQUIRE(sph_probe_create(w, &def, gauge) == SPH_OK, "gauge: %s", sph_get_last_error());
-}
-
 /* Probes and gauges (tests/mpi/test_mpi_scene_sums.c's probes on the CPU): the stirred column with a
  * point probe inside it and a gauge along y (the slabs' axis, so its points lie in every rank's slab),
  * sampled every substep, two frames of 8 substeps, with the weakly compressible solver or DFSPH.
@@ -165,8 +149,8 @@ void mpi_cuda_probes_case(const char* name, sph_context* cuda, sph_solver solver
   def.capacity = 32768;
   def.solver = solver;
   mpi_test_make_worlds(cuda, &def, column_min, column_max, 0.5f, MPI_COMM_WORLD, NULL, &w);
-  add_probes(w.world, &point, &gauge);
-  if (w.single) add_probes(w.single, &single_point, &single_gauge);
+  mpi_test_add_probes(w.world, &point, &gauge);
+  if (w.single) mpi_test_add_probes(w.single, &single_point, &single_gauge);
   for (int f = 0; f < 2; ++f) {
     sph_probe_reading got[2], want[2], first[2];
     mpi_test_step(w.world, 8, 1);
@@ -228,22 +212,6 @@ static int compare_ids(const void* a, const void* b) {
   return (x > y) - (x < y);
 }
 
-/* The last step's removed ids (malloc'd, *count of them) and its SPH_EVENT_SINK_REMOVED count. */
-static uint32_t* last_removed(sph_world* w, uint32_t* count, uint32_t* events_count) {
-  sph_event events[8];
-  uint32_t n = 0, events_n = 0;
-  uint32_t* ids;
-  REQUIRE(sph_world_get_removed_ids(w, NULL, 0, &n) == SPH_OK || n > 0, "removed ids count");
-  ids = (uint32_t*)malloc(sizeof(uint32_t) * ((size_t)n + 1));
-  REQUIRE(ids != NULL, "malloc");
-  REQUIRE(sph_world_get_removed_ids(w, ids, n, count) == SPH_OK, "removed ids");
-  REQUIRE(sph_world_get_events(w, events, 8, &events_n) == SPH_OK, "events");
-  *events_count = 0;
-  for (uint32_t i = 0; i < events_n && i < 8; ++i)
-    if (events[i].type == SPH_EVENT_SINK_REMOVED) *events_count += events[i].count;
-  return ids;
-}
-
 /* Sinks (tests/mpi/test_mpi_sources.c's sink on the CPU): the stirred column with a sink that removes
  * what lies above y = 0.185 m (the column is 0.2 m tall), two frames of 8 substeps, with `solver`.
  * Each rank removes its own particles after each substep, its ghosts dropped first. Checked on rank 0,
@@ -301,7 +269,7 @@ void mpi_cuda_sinks_case(const char* name, sph_context* cuda, sph_solver solver)
     uint32_t* gathered = NULL;
     sph_result r;
     mpi_test_step(w.world, 8, 1);
-    mine_ids = last_removed(w.world, &mine, &mine_events);
+    mine_ids = mpi_test_removed_ids(w.world, &mine, &mine_events);
     MPI_Allreduce(&mine, &world_removed, 1, MPI_UINT32_T, MPI_SUM, MPI_COMM_WORLD);
     MPI_Reduce(&mine_events, &events, 1, MPI_UINT32_T, MPI_SUM, 0, MPI_COMM_WORLD);
     if (g_rank == 0) {
@@ -318,7 +286,7 @@ void mpi_cuda_sinks_case(const char* name, sph_context* cuda, sph_solver solver)
       uint32_t* want_ids;
       sph_stats stats;
       mpi_test_step(w.single, 8, 0);
-      want_ids = last_removed(w.single, &want_n, &want_events);
+      want_ids = mpi_test_removed_ids(w.single, &want_n, &want_events);
       qsort(want_ids, want_n, sizeof(uint32_t), compare_ids);
       REQUIRE(sph_stats_init(&stats) == SPH_OK && sph_world_get_stats(w.single, &stats) == SPH_OK, "stats");
       printf("%s frame %d on %d ranks: %u removed (%u events), %llu left; the undivided world %u (%u), %u\n",

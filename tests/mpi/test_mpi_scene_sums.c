@@ -42,22 +42,6 @@ static void read_world(sph_world* w, sph_collider_id tank, sph_probe_id point, s
   }
 }
 
-static void add_probes(sph_world* w, sph_probe_id* point, sph_probe_id* gauge) {
-  sph_probe_def def;
-  REQUIRE(sph_probe_def_init(&def) == SPH_OK, "probe init");
-  def.sampling = SPH_PROBE_EVERY_SUBSTEP;
-  def.position.x = 0.05f;
-  def.position.y = 0.02f;
-  def.position.z = 0.03f;
-  REQUIRE(sph_probe_create(w, &def, point) == SPH_OK, "point probe");
-  def.kind = SPH_PROBE_GAUGE;
-  def.position.x = 0.031f;
-  def.position.y = -0.01f;
-  def.position.z = 0.027f;
-  def.length = 0.25f;
-  REQUIRE(sph_probe_create(w, &def, gauge) == SPH_OK, "gauge");
-}
-
 static double norm3(const sph_vec3* v) {
   return sqrt((double)v->x * v->x + (double)v->y * v->y + (double)v->z * v->z);
 }
@@ -80,8 +64,8 @@ int main(int argc, char** argv) {
   mpi_test_world_def(&def);
   def.features = SPH_FEATURE_COLLIDER_LOADS;
   (void)make_worlds(context, &def, column_min, column_max, 2.0f, &single, &world, &single_tank, &tank);
-  add_probes(world, &point, &gauge);
-  if (single) add_probes(single, &single_point, &single_gauge);
+  mpi_test_add_probes(world, &point, &gauge);
+  if (single) mpi_test_add_probes(single, &single_point, &single_gauge);
   for (int f = 0; f < 2; ++f) {
     readings got, want;
     sph_stats stats;

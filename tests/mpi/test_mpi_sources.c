@@ -56,22 +56,6 @@ static void add_source_and_sink(sph_context* context, sph_world* w) {
   REQUIRE(sph_sink_create(w, &sink, &sink_id) == SPH_OK, "sink");
 }
 
-/* The removed ids and the sink events' count of the last step. */
-static uint32_t* removed_ids(sph_world* w, uint32_t* count, uint32_t* event_count) {
-  uint32_t n = 0, events_n = 0;
-  uint32_t* ids;
-  sph_event events[8];
-  REQUIRE(sph_world_get_removed_ids(w, NULL, 0, &n) == SPH_OK || n > 0, "removed ids count");
-  ids = (uint32_t*)malloc(sizeof(uint32_t) * ((size_t)n + 1));
-  REQUIRE(ids != NULL, "malloc");
-  REQUIRE(sph_world_get_removed_ids(w, ids, n, count) == SPH_OK, "removed ids");
-  REQUIRE(sph_world_get_events(w, events, 8, &events_n) == SPH_OK, "events");
-  *event_count = 0;
-  for (uint32_t i = 0; i < events_n && i < 8; ++i)
-    if (events[i].type == SPH_EVENT_SINK_REMOVED) *event_count += events[i].count;
-  return ids;
-}
-
 /* The particles SPH_EVENT_SOURCE_CAPACITY_REACHED says the last step did not emit. */
 static uint32_t not_emitted(sph_world* w) {
   sph_event events[8];
@@ -155,7 +139,7 @@ int main(int argc, char** argv) {
     mpi_test_step_stats(world, 3, 1, &stats);
     REQUIRE(sph_mpi_counts_init(&counts) == SPH_OK && sph_mpi_world_get_counts(world, &counts) == SPH_OK,
             "counts");
-    mine_ids = removed_ids(world, &mine, &mine_events);
+    mine_ids = mpi_test_removed_ids(world, &mine, &mine_events);
     MPI_Gather(&mine, 1, MPI_INT, sizes, 1, MPI_INT, 0, MPI_COMM_WORLD);
     if (g_rank == 0)
       for (int r = 0; r < g_size; ++r) {
@@ -193,7 +177,7 @@ int main(int argc, char** argv) {
       uint32_t want_events = 0;
       uint32_t* want_ids;
       mpi_test_step_stats(single, 3, 0, &stats);
-      want_ids = removed_ids(single, &want_n, &want_events);
+      want_ids = mpi_test_removed_ids(single, &want_n, &want_events);
       qsort(want_ids, want_n, sizeof(uint32_t), compare_ids);
       qsort(all_ids, (size_t)total, sizeof(uint32_t), compare_ids);
       CHECK((uint32_t)total == want_n && memcmp(all_ids, want_ids, sizeof(uint32_t) * want_n) == 0,
