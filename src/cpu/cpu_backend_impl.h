@@ -219,7 +219,7 @@ class CpuBackend final : public Backend {
   // columns); the errors over the world's particles (the mean summed over the ranks, the largest
   // the ranks' largest).
   void dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls, float dt);
-  DfsphErrors dfsph_errors();
+  DfsphErrors dfsph_errors(DfsphSolve kind);
   // The density solve by conjugate gradients (cpu_dfsph_cg.cpp; sph_dfsph_params.linear_solver);
   // its rate pass (each particle's value into cg_value_; returns the mean and largest error); a contact held
   // within an iteration (v_i changed by dv): the values of i and its neighbours.

@@ -93,21 +93,23 @@ void CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, c
   });
 }
 
-DfsphErrors CpuBackend::dfsph_errors() {
-  // Exact, so the mean is the same bits whichever particles a rank holds (exact_float_sum.h).
+DfsphErrors CpuBackend::dfsph_errors(DfsphSolve kind) {
+  // Exact, so the mean is the same bits whichever particles a rank holds (exact_float_sum.h). The
+  // largest only for the density solve, which bounds it (0 for the divergence solve, as on CUDA).
+  const bool density = kind == DfsphSolve::Density;
   const float* error = dfsph_residual_.data();
   ExactFloatSum sum;
   float largest = 0.0f;
   for (uint32_t i = 0; i < count_; ++i)
     if (!ghost(i)) {
       sum.add(error[i]);
-      largest = error[i] > largest ? error[i] : largest;
+      if (density) largest = error[i] > largest ? error[i] : largest;
     }
   int64_t particles = count_;
   if (ranks_) {
     halo_agree();  // (the shares' buffers: a rank that failed there meets the others here)
     ranks_->all_sum(sum.terms(), ExactFloatSum::kTerms);
-    ranks_->all_max(&largest, 1);
+    if (density) ranks_->all_max(&largest, 1);
     particles = halo_world_count_;
   }
   return {particles > 0 ? static_cast<float>(sum.value() / static_cast<double>(particles)) : 0.0f, largest};
@@ -148,7 +150,7 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
     void share_steps() {
       if (b.ranks_) b.halo_share_dfsph_step();
     }
-    DfsphErrors errors() { return b.dfsph_errors(); }
+    DfsphErrors errors() { return b.dfsph_errors(kind); }
     void checked(uint32_t, const DfsphErrors&, bool) {}
   } passes{*this, kind, fluid, walls, dt, v, carried, carry_scale};
   const DfsphLoopOutcome o = run_dfsph_jacobi(passes, bounds, min_iterations, max_iterations);
