@@ -149,17 +149,7 @@ const uint32_t* CudaBackend::halo_apply_sinks(const PipelineSetup& setup, uint32
   const uint32_t kept = *kept_out;
   if (kept == n) return counts;
   r_->sinks.enqueue_compact(*b.store, n, kept, counts, s);
-  const uint32_t removed = n - kept;
-  HostVector<uint32_t> ids(removed), sinks(removed);
-  cuda_check(cudaMemcpyAsync(ids.data(), r_->sinks.removed_ids(), sizeof(uint32_t) * removed,
-                             cudaMemcpyDeviceToHost, s),
-             "copy of the removed ids");
-  cuda_check(cudaMemcpyAsync(sinks.data(), r_->sinks.removed_sinks(), sizeof(uint32_t) * removed,
-                             cudaMemcpyDeviceToHost, s),
-             "copy of the removed ids' sinks");
-  cuda_check(cudaStreamSynchronize(s), "sinks");
-  removed_ids.insert(removed_ids.end(), ids.begin(), ids.end());
-  for (uint32_t k : sinks) ++removed_by_sink[k];
+  r_->sinks.take_removed(n - kept, removed_ids, removed_by_sink, s);
   halo_owned_ = kept;
   return counts;
 }

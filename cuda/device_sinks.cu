@@ -142,4 +142,19 @@ void DeviceSinkCompactor::enqueue_compact(const DeviceParticleStore& store, uint
   }
 }
 
+void DeviceSinkCompactor::take_removed(uint32_t removed, HostVector<uint32_t>& removed_ids,
+                                       HostVector<uint32_t>& removed_by_sink, cudaStream_t stream) {
+  host_ids_.resize(removed);
+  host_sinks_.resize(removed);
+  cuda_check(cudaMemcpyAsync(host_ids_.data(), removed_id_.get(), sizeof(uint32_t) * removed,
+                             cudaMemcpyDeviceToHost, stream),
+             "copy of the removed ids");
+  cuda_check(cudaMemcpyAsync(host_sinks_.data(), removed_sink_.get(), sizeof(uint32_t) * removed,
+                             cudaMemcpyDeviceToHost, stream),
+             "copy of the removed ids' sinks");
+  cuda_check(cudaStreamSynchronize(stream), "sinks");
+  removed_ids.insert(removed_ids.end(), host_ids_.begin(), host_ids_.end());
+  for (uint32_t k : host_sinks_) ++removed_by_sink[k];
+}
+
 }  // namespace sph

@@ -10,6 +10,7 @@
 
 #include <cuda_runtime.h>
 
+#include "../src/core/host_memory.h"
 #include "../src/physics/sink_region.h"
 #include "device_array.h"
 #include "device_particle_store.h"
@@ -39,6 +40,10 @@ class DeviceSinkCompactor {
                        cudaStream_t stream);
   const uint32_t* removed_ids() const { return removed_id_.get(); }
   const uint32_t* removed_sinks() const { return removed_sink_.get(); }
+  // After enqueue_compact: waits for the stream, appends the `removed` ids to removed_ids (in the
+  // compaction's order) and counts them per sink into removed_by_sink (one entry per sink).
+  void take_removed(uint32_t removed, HostVector<uint32_t>& removed_ids,
+                    HostVector<uint32_t>& removed_by_sink, cudaStream_t stream);
   // A side array of `capacity` entries for the neighbour counts of the last density pass.
   uint32_t* counts() const { return counts_.get(); }
 
@@ -55,6 +60,7 @@ class DeviceSinkCompactor {
   DeviceArray<uint32_t> kept_;
   DeviceArray<unsigned char> temp_;
   size_t temp_bytes_ = 0;
+  HostVector<uint32_t> host_ids_, host_sinks_;  // take_removed's staging, kept between frames
 };
 
 }  // namespace sph

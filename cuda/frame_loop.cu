@@ -255,7 +255,6 @@ uint32_t CudaBackend::run_frame_on_stream(PipelineSetup setup, uint32_t sink_cou
              "copy of the loop condition");
   cuda_check(cudaStreamSynchronize(s), "frame begin");
   const uint32_t* counts_after_sinks = nullptr;
-  HostVector<uint32_t> ids, sinks;
   while (out->run) {
     setup.count = n;
     enqueue_substep(setup, b, LoopCondition{}, s);
@@ -291,18 +290,7 @@ uint32_t CudaBackend::run_frame_on_stream(PipelineSetup setup, uint32_t sink_cou
       b.statistics->enqueue_neighbor_counts(setup.fluid, b.grid->view(), a, n, counts, s);
     }
     r_->sinks.enqueue_compact(*b.store, n, kept, counts, s);
-    const uint32_t removed = n - kept;
-    ids.resize(removed);
-    sinks.resize(removed);
-    cuda_check(cudaMemcpyAsync(ids.data(), r_->sinks.removed_ids(), sizeof(uint32_t) * removed,
-                               cudaMemcpyDeviceToHost, s),
-               "copy of the removed ids");
-    cuda_check(cudaMemcpyAsync(sinks.data(), r_->sinks.removed_sinks(), sizeof(uint32_t) * removed,
-                               cudaMemcpyDeviceToHost, s),
-               "copy of the removed ids' sinks");
-    cuda_check(cudaStreamSynchronize(s), "sinks");
-    removed_ids.insert(removed_ids.end(), ids.begin(), ids.end());
-    for (uint32_t k : sinks) ++removed_by_sink[k];
+    r_->sinks.take_removed(n - kept, removed_ids, removed_by_sink, s);
     n = kept;
     counts_after_sinks = counts;
   }
