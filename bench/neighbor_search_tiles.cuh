@@ -1,0 +1,467 @@
+// SPDX-License-Identifier: MIT
+// Warp-cooperative variants of the two gather passes (issue 18, session 15), for
+// neighbor_search_variants.cu: that file includes this one after its anonymous namespace (Grid,
+// Consts, for_each_run, kH27, CHECK, median), which this one reopens (not a standalone header).
+//
+// Why: one thread a particle makes a warp's 32 lanes walk 32 different candidate runs whose hits
+// fall in different lanes (ncu: 17-23 of 32 lanes active). Here a warp takes a chunk of up to 32
+// consecutive particles of one cell; all of them have the same 27 cells, so the warp walks the
+// cell's nine row runs once, loads each run in tiles of 32 candidates into shared memory
+// (coalesced, one float4 a lane) and every lane tests tile entries: the trip counts are the same
+// in every lane. With m particles in the chunk (8 on average at h = 1.8 spacings), G = 32 / m
+// lanes share a particle: lane a G + s takes tile entries s, s + G, ... of particle a, and the
+// G partial sums are added in lane order by shuffles (a fixed order: the same bits on every run).
+//
+// The force pass's pair terms are costly and only about one candidate in five is a neighbour, so
+// testing and evaluating in the same loop leaves most lanes idle while a few evaluate. The list
+// variant compacts the hits first: per step, __ballot_sync of the hits, and each hit is appended
+// at its rank among its group's hits (__popc) to its particle's list in shared memory; then the
+// G lanes of each particle evaluate its list, every G-th entry, so lanes stay busy whichever
+// candidates hit. A list that could overflow is evaluated early (a flush), so any count works.
+// One queue for the whole warp (the issue's first idea) would mix particles in a batch of 32 and
+// need a segmented reduction per batch to sum them in a fixed order; per-particle lists keep each
+// particle's pairs in one group of lanes and need only the final G-lane sum.
+//
+// Determinism: the lists' order (tile, step, lane) and the final sums' order are fixed, so a
+// result depends on the data and m only, never on timing. The order differs from the thread-a-
+// particle passes (partial sums over every G-th candidate, then their sum), so results equal the
+// reference's to rounding, not bit for bit (the library requires the same bits run to run, not
+// the old order; the checks below compare within tolerances and also rerun for equal bits).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <cub/device/device_select.cuh>
+#include <string>
+#include <vector>
+
+namespace {
+
+constexpr unsigned kFullMask = 0xffffffffu;
+constexpr unsigned kTileWarps = 4;   // 128 threads a block
+constexpr unsigned kListPool = 512;  // neighbour-list entries a warp: 2 KiB, 64 a particle at m = 8
+
+// Chunk starts: particle i starts a chunk if it is the 0th, 32nd, ... particle of its cell.
+// index[i] = i is the input of the compaction.
+__global__ void chunk_flag_kernel(Grid g, const float4* p, unsigned n, unsigned* index, unsigned char* flag) {
+  const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const float4 q = p[i];
+  const int cx = wrap(cell_coord(q.x, g.inv_cell), g.nx), cy = wrap(cell_coord(q.y, g.inv_cell), g.ny),
+            cz = wrap(cell_coord(q.z, g.inv_cell), g.nz);
+  const unsigned key = static_cast<unsigned>(cx + g.nx * (cy + g.ny * cz));
+  index[i] = i;
+  flag[i] = ((i - g.start[key]) & 31u) == 0u ? 1 : 0;
+}
+
+// A lane's place in its chunk: particle a (of m), slice s (of G).
+struct TileLanes {
+  unsigned lane, m, G, a, slice, first, group_mask;
+  bool active;  // a < m: lanes m G .. 31 only load tiles and vote
+};
+
+__device__ inline TileLanes tile_lanes(unsigned m) {
+  TileLanes t;
+  t.lane = threadIdx.x & 31u;
+  t.m = m;
+  t.G = 32u / m;
+  t.a = t.lane / t.G;
+  t.slice = t.lane - t.a * t.G;
+  t.first = t.a * t.G;
+  t.group_mask = t.G == 32u ? kFullMask : ((1u << t.G) - 1u) << t.first;
+  t.active = t.a < m;
+  return t;
+}
+
+// The sum of x over the lanes of this lane's group, added in lane order (fixed), in every lane.
+template <class T>
+__device__ inline T group_sum(const TileLanes& t, T x) {
+  T s = 0;
+  for (unsigned k = 0; k < t.G; ++k) s += __shfl_sync(kFullMask, x, (t.first + k) & 31u);
+  return s;
+}
+
+// The chunk of warp w: [begin, end), all of one cell.
+struct ChunkRange {
+  unsigned begin, end;
+};
+__device__ inline ChunkRange chunk_of(const unsigned* chunk_begin, unsigned chunks, unsigned n, unsigned w) {
+  return ChunkRange{chunk_begin[w], w + 1 < chunks ? chunk_begin[w + 1] : n};
+}
+
+// Calls test(base, cnt) for each tile of up to 32 candidates of the chunk's cell, once the tile's
+// positions are in `tile`; the runs and their order are for_each_run<kH27>'s (every particle of
+// a cell has the same ones), so the candidates are exactly the reference's.
+template <class Test>
+__device__ inline void for_each_tile(const Grid& g, float3 x_cell, const float4* __restrict__ p, float4* tile,
+                                     unsigned lane, Test&& test) {
+  for_each_run<kH27>(g, x_cell, 0.0f, [&](unsigned b, unsigned e) {
+    for (unsigned base = b; base < e; base += 32u) {
+      const unsigned cnt = min(32u, e - base);
+      __syncwarp();
+      if (lane < cnt) tile[lane] = p[base + lane];
+      __syncwarp();
+      test(base, cnt);
+    }
+  });
+}
+
+// Density, a warp a chunk. kFast: branchless with r = r2 rsqrt(r2) (density_fast_kernel's
+// arithmetic); else the reference's exact form, counting neighbours.
+template <bool kFast>
+__global__ void __launch_bounds__(128)
+    density_tile_kernel(Grid g, Consts k, const float4* __restrict__ p,
+                        const unsigned* __restrict__ chunk_begin, unsigned chunks, unsigned n, float* rho,
+                        unsigned* neighbours) {
+  __shared__ float4 tiles[kTileWarps][32];
+  const unsigned warp = threadIdx.x / 32u, w = blockIdx.x * kTileWarps + warp;
+  if (w >= chunks) return;  // whole warps only
+  const ChunkRange c = chunk_of(chunk_begin, chunks, n, w);
+  const TileLanes t = tile_lanes(c.end - c.begin);
+  const unsigned i = c.begin + min(t.a, t.m - 1u);
+  const float4 pi = p[i], p0 = p[c.begin];
+  float sum = 0.0f;
+  unsigned nb = 0;
+  for_each_tile(g, make_float3(p0.x, p0.y, p0.z), p, tiles[warp], t.lane, [&](unsigned base, unsigned cnt) {
+    if (!t.active) return;
+    for (unsigned u = t.slice; u < cnt; u += t.G) {
+      const float4 q = tiles[warp][u];
+      const float dx = pi.x - q.x, dy = pi.y - q.y, dz = pi.z - q.z;
+      const float r2 = dx * dx + dy * dy + dz * dz;
+      if (kFast) {
+        const float d = fmaxf(k.h - r2 * rsqrtf(fmaxf(r2, 1e-30f)), 0.0f);
+        sum += d * d * d;
+      } else if (r2 < k.h2 && base + u != i) {
+        const float d = k.h - sqrtf(r2);
+        sum += d * d * d;
+        ++nb;
+      }
+    }
+  });
+  sum = group_sum(t, sum);
+  nb = group_sum(t, nb);
+  if (t.active && t.slice == 0u) {
+    rho[i] =
+        kFast ? k.mass * (k.self + k.spiky * (sum - k.h * k.h * k.h)) : k.mass * (k.self + k.spiky * sum);
+    if (!kFast) neighbours[i] = nb;
+  }
+}
+
+struct PairSums {
+  float ax, ay, az, ox, oy, oz, vx, vy, vz;
+};
+
+// One pair's terms, as force_kernel (exact) or force_tuned_kernel<true, ...> (kFast). kLean: the
+// symmetric pressure term in one sum, -(p_j / rho_j^2 + p_i / rho_i^2) grad W, with
+// ci = p_i / rho_i^2 taken once a particle (three accumulators and three products fewer a pair;
+// the same value as the reference's two sums, other rounding).
+template <bool kFast, bool kLean>
+__device__ inline void add_pair(PairSums& s, const Consts& k, const float4& pi, const float4& vi, float ci,
+                                const float4& q, const float4& w) {
+  const float dx = pi.x - q.x, dy = pi.y - q.y, dz = pi.z - q.z;
+  const float r2 = dx * dx + dy * dy + dz * dz;
+  float gm, r;
+  if (kFast) {
+    const float inv_r = rsqrtf(fmaxf(r2, 1e-30f));
+    r = r2 * inv_r;
+    const float d = k.h - r;
+    gm = k.spiky_grad * d * d * inv_r;
+  } else {
+    r = sqrtf(r2);
+    if (r <= 0.0f) return;
+    const float d = k.h - r;
+    gm = k.spiky_grad * d * d / r;
+  }
+  const float d = k.h - r;
+  if (kLean) {
+    const float g = gm * (-q.w * w.w * w.w - ci);
+    s.ax += g * dx;
+    s.ay += g * dy;
+    s.az += g * dz;
+  } else {
+    const float pj = -q.w * w.w * w.w;
+    s.ax += gm * dx * pj;
+    s.ay += gm * dy * pj;
+    s.az += gm * dz * pj;
+    s.ox += gm * dx * -pi.w;
+    s.oy += gm * dy * -pi.w;
+    s.oz += gm * dz * -pi.w;
+  }
+  const float l = k.visc_lap * d * w.w;
+  s.vx += (w.x - vi.x) * l;
+  s.vy += (w.y - vi.y) * l;
+  s.vz += (w.z - vi.z) * l;
+}
+
+// The force-like pass, a warp a chunk. kLists: hits compacted into per-particle lists (ballot),
+// then evaluated by the particle's G lanes; else each lane tests its entries of a tile into a
+// mask and evaluates the set bits (the library's two phases, on tiles). kMinBlocks: the
+// register cap of __launch_bounds__ (12 blocks of 128: 40 registers).
+template <bool kFast, bool kLists, bool kLean, int kMinBlocks>
+__global__ void __launch_bounds__(128, kMinBlocks)
+    force_tile_kernel(Grid g, Consts k, const float4* __restrict__ p, const float4* __restrict__ v,
+                      const unsigned* __restrict__ chunk_begin, unsigned chunks, unsigned n, float4* acc) {
+  __shared__ float4 tiles[kTileWarps][32];
+  __shared__ unsigned lists[kLists ? kTileWarps : 1][kLists ? kListPool : 1];
+  const unsigned warp = threadIdx.x / 32u, w = blockIdx.x * kTileWarps + warp;
+  if (w >= chunks) return;
+  const ChunkRange c = chunk_of(chunk_begin, chunks, n, w);
+  const TileLanes t = tile_lanes(c.end - c.begin);
+  const unsigned i = c.begin + min(t.a, t.m - 1u);
+  const float4 pi = p[i], vi = v[i], p0 = p[c.begin];
+  const float ci = pi.w * vi.w * vi.w;
+  PairSums s{};
+  const unsigned cap = kListPool / t.m;  // >= 16 and >= 16 G
+  unsigned* list = lists[kLists ? warp : 0] + (kLists ? min(t.a, t.m - 1u) * cap : 0u);
+  unsigned count = 0;  // this particle's list length, the same in all its lanes
+  const unsigned below = (1u << t.lane) - 1u;
+  auto flush = [&]() {
+    __syncwarp();
+    if (t.active)
+      for (unsigned q = t.slice; q < count; q += t.G) {
+        const unsigned j = list[q];
+        add_pair<kFast, kLean>(s, k, pi, vi, ci, p[j], v[j]);
+      }
+    count = 0;
+    __syncwarp();
+  };
+  for_each_tile(g, make_float3(p0.x, p0.y, p0.z), p, tiles[warp], t.lane, [&](unsigned base, unsigned cnt) {
+    if (kLists) {
+      const unsigned steps = (cnt + t.G - 1u) / t.G;  // the same in every lane
+      for (unsigned u = 0; u < steps; ++u) {
+        if (__any_sync(kFullMask, t.active && count + t.G > cap)) flush();
+        const unsigned e = t.slice + u * t.G;
+        bool hit = false;
+        if (t.active && e < cnt) {
+          const float4 q = tiles[warp][e];
+          const float dx = pi.x - q.x, dy = pi.y - q.y, dz = pi.z - q.z;
+          hit = dx * dx + dy * dy + dz * dz < k.h2 && base + e != i;
+        }
+        const unsigned mine = __ballot_sync(kFullMask, hit) & t.group_mask;
+        if (hit) list[count + __popc(mine & below)] = base + e;
+        count += __popc(mine);
+      }
+    } else {
+      if (!t.active) return;
+      unsigned hits = 0;  // bit u: tile entry slice + u G
+      for (unsigned e = t.slice, u = 0; e < cnt; e += t.G, ++u) {
+        const float4 q = tiles[warp][e];
+        const float dx = pi.x - q.x, dy = pi.y - q.y, dz = pi.z - q.z;
+        hits |= ((dx * dx + dy * dy + dz * dz < k.h2 && base + e != i) ? 1u : 0u) << u;
+      }
+      while (hits) {
+        const unsigned e = t.slice + static_cast<unsigned>(__ffs(hits) - 1) * t.G;
+        hits &= hits - 1u;
+        add_pair<kFast, kLean>(s, k, pi, vi, ci, tiles[warp][e], v[base + e]);
+      }
+    }
+  });
+  if (kLists) flush();
+  s.ax = group_sum(t, s.ax);
+  s.ay = group_sum(t, s.ay);
+  s.az = group_sum(t, s.az);
+  if (!kLean) {
+    s.ox = group_sum(t, s.ox);
+    s.oy = group_sum(t, s.oy);
+    s.oz = group_sum(t, s.oz);
+  }
+  s.vx = group_sum(t, s.vx);
+  s.vy = group_sum(t, s.vy);
+  s.vz = group_sum(t, s.vz);
+  if (t.active && t.slice == 0u) {
+    const float sq = vi.w * vi.w;
+    const float m_rho = k.mass * vi.w;
+    if (kLean)
+      acc[i] = make_float4(s.ax * k.mass + s.vx * k.mu * m_rho, s.ay * k.mass + s.vy * k.mu * m_rho - 9.81f,
+                           s.az * k.mass + s.vz * k.mu * m_rho, 0.0f);
+    else
+      acc[i] = make_float4((s.ax + s.ox * sq) * k.mass + s.vx * k.mu * m_rho,
+                           (s.ay + s.oy * sq) * k.mass + s.vy * k.mu * m_rho - 9.81f,
+                           (s.az + s.oz * sq) * k.mass + s.vz * k.mu * m_rho, 0.0f);
+  }
+}
+
+// What the tile variants are checked against: the h27 plain passes of the same sort (sorted order).
+struct TileReference {
+  Grid g;
+  Consts k;
+  const float4* pos;  // sorted, .w packed (pressure) as for the force pass
+  const float4* vel;  // sorted, .w = 1 / density
+  unsigned n;
+  int repeat;
+  double candidates;              // mean candidates a particle (h27's: the tiles test the same)
+  const std::vector<float>* rho;  // density_kernel<kH27>
+  const std::vector<unsigned>* neighbours;
+  const std::vector<float4>* acc;  // force_kernel<kH27>
+};
+
+// Limits: the tiles sum the same terms in another order (partial sums of every G-th candidate),
+// so densities (positive terms) move by a few float roundings, 1e-6 at most in practice (the
+// rsqrt rows differ by 1.2e-6 and 1.3e-7); 1e-5 leaves room. Accelerations sum terms of both
+// signs, so cancellation can magnify the same roundings: 1e-4. A wrong neighbour set is caught
+// by the exact neighbour counts, not by these limits (a neighbour near r = h adds almost nothing).
+constexpr double kTileDensityLimit = 1e-5;
+constexpr double kTileForceLimit = 1e-4;
+
+// Runs, times and checks the tile variants; prints a row each. Returns false if a check failed.
+inline bool run_tile_variants(const TileReference& ref) {
+  const unsigned n = ref.n;
+  unsigned *d_index, *d_chunks, *d_num, *d_nb;
+  unsigned char* d_flag;
+  float* d_rho;
+  float4* d_acc;
+  CHECK(cudaMalloc(&d_index, n * sizeof(unsigned)));
+  CHECK(cudaMalloc(&d_chunks, n * sizeof(unsigned)));
+  CHECK(cudaMalloc(&d_num, sizeof(unsigned)));
+  CHECK(cudaMalloc(&d_nb, n * sizeof(unsigned)));
+  CHECK(cudaMalloc(&d_flag, n));
+  CHECK(cudaMalloc(&d_rho, n * sizeof(float)));
+  CHECK(cudaMalloc(&d_acc, n * sizeof(float4)));
+  size_t temp_bytes = 0;
+  CHECK(
+      cub::DeviceSelect::Flagged(nullptr, temp_bytes, d_index, d_flag, d_chunks, d_num, static_cast<int>(n)));
+  void* temp = nullptr;
+  CHECK(cudaMalloc(&temp, temp_bytes));
+  cudaEvent_t e0, e1;
+  CHECK(cudaEventCreate(&e0));
+  CHECK(cudaEventCreate(&e1));
+  auto time = [&](auto&& launch) {
+    std::vector<float> t;
+    for (int r = 0; r < ref.repeat + 3; ++r) {
+      CHECK(cudaEventRecord(e0));
+      launch();
+      CHECK(cudaEventRecord(e1));
+      CHECK(cudaEventSynchronize(e1));
+      float ms = 0;
+      CHECK(cudaEventElapsedTime(&ms, e0, e1));
+      if (r >= 3) t.push_back(ms);
+    }
+    CHECK(cudaGetLastError());
+    return median(t);
+  };
+  const unsigned blocks = (n + 127) / 128;
+  const float chunk_ms = time([&] {
+    chunk_flag_kernel<<<blocks, 128>>>(ref.g, ref.pos, n, d_index, d_flag);
+    CHECK(
+        cub::DeviceSelect::Flagged(temp, temp_bytes, d_index, d_flag, d_chunks, d_num, static_cast<int>(n)));
+  });
+  unsigned chunks = 0;
+  CHECK(cudaMemcpy(&chunks, d_num, sizeof(unsigned), cudaMemcpyDeviceToHost));
+  std::vector<unsigned> begins(chunks);
+  CHECK(cudaMemcpy(begins.data(), d_chunks, chunks * sizeof(unsigned), cudaMemcpyDeviceToHost));
+  double busy = 0.0;  // lanes with a particle, m (32 / m) of 32
+  for (unsigned c = 0; c < chunks; ++c) {
+    const unsigned m = (c + 1 < chunks ? begins[c + 1] : n) - begins[c];
+    busy += m * (32u / m);
+  }
+  std::printf(
+      "  tiles  %u chunks of one cell (%.2f particles, %.0f %% of lanes hold one), chunk list %.4f ms\n",
+      chunks, double(n) / chunks, 100.0 * busy / (32.0 * chunks), chunk_ms);
+  const unsigned tile_blocks = (chunks + kTileWarps - 1) / kTileWarps;
+  bool ok = true;
+
+  std::vector<float> rho(n), rho_again(n);
+  std::vector<unsigned> nb(n);
+  auto density_row = [&](const char* name, bool exact, auto&& launch) {
+    launch();
+    CHECK(cudaGetLastError());
+    CHECK(cudaMemcpy(rho.data(), d_rho, n * sizeof(float), cudaMemcpyDeviceToHost));
+    double worst = 0.0, neigh = 0.0;
+    unsigned wrong = 0;
+    for (unsigned i = 0; i < n; ++i)
+      worst = std::max(worst, std::fabs(double(rho[i]) - (*ref.rho)[i]) / std::fabs(double((*ref.rho)[i])));
+    if (exact) {
+      CHECK(cudaMemcpy(nb.data(), d_nb, n * sizeof(unsigned), cudaMemcpyDeviceToHost));
+      for (unsigned i = 0; i < n; ++i) {
+        neigh += nb[i];
+        wrong += nb[i] != (*ref.neighbours)[i];
+      }
+    }
+    const float ms = time(launch);
+    CHECK(cudaMemcpy(rho_again.data(), d_rho, n * sizeof(float), cudaMemcpyDeviceToHost));
+    const bool same = std::memcmp(rho.data(), rho_again.data(), n * sizeof(float)) == 0;
+    const bool pass = worst <= kTileDensityLimit && wrong == 0 && same;
+    ok = ok && pass;
+    char neigh_text[32] = "-";
+    if (exact) std::snprintf(neigh_text, sizeof neigh_text, "%.1f", neigh / n);
+    std::printf("  tiles  %-40s %.4f ms  cand %.1f neigh %s  rel %.1e (limit %.0e)  %s%s  %s\n", name, ms,
+                ref.candidates, neigh_text, worst, kTileDensityLimit,
+                exact ? (wrong ? "counts DIFFER, " : "counts equal, ") : "",
+                same ? "same bits on rerun" : "bits CHANGED on rerun", pass ? "PASS" : "FAIL");
+  };
+  density_row("density tiles, exact (sqrt, r < h)", true, [&] {
+    density_tile_kernel<false><<<tile_blocks, 128>>>(ref.g, ref.k, ref.pos, d_chunks, chunks, n, d_rho, d_nb);
+  });
+  density_row("density tiles, rsqrt branchless", false, [&] {
+    density_tile_kernel<true><<<tile_blocks, 128>>>(ref.g, ref.k, ref.pos, d_chunks, chunks, n, d_rho, d_nb);
+  });
+
+  std::vector<float4> acc(n), acc_again(n);
+  auto force_row = [&](const char* name, auto&& launch) {
+    launch();
+    CHECK(cudaGetLastError());
+    CHECK(cudaMemcpy(acc.data(), d_acc, n * sizeof(float4), cudaMemcpyDeviceToHost));
+    double worst = 0.0;
+    for (unsigned i = 0; i < n; ++i) {
+      const float4 a = acc[i], b = (*ref.acc)[i];
+      const double dx = a.x - b.x, dy = a.y - b.y, dz = a.z - b.z;
+      const double m = std::sqrt(double(b.x) * b.x + double(b.y) * b.y + double(b.z) * b.z);
+      worst = std::max(worst, std::sqrt(dx * dx + dy * dy + dz * dz) / std::max(m, 1e-3));
+    }
+    const float ms = time(launch);
+    CHECK(cudaMemcpy(acc_again.data(), d_acc, n * sizeof(float4), cudaMemcpyDeviceToHost));
+    const bool same = std::memcmp(acc.data(), acc_again.data(), n * sizeof(float4)) == 0;
+    const bool pass = worst <= kTileForceLimit && same;
+    ok = ok && pass;
+    std::printf("  tiles  %-40s %.4f ms  rel %.1e (limit %.0e)  %s  %s\n", name, ms, worst, kTileForceLimit,
+                same ? "same bits on rerun" : "bits CHANGED on rerun", pass ? "PASS" : "FAIL");
+  };
+  force_row("force tiles, exact, two phases", [&] {
+    force_tile_kernel<false, false, false, 1>
+        <<<tile_blocks, 128>>>(ref.g, ref.k, ref.pos, ref.vel, d_chunks, chunks, n, d_acc);
+  });
+  force_row("force tiles, rsqrt, two phases", [&] {
+    force_tile_kernel<true, false, false, 1>
+        <<<tile_blocks, 128>>>(ref.g, ref.k, ref.pos, ref.vel, d_chunks, chunks, n, d_acc);
+  });
+  force_row("force tiles, exact, ballot lists", [&] {
+    force_tile_kernel<false, true, false, 1>
+        <<<tile_blocks, 128>>>(ref.g, ref.k, ref.pos, ref.vel, d_chunks, chunks, n, d_acc);
+  });
+  force_row("force tiles, rsqrt, ballot lists", [&] {
+    force_tile_kernel<true, true, false, 1>
+        <<<tile_blocks, 128>>>(ref.g, ref.k, ref.pos, ref.vel, d_chunks, chunks, n, d_acc);
+  });
+  force_row("force tiles, rsqrt, lists, lean pair", [&] {
+    force_tile_kernel<true, true, true, 1>
+        <<<tile_blocks, 128>>>(ref.g, ref.k, ref.pos, ref.vel, d_chunks, chunks, n, d_acc);
+  });
+  force_row("force tiles, rsqrt, lists, lean, 10 blk/SM", [&] {
+    force_tile_kernel<true, true, true, 10>
+        <<<tile_blocks, 128>>>(ref.g, ref.k, ref.pos, ref.vel, d_chunks, chunks, n, d_acc);
+  });
+  force_row("force tiles, rsqrt, lists, lean, 12 blk/SM", [&] {
+    force_tile_kernel<true, true, true, 12>
+        <<<tile_blocks, 128>>>(ref.g, ref.k, ref.pos, ref.vel, d_chunks, chunks, n, d_acc);
+  });
+  force_row("force tiles, rsqrt, 2 phases, lean, 12 blk", [&] {
+    force_tile_kernel<true, false, true, 12>
+        <<<tile_blocks, 128>>>(ref.g, ref.k, ref.pos, ref.vel, d_chunks, chunks, n, d_acc);
+  });
+
+  CHECK(cudaEventDestroy(e0));
+  CHECK(cudaEventDestroy(e1));
+  CHECK(cudaFree(temp));
+  CHECK(cudaFree(d_index));
+  CHECK(cudaFree(d_chunks));
+  CHECK(cudaFree(d_num));
+  CHECK(cudaFree(d_nb));
+  CHECK(cudaFree(d_flag));
+  CHECK(cudaFree(d_rho));
+  CHECK(cudaFree(d_acc));
+  return ok;
+}
+
+}  // namespace
