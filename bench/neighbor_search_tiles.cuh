@@ -91,21 +91,46 @@ __device__ inline ChunkRange chunk_of(const unsigned* chunk_begin, unsigned chun
   return ChunkRange{chunk_begin[w], w + 1 < chunks ? chunk_begin[w + 1] : n};
 }
 
-// Calls test(base, cnt) for each tile of up to 32 candidates of the chunk's cell, once the tile's
-// positions are in `tile`; the runs and their order are for_each_run<kH27>'s (every particle of
-// a cell has the same ones), so the candidates are exactly the reference's.
+// The chunk's candidate runs, for_each_run<kH27>'s for its cell (every particle of a cell has the
+// same ones, so the candidates are exactly the reference's), in the same order: lane r < 9 finds
+// row r's run, two segments where the row wraps (else the second is empty), so that the tile
+// loop below carries two registers of walk state instead of the row loops' dozen.
+constexpr unsigned kRunSegments = 18;
+__device__ inline void load_runs(const Grid& g, float3 x_cell, unsigned lane, uint2* runs) {
+  if (lane < 9u) {
+    const int cx = cell_coord(x_cell.x, g.inv_cell), cy = cell_coord(x_cell.y, g.inv_cell),
+              cz = cell_coord(x_cell.z, g.inv_cell);
+    const int wx = wrap(cx, g.nx), wy = wrap_add(wrap(cy, g.ny), static_cast<int>(lane % 3u) - 1, g.ny),
+              wz = wrap_add(wrap(cz, g.nz), static_cast<int>(lane / 3u) - 1, g.nz);
+    const int a = wrap_add(wx, -1, g.nx), b = wrap_add(wx, 1, g.nx);
+    const unsigned row =
+        static_cast<unsigned>(g.nx) * (static_cast<unsigned>(wy) + g.ny * static_cast<unsigned>(wz));
+    if (a <= b) {
+      runs[2 * lane] = make_uint2(__ldg(g.start + row + a), __ldg(g.start + row + b + 1));
+      runs[2 * lane + 1] = make_uint2(0u, 0u);
+    } else {
+      runs[2 * lane] = make_uint2(__ldg(g.start + row + a), __ldg(g.start + row + g.nx));
+      runs[2 * lane + 1] = make_uint2(__ldg(g.start + row), __ldg(g.start + row + b + 1));
+    }
+  }
+  __syncwarp();
+}
+
+// Calls test(base, cnt) for each tile of up to 32 candidates of the chunk's runs, once the
+// tile's positions are in `tile`.
 template <class Test>
-__device__ inline void for_each_tile(const Grid& g, float3 x_cell, const float4* __restrict__ p, float4* tile,
+__device__ inline void for_each_tile(const uint2* runs, const float4* __restrict__ p, float4* tile,
                                      unsigned lane, Test&& test) {
-  for_each_run<kH27>(g, x_cell, 0.0f, [&](unsigned b, unsigned e) {
-    for (unsigned base = b; base < e; base += 32u) {
-      const unsigned cnt = min(32u, e - base);
+  for (unsigned r = 0; r < kRunSegments; ++r) {
+    const uint2 run = runs[r];
+    for (unsigned base = run.x; base < run.y; base += 32u) {
+      const unsigned cnt = min(32u, run.y - base);
       __syncwarp();
       if (lane < cnt) tile[lane] = p[base + lane];
       __syncwarp();
       test(base, cnt);
     }
-  });
+  }
 }
 
 // Density, a warp a chunk. kFast: branchless with r = r2 rsqrt(r2) (density_fast_kernel's
@@ -116,6 +141,7 @@ __global__ void __launch_bounds__(128)
                         const unsigned* __restrict__ chunk_begin, unsigned chunks, unsigned n, float* rho,
                         unsigned* neighbours) {
   __shared__ float4 tiles[kTileWarps][32];
+  __shared__ uint2 runs[kTileWarps][kRunSegments];
   const unsigned warp = threadIdx.x / 32u, w = blockIdx.x * kTileWarps + warp;
   if (w >= chunks) return;  // whole warps only
   const ChunkRange c = chunk_of(chunk_begin, chunks, n, w);
@@ -124,7 +150,8 @@ __global__ void __launch_bounds__(128)
   const float4 pi = p[i], p0 = p[c.begin];
   float sum = 0.0f;
   unsigned nb = 0;
-  for_each_tile(g, make_float3(p0.x, p0.y, p0.z), p, tiles[warp], t.lane, [&](unsigned base, unsigned cnt) {
+  load_runs(g, make_float3(p0.x, p0.y, p0.z), t.lane, runs[warp]);
+  for_each_tile(runs[warp], p, tiles[warp], t.lane, [&](unsigned base, unsigned cnt) {
     if (!t.active) return;
     for (unsigned u = t.slice; u < cnt; u += t.G) {
       const float4 q = tiles[warp][u];
@@ -204,6 +231,7 @@ __global__ void __launch_bounds__(128, kMinBlocks)
     force_tile_kernel(Grid g, Consts k, const float4* __restrict__ p, const float4* __restrict__ v,
                       const unsigned* __restrict__ chunk_begin, unsigned chunks, unsigned n, float4* acc) {
   __shared__ float4 tiles[kTileWarps][32];
+  __shared__ uint2 runs[kTileWarps][kRunSegments];
   __shared__ unsigned lists[kLists ? kTileWarps : 1][kLists ? kListPool : 1];
   const unsigned warp = threadIdx.x / 32u, w = blockIdx.x * kTileWarps + warp;
   if (w >= chunks) return;
@@ -227,7 +255,8 @@ __global__ void __launch_bounds__(128, kMinBlocks)
     count = 0;
     __syncwarp();
   };
-  for_each_tile(g, make_float3(p0.x, p0.y, p0.z), p, tiles[warp], t.lane, [&](unsigned base, unsigned cnt) {
+  load_runs(g, make_float3(p0.x, p0.y, p0.z), t.lane, runs[warp]);
+  for_each_tile(runs[warp], p, tiles[warp], t.lane, [&](unsigned base, unsigned cnt) {
     if (kLists) {
       const unsigned steps = (cnt + t.G - 1u) / t.G;  // the same in every lane
       for (unsigned u = 0; u < steps; ++u) {
