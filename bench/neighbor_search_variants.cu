@@ -17,7 +17,8 @@
 // relative difference below 1e-5).
 //
 // The warp-cooperative variants (a warp per chunk of one cell, candidates in shared-memory tiles,
-// ballot-compacted neighbour lists) are in neighbor_search_tiles.cuh; they run on the h27 layout
+// ballot-compacted neighbour lists) are in neighbor_search_tiles.cuh, their runner in
+// neighbor_search_tiles_check.cuh; they run on the h27 layout
 // and are checked against its plain passes (the program exits 1 if one fails).
 //
 // Usage: neighbor_search_variants [--particles N] [--repeat R] [--jitter J] [--layouts all|h27]
@@ -482,7 +483,7 @@ float median(std::vector<float> v) {
 
 }  // namespace
 
-#include "neighbor_search_tiles.cuh"
+#include "neighbor_search_tiles_check.cuh"
 
 int main(int argc, char** argv) {
   unsigned target = 1000000;
