@@ -18,8 +18,8 @@
 //
 // The warp-cooperative variants (a warp per chunk of one cell, candidates in shared-memory tiles,
 // ballot-compacted neighbour lists) are in neighbor_search_tiles.cuh, their runner in
-// neighbor_search_tiles_check.cuh; they run on the h27 layout
-// and are checked against its plain passes (the program exits 1 if one fails).
+// neighbor_search_tiles_check.cuh; they run on the h27 layout and are checked against its plain
+// passes (the program exits 1 if one fails).
 //
 // Usage: neighbor_search_variants [--particles N] [--repeat R] [--jitter J] [--layouts all|h27]
 #include <cuda_runtime.h>
