@@ -16,7 +16,12 @@
 // Each variant's densities are checked against h27's (same neighbours, other summation order:
 // relative difference below 1e-5).
 //
-// Usage: neighbor_search_variants [--particles N] [--repeat R] [--jitter J]
+// The warp-cooperative variants (a warp per chunk of one cell, candidates in shared-memory tiles,
+// ballot-compacted neighbour lists) are in neighbor_search_tiles.cuh, their runner in
+// neighbor_search_tiles_check.cuh; they run on the h27 layout and are checked against its plain
+// passes (the program exits 1 if one fails).
+//
+// Usage: neighbor_search_variants [--particles N] [--repeat R] [--jitter J] [--layouts all|h27]
 #include <cuda_runtime.h>
 
 #include <algorithm>
@@ -355,8 +360,10 @@ __global__ void force_kernel(Grid g, Consts k, const float4* __restrict__ p, con
 // Tuning variants of the h27 force pass: kFast evaluates 1/r with rsqrtf instead of an IEEE
 // square root and division (about 16 instructions fewer a pair); kPrefetch loads the next
 // neighbour's records before the current pair's arithmetic, so a load's latency overlaps work;
-// kMinBlocks caps registers through __launch_bounds__ (more warps in flight).
-template <bool kFast, bool kPrefetch, int kMinBlocks>
+// kMinBlocks caps registers through __launch_bounds__ (more warps in flight); kLean sums the
+// symmetric pressure term in one set of three, -(p_j / rho_j^2 + p_i / rho_i^2) grad W (the
+// same value, three accumulators fewer; ox, oy, oz stay 0).
+template <bool kFast, bool kPrefetch, int kMinBlocks, bool kLean = false>
 __global__ void __launch_bounds__(128, kMinBlocks)
     force_tuned_kernel(Grid g, Consts k, const float4* __restrict__ p, const float4* __restrict__ v,
                        unsigned n, float4* acc) {
@@ -366,6 +373,7 @@ __global__ void __launch_bounds__(128, kMinBlocks)
   const float4 vi = v[i];
   const float3 xi = make_float3(pi.x, pi.y, pi.z);
   float ax = 0, ay = 0, az = 0, ox = 0, oy = 0, oz = 0, vx = 0, vy = 0, vz = 0;
+  const float ci = pi.w * vi.w * vi.w;  // kLean: p_i / rho_i^2, once
   auto pair = [&](const float4& q, const float4& w) {
     const float dx = xi.x - q.x, dy = xi.y - q.y, dz = xi.z - q.z;
     const float r2 = dx * dx + dy * dy + dz * dz;
@@ -380,13 +388,20 @@ __global__ void __launch_bounds__(128, kMinBlocks)
     }
     const float d = k.h - r;
     const float gm = k.spiky_grad * d * d * inv_r;
-    const float pj = -q.w * w.w * w.w;
-    ax += gm * dx * pj;
-    ay += gm * dy * pj;
-    az += gm * dz * pj;
-    ox += gm * dx * -pi.w;
-    oy += gm * dy * -pi.w;
-    oz += gm * dz * -pi.w;
+    if (kLean) {
+      const float gp = gm * (-q.w * w.w * w.w - ci);
+      ax += gp * dx;
+      ay += gp * dy;
+      az += gp * dz;
+    } else {
+      const float pj = -q.w * w.w * w.w;
+      ax += gm * dx * pj;
+      ay += gm * dy * pj;
+      az += gm * dz * pj;
+      ox += gm * dx * -pi.w;
+      oy += gm * dy * -pi.w;
+      oz += gm * dz * -pi.w;
+    }
     const float l = k.visc_lap * d * w.w;
     vx += (w.x - vi.x) * l;
     vy += (w.y - vi.y) * l;
@@ -468,14 +483,18 @@ float median(std::vector<float> v) {
 
 }  // namespace
 
+#include "neighbor_search_tiles_check.cuh"
+
 int main(int argc, char** argv) {
   unsigned target = 1000000;
   int repeat = 20;
   float jitter = 0.1f;  // fraction of the spacing: a lattice disturbed like the moving sphere
+  int layouts = 4;      // --layouts h27: only the library's layout, its tuning rows and the tiles
   for (int a = 1; a + 1 < argc; a += 2) {
     if (!std::strcmp(argv[a], "--particles")) target = static_cast<unsigned>(std::atof(argv[a + 1]));
     if (!std::strcmp(argv[a], "--repeat")) repeat = std::atoi(argv[a + 1]);
     if (!std::strcmp(argv[a], "--jitter")) jitter = static_cast<float>(std::atof(argv[a + 1]));
+    if (!std::strcmp(argv[a], "--layouts")) layouts = std::strcmp(argv[a + 1], "h27") ? 4 : 1;
   }
   const float s = 0.02f, h = 1.8f * s;
   // FCC sphere with about `target` points (4 per cube of side s sqrt 2).
@@ -545,7 +564,8 @@ int main(int argc, char** argv) {
   std::printf("%-8s %6s %9s %7s %7s %9s %9s %8s %10s\n", "variant", "cell", "table", "cand", "neigh",
               "density", "force", "sort", "max_rel");
   std::vector<float> rho_ref;
-  for (int v = 0; v < 4; ++v) {
+  bool tiles_ok = true;
+  for (int v = 0; v < layouts; ++v) {
     const bool half = v == kHalf125 || v == kHalfPruned;
     const float cell = half ? 0.5f * h : h;
     // h cells: about one table slot per particle (the library); h/2 cells: two per particle.
@@ -764,6 +784,12 @@ int main(int argc, char** argv) {
         force_row("force fast + prefetch, min 12 blocks", [&] {
           force_tuned_kernel<true, true, 12><<<blocks, 128>>>(g, k, d_spos, d_svel, n, d_acc);
         });
+        force_row("force fast, lean pair", [&] {
+          force_tuned_kernel<true, false, 1, true><<<blocks, 128>>>(g, k, d_spos, d_svel, n, d_acc);
+        });
+        force_row("force fast, lean pair, min 12 blocks", [&] {
+          force_tuned_kernel<true, false, 12, true><<<blocks, 128>>>(g, k, d_spos, d_svel, n, d_acc);
+        });
         for (unsigned bs : {64u, 256u}) {
           const unsigned nb = (n + bs - 1) / bs;
           const float ms = time([&] { force_kernel<kH27><<<nb, bs>>>(g, k, d_spos, d_svel, n, d_acc); });
@@ -775,6 +801,9 @@ int main(int argc, char** argv) {
             time([&] { density_fast_kernel<<<blocks, 128>>>(g, k, d_spos, n, d_rho); });
         rows.push_back(Row{"density fast rsqrt, branchless", fast_density, rel_rho()});
         for (const Row& r : rows) std::printf("  h27    %-42s %.4f ms (rel %.1e)\n", r.name, r.ms, r.rel);
+        // The warp-cooperative passes (neighbor_search_tiles.cuh), checked against the plain ones.
+        tiles_ok = run_tile_variants(
+            TileReference{g, k, d_spos, d_svel, n, repeat, mean_c / n, &rho, &nb, &acc_ref});
       }
       std::printf(
           "  %-6s branchless density %.4f ms (rel %.1e); mask density %.4f ms (rel %.1e) + force from "
@@ -784,5 +813,6 @@ int main(int argc, char** argv) {
     CHECK(cudaFree(temp));
     CHECK(cudaFree(d_start));
   }
-  return 0;
+  if (!tiles_ok) std::printf("FAIL: a tile variant differs from the reference beyond its limit\n");
+  return tiles_ok ? 0 : 1;
 }
