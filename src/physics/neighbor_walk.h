@@ -74,11 +74,15 @@ SPH_HD void for_each_neighbor_candidate(const GridView& grid, Vec3 p, Visit&& vi
 // candidate of for_each_neighbor_range's walk (in its order, from 0) is a neighbour. Positions do
 // not change between DFSPH's density pass and the end of its solves, so the pass that walks every
 // candidate once can record them, and the solves' many passes visit only the set bits
-// (for_each_masked_neighbor). Eight words: bits 0-254 for candidates 0-254, bit 255 (word 7's
-// top bit) marks a particle with more candidates than that, whose passes walk all of them.
-constexpr uint32_t kNeighborMaskWords = 8;
-constexpr uint32_t kNeighborMaskCandidates = 32u * kNeighborMaskWords - 1u;  // 255
-constexpr uint32_t kNeighborMaskOverflow = 0x80000000u;                      // in word 7
+// (for_each_masked_neighbor). Twelve words: bits 0-382 for candidates 0-382, bit 383 (the last
+// word's top bit) marks a particle with more candidates than that, whose passes walk all of them.
+// Why 383 and not 255: on an FCC lattice at rest at the default radius (1.8 spacings) the 27
+// cells of 16 % of the particles hold 256-259 candidates (45 % at a 3 % closer spacing), all the
+// particles of a cell alike, and a warp waits for its slowest lane's full walk; 383 holds the
+// lattice at rest and at a 5 % closer spacing (host counts, docs/cuda.md).
+constexpr uint32_t kNeighborMaskWords = 12;
+constexpr uint32_t kNeighborMaskCandidates = 32u * kNeighborMaskWords - 1u;  // 383
+constexpr uint32_t kNeighborMaskOverflow = 0x80000000u;                      // in the last word
 
 // The index of the lowest set bit of x != 0.
 SPH_HD uint32_t lowest_set_bit(uint32_t x) {
@@ -113,7 +117,7 @@ struct NeighborMaskWriter {
       out[kNeighborMaskWords - 1u] = kNeighborMaskOverflow;  // the other words are not read
       return;
     }
-    uint32_t w = count >> 5;  // the words written so far (count <= 255: at most 7)
+    uint32_t w = count >> 5;  // the words written so far (count <= 383: at most 11)
     if (count & 31u) out[w++] = word;
     for (; w < kNeighborMaskWords; ++w) out[w] = 0u;
   }
@@ -126,7 +130,7 @@ template <class Visit>
 SPH_HD void for_each_masked_neighbor(const GridView& grid, Vec3 p, const uint32_t* mask, Visit&& visit) {
   if (mask[kNeighborMaskWords - 1u] & kNeighborMaskOverflow)
     return for_each_neighbor_candidate(grid, p, visit);
-  uint32_t k = 0;  // the walk index of the run's first candidate (all below 255 here)
+  uint32_t k = 0;  // the walk index of the run's first candidate (all below 383 here)
   for_each_neighbor_range(grid, p, [&](uint32_t begin, uint32_t end) {
     const uint32_t last = k + (end - begin);
     // The run's bits, at most 32 at a time (a run can start and end inside a word).
