@@ -125,19 +125,19 @@ struct NeighborMaskWriter {
 
 // Calls visit(j) for the candidates of for_each_neighbor_candidate (same rows, same order) whose
 // bit is set in mask (NeighborMaskWriter's, for this particle's position and the same table);
-// for every candidate where the mask overflowed.
+// for every candidate where the mask overflowed or is null. One loop for all three, so that a
+// kernel holds one copy of the pass's body (registers, code size).
 template <class Visit>
 SPH_HD void for_each_masked_neighbor(const GridView& grid, Vec3 p, const uint32_t* mask, Visit&& visit) {
-  if (mask[kNeighborMaskWords - 1u] & kNeighborMaskOverflow)
-    return for_each_neighbor_candidate(grid, p, visit);
-  uint32_t k = 0;  // the walk index of the run's first candidate (all below 383 here)
+  const bool all = !mask || (mask[kNeighborMaskWords - 1u] & kNeighborMaskOverflow);
+  uint32_t k = 0;  // the walk index of the run's first candidate (below 383 unless `all`)
   for_each_neighbor_range(grid, p, [&](uint32_t begin, uint32_t end) {
     const uint32_t last = k + (end - begin);
     // The run's bits, at most 32 at a time (a run can start and end inside a word).
     for (uint32_t first = k; first < last;) {
       const uint32_t shift = first & 31u;
       const uint32_t take = (32u - shift < last - first) ? 32u - shift : last - first;
-      uint32_t bits = mask[first >> 5] >> shift;
+      uint32_t bits = all ? 0xffffffffu : mask[first >> 5] >> shift;
       if (take < 32u) bits &= (1u << take) - 1u;
       const uint32_t j0 = begin + (first - k);
       while (bits) {
@@ -152,8 +152,9 @@ SPH_HD void for_each_masked_neighbor(const GridView& grid, Vec3 p, const uint32_
 
 // The candidates a neighbour pass visits: every candidate of the 27 cells (the default, both
 // backends), or, with masks (CUDA DFSPH's solves: kNeighborMaskWords words per particle, written
-// by the density pass), those of particle i's mask. The passes keep their own r < h test on what
-// they visit, so both walks give the same terms in the same order.
+// by the density pass), those of particle i's mask (every candidate, through the same loop, where
+// masks is null). The passes keep their own r < h test on what they visit, so both walks give the
+// same terms in the same order.
 struct AllCandidates {
   template <class Visit>
   SPH_HD void operator()(const GridView& grid, Vec3 p, uint32_t, Visit&& visit) const {
@@ -164,10 +165,8 @@ struct MaskedCandidates {
   const uint32_t* masks;  // null: every candidate
   template <class Visit>
   SPH_HD void operator()(const GridView& grid, Vec3 p, uint32_t i, Visit&& visit) const {
-    if (masks)
-      for_each_masked_neighbor(grid, p, masks + static_cast<size_t>(i) * kNeighborMaskWords, visit);
-    else
-      for_each_neighbor_candidate(grid, p, visit);
+    for_each_masked_neighbor(grid, p, masks ? masks + static_cast<size_t>(i) * kNeighborMaskWords : nullptr,
+                             visit);
   }
 };
 

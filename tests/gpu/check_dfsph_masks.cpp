@@ -12,11 +12,11 @@
 //   - Jacobi, the default kernel radius (1.8 spacings: about 220 candidates inside the fluid);
 //   - conjugate gradients, the same;
 //   - Jacobi with the kernel radius at 3.0 spacings: at the start 702 of the 1,536 particles have
-//     more than 383 candidates (the masks' capacity) (their masks overflow and their passes walk every candidate),
-//     next to particles whose masks are used. The check counts each particle's candidates on
-//     the host at the start (the particles in the 27 cells around its cell, cell = floor(x / h)
-//     in float as the device computes it; a table that folds distant cells together would only
-//     add candidates) and requires both kinds.
+//     more than 383 candidates (the masks' capacity) (their masks overflow and their passes walk every
+//     candidate), next to particles whose masks are used. The check counts each particle's candidates on the
+//     host at the start (the particles in the 27 cells around its cell, cell = floor(x / h) in float as the
+//     device computes it; a table that folds distant cells together would only add candidates) and requires
+//     both kinds.
 // The default kernel radius on this 6-layer slab: no particle overflows, every pass masked.
 #include <cmath>
 #include <cstdlib>
@@ -174,6 +174,7 @@ int main() {
   // Both kinds of particle: overflowing masks and used ones (1,536 particles).
   const uint32_t over = check(Case{"Jacobi, kernel radius 3.0 spacings", false, 3.0f});
   report(over > 0 && over < 1536u, "dfsph masks: the crowded case mixes overflowing and masked particles",
-         "%u of 1536 particles with more than 383 candidates at the start (702 when this check was written)", over);
+         "%u of 1536 particles with more than 383 candidates at the start (702 when this check was written)",
+         over);
   return finish();
 }

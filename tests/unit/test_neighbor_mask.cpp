@@ -5,7 +5,7 @@
 // k-th candidate of the plain 27-cell walk that is within the mask's bound (neighbor_mask_bound)
 // and not the particle itself, and is marked overflowing exactly when the walk has more than 383
 // candidates; for_each_masked_neighbor visits exactly those candidates, in the plain walk's order
-// (every candidate where the mask overflowed); and the two solve passes (density_rate,
+// (every candidate where the mask overflowed or is null); and the two solve passes (density_rate,
 // pressure_velocity_change) give the same bits through the masked walk as through the plain one.
 // The scenes: a table folded over a larger cloud (rows that wrap around the table, far
 // particles in folded slots) dense enough that some particles overflow and others do not; a
@@ -139,6 +139,9 @@ Tally check_table(const Table& t) {
     std::vector<uint32_t> visited;
     sph::for_each_masked_neighbor(view, xi, mask, [&](uint32_t j) { visited.push_back(j); });
     ok = ok && visited == (overflow ? candidates : kept);
+    std::vector<uint32_t> without;  // no mask: every candidate
+    sph::for_each_masked_neighbor(view, xi, nullptr, [&](uint32_t j) { without.push_back(j); });
+    ok = ok && without == candidates;
     // The solves' passes through both walks.
     const sph::MaskedCandidates masked{masks.data()};
     const float rate = sph::density_rate(f, view, t.positions.data(), t.velocities.data(), no_walls, i);
