@@ -8,16 +8,17 @@
 // velocities, densities, pressures, ids) and every frame's solve statistics (substeps, both
 // solves' iterations, the achieved error's bits).
 // The scene: the Martin & Moyce dam break of check_dfsph_cg.cpp (16 lattice layers across the
-// column, the tank's walls as a collider, so the contacts are exercised), 40 frames of 3 ms,
-//   - Jacobi, the default kernel radius (1.8 spacings: about 220 candidates inside the fluid);
+// column, a 6-layer slab, 1,536 particles; the tank's walls as a collider, so the contacts are
+// exercised), 40 frames of 3 ms:
+//   - Jacobi at the default kernel radius (1.8 spacings): no particle of the thin slab has more
+//     than 383 candidates (the masks' capacity), every pass is masked;
 //   - conjugate gradients, the same;
 //   - Jacobi with the kernel radius at 3.0 spacings: at the start 702 of the 1,536 particles have
-//     more than 383 candidates (the masks' capacity) (their masks overflow and their passes walk every
-//     candidate), next to particles whose masks are used. The check counts each particle's candidates on the
-//     host at the start (the particles in the 27 cells around its cell, cell = floor(x / h) in float as the
-//     device computes it; a table that folds distant cells together would only add candidates) and requires
-//     both kinds.
-// The default kernel radius on this 6-layer slab: no particle overflows, every pass masked.
+//     more than 383 candidates (their masks overflow and their passes walk every candidate),
+//     next to particles whose masks are used. The check counts each particle's candidates on
+//     the host at the start (the particles of the 27 cells around its cell, cell = floor(x / h)
+//     in float as the device computes it; a table that folds distant cells together would only
+//     add candidates) and requires both kinds.
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
