@@ -24,11 +24,14 @@
 // weakly compressible solver (with the normalised density and the density diffusion, whose
 // republished densities the ghosts take again, surface tension, whose colour normals they take:
 // substep_pipeline.cu, and collider loads, each rank's own particles' impulses added over the
-// ranks at the frame's end: cuda_halo_frame.cu) or DFSPH's Jacobi solves (the host drives each
-// solve an iteration at a time, core/dfsph_jacobi_loop.h: the ghosts take their owners' densities
-// and factors after the density pass, velocities and pressure steps within each iteration, and
-// the mean error is an exact sum added over the ranks); attach_ranks refuses RK4 and springs by
-// name, the step DFSPH's conjugate gradients (frame_loop.cu).
+// ranks at the frame's end: cuda_halo_frame.cu), RK4 (each of its four stages sorts, so each
+// gathers its halo; between two stages the ranks agree on a failure, the ghosts go and the stage
+// state, rk4_start and rk4_sum, travels with the migrants: halo_next_stage, as on the CPU rank)
+// or DFSPH's Jacobi solves (the host drives each solve an iteration at a time,
+// core/dfsph_jacobi_loop.h: the ghosts take their owners' densities and factors after the density
+// pass, velocities and pressure steps within each iteration, and the mean error is an exact sum
+// added over the ranks); attach_ranks refuses springs by name, the step DFSPH's conjugate
+// gradients (frame_loop.cu).
 #include <cstring>
 #include <memory>
 #include <string>
@@ -66,7 +69,6 @@ void CudaBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks,
   } features[] = {{kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks)"}};
   for (const auto& f : features)
     if (config_.features & f.bit) refuse(f.name);
-  if (config_.integrator == Integrator::Rk4) refuse("the RK4 integrator");
   require_alive();
   DeviceGuard guard(device_);
   guarded([&] {
@@ -154,6 +156,14 @@ HostVector<HaloArray> CudaBackend::halo_arrays() const {
     if (bytes % 4 != 0)
       throw Error(Status::Internal, std::string("halo: array ") + m->spec.name + " is not in words");
     v.push_back(HaloArray{m->side[0].get(), static_cast<uint32_t>(bytes)});
+  }
+  // RK4's stage state between two stages: it lives through a substep, and a particle may change
+  // ranks between its stages (ghosts take it too, as on the CPU rank, and never read it).
+  static_assert(sizeof(ParticleState) % 4 == 0 && sizeof(Rk4Accumulator) % 4 == 0, "RK4's state in words");
+  if (halo_rk4_side_ != kNoRk4Side) {
+    const int side = halo_rk4_side_;
+    v.push_back(HaloArray{reinterpret_cast<unsigned char*>(a.rk4_start[side]), sizeof(ParticleState)});
+    v.push_back(HaloArray{reinterpret_cast<unsigned char*>(a.rk4_sum[side]), sizeof(Rk4Accumulator)});
   }
   return v;
 }
