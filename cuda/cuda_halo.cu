@@ -325,9 +325,10 @@ void CudaBackend::halo_share_dfsph_steps(cudaStream_t stream) {
 }
 
 // As the CPU rank's (CpuBackend::dfsph_errors): the rank's exact bins, added over the ranks, over
-// the world's count, and the ranks' largest error; the same bits on every rank, whichever
-// particles each holds.
-DfsphErrors CudaBackend::halo_dfsph_errors(cudaStream_t stream) {
+// the world's count, and the ranks' largest error, for the density solve only, which bounds it
+// (the divergence solve's rate kernel leaves it 0: no all_max per divergence iteration); the same
+// bits on every rank, whichever particles each holds.
+DfsphErrors CudaBackend::halo_dfsph_errors(bool divergence, cudaStream_t stream) {
   ExactFloatSum sum;
   const int64_t* words = r_->halo->download_error_bins(stream);
   std::memcpy(sum.terms(), words, sizeof(int64_t) * ExactFloatSum::kTerms);
@@ -336,7 +337,7 @@ DfsphErrors CudaBackend::halo_dfsph_errors(cudaStream_t stream) {
   std::memcpy(&largest, &largest_bits, sizeof largest);
   halo_agree();  // (the refreshes' buffers: a rank that failed there meets the others here)
   ranks_->all_sum(sum.terms(), ExactFloatSum::kTerms);
-  ranks_->all_max(&largest, 1);
+  if (!divergence) ranks_->all_max(&largest, 1);
   const int64_t particles = halo_world_count_;
   return {particles > 0 ? static_cast<float>(sum.value() / static_cast<double>(particles)) : 0.0f, largest};
 }

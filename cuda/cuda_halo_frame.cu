@@ -74,7 +74,9 @@ class CudaBackend::HaloHooks final : public SubstepHooks {
   void share_velocities(Float4* v, cudaStream_t stream) override { b_.halo_share_velocities(v, stream); }
   void share_steps(cudaStream_t stream) override { b_.halo_share_dfsph_steps(stream); }
   unsigned long long* error_bins() override { return b_.r_->halo->error_bins(); }
-  DfsphErrors errors(cudaStream_t stream) override { return b_.halo_dfsph_errors(stream); }
+  DfsphErrors errors(bool divergence, cudaStream_t stream) override {
+    return b_.halo_dfsph_errors(divergence, stream);
+  }
 
  private:
   CudaBackend& b_;
