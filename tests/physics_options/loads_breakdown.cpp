@@ -11,8 +11,9 @@
 //
 // --step: the lattice step (default 0.01 m; issue 17, "Loads against resolution" in
 // docs/validation.md): the layers fill the same tank (16 x 20 x 16 cm rounded to whole layers), h,
-// the voxels and the window's substeps scale with it (frames of 0.5 ms x step / 1 cm), the box and
-// the tank stay in metres. --frames: the window's substeps (default 0.4 s of them, 800 at 1 cm);
+// the voxels (the box's: a whole number across its half side) and the window's substeps scale with it (frames
+// of 0.5 ms x step / 1 cm), the box and the tank stay in metres. --frames: the window's substeps (default 0.4
+// s of them, 800 at 1 cm);
 // --sample-every N: read back and sum only every Nth of them (default 1; the others are stepped
 // unread, a cheaper average of the same window at fine steps). The last line, RESULT ..., is for
 // scripts (scripts/loads-resolution). --check-loads: fail unless the loads on the box
@@ -153,6 +154,9 @@ int main(int argc, char** argv) {
     return 2;
   }
   const sph_backend backend = support_backend_from_name(backend_name, SPH_BACKEND_CPU);
+  // The box's voxels: about step / 2, a whole number of them across its half side, so that its faces
+  // lie on samples as at 1 cm (6 of 5 mm), where the trilinear field's zero level is exact.
+  const double box_voxel = kHalf / std::max(1.0, std::round(kHalf / (0.5 * step)));
   const auto started = std::chrono::steady_clock::now();
 
   // The scene of test_collider_loads.c's submerged_box_force.
@@ -205,7 +209,7 @@ int main(int argc, char** argv) {
   check(sph_shape_desc_init(&shape), "sph_shape_desc_init");
   shape.shape = SPH_SHAPE_BOX;
   shape.half_extents.x = shape.half_extents.y = shape.half_extents.z = static_cast<float>(kHalf);
-  shape.voxel_size = static_cast<float>(0.5 * step);
+  shape.voxel_size = static_cast<float>(box_voxel);
   shape.padding_voxels = 8;
   check(sph_sdf_create_shape(w.context, &shape, &box_sdf), "sph_sdf_create_shape");
   sph_collider_def collider;
@@ -226,7 +230,7 @@ int main(int argc, char** argv) {
   spec.kind = sph::ShapeKind::Box;
   spec.half_extents =
       sph::Vec3{static_cast<float>(kHalf), static_cast<float>(kHalf), static_cast<float>(kHalf)};
-  spec.voxel_size = static_cast<float>(0.5 * step);
+  spec.voxel_size = static_cast<float>(box_voxel);
   spec.padding_voxels = 8;
   const auto asset = sph::build_shape_sdf(spec, 1u << 24);
   const sph::BoundaryCalibration calibration = sph::fcc_boundary_calibration(spacing, h);

@@ -24,7 +24,8 @@
 // each frame. The water level is the volume of the particles over a 6 x 6 cm square of the floor
 // between the box and the tank's corner (2 cm from each) divided by its area (the test's gauge
 // is refused on DFSPH); the draft is that level less the box's bottom, averaged over the last
-// second, against Archimedes' 5 cm.
+// second, against Archimedes' 5 cm; and by the level the particles' volume gives (below: at 1 cm the
+// square's gauge reads 2.2 cm above it, docs/validation.md "Loads against resolution").
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -89,6 +90,9 @@ int main(int argc, char** argv) {
   }
   const auto started = std::chrono::steady_clock::now();
   const double spacing = step * std::sqrt(2.0), scale = spacing / 0.02;  // 1 at the default
+  // The box's voxels: about spacing / 2, a whole number across its half side (5 of 1 cm at the default),
+  // so that its faces lie on samples, where the trilinear field's zero level is exact.
+  const double box_voxel = kHalf / std::max(1.0, std::round(kHalf / (0.01 * scale)));
   sph_world_def def;
   sph_world_def_init(&def);
   def.particle_spacing = static_cast<float>(spacing);
@@ -108,7 +112,7 @@ int main(int argc, char** argv) {
   check(sph_shape_desc_init(&shape), "sph_shape_desc_init");
   shape.shape = SPH_SHAPE_BOX;
   shape.half_extents.x = shape.half_extents.y = shape.half_extents.z = static_cast<float>(kHalf);
-  shape.voxel_size = static_cast<float>(0.01 * scale);
+  shape.voxel_size = static_cast<float>(box_voxel);
   shape.padding_voxels = 8;
   check(sph_sdf_create_shape(w.context, &shape, &box_sdf), "sph_sdf_create_shape");
   const double mass = 500.0 * 8.0 * kHalf * kHalf * kHalf, archimedes = mass / (1000.0 * 4.0 * kHalf * kHalf);
@@ -134,7 +138,7 @@ int main(int argc, char** argv) {
   spec.kind = sph::ShapeKind::Box;
   spec.half_extents =
       sph::Vec3{static_cast<float>(kHalf), static_cast<float>(kHalf), static_cast<float>(kHalf)};
-  spec.voxel_size = static_cast<float>(0.01 * scale);
+  spec.voxel_size = static_cast<float>(box_voxel);
   spec.padding_voxels = 8;
   const auto asset = sph::build_shape_sdf(spec, 1u << 24);
   const auto map = sph::compute_boundary_map(*asset, h, level, sph::CpuParallel(2));
@@ -207,6 +211,11 @@ int main(int argc, char** argv) {
   }
   water_level /= sampled_time, mean /= late_time;
   const double draft = water_level - (mean - kHalf);
+  // A second level that no gauge's packing moves: the particles' volume at rho0 (m / rho0 each) and the
+  // box's part below the level fill the tank's 30 x 30 cm floor, N v + A_box (L - bottom) = A_tank L.
+  const double volume_level =
+      (n * static_cast<double>(w.mass) / rho0 - 0.01 * (mean - kHalf)) / (0.09 - 4.0 * kHalf * kHalf);
+  const double volume_draft = volume_level - (mean - kHalf);
   double early = 0.0, settled = 0.0;
   for (int frame = static_cast<int>(std::lround(0.25 / dt)); frame < std::lround(0.75 / dt); ++frame)
     early = std::fmax(early, std::fabs(heights[frame] - mean));
@@ -215,9 +224,10 @@ int main(int argc, char** argv) {
   std::printf(
       "floating box, backend %s, solver %s, %u particles: centre %.4f m, water level %.4f m (volume over the "
       "floor's square), draft %.2f cm (Archimedes %.2f cm, %+.1f %%), heave %.2f cm at 0.25-0.75 s, %.2f cm "
-      "over the last second\n",
+      "over the last second; by the volume's level %.4f m the draft %.2f cm (%+.1f %%)\n",
       backend_name, dfsph ? "dfsph" : "wcsph", n, mean, water_level, 100.0 * draft, 100.0 * archimedes,
-      100.0 * (draft / archimedes - 1.0), 100.0 * early, 100.0 * settled);
+      100.0 * (draft / archimedes - 1.0), 100.0 * early, 100.0 * settled, volume_level, 100.0 * volume_draft,
+      100.0 * (volume_draft / archimedes - 1.0));
   if (from_loads)
     std::printf(
         "last second: the loads' vertical force %.4f N, the walls' reaction on the host %.4f N, the weight "
@@ -225,10 +235,12 @@ int main(int argc, char** argv) {
         api_y / sampled_time, host_y / sampled_time, mass * kGravity);
   std::printf(
       "RESULT case=floating_box backend=%s solver=%s step=%.5f h=%.5f particles=%u substeps=%llu force=%s "
-      "draft_err=%+.2f draft_cm=%.3f level=%.4f heave_early_cm=%.2f heave_late_cm=%.2f seconds=%.1f\n",
+      "draft_err=%+.2f draft_cm=%.3f level=%.4f volume_draft_err=%+.2f volume_level=%.4f heave_early_cm=%.2f "
+      "heave_late_cm=%.2f seconds=%.1f\n",
       backend_name, dfsph ? "dfsph" : "wcsph", step, static_cast<double>(h), n,
       static_cast<unsigned long long>(substeps), from_loads ? "loads" : "host",
-      100.0 * (draft / archimedes - 1.0), 100.0 * draft, water_level, 100.0 * early, 100.0 * settled,
+      100.0 * (draft / archimedes - 1.0), 100.0 * draft, water_level,
+      100.0 * (volume_draft / archimedes - 1.0), volume_level, 100.0 * early, 100.0 * settled,
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
   check(sph_sdf_destroy(tank_sdf), "sph_sdf_destroy");
   check(sph_sdf_destroy(box_sdf), "sph_sdf_destroy");
