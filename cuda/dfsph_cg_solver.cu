@@ -68,7 +68,7 @@ __global__ void __launch_bounds__(kDfsphCheckBlock) cg_first_check_kernel(CgSolv
   state->cg_restart = 1;
   state->cg_skip = 0;
   state->cg_outside_largest_bits = 0u;  // (each measurement's check takes and clears it)
-  dfsph_continue_solve(state, state->pressure_tally, dfsph_cg_bounds(c), Dfsph::kMinIterations,
+  dfsph_continue_solve(state, state->pressure_tally, dfsph_density_bounds(c), Dfsph::kMinIterations,
                        c.max_iterations, s.cond);
 }
 
@@ -101,7 +101,7 @@ __global__ void __launch_bounds__(kDfsphCheckBlock) cg_restart_check_kernel(CgSo
   state->cg_sz = sz;
   state->cg_restart = 0;
   if (sz == 0.0 && state->solve_iterations >= Dfsph::kMinIterations)
-    dfsph_stop_solve(state, state->pressure_tally, dfsph_cg_bounds(s.fluid.methods.dfsph), s.cond);
+    dfsph_stop_solve(state, state->pressure_tally, dfsph_density_bounds(s.fluid.methods.dfsph), s.cond);
 }
 
 // The operator on p, first half: the velocities p would give (a binding contact's normal part
@@ -215,7 +215,7 @@ __global__ void __launch_bounds__(kDfsphCheckBlock) cg_error_check_kernel(CgSolv
   FrameState* state = s.state;
   if (state->solve_run == 0) return;
   const Dfsph::Constants& c = s.fluid.methods.dfsph;
-  const DfsphBounds bounds = dfsph_cg_bounds(c);
+  const DfsphBounds bounds = dfsph_density_bounds(c);
   const bool measured = state->cg_skip == 0;  // uniform: the block reads it before any thread writes it
   double error = 0.0, outside = 0.0;
   if (measured) {

@@ -77,7 +77,7 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
                             "does not work with ") +
                     refused + " yet; use SPH_DFSPH_JACOBI");
   const Dfsph::Constants& c = fluid.methods.dfsph;
-  const DfsphBounds bounds = dfsph_cg_bounds(c);
+  const DfsphBounds bounds = dfsph_density_bounds(c);
   const uint32_t n = count_;
   float* p = columns_.dfsph_step();  // the search direction, read by the velocity update as k
   float* value = cg_value_.data();
