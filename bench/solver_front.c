@@ -5,7 +5,8 @@
  * bounds, at each resolution asked for, on the chosen backend. Per run: wall seconds per
  * simulated second, substeps, neighbour passes, the mean and largest compression (density
  * error) of the particles above rest density, the front's mean error against the measurements
- * (one fitted shift, as the validation), and DFSPH's solve iterations.
+ * (one fitted shift, as the validation), and DFSPH's solve iterations, capped solves and the largest
+ * error of one particle a density solve ended with ("solve lg", sph_stats.density_error_largest).
  *
  *   solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1]
  *                [--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg]
@@ -194,13 +195,14 @@ int main(int argc, char** argv) {
       "backend,solver,parameter,layers,particles,simulated_s,wall_s,wall_s_per_simulated_s,substeps,"
       "neighbor_passes,pressure_iterations,divergence_iterations,density_error_mean,density_error_max,"
       "solve_error_max,front_shift_T,front_error_mean,front_error_max,status,ms_per_substep,neighbors_mean,"
-      "ms_hash_sort,ms_cell_ranges,ms_density,ms_forces,ms_integrate,ms_collide,ms_emit,ms_other\n");
+      "ms_hash_sort,ms_cell_ranges,ms_density,ms_forces,ms_integrate,ms_collide,ms_emit,ms_other,"
+      "solve_error_largest\n");
   printf(
       "%s backend; dam break of Martin & Moyce for %.2f simulated s; front errors over T in [%.1f, %.1f]\n",
       resolved == SPH_BACKEND_CUDA ? "CUDA" : "CPU", seconds, DAM_BREAK_T_FIRST, DAM_BREAK_T_LAST);
-  printf("%-6s %-9s %6s %9s %10s %9s %10s %8s %8s %8s %8s %8s %6s %9s %6s\n", "solver", "parameter", "layers",
-         "particles", "wall/sim", "substeps", "nb passes", "rho err", "rho max", "front", "it/step", "div it",
-         "capped", "ms/subst", "nbrs");
+  printf("%-6s %-9s %6s %9s %10s %9s %10s %8s %8s %8s %8s %8s %6s %9s %6s %8s\n", "solver", "parameter",
+         "layers", "particles", "wall/sim", "substeps", "nb passes", "rho err", "rho max", "front", "it/step",
+         "div it", "capped", "ms/subst", "nbrs", "solve lg");
   for (int l = 0; l < resolutions; ++l) {
     for (int r = 0; r < run_count; ++r) {
       dam_break_config config;
@@ -245,15 +247,17 @@ int main(int argc, char** argv) {
           result->mean_error, result->max_error, substep_ms, result->neighbors_mean);
       for (int k = 0; k < SPH_STAGE_COUNT; ++k)
         fprintf(csv, ",%.5f", result->substeps ? result->stage_ms[k] / (double)result->substeps : 0.0);
-      fprintf(csv, "\n");
+      fprintf(csv, ",%.6f\n", result->density_error_largest);
       fflush(csv);
-      printf("%-6s %-9g %6u %9u %10.2f %9llu %10.0f %7.2f%% %7.2f%% %7.2f%% %8.2f %8.2f %6u %9.4f %6.1f\n",
-             dfsph ? "DFSPH" : "WCSPH", runs[r].value, layers[l], result->particles,
-             result->wall_seconds / result->simulated_seconds, (unsigned long long)result->substeps, passes,
-             100.0 * result->mean_compression, 100.0 * result->max_compression, 100.0 * result->mean_error,
-             dfsph ? (double)result->pressure_iterations / (double)result->substeps : 0.0,
-             dfsph ? (double)result->divergence_iterations / (double)result->substeps : 0.0,
-             result->capped_substeps, substep_ms, result->neighbors_mean);
+      printf(
+          "%-6s %-9g %6u %9u %10.2f %9llu %10.0f %7.2f%% %7.2f%% %7.2f%% %8.2f %8.2f %6u %9.4f %6.1f "
+          "%7.2f%%\n",
+          dfsph ? "DFSPH" : "WCSPH", runs[r].value, layers[l], result->particles,
+          result->wall_seconds / result->simulated_seconds, (unsigned long long)result->substeps, passes,
+          100.0 * result->mean_compression, 100.0 * result->max_compression, 100.0 * result->mean_error,
+          dfsph ? (double)result->pressure_iterations / (double)result->substeps : 0.0,
+          dfsph ? (double)result->divergence_iterations / (double)result->substeps : 0.0,
+          result->capped_substeps, substep_ms, result->neighbors_mean, 100.0 * result->density_error_largest);
       printf("       stages, ms/substep:");
       for (int k = 0; k < SPH_STAGE_COUNT; ++k)
         printf(" %.4f", result->substeps ? result->stage_ms[k] / (double)result->substeps : 0.0);

@@ -205,7 +205,7 @@ class CudaBackend final : public Backend {
   void halo_after_dfsph_density(cudaStream_t stream);
   void halo_share_velocities(Float4* v, cudaStream_t stream);
   void halo_share_dfsph_steps(cudaStream_t stream);
-  DfsphErrors halo_dfsph_errors(cudaStream_t stream);
+  DfsphErrors halo_dfsph_errors(bool divergence, cudaStream_t stream);
   // Probes: each sample point's gather becomes its owner rank's (core/rank_probe_points.h).
   void halo_pick_probe_points(const DeviceProbes& probes, cudaStream_t stream);
   // The ghosts take their owners' records (DeviceHalo::pack_records / enqueue_apply_records) of
@@ -213,6 +213,10 @@ class CudaBackend final : public Backend {
   template <class Record>
   void halo_refresh(cudaStream_t stream, const char* what, const ParticleArrays& a);
   void halo_before_end(cudaStream_t stream);  // maxima and failures reduced over the ranks
+  // RK4: a stage's end and the next stage's halo (SubstepHooks::next_stage).
+  bool halo_next_stage(int stage, uint32_t* count, cudaStream_t stream);
+  // The substep's state so far (pinned; after the stream), the records' id check thrown.
+  const FrameState& halo_substep_state(cudaStream_t stream);
   void halo_sum_loads(ColliderLoadSums* sums, uint32_t colliders);  // the frame's loads over the ranks
   // Sinks after a substep, as on the CPU rank: the ghosts dropped, then the rank's own particles
   // tested and compacted (its removed ids and counts appended); after the frame's last substep
@@ -221,7 +225,7 @@ class CudaBackend final : public Backend {
                                    HostVector<uint32_t>& removed_ids, HostVector<uint32_t>& removed_by_sink);
   // The owned particles, in the sorted order; `counts` (per particle, sorted order) kept with them.
   void halo_drop_ghosts(uint32_t* counts = nullptr);
-  HostVector<HaloArray> halo_arrays() const;  // what travels with a particle
+  HostVector<HaloArray> halo_arrays() const;  // what travels with a particle (halo_rk4_side_)
   std::vector<RankBytes> halo_send(const uint32_t* starts);
   uint32_t halo_receive(const RankBytes& in, uint32_t first);
   bool halo_any(bool flag) const;
@@ -239,6 +243,10 @@ class CudaBackend final : public Backend {
   // list, DeviceHalo::kept_list); kNoKeptList before it.
   static constexpr uint32_t kNoKeptList = UINT32_MAX;
   uint32_t halo_kept_ = kNoKeptList;
+  // Between RK4's stages: the side of the stage state (rk4_start, rk4_sum) the last stage left,
+  // which travels and is kept with the particles (halo_next_stage); kNoRk4Side otherwise.
+  static constexpr int kNoRk4Side = -1;
+  int halo_rk4_side_ = kNoRk4Side;
 
   WorldConfig config_;
   int device_;

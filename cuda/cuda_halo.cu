@@ -24,11 +24,14 @@
 // weakly compressible solver (with the normalised density and the density diffusion, whose
 // republished densities the ghosts take again, surface tension, whose colour normals they take:
 // substep_pipeline.cu, and collider loads, each rank's own particles' impulses added over the
-// ranks at the frame's end: cuda_halo_frame.cu) or DFSPH's Jacobi solves (the host drives each
-// solve an iteration at a time, core/dfsph_jacobi_loop.h: the ghosts take their owners' densities
-// and factors after the density pass, velocities and pressure steps within each iteration, and
-// the mean error is an exact sum added over the ranks); attach_ranks refuses RK4 and springs by
-// name, the step DFSPH's conjugate gradients (frame_loop.cu).
+// ranks at the frame's end: cuda_halo_frame.cu), RK4 (each of its four stages sorts, so each
+// gathers its halo; between two stages the ranks agree on a failure, the ghosts go and the stage
+// state, rk4_start and rk4_sum, travels with the migrants: halo_next_stage, as on the CPU rank)
+// or DFSPH's Jacobi solves (the host drives each solve an iteration at a time,
+// core/dfsph_jacobi_loop.h: the ghosts take their owners' densities and factors after the density
+// pass, velocities and pressure steps within each iteration, and the mean error is an exact sum
+// added over the ranks); attach_ranks refuses springs by name, the step DFSPH's conjugate
+// gradients (frame_loop.cu).
 #include <cstring>
 #include <memory>
 #include <string>
@@ -66,7 +69,6 @@ void CudaBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks,
   } features[] = {{kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks)"}};
   for (const auto& f : features)
     if (config_.features & f.bit) refuse(f.name);
-  if (config_.integrator == Integrator::Rk4) refuse("the RK4 integrator");
   require_alive();
   DeviceGuard guard(device_);
   guarded([&] {
@@ -154,6 +156,14 @@ HostVector<HaloArray> CudaBackend::halo_arrays() const {
     if (bytes % 4 != 0)
       throw Error(Status::Internal, std::string("halo: array ") + m->spec.name + " is not in words");
     v.push_back(HaloArray{m->side[0].get(), static_cast<uint32_t>(bytes)});
+  }
+  // RK4's stage state between two stages: it lives through a substep, and a particle may change
+  // ranks between its stages (ghosts take it too, as on the CPU rank, and never read it).
+  static_assert(sizeof(ParticleState) % 4 == 0 && sizeof(Rk4Accumulator) % 4 == 0, "RK4's state in words");
+  if (halo_rk4_side_ != kNoRk4Side) {
+    const int side = halo_rk4_side_;
+    v.push_back(HaloArray{reinterpret_cast<unsigned char*>(a.rk4_start[side]), sizeof(ParticleState)});
+    v.push_back(HaloArray{reinterpret_cast<unsigned char*>(a.rk4_sum[side]), sizeof(Rk4Accumulator)});
   }
   return v;
 }
@@ -315,9 +325,10 @@ void CudaBackend::halo_share_dfsph_steps(cudaStream_t stream) {
 }
 
 // As the CPU rank's (CpuBackend::dfsph_errors): the rank's exact bins, added over the ranks, over
-// the world's count, and the ranks' largest error; the same bits on every rank, whichever
-// particles each holds.
-DfsphErrors CudaBackend::halo_dfsph_errors(cudaStream_t stream) {
+// the world's count, and the ranks' largest error, for the density solve only, which bounds it
+// (the divergence solve's rate kernel leaves it 0: no all_max per divergence iteration); the same
+// bits on every rank, whichever particles each holds.
+DfsphErrors CudaBackend::halo_dfsph_errors(bool divergence, cudaStream_t stream) {
   ExactFloatSum sum;
   const int64_t* words = r_->halo->download_error_bins(stream);
   std::memcpy(sum.terms(), words, sizeof(int64_t) * ExactFloatSum::kTerms);
@@ -326,7 +337,7 @@ DfsphErrors CudaBackend::halo_dfsph_errors(cudaStream_t stream) {
   std::memcpy(&largest, &largest_bits, sizeof largest);
   halo_agree();  // (the refreshes' buffers: a rank that failed there meets the others here)
   ranks_->all_sum(sum.terms(), ExactFloatSum::kTerms);
-  ranks_->all_max(&largest, 1);
+  if (!divergence) ranks_->all_max(&largest, 1);
   const int64_t particles = halo_world_count_;
   return {particles > 0 ? static_cast<float>(sum.value() / static_cast<double>(particles)) : 0.0f, largest};
 }

@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: MIT
 // A distributed CUDA rank's frame (cuda_halo.cu has the rank's arrays and its exchanges): the
 // stream driver with the halo's steps as hooks of the substep (SubstepHooks), the frame's start
-// (the world's max speed and acceleration, new slabs when out of balance) and the reduction of
-// each substep's maxima and failures over the ranks before the device's end-of-substep kernel,
-// which then picks the same next step on every rank (and fails on every rank together); the
-// sinks after each substep, on the rank's own particles (its removed ids are its own, as on the
-// CPU rank).
+// (the world's max speed and acceleration, new slabs when out of balance), RK4's stage ends (a
+// failure agreed, the halo gathered anew) and the reduction of each substep's maxima and
+// failures over the ranks before the device's end-of-substep kernel, which then picks the same
+// next step on every rank (and fails on every rank together); the sinks after each substep, on
+// the rank's own particles (its removed ids are its own, as on the CPU rank).
 #include <algorithm>
 #include <cstring>
 #include <vector>
@@ -32,17 +32,27 @@ __global__ void set_step_inputs_kernel(FrameState* s, float max_speed, float max
   s->max_acceleration = max_acceleration;
 }
 
-// The substep's maxima and failures as every rank found them; this rank's own failure keeps its
-// own particle (the message names it), another rank's is named by its id.
+// The substep's maxima and failures as every rank found them; this rank's own failure (at any
+// RK4 stage) keeps its own particle (the message names it), another rank's is named by its id.
 __global__ void set_reduced_kernel(FrameState* s, uint32_t v2max_bits, uint32_t a2max_bits,
                                    unsigned long long crowded, uint32_t bad_id) {
   s->v2max_bits = v2max_bits;
   s->a2max_bits = a2max_bits;
   if (s->crowded_key == 0) s->crowded_key = crowded;
-  if (bad_id != kAllFinite && s->bad_key[0] == kNoBadParticle) {
+  bool own = false;
+  for (int k = 0; k < kRk4Stages; ++k) own = own || s->bad_key[k] != kNoBadParticle;
+  if (bad_id != kAllFinite && !own) {
     s->bad_key[0] = bad_id;
     s->bad_counts[0] = 1;
   }
+}
+
+// The id of this rank's first non-finite particle (the first stage that had one, as the
+// end-of-substep kernel picks it), or kAllFinite.
+int64_t first_bad_id(const FrameState& f) {
+  for (int k = 0; k < kRk4Stages; ++k)
+    if (f.bad_key[k] != kNoBadParticle) return static_cast<int64_t>(f.bad_key[k] & 0xffffffffu);
+  return kAllFinite;
 }
 
 }  // namespace
@@ -53,6 +63,9 @@ class CudaBackend::HaloHooks final : public SubstepHooks {
   void after_sort(cudaStream_t stream) override { b_.halo_after_sort(stream); }
   void after_density(cudaStream_t stream) override { b_.halo_after_density(stream); }
   void after_normals(cudaStream_t stream) override { b_.halo_after_normals(stream); }
+  bool next_stage(int stage, uint32_t* count, cudaStream_t stream) override {
+    return b_.halo_next_stage(stage, count, stream);
+  }
   void before_end(cudaStream_t stream) override { b_.halo_before_end(stream); }
   void after_dfsph_density(cudaStream_t stream) override { b_.halo_after_dfsph_density(stream); }
   void after_probe_points(const DeviceProbes& probes, cudaStream_t stream) override {
@@ -61,7 +74,9 @@ class CudaBackend::HaloHooks final : public SubstepHooks {
   void share_velocities(Float4* v, cudaStream_t stream) override { b_.halo_share_velocities(v, stream); }
   void share_steps(cudaStream_t stream) override { b_.halo_share_dfsph_steps(stream); }
   unsigned long long* error_bins() override { return b_.r_->halo->error_bins(); }
-  DfsphErrors errors(cudaStream_t stream) override { return b_.halo_dfsph_errors(stream); }
+  DfsphErrors errors(bool divergence, cudaStream_t stream) override {
+    return b_.halo_dfsph_errors(divergence, stream);
+  }
 
  private:
   CudaBackend& b_;
@@ -96,8 +111,7 @@ void CudaBackend::halo_sum_loads(ColliderLoadSums* sums, uint32_t colliders) {
   if (colliders > 0) std::memcpy(sums, v.data(), sizeof(double) * v.size());
 }
 
-void CudaBackend::halo_before_end(cudaStream_t stream) {
-  const RankTransport& t = *ranks_;
+const FrameState& CudaBackend::halo_substep_state(cudaStream_t stream) {
   DeviceHalo& h = *r_->halo;
   FrameState* out = r_->state_output.get();
   cuda_check(cudaMemcpyAsync(out, r_->state.get(), sizeof(FrameState), cudaMemcpyDeviceToHost, stream),
@@ -112,9 +126,33 @@ void CudaBackend::halo_before_end(cudaStream_t stream) {
                 "halo: a rank's records (densities, colour normals, DFSPH's velocities or steps) came in "
                 "another order than its ghosts");
   }
-  const FrameState& f = *out;
-  int64_t bad =
-      f.bad_key[0] != kNoBadParticle ? static_cast<int64_t>(f.bad_key[0] & 0xffffffffu) : kAllFinite;
+  return *out;
+}
+
+// As the CPU rank's RK4 (CpuBackend::substep_rk4): a stage ends as a substep does, so a failure of
+// any rank (a non-finite particle, a crowded slot) ends the substep at that stage on every rank,
+// and no rank sorts or sends a failed stage's state. Otherwise the ghosts go and the next stage
+// gathers its halo, the stage state (the side the last stage's forces wrote, which the next
+// reorder reads: stage & 1, substep_kernels.cu) travelling and kept with the particles.
+bool CudaBackend::halo_next_stage(int stage, uint32_t* count, cudaStream_t stream) {
+  const FrameState& f = halo_substep_state(stream);
+  const bool failed = first_bad_id(f) != kAllFinite || f.crowded_key != 0;
+  if (halo_any(failed)) return false;  // (an agreement: the stage's passes and the records' buffers)
+  struct Side {
+    int& side;
+    ~Side() { side = kNoRk4Side; }
+  } with_state{halo_rk4_side_};
+  halo_rk4_side_ = stage & 1;
+  halo_drop_ghosts();
+  halo_gather();
+  *count = halo_owned_ + halo_ghosts_;
+  return true;
+}
+
+void CudaBackend::halo_before_end(cudaStream_t stream) {
+  const RankTransport& t = *ranks_;
+  const FrameState& f = halo_substep_state(stream);
+  int64_t bad = first_bad_id(f);
   agree(t, &bad);  // (the substep's passes and the records' buffers)
   int64_t maxima[3] = {f.v2max_bits, f.a2max_bits, static_cast<int64_t>(f.crowded_key)};
   t.all_max(maxima, 3);
@@ -187,6 +225,8 @@ uint32_t CudaBackend::run_frame_distributed(PipelineSetup setup, uint32_t sink_c
       setup.tuning.particle_lanes = lanes_per_particle(
           tuning_, static_cast<uint32_t>(std::min<int64_t>(halo_world_count_, UINT32_MAX)));
     enqueue_substep(setup, b, LoopCondition{}, s, &hooks);
+    setup.count = halo_owned_ + halo_ghosts_;  // (RK4: its last stage's halo)
+    setup.ghosts = halo_ghosts_;
     cuda_check(cudaMemcpyAsync(&out->run, &b.state->run, sizeof(uint32_t), cudaMemcpyDeviceToHost, s),
                "copy of the loop condition");
     cuda_check(

@@ -4,8 +4,8 @@
 // method; the twin of src/cpu/cpu_dfsph_cg.cpp, which it follows step by step). An iteration is a
 // fixed list of kernels, so it runs in the Jacobi solve's loop (dfsph_solve_loop.cuh): the CPU
 // driver's branches (a new cycle, no descent along p, a restart for the compression outside the
-// set) are flags in FrameState that the one-block kernels set and the particle kernels read, every
-// thread of a kernel taking the same branch. The sums are block trees and one block's sum of the
+// set, dfsph_cg_restart_due) are flags in FrameState that the one-block kernels set and the particle kernels
+// read, every thread of a kernel taking the same branch. The sums are block trees and one block's sum of the
 // block sums (fixed order: the same bits every run; not the CPU's exact sums, so the two backends
 // agree to rounding). The contacts: the CPU holds them in storage order, each held particle adding
 // m dv . grad W_ij to its neighbours' values; a particle's hold depends on its own velocity alone,
@@ -68,7 +68,8 @@ __global__ void __launch_bounds__(kDfsphCheckBlock) cg_first_check_kernel(CgSolv
   dfsph_take_largest(state);
   state->cg_restart = 1;
   state->cg_skip = 0;
-  dfsph_continue_solve(state, state->pressure_tally, dfsph_cg_bounds(c), Dfsph::kMinIterations,
+  state->cg_outside_largest_bits = 0u;  // (each measurement's check takes and clears it)
+  dfsph_continue_solve(state, state->pressure_tally, dfsph_density_bounds(c), Dfsph::kMinIterations,
                        c.max_iterations, s.cond);
 }
 
@@ -101,7 +102,7 @@ __global__ void __launch_bounds__(kDfsphCheckBlock) cg_restart_check_kernel(CgSo
   state->cg_sz = sz;
   state->cg_restart = 0;
   if (sz == 0.0 && state->solve_iterations >= Dfsph::kMinIterations)
-    dfsph_stop_solve(state, state->pressure_tally, dfsph_cg_bounds(s.fluid.methods.dfsph), s.cond);
+    dfsph_stop_solve(state, state->pressure_tally, dfsph_density_bounds(s.fluid.methods.dfsph), s.cond);
 }
 
 // The operator on p, first half: the velocities p would give (a binding contact's normal part
@@ -183,7 +184,8 @@ __global__ void cg_update_kernel(CgSolve s) {
 // The held contacts' changes added to the values (the rate of the held changes: m (dv_i - dv_j) .
 // grad W_ij and dv_i . grad rho_b, what the CPU's walks add); each particle's error, and the block
 // sums of the errors (partials [0, blocks)) and of those outside the set that a new set could take
-// (a factor; [blocks, 2 blocks)).
+// (a factor; [blocks, 2 blocks)); the largest error, and the largest of those outside the set (a
+// maximum: the same whatever order the blocks run in).
 __global__ void __launch_bounds__(kDfsphSolveBlock) cg_error_kernel(CgSolve s) {
   if (skipped(s)) return;
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
@@ -205,14 +207,17 @@ __global__ void __launch_bounds__(kDfsphSolveBlock) cg_error_kernel(CgSolve s) {
   dfsph_block_sum_to(s.partials, error);
   dfsph_block_sum_to(s.partials + s.blocks, outside);
   dfsph_block_max_to(&s.state->solve_largest_bits, static_cast<float>(error));
+  dfsph_block_max_to(&s.state->cg_outside_largest_bits, static_cast<float>(outside));
 }
 
-// The mean error; a restart when the compression outside the set needs a larger set; the loop's
-// test (also after an iteration without descent, with the error it had).
+// The mean and largest errors; a restart when the compression outside the set needs a larger set
+// (dfsph_cg_restart_due); the loop's test (also after an iteration without descent, with the error
+// it had).
 __global__ void __launch_bounds__(kDfsphCheckBlock) cg_error_check_kernel(CgSolve s) {
   FrameState* state = s.state;
   if (state->solve_run == 0) return;
   const Dfsph::Constants& c = s.fluid.methods.dfsph;
+  const DfsphBounds bounds = dfsph_density_bounds(c);
   const bool measured = state->cg_skip == 0;  // uniform: the block reads it before any thread writes it
   double error = 0.0, outside = 0.0;
   if (measured) {
@@ -224,13 +229,14 @@ __global__ void __launch_bounds__(kDfsphCheckBlock) cg_error_check_kernel(CgSolv
     // (n > 0 here: with no particles p . A p is 0 and every iteration skips its measurement)
     state->solve_error = static_cast<float>(error / static_cast<double>(s.n));
     dfsph_take_largest(state);
-    if (outside / static_cast<double>(s.n) >= Dfsph::kCgRestartShare * c.density_error) {
+    const float outside_largest = __uint_as_float(state->cg_outside_largest_bits);
+    state->cg_outside_largest_bits = 0u;
+    if (dfsph_cg_restart_due(bounds, outside / static_cast<double>(s.n), outside_largest)) {
       state->cg_restart = 1;
       state->cg_skip = 1;
     }
   }
-  dfsph_continue_solve(state, state->pressure_tally, dfsph_cg_bounds(c), Dfsph::kMinIterations,
-                       c.max_iterations, s.cond);
+  dfsph_continue_solve(state, state->pressure_tally, bounds, Dfsph::kMinIterations, c.max_iterations, s.cond);
 }
 
 // z (the Jacobi step) over the set, and the block sums of value . z.

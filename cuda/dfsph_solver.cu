@@ -309,7 +309,7 @@ void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid
         check_launch("dfsph_residual_kernel");
       }
       void share_steps() { rank.share_steps(stream); }
-      DfsphErrors errors() { return rank.errors(stream); }
+      DfsphErrors errors() { return rank.errors(divergence, stream); }
       void checked(uint32_t iterations, const DfsphErrors& errors, bool) {
         dfsph_rank_check_kernel<<<1, 1, 0, stream>>>(iterations, errors, bounds, min_iterations,
                                                      max_iterations, divergence, state);

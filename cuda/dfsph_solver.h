@@ -65,8 +65,9 @@ struct DfsphRankSteps {
   // largest of them (the density solve's; atomicMax).
   virtual unsigned long long* error_bins() = 0;
   // The world's errors: the mean, the bins (after the rate pass) added over the ranks, over the
-  // world's particle count; the largest, the ranks' largest. Waits for the stream.
-  virtual DfsphErrors errors(cudaStream_t stream) = 0;
+  // world's particle count; the largest, the ranks' largest (the density solve's; 0 for the
+  // divergence solve, with no reduction). Waits for the stream.
+  virtual DfsphErrors errors(bool divergence, cudaStream_t stream) = 0;
 };
 
 // Where a solve's loop runs and what it needs beyond the particles.

@@ -67,12 +67,13 @@ struct FrameState {
   float solve_largest;          // and its largest particle error (the density solve's only)
   uint32_t solve_largest_bits;  // the largest of the measurement in progress, as float bits (atomicMax)
   // The conjugate gradients' density solve (dfsph_cg_solver.cu): a new cycle is due; the rest of
-  // this iteration is skipped (no descent along p, or a restart); a contact was held in it;
+  // this iteration is skipped (no descent along p, or a restart); a contact was held in it; the
+  // largest error outside the active set of the measurement in progress (float bits, atomicMax);
   // value . z over the active set; the step along p and the next direction's share of p.
   uint32_t cg_restart;
   uint32_t cg_skip;
   uint32_t cg_held;
-  uint32_t cg_pad;
+  uint32_t cg_outside_largest_bits;
   double cg_sz;
   float cg_alpha;
   float cg_beta;

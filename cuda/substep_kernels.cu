@@ -123,7 +123,8 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
     acc = gather_acceleration_masked<Terms, true, G>(f, grid, a.sorted_position, a.sorted_velocity,
                                                      a.neighbor_count, a.colour_normal, i, group);
   }
-  if (i < n && group.lane == 0) {
+  // A distributed rank's ghost is its owner's to move; it leaves no trace in the maxima.
+  if (i < n && group.lane == 0 && !(a.halo_ghost && a.halo_ghost[i])) {
     // This stage's side, (stage + 1) % 2, picked without a run-time index into the struct.
     ParticleState* start = (stage & 1) ? a.rk4_start[0] : a.rk4_start[1];
     Rk4Accumulator* sums = (stage & 1) ? a.rk4_sum[0] : a.rk4_sum[1];

@@ -28,7 +28,7 @@ void enqueue_frame_begin(const PipelineSetup& setup, const PipelineBuffers& b, L
 void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
                      cudaStream_t stream, SubstepHooks* hooks) {
   const ParticleArrays& a = b.store->arrays();
-  const uint32_t n = setup.count;
+  uint32_t n = setup.count;  // (a distributed rank's RK4 stages gather their own halos)
   const bool rk4 = setup.integrator == Integrator::Rk4;
   const int stages = rk4 ? kRk4Stages : 1;
   if (setup.options.dfsph) {
@@ -63,9 +63,8 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
     enqueue_end_substep(b.state, setup.limits, setup.max_substeps, 1, cond, stream);
     return;
   }
-  if (hooks && rk4)
-    throw Error(Status::Internal, "substep: a distributed rank's steps are symplectic Euler's");
   for (int stage = 0; stage < stages; ++stage) {
+    if (hooks && stage > 0 && !hooks->next_stage(stage, &n, stream)) break;
     b.grid->enqueue_sort(a.position, n, b.state, stream, hooks ? hooks->visit : nullptr);
     b.grid->enqueue_cell_starts(n, b.state, stream);
     if (hooks) hooks->after_sort(stream);

@@ -55,9 +55,15 @@ struct PipelineBuffers {
 // each may wait for the stream): the sort's visit order, and calls after the sort (the grid's
 // order and cell starts are enqueued), after the density pass (the ghosts take their owners'
 // densities) and before the end-of-substep kernel (the maxima and failures reduced over ranks);
-// with DFSPH, after its density pass and inside its solves (DfsphRankSteps).
+// with DFSPH, after its density pass and inside its solves (DfsphRankSteps); with RK4, between
+// its stages.
 struct SubstepHooks : DfsphRankSteps {
   const uint32_t* visit = nullptr;
+  // RK4: before stage `stage` (1-3) sorts, the last one ends as a substep does on the CPU rank: a
+  // failure agreed over the ranks (false: every rank ends the substep there, and before_end
+  // reduces what failed), the ghosts dropped, the halo gathered anew (migrants with the stage
+  // state); *count becomes the rank's particles and ghosts.
+  virtual bool next_stage(int stage, uint32_t* count, cudaStream_t stream) = 0;
   virtual void after_sort(cudaStream_t stream) = 0;
   virtual void after_density(cudaStream_t stream) = 0;
   virtual void after_dfsph_density(cudaStream_t stream) = 0;  // DFSPH's density pass
@@ -69,7 +75,7 @@ struct SubstepHooks : DfsphRankSteps {
 
 void enqueue_frame_begin(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
                          cudaStream_t stream);
-// hooks: a distributed rank's (symplectic Euler or DFSPH; null otherwise).
+// hooks: a distributed rank's (null otherwise).
 void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
                      cudaStream_t stream, SubstepHooks* hooks = nullptr);
 // counts: the neighbour counts of the last density pass when a sink compaction left the sorted

@@ -619,9 +619,9 @@ typedef struct sph_dfsph_params {
                                          setting it (or loading a checkpoint with it) is
                                          UNSUPPORTED, the world unchanged */
   float density_error_max;            /* (0.2.0) bound on the density solve's largest error, max(rho* -
-                                         rho0, 0) / rho0 of any one particle: the Jacobi solve iterates
-                                         while this or the mean is above its bound (then the cap; the
-                                         conjugate gradients bound the mean only); default
+                                         rho0, 0) / rho0 of any one particle: the density solve (Jacobi
+                                         or conjugate gradients) iterates while this or the mean is
+                                         above its bound (then the cap); default
                                          0.05 (5 %); in (0, 1]; 0 = default; a value below
                                          density_error acts as density_error. Without it a small
                                          violent region of a large world (a splash at a wall) stays

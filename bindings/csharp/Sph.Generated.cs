@@ -1178,11 +1178,11 @@ namespace Sph
         public uint LinearSolver;
         /// <summary>
         /// float density_error_max: (0.2.0) bound on the density solve's largest error, max(rho* -
-        /// rho0, 0) / rho0 of any one particle: the Jacobi solve iterates while this or the mean is
-        /// above its bound (then the cap; the conjugate gradients bound the mean only); default 0.05 (5
-        /// %); in (0, 1]; 0 = default; a value below density_error acts as density_error. Without it a
-        /// small violent region of a large world (a splash at a wall) stays compressed by 50-100 %, as
-        /// it barely moves the mean
+        /// rho0, 0) / rho0 of any one particle: the density solve (Jacobi or conjugate gradients)
+        /// iterates while this or the mean is above its bound (then the cap); default 0.05 (5 %); in
+        /// (0, 1]; 0 = default; a value below density_error acts as density_error. Without it a small
+        /// violent region of a large world (a splash at a wall) stays compressed by 50-100 %, as it
+        /// barely moves the mean
         /// </summary>
         public float DensityErrorMax;
 

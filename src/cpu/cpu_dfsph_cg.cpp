@@ -77,7 +77,7 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
                             "does not work with ") +
                     refused + " yet; use SPH_DFSPH_JACOBI");
   const Dfsph::Constants& c = fluid.methods.dfsph;
-  const DfsphBounds bounds = dfsph_cg_bounds(c);
+  const DfsphBounds bounds = dfsph_density_bounds(c);
   const uint32_t n = count_;
   float* p = columns_.dfsph_step();  // the search direction, read by the velocity update as k
   float* value = cg_value_.data();
@@ -167,16 +167,18 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
       }
     parallel().for_each(n, [&](uint32_t i) { z[i] = dfsph_cg_error(value[i], rho0); });
     ExactFloatSum error_sum, outside_sum;
-    float largest = 0.0f;
+    float largest = 0.0f, outside_largest = 0.0f;
     for (uint32_t i = 0; i < n; ++i) {
       error_sum.add(z[i]);
       largest = z[i] > largest ? z[i] : largest;
-      // (only what a new set could take: a particle without a factor, which no pressure reaches,
-      // would restart every cycle)
-      if (!(state[i] & kActive) && factor[i] > 0.0f) outside_sum.add(z[i]);
+      // (only what a new set could take: dfsph_cg_restart_due)
+      if (!(state[i] & kActive) && factor[i] > 0.0f) {
+        outside_sum.add(z[i]);
+        outside_largest = z[i] > outside_largest ? z[i] : outside_largest;
+      }
     }
     error = {static_cast<float>(error_sum.value() / static_cast<double>(n)), largest};
-    if (outside_sum.value() / static_cast<double>(n) >= Dfsph::kCgRestartShare * bounds.mean) {
+    if (dfsph_cg_restart_due(bounds, outside_sum.value() / static_cast<double>(n), outside_largest)) {
       restart = true;  // the compression outside the set needs a larger set
       continue;
     }

@@ -159,9 +159,10 @@ struct DfsphErrors {
   float mean;
   float largest;
 };
-// The solves' bounds, on both backends: the mean error's, and (the density solve) the largest
-// particle error's. A solve goes on while one is unmet (or its minimum has not run) and below its
-// cap; one that stops with a bound unmet is capped. The divergence solve bounds only its mean.
+// The solves' bounds, on both backends: the mean error's, and (the density solve, Jacobi or
+// conjugate gradients alike) the largest particle error's. A solve goes on while one is unmet (or its minimum
+// has not run) and below its cap; one that stops with a bound unmet is capped. The divergence solve bounds
+// only its mean.
 struct DfsphBounds {
   float mean;
   float largest;
@@ -173,11 +174,6 @@ SPH_HD bool dfsph_bounds_unmet(const DfsphBounds& b, const DfsphErrors& e) {
 SPH_HD DfsphBounds dfsph_density_bounds(const Dfsph::Constants& c) {
   return {c.density_error, c.density_error_max};
 }
-// The conjugate gradients' density solve (dfsph_cg.h) bounds its mean only: with the largest-error
-// bound it stopped at its cap of 100 iterations in 5 (CPU) and 8 (CUDA) of gpu_check_dfsph_cg's 50
-// dam-break substeps (H200, session 14), its active set and restarts being built around the
-// mean. Not studied yet; the Jacobi solve is the default.
-SPH_HD DfsphBounds dfsph_cg_bounds(const Dfsph::Constants& c) { return {c.density_error, kDfsphNoBound}; }
 SPH_HD DfsphBounds dfsph_divergence_bounds(const Dfsph::Constants& c) {
   return {c.divergence_error, kDfsphNoBound};
 }

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: MIT
 // DFSPH's density solve by conjugate gradients (sph_dfsph_params.linear_solver =
-// SPH_DFSPH_CONJUGATE_GRADIENTS; CPU only for now): the per-particle formulas, written for both
-// backends. The divergence solve stays a Jacobi iteration (measured: conjugate gradients took
-// more of its iterations; docs/validation.md, "DFSPH by conjugate gradients").
+// SPH_DFSPH_CONJUGATE_GRADIENTS): the per-particle formulas and the restart rule, written for both
+// backends (src/cpu/cpu_dfsph_cg.cpp, cuda/dfsph_cg_solver.cu). The divergence solve stays a Jacobi iteration
+// (measured: conjugate gradients took more of its iterations; docs/validation.md, "DFSPH by conjugate
+// gradients").
 //
 // Why it is a symmetric system: with equal masses the velocity update is dv = -dt G k,
 // (G k)_i = sum_j m (k_i + k_j) grad W_ij + k_i grad rho_b, and the density rate is
@@ -19,7 +20,8 @@
 // with a factor. The search direction is 0 outside it; every particle's value is tracked (it is
 // affine in v), so the solve's error counts all particles. A cycle restarts (steepest descent
 // from the current state, the set taken anew) when the compression outside its set reaches
-// kCgRestartShare of the bound. A particle's pressure may fall below 0 within a substep (the
+// kCgRestartShare of the mean bound or one particle outside it is above the largest bound
+// (dfsph_cg_restart_due). A particle's pressure may fall below 0 within a substep (the
 // velocities keep what it applied); the solve keeps its positive part (dfsph_cg_kept_pressure).
 //
 // Each iteration is one velocity update with the search direction p as k (dv_p = -dt G p) and one
@@ -72,6 +74,16 @@ SPH_HD bool dfsph_cg_active(float value, float carried, float factor) {
 // The preconditioned residual z_i: the Jacobi step's k_i for the value.
 SPH_HD float dfsph_cg_step(float value, float factor, float dt) { return value * factor / (dt * dt); }
 
+// Whether the cycle must restart with a new set, from the errors of the particles outside the set
+// that a new set could take (with a factor: one without, which no pressure reaches, would restart
+// every cycle): their sum over all particles' count (outside_mean, a double as the backends' sums)
+// at kCgRestartShare of the mean bound, or one of them above the largest bound. The mean alone let
+// a particle compressed during the cycle outside the set stay above density_error_max, which no
+// iteration of the cycle could lower, and the solve ran to its cap (docs/validation.md, "DFSPH by
+// conjugate gradients").
+SPH_HD bool dfsph_cg_restart_due(const DfsphBounds& bounds, double outside_mean, float outside_largest) {
+  return outside_mean >= Dfsph::kCgRestartShare * bounds.mean || outside_largest > bounds.largest;
+}
 // What the solve keeps of a particle's pressure for the next warm start, the checkpoints and the
 // pressure attribute: its positive part (the Jacobi solve's pressures are never negative, and a
 // checkpoint with a negative one is refused as corrupt).

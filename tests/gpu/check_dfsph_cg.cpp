@@ -2,11 +2,13 @@
 // DFSPH's density solve by conjugate gradients (sph_dfsph_params.linear_solver =
 // SPH_DFSPH_CONJUGATE_GRADIENTS) on the CUDA backend against the CPU backend (issue 16): the
 // Martin & Moyce dam break of tests/support/dam_break.c (its tank, column and parameters) at 16
-// lattice layers across the column, 1,536 particles, the bound 0.1 %, 40 frames of 3 ms (dt_max =
-// the frame; the speed limit splits the last 11 frames in two). Measured on the CPU: 2 iterations
-// a substep (the minimum) for the first 14 frames, then 4-9 as the column falls, 4.67 a substep
-// over the 51 substeps. The walls are the tank's collider, so the solve's contacts (binding at a
-// cycle's start, held within it) are exercised.
+// lattice layers across the column, 1,536 particles, the bounds 0.1 % (mean) and 5 % (largest
+// particle error, density_error_max, the default), 40 frames of 3 ms (dt_max =
+// the frame; the speed limit splits the last 11 frames in two). Measured on the CPU (session 15, both
+// bounds): 2 iterations a substep (the minimum) for the first 13 frames, then 3-8 as the column
+// falls, 4.43 a substep over the 51 substeps (4.67 with the mean bound alone), the largest particle
+// error up to 4.63 % (frame 16), none capped. The walls are the tank's collider, so the solve's contacts
+// (binding at a cycle's start, held within it) are exercised.
 //   - iterations: each frame's substeps equal and its density-solve iterations within 1 a substep
 //     (the frame's sum within its substep count, its largest within 1) on every frame that starts
 //     from states within 1e-3 of max |x| of each other: the CPU sums in exact arithmetic, the GPU
@@ -23,7 +25,12 @@
 //     set, the states drift to 2.4e-4 of max |x| by frame 11 and 1 % by frame 20 under CG, against
 //     8e-7 and 2e-6 under Jacobi (SPH_CHECK_DFSPH_SOLVER=jacobi), with equal iteration counts
 //     through frame 13 (docs/performance.md, session 12);
-//   - the achieved error within the bound on both, every substep, none capped;
+//   - the achieved mean error within its bound and every substep's largest particle error
+//     (sph_stats.density_error_largest) within density_error_max on both, none capped: the solve
+//     stops only with both bounds met or at its cap (no tolerance). With the largest bound and the
+//     restart rule on the mean alone 5 (CPU) and 8 (CUDA) of the 50 substeps ran to the cap of 100
+//     (H200, session 14); the restart on a particle outside the set above the largest bound
+//     (dfsph_cg_restart_due) is what this checks on the device;
 //   - two runs through the CUDA graph and one through the stream driver give the same bits
 //     (positions, velocities, densities, pressures, ids, and every frame's statistics).
 #include <cstdlib>
@@ -36,17 +43,18 @@ using namespace gpu_check;
 
 namespace {
 
-constexpr uint32_t kLayers = 16;    // across the column (slab: 6)
-constexpr uint32_t kFrames = 40;    // 120 ms: the front has moved about one column width
-constexpr uint32_t kCompareAt = 5;  // before frame 6's wall contact (see above)
-constexpr float kFrame = 3e-3f;     // s, and dt_max
-constexpr float kBound = 0.001f;    // the density solve's default bound
+constexpr uint32_t kLayers = 16;        // across the column (slab: 6)
+constexpr uint32_t kFrames = 40;        // 120 ms: the front has moved about one column width
+constexpr uint32_t kCompareAt = 5;      // before frame 6's wall contact (see above)
+constexpr float kFrame = 3e-3f;         // s, and dt_max
+constexpr float kBound = 0.001f;        // the density solve's default bound
+constexpr float kBoundLargest = 0.05f;  // and its default bound on the largest particle error
 constexpr double kGravity = 9.81;
 
 // One frame's sph_stats of the density solve.
 struct FrameStats {
   uint32_t substeps, iterations, iterations_max, capped;
-  float error;
+  float error, largest;
 };
 
 struct Run {
@@ -87,6 +95,7 @@ Run run(sph_backend backend, bool stream_frames) {
   sph_dfsph_params dfsph;
   sph_dfsph_params_init(&dfsph);
   dfsph.density_error = kBound;
+  dfsph.density_error_max = kBoundLargest;
   // SPH_CHECK_DFSPH_SOLVER=jacobi: the same comparison for the Jacobi solve (a diagnosis: how far
   // the default solve's backends drift apart on this scene).
   const char* solver = std::getenv("SPH_CHECK_DFSPH_SOLVER");
@@ -103,7 +112,8 @@ Run run(sph_backend backend, bool stream_frames) {
     require_ok(sph_world_step(world, kFrame), "sph_world_step");
     const sph_stats st = get_stats(world);
     out.stats.push_back(FrameStats{st.substeps, st.pressure_iterations, st.pressure_iterations_max,
-                                   st.pressure_solves_capped, st.density_error_max});
+                                   st.pressure_solves_capped, st.density_error_max,
+                                   st.density_error_largest});
     if (f == kCompareAt) out.early = read_state(world);
     out.frames.push_back(read_state(world));
   }
@@ -119,27 +129,31 @@ bool same_stats(const Run& a, const Run& b) {
   for (size_t i = 0; i < a.stats.size(); ++i)
     if (a.stats[i].substeps != b.stats[i].substeps || a.stats[i].iterations != b.stats[i].iterations ||
         a.stats[i].iterations_max != b.stats[i].iterations_max || a.stats[i].capped != b.stats[i].capped ||
-        std::memcmp(&a.stats[i].error, &b.stats[i].error, sizeof(float)) != 0)
+        std::memcmp(&a.stats[i].error, &b.stats[i].error, sizeof(float)) != 0 ||
+        std::memcmp(&a.stats[i].largest, &b.stats[i].largest, sizeof(float)) != 0)
       return false;
   return true;
 }
 
-// The solve within its bound on every substep, none capped.
+// The solve within both bounds on every substep, none capped.
 void check_bound(const Run& r, const char* backend) {
   uint32_t capped = 0, substeps = 0, iterations = 0, most = 0;
-  float worst = 0.0f;
+  float worst = 0.0f, largest = 0.0f;
   for (const FrameStats& s : r.stats) {
     capped += s.capped;
     substeps += s.substeps;
     worst = std::max(worst, s.error);
+    largest = std::max(largest, s.largest);
     iterations += s.iterations;
     most = std::max(most, s.iterations_max);
   }
-  const std::string name = std::string("dfsph cg: ") + backend + " within the bound";
-  report(capped == 0 && worst <= kBound, name.c_str(),
-         "largest achieved error %.4f %% (bound %.2f %%), %u capped, %u substeps, %.2f iterations a substep "
-         "(largest %u)",
-         100.0 * worst, 100.0 * kBound, capped, substeps, double(iterations) / std::max(substeps, 1u), most);
+  const std::string name = std::string("dfsph cg: ") + backend + " within the bounds";
+  report(
+      capped == 0 && worst <= kBound && largest <= kBoundLargest, name.c_str(),
+      "largest achieved mean error %.4f %% (bound %.2f %%), largest particle error %.3f %% (bound %.0f %%), "
+      "%u capped, %u substeps, %.2f iterations a substep (largest %u)",
+      100.0 * worst, 100.0 * kBound, 100.0 * largest, 100.0 * kBoundLargest, capped, substeps,
+      double(iterations) / std::max(substeps, 1u), most);
 }
 
 }  // namespace

@@ -26,10 +26,10 @@ and one message naming the option (CI: no GPU).
 rank stops after the same frame (they agree once before and once after each step), exit code
 130, the manifests end "interrupted" at that frame, whose files (and the probes' rows) are all
 there.
---backend cuda: both programs on the CUDA backend (scripts/gpu-test), the scene without its
-sinks, probes, source and loads (a CUDA rank refuses sinks and probes): the distributed CUDA
+--backend cuda: both programs on the CUDA backend (scripts/gpu-test), the whole scene (CUDA ranks
+run its sink, probes, source and loads since session 15), checked as above: the distributed CUDA
 world against the undivided CUDA world, bit for bit while the tables cover the tank
-(docs/distributed.md, "The CUDA backend as a rank").
+(docs/distributed.md, "The CUDA backend as a rank"), the source's particles on more than one rank.
 """
 import json
 import glob
@@ -186,16 +186,6 @@ def main(argv):
     backend = options[options.index("--backend") + 1] if "--backend" in options else "cpu"
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
-    if backend == "cuda":
-        with open(scene, encoding="utf-8") as f:
-            desc = json.load(f)
-        for key in ("sinks", "probes", "sources"):
-            desc.pop(key, None)
-        for collider in desc.get("colliders", []):
-            collider.pop("loads", None)
-        scene = os.path.join(work, "no_sinks.json")
-        with open(scene, "w", encoding="utf-8") as f:
-            json.dump(desc, f)
     single, merged = os.path.join(work, "single"), os.path.join(work, "np" + ranks)
     run([sph_run, scene, "--backend", backend, "--format", "csv", "--threads", "1", "--quiet", "--out", single,
          "--stats-json", single + ".json"])
@@ -232,7 +222,7 @@ def main(argv):
         assert union == b, f"{name}: the ranks' files hold {len(union)} particles, the merged {len(b)}"
     assert len(glob.glob(os.path.join(merged, "rank*"))) == int(ranks), "one folder per rank"
     # The source spans the slabs: its particles were emitted (and held) on more than one rank.
-    assert backend == "cuda" or len(emitting) > 1, f"the source's particles were on {sorted(emitting)} only"
+    assert len(emitting) > 1, f"the source's particles were on {sorted(emitting)} only"
     if differing:
         sys.exit(f"FAIL: {differing} of {len(frames)} frames differ between sph-run and sph-run-mpi -np {ranks}")
     print(f"{len(frames)} frames of {len(a)} particles ({len(a) - first} more than frame 0: the source's, held on "
@@ -252,14 +242,14 @@ def main(argv):
     if p.returncode == 4:
         assert "--backend cuda" in p.stderr and p.stderr.count("sph-run-mpi:") == 1, p.stderr
         print("no GPU:", p.stderr.strip().splitlines()[0])
-    else:
-        assert p.returncode in (0, 3), f"--backend cuda exited {p.returncode}\n{p.stderr}"
-        print(f"--backend cuda: exit {p.returncode} (a GPU is here; 3 = the CUDA rank refused the scene's sinks)")
+    else:  # a GPU is here: CUDA ranks run the whole scene (its sink, probes, source and loads)
+        assert p.returncode == 0, f"--backend cuda exited {p.returncode}\n{p.stderr}"
+        print("--backend cuda: exit 0 (a GPU is here)")
 
     with open(scene, encoding="utf-8") as f:
         text = f.read()
     # Springs: the library refuses the world (sph_mpi_world_create) and names the feature (RK4,
-    # refused here before, works distributed since wt-mpisolve).
+    # refused here before, works distributed since wt-mpisolve, on CUDA ranks since session 15).
     bad_scene = os.path.join(work, "with_springs.json")
     with open(bad_scene, "w", encoding="utf-8") as f:
         f.write(text.replace('"capacity": 4000', '"capacity": 4000, "features": ["springs"]', 1))

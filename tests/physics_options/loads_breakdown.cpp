@@ -7,9 +7,16 @@
 //
 //   physics_loads_breakdown [--backend cpu|cuda] [--solver wcsph|dfsph] [--dt-max SECONDS]
 //                           [--settle SECONDS] [--perturb SEED] [--frames N] [--check-loads]
-//                           [--self-check | --self-check-only]
+//                           [--self-check | --self-check-only] [--step METRES] [--sample-every N]
 //
-// --frames: the sampled substeps (default 800). --check-loads: fail unless the loads on the box
+// --step: the lattice step (default 0.01 m; issue 17, "Loads against resolution" in
+// docs/validation.md): the layers fill the same tank (16 x 20 x 16 cm rounded to whole layers), h,
+// the voxels (the box's: a whole number across its half side) and the window's substeps scale with it (frames
+// of 0.5 ms x step / 1 cm), the box and the tank stay in metres. --frames: the window's substeps (default 0.4
+// s of them, 800 at 1 cm);
+// --sample-every N: read back and sum only every Nth of them (default 1; the others are stepped
+// unread, a cheaper average of the same window at fine steps). The last line, RESULT ..., is for
+// scripts (scripts/loads-resolution). --check-loads: fail unless the loads on the box
 // equal the host's sum of its walls' reaction and the loads on both colliders the fluid's
 // momentum change (M g - dP/dt), each within 1e-3 N (the ctest physics_loads_breakdown_dfsph).
 //
@@ -56,6 +63,7 @@
 // the adjoining edges and corners). BREAKDOWN_DEBUG=1 first prints the host map along the top face's
 // normal (K Phi(spacing / 2) must be the calibration's 23.1 % of rho0).
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -71,13 +79,14 @@
 #include "cpu/cpu_boundary_maps.h"
 #include "cpu/cpu_parallel.h"
 #include "physics/boundary_density.h"
+#include "physics/boundary_integrals.h"
 #include "support.h"
 
 namespace {
 
 using namespace loads_breakdown;  // NOLINT: the regions' names (box_regions.h)
 
-const double kStep = 0.01, kGravity = 9.81, kSide = 0.16;
+const double kGravity = 9.81, kSide = 0.16, kFill = 0.2;
 const double kCentre[3] = {0.08, 0.08, 0.08};
 
 void check(sph_result r, const char* what) {
@@ -99,8 +108,8 @@ struct Tally {
 int main(int argc, char** argv) {
   const char* backend_name = sph_test_backend_name();  // SPH_TEST_BACKEND, unset: cpu
   bool dfsph = false, self_check = false, only = false, check_loads = false;
-  int frames = 800;
-  double settle_time = 0.8;
+  int frames = 0, every = 1;
+  double settle_time = 0.8, step = 0.01;
   unsigned long perturb = 0;
   double dt_max = 0.0;
   for (int k = 1; k < argc; ++k) {
@@ -118,6 +127,10 @@ int main(int argc, char** argv) {
       self_check = true;
     else if (std::strcmp(argv[k], "--frames") == 0 && k + 1 < argc)
       frames = std::max(1, std::atoi(argv[++k]));
+    else if (std::strcmp(argv[k], "--step") == 0 && k + 1 < argc)
+      step = std::atof(argv[++k]);
+    else if (std::strcmp(argv[k], "--sample-every") == 0 && k + 1 < argc)
+      every = std::max(1, std::atoi(argv[++k]));
     else if (std::strcmp(argv[k], "--check-loads") == 0)
       check_loads = true;
     else if (std::strcmp(argv[k], "--self-check-only") == 0)
@@ -126,22 +139,36 @@ int main(int argc, char** argv) {
       std::fprintf(
           stderr,
           "usage: %s [--backend cpu|cuda] [--solver wcsph|dfsph] [--dt-max SECONDS] [--settle "
-          "SECONDS] [--perturb SEED] [--frames N] [--check-loads] [--self-check | --self-check-only]\n",
+          "SECONDS] [--perturb SEED] [--frames N] [--check-loads] [--self-check | --self-check-only] [--step "
+          "METRES] [--sample-every N]\n",
           argv[0]);
       return 2;
     }
   }
+  if (!(step >= 0.002 && step <= 0.02) || (check_loads && every > 1)) {
+    // --check-loads compares the momentum over the whole window with the sampled substeps' loads.
+    std::fprintf(stderr,
+                 "--step %g: give a lattice step between 0.002 and 0.02 m (and --check-loads without "
+                 "--sample-every)\n",
+                 step);
+    return 2;
+  }
   const sph_backend backend = support_backend_from_name(backend_name, SPH_BACKEND_CPU);
+  // The box's voxels: about step / 2, a whole number of them across its half side, so that its faces
+  // lie on samples as at 1 cm (6 of 5 mm), where the trilinear field's zero level is exact.
+  const double box_voxel = kHalf / std::max(1.0, std::round(kHalf / (0.5 * step)));
+  const auto started = std::chrono::steady_clock::now();
 
   // The scene of test_collider_loads.c's submerged_box_force.
-  const uint32_t layers[3] = {16, 20, 16};
+  const uint32_t side_layers = static_cast<uint32_t>(std::lround(kSide / step)),
+                 layers[3] = {side_layers, static_cast<uint32_t>(std::lround(kFill / step)), side_layers};
   float* lattice = nullptr;
   uint32_t n = 0, kept = 0;
-  check(support_fcc_box(layers, kStep, nullptr, &lattice, &n), "support_fcc_box");
+  check(support_fcc_box(layers, step, nullptr, &lattice, &n), "support_fcc_box");
   for (uint32_t i = 0; i < n; ++i) {
     bool inside = true;
     for (int k = 0; k < 3; ++k)
-      inside = inside && std::fabs(lattice[3 * i + k] - kCentre[k]) < kHalf + 0.5 * kStep;
+      inside = inside && std::fabs(lattice[3 * i + k] - kCentre[k]) < kHalf + 0.5 * step;
     if (inside) continue;
     std::memmove(lattice + 3 * kept, lattice + 3 * i, 3 * sizeof(float));
     ++kept;
@@ -155,7 +182,7 @@ int main(int argc, char** argv) {
   }
   sph_world_def def;
   sph_world_def_init(&def);
-  def.particle_spacing = static_cast<float>(kStep * std::sqrt(2.0));
+  def.particle_spacing = static_cast<float>(step * std::sqrt(2.0));
   def.capacity = kept;
   def.features = SPH_FEATURE_BOUNDARY_DENSITY | SPH_FEATURE_COLLIDER_LOADS;
   if (dfsph) def.solver = SPH_SOLVER_DFSPH;
@@ -176,13 +203,13 @@ int main(int argc, char** argv) {
   const double tank_min[3] = {0.0, 0.0, 0.0}, tank_max[3] = {kSide, 0.4, kSide};
   sph_sdf *tank_sdf = nullptr, *box_sdf = nullptr;
   sph_collider_id tank;
-  check(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * kStep, 0.0f, &tank_sdf, &tank),
+  check(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * step, 0.0f, &tank_sdf, &tank),
         "support_tank_between");
   sph_shape_desc shape;
   check(sph_shape_desc_init(&shape), "sph_shape_desc_init");
   shape.shape = SPH_SHAPE_BOX;
   shape.half_extents.x = shape.half_extents.y = shape.half_extents.z = static_cast<float>(kHalf);
-  shape.voxel_size = 0.005f;
+  shape.voxel_size = static_cast<float>(box_voxel);
   shape.padding_voxels = 8;
   check(sph_sdf_create_shape(w.context, &shape, &box_sdf), "sph_sdf_create_shape");
   sph_collider_def collider;
@@ -203,7 +230,7 @@ int main(int argc, char** argv) {
   spec.kind = sph::ShapeKind::Box;
   spec.half_extents =
       sph::Vec3{static_cast<float>(kHalf), static_cast<float>(kHalf), static_cast<float>(kHalf)};
-  spec.voxel_size = 0.005f;
+  spec.voxel_size = static_cast<float>(box_voxel);
   spec.padding_voxels = 8;
   const auto asset = sph::build_shape_sdf(spec, 1u << 24);
   const sph::BoundaryCalibration calibration = sph::fcc_boundary_calibration(spacing, h);
@@ -217,10 +244,15 @@ int main(int argc, char** argv) {
     for (double d : {0.0, 0.0035, 0.00707, 0.0141, 0.02}) {
       const sph::Vec3 at{0.0f, static_cast<float>(kHalf + d), 0.0f};
       const sph::LocalBoundaryShare s = sph::local_boundary_share(grid, map.data(), 1.0f, level, h, at);
-      std::printf("debug: d %.4f distance %.5f K Phi %.2f K grad Phi (%.1f, %.1f, %.1f)\n", d,
-                  static_cast<double>(sph::sample_distance(grid, at)), static_cast<double>(K * s.share),
-                  static_cast<double>(K * s.gradient.x), static_cast<double>(K * s.gradient.y),
-                  static_cast<double>(K * s.gradient.z));
+      // Beside it the flat wall's (the half space below the face moved delta into the box).
+      const double flat = d + calibration.offset;
+      std::printf(
+          "debug: d %.4f distance %.5f K Phi %.2f K grad Phi (%.1f, %.1f, %.1f); a flat wall's K Phi %.2f, "
+          "K dPhi/dd %.1f\n",
+          d, static_cast<double>(sph::sample_distance(grid, at)), static_cast<double>(K * s.share),
+          static_cast<double>(K * s.gradient.x), static_cast<double>(K * s.gradient.y),
+          static_cast<double>(K * s.gradient.z), K * sph::spiky_half_space<double>(flat, h),
+          K * sph::spiky_half_space_slope<double>(flat, h));
     }
   }
   const double expected = rho0 * kGravity * 8.0 * kHalf * kHalf * kHalf, area = 4.0 * kHalf * kHalf;
@@ -229,17 +261,27 @@ int main(int argc, char** argv) {
   double api[3] = {0.0, 0.0, 0.0}, api_time = 0.0;
   int samples = 0;
   std::vector<float> x(3 * static_cast<size_t>(kept)), after(x.size()), rho(kept), p(kept);
-  // Settle 0.8 s (--settle) in frames of 20 ms, then 0.4 s in frames of 0.5 ms: one substep each (the step
-  // limits allow 1 ms), so the positions read before a frame are its substep's start, where the
-  // density pass put the pressures and densities read after it.
+  // Settle 0.8 s (--settle) in frames of 20 ms, then 0.4 s in frames of 0.5 ms (at 1 cm; both limits scale
+  // with h): one substep each (the step limits allow 1 ms), so the positions read before a frame are its
+  // substep's start, where the density pass put the pressures and densities read after it.
   const int settle = static_cast<int>(std::lround(settle_time / 0.02));
-  const float frame_time = 0.0005f;
+  const float frame_time = static_cast<float>(0.0005 * step / 0.01);
+  if (frames == 0) frames = static_cast<int>(std::lround(0.4 / frame_time));
+  uint64_t substeps = 0;  // all the world took, for the cost (particles x substeps)
+  const auto step_counted = [&](float seconds) {
+    check(sph_world_step(w.world, seconds), "sph_world_step");
+    sph_stats stats;
+    check(sph_stats_init(&stats), "sph_stats_init");
+    check(sph_world_get_stats(w.world, &stats), "sph_world_get_stats");
+    substeps += stats.substeps;
+    return stats.substeps;
+  };
   // The self-check: the first substep from the lattice has no contacts yet, so with the loads on its
   // loads are the walls' reaction alone, which the host's map must reproduce.
   if (self_check) {
     uint32_t c0 = 0;
     check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, x.data(), kept, &c0), "read positions");
-    check(sph_world_step(w.world, frame_time), "sph_world_step");
+    step_counted(frame_time);
     check(support_read_by_id(w.world, SPH_ATTRIBUTE_DENSITY, rho.data(), kept, &c0), "read densities");
     check(support_read_by_id(w.world, SPH_ATTRIBUTE_PRESSURE, p.data(), kept, &c0), "read pressures");
     double f[3] = {0.0, 0.0, 0.0};
@@ -281,31 +323,33 @@ int main(int argc, char** argv) {
   sph::ShapeSpec tank_spec;
   tank_spec.kind = sph::ShapeKind::Box;
   tank_spec.half_extents = sph::Vec3{static_cast<float>(0.5 * kSide), 0.2f, static_cast<float>(0.5 * kSide)};
-  tank_spec.voxel_size = static_cast<float>(0.5 * kStep);
+  tank_spec.voxel_size = static_cast<float>(0.5 * step);
   const auto tank_asset = sph::build_shape_sdf(tank_spec, 1u << 24);
   const float tank_level = static_cast<float>(calibration.offset);
   const auto tank_map = sph::compute_boundary_map(*tank_asset, h, tank_level, sph::CpuParallel(2));
   const sph::SdfGridView tank_grid = tank_asset->host_view();
-  for (int frame = 0; frame < settle; ++frame) check(sph_world_step(w.world, 0.02f), "sph_world_step");
+  for (int frame = 0; frame < settle; ++frame) step_counted(0.02f);
   uint32_t count = 0;
   std::vector<float> velocity(x.size());
   check(support_read_by_id(w.world, SPH_ATTRIBUTE_VELOCITY, velocity.data(), kept, &count),
         "read velocities");
   for (uint32_t i = 0; i < count; ++i)
     for (int k = 0; k < 3; ++k) momentum[k] -= static_cast<double>(w.mass) * velocity[3 * i + k];
-  check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, x.data(), kept, &count), "read positions");
+  bool have_start = false;  // x holds the next substep's start
   for (int frame = 0; frame < frames; ++frame) {
-    check(sph_world_step(w.world, frame_time), "sph_world_step");
+    const bool sampled = frame % every == 0;
+    if (sampled && !have_start)
+      check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, x.data(), kept, &count), "read positions");
+    const uint32_t took = step_counted(frame_time);
+    if (took != 1) {
+      std::fprintf(stderr, "frame %d took %u substeps, not 1: lower the frame time\n", frame, took);
+      return 1;
+    }
+    have_start = false;
+    if (!sampled) continue;
     check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, after.data(), kept, &count), "read positions");
     check(support_read_by_id(w.world, SPH_ATTRIBUTE_DENSITY, rho.data(), kept, &count), "read densities");
     check(support_read_by_id(w.world, SPH_ATTRIBUTE_PRESSURE, p.data(), kept, &count), "read pressures");
-    sph_stats stats;
-    check(sph_stats_init(&stats), "sph_stats_init");
-    check(sph_world_get_stats(w.world, &stats), "sph_world_get_stats");
-    if (stats.substeps != 1) {
-      std::fprintf(stderr, "frame %d took %u substeps, not 1: lower the frame time\n", frame, stats.substeps);
-      return 1;
-    }
     if (loads) {
       sph_collider_loads l;
       check(sph_collider_loads_init(&l), "sph_collider_loads_init");
@@ -335,7 +379,7 @@ int main(int argc, char** argv) {
       int used = 0;
       for (double c : column)
         if (c > 0.0) plane += c, ++used;
-      plane = plane / used + 0.5 * kStep;
+      plane = plane / used + 0.5 * step;
     }
     auto interior = [&](uint32_t i, double below) {
       const double px = x[3 * i], py = x[3 * i + 1], pz = x[3 * i + 2];
@@ -380,6 +424,7 @@ int main(int argc, char** argv) {
     }
     ++samples;
     x.swap(after);
+    have_start = true;
   }
   const double mean_level = level_sum / samples;
   const double top_face = kCentre[1] + kHalf, bottom_face = kCentre[1] - kHalf;
@@ -475,6 +520,22 @@ int main(int argc, char** argv) {
       std::printf("check-loads %s (largest difference %.3g N)\n", pass ? "passed" : "FAILED", worst);
       if (!pass) return 1;
     }
+  }
+  {
+    // One line for scripts: the box's force (the loads where the world has them, else the walls'
+    // reaction) and its parts against rho0 g V, the faces' own regions against rho0 g d A.
+    const double walls = total[1] / expected - 1.0;
+    const double force = loads ? api[1] / api_time / expected - 1.0 : walls;
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    std::printf(
+        "RESULT case=submerged_box backend=%s solver=%s step=%.5f h=%.5f particles=%u substeps=%llu "
+        "seed=%lu samples=%d force_err=%+.2f walls_err=%+.2f top_err=%+.2f bottom_err=%+.2f side_err=%+.2f "
+        "level=%.4f seconds=%.1f\n",
+        backend_name, dfsph ? "dfsph" : "wcsph", step, static_cast<double>(h), kept,
+        static_cast<unsigned long long>(substeps), perturb, samples, 100.0 * force, 100.0 * walls,
+        100.0 * (tally[kTop].force[1] / samples / top_expected - 1.0),
+        100.0 * (tally[kBottom].force[1] / samples / bottom_expected - 1.0),
+        100.0 * (tally[kSides].normal / samples / 4.0 / side_expected - 1.0), mean_level, seconds);
   }
   std::free(lattice);
   check(sph_sdf_destroy(tank_sdf), "sph_sdf_destroy");

@@ -5,7 +5,16 @@
 // and the probes) can be measured (issue 17 item 5; docs/validation.md, "The submerged box per
 // region").
 //
-//   physics_loads_floating_box [--backend cpu|cuda] [--solver wcsph|dfsph]
+//   physics_loads_floating_box [--backend cpu|cuda] [--solver wcsph|dfsph] [--step METRES]
+//                              [--force host|loads] [--sample-every N]
+//
+// --step: the lattice step, spacing / sqrt 2 (default 0.0141421 m, the 2 cm spacing;
+// docs/validation.md, "Loads against resolution"): h, the voxels and the frames (0.5 ms x spacing /
+// 2 cm) scale with it, the box, the tank and the water's 20 cm stay in metres. --force: what steps
+// the body: the loads (WCSPH's default; DFSPH's loads came later, so there it is asked for) or the
+// host's walls' reaction (DFSPH's default). --sample-every N (with the loads only): read back and
+// sum only every Nth frame (the level, the host's sum; default 1), the cheap way at fine steps.
+// The last line, RESULT ..., is for scripts (scripts/loads-resolution).
 //
 // Frames of 0.5 ms, one substep each, for 3 s. The fluid's force on the box per substep is summed
 // on the host as physics_loads_breakdown does (the walls' reaction m (p / rho^2) K grad Phi_box at
@@ -15,7 +24,10 @@
 // each frame. The water level is the volume of the particles over a 6 x 6 cm square of the floor
 // between the box and the tank's corner (2 cm from each) divided by its area (the test's gauge
 // is refused on DFSPH); the draft is that level less the box's bottom, averaged over the last
-// second, against Archimedes' 5 cm.
+// second, against Archimedes' 5 cm; and by the level the particles' volume gives (below: at 1 cm the
+// square's gauge reads 2.2 cm above it, docs/validation.md "Loads against resolution").
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -45,34 +57,62 @@ void check(sph_result r, const char* what) {
 int main(int argc, char** argv) {
   const char* backend_name = "cpu";
   bool dfsph = false;
+  const char* force_from = nullptr;
+  double step = 0.02 / std::sqrt(2.0);
+  int every = 1;
   for (int k = 1; k < argc; ++k) {
     if (std::strcmp(argv[k], "--backend") == 0 && k + 1 < argc)
       backend_name = argv[++k];
     else if (std::strcmp(argv[k], "--solver") == 0 && k + 1 < argc)
       dfsph = std::strcmp(argv[++k], "dfsph") == 0;
+    else if (std::strcmp(argv[k], "--step") == 0 && k + 1 < argc)
+      step = std::atof(argv[++k]);
+    else if (std::strcmp(argv[k], "--force") == 0 && k + 1 < argc)
+      force_from = argv[++k];
+    else if (std::strcmp(argv[k], "--sample-every") == 0 && k + 1 < argc)
+      every = std::max(1, std::atoi(argv[++k]));
     else {
-      std::fprintf(stderr, "usage: %s [--backend cpu|cuda] [--solver wcsph|dfsph]\n", argv[0]);
+      std::fprintf(
+          stderr,
+          "usage: %s [--backend cpu|cuda] [--solver wcsph|dfsph] [--step METRES] [--force host|loads] "
+          "[--sample-every N]\n",
+          argv[0]);
       return 2;
     }
   }
+  const bool from_loads = force_from ? std::strcmp(force_from, "loads") == 0 : !dfsph;
+  if (!(step >= 0.002 && step <= 0.02) ||
+      (force_from && !from_loads && std::strcmp(force_from, "host") != 0) || (every > 1 && !from_loads)) {
+    std::fprintf(stderr,
+                 "give a --step between 0.002 and 0.02 m, --force host or loads, --sample-every with "
+                 "--force loads only\n");
+    return 2;
+  }
+  const auto started = std::chrono::steady_clock::now();
+  const double spacing = step * std::sqrt(2.0), scale = spacing / 0.02;  // 1 at the default
+  // The box's voxels: about spacing / 2, a whole number across its half side (5 of 1 cm at the default),
+  // so that its faces lie on samples, where the trilinear field's zero level is exact.
+  const double box_voxel = kHalf / std::max(1.0, std::round(kHalf / (0.01 * scale)));
   sph_world_def def;
   sph_world_def_init(&def);
-  def.particle_spacing = 0.02f;
-  def.capacity = 8000;
-  def.features = SPH_FEATURE_BOUNDARY_DENSITY | (dfsph ? 0u : SPH_FEATURE_COLLIDER_LOADS);
+  def.particle_spacing = static_cast<float>(spacing);
+  // fill_box's 0.018 m^3 at 2 step^3 a particle (3182 at the default), with room.
+  def.capacity = std::max(8000u, static_cast<uint32_t>(1.5 * 0.018 / (2.0 * step * step * step)));
+  def.features = SPH_FEATURE_BOUNDARY_DENSITY | (from_loads ? SPH_FEATURE_COLLIDER_LOADS : 0u);
   if (dfsph) def.solver = SPH_SOLVER_DFSPH;
   support_world w;
   std::memset(&w, 0, sizeof w);
   check(support_world_open(&w, support_backend_from_name(backend_name, SPH_BACKEND_CPU), &def, nullptr),
         "support_world_open");
-  const support_tank tank = {{0.0f, 0.25f, 0.0f}, {0.15f, 0.25f, 0.15f}, 0.01f, 0.0f};
+  const support_tank tank = {
+      {0.0f, 0.25f, 0.0f}, {0.15f, 0.25f, 0.15f}, static_cast<float>(0.01 * scale), 0.0f};
   sph_sdf *tank_sdf = nullptr, *box_sdf = nullptr;
   check(support_tank_create(w.context, w.world, &tank, &tank_sdf, nullptr), "support_tank_create");
   sph_shape_desc shape;
   check(sph_shape_desc_init(&shape), "sph_shape_desc_init");
   shape.shape = SPH_SHAPE_BOX;
   shape.half_extents.x = shape.half_extents.y = shape.half_extents.z = static_cast<float>(kHalf);
-  shape.voxel_size = 0.01f;
+  shape.voxel_size = static_cast<float>(box_voxel);
   shape.padding_voxels = 8;
   check(sph_sdf_create_shape(w.context, &shape, &box_sdf), "sph_sdf_create_shape");
   const double mass = 500.0 * 8.0 * kHalf * kHalf * kHalf, archimedes = mass / (1000.0 * 4.0 * kHalf * kHalf);
@@ -98,7 +138,7 @@ int main(int argc, char** argv) {
   spec.kind = sph::ShapeKind::Box;
   spec.half_extents =
       sph::Vec3{static_cast<float>(kHalf), static_cast<float>(kHalf), static_cast<float>(kHalf)};
-  spec.voxel_size = 0.01f;
+  spec.voxel_size = static_cast<float>(box_voxel);
   spec.padding_voxels = 8;
   const auto asset = sph::build_shape_sdf(spec, 1u << 24);
   const auto map = sph::compute_boundary_map(*asset, h, level, sph::CpuParallel(2));
@@ -110,24 +150,33 @@ int main(int argc, char** argv) {
   check(sph_world_get_stats(w.world, &stats), "sph_world_get_stats");
   n = stats.particle_count;
   std::vector<float> x(3 * static_cast<size_t>(n)), after(x.size()), rho(n), p(n);
-  const int frames = 6000, late = 2000;
-  const double dt = 0.0005;
-  double heights[6000], water_level = 0.0, mean = 0.0, host_y = 0.0, api_y = 0.0, late_time = 0.0;
+  const double dt = 0.0005 * scale;
+  const int frames = static_cast<int>(std::lround(3.0 / dt)), late = static_cast<int>(std::lround(1.0 / dt));
+  std::vector<double> heights(frames);
+  double water_level = 0.0, mean = 0.0, host_y = 0.0, api_y = 0.0, late_time = 0.0, sampled_time = 0.0;
   uint32_t count = 0;
-  check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, x.data(), n, &count), "read positions");
+  uint64_t substeps = 0;    // all the world took, for the cost (particles x substeps)
+  bool have_start = false;  // x holds the next substep's start
   for (int frame = 0; frame < frames; ++frame) {
+    const bool sampled = frame % every == 0;
+    if (sampled && !have_start)
+      check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, x.data(), n, &count), "read positions");
     check(sph_world_step(w.world, static_cast<float>(dt)), "sph_world_step");
     check(sph_world_get_stats(w.world, &stats), "sph_world_get_stats");
+    substeps += stats.substeps;
     if (stats.substeps != 1) {
       std::fprintf(stderr, "frame %d took %u substeps, not 1\n", frame, stats.substeps);
       return 1;
     }
-    check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, after.data(), n, &count), "read positions");
-    check(support_read_by_id(w.world, SPH_ATTRIBUTE_DENSITY, rho.data(), n, &count), "read densities");
-    check(support_read_by_id(w.world, SPH_ATTRIBUTE_PRESSURE, p.data(), n, &count), "read pressures");
-    // The walls' reaction at the substep's start, the box at its pose then (the last frame's end).
+    have_start = false;
     double force[3] = {0.0, 0.0, 0.0}, column = 0.0;
-    for (uint32_t i = 0; i < count; ++i) {
+    if (sampled) {
+      check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, after.data(), n, &count), "read positions");
+      check(support_read_by_id(w.world, SPH_ATTRIBUTE_DENSITY, rho.data(), n, &count), "read densities");
+      check(support_read_by_id(w.world, SPH_ATTRIBUTE_PRESSURE, p.data(), n, &count), "read pressures");
+    }
+    // The walls' reaction at the substep's start, the box at its pose then (the last frame's end).
+    for (uint32_t i = 0; sampled && i < count; ++i) {
       const sph::Vec3 local{static_cast<float>(x[3 * i] - position[0]),
                             static_cast<float>(x[3 * i + 1] - position[1]),
                             static_cast<float>(x[3 * i + 2] - position[2])};
@@ -137,11 +186,11 @@ int main(int argc, char** argv) {
       const double px = after[3 * i], pz = after[3 * i + 2];
       column += px > -0.13 && px < -0.07 && pz > -0.13 && pz < -0.07;
     }
-    if (!dfsph) {  // step from the loads (contacts included), as the test
+    if (from_loads) {  // step from the loads (contacts included), as the test
       sph_collider_loads l;
       check(sph_collider_loads_init(&l), "sph_collider_loads_init");
       check(sph_collider_get_loads(w.world, box, &l), "sph_collider_get_loads");
-      if (frame >= frames - late) host_y += force[1] * dt, api_y += l.force.y * dt;
+      if (frame >= frames - late && sampled) host_y += force[1] * dt, api_y += l.force.y * dt;
       force[0] = l.force.x, force[1] = l.force.y, force[2] = l.force.z;
     }
     force[1] -= mass * kGravity;
@@ -153,29 +202,46 @@ int main(int argc, char** argv) {
     check(sph_collider_set_target_transform(w.world, box, &target), "sph_collider_set_target_transform");
     heights[frame] = position[1];
     if (frame >= frames - late) {
-      water_level += column * (static_cast<double>(w.mass) / rho0) / (0.06 * 0.06) * dt;
+      if (sampled) water_level += column * (static_cast<double>(w.mass) / rho0) / (0.06 * 0.06) * dt;
       mean += position[1] * dt;
       late_time += dt;
+      sampled_time += sampled ? dt : 0.0;
     }
-    x.swap(after);
+    if (sampled) x.swap(after), have_start = true;
   }
-  water_level /= late_time, mean /= late_time;
+  water_level /= sampled_time, mean /= late_time;
   const double draft = water_level - (mean - kHalf);
+  // A second level that no gauge's packing moves: the particles' volume at rho0 (m / rho0 each) and the
+  // box's part below the level fill the tank's 30 x 30 cm floor, N v + A_box (L - bottom) = A_tank L.
+  const double volume_level =
+      (n * static_cast<double>(w.mass) / rho0 - 0.01 * (mean - kHalf)) / (0.09 - 4.0 * kHalf * kHalf);
+  const double volume_draft = volume_level - (mean - kHalf);
   double early = 0.0, settled = 0.0;
-  for (int frame = 500; frame < 1500; ++frame) early = std::fmax(early, std::fabs(heights[frame] - mean));
+  for (int frame = static_cast<int>(std::lround(0.25 / dt)); frame < std::lround(0.75 / dt); ++frame)
+    early = std::fmax(early, std::fabs(heights[frame] - mean));
   for (int frame = frames - late; frame < frames; ++frame)
     settled = std::fmax(settled, std::fabs(heights[frame] - mean));
   std::printf(
       "floating box, backend %s, solver %s, %u particles: centre %.4f m, water level %.4f m (volume over the "
       "floor's square), draft %.2f cm (Archimedes %.2f cm, %+.1f %%), heave %.2f cm at 0.25-0.75 s, %.2f cm "
-      "over the last second\n",
+      "over the last second; by the volume's level %.4f m the draft %.2f cm (%+.1f %%)\n",
       backend_name, dfsph ? "dfsph" : "wcsph", n, mean, water_level, 100.0 * draft, 100.0 * archimedes,
-      100.0 * (draft / archimedes - 1.0), 100.0 * early, 100.0 * settled);
-  if (!dfsph)
+      100.0 * (draft / archimedes - 1.0), 100.0 * early, 100.0 * settled, volume_level, 100.0 * volume_draft,
+      100.0 * (volume_draft / archimedes - 1.0));
+  if (from_loads)
     std::printf(
         "last second: the loads' vertical force %.4f N, the walls' reaction on the host %.4f N, the weight "
         "%.4f N\n",
-        api_y / late_time, host_y / late_time, mass * kGravity);
+        api_y / sampled_time, host_y / sampled_time, mass * kGravity);
+  std::printf(
+      "RESULT case=floating_box backend=%s solver=%s step=%.5f h=%.5f particles=%u substeps=%llu force=%s "
+      "draft_err=%+.2f draft_cm=%.3f level=%.4f volume_draft_err=%+.2f volume_level=%.4f heave_early_cm=%.2f "
+      "heave_late_cm=%.2f seconds=%.1f\n",
+      backend_name, dfsph ? "dfsph" : "wcsph", step, static_cast<double>(h), n,
+      static_cast<unsigned long long>(substeps), from_loads ? "loads" : "host",
+      100.0 * (draft / archimedes - 1.0), 100.0 * draft, water_level,
+      100.0 * (volume_draft / archimedes - 1.0), volume_level, 100.0 * early, 100.0 * settled,
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
   check(sph_sdf_destroy(tank_sdf), "sph_sdf_destroy");
   check(sph_sdf_destroy(box_sdf), "sph_sdf_destroy");
   check(support_world_close(&w), "support_world_close");

@@ -6,7 +6,13 @@
 // is still measured without) (issue 17 item 5; docs/validation.md, "The submerged box per
 // region").
 //
-//   physics_loads_side_wall [--backend cpu|cuda] [--solver wcsph|dfsph]
+//   physics_loads_side_wall [--backend cpu|cuda] [--solver wcsph|dfsph] [--step METRES] [--sample-every N]
+//
+// --step: the lattice step (default 0.01 m; docs/validation.md, "Loads against resolution"): the
+// layers fill the same 10 x 14 x 10 cm (rounded to whole layers; H is then the lattice's volume
+// over the tank's floor, 14 cm at 1 cm), h, the voxels and the frames scale with it (0.5 ms x step /
+// 1 cm, over the same 0.4 s). --sample-every N: sum every Nth substep only (default 1). The last
+// line, RESULT ..., is for scripts (scripts/loads-resolution).
 //
 // As physics_loads_breakdown: settled 0.8 s in frames of 20 ms, then 0.4 s in frames of 0.5 ms,
 // one substep each; around each the positions before it and the densities and pressures after it,
@@ -18,6 +24,8 @@
 // computed on the host) is what both colliders receive besides. With the loads (WCSPH) the plane's
 // loads over the same substeps are printed beside it. References: rho0 g H^2 W / 2, and for WCSPH
 // the resting compressible column's k rho0 (H - D) W (test_collider_loads.c).
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -35,7 +43,7 @@
 
 namespace {
 
-const double kStep = 0.01, kGravity = 9.81, kStiffness = 100.0;
+const double kGravity = 9.81, kStiffness = 100.0, kWidth = 0.1, kDepth = 0.14;
 
 void check(sph_result r, const char* what) {
   if (r == SPH_OK) return;
@@ -48,25 +56,42 @@ void check(sph_result r, const char* what) {
 int main(int argc, char** argv) {
   const char* backend_name = "cpu";
   bool dfsph = false;
+  double step = 0.01;
+  int every = 1;
   for (int k = 1; k < argc; ++k) {
     if (std::strcmp(argv[k], "--backend") == 0 && k + 1 < argc)
       backend_name = argv[++k];
     else if (std::strcmp(argv[k], "--solver") == 0 && k + 1 < argc)
       dfsph = std::strcmp(argv[++k], "dfsph") == 0;
+    else if (std::strcmp(argv[k], "--step") == 0 && k + 1 < argc)
+      step = std::atof(argv[++k]);
+    else if (std::strcmp(argv[k], "--sample-every") == 0 && k + 1 < argc)
+      every = std::max(1, std::atoi(argv[++k]));
     else {
-      std::fprintf(stderr, "usage: %s [--backend cpu|cuda] [--solver wcsph|dfsph]\n", argv[0]);
+      std::fprintf(
+          stderr,
+          "usage: %s [--backend cpu|cuda] [--solver wcsph|dfsph] [--step METRES] [--sample-every N]\n",
+          argv[0]);
       return 2;
     }
   }
-  const uint32_t layers[3] = {10, 14, 10};
-  const double width = 10 * kStep, depth = 14 * kStep;
-  const double tank_min[3] = {-0.05, 0.0, 0.0}, tank_max[3] = {width, 2.0 * depth, width};
+  if (!(step >= 0.002 && step <= 0.02)) {
+    std::fprintf(stderr, "--step %g: give a lattice step between 0.002 and 0.02 m\n", step);
+    return 2;
+  }
+  const auto started = std::chrono::steady_clock::now();
+  const uint32_t across = static_cast<uint32_t>(std::lround(kWidth / step));
+  const uint32_t layers[3] = {across, static_cast<uint32_t>(std::lround(kDepth / step)), across};
+  const double width = kWidth;
+  const double tank_min[3] = {-0.05, 0.0, 0.0}, tank_max[3] = {width, 2.0 * kDepth, width};
   float* lattice = nullptr;
   uint32_t n = 0;
-  check(support_fcc_box(layers, kStep, nullptr, &lattice, &n), "support_fcc_box");
+  check(support_fcc_box(layers, step, nullptr, &lattice, &n), "support_fcc_box");
+  // The water's depth: the lattice's volume (2 step^3 a point) over the tank's floor.
+  const double depth = 2.0 * n * step * step * step / (width * width);
   sph_world_def def;
   sph_world_def_init(&def);
-  def.particle_spacing = static_cast<float>(kStep * std::sqrt(2.0));
+  def.particle_spacing = static_cast<float>(step * std::sqrt(2.0));
   def.capacity = n;
   def.features = SPH_FEATURE_BOUNDARY_DENSITY | SPH_FEATURE_COLLIDER_LOADS;
   if (dfsph) def.solver = SPH_SOLVER_DFSPH;
@@ -87,7 +112,7 @@ int main(int argc, char** argv) {
     check(support_world_set_params(&w), "sph_world_set_params");
   }
   sph_sdf *tank_sdf = nullptr, *wall_sdf = nullptr;
-  check(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * kStep, 0.0f, &tank_sdf, nullptr),
+  check(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * step, 0.0f, &tank_sdf, nullptr),
         "support_tank_between");
   // The plane: the plane shape's solid y < 0 turned so that +y goes to +x (test_collider_loads.c's
   // add_axis_wall(axis 0, sign -1)): solid x < 0.
@@ -95,7 +120,7 @@ int main(int argc, char** argv) {
   check(sph_shape_desc_init(&shape), "sph_shape_desc_init");
   shape.shape = SPH_SHAPE_PLANE;
   shape.half_extents.x = 0.3f, shape.half_extents.y = 0.05f, shape.half_extents.z = 0.3f;
-  shape.voxel_size = 0.01f;
+  shape.voxel_size = static_cast<float>(step);
   check(sph_sdf_create_shape(w.context, &shape, &wall_sdf), "sph_sdf_create_shape");
   sph_collider_def collider;
   check(sph_collider_def_init(&collider), "sph_collider_def_init");
@@ -115,7 +140,7 @@ int main(int argc, char** argv) {
   tank_spec.half_extents = sph::Vec3{static_cast<float>(0.5 * (tank_max[0] - tank_min[0])),
                                      static_cast<float>(0.5 * (tank_max[1] - tank_min[1])),
                                      static_cast<float>(0.5 * (tank_max[2] - tank_min[2]))};
-  tank_spec.voxel_size = static_cast<float>(0.5 * kStep);
+  tank_spec.voxel_size = static_cast<float>(0.5 * step);
   const auto tank_asset = sph::build_shape_sdf(tank_spec, 1u << 24);
   const auto tank_map =
       sph::compute_boundary_map(*tank_asset, h, static_cast<float>(delta), sph::CpuParallel(2));
@@ -124,27 +149,39 @@ int main(int argc, char** argv) {
                                  0.5 * (tank_max[2] + tank_min[2])};
 
   std::vector<float> x(3 * static_cast<size_t>(n)), after(x.size()), velocity(x.size()), rho(n), p(n);
-  for (int frame = 0; frame < 40; ++frame) check(sph_world_step(w.world, 0.02f), "sph_world_step");
-  const int frames = 800;
-  const float frame_time = 0.0005f;
+  uint64_t substeps = 0;  // all the world took, for the cost (particles x substeps)
+  const auto step_counted = [&](float seconds) {
+    check(sph_world_step(w.world, seconds), "sph_world_step");
+    sph_stats stats;
+    check(sph_stats_init(&stats), "sph_stats_init");
+    check(sph_world_get_stats(w.world, &stats), "sph_world_get_stats");
+    substeps += stats.substeps;
+    return stats.substeps;
+  };
+  for (int frame = 0; frame < 40; ++frame) step_counted(0.02f);
+  const float frame_time = static_cast<float>(0.0005 * step / 0.01);
+  const int frames = static_cast<int>(std::lround(0.4 / frame_time));
+  int samples = 0;
+  bool have_start = false;  // x holds the next substep's start
   uint32_t count = 0;
   double plane = 0.0, tank[3] = {0.0, 0.0, 0.0}, api = 0.0, api_time = 0.0, momentum[3] = {0.0, 0.0, 0.0};
-  check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, x.data(), n, &count), "read positions");
   check(support_read_by_id(w.world, SPH_ATTRIBUTE_VELOCITY, velocity.data(), n, &count), "read velocities");
   for (uint32_t i = 0; i < count; ++i)
     for (int k = 0; k < 3; ++k) momentum[k] -= static_cast<double>(w.mass) * velocity[3 * i + k];
   for (int frame = 0; frame < frames; ++frame) {
-    check(sph_world_step(w.world, frame_time), "sph_world_step");
+    const bool sampled = frame % every == 0;
+    if (sampled && !have_start)
+      check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, x.data(), n, &count), "read positions");
+    const uint32_t took = step_counted(frame_time);
+    if (took != 1) {
+      std::fprintf(stderr, "frame %d took %u substeps, not 1\n", frame, took);
+      return 1;
+    }
+    have_start = false;
+    if (!sampled) continue;
     check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, after.data(), n, &count), "read positions");
     check(support_read_by_id(w.world, SPH_ATTRIBUTE_DENSITY, rho.data(), n, &count), "read densities");
     check(support_read_by_id(w.world, SPH_ATTRIBUTE_PRESSURE, p.data(), n, &count), "read pressures");
-    sph_stats stats;
-    check(sph_stats_init(&stats), "sph_stats_init");
-    check(sph_world_get_stats(w.world, &stats), "sph_world_get_stats");
-    if (stats.substeps != 1) {
-      std::fprintf(stderr, "frame %d took %u substeps, not 1\n", frame, stats.substeps);
-      return 1;
-    }
     if (loads) {
       sph_collider_loads l;
       check(sph_collider_loads_init(&l), "sph_collider_loads_init");
@@ -163,24 +200,26 @@ int main(int argc, char** argv) {
       tank[0] += c * g.x, tank[1] += c * g.y, tank[2] += c * g.z;
     }
     x.swap(after);
+    have_start = true;
+    ++samples;
   }
   check(support_read_by_id(w.world, SPH_ATTRIBUTE_VELOCITY, velocity.data(), n, &count), "read velocities");
   for (uint32_t i = 0; i < count; ++i)
     for (int k = 0; k < 3; ++k) momentum[k] += static_cast<double>(w.mass) * velocity[3 * i + k];
   const double seconds = static_cast<double>(frame_time) * frames,
                weight = n * static_cast<double>(w.mass) * kGravity;
-  const double push = -plane / frames;  // the fluid pushes the plane towards -x
+  const double push = -plane / samples;  // the fluid pushes the plane towards -x
   const double incompressible = rho0 * kGravity * depth * depth * width / 2.0;
   const double a = kGravity / kStiffness, column = std::log1p(a * depth) / a;
   const double compressible = kStiffness * rho0 * (depth - column) * width;
   double rest[3];
-  const double walls[3] = {plane / frames + tank[0] / frames, tank[1] / frames, tank[2] / frames};
+  const double walls[3] = {plane / samples + tank[0] / samples, tank[1] / samples, tank[2] / samples};
   for (int k = 0; k < 3; ++k) rest[k] = -(k == 1 ? weight : 0.0) - momentum[k] / seconds - walls[k];
   std::printf(
-      "hydrostatic side wall, backend %s, solver %s, %u particles, h %.4f m: the plane's walls' reaction "
-      "%.4f N: %+.2f %% of rho0 g H^2 W / 2 = %.4f N, %+.2f %% of the compressible column's %.4f N (k = "
-      "%g)\n",
-      backend_name, dfsph ? "dfsph" : "wcsph", n, static_cast<double>(h), push,
+      "hydrostatic side wall, backend %s, solver %s, %u particles, step %.5f m, h %.4f m, H %.4f m: the "
+      "plane's walls' reaction %.4f N: %+.2f %% of rho0 g H^2 W / 2 = %.4f N, %+.2f %% of the compressible "
+      "column's %.4f N (k = %g)\n",
+      backend_name, dfsph ? "dfsph" : "wcsph", n, step, static_cast<double>(h), depth, push,
       100.0 * (push / incompressible - 1.0), incompressible, 100.0 * (push / compressible - 1.0),
       compressible, kStiffness);
   std::printf(
@@ -190,6 +229,20 @@ int main(int argc, char** argv) {
   if (loads)
     std::printf("the plane's loads over the same substeps: %.4f N (%+.2f %% of the compressible column's)\n",
                 -api / api_time, 100.0 * (-api / api_time / compressible - 1.0));
+  {
+    // One line for scripts: force_err against each solver's reference (WCSPH: the compressible
+    // column at k = 100, the test's; DFSPH: rho0 g H^2 W / 2).
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    const double incompressible_err = push / incompressible - 1.0,
+                 compressible_err = push / compressible - 1.0;
+    std::printf(
+        "RESULT case=side_wall backend=%s solver=%s step=%.5f h=%.5f particles=%u substeps=%llu samples=%d "
+        "force_err=%+.2f incompressible_err=%+.2f compressible_err=%+.2f depth=%.4f seconds=%.1f\n",
+        backend_name, dfsph ? "dfsph" : "wcsph", step, static_cast<double>(h), n,
+        static_cast<unsigned long long>(substeps), samples,
+        100.0 * (dfsph ? incompressible_err : compressible_err), 100.0 * incompressible_err,
+        100.0 * compressible_err, depth, seconds);
+  }
   std::free(lattice);
   check(sph_sdf_destroy(tank_sdf), "sph_sdf_destroy");
   check(sph_sdf_destroy(wall_sdf), "sph_sdf_destroy");

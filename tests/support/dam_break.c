@@ -196,6 +196,8 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
         result->density_error_mean += (double)stats.density_error_mean * stats.substeps;
         if (stats.density_error_max > result->density_error_max)
           result->density_error_max = stats.density_error_max;
+        if (stats.density_error_largest > result->density_error_largest)
+          result->density_error_largest = stats.density_error_largest;
         result->capped_substeps += stats.pressure_solves_capped;
         for (int k = 0; k < SPH_STAGE_COUNT; ++k) result->stage_ms[k] += stats.stage_ms[k];
         result->neighbors_mean += (double)stats.neighbors_mean * stats.substeps;

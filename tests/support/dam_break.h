@@ -86,10 +86,13 @@ typedef struct dam_break_result {
   uint64_t pressure_iterations;   /* density-solve iterations, summed over the substeps */
   uint64_t divergence_iterations; /* divergence-solve iterations, summed */
   uint32_t pressure_iterations_max;
-  double density_error_mean; /* the density solve's achieved mean error, averaged over substeps */
-  double density_error_max;  /* the largest of any substep */
-  uint32_t capped_substeps;  /* substeps whose density solve stopped at its cap (sph_stats) */
-  uint32_t capped_events;    /* the counts of SPH_EVENT_PRESSURE_SOLVE_CAPPED events, summed */
+  double density_error_mean;    /* the density solve's achieved mean error, averaged over substeps */
+  double density_error_max;     /* the largest of any substep */
+  double density_error_largest; /* the largest error of one particle any density solve ended with
+                                   (sph_stats.density_error_largest; within density_error_max unless
+                                   that solve was capped) */
+  uint32_t capped_substeps;     /* substeps whose density solve stopped at its cap (sph_stats) */
+  uint32_t capped_events;       /* the counts of SPH_EVENT_PRESSURE_SOLVE_CAPPED events, summed */
   /* Where the wall time went (sph_stats' stage_ms summed over the frames, ms) and the mean
    * neighbour count (sph_stats' neighbors_mean, weighted by the frames' substeps): what tells
    * two runs' substep costs apart (bench/solver_front prints them). */

@@ -38,7 +38,7 @@ const char* const kMpiUsage =
     "                      where there is no such GPU; the host-staged halo); auto and cpu: the CPU\n"
     "Rank 0 writes the probes' and loads' CSV files and --stats-json (the world's figures).\n"
     "Ctrl-C (SIGINT or SIGTERM on any rank) stops every rank after the same frame.\n"
-    "No OpenVDB outputs; a CUDA rank refuses what docs/distributed.md lists (sinks, probes).\n";
+    "No OpenVDB outputs; the ranks refuse what docs/distributed.md lists (springs, ...).\n";
 
 struct ContextOwner {
   sph_context* context = nullptr;
@@ -158,8 +158,8 @@ int run(const Ranks& ranks, int argc, char** argv) {
   } catch (const SceneError& e) {
     return fail(ranks, kExitScene, cli.scene + ": " + e.what());
   } catch (const LibraryError& e) {
-    // A feature the ranks' backend refuses (a CUDA rank's sinks or probes, at the first step,
-    // on every rank alike): a scene this program cannot run, as the world's own refusals are.
+    // A feature the ranks refuse after the world's creation (DFSPH's conjugate gradients, on every
+    // rank alike): a scene this program cannot run, as the world's own refusals are.
     return fail(ranks, e.code() == SPH_ERROR_UNSUPPORTED ? kExitScene : kExitRuntime, e.what());
   }
 }
