@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
 // The CUDA backend's particles: creation, appends, truncation, copies out, checkpoints and the
 // interop tier of sph_cuda.h (the twin of src/cpu/cpu_backend.cpp; frames are frame_loop.cu).
-#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -15,18 +14,6 @@
 #include "device_springs.h"
 
 namespace sph {
-namespace {
-
-// DFSPH's candidate masks (physics/neighbor_walk.h), unless the environment says
-// SPH_CUDA_NEIGHBOR_MASKS=0 when the world is created: a test hook (tests/gpu/check_dfsph_masks.cpp
-// compares runs with and without them, which must be the same bits), not a setting.
-bool neighbor_masks_wanted() {
-  const char* value = std::getenv("SPH_CUDA_NEIGHBOR_MASKS");
-  return !(value && std::strcmp(value, "0") == 0);
-}
-
-}  // namespace
-
 CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBackendOptions& options)
     : config_(config), device_(device) {
   DeviceGuard guard(device_);
@@ -50,7 +37,7 @@ CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBacken
   if (config.features & kFeatureUserAttribute)
     arrays.push_back(ParticleArraySpec{kArraySortedUserAttribute, sizeof(uint32_t),
                                        ParticleArrayRole::Scratch, 1, nullptr, nullptr});
-  if (options_.dfsph && neighbor_masks_wanted())
+  if (options_.dfsph && options.dfsph_masks)
     arrays.push_back(ParticleArraySpec{kArrayDfsphNeighborMask, sizeof(uint32_t), ParticleArrayRole::Scratch,
                                        kNeighborMaskWords, nullptr, nullptr});
   r->store = std::make_unique<DeviceParticleStore>(config.capacity, arrays);

@@ -70,7 +70,7 @@ struct ParticleArrays {
   Float4* dfsph_contact_impulse;  // null unless SPH_FEATURE_COLLIDER_LOADS: the clamp's (collider_loads.h)
   float* dfsph_residual;          // the conjugate gradients' preconditioned residual z
   // The density pass's candidate masks for the solves' passes (kNeighborMaskWords words a
-  // particle, physics/neighbor_walk.h); null unless DFSPH, or with SPH_CUDA_NEIGHBOR_MASKS=0.
+  // particle, physics/neighbor_walk.h); null unless DFSPH, or with sph_context_def.cuda_dfsph_masks off.
   uint32_t* dfsph_neighbor_mask;
   // Null where the conjugate gradients cannot run (particle_arrays.cpp): their density solve's
   // rho* - rho0, its change along the search direction, that direction's velocity change, flags.

@@ -33,12 +33,11 @@ __global__ void dfsph_density_kernel(FluidConstants fluid, GridView grid, Partic
   }
   // The candidate masks of the solves' passes, recorded by this walk (the positions are the
   // substep's until the solves end).
+  // (The same code without masks: a null writer stores nothing; see NeighborMaskWriter.)
+  uint32_t* const mask =
+      a.dfsph_neighbor_mask ? a.dfsph_neighbor_mask + static_cast<size_t>(i) * kNeighborMaskWords : nullptr;
   const DfsphDensitySample s =
-      a.dfsph_neighbor_mask
-          ? gather_density_and_factor(
-                fluid, grid, a.sorted_position, wall, i,
-                NeighborMaskWriter{a.dfsph_neighbor_mask + static_cast<size_t>(i) * kNeighborMaskWords})
-          : gather_density_and_factor(fluid, grid, a.sorted_position, wall, i);
+      gather_density_and_factor(fluid, grid, a.sorted_position, wall, i, NeighborMaskWriter{mask});
   a.density[i] = s.density;
   a.neighbor_count[i] = s.neighbor_count;
   a.dfsph_factor[i] = s.factor;

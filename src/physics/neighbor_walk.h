@@ -98,7 +98,10 @@ SPH_HD uint32_t lowest_set_bit(uint32_t x) {
 }
 
 // Writes one particle's mask as a walk goes: add(keep) once per candidate, in the walk's order,
-// then finish(). out: the particle's kNeighborMaskWords words (all of them written).
+// then finish(). out: the particle's kNeighborMaskWords words (all of them written), or null: a
+// world without masks, whose density pass runs this same code and stores nothing. (One
+// instantiation of the pass for both: a second one, compiled apart, may contract its arithmetic
+// into other fused multiply-adds and give other bits; with and without masks must be the same.)
 struct NeighborMaskWriter {
   uint32_t* out;
   uint32_t count = 0;  // candidates so far
@@ -108,11 +111,12 @@ struct NeighborMaskWriter {
     if (keep && count < kNeighborMaskCandidates) word |= 1u << (count & 31u);
     ++count;
     if ((count & 31u) == 0u && count <= 32u * kNeighborMaskWords) {
-      out[(count >> 5) - 1u] = word;
+      if (out) out[(count >> 5) - 1u] = word;
       word = 0u;
     }
   }
   SPH_HD void finish() const {
+    if (!out) return;
     if (count > kNeighborMaskCandidates) {
       out[kNeighborMaskWords - 1u] = kNeighborMaskOverflow;  // the other words are not read
       return;

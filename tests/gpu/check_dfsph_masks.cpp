@@ -3,8 +3,9 @@
 // density pass records which of each particle's 27-cell candidates are neighbours, and the
 // solves' passes (the Jacobi solves' velocity updates and density rates, the conjugate
 // gradients' passes) visit only those. The skipped candidates contribute nothing, so a run with
-// the masks must give the same bits as the same run without them (SPH_CUDA_NEIGHBOR_MASKS=0 when
-// the world is created, the test hook of cuda/cuda_backend.cu): every frame's state (positions,
+// the masks must give the same bits as the same run without them (sph_context_def.cuda_dfsph_masks
+// = SPH_CUDA_DFSPH_MASKS_OFF; both runs execute the same kernels, which walk every candidate where
+// a particle has no mask): every frame's state (positions,
 // velocities, densities, pressures, ids) and every frame's solve statistics (substeps, both
 // solves' iterations, the achieved error's bits).
 // The scene: the Martin & Moyce dam break of check_dfsph_cg.cpp (16 lattice layers across the
@@ -82,7 +83,9 @@ uint32_t overflows(const float* positions, uint32_t n, float h) {
 }
 
 Run run(const Case& c, bool masks) {
+  context_tuning().dfsph_masks_off = !masks;
   sph_context* context = make_context(SPH_BACKEND_CUDA);
+  context_tuning().dfsph_masks_off = false;
   const double a = 0.05715, step = a / kLayers;
   const uint32_t layers[3] = {kLayers, 2 * kLayers, 6};
   const double tank_min[3] = {0.0, 0.0, 0.0};
@@ -97,12 +100,8 @@ Run run(const Case& c, bool masks) {
   if (c.kernel_ratio > 0.0f) def.kernel_radius = c.kernel_ratio * def.particle_spacing;
   def.solver = SPH_SOLVER_DFSPH;
   def.equation_of_state = SPH_EOS_IDEAL_GAS;
-  // The hook is read when the world is created.
-  if (!masks) setenv("SPH_CUDA_NEIGHBOR_MASKS", "0", 1);
   sph_world* world = nullptr;
-  const sph_result created = sph_world_create(context, &def, &world);
-  unsetenv("SPH_CUDA_NEIGHBOR_MASKS");
-  require_ok(created, "sph_world_create");
+  require_ok(sph_world_create(context, &def, &world), "sph_world_create");
   sph_world_def resolved;
   sph_world_def_init(&resolved);
   require_ok(sph_world_get_def(world, &resolved), "sph_world_get_def");

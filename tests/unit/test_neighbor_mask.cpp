@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The candidate masks of CUDA DFSPH's solves (src/physics/neighbor_walk.h, issue 18) against
 // brute force on the host: for every particle of a scene, the mask that the density pass
-// (gather_density_and_factor with a NeighborMaskWriter) records has bit k set exactly for the
+// (gather_density_and_factor with a NeighborMaskWriter; with a null one it stores nothing and
+// gives the same sample) records has bit k set exactly for the
 // k-th candidate of the plain 27-cell walk that is within the mask's bound (neighbor_mask_bound)
 // and not the particle itself, and is marked overflowing exactly when the walk has more than 383
 // candidates; for_each_masked_neighbor visits exactly those candidates, in the plain walk's order
@@ -110,7 +111,11 @@ Tally check_table(const Table& t) {
         sph::gather_density_and_factor(f, view, t.positions.data(), sph::no_boundary_share(), i);
     const sph::DfsphDensitySample recorded = sph::gather_density_and_factor(
         f, view, t.positions.data(), sph::no_boundary_share(), i, sph::NeighborMaskWriter{mask});
-    bool ok = same_bits(plain, recorded);
+    // A world without masks runs the recording pass with a null writer (cuda/dfsph_solver.cu):
+    // the same sample, nothing stored.
+    const sph::DfsphDensitySample unrecorded = sph::gather_density_and_factor(
+        f, view, t.positions.data(), sph::no_boundary_share(), i, sph::NeighborMaskWriter{nullptr});
+    bool ok = same_bits(plain, recorded) && same_bits(plain, unrecorded);
     // Brute force: the candidates in the walk's order, and those within the bound.
     std::vector<uint32_t> candidates, kept;
     sph::for_each_neighbor_range(view, xi, [&](uint32_t begin, uint32_t end) {
