@@ -10,8 +10,8 @@
  *
  *   solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1]
  *                [--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg]
- *                [--dfsph-max 0.05] [--walls-in-density] [--particle-lanes N] [--frame-log]
- *                [--out solver_front.csv]
+ *                [--dfsph-max 0.05] [--walls-in-density] [--particle-lanes N] [--no-dfsph-masks]
+ *                [--frame-log] [--out solver_front.csv]
  *
  * --wcsph: the weakly compressible runs' speeds of sound, as multiples of the free-fall speed;
  * --dfsph: the DFSPH runs' density error bounds (0.001 = 0.1 %); `none` leaves a solver out.
@@ -21,8 +21,10 @@
  * library's). --walls-in-density: the tank's walls count in the density and pressure
  * (SPH_FEATURE_BOUNDARY_DENSITY) for both solvers; without it they are collision-only.
  * --particle-lanes: the CUDA context's cuda_particle_lanes (threads per particle of the neighbour
- * passes; 0, the default, is the library's choice). --frame-log: one line a frame on stdout with the
- * step's statistics and where the densest particle is (in column widths), for diagnosing a run.
+ * passes; 0, the default, is the library's choice). --no-dfsph-masks: the CUDA context's
+ * cuda_dfsph_masks = SPH_CUDA_DFSPH_MASKS_OFF (the solves walk every candidate; the same bits).
+ * --frame-log: one line a frame on stdout with the step's statistics and where the densest
+ * particle is (in column widths), for diagnosing a run.
  *
  * --sample-T: the front's sampling interval in T (0.1 = 5.4 ms). Each sample ends a frame, and a
  * frame's landing step caps the substep, so a fine sampling (the validation's 0.025 = 1.35 ms)
@@ -90,7 +92,7 @@ int main(int argc, char** argv) {
   double seconds = 1.0, sample_T = 0.1;
   const char* out_path = "solver_front.csv";
   uint32_t linear_solver = 0; /* the library's default */
-  uint32_t features = 0, particle_lanes = 0;
+  uint32_t features = 0, particle_lanes = 0, dfsph_masks = 0;
   double dfsph_max = 0.0; /* the library's default */
   int frame_log = 0;
   sph_backend backend = SPH_BACKEND_AUTO, resolved = SPH_BACKEND_CPU;
@@ -150,6 +152,8 @@ int main(int argc, char** argv) {
       }
     } else if (strcmp(argv[i], "--particle-lanes") == 0 && i + 1 < argc) {
       particle_lanes = (uint32_t)strtoul(argv[++i], NULL, 10);
+    } else if (strcmp(argv[i], "--no-dfsph-masks") == 0) {
+      dfsph_masks = SPH_CUDA_DFSPH_MASKS_OFF;
     } else if (strcmp(argv[i], "--frame-log") == 0) {
       frame_log = 1;
     } else if (strcmp(argv[i], "--dfsph-solver") == 0 && i + 1 < argc) {
@@ -167,7 +171,8 @@ int main(int argc, char** argv) {
           stderr,
           "usage: solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1] "
           "[--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg] [--dfsph-max 0.05] "
-          "[--walls-in-density] [--particle-lanes N] [--frame-log] [--out solver_front.csv]\n");
+          "[--walls-in-density] [--particle-lanes N] [--no-dfsph-masks] [--frame-log] [--out "
+          "solver_front.csv]\n");
       return 2;
     }
   }
@@ -178,6 +183,7 @@ int main(int argc, char** argv) {
     sph_context_def_init(&cdef);
     cdef.backend = backend;
     cdef.cuda_particle_lanes = particle_lanes;
+    cdef.cuda_dfsph_masks = dfsph_masks;
     if (sph_context_create(&cdef, &context) != SPH_OK) context = NULL;
   }
   if (!context) {

@@ -14,7 +14,6 @@
 #include "device_springs.h"
 
 namespace sph {
-
 CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBackendOptions& options)
     : config_(config), device_(device) {
   DeviceGuard guard(device_);
@@ -38,6 +37,9 @@ CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBacken
   if (config.features & kFeatureUserAttribute)
     arrays.push_back(ParticleArraySpec{kArraySortedUserAttribute, sizeof(uint32_t),
                                        ParticleArrayRole::Scratch, 1, nullptr, nullptr});
+  if (options_.dfsph && options.dfsph_masks)
+    arrays.push_back(ParticleArraySpec{kArrayDfsphNeighborMask, sizeof(uint32_t), ParticleArrayRole::Scratch,
+                                       kNeighborMaskWords, nullptr, nullptr});
   r->store = std::make_unique<DeviceParticleStore>(config.capacity, arrays);
   // The sorted positions are free while the sort runs: its temporary storage goes there.
   r->grid = std::make_unique<DeviceNeighborGrid>(

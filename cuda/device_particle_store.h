@@ -69,6 +69,9 @@ struct ParticleArrays {
   Float4* dfsph_contact;          // the particle's contact with the colliders (n, smallest normal speed)
   Float4* dfsph_contact_impulse;  // null unless SPH_FEATURE_COLLIDER_LOADS: the clamp's (collider_loads.h)
   float* dfsph_residual;          // the conjugate gradients' preconditioned residual z
+  // The density pass's candidate masks for the solves' passes (kNeighborMaskWords words a
+  // particle, physics/neighbor_walk.h); null unless DFSPH, or with sph_context_def.cuda_dfsph_masks off.
+  uint32_t* dfsph_neighbor_mask;
   // Null where the conjugate gradients cannot run (particle_arrays.cpp): their density solve's
   // rho* - rho0, its change along the search direction, that direction's velocity change, flags.
   float* dfsph_cg_value;
@@ -90,6 +93,9 @@ struct ParticleArrays {
 constexpr const char* kArraySortedUserAttribute = "sorted_user_attribute";
 // A distributed rank's ghost mask (ParticleArrays::halo_ghost; Scratch).
 constexpr const char* kArrayHaloGhost = "distributed_ghost";
+// DFSPH's candidate masks (ParticleArrays::dfsph_neighbor_mask; Scratch, kNeighborMaskWords
+// uint32 a particle).
+constexpr const char* kArrayDfsphNeighborMask = "dfsph_neighbor_mask";
 
 // A method's array on the device: its elements (two sides for a Sorted array) and, for a
 // Carried one, the snapshot of the frame's start.

@@ -47,7 +47,8 @@ __global__ void __launch_bounds__(kDfsphSolveBlock) cg_measure_kernel(CgSolve s)
   double error = 0.0;
   if (i < s.n) {
     const float dt = s.state->clock.dt_float;
-    const float rate = density_rate(s.fluid, s.grid, s.a.sorted_position, s.a.velocity, walls_of(s), i);
+    const float rate = density_rate(s.fluid, s.grid, s.a.sorted_position, s.a.velocity, walls_of(s), i,
+                                    MaskedCandidates{s.a.dfsph_neighbor_mask});
     const float value = dfsph_cg_value(rate, s.a.density[i], s.fluid.rest_density, dt);
     s.a.dfsph_cg_value[i] = value;
     error = dfsph_cg_error(value, s.fluid.rest_density);
@@ -112,7 +113,8 @@ __global__ void __launch_bounds__(kDfsphSolveBlock) cg_direction_kernel(CgSolve 
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= s.n) return;
   const float dt = s.state->clock.dt_float;
-  Vec3 d = pressure_velocity_change(s.fluid, s.grid, s.a.sorted_position, s.a.dfsph_step, walls_of(s), i, dt);
+  Vec3 d = pressure_velocity_change(s.fluid, s.grid, s.a.sorted_position, s.a.dfsph_step, walls_of(s), i, dt,
+                                    MaskedCandidates{s.a.dfsph_neighbor_mask});
   if (s.a.dfsph_cg_state[i] & kBinds) d = dfsph_contact_project(s.a.dfsph_contact[i], d);
   s.a.dfsph_cg_velocity_step[i] = make_float4_record(d, 0.0f);
 }
@@ -126,8 +128,8 @@ __global__ void __launch_bounds__(kDfsphSolveBlock) cg_change_kernel(CgSolve s) 
   if (i < s.n) {
     const float dt = s.state->clock.dt_float;
     const DfsphWalls walls = walls_of(s);
-    const float rate =
-        density_rate(s.fluid, s.grid, s.a.sorted_position, s.a.dfsph_cg_velocity_step, walls, i);
+    const float rate = density_rate(s.fluid, s.grid, s.a.sorted_position, s.a.dfsph_cg_velocity_step, walls,
+                                    i, MaskedCandidates{s.a.dfsph_neighbor_mask});
     const float change = dfsph_cg_change(rate, walls, i, dt);
     s.a.dfsph_cg_change[i] = change;
     if (s.a.dfsph_cg_state[i] & kActive) pq = static_cast<double>(-s.a.dfsph_step[i] * change);
@@ -193,8 +195,8 @@ __global__ void __launch_bounds__(kDfsphSolveBlock) cg_error_kernel(CgSolve s) {
     if (s.contacts && s.state->cg_held) {
       const float dt = s.state->clock.dt_float;
       const DfsphWalls walls = walls_of(s);
-      const float rate =
-          density_rate(s.fluid, s.grid, s.a.sorted_position, s.a.dfsph_cg_velocity_step, walls, i);
+      const float rate = density_rate(s.fluid, s.grid, s.a.sorted_position, s.a.dfsph_cg_velocity_step, walls,
+                                      i, MaskedCandidates{s.a.dfsph_neighbor_mask});
       value += dfsph_cg_change(rate, walls, i, dt);
       s.a.dfsph_cg_value[i] = value;
     }

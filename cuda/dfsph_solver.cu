@@ -31,7 +31,13 @@ __global__ void dfsph_density_kernel(FluidConstants fluid, GridView grid, Partic
         boundary_share(fluid.methods.boundary, scene.colliders, scene.collider_count, xyz(p), at.s, at.tau);
     a.boundary_gradient[i] = pack_boundary(wall);
   }
-  const DfsphDensitySample s = gather_density_and_factor(fluid, grid, a.sorted_position, wall, i);
+  // The candidate masks of the solves' passes, recorded by this walk (the positions are the
+  // substep's until the solves end).
+  // (The same code without masks: a null writer stores nothing; see NeighborMaskWriter.)
+  uint32_t* const mask =
+      a.dfsph_neighbor_mask ? a.dfsph_neighbor_mask + static_cast<size_t>(i) * kNeighborMaskWords : nullptr;
+  const DfsphDensitySample s =
+      gather_density_and_factor(fluid, grid, a.sorted_position, wall, i, NeighborMaskWriter{mask});
   a.density[i] = s.density;
   a.neighbor_count[i] = s.neighbor_count;
   a.dfsph_factor[i] = s.factor;
@@ -78,8 +84,9 @@ __global__ void dfsph_correct_kernel(FluidConstants fluid, GridView grid, Partic
   if (i >= n) return;
   const float dt = state->clock.dt_float;
   const float scale = divergence ? dt : 1.0f;
-  Vec3 vi = xyz(v[i]) + pressure_velocity_change(fluid, grid, a.sorted_position, k,
-                                                 DfsphWalls{a.boundary_gradient}, i, dt);
+  Vec3 vi =
+      xyz(v[i]) + pressure_velocity_change(fluid, grid, a.sorted_position, k, DfsphWalls{a.boundary_gradient},
+                                           i, dt, MaskedCandidates{a.dfsph_neighbor_mask});
   if (contacts) vi = dfsph_clamp(a, i, vi);
   v[i] = make_float4_record(vi, v[i].w);
   carried[i] = (kWarm ? 0.0f : carried[i]) + k[i] * scale;
@@ -112,7 +119,8 @@ __global__ void __launch_bounds__(kDfsphSolveBlock)
   double error = 0.0;
   if (i < n) {
     const float dt = state->clock.dt_float;
-    const float rate = density_rate(fluid, grid, a.sorted_position, v, DfsphWalls{a.boundary_gradient}, i);
+    const float rate = density_rate(fluid, grid, a.sorted_position, v, DfsphWalls{a.boundary_gradient}, i,
+                                    MaskedCandidates{a.dfsph_neighbor_mask});
     const DfsphResidual r =
         kDivergence ? divergence_residual(fluid.methods.dfsph, rate, a.neighbor_count[i], a.dfsph_factor[i],
                                           fluid.rest_density, dt)

@@ -108,6 +108,8 @@ typedef enum sph_cuda_frames {
   SPH_CUDA_FRAMES_STREAM = 1, /* each frame launched kernel by kernel: for profilers and sanitizers */
   SPH_CUDA_FRAMES_FORCE32 = 0x7fffffff
 } sph_cuda_frames;
+/** sph_context_def.cuda_dfsph_masks: 0 = on (the default), or this = off. */
+#define SPH_CUDA_DFSPH_MASKS_OFF 1u
 
 typedef enum sph_integrator {
   SPH_INTEGRATOR_SYMPLECTIC_EULER = 0, /* v += a dt, then x += v dt: one force evaluation */
@@ -329,8 +331,13 @@ typedef struct sph_context_def {
   sph_backend backend;       /* default SPH_BACKEND_AUTO */
   int32_t device_ordinal;    /* CUDA device; -1 (default) and 0 = device 0 */
   uint32_t cpu_worker_count; /* CPU backend threads; 0 (default) = all hardware threads */
-  uint32_t reserved0;        /* must be 0 */
-  sph_log_fn log_fn;         /* optional; NULL = no logging */
+  /* (0.2.0) DFSPH's candidate masks on the CUDA backend (docs/cuda.md): 0 (default) = on: the
+     density pass records which of each particle's 27-cell candidates are neighbours (48 bytes a
+     particle of capacity) and the solves' passes visit only those; SPH_CUDA_DFSPH_MASKS_OFF = off:
+     they walk every candidate (no memory, slower passes). The same bits either way. A CPU context
+     and a weakly compressible world check and ignore it; any other value is INVALID_ARGUMENT. */
+  uint32_t cuda_dfsph_masks;
+  sph_log_fn log_fn; /* optional; NULL = no logging */
   void* log_user_data;       /* passed to log_fn */
   /* Tuning of the CUDA backend (a CPU context checks and ignores it; docs/cuda.md). Results do
      not depend on it: every choice computes the same particles bit for bit, except

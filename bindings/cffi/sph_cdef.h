@@ -13,6 +13,7 @@
 #define SPH_VERSION_PATCH 0
 #define SPH_VERSION 4096
 #define SPH_ABI_VERSION 0
+#define SPH_CUDA_DFSPH_MASKS_OFF 1
 #define SPH_FEATURE_NONE 0
 #define SPH_FEATURE_SURFACE_TENSION 1
 #define SPH_FEATURE_NORMALIZED_DENSITY 2
@@ -233,7 +234,7 @@ typedef struct sph_context_def {
   sph_backend backend;
   int32_t device_ordinal;
   uint32_t cpu_worker_count;
-  uint32_t reserved0;
+  uint32_t cuda_dfsph_masks;
   sph_log_fn log_fn;
   void* log_user_data;
   sph_cuda_frames cuda_frames;

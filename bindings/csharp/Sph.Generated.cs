@@ -19,6 +19,8 @@ namespace Sph
         public const uint SPH_VERSION = 4096u;
         /// <summary>ABI version: equals the SONAME major (libsph.so.0).</summary>
         public const int SPH_ABI_VERSION = 0;
+        /// <summary>sph_context_def.cuda_dfsph_masks: 0 = on (the default), or this = off.</summary>
+        public const uint SPH_CUDA_DFSPH_MASKS_OFF = 1u;
         public const uint SPH_FEATURE_NONE = 0u;
         /// <summary>
         /// Surface tension: the Morris colour field (thesis eq. 20-23) applied as a capillary stress,
@@ -828,8 +830,15 @@ namespace Sph
         public int DeviceOrdinal;
         /// <summary>uint32_t cpu_worker_count: CPU backend threads; 0 (default) = all hardware threads</summary>
         public uint CpuWorkerCount;
-        /// <summary>uint32_t reserved0: must be 0</summary>
-        public uint Reserved0;
+        /// <summary>
+        /// uint32_t cuda_dfsph_masks: (0.2.0) DFSPH's candidate masks on the CUDA backend
+        /// (docs/cuda.md): 0 (default) = on: the density pass records which of each particle's 27-cell
+        /// candidates are neighbours (48 bytes a particle of capacity) and the solves' passes visit
+        /// only those; SPH_CUDA_DFSPH_MASKS_OFF = off: they walk every candidate (no memory, slower
+        /// passes). The same bits either way. A CPU context and a weakly compressible world check and
+        /// ignore it; any other value is INVALID_ARGUMENT.
+        /// </summary>
+        public uint CudaDfsphMasks;
         /// <summary>sph_log_fn log_fn: optional; NULL = no logging</summary>
         public IntPtr LogFn;
         /// <summary>void* log_user_data: passed to log_fn</summary>
@@ -3992,7 +4001,7 @@ namespace Sph
             "Backend",
             "DeviceOrdinal",
             "CpuWorkerCount",
-            "Reserved0",
+            "CudaDfsphMasks",
             "LogFn",
             "LogUserData",
             "CudaFrames",

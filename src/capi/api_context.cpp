@@ -41,7 +41,12 @@ sph::CudaTuning cuda_tuning_from_def(const sph_context_def& d) {
     throw Error(Status::InvalidArgument,
                 "def->cuda_particle_lanes: " + std::to_string(lanes) +
                     " threads per particle; use 0 (the library's choice), 1, 2, 4 or 8");
+  if (d.cuda_dfsph_masks != 0 && d.cuda_dfsph_masks != SPH_CUDA_DFSPH_MASKS_OFF)
+    throw Error(Status::InvalidArgument,
+                "def->cuda_dfsph_masks: " + std::to_string(d.cuda_dfsph_masks) +
+                    " is neither 0 (on, the default) nor SPH_CUDA_DFSPH_MASKS_OFF (1)");
   sph::CudaTuning t;
+  t.dfsph_masks = d.cuda_dfsph_masks == 0;
   t.stream_frames = frames == SPH_CUDA_FRAMES_STREAM;
   t.density_block = block(d.cuda_density_block, "cuda_density_block");
   t.force_block = block(d.cuda_force_block, "cuda_force_block");
@@ -122,7 +127,6 @@ SPH_API sph_result SPH_CALL sph_context_create(const sph_context_def* def, sph_c
       throw Error(Status::InvalidArgument,
                   "def->device_ordinal: must be -1 (default) or a device index, got " +
                       std::to_string(d.device_ordinal));
-    if (d.reserved0 != 0) throw Error(Status::InvalidArgument, "def->reserved0: must be 0");
     if (d.cpu_worker_count > 4096)
       throw Error(Status::InvalidArgument,
                   "def->cpu_worker_count: " + std::to_string(d.cpu_worker_count) + " is more than 4096");

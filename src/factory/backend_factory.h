@@ -31,6 +31,7 @@ struct CudaTuning {
   uint32_t force_block = 0;    // threads per block of the force kernels
   uint32_t particle_lanes =
       0;  // threads per particle of the neighbour passes: 0 (the backend's choice), 1, 2, 4, 8
+  bool dfsph_masks = true;  // DFSPH's candidate masks (physics/neighbor_walk.h)
 };
 
 // cpu_tasks: the engine's task system for a CPU backend's loops (none: OpenMP's cpu_workers).

@@ -102,13 +102,29 @@ SPH_HD Vec3 dfsph_velocity_change(Vec3 sum, const DfsphWalls& walls, uint32_t i,
   return sum * (-dt);
 }
 
+// The bound of a candidate mask's test (neighbor_walk.h), r^2 < h^2 widened by 2^-12 of itself:
+// far more than the few ulps by which two compilations of r^2 can differ (FMA contraction), so a
+// mask never drops a candidate that a pass's own r^2 < h^2 keeps. The passes still test what
+// they visit: the masked walk gives them the same terms in the same order, whatever the mask's
+// few extra candidates at r just above h.
+SPH_HD float neighbor_mask_bound(float h2) { return h2 + h2 * 2.44140625e-4f; }
+
+// The density pass's walk without a mask to record (NeighborMaskWriter's interface).
+struct NoNeighborMask {
+  SPH_HD void add(bool) {}
+  SPH_HD void finish() const {}
+};
+
 // The density of density.h (the same sum in the same order) and the factor, in one walk.
 // wall: the walls' share at x_i (boundary_share; no_boundary_share() without the feature).
+// mask: NeighborMaskWriter to record particle i's candidate mask for the solves' passes.
+template <class Mask = NoNeighborMask>
 SPH_HD DfsphDensitySample gather_density_and_factor(const FluidBase& f, const GridView& grid,
                                                     const Float4* positions, const BoundaryShare& wall,
-                                                    uint32_t i) {
+                                                    uint32_t i, Mask mask = Mask{}) {
   const KernelCoefficients mk = mass_gradient_kernel(f);
   const Vec3 xi = xyz(positions[i]);
+  const float bound = neighbor_mask_bound(f.kernel.h2);
   float sum = 0.0f;
   uint32_t neighbors = 0;
   Vec3 gradient{0.0f, 0.0f, 0.0f};  // sum_j m grad W_ij
@@ -116,6 +132,7 @@ SPH_HD DfsphDensitySample gather_density_and_factor(const FluidBase& f, const Gr
   for_each_neighbor_candidate(grid, xi, [&](uint32_t j) {
     const Vec3 d = xi - xyz(positions[j]);
     const float r2 = length_squared(d);
+    mask.add(r2 < bound && j != i);
     if (r2 < f.kernel.h2 && j != i) {
       const DfsphFactorTermsOf<float> t = dfsph_factor_pair_terms(f, mk, d, r2);
       sum += t.kernel;
@@ -124,17 +141,20 @@ SPH_HD DfsphDensitySample gather_density_and_factor(const FluidBase& f, const Gr
       squares += t.square;
     }
   });
+  mask.finish();
   return dfsph_density_and_factor(f, sum, neighbors, gradient, squares, wall);
 }
 
 // D rho_i / Dt = sum_j m (v_i - v_j) . grad W_ij over the velocities `velocities` (xyz).
+// walk: the candidates it visits (neighbor_walk.h: AllCandidates, or MaskedCandidates on CUDA).
+template <class Walk = AllCandidates>
 SPH_HD float density_rate(const FluidBase& f, const GridView& grid, const Float4* positions,
-                          const Float4* velocities, const DfsphWalls& walls, uint32_t i) {
+                          const Float4* velocities, const DfsphWalls& walls, uint32_t i, Walk walk = Walk{}) {
   const KernelCoefficients mk = mass_gradient_kernel(f);
   const Vec3 xi = xyz(positions[i]);
   const Vec3 vi = xyz(velocities[i]);
   float rate = 0.0f;
-  for_each_neighbor_candidate(grid, xi, [&](uint32_t j) {
+  walk(grid, xi, i, [&](uint32_t j) {
     const Vec3 d = xi - xyz(positions[j]);
     const float r2 = length_squared(d);
     if (r2 < f.kernel.h2 && j != i) rate += density_rate_pair_term(mk, d, r2, vi - xyz(velocities[j]));
@@ -144,13 +164,16 @@ SPH_HD float density_rate(const FluidBase& f, const GridView& grid, const Float4
 
 // The velocity change of particle i from the pressures k (k_j = p_j / rho_j^2 of this
 // iteration): -dt sum_j m (k_i + k_j) grad W_ij, which pushes compressed neighbours apart.
+// walk: as density_rate's.
+template <class Walk = AllCandidates>
 SPH_HD Vec3 pressure_velocity_change(const FluidBase& f, const GridView& grid, const Float4* positions,
-                                     const float* k, const DfsphWalls& walls, uint32_t i, float dt) {
+                                     const float* k, const DfsphWalls& walls, uint32_t i, float dt,
+                                     Walk walk = Walk{}) {
   const KernelCoefficients mk = mass_gradient_kernel(f);
   const Vec3 xi = xyz(positions[i]);
   const float ki = k[i];
   Vec3 sum{0.0f, 0.0f, 0.0f};
-  for_each_neighbor_candidate(grid, xi, [&](uint32_t j) {
+  walk(grid, xi, i, [&](uint32_t j) {
     const Vec3 d = xi - xyz(positions[j]);
     const float r2 = length_squared(d);
     if (r2 < f.kernel.h2 && j != i) sum += pressure_velocity_pair_term(mk, d, r2, ki + k[j]);

@@ -5,6 +5,7 @@
 // one x-row are a single contiguous index range unless the row wraps around the table.
 #pragma once
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "float4_types.h"
@@ -68,5 +69,109 @@ SPH_HD void for_each_neighbor_candidate(const GridView& grid, Vec3 p, Visit&& vi
     for (uint32_t j = begin; j < end; ++j) visit(j);
   });
 }
+
+// A particle's candidate mask (CUDA DFSPH, issue 18): bit k of the mask says whether the k-th
+// candidate of for_each_neighbor_range's walk (in its order, from 0) is a neighbour. Positions do
+// not change between DFSPH's density pass and the end of its solves, so the pass that walks every
+// candidate once can record them, and the solves' many passes visit only the set bits
+// (for_each_masked_neighbor). Twelve words: bits 0-382 for candidates 0-382, bit 383 (the last
+// word's top bit) marks a particle with more candidates than that, whose passes walk all of them.
+// Why 383 and not 255: on an FCC lattice at rest at the default radius (1.8 spacings) the 27
+// cells of 16 % of the particles hold 256-259 candidates (45 % at a 3 % closer spacing), all the
+// particles of a cell alike, and a warp waits for its slowest lane's full walk; 383 holds the
+// lattice at rest and at a 5 % closer spacing (host counts, docs/cuda.md).
+constexpr uint32_t kNeighborMaskWords = 12;
+constexpr uint32_t kNeighborMaskCandidates = 32u * kNeighborMaskWords - 1u;  // 383
+constexpr uint32_t kNeighborMaskOverflow = 0x80000000u;                      // in the last word
+
+// The index of the lowest set bit of x != 0.
+SPH_HD uint32_t lowest_set_bit(uint32_t x) {
+#if defined(__CUDA_ARCH__)
+  return static_cast<uint32_t>(__ffs(static_cast<int>(x)) - 1);
+#elif defined(__GNUC__) || defined(__clang__)
+  return static_cast<uint32_t>(__builtin_ctz(x));
+#else
+  uint32_t b = 0;
+  while (!(x & 1u)) x >>= 1, ++b;
+  return b;
+#endif
+}
+
+// Writes one particle's mask as a walk goes: add(keep) once per candidate, in the walk's order,
+// then finish(). out: the particle's kNeighborMaskWords words (all of them written), or null: a
+// world without masks, whose density pass runs this same code and stores nothing. (One
+// instantiation of the pass for both: a second one, compiled apart, may contract its arithmetic
+// into other fused multiply-adds and give other bits; with and without masks must be the same.)
+struct NeighborMaskWriter {
+  uint32_t* out;
+  uint32_t count = 0;  // candidates so far
+  uint32_t word = 0;   // the bits of the word being filled
+
+  SPH_HD void add(bool keep) {
+    if (keep && count < kNeighborMaskCandidates) word |= 1u << (count & 31u);
+    ++count;
+    if ((count & 31u) == 0u && count <= 32u * kNeighborMaskWords) {
+      if (out) out[(count >> 5) - 1u] = word;
+      word = 0u;
+    }
+  }
+  SPH_HD void finish() const {
+    if (!out) return;
+    if (count > kNeighborMaskCandidates) {
+      out[kNeighborMaskWords - 1u] = kNeighborMaskOverflow;  // the other words are not read
+      return;
+    }
+    uint32_t w = count >> 5;  // the words written so far (count <= 383: at most 11)
+    if (count & 31u) out[w++] = word;
+    for (; w < kNeighborMaskWords; ++w) out[w] = 0u;
+  }
+};
+
+// Calls visit(j) for the candidates of for_each_neighbor_candidate (same rows, same order) whose
+// bit is set in mask (NeighborMaskWriter's, for this particle's position and the same table);
+// for every candidate where the mask overflowed or is null. One loop for all three, so that a
+// kernel holds one copy of the pass's body (registers, code size).
+template <class Visit>
+SPH_HD void for_each_masked_neighbor(const GridView& grid, Vec3 p, const uint32_t* mask, Visit&& visit) {
+  const bool all = !mask || (mask[kNeighborMaskWords - 1u] & kNeighborMaskOverflow);
+  uint32_t k = 0;  // the walk index of the run's first candidate (below 383 unless `all`)
+  for_each_neighbor_range(grid, p, [&](uint32_t begin, uint32_t end) {
+    const uint32_t last = k + (end - begin);
+    // The run's bits, at most 32 at a time (a run can start and end inside a word).
+    for (uint32_t first = k; first < last;) {
+      const uint32_t shift = first & 31u;
+      const uint32_t take = (32u - shift < last - first) ? 32u - shift : last - first;
+      uint32_t bits = all ? 0xffffffffu : mask[first >> 5] >> shift;
+      if (take < 32u) bits &= (1u << take) - 1u;
+      const uint32_t j0 = begin + (first - k);
+      while (bits) {
+        visit(j0 + lowest_set_bit(bits));
+        bits &= bits - 1u;
+      }
+      first += take;
+    }
+    k = last;
+  });
+}
+
+// The candidates a neighbour pass visits: every candidate of the 27 cells (the default, both
+// backends), or, with masks (CUDA DFSPH's solves: kNeighborMaskWords words per particle, written
+// by the density pass), those of particle i's mask (every candidate, through the same loop, where
+// masks is null). The passes keep their own r < h test on what they visit, so both walks give the
+// same terms in the same order.
+struct AllCandidates {
+  template <class Visit>
+  SPH_HD void operator()(const GridView& grid, Vec3 p, uint32_t, Visit&& visit) const {
+    for_each_neighbor_candidate(grid, p, visit);
+  }
+};
+struct MaskedCandidates {
+  const uint32_t* masks;  // null: every candidate
+  template <class Visit>
+  SPH_HD void operator()(const GridView& grid, Vec3 p, uint32_t i, Visit&& visit) const {
+    for_each_masked_neighbor(grid, p, masks ? masks + static_cast<size_t>(i) * kNeighborMaskWords : nullptr,
+                             visit);
+  }
+};
 
 }  // namespace sph

@@ -51,7 +51,7 @@ static void test_def_init(void** state) {
   assert_int_equal(def.backend, SPH_BACKEND_AUTO);
   assert_int_equal(def.device_ordinal, -1);
   assert_int_equal(def.cpu_worker_count, 0);
-  assert_int_equal(def.reserved0, 0);
+  assert_int_equal(def.cuda_dfsph_masks, 0);
   assert_null(def.log_fn);
   assert_null(def.log_user_data);
   assert_int_equal(def.cuda_frames, SPH_CUDA_FRAMES_GRAPH);
@@ -141,8 +141,11 @@ static void test_create_bad_fields(void** state) {
   def.device_ordinal = INT32_MIN;
   EXPECT_CREATE_FAILS(&def, SPH_ERROR_INVALID_ARGUMENT, "device_ordinal");
   sph_test_context_def_init(&def);
-  def.reserved0 = 1;
-  EXPECT_CREATE_FAILS(&def, SPH_ERROR_INVALID_ARGUMENT, "reserved0");
+  def.cuda_dfsph_masks = 2;
+  EXPECT_CREATE_FAILS(&def, SPH_ERROR_INVALID_ARGUMENT, "cuda_dfsph_masks");
+  sph_test_context_def_init(&def);
+  def.cuda_dfsph_masks = 0xffffffffu;
+  EXPECT_CREATE_FAILS(&def, SPH_ERROR_INVALID_ARGUMENT, "cuda_dfsph_masks");
   sph_test_context_def_init(&def);
   def.cpu_worker_count = 0xffffffffu;
   EXPECT_CREATE_FAILS(&def, SPH_ERROR_INVALID_ARGUMENT, "cpu_worker_count");
@@ -185,6 +188,11 @@ static void test_create_cuda_tuning(void** state) {
     EXPECT_OK(sph_context_create(&def, &context));
     EXPECT_OK(sph_context_destroy(context));
   }
+  /* Both values of cuda_dfsph_masks (a CPU context checks and ignores them). */
+  sph_test_context_def_init(&def);
+  def.cuda_dfsph_masks = SPH_CUDA_DFSPH_MASKS_OFF;
+  EXPECT_OK(sph_context_create(&def, &context));
+  EXPECT_OK(sph_context_destroy(context));
   for (i = 0; i < sizeof good_blocks / sizeof good_blocks[0]; ++i) {
     sph_test_context_def_init(&def);
     def.cuda_frames = SPH_CUDA_FRAMES_STREAM;

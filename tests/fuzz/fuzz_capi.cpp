@@ -369,7 +369,7 @@ class Program {
     std::memcpy(&def.value.backend, &backend, sizeof backend);
     def.value.cpu_worker_count = in_.chance(240) ? 1 : in_.u32();
     if (def.value.cpu_worker_count > 4 && def.value.cpu_worker_count < 100000) def.value.cpu_worker_count = 2;
-    if (in_.chance(8)) def.value.reserved0 = in_.u32();
+    if (in_.chance(8)) def.value.cuda_dfsph_masks = in_.u32();
     if (in_.chance(8)) def.value.header_version = in_.u32();
     if (in_.chance(8)) def.value.device_ordinal = static_cast<int32_t>(in_.u32());
     def.value.struct_size = struct_size(sizeof(sph_context_def));

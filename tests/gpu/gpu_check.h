@@ -72,7 +72,8 @@ struct ContextTuning {
   bool stream_frames = false;
   uint32_t density_block = 0;  // 0: the library's default
   uint32_t force_block = 0;
-  uint32_t particle_lanes = 0;  // cuda_particle_lanes; 0: the library's choice
+  uint32_t particle_lanes = 0;   // cuda_particle_lanes; 0: the library's choice
+  bool dfsph_masks_off = false;  // cuda_dfsph_masks = SPH_CUDA_DFSPH_MASKS_OFF (check_dfsph_masks)
 };
 inline ContextTuning& context_tuning() {
   static ContextTuning tuning;
@@ -98,6 +99,12 @@ auto apply_particle_lanes(Def& def, int) -> decltype(def.cuda_particle_lanes, vo
 }
 template <class Def>
 void apply_particle_lanes(Def&, long) {}
+template <class Def>
+auto apply_dfsph_masks(Def& def, int) -> decltype(def.cuda_dfsph_masks, void()) {
+  def.cuda_dfsph_masks = context_tuning().dfsph_masks_off ? 1u : 0u;  // SPH_CUDA_DFSPH_MASKS_OFF : on
+}
+template <class Def>
+void apply_dfsph_masks(Def&, long) {}
 
 inline sph_context* make_context(sph_backend backend) {
   sph_context_def def;
@@ -105,6 +112,7 @@ inline sph_context* make_context(sph_backend backend) {
   def.backend = backend;
   apply_context_tuning(def, 0);
   apply_particle_lanes(def, 0);
+  apply_dfsph_masks(def, 0);
   sph_context* context = nullptr;
   require_ok(sph_context_create(&def, &context), "sph_context_create");
   return context;

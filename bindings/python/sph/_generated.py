@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'ca2920f7a987c86cbdc167f4b2132312951ada1143937937bf602c423dc611d9', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '10c14f6b37e923ae4b9abc5828de128db4766751d2147533349222057a911844', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -25,6 +25,8 @@ SPH_VERSION_PATCH = 0
 SPH_VERSION = 4096
 #: ABI version: equals the SONAME major (libsph.so.0).
 SPH_ABI_VERSION = 0
+#: sph_context_def.cuda_dfsph_masks: 0 = on (the default), or this = off.
+SPH_CUDA_DFSPH_MASKS_OFF = 1
 SPH_FEATURE_NONE = 0
 #: Surface tension: the Morris colour field (thesis eq. 20-23) applied as a capillary stress, plus
 #: a short-range cohesion (Akinci et al. 2013) carrying 15 % of sigma; parameters in
@@ -825,7 +827,7 @@ class ContextDef(_SphStruct):
         backend (sph_backend): default SPH_BACKEND_AUTO
         device_ordinal (int32_t): CUDA device; -1 (default) and 0 = device 0
         cpu_worker_count (uint32_t): CPU backend threads; 0 (default) = all hardware threads
-        reserved0 (uint32_t): must be 0
+        cuda_dfsph_masks (uint32_t): (0.2.0) DFSPH's candidate masks on the CUDA backend (docs/cuda.md): 0 (default) = on: the density pass records which of each particle's 27-cell candidates are neighbours (48 bytes a particle of capacity) and the solves' passes visit only those; SPH_CUDA_DFSPH_MASKS_OFF = off: they walk every candidate (no memory, slower passes). The same bits either way. A CPU context and a weakly compressible world check and ignore it; any other value is INVALID_ARGUMENT.
         log_fn (sph_log_fn): optional; NULL = no logging
         log_user_data (void*): passed to log_fn
         cuda_frames (sph_cuda_frames): Tuning of the CUDA backend (a CPU context checks and ignores it; docs/cuda.md). Results do not depend on it: every choice computes the same particles bit for bit, except cuda_particle_lanes (the order of the neighbour sums: the last bits).
@@ -845,7 +847,7 @@ class ContextDef(_SphStruct):
         ('backend', sph_backend),
         ('device_ordinal', _c.c_int32),
         ('cpu_worker_count', _c.c_uint32),
-        ('reserved0', _c.c_uint32),
+        ('cuda_dfsph_masks', _c.c_uint32),
         ('log_fn', sph_log_fn),
         ('log_user_data', _c.c_void_p),
         ('cuda_frames', sph_cuda_frames),
@@ -861,7 +863,7 @@ class ContextDef(_SphStruct):
     ]
     _sph_c_name_ = 'sph_context_def'
     _sph_size_ = 104
-    _sph_offsets_ = (('struct_size', 0), ('header_version', 4), ('backend', 8), ('device_ordinal', 12), ('cpu_worker_count', 16), ('reserved0', 20), ('log_fn', 24), ('log_user_data', 32), ('cuda_frames', 40), ('cuda_density_block', 44), ('cuda_force_block', 48), ('cuda_particle_lanes', 52), ('enqueue_task', 56), ('finish_task', 64), ('task_user_context', 72), ('alloc_fn', 80), ('free_fn', 88), ('alloc_user_context', 96))
+    _sph_offsets_ = (('struct_size', 0), ('header_version', 4), ('backend', 8), ('device_ordinal', 12), ('cpu_worker_count', 16), ('cuda_dfsph_masks', 20), ('log_fn', 24), ('log_user_data', 32), ('cuda_frames', 40), ('cuda_density_block', 44), ('cuda_force_block', 48), ('cuda_particle_lanes', 52), ('enqueue_task', 56), ('finish_task', 64), ('task_user_context', 72), ('alloc_fn', 80), ('free_fn', 88), ('alloc_user_context', 96))
     _sph_init_ = 'sph_context_def_init_sized'
     _sph_assigns_ = {'header_version': SPH_VERSION}
     _sph_enums_ = {'backend': Backend, 'cuda_frames': CudaFrames}

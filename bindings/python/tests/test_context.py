@@ -49,8 +49,8 @@ def test_cuda_allocator_rules():
     ("struct_size", 4, sph.Result.ERROR_VERSION_MISMATCH),
     ("header_version", sph.make_version(sph.BINDINGS_VERSION[0] + 1, 0, 0), sph.Result.ERROR_VERSION_MISMATCH),
     ("backend", 7, sph.Result.ERROR_UNSUPPORTED),
-    ("reserved0", 1, sph.Result.ERROR_INVALID_ARGUMENT),
     ("cuda_particle_lanes", 3, sph.Result.ERROR_INVALID_ARGUMENT),
+    ("cuda_dfsph_masks", 2, sph.Result.ERROR_INVALID_ARGUMENT),
 ])
 def test_bad_context_def(field, value, result):
     d = sph.ContextDef(backend=sph.Backend.CPU)

@@ -1,0 +1,222 @@
+// SPDX-License-Identifier: MIT
+// The candidate masks of CUDA DFSPH's solves (src/physics/neighbor_walk.h, issue 18) against
+// brute force on the host: for every particle of a scene, the mask that the density pass
+// (gather_density_and_factor with a NeighborMaskWriter; with a null one it stores nothing and
+// gives the same sample) records has bit k set exactly for the
+// k-th candidate of the plain 27-cell walk that is within the mask's bound (neighbor_mask_bound)
+// and not the particle itself, and is marked overflowing exactly when the walk has more than 383
+// candidates; for_each_masked_neighbor visits exactly those candidates, in the plain walk's order
+// (every candidate where the mask overflowed or is null); and the two solve passes (density_rate,
+// pressure_velocity_change) give the same bits through the masked walk as through the plain one.
+// The scenes: a table folded over a larger cloud (rows that wrap around the table, far
+// particles in folded slots) dense enough that some particles overflow and others do not; a
+// lattice at h / 2 whose pairs at exactly r = h sit on the passes' test's edge (inside the mask's
+// bound, outside r < h); a sparse cloud.
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+extern "C" {
+#include <cmocka.h>
+}
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "core/config.h"
+#include "physics/dfsph_passes.h"
+#include "physics/neighbor_walk.h"
+
+namespace {
+
+using sph::Float4;
+using sph::Vec3;
+
+constexpr float kH = 1.0f;  // the cell size; positions in units of h keep the lattice exact
+
+// A dense cell-start table over an nx * ny * nz table, built here (not by a backend's grid) so
+// that the table can be much smaller than the cloud: the positions sorted by slot (stable).
+struct Table {
+  sph::GridShape shape;
+  std::vector<uint32_t> cell_start;
+  std::vector<Float4> positions;
+  std::vector<Float4> velocities;
+  std::vector<float> k;
+
+  Table(const std::vector<Vec3>& points, int32_t n_axis, uint32_t seed) {
+    shape =
+        sph::GridShape{1.0f / kH, n_axis, n_axis, n_axis, static_cast<uint32_t>(n_axis * n_axis * n_axis)};
+    const uint32_t n = static_cast<uint32_t>(points.size());
+    std::vector<uint32_t> order(n);
+    for (uint32_t i = 0; i < n; ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+      return sph::cell_hash_of_position(shape, points[a]) < sph::cell_hash_of_position(shape, points[b]);
+    });
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> speed(-0.2f, 0.2f), pressure(0.0f, 1e-3f);
+    for (uint32_t i = 0; i < n; ++i) {
+      positions.push_back(sph::make_float4_record(points[order[i]], 0.0f));
+      velocities.push_back(Float4{speed(rng), speed(rng), speed(rng), 0.0f});
+      k.push_back(pressure(rng));
+    }
+    cell_start.assign(shape.cell_count + 1u, n);
+    for (uint32_t c = 0, i = 0; c <= shape.cell_count; ++c) {
+      while (i < n && sph::cell_hash_of_position(shape, xyz(positions[i])) < c) ++i;
+      cell_start[c] = i;
+    }
+  }
+  sph::GridView view() const { return sph::GridView{shape, cell_start.data()}; }
+  uint32_t size() const { return static_cast<uint32_t>(positions.size()); }
+};
+
+sph::FluidConstants fluid() {
+  sph::WorldConfig config;
+  config.kernel_radius = kH;
+  config.particle_spacing = kH / 1.8f;
+  config.rest_density = 1000.0f;
+  config.particle_mass =
+      1000.0f * config.particle_spacing * config.particle_spacing * config.particle_spacing;
+  config.density_self_weight = 1.0f;
+  config.solver = sph::Solver::Dfsph;
+  return sph::make_fluid_constants(config, sph::RuntimeParams{});
+}
+
+template <class T>
+bool same_bits(const T& a, const T& b) {
+  return std::memcmp(&a, &b, sizeof(T)) == 0;
+}
+
+struct Tally {
+  uint32_t particles = 0, overflowed = 0, wrapped_rows = 0, edge_pairs = 0, mismatches = 0;
+};
+
+// Every particle of the table against brute force (the file's header).
+Tally check_table(const Table& t) {
+  const sph::FluidConstants f = fluid();
+  const sph::GridView view = t.view();
+  const float bound = sph::neighbor_mask_bound(f.kernel.h2);
+  const float dt = 1e-3f;
+  const sph::DfsphWalls no_walls{nullptr};
+  std::vector<uint32_t> masks(static_cast<size_t>(t.size()) * sph::kNeighborMaskWords, 0xdeadbeefu);
+  Tally tally;
+  for (uint32_t i = 0; i < t.size(); ++i) {
+    ++tally.particles;
+    const Vec3 xi = sph::xyz(t.positions[i]);
+    uint32_t* mask = masks.data() + static_cast<size_t>(i) * sph::kNeighborMaskWords;
+    // The density pass with and without recording: the same sample.
+    const sph::DfsphDensitySample plain =
+        sph::gather_density_and_factor(f, view, t.positions.data(), sph::no_boundary_share(), i);
+    const sph::DfsphDensitySample recorded = sph::gather_density_and_factor(
+        f, view, t.positions.data(), sph::no_boundary_share(), i, sph::NeighborMaskWriter{mask});
+    // A world without masks runs the recording pass with a null writer (cuda/dfsph_solver.cu):
+    // the same sample, nothing stored.
+    const sph::DfsphDensitySample unrecorded = sph::gather_density_and_factor(
+        f, view, t.positions.data(), sph::no_boundary_share(), i, sph::NeighborMaskWriter{nullptr});
+    bool ok = same_bits(plain, recorded) && same_bits(plain, unrecorded);
+    // Brute force: the candidates in the walk's order, and those within the bound.
+    std::vector<uint32_t> candidates, kept;
+    sph::for_each_neighbor_range(view, xi, [&](uint32_t begin, uint32_t end) {
+      for (uint32_t j = begin; j < end; ++j) candidates.push_back(j);
+    });
+    sph::GridShape g = view.shape;
+    const sph::CellCoord c = sph::cell_of(g, xi);
+    if (sph::wrap_index(c.x, g.nx) == 0 || sph::wrap_index(c.x, g.nx) == g.nx - 1) ++tally.wrapped_rows;
+    for (uint32_t j : candidates) {
+      const float r2 = sph::length_squared(xi - sph::xyz(t.positions[j]));
+      if (r2 < bound && j != i) kept.push_back(j);
+      if (r2 == f.kernel.h2) ++tally.edge_pairs;
+    }
+    const bool overflow = candidates.size() > sph::kNeighborMaskCandidates;
+    tally.overflowed += overflow;
+    ok = ok && ((mask[sph::kNeighborMaskWords - 1] & sph::kNeighborMaskOverflow) != 0) == overflow;
+    if (!overflow) {
+      for (uint32_t k = 0; k < 32u * sph::kNeighborMaskWords; ++k) {
+        const bool bit = (mask[k >> 5] >> (k & 31u)) & 1u;
+        const bool expected =
+            k < candidates.size() && std::find(kept.begin(), kept.end(), candidates[k]) != kept.end();
+        ok = ok && bit == expected;
+      }
+    }
+    // The masked walk's visits.
+    std::vector<uint32_t> visited;
+    sph::for_each_masked_neighbor(view, xi, mask, [&](uint32_t j) { visited.push_back(j); });
+    ok = ok && visited == (overflow ? candidates : kept);
+    std::vector<uint32_t> without;  // no mask: every candidate
+    sph::for_each_masked_neighbor(view, xi, nullptr, [&](uint32_t j) { without.push_back(j); });
+    ok = ok && without == candidates;
+    // The solves' passes through both walks.
+    const sph::MaskedCandidates masked{masks.data()};
+    const float rate = sph::density_rate(f, view, t.positions.data(), t.velocities.data(), no_walls, i);
+    const float rate_masked =
+        sph::density_rate(f, view, t.positions.data(), t.velocities.data(), no_walls, i, masked);
+    const Vec3 dv = sph::pressure_velocity_change(f, view, t.positions.data(), t.k.data(), no_walls, i, dt);
+    const Vec3 dv_masked =
+        sph::pressure_velocity_change(f, view, t.positions.data(), t.k.data(), no_walls, i, dt, masked);
+    ok = ok && same_bits(rate, rate_masked) && same_bits(dv, dv_masked);
+    ok = ok && (rate != 0.0f || plain.neighbor_count == 0);  // the passes saw neighbours
+    if (!ok && tally.mismatches++ < 5)
+      std::printf("  particle %u: %zu candidates, %zu kept, %zu visited\n", i, candidates.size(), kept.size(),
+                  visited.size());
+  }
+  return tally;
+}
+
+std::vector<Vec3> uniform_cloud(uint32_t count, float extent, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0.0f, extent);
+  std::vector<Vec3> points(count);
+  for (Vec3& p : points) p = Vec3{u(rng), u(rng), u(rng)};
+  return points;
+}
+
+// 7 h of cloud folded onto a 5-slot table: slots 0-1 hold two cells' particles, and the rows of
+// the edge slots wrap. 6 particles a cell: 162 candidates where no axis folds, 384 where all three do.
+void test_folded_table(void**) {
+  const Table t(uniform_cloud(2058, 7.0f * kH, 1), 5, 2);
+  const Tally r = check_table(t);
+  std::printf("folded table: %u particles, %u overflowing, %u in wrapping rows, %u mismatches\n", r.particles,
+              r.overflowed, r.wrapped_rows, r.mismatches);
+  assert_int_equal(r.mismatches, 0);
+  assert_true(r.overflowed > 0 && r.overflowed < r.particles);  // both kinds of particle exercised
+  assert_true(r.wrapped_rows > 0);
+}
+
+// A cubic lattice at h / 2 (exact in float): pairs two steps apart along an axis are at r^2 = h^2
+// exactly, which the mask keeps and the passes' test drops. 8 particles a cell: 216 candidates.
+void test_lattice_edges(void**) {
+  std::vector<Vec3> points;
+  for (int z = 0; z < 14; ++z)
+    for (int y = 0; y < 14; ++y)
+      for (int x = 0; x < 14; ++x)
+        points.push_back(Vec3{0.5f * x + 0.25f, 0.5f * y + 0.25f, 0.5f * z + 0.25f});
+  const Table t(points, 8, 3);
+  const Tally r = check_table(t);
+  std::printf("lattice: %u particles, %u overflowing, %u pairs at r = h, %u mismatches\n", r.particles,
+              r.overflowed, r.edge_pairs, r.mismatches);
+  assert_int_equal(r.mismatches, 0);
+  assert_true(r.edge_pairs > 0);
+}
+
+// Few particles a cell, and a table larger than the cloud: short masks, most words zero.
+void test_sparse(void**) {
+  const Table t(uniform_cloud(300, 6.0f * kH, 4), 8, 5);
+  const Tally r = check_table(t);
+  std::printf("sparse: %u particles, %u overflowing, %u mismatches\n", r.particles, r.overflowed,
+              r.mismatches);
+  assert_int_equal(r.mismatches, 0);
+  assert_int_equal(r.overflowed, 0);
+}
+
+}  // namespace
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_folded_table),
+      cmocka_unit_test(test_lattice_edges),
+      cmocka_unit_test(test_sparse),
+  };
+  return cmocka_run_group_tests(tests, nullptr, nullptr);
+}
