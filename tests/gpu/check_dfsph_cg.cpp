@@ -37,6 +37,7 @@
 #include <cstring>
 #include <vector>
 
+#include "dfsph_dam_break.h"
 #include "gpu_check.h"
 
 using namespace gpu_check;
@@ -68,30 +69,6 @@ Run run(sph_backend backend, bool stream_frames) {
   context_tuning().stream_frames = stream_frames;
   sph_context* context = make_context(backend);
   context_tuning().stream_frames = false;
-  // The geometry of dam_break_run (tests/support/dam_break.c), walls at the lattice's faces.
-  const double a = 0.05715, step = a / kLayers;
-  const uint32_t layers[3] = {kLayers, 2 * kLayers, 6};
-  const double tank_min[3] = {0.0, 0.0, 0.0};
-  const double tank_max[3] = {6.0 * a, 3.0 * a, step * layers[2]};
-  float* positions = nullptr;
-  uint32_t n = 0;
-  require_ok(support_fcc_box(layers, step, nullptr, &positions, &n), "support_fcc_box");
-  sph_world_def def;
-  sph_world_def_init(&def);
-  def.capacity = n;
-  def.particle_spacing = static_cast<float>(step * std::sqrt(2.0));
-  def.solver = SPH_SOLVER_DFSPH;
-  def.equation_of_state = SPH_EOS_IDEAL_GAS;
-  sph_world* world = nullptr;
-  require_ok(sph_world_create(context, &def, &world), "sph_world_create");
-  sph_world_params params;
-  sph_world_params_init(&params);
-  params.gravity.y = static_cast<float>(-kGravity);
-  params.viscosity = 0.05f;
-  params.step_factor = 0.4f;
-  params.dt_max = kFrame;
-  params.max_substeps = 100000;
-  require_ok(sph_world_set_params(world, &params), "sph_world_set_params");
   sph_dfsph_params dfsph;
   sph_dfsph_params_init(&dfsph);
   dfsph.density_error = kBound;
@@ -101,25 +78,22 @@ Run run(sph_backend backend, bool stream_frames) {
   const char* solver = std::getenv("SPH_CHECK_DFSPH_SOLVER");
   dfsph.linear_solver =
       solver && std::strcmp(solver, "jacobi") == 0 ? SPH_DFSPH_JACOBI : SPH_DFSPH_CONJUGATE_GRADIENTS;
-  require_ok(sph_world_set_dfsph_params(world, &dfsph), "sph_world_set_dfsph_params(conjugate gradients)");
-  sph_sdf* tank = nullptr;
-  require_ok(support_tank_between(context, world, tank_min, tank_max, 0.5 * step, 0.0f, &tank, nullptr),
-             "support_tank_between");
-  require_ok(support_spawn(world, positions, nullptr, n), "support_spawn");
-  std::free(positions);
   Run out;
-  for (uint32_t f = 1; f <= kFrames; ++f) {
-    require_ok(sph_world_step(world, kFrame), "sph_world_step");
-    const sph_stats st = get_stats(world);
-    out.stats.push_back(FrameStats{st.substeps, st.pressure_iterations, st.pressure_iterations_max,
-                                   st.pressure_solves_capped, st.density_error_max,
-                                   st.density_error_largest});
-    if (f == kCompareAt) out.early = read_state(world);
-    out.frames.push_back(read_state(world));
+  {
+    DfsphDamBreak scene;
+    make_dfsph_dam_break(context, kLayers, kFrame, kGravity, 0.0f, dfsph, &scene);
+    sph_world* world = scene.world;
+    for (uint32_t f = 1; f <= kFrames; ++f) {
+      require_ok(sph_world_step(world, kFrame), "sph_world_step");
+      const sph_stats st = get_stats(world);
+      out.stats.push_back(FrameStats{st.substeps, st.pressure_iterations, st.pressure_iterations_max,
+                                     st.pressure_solves_capped, st.density_error_max,
+                                     st.density_error_largest});
+      if (f == kCompareAt) out.early = read_state(world);
+      out.frames.push_back(read_state(world));
+    }
+    out.late = read_state(world);
   }
-  out.late = read_state(world);
-  sph_world_destroy(world);
-  sph_sdf_destroy(tank);
   sph_context_destroy(context);
   return out;
 }

@@ -28,6 +28,7 @@
 #include <tuple>
 #include <vector>
 
+#include "dfsph_dam_break.h"
 #include "gpu_check.h"
 
 using namespace gpu_check;
@@ -86,54 +87,25 @@ Run run(const Case& c, bool masks) {
   context_tuning().dfsph_masks_off = !masks;
   sph_context* context = make_context(SPH_BACKEND_CUDA);
   context_tuning().dfsph_masks_off = false;
-  const double a = 0.05715, step = a / kLayers;
-  const uint32_t layers[3] = {kLayers, 2 * kLayers, 6};
-  const double tank_min[3] = {0.0, 0.0, 0.0};
-  const double tank_max[3] = {6.0 * a, 3.0 * a, step * layers[2]};
-  float* positions = nullptr;
-  uint32_t n = 0;
-  require_ok(support_fcc_box(layers, step, nullptr, &positions, &n), "support_fcc_box");
-  sph_world_def def;
-  sph_world_def_init(&def);
-  def.capacity = n;
-  def.particle_spacing = static_cast<float>(step * std::sqrt(2.0));
-  if (c.kernel_ratio > 0.0f) def.kernel_radius = c.kernel_ratio * def.particle_spacing;
-  def.solver = SPH_SOLVER_DFSPH;
-  def.equation_of_state = SPH_EOS_IDEAL_GAS;
-  sph_world* world = nullptr;
-  require_ok(sph_world_create(context, &def, &world), "sph_world_create");
-  sph_world_def resolved;
-  sph_world_def_init(&resolved);
-  require_ok(sph_world_get_def(world, &resolved), "sph_world_get_def");
-  sph_world_params params;
-  sph_world_params_init(&params);
-  params.gravity.y = -9.81f;
-  params.viscosity = 0.05f;
-  params.step_factor = 0.4f;
-  params.dt_max = kFrame;
-  params.max_substeps = 100000;
-  require_ok(sph_world_set_params(world, &params), "sph_world_set_params");
   sph_dfsph_params dfsph;
   sph_dfsph_params_init(&dfsph);
   dfsph.linear_solver = c.conjugate_gradients ? SPH_DFSPH_CONJUGATE_GRADIENTS : SPH_DFSPH_JACOBI;
-  require_ok(sph_world_set_dfsph_params(world, &dfsph), "sph_world_set_dfsph_params");
-  sph_sdf* tank = nullptr;
-  require_ok(support_tank_between(context, world, tank_min, tank_max, 0.5 * step, 0.0f, &tank, nullptr),
-             "support_tank_between");
   Run out;
-  out.overflows = overflows(positions, n, resolved.kernel_radius);
-  require_ok(support_spawn(world, positions, nullptr, n), "support_spawn");
-  std::free(positions);
-  for (uint32_t f = 1; f <= kFrames; ++f) {
-    require_ok(sph_world_step(world, kFrame), "sph_world_step");
-    const sph_stats st = get_stats(world);
-    out.stats.push_back(FrameStats{st.substeps, st.pressure_iterations, st.pressure_iterations_max,
-                                   st.divergence_iterations, st.pressure_solves_capped,
-                                   st.density_error_max});
-    out.frames.push_back(read_state(world));
+  {
+    DfsphDamBreak scene;
+    make_dfsph_dam_break(context, kLayers, kFrame, 9.81, c.kernel_ratio, dfsph, &scene);
+    sph_world* world = scene.world;
+    const uint32_t n = static_cast<uint32_t>(scene.start.size() / 3);
+    out.overflows = overflows(scene.start.data(), n, scene.kernel_radius);
+    for (uint32_t f = 1; f <= kFrames; ++f) {
+      require_ok(sph_world_step(world, kFrame), "sph_world_step");
+      const sph_stats st = get_stats(world);
+      out.stats.push_back(FrameStats{st.substeps, st.pressure_iterations, st.pressure_iterations_max,
+                                     st.divergence_iterations, st.pressure_solves_capped,
+                                     st.density_error_max});
+      out.frames.push_back(read_state(world));
+    }
   }
-  sph_world_destroy(world);
-  sph_sdf_destroy(tank);
   sph_context_destroy(context);
   return out;
 }
