@@ -10,7 +10,7 @@
  *   rest_sphere [--particles N|largest] [--frames F] [--warmup W] [--backend cpu|cuda|auto]
  *               [--case rest|moving|both] [--option NAME] [--json FILE] [--csv FILE] [--label TEXT]
  *               [--cuda-frames graph|stream] [--density-block N] [--force-block N]
- *               [--particle-lanes N] [--threads N]
+ *               [--particle-lanes N] [--threads N] [--dfsph-masks on|off]
  *
  * --threads sets the CPU backend's workers (sph_context_def.cpu_worker_count), so that a run on a
  * larger host can measure two workers (issue 18's CPU goal); pin them with taskset to two cores.
@@ -31,7 +31,8 @@
  * (cuda_frames, cuda_density_block, cuda_force_block; docs/cuda.md): the stream driver launches
  * kernel by kernel, which is what a profiler such as ncu needs (scripts/bench-gpu).
  * --particle-lanes sets cuda_particle_lanes (threads per particle of the neighbour passes: 1, 2,
- * 4 or 8; scripts/bench-lanes compares them).
+ * 4 or 8; scripts/bench-lanes compares them). --dfsph-masks off sets cuda_dfsph_masks =
+ * SPH_CUDA_DFSPH_MASKS_OFF (with --option dfsph: the world's bytes without the candidate masks).
  *
  * Prints a table per case; --json writes the results as a JSON array, --csv appends rows
  * (with a header when the file is new). Times are the wall time of sph_world_step (which
@@ -67,6 +68,7 @@ typedef struct options {
   uint32_t force_block;
   uint32_t particle_lanes; /* 0: the library's choice */
   uint32_t threads;        /* CPU workers; 0: the library's default, one per processor */
+  uint32_t dfsph_masks;    /* sph_context_def.cuda_dfsph_masks: 0 on, SPH_CUDA_DFSPH_MASKS_OFF */
 } options;
 
 typedef struct result {
@@ -194,6 +196,7 @@ static result run_case(const options* o, int moving) {
   cdef.cuda_force_block = o->force_block;
   cdef.cuda_particle_lanes = o->particle_lanes;
   cdef.cpu_worker_count = o->threads;
+  cdef.cuda_dfsph_masks = o->dfsph_masks;
   sph_context* context = NULL;
   check(sph_context_create(&cdef, &context), "sph_context_create");
   sph_backend resolved;
@@ -367,13 +370,13 @@ static void usage(void) {
           "none|surface_tension|normalized_density|density_diffusion|\n"
           "                   clavet|tait|rk4|acoustic_limit|springs|dfsph] [--json FILE] [--csv FILE]\n"
           "                   [--label TEXT] [--cuda-frames graph|stream] [--density-block N]\n"
-          "                   [--force-block N] [--particle-lanes N] [--threads N]\n");
+          "                   [--force-block N] [--particle-lanes N] [--threads N] [--dfsph-masks on|off]\n");
   exit(2);
 }
 
 int main(int argc, char** argv) {
   options o = {100000, 0, "none", 100, 3, SPH_BACKEND_AUTO, "both", NULL, NULL, NULL, SPH_CUDA_FRAMES_GRAPH,
-               0,      0, 0,      0};
+               0,      0, 0,      0,   0};
   for (int i = 1; i < argc; ++i) {
     const char* a = argv[i];
     const char* v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -408,6 +411,9 @@ int main(int argc, char** argv) {
       o.particle_lanes = (uint32_t)strtoul(v, NULL, 10);
     } else if (strcmp(a, "--threads") == 0) {
       o.threads = (uint32_t)strtoul(v, NULL, 10);
+    } else if (strcmp(a, "--dfsph-masks") == 0) {
+      if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0) usage();
+      o.dfsph_masks = strcmp(v, "off") == 0 ? SPH_CUDA_DFSPH_MASKS_OFF : 0u;
     } else {
       usage();
     }
