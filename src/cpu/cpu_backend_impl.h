@@ -249,6 +249,11 @@ class CpuBackend final : public Backend {
   // in the same order. Each step is collective.
   // A ghost of this substep (never in a world that is not distributed).
   bool ghost(uint32_t i) const { return origin_ && origin_[i] != 0u; }
+  // A spring ghost: a ghost that is only the far end of an owned particle's spring, from past the
+  // halo (origin_ above the rank count; cpu_halo_springs.cpp). No neighbour pass reads it.
+  bool spring_ghost(uint32_t i) const {
+    return origin_ && origin_[i] > static_cast<uint32_t>(ranks_->size());
+  }
   // The frame's start: the world's max speed, and new slabs when the ranks are out of balance.
   void halo_begin_frame();
   // Before the sort: owned particles that left the slab migrate, ghosts arrive; the world's
@@ -290,6 +295,19 @@ class CpuBackend final : public Backend {
   uint32_t halo_unpack(const RankBytes& in, uint32_t origin);
   // Keeps the particles keep_order_ lists (ascending), in that order.
   void halo_keep(size_t kept);
+  // Springs across ranks (cpu_halo_springs.cpp). Outside a substep's sorted part the spring
+  // lists name their partners by id. halo_gather_spring_partners (after the ghosts' arrival):
+  // each partner id of an owned particle that is neither owned nor a ghost comes from its owner
+  // as a spring ghost (none: a sink removed it). halo_resolve_springs (after the sort): the ids
+  // become storage indices (a partner held nowhere: the spring is dropped, as a sink's removal
+  // drops it in the undivided world). halo_springs_to_ids (the substep's end, before the ghosts
+  // go): back to ids. halo_share_spring_candidates (linking, between its passes): each ghost
+  // takes its owner's candidates. halo_spring_index: the storage index of an id, or kNoSpring.
+  void halo_gather_spring_partners(uint32_t owned);
+  void halo_resolve_springs();
+  void halo_springs_to_ids();
+  void halo_share_spring_candidates();
+  uint32_t halo_spring_index(uint32_t id) const;
 
   std::shared_ptr<const RankTransport> ranks_;
   DistributedOptions distributed_options_;
@@ -298,9 +316,12 @@ class CpuBackend final : public Backend {
   DistributedCounters halo_counters_;
   GridShape halo_shape_{};
   HostVector<uint32_t> halo_visit_;
-  int64_t halo_world_count_ = 0;    // the particles every rank owns, this substep
-  CpuArrayRef<uint64_t> sort_key_;  // Carried
-  CpuArrayRef<uint32_t> origin_;    // Sorted: 0 owned, else 1 + the rank the ghost came from
+  int64_t halo_world_count_ = 0;       // the particles every rank owns, this substep
+  CpuArrayRef<uint64_t> sort_key_;     // Carried
+  CpuArrayRef<uint32_t> origin_;       // Sorted: 0 owned, else 1 + the rank the ghost came from
+                                       // (+ the rank count for a spring ghost)
+  HostVector<uint64_t> halo_ids_;      // springs: (id << 32 | storage index) of every particle, sorted
+  bool halo_springs_indexed_ = false;  // springs: the lists hold storage indices (resolved), not ids
 
   WorldConfig config_;
   CpuParallel workers_;  // OpenMP's, or the engine's task system (cpu_parallel.h)
