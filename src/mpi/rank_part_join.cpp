@@ -57,7 +57,8 @@ RankFileBlock rank_file_block(uint32_t saved, int rank, int ranks) {
 
 void join_rank_parts(CheckpointPart& into, bool keep_own, const std::vector<CheckpointPart>& others) {
   if (into.config.features & kFeatureSprings)
-    throw Error(Status::Unsupported, "springs: a distributed world has none to load on another rank count");
+    throw Error(Status::Unsupported,
+                "springs: a distributed world's checkpoint holds none (saves refuse them)");
   ParticleSnapshot& s = into.particles;
   if (!keep_own) {
     drop_particles(s);

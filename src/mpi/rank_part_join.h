@@ -27,7 +27,7 @@ RankFileBlock rank_file_block(uint32_t saved, int rank, int ranks);
 // the sort keys) after its own, or instead of them unless keep_own; the last frame's removed
 // ids and sink-removal counts likewise; the capacity raised to the particles' count. Throws
 // CorruptData for parts of different worlds or a duplicate id, Capacity past max_capacity,
-// Unsupported for springs (no distributed world has them).
+// Unsupported for springs (sph_mpi_world_save_file refuses a world with them).
 void join_rank_parts(CheckpointPart& into, bool keep_own, const std::vector<CheckpointPart>& others);
 
 }  // namespace sph
