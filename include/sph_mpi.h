@@ -168,8 +168,7 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather_removed_ids(const sph_world* wo
  * the previous set as it was and named by its manifest; a failed save removes the files it
  * wrote, a crash leaves them beside the set (files no manifest names).
  * Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL or empty path; a file that cannot be written:
- * the message says which and why), UNSUPPORTED (not a distributed world; a world with
- * SPH_FEATURE_SPRINGS, whose springs join particles of different ranks), WORLD_LOCKED,
+ * the message says which and why), UNSUPPORTED (not a distributed world), WORLD_LOCKED,
  * OUT_OF_HOST_MEMORY; a rank whose own save succeeded returns the failing rank's code.
  */
 SPH_API sph_result SPH_CALL sph_mpi_world_save_file(const sph_world* world, const char* path);

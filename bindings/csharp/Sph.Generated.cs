@@ -3503,9 +3503,9 @@ namespace Sph
         /// manifest is in place, leaves the previous set as it was and named by its manifest; a failed
         /// save removes the files it wrote, a crash leaves them beside the set (files no manifest
         /// names). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL or empty path; a file that cannot be
-        /// written: the message says which and why), UNSUPPORTED (not a distributed world; a world with
-        /// SPH_FEATURE_SPRINGS, whose springs join particles of different ranks), WORLD_LOCKED,
-        /// OUT_OF_HOST_MEMORY; a rank whose own save succeeded returns the failing rank's code.
+        /// written: the message says which and why), UNSUPPORTED (not a distributed world),
+        /// WORLD_LOCKED, OUT_OF_HOST_MEMORY; a rank whose own save succeeded returns the failing rank's
+        /// code.
         /// </summary>
         [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_mpi_world_save_file(WorldHandle world, byte[] path);

@@ -78,12 +78,6 @@ std::string staged_path(const std::string& path, int rank) {
 // Writes this rank's file under its staged name; returns its manifest entry (the name the file
 // will have once every rank has staged its own).
 RankFileEntry stage_rank(const sph_world* world, const RankTransport& ranks, const std::string& path) {
-  // Between substeps a rank's spring lists name their partners by id, which may live on another
-  // rank (src/cpu/cpu_halo_springs.cpp); the checkpoint format holds storage indices of one file.
-  if (world->world->config().features & kFeatureSprings)
-    throw Error(Status::Unsupported,
-                "springs: a distributed world with SPH_FEATURE_SPRINGS cannot be saved yet (its springs "
-                "join particles of different ranks; docs/distributed.md)");
   CheckpointOrigin origin;
   origin.backend = static_cast<uint32_t>(world->context->backend);
   origin.library_version = SPH_VERSION;
@@ -200,8 +194,6 @@ std::unique_ptr<World> load_rank(sph_context* context, const std::shared_ptr<con
     world = read_checkpoint(
         bytes.data(), bytes.size(),
         [&](const WorldConfig& config) {
-          if (config.features & kFeatureSprings)  // (no save writes one: stage_rank refuses)
-            throw Error(Status::Unsupported, "springs: a distributed world's checkpoint with springs");
           std::unique_ptr<Backend> b =
               make_backend(context->backend, config, context->device_ordinal, context->cpu_workers,
                            context->cpu_tasks, context->cuda_tuning);

@@ -18,7 +18,7 @@
  *   - RK4 (each stage sorts, resolves and returns the lists to ids) and DFSPH.
  * Each: after the substeps, the particles equal the undivided world's bit for bit (the spring
  * sums run over the same slots with the same partners' bits: no tolerance), the count is the
- * world's. Also: a distributed world with springs refuses sph_mpi_world_save_file, naming them. */
+ * world's. Also rank checkpoints of a world with springs, restored, loaded, and loaded on one rank. */
 #include <math.h>
 #include <mpi.h>
 #include <stdio.h>
@@ -211,19 +211,74 @@ static void run_case(sph_context* context, const spring_case* c) {
   free(pairs);
 }
 
-/* A distributed world with springs refuses rank checkpoints (their lists name partners across the
- * ranks), on every rank alike, naming the feature. */
-static void check_save_refused(sph_context* context) {
+/* Rank checkpoints with springs (their lists name partners by id): the elastic stirred column saved
+ * after 10 substeps, stepped 10 more live, restored into the world and loaded as a new world on
+ * every rank, and loaded on rank 0 alone (another rank count, whose rank joins every saved file):
+ * each, stepped 10 substeps more, equals the undivided world stepped 20, bit for bit. */
+static void check_checkpoint(sph_context* context) {
+  const sph_vec3 column_min = {0.0f, 0.0f, 0.0f}, column_max = {0.1f, 0.2f, 0.06f};
+  const spring_case c = {
+      "checkpoint",     2.0f, 1e4f, 20.0f, 0.0f, 0.1f, 0, 0, 0, SPH_INTEGRATOR_SYMPLECTIC_EULER,
+      SPH_SOLVER_WCSPH, 20};
+  const char* path = "mpi_springs_checkpoint.sphcp";
   sph_world_def def;
+  sph_world* single = NULL;
   sph_world* world = NULL;
-  sph_result r;
+  sph_world* loaded = NULL;
+  sph_collider_id single_tank, tank;
+  MPI_Comm alone;
+  char name[512];
   mpi_test_world_def(&def);
   def.features = SPH_FEATURE_SPRINGS;
-  REQUIRE(sph_mpi_world_create(context, &def, MPI_TEST_COMM, NULL, &world) == SPH_OK, "world with springs");
-  r = sph_mpi_world_save_file(world, "mpi_springs_refused.sphcp");
-  CHECK(r == SPH_ERROR_UNSUPPORTED && strstr(sph_get_last_error(), "springs") != NULL,
-        "saving a world with springs: %d (%s)", (int)r, sph_get_last_error());
+  make_worlds(context, &def, column_min, column_max, c.stir, &single, &world, &single_tank, &tank);
+  set_springs(world, &c);
+  if (g_rank == 0) {
+    set_springs(single, &c);
+    mpi_test_step(single, 20, 0);
+  }
+  mpi_test_step(world, 10, 1);
+  REQUIRE(sph_mpi_world_save_file(world, path) == SPH_OK, "save: %s", sph_get_last_error());
+  mpi_test_step(world, 10, 1);
+  expect_same_particles(single, world, "springs: the live world after a save");
+  REQUIRE(sph_mpi_world_restore_file(world, path) == SPH_OK, "restore: %s", sph_get_last_error());
+  mpi_test_step(world, 10, 1);
+  expect_same_particles(single, world, "springs: restored");
+  REQUIRE(sph_mpi_world_load_file(context, MPI_TEST_COMM, path, &loaded) == SPH_OK, "load: %s",
+          sph_get_last_error());
+  mpi_test_step(loaded, 10, 1);
+  expect_same_particles(single, loaded, "springs: loaded");
+  REQUIRE(sph_world_destroy(loaded) == SPH_OK, "destroy");
+  /* Rank 0 alone takes every rank's file: springs whose ends were saved on two ranks join. */
+  MPI_Comm_split(MPI_COMM_WORLD, g_rank == 0 ? 0 : MPI_UNDEFINED, g_rank, &alone);
+  if (g_rank == 0) {
+    uint32_t* want_id = NULL;
+    float *want_x = NULL, *want_v = NULL, *got_x = NULL, *got_v = NULL;
+    double worst = 0.0;
+    uint32_t m, differ;
+    loaded = NULL;
+    REQUIRE(sph_mpi_world_load_file(context, (int32_t)MPI_Comm_c2f(alone), path, &loaded) == SPH_OK,
+            "load on one rank: %s", sph_get_last_error());
+    mpi_test_step(loaded, 10, 1);
+    m = read_in_id_order(single, &want_id, &want_x, &want_v);
+    mpi_test_gather_on(loaded, alone, m, &got_x, &got_v);
+    differ = mpi_differ(got_x, got_v, want_x, want_v, m, &worst);
+    CHECK(differ == 0, "springs: saved on %d ranks, loaded on 1: %u of %u particles differ", g_size, differ,
+          m);
+    printf("springs: saved on %d ranks, loaded on 1: %u particles, %u differ\n", g_size, m, differ);
+    REQUIRE(sph_world_destroy(loaded) == SPH_OK, "destroy");
+    MPI_Comm_free(&alone);
+    free(want_id);
+    free(want_x);
+    free(want_v);
+    free(got_x);
+    free(got_v);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (mpi_test_rank_file(path, g_rank, name, sizeof name)) remove(name);
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (g_rank == 0) remove(path);
   REQUIRE(sph_world_destroy(world) == SPH_OK, "destroy");
+  if (single) REQUIRE(sph_world_destroy(single) == SPH_OK, "destroy");
 }
 
 int main(int argc, char** argv) {
@@ -245,6 +300,6 @@ int main(int argc, char** argv) {
   };
   mpi_test_init(&argc, &argv, &context);
   for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) run_case(context, &cases[k]);
-  check_save_refused(context);
+  check_checkpoint(context);
   return mpi_test_finish(context, "mpi_springs");
 }
