@@ -28,6 +28,7 @@
 #include "../physics/probe_sampling.h"
 #include "../physics/springs.h"
 #include "cpu_boundary_maps.h"
+#include "cpu_id_table.h"
 #include "cpu_neighbor_columns.h"
 #include "cpu_neighbor_grid.h"
 #include "cpu_parallel.h"
@@ -297,17 +298,17 @@ class CpuBackend final : public Backend {
   void halo_keep(size_t kept);
   // Springs across ranks (cpu_halo_springs.cpp). Outside a substep's sorted part the spring
   // lists name their partners by id. halo_gather_spring_partners (after the ghosts' arrival):
-  // each partner id of an owned particle that is neither owned nor a ghost comes from its owner
-  // as a spring ghost (none: a sink removed it). halo_resolve_springs (after the sort): the ids
-  // become storage indices (a partner held nowhere: the spring is dropped, as a sink's removal
-  // drops it in the undivided world). halo_springs_to_ids (the substep's end, before the ghosts
-  // go): back to ids. halo_share_spring_candidates (linking, between its passes): each ghost
-  // takes its owner's candidates. halo_spring_index: the storage index of an id, or kNoSpring.
+  // the owned lists' ids become storage indices; each partner neither owned nor a ghost comes
+  // from its owner as a spring ghost (none: a sink removed it, and the spring is dropped, as a
+  // sink's removal drops it in the undivided world). halo_resolve_springs (after the sort): the
+  // partners follow the sort. halo_springs_to_ids (the substep's end, before the ghosts go): back
+  // to ids. halo_share_spring_candidates (linking, between its passes): each ghost takes its
+  // owner's candidates. halo_index_ids: halo_id_table_ from the particles held now.
   void halo_gather_spring_partners(uint32_t owned);
   void halo_resolve_springs();
   void halo_springs_to_ids();
   void halo_share_spring_candidates();
-  uint32_t halo_spring_index(uint32_t id) const;
+  void halo_index_ids();
 
   std::shared_ptr<const RankTransport> ranks_;
   DistributedOptions distributed_options_;
@@ -316,12 +317,17 @@ class CpuBackend final : public Backend {
   DistributedCounters halo_counters_;
   GridShape halo_shape_{};
   HostVector<uint32_t> halo_visit_;
-  int64_t halo_world_count_ = 0;       // the particles every rank owns, this substep
-  CpuArrayRef<uint64_t> sort_key_;     // Carried
-  CpuArrayRef<uint32_t> origin_;       // Sorted: 0 owned, else 1 + the rank the ghost came from
-                                       // (+ the rank count for a spring ghost)
-  HostVector<uint64_t> halo_ids_;      // springs: (id << 32 | storage index) of every particle, sorted
-  bool halo_springs_indexed_ = false;  // springs: the lists hold storage indices (resolved), not ids
+  int64_t halo_world_count_ = 0;    // the particles every rank owns, this substep
+  CpuArrayRef<uint64_t> sort_key_;  // Carried
+  CpuArrayRef<uint32_t> origin_;    // Sorted: 0 owned, else 1 + the rank the ghost came from
+                                    // (+ the rank count for a spring ghost)
+  // Springs: the held particles' ids to their indices, the partners waiting for spring ghosts
+  // (kSpringSlots ids per owned particle), the sort's inverse permutation; whether the owned
+  // lists hold storage indices (from the gather to the substep's end) or ids.
+  CpuIdTable halo_id_table_;
+  HostVector<uint32_t> halo_missing_;
+  HostVector<uint32_t> halo_inverse_;
+  bool halo_springs_indexed_ = false;
 
   WorldConfig config_;
   CpuParallel workers_;  // OpenMP's, or the engine's task system (cpu_parallel.h)

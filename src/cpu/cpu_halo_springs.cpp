@@ -7,17 +7,18 @@
 // reorder on their own (migration, ghosts arriving and leaving), so outside the sorted part of a
 // substep a rank's lists name their partners by id instead, and no reorder rewrites them
 // (attach_ranks clears the array's rewrite):
-//   before the sort  (halo_gather_spring_partners) each partner of an owned particle that is
+//   before the sort  (halo_gather_spring_partners, once the ghosts are in) the owned lists' ids
+//                    become storage indices (a hash table of the ids held); each partner that is
 //                    neither owned here nor a ghost comes from its owner as a spring ghost: an
 //                    elastic spring has no longest length, so its far end may be past the halo,
 //                    one cell layer deep. One exchange of the wanted ids (to every rank), one of
 //                    the particles (halo_pack's records). A spring ghost is in no neighbour walk
 //                    of an owned particle (its cell layer is two or more from the slab) and
 //                    takes no density record; the spring force reads its position and velocity,
-//                    which are its owner's at the substep's start;
-//   after the sort   (halo_resolve_springs) ids become storage indices; an id held nowhere is a
+//                    which are its owner's at the substep's start. An id held by no rank is a
 //                    particle a sink removed, and the spring is dropped (partner kNoSpring, rest
 //                    0), as the undivided world's rewrite drops it at the removal;
+//   after the sort   (halo_resolve_springs) the partners follow the sort's permutation;
 //   linking          (spring_pass) pass 1 runs on the owned particles, whose neighbour cells are
 //                    complete; the ghosts take their owners' candidates (ids, as local indices,
 //                    halo_share_spring_candidates); pass 2 links the owned particles. Every rank
@@ -40,6 +41,8 @@ namespace {
 // A ghost's link candidate that this rank does not hold: no owned particle, so no match in
 // spring_link, and not kNoSpring, which ends a candidate list.
 constexpr uint32_t kCandidateElsewhere = kNoSpring - 1u;
+// A partner no particle here has until the spring ghosts arrive (its id kept in halo_missing_).
+constexpr uint32_t kPartnerPending = kNoSpring - 1u;
 
 // Linking's pass 1 of an owned particle, sent to the ranks that hold it as a ghost.
 struct HaloSpringCandidateRecord {
@@ -55,27 +58,40 @@ RankBytes id_bytes(const std::vector<uint32_t>& ids) {
 
 }  // namespace
 
-uint32_t CpuBackend::halo_spring_index(uint32_t id) const {
-  const uint64_t key = static_cast<uint64_t>(id) << 32;
-  const auto at = std::lower_bound(halo_ids_.begin(), halo_ids_.end(), key);
-  if (at == halo_ids_.end() || (*at >> 32) != id) return kNoSpring;
-  return static_cast<uint32_t>(*at & 0xffffffffu);
+void CpuBackend::halo_index_ids() {
+  halo_id_table_.reset(count_);
+  for (uint32_t i = 0; i < count_; ++i) halo_id_table_.insert(id_[i], i);
 }
 
 void CpuBackend::halo_gather_spring_partners(uint32_t owned) {
-  halo_springs_indexed_ = false;  // (ids between substeps; a rolled-back substep restored them)
   const RankTransport& t = *ranks_;
   const int me = t.rank();
   const int size = t.size();
-  std::vector<uint32_t> held(id_.data(), id_.data() + count_);  // owned and ghosts
-  std::sort(held.begin(), held.end());
-  std::vector<uint32_t> wanted;
-  const SpringList* lists = springs_.data();
-  for (uint32_t i = 0; i < owned; ++i)
+  // The owned lists' partner ids to the indices of the particles held now (owned and ghosts);
+  // those held nowhere here wait, their ids aside, for the spring ghosts.
+  halo_index_ids();
+  halo_missing_.assign(static_cast<size_t>(owned) * kSpringSlots, kNoSpring);
+  SpringList* lists = springs_.data();
+  uint32_t* missing = halo_missing_.data();
+  const CpuIdTable& table = halo_id_table_;
+  parallel().for_each(owned, [&](uint32_t i) {
+    SpringList& l = lists[i];
     for (uint32_t k = 0; k < kSpringSlots; ++k) {
-      const uint32_t p = lists[i].partner[k];
-      if (p != kNoSpring && !std::binary_search(held.begin(), held.end(), p)) wanted.push_back(p);
+      const uint32_t p = l.partner[k];
+      if (p == kNoSpring) continue;
+      const uint32_t j = table.find(p);
+      if (j != CpuIdTable::kAbsent) {
+        l.partner[k] = j;
+      } else {
+        missing[static_cast<size_t>(i) * kSpringSlots + k] = p;
+        l.partner[k] = kPartnerPending;
+      }
     }
+  });
+  halo_springs_indexed_ = true;  // (halo_springs_to_ids turns them back at the substep's end)
+  std::vector<uint32_t> wanted;
+  for (size_t e = 0; e < halo_missing_.size(); ++e)
+    if (missing[e] != kNoSpring) wanted.push_back(missing[e]);
   std::sort(wanted.begin(), wanted.end());
   wanted.erase(std::unique(wanted.begin(), wanted.end()), wanted.end());
   std::vector<RankBytes> out(static_cast<size_t>(size));
@@ -83,9 +99,6 @@ void CpuBackend::halo_gather_spring_partners(uint32_t owned) {
     if (r != me) out[static_cast<size_t>(r)] = id_bytes(wanted);
   std::vector<RankBytes> in = t.exchange(out);  // (an agreement: the ghosts' arrival, the wants)
   // What this rank owns of each rank's wants, in the wanted (ascending id) order.
-  std::vector<uint64_t> mine(owned);
-  for (uint32_t i = 0; i < owned; ++i) mine[i] = (static_cast<uint64_t>(id_[i]) << 32) | i;
-  std::sort(mine.begin(), mine.end());
   for (int r = 0; r < size; ++r) {
     RankBytes& to = out[static_cast<size_t>(r)];
     to.clear();
@@ -93,30 +106,47 @@ void CpuBackend::halo_gather_spring_partners(uint32_t owned) {
     for (size_t k = 0; k + sizeof(uint32_t) <= asked.size(); k += sizeof(uint32_t)) {
       uint32_t id;
       std::memcpy(&id, asked.data() + k, sizeof id);
-      const uint64_t key = static_cast<uint64_t>(id) << 32;
-      const auto at = std::lower_bound(mine.begin(), mine.end(), key);
-      if (at != mine.end() && (*at >> 32) == id) halo_pack(static_cast<uint32_t>(*at & 0xffffffffu), to);
+      const uint32_t j = table.find(id);
+      if (j != CpuIdTable::kAbsent && j < owned) halo_pack(j, to);
     }
   }
   in = t.exchange(out);  // (an agreement: the spring ghosts' packing)
+  const uint32_t first = count_;
   for (int r = 0; r < size; ++r)
     halo_unpack(in[static_cast<size_t>(r)], static_cast<uint32_t>(size) + static_cast<uint32_t>(r) + 1u);
+  if (wanted.empty()) return;
+  // The waiting partners: a spring ghost's index, or none (a sink removed the partner: the
+  // spring is dropped, as the undivided world's rewrite drops it at the removal).
+  std::vector<uint64_t> arrived(count_ - first);
+  for (uint32_t i = first; i < count_; ++i) arrived[i - first] = (static_cast<uint64_t>(id_[i]) << 32) | i;
+  std::sort(arrived.begin(), arrived.end());
+  lists = springs_.data();  // (the arrivals resized the store)
+  parallel().for_each(owned, [&](uint32_t i) {
+    SpringList& l = lists[i];
+    for (uint32_t k = 0; k < kSpringSlots; ++k) {
+      if (l.partner[k] != kPartnerPending) continue;
+      const uint32_t id = missing[static_cast<size_t>(i) * kSpringSlots + k];
+      const auto at = std::lower_bound(arrived.begin(), arrived.end(), static_cast<uint64_t>(id) << 32);
+      const bool found = at != arrived.end() && (*at >> 32) == id;
+      l.partner[k] = found ? static_cast<uint32_t>(*at & 0xffffffffu) : kNoSpring;
+      if (!found) l.rest[k] = 0.0f;
+    }
+  });
 }
 
 void CpuBackend::halo_resolve_springs() {
-  halo_ids_.resize(count_);
-  for (uint32_t i = 0; i < count_; ++i) halo_ids_[i] = (static_cast<uint64_t>(id_[i]) << 32) | i;
-  std::sort(halo_ids_.begin(), halo_ids_.end());
-  halo_springs_indexed_ = true;
+  // The sort moved every particle (store_.permute, which rewrites no spring list in a distributed
+  // world): the owned lists' partners follow it.
+  const uint32_t* order = grid_.order().data();  // new index i holds old index order[i]
+  halo_inverse_.resize(count_);
+  uint32_t* inverse = halo_inverse_.data();
+  for (uint32_t i = 0; i < count_; ++i) inverse[order[i]] = i;
   SpringList* lists = springs_.data();
   parallel().for_each(count_, [&](uint32_t i) {
     if (ghost(i)) return;  // (a ghost's list is its owner's to use)
     SpringList& l = lists[i];
-    for (uint32_t k = 0; k < kSpringSlots; ++k) {
-      if (l.partner[k] == kNoSpring) continue;
-      l.partner[k] = halo_spring_index(l.partner[k]);
-      if (l.partner[k] == kNoSpring) l.rest[k] = 0.0f;  // a sink removed the partner
-    }
+    for (uint32_t k = 0; k < kSpringSlots; ++k)
+      if (l.partner[k] != kNoSpring) l.partner[k] = inverse[l.partner[k]];
   });
 }
 
@@ -136,6 +166,7 @@ void CpuBackend::halo_springs_to_ids() {
 
 void CpuBackend::halo_share_spring_candidates() {
   using Record = HaloSpringCandidateRecord;
+  halo_index_ids();  // (the sorted order's indices)
   uint32_t* candidates = spring_candidates_.data();
   halo_share<Record>(
       "spring candidates",
@@ -154,8 +185,8 @@ void CpuBackend::halo_share_spring_candidates() {
             theirs[k] = kNoSpring;
             continue;
           }
-          const uint32_t j = halo_spring_index(r.candidate[k]);
-          theirs[k] = j == kNoSpring ? kCandidateElsewhere : j;
+          const uint32_t j = halo_id_table_.find(r.candidate[k]);
+          theirs[k] = j == CpuIdTable::kAbsent ? kCandidateElsewhere : j;
         }
       });
 }
