@@ -6,7 +6,8 @@
 //                     array), the ghosts arrive (the owned particles of the cell layer beside
 //                     the slab), the world's grid shape is reduced from every rank's extent;
 //   after the sort    each particle's key becomes its slot and place in the slot (springs: the
-//                     lists' partner ids become storage indices; cpu_halo_springs.cpp);
+//                     lists' partners, ids until the ghosts came, follow the sort;
+//                     cpu_halo_springs.cpp);
 //   after density     the ghosts take their owners' density, pressure and neighbour count
 //                     (the force pass reads them), again after the normalised density's filter
 //                     and the diffusion, and their colour normals after that pass;
@@ -178,7 +179,8 @@ void CpuBackend::halo_gather() {
   }
   in = t.exchange(out);  // (an agreement: the migrants' arrival, the ghosts' packing)
   for (int r = 0; r < size; ++r) halo_unpack(in[static_cast<size_t>(r)], static_cast<uint32_t>(r) + 1u);
-  // Springs: the partners of owned particles that are neither owned nor ghosts (cpu_halo_springs.cpp).
+  // Springs: the owned lists' partner ids to indices, the partners held nowhere here as spring
+  // ghosts (cpu_halo_springs.cpp).
   if (springs_) halo_gather_spring_partners(owned);
   halo_counters_.ghosts = count_ - owned;
   // The world's grid: the extent and count of every rank's owned particles (what the undivided
@@ -229,7 +231,7 @@ void CpuBackend::halo_keys() {
   for (uint32_t c = 0; c < view.shape.cell_count; ++c)
     for (uint32_t i = view.cell_start[c]; i < view.cell_start[c + 1]; ++i)
       key[i] = (static_cast<uint64_t>(c) << 32) | (i - view.cell_start[c]);
-  if (springs_) halo_resolve_springs();  // the spring lists' partners: ids to storage indices
+  if (springs_) halo_resolve_springs();  // the spring lists' partners follow the sort
 }
 
 void CpuBackend::halo_share_density() {
