@@ -1,10 +1,12 @@
 /* SPDX-License-Identifier: MIT */
 /* The two-rank calibration of docs/scaling.md's model on the CPU backend (issue 19 item 6):
  *
- *   mpirun -np R bench/mpi_halo [--spacing S] [--substeps K] [--backend cpu|cuda]
+ *   mpirun -np R bench/mpi_halo [--spacing S] [--substeps K] [--backend cpu|cuda] [--springs 1]
  *
  * --backend cuda: every rank on the CUDA backend (the host-staged halo path; ranks on one GPU
- * share it), the GPU calibration of the model.
+ * share it), the GPU calibration of the model. --springs 1: with SPH_FEATURE_SPRINGS (every
+ * particle linked to its lattice neighbours in the warm-up frame; springs across ranks, CPU
+ * ranks only), the cost of their exchanges and spring ghosts.
  * A water block of 0.8 x 0.4 x 0.2 m at rest in a closed tank (the slabs cut its 0.8 m axis),
  * stepped one warm-up frame (the first cut and its migration) and then timed over K substeps
  * (default 20). Prints, on rank 0: the ranks, the particles per rank, the ghosts (halo) per rank
@@ -60,6 +62,7 @@ int main(int argc, char** argv) {
   float spacing = 0.01f;
   uint32_t substeps = 20;
   sph_backend backend = SPH_BACKEND_CPU;
+  int springs = 0;
   int rank, size;
   sph_context* context = NULL;
   sph_world* scratch = NULL;
@@ -81,11 +84,13 @@ int main(int argc, char** argv) {
     if (strcmp(argv[i], "--spacing") == 0) spacing = (float)atof(argv[i + 1]);
     if (strcmp(argv[i], "--substeps") == 0) substeps = (uint32_t)atoi(argv[i + 1]);
     if (strcmp(argv[i], "--backend") == 0) backend = support_backend_from_name(argv[i + 1], SPH_BACKEND_CPU);
+    if (strcmp(argv[i], "--springs") == 0) springs = atoi(argv[i + 1]) != 0;
   }
   need(support_context_create(backend, &context), "context");
   need(sph_world_def_init(&def), "def");
   def.particle_spacing = spacing;
   def.kernel_radius = 1.8f * spacing;
+  if (springs) def.features |= SPH_FEATURE_SPRINGS;
   /* The block holds about sqrt 2 (0.8 x 0.4 x 0.2 m) / spacing^3 particles (the FCC lattice);
    * room for all of them on any rank, at least 2^20. */
   {
@@ -126,7 +131,7 @@ int main(int argc, char** argv) {
      * slab, h / L of the block's particles (L = 0.8 m, the cut axis); 2 (R - 1) faces. */
     const double h = 1.8 * spacing;
     const double model = size > 1 ? n * h / 0.8 * 2.0 * (size - 1) / size : 0.0;
-    printf("backend %s\n", backend == SPH_BACKEND_CUDA ? "cuda" : "cpu");
+    printf("backend %s%s\n", backend == SPH_BACKEND_CUDA ? "cuda" : "cpu", springs ? ", springs" : "");
     printf("ranks %d, %u particles (%.0f per rank, the fullest %lld), %u substeps\n", size, n,
            (double)n / size, (long long)owned_max, stats.substeps);
     printf(

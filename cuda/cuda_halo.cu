@@ -30,8 +30,8 @@
 // or DFSPH's Jacobi solves (the host drives each solve an iteration at a time,
 // core/dfsph_jacobi_loop.h: the ghosts take their owners' densities and factors after the density
 // pass, velocities and pressure steps within each iteration, and the mean error is an exact sum
-// added over the ranks); attach_ranks refuses springs by name, the step DFSPH's conjugate
-// gradients (frame_loop.cu).
+// added over the ranks); attach_ranks refuses springs by name (the CPU rank runs them:
+// src/cpu/cpu_halo_springs.cpp), the step DFSPH's conjugate gradients (frame_loop.cu).
 #include <cstring>
 #include <memory>
 #include <string>
@@ -66,7 +66,8 @@ void CudaBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks,
   const struct {
     uint32_t bit;
     const char* name;
-  } features[] = {{kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks)"}};
+  } features[] = {
+      {kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks run on the CPU backend's ranks)"}};
   for (const auto& f : features)
     if (config_.features & f.bit) refuse(f.name);
   require_alive();

@@ -85,10 +85,12 @@ ParticleSnapshot read_checkpoint_particles(ByteReader& r, const WorldConfig& con
   return s;
 }
 
-// The spring lists: every partner an index of another particle, every rest length in
-// [0, h], and every spring stored at both ends with the same rest length (bit for bit), as
-// the solver keeps them.
-void read_checkpoint_springs(ByteReader& r, const WorldConfig& config, uint32_t next_id,
+// The spring lists: every partner another particle (an index of this file; in a rank's part an id,
+// which may be of a particle on another rank), every rest length in [0, h], and every spring whose
+// two ends are in the file stored at both ends with the same rest length (bit for bit), as the
+// solver keeps them. (A rank's part may name an id no rank holds: a particle a sink removed in the
+// saved substep, whose spring the next substep drops.)
+void read_checkpoint_springs(ByteReader& r, const WorldConfig& config, uint32_t next_id, bool partner_ids,
                              ParticleSnapshot& s) {
   const uint32_t n = static_cast<uint32_t>(s.id.size());
   const uint32_t link_from = r.u32();
@@ -111,27 +113,41 @@ void read_checkpoint_springs(ByteReader& r, const WorldConfig& config, uint32_t 
                   " has a rest length");
         continue;
       }
-      if (j >= n || j == i)
-        corrupt(r.what() + ": particle " + std::to_string(i) + " has a spring to " + std::to_string(j) +
-                ", which is not another particle");
+      if (partner_ids ? (j >= next_id || j == s.id[i]) : (j >= n || j == i))
+        corrupt(r.what() + ": particle " + std::to_string(i) + " has a spring to " +
+                (partner_ids ? "id " : "") + std::to_string(j) + ", which is not another particle");
       if (list.rest[k] < 0.0f || list.rest[k] > config.kernel_radius)
         corrupt(r.what() + ": a spring rest length of particle " + std::to_string(i) + " is outside [0, h]");
     }
   }
+  // A rank's part: the file's index of each id (ids are unique, checked with the particles).
+  HostVector<uint64_t> by_id(partner_ids ? n : 0);
+  for (uint32_t i = 0; i < by_id.size(); ++i) by_id[i] = (static_cast<uint64_t>(s.id[i]) << 32) | i;
+  std::sort(by_id.begin(), by_id.end());
+  const auto index_of = [&](uint32_t partner) {
+    if (!partner_ids) return partner;
+    const auto at = std::lower_bound(by_id.begin(), by_id.end(), static_cast<uint64_t>(partner) << 32);
+    return at == by_id.end() || (*at >> 32) != partner ? kNoSpring : static_cast<uint32_t>(*at & 0xffffffffu);
+  };
   for (uint32_t i = 0; i < n; ++i)
     for (uint32_t k = 0; k < kSpringSlots; ++k) {
-      const uint32_t j = springs[i].partner[k];
-      if (j == kNoSpring) continue;
-      uint32_t matches = 0;
-      for (uint32_t m = 0; m < kSpringSlots; ++m)
-        if (springs[j].partner[m] == i &&
-            std::memcmp(&springs[j].rest[m], &springs[i].rest[k], sizeof(float)) == 0)
-          ++matches;
+      const uint32_t p = springs[i].partner[k];
+      if (p == kNoSpring) continue;
       uint32_t copies = 0;
-      for (uint32_t m = 0; m < kSpringSlots; ++m) copies += springs[i].partner[m] == j ? 1u : 0u;
+      for (uint32_t m = 0; m < kSpringSlots; ++m) copies += springs[i].partner[m] == p ? 1u : 0u;
+      const uint32_t j = index_of(p);
+      const uint32_t me = partner_ids ? s.id[i] : i;
+      uint32_t matches = 1;  // (a partner in another rank's part: its own file is checked there)
+      if (j != kNoSpring) {
+        matches = 0;
+        for (uint32_t m = 0; m < kSpringSlots; ++m)
+          if (springs[j].partner[m] == me &&
+              std::memcmp(&springs[j].rest[m], &springs[i].rest[k], sizeof(float)) == 0)
+            ++matches;
+      }
       if (matches != 1 || copies != 1)
         corrupt(r.what() + ": the spring between particles " + std::to_string(i) + " and " +
-                std::to_string(j) + " is not stored once at each end with one rest length");
+                std::to_string(p) + " is not stored once at each end with one rest length");
     }
   s.set_carried(kArraySprings, springs);
   s.set_carried(kArraySpringLinkFrom, HostVector<uint32_t>{link_from});

@@ -16,6 +16,9 @@ namespace sph {
 ParticleSnapshot read_checkpoint_particles(ByteReader& r, const WorldConfig& config, uint32_t next_id);
 // The spring lists (SPH_FEATURE_SPRINGS) into s: every partner an index of another particle,
 // every rest length in [0, h], every spring stored at both ends alike.
-void read_checkpoint_springs(ByteReader& r, const WorldConfig& config, uint32_t next_id, ParticleSnapshot& s);
+// partner_ids: a rank's part of a distributed world, whose lists name partners by id (the ends
+// of a spring may be on different ranks: src/cpu/cpu_halo_springs.cpp).
+void read_checkpoint_springs(ByteReader& r, const WorldConfig& config, uint32_t next_id, bool partner_ids,
+                             ParticleSnapshot& s);
 
 }  // namespace sph

@@ -269,7 +269,8 @@ Front read_front(ByteReader& payload, uint32_t version, bool rank_part) {
   ByteReader part = next_section(payload, 3);
   ParticleSnapshot& particles = f.part.particles;
   particles = read_checkpoint_particles(part, config, clock.next_id);
-  if (config.features & kFeatureSprings) read_checkpoint_springs(part, config, clock.next_id, particles);
+  if (config.features & kFeatureSprings)
+    read_checkpoint_springs(part, config, clock.next_id, rank_part, particles);
   if (rank_part) {
     // Any value is a valid order (keys only order the next sort); the count is checked first.
     part.need_elements(particles.id.size(), sizeof(uint64_t), "sort keys");

@@ -28,6 +28,7 @@
 #include "../physics/probe_sampling.h"
 #include "../physics/springs.h"
 #include "cpu_boundary_maps.h"
+#include "cpu_id_table.h"
 #include "cpu_neighbor_columns.h"
 #include "cpu_neighbor_grid.h"
 #include "cpu_parallel.h"
@@ -249,6 +250,11 @@ class CpuBackend final : public Backend {
   // in the same order. Each step is collective.
   // A ghost of this substep (never in a world that is not distributed).
   bool ghost(uint32_t i) const { return origin_ && origin_[i] != 0u; }
+  // A spring ghost: a ghost that is only the far end of an owned particle's spring, from past the
+  // halo (origin_ above the rank count; cpu_halo_springs.cpp). No neighbour pass reads it.
+  bool spring_ghost(uint32_t i) const {
+    return origin_ && origin_[i] > static_cast<uint32_t>(ranks_->size());
+  }
   // The frame's start: the world's max speed, and new slabs when the ranks are out of balance.
   void halo_begin_frame();
   // Before the sort: owned particles that left the slab migrate, ghosts arrive; the world's
@@ -290,6 +296,19 @@ class CpuBackend final : public Backend {
   uint32_t halo_unpack(const RankBytes& in, uint32_t origin);
   // Keeps the particles keep_order_ lists (ascending), in that order.
   void halo_keep(size_t kept);
+  // Springs across ranks (cpu_halo_springs.cpp). Outside a substep's sorted part the spring
+  // lists name their partners by id. halo_gather_spring_partners (after the ghosts' arrival):
+  // the owned lists' ids become storage indices; each partner neither owned nor a ghost comes
+  // from its owner as a spring ghost (none: a sink removed it, and the spring is dropped, as a
+  // sink's removal drops it in the undivided world). halo_resolve_springs (after the sort): the
+  // partners follow the sort. halo_springs_to_ids (the substep's end, before the ghosts go): back
+  // to ids. halo_share_spring_candidates (linking, between its passes): each ghost takes its
+  // owner's candidates. halo_index_ids: halo_id_table_ from the particles held now.
+  void halo_gather_spring_partners(uint32_t owned);
+  void halo_resolve_springs();
+  void halo_springs_to_ids();
+  void halo_share_spring_candidates();
+  void halo_index_ids();
 
   std::shared_ptr<const RankTransport> ranks_;
   DistributedOptions distributed_options_;
@@ -301,6 +320,14 @@ class CpuBackend final : public Backend {
   int64_t halo_world_count_ = 0;    // the particles every rank owns, this substep
   CpuArrayRef<uint64_t> sort_key_;  // Carried
   CpuArrayRef<uint32_t> origin_;    // Sorted: 0 owned, else 1 + the rank the ghost came from
+                                    // (+ the rank count for a spring ghost)
+  // Springs: the held particles' ids to their indices, the partners waiting for spring ghosts
+  // (kSpringSlots ids per owned particle), the sort's inverse permutation; whether the owned
+  // lists hold storage indices (from the gather to the substep's end) or ids.
+  CpuIdTable halo_id_table_;
+  HostVector<uint32_t> halo_missing_;
+  HostVector<uint32_t> halo_inverse_;
+  bool halo_springs_indexed_ = false;
 
   WorldConfig config_;
   CpuParallel workers_;  // OpenMP's, or the engine's task system (cpu_parallel.h)

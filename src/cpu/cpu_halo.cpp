@@ -5,7 +5,9 @@
 //   before the sort   particles that left the slab migrate to their owner (every carried
 //                     array), the ghosts arrive (the owned particles of the cell layer beside
 //                     the slab), the world's grid shape is reduced from every rank's extent;
-//   after the sort    each particle's key becomes its slot and place in the slot;
+//   after the sort    each particle's key becomes its slot and place in the slot (springs: the
+//                     lists' partners, ids until the ghosts came, follow the sort;
+//                     cpu_halo_springs.cpp);
 //   after density     the ghosts take their owners' density, pressure and neighbour count
 //                     (the force pass reads them), again after the normalised density's filter
 //                     and the diffusion, and their colour normals after that pass;
@@ -37,24 +39,12 @@ namespace {
 
 constexpr const char* kArrayOrigin = "distributed_origin";
 
-void refuse(const std::string& what) {
-  throw Error(Status::Unsupported, "world: " + what +
-                                       " does not work in a distributed world yet (docs/distributed.md lists "
-                                       "what does)");
-}
-
 }  // namespace
 
 void CpuBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks, const DistributedOptions& options) {
   if (!ranks) throw Error(Status::Internal, "attach_ranks: no transport");
   if (count_ != 0 || ranks_)
     throw Error(Status::Internal, "attach_ranks: the backend already holds particles");
-  const struct {
-    uint32_t bit;
-    const char* name;
-  } features[] = {{kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks)"}};
-  for (const auto& f : features)
-    if (config_.features & f.bit) refuse(f.name);
   const auto array = [](const char* name, uint32_t size, ParticleArrayRole role) {
     return ParticleArraySpec{name, size, role, 1, nullptr, nullptr};
   };
@@ -64,6 +54,9 @@ void CpuBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks, const 
   distributed_options_ = options;
   slabs_ = SlabDecomposition(ranks->size());
   ranks_ = std::move(ranks);
+  // Springs across ranks (cpu_halo_springs.cpp): the lists name their partners by id through the
+  // halo's steps, so no reorder may rewrite them as storage indices.
+  if (springs_) springs_.array()->spec.rewrite_indices = nullptr;
 }
 
 DistributedCounters CpuBackend::distributed_counters() const {
@@ -186,6 +179,9 @@ void CpuBackend::halo_gather() {
   }
   in = t.exchange(out);  // (an agreement: the migrants' arrival, the ghosts' packing)
   for (int r = 0; r < size; ++r) halo_unpack(in[static_cast<size_t>(r)], static_cast<uint32_t>(r) + 1u);
+  // Springs: the owned lists' partner ids to indices, the partners held nowhere here as spring
+  // ghosts (cpu_halo_springs.cpp).
+  if (springs_) halo_gather_spring_partners(owned);
   halo_counters_.ghosts = count_ - owned;
   // The world's grid: the extent and count of every rank's owned particles (what the undivided
   // world's grid sees).
@@ -205,6 +201,13 @@ void CpuBackend::halo_gather() {
   t.all_max(hi, 3);
   t.all_sum(&total, 1);
   halo_world_count_ = total;
+  if (link_from_) {
+    // The lowest id that waits for springs, over the ranks: every rank links in the same substep
+    // (the linking exchanges its candidates), as the undivided world, whose word is the minimum.
+    int64_t from = link_from_[0];
+    t.all_min(&from, 1);
+    link_from_[0] = static_cast<uint32_t>(from);
+  }
   const bool any = total > 0;
   const CellCoord clo =
       any ? CellCoord{static_cast<int32_t>(lo[0]), static_cast<int32_t>(lo[1]), static_cast<int32_t>(lo[2])}
@@ -228,6 +231,7 @@ void CpuBackend::halo_keys() {
   for (uint32_t c = 0; c < view.shape.cell_count; ++c)
     for (uint32_t i = view.cell_start[c]; i < view.cell_start[c + 1]; ++i)
       key[i] = (static_cast<uint64_t>(c) << 32) | (i - view.cell_start[c]);
+  if (springs_) halo_resolve_springs();  // the spring lists' partners follow the sort
 }
 
 void CpuBackend::halo_share_density() {
@@ -261,6 +265,7 @@ void CpuBackend::halo_share_normals() {
 }
 
 uint32_t CpuBackend::halo_end_substep(uint32_t bad_id) {
+  if (springs_) halo_springs_to_ids();  // before the ghosts go, whose indices the lists hold
   keep_order_.clear();
   for (uint32_t i = 0; i < count_; ++i)
     if (!ghost(i)) keep_order_.push_back(i);

@@ -33,7 +33,7 @@ void CpuBackend::halo_share(const char* what, Make&& make, Apply&& apply) {
   const std::vector<RankBytes> in = t.exchange(out);
   std::vector<size_t> read(static_cast<size_t>(size), 0);
   for (uint32_t i = 0; i < count_; ++i) {
-    if (!ghost(i)) continue;
+    if (!ghost(i) || spring_ghost(i)) continue;  // (a spring ghost is no neighbour: no record)
     const size_t from = origin_[i] - 1u;
     Record r;
     if ((read[from] + 1) * sizeof r > in[from].size())

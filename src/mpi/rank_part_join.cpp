@@ -24,12 +24,16 @@ bool same_world(const WorldConfig& a, const WorldConfig& b) {
          std::memcmp(&a.particle_mass, &b.particle_mass, sizeof(float)) == 0;
 }
 
+// A carried array of one element per world, not per particle (springs' lowest waiting id).
+bool world_word(const CarriedArray& a) { return a.name == kArraySpringLinkFrom; }
+
 void drop_particles(ParticleSnapshot& s) {
   s.position.clear();
   s.velocity.clear();
   s.id.clear();
   s.density.clear();
-  for (CarriedArray& a : s.carried) a.bytes.clear();
+  for (CarriedArray& a : s.carried)
+    if (!world_word(a)) a.bytes.clear();
 }
 
 template <class T>
@@ -56,8 +60,6 @@ RankFileBlock rank_file_block(uint32_t saved, int rank, int ranks) {
 }
 
 void join_rank_parts(CheckpointPart& into, bool keep_own, const std::vector<CheckpointPart>& others) {
-  if (into.config.features & kFeatureSprings)
-    throw Error(Status::Unsupported, "springs: a distributed world has none to load on another rank count");
   ParticleSnapshot& s = into.particles;
   if (!keep_own) {
     drop_particles(s);
@@ -76,6 +78,17 @@ void join_rank_parts(CheckpointPart& into, bool keep_own, const std::vector<Chec
     if (p.carried.size() != s.carried.size()) corrupt("they carry different per-particle arrays");
     for (CarriedArray& a : s.carried) {
       const CarriedArray* b = p.find(a.name.c_str());
+      if (world_word(a)) {
+        // Springs' lowest waiting id: the smallest of the parts (the ranks reduce it again at the
+        // next substep; spring lists name partners by id, so they join as they are).
+        uint32_t mine = 0, theirs = 0;
+        if (!b || a.bytes.size() != sizeof mine || b->bytes.size() != sizeof theirs)
+          corrupt("they carry different per-world words ('" + a.name + "')");
+        std::memcpy(&mine, a.bytes.data(), sizeof mine);
+        std::memcpy(&theirs, b->bytes.data(), sizeof theirs);
+        if (theirs < mine) std::memcpy(a.bytes.data(), &theirs, sizeof theirs);
+        continue;
+      }
       if (!b || b->element_size != a.element_size || b->bytes.size() != p.id.size() * b->element_size)
         corrupt("they carry different per-particle arrays ('" + a.name + "')");
       a.bytes.insert(a.bytes.end(), b->bytes.begin(), b->bytes.end());

@@ -26,8 +26,9 @@ RankFileBlock rank_file_block(uint32_t saved, int rank, int ranks);
 // Joins `others` (parts of the same save) into `into`: their particles (every carried array,
 // the sort keys) after its own, or instead of them unless keep_own; the last frame's removed
 // ids and sink-removal counts likewise; the capacity raised to the particles' count. Throws
-// CorruptData for parts of different worlds or a duplicate id, Capacity past max_capacity,
-// Unsupported for springs (no distributed world has them).
+// CorruptData for parts of different worlds or a duplicate id, Capacity past max_capacity.
+// Springs join as they are (their lists name partners by id); their lowest waiting id is the
+// parts' smallest.
 void join_rank_parts(CheckpointPart& into, bool keep_own, const std::vector<CheckpointPart>& others);
 
 }  // namespace sph

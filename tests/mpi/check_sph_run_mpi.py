@@ -3,7 +3,7 @@
 """sph-run-mpi under mpirun against sph-run (ctest label mpi; issue 19).
 
     check_sph_run_mpi.py MPIEXEC SPH_RUN SPH_RUN_MPI SCENE WORKDIR RANKS [--refusals] [--interrupt]
-                         [--backend cuda]
+                         [--backend cuda] [--vdb COMPARE_VDB_FRAMES]
 
 Runs SCENE with sph-run (libsph, one undivided world) and with RANKS ranks of sph-run-mpi
 (libsph_mpi), both as CSV frames with --stats-json, and asserts that every frame of the merged
@@ -19,13 +19,22 @@ differently (tests/mpi/test_mpi_scene_sums.c measured ~1e-8). The --stats-json d
 on the frames, substeps, particle counts, time steps and top speed exactly, and on the mean
 neighbour count within 1e-5 (the ranks' means weighted by their particles: another summation
 order). Also that the --per-rank files of each frame hold every particle once, each as the
-merged frame has it, and (--refusals) that sph-run-mpi refuses a scene with springs, naming it,
-and that --backend cuda either runs (a GPU is there) or fails on every rank with exit code 4
-and one message naming the option (CI: no GPU).
+merged frame has it, and (--refusals) that --backend cuda either runs (a GPU is there) or fails on every rank with exit code 4
+and one message naming the option (CI: no GPU); then the scene with springs, whose merged frames
+equal sph-run's bit for bit on CPU ranks (springs across ranks), and which CUDA ranks refuse
+(exit 3, naming SPH_FEATURE_SPRINGS).
 --interrupt: SIGINT to one rank alone (not rank 0 as a rule) once frame 1 is complete: every
 rank stops after the same frame (they agree once before and once after each step), exit code
 130, the manifests end "interrupted" at that frame, whose files (and the probes' rows) are all
 there.
+--vdb COMPARE_VDB_FRAMES (builds with OpenVDB): both programs also write vdb frames and surfaces
+(--format csv,vdb --surface), and every merged vdb file equals sph-run's as compare_vdb_frames reads
+it: the points by id (voxel, position in it, v, density) and the level sets voxel for voxel, bit for
+bit; the surface meshes (.obj) byte for byte. Then the scene with a .vdb shape (sph-run's first
+surface, moved into the column's edge) as a collider, which sph-run-mpi loads through libsph_vdb_mpi:
+the merged frames equal sph-run's bit for bit (by frame 3, 470 of the 560 particles are elsewhere
+than without the collider: measured once, 2026-12-03). The same particles give the same level set in any
+order (ParticlesToLevelSet's union of spheres is a minimum, which rounds nothing), so no tolerance.
 --backend cuda: both programs on the CUDA backend (scripts/gpu-test), the whole scene (CUDA ranks
 run its sink, probes, source and loads since session 15), checked as above: the distributed CUDA
 world against the undivided CUDA world, bit for bit while the tables cover the tank
@@ -114,6 +123,51 @@ def check_stats(single, merged, ranks):
           f"(at most {b['particles_max']}), {b['migrated']} migrated: as sph-run's")
 
 
+def check_vdb(compare_vdb, single, merged, frames):
+    """The merged vdb frames and surfaces equal sph-run's (compare_vdb_frames), the meshes byte for byte;
+    each rank's folder holds its own particles' vdb frames and no surface."""
+    names = sorted(os.path.basename(f) for f in glob.glob(os.path.join(single, "fluid_*.vdb")) +
+                   glob.glob(os.path.join(single, "surface_*.vdb")))
+    got = sorted(os.path.basename(f) for f in glob.glob(os.path.join(merged, "fluid_*.vdb")) +
+                 glob.glob(os.path.join(merged, "surface_*.vdb")))
+    assert names == got and len(names) == 2 * frames, f"sph-run wrote {names}, sph-run-mpi {got}"
+    for name in names:
+        p = subprocess.run([compare_vdb, os.path.join(single, name), os.path.join(merged, name)],
+                           capture_output=True, text=True, timeout=60)
+        assert p.returncode == 0, f"{name}: {p.stdout}{p.stderr}"
+        last = p.stdout.strip()
+    for obj in sorted(glob.glob(os.path.join(single, "surface_*.obj"))):
+        with open(obj, "rb") as f, open(os.path.join(merged, os.path.basename(obj)), "rb") as g:
+            assert f.read() == g.read(), f"{os.path.basename(obj)} differs from sph-run's"
+    for d in sorted(glob.glob(os.path.join(merged, "rank*"))):
+        assert len(glob.glob(os.path.join(d, "fluid_*.vdb"))) == frames, f"{d}: not {frames} vdb frames"
+        assert not glob.glob(os.path.join(d, "surface_*")), f"{d}: a rank's surface"
+    print(f"{len(names)} vdb files (points and surfaces) and {frames} meshes equal sph-run's bit for bit "
+          f"(last: {last})")
+
+
+def check_vdb_shape(mpiexec, sph_run, sph_run_mpi, scene, work, ranks):
+    """A .vdb shape (sph-run's first surface, the column's, moved 0.18 m along x into the column's edge) as a
+    collider: sph-run-mpi loads it (libsph_vdb_mpi) and its merged frames equal sph-run's bit for bit."""
+    with open(scene, encoding="utf-8") as f:
+        doc = json.load(f)
+    level_set = os.path.abspath(os.path.join(work, "single", "surface_0000.vdb"))
+    doc["colliders"].append({"name": "vdb block", "shape": {"type": "vdb", "file": level_set},
+                             "transform": {"position": [0.18, 0.0, 0.0]}})
+    with_vdb = os.path.join(work, "with_vdb_shape.json")
+    with open(with_vdb, "w", encoding="utf-8") as f:
+        json.dump(doc, f)
+    single, merged = os.path.join(work, "vdb_shape_single"), os.path.join(work, "vdb_shape_np" + ranks)
+    common = ["--format", "csv", "--frames", "3", "--threads", "1", "--quiet"]
+    run([sph_run, with_vdb, "--backend", "cpu", *common, "--out", single])
+    run([mpiexec, "--oversubscribe", "-np", ranks, sph_run_mpi, with_vdb, "--backend", "cpu", *common, "--out", merged])
+    frames = sorted(os.path.basename(f) for f in glob.glob(os.path.join(single, "fluid_*.csv")))
+    assert len(frames) == 4, f"sph-run wrote {frames}"
+    for name in frames:
+        assert rows(os.path.join(single, name)) == rows(os.path.join(merged, name)), f"vdb shape: {name} differs"
+    print(f"a .vdb shape as a collider: {len(frames)} frames on {ranks} ranks == sph-run, bit for bit")
+
+
 def manifest_end(directory):
     path = os.path.join(directory, "sph-run-manifest.jsonl")
     if not os.path.exists(path):
@@ -186,10 +240,12 @@ def main(argv):
     backend = options[options.index("--backend") + 1] if "--backend" in options else "cpu"
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
+    compare_vdb = options[options.index("--vdb") + 1] if "--vdb" in options else None
+    outputs = ["--format", "csv,vdb", "--surface"] if compare_vdb else ["--format", "csv"]
     single, merged = os.path.join(work, "single"), os.path.join(work, "np" + ranks)
-    run([sph_run, scene, "--backend", backend, "--format", "csv", "--threads", "1", "--quiet", "--out", single,
+    run([sph_run, scene, "--backend", backend, *outputs, "--threads", "1", "--quiet", "--out", single,
          "--stats-json", single + ".json"])
-    p = run([mpiexec, "--oversubscribe", "-np", ranks, sph_run_mpi, scene, "--backend", backend, "--format", "csv",
+    p = run([mpiexec, "--oversubscribe", "-np", ranks, sph_run_mpi, scene, "--backend", backend, *outputs,
              "--threads", "1", "--quiet", "--per-rank", "--out", merged, "--stats-json", merged + ".json"])
     print(p.stdout.strip())
 
@@ -229,6 +285,9 @@ def main(argv):
           f"{len(emitting)} ranks): sph-run-mpi on {ranks} ranks == sph-run, bit for bit ({backend} backend)")
     check_object_files(single, merged)
     check_stats(single + ".json", merged + ".json", int(ranks))
+    if compare_vdb:
+        check_vdb(compare_vdb, single, merged, len(frames))
+        check_vdb_shape(mpiexec, sph_run, sph_run_mpi, scene, work, ranks)
     if "--interrupt" in options:
         check_interrupt(mpiexec, sph_run_mpi, scene, work, ranks, backend)
     if "--refusals" not in options:
@@ -246,19 +305,40 @@ def main(argv):
         assert p.returncode == 0, f"--backend cuda exited {p.returncode}\n{p.stderr}"
         print("--backend cuda: exit 0 (a GPU is here)")
 
+    check_springs(mpiexec, sph_run, sph_run_mpi, scene, work, ranks, backend)
+    return 0
+
+
+def check_springs(mpiexec, sph_run, sph_run_mpi, scene, work, ranks, backend):
+    """The scene with springs: on CPU ranks (since wt-springrank) every merged frame equals sph-run's bit
+    for bit, springs crossing the slabs; CUDA ranks refuse the world, naming the feature (exit 3)."""
     with open(scene, encoding="utf-8") as f:
         text = f.read()
-    # Springs: the library refuses the world (sph_mpi_world_create) and names the feature (RK4,
-    # refused here before, works distributed since wt-mpisolve, on CUDA ranks since session 15).
-    bad_scene = os.path.join(work, "with_springs.json")
-    with open(bad_scene, "w", encoding="utf-8") as f:
+    springs = os.path.join(work, "with_springs.json")
+    with open(springs, "w", encoding="utf-8") as f:
         f.write(text.replace('"capacity": 4000', '"capacity": 4000, "features": ["springs"]', 1))
-    p = run([mpiexec, "--oversubscribe", "-np", ranks, sph_run_mpi, bad_scene, "--quiet", "--out",
-             os.path.join(work, "refused")], expect=3)
-    assert "world" in p.stderr and "SPH_FEATURE_SPRINGS" in p.stderr, p.stderr
-    assert p.stderr.count("sph-run-mpi:") == 1, f"one message, from rank 0:\n{p.stderr}"
-    print("refused:", p.stderr.strip().splitlines()[0])
-    return 0
+    out = os.path.join(work, "springs_np" + ranks)
+    if backend == "cuda":
+        p = run([mpiexec, "--oversubscribe", "-np", ranks, sph_run_mpi, springs, "--backend", "cuda", "--quiet",
+                 "--out", out], expect=3)
+        assert "world" in p.stderr and "SPH_FEATURE_SPRINGS" in p.stderr, p.stderr
+        assert p.stderr.count("sph-run-mpi:") == 1, f"one message, from rank 0:\n{p.stderr}"
+        print("springs on CUDA ranks refused:", p.stderr.strip().splitlines()[0])
+        return
+    single = os.path.join(work, "springs_single")
+    run([sph_run, springs, "--backend", "cpu", "--format", "csv", "--threads", "1", "--quiet", "--out", single])
+    run([mpiexec, "--oversubscribe", "-np", ranks, sph_run_mpi, springs, "--backend", "cpu", "--format", "csv",
+         "--threads", "1", "--quiet", "--out", out])
+    frames = sorted(os.path.basename(f) for f in glob.glob(os.path.join(single, "fluid_*.csv")))
+    assert len(frames) >= 2, f"sph-run wrote {frames}"
+    for name in frames:
+        _, a = rows(os.path.join(single, name))
+        _, b = rows(os.path.join(out, name))
+        bad = [k for k in a if a[k] != b.get(k)]
+        assert a.keys() == b.keys() and not bad, (f"springs: {name}: {len(bad)} of {len(a)} particles differ from "
+                                                  f"sph-run's" + (f"; id {bad[0]}: {a[bad[0]]} vs {b.get(bad[0])}"
+                                                                  if bad else ""))
+    print(f"springs: {len(frames)} frames of {len(a)} particles on {ranks} ranks == sph-run, bit for bit")
 
 
 if __name__ == "__main__":

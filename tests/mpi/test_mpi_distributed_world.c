@@ -181,26 +181,13 @@ static void run_scene(sph_context* context, const char* name, float stir_speed, 
   free(got_id);
 }
 
-/* A def that does not work distributed yet: refused with UNSUPPORTED, the message naming `name`. */
-static void expect_refused(sph_context* context, const sph_world_def* def, const char* name) {
-  sph_world* world = NULL;
-  const sph_result r =
-      sph_mpi_world_create(context, def, (int32_t)MPI_Comm_c2f(MPI_COMM_WORLD), NULL, &world);
-  CHECK(r == SPH_ERROR_UNSUPPORTED && world == NULL, "%s: %d", name, (int)r);
-  CHECK(strstr(sph_get_last_error(), name) != NULL, "the message names %s: %s", name, sph_get_last_error());
-  if (world) sph_world_destroy(world);
-}
-
-/* What does not work distributed yet is refused, naming the feature. */
+/* What does not work distributed is refused (springs work since wt-springrank: test_mpi_springs.c). */
 static void check_refusals(sph_context* context) {
   sph_world_def def;
   sph_world* world = NULL;
   sph_spawn_desc spawn;
   const float p[3] = {0.05f, 0.05f, 0.03f};
   const int32_t comm = (int32_t)MPI_Comm_c2f(MPI_COMM_WORLD);
-  mpi_test_world_def(&def);
-  def.features = SPH_FEATURE_SPRINGS;
-  expect_refused(context, &def, "SPH_FEATURE_SPRINGS");
   mpi_test_world_def(&def);
   REQUIRE(sph_mpi_world_create(context, &def, comm, NULL, &world) == SPH_OK, "world");
   REQUIRE(sph_spawn_desc_init(&spawn) == SPH_OK, "spawn init");

@@ -48,8 +48,9 @@ void check_rank_named(int culprit, const char* what) {
         sph_get_last_error());
 }
 
-// An allocation failure at each allocation of the last rank's step in turn.
-void allocation_failures(sph_context* context) {
+// An allocation failure at each allocation of the last rank's step in turn (with springs: their
+// linking, spring ghosts and the lists' ids through the rollback too).
+void allocation_failures(sph_context* context, uint32_t features, const char* name) {
   sph_world_def def;
   sph_world* world = NULL;
   sph_world* undisturbed = NULL;
@@ -57,6 +58,7 @@ void allocation_failures(sph_context* context) {
   long k = 0;
   const int victim = g_size - 1;
   mpi_test_world_def(&def);
+  def.features = features;
   def.particle_spacing = 0.02f;  // 150 particles: a step per allocation point
   def.kernel_radius = 0.036f;
   mpi_test_dam(context, &def, 2.0f, NULL, NULL, &world, &n);
@@ -98,9 +100,10 @@ void allocation_failures(sph_context* context) {
       CHECK(differ == 0, "after the failures, %u of %u particles differ from the undisturbed world", differ,
             n);
       printf(
-          "allocation failures on rank %d of %d: %ld allocation points of a %u-substep step failed in turn, "
+          "%s: allocation failures on rank %d of %d: %ld allocation points of a %u-substep step failed in "
+          "turn, "
           "each on every rank; then %u particles differ from the undisturbed world\n",
-          victim, g_size, k, kSubsteps, differ);
+          name, victim, g_size, k, kSubsteps, differ);
     }
     free(x0);
     free(v0);
@@ -156,7 +159,8 @@ void crowded_cell(sph_context* context) {
 int main(int argc, char** argv) {
   sph_context* context = NULL;
   mpi_test_init(&argc, &argv, &context);
-  allocation_failures(context);
+  allocation_failures(context, SPH_FEATURE_NONE, "the stirred column");
+  allocation_failures(context, SPH_FEATURE_SPRINGS, "the stirred column with springs");
   crowded_cell(context);
   return mpi_test_finish(context, "mpi rank failures");
 }

@@ -19,11 +19,13 @@
 #include "frame_writer.h"
 #include "image.h"
 #include "library_error.h"
+#include "output_options.h"
 #include "ranks.h"
 #include "run_frames.h"
 #include "scene_error.h"
 #include "scene_parser.h"
 #include "sph_mpi.h"
+#include "vdb_bounds.h"
 
 namespace sph_tools {
 namespace {
@@ -38,7 +40,8 @@ const char* const kMpiUsage =
     "                      where there is no such GPU; the host-staged halo); auto and cpu: the CPU\n"
     "Rank 0 writes the probes' and loads' CSV files and --stats-json (the world's figures).\n"
     "Ctrl-C (SIGINT or SIGTERM on any rank) stops every rank after the same frame.\n"
-    "No OpenVDB outputs; the ranks refuse what docs/distributed.md lists (springs, ...).\n";
+    "The vdb frames and surfaces are the merged world's (rank<R>/ holds no surface); the ranks refuse\n"
+    "what docs/distributed.md lists.\n";
 
 struct ContextOwner {
   sph_context* context = nullptr;
@@ -82,32 +85,6 @@ sph_result create_context(const Ranks& ranks, const CliOptions& cli, sph_context
   return r;
 }
 
-std::string file_stem(const std::string& path) {
-  const size_t slash = path.find_last_of('/');
-  std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
-  const size_t dot = name.find_last_of('.');
-  return dot == std::string::npos || dot == 0 ? name : name.substr(0, dot);
-}
-
-// The output options as sph-run resolves them (command line over scene file over defaults),
-// in a build without OpenVDB. "" or what is wrong.
-std::string output_options(const CliOptions& cli, const SceneDesc& scene, FrameWriterOptions* out) {
-  out->directory = cli.out                           ? *cli.out
-                   : !scene.output.directory.empty() ? scene.output.directory
-                                                     : "out/" + file_stem(cli.scene);
-  out->formats = cli.formats                     ? *cli.formats
-                 : !scene.output.formats.empty() ? scene.output.formats
-                                                 : std::vector<OutputFormat>{OutputFormat::kPly};
-  for (OutputFormat f : out->formats)
-    if (!format_available(f))
-      return std::string("--format ") + format_extension(f) +
-             ": sph-run-mpi has no OpenVDB; use ply, csv or vtp";
-  if (cli.surface || scene.output.surface) return "surfaces need OpenVDB, which sph-run-mpi lacks";
-  out->preview = cli.preview || scene.output.preview;
-  if (out->preview && !png_available()) return "preview images need libpng, which this build lacks";
-  return "";
-}
-
 int run(const Ranks& ranks, int argc, char** argv) {
   // --per-rank is sph-run-mpi's own; the rest is sph-run's command line.
   bool per_rank = false;
@@ -126,7 +103,12 @@ int run(const Ranks& ranks, int argc, char** argv) {
   }
   if (cli.help || cli.version) {
     if (ranks.rank == 0 && cli.help) std::printf("%s%s", usage_text(), kMpiUsage);
-    if (ranks.rank == 0 && cli.version) std::printf("sph-run-mpi, %s\n", sph_get_build_info());
+    if (ranks.rank == 0 && cli.version) {
+      std::printf("sph-run-mpi, %s\n", sph_get_build_info());
+      std::printf(
+          "outputs: csv, ply, vtp (+ fluid.pvd)%s%s%s\n", format_available(OutputFormat::kVdb) ? ", vdb" : "",
+          surface_available() ? ", surfaces (vdb + obj)" : "", png_available() ? ", preview (png)" : "");
+    }
     return kExitOk;
   }
   SceneDesc scene;
@@ -136,9 +118,12 @@ int run(const Ranks& ranks, int argc, char** argv) {
     return fail(ranks, kExitScene, cli.scene + ": " + e.what());
   }
   if (cli.frames) scene.frames = *cli.frames;
+  fill_vdb_bounds(&scene);  // the extent of .vdb level sets, for the preview
+  // sph-run's outputs, vdb frames and surfaces included where the build has OpenVDB.
   FrameWriterOptions out;
-  const std::string unavailable = output_options(cli, scene, &out);
-  if (!unavailable.empty()) return fail(ranks, kExitUnavailable, unavailable);
+  std::string problem;
+  const int unavailable = resolve_output_options(cli, scene, &out, &problem);
+  if (unavailable != kExitOk) return fail(ranks, unavailable, problem);
 
   ContextOwner owner;
   const sph_result r = create_context(ranks, cli, &owner.context);

@@ -84,6 +84,8 @@ int run_frames(const Ranks& ranks, const CliOptions& cli, const SceneDesc& scene
       FrameWriterOptions mine = out;
       mine.directory = out.directory + "/rank" + std::to_string(ranks.rank);
       mine.preview = false;
+      // The surface is the merged world's alone: a rank's own would be cut open at its slab's faces.
+      mine.surface = false;
       own_writer = std::make_unique<FrameWriter>(mine, runtime, header);
     }
   } catch (const std::exception& e) {

@@ -239,10 +239,12 @@ static class MpiTests
     {
         using (var ctx = Cpu())
         {
+            // Springs run distributed on CPU ranks (they were refused, naming the feature).
             var springs = Def(100);
             springs.Features = (uint)FeatureFlags.Springs;
-            SphException e = Throws(Result.ErrorUnsupported, () => new DistributedWorld(ctx, Mpi.CommWorld, springs));
-            Assert(e.LibraryMessage.Contains("SPH_FEATURE_SPRINGS"), "the refused feature is named: " + e.LibraryMessage);
+            using (var springy = new DistributedWorld(ctx, Mpi.CommWorld, springs))
+            {
+            }
             var options = MpiWorldDef.Default();
             options.RebalanceThresholdPercent = 50;
             using (var world = new DistributedWorld(ctx, Mpi.CommWorld, Def(100), options))
