@@ -31,7 +31,9 @@
 // core/dfsph_jacobi_loop.h: the ghosts take their owners' densities and factors after the density
 // pass, velocities and pressure steps within each iteration, and the mean error is an exact sum
 // added over the ranks); attach_ranks refuses springs by name, the step DFSPH's conjugate
-// gradients (frame_loop.cu).
+// gradients (frame_loop.cu; the CPU rank runs them, src/cpu/cpu_dfsph_cg.cpp: the device solve's
+// kernels run in the device loop, its sums are block trees rather than exact, and the host
+// would have to drive each of its iterations as dfsph_jacobi_loop.h drives the Jacobi's).
 #include <cstring>
 #include <memory>
 #include <string>

@@ -94,10 +94,12 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
   if (config_.solver == Solver::Dfsph &&
       setup.fluid.methods.dfsph.linear_solver == kDfsphConjugateGradients &&
       (distributed() || (config_.features & (kFeatureBoundaryDensity | kFeatureColliderLoads))))
-    throw Error(Status::Unsupported,
-                "step: DFSPH's conjugate gradients solve (sph_dfsph_params.linear_solver = "
-                "SPH_DFSPH_CONJUGATE_GRADIENTS) does not work with a distributed world, "
-                "SPH_FEATURE_BOUNDARY_DENSITY or SPH_FEATURE_COLLIDER_LOADS yet; use SPH_DFSPH_JACOBI");
+    throw Error(
+        Status::Unsupported,
+        "step: DFSPH's conjugate gradients solve (sph_dfsph_params.linear_solver = "
+        "SPH_DFSPH_CONJUGATE_GRADIENTS) does not work with a distributed world on the CUDA backend "
+        "(the CPU backend's ranks run it), SPH_FEATURE_BOUNDARY_DENSITY or SPH_FEATURE_COLLIDER_LOADS "
+        "yet; use SPH_DFSPH_JACOBI");
   setup.limits = make_step_limits(config_, params);
   setup.max_substeps = params.stepping.max_substeps;
   setup.options = options_;

@@ -324,7 +324,8 @@ void mpi_cuda_sinks_case(const char* name, sph_context* cuda, sph_solver solver)
   sph_world_destroy(w.world);
 }
 
-/* DFSPH's conjugate gradients stay refused on a rank (both backends), when the parameters are set. */
+/* DFSPH's conjugate gradients stay refused on a CUDA rank (the CPU rank runs them, test_mpi_solvers.c),
+ * when the parameters are set. */
 void mpi_cuda_expect_cg_refused(sph_context* cuda) {
   sph_world_def def;
   sph_dfsph_params dfsph;
