@@ -5,7 +5,9 @@
 //     (the replaced operator new of tests/support/allocation_injector.h, armed on that rank
 //     only): every rank returns SPH_ERROR_OUT_OF_HOST_MEMORY (the others' messages name the
 //     failing rank) instead of waiting in MPI for it, every rank's world is as before the step
-//     (gathered bit for bit), and the world then steps on exactly as an undisturbed copy;
+//     (gathered bit for bit), and the world then steps on exactly as an undisturbed copy; again
+//     with DFSPH's density solve by conjugate gradients (the allocations of its exchanges inside
+//     each iteration, followed by the reductions of its sums);
 //   - a crowded cell (700 particles in one cell, more than the 528 one may hold) on whichever
 //     rank owns it, and the ranks holding it as ghosts: every rank returns SPH_ERROR_CAPACITY and
 //     the world is unchanged.
@@ -48,8 +50,10 @@ void check_rank_named(int culprit, const char* what) {
         sph_get_last_error());
 }
 
-// An allocation failure at each allocation of the last rank's step in turn.
-void allocation_failures(sph_context* context) {
+// An allocation failure at each allocation of the last rank's step in turn; with `cg`, a DFSPH
+// world whose density solve runs by conjugate gradients (its exchanges of the search directions
+// and velocity steps and its sums' reductions inside each iteration).
+void allocation_failures(sph_context* context, bool cg) {
   sph_world_def def;
   sph_world* world = NULL;
   sph_world* undisturbed = NULL;
@@ -59,10 +63,20 @@ void allocation_failures(sph_context* context) {
   mpi_test_world_def(&def);
   def.particle_spacing = 0.02f;  // 150 particles: a step per allocation point
   def.kernel_radius = 0.036f;
+  if (cg) def.solver = SPH_SOLVER_DFSPH;
   mpi_test_dam(context, &def, 2.0f, NULL, NULL, &world, &n);
   mpi_test_dam(context, &def, 2.0f, NULL, NULL, &undisturbed, &n);
   set_substeps(world);
   set_substeps(undisturbed);
+  if (cg) {
+    sph_dfsph_params dfsph;
+    REQUIRE(sph_dfsph_params_init(&dfsph) == SPH_OK, "dfsph params init");
+    dfsph.linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS;
+    dfsph.density_error = 1e-5f;  // (iterations past the minimum: the loop's exchanges and sums)
+    REQUIRE(sph_world_set_dfsph_params(world, &dfsph) == SPH_OK &&
+                sph_world_set_dfsph_params(undisturbed, &dfsph) == SPH_OK,
+            "dfsph params: %s", sph_get_last_error());
+  }
   for (k = 0; k < 100000; ++k) {
     float *x0 = NULL, *v0 = NULL, *x1 = NULL, *v1 = NULL;
     bool injected = false;
@@ -98,9 +112,9 @@ void allocation_failures(sph_context* context) {
       CHECK(differ == 0, "after the failures, %u of %u particles differ from the undisturbed world", differ,
             n);
       printf(
-          "allocation failures on rank %d of %d: %ld allocation points of a %u-substep step failed in turn, "
-          "each on every rank; then %u particles differ from the undisturbed world\n",
-          victim, g_size, k, kSubsteps, differ);
+          "allocation failures on rank %d of %d%s: %ld allocation points of a %u-substep step failed in "
+          "turn, each on every rank; then %u particles differ from the undisturbed world\n",
+          victim, g_size, cg ? " (DFSPH, conjugate gradients)" : "", k, kSubsteps, differ);
     }
     free(x0);
     free(v0);
@@ -156,7 +170,8 @@ void crowded_cell(sph_context* context) {
 int main(int argc, char** argv) {
   sph_context* context = NULL;
   mpi_test_init(&argc, &argv, &context);
-  allocation_failures(context);
+  allocation_failures(context, false);
+  allocation_failures(context, true);
   crowded_cell(context);
   return mpi_test_finish(context, "mpi rank failures");
 }
