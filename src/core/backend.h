@@ -130,9 +130,6 @@ class Backend {
   virtual void restore_distributed_state(const DistributedState&) {
     throw Error(Status::Internal, "restore_distributed_state: not a distributed world");
   }
-  // Whether DFSPH's density solve by conjugate gradients runs on this backend's ranks (the CPU
-  // rank's does; capi/dfsph_solver_check.h refuses it on the others).
-  virtual bool distributed_dfsph_cg() const { return false; }
   // Call at the end of the catch block of a step: rethrows the exception being handled. In a
   // distributed world, a failure of this rank alone first meets the other ranks at their next
   // agreement, so that they fail too instead of waiting for it (core/rank_agreement.h).

@@ -83,7 +83,6 @@ class CpuBackend final : public Backend {
   DistributedState distributed_state() const override;
   void restore_distributed_state(const DistributedState& state) override;
   void rethrow_step_failure() const override;
-  bool distributed_dfsph_cg() const override { return true; }
 
   uint64_t memory_bytes() const override {
     return store_.bytes() + grid_.bytes() + columns_.bytes() + boundary_maps_.bytes();
