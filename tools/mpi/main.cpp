@@ -159,7 +159,8 @@ int run(const Ranks& ranks, int argc, char** argv) {
     return fail(ranks, kExitScene, cli.scene + ": " + e.what());
   } catch (const LibraryError& e) {
     // A feature the ranks refuse after the world's creation (DFSPH's conjugate gradients with the
-    // walls' density or the loads, on every rank alike): a scene this program cannot run, as the world's own refusals are.
+    // walls' density or the loads, on every rank alike): a scene this program cannot run, as the world's own
+    // refusals are.
     return fail(ranks, e.code() == SPH_ERROR_UNSUPPORTED ? kExitScene : kExitRuntime, e.what());
   }
 }
