@@ -206,6 +206,8 @@ class CudaBackend final : public Backend {
   void halo_share_velocities(Float4* v, cudaStream_t stream);
   void halo_share_dfsph_steps(cudaStream_t stream);
   DfsphErrors halo_dfsph_errors(bool divergence, cudaStream_t stream);
+  // The conjugate gradients' sums and maxima over the world (DfsphRankSteps::cg_world).
+  int64_t halo_dfsph_cg_world(int sums, double* values, int maxima, float* largest, cudaStream_t stream);
   // Probes: each sample point's gather becomes its owner rank's (core/rank_probe_points.h).
   void halo_pick_probe_points(const DeviceProbes& probes, cudaStream_t stream);
   // The ghosts take their owners' records (DeviceHalo::pack_records / enqueue_apply_records) of

@@ -30,8 +30,11 @@
 // or DFSPH's Jacobi solves (the host drives each solve an iteration at a time,
 // core/dfsph_jacobi_loop.h: the ghosts take their owners' densities and factors after the density
 // pass, velocities and pressure steps within each iteration, and the mean error is an exact sum
-// added over the ranks); attach_ranks refuses springs by name (the CPU rank runs them:
-// src/cpu/cpu_halo_springs.cpp), the step DFSPH's conjugate gradients (frame_loop.cu).
+// added over the ranks) and its density solve by conjugate gradients (the host drives it as the
+// CPU rank's loop, dfsph_cg_solver.cu's enqueue_dfsph_cg_rank_solve: the ghosts take their owners'
+// search directions and velocity steps within each iteration, its sums are exact sums added over
+// the ranks, halo_dfsph_cg_world); attach_ranks refuses springs by name (the CPU rank runs them:
+// src/cpu/cpu_halo_springs.cpp).
 #include <cstring>
 #include <memory>
 #include <string>
@@ -331,7 +334,7 @@ void CudaBackend::halo_share_dfsph_steps(cudaStream_t stream) {
 // bits on every rank, whichever particles each holds.
 DfsphErrors CudaBackend::halo_dfsph_errors(bool divergence, cudaStream_t stream) {
   ExactFloatSum sum;
-  const int64_t* words = r_->halo->download_error_bins(stream);
+  const int64_t* words = r_->halo->download_error_bins(stream, kDfsphRankErrorWords);
   std::memcpy(sum.terms(), words, sizeof(int64_t) * ExactFloatSum::kTerms);
   const uint32_t largest_bits = static_cast<uint32_t>(static_cast<uint64_t>(words[ExactFloatSum::kTerms]));
   float largest = 0.0f;
@@ -341,6 +344,31 @@ DfsphErrors CudaBackend::halo_dfsph_errors(bool divergence, cudaStream_t stream)
   if (!divergence) ranks_->all_max(&largest, 1);
   const int64_t particles = halo_world_count_;
   return {particles > 0 ? static_cast<float>(sum.value() / static_cast<double>(particles)) : 0.0f, largest};
+}
+
+// As the CPU rank's (CpuBackend::dfsph_cg_world): the rank's exact bins of each sum added over the
+// ranks, its maxima the ranks' largest, after an agreement; the same bits on every rank.
+int64_t CudaBackend::halo_dfsph_cg_world(int sums, double* values, int maxima, float* largest,
+                                         cudaStream_t stream) {
+  constexpr int kTerms = ExactFloatSum::kTerms;
+  if (sums > 3 || maxima > 2) throw Error(Status::Internal, "halo: more DFSPH sums than the bins hold");
+  const int64_t* words = r_->halo->download_error_bins(stream, kDfsphRankCgWords);
+  ExactFloatSum sum[3];
+  for (int s = 0; s < sums; ++s) std::memcpy(sum[s].terms(), words + s * kTerms, sizeof(int64_t) * kTerms);
+  for (int m = 0; m < maxima; ++m) {
+    const uint32_t bits = static_cast<uint32_t>(static_cast<uint64_t>(words[kDfsphRankCgMaxima + m]));
+    std::memcpy(&largest[m], &bits, sizeof bits);
+  }
+  int64_t bins[3 * kTerms];  // (on the stack: no allocation between the agreement and the sum)
+  for (int s = 0; s < sums; ++s) std::memcpy(bins + s * kTerms, sum[s].terms(), sizeof(int64_t) * kTerms);
+  halo_agree();  // (the refreshes' buffers: a rank that failed there meets the others here)
+  ranks_->all_sum(bins, sums * kTerms);
+  if (maxima > 0) ranks_->all_max(largest, maxima);
+  for (int s = 0; s < sums; ++s) {
+    std::memcpy(sum[s].terms(), bins + s * kTerms, sizeof(int64_t) * kTerms);
+    values[s] = sum[s].value();
+  }
+  return halo_world_count_;
 }
 
 // The points' gathers through the host: down, the owners' picked (the CPU rank's rule), up.

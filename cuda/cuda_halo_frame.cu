@@ -77,6 +77,9 @@ class CudaBackend::HaloHooks final : public SubstepHooks {
   DfsphErrors errors(bool divergence, cudaStream_t stream) override {
     return b_.halo_dfsph_errors(divergence, stream);
   }
+  int64_t cg_world(int sums, double* values, int maxima, float* largest, cudaStream_t stream) override {
+    return b_.halo_dfsph_cg_world(sums, values, maxima, largest, stream);
+  }
 
  private:
   CudaBackend& b_;

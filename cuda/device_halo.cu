@@ -148,8 +148,8 @@ DeviceHalo::DeviceHalo(uint32_t capacity, int ranks) : capacity_(capacity), rank
   visit_.allocate(n, "halo visit order");
   sorted_keys_.allocate(n, "halo sorted keys");
   mismatch_.allocate(1, "halo id check");
-  error_bins_.allocate(kDfsphRankErrorWords, "halo DFSPH error bins");
-  host_error_bins_.allocate(kDfsphRankErrorWords, "halo DFSPH error bins (host)");
+  error_bins_.allocate(kDfsphRankCgWords, "halo DFSPH error bins");
+  host_error_bins_.allocate(kDfsphRankCgWords, "halo DFSPH error bins (host)");
   host_cuts_.allocate(static_cast<size_t>(std::max(ranks - 1, 1)), "halo slab cuts (host)");
   host_words_.allocate(words, "halo list starts (host)");
   std::fill(host_words_.get(), host_words_.get() + words, 0u);
@@ -298,9 +298,10 @@ SPH_HALO_RECORD(HaloVelocityRecord)
 SPH_HALO_RECORD(HaloDfsphStepRecord)
 #undef SPH_HALO_RECORD
 
-const int64_t* DeviceHalo::download_error_bins(cudaStream_t stream) {
-  cuda_check(cudaMemcpyAsync(host_error_bins_.get(), error_bins_.get(),
-                             sizeof(int64_t) * kDfsphRankErrorWords, cudaMemcpyDeviceToHost, stream),
+const int64_t* DeviceHalo::download_error_bins(cudaStream_t stream, uint32_t words) {
+  if (words > kDfsphRankCgWords) throw Error(Status::Internal, "halo: more DFSPH error words than allocated");
+  cuda_check(cudaMemcpyAsync(host_error_bins_.get(), error_bins_.get(), sizeof(int64_t) * words,
+                             cudaMemcpyDeviceToHost, stream),
              "copy of the DFSPH error bins");
   cuda_check(cudaStreamSynchronize(stream), "the DFSPH error bins");
   return host_error_bins_.get();

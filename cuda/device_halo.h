@@ -101,9 +101,10 @@ class DeviceHalo {
 
   // DFSPH's error words (dfsph_solver.h's kDfsphRankErrorWords: core/exact_float_sum.h's bins, int64
   // as two's complement, then the largest error's float bits): the rate pass adds the rank's own
-  // particles' errors; the host reads them (waits).
+  // particles' errors; the host reads them (waits). The conjugate gradients' use kDfsphRankCgWords
+  // of them (their sums and maxima), reading `words`.
   unsigned long long* error_bins() const { return error_bins_.get(); }
-  const int64_t* download_error_bins(cudaStream_t stream);
+  const int64_t* download_error_bins(cudaStream_t stream, uint32_t words);
 
   uint64_t bytes() const;
 

@@ -12,6 +12,7 @@
 #include <cuda_runtime.h>
 
 #include "../src/core/dfsph_jacobi_loop.h"
+#include "../src/core/exact_float_sum.h"
 #include "../src/core/host_memory.h"
 #include "../src/core/solver_record.h"
 #include "cuda_status.h"
@@ -69,6 +70,23 @@ __device__ inline void dfsph_block_max_to(Word* largest, float error) {
   if ((threadIdx.x & 31u) == 0u && bits != 0u) atomicMax(&block_largest, bits);
   __syncthreads();
   if (threadIdx.x == 0 && block_largest != 0u) atomicMax(largest, static_cast<Word>(block_largest));
+}
+
+// Adds x (when `own`) into the exact sum's bins (core/exact_float_sum.h, int64 as two's
+// complement): the block's into shared bins, then its nonzero bins into the device's. Integer
+// additions, so any order of the threads and blocks gives the same bins. Every thread calls it;
+// calls in a row reuse the shared bins (each thread clears and flushes the same ones).
+__device__ inline void exact_bins_add(unsigned long long* bins, bool own, float x) {
+  __shared__ unsigned long long local[ExactFloatSum::kTerms];
+  for (unsigned b = threadIdx.x; b < ExactFloatSum::kTerms; b += blockDim.x) local[b] = 0ull;
+  __syncthreads();
+  if (own) {
+    const ExactFloatTerm t = exact_float_term(__float_as_uint(x));
+    atomicAdd(&local[t.bin], static_cast<unsigned long long>(t.term));
+  }
+  __syncthreads();
+  for (unsigned b = threadIdx.x; b < ExactFloatSum::kTerms; b += blockDim.x)
+    if (local[b] != 0ull) atomicAdd(&bins[b], local[b]);
 }
 
 // The measurement's largest particle error into state->solve_largest, ready for the next. One thread.

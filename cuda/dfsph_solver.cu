@@ -92,22 +92,6 @@ __global__ void dfsph_correct_kernel(FluidConstants fluid, GridView grid, Partic
   carried[i] = (kWarm ? 0.0f : carried[i]) + k[i] * scale;
 }
 
-// Adds x (when `own`) into the exact sum's bins (core/exact_float_sum.h, int64 as two's
-// complement): the block's into shared bins, then its nonzero bins into the device's. Integer
-// additions, so any order of the threads and blocks gives the same bins. Every thread calls it.
-__device__ void exact_bins_add(unsigned long long* bins, bool own, float x) {
-  __shared__ unsigned long long local[ExactFloatSum::kTerms];
-  for (unsigned b = threadIdx.x; b < ExactFloatSum::kTerms; b += blockDim.x) local[b] = 0ull;
-  __syncthreads();
-  if (own) {
-    const ExactFloatTerm t = exact_float_term(__float_as_uint(x));
-    atomicAdd(&local[t.bin], static_cast<unsigned long long>(t.term));
-  }
-  __syncthreads();
-  for (unsigned b = threadIdx.x; b < ExactFloatSum::kTerms; b += blockDim.x)
-    if (local[b] != 0ull) atomicAdd(&bins[b], local[b]);
-}
-
 // New pressures from the rates over v; each block's error sum to partials[block], or (kExact, a
 // distributed rank) the errors of the rank's own particles into the exact sum's bins.
 template <bool kDivergence, bool kExact>
@@ -266,10 +250,18 @@ void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid
                                                            cond, state);
     check_launch("dfsph_check_kernel");
   };
+  if (loops.rank && !divergence && c.linear_solver == kDfsphConjugateGradients) {
+    // A distributed rank's conjugate gradients: the warm start, the ghosts' velocities, then the
+    // host-driven solve (dfsph_cg_solver.cu, the CPU rank's loop).
+    dfsph_correct_kernel<true>
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, warm, carried, divergence, contacts, state);
+    check_launch("dfsph_correct_kernel");
+    loops.rank->share_velocities(v, stream);
+    return enqueue_dfsph_cg_rank_solve(fluid, grid, a, n, contacts, *loops.rank, state, stream);
+  }
   if (loops.rank) {
     // A distributed rank: the host drives the loop, the ghosts' refreshes and the world's error
-    // between the passes (core/dfsph_jacobi_loop.h, the CPU rank's loop); the conjugate gradients
-    // are refused before the step (frame_loop.cu).
+    // between the passes (core/dfsph_jacobi_loop.h, the CPU rank's loop).
     struct Passes {
       const FluidConstants& fluid;
       const GridView& grid;

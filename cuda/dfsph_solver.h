@@ -53,6 +53,10 @@ void enqueue_dfsph_density(const FluidConstants& fluid, const GridView& grid, co
 // and reads the world's mean error.
 // A distributed rank's error words: the exact sum's bins, then the largest error's float bits.
 constexpr uint32_t kDfsphRankErrorWords = ExactFloatSum::kTerms + 1;
+// The conjugate gradients' (dfsph_cg_solver.cu) in the same buffer: up to three exact sums' bins
+// (sum s at word s kTerms), then up to two maxima's float bits from word kDfsphRankCgMaxima.
+constexpr uint32_t kDfsphRankCgMaxima = 3 * ExactFloatSum::kTerms;
+constexpr uint32_t kDfsphRankCgWords = kDfsphRankCgMaxima + 2;
 
 struct DfsphRankSteps {
   virtual ~DfsphRankSteps() = default;
@@ -68,6 +72,11 @@ struct DfsphRankSteps {
   // world's particle count; the largest, the ranks' largest (the density solve's; 0 for the
   // divergence solve, with no reduction). Waits for the stream.
   virtual DfsphErrors errors(bool divergence, cudaStream_t stream) = 0;
+  // The conjugate gradients' sums and maxima: error_bins() holds kDfsphRankCgWords words, `sums`
+  // exact sums' bins and `maxima` maxima (the layout above) of the rank's own particles; the
+  // world's sums (the bins added over the ranks, as doubles) into values, its maxima (the ranks'
+  // largest) into largest; returns the world's particle count. Waits for the stream.
+  virtual int64_t cg_world(int sums, double* values, int maxima, float* largest, cudaStream_t stream) = 0;
 };
 
 // Where a solve's loop runs and what it needs beyond the particles.
@@ -84,6 +93,13 @@ struct DfsphLoops {
 void enqueue_dfsph_cg_solve(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                             uint32_t n, bool contacts, const DfsphLoops& loops, const LoopCondition& cond,
                             FrameState* state, cudaStream_t stream);
+// The same on a distributed rank, after the warm start's velocity update and the ghosts' taking
+// their owners' velocities: the host drives it as the CPU rank's loop (src/cpu/cpu_dfsph_cg.cpp),
+// the ghosts taking their owners' search directions and velocity steps in each iteration, the
+// sums exact and added over the ranks (rank.cg_world), the solve's record written at its end.
+void enqueue_dfsph_cg_rank_solve(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                                 uint32_t n, bool contacts, DfsphRankSteps& rank, FrameState* state,
+                                 cudaStream_t stream);
 
 // After the density pass (and the spring pass): the divergence solve (unless skipped), the
 // non-pressure accelerations, the density solve, positions, colliders and the reductions of the

@@ -89,15 +89,15 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
   setup.integrator = config_.integrator;
   setup.fluid = make_fluid_constants(config_, params);
   // Refused first when the parameters are set (capi/dfsph_solver_check.h); this holds for the paths
-  // that reach the step otherwise (a distributed world loaded from its ranks' checkpoints), where
-  // the world also has no arrays for them (particle_arrays.cpp).
+  // that reach the step otherwise, where the world also has no arrays for them (particle_arrays.cpp).
+  // (A distributed rank runs them since session 16: dfsph_cg_solver.cu's host-driven loop.)
   if (config_.solver == Solver::Dfsph &&
       setup.fluid.methods.dfsph.linear_solver == kDfsphConjugateGradients &&
-      (distributed() || (config_.features & (kFeatureBoundaryDensity | kFeatureColliderLoads))))
+      (config_.features & (kFeatureBoundaryDensity | kFeatureColliderLoads)))
     throw Error(Status::Unsupported,
                 "step: DFSPH's conjugate gradients solve (sph_dfsph_params.linear_solver = "
-                "SPH_DFSPH_CONJUGATE_GRADIENTS) does not work with a distributed world, "
-                "SPH_FEATURE_BOUNDARY_DENSITY or SPH_FEATURE_COLLIDER_LOADS yet; use SPH_DFSPH_JACOBI");
+                "SPH_DFSPH_CONJUGATE_GRADIENTS) does not work with SPH_FEATURE_BOUNDARY_DENSITY or "
+                "SPH_FEATURE_COLLIDER_LOADS yet; use SPH_DFSPH_JACOBI");
   setup.limits = make_step_limits(config_, params);
   setup.max_substeps = params.stepping.max_substeps;
   setup.options = options_;

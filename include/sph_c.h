@@ -621,7 +621,7 @@ typedef struct sph_dfsph_params {
                                          or SPH_DFSPH_CONJUGATE_GRADIENTS (the divergence solve is
                                          always Jacobi); 0 = default; any other value is
                                          INVALID_ARGUMENT. Conjugate gradients run on the CPU and
-                                         CUDA backends; in a distributed world or with
+                                         CUDA backends, distributed worlds included; with
                                          SPH_FEATURE_BOUNDARY_DENSITY or SPH_FEATURE_COLLIDER_LOADS
                                          setting it (or loading a checkpoint with it) is
                                          UNSUPPORTED, the world unchanged */

@@ -38,6 +38,7 @@
 namespace sph {
 
 using Clock = std::chrono::steady_clock;
+class ExactFloatSum;
 
 inline double elapsed_ms(Clock::time_point since) {
   return std::chrono::duration<double, std::milli>(Clock::now() - since).count();
@@ -229,6 +230,11 @@ class CpuBackend final : public Backend {
   DfsphErrors dfsph_cg_measure(const FluidConstants& fluid, const DfsphWalls& walls, float dt);
   void dfsph_cg_hold_contact(const FluidConstants& fluid, const DfsphWalls& walls, float dt, uint32_t i,
                              Vec3 dv);
+  // The world's sums and maxima from a rank's (the exact sums' bins added over the ranks, at most
+  // three; the maxima the ranks' largest), after an agreement; nothing undivided. The particles
+  // the solve's means divide by: the world's.
+  void dfsph_cg_world(ExactFloatSum* sums, int n_sums, float* maxima, int n_maxima);
+  int64_t dfsph_cg_particles() const;
 
   // Springs (SPH_FEATURE_SPRINGS), after the sort: the particles that wait for springs make
   // them (two passes, springs.h), then every particle gathers its spring acceleration into a
@@ -268,9 +274,10 @@ class CpuBackend final : public Backend {
   void halo_share_normals();
   // DFSPH (cpu_halo_solvers.cpp): the ghosts' density, factor and neighbour count after the
   // density pass, their velocities v after each velocity update, their pressure steps after each
-  // rate pass.
+  // rate pass (the conjugate gradients' solve: v, its search directions p in the steps' column and
+  // its velocity steps dv_p in `v`; `what` names them in an error).
   void halo_share_dfsph_density();
-  void halo_share_velocities(Float4* v);
+  void halo_share_velocities(Float4* v, const char* what = "DFSPH velocities");
   void halo_share_dfsph_step();
   // Each probe point's sums from the rank whose slab holds it; the colliders' load sums of the
   // frame added over the ranks in rank order.

@@ -5,7 +5,19 @@
 // direction as k and one rate pass over the velocities it would give, as a Jacobi iteration's
 // two passes. Every sum is exact (exact_float_sum.h) and taken in storage order, and the
 // contacts are held in storage order, so no result depends on the worker count.
+//
+// On a rank of a distributed world (docs/distributed.md) the passes run over the rank's own
+// particles and its ghosts, as the Jacobi solve's do, and a ghost's results of a neighbour pass
+// (its neighbourhood is incomplete) are replaced by its owner's where a neighbour reads them: the
+// ghosts take their owners' velocities after the warm start's update, their search directions p
+// before each velocity update of p, and their velocity steps dv_p after it (the rate pass reads
+// them). Everything else a ghost holds follows from these as its owner's does (v, the carried
+// pressure, the contact holds, which depend on the particle's own velocity alone); its tracked
+// value is its own and never read. The sums and the maxima cover the rank's own particles; their
+// bins are added over the ranks and the maxima taken over them (dfsph_cg_world), and the means
+// divide by the world's count, so every rank takes the undivided world's decisions and bits.
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include "../core/exact_float_sum.h"
@@ -32,11 +44,29 @@ DfsphErrors CpuBackend::dfsph_cg_measure(const FluidConstants& fluid, const Dfsp
   });
   ExactFloatSum sum;
   float largest = 0.0f;
-  for (uint32_t i = 0; i < count_; ++i) {
-    sum.add(error[i]);
-    largest = error[i] > largest ? error[i] : largest;
-  }
-  return {count_ > 0 ? static_cast<float>(sum.value() / static_cast<double>(count_)) : 0.0f, largest};
+  for (uint32_t i = 0; i < count_; ++i)
+    if (!ghost(i)) {
+      sum.add(error[i]);
+      largest = error[i] > largest ? error[i] : largest;
+    }
+  dfsph_cg_world(&sum, 1, &largest, 1);
+  const int64_t particles = dfsph_cg_particles();
+  return {particles > 0 ? static_cast<float>(sum.value() / static_cast<double>(particles)) : 0.0f, largest};
+}
+
+int64_t CpuBackend::dfsph_cg_particles() const { return ranks_ ? halo_world_count_ : int64_t{count_}; }
+
+void CpuBackend::dfsph_cg_world(ExactFloatSum* sums, int n_sums, float* maxima, int n_maxima) {
+  if (!ranks_) return;
+  constexpr int kTerms = ExactFloatSum::kTerms;
+  constexpr int kMostSums = 3;
+  if (n_sums > kMostSums) throw Error(Status::Internal, "dfsph_cg_world: more sums than its buffer holds");
+  int64_t bins[kMostSums * kTerms];  // (on the stack: no allocation between the agreement and the sum)
+  for (int s = 0; s < n_sums; ++s) std::memcpy(bins + s * kTerms, sums[s].terms(), sizeof(int64_t) * kTerms);
+  halo_agree();  // (the exchanges' buffers: a rank that failed there meets the others here)
+  ranks_->all_sum(bins, n_sums * kTerms);
+  if (n_maxima > 0) ranks_->all_max(maxima, n_maxima);
+  for (int s = 0; s < n_sums; ++s) std::memcpy(sums[s].terms(), bins + s * kTerms, sizeof(int64_t) * kTerms);
 }
 
 void CpuBackend::dfsph_cg_hold_contact(const FluidConstants& fluid, const DfsphWalls& walls, float dt,
@@ -62,14 +92,13 @@ void CpuBackend::dfsph_cg_hold_contact(const FluidConstants& fluid, const DfsphW
 
 CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid, const DfsphWalls& walls,
                                                     float dt, Float4* v, float* carried) {
-  const char* refused =
-      ranks_ ? "a distributed world" : (walls.records ? "SPH_FEATURE_BOUNDARY_DENSITY" : nullptr);
+  const char* refused = walls.records ? "SPH_FEATURE_BOUNDARY_DENSITY" : nullptr;
   // With the walls in the density the operator is symmetric and positive definite
   // (tests/unit/test_dfsph_cg_operator.cpp) and the dam break converges, but a fluid ball started
   // a third inside a tank's floor drives the solve to its cap every substep until the state fails
   // (docs/validation.md, "DFSPH by conjugate gradients"): refused. Refused first when the
   // parameters are set (capi/dfsph_solver_check.h); this holds for the paths that reach the step
-  // otherwise (a distributed world loaded from its ranks' checkpoints).
+  // otherwise.
   if (refused)
     throw Error(Status::Unsupported,
                 std::string("step: DFSPH's conjugate gradients solve "
@@ -99,7 +128,9 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
     carried[i] = 0.0f;
   });
   dfsph_correct(fluid, walls, dt, v, carried, 1.0f);
+  if (ranks_) halo_share_velocities(v);  // (the rate pass reads the ghosts' velocities)
   DfsphErrors error = dfsph_cg_measure(fluid, walls, dt);
+  const double particles = static_cast<double>(dfsph_cg_particles());
 
   uint32_t iterations = 0;
   bool restart = true;
@@ -116,20 +147,24 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
       });
       ExactFloatSum s;
       for (uint32_t i = 0; i < n; ++i)
-        if (state[i] & kActive) s.add(value[i] * p[i]);
+        if ((state[i] & kActive) && !ghost(i)) s.add(value[i] * p[i]);
+      dfsph_cg_world(&s, 1, nullptr, 0);
       sz = s.value();
       restart = false;
       // Nothing that pressure can reach is off its rest density: done, once the minimum ran (as
       // the Jacobi solve's, whose iterations then apply no pressure either).
       if (sz == 0.0 && iterations >= Dfsph::kMinIterations) break;
     }
-    // The operator on p: the velocities p would give, and their rates.
+    // The operator on p: the velocities p would give, and their rates (on a rank, the velocity
+    // update reads the ghosts' p and the rate pass their dv_p: each takes its owner's).
+    if (ranks_) halo_share_dfsph_step();
     parallel().for_each(n, [&](uint32_t i) {
       Vec3 d = change_of(fluid, view, columns, p, walls, i, dt);
       if (state[i] & kBinds) d = dfsph_contact_project(contact[i], d);
       dv[i] = make_float4_record(d, 0.0f);
       columns_.set_velocity(i, d);
     });
+    if (ranks_) halo_share_velocities(dv, "DFSPH velocity steps");
     // The rates of dv_p alone (linear, so the tracked values' rounding is never amplified by a
     // long step, as it would be by value(v + dv_p) - value).
     parallel().for_each(n, [&](uint32_t i) {
@@ -137,7 +172,8 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
     });
     ExactFloatSum pq_sum;  // p . A p (the value falls along p)
     for (uint32_t i = 0; i < n; ++i)
-      if (state[i] & kActive) pq_sum.add(-p[i] * change[i]);
+      if ((state[i] & kActive) && !ghost(i)) pq_sum.add(-p[i] * change[i]);
+    dfsph_cg_world(&pq_sum, 1, nullptr, 0);
     const double pq = pq_sum.value();
     ++iterations;
     if (!(pq > 0.0)) {  // no descent left along p (rounding): a new cycle from the same state
@@ -166,29 +202,33 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
         dfsph_cg_hold_contact(fluid, walls, dt, i, held - vi);
       }
     parallel().for_each(n, [&](uint32_t i) { z[i] = dfsph_cg_error(value[i], rho0); });
-    ExactFloatSum error_sum, outside_sum;
-    float largest = 0.0f, outside_largest = 0.0f;
+    // The errors, those outside the set (only what a new set could take: dfsph_cg_restart_due),
+    // and value . z over the set for the next direction, taken before the restart rule is known
+    // so that one reduction carries the three sums on a rank (a restart drops the third).
+    ExactFloatSum sums[3];
+    float maxima[2] = {0.0f, 0.0f};  // the largest error, the largest outside the set
     for (uint32_t i = 0; i < n; ++i) {
-      error_sum.add(z[i]);
-      largest = z[i] > largest ? z[i] : largest;
-      // (only what a new set could take: dfsph_cg_restart_due)
+      if (ghost(i)) continue;
+      sums[0].add(z[i]);
+      maxima[0] = z[i] > maxima[0] ? z[i] : maxima[0];
       if (!(state[i] & kActive) && factor[i] > 0.0f) {
-        outside_sum.add(z[i]);
-        outside_largest = z[i] > outside_largest ? z[i] : outside_largest;
+        sums[1].add(z[i]);
+        maxima[1] = z[i] > maxima[1] ? z[i] : maxima[1];
       }
     }
-    error = {static_cast<float>(error_sum.value() / static_cast<double>(n)), largest};
-    if (dfsph_cg_restart_due(bounds, outside_sum.value() / static_cast<double>(n), outside_largest)) {
+    // z, the Jacobi step of the value over the set.
+    parallel().for_each(
+        n, [&](uint32_t i) { z[i] = (state[i] & kActive) ? dfsph_cg_step(value[i], factor[i], dt) : 0.0f; });
+    for (uint32_t i = 0; i < n; ++i)
+      if ((state[i] & kActive) && !ghost(i)) sums[2].add(value[i] * z[i]);
+    dfsph_cg_world(sums, 3, maxima, 2);
+    error = {static_cast<float>(sums[0].value() / particles), maxima[0]};
+    if (dfsph_cg_restart_due(bounds, sums[1].value() / particles, maxima[1])) {
       restart = true;  // the compression outside the set needs a larger set
       continue;
     }
-    // z and the next direction p = z + beta p over the set.
-    parallel().for_each(
-        n, [&](uint32_t i) { z[i] = (state[i] & kActive) ? dfsph_cg_step(value[i], factor[i], dt) : 0.0f; });
-    ExactFloatSum s;
-    for (uint32_t i = 0; i < n; ++i)
-      if (state[i] & kActive) s.add(value[i] * z[i]);
-    const double sz_next = s.value();
+    // The next direction p = z + beta p over the set.
+    const double sz_next = sums[2].value();
     const float beta = static_cast<float>(sz_next / sz);
     sz = sz_next;
     parallel().for_each(n, [&](uint32_t i) { p[i] = (state[i] & kActive) ? z[i] + beta * p[i] : 0.0f; });

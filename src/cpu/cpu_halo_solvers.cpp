@@ -5,7 +5,10 @@
 //              and their pressure steps k after each rate pass (the next pass reads both of its
 //              neighbours; core/dfsph_jacobi_loop.h, the loop the CUDA rank runs too); the
 //              solve's mean error is an exact sum whose bins are added over the ranks
-//              (cpu_dfsph_solver.cpp): every rank runs the undivided world's iterations;
+//              (cpu_dfsph_solver.cpp): every rank runs the undivided world's iterations; the
+//              density solve by conjugate gradients (cpu_dfsph_cg.cpp) shares the velocities
+//              after its warm start, then in each iteration the search directions p (in the
+//              steps' column) and the velocity steps dv_p, and adds its sums' bins likewise;
 //   probes     each sample point is gathered by the rank whose slab holds its cell layer (its
 //              neighbour cells are complete there, in the undivided world's order) and every
 //              rank takes that rank's sums (core/rank_probe_points.h, the CUDA rank's too):
@@ -39,10 +42,10 @@ void CpuBackend::halo_share_dfsph_density() {
       });
 }
 
-void CpuBackend::halo_share_velocities(Float4* v) {
+void CpuBackend::halo_share_velocities(Float4* v, const char* what) {
   using Record = HaloVelocityRecord;  // (its padding a member, zeroed)
   halo_share<Record>(
-      "DFSPH velocities",
+      what,
       [&](uint32_t i) {
         return Record{id_[i], {0u, 0u, 0u}, v[i]};
       },

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* The CUDA rank's DFSPH, probes, sinks and conjugate-gradients refusal cases of gpu_check_mpi
+/* The CUDA rank's DFSPH (Jacobi and conjugate gradients), probes and sinks cases of gpu_check_mpi
  * (tests/mpi/test_mpi_cuda.c runs them; test_mpi_cuda_cases.c says what each checks). */
 #pragma once
 
@@ -16,5 +16,6 @@ void mpi_cuda_dfsph_case(const char* name, sph_context* cuda, sph_context* cpu, 
 void mpi_cuda_probes_case(const char* name, sph_context* cuda, sph_solver solver);
 /* A sink over the stirred column's top, with `solver`. */
 void mpi_cuda_sinks_case(const char* name, sph_context* cuda, sph_solver solver);
-/* SPH_DFSPH_CONJUGATE_GRADIENTS refused on a distributed CUDA world. */
-void mpi_cuda_expect_cg_refused(sph_context* cuda);
+/* DFSPH's conjugate gradients on CUDA ranks against the same world on one rank, bit for bit; `cap`:
+ * the density solve capped there (0: not). */
+void mpi_cuda_cg_case(const char* name, sph_context* cuda, float stir, uint32_t cap);

@@ -13,7 +13,10 @@
  *     world is unchanged after each (its gathered state equal bit for bit);
  *   - a communicator of another rank count loads the set (test_mpi_checkpoint_ranks.c steps it);
  *   - a rank's file is not a world (sph_world_load_file refuses it), and sph_world_save_file and
- *     sph_world_restore refuse a distributed world. */
+ *     sph_world_restore refuse a distributed world;
+ *   - a DFSPH world whose density solve runs by conjugate gradients (its warm-start pressures
+ *     travel in the rank files): A, B and C equal bit for bit too, the loaded world's solver
+ *     the saved one's. */
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -77,6 +80,70 @@ static void expect_failed_restore(sph_world* world, uint32_t n, const char* path
   free(v0);
   free(x1);
   free(v1);
+}
+
+/* The stirred column on DFSPH with the conjugate gradients' density solve: saved after 4 substeps,
+ * then 6 more from the live world (A), the restored one (B) and a loaded one (C). */
+static void conjugate_gradients(sph_context* context) {
+  sph_world_def def;
+  sph_world* world = NULL;
+  sph_world* loaded = NULL;
+  sph_dfsph_params dfsph;
+  sph_stats a_stats, b_stats, c_stats;
+  uint32_t n = 0;
+  float *ax = NULL, *av = NULL, *bx = NULL, *bv = NULL, *cx = NULL, *cv = NULL;
+  char ck[256];
+  path_of(ck, sizeof ck, "cg.sphck");
+  mpi_test_world_def(&def);
+  def.solver = SPH_SOLVER_DFSPH;
+  mpi_test_dam(context, &def, 2.0f, NULL, NULL, &world, &n);
+  REQUIRE(sph_dfsph_params_init(&dfsph) == SPH_OK, "dfsph params init");
+  dfsph.linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS;
+  dfsph.density_error = 1e-5f; /* (the convergence test, not the minimum, ends the solves) */
+  REQUIRE(sph_world_set_dfsph_params(world, &dfsph) == SPH_OK, "dfsph params: %s", sph_get_last_error());
+  mpi_test_step(world, 4, 1);
+  REQUIRE(sph_mpi_world_save_file(world, ck) == SPH_OK, "save: %s", sph_get_last_error());
+  mpi_test_step_stats(world, 6, 1, &a_stats);
+  mpi_test_gather(world, n, &ax, &av);
+  REQUIRE(sph_mpi_world_restore_file(world, ck) == SPH_OK, "restore: %s", sph_get_last_error());
+  mpi_test_step_stats(world, 6, 1, &b_stats);
+  mpi_test_gather(world, n, &bx, &bv);
+  REQUIRE(sph_mpi_world_load_file(context, MPI_TEST_COMM, ck, &loaded) == SPH_OK, "load: %s",
+          sph_get_last_error());
+  sph_dfsph_params_init(&dfsph);
+  REQUIRE(sph_world_get_dfsph_params(loaded, &dfsph) == SPH_OK, "dfsph params");
+  CHECK(dfsph.linear_solver == SPH_DFSPH_CONJUGATE_GRADIENTS, "the loaded world's solver: %u",
+        dfsph.linear_solver);
+  mpi_test_step_stats(loaded, 6, 1, &c_stats);
+  mpi_test_gather(loaded, n, &cx, &cv);
+  CHECK(a_stats.pressure_iterations == b_stats.pressure_iterations &&
+            a_stats.pressure_iterations == c_stats.pressure_iterations && a_stats.pressure_iterations > 0,
+        "conjugate gradients: %u, %u and %u density iterations", a_stats.pressure_iterations,
+        b_stats.pressure_iterations, c_stats.pressure_iterations);
+  if (g_rank == 0) {
+    const uint32_t restored_differ = mpi_differ(ax, av, bx, bv, n, NULL);
+    const uint32_t loaded_differ = mpi_differ(ax, av, cx, cv, n, NULL);
+    CHECK(restored_differ == 0 && loaded_differ == 0,
+          "conjugate gradients: restored %u, loaded %u of %u particles differ", restored_differ,
+          loaded_differ, n);
+    printf(
+        "checkpoint with DFSPH's conjugate gradients on %d ranks: %u particles, %u density iterations in %u "
+        "substeps after the save: restored %u differ, loaded %u differ\n",
+        g_size, n, a_stats.pressure_iterations, 6u, restored_differ, loaded_differ);
+  }
+  free(ax);
+  free(av);
+  free(bx);
+  free(bv);
+  free(cx);
+  free(cv);
+  REQUIRE(sph_world_destroy(loaded) == SPH_OK && sph_world_destroy(world) == SPH_OK, "destroy");
+  {
+    char name[300];
+    if (mpi_test_rank_file(ck, g_rank, name, sizeof name)) remove(name);
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (g_rank == 0) remove(ck);
+  }
 }
 
 int main(int argc, char** argv) {
@@ -239,6 +306,7 @@ int main(int argc, char** argv) {
   }
 
   REQUIRE(sph_world_destroy(world) == SPH_OK, "destroy");
+  conjugate_gradients(context);
   MPI_Barrier(MPI_COMM_WORLD);
   {
     char name[300];

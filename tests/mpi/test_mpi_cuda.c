@@ -21,10 +21,11 @@
  * tension), the collider loads (run_loads_case), the collapse that makes the ranks rebalance (12 frames of 20
  * substeps, spacing 12.5 mm), RK4 (the stirred column, and with the collider loads), DFSPH's Jacobi solves
  * (test_mpi_cuda_cases.c: the dam break, the stirred column with and without the divergence solve), probes
- * and gauges and sinks (there too, both solvers), and the refusals (springs, DFSPH's conjugate gradients:
- * SPH_ERROR_UNSUPPORTED naming them). With
- * SPH_MPI_CUDA_QUICK set, the dam breaks (WCSPH and DFSPH) and the refusals only (a run under
- * compute-sanitizer). */
+ * and gauges and sinks (there too, both solvers), DFSPH's conjugate gradients (test_mpi_cuda_cases.c,
+ * mpi_cuda_cg_case: against the same world on one rank, bit for bit), and the refusal of springs
+ * (SPH_ERROR_UNSUPPORTED naming them). With
+ * SPH_MPI_CUDA_QUICK set, the dam breaks (WCSPH, DFSPH, DFSPH by conjugate gradients) and the refusals only
+ * (a run under compute-sanitizer). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -255,7 +256,11 @@ int main(int argc, char** argv) {
     mpi_cuda_sinks_case("sinks", cuda, SPH_SOLVER_WCSPH);
     mpi_cuda_sinks_case("DFSPH sinks", cuda, SPH_SOLVER_DFSPH);
   }
-  mpi_cuda_expect_cg_refused(cuda);
+  mpi_cuda_cg_case("DFSPH CG dam break", cuda, 0.0f, 0);
+  if (!quick) {
+    mpi_cuda_cg_case("DFSPH CG stirred column", cuda, 2.0f, 0);
+    mpi_cuda_cg_case("DFSPH CG stirred column, capped solves", cuda, 2.0f, 4);
+  }
   mpi_test_world_def(&def);
   def.features = SPH_FEATURE_SPRINGS;
   expect_refused(cuda, &def, "SPH_FEATURE_SPRINGS");

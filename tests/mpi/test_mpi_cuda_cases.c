@@ -324,20 +324,95 @@ void mpi_cuda_sinks_case(const char* name, sph_context* cuda, sph_solver solver)
   sph_world_destroy(w.world);
 }
 
-/* DFSPH's conjugate gradients stay refused on a rank (both backends), when the parameters are set. */
-void mpi_cuda_expect_cg_refused(sph_context* cuda) {
+/* DFSPH's density solve by conjugate gradients on CUDA ranks (dfsph_cg_solver.cu's host-driven
+ * loop, the CPU rank's: the ghosts take their owners' search directions and velocity steps in each
+ * iteration, the sums are exact sums added over the ranks). The undivided CUDA world sums in doubles
+ * in a fixed tree instead, so alpha and beta, and then the particles, differ from it by roundings:
+ * the reference is the same world distributed over one rank (rank 0 alone, MPI_COMM_SELF), whose
+ * sums are the same exact sums. Checked: the particles bit for bit against it, the iteration counts,
+ * the capped solves and the mean and largest errors equal to its and the same on every rank; the
+ * undivided CUDA world's iterations and distance are printed. With `cap`, the density solve capped
+ * at `cap` iterations (a bound of 1e-8): capped solves in every frame. */
+void mpi_cuda_cg_case(const char* name, sph_context* cuda, float stir, uint32_t cap) {
+  const uint32_t frames[2] = {7, 5};
   sph_world_def def;
   sph_dfsph_params dfsph;
+  sph_world* single = NULL;
   sph_world* world = NULL;
-  sph_result r;
+  sph_world* one = NULL;
+  uint32_t n = 0, n_one = 0;
+  float *x = NULL, *v = NULL, *one_x = NULL, *one_v = NULL, *want_x = NULL, *want_v = NULL;
   mpi_test_world_def(&def);
+  def.capacity = 32768;
   def.solver = SPH_SOLVER_DFSPH;
-  REQUIRE(sph_mpi_world_create(cuda, &def, MPI_TEST_COMM, NULL, &world) == SPH_OK, "a DFSPH rank: %s",
-          sph_get_last_error());
+  mpi_test_dam(cuda, &def, stir, NULL, &single, &world, &n);
+  if (g_rank == 0) mpi_test_dam_on(cuda, &def, stir, MPI_COMM_SELF, NULL, NULL, &one, &n_one);
   REQUIRE(sph_dfsph_params_init(&dfsph) == SPH_OK, "dfsph params init");
   dfsph.linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS;
-  r = sph_world_set_dfsph_params(world, &dfsph);
-  CHECK(r == SPH_ERROR_UNSUPPORTED && strstr(sph_get_last_error(), "SPH_DFSPH_CONJUGATE_GRADIENTS") != NULL,
-        "conjugate gradients on a distributed CUDA world: %d '%s'", (int)r, sph_get_last_error());
+  dfsph.density_error = 1e-5f;
+  dfsph.divergence_error = 0.1f;
+  if (cap > 0) {
+    dfsph.density_error = 1e-8f;
+    dfsph.max_iterations = cap;
+  }
+  REQUIRE(sph_world_set_dfsph_params(world, &dfsph) == SPH_OK, "dfsph params: %s", sph_get_last_error());
+  if (single) REQUIRE(sph_world_set_dfsph_params(single, &dfsph) == SPH_OK, "dfsph params");
+  if (one) REQUIRE(sph_world_set_dfsph_params(one, &dfsph) == SPH_OK, "dfsph params");
+  for (int f = 0; f < 2; ++f) {
+    sph_stats got, first, ref, want;
+    mpi_test_step_stats(world, frames[f], 1, &got);
+    first = got;
+    MPI_Bcast(&first, (int)sizeof first, MPI_BYTE, 0, MPI_COMM_WORLD);
+    CHECK(first.pressure_iterations == got.pressure_iterations &&
+              first.pressure_solves_capped == got.pressure_solves_capped &&
+              memcmp(&first.density_error_mean, &got.density_error_mean, sizeof(float)) == 0 &&
+              memcmp(&first.density_error_largest, &got.density_error_largest, sizeof(float)) == 0,
+          "%s frame %d: rank %d ran other iterations than rank 0", name, f, g_rank);
+    if (g_rank != 0) continue;
+    mpi_test_step_stats(one, frames[f], 1, &ref);
+    mpi_test_step_stats(single, frames[f], 0, &want);
+    printf(
+        "%s frame %d on %d ranks: %u density iterations (at most %u), %u capped; one rank %u (%u), %u "
+        "capped; "
+        "undivided CUDA world %u (%u), %u capped (printed only)\n",
+        name, f, g_size, got.pressure_iterations, got.pressure_iterations_max, got.pressure_solves_capped,
+        ref.pressure_iterations, ref.pressure_iterations_max, ref.pressure_solves_capped,
+        want.pressure_iterations, want.pressure_iterations_max, want.pressure_solves_capped);
+    CHECK(got.pressure_iterations == ref.pressure_iterations &&
+              got.pressure_iterations_max == ref.pressure_iterations_max &&
+              got.divergence_iterations == ref.divergence_iterations &&
+              got.pressure_solves_capped == ref.pressure_solves_capped &&
+              memcmp(&got.density_error_mean, &ref.density_error_mean, sizeof(float)) == 0 &&
+              memcmp(&got.density_error_largest, &ref.density_error_largest, sizeof(float)) == 0,
+          "%s frame %d: the iterations or errors differ from the one-rank world's", name, f);
+    CHECK(stir == 0.0f || cap > 0 || f == 0 || got.pressure_iterations > 2 * frames[f],
+          "%s frame %d: the density solves stopped at the minimum (%u iterations): the test never decided",
+          name, f, got.pressure_iterations);
+    CHECK(cap == 0 || (got.pressure_solves_capped > 0 && got.pressure_iterations_max == cap),
+          "%s frame %d: %u capped solves, at most %u iterations (cap %u)", name, f,
+          got.pressure_solves_capped, got.pressure_iterations_max, cap);
+  }
+  mpi_test_gather(world, n, &x, &v);
+  if (g_rank == 0) {
+    uint32_t differ, differ_undivided;
+    mpi_test_gather_on(one, MPI_COMM_SELF, n_one, &one_x, &one_v);
+    mpi_test_read(single, n, &want_x, &want_v);
+    differ = mpi_differ(one_x, one_v, x, v, n, NULL);
+    differ_undivided = mpi_differ(want_x, want_v, x, v, n, NULL);
+    printf(
+        "%s on %d ranks: %u of %u particles differ from the one-rank CUDA world in any bit; the undivided "
+        "CUDA world: %u differ, max |dx| %.3g m (printed only)\n",
+        name, g_size, differ, n, differ_undivided, (double)max_abs_difference(want_x, x, n));
+    CHECK(n == n_one && differ == 0, "%s: %u of %u particles differ from the one-rank CUDA world", name,
+          differ, n);
+    free(one_x);
+    free(one_v);
+    free(want_x);
+    free(want_v);
+    sph_world_destroy(one);
+    sph_world_destroy(single);
+  }
+  free(x);
+  free(v);
   sph_world_destroy(world);
 }

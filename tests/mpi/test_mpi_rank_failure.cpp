@@ -5,7 +5,9 @@
 //     (the replaced operator new of tests/support/allocation_injector.h, armed on that rank
 //     only): every rank returns SPH_ERROR_OUT_OF_HOST_MEMORY (the others' messages name the
 //     failing rank) instead of waiting in MPI for it, every rank's world is as before the step
-//     (gathered bit for bit), and the world then steps on exactly as an undisturbed copy;
+//     (gathered bit for bit), and the world then steps on exactly as an undisturbed copy; again
+//     with DFSPH's density solve by conjugate gradients (the allocations of its exchanges inside
+//     each iteration, followed by the reductions of its sums);
 //   - a crowded cell (700 particles in one cell, more than the 528 one may hold) on whichever
 //     rank owns it, and the ranks holding it as ghosts: every rank returns SPH_ERROR_CAPACITY and
 //     the world is unchanged.
@@ -49,8 +51,10 @@ void check_rank_named(int culprit, const char* what) {
 }
 
 // An allocation failure at each allocation of the last rank's step in turn (with springs: their
-// linking, spring ghosts and the lists' ids through the rollback too).
-void allocation_failures(sph_context* context, uint32_t features, const char* name) {
+// linking, spring ghosts and the lists' ids through the rollback too; with `cg`, a DFSPH world whose
+// density solve runs by conjugate gradients: its exchanges of the search directions and velocity
+// steps and its sums' reductions inside each iteration).
+void allocation_failures(sph_context* context, uint32_t features, bool cg, const char* name) {
   sph_world_def def;
   sph_world* world = NULL;
   sph_world* undisturbed = NULL;
@@ -61,10 +65,20 @@ void allocation_failures(sph_context* context, uint32_t features, const char* na
   def.features = features;
   def.particle_spacing = 0.02f;  // 150 particles: a step per allocation point
   def.kernel_radius = 0.036f;
+  if (cg) def.solver = SPH_SOLVER_DFSPH;
   mpi_test_dam(context, &def, 2.0f, NULL, NULL, &world, &n);
   mpi_test_dam(context, &def, 2.0f, NULL, NULL, &undisturbed, &n);
   set_substeps(world);
   set_substeps(undisturbed);
+  if (cg) {
+    sph_dfsph_params dfsph;
+    REQUIRE(sph_dfsph_params_init(&dfsph) == SPH_OK, "dfsph params init");
+    dfsph.linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS;
+    dfsph.density_error = 1e-5f;  // (iterations past the minimum: the loop's exchanges and sums)
+    REQUIRE(sph_world_set_dfsph_params(world, &dfsph) == SPH_OK &&
+                sph_world_set_dfsph_params(undisturbed, &dfsph) == SPH_OK,
+            "dfsph params: %s", sph_get_last_error());
+  }
   for (k = 0; k < 100000; ++k) {
     float *x0 = NULL, *v0 = NULL, *x1 = NULL, *v1 = NULL;
     bool injected = false;
@@ -101,8 +115,7 @@ void allocation_failures(sph_context* context, uint32_t features, const char* na
             n);
       printf(
           "%s: allocation failures on rank %d of %d: %ld allocation points of a %u-substep step failed in "
-          "turn, "
-          "each on every rank; then %u particles differ from the undisturbed world\n",
+          "turn, each on every rank; then %u particles differ from the undisturbed world\n",
           name, victim, g_size, k, kSubsteps, differ);
     }
     free(x0);
@@ -159,8 +172,9 @@ void crowded_cell(sph_context* context) {
 int main(int argc, char** argv) {
   sph_context* context = NULL;
   mpi_test_init(&argc, &argv, &context);
-  allocation_failures(context, SPH_FEATURE_NONE, "the stirred column");
-  allocation_failures(context, SPH_FEATURE_SPRINGS, "the stirred column with springs");
+  allocation_failures(context, SPH_FEATURE_NONE, false, "the stirred column");
+  allocation_failures(context, SPH_FEATURE_SPRINGS, false, "the stirred column with springs");
+  allocation_failures(context, SPH_FEATURE_NONE, true, "the stirred column, DFSPH with conjugate gradients");
   crowded_cell(context);
   return mpi_test_finish(context, "mpi rank failures");
 }

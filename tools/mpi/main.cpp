@@ -143,8 +143,9 @@ int run(const Ranks& ranks, int argc, char** argv) {
   } catch (const SceneError& e) {
     return fail(ranks, kExitScene, cli.scene + ": " + e.what());
   } catch (const LibraryError& e) {
-    // A feature the ranks refuse after the world's creation (DFSPH's conjugate gradients, on every
-    // rank alike): a scene this program cannot run, as the world's own refusals are.
+    // A feature the ranks refuse after the world's creation (DFSPH's conjugate gradients with the
+    // walls' density or the loads, on every rank alike): a scene this program cannot run, as the world's own
+    // refusals are.
     return fail(ranks, e.code() == SPH_ERROR_UNSUPPORTED ? kExitScene : kExitRuntime, e.what());
   }
 }
