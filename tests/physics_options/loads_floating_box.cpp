@@ -229,6 +229,15 @@ int main(int argc, char** argv) {
   const double volume_level =
       (n * static_cast<double>(w.mass) / rho0 - 0.01 * (mean - kHalf)) / (0.09 - 4.0 * kHalf * kHalf);
   const double volume_draft = volume_level - (mean - kHalf);
+  // The same with the film the walls' calibration keeps free of water at every wall, (spacing -
+  // step) / 2 (docs/validation.md, "Loads on a hydrostatic tank's side wall"): the water stands on
+  // the floor's film, within the tank's walls' and outside the box's (grown by it):
+  // N v = (0.3 - 2 f)^2 (L - f) - (0.1 + 2 f)^2 (L - (bottom - f)).
+  const double film = 0.5 * (spacing - step), bottom = mean - kHalf;
+  const double inner = (0.3 - 2.0 * film) * (0.3 - 2.0 * film),
+               grown = (0.1 + 2.0 * film) * (0.1 + 2.0 * film);
+  const double film_level =
+      (n * static_cast<double>(w.mass) / rho0 + inner * film - grown * (bottom - film)) / (inner - grown);
   double early = 0.0, settled = 0.0;
   for (int frame = static_cast<int>(std::lround(0.25 / dt)); frame < std::lround(0.75 / dt); ++frame)
     early = std::fmax(early, std::fabs(heights[frame] - mean));
@@ -241,6 +250,10 @@ int main(int argc, char** argv) {
       backend_name, dfsph ? "dfsph" : "wcsph", n, mean, water_level, 100.0 * draft, 100.0 * archimedes,
       100.0 * (draft / archimedes - 1.0), 100.0 * early, 100.0 * settled, volume_level, 100.0 * volume_draft,
       100.0 * (volume_draft / archimedes - 1.0));
+  std::printf(
+      "the particles' volume with the walls' films (%.2f mm): level %.4f m, draft %.2f cm (%+.1f %%)\n",
+      1000.0 * film, film_level, 100.0 * (film_level - bottom),
+      100.0 * ((film_level - bottom) / archimedes - 1.0));
   std::printf(
       "the square's patched count (each particle spread over a step's square): level %.4f m, draft %.2f cm "
       "(%+.1f %%)\n",
