@@ -78,8 +78,12 @@ __global__ void dfsph_correct_kernel(FluidConstants fluid, GridView grid, Partic
   if (i >= n) return;
   const float dt = state->clock.dt_float;
   const float scale = divergence ? dt : 1.0f;
-  Vec3 vi = xyz(v[i]) + pressure_velocity_change(fluid, grid, a.sorted_position, k,
-                                                 DfsphWalls{a.boundary_gradient}, i, dt);
+  const DfsphWalls walls{a.boundary_gradient};
+  // SPH_DFSPH_CORRECTED_GRADIENT: the corrected gradient (physics/dfsph_gradient_correction.h).
+  Vec3 vi =
+      xyz(v[i]) + (fluid.methods.dfsph.gradient_correction
+                       ? pressure_velocity_change_corrected(fluid, grid, a.sorted_position, k, walls, i, dt)
+                       : pressure_velocity_change(fluid, grid, a.sorted_position, k, walls, i, dt));
   if (contacts) vi = dfsph_clamp(a, i, vi);
   v[i] = make_float4_record(vi, v[i].w);
   carried[i] = (kWarm ? 0.0f : carried[i]) + k[i] * scale;

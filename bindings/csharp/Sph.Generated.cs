@@ -100,6 +100,12 @@ namespace Sph
         /// <summary>sph_dfsph_params.flags no divergence solve (cheaper; a noisier pressure)</summary>
         public const uint SPH_DFSPH_SKIP_DIVERGENCE_SOLVE = 1u;
         /// <summary>
+        /// the Jacobi solves' pressure gradient corrected to first order (Bonet &amp; Lok's L_i,
+        /// difference \ form; docs/physics.md, DFSPH): the hydrostatic pressure exact on any packing,
+        /// momentum no     \ longer exactly conserved
+        /// </summary>
+        public const uint SPH_DFSPH_CORRECTED_GRADIENT = 2u;
+        /// <summary>
         /// sph_dfsph_params.linear_solver (docs/physics.md, DFSPH) the Jacobi step of Bender &amp;
         /// Koschier (the default)
         /// </summary>
