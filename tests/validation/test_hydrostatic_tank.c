@@ -102,7 +102,9 @@ static void test_hydrostatic_dfsph(void** state) {
 /* The same with the solves' pressure gradient corrected (SPH_DFSPH_CORRECTED_GRADIENT,
  * physics/dfsph_gradient_correction.h): the issue's 0.5 % on every interior slice. Measured
  * (session 16): 0.08 % mean, 0.16 % worst (each particle's pressure scatters 1.8-2.7 % about
- * rho0 g d instead of 6-8 %), v_rms 0.035 m/s; 16 layers 0.20 % / 0.46 %. */
+ * rho0 g d instead of 6-8 %), v_rms 0.035 m/s; 16 layers 0.20 % / 0.46 %. Little margin in other
+ * settings: a 6 s run 0.53 %, a density bound of 1e-4 0.62 %, dt_max 2 ms 1.58 % (docs/validation.md,
+ * "DFSPH: hydrostatic tank", session 16). */
 static void test_hydrostatic_dfsph_corrected(void** state) {
   tank_case tc = dfsph_tank("DFSPH, boundary density, corrected gradient, p = rho0 g d",
                             SPH_FEATURE_BOUNDARY_DENSITY, 0.005, 0.0f);
