@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'e654693cb4251a249dac7ebc0f5f491127c9d003a9e6993c083c7450cad15da0', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '6ebdc6d3ac863912d6f17dda6f68be59f8b7108d9edc385efc57341ed04bc57e', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -87,9 +87,10 @@ SPH_STEP_LIMIT_ACOUSTIC = 1
 SPH_STEP_LIMIT_FORCE = 2
 #: sph_dfsph_params.flags no divergence solve (cheaper; a noisier pressure)
 SPH_DFSPH_SKIP_DIVERGENCE_SOLVE = 1
-#: the Jacobi solves' pressure gradient corrected to first order (Bonet & Lok's L_i, difference \
-#: form; docs/physics.md, DFSPH): the hydrostatic pressure exact on any packing, momentum no     \
-#: longer exactly conserved
+#: the Jacobi solves' pressure gradient corrected to first order (Bonet & Lok's L_i;
+#: docs/physics.md, \ DFSPH): a resting fluid's pressure within 0.5 % of rho0 g d, but momentum
+#: only nearly conserved    \ and energy not bounded in violent flow; not with
+#: SPH_DFSPH_CONJUGATE_GRADIENTS
 SPH_DFSPH_CORRECTED_GRADIENT = 2
 #: sph_dfsph_params.linear_solver (docs/physics.md, DFSPH) the Jacobi step of Bender & Koschier
 #: (the default)
