@@ -74,7 +74,7 @@ __global__ void dfsph_begin_solve_kernel(FrameState* state) {
 // v += the pressures k's velocity change (held to the contacts); carried gets k times the
 // solve's scale (dt for the divergence solve's impulse), added, or replacing the state-order
 // values on the warm start's pass.
-template <bool kWarm>
+template <bool kWarm, bool kCorrected>
 __global__ void dfsph_correct_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
                                      Float4* v, const float* k, float* carried, bool divergence,
                                      bool contacts, FrameState* state) {
@@ -84,12 +84,39 @@ __global__ void dfsph_correct_kernel(FluidConstants fluid, GridView grid, Partic
   if (i >= n) return;
   const float dt = state->clock.dt_float;
   const float scale = divergence ? dt : 1.0f;
-  Vec3 vi =
-      xyz(v[i]) + pressure_velocity_change(fluid, grid, a.sorted_position, k, DfsphWalls{a.boundary_gradient},
-                                           i, dt, MaskedCandidates{a.dfsph_neighbor_mask});
+  // kCorrected: SPH_DFSPH_CORRECTED_GRADIENT (physics/dfsph_gradient_correction.h), its own
+  // instantiation so that the default kernel keeps its registers.
+  const DfsphWalls walls{a.boundary_gradient};
+  const MaskedCandidates walk{a.dfsph_neighbor_mask};
+  Vec3 vi = xyz(v[i]);
+  if constexpr (kCorrected)
+    vi += pressure_velocity_change_corrected(fluid, grid, a.sorted_position, k, walls, i, dt, walk);
+  else
+    vi += pressure_velocity_change(fluid, grid, a.sorted_position, k, walls, i, dt, walk);
   if (contacts) vi = dfsph_clamp(a, i, vi);
   v[i] = make_float4_record(vi, v[i].w);
   carried[i] = (kWarm ? 0.0f : carried[i]) + k[i] * scale;
+}
+
+// One launch of the velocity update: the warm start's pass (`warm`, replacing the carried values)
+// or an iteration's, with the gradient the world's parameters choose.
+void launch_correct(bool warm, const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                    uint32_t n, Float4* v, const float* k, float* carried, bool divergence, bool contacts,
+                    FrameState* state, unsigned blocks, unsigned threads, cudaStream_t stream) {
+  const bool corrected = fluid.methods.dfsph.gradient_correction != 0;
+  if (warm && corrected)
+    dfsph_correct_kernel<true, true>
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, k, carried, divergence, contacts, state);
+  else if (warm)
+    dfsph_correct_kernel<true, false>
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, k, carried, divergence, contacts, state);
+  else if (corrected)
+    dfsph_correct_kernel<false, true>
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, k, carried, divergence, contacts, state);
+  else
+    dfsph_correct_kernel<false, false>
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, k, carried, divergence, contacts, state);
+  check_launch("dfsph_correct_kernel");
 }
 
 // New pressures from the rates over v; each block's error sum to partials[block], or (kExact, a
@@ -253,9 +280,8 @@ void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid
   if (loops.rank && !divergence && c.linear_solver == kDfsphConjugateGradients) {
     // A distributed rank's conjugate gradients: the warm start, the ghosts' velocities, then the
     // host-driven solve (dfsph_cg_solver.cu, the CPU rank's loop).
-    dfsph_correct_kernel<true>
-        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, warm, carried, divergence, contacts, state);
-    check_launch("dfsph_correct_kernel");
+    launch_correct(true, fluid, grid, a, n, v, warm, carried, divergence, contacts, state, blocks, threads,
+                   stream);
     loops.rank->share_velocities(v, stream);
     return enqueue_dfsph_cg_rank_solve(fluid, grid, a, n, contacts, *loops.rank, state, stream);
   }
@@ -278,13 +304,8 @@ void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid
       cudaStream_t stream;
       unsigned blocks, threads;
       void velocity_update(bool first) {
-        if (first)
-          dfsph_correct_kernel<true><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, warm, carried,
-                                                                     divergence, contacts, state);
-        else
-          dfsph_correct_kernel<false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, a.dfsph_step,
-                                                                      carried, divergence, contacts, state);
-        check_launch("dfsph_correct_kernel");
+        launch_correct(first, fluid, grid, a, n, v, first ? warm : a.dfsph_step, carried, divergence,
+                       contacts, state, blocks, threads, stream);
       }
       void share_velocities() { rank.share_velocities(v, stream); }
       void rates() {
@@ -313,18 +334,16 @@ void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid
     run_dfsph_jacobi(passes, bounds, min_iterations, max_iterations);
     return;
   }
-  dfsph_correct_kernel<true>
-      <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, warm, carried, divergence, contacts, state);
-  check_launch("dfsph_correct_kernel");
+  launch_correct(true, fluid, grid, a, n, v, warm, carried, divergence, contacts, state, blocks, threads,
+                 stream);
   // The same warm start (as the CPU backend's), then the conjugate gradients' iterations.
   if (!divergence && c.linear_solver == kDfsphConjugateGradients)
     return enqueue_dfsph_cg_solve(fluid, grid, a, n, contacts, loops, cond, state, stream);
   residual();
   check(true);
   run_solve_loop(cond, state, loops.host_state, stream, [&] {
-    dfsph_correct_kernel<false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, a.dfsph_step, carried,
-                                                                divergence, contacts, state);
-    check_launch("dfsph_correct_kernel");
+    launch_correct(false, fluid, grid, a, n, v, a.dfsph_step, carried, divergence, contacts, state, blocks,
+                   threads, stream);
     residual();
     check(false);
   });

@@ -598,6 +598,10 @@ SPH_API sph_result SPH_CALL sph_world_get_density_diffusion_params(const sph_wor
 
 /** sph_dfsph_params.flags */
 #define SPH_DFSPH_SKIP_DIVERGENCE_SOLVE 0x1u /* no divergence solve (cheaper; a noisier pressure) */
+#define SPH_DFSPH_CORRECTED_GRADIENT                                                                         \
+  0x2u /* the Jacobi solves' pressure gradient corrected to first order (Bonet & Lok's L_i; docs/physics.md, \
+          DFSPH): a resting fluid's pressure within 0.5 % of rho0 g d, but momentum only nearly conserved    \
+          and energy not bounded in violent flow; not with SPH_DFSPH_CONJUGATE_GRADIENTS */
 /** sph_dfsph_params.linear_solver (docs/physics.md, DFSPH) */
 #define SPH_DFSPH_JACOBI 1u /* the Jacobi step of Bender & Koschier (the default) */
 #define SPH_DFSPH_CONJUGATE_GRADIENTS                    \

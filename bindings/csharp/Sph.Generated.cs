@@ -102,6 +102,13 @@ namespace Sph
         /// <summary>sph_dfsph_params.flags no divergence solve (cheaper; a noisier pressure)</summary>
         public const uint SPH_DFSPH_SKIP_DIVERGENCE_SOLVE = 1u;
         /// <summary>
+        /// the Jacobi solves' pressure gradient corrected to first order (Bonet &amp; Lok's L_i;
+        /// docs/physics.md, \ DFSPH): a resting fluid's pressure within 0.5 % of rho0 g d, but momentum
+        /// only nearly conserved    \ and energy not bounded in violent flow; not with
+        /// SPH_DFSPH_CONJUGATE_GRADIENTS
+        /// </summary>
+        public const uint SPH_DFSPH_CORRECTED_GRADIENT = 2u;
+        /// <summary>
         /// sph_dfsph_params.linear_solver (docs/physics.md, DFSPH) the Jacobi step of Bender &amp;
         /// Koschier (the default)
         /// </summary>

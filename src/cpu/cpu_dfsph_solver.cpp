@@ -58,7 +58,10 @@ void CpuBackend::dfsph_correct(const FluidConstants& fluid, const DfsphWalls& wa
   const NeighborColumns columns = columns_.view();
   const float* k = columns_.dfsph_step();
   const Float4* contact = dfsph_contacts_ ? dfsph_contact_.data() : nullptr;
-  const SimdPasses::DfsphVelocityChangeFn change = simd_.dfsph_velocity_change;
+  // SPH_DFSPH_CORRECTED_GRADIENT: the corrected gradient (physics/dfsph_gradient_correction.h).
+  const SimdPasses::DfsphVelocityChangeFn change = fluid.methods.dfsph.gradient_correction
+                                                       ? simd_.dfsph_velocity_change_corrected
+                                                       : simd_.dfsph_velocity_change;
   // The gather reads positions and k; each particle writes only its own velocity (record and
   // column), which the next rate pass reads.
   parallel().for_each(count_, [&](uint32_t i) {

@@ -45,7 +45,11 @@
 namespace sph {
 
 // sph_dfsph_params.flags (SPH_DFSPH_*).
-enum DfsphFlags : uint32_t { kDfsphSkipDivergenceSolve = 1u << 0, kDfsphFlagsAll = 1u };
+enum DfsphFlags : uint32_t {
+  kDfsphSkipDivergenceSolve = 1u << 0,
+  kDfsphCorrectedGradient = 1u << 1,  // dfsph_gradient_correction.h
+  kDfsphFlagsAll = 3u
+};
 // sph_dfsph_params.linear_solver (SPH_DFSPH_JACOBI, SPH_DFSPH_CONJUGATE_GRADIENTS): how the
 // density solve iterates (dfsph_cg.h has the conjugate gradients' method).
 enum DfsphLinearSolver : uint32_t { kDfsphJacobi = 1, kDfsphConjugateGradients = 2 };
@@ -92,7 +96,17 @@ struct Dfsph {
       real_field("density_error_max", &Params::density_error_max, above_up_to(0.0, 1.0), ZeroMeans::Default,
                  ""),
   };
-  static bool check(const Params&, const WorldShape&, ParamConflict&) { return true; }
+  // The corrected gradient is the Jacobi solves' (dfsph_gradient_correction.h): its operator is not
+  // the symmetric one the conjugate gradients' density solve needs (dfsph_cg.h).
+  static bool check(const Params& p, const WorldShape&, ParamConflict& out) {
+    if ((p.flags & kDfsphCorrectedGradient) && p.linear_solver == kDfsphConjugateGradients) {
+      out = ParamConflict{"flags", static_cast<float>(p.flags),
+                          "(SPH_DFSPH_CORRECTED_GRADIENT) works with SPH_DFSPH_JACOBI only, not",
+                          "linear_solver", static_cast<float>(p.linear_solver)};
+      return false;
+    }
+    return true;
+  }
 
   // The density solve runs at least this many iterations (the reference's minimum: a first
   // iteration alone, from a warm start, can stop on an error it has not looked at since).
@@ -119,7 +133,8 @@ struct Dfsph {
     uint32_t max_divergence_iterations;
     uint32_t divergence_solve;  // 1 unless kDfsphSkipDivergenceSolve
     uint32_t min_divergence_neighbors;
-    uint32_t linear_solver;  // DfsphLinearSolver
+    uint32_t linear_solver;        // DfsphLinearSolver
+    uint32_t gradient_correction;  // 1: the Jacobi solves' corrected gradient (dfsph_gradient_correction.h)
   };
   static Constants make_constants(const Params& p, const WorldShape& shape, const LatticeSums& lattice) {
     Constants c;
@@ -135,6 +150,7 @@ struct Dfsph {
         static_cast<double>(lattice.neighbor_count(shape.particle_spacing, shape.kernel_radius));
     c.min_divergence_neighbors = static_cast<uint32_t>(kDivergenceNeighborShare * full + 0.5);
     c.linear_solver = p.linear_solver;
+    c.gradient_correction = (p.flags & kDfsphCorrectedGradient) ? 1u : 0u;
     return c;
   }
 

@@ -26,6 +26,7 @@
 #include "collider_response.h"
 #include "dfsph.h"
 #include "dfsph_boundary.h"
+#include "dfsph_gradient_correction.h"
 #include "float4_types.h"
 #include "fluid_base.h"
 #include "kernels.h"
@@ -179,6 +180,35 @@ SPH_HD Vec3 pressure_velocity_change(const FluidBase& f, const GridView& grid, c
     if (r2 < f.kernel.h2 && j != i) sum += pressure_velocity_pair_term(mk, d, r2, ki + k[j]);
   });
   return dfsph_velocity_change(sum, walls, i, ki, dt);
+}
+
+// The same with the corrected gradient (SPH_DFSPH_CORRECTED_GRADIENT, dfsph_gradient_correction.h): B_i
+// and the zeroth-order sum gathered in the same walk.
+SPH_HD Vec3 dfsph_corrected_velocity_change(const FluidBase& f, Vec3 sum, const GradientMomentOf<float>& m,
+                                            const DfsphWalls& walls, uint32_t i, float ki, float dt) {
+  return dfsph_velocity_change(corrected_pressure_sum(sum, m, ki, f.rest_density), walls, i, ki, dt);
+}
+// walk: as density_rate's.
+template <class Walk = AllCandidates>
+SPH_HD Vec3 pressure_velocity_change_corrected(const FluidBase& f, const GridView& grid,
+                                               const Float4* positions, const float* k,
+                                               const DfsphWalls& walls, uint32_t i, float dt,
+                                               Walk walk = Walk{}) {
+  const KernelCoefficients mk = mass_gradient_kernel(f);
+  const Vec3 xi = xyz(positions[i]);
+  const float ki = k[i];
+  Vec3 sum{0.0f, 0.0f, 0.0f};
+  GradientMomentOf<float> moment = zero_gradient_moment(0.0f);
+  walk(grid, xi, i, [&](uint32_t j) {
+    const Vec3 d = xi - xyz(positions[j]);
+    const float r2 = length_squared(d);
+    if (r2 < f.kernel.h2 && j != i) {
+      const Vec3 g = spiky_gradient(mk, d, square_root(r2));
+      sum += g * (ki + k[j]);
+      add_gradient_moment(moment, g, d);
+    }
+  });
+  return dfsph_corrected_velocity_change(f, sum, moment, walls, i, ki, dt);
 }
 
 // One particle's result of a residual pass.

@@ -334,6 +334,27 @@ static void test_each_rule_fires_with_its_message(void** state) {
     assert_string_equal(sph_get_last_error(),
                         "sph_world_set_tait_params: params->speed_of_sound: must be > 0, got -1");
   }
+  /* DFSPH's corrected gradient is the Jacobi solves' only: with the conjugate gradients refused, the
+   * parameters unchanged; with Jacobi accepted. */
+  {
+    sph_dfsph_params before, dp, after;
+    sph_dfsph_params_init(&before);
+    EXPECT_OK(sph_world_get_dfsph_params(f->dfsph, &before));
+    dp = before;
+    dp.flags = SPH_DFSPH_CORRECTED_GRADIENT;
+    dp.linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS;
+    assert_int_equal(sph_world_set_dfsph_params(f->dfsph, &dp), SPH_ERROR_INVALID_ARGUMENT);
+    assert_string_equal(
+        sph_get_last_error(),
+        "sph_world_set_dfsph_params: params->flags: 2 (SPH_DFSPH_CORRECTED_GRADIENT) works with "
+        "SPH_DFSPH_JACOBI only, not params->linear_solver 2");
+    sph_dfsph_params_init(&after);
+    EXPECT_OK(sph_world_get_dfsph_params(f->dfsph, &after));
+    assert_memory_equal(&before, &after, sizeof before);
+    dp.linear_solver = SPH_DFSPH_JACOBI;
+    EXPECT_OK(sph_world_set_dfsph_params(f->dfsph, &dp));
+    EXPECT_OK(sph_world_set_dfsph_params(f->dfsph, &before));
+  }
 }
 
 /* Every described bound is enforced at that very value: just past it fails naming the field,

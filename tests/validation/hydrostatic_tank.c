@@ -72,11 +72,14 @@ static void open_tank(const tank_case* tc, double gap, support_world* w, sph_sdf
   if (tc->solver != SPH_SOLVER_DFSPH) params.step_limits = SPH_STEP_LIMIT_ACOUSTIC;
   if (tc->dt_max > 0.0f) params.dt_max = tc->dt_max;
   EXPECT_OK(sph_world_set_params(w->world, &params));
-  if (tc->solver == SPH_SOLVER_DFSPH && tc->density_error > 0.0f) {
+  if (tc->solver == SPH_SOLVER_DFSPH && (tc->density_error > 0.0f || tc->dfsph_flags)) {
     sph_dfsph_params dp;
     sph_dfsph_params_init(&dp);
-    dp.density_error = tc->density_error;
-    dp.max_iterations = 1000;
+    if (tc->density_error > 0.0f) {
+      dp.density_error = tc->density_error;
+      dp.max_iterations = 1000;
+    }
+    dp.flags = tc->dfsph_flags;
     EXPECT_OK(sph_world_set_dfsph_params(w->world, &dp));
   }
   *k = params.stiffness;
@@ -251,12 +254,13 @@ void run_tank(const tank_case* tc) {
                         "the gauges' pressure (the SPH interpolant, horizontal lines), per slice");
     }
     {
-      FILE* out = validation_open_output(
-          tc->solver == SPH_SOLVER_DFSPH
-              ? (tc->features ? "hydrostatic_dfsph_boundary.txt" : "hydrostatic_dfsph.txt")
-          : tc->eos == SPH_EOS_TAIT ? "hydrostatic_tait.txt"
-          : tc->features            ? "hydrostatic_ideal_gas_boundary.txt"
-                                    : "hydrostatic_ideal_gas.txt");
+      FILE* out = validation_open_output(tc->solver == SPH_SOLVER_DFSPH
+                                             ? (tc->dfsph_flags ? "hydrostatic_dfsph_corrected.txt"
+                                                : tc->features  ? "hydrostatic_dfsph_boundary.txt"
+                                                                : "hydrostatic_dfsph.txt")
+                                         : tc->eos == SPH_EOS_TAIT ? "hydrostatic_tait.txt"
+                                         : tc->features            ? "hydrostatic_ideal_gas_boundary.txt"
+                                                                   : "hydrostatic_ideal_gas.txt");
       if (out) {
         fprintf(out, "%s %u %.3f %.3f %.2f %.3e %.4f\n", tc->name, n, 100.0 * fit.mean, 100.0 * fit.worst,
                 (fit.surface - top_layer) / h, lowest / def.particle_spacing, 100.0 * rest_share);

@@ -21,6 +21,7 @@ typedef struct tank_case {
   double seconds;        /* simulated time */
   float dt_max;          /* the step's ceiling, s (0: the library's default, 1 ms) */
   float density_error;   /* DFSPH's density-solve bound (0: the library's default, 0.1 %) */
+  uint32_t dfsph_flags;  /* sph_dfsph_params.flags (SPH_DFSPH_CORRECTED_GRADIENT) */
   /* The settling experiments (docs/validation.md, "DFSPH: hydrostatic tank"); 0 = as before. */
   float frame;           /* frame length, s (0: 0.02); one substep's (dt_max) samples every substep */
   double window;         /* the averaged share of the run (0: the second half) */

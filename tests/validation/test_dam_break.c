@@ -115,6 +115,8 @@ static void test_dam_break(void** state) {
 /* SPH_DFSPH_JACOBI or SPH_DFSPH_CONJUGATE_GRADIENTS for the DFSPH cases (0: the default); the
  * _cg cases hold the conjugate gradients' solve to the same bounds. */
 static uint32_t dfsph_linear_solver = 0;
+/* sph_dfsph_params.flags for the DFSPH cases (the _corrected cases: SPH_DFSPH_CORRECTED_GRADIENT). */
+static uint32_t dfsph_flags = 0;
 
 static void run_dfsph(uint32_t features) {
   sph_context* context = NULL;
@@ -127,6 +129,7 @@ static void run_dfsph(uint32_t features) {
   config.solver = SPH_SOLVER_DFSPH;
   config.features = features;
   config.dfsph_linear_solver = dfsph_linear_solver;
+  config.dfsph_flags = dfsph_flags;
   r = dam_break_run(context, &config, result, trace_line, getenv("SPH_TRACE") ? stdout : NULL);
   if (r != SPH_OK) printf("dam break failed: %s: %s\n", sph_result_string(r), result->message);
   assert_int_equal(r, SPH_OK);
@@ -150,7 +153,10 @@ static void run_dfsph(uint32_t features) {
       100.0 * result->mean_error_unshifted, 100.0 * result->max_error_unshifted,
       100.0 * result->max_compression, result->escaped);
   {
-    FILE* out = validation_open_output(features ? "dam_break_dfsph_boundary.txt" : "dam_break_dfsph.txt");
+    FILE* out = validation_open_output(
+        dfsph_flags ? (features ? "dam_break_dfsph_boundary_corrected.txt" : "dam_break_dfsph_corrected.txt")
+        : features  ? "dam_break_dfsph_boundary.txt"
+                    : "dam_break_dfsph.txt");
     if (out) {
       fprintf(out, "%u %u %.4f %.3f %.3f %.5f %llu %llu\n", config.layers_across, result->particles,
               result->shift_T, 100.0 * result->mean_error, 100.0 * result->max_error,
@@ -214,10 +220,15 @@ static void test_dfsph_capped(void** state) {
   EXPECT_OK(sph_context_destroy(context));
 }
 
-/* argv[1] picks one case (wcsph | diffusion | dfsph | dfsph_boundary | dfsph_capped, and dfsph_cg
- * with the conjugate gradients' density solve); none runs wcsph. */
+/* argv[1] picks one case (wcsph | diffusion | dfsph | dfsph_boundary | dfsph_capped, dfsph_cg
+ * with the conjugate gradients' density solve, dfsph_corrected and dfsph_boundary_corrected with
+ * SPH_DFSPH_CORRECTED_GRADIENT); none runs wcsph. */
 int main(int argc, char** argv) {
   const char* which = argc >= 2 ? argv[1] : "wcsph";
+  if (strcmp(which, "dfsph_corrected") == 0 || strcmp(which, "dfsph_boundary_corrected") == 0) {
+    dfsph_flags = SPH_DFSPH_CORRECTED_GRADIENT;
+    which = strcmp(which, "dfsph_corrected") == 0 ? "dfsph" : "dfsph_boundary";
+  }
   if (strcmp(which, "dfsph_cg") == 0) {
     dfsph_linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS;
     which = "dfsph";

@@ -40,9 +40,10 @@
 
 typedef struct sphere_case {
   const char* name;
-  double disturbance; /* start speeds uniform in [-d, d] per component, m/s */
-  int check_density;  /* assert the interior density bounds */
-  sph_solver solver;  /* 0: the weakly compressible scheme */
+  double disturbance;   /* start speeds uniform in [-d, d] per component, m/s */
+  int check_density;    /* assert the interior density bounds */
+  sph_solver solver;    /* 0: the weakly compressible scheme */
+  uint32_t dfsph_flags; /* sph_dfsph_params.flags (SPH_DFSPH_CORRECTED_GRADIENT) */
 } sphere_case;
 
 static void run_sphere(const sphere_case* sc) {
@@ -69,6 +70,13 @@ static void run_sphere(const sphere_case* sc) {
   ball.speed = disturbance;
   EXPECT_OK(support_rest_sphere_open(&w, sph_test_backend(), &def, &params, &ball, &n));
   world = w.world;
+  if (sc->dfsph_flags) {
+    sph_dfsph_params dp;
+    sph_dfsph_params_init(&dp);
+    EXPECT_OK(sph_world_get_dfsph_params(world, &dp));
+    dp.flags = sc->dfsph_flags;
+    EXPECT_OK(sph_world_set_dfsph_params(world, &dp));
+  }
   h = w.def.kernel_radius;
   rest = w.def.rest_density;
   mass = w.mass;
@@ -185,37 +193,45 @@ static void run_sphere(const sphere_case* sc) {
 }
 
 static void test_rest(void** state) {
-  const sphere_case sc = {"rest", 0.0, 1, SPH_SOLVER_WCSPH};
+  const sphere_case sc = {"rest", 0.0, 1, SPH_SOLVER_WCSPH, 0u};
   (void)state;
   run_sphere(&sc);
 }
 
 static void test_disturbed(void** state) {
-  const sphere_case sc = {"disturbed", 1e-3, 0, SPH_SOLVER_WCSPH};
+  const sphere_case sc = {"disturbed", 1e-3, 0, SPH_SOLVER_WCSPH, 0u};
   (void)state;
   run_sphere(&sc);
 }
 
 static void test_disturbed_density(void** state) {
-  const sphere_case sc = {"disturbed_density", 1e-3, 1, SPH_SOLVER_WCSPH};
+  const sphere_case sc = {"disturbed_density", 1e-3, 1, SPH_SOLVER_WCSPH, 0u};
   (void)state;
   run_sphere(&sc);
 }
 
 /* DFSPH (issue 16 item 4): the same sphere and bounds with the incompressible solver. */
 static void test_dfsph_rest(void** state) {
-  const sphere_case sc = {"dfsph_rest", 0.0, 1, SPH_SOLVER_DFSPH};
+  const sphere_case sc = {"dfsph_rest", 0.0, 1, SPH_SOLVER_DFSPH, 0u};
+  (void)state;
+  run_sphere(&sc);
+}
+
+/* The same with DFSPH's corrected gradient (SPH_DFSPH_CORRECTED_GRADIENT). */
+static void test_dfsph_rest_corrected(void** state) {
+  const sphere_case sc = {"dfsph_rest_corrected", 0.0, 1, SPH_SOLVER_DFSPH, SPH_DFSPH_CORRECTED_GRADIENT};
   (void)state;
   run_sphere(&sc);
 }
 
 static void test_dfsph_disturbed(void** state) {
-  const sphere_case sc = {"dfsph_disturbed", 1e-3, 1, SPH_SOLVER_DFSPH};
+  const sphere_case sc = {"dfsph_disturbed", 1e-3, 1, SPH_SOLVER_DFSPH, 0u};
   (void)state;
   run_sphere(&sc);
 }
 
-/* argv[1] picks one run (rest | disturbed | disturbed_density | dfsph_rest | dfsph_disturbed);
+/* argv[1] picks one run (rest | disturbed | disturbed_density | dfsph_rest | dfsph_rest_corrected |
+ * dfsph_disturbed);
  * none runs rest and disturbed. */
 int main(int argc, char** argv) {
   const struct CMUnitTest rest[] = {cmocka_unit_test(test_rest)};
@@ -223,7 +239,10 @@ int main(int argc, char** argv) {
   const struct CMUnitTest disturbed_density[] = {cmocka_unit_test(test_disturbed_density)};
   const struct CMUnitTest dfsph_rest[] = {cmocka_unit_test(test_dfsph_rest)};
   const struct CMUnitTest dfsph_disturbed[] = {cmocka_unit_test(test_dfsph_disturbed)};
+  const struct CMUnitTest dfsph_rest_corrected[] = {cmocka_unit_test(test_dfsph_rest_corrected)};
   int failed = 0;
+  if (argc >= 2 && strcmp(argv[1], "dfsph_rest_corrected") == 0)
+    failed += cmocka_run_group_tests_name("rest_sphere_dfsph_corrected", dfsph_rest_corrected, NULL, NULL);
   if (argc >= 2 && strcmp(argv[1], "dfsph_rest") == 0)
     failed += cmocka_run_group_tests_name("rest_sphere_dfsph", dfsph_rest, NULL, NULL);
   if (argc >= 2 && strcmp(argv[1], "dfsph_disturbed") == 0)

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '7e8caf62b53ff6d585666820b690fe59fd7cbb3df9e59dc005bf9cec023f35e9', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '362e44e1ccc1165337a077cb036bb83b543ff1eff739448d385b420b64684202', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -89,6 +89,11 @@ SPH_STEP_LIMIT_ACOUSTIC = 1
 SPH_STEP_LIMIT_FORCE = 2
 #: sph_dfsph_params.flags no divergence solve (cheaper; a noisier pressure)
 SPH_DFSPH_SKIP_DIVERGENCE_SOLVE = 1
+#: the Jacobi solves' pressure gradient corrected to first order (Bonet & Lok's L_i;
+#: docs/physics.md, \ DFSPH): a resting fluid's pressure within 0.5 % of rho0 g d, but momentum
+#: only nearly conserved    \ and energy not bounded in violent flow; not with
+#: SPH_DFSPH_CONJUGATE_GRADIENTS
+SPH_DFSPH_CORRECTED_GRADIENT = 2
 #: sph_dfsph_params.linear_solver (docs/physics.md, DFSPH) the Jacobi step of Bender & Koschier
 #: (the default)
 SPH_DFSPH_JACOBI = 1
