@@ -337,8 +337,8 @@ typedef struct sph_context_def {
      they walk every candidate (no memory, slower passes). The same bits either way. A CPU context
      and a weakly compressible world check and ignore it; any other value is INVALID_ARGUMENT. */
   uint32_t cuda_dfsph_masks;
-  sph_log_fn log_fn; /* optional; NULL = no logging */
-  void* log_user_data;       /* passed to log_fn */
+  sph_log_fn log_fn;   /* optional; NULL = no logging */
+  void* log_user_data; /* passed to log_fn */
   /* Tuning of the CUDA backend (a CPU context checks and ignores it; docs/cuda.md). Results do
      not depend on it: every choice computes the same particles bit for bit, except
      cuda_particle_lanes (the order of the neighbour sums: the last bits). */
