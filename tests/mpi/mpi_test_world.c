@@ -132,6 +132,20 @@ void mpi_test_read(sph_world* single, uint32_t n, float** x, float** v) {
   REQUIRE(support_copy_by_id(single, SPH_ATTRIBUTE_VELOCITY, (void**)v, &m) == SPH_OK && m == n, "read");
 }
 
+void mpi_test_add_top_sink(sph_world* world) {
+  sph_sink_def sink;
+  sph_sink_id id;
+  REQUIRE(sph_sink_def_init(&sink) == SPH_OK, "sink init");
+  sink.mode = SPH_SINK_OUTSIDE_BOUNDS;
+  sink.bounds_min.x = -1.0f;
+  sink.bounds_min.y = -1.0f;
+  sink.bounds_min.z = -1.0f;
+  sink.bounds_max.x = 1.0f;
+  sink.bounds_max.y = 0.185f;
+  sink.bounds_max.z = 1.0f;
+  REQUIRE(sph_sink_create(world, &sink, &id) == SPH_OK, "sink: %s", sph_get_last_error());
+}
+
 void mpi_test_add_probes(sph_world* world, sph_probe_id* point, sph_probe_id* gauge) {
   sph_probe_def def;
   REQUIRE(sph_probe_def_init(&def) == SPH_OK, "probe init");

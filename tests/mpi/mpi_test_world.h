@@ -69,6 +69,9 @@ void mpi_test_read(sph_world* single, uint32_t n, float** x, float** v);
 /* A point probe at (0.05, 0.02, 0.03) m and a gauge 0.25 m long from (0.031, -0.01, 0.027) m against
  * gravity, both sampled every substep (the stirred column's probes). */
 void mpi_test_add_probes(sph_world* world, sph_probe_id* point, sph_probe_id* gauge);
+/* A sink removing every particle outside [-1, 1] x [-1, 0.185] x [-1, 1] m: the stirred column's
+ * top, where splashes go. */
+void mpi_test_add_top_sink(sph_world* world);
 /* The last step's removed ids (malloc'd, *count of them) and its SPH_EVENT_SINK_REMOVED count. */
 uint32_t* mpi_test_removed_ids(sph_world* world, uint32_t* count, uint32_t* event_count);
 /* The path of rank `rank`'s file named in the manifest at `manifest` (in its directory; the

@@ -193,20 +193,6 @@ void mpi_cuda_probes_case(const char* name, sph_context* cuda, sph_solver solver
   sph_world_destroy(w.world);
 }
 
-static void add_sink(sph_world* w) {
-  sph_sink_def sink;
-  sph_sink_id id;
-  REQUIRE(sph_sink_def_init(&sink) == SPH_OK, "sink init");
-  sink.mode = SPH_SINK_OUTSIDE_BOUNDS;
-  sink.bounds_min.x = -1.0f;
-  sink.bounds_min.y = -1.0f;
-  sink.bounds_min.z = -1.0f;
-  sink.bounds_max.x = 1.0f;
-  sink.bounds_max.y = 0.185f;
-  sink.bounds_max.z = 1.0f;
-  REQUIRE(sph_sink_create(w, &sink, &id) == SPH_OK, "sink: %s", sph_get_last_error());
-}
-
 static int compare_ids(const void* a, const void* b) {
   const uint32_t x = *(const uint32_t*)a, y = *(const uint32_t*)b;
   return (x > y) - (x < y);
@@ -261,8 +247,8 @@ void mpi_cuda_sinks_case(const char* name, sph_context* cuda, sph_solver solver)
   def.capacity = 32768;
   def.solver = solver;
   mpi_test_make_worlds(cuda, &def, column_min, column_max, 0.5f, MPI_COMM_WORLD, NULL, &w);
-  add_sink(w.world);
-  if (w.single) add_sink(w.single);
+  mpi_test_add_top_sink(w.world);
+  if (w.single) mpi_test_add_top_sink(w.single);
   for (int f = 0; f < 2; ++f) {
     uint32_t mine = 0, mine_events = 0, events = 0, world_removed = 0, gathered_n = 0;
     uint32_t* mine_ids;

@@ -26,8 +26,6 @@ static void add_source_and_sink(sph_context* context, sph_world* w) {
   sph_sdf* box = NULL;
   sph_source_def source;
   sph_source_id source_id;
-  sph_sink_def sink;
-  sph_sink_id sink_id;
   REQUIRE(sph_shape_desc_init(&shape) == SPH_OK, "shape init");
   shape.half_extents.x = 0.03f;
   shape.half_extents.y = 0.095f;
@@ -45,15 +43,7 @@ static void add_source_and_sink(sph_context* context, sph_world* w) {
   source.velocity.x = -0.5f;
   REQUIRE(sph_source_create(w, &source, &source_id) == SPH_OK, "source");
   sph_sdf_destroy(box);
-  REQUIRE(sph_sink_def_init(&sink) == SPH_OK, "sink init");
-  sink.mode = SPH_SINK_OUTSIDE_BOUNDS;
-  sink.bounds_min.x = -1.0f;
-  sink.bounds_min.y = -1.0f;
-  sink.bounds_min.z = -1.0f;
-  sink.bounds_max.x = 1.0f;
-  sink.bounds_max.y = 0.185f;
-  sink.bounds_max.z = 1.0f;
-  REQUIRE(sph_sink_create(w, &sink, &sink_id) == SPH_OK, "sink");
+  mpi_test_add_top_sink(w);
 }
 
 /* The particles SPH_EVENT_SOURCE_CAPACITY_REACHED says the last step did not emit. */

@@ -62,20 +62,6 @@ static void set_springs(sph_world* w, const spring_case* c) {
   REQUIRE(sph_world_set_spring_params(w, &p) == SPH_OK, "set spring params");
 }
 
-static void add_sink(sph_world* w) {
-  sph_sink_def sink;
-  sph_sink_id id;
-  REQUIRE(sph_sink_def_init(&sink) == SPH_OK, "sink init");
-  sink.mode = SPH_SINK_OUTSIDE_BOUNDS;
-  sink.bounds_min.x = -1.0f;
-  sink.bounds_min.y = -1.0f;
-  sink.bounds_min.z = -1.0f;
-  sink.bounds_max.x = 1.0f;
-  sink.bounds_max.y = 0.185f;
-  sink.bounds_max.z = 1.0f;
-  REQUIRE(sph_sink_create(w, &sink, &id) == SPH_OK, "sink");
-}
-
 /* A block [0.25, 0.33] x [0, 0.08] x [0, 0.06]: filled into the undivided world (rank 0) and added
  * to the distributed one by the last rank alone, with the same positions; *n grows on every rank. */
 static void add_block(sph_world* single, sph_world* world, uint32_t* n) {
@@ -169,7 +155,7 @@ static void run_case(sph_context* context, const spring_case* c) {
   (void)single_tank;
   (void)tank;
   set_springs(world, c);
-  if (c->sink) add_sink(world);
+  if (c->sink) mpi_test_add_top_sink(world);
   if (g_rank == 0) {
     uint32_t* ids = NULL;
     float* x = NULL;
@@ -178,7 +164,7 @@ static void run_case(sph_context* context, const spring_case* c) {
     REQUIRE(m == n, "the column");
     pairs = linked_pairs(x, n, &pair_count);
     set_springs(single, c);
-    if (c->sink) add_sink(single);
+    if (c->sink) mpi_test_add_top_sink(single);
     free(ids);
     free(x);
     free(v);
