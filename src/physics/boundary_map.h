@@ -164,7 +164,17 @@ SPH_HD float boundary_map_correction(const SdfGridView& g, const Affine3x4& inde
   const Vec3 x =
       apply_affine(index_to_local, Vec3{static_cast<float>(i), static_cast<float>(j), static_cast<float>(k)});
   const float share = boundary_quadrature_share(g, x, phi, h, level);
-  if (map_corrects_distance(level)) return spiky_half_space_inverse(share, h) - phi;
+  if (map_corrects_distance(level)) {
+    // The inverse's slope grows without bound as the share nears 0 or 1 (one float ulp at 1 moves
+    // the distance by 0.03 h), and the quadrature's share carries rounding errors of order 1e-7
+    // whatever its size, which the host's and the device's compilations make differently: a share
+    // within kShareMargin of 0 or 1 is inverted at the margin (dD/dq there about 2e3 h, so 1e-7
+    // moves D by 2e-4 h), an over- or under-read of at most kShareMargin of the share.
+    constexpr float kShareMargin = 1e-5f;
+    const float q =
+        share < kShareMargin ? kShareMargin : (share > 1.0f - kShareMargin ? 1.0f - kShareMargin : share);
+    return spiky_half_space_inverse(q, h) - phi;
+  }
   return share - local_boundary_share(g, nullptr, 1.0f, level, h, x).share;
 }
 
