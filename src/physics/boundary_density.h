@@ -22,10 +22,11 @@
 // phi the SDF (trilinear), sigma the collider's sign (-1 for an inverted collider, whose solid is
 // the complement: Phi = 1 - the share of {phi < L}), Phi_flat the closed-form half-space share
 // (boundary_integrals.h), and the correction for the level L what curvature, corners and thin
-// walls add, computed per asset, kernel radius and level by a quadrature over the solid (value
-// and gradient per voxel) and interpolated as a cubic Hermite of both. The gradient being that
-// of the sampled value makes the wall's force conservative (local_boundary_share). A flat wall
-// is exact at any voxel size (the trilinear SDF of a plane is the plane).
+// walls add (a solid's map, L < 0, corrects the distance instead: Phi = Phi_flat(phi - L + e(x)),
+// e the map's offset; map_corrects_distance says why), computed per asset, kernel radius and level by a
+// quadrature over the solid (value and gradient per voxel) and interpolated as a cubic Hermite of both. The
+// gradient being that of the sampled value makes the wall's force conservative (local_boundary_share). A flat
+// wall is exact at any voxel size (the trilinear SDF of a plane is the plane).
 //
 // The pressure force of the wall (Akinci et al. 2012 with the wall's share as the boundary
 // "particles"): a_i = -(p_i / rho_i^2) grad rho_b(x_i). It is minus the gradient of the fluid's
@@ -198,6 +199,13 @@ SPH_HD InterpolatedCorrection hermite_correction(const Float4* data, const SdfGr
   return out;
 }
 
+// The form of a map's correction for the solid {phi < level} (boundary_map.h): a distance where the
+// level lies below the SDF's surface (a solid collider's map: its solid moved delta into it, the
+// particles outside it, where a convex edge's share falls far below the flat share and an added
+// share interpolated across the edge went negative), a share elsewhere (a container's map, whose
+// particles lie inside the cavity grown by delta; and level 0).
+SPH_HD bool map_corrects_distance(float level) { return level < 0.0f; }
+
 // Phi and grad Phi (local frame) of the solid where sigma (phi - level) < 0, at a local point: the
 // flat-wall share of the trilinear SDF plus the map's correction for that level (null map: the
 // flat-wall share alone).
@@ -223,26 +231,33 @@ SPH_HD LocalBoundaryShare local_boundary_share(const SdfGridView& g, const Float
     const float n = length(away);
     if (n > 0.0f) gradient_index += away * (g.min_voxel_size / n);
   }
-  distance = sign * (distance - level);
-  LocalBoundaryShare out;
-  out.share = spiky_half_space(distance, h);
-  // The gradient is that of the sampled share itself (the flat share's through the trilinear
-  // SDF's, plus the correction's Hermite interpolant's), not an interpolation of gradients: the
-  // wall's force is then minus the gradient of the energy the density pass sees, so a static wall
-  // does no net work on a particle that comes back to where it was. Trilinear interpolation of
-  // the map's value and gradient channels separately did not hold that: where the SDF has a kink
-  // (a box's edges) the two disagree by up to 10 % of the slope, and a closed tank at rest gained
-  // 0.5-0.9 J/s without viscosity (docs/physics.md, "Energy").
-  Vec3 share_gradient = gradient_index * (spiky_half_space_slope(distance, h) * sign);
+  // The map's correction (boundary_map.h): for a solid's map a distance, the offset e by which the
+  // flat share must be moved to give the solid's share; for a container's a share added to it.
+  const bool as_distance = map_corrects_distance(level);
+  float offset = 0.0f, added = 0.0f;
+  Vec3 offset_gradient{0.0f, 0.0f, 0.0f}, added_gradient{0.0f, 0.0f, 0.0f};
   // A map node is nonzero only where |phi - level| < h (boundary_map.h); a cell none of whose
   // corners is there interpolates zero, so it is not read. (The test is on the corners rather
   // than on the sample's distance so that the sampled share has no step at the band's edge.)
   if (correction && phi.lo - level < h && phi.hi - level > -h) {
     InterpolatedCorrection d = hermite_correction(correction, g, cell);
     if (cell.outside > 0.0f) d.gradient = without_clamped_axes(d.gradient, g, idx);
-    out.share += sign * d.value;
-    share_gradient += d.gradient * sign;
+    (as_distance ? offset : added) = d.value;
+    (as_distance ? offset_gradient : added_gradient) = d.gradient;
   }
+  distance = sign * (distance - level + offset);
+  LocalBoundaryShare out;
+  out.share = spiky_half_space(distance, h) + sign * added;
+  // The gradient is that of the sampled share itself (the flat share's slope times the gradient of
+  // the trilinear SDF and the offset, plus the added share's Hermite interpolant's), not an
+  // interpolation of gradients: the wall's force is then minus the gradient of the energy the
+  // density pass sees, so a static wall does no net work on a particle that comes back to where it
+  // was. Trilinear interpolation of a map's value and gradient channels separately did not hold
+  // that: where the SDF has a kink (a box's edges) the two disagree by up to 10 % of the slope, and
+  // a closed tank at rest gained 0.5-0.9 J/s without viscosity (docs/physics.md, "Energy").
+  const Vec3 share_gradient =
+      (gradient_index + offset_gradient) * (spiky_half_space_slope(distance, h) * sign) +
+      added_gradient * sign;
   out.gradient = apply_linear_transposed(g.local_to_index, share_gradient);
   return out;
 }

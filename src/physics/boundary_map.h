@@ -8,7 +8,12 @@
 // of those values, which the sampling's cubic Hermite interpolation takes at the voxels: one
 // Float4 (correction, slope x, slope y, slope z) per voxel. Zero where |phi - L| >= h: the kernel
 // sees one side only there (for an SDF that is a distance), so the voxels to compute are a band
-// of 2 h around the surface; the rest of the map is zero. Both backends call
+// of 2 h around the surface; the rest of the map is zero. For a solid collider's map (level < 0,
+// map_corrects_distance) the value is a distance instead, the offset e with
+// Phi_flat(phi - level + e) = Phi at the node, interpolated and differenced the same way: outside a
+// solid's convex edge an added share is nearly minus the flat share, a quintic of the distance
+// that the interpolation across an edge between samples missed by up to 0.035 and made negative
+// (docs/physics.md, "A solid's map corrects the distance"). Both backends call
 // boundary_map_correction per band voxel, then, with every value in place, boundary_map_slope:
 // the CPU backend on host threads, the CUDA backend one thread per voxel.
 //
@@ -132,8 +137,24 @@ SPH_HD float boundary_quadrature_share(const SdfGridView& g, Vec3 x, float phi, 
   return share;
 }
 
-// The correction of voxel (i, j, k) for the solid {phi < level}; index_to_local is the inverse of
-// g.local_to_index.
+// The flat share's inverse: the distance D in [-h, h] from a flat wall at which the half space's
+// share is q (spiky_half_space decreases from 1 at -h to 0 at h), by bisection in double (the
+// map's construction only); q <= 0 gives h and q >= 1 gives -h.
+SPH_HD float spiky_half_space_inverse(float q, float h) {
+  double lo = -static_cast<double>(h), hi = static_cast<double>(h);
+  if (!(q > 0.0f)) return h;
+  if (!(q < 1.0f)) return -h;
+  for (int k = 0; k < 48; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (spiky_half_space<double>(mid, h) > static_cast<double>(q) ? lo : hi) = mid;
+  }
+  return static_cast<float>(0.5 * (lo + hi));
+}
+
+// The correction of voxel (i, j, k) for the solid {phi < level} (index_to_local is the inverse of
+// g.local_to_index): for a solid's map (map_corrects_distance) the offset e (m) that makes the flat
+// share of the moved distance the quadrature's share, Phi_flat(phi - level + e) = Phi; otherwise
+// the share Phi - Phi_flat(phi - level).
 SPH_HD float boundary_map_correction(const SdfGridView& g, const Affine3x4& index_to_local, int32_t i,
                                      int32_t j, int32_t k, float h, float level) {
   const float phi =
@@ -142,8 +163,19 @@ SPH_HD float boundary_map_correction(const SdfGridView& g, const Affine3x4& inde
   if (!(phi > -h && phi < h)) return 0.0f;
   const Vec3 x =
       apply_affine(index_to_local, Vec3{static_cast<float>(i), static_cast<float>(j), static_cast<float>(k)});
-  return boundary_quadrature_share(g, x, phi, h, level) -
-         local_boundary_share(g, nullptr, 1.0f, level, h, x).share;
+  const float share = boundary_quadrature_share(g, x, phi, h, level);
+  if (map_corrects_distance(level)) {
+    // The inverse's slope grows without bound as the share nears 0 or 1 (one float ulp at 1 moves
+    // the distance by 0.03 h), and the quadrature's share carries rounding errors of order 1e-7
+    // whatever its size, which the host's and the device's compilations make differently: a share
+    // within kShareMargin of 0 or 1 is inverted at the margin (dD/dq there about 2e3 h, so 1e-7
+    // moves D by 2e-4 h), an over- or under-read of at most kShareMargin of the share.
+    constexpr float kShareMargin = 1e-5f;
+    const float q =
+        share < kShareMargin ? kShareMargin : (share > 1.0f - kShareMargin ? 1.0f - kShareMargin : share);
+    return spiky_half_space_inverse(q, h) - phi;
+  }
+  return share - local_boundary_share(g, nullptr, 1.0f, level, h, x).share;
 }
 
 // The slopes (d/d index) the sampling's Hermite interpolation takes at voxel (i, j, k): central

@@ -8,6 +8,7 @@
 //   physics_loads_breakdown [--backend cpu|cuda] [--solver wcsph|dfsph] [--dt-max SECONDS]
 //                           [--settle SECONDS] [--perturb SEED] [--frames N] [--check-loads]
 //                           [--self-check | --self-check-only] [--step METRES] [--sample-every N]
+//                           [--box-voxel METRES]
 //
 // --step: the lattice step (default 0.01 m; issue 17, "Loads against resolution" in
 // docs/validation.md): the layers fill the same tank (16 x 20 x 16 cm rounded to whole layers), h,
@@ -19,6 +20,11 @@
 // scripts (scripts/loads-resolution). --check-loads: fail unless the loads on the box
 // equal the host's sum of its walls' reaction and the loads on both colliders the fluid's
 // momentum change (M g - dP/dt), each within 1e-3 N (the ctest physics_loads_breakdown_dfsph).
+//
+// --box-voxel: the box's SDF voxel (default: about step / 2, a whole number across its half side, so
+// that its faces lie on samples); 0.0055 at the default step puts its faces between samples, as a
+// user's box usually is (docs/validation.md, "The submerged box: particles resting on a box whose
+// faces lie between samples").
 //
 // --perturb moves every lattice point by up to 1e-7 m (uniform per axis, a generator seeded with
 // SEED): a change of the size of a float's rounding, to see how far the box's settled state
@@ -80,6 +86,7 @@
 #include "cpu/cpu_parallel.h"
 #include "physics/boundary_density.h"
 #include "physics/boundary_integrals.h"
+#include "substep_reader.h"
 #include "support.h"
 
 namespace {
@@ -111,7 +118,7 @@ int main(int argc, char** argv) {
   int frames = 0, every = 1;
   double settle_time = 0.8, step = 0.01;
   unsigned long perturb = 0;
-  double dt_max = 0.0;
+  double dt_max = 0.0, box_voxel_arg = 0.0;
   for (int k = 1; k < argc; ++k) {
     if (std::strcmp(argv[k], "--backend") == 0 && k + 1 < argc)
       backend_name = argv[++k];
@@ -131,6 +138,8 @@ int main(int argc, char** argv) {
       step = std::atof(argv[++k]);
     else if (std::strcmp(argv[k], "--sample-every") == 0 && k + 1 < argc)
       every = std::max(1, std::atoi(argv[++k]));
+    else if (std::strcmp(argv[k], "--box-voxel") == 0 && k + 1 < argc)
+      box_voxel_arg = std::atof(argv[++k]);
     else if (std::strcmp(argv[k], "--check-loads") == 0)
       check_loads = true;
     else if (std::strcmp(argv[k], "--self-check-only") == 0)
@@ -140,23 +149,25 @@ int main(int argc, char** argv) {
           stderr,
           "usage: %s [--backend cpu|cuda] [--solver wcsph|dfsph] [--dt-max SECONDS] [--settle "
           "SECONDS] [--perturb SEED] [--frames N] [--check-loads] [--self-check | --self-check-only] [--step "
-          "METRES] [--sample-every N]\n",
+          "METRES] [--sample-every N] [--box-voxel METRES]\n",
           argv[0]);
       return 2;
     }
   }
-  if (!(step >= 0.002 && step <= 0.02) || (check_loads && every > 1)) {
+  if (!(step >= 0.002 && step <= 0.02) || (check_loads && every > 1) ||
+      !(box_voxel_arg == 0.0 || (box_voxel_arg >= 0.001 && box_voxel_arg <= 0.02))) {
     // --check-loads compares the momentum over the whole window with the sampled substeps' loads.
     std::fprintf(stderr,
-                 "--step %g: give a lattice step between 0.002 and 0.02 m (and --check-loads without "
-                 "--sample-every)\n",
-                 step);
+                 "--step %g, --box-voxel %g: give a lattice step between 0.002 and 0.02 m, a box voxel "
+                 "between 0.001 and 0.02 m (and --check-loads without --sample-every)\n",
+                 step, box_voxel_arg);
     return 2;
   }
   const sph_backend backend = support_backend_from_name(backend_name, SPH_BACKEND_CPU);
   // The box's voxels: about step / 2, a whole number of them across its half side, so that its faces
   // lie on samples as at 1 cm (6 of 5 mm), where the trilinear field's zero level is exact.
-  const double box_voxel = kHalf / std::max(1.0, std::round(kHalf / (0.5 * step)));
+  const double box_voxel =
+      box_voxel_arg > 0.0 ? box_voxel_arg : kHalf / std::max(1.0, std::round(kHalf / (0.5 * step)));
   const auto started = std::chrono::steady_clock::now();
 
   // The scene of test_collider_loads.c's submerged_box_force.
@@ -260,7 +271,8 @@ int main(int argc, char** argv) {
   double interior_ratio = 0.0, interior_count = 0.0, level_sum = 0.0, plane_sum = 0.0;
   double api[3] = {0.0, 0.0, 0.0}, api_time = 0.0;
   int samples = 0;
-  std::vector<float> x(3 * static_cast<size_t>(kept)), after(x.size()), rho(kept), p(kept);
+  loads_sampling::SubstepReader reader(kept);
+  std::vector<float>&x = reader.start, &after = reader.end, &rho = reader.density, &p = reader.pressure;
   // Settle 0.8 s (--settle) in frames of 20 ms, then 0.4 s in frames of 0.5 ms (at 1 cm; both limits scale
   // with h): one substep each (the step limits allow 1 ms), so the positions read before a frame are its
   // substep's start, where the density pass put the pressures and densities read after it.
@@ -335,21 +347,11 @@ int main(int argc, char** argv) {
         "read velocities");
   for (uint32_t i = 0; i < count; ++i)
     for (int k = 0; k < 3; ++k) momentum[k] -= static_cast<double>(w.mass) * velocity[3 * i + k];
-  bool have_start = false;  // x holds the next substep's start
   for (int frame = 0; frame < frames; ++frame) {
     const bool sampled = frame % every == 0;
-    if (sampled && !have_start)
-      check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, x.data(), kept, &count), "read positions");
-    const uint32_t took = step_counted(frame_time);
-    if (took != 1) {
-      std::fprintf(stderr, "frame %d took %u substeps, not 1: lower the frame time\n", frame, took);
-      return 1;
-    }
-    have_start = false;
+    if (!reader.frame(w.world, sampled, frame, frame_time, step_counted)) return 1;
     if (!sampled) continue;
-    check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, after.data(), kept, &count), "read positions");
-    check(support_read_by_id(w.world, SPH_ATTRIBUTE_DENSITY, rho.data(), kept, &count), "read densities");
-    check(support_read_by_id(w.world, SPH_ATTRIBUTE_PRESSURE, p.data(), kept, &count), "read pressures");
+    count = reader.count;
     if (loads) {
       sph_collider_loads l;
       check(sph_collider_loads_init(&l), "sph_collider_loads_init");
@@ -423,8 +425,7 @@ int main(int argc, char** argv) {
       if (interior(i, plane - 0.03)) interior_ratio += ratio, interior_count += 1.0;
     }
     ++samples;
-    x.swap(after);
-    have_start = true;
+    reader.advance();
   }
   const double mean_level = level_sum / samples;
   const double top_face = kCentre[1] + kHalf, bottom_face = kCentre[1] - kHalf;

@@ -39,6 +39,7 @@
 #include "cpu/cpu_parallel.h"
 #include "physics/boundary_density.h"
 #include "physics/boundary_integrals.h"
+#include "substep_reader.h"
 #include "support.h"
 
 namespace {
@@ -148,7 +149,9 @@ int main(int argc, char** argv) {
   const double tank_centre[3] = {0.5 * (tank_max[0] + tank_min[0]), 0.5 * (tank_max[1] + tank_min[1]),
                                  0.5 * (tank_max[2] + tank_min[2])};
 
-  std::vector<float> x(3 * static_cast<size_t>(n)), after(x.size()), velocity(x.size()), rho(n), p(n);
+  loads_sampling::SubstepReader reader(n);
+  std::vector<float>&x = reader.start, &rho = reader.density, &p = reader.pressure;
+  std::vector<float> velocity(x.size());
   uint64_t substeps = 0;  // all the world took, for the cost (particles x substeps)
   const auto step_counted = [&](float seconds) {
     check(sph_world_step(w.world, seconds), "sph_world_step");
@@ -162,7 +165,6 @@ int main(int argc, char** argv) {
   const float frame_time = static_cast<float>(0.0005 * step / 0.01);
   const int frames = static_cast<int>(std::lround(0.4 / frame_time));
   int samples = 0;
-  bool have_start = false;  // x holds the next substep's start
   uint32_t count = 0;
   double plane = 0.0, tank[3] = {0.0, 0.0, 0.0}, api = 0.0, api_time = 0.0, momentum[3] = {0.0, 0.0, 0.0};
   check(support_read_by_id(w.world, SPH_ATTRIBUTE_VELOCITY, velocity.data(), n, &count), "read velocities");
@@ -170,18 +172,9 @@ int main(int argc, char** argv) {
     for (int k = 0; k < 3; ++k) momentum[k] -= static_cast<double>(w.mass) * velocity[3 * i + k];
   for (int frame = 0; frame < frames; ++frame) {
     const bool sampled = frame % every == 0;
-    if (sampled && !have_start)
-      check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, x.data(), n, &count), "read positions");
-    const uint32_t took = step_counted(frame_time);
-    if (took != 1) {
-      std::fprintf(stderr, "frame %d took %u substeps, not 1\n", frame, took);
-      return 1;
-    }
-    have_start = false;
+    if (!reader.frame(w.world, sampled, frame, frame_time, step_counted)) return 1;
     if (!sampled) continue;
-    check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, after.data(), n, &count), "read positions");
-    check(support_read_by_id(w.world, SPH_ATTRIBUTE_DENSITY, rho.data(), n, &count), "read densities");
-    check(support_read_by_id(w.world, SPH_ATTRIBUTE_PRESSURE, p.data(), n, &count), "read pressures");
+    count = reader.count;
     if (loads) {
       sph_collider_loads l;
       check(sph_collider_loads_init(&l), "sph_collider_loads_init");
@@ -199,8 +192,7 @@ int main(int argc, char** argv) {
               .gradient;
       tank[0] += c * g.x, tank[1] += c * g.y, tank[2] += c * g.z;
     }
-    x.swap(after);
-    have_start = true;
+    reader.advance();
     ++samples;
   }
   check(support_read_by_id(w.world, SPH_ATTRIBUTE_VELOCITY, velocity.data(), n, &count), "read velocities");

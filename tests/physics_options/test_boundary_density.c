@@ -491,7 +491,12 @@ static void test_updated_asset_recomputes_its_map(void** state) {
       "from the old map's\n",
       worst, 100.0 * changed);
   assert_true(worst <= 1e-6);
-  assert_true(changed > 0.05); /* the ball grew into the slab's kernel support */
+  /* The ball grew into the slab's kernel support: its nearest particle lies about 0.69 h from the
+   * grown ball's moved surface (radius 0.1 m less delta), where a ball of 2.5 h holds a share of
+   * about 0.0018-0.0023 of the kernel (test_boundary_map.cpp's brute force at 0.71 h, radius 2.8 h),
+   * 2.2-2.8 % of rho0 at K = 12 rho0. Measured 2.0 % with a solid's map correcting the distance
+   * (boundary_map.h; its added share, before session 16, read more than 5 % on these 2 cm voxels). */
+  assert_true(changed > 0.01);
   free(small), free(large), free(before), free(updated), free(fresh);
 }
 
