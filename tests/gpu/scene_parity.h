@@ -148,7 +148,8 @@ inline void compare_scene(const SceneHooks& h) {
   std::map<uint32_t, uint32_t> gpu_index;
   for (uint32_t i = 0; i < g.state.count; ++i) gpu_index[g.state.id[i]] = i;
   double scale = 0.0, dp = 0.0, vscale = 1e-2, dv = 0.0;
-  uint32_t missing = 0;
+  uint32_t missing = 0, worst = 0;
+  std::vector<double> parted(c.state.count, 0.0);
   for (uint32_t i = 0; i < c.state.count; ++i) {
     const auto it = gpu_index.find(c.state.id[i]);
     if (it == gpu_index.end()) {
@@ -165,12 +166,31 @@ inline void compare_scene(const SceneHooks& h) {
       e2 += (cv - gv) * (cv - gv);
       w2 += cv * cv;
     }
+    parted[i] = std::sqrt(d2);
+    if (parted[i] > dp) worst = i;
     dp = std::max(dp, std::sqrt(d2));
     scale = std::max(scale, std::sqrt(p2));
     dv = std::max(dv, std::sqrt(e2));
     vscale = std::max(vscale, std::sqrt(w2));
   }
   report(missing == 0, (name + "/ids").c_str(), "%u of the CPU's ids missing on the GPU", missing);
+  // Where the two part: how many particles (a few at a contact branch, or all after a solve took
+  // another iteration count), the worst one's place, and the solves' iteration sums.
+  if (c.state.count > 0 && dp > 1e-4 * scale) {
+    uint32_t beyond = 0;
+    for (const double d : parted) beyond += d > 1e-4 * scale ? 1u : 0u;
+    std::printf(
+        "NOTE %s: %u particles part by more than 1e-4 of the extent; the worst, id %u, at (%.4f, %.4f, "
+        "%.4f) m on the CPU, v (%.3f, %.3f, %.3f) m/s\n",
+        name.c_str(), beyond, c.state.id[worst], c.state.position[3 * worst], c.state.position[3 * worst + 1],
+        c.state.position[3 * worst + 2], c.state.velocity[3 * worst], c.state.velocity[3 * worst + 1],
+        c.state.velocity[3 * worst + 2]);
+  }
+  if (h.spec.solver == SPH_SOLVER_DFSPH)
+    std::printf("NOTE %s: DFSPH iterations (GPU/CPU): density %u/%u (most %u/%u), divergence %u/%u\n",
+                name.c_str(), g.stats.pressure_iterations, c.stats.pressure_iterations,
+                g.stats.pressure_iterations_max, c.stats.pressure_iterations_max,
+                g.stats.divergence_iterations, c.stats.divergence_iterations);
   report_or_note(h.strict, dp <= 1e-4 * scale, name + "/positions",
                  format_detail("max |x_gpu - x_cpu| = %.3g m, %.3g relative to max |x| = %.3g m (limit 1e-4)",
                                dp, scale > 0 ? dp / scale : 0.0, scale));
