@@ -168,9 +168,12 @@ SPH_HD float boundary_map_correction(const SdfGridView& g, const Affine3x4& inde
     // The inverse's slope grows without bound as the share nears 0 or 1 (one float ulp at 1 moves
     // the distance by 0.03 h), and the quadrature's share carries rounding errors of order 1e-7
     // whatever its size, which the host's and the device's compilations make differently: a share
-    // within kShareMargin of 0 or 1 is inverted at the margin (dD/dq there about 2e3 h, so 1e-7
-    // moves D by 2e-4 h), an over- or under-read of at most kShareMargin of the share.
-    constexpr float kShareMargin = 1e-5f;
+    // within kShareMargin of 0 or 1 is inverted at the margin, an over- or under-read of at most
+    // kShareMargin of a whole wall's share. 1e-5 (the inverse's slope there about 2e3 h) was not
+    // enough: a DFSPH paddle driven through a ball parted by 2.5 mm within 10 substeps, on the CPU,
+    // when the shares were moved by +-1e-7 before the inversion (as the H200's did, by the same
+    // 2.5 mm); at 1e-3 the same perturbation moves the run by 3e-7 m (docs/physics.md).
+    constexpr float kShareMargin = 1e-3f;
     const float q =
         share < kShareMargin ? kShareMargin : (share > 1.0f - kShareMargin ? 1.0f - kShareMargin : share);
     return spiky_half_space_inverse(q, h) - phi;
