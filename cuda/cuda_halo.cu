@@ -31,7 +31,7 @@
 // core/dfsph_jacobi_loop.h: the ghosts take their owners' densities and factors after the density
 // pass, velocities and pressure steps within each iteration, and the mean error is an exact sum
 // added over the ranks) and its density solve by conjugate gradients (the host drives it as the
-// CPU rank's loop, dfsph_cg_solver.cu's enqueue_dfsph_cg_rank_solve: the ghosts take their owners'
+// CPU rank's loop, dfsph_cg_rank_solver.cu's enqueue_dfsph_cg_rank_solve: the ghosts take their owners'
 // search directions and velocity steps within each iteration, its sums are exact sums added over
 // the ranks, halo_dfsph_cg_world); attach_ranks refuses springs by name (the CPU rank runs them:
 // src/cpu/cpu_halo_springs.cpp).
