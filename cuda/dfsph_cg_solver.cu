@@ -10,32 +10,13 @@
 // agree to rounding). The contacts: the CPU holds them in storage order, each held particle adding
 // m dv . grad W_ij to its neighbours' values; a particle's hold depends on its own velocity alone,
 // so here every particle holds its own and a gather adds the same terms (the rate of the held
-// changes, dfsph_cg_change), one more neighbour pass in an iteration that held any.
-#include "../src/physics/dfsph_cg.h"
-#include "../src/physics/dfsph_passes.h"
-#include "dfsph_solve_loop.cuh"
-#include "dfsph_solver.h"
+// changes, dfsph_cg_change), one more neighbour pass in an iteration that held any. A distributed
+// rank's solve is dfsph_cg_rank_solver.cu's; what both share, dfsph_cg_common.cuh.
+#include "dfsph_cg_common.cuh"
 #include "kernel_launch.h"
 
 namespace sph {
 namespace {
-
-constexpr uint8_t kActive = 1, kBinds = 2;
-
-// What every kernel of the solve reads.
-struct CgSolve {
-  FluidConstants fluid;
-  GridView grid;
-  ParticleArrays a;
-  uint32_t n;
-  bool contacts;
-  uint32_t blocks;  // of kDfsphSolveBlock threads: partials [0, blocks) and [blocks, 2 blocks)
-  LoopCondition cond;
-  FrameState* state;
-  double* partials;
-};
-
-__device__ DfsphWalls walls_of(const CgSolve& s) { return DfsphWalls{s.a.boundary_gradient}; }
 
 __device__ bool skipped(const CgSolve& s) { return s.state->solve_run == 0 || s.state->cg_skip != 0; }
 
@@ -44,15 +25,7 @@ __device__ bool skipped(const CgSolve& s) { return s.state->solve_run == 0 || s.
 __global__ void __launch_bounds__(kDfsphSolveBlock) cg_measure_kernel(CgSolve s) {
   if (s.state->solve_run == 0) return;
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  double error = 0.0;
-  if (i < s.n) {
-    const float dt = s.state->clock.dt_float;
-    const float rate = density_rate(s.fluid, s.grid, s.a.sorted_position, s.a.velocity, walls_of(s), i,
-                                    MaskedCandidates{s.a.dfsph_neighbor_mask});
-    const float value = dfsph_cg_value(rate, s.a.density[i], s.fluid.rest_density, dt);
-    s.a.dfsph_cg_value[i] = value;
-    error = dfsph_cg_error(value, s.fluid.rest_density);
-  }
+  const double error = i < s.n ? cg_measure_particle(s, i) : 0.0f;
   dfsph_block_sum_to(s.partials, error);
   dfsph_block_max_to(&s.state->solve_largest_bits, static_cast<float>(error));
 }
@@ -80,14 +53,8 @@ __global__ void __launch_bounds__(kDfsphSolveBlock) cg_restart_kernel(CgSolve s)
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   double sz = 0.0;
   if (i < s.n) {
-    const float dt = s.state->clock.dt_float;
-    const float value = s.a.dfsph_cg_value[i], factor = s.a.dfsph_factor[i];
-    const bool active = dfsph_cg_active(value, s.a.dfsph_pressure[i], factor);
-    const bool binds = s.contacts && dfsph_contact_binds(s.a.dfsph_contact[i], xyz(s.a.velocity[i]));
-    s.a.dfsph_cg_state[i] = static_cast<uint8_t>((active ? kActive : 0) | (binds ? kBinds : 0));
-    const float p = active ? dfsph_cg_step(value, factor, dt) : 0.0f;
-    s.a.dfsph_step[i] = p;
-    if (active) sz = static_cast<double>(value * p);
+    const CgTerm t = cg_restart_particle(s, i);
+    if (t.active) sz = static_cast<double>(t.value);
   }
   dfsph_block_sum_to(s.partials, sz);
 }
@@ -105,20 +72,6 @@ __global__ void __launch_bounds__(kDfsphCheckBlock) cg_restart_check_kernel(CgSo
     dfsph_stop_solve(state, state->pressure_tally, dfsph_density_bounds(s.fluid.methods.dfsph), s.cond);
 }
 
-// The operator on p, first half: the velocities p would give (a binding contact's normal part
-// removed).
-__global__ void __launch_bounds__(kDfsphSolveBlock) cg_direction_kernel(CgSolve s) {
-  if (s.state->solve_run == 0) return;
-  mark_stage(s.state, kStageForces);
-  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i >= s.n) return;
-  const float dt = s.state->clock.dt_float;
-  Vec3 d = pressure_velocity_change(s.fluid, s.grid, s.a.sorted_position, s.a.dfsph_step, walls_of(s), i, dt,
-                                    MaskedCandidates{s.a.dfsph_neighbor_mask});
-  if (s.a.dfsph_cg_state[i] & kBinds) d = dfsph_contact_project(s.a.dfsph_contact[i], d);
-  s.a.dfsph_cg_velocity_step[i] = make_float4_record(d, 0.0f);
-}
-
 // Second half: the change of each value from the rates of dv_p alone, and the block sums of
 // p . A p (-p . change over the set).
 __global__ void __launch_bounds__(kDfsphSolveBlock) cg_change_kernel(CgSolve s) {
@@ -126,13 +79,8 @@ __global__ void __launch_bounds__(kDfsphSolveBlock) cg_change_kernel(CgSolve s) 
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   double pq = 0.0;
   if (i < s.n) {
-    const float dt = s.state->clock.dt_float;
-    const DfsphWalls walls = walls_of(s);
-    const float rate = density_rate(s.fluid, s.grid, s.a.sorted_position, s.a.dfsph_cg_velocity_step, walls,
-                                    i, MaskedCandidates{s.a.dfsph_neighbor_mask});
-    const float change = dfsph_cg_change(rate, walls, i, dt);
-    s.a.dfsph_cg_change[i] = change;
-    if (s.a.dfsph_cg_state[i] & kActive) pq = static_cast<double>(-s.a.dfsph_step[i] * change);
+    const CgTerm t = cg_change_particle(s, i);
+    if (t.active) pq = static_cast<double>(t.value);
   }
   dfsph_block_sum_to(s.partials, pq);
 }
@@ -155,54 +103,18 @@ __global__ void __launch_bounds__(kDfsphCheckBlock) cg_step_check_kernel(CgSolve
   state->cg_skip = 0;
 }
 
-// v += alpha dv_p, the pressure += alpha p, value += alpha change; then the contact held as the
-// Jacobi solve holds it, its change kept in dv for the gather (0 where none was held).
-__global__ void cg_update_kernel(CgSolve s) {
-  if (skipped(s)) return;
-  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i >= s.n) return;
-  const float alpha = s.state->cg_alpha;
-  const Float4 v = s.a.velocity[i];
-  Vec3 vi = xyz(v) + xyz(s.a.dfsph_cg_velocity_step[i]) * alpha;
-  s.a.dfsph_pressure[i] += alpha * s.a.dfsph_step[i];
-  s.a.dfsph_cg_value[i] += alpha * s.a.dfsph_cg_change[i];
-  if (s.contacts) {
-    Vec3 held_change{0.0f, 0.0f, 0.0f};
-    const Float4 contact = s.a.dfsph_contact[i];
-    if (dfsph_contact_moved(contact, vi)) {
-      const Vec3 held = respect_contact(contact, vi);
-      held_change = held - vi;
-      vi = held;
-      s.a.dfsph_cg_state[i] |= kBinds;
-      s.state->cg_held = 1;  // every writer writes 1
-    }
-    s.a.dfsph_cg_velocity_step[i] = make_float4_record(held_change, 0.0f);
-  }
-  s.a.velocity[i] = make_float4_record(vi, v.w);
-}
-
-// The held contacts' changes added to the values (the rate of the held changes: m (dv_i - dv_j) .
-// grad W_ij and dv_i . grad rho_b, what the CPU's walks add); each particle's error, and the block
-// sums of the errors (partials [0, blocks)) and of those outside the set that a new set could take
-// (a factor; [blocks, 2 blocks)); the largest error, and the largest of those outside the set (a
-// maximum: the same whatever order the blocks run in).
+// The held contacts' changes added to the values (cg_held_value); each particle's error, and the
+// block sums of the errors (partials [0, blocks)) and of those outside the set that a new set
+// could take (a factor; [blocks, 2 blocks)); the largest error, and the largest of those outside
+// the set (a maximum: the same whatever order the blocks run in).
 __global__ void __launch_bounds__(kDfsphSolveBlock) cg_error_kernel(CgSolve s) {
   if (skipped(s)) return;
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   double error = 0.0, outside = 0.0;
   if (i < s.n) {
-    float value = s.a.dfsph_cg_value[i];
-    if (s.contacts && s.state->cg_held) {
-      const float dt = s.state->clock.dt_float;
-      const DfsphWalls walls = walls_of(s);
-      const float rate = density_rate(s.fluid, s.grid, s.a.sorted_position, s.a.dfsph_cg_velocity_step, walls,
-                                      i, MaskedCandidates{s.a.dfsph_neighbor_mask});
-      value += dfsph_cg_change(rate, walls, i, dt);
-      s.a.dfsph_cg_value[i] = value;
-    }
-    const float z = dfsph_cg_error(value, s.fluid.rest_density);
+    const float z = dfsph_cg_error(cg_held_value(s, i), s.fluid.rest_density);
     error = z;
-    if (!(s.a.dfsph_cg_state[i] & kActive) && s.a.dfsph_factor[i] > 0.0f) outside = z;
+    if (!(s.a.dfsph_cg_state[i] & kCgActive) && s.a.dfsph_factor[i] > 0.0f) outside = z;
   }
   dfsph_block_sum_to(s.partials, error);
   dfsph_block_sum_to(s.partials + s.blocks, outside);
@@ -245,11 +157,8 @@ __global__ void __launch_bounds__(kDfsphSolveBlock) cg_residual_kernel(CgSolve s
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   double sz = 0.0;
   if (i < s.n) {
-    const float value = s.a.dfsph_cg_value[i];
-    const bool active = s.a.dfsph_cg_state[i] & kActive;
-    const float z = active ? dfsph_cg_step(value, s.a.dfsph_factor[i], s.state->clock.dt_float) : 0.0f;
-    s.a.dfsph_residual[i] = z;
-    if (active) sz = static_cast<double>(value * z);
+    const CgTerm t = cg_residual_particle(s, i, s.a.dfsph_cg_value[i]);
+    if (t.active) sz = static_cast<double>(t.value);
   }
   dfsph_block_sum_to(s.partials, sz);
 }
@@ -263,6 +172,50 @@ __global__ void __launch_bounds__(kDfsphCheckBlock) cg_beta_kernel(CgSolve s) {
   state->cg_sz = sz;
 }
 
+}  // namespace
+
+// ---- The particle kernels without sums, which the rank's solve runs too (dfsph_cg_common.cuh) ----
+
+// The operator on p, first half: the velocities p would give (a binding contact's normal part
+// removed).
+__global__ void __launch_bounds__(kDfsphSolveBlock) cg_direction_kernel(CgSolve s) {
+  if (s.state->solve_run == 0) return;
+  mark_stage(s.state, kStageForces);
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= s.n) return;
+  const float dt = s.state->clock.dt_float;
+  Vec3 d = pressure_velocity_change(s.fluid, s.grid, s.a.sorted_position, s.a.dfsph_step, cg_walls(s), i, dt,
+                                    cg_walk(s));
+  if (s.a.dfsph_cg_state[i] & kCgBinds) d = dfsph_contact_project(s.a.dfsph_contact[i], d);
+  s.a.dfsph_cg_velocity_step[i] = make_float4_record(d, 0.0f);
+}
+
+// v += alpha dv_p, the pressure += alpha p, value += alpha change; then the contact held as the
+// Jacobi solve holds it, its change kept in dv for the gather (0 where none was held).
+__global__ void cg_update_kernel(CgSolve s) {
+  if (skipped(s)) return;
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= s.n) return;
+  const float alpha = s.state->cg_alpha;
+  const Float4 v = s.a.velocity[i];
+  Vec3 vi = xyz(v) + xyz(s.a.dfsph_cg_velocity_step[i]) * alpha;
+  s.a.dfsph_pressure[i] += alpha * s.a.dfsph_step[i];
+  s.a.dfsph_cg_value[i] += alpha * s.a.dfsph_cg_change[i];
+  if (s.contacts) {
+    Vec3 held_change{0.0f, 0.0f, 0.0f};
+    const Float4 contact = s.a.dfsph_contact[i];
+    if (dfsph_contact_moved(contact, vi)) {
+      const Vec3 held = respect_contact(contact, vi);
+      held_change = held - vi;
+      vi = held;
+      s.a.dfsph_cg_state[i] |= kCgBinds;
+      s.state->cg_held = 1;  // every writer writes 1
+    }
+    s.a.dfsph_cg_velocity_step[i] = make_float4_record(held_change, 0.0f);
+  }
+  s.a.velocity[i] = make_float4_record(vi, v.w);
+}
+
 // The next direction p = z + beta p over the set.
 __global__ void cg_next_direction_kernel(CgSolve s) {
   if (skipped(s)) return;
@@ -270,127 +223,7 @@ __global__ void cg_next_direction_kernel(CgSolve s) {
   if (i >= s.n) return;
   const float beta = s.state->cg_beta;
   s.a.dfsph_step[i] =
-      (s.a.dfsph_cg_state[i] & kActive) ? s.a.dfsph_residual[i] + beta * s.a.dfsph_step[i] : 0.0f;
-}
-
-// ---- A distributed rank's solve: the host drives it as src/cpu/cpu_dfsph_cg.cpp's loop ----------
-// Each kernel below adds the terms of the rank's own particles (not its ghosts) into the exact sums'
-// bins (dfsph_solver.h's kDfsphRankCgWords layout: sum s at word s kTerms, the maxima from
-// kDfsphRankCgMaxima), which the host adds over the ranks (DfsphRankSteps::cg_world). The particle
-// kernels without sums (the direction, the update, the next direction) are the undivided solve's,
-// the host writing alpha, beta and the flags they read (cg_rank_set_kernel).
-
-__device__ bool cg_own(const CgSolve& s, uint32_t i) {
-  return i < s.n && !(s.a.halo_ghost && s.a.halo_ghost[i]);
-}
-
-constexpr uint32_t kCgTerms = ExactFloatSum::kTerms;
-
-// After the warm start: each particle's value; the sum and largest of the errors.
-__global__ void __launch_bounds__(kDfsphSolveBlock)
-    cg_rank_measure_kernel(CgSolve s, unsigned long long* bins) {
-  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  float error = 0.0f;
-  if (i < s.n) {
-    const float dt = s.state->clock.dt_float;
-    const float rate = density_rate(s.fluid, s.grid, s.a.sorted_position, s.a.velocity, walls_of(s), i);
-    const float value = dfsph_cg_value(rate, s.a.density[i], s.fluid.rest_density, dt);
-    s.a.dfsph_cg_value[i] = value;
-    error = dfsph_cg_error(value, s.fluid.rest_density);
-  }
-  const bool own = cg_own(s, i);
-  exact_bins_add(bins, own, error);
-  dfsph_block_max_to(bins + kDfsphRankCgMaxima, own ? error : 0.0f);
-}
-
-// A new cycle: the set, the binding contacts, the steepest direction; the sum of value . p.
-__global__ void __launch_bounds__(kDfsphSolveBlock)
-    cg_rank_restart_kernel(CgSolve s, unsigned long long* bins) {
-  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  float sz = 0.0f;
-  bool active = false;
-  if (i < s.n) {
-    const float dt = s.state->clock.dt_float;
-    const float value = s.a.dfsph_cg_value[i], factor = s.a.dfsph_factor[i];
-    active = dfsph_cg_active(value, s.a.dfsph_pressure[i], factor);
-    const bool binds = s.contacts && dfsph_contact_binds(s.a.dfsph_contact[i], xyz(s.a.velocity[i]));
-    s.a.dfsph_cg_state[i] = static_cast<uint8_t>((active ? kActive : 0) | (binds ? kBinds : 0));
-    const float p = active ? dfsph_cg_step(value, factor, dt) : 0.0f;
-    s.a.dfsph_step[i] = p;
-    sz = value * p;
-  }
-  exact_bins_add(bins, cg_own(s, i) && active, sz);
-}
-
-// The change of each value from the rates of dv_p alone; the sum of p . A p over the set.
-__global__ void __launch_bounds__(kDfsphSolveBlock)
-    cg_rank_change_kernel(CgSolve s, unsigned long long* bins) {
-  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  float pq = 0.0f;
-  bool active = false;
-  if (i < s.n) {
-    const float dt = s.state->clock.dt_float;
-    const DfsphWalls walls = walls_of(s);
-    const float rate =
-        density_rate(s.fluid, s.grid, s.a.sorted_position, s.a.dfsph_cg_velocity_step, walls, i);
-    const float change = dfsph_cg_change(rate, walls, i, dt);
-    s.a.dfsph_cg_change[i] = change;
-    active = (s.a.dfsph_cg_state[i] & kActive) != 0;
-    pq = -s.a.dfsph_step[i] * change;
-  }
-  exact_bins_add(bins, cg_own(s, i) && active, pq);
-}
-
-// The held contacts' changes added to the values (as cg_error_kernel); the sums of the errors
-// (sum 0), of those outside the set that a new set could take (sum 1) and, with z the Jacobi step
-// over the set (into dfsph_residual), of value . z (sum 2, dropped by a restart); the largest error
-// and the largest outside the set.
-__global__ void __launch_bounds__(kDfsphSolveBlock)
-    cg_rank_error_kernel(CgSolve s, unsigned long long* bins) {
-  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  float error = 0.0f, sz = 0.0f;
-  bool active = false, outside = false;
-  if (i < s.n) {
-    const float dt = s.state->clock.dt_float;
-    float value = s.a.dfsph_cg_value[i];
-    if (s.contacts && s.state->cg_held) {
-      const DfsphWalls walls = walls_of(s);
-      const float rate =
-          density_rate(s.fluid, s.grid, s.a.sorted_position, s.a.dfsph_cg_velocity_step, walls, i);
-      value += dfsph_cg_change(rate, walls, i, dt);
-      s.a.dfsph_cg_value[i] = value;
-    }
-    error = dfsph_cg_error(value, s.fluid.rest_density);
-    active = (s.a.dfsph_cg_state[i] & kActive) != 0;
-    outside = !active && s.a.dfsph_factor[i] > 0.0f;
-    const float z = active ? dfsph_cg_step(value, s.a.dfsph_factor[i], dt) : 0.0f;
-    s.a.dfsph_residual[i] = z;
-    sz = value * z;
-  }
-  const bool own = cg_own(s, i);
-  exact_bins_add(bins, own, error);
-  exact_bins_add(bins + kCgTerms, own && outside, error);
-  exact_bins_add(bins + 2 * kCgTerms, own && active, sz);
-  dfsph_block_max_to(bins + kDfsphRankCgMaxima, own ? error : 0.0f);
-  dfsph_block_max_to(bins + kDfsphRankCgMaxima + 1, own && outside ? error : 0.0f);
-}
-
-// What the undivided solve's particle kernels read of the state: the step, the next direction's
-// beta, no skip, no contact held yet. One thread.
-__global__ void cg_rank_set_kernel(FrameState* state, float alpha, float beta) {
-  state->cg_alpha = alpha;
-  state->cg_beta = beta;
-  state->cg_skip = 0;
-  state->cg_held = 0;
-}
-
-// The solve's record, as the undivided solve's check kernels leave it. One thread.
-__global__ void cg_rank_record_kernel(FrameState* state, uint32_t iterations, DfsphErrors errors,
-                                      DfsphBounds bounds) {
-  state->solve_iterations = iterations;
-  state->solve_error = errors.mean;
-  state->solve_largest = errors.largest;
-  dfsph_stop_solve(state, state->pressure_tally, bounds, LoopCondition{});
+      (s.a.dfsph_cg_state[i] & kCgActive) ? s.a.dfsph_residual[i] + beta * s.a.dfsph_step[i] : 0.0f;
 }
 
 // What the solve keeps of each pressure: its positive part (dfsph_cg_kept_pressure).
@@ -398,8 +231,6 @@ __global__ void cg_keep_kernel(float* pressure, uint32_t n) {
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i < n) pressure[i] = dfsph_cg_kept_pressure(pressure[i]);
 }
-
-}  // namespace
 
 void enqueue_dfsph_cg_solve(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                             uint32_t n, bool contacts, const DfsphLoops& loops, const LoopCondition& cond,
@@ -431,83 +262,6 @@ void enqueue_dfsph_cg_solve(const FluidConstants& fluid, const GridView& grid, c
     check(cg_beta_kernel, "cg_beta_kernel");
     particles(cg_next_direction_kernel, "cg_next_direction_kernel");
   });
-  cg_keep_kernel<<<blocks, threads, 0, stream>>>(a.dfsph_pressure, n);
-  check_launch("cg_keep_kernel");
-}
-
-void enqueue_dfsph_cg_rank_solve(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
-                                 uint32_t n, bool contacts, DfsphRankSteps& rank, FrameState* state,
-                                 cudaStream_t stream) {
-  if (!a.dfsph_cg_value || !a.dfsph_residual)
-    throw Error(Status::Internal, "DFSPH's conjugate gradients: the world has no arrays for them");
-  const Dfsph::Constants& c = fluid.methods.dfsph;
-  const DfsphBounds bounds = dfsph_density_bounds(c);
-  const unsigned threads = kDfsphSolveBlock, blocks = blocks_for(n, threads);
-  const CgSolve s{fluid, grid, a, n, contacts, blocks, LoopCondition{}, state, nullptr};
-  unsigned long long* bins = rank.error_bins();
-  // A kernel that adds into the bins, after they are cleared.
-  auto summed = [&](void (*kernel)(CgSolve, unsigned long long*), const char* name) {
-    cuda_check(cudaMemsetAsync(bins, 0, sizeof(unsigned long long) * kDfsphRankCgWords, stream),
-               "DFSPH conjugate gradients' bins reset");
-    kernel<<<blocks, threads, 0, stream>>>(s, bins);
-    check_launch(name);
-  };
-  auto particles = [&](void (*kernel)(CgSolve), const char* name) {
-    kernel<<<blocks, threads, 0, stream>>>(s);
-    check_launch(name);
-  };
-  auto set = [&](float alpha, float beta) {
-    cg_rank_set_kernel<<<1, 1, 0, stream>>>(state, alpha, beta);
-    check_launch("cg_rank_set_kernel");
-  };
-  double sums[3] = {0.0, 0.0, 0.0};
-  float maxima[2] = {0.0f, 0.0f};
-  summed(cg_rank_measure_kernel, "cg_rank_measure_kernel");
-  const int64_t count = rank.cg_world(1, sums, 1, maxima, stream);
-  const double particles_in_world = static_cast<double>(count);
-  DfsphErrors error{count > 0 ? static_cast<float>(sums[0] / particles_in_world) : 0.0f, maxima[0]};
-  uint32_t iterations = 0;
-  bool restart = true;
-  double sz = 0.0;  // value . z over the active set
-  float alpha = 0.0f;
-  while ((dfsph_bounds_unmet(bounds, error) || iterations < Dfsph::kMinIterations) &&
-         iterations < c.max_iterations) {
-    if (restart) {
-      summed(cg_rank_restart_kernel, "cg_rank_restart_kernel");
-      rank.cg_world(1, sums, 0, nullptr, stream);
-      sz = sums[0];
-      restart = false;
-      if (sz == 0.0 && iterations >= Dfsph::kMinIterations) break;
-    }
-    // The operator on p: the ghosts' p before the velocities it gives, their dv_p before the rates.
-    rank.share_steps(stream);
-    particles(cg_direction_kernel, "cg_direction_kernel");
-    rank.share_velocities(a.dfsph_cg_velocity_step, stream);
-    summed(cg_rank_change_kernel, "cg_rank_change_kernel");
-    rank.cg_world(1, sums, 0, nullptr, stream);
-    const double pq = sums[0];
-    ++iterations;
-    if (!(pq > 0.0)) {  // no descent left along p (rounding): a new cycle from the same state
-      restart = true;
-      continue;
-    }
-    alpha = static_cast<float>(sz / pq);
-    set(alpha, 0.0f);
-    particles(cg_update_kernel, "cg_update_kernel");
-    summed(cg_rank_error_kernel, "cg_rank_error_kernel");
-    rank.cg_world(3, sums, 2, maxima, stream);
-    error = {static_cast<float>(sums[0] / particles_in_world), maxima[0]};
-    if (dfsph_cg_restart_due(bounds, sums[1] / particles_in_world, maxima[1])) {
-      restart = true;
-      continue;
-    }
-    const float beta = static_cast<float>(sums[2] / sz);
-    sz = sums[2];
-    set(alpha, beta);
-    particles(cg_next_direction_kernel, "cg_next_direction_kernel");
-  }
-  cg_rank_record_kernel<<<1, 1, 0, stream>>>(state, iterations, error, bounds);
-  check_launch("cg_rank_record_kernel");
   cg_keep_kernel<<<blocks, threads, 0, stream>>>(a.dfsph_pressure, n);
   check_launch("cg_keep_kernel");
 }

@@ -279,7 +279,7 @@ void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid
   };
   if (loops.rank && !divergence && c.linear_solver == kDfsphConjugateGradients) {
     // A distributed rank's conjugate gradients: the warm start, the ghosts' velocities, then the
-    // host-driven solve (dfsph_cg_solver.cu, the CPU rank's loop).
+    // host-driven solve (dfsph_cg_rank_solver.cu, the CPU rank's loop).
     launch_correct(true, fluid, grid, a, n, v, warm, carried, divergence, contacts, state, blocks, threads,
                    stream);
     loops.rank->share_velocities(v, stream);

@@ -93,10 +93,11 @@ struct DfsphLoops {
 void enqueue_dfsph_cg_solve(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                             uint32_t n, bool contacts, const DfsphLoops& loops, const LoopCondition& cond,
                             FrameState* state, cudaStream_t stream);
-// The same on a distributed rank, after the warm start's velocity update and the ghosts' taking
-// their owners' velocities: the host drives it as the CPU rank's loop (src/cpu/cpu_dfsph_cg.cpp),
-// the ghosts taking their owners' search directions and velocity steps in each iteration, the
-// sums exact and added over the ranks (rank.cg_world), the solve's record written at its end.
+// The same on a distributed rank (dfsph_cg_rank_solver.cu), after the warm start's velocity
+// update and the ghosts' taking their owners' velocities: the host drives it as the CPU rank's
+// loop (src/cpu/cpu_dfsph_cg.cpp), the ghosts taking their owners' search directions and velocity
+// steps in each iteration, the sums exact and added over the ranks (rank.cg_world), the solve's
+// record written at its end.
 void enqueue_dfsph_cg_rank_solve(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                                  uint32_t n, bool contacts, DfsphRankSteps& rank, FrameState* state,
                                  cudaStream_t stream);

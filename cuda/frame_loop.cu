@@ -90,7 +90,7 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
   setup.fluid = make_fluid_constants(config_, params);
   // Refused first when the parameters are set (capi/dfsph_solver_check.h); this holds for the paths
   // that reach the step otherwise, where the world also has no arrays for them (particle_arrays.cpp).
-  // (A distributed rank runs them since session 16: dfsph_cg_solver.cu's host-driven loop.)
+  // (A distributed rank runs them since session 16: dfsph_cg_rank_solver.cu's host-driven loop.)
   if (config_.solver == Solver::Dfsph &&
       setup.fluid.methods.dfsph.linear_solver == kDfsphConjugateGradients &&
       (config_.features & (kFeatureBoundaryDensity | kFeatureColliderLoads)))

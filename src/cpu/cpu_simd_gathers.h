@@ -216,8 +216,11 @@ SPH_SIMD_GATHER float dfsph_density_rate(const FluidBase& f, const GridView& gri
   return sph::dfsph_density_rate(reduce_sum(rate), walls, i, vi);
 }
 
-// DFSPH's velocity change (pressure_velocity_change) from the pressures k (a column: padded).
-template <class L>
+// DFSPH's velocity change from the pressures k (a column: padded): pressure_velocity_change, or
+// with kCorrected pressure_velocity_change_corrected (the corrected gradient: B_i and the
+// zeroth-order sum gathered in the same walk). Each keeps its scalar twin's terms: the plain one
+// selects the pair term, the corrected one the gradient before its product.
+template <class L, bool kCorrected>
 SPH_SIMD_GATHER Vec3 dfsph_velocity_change(const FluidBase& f, const GridView& grid, const NeighborColumns& c,
                                            const float* k, const DfsphWalls& walls, uint32_t i, float dt) {
   const KernelCoefficients mk = mass_gradient_kernel(f);
@@ -227,42 +230,29 @@ SPH_SIMD_GATHER Vec3 dfsph_velocity_change(const FluidBase& f, const GridView& g
   const L h2(f.kernel.h2), zero(0.0f), k_i(ki);
   const Vec3Of<L> zero3{zero, zero, zero};
   Vec3Of<L> sum = zero3;
+  GradientMomentOf<L> moment = zero_gradient_moment(zero);  // (kCorrected only)
   for_each_candidate_run<L>(grid, xi, i, true, [&](uint32_t base, const typename L::Mask& valid) {
     const Vec3Of<L> d = x - load3<L>(c.x, c.y, c.z, base);
     const L r2 = length_squared(d);
     const typename L::Mask neighbor = valid && r2 < h2;
     if (!any(neighbor)) return;
-    sum += select(neighbor, pressure_velocity_pair_term(mk, d, r2, k_i + L::load(k + base)), zero3);
+    const L k_ij = k_i + L::load(k + base);
+    if constexpr (kCorrected) {
+      const Vec3Of<L> g = select(neighbor, spiky_gradient(mk, d, square_root(r2)), zero3);
+      sum += g * k_ij;
+      add_gradient_moment(moment, g, d);
+    } else {
+      sum += select(neighbor, pressure_velocity_pair_term(mk, d, r2, k_ij), zero3);
+    }
   });
-  return sph::dfsph_velocity_change(reduce_vec3(sum), walls, i, ki, dt);
-}
-
-// The same with the corrected gradient (pressure_velocity_change_corrected).
-template <class L>
-SPH_SIMD_GATHER Vec3 dfsph_velocity_change_corrected(const FluidBase& f, const GridView& grid,
-                                                     const NeighborColumns& c, const float* k,
-                                                     const DfsphWalls& walls, uint32_t i, float dt) {
-  const KernelCoefficients mk = mass_gradient_kernel(f);
-  const Vec3 xi{c.x[i], c.y[i], c.z[i]};
-  const Vec3Of<L> x = broadcast<L>(xi);
-  const float ki = k[i];
-  const L h2(f.kernel.h2), zero(0.0f), k_i(ki);
-  const Vec3Of<L> zero3{zero, zero, zero};
-  Vec3Of<L> sum = zero3;
-  GradientMomentOf<L> moment = zero_gradient_moment(zero);
-  for_each_candidate_run<L>(grid, xi, i, true, [&](uint32_t base, const typename L::Mask& valid) {
-    const Vec3Of<L> d = x - load3<L>(c.x, c.y, c.z, base);
-    const L r2 = length_squared(d);
-    const typename L::Mask neighbor = valid && r2 < h2;
-    if (!any(neighbor)) return;
-    const Vec3Of<L> g = select(neighbor, spiky_gradient(mk, d, square_root(r2)), zero3);
-    sum += g * (k_i + L::load(k + base));
-    add_gradient_moment(moment, g, d);
-  });
-  const GradientMomentOf<float> m{reduce_sum(moment.xx),     reduce_sum(moment.xy), reduce_sum(moment.xz),
-                                  reduce_sum(moment.yy),     reduce_sum(moment.yz), reduce_sum(moment.zz),
-                                  reduce_vec3(moment.zeroth)};
-  return sph::dfsph_corrected_velocity_change(f, reduce_vec3(sum), m, walls, i, ki, dt);
+  if constexpr (kCorrected) {
+    const GradientMomentOf<float> m{reduce_sum(moment.xx),     reduce_sum(moment.xy), reduce_sum(moment.xz),
+                                    reduce_sum(moment.yy),     reduce_sum(moment.yz), reduce_sum(moment.zz),
+                                    reduce_vec3(moment.zeroth)};
+    return sph::dfsph_corrected_velocity_change(f, reduce_vec3(sum), m, walls, i, ki, dt);
+  } else {
+    return sph::dfsph_velocity_change(reduce_vec3(sum), walls, i, ki, dt);
+  }
 }
 
 // Particle i as the force terms see it (force_particle in forces.h), from the columns.
@@ -356,8 +346,8 @@ constexpr SimdPasses make_simd_passes(SimdTarget target, const char* name) {
                     &acceleration_without_pressure_for<L>,
                     &dfsph_density_and_factor<L>,
                     &dfsph_density_rate<L>,
-                    &dfsph_velocity_change<L>,
-                    &dfsph_velocity_change_corrected<L>};
+                    &dfsph_velocity_change<L, false>,
+                    &dfsph_velocity_change<L, true>};
 }
 
 }  // namespace simd

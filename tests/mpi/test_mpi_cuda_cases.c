@@ -310,7 +310,7 @@ void mpi_cuda_sinks_case(const char* name, sph_context* cuda, sph_solver solver)
   sph_world_destroy(w.world);
 }
 
-/* DFSPH's density solve by conjugate gradients on CUDA ranks (dfsph_cg_solver.cu's host-driven
+/* DFSPH's density solve by conjugate gradients on CUDA ranks (dfsph_cg_rank_solver.cu's host-driven
  * loop, the CPU rank's: the ghosts take their owners' search directions and velocity steps in each
  * iteration, the sums are exact sums added over the ranks). The undivided CUDA world sums in doubles
  * in a fixed tree instead, so alpha and beta, and then the particles, differ from it by roundings:
