@@ -80,10 +80,13 @@ uint32_t CudaBackend::halo_gather_spring_partners(uint32_t owned, uint32_t n) {
     h.enqueue_origin(n, m, static_cast<uint32_t>(size + r), s);
     n += m;
   }
-  if (waiting == 0) return n;
-  // The waiting partners: a spring ghost's index, or none (a sink removed the partner).
-  hs.index_ids(a.id, n, s);
-  hs.resolve_waiting(a.springs, owned, s);
+  if (waiting > 0) {
+    // The waiting partners: a spring ghost's index, or none (a sink removed the partner).
+    hs.index_ids(a.id, n, s);
+    hs.resolve_waiting(a.springs, owned, s);
+  }
+  // (The link word is read after the ghosts' agreement, where nothing may fail on one rank alone.)
+  cuda_check(cudaStreamSynchronize(s), "the spring partners");
   return n;
 }
 
