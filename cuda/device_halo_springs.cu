@@ -141,7 +141,7 @@ void DeviceHaloSprings::ensure_temp(size_t bytes) {
 }
 
 void DeviceHaloSprings::ensure_asked(uint32_t m) {
-  if (m <= asked_.size()) return;
+  if (m <= asked_flags_.size()) return;  // (allocated last: a failure half-way grows again)
   const size_t grown = static_cast<size_t>(m) + m / 2 + 64;
   asked_.allocate(grown, "halo spring ids asked");
   asked_idx_.allocate(grown, "halo spring ids asked: indices");
