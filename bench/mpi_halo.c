@@ -5,8 +5,8 @@
  *
  * --backend cuda: every rank on the CUDA backend (the host-staged halo path; ranks on one GPU
  * share it), the GPU calibration of the model. --springs 1: with SPH_FEATURE_SPRINGS (every
- * particle linked to its lattice neighbours in the warm-up frame; springs across ranks, CPU
- * ranks only), the cost of their exchanges and spring ghosts.
+ * particle linked to its lattice neighbours in the warm-up frame; springs across ranks, on CPU
+ * ranks and, since session 17, CUDA ranks), the cost of their exchanges and spring ghosts.
  * A water block of 0.8 x 0.4 x 0.2 m at rest in a closed tank (the slabs cut its 0.8 m axis),
  * stepped one warm-up frame (the first cut and its migration) and then timed over K substeps
  * (default 20). Prints, on rank 0: the ranks, the particles per rank, the ghosts (halo) per rank

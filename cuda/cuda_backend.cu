@@ -198,7 +198,7 @@ uint64_t CudaBackend::memory_bytes() const {
   return r_->store->bytes() + r_->grid->bytes() + r_->statistics->bytes() + r_->state.bytes() +
          r_->sdf_cache.bytes() + r_->scene_buffer.bytes() + r_->sinks.bytes() + r_->solve_partials.bytes() +
          r_->boundary_maps.bytes() + r_->loads.bytes() + r_->probes.bytes() +
-         (r_->halo ? r_->halo->bytes() : 0);
+         (r_->halo ? r_->halo->bytes() : 0) + (r_->halo_springs ? r_->halo_springs->bytes() : 0);
 }
 
 DeviceAttributeView CudaBackend::device_attribute(AttributeKind kind) const {

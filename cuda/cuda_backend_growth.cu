@@ -124,6 +124,8 @@ void CudaBackend::reserve(uint32_t capacity, const GrowthNeeds& needs) {
     if (needs.load_colliders != 0) loads.reserve(needs.load_colliders, capacity);
     std::unique_ptr<DeviceHalo> halo;
     if (r_->halo) halo = std::make_unique<DeviceHalo>(capacity, ranks_->size());
+    std::unique_ptr<DeviceHaloSprings> halo_springs;
+    if (r_->halo_springs) halo_springs = std::make_unique<DeviceHaloSprings>(capacity);
     store->enqueue_copy_from(*r_->store, count_, r_->stream);
     cuda_check(cudaStreamSynchronize(r_->stream), "growth of the particle storage");
     // Nothing below throws: the new buffers replace the old ones (freed at the end of scope).
@@ -135,6 +137,7 @@ void CudaBackend::reserve(uint32_t capacity, const GrowthNeeds& needs) {
     if (needs.sinks) std::swap(r_->sinks, sinks);
     if (needs.load_colliders != 0) std::swap(r_->loads, loads);
     if (halo) r_->halo.swap(halo);
+    if (halo_springs) r_->halo_springs.swap(halo_springs);
   });
   config_.capacity = capacity;
   ++epoch_;

@@ -17,6 +17,7 @@
 #include "device_array.h"
 #include "device_boundary_maps.h"
 #include "device_halo.h"
+#include "device_halo_springs.h"
 #include "device_neighbor_grid.h"
 #include "device_particle_store.h"
 #include "device_scene.h"
@@ -50,7 +51,8 @@ struct DeviceResources {
   DeviceProbeBuffers probes;
   DeviceSceneBuffer scene_buffer;
   DeviceSinkCompactor sinks;
-  std::unique_ptr<DeviceHalo> halo;  // a distributed world's rank only (cuda_halo.cu)
+  std::unique_ptr<DeviceHalo> halo;                 // a distributed world's rank only (cuda_halo.cu)
+  std::unique_ptr<DeviceHaloSprings> halo_springs;  // and with springs (cuda_halo_springs.cu)
 
   ~DeviceResources() {
     if (stream && cudaStreamSynchronize(stream) != cudaSuccess) (void)cudaGetLastError();
@@ -228,6 +230,14 @@ class CudaBackend final : public Backend {
   // The owned particles, in the sorted order; `counts` (per particle, sorted order) kept with them.
   void halo_drop_ghosts(uint32_t* counts = nullptr);
   HostVector<HaloArray> halo_arrays() const;  // what travels with a particle (halo_rk4_side_)
+  // Springs across ranks (cuda_halo_springs.cu): after the ghosts' arrival, the owned lists' ids to
+  // indices and the spring ghosts appended after the n particles held (returns the new count);
+  // the lowest waiting id over the ranks (after the ghosts' agreement); between linking's passes,
+  // the ghosts' candidates from their owners; the lists back to ids (halo_drop_ghosts).
+  uint32_t halo_gather_spring_partners(uint32_t owned, uint32_t n);
+  void halo_agree_link_from();
+  void halo_share_spring_candidates(cudaStream_t stream);
+  void halo_springs_to_ids();
   std::vector<RankBytes> halo_send(const uint32_t* starts);
   uint32_t halo_receive(const RankBytes& in, uint32_t first);
   bool halo_any(bool flag) const;
@@ -249,6 +259,10 @@ class CudaBackend final : public Backend {
   // which travels and is kept with the particles (halo_next_stage); kNoRk4Side otherwise.
   static constexpr int kNoRk4Side = -1;
   int halo_rk4_side_ = kNoRk4Side;
+  // Springs: whether the owned lists hold storage indices (from the gather to the ghosts' drop) or
+  // ids; whether this substep links (the lowest waiting id over the ranks is an id).
+  bool halo_springs_indexed_ = false;
+  bool halo_linking_ = false;
 
   WorldConfig config_;
   int device_;

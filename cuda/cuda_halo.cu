@@ -33,9 +33,11 @@
 // added over the ranks) and its density solve by conjugate gradients (the host drives it as the
 // CPU rank's loop, dfsph_cg_rank_solver.cu's enqueue_dfsph_cg_rank_solve: the ghosts take their
 // owners' search directions and velocity steps within each iteration, its sums are exact sums
-// added over the ranks, halo_dfsph_cg_world); attach_ranks refuses springs by name (the CPU rank
-// runs them: src/cpu/cpu_halo_springs.cpp). The exchanges within a substep after the sort (the
-// ghosts' records, the solves' sums, the probes' points) are cuda_halo_records.cu's.
+// added over the ranks, halo_dfsph_cg_world); springs, whose lists name partners by id between
+// substeps, with spring ghosts and the linking's candidates (cuda_halo_springs.cu, as
+// src/cpu/cpu_halo_springs.cpp). The exchanges within a substep after the sort (the ghosts'
+// records, the solves' sums, the probes' points) are cuda_halo_records.cu's.
+#include <cstring>
 #include <memory>
 #include <string>
 #include <utility>
@@ -49,28 +51,12 @@
 #include "kernel_launch.h"
 
 namespace sph {
-namespace {
-
-void refuse(const std::string& what) {
-  throw Error(Status::Unsupported, "world: " + what +
-                                       " does not work in a distributed world on the CUDA backend yet "
-                                       "(docs/distributed.md lists what does)");
-}
-
-}  // namespace
 
 void CudaBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks,
                                const DistributedOptions& options) {
   if (!ranks) throw Error(Status::Internal, "attach_ranks: no transport");
   if (count_ != 0 || ranks_)
     throw Error(Status::Internal, "attach_ranks: the backend already holds particles");
-  const struct {
-    uint32_t bit;
-    const char* name;
-  } features[] = {
-      {kFeatureSprings, "SPH_FEATURE_SPRINGS (springs across ranks run on the CPU backend's ranks)"}};
-  for (const auto& f : features)
-    if (config_.features & f.bit) refuse(f.name);
   require_alive();
   DeviceGuard guard(device_);
   guarded([&] {
@@ -90,12 +76,15 @@ void CudaBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks,
         store->arrays().sorted_position, sizeof(Float4) * static_cast<size_t>(capacity),
         /*fit_to_extent=*/false);
     auto halo = std::make_unique<DeviceHalo>(capacity, ranks->size());
+    std::unique_ptr<DeviceHaloSprings> springs;
+    if (options_.springs) springs = std::make_unique<DeviceHaloSprings>(capacity);
     store->enqueue_initial_world_words(r_->stream);
     cuda_check(cudaStreamSynchronize(r_->stream), "a distributed rank's arrays");
     r_->graph.reset();
     r_->grid.swap(grid);
     r_->store.swap(store);
     r_->halo.swap(halo);
+    r_->halo_springs.swap(springs);
   });
   use_graphs_ = false;
   distributed_options_ = options;
@@ -247,6 +236,9 @@ void CudaBackend::halo_gather() {
     h.enqueue_origin(n, m, static_cast<uint32_t>(r), s);
     n += m;
   }
+  // Springs: the owned lists' partner ids to indices, the partners held nowhere here as spring
+  // ghosts (cuda_halo_springs.cu).
+  if (r_->halo_springs) n = halo_gather_spring_partners(owned, n);
   halo_owned_ = owned;
   halo_ghosts_ = n - owned;
   halo_counters_.ghosts = halo_ghosts_;
@@ -254,6 +246,7 @@ void CudaBackend::halo_gather() {
   halo_agree();  // (the ghosts' arrival)
   t.all_sum(&total, 1);
   halo_world_count_ = total;
+  if (r_->halo_springs) halo_agree_link_from();
   h.enqueue_visit(static_cast<const uint64_t*>(r_->store->find(kArrayDistributedSortKey)), n, s);
 }
 
@@ -264,6 +257,7 @@ void CudaBackend::halo_after_sort(cudaStream_t stream) {
 }
 
 void CudaBackend::halo_drop_ghosts(uint32_t* counts) {
+  if (r_->halo_springs) halo_springs_to_ids();  // before the ghosts go, whose indices the lists hold
   if (halo_ghosts_ == 0) return;
   HostVector<HaloArray> arrays = halo_arrays();
   if (counts) arrays.push_back(HaloArray{reinterpret_cast<unsigned char*>(counts), sizeof(uint32_t)});

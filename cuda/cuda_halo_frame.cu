@@ -73,6 +73,7 @@ class CudaBackend::HaloHooks final : public SubstepHooks {
   }
   void share_velocities(Float4* v, cudaStream_t stream) override { b_.halo_share_velocities(v, stream); }
   void share_steps(cudaStream_t stream) override { b_.halo_share_dfsph_steps(stream); }
+  void between_link_passes(cudaStream_t stream) override { b_.halo_share_spring_candidates(stream); }
   unsigned long long* error_bins() override { return b_.r_->halo->error_bins(); }
   DfsphErrors errors(bool divergence, cudaStream_t stream) override {
     return b_.halo_dfsph_errors(divergence, stream);
@@ -204,6 +205,9 @@ uint32_t CudaBackend::run_frame_distributed(PipelineSetup setup, uint32_t sink_c
   FrameState* out = b.state_output;
   halo_owned_ = count_;
   halo_ghosts_ = 0;
+  // (Between frames the spring lists hold ids, also after a rolled-back frame: the snapshot's.)
+  halo_springs_indexed_ = false;
+  halo_linking_ = false;
   // A failure agreed at the frame's start rolls back to here: the snapshot and the step inputs
   // are taken before it (enqueue_frame_begin takes them again, after the reductions).
   b.store->enqueue_snapshot(count_, s);

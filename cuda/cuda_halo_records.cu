@@ -56,6 +56,10 @@ void CudaBackend::halo_refresh(cudaStream_t stream, const char* what, const Part
   h.enqueue_apply_records(a, h.list() + sent, got.data(), static_cast<uint32_t>(got.size()), stream);
 }
 
+// (cuda_halo_springs.cu's linking refreshes the ghosts' candidates.)
+template void CudaBackend::halo_refresh<HaloSpringCandidateRecord>(cudaStream_t, const char*,
+                                                                   const ParticleArrays&);
+
 void CudaBackend::halo_after_density(cudaStream_t stream) {
   halo_refresh<HaloDensityRecord>(stream, "density records", r_->store->arrays());
 }

@@ -103,6 +103,26 @@ struct HaloRecordFields<HaloDfsphStepRecord> {
   }
 };
 
+// Springs' linking (cuda_halo_springs.cu): an owned particle's candidates as ids; a ghost takes
+// them as ids, which DeviceHaloSprings::candidates_to_indices then finds among the particles here.
+template <>
+struct HaloRecordFields<HaloSpringCandidateRecord> {
+  static constexpr const char* kCopyOut = "copy of the halo's spring candidates";
+  static constexpr const char* kCopyIn = "copy of the ghosts' spring candidates";
+  __device__ static HaloSpringCandidateRecord pack(const ParticleArrays& a, uint32_t i) {
+    HaloSpringCandidateRecord r;
+    r.id = a.sorted_id[i];
+    const uint32_t* mine = a.spring_candidates + static_cast<uint64_t>(i) * kSpringSlots;
+    for (uint32_t k = 0; k < kSpringSlots; ++k)
+      r.candidate[k] = mine[k] == kNoSpring ? kNoSpring : a.sorted_id[mine[k]];
+    return r;
+  }
+  __device__ static void apply(const ParticleArrays& a, uint32_t i, const HaloSpringCandidateRecord& r) {
+    uint32_t* theirs = a.spring_candidates + static_cast<uint64_t>(i) * kSpringSlots;
+    for (uint32_t k = 0; k < kSpringSlots; ++k) theirs[k] = r.candidate[k];
+  }
+};
+
 template <class Record>
 __global__ void pack_records_kernel(ParticleArrays a, const uint32_t* __restrict__ idx, uint32_t m,
                                     Record* __restrict__ out) {
@@ -296,6 +316,7 @@ SPH_HALO_RECORD(HaloNormalRecord)
 SPH_HALO_RECORD(HaloDfsphDensityRecord)
 SPH_HALO_RECORD(HaloVelocityRecord)
 SPH_HALO_RECORD(HaloDfsphStepRecord)
+SPH_HALO_RECORD(HaloSpringCandidateRecord)
 #undef SPH_HALO_RECORD
 
 const int64_t* DeviceHalo::download_error_bins(cudaStream_t stream, uint32_t words) {

@@ -58,7 +58,8 @@ class DeviceHalo {
   const uint32_t* list_ghosts(const Float4* positions, uint32_t n, int axis, float inv_cell_size, int me,
                               cudaStream_t stream);
   const uint32_t* list() const { return list_.get(); }
-  // Particles [first, first + m) are ghosts from rank `origin` (enqueued).
+  // Particles [first, first + m) are ghosts from rank `origin` (enqueued); spring ghosts from rank r
+  // (cuda_halo_springs.cu) have origin ranks + r, and take no records.
   void enqueue_origin(uint32_t first, uint32_t m, uint32_t origin, cudaStream_t stream);
 
   // The arrays of the particles idx[0, m) names (a device list), one array after the other (each

@@ -54,7 +54,8 @@ __global__ void ghost_keys_kernel(const Float4* __restrict__ positions, uint32_t
 // After the sort, sorted place i of particle order[i]: the ghost mask and new sort key (slot,
 // place in it), whether it is owned (the kept list), and its entries: an owned particle beside
 // rank d's slab under key d (d's ghosts read its density record), a ghost from rank r under key
-// ranks + r (it takes a record from r); key 2 ranks: none. An order past the particles raises
+// ranks + r (it takes a record from r); key 2 ranks: none (also a spring ghost's, whose origin is
+// ranks + r: cuda_halo_springs.cu). An order past the particles raises
 // the check word and lists nothing.
 __global__ void mark_kernel(const uint32_t* __restrict__ order, const uint32_t* __restrict__ sorted_slots,
                             const uint32_t* __restrict__ cell_start, uint32_t n, uint32_t owned,
@@ -78,9 +79,9 @@ __global__ void mark_kernel(const uint32_t* __restrict__ order, const uint32_t* 
     const int c = slab_ghost_destinations(cuts, ranks - 1, layers[k], me, dst);
     if (c > 0) first = static_cast<uint32_t>(dst[0]);
     if (c > 1) second = static_cast<uint32_t>(dst[1]);
-  } else {
+  } else if (origin[k] < static_cast<uint32_t>(ranks)) {
     first = static_cast<uint32_t>(ranks) + origin[k];
-  }
+  }  // (else a spring ghost: in no neighbour walk of an owned particle, it takes no record)
   kept[i] = k < owned ? 1 : 0;
   keys[2 * i] = first;
   keys[2 * i + 1] = second;

@@ -129,7 +129,9 @@ void DeviceSinkCompactor::enqueue_compact(const DeviceParticleStore& store, uint
   copy_back(a.id, a.sorted_id, kept, stream, "compaction of ids");
   copy_back(a.density, density_out, kept, stream, "compaction of densities");
   if (counts) copy_back(counts, counts_out_.get(), kept, stream, "compaction of neighbour counts");
-  if (a.springs) enqueue_spring_compact(a, n, kept, keep_.get(), scan_.get(), stream);  // SPH_FEATURE_SPRINGS
+  // SPH_FEATURE_SPRINGS; a distributed rank's lists (its ghost mask: a rank) name partners by id.
+  if (a.springs)
+    enqueue_spring_compact(a, n, kept, keep_.get(), scan_.get(), a.halo_ghost != nullptr, stream);
   // The methods' other carried arrays (the normalised density's factors, say), one at a time
   // through the output buffer, in stream order after the densities.
   for (const auto& m : store.method_arrays()) {

@@ -12,9 +12,11 @@ __global__ void spring_inverse_kernel(const uint32_t* __restrict__ order, uint32
 
 __global__ void spring_reorder_kernel(const SpringList* __restrict__ springs,
                                       const uint32_t* __restrict__ order,
-                                      const uint32_t* __restrict__ inverse, uint32_t n, SpringList* sorted) {
+                                      const uint32_t* __restrict__ inverse,
+                                      const uint32_t* __restrict__ ghost, uint32_t n, SpringList* sorted) {
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i < n) sorted[i] = remap_spring_list(springs[order[i]], inverse);
+  if (i >= n) return;
+  sorted[i] = ghost && ghost[i] ? springs[order[i]] : remap_spring_list(springs[order[i]], inverse);
 }
 
 __global__ void spring_candidates_kernel(SpringConstants c, GridView grid, ParticleArrays a, uint32_t n) {
@@ -22,6 +24,11 @@ __global__ void spring_candidates_kernel(SpringConstants c, GridView grid, Parti
   if (from == kNoPendingLinks) return;  // nobody waits: the usual case, one load per thread
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
+  if (a.halo_ghost && a.halo_ghost[i]) {  // (a ghost's come from its owner)
+    for (uint32_t k = 0; k < kSpringSlots; ++k)
+      a.spring_candidates[static_cast<uint64_t>(i) * kSpringSlots + k] = kNoSpring;
+    return;
+  }
   spring_candidates(c, grid, a.sorted_position, a.sorted_id, from, a.sorted_springs[i], i,
                     a.spring_candidates + static_cast<uint64_t>(i) * kSpringSlots);
 }
@@ -29,7 +36,7 @@ __global__ void spring_candidates_kernel(SpringConstants c, GridView grid, Parti
 __global__ void spring_link_kernel(ParticleArrays a, uint32_t n) {
   if (*a.link_from == kNoPendingLinks) return;
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i >= n) return;
+  if (i >= n || (a.halo_ghost && a.halo_ghost[i])) return;
   SpringList own = a.sorted_springs[i];
   spring_link(a.sorted_position, a.spring_candidates, i, own);
   a.sorted_springs[i] = own;
@@ -41,6 +48,11 @@ __global__ void spring_force_kernel(SpringConstants c, ParticleArrays a, uint32_
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
   SpringList own = a.sorted_springs[i];
+  if (a.halo_ghost && a.halo_ghost[i]) {  // (its owner's to compute)
+    a.spring_acceleration[i] = make_float4_record(Vec3{0.0f, 0.0f, 0.0f}, 0.0f);
+    a.springs[i] = own;
+    return;
+  }
   const Vec3 acc = spring_acceleration<kUpdateRest>(c, a.sorted_position, a.sorted_velocity, i, own,
                                                     state->clock.dt_float);
   a.spring_acceleration[i] = make_float4_record(acc, 0.0f);
@@ -58,7 +70,7 @@ __global__ void spring_compact_kernel(const SpringList* __restrict__ springs,
                                       const uint32_t* __restrict__ keep, const uint32_t* __restrict__ scan,
                                       const uint32_t* __restrict__ inverse, uint32_t n, SpringList* out) {
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i < n && keep[i]) out[scan[i]] = remap_spring_list(springs[i], inverse);
+  if (i < n && keep[i]) out[scan[i]] = inverse ? remap_spring_list(springs[i], inverse) : springs[i];
 }
 
 __global__ void springs_appended_kernel(uint32_t* link_from, uint32_t first_id) {
@@ -78,17 +90,18 @@ void enqueue_spring_reorder(const ParticleArrays& a, const uint32_t* order, uint
   const unsigned blocks = blocks_for(n, kDefaultBlockSize);
   spring_inverse_kernel<<<blocks, kDefaultBlockSize, 0, stream>>>(order, n, a.spring_inverse);
   check_launch("spring_inverse_kernel");
-  spring_reorder_kernel<<<blocks, kDefaultBlockSize, 0, stream>>>(a.springs, order, a.spring_inverse, n,
-                                                                  a.sorted_springs);
+  spring_reorder_kernel<<<blocks, kDefaultBlockSize, 0, stream>>>(a.springs, order, a.spring_inverse,
+                                                                  a.halo_ghost, n, a.sorted_springs);
   check_launch("spring_reorder_kernel");
 }
 
 void enqueue_spring_pass(const SpringConstants& c, const GridView& grid, const ParticleArrays& a, uint32_t n,
-                         bool update_rest, FrameState* state, cudaStream_t stream) {
+                         bool update_rest, FrameState* state, cudaStream_t stream, SpringRankStep* rank) {
   constexpr unsigned kThreads = 128;
   const unsigned blocks = blocks_for(n, kThreads);
   spring_candidates_kernel<<<blocks, kThreads, 0, stream>>>(c, grid, a, n);
   check_launch("spring_candidates_kernel");
+  if (rank) rank->between_link_passes(stream);
   spring_link_kernel<<<blocks, kThreads, 0, stream>>>(a, n);
   check_launch("spring_link_kernel");
   cuda_check(cudaMemsetAsync(a.link_from, 0xff, sizeof(uint32_t), stream), "spring link state clear");
@@ -100,12 +113,14 @@ void enqueue_spring_pass(const SpringConstants& c, const GridView& grid, const P
 }
 
 void enqueue_spring_compact(const ParticleArrays& a, uint32_t n, uint32_t kept, const uint32_t* keep,
-                            const uint32_t* scan, cudaStream_t stream) {
+                            const uint32_t* scan, bool partner_ids, cudaStream_t stream) {
   const unsigned blocks = blocks_for(n, kDefaultBlockSize);
-  spring_compact_index_kernel<<<blocks, kDefaultBlockSize, 0, stream>>>(keep, scan, n, a.spring_inverse);
-  check_launch("spring_compact_index_kernel");
-  spring_compact_kernel<<<blocks, kDefaultBlockSize, 0, stream>>>(a.springs, keep, scan, a.spring_inverse, n,
-                                                                  a.sorted_springs);
+  if (!partner_ids) {
+    spring_compact_index_kernel<<<blocks, kDefaultBlockSize, 0, stream>>>(keep, scan, n, a.spring_inverse);
+    check_launch("spring_compact_index_kernel");
+  }
+  spring_compact_kernel<<<blocks, kDefaultBlockSize, 0, stream>>>(
+      a.springs, keep, scan, partner_ids ? nullptr : a.spring_inverse, n, a.sorted_springs);
   check_launch("spring_compact_kernel");
   if (kept > 0)
     cuda_check(cudaMemcpyAsync(a.springs, a.sorted_springs, sizeof(SpringList) * kept,

@@ -28,18 +28,36 @@ constexpr const char* kArraySortedSprings = "sorted_springs";
 constexpr const char* kArraySpringInverse = "spring_inverse";
 std::vector<ParticleArraySpec> spring_device_arrays();
 
-// sorted_springs[i] = springs[order[i]] with partners mapped to their new indices.
+// A distributed rank's ghosts (a.halo_ghost, sorted order; null in an undivided world) neither
+// link nor move: their lists name partners by id (their owners compute their springs), the
+// reorder moves them unchanged, pass 1 gives them no candidates of their own (a rank's step takes
+// their owners') and the force pass none (cuda_halo_springs.cu, as src/cpu/cpu_springs.cpp).
+
+// sorted_springs[i] = springs[order[i]] with partners mapped to their new indices (a ghost's
+// list unchanged).
 void enqueue_spring_reorder(const ParticleArrays& a, const uint32_t* order, uint32_t n, cudaStream_t stream);
+
+// A distributed rank's step between linking's two passes: the ghosts take their owners'
+// candidates (SubstepHooks, substep_pipeline.h).
+struct SpringRankStep {
+  virtual ~SpringRankStep() = default;
+  virtual void between_link_passes(cudaStream_t stream) = 0;
+};
 
 // Linking (when a particle waits), then spring_acceleration[i] from the sorted state; with
 // update_rest (a substep's first force evaluation) the rest lengths flow. Writes the lists
-// back to a.springs in the sorted order, which the force pass makes the state order.
+// back to a.springs in the sorted order, which the force pass makes the state order. rank: a
+// distributed rank's step between the link passes (null otherwise).
 void enqueue_spring_pass(const SpringConstants& c, const GridView& grid, const ParticleArrays& a, uint32_t n,
-                         bool update_rest, FrameState* state, cudaStream_t stream);
+                         bool update_rest, FrameState* state, cudaStream_t stream,
+                         SpringRankStep* rank = nullptr);
 
 // A sink's stable compaction: survivor i goes to scan[i]; springs to removed particles drop.
+// partner_ids (a distributed rank between substeps: the lists name partners by id): the lists
+// move unchanged, and a spring to a removed particle drops at the next substep (no particle
+// holds its id then).
 void enqueue_spring_compact(const ParticleArrays& a, uint32_t n, uint32_t kept, const uint32_t* keep,
-                            const uint32_t* scan, cudaStream_t stream);
+                            const uint32_t* scan, bool partner_ids, cudaStream_t stream);
 
 // After an append of particles with ids from first_id: link_from = min(link_from, first_id).
 void enqueue_springs_appended(const ParticleArrays& a, uint32_t first_id, cudaStream_t stream);

@@ -48,7 +48,7 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
       if (hooks) hooks->after_normals(stream);
     }
     if (setup.options.springs)
-      enqueue_spring_pass(setup.springs, b.grid->view(), a, n, true, b.state, stream);
+      enqueue_spring_pass(setup.springs, b.grid->view(), a, n, true, b.state, stream, hooks);
     const DfsphLoops loops{cond.in_graph, b.solve_partials, b.state_output, hooks};
     const bool loads = setup.loads.on();
     enqueue_dfsph_step(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene, loops,
@@ -92,7 +92,7 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
     if (stage == 0 && setup.probes.on())
       enqueue_probes(setup.probes, b.grid->view(), a, b.state, stream, hooks);
     if (setup.options.springs)
-      enqueue_spring_pass(setup.springs, b.grid->view(), a, n, stage == 0, b.state, stream);
+      enqueue_spring_pass(setup.springs, b.grid->view(), a, n, stage == 0, b.state, stream, hooks);
     const bool loads = setup.loads.on();
     if (rk4)
       enqueue_forces_rk4(setup.fluid, b.grid->view(), a, n, stage, setup.options, setup.tuning, setup.scene,

@@ -56,8 +56,8 @@ struct PipelineBuffers {
 // order and cell starts are enqueued), after the density pass (the ghosts take their owners'
 // densities) and before the end-of-substep kernel (the maxima and failures reduced over ranks);
 // with DFSPH, after its density pass and inside its solves (DfsphRankSteps); with RK4, between
-// its stages.
-struct SubstepHooks : DfsphRankSteps {
+// its stages; with springs, between linking's two passes (SpringRankStep).
+struct SubstepHooks : DfsphRankSteps, SpringRankStep {
   const uint32_t* visit = nullptr;
   // RK4: before stage `stage` (1-3) sorts, the last one ends as a substep does on the CPU rank: a
   // failure agreed over the ranks (false: every rank ends the substep there, and before_end

@@ -59,4 +59,14 @@ struct HaloDfsphStepRecord {
 
 static_assert(sizeof(HaloDfsphStepRecord) == 8, "a pressure step's record is two words");
 
+// Springs' linking, between its two passes (src/cpu/cpu_halo_springs.cpp, cuda/cuda_halo_springs.cu):
+// an owned particle's nearest candidates (pass 1), as ids, nearest first, padded with kNoSpring
+// (physics/springs.h's kSpringSlots of them: 16).
+struct HaloSpringCandidateRecord {
+  uint32_t id;
+  uint32_t candidate[16];
+};
+
+static_assert(sizeof(HaloSpringCandidateRecord) == 68, "a spring candidates' record is 17 words");
+
 }  // namespace sph

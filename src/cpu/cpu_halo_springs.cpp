@@ -32,6 +32,7 @@
 #include <cstring>
 #include <vector>
 
+#include "../core/halo_records.h"
 #include "cpu_halo_share.h"
 
 namespace sph {
@@ -44,11 +45,8 @@ constexpr uint32_t kCandidateElsewhere = kNoSpring - 1u;
 // A partner no particle here has until the spring ghosts arrive (its id kept in halo_missing_).
 constexpr uint32_t kPartnerPending = kNoSpring - 1u;
 
-// Linking's pass 1 of an owned particle, sent to the ranks that hold it as a ghost.
-struct HaloSpringCandidateRecord {
-  uint32_t id;
-  uint32_t candidate[kSpringSlots];  // ids, nearest first; kNoSpring-padded
-};
+static_assert(sizeof(HaloSpringCandidateRecord::candidate) == sizeof(uint32_t) * kSpringSlots,
+              "a candidates' record holds kSpringSlots ids");
 
 RankBytes id_bytes(const std::vector<uint32_t>& ids) {
   RankBytes b(ids.size() * sizeof(uint32_t));

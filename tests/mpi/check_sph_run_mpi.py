@@ -21,8 +21,8 @@ neighbour count within 1e-5 (the ranks' means weighted by their particles: anoth
 order). Also that the --per-rank files of each frame hold every particle once, each as the
 merged frame has it, and (--refusals) that --backend cuda either runs (a GPU is there) or fails on every rank with exit code 4
 and one message naming the option (CI: no GPU); then the scene with springs, whose merged frames
-equal sph-run's bit for bit on CPU ranks (springs across ranks), and which CUDA ranks refuse
-(exit 3, naming SPH_FEATURE_SPRINGS).
+equal sph-run's bit for bit (springs across ranks; with --backend cuda on CUDA ranks against
+sph-run --backend cuda, also without --refusals: scripts/gpu-test runs it).
 --interrupt: SIGINT to one rank alone (not rank 0 as a rule) once frame 1 is complete: every
 rank stops after the same frame (they agree once before and once after each step), exit code
 130, the manifests end "interrupted" at that frame, whose files (and the probes' rows) are all
@@ -290,6 +290,8 @@ def main(argv):
         check_vdb_shape(mpiexec, sph_run, sph_run_mpi, scene, work, ranks)
     if "--interrupt" in options:
         check_interrupt(mpiexec, sph_run_mpi, scene, work, ranks, backend)
+    if backend == "cuda":
+        check_springs(mpiexec, sph_run, sph_run_mpi, scene, work, ranks, backend)
     if "--refusals" not in options:
         return 0
 
@@ -305,29 +307,24 @@ def main(argv):
         assert p.returncode == 0, f"--backend cuda exited {p.returncode}\n{p.stderr}"
         print("--backend cuda: exit 0 (a GPU is here)")
 
-    check_springs(mpiexec, sph_run, sph_run_mpi, scene, work, ranks, backend)
+    if backend != "cuda":  # (with --backend cuda, checked above)
+        check_springs(mpiexec, sph_run, sph_run_mpi, scene, work, ranks, backend)
     return 0
 
 
 def check_springs(mpiexec, sph_run, sph_run_mpi, scene, work, ranks, backend):
-    """The scene with springs: on CPU ranks (since wt-springrank) every merged frame equals sph-run's bit
-    for bit, springs crossing the slabs; CUDA ranks refuse the world, naming the feature (exit 3)."""
+    """The scene with springs: every merged frame equals sph-run's bit for bit, springs crossing the slabs,
+    on CPU ranks (since wt-springrank) and on CUDA ranks against sph-run --backend cuda (since
+    wt-cudaspring, where they were refused before)."""
     with open(scene, encoding="utf-8") as f:
         text = f.read()
     springs = os.path.join(work, "with_springs.json")
     with open(springs, "w", encoding="utf-8") as f:
         f.write(text.replace('"capacity": 4000', '"capacity": 4000, "features": ["springs"]', 1))
     out = os.path.join(work, "springs_np" + ranks)
-    if backend == "cuda":
-        p = run([mpiexec, "--oversubscribe", "-np", ranks, sph_run_mpi, springs, "--backend", "cuda", "--quiet",
-                 "--out", out], expect=3)
-        assert "world" in p.stderr and "SPH_FEATURE_SPRINGS" in p.stderr, p.stderr
-        assert p.stderr.count("sph-run-mpi:") == 1, f"one message, from rank 0:\n{p.stderr}"
-        print("springs on CUDA ranks refused:", p.stderr.strip().splitlines()[0])
-        return
     single = os.path.join(work, "springs_single")
-    run([sph_run, springs, "--backend", "cpu", "--format", "csv", "--threads", "1", "--quiet", "--out", single])
-    run([mpiexec, "--oversubscribe", "-np", ranks, sph_run_mpi, springs, "--backend", "cpu", "--format", "csv",
+    run([sph_run, springs, "--backend", backend, "--format", "csv", "--threads", "1", "--quiet", "--out", single])
+    run([mpiexec, "--oversubscribe", "-np", ranks, sph_run_mpi, springs, "--backend", backend, "--format", "csv",
          "--threads", "1", "--quiet", "--out", out])
     frames = sorted(os.path.basename(f) for f in glob.glob(os.path.join(single, "fluid_*.csv")))
     assert len(frames) >= 2, f"sph-run wrote {frames}"
@@ -338,7 +335,8 @@ def check_springs(mpiexec, sph_run, sph_run_mpi, scene, work, ranks, backend):
         assert a.keys() == b.keys() and not bad, (f"springs: {name}: {len(bad)} of {len(a)} particles differ from "
                                                   f"sph-run's" + (f"; id {bad[0]}: {a[bad[0]]} vs {b.get(bad[0])}"
                                                                   if bad else ""))
-    print(f"springs: {len(frames)} frames of {len(a)} particles on {ranks} ranks == sph-run, bit for bit")
+    print(f"springs: {len(frames)} frames of {len(a)} particles on {ranks} ranks == sph-run, bit for bit "
+          f"({backend} backend)")
 
 
 if __name__ == "__main__":

@@ -22,15 +22,17 @@
  * substeps, spacing 12.5 mm), RK4 (the stirred column, and with the collider loads), DFSPH's Jacobi solves
  * (test_mpi_cuda_cases.c: the dam break, the stirred column with and without the divergence solve), probes
  * and gauges and sinks (there too, both solvers), DFSPH's conjugate gradients (test_mpi_cuda_cases.c,
- * mpi_cuda_cg_case: against the same world on one rank, bit for bit), and the refusal of springs
- * (SPH_ERROR_UNSUPPORTED naming them). With
- * SPH_MPI_CUDA_QUICK set, the dam breaks (WCSPH, DFSPH, DFSPH by conjugate gradients) and the refusals only
- * (a run under compute-sanitizer). */
+ * mpi_cuda_cg_case: against the same world on one rank, bit for bit), and springs across ranks
+ * (mpi_springs_cases.c, the CPU ranks' test_mpi_springs.c cases on the CUDA ranks at capacity
+ * 32768: bit for bit against the undivided CUDA world). With SPH_MPI_CUDA_QUICK set, the dam
+ * breaks only (WCSPH, DFSPH, DFSPH by conjugate gradients: a run under compute-sanitizer). With
+ * the argument `springs`, the springs cases only. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "mpi_cuda_cases.h"
+#include "mpi_springs_cases.h"
 #include "mpi_test_world.h"
 #include "support.h"
 
@@ -173,14 +175,6 @@ static void run_loads_case(const char* name, sph_context* cuda, const sph_world_
   sph_world_destroy(w.world);
 }
 
-static void expect_refused(sph_context* cuda, const sph_world_def* def, const char* what) {
-  sph_world* world = NULL;
-  const sph_result r = sph_mpi_world_create(cuda, def, MPI_TEST_COMM, NULL, &world);
-  CHECK(r == SPH_ERROR_UNSUPPORTED && strstr(sph_get_last_error(), what) != NULL,
-        "a distributed CUDA world with %s: %d '%s'", what, (int)r, sph_get_last_error());
-  if (r == SPH_OK) sph_world_destroy(world);
-}
-
 int main(int argc, char** argv) {
   sph_context* cpu = NULL;
   sph_context* cuda = NULL;
@@ -188,9 +182,16 @@ int main(int argc, char** argv) {
   sph_world_def def;
   /* The dam break alone (scripts/gpu-mpi-test's compute-sanitizer run). */
   const int quick = getenv("SPH_MPI_CUDA_QUICK") != NULL;
+  int springs_only;
   mpi_test_init(&argc, &argv, &cpu);
+  springs_only = argc > 1 && strcmp(argv[1], "springs") == 0;
   cuda = cuda_context(0);
   cuda_one_lane = cuda_context(1);
+  if (springs_only) {
+    mpi_springs_cases(cuda, 32768);
+    REQUIRE(sph_context_destroy(cuda) == SPH_OK && sph_context_destroy(cuda_one_lane) == SPH_OK, "destroy");
+    return mpi_test_finish(cpu, "mpi_cuda springs");
+  }
 
   mpi_test_world_def(&def);
   def.capacity = 32768; /* 32 slots an axis: the tank's 23 x 12 x 4 cells never fold */
@@ -261,9 +262,8 @@ int main(int argc, char** argv) {
     mpi_cuda_cg_case("DFSPH CG stirred column", cuda, 2.0f, 0);
     mpi_cuda_cg_case("DFSPH CG stirred column, capped solves", cuda, 2.0f, 4);
   }
-  mpi_test_world_def(&def);
-  def.features = SPH_FEATURE_SPRINGS;
-  expect_refused(cuda, &def, "SPH_FEATURE_SPRINGS");
+  /* Springs across ranks: the CPU ranks' cases (test_mpi_springs.c) on the CUDA ranks. */
+  if (!quick) mpi_springs_cases(cuda, 32768);
 
   REQUIRE(sph_context_destroy(cuda) == SPH_OK && sph_context_destroy(cuda_one_lane) == SPH_OK, "destroy");
   return mpi_test_finish(cpu, "mpi_cuda");
