@@ -52,6 +52,10 @@ static float max_abs_difference(const float* a, const float* b, uint32_t n) {
   return m;
 }
 
+/* How far a case's distributed CUDA world may lie from the undivided one (m): 0, bit for bit (every
+ * case but the folded table with several lanes, whose sums round differently: main). */
+static float g_undivided_bound = 0.0f;
+
 /* One case: `frames` frames of `substeps` on the CUDA context `cuda` (distributed and undivided)
  * and on the CPU context `cpu` (distributed), compared on rank 0. */
 static void run_case(const char* name, sph_context* cuda, sph_context* cpu, const sph_world_def* def,
@@ -79,18 +83,24 @@ static void run_case(const char* name, sph_context* cuda, sph_context* cpu, cons
     float particle_mass = 0.0f;
     double mass;
     uint32_t differ;
-    float dx_cpu;
+    float dx_cpu, dx_single;
     REQUIRE(sph_world_get_particle_mass(single, &particle_mass) == SPH_OK, "particle mass");
     mass = (double)n * (double)particle_mass;
     mpi_test_read(single, n, &want_x, &want_v);
     differ = mpi_differ(want_x, want_v, x, v, n, NULL);
     dx_cpu = max_abs_difference(cpu_x, x, n);
+    dx_single = max_abs_difference(want_x, x, n);
     printf(
-        "%s on %d ranks: %u particles (mass %.6g kg), %u differ from the undivided CUDA world in any bit; "
-        "max |x_cuda - x_cpu| %.3g m; %u rebalances, %llu ghosts in the last substep, %llu migrations\n",
-        name, g_size, n, mass, differ, (double)dx_cpu, counts.rebalances,
+        "%s on %d ranks: %u particles (mass %.6g kg), %u differ from the undivided CUDA world in any bit "
+        "(by at most %.3g m); max |x_cuda - x_cpu| %.3g m; %u rebalances, %llu ghosts in the last substep, "
+        "%llu migrations\n",
+        name, g_size, n, mass, differ, (double)dx_single, (double)dx_cpu, counts.rebalances,
         (unsigned long long)counts.global_ghosts, (unsigned long long)counts.migrated);
-    CHECK(differ == 0, "%s: %u of %u particles differ from the undivided CUDA world", name, differ, n);
+    if (g_undivided_bound > 0.0f)
+      CHECK(dx_single <= g_undivided_bound, "%s: %.3g m from the undivided CUDA world (bound %.3g m)", name,
+            (double)dx_single, (double)g_undivided_bound);
+    else
+      CHECK(differ == 0, "%s: %u of %u particles differ from the undivided CUDA world", name, differ, n);
     CHECK(!compare_cpu || dx_cpu <= 1e-4f * 0.4f,
           "%s: the CUDA and CPU distributed worlds %.3g m apart (bound 4e-5 m)", name, (double)dx_cpu);
     CHECK(n == n_cpu, "%s: %u particles on the CPU world, %u on the CUDA world", name, n_cpu, n);
@@ -223,6 +233,16 @@ int main(int argc, char** argv) {
     def.features = 0;
     mpi_test_world_def(&def); /* capacity 4096: 16 slots an axis, folded along x */
     run_case("stirred column, folded table, one lane", cuda_one_lane, cpu, &def, 0.5f, 1, 20, 1);
+    /* The same folded table with the default lane groups: a slot's far particles decide which lane
+     * adds which neighbour, and a rank holds other far particles than the undivided world (and
+     * keeps the capacity's cubic table where the undivided world fits its extent), so the lanes'
+     * partial sums round differently: not bit for bit. The issue's bound for such a regime, 1e-6
+     * of the tank's 0.4 m after 20 substeps (CPU and GPU, which also differ by roundings, part by
+     * 5e-8 to 7e-7 m over these cases). */
+    mpi_test_world_def(&def);
+    g_undivided_bound = 1e-6f * 0.4f;
+    run_case("stirred column, folded table, default lanes", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    g_undivided_bound = 0.0f;
     mpi_test_world_def(&def);
     def.capacity = 32768;
     def.particle_spacing = 0.0125f;
