@@ -8,7 +8,14 @@
 //   physics_loads_breakdown [--backend cpu|cuda] [--solver wcsph|dfsph] [--dt-max SECONDS]
 //                           [--settle SECONDS] [--perturb SEED] [--frames N] [--check-loads]
 //                           [--self-check | --self-check-only] [--step METRES] [--sample-every N]
-//                           [--box-voxel METRES]
+//                           [--box-voxel METRES] [--initial-densities] [--full-first-layer]
+//
+// --initial-densities: print rho / rho0 of the lattice as spawned (one 1 us substep without gravity)
+// at the box's first layer per region and at the tank's floor away from the box, then stop: the
+// walls' share beside a finite solid against a flat wall's (docs/validation.md, "Session 17: the
+// step / 2 placement again"). --full-first-layer: cut the lattice a quarter step beyond the box's
+// faces instead of the test's half step, which float rounding makes drop the first layer below three
+// of its faces.
 //
 // --step: the lattice step (default 0.01 m; issue 17, "Loads against resolution" in
 // docs/validation.md): the layers fill the same tank (16 x 20 x 16 cm rounded to whole layers), h,
@@ -114,7 +121,8 @@ struct Tally {
 
 int main(int argc, char** argv) {
   const char* backend_name = sph_test_backend_name();  // SPH_TEST_BACKEND, unset: cpu
-  bool dfsph = false, self_check = false, only = false, check_loads = false, initial = false;
+  bool dfsph = false, self_check = false, only = false, check_loads = false, initial = false,
+       full_first_layer = false;
   int frames = 0, every = 1;
   double settle_time = 0.8, step = 0.01;
   unsigned long perturb = 0;
@@ -146,12 +154,14 @@ int main(int argc, char** argv) {
       self_check = only = true;
     else if (std::strcmp(argv[k], "--initial-densities") == 0)
       initial = true;
+    else if (std::strcmp(argv[k], "--full-first-layer") == 0)
+      full_first_layer = true;
     else {
       std::fprintf(
           stderr,
           "usage: %s [--backend cpu|cuda] [--solver wcsph|dfsph] [--dt-max SECONDS] [--settle "
           "SECONDS] [--perturb SEED] [--frames N] [--check-loads] [--self-check | --self-check-only] [--step "
-          "METRES] [--sample-every N] [--box-voxel METRES] [--initial-densities]\n",
+          "METRES] [--sample-every N] [--box-voxel METRES] [--initial-densities] [--full-first-layer]\n",
           argv[0]);
       return 2;
     }
@@ -178,10 +188,13 @@ int main(int argc, char** argv) {
   float* lattice = nullptr;
   uint32_t n = 0, kept = 0;
   check(support_fcc_box(layers, step, nullptr, &lattice, &n), "support_fcc_box");
+  // The test's cut, kHalf + step / 2, drops by float rounding the layer step / 2 below the box's bottom,
+  // -x and -z faces (|0.045f - 0.08| < 0.035): those faces start 1.5 steps from the water. With
+  // --full-first-layer the cut lies a quarter step beyond the faces and keeps that layer.
+  const double cut = kHalf + (full_first_layer ? 0.25 : 0.5) * step;
   for (uint32_t i = 0; i < n; ++i) {
     bool inside = true;
-    for (int k = 0; k < 3; ++k)
-      inside = inside && std::fabs(lattice[3 * i + k] - kCentre[k]) < kHalf + 0.5 * step;
+    for (int k = 0; k < 3; ++k) inside = inside && std::fabs(lattice[3 * i + k] - kCentre[k]) < cut;
     if (inside) continue;
     std::memmove(lattice + 3 * kept, lattice + 3 * i, 3 * sizeof(float));
     ++kept;
