@@ -8,7 +8,14 @@
 //   physics_loads_breakdown [--backend cpu|cuda] [--solver wcsph|dfsph] [--dt-max SECONDS]
 //                           [--settle SECONDS] [--perturb SEED] [--frames N] [--check-loads]
 //                           [--self-check | --self-check-only] [--step METRES] [--sample-every N]
-//                           [--box-voxel METRES]
+//                           [--box-voxel METRES] [--initial-densities] [--full-first-layer]
+//
+// --initial-densities: print rho / rho0 of the lattice as spawned (one 1 us substep without gravity)
+// at the box's first layer per region and at the tank's floor away from the box, then stop: the
+// walls' share beside a finite solid against a flat wall's (docs/validation.md, "Session 17: the
+// step / 2 placement again"). --full-first-layer: cut the lattice a quarter step beyond the box's
+// faces instead of the test's half step, which float rounding makes drop the first layer below three
+// of its faces.
 //
 // --step: the lattice step (default 0.01 m; issue 17, "Loads against resolution" in
 // docs/validation.md): the layers fill the same tank (16 x 20 x 16 cm rounded to whole layers), h,
@@ -114,7 +121,8 @@ struct Tally {
 
 int main(int argc, char** argv) {
   const char* backend_name = sph_test_backend_name();  // SPH_TEST_BACKEND, unset: cpu
-  bool dfsph = false, self_check = false, only = false, check_loads = false;
+  bool dfsph = false, self_check = false, only = false, check_loads = false, initial = false,
+       full_first_layer = false;
   int frames = 0, every = 1;
   double settle_time = 0.8, step = 0.01;
   unsigned long perturb = 0;
@@ -144,12 +152,16 @@ int main(int argc, char** argv) {
       check_loads = true;
     else if (std::strcmp(argv[k], "--self-check-only") == 0)
       self_check = only = true;
+    else if (std::strcmp(argv[k], "--initial-densities") == 0)
+      initial = true;
+    else if (std::strcmp(argv[k], "--full-first-layer") == 0)
+      full_first_layer = true;
     else {
       std::fprintf(
           stderr,
           "usage: %s [--backend cpu|cuda] [--solver wcsph|dfsph] [--dt-max SECONDS] [--settle "
           "SECONDS] [--perturb SEED] [--frames N] [--check-loads] [--self-check | --self-check-only] [--step "
-          "METRES] [--sample-every N] [--box-voxel METRES]\n",
+          "METRES] [--sample-every N] [--box-voxel METRES] [--initial-densities] [--full-first-layer]\n",
           argv[0]);
       return 2;
     }
@@ -176,10 +188,13 @@ int main(int argc, char** argv) {
   float* lattice = nullptr;
   uint32_t n = 0, kept = 0;
   check(support_fcc_box(layers, step, nullptr, &lattice, &n), "support_fcc_box");
+  // The test's cut, kHalf + step / 2, drops by float rounding the layer step / 2 below the box's bottom,
+  // -x and -z faces (|0.045f - 0.08| < 0.035): those faces start 1.5 steps from the water. With
+  // --full-first-layer the cut lies a quarter step beyond the faces and keeps that layer.
+  const double cut = kHalf + (full_first_layer ? 0.25 : 0.5) * step;
   for (uint32_t i = 0; i < n; ++i) {
     bool inside = true;
-    for (int k = 0; k < 3; ++k)
-      inside = inside && std::fabs(lattice[3 * i + k] - kCentre[k]) < kHalf + 0.5 * step;
+    for (int k = 0; k < 3; ++k) inside = inside && std::fabs(lattice[3 * i + k] - kCentre[k]) < cut;
     if (inside) continue;
     std::memmove(lattice + 3 * kept, lattice + 3 * i, 3 * sizeof(float));
     ++kept;
@@ -288,6 +303,44 @@ int main(int argc, char** argv) {
     substeps += stats.substeps;
     return stats.substeps;
   };
+  // --initial-densities: the lattice as spawned, one substep of 1 us without gravity, so the densities
+  // are the spawn positions' (as test_boundary_density.c reads a block's): rho / rho0 of the box's
+  // first layer (particles within a step of it) per region, and of the tank's first layer away from
+  // the box (the flat walls' reference).
+  if (initial) {
+    check(support_set_gravity_and_steps(w.world, 0.0f, 0.0f, 0.0f, 1e-6f, 1e-6f), "set gravity");
+    check(sph_world_step(w.world, 1e-6f), "sph_world_step");
+    uint32_t c0 = 0;
+    check(support_read_by_id(w.world, SPH_ATTRIBUTE_POSITION, x.data(), kept, &c0), "read positions");
+    check(support_read_by_id(w.world, SPH_ATTRIBUTE_DENSITY, rho.data(), kept, &c0), "read densities");
+    double sum[kRegions + 1] = {}, lo[kRegions + 1], hi[kRegions + 1], count[kRegions + 1] = {};
+    for (int r = 0; r <= kRegions; ++r) lo[r] = 1e9, hi[r] = -1e9;
+    for (uint32_t i = 0; i < c0; ++i) {
+      const double local[3] = {x[3 * i] - kCentre[0], x[3 * i + 1] - kCentre[1], x[3 * i + 2] - kCentre[2]};
+      double beyond = 0.0;  // the largest distance beyond a face, per axis (the first layer: step / 2)
+      for (int k = 0; k < 3; ++k) beyond = std::fmax(beyond, std::fabs(local[k]) - kHalf);
+      const double wall =
+          std::fmin(std::fmin(x[3 * i], kSide - x[3 * i]), std::fmin(x[3 * i + 2], kSide - x[3 * i + 2]));
+      int r = -1;
+      if (beyond < step)
+        r = region_of(local);
+      else if (x[3 * i + 1] < step && wall > h && beyond > h)
+        r = kRegions;  // the floor, away from all else
+      if (r < 0) continue;
+      const double v = rho[i] / rho0;
+      sum[r] += v, count[r] += 1.0, lo[r] = std::fmin(lo[r], v), hi[r] = std::fmax(hi[r], v);
+    }
+    std::printf(
+        "initial densities (the lattice as spawned, no gravity), K %.1f kg/m^3, delta %.4f m: first layer "
+        "rho / rho0 mean [min, max] (particles)\n",
+        static_cast<double>(K), calibration.offset);
+    for (int r = 0; r <= kRegions; ++r)
+      if (count[r] > 0.0)
+        std::printf("  %-15s %.4f [%.4f, %.4f] (%.0f)\n", r < kRegions ? kRegionNames[r] : "tank floor",
+                    sum[r] / count[r], lo[r], hi[r], count[r]);
+    support_world_close(&w);
+    return 0;
+  }
   // The self-check: the first substep from the lattice has no contacts yet, so with the loads on its
   // loads are the walls' reaction alone, which the host's map must reproduce.
   if (self_check) {
