@@ -55,7 +55,10 @@ void capi_submerged_box_open(capi_submerged_box* s, const sph_world_def* def,
   assert_int_equal(support_fcc_box(layers, step, NULL, &lattice, &n), SPH_OK);
   for (uint32_t i = 0; i < n; ++i) {
     int inside = 1;
-    for (int k = 0; k < 3; ++k) inside = inside && fabs(lattice[3 * i + k] - centre[k]) < half + 0.5 * step;
+    /* The cut lies a quarter step beyond the faces: the first layer outside lies half a step from
+     * each face, exactly at half + step / 2, where a cut there dropped it by float rounding below
+     * the bottom, -x and -z faces (and kept it above the others) until session 17. */
+    for (int k = 0; k < 3; ++k) inside = inside && fabs(lattice[3 * i + k] - centre[k]) < half + 0.25 * step;
     if (inside) continue;
     memmove(lattice + 3 * s->count, lattice + 3 * i, 3 * sizeof(float));
     ++s->count;

@@ -90,13 +90,14 @@ static void test_submerged_box_buoyancy(void** state) {
   expected = s.w.def.rest_density * kGravity * 8.0 * half * half * half;
   print_message("DFSPH submerged box: force (%.4f, %.4f, %.4f) N, rho0 g V = %.4f N: buoyancy %+.2f %%\n",
                 force[0], force[1], force[2], expected, 100.0 * (force[1] / expected - 1.0));
-  /* Measured -18.7 % (CPU, 2026-12-02): DFSPH's walls in the density under-carry this box, as
-   * physics_loads_breakdown's host sum of its walls' reaction alone reads -12.9 % to -18.3 % over
-   * settle times and lattice perturbations of 1e-7 m (docs/validation.md, "The submerged box per
-   * region"); the loads add the clamp's and the contacts' few percent. The bound is that spread's
-   * end with room for the window (22 %); the issue's 2 % is asserted with DFLOADS_STRICT=1
+  /* Measured -3.80 % on the CPU (session 17, the scene's first layer kept below three faces; +1.01 %
+   * without it, -4.23 % on the H200), -18.7 % before a solid's map corrected the distance (session
+   * 16; docs/validation.md, "The submerged box per region" and "Session 17: the inverse's margin").
+   * One draw of a window in which the water still sloshes (a sideways force of 0.6 N, 28 % of
+   * rho0 g V): the bound, 8 %, is twice the largest reading since session 16 (it was 22 % for the
+   * -12.9 % to -18.3 % spread before); the issue's 2 % is asserted with DFLOADS_STRICT=1
    * (physics_dfsph_loads_strict_KNOWN_ISSUE). The force must still point up. */
-  assert_true((force[1] > 0.0 && fabs(force[1] / expected - 1.0) <= buoyancy_bound(0.22)) || measuring());
+  assert_true((force[1] > 0.0 && fabs(force[1] / expected - 1.0) <= buoyancy_bound(0.08)) || measuring());
   capi_submerged_box_close(&s);
 }
 
