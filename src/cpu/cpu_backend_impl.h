@@ -23,7 +23,6 @@
 #include "../core/solver_record.h"
 #include "../physics/collider_loads.h"
 #include "../physics/dfsph_passes.h"
-#include "../physics/dfsph_symmetric_gradient.h"
 #include "../physics/forces.h"
 #include "../physics/integrate.h"
 #include "../physics/probe_sampling.h"
@@ -223,11 +222,6 @@ class CpuBackend final : public Backend {
   // the ranks' largest).
   void dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls, float dt);
   DfsphErrors dfsph_errors(DfsphSolve kind);
-  // The momentum-conserving corrected gradient (physics/dfsph_symmetric_gradient.h, experiment):
-  // each particle's L and a for the substep's positions; its velocity change.
-  void dfsph_symmetric_prepare(const FluidConstants& fluid, const DfsphWalls& walls);
-  Vec3 dfsph_symmetric_change(const FluidConstants& fluid, const float* k, const DfsphWalls& walls,
-                              uint32_t i, float dt) const;
   // The density solve by conjugate gradients (cpu_dfsph_cg.cpp; sph_dfsph_params.linear_solver);
   // its rate pass (each particle's value into cg_value_; returns the mean and largest error); a contact held
   // within an iteration (v_i changed by dv): the values of i and its neighbours.
@@ -367,25 +361,20 @@ class CpuBackend final : public Backend {
   CpuArrayRef<uint32_t> link_from_;    // one word: the lowest id that waits for its springs
   CpuArrayRef<uint32_t> spring_candidates_;
   CpuArrayRef<Float4> spring_acceleration_;
-  CpuArrayRef<float> dfsph_pressure_;          // DFSPH: the density solve's p / rho^2 (warm start)
-  CpuArrayRef<float> dfsph_divergence_;        // DFSPH: the divergence solve's p / rho^2 times dt
-  CpuArrayRef<float> dfsph_factor_;            // DFSPH: alpha / rho of the density pass
-  CpuArrayRef<float> dfsph_residual_;          // DFSPH: each particle's share of the solve's error
-  CpuArrayRef<Float4> dfsph_contact_;          // DFSPH: each particle's contact with the colliders
-  CpuArrayRef<Float4> clamp_impulse_;          // DFSPH with the loads: the clamp's, per particle
-  bool dfsph_contacts_ = false;                // DFSPH: the substep has colliders (contacts to respect)
-  HostVector<ColliderView> dfsph_colliders_;   // DFSPH: the substep's colliders, for the contacts
-  HostVector<SymmetricCorrection> symgrad_;    // DFSPH experiment: L and a per particle
-  HostVector<Vec3> symgrad_t_, symgrad_next_;  // ... the zeroth-order target, the sweep's new a
-  HostVector<float> symgrad_s_;                // ... sum_j m W_ij
-  int symgrad_mode_ = -1;                      // ... SPH_SYMGRAD (bit 0: L, bit 1: a), -1 unread
-  int symgrad_sweeps_ = 4;                     // ... SPH_SYMGRAD_SWEEPS
-  CpuArrayRef<float> cg_value_;                // DFSPH by conjugate gradients: rho* - rho0 per particle
-  CpuArrayRef<float> cg_change_;               // ... its change along the search direction
-  CpuArrayRef<Float4> cg_velocity_step_;       // ... the velocity change of the search direction
-  CpuArrayRef<uint8_t> cg_state_;              // ... in the active set; contact binds
-  CpuArrayRef<Float4> boundary_;          // boundary density: (grad rho_b, v_b . grad rho_b) per particle
-  CpuArrayRef<uint32_t> user_attribute_;  // SPH_FEATURE_USER_ATTRIBUTE: the caller's value
+  CpuArrayRef<float> dfsph_pressure_;         // DFSPH: the density solve's p / rho^2 (warm start)
+  CpuArrayRef<float> dfsph_divergence_;       // DFSPH: the divergence solve's p / rho^2 times dt
+  CpuArrayRef<float> dfsph_factor_;           // DFSPH: alpha / rho of the density pass
+  CpuArrayRef<float> dfsph_residual_;         // DFSPH: each particle's share of the solve's error
+  CpuArrayRef<Float4> dfsph_contact_;         // DFSPH: each particle's contact with the colliders
+  CpuArrayRef<Float4> clamp_impulse_;         // DFSPH with the loads: the clamp's, per particle
+  bool dfsph_contacts_ = false;               // DFSPH: the substep has colliders (contacts to respect)
+  HostVector<ColliderView> dfsph_colliders_;  // DFSPH: the substep's colliders, for the contacts
+  CpuArrayRef<float> cg_value_;               // DFSPH by conjugate gradients: rho* - rho0 per particle
+  CpuArrayRef<float> cg_change_;              // ... its change along the search direction
+  CpuArrayRef<Float4> cg_velocity_step_;      // ... the velocity change of the search direction
+  CpuArrayRef<uint8_t> cg_state_;             // ... in the active set; contact binds
+  CpuArrayRef<Float4> boundary_;              // boundary density: (grad rho_b, v_b . grad rho_b) per particle
+  CpuArrayRef<uint32_t> user_attribute_;      // SPH_FEATURE_USER_ATTRIBUTE: the caller's value
   CpuBoundaryMaps boundary_maps_;
   HostVector<ColliderView> collider_views_;  // the frame's colliders, for the density pass
   HostVector<ColliderLoadSums> load_sums_;   // the frame's impulses per collider (loads on)

@@ -19,8 +19,6 @@
 // the collision response's contacts (physics/collider_loads.h).
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include "../core/dfsph_jacobi_loop.h"
 #include "../core/exact_float_sum.h"
@@ -66,144 +64,13 @@ void CpuBackend::dfsph_correct(const FluidConstants& fluid, const DfsphWalls& wa
                                                        : simd_.dfsph_velocity_change;
   // The gather reads positions and k; each particle writes only its own velocity (record and
   // column), which the next rate pass reads.
-  const bool symmetric = fluid.methods.dfsph.gradient_correction && symgrad_mode_ > 0;
   parallel().for_each(count_, [&](uint32_t i) {
-    Vec3 vi = xyz(v[i]) + (symmetric ? dfsph_symmetric_change(fluid, k, walls, i, dt)
-                                     : change(fluid, view, columns, k, walls, i, dt));
+    Vec3 vi = xyz(v[i]) + change(fluid, view, columns, k, walls, i, dt);
     if (contact) dfsph_clamp(i, vi);
     v[i] = make_float4_record(vi, v[i].w);
     columns_.set_velocity(i, vi);
     carried[i] += k[i] * carry_scale;
   });
-}
-
-// The momentum-conserving corrected gradient (experiment; physics/dfsph_symmetric_gradient.h).
-void CpuBackend::dfsph_symmetric_prepare(const FluidConstants& fluid, const DfsphWalls& walls) {
-  const GridView view = grid_.view();
-  const Float4* pos = position_.data();
-  const KernelCoefficients mk = mass_gradient_kernel(fluid);
-  const float h2 = fluid.kernel.h2, rho0 = fluid.rest_density, m = fluid.particle_mass;
-  const int mode = symgrad_mode_;
-  symgrad_.resize(count_);
-  symgrad_t_.resize(count_);
-  symgrad_next_.resize(count_);
-  symgrad_s_.resize(count_);
-  SymmetricCorrection* sc = symgrad_.data();
-  Vec3* t = symgrad_t_.data();
-  float* s = symgrad_s_.data();
-  std::vector<float> fade(count_);
-  parallel().for_each(count_, [&](uint32_t i) {
-    const Vec3 xi = xyz(pos[i]);
-    GradientMomentOf<float> mo = zero_gradient_moment(0.0f);
-    float sum_w = 0.0f;
-    for_each_neighbor_candidate(view, xi, [&](uint32_t j) {
-      const Vec3 d = xi - xyz(pos[j]);
-      const float r2 = length_squared(d);
-      if (r2 < h2 && j != i) {
-        const float r = square_root(r2);
-        add_gradient_moment(mo, spiky_gradient(mk, d, r), d);
-        sum_w += m * spiky_value(fluid.kernel, r);
-      }
-    });
-    const float w = correction_fade(mo, rho0);
-    fade[i] = w;
-    faded_inverse(mo, rho0, (mode & 1) ? w : 0.0f, sc[i].l);
-    sc[i].a = Vec3{0.0f, 0.0f, 0.0f};
-    s[i] = sum_w;
-    t[i] = mo.zeroth;
-  });
-  if (!(mode & 2)) return;
-  // The zeroth-order sum with the averaged L, and its share to remove.
-  const float keep = std::getenv("SPH_SYMGRAD_SHARE")
-                         ? static_cast<float>(std::atof(std::getenv("SPH_SYMGRAD_SHARE")))
-                         : 1.0f;
-  parallel().for_each(count_, [&](uint32_t i) {
-    const Vec3 xi = xyz(pos[i]);
-    Vec3 z{0.0f, 0.0f, 0.0f};
-    for_each_neighbor_candidate(view, xi, [&](uint32_t j) {
-      const Vec3 d = xi - xyz(pos[j]);
-      const float r2 = length_squared(d);
-      if (r2 < h2 && j != i)
-        z += averaged_correction(sc[i].l, sc[j].l, spiky_gradient(mk, d, square_root(r2)));
-    });
-    symgrad_next_[i] = (mode & 4) ? z : (z + wall_pressure_gradient(walls, i) * 0.5f) * (fade[i] * keep);
-  });
-  std::swap(symgrad_t_, symgrad_next_);
-  t = symgrad_t_.data();
-  if (mode & 4) {
-    // Only the rough part: Z less its w-weighted mean over the neighbours.
-    Vec3* next = symgrad_next_.data();
-    parallel().for_each(count_, [&](uint32_t i) {
-      const Vec3 xi = xyz(pos[i]);
-      Vec3 mean{0.0f, 0.0f, 0.0f};
-      for_each_neighbor_candidate(view, xi, [&](uint32_t j) {
-        const Vec3 d = xi - xyz(pos[j]);
-        const float r2 = length_squared(d);
-        if (r2 < h2 && j != i) mean += t[j] * (m * spiky_value(fluid.kernel, square_root(r2)));
-      });
-      next[i] = s[i] > 0.0f ? (t[i] - mean * (1.0f / s[i])) * (fade[i] * keep) : Vec3{0.0f, 0.0f, 0.0f};
-    });
-    std::swap(symgrad_t_, symgrad_next_);
-    t = symgrad_t_.data();
-  }
-  for (int sweep = 0; sweep < symgrad_sweeps_; ++sweep) {
-    Vec3* next = symgrad_next_.data();
-    parallel().for_each(count_, [&](uint32_t i) {
-      const Vec3 xi = xyz(pos[i]);
-      Vec3 acc = t[i];
-      for_each_neighbor_candidate(view, xi, [&](uint32_t j) {
-        const Vec3 d = xi - xyz(pos[j]);
-        const float r2 = length_squared(d);
-        if (r2 < h2 && j != i) acc += sc[j].a * (m * spiky_value(fluid.kernel, square_root(r2)));
-      });
-      next[i] = s[i] > 0.0f ? acc * (1.0f / s[i]) : Vec3{0.0f, 0.0f, 0.0f};
-    });
-    for (uint32_t i = 0; i < count_; ++i) sc[i].a = next[i];
-  }
-  static int reports = 0;
-  if (std::getenv("SPH_SYMGRAD_VERBOSE") && reports < 20) {
-    // The residual sum_j G_ij - (Z_i - t_i) = t_i - (S_i a_i - sum_j w_ij a_j), RMS against t's.
-    double t2 = 0.0, r2sum = 0.0;
-    for (uint32_t i = 0; i < count_; ++i) {
-      const Vec3 xi = xyz(pos[i]);
-      Vec3 lap = sc[i].a * s[i];
-      for_each_neighbor_candidate(view, xi, [&](uint32_t j) {
-        const Vec3 d = xi - xyz(pos[j]);
-        const float r2 = length_squared(d);
-        if (r2 < h2 && j != i) lap = lap - sc[j].a * (m * spiky_value(fluid.kernel, square_root(r2)));
-      });
-      const Vec3 r = t[i] - lap;
-      t2 += length_squared(t[i]);
-      r2sum += length_squared(r);
-    }
-    std::printf("symgrad: target rms %.4g, residual rms %.4g\n", std::sqrt(t2 / count_),
-                std::sqrt(r2sum / count_));
-    ++reports;
-  }
-}
-
-Vec3 CpuBackend::dfsph_symmetric_change(const FluidConstants& fluid, const float* k, const DfsphWalls& walls,
-                                        uint32_t i, float dt) const {
-  const GridView view = grid_.view();
-  const Float4* pos = position_.data();
-  const KernelCoefficients mk = mass_gradient_kernel(fluid);
-  const float h2 = fluid.kernel.h2, m = fluid.particle_mass;
-  const SymmetricCorrection* sc = symgrad_.data();
-  const Vec3 xi = xyz(pos[i]);
-  const float ki = k[i];
-  const bool zeroth = (symgrad_mode_ & 2) != 0;
-  Vec3 sum{0.0f, 0.0f, 0.0f};
-  for_each_neighbor_candidate(view, xi, [&](uint32_t j) {
-    const Vec3 d = xi - xyz(pos[j]);
-    const float r2 = length_squared(d);
-    if (r2 < h2 && j != i) {
-      const float r = square_root(r2);
-      Vec3 g = averaged_correction(sc[i].l, sc[j].l, spiky_gradient(mk, d, r));
-      if (zeroth) g = g - (sc[i].a - sc[j].a) * (m * spiky_value(fluid.kernel, r));
-      sum += g * (ki + k[j]);
-    }
-  });
-  return dfsph_velocity_change(sum, walls, i, ki, dt);
 }
 
 void CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls,
@@ -301,11 +168,6 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
   const float dt = time.dt;
   const DfsphWalls walls{boundary_.data()};  // the walls' share (dfsph_boundary.h), null without it
   dfsph_find_contacts(scene, time);
-  if (symgrad_mode_ < 0) {
-    symgrad_mode_ = std::getenv("SPH_SYMGRAD") ? std::atoi(std::getenv("SPH_SYMGRAD")) : 0;
-    if (std::getenv("SPH_SYMGRAD_SWEEPS")) symgrad_sweeps_ = std::atoi(std::getenv("SPH_SYMGRAD_SWEEPS"));
-  }
-  if (fluid.methods.dfsph.gradient_correction && symgrad_mode_ > 0) dfsph_symmetric_prepare(fluid, walls);
   // 2. The divergence solve corrects the current velocities in place (a failed frame restores
   // them from the snapshot).
   if (fluid.methods.dfsph.divergence_solve) {
