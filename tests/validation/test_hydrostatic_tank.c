@@ -81,6 +81,8 @@ static tank_case dfsph_tank(const char* name, uint32_t features, double bound, f
     tc.width_layers = (uint32_t)atoi(getenv("HYDRO_LAYERS"));
     tc.depth_layers = 2u * tc.width_layers;
   }
+  /* HYDRO_WIDTH=N: N layers across at the case's depth (more particles a slice, the same column). */
+  if (getenv("HYDRO_WIDTH")) tc.width_layers = (uint32_t)atoi(getenv("HYDRO_WIDTH"));
   if (getenv("HYDRO_SECONDS")) tc.seconds = atof(getenv("HYDRO_SECONDS"));
   if (getenv("HYDRO_DT_MAX")) tc.dt_max = (float)atof(getenv("HYDRO_DT_MAX"));
   if (getenv("HYDRO_KERNEL")) tc.kernel_spacings = (float)atof(getenv("HYDRO_KERNEL"));
