@@ -237,13 +237,13 @@ int main(int argc, char** argv) {
     def.features = 0;
     mpi_test_world_def(&def); /* capacity 4096: 16 slots an axis, folded along x */
     run_case("stirred column, folded table, one lane", cuda_one_lane, cpu, &def, 0.5f, 1, 20, 1);
-    /* The same folded table with four lanes a particle (the default picks one for this small world:
-     * bit for bit, measured on the H200 in session 17): a slot's far particles decide which lane
-     * adds which neighbour, and a rank holds other far particles than the undivided world (and
-     * keeps the capacity's cubic table where the undivided world fits its extent), so the lanes'
-     * partial sums round differently: not bit for bit. The issue's bound for such a regime, 1e-6
-     * of the tank's 0.4 m after 20 substeps (CPU and GPU, which also differ by roundings, part by
-     * 5e-8 to 7e-7 m over these cases). */
+    /* The same folded table with four lanes a particle (what the default picks below 135k
+     * particles): a slot's far particles decide which lane adds which neighbour, and a rank holds
+     * other far particles than the undivided world (and keeps the capacity's cubic table where the
+     * undivided world fits its extent), so the lanes' partial sums may round differently; asserted
+     * within the issue's bound for a non-canonical order, 1e-6 of the tank's 0.4 m after 20
+     * substeps (CPU and GPU, which differ by roundings, part by 5e-8 to 7e-7 m over these cases).
+     * Measured on the H200 (session 17, default lanes): bit for bit on 1 and 2 ranks all the same. */
     mpi_test_world_def(&def);
     g_undivided_bound = 1e-6f * 0.4f;
     run_case("stirred column, folded table, four lanes", cuda_four_lanes, cpu, &def, 0.5f, 1, 20, 1);
