@@ -64,35 +64,6 @@ static void set_springs(sph_world* w, const spring_case* c) {
   REQUIRE(sph_world_set_spring_params(w, &p) == SPH_OK, "set spring params");
 }
 
-/* A block [0.25, 0.33] x [0, 0.08] x [0, 0.06]: filled into the undivided world (rank 0) and added
- * to the distributed one by the last rank alone, with the same positions; *n grows on every rank. */
-static void add_block(sph_world* single, sph_world* world, uint32_t* n) {
-  float* positions = NULL;
-  uint32_t added = 0, total = 0;
-  if (g_rank == 0) {
-    sph_fill_box_desc box;
-    REQUIRE(sph_fill_box_desc_init(&box) == SPH_OK, "fill init");
-    box.min.x = 0.25f;
-    box.max.x = 0.33f;
-    box.max.y = 0.08f;
-    box.max.z = 0.06f;
-    REQUIRE(sph_world_fill_box(single, &box, &added) == SPH_OK, "fill");
-    REQUIRE(support_copy_by_id(single, SPH_ATTRIBUTE_POSITION, (void**)&positions, &total) == SPH_OK, "read");
-    REQUIRE(total == *n + added, "%u particles after the block", total);
-  }
-  MPI_Bcast(&added, 1, MPI_UINT32_T, 0, MPI_COMM_WORLD);
-  if (g_rank != 0) {
-    positions = (float*)malloc(sizeof(float) * 3 * ((size_t)*n + added + 1));
-    REQUIRE(positions != NULL, "malloc");
-  }
-  MPI_Bcast(positions + 3 * (size_t)*n, (int)(3 * added), MPI_FLOAT, 0, MPI_COMM_WORLD);
-  REQUIRE(sph_mpi_world_add_particles(world, positions + 3 * (size_t)*n, NULL,
-                                      g_rank == g_size - 1 ? added : 0, NULL) == SPH_OK,
-          "the last rank adds the block");
-  *n += added;
-  free(positions);
-}
-
 /* Rank 0: the linked pairs of the first n ids (closer than the link radius, 1.2 spacings, at
  * `x`, by id: every lattice neighbour, 12 at most, fits the 16 slots), as pairs of ids. */
 static uint32_t* linked_pairs(const float* x, uint32_t n, uint32_t* count) {
@@ -175,7 +146,9 @@ static void run_case(sph_context* context, uint32_t capacity, const spring_case*
   if (before) {
     if (g_rank == 0) mpi_test_step(single, before, 0);
     mpi_test_step(world, before, 1);
-    add_block(single, world, &n);
+    /* A block [0.25, 0.33] x [0, 0.08] x [0, 0.06], added by the last rank. */
+    mpi_test_add_block(single, world, (sph_vec3){0.25f, 0.0f, 0.0f}, (sph_vec3){0.33f, 0.08f, 0.06f},
+                       g_size - 1, &n);
   }
   if (g_rank == 0) mpi_test_step(single, c->substeps - before, 0);
   mpi_test_step(world, c->substeps - before, 1);

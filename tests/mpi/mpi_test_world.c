@@ -146,6 +146,34 @@ void mpi_test_add_top_sink(sph_world* world) {
   REQUIRE(sph_sink_create(world, &sink, &id) == SPH_OK, "sink: %s", sph_get_last_error());
 }
 
+void mpi_test_add_block(sph_world* single, sph_world* world, sph_vec3 lo, sph_vec3 hi, int adder,
+                        uint32_t* n) {
+  float* positions = NULL;
+  uint32_t added = 0, total = 0;
+  if (g_rank == 0) {
+    sph_fill_box_desc box;
+    REQUIRE(sph_fill_box_desc_init(&box) == SPH_OK, "fill init");
+    box.min = lo;
+    box.max = hi;
+    REQUIRE(sph_world_fill_box(single, &box, &added) == SPH_OK, "fill");
+    REQUIRE(support_copy_by_id(single, SPH_ATTRIBUTE_POSITION, (void**)&positions, &total) == SPH_OK, "read");
+    REQUIRE(total == *n + added, "%u particles after the block", total);
+  }
+  MPI_Bcast(&added, 1, MPI_UINT32_T, 0, MPI_COMM_WORLD);
+  if (adder != 0) { /* the adder takes rank 0's positions */
+    if (g_rank != 0) {
+      positions = (float*)malloc(sizeof(float) * 3 * ((size_t)*n + added + 1));
+      REQUIRE(positions != NULL, "malloc");
+    }
+    MPI_Bcast(positions + 3 * (size_t)*n, (int)(3 * added), MPI_FLOAT, 0, MPI_COMM_WORLD);
+  }
+  REQUIRE(sph_mpi_world_add_particles(world, g_rank == adder ? positions + 3 * (size_t)*n : NULL, NULL,
+                                      g_rank == adder ? added : 0, NULL) == SPH_OK,
+          "rank %d adds the block", adder);
+  *n += added;
+  free(positions);
+}
+
 void mpi_test_add_probes(sph_world* world, sph_probe_id* point, sph_probe_id* gauge) {
   sph_probe_def def;
   REQUIRE(sph_probe_def_init(&def) == SPH_OK, "probe init");

@@ -72,6 +72,11 @@ void mpi_test_add_probes(sph_world* world, sph_probe_id* point, sph_probe_id* ga
 /* A sink removing every particle outside [-1, 1] x [-1, 0.185] x [-1, 1] m: the stirred column's
  * top, where splashes go. */
 void mpi_test_add_top_sink(sph_world* world);
+/* A block [lo, hi] filled into the undivided world `single` (on rank 0) and added to the
+ * distributed `world` by rank `adder` alone, with the same positions; *n grows by the block's
+ * count on every rank. */
+void mpi_test_add_block(sph_world* single, sph_world* world, sph_vec3 lo, sph_vec3 hi, int adder,
+                        uint32_t* n);
 /* The last step's removed ids (malloc'd, *count of them) and its SPH_EVENT_SINK_REMOVED count. */
 uint32_t* mpi_test_removed_ids(sph_world* world, uint32_t* count, uint32_t* event_count);
 /* The path of rank `rank`'s file named in the manifest at `manifest` (in its directory; the

@@ -56,32 +56,6 @@ static void check_halo(const sph_mpi_counts* counts, const float* start, uint64_
   free(all);
 }
 
-/* A second block, [0.25, 0.35] x [0, 0.1] x [0, 0.06], filled into the undivided world (rank 0)
- * and added from rank 0 to the distributed one; *n grows by its count on every rank. */
-static void add_block(sph_world* single, sph_world* world, uint32_t* n) {
-  float* positions = NULL;
-  uint32_t total = 0, added = 0;
-  if (g_rank == 0) {
-    sph_fill_box_desc box;
-    REQUIRE(sph_fill_box_desc_init(&box) == SPH_OK, "fill init");
-    box.min.x = 0.25f;
-    box.min.y = 0.0f;
-    box.min.z = 0.0f;
-    box.max.x = 0.35f;
-    box.max.y = 0.1f;
-    box.max.z = 0.06f;
-    REQUIRE(sph_world_fill_box(single, &box, &added) == SPH_OK, "fill");
-    REQUIRE(support_copy_by_id(single, SPH_ATTRIBUTE_POSITION, (void**)&positions, &total) == SPH_OK, "read");
-    REQUIRE(total == *n + added, "%u particles after the block", total);
-  }
-  REQUIRE(sph_mpi_world_add_particles(world, positions ? positions + 3 * (size_t)*n : NULL, NULL, added,
-                                      NULL) == SPH_OK,
-          "add the block");
-  MPI_Bcast(&added, 1, MPI_UINT32_T, 0, MPI_COMM_WORLD);
-  *n += added;
-  free(positions);
-}
-
 /* One scene: the undivided world (rank 0) and the distributed one (every rank). With `block`,
  * a second block joins after 10 substeps, off to one side: the ranks are out of balance, and
  * the world's longest axis changes from y to x, so the next frame cuts new slabs. */
@@ -115,7 +89,8 @@ static void run_scene(sph_context* context, const char* name, float stir_speed, 
   if (block) {
     if (g_rank == 0) mpi_test_step(single, 10, 0);
     mpi_test_step(world, 10, 1);
-    add_block(single, world, &n);
+    /* A second block, [0.25, 0.35] x [0, 0.1] x [0, 0.06], added from rank 0. */
+    mpi_test_add_block(single, world, (sph_vec3){0.25f, 0.0f, 0.0f}, (sph_vec3){0.35f, 0.1f, 0.06f}, 0, &n);
   }
   if (g_rank == 0) mpi_test_step(single, block ? 9 : 19, 0);
   mpi_test_step(world, block ? 9 : 19, 1);
