@@ -33,6 +33,7 @@
 #include <string.h>
 
 #include "hydrostatic_tank_gauges.h"
+#include "hydrostatic_tank_interp.h"
 #include "hydrostatic_tank_moment.h"
 #include "hydrostatic_tank_profile.h"
 #include "validation_util.h"
@@ -113,6 +114,7 @@ void run_tank(const tank_case* tc) {
   sph_sdf* sdf = NULL;
   tank_gauges* gauges = NULL;
   tank_moment* moment = NULL;
+  tank_interp* interp = NULL;
   float* x = NULL;
   float* p = NULL;
   float* rho = NULL;
@@ -143,7 +145,8 @@ void run_tank(const tank_case* tc) {
   bin = h;
   if (tc->gauges) {
     gauges = tank_gauges_create(world, width, depth, h, bin, nl, step);
-    moment = tank_moment_create(nl);
+    moment = tank_moment_create(nl, (tc->dfsph_flags & SPH_DFSPH_CORRECTED_GRADIENT) != 0u);
+    interp = tank_interp_create(nl, width, depth, h, bin, step);
   }
 
   layer_sum = (double*)calloc(nl, sizeof(double));
@@ -182,8 +185,12 @@ void run_tank(const tank_case* tc) {
       EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_DENSITY, (void**)&rho, &count));
     }
     /* (the moment's neighbour sums once per 20 ms at most: they are the run's costliest host work) */
-    if (moment && f >= window_start && (f - window_start) % (int)(0.02 / frame_dt + 0.5) == 0)
+    if (moment && f >= window_start && (f - window_start) % (int)(0.02 / frame_dt + 0.5) == 0) {
       tank_moment_add(moment, n, x, p, rho, mass, rho0, h, width, bin, step);
+      /* (the brute force every 0.1 s: 20 states of the 2 s window) */
+      if ((f - window_start) % (int)(0.1 / frame_dt + 0.5) == 0)
+        tank_interp_add(interp, n, x, p, rho, mass, rho0);
+    }
     for (uint32_t i = 0; i < n; ++i) {
       if (x[3 * i + 1] < lowest) lowest = x[3 * i + 1];
       if (f < window_start) continue;
@@ -250,8 +257,22 @@ void run_tank(const tank_case* tc) {
       particle_scatter(&model, &fit, n, nl, bin, particle_p, particle_y, inside, window_frames);
       tank_moment_print(moment, layer_y, fit.surface, rho0, GRAVITY, h);
       tank_gauges_profile(gauges, bin, layer_sum, layer_y, layer_count);
-      (void)fit_profile(&model, top_layer, nl, layer_sum, layer_y, NULL, layer_count,
+      {
+        const profile_fit g =
+            fit_profile(&model, top_layer, nl, layer_sum, layer_y, NULL, layer_count,
                         "the gauges' pressure (the SPH interpolant, horizontal lines), per slice");
+        double* by_hand = (double*)calloc(nl, sizeof(double));
+        double* y_w = (double*)calloc(nl, sizeof(double));
+        uint32_t* states = (uint32_t*)calloc(nl, sizeof(uint32_t));
+        assert_true(by_hand && y_w && states);
+        tank_interp_print(interp, layer_sum, g.surface, rho0, GRAVITY);
+        tank_interp_profile(interp, by_hand, y_w, states);
+        (void)fit_profile(&model, top_layer, nl, layer_sum, y_w, NULL, layer_count,
+                          "the gauges' pressure at the Shepard mean height y_w, per slice");
+        free(by_hand);
+        free(y_w);
+        free(states);
+      }
     }
     {
       FILE* out = validation_open_output(tc->solver == SPH_SOLVER_DFSPH
@@ -279,6 +300,7 @@ void run_tank(const tank_case* tc) {
   }
   tank_gauges_destroy(gauges, world);
   tank_moment_destroy(moment);
+  tank_interp_destroy(interp);
   free(layer_sum);
   free(layer_rho);
   free(layer_y);
