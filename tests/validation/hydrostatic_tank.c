@@ -120,6 +120,9 @@ void run_tank(const tank_case* tc) {
   float* rho = NULL;
   float mass = 0.0f;
   double *layer_sum, *layer_y, *layer_rho, *particle_p, *particle_y;
+  /* the odd frames' share of the slices' sums: the time sampling's spread (docs/validation.md) */
+  double *odd_sum, *odd_y;
+  uint32_t* odd_count;
   uint32_t* layer_count;
   uint8_t* inside;
   double k, c, h, rho0, lowest = 1e30, top_layer = -1e30;
@@ -153,6 +156,10 @@ void run_tank(const tank_case* tc) {
   layer_rho = (double*)calloc(nl, sizeof(double));
   layer_y = (double*)calloc(nl, sizeof(double));
   layer_count = (uint32_t*)calloc(nl, sizeof(uint32_t));
+  odd_sum = (double*)calloc(nl, sizeof(double));
+  odd_y = (double*)calloc(nl, sizeof(double));
+  odd_count = (uint32_t*)calloc(nl, sizeof(uint32_t));
+  assert_true(odd_sum && odd_y && odd_count);
   particle_p = (double*)calloc(n, sizeof(double));
   particle_y = (double*)calloc(n, sizeof(double));
   inside = (uint8_t*)malloc(n);
@@ -207,6 +214,11 @@ void run_tank(const tank_case* tc) {
         layer_rho[layer] += rho[i];
         layer_y[layer] += x[3 * i + 1];
         ++layer_count[layer];
+        if ((f - window_start) % 2) {
+          odd_sum[layer] += p[i];
+          odd_y[layer] += x[3 * i + 1];
+          ++odd_count[layer];
+        }
       }
     }
     if (f == frames - 1) {
@@ -253,6 +265,20 @@ void run_tank(const tank_case* tc) {
         "(%.3f spacings)\n",
         fit.used, 100.0 * fit.mean, 100.0 * fit.worst, 100.0 * tc->bound, lowest,
         lowest / def.particle_spacing);
+    /* The odd frames' slice means against the even frames' at the same height (along rho0 g): how
+     * far the window's frame-end sampling moves the particles' reading. */
+    printf("  the particles' pressure, odd frames of the window against even ones, per slice:");
+    for (uint32_t l = 0; l < nl; ++l) {
+      const uint32_t even_count = layer_count[l] - odd_count[l];
+      double po, yo, pe, ye;
+      if (!odd_count[l] || !even_count) continue;
+      po = odd_sum[l] / odd_count[l];
+      yo = odd_y[l] / odd_count[l];
+      pe = (layer_sum[l] * layer_count[l] - odd_sum[l]) / even_count;
+      ye = (layer_y[l] * layer_count[l] - odd_y[l]) / even_count;
+      printf(" %+.2f%%", 100.0 * ((po + rho0 * GRAVITY * (yo - ye)) / pe - 1.0));
+    }
+    printf("\n");
     if (tc->gauges) {
       particle_scatter(&model, &fit, n, nl, bin, particle_p, particle_y, inside, window_frames);
       tank_moment_print(moment, layer_y, fit.surface, rho0, GRAVITY, h);
@@ -305,6 +331,9 @@ void run_tank(const tank_case* tc) {
   free(layer_rho);
   free(layer_y);
   free(layer_count);
+  free(odd_sum);
+  free(odd_y);
+  free(odd_count);
   free(particle_p);
   free(particle_y);
   free(inside);
