@@ -33,6 +33,7 @@
 #include <string.h>
 
 #include "hydrostatic_tank_gauges.h"
+#include "hydrostatic_tank_interp.h"
 #include "hydrostatic_tank_moment.h"
 #include "hydrostatic_tank_profile.h"
 #include "validation_util.h"
@@ -113,11 +114,15 @@ void run_tank(const tank_case* tc) {
   sph_sdf* sdf = NULL;
   tank_gauges* gauges = NULL;
   tank_moment* moment = NULL;
+  tank_interp* interp = NULL;
   float* x = NULL;
   float* p = NULL;
   float* rho = NULL;
   float mass = 0.0f;
   double *layer_sum, *layer_y, *layer_rho, *particle_p, *particle_y;
+  /* the odd frames' share of the slices' sums: the time sampling's spread (docs/validation.md) */
+  double *odd_sum, *odd_y;
+  uint32_t* odd_count;
   uint32_t* layer_count;
   uint8_t* inside;
   double k, c, h, rho0, lowest = 1e30, top_layer = -1e30;
@@ -143,13 +148,18 @@ void run_tank(const tank_case* tc) {
   bin = h;
   if (tc->gauges) {
     gauges = tank_gauges_create(world, width, depth, h, bin, nl, step);
-    moment = tank_moment_create(nl);
+    moment = tank_moment_create(nl, (tc->dfsph_flags & SPH_DFSPH_CORRECTED_GRADIENT) != 0u);
+    interp = tank_interp_create(nl, width, depth, h, bin, step);
   }
 
   layer_sum = (double*)calloc(nl, sizeof(double));
   layer_rho = (double*)calloc(nl, sizeof(double));
   layer_y = (double*)calloc(nl, sizeof(double));
   layer_count = (uint32_t*)calloc(nl, sizeof(uint32_t));
+  odd_sum = (double*)calloc(nl, sizeof(double));
+  odd_y = (double*)calloc(nl, sizeof(double));
+  odd_count = (uint32_t*)calloc(nl, sizeof(uint32_t));
+  assert_true(odd_sum && odd_y && odd_count);
   particle_p = (double*)calloc(n, sizeof(double));
   particle_y = (double*)calloc(n, sizeof(double));
   inside = (uint8_t*)malloc(n);
@@ -182,8 +192,12 @@ void run_tank(const tank_case* tc) {
       EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_DENSITY, (void**)&rho, &count));
     }
     /* (the moment's neighbour sums once per 20 ms at most: they are the run's costliest host work) */
-    if (moment && f >= window_start && (f - window_start) % (int)(0.02 / frame_dt + 0.5) == 0)
+    if (moment && f >= window_start && (f - window_start) % (int)(0.02 / frame_dt + 0.5) == 0) {
       tank_moment_add(moment, n, x, p, rho, mass, rho0, h, width, bin, step);
+      /* (the brute force every 0.1 s: 20 states of the 2 s window) */
+      if ((f - window_start) % (int)(0.1 / frame_dt + 0.5) == 0)
+        tank_interp_add(interp, n, x, p, rho, mass, rho0);
+    }
     for (uint32_t i = 0; i < n; ++i) {
       if (x[3 * i + 1] < lowest) lowest = x[3 * i + 1];
       if (f < window_start) continue;
@@ -200,6 +214,11 @@ void run_tank(const tank_case* tc) {
         layer_rho[layer] += rho[i];
         layer_y[layer] += x[3 * i + 1];
         ++layer_count[layer];
+        if ((f - window_start) % 2) {
+          odd_sum[layer] += p[i];
+          odd_y[layer] += x[3 * i + 1];
+          ++odd_count[layer];
+        }
       }
     }
     if (f == frames - 1) {
@@ -246,12 +265,40 @@ void run_tank(const tank_case* tc) {
         "(%.3f spacings)\n",
         fit.used, 100.0 * fit.mean, 100.0 * fit.worst, 100.0 * tc->bound, lowest,
         lowest / def.particle_spacing);
+    /* The odd frames' slice means against the even frames' at the same height (along rho0 g): how
+     * far the window's frame-end sampling moves the particles' reading. */
+    printf("  the particles' pressure, odd frames of the window against even ones, per slice:");
+    for (uint32_t l = 0; l < nl; ++l) {
+      const uint32_t even_count = layer_count[l] - odd_count[l];
+      double po, yo, pe, ye;
+      if (!odd_count[l] || !even_count) continue;
+      po = odd_sum[l] / odd_count[l];
+      yo = odd_y[l] / odd_count[l];
+      pe = (layer_sum[l] * layer_count[l] - odd_sum[l]) / even_count;
+      ye = (layer_y[l] * layer_count[l] - odd_y[l]) / even_count;
+      printf(" %+.2f%%", 100.0 * ((po + rho0 * GRAVITY * (yo - ye)) / pe - 1.0));
+    }
+    printf("\n");
     if (tc->gauges) {
       particle_scatter(&model, &fit, n, nl, bin, particle_p, particle_y, inside, window_frames);
       tank_moment_print(moment, layer_y, fit.surface, rho0, GRAVITY, h);
       tank_gauges_profile(gauges, bin, layer_sum, layer_y, layer_count);
-      (void)fit_profile(&model, top_layer, nl, layer_sum, layer_y, NULL, layer_count,
+      {
+        const profile_fit g =
+            fit_profile(&model, top_layer, nl, layer_sum, layer_y, NULL, layer_count,
                         "the gauges' pressure (the SPH interpolant, horizontal lines), per slice");
+        double* by_hand = (double*)calloc(nl, sizeof(double));
+        double* y_w = (double*)calloc(nl, sizeof(double));
+        uint32_t* states = (uint32_t*)calloc(nl, sizeof(uint32_t));
+        assert_true(by_hand && y_w && states);
+        tank_interp_print(interp, layer_sum, g.surface, rho0, GRAVITY);
+        tank_interp_profile(interp, by_hand, y_w, states);
+        (void)fit_profile(&model, top_layer, nl, layer_sum, y_w, NULL, layer_count,
+                          "the gauges' pressure at the Shepard mean height y_w, per slice");
+        free(by_hand);
+        free(y_w);
+        free(states);
+      }
     }
     {
       FILE* out = validation_open_output(tc->solver == SPH_SOLVER_DFSPH
@@ -279,10 +326,14 @@ void run_tank(const tank_case* tc) {
   }
   tank_gauges_destroy(gauges, world);
   tank_moment_destroy(moment);
+  tank_interp_destroy(interp);
   free(layer_sum);
   free(layer_rho);
   free(layer_y);
   free(layer_count);
+  free(odd_sum);
+  free(odd_y);
+  free(odd_count);
   free(particle_p);
   free(particle_y);
   free(inside);

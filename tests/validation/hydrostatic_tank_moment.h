@@ -8,7 +8,9 @@
 
 typedef struct tank_moment tank_moment;
 
-tank_moment* tank_moment_create(uint32_t bins);
+/* corrected: the run's solves use SPH_DFSPH_CORRECTED_GRADIENT; the moment, the acceleration and
+ * its zeroth-order part are then those of the corrected operator (hydrostatic_tank_moment.c). */
+tank_moment* tank_moment_create(uint32_t bins, int corrected);
 /* Adds one frame: the interior particles (h from the side walls) of each slice `bin` thick;
  * x: positions (xyz), p: the particles' pressure, rho: their density; step: the
  * lattice's (the kernel's scale). */

@@ -87,6 +87,9 @@ static tank_case dfsph_tank(const char* name, uint32_t features, double bound, f
   if (getenv("HYDRO_DT_MAX")) tc.dt_max = (float)atof(getenv("HYDRO_DT_MAX"));
   if (getenv("HYDRO_KERNEL")) tc.kernel_spacings = (float)atof(getenv("HYDRO_KERNEL"));
   if (getenv("HYDRO_FLAGS")) tc.dfsph_flags = (uint32_t)atoi(getenv("HYDRO_FLAGS"));
+  /* HYDRO_FRAME (s): another frame length; at dt_max every frame is one substep, so the particles'
+   * reading (read at frame ends) samples every substep, as the gauges do (docs/validation.md). */
+  if (getenv("HYDRO_FRAME")) tc.frame = (float)atof(getenv("HYDRO_FRAME"));
   tc.gauges = 1;
   return tc;
 }
