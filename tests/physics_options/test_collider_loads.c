@@ -289,8 +289,8 @@ static void test_submerged_box_buoyancy(void** state) {
       on, 100.0 * (on / expected - 1.0), off, 100.0 * (off / expected - 1.0), expected);
   /* 12 %: the measured spread of this case, not one draw of it. The unperturbed CPU run reads
    * +2.9 % since session 17 (the scene's first layer kept below three faces; +4.7 % without it, +5.6 %
-   * at session 16's share margin, -4.7 % before a solid's map corrected the distance); before that, moving the
-   * lattice by 1e-7 m gives -2.7 % to -10.6 % (physics_loads_breakdown
+   * at session 16's share margin, -4.7 % before a solid's map corrected the distance); before that, moving
+   * the lattice by 1e-7 m gives -2.7 % to -10.6 % (physics_loads_breakdown
    * --perturb; no particle caught inside the box's edges, no contacts: the walls in the density
    * alone carry the box, and its settled state's average depends on rounding; docs/validation.md
    * "The submerged box: particles caught inside its edges"). The bound is the spread's end with room for
