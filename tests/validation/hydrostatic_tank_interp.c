@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "tank_cell_grid.h"
 #include "validation_util.h"
 
 struct tank_interp {
@@ -74,30 +75,8 @@ tank_interp* tank_interp_create(uint32_t bins, double width, double depth, doubl
 void tank_interp_add(tank_interp* t, uint32_t n, const float* x, const float* p, const float* rho,
                      double mass, double rho0) {
   const double h = t->h, h2 = h * h, poly6 = 315.0 / (64.0 * M_PI * pow(h, 9.0));
-  double lo[3] = {1e30, 1e30, 1e30}, hi[3] = {-1e30, -1e30, -1e30};
-  int dims[3];
-  uint32_t cells, *start, *order, *cell_of, *fill;
-  for (uint32_t i = 0; i < n; ++i)
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = fmin(lo[a], x[3 * i + a]);
-      hi[a] = fmax(hi[a], x[3 * i + a]);
-    }
-  for (int a = 0; a < 3; ++a) dims[a] = (int)((hi[a] - lo[a]) / h) + 1;
-  cells = (uint32_t)(dims[0] * dims[1] * dims[2]);
-  start = (uint32_t*)calloc(cells + 1u, sizeof(uint32_t));
-  order = (uint32_t*)malloc(sizeof(uint32_t) * n);
-  cell_of = (uint32_t*)malloc(sizeof(uint32_t) * n);
-  fill = (uint32_t*)malloc(sizeof(uint32_t) * cells);
-  assert_true(start && order && cell_of && fill);
-  for (uint32_t i = 0; i < n; ++i) {
-    int c[3];
-    for (int a = 0; a < 3; ++a) c[a] = (int)((x[3 * i + a] - lo[a]) / h);
-    cell_of[i] = (uint32_t)((c[2] * dims[1] + c[1]) * dims[0] + c[0]);
-    ++start[cell_of[i] + 1u];
-  }
-  for (uint32_t c = 0; c < cells; ++c) start[c + 1u] += start[c];
-  for (uint32_t c = 0; c < cells; ++c) fill[c] = start[c];
-  for (uint32_t i = 0; i < n; ++i) order[fill[cell_of[i]]++] = i;
+  tank_cell_grid grid;
+  tank_cell_grid_build(&grid, x, n, h);
   free(t->k_weight);
   t->k_weight = (double*)calloc((size_t)n * t->bins, sizeof(double));
   assert_non_null(t->k_weight);
@@ -129,33 +108,24 @@ void tank_interp_add(tank_interp* t, uint32_t n, const float* x, const float* p,
       for (uint32_t l = 0; l < lines; ++l)
         for (uint32_t k = 0; k < samples; ++k) {
           const double q[3] = {margin + (k + 0.5) * dx, y, margin + l * t->step};
-          int c[3];
-          for (int a = 0; a < 3; ++a) c[a] = (int)floor((q[a] - lo[a]) / h);
-          for (int dz = -1; dz <= 1; ++dz)
-            for (int dy = -1; dy <= 1; ++dy)
-              for (int dxc = -1; dxc <= 1; ++dxc) {
-                const int cx = c[0] + dxc, cy = c[1] + dy, cz = c[2] + dz;
-                uint32_t cell;
-                if (cx < 0 || cy < 0 || cz < 0 || cx >= dims[0] || cy >= dims[1] || cz >= dims[2]) continue;
-                cell = (uint32_t)((cz * dims[1] + cy) * dims[0] + cx);
-                for (uint32_t e = start[cell]; e < start[cell + 1u]; ++e) {
-                  const uint32_t j = order[e];
-                  const double d[3] = {q[0] - x[3 * j], q[1] - x[3 * j + 1], q[2] - x[3 * j + 2]};
-                  const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                  double w, v, v0;
-                  if (r2 >= h2) continue;
-                  w = poly6 * (h2 - r2) * (h2 - r2) * (h2 - r2);
-                  v = mass / rho[j] * w;
-                  v0 = mass / rho0 * w;
-                  s += v;
-                  if (pass >= 2) t->k_weight[(size_t)b * n + j] += v;
-                  sp += v * p[j];
-                  sy += v * x[3 * j + 1];
-                  s0 += v0;
-                  sp0 += v0 * p[j];
-                  sy0 += v0 * x[3 * j + 1];
-                }
-              }
+          const uint32_t near = tank_cell_grid_near(&grid, q);
+          for (uint32_t e = 0; e < near; ++e) {
+            const uint32_t j = grid.candidates[e];
+            const double d[3] = {q[0] - x[3 * j], q[1] - x[3 * j + 1], q[2] - x[3 * j + 2]};
+            const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            double w, v, v0;
+            if (r2 >= h2) continue;
+            w = poly6 * (h2 - r2) * (h2 - r2) * (h2 - r2);
+            v = mass / rho[j] * w;
+            v0 = mass / rho0 * w;
+            s += v;
+            if (pass >= 2) t->k_weight[(size_t)b * n + j] += v;
+            sp += v * p[j];
+            sy += v * x[3 * j + 1];
+            s0 += v0;
+            sp0 += v0 * p[j];
+            sy0 += v0 * x[3 * j + 1];
+          }
         }
       if (s <= 0.0) continue;
       if (pass >= 2) {
@@ -198,10 +168,7 @@ void tank_interp_add(tank_interp* t, uint32_t n, const float* x, const float* p,
     t->d_band[b] += k_b > 0.0 ? kq_b / k_b - kq_i / k_i : 0.0;
     t->band_share[b] += k_b / (k_b + k_i);
   }
-  free(start);
-  free(order);
-  free(cell_of);
-  free(fill);
+  tank_cell_grid_free(&grid);
 }
 
 void tank_interp_profile(const tank_interp* t, double* pressure, double* y_weighted, uint32_t* count) {

@@ -31,6 +31,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "tank_cell_grid.h"
 #include "validation_util.h"
 
 struct tank_moment {
@@ -109,71 +110,39 @@ static void corrected_operator(double b[3][3], const double sum[3], const double
 /* The neighbours by a cell grid of cells h wide over the particles' bounding box. */
 void tank_moment_add(tank_moment* t, uint32_t n, const float* x, const float* p, const float* rho,
                      double mass, double rho0, double h, double width, double bin, double step) {
-  double lo[3] = {1e30, 1e30, 1e30}, hi[3] = {-1e30, -1e30, -1e30};
-  int dims[3];
-  uint32_t cells, *start, *order, *cell_of;
+  tank_cell_grid grid;
   const double grad = -45.0 / (M_PI * pow(h, 6.0)) * spiky_scale(step, h); /* dW/dr = grad (h - r)^2 */
-  for (uint32_t i = 0; i < n; ++i)
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = fmin(lo[a], x[3 * i + a]);
-      hi[a] = fmax(hi[a], x[3 * i + a]);
-    }
-  for (int a = 0; a < 3; ++a) dims[a] = (int)((hi[a] - lo[a]) / h) + 1;
-  cells = (uint32_t)(dims[0] * dims[1] * dims[2]);
-  start = (uint32_t*)calloc(cells + 1u, sizeof(uint32_t));
-  order = (uint32_t*)malloc(sizeof(uint32_t) * n);
-  cell_of = (uint32_t*)malloc(sizeof(uint32_t) * n);
-  assert_true(start && order && cell_of);
-  for (uint32_t i = 0; i < n; ++i) {
-    int c[3];
-    for (int a = 0; a < 3; ++a) c[a] = (int)((x[3 * i + a] - lo[a]) / h);
-    cell_of[i] = (uint32_t)((c[2] * dims[1] + c[1]) * dims[0] + c[0]);
-    ++start[cell_of[i] + 1u];
-  }
-  for (uint32_t c = 0; c < cells; ++c) start[c + 1u] += start[c];
-  {
-    uint32_t* fill = (uint32_t*)malloc(sizeof(uint32_t) * cells);
-    assert_non_null(fill);
-    for (uint32_t c = 0; c < cells; ++c) fill[c] = start[c];
-    for (uint32_t i = 0; i < n; ++i) order[fill[cell_of[i]]++] = i;
-    free(fill);
-  }
+  tank_cell_grid_build(&grid, x, n, h);
   for (uint32_t i = 0; i < n; ++i) {
     const double xi = x[3 * i], yi = x[3 * i + 1], zi = x[3 * i + 2];
     const double ki = p[i] / ((double)rho[i] * rho[i]);
     const int l = (int)floor(yi / bin);
-    int c[3];
     double moment = 0.0, virial = 0.0, lift = 0.0, zeroth = 0.0;
     double b[3][3] = {{0.0}}, sum[3] = {0.0, 0.0, 0.0}, z[3] = {0.0, 0.0, 0.0};
     if (xi < h || xi > width - h || zi < h || zi > width - h || l < 0 || l >= (int)t->bins) continue;
-    for (int a = 0; a < 3; ++a) c[a] = (int)((x[3 * i + a] - lo[a]) / h);
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
-          uint32_t cell;
-          if (cx < 0 || cy < 0 || cz < 0 || cx >= dims[0] || cy >= dims[1] || cz >= dims[2]) continue;
-          cell = (uint32_t)((cz * dims[1] + cy) * dims[0] + cx);
-          for (uint32_t s = start[cell]; s < start[cell + 1u]; ++s) {
-            const uint32_t j = order[s];
-            const double d[3] = {xi - x[3 * j], yi - x[3 * j + 1], zi - x[3 * j + 2]};
-            const double r = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-            double dwdy, kj;
-            if (j == i || r >= h || r <= 0.0) continue;
-            dwdy = grad * (h - r) * (h - r) * d[1] / r;
-            kj = p[j] / ((double)rho[j] * rho[j]);
-            for (int a = 0; a < 3; ++a) {
-              const double g = mass * grad * (h - r) * (h - r) * d[a] / r; /* m grad W_ij, component a */
-              for (int c2 = 0; c2 < 3; ++c2) b[a][c2] -= g * d[c2] / rho0;
-              sum[a] += (ki + kj) * g;
-              z[a] += g;
-            }
-            moment -= (mass / rho0) * d[1] * dwdy;
-            virial -= 0.5 * rho0 * mass * (ki + kj) * d[1] * dwdy;
-            lift -= mass * (ki + kj) * dwdy;
-            zeroth -= 2.0 * mass * ki * dwdy;
-          }
+    {
+      const double q[3] = {xi, yi, zi};
+      const uint32_t near = tank_cell_grid_near(&grid, q);
+      for (uint32_t e = 0; e < near; ++e) {
+        const uint32_t j = grid.candidates[e];
+        const double d[3] = {xi - x[3 * j], yi - x[3 * j + 1], zi - x[3 * j + 2]};
+        const double r = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        double dwdy, kj;
+        if (j == i || r >= h || r <= 0.0) continue;
+        dwdy = grad * (h - r) * (h - r) * d[1] / r;
+        kj = p[j] / ((double)rho[j] * rho[j]);
+        for (int a = 0; a < 3; ++a) {
+          const double g = mass * grad * (h - r) * (h - r) * d[a] / r; /* m grad W_ij, component a */
+          for (int c2 = 0; c2 < 3; ++c2) b[a][c2] -= g * d[c2] / rho0;
+          sum[a] += (ki + kj) * g;
+          z[a] += g;
         }
+        moment -= (mass / rho0) * d[1] * dwdy;
+        virial -= 0.5 * rho0 * mass * (ki + kj) * d[1] * dwdy;
+        lift -= mass * (ki + kj) * dwdy;
+        zeroth -= 2.0 * mass * ki * dwdy;
+      }
+    }
     if (t->corrected) corrected_operator(b, sum, z, ki, &moment, &lift, &zeroth);
     t->moment[l] += moment;
     t->virial[l] += virial;
@@ -181,9 +150,7 @@ void tank_moment_add(tank_moment* t, uint32_t n, const float* x, const float* p,
     t->zeroth[l] += zeroth;
     ++t->count[l];
   }
-  free(start);
-  free(order);
-  free(cell_of);
+  tank_cell_grid_free(&grid);
 }
 
 void tank_moment_print(const tank_moment* t, const double* y, double surface, double rho0, double g,
