@@ -230,7 +230,8 @@ SPH_SIMD_GATHER Vec3 dfsph_velocity_change(const FluidBase& f, const GridView& g
   const L h2(f.kernel.h2), zero(0.0f), k_i(ki);
   const Vec3Of<L> zero3{zero, zero, zero};
   Vec3Of<L> sum = zero3;
-  GradientMomentOf<L> moment = zero_gradient_moment(zero);  // (kCorrected only)
+  // B_i and the zeroth-order sum: an empty struct without kCorrected.
+  GradientMomentIf<L, kCorrected> moment = gradient_moment_if<kCorrected>(zero);
   for_each_candidate_run<L>(grid, xi, i, true, [&](uint32_t base, const typename L::Mask& valid) {
     const Vec3Of<L> d = x - load3<L>(c.x, c.y, c.z, base);
     const L r2 = length_squared(d);
