@@ -14,6 +14,13 @@ namespace {
 
 constexpr uint32_t kSlots = kSpringSlots;
 
+// CUB's item counts, 64-bit: the selections run over kSlots (16) entries a particle, past INT_MAX
+// above 134,217,727 particles on a rank (an int count overflowed there); CUB takes int64 counts
+// (DeviceSelect's are int64 in CCCL 3; DeviceRadixSort picks its offsets from the count's type).
+// The table's sorts stay int: n <= the capacity <= 2^30 (sph_world_def).
+using ItemCount = int64_t;
+ItemCount entries_of(uint64_t particles) { return static_cast<ItemCount>(particles * kSlots); }
+
 // The index of the particle whose id is `id` in the table (ids ascending, each once), or kNoSpring.
 __device__ uint32_t find_index(const uint32_t* __restrict__ ids, const uint32_t* __restrict__ idx, uint32_t n,
                                uint32_t id) {
@@ -123,8 +130,8 @@ DeviceHaloSprings::DeviceHaloSprings(uint32_t capacity) : capacity_(capacity) {
                  static_cast<const uint32_t*>(nullptr), static_cast<uint32_t*>(nullptr), static_cast<int>(n)),
              "halo spring table sort size query");
   cuda_check(cub::DeviceSelect::If(nullptr, select, static_cast<const uint32_t*>(nullptr),
-                                   static_cast<uint32_t*>(nullptr), static_cast<uint32_t*>(nullptr),
-                                   static_cast<int>(n * kSlots), IsId{}),
+                                   static_cast<uint32_t*>(nullptr), static_cast<uint64_t*>(nullptr),
+                                   entries_of(n), IsId{}),
              "halo spring wanted size query");
   ensure_temp(std::max(sort, select));
   iota_kernel<<<blocks_for(static_cast<uint32_t>(n), kDefaultBlockSize), kDefaultBlockSize>>>(
@@ -149,7 +156,7 @@ void DeviceHaloSprings::ensure_asked(uint32_t m) {
   asked_flags_.allocate(grown, "halo spring ids asked: flags");
   size_t select = 0;
   cuda_check(cub::DeviceSelect::Flagged(nullptr, select, asked_idx_.get(), asked_flags_.get(), found_.get(),
-                                        words_.get(), static_cast<int>(grown)),
+                                        words_.get(), static_cast<ItemCount>(grown)),
              "halo spring asked size query");
   ensure_temp(select);
 }
@@ -177,7 +184,7 @@ const uint32_t* DeviceHaloSprings::index_owned_lists(SpringList* lists, uint32_t
       lists, owned, table_ids_.get(), table_idx_.get(), table_n_, missing_.get());
   check_launch("index_owned_kernel");
   // The waiting ids (usually none: one count comes back), then sorted and each kept once.
-  const int entries = static_cast<int>(static_cast<uint64_t>(owned) * kSlots);
+  const ItemCount entries = entries_of(owned);
   size_t bytes = 0;
   cuda_check(cub::DeviceSelect::If(nullptr, bytes, missing_.get(), wanted_.get(), words_.get(), entries,
                                    IsId{}, stream),
@@ -187,27 +194,27 @@ const uint32_t* DeviceHaloSprings::index_owned_lists(SpringList* lists, uint32_t
                                    IsId{}, stream),
              "halo spring wanted ids");
   cuda_check(
-      cudaMemcpyAsync(host_words_.get(), words_.get(), sizeof(uint32_t), cudaMemcpyDeviceToHost, stream),
+      cudaMemcpyAsync(host_words_.get(), words_.get(), sizeof(uint64_t), cudaMemcpyDeviceToHost, stream),
       "copy of the halo spring wanted count");
   cuda_check(cudaStreamSynchronize(stream), "halo spring wanted count");
-  const uint32_t waiting = host_words_.get()[0];
+  const uint64_t waiting = host_words_.get()[0];  // (up to 16 a particle: beyond 32 bits above 2^28)
   if (waiting == 0) return host_ids_.get();
   if (waiting > wanted_sorted_.size())
     wanted_sorted_.allocate(waiting + waiting / 2 + 64, "halo spring ids sorted");
   bytes = 0;
   cuda_check(cub::DeviceRadixSort::SortKeys(nullptr, bytes, wanted_.get(), wanted_sorted_.get(),
-                                            static_cast<int>(waiting), 0, 32, stream),
+                                            static_cast<ItemCount>(waiting), 0, 32, stream),
              "halo spring wanted sort size query");
   size_t unique = 0;
   cuda_check(cub::DeviceSelect::Unique(nullptr, unique, wanted_sorted_.get(), wanted_.get(), words_.get() + 1,
-                                       static_cast<int>(waiting), stream),
+                                       static_cast<ItemCount>(waiting), stream),
              "halo spring wanted unique size query");
   ensure_temp(std::max(bytes, unique));
   cuda_check(cub::DeviceRadixSort::SortKeys(temp_.get(), bytes, wanted_.get(), wanted_sorted_.get(),
-                                            static_cast<int>(waiting), 0, 32, stream),
+                                            static_cast<ItemCount>(waiting), 0, 32, stream),
              "halo spring wanted sort");
   cuda_check(cub::DeviceSelect::Unique(temp_.get(), unique, wanted_sorted_.get(), wanted_.get(),
-                                       words_.get() + 1, static_cast<int>(waiting), stream),
+                                       words_.get() + 1, static_cast<ItemCount>(waiting), stream),
              "halo spring wanted unique");
   if (waiting > host_ids_count_) {
     host_ids_count_ = 0;
@@ -215,14 +222,14 @@ const uint32_t* DeviceHaloSprings::index_owned_lists(SpringList* lists, uint32_t
     host_ids_count_ = waiting;
   }
   // (At most `waiting` unique ids: the whole range comes down with the count, one wait.)
-  cuda_check(cudaMemcpyAsync(host_words_.get() + 1, words_.get() + 1, sizeof(uint32_t),
+  cuda_check(cudaMemcpyAsync(host_words_.get() + 1, words_.get() + 1, sizeof(uint64_t),
                              cudaMemcpyDeviceToHost, stream),
              "copy of the halo spring unique count");
   cuda_check(cudaMemcpyAsync(host_ids_.get(), wanted_.get(), sizeof(uint32_t) * waiting,
                              cudaMemcpyDeviceToHost, stream),
              "copy of the halo spring wanted ids");
   cuda_check(cudaStreamSynchronize(stream), "halo spring wanted ids");
-  *count = host_words_.get()[1];
+  *count = static_cast<uint32_t>(host_words_.get()[1]);  // (distinct uint32 ids: fits)
   return host_ids_.get();
 }
 
@@ -239,17 +246,17 @@ const uint32_t* DeviceHaloSprings::find_owned(const uint32_t* asked, uint32_t m,
   check_launch("find_owned_kernel");
   size_t bytes = 0;
   cuda_check(cub::DeviceSelect::Flagged(nullptr, bytes, asked_idx_.get(), asked_flags_.get(), found_.get(),
-                                        words_.get(), static_cast<int>(m), stream),
+                                        words_.get(), static_cast<ItemCount>(m), stream),
              "halo spring asked size query");
   ensure_temp(bytes);
   cuda_check(cub::DeviceSelect::Flagged(temp_.get(), bytes, asked_idx_.get(), asked_flags_.get(),
-                                        found_.get(), words_.get(), static_cast<int>(m), stream),
+                                        found_.get(), words_.get(), static_cast<ItemCount>(m), stream),
              "halo spring ids found");
   cuda_check(
-      cudaMemcpyAsync(host_words_.get(), words_.get(), sizeof(uint32_t), cudaMemcpyDeviceToHost, stream),
+      cudaMemcpyAsync(host_words_.get(), words_.get(), sizeof(uint64_t), cudaMemcpyDeviceToHost, stream),
       "copy of the halo spring found count");
   cuda_check(cudaStreamSynchronize(stream), "halo spring ids found");  // (asked: pageable, copied by now)
-  *found = host_words_.get()[0];
+  *found = static_cast<uint32_t>(host_words_.get()[0]);                // (at most m)
   return found_.get();
 }
 

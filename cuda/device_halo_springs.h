@@ -73,10 +73,10 @@ class DeviceHaloSprings {
   DeviceArray<uint32_t> asked_, asked_idx_, found_;  // grow on demand
   DeviceArray<unsigned char> asked_flags_;
   size_t asked_count_ = 0;
-  DeviceArray<uint32_t> words_;  // selected counts
+  DeviceArray<uint64_t> words_;  // selected counts (64-bit: 16 entries a particle)
   DeviceArray<unsigned char> temp_;
   size_t temp_bytes_ = 0;
-  PinnedArray<uint32_t> host_words_;
+  PinnedArray<uint64_t> host_words_;
   PinnedArray<uint32_t> host_ids_;  // grows on demand
   size_t host_ids_count_ = 0;
   PinnedArray<uint32_t> host_word_;

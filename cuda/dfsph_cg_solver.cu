@@ -184,8 +184,9 @@ __global__ void __launch_bounds__(kDfsphSolveBlock) cg_direction_kernel(CgSolve 
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= s.n) return;
   const float dt = s.state->clock.dt_float;
-  Vec3 d = pressure_velocity_change(s.fluid, s.grid, s.a.sorted_position, s.a.dfsph_step, cg_walls(s), i, dt,
-                                    cg_walk(s));
+  // (the conjugate gradients refuse the corrected gradient: the operator must be symmetric)
+  Vec3 d = pressure_velocity_change<false>(s.fluid, s.grid, s.a.sorted_position, s.a.dfsph_step, cg_walls(s),
+                                           i, dt, cg_walk(s));
   if (s.a.dfsph_cg_state[i] & kCgBinds) d = dfsph_contact_project(s.a.dfsph_contact[i], d);
   s.a.dfsph_cg_velocity_step[i] = make_float4_record(d, 0.0f);
 }

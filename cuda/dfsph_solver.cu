@@ -89,10 +89,7 @@ __global__ void dfsph_correct_kernel(FluidConstants fluid, GridView grid, Partic
   const DfsphWalls walls{a.boundary_gradient};
   const MaskedCandidates walk{a.dfsph_neighbor_mask};
   Vec3 vi = xyz(v[i]);
-  if constexpr (kCorrected)
-    vi += pressure_velocity_change_corrected(fluid, grid, a.sorted_position, k, walls, i, dt, walk);
-  else
-    vi += pressure_velocity_change(fluid, grid, a.sorted_position, k, walls, i, dt, walk);
+  vi += pressure_velocity_change<kCorrected>(fluid, grid, a.sorted_position, k, walls, i, dt, walk);
   if (contacts) vi = dfsph_clamp(a, i, vi);
   v[i] = make_float4_record(vi, v[i].w);
   carried[i] = (kWarm ? 0.0f : carried[i]) + k[i] * scale;

@@ -216,9 +216,9 @@ SPH_SIMD_GATHER float dfsph_density_rate(const FluidBase& f, const GridView& gri
   return sph::dfsph_density_rate(reduce_sum(rate), walls, i, vi);
 }
 
-// DFSPH's velocity change from the pressures k (a column: padded): pressure_velocity_change, or
-// with kCorrected pressure_velocity_change_corrected (the corrected gradient: B_i and the
-// zeroth-order sum gathered in the same walk). Each keeps its scalar twin's terms: the plain one
+// DFSPH's velocity change from the pressures k (a column: padded): pressure_velocity_change<kCorrected>'s
+// SIMD twin (with kCorrected the corrected gradient: B_i and the zeroth-order sum gathered in the
+// same walk). Each keeps its scalar twin's terms: the plain one
 // selects the pair term, the corrected one the gradient before its product.
 template <class L, bool kCorrected>
 SPH_SIMD_GATHER Vec3 dfsph_velocity_change(const FluidBase& f, const GridView& grid, const NeighborColumns& c,
@@ -230,7 +230,8 @@ SPH_SIMD_GATHER Vec3 dfsph_velocity_change(const FluidBase& f, const GridView& g
   const L h2(f.kernel.h2), zero(0.0f), k_i(ki);
   const Vec3Of<L> zero3{zero, zero, zero};
   Vec3Of<L> sum = zero3;
-  GradientMomentOf<L> moment = zero_gradient_moment(zero);  // (kCorrected only)
+  // B_i and the zeroth-order sum: an empty struct without kCorrected.
+  GradientMomentIf<L, kCorrected> moment = gradient_moment_if<kCorrected>(zero);
   for_each_candidate_run<L>(grid, xi, i, true, [&](uint32_t base, const typename L::Mask& valid) {
     const Vec3Of<L> d = x - load3<L>(c.x, c.y, c.z, base);
     const L r2 = length_squared(d);

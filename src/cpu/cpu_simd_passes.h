@@ -59,7 +59,7 @@ struct SimdPasses {
   DfsphFactorFn dfsph_density_and_factor;
   DfsphRateFn dfsph_density_rate;
   DfsphVelocityChangeFn dfsph_velocity_change;
-  // The same with the corrected gradient (pressure_velocity_change_corrected, SPH_DFSPH_CORRECTED_GRADIENT).
+  // The same with the corrected gradient (pressure_velocity_change<true>, SPH_DFSPH_CORRECTED_GRADIENT).
   DfsphVelocityChangeFn dfsph_velocity_change_corrected;
 };
 

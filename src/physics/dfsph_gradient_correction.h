@@ -74,6 +74,27 @@ SPH_HD void add_gradient_moment(GradientMomentOf<T>& b, Vec3Of<T> g, Vec3Of<T> d
   b.zeroth += g;
 }
 
+// The moment a velocity update gathers: GradientMomentOf<T> with the correction (kCorrected),
+// an empty struct without it, so that the plain update's walk carries no moment at all.
+struct NoGradientMoment {};
+template <class T, bool kCorrected>
+struct GradientMomentIfOf {
+  using type = NoGradientMoment;
+};
+template <class T>
+struct GradientMomentIfOf<T, true> {
+  using type = GradientMomentOf<T>;
+};
+template <class T, bool kCorrected>
+using GradientMomentIf = typename GradientMomentIfOf<T, kCorrected>::type;
+template <bool kCorrected, class T>
+SPH_HD GradientMomentIf<T, kCorrected> gradient_moment_if(T zero) {
+  if constexpr (kCorrected)
+    return zero_gradient_moment(zero);
+  else
+    return NoGradientMoment{};
+}
+
 // The corrected sum from sum = sum_j m (k_i + k_j) grad W_ij and the moment (rho0 B_i, Z_i): the sum
 // the velocity update multiplies by -dt, before the walls' share. Blended with the uncorrected sum by
 // the fade's weight w; uncorrected where det B is not positive.

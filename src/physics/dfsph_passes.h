@@ -5,6 +5,7 @@
 //                              D_i = |sum_j m grad W_ij|^2 + sum_j |m grad W_ij|^2
 //   density_rate               D rho_i / Dt = sum_j m (v_i - v_j) . grad W_ij
 //   pressure_velocity_change   -dt sum_j m (k_i + k_j) grad W_ij,  k = kappa / rho = p / rho^2
+//                              (<true>: with the corrected gradient, dfsph_gradient_correction.h)
 // and the per-particle step between them (divergence_residual, density_residual) that turns a
 // rate into the particle's pressure k_i and its share of the solve's mean error. The walls enter
 // each gather through one call (dfsph_boundary.h).
@@ -163,10 +164,20 @@ SPH_HD float density_rate(const FluidBase& f, const GridView& grid, const Float4
   return dfsph_density_rate(rate, walls, i, vi);
 }
 
+// The corrected gradient's ending (SPH_DFSPH_CORRECTED_GRADIENT, dfsph_gradient_correction.h): sum as
+// dfsph_velocity_change's, m the moment (B_i and the zeroth-order sum) gathered in the same walk.
+SPH_HD Vec3 dfsph_corrected_velocity_change(const FluidBase& f, Vec3 sum, const GradientMomentOf<float>& m,
+                                            const DfsphWalls& walls, uint32_t i, float ki, float dt) {
+  return dfsph_velocity_change(corrected_pressure_sum(sum, m, ki, f.rest_density), walls, i, ki, dt);
+}
+
 // The velocity change of particle i from the pressures k (k_j = p_j / rho_j^2 of this
 // iteration): -dt sum_j m (k_i + k_j) grad W_ij, which pushes compressed neighbours apart.
-// walk: as density_rate's.
-template <class Walk = AllCandidates>
+// kCorrected: with the corrected gradient (SPH_DFSPH_CORRECTED_GRADIENT), whose moment is gathered
+// in the same walk from the gradient before its product; without it the walk gathers the sum alone.
+// The two branches are the SIMD twin's (cpu_simd_gathers.h), and each compiles to the code of the
+// two functions this one replaced (CUDA's PTX compared). walk: as density_rate's.
+template <bool kCorrected, class Walk = AllCandidates>
 SPH_HD Vec3 pressure_velocity_change(const FluidBase& f, const GridView& grid, const Float4* positions,
                                      const float* k, const DfsphWalls& walls, uint32_t i, float dt,
                                      Walk walk = Walk{}) {
@@ -174,41 +185,23 @@ SPH_HD Vec3 pressure_velocity_change(const FluidBase& f, const GridView& grid, c
   const Vec3 xi = xyz(positions[i]);
   const float ki = k[i];
   Vec3 sum{0.0f, 0.0f, 0.0f};
+  GradientMomentIf<float, kCorrected> moment = gradient_moment_if<kCorrected>(0.0f);
   walk(grid, xi, i, [&](uint32_t j) {
     const Vec3 d = xi - xyz(positions[j]);
     const float r2 = length_squared(d);
-    if (r2 < f.kernel.h2 && j != i) sum += pressure_velocity_pair_term(mk, d, r2, ki + k[j]);
-  });
-  return dfsph_velocity_change(sum, walls, i, ki, dt);
-}
-
-// The same with the corrected gradient (SPH_DFSPH_CORRECTED_GRADIENT, dfsph_gradient_correction.h): B_i
-// and the zeroth-order sum gathered in the same walk.
-SPH_HD Vec3 dfsph_corrected_velocity_change(const FluidBase& f, Vec3 sum, const GradientMomentOf<float>& m,
-                                            const DfsphWalls& walls, uint32_t i, float ki, float dt) {
-  return dfsph_velocity_change(corrected_pressure_sum(sum, m, ki, f.rest_density), walls, i, ki, dt);
-}
-// walk: as density_rate's.
-template <class Walk = AllCandidates>
-SPH_HD Vec3 pressure_velocity_change_corrected(const FluidBase& f, const GridView& grid,
-                                               const Float4* positions, const float* k,
-                                               const DfsphWalls& walls, uint32_t i, float dt,
-                                               Walk walk = Walk{}) {
-  const KernelCoefficients mk = mass_gradient_kernel(f);
-  const Vec3 xi = xyz(positions[i]);
-  const float ki = k[i];
-  Vec3 sum{0.0f, 0.0f, 0.0f};
-  GradientMomentOf<float> moment = zero_gradient_moment(0.0f);
-  walk(grid, xi, i, [&](uint32_t j) {
-    const Vec3 d = xi - xyz(positions[j]);
-    const float r2 = length_squared(d);
-    if (r2 < f.kernel.h2 && j != i) {
+    if (!(r2 < f.kernel.h2 && j != i)) return;
+    if constexpr (kCorrected) {
       const Vec3 g = spiky_gradient(mk, d, square_root(r2));
       sum += g * (ki + k[j]);
       add_gradient_moment(moment, g, d);
+    } else {
+      sum += pressure_velocity_pair_term(mk, d, r2, ki + k[j]);
     }
   });
-  return dfsph_corrected_velocity_change(f, sum, moment, walls, i, ki, dt);
+  if constexpr (kCorrected)
+    return dfsph_corrected_velocity_change(f, sum, moment, walls, i, ki, dt);
+  else
+    return dfsph_velocity_change(sum, walls, i, ki, dt);
 }
 
 // One particle's result of a residual pass.

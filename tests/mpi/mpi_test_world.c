@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 #include "mpi_test_world.h"
 
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -105,6 +106,36 @@ void mpi_test_step_stats(sph_world* world, uint32_t substeps, int distributed, s
   REQUIRE(sph_stats_init(stats) == SPH_OK, "stats init");
   REQUIRE(sph_world_get_stats(world, stats) == SPH_OK, "stats");
   CHECK(stats->substeps == substeps, "%u substeps, expected %u", stats->substeps, substeps);
+}
+
+/* The solver fields of sph_stats, each 32 bits (a uint32_t count or a float). */
+#define MPI_TEST_SOLVER_FIELD(field) \
+  { #field, offsetof(sph_stats, field), sizeof(((const sph_stats*)0)->field) }
+static const struct {
+  const char* name;
+  size_t offset, size;
+} kSolverFields[] = {
+    MPI_TEST_SOLVER_FIELD(pressure_iterations),    MPI_TEST_SOLVER_FIELD(pressure_iterations_max),
+    MPI_TEST_SOLVER_FIELD(divergence_iterations),  MPI_TEST_SOLVER_FIELD(divergence_iterations_max),
+    MPI_TEST_SOLVER_FIELD(density_error_mean),     MPI_TEST_SOLVER_FIELD(density_error_max),
+    MPI_TEST_SOLVER_FIELD(divergence_error_mean),  MPI_TEST_SOLVER_FIELD(divergence_error_max),
+    MPI_TEST_SOLVER_FIELD(pressure_solves_capped), MPI_TEST_SOLVER_FIELD(divergence_solves_capped),
+    MPI_TEST_SOLVER_FIELD(density_error_largest),
+};
+#undef MPI_TEST_SOLVER_FIELD
+enum { kSolverFieldCount = sizeof kSolverFields / sizeof kSolverFields[0] };
+
+const char* mpi_test_solver_stats_differ(const sph_stats* stats) {
+  uint32_t bits[kSolverFieldCount], lowest[kSolverFieldCount], highest[kSolverFieldCount];
+  for (size_t k = 0; k < kSolverFieldCount; ++k) {
+    REQUIRE(kSolverFields[k].size == sizeof(uint32_t), "sph_stats.%s is not 32 bits", kSolverFields[k].name);
+    memcpy(&bits[k], (const unsigned char*)stats + kSolverFields[k].offset, sizeof(uint32_t));
+  }
+  MPI_Allreduce(bits, lowest, kSolverFieldCount, MPI_UINT32_T, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Allreduce(bits, highest, kSolverFieldCount, MPI_UINT32_T, MPI_MAX, MPI_COMM_WORLD);
+  for (size_t k = 0; k < kSolverFieldCount; ++k)
+    if (lowest[k] != highest[k]) return kSolverFields[k].name;
+  return NULL;
 }
 
 void mpi_test_gather(sph_world* world, uint32_t n, float** x, float** v) {

@@ -60,6 +60,12 @@ void mpi_test_dam_on(sph_context* context, const sph_world_def* def, float stir,
 void mpi_test_step(sph_world* world, uint32_t substeps, int distributed);
 /* mpi_test_step, the frame's stats in *stats. */
 void mpi_test_step_stats(sph_world* world, uint32_t substeps, int distributed, sph_stats* stats);
+/* Whether every rank holds the same solver statistics, bit for bit: every field of `stats` that
+ * the DFSPH solves write (pressure_iterations through divergence_solves_capped, and
+ * density_error_largest), by an all-reduce of each field's minimum and maximum over MPI_COMM_WORLD
+ * (a float by its bits). Collective. NULL when they agree on every field, else the name of the
+ * first field that differs (the same answer on every rank). */
+const char* mpi_test_solver_stats_differ(const sph_stats* stats);
 /* The distributed world's positions and velocities by id on rank 0 (malloc'd; NULL elsewhere). */
 void mpi_test_gather(sph_world* world, uint32_t n, float** x, float** v);
 /* mpi_test_gather for a world on `comm`: onto its rank 0. */

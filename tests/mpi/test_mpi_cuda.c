@@ -52,26 +52,33 @@ static float max_abs_difference(const float* a, const float* b, uint32_t n) {
   return m;
 }
 
-/* How far a case's distributed CUDA world may lie from the undivided one (m): 0, bit for bit (every
- * case but the folded table with several lanes, whose sums round differently: main). */
-static float g_undivided_bound = 0.0f;
+/* One weakly compressible case of run_case. */
+typedef struct cuda_case {
+  const char* name;
+  float stir;                /* the column's random velocities, up to stir m/s (0: the dam break at rest) */
+  uint32_t frames, substeps; /* frames of `substeps` substeps */
+  int compare_cpu;           /* 1: the distributed CPU world within 4e-5 m asserted; 0: printed only */
+  float undivided_bound;     /* how far (m) the distributed CUDA world may lie from the undivided one: 0,
+                                bit for bit (every case but the folded table with several lanes, whose
+                                sums round differently: main) */
+} cuda_case;
 
-/* One case: `frames` frames of `substeps` on the CUDA context `cuda` (distributed and undivided)
+/* One case: c->frames frames of c->substeps on the CUDA context `cuda` (distributed and undivided)
  * and on the CPU context `cpu` (distributed), compared on rank 0. */
-static void run_case(const char* name, sph_context* cuda, sph_context* cpu, const sph_world_def* def,
-                     float stir, uint32_t frames, uint32_t substeps, int compare_cpu) {
+static void run_case(const cuda_case* c, sph_context* cuda, sph_context* cpu, const sph_world_def* def) {
+  const char* name = c->name;
   sph_world* single = NULL;
   sph_world* world = NULL;
   sph_world* cpu_world = NULL;
   sph_mpi_counts counts;
   uint32_t n = 0, n_cpu = 0;
   float *x = NULL, *v = NULL, *want_x = NULL, *want_v = NULL, *cpu_x = NULL, *cpu_v = NULL;
-  mpi_test_dam(cuda, def, stir, NULL, &single, &world, &n);
-  mpi_test_dam(cpu, def, stir, NULL, NULL, &cpu_world, &n_cpu);
-  for (uint32_t f = 0; f < frames; ++f) {
-    if (g_rank == 0) mpi_test_step(single, substeps, 0);
-    mpi_test_step(world, substeps, 1);
-    mpi_test_step(cpu_world, substeps, 1);
+  mpi_test_dam(cuda, def, c->stir, NULL, &single, &world, &n);
+  mpi_test_dam(cpu, def, c->stir, NULL, NULL, &cpu_world, &n_cpu);
+  for (uint32_t f = 0; f < c->frames; ++f) {
+    if (g_rank == 0) mpi_test_step(single, c->substeps, 0);
+    mpi_test_step(world, c->substeps, 1);
+    mpi_test_step(cpu_world, c->substeps, 1);
   }
   REQUIRE(sph_mpi_counts_init(&counts) == SPH_OK && sph_mpi_world_get_counts(world, &counts) == SPH_OK,
           "counts");
@@ -96,12 +103,12 @@ static void run_case(const char* name, sph_context* cuda, sph_context* cpu, cons
         "%llu migrations\n",
         name, g_size, n, mass, differ, (double)dx_single, (double)dx_cpu, counts.rebalances,
         (unsigned long long)counts.global_ghosts, (unsigned long long)counts.migrated);
-    if (g_undivided_bound > 0.0f)
-      CHECK(dx_single <= g_undivided_bound, "%s: %.3g m from the undivided CUDA world (bound %.3g m)", name,
-            (double)dx_single, (double)g_undivided_bound);
+    if (c->undivided_bound > 0.0f)
+      CHECK(dx_single <= c->undivided_bound, "%s: %.3g m from the undivided CUDA world (bound %.3g m)", name,
+            (double)dx_single, (double)c->undivided_bound);
     else
       CHECK(differ == 0, "%s: %u of %u particles differ from the undivided CUDA world", name, differ, n);
-    CHECK(!compare_cpu || dx_cpu <= 1e-4f * 0.4f,
+    CHECK(!c->compare_cpu || dx_cpu <= 1e-4f * 0.4f,
           "%s: the CUDA and CPU distributed worlds %.3g m apart (bound 4e-5 m)", name, (double)dx_cpu);
     CHECK(n == n_cpu, "%s: %u particles on the CPU world, %u on the CUDA world", name, n_cpu, n);
     free(want_x);
@@ -209,34 +216,37 @@ int main(int argc, char** argv) {
 
   mpi_test_world_def(&def);
   def.capacity = 32768; /* 32 slots an axis: the tank's 23 x 12 x 4 cells never fold */
-  run_case("dam break", cuda, cpu, &def, 0.0f, 1, 20, 1);
+  run_case(&(cuda_case){"dam break", 0.0f, 1, 20, 1, 0.0f}, cuda, cpu, &def);
   if (!quick) {
-    run_case("stirred column", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    run_case(&(cuda_case){"stirred column", 0.5f, 1, 20, 1, 0.0f}, cuda, cpu, &def);
     /* The neighbour counts cross in the density records (Clavet's viscosity reads them); the walls'
      * density is each particle's own, inside the density its owner sends; the user attribute is a
      * carried array that migrates. */
     def.viscosity_method = SPH_VISCOSITY_CLAVET;
     def.features = SPH_FEATURE_USER_ATTRIBUTE;
-    run_case("stirred column, Clavet's viscosity, user attribute", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    run_case(&(cuda_case){"stirred column, Clavet's viscosity, user attribute", 0.5f, 1, 20, 1, 0.0f}, cuda,
+             cpu, &def);
     def.viscosity_method = SPH_VISCOSITY_MUELLER;
     def.features = SPH_FEATURE_BOUNDARY_DENSITY;
-    run_case("stirred column, the walls' density", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    run_case(&(cuda_case){"stirred column, the walls' density", 0.5f, 1, 20, 1, 0.0f}, cuda, cpu, &def);
     /* The normalised density's filter and the density diffusion publish the densities again after
      * the summation: the ghosts take their owners' records after each publication (as on the CPU
      * rank), so an owned particle's filter and forces read the undivided world's values. */
     def.features = SPH_FEATURE_NORMALIZED_DENSITY;
-    run_case("stirred column, normalised density", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    run_case(&(cuda_case){"stirred column, normalised density", 0.5f, 1, 20, 1, 0.0f}, cuda, cpu, &def);
     def.features = SPH_FEATURE_NORMALIZED_DENSITY | SPH_FEATURE_DENSITY_DIFFUSION;
-    run_case("stirred column, normalised density and diffusion", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    run_case(&(cuda_case){"stirred column, normalised density and diffusion", 0.5f, 1, 20, 1, 0.0f}, cuda,
+             cpu, &def);
     /* Surface tension: the colour normals' pass reads the ghosts' densities (refreshed), and the
      * ghosts take their owners' normals after it (the force pass reads them). */
     def.features = SPH_FEATURE_SURFACE_TENSION;
-    run_case("stirred column, surface tension", cuda, cpu, &def, 0.5f, 1, 20, 1);
+    run_case(&(cuda_case){"stirred column, surface tension", 0.5f, 1, 20, 1, 0.0f}, cuda, cpu, &def);
     def.features = SPH_FEATURE_COLLIDER_LOADS;
     run_loads_case("collider loads", cuda, &def);
     def.features = 0;
     mpi_test_world_def(&def); /* capacity 4096: 16 slots an axis, folded along x */
-    run_case("stirred column, folded table, one lane", cuda_one_lane, cpu, &def, 0.5f, 1, 20, 1);
+    run_case(&(cuda_case){"stirred column, folded table, one lane", 0.5f, 1, 20, 1, 0.0f}, cuda_one_lane, cpu,
+             &def);
     /* The same folded table with four lanes a particle (what the default picks below 135k
      * particles): a slot's far particles decide which lane adds which neighbour, and a rank holds
      * other far particles than the undivided world (and keeps the capacity's cubic table where the
@@ -245,14 +255,13 @@ int main(int argc, char** argv) {
      * substeps (CPU and GPU, which differ by roundings, part by 5e-8 to 7e-7 m over these cases).
      * Measured on the H200 (session 17, default lanes): bit for bit on 1 and 2 ranks all the same. */
     mpi_test_world_def(&def);
-    g_undivided_bound = 1e-6f * 0.4f;
-    run_case("stirred column, folded table, four lanes", cuda_four_lanes, cpu, &def, 0.5f, 1, 20, 1);
-    g_undivided_bound = 0.0f;
+    run_case(&(cuda_case){"stirred column, folded table, four lanes", 0.5f, 1, 20, 1, 1e-6f * 0.4f},
+             cuda_four_lanes, cpu, &def);
     mpi_test_world_def(&def);
     def.capacity = 32768;
     def.particle_spacing = 0.0125f;
     def.kernel_radius = 1.8f * 0.0125f;
-    run_case("collapse with rebalancing", cuda, cpu, &def, 0.0f, 12, 20, 0);
+    run_case(&(cuda_case){"collapse with rebalancing", 0.0f, 12, 20, 0, 0.0f}, cuda, cpu, &def);
     /* RK4 (tests/mpi/test_mpi_solvers.c's case on the CPU ranks): each of the four stages sorts, so
      * each gathers its halo, the ranks agreeing on a failure between stages, and the stage state
      * (rk4_start, rk4_sum) travels with a particle that changes ranks between two stages. The
@@ -265,7 +274,7 @@ int main(int argc, char** argv) {
     mpi_test_world_def(&def);
     def.capacity = 32768;
     def.integrator = SPH_INTEGRATOR_RK4;
-    run_case("RK4 stirred column", cuda, cpu, &def, 2.0f, 2, 6, 0);
+    run_case(&(cuda_case){"RK4 stirred column", 2.0f, 2, 6, 0, 0.0f}, cuda, cpu, &def);
     def.features = SPH_FEATURE_COLLIDER_LOADS;
     run_loads_case("RK4 collider loads", cuda, &def);
   }

@@ -152,14 +152,15 @@ Tally check_table(const Table& t) {
     const float rate = sph::density_rate(f, view, t.positions.data(), t.velocities.data(), no_walls, i);
     const float rate_masked =
         sph::density_rate(f, view, t.positions.data(), t.velocities.data(), no_walls, i, masked);
-    const Vec3 dv = sph::pressure_velocity_change(f, view, t.positions.data(), t.k.data(), no_walls, i, dt);
-    const Vec3 dv_masked =
-        sph::pressure_velocity_change(f, view, t.positions.data(), t.k.data(), no_walls, i, dt, masked);
+    const Vec3 dv =
+        sph::pressure_velocity_change<false>(f, view, t.positions.data(), t.k.data(), no_walls, i, dt);
+    const Vec3 dv_masked = sph::pressure_velocity_change<false>(f, view, t.positions.data(), t.k.data(),
+                                                                no_walls, i, dt, masked);
     // The corrected gradient's pass (SPH_DFSPH_CORRECTED_GRADIENT) through both walks.
     const Vec3 dvc =
-        sph::pressure_velocity_change_corrected(f, view, t.positions.data(), t.k.data(), no_walls, i, dt);
-    const Vec3 dvc_masked = sph::pressure_velocity_change_corrected(f, view, t.positions.data(), t.k.data(),
-                                                                    no_walls, i, dt, masked);
+        sph::pressure_velocity_change<true>(f, view, t.positions.data(), t.k.data(), no_walls, i, dt);
+    const Vec3 dvc_masked =
+        sph::pressure_velocity_change<true>(f, view, t.positions.data(), t.k.data(), no_walls, i, dt, masked);
     ok = ok && same_bits(rate, rate_masked) && same_bits(dv, dv_masked) && same_bits(dvc, dvc_masked);
     ok = ok && (rate != 0.0f || plain.neighbor_count == 0);  // the passes saw neighbours
     if (!ok && tally.mismatches++ < 5)

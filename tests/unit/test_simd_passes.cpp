@@ -344,7 +344,7 @@ void check_dfsph(bool walls) {
       const float rate_scalar =
           sph::density_rate(f, view, s.positions.data(), s.velocities.data(), dfsph_walls, i);
       const Vec3 change_scalar =
-          sph::pressure_velocity_change(f, view, s.positions.data(), k.data(), dfsph_walls, i, dt);
+          sph::pressure_velocity_change<false>(f, view, s.positions.data(), k.data(), dfsph_walls, i, dt);
       // The terms' magnitudes, from the scalar's own float terms.
       double g_abs[3] = {0.0, 0.0, 0.0}, g_sum[3] = {0.0, 0.0, 0.0}, squares = 0.0, rate_abs = 0.0;
       double change_abs[3] = {0.0, 0.0, 0.0};
@@ -410,7 +410,7 @@ void check_dfsph(bool walls) {
       // a difference of sums: bounded by 4 (n + 1) u of the terms' magnitudes, times 16 for the inverse's
       // rounding and norm.
       const Vec3 corrected_scalar =
-          sph::pressure_velocity_change_corrected(f, view, s.positions.data(), k.data(), dfsph_walls, i, dt);
+          sph::pressure_velocity_change<true>(f, view, s.positions.data(), k.data(), dfsph_walls, i, dt);
       const Vec3 corrected =
           generic.dfsph_velocity_change_corrected(f, view, columns, k.data(), dfsph_walls, i, dt);
       {
@@ -488,8 +488,9 @@ void test_dfsph_corrected_gradient_is_first_order(void**) {
         {(b[1][0] * b[2][1] - b[1][1] * b[2][0]) / det, (b[0][1] * b[2][0] - b[0][0] * b[2][1]) / det,
          (b[0][0] * b[1][1] - b[0][1] * b[1][0]) / det}};
     const Vec3 got =
-        sph::pressure_velocity_change_corrected(f, view, s.positions.data(), k.data(), no_walls, i, dt);
-    const Vec3 plain = sph::pressure_velocity_change(f, view, s.positions.data(), k.data(), no_walls, i, dt);
+        sph::pressure_velocity_change<true>(f, view, s.positions.data(), k.data(), no_walls, i, dt);
+    const Vec3 plain =
+        sph::pressure_velocity_change<false>(f, view, s.positions.data(), k.data(), no_walls, i, dt);
     const double got_v[3] = {got.x, got.y, got.z}, plain_v[3] = {plain.x, plain.y, plain.z};
     double l_norm = 0.0;
     for (int r = 0; r < 3; ++r)
