@@ -72,6 +72,7 @@ static void open_tank(const tank_case* tc, double gap, support_world* w, sph_sdf
    * acoustic limit keeps c dt below 0.4 h whatever the speeds. */
   if (tc->solver != SPH_SOLVER_DFSPH) params.step_limits = SPH_STEP_LIMIT_ACOUSTIC;
   if (tc->dt_max > 0.0f) params.dt_max = tc->dt_max;
+  if (tc->dt_min > 0.0f) params.dt_min = tc->dt_min;
   EXPECT_OK(sph_world_set_params(w->world, &params));
   if (tc->solver == SPH_SOLVER_DFSPH && (tc->density_error > 0.0f || tc->dfsph_flags)) {
     sph_dfsph_params dp;

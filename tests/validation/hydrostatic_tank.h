@@ -20,6 +20,8 @@ typedef struct tank_case {
   double step;           /* lattice step (spacing / sqrt 2), m */
   double seconds;        /* simulated time */
   float dt_max;          /* the step's ceiling, s (0: the library's default, 1 ms) */
+  float dt_min;          /* the step's floor, s (0: the library's default, 1e-6 s); dt_min = dt_max pins
+                            every substep (docs/physics.md, "How a frame splits into substeps") */
   float density_error;   /* DFSPH's density-solve bound (0: the library's default, 0.1 %) */
   uint32_t dfsph_flags;  /* sph_dfsph_params.flags (SPH_DFSPH_CORRECTED_GRADIENT) */
   /* The settling experiments (docs/validation.md, "DFSPH: hydrostatic tank"); 0 = as before. */
