@@ -242,13 +242,16 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
     static double sum_dr = 0.0, max_dr = 0.0, sum_g2 = 0.0;
     static uint64_t full_count = 0;
     static uint64_t calls = 0, count = 0;
+    // SPH_SHIFT_STEPS: shift only in the first that many substeps (0: always); the stats go on.
+    static const uint64_t steps = static_cast<uint64_t>(env("SPH_SHIFT_STEPS", 0.0f));
+    const bool active = steps == 0 || calls < steps;
     parallel().for_each(count_, [&](uint32_t i) {
       const ZerothMoment z = gather_zeroth_moment(fluid, view, pos, i);
       const Vec3 wg = b ? boundary_gradient(b[i]) : Vec3{0.0f, 0.0f, 0.0f};
       const float fluid_density = fluid.particle_mass * (fluid.density_self_weight + z.kernel_sum);
       const float fill = static_cast<float>(nb[i]) / n0 + (density[i] - fluid_density) / fluid.rest_density;
       const Vec3 dr = shift_displacement(fluid, shifting, z.gradient, wg, fill, spacing);
-      next_pos[i] = make_float4_record(xyz(next_pos[i]) + dr, next_pos[i].w);
+      if (active) next_pos[i] = make_float4_record(xyz(next_pos[i]) + dr, next_pos[i].w);
       if (std::getenv("SPH_SHIFT_STATS")) {
         const double l = std::sqrt(static_cast<double>(length_squared(dr))) / spacing;
         sum_dr += l;
@@ -261,7 +264,7 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
         }
       }
     });
-    if (std::getenv("SPH_SHIFT_STATS") && ++calls % 250 == 0)
+    if (++calls % 125 == 0 && std::getenv("SPH_SHIFT_STATS"))
       std::fprintf(stderr, "shift: mean %.2e max %.2e spacings a substep, rms h|grad C| %.4f (%.0f%% full)\n",
                    sum_dr / static_cast<double>(count), max_dr,
                    std::sqrt(sum_g2 / static_cast<double>(full_count)),
