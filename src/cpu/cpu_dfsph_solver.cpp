@@ -19,12 +19,9 @@
 // the collision response's contacts (physics/collider_loads.h).
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include "../core/dfsph_jacobi_loop.h"
 #include "../core/exact_float_sum.h"
-#include "../physics/particle_shifting.h"
 #include "cpu_backend_impl.h"
 
 namespace sph {
@@ -223,54 +220,6 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
     start[i].w = p;
     next_pos[i] = make_float4_record(xyz(pos[i]) + xyz(next_vel[i]) * dt, p);
   });
-  // EXPERIMENT (env): particle shifting (physics/particle_shifting.h) from the start's packing.
-  static const char* shift_env = std::getenv("SPH_SHIFT");
-  if (shift_env) {
-    auto env = [](const char* name, float fallback) {
-      const char* v = std::getenv(name);
-      return v ? static_cast<float>(std::atof(v)) : fallback;
-    };
-    static const ParticleShifting shifting{static_cast<float>(std::atof(shift_env)),
-                                           env("SPH_SHIFT_MAX", 0.02f), env("SPH_SHIFT_FULL", 0.95f),
-                                           env("SPH_SHIFT_NONE", 0.8f), env("SPH_SHIFT_WALL", 1.0f)};
-    const Float4* b = boundary_.data();
-    const float spacing = config_.particle_spacing;
-    const float h = config_.kernel_radius;
-    // a uniform packing's neighbour count at the lattice's number density (sqrt 2 / s^3)
-    const float n0 = 4.18879f * h * h * h * 1.41421356f / (spacing * spacing * spacing);
-    const uint32_t* nb = neighbors_.data();
-    static double sum_dr = 0.0, max_dr = 0.0, sum_g2 = 0.0;
-    static uint64_t full_count = 0;
-    static uint64_t calls = 0, count = 0;
-    // SPH_SHIFT_STEPS: shift only in the first that many substeps (0: always); the stats go on.
-    static const uint64_t steps = static_cast<uint64_t>(env("SPH_SHIFT_STEPS", 0.0f));
-    const bool active = steps == 0 || calls < steps;
-    parallel().for_each(count_, [&](uint32_t i) {
-      const ZerothMoment z = gather_zeroth_moment(fluid, view, pos, i);
-      const Vec3 wg = b ? boundary_gradient(b[i]) : Vec3{0.0f, 0.0f, 0.0f};
-      const float fluid_density = fluid.particle_mass * (fluid.density_self_weight + z.kernel_sum);
-      const float fill = static_cast<float>(nb[i]) / n0 + (density[i] - fluid_density) / fluid.rest_density;
-      const Vec3 dr = shift_displacement(fluid, shifting, z.gradient, wg, fill, spacing);
-      if (active) next_pos[i] = make_float4_record(xyz(next_pos[i]) + dr, next_pos[i].w);
-      if (std::getenv("SPH_SHIFT_STATS")) {
-        const double l = std::sqrt(static_cast<double>(length_squared(dr))) / spacing;
-        sum_dr += l;
-        max_dr = std::max(max_dr, l);
-        ++count;
-        if (fill >= shifting.full) {
-          const Vec3 g = (z.gradient + wg * shifting.wall_weight) * (h / fluid.rest_density);
-          sum_g2 += static_cast<double>(length_squared(g));
-          ++full_count;
-        }
-      }
-    });
-    if (++calls % 125 == 0 && std::getenv("SPH_SHIFT_STATS"))
-      std::fprintf(stderr, "shift: mean %.2e max %.2e spacings a substep, rms h|grad C| %.4f (%.0f%% full)\n",
-                   sum_dr / static_cast<double>(count), max_dr,
-                   std::sqrt(sum_g2 / static_cast<double>(full_count)),
-                   100.0 * static_cast<double>(full_count) / static_cast<double>(count)),
-          sum_dr = max_dr = sum_g2 = 0.0, count = full_count = 0;
-  }
   report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
   sample_probes(scene, dt, report);
   if (loads_on()) {
