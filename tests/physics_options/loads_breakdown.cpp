@@ -9,7 +9,13 @@
 //                           [--settle SECONDS] [--perturb SEED] [--frames N] [--check-loads]
 //                           [--self-check | --self-check-only] [--step METRES] [--sample-every N]
 //                           [--box-voxel METRES] [--initial-densities] [--full-first-layer]
+//                           [--centre-y METRES]
 //
+// --centre-y: the box's centre height (default 0.08 m). With the box through the free surface (0.19:
+// its top 2 cm above the water) the program also prints the water's level by its volume (each
+// particle's m / max(rho, rho0) over the tank less the box), the hydrostatic level and the level the
+// box's force stands for (bottom + F / (rho0 g A)): a floating box's draft without its dynamics
+// (docs/validation.md, "Session 18: a finite solid's share that keeps its size").
 // --initial-densities: print rho / rho0 of the lattice as spawned (one 1 us substep without gravity)
 // at the box's first layer per region and at the tank's floor away from the box, then stop: the
 // walls' share beside a finite solid against a flat wall's (docs/validation.md, "Session 17: the
@@ -101,7 +107,7 @@ namespace {
 using namespace loads_breakdown;  // NOLINT: the regions' names (box_regions.h)
 
 const double kGravity = 9.81, kSide = 0.16, kFill = 0.2;
-const double kCentre[3] = {0.08, 0.08, 0.08};
+double kCentre[3] = {0.08, 0.08, 0.08};  // --centre-y sets the height
 
 void check(sph_result r, const char* what) {
   if (r == SPH_OK) return;
@@ -156,23 +162,28 @@ int main(int argc, char** argv) {
       initial = true;
     else if (std::strcmp(argv[k], "--full-first-layer") == 0)
       full_first_layer = true;
+    else if (std::strcmp(argv[k], "--centre-y") == 0 && k + 1 < argc)
+      kCentre[1] = std::atof(argv[++k]);
     else {
       std::fprintf(
           stderr,
           "usage: %s [--backend cpu|cuda] [--solver wcsph|dfsph] [--dt-max SECONDS] [--settle "
           "SECONDS] [--perturb SEED] [--frames N] [--check-loads] [--self-check | --self-check-only] [--step "
-          "METRES] [--sample-every N] [--box-voxel METRES] [--initial-densities] [--full-first-layer]\n",
+          "METRES] [--sample-every N] [--box-voxel METRES] [--initial-densities] [--full-first-layer] "
+          "[--centre-y METRES]\n",
           argv[0]);
       return 2;
     }
   }
   if (!(step >= 0.002 && step <= 0.02) || (check_loads && every > 1) ||
-      !(box_voxel_arg == 0.0 || (box_voxel_arg >= 0.001 && box_voxel_arg <= 0.02))) {
+      !(box_voxel_arg == 0.0 || (box_voxel_arg >= 0.001 && box_voxel_arg <= 0.02)) ||
+      !(kCentre[1] >= 0.05 && kCentre[1] <= 0.3)) {
     // --check-loads compares the momentum over the whole window with the sampled substeps' loads.
     std::fprintf(stderr,
-                 "--step %g, --box-voxel %g: give a lattice step between 0.002 and 0.02 m, a box voxel "
-                 "between 0.001 and 0.02 m (and --check-loads without --sample-every)\n",
-                 step, box_voxel_arg);
+                 "--step %g, --box-voxel %g, --centre-y %g: give a lattice step between 0.002 and 0.02 m, a "
+                 "box voxel between 0.001 and 0.02 m, a centre between 0.05 and 0.3 m (inside the 0.4 m "
+                 "tank, above its floor) (and --check-loads without --sample-every)\n",
+                 step, box_voxel_arg, kCentre[1]);
     return 2;
   }
   const sph_backend backend = support_backend_from_name(backend_name, SPH_BACKEND_CPU);
@@ -529,6 +540,30 @@ int main(int argc, char** argv) {
       100.0 * (tally[kSides].normal / samples / 4.0 / side_expected - 1.0), side_expected);
   std::printf("walls' reaction, all regions: (%+.4f, %+.4f, %+.4f) N, buoyancy %+.2f %% of rho0 g V\n",
               total[0], total[1], total[2], 100.0 * (total[1] / expected - 1.0));
+  if (top_face > plane_sum / samples) {
+    // A box through the free surface (--centre-y): its force against rho0 g A (level - bottom) for
+    // the hydrostatic level and for the top plane's.
+    // The water's level by its volume at the last substep: each particle's m / max(rho, rho0) (the
+    // compression counted, the free surface's summation deficit not), over the tank less the box.
+    double volume = 0.0;
+    for (uint32_t i = 0; i < count; ++i)
+      volume +=
+          static_cast<double>(w.mass) / std::fmax(static_cast<double>(rho[i]), static_cast<double>(rho0));
+    const double by_volume = (volume - area * bottom_face) / (kSide * kSide - area);
+    std::printf(
+        "through the surface: the volume's level %.4f m, the hydrostatic level %.2f mm below it, the "
+        "force's level (bottom + F / (rho0 g A)) %.2f mm below it\n",
+        by_volume, 1e3 * (by_volume - mean_level),
+        1e3 * (by_volume - bottom_face - total[1] / (rho0 * kGravity * area)));
+    const double by_h = rho0 * kGravity * area * (mean_level - bottom_face),
+                 by_plane = rho0 * kGravity * area * (plane_sum / samples - bottom_face);
+    std::printf(
+        "through the surface: rho0 g A (level - bottom) %.4f N by the hydrostatic level (force %+.2f %%), "
+        "%.4f N "
+        "by the top plane's (force %+.2f %%); the force's level less the plane's %.2f mm\n",
+        by_h, 100.0 * (total[1] / by_h - 1.0), by_plane, 100.0 * (total[1] / by_plane - 1.0),
+        1e3 * (total[1] / (rho0 * kGravity * area) + bottom_face - plane_sum / samples));
+  }
   if (loads) {
     const double l[3] = {api[0] / api_time, api[1] / api_time, api[2] / api_time};
     std::printf(
