@@ -6,7 +6,12 @@
 // region").
 //
 //   physics_loads_floating_box [--backend cpu|cuda] [--solver wcsph|dfsph] [--step METRES]
-//                              [--force host|loads] [--sample-every N]
+//                              [--force host|loads] [--sample-every N] [--spawned]
+//
+// --spawned: the box starts at rest at Archimedes' draft (its bottom 5 cm below the fill's 20 cm), the
+// fill's lattice cut the fill's wall margin around it, instead of dropped from 1 cm above the water.
+// The program also prints the level by the particles' volume at their densities (m / max(rho, rho0)
+// at the last sampled substep: the compression counted, the free surface's deficit not).
 //
 // --step: the lattice step, spacing / sqrt 2 (default 0.0141421 m, the 2 cm spacing;
 // docs/validation.md, "Loads against resolution"): h, the voxels and the frames (0.5 ms x spacing /
@@ -59,7 +64,7 @@ void check(sph_result r, const char* what) {
 
 int main(int argc, char** argv) {
   const char* backend_name = "cpu";
-  bool dfsph = false;
+  bool dfsph = false, spawned = false;
   const char* force_from = nullptr;
   double step = 0.02 / std::sqrt(2.0);
   int every = 1;
@@ -74,11 +79,13 @@ int main(int argc, char** argv) {
       force_from = argv[++k];
     else if (std::strcmp(argv[k], "--sample-every") == 0 && k + 1 < argc)
       every = std::max(1, std::atoi(argv[++k]));
+    else if (std::strcmp(argv[k], "--spawned") == 0)
+      spawned = true;
     else {
       std::fprintf(
           stderr,
           "usage: %s [--backend cpu|cuda] [--solver wcsph|dfsph] [--step METRES] [--force host|loads] "
-          "[--sample-every N]\n",
+          "[--sample-every N] [--spawned]\n",
           argv[0]);
       return 2;
     }
@@ -119,7 +126,10 @@ int main(int argc, char** argv) {
   shape.padding_voxels = 8;
   check(sph_sdf_create_shape(w.context, &shape, &box_sdf), "sph_sdf_create_shape");
   const double mass = 500.0 * 8.0 * kHalf * kHalf * kHalf, archimedes = mass / (1000.0 * 4.0 * kHalf * kHalf);
-  double position[3] = {0.0, kDepth + kHalf + 0.01, 0.0}, velocity[3] = {0.0, 0.0, 0.0};
+  // --spawned: the box at rest at Archimedes' draft in the fill, the fill's
+  // lattice cut step / 2 around it, instead of dropped from 1 cm above the water.
+  double position[3] = {0.0, spawned ? kDepth - archimedes + kHalf : kDepth + kHalf + 0.01, 0.0},
+         velocity[3] = {0.0, 0.0, 0.0};
   sph_collider_def collider;
   check(sph_collider_def_init(&collider), "sph_collider_def_init");
   collider.sdf = box_sdf;
@@ -131,7 +141,21 @@ int main(int argc, char** argv) {
   sph_fill_box_desc_init(&water);
   water.min.x = -0.15f, water.min.y = 0.0f, water.min.z = -0.15f;
   water.max.x = 0.15f, water.max.y = static_cast<float>(kDepth), water.max.z = 0.15f;
-  check(sph_world_fill_box(w.world, &water, nullptr), "sph_world_fill_box");
+  if (!spawned) {
+    check(sph_world_fill_box(w.world, &water, nullptr), "sph_world_fill_box");
+  } else {
+    const float s = static_cast<float>(spacing);
+    const double gap = 0.5 * spacing, grown = kHalf + gap;  // sph_world_fill_box's margin
+    const auto points = sph::fcc_points_in_box(sph::Vec3{water.min.x, water.min.y, water.min.z},
+                                               sph::Vec3{water.max.x, water.max.y, water.max.z}, s);
+    std::vector<float> kept;
+    for (const sph::Vec3& q : points)
+      if (!(std::fabs(q.x - position[0]) < grown && std::fabs(q.y - position[1]) < grown &&
+            std::fabs(q.z - position[2]) < grown))
+        kept.insert(kept.end(), {q.x, q.y, q.z});
+    check(support_spawn(w.world, kept.data(), nullptr, static_cast<uint32_t>(kept.size() / 3)),
+          "support_spawn");
+  }
 
   const float h = w.def.kernel_radius, rho0 = w.def.rest_density;
   const sph::BoundaryCalibration calibration = sph::fcc_boundary_calibration(w.def.particle_spacing, h);
@@ -253,6 +277,17 @@ int main(int argc, char** argv) {
       backend_name, dfsph ? "dfsph" : "wcsph", n, mean, water_level, 100.0 * draft, 100.0 * archimedes,
       100.0 * (draft / archimedes - 1.0), 100.0 * early, 100.0 * settled, volume_level, 100.0 * volume_draft,
       100.0 * (volume_draft / archimedes - 1.0));
+  {
+    // The volume's level with the compression, each particle's
+    // m / max(rho, rho0) at the last sampled substep (the free surface's summation deficit not counted).
+    double compressed = 0.0;
+    for (uint32_t i = 0; i < count; ++i)
+      compressed +=
+          static_cast<double>(w.mass) / std::fmax(static_cast<double>(rho[i]), static_cast<double>(rho0));
+    const double level_c = (compressed - 0.01 * (mean - kHalf)) / (0.09 - 4.0 * kHalf * kHalf);
+    std::printf("the particles' volume at their densities: level %.4f m, draft %.2f cm (%+.1f %%)\n", level_c,
+                100.0 * (level_c - (mean - kHalf)), 100.0 * ((level_c - (mean - kHalf)) / archimedes - 1.0));
+  }
   std::printf(
       "the particles' volume with the walls' films (%.2f mm): level %.4f m, draft %.2f cm (%+.1f %%)\n",
       1000.0 * film, film_level, 100.0 * (film_level - bottom),
