@@ -852,8 +852,9 @@ SPH_API sph_result SPH_CALL sph_world_fill_sphere(sph_world* world, const sph_fi
 
 /**
  * Advances the world by frame_dt seconds (> 0, finite) in adaptive substeps: each substep's
- * dt = step_factor * h / v_max clamped to [dt_min, dt_max], shortened at the end so that the
- * substeps add up to frame_dt exactly (the last one or two may be shorter than dt_min).
+ * dt = step_factor * h / v_max clamped to [dt_min, dt_max], the frame's remaining time spread
+ * evenly over the fewest such substeps, so that they add up to frame_dt exactly (they may be
+ * shorter than dt_min; docs/api.md, "Stepping").
  * Blocks until the frame is done. Returns SPH_INCOMPLETE if max_substeps ran out first, or
  * the step budget (sph_world_set_step_budget) or a cancel (sph_world_cancel_step) stopped it:
  * the world is then as after its last whole substep, consistent and ready to step again

@@ -2712,15 +2712,16 @@ namespace Sph
 
         /// <summary>
         /// Advances the world by frame_dt seconds (&gt; 0, finite) in adaptive substeps: each substep's
-        /// dt = step_factor * h / v_max clamped to [dt_min, dt_max], shortened at the end so that the
-        /// substeps add up to frame_dt exactly (the last one or two may be shorter than dt_min). Blocks
-        /// until the frame is done. Returns SPH_INCOMPLETE if max_substeps ran out first, or the step
-        /// budget (sph_world_set_step_budget) or a cancel (sph_world_cancel_step) stopped it: the world
-        /// is then as after its last whole substep, consistent and ready to step again
-        /// (sph_stats.frame_time and substeps say how far it got). SPH_ERROR_NON_FINITE if a substep
-        /// produced a NaN/Inf, SPH_ERROR_CAPACITY if more particles than 64 times the rest density
-        /// allows piled into one cell of side h (the neighbour work would grow with their square; the
-        /// message says where): the world is restored to its state before this call.
+        /// dt = step_factor * h / v_max clamped to [dt_min, dt_max], the frame's remaining time spread
+        /// evenly over the fewest such substeps, so that they add up to frame_dt exactly (they may be
+        /// shorter than dt_min; docs/api.md, "Stepping"). Blocks until the frame is done. Returns
+        /// SPH_INCOMPLETE if max_substeps ran out first, or the step budget (sph_world_set_step_budget)
+        /// or a cancel (sph_world_cancel_step) stopped it: the world is then as after its last whole
+        /// substep, consistent and ready to step again (sph_stats.frame_time and substeps say how far
+        /// it got). SPH_ERROR_NON_FINITE if a substep produced a NaN/Inf, SPH_ERROR_CAPACITY if more
+        /// particles than 64 times the rest density allows piled into one cell of side h (the neighbour
+        /// work would grow with their square; the message says where): the world is restored to its
+        /// state before this call.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_step(WorldHandle world, float frameDt);

@@ -3,6 +3,7 @@
 // of a frame. Shared so both backends take the very same steps.
 #pragma once
 
+#include <math.h>
 #include <stdint.h>
 
 #include "host_device.h"
@@ -85,12 +86,22 @@ SPH_HD float controller_dt(const StepLimits& s, float max_speed, float max_accel
 
 SPH_HD float controller_dt(const StepLimits& s, float max_speed) { return controller_dt(s, max_speed, 0.0f); }
 
-// Shortens dt so the frame ends exactly: take the remainder when it fits, and split a
-// remainder between dt and 2 dt in halves so no sliver of a step is left at the end.
+// A remainder this share of a step above a whole number of steps counts as that number: the
+// frame then lands in those steps, each longer than dt by at most this share, where a rounding
+// hair (0.003f against a limit one ulp below it) would otherwise cost a substep more.
+constexpr double kLandingSlack = 1e-4;
+
+// Shortens dt so the frame ends exactly: the remainder is spread evenly over the fewest substeps
+// of at most dt that hold it, n = ceil(remaining / dt), each remaining / n (re-planned every
+// substep, since the limit moves). The same count as taking whole steps while 2 dt remain and
+// halving the last remainder between dt and 2 dt, but never a short step right after long ones:
+// DFSPH's solves remove the last step's leftover compression within the next one, so a 2 ms
+// step after 4 ms ones over-pushes, and a settled tank read at those frame ends missed rho0 g d by
+// 6 % (docs/physics.md, "How a frame splits into substeps").
 SPH_HD double landing_dt(double dt, double remaining) {
   if (remaining <= dt) return remaining;
-  if (remaining < 2.0 * dt) return 0.5 * remaining;
-  return dt;
+  const double steps = ceil(remaining / dt - kLandingSlack);
+  return steps <= 1.0 ? remaining : remaining / steps;
 }
 
 }  // namespace sph

@@ -1,12 +1,13 @@
 // SPDX-License-Identifier: MIT
 /* How sph_world_step splits a frame into substeps (docs/physics.md, "How a frame splits into
  * substeps"), pinned on the backend under test:
- * - The landing rule (physics/step_control.h, landing_dt): each substep takes the controller's dt
- *   (lambda h / v_max within [dt_min, dt_max]) while at least 2 dt remain, a remainder between dt
- *   and 2 dt in two halves, and the last remainder whole. So when the speed limit binds, the frame
- *   length sets the steps: at a 3 ms limit a 4 ms frame takes two 2 ms substeps and a 20 ms frame
- *   five of 3 ms and two of 2.5 ms. And in float, a 20 ms frame at dt 4 ms lands its last two
- *   substeps one float step short of 4 ms (0.02f is less than five times 0.004f).
+ * - The landing rule (physics/step_control.h, landing_dt): each substep spreads what is left of
+ *   the frame evenly over the fewest substeps of at most the controller's dt (lambda h / v_max
+ *   within [dt_min, dt_max]) that hold it, a rounding hair (1e-4 of a step) forgiven. So when the
+ *   speed limit binds, the frame length sets the steps: at a 3 ms limit a 4 ms frame takes two
+ *   2 ms substeps and a 20 ms frame seven of 2.857 ms; at dt_max 3.9999 ms a 20 ms frame takes six
+ *   of 3.333 ms, never a short step after long ones. And in float, a 20 ms frame at dt 4 ms takes
+ *   five substeps one float step short of 4 ms (0.02f is less than five times 0.004f).
  * - Nothing else of a frame touches the trajectory: with the same substeps (a pinned step that
  *   divides the frame exactly in binary), one frame of five substeps and five frames of one
  *   substep end bit for bit the same, on DFSPH with the walls in the density (both solves' warm
@@ -31,11 +32,11 @@ typedef struct split {
 } split;
 
 /* One frame of frame_dt for a lone particle moving at `speed` with no gravity (no neighbours, so no
- * force: the speed, and with it the speed limit, stays constant), dt_max 4 ms. The spacing is 10 cm
+ * force: the speed, and with it the speed limit, stays constant), under dt_max. The spacing is 10 cm
  * (h = 18 cm), so that the equation of state's stability ceiling (lambda h / sqrt(k), 7.2 ms at
  * the default k) stays above dt_max (at the default 2 cm it is 1.44 ms). *limit receives the
  * speed limit lambda h / v as the step control computes it (float). */
-static split one_frame(float frame_dt, float speed, float* limit) {
+static split one_frame(float frame_dt, float speed, float dt_max, float* limit) {
   support_world w;
   sph_world_def def;
   sph_world_params params;
@@ -47,7 +48,7 @@ static split one_frame(float frame_dt, float speed, float* limit) {
   def.capacity = 1;
   def.particle_spacing = 0.1f;
   EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
-  EXPECT_OK(support_set_gravity_and_steps(w.world, 0.0f, 0.0f, 0.0f, 1e-6f, 0.004f));
+  EXPECT_OK(support_set_gravity_and_steps(w.world, 0.0f, 0.0f, 0.0f, 1e-6f, dt_max));
   EXPECT_OK(support_spawn(w.world, position, velocity, 1));
   sph_world_params_init(&params);
   EXPECT_OK(sph_world_get_params(w.world, &params));
@@ -72,56 +73,63 @@ static void test_speed_limited_frames_split_by_the_landing_rule(void** state) {
   (void)state;
   {
     /* 4 ms frame: 4 ms remain, more than the 3 ms limit but less than two: two halves. */
-    const split s = one_frame(0.004f, 24.0f, &limit);
+    const split s = one_frame(0.004f, 24.0f, 0.004f, &limit);
     assert_true(fabs(limit - 0.003f) < 1e-6f);
     assert_int_equal(s.substeps, 2);
     assert_true(fabs(s.dt_min - 0.002f) < 1e-7f && fabs(s.dt_max - 0.002f) < 1e-7f);
   }
   {
-    /* 20 ms frame: five substeps at the limit (15 ms), then the 5 ms left (< 2 x 3 ms) in halves. */
-    const split s = one_frame(0.02f, 24.0f, &limit);
-    const double half = 0.5 * (0.02 - 5.0 * (double)limit);
+    /* 20 ms frame: 6.67 limits, so seven even substeps of 2.857 ms (taking whole 3 ms steps first
+     * would end in two of 2.5 ms: the same count, uneven). */
+    const split s = one_frame(0.02f, 24.0f, 0.004f, &limit);
+    const double even = (double)0.02f / 7.0;
     assert_int_equal(s.substeps, 7);
-    assert_true(s.dt_max == limit);
-    assert_true(fabs(s.dt_min - half) < 1e-7);
-    /* (2.5 ms: never a sliver, never above the limit) */
-    assert_true(s.dt_min > 0.5f * limit && s.dt_min < limit);
+    assert_true(fabs(s.dt_min - even) < 1e-9 && fabs(s.dt_max - even) < 1e-9);
+    assert_true(s.dt_max < limit); /* never above the limit */
   }
   {
     /* A frame of exactly the limit: one substep of the whole frame. */
-    const split s = one_frame(limit, 24.0f, &limit);
+    const split s = one_frame(limit, 24.0f, 0.004f, &limit);
     assert_int_equal(s.substeps, 1);
     assert_true(s.dt_min == limit && s.dt_max == limit);
   }
   {
-    /* 0.003f is 2.6e-11 s above 0.003 and the limit (0.4f h / 24, in float) 2.1e-10 s below it:
-     * a remainder a hair longer than dt is already "between dt and 2 dt", and the frame takes two
-     * halves of 1.5 ms. */
-    const split s = one_frame(0.003f, 24.0f, &limit);
+    /* 0.003f is 2.6e-11 s above 0.003 and the limit (0.4f h / 24, in float) 2.1e-10 s below it: a
+     * remainder a rounding hair (well under 1e-4 of a step) above dt is one substep, not two halves
+     * of 1.5 ms. */
+    const split s = one_frame(0.003f, 24.0f, 0.004f, &limit);
     assert_true(limit < 0.003f);
-    assert_int_equal(s.substeps, 2);
-    assert_true(s.dt_min == s.dt_max && fabs(s.dt_min - 0.0015) < 1e-9);
+    assert_int_equal(s.substeps, 1);
+    assert_true(s.dt_min == 0.003f && s.dt_max == 0.003f);
+    assert_true((double)s.dt_max <= (double)limit * (1.0 + 1e-4));
   }
 }
 
-/* At rest the step is dt_max (4 ms). A 4 ms frame is one substep of 0.004f; a 20 ms frame is five
- * substeps whose last two are one float step short: 0.02f < 5 x 0.004f, so after three full
- * substeps 7.999999 ms remain (< 2 dt) and are halved. */
-static void test_frames_at_dt_max_land_one_float_step_short(void** state) {
+/* At rest the step is dt_max. A 4 ms frame at dt_max 4 ms is one substep of 0.004f; a 20 ms frame
+ * is five even substeps, each one float step short of 0.004f (0.02f < 5 x 0.004f, and 0.02f / 5
+ * rounds down in float). At dt_max 3.9999 ms (a hair below a fifth of the frame) a 20 ms frame is
+ * six even substeps of 3.333 ms: before session 18 it was four of 3.9999 ms and two of 2.0002 ms,
+ * the alternation that made DFSPH's frame-end pressure miss by 6 % (docs/physics.md). */
+static void test_frames_at_dt_max_land_evenly(void** state) {
   float limit = 0.0f;
   (void)state;
   {
-    const split s = one_frame(0.004f, 0.0f, &limit);
+    const split s = one_frame(0.004f, 0.0f, 0.004f, &limit);
     assert_int_equal(s.substeps, 1);
     assert_true(s.dt_min == 0.004f && s.dt_max == 0.004f);
   }
   {
-    const split s = one_frame(0.02f, 0.0f, &limit);
-    const float landing = (float)(0.5 * ((double)0.02f - 3.0 * (double)0.004f));
+    const split s = one_frame(0.02f, 0.0f, 0.004f, &limit);
+    const float even = (float)((double)0.02f / 5.0);
     assert_int_equal(s.substeps, 5);
-    assert_true(s.dt_max == 0.004f);
-    assert_true(s.dt_min == landing);
-    assert_true(landing < 0.004f && 0.004f - landing < 1e-9f); /* one float step (4.7e-10 s) */
+    assert_true(s.dt_min == even && s.dt_max == even);
+    assert_true(even < 0.004f && 0.004f - even < 1e-9f); /* one float step (4.7e-10 s) */
+  }
+  {
+    const split s = one_frame(0.02f, 0.0f, 0.0039999f, &limit);
+    const double even = (double)0.02f / 6.0;
+    assert_int_equal(s.substeps, 6);
+    assert_true(fabs(s.dt_min - even) < 1e-9 && fabs(s.dt_max - even) < 1e-9);
   }
 }
 
@@ -209,8 +217,8 @@ static void test_same_substeps_same_trajectory(void** state) {
   close_collapse(&five);
 }
 
-/* The same with 20 ms and 4 ms frames and dt pinned at 4 ms (0.004f): the 20 ms frames' last two
- * substeps are one float step short (above), so the runs part; how far they part in 80 ms is
+/* The same with 20 ms and 4 ms frames and dt pinned at 4 ms (0.004f): the 20 ms frames' substeps
+ * are one float step short (above), so the runs part; how far they part in 80 ms is
  * printed, not bounded (it is the scene's sensitivity, which test_same_substeps_same_trajectory
  * shows is the only cause). */
 static void test_float_landing_parts_the_runs(void** state) {
@@ -233,7 +241,7 @@ static void test_float_landing_parts_the_runs(void** state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_speed_limited_frames_split_by_the_landing_rule),
-      cmocka_unit_test(test_frames_at_dt_max_land_one_float_step_short),
+      cmocka_unit_test(test_frames_at_dt_max_land_evenly),
       cmocka_unit_test(test_same_substeps_same_trajectory),
       cmocka_unit_test(test_float_landing_parts_the_runs),
   };
