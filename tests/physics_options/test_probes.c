@@ -193,7 +193,7 @@ static void test_brute_force(void** state) {
 /* ---- a resting tank ------------------------------------------------------------------------- */
 
 /* Water 12 x 24 x 12 layers (12 cm wide, H = 24 cm deep) settled in a closed tank for 1.2 s (the
- * acoustic step limit; the default viscosity damps the start-up waves), then read over 0.4 s:
+ * acoustic step limit; the default viscosity damps the start-up waves), then read over 1.6 s:
  * a gauge through the centre from 3 cm below the floor to 0.45 m, point probes on the centre line
  * at y = 4, 8, 12 and 16 cm, every substep averaged (capi_resting_tank_open). */
 static void resting_tank(uint32_t features) {
@@ -215,7 +215,12 @@ static void resting_tank(uint32_t features) {
   /* One substep's pressure per frame at 8 cm: its spread over time is the solver's pressure noise
    * (reported for the density diffusion of issue 17 item 3 to compare against). */
   snapshot = add_point(w->world, width / 2, heights[1], width / 2, SPH_PROBE_EVERY_FRAME);
-  for (int frame = 0; frame < 80; ++frame) {
+  /* The window: 80 frames (1.6 s). The probes' mean over 0.4 s (20 frames) swung by about 1 % of
+   * rho0 g d between draws of the same settling (CPU -0.19 % and CUDA -1.93 % at 8 cm, the same
+   * code): the tank's sloshing has periods of tenths of a second, so 0.4 s held too few of them
+   * for the 1 % bound. PROBES_WINDOW=N (frames) measures another window. */
+  const int window = getenv("PROBES_WINDOW") ? atoi(getenv("PROBES_WINDOW")) : 80;
+  for (int frame = 0; frame < 60 + window; ++frame) {
     EXPECT_OK(sph_world_step(w->world, 0.02f));
     if (frame < 60) continue;
     {
@@ -267,7 +272,7 @@ static void resting_tank(uint32_t features) {
     print_message("  (p(4 cm) - p(16 cm)) / 12 cm = %.2f Pa/m against rho0 g = %.2f Pa/m (%+.2f %%)\n",
                   gradient, rho0 * kGravity, 100.0 * (gradient / (rho0 * kGravity) - 1.0));
     /* Without the walls in the density: the pressure gradient within 1 % of rho0 g (the issue's
-     * bound for a probe's pressure; measured -0.53 %), and the absolute pressure only printed:
+     * bound for a probe's pressure; measured -0.10 % over 1.6 s), and the absolute pressure only printed:
      * it reads a near constant 95 Pa below rho0 g d (-7 % at 14 cm, -44 % at 2 cm). That is the
      * tank's walls, not the probe: the particles within h of the walls read low densities and
      * pack tighter, the middle of the tank stands 24 % below n m / (rho0 A) and its pressure does
@@ -295,7 +300,9 @@ static void resting_tank(uint32_t features) {
           heights[j], d, pressure[j], want, pressure[j] - want,
           100.0 * (pressure[j] - want) / (rho0 * kGravity * d));
       /* The issue's 1 % of rho0 g d, at depths of 9-21 cm (3.7-8.5 h: below the diffuse surface
-       * layer, the top h, where a kernel reaches into air); measured -0.2 % to -0.6 %. */
+       * layer, the top h, where a kernel reaches into air); measured -0.77 % to -0.94 % over 1.6 s
+       * (CPU, even substeps; with the halved landing before session 18, -0.79 % to -1.67 %: the
+       * 0.4 s window's -0.2 % to -0.6 % was a lucky draw). */
       assert_true(fabs(pressure[j] - want) <= 0.01 * rho0 * kGravity * d || measuring());
     }
   }
