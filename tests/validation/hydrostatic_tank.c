@@ -74,13 +74,18 @@ static void open_tank(const tank_case* tc, double gap, support_world* w, sph_sdf
   if (tc->dt_max > 0.0f) params.dt_max = tc->dt_max;
   if (tc->dt_min > 0.0f) params.dt_min = tc->dt_min;
   EXPECT_OK(sph_world_set_params(w->world, &params));
-  if (tc->solver == SPH_SOLVER_DFSPH && (tc->density_error > 0.0f || tc->dfsph_flags)) {
+  /* HYDRO_MAX_IT (the density solve's cap) and HYDRO_CG=1 (conjugate gradients): measurements of
+   * the deep tanks' start (docs/validation.md, "DFSPH: hydrostatic tank"). */
+  if (tc->solver == SPH_SOLVER_DFSPH &&
+      (tc->density_error > 0.0f || tc->dfsph_flags || getenv("HYDRO_MAX_IT") || getenv("HYDRO_CG"))) {
     sph_dfsph_params dp;
     sph_dfsph_params_init(&dp);
     if (tc->density_error > 0.0f) {
       dp.density_error = tc->density_error;
       dp.max_iterations = 1000;
     }
+    if (getenv("HYDRO_MAX_IT")) dp.max_iterations = (uint32_t)atoi(getenv("HYDRO_MAX_IT"));
+    if (getenv("HYDRO_CG")) dp.linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS;
     dp.flags = tc->dfsph_flags;
     EXPECT_OK(sph_world_set_dfsph_params(w->world, &dp));
   }
@@ -183,6 +188,21 @@ void run_tank(const tank_case* tc) {
       }
       if ((f + 1) % (int)(0.2 / frame_dt + 0.5) == 0)
         printf("  t = %.1f s: kinetic energy %.3g J\n", frame_dt * (f + 1), ke);
+    }
+    /* HYDRO_STATS=1: every frame's step statistics (a measurement of how a run that does not
+     * settle goes wrong: speeds, the solves' iterations and caps). */
+    if (getenv("HYDRO_STATS")) {
+      sph_stats st;
+      sph_stats_init(&st);
+      EXPECT_OK(sph_world_get_stats(world, &st));
+      printf(
+          "  frame %d: substeps %u dt %.3g..%.3g s, max speed %.3g m/s, density %.1f..%.1f, pressure it %u "
+          "(max %u, "
+          "capped %u), divergence it %u (max %u, capped %u), largest error %.3g %%\n",
+          f + 1, st.substeps, st.dt_min, st.dt_max, st.max_speed, st.density_min, st.density_max,
+          st.pressure_iterations, st.pressure_iterations_max, st.pressure_solves_capped,
+          st.divergence_iterations, st.divergence_iterations_max, st.divergence_solves_capped,
+          100.0 * st.density_error_largest);
     }
     if (gauges && f >= window_start) tank_gauges_read(gauges, world);
     {

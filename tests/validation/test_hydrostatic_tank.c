@@ -84,6 +84,9 @@ static tank_case dfsph_tank(const char* name, uint32_t features, double bound, f
   /* HYDRO_WIDTH=N: N layers across at the case's depth (more particles a slice, the same column). */
   if (getenv("HYDRO_WIDTH")) tc.width_layers = (uint32_t)atoi(getenv("HYDRO_WIDTH"));
   if (getenv("HYDRO_SECONDS")) tc.seconds = atof(getenv("HYDRO_SECONDS"));
+  /* HYDRO_STEP (m): another lattice step (the resolution at a given depth: the deep tanks' step
+   * against h, docs/validation.md). */
+  if (getenv("HYDRO_STEP")) tc.step = atof(getenv("HYDRO_STEP"));
   if (getenv("HYDRO_DT_MAX")) tc.dt_max = (float)atof(getenv("HYDRO_DT_MAX"));
   /* HYDRO_DT_MIN (s): the step's floor; at HYDRO_DT_MAX it pins every substep. */
   if (getenv("HYDRO_DT_MIN")) tc.dt_min = (float)atof(getenv("HYDRO_DT_MIN"));
