@@ -53,9 +53,9 @@ void capi_resting_tank_close(capi_resting_tank* t);
  * 1 cm step (docs/validation.md, "Loads on a hydrostatic tank's side wall"). */
 #define CAPI_RESTING_FILM (0.5 * (1.4142135623730951 - 1.0) * 0.01)
 /* The area the resting tank's water stands on: the tank's inner width less a film at each side
- * wall, squared (measured: the gauge's water height is the water's mass over this area within
- * 0.1 %, and over the tank's inner area 7 % high; docs/validation.md, "The resting tank's probes
- * against the weight above"). */
+ * wall, squared. Measured: the centre's gauge reads the water's mass over this area 0.3-1.6 % low
+ * (WCSPH, 19 draws; the middle's water a little lighter than the mean), over the tank's inner area
+ * 6.9 % high (docs/validation.md, "The resting tank's probes against the weight above"). */
 double capi_resting_water_area(void);
 /* Adds to kernel[i] and slab[i] (i < n) the number of the world's particles above heights[i], a
  * particle straddling a height counted in part: by the SPH interpolant's own column (`kernel`: the

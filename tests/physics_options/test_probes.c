@@ -474,7 +474,7 @@ static void resting_tank(uint32_t features) {
       }
       /* absolute_bound() of the weight above, at depths of 8-20 cm (3-8 h: below the diffuse
        * surface layer, the top h, where a kernel reaches into air). Why not 1 % (PROBES_STRESS):
-       * the pressure force carries the weight above through the whole plane within 0.5 %, but over
+       * the pressure force carries the weight above through the whole plane within 0.9 %, but over
        * the tank's middle it carries 0.5-10 % more than the mean, and there the settled packing's
        * gradient moment is 1.022 (1 on the lattice the kernel is scaled on), so the interpolated
        * pressure is not the stress at the percent level. */
