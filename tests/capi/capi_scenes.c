@@ -139,3 +139,37 @@ void capi_resting_tank_close(capi_resting_tank* t) {
   EXPECT_OK(sph_sdf_destroy(t->sdf));
   EXPECT_OK(support_world_close(&t->w));
 }
+
+double capi_resting_water_area(void) {
+  const double width = CAPI_RESTING_WIDTH - 2.0 * CAPI_RESTING_FILM;
+  return width * width;
+}
+
+/* The share of a particle's mass above y: poly6, W = 315 / (64 pi h^9) (h^2 - r^2)^3, integrated
+ * over the horizontal plane at height offset t h from its centre is (315 / 256) (1 - t^2)^4 / h
+ * (normalised over t in [-1, 1]); its integral from t to 1 is 1/2 - (315 / 256) G(t),
+ * G(t) = t - 4 t^3 / 3 + 6 t^5 / 5 - 4 t^7 / 7 + t^9 / 9 (G(1) = 128 / 315). */
+static double kernel_share_above(double t) {
+  const double u = fmin(1.0, fmax(-1.0, t)), u2 = u * u;
+  const double g = u * (1.0 + u2 * (-4.0 / 3.0 + u2 * (6.0 / 5.0 + u2 * (-4.0 / 7.0 + u2 / 9.0))));
+  return 0.5 - 315.0 / 256.0 * g;
+}
+
+void capi_count_above(const sph_world* world, double h, const double* heights, int n, double* kernel,
+                      double* slab) {
+  const double step = 0.01; /* support_resting_tank's lattice step */
+  uint32_t count = 0;
+  float* x;
+  EXPECT_OK(sph_world_get_particle_count(world, &count));
+  x = (float*)malloc(sizeof(float) * 3 * (count ? count : 1));
+  assert_non_null(x);
+  EXPECT_OK(sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, x, sizeof(float) * 3 * count, 0, 0, count,
+                                     NULL));
+  for (uint32_t j = 0; j < count; ++j)
+    for (int i = 0; i < n; ++i) {
+      const double dy = x[3 * j + 1] - heights[i];
+      if (kernel) kernel[i] += kernel_share_above(-dy / h);
+      if (slab) slab[i] += fmin(1.0, fmax(0.0, dy / step + 0.5));
+    }
+  free(x);
+}

@@ -48,6 +48,24 @@ void capi_resting_tank_open(capi_resting_tank* t, const sph_world_def* def, cons
                             sph_probe_sampling gauge_sampling);
 void capi_resting_tank_close(capi_resting_tank* t);
 
+/* ---- the weight above: the resting tank's hydrostatic reference ------------------------------ */
+/* The film the walls' calibration keeps free of water at every wall, (spacing - step) / 2 at the
+ * 1 cm step (docs/validation.md, "Loads on a hydrostatic tank's side wall"). */
+#define CAPI_RESTING_FILM (0.5 * (1.4142135623730951 - 1.0) * 0.01)
+/* The area the resting tank's water stands on: the tank's inner width less a film at each side
+ * wall, squared. Measured: the centre's gauge reads the water's mass over this area 0.3-1.6 % low
+ * (WCSPH, 19 draws; the middle's water a little lighter than the mean), over the tank's inner area
+ * 6.9 % high (docs/validation.md, "The resting tank's probes against the weight above"). */
+double capi_resting_water_area(void);
+/* Adds to kernel[i] and slab[i] (i < n) the number of the world's particles above heights[i], a
+ * particle straddling a height counted in part: by the SPH interpolant's own column (`kernel`: the
+ * share of the particle's mass in the poly6 kernel of radius h the probes sample with, integrated
+ * over the horizontal plane, that lies above the height) and as a slab one lattice step thick about
+ * its centre (`slab`; either may be NULL). Times the particle mass and g over the water's area:
+ * the weight above per unit area, the pressure hydrostatics asks for. */
+void capi_count_above(const sph_world* world, double h, const double* heights, int n, double* kernel,
+                      double* slab);
+
 /* ---- a fixed box submerged in a tank ---------------------------------------------------------- */
 #define CAPI_SUBMERGED_HALF 0.03 /* m, the box's half side */
 
