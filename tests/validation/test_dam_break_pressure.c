@@ -22,7 +22,9 @@
  * DAM_PRESSURE_MEASURE=1 prints without asserting (and reads probes half and a quarter kernel
  * radius off the wall and a gauge at it); DAM_PRESSURE_STEPS=N, DAM_PRESSURE_PERTURB=SEED,
  * DAM_PRESSURE_ENSEMBLE=DRAWS, DAM_PRESSURE_C=m/s, DAM_PRESSURE_EOS=tait, DAM_PRESSURE_SOLVER=dfsph,
- * DAM_PRESSURE_PROBE_OFFSET=kernel radii, DAM_PRESSURE_FEATURES=bits, DAM_PRESSURE_HYDROSTATIC_START=1. */
+ * DAM_PRESSURE_PROBE_OFFSET=kernel radii, DAM_PRESSURE_FEATURES=bits, DAM_PRESSURE_HYDROSTATIC_START=1,
+ * DAM_PRESSURE_SLAB=layers (the slab's thickness, default 4), DAM_PRESSURE_VISCOSITY=Pa s (default
+ * 0.05), DAM_PRESSURE_STEP_FACTOR=lambda (the acoustic limit's factor, default the library's 0.4). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -122,14 +124,16 @@ static reading dam_break_pressure(uint32_t features, const char* name, int whole
                           : validation_full()          ? 32u
                                                        : 16u;
   const double step = kHeight / across;
-  const uint32_t layers[3] = {2u * across, across, 4u};
+  /* the slab's thickness in lattice layers (DAM_PRESSURE_SLAB=N measures another) */
+  const uint32_t slab = getenv("DAM_PRESSURE_SLAB") ? (uint32_t)atoi(getenv("DAM_PRESSURE_SLAB")) : 4u;
+  const uint32_t layers[3] = {2u * across, across, slab};
   /* The walls stand (spacing - step) / 2 beyond the lattice's outer mid-planes, where the walls
    * in the density hold a resting layer (docs/validation.md, "Loads on a hydrostatic tank's side
    * wall"): a lattice against them at step / 2 starts compressed and throws droplets, one of
    * which reached the far wall at t* = 1.05 in a first try. */
   const double film = 0.5 * (sqrt(2.0) - 1.0) * step;
   const double length = kTankLength * kHeight - film; /* the far wall from the lattice's origin */
-  const double tank_min[3] = {-film, -film, -film}, tank_max[3] = {length, 3.0 * kHeight, 4.0 * step + film};
+  const double tank_min[3] = {-film, -film, -film}, tank_max[3] = {length, 3.0 * kHeight, slab * step + film};
   const double time_scale = sqrt(kHeight / kGravity), pressure_scale = 1000.0 * kGravity * kHeight;
   /* The impact-only cases stop at t* = 3.2, after the latest impact their bound admits (1.15 x
    * 2.478 = 2.85); the plateau's window ends at 4.5, so the whole cases, measuring runs and
@@ -147,10 +151,14 @@ static reading dam_break_pressure(uint32_t features, const char* name, int whole
   sph_probe_def probe_def;
   sph_probe_id probe, extra[4];
   double gauge_scale = 1.0;
-  static double extra_p[3][MAX_FRAMES];
+  static double extra_p[3][MAX_FRAMES], side_p[MAX_FRAMES], wall_fill[MAX_FRAMES], wall_u[MAX_FRAMES],
+      wall_v[MAX_FRAMES];
+  sph_probe_id side;
+  memset(&side, 0, sizeof side);
   /* the probe's distance from the far wall in kernel radii (DAM_PRESSURE_PROBE_OFFSET measures another) */
   const double offset = getenv("DAM_PRESSURE_PROBE_OFFSET") ? atof(getenv("DAM_PRESSURE_PROBE_OFFSET")) : 0.0;
   double t_sim, t_data, plateau_sim, plateau_data;
+  assert_true(slab >= 2u); /* a probe on the centre plane needs fluid on both sides of it */
   assert_int_equal(support_fcc_box(layers, step, NULL, &lattice, &n), SPH_OK);
   sph_world_params_init(&params);
   sph_world_def_init(&def);
@@ -182,6 +190,9 @@ static reading dam_break_pressure(uint32_t features, const char* name, int whole
   def.features = SPH_FEATURE_BOUNDARY_DENSITY | features;
   params.step_limits = SPH_STEP_LIMIT_ACOUSTIC;
   params.viscosity = 0.05f; /* the Martin & Moyce validation's (tests/support/dam_break.c) */
+  if (getenv("DAM_PRESSURE_VISCOSITY")) params.viscosity = (float)atof(getenv("DAM_PRESSURE_VISCOSITY"));
+  if (getenv("DAM_PRESSURE_STEP_FACTOR"))
+    params.step_factor = (float)atof(getenv("DAM_PRESSURE_STEP_FACTOR"));
   EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, &params));
   scene_tait(w.world, &def);
   EXPECT_OK(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * step, 0.0f, &sdf, NULL));
@@ -191,9 +202,14 @@ static reading dam_break_pressure(uint32_t features, const char* name, int whole
   probe_def.sampling = SPH_PROBE_EVERY_SUBSTEP;
   probe_def.position.x = (float)(length - offset * w.def.kernel_radius);
   probe_def.position.y = (float)(kSensorHeight * kHeight);
-  probe_def.position.z = (float)(2.0 * step);
+  probe_def.position.z = (float)(0.5 * slab * step); /* the slab's centre plane */
   EXPECT_OK(sph_probe_create(w.world, &probe_def, &probe));
   if (measuring()) {
+    /* Measuring only: a probe on the far wall at the sensor's height in the first layer's plane by
+     * the near side wall (the slab's edge, against the centre plane's) */
+    probe_def.position.z = (float)(0.5 * step);
+    EXPECT_OK(sph_probe_create(w.world, &probe_def, &side));
+    probe_def.position.z = (float)(0.5 * slab * step);
     /* Measuring only: probes half and a quarter kernel radius off the wall, and a gauge half a
      * kernel radius off it from below the floor (the water's height at the wall: the hydrostatic
      * pressure at the sensor, rho g (eta - y_s)). */
@@ -218,6 +234,15 @@ static reading dam_break_pressure(uint32_t features, const char* name, int whole
     EXPECT_OK(sph_probe_get_reading(w.world, probe, &r));
     sim_t[frames] = (frames + 0.5) * frame / time_scale; /* the frame's mean */
     sim_p[frames] = r.pressure / pressure_scale;
+    wall_fill[frames] = r.kernel_sum;
+    wall_u[frames] = r.velocity.x / sqrt(kGravity * kHeight);
+    wall_v[frames] = r.velocity.y / sqrt(kGravity * kHeight);
+    if (measuring()) {
+      sph_probe_reading e;
+      EXPECT_OK(sph_probe_reading_init(&e));
+      EXPECT_OK(sph_probe_get_reading(w.world, side, &e));
+      side_p[frames] = e.pressure / pressure_scale;
+    }
     if (measuring() && frames == 0) {
       EXPECT_OK(sph_probe_get_reading(w.world, extra[3], &r));
       gauge_scale = (r.water_height - film) / kHeight;
@@ -255,6 +280,13 @@ static reading dam_break_pressure(uint32_t features, const char* name, int whole
           window_mean(sim_t, extra_p[0], frames, 3.3, 4.5), window_mean(sim_t, extra_p[1], frames, 3.3, 4.5),
           window_mean(sim_t, extra_p[2], frames, 3.3, 4.5), gauge_scale,
           crossing(sim_t, extra_p[0], frames, 0.1), crossing(sim_t, extra_p[1], frames, 0.1));
+    if (measuring())
+      print_message(
+          "  slab %u layers, viscosity %.4g Pa s: plateau p* by the side wall %.3f; the sensor's kernel sum "
+          "over the plateau %.3f, its velocity (%.3f, %.3f) sqrt(g H)\n",
+          slab, params.viscosity, window_mean(sim_t, side_p, frames, 3.3, 4.5),
+          window_mean(sim_t, wall_fill, frames, 3.3, 4.5), window_mean(sim_t, wall_u, frames, 3.3, 4.5),
+          window_mean(sim_t, wall_v, frames, 3.3, 4.5));
   }
   {
     /* the series of the lattice as built (an ensemble's other draws would overwrite it) */
