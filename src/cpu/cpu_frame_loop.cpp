@@ -38,6 +38,8 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
                 "(sph_dfsph_params.linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS) is not supported yet; the "
                 "loads follow the Jacobi solve's velocity updates, use SPH_DFSPH_JACOBI");
   const StepLimits limits = make_step_limits(config_, params);
+  frame_limits_ = limits;
+  fluid_height_ = 0.0f;
   SceneFrame scene = scene_in;
   bind_scene_views(scene, [](const SdfAsset& a) { return a.host_view(); });
   bind_boundary_maps(fluid, scene);
@@ -74,8 +76,14 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
         report.interrupted = true;
         break;
       }
+      // DFSPH's depth limit: H from the positions this substep starts from (a distributed world's
+      // ranks reduced it over the world with the maxima).
+      if (!ranks_ && depth_limit_on()) {
+        const HeightSpan span = measure_height_span();
+        fluid_height_ = height_of_span(span.lo, span.hi);
+      }
       pick_next_step(clock, frame_dt, limits, std::max(max_speed_, scene.max_collider_speed),
-                     max_acceleration_);
+                     max_acceleration_, fluid_height_);
       fluid.dt = clock.dt_float;
       uint32_t bad =
           config_.solver == Solver::Dfsph         ? substep_dfsph(fluid, scene, clock.time, report, tallies)
