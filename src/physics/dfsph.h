@@ -32,7 +32,8 @@
 //
 // Not used by DFSPH: the equation of state (its stiffness and Tait's speed of sound) and the
 // acoustic step limit; the step is dt = step_factor h / v_max (a CFL number on the particle
-// speed), clamped by dt_max and by the viscous, spring and force limits of the methods.
+// speed), clamped by dt_max, by the viscous, spring and force limits of the methods, and by the
+// depth limit f h / sqrt(|g| H) (depth_step_factor; step_control.h), which still water needs.
 #pragma once
 
 #include <stdint.h>
