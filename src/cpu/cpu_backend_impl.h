@@ -106,6 +106,12 @@ class CpuBackend final : public Backend {
   };
   HeightSpan measure_height_span() const;
   bool depth_limit_on() const { return frame_limits_.depth_step_factor > 0.0f; }
+  // fluid_height_ from this rank's particles alone (an undivided world's; 0 where the limit is off).
+  void measure_fluid_height() {
+    if (!depth_limit_on()) return;
+    const HeightSpan span = measure_height_span();
+    fluid_height_ = height_of_span(span.lo, span.hi);
+  }
 
   // Hash, sort, reorder every attribute, then density and pressure (packed into the w slots).
   // With SPH_FEATURE_BOUNDARY_DENSITY the colliders' share joins the density, their poses at
@@ -406,9 +412,10 @@ class CpuBackend final : public Backend {
   uint32_t count_ = 0;
   float max_speed_ = 0.0f;
   float max_acceleration_ = 0.0f;  // of the last force evaluation, for the force step limit
-  // The frame's step limits, and H of the depth limit for the next step (0: off): measured from
-  // the positions before each step is picked (a distributed world's ranks reduce it with the
-  // maxima in halo_begin_frame and halo_end_substep), so nothing about it is saved or restored.
+  // The frame's step limits, and H of the depth limit for the next step (0: off): measured at the
+  // frame's start and after each substep, before its sinks (a distributed world's ranks reduce it
+  // with the maxima in halo_begin_frame and halo_end_substep), so nothing about it is saved or
+  // restored.
   StepLimits frame_limits_{};
   float fluid_height_ = 0.0f;
   NonFiniteFailure non_finite_;  // of the last failed substep, for its error message

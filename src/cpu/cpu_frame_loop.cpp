@@ -53,7 +53,13 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
   const float saved_max_acceleration = max_acceleration_;
   spring_constants_ = fluid.methods.springs;
   if (!max_speed_valid_) max_speed_ = compute_max_speed();
-  if (ranks_) halo_begin_frame();
+  // DFSPH's depth limit: H of the first step from the frame's positions, of each next one from the
+  // positions a substep leaves before the sinks run (as the CUDA backend measures it, and as the
+  // max speed is taken); a distributed world's ranks reduce it over the world with the maxima.
+  if (ranks_)
+    halo_begin_frame();
+  else
+    measure_fluid_height();
 
   // Puts the particles back as they were before the frame: on a non-finite state and on any
   // exception (an allocation that fails halfway through a frame), so a failed step changes
@@ -76,12 +82,6 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
         report.interrupted = true;
         break;
       }
-      // DFSPH's depth limit: H from the positions this substep starts from (a distributed world's
-      // ranks reduced it over the world with the maxima).
-      if (!ranks_ && depth_limit_on()) {
-        const HeightSpan span = measure_height_span();
-        fluid_height_ = height_of_span(span.lo, span.hi);
-      }
       pick_next_step(clock, frame_dt, limits, std::max(max_speed_, scene.max_collider_speed),
                      max_acceleration_, fluid_height_);
       fluid.dt = clock.dt_float;
@@ -89,7 +89,10 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
           config_.solver == Solver::Dfsph         ? substep_dfsph(fluid, scene, clock.time, report, tallies)
           : config_.integrator == Integrator::Rk4 ? substep_rk4(fluid, scene, clock.time, report)
                                                   : substep_euler(fluid, scene, clock.time, report);
-      if (ranks_) bad = halo_end_substep(bad);
+      if (ranks_)
+        bad = halo_end_substep(bad);
+      else if (bad == kAllFinite)
+        measure_fluid_height();
       if (bad != kAllFinite) {
         roll_back();
         non_finite_.substep = clock.substeps + 1;
