@@ -10,7 +10,10 @@
  *     4.5 ms (0.3 h / sqrt(g H) is about 4 ms at h = 1.8 cm, H about 0.19 m), where dt_max and the
  *     CFL would take the 20 ms frame of still water in one;
  *   - every rank's sph_stats substeps, dt_min and dt_max equal the undivided world's bit for bit,
- *     and the gathered particles equal its particles bit for bit. */
+ *     and the gathered particles equal its particles bit for bit.
+ * With the argument `cuda` (not a ctest: CI has no GPU) the same on CUDA ranks against an undivided
+ * CUDA world (the height span reduced on the device, its keys over the ranks: cuda_halo_frame.cu):
+ * `mpirun --oversubscribe -np 2 build/tests/mpi/mpi_depth_step cuda`. */
 #include "mpi_compare.h"
 
 static void set_stepping(sph_world* world, uint32_t dfsph_flags) {
@@ -40,6 +43,10 @@ int main(int argc, char** argv) {
   sph_collider_id single_tank, tank;
   const sph_vec3 column_min = {0.0f, 0.0f, 0.0f}, column_max = {0.06f, 0.2f, 0.06f};
   mpi_test_init(&argc, &argv, &context);
+  if (argc > 1 && strcmp(argv[1], "cuda") == 0) {
+    REQUIRE(sph_context_destroy(context) == SPH_OK, "context destroy");
+    REQUIRE(support_context_create(SPH_BACKEND_CUDA, &context) == SPH_OK, "CUDA context");
+  }
   mpi_test_world_def(&def);
   def.solver = SPH_SOLVER_DFSPH;
   (void)make_worlds(context, &def, column_min, column_max, 0.0f, &single, &world, &single_tank, &tank);
