@@ -14,8 +14,9 @@
  * - the depth step limit dt <= f h / sqrt(|g| H) (docs/physics.md, DFSPH, Limits): a column at rest
  *   under an oblique gravity takes f h / sqrt(|g| H), H brute-forced from the particles' positions
  *   (max - min of x . g / |g| in double); off by SPH_DFSPH_NO_DEPTH_STEP_LIMIT and without gravity
- *   it takes dt_max, and dt_min wins over it; bad factors (INVALID_ARGUMENT) and unknown flag bits
- *   (UNSUPPORTED) are refused with the world unchanged. */
+ *   it takes dt_max, and dt_min wins over it; a world loaded or restored from a checkpoint takes
+ *   the same limited steps and trajectory bit for bit (H is measured, not stored); bad factors
+ * (INVALID_ARGUMENT) and unknown flag bits (UNSUPPORTED) are refused with the world unchanged. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -282,6 +283,46 @@ static void test_depth_step_limit(void** state) {
   scene_close(&s);
 }
 
+/* H is measured, never stored: a world loaded from a checkpoint (and one restored from it) takes
+ * the same limited steps and the same trajectory as the original, bit for bit. */
+static void test_depth_step_after_checkpoint(void** state) {
+  scene s, l;
+  const sph_vec3 g = {0.0f, -9.81f, 0.0f};
+  uint64_t size = 0;
+  uint32_t n = 0;
+  void* buffer;
+  sph_stats a, b;
+  (void)state;
+  open_column(&s, g, 0.05f, 10000u, 0u);
+  SCENE_OK(sph_world_step(s.world, 0.02f));
+  SCENE_OK(sph_world_get_particle_count(s.world, &n));
+  SCENE_OK(sph_world_save(s.world, NULL, 0, &size));
+  buffer = malloc(size);
+  assert_non_null(buffer);
+  SCENE_OK(sph_world_save(s.world, buffer, size, &size));
+  l = s;
+  SCENE_OK(sph_world_load(s.context, buffer, size, &l.world));
+  for (int f = 0; f < 2; ++f) {
+    SCENE_OK(sph_world_step(s.world, 0.02f));
+    SCENE_OK(sph_world_step(l.world, 0.02f));
+    sph_stats_init(&a);
+    sph_stats_init(&b);
+    SCENE_OK(sph_world_get_stats(s.world, &a));
+    SCENE_OK(sph_world_get_stats(l.world, &b));
+    assert_int_equal(a.substeps, b.substeps);
+    assert_true(a.dt_min == b.dt_min && a.dt_max == b.dt_max);
+    assert_true(a.dt_max < 0.006f); /* the limit binds (about 4.6 ms; dt_max 50 ms) */
+  }
+  expect_same_state(&s, l.world, n);
+  SCENE_OK(sph_world_restore(s.world, buffer, size));
+  SCENE_OK(sph_world_step(s.world, 0.02f));
+  SCENE_OK(sph_world_step(s.world, 0.02f));
+  expect_same_state(&s, l.world, n);
+  SCENE_OK(sph_world_destroy(l.world));
+  free(buffer);
+  scene_close(&s);
+}
+
 static void test_depth_step_params_refused(void** state) {
   scene s;
   sph_dfsph_params dp, now;
@@ -324,6 +365,7 @@ int main(void) {
       cmocka_unit_test(test_non_finite_rolls_back),
       cmocka_unit_test(test_cg_refused_when_set),
       cmocka_unit_test(test_depth_step_limit),
+      cmocka_unit_test(test_depth_step_after_checkpoint),
       cmocka_unit_test(test_depth_step_params_refused),
   };
   return cmocka_run_group_tests_name("physics_dfsph", tests, NULL, NULL);
