@@ -197,8 +197,9 @@ class CudaBackend final : public Backend {
   uint32_t run_frame_distributed(PipelineSetup setup, uint32_t sink_count, HostVector<uint32_t>& removed_ids,
                                  HostVector<uint32_t>& removed_by_sink, const StepInterrupt& interrupt,
                                  bool& interrupted);
-  void halo_begin_frame();  // the world's max speed and acceleration; new slabs when out of balance
-  void halo_gather();       // migration, then ghosts; the visit order of the sort
+  // The world's max speed and acceleration and DFSPH's height span; new slabs when out of balance.
+  void halo_begin_frame(const StepLimits& limits);
+  void halo_gather();                            // migration, then ghosts; the visit order of the sort
   void halo_after_sort(cudaStream_t stream);     // ghost mask, new keys, the lists of the records
   void halo_after_density(cudaStream_t stream);  // the ghosts take their owners' density records
   void halo_after_normals(cudaStream_t stream);  // and their colour normals (surface tension)

@@ -27,17 +27,23 @@ __global__ void save_rollback_inputs_kernel(FrameState* s) {
   s->saved_max_acceleration = s->max_acceleration;
 }
 
-__global__ void set_step_inputs_kernel(FrameState* s, float max_speed, float max_acceleration) {
+__global__ void set_step_inputs_kernel(FrameState* s, float max_speed, float max_acceleration,
+                                       uint32_t height_lo_key, uint32_t height_hi_key) {
   s->max_speed = max_speed;
   s->max_acceleration = max_acceleration;
+  s->height_lo_key = height_lo_key;
+  s->height_hi_key = height_hi_key;
 }
 
 // The substep's maxima and failures as every rank found them; this rank's own failure (at any
 // RK4 stage) keeps its own particle (the message names it), another rank's is named by its id.
 __global__ void set_reduced_kernel(FrameState* s, uint32_t v2max_bits, uint32_t a2max_bits,
-                                   unsigned long long crowded, uint32_t bad_id) {
+                                   unsigned long long crowded, uint32_t bad_id, uint32_t height_lo_key,
+                                   uint32_t height_hi_key) {
   s->v2max_bits = v2max_bits;
   s->a2max_bits = a2max_bits;
+  s->height_lo_key = height_lo_key;
+  s->height_hi_key = height_hi_key;
   if (s->crowded_key == 0) s->crowded_key = crowded;
   bool own = false;
   for (int k = 0; k < kRk4Stages; ++k) own = own || s->bad_key[k] != kNoBadParticle;
@@ -86,17 +92,31 @@ class CudaBackend::HaloHooks final : public SubstepHooks {
   CudaBackend& b_;
 };
 
-void CudaBackend::halo_begin_frame() {
+void CudaBackend::halo_begin_frame(const StepLimits& limits) {
   const RankTransport& t = *ranks_;
   std::vector<int64_t> held(static_cast<size_t>(t.size()), 0);
   const HostVector<Float4> positions =
       count_ > 0 ? download(static_cast<const Float4*>(r_->store->arrays().position), count_)
                  : HostVector<Float4>{};
+  // DFSPH's depth limit: this rank's height span on the device (every particle held between frames
+  // is owned), reduced over the ranks below with the maxima, so every rank's first step reads the
+  // world's H (enqueue_frame_begin then measures nothing).
+  const bool depth = limits.depth_step_factor > 0.0f;
+  if (depth)
+    guarded([&] {
+      enqueue_height_span(r_->store->arrays().position, nullptr, count_, limits, r_->state.get(), r_->stream);
+    });
   const HostVector<FrameState> state = download(static_cast<const FrameState*>(r_->state.get()), 1u);
   halo_agree();  // (the frame's start: the step's code before it ran on each rank alone)
   float maxima[2] = {state[0].max_speed, state[0].max_acceleration};
   t.all_max(maxima, 2);
-  set_step_inputs_kernel<<<1, 1, 0, r_->stream>>>(r_->state.get(), maxima[0], maxima[1]);
+  // The keys as integers, the lowest as the largest of its complement (one reduction for both).
+  int64_t keys[2] = {static_cast<int64_t>(kHeightLoReset - state[0].height_lo_key),
+                     static_cast<int64_t>(state[0].height_hi_key)};
+  if (depth) t.all_max(keys, 2);
+  set_step_inputs_kernel<<<1, 1, 0, r_->stream>>>(r_->state.get(), maxima[0], maxima[1],
+                                                  kHeightLoReset - static_cast<uint32_t>(keys[0]),
+                                                  static_cast<uint32_t>(keys[1]));
   check_launch("set_step_inputs_kernel");
   if (rebalance_slabs(t, slabs_, slabs_cut_, distributed_options_.rebalance_threshold, count_,
                       1.0f / config_.kernel_radius, held, [&](uint32_t i) { return positions[i]; })) {
@@ -158,11 +178,16 @@ void CudaBackend::halo_before_end(cudaStream_t stream) {
   const FrameState& f = halo_substep_state(stream);
   int64_t bad = first_bad_id(f);
   agree(t, &bad);  // (the substep's passes and the records' buffers)
-  int64_t maxima[3] = {f.v2max_bits, f.a2max_bits, static_cast<int64_t>(f.crowded_key)};
-  t.all_max(maxima, 3);
+  // DFSPH's depth limit: the height keys likewise (the lowest as the largest of its complement; the
+  // reset keys, where the limit is off or a rank holds nothing, lose to any particle's).
+  int64_t maxima[5] = {f.v2max_bits, f.a2max_bits, static_cast<int64_t>(f.crowded_key),
+                       static_cast<int64_t>(kHeightLoReset - f.height_lo_key),
+                       static_cast<int64_t>(f.height_hi_key)};
+  t.all_max(maxima, 5);
   set_reduced_kernel<<<1, 1, 0, stream>>>(
       r_->state.get(), static_cast<uint32_t>(maxima[0]), static_cast<uint32_t>(maxima[1]),
-      static_cast<unsigned long long>(maxima[2]), static_cast<uint32_t>(bad));
+      static_cast<unsigned long long>(maxima[2]), static_cast<uint32_t>(bad),
+      kHeightLoReset - static_cast<uint32_t>(maxima[3]), static_cast<uint32_t>(maxima[4]));
   check_launch("set_reduced_kernel");
 }
 
@@ -213,10 +238,10 @@ uint32_t CudaBackend::run_frame_distributed(PipelineSetup setup, uint32_t sink_c
   b.store->enqueue_snapshot(count_, s);
   save_rollback_inputs_kernel<<<1, 1, 0, s>>>(b.state);
   check_launch("save_rollback_inputs_kernel");
-  halo_begin_frame();
+  halo_begin_frame(setup.limits);
   setup.count = count_;
   setup.ghosts = 0;
-  enqueue_frame_begin(setup, b, LoopCondition{}, s);
+  enqueue_frame_begin(setup, b, LoopCondition{}, s, false);
   cuda_check(cudaMemcpyAsync(&out->run, &b.state->run, sizeof(uint32_t), cudaMemcpyDeviceToHost, s),
              "copy of the loop condition");
   cuda_check(cudaStreamSynchronize(s), "frame begin");

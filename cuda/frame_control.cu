@@ -8,9 +8,14 @@ namespace {
 
 // The CPU backend's step choice (substep_clock.h): the controller sees the faster of the fluid
 // and the colliders' surfaces, so a fast paddle cannot skip a particle between substeps.
+// DFSPH's depth limit reads H from the keys its last measurement left (enqueue_height_span; a
+// distributed rank's were reduced over the ranks), 0 where the limit is off.
 __device__ void pick_step(FrameState* s, const StepLimits& limits) {
+  s->fluid_height = limits.depth_step_factor > 0.0f
+                        ? height_of_span(height_of_key(s->height_lo_key), height_of_key(s->height_hi_key))
+                        : 0.0f;
   pick_next_step(s->clock, s->frame_dt, limits, fmaxf(s->max_speed, s->max_collider_speed),
-                 s->max_acceleration);
+                 s->max_acceleration, s->fluid_height);
 }
 
 __device__ void set_run(FrameState* s, uint32_t run, const LoopCondition& cond) {
@@ -97,6 +102,47 @@ __global__ void speed_max_kernel(const Float4* __restrict__ velocity, uint32_t n
   block_max_to(&s->v2max_bits, i < n ? length_squared(xyz(velocity[i])) : 0.0f);
 }
 
+// The lowest and highest x . g/|g| of the particles [0, n) (a distributed rank's ghosts left out:
+// their owners hold them), reduced over the block, then one atomicMin/atomicMax per block on the
+// keys: exact in any order, as the CPU backend's reduction (cpu_frame_control.cpp).
+__global__ void height_span_kernel(const Float4* __restrict__ position, const uint32_t* __restrict__ ghost,
+                                   uint32_t n, StepLimits limits, FrameState* s) {
+  __shared__ float warp_lo[32], warp_hi[32];
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  float lo = INFINITY, hi = -INFINITY;
+  if (i < n && !(ghost && ghost[i])) {
+    const float y = height_along(limits, xyz(position[i]));
+    if (!isnan(y)) lo = hi = y;  // (fminf/fmaxf leave NaN out, as the CPU's fmin/fmax)
+  }
+  for (int offset = 16; offset > 0; offset >>= 1) {
+    lo = fminf(lo, __shfl_xor_sync(0xffffffffu, lo, offset));
+    hi = fmaxf(hi, __shfl_xor_sync(0xffffffffu, hi, offset));
+  }
+  const unsigned lane = threadIdx.x & 31u, warp = threadIdx.x >> 5;
+  if (lane == 0) {
+    warp_lo[warp] = lo;
+    warp_hi[warp] = hi;
+  }
+  __syncthreads();
+  if (warp != 0) return;
+  const unsigned warps = (blockDim.x + 31u) >> 5;
+  lo = lane < warps ? warp_lo[lane] : INFINITY;
+  hi = lane < warps ? warp_hi[lane] : -INFINITY;
+  for (int offset = 16; offset > 0; offset >>= 1) {
+    lo = fminf(lo, __shfl_xor_sync(0xffffffffu, lo, offset));
+    hi = fmaxf(hi, __shfl_xor_sync(0xffffffffu, hi, offset));
+  }
+  if (lane == 0 && lo <= hi) {
+    atomicMin(&s->height_lo_key, height_key(lo));
+    atomicMax(&s->height_hi_key, height_key(hi));
+  }
+}
+
+__global__ void reset_height_span_kernel(FrameState* s) {
+  s->height_lo_key = kHeightLoReset;
+  s->height_hi_key = kHeightHiReset;
+}
+
 __global__ void finish_speed_max_kernel(FrameState* s) {
   s->max_speed = sqrtf(__uint_as_float(s->v2max_bits));
   s->v2max_bits = 0;
@@ -129,6 +175,16 @@ void enqueue_recompute_max_speed(const Float4* velocity, uint32_t n, FrameState*
   check_launch("speed_max_kernel");
   finish_speed_max_kernel<<<1, 1, 0, stream>>>(state);
   check_launch("finish_speed_max_kernel");
+}
+
+void enqueue_height_span(const Float4* position, const uint32_t* ghost, uint32_t n, const StepLimits& limits,
+                         FrameState* state, cudaStream_t stream) {
+  reset_height_span_kernel<<<1, 1, 0, stream>>>(state);
+  check_launch("reset_height_span_kernel");
+  if (n == 0) return;
+  height_span_kernel<<<blocks_for(n, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(position, ghost, n,
+                                                                                         limits, state);
+  check_launch("height_span_kernel");
 }
 
 void enqueue_restore_max_speed(FrameState* state, cudaStream_t stream) {

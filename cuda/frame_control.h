@@ -35,6 +35,12 @@ void enqueue_end_substep(FrameState* state, const StepLimits& limits, uint32_t m
 // particles were added.
 void enqueue_recompute_max_speed(const Float4* velocity, uint32_t n, FrameState* state, cudaStream_t stream);
 
+// DFSPH's depth limit (step_control.h): the lowest and highest x . g/|g| of position[0, n) into
+// the state's height keys, which the next step's pick reads (begin frame, end of substep). ghost:
+// a distributed rank's ghost mask in the same order (null: every particle counts).
+void enqueue_height_span(const Float4* position, const uint32_t* ghost, uint32_t n, const StepLimits& limits,
+                         FrameState* state, cudaStream_t stream);
+
 // max_speed = saved_max_speed, after a rollback.
 void enqueue_restore_max_speed(FrameState* state, cudaStream_t stream);
 

@@ -5,6 +5,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "../src/core/density_record.h"
 #include "../src/core/frame_report.h"
@@ -47,6 +48,12 @@ struct FrameState {
   float saved_max_acceleration;           // max_acceleration at the start of the frame, for a rollback
   float emission_saved_max_speed;         // max_speed before a step's emission (save_step_inputs)
   float emission_saved_max_acceleration;  // likewise max_acceleration
+  // DFSPH's depth limit (step_control.h): the lowest and highest x . g/|g| of the particles the
+  // next step starts from, as order-preserving keys (height_key; atomicMin/atomicMax), reset
+  // before each measurement (enqueue_height_span), and H = hi - lo as the step was picked with.
+  uint32_t height_lo_key;
+  uint32_t height_hi_key;
+  float fluid_height;
   // Per RK4 stage (symplectic Euler uses [0]): ((sorted index << 2 | NonFiniteStage) << 32 | id),
   // the minimum wins, which is the particle the CPU backend names (indices < 2^30 = capacity).
   unsigned long long bad_key[kRk4Stages];
@@ -84,6 +91,24 @@ struct FrameState {
   unsigned long long timing_last_ns;
   unsigned long long stage_ns[kStageCount];
 };
+
+// A float as a key whose unsigned order is the float order (negative values included), and back:
+// the height span's lowest and highest projections reduce by atomicMin/atomicMax on the keys, and
+// a distributed rank's keys by integer min/max over the ranks. The reset keys (0xffffffff for the
+// lowest, 0 for the highest) read back as NaN: height_of_span gives 0 for them.
+SPH_HD uint32_t height_key(float value) {
+  uint32_t bits;
+  memcpy(&bits, &value, sizeof bits);
+  return (bits & 0x80000000u) ? ~bits : (bits | 0x80000000u);
+}
+SPH_HD float height_of_key(uint32_t key) {
+  const uint32_t bits = (key & 0x80000000u) ? (key & 0x7fffffffu) : ~key;
+  float value;
+  memcpy(&value, &bits, sizeof value);
+  return value;
+}
+constexpr uint32_t kHeightLoReset = 0xffffffffu;
+constexpr uint32_t kHeightHiReset = 0u;
 
 static_assert(offsetof(FrameState, frame_dt) == offsetof(FrameInput, frame_dt) &&
                   offsetof(FrameState, max_collider_speed) == offsetof(FrameInput, max_collider_speed),

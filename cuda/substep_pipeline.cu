@@ -16,9 +16,13 @@ void enqueue_probes(const DeviceProbes& probes, const GridView& grid, const Part
 }  // namespace
 
 void enqueue_frame_begin(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
-                         cudaStream_t stream) {
+                         cudaStream_t stream, bool measure_height) {
   cuda_check(cudaMemcpyAsync(b.state, b.input, sizeof(FrameInput), cudaMemcpyHostToDevice, stream),
              "copy of the frame input");
+  // DFSPH's depth limit: H of the first step from the frame's positions (a distributed rank's
+  // were measured and reduced over the ranks before: measure_height false).
+  if (measure_height && setup.limits.depth_step_factor > 0.0f)
+    enqueue_height_span(b.store->arrays().position, nullptr, setup.count, setup.limits, b.state, stream);
   enqueue_begin_frame(b.state, setup.limits, setup.max_substeps, cond, stream);
   b.store->enqueue_snapshot(setup.count, stream);
   if (setup.loads.on()) enqueue_loads_begin(setup.loads, stream);
@@ -59,6 +63,10 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
     if (loads)
       enqueue_loads(setup.fluid, a, n, setup.scene, setup.loads, setup.options.boundary_density, 0.0f, 1.0f,
                     true, false, b.state, stream);
+    // DFSPH's depth limit: H of the next step from the positions this substep leaves (after the
+    // loads pass's collisions), before a distributed rank's reduction over the ranks.
+    if (setup.limits.depth_step_factor > 0.0f)
+      enqueue_height_span(a.position, a.halo_ghost, n, setup.limits, b.state, stream);
     if (hooks) hooks->before_end(stream);
     enqueue_end_substep(b.state, setup.limits, setup.max_substeps, 1, cond, stream);
     return;

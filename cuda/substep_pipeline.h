@@ -73,8 +73,10 @@ struct SubstepHooks : DfsphRankSteps, SpringRankStep {
   virtual void before_end(cudaStream_t stream) = 0;
 };
 
+// measure_height: DFSPH's depth limit measures H from the frame's positions here (false: a
+// distributed rank's, measured and reduced over the ranks in halo_begin_frame).
 void enqueue_frame_begin(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
-                         cudaStream_t stream);
+                         cudaStream_t stream, bool measure_height = true);
 // hooks: a distributed rank's (null otherwise).
 void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopCondition cond,
                      cudaStream_t stream, SubstepHooks* hooks = nullptr);

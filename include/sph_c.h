@@ -602,6 +602,9 @@ SPH_API sph_result SPH_CALL sph_world_get_density_diffusion_params(const sph_wor
   0x2u /* the Jacobi solves' pressure gradient corrected to first order (Bonet & Lok's L_i; docs/physics.md, \
           DFSPH): a resting fluid's pressure within 0.5 % of rho0 g d, but momentum only nearly conserved    \
           and energy not bounded in violent flow; not with SPH_DFSPH_CONJUGATE_GRADIENTS */
+#define SPH_DFSPH_NO_DEPTH_STEP_LIMIT                                                                      \
+  0x4u /* (0.2.0) the depth step limit off (sph_dfsph_params.depth_step_factor): for a scene whose step is \
+          known to hold still water of its depth, or whose lowest and highest water are far apart */
 /** sph_dfsph_params.linear_solver (docs/physics.md, DFSPH) */
 #define SPH_DFSPH_JACOBI 1u /* the Jacobi step of Bender & Koschier (the default) */
 #define SPH_DFSPH_CONJUGATE_GRADIENTS                    \
@@ -637,8 +640,15 @@ typedef struct sph_dfsph_params {
                                          density_error acts as density_error. Without it a small
                                          violent region of a large world (a splash at a wall) stays
                                          compressed by 50-100 %, as it barely moves the mean */
+  float depth_step_factor;            /* (0.2.0) f of the depth step limit dt <= f h / sqrt(|g| H), H the
+                                         fluid's extent along gravity (its highest particle's height
+                                         above its lowest), measured every substep: still water held
+                                         by DFSPH blows apart above about 0.37 h / sqrt(|g| depth)
+                                         (docs/physics.md, DFSPH, Limits); default 0.3; in (0, 1];
+                                         0 = default. No limit without gravity or with
+                                         SPH_DFSPH_NO_DEPTH_STEP_LIMIT; dt_min still wins */
 } sph_dfsph_params;
-SPH_STATIC_ASSERT(sizeof(sph_dfsph_params) == 32, sph_dfsph_params_size);
+SPH_STATIC_ASSERT(sizeof(sph_dfsph_params) == 36, sph_dfsph_params_size);
 
 SPH_API sph_result SPH_CALL sph_dfsph_params_init_sized(sph_dfsph_params* params, uint32_t size);
 static inline sph_result sph_dfsph_params_init(sph_dfsph_params* params) {

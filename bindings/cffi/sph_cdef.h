@@ -26,6 +26,7 @@
 #define SPH_STEP_LIMIT_FORCE 2
 #define SPH_DFSPH_SKIP_DIVERGENCE_SOLVE 1
 #define SPH_DFSPH_CORRECTED_GRADIENT 2
+#define SPH_DFSPH_NO_DEPTH_STEP_LIMIT 4
 #define SPH_DFSPH_JACOBI 1
 #define SPH_DFSPH_CONJUGATE_GRADIENTS 2
 #define SPH_SHAPE_FLAG_OPEN_TOP 1
@@ -313,6 +314,7 @@ typedef struct sph_dfsph_params {
   uint32_t flags;
   uint32_t linear_solver;
   float density_error_max;
+  float depth_step_factor;
 } sph_dfsph_params;
 typedef struct sph_params_info {
   uint32_t struct_size;

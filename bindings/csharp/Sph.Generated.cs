@@ -109,6 +109,12 @@ namespace Sph
         /// </summary>
         public const uint SPH_DFSPH_CORRECTED_GRADIENT = 2u;
         /// <summary>
+        /// (0.2.0) the depth step limit off (sph_dfsph_params.depth_step_factor): for a scene whose
+        /// step is \ known to hold still water of its depth, or whose lowest and highest water are far
+        /// apart
+        /// </summary>
+        public const uint SPH_DFSPH_NO_DEPTH_STEP_LIMIT = 4u;
+        /// <summary>
         /// sph_dfsph_params.linear_solver (docs/physics.md, DFSPH) the Jacobi step of Bender &amp;
         /// Koschier (the default)
         /// </summary>
@@ -1154,7 +1160,7 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_dfsph_params (32 bytes)</summary>
+    /// <summary>sph_dfsph_params (36 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct DfsphParams
     {
@@ -1201,6 +1207,14 @@ namespace Sph
         /// barely moves the mean
         /// </summary>
         public float DensityErrorMax;
+        /// <summary>
+        /// float depth_step_factor: (0.2.0) f of the depth step limit dt &lt;= f h / sqrt(|g| H), H the
+        /// fluid's extent along gravity (its highest particle's height above its lowest), measured
+        /// every substep: still water held by DFSPH blows apart above about 0.37 h / sqrt(|g| depth)
+        /// (docs/physics.md, DFSPH, Limits); default 0.3; in (0, 1]; 0 = default. No limit without
+        /// gravity or with SPH_DFSPH_NO_DEPTH_STEP_LIMIT; dt_min still wins
+        /// </summary>
+        public float DepthStepFactor;
 
         /// <summary>A DfsphParams with the library's defaults (sph_dfsph_params_init_sized).</summary>
         public static DfsphParams Default()
@@ -3684,7 +3698,7 @@ namespace Sph
             8,
             28,
             8,
-            32,
+            36,
             32,
             72,
             32,
@@ -3782,6 +3796,7 @@ namespace Sph
             typeof(SpringParams),
             typeof(DensityDiffusionParams),
             typeof(DensityDiffusionParams),
+            typeof(DfsphParams),
             typeof(DfsphParams),
             typeof(DfsphParams),
             typeof(DfsphParams),
@@ -4071,6 +4086,7 @@ namespace Sph
             "Flags",
             "LinearSolver",
             "DensityErrorMax",
+            "DepthStepFactor",
             "StructSize",
             "ParamsSize",
             "FieldCount",
@@ -4352,6 +4368,7 @@ namespace Sph
             20,
             24,
             28,
+            32,
             0,
             4,
             8,

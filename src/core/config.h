@@ -116,6 +116,16 @@ inline StepLimits make_step_limits(const WorldConfig& c, const RuntimeParams& p)
     s.sound_speed = speed_of_sound(make_eos_constants(p.methods, c.selection(), c.shape()));
   s.use_force_limit = (p.stepping.step_limits & kStepLimitForce) ? 1u : 0u;
   s.stability_dt = method_stability_ceiling(p.methods, c.selection(), c.shape());
+  // DFSPH's depth limit (step_control.h). Not the weakly compressible scheme's: its acoustic
+  // limit (a sound speed of 10 u_ff or more) is already far shorter than sqrt(|g| H) allows.
+  const Vec3 g = p.stepping.gravity;
+  const float g_magnitude = SPH_SQRTF(g.x * g.x + g.y * g.y + g.z * g.z);
+  const Dfsph::Params& dfsph = params_of<Dfsph>(p);
+  const bool depth_on = c.solver == Solver::Dfsph && !(dfsph.flags & kDfsphNoDepthStepLimit) &&
+                        g_magnitude > 0.0f && g_magnitude < INFINITY;
+  s.depth_step_factor = depth_on ? dfsph.depth_step_factor : 0.0f;
+  s.gravity_magnitude = depth_on ? g_magnitude : 0.0f;
+  s.down = depth_on ? Vec3{g.x / g_magnitude, g.y / g_magnitude, g.z / g_magnitude} : Vec3{0.0f, 0.0f, 0.0f};
   return s;
 }
 

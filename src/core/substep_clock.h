@@ -41,9 +41,12 @@ SPH_HD bool clock_running(const SubstepClock& c, uint32_t max_substeps) {
 
 // The next substep's step and its place in the frame. speed: the faster of the fluid's |v|max
 // and the colliders' surfaces, so a fast paddle cannot skip a particle between substeps.
+// fluid_height: H of DFSPH's depth limit, measured from the positions the substep starts from
+// (0 where the limit is off).
 SPH_HD void pick_next_step(SubstepClock& c, double frame_dt, const StepLimits& limits, float speed,
-                           float max_acceleration) {
-  c.dt = landing_dt(static_cast<double>(controller_dt(limits, speed, max_acceleration)), c.remaining);
+                           float max_acceleration, float fluid_height) {
+  c.dt = landing_dt(static_cast<double>(controller_dt(limits, speed, max_acceleration, fluid_height)),
+                    c.remaining);
   c.dt_float = static_cast<float>(c.dt);
   const double elapsed = c.time_advanced;
   c.time.tau0 = static_cast<float>(elapsed);

@@ -99,6 +99,19 @@ class CpuBackend final : public Backend {
   int n() const { return static_cast<int>(count_); }
 
   float compute_max_speed() const;
+  // DFSPH's depth limit (step_control.h): the lowest and highest x . g/|g| of the particles
+  // held, under frame_limits_ (lo > hi when none is held).
+  struct HeightSpan {
+    float lo = INFINITY, hi = -INFINITY;
+  };
+  HeightSpan measure_height_span() const;
+  bool depth_limit_on() const { return frame_limits_.depth_step_factor > 0.0f; }
+  // fluid_height_ from this rank's particles alone (an undivided world's; 0 where the limit is off).
+  void measure_fluid_height() {
+    if (!depth_limit_on()) return;
+    const HeightSpan span = measure_height_span();
+    fluid_height_ = height_of_span(span.lo, span.hi);
+  }
 
   // Hash, sort, reorder every attribute, then density and pressure (packed into the w slots).
   // With SPH_FEATURE_BOUNDARY_DENSITY the colliders' share joins the density, their poses at
@@ -263,6 +276,7 @@ class CpuBackend final : public Backend {
   }
   // The frame's start: the world's max speed, and new slabs when the ranks are out of balance.
   void halo_begin_frame();
+  void reduce_step_inputs();  // the maxima and the height span over the ranks (cpu_halo.cpp)
   // Before the sort: owned particles that left the slab migrate, ghosts arrive; the world's
   // grid shape and this rank's sort order go to halo_shape_ and halo_visit_.
   void halo_gather();
@@ -398,7 +412,13 @@ class CpuBackend final : public Backend {
   uint32_t count_ = 0;
   float max_speed_ = 0.0f;
   float max_acceleration_ = 0.0f;  // of the last force evaluation, for the force step limit
-  NonFiniteFailure non_finite_;    // of the last failed substep, for its error message
+  // The frame's step limits, and H of the depth limit for the next step (0: off): measured at the
+  // frame's start and after each substep, before its sinks (a distributed world's ranks reduce it
+  // with the maxima in halo_begin_frame and halo_end_substep), so nothing about it is saved or
+  // restored.
+  StepLimits frame_limits_{};
+  float fluid_height_ = 0.0f;
+  NonFiniteFailure non_finite_;  // of the last failed substep, for its error message
   bool max_speed_valid_ = false;
   struct StepInputs {
     float max_speed = 0.0f, max_acceleration = 0.0f;

@@ -16,6 +16,24 @@ float CpuBackend::compute_max_speed() const {
   return std::sqrt(v2max);
 }
 
+// Min and max are exact in any order, so the span is the same bits whatever the workers and, over
+// the ranks, whatever the decomposition.
+CpuBackend::HeightSpan CpuBackend::measure_height_span() const {
+  const Float4* pos = position_.data();
+  return parallel().reduce(
+      count_, HeightSpan{},
+      [&](uint32_t i, HeightSpan& s) {
+        const float y = height_along(frame_limits_, xyz(pos[i]));
+        s.lo = std::fmin(s.lo, y);
+        s.hi = std::fmax(s.hi, y);
+      },
+      [](HeightSpan a, const HeightSpan& b) {
+        a.lo = std::fmin(a.lo, b.lo);
+        a.hi = std::fmax(a.hi, b.hi);
+        return a;
+      });
+}
+
 // Max speed and the first non-finite particle of the state in next_*.
 uint32_t CpuBackend::scan_next_state(float& v2max) const {
   const Float4* next_pos = next_position_.data();

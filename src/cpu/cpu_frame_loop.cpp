@@ -38,6 +38,8 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
                 "(sph_dfsph_params.linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS) is not supported yet; the "
                 "loads follow the Jacobi solve's velocity updates, use SPH_DFSPH_JACOBI");
   const StepLimits limits = make_step_limits(config_, params);
+  frame_limits_ = limits;
+  fluid_height_ = 0.0f;
   SceneFrame scene = scene_in;
   bind_scene_views(scene, [](const SdfAsset& a) { return a.host_view(); });
   bind_boundary_maps(fluid, scene);
@@ -51,7 +53,13 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
   const float saved_max_acceleration = max_acceleration_;
   spring_constants_ = fluid.methods.springs;
   if (!max_speed_valid_) max_speed_ = compute_max_speed();
-  if (ranks_) halo_begin_frame();
+  // DFSPH's depth limit: H of the first step from the frame's positions, of each next one from the
+  // positions a substep leaves before the sinks run (as the CUDA backend measures it, and as the
+  // max speed is taken); a distributed world's ranks reduce it over the world with the maxima.
+  if (ranks_)
+    halo_begin_frame();
+  else
+    measure_fluid_height();
 
   // Puts the particles back as they were before the frame: on a non-finite state and on any
   // exception (an allocation that fails halfway through a frame), so a failed step changes
@@ -75,13 +83,16 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
         break;
       }
       pick_next_step(clock, frame_dt, limits, std::max(max_speed_, scene.max_collider_speed),
-                     max_acceleration_);
+                     max_acceleration_, fluid_height_);
       fluid.dt = clock.dt_float;
       uint32_t bad =
           config_.solver == Solver::Dfsph         ? substep_dfsph(fluid, scene, clock.time, report, tallies)
           : config_.integrator == Integrator::Rk4 ? substep_rk4(fluid, scene, clock.time, report)
                                                   : substep_euler(fluid, scene, clock.time, report);
-      if (ranks_) bad = halo_end_substep(bad);
+      if (ranks_)
+        bad = halo_end_substep(bad);
+      else if (bad == kAllFinite)
+        measure_fluid_height();
       if (bad != kAllFinite) {
         roll_back();
         non_finite_.substep = clock.substeps + 1;

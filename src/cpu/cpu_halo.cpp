@@ -132,14 +132,29 @@ void CpuBackend::halo_keep(size_t kept) {
   store_.resize(count_);
 }
 
+// The next step's inputs over the ranks: the largest speed and acceleration, and with DFSPH's depth
+// limit the world's height span (its lowest point as the largest of -lo), over the owned particles
+// (every particle held between substeps is owned), in one reduction. min and max are exact: every
+// rank takes the undivided world's H, bit for bit.
+void CpuBackend::reduce_step_inputs() {
+  float maxima[4] = {max_speed_, max_acceleration_, 0.0f, 0.0f};
+  const bool depth = depth_limit_on();
+  if (depth) {
+    const HeightSpan span = measure_height_span();
+    maxima[2] = -span.lo;
+    maxima[3] = span.hi;
+  }
+  ranks_->all_max(maxima, depth ? 4 : 2);
+  max_speed_ = maxima[0];
+  max_acceleration_ = maxima[1];
+  fluid_height_ = depth ? height_of_span(-maxima[2], maxima[3]) : 0.0f;
+}
+
 void CpuBackend::halo_begin_frame() {
   const RankTransport& t = *ranks_;
   std::vector<int64_t> held(static_cast<size_t>(t.size()), 0);
   halo_agree();  // (the frame's start: the step's code before it ran on each rank alone)
-  float maxima[2] = {max_speed_, max_acceleration_};
-  t.all_max(maxima, 2);
-  max_speed_ = maxima[0];
-  max_acceleration_ = maxima[1];
+  reduce_step_inputs();
   // Particles per rank, and the world's extent in cells (core/slab_rebalance.h).
   if (rebalance_slabs(t, slabs_, slabs_cut_, distributed_options_.rebalance_threshold, count_,
                       1.0f / config_.kernel_radius, held, [this](uint32_t i) { return position_[i]; })) {
@@ -273,10 +288,7 @@ uint32_t CpuBackend::halo_end_substep(uint32_t bad_id) {
   const RankTransport& t = *ranks_;
   int64_t bad = bad_id;
   agree(t, &bad);  // (the force and integration passes)
-  float maxima[2] = {max_speed_, max_acceleration_};
-  t.all_max(maxima, 2);
-  max_speed_ = maxima[0];
-  max_acceleration_ = maxima[1];
+  reduce_step_inputs();
   if (bad != static_cast<int64_t>(kAllFinite) && bad_id == kAllFinite) {
     // Another rank's particle: that rank's message classifies it.
     non_finite_ = NonFiniteFailure{};

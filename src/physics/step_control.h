@@ -59,13 +59,45 @@ struct StepLimits {
   float sound_speed;         // > 0: the acoustic limit dt <= lambda h / c applies
   uint32_t use_force_limit;  // the force limit dt <= lambda sqrt(h / |a|_max) applies
   float stability_dt;        // > 0: the methods' stability ceiling (methods.h), whatever dt_max says
+  // DFSPH's depth limit dt <= f h / sqrt(|g| H) (below): f (0: the limit is off: another solver,
+  // no gravity, or SPH_DFSPH_NO_DEPTH_STEP_LIMIT), |g|, and g / |g|, along which H is measured.
+  float depth_step_factor;
+  float gravity_magnitude;
+  Vec3 down;
 };
 
-// dt = lambda h / v_max (eq. 32), with the acoustic and force limits where asked for and the
-// stability ceiling always, clamped to [dt_min, dt_max]; v_max = 0 and no other limit gives
-// dt_max. dt_min is the caller's explicit floor and wins over the ceiling (fixed-step runs pin
-// dt_min = dt_max); a non-finite step above the ceiling says so in its error.
-SPH_HD float controller_dt(const StepLimits& s, float max_speed, float max_acceleration) {
+// DFSPH's depth limit. Still water held by DFSPH blows apart when dt > about 0.37 h / sqrt(|g| D),
+// D the water's depth (H200, 0.24-0.96 m deep tanks at lattice steps of 1 cm and 5 mm: every run
+// at dt sqrt(g D) / h <= 0.36 settled, every run at >= 0.39 blew; docs/validation.md, "Session
+// 19"), a bound that neither the CFL (the water is at rest) nor the force limit (|a| is about g)
+// sees: sqrt(g D) = sqrt(p / rho0) at the floor, the pressure's own speed. D is read as H, the
+// fluid's extent along gravity (max - min of x . g / |g| over the particles), so the limit needs
+// no feedback through the solve (a limit on the pressure itself collapsed the step: DFSPH's
+// pressure holds the step's own correction); H >= D, so the limit is conservative where the
+// fluid's lowest and highest particles are not one column (two pools at different heights).
+// height_along is the projection whose max - min is H; every backend and rank uses it.
+SPH_HD float height_along(const StepLimits& s, Vec3 x) {
+  return x.x * s.down.x + x.y * s.down.y + x.z * s.down.z;
+}
+
+// H from the lowest and highest projection (0 for no particle: lo > hi).
+SPH_HD float height_of_span(float lo, float hi) { return hi > lo ? hi - lo : 0.0f; }
+
+// f h / sqrt(|g| H), or 0 where the limit does not apply (off, or H <= 0 or not finite).
+SPH_HD float depth_step_limit(const StepLimits& s, float fluid_height) {
+  if (!(s.depth_step_factor > 0.0f) || !(fluid_height > 0.0f) || !(s.gravity_magnitude > 0.0f)) return 0.0f;
+  const float gh = s.gravity_magnitude * fluid_height;
+  if (!(gh < INFINITY)) return 0.0f;
+  return s.depth_step_factor * s.kernel_radius / SPH_SQRTF(gh);
+}
+
+// dt = lambda h / v_max (eq. 32), with the acoustic and force limits where asked for, the
+// stability ceiling always and DFSPH's depth limit where it is on (fluid_height: H, the fluid's
+// extent along gravity, measured this substep), clamped to [dt_min, dt_max]; v_max = 0 and no
+// other limit gives dt_max. dt_min is the caller's explicit floor and wins over the ceiling and
+// the depth limit (fixed-step runs pin dt_min = dt_max); a non-finite step above the ceiling says
+// so in its error.
+SPH_HD float controller_dt(const StepLimits& s, float max_speed, float max_acceleration, float fluid_height) {
   float dt = s.dt_max;
   if (s.stability_dt > 0.0f && s.stability_dt < dt) dt = s.stability_dt;
   if (max_speed > 0.0f) {
@@ -80,11 +112,18 @@ SPH_HD float controller_dt(const StepLimits& s, float max_speed, float max_accel
     const float candidate = s.step_factor * SPH_SQRTF(s.kernel_radius / max_acceleration);
     if (candidate < dt) dt = candidate;
   }
+  const float depth = depth_step_limit(s, fluid_height);
+  if (depth > 0.0f && depth < dt) dt = depth;
   if (dt < s.dt_min) dt = s.dt_min;
   return dt;
 }
 
-SPH_HD float controller_dt(const StepLimits& s, float max_speed) { return controller_dt(s, max_speed, 0.0f); }
+SPH_HD float controller_dt(const StepLimits& s, float max_speed, float max_acceleration) {
+  return controller_dt(s, max_speed, max_acceleration, 0.0f);
+}
+SPH_HD float controller_dt(const StepLimits& s, float max_speed) {
+  return controller_dt(s, max_speed, 0.0f, 0.0f);
+}
 
 // A remainder this share of a step above a whole number of steps counts as that number: the
 // frame then lands in those steps, each longer than dt by at most this share, where a rounding

@@ -10,7 +10,13 @@
  * - the conjugate gradients' density solve refused where it does not run (the walls in the
  *   density, on either backend) when the parameters are set, not at the step: both
  *   setters return SPH_ERROR_UNSUPPORTED naming the reason, the parameters stay Jacobi and the
- *   world steps. */
+ *   world steps;
+ * - the depth step limit dt <= f h / sqrt(|g| H) (docs/physics.md, DFSPH, Limits): a column at rest
+ *   under an oblique gravity takes f h / sqrt(|g| H), H brute-forced from the particles' positions
+ *   (max - min of x . g / |g| in double); off by SPH_DFSPH_NO_DEPTH_STEP_LIMIT and without gravity
+ *   it takes dt_max, and dt_min wins over it; a world loaded or restored from a checkpoint takes
+ *   the same limited steps and trajectory bit for bit (H is measured, not stored); bad factors
+ * (INVALID_ARGUMENT) and unknown flag bits (UNSUPPORTED) are refused with the world unchanged. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -160,12 +166,207 @@ static void test_cg_refused_when_set(void** state) {
   scene_close(&s);
 }
 
+/* A DFSPH column 10 x 60 x 10 cm (spacing 2 cm, h 3.6 cm) at rest, no walls: only its first substep
+ * is looked at, before any pressure moves it. */
+static void open_column(scene* s, sph_vec3 gravity, float dt_max, uint32_t max_substeps,
+                        uint32_t dfsph_flags) {
+  sph_world_def def;
+  sph_world_params params;
+  sph_dfsph_params dp;
+  sph_fill_box_desc box;
+  uint32_t n = 0;
+  sph_world_def_init(&def);
+  def.capacity = 8000;
+  def.particle_spacing = kSpacing;
+  def.solver = SPH_SOLVER_DFSPH;
+  sph_world_params_init(&params);
+  params.gravity = gravity;
+  params.dt_max = dt_max;
+  params.dt_min = 1e-6f;
+  params.max_substeps = max_substeps;
+  SCENE_OK(support_world_open(s, sph_test_backend(), &def, &params));
+  sph_dfsph_params_init(&dp);
+  dp.flags = dfsph_flags;
+  SCENE_OK(sph_world_set_dfsph_params(s->world, &dp));
+  sph_fill_box_desc_init(&box);
+  box.max.x = 0.1f;
+  box.max.y = 0.6f;
+  box.max.z = 0.1f;
+  SCENE_OK(sph_world_fill_box(s->world, &box, &n));
+  assert_true(n > 300);
+}
+
+/* H: max - min of x . g / |g| over the world's particles, in double. */
+static double brute_force_height(scene* s, sph_vec3 g) {
+  uint32_t n = 0;
+  float* x;
+  double lo = INFINITY, hi = -INFINITY;
+  const double gm = sqrt((double)g.x * g.x + (double)g.y * g.y + (double)g.z * g.z);
+  SCENE_OK(sph_world_get_particle_count(s->world, &n));
+  x = (float*)malloc(12 * (size_t)n);
+  assert_non_null(x);
+  assert_int_equal(scene_positions(s, x, n), n);
+  for (uint32_t i = 0; i < n; ++i) {
+    const double y = ((double)x[3 * i] * g.x + (double)x[3 * i + 1] * g.y + (double)x[3 * i + 2] * g.z) / gm;
+    lo = y < lo ? y : lo;
+    hi = y > hi ? y : hi;
+  }
+  free(x);
+  return hi - lo;
+}
+
+/* The first substep's dt of a frame of frame_dt (sph_stats.dt_max; one substep when max_substeps is 1). */
+static float first_dt(scene* s, float frame_dt) {
+  sph_stats st;
+  const sph_result r = sph_world_step(s->world, frame_dt);
+  assert_true(r == SPH_OK || r == SPH_INCOMPLETE);
+  sph_stats_init(&st);
+  SCENE_OK(sph_world_get_stats(s->world, &st));
+  assert_true(st.substeps >= 1);
+  return st.dt_max;
+}
+
+static void test_depth_step_limit(void** state) {
+  scene s;
+  sph_world_def def;
+  sph_dfsph_params dp;
+  const sph_vec3 g = {2.0f, -9.0f, 1.5f};
+  double gm, height, want, frame, lo, hi, n;
+  float dt;
+  (void)state;
+  open_column(&s, g, 1.0f, 1u, 0u); /* dt_max 1 s: the water at rest, the depth limit alone binds */
+  sph_world_def_init(&def);
+  SCENE_OK(sph_world_get_def(s.world, &def));
+  sph_dfsph_params_init(&dp);
+  SCENE_OK(sph_world_get_dfsph_params(s.world, &dp));
+  assert_true(dp.depth_step_factor == 0.3f); /* the default */
+  gm = sqrt((double)g.x * g.x + (double)g.y * g.y + (double)g.z * g.z);
+  height = brute_force_height(&s, g);
+  assert_true(height > 0.55 && height < 0.65);
+  want = 0.3 * (double)def.kernel_radius / sqrt(gm * height);
+  /* One substep of a frame a million of them long: landing_dt spreads the frame over
+   * n = ceil(frame / dt_c - 1e-4) steps (step_control.h), so the step taken, frame / n, brackets
+   * the controller's dt_c within one part in a million: frame / (n + 1e-4) <= dt_c <
+   * frame / (n - 1 + 1e-4). The tolerance on top, 1e-6 of dt, is float rounding: the library
+   * projects the positions and evaluates f h / sqrt(|g| H) in float (a few ulps, 6e-8 each). */
+  frame = (double)(float)(1e6 * want);
+  dt = first_dt(&s, (float)frame);
+  n = floor(frame / (double)dt + 0.5);
+  assert_true(n > 9.9e5 && n < 1.01e6);
+  lo = frame / (n + 1e-4);
+  hi = frame / (n - 1.0 + 1e-4);
+  print_message("depth limit: H %.6f m, f h / sqrt(|g| H) %.9g s, the controller's in [%.9g, %.9g) s\n",
+                height, want, lo, hi);
+  assert_true(want >= lo * (1.0 - 1e-6) && want < hi * (1.0 + 1e-6));
+  scene_close(&s);
+
+  /* Off by the flag, and without gravity: dt_max (20 steps of 50 ms in a 1 s frame). */
+  open_column(&s, g, 0.05f, 1u, SPH_DFSPH_NO_DEPTH_STEP_LIMIT);
+  assert_true(first_dt(&s, 1.0f) == (float)(1.0 / 20.0));
+  scene_close(&s);
+  {
+    const sph_vec3 none = {0.0f, 0.0f, 0.0f};
+    open_column(&s, none, 0.05f, 1u, 0u);
+    assert_true(first_dt(&s, 1.0f) == (float)(1.0 / 20.0));
+    scene_close(&s);
+  }
+  /* dt_min wins over the limit (a fixed-step run pins dt_min = dt_max). */
+  open_column(&s, g, 0.05f, 1u, 0u);
+  {
+    sph_world_params p;
+    sph_world_params_init(&p);
+    SCENE_OK(sph_world_get_params(s.world, &p));
+    p.dt_min = 0.05f;
+    SCENE_OK(sph_world_set_params(s.world, &p));
+  }
+  assert_true(first_dt(&s, 1.0f) == (float)(1.0 / 20.0));
+  scene_close(&s);
+}
+
+/* H is measured, never stored: a world loaded from a checkpoint (and one restored from it) takes
+ * the same limited steps and the same trajectory as the original, bit for bit. */
+static void test_depth_step_after_checkpoint(void** state) {
+  scene s, l;
+  const sph_vec3 g = {0.0f, -9.81f, 0.0f};
+  uint64_t size = 0;
+  uint32_t n = 0;
+  void* buffer;
+  sph_stats a, b;
+  (void)state;
+  open_column(&s, g, 0.05f, 10000u, 0u);
+  SCENE_OK(sph_world_step(s.world, 0.02f));
+  SCENE_OK(sph_world_get_particle_count(s.world, &n));
+  SCENE_OK(sph_world_save(s.world, NULL, 0, &size));
+  buffer = malloc(size);
+  assert_non_null(buffer);
+  SCENE_OK(sph_world_save(s.world, buffer, size, &size));
+  l = s;
+  SCENE_OK(sph_world_load(s.context, buffer, size, &l.world));
+  for (int f = 0; f < 2; ++f) {
+    SCENE_OK(sph_world_step(s.world, 0.02f));
+    SCENE_OK(sph_world_step(l.world, 0.02f));
+    sph_stats_init(&a);
+    sph_stats_init(&b);
+    SCENE_OK(sph_world_get_stats(s.world, &a));
+    SCENE_OK(sph_world_get_stats(l.world, &b));
+    assert_int_equal(a.substeps, b.substeps);
+    assert_true(a.dt_min == b.dt_min && a.dt_max == b.dt_max);
+    assert_true(a.dt_max < 0.006f); /* the limit binds (about 4.6 ms; dt_max 50 ms) */
+  }
+  expect_same_state(&s, l.world, n);
+  SCENE_OK(sph_world_restore(s.world, buffer, size));
+  SCENE_OK(sph_world_step(s.world, 0.02f));
+  SCENE_OK(sph_world_step(s.world, 0.02f));
+  expect_same_state(&s, l.world, n);
+  SCENE_OK(sph_world_destroy(l.world));
+  free(buffer);
+  scene_close(&s);
+}
+
+static void test_depth_step_params_refused(void** state) {
+  scene s;
+  sph_dfsph_params dp, now;
+  const sph_vec3 g = {0.0f, -9.81f, 0.0f};
+  const float bad[] = {-0.1f, 1.5f, NAN, INFINITY, -INFINITY};
+  (void)state;
+  open_column(&s, g, 0.05f, 1u, 0u);
+  sph_dfsph_params_init(&dp);
+  dp.depth_step_factor = 0.2f;
+  SCENE_OK(sph_world_set_dfsph_params(s.world, &dp));
+  for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
+    sph_dfsph_params_init(&dp);
+    dp.depth_step_factor = bad[k];
+    assert_int_equal(sph_world_set_dfsph_params(s.world, &dp), SPH_ERROR_INVALID_ARGUMENT);
+    assert_non_null(strstr(sph_get_last_error(), "depth_step_factor"));
+  }
+  sph_dfsph_params_init(&dp);
+  dp.flags = 0x8u; /* an unknown bit: UNSUPPORTED, as every bit set's unknown bits (param_table.h) */
+  assert_int_equal(sph_world_set_dfsph_params(s.world, &dp), SPH_ERROR_UNSUPPORTED);
+  assert_non_null(strstr(sph_get_last_error(), "flags"));
+  sph_dfsph_params_init(&now);
+  SCENE_OK(sph_world_get_dfsph_params(s.world, &now));
+  assert_true(now.depth_step_factor == 0.2f); /* unchanged */
+  assert_int_equal(now.flags, 0u);
+  /* 0 is the default; 1 the largest accepted. */
+  sph_dfsph_params_init(&dp);
+  dp.depth_step_factor = 0.0f;
+  SCENE_OK(sph_world_set_dfsph_params(s.world, &dp));
+  SCENE_OK(sph_world_get_dfsph_params(s.world, &now));
+  assert_true(now.depth_step_factor == 0.3f);
+  dp.depth_step_factor = 1.0f;
+  SCENE_OK(sph_world_set_dfsph_params(s.world, &dp));
+  scene_close(&s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_checkpoint_bitwise),
       cmocka_unit_test(test_checkpoint_bitwise_boundary_density),
       cmocka_unit_test(test_non_finite_rolls_back),
       cmocka_unit_test(test_cg_refused_when_set),
+      cmocka_unit_test(test_depth_step_limit),
+      cmocka_unit_test(test_depth_step_after_checkpoint),
+      cmocka_unit_test(test_depth_step_params_refused),
   };
   return cmocka_run_group_tests_name("physics_dfsph", tests, NULL, NULL);
 }

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '3b9ac5ae4054dbeb2fe30a2365a7b054c107b3ea429fd8b924b97330e8e117bd', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': 'e596775ad10a31906eb5fed6202dbfbd3ae2d0eced4c11f2fa462cb2f31eb9f1', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -94,6 +94,9 @@ SPH_DFSPH_SKIP_DIVERGENCE_SOLVE = 1
 #: only nearly conserved    \ and energy not bounded in violent flow; not with
 #: SPH_DFSPH_CONJUGATE_GRADIENTS
 SPH_DFSPH_CORRECTED_GRADIENT = 2
+#: (0.2.0) the depth step limit off (sph_dfsph_params.depth_step_factor): for a scene whose step is
+#: \ known to hold still water of its depth, or whose lowest and highest water are far apart
+SPH_DFSPH_NO_DEPTH_STEP_LIMIT = 4
 #: sph_dfsph_params.linear_solver (docs/physics.md, DFSPH) the Jacobi step of Bender & Koschier
 #: (the default)
 SPH_DFSPH_JACOBI = 1
@@ -1094,6 +1097,7 @@ class DfsphParams(_SphStruct):
         flags (uint32_t): SPH_DFSPH_* bits; default 0
         linear_solver (uint32_t): how the density solve iterates: SPH_DFSPH_JACOBI (the default) or SPH_DFSPH_CONJUGATE_GRADIENTS (the divergence solve is always Jacobi); 0 = default; any other value is INVALID_ARGUMENT. Conjugate gradients run on the CPU and CUDA backends, distributed worlds included; with SPH_FEATURE_BOUNDARY_DENSITY or SPH_FEATURE_COLLIDER_LOADS setting it (or loading a checkpoint with it) is UNSUPPORTED, the world unchanged
         density_error_max (float): (0.2.0) bound on the density solve's largest error, max(rho* - rho0, 0) / rho0 of any one particle: the density solve (Jacobi or conjugate gradients) iterates while this or the mean is above its bound (then the cap); default 0.05 (5 %); in (0, 1]; 0 = default; a value below density_error acts as density_error. Without it a small violent region of a large world (a splash at a wall) stays compressed by 50-100 %, as it barely moves the mean
+        depth_step_factor (float): (0.2.0) f of the depth step limit dt <= f h / sqrt(|g| H), H the fluid's extent along gravity (its highest particle's height above its lowest), measured every substep: still water held by DFSPH blows apart above about 0.37 h / sqrt(|g| depth) (docs/physics.md, DFSPH, Limits); default 0.3; in (0, 1]; 0 = default. No limit without gravity or with SPH_DFSPH_NO_DEPTH_STEP_LIMIT; dt_min still wins
     """
     _fields_ = [
         ('struct_size', _c.c_uint32),
@@ -1104,10 +1108,11 @@ class DfsphParams(_SphStruct):
         ('flags', _c.c_uint32),
         ('linear_solver', _c.c_uint32),
         ('density_error_max', _c.c_float),
+        ('depth_step_factor', _c.c_float),
     ]
     _sph_c_name_ = 'sph_dfsph_params'
-    _sph_size_ = 32
-    _sph_offsets_ = (('struct_size', 0), ('density_error', 4), ('divergence_error', 8), ('max_iterations', 12), ('max_divergence_iterations', 16), ('flags', 20), ('linear_solver', 24), ('density_error_max', 28))
+    _sph_size_ = 36
+    _sph_offsets_ = (('struct_size', 0), ('density_error', 4), ('divergence_error', 8), ('max_iterations', 12), ('max_divergence_iterations', 16), ('flags', 20), ('linear_solver', 24), ('density_error_max', 28), ('depth_step_factor', 32))
     _sph_init_ = 'sph_dfsph_params_init_sized'
 
 
