@@ -24,7 +24,9 @@
  * DAM_PRESSURE_ENSEMBLE=DRAWS, DAM_PRESSURE_C=m/s, DAM_PRESSURE_EOS=tait, DAM_PRESSURE_SOLVER=dfsph,
  * DAM_PRESSURE_PROBE_OFFSET=kernel radii, DAM_PRESSURE_FEATURES=bits, DAM_PRESSURE_HYDROSTATIC_START=1,
  * DAM_PRESSURE_SLAB=layers (the slab's thickness, default 4), DAM_PRESSURE_VISCOSITY=Pa s (default
- * 0.05), DAM_PRESSURE_STEP_FACTOR=lambda (the acoustic limit's factor, default the library's 0.4). */
+ * 0.05), DAM_PRESSURE_ALPHA=alpha and DAM_PRESSURE_VISCOSITY_RULE=h (a viscosity in proportion to h:
+ * case_viscosity), DAM_PRESSURE_STEP_FACTOR=lambda (the acoustic limit's factor, default the
+ * library's 0.4). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -111,6 +113,32 @@ static void scene_tait(sph_world* world, const sph_world_def* def) {
   EXPECT_OK(sph_world_set_tait_params(world, &tait));
 }
 
+/* The case's numerical viscosity, Mueller's mu: 0.05 Pa s, the Martin & Moyce validation's
+ * (tests/support/dam_break.c), at every resolution. Measuring knobs (docs/validation.md, "Session
+ * 20: a viscosity in proportion to h"): DAM_PRESSURE_VISCOSITY=mu (Pa s) another constant;
+ * DAM_PRESSURE_ALPHA=alpha the viscosity of Monaghan's artificial viscosity, mu = rho0 alpha c h / 20
+ * (its shear viscosity nu = alpha c h_M / 10 in 3D in the continuum limit, whatever the kernel, with
+ * h_M = h / 2 the smoothing length of a kernel whose radius is h; Mueller's term is consistent,
+ * sum_j V_j (v_j - v_i) lap W -> lap v), so in proportion to h and c; DAM_PRESSURE_VISCOSITY_RULE=h
+ * the same anchored at 0.05 Pa s at 16 steps and 15 m/s (alpha = 0.0042; 0.025 at 32 steps), exactly
+ * 0.05 there. mu in proportion to h holds the plateau closer than a constant 0.05 at 24-64 steps
+ * but still falls (-16 % at 32 and 48, -21 % at 64 on the H200), so it is not the case's rule. */
+static const double kRestDensity = 1000.0;
+static const double kViscosity = 0.05; /* Pa s */
+
+/* The kernel radius, the library's default 1.8 particle spacings (the FCC spacing step sqrt 2). */
+static double kernel_radius(double step) { return 1.8 * step * sqrt(2.0); }
+
+/* mu for the lattice step and the speed of sound c (the knobs above). */
+static double case_viscosity(double step, double c) {
+  const char* rule = getenv("DAM_PRESSURE_VISCOSITY_RULE");
+  if (getenv("DAM_PRESSURE_VISCOSITY")) return atof(getenv("DAM_PRESSURE_VISCOSITY"));
+  if (getenv("DAM_PRESSURE_ALPHA"))
+    return kRestDensity * atof(getenv("DAM_PRESSURE_ALPHA")) * c * kernel_radius(step) / 20.0;
+  if (rule && strcmp(rule, "h") == 0) return kViscosity * (step / (kHeight / 16.0)) * (c / kSoundSpeed);
+  return kViscosity;
+}
+
 /* One run's readings against Buchner's, relative (0.01 = 1 % late or high). */
 typedef struct reading {
   double impact, plateau;
@@ -189,8 +217,7 @@ static reading dam_break_pressure(uint32_t features, const char* name, int whole
   if (getenv("DAM_PRESSURE_FEATURES")) features = (uint32_t)strtoul(getenv("DAM_PRESSURE_FEATURES"), NULL, 0);
   def.features = SPH_FEATURE_BOUNDARY_DENSITY | features;
   params.step_limits = SPH_STEP_LIMIT_ACOUSTIC;
-  params.viscosity = 0.05f; /* the Martin & Moyce validation's (tests/support/dam_break.c) */
-  if (getenv("DAM_PRESSURE_VISCOSITY")) params.viscosity = (float)atof(getenv("DAM_PRESSURE_VISCOSITY"));
+  params.viscosity = (float)case_viscosity(step, sqrt(params.stiffness));
   if (getenv("DAM_PRESSURE_STEP_FACTOR"))
     params.step_factor = (float)atof(getenv("DAM_PRESSURE_STEP_FACTOR"));
   EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, &params));
@@ -282,11 +309,12 @@ static reading dam_break_pressure(uint32_t features, const char* name, int whole
           crossing(sim_t, extra_p[0], frames, 0.1), crossing(sim_t, extra_p[1], frames, 0.1));
     if (measuring())
       print_message(
-          "  slab %u layers, viscosity %.4g Pa s: plateau p* by the side wall %.3f; the sensor's kernel sum "
-          "over the plateau %.3f, its velocity (%.3f, %.3f) sqrt(g H)\n",
-          slab, params.viscosity, window_mean(sim_t, side_p, frames, 3.3, 4.5),
-          window_mean(sim_t, wall_fill, frames, 3.3, 4.5), window_mean(sim_t, wall_u, frames, 3.3, 4.5),
-          window_mean(sim_t, wall_v, frames, 3.3, 4.5));
+          "  slab %u layers, viscosity %.4g Pa s (alpha %.4f): plateau p* by the side wall %.3f; the "
+          "sensor's kernel sum over the plateau %.3f, its velocity (%.3f, %.3f) sqrt(g H)\n",
+          slab, params.viscosity,
+          20.0 * params.viscosity / (kRestDensity * sqrt(params.stiffness) * kernel_radius(step)),
+          window_mean(sim_t, side_p, frames, 3.3, 4.5), window_mean(sim_t, wall_fill, frames, 3.3, 4.5),
+          window_mean(sim_t, wall_u, frames, 3.3, 4.5), window_mean(sim_t, wall_v, frames, 3.3, 4.5));
   }
   {
     /* the series of the lattice as built (an ensemble's other draws would overwrite it) */
