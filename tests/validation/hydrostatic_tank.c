@@ -107,6 +107,54 @@ static void open_tank(const tank_case* tc, double gap, support_world* w, sph_sdf
   free(lattice_points);
 }
 
+/* HYDRO_STATS=1: where the particles faster than 0.5 m/s are (a still tank's bursts: which
+ * place throws them, docs/validation.md, "Session 19: deep tanks"). Regions, first match wins:
+ * above the water (more than h over its top layer), a vertical edge (within h of two side
+ * walls), a floor edge (within h of the floor and a side wall), a side wall, the floor, the
+ * surface (within h of the top layer), the bulk. */
+static void report_fast_particles(int frame, uint32_t n, const float* x, const float* v, double width,
+                                  double depth, double h) {
+  enum { kAbove, kEdge, kFloorEdge, kSide, kFloor, kSurface, kBulk, kRegions };
+  static const char* const names[kRegions] = {"above", "vertical edge", "floor edge", "side wall",
+                                              "floor", "surface",       "bulk"};
+  uint32_t count[kRegions] = {0};
+  uint32_t fast = 0, fastest = 0;
+  double top_speed = 0.0;
+  for (uint32_t i = 0; i < n; ++i) {
+    const double speed = sqrt((double)v[3 * i] * v[3 * i] + (double)v[3 * i + 1] * v[3 * i + 1] +
+                              (double)v[3 * i + 2] * v[3 * i + 2]);
+    if (speed > top_speed) {
+      top_speed = speed;
+      fastest = i;
+    }
+    if (speed <= 0.5) continue;
+    ++fast;
+    const double px = x[3 * i], py = x[3 * i + 1], pz = x[3 * i + 2];
+    const int near_x = px < h || px > width - h, near_z = pz < h || pz > width - h;
+    const int walls = near_x + near_z, floor = py < h;
+    int region = kBulk;
+    if (py > depth + h)
+      region = kAbove;
+    else if (walls == 2)
+      region = kEdge;
+    else if (walls == 1 && floor)
+      region = kFloorEdge;
+    else if (walls == 1)
+      region = kSide;
+    else if (floor)
+      region = kFloor;
+    else if (py > depth - h)
+      region = kSurface;
+    ++count[region];
+  }
+  if (fast == 0) return;
+  printf("  frame %d: %u particles over 0.5 m/s:", frame, fast);
+  for (int r = 0; r < kRegions; ++r)
+    if (count[r]) printf(" %s %u", names[r], count[r]);
+  printf("; fastest %.3g m/s at (%.3f, %.3f, %.3f) m moving (%.2f, %.2f, %.2f)\n", top_speed, x[3 * fastest],
+         x[3 * fastest + 1], x[3 * fastest + 2], v[3 * fastest], v[3 * fastest + 1], v[3 * fastest + 2]);
+}
+
 void run_tank(const tank_case* tc) {
   const uint32_t nl = tc->depth_layers;
   const double step = tc->step;
@@ -214,6 +262,12 @@ void run_tank(const tank_case* tc) {
       assert_int_equal(count, n);
       EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_PRESSURE, (void**)&p, &count));
       EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_DENSITY, (void**)&rho, &count));
+      if (getenv("HYDRO_STATS")) {
+        float* v = NULL;
+        EXPECT_OK(support_copy_by_id(world, SPH_ATTRIBUTE_VELOCITY, (void**)&v, &count));
+        report_fast_particles(f + 1, n, x, v, width, depth, h);
+        free(v);
+      }
     }
     /* (the moment's neighbour sums once per 20 ms at most: they are the run's costliest host work) */
     if (moment && f >= window_start && (f - window_start) % (int)(0.02 / frame_dt + 0.5) == 0) {
