@@ -276,7 +276,9 @@ class CpuBackend final : public Backend {
   }
   // The frame's start: the world's max speed, and new slabs when the ranks are out of balance.
   void halo_begin_frame();
-  void reduce_step_inputs();  // the maxima and the height span over the ranks (cpu_halo.cpp)
+  HeightSpan own_height_span() const;  // this rank's span (an empty one where the limit is off)
+  void reduce_step_inputs(
+      const HeightSpan& span);  // the maxima and the height span over the ranks (cpu_halo.cpp)
   // Before the sort: owned particles that left the slab migrate, ghosts arrive; the world's
   // grid shape and this rank's sort order go to halo_shape_ and halo_visit_.
   void halo_gather();

@@ -135,12 +135,18 @@ void CpuBackend::halo_keep(size_t kept) {
 // The next step's inputs over the ranks: the largest speed and acceleration, and with DFSPH's depth
 // limit the world's height span (its lowest point as the largest of -lo), over the owned particles
 // (every particle held between substeps is owned), in one reduction. min and max are exact: every
-// rank takes the undivided world's H, bit for bit.
-void CpuBackend::reduce_step_inputs() {
+// rank takes the undivided world's H, bit for bit. `span` is this rank's own, measured by the caller
+// before the agreement that precedes this call: the measurement allocates (the reduction's
+// partials), and a rank that fails there must meet the others at that agreement, never at this
+// all_max (core/rank_agreement.h).
+CpuBackend::HeightSpan CpuBackend::own_height_span() const {
+  return depth_limit_on() ? measure_height_span() : HeightSpan{};
+}
+
+void CpuBackend::reduce_step_inputs(const HeightSpan& span) {
   float maxima[4] = {max_speed_, max_acceleration_, 0.0f, 0.0f};
   const bool depth = depth_limit_on();
   if (depth) {
-    const HeightSpan span = measure_height_span();
     maxima[2] = -span.lo;
     maxima[3] = span.hi;
   }
@@ -153,8 +159,9 @@ void CpuBackend::reduce_step_inputs() {
 void CpuBackend::halo_begin_frame() {
   const RankTransport& t = *ranks_;
   std::vector<int64_t> held(static_cast<size_t>(t.size()), 0);
+  const HeightSpan span = own_height_span();
   halo_agree();  // (the frame's start: the step's code before it ran on each rank alone)
-  reduce_step_inputs();
+  reduce_step_inputs(span);
   // Particles per rank, and the world's extent in cells (core/slab_rebalance.h).
   if (rebalance_slabs(t, slabs_, slabs_cut_, distributed_options_.rebalance_threshold, count_,
                       1.0f / config_.kernel_radius, held, [this](uint32_t i) { return position_[i]; })) {
@@ -287,8 +294,9 @@ uint32_t CpuBackend::halo_end_substep(uint32_t bad_id) {
   halo_keep(keep_order_.size());
   const RankTransport& t = *ranks_;
   int64_t bad = bad_id;
+  const HeightSpan span = own_height_span();
   agree(t, &bad);  // (the force and integration passes)
-  reduce_step_inputs();
+  reduce_step_inputs(span);
   if (bad != static_cast<int64_t>(kAllFinite) && bad_id == kAllFinite) {
     // Another rank's particle: that rank's message classifies it.
     non_finite_ = NonFiniteFailure{};
