@@ -971,7 +971,7 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_world_params (48 bytes)</summary>
+    /// <summary>sph_world_params (52 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct WorldParams
     {
@@ -1004,6 +1004,14 @@ namespace Sph
         public uint StepLimits;
         /// <summary>uint32_t reserved0: must be 0</summary>
         public uint Reserved0;
+        /// <summary>
+        /// float tension_ratio: (0.2.0) tau, dimensionless: the equation of state (both laws) holds
+        /// down to (1 - tau) rho0 and keeps its value there below it, a bounded tension (-k tau rho0
+        /// for the ideal gas); default 0, the clamp at zero below rho0; in [0, 0.125]; 0 is the clamp.
+        /// A small tau lets a disturbed fluid pull back instead of swelling; a larger one acts as a
+        /// cohesion at free surfaces (docs/physics.md, Equation of state). No effect with DFSPH
+        /// </summary>
+        public float TensionRatio;
 
         /// <summary>A WorldParams with the library's defaults (sph_world_params_init_sized).</summary>
         public static WorldParams Default()
@@ -3692,7 +3700,7 @@ namespace Sph
             12,
             104,
             48,
-            48,
+            52,
             16,
             16,
             8,
@@ -3767,6 +3775,7 @@ namespace Sph
             typeof(WorldDef),
             typeof(WorldDef),
             typeof(WorldDef),
+            typeof(WorldParams),
             typeof(WorldParams),
             typeof(WorldParams),
             typeof(WorldParams),
@@ -4059,6 +4068,7 @@ namespace Sph
             "DtMax",
             "StepLimits",
             "Reserved0",
+            "TensionRatio",
             "StructSize",
             "Coefficient",
             "NormalThreshold",
@@ -4341,6 +4351,7 @@ namespace Sph
             36,
             40,
             44,
+            48,
             0,
             4,
             8,
