@@ -476,8 +476,16 @@ typedef struct sph_world_params {
   float dt_max;          /* s; default 1e-3; >= dt_min (after defaults); 0 = default */
   uint32_t step_limits;  /* SPH_STEP_LIMIT_* bits; default 0 (eq. 32 alone) */
   uint32_t reserved0;    /* must be 0 */
+  float tension_ratio;   /* (0.2.0) tau, dimensionless: the equation of state (both laws) holds down to
+                            (1 - tau) rho0 and keeps its value there below it, a bounded tension
+                            (-k tau rho0 for the ideal gas); default 0, the clamp at zero below
+                            rho0; in [0, 0.125]; 0 is the clamp. It lets a disturbed fluid pull
+                            back instead of swelling. Use it with SPH_FEATURE_NORMALIZED_DENSITY:
+                            with the plain summation density every free-surface particle sits below
+                            the floor and takes the whole tension, and the surface clumps and sheds
+                            (docs/physics.md, "The equation of state's floor"). No effect with DFSPH */
 } sph_world_params;
-SPH_STATIC_ASSERT(sizeof(sph_world_params) == 48, sph_world_params_size);
+SPH_STATIC_ASSERT(sizeof(sph_world_params) == 52, sph_world_params_size);
 
 SPH_API sph_result SPH_CALL sph_world_params_init_sized(sph_world_params* params, uint32_t size);
 static inline sph_result sph_world_params_init(sph_world_params* params) {

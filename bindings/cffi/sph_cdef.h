@@ -275,6 +275,7 @@ typedef struct sph_world_params {
   float dt_max;
   uint32_t step_limits;
   uint32_t reserved0;
+  float tension_ratio;
 } sph_world_params;
 typedef struct sph_surface_tension_params {
   uint32_t struct_size;

@@ -971,7 +971,7 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_world_params (48 bytes)</summary>
+    /// <summary>sph_world_params (52 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct WorldParams
     {
@@ -1004,6 +1004,16 @@ namespace Sph
         public uint StepLimits;
         /// <summary>uint32_t reserved0: must be 0</summary>
         public uint Reserved0;
+        /// <summary>
+        /// float tension_ratio: (0.2.0) tau, dimensionless: the equation of state (both laws) holds
+        /// down to (1 - tau) rho0 and keeps its value there below it, a bounded tension (-k tau rho0
+        /// for the ideal gas); default 0, the clamp at zero below rho0; in [0, 0.125]; 0 is the clamp.
+        /// It lets a disturbed fluid pull back instead of swelling. Use it with
+        /// SPH_FEATURE_NORMALIZED_DENSITY: with the plain summation density every free-surface particle
+        /// sits below the floor and takes the whole tension, and the surface clumps and sheds
+        /// (docs/physics.md, "The equation of state's floor"). No effect with DFSPH
+        /// </summary>
+        public float TensionRatio;
 
         /// <summary>A WorldParams with the library's defaults (sph_world_params_init_sized).</summary>
         public static WorldParams Default()
@@ -3692,7 +3702,7 @@ namespace Sph
             12,
             104,
             48,
-            48,
+            52,
             16,
             16,
             8,
@@ -3767,6 +3777,7 @@ namespace Sph
             typeof(WorldDef),
             typeof(WorldDef),
             typeof(WorldDef),
+            typeof(WorldParams),
             typeof(WorldParams),
             typeof(WorldParams),
             typeof(WorldParams),
@@ -4059,6 +4070,7 @@ namespace Sph
             "DtMax",
             "StepLimits",
             "Reserved0",
+            "TensionRatio",
             "StructSize",
             "Coefficient",
             "NormalThreshold",
@@ -4341,6 +4353,7 @@ namespace Sph
             36,
             40,
             44,
+            48,
             0,
             4,
             8,

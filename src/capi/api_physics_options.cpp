@@ -28,13 +28,15 @@ const std::vector<ParamsBinding>& params_bindings() {
           "world",
           "sph_world_params",
           sizeof(sph_world_params),
+          kFirstStructSize<sph_world_params>,
           nullptr,
           nullptr,
           {part<Stepping>({SPH_AT(sph_world_params, max_substeps), SPH_AT(sph_world_params, gravity),
                            SPH_AT(sph_world_params, step_factor), SPH_AT(sph_world_params, dt_min),
                            SPH_AT(sph_world_params, dt_max), SPH_AT(sph_world_params, step_limits)}),
            part<IdealGasEos>({SPH_AT(sph_world_params, stiffness)}),
-           part<MuellerViscosity>({SPH_AT(sph_world_params, viscosity)})},
+           part<MuellerViscosity>({SPH_AT(sph_world_params, viscosity)}),
+           part<WeaklyCompressible>({SPH_AT(sph_world_params, tension_ratio)})},
           {{"reserved0", SPH_AT(sph_world_params, reserved0)}}},
       option<SurfaceTension, sph_surface_tension_params>(
           SPH_PARAMS_SURFACE_TENSION, "sph_surface_tension_params", "SPH_FEATURE_SURFACE_TENSION",
@@ -86,12 +88,12 @@ sph_result init_params(const char* function, sph_params_kind kind, void* user, u
     const sph::ParamsBinding& b = sph::params_binding(kind, "kind");
     if (!user) throw Error(Status::InvalidArgument, "params: is NULL");
     sph::require_plausible_struct_size(size, "params", ": size ");  // before `size` bytes are cleared
-    if (size < b.size)
-      throw Error(Status::VersionMismatch,
-                  "params: size " + std::to_string(size) + " is smaller than " + std::to_string(b.size));
+    if (size < b.first_size)
+      throw Error(Status::VersionMismatch, "params: size " + std::to_string(size) + " is smaller than " +
+                                               std::to_string(b.first_size));
     const sph::PublicParams defaults = sph::public_params(b, sph::RuntimeParams{});
     std::memset(user, 0, size);
-    std::memcpy(user, defaults.bytes, b.size);
+    std::memcpy(user, defaults.bytes, size < b.size ? size : b.size);  // an older caller's prefix
     std::memcpy(user, &size, sizeof size);
     return SPH_OK;
   });

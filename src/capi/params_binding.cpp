@@ -60,9 +60,9 @@ PublicParams read_public_params(const ParamsBinding& b, const void* user, const 
   uint32_t size;
   std::memcpy(&size, user, sizeof size);
   require_plausible_struct_size(size, name, "->struct_size: ");  // before its tail is read
-  if (size < b.size)
+  if (size < b.first_size)
     throw Error(Status::VersionMismatch, std::string(name) + "->struct_size: " + std::to_string(size) +
-                                             " is smaller than " + std::to_string(b.size) +
+                                             " is smaller than " + std::to_string(b.first_size) +
                                              "; fill the struct with its _init() function");
   const unsigned char* bytes = static_cast<const unsigned char*>(user);
   for (uint32_t i = b.size; i < size; ++i)
@@ -70,8 +70,8 @@ PublicParams read_public_params(const ParamsBinding& b, const void* user, const 
       throw Error(Status::Unsupported,
                   std::string(name) + "->struct_size: " + std::to_string(size) +
                       " has fields this library version does not know, and they are not zero");
-  PublicParams copy{};
-  std::memcpy(copy.bytes, bytes, b.size);
+  PublicParams copy{};  // an older caller's struct: the fields it lacks read as zero (the old behaviour)
+  std::memcpy(copy.bytes, bytes, size < b.size ? size : b.size);
   for (const ReservedWord& w : b.reserved) {
     uint32_t v;
     std::memcpy(&v, copy.bytes + w.offset, sizeof v);

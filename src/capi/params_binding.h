@@ -16,6 +16,7 @@
 #include "../core/config.h"
 #include "../core/param_validation.h"
 #include "sph_c.h"
+#include "struct_io.h"
 
 namespace sph {
 
@@ -39,6 +40,7 @@ struct ParamsBinding {
   const char* name;       // "tait": the scene file's key
   const char* type_name;  // "sph_tait_params"
   uint32_t size;          // sizeof the public struct
+  uint32_t first_size;    // its size in the first release that had it (struct_io.h, kFirstStructSize)
   // The method whose switch must be on for the struct to be used (FEATURE_DISABLED otherwise,
   // naming `requirement`); null for the world's own parameters.
   bool (*enabled)(const MethodSelection&);
@@ -126,9 +128,15 @@ bool method_runs(const MethodSelection& s) {
 template <class Method, class Public, size_t N>
 ParamsBinding option(sph_params_kind kind, const char* type_name, const char* requirement,
                      const uint32_t (&offsets)[N], std::vector<ReservedWord> reserved) {
-  return ParamsBinding{
-      kind,        Method::kName,           type_name,          sizeof(Public), &method_runs<Method>,
-      requirement, {part<Method>(offsets)}, std::move(reserved)};
+  return ParamsBinding{kind,
+                       Method::kName,
+                       type_name,
+                       sizeof(Public),
+                       kFirstStructSize<Public>,
+                       &method_runs<Method>,
+                       requirement,
+                       {part<Method>(offsets)},
+                       std::move(reserved)};
 }
 
 // The table (api_physics_options.cpp), indexed by sph_params_kind.
@@ -144,7 +152,8 @@ struct PublicParams {
 };
 
 // The caller's struct (struct_size rules of struct_io.h) as bytes of the library's size, its
-// reserved words checked.
+// reserved words checked: a struct from an older header (first_size up to size) reads the fields
+// it lacks as zero.
 PublicParams read_public_params(const ParamsBinding& b, const void* user, const char* name);
 // Public bytes into the runtime parameters: fields copied with the zero rule, then validated
 // (InvalidArgument / Unsupported with "name->field" messages). Changes only `into`.

@@ -31,6 +31,8 @@ template <>
 inline constexpr uint32_t kFirstStructSize<sph_world_def> =
     40;  // 0.1.0; 0.2.0 adds the solver, then max_capacity (44 and 48)
 template <>
+inline constexpr uint32_t kFirstStructSize<sph_world_params> = 48;  // 0.1.0; 0.2.0 adds tension_ratio (52)
+template <>
 inline constexpr uint32_t kFirstStructSize<sph_stats> =
     104;  // 0.1.0; 0.2.0 adds DFSPH's solves, then the capacity (144 and 160)
 

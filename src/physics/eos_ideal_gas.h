@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
-// The thesis's modified ideal-gas law (eq. 15, Desbrun & Cani): p = k (rho - rho0), clamped at
-// zero below rest density (methods.h, pressure_from_density, says why). k is the squared numerical speed of
+// The thesis's modified ideal-gas law (eq. 15, Desbrun & Cani): p = k (rho - rho0), held at its
+// value at (1 - tau) rho0 below that density (tau = sph_world_params.tension_ratio, default 0: the
+// clamp at zero; methods.h, pressure_from_density, says why). k is the squared numerical speed of
 // sound. Its parameter is sph_world_params.stiffness.
 #pragma once
 
@@ -26,7 +27,7 @@ struct IdealGasEos {
   };
   static Constants make_constants(const Params& p) { return Constants{p.stiffness}; }
 
-  // excess = rho - rho0 > 0.
+  // excess = rho - rho0 >= -tau rho0 (negative: a tension).
   SPH_HD static float pressure(const Constants& c, float excess) { return c.stiffness * excess; }
   SPH_HD static float squared_sound_speed(const Constants& c) { return c.stiffness; }
 };

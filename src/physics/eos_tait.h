@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Tait's law (gamma = 7) from a chosen speed of sound c: p = B ((rho / rho0)^7 - 1),
-// B = rho0 c^2 / 7, clamped at zero below rest density (methods.h, pressure_from_density, says why).
+// B = rho0 c^2 / 7, held at its value at (1 - tau) rho0 below that density (tau =
+// sph_world_params.tension_ratio, default 0: the clamp at zero; methods.h, pressure_from_density,
+// says why).
 #pragma once
 
 #include "host_device.h"
@@ -27,7 +29,7 @@ struct TaitEos {
     return Constants{s.rest_density * p.speed_of_sound * p.speed_of_sound / 7.0f};
   }
 
-  // density > rest_density.
+  // density >= (1 - tau) rest_density (below rest_density: a tension).
   SPH_HD static float pressure(const Constants& c, float density, float rest_density) {
     const float r = density / rest_density;
     const float r2 = r * r;

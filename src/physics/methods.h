@@ -54,21 +54,28 @@ enum class Solver : uint32_t { WeaklyCompressible = 0, Dfsph = 1 };
 
 struct EosConstants {
   EquationOfState kind;
-  float rest_density;  // rho0
+  float rest_density;   // rho0
+  float tension_floor;  // (1 - tau) rho0: the law holds down to it (WeaklyCompressible::tension_floor)
   IdealGasEos::Constants ideal_gas;
   TaitEos::Constants tait;
 };
 
-// Both laws are clamped at zero below rest density. Particles at a free surface miss
-// neighbours, so their summed density is low; an unclamped law turns that deficit into a
-// strong tension that pulls surface particles into clumps and flings them off (the tensile
-// instability). Clamping is the usual weakly-compressible SPH treatment: the fluid resists
-// compression and the free surface is left alone (cohesion belongs to surface tension).
+// Both laws are held at their value at the tension floor (1 - tau) rho0 below it, tau the
+// world's tension_ratio (sph_world_params; default 0, the floor at rho0: the clamp at zero).
+// Why a floor: particles at a free surface miss neighbours, so their summed density is low; an
+// unbounded law turns that deficit into a strong tension that pulls surface particles into
+// clumps and flings them off (the tensile instability). The clamp at zero is the usual
+// weakly-compressible SPH treatment: the fluid resists compression and the free surface is left
+// alone (cohesion belongs to surface tension). Its cost: a fluid that cannot pull swells at no
+// cost wherever it is disturbed (the rest sphere's interior 2.7 % below rho0), and the pressure
+// noise at a wall is rectified into a positive mean (docs/validation.md, session 21). A small tau
+// lets the law pull a little, down to p((1 - tau) rho0) = -k tau rho0 for the ideal gas, while
+// the surface, tau and more below rho0, is held at that bounded tension (docs/physics.md).
+// A NaN density stays NaN (the comparison is false), so the non-finite diagnosis still sees it.
 SPH_HD float pressure_from_density(const EosConstants& e, float density) {
-  const float excess = density - e.rest_density;
-  if (excess <= 0.0f) return 0.0f;
-  if (e.kind == EquationOfState::Tait) return TaitEos::pressure(e.tait, density, e.rest_density);
-  return IdealGasEos::pressure(e.ideal_gas, excess);
+  const float rho = density < e.tension_floor ? e.tension_floor : density;
+  if (e.kind == EquationOfState::Tait) return TaitEos::pressure(e.tait, rho, e.rest_density);
+  return IdealGasEos::pressure(e.ideal_gas, rho - e.rest_density);
 }
 
 // The numerical speed of sound of the law at rest density (for the acoustic step limit).
@@ -177,6 +184,7 @@ struct MethodParams {
   Springs::Params springs;
   Dfsph::Params dfsph;
   DensityDiffusion::Params density_diffusion;
+  WeaklyCompressible::Params wcsph;
 };
 
 // Calls visit(Tag<Method>{}, params) for each method with parameters, in the list's order (the
@@ -190,7 +198,8 @@ void for_each_method_params(Params& p, Visit&& visit) {
   visit(Tag<SurfaceTension>{}, p.surface_tension);
   visit(Tag<Springs>{}, p.springs);
   visit(Tag<Dfsph>{}, p.dfsph);
-  visit(Tag<DensityDiffusion>{}, p.density_diffusion);  // last: checkpoints before it lack its block
+  visit(Tag<DensityDiffusion>{}, p.density_diffusion);  // checkpoints before format 4 lack its block
+  visit(Tag<WeaklyCompressible>{}, p.wcsph);            // last: checkpoints before format 11 lack its block
 }
 
 // ---- constants: derived per frame from the Params and the world's shape ---------------------
@@ -211,6 +220,7 @@ inline EosConstants make_eos_constants(const MethodParams& p, const MethodSelect
   EosConstants e;
   e.kind = s.equation_of_state;
   e.rest_density = shape.rest_density;
+  e.tension_floor = WeaklyCompressible::tension_floor(p.wcsph, shape);
   e.ideal_gas = IdealGasEos::make_constants(p.ideal_gas);
   e.tait = TaitEos::make_constants(p.tait, shape);
   return e;

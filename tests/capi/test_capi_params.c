@@ -120,6 +120,7 @@ static void test_zeroed_structs_take_the_documented_values(void** state) {
   assert_true(w.dt_max == 1e-3f);
   assert_int_equal(w.step_limits, 0);
   assert_int_equal(w.reserved0, 0);
+  assert_true(w.tension_ratio == 0.0f); /* the clamp at zero below rho0 */
 
   memset(&st, 0, sizeof st);
   st.struct_size = sizeof st;
@@ -257,6 +258,8 @@ static void test_each_rule_fires_with_its_message(void** state) {
        "params->dt_max: 1e-07 is smaller than params->dt_min 1e-06"},
       {SPH_PARAMS_WORLD, offsetof(sph_world_params, gravity.y), NAN, SPH_ERROR_INVALID_ARGUMENT,
        "params->gravity: has a non-finite component"},
+      {SPH_PARAMS_WORLD, offsetof(sph_world_params, tension_ratio), 0.25f, SPH_ERROR_INVALID_ARGUMENT,
+       "params->tension_ratio: must be in [0, 0.125], got 0.25"},
       {SPH_PARAMS_SURFACE_TENSION, offsetof(sph_surface_tension_params, coefficient), -1.0f,
        SPH_ERROR_INVALID_ARGUMENT, "params->coefficient: must be >= 0, got -1"},
       {SPH_PARAMS_SURFACE_TENSION, offsetof(sph_surface_tension_params, normal_threshold), -2.0f,
@@ -441,6 +444,8 @@ static void test_descriptions_match_the_header(void** state) {
        SPH_PARAM_ZERO_IS_DEFAULT},
       {SPH_PARAMS_WORLD, "step_limits", offsetof(sph_world_params, step_limits), SPH_PARAM_FLAGS,
        SPH_PARAM_ZERO_IS_VALUE},
+      {SPH_PARAMS_WORLD, "tension_ratio", offsetof(sph_world_params, tension_ratio), SPH_PARAM_FLOAT,
+       SPH_PARAM_ZERO_IS_VALUE},
       {SPH_PARAMS_SURFACE_TENSION, "coefficient", offsetof(sph_surface_tension_params, coefficient),
        SPH_PARAM_FLOAT, SPH_PARAM_ZERO_IS_VALUE},
       {SPH_PARAMS_SURFACE_TENSION, "normal_threshold", offsetof(sph_surface_tension_params, normal_threshold),
@@ -485,7 +490,7 @@ static void test_descriptions_match_the_header(void** state) {
     const char* type_name;
     uint32_t size, fields;
   } kinds[SPH_PARAMS_KIND_COUNT] = {
-      {"world", "sph_world_params", sizeof(sph_world_params), 8},
+      {"world", "sph_world_params", sizeof(sph_world_params), 9},
       {"surface_tension", "sph_surface_tension_params", sizeof(sph_surface_tension_params), 2},
       {"clavet", "sph_clavet_viscosity_params", sizeof(sph_clavet_viscosity_params), 2},
       {"tait", "sph_tait_params", sizeof(sph_tait_params), 1},
@@ -525,6 +530,10 @@ static void test_descriptions_match_the_header(void** state) {
               field.upper_bound == SPH_BOUND_INCLUSIVE && field.default_value[0] == 0.4f);
   EXPECT_OK(sph_params_get_field_info(SPH_PARAMS_WORLD, 7, &field));
   assert_true(field.upper == (double)(SPH_STEP_LIMIT_ACOUSTIC | SPH_STEP_LIMIT_FORCE));
+  EXPECT_OK(sph_params_get_field_info(SPH_PARAMS_WORLD, 8, &field));
+  assert_true(field.lower == 0.0 && field.lower_bound == SPH_BOUND_INCLUSIVE && field.upper == 0.125 &&
+              field.upper_bound == SPH_BOUND_INCLUSIVE && field.default_value[0] == 0.0f);
+  assert_string_equal(field.unit, "");
   EXPECT_OK(sph_params_get_field_info(SPH_PARAMS_SPRINGS, 2, &field));
   assert_true(field.lower == 0.0 && field.upper == 1.0 && field.default_value[0] == 0.1f);
   /* Bad queries. */
@@ -548,7 +557,7 @@ static void test_methods_are_listed_with_their_switches(void** state) {
        SPH_PARAMS_SURFACE_TENSION},
       {"normalized_density", SPH_METHOD_SWITCH_FEATURE, SPH_FEATURE_NORMALIZED_DENSITY, 0, SPH_PARAMS_WORLD},
       {"springs", SPH_METHOD_SWITCH_FEATURE, SPH_FEATURE_SPRINGS, 1, SPH_PARAMS_SPRINGS},
-      {"wcsph", SPH_METHOD_SWITCH_SOLVER, SPH_SOLVER_WCSPH, 0, SPH_PARAMS_WORLD},
+      {"wcsph", SPH_METHOD_SWITCH_SOLVER, SPH_SOLVER_WCSPH, 1, SPH_PARAMS_WORLD}, /* tension_ratio */
       {"dfsph", SPH_METHOD_SWITCH_SOLVER, SPH_SOLVER_DFSPH, 1, SPH_PARAMS_DFSPH},
       {"boundary_density", SPH_METHOD_SWITCH_FEATURE, SPH_FEATURE_BOUNDARY_DENSITY, 0, SPH_PARAMS_WORLD},
       {"collider_loads", SPH_METHOD_SWITCH_FEATURE, SPH_FEATURE_COLLIDER_LOADS, 0, SPH_PARAMS_WORLD},

@@ -48,7 +48,7 @@ const Case kCases[] = {
     {R"({"params": {"surface_tension": 0.07}})",
      "params.surface_tension: unknown field; params takes max_substeps, gravity, stiffness, viscosity, "
      "step_factor, "
-     "dt_min, dt_max, step_limits"},
+     "dt_min, dt_max, step_limits, tension_ratio"},
     {R"({"world": {"features": ["surface_tension", "foam"]}})",
      "world.features[1]: expected \"surface_tension\", \"normalized_density\", \"springs\", "
      "\"boundary_density\", \"collider_loads\" or \"density_diffusion\", got the string \"foam\""},

@@ -26,7 +26,9 @@
  * DAM_PRESSURE_SLAB=layers (the slab's thickness, default 4), DAM_PRESSURE_VISCOSITY=Pa s (default
  * 0.05), DAM_PRESSURE_ALPHA=alpha and DAM_PRESSURE_VISCOSITY_RULE=h (a viscosity in proportion to h:
  * case_viscosity), DAM_PRESSURE_STEP_FACTOR=lambda (the acoustic limit's factor, default the
- * library's 0.4). */
+ * library's 0.4), DAM_PRESSURE_TENSION=tau (sph_world_params.tension_ratio, the equation of
+ * state's bounded tension; default 0, the clamp; docs/validation.md, "Session 21: a bounded
+ * tension"). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -220,6 +222,7 @@ static reading dam_break_pressure(uint32_t features, const char* name, int whole
   params.viscosity = (float)case_viscosity(step, sqrt(params.stiffness));
   if (getenv("DAM_PRESSURE_STEP_FACTOR"))
     params.step_factor = (float)atof(getenv("DAM_PRESSURE_STEP_FACTOR"));
+  if (getenv("DAM_PRESSURE_TENSION")) params.tension_ratio = (float)atof(getenv("DAM_PRESSURE_TENSION"));
   EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, &params));
   scene_tait(w.world, &def);
   EXPECT_OK(support_tank_between(w.context, w.world, tank_min, tank_max, 0.5 * step, 0.0f, &sdf, NULL));

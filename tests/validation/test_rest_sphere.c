@@ -3,7 +3,7 @@
  * at rest density, no gravity, no colliders, water defaults, the default kernel radius, 100
  * frames at 25 frames/s with dt_max = 1 ms.
  *
- * Three runs (argv[1]):
+ * Runs (argv[1]):
  * - rest: the issue's case, the benchmark's sphere as specified: zero start velocity. Every
  *   bound below applies. It fails if the density sum is miscalibrated (the interior would not
  *   sit at rho0), if the free surface is unstable (an EOS with tension flings surface particles
@@ -16,6 +16,8 @@
  *   about 2.4 % below rho0, while its kinetic energy decays. That is the model (a fluid without
  *   cohesion), not a numerical fault; BENCHMARK.md's "moving" run at +-0.1 m/s disperses the
  *   ball outright (radius +17 % in 0.4 s), as a drop without surface tension would.
+ * - disturbed_tension: the disturbed run with the density bounds, a bounded tension
+ *   (tension_ratio 0.005) and the normalised density: it holds rho0 within 0.1 % (below).
  *
  * Bounds (the issue's), and why they are the right ones:
  * - interior density (particles more than 2 h inside the surface, where the kernel sees a full
@@ -44,6 +46,9 @@ typedef struct sphere_case {
   int check_density;    /* assert the interior density bounds */
   sph_solver solver;    /* 0: the weakly compressible scheme */
   uint32_t dfsph_flags; /* sph_dfsph_params.flags (SPH_DFSPH_CORRECTED_GRADIENT) */
+  float tension_ratio;  /* sph_world_params.tension_ratio; REST_SPHERE_TENSION overrides it (a
+                           measurement switch) */
+  uint32_t features;    /* sph_world_def.features */
 } sphere_case;
 
 static void run_sphere(const sphere_case* sc) {
@@ -65,7 +70,15 @@ static void run_sphere(const sphere_case* sc) {
   def.particle_spacing = spacing;
   def.capacity = 0; /* the ball's particles */
   def.solver = sc->solver;
+  def.features = sc->features;
+  /* A measurement switch: the Shepard-normalised density, whose surface particles read about rho0
+   * instead of a kernel's missing share below it (docs/validation.md, session 21). */
+  if (getenv("REST_SPHERE_NORMALIZED") && atoi(getenv("REST_SPHERE_NORMALIZED")))
+    def.features |= SPH_FEATURE_NORMALIZED_DENSITY;
   EXPECT_OK(support_params_gravity_and_steps(&params, 0.0f, 0.0f, 0.0f, 1e-6f, 1e-3f));
+  params.tension_ratio =
+      getenv("REST_SPHERE_TENSION") ? (float)atof(getenv("REST_SPHERE_TENSION")) : sc->tension_ratio;
+  if (params.tension_ratio != 0.0f) printf("tension_ratio %g\n", (double)params.tension_ratio);
   ball.radius = radius;
   ball.speed = disturbance;
   EXPECT_OK(support_rest_sphere_open(&w, sph_test_backend(), &def, &params, &ball, &n));
@@ -175,6 +188,13 @@ static void run_sphere(const sphere_case* sc) {
     assert_true(worst_mean <= 0.01);
     assert_true(worst_particle <= 0.02);
   }
+  if (sc->check_density && sc->tension_ratio > 0.0f) {
+    /* A fluid that pulls as it pushes answers a 1 mm/s disturbance with acoustic density
+     * fluctuations, about v / c = 1e-4 of rho0 (c = 10 m/s); 0.1 % is ten times that, and below the
+     * normalised density's own 0.43 % without a tension (a fluid that only pushes swells). */
+    assert_true(worst_mean <= 0.001);
+    assert_true(worst_particle <= 0.001);
+  }
   assert_true(worst_radius <= 0.02);
   if (disturbance > 0.0) {
     /* Decaying: below the start, and the second half's peak below the first half's. */
@@ -193,50 +213,65 @@ static void run_sphere(const sphere_case* sc) {
 }
 
 static void test_rest(void** state) {
-  const sphere_case sc = {"rest", 0.0, 1, SPH_SOLVER_WCSPH, 0u};
+  const sphere_case sc = {"rest", 0.0, 1, SPH_SOLVER_WCSPH, 0u, 0.0f, 0u};
   (void)state;
   run_sphere(&sc);
 }
 
 static void test_disturbed(void** state) {
-  const sphere_case sc = {"disturbed", 1e-3, 0, SPH_SOLVER_WCSPH, 0u};
+  const sphere_case sc = {"disturbed", 1e-3, 0, SPH_SOLVER_WCSPH, 0u, 0.0f, 0u};
   (void)state;
   run_sphere(&sc);
 }
 
 static void test_disturbed_density(void** state) {
-  const sphere_case sc = {"disturbed_density", 1e-3, 1, SPH_SOLVER_WCSPH, 0u};
+  const sphere_case sc = {"disturbed_density", 1e-3, 1, SPH_SOLVER_WCSPH, 0u, 0.0f, 0u};
+  (void)state;
+  run_sphere(&sc);
+}
+
+/* The known issue's run with a bounded tension (sph_world_params.tension_ratio, 0.005) and the
+ * normalised density, whose free surface reads about rho0: the interior stays at rho0 (measured
+ * 0.000 % mean, 0.001 % worst; docs/validation.md, "Session 21: a bounded tension"). With the plain
+ * summation density a tension cannot be used here: every surface particle sits far below the
+ * floor and takes the whole tension, and the ball sheds even at rest (tau 0.0005: radius +1.7 %). */
+static void test_disturbed_tension(void** state) {
+  const sphere_case sc = {"disturbed_tension",           1e-3, 1, SPH_SOLVER_WCSPH, 0u, 0.005f,
+                          SPH_FEATURE_NORMALIZED_DENSITY};
   (void)state;
   run_sphere(&sc);
 }
 
 /* DFSPH (issue 16 item 4): the same sphere and bounds with the incompressible solver. */
 static void test_dfsph_rest(void** state) {
-  const sphere_case sc = {"dfsph_rest", 0.0, 1, SPH_SOLVER_DFSPH, 0u};
+  const sphere_case sc = {"dfsph_rest", 0.0, 1, SPH_SOLVER_DFSPH, 0u, 0.0f, 0u};
   (void)state;
   run_sphere(&sc);
 }
 
 /* The same with DFSPH's corrected gradient (SPH_DFSPH_CORRECTED_GRADIENT). */
 static void test_dfsph_rest_corrected(void** state) {
-  const sphere_case sc = {"dfsph_rest_corrected", 0.0, 1, SPH_SOLVER_DFSPH, SPH_DFSPH_CORRECTED_GRADIENT};
+  const sphere_case sc = {"dfsph_rest_corrected",       0.0,  1, SPH_SOLVER_DFSPH,
+                          SPH_DFSPH_CORRECTED_GRADIENT, 0.0f, 0u};
   (void)state;
   run_sphere(&sc);
 }
 
 static void test_dfsph_disturbed(void** state) {
-  const sphere_case sc = {"dfsph_disturbed", 1e-3, 1, SPH_SOLVER_DFSPH, 0u};
+  const sphere_case sc = {"dfsph_disturbed", 1e-3, 1, SPH_SOLVER_DFSPH, 0u, 0.0f, 0u};
   (void)state;
   run_sphere(&sc);
 }
 
-/* argv[1] picks one run (rest | disturbed | disturbed_density | dfsph_rest | dfsph_rest_corrected |
+/* argv[1] picks one run (rest | disturbed | disturbed_density | disturbed_tension | dfsph_rest |
+ * dfsph_rest_corrected |
  * dfsph_disturbed);
  * none runs rest and disturbed. */
 int main(int argc, char** argv) {
   const struct CMUnitTest rest[] = {cmocka_unit_test(test_rest)};
   const struct CMUnitTest disturbed[] = {cmocka_unit_test(test_disturbed)};
   const struct CMUnitTest disturbed_density[] = {cmocka_unit_test(test_disturbed_density)};
+  const struct CMUnitTest disturbed_tension[] = {cmocka_unit_test(test_disturbed_tension)};
   const struct CMUnitTest dfsph_rest[] = {cmocka_unit_test(test_dfsph_rest)};
   const struct CMUnitTest dfsph_disturbed[] = {cmocka_unit_test(test_dfsph_disturbed)};
   const struct CMUnitTest dfsph_rest_corrected[] = {cmocka_unit_test(test_dfsph_rest_corrected)};
@@ -251,6 +286,8 @@ int main(int argc, char** argv) {
     failed += cmocka_run_group_tests_name("rest_sphere", rest, NULL, NULL);
   if (argc < 2 || strcmp(argv[1], "disturbed") == 0)
     failed += cmocka_run_group_tests_name("rest_sphere_disturbed", disturbed, NULL, NULL);
+  if (argc >= 2 && strcmp(argv[1], "disturbed_tension") == 0)
+    failed += cmocka_run_group_tests_name("rest_sphere_disturbed_tension", disturbed_tension, NULL, NULL);
   if (argc >= 2 && strcmp(argv[1], "disturbed_density") == 0)
     failed += cmocka_run_group_tests_name("rest_sphere_disturbed_density", disturbed_density, NULL, NULL);
   return failed;

@@ -30,7 +30,8 @@ COUNT = {"type": "integer", "minimum": 0, "maximum": 4294967295}
 
 # The params structs, by scene-file key (sph_params_get_info's name): field -> kind.
 WORLD_PARAMS = {"max_substeps": "uint", "gravity": "vec3", "stiffness": "float", "viscosity": "float",
-                "step_factor": "float", "dt_min": "float", "dt_max": "float", "step_limits": "uint"}
+                "step_factor": "float", "dt_min": "float", "dt_max": "float", "step_limits": "uint",
+                "tension_ratio": "float"}
 PHYSICS_PARAMS = {
     "surface_tension": {"coefficient": "float", "normal_threshold": "float"},
     "clavet": {"linear": "float", "quadratic": "float"},

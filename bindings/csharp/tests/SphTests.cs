@@ -570,7 +570,9 @@ static class Tests
         AssertEqual("tait", Utf8.FromNative(Library.ParamsInfo(ParamsKind.Tait).Name), "params name");
         AssertEqual((uint)Marshal.SizeOf(typeof(SpringParams)), Library.ParamsInfo(ParamsKind.Springs).ParamsSize, "size");
         ParamFieldInfo[] fields = Library.ParamFields(ParamsKind.World);
-        AssertEqual(8, fields.Length, "sph_world_params fields");
+        AssertEqual(9, fields.Length, "sph_world_params fields");
+        AssertEqual("tension_ratio", Utf8.FromNative(fields[8].Name), "the last field");
+        AssertEqual(ParamZero.Value, fields[8].Zero, "tension_ratio: 0 is the clamp");
         AssertEqual("gravity", Utf8.FromNative(fields[1].Name), "second field");
         AssertEqual(ParamZero.Value, fields[1].Zero, "gravity: 0 is no gravity");
         AssertEqual(-9.81f, fields[1].DefaultValue.E1, "gravity default y");

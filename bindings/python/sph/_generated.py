@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'e596775ad10a31906eb5fed6202dbfbd3ae2d0eced4c11f2fa462cb2f31eb9f1', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': 'cafc781b713400aeaed918ec487b4817a0bea6096d1b4b8a27226d66a11319e1', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -939,6 +939,7 @@ class WorldParams(_SphStruct):
         dt_max (float): s; default 1e-3; >= dt_min (after defaults); 0 = default
         step_limits (uint32_t): SPH_STEP_LIMIT_* bits; default 0 (eq. 32 alone)
         reserved0 (uint32_t): must be 0
+        tension_ratio (float): (0.2.0) tau, dimensionless: the equation of state (both laws) holds down to (1 - tau) rho0 and keeps its value there below it, a bounded tension (-k tau rho0 for the ideal gas); default 0, the clamp at zero below rho0; in [0, 0.125]; 0 is the clamp. It lets a disturbed fluid pull back instead of swelling. Use it with SPH_FEATURE_NORMALIZED_DENSITY: with the plain summation density every free-surface particle sits below the floor and takes the whole tension, and the surface clumps and sheds (docs/physics.md, "The equation of state's floor"). No effect with DFSPH
     """
     _fields_ = [
         ('struct_size', _c.c_uint32),
@@ -951,10 +952,11 @@ class WorldParams(_SphStruct):
         ('dt_max', _c.c_float),
         ('step_limits', _c.c_uint32),
         ('reserved0', _c.c_uint32),
+        ('tension_ratio', _c.c_float),
     ]
     _sph_c_name_ = 'sph_world_params'
-    _sph_size_ = 48
-    _sph_offsets_ = (('struct_size', 0), ('max_substeps', 4), ('gravity', 8), ('stiffness', 20), ('viscosity', 24), ('step_factor', 28), ('dt_min', 32), ('dt_max', 36), ('step_limits', 40), ('reserved0', 44))
+    _sph_size_ = 52
+    _sph_offsets_ = (('struct_size', 0), ('max_substeps', 4), ('gravity', 8), ('stiffness', 20), ('viscosity', 24), ('step_factor', 28), ('dt_min', 32), ('dt_max', 36), ('step_limits', 40), ('reserved0', 44), ('tension_ratio', 48))
     _sph_init_ = 'sph_world_params_init_sized'
 
 

@@ -160,7 +160,7 @@ def test_params_are_described_for_tools():
     assert sph.params_info("clavet").params_size == ctypes.sizeof(sph.ClavetViscosityParams)
     names = [f.name for f in sph.param_fields(sph.ParamsKind.WORLD)]
     assert names == [b"max_substeps", b"gravity", b"stiffness", b"viscosity", b"step_factor", b"dt_min", b"dt_max",
-                     b"step_limits"]
+                     b"step_limits", b"tension_ratio"]
     speed = sph.param_fields("tait")[0]
     assert (speed.name, speed.unit, speed.offset) == (b"speed_of_sound", b"m/s", sph.TaitParams.speed_of_sound.offset)
     assert speed.lower == 0.0 and speed.lower_bound == sph.ParamBound.EXCLUSIVE
@@ -174,7 +174,8 @@ def test_params_are_described_for_tools():
                              b"boundary_density", b"collider_loads", b"density_diffusion"]
     assert methods[b"density_diffusion"].params_kind == sph.ParamsKind.DENSITY_DIFFUSION
     assert methods[b"dfsph"].switch_by == sph.MethodSwitch.SOLVER and methods[b"dfsph"].value == sph.Solver.DFSPH
-    assert methods[b"dfsph"].params_kind == sph.ParamsKind.DFSPH and not methods[b"wcsph"].has_params
+    assert methods[b"dfsph"].params_kind == sph.ParamsKind.DFSPH
+    assert methods[b"wcsph"].has_params and methods[b"wcsph"].params_kind == sph.ParamsKind.WORLD  # tension_ratio
     assert methods[b"springs"].switch_by == sph.MethodSwitch.FEATURE
     assert methods[b"springs"].value == sph.Feature.SPRINGS and methods[b"springs"].has_params
     assert methods[b"tait"].params_kind == sph.ParamsKind.TAIT

@@ -10,8 +10,8 @@ import sph
 
 def test_defaults_come_from_the_init_functions():
     p = sph.WorldParams()
-    assert p.struct_size == ctypes.sizeof(sph.WorldParams) == 48
-    assert (p.max_substeps, p.stiffness, p.viscosity) == (10000, 100, 1)
+    assert p.struct_size == ctypes.sizeof(sph.WorldParams) == 52
+    assert (p.max_substeps, p.stiffness, p.viscosity, p.tension_ratio) == (10000, 100, 1, 0)
     d = sph.WorldDef()
     assert d.header_version == sph.raw.SPH_VERSION  # what the inline sph_world_def_init adds
     assert sph.ContextDef().header_version == sph.raw.SPH_VERSION
