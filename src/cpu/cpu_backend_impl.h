@@ -106,10 +106,11 @@ class CpuBackend final : public Backend {
   };
   HeightSpan measure_height_span() const;
   bool depth_limit_on() const { return frame_limits_.depth_step_factor > 0.0f; }
+  // This rank's span (an empty one where the limit is off).
+  HeightSpan own_height_span() const { return depth_limit_on() ? measure_height_span() : HeightSpan{}; }
   // fluid_height_ from this rank's particles alone (an undivided world's; 0 where the limit is off).
   void measure_fluid_height() {
-    if (!depth_limit_on()) return;
-    const HeightSpan span = measure_height_span();
+    const HeightSpan span = own_height_span();
     fluid_height_ = height_of_span(span.lo, span.hi);
   }
 
@@ -276,9 +277,8 @@ class CpuBackend final : public Backend {
   }
   // The frame's start: the world's max speed, and new slabs when the ranks are out of balance.
   void halo_begin_frame();
-  HeightSpan own_height_span() const;  // this rank's span (an empty one where the limit is off)
-  void reduce_step_inputs(
-      const HeightSpan& span);  // the maxima and the height span over the ranks (cpu_halo.cpp)
+  // The maxima and the height span over the ranks (cpu_halo.cpp).
+  void reduce_step_inputs(const HeightSpan& span);
   // Before the sort: owned particles that left the slab migrate, ghosts arrive; the world's
   // grid shape and this rank's sort order go to halo_shape_ and halo_visit_.
   void halo_gather();

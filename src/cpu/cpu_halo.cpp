@@ -139,10 +139,6 @@ void CpuBackend::halo_keep(size_t kept) {
 // before the agreement that precedes this call: the measurement allocates (the reduction's
 // partials), and a rank that fails there must meet the others at that agreement, never at this
 // all_max (core/rank_agreement.h).
-CpuBackend::HeightSpan CpuBackend::own_height_span() const {
-  return depth_limit_on() ? measure_height_span() : HeightSpan{};
-}
-
 void CpuBackend::reduce_step_inputs(const HeightSpan& span) {
   float maxima[4] = {max_speed_, max_acceleration_, 0.0f, 0.0f};
   const bool depth = depth_limit_on();
