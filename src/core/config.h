@@ -119,7 +119,7 @@ inline StepLimits make_step_limits(const WorldConfig& c, const RuntimeParams& p)
   // DFSPH's depth limit (step_control.h). Not the weakly compressible scheme's: its acoustic
   // limit (a sound speed of 10 u_ff or more) is already far shorter than sqrt(|g| H) allows.
   const Vec3 g = p.stepping.gravity;
-  const float g_magnitude = SPH_SQRTF(g.x * g.x + g.y * g.y + g.z * g.z);
+  const float g_magnitude = length(g);
   const Dfsph::Params& dfsph = params_of<Dfsph>(p);
   const bool depth_on = c.solver == Solver::Dfsph && !(dfsph.flags & kDfsphNoDepthStepLimit) &&
                         g_magnitude > 0.0f && g_magnitude < INFINITY;

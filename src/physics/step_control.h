@@ -76,9 +76,7 @@ struct StepLimits {
 // pressure holds the step's own correction); H >= D, so the limit is conservative where the
 // fluid's lowest and highest particles are not one column (two pools at different heights).
 // height_along is the projection whose max - min is H; every backend and rank uses it.
-SPH_HD float height_along(const StepLimits& s, Vec3 x) {
-  return x.x * s.down.x + x.y * s.down.y + x.z * s.down.z;
-}
+SPH_HD float height_along(const StepLimits& s, Vec3 x) { return dot(x, s.down); }
 
 // H from the lowest and highest projection (0 for no particle: lo > hi).
 SPH_HD float height_of_span(float lo, float hi) { return hi > lo ? hi - lo : 0.0f; }
