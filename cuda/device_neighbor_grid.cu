@@ -5,6 +5,7 @@
 
 #include "../src/physics/grid_fit.h"
 #include "../src/physics/grid_hash.h"
+#include "block_reduce.cuh"
 #include "device_lower_bound.cuh"
 #include "device_neighbor_grid.h"
 #include "kernel_launch.h"
@@ -16,11 +17,6 @@ constexpr unsigned kExtentBlocks = 1024;  // grid-stride: few blocks, so few ato
 
 __device__ __forceinline__ uint32_t cell_code(int32_t c) {
   return static_cast<uint32_t>(static_cast<int64_t>(c) + 2147483648ll);
-}
-
-__device__ __forceinline__ uint32_t warp_max_u32(uint32_t v) {
-  for (int offset = 16; offset > 0; offset >>= 1) v = max(v, __shfl_xor_sync(0xffffffffu, v, offset));
-  return v;
 }
 
 // The particles' cell extent into live->lowest_code / highest_code (zero on entry: zeroed at the
@@ -44,7 +40,7 @@ __global__ void __launch_bounds__(kDefaultBlockSize)
   }
   const unsigned lane = threadIdx.x & 31u, warp = threadIdx.x >> 5;
   for (int k = 0; k < 6; ++k) {
-    const uint32_t v = warp_max_u32(codes[k]);
+    const uint32_t v = warp_reduce(codes[k], MaxOp{});
     if (lane == 0) warp_codes[warp][k] = v;
   }
   __syncthreads();

@@ -114,25 +114,9 @@ __global__ void height_span_kernel(const Float4* __restrict__ position, const ui
     const float y = height_along(limits, xyz(position[i]));
     if (!isnan(y)) lo = hi = y;  // (fminf/fmaxf leave NaN out, as the CPU's fmin/fmax)
   }
-  for (int offset = 16; offset > 0; offset >>= 1) {
-    lo = fminf(lo, __shfl_xor_sync(0xffffffffu, lo, offset));
-    hi = fmaxf(hi, __shfl_xor_sync(0xffffffffu, hi, offset));
-  }
-  const unsigned lane = threadIdx.x & 31u, warp = threadIdx.x >> 5;
-  if (lane == 0) {
-    warp_lo[warp] = lo;
-    warp_hi[warp] = hi;
-  }
-  __syncthreads();
-  if (warp != 0) return;
-  const unsigned warps = (blockDim.x + 31u) >> 5;
-  lo = lane < warps ? warp_lo[lane] : INFINITY;
-  hi = lane < warps ? warp_hi[lane] : -INFINITY;
-  for (int offset = 16; offset > 0; offset >>= 1) {
-    lo = fminf(lo, __shfl_xor_sync(0xffffffffu, lo, offset));
-    hi = fmaxf(hi, __shfl_xor_sync(0xffffffffu, hi, offset));
-  }
-  if (lane == 0 && lo <= hi) {
+  lo = block_reduce(lo, INFINITY, MinOp{}, warp_lo);
+  hi = block_reduce(hi, -INFINITY, MaxOp{}, warp_hi);
+  if (threadIdx.x == 0 && lo <= hi) {
     atomicMin(&s->height_lo_key, height_key(lo));
     atomicMax(&s->height_hi_key, height_key(hi));
   }
