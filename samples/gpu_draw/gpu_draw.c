@@ -18,16 +18,56 @@
  *   particle_renderer_draw + PNG               ... while frame f is drawn and written
  *
  * Usage: gpu_draw [OUTPUT_DIR] [--frames N]   (default out/gpu_draw, 30 frames at 60 fps)
- * Writes OUTPUT_DIR/frame_0000.png .. frame_NNNN.png (640 x 360). Exits 77 when there is no
+ * Writes OUTPUT_DIR/frame_0000.png .. frame_NNNN.png (640 x 360), then reads the last frame's
+ * vertices back from GL and checks them against the world's positions (exit 1 if any differs).
+ * Exits 77 when there is no
  * CUDA device or no EGL device for it (scripts/gpu-test runs it on a GPU machine). */
 #include <cuda_runtime_api.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "draw_scene.h"
 #include "gpu_draw_interop.h"
 #include "sample_io.h"
 #include "sph_cuda.h"
+
+/* The last frame's vertices, read back from GL, against the world's positions copied through the
+ * host (no step is in flight then): the interop path must hand GL exactly the world's floats. A
+ * picture can look plausible with stale or missing vertices; this names which side went wrong
+ * when png_check finds a blank image. Returns 0 when all count vertices match bit for bit. */
+static int check_last_frame(particle_renderer* renderer, const draw_scene* scene, uint32_t count) {
+  particle_vertex* vertices = (particle_vertex*)malloc(sizeof(particle_vertex) * (count ? count : 1));
+  float* positions = (float*)malloc(12 * (size_t)(count ? count : 1));
+  uint32_t i, differ = 0, first = 0, n = 0;
+  int failed = !vertices || !positions;
+  failed =
+      failed || sample_failed(sph_world_get_particle_count(scene->world, &n), "sph_world_get_particle_count");
+  if (!failed && n != count) {
+    fprintf(stderr, "gpu_draw: the last frame drew %u vertices, the world holds %u particles\n", count, n);
+    failed = 1;
+  }
+  failed = failed || particle_renderer_read_vertices(renderer, count, vertices) ||
+           sample_failed(sph_world_copy_attribute(scene->world, SPH_ATTRIBUTE_POSITION, positions,
+                                                  12ull * (count ? count : 1), 0, 0, count, NULL),
+                         "sph_world_copy_attribute");
+  for (i = 0; !failed && i < count; ++i) {
+    const float* x = positions + 3 * i;
+    if (memcmp(&vertices[i].x, x, 12) != 0 && differ++ == 0) first = i;
+  }
+  if (!failed && differ > 0) {
+    const float* x = positions + 3 * first;
+    fprintf(stderr,
+            "gpu_draw: %u of %u vertices in GL's buffer differ from the world's positions (first: vertex %u "
+            "(%g, %g, %g), particle (%g, %g, %g))\n",
+            differ, count, first, vertices[first].x, vertices[first].y, vertices[first].z, x[0], x[1], x[2]);
+    failed = 1;
+  }
+  if (!failed) printf("last frame: the %u vertices GL drew equal the world's positions bit for bit\n", count);
+  free(vertices);
+  free(positions);
+  return failed;
+}
 
 int main(int argc, char** argv) {
   const char* out_dir = "out/gpu_draw";
@@ -40,6 +80,7 @@ int main(int argc, char** argv) {
   draw_interop* interop = NULL;
   uint8_t* rgba = NULL;
   int stepping = 0;
+  uint32_t count = 0;
 
   status = sample_parse_args(argc, argv, "gpu_draw", &out_dir, &frames, &backend);
   if (status != 0) return status;
@@ -73,7 +114,7 @@ int main(int argc, char** argv) {
          particle_renderer_api(renderer), particle_renderer_device(renderer), frames, out_dir);
 
   for (frame = 0; frame <= frames; ++frame) {
-    uint32_t count = 0;
+    count = 0;
     if (draw_interop_fill(interop, scene.world, &count)) goto done;
     if (frame < frames) { /* the next frame runs while this one is drawn */
       if (sample_failed(sph_world_step_begin(scene.world, 1.0f / 60.0f), "sph_world_step_begin")) goto done;
@@ -88,6 +129,7 @@ int main(int argc, char** argv) {
     if (frame % 10 == 0 || frame == frames)
       printf("frame %3d/%d  %u particles drawn\n", frame, frames, count);
   }
+  if (check_last_frame(renderer, &scene, count)) goto done;
   status = 0;
 
 done:

@@ -28,6 +28,8 @@
   X(PFNGLBINDBUFFERPROC, BindBuffer)                           \
   X(PFNGLBUFFERDATAPROC, BufferData)                           \
   X(PFNGLBUFFERSUBDATAPROC, BufferSubData)                     \
+  X(PFNGLMAPBUFFERRANGEPROC, MapBufferRange)                   \
+  X(PFNGLUNMAPBUFFERPROC, UnmapBuffer)                         \
   X(PFNGLDELETEBUFFERSPROC, DeleteBuffers)                     \
   X(PFNGLGENVERTEXARRAYSPROC, GenVertexArrays)                 \
   X(PFNGLBINDVERTEXARRAYPROC, BindVertexArray)                 \
@@ -268,6 +270,28 @@ int particle_renderer_upload(particle_renderer* r, const particle_vertex* vertic
   r->gl.BindBuffer(GL_ARRAY_BUFFER, r->vertex_buffer);
   r->gl.BufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)count * (GLsizeiptr)sizeof(particle_vertex), vertices);
   return r->gl.GetError() == GL_NO_ERROR ? 0 : 1;
+}
+
+int particle_renderer_read_vertices(particle_renderer* r, uint32_t count, particle_vertex* out) {
+  const void* mapped;
+  GLboolean intact;
+  if (count > r->def.capacity) {
+    fprintf(stderr, "particle_renderer: %u vertices asked back, the buffer holds %u\n", count,
+            r->def.capacity);
+    return 1;
+  }
+  if (count == 0) return 0;
+  r->gl.BindBuffer(GL_ARRAY_BUFFER, r->vertex_buffer);
+  mapped = r->gl.MapBufferRange(GL_ARRAY_BUFFER, 0, (GLsizeiptr)count * (GLsizeiptr)sizeof(particle_vertex),
+                                GL_MAP_READ_BIT);
+  if (!mapped) {
+    fprintf(stderr, "particle_renderer: glMapBufferRange failed (GL error 0x%x)\n",
+            (unsigned)r->gl.GetError());
+    return 1;
+  }
+  memcpy(out, mapped, (size_t)count * sizeof(particle_vertex));
+  intact = r->gl.UnmapBuffer(GL_ARRAY_BUFFER); /* GL_FALSE: the store was lost while mapped */
+  return intact == GL_TRUE && r->gl.GetError() == GL_NO_ERROR ? 0 : 1;
 }
 
 int particle_renderer_draw(particle_renderer* r, uint32_t count, uint8_t* rgba) {

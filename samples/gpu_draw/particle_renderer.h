@@ -50,6 +50,11 @@ const char* particle_renderer_device(const particle_renderer* renderer);
 /* The host path: copies count vertices into the buffer (glBufferSubData). Returns 0 or 1. */
 int particle_renderer_upload(particle_renderer* renderer, const particle_vertex* vertices, uint32_t count);
 
+/* Reads the first count vertices of the buffer back into out (glMapBufferRange for reading, which
+ * both APIs have): what the GPU draws, for a program that checks a writer of the buffer (a CUDA
+ * kernel through interop) against its source. Returns 0 or 1 (printed). */
+int particle_renderer_read_vertices(particle_renderer* renderer, uint32_t count, particle_vertex* out);
+
 /* Draws the first count vertices of the buffer and reads the image into rgba (width * height * 4
  * bytes, rows bottom to top as glReadPixels gives them). Returns 0 or 1 (a GL error, printed). */
 int particle_renderer_draw(particle_renderer* renderer, uint32_t count, uint8_t* rgba);
