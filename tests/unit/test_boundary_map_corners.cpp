@@ -18,7 +18,7 @@
 // +0.41 rho0 at K = 12 rho0: the flat share of the trilinear SDF, which cuts the SDF's kink on an
 // edge's bisector, docs/physics.md "Walls in the density", Limits). A change that removes that
 // over-read must move these numbers (docs/validation.md lists what one tried and measured).
-// BM_MEASURE=1 prints without asserting the sampled over-read.
+// BM_MEASURE=1 prints without asserting the sampled over-read; BM_VOXEL=v sets the voxel (m).
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -83,7 +83,8 @@ void test_edges_and_corners(void**) {
   box.kind = sph::ShapeKind::Box;
   box.half_extents = sph::Vec3{static_cast<float>(0.5 * length), static_cast<float>(0.5 * length),
                                static_cast<float>(0.5 * length)};
-  box.voxel_size = 0.01f;
+  // BM_VOXEL=v (m) measures another voxel size (the sampled over-read against the voxel).
+  box.voxel_size = std::getenv("BM_VOXEL") ? static_cast<float>(std::atof(std::getenv("BM_VOXEL"))) : 0.01f;
   const auto asset = sph::build_shape_sdf(box, 1u << 24);
   const sph::BoundaryCalibration c =
       sph::fcc_boundary_calibration(static_cast<float>(s), static_cast<float>(h));

@@ -100,7 +100,12 @@ static void open_tank(const tank_case* tc, double gap, support_world* w, sph_sdf
     EXPECT_OK(sph_world_get_tait_params(w->world, &tait));
     *c = tait.speed_of_sound;
   }
-  EXPECT_OK(support_tank_between(w->context, w->world, tank_min, tank_max, 0.5 * step, 0.0f, sdf, NULL));
+  /* HYDRO_VOXEL=v: the tank's SDF voxel in lattice steps (default 0.5): the walls' share at the
+   * edges and corners over-reads by an amount that shrinks with the voxel (boundary_map_corners,
+   * BM_VOXEL; docs/validation.md, "Session 22: the corners' over-read against the voxel"). */
+  const double voxel_steps = getenv("HYDRO_VOXEL") ? atof(getenv("HYDRO_VOXEL")) : 0.5;
+  EXPECT_OK(
+      support_tank_between(w->context, w->world, tank_min, tank_max, voxel_steps * step, 0.0f, sdf, NULL));
 
   EXPECT_OK(support_spawn(w->world, lattice_points, NULL, *n));
   EXPECT_OK(sph_world_get_particle_mass(w->world, mass));
