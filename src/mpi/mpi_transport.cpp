@@ -2,6 +2,8 @@
 #include "mpi_transport.h"
 
 #include <climits>
+#include <cstdlib>
+#include <cstring>
 #include <string>
 
 #include "../core/rank_agreement.h"
@@ -18,6 +20,16 @@ void check(int code, const char* what) {
   MPI_Error_string(code, text, &length);
   throw Error(Status::Internal,
               std::string("MPI: ") + what + " failed: " + std::string(text, static_cast<size_t>(length)));
+}
+
+// The signature one rank contributes: kind in the high half, the detail in the low half.
+int64_t signature(Collective kind, int64_t detail) {
+  return static_cast<int64_t>(kind) * (int64_t{1} << 32) + (detail & 0xffffffffll);
+}
+
+std::string describe(int64_t sig) {
+  const auto kind = static_cast<Collective>(sig >> 32);
+  return std::string(collective_name(kind)) + " (" + std::to_string(sig & 0xffffffffll) + ")";
 }
 
 int as_count(size_t n) {
@@ -38,6 +50,55 @@ MpiTransport::MpiTransport(MPI_Comm comm) {
   MPI_Comm_set_errhandler(comm_, MPI_ERRORS_RETURN);
   MPI_Comm_rank(comm_, &rank_);
   MPI_Comm_size(comm_, &size_);
+  // The switch is agreed (a rank without it turns it off everywhere): ranks that disagreed about
+  // checking would meet a check's all-reduce against another rank's collective.
+  const char* env = std::getenv("SPH_MPI_CHECK_COLLECTIVES");
+  int on = env && std::strcmp(env, "1") == 0 ? 1 : 0;
+  check(MPI_Allreduce(MPI_IN_PLACE, &on, 1, MPI_INT, MPI_MIN, comm_),
+        "MPI_Allreduce (the collective check's switch)");
+  check_collectives_ = on != 0;
+}
+
+const char* collective_name(Collective kind) {
+  switch (kind) {
+    case Collective::AllMinInt64:
+      return "all_min of int64";
+    case Collective::AllMaxInt64:
+      return "all_max of int64";
+    case Collective::AllSumInt64:
+      return "all_sum of int64";
+    case Collective::AllMaxFloat:
+      return "all_max of float";
+    case Collective::ExclusiveSum:
+      return "exclusive_sum";
+    case Collective::Alltoall:
+      return "exchange's MPI_Alltoall";
+    case Collective::Alltoallv:
+      return "exchange's MPI_Alltoallv";
+    case Collective::Gather:
+      return "gather's MPI_Gather to root";
+    case Collective::Gatherv:
+      return "gather's MPI_Gatherv to root";
+    case Collective::BroadcastSize:
+      return "broadcast's size from root";
+    case Collective::BroadcastBytes:
+      return "broadcast's bytes from root";
+  }
+  return "an unknown collective";
+}
+
+void MpiTransport::match(Collective kind, int64_t detail) const {
+  if (!check_collectives_) return;
+  const int64_t mine = signature(kind, detail);
+  int64_t range[2] = {mine, -mine};  // the largest signature and minus the smallest
+  check(MPI_Allreduce(MPI_IN_PLACE, range, 2, MPI_INT64_T, MPI_MAX, comm_),
+        "MPI_Allreduce (collective check)");
+  if (range[0] == -range[1]) return;
+  throw Error(Status::Internal,
+              "MPI collective check (SPH_MPI_CHECK_COLLECTIVES=1): the ranks were in "
+              "different collectives: rank " +
+                  std::to_string(rank_) + " in " + describe(mine) + "; the ranks' calls range from " +
+                  describe(-range[1]) + " to " + describe(range[0]));
 }
 
 MpiTransport::~MpiTransport() {
@@ -47,20 +108,25 @@ MpiTransport::~MpiTransport() {
 }
 
 void MpiTransport::all_min(int64_t* values, int n) const {
+  match(Collective::AllMinInt64, n);
   check(MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_INT64_T, MPI_MIN, comm_), "MPI_Allreduce");
 }
 void MpiTransport::all_max(int64_t* values, int n) const {
+  match(Collective::AllMaxInt64, n);
   check(MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_INT64_T, MPI_MAX, comm_), "MPI_Allreduce");
 }
 void MpiTransport::all_sum(int64_t* values, int n) const {
+  match(Collective::AllSumInt64, n);
   check(MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_INT64_T, MPI_SUM, comm_), "MPI_Allreduce");
 }
 void MpiTransport::all_max(float* values, int n) const {
+  match(Collective::AllMaxFloat, n);
   check(MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_FLOAT, MPI_MAX, comm_), "MPI_Allreduce");
 }
 
 int64_t MpiTransport::exclusive_sum(int64_t value) const {
   int64_t below = 0;
+  match(Collective::ExclusiveSum, 1);
   check(MPI_Exscan(&value, &below, 1, MPI_INT64_T, MPI_SUM, comm_), "MPI_Exscan");
   return rank_ == 0 ? 0 : below;  // (MPI leaves rank 0's result undefined)
 }
@@ -89,6 +155,7 @@ std::vector<RankBytes> MpiTransport::exchange(const std::vector<RankBytes>& send
     rethrow_agreed(*this);
   }
   agree(*this);
+  match(Collective::Alltoall, 1);
   check(MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm_), "MPI_Alltoall");
   try {
     size_t received = 0;
@@ -101,6 +168,7 @@ std::vector<RankBytes> MpiTransport::exchange(const std::vector<RankBytes>& send
     rethrow_agreed(*this);
   }
   agree(*this);
+  match(Collective::Alltoallv, 0);
   check(MPI_Alltoallv(packed.data(), send_counts.data(), send_offsets.data(), MPI_BYTE, in.data(),
                       recv_counts.data(), recv_offsets.data(), MPI_BYTE, comm_),
         "MPI_Alltoallv");
@@ -124,6 +192,7 @@ std::vector<RankBytes> MpiTransport::gather(const RankBytes& mine, int root) con
     rethrow_agreed(*this);
   }
   agree(*this);
+  match(Collective::Gather, root);
   check(MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, root, comm_), "MPI_Gather");
   try {
     size_t total = 0;
@@ -137,6 +206,7 @@ std::vector<RankBytes> MpiTransport::gather(const RankBytes& mine, int root) con
     rethrow_agreed(*this);
   }
   agree(*this);
+  match(Collective::Gatherv, root);
   check(MPI_Gatherv(mine.data(), count, MPI_BYTE, all.data(), counts.data(), offsets.data(), MPI_BYTE, root,
                     comm_),
         "MPI_Gatherv");
@@ -151,8 +221,10 @@ std::vector<RankBytes> MpiTransport::gather(const RankBytes& mine, int root) con
 
 RankBytes MpiTransport::broadcast(const RankBytes& bytes, int root) const {
   uint64_t size = bytes.size();
+  match(Collective::BroadcastSize, root);
   check(MPI_Bcast(&size, 1, MPI_UINT64_T, root, comm_), "MPI_Bcast");
   RankBytes out(rank_ == root ? bytes : RankBytes(static_cast<size_t>(size)));
+  match(Collective::BroadcastBytes, root);
   check(MPI_Bcast(out.data(), as_count(out.size()), MPI_BYTE, root, comm_), "MPI_Bcast");
   return out;
 }

@@ -9,9 +9,29 @@
 
 namespace sph {
 
+// The collectives this transport issues, named for the collective check (below).
+enum class Collective : int64_t {
+  AllMinInt64 = 1,
+  AllMaxInt64,
+  AllSumInt64,
+  AllMaxFloat,
+  ExclusiveSum,
+  Alltoall,
+  Alltoallv,
+  Gather,
+  Gatherv,
+  BroadcastSize,
+  BroadcastBytes,
+};
+const char* collective_name(Collective kind);
+
 class MpiTransport final : public RankTransport {
  public:
   // Duplicates `comm`, so the world's messages never meet the caller's. Throws Error.
+  // COLLECTIVE: the ranks agree on the collective check (SPH_MPI_CHECK_COLLECTIVES=1 on every
+  // rank turns it on; docs/distributed.md): before each collective, one all-reduce of the call's
+  // signature, so that ranks in different collectives (a bug in the library's rank code) all
+  // throw Internal naming the calls instead of hanging or truncating in MPI.
   explicit MpiTransport(MPI_Comm comm);
   ~MpiTransport() override;
   MpiTransport(const MpiTransport&) = delete;
@@ -28,10 +48,18 @@ class MpiTransport final : public RankTransport {
   std::vector<RankBytes> gather(const RankBytes& mine, int root) const override;
   RankBytes broadcast(const RankBytes& bytes, int root) const override;
 
+  bool checks_collectives() const { return check_collectives_; }
+
  private:
+  // With the check on: every rank's (kind, detail) must be the same, else every rank throws
+  // Internal. `detail` is the element count, or the root of a rooted call; 0 for the v-variants,
+  // whose counts differ between ranks by design.
+  void match(Collective kind, int64_t detail) const;
+
   MPI_Comm comm_ = MPI_COMM_NULL;
   int rank_ = 0;
   int size_ = 1;
+  bool check_collectives_ = false;
 };
 
 }  // namespace sph
