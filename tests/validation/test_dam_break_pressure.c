@@ -21,14 +21,13 @@
  * SPH_VALIDATION_FULL=1 (scripts/validate --full): 32. Measuring knobs (docs/validation.md):
  * DAM_PRESSURE_MEASURE=1 prints without asserting (and reads probes half and a quarter kernel
  * radius off the wall and a gauge at it); DAM_PRESSURE_STEPS=N, DAM_PRESSURE_PERTURB=SEED,
- * DAM_PRESSURE_ENSEMBLE=DRAWS, DAM_PRESSURE_C=m/s, DAM_PRESSURE_EOS=tait, DAM_PRESSURE_SOLVER=dfsph,
- * DAM_PRESSURE_PROBE_OFFSET=kernel radii, DAM_PRESSURE_FEATURES=bits, DAM_PRESSURE_HYDROSTATIC_START=1,
- * DAM_PRESSURE_SLAB=layers (the slab's thickness, default 4), DAM_PRESSURE_VISCOSITY=Pa s (default
- * 0.05), DAM_PRESSURE_ALPHA=alpha and DAM_PRESSURE_VISCOSITY_RULE=h (a viscosity in proportion to h:
- * case_viscosity), DAM_PRESSURE_STEP_FACTOR=lambda (the acoustic limit's factor, default the
- * library's 0.4), DAM_PRESSURE_TENSION=tau (sph_world_params.tension_ratio, the equation of
- * state's bounded tension; default 0, the clamp; docs/validation.md, "Session 21: a bounded
- * tension"). */
+ * DAM_PRESSURE_ENSEMBLE=DRAWS, DAM_PRESSURE_FIRST_DRAW=K, DAM_PRESSURE_C=m/s, DAM_PRESSURE_EOS=tait,
+ * DAM_PRESSURE_SOLVER=dfsph, DAM_PRESSURE_PROBE_OFFSET=kernel radii, DAM_PRESSURE_FEATURES=bits,
+ * DAM_PRESSURE_HYDROSTATIC_START=1, DAM_PRESSURE_SLAB=layers (the slab's thickness, default 4),
+ * DAM_PRESSURE_VISCOSITY=Pa s (default 0.05), DAM_PRESSURE_ALPHA=alpha and DAM_PRESSURE_VISCOSITY_RULE=h (a
+ * viscosity in proportion to h: case_viscosity), DAM_PRESSURE_STEP_FACTOR=lambda (the acoustic limit's
+ * factor, default the library's 0.4), DAM_PRESSURE_TENSION=tau (sph_world_params.tension_ratio, the equation
+ * of state's bounded tension; default 0, the clamp; docs/validation.md, "Session 21: a bounded tension"). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -373,11 +372,14 @@ static void test_diffusion(void** state) {
  * little. The impact within 5 %, the plateau within 20 %, both of the ensemble's mean. */
 static void ensemble(uint32_t features, const char* name) {
   const int draws = getenv("DAM_PRESSURE_ENSEMBLE") ? atoi(getenv("DAM_PRESSURE_ENSEMBLE")) : 6;
+  /* DAM_PRESSURE_FIRST_DRAW=k: the draws k .. k + draws - 1 (more draws of a measured ensemble, or
+   * one draw a process to run them side by side) */
+  const int first = getenv("DAM_PRESSURE_FIRST_DRAW") ? atoi(getenv("DAM_PRESSURE_FIRST_DRAW")) : 0;
   reading mean = {0.0, 0.0};
   double lo[2] = {1e9, 1e9}, hi[2] = {-1e9, -1e9};
   assert_true(draws >= 1);
   for (int i = 0; i < draws; ++i) {
-    const reading r = dam_break_pressure(features, name, 1, (uint64_t)i);
+    const reading r = dam_break_pressure(features, name, 1, (uint64_t)(first + i));
     mean.impact += r.impact / draws;
     mean.plateau += r.plateau / draws;
     lo[0] = fmin(lo[0], r.impact), hi[0] = fmax(hi[0], r.impact);
