@@ -94,11 +94,16 @@ void MpiTransport::match(Collective kind, int64_t detail) const {
   check(MPI_Allreduce(MPI_IN_PLACE, range, 2, MPI_INT64_T, MPI_MAX, comm_),
         "MPI_Allreduce (collective check)");
   if (range[0] == -range[1]) return;
-  throw Error(Status::Internal,
-              "MPI collective check (SPH_MPI_CHECK_COLLECTIVES=1): the ranks were in "
-              "different collectives: rank " +
-                  std::to_string(rank_) + " in " + describe(mine) + "; the ranks' calls range from " +
-                  describe(-range[1]) + " to " + describe(range[0]));
+  // Every rank knows of this failure already: an AgreedRankFailure, which rethrow_agreed passes
+  // on as it is. A plain Error would send a rank whose collective sat inside a step's try block
+  // into an agreement that a rank thrown out of its own catch block (rethrow_agreed's all_min
+  // against the others' collective, session 21's shape) never reaches.
+  throw AgreedRankFailure(Status::Internal,
+                          "MPI collective check (SPH_MPI_CHECK_COLLECTIVES=1): the ranks were in "
+                          "different collectives: rank " +
+                              std::to_string(rank_) + " in " + describe(mine) +
+                              "; the ranks' calls range from " + describe(-range[1]) + " to " +
+                              describe(range[0]));
 }
 
 MpiTransport::~MpiTransport() {

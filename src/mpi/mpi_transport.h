@@ -52,8 +52,9 @@ class MpiTransport final : public RankTransport {
 
  private:
   // With the check on: every rank's (kind, detail) must be the same, else every rank throws
-  // Internal. `detail` is the element count, or the root of a rooted call; 0 for the v-variants,
-  // whose counts differ between ranks by design.
+  // Internal (an AgreedRankFailure: no rank joins the others again on its way out). `detail` is
+  // the element count, or the root of a rooted call; 0 for the v-variants, whose counts differ
+  // between ranks by design.
   void match(Collective kind, int64_t detail) const;
 
   MPI_Comm comm_ = MPI_COMM_NULL;

@@ -8,6 +8,12 @@
 //   - a kind mismatch (all_max of float against all_min of int64), a count mismatch (all_sum of
 //     2 against 3), and a mismatch inside exchange against gather (both begin with an agreement,
 //     which matches; their next calls differ): every rank throws Internal;
+//   - session 21's shape: rank 0 fails on its own and joins the others at an agreement
+//     (rethrow_agreed, as a step's catch block does) while they are in an all_max of four floats
+//     with no agreement before it: every rank throws Internal and none waits. The check's error
+//     is an AgreedRankFailure, which rethrow_agreed passes on without meeting the others again: a
+//     plain Error would send the others into an agreement that rank 0, already out of its own
+//     catch block, never reaches;
 //   - the switch is agreed: set on rank 0 alone it is off on every rank.
 // A rank that hung would run the test into ctest's timeout.
 #include <mpi.h>
@@ -17,6 +23,7 @@
 #include <cstring>
 #include <string>
 
+#include "core/rank_agreement.h"
 #include "core/status.h"
 #include "mpi/mpi_transport.h"
 
@@ -38,6 +45,8 @@ void expect_mismatch(const char* name, Body&& body) {
     expect(false, std::string(name) + ": no error");
   } catch (const sph::Error& e) {
     expect(e.status() == sph::Status::Internal, std::string(name) + ": status is not Internal: " + e.what());
+    expect(dynamic_cast<const sph::AgreedRankFailure*>(&e) != nullptr,
+           std::string(name) + ": not an AgreedRankFailure (rethrow_agreed would meet the others again)");
     expect(std::strstr(e.what(), "different collectives") != nullptr,
            std::string(name) + ": the message does not name the mismatch: " + e.what());
     if (g_rank == 0) printf("%s: every rank throws Internal; rank 0's message: %s\n", name, e.what());
@@ -105,6 +114,15 @@ int main(int argc, char** argv) {
           t.exchange(std::vector<sph::RankBytes>(static_cast<size_t>(g_size)));
         else
           t.gather(sph::RankBytes(1, 0), 0);
+      });
+      expect_mismatch("rank 0 fails and joins an agreement, all_max of 4 floats elsewhere", [&] {
+        try {
+          if (g_rank == 0) throw sph::Error(sph::Status::OutOfHostMemory, "a failure injected on rank 0");
+          float v[4] = {0, 0, 0, 0};
+          t.all_max(v, 4);  // (the bug: a collective after code that can fail, unagreed)
+        } catch (...) {
+          sph::rethrow_agreed(t);
+        }
       });
       // The ranks threw at the same call, so they are in step: the transport works on.
       matching_calls(t);
