@@ -54,8 +54,9 @@ MpiTransport::MpiTransport(MPI_Comm comm) {
   // checking would meet a check's all-reduce against another rank's collective.
   const char* env = std::getenv("SPH_MPI_CHECK_COLLECTIVES");
   int on = env && std::strcmp(env, "1") == 0 ? 1 : 0;
-  check(MPI_Allreduce(MPI_IN_PLACE, &on, 1, MPI_INT, MPI_MIN, comm_),
-        "MPI_Allreduce (the collective check's switch)");
+  const int agreed = MPI_Allreduce(MPI_IN_PLACE, &on, 1, MPI_INT, MPI_MIN, comm_);
+  if (agreed != MPI_SUCCESS) MPI_Comm_free(&comm_);  // no destructor runs after a throw here
+  check(agreed, "MPI_Allreduce (the collective check's switch)");
   check_collectives_ = on != 0;
 }
 
