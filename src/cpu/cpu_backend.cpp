@@ -78,6 +78,7 @@ void CpuBackend::append(const Vec3* positions, const Vec3* velocities, uint32_t 
   store_.resize(total);
   Float4* position = position_.data();
   Float4* velocity = velocity_.data();
+  uint64_t* sort_key = rank_ ? rank_->sort_keys() : nullptr;
   for (uint32_t k = 0; k < n; ++k) {
     const uint32_t i = count_ + k;
     const Vec3 v = velocities ? velocities[k] : Vec3{0.0f, 0.0f, 0.0f};
@@ -87,7 +88,7 @@ void CpuBackend::append(const Vec3* positions, const Vec3* velocities, uint32_t 
     density_[i] = config_.rest_density;
     neighbors_[i] = 0;
     if (user_attribute_) user_attribute_[i] = user_attribute;
-    if (sort_key_) sort_key_[i] = kAppendedSortKey | (first_id + k);
+    if (sort_key) sort_key[i] = kAppendedSortKey | (first_id + k);
   }
   count_ = total;
   max_speed_valid_ = false;
@@ -155,9 +156,10 @@ ParticleSnapshot CpuBackend::export_particles() const {
     s.carried.push_back(std::move(c));
   }
   // A distributed rank's sort keys (its checkpoint carries them: they order the next sort).
-  if (ranks_)
-    s.set_carried(kArrayDistributedSortKey,
-                  HostVector<uint64_t>(sort_key_.data(), sort_key_.data() + count_));
+  if (rank_) {
+    const uint64_t* keys = rank_->sort_keys();
+    s.set_carried(kArrayDistributedSortKey, HostVector<uint64_t>(keys, keys + count_));
+  }
   return s;
 }
 
@@ -170,7 +172,7 @@ void CpuBackend::import_particles(const ParticleSnapshot& s) {
   // checkpoint, into a fresh backend).
   std::vector<ParticleArraySpec> carried_specs = method_arrays_;
   HostVector<uint64_t> keys;
-  if (ranks_) {
+  if (rank_) {
     keys = s.carried_as<uint64_t>(kArrayDistributedSortKey);
     if (n != count_ && !(count_ == 0 && keys.size() == n))
       throw Error(Status::Unsupported,
@@ -192,7 +194,7 @@ void CpuBackend::import_particles(const ParticleSnapshot& s) {
   std::copy(s.density.begin(), s.density.end(), density_.data());
   std::fill(neighbors_.data(), neighbors_.data() + n, 0u);
   for (auto& c : carried) c.first->bytes.swap(c.second);
-  if (keys.size() == n) std::copy(keys.begin(), keys.end(), sort_key_.data());
+  if (rank_ && keys.size() == n) std::copy(keys.begin(), keys.end(), rank_->sort_keys());
   count_ = n;
   max_speed_ = s.max_speed;
   max_speed_valid_ = true;

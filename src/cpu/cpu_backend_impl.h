@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,7 @@
 #include "cpu_neighbor_grid.h"
 #include "cpu_parallel.h"
 #include "cpu_particle_store.h"
+#include "cpu_rank_halo.h"
 #include "cpu_simd_passes.h"
 
 namespace sph {
@@ -78,9 +80,11 @@ class CpuBackend final : public Backend {
 
   // Distributed worlds (cpu_halo.cpp).
   void attach_ranks(std::shared_ptr<const RankTransport> ranks, const DistributedOptions& options) override;
-  const RankTransport* rank_transport() const override { return ranks_.get(); }
+  const RankTransport* rank_transport() const override { return rank_ ? &rank_->transport() : nullptr; }
   DistributedCounters distributed_counters() const override;
-  std::shared_ptr<const RankTransport> shared_rank_transport() const override { return ranks_; }
+  std::shared_ptr<const RankTransport> shared_rank_transport() const override {
+    return rank_ ? rank_->shared_transport() : nullptr;
+  }
   DistributedState distributed_state() const override;
   void restore_distributed_state(const DistributedState& state) override;
   void rethrow_step_failure() const override;
@@ -262,28 +266,17 @@ class CpuBackend final : public Backend {
   // Density and neighbour statistics of the last density evaluation.
   void summarize(FrameReport& report) const;
 
-  // ---- a distributed world's rank (cpu_halo.cpp; include/sph_mpi.h). Between substeps a rank
-  // holds the particles it owns; during one it also holds ghosts (origin_ != 0), the owned
-  // particles of the cell layer beside its slab. The sort takes the particles in the order of
-  // their keys (sort_key_: slot and place in it at the last sort, the same on every rank), so
-  // each cell lists its particles in the order one undivided world would, and every sum runs
-  // in the same order. Each step is collective.
+  // ---- a distributed world's rank (cpu_halo.cpp; include/sph_mpi.h): its halo steps and the
+  // state they own are rank_'s (cpu_rank_halo.h). The backend's side, each step collective:
+  // which of its values the ghosts take, and the step's inputs over the ranks.
   // A ghost of this substep (never in a world that is not distributed).
-  bool ghost(uint32_t i) const { return origin_ && origin_[i] != 0u; }
-  // A spring ghost: a ghost that is only the far end of an owned particle's spring, from past the
-  // halo (origin_ above the rank count; cpu_halo_springs.cpp). No neighbour pass reads it.
-  bool spring_ghost(uint32_t i) const {
-    return origin_ && origin_[i] > static_cast<uint32_t>(ranks_->size());
-  }
+  bool ghost(uint32_t i) const { return rank_ && rank_->ghost(i); }
+  // Each particle's origin (CpuRankHalo::origins; null in an undivided world).
+  const uint32_t* origins() const { return rank_ ? rank_->origins() : nullptr; }
   // The frame's start: the world's max speed, and new slabs when the ranks are out of balance.
   void halo_begin_frame();
-  // The maxima and the height span over the ranks (cpu_halo.cpp).
+  // The maxima and the height span over the ranks.
   void reduce_step_inputs(const HeightSpan& span);
-  // Before the sort: owned particles that left the slab migrate, ghosts arrive; the world's
-  // grid shape and this rank's sort order go to halo_shape_ and halo_visit_.
-  void halo_gather();
-  // After the sort: the keys of the new order.
-  void halo_keys();
   // After the density pass: the ghosts take their owners' densities and pressures; after the
   // colour-field pass (surface tension), their normals.
   void halo_share_density();
@@ -295,62 +288,9 @@ class CpuBackend final : public Backend {
   void halo_share_dfsph_density();
   void halo_share_velocities(Float4* v, const char* what = "DFSPH velocities");
   void halo_share_dfsph_step();
-  // Each probe point's sums from the rank whose slab holds it; the colliders' load sums of the
-  // frame added over the ranks in rank order.
-  void halo_pick_probe_points(const SceneFrame& scene);
-  void halo_sum_loads();
-  template <class Record, class Make, class Apply>
-  void halo_share(const char* what, Make&& make, Apply&& apply);
   // The substep's end: ghosts dropped, the step size's inputs and any failure agreed by all
   // ranks. Returns the world's first non-finite particle id (kAllFinite: none).
   uint32_t halo_end_substep(uint32_t bad_id);
-  // Whether `flag` is raised on any rank; an agreement (rank_agreement.h), as every collective
-  // step below is: it throws on every rank when one failed since the last.
-  bool halo_any(bool flag) const;
-  // An agreement of its own, before ranks meet after code that can fail.
-  void halo_agree() const;
-  // Cell layer of particle i along the slabs' axis.
-  int32_t halo_layer(uint32_t i) const;
-  // Appends particle i's carried arrays to `out` / appends the records of `in` as particles
-  // whose origin_ is `origin`; returns how many.
-  void halo_pack(uint32_t i, RankBytes& out) const;
-  // Whether an array moves with its particle: the carried ones, and RK4's stage state.
-  static bool halo_travels(const ParticleArraySpec& spec);
-  uint32_t halo_unpack(const RankBytes& in, uint32_t origin);
-  // Keeps the particles keep_order_ lists (ascending), in that order.
-  void halo_keep(size_t kept);
-  // Springs across ranks (cpu_halo_springs.cpp). Outside a substep's sorted part the spring
-  // lists name their partners by id. halo_gather_spring_partners (after the ghosts' arrival):
-  // the owned lists' ids become storage indices; each partner neither owned nor a ghost comes
-  // from its owner as a spring ghost (none: a sink removed it, and the spring is dropped, as a
-  // sink's removal drops it in the undivided world). halo_resolve_springs (after the sort): the
-  // partners follow the sort. halo_springs_to_ids (the substep's end, before the ghosts go): back
-  // to ids. halo_share_spring_candidates (linking, between its passes): each ghost takes its
-  // owner's candidates. halo_index_ids: halo_id_table_ from the particles held now.
-  void halo_gather_spring_partners(uint32_t owned);
-  void halo_resolve_springs();
-  void halo_springs_to_ids();
-  void halo_share_spring_candidates();
-  void halo_index_ids();
-
-  std::shared_ptr<const RankTransport> ranks_;
-  DistributedOptions distributed_options_;
-  SlabDecomposition slabs_;
-  bool slabs_cut_ = false;
-  DistributedCounters halo_counters_;
-  GridShape halo_shape_{};
-  HostVector<uint32_t> halo_visit_;
-  int64_t halo_world_count_ = 0;    // the particles every rank owns, this substep
-  CpuArrayRef<uint64_t> sort_key_;  // Carried
-  CpuArrayRef<uint32_t> origin_;    // Sorted: 0 owned, else 1 + the rank the ghost came from
-                                    // (+ the rank count for a spring ghost)
-  // Springs: the held particles' ids to their indices, the partners waiting for spring ghosts
-  // (kSpringSlots ids per owned particle), the sort's inverse permutation; whether the owned
-  // lists hold storage indices (from the gather to the substep's end) or ids.
-  CpuIdTable halo_id_table_;
-  HostVector<uint32_t> halo_missing_;
-  HostVector<uint32_t> halo_inverse_;
-  bool halo_springs_indexed_ = false;
 
   WorldConfig config_;
   CpuParallel workers_;  // OpenMP's, or the engine's task system (cpu_parallel.h)
@@ -398,7 +338,7 @@ class CpuBackend final : public Backend {
   HostVector<Vec3> load_points_;             // per collider: at the wall pass's time, at the end
   HostVector<ProbeGather> probe_points_;     // per sample point of the frame's probes
   HostVector<ProbeSums> probe_sums_;         // per probe: the frame's samples
-  HostVector<uint32_t> keep_order_;
+  HostVector<uint32_t> keep_order_;          // apply_sinks: the particles that stay
   // The three maxima an integration pass reduces, and the first non-finite particle.
   struct StateScan {
     float a2max = 0.0f, v2max = 0.0f;
@@ -426,6 +366,9 @@ class CpuBackend final : public Backend {
     float max_speed = 0.0f, max_acceleration = 0.0f;
     bool max_speed_valid = false;
   } saved_inputs_;  // save_step_inputs()
+  // A distributed world's rank, null in an undivided world. Declared last: it refers to the
+  // store, the count and the workers above.
+  std::unique_ptr<CpuRankHalo> rank_;
 };
 
 }  // namespace sph

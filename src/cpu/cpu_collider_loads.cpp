@@ -41,7 +41,7 @@ void CpuBackend::collide_with_loads(const FluidConstants& fluid, const SceneFram
   Float4* next_vel = next_velocity_.data();
   const Vec3* points = load_points_.data();
   LoadImpulse* partial = load_blocks_.data();
-  const uint32_t* origin = origin_.data();  // null unless distributed
+  const uint32_t* origin = origins();  // null unless distributed
   // Blocks go out dynamically like every loop's particles (kParticleChunk); their sums are kept
   // per block and added in block order below, so the split changes no bit.
   constexpr size_t kBlocksPerChunk = kParticleChunk / kLoadBlock;

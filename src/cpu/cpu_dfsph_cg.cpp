@@ -54,18 +54,18 @@ DfsphErrors CpuBackend::dfsph_cg_measure(const FluidConstants& fluid, const Dfsp
   return {particles > 0 ? static_cast<float>(sum.value() / static_cast<double>(particles)) : 0.0f, largest};
 }
 
-int64_t CpuBackend::dfsph_cg_particles() const { return ranks_ ? halo_world_count_ : int64_t{count_}; }
+int64_t CpuBackend::dfsph_cg_particles() const { return rank_ ? rank_->world_count() : int64_t{count_}; }
 
 void CpuBackend::dfsph_cg_world(ExactFloatSum* sums, int n_sums, float* maxima, int n_maxima) {
-  if (!ranks_) return;
+  if (!rank_) return;
   constexpr int kTerms = ExactFloatSum::kTerms;
   constexpr int kMostSums = 3;
   if (n_sums > kMostSums) throw Error(Status::Internal, "dfsph_cg_world: more sums than its buffer holds");
   int64_t bins[kMostSums * kTerms];  // (on the stack: no allocation between the agreement and the sum)
   for (int s = 0; s < n_sums; ++s) std::memcpy(bins + s * kTerms, sums[s].terms(), sizeof(int64_t) * kTerms);
-  halo_agree();  // (the exchanges' buffers: a rank that failed there meets the others here)
-  ranks_->all_sum(bins, n_sums * kTerms);
-  if (n_maxima > 0) ranks_->all_max(maxima, n_maxima);
+  rank_->agree();  // (the exchanges' buffers: a rank that failed there meets the others here)
+  rank_->transport().all_sum(bins, n_sums * kTerms);
+  if (n_maxima > 0) rank_->transport().all_max(maxima, n_maxima);
   for (int s = 0; s < n_sums; ++s) std::memcpy(sums[s].terms(), bins + s * kTerms, sizeof(int64_t) * kTerms);
 }
 
@@ -128,7 +128,7 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
     carried[i] = 0.0f;
   });
   dfsph_correct(fluid, walls, dt, v, carried, 1.0f);
-  if (ranks_) halo_share_velocities(v);  // (the rate pass reads the ghosts' velocities)
+  if (rank_) halo_share_velocities(v);  // (the rate pass reads the ghosts' velocities)
   DfsphErrors error = dfsph_cg_measure(fluid, walls, dt);
   const double particles = static_cast<double>(dfsph_cg_particles());
 
@@ -157,14 +157,14 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
     }
     // The operator on p: the velocities p would give, and their rates (on a rank, the velocity
     // update reads the ghosts' p and the rate pass their dv_p: each takes its owner's).
-    if (ranks_) halo_share_dfsph_step();
+    if (rank_) halo_share_dfsph_step();
     parallel().for_each(n, [&](uint32_t i) {
       Vec3 d = change_of(fluid, view, columns, p, walls, i, dt);
       if (state[i] & kBinds) d = dfsph_contact_project(contact[i], d);
       dv[i] = make_float4_record(d, 0.0f);
       columns_.set_velocity(i, d);
     });
-    if (ranks_) halo_share_velocities(dv, "DFSPH velocity steps");
+    if (rank_) halo_share_velocities(dv, "DFSPH velocity steps");
     // The rates of dv_p alone (linear, so the tracked values' rounding is never amplified by a
     // long step, as it would be by value(v + dv_p) - value).
     parallel().for_each(n, [&](uint32_t i) {

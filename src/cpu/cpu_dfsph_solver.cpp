@@ -109,11 +109,11 @@ DfsphErrors CpuBackend::dfsph_errors(DfsphSolve kind) {
       if (density) largest = error[i] > largest ? error[i] : largest;
     }
   int64_t particles = count_;
-  if (ranks_) {
-    halo_agree();  // (the shares' buffers: a rank that failed there meets the others here)
-    ranks_->all_sum(sum.terms(), ExactFloatSum::kTerms);
-    if (density) ranks_->all_max(&largest, 1);
-    particles = halo_world_count_;
+  if (rank_) {
+    rank_->agree();  // (the shares' buffers: a rank that failed there meets the others here)
+    rank_->transport().all_sum(sum.terms(), ExactFloatSum::kTerms);
+    if (density) rank_->transport().all_max(&largest, 1);
+    particles = rank_->world_count();
   }
   return {particles > 0 ? static_cast<float>(sum.value() / static_cast<double>(particles)) : 0.0f, largest};
 }
@@ -147,11 +147,11 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
     float carry_scale;
     void velocity_update(bool) { b.dfsph_correct(fluid, walls, dt, v, carried, carry_scale); }
     void share_velocities() {
-      if (b.ranks_) b.halo_share_velocities(v);
+      if (b.rank_) b.halo_share_velocities(v);
     }
     void rates() { b.dfsph_residuals(kind, fluid, walls, dt); }
     void share_steps() {
-      if (b.ranks_) b.halo_share_dfsph_step();
+      if (b.rank_) b.halo_share_dfsph_step();
     }
     DfsphErrors errors() { return b.dfsph_errors(kind); }
     void checked(uint32_t, const DfsphErrors&, bool) {}
@@ -189,7 +189,7 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
   const AccelerationFn non_pressure = simd_.acceleration_without_pressure_for(config_.selection());
   const NeighborColumns columns = columns_.view();
   const Float4* contact = dfsph_contacts_ ? dfsph_contact_.data() : nullptr;
-  const uint32_t* origin = origin_.data();  // null unless distributed
+  const uint32_t* origin = origins();  // null unless distributed
   const float a2max = parallel().reduce(
       count_, 0.0f,
       [&](uint32_t i, float& m) {

@@ -38,7 +38,7 @@ CpuBackend::HeightSpan CpuBackend::measure_height_span() const {
 uint32_t CpuBackend::scan_next_state(float& v2max) const {
   const Float4* next_pos = next_position_.data();
   const Float4* next_vel = next_velocity_.data();
-  const uint32_t* origin = origin_.data();  // null unless distributed
+  const uint32_t* origin = origins();  // null unless distributed
   const StateScan scan = parallel().reduce(
       count_, StateScan{},
       [&](uint32_t i, StateScan& s) {

@@ -56,7 +56,7 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
   // DFSPH's depth limit: H of the first step from the frame's positions, of each next one from the
   // positions a substep leaves before the sinks run (as the CUDA backend measures it, and as the
   // max speed is taken); a distributed world's ranks reduce it over the world with the maxima.
-  if (ranks_)
+  if (rank_)
     halo_begin_frame();
   else
     measure_fluid_height();
@@ -78,7 +78,7 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
   try {
     while (clock_running(clock, params.stepping.max_substeps)) {
       // A distributed world's ranks stop together: a cancel or budget seen by any rank stops all.
-      if (ranks_ ? halo_any(scene.interrupt.requested()) : scene.interrupt.requested()) {
+      if (rank_ ? rank_->any(scene.interrupt.requested()) : scene.interrupt.requested()) {
         report.interrupted = true;
         break;
       }
@@ -89,7 +89,7 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
           config_.solver == Solver::Dfsph         ? substep_dfsph(fluid, scene, clock.time, report, tallies)
           : config_.integrator == Integrator::Rk4 ? substep_rk4(fluid, scene, clock.time, report)
                                                   : substep_euler(fluid, scene, clock.time, report);
-      if (ranks_)
+      if (rank_)
         bad = halo_end_substep(bad);
       else if (bad == kAllFinite)
         measure_fluid_height();
@@ -98,7 +98,7 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
         non_finite_.substep = clock.substeps + 1;
         non_finite_.dt = clock.dt_float;
         // (Every rank of a distributed world has found it in halo_end_substep's agreement.)
-        if (ranks_) throw AgreedRankFailure(Status::NonFinite, non_finite_message(non_finite_, limits));
+        if (rank_) throw AgreedRankFailure(Status::NonFinite, non_finite_message(non_finite_, limits));
         throw Error(Status::NonFinite, non_finite_message(non_finite_, limits));
       }
       if (!scene.sinks.empty()) apply_sinks(scene, report);
@@ -106,7 +106,7 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
     }
     // The frame's end: a rank that failed after the last substep's agreement (its sinks) fails
     // every rank; nothing after this can fail.
-    if (ranks_) halo_agree();
+    if (rank_) rank_->agree();
   } catch (const Error& e) {
     if (e.status() != Status::NonFinite) roll_back();  // NonFinite has rolled back already
     throw;
@@ -115,7 +115,8 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
     throw;
   }
   report_clock(clock, report);
-  if (ranks_ && !load_sums_.empty()) halo_sum_loads();  // every rank reads the world's loads
+  // Every rank reads the world's loads.
+  if (rank_ && !load_sums_.empty()) rank_->sum_loads(load_sums_.data(), load_sums_.size());
   report.pressure_solve = finish_solve(tallies.pressure);
   report.divergence_solve = finish_solve(tallies.divergence);
   report.max_speed = max_speed_;

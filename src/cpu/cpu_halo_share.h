@@ -1,21 +1,22 @@
 // SPDX-License-Identifier: MIT
-// The halo's refresh of per-particle values (cpu_halo.cpp, cpu_halo_solvers.cpp): each owned
-// particle beside another rank's slab sends a record to that rank, each ghost takes its owner's.
+// The halo's refresh of per-particle values (CpuRankHalo::share, for the records of cpu_halo.cpp,
+// cpu_halo_solvers.cpp and cpu_halo_springs.cpp): each owned particle beside another rank's slab
+// sends a record to that rank, each ghost takes its owner's.
 #pragma once
 
 #include <cstring>
 #include <string>
+#include <vector>
 
-#include "cpu_backend_impl.h"
+#include "../core/status.h"
+#include "cpu_rank_halo.h"
 
 namespace sph {
 
-// Each owned particle beside another rank's slab sends make(i) (a Record, which starts with the
-// particle's id) to that rank; each ghost takes apply(i, record) from its owner's. Both sides
-// list the particles in the sorted order, which is the same on every rank for the particles
-// they share: the receiver reads them in its own order (the ids check it).
+// Both sides list the particles in the sorted order, which is the same on every rank for the
+// particles they share: the receiver reads them in its own order (the ids check it).
 template <class Record, class Make, class Apply>
-void CpuBackend::halo_share(const char* what, Make&& make, Apply&& apply) {
+void CpuRankHalo::share(const char* what, Make&& make, Apply&& apply) {
   const RankTransport& t = *ranks_;
   const int me = t.rank();
   const int size = t.size();
@@ -23,7 +24,7 @@ void CpuBackend::halo_share(const char* what, Make&& make, Apply&& apply) {
   for (uint32_t i = 0; i < count_; ++i) {
     if (ghost(i)) continue;
     int to[2];
-    const int n = slabs_.ghost_destinations(halo_layer(i), me, to);
+    const int n = slabs_.ghost_destinations(layer(i), me, to);
     if (n == 0) continue;
     const Record r = make(i);
     const unsigned char* from = reinterpret_cast<const unsigned char*>(&r);

@@ -20,6 +20,7 @@
 #include "../core/halo_records.h"
 #include "../core/rank_probe_points.h"
 #include "../core/rank_sums.h"
+#include "cpu_backend_impl.h"
 #include "cpu_halo_share.h"
 
 namespace sph {
@@ -27,7 +28,7 @@ namespace sph {
 void CpuBackend::halo_share_dfsph_density() {
   using Record = HaloDfsphDensityRecord;
   float* factor = dfsph_factor_.data();
-  halo_share<Record>(
+  rank_->share<Record>(
       "DFSPH densities",
       [&](uint32_t i) {
         return Record{id_[i], density_[i], factor[i], velocity_[i].w, neighbors_[i]};
@@ -44,7 +45,7 @@ void CpuBackend::halo_share_dfsph_density() {
 
 void CpuBackend::halo_share_velocities(Float4* v, const char* what) {
   using Record = HaloVelocityRecord;  // (its padding a member, zeroed)
-  halo_share<Record>(
+  rank_->share<Record>(
       what,
       [&](uint32_t i) {
         return Record{id_[i], {0u, 0u, 0u}, v[i]};
@@ -58,7 +59,7 @@ void CpuBackend::halo_share_velocities(Float4* v, const char* what) {
 void CpuBackend::halo_share_dfsph_step() {
   using Record = HaloDfsphStepRecord;
   float* k = columns_.dfsph_step();
-  halo_share<Record>(
+  rank_->share<Record>(
       "DFSPH pressure steps",
       [&](uint32_t i) {
         return Record{id_[i], k[i]};
@@ -66,23 +67,23 @@ void CpuBackend::halo_share_dfsph_step() {
       [&](uint32_t i, const Record& r) { k[i] = r.k; });
 }
 
-void CpuBackend::halo_pick_probe_points(const SceneFrame& scene) {
-  pick_rank_probe_points(*ranks_, slabs_, config_.kernel_radius, scene.probes.data(), scene.probes.size(),
-                         probe_points_.data(), probe_points_.size());
+void CpuRankHalo::pick_probe_points(const ProbeView* probes, size_t probe_count, ProbeGather* points,
+                                    size_t point_count) const {
+  pick_rank_probe_points(*ranks_, slabs_, kernel_radius_, probes, probe_count, points, point_count);
 }
 
-void CpuBackend::halo_sum_loads() {
+void CpuRankHalo::sum_loads(ColliderLoadSums* loads, size_t count) const {
   HostVector<double> sums;
-  sums.reserve(6 * load_sums_.size());
-  for (const ColliderLoadSums& c : load_sums_) {
-    sums.insert(sums.end(), c.linear, c.linear + 3);
-    sums.insert(sums.end(), c.angular, c.angular + 3);
+  sums.reserve(6 * count);
+  for (size_t c = 0; c < count; ++c) {
+    sums.insert(sums.end(), loads[c].linear, loads[c].linear + 3);
+    sums.insert(sums.end(), loads[c].angular, loads[c].angular + 3);
   }
   ordered_rank_sum(*ranks_, sums.data(), sums.size());
-  for (size_t c = 0; c < load_sums_.size(); ++c)
+  for (size_t c = 0; c < count; ++c)
     for (int k = 0; k < 3; ++k) {
-      load_sums_[c].linear[k] = sums[6 * c + static_cast<size_t>(k)];
-      load_sums_[c].angular[k] = sums[6 * c + 3 + static_cast<size_t>(k)];
+      loads[c].linear[k] = sums[6 * c + static_cast<size_t>(k)];
+      loads[c].angular[k] = sums[6 * c + 3 + static_cast<size_t>(k)];
     }
 }
 

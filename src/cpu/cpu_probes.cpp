@@ -33,7 +33,8 @@ void CpuBackend::sample_probes(const SceneFrame& scene, float dt, FrameReport& r
     for (uint32_t q = 0; q < p.point_count; ++q)
       points[p.first_point + q] = gather_probe_point(constants, view, pos, vel, probe_point(p, q));
   });
-  if (ranks_) halo_pick_probe_points(scene);  // every rank reads each point's owner's sums
+  // Every rank reads each point's owner's sums.
+  if (rank_) rank_->pick_probe_points(probes, scene.probes.size(), points, probe_points_.size());
   for (int k = 0; k < probe_count; ++k) {
     const ProbeView& p = probes[k];
     ProbeGather g = zero_probe_gather();

@@ -20,7 +20,7 @@ void CpuBackend::spring_pass(float dt, bool first_evaluation, FrameReport& repor
   const SpringConstants& c = spring_constants_;
   // A distributed world's ghosts (origin != 0) neither link nor move: their lists name partners
   // by id, and their owners compute their springs (cpu_halo_springs.cpp).
-  const uint32_t* origin = origin_.data();  // null unless distributed
+  const uint32_t* origin = origins();  // null unless distributed
   if (link_from_[0] != kNoPendingLinks) {
     const GridView view = grid_.view();
     const uint32_t* ids = id_.data();
@@ -34,7 +34,7 @@ void CpuBackend::spring_pass(float dt, bool first_evaluation, FrameReport& repor
       }
       spring_candidates(c, view, pos, ids, from, lists[i], static_cast<uint32_t>(i), mine);
     });
-    if (ranks_) halo_share_spring_candidates();
+    if (rank_) rank_->share_spring_candidates();
     parallel().for_each(count_, [&](uint32_t i) {
       if (!(origin && origin[i])) spring_link(pos, candidates, static_cast<uint32_t>(i), lists[i]);
     });

@@ -17,16 +17,16 @@ namespace sph {
 void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame& scene, StageTime at,
                                   FrameReport& report, float diffusion_dt) {
   auto t = Clock::now();
-  if (ranks_) halo_gather();
-  grid_.build(position_.data(), count_, workers_, ranks_ ? &halo_shape_ : nullptr,
-              ranks_ ? halo_visit_.data() : nullptr);
+  if (rank_) rank_->gather();
+  grid_.build(position_.data(), count_, workers_, rank_ ? rank_->grid_shape() : nullptr,
+              rank_ ? rank_->visit_order() : nullptr);
   columns_.resize(count_);
   // The columns copy each block of the new order as soon as it is reordered (data() is the new
   // order inside the reorder).
   store_.permute(grid_.order().data(), count_, parallel(), [this](size_t first, size_t last) {
     columns_.copy_state(position_.data(), velocity_.data(), first, last);
   });
-  if (ranks_) halo_keys();
+  if (rank_) rank_->after_sort(grid_);
   report.stage_ms[kStageHashSort] += static_cast<float>(elapsed_ms(t));
 
   t = Clock::now();
@@ -64,7 +64,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
       columns_.set_density(i, 0.0f, vel[i].w);
       columns_.set_neighbor_count(i, s.neighbor_count);
     });
-    if (ranks_) halo_share_dfsph_density();
+    if (rank_) halo_share_dfsph_density();
   } else {
     parallel().for_each(count_, [&](uint32_t i) {
       DensitySample s = simd_.density(fluid, view, columns, static_cast<uint32_t>(i));
@@ -83,7 +83,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
       columns_.set_density(static_cast<uint32_t>(i), pos[i].w, vel[i].w);
       columns_.set_neighbor_count(static_cast<uint32_t>(i), s.neighbor_count);
     });
-    if (ranks_) halo_share_density();
+    if (rank_) halo_share_density();
   }
   // The Shepard filter, unless the density diffusion keeps the carried density instead
   // (density_diffusion.h says why one or the other).
@@ -105,7 +105,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
       vel[i].w = 1.0f / normalized_[i];
       columns_.set_density(static_cast<uint32_t>(i), pos[i].w, vel[i].w);
     });
-    if (ranks_) halo_share_density();  // the ghosts' filtered densities are their owners'
+    if (rank_) halo_share_density();  // the ghosts' filtered densities are their owners'
   }
   if (diffusion_dt > 0.0f) diffuse_density(fluid, diffusion_dt);
   if (config_.features & kFeatureSurfaceTension) {
@@ -114,7 +114,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
       normals_[i] = simd_.colour_normal(fluid, view, columns, static_cast<uint32_t>(i));
       columns_.set_normal(static_cast<uint32_t>(i), normals_[i]);
     });
-    if (ranks_) halo_share_normals();
+    if (rank_) halo_share_normals();
   }
   report.stage_ms[kStageDensity] += static_cast<float>(elapsed_ms(t));
 }
@@ -141,7 +141,7 @@ void CpuBackend::diffuse_density(const FluidConstants& fluid, float dt) {
     vel[i].w = 1.0f / normalized_[i];
     columns_.set_density(static_cast<uint32_t>(i), pos[i].w, vel[i].w);
   });
-  if (ranks_) halo_share_density();  // the ghosts' diffused densities are their owners'
+  if (rank_) halo_share_density();  // the ghosts' diffused densities are their owners'
 }
 
 // Acceleration of particle i: the neighbour gather with the world's force terms compiled in

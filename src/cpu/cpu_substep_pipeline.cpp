@@ -18,7 +18,7 @@ void CpuBackend::collide(const SceneFrame& scene, const SubstepTime& time, OldPo
   const float h = config_.kernel_radius;
   Float4* next_pos = next_position_.data();
   Float4* next_vel = next_velocity_.data();
-  const uint32_t* origin = origin_.data();  // null unless distributed
+  const uint32_t* origin = origins();  // null unless distributed
   parallel().for_each(count_, [&](uint32_t i) {
     if (origin && origin[i]) return;  // (a distributed world's halo: its owner moves it)
     Vec3 x = xyz(next_pos[i]);
@@ -56,7 +56,7 @@ uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame
   // end-of-substep scan (max speed, first non-finite particle) rides in the force loop: one pass
   // over the particles less. Both reductions are order-independent, so the bits are the scan's.
   const bool scan_in_loop = scene.colliders.empty() && !loads_on();
-  const uint32_t* origin = origin_.data();  // null unless distributed
+  const uint32_t* origin = origins();  // null unless distributed
   const StateScan forces = parallel().reduce(
       count_, StateScan{},
       [&](uint32_t i, StateScan& r) {
@@ -119,7 +119,7 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
     const NeighborColumns columns = columns_.view();
     const ParticleState* start = rk4_start_.data();
     Rk4Accumulator* sums = rk4_sum_.data();
-    const uint32_t* origin = origin_.data();  // null unless distributed
+    const uint32_t* origin = origins();  // null unless distributed
     const float stage_a2max = parallel().reduce(
         count_, 0.0f,
         [&](uint32_t i, float& m) {
@@ -151,7 +151,7 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
     uint32_t bad = finish_substep(v2max, bad_index);
     // A distributed world's stage ends as a substep does: the ghosts go (the next stage's sort
     // gathers them anew) and the ranks agree on a failure, so all stop at the same stage.
-    if (ranks_) bad = halo_end_substep(bad);
+    if (rank_) bad = halo_end_substep(bad);
     report.stage_ms[kStageIntegrate] += static_cast<float>(elapsed_ms(t));
     if (bad != kAllFinite) return bad;
   }
