@@ -338,7 +338,7 @@ class CpuBackend final : public Backend {
   HostVector<Vec3> load_points_;             // per collider: at the wall pass's time, at the end
   HostVector<ProbeGather> probe_points_;     // per sample point of the frame's probes
   HostVector<ProbeSums> probe_sums_;         // per probe: the frame's samples
-  HostVector<uint32_t> keep_order_;          // apply_sinks: the particles that stay
+  HostVector<uint32_t> keep_order_;          // apply_sinks, the rank's halo: the particles that stay
   // The three maxima an integration pass reduces, and the first non-finite particle.
   struct StateScan {
     float a2max = 0.0f, v2max = 0.0f;

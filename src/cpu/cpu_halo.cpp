@@ -55,6 +55,7 @@ CpuRankHalo::CpuRankHalo(std::shared_ptr<const RankTransport> ranks, const Distr
       options_(options),
       store_(particles.store),
       count_(particles.count),
+      keep_(particles.keep),
       workers_(particles.workers),
       kernel_radius_(particles.kernel_radius),
       position_(particles.position),
@@ -251,7 +252,7 @@ void CpuBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks, const 
     throw Error(Status::Internal, "attach_ranks: the backend already holds particles");
   rank_ = std::make_unique<CpuRankHalo>(
       std::move(ranks), options,
-      CpuRankParticles{store_, count_, workers_, config_.kernel_radius, position_, id_, springs_,
+      CpuRankParticles{store_, count_, keep_order_, workers_, config_.kernel_radius, position_, id_, springs_,
                        spring_candidates_, link_from_});
   // Springs across ranks (cpu_halo_springs.cpp): the lists name their partners by id through the
   // halo's steps, so no reorder may rewrite them as storage indices.

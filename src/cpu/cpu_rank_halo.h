@@ -38,11 +38,13 @@ struct ProbeGather;
 struct ProbeView;
 
 // The backend's particles as its rank moves them: the store and its count (which the migration,
-// the ghosts and their removal change), the workers of its loops, and the arrays the halo's own
-// steps read (the springs' null without SPH_FEATURE_SPRINGS).
+// the ghosts and their removal change), the list of the particles a permutation keeps (shared
+// with the sinks, which never run inside a halo step), the workers of its loops, and the arrays
+// the halo's own steps read (the springs' null without SPH_FEATURE_SPRINGS).
 struct CpuRankParticles {
   CpuParticleStore& store;
   uint32_t& count;
+  HostVector<uint32_t>& keep;
   const CpuParallel& workers;
   float kernel_radius;
   CpuArrayRef<Float4> position;
@@ -137,6 +139,7 @@ class CpuRankHalo {
   // The backend's (CpuRankParticles).
   CpuParticleStore& store_;
   uint32_t& count_;
+  HostVector<uint32_t>& keep_;
   const CpuParallel& workers_;
   float kernel_radius_;
   CpuArrayRef<Float4> position_;
@@ -150,7 +153,6 @@ class CpuRankHalo {
   DistributedCounters counters_;
   GridShape shape_{};
   HostVector<uint32_t> visit_;
-  HostVector<uint32_t> keep_;
   int64_t world_count_ = 0;
   CpuArrayRef<uint64_t> sort_key_;  // Carried
   CpuArrayRef<uint32_t> origin_;    // Sorted (origins())
