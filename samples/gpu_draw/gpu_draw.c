@@ -20,8 +20,8 @@
  * Usage: gpu_draw [OUTPUT_DIR] [--frames N]   (default out/gpu_draw, 30 frames at 60 fps)
  * Writes OUTPUT_DIR/frame_0000.png .. frame_NNNN.png (640 x 360), then reads the last frame's
  * vertices back from GL and checks them against the world's positions (exit 1 if any differs).
- * Exits 77 when there is no
- * CUDA device or no EGL device for it (scripts/gpu-test runs it on a GPU machine). */
+ * Exits 77 when there is no CUDA device or no EGL device for it (scripts/gpu-test runs it on a
+ * GPU machine). */
 #include <cuda_runtime_api.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -37,8 +37,9 @@
  * picture can look plausible with stale or missing vertices; this names which side went wrong
  * when png_check finds a blank image. Returns 0 when all count vertices match bit for bit. */
 static int check_last_frame(particle_renderer* renderer, const draw_scene* scene, uint32_t count) {
-  particle_vertex* vertices = (particle_vertex*)malloc(sizeof(particle_vertex) * (count ? count : 1));
-  float* positions = (float*)malloc(12 * (size_t)(count ? count : 1));
+  const size_t slots = count ? count : 1; /* (malloc(0) may give NULL) */
+  particle_vertex* vertices = (particle_vertex*)malloc(sizeof(particle_vertex) * slots);
+  float* positions = (float*)malloc(12 * slots);
   uint32_t i, differ = 0, first = 0, n = 0;
   int failed = !vertices || !positions;
   failed =
@@ -48,8 +49,8 @@ static int check_last_frame(particle_renderer* renderer, const draw_scene* scene
     failed = 1;
   }
   failed = failed || particle_renderer_read_vertices(renderer, count, vertices) ||
-           sample_failed(sph_world_copy_attribute(scene->world, SPH_ATTRIBUTE_POSITION, positions,
-                                                  12ull * (count ? count : 1), 0, 0, count, NULL),
+           sample_failed(sph_world_copy_attribute(scene->world, SPH_ATTRIBUTE_POSITION, positions, 12 * slots,
+                                                  0, 0, count, NULL),
                          "sph_world_copy_attribute");
   for (i = 0; !failed && i < count; ++i) {
     const float* x = positions + 3 * i;

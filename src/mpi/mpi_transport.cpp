@@ -27,6 +27,34 @@ int64_t signature(Collective kind, int64_t detail) {
   return static_cast<int64_t>(kind) * (int64_t{1} << 32) + (detail & 0xffffffffll);
 }
 
+const char* collective_name(Collective kind) {
+  switch (kind) {
+    case Collective::AllMinInt64:
+      return "all_min of int64";
+    case Collective::AllMaxInt64:
+      return "all_max of int64";
+    case Collective::AllSumInt64:
+      return "all_sum of int64";
+    case Collective::AllMaxFloat:
+      return "all_max of float";
+    case Collective::ExclusiveSum:
+      return "exclusive_sum";
+    case Collective::Alltoall:
+      return "exchange's MPI_Alltoall";
+    case Collective::Alltoallv:
+      return "exchange's MPI_Alltoallv";
+    case Collective::Gather:
+      return "gather's MPI_Gather to root";
+    case Collective::Gatherv:
+      return "gather's MPI_Gatherv to root";
+    case Collective::BroadcastSize:
+      return "broadcast's size from root";
+    case Collective::BroadcastBytes:
+      return "broadcast's bytes from root";
+  }
+  return "an unknown collective";
+}
+
 std::string describe(int64_t sig) {
   const auto kind = static_cast<Collective>(sig >> 32);
   return std::string(collective_name(kind)) + " (" + std::to_string(sig & 0xffffffffll) + ")";
@@ -58,34 +86,6 @@ MpiTransport::MpiTransport(MPI_Comm comm) {
   if (agreed != MPI_SUCCESS) MPI_Comm_free(&comm_);  // no destructor runs after a throw here
   check(agreed, "MPI_Allreduce (the collective check's switch)");
   check_collectives_ = on != 0;
-}
-
-const char* collective_name(Collective kind) {
-  switch (kind) {
-    case Collective::AllMinInt64:
-      return "all_min of int64";
-    case Collective::AllMaxInt64:
-      return "all_max of int64";
-    case Collective::AllSumInt64:
-      return "all_sum of int64";
-    case Collective::AllMaxFloat:
-      return "all_max of float";
-    case Collective::ExclusiveSum:
-      return "exclusive_sum";
-    case Collective::Alltoall:
-      return "exchange's MPI_Alltoall";
-    case Collective::Alltoallv:
-      return "exchange's MPI_Alltoallv";
-    case Collective::Gather:
-      return "gather's MPI_Gather to root";
-    case Collective::Gatherv:
-      return "gather's MPI_Gatherv to root";
-    case Collective::BroadcastSize:
-      return "broadcast's size from root";
-    case Collective::BroadcastBytes:
-      return "broadcast's bytes from root";
-  }
-  return "an unknown collective";
 }
 
 void MpiTransport::match(Collective kind, int64_t detail) const {

@@ -23,7 +23,6 @@ enum class Collective : int64_t {
   BroadcastSize,
   BroadcastBytes,
 };
-const char* collective_name(Collective kind);
 
 class MpiTransport final : public RankTransport {
  public:
