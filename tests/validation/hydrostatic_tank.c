@@ -227,6 +227,28 @@ void run_tank(const tank_case* tc) {
   inside = (uint8_t*)malloc(n);
   assert_true(layer_sum && layer_rho && layer_y && layer_count && particle_p && particle_y && inside);
   memset(inside, 1, n);
+  /* HYDRO_PACK=N (and HYDRO_PACK_DT, s, default 1 ms): before the run, N steps without gravity,
+   * every velocity zeroed after each, so the walls' over-read at the edges moves the spawned
+   * lattice to where it reads rho0 before the column is loaded (a measurement of the deep tanks'
+   * first-frame kick, docs/validation.md, "Session 23"). */
+  if (getenv("HYDRO_PACK")) {
+    const int pack_steps = atoi(getenv("HYDRO_PACK"));
+    const float pack_dt = getenv("HYDRO_PACK_DT") ? (float)atof(getenv("HYDRO_PACK_DT")) : 0.001f;
+    sph_world_params loaded, weightless;
+    float* still = (float*)calloc(3 * (size_t)n, sizeof(float));
+    assert_non_null(still);
+    sph_world_params_init(&loaded);
+    EXPECT_OK(sph_world_get_params(world, &loaded));
+    weightless = loaded;
+    weightless.gravity.x = weightless.gravity.y = weightless.gravity.z = 0.0f;
+    EXPECT_OK(sph_world_set_params(world, &weightless));
+    for (int s = 0; s < pack_steps; ++s) {
+      EXPECT_OK(sph_world_step(world, pack_dt));
+      EXPECT_OK(sph_world_set_attribute(world, SPH_ATTRIBUTE_VELOCITY, still, 12 * (uint64_t)n, 0, 0, n));
+    }
+    EXPECT_OK(sph_world_set_params(world, &loaded));
+    free(still);
+  }
   for (int f = 0; f < frames; ++f) {
     EXPECT_OK(sph_world_step(world, (float)frame_dt));
     if ((f + 1) * frame_dt < tc->damp_until && f % damp_every == damp_every - 1) {
