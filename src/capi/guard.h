@@ -37,6 +37,19 @@ inline void report_failure(const LogTarget& log, const char* function, sph_resul
   }
 }
 
+// Tells the log callback of a successful call's warning (SPH_LOG_WARNING, code SPH_OK). The
+// thread's last error stays clear: the call succeeded, whatever the callback called meanwhile.
+inline void report_warning(const LogTarget& log, const char* function, const char* what) {
+  static thread_local bool in_callback = false;
+  if (!log.fn || in_callback) return;
+  char message[1024];
+  std::snprintf(message, sizeof message, "%s: %s", function, what);
+  in_callback = true;
+  log.fn(log.user_data, SPH_LOG_WARNING, SPH_OK, message);
+  in_callback = false;
+  clear_last_error();
+}
+
 template <class Body>
 sph_result guarded(const char* function, const LogTarget& log, Body&& body) noexcept {
   clear_last_error();

@@ -182,6 +182,63 @@ static void test_log_callback(void** state) {
   assert_int_equal(log.calls, 3);
 }
 
+/* One collider of an SDF made by sph_sdf_create_shape in a world of `features`, spacing 2 cm
+ * (lattice step 1.414 cm); returns how many times the log callback was called meanwhile. */
+static int collider_log_calls(sph_context* context, log_record* log, uint32_t features, sph_shape shape,
+                              float voxel) {
+  sph_world_def wdef;
+  sph_world* world = NULL;
+  sph_shape_desc desc;
+  sph_sdf* sdf = NULL;
+  sph_collider_def cdef;
+  sph_collider_id id;
+  int before;
+  sph_world_def_init(&wdef);
+  wdef.capacity = 64;
+  wdef.particle_spacing = 0.02f;
+  wdef.features = features;
+  EXPECT_OK(sph_world_create(context, &wdef, &world));
+  sph_shape_desc_init(&desc);
+  desc.shape = shape;
+  desc.half_extents = (sph_vec3){0.1f, 0.1f, 0.1f};
+  desc.voxel_size = voxel;
+  EXPECT_OK(sph_sdf_create_shape(context, &desc, &sdf));
+  sph_collider_def_init(&cdef);
+  cdef.sdf = sdf;
+  before = log->calls;
+  EXPECT_OK(sph_collider_create(world, &cdef, &id));
+  assert_string_equal(sph_get_last_error(), ""); /* a success, whatever it logged */
+  EXPECT_OK(sph_world_destroy(world));
+  EXPECT_OK(sph_sdf_destroy(sdf));
+  return log->calls - before;
+}
+
+/* With the walls in the density a collider whose SDF is coarser than half the lattice step
+ * (here 7.07 mm) is a warning (SPH_LOG_WARNING, SPH_OK) naming the voxel; a finer one, a plane's
+ * (exact at any voxel), or a world without the feature is not logged (docs/api.md, log_fn). */
+static void test_log_coarse_sdf_warning(void** state) {
+  log_record log;
+  sph_context_def def;
+  sph_context* context = NULL;
+  (void)state;
+  memset(&log, 0, sizeof log);
+  sph_test_context_def_init(&def);
+  def.log_fn = record_log;
+  def.log_user_data = &log;
+  EXPECT_OK(sph_context_create(&def, &context));
+  assert_int_equal(collider_log_calls(context, &log, SPH_FEATURE_BOUNDARY_DENSITY, SPH_SHAPE_BOX, 0.01f), 1);
+  assert_int_equal(log.level, SPH_LOG_WARNING);
+  assert_int_equal(log.code, SPH_OK);
+  assert_non_null(strstr(log.message, "sph_collider_create"));
+  assert_non_null(strstr(log.message, "0.01 m"));
+  assert_non_null(strstr(log.message, "0.007071 m"));
+  assert_int_equal(collider_log_calls(context, &log, SPH_FEATURE_BOUNDARY_DENSITY, SPH_SHAPE_BOX, 0.005f), 0);
+  assert_int_equal(collider_log_calls(context, &log, SPH_FEATURE_BOUNDARY_DENSITY, SPH_SHAPE_PLANE, 0.01f),
+                   0);
+  assert_int_equal(collider_log_calls(context, &log, 0u, SPH_SHAPE_BOX, 0.01f), 0);
+  EXPECT_OK(sph_context_destroy(context));
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_version),
@@ -190,6 +247,7 @@ int main(void) {
       cmocka_unit_test(test_last_error),
       cmocka_unit_test(test_last_error_thread_local),
       cmocka_unit_test(test_log_callback),
+      cmocka_unit_test(test_log_coarse_sdf_warning),
   };
   return cmocka_run_group_tests_name("capi_diagnostics", tests, NULL, NULL);
 }
