@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "coarse_sdf_warning.h"
 
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -10,17 +9,6 @@
 
 namespace sph {
 namespace {
-
-// The longest voxel edge of an asset (m): the largest column norm of its index-to-local map.
-double longest_voxel_edge(const SdfAsset& sdf) {
-  const float* m = sdf.index_to_local().m;
-  double longest = 0.0;
-  for (int c = 0; c < 3; ++c)
-    longest = std::max(longest,
-                       std::sqrt(static_cast<double>(m[c]) * m[c] + static_cast<double>(m[4 + c]) * m[4 + c] +
-                                 static_cast<double>(m[8 + c]) * m[8 + c]));
-  return longest;
-}
 
 // Whether an asset's distances are an affine function of the voxel index (a plane's SDF), within
 // a thousandth of a voxel: the affine function through voxel (0, 0, 0) and its neighbours along
@@ -53,7 +41,7 @@ void warn_if_coarse_for_boundary_density(const sph_world* world, const SdfAsset*
   const WorldConfig& config = world->world->config();
   if (!sdf || !(config.features & SPH_FEATURE_BOUNDARY_DENSITY)) return;
   const double half_step = 0.5 * config.particle_spacing / std::sqrt(2.0);
-  const double voxel = longest_voxel_edge(*sdf);
+  const double voxel = sdf->max_voxel_size();
   if (!(voxel > half_step * (1.0 + 1e-4)) || is_affine(*sdf, voxel)) return;
   char what[512];
   std::snprintf(what, sizeof what,

@@ -47,6 +47,10 @@ SdfAsset::SdfAsset(int32_t nx, int32_t ny, int32_t nz, const Affine3x4& index_to
   distance_.assign(voxel_count(), 0.0f);
 }
 
+double SdfAsset::max_voxel_size() const {
+  return to_matrix(index_to_local_).topLeftCorner<3, 3>().colwise().norm().maxCoeff();
+}
+
 bool SdfAsset::has_moving_surface() const {
   for (const Vec3& v : velocity_)
     if (v.x != 0.0f || v.y != 0.0f || v.z != 0.0f) return true;

@@ -26,6 +26,9 @@ class SdfAsset {
   int32_t nz() const { return nz_; }
   uint64_t voxel_count() const { return static_cast<uint64_t>(nx_) * ny_ * nz_; }
   const Affine3x4& index_to_local() const { return index_to_local_; }
+  // The longest voxel edge in local units: the largest column norm of the index-to-local map's
+  // linear part (the shortest is the sampling view's min_voxel_size).
+  double max_voxel_size() const;
 
   HostVector<float>& distance() { return distance_; }
   HostVector<Vec3>& velocity() { return velocity_; }   // empty when the asset has none
