@@ -25,6 +25,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "mpi_compare.h"
 #include "mpi_springs_cases.h"
@@ -182,7 +183,10 @@ static void check_checkpoint(sph_context* context, uint32_t capacity) {
   const spring_case c = {
       "checkpoint",     2.0f, 1e4f, 20.0f, 0.0f, 0.1f, 0, 0, 0, SPH_INTEGRATOR_SYMPLECTIC_EULER,
       SPH_SOLVER_WCSPH, 20};
-  const char* path = "mpi_springs_checkpoint.sphcp";
+  /* A name of this run's own: ctest -j2 runs mpi_springs_np1 and _np2 side by side in one folder,
+   * and with one name each restored the other's save (CI, session 24). Rank 0's process id, shared. */
+  long run_id = (long)getpid();
+  char path[128];
   sph_world_def def;
   sph_world* single = NULL;
   sph_world* world = NULL;
@@ -190,6 +194,8 @@ static void check_checkpoint(sph_context* context, uint32_t capacity) {
   sph_collider_id single_tank, tank;
   MPI_Comm alone;
   char name[512];
+  MPI_Bcast(&run_id, 1, MPI_LONG, 0, MPI_COMM_WORLD);
+  snprintf(path, sizeof path, "mpi_springs_checkpoint.np%d.%ld.sphcp", g_size, run_id);
   mpi_test_world_def(&def);
   if (capacity) def.capacity = capacity;
   def.features = SPH_FEATURE_SPRINGS;
