@@ -30,13 +30,13 @@ bool is_affine(const SdfAsset& sdf, double voxel) {
   return true;
 }
 
+}  // namespace
+
 // With the walls in the density an SDF's edges and corners read more wall than they hold, by a
 // share that grows with the voxel (the trilinear sampling smooths the kink), and deep still water
 // under DFSPH bursts from them (docs/physics.md, "Walls in the density" and DFSPH, Limits). A
 // coarse asset is legal; the log says so when a collider takes it. A plane's SDF is exact at any
 // voxel: no warning.
-}  // namespace
-
 void warn_if_coarse_for_boundary_density(const sph_world* world, const SdfAsset* sdf) {
   const WorldConfig& config = world->world->config();
   if (!sdf || !(config.features & SPH_FEATURE_BOUNDARY_DENSITY)) return;

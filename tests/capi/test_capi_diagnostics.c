@@ -138,19 +138,25 @@ static void record_log(void* user_data, sph_log_level level, sph_result code, co
   snprintf(r->message, sizeof r->message, "%s", message ? message : "(null)");
 }
 
-static void test_log_callback(void** state) {
-  log_record log;
+/* A test context whose log callback records into *log (cleared first). */
+static sph_context* create_logging_context(log_record* log) {
   sph_context_def def;
   sph_context* context = NULL;
+  memset(log, 0, sizeof *log);
+  sph_test_context_def_init(&def);
+  def.log_fn = record_log;
+  def.log_user_data = log;
+  EXPECT_OK(sph_context_create(&def, &context));
+  return context;
+}
+
+static void test_log_callback(void** state) {
+  log_record log;
+  sph_context* context = create_logging_context(&log);
   sph_world_def wdef;
   sph_world* world = NULL;
   sph_world_params params;
   (void)state;
-  memset(&log, 0, sizeof log);
-  sph_test_context_def_init(&def);
-  def.log_fn = record_log;
-  def.log_user_data = &log;
-  EXPECT_OK(sph_context_create(&def, &context));
   /* A failed world creation on this context is logged, with the same message. */
   sph_world_def_init(&wdef);
   wdef.capacity = 0xffffffffu;
@@ -218,14 +224,8 @@ static int collider_log_calls(sph_context* context, log_record* log, uint32_t fe
  * (exact at any voxel), or a world without the feature is not logged (docs/api.md, log_fn). */
 static void test_log_coarse_sdf_warning(void** state) {
   log_record log;
-  sph_context_def def;
-  sph_context* context = NULL;
+  sph_context* context = create_logging_context(&log);
   (void)state;
-  memset(&log, 0, sizeof log);
-  sph_test_context_def_init(&def);
-  def.log_fn = record_log;
-  def.log_user_data = &log;
-  EXPECT_OK(sph_context_create(&def, &context));
   assert_int_equal(collider_log_calls(context, &log, SPH_FEATURE_BOUNDARY_DENSITY, SPH_SHAPE_BOX, 0.01f), 1);
   assert_int_equal(log.level, SPH_LOG_WARNING);
   assert_int_equal(log.code, SPH_OK);
