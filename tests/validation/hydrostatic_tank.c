@@ -249,8 +249,28 @@ void run_tank(const tank_case* tc) {
     EXPECT_OK(sph_world_set_params(world, &loaded));
     free(still);
   }
+  /* HYDRO_RAMP=R (s): gravity rises linearly from 0 to its value over the first R seconds, in
+   * steps of a quarter frame, so the column's hydrostatic pressure is built in ~4R/frame small
+   * loads instead of one (a measurement of the deep tanks' first-frame kick: is it the sudden
+   * load? docs/validation.md, "Session 25"). */
+  const double ramp_seconds = getenv("HYDRO_RAMP") ? atof(getenv("HYDRO_RAMP")) : 0.0;
+  sph_world_params ramp_params;
+  sph_world_params_init(&ramp_params);
+  EXPECT_OK(sph_world_get_params(world, &ramp_params));
+  const sph_vec3 full_gravity = ramp_params.gravity;
   for (int f = 0; f < frames; ++f) {
-    EXPECT_OK(sph_world_step(world, (float)frame_dt));
+    if (f * frame_dt < ramp_seconds) {
+      for (int q = 0; q < 4; ++q) {
+        const double share = fmin(1.0, (f * frame_dt + (q + 1) * 0.25 * frame_dt) / ramp_seconds);
+        ramp_params.gravity.x = (float)(share * full_gravity.x);
+        ramp_params.gravity.y = (float)(share * full_gravity.y);
+        ramp_params.gravity.z = (float)(share * full_gravity.z);
+        EXPECT_OK(sph_world_set_params(world, &ramp_params));
+        EXPECT_OK(sph_world_step(world, (float)(0.25 * frame_dt)));
+      }
+    } else {
+      EXPECT_OK(sph_world_step(world, (float)frame_dt));
+    }
     if ((f + 1) * frame_dt < tc->damp_until && f % damp_every == damp_every - 1) {
       float* still = (float*)calloc(3 * (size_t)n, sizeof(float));
       assert_non_null(still);
