@@ -20,19 +20,32 @@ inline sph_result to_result(Status s) { return static_cast<sph_result>(static_ca
 
 inline sph_result fail(Status status, const std::string& message) { throw Error(status, message); }
 
+// Whether this thread is inside a log callback now. One flag for warnings and failures alike:
+// while the callback runs, nothing the library reports on this thread reaches a callback again
+// (no recursion, one level deep at most); the calls it makes still return their codes and set
+// the thread's last error as usual.
+inline bool& inside_log_callback() {
+  static thread_local bool inside = false;
+  return inside;
+}
+
+// Calls the log callback with the flag above set for its duration.
+inline void call_log_callback(const LogTarget& log, sph_log_level level, sph_result code,
+                              const char* message) {
+  inside_log_callback() = true;
+  log.fn(log.user_data, level, code, message);
+  inside_log_callback() = false;
+}
+
 // Sets the thread's last error and tells the log callback. The callback may call into the
 // library (sph_world_get_stats, say), which clears or replaces the thread's last error, so the
 // message is set again after it returns: the failing call's message is what its caller reads.
-// A failure inside the callback itself is not reported to the callback again (no recursion).
 inline void report_failure(const LogTarget& log, const char* function, sph_result code, const char* what) {
-  static thread_local bool in_callback = false;
   char message[1024];
   std::snprintf(message, sizeof message, "%s: %s", function, what);
   set_last_error(message);
-  if (log.fn && !in_callback) {
-    in_callback = true;
-    log.fn(log.user_data, SPH_LOG_ERROR, code, message);
-    in_callback = false;
+  if (log.fn && !inside_log_callback()) {
+    call_log_callback(log, SPH_LOG_ERROR, code, message);
     set_last_error(message);
   }
 }
@@ -40,13 +53,10 @@ inline void report_failure(const LogTarget& log, const char* function, sph_resul
 // Tells the log callback of a successful call's warning (SPH_LOG_WARNING, code SPH_OK). The
 // thread's last error stays clear: the call succeeded, whatever the callback called meanwhile.
 inline void report_warning(const LogTarget& log, const char* function, const char* what) {
-  static thread_local bool in_callback = false;
-  if (!log.fn || in_callback) return;
+  if (!log.fn || inside_log_callback()) return;
   char message[1024];
   std::snprintf(message, sizeof message, "%s: %s", function, what);
-  in_callback = true;
-  log.fn(log.user_data, SPH_LOG_WARNING, SPH_OK, message);
-  in_callback = false;
+  call_log_callback(log, SPH_LOG_WARNING, SPH_OK, message);
   clear_last_error();
 }
 

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 /* Version queries, result strings, the thread-local last error and the log callback. */
 #include <pthread.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -239,6 +240,93 @@ static void test_log_coarse_sdf_warning(void** state) {
   EXPECT_OK(sph_context_destroy(context));
 }
 
+/* A log callback that, on its first call, makes a failing call on `world` (a negative frame) and
+ * keeps what that call returned and the last error it left, then records every call's level. */
+typedef struct {
+  int calls;
+  sph_log_level levels[4];
+  sph_world* world;
+  sph_result inner;
+  char inner_error[1024];
+} reentrant_log;
+
+static void fail_inside_log(void* user_data, sph_log_level level, sph_result code, const char* message) {
+  reentrant_log* r = (reentrant_log*)user_data;
+  (void)code;
+  (void)message;
+  if (r->calls < 4) r->levels[r->calls] = level;
+  if (r->calls++ == 0 && r->world) {
+    r->inner = sph_world_step(r->world, -1.0f);
+    snprintf(r->inner_error, sizeof r->inner_error, "%s", sph_get_last_error());
+  }
+}
+
+/* A call that fails inside the log callback returns its code and sets the last error as usual,
+ * but is not reported to the callback again, whether the callback was telling of a failure or of
+ * a warning (one flag for both; docs/api.md): the callback runs once per outer call. (Before,
+ * each kind kept its own flag, so a failure inside a warning's callback was told to it again.) */
+static void test_log_callback_no_recursion(void** state) {
+  reentrant_log log;
+  sph_context_def def;
+  sph_context* context = NULL;
+  sph_world_def wdef;
+  sph_world_params params;
+  sph_shape_desc desc;
+  sph_sdf* sdf = NULL;
+  sph_collider_def cdef;
+  sph_collider_id id;
+  (void)state;
+  memset(&log, 0, sizeof log);
+  sph_test_context_def_init(&def);
+  def.log_fn = fail_inside_log;
+  def.log_user_data = &log;
+  EXPECT_OK(sph_context_create(&def, &context));
+  sph_world_def_init(&wdef);
+  wdef.capacity = 64;
+  wdef.particle_spacing = 0.02f;
+  wdef.features = SPH_FEATURE_BOUNDARY_DENSITY;
+  EXPECT_OK(sph_world_create(context, &wdef, &log.world));
+
+  /* Inside a failure's callback. */
+  sph_world_params_init(&params);
+  params.step_factor = -1.0f;
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "step_factor", sph_world_set_params(log.world, &params));
+  assert_int_equal(log.calls, 1);
+  assert_int_equal(log.levels[0], SPH_LOG_ERROR);
+  assert_int_equal(log.inner, SPH_ERROR_INVALID_ARGUMENT);
+  assert_non_null(strstr(log.inner_error, "frame_dt"));
+
+  /* Inside a warning's callback (a collider whose SDF is coarser than half the lattice step). */
+  memset(&log, 0, offsetof(reentrant_log, world));
+  log.inner = SPH_OK;
+  log.inner_error[0] = '\0';
+  sph_shape_desc_init(&desc);
+  desc.shape = SPH_SHAPE_BOX;
+  desc.half_extents = (sph_vec3){0.1f, 0.1f, 0.1f};
+  desc.voxel_size = 0.01f;
+  EXPECT_OK(sph_sdf_create_shape(context, &desc, &sdf));
+  sph_collider_def_init(&cdef);
+  cdef.sdf = sdf;
+  EXPECT_OK(sph_collider_create(log.world, &cdef, &id));
+  assert_string_equal(sph_get_last_error(), ""); /* the outer call succeeded */
+  assert_int_equal(log.calls, 1);
+  assert_int_equal(log.levels[0], SPH_LOG_WARNING);
+  /* (the warning is told while sph_collider_create holds the world, so the inner step is refused
+   * as WORLD_LOCKED before its frame is read) */
+  assert_int_equal(log.inner, SPH_ERROR_WORLD_LOCKED);
+  assert_non_null(strstr(log.inner_error, "sph_world_step"));
+
+  /* Outside any callback, reporting goes on as before. */
+  memset(&log, 0, offsetof(reentrant_log, world));
+  log.inner = SPH_OK;
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "frame_dt", sph_world_step(log.world, -2.0f));
+  assert_int_equal(log.calls, 1);
+  assert_int_equal(log.inner, SPH_ERROR_INVALID_ARGUMENT);
+  EXPECT_OK(sph_world_destroy(log.world));
+  EXPECT_OK(sph_sdf_destroy(sdf));
+  EXPECT_OK(sph_context_destroy(context));
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_version),
@@ -248,6 +336,7 @@ int main(void) {
       cmocka_unit_test(test_last_error_thread_local),
       cmocka_unit_test(test_log_callback),
       cmocka_unit_test(test_log_coarse_sdf_warning),
+      cmocka_unit_test(test_log_callback_no_recursion),
   };
   return cmocka_run_group_tests_name("capi_diagnostics", tests, NULL, NULL);
 }
