@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
 /* Version queries, result strings, the thread-local last error and the log callback. */
 #include <pthread.h>
-#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -261,6 +260,13 @@ static void fail_inside_log(void* user_data, sph_log_level level, sph_result cod
   }
 }
 
+/* Forgets the calls recorded so far; the world stays. */
+static void rearm(reentrant_log* r) {
+  r->calls = 0;
+  r->inner = SPH_OK;
+  r->inner_error[0] = '\0';
+}
+
 /* A call that fails inside the log callback returns its code and sets the last error as usual,
  * but is not reported to the callback again, whether the callback was telling of a failure or of
  * a warning (one flag for both; docs/api.md): the callback runs once per outer call. (Before,
@@ -297,9 +303,7 @@ static void test_log_callback_no_recursion(void** state) {
   assert_non_null(strstr(log.inner_error, "frame_dt"));
 
   /* Inside a warning's callback (a collider whose SDF is coarser than half the lattice step). */
-  memset(&log, 0, offsetof(reentrant_log, world));
-  log.inner = SPH_OK;
-  log.inner_error[0] = '\0';
+  rearm(&log);
   sph_shape_desc_init(&desc);
   desc.shape = SPH_SHAPE_BOX;
   desc.half_extents = (sph_vec3){0.1f, 0.1f, 0.1f};
@@ -317,8 +321,7 @@ static void test_log_callback_no_recursion(void** state) {
   assert_non_null(strstr(log.inner_error, "sph_world_step"));
 
   /* Outside any callback, reporting goes on as before. */
-  memset(&log, 0, offsetof(reentrant_log, world));
-  log.inner = SPH_OK;
+  rearm(&log);
   EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "frame_dt", sph_world_step(log.world, -2.0f));
   assert_int_equal(log.calls, 1);
   assert_int_equal(log.inner, SPH_ERROR_INVALID_ARGUMENT);
