@@ -7,7 +7,8 @@
 #   sph_log / sph_warn / sph_die  messages on stderr, prefixed with the calling script's name
 #   sph_install_packages          apt-get installs whatever of SPH_PACKAGES is missing
 #   sph_configure DIR [ARGS...]   cmake -G Ninja into DIR (Release unless ARGS say otherwise)
-#   sph_configure_sanitizer_tree DIR   the clang ASan + UBSan + libFuzzer tree (build-sanitize/)
+#   sph_configure_sanitizer_tree DIR [ARGS...]   the clang ASan + UBSan + libFuzzer tree
+#                                 (build-sanitize/; without MPI unless ARGS say -DSPH_WITH_MPI=ON)
 #   sph_build DIR [TARGETS...]    ninja in DIR
 #
 # Environment knobs:
@@ -127,6 +128,10 @@ sph_configure() {
 # GCC -O2 build and the reports keep function names and line numbers. Without CUDA, the
 # benchmarks and sph-run's OpenVDB outputs (the slowest code to compile; the Release build tests
 # them); with libsph_vdb, which fuzz_vdb needs. Warnings are not errors here: build/ enforces them.
+# Without libsph_mpi (SPH_WITH_MPI=OFF): neither the sanitizer ctest stage (it leaves label mpi out)
+# nor the fuzz harnesses use it, and it compiles the distributed code for nothing; scripts/
+# sanitize-mpi passes -DSPH_WITH_MPI=ON (an extra argument wins) to build and run the mpi tests here.
+# CMake keeps the value in the cache, so each script states it and the tree follows the last one.
 sph_configure_sanitizer_tree() {
   local dir="$1"
   command -v clang++ >/dev/null 2>&1 || sph_die "clang++ not found (Debian: apt-get install clang libclang-rt-14-dev)"
@@ -139,7 +144,7 @@ sph_configure_sanitizer_tree() {
     "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O2 -gline-tables-only -DNDEBUG" \
     "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -gline-tables-only -DNDEBUG" \
     -DSPH_SANITIZE=ON -DSPH_FUZZ=ON -DSPH_WITH_CUDA=OFF -DSPH_RUN_WITH_OPENVDB=OFF -DSPH_BUILD_BENCH=OFF \
-    -DSPH_WARNINGS_AS_ERRORS=OFF "${@:2}"
+    -DSPH_WARNINGS_AS_ERRORS=OFF -DSPH_WITH_MPI=OFF "${@:2}"
 }
 
 # sph_build DIR [TARGETS...]
