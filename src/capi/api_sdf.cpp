@@ -2,6 +2,7 @@
 // SDF assets: grids from the caller, analytic shapes, sub-box updates.
 #include <vector>
 
+#include "../core/sdf_limits.h"
 #include "../core/sdf_shapes.h"
 #include "grid_from_public.h"
 #include "guard.h"
@@ -14,8 +15,6 @@ using sph::Error;
 using sph::Status;
 
 namespace {
-
-constexpr uint64_t kMaxVoxels = 1ull << 31;
 
 sph::LogTarget context_of_sdf(const sph_sdf* sdf) { return sph::log_target_of(sdf); }
 
@@ -47,7 +46,8 @@ uint64_t voxel_count(const uint32_t dims[3], const std::string& name) {
   if (dims[0] == 0 || dims[1] == 0 || dims[2] == 0)
     throw Error(Status::InvalidArgument, name + "dims: every dimension must be >= 1 (required)");
   const uint64_t n = static_cast<uint64_t>(dims[0]) * dims[1] * dims[2];
-  if (n > kMaxVoxels || dims[0] > (1u << 30) || dims[1] > (1u << 30) || dims[2] > (1u << 30))
+  if (n > sph::kMaxSdfVoxels || dims[0] > sph::kMaxSdfDim || dims[1] > sph::kMaxSdfDim ||
+      dims[2] > sph::kMaxSdfDim)
     throw Error(Status::Capacity, name + "dims: more than 2^31 voxels");
   return n;
 }
@@ -188,7 +188,7 @@ SPH_API sph_result SPH_CALL sph_sdf_create_shape(sph_context* context, const sph
     sph::require_positive(spec.voxel_size, "desc->voxel_size");
     spec.padding_voxels =
         d.padding_voxels == 0 ? 4 : static_cast<int32_t>(std::min<uint32_t>(d.padding_voxels, 1u << 20));
-    return publish(hold, sph::build_shape_sdf(spec, kMaxVoxels), out);
+    return publish(hold, sph::build_shape_sdf(spec, sph::kMaxSdfVoxels), out);
   });
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "../core/mesh_sdf.h"
+#include "../core/sdf_limits.h"
 #include "guard.h"
 #include "handles.h"
 #include "init_struct.h"
@@ -11,12 +12,6 @@
 
 using sph::Error;
 using sph::Status;
-
-namespace {
-
-constexpr uint64_t kMaxVoxels = 1ull << 31;  // as for every other asset (api_sdf.cpp)
-
-}  // namespace
 
 extern "C" {
 
@@ -52,7 +47,7 @@ SPH_API sph_result SPH_CALL sph_sdf_create_from_mesh(sph_context* context, const
                               : static_cast<int32_t>(std::min<uint32_t>(d.padding_voxels, 1u << 20));
     auto handle = std::make_unique<sph_sdf>();
     handle->context = hold.get();
-    handle->asset = sph::build_mesh_sdf(spec, kMaxVoxels);
+    handle->asset = sph::build_mesh_sdf(spec, sph::kMaxSdfVoxels);
     *out = sph::publish_sdf(std::move(handle));
     return SPH_OK;
   });

@@ -83,8 +83,6 @@ constexpr uint32_t kNoAsset = 0xffffffffu;       // an object without this asset
 constexpr uint32_t kAssetHasVelocity = 1u << 0;  // SDF asset channel bits
 constexpr uint32_t kAssetHasFriction = 1u << 1;
 constexpr uint32_t kMaxObjectSlots = 65536;  // the C layer's limit per kind
-constexpr uint32_t kMaxAssetDim = 1u << 30;
-constexpr uint64_t kMaxAssetVoxels = 1ull << 31;
 
 }  // namespace checkpoint
 }  // namespace sph

@@ -8,7 +8,7 @@
 namespace sph {
 namespace {
 
-[[noreturn]] void corrupt(const ByteReader& r, const std::string& message) {
+[[noreturn]] void corrupt_params(const ByteReader& r, const std::string& message) {
   throw Error(Status::CorruptData, "checkpoint: " + r.what() + ": " + message);
 }
 
@@ -74,18 +74,18 @@ RuntimeParams read_params(ByteReader& r, const WorldConfig& config) {
   RuntimeParams p;
   const uint32_t blocks = r.u32();
   if (blocks > kMaxBlocks)
-    corrupt(r, std::to_string(blocks) + " parameter blocks, more than " + std::to_string(kMaxBlocks));
+    corrupt_params(r, std::to_string(blocks) + " parameter blocks, more than " + std::to_string(kMaxBlocks));
   std::string seen = "|";
   for (uint32_t b = 0; b < blocks; ++b) {
     const uint32_t length = r.u32();
     if (length == 0 || length > kMaxNameLength)
-      corrupt(r,
-              "parameter block " + std::to_string(b) + " has a name of " + std::to_string(length) + " bytes");
+      corrupt_params(
+          r, "parameter block " + std::to_string(b) + " has a name of " + std::to_string(length) + " bytes");
     r.need(length);
     std::string name(length, '\0');
     for (char& c : name) c = static_cast<char>(r.u8());
     if (seen.find("|" + name + "|") != std::string::npos)
-      corrupt(r, "the parameters of '" + name + "' appear twice");
+      corrupt_params(r, "the parameters of '" + name + "' appear twice");
     seen += name + "|";
     const uint32_t count = r.u32();
     bool known = false;
@@ -94,11 +94,11 @@ RuntimeParams read_params(ByteReader& r, const WorldConfig& config) {
       if (known || name != Method::kName) return;
       known = true;
       if (count > field_count<Method>())
-        corrupt(r, "'" + name + "' has " + std::to_string(count) + " fields; this library knows " +
-                       std::to_string(field_count<Method>()));
+        corrupt_params(r, "'" + name + "' has " + std::to_string(count) + " fields; this library knows " +
+                              std::to_string(field_count<Method>()));
       read_fields<Method>(r, count, params);
     });
-    if (!known) corrupt(r, "parameters of an unknown method '" + name + "'");
+    if (!known) corrupt_params(r, "parameters of an unknown method '" + name + "'");
   }
   validate_all(r, p, config);
   return p;

@@ -10,6 +10,7 @@
 #include "field_error.h"
 #include "pose_rules.h"
 #include "scene_build.h"
+#include "sdf_limits.h"
 
 namespace sph {
 namespace {
@@ -21,11 +22,11 @@ std::shared_ptr<SdfAsset> read_asset(ByteReader& r, uint32_t index) {
   uint32_t dims[3];
   for (uint32_t& d : dims) {
     d = r.u32();
-    if (d == 0 || d > kMaxAssetDim)
+    if (d == 0 || d > kMaxSdfDim)
       corrupt(r.what() + ": " + name + " has a dimension of " + std::to_string(d));
   }
   const uint64_t n = uint64_t{dims[0]} * dims[1] * dims[2];
-  if (n > kMaxAssetVoxels) corrupt(r.what() + ": " + name + " has more than 2^31 voxels");
+  if (n > kMaxSdfVoxels) corrupt(r.what() + ": " + name + " has more than 2^31 voxels");
   const uint32_t channels = r.u32();
   if (channels & ~(kAssetHasVelocity | kAssetHasFriction))
     corrupt(r.what() + ": " + name + " has unknown channel bits " + hex32(channels));
