@@ -6,10 +6,12 @@
 #include "guard.h"
 #include "handles.h"
 #include "init_struct.h"
+#include "public_vec3.h"
 #include "struct_io.h"
 
 using sph::Error;
 using sph::Status;
+using sph::to_public;
 
 namespace {
 
@@ -18,8 +20,6 @@ void require_loads(const sph_world* world) {
     throw Error(Status::FeatureDisabled,
                 "world: SPH_FEATURE_COLLIDER_LOADS is not enabled in its sph_world_def");
 }
-
-sph_vec3 to_public(const sph::Vec3& v) { return sph_vec3{v.x, v.y, v.z}; }
 
 }  // namespace
 

@@ -6,6 +6,7 @@
 #include "guard.h"
 #include "handles.h"
 #include "init_struct.h"
+#include "public_vec3.h"
 #include "struct_io.h"
 #include "validate.h"
 
@@ -13,6 +14,7 @@ using sph::HostVector;
 
 using sph::Error;
 using sph::Status;
+using sph::vec3_from_public;
 
 namespace {
 
@@ -22,8 +24,6 @@ sph::Vec3 read_vec3(const float* base, uint64_t stride, uint32_t i) {
   std::memcpy(v, p, sizeof v);
   return sph::Vec3{v[0], v[1], v[2]};
 }
-
-sph::Vec3 vec3_from_public(const sph_vec3& v) { return sph::Vec3{v.x, v.y, v.z}; }
 
 size_t element_size(sph_attribute a) {
   return (a == SPH_ATTRIBUTE_POSITION || a == SPH_ATTRIBUTE_VELOCITY) ? 3 * sizeof(float) : sizeof(float);

@@ -6,18 +6,14 @@
 #include "guard.h"
 #include "handles.h"
 #include "init_struct.h"
+#include "public_vec3.h"
 #include "struct_io.h"
 #include "validate.h"
 
 using sph::Error;
 using sph::Status;
-
-namespace {
-
-sph_vec3 to_public(const sph::Vec3& v) { return sph_vec3{v.x, v.y, v.z}; }
-sph::Vec3 from_public(const sph_vec3& v) { return sph::Vec3{v.x, v.y, v.z}; }
-
-}  // namespace
+using sph::to_public;
+using sph::vec3_from_public;
 
 extern "C" {
 
@@ -48,10 +44,10 @@ SPH_API sph_result SPH_CALL sph_probe_create(sph_world* world, const sph_probe_d
       sph::ProbeSpec spec;
       spec.gauge = kind == SPH_PROBE_GAUGE;
       spec.every_substep = sampling == SPH_PROBE_EVERY_SUBSTEP;
-      spec.position = from_public(d.position);
+      spec.position = vec3_from_public(d.position);
       // A point reads only its position (the gauge fields are ignored, as documented).
       if (spec.gauge) {
-        spec.direction = from_public(d.direction);
+        spec.direction = vec3_from_public(d.direction);
         spec.length = d.length;
         spec.sample_spacing = d.sample_spacing;
       }

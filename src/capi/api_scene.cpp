@@ -9,6 +9,7 @@
 #include "guard.h"
 #include "handles.h"
 #include "init_struct.h"
+#include "public_vec3.h"
 #include "struct_io.h"
 #include "validate.h"
 
@@ -16,6 +17,8 @@ using sph::HostVector;
 
 using sph::Error;
 using sph::Status;
+using sph::to_public;
+using sph::vec3_from_public;
 
 namespace {
 
@@ -30,8 +33,6 @@ sph_transform to_public(const sph::RigidTransform& t) {
   return sph_transform{sph_vec3{t.position.x, t.position.y, t.position.z},
                        sph_quat{t.rotation.x, t.rotation.y, t.rotation.z, t.rotation.w}};
 }
-
-sph::Vec3 vec3_from_public(const sph_vec3& v) { return sph::Vec3{v.x, v.y, v.z}; }
 
 // An SDF handle of the world's context, or NULL (whether one is required is the world's rule).
 // The asset is taken under the handle registry's lock (use_sdf), so a racing sph_sdf_destroy

@@ -29,12 +29,20 @@ inline bool& inside_log_callback() {
   return inside;
 }
 
-// Calls the log callback with the flag above set for its duration.
+// Calls the log callback with the flag above set for its duration. A callback must return
+// normally (sph_log_fn); one written in C++ that throws anyway has its exception dropped here,
+// so that it cannot leave the flag set (silencing the thread's later reports) nor reach
+// guarded()'s noexcept boundary from inside a catch handler (std::terminate).
 inline void call_log_callback(const LogTarget& log, sph_log_level level, sph_result code,
-                              const char* message) {
-  inside_log_callback() = true;
-  log.fn(log.user_data, level, code, message);
-  inside_log_callback() = false;
+                              const char* message) noexcept {
+  struct InsideScope {
+    InsideScope() { inside_log_callback() = true; }
+    ~InsideScope() { inside_log_callback() = false; }
+  } inside;
+  try {
+    log.fn(log.user_data, level, code, message);
+  } catch (...) {
+  }
 }
 
 // Sets the thread's last error and tells the log callback. The callback may call into the

@@ -8,10 +8,9 @@
 
 #include "../physics/vec3.h"
 #include "field_error.h"
+#include "param_validation.h"  // describe_value: the shortest decimal that reads back as the float
 
 namespace sph {
-
-inline std::string describe_value(float v) { return std::to_string(v); }
 
 inline void require_finite_field(float v, const std::string& field) {
   if (!std::isfinite(v)) throw FieldError(Status::InvalidArgument, field, "is not finite");

@@ -17,25 +17,24 @@ namespace {
 
 using V3 = Eigen::Vector3d;
 
-void require(bool ok, const std::string& message) {
-  if (!ok) throw Error(Status::InvalidArgument, message);
-}
-
 HostVector<MeshTriangle> read_triangles(const MeshSpec& s, V3* low, V3* high) {
-  require(s.vertices != nullptr, "desc->vertices: is NULL (required)");
-  require(s.indices != nullptr, "desc->indices: is NULL (required)");
-  require(s.vertex_count >= 3, "desc->vertex_count: " + std::to_string(s.vertex_count) + " is below 3");
-  require(s.index_count >= 3 && s.index_count % 3 == 0,
-          "desc->index_count: " + std::to_string(s.index_count) + " is not a positive multiple of 3");
-  require(s.vertex_stride >= 3 * sizeof(float),
-          "desc->vertex_stride: " + std::to_string(s.vertex_stride) + " is below 12 bytes (three floats)");
+  require_argument(s.vertices != nullptr, "desc->vertices: is NULL (required)");
+  require_argument(s.indices != nullptr, "desc->indices: is NULL (required)");
+  require_argument(s.vertex_count >= 3,
+                   "desc->vertex_count: " + std::to_string(s.vertex_count) + " is below 3");
+  require_argument(
+      s.index_count >= 3 && s.index_count % 3 == 0,
+      "desc->index_count: " + std::to_string(s.index_count) + " is not a positive multiple of 3");
+  require_argument(
+      s.vertex_stride >= 3 * sizeof(float),
+      "desc->vertex_stride: " + std::to_string(s.vertex_stride) + " is below 12 bytes (three floats)");
   HostVector<V3> points(s.vertex_count);
   const unsigned char* bytes = reinterpret_cast<const unsigned char*>(s.vertices);
   for (uint32_t i = 0; i < s.vertex_count; ++i) {
     float xyz[3];
     std::memcpy(xyz, bytes + static_cast<size_t>(i) * s.vertex_stride, sizeof xyz);
-    require(std::isfinite(xyz[0]) && std::isfinite(xyz[1]) && std::isfinite(xyz[2]),
-            "desc->vertices[" + std::to_string(i) + "]: is not finite");
+    require_argument(std::isfinite(xyz[0]) && std::isfinite(xyz[1]) && std::isfinite(xyz[2]),
+                     "desc->vertices[" + std::to_string(i) + "]: is not finite");
     points[i] = V3(xyz[0], xyz[1], xyz[2]);
   }
   *low = V3::Constant(INFINITY);
@@ -46,9 +45,9 @@ HostVector<MeshTriangle> read_triangles(const MeshSpec& s, V3* low, V3* high) {
     uint32_t corner[3];
     for (int k = 0; k < 3; ++k) {
       corner[k] = s.indices[3 * t + k];
-      require(corner[k] < s.vertex_count, "desc->indices[" + std::to_string(3 * t + k) +
-                                              "]: " + std::to_string(corner[k]) +
-                                              " is not below vertex_count " + std::to_string(s.vertex_count));
+      require_argument(corner[k] < s.vertex_count,
+                       "desc->indices[" + std::to_string(3 * t + k) + "]: " + std::to_string(corner[k]) +
+                           " is not below vertex_count " + std::to_string(s.vertex_count));
       *low = low->cwiseMin(points[corner[k]]);
       *high = high->cwiseMax(points[corner[k]]);
     }
@@ -181,10 +180,12 @@ void apply_sign(const Grid& g, const HostVector<MeshTriangle>& triangles, double
 }  // namespace
 
 std::shared_ptr<SdfAsset> build_mesh_sdf(const MeshSpec& s, uint64_t max_voxels) {
-  require(std::isfinite(s.voxel_size) && s.voxel_size > 0.0f, "desc->voxel_size: must be finite and > 0");
-  require(std::isfinite(s.band_width) && s.band_width >= 1.0f && s.band_width <= 64.0f,
-          "desc->band_width: must be in [1, 64] voxels");
-  require(s.padding_voxels >= 1 && s.padding_voxels <= 1024, "desc->padding_voxels: must be in [1, 1024]");
+  require_argument(std::isfinite(s.voxel_size) && s.voxel_size > 0.0f,
+                   "desc->voxel_size: must be finite and > 0");
+  require_argument(std::isfinite(s.band_width) && s.band_width >= 1.0f && s.band_width <= 64.0f,
+                   "desc->band_width: must be in [1, 64] voxels");
+  require_argument(s.padding_voxels >= 1 && s.padding_voxels <= 1024,
+                   "desc->padding_voxels: must be in [1, 1024]");
   V3 low, high;
   const HostVector<MeshTriangle> triangles = read_triangles(s, &low, &high);
   Grid g;

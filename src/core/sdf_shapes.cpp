@@ -43,10 +43,6 @@ V3 shape_half_bounds(const ShapeSpec& s) {
   return V3::Zero();
 }
 
-void require(bool ok, const std::string& message) {
-  if (!ok) throw Error(Status::InvalidArgument, message);
-}
-
 }  // namespace
 
 float shape_distance(const ShapeSpec& s, Vec3 point) {
@@ -93,14 +89,17 @@ float shape_distance(const ShapeSpec& s, Vec3 point) {
 }
 
 std::shared_ptr<SdfAsset> build_shape_sdf(const ShapeSpec& s, uint64_t max_voxels) {
-  require(std::isfinite(s.voxel_size) && s.voxel_size > 0.0f, "desc->voxel_size: must be finite and > 0");
-  require(s.padding_voxels >= 1 && s.padding_voxels <= 1024, "desc->padding_voxels: must be in [1, 1024]");
+  require_argument(std::isfinite(s.voxel_size) && s.voxel_size > 0.0f,
+                   "desc->voxel_size: must be finite and > 0");
+  require_argument(s.padding_voxels >= 1 && s.padding_voxels <= 1024,
+                   "desc->padding_voxels: must be in [1, 1024]");
   const V3 half = shape_half_bounds(s);
-  require(half.allFinite() && (half.array() > 0.0).all(),
-          "desc: the shape's dimensions must be finite and > 0 (half_extents, radius, half_height)");
-  require(std::isfinite(s.wall_thickness) && s.wall_thickness >= 0.0f, "desc->wall_thickness: must be >= 0");
+  require_argument(half.allFinite() && (half.array() > 0.0).all(),
+                   "desc: the shape's dimensions must be finite and > 0 (half_extents, radius, half_height)");
+  require_argument(std::isfinite(s.wall_thickness) && s.wall_thickness >= 0.0f,
+                   "desc->wall_thickness: must be >= 0");
   if (s.kind == ShapeKind::Cup)
-    require(s.wall_thickness > 0.0f, "desc->wall_thickness: a cup needs walls > 0");
+    require_argument(s.wall_thickness > 0.0f, "desc->wall_thickness: a cup needs walls > 0");
   const double voxel = s.voxel_size;
   double dims[3];
   for (int a = 0; a < 3; ++a) dims[a] = 2.0 * std::ceil(half[a] / voxel) + 2.0 * s.padding_voxels + 1.0;

@@ -38,4 +38,9 @@ class Error : public std::runtime_error {
   Status status_;
 };
 
+// Throws InvalidArgument with `message` unless `ok`: the input checks of the asset builders.
+inline void require_argument(bool ok, const std::string& message) {
+  if (!ok) throw Error(Status::InvalidArgument, message);
+}
+
 }  // namespace sph

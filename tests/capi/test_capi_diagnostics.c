@@ -239,12 +239,14 @@ static void test_log_coarse_sdf_warning(void** state) {
   EXPECT_OK(sph_context_destroy(context));
 }
 
-/* A log callback that, on its first call, makes a failing call on `world` (a negative frame) and
- * keeps what that call returned and the last error it left, then records every call's level. */
+/* A log callback that, on its first call, makes a call on `world` and keeps what that call
+ * returned and the last error it left, then records every call's level: with `sdf` NULL a
+ * failing step (a negative frame), otherwise a collider of `sdf` (a warning when it is coarse). */
 typedef struct {
   int calls;
   sph_log_level levels[4];
   sph_world* world;
+  sph_sdf* sdf;
   sph_result inner;
   char inner_error[1024];
 } reentrant_log;
@@ -255,7 +257,15 @@ static void fail_inside_log(void* user_data, sph_log_level level, sph_result cod
   (void)message;
   if (r->calls < 4) r->levels[r->calls] = level;
   if (r->calls++ == 0 && r->world) {
-    r->inner = sph_world_step(r->world, -1.0f);
+    if (r->sdf) {
+      sph_collider_def cdef;
+      sph_collider_id id;
+      sph_collider_def_init(&cdef);
+      cdef.sdf = r->sdf;
+      r->inner = sph_collider_create(r->world, &cdef, &id);
+    } else {
+      r->inner = sph_world_step(r->world, -1.0f);
+    }
     snprintf(r->inner_error, sizeof r->inner_error, "%s", sph_get_last_error());
   }
 }
@@ -325,6 +335,17 @@ static void test_log_callback_no_recursion(void** state) {
   EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "frame_dt", sph_world_step(log.world, -2.0f));
   assert_int_equal(log.calls, 1);
   assert_int_equal(log.inner, SPH_ERROR_INVALID_ARGUMENT);
+
+  /* A warning inside a failure's callback: the coarse collider is made (the failing call has
+   * released the world by then) and its warning is not told. */
+  rearm(&log);
+  log.sdf = sdf;
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "frame_dt", sph_world_step(log.world, -2.0f));
+  assert_int_equal(log.calls, 1);
+  assert_int_equal(log.levels[0], SPH_LOG_ERROR);
+  assert_int_equal(log.inner, SPH_OK);
+  assert_string_equal(log.inner_error, "");
+  assert_non_null(strstr(sph_get_last_error(), "frame_dt")); /* the outer call's message again */
   EXPECT_OK(sph_world_destroy(log.world));
   EXPECT_OK(sph_sdf_destroy(sdf));
   EXPECT_OK(sph_context_destroy(context));

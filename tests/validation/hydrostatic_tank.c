@@ -252,7 +252,9 @@ void run_tank(const tank_case* tc) {
   /* HYDRO_RAMP=R (s): gravity rises linearly from 0 to its value over the first R seconds, in
    * steps of a quarter frame, so the column's hydrostatic pressure is built in ~4R/frame small
    * loads instead of one (a measurement of the deep tanks' first-frame kick: is it the sudden
-   * load? docs/validation.md, "Session 25"). */
+   * load? docs/validation.md, "Session 25"). HYDRO_STATS' line of a ramp frame is its last
+   * quarter's (the statistics are the last sph_world_step's), and the quarter calls split the
+   * frame's substeps at 5 ms. */
   const double ramp_seconds = getenv("HYDRO_RAMP") ? atof(getenv("HYDRO_RAMP")) : 0.0;
   sph_world_params ramp_params;
   sph_world_params_init(&ramp_params);
