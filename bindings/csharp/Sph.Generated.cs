@@ -514,9 +514,9 @@ namespace Sph
     /// <summary>
     /// sph_log_fn: Log callback. Called only on a thread that is inside an sph_ call on this context
     /// (never from internal worker threads). message is valid for the duration of the call. It must
-    /// return normally: no longjmp out of it (the calling sph_ function's world stays locked), and a
-    /// C++ exception thrown from it is caught and dropped. Nothing reported while it runs reaches it
-    /// again (docs/api.md, "Result codes and the last error").
+    /// return normally: no longjmp out of it (it leaves the thread's later reports silenced and, from a
+    /// warning, the world locked), and a C++ exception thrown from it is caught and dropped. Nothing
+    /// reported while it runs reaches it again (docs/api.md, "Result codes and the last error").
     /// </summary>
     [UnmanagedFunctionPointer(CallingConvention.Cdecl)]
     public delegate void LogFn(IntPtr userData, LogLevel level, Result code, IntPtr message);

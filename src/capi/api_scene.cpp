@@ -17,7 +17,6 @@ using sph::HostVector;
 
 using sph::Error;
 using sph::Status;
-using sph::to_public;
 using sph::vec3_from_public;
 
 namespace {

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'ac20d4dfd45693ad1667f88131e03ecc9a1087b210f7ce8021e31a748b2309ac', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '261228c326c2647559937b7b525023cba95ca97e0a626787515a01dc3718cddb', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -748,9 +748,9 @@ class sph_sdf(_Opaque):
 
 #: Log callback. Called only on a thread that is inside an sph_ call on this context (never from
 #: internal worker threads). message is valid for the duration of the call. It must return
-#: normally: no longjmp out of it (the calling sph_ function's world stays locked), and a C++
-#: exception thrown from it is caught and dropped. Nothing reported while it runs reaches it again
-#: (docs/api.md, "Result codes and the last error").
+#: normally: no longjmp out of it (it leaves the thread's later reports silenced and, from a
+#: warning, the world locked), and a C++ exception thrown from it is caught and dropped. Nothing
+#: reported while it runs reaches it again (docs/api.md, "Result codes and the last error").
 sph_log_fn = _c.CFUNCTYPE(None, _c.c_void_p, sph_log_level, sph_result, _c.c_char_p)
 #: The engine's task system (the shape of Box2D v3's b2EnqueueTaskCallback and
 #: b2FinishTaskCallback; docs/embedding.md, "Threads"). With one, a CPU context runs every parallel
