@@ -77,6 +77,13 @@ sph_collider_loads capi_loads_of(const sph_world* world, sph_collider_id id);
 /* The fluid's momentum, sum m v over the particles of mass `mass`, in double. */
 void capi_fluid_momentum(const sph_world* world, float mass, double p[3]);
 
+/* ---- the log callback's warning -------------------------------------------------------------- */
+/* A world on `context` (64 particles, 2 cm spacing, lattice step 1.414 cm, walls in the density)
+ * and a box SDF whose 1 cm voxel is coarser than half that step: a collider of it is made and
+ * logs a warning (docs/api.md, log_fn). capi_coarse_collider adds one such collider. */
+void capi_coarse_collider_case(sph_context* context, sph_world** world, sph_sdf** sdf);
+sph_result capi_coarse_collider(sph_world* world, sph_sdf* sdf);
+
 /* ---- running some of a file's cases ---------------------------------------------------------- */
 /* Runs the cases of `tests` named in argv[1..] in that order, or all of them without names (a
  * ctest per group of cases, e.g. so that the sanitizer stage can leave out the long settling

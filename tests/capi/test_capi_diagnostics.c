@@ -257,15 +257,7 @@ static void fail_inside_log(void* user_data, sph_log_level level, sph_result cod
   (void)message;
   if (r->calls < 4) r->levels[r->calls] = level;
   if (r->calls++ == 0 && r->world) {
-    if (r->sdf) {
-      sph_collider_def cdef;
-      sph_collider_id id;
-      sph_collider_def_init(&cdef);
-      cdef.sdf = r->sdf;
-      r->inner = sph_collider_create(r->world, &cdef, &id);
-    } else {
-      r->inner = sph_world_step(r->world, -1.0f);
-    }
+    r->inner = r->sdf ? capi_coarse_collider(r->world, r->sdf) : sph_world_step(r->world, -1.0f);
     snprintf(r->inner_error, sizeof r->inner_error, "%s", sph_get_last_error());
   }
 }
@@ -285,23 +277,15 @@ static void test_log_callback_no_recursion(void** state) {
   reentrant_log log;
   sph_context_def def;
   sph_context* context = NULL;
-  sph_world_def wdef;
   sph_world_params params;
-  sph_shape_desc desc;
   sph_sdf* sdf = NULL;
-  sph_collider_def cdef;
-  sph_collider_id id;
   (void)state;
   memset(&log, 0, sizeof log);
   sph_test_context_def_init(&def);
   def.log_fn = fail_inside_log;
   def.log_user_data = &log;
   EXPECT_OK(sph_context_create(&def, &context));
-  sph_world_def_init(&wdef);
-  wdef.capacity = 64;
-  wdef.particle_spacing = 0.02f;
-  wdef.features = SPH_FEATURE_BOUNDARY_DENSITY;
-  EXPECT_OK(sph_world_create(context, &wdef, &log.world));
+  capi_coarse_collider_case(context, &log.world, &sdf);
 
   /* Inside a failure's callback. */
   sph_world_params_init(&params);
@@ -314,14 +298,7 @@ static void test_log_callback_no_recursion(void** state) {
 
   /* Inside a warning's callback (a collider whose SDF is coarser than half the lattice step). */
   rearm(&log);
-  sph_shape_desc_init(&desc);
-  desc.shape = SPH_SHAPE_BOX;
-  desc.half_extents = (sph_vec3){0.1f, 0.1f, 0.1f};
-  desc.voxel_size = 0.01f;
-  EXPECT_OK(sph_sdf_create_shape(context, &desc, &sdf));
-  sph_collider_def_init(&cdef);
-  cdef.sdf = sdf;
-  EXPECT_OK(sph_collider_create(log.world, &cdef, &id));
+  EXPECT_OK(capi_coarse_collider(log.world, sdf));
   assert_string_equal(sph_get_last_error(), ""); /* the outer call succeeded */
   assert_int_equal(log.calls, 1);
   assert_int_equal(log.levels[0], SPH_LOG_WARNING);

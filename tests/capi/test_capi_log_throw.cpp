@@ -30,32 +30,17 @@ void test_throwing_callback(void** state) {
   ThrowingLog log;
   sph_context_def def;
   sph_context* context = nullptr;
-  sph_world_def wdef;
   sph_world* world = nullptr;
-  sph_shape_desc desc;
   sph_sdf* sdf = nullptr;
-  sph_collider_def cdef;
-  sph_collider_id id;
   (void)state;
   sph_test_context_def_init(&def);
   def.log_fn = throw_from_log;
   def.log_user_data = &log;
   EXPECT_OK(sph_context_create(&def, &context));
-  sph_world_def_init(&wdef);
-  wdef.capacity = 64;
-  wdef.particle_spacing = 0.02f;
-  wdef.features = SPH_FEATURE_BOUNDARY_DENSITY;
-  EXPECT_OK(sph_world_create(context, &wdef, &world));
+  capi_coarse_collider_case(context, &world, &sdf);
 
   /* A warning's callback throws: the call succeeded and says so. */
-  sph_shape_desc_init(&desc);
-  desc.shape = SPH_SHAPE_BOX;
-  desc.half_extents = sph_vec3{0.1f, 0.1f, 0.1f};
-  desc.voxel_size = 0.01f; /* coarser than half the lattice step: a warning */
-  EXPECT_OK(sph_sdf_create_shape(context, &desc, &sdf));
-  sph_collider_def_init(&cdef);
-  cdef.sdf = sdf;
-  EXPECT_OK(sph_collider_create(world, &cdef, &id));
+  EXPECT_OK(capi_coarse_collider(world, sdf));
   assert_int_equal(log.calls, 1);
   assert_int_equal(log.last_level, SPH_LOG_WARNING);
   assert_string_equal(sph_get_last_error(), "");
