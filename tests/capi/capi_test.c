@@ -196,22 +196,27 @@ sph_collider_loads capi_loads_of(const sph_world* world, sph_collider_id id) {
   return l;
 }
 
-void capi_coarse_collider_case(sph_context* context, sph_world** world, sph_sdf** sdf) {
+void capi_collider_case(sph_context* context, uint32_t features, sph_shape shape, float voxel,
+                        sph_world** world, sph_sdf** sdf) {
   sph_world_def wdef;
   sph_shape_desc desc;
   sph_world_def_init(&wdef);
   wdef.capacity = 64;
   wdef.particle_spacing = 0.02f;
-  wdef.features = SPH_FEATURE_BOUNDARY_DENSITY;
+  wdef.features = features;
   EXPECT_OK(sph_world_create(context, &wdef, world));
   sph_shape_desc_init(&desc);
-  desc.shape = SPH_SHAPE_BOX;
+  desc.shape = shape;
   desc.half_extents = (sph_vec3){0.1f, 0.1f, 0.1f};
-  desc.voxel_size = 0.01f;
+  desc.voxel_size = voxel;
   EXPECT_OK(sph_sdf_create_shape(context, &desc, sdf));
 }
 
-sph_result capi_coarse_collider(sph_world* world, sph_sdf* sdf) {
+void capi_coarse_collider_case(sph_context* context, sph_world** world, sph_sdf** sdf) {
+  capi_collider_case(context, SPH_FEATURE_BOUNDARY_DENSITY, SPH_SHAPE_BOX, 0.01f, world, sdf);
+}
+
+sph_result capi_add_collider(sph_world* world, sph_sdf* sdf) {
   sph_collider_def cdef;
   sph_collider_id id;
   sph_collider_def_init(&cdef);

@@ -78,11 +78,15 @@ sph_collider_loads capi_loads_of(const sph_world* world, sph_collider_id id);
 void capi_fluid_momentum(const sph_world* world, float mass, double p[3]);
 
 /* ---- the log callback's warning -------------------------------------------------------------- */
-/* A world on `context` (64 particles, 2 cm spacing, lattice step 1.414 cm, walls in the density)
- * and a box SDF whose 1 cm voxel is coarser than half that step: a collider of it is made and
- * logs a warning (docs/api.md, log_fn). capi_coarse_collider adds one such collider. */
+/* A world on `context` of `features` (64 particles, 2 cm spacing: lattice step 1.414 cm) and an
+ * SDF of `shape` (half extents 10 cm) at `voxel` m. With SPH_FEATURE_BOUNDARY_DENSITY, a box and
+ * a voxel of 1 cm (coarser than half the step) a collider of it is made and logs a warning
+ * (docs/api.md, log_fn); capi_coarse_collider_case makes that one. capi_add_collider adds a
+ * collider of `sdf`. */
+void capi_collider_case(sph_context* context, uint32_t features, sph_shape shape, float voxel,
+                        sph_world** world, sph_sdf** sdf);
 void capi_coarse_collider_case(sph_context* context, sph_world** world, sph_sdf** sdf);
-sph_result capi_coarse_collider(sph_world* world, sph_sdf* sdf);
+sph_result capi_add_collider(sph_world* world, sph_sdf* sdf);
 
 /* ---- running some of a file's cases ---------------------------------------------------------- */
 /* Runs the cases of `tests` named in argv[1..] in that order, or all of them without names (a

@@ -188,31 +188,16 @@ static void test_log_callback(void** state) {
   assert_int_equal(log.calls, 3);
 }
 
-/* One collider of an SDF made by sph_sdf_create_shape in a world of `features`, spacing 2 cm
- * (lattice step 1.414 cm); returns how many times the log callback was called meanwhile. */
+/* One collider of an SDF made by sph_sdf_create_shape in a world of `features` (capi_collider_case:
+ * spacing 2 cm, lattice step 1.414 cm); returns how many times the log callback was called meanwhile. */
 static int collider_log_calls(sph_context* context, log_record* log, uint32_t features, sph_shape shape,
                               float voxel) {
-  sph_world_def wdef;
   sph_world* world = NULL;
-  sph_shape_desc desc;
   sph_sdf* sdf = NULL;
-  sph_collider_def cdef;
-  sph_collider_id id;
   int before;
-  sph_world_def_init(&wdef);
-  wdef.capacity = 64;
-  wdef.particle_spacing = 0.02f;
-  wdef.features = features;
-  EXPECT_OK(sph_world_create(context, &wdef, &world));
-  sph_shape_desc_init(&desc);
-  desc.shape = shape;
-  desc.half_extents = (sph_vec3){0.1f, 0.1f, 0.1f};
-  desc.voxel_size = voxel;
-  EXPECT_OK(sph_sdf_create_shape(context, &desc, &sdf));
-  sph_collider_def_init(&cdef);
-  cdef.sdf = sdf;
+  capi_collider_case(context, features, shape, voxel, &world, &sdf);
   before = log->calls;
-  EXPECT_OK(sph_collider_create(world, &cdef, &id));
+  EXPECT_OK(capi_add_collider(world, sdf));
   assert_string_equal(sph_get_last_error(), ""); /* a success, whatever it logged */
   EXPECT_OK(sph_world_destroy(world));
   EXPECT_OK(sph_sdf_destroy(sdf));
@@ -257,7 +242,7 @@ static void fail_inside_log(void* user_data, sph_log_level level, sph_result cod
   (void)message;
   if (r->calls < 4) r->levels[r->calls] = level;
   if (r->calls++ == 0 && r->world) {
-    r->inner = r->sdf ? capi_coarse_collider(r->world, r->sdf) : sph_world_step(r->world, -1.0f);
+    r->inner = r->sdf ? capi_add_collider(r->world, r->sdf) : sph_world_step(r->world, -1.0f);
     snprintf(r->inner_error, sizeof r->inner_error, "%s", sph_get_last_error());
   }
 }
@@ -298,7 +283,7 @@ static void test_log_callback_no_recursion(void** state) {
 
   /* Inside a warning's callback (a collider whose SDF is coarser than half the lattice step). */
   rearm(&log);
-  EXPECT_OK(capi_coarse_collider(log.world, sdf));
+  EXPECT_OK(capi_add_collider(log.world, sdf));
   assert_string_equal(sph_get_last_error(), ""); /* the outer call succeeded */
   assert_int_equal(log.calls, 1);
   assert_int_equal(log.levels[0], SPH_LOG_WARNING);

@@ -40,7 +40,7 @@ void test_throwing_callback(void** state) {
   capi_coarse_collider_case(context, &world, &sdf);
 
   /* A warning's callback throws: the call succeeded and says so. */
-  EXPECT_OK(capi_coarse_collider(world, sdf));
+  EXPECT_OK(capi_add_collider(world, sdf));
   assert_int_equal(log.calls, 1);
   assert_int_equal(log.last_level, SPH_LOG_WARNING);
   assert_string_equal(sph_get_last_error(), "");
