@@ -95,28 +95,45 @@ SPH_HD GradientMomentIf<T, kCorrected> gradient_moment_if(T zero) {
     return NoGradientMoment{};
 }
 
+// The corrected sum and the fade's weight w it was blended with (0: the uncorrected sum).
+struct CorrectedPressureSum {
+  Vec3 sum;
+  float weight;
+};
+
 // The corrected sum from sum = sum_j m (k_i + k_j) grad W_ij and the moment (rho0 B_i, Z_i): the sum
 // the velocity update multiplies by -dt, before the walls' share. Blended with the uncorrected sum by
-// the fade's weight w; uncorrected where det B is not positive.
-SPH_HD Vec3 corrected_pressure_sum(Vec3 sum, const GradientMomentOf<float>& m, float ki, float rest_density) {
+// the fade's weight w; uncorrected (w = 0) where det B is not positive.
+SPH_HD CorrectedPressureSum corrected_pressure_sum(Vec3 sum, const GradientMomentOf<float>& m, float ki,
+                                                   float rest_density) {
   const float s = 1.0f / rest_density;
   const float a = m.xx * s, b = m.xy * s, c = m.xz * s, d = m.yy * s, e = m.yz * s, f = m.zz * s;
   const float t = (a + d + f) * (1.0f / 3.0f);
   float w = (t - DfsphGradientCorrection::kNone) /
             (DfsphGradientCorrection::kFull - DfsphGradientCorrection::kNone);
   w = w < 0.0f ? 0.0f : (w > 1.0f ? 1.0f : w);
-  if (w <= 0.0f) return sum;
+  if (w <= 0.0f) return CorrectedPressureSum{sum, 0.0f};
   // The adjugate of the symmetric B = [[a b c] [b d e] [c e f]].
   const float A = d * f - e * e, Bc = c * e - b * f, C = b * e - c * d;
   const float det = a * A + b * Bc + c * C;
-  if (!(det > 0.0f)) return sum;
+  if (!(det > 0.0f)) return CorrectedPressureSum{sum, 0.0f};
   const float D = a * f - c * c, E = b * c - a * e, F = a * d - b * b;
   const float inv = 1.0f / det;
   // The difference form's sum plus the kept share of the zeroth-order term.
   const Vec3 r = sum - m.zeroth * (2.0f * (1.0f - DfsphGradientCorrection::kKeptZeroth) * ki);
   const Vec3 lr{inv * (A * r.x + Bc * r.y + C * r.z), inv * (Bc * r.x + D * r.y + E * r.z),
                 inv * (C * r.x + E * r.y + F * r.z)};
-  return sum + (lr - sum) * w;
+  return CorrectedPressureSum{sum + (lr - sum) * w, w};
+}
+
+// The share of the walls' term k_i grad rho_b that the corrected update keeps: the walls' share is
+// the zeroth-order term of the part of the neighbourhood the walls stand for (at uniform pressure it
+// balances the fluid's 2 k_i Z_i at a calibrated wall), so it keeps the same share beta as the
+// fluid's, blended by the same weight. Kept whole, it pushed the layers h or so from a wall (where
+// the fade lets the correction in) away from it by 2 (1 - beta) k_i |Z_i| w: a tank started with its
+// first layer step / 2 from the walls went non-finite in its first frame (session 26).
+SPH_HD float corrected_wall_share(float weight) {
+  return 1.0f - weight * (1.0f - DfsphGradientCorrection::kKeptZeroth);
 }
 
 }  // namespace sph

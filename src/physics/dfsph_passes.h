@@ -168,7 +168,8 @@ SPH_HD float density_rate(const FluidBase& f, const GridView& grid, const Float4
 // dfsph_velocity_change's, m the moment (B_i and the zeroth-order sum) gathered in the same walk.
 SPH_HD Vec3 dfsph_corrected_velocity_change(const FluidBase& f, Vec3 sum, const GradientMomentOf<float>& m,
                                             const DfsphWalls& walls, uint32_t i, float ki, float dt) {
-  return dfsph_velocity_change(corrected_pressure_sum(sum, m, ki, f.rest_density), walls, i, ki, dt);
+  const CorrectedPressureSum c = corrected_pressure_sum(sum, m, ki, f.rest_density);
+  return dfsph_velocity_change(c.sum, walls, i, ki * corrected_wall_share(c.weight), dt);
 }
 
 // The velocity change of particle i from the pressures k (k_j = p_j / rho_j^2 of this

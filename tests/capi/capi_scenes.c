@@ -7,7 +7,7 @@
 
 static const double kGravity = 9.81;
 
-capi_momentum_balance capi_collapse_momentum_balance(const sph_world_def* def) {
+capi_momentum_balance capi_collapse_momentum_balance(const sph_world_def* def, uint32_t dfsph_flags) {
   const support_water_tank column = support_collapsing_column(0.0f);
   support_world w;
   sph_sdf* sdf = NULL;
@@ -16,6 +16,7 @@ capi_momentum_balance capi_collapse_momentum_balance(const sph_world_def* def) {
   double p0[3], p1[3];
   memset(&out, 0, sizeof out);
   EXPECT_OK(support_water_tank_open(&w, sph_test_backend(), def, NULL, &column, &sdf, &tank, &out.count));
+  if (dfsph_flags) capi_set_dfsph_flags(w.world, dfsph_flags);
   capi_fluid_momentum(w.world, w.mass, p0);
   for (int frame = 0; frame < 15; ++frame) {
     sph_collider_loads l;

@@ -233,3 +233,11 @@ void capi_fluid_momentum(const sph_world* world, float mass, double p[3]) {
     for (int k = 0; k < 3; ++k) p[k] += (double)mass * v[3 * i + k];
   free(v);
 }
+
+void capi_set_dfsph_flags(sph_world* world, uint32_t flags) {
+  sph_dfsph_params dp;
+  EXPECT_OK(sph_dfsph_params_init(&dp));
+  EXPECT_OK(sph_world_get_dfsph_params(world, &dp));
+  dp.flags = flags;
+  EXPECT_OK(sph_world_set_dfsph_params(world, &dp));
+}

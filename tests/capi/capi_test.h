@@ -77,6 +77,10 @@ sph_collider_loads capi_loads_of(const sph_world* world, sph_collider_id id);
 /* The fluid's momentum, sum m v over the particles of mass `mass`, in double. */
 void capi_fluid_momentum(const sph_world* world, float mass, double p[3]);
 
+/* ---- DFSPH ------------------------------------------------------------------------------------ */
+/* Sets the world's sph_dfsph_params.flags, its other DFSPH parameters kept (checked). */
+void capi_set_dfsph_flags(sph_world* world, uint32_t flags);
+
 /* ---- the log callback's warning -------------------------------------------------------------- */
 /* A world on `context` of `features` (64 particles, 2 cm spacing: lattice step 1.414 cm) and an
  * SDF of `shape` (half extents 10 cm) at `voxel` m. With SPH_FEATURE_BOUNDARY_DENSITY, a box and

@@ -46,22 +46,33 @@ static sph_world_def dfsph_def(uint32_t features, uint32_t capacity) {
   return def;
 }
 
+/* DFLOADS_FLAGS=BITS (measuring): sph_dfsph_params.flags for the submerged box and the resting tank,
+ * e.g. SPH_DFSPH_CORRECTED_GRADIENT (docs/validation.md, "Session 26"). */
+static void apply_measured_flags(sph_world* world) {
+  if (getenv("DFLOADS_FLAGS"))
+    capi_set_dfsph_flags(world, (uint32_t)strtoul(getenv("DFLOADS_FLAGS"), NULL, 0));
+}
+
 /* ---- momentum balance ------------------------------------------------------------------------ */
 
 /* A column 6 x 14 x 8 layers collapsing in a tank 16 x 30 x 8 layers for 0.3 s (the fluid hits the
  * far wall; test_collider_loads.c's case on DFSPH, capi_collapse_momentum_balance). Bound 1 % (the
  * issue's): the pair terms of the solves' velocity updates and of the non-pressure forces cancel
  * in pairs, so what is left is the rounding of float sums over ~1000 particles and ~100 substeps. */
-static void momentum_balance(uint32_t features) {
+static capi_momentum_balance momentum_balance_with(uint32_t features, uint32_t dfsph_flags) {
   const sph_world_def def = dfsph_def(SPH_FEATURE_COLLIDER_LOADS | features, 0);
-  const capi_momentum_balance b = capi_collapse_momentum_balance(&def);
+  const capi_momentum_balance b = capi_collapse_momentum_balance(&def, dfsph_flags);
   print_message(
-      "DFSPH momentum balance (features 0x%x, %u particles): fluid dP = (%.4g, %.4g, %.4g), colliders' "
-      "J = (%.4g, %.4g, %.4g), gravity %.4g N s over %.3f s: residual %.3g %%\n",
-      features, b.count, b.fluid_change[0], b.fluid_change[1], b.fluid_change[2], b.impulse[0], b.impulse[1],
-      b.impulse[2], b.weight_impulse, b.time, 100.0 * b.error);
+      "DFSPH momentum balance (features 0x%x, flags 0x%x, %u particles): fluid dP = (%.4g, %.4g, %.4g), "
+      "colliders' J = (%.4g, %.4g, %.4g), gravity %.4g N s over %.3f s: residual %.3g %%\n",
+      features, dfsph_flags, b.count, b.fluid_change[0], b.fluid_change[1], b.fluid_change[2], b.impulse[0],
+      b.impulse[1], b.impulse[2], b.weight_impulse, b.time, 100.0 * b.error);
   assert_true(fabs(b.time - 0.3) < 1e-6);
-  assert_true(b.error <= 0.01 || measuring());
+  return b;
+}
+
+static void momentum_balance(uint32_t features) {
+  assert_true(momentum_balance_with(features, 0u).error <= 0.01 || measuring());
 }
 
 static void test_momentum_balance_contacts(void** state) {
@@ -72,6 +83,19 @@ static void test_momentum_balance_contacts(void** state) {
 static void test_momentum_balance_boundary_density(void** state) {
   (void)state;
   momentum_balance(SPH_FEATURE_BOUNDARY_DENSITY);
+}
+
+/* The same with the corrected gradient (SPH_DFSPH_CORRECTED_GRADIENT), whose pair terms are not
+ * antisymmetric: the fluid's own pairs change its momentum, which no collider receives, so the
+ * balance misses by the correction's error (docs/physics.md, DFSPH, the corrected gradient's
+ * limits). Measured (CPU, session 26) 5.74 % of gravity's impulse (5.55 % before the walls' share
+ * kept the correction's share: that change is not what misses). Bound 12 %, about twice that: a guard
+ * on the documented limit, not the issue's 1 % (asserted with DFLOADS_STRICT=1, a known issue). */
+static void test_momentum_balance_corrected_gradient(void** state) {
+  const capi_momentum_balance b =
+      momentum_balance_with(SPH_FEATURE_BOUNDARY_DENSITY, SPH_DFSPH_CORRECTED_GRADIENT);
+  (void)state;
+  assert_true(b.error <= (getenv("DFLOADS_STRICT") ? 0.01 : 0.12) || measuring());
 }
 
 /* ---- buoyancy of a fixed submerged box ---------------------------------------------------------- */
@@ -86,6 +110,7 @@ static void test_submerged_box_buoyancy(void** state) {
   double force[3], expected;
   (void)state;
   capi_submerged_box_open(&s, &def, NULL);
+  apply_measured_flags(s.w.world);
   capi_mean_force(s.w.world, s.box, 50, 40, force);
   expected = s.w.def.rest_density * kGravity * 8.0 * half * half * half;
   print_message("DFSPH submerged box: force (%.4f, %.4f, %.4f) N, rho0 g V = %.4f N: buoyancy %+.2f %%\n",
@@ -134,7 +159,7 @@ static sph_probe_reading reading_of(const sph_world* world, sph_probe_id id) {
  * DFLOADS_WINDOW=N averages N frames instead of 20, DFLOADS_SCAN=1 adds point probes every quarter
  * step from 1 to 23 cm on the centre line against the weight above. */
 #define DF_SCAN 89
-static void test_resting_tank_probes(void** state) {
+static void resting_tank_probes(uint32_t dfsph_flags) {
   const sph_world_def def = dfsph_def(SPH_FEATURE_BOUNDARY_DENSITY, 0);
   const double* heights = capi_resting_heights;
   const double film = CAPI_RESTING_FILM, area = capi_resting_water_area();
@@ -147,9 +172,12 @@ static void test_resting_tank_probes(void** state) {
   double above[4] = {0.0, 0.0, 0.0, 0.0}, column_height[4] = {0.0, 0.0, 0.0, 0.0}, want[4], column_time = 0.0;
   double scan_y[DF_SCAN], scan_p[DF_SCAN], scan_above[DF_SCAN], scan_time = 0.0;
   int frames = 0;
-  (void)state;
   capi_resting_tank_open(&t, &def, NULL, SPH_PROBE_EVERY_SUBSTEP);
   world = t.w.world;
+  if (dfsph_flags)
+    capi_set_dfsph_flags(world, dfsph_flags);
+  else
+    apply_measured_flags(world);
   rho0 = t.w.def.rest_density;
   for (int k = 0; measuring() && k < 4; ++k)
     columns[k] = add_probe(world, CAPI_RESTING_WIDTH / 2, heights[k], CAPI_RESTING_WIDTH / 2, SPH_PROBE_GAUGE,
@@ -309,13 +337,29 @@ static void test_conjugate_gradients_refused(void** state) {
   EXPECT_OK(support_world_close(&w));
 }
 
+static void test_resting_tank_probes(void** state) {
+  (void)state;
+  resting_tank_probes(0u);
+}
+
+/* The same tank with the corrected gradient (SPH_DFSPH_CORRECTED_GRADIENT): the same bounds. Before
+ * session 26 its first frame ran out of substeps (every density solve capped, speeds of 4e16 m/s;
+ * physics_dfsph_extremes_corrected_wall); measured since: +0.71, +0.69, +1.08, +0.30 % at 4, 8, 12 and
+ * 16 cm against the default's -1.38, -0.48, -1.04, -1.13 %, the difference +1.04 % (-1.59 %). */
+static void test_resting_tank_probes_corrected(void** state) {
+  (void)state;
+  resting_tank_probes(SPH_DFSPH_CORRECTED_GRADIENT);
+}
+
 int main(int argc, char** argv) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_conjugate_gradients_refused),
       cmocka_unit_test(test_checkpoint_carries_probes),
       cmocka_unit_test(test_momentum_balance_contacts),
       cmocka_unit_test(test_momentum_balance_boundary_density),
+      cmocka_unit_test(test_momentum_balance_corrected_gradient),
       cmocka_unit_test(test_resting_tank_probes),
+      cmocka_unit_test(test_resting_tank_probes_corrected),
       cmocka_unit_test(test_submerged_box_buoyancy),
   };
   /* With names, only those cases (the ctests split off the settled tanks, which the sanitizer

@@ -59,6 +59,16 @@ static void open_tank(const tank_case* tc, double gap, support_world* w, sph_sdf
   sph_world_params params;
   float* lattice_points = NULL;
   EXPECT_OK(support_fcc_box(lattice, step, origin, &lattice_points, n));
+  /* HYDRO_PERTURB=SEED: every coordinate moved by up to 1e-7 m (a generator seeded with SEED),
+   * another draw of the same settling: how much of a reading is the draw's (docs/validation.md,
+   * "Session 26"). */
+  if (getenv("HYDRO_PERTURB")) {
+    uint64_t state = strtoull(getenv("HYDRO_PERTURB"), NULL, 10) * 0x9E3779B97F4A7C15ull;
+    for (uint32_t i = 0; i < 3u * *n; ++i) {
+      state = state * 6364136223846793005ull + 1442695040888963407ull;
+      lattice_points[i] += (float)(((double)(state >> 11) * (1.0 / 9007199254740992.0) * 2.0 - 1.0) * 1e-7);
+    }
+  }
   sph_world_def_init(&def);
   def.capacity = *n;
   def.particle_spacing = (float)(step * sqrt(2.0));
@@ -169,7 +179,11 @@ void run_tank(const tank_case* tc) {
    * layer at rest (as physics_boundary_density's tank): at step/2 (0.35 spacings) the walls'
    * share over-reads and the lattice starts compressed against them. Without it the walls stand
    * at the lattice's faces, as before. */
-  const double gap = (tc->features & SPH_FEATURE_BOUNDARY_DENSITY) ? 0.5 * step * (sqrt(2.0) - 1.0) : 0.0;
+  /* HYDRO_GAP=g: the walls g lattice steps beyond the placement above (0: the lattice's own
+   * step / 2, where support_fcc_box's outer points lie; docs/validation.md, "Session 26"). */
+  const double gap = getenv("HYDRO_GAP")                             ? atof(getenv("HYDRO_GAP")) * step
+                     : (tc->features & SPH_FEATURE_BOUNDARY_DENSITY) ? 0.5 * step * (sqrt(2.0) - 1.0)
+                                                                     : 0.0;
   support_world w;
   sph_world* world;
   sph_world_def def;
@@ -425,6 +439,11 @@ void run_tank(const tank_case* tc) {
         free(by_hand);
         free(y_w);
         free(states);
+        /* Both readings of the same field within the bound: the particles' plain mean and the
+         * gauges' interpolant weight the per-particle pattern differently (docs/validation.md,
+         * "DFSPH: hydrostatic tank", session 17), so a pass in one alone is not a pass. */
+        assert_true(g.used >= 5);
+        assert_true(g.worst <= tc->bound);
       }
     }
     {
