@@ -26,7 +26,9 @@
 //   - DFSPH, once per substep after both solves: wall_reaction_impulse(collider gradient, m,
 //     p_i / rho_i^2 * dt) with p = (k + k_v / dt) rho^2 (dfsph_pressure: the sums both solves
 //     carry), which is the sum of what every velocity update of both solves applied
-//     (v_i -= dt k_i grad rho_b each, the warm start included), at the substep's start; the
+//     (v_i -= dt k_i grad rho_b each, the warm start included; with SPH_DFSPH_CORRECTED_GRADIENT
+//     the particle received only corrected_wall_share of it where the correction acts, which this
+//     sum does not know, so it over-counts there: docs/physics.md), at the substep's start; the
 //     impulses of its contact clamp (respect_contact after each velocity update of both solves
 //     and after the non-pressure accelerations), summed per particle (add_clamp into
 //     kArrayDfsphContactImpulse) and given to the collider of the particle's contact at the

@@ -8,7 +8,8 @@
 //   2. both solves' density rate (density_rate): D rho_i / Dt += (v_i - v_b) . grad rho_b(x_i),
 //      v_b the wall's velocity at x_i (boundary_density_rate: zero flux for a static collider);
 //   3. both solves' velocity update (pressure_velocity_change): the wall's share with k_i alone,
-//      v_i -= dt k_i grad rho_b(x_i) (boundary_gradient).
+//      v_i -= dt k_i grad rho_b(x_i) (boundary_gradient); with SPH_DFSPH_CORRECTED_GRADIENT times
+//      the fluid's kept share where the correction acts (dfsph_gradient_correction.h).
 // The density pass of each backend computes the share once per substep (boundary_share, at the
 // substep's start), adds its density and stores its record, (grad rho_b, v_b . grad rho_b), in
 // the array kArrayBoundaryGradient; the solves read the record through DfsphWalls. The walls'

@@ -19,15 +19,19 @@
 // zeroth-order term. That share is kept because the difference form alone exerts no force for a
 // uniform pressure, so nothing holds the packing: measured, the tank then never settles (v_rms
 // 0.12-0.18 m/s against 0.03). beta = 0.2 keeps it at rest (0.035 m/s) while the particles' scatter
-// falls to 2-3 %; 0.5 gives 3.5-5 %. The removed share does work: the DFSPH closed box gains 4.4 %
-// energy at 0.2 (none at 0.4 and above, where the tank misses 0.5 %; docs/physics.md).
+// falls to 2-3 %; 0.5 gives 3.5-5 %. The removed share can do work: session 16 measured the DFSPH
+// closed box gaining 4.4 % energy at 0.2 (none at 0.4 and above); today it reads -0.08 %, as
+// without the flag (docs/physics.md).
 //
 // Where the neighbourhood is truncated (a free surface, the first layers at a wall) B loses rank
 // and removing the zeroth-order term would let a particle's own pressure pull it into the fluid
 // (the Jacobi step's diagonal turns negative: the tank went non-finite within 5 substeps with the
 // fade below), so the correction fades out with the mean of B's diagonal, t = trace(B) / 3 (1 in
 // the bulk, about 0.5 at a flat surface): the full correction at t >= kFull, none at t <= kNone,
-// linear in between. The walls' share (dfsph_boundary.h, place 3) is added uncorrected.
+// linear in between. The walls' share (dfsph_boundary.h, place 3) is not multiplied by L_i, but
+// keeps the same share of itself as the fluid's zeroth-order term (corrected_wall_share, below).
+// The loads (collider_loads.h) still count it whole: where w > 0 they over-count the walls'
+// reaction by (1 - beta) w k_i grad rho_b (not measured apart; docs/physics.md).
 //
 // The price: the pair terms are no longer antisymmetric (L_i != L_j, and the zeroth-order removal
 // is one-sided), so the fluid's momentum is not conserved to round-off (docs/physics.md measures

@@ -523,6 +523,75 @@ void test_dfsph_corrected_gradient_is_first_order(void**) {
   assert_true(worst_uncorrected > 0.05);
 }
 
+// The walls' share under the corrected gradient (dfsph_gradient_correction.h, corrected_wall_share):
+// where the fade's weight is 1 the walls' term k_i grad rho_b keeps the share beta the fluid's
+// zeroth-order term keeps, and the plain update keeps it whole. The same cloud with a wall record
+// grad rho_b = (3, -2, 1) rho0 / h at every particle: the difference the walls make to each update
+// is -dt beta k_i grad rho_b (corrected) and -dt k_i grad rho_b (plain), within the rounding of one
+// addition and one product on sums of that size. Before session 26 the corrected update kept the
+// walls' term whole, which pushed particles near a wall off it (docs/physics.md).
+void test_dfsph_corrected_gradient_wall_share(void**) {
+  Scene s(uniform_cloud(3000, Vec3{0.0f, 0.0f, 0.0f},
+                        0.5f * std::cbrt(3000.0f * 4.18879f * kH * kH * kH / 40.0f), 11),
+          50);
+  const sph::FluidConstants f = s.fluid(sph::MethodSelection{});
+  const sph::GridView view = s.view();
+  const float dt = 1e-3f, k0 = 5e-4f;
+  const double beta = sph::DfsphGradientCorrection::kKeptZeroth;
+  const float scale = f.rest_density / f.kernel.h;
+  const Vec3 wall{3.0f * scale, -2.0f * scale, 1.0f * scale};
+  std::vector<float> k(s.n + sph::kLanePadding, k0);
+  std::vector<sph::Float4> records(s.n, sph::Float4{wall.x, wall.y, wall.z, 0.0f});
+  const sph::DfsphWalls no_walls{nullptr}, walls{records.data()};
+  uint32_t full = 0, failures = 0;
+  for (uint32_t i = 0; i < s.n; ++i) {
+    const Vec3 corrected =
+        sph::pressure_velocity_change<true>(f, view, s.positions.data(), k.data(), no_walls, i, dt);
+    const Vec3 corrected_walls =
+        sph::pressure_velocity_change<true>(f, view, s.positions.data(), k.data(), walls, i, dt);
+    const Vec3 plain =
+        sph::pressure_velocity_change<false>(f, view, s.positions.data(), k.data(), no_walls, i, dt);
+    const Vec3 plain_walls =
+        sph::pressure_velocity_change<false>(f, view, s.positions.data(), k.data(), walls, i, dt);
+    // The fade's weight from the particle's own moment, as the update computes it.
+    sph::GradientMomentOf<float> m = sph::zero_gradient_moment(0.0f);
+    const sph::KernelCoefficients mk = sph::mass_gradient_kernel(f);
+    const Vec3 xi = sph::xyz(s.positions[i]);
+    sph::for_each_neighbor_candidate(view, xi, [&](uint32_t j) {
+      const Vec3 d = xi - sph::xyz(s.positions[j]);
+      const float r2 = sph::length_squared(d);
+      if (r2 < f.kernel.h2 && j != i)
+        sph::add_gradient_moment(m, sph::spiky_gradient(mk, d, std::sqrt(r2)), d);
+    });
+    const float weight = sph::corrected_pressure_sum(Vec3{0.0f, 0.0f, 0.0f}, m, k0, f.rest_density).weight;
+    const double share = weight >= 1.0f ? beta : 1.0 - weight * (1.0 - beta);
+    if (weight >= 1.0f) ++full;
+    const double cw[3] = {corrected_walls.x - corrected.x, corrected_walls.y - corrected.y,
+                          corrected_walls.z - corrected.z};
+    const double pw[3] = {plain_walls.x - plain.x, plain_walls.y - plain.y, plain_walls.z - plain.z};
+    const double wv[3] = {wall.x, wall.y, wall.z};
+    const double c_size[3] = {std::fabs(corrected.x), std::fabs(corrected.y), std::fabs(corrected.z)};
+    const double p_size[3] = {std::fabs(plain.x), std::fabs(plain.y), std::fabs(plain.z)};
+    bool ok = true;
+    for (int r = 0; r < 3; ++r) {
+      const double want_c = -dt * share * k0 * wv[r], want_p = -dt * k0 * wv[r];
+      // One addition, one product by -dt, and the share's and k_i's products: 8 u of the larger term.
+      ok = ok && std::fabs(cw[r] - want_c) <= 8.0 * kUnitRoundoff * (c_size[r] + std::fabs(want_c) + 1e-30);
+      ok = ok && std::fabs(pw[r] - want_p) <= 8.0 * kUnitRoundoff * (p_size[r] + std::fabs(want_p) + 1e-30);
+      if (!ok && failures < 5)
+        std::printf(
+            "  particle %u axis %d: walls' part corrected %.9g (want %.9g, weight %.3f), plain %.9g (want "
+            "%.9g)\n",
+            i, r, cw[r], want_c, static_cast<double>(weight), pw[r], want_p);
+    }
+    if (!ok) ++failures;
+  }
+  std::printf("corrected gradient's walls' share: %u particles with a full correction, %u of %u off\n", full,
+              failures, s.n);
+  assert_true(full > 300u);
+  assert_int_equal(failures, 0);
+}
+
 void test_dfsph_passes(void**) { check_dfsph(false); }
 void test_dfsph_passes_walls(void**) { check_dfsph(true); }
 
@@ -550,6 +619,7 @@ int main() {
       cmocka_unit_test(test_dfsph_passes),
       cmocka_unit_test(test_dfsph_passes_walls),
       cmocka_unit_test(test_dfsph_corrected_gradient_is_first_order),
+      cmocka_unit_test(test_dfsph_corrected_gradient_wall_share),
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);
 }

@@ -121,8 +121,8 @@ static void test_hydrostatic_dfsph(void** state) {
  * physics/dfsph_gradient_correction.h): the issue's 0.5 % on every interior slice, on a tank 24
  * layers wide (24 x 24 x 24, 6,912 particles). Each particle's pressure scatters 1.5-2.2 % about
  * rho0 g d (6-8 % at the default gradient), so a slice's mean over about 420 interior particles
- * has a standard error of 0.08-0.11 %; 12 wide (55 particles a slice) it was 0.3-0.6 %, and the
- * worst of six slices read 0.16 % (CPU, session 16), 0.66 % (H200) or 1.03 % (CPU, session 25): a
+ * has a standard error of 0.08-0.13 %; 12 wide (about 50 particles a slice) it was 0.3-0.6 %, and the
+ * worst of six slices read 0.16 % (CPU, session 16), 0.66 % (H200) or 1.03 % (CPU, at 30819b0): a
  * draw, not a bound held. Measured 24 wide (CPU, session 26): 0.13 % mean, 0.27 % worst; with the
  * lattice moved by up to 1e-7 m (HYDRO_PERTURB=1, 2) 0.08 % / 0.19 % and 0.06 % / 0.18 %; the
  * gauges 0.18-0.20 % worst (docs/validation.md, "DFSPH: hydrostatic tank", session 26). The
