@@ -19,9 +19,9 @@
 // zeroth-order term. That share is kept because the difference form alone exerts no force for a
 // uniform pressure, so nothing holds the packing: measured, the tank then never settles (v_rms
 // 0.12-0.18 m/s against 0.03). beta = 0.2 keeps it at rest (0.035 m/s) while the particles' scatter
-// falls to 2-3 %; 0.5 gives 3.5-5 %. The removed share can do work: session 16 measured the DFSPH
-// closed box gaining 4.4 % energy at 0.2 (none at 0.4 and above); today it reads -0.08 %, as
-// without the flag (docs/physics.md).
+// falls to 2-3 %; 0.5 gives 3.5-5 %. The removed share does work: the DFSPH closed box gains 4.4 %
+// energy at 0.2 on the CPU in session 16 (none at 0.4 and above), and in session 26 -0.08 % on the
+// CPU but +162 % on an H200: a draw of an unstable case (docs/physics.md).
 //
 // Where the neighbourhood is truncated (a free surface, the first layers at a wall) B loses rank
 // and removing the zeroth-order term would let a particle's own pressure pull it into the fluid
