@@ -210,13 +210,7 @@ int main(int argc, char** argv) {
     std::memmove(lattice + 3 * kept, lattice + 3 * i, 3 * sizeof(float));
     ++kept;
   }
-  if (perturb != 0) {
-    uint64_t state = perturb * 0x9E3779B97F4A7C15ull;
-    for (uint32_t i = 0; i < 3 * kept; ++i) {
-      state = state * 6364136223846793005ull + 1442695040888963407ull;
-      lattice[i] += static_cast<float>(((state >> 11) * (1.0 / 9007199254740992.0) * 2.0 - 1.0) * 1e-7);
-    }
-  }
+  if (perturb != 0) support_nudge(lattice, kept, perturb, 1e-7);
   sph_world_def def;
   sph_world_def_init(&def);
   def.particle_spacing = static_cast<float>(step * std::sqrt(2.0));

@@ -20,3 +20,11 @@ void support_random_velocities(float* velocities, uint32_t count, double speed, 
     velocities[i] = drift ? drift[i % 3] + random : random;
   }
 }
+
+void support_nudge(float* xyz, uint32_t count, uint64_t seed, double amplitude) {
+  uint64_t state = seed * 0x9E3779B97F4A7C15ull;
+  for (uint32_t i = 0; i < 3 * count; ++i) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    xyz[i] += (float)(((double)(state >> 11) * (1.0 / 9007199254740992.0) * 2.0 - 1.0) * amplitude);
+  }
+}

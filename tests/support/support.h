@@ -54,6 +54,10 @@ double support_random(uint64_t* state);
  * ...; with `drift` (3 floats, or NULL) each component is drift[k] + that, added in float. */
 void support_random_velocities(float* velocities, uint32_t count, double speed, const float* drift,
                                uint64_t* state);
+/** Moves each of 3 * count coordinates by (float)(amplitude * (2 u - 1)), u in [0, 1) from a 64-bit
+ * linear congruential generator seeded with `seed` (another sequence than support_random's): the
+ * rounding-sized nudges the validation and loads measurements call draws (seed N, 1e-7 m). */
+void support_nudge(float* xyz, uint32_t count, uint64_t seed, double amplitude);
 
 /* ---- FCC lattices ----------------------------------------------------------------------------- */
 

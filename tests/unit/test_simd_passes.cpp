@@ -564,7 +564,7 @@ void test_dfsph_corrected_gradient_wall_share(void**) {
         sph::add_gradient_moment(m, sph::spiky_gradient(mk, d, std::sqrt(r2)), d);
     });
     const float weight = sph::corrected_pressure_sum(Vec3{0.0f, 0.0f, 0.0f}, m, k0, f.rest_density).weight;
-    const double share = weight >= 1.0f ? beta : 1.0 - weight * (1.0 - beta);
+    const double share = 1.0 - weight * (1.0 - beta);
     if (weight >= 1.0f) ++full;
     const double cw[3] = {corrected_walls.x - corrected.x, corrected_walls.y - corrected.y,
                           corrected_walls.z - corrected.z};

@@ -62,13 +62,8 @@ static void open_tank(const tank_case* tc, double gap, support_world* w, sph_sdf
   /* HYDRO_PERTURB=SEED: every coordinate moved by up to 1e-7 m (a generator seeded with SEED),
    * another draw of the same settling: how much of a reading is the draw's (docs/validation.md,
    * "Session 26"). */
-  if (getenv("HYDRO_PERTURB")) {
-    uint64_t state = strtoull(getenv("HYDRO_PERTURB"), NULL, 10) * 0x9E3779B97F4A7C15ull;
-    for (uint32_t i = 0; i < 3u * *n; ++i) {
-      state = state * 6364136223846793005ull + 1442695040888963407ull;
-      lattice_points[i] += (float)(((double)(state >> 11) * (1.0 / 9007199254740992.0) * 2.0 - 1.0) * 1e-7);
-    }
-  }
+  if (getenv("HYDRO_PERTURB"))
+    support_nudge(lattice_points, *n, strtoull(getenv("HYDRO_PERTURB"), NULL, 10), 1e-7);
   sph_world_def_init(&def);
   def.capacity = *n;
   def.particle_spacing = (float)(step * sqrt(2.0));

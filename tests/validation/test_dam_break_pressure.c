@@ -204,14 +204,8 @@ static reading dam_break_pressure(uint32_t features, const char* name, int whole
     }
   }
   if (!seed && getenv("DAM_PRESSURE_PERTURB")) seed = strtoull(getenv("DAM_PRESSURE_PERTURB"), NULL, 10);
-  if (seed) {
-    /* Rounding-sized moves (the ensemble's draws): how far rounding alone moves the readings. */
-    uint64_t state = seed * 0x9E3779B97F4A7C15ull;
-    for (uint32_t i = 0; i < 3 * n; ++i) {
-      state = state * 6364136223846793005ull + 1442695040888963407ull;
-      lattice[i] += (float)(((double)(state >> 11) * (1.0 / 9007199254740992.0) * 2.0 - 1.0) * 1e-7);
-    }
-  }
+  /* Rounding-sized moves (the ensemble's draws): how far rounding alone moves the readings. */
+  if (seed) support_nudge(lattice, n, seed, 1e-7);
   def.particle_spacing = (float)(step * sqrt(2.0));
   def.capacity = n;
   /* DAM_PRESSURE_FEATURES=BITS (measuring only) replaces the case's feature bits */
