@@ -10,7 +10,7 @@
  *   rest_sphere [--particles N|largest] [--frames F] [--warmup W] [--backend cpu|cuda|auto]
  *               [--case rest|moving|both] [--option NAME] [--json FILE] [--csv FILE] [--label TEXT]
  *               [--cuda-frames graph|stream] [--density-block N] [--force-block N]
- *               [--particle-lanes N] [--threads N] [--dfsph-masks on|off]
+ *               [--particle-lanes N] [--threads N] [--dfsph-masks on|off|lists]
  *
  * --threads sets the CPU backend's workers (sph_context_def.cpu_worker_count), so that a run on a
  * larger host can measure two workers (issue 18's CPU goal); pin them with taskset to two cores.
@@ -32,7 +32,8 @@
  * kernel by kernel, which is what a profiler such as ncu needs (scripts/bench-gpu).
  * --particle-lanes sets cuda_particle_lanes (threads per particle of the neighbour passes: 1, 2,
  * 4 or 8; scripts/bench-lanes compares them). --dfsph-masks off sets cuda_dfsph_masks =
- * SPH_CUDA_DFSPH_MASKS_OFF (with --option dfsph: the world's bytes without the candidate masks).
+ * SPH_CUDA_DFSPH_MASKS_OFF (with --option dfsph: the world's bytes without the candidate masks);
+ * --dfsph-masks lists sets SPH_CUDA_DFSPH_NEIGHBOR_LISTS (the solves loop over neighbour lists).
  *
  * Prints a table per case; --json writes the results as a JSON array, --csv appends rows
  * (with a header when the file is new). Times are the wall time of sph_world_step (which
@@ -68,7 +69,8 @@ typedef struct options {
   uint32_t force_block;
   uint32_t particle_lanes; /* 0: the library's choice */
   uint32_t threads;        /* CPU workers; 0: the library's default, one per processor */
-  uint32_t dfsph_masks;    /* sph_context_def.cuda_dfsph_masks: 0 on, SPH_CUDA_DFSPH_MASKS_OFF */
+  uint32_t
+      dfsph_masks; /* sph_context_def.cuda_dfsph_masks: 0 on, SPH_CUDA_DFSPH_MASKS_OFF, _NEIGHBOR_LISTS */
 } options;
 
 typedef struct result {
@@ -370,7 +372,8 @@ static void usage(void) {
           "none|surface_tension|normalized_density|density_diffusion|\n"
           "                   clavet|tait|rk4|acoustic_limit|springs|dfsph] [--json FILE] [--csv FILE]\n"
           "                   [--label TEXT] [--cuda-frames graph|stream] [--density-block N]\n"
-          "                   [--force-block N] [--particle-lanes N] [--threads N] [--dfsph-masks on|off]\n");
+          "                   [--force-block N] [--particle-lanes N] [--threads N] [--dfsph-masks "
+          "on|off|lists]\n");
   exit(2);
 }
 
@@ -412,8 +415,10 @@ int main(int argc, char** argv) {
     } else if (strcmp(a, "--threads") == 0) {
       o.threads = (uint32_t)strtoul(v, NULL, 10);
     } else if (strcmp(a, "--dfsph-masks") == 0) {
-      if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0) usage();
-      o.dfsph_masks = strcmp(v, "off") == 0 ? SPH_CUDA_DFSPH_MASKS_OFF : 0u;
+      if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0 && strcmp(v, "lists") != 0) usage();
+      o.dfsph_masks = strcmp(v, "off") == 0     ? SPH_CUDA_DFSPH_MASKS_OFF
+                      : strcmp(v, "lists") == 0 ? SPH_CUDA_DFSPH_NEIGHBOR_LISTS
+                                                : 0u;
     } else {
       usage();
     }

@@ -11,6 +11,7 @@
  *   solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1]
  *                [--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg]
  *                [--dfsph-max 0.05] [--walls-in-density] [--particle-lanes N] [--no-dfsph-masks]
+ *                [--dfsph-lists]
  *                [--frame-log] [--out solver_front.csv]
  *
  * --wcsph: the weakly compressible runs' speeds of sound, as multiples of the free-fall speed;
@@ -23,6 +24,8 @@
  * --particle-lanes: the CUDA context's cuda_particle_lanes (threads per particle of the neighbour
  * passes; 0, the default, is the library's choice). --no-dfsph-masks: the CUDA context's
  * cuda_dfsph_masks = SPH_CUDA_DFSPH_MASKS_OFF (the solves walk every candidate; the same bits).
+ * --dfsph-lists: cuda_dfsph_masks = SPH_CUDA_DFSPH_NEIGHBOR_LISTS (the solves loop over each
+ * particle's neighbour list; the same bits).
  * --frame-log: one line a frame on stdout with the step's statistics and where the densest
  * particle is (in column widths), for diagnosing a run.
  *
@@ -154,6 +157,8 @@ int main(int argc, char** argv) {
       particle_lanes = (uint32_t)strtoul(argv[++i], NULL, 10);
     } else if (strcmp(argv[i], "--no-dfsph-masks") == 0) {
       dfsph_masks = SPH_CUDA_DFSPH_MASKS_OFF;
+    } else if (strcmp(argv[i], "--dfsph-lists") == 0) {
+      dfsph_masks = SPH_CUDA_DFSPH_NEIGHBOR_LISTS;
     } else if (strcmp(argv[i], "--frame-log") == 0) {
       frame_log = 1;
     } else if (strcmp(argv[i], "--dfsph-solver") == 0 && i + 1 < argc) {
@@ -171,7 +176,7 @@ int main(int argc, char** argv) {
           stderr,
           "usage: solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1] "
           "[--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg] [--dfsph-max 0.05] "
-          "[--walls-in-density] [--particle-lanes N] [--no-dfsph-masks] [--frame-log] [--out "
+          "[--walls-in-density] [--particle-lanes N] [--no-dfsph-masks] [--dfsph-lists] [--frame-log] [--out "
           "solver_front.csv]\n");
       return 2;
     }

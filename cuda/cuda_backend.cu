@@ -40,6 +40,9 @@ CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBacken
   if (options_.dfsph && options.dfsph_masks)
     arrays.push_back(ParticleArraySpec{kArrayDfsphNeighborMask, sizeof(uint32_t), ParticleArrayRole::Scratch,
                                        kNeighborMaskWords, nullptr, nullptr});
+  if (options_.dfsph && options.dfsph_masks && options.dfsph_lists)
+    arrays.push_back(ParticleArraySpec{kArrayDfsphNeighborList, sizeof(uint32_t), ParticleArrayRole::Scratch,
+                                       kNeighborListRows, nullptr, nullptr});
   r->store = std::make_unique<DeviceParticleStore>(config.capacity, arrays);
   // The sorted positions are free while the sort runs: its temporary storage goes there.
   r->grid = std::make_unique<DeviceNeighborGrid>(

@@ -19,6 +19,7 @@ struct CudaBackendOptions {
   unsigned force_block = 128;    // threads per block of the force kernels
   unsigned particle_lanes = 0;   // lane groups (KernelTuning::particle_lanes): 0 = by particle count
   bool dfsph_masks = true;       // DFSPH's candidate masks (physics/neighbor_walk.h), 48 B a particle
+  bool dfsph_lists = false;      // and its neighbour lists (needs the masks), 256 B a particle
 };
 
 std::unique_ptr<Backend> make_cuda_backend(const WorldConfig& config, int device_ordinal,

@@ -60,6 +60,8 @@ DeviceParticleStore::DeviceParticleStore(uint32_t capacity,
   arrays_.dfsph_contact_impulse = static_cast<Float4*>(find(kArrayDfsphContactImpulse));
   arrays_.dfsph_residual = static_cast<float*>(find(kArrayDfsphResidual));
   arrays_.dfsph_neighbor_mask = static_cast<uint32_t*>(find(kArrayDfsphNeighborMask));
+  arrays_.dfsph_neighbor_list = static_cast<uint32_t*>(find(kArrayDfsphNeighborList));
+  arrays_.dfsph_list_stride = capacity;
   arrays_.dfsph_cg_value = static_cast<float*>(find(kArrayDfsphCgValue));
   arrays_.dfsph_cg_change = static_cast<float*>(find(kArrayDfsphCgChange));
   arrays_.dfsph_cg_velocity_step = static_cast<Float4*>(find(kArrayDfsphCgVelocityStep));

@@ -72,6 +72,11 @@ struct ParticleArrays {
   // The density pass's candidate masks for the solves' passes (kNeighborMaskWords words a
   // particle, physics/neighbor_walk.h); null unless DFSPH, or with sph_context_def.cuda_dfsph_masks off.
   uint32_t* dfsph_neighbor_mask;
+  // The solves' neighbour lists (kNeighborListRows uint32 a particle, slot-major with stride
+  // dfsph_list_stride, the capacity; physics/neighbor_walk.h), written from the masks after the
+  // density pass; null unless sph_context_def.cuda_dfsph_masks = SPH_CUDA_DFSPH_NEIGHBOR_LISTS.
+  uint32_t* dfsph_neighbor_list;
+  uint32_t dfsph_list_stride;
   // Null where the conjugate gradients cannot run (particle_arrays.cpp): their density solve's
   // rho* - rho0, its change along the search direction, that direction's velocity change, flags.
   float* dfsph_cg_value;
@@ -96,6 +101,9 @@ constexpr const char* kArrayHaloGhost = "distributed_ghost";
 // DFSPH's candidate masks (ParticleArrays::dfsph_neighbor_mask; Scratch, kNeighborMaskWords
 // uint32 a particle).
 constexpr const char* kArrayDfsphNeighborMask = "dfsph_neighbor_mask";
+// DFSPH's neighbour lists (ParticleArrays::dfsph_neighbor_list; Scratch, kNeighborListRows uint32
+// a particle, laid out slot-major).
+constexpr const char* kArrayDfsphNeighborList = "dfsph_neighbor_list";
 
 // A method's array on the device: its elements (two sides for a Sorted array) and, for a
 // Carried one, the snapshot of the frame's start.

@@ -35,11 +35,9 @@ struct CgSolve {
 
 __device__ inline DfsphWalls cg_walls(const CgSolve& s) { return DfsphWalls{s.a.boundary_gradient}; }
 
-// The neighbours of particle i, through the density pass's candidate masks (every candidate
-// where the world has none).
-__device__ inline MaskedCandidates cg_walk(const CgSolve& s) {
-  return MaskedCandidates{s.a.dfsph_neighbor_mask};
-}
+// The neighbours of particle i, through the density pass's neighbour lists or candidate masks
+// (every candidate where the world has neither).
+__device__ inline ListedCandidates cg_walk(const CgSolve& s) { return solve_walk(s.a); }
 
 // A particle's term of a sum over the cycle's set, and whether it is in the set.
 struct CgTerm {

@@ -26,6 +26,12 @@ namespace sph {
 // Threads of the one-block kernels that sum the block sums and decide.
 constexpr unsigned kDfsphCheckBlock = 256;
 
+// The candidates the solves' passes visit: the neighbour lists where the world keeps them, the
+// masks where it keeps those, every candidate otherwise (physics/neighbor_walk.h).
+__device__ inline ListedCandidates solve_walk(const ParticleArrays& a) {
+  return ListedCandidates{a.dfsph_neighbor_mask, a.dfsph_neighbor_list, a.dfsph_list_stride};
+}
+
 // Fixed-shape tree over a block's shared slots: the same additions in the same order every run.
 template <unsigned kBlock>
 __device__ void block_tree_sum(double* slots) {

@@ -64,6 +64,16 @@ __device__ Vec3 dfsph_clamp(const ParticleArrays& a, uint32_t i, Vec3 v) {
   return held;
 }
 
+// Particle i's neighbour list from its mask (the lists' world only), after the density pass wrote
+// the masks and before the solves read either.
+__global__ void dfsph_list_kernel(GridView grid, ParticleArrays a, uint32_t n) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  write_neighbor_list(grid, xyz(a.sorted_position[i]),
+                      a.dfsph_neighbor_mask + static_cast<size_t>(i) * kNeighborMaskWords,
+                      a.dfsph_neighbor_list, a.dfsph_list_stride, i);
+}
+
 __global__ void dfsph_begin_solve_kernel(FrameState* state) {
   state->solve_run = 1;
   state->solve_iterations = 0;
@@ -87,7 +97,7 @@ __global__ void dfsph_correct_kernel(FluidConstants fluid, GridView grid, Partic
   // kCorrected: SPH_DFSPH_CORRECTED_GRADIENT (physics/dfsph_gradient_correction.h), its own
   // instantiation so that the default kernel keeps its registers.
   const DfsphWalls walls{a.boundary_gradient};
-  const MaskedCandidates walk{a.dfsph_neighbor_mask};
+  const ListedCandidates walk = solve_walk(a);
   Vec3 vi = xyz(v[i]);
   vi += pressure_velocity_change<kCorrected>(fluid, grid, a.sorted_position, k, walls, i, dt, walk);
   if (contacts) vi = dfsph_clamp(a, i, vi);
@@ -127,8 +137,8 @@ __global__ void __launch_bounds__(kDfsphSolveBlock)
   double error = 0.0;
   if (i < n) {
     const float dt = state->clock.dt_float;
-    const float rate = density_rate(fluid, grid, a.sorted_position, v, DfsphWalls{a.boundary_gradient}, i,
-                                    MaskedCandidates{a.dfsph_neighbor_mask});
+    const float rate =
+        density_rate(fluid, grid, a.sorted_position, v, DfsphWalls{a.boundary_gradient}, i, solve_walk(a));
     const DfsphResidual r =
         kDivergence ? divergence_residual(fluid.methods.dfsph, rate, a.neighbor_count[i], a.dfsph_factor[i],
                                           fluid.rest_density, dt)
@@ -357,6 +367,10 @@ void enqueue_dfsph_density(const FluidConstants& fluid, const GridView& grid, co
   else
     dfsph_density_kernel<false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
   check_launch("dfsph_density_kernel");
+  if (a.dfsph_neighbor_list && a.dfsph_neighbor_mask && n != 0) {
+    dfsph_list_kernel<<<blocks, threads, 0, stream>>>(grid, a, n);
+    check_launch("dfsph_list_kernel");
+  }
 }
 
 void enqueue_dfsph_step(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,

@@ -41,12 +41,15 @@ sph::CudaTuning cuda_tuning_from_def(const sph_context_def& d) {
     throw Error(Status::InvalidArgument,
                 "def->cuda_particle_lanes: " + std::to_string(lanes) +
                     " threads per particle; use 0 (the library's choice), 1, 2, 4 or 8");
-  if (d.cuda_dfsph_masks != 0 && d.cuda_dfsph_masks != SPH_CUDA_DFSPH_MASKS_OFF)
+  if (d.cuda_dfsph_masks != 0 && d.cuda_dfsph_masks != SPH_CUDA_DFSPH_MASKS_OFF &&
+      d.cuda_dfsph_masks != SPH_CUDA_DFSPH_NEIGHBOR_LISTS)
     throw Error(Status::InvalidArgument,
                 "def->cuda_dfsph_masks: " + std::to_string(d.cuda_dfsph_masks) +
-                    " is neither 0 (on, the default) nor SPH_CUDA_DFSPH_MASKS_OFF (1)");
+                    " is none of 0 (masks, the default), SPH_CUDA_DFSPH_MASKS_OFF (1) and "
+                    "SPH_CUDA_DFSPH_NEIGHBOR_LISTS (2)");
   sph::CudaTuning t;
-  t.dfsph_masks = d.cuda_dfsph_masks == 0;
+  t.dfsph_masks = d.cuda_dfsph_masks != SPH_CUDA_DFSPH_MASKS_OFF;
+  t.dfsph_lists = d.cuda_dfsph_masks == SPH_CUDA_DFSPH_NEIGHBOR_LISTS;
   t.stream_frames = frames == SPH_CUDA_FRAMES_STREAM;
   t.density_block = block(d.cuda_density_block, "cuda_density_block");
   t.force_block = block(d.cuda_force_block, "cuda_force_block");

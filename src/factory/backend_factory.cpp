@@ -68,6 +68,7 @@ std::unique_ptr<Backend> make_backend(BackendKind kind, const WorldConfig& confi
     if (cuda_tuning.force_block != 0) options.force_block = cuda_tuning.force_block;
     options.particle_lanes = cuda_tuning.particle_lanes;
     options.dfsph_masks = cuda_tuning.dfsph_masks;
+    options.dfsph_lists = cuda_tuning.dfsph_lists;
     return make_cuda_backend(config, device_ordinal < 0 ? 0 : device_ordinal, options);
   }
 #else

@@ -174,4 +174,50 @@ struct MaskedCandidates {
   }
 };
 
+// DFSPH's neighbour lists (CUDA, sph_context_def.cuda_dfsph_masks = SPH_CUDA_DFSPH_NEIGHBOR_LISTS):
+// the masked walk's visits written out once a substep, so that the solves' many passes loop over
+// a particle's own short list instead of the 27 cells' runs, whose lengths and bits differ from
+// lane to lane of a warp (session 16's ncu: about 11 of 32 lanes active in the masked passes).
+// Slot-major, so that a warp's 32 particles read one slot in one coalesced line: entry s of
+// particle i at list[s * stride + i], stride the world's capacity; slot 0 holds the count and
+// slots 1..count the indices, in the masked walk's order (the same terms in the same order: the
+// same bits). A particle with more than kNeighborListSlots visits keeps its count and walks its
+// mask. 64 slots (256 B a particle): at the default radius a particle at rest has about 35
+// neighbours (the mask's visits add those just past h), a compressed one rarely 60.
+constexpr uint32_t kNeighborListSlots = 63;
+constexpr uint32_t kNeighborListRows = kNeighborListSlots + 1;  // uint32 a particle, the count's included
+
+// Writes particle i's list from its mask (for_each_masked_neighbor's visits, in order).
+SPH_HD void write_neighbor_list(const GridView& grid, Vec3 p, const uint32_t* mask, uint32_t* list,
+                                uint32_t stride, uint32_t i) {
+  uint32_t count = 0;
+  for_each_masked_neighbor(grid, p, mask, [&](uint32_t j) {
+    ++count;
+    if (count <= kNeighborListSlots) list[static_cast<size_t>(count) * stride + i] = j;
+  });
+  list[i] = count;
+}
+
+// The walk of the solves' passes with lists: particle i's list where it holds every visit, its
+// masked walk otherwise (or where the world has no lists: lists null).
+struct ListedCandidates {
+  const uint32_t* masks;  // null: every candidate
+  const uint32_t* lists;  // null: the masked walk for every particle
+  uint32_t stride;        // the lists' capacity
+  template <class Visit>
+  SPH_HD void operator()(const GridView& grid, Vec3 p, uint32_t i, Visit&& visit) const {
+    const uint32_t count = lists ? lists[i] : kNeighborListSlots + 1u;
+    if (count <= kNeighborListSlots) {
+      const uint32_t* entry = lists + i;
+#ifndef SPH_EXP_LIST_UNROLL
+#define SPH_EXP_LIST_UNROLL 1
+#endif
+      SPH_UNROLL(SPH_EXP_LIST_UNROLL)
+      for (uint32_t s = 1; s <= count; ++s) visit(entry[static_cast<size_t>(s) * stride]);
+      return;
+    }
+    MaskedCandidates{masks}(grid, p, i, visit);
+  }
+};
+
 }  // namespace sph

@@ -141,7 +141,7 @@ static void test_create_bad_fields(void** state) {
   def.device_ordinal = INT32_MIN;
   EXPECT_CREATE_FAILS(&def, SPH_ERROR_INVALID_ARGUMENT, "device_ordinal");
   sph_test_context_def_init(&def);
-  def.cuda_dfsph_masks = 2;
+  def.cuda_dfsph_masks = 3; /* past SPH_CUDA_DFSPH_NEIGHBOR_LISTS */
   EXPECT_CREATE_FAILS(&def, SPH_ERROR_INVALID_ARGUMENT, "cuda_dfsph_masks");
   sph_test_context_def_init(&def);
   def.cuda_dfsph_masks = 0xffffffffu;

@@ -7,7 +7,9 @@
 // = SPH_CUDA_DFSPH_MASKS_OFF; both runs execute the same kernels, which walk every candidate where
 // a particle has no mask): every frame's state (positions,
 // velocities, densities, pressures, ids) and every frame's solve statistics (substeps, both
-// solves' iterations, the achieved error's bits).
+// solves' iterations, the achieved error's bits). The neighbour lists written from the masks
+// (SPH_CUDA_DFSPH_NEIGHBOR_LISTS: the solves loop over each particle's list of up to 63 of the
+// masked walk's visits, and walk the mask past that) must give those bits too.
 // The scene: the Martin & Moyce dam break of check_dfsph_cg.cpp (16 lattice layers across the
 // column, a 6-layer slab, 1,536 particles; the tank's walls as a collider, so the contacts are
 // exercised), 40 frames of 3 ms:
@@ -16,7 +18,9 @@
 //   - conjugate gradients, the same;
 //   - Jacobi with the kernel radius at 3.0 spacings: at the start 702 of the 1,536 particles have
 //     more than 383 candidates (their masks overflow and their passes walk every candidate),
-//     next to particles whose masks are used. The check counts each particle's candidates on
+//     next to particles whose masks are used (and, with lists, particles whose 63-slot lists
+//     overflow, since every overflowing mask's walk visits every candidate, next to listed
+//     ones). The check counts each particle's candidates on
 //     the host at the start (the particles of the 27 cells around its cell, cell = floor(x / h)
 //     in float as the device computes it; a table that folds distant cells together would only
 //     add candidates) and requires both kinds.
@@ -83,10 +87,12 @@ uint32_t overflows(const float* positions, uint32_t n, float h) {
   return over;
 }
 
-Run run(const Case& c, bool masks) {
-  context_tuning().dfsph_masks_off = !masks;
+// masks: sph_context_def.cuda_dfsph_masks (0 the masks, SPH_CUDA_DFSPH_MASKS_OFF, or
+// SPH_CUDA_DFSPH_NEIGHBOR_LISTS).
+Run run(const Case& c, uint32_t masks) {
+  context_tuning().dfsph_masks = masks;
   sph_context* context = make_context(SPH_BACKEND_CUDA);
-  context_tuning().dfsph_masks_off = false;
+  context_tuning().dfsph_masks = 0;
   sph_dfsph_params dfsph;
   sph_dfsph_params_init(&dfsph);
   dfsph.linear_solver = c.conjugate_gradients ? SPH_DFSPH_CONJUGATE_GRADIENTS : SPH_DFSPH_JACOBI;
@@ -117,23 +123,33 @@ bool same_stats(const FrameStats& a, const FrameStats& b) {
 }
 
 // Returns the run's count of overflowing particles at the start.
+// The first frame where two runs differ (0: none).
+uint32_t first_frame_apart(const Run& a, const Run& b) {
+  for (uint32_t f = 0; f < kFrames; ++f)
+    if (!same_stats(a.stats[f], b.stats[f]) || !states_identical(a.frames[f], b.frames[f])) return f + 1;
+  return 0;
+}
+
 uint32_t check(const Case& c) {
-  const Run with = run(c, true);
-  const Run without = run(c, false);
-  uint32_t first_apart = 0, substeps = 0, iterations = 0;
-  for (uint32_t f = 0; f < kFrames && first_apart == 0; ++f)
-    if (!same_stats(with.stats[f], without.stats[f]) || !states_identical(with.frames[f], without.frames[f]))
-      first_apart = f + 1;
+  const Run with = run(c, 0);
+  const Run without = run(c, SPH_CUDA_DFSPH_MASKS_OFF);
+  const Run listed = run(c, SPH_CUDA_DFSPH_NEIGHBOR_LISTS);
+  const uint32_t masks_apart = first_frame_apart(with, without);
+  const uint32_t lists_apart = first_frame_apart(listed, without);
+  uint32_t substeps = 0, iterations = 0;
   for (const FrameStats& s : with.stats) {
     substeps += s.substeps;
     iterations += s.iterations;
   }
   const std::string name = std::string("dfsph masks: ") + c.name + ", the same bits without the masks";
-  report(first_apart == 0, name.c_str(),
+  report(masks_apart == 0, name.c_str(),
          "%u frames, %u substeps, %.2f density iterations a substep, %u particles, %u with more than 383 "
          "candidates at the start; first frame apart: %u (0: none)",
          kFrames, substeps, double(iterations) / (substeps ? substeps : 1), with.frames.back().count,
-         with.overflows, first_apart);
+         with.overflows, masks_apart);
+  const std::string lists =
+      std::string("dfsph neighbour lists: ") + c.name + ", the same bits without the masks";
+  report(lists_apart == 0, lists.c_str(), "%u frames; first frame apart: %u (0: none)", kFrames, lists_apart);
   return with.overflows;
 }
 

@@ -72,8 +72,8 @@ struct ContextTuning {
   bool stream_frames = false;
   uint32_t density_block = 0;  // 0: the library's default
   uint32_t force_block = 0;
-  uint32_t particle_lanes = 0;   // cuda_particle_lanes; 0: the library's choice
-  bool dfsph_masks_off = false;  // cuda_dfsph_masks = SPH_CUDA_DFSPH_MASKS_OFF (check_dfsph_masks)
+  uint32_t particle_lanes = 0;  // cuda_particle_lanes; 0: the library's choice
+  uint32_t dfsph_masks = 0;     // cuda_dfsph_masks: 0 masks, 1 off, 2 lists (check_dfsph_masks)
 };
 inline ContextTuning& context_tuning() {
   static ContextTuning tuning;
@@ -101,7 +101,7 @@ template <class Def>
 void apply_particle_lanes(Def&, long) {}
 template <class Def>
 auto apply_dfsph_masks(Def& def, int) -> decltype(def.cuda_dfsph_masks, void()) {
-  def.cuda_dfsph_masks = context_tuning().dfsph_masks_off ? 1u : 0u;  // SPH_CUDA_DFSPH_MASKS_OFF : on
+  def.cuda_dfsph_masks = context_tuning().dfsph_masks;
 }
 template <class Def>
 void apply_dfsph_masks(Def&, long) {}

@@ -91,6 +91,7 @@ bool same_bits(const T& a, const T& b) {
 
 struct Tally {
   uint32_t particles = 0, overflowed = 0, wrapped_rows = 0, edge_pairs = 0, mismatches = 0;
+  uint32_t listed = 0;  // particles whose neighbour list holds every visit (the rest walk their masks)
 };
 
 // Every particle of the table against brute force (the file's header).
@@ -101,6 +102,9 @@ Tally check_table(const Table& t) {
   const float dt = 1e-3f;
   const sph::DfsphWalls no_walls{nullptr};
   std::vector<uint32_t> masks(static_cast<size_t>(t.size()) * sph::kNeighborMaskWords, 0xdeadbeefu);
+  // The lists, slot-major with a stride above the particle count (a world's capacity).
+  const uint32_t stride = t.size() + 7u;
+  std::vector<uint32_t> lists(static_cast<size_t>(stride) * sph::kNeighborListRows, 0xdeadbeefu);
   Tally tally;
   for (uint32_t i = 0; i < t.size(); ++i) {
     ++tally.particles;
@@ -147,6 +151,18 @@ Tally check_table(const Table& t) {
     std::vector<uint32_t> without;  // no mask: every candidate
     sph::for_each_masked_neighbor(view, xi, nullptr, [&](uint32_t j) { without.push_back(j); });
     ok = ok && without == candidates;
+    // The list written from the mask: its count is the masked walk's, and the listed walk visits
+    // what the masked walk does, in its order, from the list or (past 63) from the mask.
+    sph::write_neighbor_list(view, xi, mask, lists.data(), stride, i);
+    ok = ok && lists[i] == visited.size();
+    tally.listed += visited.size() <= sph::kNeighborListSlots;
+    const sph::ListedCandidates listed{masks.data(), lists.data(), stride};
+    std::vector<uint32_t> listed_visits;
+    listed(view, xi, i, [&](uint32_t j) { listed_visits.push_back(j); });
+    ok = ok && listed_visits == visited;
+    std::vector<uint32_t> unlisted;  // a world without lists: the masked walk
+    sph::ListedCandidates{masks.data(), nullptr, 0}(view, xi, i, [&](uint32_t j) { unlisted.push_back(j); });
+    ok = ok && unlisted == visited;
     // The solves' passes through both walks.
     const sph::MaskedCandidates masked{masks.data()};
     const float rate = sph::density_rate(f, view, t.positions.data(), t.velocities.data(), no_walls, i);
@@ -162,6 +178,13 @@ Tally check_table(const Table& t) {
     const Vec3 dvc_masked =
         sph::pressure_velocity_change<true>(f, view, t.positions.data(), t.k.data(), no_walls, i, dt, masked);
     ok = ok && same_bits(rate, rate_masked) && same_bits(dv, dv_masked) && same_bits(dvc, dvc_masked);
+    const float rate_listed =
+        sph::density_rate(f, view, t.positions.data(), t.velocities.data(), no_walls, i, listed);
+    const Vec3 dv_listed = sph::pressure_velocity_change<false>(f, view, t.positions.data(), t.k.data(),
+                                                                no_walls, i, dt, listed);
+    const Vec3 dvc_listed =
+        sph::pressure_velocity_change<true>(f, view, t.positions.data(), t.k.data(), no_walls, i, dt, listed);
+    ok = ok && same_bits(rate, rate_listed) && same_bits(dv, dv_listed) && same_bits(dvc, dvc_listed);
     ok = ok && (rate != 0.0f || plain.neighbor_count == 0);  // the passes saw neighbours
     if (!ok && tally.mismatches++ < 5)
       std::printf("  particle %u: %zu candidates, %zu kept, %zu visited\n", i, candidates.size(), kept.size(),
@@ -183,10 +206,11 @@ std::vector<Vec3> uniform_cloud(uint32_t count, float extent, uint32_t seed) {
 void test_folded_table(void**) {
   const Table t(uniform_cloud(2058, 7.0f * kH, 1), 5, 2);
   const Tally r = check_table(t);
-  std::printf("folded table: %u particles, %u overflowing, %u in wrapping rows, %u mismatches\n", r.particles,
-              r.overflowed, r.wrapped_rows, r.mismatches);
+  std::printf("folded table: %u particles, %u overflowing, %u listed, %u in wrapping rows, %u mismatches\n",
+              r.particles, r.overflowed, r.listed, r.wrapped_rows, r.mismatches);
   assert_int_equal(r.mismatches, 0);
   assert_true(r.overflowed > 0 && r.overflowed < r.particles);  // both kinds of particle exercised
+  assert_true(r.listed > 0 && r.listed < r.particles);          // lists used, and walks past them
   assert_true(r.wrapped_rows > 0);
 }
 
@@ -200,9 +224,10 @@ void test_lattice_edges(void**) {
         points.push_back(Vec3{0.5f * x + 0.25f, 0.5f * y + 0.25f, 0.5f * z + 0.25f});
   const Table t(points, 8, 3);
   const Tally r = check_table(t);
-  std::printf("lattice: %u particles, %u overflowing, %u pairs at r = h, %u mismatches\n", r.particles,
-              r.overflowed, r.edge_pairs, r.mismatches);
+  std::printf("lattice: %u particles, %u overflowing, %u listed, %u pairs at r = h, %u mismatches\n",
+              r.particles, r.overflowed, r.listed, r.edge_pairs, r.mismatches);
   assert_int_equal(r.mismatches, 0);
+  assert_int_equal(r.listed, r.particles);  // 33 to 44 visits a particle: every list holds them
   assert_true(r.edge_pairs > 0);
 }
 

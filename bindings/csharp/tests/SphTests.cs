@@ -122,7 +122,7 @@ static class Tests
         def.StructSize = 4;
         Throws(Result.ErrorVersionMismatch, () => new Context(def));
         def = ContextDef.Default();
-        def.CudaDfsphMasks = 2;
+        def.CudaDfsphMasks = 3;
         Throws(Result.ErrorInvalidArgument, () => new Context(def));
         def = ContextDef.Default();
         def.HeaderVersion = Library.MakeVersion(Constants.SPH_VERSION_MAJOR + 1, 0, 0);

@@ -50,7 +50,7 @@ def test_cuda_allocator_rules():
     ("header_version", sph.make_version(sph.BINDINGS_VERSION[0] + 1, 0, 0), sph.Result.ERROR_VERSION_MISMATCH),
     ("backend", 7, sph.Result.ERROR_UNSUPPORTED),
     ("cuda_particle_lanes", 3, sph.Result.ERROR_INVALID_ARGUMENT),
-    ("cuda_dfsph_masks", 2, sph.Result.ERROR_INVALID_ARGUMENT),
+    ("cuda_dfsph_masks", 3, sph.Result.ERROR_INVALID_ARGUMENT),
 ])
 def test_bad_context_def(field, value, result):
     d = sph.ContextDef(backend=sph.Backend.CPU)
@@ -58,6 +58,14 @@ def test_bad_context_def(field, value, result):
     with pytest.raises(sph.SphError) as e:
         sph.Context(definition=d)
     assert e.value.result == result, e.value
+
+
+@pytest.mark.parametrize("value", [0, 1, 2])
+def test_cuda_dfsph_masks_values(value):
+    """Every named value is accepted (a CPU context checks and ignores it)."""
+    d = sph.ContextDef(backend=sph.Backend.CPU, cuda_dfsph_masks=value)
+    with sph.Context(definition=d) as c:
+        assert c.backend == sph.Backend.CPU
 
 
 def test_close_closes_the_worlds_and_assets_created_on_it():
