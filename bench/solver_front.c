@@ -11,7 +11,7 @@
  *   solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1]
  *                [--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg]
  *                [--dfsph-max 0.05] [--walls-in-density] [--particle-lanes N] [--no-dfsph-masks]
- *                [--dfsph-lists]
+ *                [--dfsph-lists] [--dfsph-step-factor 0.4]
  *                [--frame-log] [--out solver_front.csv]
  *
  * --wcsph: the weakly compressible runs' speeds of sound, as multiples of the free-fall speed;
@@ -25,7 +25,9 @@
  * passes; 0, the default, is the library's choice). --no-dfsph-masks: the CUDA context's
  * cuda_dfsph_masks = SPH_CUDA_DFSPH_MASKS_OFF (the solves walk every candidate; the same bits).
  * --dfsph-lists: cuda_dfsph_masks = SPH_CUDA_DFSPH_NEIGHBOR_LISTS (the solves loop over each
- * particle's neighbour list; the same bits).
+ * particle's neighbour list; the same bits). --dfsph-step-factor: the DFSPH runs' lambda of
+ * dt = lambda h / v_max (sph_world_params.step_factor; default the dam break's 0.4; the weakly
+ * compressible runs keep 0.4, which their acoustic limit shares).
  * --frame-log: one line a frame on stdout with the step's statistics and where the densest
  * particle is (in column widths), for diagnosing a run.
  *
@@ -96,7 +98,8 @@ int main(int argc, char** argv) {
   const char* out_path = "solver_front.csv";
   uint32_t linear_solver = 0; /* the library's default */
   uint32_t features = 0, particle_lanes = 0, dfsph_masks = 0;
-  double dfsph_max = 0.0; /* the library's default */
+  double dfsph_max = 0.0;         /* the library's default */
+  double dfsph_step_factor = 0.0; /* 0: the dam break's default */
   int frame_log = 0;
   sph_backend backend = SPH_BACKEND_AUTO, resolved = SPH_BACKEND_CPU;
   sph_context* context = NULL;
@@ -157,6 +160,11 @@ int main(int argc, char** argv) {
       particle_lanes = (uint32_t)strtoul(argv[++i], NULL, 10);
     } else if (strcmp(argv[i], "--no-dfsph-masks") == 0) {
       dfsph_masks = SPH_CUDA_DFSPH_MASKS_OFF;
+    } else if (strcmp(argv[i], "--dfsph-step-factor") == 0 && i + 1 < argc) {
+      if (parse_values(argv[++i], &dfsph_step_factor, 1) != 1 || dfsph_step_factor > 10.0) {
+        fprintf(stderr, "solver_front: --dfsph-step-factor takes one lambda in (0, 10]\n");
+        return 2;
+      }
     } else if (strcmp(argv[i], "--dfsph-lists") == 0) {
       dfsph_masks = SPH_CUDA_DFSPH_NEIGHBOR_LISTS;
     } else if (strcmp(argv[i], "--frame-log") == 0) {
@@ -176,7 +184,8 @@ int main(int argc, char** argv) {
           stderr,
           "usage: solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1] "
           "[--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg] [--dfsph-max 0.05] "
-          "[--walls-in-density] [--particle-lanes N] [--no-dfsph-masks] [--dfsph-lists] [--frame-log] [--out "
+          "[--walls-in-density] [--particle-lanes N] [--no-dfsph-masks] [--dfsph-lists] [--dfsph-step-factor "
+          "L] [--frame-log] [--out "
           "solver_front.csv]\n");
       return 2;
     }
@@ -230,6 +239,7 @@ int main(int argc, char** argv) {
       if (dfsph) {
         config.density_error = (float)runs[r].value;
         config.density_error_max = (float)dfsph_max;
+        if (dfsph_step_factor > 0.0) config.step_factor = (float)dfsph_step_factor;
       } else {
         config.speed_of_sound = (float)(runs[r].value * free_fall);
       }
