@@ -13,7 +13,10 @@
  * - past max_capacity a spawn or fill is refused with SPH_ERROR_CAPACITY, a message naming the
  *   limit, and the world unchanged;
  * - a failed step on a grown world rolls back, and the world then steps like a copy;
- * - a grown world's checkpoint restores its capacity and max_capacity and steps on bit for bit.
+ * - a grown world's checkpoint restores its capacity and max_capacity and steps on bit for bit;
+ * - a DFSPH world grown before its first step steps as a world created at its capacity (its
+ *   capacity-strided arrays, such as the CUDA neighbour lists of SPH_TEST_CUDA_DFSPH_MASKS=lists,
+ *   reallocated with it).
  * Runs on SPH_TEST_BACKEND (cpu by default; the lead runs it with cuda on the GPU machine). */
 #include <stdlib.h>
 #include <string.h>
@@ -30,16 +33,22 @@ static sph_stats stats_of(const sph_world* world) {
   return s;
 }
 
-static sph_world* make_world(sph_context* context, uint32_t capacity, uint32_t max_capacity) {
+static sph_world* make_solver_world(sph_context* context, uint32_t capacity, uint32_t max_capacity,
+                                    sph_solver solver) {
   sph_world_def def;
   sph_world* world = NULL;
   sph_world_def_init(&def);
   def.capacity = capacity;
   def.max_capacity = max_capacity;
+  def.solver = solver;
   def.particle_spacing = SPACING;
   EXPECT_OK(sph_world_create(context, &def, &world));
   EXPECT_OK(support_set_gravity_and_steps(world, 0.0f, -9.81f, 0.0f, 1e-5f, 2e-3f));
   return world;
+}
+
+static sph_world* make_world(sph_context* context, uint32_t capacity, uint32_t max_capacity) {
+  return make_solver_world(context, capacity, max_capacity, SPH_SOLVER_WCSPH);
 }
 
 /* A block of FCC points `layers` wide with its corner at (x, 0, 0), moving in x at `speed` (so
@@ -163,6 +172,37 @@ static void test_spawn_grows_like_a_larger_world(void** state) {
   s = stats_of(grown);
   assert_int_equal(s.capacity, 218);
   assert_int_equal(s.capacity_growths, 4);
+  EXPECT_OK(sph_world_destroy(grown));
+  EXPECT_OK(sph_world_destroy(large));
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+/* The same with DFSPH: three batches grow the world to 109 slots, then six frames against a world
+ * created at 109 (the solves' iterations too: the same bits). */
+static void test_dfsph_grows_like_a_larger_world(void** state) {
+  sph_context* context = NULL;
+  sph_world *grown, *large;
+  sph_stats g, l;
+  (void)state;
+  EXPECT_OK(sph_test_context_create(&context));
+  grown = make_solver_world(context, 8, 4096, SPH_SOLVER_DFSPH);
+  large = make_solver_world(context, 109, 0, SPH_SOLVER_DFSPH);
+  spawn_block(grown, 3, 0.0f, 0.5f);
+  spawn_block(grown, 4, 0.3f, -0.5f);
+  spawn_block(grown, 5, -0.4f, 0.25f);
+  spawn_block(large, 3, 0.0f, 0.5f);
+  spawn_block(large, 4, 0.3f, -0.5f);
+  spawn_block(large, 5, -0.4f, 0.25f);
+  assert_int_equal(stats_of(grown).capacity, 109);
+  assert_int_equal(stats_of(grown).capacity_growths, 3);
+  steps(grown, 6);
+  steps(large, 6);
+  g = stats_of(grown);
+  l = stats_of(large);
+  assert_true(g.pressure_iterations > 0); /* the solves ran */
+  assert_int_equal(g.pressure_iterations, l.pressure_iterations);
+  assert_int_equal(g.divergence_iterations, l.divergence_iterations);
+  capi_expect_same_particles(grown, large);
   EXPECT_OK(sph_world_destroy(grown));
   EXPECT_OK(sph_world_destroy(large));
   EXPECT_OK(sph_context_destroy(context));
@@ -409,6 +449,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_def_defaults_and_refusals),
       cmocka_unit_test(test_spawn_grows_like_a_larger_world),
+      cmocka_unit_test(test_dfsph_grows_like_a_larger_world),
       cmocka_unit_test(test_growth_between_steps_changes_nothing),
       cmocka_unit_test(test_source_grows_the_world),
       cmocka_unit_test(test_max_capacity_refused),

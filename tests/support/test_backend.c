@@ -1,5 +1,8 @@
 // SPDX-License-Identifier: MIT
-/* The backend of the tests' contexts (SPH_TEST_BACKEND) and backends named on a command line. */
+/* The backend of the tests' contexts (SPH_TEST_BACKEND) and backends named on a command line; the
+ * CUDA contexts' DFSPH walk (SPH_TEST_CUDA_DFSPH_MASKS = on, off or lists: sph_context_def's
+ * cuda_dfsph_masks; unset: the library's default), so that scripts/gpu-test can run the DFSPH
+ * tests through the neighbour lists as well. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -20,9 +23,22 @@ const char* sph_test_backend_name(void) {
   return value;
 }
 
+/* sph_context_def.cuda_dfsph_masks from SPH_TEST_CUDA_DFSPH_MASKS (a CPU context ignores it). */
+static uint32_t test_dfsph_masks(void) {
+  const char* value = getenv("SPH_TEST_CUDA_DFSPH_MASKS");
+  if (value == NULL || value[0] == '\0' || strcmp(value, "on") == 0) return 0u;
+  if (strcmp(value, "off") == 0) return SPH_CUDA_DFSPH_MASKS_OFF;
+  if (strcmp(value, "lists") == 0) return SPH_CUDA_DFSPH_NEIGHBOR_LISTS;
+  fprintf(stderr, "SPH_TEST_CUDA_DFSPH_MASKS=%s: expected on, off or lists\n", value);
+  exit(2);
+}
+
 sph_result sph_test_context_def_init(sph_context_def* def) {
   const sph_result r = sph_context_def_init(def);
-  if (r == SPH_OK) def->backend = sph_test_backend();
+  if (r == SPH_OK) {
+    def->backend = sph_test_backend();
+    def->cuda_dfsph_masks = test_dfsph_masks();
+  }
   return r;
 }
 
@@ -43,5 +59,6 @@ sph_result support_context_create(sph_backend backend, sph_context** out) {
   const sph_result r = sph_context_def_init(&def);
   if (r != SPH_OK) return r;
   def.backend = backend;
+  def.cuda_dfsph_masks = test_dfsph_masks();
   return sph_context_create(&def, out);
 }
