@@ -9,10 +9,11 @@
 // kernels without sums (the direction, the update, the next direction: dfsph_cg_solver.cu), the
 // host writing alpha, beta and the flags they read (cg_rank_set_kernel).
 //
-// The neighbour passes walk the density pass's candidate masks, as the undivided solve's: that
-// pass wrote them for every particle the rank holds, ghosts included (they arrived before the
-// sort), from the positions and the grid that the solves read; the refreshes within the substep
-// (the ghosts' densities and factors, velocities, pressure steps) write neither.
+// The neighbour passes walk the density pass's candidate masks (or the neighbour lists written
+// from them), as the undivided solve's: that pass wrote them for every particle the rank holds,
+// ghosts included (they arrived before the sort), from the positions and the grid that the
+// solves read; the refreshes within the substep (the ghosts' densities and factors, velocities,
+// pressure steps) write none of them.
 #include "dfsph_cg_common.cuh"
 #include "kernel_launch.h"
 

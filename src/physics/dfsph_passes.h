@@ -148,7 +148,8 @@ SPH_HD DfsphDensitySample gather_density_and_factor(const FluidBase& f, const Gr
 }
 
 // D rho_i / Dt = sum_j m (v_i - v_j) . grad W_ij over the velocities `velocities` (xyz).
-// walk: the candidates it visits (neighbor_walk.h: AllCandidates, or MaskedCandidates on CUDA).
+// walk: the candidates it visits (neighbor_walk.h: AllCandidates, or on CUDA ListedCandidates, which
+// walks the particle's neighbour list or its mask).
 template <class Walk = AllCandidates>
 SPH_HD float density_rate(const FluidBase& f, const GridView& grid, const Float4* positions,
                           const Float4* velocities, const DfsphWalls& walls, uint32_t i, Walk walk = Walk{}) {

@@ -157,8 +157,9 @@ SPH_HD void for_each_masked_neighbor(const GridView& grid, Vec3 p, const uint32_
 // The candidates a neighbour pass visits: every candidate of the 27 cells (the default, both
 // backends), or, with masks (CUDA DFSPH's solves: kNeighborMaskWords words per particle, written
 // by the density pass), those of particle i's mask (every candidate, through the same loop, where
-// masks is null). The passes keep their own r < h test on what they visit, so both walks give the
-// same terms in the same order.
+// masks is null), or, with lists (ListedCandidates below), those of particle i's list. The passes
+// keep their own r < h test on what they visit, so every walk gives the same terms in the same
+// order.
 struct AllCandidates {
   template <class Visit>
   SPH_HD void operator()(const GridView& grid, Vec3 p, uint32_t, Visit&& visit) const {
@@ -181,15 +182,24 @@ struct MaskedCandidates {
 // Slot-major, so that a warp's 32 particles read one slot in one coalesced line: entry s of
 // particle i at list[s * stride + i], stride the world's capacity; slot 0 holds the count and
 // slots 1..count the indices, in the masked walk's order (the same terms in the same order: the
-// same bits). A particle with more than kNeighborListSlots visits keeps its count and walks its
-// mask. 64 slots (256 B a particle): at the default radius a particle at rest has about 35
-// neighbours (the mask's visits add those just past h), a compressed one rarely 60.
+// same bits). A particle with more than kNeighborListSlots visits, or an overflowed mask (which
+// visits every candidate), gets a count past the slots and walks its mask. 64 slots (256 B a
+// particle): at the default radius a particle at rest has about 35 neighbours (the mask's visits
+// add those just past h), a compressed one rarely 60.
+// One caveat: a kernel holds two inlined copies of its pass's body (the list's loop and the
+// mask's), and the same bits need both compiled to the same arithmetic; gpu_check_dfsph_masks is
+// what shows it for a compiler and an architecture (nvcc 13, sm_90, session 27).
 constexpr uint32_t kNeighborListSlots = 63;
 constexpr uint32_t kNeighborListRows = kNeighborListSlots + 1;  // uint32 a particle, the count's included
 
-// Writes particle i's list from its mask (for_each_masked_neighbor's visits, in order).
+// Writes particle i's list from its mask (for_each_masked_neighbor's visits, in order); slot 0
+// gets the count, or, for an overflowed or null mask, kNeighborListSlots + 1 without a walk.
 SPH_HD void write_neighbor_list(const GridView& grid, Vec3 p, const uint32_t* mask, uint32_t* list,
                                 uint32_t stride, uint32_t i) {
+  if (!mask || (mask[kNeighborMaskWords - 1u] & kNeighborMaskOverflow)) {
+    list[i] = kNeighborListSlots + 1u;
+    return;
+  }
   uint32_t count = 0;
   for_each_masked_neighbor(grid, p, mask, [&](uint32_t j) {
     ++count;

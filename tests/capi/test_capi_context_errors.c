@@ -188,9 +188,13 @@ static void test_create_cuda_tuning(void** state) {
     EXPECT_OK(sph_context_create(&def, &context));
     EXPECT_OK(sph_context_destroy(context));
   }
-  /* Both values of cuda_dfsph_masks (a CPU context checks and ignores them). */
+  /* The other values of cuda_dfsph_masks (a CPU context checks and ignores them). */
   sph_test_context_def_init(&def);
   def.cuda_dfsph_masks = SPH_CUDA_DFSPH_MASKS_OFF;
+  EXPECT_OK(sph_context_create(&def, &context));
+  EXPECT_OK(sph_context_destroy(context));
+  sph_test_context_def_init(&def);
+  def.cuda_dfsph_masks = SPH_CUDA_DFSPH_NEIGHBOR_LISTS;
   EXPECT_OK(sph_context_create(&def, &context));
   EXPECT_OK(sph_context_destroy(context));
   for (i = 0; i < sizeof good_blocks / sizeof good_blocks[0]; ++i) {

@@ -51,7 +51,9 @@ struct FrameStats {
 struct Run {
   std::vector<FrameStats> stats;
   std::vector<State> frames;
-  uint32_t overflows = 0;  // particles with more than 383 candidates at the start
+  uint32_t overflows = 0;     // particles with more than 383 candidates at the start
+  uint64_t memory_bytes = 0;  // sph_stats.memory_bytes at the end
+  uint32_t capacity = 0;
 };
 
 struct Case {
@@ -111,6 +113,9 @@ Run run(const Case& c, uint32_t masks) {
                                      st.density_error_max});
       out.frames.push_back(read_state(world));
     }
+    const sph_stats end = get_stats(world);
+    out.memory_bytes = end.memory_bytes;
+    out.capacity = end.capacity;
   }
   sph_context_destroy(context);
   return out;
@@ -150,6 +155,13 @@ uint32_t check(const Case& c) {
   const std::string lists =
       std::string("dfsph neighbour lists: ") + c.name + ", the same bits without the masks";
   report(lists_apart == 0, lists.c_str(), "%u frames; first frame apart: %u (0: none)", kFrames, lists_apart);
+  // The setting took effect (else the lists' run would be the masks' and the check above vacuous):
+  // the lists' world holds 64 uint32 a particle of capacity more.
+  const uint64_t extra = listed.memory_bytes - with.memory_bytes;
+  const std::string held = std::string("dfsph neighbour lists: ") + c.name + ", the lists are allocated";
+  report(listed.memory_bytes > with.memory_bytes && extra == 256ull * with.capacity, held.c_str(),
+         "%llu bytes more than the masks' world for a capacity of %u (256 a particle expected)",
+         static_cast<unsigned long long>(listed.memory_bytes - with.memory_bytes), with.capacity);
   return with.overflows;
 }
 

@@ -42,6 +42,7 @@ static sph_context* cuda_context(uint32_t lanes) {
   REQUIRE(sph_context_def_init(&cdef) == SPH_OK, "context def");
   cdef.backend = SPH_BACKEND_CUDA;
   cdef.cuda_particle_lanes = lanes;
+  cdef.cuda_dfsph_masks = sph_test_cuda_dfsph_masks(); /* scripts/gpu-test: once more with lists */
   REQUIRE(sph_context_create(&cdef, &c) == SPH_OK, "CUDA context: %s", sph_get_last_error());
   return c;
 }

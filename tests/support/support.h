@@ -35,6 +35,10 @@ sph_backend sph_test_backend(void);
 const char* sph_test_backend_name(void);
 /** sph_context_def_init() with the test backend filled in. */
 sph_result sph_test_context_def_init(sph_context_def* def);
+/* sph_context_def.cuda_dfsph_masks from SPH_TEST_CUDA_DFSPH_MASKS (on, off or lists; unset: the
+ * default), which sph_test_context_def_init and support_context_create apply; exits 2 on another
+ * value. A CPU context ignores it. */
+uint32_t sph_test_cuda_dfsph_masks(void);
 /** Creates a context on the test backend with defaults otherwise. */
 sph_result sph_test_context_create(sph_context** out);
 

@@ -23,8 +23,7 @@ const char* sph_test_backend_name(void) {
   return value;
 }
 
-/* sph_context_def.cuda_dfsph_masks from SPH_TEST_CUDA_DFSPH_MASKS (a CPU context ignores it). */
-static uint32_t test_dfsph_masks(void) {
+uint32_t sph_test_cuda_dfsph_masks(void) {
   const char* value = getenv("SPH_TEST_CUDA_DFSPH_MASKS");
   if (value == NULL || value[0] == '\0' || strcmp(value, "on") == 0) return 0u;
   if (strcmp(value, "off") == 0) return SPH_CUDA_DFSPH_MASKS_OFF;
@@ -37,7 +36,7 @@ sph_result sph_test_context_def_init(sph_context_def* def) {
   const sph_result r = sph_context_def_init(def);
   if (r == SPH_OK) {
     def->backend = sph_test_backend();
-    def->cuda_dfsph_masks = test_dfsph_masks();
+    def->cuda_dfsph_masks = sph_test_cuda_dfsph_masks();
   }
   return r;
 }
@@ -59,6 +58,6 @@ sph_result support_context_create(sph_backend backend, sph_context** out) {
   const sph_result r = sph_context_def_init(&def);
   if (r != SPH_OK) return r;
   def.backend = backend;
-  def.cuda_dfsph_masks = test_dfsph_masks();
+  def.cuda_dfsph_masks = sph_test_cuda_dfsph_masks();
   return sph_context_create(&def, out);
 }

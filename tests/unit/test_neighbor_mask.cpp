@@ -91,7 +91,8 @@ bool same_bits(const T& a, const T& b) {
 
 struct Tally {
   uint32_t particles = 0, overflowed = 0, wrapped_rows = 0, edge_pairs = 0, mismatches = 0;
-  uint32_t listed = 0;  // particles whose neighbour list holds every visit (the rest walk their masks)
+  uint32_t listed = 0;      // particles whose neighbour list holds every visit (the rest walk their masks)
+  uint32_t long_lists = 0;  // particles with a mask of their own (not overflowed) and more than 63 visits
 };
 
 // Every particle of the table against brute force (the file's header).
@@ -154,8 +155,9 @@ Tally check_table(const Table& t) {
     // The list written from the mask: its count is the masked walk's, and the listed walk visits
     // what the masked walk does, in its order, from the list or (past 63) from the mask.
     sph::write_neighbor_list(view, xi, mask, lists.data(), stride, i);
-    ok = ok && lists[i] == visited.size();
+    ok = ok && lists[i] == (overflow ? sph::kNeighborListSlots + 1u : visited.size());
     tally.listed += visited.size() <= sph::kNeighborListSlots;
+    tally.long_lists += !overflow && visited.size() > sph::kNeighborListSlots;
     const sph::ListedCandidates listed{masks.data(), lists.data(), stride};
     std::vector<uint32_t> listed_visits;
     listed(view, xi, i, [&](uint32_t j) { listed_visits.push_back(j); });
@@ -231,6 +233,48 @@ void test_lattice_edges(void**) {
   assert_true(r.edge_pairs > 0);
 }
 
+// 13 particles a cell (about 351 candidates and 54 neighbours): masks that hold (below 384
+// candidates) with more than 63 visits, whose lists overflow and whose passes walk the masks,
+// beside listed particles. Then masks made by hand with exactly 63 and 64 bits set: the first
+// list is full and used, the second one past the slots.
+void test_long_lists(void**) {
+  const Table t(uniform_cloud(2808, 6.0f * kH, 6), 6, 7);
+  const Tally r = check_table(t);
+  std::printf(
+      "long lists: %u particles, %u overflowing, %u listed, %u with more than 63 visits, %u mismatches\n",
+      r.particles, r.overflowed, r.listed, r.long_lists, r.mismatches);
+  assert_int_equal(r.mismatches, 0);
+  assert_true(r.long_lists > 0 && r.listed > 0);
+  const sph::GridView view = t.view();
+  const uint32_t stride = t.size();
+  std::vector<uint32_t> lists(static_cast<size_t>(stride) * sph::kNeighborListRows, 0xdeadbeefu);
+  for (uint32_t bits : {sph::kNeighborListSlots, sph::kNeighborListSlots + 1u}) {
+    uint32_t checked = 0;
+    for (uint32_t i = 0; i < t.size(); i += 97) {
+      const Vec3 xi = sph::xyz(t.positions[i]);
+      uint32_t candidates = 0;
+      sph::for_each_neighbor_range(view, xi, [&](uint32_t b, uint32_t e) { candidates += e - b; });
+      if (candidates < bits || candidates > sph::kNeighborMaskCandidates) continue;
+      uint32_t mask[sph::kNeighborMaskWords] = {};
+      for (uint32_t k = 0; k < bits; ++k) mask[k >> 5] |= 1u << (k & 31u);  // the first `bits` candidates
+      std::vector<uint32_t> masked, listed;
+      sph::for_each_masked_neighbor(view, xi, mask, [&](uint32_t j) { masked.push_back(j); });
+      sph::write_neighbor_list(view, xi, mask, lists.data(), stride, i);
+      // A world of this one particle's mask: the listed walk reads masks + i * words.
+      std::vector<uint32_t> masks(static_cast<size_t>(t.size()) * sph::kNeighborMaskWords, 0u);
+      std::copy(mask, mask + sph::kNeighborMaskWords,
+                masks.begin() + static_cast<std::ptrdiff_t>(i) * sph::kNeighborMaskWords);
+      sph::ListedCandidates{masks.data(), lists.data(), stride}(view, xi, i,
+                                                                [&](uint32_t j) { listed.push_back(j); });
+      assert_int_equal(masked.size(), bits);
+      assert_int_equal(lists[i], bits);
+      assert_true(listed == masked);
+      ++checked;
+    }
+    assert_true(checked > 10);  // of 29 particles tried
+  }
+}
+
 // Few particles a cell, and a table larger than the cloud: short masks, most words zero.
 void test_sparse(void**) {
   const Table t(uniform_cloud(300, 6.0f * kH, 4), 8, 5);
@@ -247,6 +291,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_folded_table),
       cmocka_unit_test(test_lattice_edges),
+      cmocka_unit_test(test_long_lists),
       cmocka_unit_test(test_sparse),
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);
