@@ -13,7 +13,8 @@
  * - past max_capacity a spawn or fill is refused with SPH_ERROR_CAPACITY, a message naming the
  *   limit, and the world unchanged;
  * - a failed step on a grown world rolls back, and the world then steps like a copy;
- * - a grown world's checkpoint restores its capacity and max_capacity and steps on bit for bit;
+ * - a grown world's checkpoint restores its capacity and max_capacity and steps on bit for bit
+ *   (weakly compressible and DFSPH, grown between steps);
  * - a DFSPH world grown before its first step steps as a world created at its capacity (its
  *   capacity-strided arrays, such as the CUDA neighbour lists of SPH_TEST_CUDA_DFSPH_MASKS=lists,
  *   reallocated with it).
@@ -407,14 +408,13 @@ static void test_rollback_on_grown_world(void** state) {
 
 /* A world that grew between steps saves its capacity and max_capacity; the loaded world is a
  * world created at the grown capacity, steps on bit for bit, and may grow further. */
-static void test_checkpoint_of_grown_world(void** state) {
+static void checkpoint_of_grown_world(sph_solver solver) {
   sph_context* context = NULL;
   sph_world *world, *copy;
   sph_world_def a, b;
   sph_stats s;
-  (void)state;
   EXPECT_OK(sph_test_context_create(&context));
-  world = make_world(context, 16, 512);
+  world = make_solver_world(context, 16, 512, solver);
   spawn_block(world, 3, 0.0f, 0.5f);
   steps(world, 2);
   spawn_block(world, 4, 0.35f, -0.5f); /* 14 + 32 > 32 = 2 x 16: grows between steps */
@@ -445,6 +445,18 @@ static void test_checkpoint_of_grown_world(void** state) {
   EXPECT_OK(sph_context_destroy(context));
 }
 
+static void test_checkpoint_of_grown_world(void** state) {
+  (void)state;
+  checkpoint_of_grown_world(SPH_SOLVER_WCSPH);
+}
+
+/* The same with DFSPH: growth between steps, after the first frames were captured (on CUDA a
+ * graph, and with SPH_TEST_CUDA_DFSPH_MASKS=lists capacity-strided lists), then growth again. */
+static void test_checkpoint_of_grown_dfsph_world(void** state) {
+  (void)state;
+  checkpoint_of_grown_world(SPH_SOLVER_DFSPH);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_def_defaults_and_refusals),
@@ -455,6 +467,7 @@ int main(void) {
       cmocka_unit_test(test_max_capacity_refused),
       cmocka_unit_test(test_rollback_on_grown_world),
       cmocka_unit_test(test_checkpoint_of_grown_world),
+      cmocka_unit_test(test_checkpoint_of_grown_dfsph_world),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
