@@ -62,6 +62,7 @@ void test_usage_errors_exit_2(void**) {
   assert_int_equal(run({scene, "--frames"}, &out), 2);
   assert_true(contains(out, "--frames: missing its value"));
   assert_int_equal(run({scene, "--format", "exr"}, &out), 2);
+  assert_int_equal(run({scene, "--dfsph-lists=yes"}, &out), 2);  // a switch takes no value
   assert_int_equal(run({scene, scene}, &out), 2);
 }
 
@@ -100,6 +101,17 @@ void test_options_scene_runs(void**) {
   assert_int_equal(run({g_scenes + "/options.json", "--backend", "cpu", "--frames", "2", "--out", dir}, &out),
                    0);
   assert_true(contains(out, "2 frames"));
+}
+
+// --dfsph-lists is accepted and, on the CPU backend, changes nothing the run reports.
+void test_dfsph_lists_switch(void**) {
+  const std::string dir = cli_test::make_temp_dir("dfsph_lists");
+  std::string out;
+  assert_int_equal(run({g_scenes + "/tiny.json", "--backend", "cpu", "--frames", "1", "--format", "none",
+                        "--dfsph-lists", "--out", dir},
+                       &out),
+                   0);
+  assert_true(contains(out, "1 frames") || contains(out, "1 frame"));
 }
 
 // CUDA asked for where there is none (a CPU-only build, or no GPU) is a clean error with its
@@ -216,6 +228,7 @@ int main(int argc, char** argv) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_usage_errors_exit_2),
       cmocka_unit_test(test_scene_errors_exit_3),
+      cmocka_unit_test(test_dfsph_lists_switch),
       cmocka_unit_test(test_options_scene_runs),
       cmocka_unit_test(test_cuda_without_gpu_exits_4),
       cmocka_unit_test(test_missing_outputs_exit_5),

@@ -63,6 +63,7 @@ sph_result create_context(const Ranks& ranks, const CliOptions& cli, sph_context
   sph_context_def def;
   sph_context_def_init(&def);
   def.cpu_worker_count = cli.threads;
+  if (cli.dfsph_lists) def.cuda_dfsph_masks = SPH_CUDA_DFSPH_NEIGHBOR_LISTS;  // the CPU ignores it
   if (cli.backend != SPH_BACKEND_CUDA) {
     def.backend = SPH_BACKEND_CPU;
     return sph_context_create(&def, out);

@@ -25,6 +25,8 @@ const char* usage_text() {
          "  --preview           draw every frame to PNG, and an MP4 when ffmpeg is on PATH\n"
          "  --preview-style S   particles | surface (implies --preview; surface needs --surface)\n"
          "  --threads N         CPU backend threads (default: all)\n"
+         "  --dfsph-lists       CUDA DFSPH: neighbour lists for the solves (256 B a particle more,\n"
+         "                      faster solves; docs/cuda.md)\n"
          "  --quiet             no progress, only warnings, errors and the summary\n"
          "  --stats-json FILE   also write the summary's figures to FILE as JSON (benchmarks)\n"
          "  --version           print the library's build information\n"
@@ -37,9 +39,9 @@ const char* usage_text() {
 
 namespace {
 
-const char* const kOptions[] = {"--frames",  "--backend",    "--out",           "--format",
-                                "--surface", "--preview",    "--preview-style", "--threads",
-                                "--quiet",   "--stats-json", "--version",       "--help"};
+const char* const kOptions[] = {"--frames",  "--backend",       "--out",        "--format", "--surface",
+                                "--preview", "--preview-style", "--threads",    "--quiet",  "--stats-json",
+                                "--version", "--help",          "--dfsph-lists"};
 
 // Levenshtein distance: the number of single-character edits between a and b.
 size_t edit_distance(const std::string& a, const std::string& b) {
@@ -174,6 +176,9 @@ CliOptions parse_cli(int argc, char** argv) {
     } else if (arg == "--quiet") {
       no_value();
       o.quiet = true;
+    } else if (arg == "--dfsph-lists") {
+      no_value();
+      o.dfsph_lists = true;
     } else if (arg == "--stats-json") {
       o.stats_json = next();
       if (o.stats_json->empty()) throw UsageError("--stats-json: expected a file name");

@@ -23,6 +23,7 @@ struct CliOptions {
   bool preview = false;
   std::optional<bool> preview_surface;  // --preview-style: true for surface, false for particles
   uint32_t threads = 0;
+  bool dfsph_lists = false;  // sph_context_def.cuda_dfsph_masks = SPH_CUDA_DFSPH_NEIGHBOR_LISTS
   bool quiet = false;
   std::optional<std::string> stats_json;  // --stats-json FILE: the run's figures, machine-readable
   bool help = false;

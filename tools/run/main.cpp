@@ -71,6 +71,8 @@ int run(int argc, char** argv) {
   sph_context_def_init(&context_def);
   context_def.backend = cli.backend;
   context_def.cpu_worker_count = cli.threads;
+  // A CPU context and a weakly compressible world check and ignore it.
+  if (cli.dfsph_lists) context_def.cuda_dfsph_masks = SPH_CUDA_DFSPH_NEIGHBOR_LISTS;
   sph_result r = sph_context_create(&context_def, &owner.context);
   if (r == SPH_ERROR_UNSUPPORTED)
     return fail(kExitBackend, std::string("the ") + (cli.backend == SPH_BACKEND_CUDA ? "CUDA" : "requested") +
