@@ -64,16 +64,6 @@ __device__ Vec3 dfsph_clamp(const ParticleArrays& a, uint32_t i, Vec3 v) {
   return held;
 }
 
-// Particle i's neighbour list from its mask (the lists' world only), after the density pass wrote
-// the masks and before the solves read either.
-__global__ void dfsph_list_kernel(GridView grid, ParticleArrays a, uint32_t n) {
-  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i >= n) return;
-  write_neighbor_list(grid, xyz(a.sorted_position[i]),
-                      a.dfsph_neighbor_mask + static_cast<size_t>(i) * kNeighborMaskWords,
-                      a.dfsph_neighbor_list, a.dfsph_list_stride, i);
-}
-
 __global__ void dfsph_begin_solve_kernel(FrameState* state) {
   state->solve_run = 1;
   state->solve_iterations = 0;
@@ -367,10 +357,7 @@ void enqueue_dfsph_density(const FluidConstants& fluid, const GridView& grid, co
   else
     dfsph_density_kernel<false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
   check_launch("dfsph_density_kernel");
-  if (a.dfsph_neighbor_list && a.dfsph_neighbor_mask && n != 0) {
-    dfsph_list_kernel<<<blocks, threads, 0, stream>>>(grid, a, n);
-    check_launch("dfsph_list_kernel");
-  }
+  enqueue_dfsph_neighbor_lists(grid, a, n, threads, stream);
 }
 
 void enqueue_dfsph_step(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,

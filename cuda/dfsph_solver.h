@@ -47,6 +47,11 @@ void enqueue_dfsph_density(const FluidConstants& fluid, const GridView& grid, co
                            uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
                            const DeviceScene& scene, FrameState* state, cudaStream_t stream);
 
+// The solves' neighbour lists from the density pass's masks (dfsph_neighbor_lists.cu), in a world
+// that keeps both (SPH_CUDA_DFSPH_NEIGHBOR_LISTS); nothing otherwise.
+void enqueue_dfsph_neighbor_lists(const GridView& grid, const ParticleArrays& a, uint32_t n, unsigned threads,
+                                  cudaStream_t stream);
+
 // A distributed rank's host steps inside DFSPH's solves (cuda_halo.cu; the stream driver only):
 // the host drives each Jacobi solve, an iteration at a time, by core/dfsph_jacobi_loop.h (the CPU
 // rank's loop), which says when the ghosts take their owners' velocities and pressure steps k

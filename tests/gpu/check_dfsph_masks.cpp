@@ -127,7 +127,6 @@ bool same_stats(const FrameStats& a, const FrameStats& b) {
          std::memcmp(&a.error, &b.error, sizeof(float)) == 0;
 }
 
-// Returns the run's count of overflowing particles at the start.
 // The first frame where two runs differ (0: none).
 uint32_t first_frame_apart(const Run& a, const Run& b) {
   for (uint32_t f = 0; f < kFrames; ++f)
@@ -135,6 +134,7 @@ uint32_t first_frame_apart(const Run& a, const Run& b) {
   return 0;
 }
 
+// Returns the run's count of overflowing particles at the start.
 uint32_t check(const Case& c) {
   const Run with = run(c, 0);
   const Run without = run(c, SPH_CUDA_DFSPH_MASKS_OFF);
