@@ -39,8 +39,23 @@ struct CellCoord {
   int32_t x, y, z;
 };
 
+// The smallest normal float (FLT_MIN).
+constexpr float kSmallestNormalFloat = 1.17549435e-38f;
+
+// v, or zero where v is a denormal: what a CUDA file compiled with -ftz=true does to every input
+// and result of its float arithmetic in hardware.
+SPH_HD float flushed_to_zero(float v) {
+  return (v > -kSmallestNormalFloat && v < kSmallestNormalFloat) ? 0.0f : v;
+}
+
+// The cell along one axis. Denormals are flushed before and after the product by hand, so the cell
+// is the same whatever arithmetic flags the caller was compiled with: the CUDA density pass (-ftz)
+// writes DFSPH's neighbour masks over the runs of its cells, and the conjugate gradients' files
+// (IEEE) walk those masks again; without the flush, x = -1e-40 is cell 0 in one and -1 in the
+// other, and the masks' bits would name other candidates. The CPU gets the same cells. (The
+// comparisons are no-ops under -ftz and cost two selects an axis elsewhere.)
 SPH_HD int32_t cell_coordinate(float x, float inv_cell_size) {
-  float c = SPH_FLOORF(x * inv_cell_size);
+  float c = SPH_FLOORF(flushed_to_zero(flushed_to_zero(x) * inv_cell_size));
   c = SPH_FMINF(SPH_FMAXF(c, -kMaxCellCoordinate), kMaxCellCoordinate);
   return static_cast<int32_t>(c);
 }
