@@ -9,7 +9,7 @@
  * error of one particle a density solve ended with ("solve lg", sph_stats.density_error_largest).
  *
  *   solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1]
- *                [--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg]
+ *                [--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg|chebyshev]
  *                [--dfsph-max 0.05] [--walls-in-density] [--particle-lanes N] [--no-dfsph-masks]
  *                [--dfsph-lists] [--dfsph-step-factor 0.4]
  *                [--frame-log] [--out solver_front.csv]
@@ -175,15 +175,18 @@ int main(int argc, char** argv) {
         linear_solver = SPH_DFSPH_JACOBI;
       } else if (strcmp(argv[i], "cg") == 0) {
         linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS;
+      } else if (strcmp(argv[i], "chebyshev") == 0) {
+        linear_solver = SPH_DFSPH_CHEBYSHEV;
       } else {
-        fprintf(stderr, "solver_front: --dfsph-solver takes jacobi or cg\n");
+        fprintf(stderr, "solver_front: --dfsph-solver takes jacobi, cg or chebyshev\n");
         return 2;
       }
     } else {
       fprintf(
           stderr,
           "usage: solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1] "
-          "[--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg] [--dfsph-max 0.05] "
+          "[--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg|chebyshev] [--dfsph-max "
+          "0.05] "
           "[--walls-in-density] [--particle-lanes N] [--no-dfsph-masks] [--dfsph-lists] [--dfsph-step-factor "
           "L] [--frame-log] [--out "
           "solver_front.csv]\n");

@@ -237,8 +237,10 @@ class CpuBackend final : public Backend {
                      float* carried, float carry_scale);
   // New pressures and errors from the rates over the velocities the last dfsph_correct wrote (the
   // columns); the errors over the world's particles (the mean summed over the ranks, the largest
-  // the ranks' largest).
-  void dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls, float dt);
+  // the ranks' largest). `pass`: the solve's residual pass (0 first), and `held` the solve's
+  // pressure so far (its carried array), for the Chebyshev density solve (SPH_DFSPH_CHEBYSHEV).
+  void dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls, float dt,
+                       uint32_t pass, const float* held);
   DfsphErrors dfsph_errors(DfsphSolve kind);
   // The density solve by conjugate gradients (cpu_dfsph_cg.cpp; sph_dfsph_params.linear_solver);
   // its rate pass (each particle's value into cg_value_; returns the mean and largest error); a contact held
@@ -321,6 +323,7 @@ class CpuBackend final : public Backend {
   CpuArrayRef<float> dfsph_divergence_;       // DFSPH: the divergence solve's p / rho^2 times dt
   CpuArrayRef<float> dfsph_factor_;           // DFSPH: alpha / rho of the density pass
   CpuArrayRef<float> dfsph_residual_;         // DFSPH: each particle's share of the solve's error
+  CpuArrayRef<float> dfsph_previous_step_;    // DFSPH: the step the last iteration applied (Chebyshev)
   CpuArrayRef<Float4> dfsph_contact_;         // DFSPH: each particle's contact with the colliders
   CpuArrayRef<Float4> clamp_impulse_;         // DFSPH with the loads: the clamp's, per particle
   bool dfsph_contacts_ = false;               // DFSPH: the substep has colliders (contacts to respect)

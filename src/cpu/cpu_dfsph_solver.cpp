@@ -74,7 +74,7 @@ void CpuBackend::dfsph_correct(const FluidConstants& fluid, const DfsphWalls& wa
 }
 
 void CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls,
-                                 float dt) {
+                                 float dt, uint32_t pass, const float* held) {
   const GridView view = grid_.view();
   const NeighborColumns columns = columns_.view();
   const float* factor = dfsph_factor_.data();
@@ -85,9 +85,20 @@ void CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, c
   const Dfsph::Constants& c = fluid.methods.dfsph;
   const float rho0 = fluid.rest_density;
   const SimdPasses::DfsphRateFn density_rate_of = simd_.dfsph_density_rate;
+  // SPH_DFSPH_CHEBYSHEV (dfsph_passes.h): the density solve's steps mixed with the last ones.
+  const bool chebyshev = kind == DfsphSolve::Density && c.linear_solver == kDfsphChebyshev;
+  const float weight = chebyshev ? chebyshev_weight(pass) : 1.0f;
+  float* previous = dfsph_previous_step_.data();
   // The gather reads positions and the velocities' columns; each particle writes only its k.
   parallel().for_each(count_, [&](uint32_t i) {
     const float rate = density_rate_of(fluid, view, columns, walls, i);
+    if (chebyshev) {
+      const DfsphResidual r = density_residual_released(rate, density[i], factor[i], rho0, dt, held[i]);
+      const float step = chebyshev_step(weight, r.k, pass > 0 ? previous[i] : 0.0f, held[i]);
+      k[i] = previous[i] = step;
+      error[i] = r.error;
+      return;
+    }
     const DfsphResidual r = kind == DfsphSolve::Divergence
                                 ? divergence_residual(c, rate, neighbors[i], factor[i], rho0, dt)
                                 : density_residual(rate, density[i], factor[i], rho0, dt);
@@ -145,17 +156,18 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
     Float4* v;
     float* carried;
     float carry_scale;
+    uint32_t pass;  // the residual passes run so far
     void velocity_update(bool) { b.dfsph_correct(fluid, walls, dt, v, carried, carry_scale); }
     void share_velocities() {
       if (b.rank_) b.halo_share_velocities(v);
     }
-    void rates() { b.dfsph_residuals(kind, fluid, walls, dt); }
+    void rates() { b.dfsph_residuals(kind, fluid, walls, dt, pass++, carried); }
     void share_steps() {
       if (b.rank_) b.halo_share_dfsph_step();
     }
     DfsphErrors errors() { return b.dfsph_errors(kind); }
     void checked(uint32_t, const DfsphErrors&, bool) {}
-  } passes{*this, kind, fluid, walls, dt, v, carried, carry_scale};
+  } passes{*this, kind, fluid, walls, dt, v, carried, carry_scale, 0u};
   const DfsphLoopOutcome o = run_dfsph_jacobi(passes, bounds, min_iterations, max_iterations);
   return SolveOutcome{o.iterations, o.errors.mean, o.errors.largest, o.capped};
 }

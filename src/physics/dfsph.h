@@ -52,9 +52,10 @@ enum DfsphFlags : uint32_t {
   kDfsphNoDepthStepLimit = 1u << 2,   // the depth step limit off (step_control.h)
   kDfsphFlagsAll = 7u
 };
-// sph_dfsph_params.linear_solver (SPH_DFSPH_JACOBI, SPH_DFSPH_CONJUGATE_GRADIENTS): how the
-// density solve iterates (dfsph_cg.h has the conjugate gradients' method).
-enum DfsphLinearSolver : uint32_t { kDfsphJacobi = 1, kDfsphConjugateGradients = 2 };
+// sph_dfsph_params.linear_solver (SPH_DFSPH_JACOBI, SPH_DFSPH_CONJUGATE_GRADIENTS,
+// SPH_DFSPH_CHEBYSHEV): how the density solve iterates (dfsph_cg.h has the conjugate gradients'
+// method, dfsph_passes.h the Chebyshev steps').
+enum DfsphLinearSolver : uint32_t { kDfsphJacobi = 1, kDfsphConjugateGradients = 2, kDfsphChebyshev = 3 };
 
 // The names of DFSPH's per-particle arrays.
 constexpr const char* kArrayDfsphPressure = "dfsph_pressure";              // p / rho^2 of the density solve
@@ -62,6 +63,7 @@ constexpr const char* kArrayDfsphDivergencePressure = "dfsph_divergence";  // p_
 constexpr const char* kArrayDfsphFactor = "dfsph_factor";                  // alpha_i / rho_i
 constexpr const char* kArrayDfsphStep = "dfsph_step";                      // this iteration's k_i
 constexpr const char* kArrayDfsphResidual = "dfsph_residual";              // the particle's error
+constexpr const char* kArrayDfsphPreviousStep = "dfsph_previous_step";     // SPH_DFSPH_CHEBYSHEV: last k
 constexpr const char* kArrayDfsphWarmPressure = "dfsph_warm_pressure";     // warm start, sorted order
 constexpr const char* kArrayDfsphContact = "dfsph_contact";                // Float4: wall normal, speed
 // The conjugate gradients' density solve (dfsph_cg.h; registered by particle_arrays.cpp only where
@@ -97,18 +99,19 @@ struct Dfsph {
       count_field("max_divergence_iterations", &Params::max_divergence_iterations, at_least(1.0),
                   ZeroMeans::Default),
       bits_field("flags", &Params::flags, kDfsphFlagsAll),
-      count_field("linear_solver", &Params::linear_solver, within(1.0, 2.0), ZeroMeans::Default),
+      count_field("linear_solver", &Params::linear_solver, within(1.0, 3.0), ZeroMeans::Default),
       real_field("density_error_max", &Params::density_error_max, above_up_to(0.0, 1.0), ZeroMeans::Default,
                  ""),
       real_field("depth_step_factor", &Params::depth_step_factor, above_up_to(0.0, 1.0), ZeroMeans::Default,
                  ""),
   };
-  // The corrected gradient is the Jacobi solves' (dfsph_gradient_correction.h): its operator is not
-  // the symmetric one the conjugate gradients' density solve needs (dfsph_cg.h).
+  // The corrected gradient is the Jacobi solves' (plain and Chebyshev; dfsph_gradient_correction.h): its
+  // operator is not the symmetric one the conjugate gradients' density solve needs (dfsph_cg.h).
   static bool check(const Params& p, const WorldShape&, ParamConflict& out) {
     if ((p.flags & kDfsphCorrectedGradient) && p.linear_solver == kDfsphConjugateGradients) {
       out = ParamConflict{"flags", static_cast<float>(p.flags),
-                          "(SPH_DFSPH_CORRECTED_GRADIENT) works with SPH_DFSPH_JACOBI only, not",
+                          "(SPH_DFSPH_CORRECTED_GRADIENT) works with the Jacobi solves (SPH_DFSPH_JACOBI, "
+                          "SPH_DFSPH_CHEBYSHEV) only, not",
                           "linear_solver", static_cast<float>(p.linear_solver)};
       return false;
     }
@@ -163,15 +166,17 @@ struct Dfsph {
 
   // Carried: the two solves' pressures (warm starts; sorted, rolled back, saved). Scratch: the
   // factor, the pressure of the iteration that neighbours read, each particle's error for the
-  // solve's mean (CPU), the density solve's warm start gathered into the sorted order (CUDA), the
-  // particle's contact with the colliders (dfsph_passes.h, wall_contact), and the density pass's
-  // neighbour counts (the divergence solve skips particles with too few).
+  // solve's mean (CPU), the step the last iteration applied (SPH_DFSPH_CHEBYSHEV), the density solve's warm
+  // start gathered into the sorted order (CUDA), the particle's contact with the colliders (dfsph_passes.h,
+  // wall_contact), and the density pass's neighbour counts (the divergence solve skips particles with too
+  // few).
   static constexpr ParticleArraySpec kArrays[] = {
       {kArrayDfsphPressure, sizeof(float), ParticleArrayRole::Carried, 1, nullptr, nullptr},
       {kArrayDfsphDivergencePressure, sizeof(float), ParticleArrayRole::Carried, 1, nullptr, nullptr},
       {kArrayDfsphFactor, sizeof(float), ParticleArrayRole::Scratch, 1, nullptr, nullptr},
       {kArrayDfsphStep, sizeof(float), ParticleArrayRole::Scratch, 1, nullptr, nullptr},
       {kArrayDfsphResidual, sizeof(float), ParticleArrayRole::Scratch, 1, nullptr, nullptr},
+      {kArrayDfsphPreviousStep, sizeof(float), ParticleArrayRole::Scratch, 1, nullptr, nullptr},
       {kArrayDfsphWarmPressure, sizeof(float), ParticleArrayRole::Scratch, 1, nullptr, nullptr},
       {kArrayDfsphContact, 4 * sizeof(float), ParticleArrayRole::Scratch, 1, nullptr, nullptr},
       {kArrayNeighborCount, sizeof(uint32_t), ParticleArrayRole::Scratch, 1, nullptr, nullptr}};

@@ -7,7 +7,8 @@
 
 static const double kGravity = 9.81;
 
-capi_momentum_balance capi_collapse_momentum_balance(const sph_world_def* def, uint32_t dfsph_flags) {
+capi_momentum_balance capi_collapse_momentum_balance(const sph_world_def* def, uint32_t dfsph_flags,
+                                                     uint32_t dfsph_linear_solver) {
   const support_water_tank column = support_collapsing_column(0.0f);
   support_world w;
   sph_sdf* sdf = NULL;
@@ -17,6 +18,13 @@ capi_momentum_balance capi_collapse_momentum_balance(const sph_world_def* def, u
   memset(&out, 0, sizeof out);
   EXPECT_OK(support_water_tank_open(&w, sph_test_backend(), def, NULL, &column, &sdf, &tank, &out.count));
   if (dfsph_flags) capi_set_dfsph_flags(w.world, dfsph_flags);
+  if (dfsph_linear_solver) {
+    sph_dfsph_params dp;
+    EXPECT_OK(sph_dfsph_params_init(&dp));
+    EXPECT_OK(sph_world_get_dfsph_params(w.world, &dp));
+    dp.linear_solver = dfsph_linear_solver;
+    EXPECT_OK(sph_world_set_dfsph_params(w.world, &dp));
+  }
   capi_fluid_momentum(w.world, w.mass, p0);
   for (int frame = 0; frame < 15; ++frame) {
     sph_collider_loads l;

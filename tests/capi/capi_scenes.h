@@ -23,9 +23,10 @@ typedef struct capi_momentum_balance {
 /* support_collapsing_column (free slip) in a world of `def` (with SPH_FEATURE_COLLIDER_LOADS; a
  * capacity of 0: the column's), 15 frames of 0.02 s: the fluid's momentum change plus the
  * impulses the walls received against gravity's impulse (9.81 m/s^2, the default). The pair
- * forces cancel in pairs, so what is left is rounding. dfsph_flags (DFSPH; 0: the defaults):
- * sph_dfsph_params.flags for the run. */
-capi_momentum_balance capi_collapse_momentum_balance(const sph_world_def* def, uint32_t dfsph_flags);
+ * forces cancel in pairs, so what is left is rounding. dfsph_flags and dfsph_linear_solver (DFSPH;
+ * 0: the defaults): sph_dfsph_params.flags and .linear_solver for the run. */
+capi_momentum_balance capi_collapse_momentum_balance(const sph_world_def* def, uint32_t dfsph_flags,
+                                                     uint32_t dfsph_linear_solver);
 
 /* ---- the resting tank and its probes --------------------------------------------------------- */
 #define CAPI_RESTING_WIDTH 0.12 /* m, the tank's and the water's, in x and z */

@@ -239,8 +239,8 @@ static void expect_rule(world_fixture* f, const rule_case* c, const params_buffe
 
 static void test_each_rule_fires_with_its_message(void** state) {
   world_fixture* f = (world_fixture*)*state;
-  const uint32_t unknown_bits = 0x10u, one = 1u, three = 3u;
-  float bits_as_float, one_as_float, three_as_float;
+  const uint32_t unknown_bits = 0x10u, one = 1u, four = 4u;
+  float bits_as_float, one_as_float, four_as_float;
   const rule_case cases[] = {
       {SPH_PARAMS_WORLD, offsetof(sph_world_params, stiffness), -1.0f, SPH_ERROR_INVALID_ARGUMENT,
        "params->stiffness: must be > 0, got -1"},
@@ -299,7 +299,7 @@ static void test_each_rule_fires_with_its_message(void** state) {
   /* Words that are not floats: unknown step-limit bits and the reserved words. */
   memcpy(&bits_as_float, &unknown_bits, sizeof bits_as_float);
   memcpy(&one_as_float, &one, sizeof one_as_float);
-  memcpy(&three_as_float, &three, sizeof three_as_float);
+  memcpy(&four_as_float, &four, sizeof four_as_float);
   {
     const rule_case words[] = {
         {SPH_PARAMS_WORLD, offsetof(sph_world_params, step_limits), bits_as_float, SPH_ERROR_UNSUPPORTED,
@@ -308,9 +308,9 @@ static void test_each_rule_fires_with_its_message(void** state) {
          "params->reserved0: is reserved and must be 0"},
         {SPH_PARAMS_SPRINGS, offsetof(sph_spring_params, reserved0), one_as_float, SPH_ERROR_INVALID_ARGUMENT,
          "params->reserved0: is reserved and must be 0"},
-        /* neither SPH_DFSPH_JACOBI nor SPH_DFSPH_CONJUGATE_GRADIENTS */
-        {SPH_PARAMS_DFSPH, offsetof(sph_dfsph_params, linear_solver), three_as_float,
-         SPH_ERROR_INVALID_ARGUMENT, "params->linear_solver: must be in [1, 2], got 3"},
+        /* none of SPH_DFSPH_JACOBI, SPH_DFSPH_CONJUGATE_GRADIENTS, SPH_DFSPH_CHEBYSHEV */
+        {SPH_PARAMS_DFSPH, offsetof(sph_dfsph_params, linear_solver), four_as_float,
+         SPH_ERROR_INVALID_ARGUMENT, "params->linear_solver: must be in [1, 3], got 4"},
     };
     for (i = 0; i < sizeof words / sizeof words[0]; ++i) {
       const params_buffer base = read_back(world_of(f, words[i].kind), words[i].kind);
@@ -352,13 +352,40 @@ static void test_each_rule_fires_with_its_message(void** state) {
     assert_string_equal(
         sph_get_last_error(),
         "sph_world_set_dfsph_params: params->flags: 2 (SPH_DFSPH_CORRECTED_GRADIENT) works with "
-        "SPH_DFSPH_JACOBI only, not params->linear_solver 2");
+        "the Jacobi solves (SPH_DFSPH_JACOBI, SPH_DFSPH_CHEBYSHEV) only, not params->linear_solver 2");
     sph_dfsph_params_init(&after);
     EXPECT_OK(sph_world_get_dfsph_params(f->dfsph, &after));
     assert_memory_equal(&before, &after, sizeof before);
     dp.linear_solver = SPH_DFSPH_JACOBI;
     EXPECT_OK(sph_world_set_dfsph_params(f->dfsph, &dp));
     EXPECT_OK(sph_world_set_dfsph_params(f->dfsph, &before));
+  }
+  /* DFSPH's Chebyshev solve: the CPU backend runs it (with the corrected gradient too); the CUDA
+   * backend refuses it as UNSUPPORTED, the parameters unchanged. */
+  {
+    sph_dfsph_params before, dp, after;
+    sph_backend backend = SPH_BACKEND_AUTO;
+    EXPECT_OK(sph_context_get_backend(f->context, &backend));
+    sph_dfsph_params_init(&before);
+    EXPECT_OK(sph_world_get_dfsph_params(f->dfsph, &before));
+    dp = before;
+    dp.flags = SPH_DFSPH_CORRECTED_GRADIENT;
+    dp.linear_solver = SPH_DFSPH_CHEBYSHEV;
+    if (backend == SPH_BACKEND_CPU) {
+      EXPECT_OK(sph_world_set_dfsph_params(f->dfsph, &dp));
+      sph_dfsph_params_init(&after);
+      EXPECT_OK(sph_world_get_dfsph_params(f->dfsph, &after));
+      assert_int_equal(after.linear_solver, SPH_DFSPH_CHEBYSHEV);
+      EXPECT_OK(sph_world_set_dfsph_params(f->dfsph, &before));
+    } else {
+      assert_int_equal(sph_world_set_dfsph_params(f->dfsph, &dp), SPH_ERROR_UNSUPPORTED);
+      assert_string_equal(sph_get_last_error(),
+                          "sph_world_set_dfsph_params: params->linear_solver: SPH_DFSPH_CHEBYSHEV (DFSPH's "
+                          "Chebyshev solve) runs on the CPU backend only for now; use SPH_DFSPH_JACOBI");
+      sph_dfsph_params_init(&after);
+      EXPECT_OK(sph_world_get_dfsph_params(f->dfsph, &after));
+      assert_memory_equal(&before, &after, sizeof before);
+    }
   }
 }
 

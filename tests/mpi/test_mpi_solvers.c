@@ -6,7 +6,9 @@
  * and pressure steps, which cross the halo after each pass, and its convergence test reads the
  * world's mean error, an exact sum over the ranks. Scenes: the dam break and the stirred
  * column (particles crossing the slab boundaries every few substeps), with the divergence solve
- * (the default) and without it, and RK4's stirred column, 12 substeps each (frames of 7 and 5).
+ * (the default) and without it, the stirred column with the Chebyshev density solve
+ * (SPH_DFSPH_CHEBYSHEV: each particle's step mixed with its last one, which stays with the particle's
+ * rank within the solve), and RK4's stirred column, 12 substeps each (frames of 7 and 5).
  * With the argument "cg" (ctest's mpi_solvers_cg_np1..3), DFSPH's density solve by conjugate
  * gradients (SPH_DFSPH_CONJUGATE_GRADIENTS, cpu_dfsph_cg.cpp), and its refusal on a rank whose walls
  * count in the density (SPH_FEATURE_BOUNDARY_DENSITY, as undivided):
@@ -45,7 +47,7 @@ typedef struct scene {
   sph_solver solver;
   sph_integrator integrator;
   uint32_t divergence_solve;
-  uint32_t linear_solver;  /* DFSPH's density solve: SPH_DFSPH_JACOBI or _CONJUGATE_GRADIENTS */
+  uint32_t linear_solver;  /* DFSPH's density solve: SPH_DFSPH_JACOBI, _CONJUGATE_GRADIENTS or _CHEBYSHEV */
   uint32_t max_iterations; /* its cap (0: the default) */
   uint32_t expect_capped;  /* 1: the cap must be reached, 0: never, 2: not checked */
   float column_x;          /* the column's width, m */
@@ -163,7 +165,8 @@ static void expect_cg_refused_with_walls(sph_context* context) {
 }
 
 int main(int argc, char** argv) {
-  const uint32_t jacobi = SPH_DFSPH_JACOBI, cg = SPH_DFSPH_CONJUGATE_GRADIENTS;
+  const uint32_t jacobi = SPH_DFSPH_JACOBI, cg = SPH_DFSPH_CONJUGATE_GRADIENTS,
+                 chebyshev = SPH_DFSPH_CHEBYSHEV;
   const sph_integrator euler = SPH_INTEGRATOR_SYMPLECTIC_EULER, rk4 = SPH_INTEGRATOR_RK4;
   const sph_solver dfsph = SPH_SOLVER_DFSPH, wcsph = SPH_SOLVER_WCSPH;
   /* name, stir, solver, integrator, divergence solve, linear solver, cap, capped, width, frames */
@@ -171,6 +174,7 @@ int main(int argc, char** argv) {
       {"DFSPH dam break", 0.0f, dfsph, euler, 1, jacobi, 0, 0, 0.1f, {7, 5}},
       {"DFSPH stirred column", 2.0f, dfsph, euler, 1, jacobi, 0, 0, 0.1f, {7, 5}},
       {"DFSPH stirred column, no divergence solve", 2.0f, dfsph, euler, 0, jacobi, 0, 0, 0.1f, {7, 5}},
+      {"DFSPH Chebyshev stirred column", 2.0f, dfsph, euler, 1, chebyshev, 0, 0, 0.1f, {7, 5}},
       {"RK4 stirred column", 2.0f, wcsph, rk4, 0, jacobi, 0, 0, 0.1f, {7, 5}},
   };
   const scene cg_scenes[] = {

@@ -90,7 +90,7 @@ static sph_collider_id add_axis_wall(support_world* w, int axis, double sign, do
  * the fluid hitting the far wall (capi_collapse_momentum_balance). Bound 1 % (the issue's). */
 static void momentum_balance(uint32_t features, sph_integrator integrator) {
   const sph_world_def def = loads_def(SPH_FEATURE_COLLIDER_LOADS | features, 0, integrator);
-  const capi_momentum_balance b = capi_collapse_momentum_balance(&def, 0u);
+  const capi_momentum_balance b = capi_collapse_momentum_balance(&def, 0u, 0u);
   print_message(
       "momentum balance (features 0x%x, %s): fluid dP = (%.4g, %.4g, %.4g), colliders' J = "
       "(%.4g, %.4g, %.4g), gravity %.4g N s over %.3f s: residual %.3g %%\n",

@@ -79,12 +79,12 @@ static void open_tank(const tank_case* tc, double gap, support_world* w, sph_sdf
   if (tc->dt_max > 0.0f) params.dt_max = tc->dt_max;
   if (tc->dt_min > 0.0f) params.dt_min = tc->dt_min;
   EXPECT_OK(sph_world_set_params(w->world, &params));
-  /* HYDRO_MAX_IT (the density solve's cap), HYDRO_CG=1 (conjugate gradients) and
-   * HYDRO_DEPTH_FACTOR (the depth step limit's f): measurements of the deep tanks
-   * (docs/validation.md, "DFSPH: hydrostatic tank"). */
+  /* HYDRO_MAX_IT (the density solve's cap), HYDRO_CG=1 (conjugate gradients), HYDRO_CHEBYSHEV=1 (the
+   * Chebyshev solve) and HYDRO_DEPTH_FACTOR (the depth step limit's f): measurements of the deep tanks
+   * and the solves (docs/validation.md, "DFSPH: hydrostatic tank"). */
   if (tc->solver == SPH_SOLVER_DFSPH &&
       (tc->density_error > 0.0f || tc->dfsph_flags || getenv("HYDRO_MAX_IT") || getenv("HYDRO_CG") ||
-       getenv("HYDRO_DEPTH_FACTOR"))) {
+       getenv("HYDRO_CHEBYSHEV") || getenv("HYDRO_DEPTH_FACTOR"))) {
     sph_dfsph_params dp;
     sph_dfsph_params_init(&dp);
     if (tc->density_error > 0.0f) {
@@ -93,6 +93,7 @@ static void open_tank(const tank_case* tc, double gap, support_world* w, sph_sdf
     }
     if (getenv("HYDRO_MAX_IT")) dp.max_iterations = (uint32_t)atoi(getenv("HYDRO_MAX_IT"));
     if (getenv("HYDRO_CG")) dp.linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS;
+    if (getenv("HYDRO_CHEBYSHEV")) dp.linear_solver = SPH_DFSPH_CHEBYSHEV;
     if (getenv("HYDRO_DEPTH_FACTOR")) dp.depth_step_factor = (float)atof(getenv("HYDRO_DEPTH_FACTOR"));
     dp.flags = tc->dfsph_flags;
     EXPECT_OK(sph_world_set_dfsph_params(w->world, &dp));
