@@ -618,7 +618,7 @@ SPH_API sph_result SPH_CALL sph_world_get_density_diffusion_params(const sph_wor
 #define SPH_DFSPH_CORRECTED_GRADIENT                                                                         \
   0x2u /* the Jacobi solves' pressure gradient corrected to first order (Bonet & Lok's L_i; docs/physics.md, \
           DFSPH): a resting fluid's pressure within 0.5 % of rho0 g d, but momentum only nearly conserved    \
-          and energy not bounded in violent flow; not with SPH_DFSPH_CONJUGATE_GRADIENTS */
+          and energy not bounded in violent flow; with SPH_DFSPH_JACOBI only */
 #define SPH_DFSPH_NO_DEPTH_STEP_LIMIT                                                                      \
   0x4u /* (0.2.0) the depth step limit off (sph_dfsph_params.depth_step_factor): for a scene whose step is \
           known to hold still water of its depth, or whose lowest and highest water are far apart */

@@ -106,8 +106,8 @@ namespace Sph
         /// <summary>
         /// the Jacobi solves' pressure gradient corrected to first order (Bonet &amp; Lok's L_i;
         /// docs/physics.md, \ DFSPH): a resting fluid's pressure within 0.5 % of rho0 g d, but momentum
-        /// only nearly conserved    \ and energy not bounded in violent flow; not with
-        /// SPH_DFSPH_CONJUGATE_GRADIENTS
+        /// only nearly conserved    \ and energy not bounded in violent flow; with SPH_DFSPH_JACOBI
+        /// only
         /// </summary>
         public const uint SPH_DFSPH_CORRECTED_GRADIENT = 2u;
         /// <summary>

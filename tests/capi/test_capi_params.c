@@ -352,7 +352,7 @@ static void test_each_rule_fires_with_its_message(void** state) {
     assert_string_equal(
         sph_get_last_error(),
         "sph_world_set_dfsph_params: params->flags: 2 (SPH_DFSPH_CORRECTED_GRADIENT) works with "
-        "the Jacobi solves (SPH_DFSPH_JACOBI, SPH_DFSPH_CHEBYSHEV) only, not params->linear_solver 2");
+        "SPH_DFSPH_JACOBI only, not params->linear_solver 2");
     sph_dfsph_params_init(&after);
     EXPECT_OK(sph_world_get_dfsph_params(f->dfsph, &after));
     assert_memory_equal(&before, &after, sizeof before);
@@ -360,8 +360,8 @@ static void test_each_rule_fires_with_its_message(void** state) {
     EXPECT_OK(sph_world_set_dfsph_params(f->dfsph, &dp));
     EXPECT_OK(sph_world_set_dfsph_params(f->dfsph, &before));
   }
-  /* DFSPH's Chebyshev solve: the CPU backend runs it (with the corrected gradient too); the CUDA
-   * backend refuses it as UNSUPPORTED, the parameters unchanged. */
+  /* DFSPH's Chebyshev solve: the CPU backend runs it (not with the corrected gradient, refused on
+   * both backends); the CUDA backend refuses it as UNSUPPORTED, the parameters unchanged. */
   {
     sph_dfsph_params before, dp, after;
     sph_backend backend = SPH_BACKEND_AUTO;
@@ -371,6 +371,12 @@ static void test_each_rule_fires_with_its_message(void** state) {
     dp = before;
     dp.flags = SPH_DFSPH_CORRECTED_GRADIENT;
     dp.linear_solver = SPH_DFSPH_CHEBYSHEV;
+    assert_int_equal(sph_world_set_dfsph_params(f->dfsph, &dp), SPH_ERROR_INVALID_ARGUMENT);
+    assert_string_equal(
+        sph_get_last_error(),
+        "sph_world_set_dfsph_params: params->flags: 2 (SPH_DFSPH_CORRECTED_GRADIENT) works with "
+        "SPH_DFSPH_JACOBI only, not params->linear_solver 3");
+    dp.flags = 0;
     if (backend == SPH_BACKEND_CPU) {
       EXPECT_OK(sph_world_set_dfsph_params(f->dfsph, &dp));
       sph_dfsph_params_init(&after);

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'a8e6a41983b9592a99bf9746fed322199ef5639d968f4c2f4026a6b4c6e7638b', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': 'fa49a731377bff604e4638f151a982dc8a5ac644ed850d2fd50297b95c279175', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -93,8 +93,7 @@ SPH_STEP_LIMIT_FORCE = 2
 SPH_DFSPH_SKIP_DIVERGENCE_SOLVE = 1
 #: the Jacobi solves' pressure gradient corrected to first order (Bonet & Lok's L_i;
 #: docs/physics.md, \ DFSPH): a resting fluid's pressure within 0.5 % of rho0 g d, but momentum
-#: only nearly conserved    \ and energy not bounded in violent flow; not with
-#: SPH_DFSPH_CONJUGATE_GRADIENTS
+#: only nearly conserved    \ and energy not bounded in violent flow; with SPH_DFSPH_JACOBI only
 SPH_DFSPH_CORRECTED_GRADIENT = 2
 #: (0.2.0) the depth step limit off (sph_dfsph_params.depth_step_factor): for a scene whose step is
 #: \ known to hold still water of its depth, or whose lowest and highest water are far apart
