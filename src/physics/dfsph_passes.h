@@ -269,9 +269,9 @@ SPH_HD float chebyshev_weight(uint32_t n) {
 // so far, warm start included; >= 0). error as density_residual's.
 SPH_HD DfsphResidual density_residual_released(float rate, float density, float factor, float rest_density,
                                                float dt, float held) {
-  const float e = density + dt * rate - rest_density;
-  if (e > 0.0f) return DfsphResidual{e * factor / (dt * dt), e / rest_density};
-  const float k = DfsphChebyshev::kRelease * e * factor / (dt * dt);
+  const float predicted = density + dt * rate;
+  if (predicted > rest_density) return density_residual(rate, density, factor, rest_density, dt);
+  const float k = DfsphChebyshev::kRelease * (predicted - rest_density) * factor / (dt * dt);
   return DfsphResidual{k < -held ? -held : k, 0.0f};
 }
 

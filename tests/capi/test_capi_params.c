@@ -237,6 +237,18 @@ static void expect_rule(world_fixture* f, const rule_case* c, const params_buffe
   assert_memory_equal(before.u.bytes, after.u.bytes, sizeof before.u.bytes);
 }
 
+/* Setting `dp` on the fixture's DFSPH world fails with `status` and `message`, its parameters still
+ * `before`. */
+static void expect_dfsph_refused(world_fixture* f, const sph_dfsph_params* dp, sph_result status,
+                                 const char* message, const sph_dfsph_params* before) {
+  sph_dfsph_params after;
+  assert_int_equal(sph_world_set_dfsph_params(f->dfsph, dp), status);
+  assert_string_equal(sph_get_last_error(), message);
+  sph_dfsph_params_init(&after);
+  EXPECT_OK(sph_world_get_dfsph_params(f->dfsph, &after));
+  assert_memory_equal(before, &after, sizeof after);
+}
+
 static void test_each_rule_fires_with_its_message(void** state) {
   world_fixture* f = (world_fixture*)*state;
   const uint32_t unknown_bits = 0x10u, one = 1u, four = 4u;
@@ -342,20 +354,17 @@ static void test_each_rule_fires_with_its_message(void** state) {
   /* DFSPH's corrected gradient is the Jacobi solves' only: with the conjugate gradients refused, the
    * parameters unchanged; with Jacobi accepted. */
   {
-    sph_dfsph_params before, dp, after;
+    sph_dfsph_params before, dp;
     sph_dfsph_params_init(&before);
     EXPECT_OK(sph_world_get_dfsph_params(f->dfsph, &before));
     dp = before;
     dp.flags = SPH_DFSPH_CORRECTED_GRADIENT;
     dp.linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS;
-    assert_int_equal(sph_world_set_dfsph_params(f->dfsph, &dp), SPH_ERROR_INVALID_ARGUMENT);
-    assert_string_equal(
-        sph_get_last_error(),
+    expect_dfsph_refused(
+        f, &dp, SPH_ERROR_INVALID_ARGUMENT,
         "sph_world_set_dfsph_params: params->flags: 2 (SPH_DFSPH_CORRECTED_GRADIENT) works with "
-        "SPH_DFSPH_JACOBI only, not params->linear_solver 2");
-    sph_dfsph_params_init(&after);
-    EXPECT_OK(sph_world_get_dfsph_params(f->dfsph, &after));
-    assert_memory_equal(&before, &after, sizeof before);
+        "SPH_DFSPH_JACOBI only, not params->linear_solver 2",
+        &before);
     dp.linear_solver = SPH_DFSPH_JACOBI;
     EXPECT_OK(sph_world_set_dfsph_params(f->dfsph, &dp));
     EXPECT_OK(sph_world_set_dfsph_params(f->dfsph, &before));
@@ -371,11 +380,11 @@ static void test_each_rule_fires_with_its_message(void** state) {
     dp = before;
     dp.flags = SPH_DFSPH_CORRECTED_GRADIENT;
     dp.linear_solver = SPH_DFSPH_CHEBYSHEV;
-    assert_int_equal(sph_world_set_dfsph_params(f->dfsph, &dp), SPH_ERROR_INVALID_ARGUMENT);
-    assert_string_equal(
-        sph_get_last_error(),
+    expect_dfsph_refused(
+        f, &dp, SPH_ERROR_INVALID_ARGUMENT,
         "sph_world_set_dfsph_params: params->flags: 2 (SPH_DFSPH_CORRECTED_GRADIENT) works with "
-        "SPH_DFSPH_JACOBI only, not params->linear_solver 3");
+        "SPH_DFSPH_JACOBI only, not params->linear_solver 3",
+        &before);
     dp.flags = 0;
     if (backend == SPH_BACKEND_CPU) {
       EXPECT_OK(sph_world_set_dfsph_params(f->dfsph, &dp));
@@ -384,13 +393,10 @@ static void test_each_rule_fires_with_its_message(void** state) {
       assert_int_equal(after.linear_solver, SPH_DFSPH_CHEBYSHEV);
       EXPECT_OK(sph_world_set_dfsph_params(f->dfsph, &before));
     } else {
-      assert_int_equal(sph_world_set_dfsph_params(f->dfsph, &dp), SPH_ERROR_UNSUPPORTED);
-      assert_string_equal(sph_get_last_error(),
-                          "sph_world_set_dfsph_params: params->linear_solver: SPH_DFSPH_CHEBYSHEV (DFSPH's "
-                          "Chebyshev solve) runs on the CPU backend only for now; use SPH_DFSPH_JACOBI");
-      sph_dfsph_params_init(&after);
-      EXPECT_OK(sph_world_get_dfsph_params(f->dfsph, &after));
-      assert_memory_equal(&before, &after, sizeof before);
+      expect_dfsph_refused(f, &dp, SPH_ERROR_UNSUPPORTED,
+                           "sph_world_set_dfsph_params: params->linear_solver: SPH_DFSPH_CHEBYSHEV (DFSPH's "
+                           "Chebyshev solve) runs on the CPU backend only for now; use SPH_DFSPH_JACOBI",
+                           &before);
     }
   }
 }
