@@ -110,7 +110,6 @@ class CudaBackend final : public Backend {
   void import_particles(const ParticleSnapshot& s) override;
 
   uint64_t memory_bytes() const override;
-  bool runs_dfsph_chebyshev() const override { return false; }  // not ported yet (frame_loop.cu)
 
   DeviceAttributeView device_attribute(AttributeKind kind) const override;
 

@@ -69,6 +69,7 @@ __global__ void dfsph_begin_solve_kernel(FrameState* state) {
   state->solve_iterations = 0;
   state->solve_largest = 0.0f;
   state->solve_largest_bits = 0u;
+  state->solve_weight = chebyshev_weight(0);
 }
 
 // v += the pressures k's velocity change (held to the contacts); carried gets k times the
@@ -129,12 +130,24 @@ __global__ void __launch_bounds__(kDfsphSolveBlock)
     const float dt = state->clock.dt_float;
     const float rate =
         density_rate(fluid, grid, a.sorted_position, v, DfsphWalls{a.boundary_gradient}, i, solve_walk(a));
-    const DfsphResidual r =
-        kDivergence ? divergence_residual(fluid.methods.dfsph, rate, a.neighbor_count[i], a.dfsph_factor[i],
-                                          fluid.rest_density, dt)
-                    : density_residual(rate, a.density[i], a.dfsph_factor[i], fluid.rest_density, dt);
-    a.dfsph_step[i] = r.k;
-    error = r.error;
+    if (!kDivergence && fluid.methods.dfsph.linear_solver == kDfsphChebyshev) {
+      // SPH_DFSPH_CHEBYSHEV (dfsph_passes.h), as the CPU backend's: the pressure held so far is the
+      // carried one, which every velocity update of this solve has added its steps to.
+      const float held = a.dfsph_pressure[i];
+      const DfsphResidual r =
+          density_residual_released(rate, a.density[i], a.dfsph_factor[i], fluid.rest_density, dt, held);
+      const float weight = state->solve_weight;
+      const float step = chebyshev_step(weight, r.k, weight == 1.0f ? 0.0f : a.dfsph_previous_step[i], held);
+      a.dfsph_step[i] = a.dfsph_previous_step[i] = step;
+      error = r.error;
+    } else {
+      const DfsphResidual r =
+          kDivergence ? divergence_residual(fluid.methods.dfsph, rate, a.neighbor_count[i], a.dfsph_factor[i],
+                                            fluid.rest_density, dt)
+                      : density_residual(rate, a.density[i], a.dfsph_factor[i], fluid.rest_density, dt);
+      a.dfsph_step[i] = r.k;
+      error = r.error;
+    }
   }
   // (if constexpr: the undivided world's kernel keeps its code and its shared memory). The largest
   // error: the density solve's only (the divergence solve does not bound it).
@@ -158,6 +171,7 @@ __global__ void __launch_bounds__(kDfsphCheckBlock)
   const double sum = dfsph_sum_partials(partials, blocks);
   if (threadIdx.x != 0) return;
   state->solve_iterations = first ? 0u : state->solve_iterations + 1u;
+  state->solve_weight = chebyshev_weight(state->solve_iterations + 1u);  // (read by the Chebyshev solve only)
   state->solve_error = n > 0 ? static_cast<float>(sum / n) : 0.0f;
   dfsph_take_largest(state);
   dfsph_continue_solve(state, divergence ? state->divergence_tally : state->pressure_tally, bounds,
@@ -170,6 +184,7 @@ __global__ void dfsph_rank_check_kernel(uint32_t iterations, DfsphErrors errors,
                                         uint32_t min_iterations, uint32_t max_iterations, bool divergence,
                                         FrameState* state) {
   state->solve_iterations = iterations;
+  state->solve_weight = chebyshev_weight(iterations + 1u);
   state->solve_error = errors.mean;
   state->solve_largest = errors.largest;
   dfsph_continue_solve(state, divergence ? state->divergence_tally : state->pressure_tally, bounds,

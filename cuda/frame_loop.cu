@@ -98,11 +98,6 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
                 "step: DFSPH's conjugate gradients solve (sph_dfsph_params.linear_solver = "
                 "SPH_DFSPH_CONJUGATE_GRADIENTS) does not work with SPH_FEATURE_BOUNDARY_DENSITY or "
                 "SPH_FEATURE_COLLIDER_LOADS yet; use SPH_DFSPH_JACOBI");
-  if (config_.solver == Solver::Dfsph && setup.fluid.methods.dfsph.linear_solver == kDfsphChebyshev)
-    throw Error(
-        Status::Unsupported,
-        "step: DFSPH's Chebyshev solve (sph_dfsph_params.linear_solver = SPH_DFSPH_CHEBYSHEV) runs on "
-        "the CPU backend only for now; use SPH_DFSPH_JACOBI");
   setup.limits = make_step_limits(config_, params);
   setup.max_substeps = params.stepping.max_substeps;
   setup.options = options_;

@@ -630,7 +630,7 @@ SPH_API sph_result SPH_CALL sph_world_get_density_diffusion_params(const sph_wor
 #define SPH_DFSPH_CHEBYSHEV                                                                                \
   3u /* (0.2.0) the Jacobi steps accelerated by Chebyshev's semi-iteration, an expanded particle's         \
          pressure released step by step: fewer iterations where the plain solve needs many (large worlds); \
-         CPU backend only for now (the CUDA backend answers UNSUPPORTED) */
+         CPU and CUDA backends */
 
 typedef struct sph_dfsph_params {
   uint32_t struct_size;               /* set by sph_dfsph_params_init */
@@ -648,9 +648,9 @@ typedef struct sph_dfsph_params {
   uint32_t linear_solver;             /* how the density solve iterates: SPH_DFSPH_JACOBI (the default),
                                          SPH_DFSPH_CONJUGATE_GRADIENTS or SPH_DFSPH_CHEBYSHEV (the
                                          divergence solve is always Jacobi); 0 = default; any other value
-                                         is INVALID_ARGUMENT. Chebyshev runs on the CPU backend only for
-                                         now (CUDA: UNSUPPORTED when set or loaded from a checkpoint, the
-                                         world unchanged). Conjugate gradients run on the CPU and
+                                         is INVALID_ARGUMENT. Chebyshev runs on the CPU and CUDA
+                                         backends, not with SPH_DFSPH_CORRECTED_GRADIENT
+                                         (INVALID_ARGUMENT). Conjugate gradients run on the CPU and
                                          CUDA backends, distributed worlds included; with
                                          SPH_FEATURE_BOUNDARY_DENSITY or SPH_FEATURE_COLLIDER_LOADS
                                          setting it (or loading a checkpoint with it) is

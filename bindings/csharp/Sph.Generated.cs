@@ -126,7 +126,7 @@ namespace Sph
         /// <summary>
         /// (0.2.0) the Jacobi steps accelerated by Chebyshev's semi-iteration, an expanded particle's
         /// \ pressure released step by step: fewer iterations where the plain solve needs many (large
-        /// worlds); \ CPU backend only for now (the CUDA backend answers UNSUPPORTED)
+        /// worlds); \ CPU and CUDA backends
         /// </summary>
         public const uint SPH_DFSPH_CHEBYSHEV = 3u;
         /// <summary>hollow box: no lid (a tank open at +y)</summary>
@@ -1216,9 +1216,9 @@ namespace Sph
         /// <summary>
         /// uint32_t linear_solver: how the density solve iterates: SPH_DFSPH_JACOBI (the default),
         /// SPH_DFSPH_CONJUGATE_GRADIENTS or SPH_DFSPH_CHEBYSHEV (the divergence solve is always
-        /// Jacobi); 0 = default; any other value is INVALID_ARGUMENT. Chebyshev runs on the CPU backend
-        /// only for now (CUDA: UNSUPPORTED when set or loaded from a checkpoint, the world unchanged).
-        /// Conjugate gradients run on the CPU and CUDA backends, distributed worlds included; with
+        /// Jacobi); 0 = default; any other value is INVALID_ARGUMENT. Chebyshev runs on the CPU and
+        /// CUDA backends, not with SPH_DFSPH_CORRECTED_GRADIENT (INVALID_ARGUMENT). Conjugate gradients
+        /// run on the CPU and CUDA backends, distributed worlds included; with
         /// SPH_FEATURE_BOUNDARY_DENSITY or SPH_FEATURE_COLLIDER_LOADS setting it (or loading a
         /// checkpoint with it) is UNSUPPORTED, the world unchanged
         /// </summary>

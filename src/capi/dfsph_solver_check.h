@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Where DFSPH's density solve by conjugate gradients (sph_dfsph_params.linear_solver =
-// SPH_DFSPH_CONJUGATE_GRADIENTS; physics/dfsph_cg.h) cannot run yet, and its Chebyshev solve
-// (SPH_DFSPH_CHEBYSHEV) on a backend that has none (CUDA, for now). Conjugate gradients: the walls in the
+// SPH_DFSPH_CONJUGATE_GRADIENTS; physics/dfsph_cg.h) cannot run yet: the walls in the
 // density (SPH_FEATURE_BOUNDARY_DENSITY) and the collider loads (SPH_FEATURE_COLLIDER_LOADS; docs/physics.md,
 // DFSPH, Limits). Refused when the parameters are set (sph_world_set_dfsph_params and
 // sph_world_set_physics_params) and when a checkpoint that carries them is loaded or restored, so that the
@@ -23,10 +22,6 @@ inline void require_supported_dfsph_solver(const World& world, const RuntimePara
                                            const char* field) {
   if (world.config().solver != Solver::Dfsph) return;
   const uint32_t solver = params_of<Dfsph>(params).linear_solver;
-  if (solver == kDfsphChebyshev && !world.backend().runs_dfsph_chebyshev())
-    throw Error(Status::Unsupported, std::string(field) +
-                                         ": SPH_DFSPH_CHEBYSHEV (DFSPH's Chebyshev solve) runs on the CPU "
-                                         "backend only for now; use SPH_DFSPH_JACOBI");
   if (solver != kDfsphConjugateGradients) return;
   const uint32_t features = world.config().features;
   const char* where = nullptr;

@@ -109,10 +109,6 @@ class Backend {
   // Bytes held for particles and grids (device bytes on a GPU backend).
   virtual uint64_t memory_bytes() const = 0;
 
-  // Whether the backend runs DFSPH's Chebyshev density solve (SPH_DFSPH_CHEBYSHEV; the CPU's
-  // only for now: capi/dfsph_solver_check.h refuses it elsewhere).
-  virtual bool runs_dfsph_chebyshev() const { return true; }
-
   // ---- distributed worlds (include/sph_mpi.h): one backend per rank ---------------------------
   // Makes this backend one rank of a world spread over `ranks` (before it holds particles):
   // every frame becomes collective (all ranks step together), particles migrate to the rank

@@ -369,12 +369,10 @@ static void test_each_rule_fires_with_its_message(void** state) {
     EXPECT_OK(sph_world_set_dfsph_params(f->dfsph, &dp));
     EXPECT_OK(sph_world_set_dfsph_params(f->dfsph, &before));
   }
-  /* DFSPH's Chebyshev solve: the CPU backend runs it (not with the corrected gradient, refused on
-   * both backends); the CUDA backend refuses it as UNSUPPORTED, the parameters unchanged. */
+  /* DFSPH's Chebyshev solve: both backends run it, not with the corrected gradient (refused, the
+   * parameters unchanged). */
   {
     sph_dfsph_params before, dp, after;
-    sph_backend backend = SPH_BACKEND_AUTO;
-    EXPECT_OK(sph_context_get_backend(f->context, &backend));
     sph_dfsph_params_init(&before);
     EXPECT_OK(sph_world_get_dfsph_params(f->dfsph, &before));
     dp = before;
@@ -386,18 +384,11 @@ static void test_each_rule_fires_with_its_message(void** state) {
         "SPH_DFSPH_JACOBI only, not params->linear_solver 3",
         &before);
     dp.flags = 0;
-    if (backend == SPH_BACKEND_CPU) {
-      EXPECT_OK(sph_world_set_dfsph_params(f->dfsph, &dp));
-      sph_dfsph_params_init(&after);
-      EXPECT_OK(sph_world_get_dfsph_params(f->dfsph, &after));
-      assert_int_equal(after.linear_solver, SPH_DFSPH_CHEBYSHEV);
-      EXPECT_OK(sph_world_set_dfsph_params(f->dfsph, &before));
-    } else {
-      expect_dfsph_refused(f, &dp, SPH_ERROR_UNSUPPORTED,
-                           "sph_world_set_dfsph_params: params->linear_solver: SPH_DFSPH_CHEBYSHEV (DFSPH's "
-                           "Chebyshev solve) runs on the CPU backend only for now; use SPH_DFSPH_JACOBI",
-                           &before);
-    }
+    EXPECT_OK(sph_world_set_dfsph_params(f->dfsph, &dp));
+    sph_dfsph_params_init(&after);
+    EXPECT_OK(sph_world_get_dfsph_params(f->dfsph, &after));
+    assert_int_equal(after.linear_solver, SPH_DFSPH_CHEBYSHEV);
+    EXPECT_OK(sph_world_set_dfsph_params(f->dfsph, &before));
   }
 }
 

@@ -99,13 +99,12 @@ static void test_momentum_balance_corrected_gradient(void** state) {
   assert_true(b.error <= (getenv("DFLOADS_STRICT") ? 0.01 : 0.12) || measuring());
 }
 
-/* The same with the Chebyshev density solve (SPH_DFSPH_CHEBYSHEV; the CPU backend's only for now):
+/* The same with the Chebyshev density solve (SPH_DFSPH_CHEBYSHEV):
  * its steps, negative ones included, go through the same velocity update, so the walls' reaction of
  * the solve's total pressure is the sum of its steps' and the balance holds as the plain solve's
  * (bound 1 %, the issue's). */
 static void test_momentum_balance_chebyshev(void** state) {
   (void)state;
-  if (sph_test_backend() != SPH_BACKEND_CPU) skip(); /* the CPU backend's only for now */
   assert_true(momentum_balance_with(SPH_FEATURE_BOUNDARY_DENSITY, 0u, SPH_DFSPH_CHEBYSHEV).error <= 0.01 ||
               measuring());
 }

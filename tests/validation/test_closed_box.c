@@ -161,8 +161,6 @@ static void test_energy_never_grows(void** state) {
 
 static void test_energy_never_grows_dfsph(void** state) {
   (void)state;
-  /* The Chebyshev solve runs on the CPU backend only for now (the CUDA backend refuses it). */
-  if (dfsph_linear_solver == SPH_DFSPH_CHEBYSHEV && sph_test_backend() != SPH_BACKEND_CPU) skip();
   run_energy_never_grows(SPH_SOLVER_DFSPH);
 }
 

@@ -124,8 +124,6 @@ static unsigned long long run_dfsph(uint32_t features) {
   dam_break_config config;
   dam_break_result* result;
   sph_result r;
-  /* The Chebyshev solve runs on the CPU backend only for now (the CUDA backend refuses it). */
-  if (dfsph_linear_solver == SPH_DFSPH_CHEBYSHEV && sph_test_backend() != SPH_BACKEND_CPU) skip();
   result = (dam_break_result*)malloc(sizeof(dam_break_result));
   assert_non_null(result);
   EXPECT_OK(sph_test_context_create(&context));

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'fa49a731377bff604e4638f151a982dc8a5ac644ed850d2fd50297b95c279175', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '3a6fb2bc2d0e2d61bfced56c9937146fd6e00f50c285acc0f19dad9e8de74312', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -105,7 +105,7 @@ SPH_DFSPH_JACOBI = 1
 SPH_DFSPH_CONJUGATE_GRADIENTS = 2
 #: (0.2.0) the Jacobi steps accelerated by Chebyshev's semi-iteration, an expanded particle's
 #: \ pressure released step by step: fewer iterations where the plain solve needs many (large
-#: worlds); \ CPU backend only for now (the CUDA backend answers UNSUPPORTED)
+#: worlds); \ CPU and CUDA backends
 SPH_DFSPH_CHEBYSHEV = 3
 #: hollow box: no lid (a tank open at +y)
 SPH_SHAPE_FLAG_OPEN_TOP = 1
@@ -1105,7 +1105,7 @@ class DfsphParams(_SphStruct):
         max_iterations (uint32_t): cap of the density solve per substep; default 100; >= 2; 0 = default. A solve that stops here above its bound is counted in sph_stats and reported as an event
         max_divergence_iterations (uint32_t): cap of the divergence solve; default 100; >= 1; 0 = default
         flags (uint32_t): SPH_DFSPH_* bits; default 0
-        linear_solver (uint32_t): how the density solve iterates: SPH_DFSPH_JACOBI (the default), SPH_DFSPH_CONJUGATE_GRADIENTS or SPH_DFSPH_CHEBYSHEV (the divergence solve is always Jacobi); 0 = default; any other value is INVALID_ARGUMENT. Chebyshev runs on the CPU backend only for now (CUDA: UNSUPPORTED when set or loaded from a checkpoint, the world unchanged). Conjugate gradients run on the CPU and CUDA backends, distributed worlds included; with SPH_FEATURE_BOUNDARY_DENSITY or SPH_FEATURE_COLLIDER_LOADS setting it (or loading a checkpoint with it) is UNSUPPORTED, the world unchanged
+        linear_solver (uint32_t): how the density solve iterates: SPH_DFSPH_JACOBI (the default), SPH_DFSPH_CONJUGATE_GRADIENTS or SPH_DFSPH_CHEBYSHEV (the divergence solve is always Jacobi); 0 = default; any other value is INVALID_ARGUMENT. Chebyshev runs on the CPU and CUDA backends, not with SPH_DFSPH_CORRECTED_GRADIENT (INVALID_ARGUMENT). Conjugate gradients run on the CPU and CUDA backends, distributed worlds included; with SPH_FEATURE_BOUNDARY_DENSITY or SPH_FEATURE_COLLIDER_LOADS setting it (or loading a checkpoint with it) is UNSUPPORTED, the world unchanged
         density_error_max (float): (0.2.0) bound on the density solve's largest error, max(rho* - rho0, 0) / rho0 of any one particle: the density solve (Jacobi or conjugate gradients) iterates while this or the mean is above its bound (then the cap); default 0.05 (5 %); in (0, 1]; 0 = default; a value below density_error acts as density_error. Without it a small violent region of a large world (a splash at a wall) stays compressed by 50-100 %, as it barely moves the mean
         depth_step_factor (float): (0.2.0) f of the depth step limit dt <= f h / sqrt(|g| H), H the fluid's extent along gravity (its highest particle's height above its lowest), measured every substep: still water held by DFSPH blows apart above about 0.37 h / sqrt(|g| depth) (docs/physics.md, DFSPH, Limits); default 0.3; in (0, 1]; 0 = default. No limit without gravity or with SPH_DFSPH_NO_DEPTH_STEP_LIMIT; dt_min still wins
     """

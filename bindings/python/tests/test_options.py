@@ -322,15 +322,11 @@ def test_dfsph_world_has_its_params_and_refuses_what_it_does_not_support(ctx):
         w.step(1 / 60)
         s = w.stats()
         assert s.pressure_iterations >= 2 * s.substeps and s.density_error_max <= 1e-4
-        # The Chebyshev solve: the same bound on the CPU backend; the CUDA backend refuses it for now.
-        if ctx.backend is sph.Backend.CPU:
-            w.set_dfsph_params(linear_solver=sph.raw.SPH_DFSPH_CHEBYSHEV)
-            w.step(1 / 60)
-            s = w.stats()
-            assert s.pressure_iterations >= 2 * s.substeps and s.density_error_max <= 1e-4
-        else:
-            e = error(w.set_dfsph_params, linear_solver=sph.raw.SPH_DFSPH_CHEBYSHEV)
-            assert e.result == sph.Result.ERROR_UNSUPPORTED and "SPH_DFSPH_CHEBYSHEV" in e.message
+        # The Chebyshev solve: the same bound.
+        w.set_dfsph_params(linear_solver=sph.raw.SPH_DFSPH_CHEBYSHEV)
+        w.step(1 / 60)
+        s = w.stats()
+        assert s.pressure_iterations >= 2 * s.substeps and s.density_error_max <= 1e-4
     with ctx.world(capacity=16) as w:
         assert w.definition.solver is sph.Solver.WCSPH
         assert error(_get, w, "dfsph_params").result == sph.Result.ERROR_FEATURE_DISABLED
