@@ -125,8 +125,8 @@ namespace Sph
         public const uint SPH_DFSPH_CONJUGATE_GRADIENTS = 2u;
         /// <summary>
         /// (0.2.0) the Jacobi steps accelerated by Chebyshev's semi-iteration, an expanded particle's
-        /// \ pressure released step by step: fewer iterations where the plain solve needs many (large
-        /// worlds); \ CPU and CUDA backends
+        /// \ pressure released step by step: about half the iterations up to ~1e5 particles (measured);
+        /// not \ yet shown stable at 1e6 (docs/physics.md). CPU and CUDA backends
         /// </summary>
         public const uint SPH_DFSPH_CHEBYSHEV = 3u;
         /// <summary>hollow box: no lid (a tank open at +y)</summary>

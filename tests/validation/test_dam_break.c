@@ -193,8 +193,8 @@ static void test_dfsph(void** state) {
 
 /* SPH_DFSPH_CHEBYSHEV (docs/physics.md, DFSPH): the same bounds, and fewer density iterations than
  * the plain Jacobi solve takes on the same case: at most 3/4 of them (measured at 20 layers, CPU,
- * session 28: 316 against 652, 0.48; the bound fails where the acceleration does nothing, 1.0, and
- * leaves room for the case's own changes). */
+ * session 29 (rho 0.9): 346 against 652, 0.53 (session 28's rho 0.95: 316, 0.48); the bound fails where the
+ * acceleration does nothing, 1.0, and leaves room for the case's own changes). */
 static void test_dfsph_chebyshev(void** state) {
   unsigned long long chebyshev, jacobi;
   (void)state;
