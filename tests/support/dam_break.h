@@ -51,7 +51,7 @@ typedef struct dam_break_config {
   float divergence_error;
   uint32_t max_iterations;
   uint32_t dfsph_flags;
-  uint32_t dfsph_linear_solver; /* SPH_DFSPH_JACOBI or SPH_DFSPH_CONJUGATE_GRADIENTS (0: default) */
+  uint32_t dfsph_linear_solver; /* SPH_DFSPH_JACOBI, _CONJUGATE_GRADIENTS or _CHEBYSHEV (0: default) */
   uint32_t features; /* sph_world_def.features added to the world's (e.g. SPH_FEATURE_BOUNDARY_DENSITY) */
   FILE* frame_log;   /* optional (NULL: none): one line a frame of the step's statistics and where the
                         densest particle is, for diagnosing a run */
