@@ -16,6 +16,8 @@ void mpi_cuda_dfsph_case(const char* name, sph_context* cuda, sph_context* cpu, 
 void mpi_cuda_probes_case(const char* name, sph_context* cuda, sph_solver solver);
 /* A sink over the stirred column's top, with `solver`. */
 void mpi_cuda_sinks_case(const char* name, sph_context* cuda, sph_solver solver);
-/* DFSPH's conjugate gradients on CUDA ranks against the same world on one rank, bit for bit; `cap`:
- * the density solve capped there (0: not). */
-void mpi_cuda_cg_case(const char* name, sph_context* cuda, float stir, uint32_t cap);
+/* DFSPH's density solve with `linear_solver` (SPH_DFSPH_CONJUGATE_GRADIENTS or SPH_DFSPH_CHEBYSHEV) on
+ * CUDA ranks against the same world on one rank, bit for bit; `cap`: the density solve capped there
+ * (0: not). */
+void mpi_cuda_rank_solver_case(const char* name, sph_context* cuda, uint32_t linear_solver, float stir,
+                               uint32_t cap);

@@ -21,8 +21,9 @@
  * tension), the collider loads (run_loads_case), the collapse that makes the ranks rebalance (12 frames of 20
  * substeps, spacing 12.5 mm), RK4 (the stirred column, and with the collider loads), DFSPH's Jacobi solves
  * (test_mpi_cuda_cases.c: the dam break, the stirred column with and without the divergence solve), probes
- * and gauges and sinks (there too, both solvers), DFSPH's conjugate gradients (test_mpi_cuda_cases.c,
- * mpi_cuda_cg_case: against the same world on one rank, bit for bit), and springs across ranks
+ * and gauges and sinks (there too, both solvers), DFSPH's conjugate gradients and Chebyshev solve
+ * (test_mpi_cuda_cases.c, mpi_cuda_rank_solver_case: against the same world on one rank, bit for bit),
+ * and springs across ranks
  * (mpi_springs_cases.c, the CPU ranks' test_mpi_springs.c cases on the CUDA ranks at capacity
  * 32768: bit for bit against the undivided CUDA world). With SPH_MPI_CUDA_QUICK set, the dam
  * breaks only (WCSPH, DFSPH, DFSPH by conjugate gradients: a run under compute-sanitizer). With
@@ -292,10 +293,13 @@ int main(int argc, char** argv) {
     mpi_cuda_sinks_case("sinks", cuda, SPH_SOLVER_WCSPH);
     mpi_cuda_sinks_case("DFSPH sinks", cuda, SPH_SOLVER_DFSPH);
   }
-  mpi_cuda_cg_case("DFSPH CG dam break", cuda, 0.0f, 0);
+  mpi_cuda_rank_solver_case("DFSPH CG dam break", cuda, SPH_DFSPH_CONJUGATE_GRADIENTS, 0.0f, 0);
   if (!quick) {
-    mpi_cuda_cg_case("DFSPH CG stirred column", cuda, 2.0f, 0);
-    mpi_cuda_cg_case("DFSPH CG stirred column, capped solves", cuda, 2.0f, 4);
+    mpi_cuda_rank_solver_case("DFSPH CG stirred column", cuda, SPH_DFSPH_CONJUGATE_GRADIENTS, 2.0f, 0);
+    mpi_cuda_rank_solver_case("DFSPH CG stirred column, capped solves", cuda, SPH_DFSPH_CONJUGATE_GRADIENTS,
+                              2.0f, 4);
+    /* (since session 29; written without a device: first run in the next scripts/gpu-test) */
+    mpi_cuda_rank_solver_case("DFSPH Chebyshev stirred column", cuda, SPH_DFSPH_CHEBYSHEV, 2.0f, 0);
   }
   /* Springs across ranks: the CPU ranks' cases (test_mpi_springs.c) on the CUDA ranks. */
   if (!quick) mpi_springs_cases(cuda, 32768);

@@ -309,7 +309,9 @@ void mpi_cuda_sinks_case(const char* name, sph_context* cuda, sph_solver solver)
 
 /* DFSPH's density solve by conjugate gradients on CUDA ranks (dfsph_cg_rank_solver.cu's host-driven
  * loop, the CPU rank's: the ghosts take their owners' search directions and velocity steps in each
- * iteration, the sums are exact sums added over the ranks). The undivided CUDA world sums in doubles
+ * iteration, the sums are exact sums added over the ranks), or by the Chebyshev solve (dfsph_solver.cu's
+ * host-driven Jacobi loop, each pass's weight set by dfsph_rank_check_kernel; the mixing is per
+ * particle, so the ghosts need only their owners' steps). The undivided CUDA world sums in doubles
  * in a fixed tree instead, so alpha and beta, and then the particles, differ from it by roundings:
  * the reference is the same world distributed over one rank (rank 0 alone, MPI_COMM_SELF), whose
  * sums are the same exact sums. Checked: the particles bit for bit against it, the iteration counts,
@@ -317,7 +319,8 @@ void mpi_cuda_sinks_case(const char* name, sph_context* cuda, sph_solver solver)
  * stats the same on every rank (mpi_test_solver_stats_differ); the
  * undivided CUDA world's iterations and distance are printed. With `cap`, the density solve capped
  * at `cap` iterations (a bound of 1e-8): capped solves in every frame. */
-void mpi_cuda_cg_case(const char* name, sph_context* cuda, float stir, uint32_t cap) {
+void mpi_cuda_rank_solver_case(const char* name, sph_context* cuda, uint32_t linear_solver, float stir,
+                               uint32_t cap) {
   const uint32_t frames[2] = {7, 5};
   sph_world_def def;
   sph_dfsph_params dfsph;
@@ -332,7 +335,7 @@ void mpi_cuda_cg_case(const char* name, sph_context* cuda, float stir, uint32_t 
   mpi_test_dam(cuda, &def, stir, NULL, &single, &world, &n);
   if (g_rank == 0) mpi_test_dam_on(cuda, &def, stir, MPI_COMM_SELF, NULL, NULL, &one, &n_one);
   REQUIRE(sph_dfsph_params_init(&dfsph) == SPH_OK, "dfsph params init");
-  dfsph.linear_solver = SPH_DFSPH_CONJUGATE_GRADIENTS;
+  dfsph.linear_solver = linear_solver;
   dfsph.density_error = 1e-5f;
   dfsph.divergence_error = 0.1f;
   if (cap > 0) {
