@@ -133,12 +133,10 @@ __global__ void __launch_bounds__(kDfsphSolveBlock)
     if (!kDivergence && fluid.methods.dfsph.linear_solver == kDfsphChebyshev) {
       // SPH_DFSPH_CHEBYSHEV (dfsph_passes.h), as the CPU backend's: the pressure held so far is the
       // carried one, which every velocity update of this solve has added its steps to.
-      const float held = a.dfsph_pressure[i];
       const DfsphResidual r =
-          density_residual_released(rate, a.density[i], a.dfsph_factor[i], fluid.rest_density, dt, held);
-      const float weight = state->solve_weight;
-      const float step = chebyshev_step(weight, r.k, weight == 1.0f ? 0.0f : a.dfsph_previous_step[i], held);
-      a.dfsph_step[i] = a.dfsph_previous_step[i] = step;
+          chebyshev_density_residual(rate, a.density[i], a.dfsph_factor[i], fluid.rest_density, dt,
+                                     a.dfsph_pressure[i], state->solve_weight, &a.dfsph_previous_step[i]);
+      a.dfsph_step[i] = a.dfsph_previous_step[i] = r.k;
       error = r.error;
     } else {
       const DfsphResidual r =

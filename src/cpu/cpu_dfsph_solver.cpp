@@ -93,9 +93,9 @@ void CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, c
   parallel().for_each(count_, [&](uint32_t i) {
     const float rate = density_rate_of(fluid, view, columns, walls, i);
     if (chebyshev) {
-      const DfsphResidual r = density_residual_released(rate, density[i], factor[i], rho0, dt, held[i]);
-      const float step = chebyshev_step(weight, r.k, pass > 0 ? previous[i] : 0.0f, held[i]);
-      k[i] = previous[i] = step;
+      const DfsphResidual r =
+          chebyshev_density_residual(rate, density[i], factor[i], rho0, dt, held[i], weight, &previous[i]);
+      k[i] = previous[i] = r.k;
       error[i] = r.error;
       return;
     }

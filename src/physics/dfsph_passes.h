@@ -293,6 +293,16 @@ SPH_HD float chebyshev_step(float weight, float jacobi_step, float previous_step
   return k < -held ? -held : k;
 }
 
+// One particle's residual pass of the Chebyshev density solve, as both backends run it: the released
+// residual mixed with `previous`, the step the particle applied in the pass before (read only past the
+// first pass, weight != 1: before it the array holds nothing of this solve). k: the step to apply
+// (and to keep as the next pass's previous); error: the plain solve's.
+SPH_HD DfsphResidual chebyshev_density_residual(float rate, float density, float factor, float rest_density,
+                                                float dt, float held, float weight, const float* previous) {
+  const DfsphResidual r = density_residual_released(rate, density, factor, rest_density, dt, held);
+  return DfsphResidual{chebyshev_step(weight, r.k, weight == 1.0f ? 0.0f : *previous, held), r.error};
+}
+
 // The colliders' no-penetration inside the solves. The collision response after the step stops a
 // particle at a wall whatever velocity the solves gave it; a solve that does not know this
 // relieves the compression of a particle pressed against a wall by moving it into the wall,
