@@ -1,5 +1,4 @@
 // SPDX-License-Identifier: MIT
-#include "../src/core/dfsph_jacobi_loop.h"
 #include "../src/core/exact_float_sum.h"
 #include "../src/physics/collider_loads.h"
 #include "../src/physics/dfsph_passes.h"
@@ -96,27 +95,6 @@ __global__ void dfsph_correct_kernel(FluidConstants fluid, GridView grid, Partic
   carried[i] = (kWarm ? 0.0f : carried[i]) + k[i] * scale;
 }
 
-// One launch of the velocity update: the warm start's pass (`warm`, replacing the carried values)
-// or an iteration's, with the gradient the world's parameters choose.
-void launch_correct(bool warm, const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
-                    uint32_t n, Float4* v, const float* k, float* carried, bool divergence, bool contacts,
-                    FrameState* state, unsigned blocks, unsigned threads, cudaStream_t stream) {
-  const bool corrected = fluid.methods.dfsph.gradient_correction != 0;
-  if (warm && corrected)
-    dfsph_correct_kernel<true, true>
-        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, k, carried, divergence, contacts, state);
-  else if (warm)
-    dfsph_correct_kernel<true, false>
-        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, k, carried, divergence, contacts, state);
-  else if (corrected)
-    dfsph_correct_kernel<false, true>
-        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, k, carried, divergence, contacts, state);
-  else
-    dfsph_correct_kernel<false, false>
-        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, k, carried, divergence, contacts, state);
-  check_launch("dfsph_correct_kernel");
-}
-
 // New pressures from the rates over v; each block's error sum to partials[block], or (kExact, a
 // distributed rank) the errors of the rank's own particles into the exact sum's bins.
 template <bool kDivergence, bool kExact>
@@ -174,19 +152,6 @@ __global__ void __launch_bounds__(kDfsphCheckBlock)
   dfsph_take_largest(state);
   dfsph_continue_solve(state, divergence ? state->divergence_tally : state->pressure_tally, bounds,
                        min_iterations, max_iterations, cond);
-}
-
-// A distributed rank's test, decided by the host (core/dfsph_jacobi_loop.h) on the world's
-// errors: the state and the record as dfsph_check_kernel leaves them, by the same rule.
-__global__ void dfsph_rank_check_kernel(uint32_t iterations, DfsphErrors errors, DfsphBounds bounds,
-                                        uint32_t min_iterations, uint32_t max_iterations, bool divergence,
-                                        FrameState* state) {
-  state->solve_iterations = iterations;
-  state->solve_weight = chebyshev_weight(iterations + 1u);
-  state->solve_error = errors.mean;
-  state->solve_largest = errors.largest;
-  dfsph_continue_solve(state, divergence ? state->divergence_tally : state->pressure_tally, bounds,
-                       min_iterations, max_iterations, LoopCondition{});
 }
 
 // v* = v + dt a with the non-pressure accelerations, into the state's velocity array (free
@@ -290,76 +255,63 @@ void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid
   if (loops.rank && !divergence && c.linear_solver == kDfsphConjugateGradients) {
     // A distributed rank's conjugate gradients: the warm start, the ghosts' velocities, then the
     // host-driven solve (dfsph_cg_rank_solver.cu, the CPU rank's loop).
-    launch_correct(true, fluid, grid, a, n, v, warm, carried, divergence, contacts, state, blocks, threads,
-                   stream);
+    launch_dfsph_correct(true, fluid, grid, a, n, v, warm, carried, divergence, contacts, state, blocks,
+                         threads, stream);
     loops.rank->share_velocities(v, stream);
     return enqueue_dfsph_cg_rank_solve(fluid, grid, a, n, contacts, *loops.rank, state, stream);
   }
-  if (loops.rank) {
-    // A distributed rank: the host drives the loop, the ghosts' refreshes and the world's error
-    // between the passes (core/dfsph_jacobi_loop.h, the CPU rank's loop).
-    struct Passes {
-      const FluidConstants& fluid;
-      const GridView& grid;
-      const ParticleArrays& a;
-      uint32_t n;
-      Float4* v;
-      const float* warm;
-      float* carried;
-      bool divergence, contacts;
-      DfsphBounds bounds;
-      uint32_t min_iterations, max_iterations;
-      DfsphRankSteps& rank;
-      FrameState* state;
-      cudaStream_t stream;
-      unsigned blocks, threads;
-      void velocity_update(bool first) {
-        launch_correct(first, fluid, grid, a, n, v, first ? warm : a.dfsph_step, carried, divergence,
-                       contacts, state, blocks, threads, stream);
-      }
-      void share_velocities() { rank.share_velocities(v, stream); }
-      void rates() {
-        unsigned long long* bins = rank.error_bins();
-        cuda_check(cudaMemsetAsync(bins, 0, sizeof(unsigned long long) * kDfsphRankErrorWords, stream),
-                   "DFSPH error bins reset");
-        if (divergence)
-          dfsph_residual_kernel<true, true>
-              <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, nullptr, bins, state);
-        else
-          dfsph_residual_kernel<false, true>
-              <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, nullptr, bins, state);
-        check_launch("dfsph_residual_kernel");
-      }
-      void share_steps() { rank.share_steps(stream); }
-      DfsphErrors errors() { return rank.errors(divergence, stream); }
-      void checked(uint32_t iterations, const DfsphErrors& errors, bool) {
-        dfsph_rank_check_kernel<<<1, 1, 0, stream>>>(iterations, errors, bounds, min_iterations,
-                                                     max_iterations, divergence, state);
-        check_launch("dfsph_rank_check_kernel");
-      }
-    } passes{fluid,          grid,           a,           n,        v,
-             warm,           carried,        divergence,  contacts, bounds,
-             min_iterations, max_iterations, *loops.rank, state,    stream,
-             blocks,         threads};
-    run_dfsph_jacobi(passes, bounds, min_iterations, max_iterations);
-    return;
-  }
-  launch_correct(true, fluid, grid, a, n, v, warm, carried, divergence, contacts, state, blocks, threads,
-                 stream);
+  if (loops.rank)  // the host drives the loop (dfsph_jacobi_rank_solver.cu)
+    return enqueue_dfsph_jacobi_rank_solve(fluid, grid, a, n, v, warm, carried, divergence, contacts, bounds,
+                                           min_iterations, max_iterations, *loops.rank, state, stream);
+  launch_dfsph_correct(true, fluid, grid, a, n, v, warm, carried, divergence, contacts, state, blocks,
+                       threads, stream);
   // The same warm start (as the CPU backend's), then the conjugate gradients' iterations.
   if (!divergence && c.linear_solver == kDfsphConjugateGradients)
     return enqueue_dfsph_cg_solve(fluid, grid, a, n, contacts, loops, cond, state, stream);
   residual();
   check(true);
   run_solve_loop(cond, state, loops.host_state, stream, [&] {
-    launch_correct(false, fluid, grid, a, n, v, a.dfsph_step, carried, divergence, contacts, state, blocks,
-                   threads, stream);
+    launch_dfsph_correct(false, fluid, grid, a, n, v, a.dfsph_step, carried, divergence, contacts, state,
+                         blocks, threads, stream);
     residual();
     check(false);
   });
 }
 
 }  // namespace
+
+void launch_dfsph_correct(bool warm, const FluidConstants& fluid, const GridView& grid,
+                          const ParticleArrays& a, uint32_t n, Float4* v, const float* k, float* carried,
+                          bool divergence, bool contacts, FrameState* state, unsigned blocks,
+                          unsigned threads, cudaStream_t stream) {
+  const bool corrected = fluid.methods.dfsph.gradient_correction != 0;
+  if (warm && corrected)
+    dfsph_correct_kernel<true, true>
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, k, carried, divergence, contacts, state);
+  else if (warm)
+    dfsph_correct_kernel<true, false>
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, k, carried, divergence, contacts, state);
+  else if (corrected)
+    dfsph_correct_kernel<false, true>
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, k, carried, divergence, contacts, state);
+  else
+    dfsph_correct_kernel<false, false>
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, k, carried, divergence, contacts, state);
+  check_launch("dfsph_correct_kernel");
+}
+
+void launch_dfsph_rank_residual(bool divergence, const FluidConstants& fluid, const GridView& grid,
+                                const ParticleArrays& a, uint32_t n, const Float4* v,
+                                unsigned long long* bins, FrameState* state, unsigned blocks,
+                                unsigned threads, cudaStream_t stream) {
+  if (divergence)
+    dfsph_residual_kernel<true, true>
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, nullptr, bins, state);
+  else
+    dfsph_residual_kernel<false, true>
+        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, nullptr, bins, state);
+  check_launch("dfsph_residual_kernel");
+}
 
 void enqueue_dfsph_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                            uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,

@@ -107,6 +107,33 @@ void enqueue_dfsph_cg_rank_solve(const FluidConstants& fluid, const GridView& gr
                                  uint32_t n, bool contacts, DfsphRankSteps& rank, FrameState* state,
                                  cudaStream_t stream);
 
+// A Jacobi solve (either solve) on a distributed rank (dfsph_jacobi_rank_solver.cu): the host
+// drives it as the CPU rank's loop (core/dfsph_jacobi_loop.h), from the warm start's velocity
+// update to the solve's record; v, warm and carried are the solve's arrays, as enqueue_solve
+// (dfsph_solver.cu) chooses them.
+void enqueue_dfsph_jacobi_rank_solve(const FluidConstants& fluid, const GridView& grid,
+                                     const ParticleArrays& a, uint32_t n, Float4* v, const float* warm,
+                                     float* carried, bool divergence, bool contacts,
+                                     const DfsphBounds& bounds, uint32_t min_iterations,
+                                     uint32_t max_iterations, DfsphRankSteps& rank, FrameState* state,
+                                     cudaStream_t stream);
+
+// The solves' passes that the rank solves launch (dfsph_solver.cu). The velocity update: v += the
+// pressures k's velocity change (held to the contacts), and carried gets k times the solve's
+// scale (dt for the divergence solve's impulse), replacing the carried values on the warm start's
+// pass (`warm`) or added on an iteration's, with the gradient the world's parameters choose.
+void launch_dfsph_correct(bool warm, const FluidConstants& fluid, const GridView& grid,
+                          const ParticleArrays& a, uint32_t n, Float4* v, const float* k, float* carried,
+                          bool divergence, bool contacts, FrameState* state, unsigned blocks,
+                          unsigned threads, cudaStream_t stream);
+// The rates over v, the new pressure steps and the errors of the rank's own particles (not its
+// ghosts) into the exact sum's bins (kDfsphRankErrorWords words), with the largest error's bits
+// for the density solve. threads must be kDfsphSolveBlock.
+void launch_dfsph_rank_residual(bool divergence, const FluidConstants& fluid, const GridView& grid,
+                                const ParticleArrays& a, uint32_t n, const Float4* v,
+                                unsigned long long* bins, FrameState* state, unsigned blocks,
+                                unsigned threads, cudaStream_t stream);
+
 // After the density pass (and the spring pass): the divergence solve (unless skipped), the
 // non-pressure accelerations, the density solve, positions, colliders and the reductions of the
 // step's end (max speed, max acceleration, the non-finite check), into the state arrays; the

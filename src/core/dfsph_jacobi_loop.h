@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // DFSPH's Jacobi solve as the host drives it, one iteration at a time, written once for the CPU
 // backend (src/cpu/cpu_dfsph_solver.cpp, undivided or a rank) and a distributed CUDA rank
-// (cuda/dfsph_solver.cu; an undivided CUDA world runs the same loop on the device,
+// (cuda/dfsph_jacobi_rank_solver.cu; an undivided CUDA world runs the same loop on the device,
 // cuda/dfsph_solve_loop.cuh, by the same stopping rule). In a distributed world this is where
 // the ghosts are refreshed between the passes (docs/distributed.md): each velocity update is
 // followed by the ghosts taking their owners' velocities (the rate pass reads its neighbours'),
