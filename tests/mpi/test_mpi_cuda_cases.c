@@ -309,10 +309,10 @@ void mpi_cuda_sinks_case(const char* name, sph_context* cuda, sph_solver solver)
 
 /* DFSPH's density solve by conjugate gradients on CUDA ranks (dfsph_cg_rank_solver.cu's host-driven
  * loop, the CPU rank's: the ghosts take their owners' search directions and velocity steps in each
- * iteration, the sums are exact sums added over the ranks), or by the Chebyshev solve (dfsph_solver.cu's
- * host-driven Jacobi loop, each pass's weight set by dfsph_rank_check_kernel; the mixing is per
- * particle, so the ghosts need only their owners' steps). The undivided CUDA world sums in doubles
- * in a fixed tree instead, so alpha and beta, and then the particles, differ from it by roundings:
+ * iteration, the sums are exact sums added over the ranks), or by the Chebyshev solve
+ * (dfsph_jacobi_rank_solver.cu's host-driven Jacobi loop, each pass's weight set by dfsph_rank_check_kernel;
+ * the mixing is per particle, so the ghosts need only their owners' steps). The undivided CUDA world sums in
+ * doubles in a fixed tree instead, so alpha and beta, and then the particles, differ from it by roundings:
  * the reference is the same world distributed over one rank (rank 0 alone, MPI_COMM_SELF), whose
  * sums are the same exact sums. Checked: the particles bit for bit against it, the iteration counts,
  * the capped solves and the mean and largest errors equal to its, and every solver field of the
