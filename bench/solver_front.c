@@ -11,7 +11,7 @@
  *   solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1]
  *                [--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg|chebyshev]
  *                [--dfsph-max 0.05] [--walls-in-density] [--particle-lanes N] [--no-dfsph-masks]
- *                [--dfsph-lists] [--dfsph-step-factor 0.4]
+ *                [--dfsph-lists] [--dfsph-step-factor 0.4] [--dfsph-divergence 1]
  *                [--frame-log] [--out solver_front.csv]
  *
  * --wcsph: the weakly compressible runs' speeds of sound, as multiples of the free-fall speed;
@@ -27,7 +27,9 @@
  * --dfsph-lists: cuda_dfsph_masks = SPH_CUDA_DFSPH_NEIGHBOR_LISTS (the solves loop over each
  * particle's neighbour list; the same bits). --dfsph-step-factor: the DFSPH runs' lambda of
  * dt = lambda h / v_max (sph_world_params.step_factor; default the dam break's 0.4; the weakly
- * compressible runs keep 0.4, which their acoustic limit shares).
+ * compressible runs keep 0.4, which their acoustic limit shares). --dfsph-divergence: the DFSPH runs'
+ * divergence solve bound (sph_dfsph_params.divergence_error, 1/s; default the library's, 1): a fixed
+ * rate, so the finer the world (the shorter its step) the tighter it holds the density change a step.
  * --frame-log: one line a frame on stdout with the step's statistics and where the densest
  * particle is (in column widths), for diagnosing a run.
  *
@@ -100,6 +102,7 @@ int main(int argc, char** argv) {
   uint32_t features = 0, particle_lanes = 0, dfsph_masks = 0;
   double dfsph_max = 0.0;         /* the library's default */
   double dfsph_step_factor = 0.0; /* 0: the dam break's default */
+  double dfsph_divergence = 0.0;  /* 0: the library's default */
   int frame_log = 0;
   sph_backend backend = SPH_BACKEND_AUTO, resolved = SPH_BACKEND_CPU;
   sph_context* context = NULL;
@@ -165,6 +168,11 @@ int main(int argc, char** argv) {
         fprintf(stderr, "solver_front: --dfsph-step-factor takes one lambda in (0, 10]\n");
         return 2;
       }
+    } else if (strcmp(argv[i], "--dfsph-divergence") == 0 && i + 1 < argc) {
+      if (parse_values(argv[++i], &dfsph_divergence, 1) != 1 || !(dfsph_divergence > 0.0)) {
+        fprintf(stderr, "solver_front: --dfsph-divergence takes one bound > 0 (1/s)\n");
+        return 2;
+      }
     } else if (strcmp(argv[i], "--dfsph-lists") == 0) {
       dfsph_masks = SPH_CUDA_DFSPH_NEIGHBOR_LISTS;
     } else if (strcmp(argv[i], "--frame-log") == 0) {
@@ -188,7 +196,7 @@ int main(int argc, char** argv) {
           "[--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg|chebyshev] [--dfsph-max "
           "0.05] "
           "[--walls-in-density] [--particle-lanes N] [--no-dfsph-masks] [--dfsph-lists] [--dfsph-step-factor "
-          "L] [--frame-log] [--out "
+          "L] [--dfsph-divergence 1] [--frame-log] [--out "
           "solver_front.csv]\n");
       return 2;
     }
@@ -243,6 +251,7 @@ int main(int argc, char** argv) {
         config.density_error = (float)runs[r].value;
         config.density_error_max = (float)dfsph_max;
         if (dfsph_step_factor > 0.0) config.step_factor = (float)dfsph_step_factor;
+        if (dfsph_divergence > 0.0) config.divergence_error = (float)dfsph_divergence;
       } else {
         config.speed_of_sound = (float)(runs[r].value * free_fall);
       }
