@@ -66,7 +66,7 @@ void enqueue_dfsph_jacobi_rank_solve(const FluidConstants& fluid, const GridView
       unsigned long long* bins = rank.error_bins();
       cuda_check(cudaMemsetAsync(bins, 0, sizeof(unsigned long long) * kDfsphRankErrorWords, stream),
                  "DFSPH error bins reset");
-      launch_dfsph_rank_residual(divergence, fluid, grid, a, n, v, bins, state, blocks, threads, stream);
+      launch_dfsph_rank_residual(divergence, fluid, grid, a, n, v, bins, state, stream);
     }
     void share_steps() { rank.share_steps(stream); }
     DfsphErrors errors() { return rank.errors(divergence, stream); }

@@ -302,8 +302,8 @@ void launch_dfsph_correct(bool warm, const FluidConstants& fluid, const GridView
 
 void launch_dfsph_rank_residual(bool divergence, const FluidConstants& fluid, const GridView& grid,
                                 const ParticleArrays& a, uint32_t n, const Float4* v,
-                                unsigned long long* bins, FrameState* state, unsigned blocks,
-                                unsigned threads, cudaStream_t stream) {
+                                unsigned long long* bins, FrameState* state, cudaStream_t stream) {
+  const unsigned threads = kDfsphSolveBlock, blocks = blocks_for(n, threads);
   if (divergence)
     dfsph_residual_kernel<true, true>
         <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, nullptr, bins, state);

@@ -128,11 +128,10 @@ void launch_dfsph_correct(bool warm, const FluidConstants& fluid, const GridView
                           unsigned threads, cudaStream_t stream);
 // The rates over v, the new pressure steps and the errors of the rank's own particles (not its
 // ghosts) into the exact sum's bins (kDfsphRankErrorWords words), with the largest error's bits
-// for the density solve. threads must be kDfsphSolveBlock.
+// for the density solve (blocks of kDfsphSolveBlock threads, the block sums' fixed tree).
 void launch_dfsph_rank_residual(bool divergence, const FluidConstants& fluid, const GridView& grid,
                                 const ParticleArrays& a, uint32_t n, const Float4* v,
-                                unsigned long long* bins, FrameState* state, unsigned blocks,
-                                unsigned threads, cudaStream_t stream);
+                                unsigned long long* bins, FrameState* state, cudaStream_t stream);
 
 // After the density pass (and the spring pass): the divergence solve (unless skipped), the
 // non-pressure accelerations, the density solve, positions, colliders and the reductions of the

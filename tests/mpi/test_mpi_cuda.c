@@ -298,7 +298,7 @@ int main(int argc, char** argv) {
     mpi_cuda_rank_solver_case("DFSPH CG stirred column", cuda, SPH_DFSPH_CONJUGATE_GRADIENTS, 2.0f, 0);
     mpi_cuda_rank_solver_case("DFSPH CG stirred column, capped solves", cuda, SPH_DFSPH_CONJUGATE_GRADIENTS,
                               2.0f, 4);
-    /* (since session 29; written without a device: first run in the next scripts/gpu-test) */
+    /* (since session 29; first run on an H100 in session 30: bit for bit on 1-3 ranks) */
     mpi_cuda_rank_solver_case("DFSPH Chebyshev stirred column", cuda, SPH_DFSPH_CHEBYSHEV, 2.0f, 0);
   }
   /* Springs across ranks: the CPU ranks' cases (test_mpi_springs.c) on the CUDA ranks. */
