@@ -12,6 +12,7 @@
  *                [--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg|chebyshev]
  *                [--dfsph-max 0.05] [--walls-in-density] [--particle-lanes N] [--no-dfsph-masks]
  *                [--dfsph-lists] [--dfsph-step-factor 0.4] [--dfsph-divergence 1]
+ *                [--dfsph-divergence-step 0.001]
  *                [--frame-log] [--out solver_front.csv]
  *
  * --wcsph: the weakly compressible runs' speeds of sound, as multiples of the free-fall speed;
@@ -28,8 +29,11 @@
  * particle's neighbour list; the same bits). --dfsph-step-factor: the DFSPH runs' lambda of
  * dt = lambda h / v_max (sph_world_params.step_factor; default the dam break's 0.4; the weakly
  * compressible runs keep 0.4, which their acoustic limit shares). --dfsph-divergence: the DFSPH runs'
- * divergence solve bound (sph_dfsph_params.divergence_error, 1/s; default the library's, 1): a fixed
- * rate, so the finer the world (the shorter its step) the tighter it holds the density change a step.
+ * divergence solve bound as a rate (sph_dfsph_params.divergence_error, 1/s; default the library's, 1);
+ * --dfsph-divergence-step: the same bound as a share a step (divergence_error_per_step; default the
+ * library's, 0.001). The solve stops at the looser of the two: to measure the rate alone, pass
+ * --dfsph-divergence-step 1e-9 (a fixed rate holds the density change a step the tighter the finer
+ * the world, docs/validation.md).
  * --frame-log: one line a frame on stdout with the step's statistics and where the densest
  * particle is (in column widths), for diagnosing a run.
  *
@@ -100,9 +104,10 @@ int main(int argc, char** argv) {
   const char* out_path = "solver_front.csv";
   uint32_t linear_solver = 0; /* the library's default */
   uint32_t features = 0, particle_lanes = 0, dfsph_masks = 0;
-  double dfsph_max = 0.0;         /* the library's default */
-  double dfsph_step_factor = 0.0; /* 0: the dam break's default */
-  double dfsph_divergence = 0.0;  /* 0: the library's default */
+  double dfsph_max = 0.0;             /* the library's default */
+  double dfsph_step_factor = 0.0;     /* 0: the dam break's default */
+  double dfsph_divergence = 0.0;      /* 0: the library's default */
+  double dfsph_divergence_step = 0.0; /* 0: the library's default */
   int frame_log = 0;
   sph_backend backend = SPH_BACKEND_AUTO, resolved = SPH_BACKEND_CPU;
   sph_context* context = NULL;
@@ -173,6 +178,12 @@ int main(int argc, char** argv) {
         fprintf(stderr, "solver_front: --dfsph-divergence takes one bound > 0 (1/s)\n");
         return 2;
       }
+    } else if (strcmp(argv[i], "--dfsph-divergence-step") == 0 && i + 1 < argc) {
+      if (parse_values(argv[++i], &dfsph_divergence_step, 1) != 1 || !(dfsph_divergence_step > 0.0) ||
+          dfsph_divergence_step > 1.0) {
+        fprintf(stderr, "solver_front: --dfsph-divergence-step takes one share in (0, 1]\n");
+        return 2;
+      }
     } else if (strcmp(argv[i], "--dfsph-lists") == 0) {
       dfsph_masks = SPH_CUDA_DFSPH_NEIGHBOR_LISTS;
     } else if (strcmp(argv[i], "--frame-log") == 0) {
@@ -196,7 +207,7 @@ int main(int argc, char** argv) {
           "[--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg|chebyshev] [--dfsph-max "
           "0.05] "
           "[--walls-in-density] [--particle-lanes N] [--no-dfsph-masks] [--dfsph-lists] [--dfsph-step-factor "
-          "L] [--dfsph-divergence 1] [--frame-log] [--out "
+          "L] [--dfsph-divergence 1] [--dfsph-divergence-step 0.001] [--frame-log] [--out "
           "solver_front.csv]\n");
       return 2;
     }
@@ -252,6 +263,7 @@ int main(int argc, char** argv) {
         config.density_error_max = (float)dfsph_max;
         if (dfsph_step_factor > 0.0) config.step_factor = (float)dfsph_step_factor;
         if (dfsph_divergence > 0.0) config.divergence_error = (float)dfsph_divergence;
+        if (dfsph_divergence_step > 0.0) config.divergence_error_per_step = (float)dfsph_divergence_step;
       } else {
         config.speed_of_sound = (float)(runs[r].value * free_fall);
       }

@@ -37,11 +37,21 @@ __global__ void dfsph_rank_check_kernel(uint32_t iterations, DfsphErrors errors,
 
 void enqueue_dfsph_jacobi_rank_solve(const FluidConstants& fluid, const GridView& grid,
                                      const ParticleArrays& a, uint32_t n, Float4* v, const float* warm,
-                                     float* carried, bool divergence, bool contacts,
-                                     const DfsphBounds& bounds, uint32_t min_iterations,
+                                     float* carried, bool divergence, bool contacts, uint32_t min_iterations,
                                      uint32_t max_iterations, DfsphRankSteps& rank, FrameState* state,
                                      cudaStream_t stream) {
   const unsigned threads = kDfsphSolveBlock, blocks = blocks_for(n, threads);
+  const Dfsph::Constants& c = fluid.methods.dfsph;
+  DfsphBounds bounds = dfsph_density_bounds(c);
+  if (divergence) {
+    // The divergence bound depends on the substep's dt, which the device chose (the same on every
+    // rank); the host reads it once a solve (each iteration waits on the device anyway).
+    float dt = 0.0f;
+    cuda_check(cudaMemcpyAsync(&dt, &state->clock.dt_float, sizeof dt, cudaMemcpyDeviceToHost, stream),
+               "DFSPH rank solve: dt download");
+    cuda_check(cudaStreamSynchronize(stream), "DFSPH rank solve: dt download");
+    bounds = dfsph_divergence_bounds(c, dt);
+  }
   struct Passes {
     const FluidConstants& fluid;
     const GridView& grid;

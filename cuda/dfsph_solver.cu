@@ -140,10 +140,13 @@ __global__ void __launch_bounds__(kDfsphSolveBlock)
 
 // The solve's mean error from the block sums; whether it goes on; its record when it stops.
 __global__ void __launch_bounds__(kDfsphCheckBlock)
-    dfsph_check_kernel(const double* partials, uint32_t blocks, uint32_t n, DfsphBounds bounds,
+    dfsph_check_kernel(const double* partials, uint32_t blocks, uint32_t n, Dfsph::Constants c,
                        uint32_t min_iterations, uint32_t max_iterations, bool divergence, bool first,
                        LoopCondition cond, FrameState* state) {
   if (state->solve_run == 0) return;
+  // (Here, not on the host: the divergence bound depends on the substep's dt, chosen on the device.)
+  const DfsphBounds bounds =
+      divergence ? dfsph_divergence_bounds(c, state->clock.dt_float) : dfsph_density_bounds(c);
   const double sum = dfsph_sum_partials(partials, blocks);
   if (threadIdx.x != 0) return;
   state->solve_iterations = first ? 0u : state->solve_iterations + 1u;
@@ -229,7 +232,6 @@ void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid
   Float4* v = divergence ? a.sorted_velocity : a.velocity;
   float* carried = divergence ? a.dfsph_divergence : a.dfsph_pressure;
   const float* warm = divergence ? a.dfsph_step : a.dfsph_warm_pressure;
-  const DfsphBounds bounds = divergence ? dfsph_divergence_bounds(c) : dfsph_density_bounds(c);
   const uint32_t min_iterations = divergence ? Dfsph::kMinDivergenceIterations : Dfsph::kMinIterations;
   const uint32_t max_iterations = divergence ? c.max_divergence_iterations : c.max_iterations;
   const unsigned threads = kDfsphSolveBlock, blocks = blocks_for(n, threads);
@@ -247,9 +249,8 @@ void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid
     check_launch("dfsph_residual_kernel");
   };
   auto check = [&](bool first) {
-    dfsph_check_kernel<<<1, kDfsphCheckBlock, 0, stream>>>(loops.partials, partial_count, n, bounds,
-                                                           min_iterations, max_iterations, divergence, first,
-                                                           cond, state);
+    dfsph_check_kernel<<<1, kDfsphCheckBlock, 0, stream>>>(
+        loops.partials, partial_count, n, c, min_iterations, max_iterations, divergence, first, cond, state);
     check_launch("dfsph_check_kernel");
   };
   if (loops.rank && !divergence && c.linear_solver == kDfsphConjugateGradients) {
@@ -261,7 +262,7 @@ void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid
     return enqueue_dfsph_cg_rank_solve(fluid, grid, a, n, contacts, *loops.rank, state, stream);
   }
   if (loops.rank)  // the host drives the loop (dfsph_jacobi_rank_solver.cu)
-    return enqueue_dfsph_jacobi_rank_solve(fluid, grid, a, n, v, warm, carried, divergence, contacts, bounds,
+    return enqueue_dfsph_jacobi_rank_solve(fluid, grid, a, n, v, warm, carried, divergence, contacts,
                                            min_iterations, max_iterations, *loops.rank, state, stream);
   launch_dfsph_correct(true, fluid, grid, a, n, v, warm, carried, divergence, contacts, state, blocks,
                        threads, stream);

@@ -113,8 +113,7 @@ void enqueue_dfsph_cg_rank_solve(const FluidConstants& fluid, const GridView& gr
 // (dfsph_solver.cu) chooses them.
 void enqueue_dfsph_jacobi_rank_solve(const FluidConstants& fluid, const GridView& grid,
                                      const ParticleArrays& a, uint32_t n, Float4* v, const float* warm,
-                                     float* carried, bool divergence, bool contacts,
-                                     const DfsphBounds& bounds, uint32_t min_iterations,
+                                     float* carried, bool divergence, bool contacts, uint32_t min_iterations,
                                      uint32_t max_iterations, DfsphRankSteps& rank, FrameState* state,
                                      cudaStream_t stream);
 

@@ -639,7 +639,9 @@ typedef struct sph_dfsph_params {
                                          the step would give); dimensionless; default 0.001
                                          (0.1 %); in (0, 1]; 0 = default */
   float divergence_error;             /* bound on the divergence solve's mean of
-                                         max(D rho / Dt, 0) / rho0, 1/s; default 1; > 0; 0 = default */
+                                         max(D rho / Dt, 0) / rho0, 1/s; default 1; > 0; 0 = default.
+                                         The solve stops at the looser of this and
+                                         divergence_error_per_step / dt */
   uint32_t max_iterations;            /* cap of the density solve per substep; default 100; >= 2;
                                          0 = default. A solve that stops here above its bound is
                                          counted in sph_stats and reported as an event */
@@ -670,8 +672,17 @@ typedef struct sph_dfsph_params {
                                          (docs/physics.md, DFSPH, Limits); default 0.3; in (0, 1];
                                          0 = default. No limit without gravity or with
                                          SPH_DFSPH_NO_DEPTH_STEP_LIMIT; dt_min still wins */
+  float divergence_error_per_step;    /* (0.2.0) the divergence solve's bound as a share of rho0 a
+                                         step, the mean of max(D rho / Dt, 0) / rho0 times dt: the
+                                         solve stops once its mean rate is below divergence_error or
+                                         below this over dt, whichever is looser (at the defaults the
+                                         rate governs steps above 1 ms, this share shorter ones, where
+                                         a fixed rate alone made the divergence solve the costlier
+                                         one: docs/physics.md, DFSPH); default 0.001 (0.1 %, as
+                                         SPlisHSPlasH); in (0, 1]; 0 = default. A tiny value (1e-9)
+                                         leaves the rate alone, a tiny divergence_error this alone */
 } sph_dfsph_params;
-SPH_STATIC_ASSERT(sizeof(sph_dfsph_params) == 36, sph_dfsph_params_size);
+SPH_STATIC_ASSERT(sizeof(sph_dfsph_params) == 40, sph_dfsph_params_size);
 
 SPH_API sph_result SPH_CALL sph_dfsph_params_init_sized(sph_dfsph_params* params, uint32_t size);
 static inline sph_result sph_dfsph_params_init(sph_dfsph_params* params) {

@@ -318,6 +318,7 @@ typedef struct sph_dfsph_params {
   uint32_t linear_solver;
   float density_error_max;
   float depth_step_factor;
+  float divergence_error_per_step;
 } sph_dfsph_params;
 typedef struct sph_params_info {
   uint32_t struct_size;

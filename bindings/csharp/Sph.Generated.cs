@@ -1183,7 +1183,7 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_dfsph_params (36 bytes)</summary>
+    /// <summary>sph_dfsph_params (40 bytes)</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct DfsphParams
     {
@@ -1197,7 +1197,8 @@ namespace Sph
         public float DensityError;
         /// <summary>
         /// float divergence_error: bound on the divergence solve's mean of max(D rho / Dt, 0) / rho0,
-        /// 1/s; default 1; &gt; 0; 0 = default
+        /// 1/s; default 1; &gt; 0; 0 = default. The solve stops at the looser of this and
+        /// divergence_error_per_step / dt
         /// </summary>
         public float DivergenceError;
         /// <summary>
@@ -1240,6 +1241,16 @@ namespace Sph
         /// gravity or with SPH_DFSPH_NO_DEPTH_STEP_LIMIT; dt_min still wins
         /// </summary>
         public float DepthStepFactor;
+        /// <summary>
+        /// float divergence_error_per_step: (0.2.0) the divergence solve's bound as a share of rho0 a
+        /// step, the mean of max(D rho / Dt, 0) / rho0 times dt: the solve stops once its mean rate is
+        /// below divergence_error or below this over dt, whichever is looser (at the defaults the rate
+        /// governs steps above 1 ms, this share shorter ones, where a fixed rate alone made the
+        /// divergence solve the costlier one: docs/physics.md, DFSPH); default 0.001 (0.1 %, as
+        /// SPlisHSPlasH); in (0, 1]; 0 = default. A tiny value (1e-9) leaves the rate alone, a tiny
+        /// divergence_error this alone
+        /// </summary>
+        public float DivergenceErrorPerStep;
 
         /// <summary>A DfsphParams with the library's defaults (sph_dfsph_params_init_sized).</summary>
         public static DfsphParams Default()
@@ -3723,7 +3734,7 @@ namespace Sph
             8,
             28,
             8,
-            36,
+            40,
             32,
             72,
             32,
@@ -3822,6 +3833,7 @@ namespace Sph
             typeof(SpringParams),
             typeof(DensityDiffusionParams),
             typeof(DensityDiffusionParams),
+            typeof(DfsphParams),
             typeof(DfsphParams),
             typeof(DfsphParams),
             typeof(DfsphParams),
@@ -4114,6 +4126,7 @@ namespace Sph
             "LinearSolver",
             "DensityErrorMax",
             "DepthStepFactor",
+            "DivergenceErrorPerStep",
             "StructSize",
             "ParamsSize",
             "FieldCount",
@@ -4397,6 +4410,7 @@ namespace Sph
             24,
             28,
             32,
+            36,
             0,
             4,
             8,

@@ -60,7 +60,8 @@ const std::vector<ParamsBinding>& params_bindings() {
           {SPH_AT(sph_dfsph_params, density_error), SPH_AT(sph_dfsph_params, divergence_error),
            SPH_AT(sph_dfsph_params, max_iterations), SPH_AT(sph_dfsph_params, max_divergence_iterations),
            SPH_AT(sph_dfsph_params, flags), SPH_AT(sph_dfsph_params, linear_solver),
-           SPH_AT(sph_dfsph_params, density_error_max), SPH_AT(sph_dfsph_params, depth_step_factor)},
+           SPH_AT(sph_dfsph_params, density_error_max), SPH_AT(sph_dfsph_params, depth_step_factor),
+           SPH_AT(sph_dfsph_params, divergence_error_per_step)},
           {}),
       option<DensityDiffusion, sph_density_diffusion_params>(
           SPH_PARAMS_DENSITY_DIFFUSION, "sph_density_diffusion_params", "SPH_FEATURE_DENSITY_DIFFUSION",

@@ -30,7 +30,7 @@ namespace sph {
 namespace checkpoint {
 
 constexpr uint8_t kMagic[8] = {'S', 'P', 'H', 'C', 'K', 'P', 'T', 0x1a};
-constexpr uint32_t kFormatVersion = 11;            // what the writer writes
+constexpr uint32_t kFormatVersion = 12;            // what the writer writes
 constexpr uint32_t kFirstProbeVersion = 6;         // the first with probes (PROB) and load points
 constexpr uint32_t kFirstThresholdVersion = 7;     // the first with load and pressure thresholds
 constexpr uint32_t kFirstLargestErrorVersion = 9;  // the solves' largest particle error in TIME

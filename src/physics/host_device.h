@@ -16,3 +16,14 @@
 #else
 #define SPH_UNROLL(n)
 #endif
+
+// a / b rounded as IEEE 754 divides, on the host and on the device whatever the file's nvcc flags
+// (-prec-div=false makes `/` approximate): for a value that a host-driven loop and a device kernel
+// must compute to the same bits (a solve's stopping bound, physics/dfsph.h).
+SPH_HD float ieee_divide(float a, float b) {
+#if defined(__CUDA_ARCH__)
+  return __fdiv_rn(a, b);
+#else
+  return a / b;
+#endif
+}

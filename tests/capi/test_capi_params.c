@@ -300,6 +300,8 @@ static void test_each_rule_fires_with_its_message(void** state) {
        "params->density_error_max: must be in (0, 1], got 1.5"},
       {SPH_PARAMS_DFSPH, offsetof(sph_dfsph_params, depth_step_factor), -0.5f, SPH_ERROR_INVALID_ARGUMENT,
        "params->depth_step_factor: must be in (0, 1], got -0.5"},
+      {SPH_PARAMS_DFSPH, offsetof(sph_dfsph_params, divergence_error_per_step), 2.0f,
+       SPH_ERROR_INVALID_ARGUMENT, "params->divergence_error_per_step: must be in (0, 1], got 2"},
       {SPH_PARAMS_DENSITY_DIFFUSION, offsetof(sph_density_diffusion_params, delta), 1.5f,
        SPH_ERROR_INVALID_ARGUMENT, "params->delta: must be in (0, 1], got 1.5"},
   };
@@ -512,6 +514,8 @@ static void test_descriptions_match_the_header(void** state) {
        SPH_PARAM_ZERO_IS_DEFAULT},
       {SPH_PARAMS_DFSPH, "depth_step_factor", offsetof(sph_dfsph_params, depth_step_factor), SPH_PARAM_FLOAT,
        SPH_PARAM_ZERO_IS_DEFAULT},
+      {SPH_PARAMS_DFSPH, "divergence_error_per_step", offsetof(sph_dfsph_params, divergence_error_per_step),
+       SPH_PARAM_FLOAT, SPH_PARAM_ZERO_IS_DEFAULT},
       {SPH_PARAMS_DENSITY_DIFFUSION, "delta", offsetof(sph_density_diffusion_params, delta), SPH_PARAM_FLOAT,
        SPH_PARAM_ZERO_IS_DEFAULT},
   };
@@ -525,7 +529,7 @@ static void test_descriptions_match_the_header(void** state) {
       {"clavet", "sph_clavet_viscosity_params", sizeof(sph_clavet_viscosity_params), 2},
       {"tait", "sph_tait_params", sizeof(sph_tait_params), 1},
       {"springs", "sph_spring_params", sizeof(sph_spring_params), 5},
-      {"dfsph", "sph_dfsph_params", sizeof(sph_dfsph_params), 8},
+      {"dfsph", "sph_dfsph_params", sizeof(sph_dfsph_params), 9},
       {"density_diffusion", "sph_density_diffusion_params", sizeof(sph_density_diffusion_params), 1},
   };
   size_t i, seen[SPH_PARAMS_KIND_COUNT] = {0};

@@ -16,7 +16,9 @@
  *   (max - min of x . g / |g| in double); off by SPH_DFSPH_NO_DEPTH_STEP_LIMIT and without gravity
  *   it takes dt_max, and dt_min wins over it; a world loaded or restored from a checkpoint takes
  *   the same limited steps and trajectory bit for bit (H is measured, not stored); bad factors
- * (INVALID_ARGUMENT) and unknown flag bits (UNSUPPORTED) are refused with the world unchanged. */
+ * (INVALID_ARGUMENT) and unknown flag bits (UNSUPPORTED) are refused with the world unchanged;
+ * - the divergence bound as a share a step (divergence_error_per_step): at a fixed step it is the
+ *   rate share / dt, bit for bit; a looser share takes fewer iterations; its range is checked. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -358,6 +360,112 @@ static void test_depth_step_params_refused(void** state) {
   scene_close(&s);
 }
 
+/* The divergence bound as a share of rho0 a step (sph_dfsph_params.divergence_error_per_step): the
+ * falling ball of the checkpoint tests at a fixed step (dt_min = dt_max = frame = 1 ms: one
+ * substep a frame, dt known exactly), `frames` frames with the divergence solve's rate bound
+ * `rate` and share `per_step`. Checks each frame's solve against the looser of the two bounds
+ * (the library's rule) unless capped, and returns the divergence iterations and the particles'
+ * positions and velocities (malloc'ed, 6 floats a particle). */
+static const float kFixedDt = 0.001f;
+
+static uint64_t run_fixed_step(float rate, float per_step, int frames, float** state_out, uint32_t* n_out) {
+  scene s;
+  sph_world_params params;
+  sph_dfsph_params dp;
+  sph_stats st;
+  uint64_t iterations = 0;
+  uint32_t n = 0;
+  const float share_rate = per_step / kFixedDt;
+  const float bound = share_rate > rate ? share_rate : rate;
+  open_dfsph_tank(&s, 0u, -9.81f);
+  sph_world_params_init(&params);
+  SCENE_OK(sph_world_get_params(s.world, &params));
+  params.dt_min = params.dt_max = kFixedDt;
+  SCENE_OK(sph_world_set_params(s.world, &params));
+  sph_dfsph_params_init(&dp);
+  dp.divergence_error = rate;
+  dp.divergence_error_per_step = per_step;
+  SCENE_OK(sph_world_set_dfsph_params(s.world, &dp));
+  for (int f = 0; f < frames; ++f) {
+    SCENE_OK(sph_world_step(s.world, kFixedDt));
+    sph_stats_init(&st);
+    SCENE_OK(sph_world_get_stats(s.world, &st));
+    assert_int_equal(st.substeps, 1);
+    assert_true(st.dt_min == kFixedDt);
+    if (st.divergence_solves_capped == 0) assert_true(st.divergence_error_max <= bound);
+    iterations += st.divergence_iterations;
+  }
+  SCENE_OK(sph_world_get_particle_count(s.world, &n));
+  *state_out = (float*)malloc(24 * (size_t)n);
+  assert_non_null(*state_out);
+  assert_int_equal(scene_positions(&s, *state_out, n), n);
+  assert_int_equal(scene_velocities(&s, *state_out + 3 * (size_t)n, n), n);
+  *n_out = n;
+  scene_close(&s);
+  return iterations;
+}
+
+/* - A share S at a fixed step dt is the rate S / dt: the world bounded by the share alone (a rate
+ *   of 1e-6 1/s, far stricter, so the looser share governs) steps bit for bit as the world bounded
+ *   by the rate S / dt alone (a share of 1e-9) - the same bound, float for float (IEEE division
+ *   on both backends, physics/dfsph.h);
+ * - the share is used: a looser share (10x) takes fewer divergence iterations, and the strict one
+ *   more than the solve's minimum (one a substep), so the bound is what stops it. */
+static void test_divergence_bound_per_step(void** state) {
+  const int frames = 40;       /* the ball lands after about 20 */
+  const float share = 0.0001f; /* 0.1 / s at 1 ms */
+  float *by_share = NULL, *by_rate = NULL, *loose = NULL;
+  uint32_t n_share = 0, n_rate = 0, n_loose = 0;
+  uint64_t it_share, it_rate, it_loose;
+  (void)state;
+  it_share = run_fixed_step(1e-6f, share, frames, &by_share, &n_share);
+  it_rate = run_fixed_step(share / kFixedDt, 1e-9f, frames, &by_rate, &n_rate);
+  it_loose = run_fixed_step(1e-6f, 10.0f * share, frames, &loose, &n_loose);
+  printf("divergence iterations over %d substeps: share %g %llu, rate %g/s %llu, share %g %llu\n", frames,
+         (double)share, (unsigned long long)it_share, (double)(share / kFixedDt), (unsigned long long)it_rate,
+         (double)(10.0f * share), (unsigned long long)it_loose);
+  assert_int_equal(n_share, n_rate);
+  assert_int_equal(it_share, it_rate);
+  assert_memory_equal(by_share, by_rate, 24 * (size_t)n_share);
+  assert_true(it_share > (uint64_t)frames);
+  assert_true(it_loose < it_share);
+  free(by_share);
+  free(by_rate);
+  free(loose);
+}
+
+/* The share's range: (0, 1], 0 the default (0.001); -0.1, 1.5, NaN and the infinities are
+ * INVALID_ARGUMENT naming the field, the world's parameters unchanged. */
+static void test_divergence_per_step_params(void** state) {
+  scene s;
+  sph_dfsph_params dp, now;
+  const float bad[] = {-0.1f, 1.5f, NAN, INFINITY, -INFINITY};
+  (void)state;
+  open_column(&s, (sph_vec3){0.0f, -9.81f, 0.0f}, 0.05f, 1u, 0u);
+  sph_dfsph_params_init(&dp);
+  assert_true(dp.divergence_error_per_step == 0.001f); /* the default */
+  dp.divergence_error_per_step = 0.002f;
+  SCENE_OK(sph_world_set_dfsph_params(s.world, &dp));
+  for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
+    sph_dfsph_params_init(&dp);
+    dp.divergence_error_per_step = bad[k];
+    assert_int_equal(sph_world_set_dfsph_params(s.world, &dp), SPH_ERROR_INVALID_ARGUMENT);
+    assert_non_null(strstr(sph_get_last_error(), "divergence_error_per_step"));
+  }
+  sph_dfsph_params_init(&now);
+  SCENE_OK(sph_world_get_dfsph_params(s.world, &now));
+  assert_true(now.divergence_error_per_step == 0.002f); /* unchanged */
+  sph_dfsph_params_init(&dp);
+  dp.divergence_error_per_step = 0.0f;
+  SCENE_OK(sph_world_set_dfsph_params(s.world, &dp));
+  SCENE_OK(sph_world_get_dfsph_params(s.world, &now));
+  assert_true(now.divergence_error_per_step == 0.001f);
+  dp.divergence_error_per_step = 1.0f;
+  SCENE_OK(sph_world_set_dfsph_params(s.world, &dp));
+  SCENE_OK(sph_world_step(s.world, 0.01f));
+  scene_close(&s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_checkpoint_bitwise),
@@ -367,6 +475,8 @@ int main(void) {
       cmocka_unit_test(test_depth_step_limit),
       cmocka_unit_test(test_depth_step_after_checkpoint),
       cmocka_unit_test(test_depth_step_params_refused),
+      cmocka_unit_test(test_divergence_bound_per_step),
+      cmocka_unit_test(test_divergence_per_step_params),
   };
   return cmocka_run_group_tests_name("physics_dfsph", tests, NULL, NULL);
 }

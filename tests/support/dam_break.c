@@ -156,6 +156,8 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
     if (config->density_error > 0.0f) dfsph.density_error = config->density_error;
     if (config->density_error_max > 0.0f) dfsph.density_error_max = config->density_error_max;
     if (config->divergence_error > 0.0f) dfsph.divergence_error = config->divergence_error;
+    if (config->divergence_error_per_step > 0.0f)
+      dfsph.divergence_error_per_step = config->divergence_error_per_step;
     if (config->max_iterations > 0) dfsph.max_iterations = config->max_iterations;
     dfsph.flags = config->dfsph_flags;
     dfsph.linear_solver = config->dfsph_linear_solver;

@@ -49,6 +49,7 @@ typedef struct dam_break_config {
   float density_error;
   float density_error_max; /* the bound on the largest particle error (0: the library's default) */
   float divergence_error;
+  float divergence_error_per_step; /* the divergence bound's share a step (0: the library's default) */
   uint32_t max_iterations;
   uint32_t dfsph_flags;
   uint32_t dfsph_linear_solver; /* SPH_DFSPH_JACOBI, _CONJUGATE_GRADIENTS or _CHEBYSHEV (0: default) */

@@ -40,7 +40,8 @@ PHYSICS_PARAMS = {
                 "damping": "float"},
     "dfsph": {"density_error": "float", "divergence_error": "float", "max_iterations": "uint",
               "max_divergence_iterations": "uint", "flags": "uint", "linear_solver": "uint",
-              "density_error_max": "float", "depth_step_factor": "float"},
+              "density_error_max": "float", "depth_step_factor": "float",
+              "divergence_error_per_step": "float"},
     "density_diffusion": {"delta": "float"},
 }
 FEATURES = ["surface_tension", "normalized_density", "springs", "boundary_density", "collider_loads",

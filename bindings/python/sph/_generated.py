@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '310d6ed49afaa385f9c019e59e1764c114bffb5d124f2849b058b8e19abfa348', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '049851dce45cf1f29f56fb18c6c57627152277e87a49d65bf1e4a596e1366cde', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -1101,13 +1101,14 @@ class DfsphParams(_SphStruct):
     Fields:
         struct_size (uint32_t): set by sph_dfsph_params_init
         density_error (float): bound on the density solve's mean error, the mean over the particles of max(rho* - rho0, 0) / rho0 (rho*: the density the step would give); dimensionless; default 0.001 (0.1 %); in (0, 1]; 0 = default
-        divergence_error (float): bound on the divergence solve's mean of max(D rho / Dt, 0) / rho0, 1/s; default 1; > 0; 0 = default
+        divergence_error (float): bound on the divergence solve's mean of max(D rho / Dt, 0) / rho0, 1/s; default 1; > 0; 0 = default. The solve stops at the looser of this and divergence_error_per_step / dt
         max_iterations (uint32_t): cap of the density solve per substep; default 100; >= 2; 0 = default. A solve that stops here above its bound is counted in sph_stats and reported as an event
         max_divergence_iterations (uint32_t): cap of the divergence solve; default 100; >= 1; 0 = default
         flags (uint32_t): SPH_DFSPH_* bits; default 0
         linear_solver (uint32_t): how the density solve iterates: SPH_DFSPH_JACOBI (the default), SPH_DFSPH_CONJUGATE_GRADIENTS or SPH_DFSPH_CHEBYSHEV (the divergence solve is always Jacobi); 0 = default; any other value is INVALID_ARGUMENT. Chebyshev runs on the CPU and CUDA backends, not with SPH_DFSPH_CORRECTED_GRADIENT (INVALID_ARGUMENT). Conjugate gradients run on the CPU and CUDA backends, distributed worlds included; with SPH_FEATURE_BOUNDARY_DENSITY or SPH_FEATURE_COLLIDER_LOADS setting it (or loading a checkpoint with it) is UNSUPPORTED, the world unchanged
         density_error_max (float): (0.2.0) bound on the density solve's largest error, max(rho* - rho0, 0) / rho0 of any one particle: the density solve (Jacobi or conjugate gradients) iterates while this or the mean is above its bound (then the cap); default 0.05 (5 %); in (0, 1]; 0 = default; a value below density_error acts as density_error. Without it a small violent region of a large world (a splash at a wall) stays compressed by 50-100 %, as it barely moves the mean
         depth_step_factor (float): (0.2.0) f of the depth step limit dt <= f h / sqrt(|g| H), H the fluid's extent along gravity (its highest particle's height above its lowest), measured every substep: still water held by DFSPH blows apart above about 0.37 h / sqrt(|g| depth) (docs/physics.md, DFSPH, Limits); default 0.3; in (0, 1]; 0 = default. No limit without gravity or with SPH_DFSPH_NO_DEPTH_STEP_LIMIT; dt_min still wins
+        divergence_error_per_step (float): (0.2.0) the divergence solve's bound as a share of rho0 a step, the mean of max(D rho / Dt, 0) / rho0 times dt: the solve stops once its mean rate is below divergence_error or below this over dt, whichever is looser (at the defaults the rate governs steps above 1 ms, this share shorter ones, where a fixed rate alone made the divergence solve the costlier one: docs/physics.md, DFSPH); default 0.001 (0.1 %, as SPlisHSPlasH); in (0, 1]; 0 = default. A tiny value (1e-9) leaves the rate alone, a tiny divergence_error this alone
     """
     _fields_ = [
         ('struct_size', _c.c_uint32),
@@ -1119,10 +1120,11 @@ class DfsphParams(_SphStruct):
         ('linear_solver', _c.c_uint32),
         ('density_error_max', _c.c_float),
         ('depth_step_factor', _c.c_float),
+        ('divergence_error_per_step', _c.c_float),
     ]
     _sph_c_name_ = 'sph_dfsph_params'
-    _sph_size_ = 36
-    _sph_offsets_ = (('struct_size', 0), ('density_error', 4), ('divergence_error', 8), ('max_iterations', 12), ('max_divergence_iterations', 16), ('flags', 20), ('linear_solver', 24), ('density_error_max', 28), ('depth_step_factor', 32))
+    _sph_size_ = 40
+    _sph_offsets_ = (('struct_size', 0), ('density_error', 4), ('divergence_error', 8), ('max_iterations', 12), ('max_divergence_iterations', 16), ('flags', 20), ('linear_solver', 24), ('density_error_max', 28), ('depth_step_factor', 32), ('divergence_error_per_step', 36))
     _sph_init_ = 'sph_dfsph_params_init_sized'
 
 

@@ -200,8 +200,10 @@ class WorldOptionsMixin:
     def dfsph_params(self):
         """DfsphParams of a world created with solver=Solver.DFSPH (sph_world_get_dfsph_params):
         density_error (the bound on the density solve's mean (rho* - rho0)+ / rho0, default
-        0.001), divergence_error (1/s, default 1), max_iterations, max_divergence_iterations and
-        flags (SPH_DFSPH_SKIP_DIVERGENCE_SOLVE). Assign a DfsphParams (or a dict of its fields)
+        0.001), divergence_error (1/s, default 1) and divergence_error_per_step (the same bound as a
+        share a step, default 0.001: the divergence solve stops at the looser of the two),
+        max_iterations, max_divergence_iterations, flags (SPH_DFSPH_*), linear_solver,
+        density_error_max and depth_step_factor (every field: include/sph_c.h). Assign a DfsphParams (or a dict of its fields)
         to replace them (sph_world_set_dfsph_params; validated, unchanged on error). Raises
         SphError(ERROR_FEATURE_DISABLED) on a weakly compressible world."""
         p = _g.DfsphParams()

@@ -303,6 +303,7 @@ def test_dfsph_world_has_its_params_and_refuses_what_it_does_not_support(ctx):
         assert (p.density_error, p.divergence_error, p.max_iterations, p.max_divergence_iterations, p.flags) == (
             pytest.approx(0.001), 1.0, 100, 100, 0)
         assert p.density_error_max == pytest.approx(0.05)
+        assert p.divergence_error_per_step == pytest.approx(0.001)
         e = error(w.set_dfsph_params, density_error_max=1.5)
         assert "params->density_error_max" in e.message and w.dfsph_params.density_error_max == pytest.approx(0.05)
         w.set_dfsph_params(density_error=1e-4, flags=sph.raw.SPH_DFSPH_SKIP_DIVERGENCE_SOLVE)
