@@ -1245,10 +1245,10 @@ namespace Sph
         /// float divergence_error_per_step: (0.2.0) the divergence solve's bound as a share of rho0 a
         /// step, the mean of max(D rho / Dt, 0) / rho0 times dt: the solve stops once its mean rate is
         /// below divergence_error or below this over dt, whichever is looser (at the defaults the rate
-        /// governs steps above 1 ms, this share shorter ones, where a fixed rate alone made the
-        /// divergence solve the costlier one: docs/physics.md, DFSPH); default 0.001 (0.1 %, as
-        /// SPlisHSPlasH); in (0, 1]; 0 = default. A tiny value (1e-9) leaves the rate alone, a tiny
-        /// divergence_error this alone
+        /// governs steps above 1 ms, which only a dt_max raised above its default 1 ms allows; this
+        /// share shorter ones, where a fixed rate alone made the divergence solve the costlier one:
+        /// docs/physics.md, DFSPH); default 0.001 (0.1 %, as SPlisHSPlasH); in (0, 1]; 0 = default. A
+        /// tiny value (1e-9) leaves the rate alone, a tiny divergence_error this alone
         /// </summary>
         public float DivergenceErrorPerStep;
 

@@ -89,7 +89,8 @@ struct Dfsph {
     // looser of the two. A fixed rate alone grows stricter as the step shrinks (0.01 % a step at the
     // million-particle dam break's 0.1 ms), and the divergence solve then spent more passes than the
     // density solve (docs/validation.md, "Session 30: the divergence bound is a fixed rate");
-    // SPlisHSPlasH bounds it at 0.1 % a step. At the defaults the rate governs steps above 1 ms.
+    // SPlisHSPlasH bounds it at 0.1 % a step. At the defaults the rate governs steps above 1 ms
+    // (possible only with dt_max raised above its default, 1 ms).
     float divergence_error_per_step = 0.001f;
     uint32_t max_iterations = 100;  // of the density solve, per substep
     uint32_t max_divergence_iterations = 100;

@@ -17,9 +17,12 @@
 #define SPH_UNROLL(n)
 #endif
 
+namespace sph {
+
 // a / b rounded as IEEE 754 divides, on the host and on the device whatever the file's nvcc flags
 // (-prec-div=false makes `/` approximate): for a value that a host-driven loop and a device kernel
-// must compute to the same bits (a solve's stopping bound, physics/dfsph.h).
+// must compute to the same bits (a solve's stopping bound, physics/dfsph.h). Normal operands and
+// quotients only: under -ftz=true the device flushes subnormal ones to zero, the host does not.
 SPH_HD float ieee_divide(float a, float b) {
 #if defined(__CUDA_ARCH__)
   return __fdiv_rn(a, b);
@@ -27,3 +30,5 @@ SPH_HD float ieee_divide(float a, float b) {
   return a / b;
 #endif
 }
+
+}  // namespace sph

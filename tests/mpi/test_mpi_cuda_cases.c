@@ -51,7 +51,8 @@ void mpi_cuda_dfsph_case(const char* name, sph_context* cuda, sph_context* cpu, 
   REQUIRE(sph_dfsph_params_init(&dfsph) == SPH_OK, "dfsph params init");
   if (!divergence_solve) dfsph.flags |= SPH_DFSPH_SKIP_DIVERGENCE_SOLVE;
   dfsph.density_error = 1e-5f;
-  dfsph.divergence_error = 0.1f;
+  dfsph.divergence_error = 1e-6f;          /* the share below governs: */
+  dfsph.divergence_error_per_step = 1e-4f; /* 0.1/s at 1 ms, through the division each backend does */
   if (cap > 0) {
     /* A bound no solve reaches in `cap` iterations: each substep's density solve stops at its cap. */
     dfsph.density_error = 1e-8f;
@@ -337,7 +338,8 @@ void mpi_cuda_rank_solver_case(const char* name, sph_context* cuda, uint32_t lin
   REQUIRE(sph_dfsph_params_init(&dfsph) == SPH_OK, "dfsph params init");
   dfsph.linear_solver = linear_solver;
   dfsph.density_error = 1e-5f;
-  dfsph.divergence_error = 0.1f;
+  dfsph.divergence_error = 1e-6f;          /* the share below governs: */
+  dfsph.divergence_error_per_step = 1e-4f; /* 0.1/s at 1 ms, through the division each backend does */
   if (cap > 0) {
     dfsph.density_error = 1e-8f;
     dfsph.max_iterations = cap;

@@ -17,8 +17,9 @@
  *   it takes dt_max, and dt_min wins over it; a world loaded or restored from a checkpoint takes
  *   the same limited steps and trajectory bit for bit (H is measured, not stored); bad factors
  * (INVALID_ARGUMENT) and unknown flag bits (UNSUPPORTED) are refused with the world unchanged;
- * - the divergence bound as a share a step (divergence_error_per_step): at a fixed step it is the
- *   rate share / dt, bit for bit; a looser share takes fewer iterations; its range is checked. */
+ * - the divergence bound as a share a step (divergence_error_per_step): over substeps of two
+ *   lengths it is the rate share / dt of each substep, bit for bit; a looser share takes fewer
+ *   iterations; its range is checked. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -361,37 +362,41 @@ static void test_depth_step_params_refused(void** state) {
 }
 
 /* The divergence bound as a share of rho0 a step (sph_dfsph_params.divergence_error_per_step): the
- * falling ball of the checkpoint tests at a fixed step (dt_min = dt_max = frame = 1 ms: one
- * substep a frame, dt known exactly), `frames` frames with the divergence solve's rate bound
- * `rate` and share `per_step`. Checks each frame's solve against the looser of the two bounds
- * (the library's rule) unless capped, and returns the divergence iterations and the particles'
- * positions and velocities (malloc'ed, 6 floats a particle). */
-static const float kFixedDt = 0.001f;
+ * falling ball of the checkpoint tests, its frames alternating between 1 ms and 0.25 ms (dt_max
+ * 1 ms: one substep a frame, whose dt is the frame's length), `frames` frames. The world's divergence
+ * solve is bounded by the share `share` alone (a rate of 1e-6 1/s, far stricter, so the looser share
+ * governs) or, with `as_rate`, by the rate share / dt set before each frame alone (a share of 1e-9).
+ * Checks each frame's solve against share / dt unless capped, and returns the divergence
+ * iterations and the particles' positions and velocities (malloc'ed, 6 floats a particle). */
+static const float kFrames[2] = {0.001f, 0.00025f};
 
-static uint64_t run_fixed_step(float rate, float per_step, int frames, float** state_out, uint32_t* n_out) {
+static uint64_t run_alternating_steps(float share, int as_rate, int frames, float** state_out,
+                                      uint32_t* n_out) {
   scene s;
   sph_world_params params;
   sph_dfsph_params dp;
   sph_stats st;
   uint64_t iterations = 0;
   uint32_t n = 0;
-  const float share_rate = per_step / kFixedDt;
-  const float bound = share_rate > rate ? share_rate : rate;
   open_dfsph_tank(&s, 0u, -9.81f);
   sph_world_params_init(&params);
   SCENE_OK(sph_world_get_params(s.world, &params));
-  params.dt_min = params.dt_max = kFixedDt;
+  params.dt_max = kFrames[0];
   SCENE_OK(sph_world_set_params(s.world, &params));
   sph_dfsph_params_init(&dp);
-  dp.divergence_error = rate;
-  dp.divergence_error_per_step = per_step;
-  SCENE_OK(sph_world_set_dfsph_params(s.world, &dp));
+  dp.divergence_error = 1e-6f;
+  dp.divergence_error_per_step = as_rate ? 1e-9f : share;
   for (int f = 0; f < frames; ++f) {
-    SCENE_OK(sph_world_step(s.world, kFixedDt));
+    const float frame = kFrames[f % 2], bound = share / frame;
+    if (as_rate || f == 0) {
+      if (as_rate) dp.divergence_error = bound;
+      SCENE_OK(sph_world_set_dfsph_params(s.world, &dp));
+    }
+    SCENE_OK(sph_world_step(s.world, frame));
     sph_stats_init(&st);
     SCENE_OK(sph_world_get_stats(s.world, &st));
     assert_int_equal(st.substeps, 1);
-    assert_true(st.dt_min == kFixedDt);
+    assert_true(st.dt_min == frame);
     if (st.divergence_solves_capped == 0) assert_true(st.divergence_error_max <= bound);
     iterations += st.divergence_iterations;
   }
@@ -405,25 +410,26 @@ static uint64_t run_fixed_step(float rate, float per_step, int frames, float** s
   return iterations;
 }
 
-/* - A share S at a fixed step dt is the rate S / dt: the world bounded by the share alone (a rate
- *   of 1e-6 1/s, far stricter, so the looser share governs) steps bit for bit as the world bounded
- *   by the rate S / dt alone (a share of 1e-9) - the same bound, float for float (IEEE division
- *   on both backends, physics/dfsph.h);
+/* - A share S is the rate S / dt of each substep's own dt: the world bounded by the share alone
+ *   steps bit for bit as the world whose rate is set to S / dt before each frame (IEEE division on
+ *   both backends, physics/dfsph.h). The frames alternate between two lengths, so a bound taken
+ *   from another substep's dt (the last one's, 4 times longer or shorter) would stop some solve at
+ *   another iteration and move the particles;
  * - the share is used: a looser share (10x) takes fewer divergence iterations, and the strict one
  *   more than the solve's minimum (one a substep), so the bound is what stops it. */
 static void test_divergence_bound_per_step(void** state) {
-  const int frames = 40;       /* the ball lands after about 20 */
-  const float share = 0.0001f; /* 0.1 / s at 1 ms */
+  const int frames = 80;       /* 50 ms: the ball lands after about 20 */
+  const float share = 0.00002f; /* 0.02 / s at 1 ms, 0.08 / s at 0.25 ms */
   float *by_share = NULL, *by_rate = NULL, *loose = NULL;
   uint32_t n_share = 0, n_rate = 0, n_loose = 0;
   uint64_t it_share, it_rate, it_loose;
   (void)state;
-  it_share = run_fixed_step(1e-6f, share, frames, &by_share, &n_share);
-  it_rate = run_fixed_step(share / kFixedDt, 1e-9f, frames, &by_rate, &n_rate);
-  it_loose = run_fixed_step(1e-6f, 10.0f * share, frames, &loose, &n_loose);
-  printf("divergence iterations over %d substeps: share %g %llu, rate %g/s %llu, share %g %llu\n", frames,
-         (double)share, (unsigned long long)it_share, (double)(share / kFixedDt), (unsigned long long)it_rate,
-         (double)(10.0f * share), (unsigned long long)it_loose);
+  it_share = run_alternating_steps(share, 0, frames, &by_share, &n_share);
+  it_rate = run_alternating_steps(share, 1, frames, &by_rate, &n_rate);
+  it_loose = run_alternating_steps(10.0f * share, 0, frames, &loose, &n_loose);
+  printf("divergence iterations over %d substeps: share %g %llu, its rate %llu, share %g %llu\n", frames,
+         (double)share, (unsigned long long)it_share, (unsigned long long)it_rate, (double)(10.0f * share),
+         (unsigned long long)it_loose);
   assert_int_equal(n_share, n_rate);
   assert_int_equal(it_share, it_rate);
   assert_memory_equal(by_share, by_rate, 24 * (size_t)n_share);
