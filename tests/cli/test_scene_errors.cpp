@@ -262,6 +262,36 @@ void test_physics_section_sets_the_methods(void**) {
   assert_int_equal(sph_context_destroy(context), SPH_OK);
 }
 
+// The solver and DFSPH's parameters (sph_dfsph_params, the divergence bound a step among them) by
+// the scene file (tests/cli/scenes/dfsph_options.json); the fields it leaves out keep their defaults.
+void test_dfsph_section_sets_the_solver(void**) {
+  sph_context_def def;
+  sph_context_def_init(&def);
+  def.backend = SPH_BACKEND_CPU;
+  def.cpu_worker_count = 1;
+  sph_context* context = nullptr;
+  assert_int_equal(sph_context_create(&def, &context), SPH_OK);
+  {
+    const sph_tools::SceneDesc scene = sph_tools::load_scene_file(CLI_SCENES_DIR "/dfsph_options.json");
+    sph_tools::SceneRuntime runtime(scene, context);
+    sph_world* w = runtime.world();
+    sph_world_def d;
+    sph_world_def_init(&d);
+    assert_int_equal(sph_world_get_def(w, &d), SPH_OK);
+    assert_int_equal(d.solver, SPH_SOLVER_DFSPH);
+    sph_dfsph_params dp;
+    sph_dfsph_params_init(&dp);
+    assert_int_equal(sph_world_get_dfsph_params(w, &dp), SPH_OK);
+    assert_true(dp.density_error == 0.002f && dp.divergence_error == 0.5f &&
+                dp.divergence_error_per_step == 0.0005f && dp.linear_solver == SPH_DFSPH_CHEBYSHEV &&
+                dp.depth_step_factor == 0.25f);
+    assert_true(dp.max_iterations == 100u && dp.max_divergence_iterations == 100u && dp.flags == 0u &&
+                dp.density_error_max == 0.05f);  // the defaults
+    assert_int_equal(runtime.step_frame(), SPH_OK);
+  }
+  assert_int_equal(sph_context_destroy(context), SPH_OK);
+}
+
 void test_missing_file_is_a_scene_error(void**) {
   std::string what;
   try {
@@ -279,6 +309,7 @@ int main() {
       cmocka_unit_test(test_each_bad_field_names_its_path),
       cmocka_unit_test(test_library_rejections_name_the_object),
       cmocka_unit_test(test_physics_section_sets_the_methods),
+      cmocka_unit_test(test_dfsph_section_sets_the_solver),
       cmocka_unit_test(test_missing_file_is_a_scene_error),
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);
