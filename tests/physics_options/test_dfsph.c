@@ -418,7 +418,7 @@ static uint64_t run_alternating_steps(float share, int as_rate, int frames, floa
  * - the share is used: a looser share (10x) takes fewer divergence iterations, and the strict one
  *   more than the solve's minimum (one a substep), so the bound is what stops it. */
 static void test_divergence_bound_per_step(void** state) {
-  const int frames = 80;       /* 50 ms: the ball lands after about 20 */
+  const int frames = 80;        /* 50 ms: the ball lands after about 20 */
   const float share = 0.00002f; /* 0.02 / s at 1 ms, 0.08 / s at 0.25 ms */
   float *by_share = NULL, *by_rate = NULL, *loose = NULL;
   uint32_t n_share = 0, n_rate = 0, n_loose = 0;
