@@ -41,17 +41,15 @@ void enqueue_dfsph_jacobi_rank_solve(const FluidConstants& fluid, const GridView
                                      uint32_t max_iterations, DfsphRankSteps& rank, FrameState* state,
                                      cudaStream_t stream) {
   const unsigned threads = kDfsphSolveBlock, blocks = blocks_for(n, threads);
-  const Dfsph::Constants& c = fluid.methods.dfsph;
-  DfsphBounds bounds = dfsph_density_bounds(c);
+  // The divergence bound depends on the substep's dt, which the device chose (the same on every
+  // rank); the host reads it once a divergence solve (each iteration waits on the device anyway).
+  float dt = 0.0f;
   if (divergence) {
-    // The divergence bound depends on the substep's dt, which the device chose (the same on every
-    // rank); the host reads it once a solve (each iteration waits on the device anyway).
-    float dt = 0.0f;
     cuda_check(cudaMemcpyAsync(&dt, &state->clock.dt_float, sizeof dt, cudaMemcpyDeviceToHost, stream),
                "DFSPH rank solve: dt download");
     cuda_check(cudaStreamSynchronize(stream), "DFSPH rank solve: dt download");
-    bounds = dfsph_divergence_bounds(c, dt);
   }
+  const DfsphBounds bounds = dfsph_solve_bounds(fluid.methods.dfsph, divergence, dt);
   struct Passes {
     const FluidConstants& fluid;
     const GridView& grid;

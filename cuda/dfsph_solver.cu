@@ -145,8 +145,7 @@ __global__ void __launch_bounds__(kDfsphCheckBlock)
                        LoopCondition cond, FrameState* state) {
   if (state->solve_run == 0) return;
   // (Here, not on the host: the divergence bound depends on the substep's dt, chosen on the device.)
-  const DfsphBounds bounds =
-      divergence ? dfsph_divergence_bounds(c, state->clock.dt_float) : dfsph_density_bounds(c);
+  const DfsphBounds bounds = dfsph_solve_bounds(c, divergence, state->clock.dt_float);
   const double sum = dfsph_sum_partials(partials, blocks);
   if (threadIdx.x != 0) return;
   state->solve_iterations = first ? 0u : state->solve_iterations + 1u;

@@ -136,7 +136,7 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
   if (c.linear_solver == kDfsphConjugateGradients && kind == DfsphSolve::Density)
     return dfsph_solve_cg(fluid, walls, dt, v, carried);
   const bool divergence = kind == DfsphSolve::Divergence;
-  const DfsphBounds bounds = divergence ? dfsph_divergence_bounds(c, dt) : dfsph_density_bounds(c);
+  const DfsphBounds bounds = dfsph_solve_bounds(c, divergence, dt);
   const uint32_t min_iterations = divergence ? Dfsph::kMinDivergenceIterations : Dfsph::kMinIterations;
   const uint32_t max_iterations = divergence ? c.max_divergence_iterations : c.max_iterations;
   // The warm start: half the last substep's pressure, applied once; the solve's own

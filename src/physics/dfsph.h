@@ -221,5 +221,9 @@ SPH_HD DfsphBounds dfsph_divergence_bounds(const Dfsph::Constants& c, float dt) 
   const float per_step = ieee_divide(c.divergence_error_per_step, dt);
   return {per_step > c.divergence_error ? per_step : c.divergence_error, kDfsphNoBound};
 }
+// The bounds of the divergence solve (divergence) or of the density solve (which does not read dt).
+SPH_HD DfsphBounds dfsph_solve_bounds(const Dfsph::Constants& c, bool divergence, float dt) {
+  return divergence ? dfsph_divergence_bounds(c, dt) : dfsph_density_bounds(c);
+}
 
 }  // namespace sph
