@@ -21,6 +21,7 @@
  *   lengths it is the rate share / dt of each substep, bit for bit; a looser share takes fewer
  *   iterations; its range is checked. */
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -326,23 +327,47 @@ static void test_depth_step_after_checkpoint(void** state) {
   scene_close(&s);
 }
 
+/* A float field of sph_dfsph_params at `offset` whose range is (0, 1] with 0 the default
+ * `fallback`: `value` is accepted; -0.1, 1.5, NaN and the infinities are INVALID_ARGUMENT naming
+ * the field, the world's parameters unchanged; 0 takes the default; 1, the largest, is accepted. */
+static float* dfsph_field(sph_dfsph_params* p, size_t offset) { return (float*)((char*)p + offset); }
+
+static void expect_unit_range_field(sph_world* world, size_t offset, const char* name, float value,
+                                    float fallback) {
+  sph_dfsph_params dp, now;
+  const float bad[] = {-0.1f, 1.5f, NAN, INFINITY, -INFINITY};
+  sph_dfsph_params_init(&dp);
+  *dfsph_field(&dp, offset) = value;
+  SCENE_OK(sph_world_set_dfsph_params(world, &dp));
+  for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
+    sph_dfsph_params_init(&dp);
+    *dfsph_field(&dp, offset) = bad[k];
+    assert_int_equal(sph_world_set_dfsph_params(world, &dp), SPH_ERROR_INVALID_ARGUMENT);
+    assert_non_null(strstr(sph_get_last_error(), name));
+  }
+  sph_dfsph_params_init(&now);
+  SCENE_OK(sph_world_get_dfsph_params(world, &now));
+  assert_true(*dfsph_field(&now, offset) == value); /* unchanged */
+  sph_dfsph_params_init(&dp);
+  *dfsph_field(&dp, offset) = 0.0f;
+  SCENE_OK(sph_world_set_dfsph_params(world, &dp));
+  SCENE_OK(sph_world_get_dfsph_params(world, &now));
+  assert_true(*dfsph_field(&now, offset) == fallback);
+  *dfsph_field(&dp, offset) = 1.0f;
+  SCENE_OK(sph_world_set_dfsph_params(world, &dp));
+}
+
 static void test_depth_step_params_refused(void** state) {
   scene s;
   sph_dfsph_params dp, now;
   const sph_vec3 g = {0.0f, -9.81f, 0.0f};
-  const float bad[] = {-0.1f, 1.5f, NAN, INFINITY, -INFINITY};
   (void)state;
   open_column(&s, g, 0.05f, 1u, 0u);
+  expect_unit_range_field(s.world, offsetof(sph_dfsph_params, depth_step_factor), "depth_step_factor", 0.2f,
+                          0.3f);
   sph_dfsph_params_init(&dp);
   dp.depth_step_factor = 0.2f;
   SCENE_OK(sph_world_set_dfsph_params(s.world, &dp));
-  for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
-    sph_dfsph_params_init(&dp);
-    dp.depth_step_factor = bad[k];
-    assert_int_equal(sph_world_set_dfsph_params(s.world, &dp), SPH_ERROR_INVALID_ARGUMENT);
-    assert_non_null(strstr(sph_get_last_error(), "depth_step_factor"));
-  }
-  sph_dfsph_params_init(&dp);
   dp.flags = 0x8u; /* an unknown bit: UNSUPPORTED, as every bit set's unknown bits (param_table.h) */
   assert_int_equal(sph_world_set_dfsph_params(s.world, &dp), SPH_ERROR_UNSUPPORTED);
   assert_non_null(strstr(sph_get_last_error(), "flags"));
@@ -350,14 +375,6 @@ static void test_depth_step_params_refused(void** state) {
   SCENE_OK(sph_world_get_dfsph_params(s.world, &now));
   assert_true(now.depth_step_factor == 0.2f); /* unchanged */
   assert_int_equal(now.flags, 0u);
-  /* 0 is the default; 1 the largest accepted. */
-  sph_dfsph_params_init(&dp);
-  dp.depth_step_factor = 0.0f;
-  SCENE_OK(sph_world_set_dfsph_params(s.world, &dp));
-  SCENE_OK(sph_world_get_dfsph_params(s.world, &now));
-  assert_true(now.depth_step_factor == 0.3f);
-  dp.depth_step_factor = 1.0f;
-  SCENE_OK(sph_world_set_dfsph_params(s.world, &dp));
   scene_close(&s);
 }
 
@@ -444,30 +461,13 @@ static void test_divergence_bound_per_step(void** state) {
  * INVALID_ARGUMENT naming the field, the world's parameters unchanged. */
 static void test_divergence_per_step_params(void** state) {
   scene s;
-  sph_dfsph_params dp, now;
-  const float bad[] = {-0.1f, 1.5f, NAN, INFINITY, -INFINITY};
+  sph_dfsph_params dp;
   (void)state;
   open_column(&s, (sph_vec3){0.0f, -9.81f, 0.0f}, 0.05f, 1u, 0u);
   sph_dfsph_params_init(&dp);
   assert_true(dp.divergence_error_per_step == 0.001f); /* the default */
-  dp.divergence_error_per_step = 0.002f;
-  SCENE_OK(sph_world_set_dfsph_params(s.world, &dp));
-  for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
-    sph_dfsph_params_init(&dp);
-    dp.divergence_error_per_step = bad[k];
-    assert_int_equal(sph_world_set_dfsph_params(s.world, &dp), SPH_ERROR_INVALID_ARGUMENT);
-    assert_non_null(strstr(sph_get_last_error(), "divergence_error_per_step"));
-  }
-  sph_dfsph_params_init(&now);
-  SCENE_OK(sph_world_get_dfsph_params(s.world, &now));
-  assert_true(now.divergence_error_per_step == 0.002f); /* unchanged */
-  sph_dfsph_params_init(&dp);
-  dp.divergence_error_per_step = 0.0f;
-  SCENE_OK(sph_world_set_dfsph_params(s.world, &dp));
-  SCENE_OK(sph_world_get_dfsph_params(s.world, &now));
-  assert_true(now.divergence_error_per_step == 0.001f);
-  dp.divergence_error_per_step = 1.0f;
-  SCENE_OK(sph_world_set_dfsph_params(s.world, &dp));
+  expect_unit_range_field(s.world, offsetof(sph_dfsph_params, divergence_error_per_step),
+                          "divergence_error_per_step", 0.002f, 0.001f);
   SCENE_OK(sph_world_step(s.world, 0.01f));
   scene_close(&s);
 }
