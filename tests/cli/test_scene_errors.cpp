@@ -155,14 +155,33 @@ void test_each_bad_field_names_its_path(void**) {
   assert_int_equal(failures, 0);
 }
 
-// Errors found while building the world carry the path of the object the library refused.
-void expect_build_error(const char* json, const char* message) {
+// A CPU context with one worker, for the scenes' worlds.
+sph_context* one_worker_context() {
   sph_context_def def;
   sph_context_def_init(&def);
   def.backend = SPH_BACKEND_CPU;
   def.cpu_worker_count = 1;
   sph_context* context = nullptr;
   assert_int_equal(sph_context_create(&def, &context), SPH_OK);
+  return context;
+}
+
+// Builds the world of tests/cli/scenes/`file`, hands it to check, then steps one frame.
+template <class Check>
+void check_scene_world(const char* file, Check check) {
+  sph_context* context = one_worker_context();
+  {
+    const sph_tools::SceneDesc scene = sph_tools::load_scene_file(std::string(CLI_SCENES_DIR "/") + file);
+    sph_tools::SceneRuntime runtime(scene, context);
+    check(runtime.world());
+    assert_int_equal(runtime.step_frame(), SPH_OK);
+  }
+  assert_int_equal(sph_context_destroy(context), SPH_OK);
+}
+
+// Errors found while building the world carry the path of the object the library refused.
+void expect_build_error(const char* json, const char* message) {
+  sph_context* context = one_worker_context();
   std::string what = "(no error)";
   try {
     const sph_tools::SceneDesc scene = sph_tools::parse_scene(json, ".");
@@ -219,16 +238,7 @@ void test_library_rejections_name_the_object(void**) {
 // The physics section sets the methods' parameters by the C structs' field names; the fields
 // the file leaves out keep their defaults (tests/cli/scenes/options.json).
 void test_physics_section_sets_the_methods(void**) {
-  sph_context_def def;
-  sph_context_def_init(&def);
-  def.backend = SPH_BACKEND_CPU;
-  def.cpu_worker_count = 1;
-  sph_context* context = nullptr;
-  assert_int_equal(sph_context_create(&def, &context), SPH_OK);
-  {
-    const sph_tools::SceneDesc scene = sph_tools::load_scene_file(CLI_SCENES_DIR "/options.json");
-    sph_tools::SceneRuntime runtime(scene, context);
-    sph_world* w = runtime.world();
+  check_scene_world("options.json", [](sph_world* w) {
     sph_world_def d;
     sph_world_def_init(&d);
     assert_int_equal(sph_world_get_def(w, &d), SPH_OK);
@@ -257,24 +267,13 @@ void test_physics_section_sets_the_methods(void**) {
     assert_int_equal(sph_world_get_spring_params(w, &sp), SPH_OK);
     assert_true(sp.stiffness == 2000.0f && sp.yield_ratio == 0.2f && sp.plasticity == 1.5f &&
                 sp.damping == 3.0f && sp.link_radius == 0.0f);
-    assert_int_equal(runtime.step_frame(), SPH_OK);
-  }
-  assert_int_equal(sph_context_destroy(context), SPH_OK);
+  });
 }
 
 // The solver and DFSPH's parameters (sph_dfsph_params, the divergence bound a step among them) by
 // the scene file (tests/cli/scenes/dfsph_options.json); the fields it leaves out keep their defaults.
 void test_dfsph_section_sets_the_solver(void**) {
-  sph_context_def def;
-  sph_context_def_init(&def);
-  def.backend = SPH_BACKEND_CPU;
-  def.cpu_worker_count = 1;
-  sph_context* context = nullptr;
-  assert_int_equal(sph_context_create(&def, &context), SPH_OK);
-  {
-    const sph_tools::SceneDesc scene = sph_tools::load_scene_file(CLI_SCENES_DIR "/dfsph_options.json");
-    sph_tools::SceneRuntime runtime(scene, context);
-    sph_world* w = runtime.world();
+  check_scene_world("dfsph_options.json", [](sph_world* w) {
     sph_world_def d;
     sph_world_def_init(&d);
     assert_int_equal(sph_world_get_def(w, &d), SPH_OK);
@@ -287,9 +286,7 @@ void test_dfsph_section_sets_the_solver(void**) {
                 dp.depth_step_factor == 0.25f);
     assert_true(dp.max_iterations == 100u && dp.max_divergence_iterations == 100u && dp.flags == 0u &&
                 dp.density_error_max == 0.05f);  // the defaults
-    assert_int_equal(runtime.step_frame(), SPH_OK);
-  }
-  assert_int_equal(sph_context_destroy(context), SPH_OK);
+  });
 }
 
 void test_missing_file_is_a_scene_error(void**) {
