@@ -4,9 +4,11 @@
  * of the column's free-fall speed sqrt(2 g 2a) = 1.50 m/s) and DFSPH at several density error
  * bounds, at each resolution asked for, on the chosen backend. Per run: wall seconds per
  * simulated second, substeps, neighbour passes, the mean and largest compression (density
- * error) of the particles above rest density, the front's mean error against the measurements
- * (one fitted shift, as the validation), and DFSPH's solve iterations, capped solves and the largest
- * error of one particle a density solve ended with ("solve lg", sph_stats.density_error_largest).
+ * error) of the particles above rest density and the mean over every particle of the compression
+ * (max(rho/rho0 - 1, 0): the measure DFSPH's bound sets, "over every particle" below the row and
+ * mean_density_error_all in the CSV, with the share above rest), the front's mean error against the
+ * measurements (one fitted shift, as the validation), and DFSPH's solve iterations, capped solves and the
+ * largest error of one particle a density solve ended with ("solve lg", sph_stats.density_error_largest).
  *
  *   solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1]
  *                [--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg|chebyshev]
@@ -238,7 +240,7 @@ int main(int argc, char** argv) {
       "neighbor_passes,pressure_iterations,divergence_iterations,density_error_mean,density_error_max,"
       "solve_error_max,front_shift_T,front_error_mean,front_error_max,status,ms_per_substep,neighbors_mean,"
       "ms_hash_sort,ms_cell_ranges,ms_density,ms_forces,ms_integrate,ms_collide,ms_emit,ms_other,"
-      "solve_error_largest\n");
+      "solve_error_largest,mean_density_error_all,above_share,solve_error_mean\n");
   printf(
       "%s backend; dam break of Martin & Moyce for %.2f simulated s; front errors over T in [%.1f, %.1f]\n",
       resolved == SPH_BACKEND_CUDA ? "CUDA" : "CPU", seconds, DAM_BREAK_T_FIRST, DAM_BREAK_T_LAST);
@@ -292,7 +294,8 @@ int main(int argc, char** argv) {
           result->mean_error, result->max_error, substep_ms, result->neighbors_mean);
       for (int k = 0; k < SPH_STAGE_COUNT; ++k)
         fprintf(csv, ",%.5f", result->substeps ? result->stage_ms[k] / (double)result->substeps : 0.0);
-      fprintf(csv, ",%.6f\n", result->density_error_largest);
+      fprintf(csv, ",%.6f,%.6f,%.4f,%.6f\n", result->density_error_largest, result->mean_density_error,
+              result->above_share, result->density_error_mean);
       fflush(csv);
       printf(
           "%-6s %-9g %6u %9u %10.2f %9llu %10.0f %7.2f%% %7.2f%% %7.2f%% %8.2f %8.2f %6u %9.4f %6.1f "
@@ -303,6 +306,11 @@ int main(int argc, char** argv) {
           dfsph ? (double)result->pressure_iterations / (double)result->substeps : 0.0,
           dfsph ? (double)result->divergence_iterations / (double)result->substeps : 0.0,
           result->capped_substeps, substep_ms, result->neighbors_mean, 100.0 * result->density_error_largest);
+      printf(
+          "       over every particle: mean density error %.4f%% (%.1f%% of them above rest); the density "
+          "solves' mean error %.4f%%\n",
+          100.0 * result->mean_density_error, 100.0 * result->above_share,
+          100.0 * result->density_error_mean);
       printf("       stages, ms/substep:");
       for (int k = 0; k < SPH_STAGE_COUNT; ++k)
         printf(" %.4f", result->substeps ? result->stage_ms[k] / (double)result->substeps : 0.0);

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: MIT
-"""Plots bench/solver_front's CSV: the front's mean error and the mean compression against wall
+"""Plots bench/solver_front's CSV: the front's mean error and the mean density error against wall
 seconds per simulated second, one marker per solver and parameter, one point per resolution.
 
     solver_front_plot.py solver_front.csv [solver_front.png]
@@ -21,6 +21,13 @@ def main():
     rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["status"] == "ok"]
     out = sys.argv[2] if len(sys.argv) > 2 else sys.argv[1].rsplit(".", 1)[0] + ".png"
     fig, (front, density) = plt.subplots(1, 2, figsize=(11, 4.5))
+    # The mean density error over every particle (DFSPH's bound's measure) where the CSV has it
+    # (session 32 on); older CSVs have only the mean over the particles above rest density.
+    everyone = bool(rows) and all(r.get("mean_density_error_all") for r in rows)
+    density_column = "mean_density_error_all" if everyone else "density_error_mean"
+    density_title = (
+        "mean density error over every particle, %" if everyone else "mean compression of those above rest, %"
+    )
     series = {}
     for r in rows:
         label = ("WCSPH c = %s u_ff" if r["solver"] == "wcsph" else "DFSPH bound %s") % r["parameter"]
@@ -30,8 +37,8 @@ def main():
         cost = [float(r["wall_s_per_simulated_s"]) for r in rs]
         marker = "o" if rs[0]["solver"] == "wcsph" else "s"
         front.plot(cost, [100 * float(r["front_error_mean"]) for r in rs], marker=marker, label=label)
-        density.plot(cost, [100 * float(r["density_error_mean"]) for r in rs], marker=marker, label=label)
-    for ax, title in ((front, "front mean error, %"), (density, "mean compression, %")):
+        density.plot(cost, [100 * float(r[density_column]) for r in rs], marker=marker, label=label)
+    for ax, title in ((front, "front mean error, %"), (density, density_title)):
         ax.set_xscale("log")
         ax.set_xlabel("wall s per simulated s (%s)" % (rows[0]["backend"] if rows else "?"))
         ax.set_ylabel(title)

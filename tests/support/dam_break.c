@@ -113,6 +113,8 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
   float* scratch = NULL;
   uint32_t n = 0;
   double compression_sum = 0.0;
+  double density_error_sum = 0.0;
+  double above_share_sum = 0.0;
   sph_result r;
 
   memset(result, 0, sizeof *result);
@@ -228,6 +230,8 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
             ++above;
           }
         compression_sum += above ? sum / above : 0.0;
+        density_error_sum += count ? sum / count : 0.0;
+        above_share_sum += count ? (double)above / count : 0.0;
         if (config->frame_log) log_frame(config->frame_log, result, &stats, positions, density, count, a);
       }
       result->T[result->samples] = result->simulated_seconds * scale;
@@ -245,6 +249,8 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
       }
     }
     result->mean_compression = frames ? compression_sum / frames : 0.0;
+    result->mean_density_error = frames ? density_error_sum / frames : 0.0;
+    result->above_share = frames ? above_share_sum / frames : 0.0;
     if (result->substeps > 0) result->density_error_mean /= (double)result->substeps;
     if (result->substeps > 0) result->neighbors_mean /= (double)result->substeps;
   }

@@ -75,6 +75,11 @@ typedef struct dam_break_result {
   double mean_compression; /* mean over samples of the mean (rho/rho0 - 1) of the
                               particles above rest density */
   double max_compression;  /* the largest density_max / rho0 - 1 seen */
+  /* mean over samples of the mean over every particle of max(rho/rho0 - 1, 0): the measure of
+     DFSPH's bound (sph_dfsph_params.density_error, Bender & Koschier's average density error),
+     which mean_compression exceeds by the share of particles below rest density */
+  double mean_density_error;
+  double above_share; /* mean over samples of the share of particles above rest density */
   /* The comparison with the measurements over T in [T_FIRST, T_LAST]: */
   double shift_T;              /* the fitted shift: simulation at T + shift against data at T */
   double mean_error;           /* mean |Z_sim - Z_meas| / Z_meas at the fitted shift */
