@@ -240,7 +240,8 @@ int main(int argc, char** argv) {
       "neighbor_passes,pressure_iterations,divergence_iterations,density_error_mean,density_error_max,"
       "solve_error_max,front_shift_T,front_error_mean,front_error_max,status,ms_per_substep,neighbors_mean,"
       "ms_hash_sort,ms_cell_ranges,ms_density,ms_forces,ms_integrate,ms_collide,ms_emit,ms_other,"
-      "solve_error_largest,mean_density_error_all,above_share,solve_error_mean\n");
+      "solve_error_largest,mean_density_error_all,above_share,solve_error_mean,interior_error,"
+      "interior_expansion,interior_share\n");
   printf(
       "%s backend; dam break of Martin & Moyce for %.2f simulated s; front errors over T in [%.1f, %.1f]\n",
       resolved == SPH_BACKEND_CUDA ? "CUDA" : "CPU", seconds, DAM_BREAK_T_FIRST, DAM_BREAK_T_LAST);
@@ -294,8 +295,9 @@ int main(int argc, char** argv) {
           result->mean_error, result->max_error, substep_ms, result->neighbors_mean);
       for (int k = 0; k < SPH_STAGE_COUNT; ++k)
         fprintf(csv, ",%.5f", result->substeps ? result->stage_ms[k] / (double)result->substeps : 0.0);
-      fprintf(csv, ",%.6f,%.6f,%.4f,%.6f\n", result->density_error_largest, result->mean_density_error,
-              result->above_share, result->density_error_mean);
+      fprintf(csv, ",%.6f,%.6f,%.4f,%.6f,%.6f,%.6f,%.4f\n", result->density_error_largest,
+              result->mean_density_error, result->above_share, result->density_error_mean,
+              result->interior_error, result->interior_expansion, result->interior_share);
       fflush(csv);
       printf(
           "%-6s %-9g %6u %9u %10.2f %9llu %10.0f %7.2f%% %7.2f%% %7.2f%% %8.2f %8.2f %6u %9.4f %6.1f "
@@ -311,6 +313,10 @@ int main(int argc, char** argv) {
           "solves' mean error %.4f%%\n",
           100.0 * result->mean_density_error, 100.0 * result->above_share,
           100.0 * result->density_error_mean);
+      printf(
+          "       full neighbourhoods (%.1f%% of the particles): mean |rho/rho0 - 1| %.4f%%, expansion "
+          "%.4f%%\n",
+          100.0 * result->interior_share, 100.0 * result->interior_error, 100.0 * result->interior_expansion);
       printf("       stages, ms/substep:");
       for (int k = 0; k < SPH_STAGE_COUNT; ++k)
         printf(" %.4f", result->substeps ? result->stage_ms[k] / (double)result->substeps : 0.0);

@@ -64,6 +64,77 @@ static double surge_front(const float* positions, uint32_t n, float* scratch, do
   }
 }
 
+/* Each particle's neighbours within h (itself included), by a grid of cells h wide over the box
+ * lo-hi (positions outside it are clamped into its border cells). The interior measure below
+ * needs to tell the particles with a full neighbourhood from those at a surface or a collision-
+ * only wall, whose density reads low for want of neighbours, not for expansion. Returns 0 when
+ * out of memory. */
+static int count_neighbors(const float* positions, uint32_t n, double h, const double lo[3],
+                           const double hi[3], uint32_t* counts) {
+  int dims[3];
+  size_t cells = 1;
+  uint32_t* cell_of = (uint32_t*)malloc(sizeof(uint32_t) * ((size_t)n + 1));
+  uint32_t* order = (uint32_t*)malloc(sizeof(uint32_t) * ((size_t)n + 1));
+  uint32_t* start;
+  for (int d = 0; d < 3; ++d) {
+    dims[d] = (int)ceil((hi[d] - lo[d]) / h) + 1;
+    cells *= (size_t)dims[d];
+  }
+  start = (uint32_t*)calloc(cells + 1, sizeof(uint32_t));
+  if (!cell_of || !order || !start) {
+    free(cell_of);
+    free(order);
+    free(start);
+    return 0;
+  }
+  for (uint32_t i = 0; i < n; ++i) {
+    int c[3];
+    for (int d = 0; d < 3; ++d) {
+      c[d] = (int)floor((positions[3 * i + d] - lo[d]) / h);
+      c[d] = c[d] < 0 ? 0 : (c[d] >= dims[d] ? dims[d] - 1 : c[d]);
+    }
+    cell_of[i] = (uint32_t)(((size_t)c[2] * dims[1] + c[1]) * dims[0] + c[0]);
+    ++start[cell_of[i] + 1];
+  }
+  for (size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
+  {
+    uint32_t* fill = (uint32_t*)malloc(sizeof(uint32_t) * (cells + 1));
+    if (!fill) {
+      free(cell_of);
+      free(order);
+      free(start);
+      return 0;
+    }
+    memcpy(fill, start, sizeof(uint32_t) * (cells + 1));
+    for (uint32_t i = 0; i < n; ++i) order[fill[cell_of[i]]++] = i;
+    free(fill);
+  }
+  for (uint32_t i = 0; i < n; ++i) {
+    const float* p = positions + 3 * i;
+    const int cx = (int)(cell_of[i] % (uint32_t)dims[0]);
+    const int cy = (int)((cell_of[i] / (uint32_t)dims[0]) % (uint32_t)dims[1]);
+    const int cz = (int)(cell_of[i] / ((uint32_t)dims[0] * (uint32_t)dims[1]));
+    uint32_t count = 0;
+    for (int z = cz - 1; z <= cz + 1; ++z)
+      for (int y = cy - 1; y <= cy + 1; ++y)
+        for (int x = cx - 1; x <= cx + 1; ++x) {
+          size_t c;
+          if (x < 0 || y < 0 || z < 0 || x >= dims[0] || y >= dims[1] || z >= dims[2]) continue;
+          c = ((size_t)z * dims[1] + y) * dims[0] + x;
+          for (uint32_t k = start[c]; k < start[c + 1]; ++k) {
+            const float* q = positions + 3 * order[k];
+            const double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+            if (dx * dx + dy * dy + dz * dz < h * h) ++count;
+          }
+        }
+    counts[i] = count;
+  }
+  free(cell_of);
+  free(order);
+  free(start);
+  return 1;
+}
+
 /* One line of a frame's statistics and where its densest particle is (config->frame_log). */
 static void log_frame(FILE* log, const dam_break_result* result, const sph_stats* stats,
                       const float* positions, const float* density, uint32_t count, double a) {
@@ -115,6 +186,9 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
   double compression_sum = 0.0;
   double density_error_sum = 0.0;
   double above_share_sum = 0.0;
+  double interior_error_sum = 0.0, interior_expansion_sum = 0.0, interior_share_sum = 0.0;
+  uint32_t full_neighborhood = 0; /* the most neighbours a particle of the lattice has at the start */
+  uint32_t* neighbors = NULL;
   sph_result r;
 
   memset(result, 0, sizeof *result);
@@ -123,10 +197,12 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
   r = support_fcc_box(layers, step, NULL, &positions, &n);
   density = (float*)malloc(sizeof(float) * ((size_t)n + 1));
   scratch = (float*)malloc(sizeof(float) * ((size_t)n + 1));
-  if (r != SPH_OK || !density || !scratch) {
+  neighbors = (uint32_t*)malloc(sizeof(uint32_t) * ((size_t)n + 1));
+  if (r != SPH_OK || !density || !scratch || !neighbors) {
     free(positions);
     free(density);
     free(scratch);
+    free(neighbors);
     return SPH_ERROR_OUT_OF_HOST_MEMORY;
   }
   result->particles = n;
@@ -176,7 +252,13 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
   if (r != SPH_OK) goto done;
   if ((r = support_spawn(world, positions, NULL, n)) != SPH_OK) goto done;
 
+  if ((r = sph_world_get_def(world, &def)) != SPH_OK) goto done;
   {
+    const double kernel_radius = def.kernel_radius;
+    const double grid_lo[3] = {tank_min[0] - kernel_radius, tank_min[1] - kernel_radius,
+                               tank_min[2] - kernel_radius};
+    const double grid_hi[3] = {tank_max[0] + kernel_radius, tank_max[1] + kernel_radius,
+                               tank_max[2] + kernel_radius};
     const double scale = time_scale();
     const double frame = config->sample_T / scale;
     const uint32_t frames = (uint32_t)ceil(config->end_T / config->sample_T);
@@ -218,20 +300,40 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
       if ((r = sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, positions, sizeof(float) * 3 * n, 0, 0,
                                         count, NULL)) != SPH_OK)
         goto done;
+      if (!count_neighbors(positions, count, kernel_radius, grid_lo, grid_hi, neighbors)) {
+        r = SPH_ERROR_OUT_OF_HOST_MEMORY;
+        goto done;
+      }
+      if (f == 0)
+        for (uint32_t i = 0; i < count; ++i)
+          if (neighbors[i] > full_neighborhood) full_neighborhood = neighbors[i];
       if (f > 0) {
-        double sum = 0.0;
-        uint32_t above = 0;
+        double sum = 0.0, interior_error = 0.0, interior_expansion = 0.0;
+        uint32_t above = 0, interior = 0;
         if ((r = sph_world_copy_attribute(world, SPH_ATTRIBUTE_DENSITY, density, sizeof(float) * n, 0, 0,
                                           count, NULL)) != SPH_OK)
           goto done;
-        for (uint32_t i = 0; i < count; ++i)
-          if (density[i] > rest) {
-            sum += density[i] / rest - 1.0;
+        for (uint32_t i = 0; i < count; ++i) {
+          const double e = density[i] / rest - 1.0;
+          if (e > 0.0) {
+            sum += e;
             ++above;
           }
+          /* A full neighbourhood: at least 85 % of the start's fullest, so a particle expanded
+           * or compressed by a few percent counts and one within about h / 3 of a surface or a
+           * collision-only wall does not. */
+          if (neighbors[i] >= 0.85 * full_neighborhood) {
+            interior_error += fabs(e);
+            interior_expansion += e < 0.0 ? -e : 0.0;
+            ++interior;
+          }
+        }
         compression_sum += above ? sum / above : 0.0;
         density_error_sum += count ? sum / count : 0.0;
         above_share_sum += count ? (double)above / count : 0.0;
+        interior_error_sum += interior ? interior_error / interior : 0.0;
+        interior_expansion_sum += interior ? interior_expansion / interior : 0.0;
+        interior_share_sum += count ? (double)interior / count : 0.0;
         if (config->frame_log) log_frame(config->frame_log, result, &stats, positions, density, count, a);
       }
       result->T[result->samples] = result->simulated_seconds * scale;
@@ -251,6 +353,9 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
     result->mean_compression = frames ? compression_sum / frames : 0.0;
     result->mean_density_error = frames ? density_error_sum / frames : 0.0;
     result->above_share = frames ? above_share_sum / frames : 0.0;
+    result->interior_error = frames ? interior_error_sum / frames : 0.0;
+    result->interior_expansion = frames ? interior_expansion_sum / frames : 0.0;
+    result->interior_share = frames ? interior_share_sum / frames : 0.0;
     if (result->substeps > 0) result->density_error_mean /= (double)result->substeps;
     if (result->substeps > 0) result->neighbors_mean /= (double)result->substeps;
   }
@@ -285,6 +390,7 @@ done:
   free(positions);
   free(density);
   free(scratch);
+  free(neighbors);
   return r;
 }
 

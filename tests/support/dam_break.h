@@ -80,6 +80,13 @@ typedef struct dam_break_result {
      which mean_compression exceeds by the share of particles below rest density */
   double mean_density_error;
   double above_share; /* mean over samples of the share of particles above rest density */
+  /* The particles with a full neighbourhood (at least 85 % of the neighbours within h that the
+     start's fullest particle had: not at a surface or a collision-only wall), mean over samples:
+     their mean |rho/rho0 - 1| (expansion counts, which mean_density_error leaves out), their mean
+     expansion max(1 - rho/rho0, 0), and their share of the particles. */
+  double interior_error;
+  double interior_expansion;
+  double interior_share;
   /* The comparison with the measurements over T in [T_FIRST, T_LAST]: */
   double shift_T;              /* the fitted shift: simulation at T + shift against data at T */
   double mean_error;           /* mean |Z_sim - Z_meas| / Z_meas at the fitted shift */
