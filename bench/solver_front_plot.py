@@ -20,7 +20,10 @@ def main():
         return 2
     rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["status"] == "ok"]
     out = sys.argv[2] if len(sys.argv) > 2 else sys.argv[1].rsplit(".", 1)[0] + ".png"
-    fig, (front, density) = plt.subplots(1, 2, figsize=(11, 4.5))
+    # The full neighbourhoods' mean |rho/rho0 - 1| (session 32 on): a third panel where the CSV has it.
+    interior = bool(rows) and all(r.get("interior_error") for r in rows)
+    fig, axes = plt.subplots(1, 3 if interior else 2, figsize=(16 if interior else 11, 4.5))
+    front, density = axes[0], axes[1]
     # The mean density error over every particle (DFSPH's bound's measure) where the CSV has it
     # (session 32 on); older CSVs have only the mean over the particles above rest density.
     everyone = bool(rows) and all(r.get("mean_density_error_all") for r in rows)
@@ -38,7 +41,12 @@ def main():
         marker = "o" if rs[0]["solver"] == "wcsph" else "s"
         front.plot(cost, [100 * float(r["front_error_mean"]) for r in rs], marker=marker, label=label)
         density.plot(cost, [100 * float(r[density_column]) for r in rs], marker=marker, label=label)
-    for ax, title in ((front, "front mean error, %"), (density, density_title)):
+        if interior:
+            axes[2].plot(cost, [100 * float(r["interior_error"]) for r in rs], marker=marker, label=label)
+    titles = [(front, "front mean error, %"), (density, density_title)]
+    if interior:
+        titles.append((axes[2], "mean |rho/rho0 - 1|, full neighbourhoods, %"))
+    for ax, title in titles:
         ax.set_xscale("log")
         ax.set_xlabel("wall s per simulated s (%s)" % (rows[0]["backend"] if rows else "?"))
         ax.set_ylabel(title)
