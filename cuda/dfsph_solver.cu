@@ -30,13 +30,14 @@ __global__ void dfsph_density_kernel(FluidConstants fluid, GridView grid, Partic
         boundary_share(fluid.methods.boundary, scene.colliders, scene.collider_count, xyz(p), at.s, at.tau);
     a.boundary_gradient[i] = pack_boundary(wall);
   }
-  // The candidate masks of the solves' passes, recorded by this walk (the positions are the
-  // substep's until the solves end).
+  // The candidate masks of the solves' passes and, with lists, the neighbour lists, recorded by
+  // this walk (the positions are the substep's until the solves end).
   // (The same code without masks: a null writer stores nothing; see NeighborMaskWriter.)
   uint32_t* const mask =
       a.dfsph_neighbor_mask ? a.dfsph_neighbor_mask + static_cast<size_t>(i) * kNeighborMaskWords : nullptr;
-  const DfsphDensitySample s =
-      gather_density_and_factor(fluid, grid, a.sorted_position, wall, i, NeighborMaskWriter{mask});
+  const DfsphDensitySample s = gather_density_and_factor(
+      fluid, grid, a.sorted_position, wall, i,
+      NeighborMaskWriter{mask, mask ? a.dfsph_neighbor_list : nullptr, a.dfsph_list_stride, i});
   a.density[i] = s.density;
   a.neighbor_count[i] = s.neighbor_count;
   a.dfsph_factor[i] = s.factor;
@@ -322,7 +323,6 @@ void enqueue_dfsph_density(const FluidConstants& fluid, const GridView& grid, co
   else
     dfsph_density_kernel<false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
   check_launch("dfsph_density_kernel");
-  enqueue_dfsph_neighbor_lists(grid, a, n, threads, stream);
 }
 
 void enqueue_dfsph_step(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,

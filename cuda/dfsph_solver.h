@@ -39,18 +39,14 @@ inline uint32_t dfsph_partial_count(uint32_t capacity) {
   return 2u * (capacity == 0 ? 1u : (capacity + kDfsphSolveBlock - 1) / kDfsphSolveBlock);
 }
 
-// DFSPH's density pass: rho_i, the neighbour counts, the factor, each particle's contact with the
-// colliders, the warm starts gathered from the state order into the sorted order, and the
-// sorted velocities (w: 1 / rho). (The colour normals, with surface tension, come after it:
-// substep_pipeline.cu, where a distributed rank's ghosts first take their owners' densities.)
+// DFSPH's density pass: rho_i, the neighbour counts, the factor, the candidate masks and neighbour
+// lists where the world keeps them, each particle's contact with the colliders, the warm starts gathered from
+// the state order into the sorted order, and the sorted velocities (w: 1 / rho). (The colour normals, with
+// surface tension, come after it: substep_pipeline.cu, where a distributed rank's ghosts first take their
+// owners' densities.)
 void enqueue_dfsph_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                            uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
                            const DeviceScene& scene, FrameState* state, cudaStream_t stream);
-
-// The solves' neighbour lists from the density pass's masks (dfsph_neighbor_lists.cu), in a world
-// that keeps both (SPH_CUDA_DFSPH_NEIGHBOR_LISTS); nothing otherwise.
-void enqueue_dfsph_neighbor_lists(const GridView& grid, const ParticleArrays& a, uint32_t n, unsigned threads,
-                                  cudaStream_t stream);
 
 // A distributed rank's host steps inside DFSPH's solves (cuda_halo.cu; the stream driver only):
 // the host drives each Jacobi solve, an iteration at a time, by core/dfsph_jacobi_loop.h (the CPU

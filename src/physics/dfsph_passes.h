@@ -113,13 +113,14 @@ SPH_HD float neighbor_mask_bound(float h2) { return h2 + h2 * 2.44140625e-4f; }
 
 // The density pass's walk without a mask to record (NeighborMaskWriter's interface).
 struct NoNeighborMask {
-  SPH_HD void add(bool) {}
+  SPH_HD void add(bool, uint32_t) {}
   SPH_HD void finish() const {}
 };
 
 // The density of density.h (the same sum in the same order) and the factor, in one walk.
 // wall: the walls' share at x_i (boundary_share; no_boundary_share() without the feature).
-// mask: NeighborMaskWriter to record particle i's candidate mask for the solves' passes.
+// mask: NeighborMaskWriter to record particle i's candidate mask (and, with lists, its neighbour
+// list) for the solves' passes.
 template <class Mask = NoNeighborMask>
 SPH_HD DfsphDensitySample gather_density_and_factor(const FluidBase& f, const GridView& grid,
                                                     const Float4* positions, const BoundaryShare& wall,
@@ -134,7 +135,7 @@ SPH_HD DfsphDensitySample gather_density_and_factor(const FluidBase& f, const Gr
   for_each_neighbor_candidate(grid, xi, [&](uint32_t j) {
     const Vec3 d = xi - xyz(positions[j]);
     const float r2 = length_squared(d);
-    mask.add(r2 < bound && j != i);
+    mask.add(r2 < bound && j != i, j);
     if (r2 < f.kernel.h2 && j != i) {
       const DfsphFactorTermsOf<float> t = dfsph_factor_pair_terms(f, mk, d, r2);
       sum += t.kernel;

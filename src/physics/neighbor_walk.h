@@ -83,6 +83,9 @@ SPH_HD void for_each_neighbor_candidate(const GridView& grid, Vec3 p, Visit&& vi
 constexpr uint32_t kNeighborMaskWords = 12;
 constexpr uint32_t kNeighborMaskCandidates = 32u * kNeighborMaskWords - 1u;  // 383
 constexpr uint32_t kNeighborMaskOverflow = 0x80000000u;                      // in the last word
+// The neighbour lists' slots (ListedCandidates, below, says why 63).
+constexpr uint32_t kNeighborListSlots = 63;
+constexpr uint32_t kNeighborListRows = kNeighborListSlots + 1;  // uint32 a particle, the count's included
 
 // The index of the lowest set bit of x != 0.
 SPH_HD uint32_t lowest_set_bit(uint32_t x) {
@@ -97,18 +100,29 @@ SPH_HD uint32_t lowest_set_bit(uint32_t x) {
 #endif
 }
 
-// Writes one particle's mask as a walk goes: add(keep) once per candidate, in the walk's order,
-// then finish(). out: the particle's kNeighborMaskWords words (all of them written), or null: a
-// world without masks, whose density pass runs this same code and stores nothing. (One
+// Writes one particle's mask as a walk goes: add(keep, j) once per candidate j, in the walk's
+// order, then finish(). out: the particle's kNeighborMaskWords words (all of them written), or
+// null: a world without masks, whose density pass runs this same code and stores nothing. (One
 // instantiation of the pass for both: a second one, compiled apart, may contract its arithmetic
 // into other fused multiply-adds and give other bits; with and without masks must be the same.)
+// list: with neighbour lists (below), the world's lists, into which the same walk writes particle
+// `particle`'s list as it records the mask: slot 0 and the visits of for_each_masked_neighbor over
+// this mask, in its order (what write_neighbor_list writes from the finished mask, without a second
+// walk of the 27 cells); null without lists.
 struct NeighborMaskWriter {
   uint32_t* out;
-  uint32_t count = 0;  // candidates so far
-  uint32_t word = 0;   // the bits of the word being filled
+  uint32_t* list = nullptr;  // the lists (slot-major, ListedCandidates), or null
+  uint32_t stride = 0;       // the lists' capacity
+  uint32_t particle = 0;     // whose list
+  uint32_t count = 0;        // candidates so far
+  uint32_t word = 0;         // the bits of the word being filled
+  uint32_t visits = 0;       // bits set so far: the masked walk's visits
 
-  SPH_HD void add(bool keep) {
-    if (keep && count < kNeighborMaskCandidates) word |= 1u << (count & 31u);
+  SPH_HD void add(bool keep, uint32_t j) {
+    if (keep && count < kNeighborMaskCandidates) {
+      word |= 1u << (count & 31u);
+      if (list && ++visits <= kNeighborListSlots) list[static_cast<size_t>(visits) * stride + particle] = j;
+    }
     ++count;
     if ((count & 31u) == 0u && count <= 32u * kNeighborMaskWords) {
       if (out) out[(count >> 5) - 1u] = word;
@@ -116,6 +130,8 @@ struct NeighborMaskWriter {
     }
   }
   SPH_HD void finish() const {
+    // An overflowed mask (its passes walk every candidate) lists nothing: a count past the slots.
+    if (list) list[particle] = count > kNeighborMaskCandidates ? kNeighborListSlots + 1u : visits;
     if (!out) return;
     if (count > kNeighborMaskCandidates) {
       out[kNeighborMaskWords - 1u] = kNeighborMaskOverflow;  // the other words are not read
@@ -189,11 +205,11 @@ struct MaskedCandidates {
 // One caveat: a kernel holds two inlined copies of its pass's body (the list's loop and the
 // mask's), and the same bits need both compiled to the same arithmetic; gpu_check_dfsph_masks is
 // what shows it for a compiler and an architecture (nvcc 13, sm_90, session 27).
-constexpr uint32_t kNeighborListSlots = 63;
-constexpr uint32_t kNeighborListRows = kNeighborListSlots + 1;  // uint32 a particle, the count's included
 
 // Writes particle i's list from its mask (for_each_masked_neighbor's visits, in order); slot 0
-// gets the count, or, for an overflowed or null mask, kNeighborListSlots + 1 without a walk.
+// gets the count, or, for an overflowed or null mask, kNeighborListSlots + 1 without a walk. The
+// lists' definition: the CUDA density pass writes the same list while it records the mask
+// (NeighborMaskWriter's list), and tests/unit/test_neighbor_mask.cpp holds the two equal.
 SPH_HD void write_neighbor_list(const GridView& grid, Vec3 p, const uint32_t* mask, uint32_t* list,
                                 uint32_t stride, uint32_t i) {
   if (!mask || (mask[kNeighborMaskWords - 1u] & kNeighborMaskOverflow)) {

@@ -8,6 +8,9 @@
 // candidates; for_each_masked_neighbor visits exactly those candidates, in the plain walk's order
 // (every candidate where the mask overflowed or is null); and the two solve passes (density_rate,
 // pressure_velocity_change) give the same bits through the masked walk as through the plain one.
+// The neighbour lists: write_neighbor_list's from each finished mask against the lists the density
+// pass writes in the same walk as the mask (NeighborMaskWriter with lists, CUDA's way), slot by slot,
+// and the listed walk against the masked one.
 // The scenes: a table folded over a larger cloud (rows that wrap around the table, far
 // particles in folded slots) dense enough that some particles overflow and others do not; a
 // lattice at h / 2 whose pairs at exactly r = h sit on the passes' test's edge (inside the mask's
@@ -91,8 +94,9 @@ bool same_bits(const T& a, const T& b) {
 
 struct Tally {
   uint32_t particles = 0, overflowed = 0, wrapped_rows = 0, edge_pairs = 0, mismatches = 0;
-  uint32_t listed = 0;      // particles whose neighbour list holds every visit (the rest walk their masks)
-  uint32_t long_lists = 0;  // particles with a mask of their own (not overflowed) and more than 63 visits
+  uint32_t listed = 0;        // particles whose neighbour list holds every visit (the rest walk their masks)
+  uint32_t long_lists = 0;    // particles with a mask of their own (not overflowed) and more than 63 visits
+  uint32_t walked_slots = 0;  // list slots the density pass's lists were compared on
 };
 
 // Every particle of the table against brute force (the file's header).
@@ -106,6 +110,9 @@ Tally check_table(const Table& t) {
   // The lists, slot-major with a stride above the particle count (a world's capacity).
   const uint32_t stride = t.size() + 7u;
   std::vector<uint32_t> lists(static_cast<size_t>(stride) * sph::kNeighborListRows, 0xdeadbeefu);
+  // The lists the density pass writes as it records the masks (CUDA with lists), to hold equal to
+  // write_neighbor_list's from the finished masks.
+  std::vector<uint32_t> walked(static_cast<size_t>(stride) * sph::kNeighborListRows, 0xdeadbeefu);
   Tally tally;
   for (uint32_t i = 0; i < t.size(); ++i) {
     ++tally.particles;
@@ -120,7 +127,13 @@ Tally check_table(const Table& t) {
     // the same sample, nothing stored.
     const sph::DfsphDensitySample unrecorded = sph::gather_density_and_factor(
         f, view, t.positions.data(), sph::no_boundary_share(), i, sph::NeighborMaskWriter{nullptr});
-    bool ok = same_bits(plain, recorded) && same_bits(plain, unrecorded);
+    // With lists: the mask again (the same words) and the list, in the same walk.
+    std::vector<uint32_t> mask_again(sph::kNeighborMaskWords, 0xdeadbeefu);
+    const sph::DfsphDensitySample listing =
+        sph::gather_density_and_factor(f, view, t.positions.data(), sph::no_boundary_share(), i,
+                                       sph::NeighborMaskWriter{mask_again.data(), walked.data(), stride, i});
+    bool ok = same_bits(plain, recorded) && same_bits(plain, unrecorded) && same_bits(plain, listing);
+    ok = ok && std::equal(mask_again.begin(), mask_again.end(), mask);
     // Brute force: the candidates in the walk's order, and those within the bound.
     std::vector<uint32_t> candidates, kept;
     sph::for_each_neighbor_range(view, xi, [&](uint32_t begin, uint32_t end) {
@@ -156,6 +169,15 @@ Tally check_table(const Table& t) {
     // what the masked walk does, in its order, from the list or (past 63) from the mask.
     sph::write_neighbor_list(view, xi, mask, lists.data(), stride, i);
     ok = ok && lists[i] == (overflow ? sph::kNeighborListSlots + 1u : visited.size());
+    // The density pass's list: the same count and, where the list holds its visits, the same slots.
+    // (Past the slots neither list is read: ListedCandidates walks the mask.)
+    ok = ok && walked[i] == lists[i];
+    if (lists[i] <= sph::kNeighborListSlots) {
+      for (uint32_t slot = 1; slot <= lists[i]; ++slot)
+        ok = ok &&
+             walked[static_cast<size_t>(slot) * stride + i] == lists[static_cast<size_t>(slot) * stride + i];
+      tally.walked_slots += lists[i];
+    }
     tally.listed += visited.size() <= sph::kNeighborListSlots;
     tally.long_lists += !overflow && visited.size() > sph::kNeighborListSlots;
     const sph::ListedCandidates listed{masks.data(), lists.data(), stride};
@@ -213,6 +235,7 @@ void test_folded_table(void**) {
   assert_int_equal(r.mismatches, 0);
   assert_true(r.overflowed > 0 && r.overflowed < r.particles);  // both kinds of particle exercised
   assert_true(r.listed > 0 && r.listed < r.particles);          // lists used, and walks past them
+  assert_true(r.walked_slots > 0);
   assert_true(r.wrapped_rows > 0);
 }
 
@@ -226,10 +249,13 @@ void test_lattice_edges(void**) {
         points.push_back(Vec3{0.5f * x + 0.25f, 0.5f * y + 0.25f, 0.5f * z + 0.25f});
   const Table t(points, 8, 3);
   const Tally r = check_table(t);
-  std::printf("lattice: %u particles, %u overflowing, %u listed, %u pairs at r = h, %u mismatches\n",
-              r.particles, r.overflowed, r.listed, r.edge_pairs, r.mismatches);
+  std::printf(
+      "lattice: %u particles, %u overflowing, %u listed, %u list slots compared, %u pairs at r = h, %u "
+      "mismatches\n",
+      r.particles, r.overflowed, r.listed, r.walked_slots, r.edge_pairs, r.mismatches);
   assert_int_equal(r.mismatches, 0);
   assert_int_equal(r.listed, r.particles);  // 33 to 44 visits a particle: every list holds them
+  assert_true(r.walked_slots > 20u * r.particles);
   assert_true(r.edge_pairs > 0);
 }
 
