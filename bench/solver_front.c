@@ -4,9 +4,13 @@
  * of the column's free-fall speed sqrt(2 g 2a) = 1.50 m/s) and DFSPH at several density error
  * bounds, at each resolution asked for, on the chosen backend. Per run: wall seconds per
  * simulated second, substeps, neighbour passes, the mean and largest compression (density
- * error) of the particles above rest density and the mean over every particle of the compression
- * (max(rho/rho0 - 1, 0): the measure DFSPH's bound sets, "over every particle" below the row and
- * mean_density_error_all in the CSV, with the share above rest), the front's mean error against the
+ * error) of the particles above rest density ("rho err" in the row; density_error_mean in the CSV,
+ * an older name), the mean over every particle of the compression (max(rho/rho0 - 1, 0): the
+ * measure DFSPH's bound sets; "over every particle" below the row, mean_density_error_all and
+ * above_share in the CSV, and the density solves' own achieved mean, solve_error_mean), the full
+ * neighbourhoods' mean |rho/rho0 - 1| and expansion, which the positive part cannot see
+ * (interior_error, interior_expansion, interior_share; dam_break.h says which particles count; a host
+ * neighbour count each frame, outside the timed steps), the front's mean error against the
  * measurements (one fitted shift, as the validation), and DFSPH's solve iterations, capped solves and the
  * largest error of one particle a density solve ended with ("solve lg", sph_stats.density_error_largest).
  *
@@ -261,6 +265,7 @@ int main(int argc, char** argv) {
       config.dfsph_linear_solver = linear_solver;
       config.features |= features;
       config.frame_log = frame_log ? stdout : NULL;
+      config.measure_interior = 1;
       if (dfsph) {
         config.density_error = (float)runs[r].value;
         config.density_error_max = (float)dfsph_max;

@@ -26,10 +26,10 @@ def main():
     front, density = axes[0], axes[1]
     # The mean density error over every particle (DFSPH's bound's measure) where the CSV has it
     # (session 32 on); older CSVs have only the mean over the particles above rest density.
-    everyone = bool(rows) and all(r.get("mean_density_error_all") for r in rows)
-    density_column = "mean_density_error_all" if everyone else "density_error_mean"
+    every_particle = bool(rows) and all(r.get("mean_density_error_all") for r in rows)
+    density_column = "mean_density_error_all" if every_particle else "density_error_mean"
     density_title = (
-        "mean density error over every particle, %" if everyone else "mean compression of those above rest, %"
+        "mean density error over every particle, %" if every_particle else "mean compression of those above rest, %"
     )
     series = {}
     for r in rows:

@@ -74,8 +74,9 @@ struct ParticleArrays {
   // particle, physics/neighbor_walk.h); null unless DFSPH, or with sph_context_def.cuda_dfsph_masks off.
   uint32_t* dfsph_neighbor_mask;
   // The solves' neighbour lists (kNeighborListRows uint32 a particle, slot-major with stride
-  // dfsph_list_stride, the capacity; physics/neighbor_walk.h), written from the masks after the
-  // density pass; null unless sph_context_def.cuda_dfsph_masks = SPH_CUDA_DFSPH_NEIGHBOR_LISTS.
+  // dfsph_list_stride, the capacity; physics/neighbor_walk.h), written by the density pass in the
+  // walk that records the masks; null unless sph_context_def.cuda_dfsph_masks =
+  // SPH_CUDA_DFSPH_NEIGHBOR_LISTS.
   uint32_t* dfsph_neighbor_list;
   uint32_t dfsph_list_stride;
   // Null where the conjugate gradients cannot run (particle_arrays.cpp): their density solve's

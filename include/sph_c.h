@@ -110,7 +110,7 @@ typedef enum sph_cuda_frames {
 } sph_cuda_frames;
 /** sph_context_def.cuda_dfsph_masks: 0 = on (the default), or this = off. */
 #define SPH_CUDA_DFSPH_MASKS_OFF 1u
-/** sph_context_def.cuda_dfsph_masks: the masks and, written from them, neighbour lists (0.2.0). */
+/** sph_context_def.cuda_dfsph_masks: the masks and, written with them, neighbour lists (0.2.0). */
 #define SPH_CUDA_DFSPH_NEIGHBOR_LISTS 2u
 
 typedef enum sph_integrator {
@@ -341,7 +341,7 @@ typedef struct sph_context_def {
      density pass records which of each particle's 27-cell candidates are neighbours (48 bytes a
      particle of capacity) and the solves' passes visit only those; SPH_CUDA_DFSPH_MASKS_OFF = off:
      they walk every candidate (no memory, slower passes); SPH_CUDA_DFSPH_NEIGHBOR_LISTS = the masks
-     and, written from them once a substep, each particle's list of up to 63 neighbours (256 bytes
+     and, written by the same walk of the density pass, each particle's list of up to 63 neighbours (256 bytes
      more a particle of capacity), which the solves' passes loop over. The same bits every way. A
      CPU context and a weakly compressible world check and ignore it; any other value is
      INVALID_ARGUMENT. */

@@ -21,7 +21,7 @@ namespace Sph
         public const int SPH_ABI_VERSION = 0;
         /// <summary>sph_context_def.cuda_dfsph_masks: 0 = on (the default), or this = off.</summary>
         public const uint SPH_CUDA_DFSPH_MASKS_OFF = 1u;
-        /// <summary>sph_context_def.cuda_dfsph_masks: the masks and, written from them, neighbour lists (0.2.0).</summary>
+        /// <summary>sph_context_def.cuda_dfsph_masks: the masks and, written with them, neighbour lists (0.2.0).</summary>
         public const uint SPH_CUDA_DFSPH_NEIGHBOR_LISTS = 2u;
         public const uint SPH_FEATURE_NONE = 0u;
         /// <summary>
@@ -859,10 +859,10 @@ namespace Sph
         /// (docs/cuda.md): 0 (default) = on: the density pass records which of each particle's 27-cell
         /// candidates are neighbours (48 bytes a particle of capacity) and the solves' passes visit
         /// only those; SPH_CUDA_DFSPH_MASKS_OFF = off: they walk every candidate (no memory, slower
-        /// passes); SPH_CUDA_DFSPH_NEIGHBOR_LISTS = the masks and, written from them once a substep,
-        /// each particle's list of up to 63 neighbours (256 bytes more a particle of capacity), which
-        /// the solves' passes loop over. The same bits every way. A CPU context and a weakly
-        /// compressible world check and ignore it; any other value is INVALID_ARGUMENT.
+        /// passes); SPH_CUDA_DFSPH_NEIGHBOR_LISTS = the masks and, written by the same walk of the
+        /// density pass, each particle's list of up to 63 neighbours (256 bytes more a particle of
+        /// capacity), which the solves' passes loop over. The same bits every way. A CPU context and a
+        /// weakly compressible world check and ignore it; any other value is INVALID_ARGUMENT.
         /// </summary>
         public uint CudaDfsphMasks;
         /// <summary>sph_log_fn log_fn: optional; NULL = no logging</summary>

@@ -32,7 +32,7 @@ struct CudaTuning {
   uint32_t particle_lanes =
       0;  // threads per particle of the neighbour passes: 0 (the backend's choice), 1, 2, 4, 8
   bool dfsph_masks = true;   // DFSPH's candidate masks (physics/neighbor_walk.h)
-  bool dfsph_lists = false;  // and the solves' neighbour lists written from them
+  bool dfsph_lists = false;  // and the solves' neighbour lists, written with them
 };
 
 // cpu_tasks: the engine's task system for a CPU backend's loops (none: OpenMP's cpu_workers).

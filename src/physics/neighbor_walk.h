@@ -116,7 +116,7 @@ struct NeighborMaskWriter {
   uint32_t particle = 0;     // whose list
   uint32_t count = 0;        // candidates so far
   uint32_t word = 0;         // the bits of the word being filled
-  uint32_t visits = 0;       // bits set so far: the masked walk's visits
+  uint32_t visits = 0;       // with a list: the bits set so far (the masked walk's visits)
 
   SPH_HD void add(bool keep, uint32_t j) {
     if (keep && count < kNeighborMaskCandidates) {
@@ -130,7 +130,8 @@ struct NeighborMaskWriter {
     }
   }
   SPH_HD void finish() const {
-    // An overflowed mask (its passes walk every candidate) lists nothing: a count past the slots.
+    // An overflowed mask (its passes walk every candidate) gets a count past the slots; the slots
+    // written before the overflow showed are never read.
     if (list) list[particle] = count > kNeighborMaskCandidates ? kNeighborListSlots + 1u : visits;
     if (!out) return;
     if (count > kNeighborMaskCandidates) {

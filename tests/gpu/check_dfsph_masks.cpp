@@ -7,7 +7,7 @@
 // = SPH_CUDA_DFSPH_MASKS_OFF; both runs execute the same kernels, which walk every candidate where
 // a particle has no mask): every frame's state (positions,
 // velocities, densities, pressures, ids) and every frame's solve statistics (substeps, both
-// solves' iterations, the achieved error's bits). The neighbour lists written from the masks
+// solves' iterations, the achieved error's bits). The neighbour lists written with the masks
 // (SPH_CUDA_DFSPH_NEIGHBOR_LISTS: the solves loop over each particle's list of up to 63 of the
 // masked walk's visits, and walk the mask past that) must give those bits too.
 // The scene: the Martin & Moyce dam break of check_dfsph_cg.cpp (16 lattice layers across the

@@ -19,8 +19,9 @@ void dam_break_config_default(dam_break_config* config, uint32_t layers_across) 
   const double a = DAM_BREAK_COLUMN_WIDTH;
   memset(config, 0, sizeof *config);
   config->layers_across = layers_across;
-  /* Six layers across the slab: more than three kernel radii (h = 1.8 spacings = 2.5 layers),
-   * so the middle layers see a full neighbourhood in z. */
+  /* Six layers across the slab, 2.35 kernel radii (h = 1.8 spacings = 2.55 layers): the two
+   * middle layers, 3 layers from the first missing one beyond either wall, see a full
+   * neighbourhood in z. */
   config->slab_layers = 6;
   config->integrator = SPH_INTEGRATOR_SYMPLECTIC_EULER;
   config->step_factor = 0.4f;
@@ -65,7 +66,8 @@ static double surge_front(const float* positions, uint32_t n, float* scratch, do
 }
 
 /* Each particle's neighbours within h (itself included), by a grid of cells h wide over the box
- * lo-hi (positions outside it are clamped into its border cells). The interior measure below
+ * lo-hi (positions outside it, or not finite, are clamped into its border cells; a pair then
+ * lies in neighbouring cells still, so none is lost). The interior measure below
  * needs to tell the particles with a full neighbourhood from those at a surface or a collision-
  * only wall, whose density reads low for want of neighbours, not for expansion. Returns 0 when
  * out of memory. */
@@ -80,7 +82,8 @@ static int count_neighbors(const float* positions, uint32_t n, double h, const d
     dims[d] = (int)ceil((hi[d] - lo[d]) / h) + 1;
     cells *= (size_t)dims[d];
   }
-  start = (uint32_t*)calloc(cells + 1, sizeof(uint32_t));
+  /* (A cell index is a uint32_t: a tank of more than 2^32 cells of h is refused as out of memory.) */
+  start = cells < UINT32_MAX ? (uint32_t*)calloc(cells + 1, sizeof(uint32_t)) : NULL;
   if (!cell_of || !order || !start) {
     free(cell_of);
     free(order);
@@ -90,8 +93,9 @@ static int count_neighbors(const float* positions, uint32_t n, double h, const d
   for (uint32_t i = 0; i < n; ++i) {
     int c[3];
     for (int d = 0; d < 3; ++d) {
-      c[d] = (int)floor((positions[3 * i + d] - lo[d]) / h);
-      c[d] = c[d] < 0 ? 0 : (c[d] >= dims[d] ? dims[d] - 1 : c[d]);
+      /* Clamped as a double, so a non-finite or far position is a border cell, not an overflow. */
+      const double x = (positions[3 * i + d] - lo[d]) / h;
+      c[d] = x >= 0.0 ? (x < (double)(dims[d] - 1) ? (int)x : dims[d] - 1) : 0;
     }
     cell_of[i] = (uint32_t)(((size_t)c[2] * dims[1] + c[1]) * dims[0] + c[0]);
     ++start[cell_of[i] + 1];
@@ -187,8 +191,9 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
   double density_error_sum = 0.0;
   double above_share_sum = 0.0;
   double interior_error_sum = 0.0, interior_expansion_sum = 0.0, interior_share_sum = 0.0;
-  uint32_t full_neighborhood = 0; /* the most neighbours a particle of the lattice has at the start */
-  uint32_t* neighbors = NULL;
+  uint32_t sampled = 0, interior_sampled = 0; /* frames measured; of them, frames with an interior */
+  uint32_t full_neighbor_count = 0; /* the most neighbours a particle of the lattice has at the start */
+  uint32_t* neighbor_counts = NULL;
   sph_result r;
 
   memset(result, 0, sizeof *result);
@@ -197,12 +202,12 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
   r = support_fcc_box(layers, step, NULL, &positions, &n);
   density = (float*)malloc(sizeof(float) * ((size_t)n + 1));
   scratch = (float*)malloc(sizeof(float) * ((size_t)n + 1));
-  neighbors = (uint32_t*)malloc(sizeof(uint32_t) * ((size_t)n + 1));
-  if (r != SPH_OK || !density || !scratch || !neighbors) {
+  neighbor_counts = (uint32_t*)malloc(sizeof(uint32_t) * ((size_t)n + 1));
+  if (r != SPH_OK || !density || !scratch || !neighbor_counts) {
     free(positions);
     free(density);
     free(scratch);
-    free(neighbors);
+    free(neighbor_counts);
     return SPH_ERROR_OUT_OF_HOST_MEMORY;
   }
   result->particles = n;
@@ -300,13 +305,15 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
       if ((r = sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, positions, sizeof(float) * 3 * n, 0, 0,
                                         count, NULL)) != SPH_OK)
         goto done;
-      if (!count_neighbors(positions, count, kernel_radius, grid_lo, grid_hi, neighbors)) {
-        r = SPH_ERROR_OUT_OF_HOST_MEMORY;
-        goto done;
+      if (config->measure_interior) {
+        if (!count_neighbors(positions, count, kernel_radius, grid_lo, grid_hi, neighbor_counts)) {
+          r = SPH_ERROR_OUT_OF_HOST_MEMORY;
+          goto done;
+        }
+        if (f == 0)
+          for (uint32_t i = 0; i < count; ++i)
+            if (neighbor_counts[i] > full_neighbor_count) full_neighbor_count = neighbor_counts[i];
       }
-      if (f == 0)
-        for (uint32_t i = 0; i < count; ++i)
-          if (neighbors[i] > full_neighborhood) full_neighborhood = neighbors[i];
       if (f > 0) {
         double sum = 0.0, interior_error = 0.0, interior_expansion = 0.0;
         uint32_t above = 0, interior = 0;
@@ -319,20 +326,23 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
             sum += e;
             ++above;
           }
-          /* A full neighbourhood: at least 85 % of the start's fullest, so a particle expanded
-           * or compressed by a few percent counts and one within about h / 3 of a surface or a
-           * collision-only wall does not. */
-          if (neighbors[i] >= 0.85 * full_neighborhood) {
+          /* (DAM_BREAK_FULL_NEIGHBORHOOD_SHARE says which particles count, and why.) */
+          if (config->measure_interior && full_neighbor_count > 0 &&
+              neighbor_counts[i] >= DAM_BREAK_FULL_NEIGHBORHOOD_SHARE * full_neighbor_count) {
             interior_error += fabs(e);
             interior_expansion += e < 0.0 ? -e : 0.0;
             ++interior;
           }
         }
+        ++sampled;
         compression_sum += above ? sum / above : 0.0;
         density_error_sum += count ? sum / count : 0.0;
         above_share_sum += count ? (double)above / count : 0.0;
-        interior_error_sum += interior ? interior_error / interior : 0.0;
-        interior_expansion_sum += interior ? interior_expansion / interior : 0.0;
+        if (interior) {
+          ++interior_sampled;
+          interior_error_sum += interior_error / interior;
+          interior_expansion_sum += interior_expansion / interior;
+        }
         interior_share_sum += count ? (double)interior / count : 0.0;
         if (config->frame_log) log_frame(config->frame_log, result, &stats, positions, density, count, a);
       }
@@ -350,12 +360,13 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
         }
       }
     }
-    result->mean_compression = frames ? compression_sum / frames : 0.0;
-    result->mean_density_error = frames ? density_error_sum / frames : 0.0;
-    result->above_share = frames ? above_share_sum / frames : 0.0;
-    result->interior_error = frames ? interior_error_sum / frames : 0.0;
-    result->interior_expansion = frames ? interior_expansion_sum / frames : 0.0;
-    result->interior_share = frames ? interior_share_sum / frames : 0.0;
+    /* Over the frames measured (the samples' cap can end the loop early). */
+    result->mean_compression = sampled ? compression_sum / sampled : 0.0;
+    result->mean_density_error = sampled ? density_error_sum / sampled : 0.0;
+    result->above_share = sampled ? above_share_sum / sampled : 0.0;
+    result->interior_error = interior_sampled ? interior_error_sum / interior_sampled : 0.0;
+    result->interior_expansion = interior_sampled ? interior_expansion_sum / interior_sampled : 0.0;
+    result->interior_share = sampled ? interior_share_sum / sampled : 0.0;
     if (result->substeps > 0) result->density_error_mean /= (double)result->substeps;
     if (result->substeps > 0) result->neighbors_mean /= (double)result->substeps;
   }
@@ -390,7 +401,7 @@ done:
   free(positions);
   free(density);
   free(scratch);
-  free(neighbors);
+  free(neighbor_counts);
   return r;
 }
 

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'a56c6330599d8447e841a2fadb9f70f792ea3bb5d07c747f32056d40bba26ccf', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '4a8a7859076b7e24c05a6a2f1821f21e86bff56d4f39cf7f1b79885ee690af57', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a7835ae6047e16fa776580ecb89208cc1fd7cee24e145f545f2cfef6b3fc90fb', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -27,7 +27,7 @@ SPH_VERSION = 4096
 SPH_ABI_VERSION = 0
 #: sph_context_def.cuda_dfsph_masks: 0 = on (the default), or this = off.
 SPH_CUDA_DFSPH_MASKS_OFF = 1
-#: sph_context_def.cuda_dfsph_masks: the masks and, written from them, neighbour lists (0.2.0).
+#: sph_context_def.cuda_dfsph_masks: the masks and, written with them, neighbour lists (0.2.0).
 SPH_CUDA_DFSPH_NEIGHBOR_LISTS = 2
 SPH_FEATURE_NONE = 0
 #: Surface tension: the Morris colour field (thesis eq. 20-23) applied as a capillary stress, plus
@@ -843,7 +843,7 @@ class ContextDef(_SphStruct):
         backend (sph_backend): default SPH_BACKEND_AUTO
         device_ordinal (int32_t): CUDA device; -1 (default) and 0 = device 0
         cpu_worker_count (uint32_t): CPU backend threads; 0 (default) = all hardware threads
-        cuda_dfsph_masks (uint32_t): (0.2.0) DFSPH's candidate masks on the CUDA backend (docs/cuda.md): 0 (default) = on: the density pass records which of each particle's 27-cell candidates are neighbours (48 bytes a particle of capacity) and the solves' passes visit only those; SPH_CUDA_DFSPH_MASKS_OFF = off: they walk every candidate (no memory, slower passes); SPH_CUDA_DFSPH_NEIGHBOR_LISTS = the masks and, written from them once a substep, each particle's list of up to 63 neighbours (256 bytes more a particle of capacity), which the solves' passes loop over. The same bits every way. A CPU context and a weakly compressible world check and ignore it; any other value is INVALID_ARGUMENT.
+        cuda_dfsph_masks (uint32_t): (0.2.0) DFSPH's candidate masks on the CUDA backend (docs/cuda.md): 0 (default) = on: the density pass records which of each particle's 27-cell candidates are neighbours (48 bytes a particle of capacity) and the solves' passes visit only those; SPH_CUDA_DFSPH_MASKS_OFF = off: they walk every candidate (no memory, slower passes); SPH_CUDA_DFSPH_NEIGHBOR_LISTS = the masks and, written by the same walk of the density pass, each particle's list of up to 63 neighbours (256 bytes more a particle of capacity), which the solves' passes loop over. The same bits every way. A CPU context and a weakly compressible world check and ignore it; any other value is INVALID_ARGUMENT.
         log_fn (sph_log_fn): optional; NULL = no logging
         log_user_data (void*): passed to log_fn
         cuda_frames (sph_cuda_frames): Tuning of the CUDA backend (a CPU context checks and ignores it; docs/cuda.md). Results do not depend on it: every choice computes the same particles bit for bit, except cuda_particle_lanes (the order of the neighbour sums: the last bits).
