@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cell_grid.h"
 #include "support.h"
 
 /* Martin & Moyce (1952), Table 2, n^2 = 2 (../shared/data/martin_moyce_1952_front_n2.csv). */
@@ -65,77 +66,26 @@ static double surge_front(const float* positions, uint32_t n, float* scratch, do
   }
 }
 
-/* Each particle's neighbours within h (itself included), by a grid of cells h wide over the box
- * lo-hi (positions outside it, or not finite, are clamped into its border cells; a pair then
- * lies in neighbouring cells still, so none is lost). The interior measure below
- * needs to tell the particles with a full neighbourhood from those at a surface or a collision-
- * only wall, whose density reads low for want of neighbours, not for expansion. Returns 0 when
- * out of memory. */
-static int count_neighbors(const float* positions, uint32_t n, double h, const double lo[3],
-                           const double hi[3], uint32_t* counts) {
-  int dims[3];
-  size_t cells = 1;
-  uint32_t* cell_of = (uint32_t*)malloc(sizeof(uint32_t) * ((size_t)n + 1));
-  uint32_t* order = (uint32_t*)malloc(sizeof(uint32_t) * ((size_t)n + 1));
-  uint32_t* start;
-  for (int d = 0; d < 3; ++d) {
-    dims[d] = (int)ceil((hi[d] - lo[d]) / h) + 1;
-    cells *= (size_t)dims[d];
-  }
-  /* (A cell index is a uint32_t: a tank of more than 2^32 cells of h is refused as out of memory.) */
-  start = cells < UINT32_MAX ? (uint32_t*)calloc(cells + 1, sizeof(uint32_t)) : NULL;
-  if (!cell_of || !order || !start) {
-    free(cell_of);
-    free(order);
-    free(start);
-    return 0;
-  }
-  for (uint32_t i = 0; i < n; ++i) {
-    int c[3];
-    for (int d = 0; d < 3; ++d) {
-      /* Clamped as a double, so a non-finite or far position is a border cell, not an overflow. */
-      const double x = (positions[3 * i + d] - lo[d]) / h;
-      c[d] = x >= 0.0 ? (x < (double)(dims[d] - 1) ? (int)x : dims[d] - 1) : 0;
-    }
-    cell_of[i] = (uint32_t)(((size_t)c[2] * dims[1] + c[1]) * dims[0] + c[0]);
-    ++start[cell_of[i] + 1];
-  }
-  for (size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
-  {
-    uint32_t* fill = (uint32_t*)malloc(sizeof(uint32_t) * (cells + 1));
-    if (!fill) {
-      free(cell_of);
-      free(order);
-      free(start);
-      return 0;
-    }
-    memcpy(fill, start, sizeof(uint32_t) * (cells + 1));
-    for (uint32_t i = 0; i < n; ++i) order[fill[cell_of[i]]++] = i;
-    free(fill);
-  }
+/* Each particle's neighbours within h (itself included), by the host cell grid (cell_grid.h).
+ * The interior measure needs to tell the particles with a full neighbourhood from those at a
+ * surface or a collision-only wall, whose density reads low for want of neighbours, not for
+ * expansion. Returns 0 when out of memory. */
+static int count_neighbors(const float* positions, uint32_t n, double h, uint32_t* counts) {
+  support_cell_grid grid;
+  if (!support_cell_grid_build(&grid, positions, n, h)) return 0;
   for (uint32_t i = 0; i < n; ++i) {
     const float* p = positions + 3 * i;
-    const int cx = (int)(cell_of[i] % (uint32_t)dims[0]);
-    const int cy = (int)((cell_of[i] / (uint32_t)dims[0]) % (uint32_t)dims[1]);
-    const int cz = (int)(cell_of[i] / ((uint32_t)dims[0] * (uint32_t)dims[1]));
+    const double q[3] = {p[0], p[1], p[2]};
+    const uint32_t near = support_cell_grid_near(&grid, q);
     uint32_t count = 0;
-    for (int z = cz - 1; z <= cz + 1; ++z)
-      for (int y = cy - 1; y <= cy + 1; ++y)
-        for (int x = cx - 1; x <= cx + 1; ++x) {
-          size_t c;
-          if (x < 0 || y < 0 || z < 0 || x >= dims[0] || y >= dims[1] || z >= dims[2]) continue;
-          c = ((size_t)z * dims[1] + y) * dims[0] + x;
-          for (uint32_t k = start[c]; k < start[c + 1]; ++k) {
-            const float* q = positions + 3 * order[k];
-            const double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
-            if (dx * dx + dy * dy + dz * dz < h * h) ++count;
-          }
-        }
+    for (uint32_t k = 0; k < near; ++k) {
+      const float* o = positions + 3 * grid.candidates[k];
+      const double dx = q[0] - o[0], dy = q[1] - o[1], dz = q[2] - o[2];
+      if (dx * dx + dy * dy + dz * dz < h * h) ++count;
+    }
     counts[i] = count;
   }
-  free(cell_of);
-  free(order);
-  free(start);
+  support_cell_grid_free(&grid);
   return 1;
 }
 
@@ -260,10 +210,6 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
   if ((r = sph_world_get_def(world, &def)) != SPH_OK) goto done;
   {
     const double kernel_radius = def.kernel_radius;
-    const double grid_lo[3] = {tank_min[0] - kernel_radius, tank_min[1] - kernel_radius,
-                               tank_min[2] - kernel_radius};
-    const double grid_hi[3] = {tank_max[0] + kernel_radius, tank_max[1] + kernel_radius,
-                               tank_max[2] + kernel_radius};
     const double scale = time_scale();
     const double frame = config->sample_T / scale;
     const uint32_t frames = (uint32_t)ceil(config->end_T / config->sample_T);
@@ -306,7 +252,7 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
                                         count, NULL)) != SPH_OK)
         goto done;
       if (config->measure_interior) {
-        if (!count_neighbors(positions, count, kernel_radius, grid_lo, grid_hi, neighbor_counts)) {
+        if (!count_neighbors(positions, count, kernel_radius, neighbor_counts)) {
           r = SPH_ERROR_OUT_OF_HOST_MEMORY;
           goto done;
         }

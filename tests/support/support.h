@@ -4,7 +4,8 @@
  * (a ball, a box tiled exactly), a world from a def and params, spawning, reading attributes in
  * storage order or by particle id, the rest sphere, the closed tank, the dam break column in a
  * tank. The Martin & Moyce dam-break case (a complete run and its comparison with the
- * measurements) is dam_break.h, here too.
+ * measurements) is dam_break.h, here too, and a host cell grid for brute-force sums is
+ * cell_grid.h.
  *
  * Plain C99 on the public API (sph_c.h) only, no test framework: C tests, C++ tests, the
  * benchmarks and the samples all link it (CMake target sph_support). Every function that calls

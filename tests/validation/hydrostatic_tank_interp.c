@@ -15,7 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "tank_cell_grid.h"
+#include "cell_grid.h"
 #include "validation_util.h"
 
 struct tank_interp {
@@ -75,8 +75,8 @@ tank_interp* tank_interp_create(uint32_t bins, double width, double depth, doubl
 void tank_interp_add(tank_interp* t, uint32_t n, const float* x, const float* p, const float* rho,
                      double mass, double rho0) {
   const double h = t->h, h2 = h * h, poly6 = 315.0 / (64.0 * M_PI * pow(h, 9.0));
-  tank_cell_grid grid;
-  tank_cell_grid_build(&grid, x, n, h);
+  support_cell_grid grid;
+  assert_true(support_cell_grid_build(&grid, x, n, h));
   free(t->k_weight);
   t->k_weight = (double*)calloc((size_t)n * t->bins, sizeof(double));
   assert_non_null(t->k_weight);
@@ -108,7 +108,7 @@ void tank_interp_add(tank_interp* t, uint32_t n, const float* x, const float* p,
       for (uint32_t l = 0; l < lines; ++l)
         for (uint32_t k = 0; k < samples; ++k) {
           const double q[3] = {margin + (k + 0.5) * dx, y, margin + l * t->step};
-          const uint32_t near = tank_cell_grid_near(&grid, q);
+          const uint32_t near = support_cell_grid_near(&grid, q);
           for (uint32_t e = 0; e < near; ++e) {
             const uint32_t j = grid.candidates[e];
             const double d[3] = {q[0] - x[3 * j], q[1] - x[3 * j + 1], q[2] - x[3 * j + 2]};
@@ -168,7 +168,7 @@ void tank_interp_add(tank_interp* t, uint32_t n, const float* x, const float* p,
     t->d_band[b] += k_b > 0.0 ? kq_b / k_b - kq_i / k_i : 0.0;
     t->band_share[b] += k_b / (k_b + k_i);
   }
-  tank_cell_grid_free(&grid);
+  support_cell_grid_free(&grid);
 }
 
 void tank_interp_profile(const tank_interp* t, double* pressure, double* y_weighted, uint32_t* count) {

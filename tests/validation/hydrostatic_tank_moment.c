@@ -31,7 +31,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "tank_cell_grid.h"
+#include "cell_grid.h"
 #include "validation_util.h"
 
 struct tank_moment {
@@ -110,9 +110,9 @@ static void corrected_operator(double b[3][3], const double sum[3], const double
 /* The neighbours by a cell grid of cells h wide over the particles' bounding box. */
 void tank_moment_add(tank_moment* t, uint32_t n, const float* x, const float* p, const float* rho,
                      double mass, double rho0, double h, double width, double bin, double step) {
-  tank_cell_grid grid;
+  support_cell_grid grid;
   const double grad = -45.0 / (M_PI * pow(h, 6.0)) * spiky_scale(step, h); /* dW/dr = grad (h - r)^2 */
-  tank_cell_grid_build(&grid, x, n, h);
+  assert_true(support_cell_grid_build(&grid, x, n, h));
   for (uint32_t i = 0; i < n; ++i) {
     const double xi = x[3 * i], yi = x[3 * i + 1], zi = x[3 * i + 2];
     const double ki = p[i] / ((double)rho[i] * rho[i]);
@@ -122,7 +122,7 @@ void tank_moment_add(tank_moment* t, uint32_t n, const float* x, const float* p,
     if (xi < h || xi > width - h || zi < h || zi > width - h || l < 0 || l >= (int)t->bins) continue;
     {
       const double q[3] = {xi, yi, zi};
-      const uint32_t near = tank_cell_grid_near(&grid, q);
+      const uint32_t near = support_cell_grid_near(&grid, q);
       for (uint32_t e = 0; e < near; ++e) {
         const uint32_t j = grid.candidates[e];
         const double d[3] = {xi - x[3 * j], yi - x[3 * j + 1], zi - x[3 * j + 2]};
@@ -150,7 +150,7 @@ void tank_moment_add(tank_moment* t, uint32_t n, const float* x, const float* p,
     t->zeroth[l] += zeroth;
     ++t->count[l];
   }
-  tank_cell_grid_free(&grid);
+  support_cell_grid_free(&grid);
 }
 
 void tank_moment_print(const tank_moment* t, const double* y, double surface, double rho0, double g,

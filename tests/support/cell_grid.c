@@ -1,12 +1,10 @@
 // SPDX-License-Identifier: MIT
-#include "tank_cell_grid.h"
+#include "cell_grid.h"
 
 #include <math.h>
 #include <stdlib.h>
 
-#include "validation_util.h"
-
-void tank_cell_grid_build(tank_cell_grid* g, const float* x, uint32_t n, double h) {
+int support_cell_grid_build(support_cell_grid* g, const float* x, uint32_t n, double h) {
   uint32_t cells, *cell_of, *fill;
   g->h = h;
   for (int a = 0; a < 3; ++a) {
@@ -24,7 +22,12 @@ void tank_cell_grid_build(tank_cell_grid* g, const float* x, uint32_t n, double 
   g->candidates = (uint32_t*)malloc(sizeof(uint32_t) * (n + 1u));
   cell_of = (uint32_t*)malloc(sizeof(uint32_t) * (n + 1u));
   fill = (uint32_t*)malloc(sizeof(uint32_t) * cells);
-  assert_true(g->start && g->order && g->candidates && cell_of && fill);
+  if (!g->start || !g->order || !g->candidates || !cell_of || !fill) {
+    support_cell_grid_free(g);
+    free(cell_of);
+    free(fill);
+    return 0;
+  }
   for (uint32_t i = 0; i < n; ++i) {
     int c[3];
     for (int a = 0; a < 3; ++a) c[a] = (int)((x[3 * i + a] - g->lo[a]) / h);
@@ -36,9 +39,10 @@ void tank_cell_grid_build(tank_cell_grid* g, const float* x, uint32_t n, double 
   for (uint32_t i = 0; i < n; ++i) g->order[fill[cell_of[i]]++] = i;
   free(cell_of);
   free(fill);
+  return 1;
 }
 
-uint32_t tank_cell_grid_near(tank_cell_grid* g, const double q[3]) {
+uint32_t support_cell_grid_near(support_cell_grid* g, const double q[3]) {
   uint32_t count = 0;
   int c[3];
   for (int a = 0; a < 3; ++a) c[a] = (int)floor((q[a] - g->lo[a]) / g->h);
@@ -54,7 +58,7 @@ uint32_t tank_cell_grid_near(tank_cell_grid* g, const double q[3]) {
   return count;
 }
 
-void tank_cell_grid_free(tank_cell_grid* g) {
+void support_cell_grid_free(support_cell_grid* g) {
   free(g->start);
   free(g->order);
   free(g->candidates);
