@@ -7,6 +7,7 @@
 #include "../src/core/exact_float_sum.h"
 #include "../src/physics/grid_hash.h"
 #include "device_halo.h"
+#include "device_iota.h"
 #include "dfsph_solver.h"
 #include "kernel_launch.h"
 
@@ -21,11 +22,6 @@ __global__ void gather_words_kernel(const uint32_t* __restrict__ src, uint32_t w
   if (t >= static_cast<uint64_t>(m) * words) return;
   const uint64_t k = t / words, w = t % words;
   dst[t] = src[static_cast<uint64_t>(idx[k]) * words + w];
-}
-
-__global__ void iota_kernel(uint32_t* v, uint32_t n) {
-  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i < n) v[i] = i;
 }
 
 // What each record takes from a particle and gives back to its ghost (core/halo_records.h).
@@ -181,9 +177,7 @@ DeviceHalo::DeviceHalo(uint32_t capacity, int ranks) : capacity_(capacity), rank
   sort_temp_.allocate(std::max<size_t>(sort_temp_bytes_, 1), "halo key sort temporary storage");
   lists_temp_bytes_ = lists_temp_bytes(static_cast<uint32_t>(2 * n));
   lists_temp_.allocate(std::max<size_t>(lists_temp_bytes_, 1), "halo lists temporary storage");
-  iota_kernel<<<blocks_for(static_cast<uint32_t>(n), kDefaultBlockSize), kDefaultBlockSize>>>(
-      iota_.get(), static_cast<uint32_t>(n));
-  check_launch("iota_kernel");
+  fill_iota(iota_.get(), static_cast<uint32_t>(n));
   cuda_check(cudaMemset(mismatch_.get(), 0, sizeof(uint32_t)), "halo id check reset");
   cuda_check(cudaDeviceSynchronize(), "halo set-up");
 }

@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "device_halo_springs.h"
+#include "device_iota.h"
 #include "device_lower_bound.cuh"
 #include "kernel_launch.h"
 
@@ -26,11 +27,6 @@ __device__ uint32_t find_index(const uint32_t* __restrict__ ids, const uint32_t*
                                uint32_t id) {
   const uint32_t at = lower_bound_u32(ids, 0, n, id);
   return at < n && ids[at] == id ? idx[at] : kNoSpring;
-}
-
-__global__ void iota_kernel(uint32_t* v, uint32_t n) {
-  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i < n) v[i] = i;
 }
 
 __global__ void index_owned_kernel(SpringList* __restrict__ lists, uint32_t owned,
@@ -134,9 +130,7 @@ DeviceHaloSprings::DeviceHaloSprings(uint32_t capacity) : capacity_(capacity) {
                                    entries_of(n), IsId{}),
              "halo spring wanted size query");
   ensure_temp(std::max(sort, select));
-  iota_kernel<<<blocks_for(static_cast<uint32_t>(n), kDefaultBlockSize), kDefaultBlockSize>>>(
-      iota_.get(), static_cast<uint32_t>(n));
-  check_launch("iota_kernel");
+  fill_iota(iota_.get(), static_cast<uint32_t>(n));
   cuda_check(cudaDeviceSynchronize(), "halo springs set-up");
 }
 
