@@ -56,7 +56,6 @@ DeviceParticleStore::DeviceParticleStore(uint32_t capacity,
   arrays_.dfsph_factor = static_cast<float*>(find(kArrayDfsphFactor));
   arrays_.dfsph_step = static_cast<float*>(find(kArrayDfsphStep));
   arrays_.dfsph_warm_pressure = static_cast<float*>(find(kArrayDfsphWarmPressure));
-  arrays_.dfsph_previous_step = static_cast<float*>(find(kArrayDfsphPreviousStep));
   arrays_.dfsph_contact = static_cast<Float4*>(find(kArrayDfsphContact));
   arrays_.dfsph_contact_impulse = static_cast<Float4*>(find(kArrayDfsphContactImpulse));
   arrays_.dfsph_residual = static_cast<float*>(find(kArrayDfsphResidual));

@@ -66,7 +66,6 @@ struct ParticleArrays {
   float* dfsph_factor;            // alpha / rho of the density pass
   float* dfsph_step;              // the iteration's p / rho^2, which neighbours read
   float* dfsph_warm_pressure;     // the density solve's warm start in the sorted order
-  float* dfsph_previous_step;     // the step the last density iteration applied (SPH_DFSPH_CHEBYSHEV)
   Float4* dfsph_contact;          // the particle's contact with the colliders (n, smallest normal speed)
   Float4* dfsph_contact_impulse;  // null unless SPH_FEATURE_COLLIDER_LOADS: the clamp's (collider_loads.h)
   float* dfsph_residual;          // the conjugate gradients' preconditioned residual z

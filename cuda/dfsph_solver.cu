@@ -114,8 +114,8 @@ __global__ void __launch_bounds__(kDfsphSolveBlock)
       // carried one, which every velocity update of this solve has added its steps to.
       const DfsphResidual r =
           chebyshev_density_residual(rate, a.density[i], a.dfsph_factor[i], fluid.rest_density, dt,
-                                     a.dfsph_pressure[i], state->solve_weight, &a.dfsph_previous_step[i]);
-      a.dfsph_step[i] = a.dfsph_previous_step[i] = r.k;
+                                     a.dfsph_pressure[i], state->solve_weight, &a.dfsph_step[i]);
+      a.dfsph_step[i] = r.k;
       error = r.error;
     } else {
       const DfsphResidual r =

@@ -60,7 +60,6 @@ CpuBackend::CpuBackend(const WorldConfig& config, unsigned workers, const TaskSy
   dfsph_divergence_ = store_.find_typed<float>(kArrayDfsphDivergencePressure);
   dfsph_factor_ = store_.find_typed<float>(kArrayDfsphFactor);
   dfsph_residual_ = store_.find_typed<float>(kArrayDfsphResidual);
-  dfsph_previous_step_ = store_.find_typed<float>(kArrayDfsphPreviousStep);
   dfsph_contact_ = store_.find_typed<Float4>(kArrayDfsphContact);
   clamp_impulse_ = store_.find_typed<Float4>(kArrayDfsphContactImpulse);
   cg_value_ = store_.find_typed<float>(kArrayDfsphCgValue);

@@ -323,7 +323,6 @@ class CpuBackend final : public Backend {
   CpuArrayRef<float> dfsph_divergence_;       // DFSPH: the divergence solve's p / rho^2 times dt
   CpuArrayRef<float> dfsph_factor_;           // DFSPH: alpha / rho of the density pass
   CpuArrayRef<float> dfsph_residual_;         // DFSPH: each particle's share of the solve's error
-  CpuArrayRef<float> dfsph_previous_step_;    // DFSPH: the step the last iteration applied (Chebyshev)
   CpuArrayRef<Float4> dfsph_contact_;         // DFSPH: each particle's contact with the colliders
   CpuArrayRef<Float4> clamp_impulse_;         // DFSPH with the loads: the clamp's, per particle
   bool dfsph_contacts_ = false;               // DFSPH: the substep has colliders (contacts to respect)

@@ -88,14 +88,13 @@ void CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, c
   // SPH_DFSPH_CHEBYSHEV (dfsph_passes.h): the density solve's steps mixed with the last ones.
   const bool chebyshev = kind == DfsphSolve::Density && c.linear_solver == kDfsphChebyshev;
   const float weight = chebyshev ? chebyshev_weight(pass) : 1.0f;
-  float* previous = dfsph_previous_step_.data();
   // The gather reads positions and the velocities' columns; each particle writes only its k.
   parallel().for_each(count_, [&](uint32_t i) {
     const float rate = density_rate_of(fluid, view, columns, walls, i);
     if (chebyshev) {
       const DfsphResidual r =
-          chebyshev_density_residual(rate, density[i], factor[i], rho0, dt, held[i], weight, &previous[i]);
-      k[i] = previous[i] = r.k;
+          chebyshev_density_residual(rate, density[i], factor[i], rho0, dt, held[i], weight, &k[i]);
+      k[i] = r.k;
       error[i] = r.error;
       return;
     }

@@ -64,7 +64,6 @@ constexpr const char* kArrayDfsphDivergencePressure = "dfsph_divergence";  // p_
 constexpr const char* kArrayDfsphFactor = "dfsph_factor";                  // alpha_i / rho_i
 constexpr const char* kArrayDfsphStep = "dfsph_step";                      // this iteration's k_i
 constexpr const char* kArrayDfsphResidual = "dfsph_residual";              // the particle's error
-constexpr const char* kArrayDfsphPreviousStep = "dfsph_previous_step";     // SPH_DFSPH_CHEBYSHEV: last k
 constexpr const char* kArrayDfsphWarmPressure = "dfsph_warm_pressure";     // warm start, sorted order
 constexpr const char* kArrayDfsphContact = "dfsph_contact";                // Float4: wall normal, speed
 // The conjugate gradients' density solve (dfsph_cg.h; registered by particle_arrays.cpp only where
@@ -178,18 +177,17 @@ struct Dfsph {
   }
 
   // Carried: the two solves' pressures (warm starts; sorted, rolled back, saved). Scratch: the
-  // factor, the pressure of the iteration that neighbours read, each particle's error for the
-  // solve's mean (CPU), the step the last iteration applied (SPH_DFSPH_CHEBYSHEV), the density solve's warm
-  // start gathered into the sorted order (CUDA), the particle's contact with the colliders (dfsph_passes.h,
-  // wall_contact), and the density pass's neighbour counts (the divergence solve skips particles with too
-  // few).
+  // factor, the pressure of the iteration that neighbours read (and, SPH_DFSPH_CHEBYSHEV, the step
+  // its next residual pass mixes in), each particle's error for the solve's mean (CPU), the density solve's
+  // warm start gathered into the sorted order (CUDA), the particle's contact with the colliders
+  // (dfsph_passes.h, wall_contact), and the density pass's neighbour counts (the divergence solve skips
+  // particles with too few).
   static constexpr ParticleArraySpec kArrays[] = {
       {kArrayDfsphPressure, sizeof(float), ParticleArrayRole::Carried, 1, nullptr, nullptr},
       {kArrayDfsphDivergencePressure, sizeof(float), ParticleArrayRole::Carried, 1, nullptr, nullptr},
       {kArrayDfsphFactor, sizeof(float), ParticleArrayRole::Scratch, 1, nullptr, nullptr},
       {kArrayDfsphStep, sizeof(float), ParticleArrayRole::Scratch, 1, nullptr, nullptr},
       {kArrayDfsphResidual, sizeof(float), ParticleArrayRole::Scratch, 1, nullptr, nullptr},
-      {kArrayDfsphPreviousStep, sizeof(float), ParticleArrayRole::Scratch, 1, nullptr, nullptr},
       {kArrayDfsphWarmPressure, sizeof(float), ParticleArrayRole::Scratch, 1, nullptr, nullptr},
       {kArrayDfsphContact, 4 * sizeof(float), ParticleArrayRole::Scratch, 1, nullptr, nullptr},
       {kArrayNeighborCount, sizeof(uint32_t), ParticleArrayRole::Scratch, 1, nullptr, nullptr}};

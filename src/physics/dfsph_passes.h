@@ -296,8 +296,11 @@ SPH_HD float chebyshev_step(float weight, float jacobi_step, float previous_step
 
 // One particle's residual pass of the Chebyshev density solve, as both backends run it: the released
 // residual mixed with `previous`, the step the particle applied in the pass before (read only past the
-// first pass, weight != 1: before it the array holds nothing of this solve). k: the step to apply
-// (and to keep as the next pass's previous); error: the plain solve's.
+// first pass, weight != 1: before it the array holds nothing of this solve). Both backends pass the
+// particle's own slot of the steps' array (dfsph_step), which still holds that step: the velocity
+// update between two residual passes only reads it, and a rank's ghosts take their owners' steps,
+// which only ghosts' own (discarded) residuals read. k: the step to apply (it overwrites `previous`
+// in the caller); error: the plain solve's.
 SPH_HD DfsphResidual chebyshev_density_residual(float rate, float density, float factor, float rest_density,
                                                 float dt, float held, float weight, const float* previous) {
   const DfsphResidual r = density_residual_released(rate, density, factor, rest_density, dt, held);
