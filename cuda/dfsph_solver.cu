@@ -11,11 +11,12 @@
 namespace sph {
 namespace {
 
-// kBoundary: SPH_FEATURE_BOUNDARY_DENSITY, the walls' share (dfsph_boundary.h, place 1) at the
-// substep's start, its record kept for the solves.
+// One particle of the density pass. kBoundary: SPH_FEATURE_BOUNDARY_DENSITY, the walls' share
+// (dfsph_boundary.h, place 1) at the substep's start, its record kept for the solves.
 template <bool kBoundary>
-__global__ void dfsph_density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
-                                     DeviceScene scene, FrameState* state) {
+__device__ __forceinline__ void dfsph_density_particle(const FluidConstants& fluid, const GridView& grid,
+                                                       const ParticleArrays& a, uint32_t n,
+                                                       const DeviceScene& scene, FrameState* state) {
   mark_stage(state, kStageDensity);
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
@@ -54,6 +55,22 @@ __global__ void dfsph_density_kernel(FluidConstants fluid, GridView grid, Partic
   }
   a.sorted_position[i].w = 0.0f;  // no equation of state: the pressure is written after the solves
   a.sorted_velocity[i] = make_float4_record(xyz(a.velocity[k]), 1.0f / s.density);
+}
+
+// The pass without the walls' share, held to 72 registers: ptxas gives it 109 uncapped, which
+// leaves room for 4 blocks of 128 threads an SM; at 72 (no spills, ptxas -v) 7 fit, and the
+// gather hides more of its memory latency. Measured in the million-particle dam break on an H100
+// (session 33, one call, the same results to the last digit): the density stage 0.972 -> 0.798
+// ms a substep with the neighbour lists, 0.841 -> 0.587 with the masks; the whole run 2.9 / 3.4 %
+// less wall time (docs/performance.md, "Session 33").
+__global__ void __maxnreg__(72) dfsph_density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a,
+                                                     uint32_t n, DeviceScene scene, FrameState* state) {
+  dfsph_density_particle<false>(fluid, grid, a, n, scene, state);
+}
+// With the walls' share (uncapped: at 72 registers it spills 220 bytes, not measured).
+__global__ void dfsph_density_walls_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
+                                           DeviceScene scene, FrameState* state) {
+  dfsph_density_particle<true>(fluid, grid, a, n, scene, state);
 }
 
 // v held to particle i's contact; with the loads, the change is added to its clamp impulses (the
@@ -319,9 +336,9 @@ void enqueue_dfsph_density(const FluidConstants& fluid, const GridView& grid, co
                            const DeviceScene& scene, FrameState* state, cudaStream_t stream) {
   const unsigned threads = tuning.density_block, blocks = blocks_for(n, threads);
   if (options.boundary_density)
-    dfsph_density_kernel<true><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
+    dfsph_density_walls_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
   else
-    dfsph_density_kernel<false><<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
+    dfsph_density_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
   check_launch("dfsph_density_kernel");
 }
 
