@@ -15,6 +15,9 @@
 # SPH_CUDA_ALONE stays alone (one that costs as much as a batch: it would serialise a batch behind
 # it); files that are not .cu pass through. Two batched files must not define the same file-local
 # name (a batch is one translation unit): shared helpers go in a header or in their own file.
+# A batched file may carry no other per-file settings (COMPILE_DEFINITIONS, COMPILE_FLAGS,
+# INCLUDE_DIRECTORIES, OBJECT_DEPENDS): its batch would drop them, so configuring stops instead.
+# Set per-file options before the call: the sources themselves are no longer in the target after.
 function(sph_cuda_batches out_var batch_size)
   set(passed)
   set(keys)
@@ -24,6 +27,13 @@ function(sph_cuda_batches out_var batch_size)
       list(APPEND passed "${src}")
       continue()
     endif()
+    foreach(property COMPILE_DEFINITIONS COMPILE_FLAGS INCLUDE_DIRECTORIES OBJECT_DEPENDS)
+      get_source_file_property(value "${src}" ${property})
+      if(value)
+        message(FATAL_ERROR "SPH_UNITY_CUDA: ${src} has its own ${property} (${value}), which its batch would "
+                            "drop; give it SPH_CUDA_ALONE or move the setting to COMPILE_OPTIONS")
+      endif()
+    endforeach()
     get_source_file_property(options "${src}" COMPILE_OPTIONS)
     if(NOT options)
       set(options "")

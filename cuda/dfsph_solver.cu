@@ -60,9 +60,9 @@ __device__ __forceinline__ void dfsph_density_particle(const FluidConstants& flu
 // The pass without the walls' share, held to 72 registers: ptxas gives it 109 uncapped, which
 // leaves room for 4 blocks of 128 threads an SM; at 72 (no spills, ptxas -v) 7 fit, and the
 // gather hides more of its memory latency. Measured in the million-particle dam break on an H100
-// (session 33, one call, the same results to the last digit): the density stage 0.972 -> 0.798
-// ms a substep with the neighbour lists, 0.841 -> 0.587 with the masks; the whole run 2.9 / 3.4 %
-// less wall time (docs/performance.md, "Session 33").
+// (session 33, one call, the cap then on the whole template; the same printed results): the
+// density stage 0.972 -> 0.798 ms a substep with the neighbour lists, 0.841 -> 0.587 with the
+// masks; the whole run 2.9 / 3.4 % less wall time (docs/performance.md, "Session 33").
 __global__ void __maxnreg__(72) dfsph_density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a,
                                                      uint32_t n, DeviceScene scene, FrameState* state) {
   dfsph_density_particle<false>(fluid, grid, a, n, scene, state);

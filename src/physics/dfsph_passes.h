@@ -296,7 +296,7 @@ SPH_HD float chebyshev_step(float weight, float jacobi_step, float previous_step
 
 // One particle's residual pass of the Chebyshev density solve, as both backends run it: the released
 // residual mixed with `previous`, the step the particle applied in the pass before (read only past the
-// first pass, weight != 1: before it the array holds nothing of this solve). Both backends pass the
+// first pass, weight != 1: before it the array holds no residual step of this solve). Both backends pass the
 // particle's own slot of the steps' array (dfsph_step), which still holds that step: the velocity
 // update between two residual passes only reads it, and a rank's ghosts take their owners' steps,
 // which only ghosts' own (discarded) residuals read. k: the step to apply (it overwrites `previous`
