@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -99,9 +100,21 @@ SPH_API sph_result SPH_CALL sph_vdb_load_sdf(sph_context* context, const char* p
 
     openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
     if (box.empty()) return fail(SPH_ERROR_INVALID_ARGUMENT, "the level set has no active voxels");
+    // The dense grid spans the active box and one voxel around it. A file's active voxels may sit
+    // at the 32-bit coordinate limits, where the box's own arithmetic (expand, dim) would overflow
+    // (found by fuzz_vdb: a box 2^32 wide gave a negative voxel count), so the extents are checked
+    // in 64 bits first.
+    double voxels = 1.0;
+    for (int a = 0; a < 3; ++a) {
+      const int64_t lo = box.min()[a], hi = box.max()[a];
+      if (lo <= static_cast<int64_t>(INT32_MIN) + 1 || hi >= static_cast<int64_t>(INT32_MAX) - 1)
+        return fail(SPH_ERROR_INVALID_ARGUMENT,
+                    "the level set's active voxels reach the 32-bit index limits (from " +
+                        std::to_string(lo) + " to " + std::to_string(hi) + ")");
+      voxels *= static_cast<double>(hi - lo + 3);
+    }
     box.expand(1);
     const openvdb::Coord dim = box.dim();
-    const double voxels = static_cast<double>(dim.x()) * dim.y() * dim.z();
     if (voxels > 2147483648.0)
       return fail(SPH_ERROR_CAPACITY,
                   "the dense grid would have " + std::to_string(voxels) + " voxels (over 2^31)");
