@@ -2,11 +2,14 @@
 /* The two-rank calibration of docs/scaling.md's model on the CPU backend (issue 19 item 6):
  *
  *   mpirun -np R bench/mpi_halo [--spacing S] [--substeps K] [--backend cpu|cuda] [--springs 1]
+ *                               [--workers W]
  *
  * --backend cuda: every rank on the CUDA backend (the host-staged halo path; ranks on one GPU
  * share it), the GPU calibration of the model. --springs 1: with SPH_FEATURE_SPRINGS (every
  * particle linked to its lattice neighbours in the warm-up frame; springs across ranks, on CPU
  * ranks and, since session 17, CUDA ranks), the cost of their exchanges and spring ghosts.
+ * --workers W: each CPU rank's worker threads (sph_context_def.cpu_worker_count; default 0, all
+ * hardware threads, which oversubscribes a machine as soon as two ranks share it).
  * A water block of 0.8 x 0.4 x 0.2 m at rest in a closed tank (the slabs cut its 0.8 m axis),
  * stepped one warm-up frame (the first cut and its migration) and then timed over K substeps
  * (default 20). Prints, on rank 0: the ranks, the particles per rank, the ghosts (halo) per rank
@@ -63,6 +66,7 @@ int main(int argc, char** argv) {
   uint32_t substeps = 20;
   sph_backend backend = SPH_BACKEND_CPU;
   int springs = 0;
+  uint32_t workers = 0;
   int rank, size;
   sph_context* context = NULL;
   sph_world* scratch = NULL;
@@ -85,8 +89,16 @@ int main(int argc, char** argv) {
     if (strcmp(argv[i], "--substeps") == 0) substeps = (uint32_t)atoi(argv[i + 1]);
     if (strcmp(argv[i], "--backend") == 0) backend = support_backend_from_name(argv[i + 1], SPH_BACKEND_CPU);
     if (strcmp(argv[i], "--springs") == 0) springs = atoi(argv[i + 1]) != 0;
+    if (strcmp(argv[i], "--workers") == 0) workers = (uint32_t)atoi(argv[i + 1]);
   }
-  need(support_context_create(backend, &context), "context");
+  {
+    sph_context_def context_def;
+    need(sph_context_def_init(&context_def), "context def");
+    context_def.backend = backend;
+    context_def.cpu_worker_count = workers;
+    context_def.cuda_dfsph_masks = sph_test_cuda_dfsph_masks();
+    need(sph_context_create(&context_def, &context), "context");
+  }
   need(sph_world_def_init(&def), "def");
   def.particle_spacing = spacing;
   def.kernel_radius = 1.8f * spacing;
@@ -131,7 +143,8 @@ int main(int argc, char** argv) {
      * slab, h / L of the block's particles (L = 0.8 m, the cut axis); 2 (R - 1) faces. */
     const double h = 1.8 * spacing;
     const double model = size > 1 ? n * h / 0.8 * 2.0 * (size - 1) / size : 0.0;
-    printf("backend %s%s\n", backend == SPH_BACKEND_CUDA ? "cuda" : "cpu", springs ? ", springs" : "");
+    printf("backend %s%s, workers a rank %u (0: all hardware threads)\n",
+           backend == SPH_BACKEND_CUDA ? "cuda" : "cpu", springs ? ", springs" : "", workers);
     printf("ranks %d, %u particles (%.0f per rank, the fullest %lld), %u substeps\n", size, n,
            (double)n / size, (long long)owned_max, stats.substeps);
     printf(

@@ -45,7 +45,10 @@ struct WorldSlot {
 struct SdfSlot {
   sph_sdf* ptr = nullptr;
   int context = -1;
-  double volume = 0.0;  // of its grid box, m^3 (for bounding source lattices)
+  // The size of its grid's box in the SDF's local frame, m: the bounding box of the index-space
+  // corners (0 .. dims - 1 per axis) under index_to_local, the box whose lattice a source keeps
+  // (src/core/scene_objects.cpp, lattice_inside).
+  double extent[3] = {0.0, 0.0, 0.0};
   bool has_velocity = false;
 };
 struct IdSlot {
@@ -821,11 +824,23 @@ class Program {
     g.data = in_.chance(8) ? nullptr : storage.data();
     if (in_.chance(8)) g.struct_size = struct_size(sizeof g);
   }
-  static double grid_volume(const sph_grid_desc& g) {
-    const float* m = g.index_to_local;
-    const double det = m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) +
-                       m[2] * (m[4] * m[9] - m[5] * m[8]);
-    return std::fabs(det) * g.dims[0] * g.dims[1] * g.dims[2];
+  // SdfSlot::extent of a grid: row r of index_to_local maps index steps to local axis r, so the
+  // corners' box spans sum_c |m[r][c]| (dims[c] - 1) along it (a sheared or rotated grid's box is
+  // larger than its volume; a grid one voxel thick has a volume but no extent along that axis).
+  // An all-zero map is the identity, 1 m voxels (sph_grid_desc).
+  static void grid_extent(const sph_grid_desc& g, double extent[3]) {
+    static const float kIdentity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    const bool zero = std::all_of(g.index_to_local, g.index_to_local + 12, [](float v) { return v == 0.0f; });
+    const float* m = zero ? kIdentity : g.index_to_local;
+    for (int r = 0; r < 3; ++r) {
+      extent[r] = 0.0;
+      for (int c = 0; c < 3; ++c)
+        extent[r] += std::fabs(static_cast<double>(m[4 * r + c])) * (static_cast<double>(g.dims[c]) - 1.0);
+    }
+  }
+  // A library-made grid (shapes, meshes): axis-aligned voxels of `voxel` metres.
+  static void voxel_extent(const uint32_t dims[3], double voxel, double extent[3]) {
+    for (int k = 0; k < 3; ++k) extent[k] = (static_cast<double>(dims[k]) - 1.0) * voxel;
   }
 
   void op_sdf_create() {
@@ -876,7 +891,8 @@ class Program {
       FUZZ_CALL(sph_sdf_destroy(out));
       return;
     }
-    sdfs_[slot] = SdfSlot{out, cslot, grid_volume(d.distance), with_velocity};
+    sdfs_[slot] = SdfSlot{out, cslot, {}, with_velocity};
+    grid_extent(d.distance, sdfs_[slot].extent);
   }
 
   void op_sdf_create_shape() {
@@ -915,8 +931,8 @@ class Program {
       FUZZ_CALL(sph_sdf_destroy(out));
       return;
     }
-    const double v = d.voxel_size;
-    sdfs_[slot] = SdfSlot{out, cslot, got * v * v * v, false};
+    sdfs_[slot] = SdfSlot{out, cslot, {}, false};
+    voxel_extent(dims, sph_fuzz::shape_size_or_default(d.voxel_size, 0.01), sdfs_[slot].extent);
   }
 
   // A small random triangle mesh (sometimes with an index out of range, a non-finite vertex, an
@@ -990,7 +1006,8 @@ class Program {
       FUZZ_CALL(sph_sdf_destroy(out));
       return;
     }
-    sdfs_[slot] = SdfSlot{out, cslot, got * voxel * voxel * voxel, false};
+    sdfs_[slot] = SdfSlot{out, cslot, {}, false};
+    voxel_extent(dims, voxel, sdfs_[slot].extent);
   }
 
   // The step budget (refused: NaN, negative, above a day; the old one kept) and a cancel request
@@ -1190,11 +1207,18 @@ class Program {
     if (in_.chance(8)) d.user_attribute = in_.u32();  // FEATURE_DISABLED unless the world has the feature
     if (in_.chance(8)) d.reserved1 = in_.u32();
     d.struct_size = struct_size(sizeof d);
-    // The library keeps the region's lattice (up to 2^28 points, legitimately); skip regions
-    // whose lattice is large but legal. FCC: sqrt(2) / s^3 points per m^3.
+    // The library keeps the region's lattice (up to 2^28 candidates, legitimately); skip regions
+    // whose lattice is large but legal. The candidates as the library counts them: the FCC
+    // points of the grid's box, floor(L / b) + 1 steps of b = s / sqrt 2 per axis, half of them.
+    // (Until session 34 this was the grid's volume times sqrt 2 / s^3, with the all-zero map
+    // read as volume 0 and a shape's default voxel as 0: an 8 x 4 x 6 grid of 1 m voxels was
+    // estimated at no points, made 3.2 million, and checkpointing them took 35 s under ASan, a
+    // fuzz timeout; the library did what its documentation says.)
     if (world_ok(slot, w) && sslot >= 0 && d.region) {
       const double s = d.spacing > 0.0f ? d.spacing : worlds_[slot].spacing;
-      const double points = sdfs_[sslot].volume * std::sqrt(2.0) / (s * s * s);
+      const double b = s / std::sqrt(2.0);
+      double points = 0.5;
+      for (double e : sdfs_[sslot].extent) points *= std::floor(e / b) + 1.0;
       if (std::isfinite(points) && points > kMaxLattice && points < 4.0 * (1u << 28)) return;
     }
     sph_source_id id{0};
