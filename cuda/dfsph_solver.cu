@@ -73,17 +73,20 @@ __global__ void dfsph_density_walls_kernel(FluidConstants fluid, GridView grid, 
   dfsph_density_particle<true>(fluid, grid, a, n, scene, state);
 }
 
-// The solves' two passes (the velocity update and the residual), each run 2-3 times a density
-// iteration, are bound by the latency of their neighbours' gathers (ncu, session 27: 26-29 cycles
-// an issued instruction, memory throughput 43-66 %), so they are given 16 blocks of 128 threads
-// an SM, a full SM's 2,048 threads, which holds them to 32 registers (46-54 and 47 before: 10
-// blocks; ptxas spills 48-56 bytes a thread in the default instantiations, 104 with the corrected
-// gradient). Measured on an H200 in session 34 (one machine, the 1M dam break at 0.1 % with the
-// Chebyshev solve; docs/performance.md, "Session 34"): with the neighbour lists 56.93 / 56.84 s a
-// simulated second -> 52.89 / 52.92 at 12 blocks (40 registers) -> 49.08 at 16, the force stage
-// 4.72 -> 3.95 ms a substep; with the masks (the default) 71.44 -> 70.66 / 70.76; the same printed
-// results in every run.
+// The solves' two passes (the velocity update and the residual), run once each a solve iteration
+// (and for the warm start and the first residual), are bound by the latency of their neighbours'
+// gathers (ncu, session 27: 26-29 cycles an issued instruction, memory throughput 43-66 %), so
+// they are given 16 blocks of 128 threads an SM, all of an sm_90 SM's 2,048 threads (an SM with
+// fewer runs fewer blocks; the cap still holds), which holds them to 32 registers (ptxas -v, sm_90:
+// 46 and 47 before, 10 blocks; 48-56 bytes of spills a thread now). Measured on an H200 in
+// session 34 (one machine, the 1M dam break at 0.1 % with the Chebyshev solve; docs/performance.md,
+// "Session 34"): with the neighbour lists 56.93 / 56.84 s a simulated second -> 52.89 / 52.92 at 12
+// blocks (40 registers) -> 49.08 at 16, the force stage 4.72 -> 3.95 ms a substep; with the masks
+// (the default) 71.44 -> 70.66 / 70.76; the same printed results in every run. The corrected
+// gradient's velocity update (54 registers, which would spill 104 bytes at 32; not timed) keeps its
+// 9 blocks. Every launch of these kernels uses kDfsphSolveBlock threads.
 constexpr int kDfsphSolveBlocksPerSm = 16;
+constexpr int kDfsphCorrectedBlocksPerSm = 9;
 
 // v held to particle i's contact; with the loads, the change is added to its clamp impulses (the
 // CPU backend's CpuBackend::dfsph_clamp).
@@ -105,7 +108,8 @@ __global__ void dfsph_begin_solve_kernel(FrameState* state) {
 // solve's scale (dt for the divergence solve's impulse), added, or replacing the state-order
 // values on the warm start's pass.
 template <bool kWarm, bool kCorrected>
-__global__ void __launch_bounds__(kDfsphSolveBlock, kDfsphSolveBlocksPerSm)
+__global__ void __launch_bounds__(kDfsphSolveBlock,
+                                  kCorrected ? kDfsphCorrectedBlocksPerSm : kDfsphSolveBlocksPerSm)
     dfsph_correct_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n, Float4* v,
                          const float* k, float* carried, bool divergence, bool contacts, FrameState* state) {
   if (state->solve_run == 0) return;

@@ -45,10 +45,10 @@ struct WorldSlot {
 struct SdfSlot {
   sph_sdf* ptr = nullptr;
   int context = -1;
-  // The size of its grid's box in the SDF's local frame, m: the bounding box of the index-space
-  // corners (0 .. dims - 1 per axis) under index_to_local, the box whose lattice a source keeps
-  // (src/core/scene_objects.cpp, lattice_inside).
-  double extent[3] = {0.0, 0.0, 0.0};
+  // Its grid's box in the SDF's local frame, m: the bounding box of the index-space corners
+  // (0 .. dims - 1 per axis) under index_to_local, in float as the library computes it, the box
+  // whose lattice a source keeps (src/core/scene_objects.cpp, lattice_inside).
+  float lo[3] = {0.0f, 0.0f, 0.0f}, hi[3] = {0.0f, 0.0f, 0.0f};
   bool has_velocity = false;
 };
 struct IdSlot {
@@ -824,23 +824,46 @@ class Program {
     g.data = in_.chance(8) ? nullptr : storage.data();
     if (in_.chance(8)) g.struct_size = struct_size(sizeof g);
   }
-  // SdfSlot::extent of a grid: row r of index_to_local maps index steps to local axis r, so the
-  // corners' box spans sum_c |m[r][c]| (dims[c] - 1) along it (a sheared or rotated grid's box is
-  // larger than its volume; a grid one voxel thick has a volume but no extent along that axis).
-  // An all-zero map is the identity, 1 m voxels (sph_grid_desc).
-  static void grid_extent(const sph_grid_desc& g, double extent[3]) {
+  // SdfSlot's box of a grid: each corner mapped by index_to_local in float (an all-zero map is the
+  // identity, 1 m voxels: sph_grid_desc), so that a large translation swallows a small extent here
+  // as it does in the library. The corners' order does not change a min or a max.
+  static void grid_box(const sph_grid_desc& g, SdfSlot& slot) {
     static const float kIdentity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
     const bool zero = std::all_of(g.index_to_local, g.index_to_local + 12, [](float v) { return v == 0.0f; });
     const float* m = zero ? kIdentity : g.index_to_local;
-    for (int r = 0; r < 3; ++r) {
-      extent[r] = 0.0;
-      for (int c = 0; c < 3; ++c)
-        extent[r] += std::fabs(static_cast<double>(m[4 * r + c])) * (static_cast<double>(g.dims[c]) - 1.0);
+    for (int c = 0; c < 8; ++c) {
+      const float idx[3] = {(c & 1) ? static_cast<float>(g.dims[0] - 1) : 0.0f,
+                            (c & 2) ? static_cast<float>(g.dims[1] - 1) : 0.0f,
+                            (c & 4) ? static_cast<float>(g.dims[2] - 1) : 0.0f};
+      for (int r = 0; r < 3; ++r) {
+        const float p = m[4 * r] * idx[0] + m[4 * r + 1] * idx[1] + m[4 * r + 2] * idx[2] + m[4 * r + 3];
+        slot.lo[r] = c == 0 ? p : std::min(slot.lo[r], p);
+        slot.hi[r] = c == 0 ? p : std::max(slot.hi[r], p);
+      }
     }
   }
-  // A library-made grid (shapes, meshes): axis-aligned voxels of `voxel` metres.
-  static void voxel_extent(const uint32_t dims[3], double voxel, double extent[3]) {
-    for (int k = 0; k < 3; ++k) extent[k] = (static_cast<double>(dims[k]) - 1.0) * voxel;
+  // A library-made grid (shapes, meshes): axis-aligned voxels of `voxel` metres whose origin the
+  // harness does not know; their translations are small (the shapes' and the meshes' bounds), so
+  // the box is taken from 0.
+  static void voxel_box(const uint32_t dims[3], double voxel, SdfSlot& slot) {
+    for (int k = 0; k < 3; ++k) {
+      slot.lo[k] = 0.0f;
+      slot.hi[k] = static_cast<float>((static_cast<double>(dims[k]) - 1.0) * voxel);
+    }
+  }
+  // The FCC candidates the library counts for a source of spacing s in that box (lattice_inside
+  // widens it by s / 2 in float, box_lattice takes s / 2 off again in double; floor(L / b) + 1
+  // steps of b = s / sqrt 2 per axis, half of them).
+  static double lattice_candidates(const SdfSlot& slot, float s) {
+    const float widen = 0.5f * s;
+    const double margin = 0.5 * s, b = s / std::sqrt(2.0);
+    double points = 0.5;
+    for (int k = 0; k < 3; ++k) {
+      const double lo = static_cast<double>(slot.lo[k] - widen) + margin;
+      const double hi = static_cast<double>(slot.hi[k] + widen) - margin;
+      points *= hi < lo ? 0.0 : std::floor((hi - lo) / b) + 1.0;
+    }
+    return points;
   }
 
   void op_sdf_create() {
@@ -891,8 +914,8 @@ class Program {
       FUZZ_CALL(sph_sdf_destroy(out));
       return;
     }
-    sdfs_[slot] = SdfSlot{out, cslot, {}, with_velocity};
-    grid_extent(d.distance, sdfs_[slot].extent);
+    sdfs_[slot] = SdfSlot{out, cslot, {}, {}, with_velocity};
+    grid_box(d.distance, sdfs_[slot]);
   }
 
   void op_sdf_create_shape() {
@@ -931,8 +954,8 @@ class Program {
       FUZZ_CALL(sph_sdf_destroy(out));
       return;
     }
-    sdfs_[slot] = SdfSlot{out, cslot, {}, false};
-    voxel_extent(dims, sph_fuzz::shape_size_or_default(d.voxel_size, 0.01), sdfs_[slot].extent);
+    sdfs_[slot] = SdfSlot{out, cslot, {}, {}, false};
+    voxel_box(dims, sph_fuzz::shape_size_or_default(d.voxel_size, 0.01), sdfs_[slot]);
   }
 
   // A small random triangle mesh (sometimes with an index out of range, a non-finite vertex, an
@@ -1006,8 +1029,8 @@ class Program {
       FUZZ_CALL(sph_sdf_destroy(out));
       return;
     }
-    sdfs_[slot] = SdfSlot{out, cslot, {}, false};
-    voxel_extent(dims, voxel, sdfs_[slot].extent);
+    sdfs_[slot] = SdfSlot{out, cslot, {}, {}, false};
+    voxel_box(dims, voxel, sdfs_[slot]);
   }
 
   // The step budget (refused: NaN, negative, above a day; the old one kept) and a cancel request
@@ -1208,17 +1231,17 @@ class Program {
     if (in_.chance(8)) d.reserved1 = in_.u32();
     d.struct_size = struct_size(sizeof d);
     // The library keeps the region's lattice (up to 2^28 candidates, legitimately); skip regions
-    // whose lattice is large but legal. The candidates as the library counts them: the FCC
-    // points of the grid's box, floor(L / b) + 1 steps of b = s / sqrt 2 per axis, half of them.
-    // (Until session 34 this was the grid's volume times sqrt 2 / s^3, with the all-zero map
-    // read as volume 0 and a shape's default voxel as 0: an 8 x 4 x 6 grid of 1 m voxels was
-    // estimated at no points, made 3.2 million, and checkpointing them took 35 s under ASan, a
-    // fuzz timeout; the library did what its documentation says.)
-    if (world_ok(slot, w) && sslot >= 0 && d.region) {
-      const double s = d.spacing > 0.0f ? d.spacing : worlds_[slot].spacing;
-      const double b = s / std::sqrt(2.0);
-      double points = 0.5;
-      for (double e : sdfs_[sslot].extent) points *= std::floor(e / b) + 1.0;
+    // whose lattice is large but legal, counted as the library counts it (lattice_candidates).
+    // Only spacings it accepts are judged (0: the world's; below a quarter of the world's: refused),
+    // so its refusals stay covered. (Until session 34 this was the grid's volume times sqrt 2 / s^3,
+    // with the all-zero map read as volume 0 and a shape's default voxel as 0: an 8 x 4 x 6 grid of
+    // 1 m voxels was estimated at no points, made 3.2 million, and checkpointing them took 35 s
+    // under ASan, a fuzz timeout; the library did what its documentation says.)
+    const float world_spacing = world_ok(slot, w) ? worlds_[slot].spacing : 0.0f;
+    const float s = d.spacing == 0.0f ? world_spacing : d.spacing;
+    if (world_ok(slot, w) && sslot >= 0 && d.region && std::isfinite(s) && s >= 0.25f * world_spacing &&
+        s > 0.0f) {
+      const double points = lattice_candidates(sdfs_[sslot], s);
       if (std::isfinite(points) && points > kMaxLattice && points < 4.0 * (1u << 28)) return;
     }
     sph_source_id id{0};
