@@ -93,10 +93,8 @@ int main(int argc, char** argv) {
   }
   {
     sph_context_def context_def;
-    need(sph_context_def_init(&context_def), "context def");
-    context_def.backend = backend;
+    need(support_context_def_init(backend, &context_def), "context def");
     context_def.cpu_worker_count = workers;
-    context_def.cuda_dfsph_masks = sph_test_cuda_dfsph_masks();
     need(sph_context_create(&context_def, &context), "context");
   }
   need(sph_world_def_init(&def), "def");

@@ -37,7 +37,7 @@ const char* sph_test_backend_name(void);
 /** sph_context_def_init() with the test backend filled in. */
 sph_result sph_test_context_def_init(sph_context_def* def);
 /* sph_context_def.cuda_dfsph_masks from SPH_TEST_CUDA_DFSPH_MASKS (on, off or lists; unset: the
- * default), which sph_test_context_def_init and support_context_create apply; exits 2 on another
+ * default), which support_context_def_init (and so the other context helpers) applies; exits 2 on another
  * value. A CPU context ignores it. */
 uint32_t sph_test_cuda_dfsph_masks(void);
 /** Creates a context on the test backend with defaults otherwise. */
@@ -46,6 +46,8 @@ sph_result sph_test_context_create(sph_context** out);
 /** The backend a command line names: "cpu", "cuda" or "auto"; `otherwise` for anything else
  * (NULL included). */
 sph_backend support_backend_from_name(const char* name, sph_backend otherwise);
+/** sph_context_def_init() with `backend` and the tests' DFSPH masks setting filled in. */
+sph_result support_context_def_init(sph_backend backend, sph_context_def* def);
 /** Creates a context on `backend` with defaults otherwise. */
 sph_result support_context_create(sph_backend backend, sph_context** out);
 

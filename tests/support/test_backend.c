@@ -33,12 +33,7 @@ uint32_t sph_test_cuda_dfsph_masks(void) {
 }
 
 sph_result sph_test_context_def_init(sph_context_def* def) {
-  const sph_result r = sph_context_def_init(def);
-  if (r == SPH_OK) {
-    def->backend = sph_test_backend();
-    def->cuda_dfsph_masks = sph_test_cuda_dfsph_masks();
-  }
-  return r;
+  return support_context_def_init(sph_test_backend(), def);
 }
 
 sph_result sph_test_context_create(sph_context** out) {
@@ -53,11 +48,17 @@ sph_backend support_backend_from_name(const char* name, sph_backend otherwise) {
   return otherwise;
 }
 
+sph_result support_context_def_init(sph_backend backend, sph_context_def* def) {
+  const sph_result r = sph_context_def_init(def);
+  if (r == SPH_OK) {
+    def->backend = backend;
+    def->cuda_dfsph_masks = sph_test_cuda_dfsph_masks();
+  }
+  return r;
+}
+
 sph_result support_context_create(sph_backend backend, sph_context** out) {
   sph_context_def def;
-  const sph_result r = sph_context_def_init(&def);
-  if (r != SPH_OK) return r;
-  def.backend = backend;
-  def.cuda_dfsph_masks = sph_test_cuda_dfsph_masks();
-  return sph_context_create(&def, out);
+  const sph_result r = support_context_def_init(backend, &def);
+  return r != SPH_OK ? r : sph_context_create(&def, out);
 }
