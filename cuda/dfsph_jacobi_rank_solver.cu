@@ -40,7 +40,6 @@ void enqueue_dfsph_jacobi_rank_solve(const FluidConstants& fluid, const GridView
                                      float* carried, bool divergence, bool contacts, uint32_t min_iterations,
                                      uint32_t max_iterations, DfsphRankSteps& rank, FrameState* state,
                                      cudaStream_t stream) {
-  const unsigned threads = kDfsphSolveBlock, blocks = blocks_for(n, threads);
   // The divergence bound depends on the substep's dt, which the device chose (the same on every
   // rank); the host reads it once a divergence solve (each iteration waits on the device anyway).
   float dt = 0.0f;
@@ -64,10 +63,9 @@ void enqueue_dfsph_jacobi_rank_solve(const FluidConstants& fluid, const GridView
     DfsphRankSteps& rank;
     FrameState* state;
     cudaStream_t stream;
-    unsigned blocks, threads;
     void velocity_update(bool first) {
       launch_dfsph_correct(first, fluid, grid, a, n, v, first ? warm : a.dfsph_step, carried, divergence,
-                           contacts, state, blocks, threads, stream);
+                           contacts, state, stream);
     }
     void share_velocities() { rank.share_velocities(v, stream); }
     void rates() {
@@ -83,8 +81,8 @@ void enqueue_dfsph_jacobi_rank_solve(const FluidConstants& fluid, const GridView
                                                    divergence, state);
       check_launch("dfsph_rank_check_kernel");
     }
-  } passes{fluid,          grid,           a,    n,     v,      warm,   carried, divergence, contacts, bounds,
-           min_iterations, max_iterations, rank, state, stream, blocks, threads};
+  } passes{fluid,          grid,           a,    n,     v,     warm, carried, divergence, contacts, bounds,
+           min_iterations, max_iterations, rank, state, stream};
   run_dfsph_jacobi(passes, bounds, min_iterations, max_iterations);
 }
 

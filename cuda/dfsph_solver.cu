@@ -289,16 +289,14 @@ void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid
   if (loops.rank && !divergence && c.linear_solver == kDfsphConjugateGradients) {
     // A distributed rank's conjugate gradients: the warm start, the ghosts' velocities, then the
     // host-driven solve (dfsph_cg_rank_solver.cu, the CPU rank's loop).
-    launch_dfsph_correct(true, fluid, grid, a, n, v, warm, carried, divergence, contacts, state, blocks,
-                         threads, stream);
+    launch_dfsph_correct(true, fluid, grid, a, n, v, warm, carried, divergence, contacts, state, stream);
     loops.rank->share_velocities(v, stream);
     return enqueue_dfsph_cg_rank_solve(fluid, grid, a, n, contacts, *loops.rank, state, stream);
   }
   if (loops.rank)  // the host drives the loop (dfsph_jacobi_rank_solver.cu)
     return enqueue_dfsph_jacobi_rank_solve(fluid, grid, a, n, v, warm, carried, divergence, contacts,
                                            min_iterations, max_iterations, *loops.rank, state, stream);
-  launch_dfsph_correct(true, fluid, grid, a, n, v, warm, carried, divergence, contacts, state, blocks,
-                       threads, stream);
+  launch_dfsph_correct(true, fluid, grid, a, n, v, warm, carried, divergence, contacts, state, stream);
   // The same warm start (as the CPU backend's), then the conjugate gradients' iterations.
   if (!divergence && c.linear_solver == kDfsphConjugateGradients)
     return enqueue_dfsph_cg_solve(fluid, grid, a, n, contacts, loops, cond, state, stream);
@@ -306,7 +304,7 @@ void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid
   check(true);
   run_solve_loop(cond, state, loops.host_state, stream, [&] {
     launch_dfsph_correct(false, fluid, grid, a, n, v, a.dfsph_step, carried, divergence, contacts, state,
-                         blocks, threads, stream);
+                         stream);
     residual();
     check(false);
   });
@@ -316,8 +314,8 @@ void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid
 
 void launch_dfsph_correct(bool warm, const FluidConstants& fluid, const GridView& grid,
                           const ParticleArrays& a, uint32_t n, Float4* v, const float* k, float* carried,
-                          bool divergence, bool contacts, FrameState* state, unsigned blocks,
-                          unsigned threads, cudaStream_t stream) {
+                          bool divergence, bool contacts, FrameState* state, cudaStream_t stream) {
+  const unsigned threads = kDfsphSolveBlock, blocks = blocks_for(n, threads);
   const bool corrected = fluid.methods.dfsph.gradient_correction != 0;
   if (warm && corrected)
     dfsph_correct_kernel<true, true>

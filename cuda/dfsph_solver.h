@@ -116,11 +116,11 @@ void enqueue_dfsph_jacobi_rank_solve(const FluidConstants& fluid, const GridView
 // The solves' passes that the rank solves launch (dfsph_solver.cu). The velocity update: v += the
 // pressures k's velocity change (held to the contacts), and carried gets k times the solve's
 // scale (dt for the divergence solve's impulse), replacing the carried values on the warm start's
-// pass (`warm`) or added on an iteration's, with the gradient the world's parameters choose.
+// pass (`warm`) or added on an iteration's, with the gradient the world's parameters choose. Blocks
+// of kDfsphSolveBlock threads, the only size the kernel's launch bounds admit.
 void launch_dfsph_correct(bool warm, const FluidConstants& fluid, const GridView& grid,
                           const ParticleArrays& a, uint32_t n, Float4* v, const float* k, float* carried,
-                          bool divergence, bool contacts, FrameState* state, unsigned blocks,
-                          unsigned threads, cudaStream_t stream);
+                          bool divergence, bool contacts, FrameState* state, cudaStream_t stream);
 // The rates over v, the new pressure steps and the errors of the rank's own particles (not its
 // ghosts) into the exact sum's bins (kDfsphRankErrorWords words), with the largest error's bits
 // for the density solve (blocks of kDfsphSolveBlock threads, the block sums' fixed tree).
