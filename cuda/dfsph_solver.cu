@@ -243,7 +243,7 @@ __global__ void dfsph_integrate_kernel(ParticleArrays a, uint32_t n, DeviceScene
     v2 = length_squared(next.velocity);
     if (a.halo_ghost && a.halo_ghost[i])
       v2 = 0.0f;  // a distributed rank's ghost: its owner's to move
-    else if (!finite3(next.position) || !isfinite(v2)) {
+    else if (!state_finite(next.position, pressure, v2, v.w)) {
       // As the CPU backend: the solves count as the integration (no acceleration to blame).
       flag_non_finite(state, 0, i, id,
                       classify_non_finite(rho, p, a.sorted_velocity[i], Vec3{0.0f, 0.0f, 0.0f}, next));

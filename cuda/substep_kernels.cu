@@ -97,7 +97,7 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
     a.velocity[i] = make_float4_record(next.velocity, v.w);
     a.id[i] = id;
     v2 = length_squared(next.velocity);
-    if (!finite3(next.position) || !isfinite(v2)) {
+    if (!state_finite(next.position, p.w, v2, v.w)) {
       flag_non_finite(state, 0, i, id, classify_non_finite(a.density[i], p, v, acc, integrated));
       v2 = 0.0f;
     }
@@ -147,7 +147,7 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
     a.velocity[i] = make_float4_record(next.velocity, v.w);
     a.id[i] = id;
     v2 = length_squared(next.velocity);
-    if (!finite3(next.position) || !isfinite(v2)) {
+    if (!state_finite(next.position, p.w, v2, v.w)) {
       flag_non_finite(state, stage, i, id, classify_non_finite(a.density[i], p, v, acc, integrated));
       v2 = 0.0f;
     }

@@ -36,6 +36,21 @@ enum NonFiniteStage : uint32_t {
 
 SPH_HD bool finite3(Vec3 v) { return SPH_ISFINITE(v.x) && SPH_ISFINITE(v.y) && SPH_ISFINITE(v.z); }
 
+// Whether a particle's new state is finite, the test of every substep's scan: its position, its
+// speed's square, and the density pass's records the state carries, its pressure (position.w)
+// and 1 / density (velocity.w). Those two reach the attributes, the probes and checkpoints (whose
+// reader refuses a non-finite one), and a particle without neighbours moves on finitely whatever
+// they hold: found by fuzz_capi, a lone particle of a world with rest_density 3e38 kept a pressure
+// of +Inf through a successful step, and the world's own checkpoint did not load.
+SPH_HD bool state_finite(Vec3 position, float pressure, float speed_squared, float inverse_density) {
+  return finite3(position) && SPH_ISFINITE(speed_squared) && SPH_ISFINITE(pressure) &&
+         SPH_ISFINITE(inverse_density);
+}
+SPH_HD bool state_finite(const Float4& position, const Float4& velocity) {
+  return state_finite(Vec3{position.x, position.y, position.z}, position.w,
+                      length_squared(Vec3{velocity.x, velocity.y, velocity.z}), velocity.w);
+}
+
 // The new state of a particle is not finite: the first of its stages whose result is not.
 // position.w is its pressure and velocity.w its 1 / density (the records of the density pass).
 SPH_HD uint32_t classify_non_finite(float density, const Float4& position, const Float4& velocity,

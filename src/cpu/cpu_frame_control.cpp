@@ -45,7 +45,7 @@ uint32_t CpuBackend::scan_next_state(float& v2max) const {
         if (origin && origin[i]) return;  // (a distributed world's halo)
         const float v2 = length_squared(xyz(next_vel[i]));
         s.v2max = std::max(s.v2max, v2);
-        if (!finite3(xyz(next_pos[i])) || !std::isfinite(v2)) s.bad_index = std::min(s.bad_index, i);
+        if (!state_finite(next_pos[i], next_vel[i])) s.bad_index = std::min(s.bad_index, i);
       },
       combine_scans);
   v2max = scan.v2max;
@@ -90,7 +90,7 @@ void CpuBackend::diagnose_non_finite(const FluidConstants& fluid, const SceneFra
   non_finite_.count = 0;
   non_finite_.ids.clear();
   for (uint32_t k = 0; k < count_; ++k) {
-    if (finite3(xyz(next_position_[k])) && std::isfinite(length_squared(xyz(next_velocity_[k])))) continue;
+    if (state_finite(next_position_[k], next_velocity_[k])) continue;
     if (++non_finite_.count <= 8) non_finite_.ids.push_back(id_[k]);
   }
 }

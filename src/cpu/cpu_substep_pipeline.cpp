@@ -71,7 +71,7 @@ uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame
         if (scan_in_loop) {
           const float v2 = length_squared(s.velocity);
           r.v2max = std::max(r.v2max, v2);
-          if (!finite3(s.position) || !std::isfinite(v2)) r.bad_index = std::min(r.bad_index, i);
+          if (!state_finite(s.position, pos[i].w, v2, vel[i].w)) r.bad_index = std::min(r.bad_index, i);
         }
       },
       combine_scans);

@@ -4,7 +4,11 @@
  * attribute copied out before and after and compared with memcmp), the same failure again on a
  * retry, and the caller can go on with a smaller dt. Provoked with valid input: uniform force
  * fields of 3e38 m/s^2 (finite each; two of them add up to +Inf, one gives a velocity whose
- * square overflows within a 1e-3 s step but not within a 1e-21 s one). */
+ * square overflows within a 1e-3 s step but not within a 1e-21 s one). And a non-finite value
+ * that moves nothing: a lone particle (no neighbours, no pressure force) in a world whose rest
+ * density (1e38 kg/m^3, valid) makes Tait's pressure overflow; the step fails in the density stage
+ * rather than leave an infinite pressure in the world (which its own checkpoint would refuse to
+ * load: found by fuzz_capi). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -61,7 +65,7 @@ static void expect_rolled_back_step(ext_world* w, const char* stage, uint32_t co
   char particles[64];
   EXPECT_ERROR(SPH_ERROR_NON_FINITE, stage, sph_world_step(w->world, 1e-3f));
   print_message("  %s\n", sph_get_last_error());
-  snprintf(particles, sizeof particles, "%u particles, ", count);
+  snprintf(particles, sizeof particles, "%u particle%s, ", count, count == 1 ? "" : "s");
   assert_non_null(strstr(sph_get_last_error(), particles));
   assert_non_null(strstr(sph_get_last_error(), "restored"));
   snprintf(message, message_size, "%s", sph_get_last_error());
@@ -114,6 +118,54 @@ static void run_rollback_case(sph_integrator integrator) {
   ext_close(&w);
 }
 
+/* The lone particle: Tait's law with rho0 = 1e38 kg/m^3 has B = rho0 c^2 / 7 = +Inf (c 10 m/s), so
+ * its pressure is not finite (Inf times the zero of (rho / rho0)^7 - 1 at rest), while, with no
+ * neighbour to push, its motion is. */
+static void run_lone_particle_case(sph_integrator integrator) {
+  ext_world w;
+  sph_world_def def;
+  const float x[3] = {0.0f, 0.0f, 0.0f}, v[3] = {0.1f, 0.0f, 0.0f};
+  char message[1024];
+  void* bytes;
+  uint64_t size = 0;
+  sph_world* loaded = NULL;
+  float* pressure;
+  uint32_t n = 0;
+  sph_world_def_init(&def);
+  def.capacity = 16;
+  def.rest_density = 1e38f;
+  def.equation_of_state = SPH_EOS_TAIT;
+  def.integrator = integrator;
+  ext_open_def(&w, def);
+  w.params.gravity.y = 0.0f;
+  ext_set_params(&w);
+  ext_spawn(&w, x, v, 1);
+  expect_rolled_back_step(&w, "density stage", 1, message, sizeof message);
+  /* The world as it was: its pressure finite, and its own checkpoint loads. */
+  pressure = (float*)ext_copy(w.world, SPH_ATTRIBUTE_PRESSURE, &n);
+  assert_int_equal(n, 1);
+  assert_true(isfinite(pressure[0]));
+  free(pressure);
+  EXT_OK(sph_world_save(w.world, NULL, 0, &size));
+  bytes = malloc((size_t)size);
+  assert_non_null(bytes);
+  EXT_OK(sph_world_save(w.world, bytes, size, &size));
+  EXT_OK(sph_world_load(w.context, bytes, size, &loaded));
+  sph_world_destroy(loaded);
+  free(bytes);
+  ext_close(&w);
+}
+
+static void test_non_finite_pressure_rolls_back_euler(void** state) {
+  (void)state;
+  run_lone_particle_case(SPH_INTEGRATOR_SYMPLECTIC_EULER);
+}
+
+static void test_non_finite_pressure_rolls_back_rk4(void** state) {
+  (void)state;
+  run_lone_particle_case(SPH_INTEGRATOR_RK4);
+}
+
 static void test_non_finite_step_rolls_back_euler(void** state) {
   (void)state;
   run_rollback_case(SPH_INTEGRATOR_SYMPLECTIC_EULER);
@@ -128,6 +180,8 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_non_finite_step_rolls_back_euler),
       cmocka_unit_test(test_non_finite_step_rolls_back_rk4),
+      cmocka_unit_test(test_non_finite_pressure_rolls_back_euler),
+      cmocka_unit_test(test_non_finite_pressure_rolls_back_rk4),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
