@@ -244,9 +244,12 @@ __global__ void dfsph_integrate_kernel(ParticleArrays a, uint32_t n, DeviceScene
     if (a.halo_ghost && a.halo_ghost[i])
       v2 = 0.0f;  // a distributed rank's ghost: its owner's to move
     else if (!state_finite(next.position, pressure, v2, v.w)) {
-      // As the CPU backend: the solves count as the integration (no acceleration to blame).
+      // As the CPU backend: the solves count as the integration (no acceleration to blame), and the
+      // record classified carries the pressure just computed (the CPU's holds it too), so a
+      // non-finite pressure is the density stage's on both.
       flag_non_finite(state, 0, i, id,
-                      classify_non_finite(rho, p, a.sorted_velocity[i], Vec3{0.0f, 0.0f, 0.0f}, next));
+                      classify_non_finite(rho, make_float4_record(xyz(p), pressure), a.sorted_velocity[i],
+                                          Vec3{0.0f, 0.0f, 0.0f}, next));
       v2 = 0.0f;
     }
     if (!collide_here) v2 = 0.0f;  // the loads pass collides and takes the speed (device_collider_loads.h)
