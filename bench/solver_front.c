@@ -12,7 +12,9 @@
  * (interior_error, interior_expansion, interior_share; dam_break.h says which particles count; a host
  * neighbour count each frame, outside the timed steps), the front's mean error against the
  * measurements (one fitted shift, as the validation), and DFSPH's solve iterations, capped solves and the
- * largest error of one particle a density solve ended with ("solve lg", sph_stats.density_error_largest).
+ * largest error of one particle a density solve ended with ("solve lg", sph_stats.density_error_largest),
+ * and an order-free digest of the final positions' bits ("final positions' digest", state_digest in
+ * the CSV: two runs agree bit for bit where it agrees; dam_break.h).
  *
  *   solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1]
  *                [--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg|chebyshev]
@@ -245,7 +247,7 @@ int main(int argc, char** argv) {
       "solve_error_max,front_shift_T,front_error_mean,front_error_max,status,ms_per_substep,neighbors_mean,"
       "ms_hash_sort,ms_cell_ranges,ms_density,ms_forces,ms_integrate,ms_collide,ms_emit,ms_other,"
       "solve_error_largest,mean_density_error_all,above_share,solve_error_mean,interior_error,"
-      "interior_expansion,interior_share\n");
+      "interior_expansion,interior_share,state_digest\n");
   printf(
       "%s backend; dam break of Martin & Moyce for %.2f simulated s; front errors over T in [%.1f, %.1f]\n",
       resolved == SPH_BACKEND_CUDA ? "CUDA" : "CPU", seconds, DAM_BREAK_T_FIRST, DAM_BREAK_T_LAST);
@@ -300,9 +302,10 @@ int main(int argc, char** argv) {
           result->mean_error, result->max_error, substep_ms, result->neighbors_mean);
       for (int k = 0; k < SPH_STAGE_COUNT; ++k)
         fprintf(csv, ",%.5f", result->substeps ? result->stage_ms[k] / (double)result->substeps : 0.0);
-      fprintf(csv, ",%.6f,%.6f,%.4f,%.6f,%.6f,%.6f,%.4f\n", result->density_error_largest,
+      fprintf(csv, ",%.6f,%.6f,%.4f,%.6f,%.6f,%.6f,%.4f,%016llx\n", result->density_error_largest,
               result->mean_density_error, result->above_share, result->density_error_mean,
-              result->interior_error, result->interior_expansion, result->interior_share);
+              result->interior_error, result->interior_expansion, result->interior_share,
+              (unsigned long long)result->state_digest);
       fflush(csv);
       printf(
           "%-6s %-9g %6u %9u %10.2f %9llu %10.0f %7.2f%% %7.2f%% %7.2f%% %8.2f %8.2f %6u %9.4f %6.1f "
@@ -326,6 +329,7 @@ int main(int argc, char** argv) {
       for (int k = 0; k < SPH_STAGE_COUNT; ++k)
         printf(" %.4f", result->substeps ? result->stage_ms[k] / (double)result->substeps : 0.0);
       printf(" (hash+sort, cell ranges, density, forces, integrate, collide, emit, other)\n");
+      printf("       final positions' digest %016llx\n", (unsigned long long)result->state_digest);
       fflush(stdout);
     }
   }

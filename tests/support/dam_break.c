@@ -39,6 +39,27 @@ void dam_break_config_default(dam_break_config* config, uint32_t layers_across) 
   config->sample_T = 0.025;
 }
 
+/* splitmix64's finaliser: every input bit reaches every output bit. */
+static uint64_t mix64(uint64_t x) {
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9ull;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+/* The sum (mod 2^64) of a mix of each particle's three coordinates' bits: the same for the same
+   bits in any order. */
+static uint64_t position_digest(const float* positions, uint32_t count) {
+  uint64_t sum = 0;
+  for (uint32_t i = 0; i < count; ++i) {
+    uint32_t b[3];
+    memcpy(b, positions + 3 * (size_t)i, sizeof b);
+    sum += mix64(mix64(((uint64_t)b[0] << 32) | b[1]) ^ b[2]);
+  }
+  return sum;
+}
+
 static double time_scale(void) { return sqrt(2.0 * GRAVITY / DAM_BREAK_COLUMN_WIDTH); }
 
 static int descending(const void* a, const void* b) {
@@ -298,6 +319,7 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
       ++result->samples;
       if (f == frames) {
         const float tol = (float)(0.5 * step);
+        result->state_digest = position_digest(positions, count);
         for (uint32_t i = 0; i < count; ++i) {
           const float* p = positions + 3 * i;
           if (p[0] < tank_min[0] - tol || p[0] > tank_max[0] + tol || p[1] < tank_min[1] - tol ||

@@ -123,6 +123,12 @@ typedef struct dam_break_result {
    * two runs' substep costs apart (bench/solver_front prints them). */
   double stage_ms[SPH_STAGE_COUNT];
   double neighbors_mean;
+  /* An order-free digest of the last frame's positions, bit for bit (position_digest in
+     dam_break.c): equal for two runs whose final positions are the same bits, whatever their
+     storage order; different (but for a 2^-64 chance) if any bit of any position differs. What
+     tells two builds or two neighbour walks apart at a million particles, where the printed
+     statistics may agree while the bits do not. Zero if the run stopped before its last frame. */
+  uint64_t state_digest;
   char message[256]; /* the failing call's message when the run failed */
 } dam_break_result;
 
