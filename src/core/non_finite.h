@@ -47,8 +47,7 @@ SPH_HD bool state_finite(Vec3 position, float pressure, float speed_squared, flo
          SPH_ISFINITE(inverse_density);
 }
 SPH_HD bool state_finite(const Float4& position, const Float4& velocity) {
-  return state_finite(Vec3{position.x, position.y, position.z}, position.w,
-                      length_squared(Vec3{velocity.x, velocity.y, velocity.z}), velocity.w);
+  return state_finite(xyz(position), position.w, length_squared(xyz(velocity)), velocity.w);
 }
 
 // The new state of a particle is not finite: the first of its stages whose result is not.
