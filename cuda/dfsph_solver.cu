@@ -201,8 +201,12 @@ __global__ void dfsph_forces_kernel(FluidConstants fluid, GridView grid, Particl
   if (i < n) {
     FluidConstants f = fluid;
     f.dt = state->clock.dt_float;
-    Vec3 acc = gather_acceleration_masked<Terms, false>(f, grid, a.sorted_position, a.sorted_velocity,
-                                                        a.neighbor_count, a.colour_normal, i);
+    // Over the solves' walk (the lists, the masks, or every candidate), one body for all three,
+    // so that they give the same bits (neighbor_walk.h). (gather_acceleration_masked, the weakly
+    // compressible pass's two-phase walk, computes r^2 once to test and again for the term.)
+    Vec3 acc = gather_acceleration<Terms, false>(
+        f, grid, ForceInputs{a.sorted_position, a.sorted_velocity, a.neighbor_count, a.colour_normal}, i,
+        solve_walk(a));
     const Float4 p = a.sorted_position[i];
     const Float4 v = a.sorted_velocity[i];
     if (kScene) acc = add_force_fields(scene, acc, xyz(p));
