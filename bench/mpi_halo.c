@@ -2,7 +2,7 @@
 /* The two-rank calibration of docs/scaling.md's model on the CPU backend (issue 19 item 6):
  *
  *   mpirun -np R bench/mpi_halo [--spacing S] [--substeps K] [--backend cpu|cuda] [--springs 1]
- *                               [--workers W]
+ *                               [--workers W] [--wait-barriers 1]
  *
  * --backend cuda: every rank on the CUDA backend (the host-staged halo path; ranks on one GPU
  * share it), the GPU calibration of the model. --springs 1: with SPH_FEATURE_SPRINGS (every
@@ -15,17 +15,82 @@
  * (default 20). Prints, on rank 0: the ranks, the particles per rank, the ghosts (halo) per rank
  * in the last substep against the model's slab halo (one support radius of the block per face
  * beside another slab: h / L of its particles), ms per substep (the slowest
- * rank, MPI_Wtime around the step) and the step's stage times; and a ping-pong of MPI messages
- * of 8 B to 8 MB between ranks 0 and 1 (their latency and bandwidth, the model's alpha and beta
- * for this host's MPI). */
+ * rank, MPI_Wtime around the step) and the step's stage times; each stage split into the time
+ * inside the transport's MPI calls (the wait there for the slowest rank and the transfer) and
+ * the rest (the rank's own work: packing, sorting, gathering ghosts, computing), on rank 0 and
+ * as the largest and smallest over the ranks, with the transport's calls over the step
+ * (mpi_halo_transport.h; issue 19; the CPU backend splits its stages so, CUDA ranks show their
+ * transport time only as the step's total, outside the stages); and a ping-pong of MPI messages of 8 B to 8
+ * MB between ranks 0 and 1 (their latency and bandwidth, the model's alpha and beta for this host's MPI).
+ * --wait-barriers 1: each transport call waits at a timed MPI_Barrier first, so the split tells
+ * the wait for the slowest rank (the barrier) from the transfer (the call after it); the
+ * barriers cost a latency a call, so the substep time is not the default run's. */
 #include <mpi.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "mpi_halo_transport.h"
 #include "sph_c.h"
 #include "sph_mpi.h"
 #include "support.h"
+
+static const char* const kStageNames[SPH_STAGE_COUNT] = {"hash+sort", "cells",   "density", "forces",
+                                                         "integrate", "collide", "emit",    "other"};
+
+/* Per rank, over the timed step: each stage's time, its transport share, that share's barrier
+ * waits and the rest; then the transport inside and outside the stages. */
+enum { kStageRows = 4, kSplitValues = kStageRows * SPH_STAGE_COUNT + 2 };
+
+static void print_row(const char* label, const double* v) {
+  printf("  %-34s", label);
+  for (int s = 0; s < SPH_STAGE_COUNT; ++s) printf(" %9.2f", v[s]);
+  printf("\n");
+}
+
+/* Rank 0 prints the split of the timed step: `before` and `after` are this rank's transport
+ * times around it, `stats` its stage times. Collective (two reductions). */
+static void print_split(int rank, int wait_barriers, const sph_stats* stats, const mpi_halo_transport* before,
+                        const mpi_halo_transport* after) {
+  double mine[kSplitValues], hi[kSplitValues], lo[kSplitValues];
+  double calls_ms[MPI_HALO_CALL_COUNT], calls_hi[MPI_HALO_CALL_COUNT];
+  double inside = 0.0;
+  for (int s = 0; s < SPH_STAGE_COUNT; ++s) {
+    mine[s] = stats->stage_ms[s];
+    mine[SPH_STAGE_COUNT + s] = after->stage_ms[s];
+    mine[2 * SPH_STAGE_COUNT + s] = after->stage_wait_ms[s];
+    mine[3 * SPH_STAGE_COUNT + s] = stats->stage_ms[s] - after->stage_ms[s];
+    inside += after->stage_ms[s];
+  }
+  mine[kSplitValues - 2] = after->total_ms - before->total_ms; /* the step's transport */
+  mine[kSplitValues - 1] = mine[kSplitValues - 2] - inside;    /* of it, outside the stages */
+  for (int c = 0; c < MPI_HALO_CALL_COUNT; ++c) calls_ms[c] = after->ms[c] - before->ms[c];
+  MPI_Reduce(mine, hi, kSplitValues, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+  MPI_Reduce(mine, lo, kSplitValues, MPI_DOUBLE, MPI_MIN, 0, MPI_COMM_WORLD);
+  MPI_Reduce(calls_ms, calls_hi, MPI_HALO_CALL_COUNT, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+  if (rank != 0) return;
+  printf("stage ms over the step, split (transport: inside its MPI calls)\n  %-34s", "");
+  for (int s = 0; s < SPH_STAGE_COUNT; ++s) printf(" %9s", kStageNames[s]);
+  printf("\n");
+  print_row("rank 0 stage", mine);
+  print_row("rank 0 transport", mine + SPH_STAGE_COUNT);
+  if (wait_barriers) print_row("rank 0 of which barrier wait", mine + 2 * SPH_STAGE_COUNT);
+  print_row("rank 0 rest", mine + 3 * SPH_STAGE_COUNT);
+  print_row("max over ranks: stage", hi);
+  print_row("max over ranks: transport", hi + SPH_STAGE_COUNT);
+  if (wait_barriers) print_row("max over ranks: barrier wait", hi + 2 * SPH_STAGE_COUNT);
+  print_row("max over ranks: rest", hi + 3 * SPH_STAGE_COUNT);
+  print_row("min over ranks: transport", lo + SPH_STAGE_COUNT);
+  print_row("min over ranks: rest", lo + 3 * SPH_STAGE_COUNT);
+  printf("transport ms over the step: rank 0 %.2f (%.2f outside the stages), max over ranks %.2f, min %.2f\n",
+         mine[kSplitValues - 2], mine[kSplitValues - 1], hi[kSplitValues - 2], lo[kSplitValues - 2]);
+  printf("transport calls over the step (rank 0: calls, ms; max ms over ranks):");
+  for (int c = 0; c < MPI_HALO_CALL_COUNT; ++c)
+    if (after->calls[c] > before->calls[c])
+      printf(" %s %llu %.2f (%.2f)", mpi_halo_call_name(c),
+             (unsigned long long)(after->calls[c] - before->calls[c]), calls_ms[c], calls_hi[c]);
+  printf("\n");
+}
 
 static void need(sph_result r, const char* what) {
   if (r != SPH_OK) {
@@ -67,6 +132,8 @@ int main(int argc, char** argv) {
   sph_backend backend = SPH_BACKEND_CPU;
   int springs = 0;
   uint32_t workers = 0;
+  int wait_barriers = 0;
+  mpi_halo_transport before, after;
   int rank, size;
   sph_context* context = NULL;
   sph_world* scratch = NULL;
@@ -90,6 +157,7 @@ int main(int argc, char** argv) {
     if (strcmp(argv[i], "--backend") == 0) backend = support_backend_from_name(argv[i + 1], SPH_BACKEND_CPU);
     if (strcmp(argv[i], "--springs") == 0) springs = atoi(argv[i + 1]) != 0;
     if (strcmp(argv[i], "--workers") == 0) workers = (uint32_t)atoi(argv[i + 1]);
+    if (strcmp(argv[i], "--wait-barriers") == 0) wait_barriers = atoi(argv[i + 1]) != 0;
   }
   {
     sph_context_def context_def;
@@ -125,10 +193,14 @@ int main(int argc, char** argv) {
   sph_mpi_world_step(world, 1.0f); /* warm-up: the first cut and its migration */
   params.max_substeps = substeps;
   need(sph_world_set_params(world, &params), "set params");
+  /* Every rank turns the barriers on before the same (timed) step. */
+  if (wait_barriers && mpi_halo_wait_at_barriers(world) != 0) MPI_Abort(MPI_COMM_WORLD, 1);
+  if (mpi_halo_transport_read(world, &before) != 0) MPI_Abort(MPI_COMM_WORLD, 1);
   MPI_Barrier(MPI_COMM_WORLD);
   t0 = MPI_Wtime();
   sph_mpi_world_step(world, 1.0f);
   mine = MPI_Wtime() - t0;
+  if (mpi_halo_transport_read(world, &after) != 0) MPI_Abort(MPI_COMM_WORLD, 1);
   MPI_Reduce(&mine, &slowest, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
   need(sph_mpi_counts_init(&c), "counts init");
   need(sph_mpi_world_get_counts(world, &c), "counts");
@@ -141,8 +213,9 @@ int main(int argc, char** argv) {
      * slab, h / L of the block's particles (L = 0.8 m, the cut axis); 2 (R - 1) faces. */
     const double h = 1.8 * spacing;
     const double model = size > 1 ? n * h / 0.8 * 2.0 * (size - 1) / size : 0.0;
-    printf("backend %s%s, workers a rank %u (0: all hardware threads)\n",
-           backend == SPH_BACKEND_CUDA ? "cuda" : "cpu", springs ? ", springs" : "", workers);
+    printf("backend %s%s, workers a rank %u (0: all hardware threads)%s\n",
+           backend == SPH_BACKEND_CUDA ? "cuda" : "cpu", springs ? ", springs" : "", workers,
+           wait_barriers ? ", a timed barrier before each transport call" : "");
     printf("ranks %d, %u particles (%.0f per rank, the fullest %lld), %u substeps\n", size, n,
            (double)n / size, (long long)owned_max, stats.substeps);
     printf(
@@ -153,6 +226,7 @@ int main(int argc, char** argv) {
     for (int s = 0; s < SPH_STAGE_COUNT; ++s) printf(" %.1f", stats.stage_ms[s]);
     printf("\n");
   }
+  print_split(rank, wait_barriers, &stats, &before, &after);
   sph_world_destroy(world);
   sph_context_destroy(context);
   if (size >= 2) ping_pong(rank);

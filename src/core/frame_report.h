@@ -55,6 +55,12 @@ struct FrameReport {
   float neighbors_mean = 0.0f;
   uint32_t neighbors_max = 0;
   float stage_ms[kStageCount] = {};
+  // Of stage_ms, the time a distributed world's rank spent inside its transport's calls
+  // (RankTransport::times: the wait for the slowest rank and the transfer), and of that the
+  // waits at the barriers MpiTransport::wait_at_barriers puts before them. The CPU backend
+  // fills them; zero on an undivided world and, as it does not split its stages so, on CUDA ranks.
+  float transport_ms[kStageCount] = {};
+  float transport_wait_ms[kStageCount] = {};
   SolveReport pressure_solve;            // DFSPH's density solve: error dimensionless, (rho* - rho0)+ / rho0
   SolveReport divergence_solve;          // DFSPH's divergence solve: error in 1/s, (D rho / Dt)+ / rho0
   HostVector<uint32_t> removed_ids;      // ids sinks removed during the frame

@@ -18,6 +18,32 @@ namespace sph {
 
 using RankBytes = HostVector<unsigned char>;
 
+// The calls a transport times (TransportTimes), by the MPI call that carries them: the
+// agreements and reductions are Allreduce, an exchange is one Alltoall of its counts and one
+// Alltoallv of its bytes, a gather a Gather and a Gatherv, a broadcast two Bcasts. Barrier: the
+// waits at the barriers a transport may put before each call (MpiTransport::wait_at_barriers).
+enum TransportCall : int {
+  kCallAllreduce = 0,
+  kCallExscan,
+  kCallAlltoall,
+  kCallAlltoallv,
+  kCallGather,
+  kCallGatherv,
+  kCallBcast,
+  kCallBarrier,
+  kTransportCallCount,
+};
+
+// Wall time a rank spent inside its transport's calls since the transport was made (issue 19:
+// a distributed stage's time is its own work plus the wait there for the slowest rank and the
+// transfer, which these tell apart from the packing and sorting around them). Only the MPI calls
+// themselves are timed, not the buffers made around them.
+struct TransportTimes {
+  uint64_t calls[kTransportCallCount] = {};
+  double ms[kTransportCallCount] = {};
+  double total_ms = 0.0;  // the sum of ms, kept as they are added (a stage reads it twice)
+};
+
 class RankTransport {
  public:
   virtual ~RankTransport() = default;
@@ -36,6 +62,8 @@ class RankTransport {
   virtual std::vector<RankBytes> gather(const RankBytes& mine, int root) const = 0;
   // Root's bytes on every rank (no agreement: the agreements' own failure path).
   virtual RankBytes broadcast(const RankBytes& bytes, int root) const = 0;
+  // The time inside the calls so far; nullptr where a transport does not time them.
+  virtual const TransportTimes* times() const { return nullptr; }
 };
 
 }  // namespace sph

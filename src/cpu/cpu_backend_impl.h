@@ -46,6 +46,14 @@ inline double elapsed_ms(Clock::time_point since) {
   return std::chrono::duration<double, std::milli>(Clock::now() - since).count();
 }
 
+// A stage's start: the clock and, on a distributed world's rank, its transport's running times,
+// so that the stage's report tells the time inside the transport's calls from the rest.
+struct StageStart {
+  Clock::time_point wall;
+  double transport_ms = 0.0;
+  double wait_ms = 0.0;
+};
+
 class CpuBackend final : public Backend {
  public:
   CpuBackend(const WorldConfig& config, unsigned workers, const TaskSystem& tasks);
@@ -267,6 +275,23 @@ class CpuBackend final : public Backend {
 
   // Density and neighbour statistics of the last density evaluation.
   void summarize(FrameReport& report) const;
+
+  // A stage's timing (FrameReport::stage_ms and, on a rank, the transport's share of it).
+  StageStart stage_start() const {
+    StageStart s{Clock::now()};
+    if (const TransportTimes* t = rank_ ? rank_->transport().times() : nullptr) {
+      s.transport_ms = t->total_ms;
+      s.wait_ms = t->ms[kCallBarrier];
+    }
+    return s;
+  }
+  void end_stage(FrameReport& report, StageIndex stage, const StageStart& start) const {
+    report.stage_ms[stage] += static_cast<float>(elapsed_ms(start.wall));
+    if (const TransportTimes* t = rank_ ? rank_->transport().times() : nullptr) {
+      report.transport_ms[stage] += static_cast<float>(t->total_ms - start.transport_ms);
+      report.transport_wait_ms[stage] += static_cast<float>(t->ms[kCallBarrier] - start.wait_ms);
+    }
+  }
 
   // ---- a distributed world's rank (cpu_halo.cpp; include/sph_mpi.h): its halo steps and the
   // state they own are rank_'s (cpu_rank_halo.h). The backend's side, each step collective:

@@ -22,7 +22,7 @@ void CpuBackend::collide_with_loads(const FluidConstants& fluid, const SceneFram
                                     OldPositions old, FrameReport& report, const Float4* clamp) {
   const uint32_t colliders = static_cast<uint32_t>(scene.colliders.size());
   if (colliders == 0) return;
-  const auto t = Clock::now();
+  const auto t = stage_start();
   const bool walls = boundary_ && wall_seconds > 0.0f;
   const bool contacts = old.records != nullptr || old.states != nullptr;
   const uint32_t blocks = (count_ + kLoadBlock - 1) / kLoadBlock;
@@ -91,7 +91,7 @@ void CpuBackend::collide_with_loads(const FluidConstants& fluid, const SceneFram
       sum.angular[1] += s.angular.y;
       sum.angular[2] += s.angular.z;
     }
-  report.stage_ms[kStageCollide] += static_cast<float>(elapsed_ms(t));
+  end_stage(report, kStageCollide, t);
 }
 
 }  // namespace sph

@@ -175,7 +175,7 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
                                    const SubstepTime& time, FrameReport& report, DfsphTallies& tallies) {
   sort_and_density(fluid, scene, stage_time(time, 0.0f), report);
   spring_pass(time.dt, true, report);
-  auto t = Clock::now();
+  auto t = stage_start();
   const float dt = time.dt;
   const DfsphWalls walls{boundary_.data()};  // the walls' share (dfsph_boundary.h), null without it
   dfsph_find_contacts(scene, time);
@@ -231,7 +231,7 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
     start[i].w = p;
     next_pos[i] = make_float4_record(xyz(pos[i]) + xyz(next_vel[i]) * dt, p);
   });
-  report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
+  end_stage(report, kStageForces, t);
   sample_probes(scene, dt, report);
   if (loads_on()) {
     // The walls' reactions of both solves, the clamp's impulses, the collision response's contacts
@@ -243,12 +243,12 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
   } else {
     collide_from(scene, time, pos, report);
   }
-  t = Clock::now();
+  t = stage_start();
   float v2max = 0.0f;
   const uint32_t bad_index = scan_next_state(v2max);
   if (bad_index != kAllFinite) diagnose_non_finite(fluid, scene, -1, bad_index);
   const uint32_t bad = finish_substep(v2max, bad_index);
-  report.stage_ms[kStageIntegrate] += static_cast<float>(elapsed_ms(t));
+  end_stage(report, kStageIntegrate, t);
   return bad;
 }
 

@@ -122,9 +122,9 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
   report.max_speed = max_speed_;
   report.collider_loads = load_sums_;
   report.probes = probe_sums_;
-  const auto t = Clock::now();
+  const auto t = stage_start();
   summarize(report);
-  report.stage_ms[kStageOther] += static_cast<float>(elapsed_ms(t));
+  end_stage(report, kStageOther, t);
   return report;
 }
 

@@ -16,7 +16,7 @@ void CpuBackend::begin_probes(const SceneFrame& scene) {
 
 void CpuBackend::sample_probes(const SceneFrame& scene, float dt, FrameReport& report) {
   if (scene.probes.empty()) return;
-  const auto t = Clock::now();
+  const auto t = stage_start();
   ProbeConstants constants;
   constants.kernel = make_kernel_coefficients(config_.kernel_radius);
   constants.particle_mass = config_.particle_mass;
@@ -41,7 +41,7 @@ void CpuBackend::sample_probes(const SceneFrame& scene, float dt, FrameReport& r
     for (uint32_t q = 0; q < p.point_count; ++q) g = g + points[p.first_point + q];
     add_probe_sample(probe_sums_[static_cast<size_t>(k)], p, probe_sample(constants, p, g), dt);
   }
-  report.stage_ms[kStageDensity] += static_cast<float>(elapsed_ms(t));
+  end_stage(report, kStageDensity, t);
 }
 
 }  // namespace sph

@@ -6,7 +6,7 @@ namespace sph {
 
 // Removes particles inside any sink, keeping the order of the rest; records their ids.
 void CpuBackend::apply_sinks(const SceneFrame& scene, FrameReport& report) {
-  const auto t = Clock::now();
+  const auto t = stage_start();
   keep_order_.clear();
   const Float4* position = position_.data();
   for (uint32_t i = 0; i < count_; ++i) {
@@ -25,7 +25,7 @@ void CpuBackend::apply_sinks(const SceneFrame& scene, FrameReport& report) {
     count_ = static_cast<uint32_t>(keep_order_.size());
     store_.resize(count_);
   }
-  report.stage_ms[kStageEmit] += static_cast<float>(elapsed_ms(t));
+  end_stage(report, kStageEmit, t);
 }
 
 }  // namespace sph

@@ -13,7 +13,7 @@ namespace sph {
 // evaluation, where the rest lengths flow (plasticity).
 void CpuBackend::spring_pass(float dt, bool first_evaluation, FrameReport& report) {
   if (!springs_) return;
-  const auto t = Clock::now();
+  const auto t = stage_start();
   const Float4* pos = position_.data();
   const Float4* vel = velocity_.data();
   SpringList* lists = springs_.data();
@@ -59,7 +59,7 @@ void CpuBackend::spring_pass(float dt, bool first_evaluation, FrameReport& repor
                     spring_acceleration<false>(c, pos, vel, static_cast<uint32_t>(i), lists[i], dt), 0.0f);
     });
   }
-  report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
+  end_stage(report, kStageForces, t);
 }
 
 }  // namespace sph

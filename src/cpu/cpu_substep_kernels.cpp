@@ -16,7 +16,7 @@ namespace sph {
 // Hash, sort, reorder every attribute, then density and pressure (packed into the w slots).
 void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame& scene, StageTime at,
                                   FrameReport& report, float diffusion_dt) {
-  auto t = Clock::now();
+  auto t = stage_start();
   if (rank_) rank_->gather();
   grid_.build(position_.data(), count_, workers_, rank_ ? rank_->grid_shape() : nullptr,
               rank_ ? rank_->visit_order() : nullptr);
@@ -27,9 +27,9 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
     columns_.copy_state(position_.data(), velocity_.data(), first, last);
   });
   if (rank_) rank_->after_sort(grid_);
-  report.stage_ms[kStageHashSort] += static_cast<float>(elapsed_ms(t));
+  end_stage(report, kStageHashSort, t);
 
-  t = Clock::now();
+  t = stage_start();
   const GridView view = grid_.view();
   const NeighborColumns columns = columns_.view();
   Float4* pos = position_.data();
@@ -116,7 +116,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
     });
     if (rank_) halo_share_normals();
   }
-  report.stage_ms[kStageDensity] += static_cast<float>(elapsed_ms(t));
+  end_stage(report, kStageDensity, t);
 }
 
 void CpuBackend::diffuse_density(const FluidConstants& fluid, float dt) {

@@ -14,7 +14,7 @@ template <class OldPosition>
 void CpuBackend::collide(const SceneFrame& scene, const SubstepTime& time, OldPosition&& x_old,
                          FrameReport& report) {
   if (scene.colliders.empty()) return;
-  const auto t = Clock::now();
+  const auto t = stage_start();
   const float h = config_.kernel_radius;
   Float4* next_pos = next_position_.data();
   Float4* next_vel = next_velocity_.data();
@@ -28,7 +28,7 @@ void CpuBackend::collide(const SceneFrame& scene, const SubstepTime& time, OldPo
     next_pos[i] = make_float4_record(x, next_pos[i].w);
     next_vel[i] = make_float4_record(v, next_vel[i].w);
   });
-  report.stage_ms[kStageCollide] += static_cast<float>(elapsed_ms(t));
+  end_stage(report, kStageCollide, t);
 }
 
 void CpuBackend::collide_from(const SceneFrame& scene, const SubstepTime& time, const Float4* old,
@@ -42,7 +42,7 @@ uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame
   sort_and_density(fluid, scene, stage_time(time, 0.0f), report, time.dt);
   sample_probes(scene, time.dt, report);
   spring_pass(time.dt, true, report);
-  auto t = Clock::now();
+  auto t = stage_start();
   const GridView view = grid_.view();
   Float4* next_pos = next_position_.data();
   Float4* next_vel = next_velocity_.data();
@@ -78,7 +78,7 @@ uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame
   float v2max = forces.v2max;
   uint32_t bad_index = forces.bad_index;
   max_acceleration_ = std::sqrt(forces.a2max);
-  report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
+  end_stage(report, kStageForces, t);
   if (loads_on()) {
     OldPositions old;
     old.records = pos;
@@ -87,11 +87,11 @@ uint32_t CpuBackend::substep_euler(const FluidConstants& fluid, const SceneFrame
     collide(
         scene, time, [&](uint32_t i) { return xyz(pos[i]); }, report);
   }
-  t = Clock::now();
+  t = stage_start();
   if (!scan_in_loop) bad_index = scan_next_state(v2max);
   if (bad_index != kAllFinite) diagnose_non_finite(fluid, scene, -1, bad_index);
   const uint32_t bad = finish_substep(v2max, bad_index);
-  report.stage_ms[kStageIntegrate] += static_cast<float>(elapsed_ms(t));
+  end_stage(report, kStageIntegrate, t);
   return bad;
 }
 
@@ -109,7 +109,7 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
                      stage == 0 ? dt : 0.0f);
     if (stage == 0) sample_probes(scene, dt, report);  // the substep's start, as with Euler
     spring_pass(dt, stage == 0, report);
-    auto t = Clock::now();
+    auto t = stage_start();
     const GridView view = grid_.view();
     Float4* next_pos = next_position_.data();
     Float4* next_vel = next_velocity_.data();
@@ -134,7 +134,7 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
         },
         [](float a, float b) { return std::max(a, b); });
     a2max = std::max(a2max, stage_a2max);
-    report.stage_ms[kStageForces] += static_cast<float>(elapsed_ms(t));
+    end_stage(report, kStageForces, t);
     if (loads_on() && (boundary_ || stage == 3)) {  // the walls' reactions, the contacts after the last
       OldPositions old;
       if (stage == 3) old.states = start;
@@ -144,7 +144,7 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
       collide(
           scene, time, [start](uint32_t i) { return start[i].position; }, report);
     }
-    t = Clock::now();
+    t = stage_start();
     float v2max = 0.0f;
     const uint32_t bad_index = scan_next_state(v2max);
     if (bad_index != kAllFinite) diagnose_non_finite(fluid, scene, stage, bad_index);
@@ -152,7 +152,7 @@ uint32_t CpuBackend::substep_rk4(const FluidConstants& fluid, const SceneFrame& 
     // A distributed world's stage ends as a substep does: the ghosts go (the next stage's sort
     // gathers them anew) and the ranks agree on a failure, so all stop at the same stage.
     if (rank_) bad = halo_end_substep(bad);
-    report.stage_ms[kStageIntegrate] += static_cast<float>(elapsed_ms(t));
+    end_stage(report, kStageIntegrate, t);
     if (bad != kAllFinite) return bad;
   }
   max_acceleration_ = std::sqrt(a2max);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "mpi_transport.h"
 
+#include <chrono>
 #include <climits>
 #include <cstdlib>
 #include <cstring>
@@ -88,11 +89,32 @@ MpiTransport::MpiTransport(MPI_Comm comm) {
   check_collectives_ = on != 0;
 }
 
+template <class Call>
+int MpiTransport::timed(TransportCall call, Call&& mpi) const {
+  using Clock = std::chrono::steady_clock;
+  auto add = [this](TransportCall c, Clock::time_point since) {
+    const double ms = std::chrono::duration<double, std::milli>(Clock::now() - since).count();
+    times_.calls[c] += 1;
+    times_.ms[c] += ms;
+    times_.total_ms += ms;
+  };
+  if (wait_at_barriers_) {
+    const auto t = Clock::now();
+    check(MPI_Barrier(comm_), "MPI_Barrier (the timed wait before a call)");
+    add(kCallBarrier, t);
+  }
+  const auto t = Clock::now();
+  const int code = mpi();
+  add(call, t);
+  return code;
+}
+
 void MpiTransport::match(Collective kind, int64_t detail) const {
   if (!check_collectives_) return;
   const int64_t mine = signature(kind, detail);
   int64_t range[2] = {mine, -mine};  // the largest signature and minus the smallest
-  check(MPI_Allreduce(MPI_IN_PLACE, range, 2, MPI_INT64_T, MPI_MAX, comm_),
+  check(timed(kCallAllreduce,
+              [&] { return MPI_Allreduce(MPI_IN_PLACE, range, 2, MPI_INT64_T, MPI_MAX, comm_); }),
         "MPI_Allreduce (collective check)");
   if (range[0] == -range[1]) return;
   // Every rank knows of this failure already: an AgreedRankFailure, which rethrow_agreed passes
@@ -115,25 +137,34 @@ MpiTransport::~MpiTransport() {
 
 void MpiTransport::all_min(int64_t* values, int n) const {
   match(Collective::AllMinInt64, n);
-  check(MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_INT64_T, MPI_MIN, comm_), "MPI_Allreduce");
+  check(timed(kCallAllreduce,
+              [&] { return MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_INT64_T, MPI_MIN, comm_); }),
+        "MPI_Allreduce");
 }
 void MpiTransport::all_max(int64_t* values, int n) const {
   match(Collective::AllMaxInt64, n);
-  check(MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_INT64_T, MPI_MAX, comm_), "MPI_Allreduce");
+  check(timed(kCallAllreduce,
+              [&] { return MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_INT64_T, MPI_MAX, comm_); }),
+        "MPI_Allreduce");
 }
 void MpiTransport::all_sum(int64_t* values, int n) const {
   match(Collective::AllSumInt64, n);
-  check(MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_INT64_T, MPI_SUM, comm_), "MPI_Allreduce");
+  check(timed(kCallAllreduce,
+              [&] { return MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_INT64_T, MPI_SUM, comm_); }),
+        "MPI_Allreduce");
 }
 void MpiTransport::all_max(float* values, int n) const {
   match(Collective::AllMaxFloat, n);
-  check(MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_FLOAT, MPI_MAX, comm_), "MPI_Allreduce");
+  check(timed(kCallAllreduce,
+              [&] { return MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_FLOAT, MPI_MAX, comm_); }),
+        "MPI_Allreduce");
 }
 
 int64_t MpiTransport::exclusive_sum(int64_t value) const {
   int64_t below = 0;
   match(Collective::ExclusiveSum, 1);
-  check(MPI_Exscan(&value, &below, 1, MPI_INT64_T, MPI_SUM, comm_), "MPI_Exscan");
+  check(timed(kCallExscan, [&] { return MPI_Exscan(&value, &below, 1, MPI_INT64_T, MPI_SUM, comm_); }),
+        "MPI_Exscan");
   return rank_ == 0 ? 0 : below;  // (MPI leaves rank 0's result undefined)
 }
 
@@ -162,7 +193,11 @@ std::vector<RankBytes> MpiTransport::exchange(const std::vector<RankBytes>& send
   }
   agree(*this);
   match(Collective::Alltoall, 1);
-  check(MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm_), "MPI_Alltoall");
+  check(timed(kCallAlltoall,
+              [&] {
+                return MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm_);
+              }),
+        "MPI_Alltoall");
   try {
     size_t received = 0;
     for (size_t r = 0; r < n; ++r) {
@@ -175,8 +210,11 @@ std::vector<RankBytes> MpiTransport::exchange(const std::vector<RankBytes>& send
   }
   agree(*this);
   match(Collective::Alltoallv, 0);
-  check(MPI_Alltoallv(packed.data(), send_counts.data(), send_offsets.data(), MPI_BYTE, in.data(),
-                      recv_counts.data(), recv_offsets.data(), MPI_BYTE, comm_),
+  check(timed(kCallAlltoallv,
+              [&] {
+                return MPI_Alltoallv(packed.data(), send_counts.data(), send_offsets.data(), MPI_BYTE,
+                                     in.data(), recv_counts.data(), recv_offsets.data(), MPI_BYTE, comm_);
+              }),
         "MPI_Alltoallv");
   // (A failure from here on is met by the caller's next agreement.)
   std::vector<RankBytes> out(n);
@@ -199,7 +237,9 @@ std::vector<RankBytes> MpiTransport::gather(const RankBytes& mine, int root) con
   }
   agree(*this);
   match(Collective::Gather, root);
-  check(MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, root, comm_), "MPI_Gather");
+  check(timed(kCallGather,
+              [&] { return MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, root, comm_); }),
+        "MPI_Gather");
   try {
     size_t total = 0;
     if (rank_ == root)
@@ -213,8 +253,11 @@ std::vector<RankBytes> MpiTransport::gather(const RankBytes& mine, int root) con
   }
   agree(*this);
   match(Collective::Gatherv, root);
-  check(MPI_Gatherv(mine.data(), count, MPI_BYTE, all.data(), counts.data(), offsets.data(), MPI_BYTE, root,
-                    comm_),
+  check(timed(kCallGatherv,
+              [&] {
+                return MPI_Gatherv(mine.data(), count, MPI_BYTE, all.data(), counts.data(), offsets.data(),
+                                   MPI_BYTE, root, comm_);
+              }),
         "MPI_Gatherv");
   std::vector<RankBytes> out;
   if (rank_ == root) {
@@ -228,10 +271,11 @@ std::vector<RankBytes> MpiTransport::gather(const RankBytes& mine, int root) con
 RankBytes MpiTransport::broadcast(const RankBytes& bytes, int root) const {
   uint64_t size = bytes.size();
   match(Collective::BroadcastSize, root);
-  check(MPI_Bcast(&size, 1, MPI_UINT64_T, root, comm_), "MPI_Bcast");
+  check(timed(kCallBcast, [&] { return MPI_Bcast(&size, 1, MPI_UINT64_T, root, comm_); }), "MPI_Bcast");
   RankBytes out(rank_ == root ? bytes : RankBytes(static_cast<size_t>(size)));
   match(Collective::BroadcastBytes, root);
-  check(MPI_Bcast(out.data(), as_count(out.size()), MPI_BYTE, root, comm_), "MPI_Bcast");
+  const int count = as_count(out.size());
+  check(timed(kCallBcast, [&] { return MPI_Bcast(out.data(), count, MPI_BYTE, root, comm_); }), "MPI_Bcast");
   return out;
 }
 

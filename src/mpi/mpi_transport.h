@@ -47,7 +47,17 @@ class MpiTransport final : public RankTransport {
   std::vector<RankBytes> gather(const RankBytes& mine, int root) const override;
   RankBytes broadcast(const RankBytes& bytes, int root) const override;
 
+  const TransportTimes* times() const override { return &times_; }
+
   bool checks_collectives() const { return check_collectives_; }
+
+  // COLLECTIVE in effect: every rank must turn it on (or off) before its next call, or the
+  // ranks meet a barrier against another call. On, each timed call waits at an MPI_Barrier first
+  // (timed as kCallBarrier): the barrier holds the wait for the slowest rank, and what the call
+  // itself takes after it is the transfer. Off by default (the extra barrier costs a latency a
+  // call); bench/mpi_halo's --wait-barriers turns it on. Const as the timing is: instrumentation,
+  // not the transport's state.
+  void wait_at_barriers(bool on) const { wait_at_barriers_ = on; }
 
  private:
   // With the check on: every rank's (kind, detail) must be the same, else every rank throws
@@ -55,11 +65,16 @@ class MpiTransport final : public RankTransport {
   // the element count, or the root of a rooted call; 0 for the v-variants, whose counts differ
   // between ranks by design.
   void match(Collective kind, int64_t detail) const;
+  // Runs one MPI call (a callable returning its code) and adds its wall time to times_[call].
+  template <class Call>
+  int timed(TransportCall call, Call&& mpi) const;
 
   MPI_Comm comm_ = MPI_COMM_NULL;
   int rank_ = 0;
   int size_ = 1;
   bool check_collectives_ = false;
+  mutable bool wait_at_barriers_ = false;
+  mutable TransportTimes times_;
 };
 
 }  // namespace sph
