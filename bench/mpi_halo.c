@@ -18,7 +18,9 @@
  * rank, MPI_Wtime around the step) and the step's stage times; each stage split into the time
  * inside the transport's MPI calls (the wait there for the slowest rank and the transfer) and
  * the rest (the rank's own work: packing, sorting, gathering ghosts, computing), on rank 0 and
- * as the largest and smallest over the ranks, with the transport's calls over the step
+ * as the largest and smallest over the ranks, then each rank's row (owned particles, ghosts, slab,
+ * mean neighbours, its force, density and hash+sort stages; whether a slow rank holds more work or
+ * runs it slower), with the transport's calls over the step
  * (mpi_halo_transport.h; issue 19; the CPU backend splits its stages so, CUDA ranks show their
  * transport time only as the step's total, outside the stages); and a ping-pong of MPI messages of 8 B to 8
  * MB between ranks 0 and 1 (their latency and bandwidth, the model's alpha and beta for this host's MPI).
@@ -90,6 +92,36 @@ static void print_split(int rank, int wait_barriers, const sph_stats* stats, con
       printf(" %s %llu %.2f (%.2f)", mpi_halo_call_name(c),
              (unsigned long long)(after->calls[c] - before->calls[c]), calls_ms[c], calls_hi[c]);
   printf("\n");
+}
+
+/* Rank 0 prints every rank's particles, ghosts, slab, mean neighbours and its compute and exchange
+ * stages (ms over the timed step; transport: inside its MPI calls): whether a slow rank holds
+ * more work or runs it slower. Collective (one gather). */
+enum { kRankValues = 9 };
+static void print_ranks(int rank, int size, const sph_mpi_counts* c, const sph_stats* stats,
+                        const mpi_halo_transport* t) {
+  const double mine[kRankValues] = {(double)c->local_count,
+                                    (double)c->local_ghosts,
+                                    (double)c->slab_first,
+                                    (double)c->slab_last,
+                                    (double)stats->neighbors_mean,
+                                    stats->stage_ms[SPH_STAGE_FORCES],
+                                    stats->stage_ms[SPH_STAGE_DENSITY],
+                                    stats->stage_ms[SPH_STAGE_HASH_SORT],
+                                    t->stage_ms[SPH_STAGE_DENSITY] + t->stage_ms[SPH_STAGE_HASH_SORT]};
+  double* all = rank == 0 ? (double*)malloc(sizeof(double) * kRankValues * (size_t)size) : NULL;
+  if (rank == 0 && !all) MPI_Abort(MPI_COMM_WORLD, 1);
+  MPI_Gather(mine, kRankValues, MPI_DOUBLE, all, kRankValues, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  if (rank != 0) return;
+  printf(
+      "per rank: owned, ghosts, slab layers, mean neighbours, forces ms, its us a particle, density ms, "
+      "hash+sort ms, their transport ms\n");
+  for (int r = 0; r < size; ++r) {
+    const double* v = all + (size_t)r * kRankValues;
+    printf("  rank %2d %7.0f %6.0f [%4.0f, %4.0f] %6.2f %8.2f %6.3f %8.2f %8.2f %8.2f\n", r, v[0], v[1], v[2],
+           v[3], v[4], v[5], v[0] > 0 ? 1e3 * v[5] / v[0] : 0.0, v[6], v[7], v[8]);
+  }
+  free(all);
 }
 
 static void need(sph_result r, const char* what) {
@@ -227,6 +259,7 @@ int main(int argc, char** argv) {
     printf("\n");
   }
   print_split(rank, wait_barriers, &stats, &before, &after);
+  print_ranks(rank, size, &c, &stats, &after);
   sph_world_destroy(world);
   sph_context_destroy(context);
   if (size >= 2) ping_pong(rank);
