@@ -191,10 +191,18 @@ __global__ void __launch_bounds__(kDfsphCheckBlock)
 }
 
 // v* = v + dt a with the non-pressure accelerations, into the state's velocity array (free
-// since the density pass gathered it), held to the contacts.
+// since the density pass gathered it), held to the contacts. With `warm` (the density solve's warm
+// pressures, a.dfsph_warm_pressure; null where the solve makes its own warm start: a distributed
+// rank, the corrected gradient), the density solve's warm start runs here too: its velocity change
+// (pressure_velocity_change's sum, term for term) is gathered in the same walk, since it reads only
+// the positions and the warm pressures, both known before this pass; then applied and held to the
+// contacts, and its pressures carried, as dfsph_correct_kernel<true, false> would in a pass of its
+// own. The same arithmetic in the same order, so the same bits, and one neighbour pass a substep
+// less (session 36).
 template <class Terms, bool kScene>
 __global__ void dfsph_forces_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
-                                    DeviceScene scene, bool divergence_solve, FrameState* state) {
+                                    DeviceScene scene, bool divergence_solve, const float* warm,
+                                    FrameState* state) {
   mark_stage(state, kStageForces);
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   float a2 = 0.0f;
@@ -202,11 +210,24 @@ __global__ void dfsph_forces_kernel(FluidConstants fluid, GridView grid, Particl
     FluidConstants f = fluid;
     f.dt = state->clock.dt_float;
     // Over the solves' walk (the lists, the masks, or every candidate), one body for all three,
-    // so that they give the same bits (neighbor_walk.h). (gather_acceleration_masked, the weakly
-    // compressible pass's two-phase walk, computes r^2 once to test and again for the term.)
-    Vec3 acc = gather_acceleration<Terms, false>(
-        f, grid, ForceInputs{a.sorted_position, a.sorted_velocity, a.neighbor_count, a.colour_normal}, i,
-        solve_walk(a));
+    // so that they give the same bits (neighbor_walk.h); each pair tested and summed with one r^2.
+    // (gather_acceleration_masked, the weakly compressible pass's two-phase walk, computes r^2 once
+    // to test and again for the term.)
+    AccelerationGather<Terms, false> gather(
+        ForceInputs{a.sorted_position, a.sorted_velocity, a.neighbor_count, a.colour_normal}, i);
+    const Vec3 xi = gather.position();
+    const KernelCoefficients mk = mass_gradient_kernel(fluid);
+    const float ki = warm ? warm[i] : 0.0f;
+    Vec3 push{0.0f, 0.0f, 0.0f};
+    solve_walk(a)(grid, xi, i, [&](uint32_t j) {
+      const Float4 pj = a.sorted_position[j];
+      const Vec3 d = xi - xyz(pj);
+      const float r2 = length_squared(d);
+      if (!is_force_neighbor(f, r2, i, j)) return;
+      gather.add(f, j, pj, d, r2);
+      if (warm) push += pressure_velocity_pair_term(mk, d, r2, ki + warm[j]);
+    });
+    Vec3 acc = gather.finish(f);
     const Float4 p = a.sorted_position[i];
     const Float4 v = a.sorted_velocity[i];
     if (kScene) acc = add_force_fields(scene, acc, xyz(p));
@@ -215,7 +236,13 @@ __global__ void dfsph_forces_kernel(FluidConstants fluid, GridView grid, Particl
     // owner's after the density solve's first velocity update.
     if (!(a.halo_ghost && a.halo_ghost[i])) a2 = length_squared(acc);
     Vec3 next = xyz(v) + acc * f.dt;
-    if (kScene && scene.collider_count != 0) next = dfsph_clamp(a, i, next);
+    const bool contacts = scene.collider_count != 0;
+    if (kScene && contacts) next = dfsph_clamp(a, i, next);
+    if (warm) {
+      next += dfsph_velocity_change(push, DfsphWalls{a.boundary_gradient}, i, ki, f.dt);
+      if (contacts) next = dfsph_clamp(a, i, next);
+      a.dfsph_pressure[i] = 0.0f + ki * 1.0f;  // (the warm pass's carried value, -0 included)
+    }
     a.velocity[i] = make_float4_record(next, v.w);
     if (!divergence_solve) a.dfsph_divergence[i] = 0.0f;  // no warm start to keep
   }
@@ -264,9 +291,10 @@ __global__ void dfsph_integrate_kernel(ParticleArrays a, uint32_t n, DeviceScene
 enum class Solve { Divergence, Density };
 
 // One solve: the warm start's pass, the initial residual and check, then the loop.
+// warm_started: the forces pass made the density solve's warm start (dfsph_forces_kernel's warm).
 void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
-                   uint32_t n, bool contacts, const DfsphLoops& loops, FrameState* state,
-                   cudaStream_t stream) {
+                   uint32_t n, bool contacts, const DfsphLoops& loops, FrameState* state, cudaStream_t stream,
+                   bool warm_started = false) {
   const bool divergence = kind == Solve::Divergence;
   const Dfsph::Constants& c = fluid.methods.dfsph;
   Float4* v = divergence ? a.sorted_velocity : a.velocity;
@@ -303,7 +331,8 @@ void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid
   if (loops.rank)  // the host drives the loop (dfsph_jacobi_rank_solver.cu)
     return enqueue_dfsph_jacobi_rank_solve(fluid, grid, a, n, v, warm, carried, divergence, contacts,
                                            min_iterations, max_iterations, *loops.rank, state, stream);
-  launch_dfsph_correct(true, fluid, grid, a, n, v, warm, carried, divergence, contacts, state, stream);
+  if (!warm_started)
+    launch_dfsph_correct(true, fluid, grid, a, n, v, warm, carried, divergence, contacts, state, stream);
   // The same warm start (as the CPU backend's), then the conjugate gradients' iterations.
   if (!divergence && c.linear_solver == kDfsphConjugateGradients)
     return enqueue_dfsph_cg_solve(fluid, grid, a, n, contacts, loops, cond, state, stream);
@@ -371,17 +400,22 @@ void enqueue_dfsph_step(const FluidConstants& fluid, const GridView& grid, const
   const bool divergence_solve = fluid.methods.dfsph.divergence_solve != 0;
   if (divergence_solve) enqueue_solve(Solve::Divergence, fluid, grid, a, n, contacts, loops, state, stream);
   const unsigned threads = tuning.force_block, blocks = blocks_for(n, threads);
+  // The density solve's warm start in the forces pass, where the solve's own first pass would be
+  // that warm start: not on a distributed rank (its solves start with the ghosts' exchanges) nor
+  // with the corrected gradient (its velocity update gathers a moment too).
+  const bool fused_warm_start = !loops.rank && fluid.methods.dfsph.gradient_correction == 0;
+  const float* warm = fused_warm_start ? a.dfsph_warm_pressure : nullptr;
   with_force_terms(options.methods, [&](auto terms) {
     using Terms = decltype(terms);
     if (scene.active())
       dfsph_forces_kernel<Terms, true>
-          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, divergence_solve, state);
+          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, divergence_solve, warm, state);
     else
       dfsph_forces_kernel<Terms, false>
-          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, divergence_solve, state);
+          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, divergence_solve, warm, state);
   });
   check_launch("dfsph_forces_kernel");
-  enqueue_solve(Solve::Density, fluid, grid, a, n, contacts, loops, state, stream);
+  enqueue_solve(Solve::Density, fluid, grid, a, n, contacts, loops, state, stream, fused_warm_start);
   if (scene.active())
     dfsph_integrate_kernel<true>
         <<<blocks, threads, 0, stream>>>(a, n, scene, divergence_solve, collide_here, state);
