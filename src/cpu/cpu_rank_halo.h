@@ -153,6 +153,11 @@ class CpuRankHalo {
   DistributedCounters counters_;
   GridShape shape_{};
   HostVector<uint32_t> visit_;
+  // gather's ordered runs of particles (where each starts), merged into visit_ when they are at
+  // most kMergedRuns; more are sorted.
+  static constexpr size_t kMergedRuns = 64;
+  HostVector<uint32_t> run_starts_;
+  HostVector<uint32_t> merged_;  // the merge's other buffer
   int64_t world_count_ = 0;
   CpuArrayRef<uint64_t> sort_key_;  // Carried
   CpuArrayRef<uint32_t> origin_;    // Sorted (origins())
