@@ -114,7 +114,8 @@ static void print_ranks(int rank, int size, const sph_mpi_counts* c, const sph_s
   MPI_Gather(mine, kRankValues, MPI_DOUBLE, all, kRankValues, MPI_DOUBLE, 0, MPI_COMM_WORLD);
   if (rank != 0) return;
   printf(
-      "per rank: owned, ghosts, slab layers, mean neighbours, forces ms, its us a particle, density ms, "
+      "per rank: owned, ghosts, slab layers, mean neighbours, forces ms, its us a particle over the step, "
+      "density ms, "
       "hash+sort ms, their transport ms\n");
   for (int r = 0; r < size; ++r) {
     const double* v = all + (size_t)r * kRankValues;

@@ -191,7 +191,9 @@ void CpuRankHalo::gather() {
   if (owned > 0) {
     // The extreme coordinates first, then their cells: cell_coordinate does not decrease with x
     // (a product, a flush of denormals, floor and a clamp, each monotone), so the cell of the
-    // smallest x is the smallest cell, and one cell_coordinate an axis does the loop's work.
+    // smallest x is the smallest cell, and one cell_coordinate an axis does the loop's work. (For
+    // finite coordinates, which the owned particles have here: a substep that leaves one
+    // non-finite rolls back before the next gather, and the API refuses them.)
     float xlo[3] = {position_[0].x, position_[0].y, position_[0].z}, xhi[3] = {xlo[0], xlo[1], xlo[2]};
     for (uint32_t i = 1; i < owned; ++i) {
       const float x[3] = {position_[i].x, position_[i].y, position_[i].z};

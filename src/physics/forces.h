@@ -170,15 +170,15 @@ class AccelerationGather<ForceTerms<Terms...>, kPressure> {
   TermSums<float, Terms...> sums_;
 };
 
-// The whole gather for particle i over the candidates of `walk` (physics/neighbor_walk.h: every
-// candidate of the neighbour cells in order, or CUDA DFSPH's masks or lists, which visit the same
-// neighbours within h in the same order), each tested and summed with one r^2.
-template <class Terms, bool kPressure = true, class Walk = AllCandidates>
+// The whole gather for particle i, walking the neighbour cells in order. (CUDA DFSPH's force pass
+// runs the same body over its solves' walk, with the density solve's warm start beside it:
+// cuda/dfsph_solver.cu.)
+template <class Terms, bool kPressure = true>
 SPH_HD Vec3 gather_acceleration(const FluidConstants& f, const GridView& grid, const ForceInputs& in,
-                                uint32_t i, const Walk& walk = Walk{}) {
+                                uint32_t i) {
   AccelerationGather<Terms, kPressure> gather(in, i);
   const Vec3 xi = gather.position();
-  walk(grid, xi, i, [&](uint32_t j) {
+  for_each_neighbor_candidate(grid, xi, [&](uint32_t j) {
     const Float4 pj = in.positions[j];
     const Vec3 d = xi - xyz(pj);
     const float r2 = length_squared(d);
