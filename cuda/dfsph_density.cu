@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: MIT
+// DFSPH's density pass on the CUDA backend (dfsph_solver.h): each particle's density, neighbour
+// count and factor in one walk that also records the solves' candidate masks and neighbour lists,
+// the warm starts, the walls' share and contacts; the solves and the step are dfsph_solver.cu's.
+#include "../src/physics/collider_loads.h"
+#include "../src/physics/dfsph_passes.h"
+#include "dfsph_solver.h"
+#include "force_gather.cuh"
+#include "kernel_launch.h"
+
+namespace sph {
+namespace {
+
+// One particle of the density pass. kBoundary: SPH_FEATURE_BOUNDARY_DENSITY, the walls' share
+// (dfsph_boundary.h, place 1) at the substep's start, its record kept for the solves.
+template <bool kBoundary>
+__device__ __forceinline__ void dfsph_density_particle(const FluidConstants& fluid, const GridView& grid,
+                                                       const ParticleArrays& a, uint32_t n,
+                                                       const DeviceScene& scene, FrameState* state) {
+  mark_stage(state, kStageDensity);
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  // The reorder left this particle's old index in w; the carried pressures are still in the
+  // old order (nothing writes them in this kernel), their sorted copies go to scratch arrays.
+  const Float4 p = a.sorted_position[i];
+  const uint32_t k = __float_as_uint(p.w);
+  BoundaryShare wall = no_boundary_share();
+  if (kBoundary) {
+    const StageTime at = stage_time(state->clock.time, 0.0f);
+    wall =
+        boundary_share(fluid.methods.boundary, scene.colliders, scene.collider_count, xyz(p), at.s, at.tau);
+    a.boundary_gradient[i] = pack_boundary(wall);
+  }
+  // The candidate masks of the solves' passes and, with lists, the neighbour lists, recorded by
+  // this walk (the positions are the substep's until the solves end).
+  // (The same code without masks: a null writer stores nothing; see NeighborMaskWriter.)
+  uint32_t* const mask =
+      a.dfsph_neighbor_mask ? a.dfsph_neighbor_mask + static_cast<size_t>(i) * kNeighborMaskWords : nullptr;
+  const DfsphDensitySample s = gather_density_and_factor(
+      fluid, grid, a.sorted_position, wall, i,
+      NeighborMaskWriter{mask, mask ? a.dfsph_neighbor_list : nullptr, a.dfsph_list_stride, i});
+  a.density[i] = s.density;
+  a.neighbor_count[i] = s.neighbor_count;
+  a.dfsph_factor[i] = s.factor;
+  // The warm starts, as the CPU backend's solve computes them (k = share * carried / scale).
+  const float dt = state->clock.dt_float;
+  a.dfsph_step[i] = Dfsph::kWarmStart * a.dfsph_divergence[k] / dt;
+  a.dfsph_warm_pressure[i] = Dfsph::kWarmStart * a.dfsph_pressure[k] / 1.0f;
+  if (scene.collider_count != 0) {
+    uint32_t collider = scene.collider_count;
+    a.dfsph_contact[i] = wall_contact(scene.colliders, scene.collider_count, state->clock.time,
+                                      scene.kernel_radius, xyz(p), collider);
+    // With the loads, the clamp's impulses start at zero, named after the contact's collider.
+    if (a.dfsph_contact_impulse) a.dfsph_contact_impulse[i] = no_clamp(collider);
+  }
+  a.sorted_position[i].w = 0.0f;  // no equation of state: the pressure is written after the solves
+  a.sorted_velocity[i] = make_float4_record(xyz(a.velocity[k]), 1.0f / s.density);
+}
+
+// The pass without the walls' share, held to 72 registers: ptxas gives it 109 uncapped, which
+// leaves room for 4 blocks of 128 threads an SM; at 72 (no spills, ptxas -v) 7 fit, and the
+// gather hides more of its memory latency. Measured in the million-particle dam break on an H100
+// (session 33, one call, the cap then on the whole template; the same printed results): the
+// density stage 0.972 -> 0.798 ms a substep with the neighbour lists, 0.841 -> 0.587 with the
+// masks; the whole run 2.9 / 3.4 % less wall time (docs/performance.md, "Session 33").
+__global__ void __maxnreg__(72) dfsph_density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a,
+                                                     uint32_t n, DeviceScene scene, FrameState* state) {
+  dfsph_density_particle<false>(fluid, grid, a, n, scene, state);
+}
+// With the walls' share (uncapped: at 72 registers it spills 220 bytes, not measured).
+__global__ void dfsph_density_walls_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
+                                           DeviceScene scene, FrameState* state) {
+  dfsph_density_particle<true>(fluid, grid, a, n, scene, state);
+}
+
+}  // namespace
+
+void enqueue_dfsph_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
+                           uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
+                           const DeviceScene& scene, FrameState* state, cudaStream_t stream) {
+  const unsigned threads = tuning.density_block, blocks = blocks_for(n, threads);
+  if (options.boundary_density)
+    dfsph_density_walls_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
+  else
+    dfsph_density_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
+  check_launch("dfsph_density_kernel");
+}
+
+}  // namespace sph
