@@ -11,7 +11,6 @@
 #pragma once
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -36,23 +35,11 @@
 #include "cpu_particle_store.h"
 #include "cpu_rank_halo.h"
 #include "cpu_simd_passes.h"
+#include "cpu_stage_timing.h"
 
 namespace sph {
 
-using Clock = std::chrono::steady_clock;
 class ExactFloatSum;
-
-inline double elapsed_ms(Clock::time_point since) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - since).count();
-}
-
-// A stage's start: the clock and, on a distributed world's rank, its transport's running times,
-// so that the stage's report tells the time inside the transport's calls from the rest.
-struct StageStart {
-  Clock::time_point wall;
-  double transport_ms = 0.0;
-  double wait_ms = 0.0;
-};
 
 class CpuBackend final : public Backend {
  public:
@@ -276,21 +263,10 @@ class CpuBackend final : public Backend {
   // Density and neighbour statistics of the last density evaluation.
   void summarize(FrameReport& report) const;
 
-  // A stage's timing (FrameReport::stage_ms and, on a rank, the transport's share of it).
-  StageStart stage_start() const {
-    StageStart s{Clock::now()};
-    if (const TransportTimes* t = rank_ ? rank_->transport().times() : nullptr) {
-      s.transport_ms = t->total_ms;
-      s.wait_ms = t->ms[kCallBarrier];
-    }
-    return s;
-  }
+  // A stage's timing (cpu_stage_timing.h: on a rank, with the transport's share of it).
+  StageStart stage_start() const { return start_stage(rank_ ? &rank_->transport() : nullptr); }
   void end_stage(FrameReport& report, StageIndex stage, const StageStart& start) const {
-    report.stage_ms[stage] += static_cast<float>(elapsed_ms(start.wall));
-    if (const TransportTimes* t = rank_ ? rank_->transport().times() : nullptr) {
-      report.transport_ms[stage] += static_cast<float>(t->total_ms - start.transport_ms);
-      report.transport_wait_ms[stage] += static_cast<float>(t->ms[kCallBarrier] - start.wait_ms);
-    }
+    sph::end_stage(report, stage, start, rank_ ? &rank_->transport() : nullptr);
   }
 
   // ---- a distributed world's rank (cpu_halo.cpp; include/sph_mpi.h): its halo steps and the
