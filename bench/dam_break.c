@@ -29,9 +29,6 @@
 #define FRAME_DT 0.04f /* 25 frames per second */
 #define GRAVITY 9.81f
 
-static const char* const stage_names[SPH_STAGE_COUNT] = {"hash_sort", "cell_ranges", "density", "forces",
-                                                         "integrate", "collide",     "emit",    "other"};
-
 static void check(sph_result r, const char* what) {
   if (r < 0) {
     fprintf(stderr, "dam_break: %s failed: %s (%s)\n", what, sph_result_string(r), sph_get_last_error());
@@ -158,7 +155,7 @@ int main(int argc, char** argv) {
   printf("  %-28s %12.1f\n", "bytes/particle", (double)s.memory_bytes / count);
   printf("  stage shares:");
   for (int k = 0; k < SPH_STAGE_COUNT; ++k)
-    printf(" %s %.1f%%", stage_names[k], stage_total > 0 ? 100.0 * stage_sum[k] / stage_total : 0.0);
+    printf(" %s %.1f%%", support_stage_name(k), stage_total > 0 ? 100.0 * stage_sum[k] / stage_total : 0.0);
   printf("\n");
   if (json) {
     FILE* j = fopen(json, "w");
@@ -176,7 +173,7 @@ int main(int argc, char** argv) {
             ms_substep, (double)substeps_total / timed, count / (ms_substep * 1e-3), neighbors_sum / timed,
             (double)s.memory_bytes / count);
     for (int k = 0; k < SPH_STAGE_COUNT; ++k)
-      fprintf(j, "\"%s\": %.6g%s", stage_names[k],
+      fprintf(j, "\"%s\": %.6g%s", support_stage_name(k),
               substeps_total ? stage_sum[k] / (double)substeps_total : 0.0,
               k + 1 < SPH_STAGE_COUNT ? ", " : "");
     fprintf(j, "}}]\n");

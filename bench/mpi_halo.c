@@ -37,16 +37,13 @@
 #include "sph_mpi.h"
 #include "support.h"
 
-static const char* const kStageNames[SPH_STAGE_COUNT] = {"hash+sort", "cells",   "density", "forces",
-                                                         "integrate", "collide", "emit",    "other"};
-
 /* Per rank, over the timed step: each stage's time, its transport share, that share's barrier
  * waits and the rest; then the transport inside and outside the stages. */
 enum { kStageRows = 4, kSplitValues = kStageRows * SPH_STAGE_COUNT + 2 };
 
 static void print_row(const char* label, const double* v) {
   printf("  %-34s", label);
-  for (int s = 0; s < SPH_STAGE_COUNT; ++s) printf(" %9.2f", v[s]);
+  for (int s = 0; s < SPH_STAGE_COUNT; ++s) printf(" %11.2f", v[s]);
   printf("\n");
 }
 
@@ -72,7 +69,7 @@ static void print_split(int rank, int wait_barriers, const sph_stats* stats, con
   MPI_Reduce(calls_ms, calls_hi, MPI_HALO_CALL_COUNT, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
   if (rank != 0) return;
   printf("stage ms over the step, split (transport: inside its MPI calls)\n  %-34s", "");
-  for (int s = 0; s < SPH_STAGE_COUNT; ++s) printf(" %9s", kStageNames[s]);
+  for (int s = 0; s < SPH_STAGE_COUNT; ++s) printf(" %11s", support_stage_name(s));
   printf("\n");
   print_row("rank 0 stage", mine);
   print_row("rank 0 transport", mine + SPH_STAGE_COUNT);

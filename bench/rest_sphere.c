@@ -94,9 +94,6 @@ typedef struct result {
   double setup_s;
 } result;
 
-static const char* const stage_names[SPH_STAGE_COUNT] = {"hash_sort", "cell_ranges", "density", "forces",
-                                                         "integrate", "collide",     "emit",    "other"};
-
 static void check(sph_result r, const char* what) {
   if (r < 0) {
     fprintf(stderr, "rest_sphere: %s failed: %s (%s)\n", what, sph_result_string(r), sph_get_last_error());
@@ -301,7 +298,7 @@ static void print_result(const result* r, const options* o) {
   }
   printf("  stage breakdown (ms per substep, share):\n");
   for (int k = 0; k < SPH_STAGE_COUNT; ++k)
-    printf("    %-14s %10.4f  %5.1f%%\n", stage_names[k], r->stage_ms_per_substep[k],
+    printf("    %-14s %10.4f  %5.1f%%\n", support_stage_name(k), r->stage_ms_per_substep[k],
            total > 0 ? 100.0 * r->stage_ms_per_substep[k] / total : 0.0);
   fflush(stdout);
 }
@@ -329,7 +326,7 @@ static void write_json(const char* path, const result* rs, int n, const options*
         r->neighbors_mean, r->neighbors_max, r->bytes_per_particle, r->density_error_mean, r->density_min,
         r->density_max, r->max_speed);
     for (int k = 0; k < SPH_STAGE_COUNT; ++k)
-      fprintf(f, "\"%s\": %.6g%s", stage_names[k], r->stage_ms_per_substep[k],
+      fprintf(f, "\"%s\": %.6g%s", support_stage_name(k), r->stage_ms_per_substep[k],
               k + 1 < SPH_STAGE_COUNT ? ", " : "");
     fprintf(f, "}}%s\n", i + 1 < n ? "," : "");
   }
@@ -350,7 +347,7 @@ static void append_csv(const char* path, const result* rs, int n, const options*
     fprintf(f,
             "label,scene,option,backend,particles,frames,substeps_per_frame,s_per_frame,ms_per_substep,"
             "particle_substeps_per_s,neighbors_mean,bytes_per_particle,density_error_mean,max_speed");
-    for (int k = 0; k < SPH_STAGE_COUNT; ++k) fprintf(f, ",ms_%s", stage_names[k]);
+    for (int k = 0; k < SPH_STAGE_COUNT; ++k) fprintf(f, ",ms_%s", support_stage_name(k));
     fprintf(f, "\n");
   }
   for (int i = 0; i < n; ++i) {

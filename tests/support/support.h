@@ -43,6 +43,11 @@ uint32_t sph_test_cuda_dfsph_masks(void);
 /** Creates a context on the test backend with defaults otherwise. */
 sph_result sph_test_context_create(sph_context** out);
 
+/** The name of sph_stats.stage_ms's entry `stage` (SPH_STAGE_HASH_SORT ...: "hash_sort", "cell_ranges",
+ * "density", "forces", "integrate", "collide", "emit", "other"), as the benchmarks print and write
+ * it; "?" out of range. */
+const char* support_stage_name(int stage);
+
 /** The backend a command line names: "cpu", "cuda" or "auto"; `otherwise` for anything else
  * (NULL included). */
 sph_backend support_backend_from_name(const char* name, sph_backend otherwise);
