@@ -53,8 +53,9 @@
  * 0.18 s, so a shorter run, >= 0.2 s, still measures the front). Neighbour passes count the
  * walks over every particle's neighbours: two per substep for the weakly compressible scheme
  * (density, forces), and for DFSPH the density and the forces plus, per solve, the warm start's
- * velocity update and first residual and two per iteration (on CUDA the density solve's warm start
- * is gathered in the force pass's walk: one pass a substep less). The plot is
+ * velocity update and first residual and two per iteration (on CUDA each solve's warm start is
+ * gathered in another pass's walk, the density solve's in the force pass, the divergence solve's in
+ * the density pass: one pass a solve less). The plot is
  * bench/solver_front_plot.py. A run that fails is a row with status "failed". */
 #include <math.h>
 #include <stdio.h>
@@ -292,8 +293,9 @@ int main(int argc, char** argv) {
         /* Per solve: the warm start's update and the first residual, then two per iteration. */
         const double solves = (double)result->substeps * (config.dfsph_flags ? 1.0 : 2.0);
         passes += 2.0 * solves + 2.0 * (double)(result->pressure_iterations + result->divergence_iterations);
-        /* On CUDA the density solve's warm start rides in the force pass's walk (session 36). */
-        if (resolved == SPH_BACKEND_CUDA) passes -= (double)result->substeps;
+        /* On CUDA each solve's warm start rides in another pass's walk: the density solve's in the
+         * force pass (session 36), the divergence solve's in the density pass (session 37). */
+        if (resolved == SPH_BACKEND_CUDA) passes -= solves;
       }
       fprintf(
           csv, "%s,%s,%g,%u,%u,%.4f,%.3f,%.3f,%llu,%.0f,%llu,%llu,%.6f,%.6f,%.6f,%.4f,%.5f,%.5f,ok,%.5f,%.2f",

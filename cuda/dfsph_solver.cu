@@ -3,6 +3,7 @@
 #include "../src/physics/collider_loads.h"
 #include "../src/physics/dfsph_passes.h"
 #include "block_reduce.cuh"
+#include "dfsph_clamp.cuh"
 #include "dfsph_solve_loop.cuh"
 #include "dfsph_solver.h"
 #include "force_gather.cuh"
@@ -25,14 +26,6 @@ namespace {
 // 9 blocks. Every launch of these kernels uses kDfsphSolveBlock threads.
 constexpr int kDfsphSolveBlocksPerSm = 16;
 constexpr int kDfsphCorrectedBlocksPerSm = 9;
-
-// v held to particle i's contact; with the loads, the change is added to its clamp impulses (the
-// CPU backend's CpuBackend::dfsph_clamp).
-__device__ Vec3 dfsph_clamp(const ParticleArrays& a, uint32_t i, Vec3 v) {
-  const Vec3 held = respect_contact(a.dfsph_contact[i], v);
-  if (a.dfsph_contact_impulse) add_clamp(a.dfsph_contact_impulse[i], v, held);
-  return held;
-}
 
 __global__ void dfsph_begin_solve_kernel(FrameState* state) {
   state->solve_run = 1;
@@ -229,7 +222,8 @@ __global__ void dfsph_integrate_kernel(ParticleArrays a, uint32_t n, DeviceScene
 enum class Solve { Divergence, Density };
 
 // One solve: the warm start's pass, the initial residual and check, then the loop.
-// warm_started: the forces pass made the density solve's warm start (dfsph_forces_kernel's warm).
+// warm_started: another pass made the solve's warm start (the divergence solve's: the density
+// pass, dfsph_density.cu; the density solve's: dfsph_forces_kernel's warm).
 void enqueue_solve(Solve kind, const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                    uint32_t n, bool contacts, const DfsphLoops& loops, FrameState* state, cudaStream_t stream,
                    bool warm_started = false) {
@@ -325,7 +319,11 @@ void enqueue_dfsph_step(const FluidConstants& fluid, const GridView& grid, const
                         FrameState* state, cudaStream_t stream) {
   const bool contacts = scene.collider_count != 0;
   const bool divergence_solve = fluid.methods.dfsph.divergence_solve != 0;
-  if (divergence_solve) enqueue_solve(Solve::Divergence, fluid, grid, a, n, contacts, loops, state, stream);
+  // The density pass made the divergence solve's warm start where the rule allows it (the same
+  // rule there: substep_pipeline.cu).
+  if (divergence_solve)
+    enqueue_solve(Solve::Divergence, fluid, grid, a, n, contacts, loops, state, stream,
+                  dfsph_divergence_warm_start_in_density_pass(fluid, options, loops.rank != nullptr));
   const unsigned threads = tuning.force_block, blocks = blocks_for(n, threads);
   // The density solve's warm start in the forces pass, where the solve's own first pass would be
   // that warm start: not on a distributed rank (its solves start with the ghosts' exchanges) nor

@@ -39,14 +39,28 @@ inline uint32_t dfsph_partial_count(uint32_t capacity) {
   return 2u * (capacity == 0 ? 1u : (capacity + kDfsphSolveBlock - 1) / kDfsphSolveBlock);
 }
 
+// Whether the divergence solve's warm start rides in the density pass (enqueue_dfsph_density's
+// divergence_warm_start; dfsph_density.cu): with the divergence solve on, in the undivided world (a
+// rank's solves start with the ghosts' exchanges), with the plain gradient (the corrected velocity
+// update gathers a moment too), and without springs (their pass, between the density pass and the
+// solve, reads the sorted velocities that the warm start changes). `rank`: a distributed rank's step.
+inline bool dfsph_divergence_warm_start_in_density_pass(const FluidConstants& fluid,
+                                                        const SubstepOptions& options, bool rank) {
+  return fluid.methods.dfsph.divergence_solve != 0 && !rank && fluid.methods.dfsph.gradient_correction == 0 &&
+         !options.springs;
+}
+
 // DFSPH's density pass: rho_i, the neighbour counts, the factor, the candidate masks and neighbour
 // lists where the world keeps them, each particle's contact with the colliders, the warm starts gathered from
-// the state order into the sorted order, and the sorted velocities (w: 1 / rho). (The colour normals, with
+// the state order into the sorted order, and the sorted velocities (w: 1 / rho). With
+// divergence_warm_start (dfsph_divergence_warm_start_in_density_pass) the sorted velocities have the
+// divergence solve's warm start applied, and its impulses are carried. (The colour normals, with
 // surface tension, come after it: substep_pipeline.cu, where a distributed rank's ghosts first take their
 // owners' densities.)
 void enqueue_dfsph_density(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                            uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
-                           const DeviceScene& scene, FrameState* state, cudaStream_t stream);
+                           const DeviceScene& scene, bool divergence_warm_start, FrameState* state,
+                           cudaStream_t stream);
 
 // A distributed rank's host steps inside DFSPH's solves (cuda_halo.cu; the stream driver only):
 // the host drives each Jacobi solve, an iteration at a time, by core/dfsph_jacobi_loop.h (the CPU

@@ -41,8 +41,10 @@ void enqueue_substep(const PipelineSetup& setup, const PipelineBuffers& b, LoopC
     if (hooks) hooks->after_sort(stream);
     enqueue_reorder(a, b.grid->order(), n, Rk4Carry::None, 0, b.grid->crowd_guard(), b.state, stream);
     if (setup.options.springs) enqueue_spring_reorder(a, b.grid->order(), n, stream);
-    enqueue_dfsph_density(setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene,
-                          b.state, stream);
+    enqueue_dfsph_density(
+        setup.fluid, b.grid->view(), a, n, setup.options, setup.tuning, setup.scene,
+        dfsph_divergence_warm_start_in_density_pass(setup.fluid, setup.options, hooks != nullptr), b.state,
+        stream);
     // A distributed rank: the ghosts take their owners' densities and factors, then their colour
     // normals, before anything reads them (as on the CPU rank); the solves' own refreshes run
     // inside them (DfsphLoops::rank).

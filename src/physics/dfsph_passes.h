@@ -117,14 +117,21 @@ struct NoNeighborMask {
   SPH_HD void finish() const {}
 };
 
+// The density pass's walk without a second sum over its pairs (gather_density_and_factor's pair).
+struct NoPairSum {
+  SPH_HD void operator()(uint32_t, Vec3, float) const {}
+};
+
 // The density of density.h (the same sum in the same order) and the factor, in one walk.
 // wall: the walls' share at x_i (boundary_share; no_boundary_share() without the feature).
 // mask: NeighborMaskWriter to record particle i's candidate mask (and, with lists, its neighbour
-// list) for the solves' passes.
-template <class Mask = NoNeighborMask>
+// list) for the solves' passes. pair(j, d, r2): called for each neighbour (r < h, j != i) in the
+// walk's order, so that another sum over the same pairs rides in this walk (the CUDA pass's
+// divergence warm start, cuda/dfsph_density.cu).
+template <class Mask = NoNeighborMask, class Pair = NoPairSum>
 SPH_HD DfsphDensitySample gather_density_and_factor(const FluidBase& f, const GridView& grid,
                                                     const Float4* positions, const BoundaryShare& wall,
-                                                    uint32_t i, Mask mask = Mask{}) {
+                                                    uint32_t i, Mask mask = Mask{}, Pair&& pair = Pair{}) {
   const KernelCoefficients mk = mass_gradient_kernel(f);
   const Vec3 xi = xyz(positions[i]);
   const float bound = neighbor_mask_bound(f.kernel.h2);
@@ -142,6 +149,7 @@ SPH_HD DfsphDensitySample gather_density_and_factor(const FluidBase& f, const Gr
       ++neighbors;
       gradient += t.gradient;
       squares += t.square;
+      pair(j, d, r2);
     }
   });
   mask.finish();
