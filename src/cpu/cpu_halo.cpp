@@ -102,32 +102,74 @@ bool CpuRankHalo::travels(const ParticleArraySpec& spec) {
          std::strcmp(spec.name, kArrayRk4Sum) == 0;
 }
 
-void CpuRankHalo::pack(uint32_t i, RankBytes& out) const {
-  for (const auto& a : store_.arrays()) {
-    if (!travels(a->spec)) continue;
-    const size_t bytes = particle_bytes(a->spec);
-    const unsigned char* from = a->bytes.data() + i * bytes;
-    out.insert(out.end(), from, from + bytes);
-  }
-}
-
-uint32_t CpuRankHalo::unpack(const RankBytes& in, uint32_t origin) {
+size_t CpuRankHalo::travelling_bytes() const {
   size_t record = 0;
   for (const auto& a : store_.arrays())
     if (travels(a->spec)) record += particle_bytes(a->spec);
+  return record;
+}
+
+namespace {
+
+// Rows `which` of a column of `bytes`-byte rows, one after the other into `to`; returns the end.
+// (A fixed size per call for the common widths, so that each copy is a load and a store.)
+template <size_t kBytes>
+unsigned char* copy_rows(unsigned char* to, const unsigned char* column, const HostVector<uint32_t>& which) {
+  for (const uint32_t i : which) {
+    std::memcpy(to, column + static_cast<size_t>(i) * kBytes, kBytes);
+    to += kBytes;
+  }
+  return to;
+}
+
+unsigned char* copy_rows(unsigned char* to, const unsigned char* column, size_t bytes,
+                         const HostVector<uint32_t>& which) {
+  switch (bytes) {
+    case 4:
+      return copy_rows<4>(to, column, which);
+    case 8:
+      return copy_rows<8>(to, column, which);
+    case 12:
+      return copy_rows<12>(to, column, which);
+    case 16:
+      return copy_rows<16>(to, column, which);
+    default:
+      for (const uint32_t i : which) {
+        std::memcpy(to, column + static_cast<size_t>(i) * bytes, bytes);
+        to += bytes;
+      }
+      return to;
+  }
+}
+
+}  // namespace
+
+// Array after array (the travelling ones' test and widths once a pack, not once a particle: the
+// per-particle loop over every array, with travels()'s string compares, was the halo's largest
+// cost outside the passes and the sort in a profile of 4 ranks, session 37).
+void CpuRankHalo::pack(const HostVector<uint32_t>& which, RankBytes& out) const {
+  out.clear();
+  if (which.empty()) return;
+  out.resize(travelling_bytes() * which.size());
+  unsigned char* to = out.data();
+  for (const auto& a : store_.arrays())
+    if (travels(a->spec)) to = copy_rows(to, a->bytes.data(), particle_bytes(a->spec), which);
+}
+
+uint32_t CpuRankHalo::unpack(const RankBytes& in, uint32_t origin) {
+  const size_t record = travelling_bytes();
   if (in.size() % record != 0) throw Error(Status::Internal, "halo: a rank sent a partial particle record");
   const uint32_t n = static_cast<uint32_t>(in.size() / record);
   if (n == 0) return 0;
   const uint32_t first = count_;
   store_.resize(static_cast<size_t>(first) + n);
   const unsigned char* from = in.data();
-  for (uint32_t k = 0; k < n; ++k)
-    for (const auto& a : store_.arrays()) {
-      if (!travels(a->spec)) continue;
-      const size_t bytes = particle_bytes(a->spec);
-      std::memcpy(a->bytes.data() + (first + k) * bytes, from, bytes);
-      from += bytes;
-    }
+  for (const auto& a : store_.arrays()) {
+    if (!travels(a->spec)) continue;
+    const size_t bytes = particle_bytes(a->spec) * n;
+    std::memcpy(a->bytes.data() + static_cast<size_t>(first) * particle_bytes(a->spec), from, bytes);
+    from += bytes;
+  }
   for (uint32_t k = 0; k < n; ++k) origin_[first + k] = origin;
   count_ = first + n;
   return n;
@@ -154,6 +196,8 @@ void CpuRankHalo::gather() {
   const int me = t.rank();
   const int size = t.size();
   std::vector<RankBytes> out(static_cast<size_t>(size));
+  sends_.resize(static_cast<size_t>(size));
+  for (HostVector<uint32_t>& to : sends_) to.clear();
   // Every particle held between substeps is owned; a substep that failed after the ghosts came
   // and was rolled back leaves their marks in this (not carried) array.
   std::fill(origin_.data(), origin_.data() + count_, 0u);
@@ -164,20 +208,22 @@ void CpuRankHalo::gather() {
     if (owner == me)
       keep_.push_back(i);
     else
-      pack(i, out[static_cast<size_t>(owner)]);
+      sends_[static_cast<size_t>(owner)].push_back(i);
   }
+  for (int r = 0; r < size; ++r) pack(sends_[static_cast<size_t>(r)], out[static_cast<size_t>(r)]);
   std::vector<RankBytes> in = t.exchange(out);  // (an agreement: the substep so far, the packing)
   counters_.migrated_out += count_ - static_cast<uint32_t>(keep_.size());
   keep(keep_.size());
   for (int r = 0; r < size; ++r) counters_.migrated_in += unpack(in[static_cast<size_t>(r)], 0u);
   const uint32_t owned = count_;
   // Ghosts: each owned particle of a layer beside another rank's slab goes to that rank.
-  for (RankBytes& b : out) b.clear();
+  for (HostVector<uint32_t>& to : sends_) to.clear();
   for (uint32_t i = 0; i < owned; ++i) {
     int to[2];
     const int n = slabs_.ghost_destinations(layer(i), me, to);
-    for (int k = 0; k < n; ++k) pack(i, out[static_cast<size_t>(to[k])]);
+    for (int k = 0; k < n; ++k) sends_[static_cast<size_t>(to[k])].push_back(i);
   }
+  for (int r = 0; r < size; ++r) pack(sends_[static_cast<size_t>(r)], out[static_cast<size_t>(r)]);
   in = t.exchange(out);  // (an agreement: the migrants' arrival, the ghosts' packing)
   for (int r = 0; r < size; ++r) unpack(in[static_cast<size_t>(r)], static_cast<uint32_t>(r) + 1u);
   // Springs: the owned lists' partner ids to indices, the partners held nowhere here as spring

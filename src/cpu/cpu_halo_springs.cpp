@@ -98,16 +98,18 @@ void CpuRankHalo::gather_spring_partners(uint32_t owned) {
     if (r != me) out[static_cast<size_t>(r)] = id_bytes(wanted);
   std::vector<RankBytes> in = t.exchange(out);  // (an agreement: the ghosts' arrival, the wants)
   // What this rank owns of each rank's wants, in the wanted (ascending id) order.
+  sends_.resize(static_cast<size_t>(size));
   for (int r = 0; r < size; ++r) {
-    RankBytes& to = out[static_cast<size_t>(r)];
-    to.clear();
+    HostVector<uint32_t>& which = sends_[static_cast<size_t>(r)];
+    which.clear();
     const RankBytes& asked = in[static_cast<size_t>(r)];
     for (size_t k = 0; k + sizeof(uint32_t) <= asked.size(); k += sizeof(uint32_t)) {
       uint32_t id;
       std::memcpy(&id, asked.data() + k, sizeof id);
       const uint32_t j = table.find(id);
-      if (j != CpuIdTable::kAbsent && j < owned) pack(j, to);
+      if (j != CpuIdTable::kAbsent && j < owned) which.push_back(j);
     }
+    pack(which, out[static_cast<size_t>(r)]);
   }
   in = t.exchange(out);  // (an agreement: the spring ghosts' packing)
   const uint32_t first = count_;

@@ -115,10 +115,13 @@ class CpuRankHalo {
   int32_t layer(uint32_t i) const;
   // Whether an array moves with its particle: the carried ones, and RK4's stage state.
   static bool travels(const ParticleArraySpec& spec);
-  // Appends particle i's travelling arrays to `out` / appends the records of `in` as particles
-  // whose origin is `origin`; returns how many.
-  void pack(uint32_t i, RankBytes& out) const;
+  // The travelling arrays of the particles `which` lists into `out` (replacing what it held), array
+  // after array, each array's rows in `which`'s order (the CUDA rank's layout, DeviceHalo::pack) /
+  // appends the particles `in` holds (one pack's bytes) with origin `origin`; returns how many.
+  void pack(const HostVector<uint32_t>& which, RankBytes& out) const;
   uint32_t unpack(const RankBytes& in, uint32_t origin);
+  // One particle's bytes of the travelling arrays.
+  size_t travelling_bytes() const;
   // Keeps the particles keep_ lists (ascending), in that order.
   void keep(size_t kept);
   // Springs across ranks (cpu_halo_springs.cpp). Outside a substep's sorted part the spring
@@ -157,7 +160,8 @@ class CpuRankHalo {
   // most kMergedRuns; more are sorted.
   static constexpr size_t kMergedRuns = 64;
   HostVector<uint32_t> run_starts_;
-  HostVector<uint32_t> merged_;  // the merge's other buffer
+  HostVector<uint32_t> merged_;              // the merge's other buffer
+  std::vector<HostVector<uint32_t>> sends_;  // the particles gather sends each rank (pack's `which`)
   int64_t world_count_ = 0;
   CpuArrayRef<uint64_t> sort_key_;  // Carried
   CpuArrayRef<uint32_t> origin_;    // Sorted (origins())
