@@ -90,6 +90,12 @@ bool CpuRankHalo::any(bool flag) const {
 
 void CpuRankHalo::agree() const { sph::agree(*ranks_); }
 
+namespace {
+
+float axis_coordinate(const Float4& p, int axis) { return axis == 0 ? p.x : (axis == 1 ? p.y : p.z); }
+
+}  // namespace
+
 int32_t CpuRankHalo::layer(uint32_t i) const {
   const Float4& p = position_[i];
   return slab_layer(p.x, p.y, p.z, slabs_.axis(), 1.0f / kernel_radius_);
@@ -253,6 +259,21 @@ void CpuRankHalo::gather() {
       hi[a] = cell_coordinate(xhi[a], inv);
     }
   }
+  // This rank's owned cells along the slabs' axis, and those of everything it holds (its table's
+  // band; rank_grid_shape).
+  const int axis = slabs_.axis();
+  const int32_t first = static_cast<int32_t>(lo[axis]), last = static_cast<int32_t>(hi[axis]);
+  int32_t held_first = first, held_last = last;
+  if (count_ > owned) {
+    float glo = axis_coordinate(position_[owned], axis), ghi = glo;
+    for (uint32_t i = owned + 1; i < count_; ++i) {
+      const float x = axis_coordinate(position_[i], axis);
+      glo = x < glo ? x : glo;
+      ghi = x > ghi ? x : ghi;
+    }
+    held_first = std::min(held_first, cell_coordinate(glo, inv));
+    held_last = std::max(held_last, cell_coordinate(ghi, inv));
+  }
   int64_t total = owned;
   agree();  // (the ghosts' arrival)
   t.all_min(lo, 3);
@@ -273,7 +294,12 @@ void CpuRankHalo::gather() {
   const CellCoord chi =
       any ? CellCoord{static_cast<int32_t>(hi[0]), static_cast<int32_t>(hi[1]), static_cast<int32_t>(hi[2])}
           : CellCoord{0, 0, 0};
-  shape_ = make_grid_shape_for_extent(kernel_radius_, clo, chi, static_cast<uint32_t>(total));
+  world_shape_ = make_grid_shape_for_extent(kernel_radius_, clo, chi, static_cast<uint32_t>(total));
+  // The rank's own table: the world's cut to the band of cells it holds (none owned: the world's),
+  // so that its size and the sort's passes over it follow what the rank holds (with the world's,
+  // every rank cleared, summed and walked the world's 2 slots a particle each substep). The keys
+  // stay the world's slots (after_sort), which every rank numbers alike.
+  shape_ = rank_grid_shape(world_shape_, clo, chi, axis, first, last, held_first, held_last);
   // The sort's order: by key, then id (two keys are equal only where the table folds). The
   // particles arrive as a few runs already in that order: the kept owned ones (in the last sort's
   // order, whose keys after_sort numbered), then each rank's migrants and each rank's ghosts (in
@@ -324,9 +350,15 @@ void CpuRankHalo::gather() {
 void CpuRankHalo::after_sort(const CpuNeighborGrid& grid) {
   const GridView view = grid.view();
   uint64_t* key = sort_key_.data();
+  // The key: the particle's slot in the world's table (where the rank's table is a band of the
+  // world's, one cell a slot in both: the world's slot of that cell) and its place in the rank's
+  // slot (the same place: the cell is complete here, its particles in the world's order).
+  const bool own_table = view.shape.cell_count != world_shape_.cell_count;
   for (uint32_t c = 0; c < view.shape.cell_count; ++c)
-    for (uint32_t i = view.cell_start[c]; i < view.cell_start[c + 1]; ++i)
-      key[i] = (static_cast<uint64_t>(c) << 32) | (i - view.cell_start[c]);
+    for (uint32_t i = view.cell_start[c]; i < view.cell_start[c + 1]; ++i) {
+      const uint64_t slot = own_table ? cell_hash_of_position(world_shape_, xyz(position_[i])) : c;
+      key[i] = (slot << 32) | (i - view.cell_start[c]);
+    }
   if (springs_) resolve_springs(grid.order().data());  // the spring lists' partners follow the sort
 }
 

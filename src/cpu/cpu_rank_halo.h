@@ -154,7 +154,8 @@ class CpuRankHalo {
   SlabDecomposition slabs_;
   bool slabs_cut_ = false;
   DistributedCounters counters_;
-  GridShape shape_{};
+  GridShape shape_{};        // the rank's table (rank_grid_shape)
+  GridShape world_shape_{};  // the undivided world's, whose slots name the sort keys
   HostVector<uint32_t> visit_;
   // gather's ordered runs of particles (where each starts), merged into visit_ when they are at
   // most kMergedRuns; more are sorted.

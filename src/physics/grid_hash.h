@@ -33,6 +33,10 @@ struct GridShape {
   float inv_cell_size;  // 1 / cell size (cell size = kernel radius h)
   int32_t nx, ny, nz;   // table dimensions, each >= 3 so the 27 neighbours are distinct slots
   uint32_t cell_count;  // nx * ny * nz
+  // Where each axis wraps: cell c lands in slot wrap_index(c, n) - shift (wrapped into [0, n)), so
+  // the cells c = shift (mod n) are slot 0. Zero except on a CPU rank's table, which covers its own
+  // band of the world's with the world's wrap points (src/cpu/cpu_halo.cpp, rank_grid_shape).
+  int32_t sx = 0, sy = 0, sz = 0;
 };
 
 struct CellCoord {
@@ -83,8 +87,15 @@ SPH_HD uint32_t hash_wrapped(const GridShape& g, int32_t wx, int32_t wy, int32_t
              (static_cast<uint32_t>(wy) + static_cast<uint32_t>(g.ny) * static_cast<uint32_t>(wz));
 }
 
+// The slot index along one axis of cell coordinate c (GridShape's shift; in [0, n)).
+SPH_HD int32_t shifted_index(int32_t c, int32_t n, int32_t shift) {
+  const int32_t w = wrap_index(c, n) - shift;
+  return w < 0 ? w + n : w;
+}
+
 SPH_HD uint32_t cell_hash(const GridShape& g, CellCoord c) {
-  return hash_wrapped(g, wrap_index(c.x, g.nx), wrap_index(c.y, g.ny), wrap_index(c.z, g.nz));
+  return hash_wrapped(g, shifted_index(c.x, g.nx, g.sx), shifted_index(c.y, g.ny, g.sy),
+                      shifted_index(c.z, g.nz, g.sz));
 }
 
 SPH_HD uint32_t cell_hash_of_position(const GridShape& g, Vec3 p) { return cell_hash(g, cell_of(g, p)); }

@@ -39,7 +39,8 @@ SPH_HD void for_each_neighbor_range(const GridView& grid, Vec3 p, VisitRange&& v
   const GridShape g = shape_of(grid);
   const CellCoord c = cell_of(g, p);
   // One remainder per axis; the neighbouring slots follow by stepping (each n >= 3).
-  const int32_t cx = wrap_index(c.x, g.nx), cy = wrap_index(c.y, g.ny), cz = wrap_index(c.z, g.nz);
+  const int32_t cx = shifted_index(c.x, g.nx, g.sx), cy = shifted_index(c.y, g.ny, g.sy),
+                cz = shifted_index(c.z, g.nz, g.sz);
   const int32_t x_lo = wrap_step(cx, -1, g.nx);
   const int32_t x_hi = wrap_step(cx, 1, g.nx);
   for (int32_t dz = -1; dz <= 1; ++dz) {
