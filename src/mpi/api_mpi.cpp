@@ -47,27 +47,46 @@ SPH_API sph_result SPH_CALL sph_mpi_counts_init_sized(sph_mpi_counts* counts, ui
 SPH_API sph_result SPH_CALL sph_mpi_world_create(sph_context* context, const sph_world_def* def, int32_t comm,
                                                  const sph_mpi_world_def* mpi_def, sph_world** out) {
   return sph::guarded("sph_mpi_world_create", context, [&] {
-    const sph::ContextHold hold(context);
-    if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
-    sph_mpi_world_def m;
-    if (mpi_def) {
-      m = sph::read_user_struct(mpi_def, "mpi_def");
-    } else {
-      m = sph::zeroed_struct<sph_mpi_world_def>();
-    }
-    const uint32_t percent =
-        m.rebalance_threshold_percent == 0 ? sph::kDefaultRebalancePercent : m.rebalance_threshold_percent;
-    if (percent > sph::kMaxRebalancePercent)
-      throw Error(
-          Status::InvalidArgument,
-          "mpi_def->rebalance_threshold_percent: must be in [0, 10000], got " + std::to_string(percent));
-    const sph_world_def d = sph::read_user_struct(def, "def");
-    // Everything above is the same on every rank; from here on the ranks meet.
+    // The communicator first: every rank duplicates it (collective), and from here on the ranks
+    // meet, so that a rank whose own arguments or world fail does not leave the others waiting in
+    // the next collective call: each rank's checks and world are agreed (a failure on one rank is
+    // every rank's, the others' messages naming it; core/rank_agreement.h).
     auto transport = std::make_shared<sph::MpiTransport>(MPI_Comm_f2c(static_cast<MPI_Fint>(comm)));
-    std::unique_ptr<sph_world> world = sph::make_world(context, d);
+    std::unique_ptr<sph::ContextHold> hold;
+    std::unique_ptr<sph_world> world;
     sph::DistributedOptions options;
-    options.rebalance_threshold = percent / 100.0;
-    world->world->backend().attach_ranks(std::move(transport), options);
+    sph::agreed(*transport, [&] {
+      hold = std::make_unique<sph::ContextHold>(context);
+      if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
+      sph_mpi_world_def m;
+      if (mpi_def) {
+        m = sph::read_user_struct(mpi_def, "mpi_def");
+      } else {
+        m = sph::zeroed_struct<sph_mpi_world_def>();
+      }
+      const uint32_t percent =
+          m.rebalance_threshold_percent == 0 ? sph::kDefaultRebalancePercent : m.rebalance_threshold_percent;
+      if (percent > sph::kMaxRebalancePercent)
+        throw Error(
+            Status::InvalidArgument,
+            "mpi_def->rebalance_threshold_percent: must be in [0, 10000], got " + std::to_string(percent));
+      options.rebalance_threshold = percent / 100.0;
+      const sph_world_def d = sph::read_user_struct(def, "def");
+      world = sph::make_world(context, d);
+    });
+    // One backend on every rank: a CPU rank and a CUDA rank keep their particles, their tables and
+    // what they send each other in different layouts (docs/distributed.md).
+    const int64_t cuda = hold->get()->backend == sph::BackendKind::Cuda ? 1 : 0;
+    int64_t lowest = cuda, highest = cuda;
+    transport->all_min(&lowest, 1);
+    transport->all_max(&highest, 1);
+    if (lowest != highest)
+      throw Error(Status::InvalidArgument, std::string("context: this rank's backend is ") +
+                                               (cuda ? "CUDA" : "the CPU") + " and another rank's is " +
+                                               (cuda ? "the CPU" : "CUDA") +
+                                               ": a distributed world needs one backend on every rank");
+    const sph::MpiTransport& ranks = *transport;  // (the world holds it from here)
+    sph::agreed(ranks, [&] { world->world->backend().attach_ranks(transport, options); });
     *out = sph::publish_world(std::move(world));
     return SPH_OK;
   });

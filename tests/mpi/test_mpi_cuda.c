@@ -194,6 +194,24 @@ static void run_loads_case(const char* name, sph_context* cuda, const sph_world_
   sph_world_destroy(w.world);
 }
 
+/* A world made with a CPU context on rank 0 and CUDA contexts on the others: refused on every rank
+ * (SPH_ERROR_INVALID_ARGUMENT, the message saying why), not a world whose ranks send each other
+ * particles in two layouts (since session 37). */
+static void mixed_backends_case(sph_context* cuda, sph_context* cpu) {
+  sph_world_def def;
+  sph_world* world = NULL;
+  sph_result r;
+  if (g_size < 2) return;
+  mpi_test_world_def(&def);
+  r = sph_mpi_world_create(g_rank == 0 ? cpu : cuda, &def, (int32_t)MPI_Comm_c2f(MPI_COMM_WORLD), NULL,
+                           &world);
+  CHECK(r == SPH_ERROR_INVALID_ARGUMENT && world == NULL, "mixed backends: rank %d returned %d (%s)", g_rank,
+        (int)r, sph_get_last_error());
+  CHECK(strstr(sph_get_last_error(), "one backend on every rank") != NULL, "mixed backends: the message: %s",
+        sph_get_last_error());
+  if (g_rank == 0) printf("PASS mixed backends on %d ranks: refused on every rank\n", g_size);
+}
+
 int main(int argc, char** argv) {
   sph_context* cpu = NULL;
   sph_context* cuda = NULL;
@@ -216,6 +234,7 @@ int main(int argc, char** argv) {
     return mpi_test_finish(cpu, "mpi_cuda springs");
   }
 
+  mixed_backends_case(cuda, cpu);
   mpi_test_world_def(&def);
   def.capacity = 32768; /* 32 slots an axis: the tank's 23 x 12 x 4 cells never fold */
   run_case(&(cuda_case){"dam break", 0.0f, 1, 20, 1, 0.0f}, cuda, cpu, &def);

@@ -10,7 +10,10 @@
 //     each iteration, followed by the reductions of its sums);
 //   - a crowded cell (700 particles in one cell, more than the 528 one may hold) on whichever
 //     rank owns it, and the ranks holding it as ghosts: every rank returns SPH_ERROR_CAPACITY and
-//     the world is unchanged.
+//     the world is unchanged;
+//   - sph_mpi_world_create refused on the last rank alone (an invalid world definition, an invalid
+//     rebalance threshold, a NULL out, a NULL context): every rank returns that rank's status, the
+//     others' messages name it, no rank gets a world, and a world made after it works.
 // A rank that waited forever would hang the test into ctest's timeout.
 #include <stdint.h>
 #include <stdio.h>
@@ -167,6 +170,49 @@ void crowded_cell(sph_context* context) {
   REQUIRE(sph_world_destroy(world) == SPH_OK, "destroy");
 }
 
+// The world's creation refused on the last rank only: before session 37 that rank returned while
+// the others went on to the next collective call and waited there for it (found by reading
+// sph_mpi_world_create; the bad arguments are each of the checks that call makes).
+void creation_refused_on_one_rank(sph_context* context) {
+  const int culprit = g_size - 1;
+  const char* cases[] = {"a negative kernel radius", "a rebalance threshold past 10000 %", "a NULL out",
+                         "a NULL context"};
+  for (int k = 0; k < 4; ++k) {
+    sph_world_def def;
+    mpi_test_world_def(&def);
+    sph_mpi_world_def mdef;
+    REQUIRE(sph_mpi_world_def_init(&mdef) == SPH_OK, "mpi def");
+    sph_world* world = NULL;
+    sph_world** out = &world;
+    sph_context* ctx = context;
+    if (g_rank == culprit) {
+      if (k == 0) def.kernel_radius = -1.0f;
+      if (k == 1) mdef.rebalance_threshold_percent = 10001;
+      if (k == 2) out = NULL;
+      if (k == 3) ctx = NULL;
+    }
+    const sph_result r = sph_mpi_world_create(ctx, &def, (int32_t)MPI_Comm_c2f(MPI_COMM_WORLD), &mdef, out);
+    // The culprit's status on every rank (a NULL context is an invalid handle).
+    const sph_result expected = k == 3 ? SPH_ERROR_INVALID_HANDLE : SPH_ERROR_INVALID_ARGUMENT;
+    CHECK(r == expected, "%s on rank %d: rank %d returned %d, not %d (%s)", cases[k], culprit, g_rank, (int)r,
+          (int)expected, sph_get_last_error());
+    CHECK(world == NULL, "%s: rank %d got a world", cases[k], g_rank);
+    check_rank_named(culprit, cases[k]);
+  }
+  // The ranks are in step: a world made now works.
+  sph_world_def def;
+  sph_world* world = NULL;
+  uint32_t n = 0;
+  mpi_test_world_def(&def);
+  mpi_test_dam(context, &def, 0.0f, NULL, NULL, &world, &n);
+  set_substeps(world);
+  CHECK(step(world) == SPH_INCOMPLETE, "a world after the refusals (its step's substeps capped): %s",
+        sph_get_last_error());
+  REQUIRE(sph_world_destroy(world) == SPH_OK, "destroy");
+  if (g_rank == 0)
+    printf("sph_mpi_world_create refused on rank %d of %d: every rank refused, 4 cases\n", culprit, g_size);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -176,5 +222,6 @@ int main(int argc, char** argv) {
   allocation_failures(context, SPH_FEATURE_SPRINGS, false, "the stirred column with springs");
   allocation_failures(context, SPH_FEATURE_NONE, true, "the stirred column, DFSPH with conjugate gradients");
   crowded_cell(context);
+  creation_refused_on_one_rank(context);
   return mpi_test_finish(context, "mpi rank failures");
 }
