@@ -23,9 +23,13 @@ void check(int code, const char* what) {
               std::string("MPI: ") + what + " failed: " + std::string(text, static_cast<size_t>(length)));
 }
 
-// The signature one rank contributes: kind in the high half, the detail in the low half.
-int64_t signature(Collective kind, int64_t detail) {
-  return static_cast<int64_t>(kind) * (int64_t{1} << 32) + (detail & 0xffffffffll);
+// The signature one rank contributes: kind in bits 32-39, the detail in the low half, and bit 40
+// set where the rank puts a timed barrier before its calls (wait_at_barriers): a rank with the
+// barriers and one without would meet in MPI_Barrier against another collective.
+constexpr int64_t kBarrierBit = int64_t{1} << 40;
+int64_t signature(Collective kind, int64_t detail, bool barrier) {
+  return static_cast<int64_t>(kind) * (int64_t{1} << 32) + (detail & 0xffffffffll) +
+         (barrier ? kBarrierBit : 0);
 }
 
 const char* collective_name(Collective kind) {
@@ -57,8 +61,9 @@ const char* collective_name(Collective kind) {
 }
 
 std::string describe(int64_t sig) {
-  const auto kind = static_cast<Collective>(sig >> 32);
-  return std::string(collective_name(kind)) + " (" + std::to_string(sig & 0xffffffffll) + ")";
+  const auto kind = static_cast<Collective>((sig >> 32) & 0xff);
+  return std::string(collective_name(kind)) + " (" + std::to_string(sig & 0xffffffffll) + ")" +
+         ((sig & kBarrierBit) ? " after a timed barrier" : "");
 }
 
 int as_count(size_t n) {
@@ -90,7 +95,7 @@ MpiTransport::MpiTransport(MPI_Comm comm) {
 }
 
 template <class Call>
-int MpiTransport::timed(TransportCall call, Call&& mpi) const {
+int MpiTransport::timed(TransportCall call, Call&& mpi, bool barrier) const {
   using Clock = std::chrono::steady_clock;
   auto add = [this](TransportCall c, Clock::time_point since) {
     const double ms = std::chrono::duration<double, std::milli>(Clock::now() - since).count();
@@ -98,7 +103,7 @@ int MpiTransport::timed(TransportCall call, Call&& mpi) const {
     times_.ms[c] += ms;
     times_.total_ms += ms;
   };
-  if (wait_at_barriers_) {
+  if (barrier && wait_at_barriers_) {
     const auto t = Clock::now();
     check(MPI_Barrier(comm_), "MPI_Barrier (the timed wait before a call)");
     add(kCallBarrier, t);
@@ -111,10 +116,12 @@ int MpiTransport::timed(TransportCall call, Call&& mpi) const {
 
 void MpiTransport::match(Collective kind, int64_t detail) const {
   if (!check_collectives_) return;
-  const int64_t mine = signature(kind, detail);
+  const int64_t mine = signature(kind, detail, wait_at_barriers_);
   int64_t range[2] = {mine, -mine};  // the largest signature and minus the smallest
-  check(timed(kCallAllreduce,
-              [&] { return MPI_Allreduce(MPI_IN_PLACE, range, 2, MPI_INT64_T, MPI_MAX, comm_); }),
+  // (Never after a barrier of its own: the check must meet a rank without the barriers.)
+  check(timed(
+            kCallAllreduce,
+            [&] { return MPI_Allreduce(MPI_IN_PLACE, range, 2, MPI_INT64_T, MPI_MAX, comm_); }, false),
         "MPI_Allreduce (collective check)");
   if (range[0] == -range[1]) return;
   // Every rank knows of this failure already: an AgreedRankFailure, which rethrow_agreed passes

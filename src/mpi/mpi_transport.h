@@ -56,7 +56,9 @@ class MpiTransport final : public RankTransport {
   // (timed as kCallBarrier): the barrier holds the wait for the slowest rank, and what the call
   // itself takes after it is the transfer. Off by default (the extra barrier costs a latency a
   // call); bench/mpi_halo's --wait-barriers turns it on. Const as the timing is: instrumentation,
-  // not the transport's state.
+  // not the transport's state. But it changes which collectives a rank calls: every rank must set
+  // the same (a rank with the barriers and one without would meet in MPI_Barrier against another
+  // call); the collective check (SPH_MPI_CHECK_COLLECTIVES=1) compares it with each call's kind.
   void wait_at_barriers(bool on) const { wait_at_barriers_ = on; }
 
  private:
@@ -65,9 +67,10 @@ class MpiTransport final : public RankTransport {
   // the element count, or the root of a rooted call; 0 for the v-variants, whose counts differ
   // between ranks by design.
   void match(Collective kind, int64_t detail) const;
-  // Runs one MPI call (a callable returning its code) and adds its wall time to times_[call].
+  // Runs one MPI call (a callable returning its code) and adds its wall time to times_[call];
+  // first a timed barrier where wait_at_barriers is on, unless `barrier` is false.
   template <class Call>
-  int timed(TransportCall call, Call&& mpi) const;
+  int timed(TransportCall call, Call&& mpi, bool barrier = true) const;
 
   MPI_Comm comm_ = MPI_COMM_NULL;
   int rank_ = 0;

@@ -14,6 +14,8 @@
 //     is an AgreedRankFailure, which rethrow_agreed passes on without meeting the others again: a
 //     plain Error would send the others into an agreement that rank 0, already out of its own
 //     catch block, never reaches;
+//   - the timed barriers (wait_at_barriers) on rank 0 alone: every rank throws Internal at its
+//     next call, naming the barrier, instead of rank 0 waiting in MPI_Barrier;
 //   - the switch is agreed: set on rank 0 alone it is off on every rank.
 // A rank that hung would run the test into ctest's timeout.
 #include <mpi.h>
@@ -124,8 +126,17 @@ int main(int argc, char** argv) {
           sph::rethrow_agreed(t);
         }
       });
+      expect_mismatch("timed barriers on rank 0 alone", [&] {
+        t.wait_at_barriers(g_rank == 0);
+        int64_t v = 0;
+        t.all_min(&v, 1);
+      });
+      t.wait_at_barriers(false);
       // The ranks threw at the same call, so they are in step: the transport works on.
       matching_calls(t);
+      t.wait_at_barriers(true);  // and with the barriers on every rank
+      matching_calls(t);
+      t.wait_at_barriers(false);
     }
     // The switch on rank 0 alone: off everywhere.
     if (g_rank == 0)
