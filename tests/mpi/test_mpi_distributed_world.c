@@ -18,6 +18,13 @@
  *     each side of its slab, counted by brute force over the gathered positions that substep
  *     started from. (That the halo's densities came in the order of its particles is checked by
  *     id inside every substep: a mismatch fails the step.)
+ * A folded table (since session 37): the stirred column with a thin block 20 m away along x, so
+ * that the world's extent is far more cells than its table's two slots a particle and far cells
+ * share slots. There a slot's run holds far particles that the walk skips by distance but that
+ * still take SIMD lanes, and a rank holds other far particles than the undivided world, so the
+ * same terms may be added in other lanes (docs/distributed.md): asserted within the issue's bound
+ * for a non-canonical order, 1e-6 of the tank's 0.4 m in position after 20 substeps, the count of
+ * particles not bit for bit equal printed (and each id once, the counts and halos as above).
  * Also: what does not work distributed is refused with SPH_ERROR_UNSUPPORTED. */
 #include <math.h>
 #include <mpi.h>
@@ -60,7 +67,7 @@ static void check_halo(const sph_mpi_counts* counts, const float* start, uint64_
  * a second block joins after 10 substeps, off to one side: the ranks are out of balance, and
  * the world's longest axis changes from y to x, so the next frame cuts new slabs. */
 static void run_scene(sph_context* context, const char* name, float stir_speed, int block, uint32_t features,
-                      sph_viscosity_method viscosity) {
+                      sph_viscosity_method viscosity, int far_block) {
   const sph_vec3 column_min = {0.0f, 0.0f, 0.0f}, column_max = {0.1f, 0.2f, 0.06f};
   sph_world_def def;
   mpi_test_worlds worlds;
@@ -84,6 +91,11 @@ static void run_scene(sph_context* context, const char* name, float stir_speed, 
   world = worlds.world;
   n = worlds.n;
   CHECK(worlds.first == (g_rank == 0 ? 0u : n), "first id %u", worlds.first);
+  /* The far block: 1 m x 2 cm x 2 cm, 20 m off along x (outside the tank, falling freely), at the
+   * column's heights: longer along x than the folded table's slots there, so its cells share slots
+   * with the column's rows whatever the table's dims. */
+  if (far_block)
+    mpi_test_add_block(single, world, (sph_vec3){20.0f, 0.1f, 0.0f}, (sph_vec3){21.0f, 0.12f, 0.02f}, 0, &n);
 
   /* 19 substeps (10, the block, 9), the positions the 20th starts from, the 20th. */
   if (block) {
@@ -136,9 +148,15 @@ static void run_scene(sph_context* context, const char* name, float stir_speed, 
     REQUIRE(support_copy_by_id(single, SPH_ATTRIBUTE_VELOCITY, (void**)&want_v, &m) == SPH_OK, "read");
     for (uint32_t i = 0; i < common; ++i) CHECK(got_id[i] == i, "id %u at %u: each id once", got_id[i], i);
     differ = mpi_differ(got_x, got_v, want_x, want_v, common, &worst);
-    CHECK(differ == 0,
-          "%s on %d ranks: %u of %u particles differ from the undivided world (worst position %g m)", name,
-          g_size, differ, n, worst);
+    if (far_block)
+      CHECK(worst <= 1e-6 * 0.4, "%s on %d ranks: %u of %u particles differ, by up to %g m (bound %g m)",
+            name, g_size, differ, n, worst, 1e-6 * 0.4);
+    else
+      CHECK(differ == 0,
+            "%s on %d ranks: %u of %u particles differ from the undivided world (worst position %g m)", name,
+            g_size, differ, n, worst);
+    if (far_block)
+      printf("%s on %d ranks: worst position %g m (bound %g m)\n", name, g_size, worst, 1e-6 * 0.4);
     printf(
         "%s on %d ranks: %u particles, 20 substeps, %u differ; %llu ghosts in the last substep, %llu "
         "migrations, "
@@ -187,24 +205,26 @@ static void check_refusals(sph_context* context) {
 int main(int argc, char** argv) {
   sph_context* context = NULL;
   mpi_test_init(&argc, &argv, &context);
-  run_scene(context, "dam break", 0.0f, 0, SPH_FEATURE_NONE, SPH_VISCOSITY_MUELLER);
-  run_scene(context, "stirred column", 2.0f, 0, SPH_FEATURE_NONE, SPH_VISCOSITY_MUELLER);
-  run_scene(context, "column and a late block", 0.0f, 1, SPH_FEATURE_NONE, SPH_VISCOSITY_MUELLER);
+  run_scene(context, "dam break", 0.0f, 0, SPH_FEATURE_NONE, SPH_VISCOSITY_MUELLER, 0);
+  run_scene(context, "stirred column", 2.0f, 0, SPH_FEATURE_NONE, SPH_VISCOSITY_MUELLER, 0);
+  run_scene(context, "column and a late block", 0.0f, 1, SPH_FEATURE_NONE, SPH_VISCOSITY_MUELLER, 0);
   /* Surface tension's colour normals: a second halo exchange after their pass. */
   run_scene(context, "stirred column with surface tension", 2.0f, 0, SPH_FEATURE_SURFACE_TENSION,
-            SPH_VISCOSITY_MUELLER);
+            SPH_VISCOSITY_MUELLER, 0);
   /* The normalised density's filter and the density diffusion: the ghosts' densities again after
    * each of their passes. */
   run_scene(context, "stirred column with normalised density", 2.0f, 0, SPH_FEATURE_NORMALIZED_DENSITY,
-            SPH_VISCOSITY_MUELLER);
+            SPH_VISCOSITY_MUELLER, 0);
   run_scene(context, "stirred column with density diffusion", 2.0f, 0,
-            SPH_FEATURE_NORMALIZED_DENSITY | SPH_FEATURE_DENSITY_DIFFUSION, SPH_VISCOSITY_MUELLER);
+            SPH_FEATURE_NORMALIZED_DENSITY | SPH_FEATURE_DENSITY_DIFFUSION, SPH_VISCOSITY_MUELLER, 0);
   /* What needs no exchange of its own: Clavet's viscosity (the neighbour counts cross with the
    * densities) and the user attribute (carried with its particle). The walls' share of the
    * density (SPH_FEATURE_BOUNDARY_DENSITY, per particle before the halo's densities) matched bit
    * for bit on 1-4 ranks too, but its boundary maps cost 5-10 s a run: not in CI. */
   run_scene(context, "stirred column with Clavet viscosity", 2.0f, 0, SPH_FEATURE_USER_ATTRIBUTE,
-            SPH_VISCOSITY_CLAVET);
+            SPH_VISCOSITY_CLAVET, 0);
+  run_scene(context, "stirred column and a far block (folded table)", 2.0f, 0, SPH_FEATURE_NONE,
+            SPH_VISCOSITY_MUELLER, 1);
   check_refusals(context);
   return mpi_test_finish(context, "mpi_distributed_world");
 }
