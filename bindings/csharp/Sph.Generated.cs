@@ -3484,10 +3484,14 @@ namespace Sph
         /// distributed world is destroyed (sph_world_destroy on every rank: it frees the duplicated
         /// communicator, which MPI counts as collective). The library duplicates the communicator, so
         /// its messages never meet the caller's. `def` as sph_world_create's (the same on every rank);
-        /// `mpi_def` may be NULL (defaults). `context` must be a CPU context. Errors: INVALID_ARGUMENT
-        /// (NULL out, a bad def, a bad communicator), UNSUPPORTED (a CUDA context; a feature, solver or
-        /// integrator that does not work distributed yet, named in the message), OUT_OF_HOST_MEMORY.
-        /// *out is untouched on error.
+        /// `mpi_def` may be NULL (defaults). `context`: a CPU or a CUDA context, of the same backend on
+        /// every rank. After the communicator's duplication the arguments are checked and the world
+        /// made inside one agreement: a failure on any rank is every rank's (the others' messages name
+        /// the failing rank), so no rank waits for another that returned. Errors: INVALID_ARGUMENT
+        /// (NULL out, a bad def or mpi_def, a bad communicator, contexts of different backends on two
+        /// ranks), INVALID_HANDLE (a NULL or destroyed context), UNSUPPORTED (a feature, solver or
+        /// integrator that does not work distributed yet, named in the message), OUT_OF_HOST_MEMORY,
+        /// and a CUDA context's device errors. *out is untouched on error.
         /// </summary>
         [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_mpi_world_create(ContextHandle context, ref WorldDef def, int comm, ref MpiWorldDef mpiDef, out WorldHandle @out);
