@@ -51,8 +51,8 @@ inline GridShape make_grid_shape_for_extent(float kernel_radius, CellCoord lo, C
 // two runs exactly where the world's is (a row is split where the table wraps, neighbor_walk.h,
 // and the CPU's SIMD lanes restart at each run, so a split elsewhere would add the same terms in
 // other lanes): the band wraps at the world's wrap point where one lies in [first, last + 1], else
-// at its own first cell. Only where the world's table does not fold (each axis holds its span and a
-// cell either side: then a slot is one cell); otherwise, where the rank owns nothing (last <
+// at its own first cell; at least 4 cells. Only where the world's table does not fold (each axis holds its
+// span and a cell either side: then a slot is one cell); otherwise, where the rank owns nothing (last <
 // first), or where the band is not narrower than the world's axis, the world's table itself.
 inline GridShape rank_grid_shape(const GridShape& world, CellCoord lo, CellCoord hi, int axis, int32_t first,
                                  int32_t last, int32_t held_first, int32_t held_last) {
@@ -71,7 +71,11 @@ inline GridShape rank_grid_shape(const GridShape& world, CellCoord lo, CellCoord
   const int32_t r = wrap_index(first, n);
   const int64_t multiple = r == 0 ? first : static_cast<int64_t>(first) + (n - r);
   const int64_t origin = multiple <= static_cast<int64_t>(last) + 1 ? multiple : band_first;
-  const int32_t band = static_cast<int32_t>(std::max<int64_t>(width, 3));
+  // At least 4 slots: a walk from outside the band (a probe point in the rank's slab beyond its
+  // particles) then meets the band's particles only at 2 h or more, never near the r < h test's
+  // rounding, where the world's walk meets none.
+  const int32_t band = static_cast<int32_t>(std::max<int64_t>(width, 4));
+  if (band >= n) return world;
   const int32_t shift = wrap_index(static_cast<int32_t>(origin), band);
   GridShape g = world;
   if (axis == 0) {

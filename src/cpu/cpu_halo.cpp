@@ -300,6 +300,7 @@ void CpuRankHalo::gather() {
   // every rank cleared, summed and walked the world's 2 slots a particle each substep). The keys
   // stay the world's slots (after_sort), which every rank numbers alike.
   shape_ = rank_grid_shape(world_shape_, clo, chi, axis, first, last, held_first, held_last);
+  own_table_ = shape_.nx != world_shape_.nx || shape_.ny != world_shape_.ny || shape_.nz != world_shape_.nz;
   // The sort's order: by key, then id (two keys are equal only where the table folds). The
   // particles arrive as a few runs already in that order: the kept owned ones (in the last sort's
   // order, whose keys after_sort numbered), then each rank's migrants and each rank's ghosts (in
@@ -353,12 +354,13 @@ void CpuRankHalo::after_sort(const CpuNeighborGrid& grid) {
   // The key: the particle's slot in the world's table (where the rank's table is a band of the
   // world's, one cell a slot in both: the world's slot of that cell) and its place in the rank's
   // slot (the same place: the cell is complete here, its particles in the world's order).
-  const bool own_table = view.shape.cell_count != world_shape_.cell_count;
-  for (uint32_t c = 0; c < view.shape.cell_count; ++c)
-    for (uint32_t i = view.cell_start[c]; i < view.cell_start[c + 1]; ++i) {
-      const uint64_t slot = own_table ? cell_hash_of_position(world_shape_, xyz(position_[i])) : c;
-      key[i] = (slot << 32) | (i - view.cell_start[c]);
-    }
+  // (One cell a slot in the band: the slot's first particle names its cell.)
+  for (uint32_t c = 0; c < view.shape.cell_count; ++c) {
+    const uint32_t begin = view.cell_start[c], end = view.cell_start[c + 1];
+    if (begin == end) continue;
+    const uint64_t slot = own_table_ ? cell_hash_of_position(world_shape_, xyz(position_[begin])) : c;
+    for (uint32_t i = begin; i < end; ++i) key[i] = (slot << 32) | (i - begin);
+  }
   if (springs_) resolve_springs(grid.order().data());  // the spring lists' partners follow the sort
 }
 

@@ -156,6 +156,7 @@ class CpuRankHalo {
   DistributedCounters counters_;
   GridShape shape_{};        // the rank's table (rank_grid_shape)
   GridShape world_shape_{};  // the undivided world's, whose slots name the sort keys
+  bool own_table_ = false;   // shape_ is the rank's band of world_shape_, not world_shape_ itself
   HostVector<uint32_t> visit_;
   // gather's ordered runs of particles (where each starts), merged into visit_ when they are at
   // most kMergedRuns; more are sorted.

@@ -52,10 +52,11 @@ SPH_API sph_result SPH_CALL sph_mpi_world_create(sph_context* context, const sph
     // the next collective call: each rank's checks and world are agreed (a failure on one rank is
     // every rank's, the others' messages naming it; core/rank_agreement.h).
     auto transport = std::make_shared<sph::MpiTransport>(MPI_Comm_f2c(static_cast<MPI_Fint>(comm)));
+    const sph::MpiTransport& ranks = *transport;
     std::unique_ptr<sph::ContextHold> hold;
-    std::unique_ptr<sph_world> world;
+    sph_world_def d;
     sph::DistributedOptions options;
-    sph::agreed(*transport, [&] {
+    sph::agreed(ranks, [&] {
       hold = std::make_unique<sph::ContextHold>(context);
       if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
       sph_mpi_world_def m;
@@ -71,11 +72,12 @@ SPH_API sph_result SPH_CALL sph_mpi_world_create(sph_context* context, const sph
             Status::InvalidArgument,
             "mpi_def->rebalance_threshold_percent: must be in [0, 10000], got " + std::to_string(percent));
       options.rebalance_threshold = percent / 100.0;
-      const sph_world_def d = sph::read_user_struct(def, "def");
-      world = sph::make_world(context, d);
+      d = sph::read_user_struct(def, "def");
     });
-    // One backend on every rank: a CPU rank and a CUDA rank keep their particles, their tables and
-    // what they send each other in different layouts (docs/distributed.md).
+    // One backend on every rank (before any world is made: a CUDA world's allocations are not
+    // wasted on a refusal, and the refusal is this one, not a rank's own): a CPU rank and a CUDA
+    // rank keep their particles, their tables and what they send each other in different layouts
+    // (docs/distributed.md).
     const int64_t cuda = hold->get()->backend == sph::BackendKind::Cuda ? 1 : 0;
     int64_t lowest = cuda, highest = cuda;
     transport->all_min(&lowest, 1);
@@ -85,9 +87,21 @@ SPH_API sph_result SPH_CALL sph_mpi_world_create(sph_context* context, const sph
                                                (cuda ? "CUDA" : "the CPU") + " and another rank's is " +
                                                (cuda ? "the CPU" : "CUDA") +
                                                ": a distributed world needs one backend on every rank");
-    const sph::MpiTransport& ranks = *transport;  // (the world holds it from here)
-    sph::agreed(ranks, [&] { world->world->backend().attach_ranks(transport, options); });
-    *out = sph::publish_world(std::move(world));
+    std::unique_ptr<sph_world> world;
+    sph::agreed(ranks, [&] {
+      world = sph::make_world(context, d);
+      world->world->backend().attach_ranks(transport, options);
+    });
+    // Published under an agreement too: a rank that fails to register its world takes the others'
+    // back out of the registry, so no rank keeps a world the others do not have.
+    sph_world* handle = nullptr;
+    try {
+      sph::agreed(ranks, [&] { handle = sph::publish_world(std::move(world)); });
+    } catch (...) {
+      if (handle && sph::try_retire_world(handle) == sph::Take::Taken) delete handle;
+      throw;
+    }
+    *out = handle;
     return SPH_OK;
   });
 }

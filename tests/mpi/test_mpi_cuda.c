@@ -201,7 +201,10 @@ static void mixed_backends_case(sph_context* cuda, sph_context* cpu) {
   sph_world_def def;
   sph_world* world = NULL;
   sph_result r;
-  if (g_size < 2) return;
+  if (g_size < 2) {
+    printf("mixed backends: skipped on one rank (needs two)\n");
+    return;
+  }
   mpi_test_world_def(&def);
   r = sph_mpi_world_create(g_rank == 0 ? cpu : cuda, &def, (int32_t)MPI_Comm_c2f(MPI_COMM_WORLD), NULL,
                            &world);

@@ -99,6 +99,20 @@ bool check_case(const Case& k) {
     if (k.axis == 2) c.z = a;
     assert_true(slots.insert(sph::cell_hash(rank, c)).second);
   }
+  // A walk from outside the band (a probe point beyond the rank's particles) meets band cells only
+  // three or more cells away (particles 2 h or more away, far from the r < h test's rounding).
+  for (int32_t a = band_first - 3; a <= band_last + 3; ++a) {
+    if (a >= band_first && a <= band_last) continue;
+    for (int32_t d = -1; d <= 1; ++d)
+      for (int32_t q = band_first; q <= band_last; ++q) {
+        CellCoord probe = k.lo, cell = k.lo;
+        if (k.axis == 0) probe.x = a + d, cell.x = q;
+        if (k.axis == 1) probe.y = a + d, cell.y = q;
+        if (k.axis == 2) probe.z = a + d, cell.z = q;
+        if (sph::cell_hash(rank, probe) == sph::cell_hash(rank, cell) && q != a + d)
+          assert_true(q - a >= 3 || a - q >= 3);
+      }
+  }
   // Every owned cell's walk: the same runs of the same cells (the other axes at their span's ends,
   // where the world's table may wrap too).
   for (int32_t a = k.first; a <= k.last; ++a)
@@ -162,6 +176,9 @@ void test_world_table_kept(void**) {
   // A narrow band of the unfolded world: 6 cells (4..9) along x instead of 23.
   g = sph::rank_grid_shape(world, lo, hi, 0, 5, 8, 4, 9);
   assert_int_equal(g.nx, 6);
+  // One owned layer and no ghosts: 3 cells read, 4 slots (the least).
+  g = sph::rank_grid_shape(world, lo, hi, 0, 7, 7, 7, 7);
+  assert_int_equal(g.nx, 4);
   assert_int_equal(g.ny, world.ny);
   assert_int_equal(g.nz, world.nz);
 }
