@@ -87,7 +87,12 @@ SPH_API sph_result SPH_CALL sph_mpi_world_add_particles(sph_world* world, const 
                                                         const float* velocities, uint32_t count,
                                                         uint32_t* out_first_id);
 
-/** COLLECTIVE. Steps the world by frame_dt on every rank; the same codes as sph_world_step. */
+/**
+ * COLLECTIVE. Steps the world by frame_dt on every rank; the same codes as sph_world_step. The
+ * ranks agree on frame_dt and the world's parameters (sph_world_set_params on each rank) before the
+ * frame: a frame_dt refused on one rank, or a frame_dt or parameters that differ between the
+ * ranks, is INVALID_ARGUMENT on every rank, the world unchanged.
+ */
 SPH_API sph_result SPH_CALL sph_mpi_world_step(sph_world* world, float frame_dt);
 
 /** Counts of a distributed world (sph_mpi_world_get_counts). */

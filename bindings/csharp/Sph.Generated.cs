@@ -3513,7 +3513,12 @@ namespace Sph
         [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_mpi_world_add_particles")]
         public static extern Result sph_mpi_world_add_particles(IntPtr world, IntPtr positions, IntPtr velocities, uint count, IntPtr outFirstId);
 
-        /// <summary>COLLECTIVE. Steps the world by frame_dt on every rank; the same codes as sph_world_step.</summary>
+        /// <summary>
+        /// COLLECTIVE. Steps the world by frame_dt on every rank; the same codes as sph_world_step. The
+        /// ranks agree on frame_dt and the world's parameters (sph_world_set_params on each rank)
+        /// before the frame: a frame_dt refused on one rank, or a frame_dt or parameters that differ
+        /// between the ranks, is INVALID_ARGUMENT on every rank, the world unchanged.
+        /// </summary>
         [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_mpi_world_step(WorldHandle world, float frameDt);
         [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_mpi_world_step")]

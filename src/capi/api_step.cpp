@@ -1,12 +1,16 @@
 // SPDX-License-Identifier: MIT
 // Stepping (with its budget and cancel) and statistics.
 #include <chrono>
+#include <cstring>
 #include <functional>
 #include <memory>
 #include <new>
 #include <string>
 #include <system_error>
 
+#include "../core/byte_io.h"
+#include "../core/checkpoint_params.h"
+#include "../core/rank_agreement.h"
 #include "guard.h"
 #include "handles.h"
 #include "init_struct.h"
@@ -21,6 +25,43 @@ namespace sph {
 namespace {
 // A budget longer than a day is a mistake, not a bound.
 constexpr double kMaxStepBudgetSeconds = 86400.0;
+
+// frame_dt checked; on a distributed world (sph_mpi.h) inside one agreement, then compared between
+// the ranks with their parameters (sph_world_set_params on each rank): a rank with a bad frame_dt
+// used to return while the others waited for it in the frame's first collective call, and a rank
+// with another frame or other parameters would take other substeps and wait alone in theirs. One
+// agreement and two all-reduces of two int64 a frame.
+void require_frame(const sph_world* world, float frame_dt) {
+  const RankTransport* ranks = world->world->backend().rank_transport();
+  if (!ranks) {
+    require_positive(frame_dt, "frame_dt");
+    return;
+  }
+  uint64_t params_hash = 0;
+  agreed(*ranks, [&] {
+    require_positive(frame_dt, "frame_dt");
+    ByteWriter w;
+    write_params(w, world->world->params());  // (the checkpoints' canonical bytes)
+    Fnv1a64 h;
+    h.add(w.buffer().data(), w.size());
+    params_hash = h.value();
+  });
+  uint32_t dt_bits;
+  std::memcpy(&dt_bits, &frame_dt, sizeof dt_bits);
+  int64_t hash_bits;
+  std::memcpy(&hash_bits, &params_hash, sizeof hash_bits);
+  int64_t lo[2] = {dt_bits, hash_bits}, hi[2] = {dt_bits, hash_bits};
+  ranks->all_min(lo, 2);
+  ranks->all_max(hi, 2);
+  if (lo[0] != hi[0])
+    throw Error(Status::InvalidArgument, "frame_dt: " + std::to_string(frame_dt) +
+                                             " on this rank and another on another rank of the distributed "
+                                             "world: every rank steps the same frame");
+  if (lo[1] != hi[1])
+    throw Error(Status::InvalidArgument,
+                "world: its parameters (sph_world_set_params) differ between the ranks of the distributed "
+                "world: every rank must set the same");
+}
 
 // One frame of a world whose lock the caller holds: true if it completed, false if its budget,
 // a cancel or max_substeps stopped it; throws on failure (the world then as before the call).
@@ -80,7 +121,7 @@ SPH_API sph_result SPH_CALL sph_world_step(sph_world* world, float frame_dt) {
   return sph::guarded("sph_world_step", sph::context_of(world), [&] {
     sph::require_world(world);
     sph::WorldLock lock(world);
-    sph::require_positive(frame_dt, "frame_dt");
+    sph::require_frame(world, frame_dt);
     return sph::run_frame(world, frame_dt) ? SPH_OK : SPH_INCOMPLETE;
   });
 }

@@ -11,6 +11,9 @@
 //   - a crowded cell (700 particles in one cell, more than the 528 one may hold) on whichever
 //     rank owns it, and the ranks holding it as ghosts: every rank returns SPH_ERROR_CAPACITY and
 //     the world is unchanged;
+//   - a frame refused on the last rank alone (frame_dt not positive), a frame_dt that differs
+//     between the ranks, parameters (sph_world_set_params) that differ: every rank returns
+//     INVALID_ARGUMENT, the world unchanged, and steps on once the ranks agree;
 //   - sph_mpi_world_create refused on the last rank alone (an invalid world definition, an invalid
 //     rebalance threshold, a NULL out, a NULL context): every rank returns that rank's status, the
 //     others' messages name it, no rank gets a world, and a world made after it works.
@@ -213,6 +216,52 @@ void creation_refused_on_one_rank(sph_context* context) {
     printf("sph_mpi_world_create refused on rank %d of %d: every rank refused, 4 cases\n", culprit, g_size);
 }
 
+// Frames the ranks disagree on (since session 37: before, a rank whose frame_dt was refused returned
+// while the others waited for it in the frame's first collective call, and ranks with other frames
+// or parameters took other substeps, each alone in its collectives).
+void frames_disagreed(sph_context* context) {
+  const int culprit = g_size - 1;
+  sph_world_def def;
+  sph_world* world = NULL;
+  uint32_t n = 0;
+  float *x0 = NULL, *v0 = NULL, *x1 = NULL, *v1 = NULL;
+  mpi_test_world_def(&def);
+  mpi_test_dam(context, &def, 0.0f, NULL, NULL, &world, &n);
+  set_substeps(world);
+  mpi_test_gather(world, n, &x0, &v0);
+  // frame_dt refused on one rank (the others' messages name it).
+  sph_result r = sph_mpi_world_step(world, g_rank == culprit ? -1.0f : 1.0f);
+  CHECK(r == SPH_ERROR_INVALID_ARGUMENT, "a negative frame_dt on rank %d: rank %d returned %d (%s)", culprit,
+        g_rank, (int)r, sph_get_last_error());
+  check_rank_named(culprit, "a negative frame_dt");
+  if (g_size > 1) {
+    r = sph_mpi_world_step(world, g_rank == culprit ? 0.5f : 1.0f);
+    CHECK(r == SPH_ERROR_INVALID_ARGUMENT && strstr(sph_get_last_error(), "every rank steps the same frame"),
+          "frame_dt 0.5 on rank %d, 1 elsewhere: rank %d returned %d (%s)", culprit, g_rank, (int)r,
+          sph_get_last_error());
+    sph_world_params p;
+    REQUIRE(sph_world_params_init(&p) == SPH_OK && sph_world_get_params(world, &p) == SPH_OK, "get params");
+    sph_world_params changed = p;
+    if (g_rank == culprit) changed.gravity.y = -9.0f;
+    REQUIRE(sph_world_set_params(world, &changed) == SPH_OK, "set params");
+    r = sph_mpi_world_step(world, 1.0f);
+    CHECK(r == SPH_ERROR_INVALID_ARGUMENT && strstr(sph_get_last_error(), "parameters"),
+          "gravity -9 on rank %d, -9.81 elsewhere: rank %d returned %d (%s)", culprit, g_rank, (int)r,
+          sph_get_last_error());
+    REQUIRE(sph_world_set_params(world, &p) == SPH_OK, "set params back");
+  }
+  mpi_test_gather(world, n, &x1, &v1);
+  CHECK(g_rank != 0 || mpi_differ(x0, v0, x1, v1, n, nullptr) == 0, "a refused frame changed the world");
+  r = sph_mpi_world_step(world, 1.0f);
+  CHECK(r == SPH_INCOMPLETE, "the frame once the ranks agree: %d (%s)", (int)r, sph_get_last_error());
+  if (g_rank == 0) printf("frames the ranks disagree on, %d ranks: refused on every rank\n", g_size);
+  free(x0);
+  free(v0);
+  free(x1);
+  free(v1);
+  REQUIRE(sph_world_destroy(world) == SPH_OK, "destroy");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -223,5 +272,6 @@ int main(int argc, char** argv) {
   allocation_failures(context, SPH_FEATURE_NONE, true, "the stirred column, DFSPH with conjugate gradients");
   crowded_cell(context);
   creation_refused_on_one_rank(context);
+  frames_disagreed(context);
   return mpi_test_finish(context, "mpi rank failures");
 }
