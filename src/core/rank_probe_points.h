@@ -22,8 +22,15 @@
 
 namespace sph {
 
+// The rank whose slab holds sample point x's cell layer: the one whose gather of it counts.
+inline int probe_point_owner(const SlabDecomposition& slabs, float kernel_radius, Vec3 x) {
+  const int axis = slabs.axis();
+  return slabs.owner(cell_coordinate(axis == 0 ? x.x : (axis == 1 ? x.y : x.z), 1.0f / kernel_radius));
+}
+
 // points[0, point_count): this rank's gathers of the sample points of probes[0, probe_count), in
-// the order of their first points; replaced by each point's owner's.
+// the order of their first points (those of points another rank owns may be left unsampled: they
+// are replaced); replaced by each point's owner's.
 inline void pick_rank_probe_points(const RankTransport& t, const SlabDecomposition& slabs,
                                    float kernel_radius, const ProbeView* probes, size_t probe_count,
                                    ProbeGather* points, size_t point_count) {
@@ -37,13 +44,10 @@ inline void pick_rank_probe_points(const RankTransport& t, const SlabDecompositi
     if (in[r].size() != bytes)
       throw Error(Status::Internal,
                   "halo: rank " + std::to_string(r) + " sampled another number of probe points");
-  const int axis = slabs.axis();
-  const float inv = 1.0f / kernel_radius;
   for (size_t k = 0; k < probe_count; ++k) {
     const ProbeView& p = probes[k];
     for (uint32_t q = 0; q < p.point_count; ++q) {
-      const Vec3 x = probe_point(p, q);
-      const int owner = slabs.owner(cell_coordinate(axis == 0 ? x.x : (axis == 1 ? x.y : x.z), inv));
+      const int owner = probe_point_owner(slabs, kernel_radius, probe_point(p, q));
       const size_t at = p.first_point + q;
       std::memcpy(&points[at], in[static_cast<size_t>(owner)].data() + at * sizeof(ProbeGather),
                   sizeof(ProbeGather));

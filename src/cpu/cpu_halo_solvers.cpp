@@ -72,6 +72,10 @@ void CpuRankHalo::pick_probe_points(const ProbeView* probes, size_t probe_count,
   pick_rank_probe_points(*ranks_, slabs_, kernel_radius_, probes, probe_count, points, point_count);
 }
 
+bool CpuRankHalo::owns_probe_point(Vec3 x) const {
+  return probe_point_owner(slabs_, kernel_radius_, x) == ranks_->rank();
+}
+
 void CpuRankHalo::sum_loads(ColliderLoadSums* loads, size_t count) const {
   HostVector<double> sums;
   sums.reserve(6 * count);

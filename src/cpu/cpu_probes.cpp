@@ -27,11 +27,18 @@ void CpuBackend::sample_probes(const SceneFrame& scene, float dt, FrameReport& r
   const ProbeView* probes = scene.probes.data();
   ProbeGather* points = probe_points_.data();
   const int probe_count = static_cast<int>(scene.probes.size());
-  // One probe a block: a gauge's points are many, a point probe's one.
+  // One probe a block: a gauge's points are many, a point probe's one. A distributed rank gathers
+  // only the points its slab holds (the others' gathers replace the rest below; its own table is
+  // a band of the world's, where a point far outside would only meet particles to reject).
+  const CpuRankHalo* rank = rank_.get();
   parallel().for_blocks(scene.probes.size(), 1, [&](size_t k, size_t) {
     const ProbeView& p = probes[k];
-    for (uint32_t q = 0; q < p.point_count; ++q)
-      points[p.first_point + q] = gather_probe_point(constants, view, pos, vel, probe_point(p, q));
+    for (uint32_t q = 0; q < p.point_count; ++q) {
+      const Vec3 x = probe_point(p, q);
+      points[p.first_point + q] = rank && !rank->owns_probe_point(x)
+                                      ? zero_probe_gather()
+                                      : gather_probe_point(constants, view, pos, vel, x);
+    }
   });
   // Every rank reads each point's owner's sums.
   if (rank_) rank_->pick_probe_points(probes, scene.probes.size(), points, probe_points_.size());

@@ -104,6 +104,8 @@ class CpuRankHalo {
   // frame added over the ranks in rank order (cpu_halo_solvers.cpp).
   void pick_probe_points(const ProbeView* probes, size_t probe_count, ProbeGather* points,
                          size_t point_count) const;
+  // Whether this rank's slab holds sample point x (its gather of x is the one every rank takes).
+  bool owns_probe_point(Vec3 x) const;
   void sum_loads(ColliderLoadSums* sums, size_t count) const;
 
  private:
