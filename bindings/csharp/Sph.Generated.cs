@@ -3515,8 +3515,9 @@ namespace Sph
 
         /// <summary>
         /// COLLECTIVE. Steps the world by frame_dt on every rank; the same codes as sph_world_step. The
-        /// ranks agree on frame_dt and the world's parameters (sph_world_set_params on each rank)
-        /// before the frame: a frame_dt refused on one rank, or a frame_dt or parameters that differ
+        /// ranks agree on frame_dt, the world's parameters (sph_world_set_params on each rank) and the
+        /// count of each kind of scene object (colliders, sources, sinks, force fields, probes) before
+        /// the frame: a frame_dt refused on one rank, or a frame_dt, parameters or counts that differ
         /// between the ranks, is INVALID_ARGUMENT on every rank, the world unchanged.
         /// </summary>
         [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl)]

@@ -30,7 +30,8 @@ constexpr double kMaxStepBudgetSeconds = 86400.0;
 // the ranks with their parameters (sph_world_set_params on each rank): a rank with a bad frame_dt
 // used to return while the others waited for it in the frame's first collective call, and a rank
 // with another frame or other parameters would take other substeps and wait alone in theirs. One
-// agreement and two all-reduces of two int64 a frame.
+// agreement and two all-reduces of three int64 a frame. The scene's objects are compared by count
+// (a rank with another collider or probe would meet the others' reductions with another size).
 void require_frame(const sph_world* world, float frame_dt) {
   const RankTransport* ranks = world->world->backend().rank_transport();
   if (!ranks) {
@@ -46,13 +47,22 @@ void require_frame(const sph_world* world, float frame_dt) {
     h.add(w.buffer().data(), w.size());
     params_hash = h.value();
   });
+  // The scene's objects by kind: each rank holds the same (the loads, the sources' and the probes'
+  // reductions have an element a collider, source or point).
+  const World& w = *world->world;
+  const uint64_t objects[5] = {w.colliders().size(), w.sources().size(), w.sinks().size(),
+                               w.force_fields().size(), w.probes().size()};
+  Fnv1a64 scene;
+  scene.add(objects, sizeof objects);
+  const uint64_t scene_hash = scene.value();
   uint32_t dt_bits;
   std::memcpy(&dt_bits, &frame_dt, sizeof dt_bits);
-  int64_t hash_bits;
-  std::memcpy(&hash_bits, &params_hash, sizeof hash_bits);
-  int64_t lo[2] = {dt_bits, hash_bits}, hi[2] = {dt_bits, hash_bits};
-  ranks->all_min(lo, 2);
-  ranks->all_max(hi, 2);
+  int64_t hashes[2];
+  std::memcpy(&hashes[0], &params_hash, sizeof hashes[0]);
+  std::memcpy(&hashes[1], &scene_hash, sizeof hashes[1]);
+  int64_t lo[3] = {dt_bits, hashes[0], hashes[1]}, hi[3] = {dt_bits, hashes[0], hashes[1]};
+  ranks->all_min(lo, 3);
+  ranks->all_max(hi, 3);
   if (lo[0] != hi[0])
     throw Error(Status::InvalidArgument, "frame_dt: " + std::to_string(frame_dt) +
                                              " on this rank and another on another rank of the distributed "
@@ -61,6 +71,12 @@ void require_frame(const sph_world* world, float frame_dt) {
     throw Error(Status::InvalidArgument,
                 "world: its parameters (sph_world_set_params) differ between the ranks of the distributed "
                 "world: every rank must set the same");
+  if (lo[2] != hi[2])
+    throw Error(Status::InvalidArgument,
+                "world: its scene differs between the ranks of the distributed world (this rank has " +
+                    std::to_string(objects[0]) + " colliders, " + std::to_string(objects[1]) + " sources, " +
+                    std::to_string(objects[2]) + " sinks, " + std::to_string(objects[3]) + " force fields, " +
+                    std::to_string(objects[4]) + " probes): every rank must add the same objects");
 }
 
 // One frame of a world whose lock the caller holds: true if it completed, false if its budget,

@@ -12,7 +12,8 @@
 //     rank owns it, and the ranks holding it as ghosts: every rank returns SPH_ERROR_CAPACITY and
 //     the world is unchanged;
 //   - a frame refused on the last rank alone (frame_dt not positive), a frame_dt that differs
-//     between the ranks, parameters (sph_world_set_params) that differ: every rank returns
+//     between the ranks, parameters (sph_world_set_params) or a scene (a probe on one rank) that
+//     differ: every rank returns
 //     INVALID_ARGUMENT, the world unchanged, and steps on once the ranks agree;
 //   - sph_mpi_world_create refused on the last rank alone (an invalid world definition, an invalid
 //     rebalance threshold, a NULL out, a NULL context): every rank returns that rank's status, the
@@ -249,6 +250,17 @@ void frames_disagreed(sph_context* context) {
           "gravity -9 on rank %d, -9.81 elsewhere: rank %d returned %d (%s)", culprit, g_rank, (int)r,
           sph_get_last_error());
     REQUIRE(sph_world_set_params(world, &p) == SPH_OK, "set params back");
+    // A probe on one rank only: the scene differs.
+    sph_probe_def probe;
+    sph_probe_id probe_id{};
+    REQUIRE(sph_probe_def_init(&probe) == SPH_OK, "probe def");
+    probe.position = sph_vec3{0.05f, 0.05f, 0.03f};
+    if (g_rank == culprit) REQUIRE(sph_probe_create(world, &probe, &probe_id) == SPH_OK, "probe");
+    r = sph_mpi_world_step(world, 1.0f);
+    CHECK(r == SPH_ERROR_INVALID_ARGUMENT && strstr(sph_get_last_error(), "scene differs"),
+          "a probe on rank %d alone: rank %d returned %d (%s)", culprit, g_rank, (int)r,
+          sph_get_last_error());
+    if (g_rank == culprit) REQUIRE(sph_probe_destroy(world, probe_id) == SPH_OK, "probe destroy");
   }
   mpi_test_gather(world, n, &x1, &v1);
   CHECK(g_rank != 0 || mpi_differ(x0, v0, x1, v1, n, nullptr) == 0, "a refused frame changed the world");
