@@ -122,6 +122,29 @@ static void print_ranks(int rank, int size, const sph_mpi_counts* c, const sph_s
   free(all);
 }
 
+/* Rank 0 prints every rank's hash+sort stage in its parts over the timed step (ms, transport
+ * included; src/core/distributed.h's HaloPhase): where a many-rank host's hash+sort goes. */
+static void print_phases(int rank, int size, const mpi_halo_transport* before,
+                         const mpi_halo_transport* after) {
+  double mine[MPI_HALO_PHASE_COUNT];
+  for (int p = 0; p < MPI_HALO_PHASE_COUNT; ++p) mine[p] = after->phase_ms[p] - before->phase_ms[p];
+  double* all = rank == 0 ? (double*)malloc(sizeof(double) * MPI_HALO_PHASE_COUNT * (size_t)size) : NULL;
+  if (rank == 0 && !all) MPI_Abort(MPI_COMM_WORLD, 1);
+  MPI_Gather(mine, MPI_HALO_PHASE_COUNT, MPI_DOUBLE, all, MPI_HALO_PHASE_COUNT, MPI_DOUBLE, 0,
+             MPI_COMM_WORLD);
+  if (rank != 0) return;
+  printf("hash+sort in parts per rank, ms over the step (transport included):");
+  for (int p = 0; p < MPI_HALO_PHASE_COUNT; ++p) printf(" %s", mpi_halo_phase_name(p));
+  printf("\n");
+  for (int r = 0; r < size; ++r) {
+    printf("  rank %2d", r);
+    for (int p = 0; p < MPI_HALO_PHASE_COUNT; ++p)
+      printf(" %8.2f", all[(size_t)r * MPI_HALO_PHASE_COUNT + p]);
+    printf("\n");
+  }
+  free(all);
+}
+
 static void need(sph_result r, const char* what) {
   if (r != SPH_OK) {
     fprintf(stderr, "mpi_halo: %s: %d %s\n", what, (int)r, sph_get_last_error());
@@ -258,6 +281,7 @@ int main(int argc, char** argv) {
   }
   print_split(rank, wait_barriers, &stats, &before, &after);
   print_ranks(rank, size, &c, &stats, &after);
+  print_phases(rank, size, &before, &after);
   sph_world_destroy(world);
   sph_context_destroy(context);
   if (size >= 2) ping_pong(rank);

@@ -8,6 +8,7 @@
 #include "mpi/mpi_transport.h"
 
 static_assert(MPI_HALO_CALL_COUNT == sph::kTransportCallCount, "mpi_halo_transport.h's calls");
+static_assert(MPI_HALO_PHASE_COUNT == sph::kHaloPhaseCount, "mpi_halo_transport.h's phases");
 
 namespace {
 
@@ -31,6 +32,8 @@ extern "C" int mpi_halo_transport_read(const sph_world* world, mpi_halo_transpor
     out->stage_ms[s] = report.transport_ms[s];
     out->stage_wait_ms[s] = report.transport_wait_ms[s];
   }
+  const sph::HaloPhaseTimes* phases = world->world->backend().halo_phase_times();
+  for (int p = 0; p < sph::kHaloPhaseCount; ++p) out->phase_ms[p] = phases ? phases->ms[p] : 0.0;
   return 0;
 }
 
@@ -39,6 +42,12 @@ extern "C" int mpi_halo_wait_at_barriers(const sph_world* world) {
   if (!t) return -1;
   t->wait_at_barriers(true);
   return 0;
+}
+
+extern "C" const char* mpi_halo_phase_name(int phase) {
+  static const char* const kNames[MPI_HALO_PHASE_COUNT] = {"migrate", "ghosts", "springs", "extent",
+                                                           "visit",   "grid",   "reorder", "keys"};
+  return phase >= 0 && phase < MPI_HALO_PHASE_COUNT ? kNames[phase] : "?";
 }
 
 extern "C" const char* mpi_halo_call_name(int call) {

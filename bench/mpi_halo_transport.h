@@ -16,6 +16,8 @@ extern "C" {
 
 /* src/core/rank_transport.h's TransportCall, in its order. */
 #define MPI_HALO_CALL_COUNT 8
+/* src/core/distributed.h's HaloPhase, in its order. */
+#define MPI_HALO_PHASE_COUNT 8
 
 typedef struct mpi_halo_transport {
   /* Since the world was made, in the transport's calls by kind (mpi_halo_call_name). */
@@ -26,6 +28,9 @@ typedef struct mpi_halo_transport {
    * the waits at the barriers mpi_halo_wait_at_barriers puts before them. */
   float stage_ms[SPH_STAGE_COUNT];
   float stage_wait_ms[SPH_STAGE_COUNT];
+  /* A CPU rank's hash+sort stage in its parts since the world was made (mpi_halo_phase_name;
+   * zero on a CUDA rank). */
+  double phase_ms[MPI_HALO_PHASE_COUNT];
 } mpi_halo_transport;
 
 /* 0, or -1 where `world` is not a distributed world. */
@@ -34,6 +39,7 @@ int mpi_halo_transport_read(const sph_world* world, mpi_halo_transport* out);
  * first (MpiTransport::wait_at_barriers). 0, or -1 as above. */
 int mpi_halo_wait_at_barriers(const sph_world* world);
 const char* mpi_halo_call_name(int call);
+const char* mpi_halo_phase_name(int phase);
 
 #ifdef __cplusplus
 }

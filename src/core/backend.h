@@ -120,6 +120,8 @@ class Backend {
   }
   // The ranks attach_ranks gave (null: not a distributed world).
   virtual const RankTransport* rank_transport() const { return nullptr; }
+  // A CPU rank's hash+sort stage in its parts (null elsewhere).
+  virtual const HaloPhaseTimes* halo_phase_times() const { return nullptr; }
   bool distributed() const { return rank_transport() != nullptr; }
   virtual DistributedCounters distributed_counters() const { return DistributedCounters{}; }
   // The ranks as attach_ranks took them (a restore attaches them to the state it builds).

@@ -31,6 +31,24 @@ struct DistributedCounters {
   int32_t slab_last = 0;
 };
 
+// A CPU rank's hash+sort stage in its parts (bench/mpi_halo; issue 19): wall ms since the world was
+// made, the transport's calls included, so that a slow stage on a many-rank host can be traced
+// without a profiler.
+enum HaloPhase : int {
+  kHaloMigrate,  // migrants classified, packed, exchanged; the kept compacted, the arrivals unpacked
+  kHaloGhosts,   // ghosts classified, packed, exchanged, unpacked
+  kHaloSprings,  // spring partners and spring ghosts
+  kHaloExtent,   // the owned and held extents, the world's reductions, the tables' shapes
+  kHaloVisit,    // the sort's visit order (the merge of the arrival runs)
+  kHaloGrid,     // the grid's counting sort over the rank's table
+  kHaloReorder,  // the store's permutation into the grid's order
+  kHaloKeys,     // the sort keys
+  kHaloPhaseCount
+};
+struct HaloPhaseTimes {
+  double ms[kHaloPhaseCount] = {};
+};
+
 // What a rank's checkpoint carries beside its particles: the decomposition and the counters, so
 // that a restored world cuts, migrates and counts as the saved one would have.
 struct DistributedState {

@@ -76,6 +76,7 @@ class CpuBackend final : public Backend {
   // Distributed worlds (cpu_halo.cpp).
   void attach_ranks(std::shared_ptr<const RankTransport> ranks, const DistributedOptions& options) override;
   const RankTransport* rank_transport() const override { return rank_ ? &rank_->transport() : nullptr; }
+  const HaloPhaseTimes* halo_phase_times() const override { return rank_ ? &rank_->phase_times() : nullptr; }
   DistributedCounters distributed_counters() const override;
   std::shared_ptr<const RankTransport> shared_rank_transport() const override {
     return rank_ ? rank_->shared_transport() : nullptr;

@@ -26,6 +26,7 @@
 // distributed world steps the single world's bits (while the grid's table covers the
 // particles' extent without folding; docs/distributed.md).
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -93,6 +94,21 @@ void CpuRankHalo::agree() const { sph::agree(*ranks_); }
 namespace {
 
 float axis_coordinate(const Float4& p, int axis) { return axis == 0 ? p.x : (axis == 1 ? p.y : p.z); }
+
+// Adds the wall time since the last lap to a phase of the hash+sort stage (HaloPhaseTimes).
+class PhaseClock {
+ public:
+  explicit PhaseClock(HaloPhaseTimes& times) : times_(times), at_(std::chrono::steady_clock::now()) {}
+  void lap(HaloPhase phase) {
+    const auto now = std::chrono::steady_clock::now();
+    times_.ms[phase] += std::chrono::duration<double, std::milli>(now - at_).count();
+    at_ = now;
+  }
+
+ private:
+  HaloPhaseTimes& times_;
+  std::chrono::steady_clock::time_point at_;
+};
 
 }  // namespace
 
@@ -201,6 +217,7 @@ void CpuRankHalo::gather() {
   const RankTransport& t = *ranks_;
   const int me = t.rank();
   const int size = t.size();
+  PhaseClock clock(phase_times_);
   std::vector<RankBytes> out(static_cast<size_t>(size));
   sends_.resize(static_cast<size_t>(size));
   for (HostVector<uint32_t>& to : sends_) to.clear();
@@ -221,6 +238,7 @@ void CpuRankHalo::gather() {
   counters_.migrated_out += count_ - static_cast<uint32_t>(keep_.size());
   keep(keep_.size());
   for (int r = 0; r < size; ++r) counters_.migrated_in += unpack(in[static_cast<size_t>(r)], 0u);
+  clock.lap(kHaloMigrate);
   const uint32_t owned = count_;
   // Ghosts: each owned particle of a layer beside another rank's slab goes to that rank.
   for (HostVector<uint32_t>& to : sends_) to.clear();
@@ -232,10 +250,12 @@ void CpuRankHalo::gather() {
   for (int r = 0; r < size; ++r) pack(sends_[static_cast<size_t>(r)], out[static_cast<size_t>(r)]);
   in = t.exchange(out);  // (an agreement: the migrants' arrival, the ghosts' packing)
   for (int r = 0; r < size; ++r) unpack(in[static_cast<size_t>(r)], static_cast<uint32_t>(r) + 1u);
+  clock.lap(kHaloGhosts);
   // Springs: the owned lists' partner ids to indices, the partners held nowhere here as spring
   // ghosts (cpu_halo_springs.cpp).
   if (springs_) gather_spring_partners(owned);
   counters_.ghosts = count_ - owned;
+  clock.lap(kHaloSprings);
   // The world's grid: the extent and count of every rank's owned particles (what the undivided
   // world's grid sees).
   const float inv = 1.0f / kernel_radius_;
@@ -301,6 +321,7 @@ void CpuRankHalo::gather() {
   // stay the world's slots (after_sort), which every rank numbers alike.
   shape_ = rank_grid_shape(world_shape_, clo, chi, axis, first, last, held_first, held_last);
   own_table_ = shape_.nx != world_shape_.nx || shape_.ny != world_shape_.ny || shape_.nz != world_shape_.nz;
+  clock.lap(kHaloExtent);
   // The sort's order: by key, then id (two keys are equal only where the table folds). The
   // particles arrive as a few runs already in that order: the kept owned ones (in the last sort's
   // order, whose keys after_sort numbered), then each rank's migrants and each rank's ghosts (in
@@ -320,6 +341,7 @@ void CpuRankHalo::gather() {
     if (before(i, i - 1)) run_starts_.push_back(i);
   if (run_starts_.size() > kMergedRuns) {
     std::sort(visit_.begin(), visit_.end(), before);
+    clock.lap(kHaloVisit);
     return;
   }
   // Bottom-up: merge neighbouring runs into the other buffer until one is left (std::merge into
@@ -346,6 +368,7 @@ void CpuRankHalo::gather() {
     run_starts_.resize(kept);
     visit_.swap(merged_);
   }
+  clock.lap(kHaloVisit);
 }
 
 void CpuRankHalo::after_sort(const CpuNeighborGrid& grid) {

@@ -61,6 +61,10 @@ class CpuRankHalo {
               const CpuRankParticles& particles);
 
   const RankTransport& transport() const { return *ranks_; }
+  // The hash+sort stage's parts (gather's own; the backend adds the grid's, the reorder's and the
+  // keys').
+  const HaloPhaseTimes& phase_times() const { return phase_times_; }
+  void add_phase_time(HaloPhase phase, double ms) { phase_times_.ms[phase] += ms; }
   const std::shared_ptr<const RankTransport>& shared_transport() const { return ranks_; }
   DistributedCounters counters() const;
   // The decomposition and counters a rank's checkpoint carries (cpu_rank_state.cpp).
@@ -159,6 +163,7 @@ class CpuRankHalo {
   GridShape shape_{};        // the rank's table (rank_grid_shape)
   GridShape world_shape_{};  // the undivided world's, whose slots name the sort keys
   bool own_table_ = false;   // shape_ is the rank's band of world_shape_, not world_shape_ itself
+  HaloPhaseTimes phase_times_;
   HostVector<uint32_t> visit_;
   // gather's ordered runs of particles (where each starts), merged into visit_ when they are at
   // most kMergedRuns; more are sorted.
