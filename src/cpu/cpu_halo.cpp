@@ -224,10 +224,18 @@ void CpuRankHalo::gather() {
   // Every particle held between substeps is owned; a substep that failed after the ghosts came
   // and was rolled back leaves their marks in this (not carried) array.
   std::fill(origin_.data(), origin_.data() + count_, 0u);
+  // This rank's slab, the layers [slab_begin, slab_end) (int64: the outer slabs reach INT32_MIN and
+  // INT32_MAX): a particle inside it needs no search of the cuts, nor, away from its two faces,
+  // any search for ghost destinations (the two per-particle loops below cost about 1 ms a substep
+  // at 84,672 particles on one rank of the development VM with a search for every particle).
+  const std::vector<int32_t>& cuts = slabs_.cuts();
+  const int64_t slab_begin = me == 0 ? int64_t{INT32_MIN} : cuts[static_cast<size_t>(me - 1)];
+  const int64_t slab_end = me == size - 1 ? int64_t{INT32_MAX} + 1 : cuts[static_cast<size_t>(me)];
   // Migration: what another rank's slab holds goes there with every carried array.
   keep_.clear();
   for (uint32_t i = 0; i < count_; ++i) {
-    const int owner = slabs_.owner(layer(i));
+    const int32_t l = layer(i);
+    const int owner = l >= slab_begin && l < slab_end ? me : slabs_.owner(l);
     if (owner == me)
       keep_.push_back(i);
     else
@@ -243,8 +251,10 @@ void CpuRankHalo::gather() {
   // Ghosts: each owned particle of a layer beside another rank's slab goes to that rank.
   for (HostVector<uint32_t>& to : sends_) to.clear();
   for (uint32_t i = 0; i < owned; ++i) {
+    const int32_t l = layer(i);
+    if (int64_t{l} - 1 >= slab_begin && int64_t{l} + 1 < slab_end) continue;  // both neighbours this rank's
     int to[2];
-    const int n = slabs_.ghost_destinations(layer(i), me, to);
+    const int n = slabs_.ghost_destinations(l, me, to);
     for (int k = 0; k < n; ++k) sends_[static_cast<size_t>(to[k])].push_back(i);
   }
   for (int r = 0; r < size; ++r) pack(sends_[static_cast<size_t>(r)], out[static_cast<size_t>(r)]);
