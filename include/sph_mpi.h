@@ -177,8 +177,9 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather_removed_ids(const sph_world* wo
  * rank. A save that fails (on any rank), or a crash before the new manifest is in place, leaves
  * the previous set as it was and named by its manifest; a failed save removes the files it
  * wrote, a crash leaves them beside the set (files no manifest names).
- * Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL or empty path; a file that cannot be written:
- * the message says which and why), UNSUPPORTED (not a distributed world), WORLD_LOCKED,
+ * Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL or empty path, or another path on another rank,
+ * refused before any file is written; a file that cannot be written: the message says which and
+ * why), UNSUPPORTED (not a distributed world), WORLD_LOCKED,
  * OUT_OF_HOST_MEMORY; a rank whose own save succeeded returns the failing rank's code.
  */
 SPH_API sph_result SPH_CALL sph_mpi_world_save_file(const sph_world* world, const char* path);
@@ -187,8 +188,9 @@ SPH_API sph_result SPH_CALL sph_mpi_world_save_file(const sph_world* world, cons
  * COLLECTIVE. Creates a distributed world over the communicator `comm` (as sph_mpi_world_create)
  * from the manifest at `path` and the rank files named in it, on any rank count (above). The
  * rebalance threshold is the saved world's. On any error on any rank, no rank creates a world
- * and *out is untouched. Errors: INVALID_HANDLE (context), INVALID_ARGUMENT (NULL path or out; a
- * file that cannot be read; a bad communicator), CORRUPT_DATA (a damaged manifest or rank file,
+ * and *out is untouched (the arguments too are checked over the ranks: a NULL out on one rank is
+ * every rank's refusal). Errors: INVALID_HANDLE (context), INVALID_ARGUMENT (NULL path or out;
+ * another path on another rank; a file that cannot be read; a bad communicator), CORRUPT_DATA (a damaged manifest or rank file,
  * a rank file whose size or hash is not the manifest's, or files of different worlds: the
  * message names the file), CAPACITY (on fewer ranks, the particles a rank takes exceed the
  * world's max_capacity, which is per rank), VERSION_MISMATCH, UNSUPPORTED (a CUDA context),

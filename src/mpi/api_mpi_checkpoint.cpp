@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -42,6 +43,24 @@ namespace {
 void require_path(const char* path) {
   if (!path) throw Error(Status::InvalidArgument, "path: is NULL");
   if (!*path) throw Error(Status::InvalidArgument, "path: is empty");
+}
+
+// COLLECTIVE, after an agreement that every rank's path is one: the same path on every rank (its
+// FNV-1a hash compared by two all-reduces of one int64). A rank that named another set would save
+// its file where the manifest does not look, or load another world's part.
+void require_same_path(const RankTransport& ranks, const char* path) {
+  Fnv1a64 h;
+  h.add(path, std::strlen(path));
+  const uint64_t hash = h.value();
+  int64_t lo, hi;
+  std::memcpy(&lo, &hash, sizeof lo);
+  hi = lo;
+  ranks.all_min(&lo, 1);
+  ranks.all_max(&hi, 1);
+  if (lo != hi)
+    throw Error(Status::InvalidArgument, std::string("path: '") + path +
+                                             "' on this rank and another on another rank: every rank must "
+                                             "name the same checkpoint");
 }
 
 // A rank's entry as it travels to rank 0.
@@ -248,9 +267,10 @@ SPH_API sph_result SPH_CALL sph_mpi_world_save_file(const sph_world* world, cons
     // rank 0 replaces the manifest, the one step that switches sets. Then each rank removes its
     // file of the old set. A failure (or a crash) before the manifest is replaced leaves the
     // old set whole and named by its manifest.
+    sph::agreed(ranks, [&] { sph::require_path(path); });
+    sph::require_same_path(ranks, path);
     try {
       sph::agreed(ranks, [&] {
-        sph::require_path(path);
         replaced = sph::replaced_files(target, ranks.rank(), ranks.size());
         const sph::RankFileEntry e = sph::stage_rank(world, ranks, target);
         file = sph::rank_file_path(target, e.name);
@@ -295,15 +315,31 @@ SPH_API sph_result SPH_CALL sph_mpi_world_save_file(const sph_world* world, cons
 SPH_API sph_result SPH_CALL sph_mpi_world_load_file(sph_context* context, int32_t comm, const char* path,
                                                     sph_world** out) {
   return sph::guarded("sph_mpi_world_load_file", context, [&] {
-    const sph::ContextHold hold(context);
-    if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
+    // The communicator first (every rank), then every check and the load agreed, as
+    // sph_mpi_world_create does: a rank refused alone does not leave the others in a collective.
     auto ranks = std::make_shared<sph::MpiTransport>(MPI_Comm_f2c(static_cast<MPI_Fint>(comm)));
-    std::unique_ptr<sph::World> loaded;
-    sph::agreed(*ranks, [&] { loaded = sph::load_rank(hold.get(), ranks, path); });
-    auto world = std::make_unique<sph_world>();
-    world->context = hold.get();
-    world->world = std::move(loaded);
-    *out = sph::publish_world(std::move(world));
+    std::unique_ptr<sph::ContextHold> hold;
+    sph::agreed(*ranks, [&] {
+      hold = std::make_unique<sph::ContextHold>(context);
+      if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
+      sph::require_path(path);
+    });
+    sph::require_same_path(*ranks, path);
+    std::unique_ptr<sph_world> world;
+    sph::agreed(*ranks, [&] {
+      std::unique_ptr<sph::World> loaded = sph::load_rank(hold->get(), ranks, path);
+      world = std::make_unique<sph_world>();
+      world->context = hold->get();
+      world->world = std::move(loaded);
+    });
+    sph_world* handle = nullptr;
+    try {
+      sph::agreed(*ranks, [&] { handle = sph::publish_world(std::move(world)); });
+    } catch (...) {
+      if (handle && sph::try_retire_world(handle) == sph::Take::Taken) delete handle;
+      throw;
+    }
+    *out = handle;
     return SPH_OK;
   });
 }
@@ -315,6 +351,8 @@ SPH_API sph_result SPH_CALL sph_mpi_world_restore_file(sph_world* world, const c
     const sph::RankTransport& ranks = sph::ranks_of(world);
     const std::shared_ptr<const sph::RankTransport> shared = world->world->backend().shared_rank_transport();
     std::unique_ptr<sph::World> loaded;
+    sph::agreed(ranks, [&] { sph::require_path(path); });
+    sph::require_same_path(ranks, path);
     // Built whole beside the world's state, swapped in once every rank has built its own.
     sph::agreed(ranks, [&] { loaded = sph::load_rank(world->context, shared, path); });
     world->world.swap(loaded);

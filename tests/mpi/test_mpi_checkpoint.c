@@ -260,6 +260,33 @@ int main(int argc, char** argv) {
   /* The set is whole again: it restores. */
   REQUIRE(sph_mpi_world_restore_file(world, ck) == SPH_OK, "restore of the repaired set");
 
+  /* Arguments refused on the last rank alone (since session 37; before, that rank returned while
+   * the others went on: a save then wrote the rank's file where the manifest does not look, a load
+   * left the others in MPI_Comm_dup or with a world of another set): every rank refuses. */
+  if (g_size > 1) {
+    char elsewhere[256];
+    sph_world* w = NULL;
+    path_of(elsewhere, sizeof elsewhere, "elsewhere.sphck");
+    r = sph_mpi_world_save_file(world, g_rank == g_size - 1 ? elsewhere : ck2);
+    CHECK(r == SPH_ERROR_INVALID_ARGUMENT && strstr(sph_get_last_error(), "same checkpoint"),
+          "a save to another path on the last rank: rank %d returned %d (%s)", g_rank, (int)r,
+          sph_get_last_error());
+    CHECK(access(elsewhere, F_OK) != 0, "the refused save wrote %s", elsewhere);
+    expect_failed_restore(world, n, g_rank == g_size - 1 ? ck2 : ck, SPH_ERROR_INVALID_ARGUMENT, -1,
+                          "same checkpoint", "a restore from another path on the last rank");
+    r = sph_mpi_world_load_file(context, MPI_TEST_COMM, g_rank == g_size - 1 ? ck2 : ck, &w);
+    CHECK(r == SPH_ERROR_INVALID_ARGUMENT && w == NULL, "a load from another path on the last rank: %d (%s)",
+          (int)r, sph_get_last_error());
+  }
+  {
+    sph_world* w = NULL;
+    r = sph_mpi_world_load_file(context, MPI_TEST_COMM, ck, g_rank == g_size - 1 ? NULL : &w);
+    CHECK(r == SPH_ERROR_INVALID_ARGUMENT && w == NULL,
+          "a load with a NULL out on the last rank: rank %d %d (%s)", g_rank, (int)r, sph_get_last_error());
+    CHECK(g_rank == g_size - 1 || strstr(sph_get_last_error(), "rank") != NULL,
+          "a load with a NULL out elsewhere: the message names the rank: %s", sph_get_last_error());
+  }
+
   /* A crash after the ranks renamed their files in and before rank 0 replaced the manifest
    * leaves the new files beside the old manifest under names of their own (the file's hash in
    * the name): emulated with the later set's files renamed to the names a save to `ck` would give
