@@ -31,7 +31,8 @@ constexpr double kMaxStepBudgetSeconds = 86400.0;
 // used to return while the others waited for it in the frame's first collective call, and a rank
 // with another frame or other parameters would take other substeps and wait alone in theirs. One
 // agreement and two all-reduces of three int64 a frame. The scene's objects are compared by count
-// (a rank with another collider or probe would meet the others' reductions with another size).
+// (a rank with another collider or probe would meet the others' reductions with another size), the
+// colliders also by pose and target.
 void require_frame(const sph_world* world, float frame_dt) {
   const RankTransport* ranks = world->world->backend().rank_transport();
   if (!ranks) {
@@ -54,6 +55,20 @@ void require_frame(const sph_world* world, float frame_dt) {
                                w.force_fields().size(), w.probes().size()};
   Fnv1a64 scene;
   scene.add(objects, sizeof objects);
+  // And the colliders' poses and targets: each rank picks the step from the fastest collider
+  // surface (SceneFrame::max_collider_speed, not reduced over the ranks), so a collider moved on
+  // one rank alone would give the ranks other substeps.
+  w.colliders().for_each([&](uint64_t, const Collider& c) {
+    const auto add_pose = [&](const RigidTransform& t) {
+      const float v[7] = {t.position.x, t.position.y, t.position.z, t.rotation.x,
+                          t.rotation.y, t.rotation.z, t.rotation.w};
+      scene.add(v, sizeof v);
+    };
+    add_pose(c.pose);
+    const uint8_t targeted = c.target ? 1 : 0;
+    scene.add(&targeted, 1);
+    if (c.target) add_pose(*c.target);
+  });
   const uint64_t scene_hash = scene.value();
   uint32_t dt_bits;
   std::memcpy(&dt_bits, &frame_dt, sizeof dt_bits);
@@ -76,7 +91,9 @@ void require_frame(const sph_world* world, float frame_dt) {
                 "world: its scene differs between the ranks of the distributed world (this rank has " +
                     std::to_string(objects[0]) + " colliders, " + std::to_string(objects[1]) + " sources, " +
                     std::to_string(objects[2]) + " sinks, " + std::to_string(objects[3]) + " force fields, " +
-                    std::to_string(objects[4]) + " probes): every rank must add the same objects");
+                    std::to_string(objects[4]) +
+                    " probes; or a collider's pose or target differs): every rank must add and move the same "
+                    "objects");
 }
 
 // One frame of a world whose lock the caller holds: true if it completed, false if its budget,
@@ -172,6 +189,11 @@ SPH_API sph_result SPH_CALL sph_cuda_world_step_begin_on_stream(sph_world* world
     sph::WorldLock lock(world);
     sph::require_positive(frame_dt, "frame_dt");
     const sph::Backend& backend = world->world->backend();
+    // As sph_world_step_begin: its MPI calls would run on the step's thread.
+    if (backend.distributed())
+      throw Error(Status::Unsupported,
+                  "world: a distributed world (sph_mpi.h) steps on the calling thread only; use "
+                  "sph_mpi_world_step");
     // Refuses a CPU world and a stream CUDA refuses.
     sph::marking_device_lost(world, [&] { backend.order_after_stream(stream); });
     auto enqueued = std::make_shared<sph::StepSignal>();

@@ -12,8 +12,8 @@
 //     rank owns it, and the ranks holding it as ghosts: every rank returns SPH_ERROR_CAPACITY and
 //     the world is unchanged;
 //   - a frame refused on the last rank alone (frame_dt not positive), a frame_dt that differs
-//     between the ranks, parameters (sph_world_set_params) or a scene (a probe on one rank) that
-//     differ: every rank returns
+//     between the ranks, parameters (sph_world_set_params) or a scene (a probe on one rank, a
+//     collider moved on one rank) that differ: every rank returns
 //     INVALID_ARGUMENT, the world unchanged, and steps on once the ranks agree;
 //   - sph_mpi_world_create refused on the last rank alone (an invalid world definition, an invalid
 //     rebalance threshold, a NULL out, a NULL context): every rank returns that rank's status, the
@@ -261,6 +261,22 @@ void frames_disagreed(sph_context* context) {
           "a probe on rank %d alone: rank %d returned %d (%s)", culprit, g_rank, (int)r,
           sph_get_last_error());
     if (g_rank == culprit) REQUIRE(sph_probe_destroy(world, probe_id) == SPH_OK, "probe destroy");
+    // A collider moved on one rank alone (each rank picks the step from its fastest collider): the
+    // same counts, another scene.
+    const support_tank far_tank = {{5.0f, 0.2f, 0.1f}, {0.2f, 0.2f, 0.1f}, 0.02f, 0.0f};
+    sph_sdf* far_sdf = nullptr;
+    sph_collider_id far_id{};
+    REQUIRE(support_tank_create(context, world, &far_tank, &far_sdf, &far_id) == SPH_OK, "a second tank");
+    if (g_rank == culprit) {
+      const sph_transform moved = {{5.0f, 0.3f, 0.1f}, {0.0f, 0.0f, 0.0f, 1.0f}};
+      REQUIRE(sph_collider_set_target_transform(world, far_id, &moved) == SPH_OK, "target");
+    }
+    r = sph_mpi_world_step(world, 1.0f);
+    CHECK(r == SPH_ERROR_INVALID_ARGUMENT && strstr(sph_get_last_error(), "scene differs"),
+          "a collider moved on rank %d alone: rank %d returned %d (%s)", culprit, g_rank, (int)r,
+          sph_get_last_error());
+    REQUIRE(sph_collider_destroy(world, far_id) == SPH_OK && sph_sdf_destroy(far_sdf) == SPH_OK,
+            "destroy tank");
   }
   mpi_test_gather(world, n, &x1, &v1);
   CHECK(g_rank != 0 || mpi_differ(x0, v0, x1, v1, n, nullptr) == 0, "a refused frame changed the world");
