@@ -89,7 +89,8 @@ SPH_API sph_result SPH_CALL sph_mpi_world_add_particles(sph_world* world, const 
 
 /**
  * COLLECTIVE. Steps the world by frame_dt on every rank; the same codes as sph_world_step. The
- * ranks agree on frame_dt, the world's parameters (sph_world_set_params on each rank), the count
+ * ranks agree on frame_dt, the world's parameters (sph_world_set_params on each rank) and
+ * definition (sph_world_def, capacities aside), the count
  * of each kind of scene object (colliders, sources, sinks, force fields, probes) and the
  * colliders' poses and targets before the frame: a frame_dt refused on one rank, or any of these
  * that differs between the ranks, is INVALID_ARGUMENT on every rank, the world unchanged.

@@ -3515,12 +3515,12 @@ namespace Sph
 
         /// <summary>
         /// COLLECTIVE. Steps the world by frame_dt on every rank; the same codes as sph_world_step. The
-        /// ranks agree on frame_dt, the world's parameters (sph_world_set_params on each rank), the
-        /// count of each kind of scene object (colliders, sources, sinks, force fields, probes) and the
-        /// colliders' poses and targets before the frame: a frame_dt refused on one rank, or any of
-        /// these that differs between the ranks, is INVALID_ARGUMENT on every rank, the world
-        /// unchanged. sph_world_step_begin and sph_cuda_world_step_begin_on_stream refuse a distributed
-        /// world (UNSUPPORTED).
+        /// ranks agree on frame_dt, the world's parameters (sph_world_set_params on each rank) and
+        /// definition (sph_world_def, capacities aside), the count of each kind of scene object
+        /// (colliders, sources, sinks, force fields, probes) and the colliders' poses and targets
+        /// before the frame: a frame_dt refused on one rank, or any of these that differs between the
+        /// ranks, is INVALID_ARGUMENT on every rank, the world unchanged. sph_world_step_begin and
+        /// sph_cuda_world_step_begin_on_stream refuse a distributed world (UNSUPPORTED).
         /// </summary>
         [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_mpi_world_step(WorldHandle world, float frameDt);

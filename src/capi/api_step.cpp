@@ -44,6 +44,18 @@ void require_frame(const sph_world* world, float frame_dt) {
     require_positive(frame_dt, "frame_dt");
     ByteWriter w;
     write_params(w, world->world->params());  // (the checkpoints' canonical bytes)
+    // And the world's definition, less its capacities (a rank's own): the solver, the methods, the
+    // lattice and the fluid.
+    const WorldConfig& c = world->world->config();
+    w.u32(c.features);
+    w.u32(static_cast<uint32_t>(c.integrator));
+    w.u32(static_cast<uint32_t>(c.viscosity_method));
+    w.u32(static_cast<uint32_t>(c.equation_of_state));
+    w.u32(static_cast<uint32_t>(c.solver));
+    w.f32(c.particle_spacing);
+    w.f32(c.kernel_radius);
+    w.f32(c.rest_density);
+    w.f32(c.particle_mass);
     Fnv1a64 h;
     h.add(w.buffer().data(), w.size());
     params_hash = h.value();
@@ -84,8 +96,8 @@ void require_frame(const sph_world* world, float frame_dt) {
                                              "world: every rank steps the same frame");
   if (lo[1] != hi[1])
     throw Error(Status::InvalidArgument,
-                "world: its parameters (sph_world_set_params) differ between the ranks of the distributed "
-                "world: every rank must set the same");
+                "world: its parameters (sph_world_set_params) or its definition (sph_world_def, capacities "
+                "aside) differ between the ranks of the distributed world: every rank must set the same");
   if (lo[2] != hi[2])
     throw Error(Status::InvalidArgument,
                 "world: its scene differs between the ranks of the distributed world (this rank has " +

@@ -12,8 +12,9 @@
 //     rank owns it, and the ranks holding it as ghosts: every rank returns SPH_ERROR_CAPACITY and
 //     the world is unchanged;
 //   - a frame refused on the last rank alone (frame_dt not positive), a frame_dt that differs
-//     between the ranks, parameters (sph_world_set_params) or a scene (a probe on one rank, a
-//     collider moved on one rank) that differ: every rank returns
+//     between the ranks, parameters (sph_world_set_params), a definition (Clavet's viscosity on one
+//     rank) or a scene (a probe on one rank, a collider moved on one rank) that differ: every rank
+//     returns
 //     INVALID_ARGUMENT, the world unchanged, and steps on once the ranks agree;
 //   - sph_mpi_world_create refused on the last rank alone (an invalid world definition, an invalid
 //     rebalance threshold, a NULL out, a NULL context): every rank returns that rank's status, the
@@ -277,6 +278,18 @@ void frames_disagreed(sph_context* context) {
           sph_get_last_error());
     REQUIRE(sph_collider_destroy(world, far_id) == SPH_OK && sph_sdf_destroy(far_sdf) == SPH_OK,
             "destroy tank");
+    // Another world definition on one rank (Clavet's viscosity): made, but its first frame refused.
+    sph_world_def other_def = def;
+    if (g_rank == culprit) other_def.viscosity_method = SPH_VISCOSITY_CLAVET;
+    sph_world* other = nullptr;
+    uint32_t other_n = 0;
+    mpi_test_dam(context, &other_def, 0.0f, NULL, NULL, &other, &other_n);
+    set_substeps(other);
+    r = sph_mpi_world_step(other, 1.0f);
+    CHECK(r == SPH_ERROR_INVALID_ARGUMENT && strstr(sph_get_last_error(), "definition"),
+          "Clavet's viscosity on rank %d alone: rank %d returned %d (%s)", culprit, g_rank, (int)r,
+          sph_get_last_error());
+    REQUIRE(sph_world_destroy(other) == SPH_OK, "destroy");
   }
   mpi_test_gather(world, n, &x1, &v1);
   CHECK(g_rank != 0 || mpi_differ(x0, v0, x1, v1, n, nullptr) == 0, "a refused frame changed the world");

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '4a8a7859076b7e24c05a6a2f1821f21e86bff56d4f39cf7f1b79885ee690af57', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a9393b1446f811f410ff0dfa557cefa89e8891b74fd3db743a1f832270cf008c', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '4a8a7859076b7e24c05a6a2f1821f21e86bff56d4f39cf7f1b79885ee690af57', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': '04c0bbb340c0ccadb47c7121dac0524465ef79b7e22281acbfe74a0d1f4e809e', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -2391,7 +2391,7 @@ FUNCTIONS = {
     'sph_mpi_world_add_particles': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_float), _c.POINTER(_c.c_float), _c.c_uint32, _c.POINTER(_c.c_uint32)), ('world', 'positions', 'velocities', 'count', 'out_first_id'),
         "COLLECTIVE. Adds `count` particles from this rank (positions and, unless NULL, velocities: 3 x float32 each, packed; count may be 0). Ids are numbered across the ranks in rank order: rank 0's first, so a world whose rank 0 adds everything numbers them as an undivided world would. Particles may be anywhere: each moves to the rank that owns its slab in the next step. All-or-nothing over the ranks: if any rank's particles are refused (INVALID_ARGUMENT as sph_world_spawn's, CAPACITY), every rank returns SPH_ERROR_INVALID_ARGUMENT (the refusing rank its own code) and no rank adds any. *out_first_id (may be NULL): this rank's first id. sph_world_spawn and the fills of sph_c.h return UNSUPPORTED on a distributed world.", 'sph_mpi'),
     'sph_mpi_world_step': (sph_result, (_c.POINTER(sph_world), _c.c_float), ('world', 'frame_dt'),
-        "COLLECTIVE. Steps the world by frame_dt on every rank; the same codes as sph_world_step. The ranks agree on frame_dt, the world's parameters (sph_world_set_params on each rank), the count of each kind of scene object (colliders, sources, sinks, force fields, probes) and the colliders' poses and targets before the frame: a frame_dt refused on one rank, or any of these that differs between the ranks, is INVALID_ARGUMENT on every rank, the world unchanged. sph_world_step_begin and sph_cuda_world_step_begin_on_stream refuse a distributed world (UNSUPPORTED).", 'sph_mpi'),
+        "COLLECTIVE. Steps the world by frame_dt on every rank; the same codes as sph_world_step. The ranks agree on frame_dt, the world's parameters (sph_world_set_params on each rank) and definition (sph_world_def, capacities aside), the count of each kind of scene object (colliders, sources, sinks, force fields, probes) and the colliders' poses and targets before the frame: a frame_dt refused on one rank, or any of these that differs between the ranks, is INVALID_ARGUMENT on every rank, the world unchanged. sph_world_step_begin and sph_cuda_world_step_begin_on_stream refuse a distributed world (UNSUPPORTED).", 'sph_mpi'),
     'sph_mpi_counts_init_sized': (sph_result, (_c.POINTER(sph_mpi_counts), _c.c_uint32), ('counts', 'size'),
         '', 'sph_mpi'),
     'sph_mpi_world_get_counts': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_mpi_counts)), ('world', 'out'),
