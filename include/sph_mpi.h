@@ -193,12 +193,11 @@ SPH_API sph_result SPH_CALL sph_mpi_world_save_file(const sph_world* world, cons
  * rebalance threshold is the saved world's. On any error on any rank, no rank creates a world
  * and *out is untouched (the arguments too are checked over the ranks: a NULL out on one rank is
  * every rank's refusal). Errors: INVALID_HANDLE (context), INVALID_ARGUMENT (NULL path or out;
- * another path on another rank; a file that cannot be read; a bad communicator), CORRUPT_DATA (a damaged manifest or rank file,
- * a rank file whose size or hash is not the manifest's, or files of different worlds: the
- * message names the file), CAPACITY (on fewer ranks, the particles a rank takes exceed the
- * world's max_capacity, which is per rank), VERSION_MISMATCH, UNSUPPORTED (a CUDA context),
- * OUT_OF_HOST_MEMORY; a rank that found nothing
- * wrong returns the first failing rank's code.
+ * another path on another rank; a file that cannot be read; a bad communicator), CORRUPT_DATA (a damaged
+ * manifest or rank file, a rank file whose size or hash is not the manifest's, or files of different worlds:
+ * the message names the file), CAPACITY (on fewer ranks, the particles a rank takes exceed the world's
+ * max_capacity, which is per rank), VERSION_MISMATCH, UNSUPPORTED (a CUDA context), OUT_OF_HOST_MEMORY; a
+ * rank that found nothing wrong returns the first failing rank's code.
  */
 SPH_API sph_result SPH_CALL sph_mpi_world_load_file(sph_context* context, int32_t comm, const char* path,
                                                     sph_world** out);
