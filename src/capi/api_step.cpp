@@ -9,6 +9,7 @@
 #include <system_error>
 
 #include "../core/byte_io.h"
+#include "../core/checkpoint.h"
 #include "../core/checkpoint_params.h"
 #include "../core/rank_agreement.h"
 #include "guard.h"
@@ -44,18 +45,11 @@ void require_frame(const sph_world* world, float frame_dt) {
     require_positive(frame_dt, "frame_dt");
     ByteWriter w;
     write_params(w, world->world->params());  // (the checkpoints' canonical bytes)
-    // And the world's definition, less its capacities (a rank's own): the solver, the methods, the
-    // lattice and the fluid.
-    const WorldConfig& c = world->world->config();
-    w.u32(c.features);
-    w.u32(static_cast<uint32_t>(c.integrator));
-    w.u32(static_cast<uint32_t>(c.viscosity_method));
-    w.u32(static_cast<uint32_t>(c.equation_of_state));
-    w.u32(static_cast<uint32_t>(c.solver));
-    w.f32(c.particle_spacing);
-    w.f32(c.kernel_radius);
-    w.f32(c.rest_density);
-    w.f32(c.particle_mass);
+    // And the world's definition as a checkpoint holds it, less its capacities (a rank's own).
+    WorldConfig definition = world->world->config();
+    definition.capacity = 0;
+    definition.max_capacity = 0;
+    write_config(w, definition);
     Fnv1a64 h;
     h.add(w.buffer().data(), w.size());
     params_hash = h.value();
@@ -84,21 +78,20 @@ void require_frame(const sph_world* world, float frame_dt) {
   const uint64_t scene_hash = scene.value();
   uint32_t dt_bits;
   std::memcpy(&dt_bits, &frame_dt, sizeof dt_bits);
-  int64_t hashes[2];
-  std::memcpy(&hashes[0], &params_hash, sizeof hashes[0]);
-  std::memcpy(&hashes[1], &scene_hash, sizeof hashes[1]);
-  int64_t lo[3] = {dt_bits, hashes[0], hashes[1]}, hi[3] = {dt_bits, hashes[0], hashes[1]};
-  ranks->all_min(lo, 3);
-  ranks->all_max(hi, 3);
-  if (lo[0] != hi[0])
+  int64_t values[3] = {dt_bits, 0, 0};
+  std::memcpy(&values[1], &params_hash, sizeof values[1]);
+  std::memcpy(&values[2], &scene_hash, sizeof values[2]);
+  bool same[3];
+  compare_over_ranks(*ranks, values, 3, same);
+  if (!same[0])
     throw Error(Status::InvalidArgument, "frame_dt: " + std::to_string(frame_dt) +
                                              " on this rank and another on another rank of the distributed "
                                              "world: every rank steps the same frame");
-  if (lo[1] != hi[1])
+  if (!same[1])
     throw Error(Status::InvalidArgument,
                 "world: its parameters (sph_world_set_params) or its definition (sph_world_def, capacities "
                 "aside) differ between the ranks of the distributed world: every rank must set the same");
-  if (lo[2] != hi[2])
+  if (!same[2])
     throw Error(Status::InvalidArgument,
                 "world: its scene differs between the ranks of the distributed world (this rank has " +
                     std::to_string(objects[0]) + " colliders, " + std::to_string(objects[1]) + " sources, " +

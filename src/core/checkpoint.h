@@ -10,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "byte_io.h"
 #include "particle_snapshot.h"
 #include "world.h"
 
@@ -23,6 +24,10 @@ struct CheckpointOrigin {
   // kFlagRankPart). A distributed world saves only as such, any other world never.
   bool rank_part = false;
 };
+
+// The world's definition section of a checkpoint (the capacities, the methods, the lattice and the
+// fluid; layout: checkpoint_format.h).
+void write_config(ByteWriter& w, const WorldConfig& c);
 
 // Serialises a world. Throws on allocation or backend (device) failures, and Unsupported for a
 // distributed world unless origin.rank_part.

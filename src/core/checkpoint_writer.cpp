@@ -57,20 +57,6 @@ void section(ByteWriter& w, uint32_t tag_value, Body&& body) {
   w.patch_u64(length_at, w.size() - start);
 }
 
-void write_config(ByteWriter& w, const WorldConfig& c) {
-  w.u32(c.capacity);
-  w.u32(c.features);
-  w.u32(static_cast<uint32_t>(c.integrator));
-  w.u32(static_cast<uint32_t>(c.viscosity_method));
-  w.u32(static_cast<uint32_t>(c.equation_of_state));
-  w.f32(c.particle_spacing);
-  w.f32(c.kernel_radius);
-  w.f32(c.rest_density);
-  w.f32(c.particle_mass);
-  w.u32(static_cast<uint32_t>(c.solver));
-  w.u32(c.max_capacity);  // version 5
-}
-
 void write_solve(ByteWriter& w, const SolveReport& s) {
   w.u32(s.iterations);
   w.u32(s.iterations_max);
@@ -187,6 +173,20 @@ void write_particle_section(ByteWriter& w, const World& world, const ParticleSna
 }
 
 }  // namespace
+
+void write_config(ByteWriter& w, const WorldConfig& c) {
+  w.u32(c.capacity);
+  w.u32(c.features);
+  w.u32(static_cast<uint32_t>(c.integrator));
+  w.u32(static_cast<uint32_t>(c.viscosity_method));
+  w.u32(static_cast<uint32_t>(c.equation_of_state));
+  w.f32(c.particle_spacing);
+  w.f32(c.kernel_radius);
+  w.f32(c.rest_density);
+  w.f32(c.particle_mass);
+  w.u32(static_cast<uint32_t>(c.solver));
+  w.u32(c.max_capacity);  // version 5
+}
 
 HostVector<uint8_t> write_checkpoint(const World& world, const CheckpointOrigin& origin) {
   if (world.backend().distributed() != origin.rank_part)

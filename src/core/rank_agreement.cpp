@@ -40,6 +40,16 @@ void agree(const RankTransport& ranks, int64_t* payload) {
   *payload = value - ranks.size();
 }
 
+void compare_over_ranks(const RankTransport& ranks, const int64_t* values, int n, bool* same) {
+  if (n < 0 || n > 4) throw Error(Status::Internal, "compare_over_ranks: at most 4 values");
+  int64_t lo[4], hi[4];
+  std::memcpy(lo, values, sizeof(int64_t) * static_cast<size_t>(n));
+  std::memcpy(hi, values, sizeof(int64_t) * static_cast<size_t>(n));
+  ranks.all_min(lo, n);
+  ranks.all_max(hi, n);
+  for (int k = 0; k < n; ++k) same[k] = lo[k] == hi[k];
+}
+
 void rethrow_agreed(const RankTransport& ranks) {
   try {
     throw;

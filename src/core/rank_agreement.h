@@ -33,6 +33,11 @@ inline void agree(const RankTransport& ranks) {
   agree(ranks, &none);
 }
 
+// COLLECTIVE, among ranks that have not failed. same[k]: whether values[k] is the same on every
+// rank, for k < n <= 4 (two all-reduces of n int64): how the ranks compare what must match (a
+// frame's inputs, a world's backend, a checkpoint's path) before they act on it.
+void compare_over_ranks(const RankTransport& ranks, const int64_t* values, int n, bool* same);
+
 // COLLECTIVE, inside a catch block: rethrows an AgreedRankFailure as it is; any other exception
 // is this rank's own failure, which meets the others at their next agreement (so that each of
 // them fails too, with the first failing rank's error) and is rethrown as an AgreedRankFailure of

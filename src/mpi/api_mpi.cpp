@@ -79,10 +79,9 @@ SPH_API sph_result SPH_CALL sph_mpi_world_create(sph_context* context, const sph
     // rank keep their particles, their tables and what they send each other in different layouts
     // (docs/distributed.md).
     const int64_t cuda = hold->get()->backend == sph::BackendKind::Cuda ? 1 : 0;
-    int64_t lowest = cuda, highest = cuda;
-    transport->all_min(&lowest, 1);
-    transport->all_max(&highest, 1);
-    if (lowest != highest)
+    bool same = true;
+    sph::compare_over_ranks(ranks, &cuda, 1, &same);
+    if (!same)
       throw Error(Status::InvalidArgument, std::string("context: this rank's backend is ") +
                                                (cuda ? "CUDA" : "the CPU") + " and another rank's is " +
                                                (cuda ? "the CPU" : "CUDA") +
@@ -92,16 +91,7 @@ SPH_API sph_result SPH_CALL sph_mpi_world_create(sph_context* context, const sph
       world = sph::make_world(context, d);
       world->world->backend().attach_ranks(transport, options);
     });
-    // Published under an agreement too: a rank that fails to register its world takes the others'
-    // back out of the registry, so no rank keeps a world the others do not have.
-    sph_world* handle = nullptr;
-    try {
-      sph::agreed(ranks, [&] { handle = sph::publish_world(std::move(world)); });
-    } catch (...) {
-      if (handle && sph::try_retire_world(handle) == sph::Take::Taken) delete handle;
-      throw;
-    }
-    *out = handle;
+    *out = sph::publish_on_every_rank(ranks, std::move(world));
     return SPH_OK;
   });
 }

@@ -46,18 +46,17 @@ void require_path(const char* path) {
 }
 
 // COLLECTIVE, after an agreement that every rank's path is one: the same path on every rank (its
-// FNV-1a hash compared by two all-reduces of one int64). A rank that named another set would save
+// FNV-1a hash compared over the ranks). A rank that named another set would save
 // its file where the manifest does not look, or load another world's part.
 void require_same_path(const RankTransport& ranks, const char* path) {
   Fnv1a64 h;
   h.add(path, std::strlen(path));
   const uint64_t hash = h.value();
-  int64_t lo, hi;
-  std::memcpy(&lo, &hash, sizeof lo);
-  hi = lo;
-  ranks.all_min(&lo, 1);
-  ranks.all_max(&hi, 1);
-  if (lo != hi)
+  int64_t value;
+  std::memcpy(&value, &hash, sizeof value);
+  bool same = true;
+  compare_over_ranks(ranks, &value, 1, &same);
+  if (!same)
     throw Error(Status::InvalidArgument, std::string("path: '") + path +
                                              "' on this rank and another on another rank: every rank must "
                                              "name the same checkpoint");
@@ -332,14 +331,7 @@ SPH_API sph_result SPH_CALL sph_mpi_world_load_file(sph_context* context, int32_
       world->context = hold->get();
       world->world = std::move(loaded);
     });
-    sph_world* handle = nullptr;
-    try {
-      sph::agreed(*ranks, [&] { handle = sph::publish_world(std::move(world)); });
-    } catch (...) {
-      if (handle && sph::try_retire_world(handle) == sph::Take::Taken) delete handle;
-      throw;
-    }
-    *out = handle;
+    *out = sph::publish_on_every_rank(*ranks, std::move(world));
     return SPH_OK;
   });
 }
