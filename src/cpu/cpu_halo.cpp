@@ -16,15 +16,14 @@
 //                     each stage's end, as each stage sorts and gathers anew).
 // DFSPH's per-iteration exchanges, the probes' and the loads' sums: cpu_halo_solvers.cpp.
 // The particles' moves, the keys and the records' wire are CpuRankHalo's (cpu_rank_halo.h; its
-// steps first below); the backend's side, last below, picks the values the ghosts take and
-// reduces the step's inputs, which are the backend's.
-// Each place where the ranks meet after code that can fail (an allocation, a crowded cell) is
-// an agreement (core/rank_agreement.h): a rank that failed joins the others' next one from its
-// catch block (rethrow_step_failure), and every rank returns the error instead of waiting.
-// The sort takes particles in key order, so each cell's particles come in the order the
-// undivided world's stable sort gives them: the neighbour sums add in the same order and a
-// distributed world steps the single world's bits (while the grid's table covers the
-// particles' extent without folding; docs/distributed.md).
+// steps first below; the messages' layout, pack and unpack: cpu_halo_pack.cpp); the backend's side, last
+// below, picks the values the ghosts take and reduces the step's inputs, which are the backend's. Each place
+// where the ranks meet after code that can fail (an allocation, a crowded cell) is an agreement
+// (core/rank_agreement.h): a rank that failed joins the others' next one from its catch block
+// (rethrow_step_failure), and every rank returns the error instead of waiting. The sort takes particles in
+// key order, so each cell's particles come in the order the undivided world's stable sort gives them: the
+// neighbour sums add in the same order and a distributed world steps the single world's bits (while the
+// grid's table covers the particles' extent without folding; docs/distributed.md).
 #include <algorithm>
 #include <chrono>
 #include <cstring>
@@ -115,86 +114,6 @@ class PhaseClock {
 int32_t CpuRankHalo::layer(uint32_t i) const {
   const Float4& p = position_[i];
   return slab_layer(p.x, p.y, p.z, slabs_.axis(), 1.0f / kernel_radius_);
-}
-
-bool CpuRankHalo::travels(const ParticleArraySpec& spec) {
-  if (spec.elements_per_particle == 0) return false;
-  // RK4's stage state lives through a substep, and a particle may change ranks between its stages.
-  return spec.role == ParticleArrayRole::Carried || std::strcmp(spec.name, kArrayRk4Start) == 0 ||
-         std::strcmp(spec.name, kArrayRk4Sum) == 0;
-}
-
-size_t CpuRankHalo::travelling_bytes() const {
-  size_t record = 0;
-  for (const auto& a : store_.arrays())
-    if (travels(a->spec)) record += particle_bytes(a->spec);
-  return record;
-}
-
-namespace {
-
-// Rows `which` of a column of `bytes`-byte rows, one after the other into `to`; returns the end.
-// (A fixed size per call for the common widths, so that each copy is a load and a store.)
-template <size_t kBytes>
-unsigned char* copy_rows(unsigned char* to, const unsigned char* column, const HostVector<uint32_t>& which) {
-  for (const uint32_t i : which) {
-    std::memcpy(to, column + static_cast<size_t>(i) * kBytes, kBytes);
-    to += kBytes;
-  }
-  return to;
-}
-
-unsigned char* copy_rows(unsigned char* to, const unsigned char* column, size_t bytes,
-                         const HostVector<uint32_t>& which) {
-  switch (bytes) {
-    case 4:
-      return copy_rows<4>(to, column, which);
-    case 8:
-      return copy_rows<8>(to, column, which);
-    case 12:
-      return copy_rows<12>(to, column, which);
-    case 16:
-      return copy_rows<16>(to, column, which);
-    default:
-      for (const uint32_t i : which) {
-        std::memcpy(to, column + static_cast<size_t>(i) * bytes, bytes);
-        to += bytes;
-      }
-      return to;
-  }
-}
-
-}  // namespace
-
-// Array after array (the travelling ones' test and widths once a pack, not once a particle: the
-// per-particle loop over every array, with travels()'s string compares, was the halo's largest
-// cost outside the passes and the sort in a profile of 4 ranks, session 37).
-void CpuRankHalo::pack(const HostVector<uint32_t>& which, RankBytes& out) const {
-  out.clear();
-  if (which.empty()) return;
-  out.resize(travelling_bytes() * which.size());
-  unsigned char* to = out.data();
-  for (const auto& a : store_.arrays())
-    if (travels(a->spec)) to = copy_rows(to, a->bytes.data(), particle_bytes(a->spec), which);
-}
-
-uint32_t CpuRankHalo::unpack(const RankBytes& in, uint32_t origin) {
-  const size_t record = travelling_bytes();
-  if (in.size() % record != 0) throw Error(Status::Internal, "halo: a rank sent a partial particle record");
-  const uint32_t n = static_cast<uint32_t>(in.size() / record);
-  if (n == 0) return 0;
-  const uint32_t first = count_;
-  store_.resize(static_cast<size_t>(first) + n);
-  const unsigned char* from = in.data();
-  for (const auto& a : store_.arrays()) {
-    if (!travels(a->spec)) continue;
-    const size_t bytes = particle_bytes(a->spec) * n;
-    std::memcpy(a->bytes.data() + static_cast<size_t>(first) * particle_bytes(a->spec), from, bytes);
-    from += bytes;
-  }
-  for (uint32_t k = 0; k < n; ++k) origin_[first + k] = origin;
-  count_ = first + n;
-  return n;
 }
 
 void CpuRankHalo::keep(size_t kept) {
@@ -332,52 +251,7 @@ void CpuRankHalo::gather() {
   shape_ = rank_grid_shape(world_shape_, clo, chi, axis, first, last, held_first, held_last);
   own_table_ = shape_.nx != world_shape_.nx || shape_.ny != world_shape_.ny || shape_.nz != world_shape_.nz;
   clock.lap(kHaloExtent);
-  // The sort's order: by key, then id (two keys are equal only where the table folds). The
-  // particles arrive as a few runs already in that order: the kept owned ones (in the last sort's
-  // order, whose keys after_sort numbered), then each rank's migrants and each rank's ghosts (in
-  // their sender's order). Merging the runs gives the order a sort would (key and id together are
-  // unique, so the order is the one sorted order) in linear time, where the sort took n log n: about 1 ms of
-  // a 40 ms substep at 84,672 particles on one rank of the development VM, and as much on each of two ranks
-  // (session 36). Many runs (the first substep, a rebalance) sort instead.
-  visit_.resize(count_);
-  for (uint32_t i = 0; i < count_; ++i) visit_[i] = i;
-  const uint64_t* key = sort_key_.data();
-  const uint32_t* id = id_.data();
-  const auto before = [key, id](uint32_t a, uint32_t b) {
-    return key[a] != key[b] ? key[a] < key[b] : id[a] < id[b];
-  };
-  run_starts_.clear();
-  for (uint32_t i = 1; i < count_ && run_starts_.size() <= kMergedRuns; ++i)
-    if (before(i, i - 1)) run_starts_.push_back(i);
-  if (run_starts_.size() > kMergedRuns) {
-    std::sort(visit_.begin(), visit_.end(), before);
-    clock.lap(kHaloVisit);
-    return;
-  }
-  // Bottom-up: merge neighbouring runs into the other buffer until one is left (std::merge into
-  // storage of our own: std::inplace_merge would take its buffer unseen, and go on without it
-  // where that allocation fails, where every other allocation of a step fails the step).
-  run_starts_.insert(run_starts_.begin(), 0u);
-  run_starts_.push_back(count_);
-  merged_.resize(count_);
-  while (run_starts_.size() > 2) {
-    size_t kept = 0;
-    size_t r = 0;
-    for (; r + 2 < run_starts_.size(); r += 2) {
-      std::merge(visit_.begin() + run_starts_[r], visit_.begin() + run_starts_[r + 1],
-                 visit_.begin() + run_starts_[r + 1], visit_.begin() + run_starts_[r + 2],
-                 merged_.begin() + run_starts_[r], before);
-      run_starts_[kept++] = run_starts_[r];
-    }
-    if (r + 1 < run_starts_.size()) {  // an odd run out: copied as it is
-      std::copy(visit_.begin() + run_starts_[r], visit_.begin() + run_starts_[r + 1],
-                merged_.begin() + run_starts_[r]);
-      run_starts_[kept++] = run_starts_[r];
-    }
-    run_starts_[kept++] = count_;
-    run_starts_.resize(kept);
-    visit_.swap(merged_);
-  }
+  order_visits();
   clock.lap(kHaloVisit);
 }
 

@@ -128,6 +128,8 @@ class CpuRankHalo {
   uint32_t unpack(const RankBytes& in, uint32_t origin);
   // One particle's bytes of the travelling arrays.
   size_t travelling_bytes() const;
+  // visit_: the held particles by sort key, then id (the sort's order; cpu_halo_visit.cpp).
+  void order_visits();
   // Keeps the particles keep_ lists (ascending), in that order.
   void keep(size_t kept);
   // Springs across ranks (cpu_halo_springs.cpp). Outside a substep's sorted part the spring
