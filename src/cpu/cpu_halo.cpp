@@ -25,7 +25,6 @@
 // neighbour sums add in the same order and a distributed world steps the single world's bits (while the
 // grid's table covers the particles' extent without folding; docs/distributed.md).
 #include <algorithm>
-#include <chrono>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -93,21 +92,6 @@ void CpuRankHalo::agree() const { sph::agree(*ranks_); }
 namespace {
 
 float axis_coordinate(const Float4& p, int axis) { return axis == 0 ? p.x : (axis == 1 ? p.y : p.z); }
-
-// Adds the wall time since the last lap to a phase of the hash+sort stage (HaloPhaseTimes).
-class PhaseClock {
- public:
-  explicit PhaseClock(HaloPhaseTimes& times) : times_(times), at_(std::chrono::steady_clock::now()) {}
-  void lap(HaloPhase phase) {
-    const auto now = std::chrono::steady_clock::now();
-    times_.ms[phase] += std::chrono::duration<double, std::milli>(now - at_).count();
-    at_ = now;
-  }
-
- private:
-  HaloPhaseTimes& times_;
-  std::chrono::steady_clock::time_point at_;
-};
 
 }  // namespace
 

@@ -64,7 +64,7 @@ class CpuRankHalo {
   // The hash+sort stage's parts (gather's own; the backend adds the grid's, the reorder's and the
   // keys').
   const HaloPhaseTimes& phase_times() const { return phase_times_; }
-  void add_phase_time(HaloPhase phase, double ms) { phase_times_.ms[phase] += ms; }
+  HaloPhaseTimes& phase_times() { return phase_times_; }
   const std::shared_ptr<const RankTransport>& shared_transport() const { return ranks_; }
   DistributedCounters counters() const;
   // The decomposition and counters a rank's checkpoint carries (cpu_rank_state.cpp).

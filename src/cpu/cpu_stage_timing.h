@@ -7,6 +7,7 @@
 
 #include <chrono>
 
+#include "../core/distributed.h"
 #include "../core/frame_report.h"
 #include "../core/rank_transport.h"
 
@@ -17,6 +18,22 @@ using Clock = std::chrono::steady_clock;
 inline double elapsed_ms(Clock::time_point since) {
   return std::chrono::duration<double, std::milli>(Clock::now() - since).count();
 }
+
+// Adds the wall time since its last lap to a phase of a CPU rank's hash+sort stage (HaloPhaseTimes,
+// bench/mpi_halo's table).
+class PhaseClock {
+ public:
+  explicit PhaseClock(HaloPhaseTimes& times) : times_(times), at_(Clock::now()) {}
+  void lap(HaloPhase phase) {
+    const Clock::time_point now = Clock::now();
+    times_.ms[phase] += std::chrono::duration<double, std::milli>(now - at_).count();
+    at_ = now;
+  }
+
+ private:
+  HaloPhaseTimes& times_;
+  Clock::time_point at_;
+};
 
 // A stage's start: the clock and the transport's running times (zero without a transport).
 struct StageStart {

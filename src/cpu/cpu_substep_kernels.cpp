@@ -4,8 +4,6 @@
 // with the world's options compiled in (the twin of cuda/substep_kernels.cu). The neighbour
 // gathers run on the processor's SIMD target (cpu_simd_passes.h) and read the sorted records as
 // columns, which these passes keep up to date next to the records.
-#include <chrono>
-
 #include "../physics/density.h"
 #include "../physics/density_diffusion.h"
 #include "../physics/density_normalization.h"
@@ -21,26 +19,21 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
   auto t = stage_start();
   if (rank_) rank_->gather();
   // (A rank times the grid, the reorder and the keys too: HaloPhaseTimes.)
-  using PhaseClock = std::chrono::steady_clock;
-  const auto ms_since = [](PhaseClock::time_point since) {
-    return std::chrono::duration<double, std::milli>(PhaseClock::now() - since).count();
-  };
-  auto phase = PhaseClock::now();
+  HaloPhaseTimes undivided;
+  PhaseClock phases(rank_ ? rank_->phase_times() : undivided);
   grid_.build(position_.data(), count_, workers_, rank_ ? rank_->grid_shape() : nullptr,
               rank_ ? rank_->visit_order() : nullptr);
-  if (rank_) rank_->add_phase_time(kHaloGrid, ms_since(phase));
-  phase = PhaseClock::now();
+  phases.lap(kHaloGrid);
   columns_.resize(count_);
   // The columns copy each block of the new order as soon as it is reordered (data() is the new
   // order inside the reorder).
   store_.permute(grid_.order().data(), count_, parallel(), [this](size_t first, size_t last) {
     columns_.copy_state(position_.data(), velocity_.data(), first, last);
   });
+  phases.lap(kHaloReorder);
   if (rank_) {
-    rank_->add_phase_time(kHaloReorder, ms_since(phase));
-    phase = PhaseClock::now();
     rank_->after_sort(grid_);
-    rank_->add_phase_time(kHaloKeys, ms_since(phase));
+    phases.lap(kHaloKeys);
   }
   end_stage(report, kStageHashSort, t);
 
