@@ -94,11 +94,7 @@ void CudaBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks,
 
 DistributedCounters CudaBackend::distributed_counters() const {
   DistributedCounters c = halo_counters_;
-  c.axis = slabs_.axis();
-  const int me = ranks_ ? ranks_->rank() : 0;
-  const std::vector<int32_t>& cuts = slabs_.cuts();
-  c.slab_first = me == 0 ? INT32_MIN : cuts[static_cast<size_t>(me - 1)];
-  c.slab_last = me == static_cast<int>(cuts.size()) ? INT32_MAX : cuts[static_cast<size_t>(me)] - 1;
+  slabs_.describe(ranks_ ? ranks_->rank() : 0, c);
   return c;
 }
 
@@ -227,7 +223,7 @@ void CudaBackend::halo_gather() {
     owned += m;
     halo_counters_.migrated_in += m;
   }
-  // Ghosts: each owned particle of a layer beside another rank's slab goes to that rank.
+  // Ghosts: each owned particle goes to the other ranks whose slabs meet its layer or those beside.
   in = t.exchange(halo_send(h.list_ghosts(position, owned, axis, inv, me, s)));
   // (an agreement: the migrants' arrival, the ghosts' packing)
   uint32_t n = owned;

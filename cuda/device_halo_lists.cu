@@ -20,18 +20,19 @@
 namespace sph {
 namespace {
 
-// Migration: key = the owner of the particle's layer, this rank's own (what stays) last.
+// Migration: key = the owner of the particle's sub-layer, this rank's own (what stays) last.
 __global__ void migrant_keys_kernel(const Float4* __restrict__ positions, uint32_t n, int axis, float inv,
                                     const int32_t* __restrict__ cuts, int ranks, int me,
                                     uint32_t* __restrict__ keys) {
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
   const Float4 p = positions[i];
-  const int owner = slab_owner(cuts, ranks - 1, slab_layer(p.x, p.y, p.z, axis, inv));
+  const int owner = slab_owner(cuts, ranks - 1, slab_position(p.x, p.y, p.z, axis, inv));
   keys[i] = owner == me ? static_cast<uint32_t>(ranks) : static_cast<uint32_t>(owner);
 }
 
-// Ghosts: entries 2i and 2i + 1 name particle i for the ranks beside its layer, in rank order
+// Ghosts: entries 2i and 2i + 1 name particle i for the other ranks whose slabs meet its layer or
+// those beside (slab_rules.h: at most two), in rank order
 // (key `ranks`: none).
 __global__ void ghost_keys_kernel(const Float4* __restrict__ positions, uint32_t n, int axis, float inv,
                                   const int32_t* __restrict__ cuts, int ranks, int me,

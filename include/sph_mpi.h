@@ -111,13 +111,19 @@ typedef struct sph_mpi_counts {
   uint32_t local_ghosts;  /* halo particles this rank held in the last substep */
   uint32_t rebalances;    /* times the slabs were cut anew (the first cut counts) */
   int32_t axis;           /* the slabs' axis: 0 x, 1 y, 2 z */
-  /* This rank's slab: the cell layers [slab_first, slab_last] along axis, cell k holding
-   * floor(x / kernel_radius) = k (INT32_MIN / INT32_MAX: open; first > last: empty). */
+  /* The cell layers this rank's slab meets, [slab_first, slab_last] along axis, cell k holding
+   * floor(x / kernel_radius) = k (INT32_MIN / INT32_MAX: open; first > last: empty). Slabs are
+   * cut between sixteenths of a layer, so a neighbour's slab may share an end layer. */
   int32_t slab_first;
   int32_t slab_last;
   uint32_t reserved0;
+  /* This rank's slab exactly: the sub-layers [slab_sub_first, slab_sub_last], sub-layer 16 k + j
+   * holding the points of layer k whose fraction x / kernel_radius - k lies in [j/16, (j+1)/16)
+   * (INT32_MIN / INT32_MAX: open; first > last: empty). */
+  int32_t slab_sub_first;
+  int32_t slab_sub_last;
 } sph_mpi_counts;
-SPH_STATIC_ASSERT(sizeof(sph_mpi_counts) == 64, sph_mpi_counts_size);
+SPH_STATIC_ASSERT(sizeof(sph_mpi_counts) == 72, sph_mpi_counts_size);
 
 SPH_API sph_result SPH_CALL sph_mpi_counts_init_sized(sph_mpi_counts* counts, uint32_t size);
 static inline sph_result sph_mpi_counts_init(sph_mpi_counts* counts) {

@@ -590,6 +590,8 @@ typedef struct sph_mpi_counts {
   int32_t slab_first;
   int32_t slab_last;
   uint32_t reserved0;
+  int32_t slab_sub_first;
+  int32_t slab_sub_last;
 } sph_mpi_counts;
 
 // libsph

@@ -2246,7 +2246,7 @@ namespace Sph
         }
     }
 
-    /// <summary>sph_mpi_counts (64 bytes): Counts of a distributed world (sph_mpi_world_get_counts).</summary>
+    /// <summary>sph_mpi_counts (72 bytes): Counts of a distributed world (sph_mpi_world_get_counts).</summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct MpiCounts
     {
@@ -2271,15 +2271,25 @@ namespace Sph
         /// <summary>int32_t axis: the slabs' axis: 0 x, 1 y, 2 z</summary>
         public int Axis;
         /// <summary>
-        /// int32_t slab_first: This rank's slab: the cell layers [slab_first, slab_last] along axis,
-        /// cell k holding floor(x / kernel_radius) = k (INT32_MIN / INT32_MAX: open; first &gt; last:
-        /// empty).
+        /// int32_t slab_first: The cell layers this rank's slab meets, [slab_first, slab_last] along
+        /// axis, cell k holding floor(x / kernel_radius) = k (INT32_MIN / INT32_MAX: open; first &gt;
+        /// last: empty). Slabs are cut between sixteenths of a layer, so a neighbour's slab may share
+        /// an end layer.
         /// </summary>
         public int SlabFirst;
         /// <summary>int32_t slab_last</summary>
         public int SlabLast;
         /// <summary>uint32_t reserved0</summary>
         public uint Reserved0;
+        /// <summary>
+        /// int32_t slab_sub_first: This rank's slab exactly: the sub-layers [slab_sub_first,
+        /// slab_sub_last], sub-layer 16 k + j holding the points of layer k whose fraction x /
+        /// kernel_radius - k lies in [j/16, (j+1)/16) (INT32_MIN / INT32_MAX: open; first &gt; last:
+        /// empty).
+        /// </summary>
+        public int SlabSubFirst;
+        /// <summary>int32_t slab_sub_last</summary>
+        public int SlabSubLast;
 
         /// <summary>A MpiCounts with the library's defaults (sph_mpi_counts_init_sized).</summary>
         public static MpiCounts Default()
@@ -3778,7 +3788,7 @@ namespace Sph
             48,
             32,
             8,
-            64,
+            72,
         };
 
         // One entry per field: struct type, C# field name, C offset.
@@ -4052,6 +4062,8 @@ namespace Sph
             typeof(CudaAllocator),
             typeof(MpiWorldDef),
             typeof(MpiWorldDef),
+            typeof(MpiCounts),
+            typeof(MpiCounts),
             typeof(MpiCounts),
             typeof(MpiCounts),
             typeof(MpiCounts),
@@ -4349,6 +4361,8 @@ namespace Sph
             "SlabFirst",
             "SlabLast",
             "Reserved0",
+            "SlabSubFirst",
+            "SlabSubLast",
         };
         public static readonly int[] FieldOffsets = {
             0,
@@ -4633,6 +4647,8 @@ namespace Sph
             52,
             56,
             60,
+            64,
+            68,
         };
 
         /// <summary>Every exported function of the header.</summary>

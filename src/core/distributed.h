@@ -27,8 +27,10 @@ struct DistributedCounters {
   uint32_t migrated_out = 0;  // particles this rank sent to others, summed over substeps
   uint32_t rebalances = 0;    // times the slabs were cut anew (the first cut counts)
   int32_t axis = 0;           // the slabs' axis (0 x, 1 y, 2 z)
-  int32_t slab_first = 0;     // this rank's cell layers [slab_first, slab_last] (empty: first > last)
-  int32_t slab_last = 0;
+  int32_t slab_first = 0;     // the cell layers this rank's slab meets [slab_first, slab_last]
+  int32_t slab_last = 0;      // (empty: first > last; SlabDecomposition::describe)
+  int32_t sub_first = 0;      // its sub-layers [sub_first, sub_last] (slab_rules.h)
+  int32_t sub_last = 0;
 };
 
 // A CPU rank's hash+sort stage in its parts (bench/mpi_halo; issue 19): wall ms since the world was
@@ -53,7 +55,7 @@ struct HaloPhaseTimes {
 // that a restored world cuts, migrates and counts as the saved one would have.
 struct DistributedState {
   int32_t axis = 0;                  // the slabs' axis
-  std::vector<int32_t> cuts;         // ranks - 1 non-decreasing cuts (SlabDecomposition::cuts)
+  std::vector<int32_t> cuts;         // ranks - 1 cuts in sub-layers (SlabDecomposition::cuts)
   bool cut = false;                  // whether the first frame's cut was made
   DistributedCounters counters;      // ghosts, migrated_in, migrated_out, rebalances (axis and slab: above)
   double rebalance_threshold = 0.2;  // DistributedOptions' (reported; attach_ranks sets it)

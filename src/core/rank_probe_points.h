@@ -18,14 +18,14 @@
 #include "../physics/probe_sampling.h"
 #include "rank_transport.h"
 #include "slab_decomposition.h"
+#include "slab_rules.h"
 #include "status.h"
 
 namespace sph {
 
-// The rank whose slab holds sample point x's cell layer: the one whose gather of it counts.
+// The rank whose slab holds sample point x's sub-layer: the one whose gather of it counts.
 inline int probe_point_owner(const SlabDecomposition& slabs, float kernel_radius, Vec3 x) {
-  const int axis = slabs.axis();
-  return slabs.owner(cell_coordinate(axis == 0 ? x.x : (axis == 1 ? x.y : x.z), 1.0f / kernel_radius));
+  return slabs.owner(slab_position(x.x, x.y, x.z, slabs.axis(), 1.0f / kernel_radius));
 }
 
 // points[0, point_count): this rank's gathers of the sample points of probes[0, probe_count), in

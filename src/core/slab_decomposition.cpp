@@ -8,15 +8,56 @@
 
 namespace sph {
 
+namespace {
+
+// (INT32_MAX too: the cut after every particle, and the end of the clamped far layers.)
+bool on_layer_boundary(int64_t sub) { return sub % kSlabSubLayers == 0 || sub == INT32_MAX; }
+
+// A slab between the first and the last that keeps every particle's ghost destinations at two
+// (slab_rules.h).
+bool middle_slab_allowed(int64_t begin, int64_t end) {
+  const int64_t width = end - begin;
+  return width == 0 || width >= kSlabMinWidth || (on_layer_boundary(begin) && on_layer_boundary(end));
+}
+
+int64_t layer_of_sub(int64_t sub) {
+  return sub >= 0 ? sub / kSlabSubLayers : -((-sub + kSlabSubLayers - 1) / kSlabSubLayers);
+}
+
+}  // namespace
+
 SlabDecomposition::SlabDecomposition(int ranks)
     : cuts_(static_cast<size_t>(ranks > 1 ? ranks - 1 : 0), INT32_MAX) {}
 
-int SlabDecomposition::owner(int32_t layer) const {
-  return slab_owner(cuts_.data(), static_cast<int>(cuts_.size()), layer);
+int SlabDecomposition::owner(int32_t sub) const {
+  return slab_owner(cuts_.data(), static_cast<int>(cuts_.size()), sub);
 }
 
 int SlabDecomposition::ghost_destinations(int32_t layer, int self, int out[2]) const {
   return slab_ghost_destinations(cuts_.data(), static_cast<int>(cuts_.size()), layer, self, out);
+}
+
+int64_t SlabDecomposition::begin(int r) const {
+  return slab_begin(cuts_.data(), static_cast<int>(cuts_.size()), r);
+}
+
+int64_t SlabDecomposition::end(int r) const {
+  return slab_end(cuts_.data(), static_cast<int>(cuts_.size()), r);
+}
+
+void SlabDecomposition::describe(int r, DistributedCounters& c) const {
+  c.axis = axis_;
+  const int64_t b = begin(r), e = end(r);
+  if (b >= e) {
+    c.slab_first = c.sub_first = 0;
+    c.slab_last = c.sub_last = -1;
+    return;
+  }
+  const bool first = r == 0, last = r == ranks() - 1;
+  c.sub_first = first ? INT32_MIN : static_cast<int32_t>(b);
+  c.sub_last = last ? INT32_MAX : static_cast<int32_t>(e - 1);
+  c.slab_first = first ? INT32_MIN : static_cast<int32_t>(layer_of_sub(b));
+  c.slab_last = last ? INT32_MAX : static_cast<int32_t>(layer_of_sub(e - 1));
 }
 
 bool SlabDecomposition::imbalanced(const std::vector<int64_t>& count, double threshold) {
@@ -30,28 +71,71 @@ bool SlabDecomposition::imbalanced(const std::vector<int64_t>& count, double thr
   return static_cast<double>(fullest) > (1.0 + threshold) * mean;
 }
 
-void SlabDecomposition::rebalance(int axis, int32_t first_layer, const std::vector<int64_t>& histogram) {
-  axis_ = axis;
-  const int n = ranks();
+namespace {
+
+// Walks the cuts' targets over a histogram of particles per layer: visit(r, k, before, target)
+// for cut r (1 .. ranks - 1) with k the histogram's index of the layer where the running count
+// reaches ceil(r * total / ranks) (histogram.size(): never) and `before` the count of the layers
+// below it.
+template <class Visit>
+void walk_targets(int ranks, const std::vector<int64_t>& histogram, Visit&& visit) {
   int64_t total = 0;
   for (int64_t c : histogram) total += c;
-  std::vector<int32_t> cuts(static_cast<size_t>(n - 1), INT32_MAX);
-  int64_t running = 0;
+  int64_t before = 0;
   size_t k = 0;
-  for (int r = 1; r < n; ++r) {
-    // The smallest layer whose running count (layers before it) reaches r * total / n.
-    const int64_t target = (total * r + n - 1) / n;
-    while (k < histogram.size() && running < target) running += histogram[k++];
-    cuts[static_cast<size_t>(r - 1)] =
-        k < histogram.size() ? first_layer + static_cast<int32_t>(k) : INT32_MAX;
+  for (int r = 1; r < ranks; ++r) {
+    const int64_t target = (total * r + ranks - 1) / ranks;
+    while (k < histogram.size() && before + histogram[k] < target) before += histogram[k++];
+    visit(r, k, before, target);
   }
+}
+
+}  // namespace
+
+std::vector<int32_t> SlabDecomposition::crossing_layers(int ranks, int32_t first_layer,
+                                                        const std::vector<int64_t>& histogram) {
+  std::vector<int32_t> layers(static_cast<size_t>(ranks > 1 ? ranks - 1 : 0), INT32_MAX);
+  walk_targets(ranks, histogram, [&](int r, size_t k, int64_t, int64_t) {
+    if (k < histogram.size()) layers[static_cast<size_t>(r - 1)] = first_layer + static_cast<int32_t>(k);
+  });
+  return layers;
+}
+
+void SlabDecomposition::rebalance(int axis, int32_t first_layer, const std::vector<int64_t>& histogram,
+                                  const std::vector<int64_t>& sixteenths) {
+  const int n = ranks();
+  if (sixteenths.size() != static_cast<size_t>(n - 1) * kSlabSubLayers)
+    throw Error(Status::Internal, "slabs: sixteenths for another number of ranks");
+  std::vector<int32_t> cuts(static_cast<size_t>(n - 1), INT32_MAX);
+  walk_targets(n, histogram, [&](int r, size_t k, int64_t before, int64_t target) {
+    if (k >= histogram.size()) return;
+    // The first sub-layer of the crossing layer that the lower ranks do not take.
+    const int64_t* mine = sixteenths.data() + static_cast<size_t>(r - 1) * kSlabSubLayers;
+    int j = 0;
+    for (int64_t running = before; j < kSlabSubLayers && running < target;) running += mine[j++];
+    cuts[static_cast<size_t>(r - 1)] = slab_sublayer(first_layer + static_cast<int32_t>(k), j);
+  });
+  bool allowed = true;
+  for (size_t r = 1; r < cuts.size(); ++r) allowed = allowed && middle_slab_allowed(cuts[r - 1], cuts[r]);
+  if (!allowed) {
+    // Slabs thinner than one and a half layers: whole layers, each cut after its crossing layer
+    // (INT32_MAX after the last one), as before sub-layers.
+    walk_targets(n, histogram, [&](int r, size_t k, int64_t, int64_t) {
+      cuts[static_cast<size_t>(r - 1)] =
+          k + 1 < histogram.size() ? slab_sublayer(first_layer + static_cast<int32_t>(k + 1), 0) : INT32_MAX;
+    });
+  }
+  axis_ = axis;
   cuts_ = cuts;
 }
 
 bool SlabDecomposition::valid(int ranks, int axis, const std::vector<int32_t>& cuts) {
   if (ranks < 1 || axis < 0 || axis > 2) return false;
   if (cuts.size() != static_cast<size_t>(ranks - 1)) return false;
-  return std::is_sorted(cuts.begin(), cuts.end());
+  if (!std::is_sorted(cuts.begin(), cuts.end())) return false;
+  for (size_t r = 1; r < cuts.size(); ++r)
+    if (!middle_slab_allowed(cuts[r - 1], cuts[r])) return false;
+  return true;
 }
 
 void SlabDecomposition::restore(int axis, const std::vector<int32_t>& cuts) {

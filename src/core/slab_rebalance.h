@@ -2,9 +2,9 @@
 // The frame's start of a distributed world's rank (include/sph_mpi.h), the same for every
 // backend (src/cpu/cpu_halo.cpp, cuda/cuda_halo.cu): when the slabs were never cut or the
 // fullest rank holds too many particles, new cuts along the longest axis of the world's extent
-// in cells, from a histogram of particles per cell layer (SlabDecomposition::rebalance). The
-// particles' cell layer along the slabs' axis (slab_layer), which every migration and ghost
-// decision reads, is in slab_rules.h.
+// in cells, from a histogram of particles per cell layer and one of the sixteenths of each layer
+// a cut falls in (SlabDecomposition::rebalance). The particles' layer and sub-layer along the
+// slabs' axis, which every migration and ghost decision reads, are in slab_rules.h.
 #pragma once
 
 #include <stdint.h>
@@ -55,7 +55,28 @@ bool rebalance_slabs(const RankTransport& t, SlabDecomposition& slabs, bool alre
   }
   agree(t);  // (the histogram's allocation)
   t.all_sum(histogram.data(), static_cast<int>(histogram.size()));
-  slabs.rebalance(axis, static_cast<int32_t>(lo[axis]), histogram);
+  // The layers the cuts fall in, each cut into sixteenths (slab_rules.h): a second sum of 16
+  // counts a cut. The crossing layers ascend, so each particle finds the first cut of its layer
+  // by a binary search and counts there; cuts in one layer share its counts.
+  const int32_t first_layer = static_cast<int32_t>(lo[axis]);
+  const std::vector<int32_t> crossing = SlabDecomposition::crossing_layers(t.size(), first_layer, histogram);
+  std::vector<int64_t> sixteenths(crossing.size() * kSlabSubLayers, 0);
+  for (uint32_t i = 0; i < count && !crossing.empty(); ++i) {
+    const auto p = position_of(i);
+    const float v = axis == 0 ? p.x : (axis == 1 ? p.y : p.z);
+    const int32_t layer = cell_coordinate(v, inv_cell_size);
+    const auto at = std::lower_bound(crossing.begin(), crossing.end(), layer);
+    if (at == crossing.end() || *at != layer) continue;
+    const size_t cut = static_cast<size_t>(at - crossing.begin());
+    ++sixteenths[cut * kSlabSubLayers + static_cast<size_t>(slab_sixteenth(v, inv_cell_size, layer))];
+  }
+  agree(t);  // (the sixteenths' allocation)
+  if (!sixteenths.empty()) t.all_sum(sixteenths.data(), static_cast<int>(sixteenths.size()));
+  for (size_t c = 1; c < crossing.size(); ++c)
+    if (crossing[c] == crossing[c - 1])
+      std::copy_n(sixteenths.begin() + static_cast<std::ptrdiff_t>((c - 1) * kSlabSubLayers), kSlabSubLayers,
+                  sixteenths.begin() + static_cast<std::ptrdiff_t>(c * kSlabSubLayers));
+  slabs.rebalance(axis, first_layer, histogram, sixteenths);
   return true;
 }
 

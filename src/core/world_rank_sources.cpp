@@ -10,6 +10,7 @@
 
 #include "../physics/grid_hash.h"
 #include "rank_agreement.h"
+#include "slab_rules.h"
 #include "status.h"
 #include "world.h"
 
@@ -30,8 +31,8 @@ HostVector<char> World::points_of_this_rank(const HostVector<Vec3>& points) cons
   HostVector<char> mine(points.size());
   for (size_t i = 0; i < points.size(); ++i) {
     const Vec3& p = points[i];
-    const int32_t layer = cell_coordinate(slab.axis == 0 ? p.x : (slab.axis == 1 ? p.y : p.z), inv);
-    mine[i] = layer >= slab.slab_first && layer <= slab.slab_last ? 1 : 0;
+    const int32_t sub = slab_position(p.x, p.y, p.z, slab.axis, inv);
+    mine[i] = sub >= slab.sub_first && sub <= slab.sub_last ? 1 : 0;
   }
   return mine;
 }

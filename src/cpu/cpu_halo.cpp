@@ -35,6 +35,7 @@
 #include "../core/halo_records.h"
 #include "../core/rank_agreement.h"
 #include "../core/slab_rebalance.h"
+#include "../core/slab_rules.h"
 #include "cpu_backend_impl.h"
 #include "cpu_halo_share.h"
 #include "cpu_neighbor_grid.h"
@@ -73,11 +74,7 @@ CpuRankHalo::CpuRankHalo(std::shared_ptr<const RankTransport> ranks, const Distr
 
 DistributedCounters CpuRankHalo::counters() const {
   DistributedCounters c = counters_;
-  c.axis = slabs_.axis();
-  const int me = ranks_->rank();
-  const std::vector<int32_t>& cuts = slabs_.cuts();
-  c.slab_first = me == 0 ? INT32_MIN : cuts[static_cast<size_t>(me - 1)];
-  c.slab_last = me == static_cast<int>(cuts.size()) ? INT32_MAX : cuts[static_cast<size_t>(me)] - 1;
+  slabs_.describe(ranks_->rank(), c);
   return c;
 }
 
@@ -98,6 +95,11 @@ float axis_coordinate(const Float4& p, int axis) { return axis == 0 ? p.x : (axi
 int32_t CpuRankHalo::layer(uint32_t i) const {
   const Float4& p = position_[i];
   return slab_layer(p.x, p.y, p.z, slabs_.axis(), 1.0f / kernel_radius_);
+}
+
+int32_t CpuRankHalo::sub_layer(uint32_t i) const {
+  const Float4& p = position_[i];
+  return slab_position(p.x, p.y, p.z, slabs_.axis(), 1.0f / kernel_radius_);
 }
 
 void CpuRankHalo::keep(size_t kept) {
@@ -127,18 +129,17 @@ void CpuRankHalo::gather() {
   // Every particle held between substeps is owned; a substep that failed after the ghosts came
   // and was rolled back leaves their marks in this (not carried) array.
   std::fill(origin_.data(), origin_.data() + count_, 0u);
-  // This rank's slab, the layers [slab_begin, slab_end) (int64: the outer slabs reach INT32_MIN and
-  // INT32_MAX): a particle inside it needs no search of the cuts, nor, away from its two faces,
-  // any search for ghost destinations (the two per-particle loops below cost about 1 ms a substep
-  // at 84,672 particles on one rank of the development VM with a search for every particle).
-  const std::vector<int32_t>& cuts = slabs_.cuts();
-  const int64_t slab_begin = me == 0 ? int64_t{INT32_MIN} : cuts[static_cast<size_t>(me - 1)];
-  const int64_t slab_end = me == size - 1 ? int64_t{INT32_MAX} + 1 : cuts[static_cast<size_t>(me)];
+  // This rank's slab, the sub-layers [slab_begin, slab_end) (int64: the outer slabs reach INT32_MIN
+  // and INT32_MAX): a particle inside it needs no search of the cuts, nor, where the layers beside
+  // and at its own lie inside it, any search for ghost destinations (the two per-particle loops
+  // below cost about 1 ms a substep at 84,672 particles on one rank of the development VM with a
+  // search for every particle).
+  const int64_t slab_begin = slabs_.begin(me), slab_end = slabs_.end(me);
   // Migration: what another rank's slab holds goes there with every carried array.
   keep_.clear();
   for (uint32_t i = 0; i < count_; ++i) {
-    const int32_t l = layer(i);
-    const int owner = l >= slab_begin && l < slab_end ? me : slabs_.owner(l);
+    const int32_t s = sub_layer(i);
+    const int owner = s >= slab_begin && s < slab_end ? me : slabs_.owner(s);
     if (owner == me)
       keep_.push_back(i);
     else
@@ -151,11 +152,13 @@ void CpuRankHalo::gather() {
   for (int r = 0; r < size; ++r) counters_.migrated_in += unpack(in[static_cast<size_t>(r)], 0u);
   clock.lap(kHaloMigrate);
   const uint32_t owned = count_;
-  // Ghosts: each owned particle of a layer beside another rank's slab goes to that rank.
+  // Ghosts: each owned particle goes to the other ranks whose slabs meet its layer or those beside.
   for (HostVector<uint32_t>& to : sends_) to.clear();
   for (uint32_t i = 0; i < owned; ++i) {
     const int32_t l = layer(i);
-    if (int64_t{l} - 1 >= slab_begin && int64_t{l} + 1 < slab_end) continue;  // both neighbours this rank's
+    if (slab_sublayer(l, -kSlabSubLayers) >= slab_begin &&
+        slab_sublayer(l, 2 * kSlabSubLayers - 1) < slab_end)
+      continue;  // the layers beside and at its own are this rank's alone
     int to[2];
     const int n = slabs_.ghost_destinations(l, me, to);
     for (int k = 0; k < n; ++k) sends_[static_cast<size_t>(to[k])].push_back(i);
@@ -282,8 +285,8 @@ void CpuBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks, const 
 DistributedCounters CpuBackend::distributed_counters() const {
   if (rank_) return rank_->counters();
   DistributedCounters c;  // (one slab, which holds every layer)
-  c.slab_first = INT32_MIN;
-  c.slab_last = INT32_MAX;
+  c.slab_first = c.sub_first = INT32_MIN;
+  c.slab_last = c.sub_last = INT32_MAX;
   return c;
 }
 

@@ -117,8 +117,9 @@ class CpuRankHalo {
   // A spring ghost: a ghost that is only the far end of an owned particle's spring, from past the
   // halo (cpu_halo_springs.cpp). No neighbour pass reads it.
   bool spring_ghost(uint32_t i) const { return origin_[i] > static_cast<uint32_t>(ranks_->size()); }
-  // Cell layer of particle i along the slabs' axis.
+  // Particle i's cell layer along the slabs' axis, and its sub-layer (slab_rules.h).
   int32_t layer(uint32_t i) const;
+  int32_t sub_layer(uint32_t i) const;
   // Whether an array moves with its particle: the carried ones, and RK4's stage state.
   static bool travels(const ParticleArraySpec& spec);
   // The travelling arrays of the particles `which` lists into `out` (replacing what it held), array

@@ -170,6 +170,8 @@ SPH_API sph_result SPH_CALL sph_mpi_world_get_counts(const sph_world* world, sph
     r.axis = c.axis;
     r.slab_first = c.slab_first;
     r.slab_last = c.slab_last;
+    r.slab_sub_first = c.sub_first;
+    r.slab_sub_last = c.sub_last;
     sph::write_output_struct(out, r, "out");
     return SPH_OK;
   });

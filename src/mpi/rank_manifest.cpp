@@ -5,6 +5,7 @@
 
 #include "../core/byte_io.h"
 #include "../core/slab_decomposition.h"
+#include "../core/slab_rules.h"
 #include "../core/status.h"
 
 namespace sph {
@@ -12,7 +13,9 @@ namespace sph {
 namespace {
 
 constexpr uint8_t kManifestMagic[8] = {'S', 'P', 'H', 'R', 'A', 'N', 'K', 0x1a};
-constexpr uint32_t kManifestVersion = 1;
+// Version 2: the cuts in sub-layers (a sixteenth of a cell layer, core/slab_rules.h); version 1's
+// were whole cell layers, read as their first sub-layers.
+constexpr uint32_t kManifestVersion = 2;
 constexpr uint32_t kMaxRanks = 1u << 24;
 
 [[noreturn]] void corrupt(const std::string& message) {
@@ -102,9 +105,9 @@ RankManifest read_rank_manifest(const uint8_t* data, size_t size) {
   for (int k = 7; k >= 0; --k) stored = (stored << 8) | data[size - 8 + static_cast<size_t>(k)];
   ByteReader r(data + sizeof kManifestMagic, size - sizeof kManifestMagic - 8, "manifest");
   const uint32_t version = r.u32();
-  if (version != kManifestVersion)
+  if (version < 1 || version > kManifestVersion)
     throw Error(Status::VersionMismatch, "manifest: version " + std::to_string(version) +
-                                             "; this library reads version " +
+                                             "; this library reads versions 1 to " +
                                              std::to_string(kManifestVersion));
   if (sum.value() != stored) corrupt("checksum mismatch: the manifest is damaged");
   RankManifest m;
@@ -121,9 +124,17 @@ RankManifest read_rank_manifest(const uint8_t* data, size_t size) {
   m.state.counters.rebalances = r.u32();
   r.need_elements(ranks - 1u, 4, "cuts");
   m.state.cuts.resize(ranks - 1u);
-  for (int32_t& c : m.state.cuts) c = static_cast<int32_t>(r.u32());
+  for (int32_t& c : m.state.cuts) {
+    c = static_cast<int32_t>(r.u32());
+    // (Version 1: a cut at INT32_MAX, past every particle, stays there; the others, far inside
+    // int32, saturate at the last whole layer that int32 sub-layers hold.)
+    if (version == 1 && c != INT32_MAX)
+      c = c > INT32_MAX / kSlabSubLayers - 1 ? INT32_MAX - (kSlabSubLayers - 1) : slab_sublayer(c, 0);
+  }
   if (!SlabDecomposition::valid(static_cast<int>(ranks), m.state.axis, m.state.cuts))
-    corrupt("the slabs' axis or cuts are not a decomposition (axis 0-2, cuts non-decreasing)");
+    corrupt(
+        "the slabs' axis or cuts are not a decomposition (axis 0-2, cuts non-decreasing, each slab "
+        "between the first and the last empty, 24 sub-layers wide or more, or of whole layers)");
   r.need_elements(ranks, 36, "rank entries");
   m.ranks.resize(ranks);
   uint64_t total = 0;

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 #include "mpi_test_world.h"
 
+#include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
@@ -267,4 +268,11 @@ int mpi_test_rank_file(const char* manifest, int rank, char* out, size_t size) {
     }
     at += 36 + length;
   }
+}
+
+int32_t mpi_test_sub_layer(float x) {
+  const float t = x * (1.0f / MPI_TEST_KERNEL_RADIUS);
+  float j = floorf((t - floorf(t)) * 16.0f);
+  j = j < 0.0f ? 0.0f : (j > 15.0f ? 15.0f : j);
+  return 16 * (int32_t)floorf(t) + (int32_t)j;
 }

@@ -70,6 +70,10 @@ const char* mpi_test_solver_stats_differ(const sph_stats* stats);
 void mpi_test_gather(sph_world* world, uint32_t n, float** x, float** v);
 /* mpi_test_gather for a world on `comm`: onto its rank 0. */
 void mpi_test_gather_on(sph_world* world, MPI_Comm comm, uint32_t n, float** x, float** v);
+/* The sub-layer of coordinate x along the slabs' axis (src/core/slab_rules.h; sph_mpi_counts'
+ * slab_sub_first/last): 16 times its cell layer floor(x / MPI_TEST_KERNEL_RADIUS), plus the
+ * sixteenth of that layer it lies in. */
+int32_t mpi_test_sub_layer(float x);
 /* An undivided world's positions and velocities by id (malloc'd). */
 void mpi_test_read(sph_world* single, uint32_t n, float** x, float** v);
 /* A point probe at (0.05, 0.02, 0.03) m and a gauge 0.25 m long from (0.031, -0.01, 0.027) m against

@@ -39,25 +39,35 @@
 
 static int32_t layer_of(float x) { return (int32_t)floorf(x * (1.0f / MPI_TEST_KERNEL_RADIUS)); }
 
-/* Each rank's halo of the last substep against the particles of the layers beside its slab, in
- * the positions `start` (rank 0's gather) that substep started from. */
+/* Each rank's halo of the last substep against the particles it does not own in the layers its
+ * slab meets and those beside them, in the positions `start` (rank 0's gather) that substep
+ * started from. */
 static void check_halo(const sph_mpi_counts* counts, const float* start, uint64_t n) {
-  int32_t mine[4] = {counts->slab_first, counts->slab_last, (int32_t)counts->local_ghosts, counts->axis};
-  int32_t* all = (int32_t*)malloc(sizeof(int32_t) * 4 * (size_t)g_size);
+  int32_t mine[6] = {counts->slab_first,
+                     counts->slab_last,
+                     counts->slab_sub_first,
+                     counts->slab_sub_last,
+                     (int32_t)counts->local_ghosts,
+                     counts->axis};
+  int32_t* all = (int32_t*)malloc(sizeof(int32_t) * 6 * (size_t)g_size);
   REQUIRE(all != NULL, "malloc");
-  MPI_Gather(mine, 4, MPI_INT32_T, all, 4, MPI_INT32_T, 0, MPI_COMM_WORLD);
+  MPI_Gather(mine, 6, MPI_INT32_T, all, 6, MPI_INT32_T, 0, MPI_COMM_WORLD);
   if (g_rank == 0) {
     for (int r = 0; r < g_size; ++r) {
-      const int32_t first = all[4 * r], last = all[4 * r + 1], ghosts = all[4 * r + 2], axis = all[4 * r + 3];
+      const int32_t* a = all + 6 * r;
+      const int32_t first = a[0], last = a[1], sub_first = a[2], sub_last = a[3], ghosts = a[4], axis = a[5];
       uint32_t expected = 0;
       for (uint64_t i = 0; i < n && first <= last; ++i) {
-        const int32_t layer = layer_of(start[3 * i + axis]);
-        if ((first != INT32_MIN && layer == first - 1) || (last != INT32_MAX && layer == last + 1))
-          ++expected;
+        const float x = start[3 * i + axis];
+        const int32_t layer = layer_of(x), sub = mpi_test_sub_layer(x);
+        const int owned = sub >= sub_first && sub <= sub_last;
+        const int below = first == INT32_MIN || layer >= first - 1,
+                  above = last == INT32_MAX || layer <= last + 1;
+        if (!owned && below && above) ++expected;
       }
       CHECK((uint32_t)ghosts == expected,
-            "rank %d (layers %d..%d along axis %d) held %d ghosts, brute force %u", r, first, last, axis,
-            ghosts, expected);
+            "rank %d (layers %d..%d, sub-layers %d..%d along axis %d) held %d ghosts, brute force %u", r,
+            first, last, sub_first, sub_last, axis, ghosts, expected);
     }
   }
   free(all);

@@ -10,7 +10,14 @@
  *     times the particle mass, conserved through the migrations and the new cuts);
  *   - the gathered particles equal the undivided world's bit for bit (the sort keys keep every
  *     sum in the undivided world's order across the new cuts, as in test_mpi_distributed_world.c:
- *     no tolerance). */
+ *     no tolerance).
+ * First, the first cut's balance (check_first_cut): a still lattice of 48 planes of 25 particles
+ * along y, planes 0.01 m apart against layers of 0.018 m, so that a layer holds one or two
+ * planes: cut between sub-layers (a sixteenth of a layer, src/core/slab_rules.h) the slabs split
+ * the world between planes, each rank holding exactly the planes up to the one where its running
+ * target ceil(r n / R) is reached (on 2 and 4 ranks 600 / 300 particles each; whole layers gave
+ * 625 + 575 and 325 + 300 + 275 + 300), and each rank holds exactly the particles whose
+ * sub-layer its slab_sub_first .. slab_sub_last names. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -19,6 +26,75 @@
 
 #define FRAME_SUBSTEPS 20
 #define FRAMES 12
+
+#define LATTICE_PLANES 48
+#define LATTICE_SIDE 5
+
+static void check_first_cut(sph_context* context) {
+  const uint32_t plane = LATTICE_SIDE * LATTICE_SIDE, n = LATTICE_PLANES * plane;
+  /* The planes sit a sixteenth's 1/18 (62.5 um) from every sub-layer boundary: one substep of
+   * 1e-5 s moves none across one. */
+  const float y0 = MPI_TEST_KERNEL_RADIUS * (4.0f + 1.0f / 18.0f) / 16.0f;
+  sph_world_def def;
+  sph_world* world = NULL;
+  sph_world_params p;
+  sph_mpi_counts counts;
+  float* positions = (float*)malloc(sizeof(float) * 3 * n);
+  float *x = NULL, *v = NULL;
+  int32_t mine[3], *all = (int32_t*)malloc(sizeof(int32_t) * 3 * (size_t)g_size);
+  REQUIRE(positions && all, "malloc");
+  for (uint32_t k = 0, i = 0; k < LATTICE_PLANES; ++k)
+    for (uint32_t a = 0; a < LATTICE_SIDE; ++a)
+      for (uint32_t b = 0; b < LATTICE_SIDE; ++b, ++i) {
+        positions[3 * i] = 0.005f + MPI_TEST_SPACING * (float)a;
+        positions[3 * i + 1] = y0 + MPI_TEST_SPACING * (float)k;
+        positions[3 * i + 2] = 0.005f + MPI_TEST_SPACING * (float)b;
+      }
+  mpi_test_world_def(&def);
+  REQUIRE(sph_mpi_world_create(context, &def, MPI_TEST_COMM, NULL, &world) == SPH_OK, "lattice world");
+  REQUIRE(sph_mpi_world_add_particles(world, positions, NULL, g_rank == 0 ? n : 0, NULL) == SPH_OK,
+          "lattice");
+  REQUIRE(support_params_gravity_and_steps(&p, 0.0f, 0.0f, 0.0f, 1e-5f, 1e-5f) == SPH_OK, "params");
+  p.max_substeps = 1;
+  REQUIRE(sph_world_set_params(world, &p) == SPH_OK, "set params");
+  REQUIRE(sph_mpi_world_step(world, 1.0f) == SPH_INCOMPLETE, "one substep");
+  REQUIRE(sph_mpi_counts_init(&counts) == SPH_OK && sph_mpi_world_get_counts(world, &counts) == SPH_OK,
+          "counts");
+  mine[0] = (int32_t)counts.local_count;
+  mine[1] = counts.slab_sub_first;
+  mine[2] = counts.slab_sub_last;
+  MPI_Gather(mine, 3, MPI_INT32_T, all, 3, MPI_INT32_T, 0, MPI_COMM_WORLD);
+  mpi_test_gather(world, n, &x, &v);
+  if (g_rank == 0) {
+    uint64_t reached = 0;
+    for (int r = 0; r < g_size; ++r) {
+      /* The planes up to the one where ceil(r n / R) is reached. */
+      const uint64_t target = ((uint64_t)n * (uint64_t)(r + 1) + (uint64_t)g_size - 1) / (uint64_t)g_size;
+      const uint64_t through = (target + plane - 1) / plane * plane;
+      const int32_t held = all[3 * r], first = all[3 * r + 1], last = all[3 * r + 2];
+      uint32_t owned = 0;
+      for (uint32_t i = 0; i < n; ++i) {
+        const int32_t sub = mpi_test_sub_layer(x[3 * i + 1]);
+        owned += sub >= first && sub <= last ? 1u : 0u;
+      }
+      CHECK(
+          (uint64_t)held == through - reached,
+          "first cut on %d ranks: rank %d holds %d particles, expected %llu (the planes up to the one where "
+          "its target %llu is reached)",
+          g_size, r, held, (unsigned long long)(through - reached), (unsigned long long)target);
+      CHECK(owned == (uint32_t)held, "rank %d holds %d particles, its sub-layers %d..%d %u", r, held, first,
+            last, owned);
+      reached = through;
+    }
+    printf("first cut on %d ranks: %u particles in planes of %u; rank 0 holds %d\n", g_size, n, plane,
+           all[0]);
+  }
+  free(positions);
+  free(all);
+  free(x);
+  free(v);
+  REQUIRE(sph_world_destroy(world) == SPH_OK, "destroy");
+}
 
 int main(int argc, char** argv) {
   sph_context* context = NULL;
@@ -32,6 +108,7 @@ int main(int argc, char** argv) {
   uint32_t* ids = NULL;
   uint64_t got = 0;
   mpi_test_init(&argc, &argv, &context);
+  check_first_cut(context);
   mpi_test_world_def(&def);
   def.particle_spacing = 0.0125f; /* 640 particles: the collapse in a few seconds of CPU on 4 ranks */
   def.kernel_radius = 1.8f * 0.0125f;

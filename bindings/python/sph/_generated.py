@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '4a8a7859076b7e24c05a6a2f1821f21e86bff56d4f39cf7f1b79885ee690af57', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': '4dd61a067e6b57f80868ddc81907cbad21214f0730e5912010f5fd84afd4b342', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '4a8a7859076b7e24c05a6a2f1821f21e86bff56d4f39cf7f1b79885ee690af57', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'ab7054093ed8e96a277521b9452f77a9b25172503ae076d23d2e49145ca243e2', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -2106,9 +2106,11 @@ class MpiCounts(_SphStruct):
         local_ghosts (uint32_t): halo particles this rank held in the last substep
         rebalances (uint32_t): times the slabs were cut anew (the first cut counts)
         axis (int32_t): the slabs' axis: 0 x, 1 y, 2 z
-        slab_first (int32_t): This rank's slab: the cell layers [slab_first, slab_last] along axis, cell k holding floor(x / kernel_radius) = k (INT32_MIN / INT32_MAX: open; first > last: empty).
+        slab_first (int32_t): The cell layers this rank's slab meets, [slab_first, slab_last] along axis, cell k holding floor(x / kernel_radius) = k (INT32_MIN / INT32_MAX: open; first > last: empty). Slabs are cut between sixteenths of a layer, so a neighbour's slab may share an end layer.
         slab_last (int32_t)
         reserved0 (uint32_t)
+        slab_sub_first (int32_t): This rank's slab exactly: the sub-layers [slab_sub_first, slab_sub_last], sub-layer 16 k + j holding the points of layer k whose fraction x / kernel_radius - k lies in [j/16, (j+1)/16) (INT32_MIN / INT32_MAX: open; first > last: empty).
+        slab_sub_last (int32_t)
     """
     _fields_ = [
         ('struct_size', _c.c_uint32),
@@ -2124,10 +2126,12 @@ class MpiCounts(_SphStruct):
         ('slab_first', _c.c_int32),
         ('slab_last', _c.c_int32),
         ('reserved0', _c.c_uint32),
+        ('slab_sub_first', _c.c_int32),
+        ('slab_sub_last', _c.c_int32),
     ]
     _sph_c_name_ = 'sph_mpi_counts'
-    _sph_size_ = 64
-    _sph_offsets_ = (('struct_size', 0), ('rank', 4), ('rank_count', 8), ('local_count', 12), ('global_count', 16), ('global_ghosts', 24), ('migrated', 32), ('local_ghosts', 40), ('rebalances', 44), ('axis', 48), ('slab_first', 52), ('slab_last', 56), ('reserved0', 60))
+    _sph_size_ = 72
+    _sph_offsets_ = (('struct_size', 0), ('rank', 4), ('rank_count', 8), ('local_count', 12), ('global_count', 16), ('global_ghosts', 24), ('migrated', 32), ('local_ghosts', 40), ('rebalances', 44), ('axis', 48), ('slab_first', 52), ('slab_last', 56), ('reserved0', 60), ('slab_sub_first', 64), ('slab_sub_last', 68))
     _sph_init_ = 'sph_mpi_counts_init_sized'
 
 
