@@ -9,7 +9,7 @@
 //              density solve by conjugate gradients (cpu_dfsph_cg.cpp) shares the velocities
 //              after its warm start, then in each iteration the search directions p (in the
 //              steps' column) and the velocity steps dv_p, and adds its sums' bins likewise;
-//   probes     each sample point is gathered by the rank whose slab holds its cell layer (its
+//   probes     each sample point is gathered by the rank whose slab holds its sub-layer (its
 //              neighbour cells are complete there, in the undivided world's order) and every
 //              rank takes that rank's sums (core/rank_probe_points.h, the CUDA rank's too):
 //              each rank reads the world's bits;

@@ -5,9 +5,10 @@
 // rank count, files or hashes do not match. Layout (little-endian, docs/checkpoint.md):
 //   magic[8] "SPHRANK\x1a", u32 version (2), u32 rank count, u64 particles of the world,
 //   u32 rebalance threshold percent, i32 slab axis, u32 first cut made (0/1), u32 rebalances,
-//   i32 cuts[rank count - 1] (sub-layers; version 1: cell layers, read too), then per rank: u32 particles, u32 ghosts of the last substep,
-//   u32 migrated in, u32 migrated out, u64 file size, u64 file FNV-1a 64, u32 name length, the
-//   file's name (in the manifest's directory); last, the FNV-1a 64 of every byte before it.
+//   i32 cuts[rank count - 1] (sub-layers; version 1: cell layers, read too), then per rank:
+//   u32 particles, u32 ghosts of the last substep, u32 migrated in, u32 migrated out, u64 file
+//   size, u64 file FNV-1a 64, u32 name length, the file's name (in the manifest's directory);
+//   last, the FNV-1a 64 of every byte before it.
 #pragma once
 
 #include <stdint.h>
