@@ -13,8 +13,9 @@
  * A water block of 0.8 x 0.4 x 0.2 m at rest in a closed tank (the slabs cut its 0.8 m axis),
  * stepped one warm-up frame (the first cut and its migration) and then timed over K substeps
  * (default 20). Prints, on rank 0: the ranks, the particles per rank, the ghosts (halo) per rank
- * in the last substep against the model's slab halo (one support radius of the block per face
- * beside another slab: h / L of its particles), ms per substep (the slowest
+ * in the last substep against the model's slab halo (per face beside another slab, one support
+ * radius of the block and the part of the slab's end layer its neighbour owns: (1 + that part)
+ * h / L of its particles), ms per substep (the slowest
  * rank, MPI_Wtime around the step) and the step's stage times; each stage split into the time
  * inside the transport's MPI calls (the wait there for the slowest rank and the transfer) and
  * the rest (the rank's own work: packing, sorting, gathering ghosts, computing), on rank 0 and
@@ -199,6 +200,7 @@ int main(int argc, char** argv) {
   uint32_t n = 0;
   double t0, mine, slowest;
   int64_t owned_max;
+  double model_sum = 0.0;
   const support_tank tank = {{0.0f, 0.3f, 0.0f}, {0.45f, 0.3f, 0.15f}, 0.01f, 0.0f};
   const sph_vec3 lo = {-0.4f, 0.0f, -0.1f}, hi = {0.4f, 0.4f, 0.1f};
   MPI_Init(&argc, &argv);
@@ -261,18 +263,30 @@ int main(int argc, char** argv) {
   need(sph_world_get_stats(world, &stats), "stats");
   owned_max = c.local_count;
   MPI_Allreduce(MPI_IN_PLACE, &owned_max, 1, MPI_INT64_T, MPI_MAX, MPI_COMM_WORLD);
+  {
+    /* docs/scaling.md's slab halo: each face beside another slab takes the layer beyond it and
+     * the part of its own end layer the slab leaves to its neighbour (cuts between sixteenths of
+     * a layer, src/core/slab_rules.h): (1 + that part) h / L of the block's particles per face
+     * (L = 0.8 m, the cut axis); at whole-layer cuts h / L a face, 2 (R - 1) faces. */
+    const double h = 1.8 * spacing, per_layer = n * h / 0.8;
+    double layers = 0.0;
+    if (c.local_count > 0 && c.slab_sub_first != INT32_MIN)
+      layers += 1.0 + (double)(((c.slab_sub_first % 16) + 16) % 16) / 16.0;
+    if (c.local_count > 0 && c.slab_sub_last != INT32_MAX)
+      layers += 1.0 + (double)(15 - ((c.slab_sub_last % 16) + 16) % 16) / 16.0;
+    model_sum = layers * per_layer;
+    MPI_Allreduce(MPI_IN_PLACE, &model_sum, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  }
   if (rank == 0) {
-    /* docs/scaling.md's slab halo: one support radius of the block per face beside another
-     * slab, h / L of the block's particles (L = 0.8 m, the cut axis); 2 (R - 1) faces. */
-    const double h = 1.8 * spacing;
-    const double model = size > 1 ? n * h / 0.8 * 2.0 * (size - 1) / size : 0.0;
+    const double model = model_sum / size;
     printf("backend %s%s, workers a rank %u (0: all hardware threads)%s\n",
            backend == SPH_BACKEND_CUDA ? "cuda" : "cpu", springs ? ", springs" : "", workers,
            wait_barriers ? ", a timed barrier before each transport call" : "");
     printf("ranks %d, %u particles (%.0f per rank, the fullest %lld), %u substeps\n", size, n,
            (double)n / size, (long long)owned_max, stats.substeps);
     printf(
-        "ghosts per rank (last substep): %.0f measured, %.0f model (h / L per slab face, h = 1.8 spacings)\n",
+        "ghosts per rank (last substep): %.0f measured, %.0f model ((1 + the end layer's share left to the "
+        "neighbour) h / L per slab face, h = 1.8 spacings)\n",
         (double)c.global_ghosts / size, model);
     printf("ms per substep (slowest rank): %.3f\n", 1e3 * slowest / stats.substeps);
     printf("rank 0 stage ms over the step:");

@@ -113,6 +113,12 @@ void SlabDecomposition::rebalance(int axis, int32_t first_layer, const std::vect
     const int64_t* mine = sixteenths.data() + static_cast<size_t>(r - 1) * kSlabSubLayers;
     int j = 0;
     for (int64_t running = before; j < kSlabSubLayers && running < target;) running += mine[j++];
+    // Where the rest of the layer is empty, the layer's end splits the same particles, and a cut
+    // there leaves both neighbours the smaller halo (a slab that meets a layer in part takes the
+    // rest of it as ghosts).
+    int empty_to = j;
+    while (empty_to < kSlabSubLayers && mine[empty_to] == 0) ++empty_to;
+    if (empty_to == kSlabSubLayers) j = kSlabSubLayers;
     cuts[static_cast<size_t>(r - 1)] = slab_sublayer(first_layer + static_cast<int32_t>(k), j);
   });
   bool allowed = true;

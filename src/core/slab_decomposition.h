@@ -42,9 +42,10 @@ class SlabDecomposition {
                                               const std::vector<int64_t>& histogram);
   // New cuts along `axis`: cut r (1 .. ranks - 1) is the first sub-layer of its crossing layer
   // where the running count reaches its target, counted with sixteenths[16 (r - 1) + j], the
-  // particles of that layer's sixteenth j. Where a slab between the first and the last would be
-  // narrower than kSlabMinWidth, every cut is a whole layer instead (the layer after its crossing
-  // layer; INT32_MAX after the last layer), which keeps the decomposition valid.
+  // particles of that layer's sixteenth j (the layer's end when the rest of it is empty). Where
+  // a slab between the first and the last would be narrower than kSlabMinWidth, every cut is a
+  // whole layer instead (the layer after its crossing layer; INT32_MAX after the last layer),
+  // which keeps the decomposition valid.
   void rebalance(int axis, int32_t first_layer, const std::vector<int64_t>& histogram,
                  const std::vector<int64_t>& sixteenths);
   const std::vector<int32_t>& cuts() const { return cuts_; }

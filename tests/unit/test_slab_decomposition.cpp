@@ -72,8 +72,9 @@ void test_sub_layers(void**) {
 // Layers 10..19 holding 4 particles each (40) over 4 ranks: targets 10, 20, 30. The running
 // count reaches 10 in layer 12 (8 below it; its particles in sixteenths 1, 5, 9, 13: the second
 // of them, in sixteenth 5, makes 10, so the cut is sub-layer 12 * 16 + 6), 20 in layer 14 (16
-// below; sixteenths 0, 4, 8, 12: 20 at sixteenth 12, cut 14 * 16 + 13) and 30 in layer 17 (28
-// below; sixteenths 2, 2, 10, 10: cut 17 * 16 + 3). Middle slabs 39 and 38 sub-layers wide.
+// below; sixteenths 0, 4, 8, 12: 20 at sixteenth 12, and the rest of the layer is empty, so the
+// cut is the layer's end, 15 * 16: the same split, a layer less of halo) and 30 in layer 17 (28
+// below; sixteenths 2, 2, 10, 10: cut 17 * 16 + 3). Middle slabs 42 and 35 sub-layers wide.
 void test_rebalance_cuts(void**) {
   SlabDecomposition s(4);
   const std::vector<int64_t> histogram(10, 4);
@@ -84,12 +85,12 @@ void test_rebalance_cuts(void**) {
   for (int j : {2, 2, 10, 10}) ++sixteenths[2 * 16 + static_cast<size_t>(j)];
   s.rebalance(2, 10, histogram, sixteenths);
   assert_int_equal(s.axis(), 2);
-  const std::vector<int32_t> want{12 * 16 + 6, 14 * 16 + 13, 17 * 16 + 3};
+  const std::vector<int32_t> want{12 * 16 + 6, 15 * 16, 17 * 16 + 3};
   assert_true(s.cuts() == want);
   assert_int_equal(s.owner(12 * 16 + 5), 0);
   assert_int_equal(s.owner(12 * 16 + 6), 1);
-  assert_int_equal(s.owner(14 * 16 + 12), 1);
-  assert_int_equal(s.owner(14 * 16 + 13), 2);
+  assert_int_equal(s.owner(14 * 16 + 15), 1);
+  assert_int_equal(s.owner(15 * 16), 2);
   assert_int_equal(s.owner(17 * 16 + 3), 3);
   // Layer 12 is shared by ranks 0 and 1: a particle there is a ghost of the other one, and of
   // nobody else (rank 2 begins in layer 14).
@@ -98,10 +99,16 @@ void test_rebalance_cuts(void**) {
   assert_int_equal(to[0], 1);
   assert_int_equal(s.ghost_destinations(12, 1, to), 1);
   assert_int_equal(to[0], 0);
-  // Layer 13 (rank 1's alone) borders layers 12 (ranks 0, 1) and 14 (ranks 1, 2).
-  assert_int_equal(s.ghost_destinations(13, 1, to), 2);
+  // Layer 13 (rank 1's alone) borders layers 12 (ranks 0, 1) and 14 (rank 1's); layer 14 borders
+  // layer 15, rank 2's whole; layer 15 borders 14 (rank 1's), layer 16 borders 17 (ranks 2, 3).
+  assert_int_equal(s.ghost_destinations(13, 1, to), 1);
   assert_int_equal(to[0], 0);
-  assert_int_equal(to[1], 2);
+  assert_int_equal(s.ghost_destinations(14, 1, to), 1);
+  assert_int_equal(to[0], 2);
+  assert_int_equal(s.ghost_destinations(15, 2, to), 1);
+  assert_int_equal(to[0], 1);
+  assert_int_equal(s.ghost_destinations(16, 2, to), 1);
+  assert_int_equal(to[0], 3);
   assert_int_equal(s.ghost_destinations(10, 0, to), 0);
   assert_int_equal(s.ghost_destinations(11, 0, to), 1);
   // What sph_mpi_counts reports.
@@ -109,7 +116,7 @@ void test_rebalance_cuts(void**) {
   s.describe(1, c);
   assert_int_equal(c.axis, 2);
   assert_int_equal(c.sub_first, 12 * 16 + 6);
-  assert_int_equal(c.sub_last, 14 * 16 + 12);
+  assert_int_equal(c.sub_last, 15 * 16 - 1);
   assert_int_equal(c.slab_first, 12);
   assert_int_equal(c.slab_last, 14);
   s.describe(0, c);
