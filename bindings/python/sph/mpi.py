@@ -144,7 +144,7 @@ class DistributedWorld(World):
     def counts(self):
         """COLLECTIVE. This rank's and the world's counts (sph_mpi_world_get_counts): an
         MpiCounts (rank, rank_count, local_count, global_count, ghosts, migrated, rebalances,
-        the slab's axis and cell layers)."""
+        the slab's axis, the cell layers it meets and its sub-layers)."""
         c = _g.MpiCounts()
         check(_mpi_library().sph_mpi_world_get_counts(self.handle, ctypes.byref(c)), "sph_mpi_world_get_counts")
         return c
