@@ -25,7 +25,8 @@
  * (test_mpi_cuda_cases.c, mpi_cuda_rank_solver_case: against the same world on one rank, bit for bit),
  * and springs across ranks
  * (mpi_springs_cases.c, the CPU ranks' test_mpi_springs.c cases on the CUDA ranks at capacity
- * 32768: bit for bit against the undivided CUDA world). With SPH_MPI_CUDA_QUICK set, the dam
+ * 32768: bit for bit against the undivided CUDA world); first, two refusals: a world with CPU and
+ * CUDA ranks, and the asynchronous step on the caller's stream. With SPH_MPI_CUDA_QUICK set, the dam
  * breaks only (WCSPH, DFSPH, DFSPH by conjugate gradients: a run under compute-sanitizer). With
  * the argument `springs`, the springs cases only. */
 #include <math.h>
@@ -35,6 +36,7 @@
 #include "mpi_cuda_cases.h"
 #include "mpi_springs_cases.h"
 #include "mpi_test_world.h"
+#include "sph_cuda.h"
 #include "support.h"
 
 static sph_context* cuda_context(uint32_t lanes) {
@@ -215,6 +217,30 @@ static void mixed_backends_case(sph_context* cuda, sph_context* cpu) {
   if (g_rank == 0) printf("PASS mixed backends on %d ranks: refused on every rank\n", g_size);
 }
 
+/* A distributed CUDA world refuses the asynchronous step on the caller's stream (its MPI calls
+ * would run on the step's thread): UNSUPPORTED on every rank, nothing started, and the world
+ * still steps collectively afterwards. */
+static void stream_step_refused_case(sph_context* cuda) {
+  sph_world_def def;
+  sph_world* world = NULL;
+  sph_result r;
+  const float position[3] = {0.05f, 0.05f, 0.03f};
+  mpi_test_world_def(&def);
+  REQUIRE(sph_mpi_world_create(cuda, &def, MPI_TEST_COMM, NULL, &world) == SPH_OK, "stream step: world");
+  REQUIRE(sph_mpi_world_add_particles(world, position, NULL, g_rank == 0 ? 1u : 0u, NULL) == SPH_OK,
+          "stream step: a particle");
+  r = sph_cuda_world_step_begin_on_stream(world, 1.0f / 60.0f, NULL);
+  CHECK(r == SPH_ERROR_UNSUPPORTED, "stream step on a distributed world: rank %d returned %d (%s)", g_rank,
+        (int)r, sph_get_last_error());
+  CHECK(strstr(sph_get_last_error(), "sph_mpi_world_step") != NULL, "stream step: the message: %s",
+        sph_get_last_error());
+  r = sph_mpi_world_step(world, 1.0f / 600.0f);
+  CHECK(r == SPH_OK || r == SPH_INCOMPLETE, "stream step: the collective step after the refusal: %d (%s)",
+        (int)r, sph_get_last_error());
+  REQUIRE(sph_world_destroy(world) == SPH_OK, "stream step: destroy");
+  if (g_rank == 0) printf("PASS stream step on %d ranks: refused on every rank\n", g_size);
+}
+
 int main(int argc, char** argv) {
   sph_context* cpu = NULL;
   sph_context* cuda = NULL;
@@ -238,6 +264,7 @@ int main(int argc, char** argv) {
   }
 
   mixed_backends_case(cuda, cpu);
+  stream_step_refused_case(cuda);
   mpi_test_world_def(&def);
   def.capacity = 32768; /* 32 slots an axis: the tank's 23 x 12 x 4 cells never fold */
   run_case(&(cuda_case){"dam break", 0.0f, 1, 20, 1, 0.0f}, cuda, cpu, &def);
