@@ -47,6 +47,12 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
   const ColliderView* colliders = collider_views_.data();
   const uint32_t collider_count = static_cast<uint32_t>(collider_views_.size());
   (void)scene;  // its colliders, with their maps bound, are collider_views_
+  // A distributed world's ghosts (null otherwise): the weakly compressible passes below skip them,
+  // as the force pass does, since each publication ends with the ghosts taking their owners'
+  // values (halo_share_density, halo_share_normals), and a ghost's own sums, over a neighbourhood
+  // that is not complete on this rank, were only ever overwritten. (A sum reads its neighbours'
+  // positions and published values alone, so the owned particles' bits do not change.)
+  const uint32_t* halo = origins();
   // The walls' share at particle i (SPH_FEATURE_BOUNDARY_DENSITY), its record kept for the force
   // pass and DFSPH's solves; none without the feature.
   auto wall = [&](int i) {
@@ -75,6 +81,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
     if (rank_) halo_share_dfsph_density();
   } else {
     parallel().for_each(count_, [&](uint32_t i) {
+      if (halo && halo[i]) return;  // a ghost: its owner's values arrive below
       DensitySample s = simd_.density(fluid, view, columns, static_cast<uint32_t>(i));
       // The walls' share is part of the summation (and so of a normalised density's kernel sum).
       if (boundary) s.density += wall(i).density;
@@ -101,6 +108,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
     const float share =
         density_factor_relaxation(fluid.dt, speed_of_sound(fluid.methods.eos), fluid.kernel.h);
     parallel().for_each(count_, [&](uint32_t i) {
+      if (halo && halo[i]) return;
       const FilteredDensity d =
           filtered_density(fluid, simd_.normalized_density(fluid, view, columns, static_cast<uint32_t>(i)),
                            normalized_[i], share);
@@ -108,6 +116,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
       normalized_[i] = d.density;
     });
     parallel().for_each(count_, [&](uint32_t i) {
+      if (halo && halo[i]) return;
       density_[i] = normalized_[i];
       pos[i].w = pressure_from_density(fluid.methods.eos, normalized_[i]);
       vel[i].w = 1.0f / normalized_[i];
@@ -119,6 +128,7 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
   if (config_.features & kFeatureSurfaceTension) {
     // Colour-field normals of every particle, which the force gather reads for neighbours.
     parallel().for_each(count_, [&](uint32_t i) {
+      if (halo && halo[i]) return;
       normals_[i] = simd_.colour_normal(fluid, view, columns, static_cast<uint32_t>(i));
       columns_.set_normal(static_cast<uint32_t>(i), normals_[i]);
     });
@@ -136,7 +146,9 @@ void CpuBackend::diffuse_density(const FluidConstants& fluid, float dt) {
   float* factor = density_factor_.data();
   // The gather reads every published rho_j; each particle writes only its own factor and side
   // slot (free once the filtered densities are published), then the diffused values are published.
+  const uint32_t* halo = origins();  // (the ghosts: as in sort_and_density)
   parallel().for_each(count_, [&](uint32_t i) {
+    if (halo && halo[i]) return;
     const float rate = simd_.density_diffusion(fluid, view, columns, static_cast<uint32_t>(i));
     const DiffusedDensity d =
         diffused_density(fluid, fluid.methods.density_diffusion, density_[i], factor[i], rate, dt);
@@ -144,6 +156,7 @@ void CpuBackend::diffuse_density(const FluidConstants& fluid, float dt) {
     normalized_[i] = d.density;
   });
   parallel().for_each(count_, [&](uint32_t i) {
+    if (halo && halo[i]) return;
     density_[i] = normalized_[i];
     pos[i].w = pressure_from_density(fluid.methods.eos, normalized_[i]);
     vel[i].w = 1.0f / normalized_[i];
