@@ -150,8 +150,8 @@ DeviceHalo::DeviceHalo(uint32_t capacity, int ranks) : capacity_(capacity), rank
   cuts_.allocate(static_cast<size_t>(std::max(ranks - 1, 1)), "halo slab cuts");
   layers_.allocate(n, "halo layers");
   origin_.allocate(n, "halo ghosts' ranks");
-  // Two entries a particle: an owned particle beside two other slabs (a slab one layer thick) is
-  // listed for both.
+  // Two entries a particle: at most two other slabs meet a particle's layer and those beside it
+  // (core/slab_rules.h), and it is listed for each.
   keys_in_.allocate(2 * n, "halo list keys");
   keys_out_.allocate(2 * n, "halo sorted list keys");
   values_.allocate(2 * n, "halo list values");

@@ -48,10 +48,11 @@ class DeviceHalo {
   // then rank 1's, ..., each ascending (the order of the host loops these replace, which the
   // receiver relies on); the host gets only where each list starts (pinned, read after the call
   // or, for enqueue_mark, after the stream).
-  //   list_migrants  particles [0, n) by the rank that owns their layer; starts[0, ranks] and
+  //   list_migrants  particles [0, n) by the rank that owns their sub-layer; starts[0, ranks] and
   //                  starts[ranks + 1] = n, with this rank's own list (what stays) last:
   //                  [starts[ranks], n). Waits for the stream.
-  //   list_ghosts    particles [0, n) to the ranks beside their layer (their layers are kept
+  //   list_ghosts    particles [0, n) to the other ranks whose slabs meet their layer or those
+  //                  beside (at most two: core/slab_rules.h; their layers are kept
   //                  for enqueue_mark); starts[0, ranks], starts[ranks] = the total. Waits.
   const uint32_t* list_migrants(const Float4* positions, uint32_t n, int axis, float inv_cell_size, int me,
                                 cudaStream_t stream);

@@ -2,7 +2,7 @@
 // Probes and gauges in a distributed world (docs/distributed.md), for both backends' ranks (the
 // CPU rank's points are on the host; the CUDA rank downloads its points, calls this, and uploads
 // them): every rank gathers every sample point over its own particles and ghosts, but only the
-// rank whose slab holds the point's cell layer has all of the point's neighbour cells, listed in
+// rank whose slab holds the point's sub-layer has all of the point's neighbour cells, listed in
 // the undivided world's order, so every rank takes that rank's gather of the point (one
 // all-to-all of the points per sampled substep). Each rank then adds the same points in the same
 // order: the readings are the undivided world's, bit for bit, on every rank.

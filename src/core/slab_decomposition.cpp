@@ -106,24 +106,35 @@ void SlabDecomposition::rebalance(int axis, int32_t first_layer, const std::vect
   const int n = ranks();
   if (sixteenths.size() != static_cast<size_t>(n - 1) * kSlabSubLayers)
     throw Error(Status::Internal, "slabs: sixteenths for another number of ranks");
-  std::vector<int32_t> cuts(static_cast<size_t>(n - 1), INT32_MAX);
+  // Each cut at the first sub-layer of its crossing layer that the lower ranks do not take (cuts),
+  // and the same cut at the layer's end where the rest of the layer is empty (at_end): both split
+  // the same particles, and the layer's end leaves both neighbours the smaller halo (a slab that
+  // meets a layer in part takes the rest of it as ghosts).
+  std::vector<int32_t> cuts(static_cast<size_t>(n - 1), INT32_MAX), at_end(cuts);
   walk_targets(n, histogram, [&](int r, size_t k, int64_t before, int64_t target) {
     if (k >= histogram.size()) return;
-    // The first sub-layer of the crossing layer that the lower ranks do not take.
     const int64_t* mine = sixteenths.data() + static_cast<size_t>(r - 1) * kSlabSubLayers;
     int j = 0;
     for (int64_t running = before; j < kSlabSubLayers && running < target;) running += mine[j++];
-    // Where the rest of the layer is empty, the layer's end splits the same particles, and a cut
-    // there leaves both neighbours the smaller halo (a slab that meets a layer in part takes the
-    // rest of it as ghosts).
     int empty_to = j;
     while (empty_to < kSlabSubLayers && mine[empty_to] == 0) ++empty_to;
-    if (empty_to == kSlabSubLayers) j = kSlabSubLayers;
-    cuts[static_cast<size_t>(r - 1)] = slab_sublayer(first_layer + static_cast<int32_t>(k), j);
+    const int32_t layer = first_layer + static_cast<int32_t>(k);
+    cuts[static_cast<size_t>(r - 1)] = slab_sublayer(layer, j);
+    at_end[static_cast<size_t>(r - 1)] =
+        slab_sublayer(layer, empty_to == kSlabSubLayers ? kSlabSubLayers : j);
   });
-  bool allowed = true;
-  for (size_t r = 1; r < cuts.size(); ++r) allowed = allowed && middle_slab_allowed(cuts[r - 1], cuts[r]);
-  if (!allowed) {
+  if (valid(n, axis, cuts)) {
+    // A cut moves to its layer's end only where both slabs beside it stay allowed (moving it up
+    // narrows the slab above, and may make the one below a thin slab that is not whole layers); the
+    // slab above is checked against the next cut before its own move, which can only widen it.
+    for (size_t c = 0; c < cuts.size(); ++c) {
+      if (at_end[c] == cuts[c]) continue;
+      const bool below_ok = c == 0 || middle_slab_allowed(cuts[c - 1], at_end[c]);
+      const bool above_ok = c + 1 >= cuts.size() || middle_slab_allowed(at_end[c], cuts[c + 1]);
+      if (below_ok && above_ok && at_end[c] <= (c + 1 < cuts.size() ? cuts[c + 1] : INT32_MAX))
+        cuts[c] = at_end[c];
+    }
+  } else {
     // Slabs thinner than one and a half layers: whole layers, each cut after its crossing layer
     // (INT32_MAX after the last one), as before sub-layers.
     walk_targets(n, histogram, [&](int r, size_t k, int64_t, int64_t) {

@@ -9,9 +9,10 @@
 //
 // Sub-layers: each cell layer k (floor(x / h) = k) is cut in kSlabSubLayers equal parts, and
 // sub-layer 16 k + j holds its points whose fraction x / h - k lies in [j / 16, (j + 1) / 16)
-// (clamped to int32, which only the clamped far cells reach). A cut between two sub-layers of
-// one layer balances the ranks to a sixteenth of a layer's particles instead of a whole layer's
-// (issue 19: at 8 and 16 ranks whole layers left the fullest rank 14 % above the mean).
+// (clamped to [INT32_MIN, INT32_MAX - 1], which only the clamped far cells reach). A cut between
+// two sub-layers of one layer balances the ranks to a sixteenth of a layer's particles instead of
+// a whole layer's (issue 19: at 8 and 16 ranks whole layers left the fullest rank 14 % above the
+// mean).
 //
 // The neighbour walk visits whole cells: a particle of layer k reads every particle of layers
 // k - 1 .. k + 1, so the ranks whose slabs meet those three layers (other than its owner) need
@@ -47,11 +48,12 @@ SPH_HD int slab_sixteenth(float v, float inv_cell_size, int32_t layer) {
   return static_cast<int>(f);
 }
 
-// Sub-layer j of layer `layer` (int64 arithmetic, clamped to int32; j may be -16 .. 31 to name
-// the layers beside).
+// Sub-layer j of layer `layer` (int64 arithmetic, clamped to [INT32_MIN, INT32_MAX - 1]: INT32_MAX
+// is no sub-layer, only the cut past every particle, so a rank whose slab begins there owns none;
+// j may be -16 .. 31 to name the layers beside).
 SPH_HD int32_t slab_sublayer(int32_t layer, int j) {
   const int64_t s = static_cast<int64_t>(layer) * kSlabSubLayers + j;
-  return s < INT32_MIN ? INT32_MIN : (s > INT32_MAX ? INT32_MAX : static_cast<int32_t>(s));
+  return s < INT32_MIN ? INT32_MIN : (s > INT32_MAX - 1 ? INT32_MAX - 1 : static_cast<int32_t>(s));
 }
 
 // Sub-layer of a point along `axis`: what ownership reads.
@@ -75,14 +77,14 @@ SPH_HD int slab_owner(const int32_t* cuts, int count, int32_t sub) {
   return lo;
 }
 
-// Rank r's slab, the sub-layers [slab_begin, slab_end) (int64: the outer ranks reach INT32_MIN
-// and INT32_MAX; empty when begin >= end).
+// Rank r's slab, the sub-layers [slab_begin, slab_end) (the outer ranks reach INT32_MIN and
+// INT32_MAX, past the last sub-layer; empty when begin >= end).
 SPH_HD int64_t slab_begin(const int32_t* cuts, int count, int r) {
   (void)count;
   return r == 0 ? int64_t{INT32_MIN} : cuts[r - 1];
 }
 SPH_HD int64_t slab_end(const int32_t* cuts, int count, int r) {
-  return r == count ? int64_t{INT32_MAX} + 1 : cuts[r];
+  return r == count ? int64_t{INT32_MAX} : cuts[r];
 }
 
 // The ranks other than `self` whose slabs meet the layers layer - 1 .. layer + 1 (0, 1 or 2 of

@@ -3,8 +3,9 @@
 // host-staged halos over a RankTransport (MPI in libsph_mpi). A substep of a rank runs the
 // single world's passes over its own particles plus ghosts, with four steps of its own:
 //   before the sort   particles that left the slab migrate to their owner (every carried
-//                     array), the ghosts arrive (the owned particles of the cell layer beside
-//                     the slab), the world's grid shape is reduced from every rank's extent;
+//                     array), the ghosts arrive (the particles it does not own in the layers
+//                     its slab meets and those beside them), the world's grid shape is reduced
+//                     from every rank's extent;
 //   after the sort    each particle's key becomes its slot and place in the slot (springs: the
 //                     lists' partners, ids until the ghosts came, follow the sort;
 //                     cpu_halo_springs.cpp);

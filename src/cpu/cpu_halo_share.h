@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The halo's refresh of per-particle values (CpuRankHalo::share, for the records of cpu_halo.cpp,
-// cpu_halo_solvers.cpp and cpu_halo_springs.cpp): each owned particle beside another rank's slab
-// sends a record to that rank, each ghost takes its owner's.
+// cpu_halo_solvers.cpp and cpu_halo_springs.cpp): each owned particle that another rank holds as
+// a ghost sends a record to that rank, each ghost takes its owner's.
 #pragma once
 
 #include <cstring>

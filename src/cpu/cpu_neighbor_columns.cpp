@@ -6,7 +6,9 @@ namespace sph {
 namespace {
 
 // Sizes a column for n particles plus the padding, which is zero (finite, and masked off). The
-// first n elements are written by the passes before anything reads them.
+// first n elements are written by the passes before anything reads them (a distributed rank's
+// spring ghosts' density and normal slots excepted: no pass writes them, and a gather loads them
+// only in lanes its mask turns off, whose values select drops).
 void size_column(HostVector<float>& column, uint32_t n, bool keep) {
   if (!keep) return column.clear();
   column.reserve(n + kLanePadding);

@@ -5,7 +5,8 @@
 // decides which of its values the ghosts take and when (cpu_halo.cpp's halo_share_*); this
 // class knows which particles are ghosts, where each particle goes, and how a record crosses to
 // the ranks beside. Between substeps a rank holds the particles it owns; during one it also
-// holds ghosts (origins() != 0), the owned particles of the cell layer beside its slab. The sort
+// holds ghosts (origins() != 0), the particles it does not own in the cell layers its slab meets
+// and those beside them (core/slab_rules.h). The sort
 // takes the particles in the order of their keys (sort_keys(): slot and place in it at the last
 // sort, the same on every rank), so each cell lists its particles in the order one undivided
 // world would, and every sum runs in the same order. Each step is collective, and each place

@@ -29,8 +29,14 @@ void test_uncut(void**) {
   assert_int_equal(s.ranks(), 3);
   assert_int_equal(s.owner(-1000), 0);
   assert_int_equal(s.owner(1 << 30), 0);
+  // The far end too: no sub-layer reaches INT32_MAX, the cut past every particle.
+  assert_int_equal(s.owner(sph::slab_position(1e30f, 0.0f, 0.0f, 0, 1.0f)), 0);
   int to[2];
   assert_int_equal(s.ghost_destinations(5, 0, to), 0);
+  assert_int_equal(s.ghost_destinations(1 << 30, 0, to), 0);
+  sph::DistributedCounters c;
+  s.describe(2, c);  // the last rank, whose slab begins at INT32_MAX: empty
+  assert_true(c.sub_first > c.sub_last);
 }
 
 // A sub-layer is the layer's sixteenth: points at the middle of sixteenth j of layer k
@@ -64,7 +70,7 @@ void test_sub_layers(void**) {
     previous = sub;
   }
   // Far cells clamp without overflow, NaN goes where cell_coordinate sends it.
-  assert_int_equal(sph::slab_position(1e30f, 0.0f, 0.0f, 0, 1.0f), INT32_MAX);
+  assert_int_equal(sph::slab_position(1e30f, 0.0f, 0.0f, 0, 1.0f), INT32_MAX - 1);
   assert_int_equal(sph::slab_position(-1e30f, 0.0f, 0.0f, 0, 1.0f), INT32_MIN);
   assert_int_equal(sph::slab_position(std::nanf(""), 0.0f, 0.0f, 0, 1.0f), INT32_MIN);
 }
@@ -154,6 +160,22 @@ void test_whole_layers_when_thin(void**) {
   assert_true(c.sub_first > c.sub_last && c.slab_first > c.slab_last);
 }
 
+// A cut moves to its layer's end only where the slabs beside it stay allowed. Layer 0 holds 10
+// particles in sixteenth 0, layer 1 holds one in each of sixteenths 0-9 and ten in sixteenth 15;
+// 3 ranks, targets 10 and 20: cut 1 after sixteenth 0 of layer 0 (its rest is empty: the layer's
+// end, 16, splits the same), cut 2 at 16 + 10. At 16 the middle slab [16, 26) would be 10 wide
+// and not whole layers, so cut 1 stays at 1 (a 25-wide middle slab) and the ranks hold 10 each;
+// moving it anyway would have thrown the decomposition back to whole layers (10 / 20 / 0).
+void test_layer_end_only_where_allowed(void**) {
+  SlabDecomposition s(3);
+  std::vector<int64_t> sixteenths(2 * 16, 0);
+  sixteenths[0] = 10;
+  for (size_t j = 0; j < 10; ++j) sixteenths[16 + j] = 1;
+  sixteenths[16 + 15] = 10;
+  s.rebalance(0, 0, {10, 20}, sixteenths);
+  assert_true(s.cuts() == (std::vector<int32_t>{1, 26}));
+}
+
 void test_valid(void**) {
   assert_true(SlabDecomposition::valid(3, 0, {5, 29}));     // a middle slab of 24
   assert_false(SlabDecomposition::valid(3, 0, {5, 28}));    // of 23
@@ -182,10 +204,11 @@ std::vector<int> brute_destinations(const std::vector<int32_t>& cuts, int32_t la
   std::vector<int> want;
   for (int r = 0; r < ranks; ++r) {
     const int64_t b = r == 0 ? int64_t{INT32_MIN} : cuts[static_cast<size_t>(r - 1)];
-    const int64_t e = r == ranks - 1 ? int64_t{INT32_MAX} + 1 : cuts[static_cast<size_t>(r)];
-    // (Sub-layers are clamped to int32: the far layers' particles all sit at its ends.)
-    const int64_t clo = std::min<int64_t>(std::max<int64_t>(lo, INT32_MIN), INT32_MAX);
-    const int64_t chi = std::min<int64_t>(std::max<int64_t>(hi, INT32_MIN), INT32_MAX);
+    const int64_t e = r == ranks - 1 ? int64_t{INT32_MAX} : cuts[static_cast<size_t>(r)];
+    // (Sub-layers are clamped to [INT32_MIN, INT32_MAX - 1]: the far layers' particles all sit
+    // at its ends.)
+    const int64_t clo = std::min<int64_t>(std::max<int64_t>(lo, INT32_MIN), INT32_MAX - 1);
+    const int64_t chi = std::min<int64_t>(std::max<int64_t>(hi, INT32_MIN), INT32_MAX - 1);
     if (r != self && b < e && b <= chi && e > clo) want.push_back(r);
   }
   return want;
@@ -249,6 +272,7 @@ int main(void) {
       cmocka_unit_test(test_sub_layers),
       cmocka_unit_test(test_rebalance_cuts),
       cmocka_unit_test(test_whole_layers_when_thin),
+      cmocka_unit_test(test_layer_end_only_where_allowed),
       cmocka_unit_test(test_valid),
       cmocka_unit_test(test_imbalance),
       cmocka_unit_test(test_rules_brute_force),
