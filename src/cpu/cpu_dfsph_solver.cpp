@@ -63,8 +63,15 @@ void CpuBackend::dfsph_correct(const FluidConstants& fluid, const DfsphWalls& wa
                                                        ? simd_.dfsph_velocity_change_corrected
                                                        : simd_.dfsph_velocity_change;
   // The gather reads positions and k; each particle writes only its own velocity (record and
-  // column), which the next rate pass reads.
+  // column), which the next rate pass reads. A distributed rank's ghosts keep only their sums of
+  // k (the conjugate gradients read them): their velocities are their owners', taken right after
+  // every call (share_velocities), and their clamps count in no load.
+  const uint32_t* halo = origins();
   parallel().for_each(count_, [&](uint32_t i) {
+    if (halo && halo[i]) {
+      carried[i] += k[i] * carry_scale;
+      return;
+    }
     Vec3 vi = xyz(v[i]) + change(fluid, view, columns, k, walls, i, dt);
     if (contact) dfsph_clamp(i, vi);
     v[i] = make_float4_record(vi, v[i].w);
@@ -88,8 +95,12 @@ void CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, c
   // SPH_DFSPH_CHEBYSHEV (dfsph_passes.h): the density solve's steps mixed with the last ones.
   const bool chebyshev = kind == DfsphSolve::Density && c.linear_solver == kDfsphChebyshev;
   const float weight = chebyshev ? chebyshev_weight(pass) : 1.0f;
-  // The gather reads positions and the velocities' columns; each particle writes only its k.
+  // The gather reads positions and the velocities' columns; each particle writes only its k. A
+  // distributed rank's ghosts are skipped: they take their owners' k right after (share_steps),
+  // and the errors leave them out.
+  const uint32_t* halo = origins();
   parallel().for_each(count_, [&](uint32_t i) {
+    if (halo && halo[i]) return;
     const float rate = density_rate_of(fluid, view, columns, walls, i);
     if (chebyshev) {
       const DfsphResidual r =
