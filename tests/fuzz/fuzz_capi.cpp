@@ -449,8 +449,6 @@ class Program {
       d.max_capacity = static_cast<uint32_t>(resolved - 1);  // below the capacity: refused (unless 0)
     else if (growth == 63)
       d.max_capacity = (1u << 30) + 1u;  // past the hard limit: refused
-    const bool max_refused =
-        d.max_capacity != 0 && (d.max_capacity < resolved || d.max_capacity > (1u << 30));
     const uint32_t integrator = in_.chance(224) ? in_.u8() % 2 : in_.u32();
     const uint32_t viscosity = in_.chance(224) ? in_.u8() % 2 : in_.u32();
     const uint32_t eos = in_.chance(224) ? in_.u8() % 2 : in_.u32();
@@ -464,6 +462,17 @@ class Program {
     }
     if (in_.chance(8)) d.header_version = in_.u32();
     d.struct_size = struct_size(sizeof(sph_world_def));
+    // What the library reads of max_capacity: the bytes of it that struct_size covers (a fuzzed
+    // size may end inside the field; the library reads min(struct_size, its size) bytes,
+    // docs/versioning.md), so the rest of the field counts as zero.
+    const uint32_t max_seen = [&] {
+      const size_t at = offsetof(sph_world_def, max_capacity);
+      uint32_t v = 0;
+      if (d.struct_size > at)
+        std::memcpy(&v, &d.max_capacity, std::min<size_t>(sizeof v, d.struct_size - at));
+      return v;
+    }();
+    const bool max_refused = max_seen != 0 && (max_seen < resolved || max_seen > (1u << 30));
     sph_world* out = nullptr;
     const sph_result r = FUZZ_CALL(sph_world_create(c, in_.chance(8) ? nullptr : &d, &out));
     if (r != SPH_OK) {
@@ -471,8 +480,7 @@ class Program {
       return;
     }
     if (cslot < 0) violation("sph_world_create succeeded on a dead or foreign context");
-    const bool read_max = d.struct_size >= offsetof(sph_world_def, max_capacity) + sizeof(uint32_t);
-    if (read_max && max_refused) violation("sph_world_create accepted max_capacity %u", d.max_capacity);
+    if (max_refused) violation("sph_world_create accepted max_capacity %u", max_seen);
     WorldSlot& w = worlds_[slot];
     w.ptr = out;
     w.context = cslot;
@@ -487,7 +495,7 @@ class Program {
     w.spacing = got.particle_spacing;
     if (got.capacity != resolved)
       violation("the world's capacity %u is not the def's %u", got.capacity, d.capacity);
-    const uint32_t max_expected = read_max && d.max_capacity != 0 ? d.max_capacity : got.capacity;
+    const uint32_t max_expected = max_seen != 0 ? max_seen : got.capacity;
     if (got.max_capacity != max_expected)
       violation("the world's max_capacity %u is not the def's %u", got.max_capacity, max_expected);
     if (!(got.kernel_radius >= got.particle_spacing)) violation("kernel radius below the spacing");
