@@ -215,11 +215,12 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
   const float a2max = parallel().reduce(
       count_, 0.0f,
       [&](uint32_t i, float& m) {
+        // A distributed world's ghost: its owner's acceleration counts, and its v* is its owner's,
+        // shared after the density solve's first velocity update, which reads no ghost's v*.
+        if (origin && origin[i]) return;
         Vec3 a = acceleration(non_pressure, fluid, view, columns, scene, i);
         if (spring) a += xyz(spring[i]);
-        // (a distributed world's halo: its owner's acceleration counts; its v* is replaced by its
-        // owner's after the density solve's first velocity update)
-        if (!(origin && origin[i])) m = std::max(m, length_squared(a));
+        m = std::max(m, length_squared(a));
         Vec3 v = xyz(vel[i]) + a * dt;
         if (contact) dfsph_clamp(i, v);
         next_vel[i] = make_float4_record(v, vel[i].w);

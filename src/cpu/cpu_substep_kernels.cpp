@@ -47,10 +47,10 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
   const ColliderView* colliders = collider_views_.data();
   const uint32_t collider_count = static_cast<uint32_t>(collider_views_.size());
   (void)scene;  // its colliders, with their maps bound, are collider_views_
-  // A distributed world's ghosts (null otherwise): the weakly compressible passes below skip them,
+  // A distributed world's ghosts (null otherwise): the density passes below skip them,
   // as the force pass does, since each publication ends with the ghosts taking their owners'
-  // values (halo_share_density, halo_share_normals), and a ghost's own sums, over a neighbourhood
-  // that is not complete on this rank, were only ever overwritten. (A sum reads its neighbours'
+  // values (halo_share_density, halo_share_dfsph_density, halo_share_normals), and a ghost's own sums, over a
+  // neighbourhood that is not complete on this rank, were only ever overwritten. (A sum reads its neighbours'
   // positions and published values alone, so the owned particles' bits do not change.)
   const uint32_t* halo = origins();
   // The walls' share at particle i (SPH_FEATURE_BOUNDARY_DENSITY), its record kept for the force
@@ -69,6 +69,10 @@ void CpuBackend::sort_and_density(const FluidConstants& fluid, const SceneFrame&
     // (cpu_dfsph_solver.cpp).
     float* dfsph_factor = dfsph_factor_.data();
     parallel().for_each(count_, [&](uint32_t i) {
+      if (halo && halo[i]) {  // a ghost: its owner's density, factor and count arrive below
+        pos[i].w = 0.0f;      // (which the share writes into the column with them)
+        return;
+      }
       const DfsphDensitySample s = simd_.dfsph_density_and_factor(fluid, view, columns, wall(i), i);
       density_[i] = s.density;
       neighbors_[i] = s.neighbor_count;
