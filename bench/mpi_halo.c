@@ -2,8 +2,12 @@
 /* The two-rank calibration of docs/scaling.md's model on the CPU backend (issue 19 item 6):
  *
  *   mpirun -np R bench/mpi_halo [--spacing S] [--substeps K] [--backend cpu|cuda] [--springs 1]
- *                               [--workers W] [--wait-barriers 1]
+ *                               [--workers W] [--wait-barriers 1] [--solver wcsph|dfsph]
  *
+ * --solver dfsph: the world steps DFSPH (the library's default linear solver and bounds) instead
+ * of the weakly compressible scheme; its solves' iterations over the timed step are printed, since
+ * a DFSPH substep's cost is mostly theirs (each iteration two neighbour passes and two halo
+ * shares).
  * --backend cuda: every rank on the CUDA backend (the host-staged halo path; ranks on one GPU
  * share it), the GPU calibration of the model. --springs 1: with SPH_FEATURE_SPRINGS (every
  * particle linked to its lattice neighbours in the warm-up frame; springs across ranks, on CPU
@@ -187,6 +191,7 @@ int main(int argc, char** argv) {
   int springs = 0;
   uint32_t workers = 0;
   int wait_barriers = 0;
+  sph_solver solver = SPH_SOLVER_WCSPH;
   mpi_halo_transport before, after;
   int rank, size;
   sph_context* context = NULL;
@@ -213,6 +218,15 @@ int main(int argc, char** argv) {
     if (strcmp(argv[i], "--springs") == 0) springs = atoi(argv[i + 1]) != 0;
     if (strcmp(argv[i], "--workers") == 0) workers = (uint32_t)atoi(argv[i + 1]);
     if (strcmp(argv[i], "--wait-barriers") == 0) wait_barriers = atoi(argv[i + 1]) != 0;
+    if (strcmp(argv[i], "--solver") == 0) {
+      if (strcmp(argv[i + 1], "dfsph") == 0) {
+        solver = SPH_SOLVER_DFSPH;
+      } else if (strcmp(argv[i + 1], "wcsph") != 0) {
+        if (rank == 0) fprintf(stderr, "mpi_halo: --solver takes wcsph or dfsph, not %s\n", argv[i + 1]);
+        MPI_Finalize();
+        return 2;
+      }
+    }
   }
   {
     sph_context_def context_def;
@@ -224,6 +238,7 @@ int main(int argc, char** argv) {
   def.particle_spacing = spacing;
   def.kernel_radius = 1.8f * spacing;
   if (springs) def.features |= SPH_FEATURE_SPRINGS;
+  def.solver = solver;
   /* The block holds about sqrt 2 (0.8 x 0.4 x 0.2 m) / spacing^3 particles (the FCC lattice);
    * room for all of them on any rank, at least 2^20. */
   {
@@ -279,8 +294,9 @@ int main(int argc, char** argv) {
   }
   if (rank == 0) {
     const double model = model_sum / size;
-    printf("backend %s%s, workers a rank %u (0: all hardware threads)%s\n",
-           backend == SPH_BACKEND_CUDA ? "cuda" : "cpu", springs ? ", springs" : "", workers,
+    printf("backend %s%s, %s, workers a rank %u (0: all hardware threads)%s\n",
+           backend == SPH_BACKEND_CUDA ? "cuda" : "cpu", springs ? ", springs" : "",
+           solver == SPH_SOLVER_DFSPH ? "DFSPH" : "WCSPH", workers,
            wait_barriers ? ", a timed barrier before each transport call" : "");
     printf("ranks %d, %u particles (%.0f per rank, the fullest %lld), %u substeps\n", size, n,
            (double)n / size, (long long)owned_max, stats.substeps);
@@ -289,6 +305,10 @@ int main(int argc, char** argv) {
         "neighbour) h / L per slab face, h = 1.8 spacings)\n",
         (double)c.global_ghosts / size, model);
     printf("ms per substep (slowest rank): %.3f\n", 1e3 * slowest / stats.substeps);
+    if (solver == SPH_SOLVER_DFSPH)
+      printf("DFSPH iterations a substep: density %.2f, divergence %.2f\n",
+             (double)stats.pressure_iterations / stats.substeps,
+             (double)stats.divergence_iterations / stats.substeps);
     printf("rank 0 stage ms over the step:");
     for (int s = 0; s < SPH_STAGE_COUNT; ++s) printf(" %.1f", stats.stage_ms[s]);
     printf("\n");
