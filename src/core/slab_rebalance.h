@@ -63,7 +63,7 @@ bool rebalance_slabs(const RankTransport& t, SlabDecomposition& slabs, bool alre
   std::vector<int64_t> sixteenths(crossing.size() * kSlabSubLayers, 0);
   for (uint32_t i = 0; i < count && !crossing.empty(); ++i) {
     const auto p = position_of(i);
-    const float v = axis == 0 ? p.x : (axis == 1 ? p.y : p.z);
+    const float v = slab_axis_coordinate(p.x, p.y, p.z, axis);
     const int32_t layer = cell_coordinate(v, inv_cell_size);
     const auto at = std::lower_bound(crossing.begin(), crossing.end(), layer);
     if (at == crossing.end() || *at != layer) continue;

@@ -33,9 +33,14 @@ namespace sph {
 constexpr int kSlabSubLayers = 16;
 constexpr int kSlabMinWidth = 24;  // sub-layers: one and a half layers
 
+// A point's coordinate along the slabs' axis (0: x, 1: y, 2: z): the one place that picks it.
+SPH_HD float slab_axis_coordinate(float x, float y, float z, int axis) {
+  return axis == 0 ? x : (axis == 1 ? y : z);
+}
+
 // Cell layer of a point along `axis`.
 SPH_HD int32_t slab_layer(float x, float y, float z, int axis, float inv_cell_size) {
-  return cell_coordinate(axis == 0 ? x : (axis == 1 ? y : z), inv_cell_size);
+  return cell_coordinate(slab_axis_coordinate(x, y, z, axis), inv_cell_size);
 }
 
 // Which sixteenth of its layer `layer` (cell_coordinate(v, inv)) coordinate v lies in, 0-15:
@@ -58,7 +63,7 @@ SPH_HD int32_t slab_sublayer(int32_t layer, int j) {
 
 // Sub-layer of a point along `axis`: what ownership reads.
 SPH_HD int32_t slab_position(float x, float y, float z, int axis, float inv_cell_size) {
-  const float v = axis == 0 ? x : (axis == 1 ? y : z);
+  const float v = slab_axis_coordinate(x, y, z, axis);
   const int32_t layer = cell_coordinate(v, inv_cell_size);
   return slab_sublayer(layer, slab_sixteenth(v, inv_cell_size, layer));
 }

@@ -89,7 +89,7 @@ void CpuRankHalo::agree() const { sph::agree(*ranks_); }
 
 namespace {
 
-float axis_coordinate(const Float4& p, int axis) { return axis == 0 ? p.x : (axis == 1 ? p.y : p.z); }
+float axis_coordinate(const Float4& p, int axis) { return slab_axis_coordinate(p.x, p.y, p.z, axis); }
 
 }  // namespace
 
