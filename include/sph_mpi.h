@@ -27,11 +27,13 @@
  * load or restore fails on one rank (an allocation, a crowded cell, a non-finite state, a file),
  * every rank returns an error and rolls back (the failing rank its own code and message, the
  * others the first failing rank's code, the message naming that rank), rather than waiting in
- * MPI for it. What is checked before the world's communicator can be used is not agreed: a NULL
- * or destroyed world (SPH_ERROR_INVALID_HANDLE), a world in use by another thread of that rank
- * (SPH_ERROR_WORLD_LOCKED) or one whose device was lost (SPH_ERROR_DEVICE_LOST) returns at once on
- * that rank while the others wait in MPI for it, as with any MPI collective that some ranks do not
- * call. After a failure that names a lost device, destroy the world on every rank.
+ * MPI for it. So is a lost device: a rank whose world answers SPH_ERROR_DEVICE_LOST (a sticky
+ * device error, seen by any call on that rank) refuses each later collective call inside the
+ * call's first agreement, so every rank returns an error that names the lost device; destroy the
+ * world on every rank. What is checked before the world's communicator can be used is not agreed:
+ * a NULL or destroyed world (SPH_ERROR_INVALID_HANDLE) or a world in use by another thread of that
+ * rank (SPH_ERROR_WORLD_LOCKED) returns at once on that rank while the others wait in MPI for it,
+ * as with any MPI collective that some ranks do not call.
  */
 #ifndef SPH_MPI_H
 #define SPH_MPI_H

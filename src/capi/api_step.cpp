@@ -42,6 +42,7 @@ void require_frame(const sph_world* world, float frame_dt) {
   }
   uint64_t params_hash = 0;
   agreed(*ranks, [&] {
+    WorldLock::require_device_not_lost(world);  // (the lock left it to this agreement)
     require_positive(frame_dt, "frame_dt");
     ByteWriter w;
     write_params(w, world->world->params());  // (the checkpoints' canonical bytes)
@@ -158,7 +159,7 @@ extern "C" {
 SPH_API sph_result SPH_CALL sph_world_step(sph_world* world, float frame_dt) {
   return sph::guarded("sph_world_step", sph::context_of(world), [&] {
     sph::require_world(world);
-    sph::WorldLock lock(world);
+    sph::WorldLock lock(world, sph::WorldLock::kAgreeDeviceLoss);  // (require_frame agrees on it)
     sph::require_frame(world, frame_dt);
     return sph::run_frame(world, frame_dt) ? SPH_OK : SPH_INCOMPLETE;
   });

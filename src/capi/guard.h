@@ -94,9 +94,14 @@ sph_result guarded(const char* function, const LogTarget& log, Body&& body) noex
 // Every call that takes a world, const ones included, holds it: the lock is taken under the
 // handle registry's mutex, so a concurrent sph_world_destroy cannot free the world meanwhile
 // (destroy takes the same lock before the world leaves the registry).
+//
+// A collective call on a distributed world (sph_mpi.h) takes it with kAgreeDeviceLoss: a rank whose
+// device was lost must not return before the others reach their first agreement, where they would
+// wait for it in MPI; the call throws require_device_not_lost's error inside that agreement instead.
 class WorldLock {
  public:
-  explicit WorldLock(const sph_world* world) : world_(world) {
+  enum DeviceLoss { kThrowDeviceLoss, kAgreeDeviceLoss };
+  explicit WorldLock(const sph_world* world, DeviceLoss device_loss = kThrowDeviceLoss) : world_(world) {
     if (!world_) throw Error(Status::InvalidHandle, "world: is NULL");
     const Take take = try_take_world(world_);
     if (take == Take::NotLive)
@@ -104,10 +109,14 @@ class WorldLock {
     if (take == Take::Busy)
       throw Error(Status::WorldLocked,
                   "world: it is in use by another call (a world is used from one thread at a time)");
-    if (world_->device_lost) {
+    if (world_->device_lost && !(device_loss == kAgreeDeviceLoss && distributed(world_))) {
       release_world(world_);
-      throw Error(Status::DeviceLost, "world: its device was lost after a sticky device error; destroy it");
+      throw_device_lost();
     }
+  }
+  // Inside a distributed collective call's first agreement (kAgreeDeviceLoss).
+  static void require_device_not_lost(const sph_world* world) {
+    if (world->device_lost) throw_device_lost();
   }
   ~WorldLock() {
     if (world_) release_world(world_);
@@ -118,6 +127,10 @@ class WorldLock {
   WorldLock& operator=(const WorldLock&) = delete;
 
  private:
+  [[noreturn]] static void throw_device_lost() {
+    throw Error(Status::DeviceLost, "world: its device was lost after a sticky device error; destroy it");
+  }
+  static bool distributed(const sph_world* world) { return world->world->backend().distributed(); }
   const sph_world* world_;
 };
 

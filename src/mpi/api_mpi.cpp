@@ -101,9 +101,10 @@ SPH_API sph_result SPH_CALL sph_mpi_world_add_particles(sph_world* world, const 
                                                         uint32_t* out_first_id) {
   return sph::guarded("sph_mpi_world_add_particles", sph::context_of(world), [&] {
     sph::require_world(world);
-    sph::WorldLock lock(world);
+    sph::WorldLock lock(world, sph::WorldLock::kAgreeDeviceLoss);
     sph::World& w = *world->world;
     const sph::RankTransport& ranks = sph::ranks_of(world);
+    sph::agreed(ranks, [&] { sph::WorldLock::require_device_not_lost(world); });
     // The ids: rank order, after what the world has numbered.
     const int64_t below = ranks.exclusive_sum(count);
     int64_t total = count;
@@ -152,8 +153,9 @@ SPH_API sph_result SPH_CALL sph_mpi_world_step(sph_world* world, float frame_dt)
 SPH_API sph_result SPH_CALL sph_mpi_world_get_counts(const sph_world* world, sph_mpi_counts* out) {
   return sph::guarded("sph_mpi_world_get_counts", sph::context_of(world), [&] {
     sph::require_world(world);
-    sph::WorldLock lock(world);
+    sph::WorldLock lock(world, sph::WorldLock::kAgreeDeviceLoss);
     const sph::RankTransport& ranks = sph::ranks_of(world);
+    sph::agreed(ranks, [&] { sph::WorldLock::require_device_not_lost(world); });
     const sph::DistributedCounters c = world->world->backend().distributed_counters();
     int64_t sums[3] = {world->world->particle_count(), c.ghosts, c.migrated_out};
     ranks.all_sum(sums, 3);  // (before any check of this rank's arguments: the other ranks wait for it)
@@ -182,7 +184,7 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t
                                                  uint64_t* out_count) {
   return sph::guarded("sph_mpi_world_gather", sph::context_of(world), [&] {
     sph::require_world(world);
-    sph::WorldLock lock(world);
+    sph::WorldLock lock(world, sph::WorldLock::kAgreeDeviceLoss);
     const sph::RankTransport& ranks = sph::ranks_of(world);
     sph::require_root(ranks, root);
     struct Record {
@@ -191,12 +193,18 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t
     };
     const sph::Backend& b = world->world->backend();
     const uint32_t n = world->world->particle_count();
-    sph::HostVector<Record> mine(n);
-    if (n > 0) {
-      b.copy_attribute(sph::AttributeKind::Id, 0, n, &mine[0].id, sizeof(Record));
-      b.copy_attribute(sph::AttributeKind::Position, 0, n, mine[0].x, sizeof(Record));
-      b.copy_attribute(sph::AttributeKind::Velocity, 0, n, mine[0].v, sizeof(Record));
-    }
+    sph::HostVector<Record> mine;
+    // This rank's records, agreed: a rank whose device copy or allocation fails (or whose device
+    // was lost before the call) must not leave the others waiting in the gather.
+    sph::agreed(ranks, [&] {
+      sph::WorldLock::require_device_not_lost(world);
+      mine.resize(n);
+      if (n > 0) {
+        b.copy_attribute(sph::AttributeKind::Id, 0, n, &mine[0].id, sizeof(Record));
+        b.copy_attribute(sph::AttributeKind::Position, 0, n, mine[0].x, sizeof(Record));
+        b.copy_attribute(sph::AttributeKind::Velocity, 0, n, mine[0].v, sizeof(Record));
+      }
+    });
     const unsigned char* bytes = reinterpret_cast<const unsigned char*>(mine.data());
     const std::vector<sph::RankBytes> all =
         ranks.gather(sph::RankBytes(bytes, bytes + n * sizeof(Record)), root);
@@ -229,13 +237,17 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather_removed_ids(const sph_world* wo
                                                              uint32_t* out_count) {
   return sph::guarded("sph_mpi_world_gather_removed_ids", sph::context_of(world), [&] {
     sph::require_world(world);
-    sph::WorldLock lock(world);
+    sph::WorldLock lock(world, sph::WorldLock::kAgreeDeviceLoss);
     const sph::RankTransport& ranks = sph::ranks_of(world);
     sph::require_root(ranks, root);
-    const sph::HostVector<uint32_t>& mine = world->world->removed_ids();
-    const unsigned char* bytes = reinterpret_cast<const unsigned char*>(mine.data());
-    const std::vector<sph::RankBytes> all =
-        ranks.gather(sph::RankBytes(bytes, bytes + mine.size() * sizeof(uint32_t)), root);
+    sph::RankBytes packed;
+    sph::agreed(ranks, [&] {
+      sph::WorldLock::require_device_not_lost(world);
+      const sph::HostVector<uint32_t>& mine = world->world->removed_ids();
+      const unsigned char* bytes = reinterpret_cast<const unsigned char*>(mine.data());
+      packed.assign(bytes, bytes + mine.size() * sizeof(uint32_t));
+    });
+    const std::vector<sph::RankBytes> all = ranks.gather(packed, root);
     if (ranks.rank() != root) {
       if (out_count) *out_count = 0;
       return SPH_OK;

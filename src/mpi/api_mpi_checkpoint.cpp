@@ -254,7 +254,7 @@ extern "C" {
 SPH_API sph_result SPH_CALL sph_mpi_world_save_file(const sph_world* world, const char* path) {
   return sph::guarded("sph_mpi_world_save_file", sph::context_of(world), [&] {
     sph::require_world(world);
-    sph::WorldLock lock(world);
+    sph::WorldLock lock(world, sph::WorldLock::kAgreeDeviceLoss);
     const sph::RankTransport& ranks = sph::ranks_of(world);
     const std::string target = path ? path : "";
     sph::RankBytes mine;
@@ -266,7 +266,10 @@ SPH_API sph_result SPH_CALL sph_mpi_world_save_file(const sph_world* world, cons
     // rank 0 replaces the manifest, the one step that switches sets. Then each rank removes its
     // file of the old set. A failure (or a crash) before the manifest is replaced leaves the
     // old set whole and named by its manifest.
-    sph::agreed(ranks, [&] { sph::require_path(path); });
+    sph::agreed(ranks, [&] {
+      sph::WorldLock::require_device_not_lost(world);
+      sph::require_path(path);
+    });
     sph::require_same_path(ranks, path);
     try {
       sph::agreed(ranks, [&] {
@@ -339,11 +342,14 @@ SPH_API sph_result SPH_CALL sph_mpi_world_load_file(sph_context* context, int32_
 SPH_API sph_result SPH_CALL sph_mpi_world_restore_file(sph_world* world, const char* path) {
   return sph::guarded("sph_mpi_world_restore_file", sph::context_of(world), [&] {
     sph::require_world(world);
-    sph::WorldLock lock(world);
+    sph::WorldLock lock(world, sph::WorldLock::kAgreeDeviceLoss);
     const sph::RankTransport& ranks = sph::ranks_of(world);
     const std::shared_ptr<const sph::RankTransport> shared = world->world->backend().shared_rank_transport();
     std::unique_ptr<sph::World> loaded;
-    sph::agreed(ranks, [&] { sph::require_path(path); });
+    sph::agreed(ranks, [&] {
+      sph::WorldLock::require_device_not_lost(world);
+      sph::require_path(path);
+    });
     sph::require_same_path(ranks, path);
     // Built whole beside the world's state, swapped in once every rank has built its own.
     sph::agreed(ranks, [&] { loaded = sph::load_rank(world->context, shared, path); });
