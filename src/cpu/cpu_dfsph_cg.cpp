@@ -6,14 +6,16 @@
 // two passes. Every sum is exact (exact_float_sum.h) and taken in storage order, and the
 // contacts are held in storage order, so no result depends on the worker count.
 //
-// On a rank of a distributed world (docs/distributed.md) the passes run over the rank's own
-// particles and its ghosts, as the Jacobi solve's do, and a ghost's results of a neighbour pass
-// (its neighbourhood is incomplete) are replaced by its owner's where a neighbour reads them: the
-// ghosts take their owners' velocities after the warm start's update, their search directions p
-// before each velocity update of p, and their velocity steps dv_p after it (the rate pass reads
-// them). Everything else a ghost holds follows from these as its owner's does (v, the carried
-// pressure, the contact holds, which depend on the particle's own velocity alone); its tracked
-// value is its own and never read. The sums and the maxima cover the rank's own particles; their
+// On a rank of a distributed world (docs/distributed.md) the neighbour passes run over the rank's
+// own particles and skip its ghosts, whose results there (over an incomplete neighbourhood) would
+// only be replaced by their owners': the ghosts take their owners' velocities after the warm
+// start's update, their search directions p before each velocity update of p, and their velocity
+// steps dv_p after it (the rate pass reads them). Everything else a ghost holds follows from these
+// as its owner's does (v, the carried pressure, the contact holds, which depend on the particle's
+// own velocity alone, and which the ghosts must still make: a held ghost adds to its neighbours'
+// tracked values, as its owner's hold does on the owner's rank); a ghost's own tracked value
+// (zero here, since its rate is not computed) feeds only its own search direction, which its
+// owner's replaces before any use. The sums and the maxima cover the rank's own particles; their
 // bins are added over the ranks and the maxima taken over them (dfsph_cg_world), and the means
 // divide by the world's count, so every rank takes the undivided world's decisions and bits.
 #include <cmath>
@@ -38,7 +40,14 @@ DfsphErrors CpuBackend::dfsph_cg_measure(const FluidConstants& fluid, const Dfsp
   float* value = cg_value_.data();
   float* error = dfsph_residual_.data();
   const SimdPasses::DfsphRateFn rate_of = simd_.dfsph_density_rate;
+  // A distributed rank's ghosts are skipped (the file's top).
+  const uint32_t* halo = origins();
   parallel().for_each(count_, [&](uint32_t i) {
+    if (halo && halo[i]) {
+      value[i] = 0.0f;
+      error[i] = 0.0f;
+      return;
+    }
     value[i] = dfsph_cg_value(rate_of(fluid, view, columns, walls, i), density[i], rho0, dt);
     error[i] = dfsph_cg_error(value[i], rho0);
   });
@@ -158,7 +167,9 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
     // The operator on p: the velocities p would give, and their rates (on a rank, the velocity
     // update reads the ghosts' p and the rate pass their dv_p: each takes its owner's).
     if (rank_) halo_share_dfsph_step();
+    const uint32_t* halo = origins();  // (a ghost's dv_p is its owner's, shared below)
     parallel().for_each(n, [&](uint32_t i) {
+      if (halo && halo[i]) return;
       Vec3 d = change_of(fluid, view, columns, p, walls, i, dt);
       if (state[i] & kBinds) d = dfsph_contact_project(contact[i], d);
       dv[i] = make_float4_record(d, 0.0f);
@@ -168,7 +179,9 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
     // The rates of dv_p alone (linear, so the tracked values' rounding is never amplified by a
     // long step, as it would be by value(v + dv_p) - value).
     parallel().for_each(n, [&](uint32_t i) {
-      change[i] = dfsph_cg_change(rate_of(fluid, view, columns, walls, i), walls, i, dt);
+      // (a ghost's rate would change only its own tracked value, which nothing reads)
+      change[i] =
+          halo && halo[i] ? 0.0f : dfsph_cg_change(rate_of(fluid, view, columns, walls, i), walls, i, dt);
     });
     ExactFloatSum pq_sum;  // p . A p (the value falls along p)
     for (uint32_t i = 0; i < n; ++i)
