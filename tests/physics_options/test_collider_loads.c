@@ -296,7 +296,10 @@ static void test_submerged_box_buoyancy(void** state) {
    * --perturb; no particle caught inside the box's edges, no contacts: the walls in the density
    * alone carry the box, and its settled state's average depends on rounding; docs/validation.md
    * "The submerged box: particles caught inside its edges"). The bound is the spread's end with room for
-   * rounding; the issue's 2 % is asserted with LOADS_STRICT=1 (physics_collider_loads_strict_KNOWN_ISSUE). */
+   * rounding; the issue's 2 % is asserted with LOADS_STRICT=1 (physics_collider_loads_strict_KNOWN_ISSUE).
+   * Session 39's ensemble of the breakdown program's box (12 seeds on CUDA, the tests' 0.8 s of settling)
+   * read +1.1 to +10.9 %, mean +6.3 %: the bound's room above that spread is small (docs/validation.md,
+   * "Session 39: the submerged box as an ensemble"). */
   assert_true((fabs(on / expected - 1.0) <= wall_bound(0.12) && fabs(on - expected) < fabs(off - expected)) ||
               measuring());
 }
