@@ -14,15 +14,6 @@
 #include "mpi_test_world.h"
 #include "sph_cuda.h"
 
-static sph_context* cuda_context(void) {
-  sph_context_def cdef;
-  sph_context* c = NULL;
-  REQUIRE(sph_context_def_init(&cdef) == SPH_OK, "context def");
-  cdef.backend = SPH_BACKEND_CUDA;
-  REQUIRE(sph_context_create(&cdef, &c) == SPH_OK, "CUDA context: %s", sph_get_last_error());
-  return c;
-}
-
 /* A collective call's result on this rank: an error everywhere, DEVICE_LOST on the lost rank, and
  * elsewhere a message that names the lost device. */
 static void expect_refused(const char* call, sph_result r, int lost_rank) {
@@ -47,7 +38,7 @@ int main(int argc, char** argv) {
   const char* path = "gpu_check_mpi_device_lost.sphrank";
   mpi_test_init(&argc, &argv, &cpu);
   lost_rank = g_size - 1;
-  cuda = cuda_context();
+  cuda = mpi_test_cuda_context(0);
   mpi_test_world_def(&def);
   def.capacity = 32768;
   mpi_test_dam(cuda, &def, 0.0f, NULL, NULL, &world, &n);

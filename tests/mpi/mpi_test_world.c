@@ -37,6 +37,17 @@ void mpi_test_world_def(sph_world_def* def) {
   def->kernel_radius = MPI_TEST_KERNEL_RADIUS;
 }
 
+sph_context* mpi_test_cuda_context(uint32_t lanes) {
+  sph_context_def cdef;
+  sph_context* c = NULL;
+  REQUIRE(sph_context_def_init(&cdef) == SPH_OK, "context def");
+  cdef.backend = SPH_BACKEND_CUDA;
+  cdef.cuda_particle_lanes = lanes;
+  cdef.cuda_dfsph_masks = sph_test_cuda_dfsph_masks(); /* scripts/gpu-test: once more with lists */
+  REQUIRE(sph_context_create(&cdef, &c) == SPH_OK, "CUDA context: %s", sph_get_last_error());
+  return c;
+}
+
 void mpi_test_dam(sph_context* context, const sph_world_def* def, float stir,
                   const sph_mpi_world_def* mpi_def, sph_world** single, sph_world** world, uint32_t* n) {
   mpi_test_dam_on(context, def, stir, MPI_COMM_WORLD, mpi_def, single, world, n);

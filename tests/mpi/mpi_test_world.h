@@ -31,6 +31,11 @@ int mpi_test_finish(sph_context* context, const char* name);
 /* No features, capacity 4096, spacing MPI_TEST_SPACING, kernel radius MPI_TEST_KERNEL_RADIUS. */
 void mpi_test_world_def(sph_world_def* def);
 
+/* A CUDA context (the GPU check programs) with `lanes` threads a particle (0: the library's choice)
+ * and the DFSPH walk SPH_TEST_CUDA_DFSPH_MASKS names (sph_test_cuda_dfsph_masks); aborts the job if
+ * it cannot be made. */
+sph_context* mpi_test_cuda_context(uint32_t lanes);
+
 /* The dam break's two worlds. */
 typedef struct mpi_test_worlds {
   sph_world* single;           /* rank 0 of the communicator: the undivided world; NULL elsewhere */

@@ -39,17 +39,6 @@
 #include "sph_cuda.h"
 #include "support.h"
 
-static sph_context* cuda_context(uint32_t lanes) {
-  sph_context_def cdef;
-  sph_context* c = NULL;
-  REQUIRE(sph_context_def_init(&cdef) == SPH_OK, "context def");
-  cdef.backend = SPH_BACKEND_CUDA;
-  cdef.cuda_particle_lanes = lanes;
-  cdef.cuda_dfsph_masks = sph_test_cuda_dfsph_masks(); /* scripts/gpu-test: once more with lists */
-  REQUIRE(sph_context_create(&cdef, &c) == SPH_OK, "CUDA context: %s", sph_get_last_error());
-  return c;
-}
-
 static float max_abs_difference(const float* a, const float* b, uint32_t n) {
   float m = 0.0f;
   for (uint32_t i = 0; i < 3 * n; ++i) m = fmaxf(m, fabsf(a[i] - b[i]));
@@ -252,9 +241,9 @@ int main(int argc, char** argv) {
   int springs_only;
   mpi_test_init(&argc, &argv, &cpu);
   springs_only = argc > 1 && strcmp(argv[1], "springs") == 0;
-  cuda = cuda_context(0);
-  cuda_one_lane = cuda_context(1);
-  cuda_four_lanes = cuda_context(4);
+  cuda = mpi_test_cuda_context(0);
+  cuda_one_lane = mpi_test_cuda_context(1);
+  cuda_four_lanes = mpi_test_cuda_context(4);
   if (springs_only) {
     mpi_springs_cases(cuda, 32768);
     REQUIRE(sph_context_destroy(cuda) == SPH_OK && sph_context_destroy(cuda_one_lane) == SPH_OK &&
