@@ -6,7 +6,14 @@
  * ranks know nothing of it. Then every rank makes the collective calls of sph_mpi.h: each must
  * return an error on every rank (the lost rank SPH_ERROR_DEVICE_LOST, the others the agreed
  * failure naming the lost device), none may leave the others waiting in MPI for it (which the
- * time limit would show as a hang), and the world and the contexts must still be destroyed. */
+ * time limit would show as a hang), and the world and the contexts must still be destroyed.
+ *
+ * --in-step: the last rank poisons its context and makes no call of its own, so that the loss
+ * surfaces inside the next step, after its first agreement. That step's failure is agreed with the
+ * status SPH_ERROR_DEVICE_LOST on every rank, and each rank's step marks its own world lost
+ * (docs/distributed.md, "A lost device is agreed"): every rank's step returns DEVICE_LOST, a local
+ * read (sph_world_copy_attribute) is then refused with it on every rank, and so is every later
+ * collective call. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -27,6 +34,12 @@ static void expect_refused(const char* call, sph_result r, int lost_rank) {
   }
 }
 
+/* --in-step: every rank's world is lost after the step that met the loss. */
+static void expect_lost(const char* call, sph_result r) {
+  CHECK(r == SPH_ERROR_DEVICE_LOST, "%s after a loss met in a step: %s, expected SPH_ERROR_DEVICE_LOST (%s)",
+        call, sph_result_string(r), sph_get_last_error());
+}
+
 int main(int argc, char** argv) {
   sph_context* cpu = NULL;
   sph_context* cuda = NULL;
@@ -36,7 +49,9 @@ int main(int argc, char** argv) {
   int lost_rank;
   void* event;
   const char* path = "gpu_check_mpi_device_lost.sphrank";
+  int in_step;
   mpi_test_init(&argc, &argv, &cpu);
+  in_step = argc > 1 && strcmp(argv[1], "--in-step") == 0;
   lost_rank = g_size - 1;
   cuda = mpi_test_cuda_context(0);
   mpi_test_world_def(&def);
@@ -49,10 +64,22 @@ int main(int argc, char** argv) {
   MPI_Barrier(MPI_COMM_WORLD);
   if (g_rank == lost_rank) {
     CHECK(mpi_poison_device() != 0, "the poisoning kernel did not fault");
-    CHECK(sph_cuda_world_record_event(world, event) == SPH_ERROR_DEVICE_LOST,
-          "record_event on the poisoned rank: %s", sph_get_last_error());
+    if (!in_step)
+      CHECK(sph_cuda_world_record_event(world, event) == SPH_ERROR_DEVICE_LOST,
+            "record_event on the poisoned rank: %s", sph_get_last_error());
   }
-  {
+  if (in_step) {
+    sph_mpi_counts counts;
+    float position[3];
+    uint32_t written = 0;
+    REQUIRE(sph_mpi_counts_init(&counts) == SPH_OK, "counts init");
+    expect_lost("sph_world_step (the loss met inside it)", sph_world_step(world, 0.01f));
+    expect_lost("sph_world_copy_attribute", sph_world_copy_attribute(world, SPH_ATTRIBUTE_POSITION, position,
+                                                                     sizeof position, 0, 0, 1, &written));
+    expect_lost("sph_world_step again", sph_world_step(world, 0.01f));
+    expect_lost("sph_mpi_world_get_counts", sph_mpi_world_get_counts(world, &counts));
+    expect_lost("sph_mpi_world_save_file", sph_mpi_world_save_file(world, path));
+  } else {
     sph_mpi_counts counts;
     float x[3] = {0.05f, 0.1f, 0.03f};
     uint64_t gathered = 0;
@@ -72,5 +99,5 @@ int main(int argc, char** argv) {
   }
   CHECK(sph_world_destroy(world) == SPH_OK, "destroy the world: %s", sph_get_last_error());
   CHECK(sph_context_destroy(cuda) == SPH_OK, "destroy the CUDA context: %s", sph_get_last_error());
-  return mpi_test_finish(cpu, "mpi_cuda device lost");
+  return mpi_test_finish(cpu, in_step ? "mpi_cuda device lost in a step" : "mpi_cuda device lost");
 }
