@@ -55,6 +55,17 @@ __global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArra
   if (t / G >= n) return;  // whole groups: n * G threads are lanes of particles
   const uint32_t i = static_cast<uint32_t>(t / G);
   const LaneGroup<G> group = LaneGroup<G>::of_thread(t);
+  // A distributed rank's ghost (the whole lane group: one particle) skips its gather: its density,
+  // pressure, 1 / density and count are its owner's, taken right after this pass
+  // (HaloDensityRecord), before any pass reads them. Its velocity still moves to the sorted
+  // order (the record does not carry it); the placeholders keep the record finite until then.
+  // (A branch of its own before the gather: the undivided world's kernel keeps its registers.)
+  // A distributed rank's ghost (the whole lane group: one particle) skips its gather: its density,
+  // pressure, 1 / density and count are its owner's, taken right after this pass
+  // (HaloDensityRecord), before any pass reads them; ghost_density_moves_kernel moves the rest.
+  // (A bare return: the undivided world's kernel keeps its registers, which a branch that wrote
+  // the ghost here raised from 30 to 34 at two and four lanes, ptxas -v, sm_90.)
+  if (is_halo_ghost(a, i)) return;
   DensitySample s = gather_density_lanes<G>(fluid, grid, a.sorted_position, i, group);
   if (group.lane != 0) return;
   // The reorder left this particle's old index in w; read it before w becomes the pressure.
@@ -83,13 +94,27 @@ __global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArra
   a.sorted_velocity[i] = make_float4_record(xyz(v), 1.0f / rho);
 }
 
+// A distributed rank's ghosts, which density_kernel skips: the velocity moved to the sorted order
+// (their density records do not carry it) and placeholders that keep the record finite until the
+// owners' records arrive (the pressure slot held the old index until here).
+__global__ void ghost_density_moves_kernel(FluidConstants fluid, ParticleArrays a, uint32_t n) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n || !a.halo_ghost[i]) return;
+  const uint32_t k = __float_as_uint(a.sorted_position[i].w);
+  a.density[i] = fluid.rest_density;
+  a.sorted_position[i].w = 0.0f;
+  a.sorted_velocity[i] = make_float4_record(xyz(a.velocity[k]), 1.0f / fluid.rest_density);
+  if (a.normalized_density) a.normalized_density[i] = fluid.rest_density;  // (the filter skips it too)
+}
+
 // Eq. 31 reads every carried rho_j: the factor is written in the new order
 // (the density kernel is done reading the old), the filtered density into the side array,
 // and both are published after every particle has been filtered.
 __global__ void normalized_density_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
                                           const FrameState* state) {
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i >= n) return;
+  // (A rank's ghost: its published density is its owner's, taken after the publication.)
+  if (i >= n || is_halo_ghost(a, i)) return;
   const float filtered = gather_normalized_density(fluid, grid, a.sorted_position, a.sorted_velocity, i);
   const float share =
       density_factor_relaxation(state->clock.dt_float, speed_of_sound(fluid.methods.eos), fluid.kernel.h);
@@ -113,7 +138,7 @@ __global__ void publish_normalized_density_kernel(FluidConstants fluid, Particle
 __global__ void density_diffusion_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n,
                                          const FrameState* state) {
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i >= n) return;
+  if (i >= n || is_halo_ghost(a, i)) return;  // (a rank's ghost: as the filter's)
   const float rate = gather_density_diffusion(fluid, fluid.methods.density_diffusion, grid, a.sorted_position,
                                               a.sorted_velocity, i);
   // The side array holds this particle's resolved factor (density_kernel's factor_to_side).
@@ -132,7 +157,7 @@ __global__ void carry_density_factor_kernel(ParticleArrays a, uint32_t n) {
 
 __global__ void colour_normal_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n) {
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i >= n) return;
+  if (i >= n || is_halo_ghost(a, i)) return;  // (a rank's ghost takes its owner's normal after)
   a.colour_normal[i] = gather_colour_normal(fluid, grid, a.sorted_position, a.sorted_velocity, i);
 }
 
@@ -184,6 +209,10 @@ void enqueue_density_summation(const FluidConstants& fluid, const GridView& grid
     launch_density<false, false>(boundary, lanes, threads, fluid, grid, a, n, scene, stage_fraction,
                                  options.density_diffusion, state, stream);
   check_launch("density_kernel");
+  if (a.halo_ghost) {  // a distributed rank's world
+    ghost_density_moves_kernel<<<blocks_for(n, threads), threads, 0, stream>>>(fluid, a, n);
+    check_launch("ghost_density_moves_kernel");
+  }
 }
 
 bool enqueue_density_republish(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,

@@ -95,6 +95,14 @@ struct ParticleArrays {
   uint32_t* halo_ghost;
 };
 
+// Whether sorted particle i is a distributed rank's ghost (never in an undivided world). A ghost's
+// sums are its owner's, taken after each pass that publishes them, so the neighbour passes skip
+// its gathers (what a ghost's own sum would give, over a neighbourhood this rank does not hold
+// whole, was only ever overwritten).
+__host__ __device__ inline bool is_halo_ghost(const ParticleArrays& a, uint32_t i) {
+  return a.halo_ghost && a.halo_ghost[i];
+}
+
 // This backend's working array for the user attribute's reorder (SPH_FEATURE_USER_ATTRIBUTE).
 constexpr const char* kArraySortedUserAttribute = "sorted_user_attribute";
 // A distributed rank's ghost mask (ParticleArrays::halo_ghost; Scratch).

@@ -67,13 +67,24 @@ __device__ __forceinline__ void dfsph_density_particle(const FluidConstants& flu
   const KernelCoefficients mk = mass_gradient_kernel(fluid);
   const float ki = kDivergenceWarmStart ? a.dfsph_step[i] : 0.0f;
   Vec3 push{0.0f, 0.0f, 0.0f};
-  const DfsphDensitySample s =
-      kDivergenceWarmStart
-          ? gather_density_and_factor(fluid, grid, a.sorted_position, wall, i, writer,
-                                      [&](uint32_t j, Vec3 d, float r2) {
-                                        push += pressure_velocity_pair_term(mk, d, r2, ki + a.dfsph_step[j]);
-                                      })
-          : gather_density_and_factor(fluid, grid, a.sorted_position, wall, i, writer);
+  // A distributed rank's ghost skips its walk where its Jacobi (or Chebyshev) solves skip it too:
+  // its density, factor, count and 1 / rho are its owner's, taken right after this pass
+  // (HaloDfsphDensityRecord), and no pass walks a ghost's candidates (dfsph_solver.cu), so its mask
+  // and list are written empty. The conjugate gradients' rank solve still walks its ghosts
+  // (dfsph_cg_rank_solver.cu), so there the pass computes them as before. The moves below (the
+  // velocity, the warm starts, the contact) stay: the records do not carry them.
+  DfsphDensitySample s;
+  if (is_halo_ghost(a, i) && fluid.methods.dfsph.linear_solver != kDfsphConjugateGradients) {
+    writer.finish();
+    s = DfsphDensitySample{fluid.rest_density, 0u, 0.0f};
+  } else {
+    s = kDivergenceWarmStart ? gather_density_and_factor(fluid, grid, a.sorted_position, wall, i, writer,
+                                                         [&](uint32_t j, Vec3 d, float r2) {
+                                                           push += pressure_velocity_pair_term(
+                                                               mk, d, r2, ki + a.dfsph_step[j]);
+                                                         })
+                             : gather_density_and_factor(fluid, grid, a.sorted_position, wall, i, writer);
+  }
   a.density[i] = s.density;
   a.neighbor_count[i] = s.neighbor_count;
   a.dfsph_factor[i] = s.factor;

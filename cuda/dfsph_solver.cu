@@ -1,4 +1,6 @@
 // SPDX-License-Identifier: MIT
+#include <type_traits>
+
 #include "../src/core/exact_float_sum.h"
 #include "../src/physics/collider_loads.h"
 #include "../src/physics/dfsph_passes.h"
@@ -38,7 +40,10 @@ __global__ void dfsph_begin_solve_kernel(FrameState* state) {
 // v += the pressures k's velocity change (held to the contacts); carried gets k times the
 // solve's scale (dt for the divergence solve's impulse), added, or replacing the state-order
 // values on the warm start's pass.
-template <bool kWarm, bool kCorrected>
+// kRank: a distributed rank's world (its ghosts skipped), its own instantiation so that the
+// undivided world's kernel keeps its registers (the ghost test cost the 32-register form 20 bytes
+// more of spills, ptxas -v, sm_90).
+template <bool kWarm, bool kCorrected, bool kRank>
 __global__ void __launch_bounds__(kDfsphSolveBlock,
                                   kCorrected ? kDfsphCorrectedBlocksPerSm : kDfsphSolveBlocksPerSm)
     dfsph_correct_kernel(FluidConstants fluid, GridView grid, ParticleArrays a, uint32_t n, Float4* v,
@@ -49,6 +54,14 @@ __global__ void __launch_bounds__(kDfsphSolveBlock,
   if (i >= n) return;
   const float dt = state->clock.dt_float;
   const float scale = divergence ? dt : 1.0f;
+  if (kRank && a.halo_ghost[i]) {
+    // A distributed rank's ghost: its velocity is its owner's, taken right after this pass
+    // (core/dfsph_jacobi_loop.h, and the conjugate gradients' warm start), so no walk; its carried
+    // pressure adds its owner's steps (shared before each use) as the owner's does, so that its
+    // pressure, which the probes read, is the owner's.
+    carried[i] = (kWarm ? 0.0f : carried[i]) + k[i] * scale;
+    return;
+  }
   // kCorrected: SPH_DFSPH_CORRECTED_GRADIENT (physics/dfsph_gradient_correction.h), its own
   // instantiation so that the default kernel keeps its registers.
   const DfsphWalls walls{a.boundary_gradient};
@@ -69,7 +82,8 @@ __global__ void __launch_bounds__(kDfsphSolveBlock, kDfsphSolveBlocksPerSm)
   if (state->solve_run == 0) return;  // the same for every thread of the grid
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   double error = 0.0;
-  if (i < n) {
+  // (A distributed rank's ghost, kExact, takes its owner's k right after this pass and adds no error.)
+  if (i < n && !(kExact && a.halo_ghost[i])) {
     const float dt = state->clock.dt_float;
     const float rate =
         density_rate(fluid, grid, a.sorted_position, v, DfsphWalls{a.boundary_gradient}, i, solve_walk(a));
@@ -137,7 +151,13 @@ __global__ void dfsph_forces_kernel(FluidConstants fluid, GridView grid, Particl
   mark_stage(state, kStageForces);
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   float a2 = 0.0f;
-  if (i < n) {
+  if (i < n && is_halo_ghost(a, i)) {
+    // A distributed rank's ghost: its owner's acceleration counts, and its v* is replaced by its
+    // owner's after the density solve's first velocity update, which reads no ghost's v* (nor
+    // its divergence warm start: a rank's solves make their own).
+    a.velocity[i] = a.sorted_velocity[i];
+    if (!divergence_solve) a.dfsph_divergence[i] = 0.0f;
+  } else if (i < n) {
     FluidConstants f = fluid;
     f.dt = state->clock.dt_float;
     // Over the solves' walk (the lists, the masks, or every candidate), one body for all three,
@@ -163,9 +183,7 @@ __global__ void dfsph_forces_kernel(FluidConstants fluid, GridView grid, Particl
     const Float4 v = a.sorted_velocity[i];
     if (kScene) acc = add_force_fields(scene, acc, xyz(p));
     if (a.spring_acceleration) acc += xyz(a.spring_acceleration[i]);
-    // A distributed rank's ghost: its owner's acceleration counts; its v* is replaced by its
-    // owner's after the density solve's first velocity update.
-    if (!(a.halo_ghost && a.halo_ghost[i])) a2 = length_squared(acc);
+    a2 = length_squared(acc);
     Vec3 next = xyz(v) + acc * f.dt;
     const bool contacts = scene.collider_count != 0;
     if (kScene && contacts) next = dfsph_clamp(a, i, next);
@@ -285,18 +303,24 @@ void launch_dfsph_correct(bool warm, const FluidConstants& fluid, const GridView
                           bool divergence, bool contacts, FrameState* state, cudaStream_t stream) {
   const unsigned threads = kDfsphSolveBlock, blocks = blocks_for(n, threads);
   const bool corrected = fluid.methods.dfsph.gradient_correction != 0;
-  if (warm && corrected)
-    dfsph_correct_kernel<true, true>
-        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, k, carried, divergence, contacts, state);
-  else if (warm)
-    dfsph_correct_kernel<true, false>
-        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, k, carried, divergence, contacts, state);
-  else if (corrected)
-    dfsph_correct_kernel<false, true>
-        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, k, carried, divergence, contacts, state);
+  const auto launch = [&](auto kernel) {
+    kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, k, carried, divergence, contacts, state);
+  };
+  const auto on = [&](auto rank) {
+    constexpr bool kRank = decltype(rank)::value;
+    if (warm && corrected)
+      launch(dfsph_correct_kernel<true, true, kRank>);
+    else if (warm)
+      launch(dfsph_correct_kernel<true, false, kRank>);
+    else if (corrected)
+      launch(dfsph_correct_kernel<false, true, kRank>);
+    else
+      launch(dfsph_correct_kernel<false, false, kRank>);
+  };
+  if (a.halo_ghost)  // a distributed rank's world (its ghost mask is allocated for ranks only)
+    on(std::true_type{});
   else
-    dfsph_correct_kernel<false, false>
-        <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, v, k, carried, divergence, contacts, state);
+    on(std::false_type{});
   check_launch("dfsph_correct_kernel");
 }
 

@@ -76,13 +76,15 @@ __global__ void forces_euler_kernel(FluidConstants fluid, GridView grid, Particl
   float v2 = 0.0f, a2 = 0.0f;
   Vec3 acc{0.0f, 0.0f, 0.0f};
   FluidConstants f = fluid;
-  if (i < n) {
+  // A distributed rank's ghost is its owner's to move (no gather: the whole lane group is one
+  // particle); it leaves no trace in the maxima.
+  const bool own = i < n && !is_halo_ghost(a, i);
+  if (own) {
     f.dt = state->clock.dt_float;  // impulse-based terms need the substep's length
     acc = gather_acceleration_masked<Terms, true, G>(f, grid, a.sorted_position, a.sorted_velocity,
                                                      a.neighbor_count, a.colour_normal, i, group);
   }
-  // A distributed rank's ghost is its owner's to move; it leaves no trace in the maxima.
-  if (i < n && group.lane == 0 && !(a.halo_ghost && a.halo_ghost[i])) {
+  if (own && group.lane == 0) {
     const Float4 p = a.sorted_position[i];
     const Float4 v = a.sorted_velocity[i];
     if (kScene) acc = add_force_fields(scene, acc, xyz(p));
@@ -118,13 +120,14 @@ __global__ void forces_rk4_kernel(FluidConstants fluid, GridView grid, ParticleA
   float v2 = 0.0f, a2 = 0.0f;
   Vec3 acc{0.0f, 0.0f, 0.0f};
   FluidConstants f = fluid;
-  if (i < n) {
+  // A distributed rank's ghost is its owner's to move (no gather); it leaves no trace in the maxima.
+  const bool own = i < n && !is_halo_ghost(a, i);
+  if (own) {
     f.dt = state->clock.dt_float;
     acc = gather_acceleration_masked<Terms, true, G>(f, grid, a.sorted_position, a.sorted_velocity,
                                                      a.neighbor_count, a.colour_normal, i, group);
   }
-  // A distributed rank's ghost is its owner's to move; it leaves no trace in the maxima.
-  if (i < n && group.lane == 0 && !(a.halo_ghost && a.halo_ghost[i])) {
+  if (own && group.lane == 0) {
     // This stage's side, (stage + 1) % 2, picked without a run-time index into the struct.
     ParticleState* start = (stage & 1) ? a.rk4_start[0] : a.rk4_start[1];
     Rk4Accumulator* sums = (stage & 1) ? a.rk4_sum[0] : a.rk4_sum[1];
