@@ -20,7 +20,7 @@
  *                [--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg|chebyshev]
  *                [--dfsph-max 0.05] [--walls-in-density] [--particle-lanes N] [--no-dfsph-masks]
  *                [--dfsph-lists] [--dfsph-step-factor 0.4] [--dfsph-divergence 1]
- *                [--dfsph-divergence-step 0.001]
+ *                [--dfsph-divergence-step 0.001] [--kernel-ratio 1.8]
  *                [--frame-log] [--out solver_front.csv]
  *
  * --wcsph: the weakly compressible runs' speeds of sound, as multiples of the free-fall speed;
@@ -42,6 +42,10 @@
  * library's, 0.001). The solve stops at the looser of the two: to measure the rate alone, pass
  * --dfsph-divergence-step 1e-9 (a fixed rate holds the density change a step the tighter the finer
  * the world, docs/validation.md).
+ * --kernel-ratio: every run's kernel radius h in particle spacings (sph_world_def.kernel_radius;
+ * default the library's, 1.8). The dam break's slab stays 6 layers thick, so a larger h reaches
+ * further into its collision-only side walls' deficit; the CUDA solves' masks hold 383 candidates
+ * and their lists 63 neighbours (at 2.2 spacings a resting particle has about 64).
  * --frame-log: one line a frame on stdout with the step's statistics and where the densest
  * particle is (in column widths), for diagnosing a run.
  *
@@ -116,6 +120,7 @@ int main(int argc, char** argv) {
   uint32_t features = 0, particle_lanes = 0, dfsph_masks = 0;
   double dfsph_max = 0.0;             /* the library's default */
   double dfsph_step_factor = 0.0;     /* 0: the dam break's default */
+  double kernel_ratio = 0.0;          /* 0: the library's default (1.8 spacings) */
   double dfsph_divergence = 0.0;      /* 0: the library's default */
   double dfsph_divergence_step = 0.0; /* 0: the library's default */
   int frame_log = 0;
@@ -178,6 +183,11 @@ int main(int argc, char** argv) {
       particle_lanes = (uint32_t)strtoul(argv[++i], NULL, 10);
     } else if (strcmp(argv[i], "--no-dfsph-masks") == 0) {
       dfsph_masks = SPH_CUDA_DFSPH_MASKS_OFF;
+    } else if (strcmp(argv[i], "--kernel-ratio") == 0 && i + 1 < argc) {
+      if (parse_values(argv[++i], &kernel_ratio, 1) != 1 || !(kernel_ratio >= 1.0 && kernel_ratio <= 4.0)) {
+        fprintf(stderr, "solver_front: --kernel-ratio takes one h / spacing in [1, 4]\n");
+        return 2;
+      }
     } else if (strcmp(argv[i], "--dfsph-step-factor") == 0 && i + 1 < argc) {
       if (parse_values(argv[++i], &dfsph_step_factor, 1) != 1 || dfsph_step_factor > 10.0) {
         fprintf(stderr, "solver_front: --dfsph-step-factor takes one lambda in (0, 10]\n");
@@ -217,7 +227,8 @@ int main(int argc, char** argv) {
           "[--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg|chebyshev] [--dfsph-max "
           "0.05] "
           "[--walls-in-density] [--particle-lanes N] [--no-dfsph-masks] [--dfsph-lists] [--dfsph-step-factor "
-          "L] [--dfsph-divergence 1] [--dfsph-divergence-step 0.001] [--frame-log] [--out "
+          "L] [--dfsph-divergence 1] [--dfsph-divergence-step 0.001] [--kernel-ratio 1.8] [--frame-log] "
+          "[--out "
           "solver_front.csv]\n");
       return 2;
     }
@@ -270,6 +281,7 @@ int main(int argc, char** argv) {
       config.features |= features;
       config.frame_log = frame_log ? stdout : NULL;
       config.measure_interior = 1;
+      config.kernel_ratio = (float)kernel_ratio;
       if (dfsph) {
         config.density_error = (float)runs[r].value;
         config.density_error_max = (float)dfsph_max;

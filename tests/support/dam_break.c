@@ -186,6 +186,7 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
   sph_world_def_init(&def);
   def.capacity = n;
   def.particle_spacing = (float)spacing;
+  if (config->kernel_ratio > 0.0f) def.kernel_radius = config->kernel_ratio * (float)spacing;
   def.integrator = config->integrator;
   def.solver = config->solver;
   def.features |= config->features;

@@ -53,9 +53,10 @@ typedef struct dam_break_config {
   uint32_t max_iterations;
   uint32_t dfsph_flags;
   uint32_t dfsph_linear_solver; /* SPH_DFSPH_JACOBI, _CONJUGATE_GRADIENTS or _CHEBYSHEV (0: default) */
-  uint32_t features; /* sph_world_def.features added to the world's (e.g. SPH_FEATURE_BOUNDARY_DENSITY) */
-  FILE* frame_log;   /* optional (NULL: none): one line a frame of the step's statistics and where the
-                        densest particle is, for diagnosing a run */
+  uint32_t features;  /* sph_world_def.features added to the world's (e.g. SPH_FEATURE_BOUNDARY_DENSITY) */
+  float kernel_ratio; /* h in particle spacings (0: the library's default, 1.8) */
+  FILE* frame_log;    /* optional (NULL: none): one line a frame of the step's statistics and where the
+                         densest particle is, for diagnosing a run */
   /* Nonzero: measure the full neighbourhoods' density error each frame (interior_* below; a host
      neighbour count over every particle, seconds a frame at a million particles, outside the
      timed steps). 0 (the default): those fields stay 0. */
