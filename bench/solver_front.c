@@ -20,7 +20,7 @@
  *                [--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg|chebyshev]
  *                [--dfsph-max 0.05] [--walls-in-density] [--particle-lanes N] [--no-dfsph-masks]
  *                [--dfsph-lists] [--dfsph-step-factor 0.4] [--dfsph-divergence 1]
- *                [--dfsph-divergence-step 0.001] [--kernel-ratio 1.8]
+ *                [--dfsph-divergence-step 0.001] [--kernel-ratio 1.8] [--slab-layers 6]
  *                [--frame-log] [--out solver_front.csv]
  *
  * --wcsph: the weakly compressible runs' speeds of sound, as multiples of the free-fall speed;
@@ -46,6 +46,8 @@
  * default the library's, 1.8). The dam break's slab stays 6 layers thick, so a larger h reaches
  * further into its collision-only side walls' deficit; the CUDA solves' masks hold 383 candidates
  * and their lists 63 neighbours (at 2.2 spacings a resting particle has about 64).
+ * --slab-layers: the dam break's lattice layers across its thin (z) direction (default 6: two
+ * middle layers with a full neighbourhood at 1.8 spacings); more makes it three-dimensional.
  * --frame-log: one line a frame on stdout with the step's statistics and where the densest
  * particle is (in column widths), for diagnosing a run.
  *
@@ -121,6 +123,7 @@ int main(int argc, char** argv) {
   double dfsph_max = 0.0;             /* the library's default */
   double dfsph_step_factor = 0.0;     /* 0: the dam break's default */
   double kernel_ratio = 0.0;          /* 0: the library's default (1.8 spacings) */
+  uint32_t slab_layers = 0;           /* 0: the dam break's 6 */
   double dfsph_divergence = 0.0;      /* 0: the library's default */
   double dfsph_divergence_step = 0.0; /* 0: the library's default */
   int frame_log = 0;
@@ -183,6 +186,12 @@ int main(int argc, char** argv) {
       particle_lanes = (uint32_t)strtoul(argv[++i], NULL, 10);
     } else if (strcmp(argv[i], "--no-dfsph-masks") == 0) {
       dfsph_masks = SPH_CUDA_DFSPH_MASKS_OFF;
+    } else if (strcmp(argv[i], "--slab-layers") == 0 && i + 1 < argc) {
+      slab_layers = (uint32_t)strtoul(argv[++i], NULL, 10);
+      if (slab_layers < 2 || slab_layers > 4096) {
+        fprintf(stderr, "solver_front: --slab-layers takes a layer count in [2, 4096]\n");
+        return 2;
+      }
     } else if (strcmp(argv[i], "--kernel-ratio") == 0 && i + 1 < argc) {
       if (parse_values(argv[++i], &kernel_ratio, 1) != 1 || !(kernel_ratio >= 1.0 && kernel_ratio <= 4.0)) {
         fprintf(stderr, "solver_front: --kernel-ratio takes one h / spacing in [1, 4]\n");
@@ -227,7 +236,8 @@ int main(int argc, char** argv) {
           "[--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg|chebyshev] [--dfsph-max "
           "0.05] "
           "[--walls-in-density] [--particle-lanes N] [--no-dfsph-masks] [--dfsph-lists] [--dfsph-step-factor "
-          "L] [--dfsph-divergence 1] [--dfsph-divergence-step 0.001] [--kernel-ratio 1.8] [--frame-log] "
+          "L] [--dfsph-divergence 1] [--dfsph-divergence-step 0.001] [--kernel-ratio 1.8] [--slab-layers 6] "
+          "[--frame-log] "
           "[--out "
           "solver_front.csv]\n");
       return 2;
@@ -282,6 +292,7 @@ int main(int argc, char** argv) {
       config.frame_log = frame_log ? stdout : NULL;
       config.measure_interior = 1;
       config.kernel_ratio = (float)kernel_ratio;
+      if (slab_layers) config.slab_layers = slab_layers;
       if (dfsph) {
         config.density_error = (float)runs[r].value;
         config.density_error_max = (float)dfsph_max;

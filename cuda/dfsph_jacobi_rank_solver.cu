@@ -26,8 +26,8 @@ __global__ void dfsph_rank_check_kernel(uint32_t iterations, DfsphErrors errors,
                                         uint32_t min_iterations, uint32_t max_iterations, bool divergence,
                                         FrameState* state) {
   state->solve_iterations = iterations;
-  state->solve_weight = chebyshev_weight(iterations + 1u);
   state->solve_error = errors.mean;
+  dfsph_chebyshev_after_test(state, iterations, errors.mean);
   state->solve_largest = errors.largest;
   dfsph_continue_solve(state, divergence ? state->divergence_tally : state->pressure_tally, bounds,
                        min_iterations, max_iterations, LoopCondition{});

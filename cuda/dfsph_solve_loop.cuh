@@ -15,6 +15,7 @@
 #include "../src/core/exact_float_sum.h"
 #include "../src/core/host_memory.h"
 #include "../src/core/solver_record.h"
+#include "../src/physics/dfsph_passes.h"
 #include "cuda_status.h"
 #include "dfsph_solver.h"
 #include "frame_control.h"
@@ -30,6 +31,20 @@ constexpr unsigned kDfsphCheckBlock = 256;
 // masks where it keeps those, every candidate otherwise (physics/neighbor_walk.h).
 __device__ inline ListedCandidates solve_walk(const ParticleArrays& a) {
   return ListedCandidates{a.dfsph_neighbor_mask, a.dfsph_neighbor_list, a.dfsph_list_stride};
+}
+
+// After the solve's test number `iterations` (0: the first) found the mean error `mean`: the
+// Chebyshev solve's guard (DfsphChebyshevGuard, dfsph_passes.h; its fields in the state) and what the
+// next residual pass applies, its weight or (solve_plain) the plain step (read by
+// SPH_DFSPH_CHEBYSHEV's density solve only). One thread.
+__device__ inline void dfsph_chebyshev_after_test(FrameState* state, uint32_t iterations, float mean) {
+  DfsphChebyshevGuard guard;
+  guard.smallest = state->solve_smallest;
+  guard.plain = state->solve_plain;
+  chebyshev_guard_check(guard, iterations, mean);
+  state->solve_smallest = guard.smallest;
+  state->solve_plain = guard.plain;
+  state->solve_weight = chebyshev_guarded_pass(guard, iterations + 1u).weight;  // (with solve_plain)
 }
 
 // Fixed-shape tree over a block's shared slots: the same additions in the same order every run.

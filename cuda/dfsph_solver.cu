@@ -35,6 +35,8 @@ __global__ void dfsph_begin_solve_kernel(FrameState* state) {
   state->solve_largest = 0.0f;
   state->solve_largest_bits = 0u;
   state->solve_weight = chebyshev_weight(0);
+  state->solve_smallest = 0.0f;
+  state->solve_plain = 0u;
 }
 
 // v += the pressures k's velocity change (held to the contacts); carried gets k times the
@@ -90,9 +92,9 @@ __global__ void __launch_bounds__(kDfsphSolveBlock, kDfsphSolveBlocksPerSm)
     if (!kDivergence && fluid.methods.dfsph.linear_solver == kDfsphChebyshev) {
       // SPH_DFSPH_CHEBYSHEV (dfsph_passes.h), as the CPU backend's: the pressure held so far is the
       // carried one, which every velocity update of this solve has added its steps to.
-      const DfsphResidual r =
-          chebyshev_density_residual(rate, a.density[i], a.dfsph_factor[i], fluid.rest_density, dt,
-                                     a.dfsph_pressure[i], state->solve_weight, &a.dfsph_step[i]);
+      const DfsphResidual r = chebyshev_density_residual(
+          rate, a.density[i], a.dfsph_factor[i], fluid.rest_density, dt, a.dfsph_pressure[i],
+          DfsphChebyshevPass{state->solve_weight, state->solve_plain}, &a.dfsph_step[i]);
       a.dfsph_step[i] = r.k;
       error = r.error;
     } else {
@@ -128,8 +130,8 @@ __global__ void __launch_bounds__(kDfsphCheckBlock)
   const double sum = dfsph_sum_partials(partials, blocks);
   if (threadIdx.x != 0) return;
   state->solve_iterations = first ? 0u : state->solve_iterations + 1u;
-  state->solve_weight = chebyshev_weight(state->solve_iterations + 1u);  // (read by the Chebyshev solve only)
   state->solve_error = n > 0 ? static_cast<float>(sum / n) : 0.0f;
+  dfsph_chebyshev_after_test(state, state->solve_iterations, state->solve_error);
   dfsph_take_largest(state);
   dfsph_continue_solve(state, divergence ? state->divergence_tally : state->pressure_tally, bounds,
                        min_iterations, max_iterations, cond);

@@ -233,10 +233,11 @@ class CpuBackend final : public Backend {
                      float* carried, float carry_scale);
   // New pressures and errors from the rates over the velocities the last dfsph_correct wrote (the
   // columns); the errors over the world's particles (the mean summed over the ranks, the largest
-  // the ranks' largest). `pass`: the solve's residual pass (0 first), and `held` the solve's
-  // pressure so far (its carried array), for the Chebyshev density solve (SPH_DFSPH_CHEBYSHEV).
+  // the ranks' largest). `pass`: the pass's Chebyshev weight or its guard's plain step
+  // (chebyshev_guarded_pass), and `held` the solve's pressure so far (its carried array), for the
+  // Chebyshev density solve (SPH_DFSPH_CHEBYSHEV; the other solves ignore both).
   void dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls, float dt,
-                       uint32_t pass, const float* held);
+                       DfsphChebyshevPass pass, const float* held);
   DfsphErrors dfsph_errors(DfsphSolve kind);
   // The density solve by conjugate gradients (cpu_dfsph_cg.cpp; sph_dfsph_params.linear_solver);
   // its rate pass (each particle's value into cg_value_; returns the mean and largest error); a contact held

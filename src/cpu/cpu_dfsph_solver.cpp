@@ -81,7 +81,7 @@ void CpuBackend::dfsph_correct(const FluidConstants& fluid, const DfsphWalls& wa
 }
 
 void CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, const DfsphWalls& walls,
-                                 float dt, uint32_t pass, const float* held) {
+                                 float dt, DfsphChebyshevPass pass, const float* held) {
   const GridView view = grid_.view();
   const NeighborColumns columns = columns_.view();
   const float* factor = dfsph_factor_.data();
@@ -94,7 +94,6 @@ void CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, c
   const SimdPasses::DfsphRateFn density_rate_of = simd_.dfsph_density_rate;
   // SPH_DFSPH_CHEBYSHEV (dfsph_passes.h): the density solve's steps mixed with the last ones.
   const bool chebyshev = kind == DfsphSolve::Density && c.linear_solver == kDfsphChebyshev;
-  const float weight = chebyshev ? chebyshev_weight(pass) : 1.0f;
   // The gather reads positions and the velocities' columns; each particle writes only its k. A
   // distributed rank's ghosts are skipped: they take their owners' k right after (share_steps),
   // and the errors leave them out.
@@ -104,7 +103,7 @@ void CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, c
     const float rate = density_rate_of(fluid, view, columns, walls, i);
     if (chebyshev) {
       const DfsphResidual r =
-          chebyshev_density_residual(rate, density[i], factor[i], rho0, dt, held[i], weight, &k[i]);
+          chebyshev_density_residual(rate, density[i], factor[i], rho0, dt, held[i], pass, &k[i]);
       k[i] = r.k;
       error[i] = r.error;
       return;
@@ -166,18 +165,23 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
     Float4* v;
     float* carried;
     float carry_scale;
-    uint32_t pass;  // the residual passes run so far
+    uint32_t pass;              // the residual passes run so far
+    DfsphChebyshevGuard guard;  // SPH_DFSPH_CHEBYSHEV's (dfsph_passes.h), on the world's errors
     void velocity_update(bool) { b.dfsph_correct(fluid, walls, dt, v, carried, carry_scale); }
     void share_velocities() {
       if (b.rank_) b.halo_share_velocities(v);
     }
-    void rates() { b.dfsph_residuals(kind, fluid, walls, dt, pass++, carried); }
+    void rates() {
+      b.dfsph_residuals(kind, fluid, walls, dt, chebyshev_guarded_pass(guard, pass++), carried);
+    }
     void share_steps() {
       if (b.rank_) b.halo_share_dfsph_step();
     }
     DfsphErrors errors() { return b.dfsph_errors(kind); }
-    void checked(uint32_t, const DfsphErrors&, bool) {}
-  } passes{*this, kind, fluid, walls, dt, v, carried, carry_scale, 0u};
+    void checked(uint32_t iterations, const DfsphErrors& errors, bool) {
+      chebyshev_guard_check(guard, iterations, errors.mean);
+    }
+  } passes{*this, kind, fluid, walls, dt, v, carried, carry_scale, 0u, DfsphChebyshevGuard{}};
   const DfsphLoopOutcome o = run_dfsph_jacobi(passes, bounds, min_iterations, max_iterations);
   return SolveOutcome{o.iterations, o.errors.mean, o.errors.largest, o.capped};
 }

@@ -265,7 +265,40 @@ struct DfsphChebyshev {
   static constexpr float kSpectralRadius = 0.9f;
   // The share of the plain step an expanded particle releases (0.5 and 0.25 measured; 0.25 kept).
   static constexpr float kRelease = 0.25f;
+  // The guard (DfsphChebyshevGuard below): a solve whose mean error passes this many times the
+  // smallest it reached takes plain steps from then on.
+  static constexpr float kGuardGrowth = 2.0f;
 };
+
+// The Chebyshev solve's guard. The weights assume the Jacobi iteration's spectral radius is at most
+// kSpectralRadius; where a world's is not (measured in session 40: kernel radii of 2.2 to 3
+// spacings, whose larger neighbourhoods the weights were not fitted to, in dam breaks of 3,000 to
+// 25,000 particles on the CPU), the semi-iteration grows the error 1.3-1.7 times an iteration
+// until the cap, and the step fails with non-finite velocities, where the plain solve converges.
+// The release is part of it: with weight 1 and the release a kernel of 3 spacings still diverged
+// (3.4 times an iteration), the plain solve's own steps (never negative) did not. So once a
+// solve's mean error passes kGuardGrowth times the smallest it reached, the rest of that solve
+// takes the plain solve's step (density_residual: weight 1, no release); the next solve starts
+// accelerated again. A
+// solve that converges never rises that far (session 28: a restart at a doubling never fired at
+// the spectral radius 0.95 on the dam break), so it leaves the accelerated solve's bits alone. Both
+// backends keep it after each test of the solve (the CPU's loop, the CUDA check kernels), on the
+// world's mean error.
+struct DfsphChebyshevGuard {
+  float smallest = 0.0f;  // the solve's smallest mean error so far
+  uint32_t plain = 0u;    // nonzero: the rest of the solve takes weight 1
+};
+
+// After the solve's test number `iterations` (0: the first, after the warm start) read `mean`.
+SPH_HD void chebyshev_guard_check(DfsphChebyshevGuard& guard, uint32_t iterations, float mean) {
+  if (iterations == 0u) {
+    guard.smallest = mean;
+    guard.plain = 0u;
+    return;
+  }
+  if (mean > DfsphChebyshev::kGuardGrowth * guard.smallest) guard.plain = 1u;
+  if (mean < guard.smallest) guard.smallest = mean;
+}
 
 // w_n of the residual pass n of a solve (0: the first, after the warm start). The recurrence
 // reaches its fixed point in floats within a few dozen steps (it contracts by about a half a
@@ -280,6 +313,16 @@ SPH_HD float chebyshev_weight(uint32_t n) {
     w = next;
   }
   return w;
+}
+
+// What residual pass n of the Chebyshev solve applies under the guard: its weight
+// (chebyshev_weight(n)), or, once the guard holds, the plain solve's step.
+struct DfsphChebyshevPass {
+  float weight;
+  uint32_t plain;  // nonzero: density_residual's step (weight 1)
+};
+SPH_HD DfsphChebyshevPass chebyshev_guarded_pass(const DfsphChebyshevGuard& guard, uint32_t n) {
+  return DfsphChebyshevPass{guard.plain ? 1.0f : chebyshev_weight(n), guard.plain};
 }
 
 // The density solve's residual with the release: density_residual's where rho* > rho0; elsewhere a
@@ -310,7 +353,10 @@ SPH_HD float chebyshev_step(float weight, float jacobi_step, float previous_step
 // which only ghosts' own (discarded) residuals read. k: the step to apply (it overwrites `previous`
 // in the caller); error: the plain solve's.
 SPH_HD DfsphResidual chebyshev_density_residual(float rate, float density, float factor, float rest_density,
-                                                float dt, float held, float weight, const float* previous) {
+                                                float dt, float held, DfsphChebyshevPass pass,
+                                                const float* previous) {
+  if (pass.plain) return density_residual(rate, density, factor, rest_density, dt);  // (the guard's)
+  const float weight = pass.weight;
   const DfsphResidual r = density_residual_released(rate, density, factor, rest_density, dt, held);
   return DfsphResidual{chebyshev_step(weight, r.k, weight == 1.0f ? 0.0f : *previous, held), r.error};
 }
