@@ -27,7 +27,7 @@ __global__ void dfsph_rank_check_kernel(uint32_t iterations, DfsphErrors errors,
                                         FrameState* state) {
   state->solve_iterations = iterations;
   state->solve_error = errors.mean;
-  dfsph_chebyshev_after_test(state, iterations, errors.mean);
+  dfsph_chebyshev_after_test(state, iterations, errors.mean, bounds.mean);
   state->solve_largest = errors.largest;
   dfsph_continue_solve(state, divergence ? state->divergence_tally : state->pressure_tally, bounds,
                        min_iterations, max_iterations, LoopCondition{});

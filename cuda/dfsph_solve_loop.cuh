@@ -33,15 +33,17 @@ __device__ inline ListedCandidates solve_walk(const ParticleArrays& a) {
   return ListedCandidates{a.dfsph_neighbor_mask, a.dfsph_neighbor_list, a.dfsph_list_stride};
 }
 
-// After the solve's test number `iterations` (0: the first) found the mean error `mean`: the
+// After the solve's test number `iterations` (0: the first) found the mean error `mean` (`bound`
+// the solve's bound on it): the
 // Chebyshev solve's guard (DfsphChebyshevGuard, dfsph_passes.h; its fields in the state) and what the
 // next residual pass applies, its weight or (solve_plain) the plain step (read by
 // SPH_DFSPH_CHEBYSHEV's density solve only). One thread.
-__device__ inline void dfsph_chebyshev_after_test(FrameState* state, uint32_t iterations, float mean) {
+__device__ inline void dfsph_chebyshev_after_test(FrameState* state, uint32_t iterations, float mean,
+                                                  float bound) {
   DfsphChebyshevGuard guard;
   guard.smallest = state->solve_smallest;
   guard.plain = state->solve_plain;
-  chebyshev_guard_check(guard, iterations, mean);
+  chebyshev_guard_check(guard, iterations, mean, bound);
   state->solve_smallest = guard.smallest;
   state->solve_plain = guard.plain;
   state->solve_weight = chebyshev_guarded_pass(guard, iterations + 1u).weight;  // (with solve_plain)

@@ -627,11 +627,11 @@ SPH_API sph_result SPH_CALL sph_world_get_density_diffusion_params(const sph_wor
 #define SPH_DFSPH_CONJUGATE_GRADIENTS                    \
   2u /* Jacobi-preconditioned conjugate gradients on the \
          compressed particles */
-#define SPH_DFSPH_CHEBYSHEV                                                                            \
-  3u /* (0.2.0) the Jacobi steps accelerated by Chebyshev's semi-iteration, an expanded particle's     \
-         pressure released step by step: about half the iterations up to ~1e5 particles (measured); at \
-         1e6 on the GPU 1.5x less wall time (docs/physics.md); a solve whose error grows to twice its  \
-         smallest takes the plain steps for the rest of it. CPU and CUDA backends */
+#define SPH_DFSPH_CHEBYSHEV                                                                                 \
+  3u /* (0.2.0) the Jacobi steps accelerated by Chebyshev's semi-iteration, an expanded particle's          \
+         pressure released step by step: about half the iterations up to ~1e5 particles (measured); at      \
+         1e6 on the GPU 1.5x less wall time (docs/physics.md); a solve whose error grows past its bound and \
+        twice its smallest takes the plain steps for the rest of it. CPU and CUDA backends */
 
 typedef struct sph_dfsph_params {
   uint32_t struct_size;               /* set by sph_dfsph_params_init */

@@ -126,8 +126,9 @@ namespace Sph
         /// <summary>
         /// (0.2.0) the Jacobi steps accelerated by Chebyshev's semi-iteration, an expanded particle's
         /// \ pressure released step by step: about half the iterations up to ~1e5 particles (measured);
-        /// at \ 1e6 on the GPU 1.5x less wall time (docs/physics.md); a solve whose error grows to
-        /// twice its  \ smallest takes the plain steps for the rest of it. CPU and CUDA backends
+        /// at      \ 1e6 on the GPU 1.5x less wall time (docs/physics.md); a solve whose error grows
+        /// past its bound and \ twice its smallest takes the plain steps for the rest of it. CPU and
+        /// CUDA backends
         /// </summary>
         public const uint SPH_DFSPH_CHEBYSHEV = 3u;
         /// <summary>hollow box: no lid (a tank open at +y)</summary>

@@ -167,6 +167,7 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
     float carry_scale;
     uint32_t pass;              // the residual passes run so far
     DfsphChebyshevGuard guard;  // SPH_DFSPH_CHEBYSHEV's (dfsph_passes.h), on the world's errors
+    DfsphBounds bounds;
     void velocity_update(bool) { b.dfsph_correct(fluid, walls, dt, v, carried, carry_scale); }
     void share_velocities() {
       if (b.rank_) b.halo_share_velocities(v);
@@ -179,9 +180,9 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
     }
     DfsphErrors errors() { return b.dfsph_errors(kind); }
     void checked(uint32_t iterations, const DfsphErrors& errors, bool) {
-      chebyshev_guard_check(guard, iterations, errors.mean);
+      chebyshev_guard_check(guard, iterations, errors.mean, bounds.mean);
     }
-  } passes{*this, kind, fluid, walls, dt, v, carried, carry_scale, 0u, DfsphChebyshevGuard{}};
+  } passes{*this, kind, fluid, walls, dt, v, carried, carry_scale, 0u, DfsphChebyshevGuard{}, bounds};
   const DfsphLoopOutcome o = run_dfsph_jacobi(passes, bounds, min_iterations, max_iterations);
   return SolveOutcome{o.iterations, o.errors.mean, o.errors.largest, o.capped};
 }

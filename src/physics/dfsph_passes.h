@@ -266,7 +266,7 @@ struct DfsphChebyshev {
   // The share of the plain step an expanded particle releases (0.5 and 0.25 measured; 0.25 kept).
   static constexpr float kRelease = 0.25f;
   // The guard (DfsphChebyshevGuard below): a solve whose mean error passes this many times the
-  // smallest it reached takes plain steps from then on.
+  // smallest it reached, and its own bound, takes plain steps from then on.
   static constexpr float kGuardGrowth = 2.0f;
 };
 
@@ -277,26 +277,30 @@ struct DfsphChebyshev {
 // until the cap, and the step fails with non-finite velocities, where the plain solve converges.
 // The release is part of it: with weight 1 and the release a kernel of 3 spacings still diverged
 // (3.4 times an iteration), the plain solve's own steps (never negative) did not. So once a
-// solve's mean error passes kGuardGrowth times the smallest it reached, the rest of that solve
-// takes the plain solve's step (density_residual: weight 1, no release); the next solve starts
-// accelerated again. A
-// solve that converges never rises that far (session 28: a restart at a doubling never fired at
-// the spectral radius 0.95 on the dam break), so it leaves the accelerated solve's bits alone. Both
-// backends keep it after each test of the solve (the CPU's loop, the CUDA check kernels), on the
-// world's mean error.
+// solve's mean error passes kGuardGrowth times the smallest it reached and the solve's own bound,
+// the rest of that solve takes the plain solve's step (density_residual: weight 1, no release); the
+// next solve starts accelerated again. A solve whose error stays within its bound, or falls, is
+// never touched (session 28: a restart at a doubling never fired at the spectral radius 0.95 on the
+// dam break), so where the guard does not fire the accelerated solve keeps its bits. Both backends
+// keep it after each test of the solve (the CPU's loop, the CUDA check kernels), on the world's
+// mean error.
 struct DfsphChebyshevGuard {
   float smallest = 0.0f;  // the solve's smallest mean error so far
   uint32_t plain = 0u;    // nonzero: the rest of the solve takes weight 1
 };
 
-// After the solve's test number `iterations` (0: the first, after the warm start) read `mean`.
-SPH_HD void chebyshev_guard_check(DfsphChebyshevGuard& guard, uint32_t iterations, float mean) {
+// After the solve's test number `iterations` (0: the first, after the warm start) read `mean`;
+// `bound` the solve's bound on it. Only a mean above the bound arms it: below, the solve may stop
+// any time, and rounding-level errors (a resting world's 0 or 1e-9 moving to 4e-9, measured in the
+// 3-spacing case's first frames) or a solve kept going by its largest-error bound are not a
+// divergence; a divergence passes the bound within an iteration or two.
+SPH_HD void chebyshev_guard_check(DfsphChebyshevGuard& guard, uint32_t iterations, float mean, float bound) {
   if (iterations == 0u) {
     guard.smallest = mean;
     guard.plain = 0u;
     return;
   }
-  if (mean > DfsphChebyshev::kGuardGrowth * guard.smallest) guard.plain = 1u;
+  if (mean > DfsphChebyshev::kGuardGrowth * guard.smallest && mean > bound) guard.plain = 1u;
   if (mean < guard.smallest) guard.smallest = mean;
 }
 

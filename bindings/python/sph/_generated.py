@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'aef0c788c154ab2533b0546661f9c4de1edcf852a7b8c78bd90485a56ecea870', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a5578d6102b62b815a8e30ab9971b3f673f74fefb99945f893d23fa6990a6ca3', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '504ac01d4f82cbedfbb3e24bdcd40525a7d5eb34cc17733fb55de01779f6c232', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a5578d6102b62b815a8e30ab9971b3f673f74fefb99945f893d23fa6990a6ca3', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -103,10 +103,10 @@ SPH_DFSPH_NO_DEPTH_STEP_LIMIT = 4
 SPH_DFSPH_JACOBI = 1
 #: Jacobi-preconditioned conjugate gradients on the \ compressed particles
 SPH_DFSPH_CONJUGATE_GRADIENTS = 2
-#: (0.2.0) the Jacobi steps accelerated by Chebyshev's semi-iteration, an expanded particle's     \
-#: pressure released step by step: about half the iterations up to ~1e5 particles (measured); at \
-#: 1e6 on the GPU 1.5x less wall time (docs/physics.md); a solve whose error grows to twice its  \
-#: smallest takes the plain steps for the rest of it. CPU and CUDA backends
+#: (0.2.0) the Jacobi steps accelerated by Chebyshev's semi-iteration, an expanded particle's
+#: \ pressure released step by step: about half the iterations up to ~1e5 particles (measured); at
+#: \ 1e6 on the GPU 1.5x less wall time (docs/physics.md); a solve whose error grows past its bound
+#: and \ twice its smallest takes the plain steps for the rest of it. CPU and CUDA backends
 SPH_DFSPH_CHEBYSHEV = 3
 #: hollow box: no lid (a tank open at +y)
 SPH_SHAPE_FLAG_OPEN_TOP = 1
