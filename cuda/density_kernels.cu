@@ -57,11 +57,6 @@ __global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArra
   const LaneGroup<G> group = LaneGroup<G>::of_thread(t);
   // A distributed rank's ghost (the whole lane group: one particle) skips its gather: its density,
   // pressure, 1 / density and count are its owner's, taken right after this pass
-  // (HaloDensityRecord), before any pass reads them. Its velocity still moves to the sorted
-  // order (the record does not carry it); the placeholders keep the record finite until then.
-  // (A branch of its own before the gather: the undivided world's kernel keeps its registers.)
-  // A distributed rank's ghost (the whole lane group: one particle) skips its gather: its density,
-  // pressure, 1 / density and count are its owner's, taken right after this pass
   // (HaloDensityRecord), before any pass reads them; ghost_density_moves_kernel moves the rest.
   // (A bare return: the undivided world's kernel keeps its registers, which a branch that wrote
   // the ghost here raised from 30 to 34 at two and four lanes, ptxas -v, sm_90.)
@@ -96,7 +91,10 @@ __global__ void density_kernel(FluidConstants fluid, GridView grid, ParticleArra
 
 // A distributed rank's ghosts, which density_kernel skips: the velocity moved to the sorted order
 // (their density records do not carry it) and placeholders that keep the record finite until the
-// owners' records arrive (the pressure slot held the old index until here).
+// owners' records arrive (the pressure slot held the old index until here). Not written for a
+// ghost: the walls' share (boundary_gradient; each particle's force and load read only its own, and
+// ghosts are neither integrated nor loaded), the normalised density's factor (only its own filter,
+// skipped too, reads it).
 __global__ void ghost_density_moves_kernel(FluidConstants fluid, ParticleArrays a, uint32_t n) {
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n || !a.halo_ghost[i]) return;
