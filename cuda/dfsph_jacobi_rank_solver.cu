@@ -12,7 +12,7 @@
 // must be the bits that its undivided check kernel writes (gpu_check_mpi compares the two worlds
 // bit for bit).
 #include "../src/core/dfsph_jacobi_loop.h"
-#include "../src/physics/dfsph_passes.h"
+#include "../src/physics/dfsph_chebyshev.h"
 #include "dfsph_solve_loop.cuh"
 #include "dfsph_solver.h"
 #include "kernel_launch.h"

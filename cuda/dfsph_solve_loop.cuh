@@ -15,7 +15,7 @@
 #include "../src/core/exact_float_sum.h"
 #include "../src/core/host_memory.h"
 #include "../src/core/solver_record.h"
-#include "../src/physics/dfsph_passes.h"
+#include "../src/physics/dfsph_chebyshev.h"
 #include "cuda_status.h"
 #include "dfsph_solver.h"
 #include "frame_control.h"
@@ -35,7 +35,7 @@ __device__ inline ListedCandidates solve_walk(const ParticleArrays& a) {
 
 // After the solve's test number `iterations` (0: the first) found the mean error `mean` (`bound`
 // the solve's bound on it): the
-// Chebyshev solve's guard (DfsphChebyshevGuard, dfsph_passes.h; its fields in the state) and what the
+// Chebyshev solve's guard (DfsphChebyshevGuard, dfsph_chebyshev.h; its fields in the state) and what the
 // next residual pass applies, its weight or (solve_plain) the plain step (read by
 // SPH_DFSPH_CHEBYSHEV's density solve only). One thread.
 __device__ inline void dfsph_chebyshev_after_test(FrameState* state, uint32_t iterations, float mean,

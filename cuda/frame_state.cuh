@@ -73,8 +73,8 @@ struct FrameState {
   float solve_error;            // the current solve's mean error
   float solve_largest;          // and its largest particle error (the density solve's only)
   uint32_t solve_largest_bits;  // the largest of the measurement in progress, as float bits (atomicMax)
-  float solve_weight;           // SPH_DFSPH_CHEBYSHEV: the next residual pass's weight (dfsph_passes.h)
-  float solve_smallest;         // and its guard (DfsphChebyshevGuard, dfsph_passes.h), kept by the
+  float solve_weight;           // SPH_DFSPH_CHEBYSHEV: the next residual pass's weight (dfsph_chebyshev.h)
+  float solve_smallest;         // and its guard (DfsphChebyshevGuard, dfsph_chebyshev.h), kept by the
   uint32_t solve_plain;         // check kernels: the smallest mean error so far; nonzero: the plain step
   // The conjugate gradients' density solve (dfsph_cg_solver.cu): a new cycle is due; the rest of
   // this iteration is skipped (no descent along p, or a restart); a contact was held in it; the

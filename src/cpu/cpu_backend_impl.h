@@ -22,6 +22,7 @@
 #include "../core/slab_decomposition.h"
 #include "../core/solver_record.h"
 #include "../physics/collider_loads.h"
+#include "../physics/dfsph_chebyshev.h"
 #include "../physics/dfsph_passes.h"
 #include "../physics/forces.h"
 #include "../physics/integrate.h"

@@ -92,7 +92,7 @@ void CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, c
   const Dfsph::Constants& c = fluid.methods.dfsph;
   const float rho0 = fluid.rest_density;
   const SimdPasses::DfsphRateFn density_rate_of = simd_.dfsph_density_rate;
-  // SPH_DFSPH_CHEBYSHEV (dfsph_passes.h): the density solve's steps mixed with the last ones.
+  // SPH_DFSPH_CHEBYSHEV (dfsph_chebyshev.h): the density solve's steps mixed with the last ones.
   const bool chebyshev = kind == DfsphSolve::Density && c.linear_solver == kDfsphChebyshev;
   // The gather reads positions and the velocities' columns; each particle writes only its k. A
   // distributed rank's ghosts are skipped: they take their owners' k right after (share_steps),
@@ -166,7 +166,7 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
     float* carried;
     float carry_scale;
     uint32_t pass;              // the residual passes run so far
-    DfsphChebyshevGuard guard;  // SPH_DFSPH_CHEBYSHEV's (dfsph_passes.h), on the world's errors
+    DfsphChebyshevGuard guard;  // SPH_DFSPH_CHEBYSHEV's (dfsph_chebyshev.h), on the world's errors
     DfsphBounds bounds;
     void velocity_update(bool) { b.dfsph_correct(fluid, walls, dt, v, carried, carry_scale); }
     void share_velocities() {

@@ -55,7 +55,7 @@ enum DfsphFlags : uint32_t {
 };
 // sph_dfsph_params.linear_solver (SPH_DFSPH_JACOBI, SPH_DFSPH_CONJUGATE_GRADIENTS,
 // SPH_DFSPH_CHEBYSHEV): how the density solve iterates (dfsph_cg.h has the conjugate gradients'
-// method, dfsph_passes.h the Chebyshev steps').
+// method, dfsph_chebyshev.h the Chebyshev steps').
 enum DfsphLinearSolver : uint32_t { kDfsphJacobi = 1, kDfsphConjugateGradients = 2, kDfsphChebyshev = 3 };
 
 // The names of DFSPH's per-particle arrays.

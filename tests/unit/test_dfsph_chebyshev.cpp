@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The Chebyshev density solve's arithmetic (src/physics/dfsph_passes.h, SPH_DFSPH_CHEBYSHEV), which
+// The Chebyshev density solve's arithmetic (src/physics/dfsph_chebyshev.h, SPH_DFSPH_CHEBYSHEV), which
 // both backends call: the weights against the recurrence worked in double and its closed-form limit
 // w* = 2 / (1 + sqrt(1 - rho^2)) (Golub & Varga), the early stop of the weights' loop, the release of an
 // expanded particle and the limit that keeps the solve's total pressure >= 0.
@@ -13,7 +13,7 @@ extern "C" {
 
 #include <cmath>
 
-#include "physics/dfsph_passes.h"
+#include "physics/dfsph_chebyshev.h"
 
 namespace {
 
