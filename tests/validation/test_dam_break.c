@@ -220,25 +220,34 @@ static void test_dfsph_boundary(void** state) {
   (void)run_dfsph(SPH_FEATURE_BOUNDARY_DENSITY);
 }
 
+/* Runs `config` in a context of the test's backend and asserts that the run succeeded; the result
+ * is the caller's to free. */
+static dam_break_result* run_case(const dam_break_config* config) {
+  sph_context* context = NULL;
+  dam_break_result* result = (dam_break_result*)malloc(sizeof(dam_break_result));
+  sph_result r;
+  assert_non_null(result);
+  EXPECT_OK(sph_test_context_create(&context));
+  r = dam_break_run(context, config, result, NULL, NULL);
+  if (r != SPH_OK) printf("dam break failed: %s: %s\n", sph_result_string(r), result->message);
+  assert_int_equal(r, SPH_OK);
+  EXPECT_OK(sph_context_destroy(context));
+  return result;
+}
+
 /* A density solve held to 2 iterations against a bound of 1e-6 cannot converge in the first
  * frames of the collapse: every such substep must be reported, in sph_stats and as an
  * SPH_EVENT_PRESSURE_SOLVE_CAPPED event (never silently), and the run must go on. */
 static void test_dfsph_capped(void** state) {
-  sph_context* context = NULL;
   dam_break_config config;
-  dam_break_result* result = (dam_break_result*)malloc(sizeof(dam_break_result));
-  sph_result r;
+  dam_break_result* result;
   (void)state;
-  assert_non_null(result);
-  EXPECT_OK(sph_test_context_create(&context));
   dam_break_config_default(&config, 10);
   config.solver = SPH_SOLVER_DFSPH;
   config.density_error = 1e-6f;
   config.max_iterations = 2;
   config.end_T = 0.5;
-  r = dam_break_run(context, &config, result, NULL, NULL);
-  if (r != SPH_OK) printf("dam break failed: %s: %s\n", sph_result_string(r), result->message);
-  assert_int_equal(r, SPH_OK);
+  result = run_case(&config);
   printf(
       "capped DFSPH: %llu substeps, %u capped in sph_stats, %u in events, max iterations %u, error max %.4f "
       "%%\n",
@@ -249,10 +258,9 @@ static void test_dfsph_capped(void** state) {
   assert_true(result->pressure_iterations_max <= 2);
   assert_true(result->density_error_max > 1e-6);
   free(result);
-  EXPECT_OK(sph_context_destroy(context));
 }
 
-/* SPH_DFSPH_CHEBYSHEV's guard (dfsph_passes.h, DfsphChebyshevGuard): a kernel radius of 3 particle
+/* SPH_DFSPH_CHEBYSHEV's guard (dfsph_chebyshev.h, DfsphChebyshevGuard): a kernel radius of 3 particle
  * spacings, whose larger neighbourhoods the weights' assumed spectral radius (0.9) does not hold for.
  * Without the guard the accelerated solve's error grew about 3 times an iteration and the second
  * substep failed with non-finite densities (session 40, CPU; kernel radii of 2.2 and 2.6 spacings
@@ -260,13 +268,9 @@ static void test_dfsph_capped(void** state) {
  * step and the run goes on: every step succeeds, every density solve ends within its bound (the
  * achieved mean error at most 0.1 %), none is capped, nothing escapes. 3,072 particles, T up to 1. */
 static void test_dfsph_chebyshev_wide_kernel(void** state) {
-  sph_context* context = NULL;
   dam_break_config config;
-  dam_break_result* result = (dam_break_result*)malloc(sizeof(dam_break_result));
-  sph_result r;
+  dam_break_result* result;
   (void)state;
-  assert_non_null(result);
-  EXPECT_OK(sph_test_context_create(&context));
   dam_break_config_default(&config, 16);
   config.slab_layers = 12;
   config.kernel_ratio = 3.0f;
@@ -274,9 +278,7 @@ static void test_dfsph_chebyshev_wide_kernel(void** state) {
   config.dfsph_linear_solver = SPH_DFSPH_CHEBYSHEV;
   config.end_T = 1.0;
   config.sample_T = 0.1;
-  r = dam_break_run(context, &config, result, NULL, NULL);
-  if (r != SPH_OK) printf("dam break failed: %s: %s\n", sph_result_string(r), result->message);
-  assert_int_equal(r, SPH_OK);
+  result = run_case(&config);
   printf(
       "Chebyshev, h = 3 spacings: %u particles, %llu substeps, density solve %llu iterations (max %u), "
       "achieved error max %.4f %% (bound 0.1 %%), %u capped, %u outside the tank\n",
@@ -288,7 +290,6 @@ static void test_dfsph_chebyshev_wide_kernel(void** state) {
   assert_true(result->density_error_max <= 0.001);
   assert_int_equal(result->escaped, 0);
   free(result);
-  EXPECT_OK(sph_context_destroy(context));
 }
 
 /* argv[1] picks one case (wcsph | diffusion | dfsph | dfsph_boundary | dfsph_capped, dfsph_cg
