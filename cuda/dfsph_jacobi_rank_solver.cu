@@ -21,13 +21,14 @@ namespace sph {
 namespace {
 
 // A distributed rank's test, decided by the host (core/dfsph_jacobi_loop.h) on the world's
-// errors: the state and the record as dfsph_check_kernel leaves them, by the same rule.
+// errors: the state and the record as dfsph_check_kernel leaves them, by the same rule
+// (`chebyshev`: SPH_DFSPH_CHEBYSHEV's density solve, the one its guard watches).
 __global__ void dfsph_rank_check_kernel(uint32_t iterations, DfsphErrors errors, DfsphBounds bounds,
                                         uint32_t min_iterations, uint32_t max_iterations, bool divergence,
-                                        FrameState* state) {
+                                        bool chebyshev, FrameState* state) {
   state->solve_iterations = iterations;
   state->solve_error = errors.mean;
-  dfsph_chebyshev_after_test(state, iterations, errors.mean, bounds.mean);
+  if (chebyshev) dfsph_chebyshev_after_test(state, iterations, errors.mean, bounds.mean);
   state->solve_largest = errors.largest;
   dfsph_continue_solve(state, divergence ? state->divergence_tally : state->pressure_tally, bounds,
                        min_iterations, max_iterations, LoopCondition{});
@@ -77,8 +78,9 @@ void enqueue_dfsph_jacobi_rank_solve(const FluidConstants& fluid, const GridView
     void share_steps() { rank.share_steps(stream); }
     DfsphErrors errors() { return rank.errors(divergence, stream); }
     void checked(uint32_t iterations, const DfsphErrors& errors, bool) {
+      const bool chebyshev = !divergence && fluid.methods.dfsph.linear_solver == kDfsphChebyshev;
       dfsph_rank_check_kernel<<<1, 1, 0, stream>>>(iterations, errors, bounds, min_iterations, max_iterations,
-                                                   divergence, state);
+                                                   divergence, chebyshev, state);
       check_launch("dfsph_rank_check_kernel");
     }
   } passes{fluid,          grid,           a,    n,     v,     warm, carried, divergence, contacts, bounds,

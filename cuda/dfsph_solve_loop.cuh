@@ -36,8 +36,9 @@ __device__ inline ListedCandidates solve_walk(const ParticleArrays& a) {
 // After the solve's test number `iterations` (0: the first) found the mean error `mean` (`bound`
 // the solve's bound on it): the
 // Chebyshev solve's guard (DfsphChebyshevGuard, dfsph_chebyshev.h; its fields in the state) and what the
-// next residual pass applies, its weight or (solve_plain) the plain step (read by
-// SPH_DFSPH_CHEBYSHEV's density solve only). One thread.
+// next residual pass applies, its weight or (solve_plain) the plain step. Called for
+// SPH_DFSPH_CHEBYSHEV's density solve only, so that solve_plain, which the solve's record counts,
+// is set by no other solve. One thread.
 __device__ inline void dfsph_chebyshev_after_test(FrameState* state, uint32_t iterations, float mean,
                                                   float bound) {
   DfsphChebyshevGuard guard;
@@ -128,7 +129,7 @@ __device__ inline DfsphErrors dfsph_solve_errors(const FrameState* state) {
 __device__ inline void dfsph_stop_solve(FrameState* state, SolveTally& tally, const DfsphBounds& bounds,
                                         LoopCondition cond) {
   record_solve(tally, state->solve_iterations, state->solve_error, state->solve_largest,
-               dfsph_bounds_unmet(bounds, dfsph_solve_errors(state)));
+               dfsph_bounds_unmet(bounds, dfsph_solve_errors(state)), state->solve_plain != 0u);
   state->solve_run = 0;
   if (cond.in_graph) cudaGraphSetConditional(cond.handle, 0u);
 }

@@ -133,7 +133,8 @@ __global__ void __launch_bounds__(kDfsphCheckBlock)
   if (threadIdx.x != 0) return;
   state->solve_iterations = first ? 0u : state->solve_iterations + 1u;
   state->solve_error = n > 0 ? static_cast<float>(sum / n) : 0.0f;
-  dfsph_chebyshev_after_test(state, state->solve_iterations, state->solve_error, bounds.mean);
+  if (!divergence && c.linear_solver == kDfsphChebyshev)
+    dfsph_chebyshev_after_test(state, state->solve_iterations, state->solve_error, bounds.mean);
   dfsph_take_largest(state);
   dfsph_continue_solve(state, divergence ? state->divergence_tally : state->pressure_tally, bounds,
                        min_iterations, max_iterations, cond);

@@ -631,7 +631,8 @@ SPH_API sph_result SPH_CALL sph_world_get_density_diffusion_params(const sph_wor
   3u /* (0.2.0) the Jacobi steps accelerated by Chebyshev's semi-iteration, an expanded particle's          \
          pressure released step by step: about half the iterations up to ~1e5 particles (measured); at      \
          1e6 on the GPU 1.5x less wall time (docs/physics.md); a solve whose error grows past its bound and \
-        twice its smallest takes the plain steps for the rest of it. CPU and CUDA backends */
+        twice its smallest takes the plain steps for the rest of it (counted:                               \
+        sph_stats.pressure_solves_guarded). CPU and CUDA backends */
 
 typedef struct sph_dfsph_params {
   uint32_t struct_size;               /* set by sph_dfsph_params_init */
@@ -1040,12 +1041,16 @@ typedef struct sph_stats {
   float density_min;       /* density statistics of the last density evaluation, kg/m^3 */
   float density_mean;
   float density_max;
-  float neighbors_mean;            /* mean neighbours per particle (self excluded) */
-  float stage_ms[SPH_STAGE_COUNT]; /* wall milliseconds per stage over the last step */
-  float step_ms;                   /* wall milliseconds of the whole last sph_world_step */
-  uint32_t reserved0;
-  uint64_t memory_bytes; /* bytes the world holds for particles and grids (device memory on
-                            the CUDA backend) */
+  float neighbors_mean;             /* mean neighbours per particle (self excluded) */
+  float stage_ms[SPH_STAGE_COUNT];  /* wall milliseconds per stage over the last step */
+  float step_ms;                    /* wall milliseconds of the whole last sph_world_step */
+  uint32_t pressure_solves_guarded; /* (0.2.0) DFSPH with SPH_DFSPH_CHEBYSHEV: substeps whose density
+                                       solve its guard turned to plain Jacobi steps, as its error had
+                                       grown (docs/physics.md, "The guard"); the solve still meets its
+                                       bound or counts as capped. 0 for every other solver (before
+                                       0.2.0: reserved, 0) */
+  uint64_t memory_bytes;            /* bytes the world holds for particles and grids (device memory on
+                                       the CUDA backend) */
   /* DFSPH's two solves over the substeps of the last step (all zero on a WCSPH world). An
      iteration is one velocity update and one new residual, after the warm start's. */
   uint32_t pressure_iterations;       /* the density solve's iterations, summed */

@@ -389,7 +389,7 @@ typedef struct sph_stats {
   float neighbors_mean;
   float stage_ms[8];
   float step_ms;
-  uint32_t reserved0;
+  uint32_t pressure_solves_guarded;
   uint64_t memory_bytes;
   uint32_t pressure_iterations;
   uint32_t pressure_iterations_max;

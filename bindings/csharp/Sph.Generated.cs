@@ -127,8 +127,8 @@ namespace Sph
         /// (0.2.0) the Jacobi steps accelerated by Chebyshev's semi-iteration, an expanded particle's
         /// \ pressure released step by step: about half the iterations up to ~1e5 particles (measured);
         /// at      \ 1e6 on the GPU 1.5x less wall time (docs/physics.md); a solve whose error grows
-        /// past its bound and \ twice its smallest takes the plain steps for the rest of it. CPU and
-        /// CUDA backends
+        /// past its bound and \ twice its smallest takes the plain steps for the rest of it (counted:
+        /// \ sph_stats.pressure_solves_guarded). CPU and CUDA backends
         /// </summary>
         public const uint SPH_DFSPH_CHEBYSHEV = 3u;
         /// <summary>hollow box: no lid (a tank open at +y)</summary>
@@ -1485,8 +1485,13 @@ namespace Sph
         public FixedFloat8 StageMs;
         /// <summary>float step_ms: wall milliseconds of the whole last sph_world_step</summary>
         public float StepMs;
-        /// <summary>uint32_t reserved0</summary>
-        public uint Reserved0;
+        /// <summary>
+        /// uint32_t pressure_solves_guarded: (0.2.0) DFSPH with SPH_DFSPH_CHEBYSHEV: substeps whose
+        /// density solve its guard turned to plain Jacobi steps, as its error had grown
+        /// (docs/physics.md, "The guard"); the solve still meets its bound or counts as capped. 0 for
+        /// every other solver (before 0.2.0: reserved, 0)
+        /// </summary>
+        public uint PressureSolvesGuarded;
         /// <summary>
         /// uint64_t memory_bytes: bytes the world holds for particles and grids (device memory on the
         /// CUDA backend)
@@ -4210,7 +4215,7 @@ namespace Sph
             "NeighborsMean",
             "StageMs",
             "StepMs",
-            "Reserved0",
+            "PressureSolvesGuarded",
             "MemoryBytes",
             "PressureIterations",
             "PressureIterationsMax",

@@ -332,6 +332,7 @@ SPH_API sph_result SPH_CALL sph_world_get_stats(const sph_world* world, sph_stat
     s.divergence_error_mean = r.divergence_solve.error_mean;
     s.divergence_error_max = r.divergence_solve.error_max;
     s.pressure_solves_capped = r.pressure_solve.capped;
+    s.pressure_solves_guarded = r.pressure_solve.guarded;
     s.divergence_solves_capped = r.divergence_solve.capped;
     s.capacity = w.config().capacity;
     s.max_capacity = w.config().max_capacity;

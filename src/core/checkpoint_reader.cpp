@@ -113,8 +113,10 @@ SolveReport read_solve(ByteReader& r, const std::string& name, uint32_t version)
   s.error_mean = non_negative(r, name + " mean error");
   s.error_max = non_negative(r, name + " largest error");
   if (version >= kFirstLargestErrorVersion) s.largest_max = non_negative(r, name + " largest particle error");
-  if (s.iterations_max > s.iterations || s.capped > s.iterations)
-    corrupt(r.what() + ": " + name + " counts more in one substep or more capped solves than iterations");
+  if (version >= kFirstGuardedVersion) s.guarded = r.u32();
+  if (s.iterations_max > s.iterations || s.capped > s.iterations || s.guarded > s.iterations)
+    corrupt(r.what() + ": " + name +
+            " counts more in one substep, or more capped or guarded solves, than iterations");
   return s;
 }
 

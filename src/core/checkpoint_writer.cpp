@@ -64,6 +64,7 @@ void write_solve(ByteWriter& w, const SolveReport& s) {
   w.f32(s.error_mean);
   w.f32(s.error_max);
   w.f32(s.largest_max);  // version 9
+  w.u32(s.guarded);      // version 13
 }
 
 // SPH_FEATURE_SPRINGS worlds only, after the particles: the lowest id still waiting for springs

@@ -32,6 +32,8 @@ struct SolveReport {
   float error_mean = 0.0f;      // the achieved mean error, averaged over the substeps
   float error_max = 0.0f;       // the largest of any substep
   float largest_max = 0.0f;     // the largest particle error any substep's solve ended with
+  uint32_t guarded = 0;         // substeps whose Chebyshev density solve its guard turned to plain
+                                // steps (dfsph_chebyshev.h); 0 for every other solve
 };
 
 // One collider's impulses over a frame (SPH_FEATURE_COLLIDER_LOADS, physics/collider_loads.h),

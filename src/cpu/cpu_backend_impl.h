@@ -217,6 +217,7 @@ class CpuBackend final : public Backend {
     float error;    // the mean
     float largest;  // the largest particle error
     bool capped;
+    bool guarded;  // the Chebyshev density solve's guard turned it to plain steps
   };
   // One solve over the velocities v (xyz; w: 1 / rho), from the warm start in `carried` (k,
   // times carry_scale: dt for the divergence solve's impulse, 1 for the density solve's

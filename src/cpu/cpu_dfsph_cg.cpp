@@ -249,7 +249,7 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
   // Kept for the warm start, the checkpoints and the pressure attribute: where it pushed
   // (dfsph_cg.h).
   parallel().for_each(n, [&](uint32_t i) { carried[i] = dfsph_cg_kept_pressure(carried[i]); });
-  return SolveOutcome{iterations, error.mean, error.largest, dfsph_bounds_unmet(bounds, error)};
+  return SolveOutcome{iterations, error.mean, error.largest, dfsph_bounds_unmet(bounds, error), false};
 }
 
 }  // namespace sph

@@ -167,6 +167,7 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
     float carry_scale;
     uint32_t pass;              // the residual passes run so far
     DfsphChebyshevGuard guard;  // SPH_DFSPH_CHEBYSHEV's (dfsph_chebyshev.h), on the world's errors
+    bool guarded;               // the guard applies: SPH_DFSPH_CHEBYSHEV's density solve
     DfsphBounds bounds;
     void velocity_update(bool) { b.dfsph_correct(fluid, walls, dt, v, carried, carry_scale); }
     void share_velocities() {
@@ -180,11 +181,22 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
     }
     DfsphErrors errors() { return b.dfsph_errors(kind); }
     void checked(uint32_t iterations, const DfsphErrors& errors, bool) {
-      chebyshev_guard_check(guard, iterations, errors.mean, bounds.mean);
+      if (guarded) chebyshev_guard_check(guard, iterations, errors.mean, bounds.mean);
     }
-  } passes{*this, kind, fluid, walls, dt, v, carried, carry_scale, 0u, DfsphChebyshevGuard{}, bounds};
+  } passes{*this,
+           kind,
+           fluid,
+           walls,
+           dt,
+           v,
+           carried,
+           carry_scale,
+           0u,
+           DfsphChebyshevGuard{},
+           !divergence && c.linear_solver == kDfsphChebyshev,
+           bounds};
   const DfsphLoopOutcome o = run_dfsph_jacobi(passes, bounds, min_iterations, max_iterations);
-  return SolveOutcome{o.iterations, o.errors.mean, o.errors.largest, o.capped};
+  return SolveOutcome{o.iterations, o.errors.mean, o.errors.largest, o.capped, passes.guard.plain != 0u};
 }
 
 uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame& scene,
@@ -200,7 +212,7 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
   if (fluid.methods.dfsph.divergence_solve) {
     const SolveOutcome o =
         dfsph_solve(DfsphSolve::Divergence, fluid, walls, dt, velocity_.data(), dfsph_divergence_.data(), dt);
-    record_solve(tallies.divergence, o.iterations, o.error, o.largest, o.capped);
+    record_solve(tallies.divergence, o.iterations, o.error, o.largest, o.capped, o.guarded);
   } else {
     std::fill(dfsph_divergence_.data(), dfsph_divergence_.data() + count_, 0.0f);  // no warm start to keep
   }
@@ -235,7 +247,7 @@ uint32_t CpuBackend::substep_dfsph(const FluidConstants& fluid, const SceneFrame
   // 4. The density solve on v*.
   const SolveOutcome o =
       dfsph_solve(DfsphSolve::Density, fluid, walls, dt, next_vel, dfsph_pressure_.data(), 1.0f);
-  record_solve(tallies.pressure, o.iterations, o.error, o.largest, o.capped);
+  record_solve(tallies.pressure, o.iterations, o.error, o.largest, o.capped, o.guarded);
   // 5. x += dt v*; w: the pressure both solves applied in this substep, p = (k + k_v) rho^2, also
   // the start's record's (the probes sample it there, at the positions the solves worked on).
   const float* k = dfsph_pressure_.data();

@@ -132,7 +132,7 @@ static const struct {
     MPI_TEST_SOLVER_FIELD(density_error_mean),     MPI_TEST_SOLVER_FIELD(density_error_max),
     MPI_TEST_SOLVER_FIELD(divergence_error_mean),  MPI_TEST_SOLVER_FIELD(divergence_error_max),
     MPI_TEST_SOLVER_FIELD(pressure_solves_capped), MPI_TEST_SOLVER_FIELD(divergence_solves_capped),
-    MPI_TEST_SOLVER_FIELD(density_error_largest),
+    MPI_TEST_SOLVER_FIELD(density_error_largest),  MPI_TEST_SOLVER_FIELD(pressure_solves_guarded),
 };
 #undef MPI_TEST_SOLVER_FIELD
 enum { kSolverFieldCount = sizeof kSolverFields / sizeof kSolverFields[0] };

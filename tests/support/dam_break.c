@@ -2,6 +2,7 @@
 #include "dam_break.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -127,6 +128,36 @@ static void log_frame(FILE* log, const dam_break_result* result, const sph_stats
           count ? positions[3 * densest] / a : 0.0, count ? positions[3 * densest + 1] / a : 0.0,
           count ? positions[3 * densest + 2] / a : 0.0);
   fflush(log);
+}
+
+/* Saves `world` to memory, loads it into a second world of `context` and sets *equal to whether the
+ * loaded world's solver statistics are `saved`'s, bit for bit (the checkpoint carries the last
+ * step's report, docs/checkpoint.md, TIME). */
+static sph_result reload_and_compare(sph_context* context, const sph_world* world, const sph_stats* saved,
+                                     int* equal) {
+  uint64_t size = 0;
+  uint8_t* buffer = NULL;
+  sph_world* loaded = NULL;
+  sph_stats got;
+  sph_result r = sph_world_save(world, NULL, 0, &size);
+  if (r != SPH_OK) return r;
+  buffer = (uint8_t*)malloc((size_t)size);
+  if (!buffer) return SPH_ERROR_OUT_OF_HOST_MEMORY;
+  if ((r = sph_world_save(world, buffer, size, &size)) == SPH_OK &&
+      (r = sph_world_load(context, buffer, size, &loaded)) == SPH_OK) {
+    sph_stats_init(&got);
+    if ((r = sph_world_get_stats(loaded, &got)) == SPH_OK) {
+      /* pressure_iterations through divergence_solves_capped, then the two fields apart from them */
+      const size_t first = offsetof(sph_stats, pressure_iterations);
+      const size_t end = offsetof(sph_stats, capacity);
+      *equal = memcmp((const char*)&got + first, (const char*)saved + first, end - first) == 0 &&
+               memcmp(&got.density_error_largest, &saved->density_error_largest, sizeof(float)) == 0 &&
+               got.pressure_solves_guarded == saved->pressure_solves_guarded;
+    }
+    sph_world_destroy(loaded);
+  }
+  free(buffer);
+  return r;
 }
 
 sph_result dam_break_run(sph_context* context, const dam_break_config* config, dam_break_result* result,
@@ -258,6 +289,11 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
         if (stats.density_error_largest > result->density_error_largest)
           result->density_error_largest = stats.density_error_largest;
         result->capped_substeps += stats.pressure_solves_capped;
+        result->guarded_substeps += stats.pressure_solves_guarded;
+        if (config->check_reload && stats.pressure_solves_guarded > 0 && !result->reload_checked &&
+            (r = reload_and_compare(context, world, &stats, &result->reload_stats_equal)) != SPH_OK)
+          goto done;
+        if (config->check_reload && stats.pressure_solves_guarded > 0) result->reload_checked = 1;
         for (int k = 0; k < SPH_STAGE_COUNT; ++k) result->stage_ms[k] += stats.stage_ms[k];
         result->neighbors_mean += (double)stats.neighbors_mean * stats.substeps;
         {

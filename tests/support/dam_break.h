@@ -61,6 +61,10 @@ typedef struct dam_break_config {
      neighbour count over every particle, seconds a frame at a million particles, outside the
      timed steps). 0 (the default): those fields stay 0. */
   int measure_interior;
+  /* Nonzero: after the first frame whose density solves the Chebyshev guard turned, save the world
+     to memory, load it into a second world and compare the two worlds' solver statistics
+     (reload_* below). 0 (the default): no save. */
+  int check_reload;
 } dam_break_config;
 
 /* The share of the start's fullest neighbour count (within h, itself included) from which a
@@ -118,7 +122,14 @@ typedef struct dam_break_result {
                                    (sph_stats.density_error_largest; within density_error_max unless
                                    that solve was capped) */
   uint32_t capped_substeps;     /* substeps whose density solve stopped at its cap (sph_stats) */
+  uint32_t guarded_substeps;    /* substeps whose Chebyshev density solve its guard turned to plain
+                                   steps (sph_stats.pressure_solves_guarded) */
   uint32_t capped_events;       /* the counts of SPH_EVENT_PRESSURE_SOLVE_CAPPED events, summed */
+  /* With config.check_reload: whether the reload happened (a frame had a guarded solve), and
+     whether the loaded world's statistics had the saved world's solver fields, bit for bit
+     (pressure_iterations ... density_error_largest, and pressure_solves_guarded). */
+  int reload_checked;
+  int reload_stats_equal;
   /* Where the wall time went (sph_stats' stage_ms summed over the frames, ms) and the mean
    * neighbour count (sph_stats' neighbors_mean, weighted by the frames' substeps): what tells
    * two runs' substep costs apart (bench/solver_front prints them). */

@@ -139,13 +139,14 @@ static unsigned long long run_dfsph(uint32_t features) {
       "DFSPH dam break%s: %u particles, %llu substeps, %.2f s wall for %.3f s simulated; density solve: %llu "
       "iterations (%.2f a substep, max %u), achieved error mean %.4f %% max %.4f %% (bound 0.1 %%), %u "
       "capped "
-      "(%u events), largest particle error %.4f %% (bound 5 %%); divergence solve %llu iterations\n",
+      "(%u events), %u guarded, largest particle error %.4f %% (bound 5 %%); divergence solve %llu "
+      "iterations\n",
       features ? " (boundary density)" : "", result->particles, (unsigned long long)result->substeps,
       result->wall_seconds, result->simulated_seconds, (unsigned long long)result->pressure_iterations,
       (double)result->pressure_iterations / (double)(result->substeps ? result->substeps : 1),
       result->pressure_iterations_max, 100.0 * result->density_error_mean, 100.0 * result->density_error_max,
-      result->capped_substeps, result->capped_events, 100.0 * result->density_error_largest,
-      (unsigned long long)result->divergence_iterations);
+      result->capped_substeps, result->capped_events, result->guarded_substeps,
+      100.0 * result->density_error_largest, (unsigned long long)result->divergence_iterations);
   printf(
       "  fitted shift dT = %+.3f: mean error %.2f %% (bound 5 %%), worst %.2f %% (bound 15 %%) over %u "
       "points; "
@@ -186,6 +187,10 @@ static unsigned long long run_dfsph(uint32_t features) {
   assert_true(result->density_error_max <= 0.001);
   assert_true(result->density_error_largest <= 0.05);
   assert_int_equal(result->escaped, 0);
+  /* Only the Chebyshev solve has a guard; at the default kernel radius (1.8 spacings) its weights'
+   * assumption holds and the guard must not fire (docs/physics.md, "The guard"): 0 guarded substeps
+   * in every one of these cases on the CPU (session 41). */
+  assert_int_equal(result->guarded_substeps, 0);
   {
     const unsigned long long iterations = result->pressure_iterations;
     free(result);
@@ -266,7 +271,8 @@ static void test_dfsph_capped(void** state) {
  * substep failed with non-finite densities (session 40, CPU; kernel radii of 2.2 and 2.6 spacings
  * failed alike in larger dam breaks, docs/validation.md); with it the solve falls back to the plain
  * step and the run goes on: every step succeeds, every density solve ends within its bound (the
- * achieved mean error at most 0.1 %), none is capped, nothing escapes. 3,072 particles, T up to 1. */
+ * achieved mean error at most 0.1 %), none is capped, nothing escapes, and the statistics say that
+ * the guard fired. 3,072 particles, T up to 1. */
 static void test_dfsph_chebyshev_wide_kernel(void** state) {
   dam_break_config config;
   dam_break_result* result;
@@ -278,13 +284,22 @@ static void test_dfsph_chebyshev_wide_kernel(void** state) {
   config.dfsph_linear_solver = SPH_DFSPH_CHEBYSHEV;
   config.end_T = 1.0;
   config.sample_T = 0.1;
+  config.check_reload = 1;
   result = run_case(&config);
   printf(
       "Chebyshev, h = 3 spacings: %u particles, %llu substeps, density solve %llu iterations (max %u), "
-      "achieved error max %.4f %% (bound 0.1 %%), %u capped, %u outside the tank\n",
+      "achieved error max %.4f %% (bound 0.1 %%), %u capped, %u guarded, %u outside the tank\n",
       result->particles, (unsigned long long)result->substeps,
       (unsigned long long)result->pressure_iterations, result->pressure_iterations_max,
-      100.0 * result->density_error_max, result->capped_substeps, result->escaped);
+      100.0 * result->density_error_max, result->capped_substeps, result->guarded_substeps, result->escaped);
+  /* The guard fired and said so (sph_stats.pressure_solves_guarded), and the solves it turned still
+   * met their bound. */
+  assert_true(result->guarded_substeps > 0);
+  assert_true(result->guarded_substeps <= result->substeps);
+  /* A checkpoint carries the count (format 13): the world loaded after the guarded frame reports
+   * that frame's solver statistics. */
+  assert_true(result->reload_checked);
+  assert_true(result->reload_stats_equal);
   assert_int_equal(result->capped_substeps, 0);
   assert_int_equal(result->capped_events, 0);
   assert_true(result->density_error_max <= 0.001);

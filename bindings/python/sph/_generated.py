@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '504ac01d4f82cbedfbb3e24bdcd40525a7d5eb34cc17733fb55de01779f6c232', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a5578d6102b62b815a8e30ab9971b3f673f74fefb99945f893d23fa6990a6ca3', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '856dcaec3a576bbbc1e1f83d4ff3cb230a0fb4bd5b646220632fd4890dfff83a', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a5578d6102b62b815a8e30ab9971b3f673f74fefb99945f893d23fa6990a6ca3', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -106,7 +106,8 @@ SPH_DFSPH_CONJUGATE_GRADIENTS = 2
 #: (0.2.0) the Jacobi steps accelerated by Chebyshev's semi-iteration, an expanded particle's
 #: \ pressure released step by step: about half the iterations up to ~1e5 particles (measured); at
 #: \ 1e6 on the GPU 1.5x less wall time (docs/physics.md); a solve whose error grows past its bound
-#: and \ twice its smallest takes the plain steps for the rest of it. CPU and CUDA backends
+#: and \ twice its smallest takes the plain steps for the rest of it (counted:
+#: \ sph_stats.pressure_solves_guarded). CPU and CUDA backends
 SPH_DFSPH_CHEBYSHEV = 3
 #: hollow box: no lid (a tank open at +y)
 SPH_SHAPE_FLAG_OPEN_TOP = 1
@@ -1339,7 +1340,7 @@ class Stats(_SphStruct):
         neighbors_mean (float): mean neighbours per particle (self excluded)
         stage_ms (float [SPH_STAGE_COUNT]): wall milliseconds per stage over the last step
         step_ms (float): wall milliseconds of the whole last sph_world_step
-        reserved0 (uint32_t)
+        pressure_solves_guarded (uint32_t): (0.2.0) DFSPH with SPH_DFSPH_CHEBYSHEV: substeps whose density solve its guard turned to plain Jacobi steps, as its error had grown (docs/physics.md, "The guard"); the solve still meets its bound or counts as capped. 0 for every other solver (before 0.2.0: reserved, 0)
         memory_bytes (uint64_t): bytes the world holds for particles and grids (device memory on the CUDA backend)
         pressure_iterations (uint32_t): DFSPH's two solves over the substeps of the last step (all zero on a WCSPH world). An iteration is one velocity update and one new residual, after the warm start's.
         pressure_iterations_max (uint32_t): most in one substep
@@ -1372,7 +1373,7 @@ class Stats(_SphStruct):
         ('neighbors_mean', _c.c_float),
         ('stage_ms', (_c.c_float * 8)),
         ('step_ms', _c.c_float),
-        ('reserved0', _c.c_uint32),
+        ('pressure_solves_guarded', _c.c_uint32),
         ('memory_bytes', _c.c_uint64),
         ('pressure_iterations', _c.c_uint32),
         ('pressure_iterations_max', _c.c_uint32),
@@ -1391,7 +1392,7 @@ class Stats(_SphStruct):
     ]
     _sph_c_name_ = 'sph_stats'
     _sph_size_ = 160
-    _sph_offsets_ = (('struct_size', 0), ('particle_count', 4), ('substeps', 8), ('neighbors_max', 12), ('simulated_time', 16), ('frame_time', 24), ('dt_min', 28), ('dt_max', 32), ('max_speed', 36), ('density_min', 40), ('density_mean', 44), ('density_max', 48), ('neighbors_mean', 52), ('stage_ms', 56), ('step_ms', 88), ('reserved0', 92), ('memory_bytes', 96), ('pressure_iterations', 104), ('pressure_iterations_max', 108), ('divergence_iterations', 112), ('divergence_iterations_max', 116), ('density_error_mean', 120), ('density_error_max', 124), ('divergence_error_mean', 128), ('divergence_error_max', 132), ('pressure_solves_capped', 136), ('divergence_solves_capped', 140), ('capacity', 144), ('max_capacity', 148), ('capacity_growths', 152), ('density_error_largest', 156))
+    _sph_offsets_ = (('struct_size', 0), ('particle_count', 4), ('substeps', 8), ('neighbors_max', 12), ('simulated_time', 16), ('frame_time', 24), ('dt_min', 28), ('dt_max', 32), ('max_speed', 36), ('density_min', 40), ('density_mean', 44), ('density_max', 48), ('neighbors_mean', 52), ('stage_ms', 56), ('step_ms', 88), ('pressure_solves_guarded', 92), ('memory_bytes', 96), ('pressure_iterations', 104), ('pressure_iterations_max', 108), ('divergence_iterations', 112), ('divergence_iterations_max', 116), ('density_error_mean', 120), ('density_error_max', 124), ('divergence_error_mean', 128), ('divergence_error_max', 132), ('pressure_solves_capped', 136), ('divergence_solves_capped', 140), ('capacity', 144), ('max_capacity', 148), ('capacity_growths', 152), ('density_error_largest', 156))
     _sph_init_ = 'sph_stats_init_sized'
 
 
