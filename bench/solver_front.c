@@ -14,7 +14,9 @@
  * measurements (one fitted shift, as the validation), and DFSPH's solve iterations, capped solves and the
  * largest error of one particle a density solve ended with ("solve lg", sph_stats.density_error_largest),
  * and an order-free digest of the final positions' bits ("final positions' digest", state_digest in
- * the CSV: two runs agree bit for bit where it agrees; dam_break.h).
+ * the CSV: two runs agree bit for bit where it agrees; dam_break.h), and the density solves the
+ * Chebyshev solve's guard turned to plain steps (sph_stats.pressure_solves_guarded; guarded_substeps in
+ * the CSV).
  *
  *   solver_front [--backend cpu|cuda|auto] [--layers 8,12,16] [--seconds 1.0] [--sample-T 0.1]
  *                [--wcsph 5,10,20] [--dfsph 0.01,0.001,0.0001] [--dfsph-solver jacobi|cg|chebyshev]
@@ -270,7 +272,7 @@ int main(int argc, char** argv) {
       "solve_error_max,front_shift_T,front_error_mean,front_error_max,status,ms_per_substep,neighbors_mean,"
       "ms_hash_sort,ms_cell_ranges,ms_density,ms_forces,ms_integrate,ms_collide,ms_emit,ms_other,"
       "solve_error_largest,mean_density_error_all,above_share,solve_error_mean,interior_error,"
-      "interior_expansion,interior_share,state_digest\n");
+      "interior_expansion,interior_share,state_digest,guarded_substeps\n");
   printf(
       "%s backend; dam break of Martin & Moyce for %.2f simulated s; front errors over T in [%.1f, %.1f]\n",
       resolved == SPH_BACKEND_CUDA ? "CUDA" : "CPU", seconds, DAM_BREAK_T_FIRST, DAM_BREAK_T_LAST);
@@ -330,10 +332,10 @@ int main(int argc, char** argv) {
           result->mean_error, result->max_error, substep_ms, result->neighbors_mean);
       for (int k = 0; k < SPH_STAGE_COUNT; ++k)
         fprintf(csv, ",%.5f", result->substeps ? result->stage_ms[k] / (double)result->substeps : 0.0);
-      fprintf(csv, ",%.6f,%.6f,%.4f,%.6f,%.6f,%.6f,%.4f,%016llx\n", result->density_error_largest,
+      fprintf(csv, ",%.6f,%.6f,%.4f,%.6f,%.6f,%.6f,%.4f,%016llx,%u\n", result->density_error_largest,
               result->mean_density_error, result->above_share, result->density_error_mean,
               result->interior_error, result->interior_expansion, result->interior_share,
-              (unsigned long long)result->state_digest);
+              (unsigned long long)result->state_digest, result->guarded_substeps);
       fflush(csv);
       printf(
           "%-6s %-9g %6u %9u %10.2f %9llu %10.0f %7.2f%% %7.2f%% %7.2f%% %8.2f %8.2f %6u %9.4f %6.1f "
@@ -346,9 +348,9 @@ int main(int argc, char** argv) {
           result->capped_substeps, substep_ms, result->neighbors_mean, 100.0 * result->density_error_largest);
       printf(
           "       over every particle: mean density error %.4f%% (%.1f%% of them above rest); the density "
-          "solves' mean error %.4f%%\n",
-          100.0 * result->mean_density_error, 100.0 * result->above_share,
-          100.0 * result->density_error_mean);
+          "solves' mean error %.4f%%; %u of them guarded (the Chebyshev solve's plain steps)\n",
+          100.0 * result->mean_density_error, 100.0 * result->above_share, 100.0 * result->density_error_mean,
+          result->guarded_substeps);
       printf(
           "       full neighbourhoods (%.1f%% of the particles): mean |rho/rho0 - 1| %.4f%%, expansion "
           "%.4f%%\n",
