@@ -3,11 +3,14 @@
  *
  *   mpirun -np R bench/mpi_halo [--spacing S] [--substeps K] [--backend cpu|cuda] [--springs 1]
  *                               [--workers W] [--wait-barriers 1] [--solver wcsph|dfsph]
+ *                               [--dfsph-solver jacobi|cg|chebyshev]
  *
- * --solver dfsph: the world steps DFSPH (the library's default linear solver and bounds) instead
- * of the weakly compressible scheme; its solves' iterations over the timed step are printed, since
- * a DFSPH substep's cost is mostly theirs (each iteration two neighbour passes and two halo
- * shares).
+ * --solver dfsph: the world steps DFSPH (the library's default bounds) instead of the weakly
+ * compressible scheme; its solves' iterations over the timed step are printed, since a DFSPH
+ * substep's cost is mostly theirs (each iteration two neighbour passes and two halo shares).
+ * --dfsph-solver: its density solve's linear solver (sph_dfsph_params.linear_solver; default the
+ * library's, Jacobi); cg's rank solve is host-driven with its own exchanges (a ghost's search
+ * direction and velocity step each iteration), so it is timed apart.
  * --backend cuda: every rank on the CUDA backend (the host-staged halo path; ranks on one GPU
  * share it), the GPU calibration of the model. --springs 1: with SPH_FEATURE_SPRINGS (every
  * particle linked to its lattice neighbours in the warm-up frame; springs across ranks, on CPU
@@ -192,6 +195,7 @@ int main(int argc, char** argv) {
   uint32_t workers = 0;
   int wait_barriers = 0;
   sph_solver solver = SPH_SOLVER_WCSPH;
+  uint32_t linear_solver = 0; /* sph_dfsph_params.linear_solver; 0: the library's default */
   mpi_halo_transport before, after;
   int rank, size;
   sph_context* context = NULL;
@@ -227,6 +231,24 @@ int main(int argc, char** argv) {
         return 2;
       }
     }
+    if (strcmp(argv[i], "--dfsph-solver") == 0) {
+      const char* name = argv[i + 1];
+      linear_solver = strcmp(name, "jacobi") == 0      ? SPH_DFSPH_JACOBI
+                      : strcmp(name, "cg") == 0        ? SPH_DFSPH_CONJUGATE_GRADIENTS
+                      : strcmp(name, "chebyshev") == 0 ? SPH_DFSPH_CHEBYSHEV
+                                                       : 0u;
+      if (linear_solver == 0u) {
+        if (rank == 0)
+          fprintf(stderr, "mpi_halo: --dfsph-solver takes jacobi, cg or chebyshev, not %s\n", name);
+        MPI_Finalize();
+        return 2;
+      }
+    }
+  }
+  if (linear_solver != 0u && solver != SPH_SOLVER_DFSPH) {
+    if (rank == 0) fprintf(stderr, "mpi_halo: --dfsph-solver needs --solver dfsph\n");
+    MPI_Finalize();
+    return 2;
   }
   {
     sph_context_def context_def;
@@ -260,6 +282,13 @@ int main(int argc, char** argv) {
   need(support_params_gravity_and_steps(&params, 0.0f, -9.81f, 0.0f, 1e-5f, 1e-3f), "params");
   params.max_substeps = 2;
   need(sph_world_set_params(world, &params), "set params");
+  if (linear_solver != 0u) {
+    sph_dfsph_params dfsph;
+    need(sph_dfsph_params_init(&dfsph), "dfsph params init");
+    need(sph_world_get_dfsph_params(world, &dfsph), "dfsph params");
+    dfsph.linear_solver = linear_solver;
+    need(sph_world_set_dfsph_params(world, &dfsph), "set dfsph params");
+  }
   sph_mpi_world_step(world, 1.0f); /* warm-up: the first cut and its migration */
   params.max_substeps = substeps;
   need(sph_world_set_params(world, &params), "set params");
@@ -296,8 +325,11 @@ int main(int argc, char** argv) {
     const double model = model_sum / size;
     printf("backend %s%s, %s, workers a rank %u (0: all hardware threads)%s\n",
            backend == SPH_BACKEND_CUDA ? "cuda" : "cpu", springs ? ", springs" : "",
-           solver == SPH_SOLVER_DFSPH ? "DFSPH" : "WCSPH", workers,
-           wait_barriers ? ", a timed barrier before each transport call" : "");
+           solver != SPH_SOLVER_DFSPH                       ? "WCSPH"
+           : linear_solver == SPH_DFSPH_CONJUGATE_GRADIENTS ? "DFSPH (conjugate gradients)"
+           : linear_solver == SPH_DFSPH_CHEBYSHEV           ? "DFSPH (Chebyshev)"
+                                                            : "DFSPH",
+           workers, wait_barriers ? ", a timed barrier before each transport call" : "");
     printf("ranks %d, %u particles (%.0f per rank, the fullest %lld), %u substeps\n", size, n,
            (double)n / size, (long long)owned_max, stats.substeps);
     printf(
