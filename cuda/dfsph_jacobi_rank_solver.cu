@@ -78,9 +78,9 @@ void enqueue_dfsph_jacobi_rank_solve(const FluidConstants& fluid, const GridView
     void share_steps() { rank.share_steps(stream); }
     DfsphErrors errors() { return rank.errors(divergence, stream); }
     void checked(uint32_t iterations, const DfsphErrors& errors, bool) {
-      const bool chebyshev = !divergence && fluid.methods.dfsph.linear_solver == kDfsphChebyshev;
-      dfsph_rank_check_kernel<<<1, 1, 0, stream>>>(iterations, errors, bounds, min_iterations, max_iterations,
-                                                   divergence, chebyshev, state);
+      dfsph_rank_check_kernel<<<1, 1, 0, stream>>>(
+          iterations, errors, bounds, min_iterations, max_iterations, divergence,
+          chebyshev_density_solve(fluid.methods.dfsph, divergence), state);
       check_launch("dfsph_rank_check_kernel");
     }
   } passes{fluid,          grid,           a,    n,     v,     warm, carried, divergence, contacts, bounds,

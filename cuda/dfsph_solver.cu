@@ -91,7 +91,7 @@ __global__ void __launch_bounds__(kDfsphSolveBlock, kDfsphSolveBlocksPerSm)
     const float dt = state->clock.dt_float;
     const float rate =
         density_rate(fluid, grid, a.sorted_position, v, DfsphWalls{a.boundary_gradient}, i, solve_walk(a));
-    if (!kDivergence && fluid.methods.dfsph.linear_solver == kDfsphChebyshev) {
+    if (chebyshev_density_solve(fluid.methods.dfsph, kDivergence)) {
       // SPH_DFSPH_CHEBYSHEV (dfsph_chebyshev.h), as the CPU backend's: the pressure held so far is the
       // carried one, which every velocity update of this solve has added its steps to.
       const DfsphResidual r = chebyshev_density_residual(
@@ -133,7 +133,7 @@ __global__ void __launch_bounds__(kDfsphCheckBlock)
   if (threadIdx.x != 0) return;
   state->solve_iterations = first ? 0u : state->solve_iterations + 1u;
   state->solve_error = n > 0 ? static_cast<float>(sum / n) : 0.0f;
-  if (!divergence && c.linear_solver == kDfsphChebyshev)
+  if (chebyshev_density_solve(c, divergence))
     dfsph_chebyshev_after_test(state, state->solve_iterations, state->solve_error, bounds.mean);
   dfsph_take_largest(state);
   dfsph_continue_solve(state, divergence ? state->divergence_tally : state->pressure_tally, bounds,

@@ -93,7 +93,7 @@ void CpuBackend::dfsph_residuals(DfsphSolve kind, const FluidConstants& fluid, c
   const float rho0 = fluid.rest_density;
   const SimdPasses::DfsphRateFn density_rate_of = simd_.dfsph_density_rate;
   // SPH_DFSPH_CHEBYSHEV (dfsph_chebyshev.h): the density solve's steps mixed with the last ones.
-  const bool chebyshev = kind == DfsphSolve::Density && c.linear_solver == kDfsphChebyshev;
+  const bool chebyshev = chebyshev_density_solve(c, kind == DfsphSolve::Divergence);
   // The gather reads positions and the velocities' columns; each particle writes only its k. A
   // distributed rank's ghosts are skipped: they take their owners' k right after (share_steps),
   // and the errors leave them out.
@@ -193,7 +193,7 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve(DfsphSolve kind, const FluidCon
            carry_scale,
            0u,
            DfsphChebyshevGuard{},
-           !divergence && c.linear_solver == kDfsphChebyshev,
+           chebyshev_density_solve(c, divergence),
            bounds};
   const DfsphLoopOutcome o = run_dfsph_jacobi(passes, bounds, min_iterations, max_iterations);
   return SolveOutcome{o.iterations, o.errors.mean, o.errors.largest, o.capped, passes.guard.plain != 0u};

@@ -42,6 +42,13 @@ struct DfsphChebyshev {
   static constexpr float kGuardGrowth = 2.0f;
 };
 
+// Whether a solve is SPH_DFSPH_CHEBYSHEV's accelerated density solve: the one whose residual pass
+// mixes its steps (chebyshev_density_residual) and whose guard is kept and counted. The divergence
+// solve, and the density solve of the other linear solvers, take the plain steps.
+SPH_HD bool chebyshev_density_solve(const Dfsph::Constants& c, bool divergence) {
+  return !divergence && c.linear_solver == kDfsphChebyshev;
+}
+
 // The Chebyshev solve's guard. The weights assume the Jacobi iteration's spectral radius is at most
 // kSpectralRadius; where a world's is not (measured in session 40: kernel radii of 2.2 to 3
 // spacings, whose larger neighbourhoods the weights were not fitted to, in dam breaks of 3,000 to

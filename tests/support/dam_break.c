@@ -290,10 +290,11 @@ sph_result dam_break_run(sph_context* context, const dam_break_config* config, d
           result->density_error_largest = stats.density_error_largest;
         result->capped_substeps += stats.pressure_solves_capped;
         result->guarded_substeps += stats.pressure_solves_guarded;
-        if (config->check_reload && stats.pressure_solves_guarded > 0 && !result->reload_checked &&
-            (r = reload_and_compare(context, world, &stats, &result->reload_stats_equal)) != SPH_OK)
-          goto done;
-        if (config->check_reload && stats.pressure_solves_guarded > 0) result->reload_checked = 1;
+        if (config->check_reload && stats.pressure_solves_guarded > 0 && !result->reload_checked) {
+          if ((r = reload_and_compare(context, world, &stats, &result->reload_stats_equal)) != SPH_OK)
+            goto done;
+          result->reload_checked = 1;
+        }
         for (int k = 0; k < SPH_STAGE_COUNT; ++k) result->stage_ms[k] += stats.stage_ms[k];
         result->neighbors_mean += (double)stats.neighbors_mean * stats.substeps;
         {
