@@ -167,9 +167,16 @@ CpuBackend::SolveOutcome CpuBackend::dfsph_solve_cg(const FluidConstants& fluid,
     // The operator on p: the velocities p would give, and their rates (on a rank, the velocity
     // update reads the ghosts' p and the rate pass their dv_p: each takes its owner's).
     if (rank_) halo_share_dfsph_step();
-    const uint32_t* halo = origins();  // (a ghost's dv_p is its owner's, shared below)
+    const uint32_t* halo = origins();
     parallel().for_each(n, [&](uint32_t i) {
-      if (halo && halo[i]) return;
+      if (halo && halo[i]) {
+        // A ghost's dv_p is its owner's, shared below; a spring ghost (beyond the density records'
+        // halo, which no share reaches and no owned particle's walk reads) keeps 0 rather than the
+        // last iteration's data, as the CUDA ranks' cg_rank_direction_kernel.
+        dv[i] = make_float4_record(Vec3{0.0f, 0.0f, 0.0f}, 0.0f);
+        columns_.set_velocity(i, Vec3{0.0f, 0.0f, 0.0f});
+        return;
+      }
       Vec3 d = change_of(fluid, view, columns, p, walls, i, dt);
       if (state[i] & kBinds) d = dfsph_contact_project(contact[i], d);
       dv[i] = make_float4_record(d, 0.0f);
