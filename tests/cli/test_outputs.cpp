@@ -426,6 +426,75 @@ void test_threshold_notices(void**) {
   }
 }
 
+// DFSPH's solves in sph-run's summary and --stats-json, and a capped solve never silent (issue 16
+// item 1): water resting in a tank, 6 frames. At the defaults: the summary's solve lines, no cap
+// reached, no warning. With max_iterations 2 under a 1e-6 bound: a warning for each frame whose
+// solves stopped at the cap, the counts in the warnings adding up to the summary's and the JSON's
+// pressure_solves_capped (> 0). A weakly compressible world prints and writes no solve figures.
+void test_dfsph_solve_report(void**) {
+  const std::string dir = cli_test::make_temp_dir("dfsph_solve_report");
+  const std::string scene_file = dir + "/tank.json", stats_file = dir + "/stats.json";
+  const char* scene = R"({
+    "world": { "capacity": 4000, "particle_spacing": 0.02, "solver": "SOLVER" },
+    PHYSICS "time": { "fps": 50, "frames": 6 },
+    "fluids": [ { "type": "box", "min": [-0.1, 0.0, -0.1], "max": [0.1, 0.08, 0.1] } ],
+    "colliders": [ { "inverted": true,
+                     "shape": { "type": "box", "half_extents": [0.1, 0.1, 0.1], "voxel_size": 0.02 },
+                     "transform": { "position": [0, 0.1, 0] } } ],
+    "output": { "format": "csv" } })";
+  struct Case {
+    const char* solver;
+    const char* physics;  // (a weakly compressible world refuses a physics.dfsph section)
+  };
+  const Case cases[] = {
+      {"dfsph", R"("physics": { "dfsph": { "max_iterations": 100, "density_error": 0.001 } },)"},
+      {"dfsph", R"("physics": { "dfsph": { "max_iterations": 2, "density_error": 1e-6 } },)"},
+      {"wcsph", ""}};
+  for (const Case& c : cases) {
+    std::string text = scene;
+    text.replace(text.find("SOLVER"), 6, c.solver);
+    text.replace(text.find("PHYSICS"), 7, c.physics);
+    cli_test::write_text(scene_file, text);
+    std::string log;
+    const int status = cli_test::run({g_sph_run, scene_file, "--backend", "cpu", "--threads", "2", "--out",
+                                      dir + "/out", "--quiet", "--stats-json", stats_file},
+                                     &log);
+    std::printf("%s", log.c_str());
+    assert_int_equal(status, 0);
+    const nlohmann::json stats = nlohmann::json::parse(cli_test::read_text(stats_file));
+    const bool dfsph = std::string(c.solver) == "dfsph";
+    assert_true((log.find("  DFSPH density solve: ") != std::string::npos) == dfsph);
+    assert_true(stats.contains("dfsph") == dfsph);
+    // The warnings' counts ("... above its bounds in N of the frame's substeps").
+    const std::string warning = "sph-run: warning: the DFSPH density solve stopped at its cap of ";
+    long warned = 0;
+    for (size_t at = log.find(warning); at != std::string::npos; at = log.find(warning, at + 1)) {
+      const size_t in = log.find(" above its bounds in ", at);
+      assert_true(in != std::string::npos);
+      warned += std::strtol(log.c_str() + in + std::strlen(" above its bounds in "), nullptr, 10);
+    }
+    if (!dfsph) {
+      assert_int_equal(warned, 0);
+      continue;
+    }
+    const nlohmann::json& d = stats.at("dfsph");
+    const long substeps = d.at("substeps").get<long>(), capped = d.at("pressure_solves_capped").get<long>();
+    assert_int_equal(substeps, stats.at("substeps").get<long>());
+    assert_true(d.at("pressure_iterations").get<long>() >= 2 * substeps);  // at least two a substep
+    assert_int_equal(warned, capped);
+    assert_true(log.find("caps above their bounds: " + std::to_string(capped) + " density") !=
+                std::string::npos);
+    if (std::strstr(c.physics, "\"max_iterations\": 2,")) {
+      assert_true(capped > 0);
+      assert_int_equal(d.at("pressure_iterations_max").get<long>(), 2);
+    } else {
+      // At the defaults the bound holds in every substep: the worst substep's mean error within it.
+      assert_int_equal(capped, 0);
+      assert_true(d.at("density_error_max").get<double>() <= 0.001);
+    }
+  }
+}
+
 // Probes (issue 17 item 2): each probe of "probes" gets probe_<index>[_<name>].csv, a row per
 // frame; a point in water resting in a tank reads a density near rho0, a gauge through it the few
 // centimetres of water (the 6 cm fluid box holds three lattice layers, 4.2 cm, before it spreads
@@ -499,6 +568,7 @@ int main(int argc, char** argv) {
       cmocka_unit_test(test_run_outputs_equal_world),
       cmocka_unit_test(test_loads_csv),
       cmocka_unit_test(test_threshold_notices),
+      cmocka_unit_test(test_dfsph_solve_report),
       cmocka_unit_test(test_probe_csv),
       cmocka_unit_test(test_obj_vertex_normals),
 #ifdef SPH_TOOLS_HAVE_OPENVDB

@@ -16,8 +16,8 @@ probe point is read by its slab's rank and shared); the tank's loads file equals
 within 1e-6 of the row's force (torque) magnitude: each rank sums its own particles' impulses,
 in blocks that hold other particles than the undivided world's blocks, so the sums round
 differently (tests/mpi/test_mpi_scene_sums.c measured ~1e-8). The --stats-json documents agree
-on the frames, substeps, particle counts, time steps and top speed exactly, and on the mean
-neighbour count within 1e-5 (the ranks' means weighted by their particles: another summation
+on the frames, substeps, particle counts, time steps, top speed and (a DFSPH scene) the solves'
+figures exactly, and on the mean neighbour count within 1e-5 (the ranks' means weighted by their particles: another summation
 order). Also that the --per-rank files of each frame hold every particle once, each as the
 merged frame has it, and (--refusals) that --backend cuda either runs (a GPU is there) or fails on every rank with exit code 4
 and one message naming the option (CI: no GPU); then the scene with springs, whose merged frames
@@ -119,8 +119,14 @@ def check_stats(single, merged, ranks):
                 "max_speed"):
         assert a[key] == b[key], f"--stats-json: {key} {b[key]} != sph-run's {a[key]}"
     assert abs(a["neighbors_mean"] - b["neighbors_mean"]) <= 1e-5 * a["neighbors_mean"], (a, b)
+    # DFSPH's solves (a DFSPH scene only): the ranks turn the undivided world's solves, their sums
+    # exact over the ranks (docs/distributed.md), so every figure is sph-run's to the printed digit.
+    assert ("dfsph" in a) == ("dfsph" in b), "--stats-json: dfsph in one document only"
+    if "dfsph" in a:
+        assert a["dfsph"] == b["dfsph"], f"--stats-json: dfsph {b['dfsph']} != sph-run's {a['dfsph']}"
     print(f"--stats-json: {b['frames']} frames, {b['substeps']} substeps, {b['particles_end']} particles "
-          f"(at most {b['particles_max']}), {b['migrated']} migrated: as sph-run's")
+          f"(at most {b['particles_max']}), {b['migrated']} migrated"
+          f"{', DFSPH solves' if 'dfsph' in a else ''}: as sph-run's")
 
 
 def check_vdb(compare_vdb, single, merged, frames):

@@ -18,6 +18,21 @@ void RunStats::add_frame(const sph_stats& s, double step_wall_ms, double output_
   for (int i = 0; i < SPH_STAGE_COUNT; ++i) stage_ms_[i] += s.stage_ms[i];
   last_ = s;
   ++frames_;
+  if (s.pressure_iterations == 0) return;  // no DFSPH solve ran (a WCSPH world, or no substep)
+  Solves& d = solves_;
+  d.substeps += s.substeps;
+  d.density_iterations += s.pressure_iterations;
+  d.divergence_iterations += s.divergence_iterations;
+  d.density_iterations_max = std::max(d.density_iterations_max, s.pressure_iterations_max);
+  d.divergence_iterations_max = std::max(d.divergence_iterations_max, s.divergence_iterations_max);
+  d.density_error_sum += static_cast<double>(s.density_error_mean) * s.substeps;
+  d.divergence_error_sum += static_cast<double>(s.divergence_error_mean) * s.substeps;
+  d.density_error_max = std::max(d.density_error_max, s.density_error_max);
+  d.divergence_error_max = std::max(d.divergence_error_max, s.divergence_error_max);
+  d.density_error_largest = std::max(d.density_error_largest, s.density_error_largest);
+  d.density_capped += s.pressure_solves_capped;
+  d.divergence_capped += s.divergence_solves_capped;
+  d.guarded += s.pressure_solves_guarded;
 }
 
 void RunStats::print(std::FILE* out, const std::string& what, const std::string& backend,
@@ -52,6 +67,29 @@ void RunStats::print(std::FILE* out, const std::string& what, const std::string&
       std::fprintf(out, " %s %.0f%%", kStages[i], 100.0 * stage_ms_[i] / total);
     std::fprintf(out, "\n");
   }
+  if (solves_.substeps > 0) {
+    const Solves& d = solves_;
+    const double n = static_cast<double>(d.substeps);
+    std::fprintf(
+        out,
+        "  DFSPH density solve: %.2f iterations a substep (most %u), error %.4f %% mean (%.4f %% in the "
+        "worst substep, %.3f %% the largest particle's)\n",
+        d.density_iterations / n, d.density_iterations_max, 100.0 * d.density_error_sum / n,
+        100.0 * d.density_error_max, 100.0 * d.density_error_largest);
+    std::fprintf(
+        out,
+        "  DFSPH divergence solve: %.2f iterations a substep (most %u), error %.3g 1/s mean (%.3g in the "
+        "worst substep)\n",
+        d.divergence_iterations / n, d.divergence_iterations_max, d.divergence_error_sum / n,
+        static_cast<double>(d.divergence_error_max));
+    std::fprintf(
+        out,
+        "  DFSPH solves stopped at their caps above their bounds: %llu density, %llu divergence (of %llu "
+        "substeps); Chebyshev guard turned %llu to plain steps\n",
+        static_cast<unsigned long long>(d.density_capped),
+        static_cast<unsigned long long>(d.divergence_capped), static_cast<unsigned long long>(d.substeps),
+        static_cast<unsigned long long>(d.guarded));
+  }
   std::fprintf(out, "  world memory: %.1f MiB\n",
                static_cast<double>(last_.memory_bytes) / (1024.0 * 1024.0));
 }
@@ -79,7 +117,28 @@ std::string RunStats::write_json(const std::string& path, const std::string& sce
                static_cast<unsigned long long>(last_.memory_bytes));
   for (int i = 0; i < SPH_STAGE_COUNT; ++i)
     std::fprintf(f, "\"%s\": %.6g%s", kStages[i], stage_ms_[i], i + 1 < SPH_STAGE_COUNT ? ", " : "");
-  std::fprintf(f, "}%s%s}\n", extra.empty() ? "" : ", ", extra.c_str());
+  std::fprintf(f, "}");
+  if (solves_.substeps > 0) {  // DFSPH's solves (sph_stats' names, over the run)
+    const Solves& d = solves_;
+    const double n = static_cast<double>(d.substeps);
+    std::fprintf(
+        f,
+        ", \"dfsph\": {\"substeps\": %llu, \"pressure_iterations\": %llu, \"pressure_iterations_max\": %u, "
+        "\"density_error_mean\": %.6g, \"density_error_max\": %.6g, \"density_error_largest\": %.6g, "
+        "\"divergence_iterations\": %llu, \"divergence_iterations_max\": %u, \"divergence_error_mean\": "
+        "%.6g, "
+        "\"divergence_error_max\": %.6g, \"pressure_solves_capped\": %llu, \"divergence_solves_capped\": "
+        "%llu, "
+        "\"pressure_solves_guarded\": %llu}",
+        static_cast<unsigned long long>(d.substeps), static_cast<unsigned long long>(d.density_iterations),
+        d.density_iterations_max, d.density_error_sum / n, static_cast<double>(d.density_error_max),
+        static_cast<double>(d.density_error_largest),
+        static_cast<unsigned long long>(d.divergence_iterations), d.divergence_iterations_max,
+        d.divergence_error_sum / n, static_cast<double>(d.divergence_error_max),
+        static_cast<unsigned long long>(d.density_capped),
+        static_cast<unsigned long long>(d.divergence_capped), static_cast<unsigned long long>(d.guarded));
+  }
+  std::fprintf(f, "%s%s}\n", extra.empty() ? "" : ", ", extra.c_str());
   const bool failed = std::ferror(f) != 0;
   const int error = errno;
   if (std::fclose(f) != 0) return std::strerror(errno);

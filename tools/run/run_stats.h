@@ -38,6 +38,17 @@ class RunStats {
   float dt_min_ = 0.0f, dt_max_ = 0.0f, speed_max_ = 0.0f;
   double stage_ms_[SPH_STAGE_COUNT] = {};
   sph_stats last_{};
+  // DFSPH's solves over the run (sph_stats' solve fields, frame by frame); a WCSPH world leaves
+  // them zero (a DFSPH substep runs at least two density iterations), and the summary leaves them out.
+  struct Solves {
+    uint64_t density_iterations = 0, divergence_iterations = 0;
+    uint32_t density_iterations_max = 0, divergence_iterations_max = 0;
+    double density_error_sum = 0.0, divergence_error_sum = 0.0;  // each frame's mean x its substeps
+    float density_error_max = 0.0f, divergence_error_max = 0.0f, density_error_largest = 0.0f;
+    uint64_t density_capped = 0, divergence_capped = 0, guarded = 0;
+    uint64_t substeps = 0;  // of the frames that ran a solve
+  };
+  Solves solves_;
 };
 
 }  // namespace sph_tools

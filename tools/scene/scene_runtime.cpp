@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "scene_runtime.h"
 
+#include <cstdio>
+
 #include "lattice_fill.h"
 #include "library_error.h"
 #include "scene_error.h"
@@ -276,6 +278,31 @@ void SceneRuntime::collect_events() {
         if (probes_[i].bits == e.object_bits)
           notices_.push_back(scene_.probes[i].path + ": the peak pressure " + std::to_string(e.count) +
                              " Pa reached its pressure_threshold");
+      continue;
+    }
+    if (e.type == SPH_EVENT_PRESSURE_SOLVE_CAPPED || e.type == SPH_EVENT_DIVERGENCE_SOLVE_CAPPED) {
+      // Never silent (issue 16): the bound the scene asked for was not met in these substeps.
+      const bool density = e.type == SPH_EVENT_PRESSURE_SOLVE_CAPPED;
+      sph_dfsph_params p;
+      sph_dfsph_params_init(&p);
+      sph_world_get_dfsph_params(world_, &p);
+      char text[320];
+      if (density)
+        std::snprintf(
+            text, sizeof text,
+            "the DFSPH density solve stopped at its cap of %u iterations above its bounds in %u of the "
+            "frame's substeps (physics.dfsph.max_iterations; density_error %g, density_error_max %g)",
+            p.max_iterations, e.count, static_cast<double>(p.density_error),
+            static_cast<double>(p.density_error_max));
+      else
+        std::snprintf(
+            text, sizeof text,
+            "the DFSPH divergence solve stopped at its cap of %u iterations above its bound in %u of "
+            "the frame's substeps (physics.dfsph.max_divergence_iterations; divergence_error %g 1/s, "
+            "divergence_error_per_step %g)",
+            p.max_divergence_iterations, e.count, static_cast<double>(p.divergence_error),
+            static_cast<double>(p.divergence_error_per_step));
+      warnings_.push_back(text);
       continue;
     }
     if (e.type != SPH_EVENT_SOURCE_CAPACITY_REACHED) continue;
