@@ -104,10 +104,21 @@ __device__ inline CgTerm cg_residual_particle(const CgSolve& s, uint32_t i, floa
   return CgTerm{value * z, active};
 }
 
+// The operator on p, first half, at particle i: the velocities p would give (a binding contact's
+// normal part removed), stored. (The conjugate gradients refuse the corrected gradient: the operator
+// must be symmetric.)
+__device__ inline void cg_direction_particle(const CgSolve& s, uint32_t i) {
+  const float dt = s.state->clock.dt_float;
+  Vec3 d = pressure_velocity_change<false>(s.fluid, s.grid, s.a.sorted_position, s.a.dfsph_step, cg_walls(s),
+                                           i, dt, cg_walk(s));
+  if (s.a.dfsph_cg_state[i] & kCgBinds) d = dfsph_contact_project(s.a.dfsph_contact[i], d);
+  s.a.dfsph_cg_velocity_step[i] = make_float4_record(d, 0.0f);
+}
+
 // The undivided solve's particle kernels that the rank's solve runs too (dfsph_cg_solver.cu):
-// the velocities p gives, the update by alpha, the next direction by beta (alpha, beta and the
-// flags from the state), and the pressure the solve keeps.
-__global__ void __launch_bounds__(kDfsphSolveBlock) cg_direction_kernel(CgSolve s);
+// the update by alpha, the next direction by beta (alpha, beta and the flags from the state), and
+// the pressure the solve keeps. (The velocities p gives: cg_direction_particle, in a kernel of each
+// solve's own, as a rank's skips its ghosts.)
 __global__ void cg_update_kernel(CgSolve s);
 __global__ void cg_next_direction_kernel(CgSolve s);
 __global__ void cg_keep_kernel(float* pressure, uint32_t n);

@@ -9,11 +9,16 @@
 // kernels without sums (the direction, the update, the next direction: dfsph_cg_solver.cu), the
 // host writing alpha, beta and the flags they read (cg_rank_set_kernel).
 //
-// The neighbour passes walk the density pass's candidate masks (or the neighbour lists written
-// from them), as the undivided solve's: that pass wrote them for every particle the rank holds,
-// ghosts included (they arrived before the sort), from the positions and the grid that the
-// solves read; the refreshes within the substep (the ghosts' densities and factors, velocities,
-// pressure steps) write none of them.
+// The neighbour passes walk the rank's own particles only, as the CPU rank's (b576397): a ghost's
+// p and dv_p are its owner's, shared before each use (above), and what a ghost's own walks gave
+// (its value, its change, its held changes' rate, its z) fed only its own search direction, which
+// its owner's replaces before any use; so a ghost's value, change and z are written 0 and its
+// neighbours are never walked. Everything else a ghost holds follows from the shared values as its
+// owner's does: its velocity, its carried pressure and its contact holds (made in cg_update_kernel
+// from its own velocity, and read by its neighbours' held-change gathers, as its owner's hold is on
+// the owner's rank). The walks use the density pass's candidate masks (or the neighbour lists
+// written from them), as the undivided solve's; that pass leaves a ghost's empty
+// (dfsph_density.cu), which no pass of this solve reads.
 #include "dfsph_cg_common.cuh"
 #include "kernel_launch.h"
 
@@ -30,8 +35,12 @@ constexpr uint32_t kCgTerms = ExactFloatSum::kTerms;
 __global__ void __launch_bounds__(kDfsphSolveBlock)
     cg_rank_measure_kernel(CgSolve s, unsigned long long* bins) {
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  const float error = i < s.n ? cg_measure_particle(s, i) : 0.0f;
   const bool own = cg_own(s, i);
+  float error = 0.0f;
+  if (own)
+    error = cg_measure_particle(s, i);
+  else if (i < s.n)
+    s.a.dfsph_cg_value[i] = 0.0f;  // a ghost's (the file's top)
   exact_bins_add(bins, own, error);
   dfsph_block_max_to(bins + kDfsphRankCgMaxima, own ? error : 0.0f);
 }
@@ -43,9 +52,16 @@ template <CgSetSum kSum>
 __global__ void __launch_bounds__(kDfsphSolveBlock)
     cg_rank_set_sum_kernel(CgSolve s, unsigned long long* bins) {
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  const bool own = cg_own(s, i);
   CgTerm t{0.0f, false};
-  if (i < s.n) t = kSum == CgSetSum::Restart ? cg_restart_particle(s, i) : cg_change_particle(s, i);
-  exact_bins_add(bins, cg_own(s, i) && t.active, t.value);
+  if constexpr (kSum == CgSetSum::Restart) {
+    if (i < s.n) t = cg_restart_particle(s, i);  // (no walk; a ghost's p is replaced before its use)
+  } else if (own) {
+    t = cg_change_particle(s, i);
+  } else if (i < s.n) {
+    s.a.dfsph_cg_change[i] = 0.0f;  // a ghost's (the file's top)
+  }
+  exact_bins_add(bins, own && t.active, t.value);
 }
 
 // The held contacts' changes added to the values (cg_held_value); the sums of the errors (sum 0),
@@ -55,21 +71,38 @@ __global__ void __launch_bounds__(kDfsphSolveBlock)
 __global__ void __launch_bounds__(kDfsphSolveBlock)
     cg_rank_error_kernel(CgSolve s, unsigned long long* bins) {
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  const bool own = cg_own(s, i);
   float error = 0.0f;
   bool outside = false;
   CgTerm sz{0.0f, false};
-  if (i < s.n) {
+  if (own) {
     const float value = cg_held_value(s, i);
     error = dfsph_cg_error(value, s.fluid.rest_density);
     sz = cg_residual_particle(s, i, value);
     outside = !sz.active && s.a.dfsph_factor[i] > 0.0f;
+  } else if (i < s.n) {
+    s.a.dfsph_residual[i] = 0.0f;  // a ghost's z: its next p is its owner's (the file's top)
   }
-  const bool own = cg_own(s, i);
   exact_bins_add(bins, own, error);
   exact_bins_add(bins + kCgTerms, own && outside, error);
   exact_bins_add(bins + 2 * kCgTerms, own && sz.active, sz.value);
   dfsph_block_max_to(bins + kDfsphRankCgMaxima, own ? error : 0.0f);
   dfsph_block_max_to(bins + kDfsphRankCgMaxima + 1, own && outside ? error : 0.0f);
+}
+
+// The operator on p, first half: the velocities p would give, for the rank's own particles (a
+// ghost's dv_p is its owner's, shared right after).
+__global__ void __launch_bounds__(kDfsphSolveBlock) cg_rank_direction_kernel(CgSolve s) {
+  if (s.state->solve_run == 0) return;  // (as the undivided solve's kernel)
+  mark_stage(s.state, kStageForces);
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  // A ghost writes 0: its owner's dv_p replaces it right after, except for a spring ghost (beyond
+  // the density records' halo, which no share reaches and no owned particle's walk reads), which
+  // keeps 0 rather than the last iteration's or substep's data.
+  if (cg_own(s, i))
+    cg_direction_particle(s, i);
+  else if (i < s.n)
+    s.a.dfsph_cg_velocity_step[i] = make_float4_record(Vec3{0.0f, 0.0f, 0.0f}, 0.0f);
 }
 
 // What the undivided solve's particle kernels read of the state: the step, the next direction's
@@ -138,7 +171,7 @@ void enqueue_dfsph_cg_rank_solve(const FluidConstants& fluid, const GridView& gr
     }
     // The operator on p: the ghosts' p before the velocities it gives, their dv_p before the rates.
     rank.share_steps(stream);
-    particles(cg_direction_kernel, "cg_direction_kernel");
+    particles(cg_rank_direction_kernel, "cg_rank_direction_kernel");
     rank.share_velocities(a.dfsph_cg_velocity_step, stream);
     summed(cg_rank_set_sum_kernel<CgSetSum::Change>, "cg_rank_change_kernel");
     rank.cg_world(1, sums, 0, nullptr, stream);

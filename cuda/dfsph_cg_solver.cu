@@ -172,24 +172,17 @@ __global__ void __launch_bounds__(kDfsphCheckBlock) cg_beta_kernel(CgSolve s) {
   state->cg_sz = sz;
 }
 
-}  // namespace
-
-// ---- The particle kernels without sums, which the rank's solve runs too (dfsph_cg_common.cuh) ----
-
-// The operator on p, first half: the velocities p would give (a binding contact's normal part
-// removed).
+// The operator on p, first half: the velocities p would give (cg_direction_particle).
 __global__ void __launch_bounds__(kDfsphSolveBlock) cg_direction_kernel(CgSolve s) {
   if (s.state->solve_run == 0) return;
   mark_stage(s.state, kStageForces);
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i >= s.n) return;
-  const float dt = s.state->clock.dt_float;
-  // (the conjugate gradients refuse the corrected gradient: the operator must be symmetric)
-  Vec3 d = pressure_velocity_change<false>(s.fluid, s.grid, s.a.sorted_position, s.a.dfsph_step, cg_walls(s),
-                                           i, dt, cg_walk(s));
-  if (s.a.dfsph_cg_state[i] & kCgBinds) d = dfsph_contact_project(s.a.dfsph_contact[i], d);
-  s.a.dfsph_cg_velocity_step[i] = make_float4_record(d, 0.0f);
+  if (i < s.n) cg_direction_particle(s, i);
 }
+
+}  // namespace
+
+// ---- The particle kernels without sums, which the rank's solve runs too (dfsph_cg_common.cuh) ----
 
 // v += alpha dv_p, the pressure += alpha p, value += alpha change; then the contact held as the
 // Jacobi solve holds it, its change kept in dv for the gather (0 where none was held).

@@ -67,14 +67,13 @@ __device__ __forceinline__ void dfsph_density_particle(const FluidConstants& flu
   const KernelCoefficients mk = mass_gradient_kernel(fluid);
   const float ki = kDivergenceWarmStart ? a.dfsph_step[i] : 0.0f;
   Vec3 push{0.0f, 0.0f, 0.0f};
-  // A distributed rank's ghost skips its walk where its Jacobi (or Chebyshev) solves skip it too:
-  // its density, factor, count and 1 / rho are its owner's, taken right after this pass
-  // (HaloDfsphDensityRecord), and no pass walks a ghost's candidates (dfsph_solver.cu), so its mask
-  // and list are written empty. The conjugate gradients' rank solve still walks its ghosts
-  // (dfsph_cg_rank_solver.cu), so there the pass computes them as before. The moves below (the
-  // velocity, the warm starts, the contact) stay: the records do not carry them.
+  // A distributed rank's ghost skips its walk: its density, factor, count and 1 / rho are its
+  // owner's, taken right after this pass (HaloDfsphDensityRecord), and no pass walks a ghost's
+  // candidates (dfsph_solver.cu; the conjugate gradients' rank solve, dfsph_cg_rank_solver.cu, since
+  // session 41), so its mask and list are written empty. The moves below (the velocity, the warm
+  // starts, the contact) stay: the records do not carry them.
   DfsphDensitySample s;
-  if (is_halo_ghost(a, i) && fluid.methods.dfsph.linear_solver != kDfsphConjugateGradients) {
+  if (is_halo_ghost(a, i)) {
     writer.finish();
     s = DfsphDensitySample{fluid.rest_density, 0u, 0.0f};
   } else {
