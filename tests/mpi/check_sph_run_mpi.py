@@ -249,11 +249,14 @@ def main(argv):
     compare_vdb = options[options.index("--vdb") + 1] if "--vdb" in options else None
     outputs = ["--format", "csv,vdb", "--surface"] if compare_vdb else ["--format", "csv"]
     single, merged = os.path.join(work, "single"), os.path.join(work, "np" + ranks)
-    run([sph_run, scene, "--backend", backend, *outputs, "--threads", "1", "--quiet", "--out", single,
-         "--stats-json", single + ".json"])
+    p_single = run([sph_run, scene, "--backend", backend, *outputs, "--threads", "1", "--quiet", "--out", single,
+                    "--stats-json", single + ".json"])
     p = run([mpiexec, "--oversubscribe", "-np", ranks, sph_run_mpi, scene, "--backend", backend, *outputs,
              "--threads", "1", "--quiet", "--per-rank", "--out", merged, "--stats-json", merged + ".json"])
     print(p.stdout.strip())
+    # A DFSPH scene's summary lines (its solves, figures equal over the ranks) read as sph-run's.
+    solve_lines = [[line for line in q.stdout.splitlines() if line.startswith("  DFSPH ")] for q in (p_single, p)]
+    assert solve_lines[0] == solve_lines[1], f"summary's DFSPH lines: {solve_lines[1]} != sph-run's {solve_lines[0]}"
 
     frames = sorted(os.path.basename(f) for f in glob.glob(os.path.join(single, "fluid_*.csv")))
     assert len(frames) >= 2, f"sph-run wrote {frames}"

@@ -183,6 +183,7 @@ int run_frames(const Ranks& ranks, const CliOptions& cli, const SceneDesc& scene
         static_cast<unsigned long long>(counts.global_count),
         static_cast<unsigned long long>(stats.substeps()), static_cast<unsigned long long>(counts.migrated),
         counts.rebalances, wall_s);
+    stats.print_solves(stdout);
     std::fflush(stdout);
   }
   if (root && cli.stats_json) {

@@ -67,31 +67,33 @@ void RunStats::print(std::FILE* out, const std::string& what, const std::string&
       std::fprintf(out, " %s %.0f%%", kStages[i], 100.0 * stage_ms_[i] / total);
     std::fprintf(out, "\n");
   }
-  if (solves_.substeps > 0) {
-    const Solves& d = solves_;
-    const double n = static_cast<double>(d.substeps);
-    std::fprintf(
-        out,
-        "  DFSPH density solve: %.2f iterations a substep (most %u), error %.4f %% mean (%.4f %% in the "
-        "worst substep, %.3f %% the largest particle's)\n",
-        d.density_iterations / n, d.density_iterations_max, 100.0 * d.density_error_sum / n,
-        100.0 * d.density_error_max, 100.0 * d.density_error_largest);
-    std::fprintf(
-        out,
-        "  DFSPH divergence solve: %.2f iterations a substep (most %u), error %.3g 1/s mean (%.3g in the "
-        "worst substep)\n",
-        d.divergence_iterations / n, d.divergence_iterations_max, d.divergence_error_sum / n,
-        static_cast<double>(d.divergence_error_max));
-    std::fprintf(
-        out,
-        "  DFSPH solves stopped at their caps above their bounds: %llu density, %llu divergence (of %llu "
-        "substeps); Chebyshev guard turned %llu to plain steps\n",
-        static_cast<unsigned long long>(d.density_capped),
-        static_cast<unsigned long long>(d.divergence_capped), static_cast<unsigned long long>(d.substeps),
-        static_cast<unsigned long long>(d.guarded));
-  }
+  print_solves(out);
   std::fprintf(out, "  world memory: %.1f MiB\n",
                static_cast<double>(last_.memory_bytes) / (1024.0 * 1024.0));
+}
+
+void RunStats::print_solves(std::FILE* out) const {
+  if (solves_.substeps == 0) return;
+  const Solves& d = solves_;
+  const double n = static_cast<double>(d.substeps);
+  std::fprintf(
+      out,
+      "  DFSPH density solve: %.2f iterations a substep (most %u), error %.4f %% mean (%.4f %% in the "
+      "worst substep, %.3f %% the largest particle's)\n",
+      d.density_iterations / n, d.density_iterations_max, 100.0 * d.density_error_sum / n,
+      100.0 * d.density_error_max, 100.0 * d.density_error_largest);
+  std::fprintf(
+      out,
+      "  DFSPH divergence solve: %.2f iterations a substep (most %u), error %.3g 1/s mean (%.3g in the "
+      "worst substep)\n",
+      d.divergence_iterations / n, d.divergence_iterations_max, d.divergence_error_sum / n,
+      static_cast<double>(d.divergence_error_max));
+  std::fprintf(
+      out,
+      "  DFSPH solves stopped at their caps above their bounds: %llu density, %llu divergence (of %llu "
+      "substeps); Chebyshev guard turned %llu to plain steps\n",
+      static_cast<unsigned long long>(d.density_capped), static_cast<unsigned long long>(d.divergence_capped),
+      static_cast<unsigned long long>(d.substeps), static_cast<unsigned long long>(d.guarded));
 }
 
 std::string RunStats::write_json(const std::string& path, const std::string& scene,

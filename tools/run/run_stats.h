@@ -23,6 +23,8 @@ class RunStats {
   }
   // Prints the summary. `what` heads it ("dam_break.json: 120 frames").
   void print(std::FILE* out, const std::string& what, const std::string& backend, double wall_s) const;
+  // DFSPH's solves over the run, three lines (print() includes them); nothing for a world without.
+  void print_solves(std::FILE* out) const;
   uint32_t frames() const { return frames_; }
   uint64_t substeps() const { return substeps_; }
   // Writes the same figures as print() as one JSON object; returns "" or why the file could not
