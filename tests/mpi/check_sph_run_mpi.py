@@ -17,8 +17,8 @@ within 1e-6 of the row's force (torque) magnitude: each rank sums its own partic
 in blocks that hold other particles than the undivided world's blocks, so the sums round
 differently (tests/mpi/test_mpi_scene_sums.c measured ~1e-8). The --stats-json documents agree
 on the frames, substeps, particle counts, time steps, top speed and (a DFSPH scene) the solves'
-figures exactly, and on the mean neighbour count within 1e-5 (the ranks' means weighted by their particles: another summation
-order). Also that the --per-rank files of each frame hold every particle once, each as the
+figures exactly (and the summaries' DFSPH lines are sph-run's), and on the mean neighbour count
+within 1e-5 (the ranks' means weighted by their particles: another summation order). Also that the --per-rank files of each frame hold every particle once, each as the
 merged frame has it, and (--refusals) that --backend cuda either runs (a GPU is there) or fails on every rank with exit code 4
 and one message naming the option (CI: no GPU); then the scene with springs, whose merged frames
 equal sph-run's bit for bit (springs across ranks; with --backend cuda on CUDA ranks against
