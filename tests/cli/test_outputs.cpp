@@ -426,10 +426,10 @@ void test_threshold_notices(void**) {
   }
 }
 
-// DFSPH's solves in sph-run's summary and --stats-json, and a capped solve never silent (issue 16
-// item 1): water resting in a tank, 6 frames. At the defaults: the summary's solve lines, no cap
-// reached, no warning. With max_iterations 2 under a 1e-6 bound: a warning for each frame whose
-// solves stopped at the cap, the counts in the warnings adding up to the summary's and the JSON's
+// DFSPH's solves in sph-run's progress lines, summary and --stats-json, and a capped solve never
+// silent (issue 16 item 1): water resting in a tank, 6 frames. At the defaults: the summary's solve lines, no
+// cap reached, no warning. With max_iterations 2 under a 1e-6 bound: a warning for each frame whose solves
+// stopped at the cap, the counts in the warnings adding up to the summary's and the JSON's
 // pressure_solves_capped (> 0). A weakly compressible world prints and writes no solve figures.
 void test_dfsph_solve_report(void**) {
   const std::string dir = cli_test::make_temp_dir("dfsph_solve_report");
@@ -457,12 +457,15 @@ void test_dfsph_solve_report(void**) {
     cli_test::write_text(scene_file, text);
     std::string log;
     const int status = cli_test::run({g_sph_run, scene_file, "--backend", "cpu", "--threads", "2", "--out",
-                                      dir + "/out", "--quiet", "--stats-json", stats_file},
+                                      dir + "/out", "--stats-json", stats_file},
                                      &log);
     std::printf("%s", log.c_str());
     assert_int_equal(status, 0);
     const nlohmann::json stats = nlohmann::json::parse(cli_test::read_text(stats_file));
     const bool dfsph = std::string(c.solver) == "dfsph";
+    // The progress lines (not a terminal: a line a frame) show the frame's iterations a substep.
+    assert_true((log.find("frame 6/6: ") != std::string::npos));
+    assert_true((log.find(" density iterations a substep), step ") != std::string::npos) == dfsph);
     assert_true((log.find("  DFSPH density solve: ") != std::string::npos) == dfsph);
     assert_true(stats.contains("dfsph") == dfsph);
     // The warnings' counts ("... above its bounds in N of the frame's substeps").

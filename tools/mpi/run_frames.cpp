@@ -151,7 +151,8 @@ int run_frames(const Ranks& ranks, const CliOptions& cli, const SceneDesc& scene
     ++written;
     stats.add_frame(world, step_ms, output_ms);
     add_output_kinds();
-    progress.frame_done(FrameReport{i, world.particle_count, world.substeps, step_ms, output_ms});
+    progress.frame_done(
+        FrameReport{i, world.particle_count, world.substeps, step_ms, output_ms, world.pressure_iterations});
   }
   progress.finish();
   if (root) objects.close(ranks);

@@ -25,9 +25,14 @@ void Progress::frame_done(const FrameReport& r) {
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   const double per_frame = r.frame > 0 ? elapsed / r.frame : 0.0;
   const double eta = per_frame * (total_ - r.frame);
+  // DFSPH's density iterations a substep: how hard the solve works for the frame's bound.
+  char solve[48] = "";
+  if (r.density_iterations > 0 && r.substeps > 0)
+    std::snprintf(solve, sizeof solve, tty_ ? "  %.1f it/substep" : " (%.1f density iterations a substep)",
+                  static_cast<double>(r.density_iterations) / r.substeps);
   if (!tty_) {
-    std::fprintf(stderr, "frame %u/%u: %u particles, %u substeps, step %.1f ms, output %.1f ms, eta %s\n",
-                 r.frame, total_, r.particles, r.substeps, r.step_ms, r.output_ms,
+    std::fprintf(stderr, "frame %u/%u: %u particles, %u substeps%s, step %.1f ms, output %.1f ms, eta %s\n",
+                 r.frame, total_, r.particles, r.substeps, solve, r.step_ms, r.output_ms,
                  format_duration(eta).c_str());
     std::fflush(stderr);
     return;
@@ -41,8 +46,8 @@ void Progress::frame_done(const FrameReport& r) {
   char bar[width + 1];
   for (int i = 0; i < width; ++i) bar[i] = i < filled ? '#' : (i == filled ? '>' : '.');
   bar[width] = '\0';
-  std::fprintf(stderr, "\r\033[Kframe %u/%u [%s] %3.0f%%  %u particles  %u substeps  %.0f ms/frame  ETA %s",
-               r.frame, total_, bar, 100.0 * share, r.particles, r.substeps, r.step_ms + r.output_ms,
+  std::fprintf(stderr, "\r\033[Kframe %u/%u [%s] %3.0f%%  %u particles  %u substeps%s  %.0f ms/frame  ETA %s",
+               r.frame, total_, bar, 100.0 * share, r.particles, r.substeps, solve, r.step_ms + r.output_ms,
                format_duration(eta).c_str());
   std::fflush(stderr);
   bar_shown_ = true;

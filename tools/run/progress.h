@@ -13,8 +13,9 @@ struct FrameReport {
   uint32_t frame = 0;
   uint32_t particles = 0;
   uint32_t substeps = 0;
-  double step_ms = 0.0;    // wall time of the frame's simulation
-  double output_ms = 0.0;  // wall time of its files
+  double step_ms = 0.0;             // wall time of the frame's simulation
+  double output_ms = 0.0;           // wall time of its files
+  uint32_t density_iterations = 0;  // DFSPH: the frame's density solve iterations (0: no solve ran)
 };
 
 class Progress {

@@ -104,7 +104,8 @@ int run_scene(sph_context* context, const std::string& backend_name, const Scene
       stats.add_frame(s, step_ms, output_ms);
       stats.add_output_kinds(writer.times().particles_ms, writer.times().surface_ms,
                              writer.times().preview_ms);
-      progress.frame_done(FrameReport{i, s.particle_count, s.substeps, step_ms, output_ms});
+      progress.frame_done(
+          FrameReport{i, s.particle_count, s.substeps, step_ms, output_ms, s.pressure_iterations});
     }
     progress.finish();
     const int signal = interrupt_signal();
