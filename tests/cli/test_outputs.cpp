@@ -445,11 +445,18 @@ void test_dfsph_solve_report(void**) {
   struct Case {
     const char* solver;
     const char* physics;  // (a weakly compressible world refuses a physics.dfsph section)
+    int density_cap;      // the density solve's cap a warning must name; 0: no density solve capped
+    int divergence_cap;   // likewise for the divergence solve
   };
   const Case cases[] = {
-      {"dfsph", R"("physics": { "dfsph": { "max_iterations": 100, "density_error": 0.001 } },)"},
-      {"dfsph", R"("physics": { "dfsph": { "max_iterations": 2, "density_error": 1e-6 } },)"},
-      {"wcsph", ""}};
+      {"dfsph", R"("physics": { "dfsph": { "max_iterations": 100, "density_error": 0.001 } },)", 0, 0},
+      {"dfsph", R"("physics": { "dfsph": { "max_iterations": 2, "density_error": 1e-6 } },)", 2, 0},
+      {"dfsph",
+       R"("physics": { "dfsph": { "max_divergence_iterations": 1, "divergence_error": 1e-6,
+                                  "divergence_error_per_step": 1e-9 } },)",
+       0, 1},
+      {"dfsph", R"("physics": { "dfsph": { "flags": 1 } },)", 0, 0},  // SPH_DFSPH_SKIP_DIVERGENCE_SOLVE
+      {"wcsph", "", 0, 0}};
   for (const Case& c : cases) {
     std::string text = scene;
     text.replace(text.find("SOLVER"), 6, c.solver);
@@ -468,33 +475,51 @@ void test_dfsph_solve_report(void**) {
     assert_true((log.find(" density iterations a substep), step ") != std::string::npos) == dfsph);
     assert_true((log.find("  DFSPH density solve: ") != std::string::npos) == dfsph);
     assert_true(stats.contains("dfsph") == dfsph);
-    // The warnings' counts ("... above its bounds in N of the frame's substeps").
-    const std::string warning = "sph-run: warning: the DFSPH density solve stopped at its cap of ";
-    long warned = 0;
-    for (size_t at = log.find(warning); at != std::string::npos; at = log.find(warning, at + 1)) {
-      const size_t in = log.find(" above its bounds in ", at);
-      assert_true(in != std::string::npos);
-      warned += std::strtol(log.c_str() + in + std::strlen(" above its bounds in "), nullptr, 10);
-    }
+    // The warnings ("frame N: the DFSPH <solve> solve stopped at its cap of C iteration(s) above its
+    // bound(s) in K of the frame's substeps"): each names the case's cap; their K summed.
+    const auto warned = [&](const std::string& solve, int cap) {
+      const std::string head = "sph-run: warning: frame ",
+                        what = ": the DFSPH " + solve + " solve stopped at its cap of ";
+      long sum = 0;
+      for (size_t at = log.find(head); at != std::string::npos; at = log.find(head, at + 1)) {
+        const size_t line_end = log.find('\n', at), here = log.find(what, at);
+        if (here == std::string::npos || here > line_end) continue;  // another warning
+        assert_true(log.compare(here + what.size(), std::to_string(cap).size() + 10,
+                                std::to_string(cap) + " iteration") == 0);
+        const size_t in = log.find(" in ", here + what.size());
+        assert_true(in != std::string::npos && in < line_end);
+        sum += std::strtol(log.c_str() + in + 4, nullptr, 10);
+      }
+      return sum;
+    };
+    const long density_warned = warned("density", c.density_cap),
+               divergence_warned = warned("divergence", c.divergence_cap);
     if (!dfsph) {
-      assert_int_equal(warned, 0);
+      assert_int_equal(density_warned + divergence_warned, 0);
       continue;
     }
     const nlohmann::json& d = stats.at("dfsph");
-    const long substeps = d.at("substeps").get<long>(), capped = d.at("pressure_solves_capped").get<long>();
+    const long substeps = d.at("substeps").get<long>(), capped = d.at("pressure_solves_capped").get<long>(),
+               divergence_capped = d.at("divergence_solves_capped").get<long>();
     assert_int_equal(substeps, stats.at("substeps").get<long>());
     assert_true(d.at("pressure_iterations").get<long>() >= 2 * substeps);  // at least two a substep
-    assert_int_equal(warned, capped);
-    assert_true(log.find("caps above their bounds: " + std::to_string(capped) + " density") !=
-                std::string::npos);
-    if (std::strstr(c.physics, "\"max_iterations\": 2,")) {
-      assert_true(capped > 0);
-      assert_int_equal(d.at("pressure_iterations_max").get<long>(), 2);
-    } else {
-      // At the defaults the bound holds in every substep: the worst substep's mean error within it.
-      assert_int_equal(capped, 0);
+    assert_int_equal(density_warned, capped);
+    assert_int_equal(divergence_warned, divergence_capped);
+    assert_true(log.find("caps above their bounds: " + std::to_string(capped) + " density, " +
+                         std::to_string(divergence_capped) + " divergence") != std::string::npos);
+    assert_true((capped > 0) == (c.density_cap > 0));
+    assert_true((divergence_capped > 0) == (c.divergence_cap > 0));
+    if (c.density_cap > 0) assert_int_equal(d.at("pressure_iterations_max").get<long>(), c.density_cap);
+    if (c.divergence_cap > 0)
+      assert_int_equal(d.at("divergence_iterations_max").get<long>(), c.divergence_cap);
+    if (c.density_cap == 0) {
+      // The density bound holds in every substep: the worst substep's mean error within it.
       assert_true(d.at("density_error_max").get<double>() <= 0.001);
     }
+    // The divergence solve switched off: no iterations, and the summary says so.
+    const bool skipped = std::strstr(c.physics, "\"flags\": 1") != nullptr;
+    assert_true((d.at("divergence_iterations").get<long>() == 0) == skipped);
+    assert_true((log.find("  DFSPH divergence solve: off\n") != std::string::npos) == skipped);
   }
 }
 

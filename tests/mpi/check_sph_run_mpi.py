@@ -18,8 +18,8 @@ in blocks that hold other particles than the undivided world's blocks, so the su
 differently (tests/mpi/test_mpi_scene_sums.c measured ~1e-8). The --stats-json documents agree
 on the frames, substeps, particle counts, time steps, top speed and (a DFSPH scene) the solves'
 figures exactly (and the summaries' DFSPH lines are sph-run's), and on the mean neighbour count
-within 1e-5 (the ranks' means weighted by their particles: another summation order). Also that the --per-rank files of each frame hold every particle once, each as the
-merged frame has it, and (--refusals) that --backend cuda either runs (a GPU is there) or fails on every rank with exit code 4
+within 1e-5 (the ranks' means weighted by their particles: another summation order). Also that
+the --per-rank files of each frame hold every particle once, each as the merged frame has it, and (--refusals) that --backend cuda either runs (a GPU is there) or fails on every rank with exit code 4
 and one message naming the option (CI: no GPU); then the scene with springs, whose merged frames
 equal sph-run's bit for bit (springs across ranks; with --backend cuda on CUDA ranks against
 sph-run --backend cuda, also without --refusals: scripts/gpu-test runs it).
@@ -108,7 +108,7 @@ def check_object_files(single, merged):
     print(f"{', '.join(names)}: probes equal sph-run's bit for bit, loads within {worst:.2g} of the magnitude")
 
 
-def check_stats(single, merged, ranks):
+def check_stats(single, merged, ranks, dfsph):
     with open(single, encoding="utf-8") as f:
         a = json.load(f)
     with open(merged, encoding="utf-8") as f:
@@ -121,8 +121,8 @@ def check_stats(single, merged, ranks):
     assert abs(a["neighbors_mean"] - b["neighbors_mean"]) <= 1e-5 * a["neighbors_mean"], (a, b)
     # DFSPH's solves (a DFSPH scene only): the ranks turn the undivided world's solves, their sums
     # exact over the ranks (docs/distributed.md), so every figure is sph-run's to the printed digit.
-    assert ("dfsph" in a) == ("dfsph" in b), "--stats-json: dfsph in one document only"
-    if "dfsph" in a:
+    assert ("dfsph" in a) == dfsph and ("dfsph" in b) == dfsph, f"--stats-json: dfsph expected {dfsph}"
+    if dfsph:
         assert a["dfsph"] == b["dfsph"], f"--stats-json: dfsph {b['dfsph']} != sph-run's {a['dfsph']}"
     print(f"--stats-json: {b['frames']} frames, {b['substeps']} substeps, {b['particles_end']} particles "
           f"(at most {b['particles_max']}), {b['migrated']} migrated"
@@ -254,8 +254,12 @@ def main(argv):
     p = run([mpiexec, "--oversubscribe", "-np", ranks, sph_run_mpi, scene, "--backend", backend, *outputs,
              "--threads", "1", "--quiet", "--per-rank", "--out", merged, "--stats-json", merged + ".json"])
     print(p.stdout.strip())
-    # A DFSPH scene's summary lines (its solves, figures equal over the ranks) read as sph-run's.
+    # A DFSPH scene's summary lines (its solves, figures equal over the ranks) read as sph-run's: three
+    # in each summary; none for a weakly compressible scene.
+    with open(scene, encoding="utf-8") as f:
+        dfsph = json.load(f).get("world", {}).get("solver") == "dfsph"
     solve_lines = [[line for line in q.stdout.splitlines() if line.startswith("  DFSPH ")] for q in (p_single, p)]
+    assert len(solve_lines[0]) == (3 if dfsph else 0), f"sph-run's summary: {p_single.stdout}"
     assert solve_lines[0] == solve_lines[1], f"summary's DFSPH lines: {solve_lines[1]} != sph-run's {solve_lines[0]}"
 
     frames = sorted(os.path.basename(f) for f in glob.glob(os.path.join(single, "fluid_*.csv")))
@@ -293,7 +297,7 @@ def main(argv):
     print(f"{len(frames)} frames of {len(a)} particles ({len(a) - first} more than frame 0: the source's, held on "
           f"{len(emitting)} ranks): sph-run-mpi on {ranks} ranks == sph-run, bit for bit ({backend} backend)")
     check_object_files(single, merged)
-    check_stats(single + ".json", merged + ".json", int(ranks))
+    check_stats(single + ".json", merged + ".json", int(ranks), dfsph)
     if compare_vdb:
         check_vdb(compare_vdb, single, merged, len(frames))
         check_vdb_shape(mpiexec, sph_run, sph_run_mpi, scene, work, ranks)

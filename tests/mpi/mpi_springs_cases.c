@@ -17,8 +17,10 @@
  *     substep (the lowest waiting id is reduced over the ranks) and the block's particles find
  *     their partners across the cuts;
  *   - RK4 (each stage sorts, resolves and returns the lists to ids) and DFSPH;
- *   - DFSPH by conjugate gradients with weak springs: its ranks skip their ghosts' walks, and a
- *     spring ghost (which no share of the solve reaches) must keep no stale velocity step.
+ *   - DFSPH by conjugate gradients with weak springs: spring ghosts (which no share of the solve
+ *     reaches) inside the CG solve, whose ranks skip their ghosts' walks (coverage: no owned
+ *     particle's walk reads a spring ghost's velocity step, so the bits do not show whether it is
+ *     written 0 or left stale).
  * Each: after the substeps, the particles equal the undivided world's bit for bit (the spring
  * sums run over the same slots with the same partners' bits: no tolerance), the count is the
  * world's. Also rank checkpoints of a world with springs, restored, loaded, and loaded on one rank. */

@@ -140,7 +140,8 @@ int run_frames(const Ranks& ranks, const CliOptions& cli, const SceneDesc& scene
     const sph_stats world = world_stats(s, interrupt_signal(), ranks.comm, &signal);
     if (signal) break;
     if (root) {
-      for (const std::string& w : runtime.warnings()) progress.note("sph-run-mpi: warning: " + w);
+      for (const std::string& w : runtime.warnings())
+        progress.note("sph-run-mpi: warning: frame " + std::to_string(i) + ": " + w);
       for (const std::string& n : runtime.notices())
         progress.note("sph-run-mpi: frame " + std::to_string(i) + ": " + n);
       if (step == SPH_INCOMPLETE)

@@ -83,7 +83,8 @@ int run_scene(sph_context* context, const std::string& backend_name, const Scene
       ++stepped;
       const double step_ms = ms_since(t);
       if (interrupt_signal()) break;  // the frame is not written: only whole frames stay
-      for (const std::string& w : runtime.warnings()) progress.note("sph-run: warning: " + w);
+      for (const std::string& w : runtime.warnings())
+        progress.note("sph-run: warning: frame " + std::to_string(i) + ": " + w);
       for (const std::string& n : runtime.notices())
         progress.note("sph-run: frame " + std::to_string(i) + ": " + n);
       if (step == SPH_INCOMPLETE)

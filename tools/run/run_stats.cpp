@@ -82,12 +82,15 @@ void RunStats::print_solves(std::FILE* out) const {
       "worst substep, %.3f %% the largest particle's)\n",
       d.density_iterations / n, d.density_iterations_max, 100.0 * d.density_error_sum / n,
       100.0 * d.density_error_max, 100.0 * d.density_error_largest);
-  std::fprintf(
-      out,
-      "  DFSPH divergence solve: %.2f iterations a substep (most %u), error %.3g 1/s mean (%.3g in the "
-      "worst substep)\n",
-      d.divergence_iterations / n, d.divergence_iterations_max, d.divergence_error_sum / n,
-      static_cast<double>(d.divergence_error_max));
+  if (d.divergence_iterations == 0)  // (SPH_DFSPH_SKIP_DIVERGENCE_SOLVE)
+    std::fprintf(out, "  DFSPH divergence solve: off\n");
+  else
+    std::fprintf(
+        out,
+        "  DFSPH divergence solve: %.2f iterations a substep (most %u), error %.3g 1/s mean (%.3g 1/s in the "
+        "worst substep)\n",
+        d.divergence_iterations / n, d.divergence_iterations_max, d.divergence_error_sum / n,
+        static_cast<double>(d.divergence_error_max));
   std::fprintf(
       out,
       "  DFSPH solves stopped at their caps above their bounds: %llu density, %llu divergence (of %llu "

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "scene_runtime.h"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "lattice_fill.h"
@@ -290,18 +291,19 @@ void SceneRuntime::collect_events() {
       if (density)
         std::snprintf(
             text, sizeof text,
-            "the DFSPH density solve stopped at its cap of %u iterations above its bounds in %u of the "
+            "the DFSPH density solve stopped at its cap of %u iteration%s above its bounds in %u of the "
             "frame's substeps (physics.dfsph.max_iterations; density_error %g, density_error_max %g)",
-            p.max_iterations, e.count, static_cast<double>(p.density_error),
-            static_cast<double>(p.density_error_max));
+            p.max_iterations, p.max_iterations == 1 ? "" : "s", e.count, static_cast<double>(p.density_error),
+            // (a largest-error bound below the mean's acts as the mean's: dfsph.h)
+            static_cast<double>(std::max(p.density_error, p.density_error_max)));
       else
         std::snprintf(
             text, sizeof text,
-            "the DFSPH divergence solve stopped at its cap of %u iterations above its bound in %u of "
+            "the DFSPH divergence solve stopped at its cap of %u iteration%s above its bound in %u of "
             "the frame's substeps (physics.dfsph.max_divergence_iterations; divergence_error %g 1/s, "
             "divergence_error_per_step %g)",
-            p.max_divergence_iterations, e.count, static_cast<double>(p.divergence_error),
-            static_cast<double>(p.divergence_error_per_step));
+            p.max_divergence_iterations, p.max_divergence_iterations == 1 ? "" : "s", e.count,
+            static_cast<double>(p.divergence_error), static_cast<double>(p.divergence_error_per_step));
       warnings_.push_back(text);
       continue;
     }
