@@ -130,10 +130,9 @@ std::string RunStats::write_json(const std::string& path, const std::string& sce
         f,
         ", \"dfsph\": {\"substeps\": %llu, \"pressure_iterations\": %llu, \"pressure_iterations_max\": %u, "
         "\"density_error_mean\": %.6g, \"density_error_max\": %.6g, \"density_error_largest\": %.6g, "
-        "\"divergence_iterations\": %llu, \"divergence_iterations_max\": %u, \"divergence_error_mean\": "
-        "%.6g, "
-        "\"divergence_error_max\": %.6g, \"pressure_solves_capped\": %llu, \"divergence_solves_capped\": "
-        "%llu, "
+        "\"divergence_iterations\": %llu, \"divergence_iterations_max\": %u, "
+        "\"divergence_error_mean\": %.6g, \"divergence_error_max\": %.6g, "
+        "\"pressure_solves_capped\": %llu, \"divergence_solves_capped\": %llu, "
         "\"pressure_solves_guarded\": %llu}",
         static_cast<unsigned long long>(d.substeps), static_cast<unsigned long long>(d.density_iterations),
         d.density_iterations_max, d.density_error_sum / n, static_cast<double>(d.density_error_max),

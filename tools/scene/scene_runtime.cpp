@@ -291,9 +291,9 @@ void SceneRuntime::collect_events() {
       if (density)
         std::snprintf(
             text, sizeof text,
-            "the DFSPH density solve stopped at its cap of %u iteration%s above its bounds in %u of the "
+            "the DFSPH density solve stopped at its cap of %u iterations above its bounds in %u of the "
             "frame's substeps (physics.dfsph.max_iterations; density_error %g, density_error_max %g)",
-            p.max_iterations, p.max_iterations == 1 ? "" : "s", e.count, static_cast<double>(p.density_error),
+            p.max_iterations, e.count, static_cast<double>(p.density_error),  // (max_iterations >= 2)
             // (a largest-error bound below the mean's acts as the mean's: dfsph.h)
             static_cast<double>(std::max(p.density_error, p.density_error_max)));
       else
