@@ -392,8 +392,8 @@ void test_loads_csv(void**) {
 
 // Threshold events (issue 17): a collider's "loads.threshold" below the water's weight and a
 // probe's "pressure_threshold" below its pressure make sph-run print a line for each frame that
-// reaches them ("sph-run: frame N: colliders[0]: ..."); thresholds no reading reaches print
-// nothing.
+// reaches them ("sph-run: frame N: colliders[0]: ..."), the first three in full and the rest folded
+// into one line at the end; thresholds no reading reaches print nothing.
 void test_threshold_notices(void**) {
   const std::string dir = cli_test::make_temp_dir("threshold_notices");
   const std::string scene_file = dir + "/thresholds.json";
@@ -401,7 +401,7 @@ void test_threshold_notices(void**) {
   // once it rests; 1e6 N and 1e6 Pa never.
   const char* scene = R"({
     "world": { "capacity": 4000, "particle_spacing": 0.02 },
-    "time": { "fps": 50, "frames": 6 },
+    "time": { "fps": 50, "frames": 8 },
     "fluids": [ { "type": "box", "min": [-0.1, 0.0, -0.1], "max": [0.1, 0.06, 0.1] } ],
     "colliders": [ { "name": "tank", "inverted": true, "loads": { "threshold": THRESHOLD },
                      "shape": { "type": "box", "half_extents": [0.1, 0.1, 0.1], "voxel_size": 0.02 },
@@ -423,6 +423,31 @@ void test_threshold_notices(void**) {
     assert_true((log.find(" N reached its loads.threshold") != std::string::npos) == low);
     assert_true((log.find(": probes[0]: the peak pressure ") != std::string::npos) == low);
     assert_true((log.find(" Pa reached its pressure_threshold") != std::string::npos) == low);
+    // A notice prints in full for the first three frames that reach it, the third saying so, and
+    // one line after the progress counts the rest (no total: a force, a pressure). The water
+    // rests on the floor from frame 3 or so on (its weight, 24 N, far above 1 N): the collider's
+    // notice folds; the probe's peak pressure, near 1 Pa at first, may miss a frame.
+    for (const std::string what : {"colliders[0]: the fluid's force", "probes[0]: the peak pressure"}) {
+      int printed = 0;
+      bool noted = false;  // the third printed frame's note
+      for (size_t at = log.find("sph-run: frame "); at != std::string::npos;
+           at = log.find("sph-run: frame ", at + 1)) {
+        const std::string line = log.substr(at, log.find('\n', at) - at);
+        if (line.find(": " + what + " ") == std::string::npos) continue;
+        ++printed;
+        noted = line.find("(from here on, frames with this message are counted") != std::string::npos;
+        assert_true(noted == (printed == 3));
+      }
+      const size_t closing = log.find("sph-run: " + what + " reached its " +
+                                      (what[0] == 'c' ? "loads.threshold" : "pressure_threshold") + " in ");
+      if (!low) assert_int_equal(printed, 0);
+      if (low) assert_true(printed >= 1 && printed <= 3);
+      if (closing != std::string::npos) {
+        assert_true(noted);
+        assert_true(log.compare(log.find('\n', closing) - 14, 14, ", not printed)") == 0);
+      }
+      if (low && what[0] == 'c') assert_true(closing != std::string::npos);
+    }
   }
 }
 
@@ -457,6 +482,7 @@ void test_dfsph_solve_report(void**) {
        0, 1},
       {"dfsph", R"("physics": { "dfsph": { "flags": 1 } },)", 0, 0},  // SPH_DFSPH_SKIP_DIVERGENCE_SOLVE
       {"wcsph", "", 0, 0}};
+  int folded_runs = 0;  // runs whose warnings were folded: at least one case must fold
   for (const Case& c : cases) {
     std::string text = scene;
     text.replace(text.find("SOLVER"), 6, c.solver);
@@ -476,19 +502,42 @@ void test_dfsph_solve_report(void**) {
     assert_true((log.find("  DFSPH density solve: ") != std::string::npos) == dfsph);
     assert_true(stats.contains("dfsph") == dfsph);
     // The warnings ("frame N: the DFSPH <solve> solve stopped at its cap of C iteration(s) above its
-    // bound(s) in K of the frame's substeps"): each names the case's cap; their K summed.
+    // bound(s) in K of the frame's substeps"): each names the case's cap; their K summed. A solve
+    // capped in every frame prints in full for the first three frames only (MessageFold), the third
+    // saying so, and the run's end adds the rest in one line ("... in 3 more frames (4 to 6, not
+    // printed): K substeps"): its K summed too.
     const auto warned = [&](const std::string& solve, int cap) {
       const std::string head = "sph-run: warning: frame ",
                         what = ": the DFSPH " + solve + " solve stopped at its cap of ";
       long sum = 0;
+      int frames = 0;
+      bool folding = false;  // the third frame printed said that the rest are counted
       for (size_t at = log.find(head); at != std::string::npos; at = log.find(head, at + 1)) {
         const size_t line_end = log.find('\n', at), here = log.find(what, at);
         if (here == std::string::npos || here > line_end) continue;  // another warning
+        assert_false(folding);  // nothing printed in full after the fold's note
+        ++frames;
         assert_true(log.compare(here + what.size(), std::to_string(cap).size() + 10,
                                 std::to_string(cap) + " iteration") == 0);
         const size_t in = log.find(" in ", here + what.size());
         assert_true(in != std::string::npos && in < line_end);
         sum += std::strtol(log.c_str() + in + 4, nullptr, 10);
+        folding = log.substr(at, line_end - at).find("(from here on, frames with this message are counted") !=
+                  std::string::npos;
+        assert_true(folding == (frames == 3));
+      }
+      const std::string rest =
+          "sph-run: warning: the DFSPH " + solve + " solve stopped at its cap above its bound";
+      const size_t at = log.find(rest);
+      if (at != std::string::npos) {
+        assert_true(folding);  // only after the third frame's note
+        ++folded_runs;
+        const size_t line_end = log.find('\n', at), more = log.find(" more frame", at),
+                     total = log.find(", not printed): ", at);
+        assert_true(more < line_end && total < line_end);
+        assert_true(std::strtol(log.c_str() + log.find(" in ", at + rest.size()) + 4, nullptr, 10) >= 1);
+        sum += std::strtol(log.c_str() + total + 16, nullptr, 10);
+        assert_true(log.compare(log.find(" substeps", total), 10, " substeps\n") == 0);
       }
       return sum;
     };
@@ -521,6 +570,7 @@ void test_dfsph_solve_report(void**) {
     assert_true((d.at("divergence_iterations").get<long>() == 0) == skipped);
     assert_true((log.find("  DFSPH divergence solve: off\n") != std::string::npos) == skipped);
   }
+  assert_true(folded_runs >= 1);  // the divergence cap's case warns in every frame: its last three fold
 }
 
 // Probes (issue 17 item 2): each probe of "probes" gets probe_<index>[_<name>].csv, a row per

@@ -14,6 +14,7 @@
 #include "library_error.h"
 #include "load_csv.h"
 #include "merged_frame.h"
+#include "message_fold.h"
 #include "particle_frame.h"
 #include "probe_csv.h"
 #include "progress.h"
@@ -98,6 +99,11 @@ int run_frames(const Ranks& ranks, const CliOptions& cli, const SceneDesc& scene
                  backend.c_str(), out.directory.c_str(), per_rank ? " (+ rank<R>/)" : "");
   install_interrupt_handlers();
   Progress progress(scene.frames, isatty(STDERR_FILENO) != 0, cli.quiet || !root);
+  MessageFold warnings("sph-run-mpi: warning: "), notices("sph-run-mpi: ");
+  const auto note = [&progress](MessageFold& fold, uint32_t frame, const FrameMessage& m) {
+    const std::string line = fold.line(frame, m);
+    if (!line.empty()) progress.note(line);
+  };
   RunStats stats;  // the world's figures (world_stats), kept by rank 0
   ObjectFiles objects;
   ParticleFrame own, all;
@@ -140,13 +146,9 @@ int run_frames(const Ranks& ranks, const CliOptions& cli, const SceneDesc& scene
     const sph_stats world = world_stats(s, interrupt_signal(), ranks.comm, &signal);
     if (signal) break;
     if (root) {
-      for (const std::string& w : runtime.warnings())
-        progress.note("sph-run-mpi: warning: frame " + std::to_string(i) + ": " + w);
-      for (const std::string& n : runtime.notices())
-        progress.note("sph-run-mpi: frame " + std::to_string(i) + ": " + n);
-      if (step == SPH_INCOMPLETE)
-        progress.note("sph-run-mpi: warning: frame " + std::to_string(i) +
-                      ": max_substeps ran out before the frame's end (raise params.max_substeps or dt_min)");
+      for (const FrameMessage& w : runtime.warnings()) note(warnings, i, w);
+      for (const FrameMessage& n : runtime.notices()) note(notices, i, n);
+      if (step == SPH_INCOMPLETE) note(warnings, i, incomplete_frame_message());
     }
     const double output_ms = write_frame(i);
     ++written;
@@ -156,6 +158,9 @@ int run_frames(const Ranks& ranks, const CliOptions& cli, const SceneDesc& scene
         FrameReport{i, world.particle_count, world.substeps, step_ms, output_ms, world.pressure_iterations});
   }
   progress.finish();
+  if (root)
+    for (const MessageFold* fold : {&warnings, &notices})
+      for (const std::string& line : fold->closing()) std::fprintf(stderr, "%s\n", line.c_str());
   if (root) objects.close(ranks);
   if (signal && root)
     std::fprintf(stderr, "sph-run-mpi: interrupted; frames 0..%u are complete in %s/\n", written - 1,

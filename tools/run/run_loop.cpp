@@ -13,6 +13,7 @@
 #include "interrupt.h"
 #include "library_error.h"
 #include "load_csv.h"
+#include "message_fold.h"
 #include "particle_frame.h"
 #include "probe_csv.h"
 #include "progress.h"
@@ -61,6 +62,11 @@ int run_scene(sph_context* context, const std::string& backend_name, const Scene
     }
     install_interrupt_handlers();
     Progress progress(scene.frames, tty, cli.quiet);
+    MessageFold warnings("sph-run: warning: "), notices("sph-run: ");
+    const auto note = [&progress](MessageFold& fold, uint32_t frame, const FrameMessage& m) {
+      const std::string line = fold.line(frame, m);
+      if (!line.empty()) progress.note(line);
+    };
     RunStats stats;
     ParticleFrame frame;
     const Clock::time_point run_start = Clock::now();
@@ -83,13 +89,9 @@ int run_scene(sph_context* context, const std::string& backend_name, const Scene
       ++stepped;
       const double step_ms = ms_since(t);
       if (interrupt_signal()) break;  // the frame is not written: only whole frames stay
-      for (const std::string& w : runtime.warnings())
-        progress.note("sph-run: warning: frame " + std::to_string(i) + ": " + w);
-      for (const std::string& n : runtime.notices())
-        progress.note("sph-run: frame " + std::to_string(i) + ": " + n);
-      if (step == SPH_INCOMPLETE)
-        progress.note("sph-run: warning: frame " + std::to_string(i) +
-                      ": max_substeps ran out before the frame's end (raise params.max_substeps or dt_min)");
+      for (const FrameMessage& w : runtime.warnings()) note(warnings, i, w);
+      for (const FrameMessage& n : runtime.notices()) note(notices, i, n);
+      if (step == SPH_INCOMPLETE) note(warnings, i, incomplete_frame_message());
       sph_stats s;
       sph_stats_init(&s);
       sph_world_get_stats(runtime.world(), &s);
@@ -109,6 +111,8 @@ int run_scene(sph_context* context, const std::string& backend_name, const Scene
           FrameReport{i, s.particle_count, s.substeps, step_ms, output_ms, s.pressure_iterations});
     }
     progress.finish();
+    for (const MessageFold* fold : {&warnings, &notices})
+      for (const std::string& line : fold->closing()) std::fprintf(stderr, "%s\n", line.c_str());
     const int signal = interrupt_signal();
     if (signal)
       std::fprintf(stderr, "sph-run: interrupted; frames 0..%u are complete in %s/\n", written - 1,

@@ -270,15 +270,19 @@ void SceneRuntime::collect_events() {
     if (e.type == SPH_EVENT_COLLIDER_LOAD_EXCEEDED) {
       for (size_t i = 0; i < colliders_.size(); ++i)
         if (colliders_[i].id.bits == e.object_bits)
-          notices_.push_back(colliders_[i].desc->path + ": the fluid's force " + std::to_string(e.count) +
-                             " N reached its loads.threshold");
+          notices_.push_back({colliders_[i].desc->path + ": the fluid's force reached its loads.threshold",
+                              colliders_[i].desc->path + ": the fluid's force " + std::to_string(e.count) +
+                                  " N reached its loads.threshold",
+                              e.count, ""});
       continue;
     }
     if (e.type == SPH_EVENT_PROBE_PRESSURE_EXCEEDED) {
       for (size_t i = 0; i < probes_.size(); ++i)
         if (probes_[i].bits == e.object_bits)
-          notices_.push_back(scene_.probes[i].path + ": the peak pressure " + std::to_string(e.count) +
-                             " Pa reached its pressure_threshold");
+          notices_.push_back({scene_.probes[i].path + ": the peak pressure reached its pressure_threshold",
+                              scene_.probes[i].path + ": the peak pressure " + std::to_string(e.count) +
+                                  " Pa reached its pressure_threshold",
+                              e.count, ""});
       continue;
     }
     if (e.type == SPH_EVENT_PRESSURE_SOLVE_CAPPED || e.type == SPH_EVENT_DIVERGENCE_SOLVE_CAPPED) {
@@ -304,15 +308,20 @@ void SceneRuntime::collect_events() {
             "divergence_error_per_step %g)",
             p.max_divergence_iterations, p.max_divergence_iterations == 1 ? "" : "s", e.count,
             static_cast<double>(p.divergence_error), static_cast<double>(p.divergence_error_per_step));
-      warnings_.push_back(text);
+      warnings_.push_back({density ? "the DFSPH density solve stopped at its cap above its bounds"
+                                   : "the DFSPH divergence solve stopped at its cap above its bound",
+                           text, e.count, "substeps"});
       continue;
     }
     if (e.type != SPH_EVENT_SOURCE_CAPACITY_REACHED) continue;
     std::string path = "sources";
     for (size_t i = 0; i < sources_.size(); ++i)
       if (sources_[i].id.bits == e.object_bits) path = scene_.sources[i].path;
-    warnings_.push_back(path + ": the world's capacity (" + std::to_string(world_limit()) + ") is reached; " +
-                        std::to_string(e.count) + " particles were not emitted (" + raise_hint() + ")");
+    warnings_.push_back({path + ": the world's capacity is reached",
+                         path + ": the world's capacity (" + std::to_string(world_limit()) +
+                             ") is reached; " + std::to_string(e.count) + " particles were not emitted (" +
+                             raise_hint() + ")",
+                         e.count, "particles not emitted"});
   }
 }
 

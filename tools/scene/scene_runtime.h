@@ -5,6 +5,7 @@
 #ifndef SPH_TOOLS_SCENE_RUNTIME_H
 #define SPH_TOOLS_SCENE_RUNTIME_H
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,17 @@
 #include "sph_c.h"
 
 namespace sph_tools {
+
+// A message of one frame's events: `kind` says what it reports in the same words every frame it
+// repeats in (sph-run folds the repeats by it: tools/run/message_fold.h), `text` the whole
+// sentence; `count` the event's amount in `unit` (substeps, particles) where such amounts add up
+// over frames, `unit` empty where they do not (a force, a pressure).
+struct FrameMessage {
+  std::string kind;
+  std::string text;
+  uint64_t count = 0;
+  std::string unit;
+};
 
 class SceneRuntime {
  public:
@@ -57,10 +69,11 @@ class SceneRuntime {
   // Returns SPH_OK or SPH_INCOMPLETE (max_substeps ran out); throws SceneError or LibraryError.
   sph_result step_frame();
 
-  // Warnings of the last step_frame (a source that reached the capacity), for the user.
-  const std::vector<std::string>& warnings() const { return warnings_; }
-  // The last frame's threshold events (colliders' loads, probes' pressure), as sentences.
-  const std::vector<std::string>& notices() const { return notices_; }
+  // Warnings of the last step_frame (a source that reached the capacity, a DFSPH solve that
+  // stopped at its cap), for the user.
+  const std::vector<FrameMessage>& warnings() const { return warnings_; }
+  // The last frame's threshold events (colliders' loads, probes' pressure).
+  const std::vector<FrameMessage>& notices() const { return notices_; }
 
  private:
   void destroy_all();
@@ -101,8 +114,8 @@ class SceneRuntime {
     bool started = false, stopped = false;
   };
   std::vector<ForceField> fields_;
-  std::vector<std::string> warnings_;
-  std::vector<std::string> notices_;
+  std::vector<FrameMessage> warnings_;
+  std::vector<FrameMessage> notices_;
 };
 
 }  // namespace sph_tools
