@@ -413,6 +413,22 @@ namespace Sph
         }
     }
 
+    public sealed partial class WorldHandle
+    {
+        // Between a StepBegin that succeeded and the StepWait that collected it: the library
+        // refuses to destroy the world meanwhile (WORLD_LOCKED), so neither Dispose nor the
+        // finaliser tries.
+        internal volatile bool StepInFlight;
+
+        // The finaliser of a world dropped with a step in flight leaks it (and keeps its
+        // context): waiting there could block the finaliser thread for a whole frame, and freeing
+        // it under the step is not possible.
+        partial void OnReleasing(ref bool keep)
+        {
+            if (StepInFlight) keep = true;
+        }
+    }
+
     /// <summary>A particle fluid on a context (sph_world). Not thread-safe: use one thread at a time.
     /// Not sealed for one subclass: DistributedWorld (SphMpi.cs), a world over MPI ranks.</summary>
     public class World : IDisposable
@@ -439,8 +455,16 @@ namespace Sph
 
         public bool IsDisposed { get; private set; }
 
+        /// <summary>Destroys the world (sph_world_destroy). While a step that StepBegin started
+        /// is in flight it throws SphException(ErrorWorldLocked) and the world stays open:
+        /// StepWait, then Dispose again. A world dropped without Dispose is destroyed by its
+        /// handle's finaliser, except with a step in flight: that world (and its context) is
+        /// leaked, never destroyed or waited for on the finaliser thread.</summary>
         public void Dispose()
         {
+            if (Handle.StepInFlight)
+                throw new SphException(Result.ErrorWorldLocked, "sph_world_destroy",
+                    "a step that StepBegin started is in flight: StepWait first");
             IsDisposed = true;
             Handle.Dispose();
         }
@@ -774,13 +798,17 @@ namespace Sph
         public void StepBegin(float frameDt)
         {
             SphException.Check(Native.sph_world_step_begin(Handle, frameDt), "sph_world_step_begin");
+            Handle.StepInFlight = true;
         }
 
         /// <summary>Waits for the frame StepBegin started and returns what Step would have returned
         /// (Ok or Incomplete), or throws its error (sph_world_step_wait).</summary>
         public Result StepWait()
         {
-            return SphException.Check(Native.sph_world_step_wait(Handle), "sph_world_step_wait");
+            Result r = Native.sph_world_step_wait(Handle);
+            // Collected (its result or its error), unless another call held the world.
+            if (r != Result.ErrorWorldLocked) Handle.StepInFlight = false;
+            return SphException.Check(r, "sph_world_step_wait");
         }
 
         /// <summary>True once the frame StepBegin started has ended, so StepWait will not block
