@@ -998,9 +998,11 @@ namespace Sph
         }
 
         /// <summary>Adds a sink: with a region (SinkMode.Region) or, region null, the def's
-        /// bounds (SinkMode.OutsideBounds).</summary>
+        /// bounds (SinkMode.OutsideBounds: a def left at Region is switched to it, as Python's
+        /// add_sink(bounds=...) does).</summary>
         public Sink CreateSink(Sdf region, SinkDef def)
         {
+            if (region == null && def.Mode == SinkMode.Region) def.Mode = SinkMode.OutsideBounds;
             SinkId id;
             using (var borrowed = new Borrowed(region != null ? region.Handle : null))
             {

@@ -1153,7 +1153,24 @@ static class Tests
                 Assert(events.Length == 1 && events[0].Type == EventType.SinkRemoved && events[0].Count == removed.Length &&
                        events[0].ObjectBits == sink.Id.Bits, "sink event");
             }
-            Throws(Result.ErrorInvalidArgument, () => world.CreateSink(null, SinkDef.Default()));
+            // Region null: the def's bounds, without setting Mode (CreateSink's summary).
+            var boundsOnly = SinkDef.Default();
+            boundsOnly.BoundsMin = new Vec3(-0.02f, -0.02f, -0.02f);
+            boundsOnly.BoundsMax = new Vec3(0.02f, 0.02f, 0.02f);
+            uint before = world.ParticleCount;
+            using (var sink = world.CreateSink(null, boundsOnly))
+            {
+                world.Step(1f / 240f);
+                uint removed = (uint)world.GetRemovedIds().Length;
+                Assert(removed > 0, "particles outside the bounds-only sink's box removed");
+                AssertEqual(before - removed, world.ParticleCount, "count after the bounds-only sink");
+            }
+            var inverted = SinkDef.Default();
+            inverted.BoundsMin = new Vec3(1, 1, 1);
+            Throws(Result.ErrorInvalidArgument, () => world.CreateSink(null, inverted));
+            var noRegion = SinkDef.Default();
+            noRegion.Mode = SinkMode.OutsideBounds;
+            using (var sink = world.CreateSink(null, noRegion)) { }
         }
     }
 
