@@ -101,14 +101,28 @@ class Context:
         device_ordinal: CUDA device (default -1 = device 0).
         cpu_worker_count: CPU backend threads (default 0 = all hardware threads).
         log: optional callable(level: LogLevel, code: Result, message: str), called on the
-            calling thread when a call on this context or its worlds fails. Exceptions it
-            raises are printed and swallowed (they cannot cross the C library).
-        definition: a ContextDef to start from instead of the defaults.
+            calling thread, inside a call on this context or its worlds: when the call fails
+            (LogLevel.ERROR with its code), and for a warning from a call that succeeds
+            (LogLevel.WARNING with Result.OK, e.g. add_collider's coarse-SDF warning in a world
+            with Feature.BOUNDARY_DENSITY; docs/api.md). Exceptions it raises are printed and
+            swallowed (they cannot cross the C library).
+        definition: a ContextDef to start from instead of the defaults. Its callbacks
+            (alloc_fn/free_fn, enqueue_task/finish_task, log_fn) and what its user_data /
+            user_context fields point into must outlive the context: the context keeps the
+            ContextDef and the ctypes objects assigned to its fields.
     """
 
     def __init__(self, backend=None, *, device_ordinal=None, cpu_worker_count=None, log=None, definition=None):
         lib = library()
         d = definition.copy() if definition is not None else _g.ContextDef()
+        # The copy has the definition's function pointers but not ctypes' references to the
+        # Python objects behind them (log_fn, enqueue_task, finish_task, alloc_fn, free_fn: their
+        # thunks) or to what its user_data / user_context fields point into (the struct's
+        # _objects). The library calls them for the context's whole life, so the context keeps
+        # the definition and a snapshot of those references (a later change to the definition
+        # cannot drop them).
+        self._definition = definition
+        self._definition_refs = dict(getattr(definition, "_objects", None) or {}) if definition is not None else {}
         if backend is not None:
             d.backend = _g.Backend[backend.upper()] if isinstance(backend, str) else _g.Backend(backend)
         if device_ordinal is not None:
@@ -161,7 +175,7 @@ class Context:
             a.user_context = user_context
         check(library().sph_cuda_context_set_allocator(self.handle, ctypes.byref(a)),
               "sph_cuda_context_set_allocator")
-        self._cuda_allocator = (alloc_fn, free_fn)  # the library keeps calling them
+        self._cuda_allocator = (alloc_fn, free_fn, user_context, a)  # the library keeps calling them
 
     def world(self, definition=None, **fields):
         """A new World on this context; see World."""
