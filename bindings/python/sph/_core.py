@@ -83,6 +83,30 @@ def _vec3_rows(values, what):
     return a
 
 
+def _integers(values, a, dtype, what):
+    """`values` (already the 1-D array `a`) as `dtype`, an integer dtype, refusing what a cast
+    would change: TypeError for values that are not integers (floats, strings; booleans pass as
+    0 and 1), ValueError for integers outside the dtype's range. numpy's own cast wraps
+    (2**32 + 5 -> 5, -1 -> 4294967295) and truncates (1.9 -> 1) silently."""
+    if len(a) == 0:
+        return np.empty(0, dtype)
+    if a.dtype.kind not in "uib" and not isinstance(values, np.ndarray):
+        a = np.asarray(values, dtype=object)  # a list mixing numpy and Python ints
+    if a.dtype.kind == "O":
+        if not all(isinstance(v, (int, np.integer)) for v in a.tolist()):
+            kinds = sorted({type(v).__name__ for v in a.tolist() if not isinstance(v, (int, np.integer))})
+            raise TypeError(f"{what}: expected integers ({dtype}), got {', '.join(kinds)}")
+        a = np.array([int(v) for v in a.tolist()], dtype=object)
+    elif a.dtype.kind not in "uib":
+        raise TypeError(f"{what}: expected integers ({dtype}), got an array of {a.dtype}")
+    lo, hi = int(a.min()), int(a.max())
+    info = np.iinfo(dtype)
+    if lo < info.min or hi > info.max:
+        bad = lo if lo < info.min else hi
+        raise ValueError(f"{what}: {bad} does not fit {dtype} ({info.min}..{info.max})")
+    return a.astype(dtype)
+
+
 def _float_ptr(a):
     return a.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
 
@@ -512,7 +536,9 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
     def set_attribute(self, attribute, values, first=0):
         """Overwrites particles [first, first + len(values)) of POSITION, VELOCITY ((n, 3)
         float32) or USER ((n,) uint32) in the world's current order (sph_world_set_attribute:
-        all-or-nothing, every value checked first). Strided numpy rows pass without a copy."""
+        all-or-nothing, every value checked first). Strided numpy rows pass without a copy.
+        USER values must be integers in [0, 2^32): others raise TypeError (floats, strings)
+        or ValueError (out of range) before anything is written, never wrap or truncate."""
         attribute = _g.Attribute(attribute)
         dtype, comps = attribute_format(attribute)
         check_int(ctypes.c_uint32, first, "first")
@@ -522,6 +548,8 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
             a = np.asarray(values)
             if a.ndim != 1:
                 raise ValueError(f"values: expected an array of shape (n,), got {a.shape}")
+            if dtype.kind in "ui" and a.dtype != dtype:
+                a = _integers(values, a, dtype, f"values ({attribute.name})")
             if a.dtype != dtype or a.strides[0] < dtype.itemsize:
                 a = np.ascontiguousarray(a, dtype=dtype)
         elem = comps * dtype.itemsize

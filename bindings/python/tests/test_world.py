@@ -343,6 +343,27 @@ def test_set_attributes_read_back_bitwise(ctx):
         assert [by_id[i] for i in w.ids().tolist()] == w.user_attributes().tolist()  # sorted along
 
 
+def test_user_attributes_refuse_what_uint32_cannot_hold(ctx):
+    """set_user_attributes never wraps or truncates: out-of-range integers raise ValueError,
+    non-integers TypeError, before anything is written."""
+    with ctx.world(capacity=2048, features="user_attribute") as w:
+        n = w.fill_box((0, 0.2, 0), (0.1, 0.3, 0.1))
+        tags = np.arange(n, dtype=np.uint32) * 3
+        w.set_user_attributes(tags)
+        for bad, kind in ([[2**32 + 5], ValueError], [[-1], ValueError], [[0, 2**64], ValueError],
+                          [np.array([2**40], np.int64), ValueError], [np.array([2**32], np.uint64), ValueError],
+                          [np.array([-3], np.int8), ValueError], [[1.9], TypeError], [np.array([1.0]), TypeError],
+                          [[1, 2.5], TypeError], [["7"], TypeError]):
+            with pytest.raises(kind):
+                w.set_user_attributes(bad, first=1)
+            np.testing.assert_array_equal(w.user_attributes(), tags, err_msg=repr(bad))
+        # What fits is written, whatever its integer type (also a list mixing numpy and Python ints).
+        w.set_user_attributes([2**32 - 1, np.uint64(4), True], first=2)
+        w.set_user_attributes(np.array([9, 8], np.int64))
+        w.set_user_attributes([])
+        np.testing.assert_array_equal(w.user_attributes()[:5], [9, 8, 2**32 - 1, 4, 1])
+
+
 def test_remove_particles_by_id(ctx):
     with ctx.world(capacity=2048) as w:
         w.fill_box((0, 0.2, 0), (0.1, 0.3, 0.1))
