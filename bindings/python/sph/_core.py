@@ -13,7 +13,7 @@ from ._checkpoint import WorldCheckpointMixin, load_world, load_world_file
 from ._cuda import WorldCudaMixin
 from ._errors import SphError, check
 from ._loader import library
-from ._options import WorldOptionsMixin
+from ._options import WorldOptionsMixin, _as_struct
 from ._scene import Sdf, WorldSceneMixin
 from ._struct import check_int
 
@@ -357,15 +357,18 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
     # -- runtime parameters
     @property
     def params(self):
-        """The runtime WorldParams (sph_world_get_params); assign a WorldParams to replace them
-        all at once (sph_world_set_params: validated as a whole, unchanged on error)."""
+        """The runtime WorldParams (sph_world_get_params); assign a WorldParams (or a dict of its
+        fields, the others at their defaults, as the other params setters take) to replace them
+        all at once (sph_world_set_params: validated as a whole, unchanged on error).
+        set_params(**fields) changes some and keeps the others."""
         p = _g.WorldParams()
         check(library().sph_world_get_params(self.handle, ctypes.byref(p)), "sph_world_get_params")
         return p
 
     @params.setter
     def params(self, params):
-        check(library().sph_world_set_params(self.handle, ctypes.byref(params)), "sph_world_set_params")
+        p = _as_struct(_g.WorldParams, params)
+        check(library().sph_world_set_params(self.handle, ctypes.byref(p)), "sph_world_set_params")
 
     def set_params(self, **fields):
         """Changes some runtime parameters, keeping the others: ``w.set_params(gravity=(0, 0, 0))``,

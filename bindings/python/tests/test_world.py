@@ -76,6 +76,21 @@ def test_params_round_trip(world):
     assert world.params.step_factor == pytest.approx(0.2) and tuple(q.gravity) == (0, 0, -1)
 
 
+def test_params_take_a_dict(world):
+    """w.params = {...}, as every other params setter: the named fields over the defaults."""
+    world.set_params(viscosity=2.5)
+    world.params = {"gravity": (0, 0, -1), "step_factor": 0.2}
+    p = world.params
+    assert tuple(p.gravity) == (0, 0, -1) and p.step_factor == pytest.approx(0.2)
+    assert p.viscosity == sph.WorldParams().viscosity, "a field not named is at its default"
+    with pytest.raises(AttributeError, match="no_such_field"):
+        world.params = {"no_such_field": 1}
+    assert error(setattr, world, "params", {"stiffness": -1.0}) == sph.Result.ERROR_INVALID_ARGUMENT
+    assert world.params == p
+    with pytest.raises(TypeError):
+        world.params = sph.TaitParams()
+
+
 def test_bad_params_change_nothing(world):
     before = world.params
     assert error(world.set_params, stiffness=-1.0) == sph.Result.ERROR_INVALID_ARGUMENT
