@@ -111,6 +111,14 @@ def _float_ptr(a):
     return a.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
 
 
+#: Worlds (with their contexts) that a finaliser could neither destroy nor wait for: dropped with
+#: an asynchronous step in flight that may need Python code to finish (World.__del__). Never freed.
+_LEAKED = []
+
+# The ContextDef fields whose callbacks may run on the threads of a world's asynchronous step.
+_STEP_THREAD_HOOKS = ("enqueue_task", "finish_task", "alloc_fn", "free_fn")
+
+
 # ---- context --------------------------------------------------------------------------------------
 class Context:
     """A backend (the CPU, or one CUDA device) that worlds are created on (sph_context).
@@ -147,6 +155,9 @@ class Context:
         # cannot drop them).
         self._definition = definition
         self._definition_refs = dict(getattr(definition, "_objects", None) or {}) if definition is not None else {}
+        # Whether an asynchronous step may call back into the caller's code (World.__del__).
+        self._step_hooks = definition is not None and any(
+            ctypes.cast(getattr(definition, f), ctypes.c_void_p).value for f in _STEP_THREAD_HOOKS)
         if backend is not None:
             d.backend = _g.Backend[backend.upper()] if isinstance(backend, str) else _g.Backend(backend)
         if device_ordinal is not None:
@@ -234,10 +245,12 @@ class Context:
             for child in children:
                 child.close()
             if getattr(self, "_leaked_worlds", 0):
-                # A distributed world dropped without close() is on it (sph.mpi): destroying the
-                # context would destroy that world, a collective call this rank alone would make.
-                warnings.warn(f"sph.Context: {self._leaked_worlds} distributed world(s) on it were dropped without "
-                              "close(); the context is leaked with them", ResourceWarning, stacklevel=2)
+                # A world the garbage collector leaked is on it: a distributed world dropped
+                # without close() (sph.mpi; destroying the context would destroy that world, a
+                # collective call this rank alone would make), or one dropped with an
+                # asynchronous step in flight that it could not wait for (World.__del__).
+                warnings.warn(f"sph.Context: {self._leaked_worlds} world(s) on it were dropped without close() and "
+                              "leaked; the context is leaked with them", ResourceWarning, stacklevel=2)
             else:
                 check(library().sph_context_destroy(self._ptr), "sph_context_destroy")
             self._ptr = None
@@ -314,8 +327,12 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
     def closed(self):
         return self._ptr is None
 
+    _step_in_flight = False  # between a step_begin() that succeeded and the step_wait() that collected it
+
     def close(self):
-        """Destroys the world and everything in it (sph_world_destroy). Idempotent."""
+        """Destroys the world and everything in it (sph_world_destroy). Idempotent. While a step
+        that step_begin() started is in flight it raises SphError(WORLD_LOCKED) and the world
+        stays open: step_wait(), then close()."""
         if self._ptr is not None:
             check(library().sph_world_destroy(self._ptr), "sph_world_destroy")
             self._ptr = None
@@ -327,12 +344,46 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
         self.close()
 
     def __del__(self):
+        """A world dropped without close() is destroyed here. One with an asynchronous step in
+        flight is first collected: the step is cancelled (it stops at its next substep
+        boundary) and waited for, so that dropping it, then closing its context, works. Except
+        when the context has task-system or allocator hooks (ContextDef.enqueue_task, alloc_fn,
+        ...) and the step has not finished: the step may need this very thread (or Python code
+        the interpreter can no longer run) to finish, so the world is leaked with its context,
+        never destroyed, with a ResourceWarning; the context's close() then warns instead of
+        destroying it. step_wait() and close() before dropping a world avoid both."""
         try:
-            if getattr(self, "_ptr", None) is not None:
-                library().sph_world_destroy(self._ptr)
-                self._ptr = None
-        except Exception:  # noqa: BLE001
+            ptr = getattr(self, "_ptr", None)
+            if ptr is None:
+                return
+            lib = library()
+            if self._step_in_flight and not self._collect_step_when_dropped(lib, ptr):
+                return
+            lib.sph_world_destroy(ptr)
+            self._ptr = None
+        except Exception:  # noqa: BLE001 - interpreter shutdown
             pass
+
+    def _collect_step_when_dropped(self, lib, ptr):
+        """__del__'s wait for the step in flight: True once collected, False when leaked."""
+        done = ctypes.c_uint32()
+        polled = lib.sph_world_step_poll(ptr, ctypes.byref(done))
+        if polled == _g.Result.OK and not done.value and getattr(self.context, "_step_hooks", True):
+            _LEAKED.append((ptr, self.context))
+            self._ptr = None
+            self.context._leaked_worlds = getattr(self.context, "_leaked_worlds", 0) + 1
+            try:
+                warnings.warn("sph.World dropped with an asynchronous step in flight on a context with task-system or "
+                              "allocator hooks: leaked with its context (the step may need this thread to finish); "
+                              "step_wait() and close() it first", ResourceWarning, stacklevel=2)
+            except Exception:  # noqa: BLE001 - warnings turned into errors: nothing may leave __del__
+                pass
+            return False
+        if polled == _g.Result.OK and not done.value:
+            lib.sph_world_cancel_step(ptr)  # its frame is dropped with it: stop at the next substep
+        lib.sph_world_step_wait(ptr)
+        self._step_in_flight = False
+        return True
 
     def __repr__(self):
         if self._ptr is None:
@@ -443,11 +494,15 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
         (sph_world_step_begin). Until step_wait() collects it every other call on the world
         raises SphError(WORLD_LOCKED), except cancel_step() and step_done()."""
         check(library().sph_world_step_begin(self.handle, float(frame_dt)), "sph_world_step_begin")
+        self._step_in_flight = True
 
     def step_wait(self):
         """Waits for the frame step_begin() started and returns what step() would have
         returned (Result.OK or Result.INCOMPLETE), or raises its error (sph_world_step_wait)."""
-        return check(library().sph_world_step_wait(self.handle), "sph_world_step_wait")
+        result = library().sph_world_step_wait(self.handle)
+        if result != _g.Result.ERROR_WORLD_LOCKED:  # collected (its result or its error)
+            self._step_in_flight = False
+        return check(result, "sph_world_step_wait")
 
     def step_done(self):
         """True once the frame step_begin() started has ended, so step_wait() will not block

@@ -1,11 +1,13 @@
 # SPDX-License-Identifier: MIT
 """Worlds: defs, params, spawning from numpy, fills, stepping, reading back, stats, errors."""
 import ctypes
+import gc
 
 import numpy as np
 import pytest
 
 import sph
+from sph import _generated as _g
 
 
 def raw(name, *args):
@@ -333,6 +335,86 @@ def test_asynchronous_step_matches_step(ctx):
             b.step_done()
         with pytest.raises(sph.SphError, match="frame_dt"):
             b.step_begin(float("nan"))
+
+
+def test_close_with_a_step_in_flight_keeps_the_world():
+    with sph.Context("cpu", cpu_worker_count=1) as c:
+        w = c.world(capacity=4096, particle_spacing=0.02)
+        w.fill_box((0.0, 0.0, 0.0), (0.16, 0.16, 0.16))
+        w.step_begin(1.0 / 60.0)
+        assert error(w.close) == sph.Result.ERROR_WORLD_LOCKED
+        assert not w.closed
+        assert w.step_wait() == sph.Result.OK
+        w.close()
+        assert w.closed
+
+
+def test_dropping_a_world_with_a_step_in_flight_waits_for_it():
+    """__del__ cancels and collects the step, then destroys the world: its context closes."""
+    before = sph.live_object_count()
+    c = sph.Context("cpu", cpu_worker_count=1)
+    w = c.world(capacity=20000, particle_spacing=0.01)
+    w.fill_box((0.0, 0.0, 0.0), (0.2, 0.2, 0.2))
+    w.step_begin(1.0)
+    assert sph.live_object_count() == before + 2
+    del w
+    gc.collect()
+    assert sph.live_object_count() == before + 1, "the world was destroyed"
+    c.close()
+    assert sph.live_object_count() == before
+
+
+class _HeldTasks:
+    """A task system (ContextDef.enqueue_task/finish_task) that runs each task when enqueued,
+    except while `hold` is set: then it runs it in finish_task."""
+
+    def __init__(self):
+        self.hold = False
+        self.held = {}
+        self.enqueue = _g.sph_enqueue_task_fn(self._enqueue)
+        self.finish = _g.sph_finish_task_fn(self._finish)
+
+    def _enqueue(self, task, item_count, _min_range, task_context, _user):
+        if not self.hold:
+            task(0, item_count, 0, task_context)
+            return None
+        handle = len(self.held) + 1
+        self.held[handle] = (task, item_count, task_context)
+        return handle
+
+    def _finish(self, handle, _user):
+        task, item_count, task_context = self.held.pop(handle)
+        task(0, item_count, 0, task_context)
+
+
+def test_dropping_a_world_whose_step_needs_python_leaks_it():
+    """With Python task-system hooks, an unfinished step may need Python code to end: the
+    finaliser leaks the world and its context (a ResourceWarning) instead of waiting forever."""
+    from sph import _core
+
+    tasks = _HeldTasks()
+    before = sph.live_object_count()
+    c = sph.Context("cpu", definition=sph.ContextDef(enqueue_task=tasks.enqueue, finish_task=tasks.finish))
+    w = c.world(capacity=4096, particle_spacing=0.02)
+    w.fill_box((0.0, 0.0, 0.0), (0.1, 0.1, 0.1))
+    tasks.hold = True
+    w.step_begin(1.0 / 60.0)
+    tasks.hold = False
+    assert not w.step_done(), "the step waits for its task"
+    with pytest.warns(ResourceWarning, match="asynchronous step in flight"):
+        del w
+        gc.collect()
+    ptr, context = _core._LEAKED[-1]
+    assert context is c and sph.live_object_count() == before + 2
+    context_ptr = c.handle
+    with pytest.warns(ResourceWarning, match="leaked"):
+        c.close()
+    # Clean up by hand: the step runs in finish_task, then the world and the context go.
+    assert sph.library().sph_world_step_wait(ptr) == sph.Result.OK
+    assert sph.library().sph_world_destroy(ptr) == sph.Result.OK
+    assert sph.library().sph_context_destroy(context_ptr) == sph.Result.OK
+    _core._LEAKED.pop()
+    assert sph.live_object_count() == before
 
 
 # ---- writing particles -------------------------------------------------------------------------
