@@ -211,6 +211,8 @@ class Context:
         check(library().sph_cuda_context_set_allocator(self.handle, ctypes.byref(a)),
               "sph_cuda_context_set_allocator")
         self._cuda_allocator = (alloc_fn, free_fn, user_context, a)  # the library keeps calling them
+        if alloc_fn is not None:
+            self._step_hooks = True  # also from an asynchronous step's thread (World.__del__)
 
     def world(self, definition=None, **fields):
         """A new World on this context; see World."""
@@ -348,10 +350,11 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
         flight is first collected: the step is cancelled (it stops at its next substep
         boundary) and waited for, so that dropping it, then closing its context, works. Except
         when the context has task-system or allocator hooks (ContextDef.enqueue_task, alloc_fn,
-        ...) and the step has not finished: the step may need this very thread (or Python code
-        the interpreter can no longer run) to finish, so the world is leaked with its context,
-        never destroyed, with a ResourceWarning; the context's close() then warns instead of
-        destroying it. step_wait() and close() before dropping a world avoid both."""
+        ..., or set_cuda_allocator's) and the step has not finished: the step may need this
+        very thread (or Python code the interpreter can no longer run) to finish, so the world
+        is leaked with its context, never destroyed, with a ResourceWarning; the context's
+        close() then warns instead of destroying it. step_wait() and close() before dropping a
+        world avoid both."""
         try:
             ptr = getattr(self, "_ptr", None)
             if ptr is None:
