@@ -1250,6 +1250,28 @@ static class Tests
         }
     }
 
+    // ---- documentation ------------------------------------------------------------------------
+
+    static string DocBefore(string source, string declaration)
+    {
+        int at = source.IndexOf(declaration);
+        Assert(at >= 0, "Sph.cs declares " + declaration);
+        int start = source.LastIndexOf("<summary>", at);
+        return source.Substring(start, at - start);
+    }
+
+    /// What the summaries say the library does is what sph_c.h says it does.
+    public static void TestSummariesFollowTheHeader()
+    {
+        string wrapper = File.ReadAllText(Path.Combine(SourceDir, "Sph.cs"));
+        string step = DocBefore(wrapper, "public Result Step(float frameDt)");
+        Assert(step.Contains("StepBudget") && step.Contains("CancelStep"), "Incomplete: max_substeps, the budget or a cancel");
+        Assert(DocBefore(wrapper, "public WorldDef Def").Contains("current capacity"), "Def reads the current capacity");
+        Assert(DocBefore(wrapper, "public delegate void LogHandler").Contains("Warning"), "the log handler gets warnings");
+        Assert(!DocBefore(wrapper, "SurfaceTension = Constants").Contains("EXPERIMENTAL"), "surface tension is calibrated");
+        Assert(DocBefore(wrapper, "NormalizedDensity = Constants").Contains("density factor"), "normalised density");
+    }
+
     // ---- coverage ---------------------------------------------------------------------------
 
     /// Every exported function is called by the idiomatic layer (Sph.cs) or is the sized init

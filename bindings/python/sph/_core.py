@@ -396,7 +396,9 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
     # -- creation-time facts
     @property
     def definition(self):
-        """The WorldDef the world was created with, defaults resolved (sph_world_get_def)."""
+        """The WorldDef the world was created with, defaults resolved (sph_world_get_def),
+        except capacity: the world's current capacity, larger than the def's once the world
+        grew (never more than max_capacity)."""
         d = _g.WorldDef()
         check(library().sph_world_get_def(self.handle, ctypes.byref(d)), "sph_world_get_def")
         return d
@@ -474,9 +476,11 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
     def step(self, frame_dt):
         """Advances the world by frame_dt seconds in adaptive substeps (sph_world_step; blocks).
 
-        Returns Result.OK, or Result.INCOMPLETE when max_substeps ran out first
-        (stats().frame_time says how far it got). Raises SphError(NON_FINITE) if a substep
-        produced NaN/Inf; the world is then as it was before the call.
+        Returns Result.OK, or Result.INCOMPLETE when max_substeps ran out first, or the step
+        budget (step_budget) or a cancel (cancel_step()) stopped it: the world is then as after
+        its last whole substep, ready to step again (stats().frame_time and substeps say how far
+        it got). Raises SphError(NON_FINITE) if a substep produced NaN/Inf, SphError(CAPACITY)
+        if too many particles piled into one cell; the world is then as it was before the call.
         """
         return check(library().sph_world_step(self.handle, float(frame_dt)), "sph_world_step")
 

@@ -417,6 +417,16 @@ def test_dropping_a_world_whose_step_needs_python_leaks_it():
     assert sph.live_object_count() == before
 
 
+def test_docstrings_follow_the_header():
+    """What the docstrings say the library does is what sph_c.h says it does."""
+    step = sph.World.step.__doc__
+    assert "budget" in step and "cancel" in step, "INCOMPLETE: max_substeps, the step budget or a cancel"
+    assert "current capacity" in sph.World.definition.__doc__, "sph_world_get_def reads the current capacity"
+    assert "WARNING" in sph.Context.__doc__, "the log callback also gets warnings"
+    assert "EXPERIMENTAL" not in sph.Feature.__doc__ and "second" not in sph.Feature.__doc__
+    assert "density factor" in sph.Feature.__doc__
+
+
 # ---- writing particles -------------------------------------------------------------------------
 def test_set_attributes_read_back_bitwise(ctx):
     with ctx.world(capacity=2048, features="user_attribute") as w:
