@@ -353,15 +353,23 @@ class Gen:
                 "            if (added) parent = owner;",
                 "        }", "",
                 "        partial void OnReleased();", "",
-                "        protected override bool ReleaseHandle()", "        {"]
+                "        // Sets keep to leave the object alive and unreleased (WorldHandle: an asynchronous",
+                "        // step holds the world).",
+                "        partial void OnReleasing(ref bool keep);", "",
+                "        // A SafeHandle is closed whatever this returns: when the object must live on (kept, or",
+                "        // its destroy refused), it is leaked with its parent reference, never freed under a",
+                "        // call that still uses it.",
+                "        protected override bool ReleaseHandle()", "        {",
+                "            bool keep = false;",
+                "            OnReleasing(ref keep);",
+                "            if (keep) return false;"]
         if destroy:
-            out.append(f"            Result result = Native.{destroy}(handle);")
-        else:
-            out.append("            Result result = Result.Ok;")
+            out += [f"            Result result = Native.{destroy}(handle);",
+                    "            if ((int)result < 0) return false;"]
         out += ["            OnReleased();",
                 "            if (parent != null)", "            {", "                parent.DangerousRelease();",
                 "                parent = null;", "            }",
-                "            return (int)result >= 0;", "        }", "    }", ""]
+                "            return true;", "        }", "    }", ""]
         return out
 
     def native(self) -> list[str]:

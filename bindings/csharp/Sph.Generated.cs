@@ -2327,16 +2327,27 @@ namespace Sph
 
         partial void OnReleased();
 
+        // Sets keep to leave the object alive and unreleased (WorldHandle: an asynchronous
+        // step holds the world).
+        partial void OnReleasing(ref bool keep);
+
+        // A SafeHandle is closed whatever this returns: when the object must live on (kept, or
+        // its destroy refused), it is leaked with its parent reference, never freed under a
+        // call that still uses it.
         protected override bool ReleaseHandle()
         {
+            bool keep = false;
+            OnReleasing(ref keep);
+            if (keep) return false;
             Result result = Native.sph_context_destroy(handle);
+            if ((int)result < 0) return false;
             OnReleased();
             if (parent != null)
             {
                 parent.DangerousRelease();
                 parent = null;
             }
-            return (int)result >= 0;
+            return true;
         }
     }
 
@@ -2359,16 +2370,27 @@ namespace Sph
 
         partial void OnReleased();
 
+        // Sets keep to leave the object alive and unreleased (WorldHandle: an asynchronous
+        // step holds the world).
+        partial void OnReleasing(ref bool keep);
+
+        // A SafeHandle is closed whatever this returns: when the object must live on (kept, or
+        // its destroy refused), it is leaked with its parent reference, never freed under a
+        // call that still uses it.
         protected override bool ReleaseHandle()
         {
+            bool keep = false;
+            OnReleasing(ref keep);
+            if (keep) return false;
             Result result = Native.sph_world_destroy(handle);
+            if ((int)result < 0) return false;
             OnReleased();
             if (parent != null)
             {
                 parent.DangerousRelease();
                 parent = null;
             }
-            return (int)result >= 0;
+            return true;
         }
     }
 
@@ -2391,16 +2413,27 @@ namespace Sph
 
         partial void OnReleased();
 
+        // Sets keep to leave the object alive and unreleased (WorldHandle: an asynchronous
+        // step holds the world).
+        partial void OnReleasing(ref bool keep);
+
+        // A SafeHandle is closed whatever this returns: when the object must live on (kept, or
+        // its destroy refused), it is leaked with its parent reference, never freed under a
+        // call that still uses it.
         protected override bool ReleaseHandle()
         {
+            bool keep = false;
+            OnReleasing(ref keep);
+            if (keep) return false;
             Result result = Native.sph_sdf_destroy(handle);
+            if ((int)result < 0) return false;
             OnReleased();
             if (parent != null)
             {
                 parent.DangerousRelease();
                 parent = null;
             }
-            return (int)result >= 0;
+            return true;
         }
     }
 

@@ -219,11 +219,16 @@ namespace Sph
     public enum FeatureFlags : uint
     {
         None = Constants.SPH_FEATURE_NONE,
-        /// <summary>Surface tension from the colour field (Morris 2000), parameters in
-        /// <see cref="World.SurfaceTensionParams"/>. EXPERIMENTAL (docs/physics.md).</summary>
+        /// <summary>Surface tension: the Morris colour field (thesis eq. 20-23) applied as a
+        /// capillary stress, plus a short-range cohesion (Akinci et al. 2013) carrying 15 % of
+        /// sigma, calibrated so that sigma is the physical N/m (Laplace pressures within 6 %, the
+        /// mode-2 Rayleigh period within 5 % at 10 particles per radius; needs about 6 or more),
+        /// parameters in <see cref="World.SurfaceTensionParams"/> (docs/physics.md).</summary>
         SurfaceTension = Constants.SPH_FEATURE_SURFACE_TENSION,
-        /// <summary>Normalised density (thesis eq. 31): a second, Shepard-filtered density pass
-        /// that narrows the density deficit of particles near a free surface.</summary>
+        /// <summary>Normalised density (thesis eq. 31): every particle carries a density factor
+        /// (4 B of state, sorted, rolled back and checkpointed) so that particles at a free surface
+        /// or a collider wall read the bulk's density instead of up to half of it; eq. 31
+        /// re-normalises the carried densities on every density pass (one more gather).</summary>
         NormalizedDensity = Constants.SPH_FEATURE_NORMALIZED_DENSITY,
         /// <summary>Elasticity and plasticity: springs between neighbours made at each particle's
         /// first substep (Clavet et al. 2005), parameters in <see cref="World.SpringParams"/>.</summary>
@@ -280,7 +285,9 @@ namespace Sph
         }
     }
 
-    /// <summary>Called when a call on a context (or its worlds) fails; on the calling thread.</summary>
+    /// <summary>Called on the thread inside a call on a context (or its worlds): when the call
+    /// fails (LogLevel.Error with its code), and for a warning from a call that succeeds
+    /// (LogLevel.Warning with Result.Ok; docs/api.md).</summary>
     public delegate void LogHandler(LogLevel level, Result code, string message);
 
     public sealed partial class ContextHandle
@@ -413,6 +420,22 @@ namespace Sph
         }
     }
 
+    public sealed partial class WorldHandle
+    {
+        // Between a StepBegin that succeeded and the StepWait that collected it: the library
+        // refuses to destroy the world meanwhile (WORLD_LOCKED), so neither Dispose nor the
+        // finaliser tries.
+        internal volatile bool StepInFlight;
+
+        // The finaliser of a world dropped with a step in flight leaks it (and keeps its
+        // context): waiting there could block the finaliser thread for a whole frame, and freeing
+        // it under the step is not possible.
+        partial void OnReleasing(ref bool keep)
+        {
+            if (StepInFlight) keep = true;
+        }
+    }
+
     /// <summary>A particle fluid on a context (sph_world). Not thread-safe: use one thread at a time.
     /// Not sealed for one subclass: DistributedWorld (SphMpi.cs), a world over MPI ranks.</summary>
     public class World : IDisposable
@@ -439,8 +462,16 @@ namespace Sph
 
         public bool IsDisposed { get; private set; }
 
+        /// <summary>Destroys the world (sph_world_destroy). While a step that StepBegin started
+        /// is in flight it throws SphException(ErrorWorldLocked) and the world stays open:
+        /// StepWait, then Dispose again. A world dropped without Dispose is destroyed by its
+        /// handle's finaliser, except with a step in flight: that world (and its context) is
+        /// leaked, never destroyed or waited for on the finaliser thread.</summary>
         public void Dispose()
         {
+            if (Handle.StepInFlight)
+                throw new SphException(Result.ErrorWorldLocked, "sph_world_destroy",
+                    "a step that StepBegin started is in flight: StepWait first");
             IsDisposed = true;
             Handle.Dispose();
         }
@@ -490,7 +521,9 @@ namespace Sph
             }
         }
 
-        /// <summary>The def the world was created with, defaults resolved.</summary>
+        /// <summary>The def the world was created with, defaults resolved, except Capacity: the
+        /// world's current capacity, larger than the def's once the world grew (never more than
+        /// MaxCapacity).</summary>
         public WorldDef Def
         {
             get
@@ -749,7 +782,10 @@ namespace Sph
         // ---- stepping -------------------------------------------------------------------------
 
         /// <summary>Advances by frameDt seconds (blocks). Returns Ok, or Incomplete when
-        /// max_substeps ran out; throws SphException (e.g. ErrorNonFinite, world rolled back).</summary>
+        /// max_substeps ran out, or the step budget (<see cref="StepBudget"/>) or a cancel
+        /// (<see cref="CancelStep"/>) stopped it: the world is then as after its last whole
+        /// substep, ready to step again. Throws SphException (e.g. ErrorNonFinite, ErrorCapacity:
+        /// the world rolled back to before the call).</summary>
         public Result Step(float frameDt)
         {
             return SphException.Check(Native.sph_world_step(Handle, frameDt), "sph_world_step");
@@ -774,13 +810,17 @@ namespace Sph
         public void StepBegin(float frameDt)
         {
             SphException.Check(Native.sph_world_step_begin(Handle, frameDt), "sph_world_step_begin");
+            Handle.StepInFlight = true;
         }
 
         /// <summary>Waits for the frame StepBegin started and returns what Step would have returned
         /// (Ok or Incomplete), or throws its error (sph_world_step_wait).</summary>
         public Result StepWait()
         {
-            return SphException.Check(Native.sph_world_step_wait(Handle), "sph_world_step_wait");
+            Result r = Native.sph_world_step_wait(Handle);
+            // Collected (its result or its error), unless another call held the world.
+            if (r != Result.ErrorWorldLocked) Handle.StepInFlight = false;
+            return SphException.Check(r, "sph_world_step_wait");
         }
 
         /// <summary>True once the frame StepBegin started has ended, so StepWait will not block
@@ -970,9 +1010,11 @@ namespace Sph
         }
 
         /// <summary>Adds a sink: with a region (SinkMode.Region) or, region null, the def's
-        /// bounds (SinkMode.OutsideBounds).</summary>
+        /// bounds (SinkMode.OutsideBounds: a def left at Region is switched to it, as Python's
+        /// add_sink(bounds=...) does).</summary>
         public Sink CreateSink(Sdf region, SinkDef def)
         {
+            if (region == null && def.Mode == SinkMode.Region) def.Mode = SinkMode.OutsideBounds;
             SinkId id;
             using (var borrowed = new Borrowed(region != null ? region.Handle : null))
             {

@@ -186,6 +186,75 @@ static class Tests
         }
     }
 
+    public static void TestDisposeWhileAStepIsInFlight()
+    {
+        uint before = Library.LiveObjectCount;
+        using (var ctx = Cpu())
+        {
+            var world = ctx.CreateWorld(SmallWorld());
+            world.FillSphere(new Vec3(0, 0, 0), 0.05f);
+            world.StepBegin(0.01f);
+            // The library refuses to destroy a world its step holds: Dispose says so and keeps it.
+            Throws(Result.ErrorWorldLocked, () => world.Dispose());
+            Assert(!world.IsDisposed && !world.Handle.IsClosed, "the world stays open");
+            world.CancelStep();
+            Result r = world.StepWait();
+            Assert(r == Result.Ok || r == Result.Incomplete, "the step is collected after the refused Dispose: " + r);
+            AssertEqual(before + 2, Library.LiveObjectCount, "context and world alive");
+            world.Dispose();
+            Assert(world.IsDisposed && world.Handle.IsClosed, "disposed after StepWait");
+        }
+        AssertEqual(before, Library.LiveObjectCount, "both released");
+    }
+
+    // On a thread of its own, so that no stack slot keeps the world reachable (mono scans
+    // stacks conservatively).
+    static WeakReference DropWorldWithAStepInFlight(Context ctx, out IntPtr raw)
+    {
+        WeakReference handle = null;
+        IntPtr pointer = IntPtr.Zero;
+        var thread = new System.Threading.Thread(() =>
+        {
+            var world = ctx.CreateWorld(SmallWorld());
+            world.FillSphere(new Vec3(0, 0, 0), 0.05f);
+            world.StepBegin(0.01f);
+            pointer = world.Handle.DangerousGetHandle();
+            handle = new WeakReference(world.Handle);
+        });
+        thread.Start();
+        thread.Join();
+        raw = pointer;
+        return handle;
+    }
+
+    public static void TestFinalizerLeaksAWorldWithAStepInFlight()
+    {
+        int calls = 0;
+        var def = ContextDef.Default();
+        def.Backend = Backend.Cpu;
+        def.CpuWorkerCount = 1;
+        var ctx = new Context(def, (l, c, m) => ++calls);
+        uint live = Library.LiveObjectCount;
+        IntPtr raw;
+        WeakReference handle = DropWorldWithAStepInFlight(ctx, out raw);
+        ctx.Dispose();  // the world holds the native context
+        for (int i = 0; i < 10 && handle.IsAlive; ++i)
+        {
+            GC.Collect();
+            GC.WaitForPendingFinalizers();
+        }
+        Assert(!handle.IsAlive, "the dropped world's handle was finalised");
+        // The finaliser neither destroyed the world nor released its context (whose log handler
+        // is still there): the step is collected through the raw pointer.
+        AssertEqual(live + 1, Library.LiveObjectCount, "world and context leaked, not destroyed");
+        Result r = Native.sph_world_step_wait(raw);
+        Assert(r == Result.Ok || r == Result.Incomplete, "the leaked world's step collected: " + r);
+        AssertEqual(Result.ErrorInvalidArgument, Native.sph_world_step(raw, -1f), "a failing call on the leaked world");
+        AssertEqual(1, calls, "the context's log handler still runs");
+        AssertEqual(Result.Ok, Native.sph_world_destroy(raw), "the leaked world destroyed by hand");
+        AssertEqual(live, Library.LiveObjectCount, "the world is gone (its context stays leaked)");
+    }
+
     // ---- worlds -----------------------------------------------------------------------------
 
     public static void TestWorldDefAndMass()
@@ -1084,7 +1153,24 @@ static class Tests
                 Assert(events.Length == 1 && events[0].Type == EventType.SinkRemoved && events[0].Count == removed.Length &&
                        events[0].ObjectBits == sink.Id.Bits, "sink event");
             }
-            Throws(Result.ErrorInvalidArgument, () => world.CreateSink(null, SinkDef.Default()));
+            // Region null: the def's bounds, without setting Mode (CreateSink's summary).
+            var boundsOnly = SinkDef.Default();
+            boundsOnly.BoundsMin = new Vec3(-0.02f, -0.02f, -0.02f);
+            boundsOnly.BoundsMax = new Vec3(0.02f, 0.02f, 0.02f);
+            uint before = world.ParticleCount;
+            using (var sink = world.CreateSink(null, boundsOnly))
+            {
+                world.Step(1f / 240f);
+                uint removed = (uint)world.GetRemovedIds().Length;
+                Assert(removed > 0, "particles outside the bounds-only sink's box removed");
+                AssertEqual(before - removed, world.ParticleCount, "count after the bounds-only sink");
+            }
+            var inverted = SinkDef.Default();
+            inverted.BoundsMin = new Vec3(1, 1, 1);
+            Throws(Result.ErrorInvalidArgument, () => world.CreateSink(null, inverted));
+            var noRegion = SinkDef.Default();
+            noRegion.Mode = SinkMode.OutsideBounds;
+            using (var sink = world.CreateSink(null, noRegion)) { }
         }
     }
 
@@ -1162,6 +1248,28 @@ static class Tests
                 File.Delete(garbage);
             }
         }
+    }
+
+    // ---- documentation ------------------------------------------------------------------------
+
+    static string DocBefore(string source, string declaration)
+    {
+        int at = source.IndexOf(declaration);
+        Assert(at >= 0, "Sph.cs declares " + declaration);
+        int start = source.LastIndexOf("<summary>", at);
+        return source.Substring(start, at - start);
+    }
+
+    /// What the summaries say the library does is what sph_c.h says it does.
+    public static void TestSummariesFollowTheHeader()
+    {
+        string wrapper = File.ReadAllText(Path.Combine(SourceDir, "Sph.cs"));
+        string step = DocBefore(wrapper, "public Result Step(float frameDt)");
+        Assert(step.Contains("StepBudget") && step.Contains("CancelStep"), "Incomplete: max_substeps, the budget or a cancel");
+        Assert(DocBefore(wrapper, "public WorldDef Def").Contains("current capacity"), "Def reads the current capacity");
+        Assert(DocBefore(wrapper, "public delegate void LogHandler").Contains("Warning"), "the log handler gets warnings");
+        Assert(!DocBefore(wrapper, "SurfaceTension = Constants").Contains("EXPERIMENTAL"), "surface tension is calibrated");
+        Assert(DocBefore(wrapper, "NormalizedDensity = Constants").Contains("density factor"), "normalised density");
     }
 
     // ---- coverage ---------------------------------------------------------------------------

@@ -13,7 +13,7 @@ from ._checkpoint import WorldCheckpointMixin, load_world, load_world_file
 from ._cuda import WorldCudaMixin
 from ._errors import SphError, check
 from ._loader import library
-from ._options import WorldOptionsMixin
+from ._options import WorldOptionsMixin, _as_struct
 from ._scene import Sdf, WorldSceneMixin
 from ._struct import check_int
 
@@ -83,8 +83,40 @@ def _vec3_rows(values, what):
     return a
 
 
+def _integers(values, a, dtype, what):
+    """`values` (already the 1-D array `a`) as `dtype`, an integer dtype, refusing what a cast
+    would change: TypeError for values that are not integers (floats, strings; booleans pass as
+    0 and 1), ValueError for integers outside the dtype's range. numpy's own cast wraps
+    (2**32 + 5 -> 5, -1 -> 4294967295) and truncates (1.9 -> 1) silently."""
+    if len(a) == 0:
+        return np.empty(0, dtype)
+    if a.dtype.kind not in "uib" and not isinstance(values, np.ndarray):
+        a = np.asarray(values, dtype=object)  # a list mixing numpy and Python ints
+    if a.dtype.kind == "O":
+        if not all(isinstance(v, (int, np.integer)) for v in a.tolist()):
+            kinds = sorted({type(v).__name__ for v in a.tolist() if not isinstance(v, (int, np.integer))})
+            raise TypeError(f"{what}: expected integers ({dtype}), got {', '.join(kinds)}")
+        a = np.array([int(v) for v in a.tolist()], dtype=object)
+    elif a.dtype.kind not in "uib":
+        raise TypeError(f"{what}: expected integers ({dtype}), got an array of {a.dtype}")
+    lo, hi = int(a.min()), int(a.max())
+    info = np.iinfo(dtype)
+    if lo < info.min or hi > info.max:
+        bad = lo if lo < info.min else hi
+        raise ValueError(f"{what}: {bad} does not fit {dtype} ({info.min}..{info.max})")
+    return a.astype(dtype)
+
+
 def _float_ptr(a):
     return a.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
+
+
+#: Worlds (with their contexts) that a finaliser could neither destroy nor wait for: dropped with
+#: an asynchronous step in flight that may need Python code to finish (World.__del__). Never freed.
+_LEAKED = []
+
+# The ContextDef fields whose callbacks may run on the threads of a world's asynchronous step.
+_STEP_THREAD_HOOKS = ("enqueue_task", "finish_task", "alloc_fn", "free_fn")
 
 
 # ---- context --------------------------------------------------------------------------------------
@@ -101,14 +133,31 @@ class Context:
         device_ordinal: CUDA device (default -1 = device 0).
         cpu_worker_count: CPU backend threads (default 0 = all hardware threads).
         log: optional callable(level: LogLevel, code: Result, message: str), called on the
-            calling thread when a call on this context or its worlds fails. Exceptions it
-            raises are printed and swallowed (they cannot cross the C library).
-        definition: a ContextDef to start from instead of the defaults.
+            calling thread, inside a call on this context or its worlds: when the call fails
+            (LogLevel.ERROR with its code), and for a warning from a call that succeeds
+            (LogLevel.WARNING with Result.OK, e.g. add_collider's coarse-SDF warning in a world
+            with Feature.BOUNDARY_DENSITY; docs/api.md). Exceptions it raises are printed and
+            swallowed (they cannot cross the C library).
+        definition: a ContextDef to start from instead of the defaults. Its callbacks
+            (alloc_fn/free_fn, enqueue_task/finish_task, log_fn) and what its user_data /
+            user_context fields point into must outlive the context: the context keeps the
+            ContextDef and the ctypes objects assigned to its fields.
     """
 
     def __init__(self, backend=None, *, device_ordinal=None, cpu_worker_count=None, log=None, definition=None):
         lib = library()
         d = definition.copy() if definition is not None else _g.ContextDef()
+        # The copy has the definition's function pointers but not ctypes' references to the
+        # Python objects behind them (log_fn, enqueue_task, finish_task, alloc_fn, free_fn: their
+        # thunks) or to what its user_data / user_context fields point into (the struct's
+        # _objects). The library calls them for the context's whole life, so the context keeps
+        # the definition and a snapshot of those references (a later change to the definition
+        # cannot drop them).
+        self._definition = definition
+        self._definition_refs = dict(getattr(definition, "_objects", None) or {}) if definition is not None else {}
+        # Whether an asynchronous step may call back into the caller's code (World.__del__).
+        self._step_hooks = definition is not None and any(
+            ctypes.cast(getattr(definition, f), ctypes.c_void_p).value for f in _STEP_THREAD_HOOKS)
         if backend is not None:
             d.backend = _g.Backend[backend.upper()] if isinstance(backend, str) else _g.Backend(backend)
         if device_ordinal is not None:
@@ -161,7 +210,9 @@ class Context:
             a.user_context = user_context
         check(library().sph_cuda_context_set_allocator(self.handle, ctypes.byref(a)),
               "sph_cuda_context_set_allocator")
-        self._cuda_allocator = (alloc_fn, free_fn)  # the library keeps calling them
+        self._cuda_allocator = (alloc_fn, free_fn, user_context, a)  # the library keeps calling them
+        if alloc_fn is not None:
+            self._step_hooks = True  # also from an asynchronous step's thread (World.__del__)
 
     def world(self, definition=None, **fields):
         """A new World on this context; see World."""
@@ -196,10 +247,12 @@ class Context:
             for child in children:
                 child.close()
             if getattr(self, "_leaked_worlds", 0):
-                # A distributed world dropped without close() is on it (sph.mpi): destroying the
-                # context would destroy that world, a collective call this rank alone would make.
-                warnings.warn(f"sph.Context: {self._leaked_worlds} distributed world(s) on it were dropped without "
-                              "close(); the context is leaked with them", ResourceWarning, stacklevel=2)
+                # A world the garbage collector leaked is on it: a distributed world dropped
+                # without close() (sph.mpi; destroying the context would destroy that world, a
+                # collective call this rank alone would make), or one dropped with an
+                # asynchronous step in flight that it could not wait for (World.__del__).
+                warnings.warn(f"sph.Context: {self._leaked_worlds} world(s) on it were dropped without close() and "
+                              "leaked; the context is leaked with them", ResourceWarning, stacklevel=2)
             else:
                 check(library().sph_context_destroy(self._ptr), "sph_context_destroy")
             self._ptr = None
@@ -276,8 +329,12 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
     def closed(self):
         return self._ptr is None
 
+    _step_in_flight = False  # between a step_begin() that succeeded and the step_wait() that collected it
+
     def close(self):
-        """Destroys the world and everything in it (sph_world_destroy). Idempotent."""
+        """Destroys the world and everything in it (sph_world_destroy). Idempotent. While a step
+        that step_begin() started is in flight it raises SphError(WORLD_LOCKED) and the world
+        stays open: step_wait(), then close()."""
         if self._ptr is not None:
             check(library().sph_world_destroy(self._ptr), "sph_world_destroy")
             self._ptr = None
@@ -289,12 +346,47 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
         self.close()
 
     def __del__(self):
+        """A world dropped without close() is destroyed here. One with an asynchronous step in
+        flight is first collected: the step is cancelled (it stops at its next substep
+        boundary) and waited for, so that dropping it, then closing its context, works. Except
+        when the context has task-system or allocator hooks (ContextDef.enqueue_task, alloc_fn,
+        ..., or set_cuda_allocator's) and the step has not finished: the step may need this
+        very thread (or Python code the interpreter can no longer run) to finish, so the world
+        is leaked with its context, never destroyed, with a ResourceWarning; the context's
+        close() then warns instead of destroying it. step_wait() and close() before dropping a
+        world avoid both."""
         try:
-            if getattr(self, "_ptr", None) is not None:
-                library().sph_world_destroy(self._ptr)
-                self._ptr = None
-        except Exception:  # noqa: BLE001
+            ptr = getattr(self, "_ptr", None)
+            if ptr is None:
+                return
+            lib = library()
+            if self._step_in_flight and not self._collect_step_when_dropped(lib, ptr):
+                return
+            lib.sph_world_destroy(ptr)
+            self._ptr = None
+        except Exception:  # noqa: BLE001 - interpreter shutdown
             pass
+
+    def _collect_step_when_dropped(self, lib, ptr):
+        """__del__'s wait for the step in flight: True once collected, False when leaked."""
+        done = ctypes.c_uint32()
+        polled = lib.sph_world_step_poll(ptr, ctypes.byref(done))
+        if polled == _g.Result.OK and not done.value and getattr(self.context, "_step_hooks", True):
+            _LEAKED.append((ptr, self.context))
+            self._ptr = None
+            self.context._leaked_worlds = getattr(self.context, "_leaked_worlds", 0) + 1
+            try:
+                warnings.warn("sph.World dropped with an asynchronous step in flight on a context with task-system or "
+                              "allocator hooks: leaked with its context (the step may need this thread to finish); "
+                              "step_wait() and close() it first", ResourceWarning, stacklevel=2)
+            except Exception:  # noqa: BLE001 - warnings turned into errors: nothing may leave __del__
+                pass
+            return False
+        if polled == _g.Result.OK and not done.value:
+            lib.sph_world_cancel_step(ptr)  # its frame is dropped with it: stop at the next substep
+        lib.sph_world_step_wait(ptr)
+        self._step_in_flight = False
+        return True
 
     def __repr__(self):
         if self._ptr is None:
@@ -304,7 +396,9 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
     # -- creation-time facts
     @property
     def definition(self):
-        """The WorldDef the world was created with, defaults resolved (sph_world_get_def)."""
+        """The WorldDef the world was created with, defaults resolved (sph_world_get_def),
+        except capacity: the world's current capacity, larger than the def's once the world
+        grew (never more than max_capacity)."""
         d = _g.WorldDef()
         check(library().sph_world_get_def(self.handle, ctypes.byref(d)), "sph_world_get_def")
         return d
@@ -319,15 +413,18 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
     # -- runtime parameters
     @property
     def params(self):
-        """The runtime WorldParams (sph_world_get_params); assign a WorldParams to replace them
-        all at once (sph_world_set_params: validated as a whole, unchanged on error)."""
+        """The runtime WorldParams (sph_world_get_params); assign a WorldParams (or a dict of its
+        fields, the others at their defaults, as the other params setters take) to replace them
+        all at once (sph_world_set_params: validated as a whole, unchanged on error).
+        set_params(**fields) changes some and keeps the others."""
         p = _g.WorldParams()
         check(library().sph_world_get_params(self.handle, ctypes.byref(p)), "sph_world_get_params")
         return p
 
     @params.setter
     def params(self, params):
-        check(library().sph_world_set_params(self.handle, ctypes.byref(params)), "sph_world_set_params")
+        p = _as_struct(_g.WorldParams, params)
+        check(library().sph_world_set_params(self.handle, ctypes.byref(p)), "sph_world_set_params")
 
     def set_params(self, **fields):
         """Changes some runtime parameters, keeping the others: ``w.set_params(gravity=(0, 0, 0))``,
@@ -379,9 +476,11 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
     def step(self, frame_dt):
         """Advances the world by frame_dt seconds in adaptive substeps (sph_world_step; blocks).
 
-        Returns Result.OK, or Result.INCOMPLETE when max_substeps ran out first
-        (stats().frame_time says how far it got). Raises SphError(NON_FINITE) if a substep
-        produced NaN/Inf; the world is then as it was before the call.
+        Returns Result.OK, or Result.INCOMPLETE when max_substeps ran out first, or the step
+        budget (step_budget) or a cancel (cancel_step()) stopped it: the world is then as after
+        its last whole substep, ready to step again (stats().frame_time and substeps say how far
+        it got). Raises SphError(NON_FINITE) if a substep produced NaN/Inf, SphError(CAPACITY)
+        if too many particles piled into one cell; the world is then as it was before the call.
         """
         return check(library().sph_world_step(self.handle, float(frame_dt)), "sph_world_step")
 
@@ -402,11 +501,15 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
         (sph_world_step_begin). Until step_wait() collects it every other call on the world
         raises SphError(WORLD_LOCKED), except cancel_step() and step_done()."""
         check(library().sph_world_step_begin(self.handle, float(frame_dt)), "sph_world_step_begin")
+        self._step_in_flight = True
 
     def step_wait(self):
         """Waits for the frame step_begin() started and returns what step() would have
         returned (Result.OK or Result.INCOMPLETE), or raises its error (sph_world_step_wait)."""
-        return check(library().sph_world_step_wait(self.handle), "sph_world_step_wait")
+        result = library().sph_world_step_wait(self.handle)
+        if result != _g.Result.ERROR_WORLD_LOCKED:  # collected (its result or its error)
+            self._step_in_flight = False
+        return check(result, "sph_world_step_wait")
 
     def step_done(self):
         """True once the frame step_begin() started has ended, so step_wait() will not block
@@ -498,7 +601,9 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
     def set_attribute(self, attribute, values, first=0):
         """Overwrites particles [first, first + len(values)) of POSITION, VELOCITY ((n, 3)
         float32) or USER ((n,) uint32) in the world's current order (sph_world_set_attribute:
-        all-or-nothing, every value checked first). Strided numpy rows pass without a copy."""
+        all-or-nothing, every value checked first). Strided numpy rows pass without a copy.
+        USER values must be integers in [0, 2^32): others raise TypeError (floats, strings)
+        or ValueError (out of range) before anything is written, never wrap or truncate."""
         attribute = _g.Attribute(attribute)
         dtype, comps = attribute_format(attribute)
         check_int(ctypes.c_uint32, first, "first")
@@ -508,6 +613,8 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
             a = np.asarray(values)
             if a.ndim != 1:
                 raise ValueError(f"values: expected an array of shape (n,), got {a.shape}")
+            if dtype.kind in "ui" and a.dtype != dtype:
+                a = _integers(values, a, dtype, f"values ({attribute.name})")
             if a.dtype != dtype or a.strides[0] < dtype.itemsize:
                 a = np.ascontiguousarray(a, dtype=dtype)
         elem = comps * dtype.itemsize

@@ -104,3 +104,4 @@ class WorldCudaMixin:
         frame (sph_cuda_world_step_begin_on_stream). Collect it with step_wait()."""
         check(library().sph_cuda_world_step_begin_on_stream(self.handle, float(frame_dt), ctypes.c_void_p(stream)),
               "sph_cuda_world_step_begin_on_stream")
+        self._step_in_flight = True

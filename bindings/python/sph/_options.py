@@ -43,10 +43,15 @@ def _flags(name, prefix, doc):
 
 Feature = _flags("Feature", "SPH_FEATURE_", """World feature bits (SPH_FEATURE_*; WorldDef.features), fixed at creation.
 
-    SURFACE_TENSION: surface tension from the colour field (Morris 2000), parameters in
-    World.surface_tension_params; EXPERIMENTAL (docs/physics.md). NORMALIZED_DENSITY: a second,
-    Shepard-filtered density pass (thesis eq. 31) that narrows the density deficit at a free
-    surface. SPRINGS: elasticity and plasticity, springs between neighbours made at each
+    SURFACE_TENSION: the Morris colour field (thesis eq. 20-23) applied as a capillary stress,
+    plus a short-range cohesion (Akinci et al. 2013) carrying 15 % of sigma, calibrated so that
+    sigma is the physical N/m (Laplace pressures within 6 %, the mode-2 Rayleigh period within
+    5 % at 10 particles per radius; needs about 6 or more), parameters in
+    World.surface_tension_params (docs/physics.md). NORMALIZED_DENSITY (thesis eq. 31): every
+    particle carries a density factor (4 B of state, sorted, rolled back and checkpointed) so
+    that particles at a free surface or a collider wall read the bulk's density instead of up
+    to half of it; eq. 31 re-normalises the carried densities on every density pass (one more
+    gather). SPRINGS: elasticity and plasticity, springs between neighbours made at each
     particle's first substep (Clavet et al. 2005), parameters in World.spring_params. A feature
     that is off allocates nothing and costs no work.""")
 

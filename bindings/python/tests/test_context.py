@@ -1,5 +1,10 @@
 # SPDX-License-Identifier: MIT
 """Contexts: creation, backend, errors with the right sph_result, closing, logging."""
+import ctypes
+import gc
+import weakref
+
+import numpy as np
 import pytest
 
 import sph
@@ -124,3 +129,41 @@ def test_log_callback_exceptions_do_not_escape(capsys):
             c.world(capacity=2**31)
     assert e.value.result == sph.Result.ERROR_INVALID_ARGUMENT
     assert "from the log callback" in capsys.readouterr().err
+
+
+def test_context_keeps_the_callbacks_of_an_inline_definition():
+    """A ContextDef made inline with Python allocator callbacks: the context keeps ctypes'
+    callback objects (their thunks, and the callables behind them) alive, not only the function
+    pointers copied from them; the library calls them for the context's life."""
+    buffers = {}
+    calls = {"alloc": 0, "free": 0}
+    refs = []
+
+    def make():
+        def alloc(size, alignment, _user):
+            calls["alloc"] += 1
+            raw = ctypes.create_string_buffer(size + alignment)
+            address = (ctypes.addressof(raw) + alignment - 1) // alignment * alignment
+            buffers[address] = raw
+            return address
+
+        def free(memory, _size, _user):
+            calls["free"] += 1
+            del buffers[memory]
+
+        refs.extend([weakref.ref(alloc), weakref.ref(free)])
+        return sph.Context("cpu", cpu_worker_count=1,
+                           definition=sph.ContextDef(alloc_fn=_g.sph_alloc_fn(alloc), free_fn=_g.sph_free_fn(free)))
+
+    c = make()
+    gc.collect()
+    junk = [ctypes.CFUNCTYPE(ctypes.c_void_p)(lambda: None) for _ in range(1000)]  # reuses freed thunks
+    assert all(r() is not None for r in refs), "the context keeps its definition's callbacks"
+    with c:
+        with c.world(capacity=1000, particle_spacing=0.02) as w:
+            assert w.fill_box((0, 0, 0), (0.1, 0.1, 0.1)) > 0
+            assert w.step(1.0 / 60.0) == sph.Result.OK
+            assert np.isfinite(w.positions()).all()
+        assert calls["alloc"] > 0, "the allocator was called"
+    assert calls["free"] == calls["alloc"] and not buffers, "everything given back"
+    del junk

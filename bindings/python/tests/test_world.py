@@ -1,11 +1,13 @@
 # SPDX-License-Identifier: MIT
 """Worlds: defs, params, spawning from numpy, fills, stepping, reading back, stats, errors."""
 import ctypes
+import gc
 
 import numpy as np
 import pytest
 
 import sph
+from sph import _generated as _g
 
 
 def raw(name, *args):
@@ -74,6 +76,21 @@ def test_params_round_trip(world):
     assert world.params == p
     q = world.set_params(step_factor=0.2)
     assert world.params.step_factor == pytest.approx(0.2) and tuple(q.gravity) == (0, 0, -1)
+
+
+def test_params_take_a_dict(world):
+    """w.params = {...}, as every other params setter: the named fields over the defaults."""
+    world.set_params(viscosity=2.5)
+    world.params = {"gravity": (0, 0, -1), "step_factor": 0.2}
+    p = world.params
+    assert tuple(p.gravity) == (0, 0, -1) and p.step_factor == pytest.approx(0.2)
+    assert p.viscosity == sph.WorldParams().viscosity, "a field not named is at its default"
+    with pytest.raises(AttributeError, match="no_such_field"):
+        world.params = {"no_such_field": 1}
+    assert error(setattr, world, "params", {"stiffness": -1.0}) == sph.Result.ERROR_INVALID_ARGUMENT
+    assert world.params == p
+    with pytest.raises(TypeError):
+        world.params = sph.TaitParams()
 
 
 def test_bad_params_change_nothing(world):
@@ -320,6 +337,96 @@ def test_asynchronous_step_matches_step(ctx):
             b.step_begin(float("nan"))
 
 
+def test_close_with_a_step_in_flight_keeps_the_world():
+    with sph.Context("cpu", cpu_worker_count=1) as c:
+        w = c.world(capacity=4096, particle_spacing=0.02)
+        w.fill_box((0.0, 0.0, 0.0), (0.16, 0.16, 0.16))
+        w.step_begin(1.0 / 60.0)
+        assert error(w.close) == sph.Result.ERROR_WORLD_LOCKED
+        assert not w.closed
+        assert w.step_wait() == sph.Result.OK
+        w.close()
+        assert w.closed
+
+
+def test_dropping_a_world_with_a_step_in_flight_waits_for_it():
+    """__del__ cancels and collects the step, then destroys the world: its context closes."""
+    before = sph.live_object_count()
+    c = sph.Context("cpu", cpu_worker_count=1)
+    w = c.world(capacity=20000, particle_spacing=0.01)
+    w.fill_box((0.0, 0.0, 0.0), (0.2, 0.2, 0.2))
+    w.step_begin(1.0)
+    assert sph.live_object_count() == before + 2
+    del w
+    gc.collect()
+    assert sph.live_object_count() == before + 1, "the world was destroyed"
+    c.close()
+    assert sph.live_object_count() == before
+
+
+class _HeldTasks:
+    """A task system (ContextDef.enqueue_task/finish_task) that runs each task when enqueued,
+    except while `hold` is set: then it runs it in finish_task."""
+
+    def __init__(self):
+        self.hold = False
+        self.held = {}
+        self.enqueue = _g.sph_enqueue_task_fn(self._enqueue)
+        self.finish = _g.sph_finish_task_fn(self._finish)
+
+    def _enqueue(self, task, item_count, _min_range, task_context, _user):
+        if not self.hold:
+            task(0, item_count, 0, task_context)
+            return None
+        handle = len(self.held) + 1
+        self.held[handle] = (task, item_count, task_context)
+        return handle
+
+    def _finish(self, handle, _user):
+        task, item_count, task_context = self.held.pop(handle)
+        task(0, item_count, 0, task_context)
+
+
+def test_dropping_a_world_whose_step_needs_python_leaks_it():
+    """With Python task-system hooks, an unfinished step may need Python code to end: the
+    finaliser leaks the world and its context (a ResourceWarning) instead of waiting forever."""
+    from sph import _core
+
+    tasks = _HeldTasks()
+    before = sph.live_object_count()
+    c = sph.Context("cpu", definition=sph.ContextDef(enqueue_task=tasks.enqueue, finish_task=tasks.finish))
+    w = c.world(capacity=4096, particle_spacing=0.02)
+    w.fill_box((0.0, 0.0, 0.0), (0.1, 0.1, 0.1))
+    tasks.hold = True
+    w.step_begin(1.0 / 60.0)
+    tasks.hold = False
+    assert not w.step_done(), "the step waits for its task"
+    with pytest.warns(ResourceWarning, match="asynchronous step in flight"):
+        del w
+        gc.collect()
+    ptr, context = _core._LEAKED[-1]
+    assert context is c and sph.live_object_count() == before + 2
+    context_ptr = c.handle
+    with pytest.warns(ResourceWarning, match="leaked"):
+        c.close()
+    # Clean up by hand: the step runs in finish_task, then the world and the context go.
+    assert sph.library().sph_world_step_wait(ptr) == sph.Result.OK
+    assert sph.library().sph_world_destroy(ptr) == sph.Result.OK
+    assert sph.library().sph_context_destroy(context_ptr) == sph.Result.OK
+    _core._LEAKED.pop()
+    assert sph.live_object_count() == before
+
+
+def test_docstrings_follow_the_header():
+    """What the docstrings say the library does is what sph_c.h says it does."""
+    step = sph.World.step.__doc__
+    assert "budget" in step and "cancel" in step, "INCOMPLETE: max_substeps, the step budget or a cancel"
+    assert "current capacity" in sph.World.definition.__doc__, "sph_world_get_def reads the current capacity"
+    assert "WARNING" in sph.Context.__doc__, "the log callback also gets warnings"
+    assert "EXPERIMENTAL" not in sph.Feature.__doc__ and "second" not in sph.Feature.__doc__
+    assert "density factor" in sph.Feature.__doc__
+
+
 # ---- writing particles -------------------------------------------------------------------------
 def test_set_attributes_read_back_bitwise(ctx):
     with ctx.world(capacity=2048, features="user_attribute") as w:
@@ -341,6 +448,27 @@ def test_set_attributes_read_back_bitwise(ctx):
             w.step(0.01)
         by_id = dict(zip(ids.tolist(), tags.tolist()))
         assert [by_id[i] for i in w.ids().tolist()] == w.user_attributes().tolist()  # sorted along
+
+
+def test_user_attributes_refuse_what_uint32_cannot_hold(ctx):
+    """set_user_attributes never wraps or truncates: out-of-range integers raise ValueError,
+    non-integers TypeError, before anything is written."""
+    with ctx.world(capacity=2048, features="user_attribute") as w:
+        n = w.fill_box((0, 0.2, 0), (0.1, 0.3, 0.1))
+        tags = np.arange(n, dtype=np.uint32) * 3
+        w.set_user_attributes(tags)
+        for bad, kind in ([[2**32 + 5], ValueError], [[-1], ValueError], [[0, 2**64], ValueError],
+                          [np.array([2**40], np.int64), ValueError], [np.array([2**32], np.uint64), ValueError],
+                          [np.array([-3], np.int8), ValueError], [[1.9], TypeError], [np.array([1.0]), TypeError],
+                          [[1, 2.5], TypeError], [["7"], TypeError]):
+            with pytest.raises(kind):
+                w.set_user_attributes(bad, first=1)
+            np.testing.assert_array_equal(w.user_attributes(), tags, err_msg=repr(bad))
+        # What fits is written, whatever its integer type (also a list mixing numpy and Python ints).
+        w.set_user_attributes([2**32 - 1, np.uint64(4), True], first=2)
+        w.set_user_attributes(np.array([9, 8], np.int64))
+        w.set_user_attributes([])
+        np.testing.assert_array_equal(w.user_attributes()[:5], [9, 8, 2**32 - 1, 4, 1])
 
 
 def test_remove_particles_by_id(ctx):
