@@ -1439,7 +1439,9 @@ typedef struct sph_source_def {
                               = 0.9 x spacing; at most the kernel radius */
   sph_vec3 velocity;       /* initial velocity (unless VELOCITY_FROM_FIELD); default 0 */
   uint32_t flags;          /* SPH_SOURCE_FLAG_* */
-  float rate;              /* CONTINUOUS: most particles per second; 0 (default) = no limit */
+  float rate;              /* CONTINUOUS: most particles per second; 0 (default) = no limit.
+                              What the region or the world could not take is emitted later,
+                              but at most one region's worth is owed */
   uint32_t user_attribute; /* the user attribute of the particles it emits; default 0; non-zero
                               needs SPH_FEATURE_USER_ATTRIBUTE (else FEATURE_DISABLED) */
   uint32_t reserved1;      /* must be 0 */
@@ -1455,8 +1457,13 @@ static inline sph_result sph_source_def_init(sph_source_def* def) {
  * world grows for it (SPH_EVENT_CAPACITY_GROWN; a growth that cannot be allocated fails the
  * step with OUT_OF_*_MEMORY, world unchanged). When max_capacity runs out, the source emits
  * what fits and the step reports an SPH_EVENT_SOURCE_CAPACITY_REACHED event; nothing else
- * changes. Errors: INVALID_ARGUMENT,
- * CAPACITY (the region holds more than 2^28 lattice points).
+ * changes (likewise once the world's 2^32 particle ids are used up: ids are never reused).
+ * Errors: INVALID_ARGUMENT (a bad field, named; a region whose lattice, at this transform,
+ * reaches farther than 65536 particle spacings from the origin, where no particle may be),
+ * CAPACITY (the region holds more than 2^28 lattice points). sph_source_set_transform refuses a
+ * transform that would move the lattice out of that reach likewise (INVALID_ARGUMENT naming
+ * transform), the source unchanged. A region's velocity channel (VELOCITY_FROM_FIELD) holds
+ * speeds below 1.8e19 m/s, as particles do (sph_sdf_create and sph_sdf_update check it).
  */
 SPH_API sph_result SPH_CALL sph_source_create(sph_world* world, const sph_source_def* def,
                                               sph_source_id* out_id);
@@ -1565,7 +1572,8 @@ typedef struct sph_probe_def {
   sph_probe_kind kind;         /* default SPH_PROBE_POINT */
   sph_probe_sampling sampling; /* default SPH_PROBE_EVERY_FRAME */
   sph_vec3 position;           /* POINT: where; GAUGE: the line's start (put it below the floor), m */
-  sph_vec3 direction;          /* GAUGE: the line's direction (normalised by the library);
+  sph_vec3 direction;          /* GAUGE: the line's direction (normalised by the library: any
+                                  finite non-zero vector, however short or long);
                                   {0,0,0} = up, against the world's gravity at each step (+y
                                   without gravity) */
   float length;                /* GAUGE: the line's length, m; > 0 */
@@ -1584,8 +1592,9 @@ static inline sph_result sph_probe_def_init(sph_probe_def* def) {
  * backend (on the device for CUDA, with no host copy per substep). Errors: INVALID_HANDLE
  * (world), INVALID_ARGUMENT (NULL def or out_id; a non-finite position or direction, a gauge's
  * length not > 0 or too many steps, a negative sample_spacing, non-zero reserved0, each named),
- * UNSUPPORTED (an unknown kind or sampling), VERSION_MISMATCH, CAPACITY (65536 probes),
- * WORLD_LOCKED. On a DFSPH world the pressure sampled is the one both its solves applied in the
+ * UNSUPPORTED (an unknown kind or sampling), VERSION_MISMATCH, CAPACITY (65536 probes, or more
+ * than 2^22 = 4194304 sample points of all probes together: a point probe samples one, a gauge
+ * its steps), WORLD_LOCKED. On a DFSPH world the pressure sampled is the one both its solves applied in the
  * substep (SPH_ATTRIBUTE_PRESSURE's), at the substep's start positions. Nothing changes on
  * error. Checkpoints of format 6 and later carry the probes (readings start again); restoring an
  * older one keeps the world's own (docs/api.md).

@@ -1924,7 +1924,10 @@ namespace Sph
         public Vec3 Velocity;
         /// <summary>uint32_t flags: SPH_SOURCE_FLAG_*</summary>
         public uint Flags;
-        /// <summary>float rate: CONTINUOUS: most particles per second; 0 (default) = no limit</summary>
+        /// <summary>
+        /// float rate: CONTINUOUS: most particles per second; 0 (default) = no limit. What the region
+        /// or the world could not take is emitted later, but at most one region's worth is owed
+        /// </summary>
         public float Rate;
         /// <summary>
         /// uint32_t user_attribute: the user attribute of the particles it emits; default 0; non-zero
@@ -2074,8 +2077,9 @@ namespace Sph
         /// <summary>sph_vec3 position: POINT: where; GAUGE: the line's start (put it below the floor), m</summary>
         public Vec3 Position;
         /// <summary>
-        /// sph_vec3 direction: GAUGE: the line's direction (normalised by the library); {0,0,0} = up,
-        /// against the world's gravity at each step (+y without gravity)
+        /// sph_vec3 direction: GAUGE: the line's direction (normalised by the library: any finite non-
+        /// zero vector, however short or long); {0,0,0} = up, against the world's gravity at each step
+        /// (+y without gravity)
         /// </summary>
         public Vec3 Direction;
         /// <summary>float length: GAUGE: the line's length, m; &gt; 0</summary>
@@ -3202,8 +3206,13 @@ namespace Sph
         /// world grows for it (SPH_EVENT_CAPACITY_GROWN; a growth that cannot be allocated fails the
         /// step with OUT_OF_*_MEMORY, world unchanged). When max_capacity runs out, the source emits
         /// what fits and the step reports an SPH_EVENT_SOURCE_CAPACITY_REACHED event; nothing else
-        /// changes. Errors: INVALID_ARGUMENT, CAPACITY (the region holds more than 2^28 lattice
-        /// points).
+        /// changes (likewise once the world's 2^32 particle ids are used up: ids are never reused).
+        /// Errors: INVALID_ARGUMENT (a bad field, named; a region whose lattice, at this transform,
+        /// reaches farther than 65536 particle spacings from the origin, where no particle may be),
+        /// CAPACITY (the region holds more than 2^28 lattice points). sph_source_set_transform refuses
+        /// a transform that would move the lattice out of that reach likewise (INVALID_ARGUMENT naming
+        /// transform), the source unchanged. A region's velocity channel (VELOCITY_FROM_FIELD) holds
+        /// speeds below 1.8e19 m/s, as particles do (sph_sdf_create and sph_sdf_update check it).
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_source_create(WorldHandle world, ref SourceDef def, out SourceId outId);
@@ -3275,11 +3284,12 @@ namespace Sph
         /// backend (on the device for CUDA, with no host copy per substep). Errors: INVALID_HANDLE
         /// (world), INVALID_ARGUMENT (NULL def or out_id; a non-finite position or direction, a gauge's
         /// length not &gt; 0 or too many steps, a negative sample_spacing, non-zero reserved0, each
-        /// named), UNSUPPORTED (an unknown kind or sampling), VERSION_MISMATCH, CAPACITY (65536
-        /// probes), WORLD_LOCKED. On a DFSPH world the pressure sampled is the one both its solves
-        /// applied in the substep (SPH_ATTRIBUTE_PRESSURE's), at the substep's start positions. Nothing
-        /// changes on error. Checkpoints of format 6 and later carry the probes (readings start again);
-        /// restoring an older one keeps the world's own (docs/api.md).
+        /// named), UNSUPPORTED (an unknown kind or sampling), VERSION_MISMATCH, CAPACITY (65536 probes,
+        /// or more than 2^22 = 4194304 sample points of all probes together: a point probe samples one,
+        /// a gauge its steps), WORLD_LOCKED. On a DFSPH world the pressure sampled is the one both its
+        /// solves applied in the substep (SPH_ATTRIBUTE_PRESSURE's), at the substep's start positions.
+        /// Nothing changes on error. Checkpoints of format 6 and later carry the probes (readings start
+        /// again); restoring an older one keeps the world's own (docs/api.md).
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_probe_create(WorldHandle world, ref ProbeDef def, out ProbeId outId);

@@ -2,6 +2,7 @@
 // SDF assets: grids from the caller, analytic shapes, sub-box updates.
 #include <vector>
 
+#include "../core/field_checks.h"
 #include "../core/sdf_limits.h"
 #include "../core/sdf_shapes.h"
 #include "grid_from_public.h"
@@ -40,6 +41,16 @@ sph::HostVector<float> read_floats(const sph_context* context, const float* data
     if (!std::isfinite(out[i]))
       throw Error(Status::InvalidArgument, name + "data[" + std::to_string(i) + "]: is not finite");
   return out;
+}
+
+// A velocity channel's values (x, y, z a voxel): speeds below 1.8e19 m/s, as a particle's (a
+// source with VELOCITY_FROM_FIELD gives its particles these; a faster one could never step).
+void require_channel_speeds(const sph::HostVector<float>& xyz, const std::string& name) {
+  for (size_t i = 0; i + 2 < xyz.size(); i += 3)
+    if (!sph::speed_fits_float(sph::Vec3{xyz[i], xyz[i + 1], xyz[i + 2]}))
+      throw Error(Status::InvalidArgument, name + "data[" + std::to_string(i) + ".." + std::to_string(i + 2) +
+                                               "]: the speed's square overflows float32 (velocities must be "
+                                               "below 1.8e19 m/s, as particles' are)");
 }
 
 uint64_t voxel_count(const uint32_t dims[3], const std::string& name) {
@@ -83,6 +94,7 @@ std::shared_ptr<sph::SdfAsset> asset_from_desc(const sph_context* context, const
       throw Error(Status::InvalidArgument, "desc->velocity->components: must be 3 (or 0, meaning 3)");
     const sph::HostVector<float> raw =
         read_floats(context, v.data, 3 * n, sph::enum_bits(v.memory), "desc->velocity->");
+    require_channel_speeds(raw, "desc->velocity->");
     asset->velocity().resize(n);
     std::memcpy(asset->velocity().data(), raw.data(), raw.size() * sizeof(float));
   }
@@ -231,6 +243,7 @@ SPH_API sph_result SPH_CALL sph_sdf_update(sph_sdf* sdf, sph_sdf_channel channel
     if (channel_bits == SPH_SDF_CHANNEL_FRICTION)
       for (float mu : values)
         if (mu < 0.0f) throw Error(Status::InvalidArgument, "data: friction coefficients must be >= 0");
+    if (channel_bits == SPH_SDF_CHANNEL_VELOCITY) require_channel_speeds(values, "");
     float* target = nullptr;
     if (channel_bits == SPH_SDF_CHANNEL_DISTANCE) {
       target = a.distance().data();

@@ -9,6 +9,7 @@
 #include "checkpoint_fields.h"
 #include "field_error.h"
 #include "pose_rules.h"
+#include "position_reach.h"
 #include "scene_build.h"
 #include "sdf_limits.h"
 
@@ -48,7 +49,11 @@ std::shared_ptr<SdfAsset> read_asset(ByteReader& r, uint32_t index) {
   if (channels & kAssetHasVelocity) {
     asset->velocity().resize(n);
     HostVector<Vec3>& velocity = asset->velocity();
-    for (uint64_t i = 0; i < n; ++i) velocity[i] = bulk_vec3(r, where.c_str(), static_cast<uint32_t>(i));
+    for (uint64_t i = 0; i < n; ++i) {
+      velocity[i] = bulk_vec3(r, where.c_str(), static_cast<uint32_t>(i));
+      if (!speed_fits_float(velocity[i]))  // sph_sdf_create's rule
+        corrupt(r.what() + ": " + where + " " + std::to_string(i) + " has a speed above 1.8e19 m/s");
+    }
   }
   if (channels & kAssetHasFriction) {
     asset->friction().resize(n);
@@ -195,6 +200,9 @@ Source read_source(ByteReader& r, const Assets& assets, const WorldConfig& confi
   s.lattice.resize(points);
   const std::string where = name + " lattice point";
   for (uint32_t i = 0; i < points; ++i) s.lattice[i] = bulk_vec3(r, where.c_str(), i);
+  // World::add_source's and set_source_pose's reach.
+  const std::string reach = lattice_reach_problem(s.lattice, s.pose, config.particle_spacing);
+  if (!reach.empty()) corrupt(r.what() + ": " + name + " transform " + reach);
   return s;
 }
 
@@ -252,7 +260,16 @@ SlotTable<ForceField> read_checkpoint_force_fields(ByteReader& r, const Checkpoi
 }
 
 SlotTable<Probe> read_checkpoint_probes(ByteReader& r, uint32_t version) {
-  return read_slots<Probe>(r, [&](const std::string& n) { return read_probe(r, version, "probe " + n); });
+  SlotTable<Probe> probes =
+      read_slots<Probe>(r, [&](const std::string& n) { return read_probe(r, version, "probe " + n); });
+  // World::add_probe's limit on the points of all probes together.
+  uint64_t points = 0;
+  for (const std::optional<Probe>& p : probes.values)
+    if (p) points += p->points();
+  if (points > kMaxProbePoints)
+    corrupt(r.what() + ": the probes sample " + std::to_string(points) + " points, more than " +
+            std::to_string(kMaxProbePoints));
+  return probes;
 }
 
 }  // namespace sph

@@ -30,9 +30,11 @@ inline void require_finite_vec3_field(const Vec3& v, const std::string& field) {
 // 1.8e19 m/s). A step takes |v|^2 for the step size and its non-finite check, so a particle
 // faster than that could never step (issue 23: spawned at 2e19 m/s, the world's carried max
 // speed became +Inf).
+inline bool speed_fits_float(const Vec3& v) { return std::isfinite(length_squared(v)); }
+
 inline void require_particle_velocity_field(const Vec3& v, const std::string& field) {
   require_finite_vec3_field(v, field);
-  if (!std::isfinite(length_squared(v)))
+  if (!speed_fits_float(v))
     throw FieldError(Status::InvalidArgument, field,
                      "its speed's square overflows float32 (speeds must be below 1.8e19 m/s; a step would "
                      "treat the particle as non-finite)");

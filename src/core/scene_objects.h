@@ -83,6 +83,9 @@ struct Probe {
   uint32_t sample_count = 1;         // gauges: the column integral's steps
   float pressure_threshold = 0.0f;   // Pa: a step whose peak pressure reaches it reports an event; 0 = none
   ProbeReading reading;
+
+  // The points it samples a step: one for a point probe, its samples for a gauge.
+  uint32_t points() const { return gauge ? sample_count : 1u; }
 };
 
 // Values equal to sph_event_type. The solver's events name no object (object_id 0).

@@ -136,11 +136,16 @@ void World::emit_sources(double frame_dt) {
     size_t allowed = accepted.size();
     if (s.mode == SourceMode::Continuous && s.rate > 0.0f) {
       s.rate_budget += static_cast<double>(s.rate) * frame_dt;
-      allowed = std::min(allowed, static_cast<size_t>(s.rate_budget));
+      // (compared in double: a budget past the size_t range must not be cast to it)
+      if (s.rate_budget < static_cast<double>(allowed)) allowed = static_cast<size_t>(s.rate_budget);
     }
+    // A world numbers its particles with 32-bit ids and never reuses one (spawn); once they run
+    // out a source emits what is left and reports the rest, as at a full capacity.
+    const size_t ids_left = UINT32_MAX - next_id_;
     HostVector<char> mine;
     if (distributed) mine = points_of_this_rank(accepted);
-    const size_t fits = distributed ? rank_emission_fits(mine, allowed) : std::min<size_t>(allowed, room());
+    const size_t fits = distributed ? rank_emission_fits(mine, std::min(allowed, ids_left))
+                                    : std::min<size_t>({allowed, room(), ids_left});
     if (fits < allowed)
       events_.push_back(Event{EventType::SourceCapacityReached, id, static_cast<uint32_t>(allowed - fits)});
     accepted.resize(fits);
@@ -149,7 +154,14 @@ void World::emit_sources(double frame_dt) {
     const size_t kept = distributed ? static_cast<size_t>(std::count(mine.begin(), mine.end(), 1)) : fits;
     if (reserve_particles(static_cast<uint64_t>(particle_count()) + kept))
       events_.push_back(Event{EventType::CapacityGrown, id, config_.capacity});
-    if (s.mode == SourceMode::Continuous && s.rate > 0.0f) s.rate_budget -= static_cast<double>(fits);
+    if (s.mode == SourceMode::Continuous && s.rate > 0.0f) {
+      // What the region or the world could not take stays owed, but at most one region's worth:
+      // "at most rate particles/s" holds over any window once the backlog is out (unbounded, a
+      // region held full for a minute then refilled whole every frame for a minute), and the
+      // budget stays within what a checkpoint carries (it outgrew 1e15 at high rates).
+      s.rate_budget =
+          std::min(s.rate_budget - static_cast<double>(fits), static_cast<double>(s.lattice.size()));
+    }
     if (distributed) {
       emit_on_ranks(accepted, velocities, mine, s.user_attribute, existing);
     } else if (!accepted.empty()) {

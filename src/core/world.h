@@ -163,8 +163,8 @@ class World {
   // A live collider; Error(InvalidHandle) otherwise.
   const Collider& collider(uint64_t id) const;
   // ---- probes and gauges (world_probes.cpp; physics/probe_sampling.h) ----
-  // add_probe: FieldError naming the field for a bad spec,
-  // Error(Capacity) past 65536 probes; the world is unchanged on error. Probes are not part of
+  // add_probe: FieldError naming the field for a bad spec, Error(Capacity) past 65536 probes or
+  // kMaxProbePoints sample points in all; the world is unchanged on error. Probes are not part of
   // SceneTables: a checkpoint of format 5 or later carries them (restore_probes), an older one
   // has none and sph_world_restore keeps the world's own (adopt_probes).
   uint64_t add_probe(const ProbeSpec& spec);
@@ -175,6 +175,8 @@ class World {
   // A live probe; Error(InvalidHandle) otherwise.
   const Probe& probe(uint64_t id) const;
   const SlotMap<Probe>& probes() const { return probes_; }
+  // The sample points of all probes a step (a point probe one, a gauge its samples).
+  uint64_t probe_points() const { return probe_points_; }
   // Takes over another world's probes with their ids, readings cleared (a restore from a file
   // before format 5 keeps the world's probes).
   void adopt_probes(const World& from);
@@ -229,6 +231,7 @@ class World {
   SlotMap<Sink> sinks_{kTagSink};
   SlotMap<ForceField> force_fields_{kTagForceField};
   SlotMap<Probe> probes_{kTagProbe};
+  uint64_t probe_points_ = 0;  // probe_points(): kept with every change of probes_
 };
 
 }  // namespace sph

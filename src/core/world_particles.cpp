@@ -7,28 +7,10 @@
 
 #include "fcc_lattice.h"
 #include "field_checks.h"
+#include "position_reach.h"
 #include "world.h"
 
 namespace sph {
-namespace {
-
-// Float32 resolves a position x to steps of about |x| 2^-23. Beyond 2^16 particle spacings
-// from the origin a step exceeds 1/128 of the spacing, and neighbour distances, densities and
-// small moves turn to rounding noise (at 1e6 m with a 2 cm spacing the steps are 6 cm: silent
-// garbage), so such positions are refused. The bound lies far inside the neighbour grid's
-// cell-coordinate range (2^30 cells of h >= spacing).
-constexpr float kMaxPositionInSpacings = 65536.0f;
-
-std::string resolution_problem(const Vec3& p, float spacing) {
-  const float limit = kMaxPositionInSpacings * spacing;
-  if (std::fabs(p.x) <= limit && std::fabs(p.y) <= limit && std::fabs(p.z) <= limit) return {};
-  return "(" + describe_value(p.x) + ", " + describe_value(p.y) + ", " + describe_value(p.z) +
-         ") lies farther than " + describe_value(limit) +
-         " m (65536 particle spacings) from the origin, where float32 positions no longer "
-         "resolve the spacing to 1/128; move the scene's origin closer or use a larger spacing";
-}
-
-}  // namespace
 
 std::string World::position_problem(const Vec3& p) const {
   if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return "is not finite";

@@ -26,11 +26,24 @@ void require_resolved(const Vec3& p, float spacing, const char* field) {
                          " m (65536 particle spacings) from the origin, where no particle may be");
 }
 
+// |v| in double: a float's square underflows below about 1e-19 (a direction of (1e-30, 0, 0)
+// would read as none) and overflows above about 1e19.
+double exact_length(const Vec3& v) {
+  const double x = v.x, y = v.y, z = v.z;
+  return std::sqrt(x * x + y * y + z * z);
+}
+
+// v / |v|, or zero for the zero vector.
+Vec3 unit_or_zero(const Vec3& v) {
+  const double n = exact_length(v);
+  if (!(n > 0.0)) return Vec3{0.0f, 0.0f, 0.0f};
+  return Vec3{static_cast<float>(v.x / n), static_cast<float>(v.y / n), static_cast<float>(v.z / n)};
+}
+
 // The gauge's direction, or the world's up (against gravity; +y without gravity).
 Vec3 gauge_axis(const Probe& p, const Vec3& gravity) {
-  const Vec3 d = length_squared(p.direction) > 0.0f ? p.direction : gravity * -1.0f;
-  const float n = length(d);
-  return n > 0.0f ? d * (1.0f / n) : Vec3{0.0f, 1.0f, 0.0f};
+  const Vec3 d = unit_or_zero(exact_length(p.direction) > 0.0 ? p.direction : gravity * -1.0f);
+  return exact_length(d) > 0.0 ? d : Vec3{0.0f, 1.0f, 0.0f};
 }
 
 }  // namespace
@@ -44,9 +57,6 @@ uint64_t World::add_probe(const ProbeSpec& spec) {
   p.position = spec.position;
   if (spec.gauge) {
     require_finite_vec3_field(spec.direction, "direction");
-    const float n = length(spec.direction);
-    if (!std::isfinite(n))
-      throw FieldError(Status::InvalidArgument, "direction", "its length overflows float32");
     require_finite_field(spec.length, "length");
     if (!(spec.length > 0.0f))
       throw FieldError(Status::InvalidArgument, "length",
@@ -64,17 +74,29 @@ uint64_t World::add_probe(const ProbeSpec& spec) {
     require_resolved(Vec3{std::fabs(spec.position.x) + reach, std::fabs(spec.position.y) + reach,
                           std::fabs(spec.position.z) + reach},
                      config_.particle_spacing, "length");
-    p.direction = n > 0.0f ? spec.direction * (1.0f / n) : Vec3{0.0f, 0.0f, 0.0f};
+    // Normalised in double: any finite non-zero direction is a direction, however short or long.
+    p.direction = unit_or_zero(spec.direction);
     p.length = spec.length;
     p.sample_count = steps < 1.0 ? 1u : static_cast<uint32_t>(steps);
   }
   if (probes_.size() >= kMaxProbes) throw Error(Status::Capacity, "a world holds at most 65536 probes");
-  return probes_.insert(std::move(p));
+  const uint64_t points = probe_points_ + p.points();
+  if (points > kMaxProbePoints)
+    throw Error(Status::Capacity, "the world's probes would sample " + std::to_string(points) +
+                                      " points a step; at most " + std::to_string(kMaxProbePoints) +
+                                      " (a point probe samples one, a gauge length / sample_spacing)");
+  const uint64_t id = probes_.insert(std::move(p));
+  probe_points_ = points;
+  return id;
 }
 
 void World::remove_probe(uint64_t id) {
   if (id == 0) return;
-  if (!probes_.erase(id)) throw Error(Status::InvalidHandle, "id: is stale or not of this world");
+  const Probe* p = probes_.find(id);
+  if (!p) throw Error(Status::InvalidHandle, "id: is stale or not of this world");
+  const uint32_t points = p->points();
+  probes_.erase(id);
+  probe_points_ -= points;
 }
 
 void World::set_probe_pressure_threshold(uint64_t id, float threshold) {
@@ -87,15 +109,20 @@ void World::adopt_probes(const World& from) {
   SlotMap<Probe> probes = from.probes_;
   probes.for_each([](uint64_t, Probe& p) { p.reading = ProbeReading{}; });
   probes_ = std::move(probes);
+  probe_points_ = from.probe_points_;
 }
 
-void World::restore_probes(SlotTable<Probe> table) { probes_.restore(std::move(table)); }
+void World::restore_probes(SlotTable<Probe> table) {
+  probes_.restore(std::move(table));
+  probe_points_ = 0;
+  probes_.for_each([&](uint64_t, const Probe& p) { probe_points_ += p.points(); });
+}
 
 const Probe& World::probe(uint64_t id) const { return probes_.at(id); }
 
 void World::add_probe_frames(SceneFrame& scene) const {
   scene.probes.reserve(probes_.size());
-  uint32_t points = 0;
+  uint32_t points = 0;  // at most kMaxProbePoints (add_probe, the checkpoint reader)
   probes_.for_each([&](uint64_t, const Probe& p) {
     ProbeView v;
     v.origin = p.position;
@@ -103,7 +130,7 @@ void World::add_probe_frames(SceneFrame& scene) const {
     if (p.gauge)
       v.step = gauge_axis(p, params_.stepping.gravity) * (p.length / static_cast<float>(p.sample_count));
     v.first_point = points;
-    v.point_count = p.gauge ? p.sample_count : 1u;
+    v.point_count = p.points();
     v.gauge = p.gauge ? 1u : 0u;
     v.every_substep = p.every_substep ? 1u : 0u;
     points += v.point_count;

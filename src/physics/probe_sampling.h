@@ -40,6 +40,10 @@ struct ProbeSampling {
 
 // Samples along a gauge at most (the C layer refuses more).
 constexpr uint32_t kMaxGaugeSamples = 65536;
+// Sample points of all a world's probes together at most (a point probe has one, a gauge its
+// samples): 2^22, 96 MiB of a frame's gathers. Without it 65536 gauges of 65536 samples (each
+// within its own bound) counted 2^32 points, which wrapped the frame's 32-bit point indices.
+constexpr uint32_t kMaxProbePoints = 1u << 22;
 
 // One probe in a frame, as both backends see it.
 struct ProbeView {

@@ -712,9 +712,89 @@ static void test_bad_input(void** state) {
   EXPECT_OK(support_world_close(&w));
 }
 
+/* All probes together sample at most 2^22 points a step (a point one, a gauge its samples): 64
+ * gauges of 65536 samples fill it, one more probe of either kind is refused with CAPACITY, and
+ * a removed gauge makes room again; a checkpoint at the limit loads. Before the limit, 65536
+ * gauges of 65536 samples (each within its own bounds) counted 2^32 points, which wrapped to 0,
+ * and the step wrote its samples into an empty buffer (a crash). */
+static void test_point_budget(void** state) {
+  support_world w;
+  sph_world_def def;
+  sph_probe_def gauge, point;
+  sph_probe_id ids[64], extra = {0x1234}, id;
+  uint64_t size = 0;
+  void* saved;
+  sph_world* loaded = NULL;
+  int k;
+  (void)state;
+  def = probe_world_def(64);
+  EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
+  EXPECT_OK(sph_probe_def_init(&gauge));
+  gauge.kind = SPH_PROBE_GAUGE;
+  gauge.length = 1.0f;
+  gauge.sample_spacing = 1.0f / 65536.0f; /* exactly 65536 steps, the most a gauge may have */
+  EXPECT_OK(sph_probe_def_init(&point));
+  for (k = 0; k < 64; ++k) EXPECT_OK(sph_probe_create(w.world, &gauge, &ids[k]));
+  EXPECT_ERROR(SPH_ERROR_CAPACITY, "4194304", sph_probe_create(w.world, &gauge, &extra));
+  EXPECT_ERROR(SPH_ERROR_CAPACITY, "points", sph_probe_create(w.world, &point, &extra));
+  assert_true(extra.bits == 0x1234);
+  EXPECT_OK(sph_world_save(w.world, NULL, 0, &size));
+  saved = malloc(size);
+  assert_non_null(saved);
+  EXPECT_OK(sph_world_save(w.world, saved, size, &size));
+  EXPECT_OK(sph_world_load(w.context, saved, size, &loaded));
+  EXPECT_ERROR(SPH_ERROR_CAPACITY, "points", sph_probe_create(loaded, &point, &extra));
+  EXPECT_OK(sph_world_destroy(loaded));
+  free(saved);
+  EXPECT_OK(sph_probe_destroy(w.world, ids[0]));
+  EXPECT_OK(sph_probe_create(w.world, &point, &id)); /* 2^22 - 65536 + 1 */
+  EXPECT_ERROR(SPH_ERROR_CAPACITY, "points", sph_probe_create(w.world, &gauge, &extra));
+  EXPECT_OK(sph_probe_destroy(w.world, id));
+  EXPECT_OK(sph_probe_create(w.world, &gauge, &ids[0])); /* full again */
+  EXPECT_OK(support_world_close(&w));
+}
+
+/* A gauge's direction is any finite non-zero vector, however short: (1e-30, 0, 0) reads as
+ * (1, 0, 0) does (its float square underflowed to 0, and the gauge read up instead). */
+static void test_gauge_tiny_direction(void** state) {
+  const uint32_t layers[3] = {6, 6, 6};
+  float* lattice = NULL;
+  uint32_t n = 0;
+  support_world w;
+  sph_world_def def;
+  sph_probe_def gauge;
+  sph_probe_id unit, tiny, huge;
+  sph_probe_reading a, b, c;
+  (void)state;
+  assert_int_equal(support_fcc_box(layers, kStep, NULL, &lattice, &n), SPH_OK);
+  def = probe_world_def(n);
+  EXPECT_OK(support_world_open(&w, sph_test_backend(), &def, NULL));
+  EXPECT_OK(support_spawn(w.world, lattice, NULL, n));
+  free(lattice);
+  EXPECT_OK(sph_probe_def_init(&gauge));
+  gauge.kind = SPH_PROBE_GAUGE;
+  gauge.position.x = -0.05f, gauge.position.y = 0.03f, gauge.position.z = 0.03f;
+  gauge.length = 0.2f;
+  gauge.direction.x = 1.0f;
+  EXPECT_OK(sph_probe_create(w.world, &gauge, &unit));
+  gauge.direction.x = 1e-30f;
+  EXPECT_OK(sph_probe_create(w.world, &gauge, &tiny));
+  gauge.direction.x = 3e38f; /* (its square overflows float: also a direction) */
+  EXPECT_OK(sph_probe_create(w.world, &gauge, &huge));
+  EXPECT_OK(sph_world_step(w.world, 0.01f));
+  a = reading_of(w.world, unit);
+  b = reading_of(w.world, tiny);
+  c = reading_of(w.world, huge);
+  assert_true(a.water_height > 0.05f); /* the block's width along x, about 0.08 m */
+  assert_true(b.water_height == a.water_height && b.density == a.density);
+  assert_true(c.water_height == a.water_height && c.density == a.density);
+  EXPECT_OK(support_world_close(&w));
+}
+
 int main(int argc, char** argv) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_bad_input),    cmocka_unit_test(test_sampling),
+      cmocka_unit_test(test_point_budget), cmocka_unit_test(test_gauge_tiny_direction),
       cmocka_unit_test(test_brute_force),  cmocka_unit_test(test_uniform_flow),
       cmocka_unit_test(test_resting_tank), cmocka_unit_test(test_resting_tank_walls_in_density),
   };

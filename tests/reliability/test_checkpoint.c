@@ -777,6 +777,69 @@ static void test_extreme_forged_values_step_without_crashing(void** state) {
   EXPECT_OK(sph_sdf_destroy(ball));
 }
 
+/* When a world's 2^32 particle ids run out (they are never reused), a source emits what ids are
+ * left and reports the rest as SPH_EVENT_SOURCE_CAPACITY_REACHED, and the step succeeds, as at a
+ * full capacity; before, every step failed with CAPACITY until the source was removed. Reached
+ * here by a forged checkpoint (TIME's next id 2^32 - 7, the checksum resealed) rather than by
+ * 2^32 emissions. */
+static void test_source_at_the_end_of_the_ids(void** state) {
+  damaged_fixture* d = (damaged_fixture*)*state;
+  sph_world_def def;
+  sph_world *world = NULL, *loaded = NULL;
+  sph_shape_desc shape;
+  sph_sdf* ball = NULL;
+  sph_source_def source;
+  sph_source_id source_id;
+  uint8_t* data;
+  uint64_t size;
+  size_t at = 48;
+  uint32_t next_id = 0xFFFFFFFFu - 6u, count = 0, events = 0, ids[8], i;
+  sph_event event[4];
+  int found = 0;
+
+  sph_world_def_init(&def);
+  def.capacity = 300;
+  EXPECT_OK(sph_world_create(d->context, &def, &world));
+  data = save_to_memory(world, &size);
+  while (at + 16 <= size) { /* the TIME section: u32 next particle id first */
+    uint64_t length = 0;
+    int b;
+    for (b = 0; b < 8; ++b) length |= (uint64_t)data[at + 8 + (size_t)b] << (8 * b);
+    if (memcmp(data + at, "TIME", 4) == 0) {
+      memcpy(data + at + 16, &next_id, 4);
+      found = 1;
+      break;
+    }
+    at += 16 + (size_t)length;
+  }
+  assert_true(found);
+  reseal(data, (size_t)size);
+  EXPECT_OK(sph_world_load(d->context, data, size, &loaded));
+  free(data);
+  EXPECT_OK(sph_world_destroy(world));
+  sph_shape_desc_init(&shape);
+  shape.shape = SPH_SHAPE_SPHERE;
+  shape.radius = 0.05f;
+  shape.voxel_size = 0.02f;
+  EXPECT_OK(sph_sdf_create_shape(d->context, &shape, &ball));
+  sph_source_def_init(&source);
+  source.region = ball;
+  source.mode = SPH_SOURCE_CONTINUOUS;
+  EXPECT_OK(sph_source_create(loaded, &source, &source_id));
+  EXPECT_OK(sph_world_step(loaded, 0.005f));
+  EXPECT_OK(sph_world_get_particle_count(loaded, &count));
+  assert_int_equal(count, 6); /* ids 2^32 - 7 ... 2^32 - 2 */
+  EXPECT_OK(sph_world_copy_attribute(loaded, SPH_ATTRIBUTE_ID, ids, sizeof ids, 0, 0, count, NULL));
+  for (i = 0; i < count; ++i) assert_true(ids[i] >= next_id);
+  EXPECT_OK(sph_world_get_events(loaded, event, 4, &events));
+  assert_true(events >= 1 && event[0].type == SPH_EVENT_SOURCE_CAPACITY_REACHED && event[0].count > 0);
+  EXPECT_OK(sph_world_step(loaded, 0.005f)); /* none left: nothing emitted, the step goes on */
+  EXPECT_OK(sph_world_get_particle_count(loaded, &count));
+  assert_int_equal(count, 6);
+  EXPECT_OK(sph_world_destroy(loaded));
+  EXPECT_OK(sph_sdf_destroy(ball));
+}
+
 static void test_wrong_magic_future_version_and_trailing_bytes(void** state) {
   damaged_fixture* d = (damaged_fixture*)*state;
   char future[32];
@@ -998,6 +1061,7 @@ int main(void) {
       cmocka_unit_test(test_every_byte_flip_is_refused),
       cmocka_unit_test(test_forged_corruption_never_crashes),
       cmocka_unit_test(test_extreme_forged_values_step_without_crashing),
+      cmocka_unit_test(test_source_at_the_end_of_the_ids),
       cmocka_unit_test(test_wrong_magic_future_version_and_trailing_bytes),
       cmocka_unit_test(test_failed_restore_changes_nothing),
   };

@@ -2,6 +2,7 @@
 /* Error paths of the scene API: every bad argument gets its code and a message naming it,
  * and the world keeps its objects (a failed create adds nothing; a stale id stays stale). */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "scene_test.h"
@@ -282,12 +283,156 @@ static void test_failed_step_undoes_emission(void** state) {
   scene_close(&s);
 }
 
+/* A source whose lattice would lie beyond the particles' reach (65536 spacings: 1310.72 m at
+ * 2 cm) is refused like a spawn there, at create and at set_transform (naming transform, the
+ * source kept where it was); before, emission put particles there unchecked (at 1e30 m every
+ * one at the same float). */
+static void test_source_reach(void** state) {
+  scene s;
+  sph_shape_desc shape;
+  sph_sdf* sdf;
+  sph_source_def source;
+  sph_source_id id = {0};
+  sph_transform far = scene_at(5000.0f, 0.0f, 0.0f), farther = scene_at(1e30f, 0.0f, 0.0f),
+                edge = scene_at(1310.0f, 0.0f, 0.0f);
+  static float positions[3 * 4000];
+  uint32_t n, i;
+  (void)state;
+  scene_open(&s, 4000, 0.02f, 0.0f, 1e-3f);
+  sph_shape_desc_init(&shape);
+  shape.shape = SPH_SHAPE_SPHERE;
+  shape.radius = 0.05f;
+  sdf = scene_shape(&s, &shape);
+  sph_source_def_init(&source);
+  source.region = sdf;
+  source.transform = far;
+  EXPECT(SPH_ERROR_INVALID_ARGUMENT, "transform", sph_source_create(s.world, &source, &id));
+  assert_true(strstr(sph_get_last_error(), "65536 particle spacings") != NULL);
+  source.transform = farther;
+  EXPECT(SPH_ERROR_INVALID_ARGUMENT, "transform", sph_source_create(s.world, &source, &id));
+  /* Within reach: the lattice (radius 5 cm) ends 1310.05 m out, inside the 1310.72 m bound. */
+  source.transform = edge;
+  SCENE_OK(sph_source_create(s.world, &source, &id));
+  SCENE_OK(sph_source_destroy(s.world, id));
+  source.transform = scene_at(0.0f, 0.0f, 0.0f);
+  source.mode = SPH_SOURCE_CONTINUOUS;
+  SCENE_OK(sph_source_create(s.world, &source, &id));
+  EXPECT(SPH_ERROR_INVALID_ARGUMENT, "transform", sph_source_set_transform(s.world, id, &far));
+  SCENE_OK(sph_world_step(s.world, 0.001f));
+  n = scene_positions(&s, positions, 4000);
+  assert_true(n > 0);
+  for (i = 0; i < n; ++i) assert_true(fabsf(positions[3 * i]) < 0.1f); /* emitted where it was */
+  SCENE_OK(sph_source_destroy(s.world, id));
+  SCENE_OK(sph_sdf_destroy(sdf));
+  scene_close(&s);
+}
+
+/* A velocity channel holds speeds a particle may have (below 1.8e19 m/s): sph_sdf_create and
+ * sph_sdf_update refuse faster ones (a source with VELOCITY_FROM_FIELD gave its particles
+ * 1e20 m/s, and every later step failed as non-finite), the asset unchanged on update. */
+static void test_velocity_channel_speeds(void** state) {
+  scene s;
+  sph_sdf_desc desc;
+  sph_grid_desc velocity;
+  sph_sdf* sdf = NULL;
+  float distance[8] = {-1, -1, -1, -1, -1, -1, -1, -1}, speeds[24], one[3] = {1e20f, 0.0f, 0.0f};
+  uint32_t origin[3] = {1, 1, 1}, size[3] = {1, 1, 1}, i;
+  sph_source_def source;
+  sph_source_id id;
+  float v[3 * 64];
+  (void)state;
+  scene_open(&s, 4000, 0.02f, 0.0f, 1e-3f);
+  for (i = 0; i < 24; ++i) speeds[i] = (i % 3 == 0) ? 2.0f : 0.0f;
+  speeds[9] = 1e20f; /* voxel 3's x */
+  sph_sdf_desc_init(&desc);
+  desc.distance.dims[0] = desc.distance.dims[1] = desc.distance.dims[2] = 2;
+  desc.distance.index_to_local[0] = desc.distance.index_to_local[5] = desc.distance.index_to_local[10] =
+      0.05f;
+  desc.distance.index_to_local[3] = desc.distance.index_to_local[7] = desc.distance.index_to_local[11] =
+      -0.025f;
+  desc.distance.data = distance;
+  sph_grid_desc_init(&velocity);
+  velocity.dims[0] = velocity.dims[1] = velocity.dims[2] = 2;
+  velocity.data = speeds;
+  desc.velocity = &velocity;
+  EXPECT(SPH_ERROR_INVALID_ARGUMENT, "desc->velocity->data[9..11]", sph_sdf_create(s.context, &desc, &sdf));
+  assert_true(strstr(sph_get_last_error(), "1.8e19") != NULL);
+  speeds[9] = 2.0f;
+  SCENE_OK(sph_sdf_create(s.context, &desc, &sdf));
+  EXPECT(SPH_ERROR_INVALID_ARGUMENT, "data[0..2]",
+         sph_sdf_update(sdf, SPH_SDF_CHANNEL_VELOCITY, origin, size, one, SPH_MEMORY_HOST));
+  /* Unchanged: a source taking its velocity from the field emits at 2 m/s, and steps. */
+  sph_source_def_init(&source);
+  source.region = sdf;
+  source.flags = SPH_SOURCE_FLAG_VELOCITY_FROM_FIELD;
+  SCENE_OK(sph_source_create(s.world, &source, &id));
+  SCENE_OK(sph_world_step(s.world, 0.001f));
+  assert_true(scene_velocities(&s, v, 64) > 0);
+  assert_true(fabsf(v[0] - 2.0f) < 0.5f);
+  SCENE_OK(sph_source_destroy(s.world, id));
+  SCENE_OK(sph_sdf_destroy(sdf));
+  scene_close(&s);
+}
+
+/* A continuous source's rate, however large (any finite rate >= 0 is accepted), emits what its
+ * region takes and leaves a world whose own checkpoint loads: before, the carried budget grew
+ * without bound (rate 1e20 made the save unloadable after one step, 1e15 with the region held
+ * full after about a hundred), and at 3e38 its cast to size_t overflowed and nothing was
+ * emitted. The budget owed is at most one region's worth, so a region blocked for a while is
+ * refilled once when it clears, not every frame for as long again. */
+static void test_source_rate_extremes(void** state) {
+  const float rates[3] = {1e15f, 1e20f, 3e38f};
+  uint32_t counts[3], k;
+  for (k = 0; k < 3; ++k) {
+    scene s;
+    sph_shape_desc shape;
+    sph_sdf* sdf;
+    sph_source_def source;
+    sph_source_id id;
+    uint64_t needed = 0, written = 0;
+    void* bytes;
+    sph_world* loaded = NULL;
+    int step;
+    (void)state;
+    scene_open(&s, 4000, 0.02f, 0.0f, 1e-3f); /* no gravity: the region stays full */
+    sph_shape_desc_init(&shape);
+    shape.shape = SPH_SHAPE_SPHERE;
+    shape.radius = 0.05f;
+    sdf = scene_shape(&s, &shape);
+    sph_source_def_init(&source);
+    source.region = sdf;
+    source.mode = SPH_SOURCE_CONTINUOUS;
+    source.rate = rates[k];
+    SCENE_OK(sph_source_create(s.world, &source, &id));
+    for (step = 0; step < 120; ++step) SCENE_OK(sph_world_step(s.world, 0.01f));
+    SCENE_OK(sph_world_get_particle_count(s.world, &counts[k]));
+    assert_true(counts[k] > 0);
+    SCENE_OK(sph_world_save(s.world, NULL, 0, &needed));
+    bytes = malloc((size_t)needed);
+    assert_non_null(bytes);
+    SCENE_OK(sph_world_save(s.world, bytes, needed, &written));
+    SCENE_OK(sph_world_load(s.context, bytes, written, &loaded));
+    SCENE_OK(sph_world_step(loaded, 0.01f));
+    SCENE_OK(sph_world_destroy(loaded));
+    free(bytes);
+    SCENE_OK(sph_source_destroy(s.world, id));
+    SCENE_OK(sph_sdf_destroy(sdf));
+    scene_close(&s);
+  }
+  /* Every rate far above the region's size per step: the same emission. */
+  assert_int_equal(counts[1], counts[0]);
+  assert_int_equal(counts[2], counts[0]);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_sdf_errors),
       cmocka_unit_test(test_collider_errors),
       cmocka_unit_test(test_source_sink_field_errors),
       cmocka_unit_test(test_failed_step_undoes_emission),
+      cmocka_unit_test(test_source_reach),
+      cmocka_unit_test(test_velocity_channel_speeds),
+      cmocka_unit_test(test_source_rate_extremes),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '856dcaec3a576bbbc1e1f83d4ff3cb230a0fb4bd5b646220632fd4890dfff83a', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a5578d6102b62b815a8e30ab9971b3f673f74fefb99945f893d23fa6990a6ca3', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': '3009522c49f20cb52041fcf8ec29d2f3f11ef26cc61d76d2de29e79ef3b551f6', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': 'a5578d6102b62b815a8e30ab9971b3f673f74fefb99945f893d23fa6990a6ca3', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -1738,7 +1738,7 @@ class SourceDef(_SphStruct):
         min_distance (float): skip lattice points closer than this to a particle, m; 0 (default) = 0.9 x spacing; at most the kernel radius
         velocity (sph_vec3): initial velocity (unless VELOCITY_FROM_FIELD); default 0
         flags (uint32_t): SPH_SOURCE_FLAG_*
-        rate (float): CONTINUOUS: most particles per second; 0 (default) = no limit
+        rate (float): CONTINUOUS: most particles per second; 0 (default) = no limit. What the region or the world could not take is emitted later, but at most one region's worth is owed
         user_attribute (uint32_t): the user attribute of the particles it emits; default 0; non-zero needs SPH_FEATURE_USER_ATTRIBUTE (else FEATURE_DISABLED)
         reserved1 (uint32_t): must be 0
     """
@@ -1908,7 +1908,7 @@ class ProbeDef(_SphStruct):
         kind (sph_probe_kind): default SPH_PROBE_POINT
         sampling (sph_probe_sampling): default SPH_PROBE_EVERY_FRAME
         position (sph_vec3): POINT: where; GAUGE: the line's start (put it below the floor), m
-        direction (sph_vec3): GAUGE: the line's direction (normalised by the library); {0,0,0} = up, against the world's gravity at each step (+y without gravity)
+        direction (sph_vec3): GAUGE: the line's direction (normalised by the library: any finite non-zero vector, however short or long); {0,0,0} = up, against the world's gravity at each step (+y without gravity)
         length (float): GAUGE: the line's length, m; > 0
         sample_spacing (float): GAUGE: the column integral's step, m; 0 = kernel radius / 8; at most 65536 steps along the line
         reserved0 (uint32_t): must be 0
@@ -2325,7 +2325,7 @@ FUNCTIONS = {
     'sph_source_def_init_sized': (sph_result, (_c.POINTER(sph_source_def), _c.c_uint32), ('def', 'size'),
         '', 'sph'),
     'sph_source_create': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_source_def), _c.POINTER(sph_source_id)), ('world', 'def', 'out_id'),
-        'Adds a source (thesis 3.3). Emission happens at the start of each sph_world_step. A growable world grows for it (SPH_EVENT_CAPACITY_GROWN; a growth that cannot be allocated fails the step with OUT_OF_*_MEMORY, world unchanged). When max_capacity runs out, the source emits what fits and the step reports an SPH_EVENT_SOURCE_CAPACITY_REACHED event; nothing else changes. Errors: INVALID_ARGUMENT, CAPACITY (the region holds more than 2^28 lattice points).', 'sph'),
+        "Adds a source (thesis 3.3). Emission happens at the start of each sph_world_step. A growable world grows for it (SPH_EVENT_CAPACITY_GROWN; a growth that cannot be allocated fails the step with OUT_OF_*_MEMORY, world unchanged). When max_capacity runs out, the source emits what fits and the step reports an SPH_EVENT_SOURCE_CAPACITY_REACHED event; nothing else changes (likewise once the world's 2^32 particle ids are used up: ids are never reused). Errors: INVALID_ARGUMENT (a bad field, named; a region whose lattice, at this transform, reaches farther than 65536 particle spacings from the origin, where no particle may be), CAPACITY (the region holds more than 2^28 lattice points). sph_source_set_transform refuses a transform that would move the lattice out of that reach likewise (INVALID_ARGUMENT naming transform), the source unchanged. A region's velocity channel (VELOCITY_FROM_FIELD) holds speeds below 1.8e19 m/s, as particles do (sph_sdf_create and sph_sdf_update check it).", 'sph'),
     'sph_source_destroy': (sph_result, (_c.POINTER(sph_world), sph_source_id), ('world', 'id'),
         '', 'sph'),
     'sph_source_set_transform': (sph_result, (_c.POINTER(sph_world), sph_source_id, _c.POINTER(sph_transform)), ('world', 'id', 'transform'),
@@ -2347,7 +2347,7 @@ FUNCTIONS = {
     'sph_probe_def_init_sized': (sph_result, (_c.POINTER(sph_probe_def), _c.c_uint32), ('def', 'size'),
         '', 'sph'),
     'sph_probe_create': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_probe_def), _c.POINTER(sph_probe_id)), ('world', 'def', 'out_id'),
-        "Adds a probe or gauge; it is sampled inside every following sph_world_step on the world's backend (on the device for CUDA, with no host copy per substep). Errors: INVALID_HANDLE (world), INVALID_ARGUMENT (NULL def or out_id; a non-finite position or direction, a gauge's length not > 0 or too many steps, a negative sample_spacing, non-zero reserved0, each named), UNSUPPORTED (an unknown kind or sampling), VERSION_MISMATCH, CAPACITY (65536 probes), WORLD_LOCKED. On a DFSPH world the pressure sampled is the one both its solves applied in the substep (SPH_ATTRIBUTE_PRESSURE's), at the substep's start positions. Nothing changes on error. Checkpoints of format 6 and later carry the probes (readings start again); restoring an older one keeps the world's own (docs/api.md).", 'sph'),
+        "Adds a probe or gauge; it is sampled inside every following sph_world_step on the world's backend (on the device for CUDA, with no host copy per substep). Errors: INVALID_HANDLE (world), INVALID_ARGUMENT (NULL def or out_id; a non-finite position or direction, a gauge's length not > 0 or too many steps, a negative sample_spacing, non-zero reserved0, each named), UNSUPPORTED (an unknown kind or sampling), VERSION_MISMATCH, CAPACITY (65536 probes, or more than 2^22 = 4194304 sample points of all probes together: a point probe samples one, a gauge its steps), WORLD_LOCKED. On a DFSPH world the pressure sampled is the one both its solves applied in the substep (SPH_ATTRIBUTE_PRESSURE's), at the substep's start positions. Nothing changes on error. Checkpoints of format 6 and later carry the probes (readings start again); restoring an older one keeps the world's own (docs/api.md).", 'sph'),
     'sph_probe_destroy': (sph_result, (_c.POINTER(sph_world), sph_probe_id), ('world', 'id'),
         'Removes a probe; id {0} is a no-op. Errors: INVALID_HANDLE (world; stale or foreign id), WORLD_LOCKED.', 'sph'),
     'sph_probe_reading_init_sized': (sph_result, (_c.POINTER(sph_probe_reading), _c.c_uint32), ('reading', 'size'),
