@@ -69,8 +69,7 @@ std::shared_ptr<const sph::SdfAsset> acceleration_grid(const sph_grid_desc* desc
   for (uint64_t i = 0; i < 3 * n; ++i)
     if (!std::isfinite(g.data[i]))
       throw Error(Status::InvalidArgument, "def->grid->data[" + std::to_string(i) + "]: is not finite");
-  auto grid = sph::make_sdf_asset(static_cast<int32_t>(g.dims[0]), static_cast<int32_t>(g.dims[1]),
-                                  static_cast<int32_t>(g.dims[2]), sph::index_to_local_from_public(g));
+  auto grid = sph::make_grid_asset(g, "def->grid->");
   grid->velocity().resize(n);
   std::memcpy(grid->velocity().data(), g.data, 3 * n * sizeof(float));
   return grid;

@@ -80,8 +80,7 @@ std::shared_ptr<sph::SdfAsset> asset_from_desc(const sph_context* context, const
     throw Error(Status::InvalidArgument, "desc->distance.components: must be 1 (or 0, meaning 1)");
   const uint64_t n = voxel_count(g.dims, "desc->distance.");
   if (!g.data) throw Error(Status::InvalidArgument, "desc->distance.data: is NULL (required)");
-  auto asset = sph::make_sdf_asset(static_cast<int32_t>(g.dims[0]), static_cast<int32_t>(g.dims[1]),
-                                   static_cast<int32_t>(g.dims[2]), sph::index_to_local_from_public(g));
+  auto asset = sph::make_grid_asset(g, "desc->distance.");
   asset->distance() = read_floats(context, g.data, n, sph::enum_bits(g.memory), "desc->distance.");
   auto same_dims = [&](const sph_grid_desc& o, const char* name) {
     if (o.dims[0] != g.dims[0] || o.dims[1] != g.dims[1] || o.dims[2] != g.dims[2])

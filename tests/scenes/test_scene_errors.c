@@ -41,7 +41,7 @@ static void test_sdf_errors(void** state) {
   EXPECT(SPH_ERROR_INVALID_ARGUMENT, "dims", sph_sdf_create(s.context, &desc, &sdf));
   desc.distance.dims[1] = 2;
   desc.distance.index_to_local[0] = 0.0f; /* singular */
-  EXPECT(SPH_ERROR_INVALID_ARGUMENT, "index_to_local", sph_sdf_create(s.context, &desc, &sdf));
+  EXPECT(SPH_ERROR_INVALID_ARGUMENT, "desc->distance.index_to_local", sph_sdf_create(s.context, &desc, &sdf));
   desc.distance.index_to_local[0] = 1.0f;
   memcpy(nan_data, data, sizeof data);
   nan_data[3] = NAN;
@@ -230,6 +230,17 @@ static void test_source_sink_field_errors(void** state) {
   grid.components = 1; /* (0 means 3 here) */
   field.grid = &grid;
   EXPECT(SPH_ERROR_INVALID_ARGUMENT, "components", sph_force_field_create(s.world, &field, &field_id));
+  {
+    float zero3[3] = {0.0f, 0.0f, 0.0f};
+    grid.components = 3;
+    grid.data = zero3;
+    grid.index_to_local[0] = NAN; /* the asset's own check, named by the caller's field */
+    EXPECT(SPH_ERROR_INVALID_ARGUMENT, "def->grid->index_to_local",
+           sph_force_field_create(s.world, &field, &field_id));
+    grid.index_to_local[0] = 1.0f;
+    grid.components = 1;
+    grid.data = NULL;
+  }
   field.kind = (sph_force_field_kind)11;
   EXPECT(SPH_ERROR_UNSUPPORTED, "kind", sph_force_field_create(s.world, &field, &field_id));
   field.kind = SPH_FORCE_FIELD_RADIAL;
