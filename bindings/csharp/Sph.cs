@@ -261,6 +261,134 @@ namespace Sph
         Force = Constants.SPH_STEP_LIMIT_FORCE,
     }
 
+    /// <summary>DFSPH option bits (SPH_DFSPH_* flags): set them with
+    /// <see cref="Sph.DfsphParams.DfsphFlags"/>.</summary>
+    [Flags]
+    public enum DfsphFlags : uint
+    {
+        None = 0,
+        /// <summary>No divergence solve (cheaper; a noisier pressure).</summary>
+        SkipDivergenceSolve = Constants.SPH_DFSPH_SKIP_DIVERGENCE_SOLVE,
+        /// <summary>The Jacobi solves' pressure gradient corrected to first order (Jacobi only).</summary>
+        CorrectedGradient = Constants.SPH_DFSPH_CORRECTED_GRADIENT,
+        /// <summary>The depth step limit (<see cref="Sph.DfsphParams.DepthStepFactor"/>) off.</summary>
+        NoDepthStepLimit = Constants.SPH_DFSPH_NO_DEPTH_STEP_LIMIT,
+    }
+
+    /// <summary>How DFSPH's density solve iterates (SPH_DFSPH_JACOBI, ...): set it with
+    /// <see cref="Sph.DfsphParams.DfsphLinearSolver"/>.</summary>
+    public enum DfsphLinearSolver : uint
+    {
+        /// <summary>0: the library's default, Jacobi.</summary>
+        Default = 0,
+        /// <summary>The Jacobi step of Bender &amp; Koschier (the default).</summary>
+        Jacobi = Constants.SPH_DFSPH_JACOBI,
+        /// <summary>Jacobi-preconditioned conjugate gradients on the compressed particles.</summary>
+        ConjugateGradients = Constants.SPH_DFSPH_CONJUGATE_GRADIENTS,
+        /// <summary>The Jacobi steps accelerated by Chebyshev's semi-iteration (not with
+        /// <see cref="DfsphFlags.CorrectedGradient"/>).</summary>
+        Chebyshev = Constants.SPH_DFSPH_CHEBYSHEV,
+    }
+
+    /// <summary>DFSPH's candidate masks on the CUDA backend (docs/cuda.md): set them with
+    /// <see cref="Sph.ContextDef.CudaDfsphMasksMode"/>. A CPU context checks and ignores them.</summary>
+    public enum CudaDfsphMasksMode : uint
+    {
+        /// <summary>0, the default: the density pass records which candidates are neighbours.</summary>
+        On = 0,
+        /// <summary>SPH_CUDA_DFSPH_MASKS_OFF: the solves walk every candidate (no memory, slower).</summary>
+        Off = Constants.SPH_CUDA_DFSPH_MASKS_OFF,
+        /// <summary>SPH_CUDA_DFSPH_NEIGHBOR_LISTS: the masks and each particle's neighbour list.</summary>
+        NeighborLists = Constants.SPH_CUDA_DFSPH_NEIGHBOR_LISTS,
+    }
+
+    /// <summary>Collider bits (SPH_COLLIDER_FLAG_*): set them with <see cref="Sph.ColliderDef.ColliderFlags"/>.</summary>
+    [Flags]
+    public enum ColliderFlags : uint
+    {
+        None = 0,
+        /// <summary>Solid where the SDF is positive (a container).</summary>
+        Inverted = Constants.SPH_COLLIDER_FLAG_INVERTED,
+    }
+
+    /// <summary>Source bits (SPH_SOURCE_FLAG_*): set them with <see cref="Sph.SourceDef.SourceFlags"/>.</summary>
+    [Flags]
+    public enum SourceFlags : uint
+    {
+        None = 0,
+        /// <summary>Emitted particles take their velocity from the region's velocity channel.</summary>
+        VelocityFromField = Constants.SPH_SOURCE_FLAG_VELOCITY_FROM_FIELD,
+    }
+
+    /// <summary>Analytic shape bits (SPH_SHAPE_FLAG_*): set them with <see cref="Sph.ShapeDesc.ShapeFlags"/>.</summary>
+    [Flags]
+    public enum ShapeFlags : uint
+    {
+        None = 0,
+        /// <summary>A hollow box without its lid (a tank open at +y).</summary>
+        OpenTop = Constants.SPH_SHAPE_FLAG_OPEN_TOP,
+    }
+
+    public partial struct DfsphParams
+    {
+        /// <summary>The <see cref="Flags"/> field as <see cref="Sph.DfsphFlags"/>:
+        /// <c>p.DfsphFlags = DfsphFlags.SkipDivergenceSolve</c>.</summary>
+        public DfsphFlags DfsphFlags
+        {
+            get { return (DfsphFlags)Flags; }
+            set { Flags = (uint)value; }
+        }
+
+        /// <summary>The <see cref="LinearSolver"/> field as <see cref="Sph.DfsphLinearSolver"/>:
+        /// <c>p.DfsphLinearSolver = DfsphLinearSolver.Chebyshev</c>.</summary>
+        public DfsphLinearSolver DfsphLinearSolver
+        {
+            get { return (DfsphLinearSolver)LinearSolver; }
+            set { LinearSolver = (uint)value; }
+        }
+    }
+
+    public partial struct ContextDef
+    {
+        /// <summary>The <see cref="CudaDfsphMasks"/> field as <see cref="Sph.CudaDfsphMasksMode"/>:
+        /// <c>def.CudaDfsphMasksMode = CudaDfsphMasksMode.NeighborLists</c>.</summary>
+        public CudaDfsphMasksMode CudaDfsphMasksMode
+        {
+            get { return (CudaDfsphMasksMode)CudaDfsphMasks; }
+            set { CudaDfsphMasks = (uint)value; }
+        }
+    }
+
+    public partial struct ColliderDef
+    {
+        /// <summary>The <see cref="Flags"/> field as <see cref="Sph.ColliderFlags"/>.</summary>
+        public ColliderFlags ColliderFlags
+        {
+            get { return (ColliderFlags)Flags; }
+            set { Flags = (uint)value; }
+        }
+    }
+
+    public partial struct SourceDef
+    {
+        /// <summary>The <see cref="Flags"/> field as <see cref="Sph.SourceFlags"/>.</summary>
+        public SourceFlags SourceFlags
+        {
+            get { return (SourceFlags)Flags; }
+            set { Flags = (uint)value; }
+        }
+    }
+
+    public partial struct ShapeDesc
+    {
+        /// <summary>The <see cref="Flags"/> field as <see cref="Sph.ShapeFlags"/>.</summary>
+        public ShapeFlags ShapeFlags
+        {
+            get { return (ShapeFlags)Flags; }
+            set { Flags = (uint)value; }
+        }
+    }
+
     public partial struct WorldDef
     {
         /// <summary>The <see cref="Features"/> field as <see cref="Sph.FeatureFlags"/>:
@@ -993,7 +1121,7 @@ namespace Sph
         {
             var def = ColliderDef.Default();
             def.Transform = transform;
-            if (inverted) def.Flags |= Constants.SPH_COLLIDER_FLAG_INVERTED;
+            if (inverted) def.ColliderFlags |= ColliderFlags.Inverted;
             return CreateCollider(sdf, def);
         }
 

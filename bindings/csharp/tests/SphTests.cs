@@ -634,6 +634,95 @@ static class Tests
         }
     }
 
+    /// The DFSPH, CUDA-mask and object #defines as enums: every constant has its member, the
+    /// properties write the raw fields, and values read back from the library as the enums.
+    public static void TestNamedOptionEnums()
+    {
+        var prefixes = new[] {
+            Tuple.Create("SPH_DFSPH_SKIP_", typeof(DfsphFlags), "SPH_DFSPH_"),
+            Tuple.Create("SPH_DFSPH_CORRECTED_", typeof(DfsphFlags), "SPH_DFSPH_"),
+            Tuple.Create("SPH_DFSPH_NO_", typeof(DfsphFlags), "SPH_DFSPH_"),
+            Tuple.Create("SPH_DFSPH_JACOBI", typeof(DfsphLinearSolver), "SPH_DFSPH_"),
+            Tuple.Create("SPH_DFSPH_CONJUGATE_", typeof(DfsphLinearSolver), "SPH_DFSPH_"),
+            Tuple.Create("SPH_DFSPH_CHEBYSHEV", typeof(DfsphLinearSolver), "SPH_DFSPH_"),
+            Tuple.Create("SPH_CUDA_DFSPH_MASKS_OFF", typeof(CudaDfsphMasksMode), "SPH_CUDA_DFSPH_MASKS_"),
+            Tuple.Create("SPH_CUDA_DFSPH_NEIGHBOR_", typeof(CudaDfsphMasksMode), "SPH_CUDA_DFSPH_"),
+            Tuple.Create("SPH_COLLIDER_FLAG_", typeof(ColliderFlags), "SPH_COLLIDER_FLAG_"),
+            Tuple.Create("SPH_SOURCE_FLAG_", typeof(SourceFlags), "SPH_SOURCE_FLAG_"),
+            Tuple.Create("SPH_SHAPE_FLAG_", typeof(ShapeFlags), "SPH_SHAPE_FLAG_"),
+        };
+        int checkedCount = 0;
+        foreach (FieldInfo f in typeof(Constants).GetFields(BindingFlags.Public | BindingFlags.Static))
+        {
+            foreach (var p in prefixes)
+            {
+                if (!f.Name.StartsWith(p.Item1)) continue;
+                object value = Enum.ToObject(p.Item2, Convert.ToUInt32(f.GetValue(null)));
+                AssertEqual(Pascal(f.Name.Substring(p.Item3.Length)), Enum.GetName(p.Item2, value), p.Item2.Name + " member of " + f.Name);
+                ++checkedCount;
+            }
+        }
+        AssertEqual(11, checkedCount, "DFSPH, CUDA-mask and object-flag constants found");
+
+        var dp = DfsphParams.Default();
+        AssertEqual(DfsphLinearSolver.Jacobi, dp.DfsphLinearSolver, "default linear solver");
+        AssertEqual(DfsphFlags.None, dp.DfsphFlags, "default DFSPH flags");
+        dp.DfsphLinearSolver = DfsphLinearSolver.Chebyshev;
+        dp.DfsphFlags = DfsphFlags.SkipDivergenceSolve | DfsphFlags.NoDepthStepLimit;
+        AssertEqual(Constants.SPH_DFSPH_CHEBYSHEV, dp.LinearSolver, "DfsphLinearSolver writes LinearSolver");
+        AssertEqual(Constants.SPH_DFSPH_SKIP_DIVERGENCE_SOLVE | Constants.SPH_DFSPH_NO_DEPTH_STEP_LIMIT, dp.Flags, "DfsphFlags writes Flags");
+        var cd = ContextDef.Default();
+        AssertEqual(CudaDfsphMasksMode.On, cd.CudaDfsphMasksMode, "masks on by default");
+        cd.CudaDfsphMasksMode = CudaDfsphMasksMode.NeighborLists;
+        AssertEqual(Constants.SPH_CUDA_DFSPH_NEIGHBOR_LISTS, cd.CudaDfsphMasks, "CudaDfsphMasksMode writes CudaDfsphMasks");
+        var collider = ColliderDef.Default();
+        collider.ColliderFlags = ColliderFlags.Inverted;
+        AssertEqual(Constants.SPH_COLLIDER_FLAG_INVERTED, collider.Flags, "ColliderFlags writes Flags");
+        var source = SourceDef.Default();
+        source.SourceFlags = SourceFlags.VelocityFromField;
+        AssertEqual(Constants.SPH_SOURCE_FLAG_VELOCITY_FROM_FIELD, source.Flags, "SourceFlags writes Flags");
+        var shape = ShapeDesc.Default();
+        shape.ShapeFlags = ShapeFlags.OpenTop;
+        AssertEqual(Constants.SPH_SHAPE_FLAG_OPEN_TOP, shape.Flags, "ShapeFlags writes Flags");
+
+        // A CPU context checks and ignores the masks; a value the library does not know is refused.
+        cd.Backend = Backend.Cpu;
+        cd.CpuWorkerCount = 1;
+        using (var ctx = new Context(cd))
+        {
+            WorldDef d = SmallWorld(256);
+            d.Solver = Solver.Dfsph;
+            using (var world = ctx.CreateWorld(d))
+            {
+                var p = world.DfsphParams;
+                p.DfsphLinearSolver = DfsphLinearSolver.ConjugateGradients;
+                p.DfsphFlags = DfsphFlags.SkipDivergenceSolve;
+                world.DfsphParams = p;
+                AssertEqual(DfsphLinearSolver.ConjugateGradients, world.DfsphParams.DfsphLinearSolver, "linear solver read back");
+                AssertEqual(DfsphFlags.SkipDivergenceSolve, world.DfsphParams.DfsphFlags, "flags read back");
+                p.DfsphLinearSolver = DfsphLinearSolver.Chebyshev;
+                p.DfsphFlags = DfsphFlags.CorrectedGradient;  // not with Chebyshev
+                Throws(Result.ErrorInvalidArgument, () => world.DfsphParams = p);
+                AssertEqual(DfsphLinearSolver.ConjugateGradients, world.DfsphParams.DfsphLinearSolver, "unchanged on error");
+                world.FillBox(new Vec3(0, 0, 0), new Vec3(0.1f, 0.1f, 0.1f));
+                world.Step(1f / 60f);
+            }
+            var box = ShapeDesc.Default();
+            box.HalfExtents = new Vec3(0.1f, 0.1f, 0.1f);
+            box.VoxelSize = 0.02f;
+            box.ShapeFlags = ShapeFlags.OpenTop;
+            using (var world = ctx.CreateWorld(SmallWorld()))
+            using (var tank = Sdf.CreateShape(ctx, box))
+            {
+                var def = ColliderDef.Default();
+                def.ColliderFlags = ColliderFlags.Inverted;
+                using (var c = world.CreateCollider(tank, def)) { }
+            }
+        }
+        cd.CudaDfsphMasksMode = (CudaDfsphMasksMode)7;
+        Throws(Result.ErrorInvalidArgument, () => new Context(cd));
+    }
+
     public static void TestPhysicsParamsByKindAndTheirDescriptions()
     {
         AssertEqual("tait", Utf8.FromNative(Library.ParamsInfo(ParamsKind.Tait).Name), "params name");

@@ -71,11 +71,13 @@ class Sdf:
     def shape(cls, context, shape=_g.Shape.BOX, **fields):
         """An analytic shape sampled into a grid (sph_sdf_create_shape); fields are those of
         ShapeDesc (half_extents, radius, half_height, wall_thickness, voxel_size, flags,
-        padding_voxels). ``open_top=True`` sets SPH_SHAPE_FLAG_OPEN_TOP."""
-        if fields.pop("open_top", False):
-            fields["flags"] = fields.get("flags", 0) | _g.SPH_SHAPE_FLAG_OPEN_TOP
+        padding_voxels); flags takes ShapeFlag members or names. ``open_top=True`` sets
+        ShapeFlag.OPEN_TOP."""
+        open_top = fields.pop("open_top", False)
         shape = _g.Shape[shape.upper()] if isinstance(shape, str) else _g.Shape(shape)
         desc = _g.ShapeDesc(shape=shape, **fields)
+        if open_top:
+            desc.flags |= _g.SPH_SHAPE_FLAG_OPEN_TOP
         out = ctypes.POINTER(_g.sph_sdf)()
         check(library().sph_sdf_create_shape(context.handle, ctypes.byref(desc), ctypes.byref(out)),
               "sph_sdf_create_shape")
@@ -395,7 +397,8 @@ class WorldSceneMixin:
         """Places an SDF asset of this world's context as a collider (sph_collider_create).
 
         ``inverted=True`` makes the solid where the SDF is positive (a container). Other fields
-        are those of ColliderDef: restitution, friction, stickiness, flags.
+        are those of ColliderDef: restitution, friction, stickiness, flags (ColliderFlag members
+        or names, ``flags="inverted"``).
         """
         d = _g.ColliderDef(transform=as_transform(transform), **fields)
         d.sdf = sdf.handle
@@ -408,7 +411,8 @@ class WorldSceneMixin:
     def add_source(self, region, transform=None, *, mode=_g.SourceMode.FILL_ONCE, **fields):
         """Adds a source that fills `region` (an Sdf, negative inside) with particles
         (sph_source_create). mode: SourceMode or "fill_once" / "continuous"; other fields are
-        those of SourceDef (spacing, min_distance, velocity, flags, rate, user_attribute)."""
+        those of SourceDef (spacing, min_distance, velocity, flags, rate, user_attribute); flags
+        takes SourceFlag members or names (``flags="velocity_from_field"``)."""
         d = _g.SourceDef(transform=as_transform(transform), mode=_enum(_g.SourceMode, mode), **fields)
         d.region = region.handle
         out = _g.SourceId()
