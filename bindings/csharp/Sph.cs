@@ -1113,7 +1113,7 @@ namespace Sph
                 def.Sdf = borrowed.Pointer;
                 SphException.Check(Native.sph_collider_create(Handle, ref def, out id), "sph_collider_create");
             }
-            return new Collider(this, id);
+            return HandOut(new Collider(this, id), id.Bits);
         }
 
         /// <summary>A collider at `transform` with the default material.</summary>
@@ -1134,7 +1134,7 @@ namespace Sph
                 def.Region = borrowed.Pointer;
                 SphException.Check(Native.sph_source_create(Handle, ref def, out id), "sph_source_create");
             }
-            return new Source(this, id);
+            return HandOut(new Source(this, id), id.Bits);
         }
 
         /// <summary>Adds a sink: with a region (SinkMode.Region) or, region null, the def's
@@ -1149,7 +1149,7 @@ namespace Sph
                 def.Region = borrowed.Pointer;
                 SphException.Check(Native.sph_sink_create(Handle, ref def, out id), "sph_sink_create");
             }
-            return new Sink(this, id);
+            return HandOut(new Sink(this, id), id.Bits);
         }
 
         /// <summary>Adds a probe or a gauge (ProbeDef.Kind), sampled inside every Step.</summary>
@@ -1157,7 +1157,7 @@ namespace Sph
         {
             ProbeId id;
             SphException.Check(Native.sph_probe_create(Handle, ref def, out id), "sph_probe_create");
-            return new Probe(this, id);
+            return HandOut(new Probe(this, id), id.Bits);
         }
 
         /// <summary>Adds a force field; `region` (optional) limits it to where that SDF is negative.</summary>
@@ -1198,10 +1198,96 @@ namespace Sph
                 if (grid.IsAllocated) grid.Free();
                 if (data.IsAllocated) data.Free();
             }
-            return new ForceField(this, id);
+            return HandOut(new ForceField(this, id), id.Bits);
         }
 
-        /// <summary>Events of the last Step (sources at capacity, sink removals, growths, capped solves, load and pressure thresholds).</summary>
+        // The wrappers CreateCollider/CreateSource/CreateSink/CreateProbe/CreateForceField handed
+        // out, by kind and id bits, held weakly (ObjectOf).
+        readonly object handedOutLock = new object();
+        readonly Dictionary<KeyValuePair<Type, ulong>, WeakReference> handedOut =
+            new Dictionary<KeyValuePair<Type, ulong>, WeakReference>();
+        int handedOutPruneAt = 64;
+
+        T HandOut<T>(T obj, ulong bits) where T : class
+        {
+            lock (handedOutLock)
+            {
+                if (handedOut.Count >= handedOutPruneAt)
+                {
+                    var dead = new List<KeyValuePair<Type, ulong>>();
+                    foreach (var entry in handedOut)
+                        if (!entry.Value.IsAlive) dead.Add(entry.Key);
+                    foreach (var key in dead) handedOut.Remove(key);
+                    handedOutPruneAt = Math.Max(64, 2 * handedOut.Count);
+                }
+                handedOut[new KeyValuePair<Type, ulong>(typeof(T), bits)] = new WeakReference(obj);
+            }
+            return obj;
+        }
+
+        static Type KindOf(EventType type)
+        {
+            switch (type)
+            {
+                case EventType.SourceCapacityReached:
+                case EventType.CapacityGrown: return typeof(Source);
+                case EventType.SinkRemoved: return typeof(Sink);
+                case EventType.ColliderLoadExceeded: return typeof(Collider);
+                case EventType.ProbePressureExceeded: return typeof(Probe);
+                default: return null;
+            }
+        }
+
+        static ulong BitsOf(object obj)
+        {
+            if (obj is Collider) return ((Collider)obj).Id.Bits;
+            if (obj is Source) return ((Source)obj).Id.Bits;
+            if (obj is Sink) return ((Sink)obj).Id.Bits;
+            if (obj is Probe) return ((Probe)obj).Id.Bits;
+            if (obj is ForceField) return ((ForceField)obj).Id.Bits;
+            return 0;
+        }
+
+        /// <summary>The <see cref="Collider"/>, <see cref="Probe"/>, <see cref="Source"/> or
+        /// <see cref="Sink"/> an event names (its ObjectBits): the very object this world's
+        /// CreateCollider / CreateProbe / CreateSource / CreateSink returned. Null when the event
+        /// names no object (the DFSPH solve events), when that object was collected (the world
+        /// holds weak references only) or disposed, or when it was not created through this World
+        /// (a loaded checkpoint's objects). The event's type gives the kind (SourceCapacityReached
+        /// and CapacityGrown a Source, SinkRemoved a Sink, ColliderLoadExceeded a Collider,
+        /// ProbePressureExceeded a Probe); for a type these bindings do not know, the one object of
+        /// any kind with those bits.</summary>
+        public object ObjectOf(Event e)
+        {
+            if (e.ObjectBits == 0) return null;
+            Type kind = KindOf(e.Type);
+            Type[] kinds = kind != null ? new[] { kind } : new[] { typeof(Collider), typeof(Probe), typeof(Source), typeof(Sink) };
+            object found = null;
+            int matches = 0;
+            lock (handedOutLock)
+            {
+                foreach (Type k in kinds)
+                {
+                    WeakReference r;
+                    if (!handedOut.TryGetValue(new KeyValuePair<Type, ulong>(k, e.ObjectBits), out r)) continue;
+                    object o = r.Target;
+                    if (o == null || BitsOf(o) != e.ObjectBits) continue;
+                    found = o;
+                    ++matches;
+                }
+            }
+            return matches == 1 ? found : null;
+        }
+
+        /// <summary>As <see cref="ObjectOf(Event)"/>, typed: null also when the event names an
+        /// object of another kind. <c>world.ObjectOf&lt;Source&gt;(e)</c>.</summary>
+        public T ObjectOf<T>(Event e) where T : class
+        {
+            return ObjectOf(e) as T;
+        }
+
+        /// <summary>Events of the last Step (sources at capacity, sink removals, growths, capped solves, load and pressure thresholds);
+        /// <see cref="ObjectOf(Event)"/> gives the object an event names.</summary>
         public Event[] GetEvents()
         {
             uint n;

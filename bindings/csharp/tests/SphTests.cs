@@ -1111,6 +1111,109 @@ static class Tests
         }
     }
 
+    // World.ObjectOf: an event gives back the very wrapper that named its object.
+    // A source whose wrapper no one keeps, created on a thread of its own (whose stack is gone
+    // once it ends, so no stale slot of it keeps the wrapper alive for mono's conservative GC).
+    static ulong CreateCollectableSource(World world, Sdf region)
+    {
+        ulong bits = 0;
+        var t = new System.Threading.Thread(() =>
+        {
+            var def = SourceDef.Default();
+            def.Transform = At(1, 0, 0);
+            bits = world.CreateSource(region, def).Id.Bits;
+        });
+        t.Start();
+        t.Join();
+        return bits;
+    }
+
+    public static void TestObjectOfSourceAtCapacity()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(SmallWorld(300)))
+        using (var ball = Ball(ctx, 0.05f))
+        {
+            var p = world.Params;
+            p.Gravity = new Vec3(0, 0, 0);
+            world.Params = p;
+            var big = ShapeDesc.Default();
+            big.HalfExtents = new Vec3(0.2f, 0.2f, 0.2f);
+            big.VoxelSize = 0.02f;
+            using (var box = Sdf.CreateShape(ctx, big))
+            {
+                var small = world.CreateSource(ball, SourceDef.Default());
+                var flood = SourceDef.Default();
+                flood.Mode = SourceMode.Continuous;
+                flood.Transform = At(3, 0, 0);
+                var f = world.CreateSource(box, flood);
+                world.Step(1f / 60f);
+                var hits = Array.FindAll(world.GetEvents(), e => e.Type == EventType.SourceCapacityReached);
+                Assert(hits.Length >= 1, "a capacity event");
+                foreach (var e in hits)
+                {
+                    Assert(ReferenceEquals(f, world.ObjectOf(e)), "ObjectOf gives the flooding source's wrapper");
+                    Assert(ReferenceEquals(f, world.ObjectOf<Source>(e)), "ObjectOf<Source>");
+                    AssertEqual(null, world.ObjectOf<Collider>(e), "ObjectOf<Collider> of a source's event");
+                }
+                Assert(!ReferenceEquals(small, world.ObjectOf(hits[0])), "not the other source");
+                var solve = new Event { Type = EventType.PressureSolveCapped, Count = 1, ObjectBits = 0 };
+                AssertEqual(null, world.ObjectOf(solve), "an event of no object");
+                var wrongKind = new Event { Type = EventType.ColliderLoadExceeded, ObjectBits = f.Id.Bits };
+                AssertEqual(null, world.ObjectOf(wrongKind), "the bits under another kind's event");
+                // Disposed: null.
+                var stale = hits[0];
+                f.Dispose();
+                AssertEqual(null, world.ObjectOf(stale), "a disposed source");
+                // Collected: null (the world holds weak references only).
+                ulong bits = CreateCollectableSource(world, ball);
+                GC.Collect();
+                GC.WaitForPendingFinalizers();
+                GC.Collect();
+                var gone = new Event { Type = EventType.SourceCapacityReached, ObjectBits = bits };
+                AssertEqual(null, world.ObjectOf(gone), "a collected source");
+                small.Dispose();
+            }
+        }
+    }
+
+    public static void TestObjectOfColliderLoadThreshold()
+    {
+        var plane = ShapeDesc.Default();
+        plane.Shape = Shape.Plane;
+        plane.HalfExtents = new Vec3(1, 0.1f, 1);
+        plane.VoxelSize = 0.03f;
+        using (var ctx = Cpu())
+        using (var floor = Sdf.CreateShape(ctx, plane))
+        {
+            var d = SmallWorld();
+            d.FeatureFlags = FeatureFlags.ColliderLoads;
+            using (var world = ctx.CreateWorld(d))
+            {
+                var c = world.CreateCollider(floor, Transform.Default());
+                var far = world.CreateCollider(floor, At(0, -5, 0));
+                uint n = world.FillBox(new Vec3(-0.08f, 0.0f, -0.08f), new Vec3(0.08f, 0.06f, 0.08f));
+                for (int i = 0; i < 10; ++i) world.Step(1f / 60f);
+                c.SetLoadThreshold(0.5f * n * world.ParticleMass * 9.81f);
+                world.Step(1f / 60f);
+                var hits = Array.FindAll(world.GetEvents(), e => e.Type == EventType.ColliderLoadExceeded);
+                AssertEqual(1, hits.Length, "one load event");
+                Assert(ReferenceEquals(c, world.ObjectOf(hits[0])), "ObjectOf gives the loaded collider's wrapper");
+                Assert(ReferenceEquals(c, world.ObjectOf<Collider>(hits[0])), "ObjectOf<Collider>");
+                Assert(!ReferenceEquals(far, world.ObjectOf(hits[0])), "not the other collider");
+                // A loaded checkpoint has the collider but not this wrapper.
+                using (var copy = ctx.LoadWorld(world.Save()))
+                {
+                    copy.Step(1f / 60f);
+                    var copied = Array.FindAll(copy.GetEvents(), e => e.Type == EventType.ColliderLoadExceeded);
+                    AssertEqual(1, copied.Length, "the copy's load event");
+                    AssertEqual(null, copy.ObjectOf(copied[0]), "no wrapper in a loaded world");
+                }
+                GC.KeepAlive(far);
+            }
+        }
+    }
+
     // Probes (issue 17 item 2): a point in water resting on a floor reads near rho0; a gauge
     // through it starting below the floor reads the water's few centimetres; bad input is refused.
     public static void TestProbes()

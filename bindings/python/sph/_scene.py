@@ -2,6 +2,7 @@
 """SDF assets and the objects placed in a world: colliders, sources, sinks, force fields."""
 import ctypes
 import os
+import weakref
 
 import numpy as np
 
@@ -385,6 +386,16 @@ class Probe(_WorldObject):
               "sph_probe_set_pressure_threshold")
 
 
+# The kind of object each event type names (docs/api.md, sph_event_type).
+_EVENT_OBJECT_KINDS = {
+    int(_g.EventType.SOURCE_CAPACITY_REACHED): Source,
+    int(_g.EventType.CAPACITY_GROWN): Source,
+    int(_g.EventType.SINK_REMOVED): Sink,
+    int(_g.EventType.COLLIDER_LOAD_EXCEEDED): Collider,
+    int(_g.EventType.PROBE_PRESSURE_EXCEEDED): Probe,
+}
+
+
 # ---- World methods --------------------------------------------------------------------------------
 def _enum(cls, value):
     return cls[value.upper()] if isinstance(value, str) else cls(value)
@@ -392,6 +403,34 @@ def _enum(cls, value):
 
 class WorldSceneMixin:
     """The World methods that place objects in it and read its events."""
+
+    # -- the wrappers this world handed out, by kind and id bits (for object_of)
+    def _handed_out(self, obj):
+        """Records obj (a Collider, Source, ...) in the world's weak map and returns it."""
+        objects = self.__dict__.get("_objects")
+        if objects is None:
+            objects = self._objects = weakref.WeakValueDictionary()
+        objects[(type(obj), obj.bits)] = obj
+        return obj
+
+    def object_of(self, event):
+        """The Collider, Probe, Source or Sink an Event names (its object_bits), as the wrapper
+        that this world's add_collider / add_probe / add_source / add_sink returned: the same
+        Python object, so ``world.object_of(e) is src``. None when the event names no object
+        (the DFSPH solve events), when the wrapper was dropped (the world keeps only weak
+        references) or destroyed, or when it was not made here (a loaded checkpoint's objects).
+        The event's type says the object's kind (EventType: SOURCE_CAPACITY_REACHED and
+        CAPACITY_GROWN a Source, SINK_REMOVED a Sink, COLLIDER_LOAD_EXCEEDED a Collider,
+        PROBE_PRESSURE_EXCEEDED a Probe); for a type these bindings do not know, the one object
+        of any kind with those bits."""
+        bits = int(event.object_bits)
+        objects = self.__dict__.get("_objects")
+        if not bits or objects is None:
+            return None
+        kind = _EVENT_OBJECT_KINDS.get(int(event.type))
+        kinds = (kind,) if kind is not None else (Collider, Probe, Source, Sink)
+        found = [o for o in (objects.get((k, bits)) for k in kinds) if o is not None and o.bits == bits]
+        return found[0] if len(found) == 1 else None
 
     def add_collider(self, sdf, transform=None, *, inverted=False, **fields):
         """Places an SDF asset of this world's context as a collider (sph_collider_create).
@@ -406,7 +445,7 @@ class WorldSceneMixin:
             d.flags |= _g.SPH_COLLIDER_FLAG_INVERTED
         out = _g.ColliderId()
         check(library().sph_collider_create(self.handle, ctypes.byref(d), ctypes.byref(out)), "sph_collider_create")
-        return Collider(self, out)
+        return self._handed_out(Collider(self, out))
 
     def add_source(self, region, transform=None, *, mode=_g.SourceMode.FILL_ONCE, **fields):
         """Adds a source that fills `region` (an Sdf, negative inside) with particles
@@ -417,7 +456,7 @@ class WorldSceneMixin:
         d.region = region.handle
         out = _g.SourceId()
         check(library().sph_source_create(self.handle, ctypes.byref(d), ctypes.byref(out)), "sph_source_create")
-        return Source(self, out)
+        return self._handed_out(Source(self, out))
 
     def add_sink(self, region=None, transform=None, *, bounds=None, **fields):
         """Adds a sink (sph_sink_create): with `region` (an Sdf) it removes particles inside it;
@@ -432,7 +471,7 @@ class WorldSceneMixin:
             d.region = region.handle
         out = _g.SinkId()
         check(library().sph_sink_create(self.handle, ctypes.byref(d), ctypes.byref(out)), "sph_sink_create")
-        return Sink(self, out)
+        return self._handed_out(Sink(self, out))
 
     def add_probe(self, position, *, gauge_length=None, sampling="frame", **fields):
         """Adds a probe at `position` (sph_probe_create); with ``gauge_length`` a gauge: the line
@@ -446,7 +485,7 @@ class WorldSceneMixin:
             d.length = gauge_length
         out = _g.ProbeId()
         check(library().sph_probe_create(self.handle, ctypes.byref(d), ctypes.byref(out)), "sph_probe_create")
-        return Probe(self, out)
+        return self._handed_out(Probe(self, out))
 
     def add_force_field(self, kind=_g.ForceFieldKind.UNIFORM, transform=None, *, region=None, grid=None,
                         grid_index_to_local=None, **fields):
@@ -465,11 +504,12 @@ class WorldSceneMixin:
         check(library().sph_force_field_create(self.handle, ctypes.byref(d), ctypes.byref(out)),
               "sph_force_field_create")
         del keep
-        return ForceField(self, out)
+        return self._handed_out(ForceField(self, out))
 
     def events(self):
         """Events of the last step as a list of Event (type: EventType, count, object_bits;
-        compare object_bits with a Source's, Sink's, Collider's or Probe's .bits) (sph_world_get_events)."""
+        world.object_of(event) gives the Source, Sink, Collider or Probe it names, or compare
+        object_bits with their .bits) (sph_world_get_events)."""
         n = ctypes.c_uint32()
         lib = library()
         check(lib.sph_world_get_events(self.handle, None, 0, ctypes.byref(n)), "sph_world_get_events")
