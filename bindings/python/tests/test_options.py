@@ -412,3 +412,20 @@ def test_object_flags_take_names(ctx):
         assert len(w) > 0 and w.velocities()[:, 1].mean() > 0.1
     with pytest.raises(ValueError):
         sph.SourceDef(flags="inverted")
+
+
+def test_every_named_option_constant_has_its_member():
+    """A constant of these prefixes added to the header fails here until _options.py names it."""
+    named = {"SPH_DFSPH_": (sph.DfsphFlag, sph.DfsphLinearSolver), "SPH_CUDA_DFSPH_": (sph.CudaDfsphMasks,),
+             "SPH_COLLIDER_FLAG_": (sph.ColliderFlag,), "SPH_SOURCE_FLAG_": (sph.SourceFlag,),
+             "SPH_SHAPE_FLAG_": (sph.ShapeFlag,)}
+    found = 0
+    for name, value in vars(sph.raw).items():
+        prefix = next((p for p in named if name.startswith(p)), None)
+        if prefix is None or not isinstance(value, int):
+            continue
+        tail = name[len(prefix):]
+        members = [m for cls in named[prefix] for m in cls.__members__.items() if m[0] in (tail, tail[len("MASKS_"):])]
+        assert members and int(members[0][1]) == value, f"{name} has no member in {[c.__name__ for c in named[prefix]]}"
+        found += 1
+    assert found == 11
