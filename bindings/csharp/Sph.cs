@@ -1477,6 +1477,45 @@ namespace Sph
             }
         }
 
+        /// <summary>An asset from grids already in memory of <paramref name="memory"/>'s kind:
+        /// with <see cref="MemoryKind.CudaDevice"/> (CUDA contexts only; a CPU context throws
+        /// SphException(ErrorUnsupported)) device addresses of the context's device, e.g. from
+        /// the engine's own cudaMalloc. distance holds ni*nj*nk floats, i fastest; velocity (3
+        /// floats per voxel) and friction are optional (IntPtr.Zero: none). The library copies
+        /// them.</summary>
+        public static Sdf Create(Context context, IntPtr distance, uint ni, uint nj, uint nk, FixedFloat12 indexToLocal,
+                                 MemoryKind memory, IntPtr velocity = default(IntPtr), IntPtr friction = default(IntPtr))
+        {
+            var pins = new List<GCHandle>();
+            try
+            {
+                var desc = SdfDesc.Default();
+                desc.Distance = Grid(distance, 1, ni, nj, nk, indexToLocal, memory);
+                if (velocity != IntPtr.Zero)
+                    desc.Velocity = Pin(new GridDesc[] { Grid(velocity, 3, ni, nj, nk, indexToLocal, memory) }, pins);
+                if (friction != IntPtr.Zero)
+                    desc.Friction = Pin(new GridDesc[] { Grid(friction, 1, ni, nj, nk, indexToLocal, memory) }, pins);
+                SdfHandle h;
+                SphException.Check(Native.sph_sdf_create(context.Handle, ref desc, out h), "sph_sdf_create");
+                return new Sdf(context, h);
+            }
+            finally
+            {
+                foreach (var p in pins) p.Free();
+            }
+        }
+
+        static GridDesc Grid(IntPtr data, uint components, uint ni, uint nj, uint nk, FixedFloat12 indexToLocal, MemoryKind memory)
+        {
+            var g = GridDesc.Default();
+            g.Dims = FixedUint3.From(new uint[] { ni, nj, nk });
+            g.IndexToLocal = indexToLocal;
+            g.Components = components;
+            g.Memory = memory;
+            g.Data = data;
+            return g;
+        }
+
         static IntPtr Pin(Array a, List<GCHandle> pins)
         {
             var h = GCHandle.Alloc(a, GCHandleType.Pinned);
@@ -1556,6 +1595,31 @@ namespace Sph
             var o = FixedUint3.From(origin);
             var s = FixedUint3.From(size);
             SphException.Check(Native.sph_sdf_update(Handle, channel, ref o, ref s, data, MemoryKind.Host), "sph_sdf_update");
+        }
+
+        /// <summary>As <see cref="Update(SdfChannel, uint[], uint[], float[])"/> from memory of
+        /// <paramref name="memory"/>'s kind: a host pointer (<see cref="MemoryKind.Host"/>: a
+        /// NativeArray's, pinned memory) or, with <see cref="MemoryKind.CudaDevice"/> (CUDA
+        /// contexts only; a CPU context throws SphException(ErrorUnsupported)), a device address
+        /// of the context's device. data holds size[0] * size[1] * size[2] floats (3 per voxel for
+        /// velocity), i fastest; the library copies them.</summary>
+        public void Update(SdfChannel channel, uint[] origin, uint[] size, IntPtr data, MemoryKind memory)
+        {
+            if (origin == null || origin.Length != 3) throw new ArgumentException("origin: 3 grid indices (i, j, k)");
+            if (size == null || size.Length != 3) throw new ArgumentException("size: 3 sample counts (i, j, k)");
+            var pins = new List<GCHandle>();
+            try
+            {
+                using (var borrowed = new Borrowed(Handle))
+                {
+                    SphException.Check(Native.sph_sdf_update(borrowed.Pointer, channel, Pin(origin, pins), Pin(size, pins), data, memory),
+                                       "sph_sdf_update");
+                }
+            }
+            finally
+            {
+                foreach (var p in pins) p.Free();
+            }
         }
 
         public bool IsDisposed { get; private set; }

@@ -1007,6 +1007,45 @@ static class Tests
         }
     }
 
+    // Sdf.Create / Sdf.Update from an IntPtr with a MemoryKind: host memory works as the float[]
+    // overloads do; device memory on a CPU context is the library's ErrorUnsupported.
+    public static void TestSdfMemoryKindOverloads()
+    {
+        using (var ctx = Cpu())
+        {
+            var distance = new float[4 * 4 * 4];
+            for (int i = 0; i < distance.Length; ++i) distance[i] = 1.0f;
+            var patch = new float[] { -0.5f, -0.5f, -0.5f, -0.5f, -0.5f, -0.5f, -0.5f, -0.5f };
+            var grid = Sdf.GridTransform(0.1f, new Vec3(0, 0, 0));
+            GCHandle d = GCHandle.Alloc(distance, GCHandleType.Pinned), p = GCHandle.Alloc(patch, GCHandleType.Pinned);
+            try
+            {
+                using (var sdf = Sdf.Create(ctx, d.AddrOfPinnedObject(), 4, 4, 4, grid, MemoryKind.Host))
+                {
+                    AssertEqual(1.0f, sdf.Sample(new Vec3(0.15f, 0.15f, 0.15f)), "host grid from an IntPtr");
+                    sdf.Update(SdfChannel.Distance, new uint[] { 1, 1, 1 }, new uint[] { 2, 2, 2 }, p.AddrOfPinnedObject(), MemoryKind.Host);
+                    AssertEqual(-0.5f, sdf.Sample(new Vec3(0.15f, 0.15f, 0.15f)), "host update from an IntPtr");
+                    var e = Throws(Result.ErrorUnsupported, () => sdf.Update(SdfChannel.Distance, new uint[] { 0, 0, 0 }, new uint[] { 2, 2, 2 },
+                                                                              new IntPtr(0x1000), MemoryKind.CudaDevice));
+                    Assert(e.LibraryMessage.Contains("memory"), "names the memory: " + e.LibraryMessage);
+                    AssertEqual(1.0f, sdf.Sample(new Vec3(0, 0, 0)), "unchanged after the refusal");
+                    ThrowsArgument(() => sdf.Update(SdfChannel.Distance, new uint[] { 0 }, new uint[] { 2, 2, 2 }, p.AddrOfPinnedObject(),
+                                                    MemoryKind.Host), "origin of 1");
+                    ThrowsArgument(() => sdf.Update(SdfChannel.Distance, new uint[] { 0, 0, 0 }, null, p.AddrOfPinnedObject(),
+                                                    MemoryKind.Host), "no size");
+                }
+                var c = Throws(Result.ErrorUnsupported, () => Sdf.Create(ctx, new IntPtr(0x1000), 4, 4, 4, grid, MemoryKind.CudaDevice,
+                                                                          new IntPtr(0x2000), new IntPtr(0x3000)));
+                Assert(c.LibraryMessage.Contains("memory"), "names the memory: " + c.LibraryMessage);
+            }
+            finally
+            {
+                d.Free();
+                p.Free();
+            }
+        }
+    }
+
     public static void TestSdfAssets()
     {
         using (var ctx = Cpu())

@@ -52,6 +52,35 @@ def _grid(values, components, index_to_local, what):
     return d, a
 
 
+def _memory(memory):
+    """A MemoryKind from itself, its int, or "host" / "cuda" (also "cuda_device")."""
+    if isinstance(memory, str):
+        name = memory.strip().upper()
+        return _g.MemoryKind.CUDA_DEVICE if name == "CUDA" else _enum(_g.MemoryKind, name)
+    return _g.MemoryKind(memory)
+
+
+def _device_pointer(value, what):
+    """A device address (an int, or an object with __cuda_array_interface__) as a float pointer."""
+    cai = getattr(value, "__cuda_array_interface__", None)
+    if cai is not None:
+        value = cai["data"][0]
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{what}: with memory=\"cuda\" expected a device address (an int), got {type(value).__name__}")
+    address = check_int(ctypes.c_uint64, value.__index__(), what)
+    return ctypes.cast(ctypes.c_void_p(address), ctypes.POINTER(ctypes.c_float))
+
+
+def _dims3(value, what):
+    """Three uint32 sample counts (i, j, k)."""
+    if value is None:
+        raise ValueError(f"{what}: required with memory=\"cuda\" (device memory has no shape): (ni, nj, nk)")
+    value = tuple(value)
+    if len(value) != 3:
+        raise ValueError(f"{what}: expected 3 sample counts (i, j, k), got {len(value)}")
+    return tuple(check_int(ctypes.c_uint32, v, f"{what}[{i}]") for i, v in enumerate(value))
+
+
 class Sdf:
     """A signed-distance asset (sph_sdf; negative inside) owned by a context, shared by the
     colliders, sources, sinks and force fields of any world on that context.
@@ -86,16 +115,26 @@ class Sdf:
 
     @classmethod
     def from_grid(cls, context, distance, *, index_to_local=None, voxel_size=None, origin=(0, 0, 0),
-                  velocity=None, friction=None):
+                  velocity=None, friction=None, memory="host", dims=None):
         """An asset from sampled grids (sph_sdf_create; copied).
 
         distance: (nk, nj, ni) signed distances in metres (i fastest, like OpenVDB's index
         space); velocity: optional (nk, nj, ni, 3) surface velocity, m/s; friction: optional
         (nk, nj, ni) coefficients. The grid's placement is index_to_local (12 floats, a
         row-major 3x4 map) or voxel_size and origin (see grid_transform).
+
+        memory="cuda" (MemoryKind.CUDA_DEVICE; CUDA contexts only): the grids are already in the
+        context's device memory. distance, velocity and friction are then device addresses
+        (ints, or objects with ``__cuda_array_interface__`` such as cupy arrays: their data
+        pointer), float32, i fastest, laid out as above, and ``dims=(ni, nj, nk)`` gives their
+        size. A CPU context raises SphError(ERROR_UNSUPPORTED).
         """
+        memory = _memory(memory)
         if index_to_local is None and voxel_size is not None:
             index_to_local = grid_transform(voxel_size, origin)
+        if memory != _g.MemoryKind.HOST:
+            return cls._from_device_grid(context, memory, _dims3(dims, "dims"), index_to_local, distance, velocity,
+                                         friction)
         dist, keep = _grid(distance, 1, index_to_local, "distance")
         desc = _g.SdfDesc(distance=dist)
         keep = [keep]
@@ -107,6 +146,27 @@ class Sdf:
             fri, a = _grid(friction, 1, index_to_local, "friction")
             keep += [fri, a]
             desc.friction = ctypes.pointer(fri)
+        out = ctypes.POINTER(_g.sph_sdf)()
+        check(library().sph_sdf_create(context.handle, ctypes.byref(desc), ctypes.byref(out)), "sph_sdf_create")
+        return cls(context, out)
+
+    @classmethod
+    def _from_device_grid(cls, context, memory, dims, index_to_local, distance, velocity, friction):
+        """from_grid's memory="cuda" path: GridDescs of device addresses."""
+        def grid(address, components, what):
+            d = _g.GridDesc(dims=dims, components=components, memory=memory, data=_device_pointer(address, what))
+            if index_to_local is not None:
+                d.index_to_local = np.asarray(index_to_local, np.float32).reshape(12)
+            return d
+
+        desc = _g.SdfDesc(distance=grid(distance, 1, "distance"))
+        keep = []
+        if velocity is not None:
+            keep.append(grid(velocity, 3, "velocity"))
+            desc.velocity = ctypes.pointer(keep[-1])
+        if friction is not None:
+            keep.append(grid(friction, 1, "friction"))
+            desc.friction = ctypes.pointer(keep[-1])
         out = ctypes.POINTER(_g.sph_sdf)()
         check(library().sph_sdf_create(context.handle, ctypes.byref(desc), ctypes.byref(out)), "sph_sdf_create")
         return cls(context, out)
@@ -177,11 +237,26 @@ class Sdf:
         check(library().sph_sdf_sample(self.handle, _g.Vec3(*local_point), ctypes.byref(d)), "sph_sdf_sample")
         return d.value
 
-    def update(self, channel, data, origin=(0, 0, 0)):
+    def update(self, channel, data, origin=(0, 0, 0), *, memory="host", size=None):
         """Overwrites a box of one channel starting at grid index origin (i, j, k) with data
         of shape (sk, sj, si) or, for the velocity channel, (sk, sj, si, 3) (sph_sdf_update).
-        Updating a channel the asset lacks creates it."""
+        Updating a channel the asset lacks creates it.
+
+        memory="cuda" (MemoryKind.CUDA_DEVICE; CUDA contexts only): data is a device address of
+        the context's device (an int, or an object with ``__cuda_array_interface__``: its data
+        pointer), float32, i fastest, and ``size=(si, sj, sk)`` gives the box. A CPU context
+        raises SphError(ERROR_UNSUPPORTED)."""
         channel = _g.SdfChannel[channel.upper()] if isinstance(channel, str) else _g.SdfChannel(channel)
+        memory = _memory(memory)
+        if memory != _g.MemoryKind.HOST:
+            size = (ctypes.c_uint32 * 3)(*_dims3(size, "size"))
+            origin = tuple(origin)
+            if len(origin) != 3:
+                raise ValueError(f"origin: expected 3 grid indices (i, j, k), got {len(origin)}")
+            at = (ctypes.c_uint32 * 3)(*(check_int(ctypes.c_uint32, v, f"origin[{i}]") for i, v in enumerate(origin)))
+            check(library().sph_sdf_update(self.handle, int(channel), at, size, _device_pointer(data, "data"),
+                                           int(memory)), "sph_sdf_update")
+            return
         a = np.ascontiguousarray(data, dtype=np.float32)
         # The library reads size[0] * size[1] * size[2] * components floats: the array's shape
         # must be exactly the channel's (a 3-D array for the velocity channel was read three

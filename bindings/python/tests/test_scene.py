@@ -426,3 +426,38 @@ def test_object_of_maps_a_load_event_to_its_collider(ctx):
             copy.step(0.02)
             assert [e.type for e in copy.events() if e.type == sph.EventType.COLLIDER_LOAD_EXCEEDED]
             assert all(copy.object_of(e) is None for e in copy.events())
+
+
+# ---- SDF grids in device memory (memory="cuda"; refused on a CPU context) ----------------------------
+def test_sdf_memory_argument(ctx):
+    # Host memory, named or by enum, behaves as before.
+    d = np.full((4, 4, 4), 1.0, np.float32)
+    for memory in ("host", sph.MemoryKind.HOST, 0):
+        with ctx.sdf(d, voxel_size=0.1, memory=memory) as s:
+            s.update("distance", np.full((2, 2, 2), -0.5, np.float32), (1, 1, 1), memory=memory)
+            assert s.sample((0.15, 0.15, 0.15)) == pytest.approx(-0.5)
+            assert s.sample((0.0, 0.0, 0.0)) == pytest.approx(1.0)
+    with ctx.sdf(d, voxel_size=0.1) as s:
+        # A device address on a CPU context: the library's UNSUPPORTED (nothing is read).
+        assert error(s.update, "distance", 0x1000, memory="cuda", size=(2, 2, 2)) == sph.Result.ERROR_UNSUPPORTED
+        assert "memory" in sph.last_error()
+        assert error(s.update, "velocity", 0x1000, (1, 1, 1), memory=sph.MemoryKind.CUDA_DEVICE,
+                     size=(1, 1, 1)) == sph.Result.ERROR_UNSUPPORTED
+        assert s.sample((0.0, 0.0, 0.0)) == pytest.approx(1.0)
+        # Device memory has no shape: size is required; data must be an address.
+        with pytest.raises(ValueError, match="size: required"):
+            s.update("distance", 0x1000, memory="cuda")
+        with pytest.raises(TypeError, match="device address"):
+            s.update("distance", np.zeros((2, 2, 2), np.float32), memory="cuda", size=(2, 2, 2))
+        with pytest.raises(KeyError):
+            s.update("distance", 0x1000, memory="gpu", size=(2, 2, 2))
+
+        class Cai:  # anything with __cuda_array_interface__ passes its data pointer
+            __cuda_array_interface__ = {"data": (0x2000, False), "shape": (8,), "typestr": "<f4", "version": 3}
+
+        assert error(s.update, "friction", Cai(), memory="cuda", size=(2, 2, 2)) == sph.Result.ERROR_UNSUPPORTED
+    assert error(ctx.sdf, 0x1000, memory="cuda", dims=(4, 4, 4), voxel_size=0.1, velocity=0x2000,
+                 friction=0x3000) == sph.Result.ERROR_UNSUPPORTED
+    assert "memory" in sph.last_error()
+    with pytest.raises(ValueError, match="dims: required"):
+        ctx.sdf(0x1000, memory="cuda")
