@@ -261,6 +261,134 @@ namespace Sph
         Force = Constants.SPH_STEP_LIMIT_FORCE,
     }
 
+    /// <summary>DFSPH option bits (SPH_DFSPH_* flags): set them with
+    /// <see cref="Sph.DfsphParams.DfsphFlags"/>.</summary>
+    [Flags]
+    public enum DfsphFlags : uint
+    {
+        None = 0,
+        /// <summary>No divergence solve (cheaper; a noisier pressure).</summary>
+        SkipDivergenceSolve = Constants.SPH_DFSPH_SKIP_DIVERGENCE_SOLVE,
+        /// <summary>The Jacobi solves' pressure gradient corrected to first order (Jacobi only).</summary>
+        CorrectedGradient = Constants.SPH_DFSPH_CORRECTED_GRADIENT,
+        /// <summary>The depth step limit (<see cref="Sph.DfsphParams.DepthStepFactor"/>) off.</summary>
+        NoDepthStepLimit = Constants.SPH_DFSPH_NO_DEPTH_STEP_LIMIT,
+    }
+
+    /// <summary>How DFSPH's density solve iterates (SPH_DFSPH_JACOBI, ...): set it with
+    /// <see cref="Sph.DfsphParams.DfsphLinearSolver"/>.</summary>
+    public enum DfsphLinearSolver : uint
+    {
+        /// <summary>0: the library's default, Jacobi.</summary>
+        Default = 0,
+        /// <summary>The Jacobi step of Bender &amp; Koschier (the default).</summary>
+        Jacobi = Constants.SPH_DFSPH_JACOBI,
+        /// <summary>Jacobi-preconditioned conjugate gradients on the compressed particles.</summary>
+        ConjugateGradients = Constants.SPH_DFSPH_CONJUGATE_GRADIENTS,
+        /// <summary>The Jacobi steps accelerated by Chebyshev's semi-iteration (not with
+        /// <see cref="DfsphFlags.CorrectedGradient"/>).</summary>
+        Chebyshev = Constants.SPH_DFSPH_CHEBYSHEV,
+    }
+
+    /// <summary>DFSPH's candidate masks on the CUDA backend (docs/cuda.md): set them with
+    /// <see cref="Sph.ContextDef.CudaDfsphMasksMode"/>. A CPU context checks and ignores them.</summary>
+    public enum CudaDfsphMasksMode : uint
+    {
+        /// <summary>0, the default: the density pass records which candidates are neighbours.</summary>
+        On = 0,
+        /// <summary>SPH_CUDA_DFSPH_MASKS_OFF: the solves walk every candidate (no memory, slower).</summary>
+        Off = Constants.SPH_CUDA_DFSPH_MASKS_OFF,
+        /// <summary>SPH_CUDA_DFSPH_NEIGHBOR_LISTS: the masks and each particle's neighbour list.</summary>
+        NeighborLists = Constants.SPH_CUDA_DFSPH_NEIGHBOR_LISTS,
+    }
+
+    /// <summary>Collider bits (SPH_COLLIDER_FLAG_*): set them with <see cref="Sph.ColliderDef.ColliderFlags"/>.</summary>
+    [Flags]
+    public enum ColliderFlags : uint
+    {
+        None = 0,
+        /// <summary>Solid where the SDF is positive (a container).</summary>
+        Inverted = Constants.SPH_COLLIDER_FLAG_INVERTED,
+    }
+
+    /// <summary>Source bits (SPH_SOURCE_FLAG_*): set them with <see cref="Sph.SourceDef.SourceFlags"/>.</summary>
+    [Flags]
+    public enum SourceFlags : uint
+    {
+        None = 0,
+        /// <summary>Emitted particles take their velocity from the region's velocity channel.</summary>
+        VelocityFromField = Constants.SPH_SOURCE_FLAG_VELOCITY_FROM_FIELD,
+    }
+
+    /// <summary>Analytic shape bits (SPH_SHAPE_FLAG_*): set them with <see cref="Sph.ShapeDesc.ShapeFlags"/>.</summary>
+    [Flags]
+    public enum ShapeFlags : uint
+    {
+        None = 0,
+        /// <summary>A hollow box without its lid (a tank open at +y).</summary>
+        OpenTop = Constants.SPH_SHAPE_FLAG_OPEN_TOP,
+    }
+
+    public partial struct DfsphParams
+    {
+        /// <summary>The <see cref="Flags"/> field as <see cref="Sph.DfsphFlags"/>:
+        /// <c>p.DfsphFlags = DfsphFlags.SkipDivergenceSolve</c>.</summary>
+        public DfsphFlags DfsphFlags
+        {
+            get { return (DfsphFlags)Flags; }
+            set { Flags = (uint)value; }
+        }
+
+        /// <summary>The <see cref="LinearSolver"/> field as <see cref="Sph.DfsphLinearSolver"/>:
+        /// <c>p.DfsphLinearSolver = DfsphLinearSolver.Chebyshev</c>.</summary>
+        public DfsphLinearSolver DfsphLinearSolver
+        {
+            get { return (DfsphLinearSolver)LinearSolver; }
+            set { LinearSolver = (uint)value; }
+        }
+    }
+
+    public partial struct ContextDef
+    {
+        /// <summary>The <see cref="CudaDfsphMasks"/> field as <see cref="Sph.CudaDfsphMasksMode"/>:
+        /// <c>def.CudaDfsphMasksMode = CudaDfsphMasksMode.NeighborLists</c>.</summary>
+        public CudaDfsphMasksMode CudaDfsphMasksMode
+        {
+            get { return (CudaDfsphMasksMode)CudaDfsphMasks; }
+            set { CudaDfsphMasks = (uint)value; }
+        }
+    }
+
+    public partial struct ColliderDef
+    {
+        /// <summary>The <see cref="Flags"/> field as <see cref="Sph.ColliderFlags"/>.</summary>
+        public ColliderFlags ColliderFlags
+        {
+            get { return (ColliderFlags)Flags; }
+            set { Flags = (uint)value; }
+        }
+    }
+
+    public partial struct SourceDef
+    {
+        /// <summary>The <see cref="Flags"/> field as <see cref="Sph.SourceFlags"/>.</summary>
+        public SourceFlags SourceFlags
+        {
+            get { return (SourceFlags)Flags; }
+            set { Flags = (uint)value; }
+        }
+    }
+
+    public partial struct ShapeDesc
+    {
+        /// <summary>The <see cref="Flags"/> field as <see cref="Sph.ShapeFlags"/>.</summary>
+        public ShapeFlags ShapeFlags
+        {
+            get { return (ShapeFlags)Flags; }
+            set { Flags = (uint)value; }
+        }
+    }
+
     public partial struct WorldDef
     {
         /// <summary>The <see cref="Features"/> field as <see cref="Sph.FeatureFlags"/>:
@@ -985,7 +1113,7 @@ namespace Sph
                 def.Sdf = borrowed.Pointer;
                 SphException.Check(Native.sph_collider_create(Handle, ref def, out id), "sph_collider_create");
             }
-            return new Collider(this, id);
+            return HandOut(new Collider(this, id), id.Bits);
         }
 
         /// <summary>A collider at `transform` with the default material.</summary>
@@ -993,7 +1121,7 @@ namespace Sph
         {
             var def = ColliderDef.Default();
             def.Transform = transform;
-            if (inverted) def.Flags |= Constants.SPH_COLLIDER_FLAG_INVERTED;
+            if (inverted) def.ColliderFlags |= ColliderFlags.Inverted;
             return CreateCollider(sdf, def);
         }
 
@@ -1006,7 +1134,7 @@ namespace Sph
                 def.Region = borrowed.Pointer;
                 SphException.Check(Native.sph_source_create(Handle, ref def, out id), "sph_source_create");
             }
-            return new Source(this, id);
+            return HandOut(new Source(this, id), id.Bits);
         }
 
         /// <summary>Adds a sink: with a region (SinkMode.Region) or, region null, the def's
@@ -1021,7 +1149,7 @@ namespace Sph
                 def.Region = borrowed.Pointer;
                 SphException.Check(Native.sph_sink_create(Handle, ref def, out id), "sph_sink_create");
             }
-            return new Sink(this, id);
+            return HandOut(new Sink(this, id), id.Bits);
         }
 
         /// <summary>Adds a probe or a gauge (ProbeDef.Kind), sampled inside every Step.</summary>
@@ -1029,7 +1157,7 @@ namespace Sph
         {
             ProbeId id;
             SphException.Check(Native.sph_probe_create(Handle, ref def, out id), "sph_probe_create");
-            return new Probe(this, id);
+            return HandOut(new Probe(this, id), id.Bits);
         }
 
         /// <summary>Adds a force field; `region` (optional) limits it to where that SDF is negative.</summary>
@@ -1070,10 +1198,96 @@ namespace Sph
                 if (grid.IsAllocated) grid.Free();
                 if (data.IsAllocated) data.Free();
             }
-            return new ForceField(this, id);
+            return HandOut(new ForceField(this, id), id.Bits);
         }
 
-        /// <summary>Events of the last Step (sources at capacity, sink removals, growths, capped solves, load and pressure thresholds).</summary>
+        // The wrappers CreateCollider/CreateSource/CreateSink/CreateProbe/CreateForceField handed
+        // out, by kind and id bits, held weakly (ObjectOf).
+        readonly object handedOutLock = new object();
+        readonly Dictionary<KeyValuePair<Type, ulong>, WeakReference> handedOut =
+            new Dictionary<KeyValuePair<Type, ulong>, WeakReference>();
+        int handedOutPruneAt = 64;
+
+        T HandOut<T>(T obj, ulong bits) where T : class
+        {
+            lock (handedOutLock)
+            {
+                if (handedOut.Count >= handedOutPruneAt)
+                {
+                    var dead = new List<KeyValuePair<Type, ulong>>();
+                    foreach (var entry in handedOut)
+                        if (!entry.Value.IsAlive) dead.Add(entry.Key);
+                    foreach (var key in dead) handedOut.Remove(key);
+                    handedOutPruneAt = Math.Max(64, 2 * handedOut.Count);
+                }
+                handedOut[new KeyValuePair<Type, ulong>(typeof(T), bits)] = new WeakReference(obj);
+            }
+            return obj;
+        }
+
+        static Type KindOf(EventType type)
+        {
+            switch (type)
+            {
+                case EventType.SourceCapacityReached:
+                case EventType.CapacityGrown: return typeof(Source);
+                case EventType.SinkRemoved: return typeof(Sink);
+                case EventType.ColliderLoadExceeded: return typeof(Collider);
+                case EventType.ProbePressureExceeded: return typeof(Probe);
+                default: return null;
+            }
+        }
+
+        static ulong BitsOf(object obj)
+        {
+            if (obj is Collider) return ((Collider)obj).Id.Bits;
+            if (obj is Source) return ((Source)obj).Id.Bits;
+            if (obj is Sink) return ((Sink)obj).Id.Bits;
+            if (obj is Probe) return ((Probe)obj).Id.Bits;
+            if (obj is ForceField) return ((ForceField)obj).Id.Bits;
+            return 0;
+        }
+
+        /// <summary>The <see cref="Collider"/>, <see cref="Probe"/>, <see cref="Source"/> or
+        /// <see cref="Sink"/> an event names (its ObjectBits): the very object this world's
+        /// CreateCollider / CreateProbe / CreateSource / CreateSink returned. Null when the event
+        /// names no object (the DFSPH solve events), when that object was collected (the world
+        /// holds weak references only) or disposed, or when it was not created through this World
+        /// (a loaded checkpoint's objects). The event's type gives the kind (SourceCapacityReached
+        /// and CapacityGrown a Source, SinkRemoved a Sink, ColliderLoadExceeded a Collider,
+        /// ProbePressureExceeded a Probe); for a type these bindings do not know, the one object of
+        /// any kind with those bits.</summary>
+        public object ObjectOf(Event e)
+        {
+            if (e.ObjectBits == 0) return null;
+            Type kind = KindOf(e.Type);
+            Type[] kinds = kind != null ? new[] { kind } : new[] { typeof(Collider), typeof(Probe), typeof(Source), typeof(Sink) };
+            object found = null;
+            int matches = 0;
+            lock (handedOutLock)
+            {
+                foreach (Type k in kinds)
+                {
+                    WeakReference r;
+                    if (!handedOut.TryGetValue(new KeyValuePair<Type, ulong>(k, e.ObjectBits), out r)) continue;
+                    object o = r.Target;
+                    if (o == null || BitsOf(o) != e.ObjectBits) continue;
+                    found = o;
+                    ++matches;
+                }
+            }
+            return matches == 1 ? found : null;
+        }
+
+        /// <summary>As <see cref="ObjectOf(Event)"/>, typed: null also when the event names an
+        /// object of another kind. <c>world.ObjectOf&lt;Source&gt;(e)</c>.</summary>
+        public T ObjectOf<T>(Event e) where T : class
+        {
+            return ObjectOf(e) as T;
+        }
+
+        /// <summary>Events of the last Step (sources at capacity, sink removals, growths, capped solves, load and pressure thresholds);
+        /// <see cref="ObjectOf(Event)"/> gives the object an event names.</summary>
         public Event[] GetEvents()
         {
             uint n;
@@ -1263,6 +1477,45 @@ namespace Sph
             }
         }
 
+        /// <summary>An asset from grids already in memory of <paramref name="memory"/>'s kind:
+        /// with <see cref="MemoryKind.CudaDevice"/> (CUDA contexts only; a CPU context throws
+        /// SphException(ErrorUnsupported)) device addresses of the context's device, e.g. from
+        /// the engine's own cudaMalloc. distance holds ni*nj*nk floats, i fastest; velocity (3
+        /// floats per voxel) and friction are optional (IntPtr.Zero: none). The library copies
+        /// them.</summary>
+        public static Sdf Create(Context context, IntPtr distance, uint ni, uint nj, uint nk, FixedFloat12 indexToLocal,
+                                 MemoryKind memory, IntPtr velocity = default(IntPtr), IntPtr friction = default(IntPtr))
+        {
+            var pins = new List<GCHandle>();
+            try
+            {
+                var desc = SdfDesc.Default();
+                desc.Distance = Grid(distance, 1, ni, nj, nk, indexToLocal, memory);
+                if (velocity != IntPtr.Zero)
+                    desc.Velocity = Pin(new GridDesc[] { Grid(velocity, 3, ni, nj, nk, indexToLocal, memory) }, pins);
+                if (friction != IntPtr.Zero)
+                    desc.Friction = Pin(new GridDesc[] { Grid(friction, 1, ni, nj, nk, indexToLocal, memory) }, pins);
+                SdfHandle h;
+                SphException.Check(Native.sph_sdf_create(context.Handle, ref desc, out h), "sph_sdf_create");
+                return new Sdf(context, h);
+            }
+            finally
+            {
+                foreach (var p in pins) p.Free();
+            }
+        }
+
+        static GridDesc Grid(IntPtr data, uint components, uint ni, uint nj, uint nk, FixedFloat12 indexToLocal, MemoryKind memory)
+        {
+            var g = GridDesc.Default();
+            g.Dims = FixedUint3.From(new uint[] { ni, nj, nk });
+            g.IndexToLocal = indexToLocal;
+            g.Components = components;
+            g.Memory = memory;
+            g.Data = data;
+            return g;
+        }
+
         static IntPtr Pin(Array a, List<GCHandle> pins)
         {
             var h = GCHandle.Alloc(a, GCHandleType.Pinned);
@@ -1342,6 +1595,31 @@ namespace Sph
             var o = FixedUint3.From(origin);
             var s = FixedUint3.From(size);
             SphException.Check(Native.sph_sdf_update(Handle, channel, ref o, ref s, data, MemoryKind.Host), "sph_sdf_update");
+        }
+
+        /// <summary>As <see cref="Update(SdfChannel, uint[], uint[], float[])"/> from memory of
+        /// <paramref name="memory"/>'s kind: a host pointer (<see cref="MemoryKind.Host"/>: a
+        /// NativeArray's, pinned memory) or, with <see cref="MemoryKind.CudaDevice"/> (CUDA
+        /// contexts only; a CPU context throws SphException(ErrorUnsupported)), a device address
+        /// of the context's device. data holds size[0] * size[1] * size[2] floats (3 per voxel for
+        /// velocity), i fastest; the library copies them.</summary>
+        public void Update(SdfChannel channel, uint[] origin, uint[] size, IntPtr data, MemoryKind memory)
+        {
+            if (origin == null || origin.Length != 3) throw new ArgumentException("origin: 3 grid indices (i, j, k)");
+            if (size == null || size.Length != 3) throw new ArgumentException("size: 3 sample counts (i, j, k)");
+            var pins = new List<GCHandle>();
+            try
+            {
+                using (var borrowed = new Borrowed(Handle))
+                {
+                    SphException.Check(Native.sph_sdf_update(borrowed.Pointer, channel, Pin(origin, pins), Pin(size, pins), data, memory),
+                                       "sph_sdf_update");
+                }
+            }
+            finally
+            {
+                foreach (var p in pins) p.Free();
+            }
         }
 
         public bool IsDisposed { get; private set; }

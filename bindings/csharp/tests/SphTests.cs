@@ -634,6 +634,100 @@ static class Tests
         }
     }
 
+    /// The DFSPH, CUDA-mask and object #defines as enums: every constant has its member, the
+    /// properties write the raw fields, and values read back from the library as the enums.
+    public static void TestNamedOptionEnums()
+    {
+        var prefixes = new[] {
+            Tuple.Create("SPH_DFSPH_SKIP_", typeof(DfsphFlags), "SPH_DFSPH_"),
+            Tuple.Create("SPH_DFSPH_CORRECTED_", typeof(DfsphFlags), "SPH_DFSPH_"),
+            Tuple.Create("SPH_DFSPH_NO_", typeof(DfsphFlags), "SPH_DFSPH_"),
+            Tuple.Create("SPH_DFSPH_JACOBI", typeof(DfsphLinearSolver), "SPH_DFSPH_"),
+            Tuple.Create("SPH_DFSPH_CONJUGATE_", typeof(DfsphLinearSolver), "SPH_DFSPH_"),
+            Tuple.Create("SPH_DFSPH_CHEBYSHEV", typeof(DfsphLinearSolver), "SPH_DFSPH_"),
+            Tuple.Create("SPH_CUDA_DFSPH_MASKS_OFF", typeof(CudaDfsphMasksMode), "SPH_CUDA_DFSPH_MASKS_"),
+            Tuple.Create("SPH_CUDA_DFSPH_NEIGHBOR_", typeof(CudaDfsphMasksMode), "SPH_CUDA_DFSPH_"),
+            Tuple.Create("SPH_COLLIDER_FLAG_", typeof(ColliderFlags), "SPH_COLLIDER_FLAG_"),
+            Tuple.Create("SPH_SOURCE_FLAG_", typeof(SourceFlags), "SPH_SOURCE_FLAG_"),
+            Tuple.Create("SPH_SHAPE_FLAG_", typeof(ShapeFlags), "SPH_SHAPE_FLAG_"),
+        };
+        int checkedCount = 0;
+        foreach (FieldInfo f in typeof(Constants).GetFields(BindingFlags.Public | BindingFlags.Static))
+        {
+            // A new constant of these families fails here until Sph.cs has its member.
+            if ((f.Name.StartsWith("SPH_DFSPH_") || f.Name.StartsWith("SPH_CUDA_DFSPH_") || f.Name.StartsWith("SPH_COLLIDER_FLAG_") ||
+                 f.Name.StartsWith("SPH_SOURCE_FLAG_") || f.Name.StartsWith("SPH_SHAPE_FLAG_")) &&
+                !Array.Exists(prefixes, p => f.Name.StartsWith(p.Item1)))
+                throw new Exception(f.Name + " has no member in Sph.cs's option enums");
+            foreach (var p in prefixes)
+            {
+                if (!f.Name.StartsWith(p.Item1)) continue;
+                object value = Enum.ToObject(p.Item2, Convert.ToUInt32(f.GetValue(null)));
+                AssertEqual(Pascal(f.Name.Substring(p.Item3.Length)), Enum.GetName(p.Item2, value), p.Item2.Name + " member of " + f.Name);
+                ++checkedCount;
+            }
+        }
+        AssertEqual(11, checkedCount, "DFSPH, CUDA-mask and object-flag constants found");
+
+        var dp = DfsphParams.Default();
+        AssertEqual(DfsphLinearSolver.Jacobi, dp.DfsphLinearSolver, "default linear solver");
+        AssertEqual(DfsphFlags.None, dp.DfsphFlags, "default DFSPH flags");
+        dp.DfsphLinearSolver = DfsphLinearSolver.Chebyshev;
+        dp.DfsphFlags = DfsphFlags.SkipDivergenceSolve | DfsphFlags.NoDepthStepLimit;
+        AssertEqual(Constants.SPH_DFSPH_CHEBYSHEV, dp.LinearSolver, "DfsphLinearSolver writes LinearSolver");
+        AssertEqual(Constants.SPH_DFSPH_SKIP_DIVERGENCE_SOLVE | Constants.SPH_DFSPH_NO_DEPTH_STEP_LIMIT, dp.Flags, "DfsphFlags writes Flags");
+        var cd = ContextDef.Default();
+        AssertEqual(CudaDfsphMasksMode.On, cd.CudaDfsphMasksMode, "masks on by default");
+        cd.CudaDfsphMasksMode = CudaDfsphMasksMode.NeighborLists;
+        AssertEqual(Constants.SPH_CUDA_DFSPH_NEIGHBOR_LISTS, cd.CudaDfsphMasks, "CudaDfsphMasksMode writes CudaDfsphMasks");
+        var collider = ColliderDef.Default();
+        collider.ColliderFlags = ColliderFlags.Inverted;
+        AssertEqual(Constants.SPH_COLLIDER_FLAG_INVERTED, collider.Flags, "ColliderFlags writes Flags");
+        var source = SourceDef.Default();
+        source.SourceFlags = SourceFlags.VelocityFromField;
+        AssertEqual(Constants.SPH_SOURCE_FLAG_VELOCITY_FROM_FIELD, source.Flags, "SourceFlags writes Flags");
+        var shape = ShapeDesc.Default();
+        shape.ShapeFlags = ShapeFlags.OpenTop;
+        AssertEqual(Constants.SPH_SHAPE_FLAG_OPEN_TOP, shape.Flags, "ShapeFlags writes Flags");
+
+        // A CPU context checks and ignores the masks; a value the library does not know is refused.
+        cd.Backend = Backend.Cpu;
+        cd.CpuWorkerCount = 1;
+        using (var ctx = new Context(cd))
+        {
+            WorldDef d = SmallWorld(256);
+            d.Solver = Solver.Dfsph;
+            using (var world = ctx.CreateWorld(d))
+            {
+                var p = world.DfsphParams;
+                p.DfsphLinearSolver = DfsphLinearSolver.ConjugateGradients;
+                p.DfsphFlags = DfsphFlags.SkipDivergenceSolve;
+                world.DfsphParams = p;
+                AssertEqual(DfsphLinearSolver.ConjugateGradients, world.DfsphParams.DfsphLinearSolver, "linear solver read back");
+                AssertEqual(DfsphFlags.SkipDivergenceSolve, world.DfsphParams.DfsphFlags, "flags read back");
+                p.DfsphLinearSolver = DfsphLinearSolver.Chebyshev;
+                p.DfsphFlags = DfsphFlags.CorrectedGradient;  // not with Chebyshev
+                Throws(Result.ErrorInvalidArgument, () => world.DfsphParams = p);
+                AssertEqual(DfsphLinearSolver.ConjugateGradients, world.DfsphParams.DfsphLinearSolver, "unchanged on error");
+                world.FillBox(new Vec3(0, 0, 0), new Vec3(0.1f, 0.1f, 0.1f));
+                world.Step(1f / 60f);
+            }
+            var box = ShapeDesc.Default();
+            box.HalfExtents = new Vec3(0.1f, 0.1f, 0.1f);
+            box.VoxelSize = 0.02f;
+            box.ShapeFlags = ShapeFlags.OpenTop;
+            using (var world = ctx.CreateWorld(SmallWorld()))
+            using (var tank = Sdf.CreateShape(ctx, box))
+            {
+                var def = ColliderDef.Default();
+                def.ColliderFlags = ColliderFlags.Inverted;
+                using (var c = world.CreateCollider(tank, def)) { }
+            }
+        }
+        cd.CudaDfsphMasksMode = (CudaDfsphMasksMode)7;
+        Throws(Result.ErrorInvalidArgument, () => new Context(cd));
+    }
+
     public static void TestPhysicsParamsByKindAndTheirDescriptions()
     {
         AssertEqual("tait", Utf8.FromNative(Library.ParamsInfo(ParamsKind.Tait).Name), "params name");
@@ -913,6 +1007,45 @@ static class Tests
         }
     }
 
+    // Sdf.Create / Sdf.Update from an IntPtr with a MemoryKind: host memory works as the float[]
+    // overloads do; device memory on a CPU context is the library's ErrorUnsupported.
+    public static void TestSdfMemoryKindOverloads()
+    {
+        using (var ctx = Cpu())
+        {
+            var distance = new float[4 * 4 * 4];
+            for (int i = 0; i < distance.Length; ++i) distance[i] = 1.0f;
+            var patch = new float[] { -0.5f, -0.5f, -0.5f, -0.5f, -0.5f, -0.5f, -0.5f, -0.5f };
+            var grid = Sdf.GridTransform(0.1f, new Vec3(0, 0, 0));
+            GCHandle d = GCHandle.Alloc(distance, GCHandleType.Pinned), p = GCHandle.Alloc(patch, GCHandleType.Pinned);
+            try
+            {
+                using (var sdf = Sdf.Create(ctx, d.AddrOfPinnedObject(), 4, 4, 4, grid, MemoryKind.Host))
+                {
+                    AssertEqual(1.0f, sdf.Sample(new Vec3(0.15f, 0.15f, 0.15f)), "host grid from an IntPtr");
+                    sdf.Update(SdfChannel.Distance, new uint[] { 1, 1, 1 }, new uint[] { 2, 2, 2 }, p.AddrOfPinnedObject(), MemoryKind.Host);
+                    AssertEqual(-0.5f, sdf.Sample(new Vec3(0.15f, 0.15f, 0.15f)), "host update from an IntPtr");
+                    var e = Throws(Result.ErrorUnsupported, () => sdf.Update(SdfChannel.Distance, new uint[] { 0, 0, 0 }, new uint[] { 2, 2, 2 },
+                                                                              new IntPtr(0x1000), MemoryKind.CudaDevice));
+                    Assert(e.LibraryMessage.Contains("memory"), "names the memory: " + e.LibraryMessage);
+                    AssertEqual(1.0f, sdf.Sample(new Vec3(0, 0, 0)), "unchanged after the refusal");
+                    ThrowsArgument(() => sdf.Update(SdfChannel.Distance, new uint[] { 0 }, new uint[] { 2, 2, 2 }, p.AddrOfPinnedObject(),
+                                                    MemoryKind.Host), "origin of 1");
+                    ThrowsArgument(() => sdf.Update(SdfChannel.Distance, new uint[] { 0, 0, 0 }, null, p.AddrOfPinnedObject(),
+                                                    MemoryKind.Host), "no size");
+                }
+                var c = Throws(Result.ErrorUnsupported, () => Sdf.Create(ctx, new IntPtr(0x1000), 4, 4, 4, grid, MemoryKind.CudaDevice,
+                                                                          new IntPtr(0x2000), new IntPtr(0x3000)));
+                Assert(c.LibraryMessage.Contains("memory"), "names the memory: " + c.LibraryMessage);
+            }
+            finally
+            {
+                d.Free();
+                p.Free();
+            }
+        }
+    }
+
     public static void TestSdfAssets()
     {
         using (var ctx = Cpu())
@@ -1018,6 +1151,109 @@ static class Tests
                 world.Step(1f / 60f);
                 Assert(Array.FindAll(world.GetEvents(), e => e.Type == EventType.ColliderLoadExceeded).Length == 0,
                        "no event above the force");
+            }
+        }
+    }
+
+    // World.ObjectOf: an event gives back the very wrapper that named its object.
+    // A source whose wrapper no one keeps, created on a thread of its own (whose stack is gone
+    // once it ends, so no stale slot of it keeps the wrapper alive for mono's conservative GC).
+    static ulong CreateCollectableSource(World world, Sdf region)
+    {
+        ulong bits = 0;
+        var t = new System.Threading.Thread(() =>
+        {
+            var def = SourceDef.Default();
+            def.Transform = At(1, 0, 0);
+            bits = world.CreateSource(region, def).Id.Bits;
+        });
+        t.Start();
+        t.Join();
+        return bits;
+    }
+
+    public static void TestObjectOfSourceAtCapacity()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(SmallWorld(300)))
+        using (var ball = Ball(ctx, 0.05f))
+        {
+            var p = world.Params;
+            p.Gravity = new Vec3(0, 0, 0);
+            world.Params = p;
+            var big = ShapeDesc.Default();
+            big.HalfExtents = new Vec3(0.2f, 0.2f, 0.2f);
+            big.VoxelSize = 0.02f;
+            using (var box = Sdf.CreateShape(ctx, big))
+            {
+                var small = world.CreateSource(ball, SourceDef.Default());
+                var flood = SourceDef.Default();
+                flood.Mode = SourceMode.Continuous;
+                flood.Transform = At(3, 0, 0);
+                var f = world.CreateSource(box, flood);
+                world.Step(1f / 60f);
+                var hits = Array.FindAll(world.GetEvents(), e => e.Type == EventType.SourceCapacityReached);
+                Assert(hits.Length >= 1, "a capacity event");
+                foreach (var e in hits)
+                {
+                    Assert(ReferenceEquals(f, world.ObjectOf(e)), "ObjectOf gives the flooding source's wrapper");
+                    Assert(ReferenceEquals(f, world.ObjectOf<Source>(e)), "ObjectOf<Source>");
+                    AssertEqual(null, world.ObjectOf<Collider>(e), "ObjectOf<Collider> of a source's event");
+                }
+                Assert(!ReferenceEquals(small, world.ObjectOf(hits[0])), "not the other source");
+                var solve = new Event { Type = EventType.PressureSolveCapped, Count = 1, ObjectBits = 0 };
+                AssertEqual(null, world.ObjectOf(solve), "an event of no object");
+                var wrongKind = new Event { Type = EventType.ColliderLoadExceeded, ObjectBits = f.Id.Bits };
+                AssertEqual(null, world.ObjectOf(wrongKind), "the bits under another kind's event");
+                // Disposed: null.
+                var stale = hits[0];
+                f.Dispose();
+                AssertEqual(null, world.ObjectOf(stale), "a disposed source");
+                // Collected: null (the world holds weak references only).
+                ulong bits = CreateCollectableSource(world, ball);
+                GC.Collect();
+                GC.WaitForPendingFinalizers();
+                GC.Collect();
+                var gone = new Event { Type = EventType.SourceCapacityReached, ObjectBits = bits };
+                AssertEqual(null, world.ObjectOf(gone), "a collected source");
+                small.Dispose();
+            }
+        }
+    }
+
+    public static void TestObjectOfColliderLoadThreshold()
+    {
+        var plane = ShapeDesc.Default();
+        plane.Shape = Shape.Plane;
+        plane.HalfExtents = new Vec3(1, 0.1f, 1);
+        plane.VoxelSize = 0.03f;
+        using (var ctx = Cpu())
+        using (var floor = Sdf.CreateShape(ctx, plane))
+        {
+            var d = SmallWorld();
+            d.FeatureFlags = FeatureFlags.ColliderLoads;
+            using (var world = ctx.CreateWorld(d))
+            {
+                var c = world.CreateCollider(floor, Transform.Default());
+                var far = world.CreateCollider(floor, At(0, -5, 0));
+                uint n = world.FillBox(new Vec3(-0.08f, 0.0f, -0.08f), new Vec3(0.08f, 0.06f, 0.08f));
+                for (int i = 0; i < 10; ++i) world.Step(1f / 60f);
+                c.SetLoadThreshold(0.5f * n * world.ParticleMass * 9.81f);
+                world.Step(1f / 60f);
+                var hits = Array.FindAll(world.GetEvents(), e => e.Type == EventType.ColliderLoadExceeded);
+                AssertEqual(1, hits.Length, "one load event");
+                Assert(ReferenceEquals(c, world.ObjectOf(hits[0])), "ObjectOf gives the loaded collider's wrapper");
+                Assert(ReferenceEquals(c, world.ObjectOf<Collider>(hits[0])), "ObjectOf<Collider>");
+                Assert(!ReferenceEquals(far, world.ObjectOf(hits[0])), "not the other collider");
+                // A loaded checkpoint has the collider but not this wrapper.
+                using (var copy = ctx.LoadWorld(world.Save()))
+                {
+                    copy.Step(1f / 60f);
+                    var copied = Array.FindAll(copy.GetEvents(), e => e.Type == EventType.ColliderLoadExceeded);
+                    AssertEqual(1, copied.Length, "the copy's load event");
+                    AssertEqual(null, copy.ObjectOf(copied[0]), "no wrapper in a loaded world");
+                }
+                GC.KeepAlive(far);
             }
         }
     }

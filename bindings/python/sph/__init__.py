@@ -27,7 +27,8 @@ from ._cuda import CudaArray
 from ._errors import SphError, SphLoadError, last_error
 from ._generated import (ABI_VERSION, STRUCTS, Attribute, Backend, Integrator, LogLevel, Result, Stage)
 from ._loader import helper_library, library, library_path
-from ._options import Feature, StepLimit, methods, param_fields, params_info, params_kind
+from ._options import (ColliderFlag, CudaDfsphMasks, DfsphFlag, DfsphLinearSolver, Feature, ShapeFlag, SourceFlag,
+                       StepLimit, methods, param_fields, params_info, params_kind)
 from ._scene import Collider, ForceField, Probe, Sdf, Sink, Source, as_transform, grid_transform
 
 # Every generated struct under its Python name (ContextDef, WorldDef, WorldParams, Stats, ...).
@@ -43,4 +44,5 @@ __all__ = ["Context", "World", "SphError", "SphLoadError", "Result", "Backend", 
            "Attribute", "Stage", "version", "abi_version", "build_info", "result_string", "last_error",
            "live_object_count", "make_version", "attribute_format", "stage_times", "library", "library_path", "helper_library",
            "ABI_VERSION", "BINDINGS_VERSION", "raw", "Sdf", "Collider", "Source", "Sink", "ForceField", "Probe", "CudaArray",
-           "as_transform", "grid_transform", "Feature", "StepLimit", "params_info", "param_fields", "methods", "params_kind", "ViscosityMethod", "EquationOfState", "Solver"] + [cls.__name__ for cls in STRUCTS]
+           "as_transform", "grid_transform", "Feature", "StepLimit", "DfsphFlag", "DfsphLinearSolver", "CudaDfsphMasks", "ColliderFlag", "SourceFlag", "ShapeFlag",
+           "params_info", "param_fields", "methods", "params_kind", "ViscosityMethod", "EquationOfState", "Solver"] + [cls.__name__ for cls in STRUCTS]

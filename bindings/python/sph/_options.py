@@ -28,7 +28,8 @@ from . import _generated as _g
 from ._errors import check
 from ._loader import library
 
-__all__ = ["Feature", "StepLimit", "WorldOptionsMixin", "params_info", "param_fields", "methods", "params_kind"]
+__all__ = ["Feature", "StepLimit", "DfsphFlag", "DfsphLinearSolver", "CudaDfsphMasks", "ColliderFlag", "SourceFlag",
+           "ShapeFlag", "WorldOptionsMixin", "params_info", "param_fields", "methods", "params_kind"]
 
 
 def _flags(name, prefix, doc):
@@ -60,9 +61,66 @@ StepLimit = _flags("StepLimit", "SPH_STEP_LIMIT_", """Step-size limits beyond eq
     ACOUSTIC: dt <= step_factor h / c, c the equation of state's speed of sound. FORCE:
     dt <= step_factor sqrt(h / |a|_max).""")
 
-# WorldDef.features and WorldParams.step_limits read back as these flags and accept their names.
-_g.WorldDef._sph_enums_ = {**_g.WorldDef._sph_enums_, "features": Feature}
-_g.WorldParams._sph_enums_ = {**_g.WorldParams._sph_enums_, "step_limits": StepLimit}
+
+def _named(name, doc, members, flag=False):
+    """An IntEnum (IntFlag with flag=True) of the header's #defines: members maps each member's
+    name to the #define's name in sph._generated (or to a plain int, for a value the header
+    gives only in prose, such as 0 = the default)."""
+    values = {k: (v if isinstance(v, int) else getattr(_g, v)) for k, v in members.items()}
+    cls = (enum.IntFlag if flag else enum.IntEnum)(name, values, module=__name__.rsplit(".", 1)[0])
+    cls.__doc__ = doc
+    return cls
+
+
+DfsphFlag = _named("DfsphFlag", """DFSPH option bits (SPH_DFSPH_* flags; DfsphParams.flags).
+
+    SKIP_DIVERGENCE_SOLVE: no divergence solve (cheaper; a noisier pressure). CORRECTED_GRADIENT:
+    the Jacobi solves' pressure gradient corrected to first order (Jacobi only).
+    NO_DEPTH_STEP_LIMIT: the depth step limit (DfsphParams.depth_step_factor) off.""",
+                   {"NONE": 0, "SKIP_DIVERGENCE_SOLVE": "SPH_DFSPH_SKIP_DIVERGENCE_SOLVE",
+                    "CORRECTED_GRADIENT": "SPH_DFSPH_CORRECTED_GRADIENT",
+                    "NO_DEPTH_STEP_LIMIT": "SPH_DFSPH_NO_DEPTH_STEP_LIMIT"}, flag=True)
+
+DfsphLinearSolver = _named("DfsphLinearSolver", """How DFSPH's density solve iterates (DfsphParams.linear_solver).
+
+    DEFAULT (0) is JACOBI; CONJUGATE_GRADIENTS (Jacobi-preconditioned); CHEBYSHEV (the Jacobi
+    steps accelerated by Chebyshev's semi-iteration, not with CORRECTED_GRADIENT).""",
+                           {"DEFAULT": 0, "JACOBI": "SPH_DFSPH_JACOBI",
+                            "CONJUGATE_GRADIENTS": "SPH_DFSPH_CONJUGATE_GRADIENTS",
+                            "CHEBYSHEV": "SPH_DFSPH_CHEBYSHEV"})
+
+CudaDfsphMasks = _named("CudaDfsphMasks", """DFSPH's candidate masks on the CUDA backend (ContextDef.cuda_dfsph_masks; docs/cuda.md).
+
+    ON (0, the default): the density pass records which of each particle's 27-cell candidates
+    are neighbours; OFF (SPH_CUDA_DFSPH_MASKS_OFF): the solves walk every candidate;
+    NEIGHBOR_LISTS (SPH_CUDA_DFSPH_NEIGHBOR_LISTS): the masks and neighbour lists. A CPU context
+    checks and ignores it.""",
+                        {"ON": 0, "OFF": "SPH_CUDA_DFSPH_MASKS_OFF",
+                         "NEIGHBOR_LISTS": "SPH_CUDA_DFSPH_NEIGHBOR_LISTS"})
+
+ColliderFlag = _flags("ColliderFlag", "SPH_COLLIDER_FLAG_", """Collider bits (SPH_COLLIDER_FLAG_*; ColliderDef.flags).
+
+    INVERTED: solid where the SDF is positive (a container).""")
+
+SourceFlag = _flags("SourceFlag", "SPH_SOURCE_FLAG_", """Source bits (SPH_SOURCE_FLAG_*; SourceDef.flags).
+
+    VELOCITY_FROM_FIELD: emitted particles take their velocity from the region's velocity
+    channel instead of SourceDef.velocity.""")
+
+ShapeFlag = _flags("ShapeFlag", "SPH_SHAPE_FLAG_", """Analytic shape bits (SPH_SHAPE_FLAG_*; ShapeDesc.flags).
+
+    OPEN_TOP: a hollow box without its lid (a tank open at +y).""")
+
+# These fields read back as their enums and flags and accept their names (a member, its name in
+# any case, "a|b" or a list for flags; a plain int still works).
+for _struct, _field, _cls in ((_g.WorldDef, "features", Feature), (_g.WorldParams, "step_limits", StepLimit),
+                              (_g.DfsphParams, "flags", DfsphFlag),
+                              (_g.DfsphParams, "linear_solver", DfsphLinearSolver),
+                              (_g.ContextDef, "cuda_dfsph_masks", CudaDfsphMasks),
+                              (_g.ColliderDef, "flags", ColliderFlag), (_g.SourceDef, "flags", SourceFlag),
+                              (_g.ShapeDesc, "flags", ShapeFlag)):
+    _struct._sph_enums_ = {**_struct._sph_enums_, _field: _cls}
+del _struct, _field, _cls
 
 
 def _as_struct(cls, value):

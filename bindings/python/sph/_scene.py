@@ -2,6 +2,7 @@
 """SDF assets and the objects placed in a world: colliders, sources, sinks, force fields."""
 import ctypes
 import os
+import weakref
 
 import numpy as np
 
@@ -51,6 +52,35 @@ def _grid(values, components, index_to_local, what):
     return d, a
 
 
+def _memory(memory):
+    """A MemoryKind from itself, its int, or "host" / "cuda" (also "cuda_device")."""
+    if isinstance(memory, str):
+        name = memory.strip().upper()
+        return _g.MemoryKind.CUDA_DEVICE if name == "CUDA" else _enum(_g.MemoryKind, name)
+    return _g.MemoryKind(memory)
+
+
+def _device_pointer(value, what):
+    """A device address (an int, or an object with __cuda_array_interface__) as a float pointer."""
+    cai = getattr(value, "__cuda_array_interface__", None)
+    if cai is not None:
+        value = cai["data"][0]
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{what}: with memory=\"cuda\" expected a device address (an int), got {type(value).__name__}")
+    address = check_int(ctypes.c_uint64, value.__index__(), what)
+    return ctypes.cast(ctypes.c_void_p(address), ctypes.POINTER(ctypes.c_float))
+
+
+def _dims3(value, what):
+    """Three uint32 sample counts (i, j, k)."""
+    if value is None:
+        raise ValueError(f"{what}: required with memory=\"cuda\" (device memory has no shape): (ni, nj, nk)")
+    value = tuple(value)
+    if len(value) != 3:
+        raise ValueError(f"{what}: expected 3 sample counts (i, j, k), got {len(value)}")
+    return tuple(check_int(ctypes.c_uint32, v, f"{what}[{i}]") for i, v in enumerate(value))
+
+
 class Sdf:
     """A signed-distance asset (sph_sdf; negative inside) owned by a context, shared by the
     colliders, sources, sinks and force fields of any world on that context.
@@ -71,11 +101,13 @@ class Sdf:
     def shape(cls, context, shape=_g.Shape.BOX, **fields):
         """An analytic shape sampled into a grid (sph_sdf_create_shape); fields are those of
         ShapeDesc (half_extents, radius, half_height, wall_thickness, voxel_size, flags,
-        padding_voxels). ``open_top=True`` sets SPH_SHAPE_FLAG_OPEN_TOP."""
-        if fields.pop("open_top", False):
-            fields["flags"] = fields.get("flags", 0) | _g.SPH_SHAPE_FLAG_OPEN_TOP
+        padding_voxels); flags takes ShapeFlag members or names. ``open_top=True`` sets
+        ShapeFlag.OPEN_TOP."""
+        open_top = fields.pop("open_top", False)
         shape = _g.Shape[shape.upper()] if isinstance(shape, str) else _g.Shape(shape)
         desc = _g.ShapeDesc(shape=shape, **fields)
+        if open_top:
+            desc.flags |= _g.SPH_SHAPE_FLAG_OPEN_TOP
         out = ctypes.POINTER(_g.sph_sdf)()
         check(library().sph_sdf_create_shape(context.handle, ctypes.byref(desc), ctypes.byref(out)),
               "sph_sdf_create_shape")
@@ -83,16 +115,26 @@ class Sdf:
 
     @classmethod
     def from_grid(cls, context, distance, *, index_to_local=None, voxel_size=None, origin=(0, 0, 0),
-                  velocity=None, friction=None):
+                  velocity=None, friction=None, memory="host", dims=None):
         """An asset from sampled grids (sph_sdf_create; copied).
 
         distance: (nk, nj, ni) signed distances in metres (i fastest, like OpenVDB's index
         space); velocity: optional (nk, nj, ni, 3) surface velocity, m/s; friction: optional
         (nk, nj, ni) coefficients. The grid's placement is index_to_local (12 floats, a
         row-major 3x4 map) or voxel_size and origin (see grid_transform).
+
+        memory="cuda" (MemoryKind.CUDA_DEVICE; CUDA contexts only): the grids are already in the
+        context's device memory. distance, velocity and friction are then device addresses
+        (ints, or objects with ``__cuda_array_interface__`` such as cupy arrays: their data
+        pointer), float32, i fastest, laid out as above, and ``dims=(ni, nj, nk)`` gives their
+        size. A CPU context raises SphError(ERROR_UNSUPPORTED).
         """
+        memory = _memory(memory)
         if index_to_local is None and voxel_size is not None:
             index_to_local = grid_transform(voxel_size, origin)
+        if memory != _g.MemoryKind.HOST:
+            return cls._from_device_grid(context, memory, _dims3(dims, "dims"), index_to_local, distance, velocity,
+                                         friction)
         dist, keep = _grid(distance, 1, index_to_local, "distance")
         desc = _g.SdfDesc(distance=dist)
         keep = [keep]
@@ -104,6 +146,27 @@ class Sdf:
             fri, a = _grid(friction, 1, index_to_local, "friction")
             keep += [fri, a]
             desc.friction = ctypes.pointer(fri)
+        out = ctypes.POINTER(_g.sph_sdf)()
+        check(library().sph_sdf_create(context.handle, ctypes.byref(desc), ctypes.byref(out)), "sph_sdf_create")
+        return cls(context, out)
+
+    @classmethod
+    def _from_device_grid(cls, context, memory, dims, index_to_local, distance, velocity, friction):
+        """from_grid's memory="cuda" path: GridDescs of device addresses."""
+        def grid(address, components, what):
+            d = _g.GridDesc(dims=dims, components=components, memory=memory, data=_device_pointer(address, what))
+            if index_to_local is not None:
+                d.index_to_local = np.asarray(index_to_local, np.float32).reshape(12)
+            return d
+
+        desc = _g.SdfDesc(distance=grid(distance, 1, "distance"))
+        keep = []
+        if velocity is not None:
+            keep.append(grid(velocity, 3, "velocity"))
+            desc.velocity = ctypes.pointer(keep[-1])
+        if friction is not None:
+            keep.append(grid(friction, 1, "friction"))
+            desc.friction = ctypes.pointer(keep[-1])
         out = ctypes.POINTER(_g.sph_sdf)()
         check(library().sph_sdf_create(context.handle, ctypes.byref(desc), ctypes.byref(out)), "sph_sdf_create")
         return cls(context, out)
@@ -174,11 +237,26 @@ class Sdf:
         check(library().sph_sdf_sample(self.handle, _g.Vec3(*local_point), ctypes.byref(d)), "sph_sdf_sample")
         return d.value
 
-    def update(self, channel, data, origin=(0, 0, 0)):
+    def update(self, channel, data, origin=(0, 0, 0), *, memory="host", size=None):
         """Overwrites a box of one channel starting at grid index origin (i, j, k) with data
         of shape (sk, sj, si) or, for the velocity channel, (sk, sj, si, 3) (sph_sdf_update).
-        Updating a channel the asset lacks creates it."""
+        Updating a channel the asset lacks creates it.
+
+        memory="cuda" (MemoryKind.CUDA_DEVICE; CUDA contexts only): data is a device address of
+        the context's device (an int, or an object with ``__cuda_array_interface__``: its data
+        pointer), float32, i fastest, and ``size=(si, sj, sk)`` gives the box. A CPU context
+        raises SphError(ERROR_UNSUPPORTED)."""
         channel = _g.SdfChannel[channel.upper()] if isinstance(channel, str) else _g.SdfChannel(channel)
+        memory = _memory(memory)
+        if memory != _g.MemoryKind.HOST:
+            size = (ctypes.c_uint32 * 3)(*_dims3(size, "size"))
+            origin = tuple(origin)
+            if len(origin) != 3:
+                raise ValueError(f"origin: expected 3 grid indices (i, j, k), got {len(origin)}")
+            at = (ctypes.c_uint32 * 3)(*(check_int(ctypes.c_uint32, v, f"origin[{i}]") for i, v in enumerate(origin)))
+            check(library().sph_sdf_update(self.handle, int(channel), at, size, _device_pointer(data, "data"),
+                                           int(memory)), "sph_sdf_update")
+            return
         a = np.ascontiguousarray(data, dtype=np.float32)
         # The library reads size[0] * size[1] * size[2] * components floats: the array's shape
         # must be exactly the channel's (a 3-D array for the velocity channel was read three
@@ -383,6 +461,16 @@ class Probe(_WorldObject):
               "sph_probe_set_pressure_threshold")
 
 
+# The kind of object each event type names (docs/api.md, sph_event_type).
+_EVENT_OBJECT_KINDS = {
+    int(_g.EventType.SOURCE_CAPACITY_REACHED): Source,
+    int(_g.EventType.CAPACITY_GROWN): Source,
+    int(_g.EventType.SINK_REMOVED): Sink,
+    int(_g.EventType.COLLIDER_LOAD_EXCEEDED): Collider,
+    int(_g.EventType.PROBE_PRESSURE_EXCEEDED): Probe,
+}
+
+
 # ---- World methods --------------------------------------------------------------------------------
 def _enum(cls, value):
     return cls[value.upper()] if isinstance(value, str) else cls(value)
@@ -391,11 +479,40 @@ def _enum(cls, value):
 class WorldSceneMixin:
     """The World methods that place objects in it and read its events."""
 
+    # -- the wrappers this world handed out, by kind and id bits (for object_of)
+    def _handed_out(self, obj):
+        """Records obj (a Collider, Source, ...) in the world's weak map and returns it."""
+        objects = self.__dict__.get("_objects")
+        if objects is None:
+            objects = self._objects = weakref.WeakValueDictionary()
+        objects[(type(obj), obj.bits)] = obj
+        return obj
+
+    def object_of(self, event):
+        """The Collider, Probe, Source or Sink an Event names (its object_bits), as the wrapper
+        that this world's add_collider / add_probe / add_source / add_sink returned: the same
+        Python object, so ``world.object_of(e) is src``. None when the event names no object
+        (the DFSPH solve events), when the wrapper was dropped (the world keeps only weak
+        references) or destroyed, or when it was not made here (a loaded checkpoint's objects).
+        The event's type says the object's kind (EventType: SOURCE_CAPACITY_REACHED and
+        CAPACITY_GROWN a Source, SINK_REMOVED a Sink, COLLIDER_LOAD_EXCEEDED a Collider,
+        PROBE_PRESSURE_EXCEEDED a Probe); for a type these bindings do not know, the one object
+        of any kind with those bits."""
+        bits = int(event.object_bits)
+        objects = self.__dict__.get("_objects")
+        if not bits or objects is None:
+            return None
+        kind = _EVENT_OBJECT_KINDS.get(int(event.type))
+        kinds = (kind,) if kind is not None else (Collider, Probe, Source, Sink)
+        found = [o for o in (objects.get((k, bits)) for k in kinds) if o is not None and o.bits == bits]
+        return found[0] if len(found) == 1 else None
+
     def add_collider(self, sdf, transform=None, *, inverted=False, **fields):
         """Places an SDF asset of this world's context as a collider (sph_collider_create).
 
         ``inverted=True`` makes the solid where the SDF is positive (a container). Other fields
-        are those of ColliderDef: restitution, friction, stickiness, flags.
+        are those of ColliderDef: restitution, friction, stickiness, flags (ColliderFlag members
+        or names, ``flags="inverted"``).
         """
         d = _g.ColliderDef(transform=as_transform(transform), **fields)
         d.sdf = sdf.handle
@@ -403,17 +520,18 @@ class WorldSceneMixin:
             d.flags |= _g.SPH_COLLIDER_FLAG_INVERTED
         out = _g.ColliderId()
         check(library().sph_collider_create(self.handle, ctypes.byref(d), ctypes.byref(out)), "sph_collider_create")
-        return Collider(self, out)
+        return self._handed_out(Collider(self, out))
 
     def add_source(self, region, transform=None, *, mode=_g.SourceMode.FILL_ONCE, **fields):
         """Adds a source that fills `region` (an Sdf, negative inside) with particles
         (sph_source_create). mode: SourceMode or "fill_once" / "continuous"; other fields are
-        those of SourceDef (spacing, min_distance, velocity, flags, rate, user_attribute)."""
+        those of SourceDef (spacing, min_distance, velocity, flags, rate, user_attribute); flags
+        takes SourceFlag members or names (``flags="velocity_from_field"``)."""
         d = _g.SourceDef(transform=as_transform(transform), mode=_enum(_g.SourceMode, mode), **fields)
         d.region = region.handle
         out = _g.SourceId()
         check(library().sph_source_create(self.handle, ctypes.byref(d), ctypes.byref(out)), "sph_source_create")
-        return Source(self, out)
+        return self._handed_out(Source(self, out))
 
     def add_sink(self, region=None, transform=None, *, bounds=None, **fields):
         """Adds a sink (sph_sink_create): with `region` (an Sdf) it removes particles inside it;
@@ -428,7 +546,7 @@ class WorldSceneMixin:
             d.region = region.handle
         out = _g.SinkId()
         check(library().sph_sink_create(self.handle, ctypes.byref(d), ctypes.byref(out)), "sph_sink_create")
-        return Sink(self, out)
+        return self._handed_out(Sink(self, out))
 
     def add_probe(self, position, *, gauge_length=None, sampling="frame", **fields):
         """Adds a probe at `position` (sph_probe_create); with ``gauge_length`` a gauge: the line
@@ -442,7 +560,7 @@ class WorldSceneMixin:
             d.length = gauge_length
         out = _g.ProbeId()
         check(library().sph_probe_create(self.handle, ctypes.byref(d), ctypes.byref(out)), "sph_probe_create")
-        return Probe(self, out)
+        return self._handed_out(Probe(self, out))
 
     def add_force_field(self, kind=_g.ForceFieldKind.UNIFORM, transform=None, *, region=None, grid=None,
                         grid_index_to_local=None, **fields):
@@ -461,11 +579,12 @@ class WorldSceneMixin:
         check(library().sph_force_field_create(self.handle, ctypes.byref(d), ctypes.byref(out)),
               "sph_force_field_create")
         del keep
-        return ForceField(self, out)
+        return self._handed_out(ForceField(self, out))
 
     def events(self):
         """Events of the last step as a list of Event (type: EventType, count, object_bits;
-        compare object_bits with a Source's, Sink's, Collider's or Probe's .bits) (sph_world_get_events)."""
+        world.object_of(event) gives the Source, Sink, Collider or Probe it names, or compare
+        object_bits with their .bits) (sph_world_get_events)."""
         n = ctypes.c_uint32()
         lib = library()
         check(lib.sph_world_get_events(self.handle, None, 0, ctypes.byref(n)), "sph_world_get_events")

@@ -334,3 +334,98 @@ def test_dfsph_world_has_its_params_and_refuses_what_it_does_not_support(ctx):
     for refused in ({"integrator": "rk4"}, {"equation_of_state": "tait"}, {"features": "normalized_density"}):
         e = error(ctx.world, capacity=16, solver="dfsph", **refused)
         assert e.result == sph.Result.ERROR_UNSUPPORTED and "SPH_SOLVER_DFSPH" in e.message
+
+
+# ---- named DFSPH options, CUDA masks and object flags (the header's #defines as enums) -------------
+def test_dfsph_linear_solver_and_flags_take_names_and_read_back_as_enums(ctx):
+    assert [(m.name, int(m)) for m in sph.DfsphLinearSolver] == [
+        ("DEFAULT", 0), ("JACOBI", sph.raw.SPH_DFSPH_JACOBI),
+        ("CONJUGATE_GRADIENTS", sph.raw.SPH_DFSPH_CONJUGATE_GRADIENTS), ("CHEBYSHEV", sph.raw.SPH_DFSPH_CHEBYSHEV)]
+    assert sph.DfsphFlag.SKIP_DIVERGENCE_SOLVE == sph.raw.SPH_DFSPH_SKIP_DIVERGENCE_SOLVE
+    assert sph.DfsphFlag.CORRECTED_GRADIENT == sph.raw.SPH_DFSPH_CORRECTED_GRADIENT
+    assert sph.DfsphFlag.NO_DEPTH_STEP_LIMIT == sph.raw.SPH_DFSPH_NO_DEPTH_STEP_LIMIT
+    # A member, its lower-case name, or (compatibility) the int: all read back as the enum.
+    for value in ("chebyshev", "CHEBYSHEV", sph.DfsphLinearSolver.CHEBYSHEV, sph.raw.SPH_DFSPH_CHEBYSHEV):
+        p = sph.DfsphParams(linear_solver=value)
+        assert p.linear_solver is sph.DfsphLinearSolver.CHEBYSHEV
+    assert sph.DfsphParams().linear_solver is sph.DfsphLinearSolver.JACOBI  # the library's default
+    assert sph.DfsphParams(linear_solver=0).linear_solver is sph.DfsphLinearSolver.DEFAULT
+    with pytest.raises(ValueError, match="is not one of default, jacobi"):
+        sph.DfsphParams(linear_solver="cheb")
+    for value in ("skip_divergence_solve|no_depth_step_limit", ["skip_divergence_solve", sph.DfsphFlag.NO_DEPTH_STEP_LIMIT],
+                  sph.DfsphFlag.SKIP_DIVERGENCE_SOLVE | sph.DfsphFlag.NO_DEPTH_STEP_LIMIT, 5):
+        p = sph.DfsphParams(flags=value)
+        assert p.flags == sph.DfsphFlag.SKIP_DIVERGENCE_SOLVE | sph.DfsphFlag.NO_DEPTH_STEP_LIMIT
+        assert isinstance(p.flags, sph.DfsphFlag)
+    assert sph.DfsphParams().flags is sph.DfsphFlag.NONE
+    with ctx.world(capacity=256, solver="dfsph") as w:
+        w.set_dfsph_params(linear_solver="conjugate_gradients", flags="skip_divergence_solve")
+        p = w.dfsph_params
+        assert p.linear_solver is sph.DfsphLinearSolver.CONJUGATE_GRADIENTS
+        assert p.flags is sph.DfsphFlag.SKIP_DIVERGENCE_SOLVE
+        w.dfsph_params = {"linear_solver": "chebyshev"}
+        assert w.physics_params("dfsph").linear_solver is sph.DfsphLinearSolver.CHEBYSHEV
+        # The library still judges the combination: Chebyshev with the corrected gradient is refused.
+        e = error(w.set_dfsph_params, flags="corrected_gradient")
+        assert e.result == sph.Result.ERROR_INVALID_ARGUMENT
+        assert w.dfsph_params.flags is sph.DfsphFlag.NONE
+        w.fill_box((0, 0, 0), (0.1, 0.1, 0.1))
+        w.step(1 / 60)
+
+
+def test_cuda_dfsph_masks_take_names(ctx):
+    assert [(m.name, int(m)) for m in sph.CudaDfsphMasks] == [
+        ("ON", 0), ("OFF", sph.raw.SPH_CUDA_DFSPH_MASKS_OFF), ("NEIGHBOR_LISTS", sph.raw.SPH_CUDA_DFSPH_NEIGHBOR_LISTS)]
+    assert sph.ContextDef().cuda_dfsph_masks is sph.CudaDfsphMasks.ON
+    for value in ("neighbor_lists", sph.CudaDfsphMasks.NEIGHBOR_LISTS, 2):
+        assert sph.ContextDef(cuda_dfsph_masks=value).cuda_dfsph_masks is sph.CudaDfsphMasks.NEIGHBOR_LISTS
+    with pytest.raises(ValueError, match="is not one of on, off, neighbor_lists"):
+        sph.ContextDef(cuda_dfsph_masks="lists")
+    # A CPU context checks and ignores it; a value the library does not know is refused.
+    with sph.Context("cpu", cpu_worker_count=1, definition=sph.ContextDef(cuda_dfsph_masks="off")) as c:
+        assert c.backend == sph.Backend.CPU
+    e = error(sph.Context, "cpu", definition=sph.ContextDef(cuda_dfsph_masks=7))
+    assert e.result == sph.Result.ERROR_INVALID_ARGUMENT
+
+
+def test_object_flags_take_names(ctx):
+    assert sph.ColliderFlag.INVERTED == sph.raw.SPH_COLLIDER_FLAG_INVERTED
+    assert sph.SourceFlag.VELOCITY_FROM_FIELD == sph.raw.SPH_SOURCE_FLAG_VELOCITY_FROM_FIELD
+    assert sph.ShapeFlag.OPEN_TOP == sph.raw.SPH_SHAPE_FLAG_OPEN_TOP
+    assert sph.ColliderDef(flags="inverted").flags is sph.ColliderFlag.INVERTED
+    assert sph.ColliderDef(flags=1).flags is sph.ColliderFlag.INVERTED
+    assert sph.ColliderDef().flags == 0 and isinstance(sph.ColliderDef().flags, sph.ColliderFlag)
+    assert sph.SourceDef(flags=["velocity_from_field"]).flags is sph.SourceFlag.VELOCITY_FROM_FIELD
+    assert sph.ShapeDesc(flags="open_top").flags is sph.ShapeFlag.OPEN_TOP
+    with ctx.world(capacity=4096, particle_spacing=0.02) as w, \
+            ctx.shape("box", half_extents=(0.1, 0.1, 0.1), voxel_size=0.02, flags="open_top") as box:
+        w.add_collider(box, flags="inverted")
+        w.add_collider(box, (1, 0, 0), flags=sph.ColliderFlag.INVERTED, inverted=True)
+        # A source whose velocity comes from its region's velocity channel.
+        vel = np.zeros((6, 6, 6, 3), np.float32)
+        vel[..., 1] = 0.5
+        with ctx.sdf(np.full((6, 6, 6), -1.0, np.float32), voxel_size=0.02, origin=(-0.05, -0.05, -0.05),
+                     velocity=vel) as region:
+            w.set_params(gravity=(0, 0, 0))
+            w.add_source(region, (0, 0, 0), flags="velocity_from_field")
+            w.step(1 / 240)
+        assert len(w) > 0 and w.velocities()[:, 1].mean() > 0.1
+    with pytest.raises(ValueError):
+        sph.SourceDef(flags="inverted")
+
+
+def test_every_named_option_constant_has_its_member():
+    """A constant of these prefixes added to the header fails here until _options.py names it."""
+    named = {"SPH_DFSPH_": (sph.DfsphFlag, sph.DfsphLinearSolver), "SPH_CUDA_DFSPH_": (sph.CudaDfsphMasks,),
+             "SPH_COLLIDER_FLAG_": (sph.ColliderFlag,), "SPH_SOURCE_FLAG_": (sph.SourceFlag,),
+             "SPH_SHAPE_FLAG_": (sph.ShapeFlag,)}
+    found = 0
+    for name, value in vars(sph.raw).items():
+        prefix = next((p for p in named if name.startswith(p)), None)
+        if prefix is None or not isinstance(value, int):
+            continue
+        tail = name[len(prefix):]
+        members = [m for cls in named[prefix] for m in cls.__members__.items() if m[0] in (tail, tail[len("MASKS_"):])]
+        assert members and int(members[0][1]) == value, f"{name} has no member in {[c.__name__ for c in named[prefix]]}"
+        found += 1
+    assert found == 11

@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: MIT
 """SDF assets, colliders, sources, sinks, force fields and events."""
 import ctypes
+import gc
 import math
 
 import numpy as np
@@ -366,3 +367,97 @@ def test_collider_loads(ctx):
             tank.set_load_threshold(10.0 * weight)
             world.step(0.02)
             assert not [e for e in world.events() if e.type == sph.EventType.COLLIDER_LOAD_EXCEEDED]
+
+
+# ---- events to the objects they name (World.object_of) ----------------------------------------------
+def test_object_of_maps_a_capacity_event_to_its_source(ctx):
+    with ctx.world(capacity=300, particle_spacing=0.02) as w, \
+            ctx.shape("box", half_extents=(0.2, 0.2, 0.2), voxel_size=0.02) as box, \
+            ctx.shape("sphere", radius=0.05, voxel_size=0.01) as ball:
+        w.set_params(gravity=(0, 0, 0))
+        small = w.add_source(ball, (1, 0, 0))
+        flood = w.add_source(box, (3, 0, 0), mode="continuous")
+        w.step(1 / 60)
+        ev = [e for e in w.events() if e.type == sph.EventType.SOURCE_CAPACITY_REACHED]
+        assert ev, w.events()
+        assert all(w.object_of(e) is flood for e in ev)
+        assert small.bits != flood.bits
+        # A sink's removal names the Sink; an event of no object gives None.
+        sink = w.add_sink(bounds=((-10, -10, -10), (2, 10, 10)))
+        w.step(1 / 60)
+        removed = [e for e in w.events() if e.type == sph.EventType.SINK_REMOVED]
+        assert removed and w.object_of(removed[0]) is sink
+        assert w.object_of(sph.Event(type=sph.EventType.PRESSURE_SOLVE_CAPPED, count=1, object_bits=0)) is None
+        # The same bits under another kind's event name nothing of that kind.
+        assert w.object_of(sph.Event(type=sph.EventType.COLLIDER_LOAD_EXCEEDED, object_bits=flood.bits)) is None
+        # An unknown event type: the one object of any kind with those bits.
+        # (None when ids of two kinds share those bits: the kind cannot be told.)
+        shared = any(o.bits == sink.bits for o in (small, flood))
+        assert w.object_of(sph.Event(type=99, object_bits=sink.bits)) is (None if shared else sink)
+        # A destroyed object, and a dropped wrapper (the world keeps weak references only), give None.
+        stale = ev[0]
+        flood.destroy()
+        assert w.object_of(stale) is None
+        bits = small.bits
+        del small
+        gc.collect()
+        assert w.object_of(sph.Event(type=sph.EventType.SOURCE_CAPACITY_REACHED, object_bits=bits)) is None
+
+
+def test_object_of_maps_a_load_event_to_its_collider(ctx):
+    with ctx.shape("box", half_extents=(0.05, 0.05, 0.05), voxel_size=0.01) as box, \
+            ctx.world(capacity=512, particle_spacing=0.02, features="collider_loads") as world:
+        tank = world.add_collider(box, (0.05, 0.05, 0.05), inverted=True)
+        other = world.add_collider(box, (1, 1, 1))
+        point = world.add_probe((0.05, 0.02, 0.05), sampling="substep")
+        n = world.fill_box((0.0, 0.0, 0.0), (0.1, 0.06, 0.1))
+        for _ in range(10):
+            world.step(0.02)
+        tank.set_load_threshold(0.5 * n * world.particle_mass * 9.81)
+        point.set_pressure_threshold(1.0)
+        world.step(0.02)
+        loads = [e for e in world.events() if e.type == sph.EventType.COLLIDER_LOAD_EXCEEDED]
+        assert len(loads) == 1 and world.object_of(loads[0]) is tank
+        assert world.object_of(loads[0]) is not other
+        pressures = [e for e in world.events() if e.type == sph.EventType.PROBE_PRESSURE_EXCEEDED]
+        assert len(pressures) == 1 and world.object_of(pressures[0]) is point
+        # A loaded checkpoint's world has the objects but not these wrappers.
+        with ctx.load_world(world.save()) as copy:
+            copy.step(0.02)
+            assert [e.type for e in copy.events() if e.type == sph.EventType.COLLIDER_LOAD_EXCEEDED]
+            assert all(copy.object_of(e) is None for e in copy.events())
+
+
+# ---- SDF grids in device memory (memory="cuda"; refused on a CPU context) ----------------------------
+def test_sdf_memory_argument(ctx):
+    # Host memory, named or by enum, behaves as before.
+    d = np.full((4, 4, 4), 1.0, np.float32)
+    for memory in ("host", sph.MemoryKind.HOST, 0):
+        with ctx.sdf(d, voxel_size=0.1, memory=memory) as s:
+            s.update("distance", np.full((2, 2, 2), -0.5, np.float32), (1, 1, 1), memory=memory)
+            assert s.sample((0.15, 0.15, 0.15)) == pytest.approx(-0.5)
+            assert s.sample((0.0, 0.0, 0.0)) == pytest.approx(1.0)
+    with ctx.sdf(d, voxel_size=0.1) as s:
+        # A device address on a CPU context: the library's UNSUPPORTED (nothing is read).
+        assert error(s.update, "distance", 0x1000, memory="cuda", size=(2, 2, 2)) == sph.Result.ERROR_UNSUPPORTED
+        assert "memory" in sph.last_error()
+        assert error(s.update, "velocity", 0x1000, (1, 1, 1), memory=sph.MemoryKind.CUDA_DEVICE,
+                     size=(1, 1, 1)) == sph.Result.ERROR_UNSUPPORTED
+        assert s.sample((0.0, 0.0, 0.0)) == pytest.approx(1.0)
+        # Device memory has no shape: size is required; data must be an address.
+        with pytest.raises(ValueError, match="size: required"):
+            s.update("distance", 0x1000, memory="cuda")
+        with pytest.raises(TypeError, match="device address"):
+            s.update("distance", np.zeros((2, 2, 2), np.float32), memory="cuda", size=(2, 2, 2))
+        with pytest.raises(KeyError):
+            s.update("distance", 0x1000, memory="gpu", size=(2, 2, 2))
+
+        class Cai:  # anything with __cuda_array_interface__ passes its data pointer
+            __cuda_array_interface__ = {"data": (0x2000, False), "shape": (8,), "typestr": "<f4", "version": 3}
+
+        assert error(s.update, "friction", Cai(), memory="cuda", size=(2, 2, 2)) == sph.Result.ERROR_UNSUPPORTED
+    assert error(ctx.sdf, 0x1000, memory="cuda", dims=(4, 4, 4), voxel_size=0.1, velocity=0x2000,
+                 friction=0x3000) == sph.Result.ERROR_UNSUPPORTED
+    assert "memory" in sph.last_error()
+    with pytest.raises(ValueError, match="dims: required"):
+        ctx.sdf(0x1000, memory="cuda")
