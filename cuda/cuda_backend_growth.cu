@@ -166,6 +166,13 @@ void CudaBackend::copy_step_inputs(bool save) {
     cuda_check(cudaMemcpyAsync(save ? saved[k] : carried[k], save ? carried[k] : saved[k], sizeof(float),
                                cudaMemcpyDeviceToDevice, r_->stream),
                "copy of the step inputs");
+  // The springs' lowest waiting id: an emission lowers it, a failed step must not leave it there.
+  uint32_t* const link_from = r_->store->arrays().link_from;
+  if (link_from)
+    cuda_check(cudaMemcpyAsync(save ? &s->emission_saved_link_from : link_from,
+                               save ? link_from : &s->emission_saved_link_from, sizeof(uint32_t),
+                               cudaMemcpyDeviceToDevice, r_->stream),
+               "copy of the springs' link state");
 }
 
 }  // namespace sph

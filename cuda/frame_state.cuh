@@ -48,6 +48,7 @@ struct FrameState {
   float saved_max_acceleration;           // max_acceleration at the start of the frame, for a rollback
   float emission_saved_max_speed;         // max_speed before a step's emission (save_step_inputs)
   float emission_saved_max_acceleration;  // likewise max_acceleration
+  uint32_t emission_saved_link_from;      // likewise the springs' lowest waiting id (with springs)
   // DFSPH's depth limit (step_control.h): the lowest and highest x . g/|g| of the particles the
   // next step starts from, as order-preserving keys (height_key; atomicMin/atomicMax), reset
   // before each measurement (enqueue_height_span), and H = hi - lo as the step was picked with.

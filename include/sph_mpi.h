@@ -67,12 +67,15 @@ static inline sph_result sph_mpi_world_def_init(sph_mpi_world_def* def) {
  * distributed world is destroyed (sph_world_destroy on every rank: it frees the duplicated
  * communicator, which MPI counts as collective). The library duplicates
  * the communicator, so its messages never meet the caller's. `def` as sph_world_create's (the
- * same on every rank); `mpi_def` may be NULL (defaults). `context`: a CPU or a CUDA context, of
+ * same on every rank); `mpi_def` may be NULL (defaults), its threshold the same on every rank
+ * (compared: INVALID_ARGUMENT on every rank otherwise). `context`: a CPU or a CUDA context, of
  * the same backend on every rank. After the communicator's duplication the arguments are checked
  * and the world made inside one agreement: a failure on any rank is every rank's (the others'
  * messages name the failing rank), so no rank waits for another that returned.
- * Errors: INVALID_ARGUMENT (NULL out, a bad def or mpi_def, a bad communicator, contexts of
- * different backends on two ranks), INVALID_HANDLE (a NULL or destroyed context), UNSUPPORTED (a
+ * Errors: INVALID_ARGUMENT (NULL out, a bad def or mpi_def, MPI_COMM_NULL or a communicator
+ * handle MPI itself refuses, contexts of different backends or rebalance thresholds that differ
+ * on two ranks), VERSION_MISMATCH (an mpi_def whose struct_size is not this version's, as every
+ * sized struct), INVALID_HANDLE (a NULL or destroyed context), UNSUPPORTED (a
  * feature, solver or integrator that does not work distributed yet, named in the message),
  * OUT_OF_HOST_MEMORY, and a CUDA context's device errors. *out is untouched on error.
  */
@@ -138,8 +141,9 @@ static inline sph_result sph_mpi_counts_init(sph_mpi_counts* counts) {
 
 /**
  * COLLECTIVE. Fills *out (initialised by sph_mpi_counts_init) with this rank's and the world's
- * counts. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL out, a bad struct_size), UNSUPPORTED
- * (not a distributed world).
+ * counts. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL out), VERSION_MISMATCH (a struct_size
+ * that is not this version's: set it with sph_mpi_counts_init), UNSUPPORTED (not a distributed
+ * world).
  */
 SPH_API sph_result SPH_CALL sph_mpi_world_get_counts(const sph_world* world, sph_mpi_counts* out);
 

@@ -95,6 +95,10 @@ void World::set_user_attributes(uint32_t first, const HostVector<uint32_t>& valu
 
 void World::remove_particles(const HostVector<uint32_t>& ids) {
   if (ids.empty()) return;
+  if (backend_->distributed())
+    throw Error(Status::Unsupported,
+                "remove_particles: the world is distributed over MPI ranks (sph_mpi.h), where removing "
+                "particles by id is not supported (the ranks' sort keys would lose their particles)");
   ParticleSnapshot s = backend_->export_particles();
   const size_t n = s.id.size();
   // Index of each id (ids are unique within a world), then every requested id checked in the

@@ -59,12 +59,14 @@ class CpuBackend final : public Backend {
   void reserve(uint32_t capacity, const GrowthNeeds&) override { config_.capacity = capacity; }
 
   void save_step_inputs() override {
-    saved_inputs_ = StepInputs{max_speed_, max_acceleration_, max_speed_valid_};
+    saved_inputs_ = StepInputs{max_speed_, max_acceleration_, max_speed_valid_,
+                               link_from_ ? link_from_[0] : kNoPendingLinks};
   }
   void restore_step_inputs() override {
     max_speed_ = saved_inputs_.max_speed;
     max_acceleration_ = saved_inputs_.max_acceleration;
     max_speed_valid_ = saved_inputs_.max_speed_valid;
+    if (link_from_) link_from_[0] = saved_inputs_.link_from;
   }
 
   void copy_attribute(AttributeKind kind, uint32_t first, uint32_t count, void* dst,
@@ -372,6 +374,9 @@ class CpuBackend final : public Backend {
   struct StepInputs {
     float max_speed = 0.0f, max_acceleration = 0.0f;
     bool max_speed_valid = false;
+    // The springs' lowest waiting id: an emission lowers it to the emitted particles' first id,
+    // and a step that then fails must not leave it there (the world's checkpoint would differ).
+    uint32_t link_from = kNoPendingLinks;
   } saved_inputs_;  // save_step_inputs()
   // A distributed world's rank, null in an undivided world. Declared last: it refers to the
   // store, the count and the workers above.

@@ -56,6 +56,7 @@ SPH_API sph_result SPH_CALL sph_mpi_world_create(sph_context* context, const sph
     std::unique_ptr<sph::ContextHold> hold;
     sph_world_def d;
     sph::DistributedOptions options;
+    int64_t percent_given = 0;
     sph::agreed(ranks, [&] {
       hold = std::make_unique<sph::ContextHold>(context);
       if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
@@ -72,8 +73,19 @@ SPH_API sph_result SPH_CALL sph_mpi_world_create(sph_context* context, const sph
             Status::InvalidArgument,
             "mpi_def->rebalance_threshold_percent: must be in [0, 10000], got " + std::to_string(percent));
       options.rebalance_threshold = percent / 100.0;
+      percent_given = percent;
       d = sph::read_user_struct(def, "def");
     });
+    // The ranks rebalance together (a rank that skipped a rebalance the others began left them
+    // in mismatched reductions: one rank's step failed, the others' waited), so the threshold is
+    // one value on every rank.
+    bool same_threshold = true;
+    sph::compare_over_ranks(ranks, &percent_given, 1, &same_threshold);
+    if (!same_threshold)
+      throw Error(
+          Status::InvalidArgument,
+          "mpi_def->rebalance_threshold_percent: this rank's " + std::to_string(percent_given) +
+              " differs from another rank's: every rank must pass the same (the ranks rebalance together)");
     // One backend on every rank (before any world is made: a CUDA world's allocations are not
     // wasted on a refusal, and the refusal is this one, not a rank's own): a CPU rank and a CUDA
     // rank keep their particles, their tables and what they send each other in different layouts

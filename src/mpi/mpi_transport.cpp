@@ -14,13 +14,16 @@ namespace sph {
 
 namespace {
 
-void check(int code, const char* what) {
-  if (code == MPI_SUCCESS) return;
+std::string mpi_error_text(int code) {
   char text[MPI_MAX_ERROR_STRING];
   int length = 0;
   MPI_Error_string(code, text, &length);
-  throw Error(Status::Internal,
-              std::string("MPI: ") + what + " failed: " + std::string(text, static_cast<size_t>(length)));
+  return std::string(text, static_cast<size_t>(length));
+}
+
+void check(int code, const char* what) {
+  if (code == MPI_SUCCESS) return;
+  throw Error(Status::Internal, std::string("MPI: ") + what + " failed: " + mpi_error_text(code));
 }
 
 // The signature one rank contributes: kind in bits 32-39, the detail in the low half, and bit 40
@@ -79,8 +82,21 @@ MpiTransport::MpiTransport(MPI_Comm comm) {
   if (!initialized)
     throw Error(Status::InvalidArgument, "comm: MPI is not initialised (call MPI_Init first)");
   if (comm == MPI_COMM_NULL) throw Error(Status::InvalidArgument, "comm: is MPI_COMM_NULL");
+  // A handle that names no communicator (a stray integer, a freed one) cannot report its error on
+  // itself: MPI raises it on MPI_COMM_WORLD, whose handler aborts the job unless the caller chose
+  // otherwise. So the duplication runs with that handler set to return, and the caller's is put
+  // back before anything else (MPI gives no other way to ask whether a handle is valid).
+  MPI_Errhandler caller_handler = MPI_ERRHANDLER_NULL;
+  MPI_Comm_get_errhandler(MPI_COMM_WORLD, &caller_handler);
+  MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
+  const int duplicated = MPI_Comm_dup(comm, &comm_);
+  MPI_Comm_set_errhandler(MPI_COMM_WORLD, caller_handler);
+  MPI_Errhandler_free(&caller_handler);
+  if (duplicated != MPI_SUCCESS)
+    throw Error(Status::InvalidArgument,
+                "comm: MPI refused to duplicate it (" + mpi_error_text(duplicated) +
+                    "): pass MPI_Comm_c2f of a valid communicator, the same on every rank");
   // Errors come back as codes (check() turns them into Errors), not as an abort.
-  check(MPI_Comm_dup(comm, &comm_), "MPI_Comm_dup");
   MPI_Comm_set_errhandler(comm_, MPI_ERRORS_RETURN);
   MPI_Comm_rank(comm_, &rank_);
   MPI_Comm_size(comm_, &size_);

@@ -199,6 +199,15 @@ static void check_refusals(sph_context* context) {
   CHECK(sph_world_spawn(world, &spawn, NULL) == SPH_ERROR_UNSUPPORTED,
         "sph_world_spawn on a distributed world");
   {
+    /* Removal by id is refused as unsupported (it was INTERNAL: "the backend carries
+     * 'distributed_sort_key'"), naming what; an empty list is a no-op as anywhere. */
+    const uint32_t ids[1] = {0};
+    CHECK(sph_world_remove_particles(world, ids, 1) == SPH_ERROR_UNSUPPORTED &&
+              strstr(sph_get_last_error(), "distributed") != NULL,
+          "sph_world_remove_particles on a distributed world");
+    CHECK(sph_world_remove_particles(world, ids, 0) == SPH_OK, "an empty removal");
+  }
+  {
     /* A refused particle on one rank: no rank adds any. */
     const float bad[3] = {NAN, 0.0f, 0.0f};
     const sph_result r = sph_mpi_world_add_particles(world, g_rank == g_size - 1 ? bad : p, NULL, 1, NULL);
@@ -210,6 +219,41 @@ static void check_refusals(sph_context* context) {
           (unsigned long long)counts.global_count);
   }
   REQUIRE(sph_world_destroy(world) == SPH_OK, "destroy");
+  {
+    /* A handle that names no communicator is refused (INVALID_ARGUMENT naming comm), not left to
+     * MPI_COMM_WORLD's handler, which aborted the job; MPI_COMM_WORLD's handler is the caller's
+     * again afterwards. On every rank at once (each rank's own handle: nothing collective runs). */
+    MPI_Errhandler before = MPI_ERRHANDLER_NULL, after = MPI_ERRHANDLER_NULL;
+    MPI_Comm freed = MPI_COMM_NULL;
+    int32_t freed_handle;
+    sph_world* none = NULL;
+    MPI_Comm_get_errhandler(MPI_COMM_WORLD, &before);
+    CHECK(sph_mpi_world_create(context, &def, 12345, NULL, &none) == SPH_ERROR_INVALID_ARGUMENT &&
+              strstr(sph_get_last_error(), "comm") != NULL && none == NULL,
+          "a stray communicator handle: %s", sph_get_last_error());
+    MPI_Comm_dup(MPI_COMM_WORLD, &freed);
+    freed_handle = (int32_t)MPI_Comm_c2f(freed);
+    MPI_Comm_free(&freed);
+    CHECK(sph_mpi_world_create(context, &def, freed_handle, NULL, &none) == SPH_ERROR_INVALID_ARGUMENT &&
+              none == NULL,
+          "a freed communicator's handle: %s", sph_get_last_error());
+    MPI_Comm_get_errhandler(MPI_COMM_WORLD, &after);
+    CHECK(before == after, "MPI_COMM_WORLD's error handler is the caller's again");
+    MPI_Errhandler_free(&before);
+    MPI_Errhandler_free(&after);
+  }
+  if (g_size > 1) {
+    /* The ranks rebalance together, so their thresholds must agree: one that differs is refused on
+     * every rank (before, the world was made, and a later step failed on one rank with MPI_ERR_TRUNCATE
+     * while the others waited). */
+    sph_mpi_world_def m;
+    sph_world* none = NULL;
+    REQUIRE(sph_mpi_world_def_init(&m) == SPH_OK, "mpi def init");
+    m.rebalance_threshold_percent = g_rank == 0 ? 1u : 10000u;
+    CHECK(sph_mpi_world_create(context, &def, comm, &m, &none) == SPH_ERROR_INVALID_ARGUMENT &&
+              strstr(sph_get_last_error(), "rebalance_threshold_percent") != NULL && none == NULL,
+          "thresholds that differ over the ranks: %s", sph_get_last_error());
+  }
 }
 
 int main(int argc, char** argv) {
