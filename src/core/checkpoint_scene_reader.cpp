@@ -49,11 +49,9 @@ std::shared_ptr<SdfAsset> read_asset(ByteReader& r, uint32_t index) {
   if (channels & kAssetHasVelocity) {
     asset->velocity().resize(n);
     HostVector<Vec3>& velocity = asset->velocity();
-    for (uint64_t i = 0; i < n; ++i) {
-      velocity[i] = bulk_vec3(r, where.c_str(), static_cast<uint32_t>(i));
-      if (!speed_fits_float(velocity[i]))  // sph_sdf_create's rule
-        corrupt(r.what() + ": " + where + " " + std::to_string(i) + " has a speed above 1.8e19 m/s");
-    }
+    // (Any finite values: a force field's grid keeps its accelerations in this channel, which may
+    // be as large as a float holds; a source's region is held to particle speeds in read_source.)
+    for (uint64_t i = 0; i < n; ++i) velocity[i] = bulk_vec3(r, where.c_str(), static_cast<uint32_t>(i));
   }
   if (channels & kAssetHasFriction) {
     asset->friction().resize(n);
@@ -190,6 +188,11 @@ Source read_source(ByteReader& r, const Assets& assets, const WorldConfig& confi
   if (spec.spacing == 0.0f || spec.min_distance == 0.0f)
     corrupt(r.what() + ": " + name + " spacing or min distance is 0 (never written)");
   Source s = by_scene_rules(r, name, [&] { return make_source(spec, config); });
+  // sph_sdf_create's and sph_sdf_update's rule on a velocity channel, for the region whose
+  // velocities this source gives its particles.
+  if (spec.velocity_from_field)
+    for (const Vec3& v : spec.region->velocity())
+      if (!speed_fits_float(v)) corrupt(r.what() + ": " + name + " region has a speed above 1.8e19 m/s");
   s.rate_budget = r.f64();
   // A budget grows by at most rate x frame time per step; far below the size_t range.
   if (!std::isfinite(s.rate_budget) || s.rate_budget < 0.0 || s.rate_budget > 1e15)
