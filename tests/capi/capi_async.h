@@ -9,7 +9,7 @@
 
 #include "capi_test.h"
 
-/* The threads /proc/self/task lists. */
+/* The threads /proc/self/task lists, once the count holds still (capi_async.c). */
 int capi_thread_count(void);
 
 /* A world of `capacity` on `context` with a block of fluid [0, side]^3 (sph_world_fill_box, at
