@@ -892,6 +892,59 @@ static void test_failed_step_keeps_the_springs_state(void** state) {
   EXPECT_OK(sph_sdf_destroy(ball));
 }
 
+/* The rule of sph_sdf_create on a velocity channel (speeds below 1.8e19 m/s), for a source that
+ * gives its particles the channel's velocities, holds for a checkpoint too: a forged one whose
+ * region holds 3e19 m/s is CORRUPT_DATA naming the source (the same channel in a force field's
+ * grid, which holds accelerations, is no error: bdecb11). */
+static void test_forged_fast_source_region_is_refused(void** state) {
+  damaged_fixture* d = (damaged_fixture*)*state;
+  sph_world_def def;
+  sph_world *world = NULL, *loaded = NULL;
+  sph_sdf_desc desc;
+  sph_grid_desc velocity;
+  sph_sdf* region = NULL;
+  sph_source_def source;
+  sph_source_id source_id;
+  float distance[8] = {-1, -1, -1, -1, -1, -1, -1, -1}, speeds[24] = {0};
+  const float marker = 1234.5f, fast = 3e19f;
+  uint8_t* data;
+  uint64_t size, at;
+  int found = 0;
+
+  sph_world_def_init(&def);
+  def.capacity = 300;
+  EXPECT_OK(sph_world_create(d->context, &def, &world));
+  sph_sdf_desc_init(&desc);
+  desc.distance.dims[0] = desc.distance.dims[1] = desc.distance.dims[2] = 2;
+  desc.distance.index_to_local[0] = desc.distance.index_to_local[5] = desc.distance.index_to_local[10] =
+      0.05f;
+  desc.distance.data = distance;
+  sph_grid_desc_init(&velocity);
+  velocity.dims[0] = velocity.dims[1] = velocity.dims[2] = 2;
+  speeds[21] = marker; /* voxel 7's x: a value to find in the bytes */
+  velocity.data = speeds;
+  desc.velocity = &velocity;
+  EXPECT_OK(sph_sdf_create(d->context, &desc, &region));
+  sph_source_def_init(&source);
+  source.region = region;
+  source.flags = SPH_SOURCE_FLAG_VELOCITY_FROM_FIELD;
+  EXPECT_OK(sph_source_create(world, &source, &source_id));
+  data = save_to_memory(world, &size);
+  for (at = 48; at + 4 <= size; ++at)
+    if (memcmp(data + at, &marker, 4) == 0) {
+      memcpy(data + at, &fast, 4);
+      ++found;
+    }
+  assert_int_equal(found, 1);
+  reseal(data, (size_t)size);
+  EXPECT_ERROR(SPH_ERROR_CORRUPT_DATA, "region has a speed above 1.8e19",
+               sph_world_load(d->context, data, size, &loaded));
+  assert_null(loaded);
+  free(data);
+  EXPECT_OK(sph_world_destroy(world));
+  EXPECT_OK(sph_sdf_destroy(region));
+}
+
 static void test_wrong_magic_future_version_and_trailing_bytes(void** state) {
   damaged_fixture* d = (damaged_fixture*)*state;
   char future[32];
@@ -1115,6 +1168,7 @@ int main(void) {
       cmocka_unit_test(test_extreme_forged_values_step_without_crashing),
       cmocka_unit_test(test_source_at_the_end_of_the_ids),
       cmocka_unit_test(test_failed_step_keeps_the_springs_state),
+      cmocka_unit_test(test_forged_fast_source_region_is_refused),
       cmocka_unit_test(test_wrong_magic_future_version_and_trailing_bytes),
       cmocka_unit_test(test_failed_restore_changes_nothing),
   };
