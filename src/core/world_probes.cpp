@@ -7,6 +7,7 @@
 
 #include "field_checks.h"
 #include "field_error.h"
+#include "position_reach.h"
 #include "status.h"
 #include "world.h"
 
@@ -14,16 +15,13 @@ namespace sph {
 namespace {
 
 constexpr size_t kMaxProbes = 65536;
-// The particles' bound (world_particles.cpp): beyond 2^16 spacings float32 positions no longer
-// resolve the spacing, and far points would only ever read air.
-constexpr float kMaxProbeCoordinateInSpacings = 65536.0f;
 
+// The particles' reach (position_reach.h): far points would only ever read air.
 void require_resolved(const Vec3& p, float spacing, const char* field) {
-  const float limit = kMaxProbeCoordinateInSpacings * spacing;
-  if (!(std::fabs(p.x) <= limit && std::fabs(p.y) <= limit && std::fabs(p.z) <= limit))
-    throw FieldError(Status::InvalidArgument, field,
-                     "lies farther than " + describe_value(limit) +
-                         " m (65536 particle spacings) from the origin, where no particle may be");
+  if (resolution_problem(p, spacing).empty()) return;
+  throw FieldError(Status::InvalidArgument, field,
+                   "lies farther than " + describe_value(kMaxPositionInSpacings * spacing) +
+                       " m (65536 particle spacings) from the origin, where no particle may be");
 }
 
 // |v| in double: a float's square underflows below about 1e-19 (a direction of (1e-30, 0, 0)

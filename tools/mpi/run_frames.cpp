@@ -99,11 +99,7 @@ int run_frames(const Ranks& ranks, const CliOptions& cli, const SceneDesc& scene
                  backend.c_str(), out.directory.c_str(), per_rank ? " (+ rank<R>/)" : "");
   install_interrupt_handlers();
   Progress progress(scene.frames, isatty(STDERR_FILENO) != 0, cli.quiet || !root);
-  MessageFold warnings("sph-run-mpi: warning: "), notices("sph-run-mpi: ");
-  const auto note = [&progress](MessageFold& fold, uint32_t frame, const FrameMessage& m) {
-    const std::string line = fold.line(frame, m);
-    if (!line.empty()) progress.note(line);
-  };
+  FrameMessages messages("sph-run-mpi");
   RunStats stats;  // the world's figures (world_stats), kept by rank 0
   ObjectFiles objects;
   ParticleFrame own, all;
@@ -146,9 +142,7 @@ int run_frames(const Ranks& ranks, const CliOptions& cli, const SceneDesc& scene
     const sph_stats world = world_stats(s, interrupt_signal(), ranks.comm, &signal);
     if (signal) break;
     if (root) {
-      for (const FrameMessage& w : runtime.warnings()) note(warnings, i, w);
-      for (const FrameMessage& n : runtime.notices()) note(notices, i, n);
-      if (step == SPH_INCOMPLETE) note(warnings, i, incomplete_frame_message());
+      messages.frame(progress, i, runtime, step);
     }
     const double output_ms = write_frame(i);
     ++written;
@@ -158,9 +152,7 @@ int run_frames(const Ranks& ranks, const CliOptions& cli, const SceneDesc& scene
         FrameReport{i, world.particle_count, world.substeps, step_ms, output_ms, world.pressure_iterations});
   }
   progress.finish();
-  if (root)
-    for (const MessageFold* fold : {&warnings, &notices})
-      for (const std::string& line : fold->closing()) std::fprintf(stderr, "%s\n", line.c_str());
+  if (root) messages.print_closing(stderr);
   if (root) objects.close(ranks);
   if (signal && root)
     std::fprintf(stderr, "sph-run-mpi: interrupted; frames 0..%u are complete in %s/\n", written - 1,

@@ -38,9 +38,22 @@ std::vector<std::string> MessageFold::closing() const {
   return lines;
 }
 
-FrameMessage incomplete_frame_message() {
-  return {"max_substeps ran out before the frame's end",
-          "max_substeps ran out before the frame's end (raise params.max_substeps or dt_min)", 0, ""};
+void FrameMessages::frame(Progress& progress, uint32_t frame, const SceneRuntime& runtime, sph_result step) {
+  const auto note = [&](MessageFold& fold, const FrameMessage& m) {
+    const std::string line = fold.line(frame, m);
+    if (!line.empty()) progress.note(line);
+  };
+  for (const FrameMessage& w : runtime.warnings()) note(warnings_, w);
+  for (const FrameMessage& n : runtime.notices()) note(notices_, n);
+  if (step == SPH_INCOMPLETE)
+    note(warnings_,
+         {"max_substeps ran out before the frame's end",
+          "max_substeps ran out before the frame's end (raise params.max_substeps or dt_min)", 0, ""});
+}
+
+void FrameMessages::print_closing(std::FILE* out) const {
+  for (const MessageFold* fold : {&warnings_, &notices_})
+    for (const std::string& line : fold->closing()) std::fprintf(out, "%s\n", line.c_str());
 }
 
 }  // namespace sph_tools

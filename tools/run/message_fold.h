@@ -9,10 +9,12 @@
 #define SPH_TOOLS_RUN_MESSAGE_FOLD_H
 
 #include <cstdint>
+#include <cstdio>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "progress.h"
 #include "scene_runtime.h"
 
 namespace sph_tools {
@@ -40,8 +42,21 @@ class MessageFold {
   std::vector<Kind> kinds_;
 };
 
-// The warning for a frame that ended with SPH_INCOMPLETE (max_substeps ran out).
-FrameMessage incomplete_frame_message();
+// A run's warnings and notices, each folded: what sph-run and sph-run-mpi print for a frame.
+class FrameMessages {
+ public:
+  // `program` heads every line ("sph-run").
+  explicit FrameMessages(const std::string& program)
+      : warnings_(program + ": warning: "), notices_(program + ": ") {}
+  // The frame's messages through `progress`: the runtime's warnings and notices of its last
+  // step_frame, and the warning of a step that ended SPH_INCOMPLETE (max_substeps ran out).
+  void frame(Progress& progress, uint32_t frame, const SceneRuntime& runtime, sph_result step);
+  // The folded kinds' lines, warnings first (after the progress).
+  void print_closing(std::FILE* out) const;
+
+ private:
+  MessageFold warnings_, notices_;
+};
 
 }  // namespace sph_tools
 

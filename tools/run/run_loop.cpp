@@ -62,11 +62,7 @@ int run_scene(sph_context* context, const std::string& backend_name, const Scene
     }
     install_interrupt_handlers();
     Progress progress(scene.frames, tty, cli.quiet);
-    MessageFold warnings("sph-run: warning: "), notices("sph-run: ");
-    const auto note = [&progress](MessageFold& fold, uint32_t frame, const FrameMessage& m) {
-      const std::string line = fold.line(frame, m);
-      if (!line.empty()) progress.note(line);
-    };
+    FrameMessages messages("sph-run");
     RunStats stats;
     ParticleFrame frame;
     const Clock::time_point run_start = Clock::now();
@@ -89,9 +85,7 @@ int run_scene(sph_context* context, const std::string& backend_name, const Scene
       ++stepped;
       const double step_ms = ms_since(t);
       if (interrupt_signal()) break;  // the frame is not written: only whole frames stay
-      for (const FrameMessage& w : runtime.warnings()) note(warnings, i, w);
-      for (const FrameMessage& n : runtime.notices()) note(notices, i, n);
-      if (step == SPH_INCOMPLETE) note(warnings, i, incomplete_frame_message());
+      messages.frame(progress, i, runtime, step);
       sph_stats s;
       sph_stats_init(&s);
       sph_world_get_stats(runtime.world(), &s);
@@ -111,8 +105,7 @@ int run_scene(sph_context* context, const std::string& backend_name, const Scene
           FrameReport{i, s.particle_count, s.substeps, step_ms, output_ms, s.pressure_iterations});
     }
     progress.finish();
-    for (const MessageFold* fold : {&warnings, &notices})
-      for (const std::string& line : fold->closing()) std::fprintf(stderr, "%s\n", line.c_str());
+    messages.print_closing(stderr);
     const int signal = interrupt_signal();
     if (signal)
       std::fprintf(stderr, "sph-run: interrupted; frames 0..%u are complete in %s/\n", written - 1,
