@@ -204,7 +204,8 @@ Source read_source(ByteReader& r, const Assets& assets, const WorldConfig& confi
   const std::string where = name + " lattice point";
   for (uint32_t i = 0; i < points; ++i) s.lattice[i] = bulk_vec3(r, where.c_str(), i);
   // World::add_source's and set_source_pose's reach.
-  const std::string reach = lattice_reach_problem(s.lattice, s.pose, config.particle_spacing);
+  s.lattice_bounds = lattice_box(s.lattice);
+  const std::string reach = lattice_reach_problem(s.lattice_bounds, s.pose, config.particle_spacing);
   if (!reach.empty()) corrupt(r.what() + ": " + name + " transform " + reach);
   return s;
 }

@@ -29,20 +29,35 @@ inline std::string resolution_problem(const Vec3& p, float spacing) {
          "resolve the spacing to 1/128; move the scene's origin closer or use a larger spacing";
 }
 
-// "" when every point of a source's lattice (region-local) lies within reach at `pose`, else
-// why not. The posed corners of the lattice's box bound it (|x| is convex, so its largest value
-// over the posed points is at most its largest over the posed corners): a lattice refused lies
-// within its box's diagonal of the bound, one accepted within it wholly.
-inline std::string lattice_reach_problem(const HostVector<Vec3>& lattice, const RigidTransform& pose,
-                                         float spacing) {
-  if (lattice.empty()) return {};
-  Vec3 lo = lattice[0], hi = lattice[0];
+// The box of a source's lattice (region-local), kept with the source so that moving it costs
+// eight corner checks, not a walk over up to kMaxSourceLatticePoints points.
+struct LatticeBox {
+  bool empty = true;
+  Vec3 lo{0.0f, 0.0f, 0.0f};
+  Vec3 hi{0.0f, 0.0f, 0.0f};
+};
+
+inline LatticeBox lattice_box(const HostVector<Vec3>& lattice) {
+  LatticeBox box;
+  if (lattice.empty()) return box;
+  box.empty = false;
+  box.lo = box.hi = lattice[0];
   for (const Vec3& p : lattice) {
-    lo = Vec3{std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-    hi = Vec3{std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    box.lo = Vec3{std::min(box.lo.x, p.x), std::min(box.lo.y, p.y), std::min(box.lo.z, p.z)};
+    box.hi = Vec3{std::max(box.hi.x, p.x), std::max(box.hi.y, p.y), std::max(box.hi.z, p.z)};
   }
+  return box;
+}
+
+// "" when every point of a source's lattice (region-local, bounded by `box`) lies within reach at
+// `pose`, else why not. The posed corners of the lattice's box bound it (|x| is convex, so its
+// largest value over the posed points is at most its largest over the posed corners): a lattice
+// refused lies within its box's diagonal of the bound, one accepted within it wholly.
+inline std::string lattice_reach_problem(const LatticeBox& box, const RigidTransform& pose, float spacing) {
+  if (box.empty) return {};
   for (int c = 0; c < 8; ++c) {
-    const Vec3 corner{(c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z};
+    const Vec3 corner{(c & 1) ? box.hi.x : box.lo.x, (c & 2) ? box.hi.y : box.lo.y,
+                      (c & 4) ? box.hi.z : box.lo.z};
     const std::string problem = resolution_problem(to_world(pose, corner), spacing);
     if (!problem.empty()) return "puts the region's lattice at " + problem;
   }

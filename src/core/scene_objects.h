@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "host_memory.h"
+#include "position_reach.h"
 #include "scene_specs.h"
 
 namespace sph {
@@ -45,6 +46,7 @@ struct Source {
   double rate_budget = 0.0;     // fractional particles carried between frames
   bool done = false;            // FillOnce: already emitted
   HostVector<Vec3> lattice;     // FCC points inside the region, in the region's frame
+  LatticeBox lattice_bounds;    // lattice_box(lattice), set wherever the lattice is
   uint32_t user_attribute = 0;  // its particles' (SPH_FEATURE_USER_ATTRIBUTE)
 };
 

@@ -52,6 +52,9 @@ uint32_t World::add_rank_particles(const HostVector<Vec3>& positions, const Host
   if (!backend_->distributed())
     throw Error(Status::Internal, "add_rank_particles: the world is not distributed");
   const uint32_t next_id_before = next_id_;
+  // undo_rank_particles puts them back: an append lowers the springs' lowest waiting id and a
+  // truncation recomputes the max speed, so without them an undone add would leave other bytes.
+  backend_->save_step_inputs();
   next_id_ = first_id;
   rank_add_ = true;
   try {
@@ -67,7 +70,10 @@ uint32_t World::add_rank_particles(const HostVector<Vec3>& positions, const Host
 }
 
 void World::undo_rank_particles(uint32_t count_before, uint32_t next_id_before) {
-  if (particle_count() > count_before) backend_->truncate(count_before);
+  if (particle_count() > count_before) {
+    backend_->truncate(count_before);
+    backend_->restore_step_inputs();  // saved by add_rank_particles
+  }
   next_id_ = next_id_before;
 }
 

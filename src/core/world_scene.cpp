@@ -40,7 +40,8 @@ uint64_t World::add_collider(const ColliderSpec& spec) {
 uint64_t World::add_source(const SourceSpec& spec) {
   Source s = make_source(spec, config_);
   s.lattice = lattice_inside(*s.region, s.spacing, kMaxSourceLatticePoints);
-  const std::string reach = lattice_reach_problem(s.lattice, s.pose, config_.particle_spacing);
+  s.lattice_bounds = lattice_box(s.lattice);
+  const std::string reach = lattice_reach_problem(s.lattice_bounds, s.pose, config_.particle_spacing);
   if (!reach.empty()) throw FieldError(Status::InvalidArgument, "transform", reach);
   require_room(sources_, "sources");
   return sources_.insert(std::move(s));
@@ -97,7 +98,7 @@ void World::set_collider_load_threshold(uint64_t id, float threshold) {
 void World::set_source_pose(uint64_t id, const RigidTransform& pose) {
   Source& s = sources_.at(id);
   require_pose(pose, "transform");
-  const std::string reach = lattice_reach_problem(s.lattice, pose, config_.particle_spacing);
+  const std::string reach = lattice_reach_problem(s.lattice_bounds, pose, config_.particle_spacing);
   if (!reach.empty()) throw FieldError(Status::InvalidArgument, "transform", reach);
   s.pose = pose;
 }

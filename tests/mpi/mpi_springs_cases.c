@@ -23,7 +23,8 @@
  *     written 0 or left stale).
  * Each: after the substeps, the particles equal the undivided world's bit for bit (the spring
  * sums run over the same slots with the same partners' bits: no tolerance), the count is the
- * world's. Also rank checkpoints of a world with springs, restored, loaded, and loaded on one rank. */
+ * world's. Also rank checkpoints of a world with springs, restored, loaded, and loaded on one rank,
+ * and an add refused on one rank leaving every rank's checkpoint bytes as they were. */
 #include <math.h>
 #include <mpi.h>
 #include <stdio.h>
@@ -261,6 +262,73 @@ static void check_checkpoint(sph_context* context, uint32_t capacity) {
   if (single) REQUIRE(sph_world_destroy(single) == SPH_OK, "destroy");
 }
 
+/* This rank's file of the set saved at `path` (malloc'd, *size bytes). */
+static unsigned char* read_rank_file(const char* path, long* size) {
+  char name[512];
+  unsigned char* bytes = NULL;
+  FILE* f;
+  *size = 0;
+  REQUIRE(mpi_test_rank_file(path, g_rank, name, sizeof name), "the manifest %s", path);
+  f = fopen(name, "rb");
+  REQUIRE(f != NULL, "open %s", name);
+  fseek(f, 0, SEEK_END);
+  *size = ftell(f);
+  fseek(f, 0, SEEK_SET);
+  bytes = (unsigned char*)malloc((size_t)*size + 1u);
+  REQUIRE(bytes != NULL && fread(bytes, 1, (size_t)*size, f) == (size_t)*size, "read %s", name);
+  fclose(f);
+  return bytes;
+}
+
+/* An add refused on one rank undoes the others' (sph_mpi_world_add_particles: no rank adds any),
+ * and leaves each rank's world as it was: before, the ranks that had appended a particle kept the
+ * springs' lowest waiting id lowered to its id (and the max speed recomputed from the velocities
+ * left), so each rank saved other bytes than before the add. Here the save after the refused add
+ * equals the save before it, file for file, on every rank. */
+static void check_refused_add(sph_context* context, uint32_t capacity) {
+  const sph_vec3 column_min = {0.0f, 0.0f, 0.0f}, column_max = {0.1f, 0.2f, 0.06f};
+  const spring_case c = {
+      "refused add",    2.0f, 1e4f, 20.0f, 0.0f, 0.1f, 0, 0, 0, SPH_INTEGRATOR_SYMPLECTIC_EULER,
+      SPH_SOLVER_WCSPH, 5,    0};
+  const float good[3] = {0.05f, 0.1f, 0.03f}, bad[3] = {NAN, 0.1f, 0.03f};
+  long run_id = (long)getpid(), size_before = 0, size_after = 0;
+  char path[128];
+  sph_world_def def;
+  sph_world* single = NULL;
+  sph_world* world = NULL;
+  sph_collider_id single_tank, tank;
+  unsigned char *before, *after;
+  sph_result r;
+  MPI_Bcast(&run_id, 1, MPI_LONG, 0, MPI_COMM_WORLD);
+  snprintf(path, sizeof path, "mpi_springs_refused_add.np%d.%ld.sphcp", g_size, run_id);
+  mpi_test_world_def(&def);
+  if (capacity) def.capacity = capacity;
+  def.features = SPH_FEATURE_SPRINGS;
+  make_worlds(context, &def, column_min, column_max, c.stir, &single, &world, &single_tank, &tank);
+  set_springs(world, &c);
+  mpi_test_step(world, c.substeps, 1); /* every particle has made its springs */
+  REQUIRE(sph_mpi_world_save_file(world, path) == SPH_OK, "save: %s", sph_get_last_error());
+  before = read_rank_file(path, &size_before);
+  r = sph_mpi_world_add_particles(world, g_rank == g_size - 1 ? bad : good, NULL, 1, NULL);
+  CHECK(r == SPH_ERROR_INVALID_ARGUMENT, "springs: a NaN on the last rank refuses the add: %d", (int)r);
+  REQUIRE(sph_mpi_world_save_file(world, path) == SPH_OK, "save: %s", sph_get_last_error());
+  after = read_rank_file(path, &size_after);
+  CHECK(size_after == size_before && memcmp(before, after, (size_t)size_before) == 0,
+        "springs: rank %d saves other bytes after a refused add (%ld against %ld)", g_rank, size_after,
+        size_before);
+  free(before);
+  free(after);
+  {
+    char name[512];
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (mpi_test_rank_file(path, g_rank, name, sizeof name)) remove(name);
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (g_rank == 0) remove(path);
+  }
+  REQUIRE(sph_world_destroy(world) == SPH_OK, "destroy");
+  if (single) REQUIRE(sph_world_destroy(single) == SPH_OK, "destroy");
+}
+
 void mpi_springs_cases(sph_context* context, uint32_t capacity) {
   const spring_case cases[] = {
       {"elastic springs", 2.0f, 1e4f, 20.0f, 0.0f, 0.1f, 0, 0, 0, SPH_INTEGRATOR_SYMPLECTIC_EULER,
@@ -281,4 +349,5 @@ void mpi_springs_cases(sph_context* context, uint32_t capacity) {
   };
   for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) run_case(context, capacity, &cases[k]);
   check_checkpoint(context, capacity);
+  check_refused_add(context, capacity);
 }
