@@ -179,8 +179,10 @@ typedef uint32_t sph_feature_flags;
 #define SPH_FEATURE_NORMALIZED_DENSITY 0x2u
 /** Elasticity and plasticity (thesis 4.4.2.1; Clavet, Beaudoin & Poulin 2005): springs between
  *  neighbouring particles, made once per particle at its first substep (so the rest shape is
- *  the spawn shape), with rest lengths that yield and creep; sph_spring_params. Costs 128 bytes
- *  per particle (host) or 256 (device) and a spring pass per force evaluation. */
+ *  the spawn shape), with rest lengths that yield and creep; sph_spring_params. Costs about 340
+ *  bytes per particle of host memory on the CPU backend (lists, their reorder buffer, link
+ *  candidates, acceleration), 468 of device memory on CUDA (docs/physics.md, springs' "Cost"),
+ *  and a spring pass per force evaluation. */
 #define SPH_FEATURE_SPRINGS 0x4u
 /** Walls in the density: every collider's solid counts in the particles' density sums (a
  *  density map per SDF asset, Koschier & Bender 2017, calibrated on the particle lattice), and
@@ -232,7 +234,7 @@ typedef enum sph_equation_of_state {
   SPH_EOS_FORCE32 = 0x7fffffff
 } sph_equation_of_state;
 
-/** The pressure solver, fixed at world creation (docs/physics.md, "Solvers"). */
+/** The pressure solver, fixed at world creation (docs/physics.md, "DFSPH: the incompressible solver"). */
 typedef enum sph_solver {
   SPH_SOLVER_WCSPH = 0, /* the thesis's weakly compressible SPH: pressure from the equation of
                            state, explicit steps under the acoustic ceiling 0.4 h / c */
@@ -410,18 +412,18 @@ typedef struct sph_world sph_world;
 /** Creation-time description of a world; fixed for the world's life. Zero means default for
  *  every field: a zeroed def is the def sph_world_def_init gives. */
 typedef struct sph_world_def {
-  uint32_t struct_size;                  /* sizeof(sph_world_def), set by sph_world_def_init */
-  uint32_t header_version;               /* SPH_VERSION of the caller's header; 0 = unchecked */
-  uint32_t capacity;                     /* particles the world has room for at creation; 0
-                                            (default) = 65536; at most 2^30. A world whose
-                                            max_capacity is larger grows past it on demand. */
-  sph_feature_flags features;            /* SPH_FEATURE_* bits; default SPH_FEATURE_NONE */
-  sph_integrator integrator;             /* default SPH_INTEGRATOR_SYMPLECTIC_EULER */
-  sph_viscosity_method viscosity_method; /* default SPH_VISCOSITY_MUELLER */
-  float particle_spacing;                /* nearest-neighbour distance of the FCC lattice, m;
-                                            0 (default) = 0.02 */
-  float kernel_radius;                   /* h, m; 0 (default) = 1.8 * particle_spacing; must be >= spacing */
-  float rest_density;                    /* rho0, kg/m^3; 0 (default) = 1000 (water) */
+  uint32_t struct_size;                    /* sizeof(sph_world_def), set by sph_world_def_init */
+  uint32_t header_version;                 /* SPH_VERSION of the caller's header; 0 = unchecked */
+  uint32_t capacity;                       /* particles the world has room for at creation; 0
+                                              (default) = 65536; at most 2^30. A world whose
+                                              max_capacity is larger grows past it on demand. */
+  sph_feature_flags features;              /* SPH_FEATURE_* bits; default SPH_FEATURE_NONE */
+  sph_integrator integrator;               /* default SPH_INTEGRATOR_SYMPLECTIC_EULER */
+  sph_viscosity_method viscosity_method;   /* default SPH_VISCOSITY_MUELLER */
+  float particle_spacing;                  /* nearest-neighbour distance of the FCC lattice, m;
+                                              0 (default) = 0.02 */
+  float kernel_radius;                     /* h, m; 0 (default) = 1.8 * spacing; in [spacing, 5 * spacing] */
+  float rest_density;                      /* rho0, kg/m^3; 0 (default) = 1000 (water) */
   sph_equation_of_state equation_of_state; /* default SPH_EOS_IDEAL_GAS */
   sph_solver solver;                       /* default SPH_SOLVER_WCSPH */
   /* Most particles the world may grow to (docs/api.md, "Growable worlds"); 0 (default) =
@@ -445,7 +447,7 @@ static inline sph_result sph_world_def_init(sph_world_def* def) {
  * an FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass).
  * Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range:
  * capacity above 2^30, max_capacity non-zero and below capacity or above 2^30, spacing < 0 or
- * non-finite, kernel_radius < spacing, rest_density < 0),
+ * non-finite, kernel_radius outside [spacing, 5 * spacing], rest_density < 0),
  * UNSUPPORTED (unknown integrator, feature bit, method or solver; a combination a solver does
  * not support, see sph_solver), VERSION_MISMATCH, OUT_OF_HOST_MEMORY,
  * OUT_OF_DEVICE_MEMORY. *out is written only on success.

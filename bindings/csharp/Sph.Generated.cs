@@ -46,7 +46,9 @@ namespace Sph
         /// Elasticity and plasticity (thesis 4.4.2.1; Clavet, Beaudoin &amp; Poulin 2005): springs
         /// between neighbouring particles, made once per particle at its first substep (so the rest
         /// shape is the spawn shape), with rest lengths that yield and creep; sph_spring_params. Costs
-        /// 128 bytes per particle (host) or 256 (device) and a spring pass per force evaluation.
+        /// about 340 bytes per particle of host memory on the CPU backend (lists, their reorder buffer,
+        /// link candidates, acceleration), 468 of device memory on CUDA (docs/physics.md, springs'
+        /// "Cost"), and a spring pass per force evaluation.
         /// </summary>
         public const uint SPH_FEATURE_SPRINGS = 4u;
         /// <summary>
@@ -312,7 +314,10 @@ namespace Sph
         Tait = 1,
     }
 
-    /// <summary>sph_solver: The pressure solver, fixed at world creation (docs/physics.md, "Solvers").</summary>
+    /// <summary>
+    /// sph_solver: The pressure solver, fixed at world creation (docs/physics.md, "DFSPH: the
+    /// incompressible solver").
+    /// </summary>
     public enum Solver : int
     {
         /// <summary>
@@ -957,7 +962,7 @@ namespace Sph
         public ViscosityMethod ViscosityMethod;
         /// <summary>float particle_spacing: nearest-neighbour distance of the FCC lattice, m; 0 (default) = 0.02</summary>
         public float ParticleSpacing;
-        /// <summary>float kernel_radius: h, m; 0 (default) = 1.8 * particle_spacing; must be &gt;= spacing</summary>
+        /// <summary>float kernel_radius: h, m; 0 (default) = 1.8 * spacing; in [spacing, 5 * spacing]</summary>
         public float KernelRadius;
         /// <summary>float rest_density: rho0, kg/m^3; 0 (default) = 1000 (water)</summary>
         public float RestDensity;
@@ -2530,10 +2535,10 @@ namespace Sph
         /// FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass).
         /// Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range:
         /// capacity above 2^30, max_capacity non-zero and below capacity or above 2^30, spacing &lt; 0
-        /// or non-finite, kernel_radius &lt; spacing, rest_density &lt; 0), UNSUPPORTED (unknown
-        /// integrator, feature bit, method or solver; a combination a solver does not support, see
-        /// sph_solver), VERSION_MISMATCH, OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY. *out is written
-        /// only on success.
+        /// or non-finite, kernel_radius outside [spacing, 5 * spacing], rest_density &lt; 0),
+        /// UNSUPPORTED (unknown integrator, feature bit, method or solver; a combination a solver does
+        /// not support, see sph_solver), VERSION_MISMATCH, OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY.
+        /// *out is written only on success.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_create(ContextHandle context, ref WorldDef def, out WorldHandle @out);
@@ -3691,10 +3696,11 @@ namespace Sph
         /// grid's linear index-to-world transform, so the asset's local frame is the file's world
         /// frame. Voxels outside the narrow band take the grid's values there (plus or minus the band
         /// width). grid_name selects a grid; NULL or "" takes the first float level set in the file.
-        /// Errors: INVALID_ARGUMENT (NULL arguments; the file cannot be opened or is not a VDB file; no
-        /// such grid; the grid is not a float level set; a non-linear transform), CAPACITY (the dense
-        /// grid would exceed 2^31 voxels), and those of sph_sdf_create. On failure *out is unchanged
-        /// and sph_vdb_get_last_error() explains. Thread-safe.
+        /// Errors: INVALID_HANDLE (NULL context), INVALID_ARGUMENT (NULL path or out; the file cannot
+        /// be opened or is not a VDB file; no such grid; the grid is not a float level set; a non-
+        /// linear transform), CAPACITY (the dense grid would exceed 2^31 voxels), and those of
+        /// sph_sdf_create. On failure *out is unchanged and sph_vdb_get_last_error() explains. Thread-
+        /// safe.
         /// </summary>
         [DllImport(LibrarySphVdb, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_vdb_load_sdf(ContextHandle context, byte[] path, byte[] gridName, out SdfHandle @out);

@@ -30,8 +30,8 @@ sph_world_def default_world_def() {
   return d;
 }
 
-// DFSPH's combinations (docs/physics.md, "Solvers"): what it does not support is refused here,
-// naming the field, rather than run with a meaning the caller did not ask for.
+// DFSPH's combinations (docs/physics.md, "DFSPH: the incompressible solver"): what it does not support is
+// refused here, naming the field, rather than run with a meaning the caller did not ask for.
 void require_dfsph_combination(const sph_world_def& d, uint32_t integrator, uint32_t eos) {
   if (integrator == SPH_INTEGRATOR_RK4)
     throw Error(Status::Unsupported,

@@ -66,7 +66,7 @@ constexpr SectionInfo kSectionOrder[] = {
     {tag('S', 'R', 'C', 'E'), "sources"},
     {tag('S', 'I', 'N', 'K'), "sinks"},
     {tag('F', 'F', 'L', 'D'), "force fields"},
-    {tag('P', 'R', 'O', 'B'), "probes"},  // from version 5
+    {tag('P', 'R', 'O', 'B'), "probes"},  // from version 6 (kFirstProbeVersion)
 };
 constexpr uint32_t kSectionCount = sizeof(kSectionOrder) / sizeof(kSectionOrder[0]);
 // The format version of a checkpoint that loaded (its header's bytes 8-11, little-endian).
@@ -75,7 +75,7 @@ inline uint32_t format_version_of(const void* data) {
   return static_cast<uint32_t>(b[8]) | (static_cast<uint32_t>(b[9]) << 8) |
          (static_cast<uint32_t>(b[10]) << 16) | (static_cast<uint32_t>(b[11]) << 24);
 }
-// The sections a file of `version` has: all but PROB before version 5.
+// The sections a file of `version` has: all but PROB before version 6.
 constexpr uint32_t section_count_of(uint32_t version) {
   return version >= kFirstProbeVersion ? kSectionCount : kSectionCount - 1;
 }

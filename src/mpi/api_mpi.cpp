@@ -69,9 +69,9 @@ SPH_API sph_result SPH_CALL sph_mpi_world_create(sph_context* context, const sph
       const uint32_t percent =
           m.rebalance_threshold_percent == 0 ? sph::kDefaultRebalancePercent : m.rebalance_threshold_percent;
       if (percent > sph::kMaxRebalancePercent)
-        throw Error(
-            Status::InvalidArgument,
-            "mpi_def->rebalance_threshold_percent: must be in [0, 10000], got " + std::to_string(percent));
+        throw Error(Status::InvalidArgument,
+                    "mpi_def->rebalance_threshold_percent: must be in [1, 10000] (0: the default, 20), got " +
+                        std::to_string(percent));
       options.rebalance_threshold = percent / 100.0;
       percent_given = percent;
       d = sph::read_user_struct(def, "def");

@@ -162,15 +162,11 @@ void SceneRuntime::add_fluid(const FluidDesc& f) {
     d.velocity = f.velocity;
     r = sph_world_fill_sphere(world_, &d, &added);
   } else {
-    std::vector<float> velocities = f.velocities;
-    if (velocities.empty())
-      for (size_t i = 0; i < f.positions.size(); i += 3)
-        velocities.insert(velocities.end(), {f.velocity.x, f.velocity.y, f.velocity.z});
     sph_spawn_desc d;
     sph_spawn_desc_init(&d);
     d.count = static_cast<uint32_t>(f.positions.size() / 3);
     d.positions = f.positions.data();
-    d.velocities = velocities.data();
+    d.velocities = f.velocities.empty() ? nullptr : f.velocities.data();  // NULL: at rest
     r = sph_world_spawn(world_, &d, nullptr);
   }
   if (r == SPH_ERROR_CAPACITY) {

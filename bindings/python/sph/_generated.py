@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '3009522c49f20cb52041fcf8ec29d2f3f11ef26cc61d76d2de29e79ef3b551f6', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': '0add86230766569cb53c5823004f1a1f673eae88192e6b8e90c55312014f6a5f', 'include/sph_vdb.h': '3ac663099a4aa5fb693d4ee5e9d0cb894eb73d5ae3cc6847170dad6b0d1caba2'}
+HEADERS = {'include/sph_c.h': 'caa90e33c41f36fbb0be8c49052fc2f08a573942cadccc75b0a45c9213f351b8', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': '0add86230766569cb53c5823004f1a1f673eae88192e6b8e90c55312014f6a5f', 'include/sph_vdb.h': '256d341729fa5ee56f09a7349d822c42a134d4a948ac22870a64546345e3e434'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -46,8 +46,10 @@ SPH_FEATURE_SURFACE_TENSION = 1
 SPH_FEATURE_NORMALIZED_DENSITY = 2
 #: Elasticity and plasticity (thesis 4.4.2.1; Clavet, Beaudoin & Poulin 2005): springs between
 #: neighbouring particles, made once per particle at its first substep (so the rest shape is the
-#: spawn shape), with rest lengths that yield and creep; sph_spring_params. Costs 128 bytes per
-#: particle (host) or 256 (device) and a spring pass per force evaluation.
+#: spawn shape), with rest lengths that yield and creep; sph_spring_params. Costs about 340 bytes
+#: per particle of host memory on the CPU backend (lists, their reorder buffer, link candidates,
+#: acceleration), 468 of device memory on CUDA (docs/physics.md, springs' "Cost"), and a spring
+#: pass per force evaluation.
 SPH_FEATURE_SPRINGS = 4
 #: Walls in the density: every collider's solid counts in the particles' density sums (a density
 #: map per SDF asset, Koschier & Bender 2017, calibrated on the particle lattice), and the wall
@@ -344,7 +346,10 @@ SPH_SOLVER_FORCE32 = 2147483647
 
 
 class Solver(_enum.IntEnum):
-    """sph_solver: The pressure solver, fixed at world creation (docs/physics.md, "Solvers")."""
+    """
+    sph_solver: The pressure solver, fixed at world creation (docs/physics.md, "DFSPH: the
+    incompressible solver").
+    """
     #: the thesis's weakly compressible SPH: pressure from the equation of state, explicit steps
     #: under the acoustic ceiling 0.4 h / c
     WCSPH = 0
@@ -903,7 +908,7 @@ class WorldDef(_SphStruct):
         integrator (sph_integrator): default SPH_INTEGRATOR_SYMPLECTIC_EULER
         viscosity_method (sph_viscosity_method): default SPH_VISCOSITY_MUELLER
         particle_spacing (float): nearest-neighbour distance of the FCC lattice, m; 0 (default) = 0.02
-        kernel_radius (float): h, m; 0 (default) = 1.8 * particle_spacing; must be >= spacing
+        kernel_radius (float): h, m; 0 (default) = 1.8 * spacing; in [spacing, 5 * spacing]
         rest_density (float): rho0, kg/m^3; 0 (default) = 1000 (water)
         equation_of_state (sph_equation_of_state): default SPH_EOS_IDEAL_GAS
         solver (sph_solver): default SPH_SOLVER_WCSPH
@@ -2169,7 +2174,7 @@ FUNCTIONS = {
     'sph_world_def_init_sized': (sph_result, (_c.POINTER(sph_world_def), _c.c_uint32), ('def', 'size'),
         '', 'sph'),
     'sph_world_create': (sph_result, (_c.POINTER(sph_context), _c.POINTER(sph_world_def), _c.POINTER(_c.POINTER(sph_world))), ('context', 'def', 'out'),
-        'Creates an empty world on a context. The particle mass is derived here: the mass at which an FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass). Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range: capacity above 2^30, max_capacity non-zero and below capacity or above 2^30, spacing < 0 or non-finite, kernel_radius < spacing, rest_density < 0), UNSUPPORTED (unknown integrator, feature bit, method or solver; a combination a solver does not support, see sph_solver), VERSION_MISMATCH, OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY. *out is written only on success.', 'sph'),
+        'Creates an empty world on a context. The particle mass is derived here: the mass at which an FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass). Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range: capacity above 2^30, max_capacity non-zero and below capacity or above 2^30, spacing < 0 or non-finite, kernel_radius outside [spacing, 5 * spacing], rest_density < 0), UNSUPPORTED (unknown integrator, feature bit, method or solver; a combination a solver does not support, see sph_solver), VERSION_MISMATCH, OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY. *out is written only on success.', 'sph'),
     'sph_world_destroy': (sph_result, (_c.POINTER(sph_world),), ('world',),
         "Destroys a world and everything in it. NULL is a no-op. It takes the world like every call that takes a world: WORLD_LOCKED while another thread's call is inside it (destroy again once that call returned); a call that races a destroy that won gets INVALID_HANDLE. Memory a call is using is never freed.", 'sph'),
     'sph_world_get_def': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_world_def)), ('world', 'out_def'),
@@ -2413,7 +2418,7 @@ FUNCTIONS = {
     'sph_mpi_world_restore_file': (sph_result, (_c.POINTER(sph_world), _c.c_char_p), ('world', 'path'),
         "COLLECTIVE. Replaces the world's whole state with the one saved at `path`, keeping its handle and communicator: afterwards it is as a world sph_mpi_world_load_file made from `path`. All-or-nothing over the ranks: on any error on any rank, every rank's world is unchanged. Errors: as sph_mpi_world_load_file, and INVALID_HANDLE, UNSUPPORTED (not a distributed world), WORLD_LOCKED.", 'sph_mpi'),
     'sph_vdb_load_sdf': (sph_result, (_c.POINTER(sph_context), _c.c_char_p, _c.c_char_p, _c.POINTER(_c.POINTER(sph_sdf))), ('context', 'path', 'grid_name', 'out'),
-        'Loads a level-set FloatGrid from a .vdb file into a new SDF asset of `context`: the grid\'s active voxels (plus one voxel of margin) become a dense grid whose index_to_local is the grid\'s linear index-to-world transform, so the asset\'s local frame is the file\'s world frame. Voxels outside the narrow band take the grid\'s values there (plus or minus the band width). grid_name selects a grid; NULL or "" takes the first float level set in the file. Errors: INVALID_ARGUMENT (NULL arguments; the file cannot be opened or is not a VDB file; no such grid; the grid is not a float level set; a non-linear transform), CAPACITY (the dense grid would exceed 2^31 voxels), and those of sph_sdf_create. On failure *out is unchanged and sph_vdb_get_last_error() explains. Thread-safe.', 'sph_vdb'),
+        'Loads a level-set FloatGrid from a .vdb file into a new SDF asset of `context`: the grid\'s active voxels (plus one voxel of margin) become a dense grid whose index_to_local is the grid\'s linear index-to-world transform, so the asset\'s local frame is the file\'s world frame. Voxels outside the narrow band take the grid\'s values there (plus or minus the band width). grid_name selects a grid; NULL or "" takes the first float level set in the file. Errors: INVALID_HANDLE (NULL context), INVALID_ARGUMENT (NULL path or out; the file cannot be opened or is not a VDB file; no such grid; the grid is not a float level set; a non-linear transform), CAPACITY (the dense grid would exceed 2^31 voxels), and those of sph_sdf_create. On failure *out is unchanged and sph_vdb_get_last_error() explains. Thread-safe.', 'sph_vdb'),
     'sph_vdb_get_last_error': (_c.c_char_p, (), (),
         'The message of the last failed sph_vdb_ call on this thread, or "" after a success.', 'sph_vdb'),
 }
