@@ -6,6 +6,7 @@
 // structure, the same step control and the same rollback.
 #pragma once
 
+#include <algorithm>
 #include <cstring>
 #include <memory>
 #include <vector>
@@ -114,6 +115,9 @@ class CudaBackend final : public Backend {
   DeviceAttributeView device_attribute(AttributeKind kind) const override;
 
   uint64_t data_epoch() const override { return epoch_; }
+  void continue_data_epoch(const Backend& previous) override {
+    if (const auto* p = dynamic_cast<const CudaBackend*>(&previous)) epoch_ = std::max(epoch_, p->epoch_) + 1;
+  }
   int device_ordinal() const override { return device_; }
   void* device_stream() const override { return r_->stream; }
 
@@ -270,6 +274,9 @@ class CudaBackend final : public Backend {
   KernelTuning tuning_;
   SubstepOptions options_;
   bool use_graphs_ = true;
+  // Set once the running frame's rollback point (the particle snapshot and the saved step inputs)
+  // is on the stream; a frame that fails before it has changed no particle and rolls nothing back.
+  bool rollback_point_enqueued_ = false;
   uint32_t count_ = 0;
   uint64_t epoch_ = 1;
   mutable bool lost_ = false;

@@ -238,6 +238,7 @@ uint32_t CudaBackend::run_frame_distributed(PipelineSetup setup, uint32_t sink_c
   b.store->enqueue_snapshot(count_, s);
   save_rollback_inputs_kernel<<<1, 1, 0, s>>>(b.state);
   check_launch("save_rollback_inputs_kernel");
+  rollback_point_enqueued_ = true;
   halo_begin_frame(setup.limits);
   setup.count = count_;
   setup.ghosts = 0;

@@ -164,15 +164,17 @@ template <bool kCounts, bool kNormalized>
 void launch_density(bool boundary, unsigned lanes, unsigned threads, const FluidConstants& fluid,
                     const GridView& grid, const ParticleArrays& a, uint32_t n, const DeviceScene& scene,
                     float stage_fraction, bool factor_to_side, FrameState* state, cudaStream_t stream) {
-  const unsigned blocks = blocks_for_lanes(n, lanes, threads);
+  const auto launch = [&](auto kernel) {
+    const unsigned t = fit_block(kernel, threads);
+    kernel<<<blocks_for_lanes(n, lanes, t), t, 0, stream>>>(fluid, grid, a, n, scene, stage_fraction,
+                                                            factor_to_side, state);
+  };
   with_lanes(lanes, [&](auto g) {
     constexpr unsigned G = decltype(g)::value;
     if (boundary)
-      density_kernel<kCounts, kNormalized, true, G>
-          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, stage_fraction, factor_to_side, state);
+      launch(density_kernel<kCounts, kNormalized, true, G>);
     else
-      density_kernel<kCounts, kNormalized, false, G>
-          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, stage_fraction, factor_to_side, state);
+      launch(density_kernel<kCounts, kNormalized, false, G>);
   });
 }
 
@@ -208,7 +210,8 @@ void enqueue_density_summation(const FluidConstants& fluid, const GridView& grid
                                  options.density_diffusion, state, stream);
   check_launch("density_kernel");
   if (a.halo_ghost) {  // a distributed rank's world
-    ghost_density_moves_kernel<<<blocks_for(n, threads), threads, 0, stream>>>(fluid, a, n);
+    const unsigned t = fit_block(ghost_density_moves_kernel, threads);
+    ghost_density_moves_kernel<<<blocks_for(n, t), t, 0, stream>>>(fluid, a, n);
     check_launch("ghost_density_moves_kernel");
   }
 }
@@ -216,19 +219,22 @@ void enqueue_density_summation(const FluidConstants& fluid, const GridView& grid
 bool enqueue_density_republish(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                                uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
                                bool first_of_substep, FrameState* state, cudaStream_t stream) {
-  const unsigned threads = tuning.density_block, blocks = blocks_for(n, threads);
+  const unsigned threads = tuning.density_block;
   if (options.density_diffusion) {
     // The diffusion keeps the carried density instead of the filter (density_diffusion.h).
     if (first_of_substep) {  // once per substep, for its whole dt
       enqueue_density_diffusion(fluid, grid, a, n, tuning, state, stream);
     } else {
-      carry_density_factor_kernel<<<blocks, threads, 0, stream>>>(a, n);
+      const unsigned t = fit_block(carry_density_factor_kernel, threads);
+      carry_density_factor_kernel<<<blocks_for(n, t), t, 0, stream>>>(a, n);
       check_launch("carry_density_factor_kernel");
     }
   } else if (options.normalized_density) {
-    normalized_density_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n, state);
+    const unsigned t = fit_block(normalized_density_kernel, threads);
+    normalized_density_kernel<<<blocks_for(n, t), t, 0, stream>>>(fluid, grid, a, n, state);
     check_launch("normalized_density_kernel");
-    publish_normalized_density_kernel<<<blocks, threads, 0, stream>>>(fluid, a, n);
+    const unsigned tp = fit_block(publish_normalized_density_kernel, threads);
+    publish_normalized_density_kernel<<<blocks_for(n, tp), tp, 0, stream>>>(fluid, a, n);
     check_launch("publish_normalized_density_kernel");
     return true;
   }
@@ -238,17 +244,18 @@ bool enqueue_density_republish(const FluidConstants& fluid, const GridView& grid
 void enqueue_density_diffusion(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                                uint32_t n, const KernelTuning& tuning, FrameState* state,
                                cudaStream_t stream) {
-  const unsigned threads = tuning.density_block, blocks = blocks_for(n, threads);
-  density_diffusion_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n, state);
+  const unsigned t = fit_block(density_diffusion_kernel, tuning.density_block);
+  density_diffusion_kernel<<<blocks_for(n, t), t, 0, stream>>>(fluid, grid, a, n, state);
   check_launch("density_diffusion_kernel");
-  publish_normalized_density_kernel<<<blocks, threads, 0, stream>>>(fluid, a, n);
+  const unsigned tp = fit_block(publish_normalized_density_kernel, tuning.density_block);
+  publish_normalized_density_kernel<<<blocks_for(n, tp), tp, 0, stream>>>(fluid, a, n);
   check_launch("publish_normalized_density_kernel");
 }
 
 void enqueue_colour_normals(const FluidConstants& fluid, const GridView& grid, const ParticleArrays& a,
                             uint32_t n, const KernelTuning& tuning, cudaStream_t stream) {
-  const unsigned threads = tuning.density_block, blocks = blocks_for(n, threads);
-  colour_normal_kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n);
+  const unsigned t = fit_block(colour_normal_kernel, tuning.density_block);
+  colour_normal_kernel<<<blocks_for(n, t), t, 0, stream>>>(fluid, grid, a, n);
   check_launch("colour_normal_kernel");
 }
 

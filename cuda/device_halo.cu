@@ -190,6 +190,7 @@ void DeviceHalo::ensure_device(size_t bytes) {
 void DeviceHalo::ensure_host(size_t bytes) {
   if (host_staging_bytes_ >= bytes) return;
   const size_t grown = bytes + bytes / 2 + 256;
+  host_staging_bytes_ = 0;  // allocate() frees the old buffer first: a failure leaves none
   host_staging_.allocate(grown, "halo staging (host)");
   host_staging_bytes_ = grown;
 }

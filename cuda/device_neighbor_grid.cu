@@ -139,7 +139,10 @@ DeviceNeighborGrid::DeviceNeighborGrid(const GridShape& shape, uint32_t capacity
   cell_start_.allocate(static_cast<size_t>(shape.cell_count) + 1, "cell-start table");
   if (fit_to_extent_) {
     live_.allocate(1, "the grid's fitted shape");
-    cuda_check(cudaMemset(live_.get(), 0, sizeof(LiveGridShape)), "the grid's extent reset");
+    // Finished before the world's (non-blocking) stream can read it: a memset on the default
+    // stream is not ordered before that stream's work.
+    cuda_check(cudaMemsetAsync(live_.get(), 0, sizeof(LiveGridShape), 0), "the grid's extent reset");
+    cuda_check(cudaStreamSynchronize(0), "the grid's extent reset");
   }
   cub::DoubleBuffer<uint32_t> keys(scratch_.keys[0], scratch_.keys[1]);
   cub::DoubleBuffer<uint32_t> values(scratch_.values[0], scratch_.values[1]);

@@ -48,6 +48,7 @@ DeviceProbes DeviceProbeBuffers::upload(const SceneFrame& scene, const ProbeCons
   if (views_.size() < probes) views_.allocate(probes, "device probe views");
   if (sums_.size() < probes) sums_.allocate(probes, "the probes' frame sums");
   if (output_slots_ < probes) {
+    output_slots_ = 0;  // allocate() frees the old copy first: a failure leaves none
     output_.allocate(probes, "the probes' host copy");
     output_slots_ = probes;
   }

@@ -130,13 +130,15 @@ void enqueue_dfsph_density(const FluidConstants& fluid, const GridView& grid, co
                            uint32_t n, const SubstepOptions& options, const KernelTuning& tuning,
                            const DeviceScene& scene, bool divergence_warm_start, FrameState* state,
                            cudaStream_t stream) {
-  const unsigned threads = tuning.density_block, blocks = blocks_for(n, threads);
+  const unsigned threads = tuning.density_block;
   if (divergence_warm_start) {
-    dfsph_warm_starts_kernel<<<blocks, threads, 0, stream>>>(a, n, state);
+    const unsigned t = fit_block(dfsph_warm_starts_kernel, threads);
+    dfsph_warm_starts_kernel<<<blocks_for(n, t), t, 0, stream>>>(a, n, state);
     check_launch("dfsph_warm_starts_kernel");
   }
   const auto launch = [&](auto kernel) {
-    kernel<<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, state);
+    const unsigned t = fit_block(kernel, threads);
+    kernel<<<blocks_for(n, t), t, 0, stream>>>(fluid, grid, a, n, scene, state);
     check_launch("dfsph_density_kernel");
   };
   if (options.boundary_density)

@@ -353,29 +353,33 @@ void enqueue_dfsph_step(const FluidConstants& fluid, const GridView& grid, const
   if (divergence_solve)
     enqueue_solve(Solve::Divergence, fluid, grid, a, n, contacts, loops, state, stream,
                   dfsph_divergence_warm_start_in_density_pass(fluid, options, loops.rank != nullptr));
-  const unsigned threads = tuning.force_block, blocks = blocks_for(n, threads);
+  const unsigned threads = tuning.force_block;
   // The density solve's warm start in the forces pass, where the solve's own first pass would be
   // that warm start: not on a distributed rank (its solves start with the ghosts' exchanges) nor
   // with the corrected gradient (its velocity update gathers a moment too).
   const bool fused_warm_start = !loops.rank && fluid.methods.dfsph.gradient_correction == 0;
   const float* warm = fused_warm_start ? a.dfsph_warm_pressure : nullptr;
+  const auto launch_forces = [&](auto kernel) {
+    const unsigned t = fit_block(kernel, threads);
+    kernel<<<blocks_for(n, t), t, 0, stream>>>(fluid, grid, a, n, scene, divergence_solve, warm, state);
+  };
   with_force_terms(options.methods, [&](auto terms) {
     using Terms = decltype(terms);
     if (scene.active())
-      dfsph_forces_kernel<Terms, true>
-          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, divergence_solve, warm, state);
+      launch_forces(dfsph_forces_kernel<Terms, true>);
     else
-      dfsph_forces_kernel<Terms, false>
-          <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, divergence_solve, warm, state);
+      launch_forces(dfsph_forces_kernel<Terms, false>);
   });
   check_launch("dfsph_forces_kernel");
   enqueue_solve(Solve::Density, fluid, grid, a, n, contacts, loops, state, stream, fused_warm_start);
+  const auto launch_integrate = [&](auto kernel) {
+    const unsigned t = fit_block(kernel, threads);
+    kernel<<<blocks_for(n, t), t, 0, stream>>>(a, n, scene, divergence_solve, collide_here, state);
+  };
   if (scene.active())
-    dfsph_integrate_kernel<true>
-        <<<blocks, threads, 0, stream>>>(a, n, scene, divergence_solve, collide_here, state);
+    launch_integrate(dfsph_integrate_kernel<true>);
   else
-    dfsph_integrate_kernel<false>
-        <<<blocks, threads, 0, stream>>>(a, n, scene, divergence_solve, collide_here, state);
+    launch_integrate(dfsph_integrate_kernel<false>);
   check_launch("dfsph_integrate_kernel");
 }
 

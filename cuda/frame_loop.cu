@@ -107,10 +107,14 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
   const bool with_sinks = !scene_in.sinks.empty();
   uint32_t count_after = count_;
   HostVector<uint32_t> removed_ids, removed_by_sink(scene_in.sinks.size(), 0u);
-  bool frame_enqueued = false;  // the frame's first work (the rollback snapshot) is on the stream
-  bool interrupted = false;     // the stream driver stopped at a substep boundary (StepInterrupt)
+  bool interrupted = false;  // the stream driver stopped at a substep boundary (StepInterrupt)
+  rollback_point_enqueued_ = false;
   try {
     guarded([&] {
+      // An error left pending on this thread by earlier CUDA calls that are not the library's (the
+      // caller's own, or an engine allocator's handled failure) would be read by the frame's first
+      // launch check as its own failure: cleared here. A sticky error persists and is reported.
+      (void)cudaGetLastError();
       bind_frame_scene(scene_in, setup);
       FrameInput* input = r_->input.get();
       input->frame_dt = frame_dt;
@@ -122,10 +126,10 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
       const bool on_graph = use_graphs_ && !distributed() && !with_sinks &&
                             !scene_in.interrupt.has_deadline() && prepare_graph(setup);
       cuda_check(cudaEventRecord(r_->frame_start, r_->stream), "cudaEventRecord");
-      frame_enqueued = true;
-      if (on_graph)
-        r_->graph.launch(r_->stream);
-      else if (distributed())
+      if (on_graph) {
+        r_->graph.launch(r_->stream);  // the snapshot is the graph's first work
+        rollback_point_enqueued_ = true;
+      } else if (distributed())
         count_after = run_frame_distributed(setup, static_cast<uint32_t>(scene_in.sinks.size()), removed_ids,
                                             removed_by_sink, scene_in.interrupt, interrupted);
       else
@@ -140,10 +144,10 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
     // A failure in the middle of a frame that did not lose the device (a host allocation
     // for the removed ids, say): the substeps already run are undone from the frame's
     // snapshot, so the failed step changes nothing.
-    if (frame_enqueued && e.status() != Status::DeviceLost) roll_back_frame();
+    if (rollback_point_enqueued_ && e.status() != Status::DeviceLost) roll_back_frame();
     throw;
   } catch (const std::exception&) {
-    if (frame_enqueued) roll_back_frame();
+    if (rollback_point_enqueued_) roll_back_frame();
     throw;
   }
   const FrameState s = *r_->state_output.get();
@@ -251,6 +255,7 @@ uint32_t CudaBackend::run_frame_on_stream(PipelineSetup setup, uint32_t sink_cou
   uint32_t n = count_;
   setup.count = n;
   enqueue_frame_begin(setup, b, LoopCondition{}, s);
+  rollback_point_enqueued_ = true;  // (nothing before it touches a particle)
   cuda_check(cudaMemcpyAsync(&out->run, &b.state->run, sizeof(uint32_t), cudaMemcpyDeviceToHost, s),
              "copy of the loop condition");
   cuda_check(cudaStreamSynchronize(s), "frame begin");

@@ -212,17 +212,18 @@ void enqueue_forces_euler(const FluidConstants& fluid, const GridView& grid, con
                           const DeviceScene& scene, bool collide_here, FrameState* state,
                           cudaStream_t stream) {
   const unsigned threads = tuning.force_block, lanes = lanes_per_particle(tuning, n);
-  const unsigned blocks = blocks_for_lanes(n, lanes, threads);
+  const auto launch = [&](auto kernel, bool collide) {
+    const unsigned t = fit_block(kernel, threads);
+    kernel<<<blocks_for_lanes(n, lanes, t), t, 0, stream>>>(fluid, grid, a, n, scene, collide, state);
+  };
   with_force_terms(options.methods, [&](auto terms) {
     using Terms = decltype(terms);
     with_lanes(lanes, [&](auto g) {
       constexpr unsigned G = decltype(g)::value;
       if (scene.active())
-        forces_euler_kernel<Terms, true, G>
-            <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, collide_here, state);
+        launch(forces_euler_kernel<Terms, true, G>, collide_here);
       else
-        forces_euler_kernel<Terms, false, G>
-            <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, scene, true, state);
+        launch(forces_euler_kernel<Terms, false, G>, true);
     });
   });
   check_launch("forces_euler_kernel");
@@ -232,17 +233,18 @@ void enqueue_forces_rk4(const FluidConstants& fluid, const GridView& grid, const
                         uint32_t n, int stage, const SubstepOptions& options, const KernelTuning& tuning,
                         const DeviceScene& scene, bool collide_here, FrameState* state, cudaStream_t stream) {
   const unsigned threads = tuning.force_block, lanes = lanes_per_particle(tuning, n);
-  const unsigned blocks = blocks_for_lanes(n, lanes, threads);
+  const auto launch = [&](auto kernel, bool collide) {
+    const unsigned t = fit_block(kernel, threads);
+    kernel<<<blocks_for_lanes(n, lanes, t), t, 0, stream>>>(fluid, grid, a, n, stage, scene, collide, state);
+  };
   with_force_terms(options.methods, [&](auto terms) {
     using Terms = decltype(terms);
     with_lanes(lanes, [&](auto g) {
       constexpr unsigned G = decltype(g)::value;
       if (scene.active())
-        forces_rk4_kernel<Terms, true, G>
-            <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, scene, collide_here, state);
+        launch(forces_rk4_kernel<Terms, true, G>, collide_here);
       else
-        forces_rk4_kernel<Terms, false, G>
-            <<<blocks, threads, 0, stream>>>(fluid, grid, a, n, stage, scene, true, state);
+        launch(forces_rk4_kernel<Terms, false, G>, true);
     });
   });
   check_launch("forces_rk4_kernel");

@@ -355,7 +355,8 @@ typedef struct sph_context_def {
      cuda_particle_lanes (the order of the neighbour sums: the last bits). */
   sph_cuda_frames cuda_frames;  /* default SPH_CUDA_FRAMES_GRAPH */
   uint32_t cuda_density_block;  /* threads per block of the density kernels: 0 (default) = 128, or
-                                   32, 64, 128, 256, 512, 1024 */
+                                   32, 64, 128, 256, 512, 1024 (a kernel whose registers do not
+                                   fit that many runs at the most that fit) */
   uint32_t cuda_force_block;    /* threads per block of the force kernels: 0 (default) = 128, or as above */
   uint32_t cuda_particle_lanes; /* threads per particle of the density and force passes (0.2.0): 0
                                    (default) = chosen by the library from the particle count (more

@@ -41,7 +41,9 @@ extern "C" {
  * The address and layout stay valid until the world's capacity grows (a world with
  * sph_world_def.max_capacity above its capacity reallocates its particles when a spawn, fill or
  * source needs room: sph_stats.capacity_growths counts it, and the epoch changes; a fixed world
- * never moves them): take the view again after any call that may add particles. The
+ * never moves them), and sph_world_restore or sph_mpi_world_restore_file replaces them (the
+ * epoch then moves past every earlier one): take the view again after any call that may add
+ * particles or restore. The
  * contents are those of data epoch `epoch`: every call that changes particles (spawn, fill, step, also a step
  * that failed and rolled back) increments the world's epoch and rewrites them in place; compare with
  * sph_cuda_world_get_epoch. The memory is the world's: read it, never write or free it.
@@ -75,7 +77,8 @@ SPH_API sph_result SPH_CALL sph_cuda_world_get_attribute(const sph_world* world,
                                                          sph_cuda_attribute_view* out);
 
 /**
- * The world's data epoch: starts at 1 and increments on every call that changes particles.
+ * The world's data epoch: starts at 1 and increments on every call that changes particles (a
+ * restore sets it past every epoch the world had).
  * A view whose epoch equals it describes the current contents. Non-blocking.
  * Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL), UNSUPPORTED, DEVICE_LOST, WORLD_LOCKED.
  */

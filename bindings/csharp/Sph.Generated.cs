@@ -884,7 +884,8 @@ namespace Sph
         public CudaFrames CudaFrames;
         /// <summary>
         /// uint32_t cuda_density_block: threads per block of the density kernels: 0 (default) = 128, or
-        /// 32, 64, 128, 256, 512, 1024
+        /// 32, 64, 128, 256, 512, 1024 (a kernel whose registers do not fit that many runs at the most
+        /// that fit)
         /// </summary>
         public uint CudaDensityBlock;
         /// <summary>
@@ -2174,10 +2175,12 @@ namespace Sph
     /// The address and layout stay valid until the world's capacity grows (a world with
     /// sph_world_def.max_capacity above its capacity reallocates its particles when a spawn, fill or
     /// source needs room: sph_stats.capacity_growths counts it, and the epoch changes; a fixed world
-    /// never moves them): take the view again after any call that may add particles. The contents are
-    /// those of data epoch `epoch`: every call that changes particles (spawn, fill, step, also a step
-    /// that failed and rolled back) increments the world's epoch and rewrites them in place; compare
-    /// with sph_cuda_world_get_epoch. The memory is the world's: read it, never write or free it.
+    /// never moves them), and sph_world_restore or sph_mpi_world_restore_file replaces them (the epoch
+    /// then moves past every earlier one): take the view again after any call that may add particles or
+    /// restore. The contents are those of data epoch `epoch`: every call that changes particles (spawn,
+    /// fill, step, also a step that failed and rolled back) increments the world's epoch and rewrites
+    /// them in place; compare with sph_cuda_world_get_epoch. The memory is the world's: read it, never
+    /// write or free it.
     /// </summary>
     [StructLayout(LayoutKind.Sequential)]
     public partial struct CudaAttributeView
@@ -3443,9 +3446,10 @@ namespace Sph
         public static extern Result sph_cuda_world_get_attribute(IntPtr world, SphAttribute attribute, IntPtr @out);
 
         /// <summary>
-        /// The world's data epoch: starts at 1 and increments on every call that changes particles. A
-        /// view whose epoch equals it describes the current contents. Non-blocking. Errors:
-        /// INVALID_HANDLE, INVALID_ARGUMENT (NULL), UNSUPPORTED, DEVICE_LOST, WORLD_LOCKED.
+        /// The world's data epoch: starts at 1 and increments on every call that changes particles (a
+        /// restore sets it past every epoch the world had). A view whose epoch equals it describes the
+        /// current contents. Non-blocking. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL),
+        /// UNSUPPORTED, DEVICE_LOST, WORLD_LOCKED.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_cuda_world_get_epoch(WorldHandle world, out ulong outEpoch);

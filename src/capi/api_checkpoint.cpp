@@ -129,10 +129,11 @@ SPH_API sph_result SPH_CALL sph_world_restore(sph_world* world, const void* data
                   "sph_mpi_world_restore_file on every rank (sph_mpi.h)");
     // The new state is built whole beside the old one, then swapped in.
     std::unique_ptr<sph::World> loaded = load_world(world->context, data, size);
-    // A file of format 5 or later carries its probes; an older one has none, and the world
+    // A file of format 6 or later carries its probes; an older one has none, and the world
     // keeps its own (the rule before probes were in checkpoints).
     if (sph::checkpoint::format_version_of(data) < sph::checkpoint::kFirstProbeVersion)
       loaded->adopt_probes(*world->world);
+    loaded->backend().continue_data_epoch(world->world->backend());
     world->world.swap(loaded);
     return SPH_OK;
   });

@@ -144,6 +144,9 @@ class Backend {
   virtual DeviceAttributeView device_attribute(AttributeKind) const { throw unsupported_interop(); }
   // Increments on every call that changes particle data (append, frames, rollbacks).
   virtual uint64_t data_epoch() const { throw unsupported_interop(); }
+  // A restore replaces a world's backend with this one: its epoch continues past `previous`'s, so
+  // a view taken before the restore (its buffers freed with the old backend) never matches.
+  virtual void continue_data_epoch(const Backend& /*previous*/) {}
   virtual int device_ordinal() const { throw unsupported_interop(); }
   virtual void* device_stream() const { throw unsupported_interop(); }  // a cudaStream_t
   // Records a caller-owned cudaEvent_t on the backend's stream / makes the stream wait for one.

@@ -11,6 +11,7 @@
 // a world whose capacity its particles fill exactly, so the call must grow it first: every
 // allocation of the growth fails in turn and must leave the world, its capacity included, as
 // it was.
+#include <cstring>
 #include <functional>
 
 #include "../../cuda/device_allocation_faults.h"
@@ -211,6 +212,85 @@ void check_call(const Call& call) {
          problem.c_str());
 }
 
+sph_probe_id add_probe(sph_world* world, float x) {
+  sph_probe_def def;
+  sph_probe_def_init(&def);
+  def.position = sph_vec3{x, -0.15f, 0.0f};
+  sph_probe_id id{};
+  require_ok(sph_probe_create(world, &def, &id), "sph_probe_create");
+  return id;
+}
+
+// A scene stepped once with two probes.
+void two_probe_frame(Scene* s, sph_probe_id ids[2]) {
+  build_scene(s, Objects::None);
+  ids[0] = add_probe(s->world, -0.14f);  // in the water
+  ids[1] = add_probe(s->world, -0.06f);
+  require_ok(sph_world_step(s->world, kFrameDt), "the two probes' first frame");
+}
+
+std::vector<sph_probe_reading> readings(const sph_world* world, const sph_probe_id* ids, int count) {
+  std::vector<sph_probe_reading> r(static_cast<size_t>(count));
+  for (int k = 0; k < count; ++k) {
+    sph_probe_reading_init(&r[k]);
+    require_ok(sph_probe_get_reading(world, ids[k], &r[k]), "sph_probe_get_reading");
+  }
+  return r;
+}
+
+// The probes' host copy grows when a step has more probes than before. An allocation that failed
+// there (OUT_OF_HOST_MEMORY, the world unchanged) left the buffer freed but its size counted, so
+// once the new probe was gone every later step copied the readings into a null pointer and
+// failed (CudaBackend's device_probes.cu). Each allocation point of the step with a third probe
+// fails in turn; then the third probe goes and the world must step, its two probes reading what
+// an undisturbed world's read.
+void check_probe_growth_failure() {
+  Scene reference;
+  sph_probe_id ids[2];
+  two_probe_frame(&reference, ids);
+  require_ok(sph_world_step(reference.world, kFrameDt), "reference frame");
+  const std::vector<sph_probe_reading> want = readings(reference.world, ids, 2);
+  const Snapshot want_state = take(reference.world);
+  destroy_scene(&reference);
+  long failed = 0;
+  bool ok = true;
+  std::string problem;
+  for (long n = 0; ok; ++n) {
+    Scene s;
+    two_probe_frame(&s, ids);
+    const sph_probe_id third = add_probe(s.world, -0.1f);
+    faults::arm_device_allocation_fault(n);
+    const sph_result r = sph_world_step(s.world, kFrameDt);
+    const bool injected = faults::disarm_device_allocation_fault();
+    if (!injected || r == SPH_OK) {
+      destroy_scene(&s);
+      if (!injected) break;
+      continue;
+    }
+    ++failed;
+    require_ok(sph_probe_destroy(s.world, third), "sph_probe_destroy");
+    const sph_result again = sph_world_step(s.world, kFrameDt);
+    if (again != SPH_OK) {
+      ok = false;
+      problem = "allocation " + std::to_string(n) +
+                " failing, then the third probe gone: the next step gave " + sph_result_string(again) + " (" +
+                sph_get_last_error() + ")";
+    } else {
+      const std::vector<sph_probe_reading> got = readings(s.world, ids, 2);
+      const bool same = std::memcmp(got.data(), want.data(), sizeof(sph_probe_reading) * 2) == 0 &&
+                        take(s.world) == want_state;
+      if (!same) {
+        ok = false;
+        problem = "allocation " + std::to_string(n) + " failing: the world or its probes step differently";
+      }
+    }
+    destroy_scene(&s);
+  }
+  report(ok && failed > 0, "allocation_faults/probe readings after a failed growth of their buffers",
+         "%ld allocation points of a step with a new probe failed once each, the probe then destroyed%s%s",
+         failed, ok ? "" : ": ", problem.c_str());
+}
+
 }  // namespace
 
 int main() {
@@ -285,5 +365,6 @@ int main() {
        true},
   };
   for (const Call& call : calls) check_call(call);
+  check_probe_growth_failure();
   return finish();
 }

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'caa90e33c41f36fbb0be8c49052fc2f08a573942cadccc75b0a45c9213f351b8', 'include/sph_cuda.h': 'cb1436bd71ad764613d5cc88f308401cadc823673fdcf1f95dc1266595700e02', 'include/sph_mpi.h': '0add86230766569cb53c5823004f1a1f673eae88192e6b8e90c55312014f6a5f', 'include/sph_vdb.h': '256d341729fa5ee56f09a7349d822c42a134d4a948ac22870a64546345e3e434'}
+HEADERS = {'include/sph_c.h': '964a366495f69975009c54aacb6a33a180874c3ee6008abe8f15257d921a9b68', 'include/sph_cuda.h': '10c29a1a1f3946f310c4a23105ed7fb70ffea9fa1a9eee03d59ab41a55b122b9', 'include/sph_mpi.h': '0add86230766569cb53c5823004f1a1f673eae88192e6b8e90c55312014f6a5f', 'include/sph_vdb.h': '256d341729fa5ee56f09a7349d822c42a134d4a948ac22870a64546345e3e434'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -854,7 +854,7 @@ class ContextDef(_SphStruct):
         log_fn (sph_log_fn): optional; NULL = no logging
         log_user_data (void*): passed to log_fn
         cuda_frames (sph_cuda_frames): Tuning of the CUDA backend (a CPU context checks and ignores it; docs/cuda.md). Results do not depend on it: every choice computes the same particles bit for bit, except cuda_particle_lanes (the order of the neighbour sums: the last bits).
-        cuda_density_block (uint32_t): threads per block of the density kernels: 0 (default) = 128, or 32, 64, 128, 256, 512, 1024
+        cuda_density_block (uint32_t): threads per block of the density kernels: 0 (default) = 128, or 32, 64, 128, 256, 512, 1024 (a kernel whose registers do not fit that many runs at the most that fit)
         cuda_force_block (uint32_t): threads per block of the force kernels: 0 (default) = 128, or as above
         cuda_particle_lanes (uint32_t): threads per particle of the density and force passes (0.2.0): 0 (default) = chosen by the library from the particle count (more lanes for small worlds, docs/cuda.md), or 1, 2, 4, 8 (a measurement knob: each sums neighbours in its own fixed order)
         enqueue_task (sph_enqueue_task_fn): The engine's task system (0.2.0): both or neither; NULL (default) = the library's OpenMP workers. A CPU context uses it for every parallel loop of its worlds and runs each asynchronous step as one task of it; cpu_worker_count then only decides whether a loop runs in parallel (1: every loop on the calling thread). A CUDA context checks and ignores it.
@@ -2012,11 +2012,12 @@ class CudaAttributeView(_SphStruct):
     and layout stay valid until the world's capacity grows (a world with
     sph_world_def.max_capacity above its capacity reallocates its particles when a spawn, fill
     or source needs room: sph_stats.capacity_growths counts it, and the epoch changes; a fixed
-    world never moves them): take the view again after any call that may add particles. The
-    contents are those of data epoch `epoch`: every call that changes particles (spawn, fill,
-    step, also a step that failed and rolled back) increments the world's epoch and rewrites
-    them in place; compare with sph_cuda_world_get_epoch. The memory is the world's: read it,
-    never write or free it.
+    world never moves them), and sph_world_restore or sph_mpi_world_restore_file replaces them
+    (the epoch then moves past every earlier one): take the view again after any call that may
+    add particles or restore. The contents are those of data epoch `epoch`: every call that
+    changes particles (spawn, fill, step, also a step that failed and rolled back) increments
+    the world's epoch and rewrites them in place; compare with sph_cuda_world_get_epoch. The
+    memory is the world's: read it, never write or free it.
 
     Fields:
         struct_size (uint32_t): sizeof(sph_cuda_attribute_view), set by the init function
@@ -2380,7 +2381,7 @@ FUNCTIONS = {
     'sph_cuda_world_get_attribute': (sph_result, (_c.POINTER(sph_world), sph_attribute, _c.POINTER(sph_cuda_attribute_view)), ('world', 'attribute', 'out'),
         'Describes where `attribute` lives (see sph_cuda_attribute_view). out->struct_size must be set (sph_cuda_attribute_view_init); only that many bytes are written. Non-blocking. Errors: INVALID_HANDLE, INVALID_ARGUMENT (out NULL), VERSION_MISMATCH (struct_size too small), UNSUPPORTED (unknown attribute, CPU world, no CUDA build), DEVICE_LOST, WORLD_LOCKED.', 'sph'),
     'sph_cuda_world_get_epoch': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_uint64)), ('world', 'out_epoch'),
-        "The world's data epoch: starts at 1 and increments on every call that changes particles. A view whose epoch equals it describes the current contents. Non-blocking. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL), UNSUPPORTED, DEVICE_LOST, WORLD_LOCKED.", 'sph'),
+        "The world's data epoch: starts at 1 and increments on every call that changes particles (a restore sets it past every epoch the world had). A view whose epoch equals it describes the current contents. Non-blocking. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL), UNSUPPORTED, DEVICE_LOST, WORLD_LOCKED.", 'sph'),
     'sph_cuda_world_get_device': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_int32)), ('world', 'out_device_ordinal'),
         'The CUDA device the world runs on. Errors: as sph_cuda_world_get_epoch.', 'sph'),
     'sph_cuda_world_get_stream': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_void_p)), ('world', 'out_stream'),
