@@ -1143,8 +1143,9 @@ static inline sph_result sph_sdf_desc_init(sph_sdf_desc* desc) {
 /**
  * Creates an SDF asset from grids (copied). The optional grids must have the same dims as
  * the distance grid (their index_to_local is ignored). Errors: INVALID_ARGUMENT (NULL data,
- * zero dims, non-finite values, a singular index_to_local, wrong components), CAPACITY (more
- * than 2^31 voxels), UNSUPPORTED (device memory on a CPU context), OUT_OF_HOST_MEMORY.
+ * zero dims, non-finite values, a singular index_to_local or one whose inverse overflows float,
+ * wrong components), CAPACITY (more than 2^31 voxels), UNSUPPORTED (device memory on a CPU
+ * context), OUT_OF_HOST_MEMORY.
  * Thread-safe with respect to other SDF calls on the context.
  */
 SPH_API sph_result SPH_CALL sph_sdf_create(sph_context* context, const sph_sdf_desc* desc, sph_sdf** out);
@@ -1221,7 +1222,9 @@ static inline sph_result sph_mesh_desc_init(sph_mesh_desc* desc) {
  * generalised winding number. Host memory only; no OpenVDB needed.
  * Blocking; costs about (triangles * (2 band_width + 1)^3 + voxels) distance evaluations.
  * Thread-safe with respect to other SDF calls on the context. Errors: INVALID_ARGUMENT (NULL
- * arrays, counts, an index out of range, a non-finite vertex, a size out of range, reserved0),
+ * arrays, counts, an index out of range, a non-finite vertex, a size out of range, reserved0,
+ * a grid (bounds plus padding) reaching past +-3.4e38 or over 1.7e38 across, where float
+ * distances overflow, a voxel_size whose inverse overflows float),
  * CAPACITY (more than 2^31 voxels: a larger voxel_size is needed), OUT_OF_HOST_MEMORY.
  */
 SPH_API sph_result SPH_CALL sph_sdf_create_from_mesh(sph_context* context, const sph_mesh_desc* desc,

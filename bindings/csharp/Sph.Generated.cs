@@ -3010,9 +3010,9 @@ namespace Sph
         /// <summary>
         /// Creates an SDF asset from grids (copied). The optional grids must have the same dims as the
         /// distance grid (their index_to_local is ignored). Errors: INVALID_ARGUMENT (NULL data, zero
-        /// dims, non-finite values, a singular index_to_local, wrong components), CAPACITY (more than
-        /// 2^31 voxels), UNSUPPORTED (device memory on a CPU context), OUT_OF_HOST_MEMORY. Thread-safe
-        /// with respect to other SDF calls on the context.
+        /// dims, non-finite values, a singular index_to_local or one whose inverse overflows float,
+        /// wrong components), CAPACITY (more than 2^31 voxels), UNSUPPORTED (device memory on a CPU
+        /// context), OUT_OF_HOST_MEMORY. Thread-safe with respect to other SDF calls on the context.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_sdf_create(ContextHandle context, ref SdfDesc desc, out SdfHandle @out);
@@ -3046,8 +3046,10 @@ namespace Sph
         /// by the generalised winding number. Host memory only; no OpenVDB needed. Blocking; costs
         /// about (triangles * (2 band_width + 1)^3 + voxels) distance evaluations. Thread-safe with
         /// respect to other SDF calls on the context. Errors: INVALID_ARGUMENT (NULL arrays, counts, an
-        /// index out of range, a non-finite vertex, a size out of range, reserved0), CAPACITY (more
-        /// than 2^31 voxels: a larger voxel_size is needed), OUT_OF_HOST_MEMORY.
+        /// index out of range, a non-finite vertex, a size out of range, reserved0, a grid (bounds plus
+        /// padding) reaching past +-3.4e38 or over 1.7e38 across, where float distances overflow, a
+        /// voxel_size whose inverse overflows float), CAPACITY (more than 2^31 voxels: a larger
+        /// voxel_size is needed), OUT_OF_HOST_MEMORY.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_sdf_create_from_mesh(ContextHandle context, ref MeshDesc desc, out SdfHandle @out);

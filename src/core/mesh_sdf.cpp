@@ -4,7 +4,9 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -203,6 +205,26 @@ std::shared_ptr<SdfAsset> build_mesh_sdf(const MeshSpec& s, uint64_t max_voxels)
   // The grid as the asset stores it (floats), so distances are exact at its voxel centres.
   g.voxel = static_cast<float>(g.voxel);
   g.origin = (low - V3::Constant(s.padding_voxels * g.voxel)).cast<float>().cast<double>();
+  // The grid's corners, its distances (up to its diagonal) and the difference of two of them
+  // (trilinear sampling) must be finite in float: vertices near float's limits and far apart
+  // (a grid about 1e38 m across) gave infinite distances and NaN samples.
+  double diagonal2 = 0.0;
+  bool corners_finite = true;
+  for (int a = 0; a < 3; ++a) {
+    const double side = (g.n[a] - 1) * g.voxel;
+    diagonal2 += side * side;
+    corners_finite = corners_finite && std::isfinite(static_cast<float>(g.origin[a])) &&
+                     std::isfinite(static_cast<float>(g.origin[a] + side));
+  }
+  const double diagonal = std::sqrt(diagonal2);
+  if (!corners_finite || !(diagonal <= 0.5 * std::numeric_limits<float>::max())) {
+    char across[32];
+    std::snprintf(across, sizeof across, "%.3g", diagonal);
+    throw Error(Status::InvalidArgument,
+                std::string("desc->vertices: the mesh's grid (its bounds plus padding) is ") + across +
+                    " m across or reaches past float's range (+-3.4e38 m); "
+                    "float distances need it within that and under 1.7e38 m across");
+  }
   Affine3x4 index_to_local{};
   for (int a = 0; a < 3; ++a) {
     index_to_local.m[a * 4 + a] = static_cast<float>(g.voxel);

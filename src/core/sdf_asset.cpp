@@ -40,6 +40,10 @@ SdfAsset::SdfAsset(int32_t nx, int32_t ny, int32_t nz, const Affine3x4& index_to
   if (!(std::fabs(det) > 1e-12 * scale * scale * scale) || !std::isfinite(det))
     throw Error(Status::InvalidArgument, "index_to_local: the linear part is singular");
   local_to_index_ = from_matrix(m.inverse());
+  // A voxel near float's smallest (a denormal) inverts to infinity, and every sample to NaN.
+  for (float v : local_to_index_.m)
+    if (!std::isfinite(v))
+      throw Error(Status::InvalidArgument, "index_to_local: its inverse (local to index) overflows float");
   // The shortest voxel edge: the smallest column norm of the linear part.
   min_voxel_size_ = static_cast<float>(linear.colwise().norm().minCoeff());
   if (!(min_voxel_size_ > 0.0f) || !std::isfinite(min_voxel_size_))

@@ -29,10 +29,17 @@ MeshTriangle make_mesh_triangle(const V3& a, const V3& b, const V3& c) {
 // Ericson, Real-Time Collision Detection (2005) 5.1.5: the closest point by the Voronoi region
 // of p (corner, edge or face) from the barycentric numerators; exact, no iteration.
 double point_triangle_distance(const V3& p, const MeshTriangle& t) {
-  if (t.degenerate)
+  const V3 ab = t.b - t.a, ac = t.c - t.a, ap = p - t.a;
+  // The barycentric numerators below (va, vb, vc) are differences of products of about
+  // |edge|^2 |ap|^2 whose sum is |ab x ac|^2, about |edge|^4: for a triangle far smaller than its
+  // distance from p they cancel to noise (the sum came out 0 and 0 / 0 NaN for a 1e-45 m triangle
+  // seen from 0.04 m, leaving voxels of its SDF infinite). Under 1e-7 of the distance (a relative
+  // error of at most about 1e-2 in the sum above it), the closest point of the edges is within the
+  // longest edge, 1e-7 of the distance, of the exact one.
+  const double longest2 = std::max({ab.squaredNorm(), ac.squaredNorm(), (t.c - t.b).squaredNorm()});
+  if (t.degenerate || longest2 < 1e-14 * ap.squaredNorm())
     return std::min({point_segment_distance(p, t.a, t.b), point_segment_distance(p, t.b, t.c),
                      point_segment_distance(p, t.c, t.a)});
-  const V3 ab = t.b - t.a, ac = t.c - t.a, ap = p - t.a;
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
   if (d1 <= 0.0 && d2 <= 0.0) return ap.norm();
   const V3 bp = p - t.b;

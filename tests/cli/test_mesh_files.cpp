@@ -186,6 +186,117 @@ void test_scene_mesh_collider(void**) {
   assert_int_equal(sph_context_destroy(context), SPH_OK);
 }
 
+// parse_mesh reads the bytes read_mesh_file reads from the file, the same way, and names the
+// caller's name in its errors.
+void test_parse_mesh_without_a_file(void**) {
+  const MeshData from_file = read_mesh_file(write_file("p.obj", tetra_obj()), 1.0f);
+  const MeshData from_bytes = sph_tools::parse_mesh(tetra_obj(), sph_tools::MeshFormat::kObj, 1.0f, "bytes");
+  assert_true(from_bytes.vertices == from_file.vertices && from_bytes.indices == from_file.indices);
+  const MeshData binary =
+      sph_tools::parse_mesh(tetra_binary_stl(), sph_tools::MeshFormat::kStl, 1.0f, "bytes");
+  assert_true(corners_of(binary) == corners_of(from_file));
+  try {
+    sph_tools::parse_mesh("v 0 0\n", sph_tools::MeshFormat::kObj, 1.0f, "memory");
+    fail_msg("a bad vertex parsed");
+  } catch (const std::runtime_error& e) {
+    assert_string_equal(e.what(), "memory: line 1: a vertex needs x y z");
+  }
+}
+
+// An index beyond long long was reported as the clamped 9223372036854775807; an "endfacet" after
+// a facet's "endfacet" added its triangle a second time.
+void test_index_overflow_and_stray_endfacet(void**) {
+  expect_read_error("j.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999999/1\n",
+                    "line 4: vertex 99999999999999999999999 is not defined before this line (3 are)");
+  expect_read_error("k.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -99999999999999999999999\n",
+                    "line 4: vertex -99999999999999999999999 is not defined");
+  expect_read_error("l.stl",
+                    "solid x\n facet normal 0 0 1\n outer loop\n vertex 0 0 0\n vertex 1 0 0\n vertex 0 1 0\n"
+                    " endloop\n endfacet\n endfacet\nendsolid\n",
+                    "facet 1: has 0 vertices, not 3");
+}
+
+// A scene's mesh collider from `obj` (text) with `voxel` (JSON), built into an asset; the
+// SceneError's message when the library refuses it.
+struct MeshBuild {
+  sph_context* context = nullptr;
+  sph_sdf* sdf = nullptr;
+  std::string error;
+  sph_tools::SceneDesc scene;
+  MeshBuild(const std::string& obj, const std::string& voxel) {
+    write_file("build.obj", obj);
+    scene = sph_tools::parse_scene(
+        R"({"colliders": [{"shape": {"type": "mesh", "file": "build.obj", "voxel_size": )" + voxel + "}}]}",
+        g_dir);
+    sph_context_def def;
+    sph_context_def_init(&def);
+    def.backend = SPH_BACKEND_CPU;
+    def.cpu_worker_count = 1;
+    assert_int_equal(sph_context_create(&def, &context), SPH_OK);
+    try {
+      sdf = sph_tools::create_sdf(context, scene.colliders.at(0).shape);
+    } catch (const sph_tools::SceneError& e) {
+      error = e.what();
+    }
+  }
+  ~MeshBuild() {
+    sph_sdf_destroy(sdf);
+    sph_context_destroy(context);
+  }
+};
+
+// Fuzz input tiny-triangle-nan-distance: a triangle far smaller than the voxels (1e-45 m at
+// 0.01 m) made point_triangle_distance divide 0 by 0 from cancelling products; the voxels it
+// alone reached stayed infinite and samples among them were NaN.
+void test_tiny_triangle_has_finite_distances(void**) {
+  MeshBuild b("v 1e-45 0 0\nv 0 1e-45 0\nv 0 0 1e-44\nf 1 2 3\n", "0.01");
+  assert_non_null(b.sdf);
+  uint32_t dims[3];
+  assert_int_equal(sph_sdf_get_dims(b.sdf, dims), SPH_OK);
+  assert_true(dims[0] == 9 && dims[1] == 9 && dims[2] == 9);
+  for (int k = 0; k < 9; ++k)
+    for (int j = 0; j < 9; ++j)
+      for (int i = 0; i < 9; ++i) {
+        const sph_vec3 p{0.01f * (i - 4), 0.01f * (j - 4), 0.01f * (k - 4)};
+        float d = NAN;
+        assert_int_equal(sph_sdf_sample(b.sdf, p, &d), SPH_OK);
+        // The triangle is a point at this scale: the distance is that to the origin.
+        const float expected = std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
+        if (!(std::fabs(d - expected) < 1e-5f))
+          fail_msg("distance %g at (%d, %d, %d), not %g", d, i, j, k, expected);
+      }
+}
+
+// Fuzz input denormal-voxel-inverse-overflow: a voxel of 2.8e-45 m (a float denormal) inverted
+// to an infinite local-to-index map, and every sample of the asset was NaN; it is refused.
+void test_denormal_voxel_is_refused(void**) {
+  MeshBuild b("v 5e-44 0 0\nv 0 0 0\nv 0 0 0\nf 1 2 3\n", "2.8e-45");
+  assert_null(b.sdf);
+  if (b.error.find("inverse (local to index) overflows float") == std::string::npos)
+    fail_msg("'%s' does not say the voxel is too small", b.error.c_str());
+}
+
+// Fuzz input grid-wider-than-float: a mesh 3.2e38 m across (its vertices finite) had a grid whose
+// distances overflowed float, and samples near its corners were NaN; it is refused.
+void test_grid_wider_than_float_is_refused(void**) {
+  MeshBuild b(
+      "v -1.6e38 -1.6e38 -1.6e38\nv 1.6e38 -1.6e38 -1.6e38\nv -1.6e38 1.6e38 -1.6e38\n"
+      "v -1.6e38 -1.6e38 1.6e38\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+      "4e37");
+  assert_null(b.sdf);
+  if (b.error.find("reaches past float's range") == std::string::npos)
+    fail_msg("'%s' does not say the grid is too large for float", b.error.c_str());
+  // A grid 1e38 m across (4 voxels of 5e36 m and the default padding of 4 each side) is fine.
+  MeshBuild smaller(
+      "v -1e37 -1e37 -1e37\nv 1e37 -1e37 -1e37\nv -1e37 1e37 -1e37\nv -1e37 -1e37 1e37\n"
+      "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+      "5e36");
+  assert_non_null(smaller.sdf);
+  float d = NAN;
+  assert_int_equal(sph_sdf_sample(smaller.sdf, sph_vec3{3e37f, 3e37f, 3e37f}, &d), SPH_OK);
+  assert_true(std::isfinite(d) && d > 0.0f);
+}
+
 }  // namespace
 
 int main() {
@@ -196,6 +307,11 @@ int main() {
       cmocka_unit_test(test_obj_and_stl_read_the_same_triangles),
       cmocka_unit_test(test_bad_files_say_where),
       cmocka_unit_test(test_scene_mesh_collider),
+      cmocka_unit_test(test_parse_mesh_without_a_file),
+      cmocka_unit_test(test_index_overflow_and_stray_endfacet),
+      cmocka_unit_test(test_tiny_triangle_has_finite_distances),
+      cmocka_unit_test(test_denormal_voxel_is_refused),
+      cmocka_unit_test(test_grid_wider_than_float_is_refused),
   };
   const int failed = cmocka_run_group_tests(tests, nullptr, nullptr);
   if (std::system(("rm -rf '" + g_dir + "'").c_str()) != 0) std::fprintf(stderr, "cannot remove %s\n", dir);

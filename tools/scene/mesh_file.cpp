@@ -96,13 +96,21 @@ MeshData read_obj(const std::string& path, const std::string& text, float scale)
         // "i", "i/t", "i//n" or "i/t/n": the vertex index is the first number; negative
         // indices count back from the last vertex defined.
         char* end = nullptr;
+        errno = 0;
         const long long index = std::strtoll(corner.c_str(), &end, 10);
         if (end == corner.c_str() || (*end != '\0' && *end != '/'))
           fail(path, where + ": \"" + corner + "\" is not a vertex index");
         const int64_t resolved = index < 0 ? defined + index : index - 1;
+        // Beyond long long, strtoll clamps: the message quotes the file's digits, not the clamp.
+        const std::string shown = errno == ERANGE
+                                      ? corner.substr(0, static_cast<size_t>(end - corner.c_str()))
+                                      : std::to_string(index);
         if (index == 0 || resolved < 0 || resolved >= defined)
-          fail(path, where + ": vertex " + std::to_string(index) + " is not defined before this line (" +
+          fail(path, where + ": vertex " + shown + " is not defined before this line (" +
                          std::to_string(defined) + " are)");
+        // A polygon of n corners makes n - 2 triangles: one past the limit fails before it grows.
+        if (m.indices.size() / 3 + polygon.size() >= kMaxTriangles + 2)
+          fail(path, "has more than 2^28 triangles");
         polygon.push_back(static_cast<uint32_t>(resolved));
       }
       if (polygon.size() < 3) fail(path, where + ": a face needs at least three vertices");
@@ -154,6 +162,8 @@ MeshData read_ascii_stl(const std::string& path, const std::string& text, float 
              "facet " + std::to_string(facet) + ": has " + std::to_string(corners) + " vertices, not 3");
       const uint32_t first = static_cast<uint32_t>(m.vertices.size() / 3 - 3);
       add_triangle(m, path, first, first + 1, first + 2);
+      // A second "endfacet" has no vertices of its own (it added the same triangle again).
+      corners = 0;
     }
   }
   if (m.indices.empty()) fail(path, "has no facets (neither binary STL of 84 + 50 n bytes nor ASCII STL)");
@@ -174,11 +184,17 @@ MeshData read_stl(const std::string& path, const std::string& bytes, float scale
 
 }  // namespace
 
+MeshData parse_mesh(const std::string& bytes, MeshFormat format, float scale,
+                    const std::string& name_for_errors) {
+  if (bytes.size() > kMaxFileBytes) fail(name_for_errors, "is larger than 2 GiB");
+  return format == MeshFormat::kObj ? read_obj(name_for_errors, bytes, scale)
+                                    : read_stl(name_for_errors, bytes, scale);
+}
+
 MeshData read_mesh_file(const std::string& path, float scale) {
   const std::string ext = lower_extension(path);
   if (ext != "obj" && ext != "stl") fail(path, "is not a .obj or .stl file");
-  const std::string bytes = read_whole(path);
-  return ext == "obj" ? read_obj(path, bytes, scale) : read_stl(path, bytes, scale);
+  return parse_mesh(read_whole(path), ext == "obj" ? MeshFormat::kObj : MeshFormat::kStl, scale, path);
 }
 
 }  // namespace sph_tools
