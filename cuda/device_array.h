@@ -57,9 +57,6 @@ class DeviceArray {
     } else if (engine) {
       cuda_check(cudaGetDevice(&device), name);
       p = engine->alloc(bytes, device, engine->user_context);
-      // What the engine's allocator left pending (a cudaMalloc it retried, say) is its own, not a
-      // failure of the library's next launch.
-      (void)cudaGetLastError();
       if (!p) e = cudaErrorMemoryAllocation;
       if (p && reinterpret_cast<uintptr_t>(p) % 256 != 0) {
         engine->free(p, bytes, device, engine->user_context);
@@ -85,10 +82,9 @@ class DeviceArray {
 
   void release() noexcept {
     if (data_) {
-      if (hooks_) {
+      if (hooks_)
         hooks_->device.free(data_, count_ * sizeof(T), device_, hooks_->device.user_context);
-        (void)cudaGetLastError();  // (as after its alloc)
-      } else if (cudaFree(data_) != cudaSuccess)
+      else if (cudaFree(data_) != cudaSuccess)
         (void)cudaGetLastError();
     }
     data_ = nullptr;

@@ -73,7 +73,10 @@ void CudaBackend::prepare_scene(const SceneFrame& scene, const RuntimeParams& pa
   DeviceGuard guard(device_);
   PipelineSetup setup;
   setup.fluid = make_fluid_constants(config_, params);
-  guarded([&] { bind_frame_scene(scene, setup); });
+  guarded([&] {
+    (void)cudaGetLastError();  // as at a frame's start (step_scene_frame)
+    bind_frame_scene(scene, setup);
+  });
 }
 
 // One frame, run by one of two drivers (docs/cuda.md): the frame graph (frame_graph.h), or the
@@ -109,11 +112,18 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
   HostVector<uint32_t> removed_ids, removed_by_sink(scene_in.sinks.size(), 0u);
   bool interrupted = false;  // the stream driver stopped at a substep boundary (StepInterrupt)
   rollback_point_enqueued_ = false;
+  // The report's per-object sums are allocated before the frame: the host allocator (maybe the
+  // engine's) can fail, and once the particles have moved nothing may.
+  FrameReport report;
+  if (config_.features & kFeatureColliderLoads)
+    report.collider_loads.assign(scene_in.colliders.size(), ColliderLoadSums{});
+  report.probes.assign(scene_in.probes.size(), ProbeSums{});
   try {
     guarded([&] {
-      // An error left pending on this thread by earlier CUDA calls that are not the library's (the
-      // caller's own, or an engine allocator's handled failure) would be read by the frame's first
-      // launch check as its own failure: cleared here. A sticky error persists and is reported.
+      // An error left pending in the library's CUDA runtime by work that handled it would be read by
+      // the frame's first launch check as the frame's own failure: cleared here (a sticky error
+      // persists and is reported). The runtime is the library's own (cudart_static, private), so
+      // a caller's CUDA calls cannot leave one; a program linking the static sph_internal can.
       (void)cudaGetLastError();
       bind_frame_scene(scene_in, setup);
       FrameInput* input = r_->input.get();
@@ -179,16 +189,11 @@ FrameReport CudaBackend::step_scene_frame(double frame_dt, const RuntimeParams& 
     throw Error(Status::Capacity, message);
   }
   count_ = count_after;
-  FrameReport report;
   report.removed_ids = std::move(removed_ids);
   report.removed_by_sink = std::move(removed_by_sink);
-  if (config_.features & kFeatureColliderLoads) {
-    // Every collider gets its sums, zero for a frame without colliders' loads (none in the scene).
-    report.collider_loads.assign(scene_in.colliders.size(), ColliderLoadSums{});
-    if (setup.loads.on())
-      for (uint32_t c = 0; c < setup.loads.colliders; ++c) report.collider_loads[c] = setup.loads.output[c];
-  }
-  report.probes.assign(scene_in.probes.size(), ProbeSums{});
+  // Every collider has its sums (allocated above), zero for a frame without colliders' loads.
+  if ((config_.features & kFeatureColliderLoads) && setup.loads.on())
+    for (uint32_t c = 0; c < setup.loads.colliders; ++c) report.collider_loads[c] = setup.loads.output[c];
   for (uint32_t k = 0; k < setup.probes.probe_count; ++k) report.probes[k] = setup.probes.output[k];
   report_clock(s.clock, report);
   report.interrupted = interrupted;

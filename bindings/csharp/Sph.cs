@@ -1323,7 +1323,7 @@ namespace Sph
             return view;
         }
 
-        /// <summary>The world's data epoch: +1 on every call that changes particles.</summary>
+        /// <summary>The world's data epoch: grows on every call that changes particles (and past every earlier one at a restore); a view whose epoch equals it is current.</summary>
         public ulong CudaEpoch
         {
             get

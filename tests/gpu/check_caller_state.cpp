@@ -1,10 +1,15 @@
 // SPDX-License-Identifier: MIT
-// What a caller's own CUDA state and tuning do to a CUDA world (a code-reading audit of session
-// 44 found each; none can be seen without a GPU):
-//   - a CUDA error left pending on the calling thread (the caller's failed cudaMalloc) must not
-//     fail the next step, nor, on the stream driver, make it "roll back" to the previous frame's
-//     snapshot (the frame was marked enqueued before its snapshot was): the step succeeds and
-//     equals an undisturbed world's, on the graph and the stream driver;
+// What CUDA state and tuning from outside a frame do to a CUDA world (a code-reading audit of
+// session 44 found each; none can be seen without a GPU):
+//   - a CUDA error left pending in the library's runtime must not fail the next step, nor, on the
+//     stream driver, make it "roll back" to the previous frame's snapshot (the frame was marked
+//     enqueued before its snapshot was): the step succeeds and equals an undisturbed world's.
+//     libsph.so links its own static CUDA runtime, so a caller's calls cannot reach it: this
+//     program links the static sph_internal (one runtime with the library, as
+//     gpu_check_allocation_faults does) and fails a cudaMalloc of its own. The stream driver's
+//     case injects it before the third frame (the bug: the second frame's snapshot restored); the
+//     graph's before the first, whose capture runs the launch checks (a later frame replays the
+//     graph and checks nothing);
 //   - block sizes of 512 and 1024 threads (sph_context_def.cuda_density_block, cuda_force_block,
 //     accepted from 32 to 1024) on kernels whose registers do not let that many threads into one
 //     block (the walls' density, the forces with colliders, DFSPH's walls pass): the steps run and
@@ -112,7 +117,8 @@ void check_block_sizes(sph_solver solver, const char* label) {
 void check_stale_error(bool stream, const char* label) {
   context_tuning().stream_frames = stream;
   Tank disturbed = make_tank(SPH_SOLVER_WCSPH), undisturbed = make_tank(SPH_SOLVER_WCSPH);
-  for (int f = 0; f < 2; ++f) {
+  const int before = stream ? 2 : 0;
+  for (int f = 0; f < before; ++f) {
     require_ok(sph_world_step(disturbed.world, kFrameDt), "step");
     require_ok(sph_world_step(undisturbed.world, kFrameDt), "step");
   }
@@ -126,7 +132,8 @@ void check_stale_error(bool stream, const char* label) {
   (void)cudaGetLastError();
   const std::string name = std::string("stale_error/") + label;
   report(caller != cudaSuccess && same, name.c_str(),
-         "a step after the caller's failed cudaMalloc (%s, not cleared): %s%s", cudaGetErrorName(caller),
+         "frame %d after a failed cudaMalloc in the library's runtime (%s, not cleared): %s%s", before + 1,
+         cudaGetErrorName(caller),
          r != SPH_OK ? sph_result_string(r)
                      : (same ? "SPH_OK, the undisturbed world's bits" : "SPH_OK, OTHER BITS"),
          message.empty() ? "" : (" (" + message + ")").c_str());

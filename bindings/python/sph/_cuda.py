@@ -68,7 +68,7 @@ class WorldCudaMixin:
 
     @property
     def cuda_epoch(self):
-        """The world's data epoch (sph_cuda_world_get_epoch): +1 on every call that changes particles."""
+        """The world's data epoch (sph_cuda_world_get_epoch): grows on every call that changes particles (past every earlier one at a restore)."""
         e = ctypes.c_uint64()
         check(library().sph_cuda_world_get_epoch(self.handle, ctypes.byref(e)), "sph_cuda_world_get_epoch")
         return e.value
