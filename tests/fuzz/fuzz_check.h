@@ -41,6 +41,18 @@ inline sph_result check_result(sph_result r, const char* call) {
   return r;
 }
 
+// The context every harness works in: the CPU backend on the calling thread alone.
+inline sph_context* create_cpu_context() {
+  sph_context_def def;
+  sph_context_def_init(&def);
+  def.backend = SPH_BACKEND_CPU;
+  def.cpu_worker_count = 1;
+  sph_context* context = nullptr;
+  if (check_result(sph_context_create(&def, &context), "sph_context_create") != SPH_OK)
+    violation("no CPU context");
+  return context;
+}
+
 }  // namespace sph_fuzz
 
 #define FUZZ_CALL(call) ::sph_fuzz::check_result((call), #call)

@@ -14,6 +14,7 @@
 #include "fuzz_check.h"
 #include "sph_c.h"
 
+using sph_fuzz::create_cpu_context;
 using sph_fuzz::violation;
 
 namespace {
@@ -21,15 +22,7 @@ namespace {
 constexpr uint32_t kMaxParticles = 4096;
 
 sph_context* shared_context() {
-  static sph_context* context = [] {
-    sph_context_def def;
-    sph_context_def_init(&def);
-    def.backend = SPH_BACKEND_CPU;
-    def.cpu_worker_count = 1;
-    sph_context* c = nullptr;
-    if (sph_context_create(&def, &c) != SPH_OK) violation("no CPU context");
-    return c;
-  }();
+  static sph_context* context = create_cpu_context();
   return context;
 }
 

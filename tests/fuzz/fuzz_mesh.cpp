@@ -25,6 +25,7 @@
 #include "sdf_factory.h"
 #include "sph_c.h"
 
+using sph_fuzz::create_cpu_context;
 using sph_fuzz::violation;
 
 namespace {
@@ -116,12 +117,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   if (!small) return 0;
 
-  sph_context_def def;
-  sph_context_def_init(&def);
-  def.backend = SPH_BACKEND_CPU;
-  def.cpu_worker_count = 1;
-  sph_context* context = nullptr;
-  if (FUZZ_CALL(sph_context_create(&def, &context)) != SPH_OK) violation("no CPU context");
+  sph_context* context = create_cpu_context();
   const uint32_t baseline = live_objects();
 
   sph_tools::ShapeDesc shape;

@@ -19,6 +19,7 @@
 #include "shape_grid_estimate.h"
 #include "sph_c.h"
 
+using sph_fuzz::create_cpu_context;
 using sph_fuzz::violation;
 
 namespace {
@@ -83,12 +84,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   scene.params.max_substeps = std::min(scene.params.max_substeps, kMaxSubsteps);
   if (!small_enough(scene)) return 0;
 
-  sph_context_def def;
-  sph_context_def_init(&def);
-  def.backend = SPH_BACKEND_CPU;
-  def.cpu_worker_count = 1;
-  sph_context* context = nullptr;
-  if (FUZZ_CALL(sph_context_create(&def, &context)) != SPH_OK) violation("no CPU context");
+  sph_context* context = create_cpu_context();
   const uint32_t baseline = live_objects();
   try {
     sph_tools::SceneRuntime runtime(scene, context);
