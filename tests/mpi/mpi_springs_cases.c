@@ -123,6 +123,31 @@ static uint32_t far_pairs(sph_world* single, const uint32_t* pairs, uint32_t cou
   return far;
 }
 
+/* The world def of every case: the test world's, at `capacity` (0: its own), with springs. */
+static void springs_def(sph_world_def* def, uint32_t capacity) {
+  mpi_test_world_def(def);
+  if (capacity) def->capacity = capacity;
+  def->features = SPH_FEATURE_SPRINGS;
+}
+
+/* A checkpoint path of this run's own, `stem`.np<ranks>.<run>.sphcp: ctest -j2 runs mpi_springs_np1
+ * and _np2 side by side in one folder, and with one name each restored the other's save (CI,
+ * session 24). The run is rank 0's process id, shared. */
+static void run_checkpoint_path(char* path, size_t size, const char* stem) {
+  long run_id = (long)getpid();
+  MPI_Bcast(&run_id, 1, MPI_LONG, 0, MPI_COMM_WORLD);
+  snprintf(path, size, "%s.np%d.%ld.sphcp", stem, g_size, run_id);
+}
+
+/* Removes the set saved at `path`: each rank its file, then rank 0 the manifest. */
+static void remove_saved_set(const char* path) {
+  char name[512];
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (mpi_test_rank_file(path, g_rank, name, sizeof name)) remove(name);
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (g_rank == 0) remove(path);
+}
+
 static void run_case(sph_context* context, uint32_t capacity, const spring_case* c) {
   const sph_vec3 column_min = {0.0f, 0.0f, 0.0f}, column_max = {0.1f, 0.2f, 0.06f};
   sph_world_def def;
@@ -133,9 +158,7 @@ static void run_case(sph_context* context, uint32_t capacity, const spring_case*
   uint32_t* pairs = NULL;
   uint32_t before = c->late_block ? 5u : 0u;
   sph_mpi_counts counts;
-  mpi_test_world_def(&def);
-  if (capacity) def.capacity = capacity;
-  def.features = SPH_FEATURE_SPRINGS;
+  springs_def(&def, capacity);
   def.integrator = c->integrator;
   def.solver = c->solver;
   n = make_worlds(context, &def, column_min, column_max, c->stir, &single, &world, &single_tank, &tank);
@@ -195,9 +218,6 @@ static void check_checkpoint(sph_context* context, uint32_t capacity) {
   const spring_case c = {
       "checkpoint",     2.0f, 1e4f, 20.0f, 0.0f, 0.1f, 0, 0, 0, SPH_INTEGRATOR_SYMPLECTIC_EULER,
       SPH_SOLVER_WCSPH, 20,   0};
-  /* A name of this run's own: ctest -j2 runs mpi_springs_np1 and _np2 side by side in one folder,
-   * and with one name each restored the other's save (CI, session 24). Rank 0's process id, shared. */
-  long run_id = (long)getpid();
   char path[128];
   sph_world_def def;
   sph_world* single = NULL;
@@ -205,12 +225,8 @@ static void check_checkpoint(sph_context* context, uint32_t capacity) {
   sph_world* loaded = NULL;
   sph_collider_id single_tank, tank;
   MPI_Comm alone;
-  char name[512];
-  MPI_Bcast(&run_id, 1, MPI_LONG, 0, MPI_COMM_WORLD);
-  snprintf(path, sizeof path, "mpi_springs_checkpoint.np%d.%ld.sphcp", g_size, run_id);
-  mpi_test_world_def(&def);
-  if (capacity) def.capacity = capacity;
-  def.features = SPH_FEATURE_SPRINGS;
+  run_checkpoint_path(path, sizeof path, "mpi_springs_checkpoint");
+  springs_def(&def, capacity);
   make_worlds(context, &def, column_min, column_max, c.stir, &single, &world, &single_tank, &tank);
   set_springs(world, &c);
   if (g_rank == 0) {
@@ -254,10 +270,7 @@ static void check_checkpoint(sph_context* context, uint32_t capacity) {
     free(got_x);
     free(got_v);
   }
-  MPI_Barrier(MPI_COMM_WORLD);
-  if (mpi_test_rank_file(path, g_rank, name, sizeof name)) remove(name);
-  MPI_Barrier(MPI_COMM_WORLD);
-  if (g_rank == 0) remove(path);
+  remove_saved_set(path);
   REQUIRE(sph_world_destroy(world) == SPH_OK, "destroy");
   if (single) REQUIRE(sph_world_destroy(single) == SPH_OK, "destroy");
 }
@@ -291,7 +304,7 @@ static void check_refused_add(sph_context* context, uint32_t capacity) {
       "refused add",    2.0f, 1e4f, 20.0f, 0.0f, 0.1f, 0, 0, 0, SPH_INTEGRATOR_SYMPLECTIC_EULER,
       SPH_SOLVER_WCSPH, 5,    0};
   const float good[3] = {0.05f, 0.1f, 0.03f}, bad[3] = {NAN, 0.1f, 0.03f};
-  long run_id = (long)getpid(), size_before = 0, size_after = 0;
+  long size_before = 0, size_after = 0;
   char path[128];
   sph_world_def def;
   sph_world* single = NULL;
@@ -299,11 +312,8 @@ static void check_refused_add(sph_context* context, uint32_t capacity) {
   sph_collider_id single_tank, tank;
   unsigned char *before, *after;
   sph_result r;
-  MPI_Bcast(&run_id, 1, MPI_LONG, 0, MPI_COMM_WORLD);
-  snprintf(path, sizeof path, "mpi_springs_refused_add.np%d.%ld.sphcp", g_size, run_id);
-  mpi_test_world_def(&def);
-  if (capacity) def.capacity = capacity;
-  def.features = SPH_FEATURE_SPRINGS;
+  run_checkpoint_path(path, sizeof path, "mpi_springs_refused_add");
+  springs_def(&def, capacity);
   make_worlds(context, &def, column_min, column_max, c.stir, &single, &world, &single_tank, &tank);
   set_springs(world, &c);
   mpi_test_step(world, c.substeps, 1); /* every particle has made its springs */
@@ -318,13 +328,7 @@ static void check_refused_add(sph_context* context, uint32_t capacity) {
         size_before);
   free(before);
   free(after);
-  {
-    char name[512];
-    MPI_Barrier(MPI_COMM_WORLD);
-    if (mpi_test_rank_file(path, g_rank, name, sizeof name)) remove(name);
-    MPI_Barrier(MPI_COMM_WORLD);
-    if (g_rank == 0) remove(path);
-  }
+  remove_saved_set(path);
   REQUIRE(sph_world_destroy(world) == SPH_OK, "destroy");
   if (single) REQUIRE(sph_world_destroy(single) == SPH_OK, "destroy");
 }
