@@ -144,6 +144,14 @@ __global__ void apply_records_kernel(ParticleArrays a, const uint32_t* __restric
 }  // namespace
 
 DeviceHalo::DeviceHalo(uint32_t capacity, int ranks) : capacity_(capacity), ranks_(ranks) {
+  // The lists hold two entries a particle and CUB counts items in int: 2 x capacity must stay
+  // below 2^31 (a rank at the world's limit of 2^30 would overflow it).
+  if (capacity > kMaxHaloCapacity)
+    throw Error(Status::Capacity, "a distributed CUDA rank holds at most " +
+                                      std::to_string(kMaxHaloCapacity) +
+                                      " particles (its halo lists count two entries a particle in 32 bits); "
+                                      "asked for " +
+                                      std::to_string(capacity));
   const size_t n = std::max<uint32_t>(capacity, 1u);
   key_bits_ = 1;
   while ((1ull << key_bits_) <= 2ull * static_cast<uint64_t>(ranks)) ++key_bits_;

@@ -36,6 +36,9 @@ struct HaloArray {
   uint32_t bytes;
 };
 
+// The most particles a rank's halo takes: its lists hold two entries a particle, counted in int.
+constexpr uint32_t kMaxHaloCapacity = (1u << 30) - 1;
+
 class DeviceHalo {
  public:
   // A rank of `ranks` ranks (their slabs' cuts come by set_cuts).
