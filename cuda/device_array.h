@@ -7,6 +7,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include <atomic>
 #include <string>
 #include <utility>
 
@@ -15,6 +16,16 @@
 #include "device_allocation_faults.h"
 
 namespace sph {
+
+// A number no earlier call returned, for a set of buffers that a captured frame graph copies to or
+// from. The graph's memset and copy nodes hold the allocations they were captured with: replaying
+// it after one of them was freed crashes in cudaGraphLaunch even when the new allocation has the
+// old address (seen on an H100, session 45). A buffer set takes a new number before it frees any
+// buffer, and the frame graph is rebuilt when the number differs (frame_loop.cu, same_setup).
+inline uint64_t next_buffer_generation() {
+  static std::atomic<uint64_t> last{0};
+  return ++last;
+}
 
 // Device memory comes from the engine's device allocator when its context has one
 // (sph_cuda_context_set_allocator; core/host_memory.h), cudaMalloc otherwise: the hooks current

@@ -119,6 +119,8 @@ void launch_loads(unsigned blocks, const FluidConstants& fluid, const ParticleAr
 
 DeviceLoads DeviceColliderLoads::reserve(uint32_t colliders, uint32_t capacity) {
   const size_t partials = static_cast<size_t>(blocks_for(capacity, kLoadBlock)) * colliders;
+  // A new generation before any buffer is freed, so that a failure below leaves it changed too.
+  if (partials > partial_slots_ || colliders > sum_slots_) generation_ = next_buffer_generation();
   // allocate() frees the old buffer first: the slot counts drop to 0 until the new one is there,
   // so a failed allocation cannot leave a count that a later, smaller frame trusts.
   if (partials > partial_slots_) {
@@ -137,6 +139,7 @@ DeviceLoads DeviceColliderLoads::reserve(uint32_t colliders, uint32_t capacity) 
   d.sums = sums_.get();
   d.output = output_.get();
   d.colliders = colliders;
+  d.generation = generation_;
   return d;
 }
 

@@ -30,6 +30,7 @@ struct DeviceLoads {
   ColliderLoadSums* sums = nullptr;    // device, per collider: the frame's impulses
   ColliderLoadSums* output = nullptr;  // pinned host, receives sums at the frame's end
   uint32_t colliders = 0;
+  uint64_t generation = 0;  // host only: changes with every reallocation (next_buffer_generation)
 
   bool on() const { return sums != nullptr; }
 };
@@ -45,6 +46,7 @@ class DeviceColliderLoads {
   DeviceArray<ColliderLoadSums> sums_;
   PinnedArray<ColliderLoadSums> output_;
   size_t partial_slots_ = 0, sum_slots_ = 0;
+  uint64_t generation_ = next_buffer_generation();
 };
 
 // The frame's sums to zero (frame begin) / to the pinned output (frame end).

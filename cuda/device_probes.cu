@@ -45,6 +45,10 @@ DeviceProbes DeviceProbeBuffers::upload(const SceneFrame& scene, const ProbeCons
   DeviceProbes d;
   if (scene.probes.empty()) return d;
   const size_t probes = scene.probes.size();
+  // A new generation before any buffer is freed, so that a failure below leaves it changed too.
+  if (views_.size() < probes || sums_.size() < probes || output_slots_ < probes ||
+      points_.size() < scene.probe_points)
+    generation_ = next_buffer_generation();
   if (views_.size() < probes) views_.allocate(probes, "device probe views");
   if (sums_.size() < probes) sums_.allocate(probes, "the probes' frame sums");
   if (output_slots_ < probes) {
@@ -64,6 +68,7 @@ DeviceProbes DeviceProbeBuffers::upload(const SceneFrame& scene, const ProbeCons
   d.probe_count = static_cast<uint32_t>(probes);
   d.point_count = scene.probe_points;
   d.constants = constants;
+  d.generation = generation_;
   return d;
 }
 

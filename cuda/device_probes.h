@@ -32,6 +32,7 @@ struct DeviceProbes {
   uint32_t probe_count = 0;
   uint32_t point_count = 0;
   ProbeConstants constants{};
+  uint64_t generation = 0;  // host only: changes with every reallocation (next_buffer_generation)
 
   bool on() const { return probe_count > 0; }
 };
@@ -51,6 +52,7 @@ class DeviceProbeBuffers {
   DeviceArray<ProbeSums> sums_;
   PinnedArray<ProbeSums> output_;
   size_t output_slots_ = 0;
+  uint64_t generation_ = next_buffer_generation();
   HostVector<ProbeView> host_views_;
 };
 

@@ -30,7 +30,8 @@ bool same_setup(const PipelineSetup& a, const PipelineSetup& b) {
          a.scene.collider_count == b.scene.collider_count && a.scene.field_count == b.scene.field_count &&
          a.scene.kernel_radius == b.scene.kernel_radius && a.loads.partials == b.loads.partials &&
          a.loads.sums == b.loads.sums && a.loads.output == b.loads.output &&
-         a.loads.colliders == b.loads.colliders && a.probes.views == b.probes.views &&
+         a.loads.colliders == b.loads.colliders && a.loads.generation == b.loads.generation &&
+         a.probes.generation == b.probes.generation && a.probes.views == b.probes.views &&
          a.probes.points == b.probes.points && a.probes.sums == b.probes.sums &&
          a.probes.output == b.probes.output && a.probes.probe_count == b.probes.probe_count &&
          a.probes.point_count == b.probes.point_count &&

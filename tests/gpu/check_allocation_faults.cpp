@@ -241,9 +241,10 @@ std::vector<sph_probe_reading> readings(const sph_world* world, const sph_probe_
 // The probes' host copy grows when a step has more probes than before. An allocation that failed
 // there (OUT_OF_HOST_MEMORY, the world unchanged) left the buffer freed but its size counted, so
 // once the new probe was gone every later step copied the readings into a null pointer and
-// failed (CudaBackend's device_probes.cu). Each allocation point of the step with a third probe
-// fails in turn; then the third probe goes and the world must step, its two probes reading what
-// an undisturbed world's read.
+// failed (CudaBackend's device_probes.cu); and a failed growth freed the sums that the cached frame
+// graph copies from, which the next step replayed (the loads case below). Each allocation point of
+// the step with a third probe fails in turn; then the third probe goes and the world must step,
+// its two probes reading what an undisturbed world's read.
 void check_probe_growth_failure() {
   Scene reference;
   sph_probe_id ids[2];
@@ -288,6 +289,111 @@ void check_probe_growth_failure() {
   }
   report(ok && failed > 0, "allocation_faults/probe readings after a failed growth of their buffers",
          "%ld allocation points of a step with a new probe failed once each, the probe then destroyed%s%s",
+         failed, ok ? "" : ": ", problem.c_str());
+}
+
+// The loads' buffers grow the same way when a step has more colliders than before (the collider's
+// first frame also uploads its SDF and the scene's views). A captured frame graph copies from the
+// loads' and the probes' sums, so it must not be replayed once a failed growth freed them: it
+// was, when the buffers came back at the old addresses, and cudaGraphLaunch crashed (session 45,
+// the probe case above; same_setup in cuda/frame_loop.cu now compares the buffers' generation).
+// Each allocation point of the step with a second collider fails in turn; then that collider
+// goes and the world must step, the first collider's loads and the particles as an undisturbed
+// world's. (Without the loads' generation in same_setup this case still passed on an H100: the
+// scene's collider views moved too, so the graph was rebuilt anyway. Whether they move is the
+// allocator's choice; the generation does not depend on it. The probe case crashed without it.)
+struct LoadsScene {
+  Scene scene;
+  sph_collider_id tank{};
+};
+
+void loads_frame(LoadsScene* l) {
+  Scene* s = &l->scene;
+  s->context = make_context(SPH_BACKEND_CUDA);
+  sph_world_def def;
+  sph_world_def_init(&def);
+  def.capacity = 4000;
+  def.particle_spacing = 0.02f;
+  def.features = SPH_FEATURE_COLLIDER_LOADS;
+  require_ok(sph_world_create(s->context, &def, &s->world), "sph_world_create (loads)");
+  sph_shape_desc shape;
+  sph_shape_desc_init(&shape);
+  shape.shape = SPH_SHAPE_BOX;
+  shape.half_extents = sph_vec3{0.2f, 0.2f, 0.1f};
+  shape.voxel_size = 0.02f;
+  require_ok(sph_sdf_create_shape(s->context, &shape, &s->tank), "tank");
+  sph_shape_desc_init(&shape);
+  shape.shape = SPH_SHAPE_SPHERE;
+  shape.radius = 0.04f;
+  shape.voxel_size = 0.02f;
+  require_ok(sph_sdf_create_shape(s->context, &shape, &s->blob), "blob");
+  sph_collider_def collider;
+  sph_collider_def_init(&collider);
+  collider.sdf = s->tank;
+  collider.flags = SPH_COLLIDER_FLAG_INVERTED;
+  require_ok(sph_collider_create(s->world, &collider, &l->tank), "tank collider");
+  sph_fill_box_desc box;
+  sph_fill_box_desc_init(&box);
+  box.min = sph_vec3{-0.18f, -0.18f, -0.08f};
+  box.max = sph_vec3{-0.02f, 0.02f, 0.08f};
+  require_ok(sph_world_fill_box(s->world, &box, nullptr), "fill");
+  require_ok(sph_world_step(s->world, kFrameDt), "the loads' first frame");
+}
+
+sph_collider_loads tank_loads(const LoadsScene& l) {
+  sph_collider_loads out;
+  sph_collider_loads_init(&out);
+  require_ok(sph_collider_get_loads(l.scene.world, l.tank, &out), "sph_collider_get_loads");
+  return out;
+}
+
+void check_load_growth_failure() {
+  LoadsScene reference;
+  loads_frame(&reference);
+  require_ok(sph_world_step(reference.scene.world, kFrameDt), "reference frame");
+  const sph_collider_loads want = tank_loads(reference);
+  const Snapshot want_state = take(reference.scene.world);
+  destroy_scene(&reference.scene);
+  long failed = 0;
+  bool ok = true;
+  std::string problem;
+  for (long n = 0; ok; ++n) {
+    LoadsScene l;
+    loads_frame(&l);
+    sph_collider_def ball;
+    sph_collider_def_init(&ball);
+    ball.sdf = l.scene.blob;
+    ball.transform = at(-0.1f, -0.12f, 0.0f);  // in the water
+    sph_collider_id second{};
+    require_ok(sph_collider_create(l.scene.world, &ball, &second), "second collider");
+    faults::arm_device_allocation_fault(n);
+    const sph_result r = sph_world_step(l.scene.world, kFrameDt);
+    const bool injected = faults::disarm_device_allocation_fault();
+    if (!injected || r == SPH_OK) {
+      destroy_scene(&l.scene);
+      if (!injected) break;
+      continue;
+    }
+    ++failed;
+    require_ok(sph_collider_destroy(l.scene.world, second), "sph_collider_destroy");
+    const sph_result again = sph_world_step(l.scene.world, kFrameDt);
+    if (again != SPH_OK) {
+      ok = false;
+      problem = "allocation " + std::to_string(n) +
+                " failing, then the second collider gone: the next step gave " + sph_result_string(again) +
+                " (" + sph_get_last_error() + ")";
+    } else {
+      const sph_collider_loads got = tank_loads(l);
+      if (std::memcmp(&got, &want, sizeof got) != 0 || !(take(l.scene.world) == want_state)) {
+        ok = false;
+        problem = "allocation " + std::to_string(n) + " failing: the world or its loads step differently";
+      }
+    }
+    destroy_scene(&l.scene);
+  }
+  report(ok && failed > 0, "allocation_faults/collider loads after a failed growth of their buffers",
+         "%ld allocation points of a step with a new collider failed once each, the collider then "
+         "destroyed%s%s",
          failed, ok ? "" : ": ", problem.c_str());
 }
 
@@ -366,5 +472,6 @@ int main() {
   };
   for (const Call& call : calls) check_call(call);
   check_probe_growth_failure();
+  check_load_growth_failure();
   return finish();
 }
