@@ -46,6 +46,11 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
   begin_loads(scene);
   begin_probes(scene);
   report.removed_by_sink.assign(scene.sinks.size(), 0u);
+  // Room for the loads' and probes' sums copied into the report after the frame, taken now: once
+  // the particles have moved nothing may allocate (the copy has no rollback behind it; the CUDA
+  // backend sizes them before its frame too).
+  report.collider_loads.reserve(load_sums_.size());
+  report.probes.reserve(probe_sums_.size());
   const uint32_t count_before = count_;
   const auto saved = store_.snapshot();
   const float saved_max_speed = max_speed_;

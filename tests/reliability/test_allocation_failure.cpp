@@ -7,8 +7,11 @@
 // allocation from then on throws std::bad_alloc (or returns null for the nothrow forms), once. For each call
 // below, n runs 0, 1, 2, ... until the call completes without reaching the n-th allocation, so every
 // allocation the call makes fails once. Each failure must come back as
-// SPH_ERROR_OUT_OF_HOST_MEMORY with a message, leave the world bitwise as it was and the live
-// object count unchanged, and the world must then go on exactly as an undisturbed copy.
+// SPH_ERROR_OUT_OF_HOST_MEMORY with a message, leave the world bitwise as it was (its particles,
+// its checkpoint's bytes, its probe readings, loads, events and step statistics) and the live
+// object count unchanged, and the world must then go on exactly as an undisturbed copy. The calls
+// run against small scenes (a tank of a few hundred particles) on worlds of several methods and
+// features: every allocation point of every call runs.
 //
 // It runs through the C API on the backend SPH_TEST_BACKEND names, so scripts/gpu-test runs it
 // on the CUDA backend too (host allocations of the CUDA backend: staging, scene uploads, ...).
@@ -20,6 +23,7 @@
 #include <atomic>
 #include <cstddef>
 #include <new>
+#include <vector>
 
 extern "C" {
 #include "capi_test.h"
@@ -40,6 +44,12 @@ struct Scene {
   sph_world* world = nullptr;
   sph_sdf* tank = nullptr;  // kept, so calls can create more colliders, sources and sinks
   sph_sdf* blob = nullptr;
+  sph_collider_id tank_collider{};
+  // What the state checks read besides the particles (empty ids: none).
+  sph_probe_id probes[3]{};
+  bool loads = false;  // the world has SPH_FEATURE_COLLIDER_LOADS: read the tank's loads
+  sph_collider_id blob_collider{};
+  std::vector<unsigned char> checkpoint;  // a checkpoint of the scene a frame ago (restore, load)
 };
 
 sph_transform at(float x, float y, float z) {
@@ -50,9 +60,9 @@ sph_transform at(float x, float y, float z) {
   return t;
 }
 
-// A tank with a sloshing block of water, a continuous source, a sink and a force field, one
-// frame behind it: every part of a frame has state to roll back.
-void build_scene(Scene* s) {
+// A tank with a sloshing block of water, a continuous source, a sink and a force field, on a world
+// of `features` and `solver`, no frame behind it yet (build_scene adds one).
+void build_world(Scene* s, sph_feature_flags features, sph_solver solver) {
   sph_context_def cdef;
   EXPECT_OK(sph_test_context_def_init(&cdef));
   cdef.cpu_worker_count = 1;
@@ -61,6 +71,8 @@ void build_scene(Scene* s) {
   sph_world_def_init(&def);
   def.capacity = kCapacity;
   def.particle_spacing = 0.025f;
+  def.features = features;
+  def.solver = solver;
   EXPECT_OK(sph_world_create(s->context, &def, &s->world));
   sph_world_params params;
   sph_world_params_init(&params);
@@ -84,8 +96,7 @@ void build_scene(Scene* s) {
   sph_collider_def_init(&collider);
   collider.sdf = s->tank;
   collider.flags = SPH_COLLIDER_FLAG_INVERTED;
-  sph_collider_id collider_id;
-  EXPECT_OK(sph_collider_create(s->world, &collider, &collider_id));
+  EXPECT_OK(sph_collider_create(s->world, &collider, &s->tank_collider));
 
   sph_fill_box_desc box;
   sph_fill_box_desc_init(&box);
@@ -119,7 +130,11 @@ void build_scene(Scene* s) {
   field.strength = 1.0f;
   sph_force_field_id field_id;
   EXPECT_OK(sph_force_field_create(s->world, &field, &field_id));
+}
 
+// The tank, one frame behind it: every part of a frame has state to roll back.
+void build_scene(Scene* s) {
+  build_world(s, SPH_FEATURE_NONE, SPH_SOLVER_WCSPH);
   EXPECT_OK(sph_world_step(s->world, kFrameDt));
 }
 
@@ -137,6 +152,193 @@ uint32_t live_objects() {
   return n;
 }
 
+// ---- the other scenes: the tank on worlds of other methods, with probes, loads, ... --------------
+// Each is the tank above with what its calls need; those named "new_*" add an object after the
+// frame, so that the next step is its first (probe buffers grown, boundary-density maps made).
+
+// The frames the probe and loads scenes run before their calls: the block falls the 2 cm onto the
+// tank's floor, so that the walls take loads and the probes read pressure.
+constexpr int kSettleFrames = 6;
+void settle(Scene* s) {
+  for (int i = 0; i < kSettleFrames; ++i) EXPECT_OK(sph_world_step(s->world, kFrameDt));
+}
+
+sph_probe_id add_probe(sph_world* world, sph_probe_kind kind, sph_probe_sampling sampling, float x) {
+  sph_probe_def def;
+  sph_probe_def_init(&def);
+  def.kind = kind;
+  def.sampling = sampling;
+  def.position = sph_vec3{x, -0.19f, 0.0f};
+  def.length = 0.3f;
+  sph_probe_id id;
+  EXPECT_OK(sph_probe_create(world, &def, &id));
+  return id;
+}
+
+// A point probe sampled every frame and a gauge sampled every substep, with readings.
+void build_probe_scene(Scene* s) {
+  build_world(s, SPH_FEATURE_NONE, SPH_SOLVER_WCSPH);
+  s->probes[0] = add_probe(s->world, SPH_PROBE_POINT, SPH_PROBE_EVERY_FRAME, -0.1f);
+  s->probes[1] = add_probe(s->world, SPH_PROBE_GAUGE, SPH_PROBE_EVERY_SUBSTEP, -0.12f);
+  EXPECT_OK(sph_probe_set_pressure_threshold(s->world, s->probes[0], 1.0f));
+  settle(s);
+}
+void build_new_probe_scene(Scene* s) {
+  build_probe_scene(s);
+  s->probes[2] = add_probe(s->world, SPH_PROBE_GAUGE, SPH_PROBE_EVERY_FRAME, -0.08f);
+}
+
+sph_collider_id add_blob_collider(Scene* s) {
+  sph_collider_def def;
+  sph_collider_def_init(&def);
+  def.sdf = s->blob;
+  def.transform = at(-0.1f, -0.15f, 0.0f);
+  sph_collider_id id;
+  EXPECT_OK(sph_collider_create(s->world, &def, &id));
+  return id;
+}
+
+// Loads on the tank (and on a collider in the water for the "new" scene).
+void build_loads_scene(Scene* s) {
+  build_world(s, SPH_FEATURE_COLLIDER_LOADS, SPH_SOLVER_WCSPH);
+  s->loads = true;
+  settle(s);
+}
+void build_new_collider_loads_scene(Scene* s) {
+  build_loads_scene(s);
+  s->blob_collider = add_blob_collider(s);
+}
+
+void build_dfsph_scene(Scene* s) {
+  build_world(s, SPH_FEATURE_NONE, SPH_SOLVER_DFSPH);
+  EXPECT_OK(sph_world_step(s->world, kFrameDt));
+}
+// DFSPH with the walls in the density and their loads; the new collider's first step makes its
+// asset's density map.
+void build_dfsph_walls_scene(Scene* s) {
+  build_world(s, SPH_FEATURE_BOUNDARY_DENSITY | SPH_FEATURE_COLLIDER_LOADS, SPH_SOLVER_DFSPH);
+  s->loads = true;
+  settle(s);
+}
+void build_new_collider_dfsph_walls_scene(Scene* s) {
+  build_dfsph_walls_scene(s);
+  s->blob_collider = add_blob_collider(s);
+}
+
+// Springs: the fill linked in the first frame, the source's particles link in each later one.
+void build_springs_scene(Scene* s) {
+  build_world(s, SPH_FEATURE_SPRINGS, SPH_SOLVER_WCSPH);
+  sph_spring_params springs;
+  sph_spring_params_init(&springs);
+  springs.plasticity = 5.0f;
+  springs.damping = 1.0f;
+  EXPECT_OK(sph_world_set_spring_params(s->world, &springs));
+  EXPECT_OK(sph_world_step(s->world, kFrameDt));
+}
+
+void build_diffusion_scene(Scene* s) {
+  build_world(s, SPH_FEATURE_NORMALIZED_DENSITY | SPH_FEATURE_DENSITY_DIFFUSION, SPH_SOLVER_WCSPH);
+  EXPECT_OK(sph_world_step(s->world, kFrameDt));
+}
+
+void build_user_attribute_scene(Scene* s) {
+  build_world(s, SPH_FEATURE_USER_ATTRIBUTE, SPH_SOLVER_WCSPH);
+  EXPECT_OK(sph_world_step(s->world, kFrameDt));
+}
+
+// The tank with a checkpoint of itself taken before its frame (sph_world_restore goes back to it,
+// sph_world_load makes a world of it).
+void build_checkpoint_scene(Scene* s) {
+  build_world(s, SPH_FEATURE_NONE, SPH_SOLVER_WCSPH);
+  uint64_t size = 0;
+  EXPECT_OK(sph_world_save(s->world, nullptr, 0, &size));
+  s->checkpoint.resize(static_cast<size_t>(size));
+  EXPECT_OK(sph_world_save(s->world, s->checkpoint.data(), size, &size));
+  EXPECT_OK(sph_world_step(s->world, kFrameDt));
+}
+
+// ---- what a call must leave as it was -----------------------------------------------------------
+// Besides the particles (capi_snapshot): the world's checkpoint (its scene, every method's state
+// and parameters, the object tables and their id generations, the last step's report, events and
+// removed ids), and what the scene's calls read that a checkpoint leaves out (probe readings,
+// loads).
+void append(std::vector<unsigned char>* out, const void* bytes, size_t size) {
+  const unsigned char* b = static_cast<const unsigned char*>(bytes);
+  out->insert(out->end(), b, b + size);
+}
+
+void checkpoint_of(const Scene* s, std::vector<unsigned char>* out) {
+  uint64_t size = 0;
+  EXPECT_OK(sph_world_save(s->world, nullptr, 0, &size));
+  out->assign(static_cast<size_t>(size), 0);
+  EXPECT_OK(sph_world_save(s->world, out->data(), size, &size));
+  out->resize(static_cast<size_t>(size));
+}
+
+// The readings, loads, events and removed ids, and the deterministic statistics of the last step
+// (not its wall times or memory), as bytes.
+void readouts_of(const Scene* s, std::vector<unsigned char>* out) {
+  out->clear();
+  for (const sph_probe_id& probe : s->probes) {
+    if (probe.bits == 0) continue;
+    sph_probe_reading reading;
+    sph_probe_reading_init(&reading);
+    EXPECT_OK(sph_probe_get_reading(s->world, probe, &reading));
+    append(out, &reading, sizeof reading);
+  }
+  if (s->loads)
+    for (const sph_collider_id& collider : {s->tank_collider, s->blob_collider}) {
+      if (collider.bits == 0) continue;
+      sph_collider_loads loads;
+      sph_collider_loads_init(&loads);
+      EXPECT_OK(sph_collider_get_loads(s->world, collider, &loads));
+      append(out, &loads, sizeof loads);
+    }
+  sph_event events[16];
+  uint32_t count = 0;
+  EXPECT_OK(sph_world_get_events(s->world, events, 16, &count));
+  append(out, &count, sizeof count);
+  append(out, events, sizeof(sph_event) * (count < 16 ? count : 16));
+  static uint32_t removed[kCapacity];
+  EXPECT_OK(sph_world_get_removed_ids(s->world, removed, kCapacity, &count));
+  append(out, &count, sizeof count);
+  append(out, removed, sizeof(uint32_t) * count);
+  sph_stats stats;
+  sph_stats_init(&stats);
+  EXPECT_OK(sph_world_get_stats(s->world, &stats));
+  const float floats[] = {stats.frame_time,
+                          stats.dt_min,
+                          stats.dt_max,
+                          stats.max_speed,
+                          stats.density_min,
+                          stats.density_mean,
+                          stats.density_max,
+                          stats.neighbors_mean,
+                          stats.density_error_mean,
+                          stats.density_error_max,
+                          stats.divergence_error_mean,
+                          stats.divergence_error_max};
+  const uint32_t words[] = {stats.particle_count,
+                            stats.substeps,
+                            stats.neighbors_max,
+                            stats.pressure_iterations,
+                            stats.divergence_iterations,
+                            stats.pressure_solves_capped,
+                            stats.divergence_solves_capped,
+                            stats.capacity};
+  append(out, floats, sizeof floats);
+  append(out, words, sizeof words);
+}
+
+void expect_same_bytes(const char* call, long n, const char* what, const std::vector<unsigned char>& before,
+                       const std::vector<unsigned char>& now) {
+  if (before == now) return;
+  size_t at = 0;
+  while (at < before.size() && at < now.size() && before[at] == now[at]) ++at;
+  fail_msg("%s with allocation %ld failing: the %s changed (%zu -> %zu bytes, first difference at byte %zu)",
+           call, n, what, before.size(), now.size(), at);
+}
+
 // ---- the calls ----------------------------------------------------------------------------------
 // Each runs one call against the scene; objects it creates on success are released by `undo`
 // (which runs unarmed).
@@ -145,7 +347,14 @@ struct Call {
   sph_result (*run)(Scene*);
   void (*undo)(Scene*);
   bool changes_world;  // on success: the scene is rebuilt for the next call
+  void (*build)(Scene*);
 };
+
+// The scene as it was before the call that is running (taken unarmed): the calls that name
+// particles (remove, set_attribute) take them from here.
+capi_snapshot g_before;
+capi_snapshot g_after_fault;
+capi_snapshot g_reference;
 
 sph_context* g_made_context = nullptr;
 sph_world* g_made_world = nullptr;
@@ -279,34 +488,172 @@ sph_result run_copy_and_stats(Scene* s) {
   return sph_world_get_events(s->world, events, 8, &count);
 }
 
+sph_result run_probe_create(Scene* s) {
+  sph_probe_def def;
+  sph_probe_def_init(&def);
+  def.kind = SPH_PROBE_GAUGE;
+  def.sampling = SPH_PROBE_EVERY_SUBSTEP;
+  def.position = sph_vec3{0.0f, -0.19f, 0.0f};
+  def.length = 0.3f;
+  sph_probe_id id;
+  return sph_probe_create(s->world, &def, &id);
+}
+
+sph_result run_probe_set_pressure_threshold(Scene* s) {
+  return sph_probe_set_pressure_threshold(s->world, s->probes[1], 2.0f);
+}
+
+sph_result run_probe_get_reading(Scene* s) {
+  sph_probe_reading reading;
+  sph_probe_reading_init(&reading);
+  sph_result r = sph_probe_get_reading(s->world, s->probes[0], &reading);
+  if (r != SPH_OK) return r;
+  return sph_probe_get_reading(s->world, s->probes[1], &reading);
+}
+
+sph_result run_collider_set_load_point(Scene* s) {
+  const sph_vec3 point = {0.0f, -0.2f, 0.0f};
+  return sph_collider_set_load_point(s->world, s->tank_collider, &point);
+}
+
+sph_result run_collider_get_loads(Scene* s) {
+  sph_collider_loads loads;
+  sph_collider_loads_init(&loads);
+  return sph_collider_get_loads(s->world, s->tank_collider, &loads);
+}
+
+sph_result run_set_spring_params(Scene* s) {
+  sph_spring_params params;
+  sph_spring_params_init(&params);
+  EXPECT_OK(sph_world_get_spring_params(s->world, &params));
+  params.stiffness = 2e4f;
+  params.yield_ratio = 0.2f;
+  return sph_world_set_spring_params(s->world, &params);
+}
+
+sph_result run_set_density_diffusion_params(Scene* s) {
+  sph_density_diffusion_params params;
+  sph_density_diffusion_params_init(&params);
+  params.delta = 0.2f;
+  return sph_world_set_density_diffusion_params(s->world, &params);
+}
+
+// The first 8 particles' positions moved by a millimetre, their velocities and user values.
+sph_result run_set_positions(Scene* s) {
+  float positions[3 * 8];
+  for (int i = 0; i < 3 * 8; ++i) positions[i] = g_before.positions[i] + 0.001f;
+  return sph_world_set_attribute(s->world, SPH_ATTRIBUTE_POSITION, positions, sizeof positions, 0, 0, 8);
+}
+
+sph_result run_set_velocities(Scene* s) {
+  float velocities[3 * 8];
+  for (int i = 0; i < 3 * 8; ++i) velocities[i] = 0.1f * static_cast<float>(i % 3);
+  return sph_world_set_attribute(s->world, SPH_ATTRIBUTE_VELOCITY, velocities, sizeof velocities, 0, 0, 8);
+}
+
+sph_result run_set_user_attributes(Scene* s) {
+  uint32_t values[8];
+  for (uint32_t i = 0; i < 8; ++i) values[i] = 7u * i + 1u;
+  return sph_world_set_attribute(s->world, SPH_ATTRIBUTE_USER, values, sizeof values, 0, 3, 8);
+}
+
+// The first, a middle and the last particle of the world's order, by id.
+sph_result run_remove_particles(Scene* s) {
+  const uint32_t ids[3] = {g_before.ids[0], g_before.ids[g_before.count / 2],
+                           g_before.ids[g_before.count - 1]};
+  return sph_world_remove_particles(s->world, ids, 3);
+}
+
+// The size query, then the checkpoint itself.
+sph_result run_save(Scene* s) {
+  static unsigned char buffer[1u << 22];
+  uint64_t size = 0;
+  sph_result r = sph_world_save(s->world, nullptr, 0, &size);
+  if (r != SPH_OK) return r;
+  assert_true(size <= sizeof buffer);
+  return sph_world_save(s->world, buffer, sizeof buffer, &size);
+}
+
+sph_result run_restore(Scene* s) {
+  return sph_world_restore(s->world, s->checkpoint.data(), s->checkpoint.size());
+}
+
+sph_result run_load(Scene* s) {
+  return sph_world_load(s->context, s->checkpoint.data(), s->checkpoint.size(), &g_made_world);
+}
+
+// The asynchronous step: the frame runs on the world's own thread (started by the first begin of
+// a scene; the injector counts that thread's allocations too). A failure inside the frame comes
+// back from the wait, the world rolled back as sph_world_step rolls it back.
+sph_result run_step_async(Scene* s) {
+  const sph_result r = sph_world_step_begin(s->world, kFrameDt);
+  if (r != SPH_OK) return r;
+  return sph_world_step_wait(s->world);
+}
+
 void no_undo(Scene*) {}
 
 const Call kCalls[] = {
-    {"sph_context_create", run_context_create, undo_context_create, false},
-    {"sph_world_create", run_world_create, undo_world_create, false},
-    {"sph_sdf_create_shape", run_sdf_create_shape, undo_sdf, false},
-    {"sph_world_fill_box", run_fill_box, no_undo, true},
-    {"sph_world_fill_sphere", run_fill_sphere, no_undo, true},
-    {"sph_world_spawn", run_spawn, no_undo, true},
-    {"sph_world_set_params", run_set_params, no_undo, true},
-    {"sph_collider_create", run_collider_create, no_undo, true},
-    {"sph_source_create", run_source_create, no_undo, true},
-    {"sph_sink_create", run_sink_create, no_undo, true},
-    {"sph_force_field_create", run_force_field_create, no_undo, true},
-    {"sph_world_step", run_step, no_undo, true},
-    {"copy_attribute + get_stats + get_events", run_copy_and_stats, no_undo, false},
+    {"sph_context_create", run_context_create, undo_context_create, false, build_scene},
+    {"sph_world_create", run_world_create, undo_world_create, false, build_scene},
+    {"sph_sdf_create_shape", run_sdf_create_shape, undo_sdf, false, build_scene},
+    {"sph_world_fill_box", run_fill_box, no_undo, true, build_scene},
+    {"sph_world_fill_sphere", run_fill_sphere, no_undo, true, build_scene},
+    {"sph_world_spawn", run_spawn, no_undo, true, build_scene},
+    {"sph_world_set_params", run_set_params, no_undo, true, build_scene},
+    {"sph_collider_create", run_collider_create, no_undo, true, build_scene},
+    {"sph_source_create", run_source_create, no_undo, true, build_scene},
+    {"sph_sink_create", run_sink_create, no_undo, true, build_scene},
+    {"sph_force_field_create", run_force_field_create, no_undo, true, build_scene},
+    {"sph_world_step", run_step, no_undo, true, build_scene},
+    {"copy_attribute + get_stats + get_events", run_copy_and_stats, no_undo, false, build_scene},
+    // The calls whose errors in sph_c.h name no OUT_OF_HOST_MEMORY (a probe's threshold and reading,
+    // a collider's load point and loads, the springs' and the density diffusion's parameters)
+    // allocate nothing: they run once, with no failure to inject (one that starts to allocate is
+    // checked as every other call).
+    // Probes and gauges.
+    {"sph_probe_create", run_probe_create, no_undo, true, build_probe_scene},
+    {"sph_probe_set_pressure_threshold", run_probe_set_pressure_threshold, no_undo, true, build_probe_scene},
+    {"sph_world_step (a new probe)", run_step, no_undo, true, build_new_probe_scene},
+    {"sph_probe_get_reading", run_probe_get_reading, no_undo, false, build_probe_scene},
+    // Loads on colliders.
+    {"sph_collider_set_load_point", run_collider_set_load_point, no_undo, true, build_loads_scene},
+    {"sph_world_step (loads, a new collider)", run_step, no_undo, true, build_new_collider_loads_scene},
+    {"sph_collider_get_loads", run_collider_get_loads, no_undo, false, build_loads_scene},
+    // DFSPH, also with the walls in the density (and their loads).
+    {"sph_world_step (DFSPH)", run_step, no_undo, true, build_dfsph_scene},
+    {"sph_world_step (DFSPH, walls, a new collider)", run_step, no_undo, true,
+     build_new_collider_dfsph_walls_scene},
+    // Springs, density diffusion.
+    {"sph_world_set_spring_params", run_set_spring_params, no_undo, true, build_springs_scene},
+    {"sph_world_step (springs)", run_step, no_undo, true, build_springs_scene},
+    {"sph_world_remove_particles (springs)", run_remove_particles, no_undo, true, build_springs_scene},
+    {"sph_world_set_density_diffusion_params", run_set_density_diffusion_params, no_undo, true,
+     build_diffusion_scene},
+    {"sph_world_step (density diffusion)", run_step, no_undo, true, build_diffusion_scene},
+    // Writing and removing particles.
+    {"sph_world_set_attribute (position)", run_set_positions, no_undo, true, build_user_attribute_scene},
+    {"sph_world_set_attribute (velocity)", run_set_velocities, no_undo, true, build_user_attribute_scene},
+    {"sph_world_set_attribute (user)", run_set_user_attributes, no_undo, true, build_user_attribute_scene},
+    {"sph_world_remove_particles", run_remove_particles, no_undo, true, build_scene},
+    // Checkpoints in memory.
+    {"sph_world_save", run_save, no_undo, false, build_scene},
+    {"sph_world_restore", run_restore, no_undo, true, build_checkpoint_scene},
+    {"sph_world_load", run_load, undo_world_create, false, build_checkpoint_scene},
+    // The asynchronous step.
+    {"sph_world_step_begin + sph_world_step_wait", run_step_async, no_undo, true, build_scene},
 };
 
-capi_snapshot g_before;
-capi_snapshot g_after_fault;
-capi_snapshot g_reference;
-
 void check_call(const Call& call) {
+  // (static: the vectors keep their storage from call to call)
+  static std::vector<unsigned char> checkpoint_before, checkpoint_now, readouts_before, readouts_now;
   Scene scene;
-  build_scene(&scene);
+  call.build(&scene);
   long faults = 0;
   for (long n = 0;; ++n) {
     capi_snapshot_take(scene.world, &g_before);
+    checkpoint_of(&scene, &checkpoint_before);
+    readouts_of(&scene, &readouts_before);
     const uint32_t objects_before = live_objects();
     arm(n);
     const sph_result r = call.run(&scene);
@@ -326,7 +673,7 @@ void check_call(const Call& call) {
       // from the same state.
       call.undo(&scene);
       destroy_scene(&scene);
-      build_scene(&scene);
+      call.build(&scene);
       continue;
     }
     if (r != SPH_ERROR_OUT_OF_HOST_MEMORY)
@@ -337,13 +684,17 @@ void check_call(const Call& call) {
     if (live_objects() != objects_before)
       fail_msg("%s with allocation %ld failing leaked a handle", call.name, n);
     EXPECT_UNCHANGED(scene.world, &g_before);
+    checkpoint_of(&scene, &checkpoint_now);
+    expect_same_bytes(call.name, n, "checkpoint", checkpoint_before, checkpoint_now);
+    readouts_of(&scene, &readouts_now);
+    expect_same_bytes(call.name, n, "readings, loads, events or statistics", readouts_before, readouts_now);
   }
-  print_message("%-40s %ld allocation points failed once each\n", call.name, faults);
+  print_message("%-45s %ld allocation points failed once each\n", call.name, faults);
 
   // After every failure the world goes on exactly like a world that never saw one.
   if (call.changes_world) {
     Scene reference;
-    build_scene(&reference);
+    call.build(&reference);
     assert_int_equal(call.run(&reference), SPH_OK);
     EXPECT_OK(sph_world_step(scene.world, kFrameDt));
     EXPECT_OK(sph_world_step(reference.world, kFrameDt));
@@ -351,6 +702,17 @@ void check_call(const Call& call) {
     capi_snapshot_take(reference.world, &g_reference);
     // The simulated time and the particles, bitwise.
     EXPECT_UNCHANGED(scene.world, &g_reference);
+    // The readings, loads, events and the step's statistics too, and the checkpoint's size (its
+    // bytes hold the steps' wall times): no object a failure added or lost.
+    readouts_of(&scene, &readouts_now);
+    readouts_of(&reference, &readouts_before);
+    expect_same_bytes(call.name, -1, "readings, loads, events or statistics (against the undisturbed world)",
+                      readouts_before, readouts_now);
+    checkpoint_of(&scene, &checkpoint_now);
+    checkpoint_of(&reference, &checkpoint_before);
+    if (checkpoint_now.size() != checkpoint_before.size())
+      fail_msg("%s: the checkpoint has %zu bytes, the undisturbed world's %zu", call.name,
+               checkpoint_now.size(), checkpoint_before.size());
     destroy_scene(&reference);
   }
   destroy_scene(&scene);
