@@ -1953,12 +1953,17 @@ class Program {
     const bool set = in_.chance(160);
     sph_result r;
     uint32_t kind;
-    Padded<sph_dfsph_params> bytes;  // 256 bytes whichever struct it holds
+    // Each struct in 256 bytes (a fuzzed struct_size stays inside); `sent` is the one passed.
+    Padded<sph_dfsph_params> dfsph;
+    Padded<sph_spring_params> springs;
+    Padded<sph_density_diffusion_params> diffusion;
+    const unsigned char* sent = nullptr;
     std::vector<unsigned char> before;
     switch (in_.u8() % 3) {
       case 0: {
         kind = SPH_PARAMS_DFSPH;
-        sph_dfsph_params& p = bytes.value;
+        sph_dfsph_params& p = dfsph.value;
+        sent = dfsph.bytes;
         sph_dfsph_params_init(&p);
         if (is_live && in_.chance(128)) FUZZ_CALL(sph_world_get_dfsph_params(w, &p));
         p.density_error = in_.maybe_hostile(0.0f, 0.01f);
@@ -1970,7 +1975,7 @@ class Program {
         p.density_error_max = in_.maybe_hostile(0.0f, 0.1f);
         p.depth_step_factor = in_.maybe_hostile(0.0f, 1.0f);
         p.divergence_error_per_step = in_.maybe_hostile(0.0f, 0.01f);
-        bound_work(kind, bytes.bytes);
+        bound_work(kind, dfsph.bytes);
         p.struct_size = struct_size(sizeof p);
         if (set && is_live) before = params_bytes(w, kind);
         r = set ? FUZZ_CALL(sph_world_set_dfsph_params(w, in_.chance(8) ? nullptr : &p))
@@ -1979,7 +1984,8 @@ class Program {
       }
       case 1: {
         kind = SPH_PARAMS_SPRINGS;
-        sph_spring_params& p = *reinterpret_cast<sph_spring_params*>(bytes.bytes);
+        sph_spring_params& p = springs.value;
+        sent = springs.bytes;
         sph_spring_params_init(&p);
         const float s = is_live ? worlds_[slot].spacing : 0.02f;
         p.stiffness = in_.maybe_hostile(0.0f, 1e4f);
@@ -1996,25 +2002,22 @@ class Program {
       }
       default: {
         kind = SPH_PARAMS_DENSITY_DIFFUSION;
-        sph_density_diffusion_params& p = *reinterpret_cast<sph_density_diffusion_params*>(bytes.bytes);
+        sph_density_diffusion_params& p = diffusion.value;
+        sent = diffusion.bytes;
         sph_density_diffusion_params_init(&p);
         p.delta = in_.maybe_hostile(0.0f, 1.0f);
         p.struct_size = struct_size(sizeof p);
         if (set && is_live) before = params_bytes(w, kind);
-        r = set ? FUZZ_CALL(sph_world_set_density_diffusion_params(
-                      w,
-                      in_.chance(8) ? nullptr : reinterpret_cast<sph_density_diffusion_params*>(bytes.bytes)))
-                : FUZZ_CALL(sph_world_get_density_diffusion_params(
-                      w, in_.chance(8) ? nullptr
-                                       : reinterpret_cast<sph_density_diffusion_params*>(bytes.bytes)));
+        r = set ? FUZZ_CALL(sph_world_set_density_diffusion_params(w, in_.chance(8) ? nullptr : &p))
+                : FUZZ_CALL(sph_world_get_density_diffusion_params(w, in_.chance(8) ? nullptr : &p));
       }
     }
     if (r == SPH_OK && !is_live) violation("method params on a dead world");
     if (!is_live) return;
     if (set) {
       uint32_t sent_size;
-      std::memcpy(&sent_size, bytes.bytes, 4);
-      check_params_set(slot, kind, r, before, bytes.bytes, sent_size);
+      std::memcpy(&sent_size, sent, 4);
+      check_params_set(slot, kind, r, before, sent, sent_size);
     } else if (r == SPH_OK && !kind_enabled(worlds_[slot], kind)) {
       violation("params kind %u read from a world without its method", kind);
     }
