@@ -79,10 +79,14 @@ struct IdSlot {
 struct Particles {
   std::vector<float> position, velocity;
   std::vector<uint32_t> id;
+  // Bitwise (NaN and -0 count as themselves). An empty vector may hold no storage (data() NULL),
+  // and memcmp with NULL is undefined even for 0 bytes, so no particles compare without it.
   bool operator==(const Particles& o) const {
-    return position.size() == o.position.size() &&
-           std::memcmp(position.data(), o.position.data(), position.size() * sizeof(float)) == 0 &&
-           std::memcmp(velocity.data(), o.velocity.data(), velocity.size() * sizeof(float)) == 0 &&
+    return position.size() == o.position.size() && velocity.size() == o.velocity.size() &&
+           (position.empty() ||
+            std::memcmp(position.data(), o.position.data(), position.size() * sizeof(float)) == 0) &&
+           (velocity.empty() ||
+            std::memcmp(velocity.data(), o.velocity.data(), velocity.size() * sizeof(float)) == 0) &&
            id == o.id;
   }
 };
