@@ -5,14 +5,24 @@
 // of sph_c.h: a known result code, a message on failure, a failed call changes nothing, a
 // successful step leaves only finite particles, and at the end every object is destroyed and
 // nothing leaks. Work per input is bounded (capacity <= 1024, <= 4 substeps per step, grids of
-// at most 32^3 voxels) so libFuzzer stays fast; absurd sizes are still passed where the
-// library must refuse them before it allocates or reads anything.
+// at most 32^3 voxels, <= 20 iterations per DFSPH solve, gauges of <= 4096 points) so libFuzzer
+// stays fast; absurd sizes are still passed where the library must refuse them before it
+// allocates or reads anything. The ops added later (step_added_op) cover every method's world
+// (DFSPH, springs, density diffusion, collider loads, the user attribute), probes and gauges,
+// collider loads, the params of every kind and their descriptions, writing and removing
+// particles, asynchronous steps (calls while the step holds the world must answer WORLD_LOCKED)
+// and checkpoint files under /tmp.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <string>
 #include <vector>
+
+#include <dirent.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "fuzz_check.h"
 #include "fuzz_input.h"
@@ -30,6 +40,13 @@ constexpr uint64_t kMaxVoxels = 32768;    // voxels per grid the harness builds
 constexpr double kMaxLattice = 1u << 16;  // source lattice points the harness allows
 constexpr double kLibraryVoxelLimit = 2147483648.0;
 constexpr int kContexts = 3, kWorlds = 4, kSdfs = 6, kIds = 8, kStale = 8;
+constexpr uint32_t kMaxSolverIterations = 20;  // DFSPH iterations per solve the harness allows
+constexpr double kMaxGaugeSteps = 4096;        // gauge sample points the harness allows (library: 65536)
+constexpr uint32_t kKnownFeatures = 0x7fu;     // every SPH_FEATURE_* bit of sph_c.h
+// Op bytes 232..253 pick the ops added after the first 29 (step_added_op). The first 29 keep
+// every other byte value, and 0xfe and 0xff, which the saved inputs use as ops (fuzzers favour
+// 0xff), keep theirs: tests/fuzz/regressions/capi decode as before.
+constexpr uint8_t kFirstAddedOp = 232, kLastAddedOp = 253;
 
 struct ContextSlot {
   sph_context* ptr = nullptr;
@@ -39,8 +56,11 @@ struct WorldSlot {
   int context = -1;
   uint32_t capacity = 0;  // the most particles it may hold: its max_capacity (it grows on demand)
   uint32_t features = 0;
-  uint32_t integrator = 0, viscosity = 0, eos = 0;
-  float spacing = 0.0f;
+  uint32_t integrator = 0, viscosity = 0, eos = 0, solver = 0;
+  float spacing = 0.0f, kernel_radius = 0.0f;
+  // A cancel that reached an asynchronous step after its last substep stays for the next step
+  // (sph_world_cancel_step): set after op_async_step cancelled, cleared by a step that ran.
+  bool cancel_maybe_pending = false;
 };
 struct SdfSlot {
   sph_sdf* ptr = nullptr;
@@ -59,10 +79,14 @@ struct IdSlot {
 struct Particles {
   std::vector<float> position, velocity;
   std::vector<uint32_t> id;
+  // Bitwise (NaN and -0 count as themselves). An empty vector may hold no storage (data() NULL),
+  // and memcmp with NULL is undefined even for 0 bytes, so no particles compare without it.
   bool operator==(const Particles& o) const {
-    return position.size() == o.position.size() &&
-           std::memcmp(position.data(), o.position.data(), position.size() * sizeof(float)) == 0 &&
-           std::memcmp(velocity.data(), o.velocity.data(), velocity.size() * sizeof(float)) == 0 &&
+    return position.size() == o.position.size() && velocity.size() == o.velocity.size() &&
+           (position.empty() ||
+            std::memcmp(position.data(), o.position.data(), position.size() * sizeof(float)) == 0) &&
+           (velocity.empty() ||
+            std::memcmp(velocity.data(), o.velocity.data(), velocity.size() * sizeof(float)) == 0) &&
            id == o.id;
   }
 };
@@ -84,7 +108,7 @@ class Program {
   ContextSlot contexts_[kContexts];
   WorldSlot worlds_[kWorlds];
   SdfSlot sdfs_[kSdfs];
-  IdSlot colliders_[kIds], sources_[kIds], sinks_[kIds], fields_[kIds];
+  IdSlot colliders_[kIds], sources_[kIds], sinks_[kIds], fields_[kIds], probes_[kIds];
   const void* stale_[kStale] = {};  // destroyed handles (never dereferenced by the harness)
   int stale_next_ = 0;
 
@@ -204,6 +228,12 @@ class Program {
   // the loaded world steps as the original does.
   void round_trip(int slot) {
     WorldSlot& ws = worlds_[slot];
+    if (ws.cancel_maybe_pending) {
+      // A cancel left by an asynchronous step would stop the world's step below and not its
+      // loaded copy's: one step takes it (or, if there was none, steps as any step does).
+      FUZZ_CALL(sph_world_step(ws.ptr, 1.0f / 600.0f));
+      ws.cancel_maybe_pending = false;
+    }
     const std::vector<uint8_t> bytes = checkpoint(ws.ptr);
     sph_world* loaded = nullptr;
     if (FUZZ_CALL(sph_world_load(contexts_[ws.context].ptr, bytes.data(), bytes.size(), &loaded)) != SPH_OK)
@@ -299,7 +329,9 @@ class Program {
 
   // ---- ops --------------------------------------------------------------------------------------
   void step_op() {
-    switch (in_.u8() % 29) {
+    const uint8_t op = in_.u8();
+    if (op >= kFirstAddedOp && op <= kLastAddedOp) return step_added_op(op - kFirstAddedOp);
+    switch (op % 29) {
       case 0:
         return op_context_create();
       case 1:
@@ -462,19 +494,26 @@ class Program {
     }
     if (in_.chance(8)) d.header_version = in_.u32();
     d.struct_size = struct_size(sizeof(sph_world_def));
-    // What the library reads of max_capacity: the bytes of it that struct_size covers (a fuzzed
-    // size may end inside the field; the library reads min(struct_size, its size) bytes,
-    // docs/versioning.md), so the rest of the field counts as zero.
-    const uint32_t max_seen = [&] {
-      const size_t at = offsetof(sph_world_def, max_capacity);
-      uint32_t v = 0;
-      if (d.struct_size > at)
-        std::memcpy(&v, &d.max_capacity, std::min<size_t>(sizeof v, d.struct_size - at));
-      return v;
-    }();
-    const bool max_refused = max_seen != 0 && (max_seen < resolved || max_seen > (1u << 30));
+    const uint32_t max_seen = max_capacity_seen(d);
     sph_world* out = nullptr;
     const sph_result r = FUZZ_CALL(sph_world_create(c, in_.chance(8) ? nullptr : &d, &out));
+    adopt_world(slot, cslot, r, out, resolved, max_seen);
+  }
+
+  // What the library reads of max_capacity: the bytes of it that struct_size covers (a fuzzed
+  // size may end inside the field; the library reads min(struct_size, its size) bytes,
+  // docs/versioning.md), so the rest of the field counts as zero.
+  static uint32_t max_capacity_seen(const sph_world_def& d) {
+    const size_t at = offsetof(sph_world_def, max_capacity);
+    uint32_t v = 0;
+    if (d.struct_size > at) std::memcpy(&v, &d.max_capacity, std::min<size_t>(sizeof v, d.struct_size - at));
+    return v;
+  }
+
+  // The checks of a sph_world_create result; a created world goes into `slot` with its work
+  // bounded (or is destroyed again when the harness cannot bound it).
+  void adopt_world(int slot, int cslot, sph_result r, sph_world* out, uint64_t resolved, uint32_t max_seen) {
+    const bool max_refused = max_seen != 0 && (max_seen < resolved || max_seen > (1u << 30));
     if (r != SPH_OK) {
       if (out) violation("sph_world_create wrote *out on failure");
       return;
@@ -492,9 +531,21 @@ class Program {
     w.integrator = static_cast<uint32_t>(got.integrator);
     w.viscosity = static_cast<uint32_t>(got.viscosity_method);
     w.eos = static_cast<uint32_t>(got.equation_of_state);
+    w.solver = static_cast<uint32_t>(got.solver);
     w.spacing = got.particle_spacing;
+    w.kernel_radius = got.kernel_radius;
+    if (w.features & ~kKnownFeatures)
+      violation("a world was created with unknown feature bits %#x", w.features);
+    if (w.solver > SPH_SOLVER_DFSPH) violation("a world was created with solver %u", w.solver);
+    // The combinations sph_solver and SPH_FEATURE_DENSITY_DIFFUSION call UNSUPPORTED.
+    if (w.solver == SPH_SOLVER_DFSPH && (w.integrator == SPH_INTEGRATOR_RK4 || w.eos == SPH_EOS_TAIT ||
+                                         (w.features & SPH_FEATURE_NORMALIZED_DENSITY)))
+      violation("a DFSPH world was created with RK4, Tait or the normalised density");
+    if ((w.features & SPH_FEATURE_DENSITY_DIFFUSION) &&
+        (w.solver != SPH_SOLVER_WCSPH || !(w.features & SPH_FEATURE_NORMALIZED_DENSITY)))
+      violation("density diffusion was created without the normalised density or with DFSPH");
     if (got.capacity != resolved)
-      violation("the world's capacity %u is not the def's %u", got.capacity, d.capacity);
+      violation("the world's capacity %u is not the def's %u", got.capacity, static_cast<uint32_t>(resolved));
     const uint32_t max_expected = max_seen != 0 ? max_seen : got.capacity;
     if (got.max_capacity != max_expected)
       violation("the world's max_capacity %u is not the def's %u", got.max_capacity, max_expected);
@@ -512,7 +563,17 @@ class Program {
     if (FUZZ_CALL(sph_world_set_params(out, &p)) != SPH_OK) {
       // The world's own params with a smaller max_substeps are valid, so this should not
       // fail; if it ever does, the harness cannot bound the world's steps and drops it.
-      destroy_world(slot);
+      return destroy_world(slot);
+    }
+    if (w.solver == SPH_SOLVER_DFSPH) {
+      // And the iterations of DFSPH's two solves (default 100 each), likewise.
+      sph_dfsph_params dp;
+      sph_dfsph_params_init(&dp);
+      if (FUZZ_CALL(sph_world_get_dfsph_params(out, &dp)) != SPH_OK)
+        violation("a DFSPH world's params cannot be read: %s", sph_get_last_error());
+      dp.max_iterations = kMaxSolverIterations;
+      dp.max_divergence_iterations = kMaxSolverIterations;
+      if (FUZZ_CALL(sph_world_set_dfsph_params(out, &dp)) != SPH_OK) destroy_world(slot);
     }
   }
 
@@ -750,8 +811,16 @@ class Program {
     const Particles before = snapshot(w);
     const std::vector<uint8_t> saved = checkpoint(w);
     const sph_result r = FUZZ_CALL(sph_world_step(w, dt));
+    check_step(slot, r, before, saved);
+  }
+
+  // What a step (or an asynchronous one's wait) answered, against the world before it: a step
+  // that ran leaves finite particles and its statistics; a failed one changed nothing.
+  void check_step(int slot, sph_result r, const Particles& before, const std::vector<uint8_t>& saved) {
+    sph_world* w = worlds_[slot].ptr;
     const Particles after = snapshot(w);
     if (r == SPH_OK || r == SPH_INCOMPLETE) {
+      worlds_[slot].cancel_maybe_pending = false;  // a pending cancel stops the step that meets it
       check_particles(worlds_[slot], after);
       sph_stats s;
       sph_stats_init(&s);
@@ -1513,6 +1582,1012 @@ class Program {
       default:
         if (sph_get_version() == 0 || !sph_get_build_info()) violation("version or build info missing");
     }
+  }
+
+  // ---- ops added after the first 29 (op bytes 232..253) -----------------------------------------
+  void step_added_op(uint8_t op) {
+    switch (op % 11) {
+      case 0:
+        return op_world_create_methods();
+      case 1:
+        return op_probe_create();
+      case 2:
+        return op_probe_ops();
+      case 3:
+        return op_collider_loads();
+      case 4:
+        return op_method_params();
+      case 5:
+        return op_params_by_kind();
+      case 6:
+        return op_params_info();
+      case 7:
+        return op_set_attribute();
+      case 8:
+        return op_remove_particles();
+      case 9:
+        return op_async_step();
+      default:
+        return op_checkpoint_file();
+    }
+  }
+
+  bool live(int slot, const void* w) const { return slot >= 0 && w; }
+
+  // The struct as the library reads it: the bytes struct_size covers, the rest zero
+  // (docs/versioning.md; a struct_size past sizeof(T) is refused unless the tail is zero).
+  template <class T>
+  static T as_read(const T& value) {
+    T out;
+    std::memset(&out, 0, sizeof out);
+    std::memcpy(&out, &value, std::min<size_t>(value.struct_size, sizeof(T)));
+    return out;
+  }
+
+  static bool finite3(const sph_vec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+  }
+
+  // A world made with any method: every feature bit, the DFSPH solver (sph_world_def.solver),
+  // mostly in combinations the solvers support, so that their calls and steps get exercised.
+  void op_world_create_methods() {
+    const int slot = pick_world();
+    if (worlds_[slot].ptr) return;
+    int cslot;
+    sph_context* c = context_arg(&cslot);
+    Padded<sph_world_def> def;
+    FUZZ_CALL(sph_world_def_init(&def.value));
+    sph_world_def& d = def.value;
+    d.capacity = in_.range(1, kMaxCapacity);
+    uint32_t features = in_.chance(240) ? in_.u8() & kKnownFeatures : in_.u32();
+    const uint32_t solver = in_.chance(232) ? in_.u8() % 2 : in_.u32();
+    uint32_t integrator = in_.chance(224) ? in_.u8() % 2 : in_.u32();
+    const uint32_t viscosity = in_.chance(224) ? in_.u8() % 2 : in_.u32();
+    uint32_t eos = in_.chance(224) ? in_.u8() % 2 : in_.u32();
+    if (in_.chance(192)) {
+      if (solver == SPH_SOLVER_DFSPH) {
+        integrator = SPH_INTEGRATOR_SYMPLECTIC_EULER;
+        eos = SPH_EOS_IDEAL_GAS;
+        features &= ~(SPH_FEATURE_NORMALIZED_DENSITY | SPH_FEATURE_DENSITY_DIFFUSION);
+      }
+      if (features & SPH_FEATURE_DENSITY_DIFFUSION) features |= SPH_FEATURE_NORMALIZED_DENSITY;
+    }
+    d.features = features;
+    std::memcpy(&d.solver, &solver, 4);
+    std::memcpy(&d.integrator, &integrator, 4);
+    std::memcpy(&d.viscosity_method, &viscosity, 4);
+    std::memcpy(&d.equation_of_state, &eos, 4);
+    if (in_.chance(32)) d.max_capacity = std::min(kMaxCapacity, d.capacity * (2u + in_.u8() % 4u));
+    if (in_.chance(128)) {
+      d.particle_spacing = in_.maybe_hostile(0.005f, 0.2f);
+      d.kernel_radius = in_.chance(128) ? 0.0f : d.particle_spacing * in_.maybe_hostile(1.0f, 5.0f);
+      d.rest_density = in_.maybe_hostile(1.0f, 3000.0f);
+    }
+    if (in_.chance(8)) d.header_version = in_.u32();
+    d.struct_size = struct_size(sizeof(sph_world_def));
+    const uint32_t max_seen = max_capacity_seen(d);
+    sph_world* out = nullptr;
+    const sph_result r = FUZZ_CALL(sph_world_create(c, in_.chance(8) ? nullptr : &d, &out));
+    adopt_world(slot, cslot, r, out, d.capacity, max_seen);
+  }
+
+  // sph_probe_create: points and gauges with hostile positions, directions, lengths and spacings.
+  void op_probe_create() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    const bool is_live = live(slot, w);
+    Padded<sph_probe_def> buf;
+    sph_probe_def& d = buf.value;
+    sph_probe_def_init(&d);
+    const uint32_t kind = enum_value(2), sampling = enum_value(2);
+    std::memcpy(&d.kind, &kind, 4);
+    std::memcpy(&d.sampling, &sampling, 4);
+    d.position = vec3(-0.5f, 0.5f);
+    d.direction = in_.chance(96) ? sph_vec3{0.0f, 0.0f, 0.0f} : vec3(-1.0f, 1.0f);
+    d.length = in_.maybe_hostile(0.0f, 0.5f);
+    d.sample_spacing = in_.chance(128) ? 0.0f : in_.maybe_hostile(0.0f, 0.05f);
+    if (in_.chance(8)) d.reserved0 = in_.u32();
+    d.struct_size = struct_size(sizeof d);
+    const sph_probe_def seen = as_read(d);
+    const bool gauge = static_cast<uint32_t>(seen.kind) == SPH_PROBE_GAUGE;
+    const float h = is_live ? worlds_[slot].kernel_radius : 0.036f;
+    const double spacing = seen.sample_spacing > 0.0f ? seen.sample_spacing : h / 8.0f;
+    const double steps = std::ceil(static_cast<double>(seen.length) / spacing);
+    // A legal gauge samples every step along it each substep: skip the long ones (the library's
+    // bound is 65536), pass those it must refuse.
+    if (gauge && std::isfinite(steps) && steps > kMaxGaugeSteps && steps <= 65536.0) return;
+    const std::vector<uint8_t> saved = is_live ? checkpoint(w) : std::vector<uint8_t>{};
+    sph_probe_id id{0};
+    const sph_result r =
+        FUZZ_CALL(sph_probe_create(w, in_.chance(8) ? nullptr : &d, in_.chance(8) ? nullptr : &id));
+    if (r != SPH_OK) {
+      if (is_live && checkpoint(w) != saved)
+        violation("a refused sph_probe_create changed the world (%d)", r);
+      return;
+    }
+    if (!is_live) violation("sph_probe_create succeeded on a dead world");
+    if (id.bits == 0) violation("a null probe id");
+    const uint32_t k = static_cast<uint32_t>(seen.kind), sm = static_cast<uint32_t>(seen.sampling);
+    if (k > SPH_PROBE_GAUGE || sm > SPH_PROBE_EVERY_SUBSTEP)
+      violation("a probe of kind %u, sampling %u", k, sm);
+    if (seen.reserved0 != 0) violation("a probe def with reserved0 %u was accepted", seen.reserved0);
+    if (!finite3(seen.position)) violation("a probe at a non-finite position was accepted");
+    if (gauge && !(finite3(seen.direction) && std::isfinite(seen.length) && seen.length > 0.0f &&
+                   std::isfinite(seen.sample_spacing) && seen.sample_spacing >= 0.0f && steps <= 65536.0))
+      violation("a gauge with a bad direction, length %g or spacing %g was accepted",
+                static_cast<double>(seen.length), static_cast<double>(seen.sample_spacing));
+    store_id(probes_, in_.u8(), id.bits, slot);
+  }
+
+  // sph_probe_destroy, sph_probe_get_reading (struct_size and canary as op_queries' stats) and
+  // sph_probe_set_pressure_threshold, with null, stale and foreign ids.
+  void op_probe_ops() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    const bool is_live = live(slot, w);
+    const sph_probe_id id{id_arg(probes_)};
+    sph_result r;
+    switch (in_.u8() % 3) {
+      case 0: {
+        const std::vector<uint8_t> saved = is_live ? checkpoint(w) : std::vector<uint8_t>{};
+        r = FUZZ_CALL(sph_probe_destroy(w, id));
+        if (is_live && id.bits == 0 && r != SPH_OK) violation("sph_probe_destroy of id {0} answered %d", r);
+        if (r != SPH_OK && is_live && checkpoint(w) != saved)
+          violation("a refused sph_probe_destroy changed the world (%d)", r);
+        break;
+      }
+      case 1: {
+        Padded<sph_probe_reading> out;
+        sph_probe_reading_init(&out.value);
+        const uint32_t size = out.value.struct_size = struct_size(sizeof(sph_probe_reading));
+        const uint32_t canary = std::min<uint32_t>(std::max<uint32_t>(size, sizeof(uint32_t)), 256);
+        std::memset(out.bytes + canary, 0xAB, 256 - canary);
+        r = FUZZ_CALL(sph_probe_get_reading(w, id, in_.chance(16) ? nullptr : &out.value));
+        for (uint32_t i = canary; i < 256; ++i)
+          if (out.bytes[i] != 0xAB)
+            violation("sph_probe_get_reading wrote past struct_size %u (r=%d)", size, r);
+        if (r == SPH_OK && size >= sizeof(sph_probe_reading)) {
+          const sph_probe_reading& o = out.value;
+          if (!(std::isfinite(o.density) && std::isfinite(o.pressure) && finite3(o.velocity) &&
+                std::isfinite(o.pressure_max) && std::isfinite(o.kernel_sum) &&
+                std::isfinite(o.water_height) && std::isfinite(o.time) && o.time >= 0.0))
+            violation("a probe reading with a non-finite value (samples %u)", o.samples);
+          if (o.samples == 0 && o.time != 0.0) violation("a probe reading of no samples over %g s", o.time);
+        }
+        break;
+      }
+      default: {
+        const float pressure = in_.maybe_hostile(0.0f, 1e5f);
+        const std::vector<uint8_t> saved = is_live ? checkpoint(w) : std::vector<uint8_t>{};
+        r = FUZZ_CALL(sph_probe_set_pressure_threshold(w, id, pressure));
+        if (r == SPH_OK && !(std::isfinite(pressure) && pressure >= 0.0f))
+          violation("sph_probe_set_pressure_threshold accepted %g", static_cast<double>(pressure));
+        if (r != SPH_OK && is_live && checkpoint(w) != saved)
+          violation("a refused sph_probe_set_pressure_threshold changed the world (%d)", r);
+      }
+    }
+    if (r == SPH_OK && !is_live) violation("a probe call succeeded on a dead world");
+  }
+
+  // sph_collider_get_loads (struct_size, canary) and sph_collider_set_load_point, on worlds
+  // with and without SPH_FEATURE_COLLIDER_LOADS.
+  void op_collider_loads() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    const bool is_live = live(slot, w);
+    const sph_collider_id id{id_arg(colliders_)};
+    sph_result r;
+    if (in_.chance(128)) {
+      Padded<sph_collider_loads> out;
+      sph_collider_loads_init(&out.value);
+      const uint32_t size = out.value.struct_size = struct_size(sizeof(sph_collider_loads));
+      const uint32_t canary = std::min<uint32_t>(std::max<uint32_t>(size, sizeof(uint32_t)), 256);
+      std::memset(out.bytes + canary, 0xAB, 256 - canary);
+      r = FUZZ_CALL(sph_collider_get_loads(w, id, in_.chance(16) ? nullptr : &out.value));
+      for (uint32_t i = canary; i < 256; ++i)
+        if (out.bytes[i] != 0xAB)
+          violation("sph_collider_get_loads wrote past struct_size %u (r=%d)", size, r);
+      if (r == SPH_OK && size >= sizeof(sph_collider_loads)) {
+        const sph_collider_loads& o = out.value;
+        if (!(finite3(o.force) && finite3(o.torque) && finite3(o.point) && std::isfinite(o.frame_time) &&
+              o.frame_time >= 0.0 && o.reserved0 == 0))
+          violation("collider loads with a non-finite value or a non-zero reserved0");
+      }
+    } else {
+      const sph_vec3 point = vec3(-0.5f, 0.5f);
+      const std::vector<uint8_t> saved = is_live ? checkpoint(w) : std::vector<uint8_t>{};
+      r = FUZZ_CALL(sph_collider_set_load_point(w, id, in_.chance(8) ? nullptr : &point));
+      if (r == SPH_OK && !finite3(point))
+        violation("sph_collider_set_load_point accepted a non-finite point");
+      if (r != SPH_OK && is_live && checkpoint(w) != saved)
+        violation("a refused sph_collider_set_load_point changed the world (%d)", r);
+    }
+    if (r == SPH_OK && !is_live) violation("a collider loads call succeeded on a dead world");
+    if (r == SPH_OK && !(worlds_[slot].features & SPH_FEATURE_COLLIDER_LOADS))
+      violation("a collider loads call succeeded on a world without SPH_FEATURE_COLLIDER_LOADS");
+  }
+
+  // ---- parameters by kind ------------------------------------------------------------------------
+  // Whether a world's def turns on the method whose params struct is `kind`.
+  static bool kind_enabled(const WorldSlot& w, uint32_t kind) {
+    switch (kind) {
+      case SPH_PARAMS_WORLD:
+        return true;
+      case SPH_PARAMS_SURFACE_TENSION:
+        return (w.features & SPH_FEATURE_SURFACE_TENSION) != 0;
+      case SPH_PARAMS_CLAVET_VISCOSITY:
+        return w.viscosity == SPH_VISCOSITY_CLAVET;
+      case SPH_PARAMS_TAIT:
+        return w.eos == SPH_EOS_TAIT;
+      case SPH_PARAMS_SPRINGS:
+        return (w.features & SPH_FEATURE_SPRINGS) != 0;
+      case SPH_PARAMS_DFSPH:
+        return w.solver == SPH_SOLVER_DFSPH;
+      case SPH_PARAMS_DENSITY_DIFFUSION:
+        return (w.features & SPH_FEATURE_DENSITY_DIFFUSION) != 0;
+      default:
+        return false;
+    }
+  }
+  static uint32_t params_size(uint32_t kind) {
+    static const uint32_t sizes[SPH_PARAMS_KIND_COUNT] = {sizeof(sph_world_params),
+                                                          sizeof(sph_surface_tension_params),
+                                                          sizeof(sph_clavet_viscosity_params),
+                                                          sizeof(sph_tait_params),
+                                                          sizeof(sph_spring_params),
+                                                          sizeof(sph_dfsph_params),
+                                                          sizeof(sph_density_diffusion_params)};
+    return kind < SPH_PARAMS_KIND_COUNT ? sizes[kind] : 0;
+  }
+  static sph_params_kind kind_arg(uint32_t kind) {
+    sph_params_kind k;
+    std::memcpy(&k, &kind, 4);
+    return k;
+  }
+  static std::vector<sph_param_field_info> fields_of(uint32_t kind) {
+    std::vector<sph_param_field_info> fields;
+    sph_params_info info;
+    sph_params_info_init(&info);
+    if (FUZZ_CALL(sph_params_get_info(kind_arg(kind), &info)) != SPH_OK) return fields;
+    for (uint32_t i = 0; i < info.field_count; ++i) {
+      sph_param_field_info f;
+      sph_param_field_info_init(&f);
+      if (FUZZ_CALL(sph_params_get_field_info(kind_arg(kind), i, &f)) != SPH_OK)
+        violation("field %u of %u of params kind %u cannot be described", i, info.field_count, kind);
+      fields.push_back(f);
+    }
+    return fields;
+  }
+  static bool in_bounds(const sph_param_field_info& f, double v) {
+    const uint32_t lb = static_cast<uint32_t>(f.lower_bound), ub = static_cast<uint32_t>(f.upper_bound);
+    if (lb == SPH_BOUND_INCLUSIVE && !(v >= f.lower)) return false;
+    if (lb == SPH_BOUND_EXCLUSIVE && !(v > f.lower)) return false;
+    if (ub == SPH_BOUND_INCLUSIVE && !(v <= f.upper)) return false;
+    if (ub == SPH_BOUND_EXCLUSIVE && !(v < f.upper)) return false;
+    return true;
+  }
+  // Whether the field at bytes + f.offset holds a value its description allows (a 0 that asks
+  // for a default or a derived value is allowed whatever the range).
+  static bool field_valid(const sph_param_field_info& f, const unsigned char* bytes) {
+    const bool zero_is_value = static_cast<uint32_t>(f.zero) == SPH_PARAM_ZERO_IS_VALUE;
+    switch (static_cast<uint32_t>(f.type)) {
+      case SPH_PARAM_FLOAT: {
+        float v;
+        std::memcpy(&v, bytes + f.offset, 4);
+        if (v == 0.0f && !zero_is_value) return true;
+        return std::isfinite(v) && in_bounds(f, v);
+      }
+      case SPH_PARAM_VEC3: {
+        sph_vec3 v;
+        std::memcpy(&v, bytes + f.offset, sizeof v);
+        return finite3(v);
+      }
+      case SPH_PARAM_UINT32: {
+        uint32_t v;
+        std::memcpy(&v, bytes + f.offset, 4);
+        if (v == 0 && !zero_is_value) return true;
+        return in_bounds(f, v);
+      }
+      case SPH_PARAM_FLAGS: {
+        uint32_t v;
+        std::memcpy(&v, bytes + f.offset, 4);
+        return (v & ~static_cast<uint32_t>(f.upper)) == 0;
+      }
+      default:
+        return false;
+    }
+  }
+  static size_t field_bytes(const sph_param_field_info& f) {
+    return static_cast<uint32_t>(f.type) == SPH_PARAM_VEC3 ? sizeof(sph_vec3) : 4;
+  }
+  // A params struct the library accepted or gave out: every described field within its
+  // description (sph_params_get_field_info "names the same rules the set calls apply").
+  static void check_fields(uint32_t kind, const unsigned char* bytes, const char* what) {
+    for (const sph_param_field_info& f : fields_of(kind))
+      if (!field_valid(f, bytes))
+        violation("%s: field %s of params kind %u out of its described range", what, f.name, kind);
+  }
+  // The world's params struct of `kind` as bytes (empty when the world does not have it).
+  std::vector<unsigned char> params_bytes(sph_world* w, uint32_t kind) {
+    const uint32_t size = params_size(kind);
+    std::vector<unsigned char> bytes(std::max<uint32_t>(size, 4), 0);
+    std::memcpy(bytes.data(), &size, 4);
+    if (FUZZ_CALL(sph_world_get_physics_params(w, kind_arg(kind), bytes.data())) != SPH_OK) bytes.clear();
+    return bytes;
+  }
+  // The harness's bounds on a world's work (kMaxSubsteps, kMaxSolverIterations) over a params
+  // struct about to be set: a 0 takes the library's default (10000 substeps, 100 iterations), and
+  // larger counts are legal but too slow here.
+  static void bound_work(uint32_t kind, unsigned char* bytes) {
+    const auto bound = [&](size_t offset, uint32_t most) {
+      uint32_t v;
+      std::memcpy(&v, bytes + offset, 4);
+      if (v == 0 || v > most) std::memcpy(bytes + offset, &most, 4);
+    };
+    if (kind == SPH_PARAMS_WORLD) bound(offsetof(sph_world_params, max_substeps), kMaxSubsteps);
+    if (kind == SPH_PARAMS_DFSPH) {
+      bound(offsetof(sph_dfsph_params, max_iterations), kMaxSolverIterations);
+      bound(offsetof(sph_dfsph_params, max_divergence_iterations), kMaxSolverIterations);
+    }
+  }
+  // After a set call of params `kind` on a live world answered r: a refused one changed nothing,
+  // an accepted one had and has values within their descriptions and a world with the method.
+  void check_params_set(int slot, uint32_t kind, sph_result r, const std::vector<unsigned char>& before,
+                        const unsigned char* sent, uint32_t sent_size) {
+    const std::vector<unsigned char> after = params_bytes(worlds_[slot].ptr, kind);
+    if (r != SPH_OK) {
+      if (after != before) violation("a refused set of params kind %u (%d) changed them", kind, r);
+      return;
+    }
+    if (!kind_enabled(worlds_[slot], kind))
+      violation("params kind %u set on a world without its method", kind);
+    std::vector<unsigned char> seen(params_size(kind), 0);
+    std::memcpy(seen.data(), sent, std::min<size_t>(sent_size, seen.size()));
+    check_fields(kind, seen.data(), "an accepted set");
+    if (after.empty()) violation("params kind %u were set but cannot be read", kind);
+    check_fields(kind, after.data(), "the params read back after a set");
+  }
+
+  // The typed calls of the DFSPH, spring and density-diffusion params (each FEATURE_DISABLED on
+  // a world without the method; nothing changes on error).
+  void op_method_params() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    const bool is_live = live(slot, w);
+    const bool set = in_.chance(160);
+    sph_result r;
+    uint32_t kind;
+    // Each struct in 256 bytes (a fuzzed struct_size stays inside); `sent` is the one passed.
+    Padded<sph_dfsph_params> dfsph;
+    Padded<sph_spring_params> springs;
+    Padded<sph_density_diffusion_params> diffusion;
+    const unsigned char* sent = nullptr;
+    std::vector<unsigned char> before;
+    switch (in_.u8() % 3) {
+      case 0: {
+        kind = SPH_PARAMS_DFSPH;
+        sph_dfsph_params& p = dfsph.value;
+        sent = dfsph.bytes;
+        sph_dfsph_params_init(&p);
+        if (is_live && in_.chance(128)) FUZZ_CALL(sph_world_get_dfsph_params(w, &p));
+        p.density_error = in_.maybe_hostile(0.0f, 0.01f);
+        p.divergence_error = in_.maybe_hostile(0.0f, 2.0f);
+        p.max_iterations = in_.chance(224) ? in_.range(0, kMaxSolverIterations) : in_.u32();
+        p.max_divergence_iterations = in_.chance(224) ? in_.range(0, kMaxSolverIterations) : in_.u32();
+        p.flags = in_.chance(224) ? in_.u8() % 8 : in_.u32();
+        p.linear_solver = in_.chance(224) ? in_.u8() % 4 : in_.u32();
+        p.density_error_max = in_.maybe_hostile(0.0f, 0.1f);
+        p.depth_step_factor = in_.maybe_hostile(0.0f, 1.0f);
+        p.divergence_error_per_step = in_.maybe_hostile(0.0f, 0.01f);
+        bound_work(kind, dfsph.bytes);
+        p.struct_size = struct_size(sizeof p);
+        if (set && is_live) before = params_bytes(w, kind);
+        r = set ? FUZZ_CALL(sph_world_set_dfsph_params(w, in_.chance(8) ? nullptr : &p))
+                : FUZZ_CALL(sph_world_get_dfsph_params(w, in_.chance(8) ? nullptr : &p));
+        break;
+      }
+      case 1: {
+        kind = SPH_PARAMS_SPRINGS;
+        sph_spring_params& p = springs.value;
+        sent = springs.bytes;
+        sph_spring_params_init(&p);
+        const float s = is_live ? worlds_[slot].spacing : 0.02f;
+        p.stiffness = in_.maybe_hostile(0.0f, 1e4f);
+        p.link_radius = in_.chance(128) ? 0.0f : in_.maybe_hostile(0.0f, 2.0f * s);
+        p.yield_ratio = in_.maybe_hostile(0.0f, 1.0f);
+        p.plasticity = in_.maybe_hostile(0.0f, 10.0f);
+        p.damping = in_.maybe_hostile(0.0f, 10.0f);
+        if (in_.chance(8)) p.reserved0 = in_.u32();
+        p.struct_size = struct_size(sizeof p);
+        if (set && is_live) before = params_bytes(w, kind);
+        r = set ? FUZZ_CALL(sph_world_set_spring_params(w, in_.chance(8) ? nullptr : &p))
+                : FUZZ_CALL(sph_world_get_spring_params(w, in_.chance(8) ? nullptr : &p));
+        break;
+      }
+      default: {
+        kind = SPH_PARAMS_DENSITY_DIFFUSION;
+        sph_density_diffusion_params& p = diffusion.value;
+        sent = diffusion.bytes;
+        sph_density_diffusion_params_init(&p);
+        p.delta = in_.maybe_hostile(0.0f, 1.0f);
+        p.struct_size = struct_size(sizeof p);
+        if (set && is_live) before = params_bytes(w, kind);
+        r = set ? FUZZ_CALL(sph_world_set_density_diffusion_params(w, in_.chance(8) ? nullptr : &p))
+                : FUZZ_CALL(sph_world_get_density_diffusion_params(w, in_.chance(8) ? nullptr : &p));
+      }
+    }
+    if (r == SPH_OK && !is_live) violation("method params on a dead world");
+    if (!is_live) return;
+    if (set) {
+      uint32_t sent_size;
+      std::memcpy(&sent_size, sent, 4);
+      check_params_set(slot, kind, r, before, sent, sent_size);
+    } else if (r == SPH_OK && !kind_enabled(worlds_[slot], kind)) {
+      violation("params kind %u read from a world without its method", kind);
+    }
+  }
+
+  // sph_world_set/get_physics_params: any kind (invalid ones too), one field of the struct set
+  // to a hostile or an in-range value at the offset sph_params_get_field_info gives.
+  void op_params_by_kind() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    const bool is_live = live(slot, w);
+    const uint32_t kind = enum_value(SPH_PARAMS_KIND_COUNT);
+    const bool set = in_.chance(160);
+    Padded<sph_world_params> buf;  // 256 bytes, aligned for any params struct
+    unsigned char* bytes = buf.bytes;
+    const uint32_t size = kind < SPH_PARAMS_KIND_COUNT ? params_size(kind) : 8;
+    std::memcpy(bytes, &size, 4);
+    if (is_live && kind < SPH_PARAMS_KIND_COUNT)
+      FUZZ_CALL(sph_world_get_physics_params(w, kind_arg(kind), bytes));
+    const std::vector<sph_param_field_info> fields =
+        kind < SPH_PARAMS_KIND_COUNT ? fields_of(kind) : std::vector<sph_param_field_info>{};
+    if (set && !fields.empty()) {
+      const sph_param_field_info& f = fields[in_.u8() % fields.size()];
+      switch (static_cast<uint32_t>(f.type)) {
+        case SPH_PARAM_FLOAT: {
+          const double lo = static_cast<uint32_t>(f.lower_bound) == SPH_BOUND_NONE ? -100.0 : f.lower;
+          const double hi = static_cast<uint32_t>(f.upper_bound) == SPH_BOUND_NONE ? lo + 100.0 : f.upper;
+          const float v =
+              in_.chance(64) ? in_.hostile() : in_.unit(static_cast<float>(lo), static_cast<float>(hi));
+          std::memcpy(bytes + f.offset, &v, 4);
+          break;
+        }
+        case SPH_PARAM_VEC3: {
+          const sph_vec3 v = vec3(-20.0f, 20.0f);
+          std::memcpy(bytes + f.offset, &v, sizeof v);
+          break;
+        }
+        default: {
+          const uint32_t v = in_.chance(64) ? in_.u32() : in_.u8() % 16;
+          std::memcpy(bytes + f.offset, &v, 4);
+        }
+      }
+      bound_work(kind, bytes);
+    }
+    if (in_.chance(16)) {
+      const uint32_t fuzzed = struct_size(size);
+      std::memcpy(bytes, &fuzzed, 4);
+    }
+    uint32_t sent_size;
+    std::memcpy(&sent_size, bytes, 4);
+    const uint32_t canary = std::min<uint32_t>(std::max<uint32_t>(sent_size, sizeof(uint32_t)), 256);
+    if (!set) std::memset(bytes + canary, 0xAB, 256 - canary);
+    const std::vector<unsigned char> before =
+        set && is_live ? params_bytes(w, kind) : std::vector<unsigned char>{};
+    void* arg = in_.chance(8) ? nullptr : bytes;
+    const sph_result r = set ? FUZZ_CALL(sph_world_set_physics_params(w, kind_arg(kind), arg))
+                             : FUZZ_CALL(sph_world_get_physics_params(w, kind_arg(kind), arg));
+    if (r == SPH_OK && kind >= SPH_PARAMS_KIND_COUNT) violation("physics params of unknown kind %u", kind);
+    if (r == SPH_OK && !is_live) violation("physics params on a dead world");
+    if (!set) {
+      for (uint32_t i = canary; i < 256; ++i)
+        if (bytes[i] != 0xAB)
+          violation("sph_world_get_physics_params wrote past struct_size %u (r=%d)", sent_size, r);
+      if (r == SPH_OK) {
+        if (!kind_enabled(worlds_[slot], kind))
+          violation("params kind %u read from a world without its method", kind);
+        if (sent_size >= size) check_fields(kind, bytes, "sph_world_get_physics_params");
+      }
+      return;
+    }
+    if (is_live && kind < SPH_PARAMS_KIND_COUNT) check_params_set(slot, kind, r, before, bytes, sent_size);
+  }
+
+  // The static descriptions: sph_params_get_info, sph_params_get_field_info and
+  // sph_get_physics_method_info with invalid kinds and indices, NULL and short structs.
+  void op_params_info() {
+    switch (in_.u8() % 3) {
+      case 0: {
+        const uint32_t kind = enum_value(SPH_PARAMS_KIND_COUNT);
+        Padded<sph_params_info> out;
+        sph_params_info_init(&out.value);
+        const uint32_t size = out.value.struct_size = struct_size(sizeof(sph_params_info));
+        const uint32_t canary = std::min<uint32_t>(std::max<uint32_t>(size, sizeof(uint32_t)), 256);
+        std::memset(out.bytes + canary, 0xAB, 256 - canary);
+        const bool null = in_.chance(16);
+        const sph_result r = FUZZ_CALL(sph_params_get_info(kind_arg(kind), null ? nullptr : &out.value));
+        for (uint32_t i = canary; i < 256; ++i)
+          if (out.bytes[i] != 0xAB) violation("sph_params_get_info wrote past struct_size %u", size);
+        if (r == SPH_OK && (kind >= SPH_PARAMS_KIND_COUNT || null))
+          violation("sph_params_get_info(%u) succeeded", kind);
+        if (kind < SPH_PARAMS_KIND_COUNT && !null && size == sizeof(sph_params_info)) {
+          if (r != SPH_OK) violation("params kind %u cannot be described: %s", kind, sph_get_last_error());
+          const sph_params_info& o = out.value;
+          if (o.params_size != params_size(kind) || o.field_count == 0 || o.reserved0 != 0 || !o.name ||
+              !o.name[0] || !o.type_name || !o.type_name[0])
+            violation("params kind %u described as %u bytes, %u fields", kind, o.params_size, o.field_count);
+        }
+        break;
+      }
+      case 1: {
+        const uint32_t kind = enum_value(SPH_PARAMS_KIND_COUNT);
+        const uint32_t index = in_.chance(224) ? in_.u8() % 16 : in_.u32();
+        Padded<sph_param_field_info> out;
+        sph_param_field_info_init(&out.value);
+        const uint32_t size = out.value.struct_size = struct_size(sizeof(sph_param_field_info));
+        const uint32_t canary = std::min<uint32_t>(std::max<uint32_t>(size, sizeof(uint32_t)), 256);
+        std::memset(out.bytes + canary, 0xAB, 256 - canary);
+        const bool null = in_.chance(16);
+        const size_t count = kind < SPH_PARAMS_KIND_COUNT ? fields_of(kind).size() : 0;
+        const sph_result r =
+            FUZZ_CALL(sph_params_get_field_info(kind_arg(kind), index, null ? nullptr : &out.value));
+        for (uint32_t i = canary; i < 256; ++i)
+          if (out.bytes[i] != 0xAB) violation("sph_params_get_field_info wrote past struct_size %u", size);
+        if (kind >= SPH_PARAMS_KIND_COUNT || null) {
+          if (r == SPH_OK) violation("sph_params_get_field_info(%u, %u) succeeded", kind, index);
+          break;
+        }
+        if (r == SPH_OK && index >= count)
+          violation("field %u of a params struct of %zu fields", index, count);
+        if (index < count && size == sizeof(sph_param_field_info)) {
+          if (r != SPH_OK) violation("field %u of params kind %u: %s", index, kind, sph_get_last_error());
+          const sph_param_field_info& f = out.value;
+          const uint32_t lb = static_cast<uint32_t>(f.lower_bound), ub = static_cast<uint32_t>(f.upper_bound);
+          if (static_cast<uint32_t>(f.type) > SPH_PARAM_FLAGS ||
+              static_cast<uint32_t>(f.zero) > SPH_PARAM_ZERO_IS_DERIVED || lb > SPH_BOUND_EXCLUSIVE ||
+              ub > SPH_BOUND_EXCLUSIVE || f.reserved0 != 0 || !f.name || !f.name[0] || !f.unit)
+            violation("field %u of params kind %u has an invalid description", index, kind);
+          if (f.offset < sizeof(uint32_t) || f.offset + field_bytes(f) > params_size(kind))
+            violation("field %s of params kind %u at offset %u", f.name, kind, f.offset);
+          if (lb != SPH_BOUND_NONE && ub != SPH_BOUND_NONE && !(f.lower <= f.upper))
+            violation("field %s of params kind %u has the range [%g, %g]", f.name, kind, f.lower, f.upper);
+          // The default a 0 takes must itself be a valid value.
+          if (static_cast<uint32_t>(f.zero) == SPH_PARAM_ZERO_IS_DEFAULT &&
+              static_cast<uint32_t>(f.type) == SPH_PARAM_FLOAT &&
+              !(std::isfinite(f.default_value[0]) && in_bounds(f, f.default_value[0])))
+            violation("field %s of params kind %u has the default %g outside its range", f.name, kind,
+                      static_cast<double>(f.default_value[0]));
+        }
+        break;
+      }
+      default: {
+        const uint32_t index = in_.chance(224) ? in_.u8() % 24 : in_.u32();
+        Padded<sph_physics_method_info> out;
+        sph_physics_method_info_init(&out.value);
+        const uint32_t size = out.value.struct_size = struct_size(sizeof(sph_physics_method_info));
+        const uint32_t canary = std::min<uint32_t>(std::max<uint32_t>(size, sizeof(uint32_t)), 256);
+        std::memset(out.bytes + canary, 0xAB, 256 - canary);
+        const bool null = in_.chance(16);
+        const sph_result r = FUZZ_CALL(sph_get_physics_method_info(index, null ? nullptr : &out.value));
+        for (uint32_t i = canary; i < 256; ++i)
+          if (out.bytes[i] != 0xAB) violation("sph_get_physics_method_info wrote past struct_size %u", size);
+        if (null) {
+          if (r == SPH_OK) violation("sph_get_physics_method_info accepted NULL");
+          break;
+        }
+        if (index == 0 && size == sizeof(sph_physics_method_info) && r != SPH_OK)
+          violation("method 0 cannot be described: %s", sph_get_last_error());
+        if (r != SPH_OK || size != sizeof(sph_physics_method_info)) break;
+        const sph_physics_method_info& m = out.value;
+        const uint32_t by = static_cast<uint32_t>(m.switch_by);
+        if (index >= m.method_count) violation("method %u of %u described", index, m.method_count);
+        if (by < SPH_METHOD_SWITCH_FEATURE || by > SPH_METHOD_SWITCH_SOLVER || m.has_params > 1 ||
+            static_cast<uint32_t>(m.params_kind) >= SPH_PARAMS_KIND_COUNT || !m.name || !m.name[0])
+          violation("method %u has an invalid description", index);
+        const bool one_bit =
+            m.value != 0 && (m.value & (m.value - 1)) == 0 && (m.value & ~kKnownFeatures) == 0;
+        if ((by == SPH_METHOD_SWITCH_FEATURE && !one_bit) || (by != SPH_METHOD_SWITCH_FEATURE && m.value > 1))
+          violation("method %s is selected by %u = %u", m.name, by, m.value);
+      }
+    }
+  }
+
+  // ---- writing and removing particles ------------------------------------------------------------
+  // sph_world_set_attribute: any attribute, range, stride and buffer size (the buffer is exactly
+  // src_size bytes, so ASan sees a read past it), hostile values. All-or-nothing: a refused call
+  // changes nothing; an accepted one wrote exactly the range, which reads back as sent.
+  void op_set_attribute() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    const bool is_live = live(slot, w);
+    const uint32_t attribute = enum_value(6);
+    const Particles before = is_live ? snapshot(w) : Particles{};
+    const uint32_t n = static_cast<uint32_t>(before.id.size());
+    const uint32_t first = in_.chance(200) ? in_.range(0, n) : in_.u32();
+    const uint32_t count = in_.chance(200) ? in_.range(0, n - std::min(first, n)) : in_.u32();
+    const bool vector = attribute == SPH_ATTRIBUTE_POSITION || attribute == SPH_ATTRIBUTE_VELOCITY;
+    const uint64_t element = vector ? 12 : 4;
+    const uint64_t stride = in_.chance(160) ? 0 : (in_.chance(224) ? in_.u8() % 40 : in_.u64());
+    const uint64_t step = stride == 0 ? element : stride;
+    const double needed =
+        count == 0 ? 0.0 : static_cast<double>(count - 1) * static_cast<double>(step) + element;
+    const uint64_t src_size =
+        in_.chance(200) && needed <= 65536.0 ? static_cast<uint64_t>(needed) : in_.u32() % 8192;
+    // A loose cloud near the origin (a few input bytes for any size), now and then a hostile value.
+    std::vector<float> src(static_cast<size_t>(src_size / 4) + 1);  // src_size bytes used, rounded up
+    const float s = is_live ? worlds_[slot].spacing : 0.02f;
+    const float origin = in_.unit(-8.0f * s, 8.0f * s);
+    for (size_t i = 0; i < src.size(); ++i) src[i] = origin + s * static_cast<float>(i % 11);
+    if (in_.chance(32)) src[in_.u16() % src.size()] = in_.hostile();
+    if (in_.chance(16)) {
+      // Legal extremes: a position at the particles' reach (65536 spacings from the origin) or
+      // just past it, a speed near the velocity limit (1.8e19 m/s).
+      const float extremes[] = {65535.0f * s, -65535.0f * s, 65537.0f * s, 1.0e19f, -1.7e19f};
+      src[in_.u16() % src.size()] = extremes[in_.u8() % 5];
+    }
+    std::vector<unsigned char> exact(static_cast<size_t>(src_size));
+    if (src_size) std::memcpy(exact.data(), src.data(), static_cast<size_t>(src_size));
+    const std::vector<uint8_t> saved = is_live ? checkpoint(w) : std::vector<uint8_t>{};
+    sph_attribute a;
+    std::memcpy(&a, &attribute, 4);
+    const void* arg =
+        in_.chance(8) ? nullptr : (exact.empty() ? static_cast<const void*>(&stride) : exact.data());
+    const sph_result r = FUZZ_CALL(sph_world_set_attribute(w, a, arg, src_size, stride, first, count));
+    if (r != SPH_OK) {
+      if (is_live && checkpoint(w) != saved)
+        violation("a refused sph_world_set_attribute changed the world (%d)", r);
+      return;
+    }
+    if (!is_live) violation("sph_world_set_attribute succeeded on a dead world");
+    if (!vector && attribute != SPH_ATTRIBUTE_USER) violation("attribute %u was written", attribute);
+    if (attribute == SPH_ATTRIBUTE_USER && !(worlds_[slot].features & SPH_FEATURE_USER_ATTRIBUTE))
+      violation("the user attribute was written on a world without it");
+    if (static_cast<uint64_t>(first) + count > n)
+      violation("particles %u + %u of %u were written", first, count, n);
+    if (count > 0 && (!arg || step < element || needed > static_cast<double>(src_size)))
+      violation("sph_world_set_attribute accepted a buffer that cannot hold %u elements", count);
+    const Particles after = snapshot(w);
+    if (after.id != before.id) violation("sph_world_set_attribute changed the particles' ids or order");
+    const unsigned char* base = static_cast<const unsigned char*>(arg);
+    for (uint32_t i = 0; i < n; ++i) {
+      const bool written = i >= first && i - first < count;
+      for (int k = 0; k < 3; ++k) {
+        const size_t at = 3 * static_cast<size_t>(i) + k;
+        float sent = 0.0f;
+        if (written && vector) std::memcpy(&sent, base + step * (i - first) + 4 * k, 4);
+        const bool position_written = written && attribute == SPH_ATTRIBUTE_POSITION;
+        const bool velocity_written = written && attribute == SPH_ATTRIBUTE_VELOCITY;
+        if (after.position[at] != (position_written ? sent : before.position[at]) ||
+            after.velocity[at] != (velocity_written ? sent : before.velocity[at]))
+          violation("particle %u after sph_world_set_attribute of [%u, +%u) is not as written", i, first,
+                    count);
+        if (written && vector && !std::isfinite(sent)) violation("a non-finite value was written");
+        if (position_written && !(std::fabs(sent) <= 65536.0f * worlds_[slot].spacing))
+          violation("a position %g beyond 65536 spacings (%g m) was written", static_cast<double>(sent),
+                    static_cast<double>(worlds_[slot].spacing));
+      }
+      if (written && attribute == SPH_ATTRIBUTE_VELOCITY) {
+        const double x = after.velocity[3 * i], y = after.velocity[3 * i + 1], z = after.velocity[3 * i + 2];
+        if (!(std::sqrt(x * x + y * y + z * z) < 1.8e19))
+          violation("a speed of 1.8e19 m/s or more was written");
+      }
+    }
+    if (attribute == SPH_ATTRIBUTE_USER && count > 0) {
+      std::vector<uint32_t> user(count);
+      uint32_t got = 0;
+      FUZZ_CALL(
+          sph_world_copy_attribute(w, SPH_ATTRIBUTE_USER, user.data(), 4ull * count, 0, first, count, &got));
+      for (uint32_t i = 0; i < count; ++i) {
+        uint32_t sent;
+        std::memcpy(&sent, base + step * i, 4);
+        if (got != count || user[i] != sent)
+          violation("user attribute %u reads %u, written %u", first + i, user[i], sent);
+      }
+    }
+  }
+
+  // The ids sph_world_get_removed_ids reports.
+  std::vector<uint32_t> removed_ids(sph_world* w) {
+    uint32_t n = 0;
+    const sph_result r = FUZZ_CALL(sph_world_get_removed_ids(w, nullptr, 0, &n));
+    if (r != SPH_OK && r != SPH_INCOMPLETE)
+      violation("the removed ids of a live world cannot be read (%d)", r);
+    std::vector<uint32_t> ids(n + 1);
+    uint32_t m = 0;
+    if (FUZZ_CALL(sph_world_get_removed_ids(w, ids.data(), n, &m)) != SPH_OK || m != n)
+      violation("the removed ids changed between two reads");
+    ids.resize(n);
+    return ids;
+  }
+
+  // sph_world_remove_particles: ids of the world, repeated, unknown or random; NULL; huge counts
+  // with NULL. All-or-nothing; an accepted call removed exactly those particles, kept the others
+  // in their order and appended the ids to the removed ids.
+  void op_remove_particles() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    const bool is_live = live(slot, w);
+    const Particles before = is_live ? snapshot(w) : Particles{};
+    const size_t n = before.id.size();
+    const uint32_t count = in_.chance(224) ? in_.u8() % 9 : in_.u32();
+    const uint32_t held = std::min<uint32_t>(count, 64);
+    std::vector<uint32_t> ids(std::max<uint32_t>(held, 1));  // exactly what count says (ASan)
+    for (uint32_t i = 0; i < held; ++i) {
+      if (n > 0 && in_.chance(216))
+        ids[i] = before.id[in_.u16() % n];
+      else
+        ids[i] = i > 0 && in_.chance(128) ? ids[in_.u8() % i] : in_.u32();
+    }
+    const bool null = in_.chance(16);
+    if (count > held && !null) return;  // the array must hold what count says
+    const std::vector<uint8_t> saved = is_live ? checkpoint(w) : std::vector<uint8_t>{};
+    const std::vector<uint32_t> removed_before = is_live ? removed_ids(w) : std::vector<uint32_t>{};
+    const sph_result r = FUZZ_CALL(sph_world_remove_particles(w, null ? nullptr : ids.data(), count));
+    if (r != SPH_OK) {
+      if (is_live && checkpoint(w) != saved)
+        violation("a refused sph_world_remove_particles changed the world (%d)", r);
+      return;
+    }
+    if (!is_live) violation("sph_world_remove_particles succeeded on a dead world");
+    if (count == 0) {
+      if (checkpoint(w) != saved) violation("removing no particle changed the world");
+      return;
+    }
+    if (null) violation("sph_world_remove_particles accepted NULL ids for %u", count);
+    std::vector<uint32_t> gone(ids.begin(), ids.begin() + count);
+    std::sort(gone.begin(), gone.end());
+    if (std::adjacent_find(gone.begin(), gone.end()) != gone.end())
+      violation("an id removed twice was accepted");
+    Particles expected;
+    for (size_t i = 0; i < n; ++i) {
+      if (std::binary_search(gone.begin(), gone.end(), before.id[i])) continue;
+      expected.id.push_back(before.id[i]);
+      for (int k = 0; k < 3; ++k) {
+        expected.position.push_back(before.position[3 * i + k]);
+        expected.velocity.push_back(before.velocity[3 * i + k]);
+      }
+    }
+    if (expected.id.size() + count != n) violation("an id of no particle of the world was accepted");
+    if (!(snapshot(w) == expected))
+      violation("the particles left after a removal are not the others in order");
+    std::vector<uint32_t> removed = removed_before;
+    removed.insert(removed.end(), ids.begin(), ids.begin() + count);
+    if (removed_ids(w) != removed) violation("the removed ids do not end with the ids removed");
+    // sph_world_get_stats: particle_count is "always current".
+    sph_stats stats;
+    sph_stats_init(&stats);
+    FUZZ_CALL(sph_world_get_stats(w, &stats));
+    if (stats.particle_count != n - count)
+      violation("stats count %u after removing %u of %zu", stats.particle_count, count, n);
+  }
+
+  // ---- asynchronous steps ------------------------------------------------------------------------
+  // A call on the world with valid arguments, made while its asynchronous step holds it: each
+  // must answer WORLD_LOCKED (sph_world_step_begin: every call but cancel and poll).
+  sph_result locked_call(sph_world* w, const std::vector<uint8_t>& saved) {
+    switch (in_.u8() % 14) {
+      case 0:
+        return FUZZ_CALL(sph_world_step(w, 0.001f));
+      case 1:
+        return FUZZ_CALL(sph_world_step_begin(w, 0.001f));
+      case 2: {
+        uint32_t n;
+        return FUZZ_CALL(sph_world_get_particle_count(w, &n));
+      }
+      case 3: {
+        sph_world_params p;
+        sph_world_params_init(&p);
+        p.max_substeps = 1;
+        return FUZZ_CALL(sph_world_set_params(w, &p));
+      }
+      case 4: {
+        uint64_t size;
+        return FUZZ_CALL(sph_world_save(w, nullptr, 0, &size));
+      }
+      case 5:
+        return FUZZ_CALL(sph_world_destroy(w));
+      case 6: {
+        const float v[3] = {0.0f, 0.0f, 0.0f};
+        return FUZZ_CALL(sph_world_set_attribute(w, SPH_ATTRIBUTE_VELOCITY, v, sizeof v, 0, 0, 0));
+      }
+      case 7:
+        return FUZZ_CALL(sph_world_remove_particles(w, nullptr, 0));
+      case 8: {
+        sph_probe_def d;
+        sph_probe_def_init(&d);
+        sph_probe_id id;
+        return FUZZ_CALL(sph_probe_create(w, &d, &id));
+      }
+      case 9: {
+        sph_stats s;
+        sph_stats_init(&s);
+        return FUZZ_CALL(sph_world_get_stats(w, &s));
+      }
+      case 10:
+        return FUZZ_CALL(sph_world_restore(w, saved.data(), saved.size()));
+      case 11: {
+        sph_dfsph_params p;
+        sph_dfsph_params_init(&p);
+        return FUZZ_CALL(sph_world_get_dfsph_params(w, &p));
+      }
+      case 12: {
+        sph_collider_loads l;
+        sph_collider_loads_init(&l);
+        return FUZZ_CALL(sph_collider_get_loads(w, sph_collider_id{id_arg(colliders_)}, &l));
+      }
+      default: {
+        float xyz[3];
+        uint32_t written;
+        return FUZZ_CALL(
+            sph_world_copy_attribute(w, SPH_ATTRIBUTE_POSITION, xyz, sizeof xyz, 0, 0, 1, &written));
+      }
+    }
+  }
+
+  // sph_world_step_begin / poll / wait: refusals without a step, calls while the step holds the
+  // world, a cancel mid-step, and the wait's result against the step's contract (and, now and
+  // then, against sph_world_step of the world's checkpoint loaded into a new world).
+  void op_async_step() {
+    int slot;
+    sph_world* w = world_arg(&slot);
+    const float dt = in_.chance(24) ? in_.hostile() : in_.unit(0.0f, 0.01f);
+    sph_bool32 done = 7;
+    if (!live(slot, w)) {
+      if (FUZZ_CALL(sph_world_step_begin(w, dt)) == SPH_OK) violation("sph_world_step_begin on a dead world");
+      if (FUZZ_CALL(sph_world_step_poll(w, &done)) == SPH_OK)
+        violation("sph_world_step_poll on a dead world");
+      if (FUZZ_CALL(sph_world_step_wait(w)) == SPH_OK) violation("sph_world_step_wait on a dead world");
+      return;
+    }
+    WorldSlot& ws = worlds_[slot];
+    if (in_.chance(64)) {
+      if (FUZZ_CALL(sph_world_step_poll(w, &done)) != SPH_ERROR_INVALID_ARGUMENT)
+        violation("sph_world_step_poll without a step did not answer INVALID_ARGUMENT");
+      if (FUZZ_CALL(sph_world_step_wait(w)) != SPH_ERROR_INVALID_ARGUMENT)
+        violation("sph_world_step_wait without a step did not answer INVALID_ARGUMENT");
+    }
+    const Particles before = snapshot(w);
+    const std::vector<uint8_t> saved = checkpoint(w);
+    double budget = 0.0;
+    FUZZ_CALL(sph_world_get_step_budget(w, &budget));
+    const bool cancel_before = ws.cancel_maybe_pending;
+    const sph_result b = FUZZ_CALL(sph_world_step_begin(w, dt));
+    if (b != SPH_OK) {
+      if (std::isfinite(dt) && dt > 0.0f)
+        violation("sph_world_step_begin refused frame_dt %g (%d)", static_cast<double>(dt), b);
+      // Nothing runs when begin fails: the world is free, and unchanged.
+      if (FUZZ_CALL(sph_world_step_wait(w)) != SPH_ERROR_INVALID_ARGUMENT)
+        violation("sph_world_step_wait after a refused begin did not answer INVALID_ARGUMENT");
+      if (checkpoint(w) != saved) violation("a refused sph_world_step_begin changed the world");
+      return;
+    }
+    if (!(std::isfinite(dt) && dt > 0.0f))
+      violation("sph_world_step_begin accepted frame_dt %g", static_cast<double>(dt));
+    bool cancelled = false;
+    const int calls = in_.u8() % 5;
+    for (int i = 0; i < calls; ++i) {
+      switch (in_.u8() % 5) {
+        case 0:
+          if (FUZZ_CALL(sph_world_cancel_step(w)) != SPH_OK)
+            violation("sph_world_cancel_step refused mid-step");
+          cancelled = true;
+          break;
+        case 1:
+          done = 7;
+          if (FUZZ_CALL(sph_world_step_poll(w, &done)) != SPH_OK || done > 1)
+            violation("sph_world_step_poll mid-step failed or said %u", done);
+          break;
+        case 2:
+          if (FUZZ_CALL(sph_world_step_poll(w, nullptr)) != SPH_ERROR_INVALID_ARGUMENT)
+            violation("sph_world_step_poll(NULL) mid-step did not answer INVALID_ARGUMENT");
+          break;
+        case 3:
+          if (FUZZ_CALL(sph_context_destroy(contexts_[ws.context].ptr)) == SPH_OK)
+            violation("sph_context_destroy destroyed the context of a stepping world");
+          break;
+        default: {
+          const sph_result r = locked_call(w, saved);
+          if (r != SPH_ERROR_WORLD_LOCKED) violation("a call mid-step answered %d, not WORLD_LOCKED", r);
+        }
+      }
+    }
+    const sph_result r = FUZZ_CALL(sph_world_step_wait(w));
+    if (FUZZ_CALL(sph_world_step_wait(w)) != SPH_ERROR_INVALID_ARGUMENT)
+      violation("a second sph_world_step_wait did not answer INVALID_ARGUMENT");
+    if (FUZZ_CALL(sph_world_step_poll(w, &done)) != SPH_ERROR_INVALID_ARGUMENT)
+      violation("sph_world_step_poll after the wait did not answer INVALID_ARGUMENT");
+    check_step(slot, r, before, saved);
+    // A cancel may have come after the step's last substep; it then waits for the next step.
+    if (cancelled) ws.cancel_maybe_pending = true;
+    if (cancelled || cancel_before || budget != 0.0 || !in_.chance(128)) return;
+    // The frame sph_world_step would run: the same answer and particles as a synchronous step of
+    // a copy (a world and its loaded copy step alike: round_trip).
+    sph_world* copy = nullptr;
+    if (FUZZ_CALL(sph_world_load(contexts_[ws.context].ptr, saved.data(), saved.size(), &copy)) != SPH_OK)
+      violation("a world's own checkpoint does not load: %s", sph_get_last_error());
+    const sph_result s = FUZZ_CALL(sph_world_step(copy, dt));
+    if (s != r) violation("an asynchronous step answered %d, the synchronous step of its copy %d", r, s);
+    if (!(snapshot(copy) == snapshot(w))) violation("an asynchronous step and a synchronous one differ");
+    if (FUZZ_CALL(sph_world_destroy(copy)) != SPH_OK) violation("destroying a loaded world failed");
+  }
+
+  // ---- checkpoint files ----------------------------------------------------------------------------
+  // This process's own paths under /tmp (libFuzzer may run several processes at once).
+  static const std::string& temp_path(int which) {
+    static const std::string base = "/tmp/sph-fuzz-capi-" + std::to_string(static_cast<long>(getpid()));
+    static const std::string paths[3] = {base + ".sphc", base + ".dir", base + ".missing/world.sphc"};
+    return paths[which];
+  }
+
+  // Whether /tmp holds a temporary file of a save to this process's paths (file or directory).
+  static bool leftover_temporary() {
+    const std::string name = temp_path(0).substr(5), dir_name = temp_path(1).substr(5);
+    bool found = false;
+    if (DIR* d = opendir("/tmp")) {
+      while (const dirent* e = readdir(d)) {
+        const std::string entry = e->d_name;
+        found |= entry.rfind(name + ".tmp-", 0) == 0 || entry.rfind(dir_name + ".tmp-", 0) == 0;
+      }
+      closedir(d);
+    }
+    return found;
+  }
+
+  // sph_world_save_file and sph_world_load_file: a saved file loads into a world that saves the
+  // same bytes; NULL, empty, missing, directory and device paths are refused and create nothing.
+  void op_checkpoint_file() {
+    const std::string& file = temp_path(0);
+    const std::string& dir = temp_path(1);
+    if (in_.chance(128)) {
+      int slot;
+      sph_world* w = world_arg(&slot);
+      const char* paths[] = {file.c_str(), nullptr, "", temp_path(2).c_str(), dir.c_str()};
+      const int which = in_.chance(192) ? 0 : in_.u8() % 5;
+      if (which == 4) mkdir(dir.c_str(), 0700);  // replacing a directory fails: the save must too
+      const sph_result r = FUZZ_CALL(sph_world_save_file(w, paths[which]));
+      if (which == 4) {
+        struct stat st;
+        if (stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) violation("a save replaced a directory");
+        rmdir(dir.c_str());
+      }
+      // Whatever happened, no temporary file of this save is left ("path.tmp-" + a suffix).
+      if (leftover_temporary())
+        violation("sph_world_save_file (path %d, %d) left a temporary file", which, r);
+      if (r != SPH_OK) {
+        if (which == 0 && live(slot, w))
+          violation("saving a live world to %s failed: %s", paths[0], sph_get_last_error());
+        return;
+      }
+      if (!live(slot, w) || which != 0) violation("sph_world_save_file succeeded (path %d)", which);
+      const std::vector<uint8_t> bytes = checkpoint(w);
+      int cslot = -1;
+      sph_context* c = in_.chance(192) ? contexts_[worlds_[slot].context].ptr : context_arg(&cslot);
+      if (c != contexts_[worlds_[slot].context].ptr && (cslot < 0 || !c)) {
+        sph_world* out = nullptr;
+        if (FUZZ_CALL(sph_world_load_file(c, file.c_str(), &out)) == SPH_OK || out)
+          violation("sph_world_load_file succeeded on a dead context");
+      } else {
+        sph_world* loaded = nullptr;
+        if (FUZZ_CALL(sph_world_load_file(c, file.c_str(), &loaded)) != SPH_OK)
+          violation("a saved checkpoint file does not load: %s", sph_get_last_error());
+        if (checkpoint(loaded) != bytes) violation("a world loaded from its file saves other bytes");
+        if (FUZZ_CALL(sph_world_destroy(loaded)) != SPH_OK) violation("destroying a loaded world failed");
+      }
+      unlink(file.c_str());
+      return;
+    }
+    int cslot;
+    sph_context* c = context_arg(&cslot);
+    const char* paths[] = {file.c_str(), nullptr, "", "/dev/zero", "/tmp", "/dev/null", temp_path(2).c_str()};
+    const int which = in_.u8() % 7;
+    unlink(file.c_str());  // (none there: a missing file)
+    sph_world* const sentinel = reinterpret_cast<sph_world*>(&stale_);
+    sph_world* out = sentinel;
+    const sph_result r = FUZZ_CALL(sph_world_load_file(c, paths[which], in_.chance(16) ? nullptr : &out));
+    if (r == SPH_OK) violation("sph_world_load_file loaded path %d", which);
+    if (out != sentinel) violation("sph_world_load_file wrote *out on failure");
   }
 
   // Destroys everything; afterwards no handle of this input may be left alive.
