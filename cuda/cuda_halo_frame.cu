@@ -286,8 +286,10 @@ uint32_t CudaBackend::run_frame_distributed(PipelineSetup setup, uint32_t sink_c
   enqueue_frame_end(setup, b, s, counts_after_sinks);
   halo_drop_ghosts();
   cuda_check(cudaStreamSynchronize(s), "frame end");
-  halo_agree();  // (the frame's end: nothing after this can fail on one rank alone)
+  // The loads' sum over the ranks before the frame's last agreement, as on the CPU rank: a rank
+  // whose part of it fails (an allocation) rolls back with the others.
   if (setup.loads.on()) halo_sum_loads(setup.loads.output, setup.loads.colliders);
+  halo_agree();  // (the frame's end: nothing after this can fail on one rank alone)
   return halo_owned_;
 }
 

@@ -109,8 +109,13 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
       if (!scene.sinks.empty()) apply_sinks(scene, report);
       advance_clock(clock);
     }
-    // The frame's end: a rank that failed after the last substep's agreement (its sinks) fails
-    // every rank; nothing after this can fail.
+    // Every rank reads the world's loads: summed over the ranks inside the frame, so that a rank
+    // whose part of the sum fails (an allocation) rolls back with the others, which meet it at the
+    // exchange's own agreement or at the one below (it was after them, outside the rollback: the
+    // ranks' worlds parted, or waited for each other forever; mpi_rank_failure's loads case).
+    if (rank_ && !load_sums_.empty()) rank_->sum_loads(load_sums_.data(), load_sums_.size());
+    // The frame's end: a rank that failed after the last substep's agreement (its sinks, the loads'
+    // sum) fails every rank; nothing after this can fail.
     if (rank_) rank_->agree();
   } catch (const Error& e) {
     if (e.status() != Status::NonFinite) roll_back();  // NonFinite has rolled back already
@@ -120,8 +125,6 @@ FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& p
     throw;
   }
   report_clock(clock, report);
-  // Every rank reads the world's loads.
-  if (rank_ && !load_sums_.empty()) rank_->sum_loads(load_sums_.data(), load_sums_.size());
   report.pressure_solve = finish_solve(tallies.pressure);
   report.divergence_solve = finish_solve(tallies.divergence);
   report.max_speed = max_speed_;

@@ -59,7 +59,8 @@ void check_rank_named(int culprit, const char* what) {
 }
 
 // An allocation failure at each allocation of the last rank's step in turn (with springs: their
-// linking, spring ghosts and the lists' ids through the rollback too; with `cg`, a DFSPH world whose
+// linking, spring ghosts and the lists' ids through the rollback too; with collider loads: the sum
+// of the tank's loads over the ranks at the frame's end; with `cg`, a DFSPH world whose
 // density solve runs by conjugate gradients: its exchanges of the search directions and velocity
 // steps and its sums' reductions inside each iteration).
 void allocation_failures(sph_context* context, uint32_t features, bool cg, const char* name) {
@@ -310,6 +311,8 @@ int main(int argc, char** argv) {
   mpi_test_init(&argc, &argv, &context);
   allocation_failures(context, SPH_FEATURE_NONE, false, "the stirred column");
   allocation_failures(context, SPH_FEATURE_SPRINGS, false, "the stirred column with springs");
+  // (The tank's loads are summed over the ranks at the frame's end: that sum's allocations too.)
+  allocation_failures(context, SPH_FEATURE_COLLIDER_LOADS, false, "the stirred column with collider loads");
   allocation_failures(context, SPH_FEATURE_NONE, true, "the stirred column, DFSPH with conjugate gradients");
   crowded_cell(context);
   creation_refused_on_one_rank(context);
