@@ -6,8 +6,10 @@
 //     only): every rank returns SPH_ERROR_OUT_OF_HOST_MEMORY (the others' messages name the
 //     failing rank) instead of waiting in MPI for it, every rank's world is as before the step
 //     (gathered bit for bit), and the world then steps on exactly as an undisturbed copy; again
-//     with DFSPH's density solve by conjugate gradients (the allocations of its exchanges inside
-//     each iteration, followed by the reductions of its sums);
+//     with springs, with the tank's collider loads (their sum over the ranks), with a probe and a
+//     gauge (their readings then equal the undisturbed world's), and with DFSPH's density solve
+//     by conjugate gradients (the allocations of its exchanges inside each iteration, followed by
+//     the reductions of its sums);
 //   - a crowded cell (700 particles in one cell, more than the 528 one may hold) on whichever
 //     rank owns it, and the ranks holding it as ghosts: every rank returns SPH_ERROR_CAPACITY and
 //     the world is unchanged;
@@ -60,10 +62,12 @@ void check_rank_named(int culprit, const char* what) {
 
 // An allocation failure at each allocation of the last rank's step in turn (with springs: their
 // linking, spring ghosts and the lists' ids through the rollback too; with collider loads: the sum
-// of the tank's loads over the ranks at the frame's end; with `cg`, a DFSPH world whose
+// of the tank's loads over the ranks at the frame's end; with `probes`, a point and a gauge sampled
+// every substep, whose readings must then equal the undisturbed world's; with `cg`, a DFSPH world whose
 // density solve runs by conjugate gradients: its exchanges of the search directions and velocity
 // steps and its sums' reductions inside each iteration).
-void allocation_failures(sph_context* context, uint32_t features, bool cg, const char* name) {
+void allocation_failures(sph_context* context, uint32_t features, bool cg, const char* name,
+                         bool probes = false) {
   sph_world_def def;
   sph_world* world = NULL;
   sph_world* undisturbed = NULL;
@@ -79,6 +83,25 @@ void allocation_failures(sph_context* context, uint32_t features, bool cg, const
   mpi_test_dam(context, &def, 2.0f, NULL, NULL, &undisturbed, &n);
   set_substeps(world);
   set_substeps(undisturbed);
+  // With `probes`: a point in the column and a gauge across it, sampled every substep (their
+  // sample points are gathered by the ranks whose slabs hold them and exchanged each substep).
+  sph_probe_id probe_ids[2][2] = {};
+  if (probes) {
+    sph_world* worlds[2] = {world, undisturbed};
+    for (int w = 0; w < 2; ++w) {
+      sph_probe_def probe;
+      REQUIRE(sph_probe_def_init(&probe) == SPH_OK, "probe def");
+      probe.sampling = SPH_PROBE_EVERY_SUBSTEP;
+      probe.position = sph_vec3{0.05f, 0.05f, 0.03f};
+      REQUIRE(sph_probe_create(worlds[w], &probe, &probe_ids[w][0]) == SPH_OK, "probe: %s",
+              sph_get_last_error());
+      probe.kind = SPH_PROBE_GAUGE;
+      probe.position = sph_vec3{0.05f, 0.0f, 0.03f};
+      probe.length = 0.2f;
+      REQUIRE(sph_probe_create(worlds[w], &probe, &probe_ids[w][1]) == SPH_OK, "gauge: %s",
+              sph_get_last_error());
+    }
+  }
   if (cg) {
     sph_dfsph_params dfsph;
     REQUIRE(sph_dfsph_params_init(&dfsph) == SPH_OK, "dfsph params init");
@@ -114,6 +137,17 @@ void allocation_failures(sph_context* context, uint32_t features, bool cg, const
     free(v1);
   }
   REQUIRE(step(undisturbed) == SPH_INCOMPLETE, "undisturbed step");
+  for (int p = 0; probes && p < 2; ++p) {
+    sph_probe_reading got, want;
+    REQUIRE(sph_probe_reading_init(&got) == SPH_OK && sph_probe_reading_init(&want) == SPH_OK,
+            "reading init");
+    REQUIRE(sph_probe_get_reading(world, probe_ids[0][p], &got) == SPH_OK &&
+                sph_probe_get_reading(undisturbed, probe_ids[1][p], &want) == SPH_OK,
+            "readings: %s", sph_get_last_error());
+    CHECK(got.samples > 0 && memcmp(&got, &want, sizeof got) == 0,
+          "%s: after the failures, probe %d reads other bits than the undisturbed world's (%u samples)", name,
+          p, got.samples);
+  }
   {
     float *x0 = NULL, *v0 = NULL, *x1 = NULL, *v1 = NULL;
     mpi_test_gather(world, n, &x0, &v0);
@@ -313,6 +347,7 @@ int main(int argc, char** argv) {
   allocation_failures(context, SPH_FEATURE_SPRINGS, false, "the stirred column with springs");
   // (The tank's loads are summed over the ranks at the frame's end: that sum's allocations too.)
   allocation_failures(context, SPH_FEATURE_COLLIDER_LOADS, false, "the stirred column with collider loads");
+  allocation_failures(context, SPH_FEATURE_NONE, false, "the stirred column with a probe and a gauge", true);
   allocation_failures(context, SPH_FEATURE_NONE, true, "the stirred column, DFSPH with conjugate gradients");
   crowded_cell(context);
   creation_refused_on_one_rank(context);
