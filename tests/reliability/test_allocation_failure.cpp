@@ -27,6 +27,7 @@
 
 extern "C" {
 #include "capi_test.h"
+#include "task_pool.h"
 }
 #include "allocation_injector.h"
 
@@ -62,10 +63,19 @@ sph_transform at(float x, float y, float z) {
 
 // A tank with a sloshing block of water, a continuous source, a sink and a force field, on a world
 // of `features` and `solver`, no frame behind it yet (build_scene adds one).
+// Set while a scene is built on the engine's task system (build_scene_on_tasks).
+bool g_on_task_pool = false;
+
 void build_world(Scene* s, sph_feature_flags features, sph_solver solver) {
   sph_context_def cdef;
   EXPECT_OK(sph_test_context_def_init(&cdef));
   cdef.cpu_worker_count = 1;
+  if (g_on_task_pool) {
+    // The engine's task system is the CPU backend's (sph_context_def.enqueue_task): a CPU context
+    // whatever SPH_TEST_BACKEND says, its loops and an asynchronous step as tasks of the test's pool.
+    cdef.backend = SPH_BACKEND_CPU;
+    task_pool_use(&cdef);
+  }
   EXPECT_OK(sph_context_create(&cdef, &s->context));
   sph_world_def def;
   sph_world_def_init(&def);
@@ -136,6 +146,15 @@ void build_world(Scene* s, sph_feature_flags features, sph_solver solver) {
 void build_scene(Scene* s) {
   build_world(s, SPH_FEATURE_NONE, SPH_SOLVER_WCSPH);
   EXPECT_OK(sph_world_step(s->world, kFrameDt));
+}
+
+// The tank on a CPU context that runs its work on the engine's task system (tests/capi/task_pool.h,
+// three threads of the test's own): a failure on a pool thread, inside the asynchronous step's
+// task, must come back from the wait as it does from the world's own thread.
+void build_scene_on_tasks(Scene* s) {
+  g_on_task_pool = true;
+  build_scene(s);
+  g_on_task_pool = false;
 }
 
 void destroy_scene(Scene* s) {
@@ -642,6 +661,11 @@ const Call kCalls[] = {
     {"sph_world_load", run_load, undo_world_create, false, build_checkpoint_scene},
     // The asynchronous step.
     {"sph_world_step_begin + sph_world_step_wait", run_step_async, no_undo, true, build_scene},
+    // The same on the engine's task system: the asynchronous step as a task of a pool (allocations
+    // on its threads fail in turn too: the injector counts them all).
+    {"sph_world_step (the engine's task system)", run_step, no_undo, true, build_scene_on_tasks},
+    {"sph_world_step_begin + sph_world_step_wait (the engine's task system)", run_step_async, no_undo, true,
+     build_scene_on_tasks},
 };
 
 void check_call(const Call& call) {
@@ -720,6 +744,13 @@ void check_call(const Call& call) {
 
 void test_every_call(void**) {
   for (const Call& call : kCalls) check_call(call);
+  // The asynchronous steps of the task-system call ran as tasks of the pool. (The scene's 226
+  // particles make each loop one block, which the library runs on the calling thread without a
+  // task: the loops' own tasks, and failures inside them, are not reached here; capi_engine_hooks
+  // runs loops on the pool, without failures.)
+  printf("the engine's task system: %u tasks on the pool, %u of them nested\n", task_pool_tasks(),
+         task_pool_nested());
+  assert_true(task_pool_tasks() > 0);
 }
 
 // The injector itself: armed at 0, the very next allocation fails.
@@ -747,5 +778,8 @@ int main(void) {
       cmocka_unit_test(test_injector_works),
       cmocka_unit_test(test_every_call),
   };
-  return cmocka_run_group_tests(tests, nullptr, nullptr);
+  task_pool_start();  // (its threads exist before any allocation is armed)
+  const int failed = cmocka_run_group_tests(tests, nullptr, nullptr);
+  task_pool_stop();
+  return failed;
 }
