@@ -324,7 +324,21 @@ class Program {
       T value;
       unsigned char bytes[256];
     };
+    uint32_t painted_from = 256;
     Padded() { std::memset(bytes, 0, sizeof bytes); }
+    // Paints the bytes past a struct_size of `size` with a canary ("only that many bytes are
+    // written"). It starts after the struct_size field even when `size` is below 4: painting over
+    // the field would hand the library a struct_size of 0xABABABAB instead of `size`.
+    void paint_past(uint32_t size) {
+      painted_from = std::min<uint32_t>(std::max<uint32_t>(size, sizeof(uint32_t)), 256);
+      std::memset(bytes + painted_from, 0xAB, 256 - painted_from);
+    }
+    // Whether the call left every painted byte as it was.
+    bool paint_intact() const {
+      for (uint32_t i = painted_from; i < 256; ++i)
+        if (bytes[i] != 0xAB) return false;
+      return true;
+    }
   };
 
   // ---- ops --------------------------------------------------------------------------------------
@@ -673,14 +687,9 @@ class Program {
         sph_stats_init(&s.value);
         s.value.struct_size = struct_size(sizeof(sph_stats));
         const uint32_t size = s.value.struct_size;
-        // The canary starts after the struct_size field even when struct_size is below 4: painting
-        // over the field would hand the library a struct_size of 0xABABABAB instead of `size`.
-        const uint32_t canary = std::min<uint32_t>(std::max<uint32_t>(size, sizeof(uint32_t)), 256);
-        std::memset(s.bytes + canary, 0xAB, 256 - canary);
+        s.paint_past(size);
         const sph_result r = FUZZ_CALL(sph_world_get_stats(w, in_.chance(16) ? nullptr : &s.value));
-        // "only that many bytes are written"
-        for (uint32_t i = canary; i < 256; ++i)
-          if (s.bytes[i] != 0xAB) violation("sph_world_get_stats wrote past struct_size %u (r=%d)", size, r);
+        if (!s.paint_intact()) violation("sph_world_get_stats wrote past struct_size %u (r=%d)", size, r);
         break;
       }
       case 3: {
@@ -1740,12 +1749,9 @@ class Program {
         Padded<sph_probe_reading> out;
         sph_probe_reading_init(&out.value);
         const uint32_t size = out.value.struct_size = struct_size(sizeof(sph_probe_reading));
-        const uint32_t canary = std::min<uint32_t>(std::max<uint32_t>(size, sizeof(uint32_t)), 256);
-        std::memset(out.bytes + canary, 0xAB, 256 - canary);
+        out.paint_past(size);
         r = FUZZ_CALL(sph_probe_get_reading(w, id, in_.chance(16) ? nullptr : &out.value));
-        for (uint32_t i = canary; i < 256; ++i)
-          if (out.bytes[i] != 0xAB)
-            violation("sph_probe_get_reading wrote past struct_size %u (r=%d)", size, r);
+        if (!out.paint_intact()) violation("sph_probe_get_reading wrote past struct_size %u (r=%d)", size, r);
         if (r == SPH_OK && size >= sizeof(sph_probe_reading)) {
           const sph_probe_reading& o = out.value;
           if (!(std::isfinite(o.density) && std::isfinite(o.pressure) && finite3(o.velocity) &&
@@ -1781,12 +1787,9 @@ class Program {
       Padded<sph_collider_loads> out;
       sph_collider_loads_init(&out.value);
       const uint32_t size = out.value.struct_size = struct_size(sizeof(sph_collider_loads));
-      const uint32_t canary = std::min<uint32_t>(std::max<uint32_t>(size, sizeof(uint32_t)), 256);
-      std::memset(out.bytes + canary, 0xAB, 256 - canary);
+      out.paint_past(size);
       r = FUZZ_CALL(sph_collider_get_loads(w, id, in_.chance(16) ? nullptr : &out.value));
-      for (uint32_t i = canary; i < 256; ++i)
-        if (out.bytes[i] != 0xAB)
-          violation("sph_collider_get_loads wrote past struct_size %u (r=%d)", size, r);
+      if (!out.paint_intact()) violation("sph_collider_get_loads wrote past struct_size %u (r=%d)", size, r);
       if (r == SPH_OK && size >= sizeof(sph_collider_loads)) {
         const sph_collider_loads& o = out.value;
         if (!(finite3(o.force) && finite3(o.torque) && finite3(o.point) && std::isfinite(o.frame_time) &&
@@ -2104,12 +2107,10 @@ class Program {
         Padded<sph_params_info> out;
         sph_params_info_init(&out.value);
         const uint32_t size = out.value.struct_size = struct_size(sizeof(sph_params_info));
-        const uint32_t canary = std::min<uint32_t>(std::max<uint32_t>(size, sizeof(uint32_t)), 256);
-        std::memset(out.bytes + canary, 0xAB, 256 - canary);
+        out.paint_past(size);
         const bool null = in_.chance(16);
         const sph_result r = FUZZ_CALL(sph_params_get_info(kind_arg(kind), null ? nullptr : &out.value));
-        for (uint32_t i = canary; i < 256; ++i)
-          if (out.bytes[i] != 0xAB) violation("sph_params_get_info wrote past struct_size %u", size);
+        if (!out.paint_intact()) violation("sph_params_get_info wrote past struct_size %u", size);
         if (r == SPH_OK && (kind >= SPH_PARAMS_KIND_COUNT || null))
           violation("sph_params_get_info(%u) succeeded", kind);
         if (kind < SPH_PARAMS_KIND_COUNT && !null && size == sizeof(sph_params_info)) {
@@ -2127,14 +2128,12 @@ class Program {
         Padded<sph_param_field_info> out;
         sph_param_field_info_init(&out.value);
         const uint32_t size = out.value.struct_size = struct_size(sizeof(sph_param_field_info));
-        const uint32_t canary = std::min<uint32_t>(std::max<uint32_t>(size, sizeof(uint32_t)), 256);
-        std::memset(out.bytes + canary, 0xAB, 256 - canary);
+        out.paint_past(size);
         const bool null = in_.chance(16);
         const size_t count = kind < SPH_PARAMS_KIND_COUNT ? fields_of(kind).size() : 0;
         const sph_result r =
             FUZZ_CALL(sph_params_get_field_info(kind_arg(kind), index, null ? nullptr : &out.value));
-        for (uint32_t i = canary; i < 256; ++i)
-          if (out.bytes[i] != 0xAB) violation("sph_params_get_field_info wrote past struct_size %u", size);
+        if (!out.paint_intact()) violation("sph_params_get_field_info wrote past struct_size %u", size);
         if (kind >= SPH_PARAMS_KIND_COUNT || null) {
           if (r == SPH_OK) violation("sph_params_get_field_info(%u, %u) succeeded", kind, index);
           break;
@@ -2167,12 +2166,10 @@ class Program {
         Padded<sph_physics_method_info> out;
         sph_physics_method_info_init(&out.value);
         const uint32_t size = out.value.struct_size = struct_size(sizeof(sph_physics_method_info));
-        const uint32_t canary = std::min<uint32_t>(std::max<uint32_t>(size, sizeof(uint32_t)), 256);
-        std::memset(out.bytes + canary, 0xAB, 256 - canary);
+        out.paint_past(size);
         const bool null = in_.chance(16);
         const sph_result r = FUZZ_CALL(sph_get_physics_method_info(index, null ? nullptr : &out.value));
-        for (uint32_t i = canary; i < 256; ++i)
-          if (out.bytes[i] != 0xAB) violation("sph_get_physics_method_info wrote past struct_size %u", size);
+        if (!out.paint_intact()) violation("sph_get_physics_method_info wrote past struct_size %u", size);
         if (null) {
           if (r == SPH_OK) violation("sph_get_physics_method_info accepted NULL");
           break;
