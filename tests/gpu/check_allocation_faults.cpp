@@ -39,16 +39,9 @@ sph_transform at(float x, float y, float z) {
 
 enum class Objects { None, BeforeFirstStep, AfterFirstStep };
 
-// A tank with water and one frame behind it; with a tank collider, a continuous source and a
-// sink added before that frame, or after it (so the next step is their first). A growable
-// world starts at capacity 16 and grows to exactly its water's count with the fill.
-void build_scene(Scene* s, Objects objects, bool growable = false) {
+// The context, the world of `def` and the tank's and the blob's SDFs (no collider yet).
+void create_world_and_shapes(Scene* s, const sph_world_def& def) {
   s->context = make_context(SPH_BACKEND_CUDA);
-  sph_world_def def;
-  sph_world_def_init(&def);
-  def.capacity = growable ? 16 : 4000;
-  def.max_capacity = growable ? 100000 : 0;
-  def.particle_spacing = 0.02f;
   require_ok(sph_world_create(s->context, &def, &s->world), "sph_world_create");
   sph_shape_desc shape;
   sph_shape_desc_init(&shape);
@@ -61,11 +54,28 @@ void build_scene(Scene* s, Objects objects, bool growable = false) {
   shape.radius = 0.04f;
   shape.voxel_size = 0.02f;
   require_ok(sph_sdf_create_shape(s->context, &shape, &s->blob), "blob");
+}
+
+// The block of water in the tank.
+void fill_water(Scene* s) {
   sph_fill_box_desc box;
   sph_fill_box_desc_init(&box);
   box.min = sph_vec3{-0.18f, -0.18f, -0.08f};
   box.max = sph_vec3{-0.02f, 0.02f, 0.08f};
   require_ok(sph_world_fill_box(s->world, &box, nullptr), "fill");
+}
+
+// A tank with water and one frame behind it; with a tank collider, a continuous source and a
+// sink added before that frame, or after it (so the next step is their first). A growable
+// world starts at capacity 16 and grows to exactly its water's count with the fill.
+void build_scene(Scene* s, Objects objects, bool growable = false) {
+  sph_world_def def;
+  sph_world_def_init(&def);
+  def.capacity = growable ? 16 : 4000;
+  def.max_capacity = growable ? 100000 : 0;
+  def.particle_spacing = 0.02f;
+  create_world_and_shapes(s, def);
+  fill_water(s);
   if (objects == Objects::AfterFirstStep) require_ok(sph_world_step(s->world, kFrameDt), "first step");
   if (objects != Objects::None) {
     sph_collider_def collider;
@@ -309,34 +319,18 @@ struct LoadsScene {
 
 void loads_frame(LoadsScene* l) {
   Scene* s = &l->scene;
-  s->context = make_context(SPH_BACKEND_CUDA);
   sph_world_def def;
   sph_world_def_init(&def);
   def.capacity = 4000;
   def.particle_spacing = 0.02f;
   def.features = SPH_FEATURE_COLLIDER_LOADS;
-  require_ok(sph_world_create(s->context, &def, &s->world), "sph_world_create (loads)");
-  sph_shape_desc shape;
-  sph_shape_desc_init(&shape);
-  shape.shape = SPH_SHAPE_BOX;
-  shape.half_extents = sph_vec3{0.2f, 0.2f, 0.1f};
-  shape.voxel_size = 0.02f;
-  require_ok(sph_sdf_create_shape(s->context, &shape, &s->tank), "tank");
-  sph_shape_desc_init(&shape);
-  shape.shape = SPH_SHAPE_SPHERE;
-  shape.radius = 0.04f;
-  shape.voxel_size = 0.02f;
-  require_ok(sph_sdf_create_shape(s->context, &shape, &s->blob), "blob");
+  create_world_and_shapes(s, def);
   sph_collider_def collider;
   sph_collider_def_init(&collider);
   collider.sdf = s->tank;
   collider.flags = SPH_COLLIDER_FLAG_INVERTED;
   require_ok(sph_collider_create(s->world, &collider, &l->tank), "tank collider");
-  sph_fill_box_desc box;
-  sph_fill_box_desc_init(&box);
-  box.min = sph_vec3{-0.18f, -0.18f, -0.08f};
-  box.max = sph_vec3{-0.02f, 0.02f, 0.08f};
-  require_ok(sph_world_fill_box(s->world, &box, nullptr), "fill");
+  fill_water(s);
   require_ok(sph_world_step(s->world, kFrameDt), "the loads' first frame");
 }
 
