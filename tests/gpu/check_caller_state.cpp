@@ -55,26 +55,9 @@ Tank make_tank(sph_solver solver) {
   def.features = SPH_FEATURE_BOUNDARY_DENSITY;
   def.solver = solver;
   require_ok(sph_world_create(t.context, &def, &t.world), "sph_world_create");
-  const double lo[3] = {0.0, 0.0, 0.0}, hi[3] = {0.6, 0.4, 0.2};
-  sph_collider_id tank_id, box_id;
-  require_ok(support_tank_between(t.context, t.world, lo, hi, 0.005, 0.0f, &t.tank, &tank_id), "tank");
-  sph_shape_desc shape;
-  sph_shape_desc_init(&shape);
-  shape.shape = SPH_SHAPE_BOX;
-  shape.half_extents = sph_vec3{0.04f, 0.04f, 0.04f};
-  shape.voxel_size = 0.005f;
-  shape.padding_voxels = 8;
-  require_ok(sph_sdf_create_shape(t.context, &shape, &t.box), "box");
-  sph_collider_def c;
-  sph_collider_def_init(&c);
-  c.sdf = t.box;
-  c.transform = sph_transform_identity();
-  c.transform.position = sph_vec3{0.4f, 0.04f, 0.1f};
-  require_ok(sph_collider_create(t.world, &c, &box_id), "box collider");
-  sph_fill_box_desc column;
-  sph_fill_box_desc_init(&column);
-  column.max = sph_vec3{0.2f, 0.3f, 0.2f};
-  require_ok(sph_world_fill_box(t.world, &column, nullptr), "fill");
+  const TankWithBox scene = add_tank_with_box(t.context, t.world, 0.005);
+  t.tank = scene.tank;
+  t.box = scene.box;
   return t;
 }
 

@@ -281,4 +281,38 @@ inline sph_stats get_stats(const sph_world* world) {
   return s;
 }
 
+// The dam break of check_loads and check_caller_state: a 0.6 x 0.4 x 0.2 m tank
+// (support_tank_between) with a fixed 8 cm box standing in it at x = 0.4 and a 0.2 x 0.3 x 0.2 m
+// column of water at its left end, both SDFs of `voxel`-sized voxels. The caller destroys the
+// SDFs after the world.
+struct TankWithBox {
+  sph_sdf* tank = nullptr;
+  sph_sdf* box = nullptr;
+  sph_collider_id tank_collider{}, box_collider{};
+};
+
+inline TankWithBox add_tank_with_box(sph_context* context, sph_world* world, double voxel) {
+  TankWithBox t;
+  const double lo[3] = {0.0, 0.0, 0.0}, hi[3] = {0.6, 0.4, 0.2};
+  require_ok(support_tank_between(context, world, lo, hi, voxel, 0.0f, &t.tank, &t.tank_collider), "tank");
+  sph_shape_desc shape;
+  sph_shape_desc_init(&shape);
+  shape.shape = SPH_SHAPE_BOX;
+  shape.half_extents = sph_vec3{0.04f, 0.04f, 0.04f};
+  shape.voxel_size = static_cast<float>(voxel);
+  shape.padding_voxels = 8;
+  require_ok(sph_sdf_create_shape(context, &shape, &t.box), "box");
+  sph_collider_def c;
+  sph_collider_def_init(&c);
+  c.sdf = t.box;
+  c.transform = sph_transform_identity();
+  c.transform.position = sph_vec3{0.4f, 0.04f, 0.1f};
+  require_ok(sph_collider_create(world, &c, &t.box_collider), "box collider");
+  sph_fill_box_desc column;
+  sph_fill_box_desc_init(&column);
+  column.max = sph_vec3{0.2f, 0.3f, 0.2f};
+  require_ok(sph_world_fill_box(world, &column, nullptr), "fill");
+  return t;
+}
+
 }  // namespace gpu_check
