@@ -48,7 +48,7 @@ CudaBackend::CudaBackend(const WorldConfig& config, int device, const CudaBacken
   r->grid = std::make_unique<DeviceNeighborGrid>(
       make_grid_shape(config.kernel_radius, config.capacity), config.capacity,
       max_particles_per_cell(config.particle_spacing, config.kernel_radius), r->store->sort_scratch(),
-      r->store->arrays().sorted_position, sizeof(Float4) * static_cast<size_t>(config.capacity));
+      r->store->arrays().sorted_position, sizeof(Float4) * static_cast<size_t>(config.capacity), r->stream);
   r->statistics = std::make_unique<FrameStatistics>(config.capacity);
   r->state.allocate(1, "frame state");
   if (options_.dfsph) r->solve_partials.allocate(dfsph_partial_count(config.capacity), "DFSPH solve sums");

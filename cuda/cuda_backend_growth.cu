@@ -111,7 +111,7 @@ void CudaBackend::reserve(uint32_t capacity, const GrowthNeeds& needs) {
     auto grid = std::make_unique<DeviceNeighborGrid>(
         make_grid_shape(config_.kernel_radius, capacity), capacity,
         max_particles_per_cell(config_.particle_spacing, config_.kernel_radius), store->sort_scratch(),
-        store->arrays().sorted_position, sizeof(Float4) * static_cast<size_t>(capacity));
+        store->arrays().sorted_position, sizeof(Float4) * static_cast<size_t>(capacity), r_->stream);
     auto statistics = std::make_unique<FrameStatistics>(capacity);
     DeviceArray<double> partials;
     if (options_.dfsph) partials.allocate(dfsph_partial_count(capacity), "DFSPH solve sums");
@@ -123,9 +123,9 @@ void CudaBackend::reserve(uint32_t capacity, const GrowthNeeds& needs) {
     DeviceColliderLoads loads;
     if (needs.load_colliders != 0) loads.reserve(needs.load_colliders, capacity);
     std::unique_ptr<DeviceHalo> halo;
-    if (r_->halo) halo = std::make_unique<DeviceHalo>(capacity, ranks_->size());
+    if (r_->halo) halo = std::make_unique<DeviceHalo>(capacity, ranks_->size(), r_->stream);
     std::unique_ptr<DeviceHaloSprings> halo_springs;
-    if (r_->halo_springs) halo_springs = std::make_unique<DeviceHaloSprings>(capacity);
+    if (r_->halo_springs) halo_springs = std::make_unique<DeviceHaloSprings>(capacity, r_->stream);
     store->enqueue_copy_from(*r_->store, count_, r_->stream);
     cuda_check(cudaStreamSynchronize(r_->stream), "growth of the particle storage");
     // Nothing below throws: the new buffers replace the old ones (freed at the end of scope).

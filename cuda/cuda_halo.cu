@@ -73,11 +73,11 @@ void CudaBackend::attach_ranks(std::shared_ptr<const RankTransport> ranks,
     auto grid = std::make_unique<DeviceNeighborGrid>(
         make_grid_shape(config_.kernel_radius, capacity), capacity,
         max_particles_per_cell(config_.particle_spacing, config_.kernel_radius), store->sort_scratch(),
-        store->arrays().sorted_position, sizeof(Float4) * static_cast<size_t>(capacity),
+        store->arrays().sorted_position, sizeof(Float4) * static_cast<size_t>(capacity), r_->stream,
         /*fit_to_extent=*/false);
-    auto halo = std::make_unique<DeviceHalo>(capacity, ranks->size());
+    auto halo = std::make_unique<DeviceHalo>(capacity, ranks->size(), r_->stream);
     std::unique_ptr<DeviceHaloSprings> springs;
-    if (options_.springs) springs = std::make_unique<DeviceHaloSprings>(capacity);
+    if (options_.springs) springs = std::make_unique<DeviceHaloSprings>(capacity, r_->stream);
     store->enqueue_initial_world_words(r_->stream);
     cuda_check(cudaStreamSynchronize(r_->stream), "a distributed rank's arrays");
     r_->graph.reset();

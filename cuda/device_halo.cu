@@ -143,7 +143,8 @@ __global__ void apply_records_kernel(ParticleArrays a, const uint32_t* __restric
 
 }  // namespace
 
-DeviceHalo::DeviceHalo(uint32_t capacity, int ranks) : capacity_(capacity), ranks_(ranks) {
+DeviceHalo::DeviceHalo(uint32_t capacity, int ranks, cudaStream_t stream)
+    : capacity_(capacity), ranks_(ranks) {
   // The lists hold two entries a particle and CUB counts items in int: 2 x capacity must stay
   // below 2^31 (a rank at the world's limit of 2^30 would overflow it).
   if (capacity > kMaxHaloCapacity)
@@ -185,9 +186,11 @@ DeviceHalo::DeviceHalo(uint32_t capacity, int ranks) : capacity_(capacity), rank
   sort_temp_.allocate(std::max<size_t>(sort_temp_bytes_, 1), "halo key sort temporary storage");
   lists_temp_bytes_ = lists_temp_bytes(static_cast<uint32_t>(2 * n));
   lists_temp_.allocate(std::max<size_t>(lists_temp_bytes_, 1), "halo lists temporary storage");
-  fill_iota(iota_.get(), static_cast<uint32_t>(n));
-  cuda_check(cudaMemset(mismatch_.get(), 0, sizeof(uint32_t)), "halo id check reset");
-  cuda_check(cudaDeviceSynchronize(), "halo set-up");
+  // On the world's stream: the legacy default stream or a device-wide synchronisation would also
+  // wait for an engine's streams and for other worlds' frames.
+  fill_iota(iota_.get(), static_cast<uint32_t>(n), stream);
+  cuda_check(cudaMemsetAsync(mismatch_.get(), 0, sizeof(uint32_t), stream), "halo id check reset");
+  cuda_check(cudaStreamSynchronize(stream), "halo set-up");
 }
 
 void DeviceHalo::ensure_device(size_t bytes) {

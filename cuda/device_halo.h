@@ -41,8 +41,9 @@ constexpr uint32_t kMaxHaloCapacity = (1u << 30) - 1;
 
 class DeviceHalo {
  public:
-  // A rank of `ranks` ranks (their slabs' cuts come by set_cuts).
-  DeviceHalo(uint32_t capacity, int ranks);
+  // A rank of `ranks` ranks (their slabs' cuts come by set_cuts). Its set-up runs on `stream`
+  // (the world's) and is waited for here.
+  DeviceHalo(uint32_t capacity, int ranks, cudaStream_t stream);
 
   // The slabs' cuts (SlabDecomposition::cuts(), ranks - 1 of them) to the device (enqueued).
   void set_cuts(const std::vector<int32_t>& cuts, cudaStream_t stream);

@@ -110,7 +110,7 @@ __global__ void candidates_to_indices_kernel(uint32_t* __restrict__ candidates,
 
 }  // namespace
 
-DeviceHaloSprings::DeviceHaloSprings(uint32_t capacity) : capacity_(capacity) {
+DeviceHaloSprings::DeviceHaloSprings(uint32_t capacity, cudaStream_t stream) : capacity_(capacity) {
   const size_t n = std::max<uint32_t>(capacity, 1u);
   iota_.allocate(n, "halo spring table values");
   table_ids_.allocate(n, "halo spring table ids");
@@ -130,8 +130,8 @@ DeviceHaloSprings::DeviceHaloSprings(uint32_t capacity) : capacity_(capacity) {
                                    entries_of(n), IsId{}),
              "halo spring wanted size query");
   ensure_temp(std::max(sort, select));
-  fill_iota(iota_.get(), static_cast<uint32_t>(n));
-  cuda_check(cudaDeviceSynchronize(), "halo springs set-up");
+  fill_iota(iota_.get(), static_cast<uint32_t>(n), stream);
+  cuda_check(cudaStreamSynchronize(stream), "halo springs set-up");
 }
 
 void DeviceHaloSprings::ensure_temp(size_t bytes) {

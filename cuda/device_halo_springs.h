@@ -34,7 +34,8 @@ constexpr uint32_t kSpringCandidateElsewhere = kNoSpring - 1u;
 
 class DeviceHaloSprings {
  public:
-  explicit DeviceHaloSprings(uint32_t capacity);
+  // Its set-up runs on `stream` (the world's) and is waited for here.
+  DeviceHaloSprings(uint32_t capacity, cudaStream_t stream);
 
   // The table: ids[0, n) (device) with their indices, sorted by id (enqueued).
   void index_ids(const uint32_t* ids, uint32_t n, cudaStream_t stream);

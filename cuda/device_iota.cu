@@ -13,8 +13,8 @@ __global__ void iota_kernel(uint32_t* v, uint32_t n) {
 
 }  // namespace
 
-void fill_iota(uint32_t* v, uint32_t n) {
-  iota_kernel<<<blocks_for(n, kDefaultBlockSize), kDefaultBlockSize>>>(v, n);
+void fill_iota(uint32_t* v, uint32_t n, cudaStream_t stream) {
+  iota_kernel<<<blocks_for(n, kDefaultBlockSize), kDefaultBlockSize, 0, stream>>>(v, n);
   check_launch("iota_kernel");
 }
 

@@ -129,7 +129,7 @@ int bits_for(uint32_t max_value) {
 
 DeviceNeighborGrid::DeviceNeighborGrid(const GridShape& shape, uint32_t capacity, uint32_t max_per_cell,
                                        SortScratch scratch, void* spare, size_t spare_bytes,
-                                       bool fit_to_extent)
+                                       cudaStream_t stream, bool fit_to_extent)
     : shape_(shape),
       fit_to_extent_(fit_to_extent),
       capacity_(capacity),
@@ -139,10 +139,10 @@ DeviceNeighborGrid::DeviceNeighborGrid(const GridShape& shape, uint32_t capacity
   cell_start_.allocate(static_cast<size_t>(shape.cell_count) + 1, "cell-start table");
   if (fit_to_extent_) {
     live_.allocate(1, "the grid's fitted shape");
-    // Finished before the world's (non-blocking) stream can read it: a memset on the default
-    // stream is not ordered before that stream's work.
-    cuda_check(cudaMemsetAsync(live_.get(), 0, sizeof(LiveGridShape), 0), "the grid's extent reset");
-    cuda_check(cudaStreamSynchronize(0), "the grid's extent reset");
+    // On the world's stream, which every reader of the shape uses: the legacy default stream
+    // would also wait for (and hold up) an engine's blocking streams.
+    cuda_check(cudaMemsetAsync(live_.get(), 0, sizeof(LiveGridShape), stream), "the grid's extent reset");
+    cuda_check(cudaStreamSynchronize(stream), "the grid's extent reset");
   }
   cub::DoubleBuffer<uint32_t> keys(scratch_.keys[0], scratch_.keys[1]);
   cub::DoubleBuffer<uint32_t> values(scratch_.values[0], scratch_.values[1]);

@@ -41,8 +41,10 @@ class DeviceNeighborGrid {
   // first fits the dims of the table's shape.cell_count slots to the particles' extent (a long
   // flume or a thin slab then folds far fewer cells onto one slot: fewer far candidates in the
   // walks); false keeps `shape` (a distributed rank's grid, whose slot order its halo follows).
+  // stream: the world's, where the fitted shape's reset runs (waited for here, so a grid dropped
+  // by a failed growth frees no memory a reset still writes).
   DeviceNeighborGrid(const GridShape& shape, uint32_t capacity, uint32_t max_per_cell, SortScratch scratch,
-                     void* spare, size_t spare_bytes, bool fit_to_extent = true);
+                     void* spare, size_t spare_bytes, cudaStream_t stream, bool fit_to_extent = true);
 
   // Hashes positions[0, n) and sorts. Afterwards order() gives, for each sorted place, the
   // particle's index before the sort. The buffers order() and sorted_keys() point to are

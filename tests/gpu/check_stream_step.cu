@@ -7,7 +7,8 @@
 //     before sph_world_step_wait: a copy of the positions equals the reference's after the frame
 //     (a copy that ran early would read the start of the frame);
 //   - runs after the caller's earlier work: a 0.3 s spin enqueued before the begin has finished
-//     when sph_world_step_wait returns (a frame of this world takes a few milliseconds).
+//     when sph_world_step_wait returns (a frame of this world takes a few milliseconds);
+// and a world's creation and frames do not wait for the caller's work on a blocking stream.
 #include <cuda_runtime.h>
 
 #include <chrono>
@@ -133,11 +134,44 @@ void check_frames(bool budget) {
   sph_context_destroy(context);
 }
 
+// A world's set-up and frames run on its own non-blocking stream: none of them waits for an
+// engine's work on a blocking stream (as a call on the legacy default stream, or a device-wide
+// synchronisation, would: the grid's extent reset and the distributed halo's set-up did before
+// session 46). A 1 s spin on the caller's blocking stream is still running after a world is
+// created, filled, stepped one frame and read back.
+void check_set_up_ignores_blocking_streams() {
+  sph_context* context = make_context(SPH_BACKEND_CUDA);
+  cudaStream_t engine = nullptr;
+  cuda_require(cudaStreamCreate(&engine), "cudaStreamCreate (blocking)");
+  cudaEvent_t spun;
+  cuda_require(cudaEventCreateWithFlags(&spun, cudaEventDisableTiming), "cudaEventCreate");
+  spin_kernel<<<1, 1, 0, engine>>>(1000000000ull);
+  cuda_require(cudaEventRecord(spun, engine), "cudaEventRecord");
+  const auto t = std::chrono::steady_clock::now();
+  sph_world* world = make_world(context);
+  require_ok(sph_world_step(world, 1.0f / 60.0f), "sph_world_step");
+  uint32_t n = 0;
+  require_ok(sph_world_get_particle_count(world, &n), "sph_world_get_particle_count");
+  const std::vector<float> p = positions_of(world, n);
+  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  const cudaError_t q = cudaEventQuery(spun);
+  report(q == cudaErrorNotReady && took < 0.9, "stream_step/set_up_ignores_blocking_streams",
+         "create, fill (%u particles), one frame and a read-back took %.3f s while the caller's 1 s spin on "
+         "a blocking stream was %s",
+         n, took, q == cudaErrorNotReady ? "still running" : "FINISHED (a call waited for it)");
+  cuda_require(cudaStreamSynchronize(engine), "cudaStreamSynchronize");
+  cudaEventDestroy(spun);
+  cudaStreamDestroy(engine);
+  sph_world_destroy(world);
+  sph_context_destroy(context);
+}
+
 }  // namespace
 
 int main() {
   exit_if_no_cuda();
   check_frames(false);
   check_frames(true);
+  check_set_up_ignores_blocking_streams();
   return finish();
 }
