@@ -7,12 +7,15 @@
 namespace sph {
 namespace {
 
-// Ends a capture that failed half-way, so the stream is usable again.
+// Ends a capture that failed half-way, so the stream is usable again. Every capture here goes
+// into a graph the FrameGraph owns (graph_, or the body of one of its WHILE nodes, which the node
+// owns): the graph cudaStreamEndCapture returns is that one, and reset() destroys it with graph_.
+// (Destroying it here too destroyed graph_ twice, or a WHILE node's body before its graph.)
 void abandon_capture(cudaStream_t stream) {
   cudaStreamCaptureStatus status = cudaStreamCaptureStatusNone;
   if (cudaStreamIsCapturing(stream, &status) == cudaSuccess && status != cudaStreamCaptureStatusNone) {
-    cudaGraph_t partial = nullptr;
-    if (cudaStreamEndCapture(stream, &partial) == cudaSuccess && partial) cudaGraphDestroy(partial);
+    cudaGraph_t captured = nullptr;
+    (void)cudaStreamEndCapture(stream, &captured);
   }
   (void)cudaGetLastError();
 }
@@ -47,7 +50,10 @@ void FrameGraph::build(const PipelineSetup& setup, const PipelineBuffers& buffer
 
     // 3. end segment after the loop.
     enqueue_frame_end(setup, buffers, stream);
-    cuda_check(cudaStreamEndCapture(stream, &graph_), "capture of the frame end");
+    // graph_ itself comes back; an invalidated capture returns null, which must not replace
+    // graph_ (reset() destroys it).
+    cudaGraph_t captured = nullptr;
+    cuda_check(cudaStreamEndCapture(stream, &captured), "capture of the frame end");
 
     cuda_check(cudaGraphInstantiate(&exec_, graph_, 0), "cudaGraphInstantiate");
   } catch (...) {
