@@ -120,6 +120,11 @@ void remove_stale_temporaries(const std::string& path) {
   const std::string host = host_tag();
   DIR* listing = ::opendir(dir.c_str());
   if (!listing) return;
+  // Closed however the loop ends: the names below are strings, whose allocations may throw.
+  struct Closer {
+    DIR* listing;
+    ~Closer() { ::closedir(listing); }
+  } closer{listing};
   while (const dirent* entry = ::readdir(listing)) {
     const unsigned long pid = temporary_owner(entry->d_name, name, host);
     if (pid == 0 || pid > static_cast<unsigned long>(INT32_MAX)) continue;
@@ -128,11 +133,15 @@ void remove_stale_temporaries(const std::string& path) {
     struct stat st;
     if (::lstat(stale.c_str(), &st) == 0 && S_ISREG(st.st_mode)) (void)::unlink(stale.c_str());
   }
-  ::closedir(listing);
 }
 
 void write_atomically(const std::string& path, const HostVector<uint8_t>& bytes) {
   remove_stale_temporaries(path);
+  // The folder, whose entry the rename changes: named before the temporary file exists, since
+  // nothing may throw once the rename has put the new file in place (the call would report an
+  // error with the file replaced).
+  const size_t slash = path.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
   std::string temp;
   int fd = -1;
   for (int attempt = 0; fd < 0; ++attempt) {
@@ -164,8 +173,6 @@ void write_atomically(const std::string& path, const HostVector<uint8_t>& bytes)
   if (closed != 0) fail("closing the checkpoint for");
   if (::rename(temp.c_str(), path.c_str()) != 0) fail("renaming the checkpoint to");
   // Make the rename itself durable (best effort: the new file is in place either way).
-  const size_t slash = path.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
   const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_CLOEXEC);
   if (dir_fd >= 0) {
     (void)::fsync(dir_fd);

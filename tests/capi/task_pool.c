@@ -13,6 +13,7 @@ typedef struct task_slot {
   void* context;
   uint32_t count, next, done;
   int in_use;
+  int nested; /* enqueued from a pool thread */
 } task_slot;
 
 static struct {
@@ -22,7 +23,7 @@ static struct {
   pthread_t threads[kTaskPoolThreads];
   int stop, running;
   atomic_int run_inline;
-  atomic_uint tasks, items_on_pool, nested, inline_tasks;
+  atomic_uint tasks, items_on_pool, nested, nested_items_on_pool, inline_tasks;
 } pool;
 
 /* The pool's threads know themselves by this (their worker index + 1; 0 elsewhere). */
@@ -63,8 +64,12 @@ static void* pool_thread(void* arg) {
       pthread_cond_wait(&pool.work, &pool.mutex);
       continue;
     }
-    run_item_locked(s, worker);
-    atomic_fetch_add(&pool.items_on_pool, 1u);
+    {
+      const int nested = s->nested; /* (the slot may be reused once its last item is done) */
+      run_item_locked(s, worker);
+      atomic_fetch_add(&pool.items_on_pool, 1u);
+      if (nested) atomic_fetch_add(&pool.nested_items_on_pool, 1u);
+    }
   }
   pthread_mutex_unlock(&pool.mutex);
   return NULL;
@@ -92,6 +97,7 @@ static void* SPH_CALL enqueue_task(sph_task_fn task, uint32_t item_count, uint32
   s->count = item_count;
   s->next = s->done = 0;
   s->in_use = 1;
+  s->nested = pool_worker != 0;
   atomic_fetch_add(&pool.tasks, 1u);
   pthread_cond_broadcast(&pool.work);
   pthread_mutex_unlock(&pool.mutex);
@@ -125,6 +131,7 @@ void task_pool_start(void) {
   atomic_store(&pool.tasks, 0u);
   atomic_store(&pool.items_on_pool, 0u);
   atomic_store(&pool.nested, 0u);
+  atomic_store(&pool.nested_items_on_pool, 0u);
   atomic_store(&pool.inline_tasks, 0u);
   for (k = 0; k < kTaskPoolThreads; ++k)
     require(pthread_create(&pool.threads[k], NULL, pool_thread, (void*)(uintptr_t)k) == 0, "pthread_create");
@@ -155,4 +162,5 @@ void task_pool_set_inline(int run_inline) { atomic_store(&pool.run_inline, run_i
 uint32_t task_pool_tasks(void) { return atomic_load(&pool.tasks); }
 uint32_t task_pool_items_on_pool(void) { return atomic_load(&pool.items_on_pool); }
 uint32_t task_pool_nested(void) { return atomic_load(&pool.nested); }
+uint32_t task_pool_nested_items_on_pool(void) { return atomic_load(&pool.nested_items_on_pool); }
 uint32_t task_pool_inline(void) { return atomic_load(&pool.inline_tasks); }

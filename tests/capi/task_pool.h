@@ -22,9 +22,10 @@ void task_pool_use(sph_context_def* def);
 void task_pool_set_inline(int run_inline);
 
 /* What the pool saw since task_pool_start. */
-uint32_t task_pool_tasks(void);         /* tasks enqueued onto the pool (not those run inline) */
-uint32_t task_pool_items_on_pool(void); /* items the pool's own threads ran */
-uint32_t task_pool_nested(void);        /* tasks enqueued from a pool thread (from inside a task) */
-uint32_t task_pool_inline(void);        /* tasks enqueue_task ran itself */
+uint32_t task_pool_tasks(void);                /* tasks enqueued onto the pool (not those run inline) */
+uint32_t task_pool_items_on_pool(void);        /* items the pool's own threads ran */
+uint32_t task_pool_nested(void);               /* tasks enqueued from a pool thread (from inside a task) */
+uint32_t task_pool_nested_items_on_pool(void); /* items of those nested tasks the pool's threads ran */
+uint32_t task_pool_inline(void);               /* tasks enqueue_task ran itself */
 
 #endif /* SPH_TASK_POOL_H */

@@ -18,6 +18,11 @@ namespace {
 
 std::atomic<long> g_countdown{-1};  // allocations to let through before one fails; -1 = off
 std::atomic<long> g_injected{0};    // failures injected since the last arm()
+// Each thread's own byte: its address names the thread (no allocation, unlike std::thread::id's
+// uses, and nothing to construct on threads the injector never saw).
+thread_local char t_thread_tag;
+std::atomic<const char*> g_armed_by{nullptr};  // the thread that called arm()
+std::atomic<bool> g_injected_elsewhere{false};
 
 bool allocation_fault_due() {
   long left = g_countdown.load(std::memory_order_relaxed);
@@ -25,6 +30,7 @@ bool allocation_fault_due() {
     if (g_countdown.compare_exchange_weak(left, left - 1, std::memory_order_relaxed)) {
       if (left == 0) {
         g_injected.fetch_add(1, std::memory_order_relaxed);
+        if (&t_thread_tag != g_armed_by.load(std::memory_order_relaxed)) g_injected_elsewhere.store(true);
         return true;
       }
       return false;
@@ -39,6 +45,8 @@ namespace alloc_fault {
 
 void arm(long n) {
   g_injected.store(0);
+  g_injected_elsewhere.store(false);
+  g_armed_by.store(&t_thread_tag);
   g_countdown.store(n);
 }
 
@@ -46,6 +54,8 @@ bool disarm() {
   g_countdown.store(-1);
   return g_injected.load() != 0;
 }
+
+bool injected_on_another_thread() { return g_injected_elsewhere.load(); }
 
 }  // namespace alloc_fault
 

@@ -11,5 +11,8 @@ namespace alloc_fault {
 void arm(long n);
 // Returns whether a failure was injected since arm(), and disarms.
 bool disarm();
+// Whether the failure injected since the last arm() came on a thread other than arm()'s caller
+// (a library thread, or a task system's worker running one of the library's tasks).
+bool injected_on_another_thread();
 
 }  // namespace alloc_fault
