@@ -772,7 +772,7 @@ sph_result run_load_file(Scene* s) {
 
 // A failed load writes no world.
 void expect_no_world_loaded(Scene*) {
-  if (g_made_world != nullptr) fail_msg("sph_world_load_file failed but wrote *out");
+  if (g_made_world != nullptr) fail_msg("%s", "sph_world_load_file failed but wrote *out");
 }
 
 // The world loaded from the file saves the file's bytes again; the file goes (the next scene
