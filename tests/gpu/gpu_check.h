@@ -26,6 +26,13 @@ inline int& failures() {
   return count;
 }
 
+// Every PASS or FAIL line report() printed: a program that reached none of its checks fails
+// (finish), rather than exiting 0 with nothing tested.
+inline int& reports() {
+  static int count = 0;
+  return count;
+}
+
 inline void report(bool ok, const char* name, const char* format, ...) {
   char detail[512];
   va_list args;
@@ -34,10 +41,17 @@ inline void report(bool ok, const char* name, const char* format, ...) {
   va_end(args);
   std::printf("%s %s: %s\n", ok ? "PASS" : "FAIL", name, detail);
   std::fflush(stdout);
+  ++reports();
   if (!ok) ++failures();
 }
 
-inline int finish() { return failures() == 0 ? 0 : 1; }
+inline int finish() {
+  if (reports() == 0) {
+    std::printf("FAIL checks: the program reported no check\n");
+    return 1;
+  }
+  return failures() == 0 ? 0 : 1;
+}
 
 // Stops the program with a FAIL line when an sph call does not return what it must.
 inline void require(sph_result r, sph_result expected, const char* what) {
