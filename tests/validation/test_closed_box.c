@@ -304,6 +304,11 @@ int main(int argc, char** argv) {
     dfsph_flags = SPH_DFSPH_CORRECTED_GRADIENT;
     return cmocka_run_group_tests_name("closed_box_momentum_dfsph_corrected", t, NULL, NULL);
   }
+  if (argc >= 2 && strcmp(argv[1], "energy") != 0 && strcmp(argv[1], "momentum") != 0) {
+    /* a name that is no case: an error, not a run of none that passes */
+    fprintf(stderr, "validation_closed_box: no case named '%s'\n", argv[1]);
+    return 2;
+  }
   if (argc < 2 || strcmp(argv[1], "energy") == 0)
     failed += cmocka_run_group_tests_name("closed_box_energy", energy, NULL, NULL);
   if (argc < 2 || strcmp(argv[1], "momentum") == 0)

@@ -3,6 +3,7 @@
  * the exact equilibrium of the equation of state in use within 3 % (DFSPH: 0.5 %), no particle
  * across the floor. The cases: the ideal gas and Tait's equation, the walls in the density, DFSPH;
  * what is compared and why: hydrostatic_tank.c. */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -191,9 +192,15 @@ int main(int argc, char** argv) {
       {"dfsph_walls_unmodelled", "hydrostatic_dfsph_walls_unmodelled", 0,
        cmocka_unit_test(test_hydrostatic_dfsph_walls_unmodelled)},
   };
-  int failed = 0;
+  int failed = 0, ran = 0;
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i)
-    if (argc < 2 ? cases[i].by_default : strcmp(argv[1], cases[i].name) == 0)
+    if (argc < 2 ? cases[i].by_default : strcmp(argv[1], cases[i].name) == 0) {
       failed += _cmocka_run_group_tests(cases[i].group, &cases[i].test, 1, NULL, NULL);
+      ++ran;
+    }
+  if (ran == 0) { /* a name that is no case: an error, not a run of none that passes */
+    fprintf(stderr, "validation_hydrostatic_tank: no case named '%s'\n", argv[1]);
+    return 2;
+  }
   return failed;
 }

@@ -275,20 +275,38 @@ int main(int argc, char** argv) {
   const struct CMUnitTest dfsph_rest[] = {cmocka_unit_test(test_dfsph_rest)};
   const struct CMUnitTest dfsph_disturbed[] = {cmocka_unit_test(test_dfsph_disturbed)};
   const struct CMUnitTest dfsph_rest_corrected[] = {cmocka_unit_test(test_dfsph_rest_corrected)};
-  int failed = 0;
-  if (argc >= 2 && strcmp(argv[1], "dfsph_rest_corrected") == 0)
+  int failed = 0, ran = 0;
+  if (argc >= 2 && strcmp(argv[1], "dfsph_rest_corrected") == 0) {
     failed += cmocka_run_group_tests_name("rest_sphere_dfsph_corrected", dfsph_rest_corrected, NULL, NULL);
-  if (argc >= 2 && strcmp(argv[1], "dfsph_rest") == 0)
+    ++ran;
+  }
+  if (argc >= 2 && strcmp(argv[1], "dfsph_rest") == 0) {
     failed += cmocka_run_group_tests_name("rest_sphere_dfsph", dfsph_rest, NULL, NULL);
-  if (argc >= 2 && strcmp(argv[1], "dfsph_disturbed") == 0)
+    ++ran;
+  }
+  if (argc >= 2 && strcmp(argv[1], "dfsph_disturbed") == 0) {
     failed += cmocka_run_group_tests_name("rest_sphere_dfsph_disturbed", dfsph_disturbed, NULL, NULL);
-  if (argc < 2 || strcmp(argv[1], "rest") == 0)
+    ++ran;
+  }
+  if (argc < 2 || strcmp(argv[1], "rest") == 0) {
     failed += cmocka_run_group_tests_name("rest_sphere", rest, NULL, NULL);
-  if (argc < 2 || strcmp(argv[1], "disturbed") == 0)
+    ++ran;
+  }
+  if (argc < 2 || strcmp(argv[1], "disturbed") == 0) {
     failed += cmocka_run_group_tests_name("rest_sphere_disturbed", disturbed, NULL, NULL);
-  if (argc >= 2 && strcmp(argv[1], "disturbed_tension") == 0)
+    ++ran;
+  }
+  if (argc >= 2 && strcmp(argv[1], "disturbed_tension") == 0) {
     failed += cmocka_run_group_tests_name("rest_sphere_disturbed_tension", disturbed_tension, NULL, NULL);
-  if (argc >= 2 && strcmp(argv[1], "disturbed_density") == 0)
+    ++ran;
+  }
+  if (argc >= 2 && strcmp(argv[1], "disturbed_density") == 0) {
     failed += cmocka_run_group_tests_name("rest_sphere_disturbed_density", disturbed_density, NULL, NULL);
+    ++ran;
+  }
+  if (ran == 0) { /* a name that is no case: an error, not a run of none that passes */
+    fprintf(stderr, "validation_rest_sphere: no case named '%s'\n", argv[1]);
+    return 2;
+  }
   return failed;
 }
