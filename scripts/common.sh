@@ -30,10 +30,13 @@ SPH_SCRIPT_NAME="$(basename "${0}")"
 # libgl1-mesa-dri (Mesa's EGL driver and llvmpipe) let gl_draw_host draw without a GPU; the
 # kit for a GPU machine without them comes from scripts/devkit-interop. libopenmpi-dev and
 # openmpi-bin build libsph_mpi and run the mpi tests; python3-mpi4py drives it from Python.
+# python3-openvdb (pyopenvdb, the same OpenVDB 10.0.1) writes the level set that the Python
+# binding's VDB test loads (bindings/python/tests/test_vdb.py; without it that test skips).
 SPH_PACKAGES=(
   cmake ninja-build g++ pkg-config git
   libcmocka-dev libeigen3-dev libxsimd-dev
   libopenvdb-dev libboost-iostreams-dev libtbb-dev nlohmann-json3-dev libopenmpi-dev openmpi-bin python3-mpi4py
+  python3-openvdb
   clang libclang-rt-14-dev libomp-dev clang-format
   python3 python3-numpy python3-pytest python3-matplotlib mono-mcs mono-runtime
   libpng-dev libegl-dev libgl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
