@@ -1,14 +1,16 @@
 // SPDX-License-Identifier: MIT
-// Sph.cs - the idiomatic C# layer over Sph.Generated.cs: Context, World, SphException.
+// Sph.cs - the idiomatic C# layer over Sph.Generated.cs: Context, World, SphException, TaskSystem.
 //
 // Unity-friendly: no unsafe code, blittable structs, Cdecl, SafeHandles for the heavy objects,
 // bulk data through pinned arrays or raw pointers (NativeArray) with a stride, never one call
-// per particle. The log callback is a static [MonoPInvokeCallback] method (IL2CPP needs that).
+// per particle. The log callback and the task system's enqueue and finish (TaskSystem) are
+// static [MonoPInvokeCallback] methods (IL2CPP needs that).
 using System;
 using System.Collections.Generic;
 using System.Runtime.InteropServices;
 using System.Text;
 using System.Text.RegularExpressions;
+using System.Threading;
 
 #if !UNITY_5_3_OR_NEWER
 namespace AOT
@@ -421,10 +423,12 @@ namespace Sph
     public sealed partial class ContextHandle
     {
         internal GCHandle LogTarget;
+        internal GCHandle TaskTarget;  // the context's TaskSystem, in task_user_context
 
         partial void OnReleased()
         {
             if (LogTarget.IsAllocated) LogTarget.Free();
+            if (TaskTarget.IsAllocated) TaskSystem.Detach(ref TaskTarget);
         }
     }
 
@@ -441,9 +445,21 @@ namespace Sph
 
         public Context(Backend backend = Backend.Auto) : this(DefFor(backend), null) { }
 
-        public Context(ContextDef def, LogHandler log = null)
+        public Context(ContextDef def, LogHandler log = null) : this(def, log, null) { }
+
+        /// <summary>A context whose CPU worlds run their parallel loops and asynchronous steps
+        /// as tasks of `taskSystem` (sph_context_def.enqueue_task / finish_task), starting no
+        /// thread of their own; e.g. <c>new Context(def, null, new ThreadPoolTaskSystem())</c>.
+        /// def.CpuWorkerCount still decides whether loops run in parallel (1: never). The
+        /// context holds the task system until the native context is destroyed (after Dispose
+        /// and its worlds'). A null taskSystem leaves def's task fields as they are; with one,
+        /// they must be unset (ArgumentException). A CUDA context checks and ignores it.</summary>
+        public Context(ContextDef def, LogHandler log, TaskSystem taskSystem)
         {
             Library.EnsureCompatible();
+            if (taskSystem != null &&
+                (def.EnqueueTask != IntPtr.Zero || def.FinishTask != IntPtr.Zero || def.TaskUserContext != IntPtr.Zero))
+                throw new ArgumentException("def already names a task system (EnqueueTask, FinishTask, TaskUserContext)", "def");
             GCHandle target = default(GCHandle);
             if (log != null)
             {
@@ -451,17 +467,25 @@ namespace Sph
                 def.LogFn = logThunkPointer;
                 def.LogUserData = GCHandle.ToIntPtr(target);
             }
+            GCHandle tasks = default(GCHandle);
+            if (taskSystem != null) tasks = taskSystem.Attach(ref def);
             ContextHandle handle;
             Result r = Native.sph_context_create(ref def, out handle);
             if ((int)r < 0)
             {
                 string message = Library.LastError;
                 if (target.IsAllocated) target.Free();
+                if (tasks.IsAllocated) TaskSystem.Detach(ref tasks);
                 throw new SphException(r, "sph_context_create", message);
             }
             handle.LogTarget = target;
+            handle.TaskTarget = tasks;
             Handle = handle;
+            TaskSystem = taskSystem;
         }
+
+        /// <summary>The task system the context was created with, or null.</summary>
+        public TaskSystem TaskSystem { get; private set; }
 
         static ContextDef DefFor(Backend backend)
         {
@@ -545,6 +569,426 @@ namespace Sph
         {
             IsDisposed = true;
             Handle.Dispose();
+        }
+    }
+
+    // ---- the engine's task system (sph_context_def.enqueue_task / finish_task) ----------------
+
+    /// <summary>One task the library enqueued on a <see cref="TaskSystem"/>: items [0,
+    /// ItemCount) of a native sph_task_fn, split into ranges of at least MinRange items. Workers
+    /// claim ranges from a shared counter (<see cref="RunNext"/>), so a range runs exactly once
+    /// whoever claims it, and a thread that must wait for the task can run the unclaimed ranges
+    /// itself (<see cref="RunAndWait"/>) instead of waiting for a worker that may never come
+    /// free. Thread-safe; never throws from RunNext for the library's own tasks (they never
+    /// throw).</summary>
+    public sealed class NativeTask
+    {
+        // One delegate per native function: the library's loops are a few dozen functions.
+        static readonly Dictionary<IntPtr, TaskFn> delegates = new Dictionary<IntPtr, TaskFn>();
+
+        readonly TaskFn function;
+        readonly IntPtr context;
+        readonly long ranges;
+        long next;      // ranges claimed (may run past `ranges`: claims that found nothing)
+        long finished;  // ranges that have run
+
+        internal NativeTask(TaskSystem owner, IntPtr function, uint itemCount, uint minRange, IntPtr context)
+        {
+            Owner = owner;
+            this.function = DelegateFor(function);
+            this.context = context;
+            ItemCount = itemCount;
+            MinRange = minRange < 1 ? 1u : minRange;
+            ranges = itemCount == 0 ? 0 : Math.Max(1L, itemCount / MinRange);
+        }
+
+        static TaskFn DelegateFor(IntPtr function)
+        {
+            lock (delegates)
+            {
+                TaskFn fn;
+                if (!delegates.TryGetValue(function, out fn))
+                {
+                    fn = (TaskFn)Marshal.GetDelegateForFunctionPointer(function, typeof(TaskFn));
+                    delegates.Add(function, fn);
+                }
+                return fn;
+            }
+        }
+
+        /// <summary>The task system the task was enqueued on.</summary>
+        public TaskSystem Owner { get; private set; }
+        /// <summary>The task's items (sph_enqueue_task_fn's item_count).</summary>
+        public uint ItemCount { get; private set; }
+        /// <summary>The fewest items a range has (the library passes 1), except a task with
+        /// fewer items than that: one range of all of them.</summary>
+        public uint MinRange { get; private set; }
+        /// <summary>The ranges the items are split into: ItemCount / MinRange, the last range
+        /// taking the remainder. At most this many workers can be busy with the task.</summary>
+        public long RangeCount { get { return ranges; } }
+
+        /// <summary>True once every range has run (each claimed and finished).</summary>
+        public bool IsComplete { get { return Volatile.Read(ref finished) == ranges; } }
+
+        /// <summary>Claims the next range and runs it on this thread, passing `worker` to the
+        /// native function; returns the items it ran, or 0 when no range was left to claim.</summary>
+        public uint RunNext(uint worker)
+        {
+            long r = Interlocked.Increment(ref next) - 1;
+            if (r >= ranges) return 0;
+            uint first = (uint)(r * MinRange);
+            uint last = r == ranges - 1 ? ItemCount : first + MinRange;
+            try
+            {
+                function(first, last, worker, context);
+            }
+            finally
+            {
+                // Even if the call itself failed, so that no waiter is left waiting.
+                if (Interlocked.Increment(ref finished) == ranges)
+                    lock (this) Monitor.PulseAll(this);
+            }
+            return last - first;
+        }
+
+        /// <summary>Runs ranges on this thread until none is left to claim; returns the items
+        /// it ran.</summary>
+        public uint RunRemaining(uint worker)
+        {
+            uint items = 0, ran;
+            while ((ran = RunNext(worker)) != 0) items += ran;
+            return items;
+        }
+
+        /// <summary>Blocks until every range has run. Only safe once none is left to claim
+        /// (after <see cref="RunRemaining"/>) or where a worker that claims them is sure to come
+        /// free; <see cref="RunAndWait"/> is the wait that cannot deadlock.</summary>
+        public void Wait()
+        {
+            var spin = new SpinWait();
+            while (!IsComplete && !spin.NextSpinWillYield) spin.SpinOnce();
+            if (IsComplete) return;
+            lock (this)
+                while (!IsComplete) Monitor.Wait(this);
+        }
+
+        /// <summary>The finish that never deadlocks: runs the unclaimed ranges on this thread,
+        /// then waits for those other threads are running. Returns the items it ran.</summary>
+        public uint RunAndWait(uint worker)
+        {
+            uint items = RunRemaining(worker);
+            Wait();
+            return items;
+        }
+    }
+
+    /// <summary>
+    /// An engine's task system for a CPU context (sph_context_def.enqueue_task / finish_task;
+    /// docs/embedding.md, "The engine's task system"): the library's parallel loops and each
+    /// asynchronous step (World.StepBegin) run as its tasks, and the library starts no thread.
+    /// Give it to <c>new Context(def, log, taskSystem)</c>; <see cref="ThreadPoolTaskSystem"/>
+    /// is a ready one. A subclass implements <see cref="Enqueue"/> (hand the task's ranges to
+    /// workers, each calling <c>task.RunNext(worker)</c> or <c>task.RunRemaining(worker)</c>)
+    /// and may override <see cref="Finish"/>. The binding does the marshalling: static
+    /// [MonoPInvokeCallback] thunks, a GCHandle to this object per context (freed when the
+    /// native context is destroyed) and one per scheduled task (freed by its finish), and the
+    /// contract's safety net: an exception from Enqueue or Finish never reaches native code,
+    /// and whatever they did, the task's unclaimed ranges are run on the calling thread before
+    /// the library is told the task is done. One task system may serve several contexts.
+    /// </summary>
+    public abstract class TaskSystem
+    {
+        // One static delegate each for every context (IL2CPP calls only static methods); the
+        // task system travels in task_user_context as a GCHandle, each task as one.
+        static readonly EnqueueTaskFn enqueueThunk = OnEnqueue;
+        static readonly FinishTaskFn finishThunk = OnFinish;
+        static readonly IntPtr enqueueThunkPointer = Marshal.GetFunctionPointerForDelegate(enqueueThunk);
+        static readonly IntPtr finishThunkPointer = Marshal.GetFunctionPointerForDelegate(finishThunk);
+
+        long tasksEnqueued, tasksRunInline, failures;
+        int tasksInFlight, contexts;
+
+        /// <summary>
+        /// Schedules the task's ranges and returns true; the library later calls
+        /// <see cref="Finish"/> for it. Or runs every range on this thread
+        /// (<c>task.RunRemaining(worker)</c>) and returns false: the task is then done (for an
+        /// asynchronous step StepBegin returns after the frame). Called from the thread inside
+        /// a call on a world and, nested, from inside an asynchronous step's task on whichever
+        /// worker runs it, concurrently from several threads: it must be thread-safe and must
+        /// not wait for the task. If it throws, the binding runs the unclaimed ranges here.
+        /// </summary>
+        public abstract bool Enqueue(NativeTask task);
+
+        /// <summary>Returns once every range of a task Enqueue scheduled has run. The default,
+        /// <c>task.RunAndWait(CurrentWorker)</c>, runs the unclaimed ranges on this thread and
+        /// then waits for those in flight, which never deadlocks (this may be a worker inside an
+        /// asynchronous step's task). Called on the thread that enqueued a loop, or on the
+        /// thread in StepWait for a step. An override that returns early or throws is made
+        /// good by the binding (the same RunAndWait), never by native code.</summary>
+        public virtual void Finish(NativeTask task)
+        {
+            task.RunAndWait(CurrentWorker);
+        }
+
+        /// <summary>The worker index passed to the native functions (the library does not read
+        /// it): by default the managed thread id.</summary>
+        public virtual uint CurrentWorker
+        {
+            get { return (uint)Thread.CurrentThread.ManagedThreadId; }
+        }
+
+        /// <summary>Tasks the library enqueued.</summary>
+        public long TasksEnqueued { get { return Interlocked.Read(ref tasksEnqueued); } }
+        /// <summary>Of those, tasks that ran whole inside the enqueue (Enqueue returned false,
+        /// or failed), for which the library got NULL and calls no finish.</summary>
+        public long TasksRunInline { get { return Interlocked.Read(ref tasksRunInline); } }
+        /// <summary>Exceptions from Enqueue or Finish caught by the binding (the items were then
+        /// run on the calling thread).</summary>
+        public long Failures { get { return Interlocked.Read(ref failures); } }
+        /// <summary>Tasks scheduled and not finished yet: each holds a GCHandle until its
+        /// finish. 0 whenever no loop or asynchronous step is running.</summary>
+        public int TasksInFlight { get { return Volatile.Read(ref tasksInFlight); } }
+        /// <summary>Native contexts holding this task system (each through a GCHandle, freed when
+        /// the native context is destroyed: after Dispose of the context and its worlds).</summary>
+        public int ContextCount { get { return Volatile.Read(ref contexts); } }
+
+        // Sets the def's three fields; the returned handle is freed by Detach.
+        internal GCHandle Attach(ref ContextDef def)
+        {
+            GCHandle target = GCHandle.Alloc(this);
+            Interlocked.Increment(ref contexts);
+            def.EnqueueTask = enqueueThunkPointer;
+            def.FinishTask = finishThunkPointer;
+            def.TaskUserContext = GCHandle.ToIntPtr(target);
+            return target;
+        }
+
+        internal static void Detach(ref GCHandle target)
+        {
+            var system = (TaskSystem)target.Target;
+            target.Free();
+            Interlocked.Decrement(ref system.contexts);
+        }
+
+        [AOT.MonoPInvokeCallback(typeof(EnqueueTaskFn))]
+        static IntPtr OnEnqueue(IntPtr task, uint itemCount, uint minRange, IntPtr taskContext, IntPtr userContext)
+        {
+            // Nothing may unwind into C: whatever fails, the items run here and NULL goes back.
+            NativeTask t = null;
+            TaskSystem system = null;
+            try
+            {
+                system = (TaskSystem)GCHandle.FromIntPtr(userContext).Target;
+                Interlocked.Increment(ref system.tasksEnqueued);
+                t = new NativeTask(system, task, itemCount, minRange, taskContext);
+                bool scheduled;
+                try
+                {
+                    scheduled = system.Enqueue(t);
+                }
+                catch (Exception e)
+                {
+                    system.Failed("Enqueue", e);
+                    scheduled = false;
+                }
+                if (scheduled)
+                {
+                    GCHandle handle = GCHandle.Alloc(t);
+                    Interlocked.Increment(ref system.tasksInFlight);
+                    return GCHandle.ToIntPtr(handle);
+                }
+                t.RunAndWait(system.SafeWorker());  // what Enqueue left (nothing, if it kept its word)
+                Interlocked.Increment(ref system.tasksRunInline);
+                return IntPtr.Zero;
+            }
+            catch (Exception e)
+            {
+                // The binding itself failed (no memory for a handle, say): the items still run.
+                Report("enqueue_task failed (the task runs on the calling thread)", e);
+                try
+                {
+                    if (system != null) Interlocked.Increment(ref system.tasksRunInline);
+                    if (t == null) t = new NativeTask(null, task, itemCount, minRange, taskContext);
+                    t.RunAndWait(0);
+                }
+                catch (Exception inner)
+                {
+                    Report("a task's items failed in enqueue_task", inner);
+                }
+                return IntPtr.Zero;
+            }
+        }
+
+        [AOT.MonoPInvokeCallback(typeof(FinishTaskFn))]
+        static void OnFinish(IntPtr userTask, IntPtr userContext)
+        {
+            GCHandle handle;
+            NativeTask t;
+            try
+            {
+                handle = GCHandle.FromIntPtr(userTask);
+                t = (NativeTask)handle.Target;
+            }
+            catch (Exception e)
+            {
+                // Not a handle OnEnqueue returned: the library broke its word; nothing to run.
+                Report("finish_task got a foreign task handle", e);
+                return;
+            }
+            TaskSystem system = t.Owner;
+            try
+            {
+                system.Finish(t);
+            }
+            catch (Exception e)
+            {
+                system.Failed("Finish", e);
+            }
+            try
+            {
+                // Whatever Finish did, the library hears of the task's end only once it ended.
+                if (!t.IsComplete) t.RunAndWait(system.SafeWorker());
+            }
+            catch (Exception e)
+            {
+                Report("a task's items failed in finish_task", e);
+            }
+            finally
+            {
+                handle.Free();
+                Interlocked.Decrement(ref system.tasksInFlight);
+            }
+        }
+
+        uint SafeWorker()
+        {
+            try
+            {
+                return CurrentWorker;
+            }
+            catch (Exception)
+            {
+                return 0;
+            }
+        }
+
+        static void Report(string what, Exception e)
+        {
+            try
+            {
+                Console.Error.WriteLine("sph: " + what + ": " + e);
+            }
+            catch (Exception)
+            {
+            }
+        }
+
+        void Failed(string what, Exception e)
+        {
+            Interlocked.Increment(ref failures);
+            try
+            {
+                OnFailure(what, e);
+            }
+            catch (Exception)
+            {
+            }
+        }
+
+        /// <summary>Called (on the failing thread) with an exception Enqueue or Finish threw,
+        /// after which the binding runs the task's items itself. The default writes it to
+        /// stderr; it must not throw.</summary>
+        protected virtual void OnFailure(string what, Exception e)
+        {
+            Console.Error.WriteLine("sph: " + GetType().Name + "." + what + " threw (its items run on the calling thread): " + e);
+        }
+    }
+
+    /// <summary>
+    /// A <see cref="TaskSystem"/> on System.Threading.ThreadPool: each task posts up to
+    /// MaxRunners pool work items that claim its ranges one at a time, and the finishing thread
+    /// runs the ranges no pool thread has claimed yet, then waits only for those in flight, so a
+    /// finish called inside an asynchronous step's task (nested) or while the pool is busy
+    /// never deadlocks. An asynchronous step (one item) goes to the pool, so StepBegin returns
+    /// at once. If the pool refuses work, the task runs on the enqueuing thread.
+    /// </summary>
+    public class ThreadPoolTaskSystem : TaskSystem
+    {
+        static readonly WaitCallback runner = RunOnPool;
+
+        [ThreadStatic] static int poolDepth;  // > 0 inside this class's pool work items
+
+        long itemsOnPool, itemsByCaller, nestedTasks;
+
+        /// <summary>maxRunners: the most pool work items one task posts; 0 (default) =
+        /// Environment.ProcessorCount.</summary>
+        public ThreadPoolTaskSystem(int maxRunners = 0)
+        {
+            if (maxRunners < 0) throw new ArgumentOutOfRangeException("maxRunners");
+            MaxRunners = maxRunners == 0 ? Math.Max(1, Environment.ProcessorCount) : maxRunners;
+        }
+
+        /// <summary>The most pool work items one task posts (the finishing thread helps too).</summary>
+        public int MaxRunners { get; private set; }
+        /// <summary>Items run by pool work items.</summary>
+        public long ItemsRunOnPool { get { return Interlocked.Read(ref itemsOnPool); } }
+        /// <summary>Items run off the pool: the unclaimed ranges a finishing thread ran itself,
+        /// and a whole task the enqueuing thread ran when the pool refused work.</summary>
+        public long ItemsRunByCaller { get { return Interlocked.Read(ref itemsByCaller); } }
+        /// <summary>Tasks enqueued from inside one of this system's pool work items: the loops
+        /// of asynchronous steps that ran on the pool.</summary>
+        public long NestedTasks { get { return Interlocked.Read(ref nestedTasks); } }
+
+        public override bool Enqueue(NativeTask task)
+        {
+            if (poolDepth > 0) Interlocked.Increment(ref nestedTasks);
+            long runners = Math.Min(task.RangeCount, (long)MaxRunners);
+            for (long i = 0; i < runners; ++i)
+            {
+                bool posted;
+                try
+                {
+                    posted = ThreadPool.UnsafeQueueUserWorkItem(runner, task);
+                }
+                catch (Exception)
+                {
+                    posted = false;
+                }
+                if (!posted)
+                {
+                    if (i > 0) break;  // the posted ones and the finish run the rest
+                    Interlocked.Add(ref itemsByCaller, task.RunRemaining(CurrentWorker));
+                    return false;      // none posted: all ran here
+                }
+            }
+            return true;
+        }
+
+        public override void Finish(NativeTask task)
+        {
+            Interlocked.Add(ref itemsByCaller, task.RunAndWait(CurrentWorker));
+        }
+
+        static void RunOnPool(object state)
+        {
+            var task = (NativeTask)state;
+            var system = (ThreadPoolTaskSystem)task.Owner;
+            ++poolDepth;
+            try
+            {
+                uint items = task.RunRemaining(system.CurrentWorker);
+                if (items != 0) Interlocked.Add(ref system.itemsOnPool, items);
+            }
+            catch (Exception e)
+            {
+                // An exception in a pool work item ends the process; the ranges it claimed are
+                // counted finished (RunNext's finally), so no finish waits for them.
+                Console.Error.WriteLine("sph: a task's items failed on the thread pool: " + e);
+            }
+            finally
+            {
+                --poolDepth;
+            }
         }
     }
 

@@ -255,6 +255,213 @@ static class Tests
         AssertEqual(live, Library.LiveObjectCount, "the world is gone (its context stays leaked)");
     }
 
+    // ---- the engine's task system (TaskSystem, ThreadPoolTaskSystem) ---------------------------
+
+    // A world above the CPU backend's parallel minimum (4096 particles: src/cpu/cpu_parallel.h),
+    // so that its loops go to the task system, in blocks of 1024.
+    static World TaskWorld(Context ctx)
+    {
+        var world = ctx.CreateWorld(SmallWorld(8192));
+        world.FillBox(new Vec3(-0.18f, 0, -0.18f), new Vec3(0.18f, 0.36f, 0.18f), new Vec3(0.3f, 0, 0));
+        Assert(world.ParticleCount > 4096, "a world the CPU backend splits: " + world.ParticleCount);
+        return world;
+    }
+
+    const float TaskFrame = 1f / 60f;
+
+    // Positions, velocities and ids after frames 1 to 4 of TaskWorld on a plain one-thread
+    // context (computed once: the task system's frames must be these bits).
+    static float[][] plainFrames;
+
+    static float[] TaskState(World world)
+    {
+        uint n = world.ParticleCount;
+        float[] state = new float[7 * n];
+        float[] v = new float[3 * n];
+        world.CopyAttribute(SphAttribute.Position, state);
+        world.CopyAttribute(SphAttribute.Velocity, v);
+        Array.Copy(v, 0, state, 3 * n, 3 * n);
+        uint[] ids = world.Ids();
+        for (int i = 0; i < ids.Length; ++i) state[6 * n + i] = BitConverter.ToSingle(BitConverter.GetBytes(ids[i]), 0);
+        return state;
+    }
+
+    static float[] PlainFrame(int frames)
+    {
+        if (plainFrames == null)
+        {
+            var states = new float[5][];
+            using (var ctx = Cpu())
+            using (var world = TaskWorld(ctx))
+                for (int f = 1; f <= 4; ++f)
+                {
+                    world.Step(TaskFrame);
+                    states[f] = TaskState(world);
+                }
+            plainFrames = states;
+        }
+        return plainFrames[frames];
+    }
+
+    static void AssertSameBits(float[] expected, float[] actual, string what)
+    {
+        AssertEqual(expected.Length, actual.Length, what + ": length");
+        for (int i = 0; i < expected.Length; ++i)
+            if (BitConverter.ToInt32(BitConverter.GetBytes(expected[i]), 0) != BitConverter.ToInt32(BitConverter.GetBytes(actual[i]), 0))
+                throw new Exception(what + ": element " + i + " differs: " + expected[i] + " vs " + actual[i]);
+    }
+
+    static Context CpuWithTasks(TaskSystem tasks, uint workers = 4)
+    {
+        var def = ContextDef.Default();
+        def.Backend = Backend.Cpu;
+        def.CpuWorkerCount = workers;  // > 1: loops run in parallel, on the task system
+        return new Context(def, null, tasks);
+    }
+
+    // Polls (never runs anything) until the frame StepBegin started has ended on the pool.
+    static void AwaitStepOnPool(World world)
+    {
+        var clock = System.Diagnostics.Stopwatch.StartNew();
+        while (!world.StepDone() && clock.Elapsed.TotalSeconds < 60) System.Threading.Thread.Sleep(1);
+        Assert(world.StepDone(), "the asynchronous step ended on the pool within 60 s");
+    }
+
+    public static void TestThreadPoolTaskSystem()
+    {
+        float[] frame3 = PlainFrame(3), frame4 = PlainFrame(4);
+        bool moved = false;
+        for (int i = 0; i < frame3.Length && !moved; ++i) moved = frame3[i] != frame4[i];
+        Assert(moved, "the fluid moves between frames (so equal bits say something)");
+        uint live = Library.LiveObjectCount;
+        var pool = new ThreadPoolTaskSystem();
+        var clock = System.Diagnostics.Stopwatch.StartNew();
+        using (var ctx = CpuWithTasks(pool))
+        {
+            Assert(ctx.TaskSystem == pool, "Context.TaskSystem");
+            AssertEqual(1, pool.ContextCount, "the context holds the task system");
+            using (var a = TaskWorld(ctx))
+            using (var b = TaskWorld(ctx))
+            {
+                // Synchronous steps: every loop through the pool, from this thread.
+                for (int f = 0; f < 3; ++f) a.Step(TaskFrame);
+                AssertSameBits(frame3, TaskState(a), "3 frames on the thread pool");
+                Assert(pool.TasksEnqueued > 0, "loops were enqueued");
+                Assert(pool.ItemsRunOnPool > 0, "items ran on pool threads");
+                AssertEqual(0L, pool.NestedTasks, "no nested task without an asynchronous step");
+                AssertEqual(0, pool.TasksInFlight, "every task finished (its GCHandle freed)");
+
+                // Asynchronous steps: the frame is one task on the pool, and its loops are tasks
+                // enqueued and finished from inside it (nested). Frame 1 is polled to its end,
+                // so the pool runs it; frame 2 is waited for at once (the wait may run it).
+                b.StepBegin(TaskFrame);
+                AwaitStepOnPool(b);
+                AssertEqual(1, pool.TasksInFlight, "the step's task awaits its finish (StepWait)");
+                AssertEqual(Result.Ok, b.StepWait(), "frame 1");
+                Assert(pool.NestedTasks > 0, "the step's loops were enqueued from inside its task on the pool");
+                b.StepBegin(TaskFrame);
+                AssertEqual(Result.Ok, b.StepWait(), "frame 2");
+                // Two worlds' frames side by side on the one pool.
+                b.StepBegin(TaskFrame);
+                a.StepBegin(TaskFrame);
+                AssertEqual(Result.Ok, a.StepWait(), "world a's frame 4");
+                AssertEqual(Result.Ok, b.StepWait(), "world b's frame 3");
+                AssertSameBits(frame3, TaskState(b), "3 asynchronous frames on the thread pool");
+                AssertSameBits(frame4, TaskState(a), "a 4th frame beside another world's");
+                AssertEqual(0, pool.TasksInFlight, "every task finished after the waits");
+                AssertEqual(0L, pool.TasksRunInline, "the pool refused nothing");
+                AssertEqual(0L, pool.Failures, "no failure");
+            }
+            AssertEqual(1, pool.ContextCount, "the context holds the task system until disposed");
+        }
+        AssertEqual(0, pool.ContextCount, "the context's GCHandle to the task system freed");
+        AssertEqual(0, pool.TasksInFlight, "no task handle left");
+        AssertEqual(live, Library.LiveObjectCount, "contexts and worlds released");
+        Console.WriteLine("  thread pool: " + pool.TasksEnqueued + " tasks (" + pool.NestedTasks + " nested), " +
+                          pool.ItemsRunOnPool + " items on the pool, " + pool.ItemsRunByCaller + " by callers, " +
+                          clock.ElapsedMilliseconds + " ms");
+    }
+
+    // A task system that breaks its contract every way the binding guards against: Enqueue
+    // throws, or claims to schedule the task and schedules nothing; Finish throws.
+    class UnreliableTaskSystem : TaskSystem
+    {
+        int calls;
+        public int Reported;
+
+        public override bool Enqueue(NativeTask task)
+        {
+            if (System.Threading.Interlocked.Increment(ref calls) % 2 == 0) throw new InvalidOperationException("no workers today");
+            return true;
+        }
+
+        public override void Finish(NativeTask task) { throw new InvalidOperationException("no finish either"); }
+
+        protected override void OnFailure(string what, Exception e) { System.Threading.Interlocked.Increment(ref Reported); }
+    }
+
+    // A task system that runs every task inside Enqueue (the NULL the header allows).
+    class InlineTaskSystem : TaskSystem
+    {
+        public override bool Enqueue(NativeTask task)
+        {
+            task.RunRemaining(CurrentWorker);
+            return false;
+        }
+    }
+
+    public static void TestTaskSystemsThatRunItemsInline()
+    {
+        float[] frame2 = PlainFrame(2);
+        uint live = Library.LiveObjectCount;
+        var inline = new InlineTaskSystem();
+        var unreliable = new UnreliableTaskSystem();
+        foreach (TaskSystem tasks in new TaskSystem[] { inline, unreliable })
+        {
+            using (var ctx = CpuWithTasks(tasks, 2))
+            using (var world = TaskWorld(ctx))
+            {
+                world.Step(TaskFrame);
+                world.StepBegin(TaskFrame);
+                if (tasks == inline) Assert(world.StepDone(), "a step whose task ran inside the enqueue ended in StepBegin");
+                AssertEqual(Result.Ok, world.StepWait(), "the asynchronous frame");
+                AssertSameBits(frame2, TaskState(world), tasks.GetType().Name + ": 2 frames");
+                Assert(tasks.TasksEnqueued > 0, "tasks enqueued");
+                AssertEqual(0, tasks.TasksInFlight, "every task finished");
+            }
+            AssertEqual(0, tasks.ContextCount, "the context's GCHandle freed");
+        }
+        AssertEqual(inline.TasksEnqueued, inline.TasksRunInline, "every task ran inline");
+        AssertEqual(0L, inline.Failures, "the inline system never failed");
+        Assert(unreliable.Failures > 0 && unreliable.Failures == unreliable.Reported, "failures caught and reported: " + unreliable.Failures);
+        Assert(unreliable.TasksRunInline > 0 && unreliable.TasksRunInline < unreliable.TasksEnqueued, "half the tasks ran inline");
+        AssertEqual(live, Library.LiveObjectCount, "contexts and worlds released");
+    }
+
+    public static void TestTaskSystemContextErrors()
+    {
+        var pool = new ThreadPoolTaskSystem(2);
+        AssertEqual(2, pool.MaxRunners, "MaxRunners");
+        var def = ContextDef.Default();
+        def.Backend = Backend.Cpu;
+        def.EnqueueTask = new IntPtr(1);  // the raw fields and a TaskSystem: refused
+        try
+        {
+            new Context(def, null, pool).Dispose();
+            throw new Exception("a def with raw task fields and a TaskSystem was accepted");
+        }
+        catch (ArgumentException)
+        {
+        }
+        def = ContextDef.Default();
+        def.Backend = Backend.Cpu;
+        def.CudaDensityBlock = 3;  // a context the library refuses: the task system is let go
+        Throws(Result.ErrorInvalidArgument, () => new Context(def, null, pool));
+        AssertEqual(0, pool.ContextCount, "no GCHandle kept by a failed context");
+        using (var ctx = new Context(ContextDef.Default(), null, null))
+            Assert(ctx.TaskSystem == null, "no task system");
+    }
+
     // ---- worlds -----------------------------------------------------------------------------
 
     public static void TestWorldDefAndMass()
