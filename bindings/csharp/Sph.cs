@@ -813,7 +813,10 @@ namespace Sph
                 }
                 catch (Exception inner)
                 {
-                    Report("a task's items failed in enqueue_task", inner);
+                    // The items could not run (no delegate for the native function, no memory):
+                    // returning NULL would tell the library they had, and it would go on with a
+                    // frame half computed. Stop the process with the reason instead.
+                    Environment.FailFast("sph: enqueue_task could not run a task's items: " + inner);
                 }
                 return IntPtr.Zero;
             }
