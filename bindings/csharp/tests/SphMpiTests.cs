@@ -358,6 +358,8 @@ static class MpiTests
         }
         Console.WriteLine(passed + " passed, " + failed + " failed");
         Mpi.Shutdown();  // MPI_Finalize, after every world was disposed (their destroy is collective)
-        return failed == 0 ? 0 : 1;
+        // An empty list of tests is a failure, not an empty pass.
+        if (passed + failed == 0) Console.WriteLine("FAIL no test ran");
+        return failed == 0 && passed > 0 ? 0 : 1;
     }
 }

@@ -1829,6 +1829,8 @@ static class Tests
             }
         }
         Console.WriteLine(passed + " passed, " + failed + " failed");
-        return failed == 0 ? 0 : 1;
+        // No test found (a renamed or non-public method) is a failure, not an empty pass.
+        if (passed + failed == 0) Console.WriteLine("FAIL no Test* method ran");
+        return failed == 0 && passed > 0 ? 0 : 1;
     }
 }
