@@ -167,3 +167,10 @@ sph_build() {
 sph_has_target() {
   ninja -C "$1" -t query "$2" >/dev/null 2>&1
 }
+
+# The tests a ctest log lists as skipped (exit 77, SKIP_RETURN_CODE: what they need is missing
+# there), comma-separated: ctest's "tests passed" line counts them as passed, so the scripts name
+# them beside it. Empty when none.
+sph_ctest_skipped() {
+  grep -E '^\s+[0-9]+ - .*\(Skipped\)' "$1" | awk '{print $3}' | paste -sd, - || true
+}
