@@ -64,6 +64,11 @@ inline void require(sph_result r, sph_result expected, const char* what) {
 inline void require_ok(sph_result r, const char* what) {
   if (r < 0) require(r, SPH_OK, what);
 }
+// Stops the program with a FAIL line for a check that cannot run as it was asked to.
+inline void fail_exit(const char* why) {
+  std::printf("FAIL setup: %s\n", why);
+  std::exit(1);
+}
 
 inline void exit_if_no_cuda() {
   sph_context_def def;
@@ -96,37 +101,55 @@ inline ContextTuning& context_tuning() {
 
 // Written against the fields by template (a def without them is left alone), because
 // scripts/compare-state builds this header against revisions from before the fields existed.
+// Each returns whether the def had the field, so that a tuning a check asks for (a non-default
+// value) fails loudly, rather than running untuned, when a field is renamed or missing.
 template <class Def>
-auto apply_context_tuning(Def& def, int) -> decltype(def.cuda_frames, def.cuda_density_block, void()) {
+auto apply_context_tuning(Def& def, int) -> decltype(def.cuda_frames, def.cuda_density_block, bool()) {
   const char* graphs = std::getenv("SPH_CUDA_GRAPHS");
   const bool stream = context_tuning().stream_frames || (graphs && std::strcmp(graphs, "0") == 0);
   def.cuda_frames =
       static_cast<decltype(def.cuda_frames)>(stream ? 1 : 0);  // SPH_CUDA_FRAMES_STREAM : _GRAPH
   def.cuda_density_block = context_tuning().density_block;
   def.cuda_force_block = context_tuning().force_block;
+  return true;
 }
 template <class Def>
-void apply_context_tuning(Def&, long) {}
+bool apply_context_tuning(Def&, long) {
+  return false;
+}
 template <class Def>
-auto apply_particle_lanes(Def& def, int) -> decltype(def.cuda_particle_lanes, void()) {
+auto apply_particle_lanes(Def& def, int) -> decltype(def.cuda_particle_lanes, bool()) {
   def.cuda_particle_lanes = context_tuning().particle_lanes;
+  return true;
 }
 template <class Def>
-void apply_particle_lanes(Def&, long) {}
+bool apply_particle_lanes(Def&, long) {
+  return false;
+}
 template <class Def>
-auto apply_dfsph_masks(Def& def, int) -> decltype(def.cuda_dfsph_masks, void()) {
+auto apply_dfsph_masks(Def& def, int) -> decltype(def.cuda_dfsph_masks, bool()) {
   def.cuda_dfsph_masks = context_tuning().dfsph_masks;
+  return true;
 }
 template <class Def>
-void apply_dfsph_masks(Def&, long) {}
+bool apply_dfsph_masks(Def&, long) {
+  return false;
+}
 
 inline sph_context* make_context(sph_backend backend) {
   sph_context_def def;
   sph_context_def_init(&def);
   def.backend = backend;
-  apply_context_tuning(def, 0);
-  apply_particle_lanes(def, 0);
-  apply_dfsph_masks(def, 0);
+  const ContextTuning& tuning = context_tuning();
+  const bool asked_frames = tuning.stream_frames || tuning.density_block || tuning.force_block;
+  if (!apply_context_tuning(def, 0) && asked_frames)
+    fail_exit(
+        "the check asks for cuda_frames / cuda_density_block / cuda_force_block, which this "
+        "build's sph_context_def lacks");
+  if (!apply_particle_lanes(def, 0) && tuning.particle_lanes)
+    fail_exit("the check asks for cuda_particle_lanes, which this build's sph_context_def lacks");
+  if (!apply_dfsph_masks(def, 0) && tuning.dfsph_masks)
+    fail_exit("the check asks for cuda_dfsph_masks, which this build's sph_context_def lacks");
   sph_context* context = nullptr;
   require_ok(sph_context_create(&def, &context), "sph_context_create");
   return context;
