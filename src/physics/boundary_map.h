@@ -118,6 +118,12 @@ SPH_HD float boundary_quadrature_share(const SdfGridView& g, Vec3 x, float phi, 
   kink = kink < -1.0f ? -1.0f : (kink > 1.0f ? 1.0f : kink);
   float share = 0.0f;
   const float azimuth_weight = 2.0f * kPi / static_cast<float>(kBoundaryMapAzimuths);
+  // The azimuths' in-plane directions, once a node rather than once a ray (the same values).
+  Vec3 across[kBoundaryMapAzimuths];
+  for (int p = 0; p < kBoundaryMapAzimuths; ++p) {
+    const float angle = azimuth_weight * (static_cast<float>(p) + 0.5f);
+    across[p] = t1 * SPH_COSF(angle) + t2 * SPH_SINF(angle);
+  }
   for (int part = 0; part < 2; ++part) {
     const float lo = part == 0 ? -1.0f : kink, hi = part == 0 ? kink : 1.0f;
     if (!(hi > lo)) continue;
@@ -128,8 +134,7 @@ SPH_HD float boundary_quadrature_share(const SdfGridView& g, Vec3 x, float phi, 
       const float sin_theta = SPH_SQRTF(1.0f - mu * mu > 0.0f ? 1.0f - mu * mu : 0.0f);
       const float w_mu = 0.5f * (hi - lo) * weight * azimuth_weight;
       for (int p = 0; p < kBoundaryMapAzimuths; ++p) {
-        const float angle = azimuth_weight * (static_cast<float>(p) + 0.5f);
-        const Vec3 w = n * mu + (t1 * SPH_COSF(angle) + t2 * SPH_SINF(angle)) * sin_theta;
+        const Vec3 w = n * mu + across[p] * sin_theta;
         share += w_mu * integrate_ray(g, x, w, h, level, steps, phi);
       }
     }
