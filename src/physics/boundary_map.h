@@ -72,26 +72,32 @@ SPH_HD void gauss_legendre8(int q, float& x, float& w) {
 
 constexpr int kBoundaryMapAzimuths = 8;
 
-// The radial integral of W r^2 over the solid's part of the ray x + r w, r in [0, h].
-SPH_HD float integrate_ray(const SdfGridView& g, Vec3 x, Vec3 w, float h, float level, int steps,
-                           float phi0) {
-  float out = 0.0f;
-  float r0 = 0.0f, a = phi0;
+// The radial integrals of W r^2 over the solid's parts of the kBoundaryMapAzimuths rays x + r w[p],
+// r in [0, h], marched together: each ray's arithmetic and order are those of one ray alone, and
+// the rays' samples of a step are taken together, so that the CPU's compiler can overlap them.
+SPH_HD void integrate_rays(const SdfGridView& g, Vec3 x, const Vec3* w, float h, float level, int steps,
+                           float phi0, float* out) {
+  constexpr int kRays = kBoundaryMapAzimuths;
+  float a[kRays], b[kRays];
+  for (int p = 0; p < kRays; ++p) a[p] = phi0, out[p] = 0.0f;
+  float r0 = 0.0f;
   for (int k = 1; k <= steps; ++k) {
     const float r1 = h * static_cast<float>(k) / static_cast<float>(steps);
-    const float b = sample_distance(g, x + w * r1) - level;
-    float lo = 1.0f, hi = 0.0f;  // the solid's part of [r0, r1], empty unless set
-    if (a < 0.0f && b < 0.0f) {
-      lo = r0, hi = r1;
-    } else if (a < 0.0f) {
-      lo = r0, hi = r0 + (r1 - r0) * (a / (a - b));
-    } else if (b < 0.0f) {
-      lo = r0 + (r1 - r0) * (a / (a - b)), hi = r1;
+    for (int p = 0; p < kRays; ++p) b[p] = sample_distance(g, x + w[p] * r1) - level;
+    for (int p = 0; p < kRays; ++p) {
+      float lo = 1.0f, hi = 0.0f;  // the solid's part of [r0, r1], empty unless set
+      if (a[p] < 0.0f && b[p] < 0.0f) {
+        lo = r0, hi = r1;
+      } else if (a[p] < 0.0f) {
+        lo = r0, hi = r0 + (r1 - r0) * (a[p] / (a[p] - b[p]));
+      } else if (b[p] < 0.0f) {
+        lo = r0 + (r1 - r0) * (a[p] / (a[p] - b[p])), hi = r1;
+      }
+      if (hi > lo) out[p] += spiky_radial_volume(hi, h) - spiky_radial_volume(lo, h);
+      a[p] = b[p];
     }
-    if (hi > lo) out += spiky_radial_volume(hi, h) - spiky_radial_volume(lo, h);
-    r0 = r1, a = b;
+    r0 = r1;
   }
-  return out;
 }
 
 // Radial samples per ray: every half of the smallest voxel, at least 8, at most 64.
@@ -133,10 +139,11 @@ SPH_HD float boundary_quadrature_share(const SdfGridView& g, Vec3 x, float phi, 
       const float mu = 0.5f * (lo + hi) + 0.5f * (hi - lo) * node;
       const float sin_theta = SPH_SQRTF(1.0f - mu * mu > 0.0f ? 1.0f - mu * mu : 0.0f);
       const float w_mu = 0.5f * (hi - lo) * weight * azimuth_weight;
-      for (int p = 0; p < kBoundaryMapAzimuths; ++p) {
-        const Vec3 w = n * mu + across[p] * sin_theta;
-        share += w_mu * integrate_ray(g, x, w, h, level, steps, phi);
-      }
+      Vec3 w[kBoundaryMapAzimuths];
+      float radial[kBoundaryMapAzimuths];
+      for (int p = 0; p < kBoundaryMapAzimuths; ++p) w[p] = n * mu + across[p] * sin_theta;
+      integrate_rays(g, x, w, h, level, steps, phi, radial);
+      for (int p = 0; p < kBoundaryMapAzimuths; ++p) share += w_mu * radial[p];
     }
   }
   return share;
