@@ -138,13 +138,13 @@ inline void compare_scene(const SceneHooks& h) {
   report(c.stats.substeps == g.stats.substeps && c.state.count == g.state.count, (name + "/substeps").c_str(),
          "%u/%u particles, %u/%u substeps (GPU/CPU), %zu removed", g.state.count, c.state.count,
          g.stats.substeps, c.stats.substeps, c.removed.size());
-  // The removed ids as a set must match; their order (storage order) matches too unless a
-  // particle sits within rounding of a cell boundary, where the two backends' 1e-7 differences
-  // can sort it differently: reported, not required.
   if (h.expects_removal)
     report(!c.removed.empty() && !g.removed.empty(), (name + "/removal_happened").c_str(),
            "%zu/%zu particles removed (GPU/CPU); the scene's sinks must remove some", g.removed.size(),
            c.removed.size());
+  // The removed ids as a set must match; their order (storage order) matches too unless a
+  // particle sits within rounding of a cell boundary, where the two backends' 1e-7 differences
+  // can sort it differently: reported, not required.
   std::vector<uint32_t> cr = c.removed, gr = g.removed;
   std::sort(cr.begin(), cr.end());
   std::sort(gr.begin(), gr.end());
