@@ -407,6 +407,16 @@ void check_load_growth_failure() {
          failed, ok ? "" : ": ", problem.c_str());
 }
 
+// The fill both fill_box calls make: a block beside the scene's water (into free capacity, or
+// growing a full world).
+sph_result fill_block(Scene& s) {
+  sph_fill_box_desc box;
+  sph_fill_box_desc_init(&box);
+  box.min = sph_vec3{0.05f, -0.18f, -0.08f};
+  box.max = sph_vec3{0.15f, -0.1f, 0.08f};
+  return sph_world_fill_box(s.world, &box, nullptr);
+}
+
 }  // namespace
 
 int main() {
@@ -452,30 +462,14 @@ int main() {
          return sph_world_create(s.context, &def, &made_world);
        },
        [&](Scene&) { sph_world_destroy(made_world); }, false},
-      allocation_free({"sph_world_fill_box", Objects::None,
-                       [](Scene& s) {
-                         sph_fill_box_desc box;
-                         sph_fill_box_desc_init(&box);
-                         box.min = sph_vec3{0.05f, -0.18f, -0.08f};
-                         box.max = sph_vec3{0.15f, -0.1f, 0.08f};
-                         return sph_world_fill_box(s.world, &box, nullptr);
-                       },
-                       nullptr, true}),
+      allocation_free({"sph_world_fill_box", Objects::None, fill_block, nullptr, true}),
       {"sph_world_step (the first frame of a collider, a source and a sink)", Objects::AfterFirstStep,
        [](Scene& s) { return sph_world_step(s.world, kFrameDt); }, nullptr, true},
       allocation_free({"sph_world_step (scene)", Objects::BeforeFirstStep,
                        [](Scene& s) { return sph_world_step(s.world, kFrameDt); }, nullptr, true}),
       allocation_free({"sph_world_step (plain)", Objects::None,
                        [](Scene& s) { return sph_world_step(s.world, kFrameDt); }, nullptr, true}),
-      {"sph_world_fill_box (growing a full world)", Objects::None,
-       [](Scene& s) {
-         sph_fill_box_desc box;
-         sph_fill_box_desc_init(&box);
-         box.min = sph_vec3{0.05f, -0.18f, -0.08f};
-         box.max = sph_vec3{0.15f, -0.1f, 0.08f};
-         return sph_world_fill_box(s.world, &box, nullptr);
-       },
-       nullptr, true, true},
+      {"sph_world_fill_box (growing a full world)", Objects::None, fill_block, nullptr, true, true},
       {"sph_world_step (a source growing a full world; a sink reserving for the new capacity)",
        Objects::AfterFirstStep, [](Scene& s) { return sph_world_step(s.world, kFrameDt); }, nullptr, true,
        true},
