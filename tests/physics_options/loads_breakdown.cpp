@@ -31,8 +31,9 @@
 // --sample-every N: read back and sum only every Nth of them (default 1; the others are stepped
 // unread, a cheaper average of the same window at fine steps). The last line, RESULT ..., is for
 // scripts (scripts/loads-resolution). --check-loads: fail unless the loads on the box
-// equal the host's sum of its walls' reaction and the loads on both colliders the fluid's
-// momentum change (M g - dP/dt), each within 1e-3 N (the ctest physics_loads_breakdown_dfsph).
+// equal the host's sum of its walls' reaction over the substeps that end with no particle on its
+// surface (at least half of them) and the loads on both colliders the fluid's momentum change
+// (M g - dP/dt) over all of them, each within 1e-3 N (the ctest physics_loads_breakdown_dfsph).
 //
 // --box-voxel: the box's SDF voxel (default: about step / 2, a whole number across its half side, so
 // that its faces lie on samples); 0.0055 at the default step puts its faces between samples, as a
@@ -290,6 +291,11 @@ int main(int argc, char** argv) {
   Tally tally[kRegions];
   double interior_ratio = 0.0, interior_count = 0.0, level_sum = 0.0, plane_sum = 0.0;
   double api[3] = {0.0, 0.0, 0.0}, api_time = 0.0;
+  // --check-loads' per-box comparison runs over the substeps that end with no particle on the box's
+  // surface: the loads there hold the walls' reaction alone (the contacts' share is what separates
+  // the two elsewhere, and no independent measure of it exists on the host).
+  double clear_api[3] = {0.0, 0.0, 0.0}, clear_host[3] = {0.0, 0.0, 0.0}, clear_time = 0.0;
+  int clear_samples = 0;
   int samples = 0;
   loads_sampling::SubstepReader reader(kept);
   std::vector<float>&x = reader.start, &after = reader.end, &rho = reader.density, &p = reader.pressure;
@@ -410,12 +416,16 @@ int main(int argc, char** argv) {
     if (!reader.frame(w.world, sampled, frame, frame_time, step_counted)) return 1;
     if (!sampled) continue;
     count = reader.count;
+    double sample_api[3] = {0.0, 0.0, 0.0}, sample_host[3] = {0.0, 0.0, 0.0}, sample_time = 0.0;
+    bool sample_touched = false;  // a particle ended this substep on or in the box's surface
     if (loads) {
       sph_collider_loads l;
       check(sph_collider_loads_init(&l), "sph_collider_loads_init");
       check(sph_collider_get_loads(w.world, box, &l), "sph_collider_get_loads");
-      api[0] += l.force.x * l.frame_time, api[1] += l.force.y * l.frame_time,
-          api[2] += l.force.z * l.frame_time;
+      sample_api[0] = l.force.x * l.frame_time, sample_api[1] = l.force.y * l.frame_time,
+      sample_api[2] = l.force.z * l.frame_time;
+      sample_time = l.frame_time;
+      for (int k = 0; k < 3; ++k) api[k] += sample_api[k];
       api_time += l.frame_time;
       check(sph_collider_get_loads(w.world, tank, &l), "sph_collider_get_loads");
       tank_loads[0] += l.force.x * l.frame_time, tank_loads[1] += l.force.y * l.frame_time;
@@ -470,17 +480,23 @@ int main(int argc, char** argv) {
       }
       Tally& t = tally[region_of(local)];
       const double f[3] = {c * s.gradient.x, c * s.gradient.y, c * s.gradient.z};
-      for (int k = 0; k < 3; ++k) t.force[k] += f[k];
+      for (int k = 0; k < 3; ++k) t.force[k] += f[k], sample_host[k] += f[k];
       if (region_of(local) == kSides) t.normal += std::fabs(std::fabs(local[0]) > kHalf ? f[0] : f[2]);
       t.count += f[0] != 0.0 || f[1] != 0.0 || f[2] != 0.0;
       {
         const sph::Vec3 end{static_cast<float>(after[3 * i] - kCentre[0]),
                             static_cast<float>(after[3 * i + 1] - kCentre[1]),
                             static_cast<float>(after[3 * i + 2] - kCentre[2])};
-        t.contacts += sph::sample_distance(grid, end) < 1e-5f;
+        const bool touched = sph::sample_distance(grid, end) < 1e-5f;
+        t.contacts += touched;
+        sample_touched = sample_touched || touched;
       }
       if (distance < h) t.near += 1.0, t.density += rho[i] / rho0, t.pressure_ratio += ratio;
       if (interior(i, plane - 0.03)) interior_ratio += ratio, interior_count += 1.0;
+    }
+    if (!sample_touched) {
+      for (int k = 0; k < 3; ++k) clear_api[k] += sample_api[k], clear_host[k] += sample_host[k];
+      clear_time += sample_time, ++clear_samples;
     }
     ++samples;
     reader.advance();
@@ -588,19 +604,27 @@ int main(int argc, char** argv) {
                   (api[1] + tank_loads[1]) / api_time - total[1] - tank_walls[1] / samples,
                   (api[2] + tank_loads[2]) / api_time - total[2] - tank_walls[2] / samples);
     if (check_loads) {
-      // The loads on the box against the host's sum of its walls' reaction over the same substeps,
-      // and the loads on both colliders against the fluid's momentum (M g - dP/dt). Bound 1e-3 N
-      // (5e-4 of rho0 g V): the float sums' rounding over ~2400 particles and the window, and on
-      // the box the contacts' and the contact clamp's share, which the settled state leaves at
-      // zero (measured 0.0000 N on both solvers at 800 substeps).
+      // The loads on the box against the host's sum of its walls' reaction, over the substeps that
+      // end with no particle on the box's surface (a settled box still gets a touch now and then: a
+      // float's rounding decides it, 0.0017-0.0022 N of contacts in 1 of 5 draws on either backend,
+      // session 48), and the loads on both colliders against the fluid's momentum (M g - dP/dt)
+      // over every substep, contacts included on both sides. Bound 1e-3 N (5e-4 of rho0 g V): the
+      // float sums' rounding over ~2400 particles and the window (measured below 1e-5 N), and
+      // DFSPH's contact clamp, which acts without a contact (0.0000 N once settled). At least half
+      // the substeps must be free of contacts, or the box's comparison would rest on too few.
       double worst = 0.0;
       for (int k = 0; k < 3; ++k) {
-        worst = std::fmax(worst, std::fabs(api[k] / api_time - total[k]));
+        if (clear_samples > 0)
+          worst = std::fmax(worst, std::fabs(clear_api[k] / clear_time - clear_host[k] / clear_samples));
         const double all = (api[k] + tank_loads[k]) / api_time;
         worst = std::fmax(worst, std::fabs(all - (-(k == 1 ? weight : 0.0) - momentum[k] / seconds)));
       }
-      const bool pass = loads && worst <= 1e-3;
-      std::printf("check-loads %s (largest difference %.3g N)\n", pass ? "passed" : "FAILED", worst);
+      const bool enough = 2 * clear_samples >= samples;
+      const bool pass = loads && enough && worst <= 1e-3;
+      std::printf(
+          "check-loads %s (largest difference %.3g N; the box's loads against its walls' reaction over %d "
+          "of the %d substeps, those that end with no particle on its surface%s)\n",
+          pass ? "passed" : "FAILED", worst, clear_samples, samples, enough ? "" : ": fewer than half");
       if (!pass) return 1;
     }
   }
