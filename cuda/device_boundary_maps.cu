@@ -14,7 +14,8 @@ __global__ void boundary_map_kernel(SdfGridView sdf, Affine3x4 index_to_local, f
   const int32_t i = static_cast<int32_t>(v % static_cast<uint64_t>(sdf.nx));
   const int32_t j = static_cast<int32_t>(row % static_cast<uint64_t>(sdf.ny));
   const int32_t k = static_cast<int32_t>(row / static_cast<uint64_t>(sdf.ny));
-  map[v] = Float4{boundary_map_correction(sdf, index_to_local, i, j, k, h, level), 0.0f, 0.0f, 0.0f};
+  map[v] =
+      Float4{boundary_map_correction(sdf, index_to_local, i, j, k, h, level, SdfSlope{}), 0.0f, 0.0f, 0.0f};
 }
 
 // After boundary_map_kernel (every value in place): each voxel's slopes from its neighbours'

@@ -15,6 +15,7 @@
 
 #include "../core/host_memory.h"
 #include "../core/sdf_asset.h"
+#include "../physics/boundary_map.h"
 #include "../physics/float4_types.h"
 #include "cpu_parallel.h"
 
@@ -53,5 +54,15 @@ class CpuBoundaryMaps {
 // brute-force integral.
 HostVector<Float4> compute_boundary_map(const SdfAsset& asset, float h, float level,
                                         const CpuParallel& parallel);
+
+// A bound on the slope of the asset's sample_distance along any local direction, from its values:
+// the trilinear interpolant's slope along an index axis is a mix of the differences of
+// neighbouring values along it, so it is at most their largest magnitude D_a (per index step);
+// outside the grid the distance to the grid's box adds at most min_voxel_size per index step; and
+// index_to_local's inverse stretches a local step by at most the square root of its matrix's
+// largest row sum times its largest column sum. The result is rounded up; a grid holding a
+// non-finite value gives none (0). compute_boundary_map uses it to skip ray samples that cannot
+// reach the solid (boundary_map.h, integrate_rays); exposed for tests.
+SdfSlope sdf_slope(const SdfAsset& asset, const CpuParallel& parallel);
 
 }  // namespace sph

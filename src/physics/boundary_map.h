@@ -72,18 +72,57 @@ SPH_HD void gauss_legendre8(int q, float& x, float& w) {
 
 constexpr int kBoundaryMapAzimuths = 8;
 
+// What lets a ray skip samples: a bound L on the slope of sample_distance along any local direction
+// (boundary_map_slope_bound), so that a sample at distance v > 0 proves every point within v / L of
+// it outside the solid. `inverse` is 1 / L (0: no bound known, every sample taken); `slack` (m) is
+// taken off v first, for the float rounding of the sampled points and values (the skipped samples
+// must be ones that would have read >= 0 when computed).
+struct RaySkip {
+  float inverse = 0.0f;
+  float slack = 0.0f;
+};
+
 // The radial integrals of W r^2 over the solid's parts of the kBoundaryMapAzimuths rays x + r w[p],
 // r in [0, h], marched together: each ray's arithmetic and order are those of one ray alone, and
 // the rays' samples of a step are taken together, so that the CPU's compiler can overlap them.
+// A step where the skip bound proves, for every ray, which side of the surface it lies on is not
+// sampled (the rays of a polar angle see a flat wall alike, so they clear together): an interval
+// with both ends outside adds nothing and one with both ends inside adds its whole radial integral,
+// neither needing the values; where a ray's sample after such steps lies on the other side, the
+// sample before it is taken then. So the sums are the bits that every sample gives.
 SPH_HD void integrate_rays(const SdfGridView& g, Vec3 x, const Vec3* w, float h, float level, int steps,
-                           float phi0, float* out) {
+                           float phi0, RaySkip skip, float* out) {
   constexpr int kRays = kBoundaryMapAzimuths;
   float a[kRays], b[kRays];
-  for (int p = 0; p < kRays; ++p) a[p] = phi0, out[p] = 0.0f;
+  // Up to r = known[p] the ray is proved (by a sample) to stay inside the solid (inside[p]) or
+  // outside it; every ray up to r = known_all.
+  float known[kRays];
+  bool inside[kRays];
+  const float phi0_size = phi0 < 0.0f ? -phi0 : phi0;
+  const float start = phi0_size > skip.slack ? (phi0_size - skip.slack) * skip.inverse : 0.0f;
+  for (int p = 0; p < kRays; ++p) a[p] = phi0, out[p] = 0.0f, known[p] = start, inside[p] = phi0 < 0.0f;
+  float known_all = start;
+  bool skipped =
+      false;  // the step before this one was not sampled (a[] holds values of the right sides, not r0's)
   float r0 = 0.0f;
   for (int k = 1; k <= steps; ++k) {
     const float r1 = h * static_cast<float>(k) / static_cast<float>(steps);
+    if (r1 < known_all) {
+      for (int p = 0; p < kRays; ++p)
+        if (inside[p] && r1 > r0) out[p] += spiky_radial_volume(r1, h) - spiky_radial_volume(r0, h);
+      skipped = true;
+      r0 = r1;
+      continue;
+    }
     for (int p = 0; p < kRays; ++p) b[p] = sample_distance(g, x + w[p] * r1) - level;
+    if (skipped) {
+      // A ray whose sample lies on the other side needs r0's own value; the others' intervals
+      // take none, and a[] holds a value of their side (a sample within the ray's proved reach).
+      for (int p = 0; p < kRays; ++p)
+        if ((b[p] < 0.0f) != inside[p]) a[p] = sample_distance(g, x + w[p] * r0) - level;
+      skipped = false;
+    }
+    known_all = h;
     for (int p = 0; p < kRays; ++p) {
       float lo = 1.0f, hi = 0.0f;  // the solid's part of [r0, r1], empty unless set
       if (a[p] < 0.0f && b[p] < 0.0f) {
@@ -95,6 +134,10 @@ SPH_HD void integrate_rays(const SdfGridView& g, Vec3 x, const Vec3* w, float h,
       }
       if (hi > lo) out[p] += spiky_radial_volume(hi, h) - spiky_radial_volume(lo, h);
       a[p] = b[p];
+      const float size = b[p] < 0.0f ? -b[p] : b[p];
+      const float reach = size > skip.slack ? r1 + (size - skip.slack) * skip.inverse : 0.0f;
+      if (reach > known[p]) known[p] = reach, inside[p] = b[p] < 0.0f;
+      known_all = known[p] < known_all ? known[p] : known_all;
     }
     r0 = r1;
   }
@@ -106,10 +149,36 @@ SPH_HD int boundary_map_ray_steps(const SdfGridView& g, float h) {
   return n < 8.0f ? 8 : (n > 64.0f ? 64 : static_cast<int>(SPH_CEILF(n)));
 }
 
+// What the host knows of an SDF's slope (sdf_slope on the CPU backend; none on the device):
+// `bound`, a bound on the slope of sample_distance along any local direction (0: none known), and
+// `cell_change`, the most its value can change across one voxel (bound times the largest voxel
+// diagonal).
+struct SdfSlope {
+  float bound = 0.0f;
+  float cell_change = 0.0f;
+};
+
+// The skip of the rays from local point x, a node within h of the surface. The slack is 2^-14 of
+// the scales that the float rounding acts on, hundreds of times the rounding itself: the sampled
+// point's (ulps of |x| + h, times the slope) and the sampled value's (ulps of the values a cell
+// within h of the surface holds: h, a cell's change, the level).
+SPH_HD RaySkip ray_skip_at(Vec3 x, float h, float level, SdfSlope slope) {
+  RaySkip skip;
+  if (!(slope.bound > 0.0f)) return skip;
+  const float ax = x.x < 0.0f ? -x.x : x.x, ay = x.y < 0.0f ? -x.y : x.y, az = x.z < 0.0f ? -x.z : x.z;
+  const float reach = (ax > ay ? (ax > az ? ax : az) : (ay > az ? ay : az)) + h;
+  const float values = 4.0f * h + slope.cell_change + (level < 0.0f ? -level : level);
+  skip.inverse = 1.0f / slope.bound;
+  skip.slack = 6.103515625e-05f * (slope.bound * reach + values);
+  return skip;
+}
+
 // The share of the solid {phi < level} at local point x by the quadrature above, phi the SDF
 // there less level (a node's own value for the map; sample_distance elsewhere): no map and no
 // interpolation, what the map stores at a node and what tests compare the sampling with.
-SPH_HD float boundary_quadrature_share(const SdfGridView& g, Vec3 x, float phi, float h, float level) {
+// slope: what lets the rays skip samples (ray_skip_at; none: every sample taken; the same share).
+SPH_HD float boundary_quadrature_share(const SdfGridView& g, Vec3 x, float phi, float h, float level,
+                                       SdfSlope slope = SdfSlope{}) {
   if (!(phi > -h)) return 1.0f;
   if (!(phi < h)) return 0.0f;
   Vec3 n = sample_normal(g, x);
@@ -120,6 +189,7 @@ SPH_HD float boundary_quadrature_share(const SdfGridView& g, Vec3 x, float phi, 
   t1 = t1 * (1.0f / length(t1));
   const Vec3 t2 = cross(n, t1);
   const int steps = boundary_map_ray_steps(g, h);
+  const RaySkip skip = ray_skip_at(x, h, level, slope);
   float kink = -phi / h;
   kink = kink < -1.0f ? -1.0f : (kink > 1.0f ? 1.0f : kink);
   float share = 0.0f;
@@ -142,7 +212,7 @@ SPH_HD float boundary_quadrature_share(const SdfGridView& g, Vec3 x, float phi, 
       Vec3 w[kBoundaryMapAzimuths];
       float radial[kBoundaryMapAzimuths];
       for (int p = 0; p < kBoundaryMapAzimuths; ++p) w[p] = n * mu + across[p] * sin_theta;
-      integrate_rays(g, x, w, h, level, steps, phi, radial);
+      integrate_rays(g, x, w, h, level, steps, phi, skip, radial);
       for (int p = 0; p < kBoundaryMapAzimuths; ++p) share += w_mu * radial[p];
     }
   }
@@ -166,16 +236,16 @@ SPH_HD float spiky_half_space_inverse(float q, float h) {
 // The correction of voxel (i, j, k) for the solid {phi < level} (index_to_local is the inverse of
 // g.local_to_index): for a solid's map (map_corrects_distance) the offset e (m) that makes the flat
 // share of the moved distance the quadrature's share, Phi_flat(phi - level + e) = Phi; otherwise
-// the share Phi - Phi_flat(phi - level).
+// the share Phi - Phi_flat(phi - level). slope: as for boundary_quadrature_share (the same value).
 SPH_HD float boundary_map_correction(const SdfGridView& g, const Affine3x4& index_to_local, int32_t i,
-                                     int32_t j, int32_t k, float h, float level) {
+                                     int32_t j, int32_t k, float h, float level, SdfSlope slope) {
   const float phi =
       -level +
       g.distance[static_cast<int64_t>(i) + static_cast<int64_t>(g.nx) * (j + static_cast<int64_t>(g.ny) * k)];
   if (!(phi > -h && phi < h)) return 0.0f;
   const Vec3 x =
       apply_affine(index_to_local, Vec3{static_cast<float>(i), static_cast<float>(j), static_cast<float>(k)});
-  const float share = boundary_quadrature_share(g, x, phi, h, level);
+  const float share = boundary_quadrature_share(g, x, phi, h, level, slope);
   if (map_corrects_distance(level)) {
     // The inverse's slope grows without bound as the share nears 0 or 1 (one float ulp at 1 moves
     // the distance by 0.03 h), and the quadrature's share carries rounding errors of order 1e-7
