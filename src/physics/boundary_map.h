@@ -73,10 +73,10 @@ SPH_HD void gauss_legendre8(int q, float& x, float& w) {
 constexpr int kBoundaryMapAzimuths = 8;
 
 // What lets a ray skip samples: a bound L on the slope of sample_distance along any local direction
-// (boundary_map_slope_bound), so that a sample at distance v > 0 proves every point within v / L of
-// it outside the solid. `inverse` is 1 / L (0: no bound known, every sample taken); `slack` (m) is
-// taken off v first, for the float rounding of the sampled points and values (the skipped samples
-// must be ones that would have read >= 0 when computed).
+// (SdfSlope below), so that a sample at distance v proves every point within |v| / L of it on the
+// same side of the surface. `inverse` is 1 / L (0: no bound known, every sample taken); `slack` (m)
+// is taken off |v| first, for the float rounding of the sampled points and values (a skipped sample
+// must be one that would have read on that side when computed).
 struct RaySkip {
   float inverse = 0.0f;
   float slack = 0.0f;
@@ -102,8 +102,8 @@ SPH_HD void integrate_rays(const SdfGridView& g, Vec3 x, const Vec3* w, float h,
   const float start = phi0_size > skip.slack ? (phi0_size - skip.slack) * skip.inverse : 0.0f;
   for (int p = 0; p < kRays; ++p) a[p] = phi0, out[p] = 0.0f, known[p] = start, inside[p] = phi0 < 0.0f;
   float known_all = start;
-  bool skipped =
-      false;  // the step before this one was not sampled (a[] holds values of the right sides, not r0's)
+  // The step before this one was not sampled: a[] holds values of the rays' proved sides, not r0's.
+  bool skipped = false;
   float r0 = 0.0f;
   for (int k = 1; k <= steps; ++k) {
     const float r1 = h * static_cast<float>(k) / static_cast<float>(steps);
