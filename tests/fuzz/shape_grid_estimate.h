@@ -14,8 +14,11 @@
 
 namespace sph_fuzz {
 
-// A size of the desc with its zero rule applied (0 = the default, sph_shape_desc).
-inline double shape_size_or_default(float value, double fallback) { return value == 0.0f ? fallback : value; }
+// A size of the desc with its zero rule applied (0 = the default, sph_shape_desc). The default is a
+// float, as the library's (sph::ShapeSpec): 0.01 as a double made the harness count 0.5 / 0.01 as 50
+// voxels where the library's 0.5 / 0.01f is 50.0000001, 51 (the capi fuzzer's invariant broke on a
+// plane of default depth, session 48; tests/fuzz/regressions/capi).
+inline double shape_size_or_default(float value, float fallback) { return value == 0.0f ? fallback : value; }
 
 // Voxels of the shape's grid; 0 for a kind the library does not know (it must refuse it).
 inline double shape_grid_voxels(const sph_shape_desc& d) {
