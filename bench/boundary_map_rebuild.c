@@ -7,7 +7,8 @@
  * its top face, frames of one 1 ms substep without gravity. Times (wall, median over the frames):
  *   first   the first frame: the map's first build and the step;
  *   steady  a frame with the map kept;
- *   update  sph_sdf_update of the whole distance channel (the copy in; the same values);
+ *   update  sph_sdf_update of the whole distance channel (the copy in; the same box's distances,
+ *           computed here in double, so within a rounding of the asset's own);
  *   rebuilt a frame after such an update: the map again and the step.
  * "map" is rebuilt - steady: the map's build, on the host threads (CPU) or the device (CUDA).
  *

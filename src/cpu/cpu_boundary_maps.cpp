@@ -65,19 +65,11 @@ SdfSlope sdf_slope(const SdfAsset& asset, const CpuParallel& parallel) {
     rows_max = std::fmax(rows_max, row_sum), columns_max = std::fmax(columns_max, column_sum);
   }
   const double bound = index_slope * std::sqrt(rows_max * columns_max) * (1.0 + 1e-6);
-  // A voxel's largest diagonal (from index_to_local's columns): the most a value changes across a cell.
-  const Affine3x4& to_local = asset.index_to_local();
-  double diagonal = 0.0;
-  for (int r = 0; r < 3; ++r) {
-    const double across = std::fabs(static_cast<double>(to_local.m[4 * r])) +
-                          std::fabs(static_cast<double>(to_local.m[4 * r + 1])) +
-                          std::fabs(static_cast<double>(to_local.m[4 * r + 2]));
-    diagonal += across * across;
-  }
   if (!(bound > 0.0) || !(bound < 3.0e38)) return SdfSlope{};
   SdfSlope slope;
   slope.bound = std::nextafter(static_cast<float>(bound), INFINITY);
-  slope.cell_change = static_cast<float>(std::fmin(bound * std::sqrt(diagonal), 3.0e38));
+  // A voxel's diagonal is at most the sum of its three edges: the most a value changes across a cell.
+  slope.cell_change = static_cast<float>(std::fmin(bound * 3.0 * asset.max_voxel_size(), 3.0e38));
   return slope;
 }
 

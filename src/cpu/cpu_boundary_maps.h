@@ -15,7 +15,6 @@
 
 #include "../core/host_memory.h"
 #include "../core/sdf_asset.h"
-#include "../physics/boundary_map.h"
 #include "../physics/float4_types.h"
 #include "cpu_parallel.h"
 

@@ -73,7 +73,7 @@ SPH_HD void gauss_legendre8(int q, float& x, float& w) {
 constexpr int kBoundaryMapAzimuths = 8;
 
 // What lets a ray skip samples: a bound L on the slope of sample_distance along any local direction
-// (SdfSlope below), so that a sample at distance v proves every point within |v| / L of it on the
+// (SdfSlope, sdf_sampling.h), so that a sample at distance v proves every point within |v| / L of it on the
 // same side of the surface. `inverse` is 1 / L (0: no bound known, every sample taken); `slack` (m)
 // is taken off |v| first, for the float rounding of the sampled points and values (a skipped sample
 // must be one that would have read on that side when computed).
@@ -109,7 +109,7 @@ SPH_HD void integrate_rays(const SdfGridView& g, Vec3 x, const Vec3* w, float h,
     const float r1 = h * static_cast<float>(k) / static_cast<float>(steps);
     if (r1 < known_all) {
       for (int p = 0; p < kRays; ++p)
-        if (inside[p] && r1 > r0) out[p] += spiky_radial_volume(r1, h) - spiky_radial_volume(r0, h);
+        if (inside[p]) out[p] += spiky_radial_volume(r1, h) - spiky_radial_volume(r0, h);
       skipped = true;
       r0 = r1;
       continue;
@@ -148,15 +148,6 @@ SPH_HD int boundary_map_ray_steps(const SdfGridView& g, float h) {
   const float n = 2.0f * h / g.min_voxel_size;
   return n < 8.0f ? 8 : (n > 64.0f ? 64 : static_cast<int>(SPH_CEILF(n)));
 }
-
-// What the host knows of an SDF's slope (sdf_slope on the CPU backend; none on the device):
-// `bound`, a bound on the slope of sample_distance along any local direction (0: none known), and
-// `cell_change`, the most its value can change across one voxel (bound times the largest voxel
-// diagonal).
-struct SdfSlope {
-  float bound = 0.0f;
-  float cell_change = 0.0f;
-};
 
 // The skip of the rays from local point x, a node within h of the surface. The slack is 2^-14 of
 // the scales that the float rounding acts on, hundreds of times the rounding itself: the sampled

@@ -45,6 +45,16 @@ struct SdfGridView {
   float min_voxel_size;      // smallest voxel edge in local units (for gradient steps)
 };
 
+// What the host knows of an SDF's slope (sdf_slope on the CPU backend, cpu_boundary_maps.h; none on
+// the device), what lets the boundary map's rays skip samples (boundary_map.h):
+// `bound`, a bound on the slope of sample_distance along any local direction (0: none known), and
+// `cell_change`, at least the most its value can change across one voxel (the bound times a voxel's
+// diagonal or more: sdf_slope takes three times the longest edge).
+struct SdfSlope {
+  float bound = 0.0f;
+  float cell_change = 0.0f;
+};
+
 struct TrilinearCell {
   int32_t i, j, k;   // lower corner, clamped into the grid
   float fx, fy, fz;  // fractions in [0, 1]
