@@ -1000,8 +1000,10 @@ SPH_API sph_result SPH_CALL sph_world_copy_attribute(const sph_world* world, sph
  * SPH_ATTRIBUTE_POSITION and SPH_ATTRIBUTE_VELOCITY (3 x float32) and SPH_ATTRIBUTE_USER
  * (uint32, needs SPH_FEATURE_USER_ATTRIBUTE). Element i is read at src + i * src_stride
  * (src_stride 0 = the element's size); src_size is the size of the buffer at src in bytes.
- * Positions must be finite and within 65536 particle spacings of the origin (as spawned ones);
- * velocities finite with a speed below 1.8e19 m/s. A written particle keeps everything else
+ * Positions must be finite and within 65536 particle spacings of the origin (as spawned ones),
+ * or equal to the particle's current position bit for bit (a step may carry a particle beyond
+ * the bound: writing every position back still succeeds); velocities finite with a speed below
+ * 1.8e19 m/s. A written particle keeps everything else
  * (its id, density, the methods' state); the next step starts from the written values, its
  * first substep sized from the new speeds. All-or-nothing: every element is checked before
  * anything is written; on any error the world is unchanged. Blocks; O(particle count) work and,

@@ -2945,18 +2945,20 @@ namespace Sph
         /// SPH_ATTRIBUTE_POSITION and SPH_ATTRIBUTE_VELOCITY (3 x float32) and SPH_ATTRIBUTE_USER
         /// (uint32, needs SPH_FEATURE_USER_ATTRIBUTE). Element i is read at src + i * src_stride
         /// (src_stride 0 = the element's size); src_size is the size of the buffer at src in bytes.
-        /// Positions must be finite and within 65536 particle spacings of the origin (as spawned ones);
-        /// velocities finite with a speed below 1.8e19 m/s. A written particle keeps everything else
-        /// (its id, density, the methods' state); the next step starts from the written values, its
-        /// first substep sized from the new speeds. All-or-nothing: every element is checked before
-        /// anything is written; on any error the world is unchanged. Blocks; O(particle count) work
-        /// and, on a CUDA world, a copy of the particle state to the host and back (batch writes into
-        /// one call). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL src with count &gt; 0, stride
-        /// smaller than the element, first + count beyond the particle count, a span that overflows, a
-        /// value out of range: the message names the element, e.g. "src[3]"; DENSITY, PRESSURE or ID,
-        /// which are not writable), BUFFER_TOO_SMALL (src_size cannot hold count elements), UNSUPPORTED
-        /// (unknown attribute), FEATURE_DISABLED (SPH_ATTRIBUTE_USER without
-        /// SPH_FEATURE_USER_ATTRIBUTE), WORLD_LOCKED, OUT_OF_HOST_MEMORY, DEVICE.
+        /// Positions must be finite and within 65536 particle spacings of the origin (as spawned ones),
+        /// or equal to the particle's current position bit for bit (a step may carry a particle beyond
+        /// the bound: writing every position back still succeeds); velocities finite with a speed below
+        /// 1.8e19 m/s. A written particle keeps everything else (its id, density, the methods' state);
+        /// the next step starts from the written values, its first substep sized from the new speeds.
+        /// All-or-nothing: every element is checked before anything is written; on any error the world
+        /// is unchanged. Blocks; O(particle count) work and, on a CUDA world, a copy of the particle
+        /// state to the host and back (batch writes into one call). Errors: INVALID_HANDLE,
+        /// INVALID_ARGUMENT (NULL src with count &gt; 0, stride smaller than the element, first + count
+        /// beyond the particle count, a span that overflows, a value out of range: the message names
+        /// the element, e.g. "src[3]"; DENSITY, PRESSURE or ID, which are not writable),
+        /// BUFFER_TOO_SMALL (src_size cannot hold count elements), UNSUPPORTED (unknown attribute),
+        /// FEATURE_DISABLED (SPH_ATTRIBUTE_USER without SPH_FEATURE_USER_ATTRIBUTE), WORLD_LOCKED,
+        /// OUT_OF_HOST_MEMORY, DEVICE.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_set_attribute(WorldHandle world, SphAttribute attribute, IntPtr src, ulong srcSize, ulong srcStride, uint first, uint count);

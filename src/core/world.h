@@ -91,8 +91,8 @@ class World {
   // InvalidArgument "first/count" when the range passes the particle count. Value errors are
   // FieldErrors naming "src[i]" (the i-th value given) or "ids[k]".
   //
-  // Positions (finite, within 65536 spacings of the origin) or velocities (finite, speed below
-  // 1.8e19 m/s) of particles [first, first + values.size()); kind is Position or Velocity.
+  // Positions (finite, within 65536 spacings of the origin or the particle's own) or velocities (finite,
+  // speed below 1.8e19 m/s) of particles [first, first + values.size()); kind is Position or Velocity.
   // Error(InvalidArgument) "first/count" unless [first, first + count) lies in the particles.
   void require_particle_range(uint32_t first, uint64_t count) const;
   void set_vectors(AttributeKind kind, uint32_t first, const HostVector<Vec3>& values);
@@ -197,8 +197,9 @@ class World {
   // user_attribute as their user attribute where the world carries one.
   uint32_t spawn(const HostVector<Vec3>& positions, const HostVector<Vec3>* velocities,
                  uint32_t user_attribute = 0);
-  // Why a position is refused (world_particles.cpp), or empty when it is fine.
-  std::string position_problem(const Vec3& p) const;
+  // Why a position is refused (world_particles.cpp), or empty when it is fine: not finite, or
+  // (check_reach) beyond the positions' reach (position_reach.h).
+  std::string position_problem(const Vec3& p, bool check_reach = true) const;
   // The end of fill_box and fill_sphere: checks the points (errors name region_fields) and
   // adds them at one velocity.
   uint32_t fill(const HostVector<Vec3>& points, const Vec3& velocity, const char* region_fields);

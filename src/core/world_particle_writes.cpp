@@ -5,6 +5,7 @@
 // on every backend) after checking everything, so an error changes nothing.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <utility>
 
@@ -58,18 +59,23 @@ void World::set_vectors(AttributeKind kind, uint32_t first, const HostVector<Vec
   if (kind != AttributeKind::Position && kind != AttributeKind::Velocity)
     throw Error(Status::Internal, "set_vectors: not a position or velocity");
   require_particle_range(first, values.size());
-  for (size_t i = 0; i < values.size(); ++i) {
-    const std::string field = "src[" + std::to_string(i) + "]";
-    if (kind == AttributeKind::Velocity) {
-      require_particle_velocity_field(values[i], field);
-    } else {
-      const std::string problem = position_problem(values[i]);
-      if (!problem.empty()) throw FieldError(Status::InvalidArgument, field, problem);
-    }
-  }
+  if (kind == AttributeKind::Velocity)
+    for (size_t i = 0; i < values.size(); ++i)
+      require_particle_velocity_field(values[i], "src[" + std::to_string(i) + "]");
   if (values.empty()) return;
   ParticleSnapshot s = backend_->export_particles();
   HostVector<Float4>& target = kind == AttributeKind::Position ? s.position : s.velocity;
+  if (kind == AttributeKind::Position)
+    for (size_t i = 0; i < values.size(); ++i) {
+      // A step may carry a particle beyond the positions' reach (position_reach.h: nothing stops
+      // free flight there); writing its own position back keeps a read-modify-write of a range
+      // working, while moving it, or another particle, to such a place is refused.
+      const Vec3 current = xyz(target[first + i]);
+      const bool unchanged = std::memcmp(&current, &values[i], sizeof(Vec3)) == 0;
+      const std::string problem = position_problem(values[i], !unchanged);
+      if (!problem.empty())
+        throw FieldError(Status::InvalidArgument, "src[" + std::to_string(i) + "]", problem);
+    }
   for (size_t i = 0; i < values.size(); ++i) {
     Float4& record = target[first + i];
     record = make_float4_record(values[i], record.w);  // w (pressure, 1/density) stays

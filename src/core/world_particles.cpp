@@ -12,9 +12,9 @@
 
 namespace sph {
 
-std::string World::position_problem(const Vec3& p) const {
+std::string World::position_problem(const Vec3& p, bool check_reach) const {
   if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return "is not finite";
-  return resolution_problem(p, config_.particle_spacing);
+  return check_reach ? resolution_problem(p, config_.particle_spacing) : std::string();
 }
 
 void World::require_room_for_particles(uint64_t count) const {

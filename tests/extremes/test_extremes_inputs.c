@@ -265,6 +265,70 @@ static void test_far_from_origin_1e6(void** state) {
   free(near);
 }
 
+/* A step may carry a particle beyond the positions' reach (65536 spacings: 1310.72 m at 2 cm);
+ * nothing stops free flight. The world goes on: steps, a checkpoint's save and load; a write of a
+ * range that gives such a particle its own position back succeeds (a read-modify-write of every
+ * position), while moving it, or another particle, beyond the bound is refused and changes
+ * nothing. */
+static void test_step_carries_particle_beyond_reach(void** state) {
+  ext_world w;
+  const float positions[6] = {0.0f, 0.0f, 0.0f, 1300.0f, 0.0f, 0.0f};
+  const float velocities[6] = {0.0f, 0.0f, 0.0f, 2000.0f, 0.0f, 0.0f};
+  const float bound = 65536.0f * 0.02f;
+  float p[6], moved[6];
+  uint32_t far = 2, near, i, written = 0;
+  capi_snapshot before;
+  sph_world* loaded = NULL;
+  void* buffer;
+  uint64_t size = 0;
+  (void)state;
+  ext_open(&w, 8, 0.02f);
+  ext_spawn(&w, positions, velocities, 2);
+  for (i = 0; i < 3; ++i) EXPECT_OK(sph_world_step(w.world, 1.0f / 60.0f));
+  EXPECT_OK(sph_world_copy_attribute(w.world, SPH_ATTRIBUTE_POSITION, p, sizeof p, 0, 0, 2, &written));
+  assert_int_equal(written, 2);
+  for (i = 0; i < 2; ++i)
+    if (fabsf(p[3 * i]) > bound) far = i;
+  assert_true(far < 2); /* the premise: a step carried it past the bound */
+  near = 1 - far;
+  print_message("  particle at x = %.2f m, beyond the bound %.2f m\n", (double)p[3 * far], (double)bound);
+
+  /* Every position back, the near one moved by 1 cm: accepted. */
+  memcpy(moved, p, sizeof p);
+  moved[3 * near + 1] += 0.01f;
+  EXPECT_OK(sph_world_set_attribute(w.world, SPH_ATTRIBUTE_POSITION, moved, sizeof moved, 0, 0, 2));
+  EXPECT_OK(sph_world_copy_attribute(w.world, SPH_ATTRIBUTE_POSITION, p, sizeof p, 0, 0, 2, NULL));
+  assert_memory_equal(p, moved, sizeof p);
+
+  /* The far particle moved by 1 m, or the near one sent beyond the bound: refused, unchanged. */
+  capi_snapshot_take(w.world, &before);
+  memcpy(moved, p, sizeof p);
+  moved[3 * far] += 1.0f;
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, far == 0 ? "src[0]" : "src[1]",
+               sph_world_set_attribute(w.world, SPH_ATTRIBUTE_POSITION, moved, sizeof moved, 0, 0, 2));
+  assert_non_null(strstr(sph_get_last_error(), "65536 particle spacings"));
+  EXPECT_UNCHANGED(w.world, &before);
+  memcpy(moved, p, sizeof p);
+  moved[3 * near] = p[3 * far];
+  EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, near == 0 ? "src[0]" : "src[1]",
+               sph_world_set_attribute(w.world, SPH_ATTRIBUTE_POSITION, moved, sizeof moved, 0, 0, 2));
+  EXPECT_UNCHANGED(w.world, &before);
+
+  /* A checkpoint keeps it, and the loaded world steps. */
+  EXPECT_OK(sph_world_save(w.world, NULL, 0, &size));
+  buffer = malloc((size_t)size);
+  assert_non_null(buffer);
+  EXPECT_OK(sph_world_save(w.world, buffer, size, &size));
+  EXPECT_OK(sph_world_load(w.context, buffer, size, &loaded));
+  EXPECT_OK(sph_world_copy_attribute(loaded, SPH_ATTRIBUTE_POSITION, moved, sizeof moved, 0, 0, 2, NULL));
+  assert_memory_equal(moved, p, sizeof p);
+  EXPECT_OK(sph_world_step(loaded, 1.0f / 60.0f));
+  EXPECT_OK(sph_world_step(w.world, 1.0f / 60.0f));
+  sph_world_destroy(loaded);
+  free(buffer);
+  ext_close(&w);
+}
+
 /* Positions at 1e30 m: spawn, box and sphere fills are refused with INVALID_ARGUMENT naming the
  * argument, and the world is unchanged. */
 static void test_position_1e30_is_refused(void** state) {
@@ -513,6 +577,7 @@ int main(void) {
       cmocka_unit_test(test_all_particles_at_one_point),
       cmocka_unit_test(test_far_from_origin_1e6),
       cmocka_unit_test(test_position_1e30_is_refused),
+      cmocka_unit_test(test_step_carries_particle_beyond_reach),
       cmocka_unit_test(test_sdf_1x1x1),
       cmocka_unit_test(test_sdf_very_large),
       cmocka_unit_test(test_spacing_near_float_precision),
