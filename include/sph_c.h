@@ -1174,7 +1174,7 @@ typedef struct sph_shape_desc {
   sph_vec3 half_extents;   /* m; each component 0 (default) = 0.5 */
   float radius;            /* m; 0 (default) = 0.5 */
   float half_height;       /* m; 0 (default) = 0.5 */
-  float wall_thickness;    /* m; default 0 (solid) */
+  float wall_thickness;    /* m; default 0 (solid); a cup has no default: it needs walls > 0 */
   float voxel_size;        /* m; 0 (default) = 0.01 */
   uint32_t flags;          /* SPH_SHAPE_FLAG_* */
   uint32_t padding_voxels; /* grid margin around the shape; 0 (default) = 4 */
@@ -1325,7 +1325,10 @@ SPH_API sph_result SPH_CALL sph_collider_destroy(sph_world* world, sph_collider_
 /**
  * Kinematic motion: the collider moves from its current pose to `target` over the next
  * sph_world_step, placed at every substep by interpolation; its velocity is derived from the
- * motion. After that step the target is its pose.
+ * motion. After that step the target is its pose; a step that returns SPH_INCOMPLETE leaves the
+ * collider where its last whole substep placed it, the target still pending (the next step moves
+ * it the rest of the way). A rotation read back (sph_collider_get_transform) and given again is
+ * kept bit for bit, so a collider told to stay where it is does not move.
  */
 SPH_API sph_result SPH_CALL sph_collider_set_target_transform(sph_world* world, sph_collider_id id,
                                                               const sph_transform* target);
@@ -1444,7 +1447,8 @@ typedef struct sph_source_def {
   sph_transform transform; /* default identity */
   float spacing;           /* FCC lattice spacing, m; 0 (default) = the world's spacing */
   float min_distance;      /* skip lattice points closer than this to a particle, m; 0 (default)
-                              = 0.9 x spacing; at most the kernel radius */
+                              = 0.9 x spacing or the kernel radius, the smaller; at most the
+                              kernel radius */
   sph_vec3 velocity;       /* initial velocity (unless VELOCITY_FROM_FIELD); default 0 */
   uint32_t flags;          /* SPH_SOURCE_FLAG_* */
   float rate;              /* CONTINUOUS: most particles per second; 0 (default) = no limit.

@@ -1645,7 +1645,7 @@ namespace Sph
         public float Radius;
         /// <summary>float half_height: m; 0 (default) = 0.5</summary>
         public float HalfHeight;
-        /// <summary>float wall_thickness: m; default 0 (solid)</summary>
+        /// <summary>float wall_thickness: m; default 0 (solid); a cup has no default: it needs walls &gt; 0</summary>
         public float WallThickness;
         /// <summary>float voxel_size: m; 0 (default) = 0.01</summary>
         public float VoxelSize;
@@ -1923,7 +1923,7 @@ namespace Sph
         public float Spacing;
         /// <summary>
         /// float min_distance: skip lattice points closer than this to a particle, m; 0 (default) = 0.9
-        /// x spacing; at most the kernel radius
+        /// x spacing or the kernel radius, the smaller; at most the kernel radius
         /// </summary>
         public float MinDistance;
         /// <summary>sph_vec3 velocity: initial velocity (unless VELOCITY_FROM_FIELD); default 0</summary>
@@ -3119,7 +3119,10 @@ namespace Sph
         /// <summary>
         /// Kinematic motion: the collider moves from its current pose to `target` over the next
         /// sph_world_step, placed at every substep by interpolation; its velocity is derived from the
-        /// motion. After that step the target is its pose.
+        /// motion. After that step the target is its pose; a step that returns SPH_INCOMPLETE leaves
+        /// the collider where its last whole substep placed it, the target still pending (the next step
+        /// moves it the rest of the way). A rotation read back (sph_collider_get_transform) and given
+        /// again is kept bit for bit, so a collider told to stay where it is does not move.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_collider_set_target_transform(WorldHandle world, ColliderId id, ref Transform target);

@@ -12,6 +12,11 @@ namespace {
 // (a few 1e-7), far below any rotation a caller meant to be different.
 constexpr double kUnitTolerance = 1e-3;
 
+// A caller's quaternion or axis whose squared length is this close to 1 is kept bit for bit:
+// dividing by its float length could move a last bit, so a pose or axis the library handed out
+// (normalised, within four roundings of 1) would come back as another one. Eight float ulps of 1.
+constexpr double kKeptAsUnit = 8.0 * 1.1920928955078125e-07;
+
 bool finite_quat(const Quat& q) {
   return std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) && std::isfinite(q.w);
 }
@@ -28,20 +33,26 @@ RigidTransform pose_from_caller(Vec3 position, Quat q, const std::string& field)
     throw FieldError(Status::InvalidArgument, field + ".rotation", "has a non-finite component");
   if (q.x == 0.0f && q.y == 0.0f && q.z == 0.0f && q.w == 0.0f)
     return RigidTransform{position, Quat{0.0f, 0.0f, 0.0f, 1.0f}};  // a zeroed struct: the identity
-  const float n = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
-  if (!(n > 1e-6f) || !std::isfinite(n))
+  // The length in double: a float's square under- or overflows for components beyond about
+  // 1e-19 or 1e19, which are still finite quaternions with a direction.
+  const double n2 = squared_length(q);
+  if (std::fabs(n2 - 1.0) <= kKeptAsUnit) return RigidTransform{position, q};
+  const double n = std::sqrt(n2);
+  if (!(n > 1e-6))
     throw FieldError(Status::InvalidArgument, field + ".rotation",
-                     "is not a rotation (length " + describe_value(n) +
+                     "is not a rotation (length " + describe_value(static_cast<float>(n)) +
                          "; give a unit quaternion, or all zeros for the identity)");
-  return RigidTransform{position, Quat{q.x / n, q.y / n, q.z / n, q.w / n}};
+  return RigidTransform{position, Quat{static_cast<float>(q.x / n), static_cast<float>(q.y / n),
+                                       static_cast<float>(q.z / n), static_cast<float>(q.w / n)}};
 }
 
 Vec3 unit_axis_from_caller(Vec3 axis, const std::string& field, const std::string& what) {
   require_finite_vec3_field(axis, field);
-  const float n = length(axis);
-  if (!(n > 0.0f) || !std::isfinite(n))
-    throw FieldError(Status::InvalidArgument, field, what + " needs a non-zero axis");
-  return axis * (1.0f / n);
+  const double n2 = double(axis.x) * axis.x + double(axis.y) * axis.y + double(axis.z) * axis.z;
+  if (std::fabs(n2 - 1.0) <= kKeptAsUnit) return axis;
+  const double n = std::sqrt(n2);
+  if (!(n > 0.0)) throw FieldError(Status::InvalidArgument, field, what + " needs a non-zero axis");
+  return Vec3{static_cast<float>(axis.x / n), static_cast<float>(axis.y / n), static_cast<float>(axis.z / n)};
 }
 
 void require_pose(const RigidTransform& pose, const std::string& field) {

@@ -15,10 +15,13 @@ namespace sph {
 
 // A caller's position and quaternion as a pose: the position must be finite; the all-zero
 // quaternion is the identity; any other must be finite and longer than 1e-6, and is divided by
-// its length. Throws FieldError naming field + ".position" or field + ".rotation".
+// its length (in double), unless it is a unit quaternion to float precision (squared length
+// within 8 ulps of 1), which is kept bit for bit: a pose read back from the library and given
+// again is the same pose. Throws FieldError naming field + ".position" or field + ".rotation".
 RigidTransform pose_from_caller(Vec3 position, Quat rotation, const std::string& field);
 
-// A caller's axis as a unit vector: finite and longer than 0, divided by its length (float).
+// A caller's axis as a unit vector: finite and longer than 0, divided by its length (in double),
+// or kept bit for bit when it is a unit vector to float precision (as pose_from_caller).
 // Throws FieldError naming `field`; `what` says what needs the axis ("a vortex").
 Vec3 unit_axis_from_caller(Vec3 axis, const std::string& field, const std::string& what);
 

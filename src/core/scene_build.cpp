@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "scene_build.h"
 
+#include <algorithm>
+
 #include "field_checks.h"
 #include "pose_rules.h"
 
@@ -55,7 +57,10 @@ Source make_source(const SourceSpec& spec, const WorldConfig& config) {
   if (s.spacing < 0.25f * config.particle_spacing)
     throw FieldError(Status::InvalidArgument, "spacing",
                      describe_value(s.spacing) + " is below a quarter of the world's particle spacing");
-  s.min_distance = spec.min_distance == 0.0f ? 0.9f * s.spacing : spec.min_distance;
+  // The default keeps within the kernel radius (the emission's neighbour search reaches no
+  // farther), so that a default is never refused for a field the caller did not set.
+  s.min_distance =
+      spec.min_distance == 0.0f ? std::min(0.9f * s.spacing, config.kernel_radius) : spec.min_distance;
   if (s.min_distance > config.kernel_radius)
     throw FieldError(Status::InvalidArgument, "min_distance",
                      describe_value(s.min_distance) + " is larger than the kernel radius " +

@@ -311,9 +311,18 @@ bool World::step(double frame_dt, const StepInterrupt& interrupt, const FrameEnq
     throw;
   }
   // Colliders arrive where they were sent; their loads are the frame's impulses over its time.
+  // A frame that stopped early (max_substeps, the budget, a cancel) leaves each moving collider
+  // where its last whole substep placed it, the pose interpolated to the time reached (the
+  // substeps' own fraction, substep_clock.h), and its target pending: the next step moves it
+  // the rest of the way.
+  const float reached = static_cast<float>(report.time_advanced / frame_dt);
   colliders_.for_each([&, index = size_t{0}](uint64_t id, Collider& c) mutable {
-    if (c.target) c.pose = *c.target;
-    c.target.reset();
+    if (c.target && report.completed) {
+      c.pose = *c.target;
+      c.target.reset();
+    } else if (c.target && report.substeps > 0) {
+      c.pose = interpolate(c.pose, *c.target, reached);
+    }
     if (index < report.collider_loads.size()) {
       c.loads = load_result(report.collider_loads[index], c, report);
       const float force = length(c.loads.force);

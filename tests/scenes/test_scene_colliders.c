@@ -194,6 +194,96 @@ static void test_fast_paddle_does_not_tunnel(void** state) {
   scene_close(&s);
 }
 
+/* Poses handed back: a rotation read with sph_collider_get_transform and given again (teleport or
+ * target) is the same rotation bit for bit, for 2,000 rotations that the library normalised from
+ * non-unit quaternions (dividing a unit quaternion by its float length again moved a last bit in
+ * about a third of them, so a collider told to stay counted as moving); quaternions and vortex
+ * axes far from unit length (1e20, 1e-30) are normalised, not refused. A step that stops early
+ * (max_substeps 1, SPH_INCOMPLETE) leaves a moving collider at the pose of the time reached, its
+ * target pending; the next step takes it the rest of the way. */
+static void test_pose_round_trip_and_incomplete_motion(void** state) {
+  scene s;
+  sph_shape_desc d;
+  sph_sdf* ball;
+  sph_collider_id id;
+  sph_transform t, a, b;
+  sph_stats stats;
+  sph_force_field_def field;
+  sph_force_field_id field_id;
+  uint32_t seed = 12345u, i, moved = 0;
+  float expected;
+  (void)state;
+  scene_open(&s, 64, 0.02f, -kG, 1e-3f);
+  sph_shape_desc_init(&d);
+  d.shape = SPH_SHAPE_SPHERE;
+  d.radius = 0.05f;
+  d.voxel_size = 0.01f;
+  ball = scene_shape(&s, &d);
+  id = add_collider(&s, ball, scene_at(-1.0f, 0.5f, 0.0f), 0, 0.0f, 0.0f);
+  for (i = 0; i < 2000; ++i) {
+    float q[4];
+    int k;
+    for (k = 0; k < 4; ++k) {
+      seed = seed * 1664525u + 1013904223u;
+      q[k] = (float)(seed >> 8) / 16777216.0f * 2.0f - 1.0f;
+    }
+    t = scene_at(-1.0f, 0.5f, 0.0f);
+    t.rotation.x = q[0], t.rotation.y = q[1], t.rotation.z = q[2], t.rotation.w = q[3] + 2.0f;
+    SCENE_OK(sph_collider_teleport(s.world, id, &t));
+    SCENE_OK(sph_collider_get_transform(s.world, id, &a));
+    moved += memcmp(&a.rotation, &t.rotation, sizeof a.rotation) != 0;
+    SCENE_OK(sph_collider_teleport(s.world, id, &a));
+    SCENE_OK(sph_collider_get_transform(s.world, id, &b));
+    assert_memory_equal(&a, &b, sizeof a);
+    SCENE_OK(sph_collider_set_target_transform(s.world, id, &a));
+    SCENE_OK(sph_collider_get_transform(s.world, id, &b));
+    assert_memory_equal(&a, &b, sizeof a);
+  }
+  assert_true(moved > 1000); /* the inputs were not unit quaternions: the library normalised them */
+  SCENE_OK(sph_world_step(s.world, 0.01f));
+  SCENE_OK(sph_collider_get_transform(s.world, id, &b));
+  assert_memory_equal(&a, &b, sizeof a);
+
+  /* Far from unit length: normalised in double. */
+  t = scene_at(-1.0f, 0.5f, 0.0f);
+  t.rotation.x = t.rotation.y = t.rotation.z = 0.0f;
+  t.rotation.w = 1e20f;
+  SCENE_OK(sph_collider_teleport(s.world, id, &t));
+  SCENE_OK(sph_collider_get_transform(s.world, id, &a));
+  assert_true(a.rotation.w == 1.0f && a.rotation.x == 0.0f && a.rotation.y == 0.0f && a.rotation.z == 0.0f);
+  sph_force_field_def_init(&field);
+  field.kind = SPH_FORCE_FIELD_VORTEX;
+  field.vector.x = 1e-30f;
+  field.strength = 1.0f;
+  SCENE_OK(sph_force_field_create(s.world, &field, &field_id));
+  field.vector.x = 1e20f;
+  SCENE_OK(sph_force_field_create(s.world, &field, &field_id));
+
+  /* Stopped early: the pose of the time reached, then the rest of the way. */
+  SCENE_OK(sph_collider_teleport(s.world, id, &t));
+  scene_spawn_one(&s, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f);
+  s.params.max_substeps = 1;
+  scene_set_params(&s);
+  t = scene_at(1.0f, 0.5f, 0.0f);
+  SCENE_OK(sph_collider_set_target_transform(s.world, id, &t));
+  assert_int_equal(sph_world_step(s.world, 1.0f / 30.0f), SPH_INCOMPLETE);
+  sph_stats_init(&stats);
+  SCENE_OK(sph_world_get_stats(s.world, &stats));
+  assert_true(stats.frame_time > 0.0f && stats.frame_time < 0.5f / 30.0f);
+  SCENE_OK(sph_collider_get_transform(s.world, id, &a));
+  expected = -1.0f + 2.0f * stats.frame_time * 30.0f;
+  print_message("  stopped after %.6f s of 1/30: the collider at x = %.6f (expected %.6f)\n",
+                (double)stats.frame_time, (double)a.position.x, (double)expected);
+  assert_true(fabsf(a.position.x - expected) < 1e-5f);
+  s.params.max_substeps = 0; /* the default */
+  scene_set_params(&s);
+  SCENE_OK(sph_world_step(s.world, 1.0f / 30.0f));
+  SCENE_OK(sph_collider_get_transform(s.world, id, &a));
+  assert_true(a.position.x == 1.0f);
+  SCENE_OK(sph_sdf_destroy(ball));
+  scene_close(&s);
+}
+
 /* Water in a cup spun about its axis at 4 rad/s for a second: every particle stays inside the
  * cup's cavity (radius 8 cm, floor at -6 cm), within a quarter spacing. */
 static void test_rotating_cup_holds_water(void** state) {
@@ -306,6 +396,7 @@ int main(void) {
       cmocka_unit_test(test_sliding_stops_where_coulomb_predicts),
       cmocka_unit_test(test_dam_break_stays_in_tank),
       cmocka_unit_test(test_fast_paddle_does_not_tunnel),
+      cmocka_unit_test(test_pose_round_trip_and_incomplete_motion),
       cmocka_unit_test(test_rotating_cup_holds_water),
       cmocka_unit_test(test_deforming_floor_carries_particle),
   };

@@ -81,6 +81,40 @@ static void test_source_fills_fcc_lattice(void** state) {
   scene_close(&s);
 }
 
+/* A source whose lattice is coarser than 2 world spacings with min_distance left at its default:
+ * 0.9 x its spacing would pass the kernel radius (1.8 spacings), which the emission's search cannot
+ * reach, so the default takes the kernel radius instead of refusing a field the caller never set.
+ * The lattice is filled once (its count within 5 % of sqrt(2) / s^3 per m^3: a coarse lattice's
+ * boundary moves the count more) and an explicit min_distance beyond the kernel radius is still
+ * refused, naming it. */
+static void test_default_min_distance_within_kernel(void** state) {
+  const float spacing = 0.02f, source_spacing = 0.05f, radius = 0.3f;
+  scene s;
+  sph_sdf* ball;
+  sph_source_def def;
+  sph_source_id id;
+  float expected;
+  uint32_t n;
+  (void)state;
+  scene_open(&s, 4000, spacing, 0.0f, 1e-3f);
+  ball = sphere_asset(&s, radius, 0.01f);
+  sph_source_def_init(&def);
+  def.region = ball;
+  def.spacing = source_spacing;
+  SCENE_OK(sph_source_create(s.world, &def, &id));
+  SCENE_OK(sph_world_step(s.world, 1e-6f));
+  n = count_of(&s);
+  expected = 4.0f / 3.0f * 3.14159265f * radius * radius * radius * sqrtf(2.0f) /
+             (source_spacing * source_spacing * source_spacing);
+  print_message("  %u particles from the 5 cm lattice (%.0f expected)\n", n, (double)expected);
+  assert_true(fabsf((float)n - expected) <= 0.05f * expected);
+  def.min_distance = 0.045f;
+  assert_int_equal(sph_source_create(s.world, &def, &id), SPH_ERROR_INVALID_ARGUMENT);
+  assert_non_null(strstr(sph_get_last_error(), "min_distance"));
+  SCENE_OK(sph_sdf_destroy(ball));
+  scene_close(&s);
+}
+
 /* A continuous source refills only where fluid left: with nothing moving it adds nothing on the
  * second step; its rate limit caps what one step emits. */
 static void test_continuous_source_respects_existing_fluid_and_rate(void** state) {
@@ -242,6 +276,7 @@ static void test_bounds_sink_removes_escapees(void** state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_source_fills_fcc_lattice),
+      cmocka_unit_test(test_default_min_distance_within_kernel),
       cmocka_unit_test(test_continuous_source_respects_existing_fluid_and_rate),
       cmocka_unit_test(test_source_at_capacity_reports_event),
       cmocka_unit_test(test_sink_removes_exactly_particles_inside),

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '511fc07bc219e088051400d1f0cf9453e4b32f63eb907434e2575cb351873096', 'include/sph_cuda.h': '10c29a1a1f3946f310c4a23105ed7fb70ffea9fa1a9eee03d59ab41a55b122b9', 'include/sph_mpi.h': '0add86230766569cb53c5823004f1a1f673eae88192e6b8e90c55312014f6a5f', 'include/sph_vdb.h': '256d341729fa5ee56f09a7349d822c42a134d4a948ac22870a64546345e3e434'}
+HEADERS = {'include/sph_c.h': 'f8e77720c0c62248f5033210ea2b57aa8086fa3849777fdd157f0d2acbe7cbe2', 'include/sph_cuda.h': '10c29a1a1f3946f310c4a23105ed7fb70ffea9fa1a9eee03d59ab41a55b122b9', 'include/sph_mpi.h': '0add86230766569cb53c5823004f1a1f673eae88192e6b8e90c55312014f6a5f', 'include/sph_vdb.h': '256d341729fa5ee56f09a7349d822c42a134d4a948ac22870a64546345e3e434'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -1474,7 +1474,7 @@ class ShapeDesc(_SphStruct):
         half_extents (sph_vec3): m; each component 0 (default) = 0.5
         radius (float): m; 0 (default) = 0.5
         half_height (float): m; 0 (default) = 0.5
-        wall_thickness (float): m; default 0 (solid)
+        wall_thickness (float): m; default 0 (solid); a cup has no default: it needs walls > 0
         voxel_size (float): m; 0 (default) = 0.01
         flags (uint32_t): SPH_SHAPE_FLAG_*
         padding_voxels (uint32_t): grid margin around the shape; 0 (default) = 4
@@ -1740,7 +1740,7 @@ class SourceDef(_SphStruct):
         region (sph_sdf*): required: particles fill where the SDF is negative
         transform (sph_transform): default identity
         spacing (float): FCC lattice spacing, m; 0 (default) = the world's spacing
-        min_distance (float): skip lattice points closer than this to a particle, m; 0 (default) = 0.9 x spacing; at most the kernel radius
+        min_distance (float): skip lattice points closer than this to a particle, m; 0 (default) = 0.9 x spacing or the kernel radius, the smaller; at most the kernel radius
         velocity (sph_vec3): initial velocity (unless VELOCITY_FROM_FIELD); default 0
         flags (uint32_t): SPH_SOURCE_FLAG_*
         rate (float): CONTINUOUS: most particles per second; 0 (default) = no limit. What the region or the world could not take is emitted later, but at most one region's worth is owed
@@ -2309,7 +2309,7 @@ FUNCTIONS = {
     'sph_collider_destroy': (sph_result, (_c.POINTER(sph_world), sph_collider_id), ('world', 'id'),
         'Removes a collider. A null id is a no-op; a stale id is INVALID_HANDLE.', 'sph'),
     'sph_collider_set_target_transform': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_transform)), ('world', 'id', 'target'),
-        'Kinematic motion: the collider moves from its current pose to `target` over the next sph_world_step, placed at every substep by interpolation; its velocity is derived from the motion. After that step the target is its pose.', 'sph'),
+        'Kinematic motion: the collider moves from its current pose to `target` over the next sph_world_step, placed at every substep by interpolation; its velocity is derived from the motion. After that step the target is its pose; a step that returns SPH_INCOMPLETE leaves the collider where its last whole substep placed it, the target still pending (the next step moves it the rest of the way). A rotation read back (sph_collider_get_transform) and given again is kept bit for bit, so a collider told to stay where it is does not move.', 'sph'),
     'sph_collider_teleport': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_transform)), ('world', 'id', 'transform'),
         'Moves a collider at once, with no velocity (nothing is pushed).', 'sph'),
     'sph_collider_get_transform': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_transform)), ('world', 'id', 'out_transform'),
