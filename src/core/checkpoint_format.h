@@ -30,11 +30,12 @@ namespace sph {
 namespace checkpoint {
 
 constexpr uint8_t kMagic[8] = {'S', 'P', 'H', 'C', 'K', 'P', 'T', 0x1a};
-constexpr uint32_t kFormatVersion = 13;            // what the writer writes
+constexpr uint32_t kFormatVersion = 14;            // what the writer writes
 constexpr uint32_t kFirstProbeVersion = 6;         // the first with probes (PROB) and load points
 constexpr uint32_t kFirstThresholdVersion = 7;     // the first with load and pressure thresholds
 constexpr uint32_t kFirstLargestErrorVersion = 9;  // the solves' largest particle error in TIME
 constexpr uint32_t kFirstGuardedVersion = 13;      // the solves' guarded count in TIME
+constexpr uint32_t kFirstSourceDebtVersion = 14;   // a source's rate budget may be negative (a debt)
 constexpr uint32_t kFirstSolverVersion = 3;        // the first with the solver, its report and warm starts
 constexpr uint32_t kFirstGrowableVersion = 5;      // the first with max_capacity in CONF
 constexpr uint32_t kOldestReadableVersion = 1;     // the oldest the reader still loads

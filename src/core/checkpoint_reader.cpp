@@ -308,7 +308,7 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   auto colliders = read_checkpoint_colliders(coll, assets, version);
   coll.expect_end();
   ByteReader srce = next_section(payload, 6);
-  auto sources = read_checkpoint_sources(srce, assets, config);
+  auto sources = read_checkpoint_sources(srce, assets, config, version);
   srce.expect_end();
   ByteReader sink = next_section(payload, 7);
   auto sinks = read_checkpoint_sinks(sink, assets);

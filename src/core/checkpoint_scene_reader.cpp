@@ -173,7 +173,8 @@ Probe read_probe(ByteReader& r, uint32_t version, const std::string& name) {
   return p;
 }
 
-Source read_source(ByteReader& r, const Assets& assets, const WorldConfig& config, const std::string& name) {
+Source read_source(ByteReader& r, const Assets& assets, const WorldConfig& config, uint32_t version,
+                   const std::string& name) {
   SourceSpec spec;
   spec.region = asset_ref(r, assets, name + " region");
   spec.pose = raw_pose(r);
@@ -194,9 +195,13 @@ Source read_source(ByteReader& r, const Assets& assets, const WorldConfig& confi
     for (const Vec3& v : spec.region->velocity())
       if (!speed_fits_float(v)) corrupt(r.what() + ": " + name + " region has a speed above 1.8e19 m/s");
   s.rate_budget = r.f64();
-  // A budget grows by at most rate x frame time per step; far below the size_t range.
-  if (!std::isfinite(s.rate_budget) || s.rate_budget < 0.0 || s.rate_budget > 1e15)
-    corrupt(r.what() + ": " + name + " rate budget is outside [0, 1e15]");
+  // A budget grows by at most rate x frame time per step; far below the size_t range. Since
+  // version 14 it may be a debt (World::step: a frame that stopped early gives back the credit
+  // of the time it did not simulate), at most kMaxSourceDebt.
+  const double lowest = version >= kFirstSourceDebtVersion ? -kMaxSourceDebt : 0.0;
+  if (!std::isfinite(s.rate_budget) || s.rate_budget < lowest || s.rate_budget > 1e15)
+    corrupt(r.what() + ": " + name + " rate budget is outside [" + (lowest < 0.0 ? "-1e15" : "0") +
+            ", 1e15]");
   s.done = flag(r, name + " done") != 0;
   const uint32_t points = r.u32();
   r.need_elements(points, 3 * sizeof(float), "lattice points");
@@ -249,9 +254,9 @@ SlotTable<Collider> read_checkpoint_colliders(ByteReader& r, const CheckpointAss
 }
 
 SlotTable<Source> read_checkpoint_sources(ByteReader& r, const CheckpointAssets& assets,
-                                          const WorldConfig& config) {
+                                          const WorldConfig& config, uint32_t version) {
   return read_slots<Source>(
-      r, [&](const std::string& n) { return read_source(r, assets, config, "source " + n); });
+      r, [&](const std::string& n) { return read_source(r, assets, config, version, "source " + n); });
 }
 
 SlotTable<Sink> read_checkpoint_sinks(ByteReader& r, const CheckpointAssets& assets) {

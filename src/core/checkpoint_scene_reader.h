@@ -22,8 +22,9 @@ CheckpointAssets read_checkpoint_assets(ByteReader& r);
 // version: the file's (load points from kFirstProbeVersion on).
 SlotTable<Collider> read_checkpoint_colliders(ByteReader& r, const CheckpointAssets& assets,
                                               uint32_t version);
+// version: the file's (a rate budget may be a debt from kFirstSourceDebtVersion on).
 SlotTable<Source> read_checkpoint_sources(ByteReader& r, const CheckpointAssets& assets,
-                                          const WorldConfig& config);
+                                          const WorldConfig& config, uint32_t version);
 SlotTable<Sink> read_checkpoint_sinks(ByteReader& r, const CheckpointAssets& assets);
 SlotTable<ForceField> read_checkpoint_force_fields(ByteReader& r, const CheckpointAssets& assets);
 // The probes as World::add_probe would have made them; readings cleared.

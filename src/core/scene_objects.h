@@ -34,6 +34,10 @@ struct Collider {
   ColliderLoadResult loads;           // of the last step (SPH_FEATURE_COLLIDER_LOADS)
 };
 
+// The most a rate-limited source may owe (particles): a frame that stops early takes back the
+// credit of the time it did not simulate, which its emission at the frame's start had spent.
+constexpr double kMaxSourceDebt = 1e15;
+
 struct Source {
   std::shared_ptr<const SdfAsset> region;
   RigidTransform pose = identity_pose();
@@ -43,7 +47,8 @@ struct Source {
   Vec3 velocity{0.0f, 0.0f, 0.0f};
   bool velocity_from_field = false;
   float rate = 0.0f;            // Continuous: particles per second at most; 0 = no limit
-  double rate_budget = 0.0;     // fractional particles carried between frames
+  double rate_budget = 0.0;     // fractional particles carried between frames; negative: a debt
+                                // (World::step), at least -kMaxSourceDebt
   bool done = false;            // FillOnce: already emitted
   HostVector<Vec3> lattice;     // FCC points inside the region, in the region's frame
   LatticeBox lattice_bounds;    // lattice_box(lattice), set wherever the lattice is

@@ -137,7 +137,8 @@ void World::emit_sources(double frame_dt) {
     if (s.mode == SourceMode::Continuous && s.rate > 0.0f) {
       s.rate_budget += static_cast<double>(s.rate) * frame_dt;
       // (compared in double: a budget past the size_t range must not be cast to it)
-      if (s.rate_budget < static_cast<double>(allowed)) allowed = static_cast<size_t>(s.rate_budget);
+      if (s.rate_budget < static_cast<double>(allowed))
+        allowed = s.rate_budget > 0.0 ? static_cast<size_t>(s.rate_budget) : 0;  // a debt emits none
     }
     // A world numbers its particles with 32-bit ids and never reuses one (spawn); once they run
     // out a source emits what is left and reports the rest, as at a full capacity.
@@ -310,6 +311,15 @@ bool World::step(double frame_dt, const StepInterrupt& interrupt, const FrameEnq
     backend_->rethrow_step_failure();
     throw;
   }
+  // A frame that stopped early gives back the rate credit of the time it did not simulate: the
+  // sources emitted at its start as if it would run whole, so the budget may become a debt that
+  // later frames pay first ("at most rate particles per second" of simulated time).
+  if (!report.completed)
+    sources_.for_each([&](uint64_t, Source& s) {
+      if (s.mode != SourceMode::Continuous || !(s.rate > 0.0f)) return;
+      const double unsimulated = std::max(frame_dt - report.time_advanced, 0.0);
+      s.rate_budget = std::max(s.rate_budget - static_cast<double>(s.rate) * unsimulated, -kMaxSourceDebt);
+    });
   // Colliders arrive where they were sent; their loads are the frame's impulses over its time.
   // A frame that stopped early (max_substeps, the budget, a cancel) leaves each moving collider
   // where its last whole substep placed it, the pose interpolated to the time reached (the

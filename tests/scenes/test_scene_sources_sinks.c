@@ -115,6 +115,66 @@ static void test_default_min_distance_within_kernel(void** state) {
   scene_close(&s);
 }
 
+/* "At most rate particles per second" of simulated time when frames stop early: a continuous
+ * source of 600 particles/s emits at each frame's start as if the frame would run whole, and a
+ * frame cut short by max_substeps (1 substep of 1 ms out of 1/60 s) gives back the credit of the
+ * time it did not simulate, a debt later frames pay first. Over 60 such frames (59 ms simulated)
+ * the count is within one frame's credit (10 particles) of rate x time; before the debt it was
+ * 600, a second's worth. A checkpoint carries the debt (format version 14), and the loaded world
+ * emits what the original does. */
+static void test_rate_holds_when_frames_stop_early(void** state) {
+  const float rate = 600.0f, frame = 1.0f / 60.0f;
+  scene s;
+  sph_sdf* ball;
+  sph_source_def def;
+  sph_source_id id;
+  sph_stats stats;
+  sph_world* loaded = NULL;
+  double simulated = 0.0;
+  uint32_t n, n_loaded = 0;
+  uint64_t size = 0;
+  void* buffer;
+  int f;
+  (void)state;
+  scene_open(&s, 20000, 0.02f, 0.0f, 1e-3f);
+  s.params.max_substeps = 1;
+  scene_set_params(&s);
+  ball = sphere_asset(&s, 0.3f, 0.01f);
+  sph_source_def_init(&def);
+  def.region = ball;
+  def.mode = SPH_SOURCE_CONTINUOUS;
+  def.rate = rate;
+  SCENE_OK(sph_source_create(s.world, &def, &id));
+  for (f = 0; f < 60; ++f) {
+    assert_int_equal(sph_world_step(s.world, frame), SPH_INCOMPLETE);
+    sph_stats_init(&stats);
+    SCENE_OK(sph_world_get_stats(s.world, &stats));
+    simulated += stats.frame_time;
+  }
+  n = count_of(&s);
+  print_message("  %u particles over %.4f s simulated (rate x time %.1f)\n", n, simulated, rate * simulated);
+  assert_true((double)n <= rate * simulated + rate * frame + 1.0);
+  assert_true((double)n >= rate * simulated - rate * frame - 1.0);
+
+  SCENE_OK(sph_world_save(s.world, NULL, 0, &size));
+  buffer = malloc((size_t)size);
+  assert_non_null(buffer);
+  SCENE_OK(sph_world_save(s.world, buffer, size, &size));
+  assert_int_equal(((const uint8_t*)buffer)[8], 14); /* the format version, little-endian */
+  SCENE_OK(sph_world_load(s.context, buffer, size, &loaded));
+  for (f = 0; f < 5; ++f) {
+    assert_int_equal(sph_world_step(s.world, frame), SPH_INCOMPLETE);
+    assert_int_equal(sph_world_step(loaded, frame), SPH_INCOMPLETE);
+  }
+  SCENE_OK(sph_world_get_particle_count(loaded, &n_loaded));
+  assert_int_equal(n_loaded, count_of(&s));
+  assert_true(count_of(&s) > n); /* the debt was paid and emission went on */
+  sph_world_destroy(loaded);
+  free(buffer);
+  SCENE_OK(sph_sdf_destroy(ball));
+  scene_close(&s);
+}
+
 /* A continuous source refills only where fluid left: with nothing moving it adds nothing on the
  * second step; its rate limit caps what one step emits. */
 static void test_continuous_source_respects_existing_fluid_and_rate(void** state) {
@@ -278,6 +338,7 @@ int main(void) {
       cmocka_unit_test(test_source_fills_fcc_lattice),
       cmocka_unit_test(test_default_min_distance_within_kernel),
       cmocka_unit_test(test_continuous_source_respects_existing_fluid_and_rate),
+      cmocka_unit_test(test_rate_holds_when_frames_stop_early),
       cmocka_unit_test(test_source_at_capacity_reports_event),
       cmocka_unit_test(test_sink_removes_exactly_particles_inside),
       cmocka_unit_test(test_bounds_sink_removes_escapees),
