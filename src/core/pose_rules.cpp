@@ -25,6 +25,8 @@ double squared_length(const Quat& q) {
   return double(q.x) * q.x + double(q.y) * q.y + double(q.z) * q.z + double(q.w) * q.w;
 }
 
+double squared_length(Vec3 v) { return double(v.x) * v.x + double(v.y) * v.y + double(v.z) * v.z; }
+
 }  // namespace
 
 RigidTransform pose_from_caller(Vec3 position, Quat q, const std::string& field) {
@@ -48,7 +50,7 @@ RigidTransform pose_from_caller(Vec3 position, Quat q, const std::string& field)
 
 Vec3 unit_axis_from_caller(Vec3 axis, const std::string& field, const std::string& what) {
   require_finite_vec3_field(axis, field);
-  const double n2 = double(axis.x) * axis.x + double(axis.y) * axis.y + double(axis.z) * axis.z;
+  const double n2 = squared_length(axis);
   if (std::fabs(n2 - 1.0) <= kKeptAsUnit) return axis;
   const double n = std::sqrt(n2);
   if (!(n > 0.0)) throw FieldError(Status::InvalidArgument, field, what + " needs a non-zero axis");
@@ -65,8 +67,7 @@ void require_pose(const RigidTransform& pose, const std::string& field) {
 
 void require_unit_axis(Vec3 axis, const std::string& field, const std::string& what) {
   require_finite_vec3_field(axis, field);
-  const double n2 = double(axis.x) * axis.x + double(axis.y) * axis.y + double(axis.z) * axis.z;
-  if (!(std::fabs(n2 - 1.0) < kUnitTolerance))
+  if (!(std::fabs(squared_length(axis) - 1.0) < kUnitTolerance))
     throw FieldError(Status::InvalidArgument, field, what + " needs a unit axis");
 }
 

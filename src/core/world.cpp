@@ -17,6 +17,9 @@ namespace {
 
 Eigen::Quaterniond to_eigen(const Quat& q) { return Eigen::Quaterniond(q.w, q.x, q.y, q.z); }
 
+// A continuous source with a rate: the one whose emission a budget of particles limits.
+bool rate_limited(const Source& s) { return s.mode == SourceMode::Continuous && s.rate > 0.0f; }
+
 // Angular velocity (world frame) that turns `from` into `to` in `seconds`.
 Vec3 angular_velocity(const Quat& from, const Quat& to, double seconds) {
   Eigen::Quaterniond delta = to_eigen(to) * to_eigen(from).conjugate();
@@ -134,7 +137,7 @@ void World::emit_sources(double frame_dt) {
                                : s.velocity);
     }
     size_t allowed = accepted.size();
-    if (s.mode == SourceMode::Continuous && s.rate > 0.0f) {
+    if (rate_limited(s)) {
       s.rate_budget += static_cast<double>(s.rate) * frame_dt;
       // (compared in double: a budget past the size_t range must not be cast to it)
       if (s.rate_budget < static_cast<double>(allowed))
@@ -155,7 +158,7 @@ void World::emit_sources(double frame_dt) {
     const size_t kept = distributed ? static_cast<size_t>(std::count(mine.begin(), mine.end(), 1)) : fits;
     if (reserve_particles(static_cast<uint64_t>(particle_count()) + kept))
       events_.push_back(Event{EventType::CapacityGrown, id, config_.capacity});
-    if (s.mode == SourceMode::Continuous && s.rate > 0.0f) {
+    if (rate_limited(s)) {
       // What the region or the world could not take stays owed, but at most one region's worth:
       // "at most rate particles/s" holds over any window once the backlog is out (unbounded, a
       // region held full for a minute then refilled whole every frame for a minute), and the
@@ -316,7 +319,7 @@ bool World::step(double frame_dt, const StepInterrupt& interrupt, const FrameEnq
   // later frames pay first ("at most rate particles per second" of simulated time).
   if (!report.completed)
     sources_.for_each([&](uint64_t, Source& s) {
-      if (s.mode != SourceMode::Continuous || !(s.rate > 0.0f)) return;
+      if (!rate_limited(s)) return;
       const double unsimulated = std::max(frame_dt - report.time_advanced, 0.0);
       s.rate_budget = std::max(s.rate_budget - static_cast<double>(s.rate) * unsimulated, -kMaxSourceDebt);
     });
