@@ -8,6 +8,7 @@
 #include "../physics/probe_sampling.h"
 #include "checkpoint_fields.h"
 #include "field_error.h"
+#include "number_text.h"
 #include "pose_rules.h"
 #include "position_reach.h"
 #include "scene_build.h"
@@ -199,9 +200,9 @@ Source read_source(ByteReader& r, const Assets& assets, const WorldConfig& confi
   // version 14 it may be a debt (World::step: a frame that stopped early gives back the credit
   // of the time it did not simulate), at most kMaxSourceDebt.
   const double lowest = version >= kFirstSourceDebtVersion ? -kMaxSourceDebt : 0.0;
-  if (!std::isfinite(s.rate_budget) || s.rate_budget < lowest || s.rate_budget > 1e15)
-    corrupt(r.what() + ": " + name + " rate budget is outside [" + (lowest < 0.0 ? "-1e15" : "0") +
-            ", 1e15]");
+  if (!std::isfinite(s.rate_budget) || s.rate_budget < lowest || s.rate_budget > kMaxSourceCredit)
+    corrupt(r.what() + ": " + name + " rate budget is outside [" + number_text(lowest) + ", " +
+            number_text(kMaxSourceCredit) + "]");
   s.done = flag(r, name + " done") != 0;
   const uint32_t points = r.u32();
   r.need_elements(points, 3 * sizeof(float), "lattice points");

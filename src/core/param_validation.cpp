@@ -5,14 +5,10 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "number_text.h"
+
 namespace sph {
 namespace {
-
-std::string number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
-}
 
 [[noreturn]] void fail(Status status, const ParamPath& path, const char* name, const std::string& what) {
   throw Error(status, path.where + path.scope + name + ": " + what);
@@ -33,10 +29,10 @@ bool above_upper(double v, const ParamRange& r) {
 std::string describe_range(const ParamRange& r) {
   const bool low = r.lower_bound != Bound::None, high = r.upper_bound != Bound::None;
   if (low && high)
-    return std::string("in ") + (r.lower_bound == Bound::Inclusive ? "[" : "(") + number(r.lower) + ", " +
-           number(r.upper) + (r.upper_bound == Bound::Inclusive ? "]" : ")");
-  if (low) return (r.lower_bound == Bound::Inclusive ? ">= " : "> ") + number(r.lower);
-  if (high) return (r.upper_bound == Bound::Inclusive ? "<= " : "< ") + number(r.upper);
+    return std::string("in ") + (r.lower_bound == Bound::Inclusive ? "[" : "(") + number_text(r.lower) +
+           ", " + number_text(r.upper) + (r.upper_bound == Bound::Inclusive ? "]" : ")");
+  if (low) return (r.lower_bound == Bound::Inclusive ? ">= " : "> ") + number_text(r.lower);
+  if (high) return (r.upper_bound == Bound::Inclusive ? "<= " : "< ") + number_text(r.upper);
   return "finite";
 }
 

@@ -37,6 +37,9 @@ struct Collider {
 // The most a rate-limited source may owe (particles): a frame that stops early takes back the
 // credit of the time it did not simulate, which its emission at the frame's start had spent.
 constexpr double kMaxSourceDebt = 1e15;
+// The most a rate budget read from a checkpoint may hold: a budget grows by at most rate x frame
+// time a step and is capped at one region's lattice (World::step), far below this.
+constexpr double kMaxSourceCredit = 1e15;
 
 struct Source {
   std::shared_ptr<const SdfAsset> region;
