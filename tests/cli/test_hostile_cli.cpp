@@ -230,6 +230,57 @@ void test_earlier_longer_run_is_replaced(void**) {
   assert_true(names == expected);
 }
 
+// The loads' and probes' tables of an earlier run go like its frames (they lingered: the manifest
+// did not record them, so a run without the probes left the old files beside the new frames); a
+// file of the same pattern that no manifest recorded stays; an object's name longer than a file
+// name may be goes into its table's name cut at 200 characters (it failed the run, "File name too
+// long", after the first frame).
+void test_earlier_run_tables_are_replaced(void**) {
+  const std::string dir = cli_test::make_temp_dir("tables");
+  const std::string out = dir + "/out";
+  const std::string scene = dir + "/tables.json";
+  const std::string long_name(300, 'n');
+  cli_test::write_text(scene, R"({
+    "world": { "capacity": 4000, "particle_spacing": 0.02 },
+    "time": { "fps": 50, "frames": 2 },
+    "fluids": [ { "type": "box", "min": [-0.1, 0.0, -0.1], "max": [0.1, 0.06, 0.1] } ],
+    "colliders": [ { "name": "tank", "inverted": true, "loads": {},
+                     "shape": { "type": "box", "half_extents": [0.1, 0.1, 0.1], "voxel_size": 0.02 },
+                     "transform": { "position": [0, 0.1, 0] } } ],
+    "probes": [ { "type": "point", "position": [0, 0.02, 0] },
+                { "type": "point", "name": ")" +
+                                  long_name + R"(", "position": [0, 0.04, 0] } ] })");
+  std::string output;
+  assert_int_equal(
+      run({scene, "--backend", "cpu", "--threads", "1", "--format", "csv", "--out", out, "--quiet"}, &output),
+      0);
+  const std::string cut = "probe_1_" + std::string(200, 'n') + ".csv";
+  for (const std::string& name : {std::string("loads_0_tank.csv"), std::string("probe_0.csv"), cut})
+    assert_true(cli_test::file_exists(out + "/" + name));
+  cli_test::write_text(out + "/probe_7_mine.csv", "a file no manifest recorded");
+  assert_int_equal(run(tiny(out, "1", "csv"), &output), 0);
+  std::vector<std::string> names = cli_test::list_dir(out);
+  std::sort(names.begin(), names.end());
+  const std::vector<std::string> expected = {"fluid_0000.csv", "fluid_0001.csv", "probe_7_mine.csv",
+                                             "sph-run-manifest.jsonl"};
+  assert_true(names == expected);
+}
+
+// A format given twice would write one file twice a frame: refused before anything runs, as a
+// usage error on the command line (exit 2) and a scene error in the file (exit 3). It passed both
+// checks and failed at the first frame ("File exists", exit 1).
+void test_repeated_format_is_refused(void**) {
+  const std::string dir = cli_test::make_temp_dir("formats");
+  std::string output;
+  assert_int_equal(run(tiny(dir + "/out", "1", "csv,ply,csv"), &output), 2);
+  assert_true(contains(output, "--format: \"csv\" is given twice in \"csv,ply,csv\""));
+  const std::string scene = dir + "/scene.json";
+  cli_test::write_text(scene, R"({"output": {"format": ["vtp", "vtp"]}})");
+  assert_int_equal(run({scene, "--out", dir + "/out", "--backend", "cpu", "--frames", "0"}, &output), 3);
+  assert_true(contains(output, "output.format[1]: expected a format not listed before it"));
+  assert_false(cli_test::file_exists(dir + "/out/fluid_0000.vtp"));
+}
+
 // ---- item 5: special files as input --------------------------------------------------------
 void test_special_input_files_are_scene_errors(void**) {
   const std::string dir = cli_test::make_temp_dir("special");
@@ -319,6 +370,8 @@ int main(int argc, char** argv) {
       cmocka_unit_test(test_foreign_files_survive),
       cmocka_unit_test(test_killed_runs_leave_whole_frames),
       cmocka_unit_test(test_earlier_longer_run_is_replaced),
+      cmocka_unit_test(test_earlier_run_tables_are_replaced),
+      cmocka_unit_test(test_repeated_format_is_refused),
       cmocka_unit_test(test_special_input_files_are_scene_errors),
       cmocka_unit_test(test_unwritable_stats_json_fails),
       cmocka_unit_test(test_file_size_limit_is_an_error),

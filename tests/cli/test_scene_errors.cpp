@@ -29,8 +29,18 @@ struct Case {
 };
 
 const Case kCases[] = {
-    {R"({"world": {"capacity": -5}})", "world.capacity: expected an integer >= 1, got -5"},
-    {R"({"world": {"capacity": 1.5}})", "world.capacity: expected an integer >= 1, got 1.5"},
+    {R"({"world": {"capacity": -5}})", "world.capacity: expected an integer in [1, 1073741824], got -5"},
+    {R"({"world": {"capacity": 1.5}})", "world.capacity: expected an integer in [1, 1073741824], got 1.5"},
+    {R"({"world": {"capacity": 4294967296}})",
+     "world.capacity: expected an integer in [1, 1073741824], got 4294967296"},
+    {R"({"world": {"max_capacity": 1073741825}})",
+     "world.max_capacity: expected an integer in [1, 1073741824], got 1073741825"},
+    {R"({"params": {"max_substeps": 4294967296}})",
+     "params.max_substeps: expected an integer in [0, 4294967295], got 4294967296"},
+    {R"({"comment": 5})", "comment: expected a string (a comment), got 5"},
+    {R"({"world": {"comment": [1, 2]}})", "world.comment: expected a string (a comment), got an array"},
+    {R"({"output": {"format": ["csv", "ply", "csv"]}})",
+     "output.format[2]: expected a format not listed before it, got the string \"csv\""},
     {R"({"world": {"particle_spacing": "small"}})",
      "world.particle_spacing: expected a positive number, got the string \"small\""},
     {R"({"world": {"particle_spacing": 0.02, "kernel_radius": 0.01}})",

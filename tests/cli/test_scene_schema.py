@@ -94,6 +94,10 @@ broken("unknown params field", lambda s: s["params"].update(stifness=60))
 broken("restitution above 1", lambda s: s["colliders"][0].update(restitution=1.5))
 broken("unknown preview style", lambda s: s["output"].update(preview={"style": "points"}))
 broken("fluid type missing", lambda s: s["fluids"][0].pop("type"))
+broken("comment that is not a string", lambda s: s["world"].update(comment=[1, 2]))
+broken("output format listed twice", lambda s: s["output"].update(format=["csv", "ply", "csv"]))
+broken("empty list of output formats", lambda s: s["output"].update(format=[]))
+broken("capacity above 2^30", lambda s: s["world"].update(capacity=2 ** 30 + 1))
 
 # ---- the lists that come from the library ----
 try:

@@ -41,10 +41,14 @@ struct ObjectFiles {
   LoadCsv loads;
   ProbeCsv probes;
 
-  void open(const Ranks& ranks, const std::string& directory, const SceneRuntime& runtime) {
+  // Opens the files and records them in `writer`'s manifest (a later run removes them).
+  void open(const Ranks& ranks, const std::string& directory, const SceneRuntime& runtime,
+            FrameWriter& writer) {
     std::string problem = loads.open(directory, runtime);
+    writer.record_tables(loads.names());
     if (!problem.empty()) abort_run(ranks, "loads: cannot write " + problem);
     problem = probes.open(directory, runtime);
+    writer.record_tables(probes.names());
     if (!problem.empty()) abort_run(ranks, "probes: cannot write " + problem);
   }
   void write(const Ranks& ranks, const SceneRuntime& runtime, uint32_t frame) {
@@ -125,7 +129,7 @@ int run_frames(const Ranks& ranks, const CliOptions& cli, const SceneDesc& scene
   };
   stats.add_output(write_frame(0));
   add_output_kinds();
-  if (root) objects.open(ranks, out.directory, runtime);
+  if (root) objects.open(ranks, out.directory, runtime, *merged);
   uint32_t written = 1;
   int signal = 0;
   for (uint32_t i = 1; i <= scene.frames; ++i) {

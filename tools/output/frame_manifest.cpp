@@ -19,7 +19,7 @@ namespace {
 // ten million frames writes about 1 GiB of it, far past any real run.
 constexpr off_t kMaxManifestBytes = 1 << 30;
 
-// The output names an earlier manifest recorded ("files" of any line; only sph-run's own names
+// The output names an earlier manifest recorded ("files" and "tables" of any line; only sph-run's own names
 // are taken, so a doctored manifest cannot name anything else to remove).
 std::vector<std::string> recorded_outputs(const std::string& path) {
   std::vector<std::string> names;
@@ -47,10 +47,13 @@ std::vector<std::string> recorded_outputs(const std::string& path) {
                                                       text.begin() + static_cast<std::ptrdiff_t>(end),
                                                       nullptr, /*allow_exceptions=*/false);
     start = end + 1;
-    if (!line.is_object() || !line.contains("files") || !line["files"].is_array()) continue;
-    for (const nlohmann::json& file : line["files"])
-      if (file.is_string() && is_output_name(file.get<std::string>()))
-        names.push_back(file.get<std::string>());
+    if (!line.is_object()) continue;
+    for (const char* key : {"files", "tables"}) {
+      if (!line.contains(key) || !line[key].is_array()) continue;
+      for (const nlohmann::json& file : line[key])
+        if (file.is_string() && is_output_name(file.get<std::string>()))
+          names.push_back(file.get<std::string>());
+    }
   }
   return names;
 }
@@ -109,6 +112,11 @@ void FrameManifest::complete(uint32_t frame, double time, const std::vector<std:
   append(nlohmann::ordered_json{
       {"frame", frame}, {"time", time}, {"state", "complete"}, {"files", file_list(files)}}
              .dump());
+}
+
+void FrameManifest::tables(const std::vector<std::string>& names) {
+  if (names.empty()) return;
+  append(nlohmann::ordered_json{{"tables", file_list(names)}}.dump());
 }
 
 void FrameManifest::writing_video(const std::string& name) {

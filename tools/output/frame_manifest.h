@@ -35,6 +35,9 @@ class FrameManifest {
   // A frame's files (output names) are about to be moved into place / all are in place.
   void writing(uint32_t frame, double time, const std::vector<std::string>& files);
   void complete(uint32_t frame, double time, const std::vector<std::string>& files);
+  // The scene objects' tables (loads, probes: written a line a frame, in place, not staged), as
+  // soon as they are created, so that a later run removes them like frames.
+  void tables(const std::vector<std::string>& names);
   // The preview video, likewise.
   void writing_video(const std::string& name);
   void complete_video(const std::string& name);

@@ -51,6 +51,8 @@ class FrameWriter {
   // Encodes the committed preview PNGs into preview.mp4 through ffmpeg (staged, then moved in).
   // Returns "" on success, else what went wrong.
   std::string write_preview_video(float fps);
+  // The scene objects' tables, recorded in the manifest (FrameManifest::tables).
+  void record_tables(const std::vector<std::string>& names) { manifest_->tables(names); }
   // The manifest's last line (FrameManifest::end).
   void end(const char* how, uint32_t last_frame) { manifest_->end(how, last_frame); }
   const FrameWriteTimes& times() const { return times_; }

@@ -56,8 +56,49 @@ bool empty_and_remove(const std::string& dir) {
 
 }  // namespace
 
+std::string object_table_name(const char* prefix, size_t index, const std::string& name) {
+  std::string file = std::string(prefix) + "_" + std::to_string(index);
+  if (!name.empty()) file += "_";
+  for (size_t i = 0; i < name.size() && i < kMaxTableNameChars; ++i) {
+    const char ch = name[i];
+    const bool kept =
+        (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '-';
+    file += kept ? ch : '_';
+  }
+  return file + ".csv";
+}
+
+namespace {
+
+// object_table_name's names, and nothing else.
+bool is_table_name(const std::string& name) {
+  static const char* const prefixes[] = {"loads_", "probe_"};
+  const size_t suffix = 4;  // ".csv"
+  if (name.size() <= suffix || name.compare(name.size() - suffix, suffix, ".csv") != 0) return false;
+  const size_t end = name.size() - suffix;
+  for (const char* prefix : prefixes) {
+    const size_t p = std::strlen(prefix);
+    if (name.compare(0, p, prefix) != 0) continue;
+    size_t i = p;
+    while (i < end && name[i] >= '0' && name[i] <= '9') ++i;
+    if (i == p) return false;  // no index
+    if (i == end) return true;
+    if (name[i] != '_' || end - (i + 1) > kMaxTableNameChars || i + 1 == end) return false;
+    for (size_t k = i + 1; k < end; ++k) {
+      const char ch = name[k];
+      if (!((ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '-' ||
+            ch == '_'))
+        return false;
+    }
+    return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 bool is_output_name(const std::string& name) {
-  if (name == "preview.mp4" || name == kSeriesName) return true;
+  if (name == "preview.mp4" || name == kSeriesName || is_table_name(name)) return true;
   struct Kind {
     const char* prefix;
     std::vector<const char*> extensions;

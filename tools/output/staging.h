@@ -12,9 +12,18 @@
 namespace sph_tools {
 
 // Whether `name` is one of sph-run's own output file names: "fluid_NNNN.vdb|ply|csv",
-// "surface_NNNN.vdb|obj", "preview_NNNN.png" (at least four digits), "fluid_NNNN.vtp", "fluid.pvd" or
-// "preview.mp4". Nothing else in an output directory is ever removed or replaced by sph-run but its manifest.
+// "surface_NNNN.vdb|obj", "preview_NNNN.png" (at least four digits), "fluid_NNNN.vtp", "fluid.pvd",
+// "preview.mp4", or a scene object's table (object_table_name). Nothing else in an output directory
+// is ever removed or replaced by sph-run but its manifest.
 bool is_output_name(const std::string& name);
+
+// The most characters of an object's name that go into its table's file name: with the prefix and
+// the index the name stays below the 255 bytes a file name may have.
+constexpr size_t kMaxTableNameChars = 200;
+// The file name of scene object `index`'s table ("loads" or "probe"): "<prefix>_<index>.csv", or
+// "<prefix>_<index>_<name>.csv" with the name's characters other than letters, digits and '-' as
+// '_', its first kMaxTableNameChars (docs/cli.md).
+std::string object_table_name(const char* prefix, size_t index, const std::string& name);
 
 // The manifest of the run that last wrote to an output directory (frame_manifest.h).
 constexpr const char* kManifestName = "sph-run-manifest.jsonl";

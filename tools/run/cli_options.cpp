@@ -106,6 +106,9 @@ std::vector<OutputFormat> parse_formats(const char* text) {
     else
       throw UsageError("--format: expected vdb, ply, csv, vtp or none (several as vtp,ply), got \"" + all +
                        "\"");
+    for (size_t k = 0; k + 1 < formats.size(); ++k)
+      if (formats[k] == formats.back())
+        throw UsageError("--format: \"" + f + "\" is given twice in \"" + all + "\"");
     if (comma == std::string::npos) break;
     start = comma + 1;
   }

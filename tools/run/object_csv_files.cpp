@@ -1,23 +1,28 @@
 // SPDX-License-Identifier: MIT
 #include "object_csv_files.h"
 
-#include <cctype>
 #include <cerrno>
 #include <cstring>
+
+#include "staging.h"
 
 namespace sph_tools {
 
 std::string ObjectCsvFiles::open(const std::string& directory, const char* prefix, size_t index,
                                  const std::string& name, const char* header) {
-  std::string path = directory + "/" + prefix + "_" + std::to_string(index);
-  if (!name.empty()) path += "_";
-  for (char ch : name) path += (std::isalnum(static_cast<unsigned char>(ch)) || ch == '-') ? ch : '_';
-  path += ".csv";
+  const std::string file_name = object_table_name(prefix, index, name);
+  const std::string path = directory + "/" + file_name;
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (!f) return path + ": " + std::strerror(errno);
-  files_.push_back(File{index, path, f});
+  files_.push_back(File{index, file_name, path, f});
   std::fputs(header, f);
   return "";
+}
+
+std::vector<std::string> ObjectCsvFiles::names() const {
+  std::vector<std::string> out;
+  for (const File& f : files_) out.push_back(f.name);
+  return out;
 }
 
 std::string ObjectCsvFiles::close() {

@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
 // The CSV files sph-run writes one per scene object (collider loads, probes):
-// <output>/<prefix>_<index>[_<name>].csv, the name's characters other than letters, digits and
-// '-' written as '_' (docs/cli.md).
+// <output>/<prefix>_<index>[_<name>].csv (object_table_name, docs/cli.md).
 #ifndef SPH_TOOLS_RUN_OBJECT_CSV_FILES_H
 #define SPH_TOOLS_RUN_OBJECT_CSV_FILES_H
 
@@ -15,7 +14,8 @@ namespace sph_tools {
 class ObjectCsvFiles {
  public:
   struct File {
-    size_t object;  // the object's index in the scene
+    size_t object;     // the object's index in the scene
+    std::string name;  // the file's name (object_table_name)
     std::string path;
     std::FILE* file;
   };
@@ -29,6 +29,8 @@ class ObjectCsvFiles {
   ~ObjectCsvFiles() { close(); }
 
   const std::vector<File>& files() const { return files_; }
+  // The names of the files open now.
+  std::vector<std::string> names() const;
 
  private:
   std::vector<File> files_;

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "object_csv_files.h"
 #include "scene_runtime.h"
@@ -20,6 +21,8 @@ class ProbeCsv {
   std::string write(const SceneRuntime& runtime, uint32_t frame, double time);
   // Closes the files (also on destruction). Returns "" or what went wrong.
   std::string close() { return files_.close(); }
+  // The names of its files (the manifest records them).
+  std::vector<std::string> names() const { return files_.names(); }
 
  private:
   ObjectCsvFiles files_;

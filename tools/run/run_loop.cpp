@@ -75,9 +75,11 @@ int run_scene(sph_context* context, const std::string& backend_name, const Scene
     uint32_t written = 1;
     LoadCsv loads;  // the colliders that ask for their loads (scene file "loads")
     const std::string loads_problem = loads.open(out.directory, runtime);
+    writer.record_tables(loads.names());  // so that a later run removes them (docs/cli.md)
     if (!loads_problem.empty()) return fail(kExitRuntime, "loads: cannot write " + loads_problem);
     ProbeCsv probes;  // the scene file's "probes"
     const std::string probes_problem = probes.open(out.directory, runtime);
+    writer.record_tables(probes.names());
     if (!probes_problem.empty()) return fail(kExitRuntime, "probes: cannot write " + probes_problem);
     for (uint32_t i = 1; i <= scene.frames && !interrupt_signal(); ++i) {
       t = Clock::now();

@@ -49,7 +49,12 @@ void JsonNode::expect_object(const char* what, std::initializer_list<const char*
 void JsonNode::expect_object(const char* what, const std::vector<std::string>& allowed) const {
   if (missing() || !value_->is_object()) fail(std::string(what) + " (an object)");
   for (auto it = value_->begin(); it != value_->end(); ++it) {
-    if (it.key() == "comment") continue;
+    if (it.key() == "comment") {
+      // A note for people, so a string (docs/scenes.md); anything else is most likely a key
+      // that lost its name.
+      if (!it.value().is_string()) (*this)["comment"].fail("a string (a comment)");
+      continue;
+    }
     bool known = false;
     for (const std::string& key : allowed) known = known || it.key() == key;
     if (!known) {
@@ -127,6 +132,9 @@ uint32_t JsonNode::count(uint32_t lo, uint32_t hi) const {
                                    : "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
   if (missing() || !value_->is_number()) fail(expected);
   const double v = value_->get<double>();
+  // "an integer >= 1" would be a riddle for 4294967296: name the bound it passed.
+  if (v > hi && std::floor(v) == v)
+    fail("an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
   if (!(v >= lo && v <= hi) || std::floor(v) != v) fail(expected);
   return static_cast<uint32_t>(v);
 }

@@ -49,7 +49,13 @@ OutputDesc parse_output(const JsonNode& node) {
   if (!format.missing()) {
     if (format.json().is_array()) {
       const size_t n = format.array_size("a list of formats", 1);
-      for (size_t i = 0; i < n; ++i) out.formats.push_back(parse_format(format.index(i)));
+      for (size_t i = 0; i < n; ++i) {
+        const OutputFormat f = parse_format(format.index(i));
+        // Each format writes one file a frame under one name: twice would be the same file.
+        for (OutputFormat earlier : out.formats)
+          if (earlier == f) format.index(i).fail("a format not listed before it");
+        out.formats.push_back(f);
+      }
     } else {
       out.formats.push_back(parse_format(format));
     }

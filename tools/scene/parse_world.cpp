@@ -1,11 +1,15 @@
 // SPDX-License-Identifier: MIT
 // The world (creation-time settings and the methods it runs), its runtime parameters and the
 // run's timing.
-#include <limits>
-
 #include "parse_parts.h"
 
 namespace sph_tools {
+
+namespace {
+// sph_world_def's capacity and max_capacity are "at most 2^30" (sph_c.h): refused here, with the
+// key's path, rather than by sph_world_create after the scene has been read.
+constexpr uint32_t kCapacityLimit = 1u << 30;
+}  // namespace
 
 void parse_world(const JsonNode& node, sph_world_def* def) {
   sph_world_def_init(def);
@@ -13,10 +17,9 @@ void parse_world(const JsonNode& node, sph_world_def* def) {
   node.expect_object(
       "world", {"capacity", "particle_spacing", "kernel_radius", "rest_density", "integrator", "features",
                 "viscosity_method", "equation_of_state", "solver", "max_capacity"});
-  def->capacity = node["capacity"].opt_count(def->capacity, 1, std::numeric_limits<uint32_t>::max());
+  def->capacity = node["capacity"].opt_count(def->capacity, 1, kCapacityLimit);
   // A growable world (docs/api.md, "Growable worlds"); the library checks it against capacity.
-  def->max_capacity =
-      node["max_capacity"].opt_count(def->max_capacity, 1, std::numeric_limits<uint32_t>::max());
+  def->max_capacity = node["max_capacity"].opt_count(def->max_capacity, 1, kCapacityLimit);
   def->particle_spacing = node["particle_spacing"].opt_positive(def->particle_spacing);
   def->kernel_radius = node["kernel_radius"].opt_positive(def->kernel_radius);
   if (def->kernel_radius != 0.0f && def->kernel_radius < def->particle_spacing)

@@ -139,7 +139,7 @@ def build():
     fmt = {"enum": FORMATS}
     output = obj({
         "directory": STRING,
-        "format": {"oneOf": [fmt, {"type": "array", "items": fmt}]},
+        "format": {"oneOf": [fmt, {"type": "array", "items": fmt, "minItems": 1, "uniqueItems": True}]},
         "surface": {"oneOf": [BOOLEAN, obj({"enabled": BOOLEAN, "particle_radius": POSITIVE,
                                              "voxel_size": POSITIVE})]},
         "preview": {"oneOf": [BOOLEAN, obj({
@@ -172,8 +172,8 @@ def build():
             "name": STRING,
             "description": STRING,
             "world": obj({
-                "capacity": {"type": "integer", "minimum": 1, "maximum": 4294967295},
-                "max_capacity": {"type": "integer", "minimum": 1, "maximum": 4294967295},
+                "capacity": {"type": "integer", "minimum": 1, "maximum": 1073741824},
+                "max_capacity": {"type": "integer", "minimum": 1, "maximum": 1073741824},
                 "particle_spacing": POSITIVE, "kernel_radius": POSITIVE, "rest_density": POSITIVE,
                 "integrator": {"enum": ["symplectic_euler", "rk4"]},
                 "features": {"type": "array", "items": {"enum": FEATURES}},
