@@ -15,7 +15,7 @@ from ._errors import SphError, check
 from ._loader import library
 from ._options import WorldOptionsMixin, _as_struct
 from ._scene import Sdf, WorldSceneMixin
-from ._struct import check_int
+from ._struct import check_int, check_real, enum_arg
 
 __all__ = ["Context", "World", "attribute_format", "version", "abi_version", "build_info", "result_string",
            "live_object_count", "make_version"]
@@ -159,7 +159,7 @@ class Context:
         self._step_hooks = definition is not None and any(
             ctypes.cast(getattr(definition, f), ctypes.c_void_p).value for f in _STEP_THREAD_HOOKS)
         if backend is not None:
-            d.backend = _g.Backend[backend.upper()] if isinstance(backend, str) else _g.Backend(backend)
+            d.backend = enum_arg(_g.Backend, backend, "backend")
         if device_ordinal is not None:
             d.device_ordinal = device_ordinal
         if cpu_worker_count is not None:
@@ -482,7 +482,7 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
         it got). Raises SphError(NON_FINITE) if a substep produced NaN/Inf, SphError(CAPACITY)
         if too many particles piled into one cell; the world is then as it was before the call.
         """
-        return check(library().sph_world_step(self.handle, float(frame_dt)), "sph_world_step")
+        return check(library().sph_world_step(self.handle, check_real(frame_dt, "frame_dt")), "sph_world_step")
 
     @property
     def step_budget(self):
@@ -494,13 +494,14 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
 
     @step_budget.setter
     def step_budget(self, seconds):
-        check(library().sph_world_set_step_budget(self.handle, float(seconds)), "sph_world_set_step_budget")
+        check(library().sph_world_set_step_budget(self.handle, check_real(seconds, "step_budget")),
+              "sph_world_set_step_budget")
 
     def step_begin(self, frame_dt):
         """Starts the frame step() would run on the world's own thread and returns at once
         (sph_world_step_begin). Until step_wait() collects it every other call on the world
         raises SphError(WORLD_LOCKED), except cancel_step() and step_done()."""
-        check(library().sph_world_step_begin(self.handle, float(frame_dt)), "sph_world_step_begin")
+        check(library().sph_world_step_begin(self.handle, check_real(frame_dt, "frame_dt")), "sph_world_step_begin")
         self._step_in_flight = True
 
     def step_wait(self):
@@ -549,19 +550,21 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
         check_int(ctypes.c_uint32, first, "first")
         if count is not None:
             check_int(ctypes.c_uint32, count, "count")
-        if count is None:
-            count = max(self.particle_count - first, 0) if out is None else len(out)
-        if out is None:
-            out = np.empty((count, comps) if comps > 1 else (count,), dtype)
-        else:
+        if out is not None:
+            if not isinstance(out, np.ndarray):
+                raise TypeError(f"out: expected a numpy array, got {type(out).__name__}")
             want = (comps,) if comps > 1 else ()
-            if out.dtype != dtype or out.shape[1:] != want:
+            if out.dtype != dtype or out.ndim != 1 + len(want) or out.shape[1:] != want:
                 shape = f"(n, {comps})" if want else "(n,)"
                 raise ValueError(f"out: {attribute.name} needs dtype {dtype} and shape {shape}, got {out.dtype} {out.shape}")
             if comps > 1 and out.strides[1] != dtype.itemsize:
                 raise ValueError("out: the components of each row must be contiguous")
             if not out.flags.writeable:
                 raise ValueError("out: array is read-only")
+        if count is None:
+            count = max(self.particle_count - first, 0) if out is None else len(out)
+        if out is None:
+            out = np.empty((count, comps) if comps > 1 else (count,), dtype)
         elem = comps * dtype.itemsize
         stride = out.strides[0] if out.ndim and len(out) > 1 else elem
         if stride < elem:
@@ -638,11 +641,14 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
 
     def remove_particles(self, ids):
         """Removes the particles with these ids (sph_world_remove_particles; all-or-nothing: an
-        unknown or repeated id raises, naming the first). The ids join removed_ids()."""
-        a = np.ascontiguousarray(np.asarray(ids, dtype=np.int64).reshape(-1))
-        if len(a) and (a.min() < 0 or a.max() > 0xFFFFFFFF):
-            raise ValueError("ids: every id must be in [0, 2^32)")
-        a = a.astype(np.uint32)
+        unknown or repeated id raises, naming the first). The ids join removed_ids(). They must be
+        integers in [0, 2^32), as set_user_attributes' values: others raise TypeError (floats,
+        strings: 1.7 removed particle 1) or ValueError (out of range) before anything is removed."""
+        a = np.asarray(ids)
+        flat = a.reshape(-1)
+        if flat.dtype != np.uint32:
+            flat = _integers(ids if a.ndim == 1 else flat, flat, np.dtype(np.uint32), "ids")
+        a = np.ascontiguousarray(flat)
         check(library().sph_world_remove_particles(self.handle, a.ctypes.data_as(ctypes.POINTER(ctypes.c_uint32)),
                                                    len(a)),
               "sph_world_remove_particles")

@@ -5,6 +5,7 @@ import ctypes
 from . import _generated as _g
 from ._errors import check
 from ._loader import library
+from ._struct import check_real
 
 __all__ = ["CudaArray", "WorldCudaMixin"]
 
@@ -102,6 +103,7 @@ class WorldCudaMixin:
         """step_begin() ordered on your cudaStream_t (an int; 0: the legacy default stream): the
         frame runs after your stream's earlier work, and your stream's later work after the
         frame (sph_cuda_world_step_begin_on_stream). Collect it with step_wait()."""
-        check(library().sph_cuda_world_step_begin_on_stream(self.handle, float(frame_dt), ctypes.c_void_p(stream)),
+        check(library().sph_cuda_world_step_begin_on_stream(self.handle, check_real(frame_dt, "frame_dt"),
+                                                            ctypes.c_void_p(stream)),
               "sph_cuda_world_step_begin_on_stream")
         self._step_in_flight = True

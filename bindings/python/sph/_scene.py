@@ -9,7 +9,7 @@ import numpy as np
 from . import _generated as _g
 from ._errors import check
 from ._loader import library
-from ._struct import check_int
+from ._struct import _convert, check_int, check_real, enum_arg
 
 __all__ = ["Sdf", "Collider", "Source", "Sink", "ForceField", "as_transform", "grid_transform", "WorldSceneMixin"]
 
@@ -32,8 +32,12 @@ def as_transform(t):
 
 
 def grid_transform(voxel_size=1.0, origin=(0.0, 0.0, 0.0)):
-    """index_to_local for an axis-aligned grid: sample (i, j, k) sits at origin + voxel_size * (i, j, k)."""
-    s = float(voxel_size)
+    """index_to_local for an axis-aligned grid: sample (i, j, k) sits at origin + voxel_size * (i, j, k).
+    voxel_size must be finite and > 0 (ValueError): 0 made the all-zero map, which the C API
+    reads as the identity (1 m voxels), and a negative size a mirrored grid."""
+    s = check_real(voxel_size, "voxel_size")
+    if not (np.isfinite(s) and s > 0):
+        raise ValueError(f"voxel_size: must be finite and > 0, got {s}")
     ox, oy, oz = (float(v) for v in origin)
     return [s, 0, 0, ox, 0, s, 0, oy, 0, 0, s, oz]
 
@@ -56,8 +60,9 @@ def _memory(memory):
     """A MemoryKind from itself, its int, or "host" / "cuda" (also "cuda_device")."""
     if isinstance(memory, str):
         name = memory.strip().upper()
-        return _g.MemoryKind.CUDA_DEVICE if name == "CUDA" else _enum(_g.MemoryKind, name)
-    return _g.MemoryKind(memory)
+        if name == "CUDA":
+            return _g.MemoryKind.CUDA_DEVICE
+    return enum_arg(_g.MemoryKind, memory, "memory")
 
 
 def _device_pointer(value, what):
@@ -104,7 +109,7 @@ class Sdf:
         padding_voxels); flags takes ShapeFlag members or names. ``open_top=True`` sets
         ShapeFlag.OPEN_TOP."""
         open_top = fields.pop("open_top", False)
-        shape = _g.Shape[shape.upper()] if isinstance(shape, str) else _g.Shape(shape)
+        shape = enum_arg(_g.Shape, shape, "shape")
         desc = _g.ShapeDesc(shape=shape, **fields)
         if open_top:
             desc.flags |= _g.SPH_SHAPE_FLAG_OPEN_TOP
@@ -234,7 +239,8 @@ class Sdf:
     def sample(self, local_point):
         """Signed distance at a point of the asset's local frame, m (sph_sdf_sample)."""
         d = ctypes.c_float()
-        check(library().sph_sdf_sample(self.handle, _g.Vec3(*local_point), ctypes.byref(d)), "sph_sdf_sample")
+        check(library().sph_sdf_sample(self.handle, _convert(_g.Vec3, local_point, "local_point"), ctypes.byref(d)),
+              "sph_sdf_sample")
         return d.value
 
     def update(self, channel, data, origin=(0, 0, 0), *, memory="host", size=None):
@@ -246,7 +252,7 @@ class Sdf:
         the context's device (an int, or an object with ``__cuda_array_interface__``: its data
         pointer), float32, i fastest, and ``size=(si, sj, sk)`` gives the box. A CPU context
         raises SphError(ERROR_UNSUPPORTED)."""
-        channel = _g.SdfChannel[channel.upper()] if isinstance(channel, str) else _g.SdfChannel(channel)
+        channel = enum_arg(_g.SdfChannel, channel, "channel")
         memory = _memory(memory)
         if memory != _g.MemoryKind.HOST:
             size = (ctypes.c_uint32 * 3)(*_dims3(size, "size"))
@@ -394,7 +400,7 @@ class Collider(_WorldObject):
     def set_load_point(self, point):
         """The point, in the collider's own frame, that the loads' torque is about (default the
         origin; pass the body's centre of mass) (sph_collider_set_load_point)."""
-        p = _g.Vec3(*point)
+        p = _convert(_g.Vec3, point, "point")
         check(library().sph_collider_set_load_point(self.world.handle, self.id, ctypes.byref(p)),
               "sph_collider_set_load_point")
 
@@ -402,7 +408,7 @@ class Collider(_WorldObject):
         """After each step whose mean force on the collider reaches ``force`` newtons, the step
         reports a COLLIDER_LOAD_EXCEEDED event (count: the force in N); 0 = none
         (sph_collider_set_load_threshold)."""
-        check(library().sph_collider_set_load_threshold(self.world.handle, self.id, float(force)),
+        check(library().sph_collider_set_load_threshold(self.world.handle, self.id, check_real(force, "force")),
               "sph_collider_set_load_threshold")
 
 
@@ -457,7 +463,8 @@ class Probe(_WorldObject):
         """After each step whose reading's pressure_max reaches ``pressure`` Pa, the step reports a
         PROBE_PRESSURE_EXCEEDED event (count: the peak in Pa); 0 = none
         (sph_probe_set_pressure_threshold)."""
-        check(library().sph_probe_set_pressure_threshold(self.world.handle, self.id, float(pressure)),
+        check(library().sph_probe_set_pressure_threshold(self.world.handle, self.id,
+                                                         check_real(pressure, "pressure")),
               "sph_probe_set_pressure_threshold")
 
 
@@ -472,8 +479,20 @@ _EVENT_OBJECT_KINDS = {
 
 
 # ---- World methods --------------------------------------------------------------------------------
-def _enum(cls, value):
-    return cls[value.upper()] if isinstance(value, str) else cls(value)
+def _sdf_handle(sdf, what):
+    """The sph_sdf* of an Sdf argument; TypeError for anything else (None was an AttributeError
+    about .handle). A closed Sdf passes NULL, which the library refuses naming the field."""
+    if not isinstance(sdf, Sdf):
+        raise TypeError(f"{what}: expected an sph.Sdf, got {type(sdf).__name__}")
+    return sdf.handle
+
+
+def _set_by(function, argument, fields, *names):
+    """TypeError when `fields` (a function's **fields) has a struct field that `argument` sets:
+    add_probe's gauge_length= sets kind and length; the one given alongside was overwritten."""
+    both = [n for n in names if n in fields]
+    if both:
+        raise TypeError(f"{function}() got {both[0]}= and {argument}=, which sets it: pass one of them")
 
 
 class WorldSceneMixin:
@@ -514,8 +533,9 @@ class WorldSceneMixin:
         are those of ColliderDef: restitution, friction, stickiness, flags (ColliderFlag members
         or names, ``flags="inverted"``).
         """
+        handle = _sdf_handle(sdf, "sdf")
         d = _g.ColliderDef(transform=as_transform(transform), **fields)
-        d.sdf = sdf.handle
+        d.sdf = handle
         if inverted:
             d.flags |= _g.SPH_COLLIDER_FLAG_INVERTED
         out = _g.ColliderId()
@@ -527,8 +547,9 @@ class WorldSceneMixin:
         (sph_source_create). mode: SourceMode or "fill_once" / "continuous"; other fields are
         those of SourceDef (spacing, min_distance, velocity, flags, rate, user_attribute); flags
         takes SourceFlag members or names (``flags="velocity_from_field"``)."""
-        d = _g.SourceDef(transform=as_transform(transform), mode=_enum(_g.SourceMode, mode), **fields)
-        d.region = region.handle
+        handle = _sdf_handle(region, "region")
+        d = _g.SourceDef(transform=as_transform(transform), mode=enum_arg(_g.SourceMode, mode, "mode"), **fields)
+        d.region = handle
         out = _g.SourceId()
         check(library().sph_source_create(self.handle, ctypes.byref(d), ctypes.byref(out)), "sph_source_create")
         return self._handed_out(Source(self, out))
@@ -536,14 +557,16 @@ class WorldSceneMixin:
     def add_sink(self, region=None, transform=None, *, bounds=None, **fields):
         """Adds a sink (sph_sink_create): with `region` (an Sdf) it removes particles inside it;
         with ``bounds=(min, max)`` it removes particles outside that world-space box."""
+        handle = _sdf_handle(region, "region") if region is not None else None
         if bounds is not None:
+            _set_by("add_sink", "bounds", fields, "bounds_min", "bounds_max")
             fields.setdefault("mode", _g.SinkMode.OUTSIDE_BOUNDS)
             fields["bounds_min"], fields["bounds_max"] = bounds
         if "mode" in fields:
-            fields["mode"] = _enum(_g.SinkMode, fields["mode"])
+            fields["mode"] = enum_arg(_g.SinkMode, fields["mode"], "mode")
         d = _g.SinkDef(transform=as_transform(transform), **fields)
-        if region is not None:
-            d.region = region.handle
+        if handle is not None:
+            d.region = handle
         out = _g.SinkId()
         check(library().sph_sink_create(self.handle, ctypes.byref(d), ctypes.byref(out)), "sph_sink_create")
         return self._handed_out(Sink(self, out))
@@ -552,12 +575,18 @@ class WorldSceneMixin:
         """Adds a probe at `position` (sph_probe_create); with ``gauge_length`` a gauge: the line
         from `position` that long along ``direction`` (default up, against gravity), reading the
         water height by a column integral. sampling: ProbeSampling or "frame" (the step's last
-        substep), "substep" (every substep, averaged); other fields of ProbeDef: direction, sample_spacing."""
-        d = _g.ProbeDef(sampling=_enum(_g.ProbeSampling, sampling), **fields)
-        d.position = _g.Vec3(*position)
+        substep), "substep" (every substep, averaged); other fields of ProbeDef: direction, sample_spacing.
+        A keyword that is no field of ProbeDef, or length= on a point probe, raises TypeError."""
+        d = _g.ProbeDef(sampling=enum_arg(_g.ProbeSampling, sampling, "sampling"), **fields)
+        d.position = _convert(_g.Vec3, position, "position")
         if gauge_length is not None:
+            _set_by("add_probe", "gauge_length", fields, "kind", "length")
             d.kind = _g.ProbeKind.GAUGE
             d.length = gauge_length
+        elif "length" in fields and d.kind != _g.ProbeKind.GAUGE:
+            # ProbeDef.length is a gauge's: on the point probe it made, length=0.3 was ignored.
+            raise TypeError("add_probe() got an unexpected keyword argument 'length' (a point probe has none; "
+                            "a gauge is add_probe(position, gauge_length=...))")
         out = _g.ProbeId()
         check(library().sph_probe_create(self.handle, ctypes.byref(d), ctypes.byref(out)), "sph_probe_create")
         return self._handed_out(Probe(self, out))
@@ -567,9 +596,13 @@ class WorldSceneMixin:
         """Adds a force field (sph_force_field_create). kind: ForceFieldKind or "uniform",
         "radial", "vortex", "grid"; fields of ForceFieldDef: vector, strength, falloff_radius.
         region: optional Sdf limiting it; grid: (nk, nj, ni, 3) accelerations for kind GRID."""
-        d = _g.ForceFieldDef(kind=_enum(_g.ForceFieldKind, kind), transform=as_transform(transform), **fields)
-        if region is not None:
-            d.region = region.handle
+        handle = _sdf_handle(region, "region") if region is not None else None
+        if grid_index_to_local is not None and grid is None:
+            raise TypeError("add_force_field(): grid_index_to_local= places grid=, which is missing")
+        d = _g.ForceFieldDef(kind=enum_arg(_g.ForceFieldKind, kind, "kind"), transform=as_transform(transform),
+                             **fields)
+        if handle is not None:
+            d.region = handle
         keep = None
         if grid is not None:
             g, a = _grid(grid, 3, grid_index_to_local, "grid")

@@ -64,14 +64,31 @@ def _field_types(cls):
     return cached
 
 
+def check_real(value, what):
+    """float(value) for a real-number argument (an int, a float, a numpy scalar, anything with
+    __float__); TypeError for anything else. float() alone parsed strings: step("0.01") ran."""
+    if not (hasattr(type(value), "__float__") or hasattr(type(value), "__index__")):
+        raise TypeError(f"{what}: expected a real number, got {type(value).__name__}")
+    return float(value)
+
+
 def _convert(ftype, value, what="value"):
-    """Accepts tuples/lists/arrays for struct and fixed-array fields; range-checks integers."""
+    """Accepts tuples/lists/arrays for struct and fixed-array fields; range-checks integers.
+    A struct from a sequence takes exactly one value per field (a Vec3 3, a Quat 4): a short
+    one was zero-filled (gravity=(0, -9.81) became (0, -9.81, 0), a rotation (0, 0, 1) the
+    quaternion (0, 0, 1, 0))."""
     if isinstance(value, ftype):
         return value
     if isinstance(ftype, type) and issubclass(ftype, SphStruct):
         if isinstance(value, dict):
             return ftype(**value)
-        return ftype(*value)
+        names = [f[0] for f in ftype._fields_]
+        if isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
+            raise TypeError(f"{what}: expected {len(names)} values ({', '.join(names)}), got {type(value).__name__}")
+        values = list(value)
+        if len(values) != len(names):
+            raise ValueError(f"{what}: expected {len(names)} values ({', '.join(names)}), got {len(values)}")
+        return ftype(*values)
     if isinstance(ftype, type) and issubclass(ftype, ctypes.Array):
         values = list(value)
         if len(values) != ftype._length_:
@@ -104,6 +121,18 @@ def _enum_value(enum_cls, value, what):
             return member
         bits |= member
     return enum_cls(bits)
+
+
+def enum_arg(enum_cls, value, what):
+    """A function argument of an enum type (Context's backend, add_source's mode, ...) from a
+    member, an int or a member name in any case; a name that is no member raises ValueError
+    naming `what` and the accepted names, as the struct fields do (not a bare KeyError)."""
+    return enum_cls(_enum_value(enum_cls, value, what))
+
+
+class UnknownField(AttributeError, TypeError):
+    """A field name a struct does not have: an AttributeError (a misspelt attribute) and a
+    TypeError (an unexpected keyword argument of World(), add_probe(), ...)."""
 
 
 class SphStruct(ctypes.Structure):
@@ -153,7 +182,7 @@ class SphStruct(ctypes.Structure):
     def __setattr__(self, name, value):
         ftype = _field_types(type(self)).get(name)
         if ftype is None:
-            raise AttributeError(f"{type(self).__name__} has no field {name!r}")
+            raise UnknownField(f"{type(self).__name__} has no field {name!r}")
         enums = type(self)._sph_enums_
         if enums and name in enums:
             value = _enum_value(enums[name], value, f"{type(self).__name__}.{name}")

@@ -46,6 +46,7 @@ from ._checkpoint import _path_bytes
 from ._core import World, _float_ptr, _vec3_rows
 from ._errors import SphLoadError, check
 from ._loader import library
+from ._struct import check_real
 
 __all__ = ["DistributedWorld", "comm_handle", "library_has_mpi"]
 
@@ -139,7 +140,8 @@ class DistributedWorld(World):
 
     def step(self, frame_dt):
         """COLLECTIVE. Advances every rank's part by frame_dt (sph_mpi_world_step); as World.step."""
-        return check(_mpi_library().sph_mpi_world_step(self.handle, float(frame_dt)), "sph_mpi_world_step")
+        return check(_mpi_library().sph_mpi_world_step(self.handle, check_real(frame_dt, "frame_dt")),
+                     "sph_mpi_world_step")
 
     def counts(self):
         """COLLECTIVE. This rank's and the world's counts (sph_mpi_world_get_counts): an

@@ -449,7 +449,7 @@ def test_sdf_memory_argument(ctx):
             s.update("distance", 0x1000, memory="cuda")
         with pytest.raises(TypeError, match="device address"):
             s.update("distance", np.zeros((2, 2, 2), np.float32), memory="cuda", size=(2, 2, 2))
-        with pytest.raises(KeyError):
+        with pytest.raises(ValueError, match="memory: 'gpu' is not one of host, cuda_device"):
             s.update("distance", 0x1000, memory="gpu", size=(2, 2, 2))
 
         class Cai:  # anything with __cuda_array_interface__ passes its data pointer
