@@ -920,7 +920,8 @@ SPH_API sph_result SPH_CALL sph_world_step(sph_world* world, float frame_dt);
  * max_seconds after it began stops at its next substep boundary and returns SPH_INCOMPLETE
  * (one substep may overrun the budget). Both backends check it between substeps: the CUDA
  * backend runs a frame with a budget on its stream driver instead of its device graph (one host
- * synchronisation a substep). 0 (the default) is no budget. Not saved in checkpoints. Errors: INVALID_HANDLE,
+ * synchronisation a substep). 0 (the default) is no budget. Not saved in checkpoints: it belongs
+ * to the handle, so sph_world_restore keeps it and a loaded world has none. Errors: INVALID_HANDLE,
  * INVALID_ARGUMENT (NaN, negative or above 86400), WORLD_LOCKED.
  */
 SPH_API sph_result SPH_CALL sph_world_set_step_budget(sph_world* world, double max_seconds);
@@ -1332,7 +1333,9 @@ SPH_API sph_result SPH_CALL sph_collider_destroy(sph_world* world, sph_collider_
  */
 SPH_API sph_result SPH_CALL sph_collider_set_target_transform(sph_world* world, sph_collider_id id,
                                                               const sph_transform* target);
-/** Moves a collider at once, with no velocity (nothing is pushed). */
+/** Moves a collider at once, with no velocity (nothing is pushed). A target still pending
+ * (sph_collider_set_target_transform) is dropped: the collider stays at `transform` until it is
+ * given a new target. */
 SPH_API sph_result SPH_CALL sph_collider_teleport(sph_world* world, sph_collider_id id,
                                                   const sph_transform* transform);
 SPH_API sph_result SPH_CALL sph_collider_get_transform(const sph_world* world, sph_collider_id id,

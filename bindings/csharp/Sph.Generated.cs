@@ -2845,8 +2845,9 @@ namespace Sph
         /// max_seconds after it began stops at its next substep boundary and returns SPH_INCOMPLETE
         /// (one substep may overrun the budget). Both backends check it between substeps: the CUDA
         /// backend runs a frame with a budget on its stream driver instead of its device graph (one
-        /// host synchronisation a substep). 0 (the default) is no budget. Not saved in checkpoints.
-        /// Errors: INVALID_HANDLE, INVALID_ARGUMENT (NaN, negative or above 86400), WORLD_LOCKED.
+        /// host synchronisation a substep). 0 (the default) is no budget. Not saved in checkpoints: it
+        /// belongs to the handle, so sph_world_restore keeps it and a loaded world has none. Errors:
+        /// INVALID_HANDLE, INVALID_ARGUMENT (NaN, negative or above 86400), WORLD_LOCKED.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_set_step_budget(WorldHandle world, double maxSeconds);
@@ -3129,7 +3130,11 @@ namespace Sph
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_set_target_transform")]
         public static extern Result sph_collider_set_target_transform(IntPtr world, ColliderId id, IntPtr target);
 
-        /// <summary>Moves a collider at once, with no velocity (nothing is pushed).</summary>
+        /// <summary>
+        /// Moves a collider at once, with no velocity (nothing is pushed). A target still pending
+        /// (sph_collider_set_target_transform) is dropped: the collider stays at `transform` until it
+        /// is given a new target.
+        /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_collider_teleport(WorldHandle world, ColliderId id, ref Transform transform);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_collider_teleport")]

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'f8e77720c0c62248f5033210ea2b57aa8086fa3849777fdd157f0d2acbe7cbe2', 'include/sph_cuda.h': '10c29a1a1f3946f310c4a23105ed7fb70ffea9fa1a9eee03d59ab41a55b122b9', 'include/sph_mpi.h': '0add86230766569cb53c5823004f1a1f673eae88192e6b8e90c55312014f6a5f', 'include/sph_vdb.h': '256d341729fa5ee56f09a7349d822c42a134d4a948ac22870a64546345e3e434'}
+HEADERS = {'include/sph_c.h': 'f12aa2458cc77b504129c150d3ed082eb3923dfe7a38a4d26bfd541653b56b61', 'include/sph_cuda.h': '10c29a1a1f3946f310c4a23105ed7fb70ffea9fa1a9eee03d59ab41a55b122b9', 'include/sph_mpi.h': '0add86230766569cb53c5823004f1a1f673eae88192e6b8e90c55312014f6a5f', 'include/sph_vdb.h': '256d341729fa5ee56f09a7349d822c42a134d4a948ac22870a64546345e3e434'}
 VERSION = (0, 1, 0)
 VERSION_STRING = "0.1.0"
 ABI_VERSION = 0
@@ -2255,7 +2255,7 @@ FUNCTIONS = {
     'sph_world_step': (sph_result, (_c.POINTER(sph_world), _c.c_float), ('world', 'frame_dt'),
         'Advances the world by frame_dt seconds (> 0, finite) in adaptive substeps: each substep\'s dt = step_factor * h / v_max clamped to [dt_min, dt_max], the frame\'s remaining time spread evenly over the fewest such substeps, so that they add up to frame_dt exactly (they may be shorter than dt_min; docs/api.md, "Stepping"). Blocks until the frame is done. Returns SPH_INCOMPLETE if max_substeps ran out first, or the step budget (sph_world_set_step_budget) or a cancel (sph_world_cancel_step) stopped it: the world is then as after its last whole substep, consistent and ready to step again (sph_stats.frame_time and substeps say how far it got). SPH_ERROR_NON_FINITE if a substep produced a NaN/Inf, SPH_ERROR_CAPACITY if more particles than 64 times the rest density allows piled into one cell of side h (the neighbour work would grow with their square; the message says where): the world is restored to its state before this call.', 'sph'),
     'sph_world_set_step_budget': (sph_result, (_c.POINTER(sph_world), _c.c_double), ('world', 'max_seconds'),
-        'Bounds the wall-clock time of each later sph_world_step of this world: a step still running max_seconds after it began stops at its next substep boundary and returns SPH_INCOMPLETE (one substep may overrun the budget). Both backends check it between substeps: the CUDA backend runs a frame with a budget on its stream driver instead of its device graph (one host synchronisation a substep). 0 (the default) is no budget. Not saved in checkpoints. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NaN, negative or above 86400), WORLD_LOCKED.', 'sph'),
+        'Bounds the wall-clock time of each later sph_world_step of this world: a step still running max_seconds after it began stops at its next substep boundary and returns SPH_INCOMPLETE (one substep may overrun the budget). Both backends check it between substeps: the CUDA backend runs a frame with a budget on its stream driver instead of its device graph (one host synchronisation a substep). 0 (the default) is no budget. Not saved in checkpoints: it belongs to the handle, so sph_world_restore keeps it and a loaded world has none. Errors: INVALID_HANDLE, INVALID_ARGUMENT (NaN, negative or above 86400), WORLD_LOCKED.', 'sph'),
     'sph_world_get_step_budget': (sph_result, (_c.POINTER(sph_world), _c.POINTER(_c.c_double)), ('world', 'out_seconds'),
         'The step budget in seconds (0: none). Errors: INVALID_HANDLE, INVALID_ARGUMENT (NULL).', 'sph'),
     'sph_world_cancel_step': (sph_result, (_c.POINTER(sph_world),), ('world',),
@@ -2311,7 +2311,7 @@ FUNCTIONS = {
     'sph_collider_set_target_transform': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_transform)), ('world', 'id', 'target'),
         'Kinematic motion: the collider moves from its current pose to `target` over the next sph_world_step, placed at every substep by interpolation; its velocity is derived from the motion. After that step the target is its pose; a step that returns SPH_INCOMPLETE leaves the collider where its last whole substep placed it, the target still pending (the next step moves it the rest of the way). A rotation read back (sph_collider_get_transform) and given again is kept bit for bit, so a collider told to stay where it is does not move.', 'sph'),
     'sph_collider_teleport': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_transform)), ('world', 'id', 'transform'),
-        'Moves a collider at once, with no velocity (nothing is pushed).', 'sph'),
+        'Moves a collider at once, with no velocity (nothing is pushed). A target still pending (sph_collider_set_target_transform) is dropped: the collider stays at `transform` until it is given a new target.', 'sph'),
     'sph_collider_get_transform': (sph_result, (_c.POINTER(sph_world), sph_collider_id, _c.POINTER(sph_transform)), ('world', 'id', 'out_transform'),
         '', 'sph'),
     'sph_collider_material_init_sized': (sph_result, (_c.POINTER(sph_collider_material), _c.c_uint32), ('material', 'size'),
