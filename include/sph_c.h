@@ -916,6 +916,20 @@ SPH_API sph_result SPH_CALL sph_world_fill_sphere(sph_world* world, const sph_fi
 SPH_API sph_result SPH_CALL sph_world_step(sph_world* world, float frame_dt);
 
 /**
+ * Builds now what the next sph_world_step would otherwise build before its first substep, so
+ * that a program pays for it when it chooses (a loading screen) rather than in its first frame,
+ * where the step budget cannot bound it: the boundary-density maps of the colliders' SDF assets
+ * (SPH_FEATURE_BOUNDARY_DENSITY: a ray integral per voxel, seconds for a large container on the
+ * CPU) and, on CUDA, the device copies of the assets and of the scene. A world needs it again
+ * after a collider gets an asset it has not stepped with, after sph_sdf_update of an asset its
+ * colliders use, and after sph_world_restore or sph_world_load (which hold their own copies of
+ * the assets). Optional: a step builds whatever is missing. Changes nothing a step or a
+ * checkpoint sees (the next step gives the same bits with or without it); sph_stats.memory_bytes
+ * counts what it built. Errors: INVALID_HANDLE, WORLD_LOCKED, OUT_OF_HOST_MEMORY,
+ * OUT_OF_DEVICE_MEMORY, DEVICE_LOST. (0.2.0)
+ */
+SPH_API sph_result SPH_CALL sph_world_prepare(sph_world* world);
+/**
  * Bounds the wall-clock time of each later sph_world_step of this world: a step still running
  * max_seconds after it began stops at its next substep boundary and returns SPH_INCOMPLETE
  * (one substep may overrun the budget). Both backends check it between substeps: the CUDA

@@ -646,6 +646,7 @@ sph_result sph_world_fill_box(sph_world* world, const sph_fill_box_desc* desc, u
 sph_result sph_fill_sphere_desc_init_sized(sph_fill_sphere_desc* desc, uint32_t size);
 sph_result sph_world_fill_sphere(sph_world* world, const sph_fill_sphere_desc* desc, uint32_t* out_count);
 sph_result sph_world_step(sph_world* world, float frame_dt);
+sph_result sph_world_prepare(sph_world* world);
 sph_result sph_world_set_step_budget(sph_world* world, double max_seconds);
 sph_result sph_world_get_step_budget(const sph_world* world, double* out_seconds);
 sph_result sph_world_cancel_step(sph_world* world);

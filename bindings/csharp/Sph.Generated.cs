@@ -2841,6 +2841,24 @@ namespace Sph
         public static extern Result sph_world_step(IntPtr world, float frameDt);
 
         /// <summary>
+        /// Builds now what the next sph_world_step would otherwise build before its first substep, so
+        /// that a program pays for it when it chooses (a loading screen) rather than in its first
+        /// frame, where the step budget cannot bound it: the boundary-density maps of the colliders'
+        /// SDF assets (SPH_FEATURE_BOUNDARY_DENSITY: a ray integral per voxel, seconds for a large
+        /// container on the CPU) and, on CUDA, the device copies of the assets and of the scene. A
+        /// world needs it again after a collider gets an asset it has not stepped with, after
+        /// sph_sdf_update of an asset its colliders use, and after sph_world_restore or sph_world_load
+        /// (which hold their own copies of the assets). Optional: a step builds whatever is missing.
+        /// Changes nothing a step or a checkpoint sees (the next step gives the same bits with or
+        /// without it); sph_stats.memory_bytes counts what it built. Errors: INVALID_HANDLE,
+        /// WORLD_LOCKED, OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY, DEVICE_LOST. (0.2.0)
+        /// </summary>
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
+        public static extern Result sph_world_prepare(WorldHandle world);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl, EntryPoint = "sph_world_prepare")]
+        public static extern Result sph_world_prepare(IntPtr world);
+
+        /// <summary>
         /// Bounds the wall-clock time of each later sph_world_step of this world: a step still running
         /// max_seconds after it began stops at its next substep boundary and returns SPH_INCOMPLETE
         /// (one substep may overrun the budget). Both backends check it between substeps: the CUDA
@@ -4780,6 +4798,7 @@ namespace Sph
             "sph_fill_sphere_desc_init_sized",
             "sph_world_fill_sphere",
             "sph_world_step",
+            "sph_world_prepare",
             "sph_world_set_step_budget",
             "sph_world_get_step_budget",
             "sph_world_cancel_step",
@@ -4867,6 +4886,7 @@ namespace Sph
         };
         /// <summary>The shared library of each function ("sph", or an optional helper).</summary>
         public static readonly string[] FunctionLibraries = {
+            "sph",
             "sph",
             "sph",
             "sph",

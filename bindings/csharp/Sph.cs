@@ -1366,6 +1366,15 @@ namespace Sph
             return SphException.Check(Native.sph_world_step(Handle, frameDt), "sph_world_step");
         }
 
+        /// <summary>Builds now what the next Step would build before its first substep (the
+        /// boundary-density maps of the colliders' assets, CUDA's device copies), so that a loading
+        /// screen pays for it rather than the first frame (sph_world_prepare). Optional; changes
+        /// nothing a step sees.</summary>
+        public void Prepare()
+        {
+            SphException.Check(Native.sph_world_prepare(Handle), "sph_world_prepare");
+        }
+
         /// <summary>Wall-clock seconds one Step may take before it stops at a substep boundary
         /// and returns Incomplete; 0 is no budget (sph_world_set/get_step_budget).</summary>
         public double StepBudget

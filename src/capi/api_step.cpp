@@ -263,6 +263,16 @@ SPH_API sph_result SPH_CALL sph_world_step_poll(const sph_world* world, sph_bool
   });
 }
 
+SPH_API sph_result SPH_CALL sph_world_prepare(sph_world* world) {
+  return sph::guarded("sph_world_prepare", sph::context_of(world), [&] {
+    sph::require_world(world);
+    sph::WorldLock lock(world);
+    const sph::MemoryScope memory(&world->context->memory);
+    sph::marking_device_lost(world, [&] { world->world->prepare(); });
+    return SPH_OK;
+  });
+}
+
 SPH_API sph_result SPH_CALL sph_world_set_step_budget(sph_world* world, double max_seconds) {
   return sph::guarded("sph_world_set_step_budget", sph::context_of(world), [&] {
     sph::require_world(world);

@@ -176,6 +176,12 @@ void World::emit_sources(double frame_dt) {
   });
 }
 
+void World::prepare() {
+  // The frame's length only sets the colliders' velocities, which nothing prepared depends on.
+  const SceneFrame scene = build_scene_frame(1.0);
+  backend_->prepare_scene(scene, params_);
+}
+
 SceneFrame World::build_scene_frame(double frame_dt) const {
   SceneFrame scene;
   colliders_.for_each([&](uint64_t, const Collider& c) {

@@ -112,6 +112,11 @@ class World {
   bool step(double frame_dt, const StepInterrupt& interrupt = StepInterrupt{},
             const FrameEnqueuedHook& enqueued = FrameEnqueuedHook{});
 
+  // Builds what the next step would build before its first substep (the collider assets' device
+  // copies, their boundary-density maps, the scene's buffers: Backend::prepare_scene), so that a
+  // caller pays for it when it chooses. Changes nothing a step or a checkpoint sees.
+  void prepare();
+
   const FrameReport& last_report() const { return report_; }
   double simulated_time() const { return simulated_time_; }
   float last_step_ms() const { return last_step_ms_; }

@@ -53,6 +53,9 @@ class CpuBackend final : public Backend {
 
   FrameReport step_scene_frame(double frame_dt, const RuntimeParams& params,
                                const SceneFrame& scene_in) override;
+  // The boundary-density maps of the scene's assets (computed on the workers when new or stale),
+  // as a frame binds them.
+  void prepare_scene(const SceneFrame& scene, const RuntimeParams& params) override;
 
   void truncate(uint32_t count) override;
   // The host arrays grow with the particles (append), so a new capacity is only a new limit.

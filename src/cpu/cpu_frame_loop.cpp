@@ -24,6 +24,13 @@ void CpuBackend::bind_boundary_maps(const FluidConstants& fluid, SceneFrame& sce
   boundary_maps_.end_frame();
 }
 
+void CpuBackend::prepare_scene(const SceneFrame& scene_in, const RuntimeParams& params) {
+  if (!boundary_) return;
+  SceneFrame scene = scene_in;
+  bind_scene_views(scene, [](const SdfAsset& a) { return a.host_view(); });
+  bind_boundary_maps(make_fluid_constants(config_, params), scene);
+}
+
 FrameReport CpuBackend::step_scene_frame(double frame_dt, const RuntimeParams& params,
                                          const SceneFrame& scene_in) {
   FrameReport report;

@@ -4,6 +4,7 @@
  * sph_world_get_stats reports after a step. */
 #include <float.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "capi_test.h"
@@ -206,6 +207,91 @@ static void test_stats_after_step(void** state) {
   assert_true(s.memory_bytes >= (uint64_t)n * 32u); /* at least position + velocity as float4 */
 }
 
+/* A world's checkpoint, malloc'd (the caller frees it). */
+static unsigned char* checkpoint_of(const sph_world* world, uint64_t* size) {
+  unsigned char* bytes;
+  EXPECT_OK(sph_world_save(world, NULL, 0, size));
+  bytes = (unsigned char*)malloc((size_t)*size);
+  assert_non_null(bytes);
+  EXPECT_OK(sph_world_save(world, bytes, *size, size));
+  return bytes;
+}
+
+/* Water in a box collider whose walls count in the density, on the test backend. */
+static void open_walled_water(support_world* w, sph_sdf** sdf) {
+  sph_world_def def;
+  sph_shape_desc box;
+  sph_collider_def cdef;
+  sph_collider_id id;
+  sph_fill_box_desc fill;
+  uint32_t filled = 0;
+  sph_world_def_init(&def);
+  def.capacity = 4096;
+  def.particle_spacing = 0.02f;
+  def.features = SPH_FEATURE_BOUNDARY_DENSITY;
+  EXPECT_OK(support_world_open(w, sph_test_backend(), &def, NULL));
+  sph_shape_desc_init(&box);
+  box.shape = SPH_SHAPE_BOX;
+  box.half_extents = (sph_vec3){0.1f, 0.1f, 0.1f};
+  box.voxel_size = 0.01f;
+  EXPECT_OK(sph_sdf_create_shape(w->context, &box, sdf));
+  sph_collider_def_init(&cdef);
+  cdef.sdf = *sdf;
+  cdef.flags = SPH_COLLIDER_FLAG_INVERTED;
+  EXPECT_OK(sph_collider_create(w->world, &cdef, &id));
+  sph_fill_box_desc_init(&fill);
+  fill.min = (sph_vec3){-0.09f, -0.09f, -0.09f};
+  fill.max = (sph_vec3){0.09f, 0.0f, 0.09f};
+  EXPECT_OK(sph_world_fill_box(w->world, &fill, &filled));
+  assert_true(filled > 100);
+}
+
+/* sph_world_prepare (0.2.0) builds what a first step would build before its first substep (here
+ * the box's boundary-density map: the world then holds it, 16 bytes a voxel, as memory_bytes
+ * shows), changes nothing a checkpoint holds, and the step after it gives the same particles, bit
+ * for bit, as a step without it (the checkpoints then differ in the steps' wall-clock timings).
+ * Its errors: a NULL or destroyed world, a world in an asynchronous step. */
+static void test_prepare_builds_what_a_step_would(void** state) {
+  support_world a, b;
+  sph_sdf *sdf_a = NULL, *sdf_b = NULL;
+  unsigned char *before_bytes, *after_bytes;
+  uint64_t before_size, after_size;
+  uint64_t memory_before;
+  sph_world* gone;
+  (void)state;
+  memset(&a, 0, sizeof a);
+  memset(&b, 0, sizeof b);
+  open_walled_water(&a, &sdf_a);
+  open_walled_water(&b, &sdf_b);
+  memory_before = get_stats(a.world).memory_bytes;
+  before_bytes = checkpoint_of(a.world, &before_size);
+  EXPECT_OK(sph_world_prepare(a.world));
+  /* The map covers the box's grid (21^3 voxels at least, with its padding more) at 16 bytes. */
+  assert_true(get_stats(a.world).memory_bytes >= memory_before + 16u * 21u * 21u * 21u);
+  EXPECT_OK(sph_world_prepare(a.world)); /* again: nothing stale, nothing to do */
+  after_bytes = checkpoint_of(a.world, &after_size);
+  assert_true(before_size == after_size && memcmp(before_bytes, after_bytes, (size_t)before_size) == 0);
+  /* b is stepped without it: the same bits. */
+  EXPECT_OK(sph_world_step(a.world, 0.01f));
+  EXPECT_OK(sph_world_step(b.world, 0.01f));
+  capi_expect_same_particles(a.world, b.world);
+  /* Errors. */
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world", sph_world_prepare(NULL));
+  EXPECT_OK(sph_world_step_begin(b.world, 0.01f));
+  EXPECT_ERROR(SPH_ERROR_WORLD_LOCKED, "world", sph_world_prepare(b.world));
+  EXPECT_OK(sph_world_step_wait(b.world));
+  free(before_bytes);
+  free(after_bytes);
+  gone = b.world;
+  EXPECT_OK(sph_world_destroy(b.world));
+  b.world = NULL;
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world", sph_world_prepare(gone));
+  EXPECT_OK(sph_sdf_destroy(sdf_a));
+  EXPECT_OK(sph_sdf_destroy(sdf_b));
+  EXPECT_OK(support_world_close(&a));
+  EXPECT_OK(support_world_close(&b));
+}
+
 int main(void) {
 #define FIXTURE(test) cmocka_unit_test_setup_teardown(test, capi_fixture_setup, capi_fixture_teardown)
   const struct CMUnitTest tests[] = {
@@ -214,6 +300,7 @@ int main(void) {
       FIXTURE(test_step_incomplete),
       FIXTURE(test_step_non_finite_rolls_back),
       cmocka_unit_test(test_stats_before_first_step),
+      cmocka_unit_test(test_prepare_builds_what_a_step_would),
       FIXTURE(test_stats_after_step),
   };
   return cmocka_run_group_tests_name("capi_step_and_stats", tests, NULL, NULL);

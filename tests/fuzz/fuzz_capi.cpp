@@ -1131,6 +1131,7 @@ class Program {
     const sph_result r = FUZZ_CALL(sph_world_set_step_budget(w, budget));
     if (!live) {
       if (r == SPH_OK) violation("sph_world_set_step_budget succeeded on a dead world");
+      if (FUZZ_CALL(sph_world_prepare(w)) == SPH_OK) violation("sph_world_prepare succeeded on a dead world");
       if (FUZZ_CALL(sph_world_cancel_step(w)) == SPH_OK)
         violation("sph_world_cancel_step succeeded on a dead world");
       return;
@@ -1141,6 +1142,13 @@ class Program {
     FUZZ_CALL(sph_world_get_step_budget(w, &got));
     if (got != (valid ? budget : old_budget))
       violation("step budget %g after setting %g (was %g)", got, budget, old_budget);
+    // sph_world_prepare builds maps and copies ahead of a step: whether it succeeds or not (an
+    // allocation), nothing a checkpoint holds may change.
+    if (in_.chance(16)) {
+      const std::vector<uint8_t> saved = checkpoint(w);
+      FUZZ_CALL(sph_world_prepare(w));
+      if (checkpoint(w) != saved) violation("sph_world_prepare changed the world's checkpoint");
+    }
     if (!in_.chance(128)) return;
     if (FUZZ_CALL(sph_world_cancel_step(w)) != SPH_OK)
       violation("sph_world_cancel_step failed on a live world");

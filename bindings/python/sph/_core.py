@@ -484,6 +484,12 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
         """
         return check(library().sph_world_step(self.handle, check_real(frame_dt, "frame_dt")), "sph_world_step")
 
+    def prepare(self):
+        """Builds now what the next step would build before its first substep (the boundary-density
+        maps of the colliders' assets, CUDA's device copies), so that a loading screen pays for it
+        rather than the first frame (sph_world_prepare). Optional; changes nothing a step sees."""
+        check(library().sph_world_prepare(self.handle), "sph_world_prepare")
+
     @property
     def step_budget(self):
         """Wall-clock seconds one step may take before it stops at a substep boundary and
