@@ -137,14 +137,19 @@ void capi_expect_unchanged(const sph_world* world, const capi_snapshot* before, 
   }
 }
 
-sph_world* capi_world_copy(sph_context* context, const sph_world* world) {
-  uint8_t* bytes;
-  uint64_t size = 0;
-  sph_world* copy = NULL;
-  EXPECT_OK(sph_world_save(world, NULL, 0, &size));
-  bytes = (uint8_t*)malloc((size_t)size);
+unsigned char* capi_save(const sph_world* world, uint64_t* size) {
+  unsigned char* bytes;
+  EXPECT_OK(sph_world_save(world, NULL, 0, size));
+  bytes = (unsigned char*)malloc((size_t)*size);
   assert_non_null(bytes);
-  EXPECT_OK(sph_world_save(world, bytes, size, &size));
+  EXPECT_OK(sph_world_save(world, bytes, *size, size));
+  return bytes;
+}
+
+sph_world* capi_world_copy(sph_context* context, const sph_world* world) {
+  uint64_t size = 0;
+  unsigned char* bytes = capi_save(world, &size);
+  sph_world* copy = NULL;
   EXPECT_OK(sph_world_load(context, bytes, size, &copy));
   free(bytes);
   return copy;

@@ -65,6 +65,8 @@ void capi_snapshot_take(const sph_world* world, capi_snapshot* out);
 void capi_expect_unchanged(const sph_world* world, const capi_snapshot* before, const char* file, int line);
 
 /* ---- copies and bitwise comparisons ------------------------------------------------------- */
+/* The world's checkpoint in memory (malloc'd: the caller frees it); *size its bytes. */
+unsigned char* capi_save(const sph_world* world, uint64_t* size);
 /* A copy of the world through its checkpoint (save, then load on `context`). */
 sph_world* capi_world_copy(sph_context* context, const sph_world* world);
 /* The same particle count and every attribute up to the ids bit for bit (the user attribute is

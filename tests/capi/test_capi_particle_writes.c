@@ -43,19 +43,10 @@ static uint32_t fill_block(sph_world* world, float size) {
   return added;
 }
 
-static unsigned char* save_bytes(const sph_world* world, uint64_t* size) {
-  unsigned char* bytes;
-  EXPECT_OK(sph_world_save(world, NULL, 0, size));
-  bytes = (unsigned char*)malloc(*size);
-  assert_non_null(bytes);
-  EXPECT_OK(sph_world_save(world, bytes, *size, size));
-  return bytes;
-}
-
 /* The world's checkpoint is what it was: nothing in it changed. */
 static void expect_same_state(const sph_world* world, const unsigned char* before, uint64_t before_size) {
   uint64_t size = 0;
-  unsigned char* now = save_bytes(world, &size);
+  unsigned char* now = capi_save(world, &size);
   assert_int_equal(size, before_size);
   assert_memory_equal(now, before, (size_t)size);
   free(now);
@@ -277,7 +268,7 @@ static void remove_and_check(sph_feature_flags features) {
   assert_int_equal(got, 0);
   {
     uint64_t size = 0;
-    unsigned char* bytes = save_bytes(world, &size);
+    unsigned char* bytes = capi_save(world, &size);
     sph_world* loaded = NULL;
     EXPECT_OK(sph_world_load(context, bytes, size, &loaded));
     EXPECT_OK(sph_world_destroy(loaded));
@@ -347,10 +338,10 @@ static void tags_through_steps(sph_integrator integrator, sph_feature_flags feat
   assert_true(moved > n / 4); /* the order did change: the test could fail */
   assert_int_equal(expect_tags(world), n);
   /* A checkpoint round trip: the loaded world carries the same values and saves the same bytes. */
-  bytes = save_bytes(world, &size);
+  bytes = capi_save(world, &size);
   EXPECT_OK(sph_world_load(context, bytes, size, &loaded));
   assert_int_equal(expect_tags(loaded), n);
-  bytes2 = save_bytes(loaded, &size2);
+  bytes2 = capi_save(loaded, &size2);
   assert_int_equal(size, size2);
   assert_memory_equal(bytes, bytes2, (size_t)size);
   EXPECT_OK(sph_world_destroy(loaded));
@@ -458,7 +449,7 @@ static void test_bad_input_changes_nothing(void** state) {
   fill_block(plain, 0.06f);
   pos = (float*)read_all(world, SPH_ATTRIBUTE_POSITION, &n);
   ids = (uint32_t*)read_all(world, SPH_ATTRIBUTE_ID, &n);
-  before = save_bytes(world, &size);
+  before = capi_save(world, &size);
   memcpy(bad, pos, sizeof bad);
 
   EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "world",
@@ -520,7 +511,7 @@ static void test_bad_input_changes_nothing(void** state) {
   /* An id that was removed is unknown afterwards. */
   EXPECT_OK(sph_world_remove_particles(world, &ids[3], 1));
   free(before);
-  before = save_bytes(world, &size);
+  before = capi_save(world, &size);
   EXPECT_ERROR(SPH_ERROR_INVALID_ARGUMENT, "ids[0]", sph_world_remove_particles(world, &ids[3], 1));
   expect_same_state(world, before, size);
 

@@ -207,16 +207,6 @@ static void test_stats_after_step(void** state) {
   assert_true(s.memory_bytes >= (uint64_t)n * 32u); /* at least position + velocity as float4 */
 }
 
-/* A world's checkpoint, malloc'd (the caller frees it). */
-static unsigned char* checkpoint_of(const sph_world* world, uint64_t* size) {
-  unsigned char* bytes;
-  EXPECT_OK(sph_world_save(world, NULL, 0, size));
-  bytes = (unsigned char*)malloc((size_t)*size);
-  assert_non_null(bytes);
-  EXPECT_OK(sph_world_save(world, bytes, *size, size));
-  return bytes;
-}
-
 /* Water in a box collider whose walls count in the density, on the test backend. */
 static void open_walled_water(support_world* w, sph_sdf** sdf) {
   sph_world_def def;
@@ -264,12 +254,12 @@ static void test_prepare_builds_what_a_step_would(void** state) {
   open_walled_water(&a, &sdf_a);
   open_walled_water(&b, &sdf_b);
   memory_before = get_stats(a.world).memory_bytes;
-  before_bytes = checkpoint_of(a.world, &before_size);
+  before_bytes = capi_save(a.world, &before_size);
   EXPECT_OK(sph_world_prepare(a.world));
   /* The map covers the box's grid (21^3 voxels at least, with its padding more) at 16 bytes. */
   assert_true(get_stats(a.world).memory_bytes >= memory_before + 16u * 21u * 21u * 21u);
   EXPECT_OK(sph_world_prepare(a.world)); /* again: nothing stale, nothing to do */
-  after_bytes = checkpoint_of(a.world, &after_size);
+  after_bytes = capi_save(a.world, &after_size);
   assert_true(before_size == after_size && memcmp(before_bytes, after_bytes, (size_t)before_size) == 0);
   /* b is stepped without it: the same bits. */
   EXPECT_OK(sph_world_step(a.world, 0.01f));
