@@ -1289,10 +1289,15 @@ SPH_STATIC_ASSERT(sizeof(sph_transform) == 28, sph_transform_size);
 SPH_API sph_transform SPH_CALL sph_transform_identity(void);
 
 /* ---- ids of objects inside a world --------------------------------------------------------
- * Colliders, sources, sinks and force fields are generational ids: a struct holding 64 bits.
- * {0} is null: no call ever returns it, destroying it is a no-op, and every other call refuses
- * it with SPH_ERROR_INVALID_HANDLE, as it refuses the id of a destroyed object (an id is never
- * reused) or of another world or kind. */
+ * Colliders, sources, sinks, force fields and probes are generational ids: a struct holding 64
+ * bits, opaque. {0} is null: no call ever returns it, destroying it is a no-op, and every other
+ * call refuses it with SPH_ERROR_INVALID_HANDLE, as it refuses the id of a destroyed object (a
+ * world never issues an id twice, across sph_world_restore too) or of another world or kind.
+ * "Another world" is told by a 16-bit world tag in every id: the n-th world sph_world_create
+ * makes on a context has tag n, wrapping after 65535 worlds (two worlds 65535 apart on one
+ * context share ids, and so do worlds of different contexts that were made n-th on each). A
+ * world loaded from a checkpoint, or restored from one, takes the saved world's tag and so shares
+ * its ids, by design: the saved ids work there (docs/api.md, "Handles and ownership"). */
 
 /** True when an id (any sph_*_id) is null. */
 #define SPH_ID_IS_NULL(id) ((id).bits == 0)

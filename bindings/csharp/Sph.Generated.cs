@@ -3587,10 +3587,12 @@ namespace Sph
         /// INVALID_ARGUMENT on every rank otherwise). `context`: a CPU or a CUDA context, of the same
         /// backend on every rank. After the communicator's duplication the arguments are checked and
         /// the world made inside one agreement: a failure on any rank is every rank's (the others'
-        /// messages name the failing rank), so no rank waits for another that returned. Errors:
-        /// INVALID_ARGUMENT (NULL out, a bad def or mpi_def, MPI_COMM_NULL or a communicator handle MPI
-        /// itself refuses, contexts of different backends or rebalance thresholds that differ on two
-        /// ranks), VERSION_MISMATCH (an mpi_def whose struct_size is not this version's, as every sized
+        /// messages name the failing rank), so no rank waits for another that returned. The world's ids
+        /// carry rank 0's next world tag on every rank (sph_c.h, "ids of objects inside a world"), so
+        /// an object made on every rank alike has the same id on every rank. Errors: INVALID_ARGUMENT
+        /// (NULL out, a bad def or mpi_def, MPI_COMM_NULL or a communicator handle MPI itself refuses,
+        /// contexts of different backends or rebalance thresholds that differ on two ranks),
+        /// VERSION_MISMATCH (an mpi_def whose struct_size is not this version's, as every sized
         /// struct), INVALID_HANDLE (a NULL or destroyed context), UNSUPPORTED (a feature, solver or
         /// integrator that does not work distributed yet, named in the message), OUT_OF_HOST_MEMORY,
         /// and a CUDA context's device errors. *out is untouched on error.

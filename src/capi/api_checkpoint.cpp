@@ -133,6 +133,9 @@ SPH_API sph_result SPH_CALL sph_world_restore(sph_world* world, const void* data
     // keeps its own (the rule before probes were in checkpoints).
     if (sph::checkpoint::format_version_of(data) < sph::checkpoint::kFirstProbeVersion)
       loaded->adopt_probes(*world->world);
+    // The world takes the checkpoint's world tag, and never issues again an id it issued before
+    // (one issued after the save included).
+    loaded->keep_issued_ids(*world->world);
     loaded->backend().continue_data_epoch(world->world->backend());
     world->world.swap(loaded);
     return SPH_OK;

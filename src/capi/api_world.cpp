@@ -154,7 +154,13 @@ std::unique_ptr<sph_world> sph::make_world(sph_context* context, const sph_world
   auto world = std::make_unique<sph_world>();
   world->context = context;
   world->world = std::make_unique<sph::World>(config, std::move(backend));
+  world->world->set_id_tag(sph::next_world_tag(context));
   return world;
+}
+
+uint16_t sph::next_world_tag(sph_context* context) {
+  const uint32_t n = context->worlds_made.fetch_add(1, std::memory_order_relaxed);  // 0 for the first
+  return static_cast<uint16_t>(n % 65535u + 1u);
 }
 
 extern "C" {

@@ -38,6 +38,11 @@ struct sph_context {
   uint32_t world_count = 0;    // worlds created on it
   uint32_t sdf_count = 0;      // SDF assets created on it
   uint32_t held_by_calls = 0;  // calls in flight that use it (ContextHold)
+  // Worlds made on it by sph_world_create and sph_mpi_world_create (not by a load): the n-th
+  // world's ids carry world tag ((n - 1) mod 65535) + 1 (next_world_tag), so that one program's
+  // calls give the same ids, and the same checkpoint bytes, run to run. Tag 0 is left to worlds
+  // loaded from checkpoints of format 14 or older.
+  std::atomic<uint32_t> worlds_made{0};
 };
 
 struct sph_sdf {
@@ -124,6 +129,8 @@ class ContextHold {
 sph_world* publish_world(std::unique_ptr<sph_world> world);
 // A new world from a def (validated here; Errors name its fields "def->..."), not yet published.
 std::unique_ptr<sph_world> make_world(sph_context* context, const sph_world_def& def);
+// The world tag of the next world made on `context` (counts it): 1, 2, ... 65535, 1, ...
+uint16_t next_world_tag(sph_context* context);
 sph_sdf* publish_sdf(std::unique_ptr<sph_sdf> sdf);
 
 // Takes a context for destruction: Taken means it left the registry and the caller deletes

@@ -41,6 +41,7 @@ using BackendMaker = std::function<std::unique_ptr<Backend>(const WorldConfig&)>
 struct CheckpointPart {
   WorldConfig config;  // capacity: the rank's own
   uint32_t next_id = 0;
+  uint16_t id_tag = 0;  // the world tag of the scene's ids (World::id_tag)
   double simulated_time = 0.0;
   ParticleSnapshot particles;  // with their sort keys (kArrayDistributedSortKey)
   FrameReport report;          // the last frame's, its removed ids the rank's

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The checkpoint layout shared by the writer and the reader (docs/checkpoint.md). All numbers
-// little-endian; floats IEEE 754. Version 8 (version 7's DFSPH block in PARM lacks
+// little-endian; floats IEEE 754. Version 15 (the u32 after next_id in TIME, reserved 0 before,
+// is the world tag of the object ids, below 65536: an older file loads with tag 0, the ids it was
+// saved with). Version 8 (version 7's DFSPH block in PARM lacks
 // linear_solver, read by field count, so it loads with the default solve). Version 6 (version 5
 // lacks the probes' section PROB and the colliders' load points: such a file loads with no probes,
 // sph_world_restore keeps the world's own, and load points at the colliders' origins; version 4
@@ -30,12 +32,13 @@ namespace sph {
 namespace checkpoint {
 
 constexpr uint8_t kMagic[8] = {'S', 'P', 'H', 'C', 'K', 'P', 'T', 0x1a};
-constexpr uint32_t kFormatVersion = 14;            // what the writer writes
+constexpr uint32_t kFormatVersion = 15;            // what the writer writes
 constexpr uint32_t kFirstProbeVersion = 6;         // the first with probes (PROB) and load points
 constexpr uint32_t kFirstThresholdVersion = 7;     // the first with load and pressure thresholds
 constexpr uint32_t kFirstLargestErrorVersion = 9;  // the solves' largest particle error in TIME
 constexpr uint32_t kFirstGuardedVersion = 13;      // the solves' guarded count in TIME
 constexpr uint32_t kFirstSourceDebtVersion = 14;   // a source's rate budget may be negative (a debt)
+constexpr uint32_t kFirstWorldTagVersion = 15;     // the world tag of the object ids in TIME
 constexpr uint32_t kFirstSolverVersion = 3;        // the first with the solver, its report and warm starts
 constexpr uint32_t kFirstGrowableVersion = 5;      // the first with max_capacity in CONF
 constexpr uint32_t kOldestReadableVersion = 1;     // the oldest the reader still loads

@@ -99,6 +99,7 @@ WorldConfig read_config(ByteReader& r, uint32_t version) {
 
 struct Clock {
   uint32_t next_id = 0;
+  uint16_t id_tag = 0;  // the object ids' world tag (0 before version 15)
   double simulated_time = 0.0;
   float last_step_ms = 0.0f;
   FrameReport report;
@@ -123,7 +124,13 @@ SolveReport read_solve(ByteReader& r, const std::string& name, uint32_t version)
 Clock read_clock(ByteReader& r, uint32_t version) {
   Clock c;
   c.next_id = r.u32();
-  zero(r, "reserved");
+  if (version >= kFirstWorldTagVersion) {
+    const uint32_t tag = r.u32();
+    if (tag > 0xffffu) corrupt(r.what() + ": the ids' world tag " + std::to_string(tag) + " is above 65535");
+    c.id_tag = static_cast<uint16_t>(tag);
+  } else {
+    zero(r, "reserved");
+  }
   c.simulated_time = r.f64();
   if (!std::isfinite(c.simulated_time) || c.simulated_time < 0.0)
     corrupt(r.what() + ": simulated time is negative or not finite");
@@ -264,6 +271,7 @@ Front read_front(ByteReader& payload, uint32_t version, bool rank_part) {
   Clock clock = read_clock(time, version);
   time.expect_end();
   f.part.next_id = clock.next_id;
+  f.part.id_tag = clock.id_tag;
   f.part.simulated_time = clock.simulated_time;
   f.part.report = std::move(clock.report);
   f.part.events = std::move(clock.events);
@@ -328,6 +336,7 @@ std::unique_ptr<World> read_checkpoint(const uint8_t* data, size_t size, const B
   std::unique_ptr<Backend> backend = make_backend(config);
   backend->import_particles(particles);
   auto world = std::make_unique<World>(config, std::move(backend));
+  world->set_id_tag(front.part.id_tag);
   world->set_params(front.params);
   world->restore_counters(front.part.next_id, front.part.simulated_time, front.part.report,
                           front.last_step_ms, front.part.events);

@@ -83,7 +83,7 @@ void write_springs(ByteWriter& w, const ParticleSnapshot& s) {
 void write_clock(ByteWriter& w, const World& world) {
   const FrameReport& r = world.last_report();
   w.u32(world.next_id());
-  w.u32(0);
+  w.u32(world.id_tag());  // version 15; 0 (reserved) before
   w.f64(world.simulated_time());
   w.f32(world.last_step_ms());
   w.u32(r.substeps);

@@ -183,13 +183,24 @@ class World {
   // The sample points of all probes a step (a point probe one, a gauge its samples).
   uint64_t probe_points() const { return probe_points_; }
   // Takes over another world's probes with their ids, readings cleared (a restore from a file
-  // before format 5 keeps the world's probes).
+  // before format 6 keeps the world's probes). Their ids keep `from`'s world tag, which may then
+  // differ from this world's (tag 0, the old file's): a later save writes this world's tag, so
+  // those probes' ids change in a world loaded from it.
   void adopt_probes(const World& from);
   // A checkpoint's probes (checkpoint_reader.cpp), readings cleared.
   void restore_probes(SlotTable<Probe> table);
 
   // Replaces the whole scene (checkpoints; see SceneTables).
   void restore_scene(SceneTables tables);
+
+  // The world tag in the ids of its objects (slot_map.h): the C layer gives a new world its
+  // context's next tag, a loaded world the saved world's (0 from a file before format 15), so
+  // that another world's ids are refused and a loaded world's are the saved ones.
+  uint16_t id_tag() const { return colliders_.world_tag(); }
+  void set_id_tag(uint16_t tag);
+  // Takes over `before`'s highest issued generations (a restore replaces a world by a world
+  // loaded beside it: no id `before` issued is issued again).
+  void keep_issued_ids(const World& before);
 
   // Read-only views; everything that changes the scene goes through the entry points above.
   const SlotMap<Collider>& colliders() const { return colliders_; }

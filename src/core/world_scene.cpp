@@ -31,6 +31,22 @@ void remove(SlotMap<T>& map, uint64_t id) {
 
 }  // namespace
 
+void World::set_id_tag(uint16_t tag) {
+  colliders_.set_world_tag(tag);
+  sources_.set_world_tag(tag);
+  sinks_.set_world_tag(tag);
+  force_fields_.set_world_tag(tag);
+  probes_.set_world_tag(tag);
+}
+
+void World::keep_issued_ids(const World& before) {
+  colliders_.keep_issued(before.colliders_);
+  sources_.keep_issued(before.sources_);
+  sinks_.keep_issued(before.sinks_);
+  force_fields_.keep_issued(before.force_fields_);
+  probes_.keep_issued(before.probes_);
+}
+
 uint64_t World::add_collider(const ColliderSpec& spec) {
   Collider c = make_collider(spec);
   require_room(colliders_, "colliders");

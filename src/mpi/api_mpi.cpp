@@ -103,6 +103,11 @@ SPH_API sph_result SPH_CALL sph_mpi_world_create(sph_context* context, const sph
       world = sph::make_world(context, d);
       world->world->backend().attach_ranks(transport, options);
     });
+    // One world tag on every rank, rank 0's, so that the replicated scene objects have the same
+    // ids on every rank (a rank's context may have made other worlds before this one).
+    int64_t tag = ranks.rank() == 0 ? world->world->id_tag() : 0;
+    ranks.all_sum(&tag, 1);
+    world->world->set_id_tag(static_cast<uint16_t>(tag));
     *out = sph::publish_on_every_rank(ranks, std::move(world));
     return SPH_OK;
   });

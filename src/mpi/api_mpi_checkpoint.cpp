@@ -352,7 +352,11 @@ SPH_API sph_result SPH_CALL sph_mpi_world_restore_file(sph_world* world, const c
     });
     sph::require_same_path(ranks, path);
     // Built whole beside the world's state, swapped in once every rank has built its own.
-    sph::agreed(ranks, [&] { loaded = sph::load_rank(world->context, shared, path); });
+    sph::agreed(ranks, [&] {
+      loaded = sph::load_rank(world->context, shared, path);
+      // No id the world issued is issued again (sph_world_restore's rule).
+      loaded->keep_issued_ids(*world->world);
+    });
     loaded->backend().continue_data_epoch(world->world->backend());
     world->world.swap(loaded);
     return SPH_OK;

@@ -2,6 +2,7 @@
 /* Worlds and their parameters through the C API: every bad def, handle and parameter returns
  * its code, names the argument, writes no output and leaves the world as it was. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "capi_test.h"
@@ -531,6 +532,218 @@ static void test_get_params(void** state) {
   for (size_t i = 0; i < sizeof grown.extra; ++i) assert_int_equal(grown.extra[i], 0xcd);
 }
 
+/* ---- ids of objects inside a world ------------------------------------------------------------ */
+/* One object of every kind (ids in a world: sph_c.h). */
+typedef struct {
+  sph_collider_id collider;
+  sph_source_id source;
+  sph_sink_id sink;
+  sph_force_field_id field;
+  sph_probe_id probe;
+} scene_ids;
+
+static sph_world* scene_world(sph_context* context) {
+  sph_world_def def;
+  sph_world* world = NULL;
+  small_world_def(&def);
+  def.features = SPH_FEATURE_COLLIDER_LOADS;
+  EXPECT_OK(sph_world_create(context, &def, &world));
+  return world;
+}
+
+static sph_sdf* ball(sph_context* context) {
+  sph_shape_desc d;
+  sph_sdf* sdf = NULL;
+  sph_shape_desc_init(&d);
+  d.shape = SPH_SHAPE_SPHERE;
+  d.radius = 0.1f;
+  d.voxel_size = 0.02f;
+  EXPECT_OK(sph_sdf_create_shape(context, &d, &sdf));
+  return sdf;
+}
+
+static sph_collider_id add_collider(sph_world* world, sph_sdf* sdf, float x) {
+  sph_collider_def d;
+  sph_collider_id id = {0};
+  sph_collider_def_init(&d);
+  d.sdf = sdf;
+  d.transform.position.x = x;
+  EXPECT_OK(sph_collider_create(world, &d, &id));
+  return id;
+}
+
+static scene_ids add_scene(sph_world* world, sph_sdf* sdf) {
+  scene_ids ids;
+  sph_source_def source;
+  sph_sink_def sink;
+  sph_force_field_def field;
+  sph_probe_def probe;
+  ids.collider = add_collider(world, sdf, 0.5f);
+  sph_source_def_init(&source);
+  source.region = sdf;
+  EXPECT_OK(sph_source_create(world, &source, &ids.source));
+  sph_sink_def_init(&sink);
+  sink.region = sdf;
+  EXPECT_OK(sph_sink_create(world, &sink, &ids.sink));
+  sph_force_field_def_init(&field);
+  EXPECT_OK(sph_force_field_create(world, &field, &ids.field));
+  sph_probe_def_init(&probe);
+  EXPECT_OK(sph_probe_create(world, &probe, &ids.probe));
+  return ids;
+}
+
+static uint8_t* save_world(const sph_world* world, uint64_t* size) {
+  uint8_t* bytes;
+  EXPECT_OK(sph_world_save(world, NULL, 0, size));
+  bytes = (uint8_t*)malloc((size_t)*size);
+  assert_non_null(bytes);
+  EXPECT_OK(sph_world_save(world, bytes, *size, size));
+  return bytes;
+}
+
+/* Every call that takes an id refuses `ids` in `world` (INVALID_HANDLE naming the id), writes
+ * no output, and the world saves the same bytes afterwards. */
+static void expect_ids_refused_at(int line, sph_world* world, const scene_ids* ids) {
+  uint64_t size_before = 0, size_after = 0;
+  uint8_t *before = save_world(world, &size_before), *after;
+  sph_transform t = sph_transform_identity(), out, untouched;
+  sph_collider_material material;
+  sph_collider_loads loads;
+  sph_probe_reading reading;
+  const sph_vec3 point = {0.1f, 0.2f, 0.3f};
+  t.position.x = 9.0f;
+  memset(&out, 0x5a, sizeof out);
+  untouched = out;
+  EXPECT_ERROR_AT(line, SPH_ERROR_INVALID_HANDLE, "id",
+                  sph_collider_get_transform(world, ids->collider, &out));
+  assert_memory_equal(&out, &untouched, sizeof out);
+  EXPECT_ERROR_AT(line, SPH_ERROR_INVALID_HANDLE, "id", sph_collider_teleport(world, ids->collider, &t));
+  EXPECT_ERROR_AT(line, SPH_ERROR_INVALID_HANDLE, "id",
+                  sph_collider_set_target_transform(world, ids->collider, &t));
+  sph_collider_material_init(&material);
+  material.friction = 0.75f;
+  EXPECT_ERROR_AT(line, SPH_ERROR_INVALID_HANDLE, "id",
+                  sph_collider_set_material(world, ids->collider, &material));
+  EXPECT_ERROR_AT(line, SPH_ERROR_INVALID_HANDLE, "id",
+                  sph_collider_get_material(world, ids->collider, &material));
+  sph_collider_loads_init(&loads);
+  EXPECT_ERROR_AT(line, SPH_ERROR_INVALID_HANDLE, "id", sph_collider_get_loads(world, ids->collider, &loads));
+  EXPECT_ERROR_AT(line, SPH_ERROR_INVALID_HANDLE, "id",
+                  sph_collider_set_load_point(world, ids->collider, &point));
+  EXPECT_ERROR_AT(line, SPH_ERROR_INVALID_HANDLE, "id",
+                  sph_collider_set_load_threshold(world, ids->collider, 5.0f));
+  EXPECT_ERROR_AT(line, SPH_ERROR_INVALID_HANDLE, "id", sph_collider_destroy(world, ids->collider));
+  EXPECT_ERROR_AT(line, SPH_ERROR_INVALID_HANDLE, "id", sph_source_set_transform(world, ids->source, &t));
+  EXPECT_ERROR_AT(line, SPH_ERROR_INVALID_HANDLE, "id", sph_source_destroy(world, ids->source));
+  EXPECT_ERROR_AT(line, SPH_ERROR_INVALID_HANDLE, "id", sph_sink_destroy(world, ids->sink));
+  EXPECT_ERROR_AT(line, SPH_ERROR_INVALID_HANDLE, "id", sph_force_field_set_transform(world, ids->field, &t));
+  EXPECT_ERROR_AT(line, SPH_ERROR_INVALID_HANDLE, "id", sph_force_field_destroy(world, ids->field));
+  sph_probe_reading_init(&reading);
+  EXPECT_ERROR_AT(line, SPH_ERROR_INVALID_HANDLE, "id", sph_probe_get_reading(world, ids->probe, &reading));
+  EXPECT_ERROR_AT(line, SPH_ERROR_INVALID_HANDLE, "id",
+                  sph_probe_set_pressure_threshold(world, ids->probe, 100.0f));
+  EXPECT_ERROR_AT(line, SPH_ERROR_INVALID_HANDLE, "id", sph_probe_destroy(world, ids->probe));
+  after = save_world(world, &size_after);
+  assert_int_equal(size_after, size_before);
+  assert_memory_equal(after, before, (size_t)size_before);
+  free(after);
+  free(before);
+}
+#define EXPECT_IDS_REFUSED(world, ids) expect_ids_refused_at(__LINE__, (world), (ids))
+
+/* The ids of every kind of object work in their own world only: two worlds of one context, made
+ * alike, each refuse the other's ids (before the world tag in the ids, the first collider of
+ * every world had the same bits, and world B moved or destroyed its own collider when given
+ * world A's id). Their bits differ; a world loaded from A's checkpoint shares A's ids (by
+ * design: it accepts the saved ids) and still refuses B's. */
+static void test_ids_of_another_world_are_refused(void** state) {
+  sph_context* context = make_context();
+  sph_sdf* sdf = ball(context);
+  sph_world *a = scene_world(context), *b = scene_world(context), *loaded = NULL;
+  const scene_ids in_a = add_scene(a, sdf), in_b = add_scene(b, sdf);
+  sph_transform t;
+  uint64_t size = 0;
+  uint8_t* saved;
+  (void)state;
+  assert_true(in_a.collider.bits != in_b.collider.bits);
+  assert_true(in_a.source.bits != in_b.source.bits);
+  assert_true(in_a.sink.bits != in_b.sink.bits);
+  assert_true(in_a.field.bits != in_b.field.bits);
+  assert_true(in_a.probe.bits != in_b.probe.bits);
+  EXPECT_IDS_REFUSED(b, &in_a);
+  EXPECT_IDS_REFUSED(a, &in_b);
+  /* Each world's own ids still work. */
+  EXPECT_OK(sph_collider_get_transform(a, in_a.collider, &t));
+  EXPECT_OK(sph_collider_get_transform(b, in_b.collider, &t));
+  /* A world loaded from A's checkpoint takes A's ids (and issues A's next ones), not B's. */
+  saved = save_world(a, &size);
+  EXPECT_OK(sph_world_load(context, saved, size, &loaded));
+  EXPECT_OK(sph_collider_get_transform(loaded, in_a.collider, &t));
+  assert_true(t.position.x == 0.5f);
+  EXPECT_IDS_REFUSED(loaded, &in_b);
+  free(saved);
+  EXPECT_OK(sph_world_destroy(loaded));
+  EXPECT_OK(sph_world_destroy(b));
+  EXPECT_OK(sph_world_destroy(a));
+  EXPECT_OK(sph_sdf_destroy(sdf));
+  EXPECT_OK(sph_context_destroy(context));
+}
+
+/* An id is never reused, a restore included: save, create X, restore, create Y: Y is not X, and
+ * X stays refused (before, Y got X's bits and the engine's stale id of X named Y). The same
+ * after a restore of another world's checkpoint, and across several restores. */
+static void test_ids_are_not_reused_after_restore(void** state) {
+  sph_context* context = make_context();
+  sph_sdf* sdf = ball(context);
+  sph_world *a = scene_world(context), *b = scene_world(context);
+  scene_ids in_a = add_scene(a, sdf), extra, again, in_b;
+  sph_collider_id first_b, second_b;
+  sph_transform t;
+  uint64_t size = 0;
+  uint8_t* saved;
+  (void)state;
+  saved = save_world(a, &size);
+  extra = add_scene(a, sdf);
+  EXPECT_OK(sph_world_restore(a, saved, size));
+  EXPECT_OK(sph_collider_get_transform(a, in_a.collider, &t)); /* the saved ids are back */
+  EXPECT_IDS_REFUSED(a, &extra);
+  again = add_scene(a, sdf);
+  assert_true(again.collider.bits != extra.collider.bits);
+  assert_true(again.source.bits != extra.source.bits);
+  assert_true(again.sink.bits != extra.sink.bits);
+  assert_true(again.field.bits != extra.field.bits);
+  assert_true(again.probe.bits != extra.probe.bits);
+  EXPECT_IDS_REFUSED(a, &extra);
+  /* Once more: neither id issued after the save comes back. */
+  EXPECT_OK(sph_world_restore(a, saved, size));
+  {
+    const scene_ids third = add_scene(a, sdf);
+    assert_true(third.collider.bits != extra.collider.bits && third.collider.bits != again.collider.bits);
+    assert_true(third.probe.bits != extra.probe.bits && third.probe.bits != again.probe.bits);
+  }
+  EXPECT_IDS_REFUSED(a, &extra);
+  EXPECT_IDS_REFUSED(a, &again);
+  /* B restores A's checkpoint: B's own ids are refused (B now has A's saved scene and ids), and
+   * no id B issued, before or after that restore, is issued again. */
+  in_b = add_scene(b, sdf);
+  EXPECT_OK(sph_world_restore(b, saved, size));
+  EXPECT_IDS_REFUSED(b, &in_b);
+  EXPECT_OK(sph_collider_get_transform(b, in_a.collider, &t));
+  first_b = add_collider(b, sdf, 1.0f);
+  assert_true(first_b.bits != in_b.collider.bits);
+  EXPECT_OK(sph_world_restore(b, saved, size));
+  second_b = add_collider(b, sdf, 1.0f);
+  assert_true(second_b.bits != first_b.bits && second_b.bits != in_b.collider.bits);
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "id", sph_collider_get_transform(b, first_b, &t));
+  EXPECT_ERROR(SPH_ERROR_INVALID_HANDLE, "id", sph_collider_destroy(b, first_b));
+  EXPECT_OK(sph_collider_get_transform(b, second_b, &t));
+  free(saved);
+  EXPECT_OK(sph_world_destroy(b));
+  EXPECT_OK(sph_world_destroy(a));
+  EXPECT_OK(sph_sdf_destroy(sdf));
+  EXPECT_OK(sph_context_destroy(context));
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_def_init),
@@ -553,6 +766,8 @@ int main(void) {
       cmocka_unit_test_setup_teardown(test_set_params_out_of_range, capi_fixture_setup,
                                       capi_fixture_teardown),
       cmocka_unit_test_setup_teardown(test_get_params, capi_fixture_setup, capi_fixture_teardown),
+      cmocka_unit_test(test_ids_of_another_world_are_refused),
+      cmocka_unit_test(test_ids_are_not_reused_after_restore),
   };
   return cmocka_run_group_tests_name("capi_world_errors", tests, NULL, NULL);
 }

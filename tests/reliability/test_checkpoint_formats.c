@@ -124,12 +124,12 @@ static void test_version_1_loads_into_the_new_params(void** state) {
   expect_generator_params(old_world);
   EXPECT_OK(sph_world_get_particle_count(old_world, &count));
   assert_int_equal(count, 87);
-  /* Saved again, it is the current version (kFormatVersion, src/core/checkpoint_format.h: 14),
+  /* Saved again, it is the current version (kFormatVersion, src/core/checkpoint_format.h: 15),
    * carries the same state and continues bit for bit alike. */
   assert_int_equal(sph_world_save(old_world, NULL, 0, &size), SPH_OK);
   v2 = (uint8_t*)malloc((size_t)size);
   EXPECT_OK(sph_world_save(old_world, v2, size, &size));
-  assert_int_equal(u32_at(v2 + 8), 14);
+  assert_int_equal(u32_at(v2 + 8), 15);
   EXPECT_OK(sph_world_load(f->context, v2, size, &resaved));
   expect_generator_params(resaved);
   capi_expect_same_particles(old_world, resaved);

@@ -160,7 +160,7 @@ static void test_rate_holds_when_frames_stop_early(void** state) {
   buffer = malloc((size_t)size);
   assert_non_null(buffer);
   SCENE_OK(sph_world_save(s.world, buffer, size, &size));
-  assert_int_equal(((const uint8_t*)buffer)[8], 14); /* the format version, little-endian */
+  assert_true(((const uint8_t*)buffer)[8] >= 14); /* the format version (14: the debt), little-endian */
   SCENE_OK(sph_world_load(s.context, buffer, size, &loaded));
   for (f = 0; f < 5; ++f) {
     assert_int_equal(sph_world_step(s.world, frame), SPH_INCOMPLETE);
