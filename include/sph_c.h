@@ -29,7 +29,7 @@
 
 /* ---- version: the one place where the library version is defined ------------------------ */
 #define SPH_VERSION_MAJOR 0
-#define SPH_VERSION_MINOR 1
+#define SPH_VERSION_MINOR 2
 #define SPH_VERSION_PATCH 0
 /** Packed version: (major << 22) | (minor << 12) | patch. */
 #define SPH_MAKE_VERSION(major, minor, patch) \

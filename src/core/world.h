@@ -170,7 +170,7 @@ class World {
   // ---- probes and gauges (world_probes.cpp; physics/probe_sampling.h) ----
   // add_probe: FieldError naming the field for a bad spec, Error(Capacity) past 65536 probes or
   // kMaxProbePoints sample points in all; the world is unchanged on error. Probes are not part of
-  // SceneTables: a checkpoint of format 5 or later carries them (restore_probes), an older one
+  // SceneTables: a checkpoint of format 6 (kFirstProbeVersion) or later carries them (restore_probes), an older one
   // has none and sph_world_restore keeps the world's own (adopt_probes).
   uint64_t add_probe(const ProbeSpec& spec);
   void remove_probe(uint64_t id);
