@@ -2847,11 +2847,11 @@ namespace Sph
         /// SDF assets (SPH_FEATURE_BOUNDARY_DENSITY: a ray integral per voxel, seconds for a large
         /// container on the CPU) and, on CUDA, the device copies of the assets and of the scene. A
         /// world needs it again after a collider gets an asset it has not stepped with, after
-        /// sph_sdf_update of an asset its colliders use, and after sph_world_restore or sph_world_load
-        /// (which hold their own copies of the assets). Optional: a step builds whatever is missing.
-        /// Changes nothing a step or a checkpoint sees (the next step gives the same bits with or
-        /// without it); sph_stats.memory_bytes counts what it built. Errors: INVALID_HANDLE,
-        /// WORLD_LOCKED, OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY, DEVICE_LOST. (0.2.0)
+        /// sph_sdf_update of an asset its colliders use, after sph_world_load (a loaded world holds its
+        /// own copies of the assets) and on CUDA after sph_world_restore. Optional: a step builds
+        /// whatever is missing. Changes nothing a step or a checkpoint sees (the next step gives the
+        /// same bits with or without it); sph_stats.memory_bytes counts what it built. Errors:
+        /// INVALID_HANDLE, WORLD_LOCKED, OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY, DEVICE_LOST. (0.2.0)
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_prepare(WorldHandle world);
@@ -3447,8 +3447,12 @@ namespace Sph
 
         /// <summary>
         /// Replaces a world's whole state with a checkpoint's (undo, retry): afterwards the world is as
-        /// a world loaded from it on the same context, and keeps its handle. All-or-nothing: on any
-        /// error the world is unchanged. Errors: as sph_world_load, and WORLD_LOCKED.
+        /// a world loaded from it on the same context, and keeps its handle, with one difference: a
+        /// collider, source, sink or force field whose asset in the checkpoint holds the same bits as
+        /// the caller's asset the same object uses now keeps the caller's asset (it follows
+        /// sph_sdf_update again, and on the CPU keeps its boundary-density maps); one whose asset
+        /// changed since the save holds the checkpoint's copy, as a loaded world does. All-or-nothing:
+        /// on any error the world is unchanged. Errors: as sph_world_load, and WORLD_LOCKED.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_restore(WorldHandle world, IntPtr data, ulong size);

@@ -136,7 +136,11 @@ SPH_API sph_result SPH_CALL sph_world_restore(sph_world* world, const void* data
     // The world takes the checkpoint's world tag, and never issues again an id it issued before
     // (one issued after the save included).
     loaded->keep_issued_ids(*world->world);
+    // Objects whose assets the caller has not changed since the save keep the caller's assets
+    // (not the checkpoint's copies), and the maps computed from them.
+    loaded->keep_caller_assets(*world->world);
     loaded->backend().continue_data_epoch(world->world->backend());
+    loaded->backend().adopt_asset_caches(world->world->backend());
     world->world.swap(loaded);
     return SPH_OK;
   });

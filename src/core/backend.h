@@ -147,6 +147,12 @@ class Backend {
   // A restore replaces a world's backend with this one: its epoch continues past `previous`'s, so
   // a view taken before the restore (its buffers freed with the old backend) never matches.
   virtual void continue_data_epoch(const Backend& /*previous*/) {}
+  // A restore replaces a world's backend with this one: it takes over what `previous` computed
+  // from the assets and may still use (the CPU backend's boundary-density maps, keyed by asset
+  // and version, so a map of an asset the restored world does not use is never read). Must not
+  // throw (it runs after the restore can no longer fail). A backend without such caches does
+  // nothing; the CUDA backend computes its maps again at the next step.
+  virtual void adopt_asset_caches(Backend& /*previous*/) noexcept {}
   virtual int device_ordinal() const { throw unsupported_interop(); }
   virtual void* device_stream() const { throw unsupported_interop(); }  // a cudaStream_t
   // Records a caller-owned cudaEvent_t on the backend's stream / makes the stream wait for one.

@@ -170,8 +170,8 @@ class World {
   // ---- probes and gauges (world_probes.cpp; physics/probe_sampling.h) ----
   // add_probe: FieldError naming the field for a bad spec, Error(Capacity) past 65536 probes or
   // kMaxProbePoints sample points in all; the world is unchanged on error. Probes are not part of
-  // SceneTables: a checkpoint of format 6 (kFirstProbeVersion) or later carries them (restore_probes), an older one
-  // has none and sph_world_restore keeps the world's own (adopt_probes).
+  // SceneTables: a checkpoint of format 6 (kFirstProbeVersion) or later carries them (restore_probes), an
+  // older one has none and sph_world_restore keeps the world's own (adopt_probes).
   uint64_t add_probe(const ProbeSpec& spec);
   void remove_probe(uint64_t id);
   // The peak pressure (Pa) whose reaching makes a step report ProbePressureExceeded; 0 = none;
@@ -201,6 +201,11 @@ class World {
   // Takes over `before`'s highest issued generations (a restore replaces a world by a world
   // loaded beside it: no id `before` issued is issued again).
   void keep_issued_ids(const World& before);
+  // Where an object of `before` with the same id uses an asset holding the same bits as this
+  // world's copy (a restore of a checkpoint whose assets the caller has not changed since), this
+  // world's object takes `before`'s asset instead of its copy: it follows the caller's
+  // sph_sdf_update again, and its boundary maps are found (Backend::adopt_asset_caches).
+  void keep_caller_assets(const World& before);
 
   // Read-only views; everything that changes the scene goes through the entry points above.
   const SlotMap<Collider>& colliders() const { return colliders_; }

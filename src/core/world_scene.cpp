@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The world's entry points for its scene: colliders, sources, sinks and force fields made from
 // specs (rules in scene_build.h), their setters, and the restore of a saved scene.
+#include <cstring>
 #include <string>
 
 #include "field_checks.h"
@@ -37,6 +38,41 @@ void World::set_id_tag(uint16_t tag) {
   sinks_.set_world_tag(tag);
   force_fields_.set_world_tag(tag);
   probes_.set_world_tag(tag);
+}
+
+namespace {
+
+template <class T>
+bool same_bits(const HostVector<T>& a, const HostVector<T>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+bool same_asset(const SdfAsset& a, const SdfAsset& b) {
+  return a.nx() == b.nx() && a.ny() == b.ny() && a.nz() == b.nz() &&
+         std::memcmp(&a.index_to_local(), &b.index_to_local(), sizeof(Affine3x4)) == 0 &&
+         same_bits(a.distance(), b.distance()) && same_bits(a.velocity(), b.velocity()) &&
+         same_bits(a.friction(), b.friction());
+}
+
+// Each live object of `mine` whose namesake in `before` uses an asset of the same bits takes it.
+template <class T>
+void take_same_assets(SlotMap<T>& mine, const SlotMap<T>& before, std::shared_ptr<const SdfAsset> T::*asset) {
+  mine.for_each([&](uint64_t id, T& object) {
+    const T* old = before.find(id);
+    if (!old) return;
+    const std::shared_ptr<const SdfAsset>& theirs = (*old).*asset;
+    std::shared_ptr<const SdfAsset>& ours = object.*asset;
+    if (ours && theirs && ours != theirs && same_asset(*ours, *theirs)) ours = theirs;
+  });
+}
+
+}  // namespace
+
+void World::keep_caller_assets(const World& before) {
+  take_same_assets(colliders_, before.colliders_, &Collider::sdf);
+  take_same_assets(sources_, before.sources_, &Source::region);
+  take_same_assets(sinks_, before.sinks_, &Sink::region);
+  take_same_assets(force_fields_, before.force_fields_, &ForceField::region);
 }
 
 void World::keep_issued_ids(const World& before) {

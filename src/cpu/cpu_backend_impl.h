@@ -91,6 +91,10 @@ class CpuBackend final : public Backend {
   void restore_distributed_state(const DistributedState& state) override;
   void rethrow_step_failure() const override;
 
+  void adopt_asset_caches(Backend& previous) noexcept override {
+    if (auto* p = dynamic_cast<CpuBackend*>(&previous)) boundary_maps_ = std::move(p->boundary_maps_);
+  }
+
   uint64_t memory_bytes() const override {
     return store_.bytes() + grid_.bytes() + columns_.bytes() + boundary_maps_.bytes();
   }

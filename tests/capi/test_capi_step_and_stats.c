@@ -282,6 +282,37 @@ static void test_prepare_builds_what_a_step_would(void** state) {
   EXPECT_OK(support_world_close(&b));
 }
 
+/* sph_world_restore keeps what the world computed from assets the checkpoint holds unchanged: on
+ * the CPU the restored world still holds the box's boundary-density map (a world loaded from the
+ * same checkpoint holds none until it steps), and the next step gives the same particles, bit for
+ * bit, as the loaded world's step, which computes the map again. (Before, every restore dropped
+ * the maps: the step after it paid for them again, 0.38 s for a 90,601-voxel tank.) The CUDA
+ * backend computes its maps again after a restore. */
+static void test_restore_keeps_the_maps_of_unchanged_assets(void** state) {
+  support_world a;
+  sph_sdf* sdf = NULL;
+  sph_world* loaded = NULL;
+  unsigned char* saved;
+  uint64_t size = 0;
+  (void)state;
+  memset(&a, 0, sizeof a);
+  open_walled_water(&a, &sdf);
+  EXPECT_OK(sph_world_step(a.world, 0.01f));
+  saved = capi_save(a.world, &size);
+  EXPECT_OK(sph_world_step(a.world, 0.01f));
+  EXPECT_OK(sph_world_restore(a.world, saved, size));
+  EXPECT_OK(sph_world_load(a.context, saved, size, &loaded));
+  if (sph_test_backend() == SPH_BACKEND_CPU)
+    assert_true(get_stats(a.world).memory_bytes >= get_stats(loaded).memory_bytes + 16u * 21u * 21u * 21u);
+  EXPECT_OK(sph_world_step(a.world, 0.01f));
+  EXPECT_OK(sph_world_step(loaded, 0.01f));
+  capi_expect_same_particles(a.world, loaded);
+  free(saved);
+  EXPECT_OK(sph_world_destroy(loaded));
+  EXPECT_OK(sph_sdf_destroy(sdf));
+  EXPECT_OK(support_world_close(&a));
+}
+
 int main(void) {
 #define FIXTURE(test) cmocka_unit_test_setup_teardown(test, capi_fixture_setup, capi_fixture_teardown)
   const struct CMUnitTest tests[] = {
@@ -291,6 +322,7 @@ int main(void) {
       FIXTURE(test_step_non_finite_rolls_back),
       cmocka_unit_test(test_stats_before_first_step),
       cmocka_unit_test(test_prepare_builds_what_a_step_would),
+      cmocka_unit_test(test_restore_keeps_the_maps_of_unchanged_assets),
       FIXTURE(test_stats_after_step),
   };
   return cmocka_run_group_tests_name("capi_step_and_stats", tests, NULL, NULL);
