@@ -200,7 +200,9 @@ typedef uint32_t sph_feature_flags;
  *  SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions, summed on the device per substep
  *  in a fixed order (bitwise deterministic) and averaged over the step's time. Costs, per
  *  substep, a reduction over the particles per collider (and with the boundary density one SDF
- *  sample per particle and collider per force evaluation); no host round trip inside a step. */
+ *  sample per particle and collider per force evaluation); no host round trip inside a step.
+ *  Without SPH_FEATURE_BOUNDARY_DENSITY a body the fluid holds off by its pressure feels none of
+ *  it (a submerged box reads almost no buoyancy): sph_world_create logs a warning then. */
 #define SPH_FEATURE_COLLIDER_LOADS 0x10u
 /** A user attribute: one uint32 per particle that the caller sets and the library never reads (a
  *  colour, a phase or material id): written with sph_world_set_attribute and read with

@@ -71,7 +71,8 @@ namespace Sph
         /// substep in a fixed order (bitwise deterministic) and averaged over the step's time. Costs,
         /// per substep, a reduction over the particles per collider (and with the boundary density one
         /// SDF sample per particle and collider per force evaluation); no host round trip inside a
-        /// step.
+        /// step. Without SPH_FEATURE_BOUNDARY_DENSITY a body the fluid holds off by its pressure feels
+        /// none of it (a submerged box reads almost no buoyancy): sph_world_create logs a warning then.
         /// </summary>
         public const uint SPH_FEATURE_COLLIDER_LOADS = 16u;
         /// <summary>

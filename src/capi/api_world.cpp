@@ -179,7 +179,17 @@ SPH_API sph_result SPH_CALL sph_world_create(sph_context* context, const sph_wor
     const sph::ContextHold hold(context);
     if (!out) throw Error(Status::InvalidArgument, "out: is NULL");
     const sph_world_def d = sph::read_user_struct(def, "def");
-    *out = sph::publish_world(sph::make_world(context, d));
+    sph_world* world = sph::publish_world(sph::make_world(context, d));
+    *out = world;
+    // Legal, and a trap for a floating body: without the walls in the density the pressure the
+    // fluid holds a wall with is not a load (docs/api.md, log_fn).
+    if ((d.features & SPH_FEATURE_COLLIDER_LOADS) && !(d.features & SPH_FEATURE_BOUNDARY_DENSITY))
+      sph::report_warning(
+          sph::log_target_of(world), "sph_world_create",
+          "SPH_FEATURE_COLLIDER_LOADS without SPH_FEATURE_BOUNDARY_DENSITY: the loads are the "
+          "collision response's contact impulses alone, so a body the fluid holds off by its "
+          "pressure feels none of it (a submerged box reads almost no buoyancy); add "
+          "SPH_FEATURE_BOUNDARY_DENSITY for the walls' pressure");
     return SPH_OK;
   });
 }

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'c0deb2c71dd4b716f7e0e007c873cee0f7fafb34279b467b00eb7490888f8c9a', 'include/sph_cuda.h': '10c29a1a1f3946f310c4a23105ed7fb70ffea9fa1a9eee03d59ab41a55b122b9', 'include/sph_mpi.h': '874c27d442b57c1afcf7bef1d57f602681dcc63634995dedcc2a1290615e064c', 'include/sph_vdb.h': '256d341729fa5ee56f09a7349d822c42a134d4a948ac22870a64546345e3e434'}
+HEADERS = {'include/sph_c.h': '6f2ca136ae0e768f8cdfb380aeb980694ade736d5333e14deeb6eec4f94fb0b5', 'include/sph_cuda.h': '10c29a1a1f3946f310c4a23105ed7fb70ffea9fa1a9eee03d59ab41a55b122b9', 'include/sph_mpi.h': '874c27d442b57c1afcf7bef1d57f602681dcc63634995dedcc2a1290615e064c', 'include/sph_vdb.h': '256d341729fa5ee56f09a7349d822c42a134d4a948ac22870a64546345e3e434'}
 VERSION = (0, 2, 0)
 VERSION_STRING = "0.2.0"
 ABI_VERSION = 0
@@ -67,7 +67,9 @@ SPH_FEATURE_BOUNDARY_DENSITY = 8
 #: SPH_FEATURE_BOUNDARY_DENSITY, the walls' pressure reactions, summed on the device per substep in
 #: a fixed order (bitwise deterministic) and averaged over the step's time. Costs, per substep, a
 #: reduction over the particles per collider (and with the boundary density one SDF sample per
-#: particle and collider per force evaluation); no host round trip inside a step.
+#: particle and collider per force evaluation); no host round trip inside a step. Without
+#: SPH_FEATURE_BOUNDARY_DENSITY a body the fluid holds off by its pressure feels none of it (a
+#: submerged box reads almost no buoyancy): sph_world_create logs a warning then.
 SPH_FEATURE_COLLIDER_LOADS = 16
 #: A user attribute: one uint32 per particle that the caller sets and the library never reads (a
 #: colour, a phase or material id): written with sph_world_set_attribute and read with
