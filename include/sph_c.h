@@ -250,10 +250,15 @@ typedef enum sph_solver {
 } sph_solver;
 
 /** Step-size limits beyond eq. 32, for sph_world_params.step_limits. */
-#define SPH_STEP_LIMIT_ACOUSTIC                                                          \
-  0x1u                            /* dt <= step_factor h / c, c the EOS's speed of sound \
-                                     (weakly compressible worlds only) */
-#define SPH_STEP_LIMIT_FORCE 0x2u /* dt <= step_factor sqrt(h / |a|_max) */
+#define SPH_STEP_LIMIT_ACOUSTIC                                \
+  0x1u /* dt <= step_factor h / c, c the EOS's speed of sound  \
+          (weakly compressible worlds only; the stability      \
+          ceiling holds dt <= 0.4 h / c already, so this binds \
+          only with a step_factor below 0.4) */
+#define SPH_STEP_LIMIT_FORCE                                                                \
+  0x2u /* dt <= step_factor sqrt(h / |a|_max), |a|_max the largest acceleration of the last \
+          substep (a world's first substep, or the first after a sudden new force, is not   \
+          bound by it) */
 
 /* ---- version and diagnostics (always thread-safe) ---------------------------------------- */
 
@@ -425,7 +430,10 @@ typedef struct sph_world_def {
   sph_viscosity_method viscosity_method;   /* default SPH_VISCOSITY_MUELLER */
   float particle_spacing;                  /* nearest-neighbour distance of the FCC lattice, m;
                                               0 (default) = 0.02 */
-  float kernel_radius;                     /* h, m; 0 (default) = 1.8 * spacing; in [spacing, 5 * spacing] */
+  float kernel_radius;                     /* h, m; 0 (default) = 1.8 * spacing; in (spacing, 5 * spacing]:
+                                              h within about 3e-6 spacings of the spacing is
+                                              refused (the lattice's nearest neighbours would lie
+                                              on the kernel's edge) */
   float rest_density;                      /* rho0, kg/m^3; 0 (default) = 1000 (water) */
   sph_equation_of_state equation_of_state; /* default SPH_EOS_IDEAL_GAS */
   sph_solver solver;                       /* default SPH_SOLVER_WCSPH */
@@ -450,7 +458,7 @@ static inline sph_result sph_world_def_init(sph_world_def* def) {
  * an FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass).
  * Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range:
  * capacity above 2^30, max_capacity non-zero and below capacity or above 2^30, spacing < 0 or
- * non-finite, kernel_radius outside [spacing, 5 * spacing], rest_density < 0),
+ * non-finite, kernel_radius outside (spacing, 5 * spacing], rest_density < 0),
  * UNSUPPORTED (unknown integrator, feature bit, method or solver; a combination a solver does
  * not support, see sph_solver), VERSION_MISMATCH, OUT_OF_HOST_MEMORY,
  * OUT_OF_DEVICE_MEMORY. *out is written only on success.
@@ -482,12 +490,18 @@ typedef struct sph_world_params {
                             at most 1000000 (a bound on one call's cost; see also the step budget) */
   sph_vec3 gravity;      /* m/s^2; default (0, -9.81, 0); finite; 0 is no gravity */
   float stiffness;       /* k of p = k (rho - rho0), m^2/s^2 (the squared numerical sound speed);
-                            default 100; > 0; 0 = default. Keep sqrt(k) * dt_max below about 0.4 h. */
+                            default 100; > 0; 0 = default. Every substep is at most 0.4 h / sqrt(k)
+                            whatever dt_max says (the stability ceiling, below). */
   float viscosity;       /* mu of Mueller's Laplacian viscosity (a numerical viscosity, not
                             water's 0.001 Pa s); default 1; >= 0; 0 is an inviscid fluid */
   float step_factor;     /* lambda of dt = lambda h / v_max; default 0.4; in (0, 10]; 0 = default */
   float dt_min;          /* s; default 1e-6; > 0; 0 = default */
-  float dt_max;          /* s; default 1e-3; >= dt_min (after defaults); 0 = default */
+  float dt_max;          /* s; default 1e-3; >= dt_min (after defaults); 0 = default. Whatever
+                            dt_max and step_factor say, a substep is also at most the stability
+                            ceiling, 0.4 h / c (c the sound speed: sqrt(stiffness) for the ideal
+                            gas) and 0.05 h^2 rho0 / viscosity (Mueller's): a larger dt_max or
+                            step_factor past it changes nothing; dt_min wins over it
+                            (docs/physics.md, "The step controller's stability ceiling") */
   uint32_t step_limits;  /* SPH_STEP_LIMIT_* bits; default 0 (eq. 32 alone) */
   uint32_t reserved0;    /* must be 0 */
   float tension_ratio;   /* (0.2.0) tau, dimensionless: the equation of state (both laws) holds down to
@@ -1469,10 +1483,11 @@ typedef struct sph_source_def {
   sph_source_mode mode;    /* default SPH_SOURCE_FILL_ONCE */
   sph_sdf* region;         /* required: particles fill where the SDF is negative */
   sph_transform transform; /* default identity */
-  float spacing;           /* FCC lattice spacing, m; 0 (default) = the world's spacing */
+  float spacing;           /* FCC lattice spacing, m; 0 (default) = the world's spacing; at least a
+                              quarter of the world's */
   float min_distance;      /* skip lattice points closer than this to a particle, m; 0 (default)
                               = 0.9 x spacing or the kernel radius, the smaller; at most the
-                              kernel radius */
+                              source's spacing and at most the kernel radius */
   sph_vec3 velocity;       /* initial velocity (unless VELOCITY_FROM_FIELD); default 0 */
   uint32_t flags;          /* SPH_SOURCE_FLAG_* */
   float rate;              /* CONTINUOUS: most particles per second; 0 (default) = no limit.

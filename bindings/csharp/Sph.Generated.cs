@@ -99,10 +99,15 @@ namespace Sph
         public const uint SPH_FEATURE_DENSITY_DIFFUSION = 64u;
         /// <summary>
         /// Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt &lt;= step_factor h /
-        /// c, c the EOS's speed of sound \ (weakly compressible worlds only)
+        /// c, c the EOS's speed of sound  \ (weakly compressible worlds only; the stability      \
+        /// ceiling holds dt &lt;= 0.4 h / c already, so this binds \ only with a step_factor below 0.4)
         /// </summary>
         public const uint SPH_STEP_LIMIT_ACOUSTIC = 1u;
-        /// <summary>dt &lt;= step_factor sqrt(h / |a|_max)</summary>
+        /// <summary>
+        /// dt &lt;= step_factor sqrt(h / |a|_max), |a|_max the largest acceleration of the last \
+        /// substep (a world's first substep, or the first after a sudden new force, is not   \ bound by
+        /// it)
+        /// </summary>
         public const uint SPH_STEP_LIMIT_FORCE = 2u;
         /// <summary>sph_dfsph_params.flags no divergence solve (cheaper; a noisier pressure)</summary>
         public const uint SPH_DFSPH_SKIP_DIVERGENCE_SOLVE = 1u;
@@ -964,7 +969,11 @@ namespace Sph
         public ViscosityMethod ViscosityMethod;
         /// <summary>float particle_spacing: nearest-neighbour distance of the FCC lattice, m; 0 (default) = 0.02</summary>
         public float ParticleSpacing;
-        /// <summary>float kernel_radius: h, m; 0 (default) = 1.8 * spacing; in [spacing, 5 * spacing]</summary>
+        /// <summary>
+        /// float kernel_radius: h, m; 0 (default) = 1.8 * spacing; in (spacing, 5 * spacing]: h within
+        /// about 3e-6 spacings of the spacing is refused (the lattice's nearest neighbours would lie on
+        /// the kernel's edge)
+        /// </summary>
         public float KernelRadius;
         /// <summary>float rest_density: rho0, kg/m^3; 0 (default) = 1000 (water)</summary>
         public float RestDensity;
@@ -1008,7 +1017,8 @@ namespace Sph
         public Vec3 Gravity;
         /// <summary>
         /// float stiffness: k of p = k (rho - rho0), m^2/s^2 (the squared numerical sound speed);
-        /// default 100; &gt; 0; 0 = default. Keep sqrt(k) * dt_max below about 0.4 h.
+        /// default 100; &gt; 0; 0 = default. Every substep is at most 0.4 h / sqrt(k) whatever dt_max
+        /// says (the stability ceiling, below).
         /// </summary>
         public float Stiffness;
         /// <summary>
@@ -1020,7 +1030,13 @@ namespace Sph
         public float StepFactor;
         /// <summary>float dt_min: s; default 1e-6; &gt; 0; 0 = default</summary>
         public float DtMin;
-        /// <summary>float dt_max: s; default 1e-3; &gt;= dt_min (after defaults); 0 = default</summary>
+        /// <summary>
+        /// float dt_max: s; default 1e-3; &gt;= dt_min (after defaults); 0 = default. Whatever dt_max
+        /// and step_factor say, a substep is also at most the stability ceiling, 0.4 h / c (c the sound
+        /// speed: sqrt(stiffness) for the ideal gas) and 0.05 h^2 rho0 / viscosity (Mueller's): a
+        /// larger dt_max or step_factor past it changes nothing; dt_min wins over it (docs/physics.md,
+        /// "The step controller's stability ceiling")
+        /// </summary>
         public float DtMax;
         /// <summary>uint32_t step_limits: SPH_STEP_LIMIT_* bits; default 0 (eq. 32 alone)</summary>
         public uint StepLimits;
@@ -1920,11 +1936,15 @@ namespace Sph
         public IntPtr Region;
         /// <summary>sph_transform transform: default identity</summary>
         public Transform Transform;
-        /// <summary>float spacing: FCC lattice spacing, m; 0 (default) = the world's spacing</summary>
+        /// <summary>
+        /// float spacing: FCC lattice spacing, m; 0 (default) = the world's spacing; at least a quarter
+        /// of the world's
+        /// </summary>
         public float Spacing;
         /// <summary>
         /// float min_distance: skip lattice points closer than this to a particle, m; 0 (default) = 0.9
-        /// x spacing or the kernel radius, the smaller; at most the kernel radius
+        /// x spacing or the kernel radius, the smaller; at most the source's spacing and at most the
+        /// kernel radius
         /// </summary>
         public float MinDistance;
         /// <summary>sph_vec3 velocity: initial velocity (unless VELOCITY_FROM_FIELD); default 0</summary>
@@ -2539,7 +2559,7 @@ namespace Sph
         /// FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass).
         /// Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range:
         /// capacity above 2^30, max_capacity non-zero and below capacity or above 2^30, spacing &lt; 0
-        /// or non-finite, kernel_radius outside [spacing, 5 * spacing], rest_density &lt; 0),
+        /// or non-finite, kernel_radius outside (spacing, 5 * spacing], rest_density &lt; 0),
         /// UNSUPPORTED (unknown integrator, feature bit, method or solver; a combination a solver does
         /// not support, see sph_solver), VERSION_MISMATCH, OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY.
         /// *out is written only on success.

@@ -5,6 +5,8 @@
 #include <stdint.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 
@@ -13,7 +15,16 @@
 
 namespace sph {
 
-inline std::string describe(float v) { return std::to_string(v); }
+// A float as a message shows it: the fewest significant digits (6 to 9) that read back as the
+// same float, so "-1e-07" rather than std::to_string's "-0.000000", and 0.099999994 apart from 0.1.
+inline std::string describe(float v) {
+  char text[32];
+  for (int digits = 6; digits <= 9; ++digits) {
+    std::snprintf(text, sizeof text, "%.*g", digits, static_cast<double>(v));
+    if (std::strtof(text, nullptr) == v || std::isnan(v)) break;
+  }
+  return text;
+}
 
 // The raw 32-bit value of an enum field or argument from the caller. C code and FFIs can put
 // any value in an sph_* enum (-1, say), but in C++ loading a value outside the enum's range is

@@ -253,11 +253,22 @@ static void test_create_out_of_range(void** state) {
   EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_INVALID_ARGUMENT, "kernel_radius");
   def.kernel_radius = 5.5f * def.particle_spacing;
   EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_INVALID_ARGUMENT, "kernel_radius");
-  /* The edges themselves are allowed. */
+  /* h = spacing, and a float step above it, are refused: the lattice's nearest neighbours would
+   * lie on the kernel's edge, where the lattice scale divides by (nearly) zero (a filled block's
+   * densities were non-finite at its first step; a technical artist's review). At 1.001 spacings
+   * a block reads rho0. */
   def.kernel_radius = def.particle_spacing;
+  EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_INVALID_ARGUMENT, "kernel_radius");
+  def.kernel_radius = nextafterf(def.particle_spacing, 1.0f);
+  EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_INVALID_ARGUMENT, "kernel_radius");
+  def.kernel_radius = def.particle_spacing * 1.001f;
   expect_create_ok(context, &def);
-  def.kernel_radius = 4.0f * def.particle_spacing;
+  /* 5 x spacing as written is allowed: 0.1f for 0.02f lies one float step above 5.0f * 0.02f. */
+  def.particle_spacing = 0.02f;
+  def.kernel_radius = 0.1f;
   expect_create_ok(context, &def);
+  def.kernel_radius = 0.1001f;
+  EXPECT_CREATE_FAILS(context, &def, SPH_ERROR_INVALID_ARGUMENT, "kernel_radius");
   EXPECT_OK(sph_context_destroy(context));
 }
 

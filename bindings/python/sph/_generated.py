@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '6f2ca136ae0e768f8cdfb380aeb980694ade736d5333e14deeb6eec4f94fb0b5', 'include/sph_cuda.h': '10c29a1a1f3946f310c4a23105ed7fb70ffea9fa1a9eee03d59ab41a55b122b9', 'include/sph_mpi.h': '874c27d442b57c1afcf7bef1d57f602681dcc63634995dedcc2a1290615e064c', 'include/sph_vdb.h': '256d341729fa5ee56f09a7349d822c42a134d4a948ac22870a64546345e3e434'}
+HEADERS = {'include/sph_c.h': '678f34e3ea636cc2b839f4f21c198df36d8db1c49443fa60259b33b8bae8799d', 'include/sph_cuda.h': '10c29a1a1f3946f310c4a23105ed7fb70ffea9fa1a9eee03d59ab41a55b122b9', 'include/sph_mpi.h': '874c27d442b57c1afcf7bef1d57f602681dcc63634995dedcc2a1290615e064c', 'include/sph_vdb.h': '256d341729fa5ee56f09a7349d822c42a134d4a948ac22870a64546345e3e434'}
 VERSION = (0, 2, 0)
 VERSION_STRING = "0.2.0"
 ABI_VERSION = 0
@@ -89,9 +89,11 @@ SPH_FEATURE_USER_ATTRIBUTE = 32
 #: alone. Costs one gather per substep instead of one per density pass (docs/physics.md).
 SPH_FEATURE_DENSITY_DIFFUSION = 64
 #: Step-size limits beyond eq. 32, for sph_world_params.step_limits. dt <= step_factor h / c, c the
-#: EOS's speed of sound \ (weakly compressible worlds only)
+#: EOS's speed of sound  \ (weakly compressible worlds only; the stability      \ ceiling holds dt
+#: <= 0.4 h / c already, so this binds \ only with a step_factor below 0.4)
 SPH_STEP_LIMIT_ACOUSTIC = 1
-#: dt <= step_factor sqrt(h / |a|_max)
+#: dt <= step_factor sqrt(h / |a|_max), |a|_max the largest acceleration of the last \ substep (a
+#: world's first substep, or the first after a sudden new force, is not   \ bound by it)
 SPH_STEP_LIMIT_FORCE = 2
 #: sph_dfsph_params.flags no divergence solve (cheaper; a noisier pressure)
 SPH_DFSPH_SKIP_DIVERGENCE_SOLVE = 1
@@ -910,7 +912,7 @@ class WorldDef(_SphStruct):
         integrator (sph_integrator): default SPH_INTEGRATOR_SYMPLECTIC_EULER
         viscosity_method (sph_viscosity_method): default SPH_VISCOSITY_MUELLER
         particle_spacing (float): nearest-neighbour distance of the FCC lattice, m; 0 (default) = 0.02
-        kernel_radius (float): h, m; 0 (default) = 1.8 * spacing; in [spacing, 5 * spacing]
+        kernel_radius (float): h, m; 0 (default) = 1.8 * spacing; in (spacing, 5 * spacing]: h within about 3e-6 spacings of the spacing is refused (the lattice's nearest neighbours would lie on the kernel's edge)
         rest_density (float): rho0, kg/m^3; 0 (default) = 1000 (water)
         equation_of_state (sph_equation_of_state): default SPH_EOS_IDEAL_GAS
         solver (sph_solver): default SPH_SOLVER_WCSPH
@@ -949,11 +951,11 @@ class WorldParams(_SphStruct):
         struct_size (uint32_t): sizeof(sph_world_params), set by sph_world_params_init
         max_substeps (uint32_t): most substeps one sph_world_step may take; default 10000; 0 = default; at most 1000000 (a bound on one call's cost; see also the step budget)
         gravity (sph_vec3): m/s^2; default (0, -9.81, 0); finite; 0 is no gravity
-        stiffness (float): k of p = k (rho - rho0), m^2/s^2 (the squared numerical sound speed); default 100; > 0; 0 = default. Keep sqrt(k) * dt_max below about 0.4 h.
+        stiffness (float): k of p = k (rho - rho0), m^2/s^2 (the squared numerical sound speed); default 100; > 0; 0 = default. Every substep is at most 0.4 h / sqrt(k) whatever dt_max says (the stability ceiling, below).
         viscosity (float): mu of Mueller's Laplacian viscosity (a numerical viscosity, not water's 0.001 Pa s); default 1; >= 0; 0 is an inviscid fluid
         step_factor (float): lambda of dt = lambda h / v_max; default 0.4; in (0, 10]; 0 = default
         dt_min (float): s; default 1e-6; > 0; 0 = default
-        dt_max (float): s; default 1e-3; >= dt_min (after defaults); 0 = default
+        dt_max (float): s; default 1e-3; >= dt_min (after defaults); 0 = default. Whatever dt_max and step_factor say, a substep is also at most the stability ceiling, 0.4 h / c (c the sound speed: sqrt(stiffness) for the ideal gas) and 0.05 h^2 rho0 / viscosity (Mueller's): a larger dt_max or step_factor past it changes nothing; dt_min wins over it (docs/physics.md, "The step controller's stability ceiling")
         step_limits (uint32_t): SPH_STEP_LIMIT_* bits; default 0 (eq. 32 alone)
         reserved0 (uint32_t): must be 0
         tension_ratio (float): (0.2.0) tau, dimensionless: the equation of state (both laws) holds down to (1 - tau) rho0 and keeps its value there below it, a bounded tension (-k tau rho0 for the ideal gas); default 0, the clamp at zero below rho0; in [0, 0.125]; 0 is the clamp. It lets a disturbed fluid pull back instead of swelling. Use it with SPH_FEATURE_NORMALIZED_DENSITY: with the plain summation density every free-surface particle sits below the floor and takes the whole tension, and the surface clumps and sheds (docs/physics.md, "The equation of state's floor"). No effect with DFSPH
@@ -1741,8 +1743,8 @@ class SourceDef(_SphStruct):
         mode (sph_source_mode): default SPH_SOURCE_FILL_ONCE
         region (sph_sdf*): required: particles fill where the SDF is negative
         transform (sph_transform): default identity
-        spacing (float): FCC lattice spacing, m; 0 (default) = the world's spacing
-        min_distance (float): skip lattice points closer than this to a particle, m; 0 (default) = 0.9 x spacing or the kernel radius, the smaller; at most the kernel radius
+        spacing (float): FCC lattice spacing, m; 0 (default) = the world's spacing; at least a quarter of the world's
+        min_distance (float): skip lattice points closer than this to a particle, m; 0 (default) = 0.9 x spacing or the kernel radius, the smaller; at most the source's spacing and at most the kernel radius
         velocity (sph_vec3): initial velocity (unless VELOCITY_FROM_FIELD); default 0
         flags (uint32_t): SPH_SOURCE_FLAG_*
         rate (float): CONTINUOUS: most particles per second; 0 (default) = no limit. What the region or the world could not take is emitted later, but at most one region's worth is owed
@@ -2177,7 +2179,7 @@ FUNCTIONS = {
     'sph_world_def_init_sized': (sph_result, (_c.POINTER(sph_world_def), _c.c_uint32), ('def', 'size'),
         '', 'sph'),
     'sph_world_create': (sph_result, (_c.POINTER(sph_context), _c.POINTER(sph_world_def), _c.POINTER(_c.POINTER(sph_world))), ('context', 'def', 'out'),
-        'Creates an empty world on a context. The particle mass is derived here: the mass at which an FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass). Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range: capacity above 2^30, max_capacity non-zero and below capacity or above 2^30, spacing < 0 or non-finite, kernel_radius outside [spacing, 5 * spacing], rest_density < 0), UNSUPPORTED (unknown integrator, feature bit, method or solver; a combination a solver does not support, see sph_solver), VERSION_MISMATCH, OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY. *out is written only on success.', 'sph'),
+        'Creates an empty world on a context. The particle mass is derived here: the mass at which an FCC lattice at particle_spacing has exactly rest_density (sph_world_get_particle_mass). Errors: INVALID_HANDLE (context NULL or lost), INVALID_ARGUMENT (a field out of range: capacity above 2^30, max_capacity non-zero and below capacity or above 2^30, spacing < 0 or non-finite, kernel_radius outside (spacing, 5 * spacing], rest_density < 0), UNSUPPORTED (unknown integrator, feature bit, method or solver; a combination a solver does not support, see sph_solver), VERSION_MISMATCH, OUT_OF_HOST_MEMORY, OUT_OF_DEVICE_MEMORY. *out is written only on success.', 'sph'),
     'sph_world_destroy': (sph_result, (_c.POINTER(sph_world),), ('world',),
         "Destroys a world and everything in it. NULL is a no-op. It takes the world like every call that takes a world: WORLD_LOCKED while another thread's call is inside it (destroy again once that call returned); a call that races a destroy that won gets INVALID_HANDLE. Memory a call is using is never freed.", 'sph'),
     'sph_world_get_def': (sph_result, (_c.POINTER(sph_world), _c.POINTER(sph_world_def)), ('world', 'out_def'),
