@@ -44,10 +44,15 @@ namespace Sph
             LibraryMessage = message;
         }
 
+        // "function: Result: detail". The library's message already starts with the function's
+        // name ("sph_world_step: frame_dt: must be > 0"): that prefix is not repeated.
         static string Format(Result result, string function, string message)
         {
             string name = Enum.IsDefined(typeof(Result), result) ? result.ToString() : "sph_result " + (int)result;
-            return (function != null ? function + ": " : "") + name + (string.IsNullOrEmpty(message) ? "" : ": " + message);
+            string detail = message;
+            if (function != null && !string.IsNullOrEmpty(detail) && detail.StartsWith(function + ":", StringComparison.Ordinal))
+                detail = detail.Substring(function.Length + 1).TrimStart();
+            return (function != null ? function + ": " : "") + name + (string.IsNullOrEmpty(detail) ? "" : ": " + detail);
         }
 
         /// <summary>Throws for a negative result (reading the thread's last error at once);
@@ -181,14 +186,45 @@ namespace Sph
         /// header ("3 x float32, metres"), so attributes added later need no code here.</summary>
         public static void AttributeFormat(SphAttribute attribute, out int components, out int componentBytes)
         {
+            string type;
+            if (!TryAttributeFormat(attribute, out components, out type))
+                throw new ArgumentException("attribute " + attribute + ": no documented element format");
+            componentBytes = 4;
+        }
+
+        // The attribute's components and their type ("float32", "uint32", "int32"); false for an
+        // attribute with no documented format (one these bindings do not know).
+        internal static bool TryAttributeFormat(SphAttribute attribute, out int components, out string componentType)
+        {
+            KeyValuePair<int, string> format;
+            lock (attributeFormats)
+            {
+                if (!attributeFormats.TryGetValue(attribute, out format))
+                {
+                    int n;
+                    string type;
+                    ParseAttributeFormat(attribute, out n, out type);
+                    format = new KeyValuePair<int, string>(n, type);
+                    attributeFormats.Add(attribute, format);
+                }
+            }
+            components = format.Key;
+            componentType = format.Value;
+            return componentType != null;
+        }
+
+        static readonly Dictionary<SphAttribute, KeyValuePair<int, string>> attributeFormats =
+            new Dictionary<SphAttribute, KeyValuePair<int, string>>();
+
+        static void ParseAttributeFormat(SphAttribute attribute, out int components, out string componentType)
+        {
             string key = null;
             foreach (var pair in Layout.EnumMemberDocs)
                 if (pair.Key.StartsWith("SPH_ATTRIBUTE_") && pair.Key.Replace("_", "").Equals("SPHATTRIBUTE" + attribute.ToString(), StringComparison.OrdinalIgnoreCase))
                     key = pair.Key;
             Match m = key == null ? Match.Empty : formatPattern.Match(Layout.EnumMemberDocs[key]);
-            if (!m.Success) throw new ArgumentException("attribute " + attribute + ": no documented element format");
-            components = m.Groups[1].Success ? int.Parse(m.Groups[1].Value) : 1;
-            componentBytes = 4;
+            components = m.Success && m.Groups[1].Success ? int.Parse(m.Groups[1].Value) : 1;
+            componentType = m.Success ? m.Groups[2].Value : null;
         }
     }
 
@@ -208,6 +244,7 @@ namespace Sph
         /// <summary>A NUL-terminated UTF-8 copy, for const char* parameters.</summary>
         public static byte[] ToNative(string s)
         {
+            if (s == null) throw new ArgumentNullException("s");
             var bytes = Encoding.UTF8.GetBytes(s);
             Array.Resize(ref bytes, bytes.Length + 1);
             return bytes;
@@ -433,7 +470,12 @@ namespace Sph
     }
 
     /// <summary>A backend (the CPU or one CUDA device) that worlds are created on (sph_context).
-    /// Dispose it when done; worlds keep it alive until they are disposed too.</summary>
+    /// Dispose it when done; worlds and assets keep the native context alive until they are
+    /// disposed too, but the Context object itself is done: after Dispose every member
+    /// (<see cref="Handle"/>, <see cref="Backend"/>, CreateWorld, LoadWorld, ...) and every call
+    /// that takes it (<c>new World(context, ...)</c>, the Sdf factories) throws
+    /// ObjectDisposedException, whatever still lives; only <see cref="IsDisposed"/>,
+    /// <see cref="TaskSystem"/> and Dispose (idempotent) still answer.</summary>
     public sealed class Context : IDisposable
     {
         // One static delegate for every context: IL2CPP can only call static methods marked
@@ -441,7 +483,35 @@ namespace Sph
         static readonly LogFn logThunk = OnLog;
         static readonly IntPtr logThunkPointer = Marshal.GetFunctionPointerForDelegate(logThunk);
 
-        public ContextHandle Handle { get; private set; }
+        ContextHandle handle;
+
+        /// <summary>The native context's handle; ObjectDisposedException after Dispose (the
+        /// handle may stay open while worlds or assets hold it, but it is theirs).</summary>
+        public ContextHandle Handle
+        {
+            get
+            {
+                ThrowIfDisposed();
+                return handle;
+            }
+        }
+
+        void ThrowIfDisposed()
+        {
+            if (IsDisposed) throw new ObjectDisposedException("Context", "the Context was disposed (its worlds and assets may still hold the native context)");
+        }
+
+        // The handle of `context`, an argument named `parameter`: ArgumentNullException for null,
+        // ObjectDisposedException once it was disposed.
+        internal static ContextHandle HandleOf(Context context, string parameter)
+        {
+            if (context == null) throw new ArgumentNullException(parameter);
+            return context.Handle;
+        }
+
+        // For SetParent after a call that checked the context: the handle even if a Dispose came
+        // meanwhile (DangerousAddRef then throws only if the native context is gone).
+        internal ContextHandle RawHandle { get { return handle; } }
 
         public Context(Backend backend = Backend.Auto) : this(DefFor(backend), null) { }
 
@@ -480,7 +550,7 @@ namespace Sph
             }
             handle.LogTarget = target;
             handle.TaskTarget = tasks;
-            Handle = handle;
+            this.handle = handle;
             TaskSystem = taskSystem;
         }
 
@@ -530,15 +600,24 @@ namespace Sph
                                "sph_cuda_context_set_allocator");
         }
 
-        public World CreateWorld(WorldDef def) { return new World(this, def); }
+        public World CreateWorld(WorldDef def)
+        {
+            ThrowIfDisposed();
+            return new World(this, def);
+        }
 
-        public World CreateWorld() { return new World(this, WorldDef.Default()); }
+        public World CreateWorld()
+        {
+            ThrowIfDisposed();
+            return new World(this, WorldDef.Default());
+        }
 
         /// <summary>A new world on this context from checkpoint bytes (sph_world_load; see
         /// World.Save). The context decides the backend, whichever saved it. Throws
         /// SphException (ErrorCorruptData for a damaged checkpoint; no world is created).</summary>
         public World LoadWorld(byte[] data)
         {
+            ThrowIfDisposed();
             if (data == null) throw new ArgumentNullException("data");
             WorldHandle handle;
             GCHandle pin = GCHandle.Alloc(data, GCHandleType.Pinned);
@@ -557,6 +636,8 @@ namespace Sph
         /// <summary>A new world on this context from a checkpoint file (sph_world_load_file).</summary>
         public World LoadWorldFile(string path)
         {
+            ThrowIfDisposed();
+            if (path == null) throw new ArgumentNullException("path");
             WorldHandle handle;
             SphException.Check(Native.sph_world_load_file(Handle, Utf8.ToNative(path), out handle), "sph_world_load_file");
             return new World(this, handle);
@@ -565,10 +646,13 @@ namespace Sph
         /// <summary>True after Dispose (the native context may live on while worlds use it).</summary>
         public bool IsDisposed { get; private set; }
 
+        /// <summary>Releases the caller's reference on the native context (idempotent): it is
+        /// destroyed now, or when the last world or asset that holds it goes.</summary>
         public void Dispose()
         {
+            if (IsDisposed) return;
             IsDisposed = true;
-            Handle.Dispose();
+            handle.Dispose();
         }
     }
 
@@ -727,6 +811,7 @@ namespace Sph
         /// good by the binding (the same RunAndWait), never by native code.</summary>
         public virtual void Finish(NativeTask task)
         {
+            if (task == null) throw new ArgumentNullException("task");
             task.RunAndWait(CurrentWorker);
         }
 
@@ -944,6 +1029,7 @@ namespace Sph
 
         public override bool Enqueue(NativeTask task)
         {
+            if (task == null) throw new ArgumentNullException("task");
             if (poolDepth > 0) Interlocked.Increment(ref nestedTasks);
             long runners = Math.Min(task.RangeCount, (long)MaxRunners);
             for (long i = 0; i < runners; ++i)
@@ -969,6 +1055,7 @@ namespace Sph
 
         public override void Finish(NativeTask task)
         {
+            if (task == null) throw new ArgumentNullException("task");
             Interlocked.Add(ref itemsByCaller, task.RunAndWait(CurrentWorker));
         }
 
@@ -1018,19 +1105,23 @@ namespace Sph
         public WorldHandle Handle { get; private set; }
         public Context Context { get; private set; }
 
+        /// <summary>A new world on <paramref name="context"/> (sph_world_create): as
+        /// <c>context.CreateWorld(def)</c>. ArgumentNullException for a null context,
+        /// ObjectDisposedException for a disposed one.</summary>
         public World(Context context, WorldDef def)
         {
+            ContextHandle contextHandle = Context.HandleOf(context, "context");
             WorldHandle handle;
-            SphException.Check(Native.sph_world_create(context.Handle, ref def, out handle), "sph_world_create");
-            handle.SetParent(context.Handle);  // the context outlives its worlds
+            SphException.Check(Native.sph_world_create(contextHandle, ref def, out handle), "sph_world_create");
+            handle.SetParent(contextHandle);  // the context outlives its worlds
             Handle = handle;
             Context = context;
         }
 
-        // A world the library created from a checkpoint.
+        // A world the library created from a checkpoint (on a context the caller checked).
         internal World(Context context, WorldHandle handle)
         {
-            handle.SetParent(context.Handle);
+            handle.SetParent(context.RawHandle);
             Handle = handle;
             Context = context;
         }
@@ -1076,6 +1167,7 @@ namespace Sph
         /// path, flushed, then renamed over it; on error a file at path is untouched.</summary>
         public void SaveFile(string path)
         {
+            if (path == null) throw new ArgumentNullException("path");
             SphException.Check(Native.sph_world_save_file(Handle, Utf8.ToNative(path)), "sph_world_save_file");
         }
 
@@ -1248,9 +1340,11 @@ namespace Sph
 
         /// <summary>The params struct of <paramref name="kind"/> (T must be its struct:
         /// WorldParams for ParamsKind.World, TaitParams for ParamsKind.Tait, ...), read from the
-        /// world (sph_world_get_physics_params).</summary>
+        /// world (sph_world_get_physics_params). Another T throws ArgumentException naming T and
+        /// the kind's struct.</summary>
         public T GetPhysicsParams<T>(ParamsKind kind) where T : struct
         {
+            CheckParamsType(typeof(T), kind);
             int size = Marshal.SizeOf(typeof(T));
             IntPtr buffer = Marshal.AllocHGlobal(size);
             try
@@ -1265,9 +1359,11 @@ namespace Sph
 
         /// <summary>Replaces the params struct of <paramref name="kind"/> with
         /// <paramref name="value"/> (its struct, struct_size set), as its typed setter does
-        /// (sph_world_set_physics_params).</summary>
+        /// (sph_world_set_physics_params). Another T throws ArgumentException, as for
+        /// <see cref="GetPhysicsParams{T}"/>.</summary>
         public void SetPhysicsParams<T>(ParamsKind kind, T value) where T : struct
         {
+            CheckParamsType(typeof(T), kind);
             IntPtr buffer = Marshal.AllocHGlobal(Marshal.SizeOf(typeof(T)));
             try
             {
@@ -1275,6 +1371,19 @@ namespace Sph
                 SphException.Check(Native.sph_world_set_physics_params(Handle, kind, buffer), "sph_world_set_physics_params");
             }
             finally { Marshal.FreeHGlobal(buffer); }
+        }
+
+        // T must be the struct Library.ParamsInfo(kind) names (its C type name, through Layout):
+        // a struct of another kind (or a Vec3) would be filled or sent as garbage, and two params
+        // structs of the same size pass the library's struct_size check. A kind whose struct these
+        // bindings do not know (a newer library's) is left to that check.
+        static void CheckParamsType(Type type, ParamsKind kind)
+        {
+            string typeName = Utf8.FromNative(Library.ParamsInfo(kind).TypeName);
+            int at = Array.IndexOf(Layout.StructNames, typeName);
+            if (at < 0 || Layout.StructTypes[at] == type) return;
+            throw new ArgumentException("T is " + type.Name + ", but the params struct of ParamsKind." + kind + " is " +
+                                        Layout.StructTypes[at].Name + " (" + typeName + ")");
         }
 
         // ---- particles in ---------------------------------------------------------------------
@@ -1298,7 +1407,8 @@ namespace Sph
         /// <summary>Adds particles from xyz triples (positions.Length / 3 particles).</summary>
         public uint Spawn(float[] positions, float[] velocities = null)
         {
-            if (positions == null || positions.Length % 3 != 0) throw new ArgumentException("positions: a multiple of 3 floats");
+            if (positions == null) throw new ArgumentNullException("positions");
+            if (positions.Length % 3 != 0) throw new ArgumentException("positions: a multiple of 3 floats");
             if (velocities != null && velocities.Length != positions.Length) throw new ArgumentException("velocities: one triple per position");
             return SpawnPinned(positions, velocities, 12, (uint)(positions.Length / 3));
         }
@@ -1446,27 +1556,98 @@ namespace Sph
             return written;
         }
 
-        /// <summary>Copies into a float array (3 floats per particle for vectors, 1 for
-        /// scalars), as many particles as fit from `first`. Returns the number written.</summary>
+        /// <summary>Copies a float32 attribute (Position, Velocity, Density, Pressure) into a
+        /// float array (3 floats per particle for vectors, 1 for scalars), as many particles as fit
+        /// from `first`. Returns the number written. A uint32 attribute (Id, User) throws
+        /// ArgumentException: copy it into a uint[].</summary>
         public uint CopyAttribute(SphAttribute attribute, float[] dst, uint first = 0)
         {
+            if (dst == null) throw new ArgumentNullException("dst");
             int components, bytes;
             Library.AttributeFormat(attribute, out components, out bytes);
+            CheckElementType(attribute, typeof(float), "dst");
             return CopyPinned(attribute, dst, (ulong)(components * bytes), (uint)(dst.Length / components), first);
         }
 
-        /// <summary>Copies a uint attribute (ids) into an array. Returns the number written.</summary>
+        /// <summary>Copies a uint32 attribute (Id, User) into an array. Returns the number
+        /// written. A float32 attribute throws ArgumentException.</summary>
         public uint CopyAttribute(SphAttribute attribute, uint[] dst, uint first = 0)
         {
+            if (dst == null) throw new ArgumentNullException("dst");
+            CheckElementType(attribute, typeof(uint), "dst");
             return CopyPinned(attribute, dst, 4, (uint)dst.Length, first);
         }
 
         /// <summary>Copies into an array of blittable structs, one per particle, the attribute
         /// written at the start of each element (stride = the struct's size): Vec3 or
-        /// UnityEngine.Vector3 arrays for positions, or an interleaved particle struct.</summary>
+        /// UnityEngine.Vector3 arrays for positions, or an interleaved particle struct. The
+        /// element's first field must hold the attribute's type: float for Position, Velocity,
+        /// Density, Pressure; uint or int for Id and User (else ArgumentException).</summary>
         public uint CopyAttribute<T>(SphAttribute attribute, T[] dst, uint first = 0) where T : struct
         {
+            if (dst == null) throw new ArgumentNullException("dst");
+            CheckElementType(attribute, typeof(T), "dst");
             return CopyPinned(attribute, dst, (ulong)Marshal.SizeOf(typeof(T)), (uint)dst.Length, first);
+        }
+
+        static readonly Dictionary<Type, Type> leadingScalars = new Dictionary<Type, Type>();
+
+        // The scalar at offset 0 of a blittable element type (float, uint, Vec3's X, a particle
+        // struct's first field's), or null when it is none of float, uint, int (cached per type).
+        static Type LeadingScalar(Type type)
+        {
+            Type scalar;
+            lock (leadingScalars)
+                if (leadingScalars.TryGetValue(type, out scalar)) return scalar;
+            try
+            {
+                scalar = FindLeadingScalar(type);
+            }
+            catch (ArgumentException)
+            {
+                scalar = null;  // Marshal.OffsetOf refused a field: a layout it does not marshal
+            }
+            lock (leadingScalars) leadingScalars[type] = scalar;
+            return scalar;
+        }
+
+        static Type FindLeadingScalar(Type type)
+        {
+            for (int depth = 0; depth < 8 && type != null; ++depth)
+            {
+                if (type == typeof(float) || type == typeof(uint) || type == typeof(int)) return type;
+                if (type.IsPrimitive || type.IsEnum || !type.IsValueType) return null;
+                Type inner = null;
+                foreach (var field in type.GetFields(System.Reflection.BindingFlags.Instance | System.Reflection.BindingFlags.Public |
+                                                     System.Reflection.BindingFlags.NonPublic))
+                {
+                    if (Marshal.OffsetOf(type, field.Name) == IntPtr.Zero)
+                    {
+                        inner = field.FieldType;
+                        break;
+                    }
+                }
+                type = inner;
+            }
+            return null;
+        }
+
+        // Refuses an element type whose leading scalar is not the attribute's component type (a
+        // float array for ids would get uint bits as floats). Attributes without a documented
+        // format, and element types whose leading scalar is unknown, are left to the library.
+        static void CheckElementType(SphAttribute attribute, Type element, string parameter)
+        {
+            int components;
+            string componentType;
+            if (!Library.TryAttributeFormat(attribute, out components, out componentType)) return;
+            Type scalar = LeadingScalar(element);
+            if (scalar == null) return;
+            bool wantFloat = componentType == "float32";
+            if (wantFloat == (scalar == typeof(float))) return;
+            throw new ArgumentException("SphAttribute." + attribute + " holds " + (components > 1 ? components + " x " : "") +
+                                        componentType + " values, which an array of " + element.Name +
+                                        (scalar == element ? "" : " (starting with " + scalar.Name + ")") + " would not hold: use " +
+                                        (wantFloat ? "a float[] or an array of Vec3" : "a uint[]"), parameter);
         }
 
         uint CopyPinned(SphAttribute attribute, Array dst, ulong stride, uint count, uint first)
@@ -1514,10 +1695,13 @@ namespace Sph
         /// <summary>Writes from an array of blittable elements, one per particle, the attribute
         /// read at the start of each (stride = the element's size): Vec3 or UnityEngine.Vector3
         /// for positions and velocities, uint for the user attribute, or an interleaved particle
-        /// struct. Particles [first, first + src.Length).</summary>
+        /// struct. Particles [first, first + src.Length). An element whose first field is not of
+        /// the attribute's type (float for Position, Velocity; uint or int for User) throws
+        /// ArgumentException.</summary>
         public void SetAttribute<T>(SphAttribute attribute, T[] src, uint first = 0) where T : struct
         {
             if (src == null) throw new ArgumentNullException("src");
+            CheckElementType(attribute, typeof(T), "src");
             ulong stride = (ulong)Marshal.SizeOf(typeof(T));
             GCHandle h = GCHandle.Alloc(src, GCHandleType.Pinned);
             try
@@ -1563,6 +1747,7 @@ namespace Sph
         /// ColliderDef.Default(); its Sdf field is set from `sdf`).</summary>
         public Collider CreateCollider(Sdf sdf, ColliderDef def)
         {
+            if (sdf == null) throw new ArgumentNullException("sdf");
             ColliderId id;
             using (var borrowed = new Borrowed(sdf.Handle))
             {
@@ -1575,6 +1760,7 @@ namespace Sph
         /// <summary>A collider at `transform` with the default material.</summary>
         public Collider CreateCollider(Sdf sdf, Transform transform, bool inverted = false)
         {
+            if (sdf == null) throw new ArgumentNullException("sdf");
             var def = ColliderDef.Default();
             def.Transform = transform;
             if (inverted) def.ColliderFlags |= ColliderFlags.Inverted;
@@ -1584,6 +1770,7 @@ namespace Sph
         /// <summary>Adds a source that fills `region` (negative inside) with particles.</summary>
         public Source CreateSource(Sdf region, SourceDef def)
         {
+            if (region == null) throw new ArgumentNullException("region");
             SourceId id;
             using (var borrowed = new Borrowed(region.Handle))
             {
@@ -1657,8 +1844,92 @@ namespace Sph
             return HandOut(new ForceField(this, id), id.Bits);
         }
 
-        // The wrappers CreateCollider/CreateSource/CreateSink/CreateProbe/CreateForceField handed
-        // out, by kind and id bits, held weakly (ObjectOf).
+        // ---- wrappers of ids: a loaded or restored world's objects ----------------------------
+
+        /// <summary>The <see cref="Sph.Collider"/> of <paramref name="id"/> in this world: the
+        /// wrapper this world handed out for it (CreateCollider's, or an earlier GetCollider's)
+        /// while it is alive and still holds the id, else a new one, which this world then hands
+        /// out (ObjectOf finds it). This is how a world made by <see cref="Sph.Context.LoadWorld"/>
+        /// (it accepts the saved world's ids, by design) or brought back by
+        /// <see cref="Restore"/> reaches its objects: keep the ids (their Bits) with the save,
+        /// e.g. <c>loaded.GetCollider(paddleId).MoveTo(pose)</c>; a wrapper whose Dispose cleared
+        /// its Id before a Restore brought the object back is replaced by a fresh one here. The id
+        /// is not checked: a stale id, or one of another world, makes the wrapper's calls throw
+        /// SphException(ErrorInvalidHandle), and its Dispose does nothing. The null id throws
+        /// ArgumentException; a disposed world ObjectDisposedException.</summary>
+        public Collider GetCollider(ColliderId id)
+        {
+            return Wrap(id.Bits, "id", () => new Collider(this, id));
+        }
+
+        /// <summary>The <see cref="Sph.Source"/> of <paramref name="id"/> in this world, as
+        /// <see cref="GetCollider"/> does for colliders.</summary>
+        public Source GetSource(SourceId id)
+        {
+            return Wrap(id.Bits, "id", () => new Source(this, id));
+        }
+
+        /// <summary>The <see cref="Sph.Sink"/> of <paramref name="id"/> in this world, as
+        /// <see cref="GetCollider"/> does for colliders.</summary>
+        public Sink GetSink(SinkId id)
+        {
+            return Wrap(id.Bits, "id", () => new Sink(this, id));
+        }
+
+        /// <summary>The <see cref="Sph.Probe"/> of <paramref name="id"/> in this world, as
+        /// <see cref="GetCollider"/> does for colliders.</summary>
+        public Probe GetProbe(ProbeId id)
+        {
+            return Wrap(id.Bits, "id", () => new Probe(this, id));
+        }
+
+        /// <summary>The <see cref="Sph.ForceField"/> of <paramref name="id"/> in this world, as
+        /// <see cref="GetCollider"/> does for colliders.</summary>
+        public ForceField GetForceField(ForceFieldId id)
+        {
+            return Wrap(id.Bits, "id", () => new ForceField(this, id));
+        }
+
+        T Wrap<T>(ulong bits, string parameter, Func<T> make) where T : class
+        {
+            if (bits == 0) throw new ArgumentException("the null id names no object", parameter);
+            if (IsDisposed || Handle.IsClosed) throw new ObjectDisposedException("World");
+            lock (handedOutLock)
+            {
+                WeakReference r;
+                if (handedOut.TryGetValue(new KeyValuePair<Type, ulong>(typeof(T), bits), out r))
+                {
+                    var held = r.Target as T;
+                    if (held != null && BitsOf(held) == bits) return held;
+                }
+                return HandOut(make(), bits);
+            }
+        }
+
+        // For the placed objects' Dispose: removes the object with `destroy` (sph_*_destroy)
+        // unless there is nothing to remove. Returns normally when the object is gone: its world
+        // was disposed (destroying the world removed it), or the library calls the id stale
+        // (ErrorInvalidHandle: a Restore to a save from before it was made, or an id of another
+        // world, already removed). Any other error (ErrorWorldLocked while StepBegin's step runs)
+        // throws, and the object stays.
+        internal void RemovePlaced(Func<WorldHandle, Result> destroy, string function)
+        {
+            if (IsDisposed || Handle.IsClosed) return;
+            Result r;
+            try
+            {
+                r = destroy(Handle);
+            }
+            catch (ObjectDisposedException)
+            {
+                return;  // the world's handle was closed meanwhile: the world is gone
+            }
+            if (r == Result.ErrorInvalidHandle) return;
+            SphException.Check(r, function);
+        }
+
+        // The wrappers CreateCollider/CreateSource/CreateSink/CreateProbe/CreateForceField (and
+        // GetCollider & co.) handed out, by kind and id bits, held weakly (ObjectOf).
         readonly object handedOutLock = new object();
         readonly Dictionary<KeyValuePair<Type, ulong>, WeakReference> handedOut =
             new Dictionary<KeyValuePair<Type, ulong>, WeakReference>();
@@ -1706,10 +1977,11 @@ namespace Sph
 
         /// <summary>The <see cref="Collider"/>, <see cref="Probe"/>, <see cref="Source"/> or
         /// <see cref="Sink"/> an event names (its ObjectBits): the very object this world's
-        /// CreateCollider / CreateProbe / CreateSource / CreateSink returned. Null when the event
-        /// names no object (the DFSPH solve events), when that object was collected (the world
-        /// holds weak references only) or disposed, or when it was not created through this World
-        /// (a loaded checkpoint's objects). The event's type gives the kind (SourceCapacityReached
+        /// CreateCollider / CreateProbe / CreateSource / CreateSink (or GetCollider / GetProbe /
+        /// GetSource / GetSink) returned. Null when the event names no object (the DFSPH solve
+        /// events), when that object was collected (the world holds weak references only) or
+        /// disposed, or when it was not handed out by this World (a loaded checkpoint's objects
+        /// before GetCollider &amp; co. wrapped them: call those with the saved ids). The event's type gives the kind (SourceCapacityReached
         /// and CapacityGrown a Source, SinkRemoved a Sink, ColliderLoadExceeded a Collider,
         /// ProbePressureExceeded a Probe); for a type these bindings do not know, the one object of
         /// any kind with those bits.</summary>
@@ -1866,7 +2138,7 @@ namespace Sph
 
         Sdf(Context context, SdfHandle handle)
         {
-            handle.SetParent(context.Handle);  // the context outlives its assets
+            handle.SetParent(context.RawHandle);  // the context outlives its assets
             Handle = handle;
             Context = context;
         }
@@ -1874,8 +2146,9 @@ namespace Sph
         /// <summary>An analytic shape sampled into a grid (ShapeDesc.Default() for the defaults).</summary>
         public static Sdf CreateShape(Context context, ShapeDesc desc)
         {
+            ContextHandle contextHandle = Context.HandleOf(context, "context");
             SdfHandle h;
-            SphException.Check(Native.sph_sdf_create_shape(context.Handle, ref desc, out h), "sph_sdf_create_shape");
+            SphException.Check(Native.sph_sdf_create_shape(contextHandle, ref desc, out h), "sph_sdf_create_shape");
             return new Sdf(context, h);
         }
 
@@ -1886,8 +2159,11 @@ namespace Sph
         /// its array fields are filled here.</summary>
         public static Sdf CreateFromMesh(Context context, float[] vertices, uint[] indices, MeshDesc? desc = null)
         {
-            if (vertices == null || vertices.Length % 3 != 0) throw new ArgumentException("vertices: x, y, z per vertex");
-            if (indices == null || indices.Length % 3 != 0) throw new ArgumentException("indices: three per triangle");
+            ContextHandle contextHandle = Context.HandleOf(context, "context");
+            if (vertices == null) throw new ArgumentNullException("vertices");
+            if (indices == null) throw new ArgumentNullException("indices");
+            if (vertices.Length % 3 != 0) throw new ArgumentException("vertices: x, y, z per vertex", "vertices");
+            if (indices.Length % 3 != 0) throw new ArgumentException("indices: three per triangle", "indices");
             var d = desc ?? MeshDesc.Default();
             var pins = new List<GCHandle>();
             try
@@ -1898,7 +2174,7 @@ namespace Sph
                 d.Indices = Pin(indices, pins);
                 d.IndexCount = (uint)indices.Length;
                 SdfHandle h;
-                SphException.Check(Native.sph_sdf_create_from_mesh(context.Handle, ref d, out h), "sph_sdf_create_from_mesh");
+                SphException.Check(Native.sph_sdf_create_from_mesh(contextHandle, ref d, out h), "sph_sdf_create_from_mesh");
                 return new Sdf(context, h);
             }
             finally
@@ -1912,8 +2188,10 @@ namespace Sph
         public static Sdf Create(Context context, float[] distance, uint ni, uint nj, uint nk, FixedFloat12 indexToLocal,
                                  float[] velocity = null, float[] friction = null)
         {
+            ContextHandle contextHandle = Context.HandleOf(context, "context");
+            if (distance == null) throw new ArgumentNullException("distance");
             ulong voxels = (ulong)ni * nj * nk;
-            if (distance == null || (ulong)distance.Length != voxels) throw new ArgumentException("distance: ni*nj*nk floats");
+            if ((ulong)distance.Length != voxels) throw new ArgumentException("distance: ni*nj*nk floats", "distance");
             if (velocity != null && (ulong)velocity.Length != 3 * voxels) throw new ArgumentException("velocity: 3 floats per voxel");
             if (friction != null && (ulong)friction.Length != voxels) throw new ArgumentException("friction: one float per voxel");
             var pins = new List<GCHandle>();
@@ -1924,7 +2202,7 @@ namespace Sph
                 if (velocity != null) desc.Velocity = Pin(new GridDesc[] { Grid(velocity, 3, ni, nj, nk, indexToLocal, pins) }, pins);
                 if (friction != null) desc.Friction = Pin(new GridDesc[] { Grid(friction, 1, ni, nj, nk, indexToLocal, pins) }, pins);
                 SdfHandle h;
-                SphException.Check(Native.sph_sdf_create(context.Handle, ref desc, out h), "sph_sdf_create");
+                SphException.Check(Native.sph_sdf_create(contextHandle, ref desc, out h), "sph_sdf_create");
                 return new Sdf(context, h);
             }
             finally
@@ -1942,6 +2220,7 @@ namespace Sph
         public static Sdf Create(Context context, IntPtr distance, uint ni, uint nj, uint nk, FixedFloat12 indexToLocal,
                                  MemoryKind memory, IntPtr velocity = default(IntPtr), IntPtr friction = default(IntPtr))
         {
+            ContextHandle contextHandle = Context.HandleOf(context, "context");
             var pins = new List<GCHandle>();
             try
             {
@@ -1952,7 +2231,7 @@ namespace Sph
                 if (friction != IntPtr.Zero)
                     desc.Friction = Pin(new GridDesc[] { Grid(friction, 1, ni, nj, nk, indexToLocal, memory) }, pins);
                 SdfHandle h;
-                SphException.Check(Native.sph_sdf_create(context.Handle, ref desc, out h), "sph_sdf_create");
+                SphException.Check(Native.sph_sdf_create(contextHandle, ref desc, out h), "sph_sdf_create");
                 return new Sdf(context, h);
             }
             finally
@@ -1994,16 +2273,21 @@ namespace Sph
         /// the file's world frame; gridName null takes the first float level set.</summary>
         public static Sdf LoadVdb(Context context, string path, string gridName = null)
         {
+            ContextHandle contextHandle = Context.HandleOf(context, "context");
+            if (path == null) throw new ArgumentNullException("path");
             SdfHandle h;
-            Result r = Native.sph_vdb_load_sdf(context.Handle, Utf8.ToNative(path),
+            Result r = Native.sph_vdb_load_sdf(contextHandle, Utf8.ToNative(path),
                                                gridName != null ? Utf8.ToNative(gridName) : null, out h);
             if ((int)r < 0) throw new SphException(r, "sph_vdb_load_sdf", Utf8.FromNative(Native.sph_vdb_get_last_error()));
             return new Sdf(context, h);
         }
 
-        /// <summary>index_to_local of an axis-aligned grid: sample (i, j, k) at origin + voxelSize * (i, j, k).</summary>
+        /// <summary>index_to_local of an axis-aligned grid: sample (i, j, k) at origin + voxelSize * (i, j, k).
+        /// ArgumentOutOfRangeException for a voxelSize that is not finite and &gt; 0.</summary>
         public static FixedFloat12 GridTransform(float voxelSize, Vec3 origin)
         {
+            if (!(voxelSize > 0) || float.IsInfinity(voxelSize))
+                throw new ArgumentOutOfRangeException("voxelSize", voxelSize, "the voxel size must be finite and > 0 (metres)");
             return FixedFloat12.From(new float[] { voxelSize, 0, 0, origin.X, 0, voxelSize, 0, origin.Y, 0, 0, voxelSize, origin.Z });
         }
 
@@ -2032,8 +2316,10 @@ namespace Sph
         {
             // The library reads size[0] * size[1] * size[2] * components floats from data, and
             // three indices from origin and size: arrays of other lengths never reach it.
-            if (origin == null || origin.Length != 3) throw new ArgumentException("origin: 3 grid indices (i, j, k)");
-            if (size == null || size.Length != 3) throw new ArgumentException("size: 3 sample counts (i, j, k)");
+            if (origin == null) throw new ArgumentNullException("origin");
+            if (size == null) throw new ArgumentNullException("size");
+            if (origin.Length != 3) throw new ArgumentException("origin: 3 grid indices (i, j, k)", "origin");
+            if (size.Length != 3) throw new ArgumentException("size: 3 sample counts (i, j, k)", "size");
             if (data == null) throw new ArgumentNullException("data");
             ulong components = channel == SdfChannel.Velocity ? 3UL : 1UL;
             ulong floats;
@@ -2061,8 +2347,10 @@ namespace Sph
         /// velocity), i fastest; the library copies them.</summary>
         public void Update(SdfChannel channel, uint[] origin, uint[] size, IntPtr data, MemoryKind memory)
         {
-            if (origin == null || origin.Length != 3) throw new ArgumentException("origin: 3 grid indices (i, j, k)");
-            if (size == null || size.Length != 3) throw new ArgumentException("size: 3 sample counts (i, j, k)");
+            if (origin == null) throw new ArgumentNullException("origin");
+            if (size == null) throw new ArgumentNullException("size");
+            if (origin.Length != 3) throw new ArgumentException("origin: 3 grid indices (i, j, k)", "origin");
+            if (size.Length != 3) throw new ArgumentException("size: 3 sample counts (i, j, k)", "size");
             var pins = new List<GCHandle>();
             try
             {
@@ -2087,7 +2375,8 @@ namespace Sph
         }
     }
 
-    /// <summary>A placed SDF the fluid cannot enter.</summary>
+    /// <summary>A placed SDF the fluid cannot enter (World.CreateCollider; a loaded or restored
+    /// world's: <see cref="World.GetCollider"/>).</summary>
     public sealed class Collider : IDisposable
     {
         public World World { get; private set; }
@@ -2171,11 +2460,19 @@ namespace Sph
             SphException.Check(Native.sph_collider_set_load_threshold(World.Handle, Id, force), "sph_collider_set_load_threshold");
         }
 
-        /// <summary>Removes the collider (idempotent).</summary>
+        /// <summary>Removes the collider (sph_collider_destroy). Idempotent, and never throws for an object
+        /// that is already gone: after its world's Dispose (destroying the world removed it; in
+        /// Unity, OnDestroy order is not fixed) or when the library calls the id stale (a Restore
+        /// to a save taken before it was made): the Id is cleared and nothing happens. Other
+        /// errors throw SphException and keep the Id, e.g. ErrorWorldLocked while a step that
+        /// StepBegin started is in flight (StepWait, then Dispose again). A Restore may bring an
+        /// object back after its Dispose: <see cref="World.GetCollider"/> with the saved id wraps it
+        /// again.</summary>
         public void Dispose()
         {
             if (Id.Bits == 0) return;
-            SphException.Check(Native.sph_collider_destroy(World.Handle, Id), "sph_collider_destroy");
+            ColliderId id = Id;
+            World.RemovePlaced(h => Native.sph_collider_destroy(h, id), "sph_collider_destroy");
             Id = default(ColliderId);
         }
     }
@@ -2193,10 +2490,19 @@ namespace Sph
             SphException.Check(Native.sph_source_set_transform(World.Handle, Id, ref transform), "sph_source_set_transform");
         }
 
+        /// <summary>Removes the source (sph_source_destroy). Idempotent, and never throws for an object
+        /// that is already gone: after its world's Dispose (destroying the world removed it; in
+        /// Unity, OnDestroy order is not fixed) or when the library calls the id stale (a Restore
+        /// to a save taken before it was made): the Id is cleared and nothing happens. Other
+        /// errors throw SphException and keep the Id, e.g. ErrorWorldLocked while a step that
+        /// StepBegin started is in flight (StepWait, then Dispose again). A Restore may bring an
+        /// object back after its Dispose: <see cref="World.GetSource"/> with the saved id wraps it
+        /// again.</summary>
         public void Dispose()
         {
             if (Id.Bits == 0) return;
-            SphException.Check(Native.sph_source_destroy(World.Handle, Id), "sph_source_destroy");
+            SourceId id = Id;
+            World.RemovePlaced(h => Native.sph_source_destroy(h, id), "sph_source_destroy");
             Id = default(SourceId);
         }
     }
@@ -2209,10 +2515,19 @@ namespace Sph
 
         internal Sink(World world, SinkId id) { World = world; Id = id; }
 
+        /// <summary>Removes the sink (sph_sink_destroy). Idempotent, and never throws for an object
+        /// that is already gone: after its world's Dispose (destroying the world removed it; in
+        /// Unity, OnDestroy order is not fixed) or when the library calls the id stale (a Restore
+        /// to a save taken before it was made): the Id is cleared and nothing happens. Other
+        /// errors throw SphException and keep the Id, e.g. ErrorWorldLocked while a step that
+        /// StepBegin started is in flight (StepWait, then Dispose again). A Restore may bring an
+        /// object back after its Dispose: <see cref="World.GetSink"/> with the saved id wraps it
+        /// again.</summary>
         public void Dispose()
         {
             if (Id.Bits == 0) return;
-            SphException.Check(Native.sph_sink_destroy(World.Handle, Id), "sph_sink_destroy");
+            SinkId id = Id;
+            World.RemovePlaced(h => Native.sph_sink_destroy(h, id), "sph_sink_destroy");
             Id = default(SinkId);
         }
     }
@@ -2244,10 +2559,19 @@ namespace Sph
             SphException.Check(Native.sph_probe_set_pressure_threshold(World.Handle, Id, pressure), "sph_probe_set_pressure_threshold");
         }
 
+        /// <summary>Removes the probe (sph_probe_destroy). Idempotent, and never throws for an object
+        /// that is already gone: after its world's Dispose (destroying the world removed it; in
+        /// Unity, OnDestroy order is not fixed) or when the library calls the id stale (a Restore
+        /// to a save taken before it was made): the Id is cleared and nothing happens. Other
+        /// errors throw SphException and keep the Id, e.g. ErrorWorldLocked while a step that
+        /// StepBegin started is in flight (StepWait, then Dispose again). A Restore may bring an
+        /// object back after its Dispose: <see cref="World.GetProbe"/> with the saved id wraps it
+        /// again.</summary>
         public void Dispose()
         {
             if (Id.Bits == 0) return;
-            SphException.Check(Native.sph_probe_destroy(World.Handle, Id), "sph_probe_destroy");
+            ProbeId id = Id;
+            World.RemovePlaced(h => Native.sph_probe_destroy(h, id), "sph_probe_destroy");
             Id = default(ProbeId);
         }
     }
@@ -2265,10 +2589,19 @@ namespace Sph
             SphException.Check(Native.sph_force_field_set_transform(World.Handle, Id, ref transform), "sph_force_field_set_transform");
         }
 
+        /// <summary>Removes the force field (sph_force_field_destroy). Idempotent, and never throws for an object
+        /// that is already gone: after its world's Dispose (destroying the world removed it; in
+        /// Unity, OnDestroy order is not fixed) or when the library calls the id stale (a Restore
+        /// to a save taken before it was made): the Id is cleared and nothing happens. Other
+        /// errors throw SphException and keep the Id, e.g. ErrorWorldLocked while a step that
+        /// StepBegin started is in flight (StepWait, then Dispose again). A Restore may bring an
+        /// object back after its Dispose: <see cref="World.GetForceField"/> with the saved id wraps it
+        /// again.</summary>
         public void Dispose()
         {
             if (Id.Bits == 0) return;
-            SphException.Check(Native.sph_force_field_destroy(World.Handle, Id), "sph_force_field_destroy");
+            ForceFieldId id = Id;
+            World.RemovePlaced(h => Native.sph_force_field_destroy(h, id), "sph_force_field_destroy");
             Id = default(ForceFieldId);
         }
     }

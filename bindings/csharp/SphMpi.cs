@@ -76,10 +76,10 @@ namespace Sph
         static WorldHandle Create(Context context, int comm, WorldDef def, MpiWorldDef? options)
         {
             RequireSphMpi();  // before any call: MpiWorldDef.Default() is one of libsph_mpi's
-            if (context == null) throw new ArgumentNullException("context");
+            ContextHandle contextHandle = Context.HandleOf(context, "context");
             MpiWorldDef mpiDef = options ?? MpiWorldDef.Default();
             WorldHandle handle;
-            SphException.Check(Native.sph_mpi_world_create(context.Handle, ref def, comm, ref mpiDef, out handle),
+            SphException.Check(Native.sph_mpi_world_create(contextHandle, ref def, comm, ref mpiDef, out handle),
                                "sph_mpi_world_create");
             return Adopt(handle);
         }
@@ -90,9 +90,10 @@ namespace Sph
         public static DistributedWorld LoadFile(Context context, int comm, string path)
         {
             RequireSphMpi();
-            if (context == null) throw new ArgumentNullException("context");
+            ContextHandle contextHandle = Context.HandleOf(context, "context");
+            if (path == null) throw new ArgumentNullException("path");
             WorldHandle handle;
-            SphException.Check(Native.sph_mpi_world_load_file(context.Handle, comm, Utf8.ToNative(path), out handle),
+            SphException.Check(Native.sph_mpi_world_load_file(contextHandle, comm, Utf8.ToNative(path), out handle),
                                "sph_mpi_world_load_file");
             return new DistributedWorld(context, comm, Adopt(handle));
         }
@@ -238,6 +239,7 @@ namespace Sph
         /// replaces the set (sph_mpi_world_save_file). Succeeds or throws on every rank.</summary>
         public new void SaveFile(string path)
         {
+            if (path == null) throw new ArgumentNullException("path");
             SphException.Check(Native.sph_mpi_world_save_file(Handle, Utf8.ToNative(path)), "sph_mpi_world_save_file");
         }
 
@@ -246,6 +248,7 @@ namespace Sph
         /// throws and keeps its state.</summary>
         public void RestoreFile(string path)
         {
+            if (path == null) throw new ArgumentNullException("path");
             SphException.Check(Native.sph_mpi_world_restore_file(Handle, Utf8.ToNative(path)), "sph_mpi_world_restore_file");
         }
     }

@@ -1764,6 +1764,268 @@ static class Tests
         }
     }
 
+    // ---- the review of the C# binding (session 51): misuse that passed or threw the wrong thing
+
+    // Throws an exception of exactly type E (not a subclass) from action; returns it.
+    static E ThrowsExactly<E>(Action action, string what) where E : Exception
+    {
+        try
+        {
+            action();
+        }
+        catch (Exception e)
+        {
+            if (e.GetType() != typeof(E)) throw new Exception(what + ": expected " + typeof(E).Name + ", got " + e);
+            return (E)e;
+        }
+        throw new Exception(what + ": expected " + typeof(E).Name + ", nothing was thrown");
+    }
+
+    static void ThrowsNull(string parameter, Action action, string what)
+    {
+        var e = ThrowsExactly<ArgumentNullException>(action, what);
+        AssertEqual(parameter, e.ParamName, what + ": the parameter named");
+    }
+
+    /// A disposed Context refuses every use, even while a world or an asset holds the native
+    /// context (which still goes only with the last of them).
+    public static void TestDisposedContextRefusesEveryMember()
+    {
+        uint before = Library.LiveObjectCount;
+        var ctx = Cpu();
+        var world = ctx.CreateWorld(SmallWorld());
+        var ball = Ball(ctx, 0.05f);
+        world.FillSphere(new Vec3(0, 0, 0), 0.05f);
+        byte[] saved = world.Save();
+        ctx.Dispose();
+        ctx.Dispose();  // idempotent
+        Assert(ctx.IsDisposed, "disposed");
+        string path = Path.Combine(Path.GetTempPath(), "sph_cs_" + Guid.NewGuid().ToString("N") + ".sphckpt");
+        var uses = new System.Collections.Generic.KeyValuePair<string, Action>[] {
+            Use("CreateWorld(def)", () => ctx.CreateWorld(SmallWorld())),
+            Use("CreateWorld()", () => ctx.CreateWorld()),
+            Use("new World", () => new World(ctx, SmallWorld())),
+            Use("Backend", () => Console.Write(ctx.Backend)),
+            Use("Handle", () => Console.Write(ctx.Handle)),
+            Use("SetCudaAllocator", () => ctx.SetCudaAllocator(CudaAllocator.Default())),
+            Use("LoadWorld", () => ctx.LoadWorld(saved)),
+            Use("LoadWorldFile", () => ctx.LoadWorldFile(path)),
+            Use("Sdf.CreateShape", () => Sdf.CreateShape(ctx, ShapeDesc.Default())),
+            Use("Sdf.CreateFromMesh", () => Sdf.CreateFromMesh(ctx, new float[9], new uint[] { 0, 1, 2 })),
+            Use("Sdf.Create", () => Sdf.Create(ctx, new float[8], 2, 2, 2, Sdf.GridTransform(0.1f, new Vec3(0, 0, 0)))),
+            Use("Sdf.Create(IntPtr)", () => Sdf.Create(ctx, IntPtr.Zero, 2, 2, 2, Sdf.GridTransform(0.1f, new Vec3(0, 0, 0)), MemoryKind.Host)),
+            Use("Sdf.LoadVdb", () => Sdf.LoadVdb(ctx, path)),
+        };
+        foreach (var use in uses) ThrowsExactly<ObjectDisposedException>(use.Value, use.Key + " on a disposed context");
+        AssertEqual(before + 3, Library.LiveObjectCount, "nothing was made; the world and the asset hold the context");
+        world.Step(0.001f);  // what holds the native context works on
+        world.CreateCollider(ball, At(0, 0, 0));
+        ball.Dispose();
+        AssertEqual(before + 2, Library.LiveObjectCount, "the world holds the context");
+        world.Dispose();
+        AssertEqual(before, Library.LiveObjectCount, "the native context went with the last world");
+    }
+
+    static System.Collections.Generic.KeyValuePair<string, Action> Use(string what, Action action)
+    {
+        return new System.Collections.Generic.KeyValuePair<string, Action>(what, action);
+    }
+
+    /// A placed object's Dispose does not throw when the object is already gone: its world was
+    /// disposed, or a Restore to an earlier save removed it. A locked world still throws.
+    public static void TestPlacedObjectDisposeWhenTheObjectIsGone()
+    {
+        uint live = Library.LiveObjectCount;
+        using (var ctx = Cpu())
+        using (var ball = Ball(ctx, 0.05f))
+        {
+            var world = ctx.CreateWorld(SmallWorld());
+            byte[] empty = world.Save();
+            var sinkDef = SinkDef.Default();
+            sinkDef.BoundsMin = new Vec3(-1, -1, -1);
+            sinkDef.BoundsMax = new Vec3(1, 1, 1);
+            var objects = new IDisposable[] {
+                world.CreateCollider(ball, At(0.5f, 0, 0)), world.CreateSource(ball, SourceDef.Default()),
+                world.CreateSink(null, sinkDef), world.CreateProbe(ProbeDef.Default()), world.CreateForceField(ForceFieldDef.Default()),
+            };
+            world.Restore(empty);  // a save from before they were made: gone
+            foreach (var o in objects)
+            {
+                o.Dispose();
+                o.Dispose();
+            }
+            var collider = world.CreateCollider(ball, At(0.5f, 0, 0));
+            AssertEqual(0UL, ((Collider)objects[0]).Id.Bits, "the Id is cleared");
+            // Locked by a step in flight: Dispose throws and the collider stays.
+            world.FillSphere(new Vec3(0, 0, 0), 0.03f);
+            world.StepBegin(0.01f);
+            Throws(Result.ErrorWorldLocked, () => collider.Dispose());
+            Assert(collider.Id.Bits != 0, "the Id is kept after a refused Dispose");
+            world.StepWait();
+            collider.Dispose();
+            Throws(Result.ErrorInvalidHandle, () => Console.Write(world.GetCollider(new ColliderId(0x1234)).Transform));
+            // The world disposed first (Unity's OnDestroy order is not fixed).
+            var placed = new IDisposable[] {
+                world.CreateCollider(ball, At(0.5f, 0, 0)), world.CreateSource(ball, SourceDef.Default()),
+                world.CreateSink(null, sinkDef), world.CreateProbe(ProbeDef.Default()), world.CreateForceField(ForceFieldDef.Default()),
+            };
+            world.Dispose();
+            foreach (var o in placed)
+            {
+                o.Dispose();
+                o.Dispose();
+            }
+        }
+        AssertEqual(live, Library.LiveObjectCount, "everything released");
+    }
+
+    /// A world loaded from a save, or restored, reaches its objects through their ids.
+    public static void TestWrappersOfIdsInLoadedAndRestoredWorlds()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(SmallWorld()))
+        using (var ball = Ball(ctx, 0.05f))
+        {
+            var paddle = world.CreateCollider(ball, At(0.5f, 0, 0));
+            var pd = ProbeDef.Default();
+            pd.Position = new Vec3(0, 0.01f, 0);
+            var probe = world.CreateProbe(pd);
+            var source = world.CreateSource(ball, SourceDef.Default());
+            var sinkDef = SinkDef.Default();
+            sinkDef.BoundsMin = new Vec3(-1, -1, -1);
+            sinkDef.BoundsMax = new Vec3(1, 1, 1);
+            var sink = world.CreateSink(null, sinkDef);
+            var field = world.CreateForceField(ForceFieldDef.Default());
+            ColliderId paddleId = new ColliderId(paddle.Id.Bits);  // what a save game keeps
+            byte[] save = world.Save();
+            Assert(ReferenceEquals(paddle, world.GetCollider(paddleId)), "this world's own wrapper");
+            using (var loaded = ctx.LoadWorld(save))
+            {
+                Collider theirs = loaded.GetCollider(paddleId);
+                Assert(!ReferenceEquals(theirs, paddle) && theirs.World == loaded, "a wrapper of the loaded world");
+                Assert(ReferenceEquals(theirs, loaded.GetCollider(paddleId)), "handed out once");
+                theirs.Teleport(At(1, 2, 3));
+                AssertEqual(1f, theirs.Transform.Position.X, "the loaded paddle moved");
+                AssertEqual(0.5f, paddle.Transform.Position.X, "the saved world's paddle did not");
+                loaded.Step(0.01f);
+                var reading = loaded.GetProbe(probe.Id).Reading;
+                Assert(reading.StructSize != 0, "the loaded probe reads");
+                loaded.GetSource(source.Id).SetTransform(At(0.1f, 0, 0));
+                loaded.GetForceField(field.Id).SetTransform(At(0.1f, 0, 0));
+                Sink theirSink = loaded.GetSink(sink.Id);
+                theirSink.Dispose();
+                Assert(!ReferenceEquals(theirSink, loaded.GetSink(sink.Id)), "a fresh wrapper once the old one's Id was cleared");
+                ThrowsArgument(() => loaded.GetCollider(default(ColliderId)), "the null id");
+            }
+            // Dispose cleared the wrapper's Id; a Restore brings the collider back natively.
+            paddle.Dispose();
+            world.Restore(save);
+            Collider back = world.GetCollider(paddleId);
+            Assert(!ReferenceEquals(back, paddle), "a fresh wrapper for the restored collider");
+            AssertEqual(paddleId.Bits, back.Id.Bits, "its id");
+            AssertEqual(0.5f, back.Transform.Position.X, "the restored paddle");
+            back.MoveTo(At(0.6f, 0, 0));
+            world.Step(0.01f);
+            back.Dispose();
+        }
+    }
+
+    /// Input that was used silently: params of another kind's struct, attributes into arrays of
+    /// another element type, a grid transform with a voxel size that is not finite and > 0.
+    public static void TestMismatchedTypesAndVoxelSizesAreRefused()
+    {
+        var def = SmallWorld();
+        def.EquationOfState = EquationOfState.Tait;
+        def.FeatureFlags = FeatureFlags.UserAttribute;
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(def))
+        {
+            var e = ThrowsExactly<ArgumentException>(() => world.GetPhysicsParams<TaitParams>(ParamsKind.World), "TaitParams as World");
+            Assert(e.Message.Contains("TaitParams") && e.Message.Contains("World"), "names T and the kind: " + e.Message);
+            ThrowsExactly<ArgumentException>(() => world.GetPhysicsParams<Vec3>(ParamsKind.World), "Vec3 as World");
+            // TaitParams and DensityDiffusionParams have the same size: struct_size cannot tell.
+            ThrowsExactly<ArgumentException>(() => world.SetPhysicsParams(ParamsKind.Tait, DensityDiffusionParams.Default()), "set");
+            AssertEqual(world.TaitParams.SpeedOfSound, world.GetPhysicsParams<TaitParams>(ParamsKind.Tait).SpeedOfSound, "the right T");
+            world.SetPhysicsParams(ParamsKind.World, world.Params);
+
+            world.FillSphere(new Vec3(0, 0, 0), 0.04f);
+            uint n = world.ParticleCount;
+            AssertEqual("dst", ThrowsExactly<ArgumentException>(() => world.CopyAttribute(SphAttribute.Id, new float[n]), "ids as floats").ParamName, "param");
+            ThrowsExactly<ArgumentException>(() => world.CopyAttribute(SphAttribute.Id, new Vec3[n]), "ids as Vec3");
+            ThrowsExactly<ArgumentException>(() => world.CopyAttribute(SphAttribute.User, new float[n]), "user as floats");
+            ThrowsExactly<ArgumentException>(() => world.CopyAttribute(SphAttribute.Position, new uint[3 * n]), "positions as uints");
+            ThrowsExactly<ArgumentException>(() => world.CopyAttribute(SphAttribute.Id, new Particle[n]), "ids into a float-first struct");
+            ThrowsExactly<ArgumentException>(() => world.SetAttribute(SphAttribute.User, new float[n]), "user from floats");
+            AssertEqual(n, world.CopyAttribute(SphAttribute.Id, new uint[n]), "ids as uints");
+            AssertEqual(n, world.CopyAttribute(SphAttribute.Id, new int[n]), "ids as ints");
+            AssertEqual(n, world.CopyAttribute(SphAttribute.Density, new float[n]), "densities as floats");
+            AssertEqual(n, world.CopyAttribute(SphAttribute.Position, new Particle[n]), "positions into particles");
+            world.SetAttribute(SphAttribute.User, new uint[n]);
+        }
+        foreach (float size in new[] { 0f, -0.1f, float.NaN, float.PositiveInfinity, float.NegativeInfinity })
+        {
+            var e = ThrowsExactly<ArgumentOutOfRangeException>(() => Sdf.GridTransform(size, new Vec3(0, 0, 0)), "voxel size " + size);
+            AssertEqual("voxelSize", e.ParamName, "the parameter named");
+        }
+        AssertEqual(float.Epsilon, Sdf.GridTransform(float.Epsilon, new Vec3(0, 0, 0))[0], "a tiny voxel is a voxel");
+    }
+
+    /// A null reference argument throws ArgumentNullException naming the public parameter.
+    public static void TestNullArgumentsNameTheirParameter()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(SmallWorld()))
+        using (var ball = Ball(ctx, 0.05f))
+        {
+            world.FillSphere(new Vec3(0, 0, 0), 0.03f);
+            var grid = Sdf.GridTransform(0.1f, new Vec3(0, 0, 0));
+            ThrowsNull("dst", () => world.CopyAttribute(SphAttribute.Position, (float[])null), "CopyAttribute(float[])");
+            ThrowsNull("dst", () => world.CopyAttribute(SphAttribute.Position, (Vec3[])null), "CopyAttribute(Vec3[])");
+            ThrowsNull("dst", () => world.CopyAttribute(SphAttribute.Id, (uint[])null), "CopyAttribute(uint[])");
+            ThrowsNull("sdf", () => world.CreateCollider(null, ColliderDef.Default()), "CreateCollider(def)");
+            ThrowsNull("sdf", () => world.CreateCollider(null, Transform.Default()), "CreateCollider(transform)");
+            ThrowsNull("region", () => world.CreateSource(null, SourceDef.Default()), "CreateSource");
+            ThrowsNull("context", () => new World(null, SmallWorld()), "new World");
+            ThrowsNull("context", () => Sdf.CreateShape(null, ShapeDesc.Default()), "Sdf.CreateShape");
+            ThrowsNull("context", () => Sdf.CreateFromMesh(null, new float[9], new uint[3]), "Sdf.CreateFromMesh");
+            ThrowsNull("vertices", () => Sdf.CreateFromMesh(ctx, null, new uint[3]), "Sdf.CreateFromMesh vertices");
+            ThrowsNull("indices", () => Sdf.CreateFromMesh(ctx, new float[9], null), "Sdf.CreateFromMesh indices");
+            ThrowsNull("context", () => Sdf.Create(null, new float[8], 2, 2, 2, grid), "Sdf.Create");
+            ThrowsNull("distance", () => Sdf.Create(ctx, null, 2, 2, 2, grid), "Sdf.Create distance");
+            ThrowsNull("context", () => Sdf.Create(null, IntPtr.Zero, 2, 2, 2, grid, MemoryKind.Host), "Sdf.Create(IntPtr)");
+            ThrowsNull("context", () => Sdf.LoadVdb(null, "x.vdb"), "Sdf.LoadVdb");
+            ThrowsNull("path", () => Sdf.LoadVdb(ctx, null), "Sdf.LoadVdb path");
+            ThrowsNull("origin", () => ball.Update(SdfChannel.Distance, null, new uint[] { 1, 1, 1 }, new float[1]), "Update origin");
+            ThrowsNull("size", () => ball.Update(SdfChannel.Distance, new uint[3], null, IntPtr.Zero, MemoryKind.Host), "Update size");
+            ThrowsNull("path", () => world.SaveFile(null), "SaveFile");
+            ThrowsNull("path", () => ctx.LoadWorldFile(null), "LoadWorldFile");
+            ThrowsNull("data", () => ctx.LoadWorld(null), "LoadWorld");
+            ThrowsNull("positions", () => world.Spawn((float[])null), "Spawn(float[])");
+            ThrowsNull("task", () => new ThreadPoolTaskSystem().Enqueue(null), "Enqueue");
+            ThrowsNull("task", () => new ThreadPoolTaskSystem().Finish(null), "Finish");
+        }
+    }
+
+    /// SphException.Message names the function once: the library's message already starts
+    /// with it.
+    public static void TestExceptionMessageNamesTheFunctionOnce()
+    {
+        using (var ctx = Cpu())
+        using (var world = ctx.CreateWorld(SmallWorld()))
+        {
+            var e = Throws(Result.ErrorInvalidArgument, () => world.StepWait());
+            Assert(e.LibraryMessage.StartsWith("sph_world_step_wait: "), "the library's message: " + e.LibraryMessage);
+            Assert(e.Message.StartsWith("sph_world_step_wait: ErrorInvalidArgument: "), e.Message);
+            AssertEqual(e.Message.IndexOf("sph_world_step_wait"), e.Message.LastIndexOf("sph_world_step_wait"), "named once: " + e.Message);
+            AssertEqual("sph_world_step_wait: ErrorInvalidArgument: " + e.LibraryMessage.Substring("sph_world_step_wait: ".Length),
+                        e.Message, "the message");
+        }
+        AssertEqual("f: ErrorBusy: x", new SphException(Result.ErrorBusy, "f", "f: x").Message, "a prefix dropped");
+        AssertEqual("f: ErrorBusy: g: x", new SphException(Result.ErrorBusy, "f", "g: x").Message, "another function's kept");
+        AssertEqual("f: ErrorBusy", new SphException(Result.ErrorBusy, "f", "").Message, "no message");
+        AssertEqual("ErrorBusy: f: x", new SphException(Result.ErrorBusy, null, "f: x").Message, "no function");
+    }
+
     /// Built without -define:SPH_MPI, every call goes to libsph: a distributed world refuses to
     /// start, saying why (tests/SphMpiTests.cs runs them on libsph_mpi). Through reflection: the
     /// Unity package's Sph.dll, which these tests also run on, has no SphMpi.cs.
