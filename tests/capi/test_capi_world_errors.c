@@ -603,20 +603,11 @@ static scene_ids add_scene(sph_world* world, sph_sdf* sdf) {
   return ids;
 }
 
-static uint8_t* save_world(const sph_world* world, uint64_t* size) {
-  uint8_t* bytes;
-  EXPECT_OK(sph_world_save(world, NULL, 0, size));
-  bytes = (uint8_t*)malloc((size_t)*size);
-  assert_non_null(bytes);
-  EXPECT_OK(sph_world_save(world, bytes, *size, size));
-  return bytes;
-}
-
 /* Every call that takes an id refuses `ids` in `world` (INVALID_HANDLE naming the id), writes
  * no output, and the world saves the same bytes afterwards. */
 static void expect_ids_refused_at(int line, sph_world* world, const scene_ids* ids) {
   uint64_t size_before = 0, size_after = 0;
-  uint8_t *before = save_world(world, &size_before), *after;
+  unsigned char *before = capi_save(world, &size_before), *after;
   sph_transform t = sph_transform_identity(), out, untouched;
   sph_collider_material material;
   sph_collider_loads loads;
@@ -654,7 +645,7 @@ static void expect_ids_refused_at(int line, sph_world* world, const scene_ids* i
   EXPECT_ERROR_AT(line, SPH_ERROR_INVALID_HANDLE, "id",
                   sph_probe_set_pressure_threshold(world, ids->probe, 100.0f));
   EXPECT_ERROR_AT(line, SPH_ERROR_INVALID_HANDLE, "id", sph_probe_destroy(world, ids->probe));
-  after = save_world(world, &size_after);
+  after = capi_save(world, &size_after);
   assert_int_equal(size_after, size_before);
   assert_memory_equal(after, before, (size_t)size_before);
   free(after);
@@ -674,7 +665,7 @@ static void test_ids_of_another_world_are_refused(void** state) {
   const scene_ids in_a = add_scene(a, sdf), in_b = add_scene(b, sdf);
   sph_transform t;
   uint64_t size = 0;
-  uint8_t* saved;
+  unsigned char* saved;
   (void)state;
   assert_true(in_a.collider.bits != in_b.collider.bits);
   assert_true(in_a.source.bits != in_b.source.bits);
@@ -687,7 +678,7 @@ static void test_ids_of_another_world_are_refused(void** state) {
   EXPECT_OK(sph_collider_get_transform(a, in_a.collider, &t));
   EXPECT_OK(sph_collider_get_transform(b, in_b.collider, &t));
   /* A world loaded from A's checkpoint takes A's ids (and issues A's next ones), not B's. */
-  saved = save_world(a, &size);
+  saved = capi_save(a, &size);
   EXPECT_OK(sph_world_load(context, saved, size, &loaded));
   EXPECT_OK(sph_collider_get_transform(loaded, in_a.collider, &t));
   assert_true(t.position.x == 0.5f);
@@ -711,9 +702,9 @@ static void test_ids_are_not_reused_after_restore(void** state) {
   sph_collider_id first_b, second_b;
   sph_transform t;
   uint64_t size = 0;
-  uint8_t* saved;
+  unsigned char* saved;
   (void)state;
-  saved = save_world(a, &size);
+  saved = capi_save(a, &size);
   extra = add_scene(a, sdf);
   EXPECT_OK(sph_world_restore(a, saved, size));
   EXPECT_OK(sph_collider_get_transform(a, in_a.collider, &t)); /* the saved ids are back */
