@@ -6,6 +6,7 @@ import os
 
 from ._errors import check
 from ._loader import library
+from ._scene import context_handle
 
 __all__ = ["WorldCheckpointMixin", "load_world", "load_world_file"]
 
@@ -28,14 +29,14 @@ def load_world(world_class, context, data):
     """A new world of world_class on context from checkpoint bytes (sph_world_load)."""
     ptr, size, _keep = _buffer(data)
     out = ctypes.POINTER(world_class._sph_type_)()
-    check(library().sph_world_load(context.handle, ptr, size, ctypes.byref(out)), "sph_world_load")
+    check(library().sph_world_load(context_handle(context), ptr, size, ctypes.byref(out)), "sph_world_load")
     return world_class._adopt(context, out)
 
 
 def load_world_file(world_class, context, path):
     """A new world of world_class on context from a checkpoint file (sph_world_load_file)."""
     out = ctypes.POINTER(world_class._sph_type_)()
-    check(library().sph_world_load_file(context.handle, _path_bytes(path), ctypes.byref(out)),
+    check(library().sph_world_load_file(context_handle(context), _path_bytes(path), ctypes.byref(out)),
           "sph_world_load_file")
     return world_class._adopt(context, out)
 

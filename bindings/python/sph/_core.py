@@ -14,7 +14,7 @@ from ._cuda import WorldCudaMixin
 from ._errors import SphError, check
 from ._loader import library
 from ._options import WorldOptionsMixin, _as_struct
-from ._scene import Sdf, WorldSceneMixin
+from ._scene import Sdf, WorldSceneMixin, context_handle
 from ._struct import check_int, check_real, enum_arg
 
 __all__ = ["Context", "World", "attribute_format", "version", "abi_version", "build_info", "result_string",
@@ -303,7 +303,8 @@ class World(WorldSceneMixin, WorldCudaMixin, WorldOptionsMixin, WorldCheckpointM
         for name, value in fields.items():
             setattr(d, name, value)
         out = ctypes.POINTER(_g.sph_world)()
-        check(library().sph_world_create(context.handle, ctypes.byref(d), ctypes.byref(out)), "sph_world_create")
+        check(library().sph_world_create(context_handle(context), ctypes.byref(d), ctypes.byref(out)),
+              "sph_world_create")
         self._ptr = out
         self.context = context
         context._children.add(self)

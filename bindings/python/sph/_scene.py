@@ -114,7 +114,7 @@ class Sdf:
         if open_top:
             desc.flags |= _g.SPH_SHAPE_FLAG_OPEN_TOP
         out = ctypes.POINTER(_g.sph_sdf)()
-        check(library().sph_sdf_create_shape(context.handle, ctypes.byref(desc), ctypes.byref(out)),
+        check(library().sph_sdf_create_shape(context_handle(context), ctypes.byref(desc), ctypes.byref(out)),
               "sph_sdf_create_shape")
         return cls(context, out)
 
@@ -135,6 +135,9 @@ class Sdf:
         size. A CPU context raises SphError(ERROR_UNSUPPORTED).
         """
         memory = _memory(memory)
+        if index_to_local is not None and voxel_size is not None:
+            # voxel_size (and origin) was ignored beside index_to_local, without a word.
+            raise TypeError("from_grid(): give index_to_local= or voxel_size= (with origin=), not both")
         if index_to_local is None and voxel_size is not None:
             index_to_local = grid_transform(voxel_size, origin)
         if memory != _g.MemoryKind.HOST:
@@ -152,7 +155,8 @@ class Sdf:
             keep += [fri, a]
             desc.friction = ctypes.pointer(fri)
         out = ctypes.POINTER(_g.sph_sdf)()
-        check(library().sph_sdf_create(context.handle, ctypes.byref(desc), ctypes.byref(out)), "sph_sdf_create")
+        check(library().sph_sdf_create(context_handle(context), ctypes.byref(desc), ctypes.byref(out)),
+              "sph_sdf_create")
         return cls(context, out)
 
     @classmethod
@@ -173,7 +177,8 @@ class Sdf:
             keep.append(grid(friction, 1, "friction"))
             desc.friction = ctypes.pointer(keep[-1])
         out = ctypes.POINTER(_g.sph_sdf)()
-        check(library().sph_sdf_create(context.handle, ctypes.byref(desc), ctypes.byref(out)), "sph_sdf_create")
+        check(library().sph_sdf_create(context_handle(context), ctypes.byref(desc), ctypes.byref(out)),
+              "sph_sdf_create")
         return cls(context, out)
 
     @classmethod
@@ -204,7 +209,7 @@ class Sdf:
             if value is not None:
                 setattr(desc, name, value)
         out = ctypes.POINTER(_g.sph_sdf)()
-        check(library().sph_sdf_create_from_mesh(context.handle, ctypes.byref(desc), ctypes.byref(out)),
+        check(library().sph_sdf_create_from_mesh(context_handle(context), ctypes.byref(desc), ctypes.byref(out)),
               "sph_sdf_create_from_mesh")
         return cls(context, out)
 
@@ -218,7 +223,7 @@ class Sdf:
 
         vdb = helper_library("sph_vdb")
         out = ctypes.POINTER(_g.sph_sdf)()
-        code = vdb.sph_vdb_load_sdf(context.handle, os.fsencode(path),
+        code = vdb.sph_vdb_load_sdf(context_handle(context), os.fsencode(path),
                                     grid_name.encode("utf-8") if grid_name else None, ctypes.byref(out))
         if code < 0:
             raise SphError(code, vdb.sph_vdb_get_last_error().decode("utf-8", "replace"), "sph_vdb_load_sdf")
@@ -479,6 +484,15 @@ _EVENT_OBJECT_KINDS = {
 
 
 # ---- World methods --------------------------------------------------------------------------------
+def context_handle(context):
+    """The sph_context* of a Context argument; TypeError for anything else (None was an
+    AttributeError about .handle). A closed Context passes NULL, which the library refuses."""
+    handle = getattr(context, "handle", None)
+    if not isinstance(handle, ctypes.POINTER(_g.sph_context)):
+        raise TypeError(f"context: expected an sph.Context, got {type(context).__name__}")
+    return handle
+
+
 def _sdf_handle(sdf, what):
     """The sph_sdf* of an Sdf argument; TypeError for anything else (None was an AttributeError
     about .handle). A closed Sdf passes NULL, which the library refuses naming the field."""

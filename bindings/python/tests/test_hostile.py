@@ -263,6 +263,22 @@ def test_sdf_arguments_must_be_sdf_assets(ctx, world):
     world.add_force_field("radial", strength=1.0).destroy()
 
 
+def test_context_arguments_must_be_contexts(ctx):
+    # World(None) and Sdf.shape(None) were AttributeError: 'NoneType' object has no attribute 'handle'.
+    with pytest.raises(TypeError, match="context: expected an sph.Context, got NoneType"):
+        sph.World(None, capacity=64)
+    with pytest.raises(TypeError, match="context: expected an sph.Context, got str"):
+        sph.Sdf.shape("cpu", "sphere", radius=0.1, voxel_size=0.02)
+    with pytest.raises(TypeError, match="context: expected an sph.Context, got NoneType"):
+        sph.Sdf.from_grid(None, np.zeros((4, 4, 4), np.float32), voxel_size=0.01)
+    # voxel_size= beside index_to_local= was ignored without a word.
+    with pytest.raises(TypeError, match="not both"):
+        sph.Sdf.from_grid(ctx, np.zeros((4, 4, 4), np.float32), voxel_size=0.01,
+                          index_to_local=sph.grid_transform(0.02))
+    with sph.World(ctx, capacity=64) as w:  # the real thing still works
+        assert w.particle_count == 0
+
+
 def test_out_arrays_and_step_arguments_are_checked(world):
     world.fill_box((0, 0, 0), (0.05, 0.05, 0.05))
     # A 0-d out= passed the shape check and failed at len() ("len() of unsized object").
