@@ -653,6 +653,15 @@ static void expect_ids_refused_at(int line, sph_world* world, const scene_ids* i
 }
 #define EXPECT_IDS_REFUSED(world, ids) expect_ids_refused_at(__LINE__, (world), (ids))
 
+/* No id of `a` has the bits of the same kind's id in `b`. */
+static void expect_all_ids_differ(const scene_ids* a, const scene_ids* b) {
+  assert_true(a->collider.bits != b->collider.bits);
+  assert_true(a->source.bits != b->source.bits);
+  assert_true(a->sink.bits != b->sink.bits);
+  assert_true(a->field.bits != b->field.bits);
+  assert_true(a->probe.bits != b->probe.bits);
+}
+
 /* The ids of every kind of object work in their own world only: two worlds of one context, made
  * alike, each refuse the other's ids (before the world tag in the ids, the first collider of
  * every world had the same bits, and world B moved or destroyed its own collider when given
@@ -667,11 +676,7 @@ static void test_ids_of_another_world_are_refused(void** state) {
   uint64_t size = 0;
   unsigned char* saved;
   (void)state;
-  assert_true(in_a.collider.bits != in_b.collider.bits);
-  assert_true(in_a.source.bits != in_b.source.bits);
-  assert_true(in_a.sink.bits != in_b.sink.bits);
-  assert_true(in_a.field.bits != in_b.field.bits);
-  assert_true(in_a.probe.bits != in_b.probe.bits);
+  expect_all_ids_differ(&in_a, &in_b);
   EXPECT_IDS_REFUSED(b, &in_a);
   EXPECT_IDS_REFUSED(a, &in_b);
   /* Each world's own ids still work. */
@@ -710,11 +715,7 @@ static void test_ids_are_not_reused_after_restore(void** state) {
   EXPECT_OK(sph_collider_get_transform(a, in_a.collider, &t)); /* the saved ids are back */
   EXPECT_IDS_REFUSED(a, &extra);
   again = add_scene(a, sdf);
-  assert_true(again.collider.bits != extra.collider.bits);
-  assert_true(again.source.bits != extra.source.bits);
-  assert_true(again.sink.bits != extra.sink.bits);
-  assert_true(again.field.bits != extra.field.bits);
-  assert_true(again.probe.bits != extra.probe.bits);
+  expect_all_ids_differ(&again, &extra);
   EXPECT_IDS_REFUSED(a, &extra);
   /* Once more: neither id issued after the save comes back. */
   EXPECT_OK(sph_world_restore(a, saved, size));

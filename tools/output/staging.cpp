@@ -56,15 +56,20 @@ bool empty_and_remove(const std::string& dir) {
 
 }  // namespace
 
+namespace {
+
+// A character of an object's name that its table's file name keeps (any other becomes '_').
+bool kept_in_table_name(char ch) {
+  return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '-';
+}
+
+}  // namespace
+
 std::string object_table_name(const char* prefix, size_t index, const std::string& name) {
   std::string file = std::string(prefix) + "_" + std::to_string(index);
   if (!name.empty()) file += "_";
-  for (size_t i = 0; i < name.size() && i < kMaxTableNameChars; ++i) {
-    const char ch = name[i];
-    const bool kept =
-        (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '-';
-    file += kept ? ch : '_';
-  }
+  for (size_t i = 0; i < name.size() && i < kMaxTableNameChars; ++i)
+    file += kept_in_table_name(name[i]) ? name[i] : '_';
   return file + ".csv";
 }
 
@@ -84,12 +89,8 @@ bool is_table_name(const std::string& name) {
     if (i == p) return false;  // no index
     if (i == end) return true;
     if (name[i] != '_' || end - (i + 1) > kMaxTableNameChars || i + 1 == end) return false;
-    for (size_t k = i + 1; k < end; ++k) {
-      const char ch = name[k];
-      if (!((ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '-' ||
-            ch == '_'))
-        return false;
-    }
+    for (size_t k = i + 1; k < end; ++k)
+      if (!kept_in_table_name(name[k]) && name[k] != '_') return false;
     return true;
   }
   return false;
