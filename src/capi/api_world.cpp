@@ -3,6 +3,7 @@
 #include <cfloat>
 
 #include "../core/fcc_lattice.h"
+#include "../core/kernel_radius_rule.h"
 #include "../physics/kernels.h"
 #include "guard.h"
 #include "handles.h"
@@ -16,7 +17,6 @@ namespace {
 
 constexpr uint32_t kMaxCapacity = sph::kMaxWorldCapacity;
 constexpr float kDefaultKernelRadiusFactor = 1.8f;  // between the 3rd (sqrt 3) and 4th (2) FCC shell
-constexpr float kMaxKernelRadiusFactor = 5.0f;
 
 sph_world_def default_world_def() {
   sph_world_def d;
@@ -110,16 +110,10 @@ sph::WorldConfig config_from_def(const sph_world_def& def) {
     h = kDefaultKernelRadiusFactor * d.particle_spacing;
   } else {
     sph::require_positive(h, "def->kernel_radius");
-    if (h < d.particle_spacing)
-      throw Error(Status::InvalidArgument, "def->kernel_radius: " + sph::describe(h) +
-                                               " is smaller than def->particle_spacing " +
-                                               sph::describe(d.particle_spacing));
-    // Within float rounding of 5 x spacing, as written (0.1f against 5 x 0.02f = 0.099999994f).
-    if (static_cast<double>(h) >
-        static_cast<double>(kMaxKernelRadiusFactor) * d.particle_spacing * (1.0 + 4.0 * FLT_EPSILON))
-      throw Error(Status::InvalidArgument, "def->kernel_radius: " + sph::describe(h) +
-                                               " is more than 5 x def->particle_spacing (hundreds of "
-                                               "neighbours per particle)");
+    if (const char* fault = sph::kernel_radius_fault(d.particle_spacing, h))
+      throw Error(Status::InvalidArgument, "def->kernel_radius: " + sph::describe(h) + " " + fault +
+                                               " (def->particle_spacing " +
+                                               sph::describe(d.particle_spacing) + ")");
   }
   const sph::KernelCoefficients k = sph::make_kernel_coefficients(h);
   const bool representable = std::isfinite(h) && std::isfinite(k.poly6) && std::isfinite(k.spiky_grad) &&
@@ -144,17 +138,11 @@ sph::WorldConfig config_from_def(const sph_world_def& def) {
   c.spiky_scale = sph::fcc_spiky_scale(d.particle_spacing, h);
   c.density_self_weight =
       sph::fcc_density_self_weight(d.particle_spacing, h, d.rest_density, mass, c.spiky_scale);
-  // At h = spacing (and a few float steps above it) the lattice's nearest neighbours sit on the
-  // kernel's edge, where W_spiky and its moment vanish: the lattice scale divides by (nearly)
-  // zero and every filled particle's density was non-finite at the first step (one float step
-  // above: a scale of 3e12). 1e9 (h about 1.000003 spacings) leaves a margin below the largest
-  // scale measured to step finitely (5e10, eight steps above); 1.8 spacings give 1.11.
-  constexpr float kMaxSpikyScale = 1e9f;
-  if (!(c.spiky_scale <= kMaxSpikyScale) || !std::isfinite(c.density_self_weight))
-    throw Error(Status::InvalidArgument, "def->kernel_radius: " + sph::describe(h) +
-                                             " is too close to def->particle_spacing " +
-                                             sph::describe(d.particle_spacing) +
-                                             ": the lattice's nearest neighbours lie on the kernel's edge");
+  if (!std::isfinite(c.density_self_weight))
+    throw Error(Status::InvalidArgument,
+                "def->kernel_radius: " + sph::describe(h) +
+                    " gives a non-finite density self term with def->particle_spacing " +
+                    sph::describe(d.particle_spacing));
   return c;
 }
 

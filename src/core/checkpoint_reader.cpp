@@ -20,6 +20,8 @@
 #include "checkpoint_scene_reader.h"
 #include "fcc_lattice.h"
 #include "field_error.h"
+#include "kernel_radius_rule.h"
+#include "number_text.h"
 #include "pose_rules.h"
 #include "scene_build.h"
 
@@ -82,8 +84,9 @@ WorldConfig read_config(ByteReader& r, uint32_t version) {
       (!(c.features & kFeatureNormalizedDensity) || c.solver == Solver::Dfsph))
     corrupt(r.what() +
             ": density diffusion without the normalised density, or with DFSPH (no world can be made so)");
-  if (c.kernel_radius < c.particle_spacing || c.kernel_radius > 5.0f * c.particle_spacing)
-    corrupt(r.what() + ": kernel radius is outside [1, 5] x the particle spacing");
+  if (const char* fault = kernel_radius_fault(c.particle_spacing, c.kernel_radius))
+    corrupt(r.what() + ": kernel radius " + number_text(c.kernel_radius) + " (particle spacing " +
+            number_text(c.particle_spacing) + ") " + fault + "; no world can be made so");
   const KernelCoefficients k = make_kernel_coefficients(c.kernel_radius);
   if (!std::isfinite(k.poly6) || !std::isfinite(k.spiky_grad) || !(k.poly6 > 0.0f) || !(k.visc_lap > 0.0f) ||
       !std::isnormal(k.h2) || !std::isnormal(c.particle_mass))

@@ -1099,6 +1099,53 @@ static void test_fixed_step_above_ceiling_round_trips(void** state) {
   EXPECT_OK(sph_context_destroy(context));
 }
 
+/* A world at the kernel radius bounds sph_world_create accepts is one the reader loads: 5 x the
+ * spacing as written (0.1f for 0.02f, one float step above 5.0f * 0.02f) saved a checkpoint its
+ * own library refused ("outside [1, 5] x the particle spacing": the reader checked in float) until
+ * the two shared one rule. And a forged radius create refuses (h = spacing: the lattice scale
+ * divides by zero) is CORRUPT_DATA, not a world whose first step is non-finite. */
+static void test_kernel_radius_bounds_round_trip(void** state) {
+  sph_context* context = NULL;
+  sph_world *world = NULL, *loaded = NULL;
+  sph_world_def def;
+  uint64_t size = 0, at;
+  uint8_t* checkpoint;
+  const float spacing = 0.02f, marker = 0.0271828f;
+  int found = 0;
+  (void)state;
+
+  EXPECT_OK(sph_test_context_create(&context));
+  sph_world_def_init(&def);
+  def.capacity = 64;
+  def.particle_spacing = spacing;
+  def.kernel_radius = 0.1f;
+  EXPECT_OK(sph_world_create(context, &def, &world));
+  checkpoint = save_to_memory(world, &size);
+  EXPECT_OK(sph_world_load(context, checkpoint, size, &loaded));
+  EXPECT_OK(sph_world_restore(world, checkpoint, size));
+  free(checkpoint);
+  EXPECT_OK(sph_world_destroy(loaded));
+  EXPECT_OK(sph_world_destroy(world));
+  loaded = NULL;
+
+  def.kernel_radius = marker;
+  EXPECT_OK(sph_world_create(context, &def, &world));
+  checkpoint = save_to_memory(world, &size);
+  for (at = 48; at + 4 <= size; ++at)
+    if (memcmp(checkpoint + at, &marker, 4) == 0) {
+      memcpy(checkpoint + at, &spacing, 4);
+      ++found;
+    }
+  assert_int_equal(found, 1);
+  reseal(checkpoint, (size_t)size);
+  EXPECT_ERROR(SPH_ERROR_CORRUPT_DATA, "too close to the particle spacing",
+               sph_world_load(context, checkpoint, size, &loaded));
+  assert_null(loaded);
+  free(checkpoint);
+  EXPECT_OK(sph_world_destroy(world));
+  EXPECT_OK(sph_context_destroy(context));
+}
+
 static void test_argument_errors(void** state) {
   sph_context* context = NULL;
   sph_world* world = NULL;
@@ -1159,6 +1206,7 @@ int main(void) {
       cmocka_unit_test(test_save_file_is_atomic),
       cmocka_unit_test(test_argument_errors),
       cmocka_unit_test(test_fixed_step_above_ceiling_round_trips),
+      cmocka_unit_test(test_kernel_radius_bounds_round_trip),
   };
   const struct CMUnitTest damaged[] = {
       cmocka_unit_test(test_every_truncation_is_refused),
