@@ -59,9 +59,11 @@ namespace Sph
         /// (77 % without), a settled tank's pressure near its walls is within 3-5 % of rho0 g d at the
         /// default stiffness (48-77 % low without). Edges and corners read high when a lattice is
         /// placed into them (docs/physics.md). The maps are computed per asset and kernel radius when a
-        /// collider first steps with the asset and after sph_sdf_update (16 bytes per SDF voxel; on the
-        /// device for CUDA). The collision response stays the no-penetration safeguard. Costs one SDF
-        /// sample per particle and collider in each density pass.
+        /// collider first steps with the asset and after sph_sdf_update of its distances (16 bytes per
+        /// SDF voxel; on the device for CUDA; the CPU recomputes, from an asset's second change on,
+        /// only the voxels within reach of those that changed, keeping 4 bytes more per voxel). The
+        /// collision response stays the no-penetration safeguard. Costs one SDF sample per particle and
+        /// collider in each density pass.
         /// </summary>
         public const uint SPH_FEATURE_BOUNDARY_DENSITY = 8u;
         /// <summary>
@@ -3102,7 +3104,11 @@ namespace Sph
         /// Overwrites the box [origin, origin + size) of one channel with data (size[0] * size[1] *
         /// size[2] * components floats, i fastest, copied). Updating the velocity or friction channel
         /// of an asset created without it creates it (zero elsewhere). Do not update an asset while a
-        /// world that uses it is inside sph_world_step on another thread. Errors: INVALID_ARGUMENT (box
+        /// world that uses it is inside sph_world_step on another thread. With
+        /// SPH_FEATURE_BOUNDARY_DENSITY a change of the distances makes the next step recompute the
+        /// asset's boundary map: on the CPU backend, from the asset's second change on, only the voxels
+        /// within a kernel radius of those whose value changed (a dug terrain pays for the dig alone; a
+        /// velocity-only update for nothing), on CUDA the whole map. Errors: INVALID_ARGUMENT (box
         /// outside the grid, NULL or non-finite data), UNSUPPORTED (unknown channel or memory).
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
 #include "cpu_boundary_maps.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "../physics/boundary_map.h"
 
@@ -73,36 +75,124 @@ SdfSlope sdf_slope(const SdfAsset& asset, const CpuParallel& parallel) {
   return slope;
 }
 
+namespace {
+
+VoxelBox whole_grid(const SdfAsset& asset) {
+  VoxelBox box;
+  box.hi[0] = asset.nx(), box.hi[1] = asset.ny(), box.hi[2] = asset.nz();
+  return box;
+}
+
+// `box` grown by reach[a] voxels along each axis a, within the grid.
+VoxelBox grown(const VoxelBox& box, const int64_t reach[3], const SdfAsset& asset) {
+  const int32_t n[3] = {asset.nx(), asset.ny(), asset.nz()};
+  VoxelBox out;
+  for (int a = 0; a < 3; ++a) {
+    out.lo[a] = static_cast<int32_t>(std::max<int64_t>(0, box.lo[a] - reach[a]));
+    out.hi[a] = static_cast<int32_t>(std::min<int64_t>(n[a], box.hi[a] + reach[a]));
+  }
+  return out;
+}
+
+// Runs body(i, j, k, index) over the voxels of `box`, a (j, k) row of it per item, `rows` a block.
+template <class Body>
+void for_box(const SdfAsset& asset, const VoxelBox& box, size_t rows, const CpuParallel& parallel,
+             Body&& body) {
+  if (box.empty()) return;
+  const size_t ny = static_cast<size_t>(box.hi[1] - box.lo[1]);
+  const size_t nz = static_cast<size_t>(box.hi[2] - box.lo[2]);
+  const size_t nx = static_cast<size_t>(asset.nx()), grid_ny = static_cast<size_t>(asset.ny());
+  parallel.for_blocks(ny * nz, rows, [&](size_t first, size_t last) {
+    for (size_t row = first; row < last; ++row) {
+      const int32_t j = box.lo[1] + static_cast<int32_t>(row % ny),
+                    k = box.lo[2] + static_cast<int32_t>(row / ny);
+      const size_t start = nx * (static_cast<size_t>(j) + grid_ny * static_cast<size_t>(k));
+      for (int32_t i = box.lo[0]; i < box.hi[0]; ++i) body(i, j, k, start + static_cast<size_t>(i));
+    }
+  });
+}
+
+}  // namespace
+
+VoxelBox changed_voxels(const SdfAsset& asset, const HostVector<float>& before, const CpuParallel& parallel) {
+  const HostVector<float>& now = asset.distance();
+  const size_t nx = static_cast<size_t>(asset.nx()), ny = static_cast<size_t>(asset.ny());
+  const size_t rows = ny * static_cast<size_t>(asset.nz());
+  constexpr size_t kRows = 64;
+  HostVector<VoxelBox> per_block((rows + kRows - 1) / kRows);
+  parallel.for_blocks(rows, kRows, [&](size_t first, size_t last) {
+    VoxelBox b;
+    for (size_t row = first; row < last; ++row) {
+      const float* a = before.data() + nx * row;
+      const float* c = now.data() + nx * row;
+      if (std::memcmp(a, c, nx * sizeof(float)) == 0) continue;
+      int32_t lo = 0, hi = static_cast<int32_t>(nx);
+      while (std::memcmp(a + lo, c + lo, sizeof(float)) == 0) ++lo;
+      while (std::memcmp(a + hi - 1, c + hi - 1, sizeof(float)) == 0) --hi;
+      const int32_t j = static_cast<int32_t>(row % ny), k = static_cast<int32_t>(row / ny);
+      if (b.empty()) {
+        b.lo[0] = lo, b.hi[0] = hi, b.lo[1] = j, b.hi[1] = j + 1, b.lo[2] = k, b.hi[2] = k + 1;
+      } else {
+        b.lo[0] = std::min(b.lo[0], lo), b.hi[0] = std::max(b.hi[0], hi);
+        b.lo[1] = std::min(b.lo[1], j), b.hi[1] = std::max(b.hi[1], j + 1);
+        b.lo[2] = std::min(b.lo[2], k), b.hi[2] = std::max(b.hi[2], k + 1);
+      }
+    }
+    per_block[first / kRows] = b;
+  });
+  VoxelBox all;
+  for (const VoxelBox& b : per_block) {
+    if (b.empty()) continue;
+    if (all.empty()) {
+      all = b;
+      continue;
+    }
+    for (int a = 0; a < 3; ++a)
+      all.lo[a] = std::min(all.lo[a], b.lo[a]), all.hi[a] = std::max(all.hi[a], b.hi[a]);
+  }
+  return all;
+}
+
+VoxelBox update_boundary_map(const SdfAsset& asset, float h, float level, const CpuParallel& parallel,
+                             const VoxelBox& changed, HostVector<Float4>& map) {
+  if (changed.empty()) return VoxelBox{};
+  const SdfGridView g = asset.host_view();
+  const Affine3x4 index_to_local = asset.index_to_local();
+  // A voxel's correction reads the SDF along its rays (local distance h), for its normal (half a
+  // voxel about it) and its flat share (its own cell): within h + a voxel of it, which along index
+  // axis a is at most that times the norm of local_to_index's row a; the trilinear cell of a point
+  // takes one voxel more, and one more covers the rounding of the points.
+  const double reach_local = static_cast<double>(h) + g.min_voxel_size;
+  int64_t reach[3];
+  for (int a = 0; a < 3; ++a) {
+    double row = 0.0;
+    for (int c = 0; c < 3; ++c)
+      row += static_cast<double>(g.local_to_index.m[4 * a + c]) * g.local_to_index.m[4 * a + c];
+    const double voxels = std::ceil(reach_local * std::sqrt(row) * (1.0 + 1e-5)) + 2.0;
+    reach[a] = voxels < 1e9 ? static_cast<int64_t>(voxels) : int64_t{1000000000};
+  }
+  const VoxelBox values = grown(changed, reach, asset);
+  const SdfSlope slope = sdf_slope(asset, parallel);
+  // One (j, k) row of voxels per item, four rows a block: the band's rows cost far more than the
+  // rest, so small blocks go out on demand.
+  for_box(asset, values, 4, parallel, [&](int32_t i, int32_t j, int32_t k, size_t v) {
+    map[v].x = boundary_map_correction(g, index_to_local, i, j, k, h, level, slope);
+  });
+  // The slopes from the values (central differences: a voxel's own and its neighbours'): all
+  // values are in place before any slope is written, and a slope writes only its own voxel's
+  // gradient channels.
+  const int64_t one[3] = {1, 1, 1};
+  for_box(asset, grown(values, one, asset), 64, parallel, [&](int32_t i, int32_t j, int32_t k, size_t v) {
+    const Vec3 s = boundary_map_slope(g, map.data(), i, j, k, h, level);
+    map[v].y = s.x, map[v].z = s.y, map[v].w = s.z;
+  });
+  return values;
+}
+
 HostVector<Float4> compute_boundary_map(const SdfAsset& asset, float h, float level,
                                         const CpuParallel& parallel) {
   HostVector<Float4> map(asset.voxel_count(), Float4{0.0f, 0.0f, 0.0f, 0.0f});
-  const SdfGridView g = asset.host_view();
-  const Affine3x4 index_to_local = asset.index_to_local();
-  const SdfSlope slope = sdf_slope(asset, parallel);
-  const size_t planes = static_cast<size_t>(asset.ny()) * static_cast<size_t>(asset.nz());
-  const size_t nx = static_cast<size_t>(asset.nx());
-  // One (j, k) row of voxels per item, four rows a block: the band's rows cost far more than the
-  // rest, so small blocks go out on demand.
-  parallel.for_blocks(planes, 4, [&](size_t first, size_t last) {
-    for (size_t row = first; row < last; ++row) {
-      const int32_t j = static_cast<int32_t>(row % asset.ny()), k = static_cast<int32_t>(row / asset.ny());
-      for (int32_t i = 0; i < asset.nx(); ++i)
-        map[static_cast<size_t>(i) + nx * row].x =
-            boundary_map_correction(g, index_to_local, i, j, k, h, level, slope);
-    }
-  });
-  // The slopes from the values: all values are in place before any slope is written, and a slope
-  // writes only its own voxel's gradient channels.
-  parallel.for_blocks(planes, 64, [&](size_t first, size_t last) {
-    for (size_t row = first; row < last; ++row) {
-      const int32_t j = static_cast<int32_t>(row % asset.ny()), k = static_cast<int32_t>(row / asset.ny());
-      for (int32_t i = 0; i < asset.nx(); ++i) {
-        const Vec3 s = boundary_map_slope(g, map.data(), i, j, k, h, level);
-        Float4& m = map[static_cast<size_t>(i) + nx * row];
-        m.y = s.x, m.z = s.y, m.w = s.z;
-      }
-    }
-  });
+  update_boundary_map(asset, h, level, parallel, whole_grid(asset), map);
   return map;
 }
 
@@ -110,13 +200,27 @@ const Float4* CpuBoundaryMaps::bind(const SdfAsset& asset, float h, float level,
                                     const CpuParallel& parallel) {
   Entry& e = entries_[std::make_pair(asset.uid(), level)];
   e.last_frame = frame_;
-  if (e.version != asset.version() || e.kernel_radius != h || e.correction.size() != asset.voxel_count()) {
-    e.version = 0;  // until the map below is complete
+  if (e.version == asset.version() && e.kernel_radius == h && e.correction.size() == asset.voxel_count())
+    return e.correction.data();
+  // A map of this h that was complete (version 0 marks one whose computation failed) for other
+  // values of the same asset (an asset's dims and transform never change).
+  const bool stale = e.version != 0 && e.kernel_radius == h && e.correction.size() == asset.voxel_count();
+  e.version = 0;  // until the map below is complete
+  if (stale && e.computed_from.size() == asset.voxel_count()) {
+    voxels_computed_ += update_boundary_map(asset, h, level, parallel,
+                                            changed_voxels(asset, e.computed_from, parallel), e.correction)
+                            .voxels();
+  } else {
+    e.computed_from.clear();
     e.correction = compute_boundary_map(asset, h, level, parallel);
-    e.kernel_radius = h;
-    e.version = asset.version();
+    voxels_computed_ += asset.voxel_count();
     ++builds_;
   }
+  // The asset changes (a deforming collider, a terrain being dug): keep what this map was made
+  // from, so that the next change recomputes only what it reaches.
+  if (stale) e.computed_from = asset.distance();
+  e.kernel_radius = h;
+  e.version = asset.version();
   return e.correction.data();
 }
 
@@ -131,7 +235,8 @@ void CpuBoundaryMaps::end_frame() {
 
 uint64_t CpuBoundaryMaps::bytes() const {
   uint64_t total = 0;
-  for (const auto& kv : entries_) total += kv.second.correction.size() * sizeof(Float4);
+  for (const auto& kv : entries_)
+    total += kv.second.correction.size() * sizeof(Float4) + kv.second.computed_from.size() * sizeof(float);
   return total;
 }
 

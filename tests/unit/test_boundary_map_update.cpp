@@ -1,0 +1,253 @@
+// SPDX-License-Identifier: MIT
+// The CPU's partial update of a boundary map after its SDF changed in part (src/cpu/cpu_boundary_maps.h,
+// changed_voxels and update_boundary_map; CpuBoundaryMaps::bind from an asset's second change on).
+// What must hold, on an open tank (a container's level above zero), a solid box (below zero) and a
+// scaled, rippled ball on a rotated, sheared grid of unequal voxels (the reach along each index
+// axis is not the same):
+//   - changed_voxels finds exactly the bounding box of the voxels whose distance changed;
+//   - the update gives the map a whole recomputation gives, bit for bit (every channel of every
+//     voxel), for a dent inside the grid and one against its faces;
+//   - the claim it rests on, checked directly against two whole computations: every voxel outside
+//     the box the update recomputed keeps its correction, and outside that box grown by one its
+//     slopes; and the update's reach is needed: some voxels outside the changed box but inside the
+//     recomputed one do change (so a reach of zero would fail the comparison above);
+//   - the cache: an asset's first change recomputes the whole map, the next ones only their boxes
+//     (voxels_computed), a velocity-only change none, and the map is the whole computation's.
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+extern "C" {
+#include <cmocka.h>
+}
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+
+#include "core/sdf_asset.h"
+#include "core/sdf_shapes.h"
+#include "cpu/cpu_boundary_maps.h"
+#include "physics/boundary_map.h"
+
+namespace {
+
+const float kH = 0.0255f;  // the loads' tests' kernel radius (1 cm lattice step)
+const sph::CpuParallel kWorkers(2);
+
+std::shared_ptr<sph::SdfAsset> tank() {
+  sph::ShapeSpec s;
+  s.kind = sph::ShapeKind::Box;
+  s.half_extents = sph::Vec3{0.08f, 0.06f, 0.07f};
+  s.wall_thickness = 0.02f;
+  s.open_top = true;
+  s.voxel_size = 0.006f;
+  return sph::build_shape_sdf(s, 1u << 22);
+}
+
+std::shared_ptr<sph::SdfAsset> solid_box() {
+  sph::ShapeSpec s;
+  s.kind = sph::ShapeKind::Box;
+  s.half_extents = sph::Vec3{0.07f, 0.05f, 0.06f};
+  s.voxel_size = 0.0055f;
+  return sph::build_shape_sdf(s, 1u << 22);
+}
+
+// Not a distance: 2.5 times a ball's distance plus a ripple, on a grid rotated about (1, 2, 3),
+// sheared, with voxels of 4, 5 and 6 mm (as test_boundary_map_skip's, larger).
+std::shared_ptr<sph::SdfAsset> rippled_ball() {
+  const double angle = 0.7, n[3] = {1.0 / std::sqrt(14.0), 2.0 / std::sqrt(14.0), 3.0 / std::sqrt(14.0)};
+  const double c = std::cos(angle), s = std::sin(angle);
+  double rotation[3][3];
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k) {
+      const double cross = r == k ? 0.0 : ((r + 1) % 3 == k ? -n[3 - r - k] : n[3 - r - k]);
+      rotation[r][k] = (r == k ? c : 0.0) + (1.0 - c) * n[r] * n[k] + s * cross;
+    }
+  const double scale[3] = {0.004, 0.005, 0.006}, shear = 0.3;
+  sph::Affine3x4 to_local{};
+  const int n_axis[3] = {40, 32, 28};
+  for (int r = 0; r < 3; ++r) {
+    for (int k = 0; k < 3; ++k) {
+      const double column = rotation[r][k] * scale[k] + (k == 1 ? shear * rotation[r][0] * scale[0] : 0.0);
+      to_local.m[4 * r + k] = static_cast<float>(column);
+    }
+    double centre = 0.0;
+    for (int k = 0; k < 3; ++k) centre += static_cast<double>(to_local.m[4 * r + k]) * 0.5 * (n_axis[k] - 1);
+    to_local.m[4 * r + 3] = static_cast<float>(-centre);
+  }
+  auto asset = std::make_shared<sph::SdfAsset>(n_axis[0], n_axis[1], n_axis[2], to_local);
+  for (int k = 0; k < n_axis[2]; ++k)
+    for (int j = 0; j < n_axis[1]; ++j)
+      for (int i = 0; i < n_axis[0]; ++i) {
+        const sph::Vec3 p = sph::apply_affine(
+            to_local, sph::Vec3{static_cast<float>(i), static_cast<float>(j), static_cast<float>(k)});
+        const double r = std::sqrt(static_cast<double>(p.x) * p.x + static_cast<double>(p.y) * p.y +
+                                   static_cast<double>(p.z) * p.z);
+        asset->distance()[static_cast<size_t>(i) + n_axis[0] * (j + static_cast<size_t>(n_axis[1]) * k)] =
+            static_cast<float>(2.5 * (r - 0.045) + 0.002 * std::sin(300.0 * p.x));
+      }
+  return asset;
+}
+
+size_t voxel_index(const sph::SdfAsset& a, int32_t i, int32_t j, int32_t k) {
+  return static_cast<size_t>(i) + static_cast<size_t>(a.nx()) * (j + static_cast<size_t>(a.ny()) * k);
+}
+
+bool inside(const sph::VoxelBox& b, int32_t i, int32_t j, int32_t k) {
+  return i >= b.lo[0] && i < b.hi[0] && j >= b.lo[1] && j < b.hi[1] && k >= b.lo[2] && k < b.hi[2];
+}
+
+// Carves a ball of radius `radius` (local units) about voxel `centre` out of the solid (the SDF's
+// max with the ball's outside distance) and adds a small ripple where it changes anything; returns
+// the bounding box of the voxels it changed, found voxel by voxel.
+sph::VoxelBox dent(sph::SdfAsset& a, const int32_t centre[3], float radius) {
+  const sph::Vec3 c = sph::apply_affine(
+      a.index_to_local(),
+      sph::Vec3{static_cast<float>(centre[0]), static_cast<float>(centre[1]), static_cast<float>(centre[2])});
+  sph::VoxelBox box;
+  bool any = false;
+  for (int32_t k = 0; k < a.nz(); ++k)
+    for (int32_t j = 0; j < a.ny(); ++j)
+      for (int32_t i = 0; i < a.nx(); ++i) {
+        const sph::Vec3 p =
+            sph::apply_affine(a.index_to_local(),
+                              sph::Vec3{static_cast<float>(i), static_cast<float>(j), static_cast<float>(k)});
+        const float out = radius - sph::length(p - c);
+        if (!(out > -0.5f * radius)) continue;
+        float& d = a.distance()[voxel_index(a, i, j, k)];
+        const float before = d;
+        d = std::fmax(d, out) + 0.0003f * std::sin(900.0f * p.y);
+        if (std::memcmp(&d, &before, sizeof d) == 0) continue;
+        if (!any) {
+          box.lo[0] = i, box.lo[1] = j, box.lo[2] = k;
+          box.hi[0] = i + 1, box.hi[1] = j + 1, box.hi[2] = k + 1;
+          any = true;
+        }
+        const int32_t at[3] = {i, j, k};
+        for (int ax = 0; ax < 3; ++ax)
+          box.lo[ax] = std::min(box.lo[ax], at[ax]), box.hi[ax] = std::max(box.hi[ax], at[ax] + 1);
+      }
+  assert_true(any);
+  a.touch();
+  return box;
+}
+
+// One dent on `asset` at `level`: the update against two whole computations.
+void check_dent(sph::SdfAsset& asset, float level, const int32_t centre[3], float radius, const char* name) {
+  const sph::HostVector<sph::Float4> before = sph::compute_boundary_map(asset, kH, level, kWorkers);
+  const sph::HostVector<float> distances = asset.distance();
+  const sph::VoxelBox expected = dent(asset, centre, radius);
+  const sph::VoxelBox changed = sph::changed_voxels(asset, distances, kWorkers);
+  for (int a = 0; a < 3; ++a) {
+    assert_int_equal(changed.lo[a], expected.lo[a]);
+    assert_int_equal(changed.hi[a], expected.hi[a]);
+  }
+  sph::HostVector<sph::Float4> updated = before;
+  const sph::VoxelBox recomputed = sph::update_boundary_map(asset, kH, level, kWorkers, changed, updated);
+  const sph::HostVector<sph::Float4> after = sph::compute_boundary_map(asset, kH, level, kWorkers);
+  size_t differing = 0, kept_wrongly = 0, moved_outside = 0, reached = 0;
+  for (int32_t k = 0; k < asset.nz(); ++k)
+    for (int32_t j = 0; j < asset.ny(); ++j)
+      for (int32_t i = 0; i < asset.nx(); ++i) {
+        const size_t v = voxel_index(asset, i, j, k);
+        differing += std::memcmp(&updated[v], &after[v], sizeof(sph::Float4)) != 0;
+        const bool value_moved = std::memcmp(&before[v].x, &after[v].x, sizeof(float)) != 0;
+        const bool slope_moved = std::memcmp(&before[v].y, &after[v].y, 3 * sizeof(float)) != 0;
+        // Outside the recomputed box nothing may move (the values), nor outside it grown by one (the slopes).
+        bool near = false;
+        for (int dk = -1; dk <= 1; ++dk)
+          for (int dj = -1; dj <= 1; ++dj)
+            for (int di = -1; di <= 1; ++di) near = near || inside(recomputed, i + di, j + dj, k + dk);
+        kept_wrongly += (value_moved && !inside(recomputed, i, j, k)) || (slope_moved && !near);
+        moved_outside += value_moved && !inside(changed, i, j, k);
+        reached += inside(recomputed, i, j, k);
+      }
+  std::printf(
+      "%-24s level %+.3f: %d x %d x %d voxels, changed box %llu, recomputed %zu, values moved "
+      "outside the changed box %zu, differing from a whole computation %zu\n",
+      name, static_cast<double>(level), asset.nx(), asset.ny(), asset.nz(),
+      static_cast<unsigned long long>(changed.voxels()), reached, moved_outside, differing);
+  assert_int_equal(differing, 0);
+  assert_int_equal(kept_wrongly, 0);
+  assert_true(moved_outside > 0);  // the reach matters
+  assert_int_equal(reached, recomputed.voxels());
+}
+
+void test_tank(void**) {
+  const auto asset = tank();
+  const int32_t floor_centre[3] = {asset->nx() / 2, 4, asset->nz() / 2};
+  check_dent(*asset, 0.007f, floor_centre, 0.02f, "open tank, floor");
+  // Against the grid's faces (the rays' samples there clamp to them).
+  const int32_t corner[3] = {1, 1, 1};
+  check_dent(*asset, 0.007f, corner, 0.025f, "open tank, grid corner");
+}
+
+void test_solid_box(void**) {
+  const auto asset = solid_box();
+  const int32_t face[3] = {asset->nx() / 2, asset->ny() / 2, asset->nz() - 6};
+  check_dent(*asset, -0.007f, face, 0.015f, "solid box, face");
+}
+
+void test_sheared_grid(void**) {
+  const auto asset = rippled_ball();
+  const int32_t side[3] = {asset->nx() - 8, asset->ny() / 2, asset->nz() / 2};
+  check_dent(*asset, -0.01f, side, 0.02f, "rippled ball, sheared");
+}
+
+// The cache: the first change recomputes all, later ones their reach, a velocity-only change nothing.
+void test_cache(void**) {
+  const auto asset = tank();
+  const float level = 0.007f;
+  sph::CpuBoundaryMaps maps;
+  auto frame = [&]() {
+    maps.begin_frame();
+    const sph::Float4* map = maps.bind(*asset, kH, level, kWorkers);
+    maps.end_frame();
+    return map;
+  };
+  frame();
+  const uint64_t voxels = asset->voxel_count();
+  assert_int_equal(maps.builds(), 1);
+  assert_int_equal(maps.voxels_computed(), voxels);
+  assert_int_equal(maps.bytes(), voxels * sizeof(sph::Float4));
+  const int32_t a[3] = {asset->nx() / 2, 4, asset->nz() / 2}, b[3] = {4, asset->ny() / 2, 4};
+  dent(*asset, a, 0.015f);
+  frame();  // the first change: no distances kept to compare with, the whole map
+  assert_int_equal(maps.builds(), 2);
+  assert_int_equal(maps.voxels_computed(), 2 * voxels);
+  assert_int_equal(maps.bytes(), voxels * (sizeof(sph::Float4) + sizeof(float)));
+  dent(*asset, b, 0.01f);
+  const sph::Float4* map = frame();
+  assert_int_equal(maps.builds(), 2);
+  const uint64_t partial = maps.voxels_computed() - 2 * voxels;
+  std::printf("cache: %llu voxels, the second change recomputed %llu\n",
+              static_cast<unsigned long long>(voxels), static_cast<unsigned long long>(partial));
+  assert_true(partial > 0 && partial < voxels / 2);
+  const sph::HostVector<sph::Float4> whole = sph::compute_boundary_map(*asset, kH, level, kWorkers);
+  assert_int_equal(std::memcmp(map, whole.data(), voxels * sizeof(sph::Float4)), 0);
+  // A change of the velocity channel alone (version bumped, distances the same): nothing recomputed.
+  asset->touch();
+  frame();
+  assert_int_equal(maps.builds(), 2);
+  assert_int_equal(maps.voxels_computed(), 2 * voxels + partial);
+  // Another kernel radius: the whole map, and no distances kept until that map's asset changes.
+  maps.begin_frame();
+  maps.bind(*asset, 0.03f, level, kWorkers);
+  maps.end_frame();
+  assert_int_equal(maps.builds(), 3);
+  assert_int_equal(maps.bytes(), voxels * sizeof(sph::Float4));
+}
+
+}  // namespace
+
+int main() {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_tank),
+      cmocka_unit_test(test_solid_box),
+      cmocka_unit_test(test_sheared_grid),
+      cmocka_unit_test(test_cache),
+  };
+  return cmocka_run_group_tests(tests, nullptr, nullptr);
+}
