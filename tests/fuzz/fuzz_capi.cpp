@@ -58,6 +58,9 @@ struct WorldSlot {
   uint32_t features = 0;
   uint32_t integrator = 0, viscosity = 0, eos = 0, solver = 0;
   float spacing = 0.0f, kernel_radius = 0.0f;
+  // The world tag its object ids carry (bits 16-31: sph_c.h, "Object ids"), once it has issued
+  // one; -1 until then. A world keeps its tag (a restore of its own checkpoint keeps it too).
+  int32_t id_tag = -1;
   // A cancel that reached an asynchronous step after its last substep stays for the next step
   // (sph_world_cancel_step): set after op_async_step cancelled, cleared by a step that ran.
   bool cancel_maybe_pending = false;
@@ -1218,8 +1221,23 @@ class Program {
   }
 
   // ---- scene objects ---------------------------------------------------------------------------
-  static void store_id(IdSlot* ids, int at, uint64_t bits, int world) {
+  void store_id(IdSlot* ids, int at, uint64_t bits, int world) {
     ids[at % kIds] = IdSlot{bits, world};
+    int32_t& tag = worlds_[world].id_tag;
+    const int32_t issued = static_cast<int32_t>((bits >> 16) & 0xffffu);
+    if (tag >= 0 && tag != issued) violation("a world issued ids with world tags %d and %d", tag, issued);
+    tag = issued;
+  }
+  // An object id with another world tag than the world's (random bits, or another world's id,
+  // unless that world shares the tag: one loaded from this world's checkpoint, or a world of
+  // another context made in the same order) names nothing in it: no call on it succeeds (the null
+  // id is the no-op the destroy calls accept).
+  void expect_foreign_id_refused(int slot, sph_world* w, uint64_t bits, sph_result r, const char* call) {
+    if (r != SPH_OK || bits == 0 || !world_ok(slot, w) || worlds_[slot].id_tag < 0) return;
+    const int32_t tag = static_cast<int32_t>((bits >> 16) & 0xffffu);
+    if (tag != worlds_[slot].id_tag)
+      violation("%s accepted id %#llx, whose world tag %d is not the world's %d", call,
+                static_cast<unsigned long long>(bits), tag, worlds_[slot].id_tag);
   }
   bool world_ok(int slot, sph_world* w) const { return slot >= 0 && w; }
 
@@ -1304,6 +1322,7 @@ class Program {
       }
     }
     if (r == SPH_OK && !world_ok(slot, w)) violation("a collider call succeeded on a dead world");
+    expect_foreign_id_refused(slot, w, id.bits, r, "a collider call");
   }
 
   void op_source_create() {
@@ -1358,14 +1377,17 @@ class Program {
                              ? FUZZ_CALL(sph_source_destroy(w, id))
                              : FUZZ_CALL(sph_source_set_transform(w, id, in_.chance(8) ? nullptr : &t));
     if (r == SPH_OK && !world_ok(slot, w)) violation("a source call succeeded on a dead world");
+    expect_foreign_id_refused(slot, w, id.bits, r, "a source call");
   }
 
   void op_sink() {
     int slot, sslot;
     sph_world* w = world_arg(&slot);
     if (in_.chance(96)) {
-      const sph_result r = FUZZ_CALL(sph_sink_destroy(w, sph_sink_id{id_arg(sinks_)}));
+      const sph_sink_id id{id_arg(sinks_)};
+      const sph_result r = FUZZ_CALL(sph_sink_destroy(w, id));
       if (r == SPH_OK && !world_ok(slot, w)) violation("sph_sink_destroy succeeded on a dead world");
+      expect_foreign_id_refused(slot, w, id.bits, r, "sph_sink_destroy");
       return;
     }
     Padded<sph_sink_def> buf;
@@ -1439,6 +1461,7 @@ class Program {
                              ? FUZZ_CALL(sph_force_field_destroy(w, id))
                              : FUZZ_CALL(sph_force_field_set_transform(w, id, in_.chance(8) ? nullptr : &t));
     if (r == SPH_OK && !world_ok(slot, w)) violation("a force field call succeeded on a dead world");
+    expect_foreign_id_refused(slot, w, id.bits, r, "a force field call");
   }
 
   void op_events() {
@@ -1781,6 +1804,7 @@ class Program {
       }
     }
     if (r == SPH_OK && !is_live) violation("a probe call succeeded on a dead world");
+    expect_foreign_id_refused(slot, w, id.bits, r, "a probe call");
   }
 
   // sph_collider_get_loads (struct_size, canary) and sph_collider_set_load_point, on worlds
@@ -1816,6 +1840,7 @@ class Program {
     if (r == SPH_OK && !is_live) violation("a collider loads call succeeded on a dead world");
     if (r == SPH_OK && !(worlds_[slot].features & SPH_FEATURE_COLLIDER_LOADS))
       violation("a collider loads call succeeded on a world without SPH_FEATURE_COLLIDER_LOADS");
+    expect_foreign_id_refused(slot, w, id.bits, r, "a collider loads call");
   }
 
   // ---- parameters by kind ------------------------------------------------------------------------
