@@ -60,10 +60,9 @@ namespace Sph
         /// default stiffness (48-77 % low without). Edges and corners read high when a lattice is
         /// placed into them (docs/physics.md). The maps are computed per asset and kernel radius when a
         /// collider first steps with the asset and after sph_sdf_update of its distances (16 bytes per
-        /// SDF voxel; on the device for CUDA; the CPU recomputes, from an asset's second change on,
-        /// only the voxels within reach of those that changed, keeping 4 bytes more per voxel). The
-        /// collision response stays the no-penetration safeguard. Costs one SDF sample per particle and
-        /// collider in each density pass.
+        /// SDF voxel; on the device for CUDA; the CPU recomputes only the voxels within reach of the
+        /// updated box). The collision response stays the no-penetration safeguard. Costs one SDF
+        /// sample per particle and collider in each density pass.
         /// </summary>
         public const uint SPH_FEATURE_BOUNDARY_DENSITY = 8u;
         /// <summary>
@@ -3106,10 +3105,11 @@ namespace Sph
         /// of an asset created without it creates it (zero elsewhere). Do not update an asset while a
         /// world that uses it is inside sph_world_step on another thread. With
         /// SPH_FEATURE_BOUNDARY_DENSITY a change of the distances makes the next step recompute the
-        /// asset's boundary map: on the CPU backend, from the asset's second change on, only the voxels
-        /// within a kernel radius of those whose value changed (a dug terrain pays for the dig alone; a
-        /// velocity-only update for nothing), on CUDA the whole map. Errors: INVALID_ARGUMENT (box
-        /// outside the grid, NULL or non-finite data), UNSUPPORTED (unknown channel or memory).
+        /// asset's boundary map: on the CPU backend only the voxels within about a kernel radius of the
+        /// box (send the box that changed: a dug terrain then pays for the dig alone; an asset re-sent
+        /// whole every frame is compared with the last values, 4 bytes a voxel, to find what moved; a
+        /// velocity or friction update costs nothing), on CUDA the whole map. Errors: INVALID_ARGUMENT
+        /// (box outside the grid, NULL or non-finite data), UNSUPPORTED (unknown channel or memory).
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_sdf_update(SdfHandle sdf, SdfChannel channel, ref FixedUint3 origin, ref FixedUint3 size, [In] float[] data, MemoryKind memory);

@@ -262,7 +262,15 @@ SPH_API sph_result SPH_CALL sph_sdf_update(sph_sdf* sdf, sph_sdf_channel channel
         std::memcpy(target + row * components, values.data() + src * components,
                     size[0] * components * sizeof(float));
       }
-    a.touch();
+    // The box it changed, so that a boundary map recomputes only what it reaches (a velocity or
+    // friction update: no distance changed).
+    sph::VoxelBox changed;
+    if (channel_bits == SPH_SDF_CHANNEL_DISTANCE)
+      for (int axis = 0; axis < 3; ++axis) {
+        changed.lo[axis] = static_cast<int32_t>(origin[axis]);
+        changed.hi[axis] = static_cast<int32_t>(origin[axis] + size[axis]);
+      }
+    a.record_change(changed);
     return SPH_OK;
   });
 }

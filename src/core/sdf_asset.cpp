@@ -79,4 +79,30 @@ SdfGridView SdfAsset::host_view() const {
                    friction_.empty() ? nullptr : friction_.data());
 }
 
+VoxelBox SdfAsset::whole_grid() const {
+  VoxelBox box;
+  box.hi[0] = nx_, box.hi[1] = ny_, box.hi[2] = nz_;
+  return box;
+}
+
+void SdfAsset::record_change(const VoxelBox& distance_box) {
+  std::lock_guard<std::mutex> lock(changes_mutex_);
+  const uint64_t version = version_.fetch_add(1) + 1;
+  changes_[version % kChangesKept] = Change{version, distance_box};
+}
+
+bool SdfAsset::distance_changed_since(uint64_t version, VoxelBox* out) const {
+  std::lock_guard<std::mutex> lock(changes_mutex_);
+  const uint64_t now = version_.load();
+  if (version > now || now - version > static_cast<uint64_t>(kChangesKept)) return false;
+  VoxelBox box;
+  for (uint64_t v = version + 1; v <= now; ++v) {
+    const Change& c = changes_[v % kChangesKept];
+    if (c.version != v) return false;
+    box = box.joined(c.distance_box);
+  }
+  *out = box;
+  return true;
+}
+
 }  // namespace sph

@@ -8,11 +8,13 @@
 
 #include <atomic>
 #include <memory>
+#include <mutex>
 #include <utility>
 #include <vector>
 
 #include "../physics/sdf_sampling.h"
 #include "host_memory.h"
+#include "voxel_box.h"
 
 namespace sph {
 
@@ -47,7 +49,14 @@ class SdfAsset {
 
   // Bumped on every change, so device copies know when to refresh.
   uint64_t version() const { return version_.load(); }
-  void touch() { version_.fetch_add(1); }
+  // A change of unknown extent: every voxel's distance may have changed.
+  void touch() { record_change(whole_grid()); }
+  // A change whose distances changed only within `distance_box` (empty: another channel's).
+  void record_change(const VoxelBox& distance_box);
+  // The box holding every distance changed since `version` (empty: none), or false when the
+  // changes since then are no longer all recorded (the last kChangesKept are).
+  bool distance_changed_since(uint64_t version, VoxelBox* out) const;
+  VoxelBox whole_grid() const;
   uint64_t uid() const { return uid_; }
   size_t bytes() const {
     return distance_.size() * sizeof(float) + velocity_.size() * sizeof(Vec3) +
@@ -64,6 +73,14 @@ class SdfAsset {
   HostVector<float> friction_;
   std::atomic<uint64_t> version_{1};
   uint64_t uid_;
+  // The last changes' distance boxes, by the version each made (a ring).
+  static constexpr int kChangesKept = 16;
+  struct Change {
+    uint64_t version = 0;
+    VoxelBox distance_box;
+  };
+  mutable std::mutex changes_mutex_;
+  Change changes_[kChangesKept];
 };
 
 // A new asset, the object and its grids from the allocator current on this thread (the engine's,

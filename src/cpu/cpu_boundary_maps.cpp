@@ -9,24 +9,28 @@
 
 namespace sph {
 
-SdfSlope sdf_slope(const SdfAsset& asset, const CpuParallel& parallel) {
+SdfSlopeMaxima sdf_slope_maxima(const SdfAsset& asset, const VoxelBox& voxels, const CpuParallel& parallel) {
   const SdfGridView g = asset.host_view();
   const size_t nx = static_cast<size_t>(g.nx), ny = static_cast<size_t>(g.ny), nz = static_cast<size_t>(g.nz);
   // A cell's lower corner runs over every voxel but the last along each axis that has more than one.
   const size_t cx = nx > 1 ? nx - 1 : 1, cy = ny > 1 ? ny - 1 : 1, cz = nz > 1 ? nz - 1 : 1;
   const size_t di = nx > 1 ? 1 : 0, dj = ny > 1 ? nx : 0, dk = nz > 1 ? nx * ny : 0;
-  struct Slopes {
-    double inside = 0.0;    // the largest squared index-space slope bound of a cell
-    double boundary = 0.0;  // the same over the cells on the grid's faces
-    bool finite = true;
-  };
-  const size_t rows = cy * cz;
-  HostVector<Slopes> per_block((rows + 15) / 16);
+  // The cells holding a voxel of the box: lower corners from a voxel below it to its last.
+  const size_t cells[3] = {cx, cy, cz};
+  size_t lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = voxels.lo[a] > 0 ? static_cast<size_t>(voxels.lo[a]) - 1 : 0;
+    hi[a] = std::min(cells[a], static_cast<size_t>(std::max(voxels.hi[a], 0)));
+    if (hi[a] <= lo[a]) return SdfSlopeMaxima{};
+  }
+  const size_t row_length = hi[1] - lo[1];
+  const size_t rows = row_length * (hi[2] - lo[2]);
+  HostVector<SdfSlopeMaxima> per_block((rows + 15) / 16);
   parallel.for_blocks(rows, 16, [&](size_t first, size_t last) {
-    Slopes s;
+    SdfSlopeMaxima s;
     for (size_t row = first; row < last; ++row) {
-      const size_t j = row % cy, k = row / cy;
-      for (size_t i = 0; i < cx; ++i) {
+      const size_t j = lo[1] + row % row_length, k = lo[2] + row / row_length;
+      for (size_t i = lo[0]; i < hi[0]; ++i) {
         const float* c = g.distance + i + nx * (j + ny * k);
         const float v[8] = {c[0], c[di], c[dj], c[dj + di], c[dk], c[dk + di], c[dk + dj], c[dk + dj + di]};
         // Along each axis the interpolant's slope is a mix of the cell's four edge differences.
@@ -46,12 +50,14 @@ SdfSlope sdf_slope(const SdfAsset& asset, const CpuParallel& parallel) {
     }
     per_block[first / 16] = s;
   });
-  Slopes all;
-  for (const Slopes& s : per_block) {
-    all.finite = all.finite && s.finite;
-    all.inside = std::fmax(all.inside, s.inside), all.boundary = std::fmax(all.boundary, s.boundary);
-  }
+  SdfSlopeMaxima all;
+  for (const SdfSlopeMaxima& s : per_block) all.add(s);
+  return all;
+}
+
+SdfSlope sdf_slope_from(const SdfAsset& asset, const SdfSlopeMaxima& all) {
   if (!all.finite) return SdfSlope{};
+  const SdfGridView g = asset.host_view();
   // Outside the grid the clamped axes' part of the slope is the extension's (min_voxel_size per
   // index step along the way out, whatever axes it splits over), the others a face cell's.
   const double extension = static_cast<double>(g.min_voxel_size);
@@ -75,13 +81,11 @@ SdfSlope sdf_slope(const SdfAsset& asset, const CpuParallel& parallel) {
   return slope;
 }
 
-namespace {
-
-VoxelBox whole_grid(const SdfAsset& asset) {
-  VoxelBox box;
-  box.hi[0] = asset.nx(), box.hi[1] = asset.ny(), box.hi[2] = asset.nz();
-  return box;
+SdfSlope sdf_slope(const SdfAsset& asset, const CpuParallel& parallel) {
+  return sdf_slope_from(asset, sdf_slope_maxima(asset, asset.whole_grid(), parallel));
 }
+
+namespace {
 
 // `box` grown by reach[a] voxels along each axis a, within the grid.
 VoxelBox grown(const VoxelBox& box, const int64_t reach[3], const SdfAsset& asset) {
@@ -114,47 +118,43 @@ void for_box(const SdfAsset& asset, const VoxelBox& box, size_t rows, const CpuP
 
 }  // namespace
 
-VoxelBox changed_voxels(const SdfAsset& asset, const HostVector<float>& before, const CpuParallel& parallel) {
+VoxelBox changed_voxels(const SdfAsset& asset, const HostVector<float>& before, const VoxelBox& within,
+                        const CpuParallel& parallel) {
+  const VoxelBox box = within.intersected(asset.whole_grid());
+  if (box.empty()) return VoxelBox{};
   const HostVector<float>& now = asset.distance();
   const size_t nx = static_cast<size_t>(asset.nx()), ny = static_cast<size_t>(asset.ny());
-  const size_t rows = ny * static_cast<size_t>(asset.nz());
+  const size_t row_length = static_cast<size_t>(box.hi[1] - box.lo[1]);
+  const size_t rows = row_length * static_cast<size_t>(box.hi[2] - box.lo[2]);
+  const size_t width = static_cast<size_t>(box.hi[0] - box.lo[0]);
   constexpr size_t kRows = 64;
   HostVector<VoxelBox> per_block((rows + kRows - 1) / kRows);
   parallel.for_blocks(rows, kRows, [&](size_t first, size_t last) {
     VoxelBox b;
     for (size_t row = first; row < last; ++row) {
-      const float* a = before.data() + nx * row;
-      const float* c = now.data() + nx * row;
-      if (std::memcmp(a, c, nx * sizeof(float)) == 0) continue;
-      int32_t lo = 0, hi = static_cast<int32_t>(nx);
+      const int32_t j = box.lo[1] + static_cast<int32_t>(row % row_length);
+      const int32_t k = box.lo[2] + static_cast<int32_t>(row / row_length);
+      const size_t start = static_cast<size_t>(box.lo[0]) + nx * (static_cast<size_t>(j) + ny * k);
+      const float* a = before.data() + start;
+      const float* c = now.data() + start;
+      if (std::memcmp(a, c, width * sizeof(float)) == 0) continue;
+      int32_t lo = 0, hi = static_cast<int32_t>(width);
       while (std::memcmp(a + lo, c + lo, sizeof(float)) == 0) ++lo;
       while (std::memcmp(a + hi - 1, c + hi - 1, sizeof(float)) == 0) --hi;
-      const int32_t j = static_cast<int32_t>(row % ny), k = static_cast<int32_t>(row / ny);
-      if (b.empty()) {
-        b.lo[0] = lo, b.hi[0] = hi, b.lo[1] = j, b.hi[1] = j + 1, b.lo[2] = k, b.hi[2] = k + 1;
-      } else {
-        b.lo[0] = std::min(b.lo[0], lo), b.hi[0] = std::max(b.hi[0], hi);
-        b.lo[1] = std::min(b.lo[1], j), b.hi[1] = std::max(b.hi[1], j + 1);
-        b.lo[2] = std::min(b.lo[2], k), b.hi[2] = std::max(b.hi[2], k + 1);
-      }
+      VoxelBox changed;
+      changed.lo[0] = box.lo[0] + lo, changed.hi[0] = box.lo[0] + hi;
+      changed.lo[1] = j, changed.hi[1] = j + 1, changed.lo[2] = k, changed.hi[2] = k + 1;
+      b = b.joined(changed);
     }
     per_block[first / kRows] = b;
   });
   VoxelBox all;
-  for (const VoxelBox& b : per_block) {
-    if (b.empty()) continue;
-    if (all.empty()) {
-      all = b;
-      continue;
-    }
-    for (int a = 0; a < 3; ++a)
-      all.lo[a] = std::min(all.lo[a], b.lo[a]), all.hi[a] = std::max(all.hi[a], b.hi[a]);
-  }
+  for (const VoxelBox& b : per_block) all = all.joined(b);
   return all;
 }
 
 VoxelBox update_boundary_map(const SdfAsset& asset, float h, float level, const CpuParallel& parallel,
-                             const VoxelBox& changed, HostVector<Float4>& map) {
+                             const VoxelBox& changed, SdfSlope slope, HostVector<Float4>& map) {
   if (changed.empty()) return VoxelBox{};
   const SdfGridView g = asset.host_view();
   const Affine3x4 index_to_local = asset.index_to_local();
@@ -172,7 +172,6 @@ VoxelBox update_boundary_map(const SdfAsset& asset, float h, float level, const 
     reach[a] = voxels < 1e9 ? static_cast<int64_t>(voxels) : int64_t{1000000000};
   }
   const VoxelBox values = grown(changed, reach, asset);
-  const SdfSlope slope = sdf_slope(asset, parallel);
   // One (j, k) row of voxels per item, four rows a block: the band's rows cost far more than the
   // rest, so small blocks go out on demand.
   for_box(asset, values, 4, parallel, [&](int32_t i, int32_t j, int32_t k, size_t v) {
@@ -192,7 +191,7 @@ VoxelBox update_boundary_map(const SdfAsset& asset, float h, float level, const 
 HostVector<Float4> compute_boundary_map(const SdfAsset& asset, float h, float level,
                                         const CpuParallel& parallel) {
   HostVector<Float4> map(asset.voxel_count(), Float4{0.0f, 0.0f, 0.0f, 0.0f});
-  update_boundary_map(asset, h, level, parallel, whole_grid(asset), map);
+  update_boundary_map(asset, h, level, parallel, asset.whole_grid(), sdf_slope(asset, parallel), map);
   return map;
 }
 
@@ -200,27 +199,48 @@ const Float4* CpuBoundaryMaps::bind(const SdfAsset& asset, float h, float level,
                                     const CpuParallel& parallel) {
   Entry& e = entries_[std::make_pair(asset.uid(), level)];
   e.last_frame = frame_;
-  if (e.version == asset.version() && e.kernel_radius == h && e.correction.size() == asset.voxel_count())
+  const uint64_t voxels = asset.voxel_count();
+  if (e.version == asset.version() && e.kernel_radius == h && e.correction.size() == voxels)
     return e.correction.data();
+  const uint64_t version = asset.version();
+  const VoxelBox whole = asset.whole_grid();
   // A map of this h that was complete (version 0 marks one whose computation failed) for other
-  // values of the same asset (an asset's dims and transform never change).
-  const bool stale = e.version != 0 && e.kernel_radius == h && e.correction.size() == asset.voxel_count();
+  // values of the same asset (an asset's dims and transform never change): what changed since.
+  VoxelBox changed = whole;
+  const bool stale = e.version != 0 && e.kernel_radius == h && e.correction.size() == voxels;
+  if (stale && !asset.distance_changed_since(e.version, &changed)) changed = whole;
+  if (stale && e.computed_from.size() == voxels)
+    changed = changed_voxels(asset, e.computed_from, changed, parallel);
   e.version = 0;  // until the map below is complete
-  if (stale && e.computed_from.size() == asset.voxel_count()) {
-    voxels_computed_ += update_boundary_map(asset, h, level, parallel,
-                                            changed_voxels(asset, e.computed_from, parallel), e.correction)
-                            .voxels();
-  } else {
+  if (!stale) {
     e.computed_from.clear();
-    e.correction = compute_boundary_map(asset, h, level, parallel);
-    voxels_computed_ += asset.voxel_count();
-    ++builds_;
+    e.correction.assign(voxels, Float4{0.0f, 0.0f, 0.0f, 0.0f});
   }
-  // The asset changes (a deforming collider, a terrain being dug): keep what this map was made
-  // from, so that the next change recomputes only what it reaches.
-  if (stale) e.computed_from = asset.distance();
+  if (changed.voxels() == voxels) {
+    e.slope = sdf_slope_maxima(asset, whole, parallel);
+    ++builds_;
+  } else {
+    e.slope.add(sdf_slope_maxima(asset, changed, parallel));
+  }
+  voxels_computed_ +=
+      update_boundary_map(asset, h, level, parallel, changed, sdf_slope_from(asset, e.slope), e.correction)
+          .voxels();
+  // Keep the distances in step (only the changed box differs), or start keeping them when more
+  // than half the grid changed at once (an asset re-sent whole: the next comparison narrows it).
+  if (e.computed_from.size() == voxels) {
+    const size_t nx = static_cast<size_t>(asset.nx()), ny = static_cast<size_t>(asset.ny());
+    for (int32_t k = changed.lo[2]; k < changed.hi[2]; ++k)
+      for (int32_t j = changed.lo[1]; j < changed.hi[1]; ++j) {
+        const size_t start = static_cast<size_t>(changed.lo[0]) + nx * (static_cast<size_t>(j) + ny * k);
+        std::copy(asset.distance().begin() + start,
+                  asset.distance().begin() + start + static_cast<size_t>(changed.hi[0] - changed.lo[0]),
+                  e.computed_from.begin() + start);
+      }
+  } else if (stale && changed.voxels() > voxels / 2) {
+    e.computed_from = asset.distance();
+  }
   e.kernel_radius = h;
-  e.version = asset.version();
+  e.version = version;
   return e.correction.data();
 }
 

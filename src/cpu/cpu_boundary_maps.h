@@ -3,10 +3,12 @@
 // src/physics/boundary_map.h): one map per SDF asset the world's colliders use, computed on host
 // threads for the world's kernel radius when a collider first steps with the asset and again
 // after every change of it (SdfAsset::version: sph_sdf_update), and dropped when no collider uses
-// the asset any more (the twin of cuda/device_boundary_maps.h). From an asset's second change on,
-// a map keeps the distances it was computed from and recomputes only the voxels within reach of
-// those that changed (a terrain dug in one place, a velocity-only update: none), with the bits a
-// whole recomputation gives.
+// the asset any more (the twin of cuda/device_boundary_maps.h). After a change a map recomputes
+// only the voxels within reach of the box the change touched (the asset records each change's box:
+// a terrain dug in one place recomputes the dig's reach, a velocity-only update nothing), with the
+// bits a whole recomputation gives; a map whose asset is sent whole (a deforming body re-sent
+// every frame) keeps the distances it was computed from and narrows that box to the voxels whose
+// value changed.
 #pragma once
 
 #include <stdint.h>
@@ -18,10 +20,24 @@
 
 #include "../core/host_memory.h"
 #include "../core/sdf_asset.h"
+#include "../core/voxel_box.h"
 #include "../physics/float4_types.h"
 #include "cpu_parallel.h"
 
 namespace sph {
+
+// What sdf_slope takes from the cells' values (below): the largest squared index-space slope bound
+// of a cell, the same over the cells on the grid's faces, and whether every value was finite.
+struct SdfSlopeMaxima {
+  double inside = 0.0;
+  double boundary = 0.0;
+  bool finite = true;
+  void add(const SdfSlopeMaxima& o) {
+    inside = inside > o.inside ? inside : o.inside;
+    boundary = boundary > o.boundary ? boundary : o.boundary;
+    finite = finite && o.finite;
+  }
+};
 
 class CpuBoundaryMaps {
  public:
@@ -31,10 +47,10 @@ class CpuBoundaryMaps {
   // `parallel`'s workers when new or stale.
   const Float4* bind(const SdfAsset& asset, float h, float level, const CpuParallel& parallel);
   void end_frame();
-  // 16 bytes per voxel of every map held, and 4 more for a changing asset's (computed_from).
+  // 16 bytes per voxel of every map held, and 4 more for a map that keeps its distances.
   uint64_t bytes() const;
-  // Maps computed since the backend was made (tests: a changed asset recomputes, an unchanged
-  // one does not), and the voxels whose correction was computed (a partial update counts its box).
+  // Whole maps computed since the backend was made (tests: a changed asset recomputes, an
+  // unchanged one does not), and the voxels whose correction was computed (a part counts its box).
   uint64_t builds() const { return builds_; }
   uint64_t voxels_computed() const { return voxels_computed_; }
 
@@ -44,8 +60,10 @@ class CpuBoundaryMaps {
     float kernel_radius = 0.0f;
     uint64_t last_frame = 0;
     HostVector<Float4> correction;
-    // The distances `correction` was computed from, kept once the asset has changed (a static
-    // asset's map never needs them); empty otherwise.
+    // What the slope bound of `correction`'s rays was made from (every cell's, or more).
+    SdfSlopeMaxima slope;
+    // The distances `correction` was computed from, kept once a change of more than half the grid
+    // came (a body re-sent whole every frame: the next comparison finds what moved); else empty.
     HostVector<float> computed_from;
   };
   using Key = std::pair<uint64_t, float>;
@@ -56,19 +74,10 @@ class CpuBoundaryMaps {
   uint64_t voxels_computed_ = 0;
 };
 
-// A box of voxels, [lo, hi) along each index axis; empty when any hi <= lo.
-struct VoxelBox {
-  int32_t lo[3] = {0, 0, 0};
-  int32_t hi[3] = {0, 0, 0};
-  bool empty() const { return !(hi[0] > lo[0] && hi[1] > lo[1] && hi[2] > lo[2]); }
-  uint64_t voxels() const {
-    return empty() ? 0 : static_cast<uint64_t>(hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
-  }
-};
-
-// The smallest box holding every voxel whose distance differs, bit for bit, between `before`
-// (the asset's voxel count of values) and the asset's distances now.
-VoxelBox changed_voxels(const SdfAsset& asset, const HostVector<float>& before, const CpuParallel& parallel);
+// The smallest box holding every voxel of `within` whose distance differs, bit for bit, between
+// `before` (the asset's voxel count of values) and the asset's distances now.
+VoxelBox changed_voxels(const SdfAsset& asset, const HostVector<float>& before, const VoxelBox& within,
+                        const CpuParallel& parallel);
 
 // The map of an asset for kernel radius h and SDF level `level` (every voxel; zero outside the band
 // |phi - level| < h), on `parallel`'s workers. Exposed for tests, which compare it with a
@@ -79,9 +88,10 @@ HostVector<Float4> compute_boundary_map(const SdfAsset& asset, float h, float le
 // up to date after the distances in `changed` were changed: recomputes the corrections of the
 // voxels within reach of `changed` (a voxel's rays reach h, its normal and flat share a voxel more)
 // and the slopes of those and their neighbours; the others keep theirs, which do not depend on the
-// changed values. The same bits as compute_boundary_map. Returns the box whose corrections it computed.
+// changed values. slope: a bound for the asset's values now (the rays' skip; any valid bound gives
+// the same bits). The same bits as compute_boundary_map. Returns the box whose corrections it computed.
 VoxelBox update_boundary_map(const SdfAsset& asset, float h, float level, const CpuParallel& parallel,
-                             const VoxelBox& changed, HostVector<Float4>& map);
+                             const VoxelBox& changed, SdfSlope slope, HostVector<Float4>& map);
 
 // A bound on the slope of the asset's sample_distance along any local direction, from its values:
 // the trilinear interpolant's slope along an index axis is a mix of the differences of
@@ -92,5 +102,11 @@ VoxelBox update_boundary_map(const SdfAsset& asset, float h, float level, const 
 // non-finite value gives none (0). compute_boundary_map uses it to skip ray samples that cannot
 // reach the solid (boundary_map.h, integrate_rays); exposed for tests.
 SdfSlope sdf_slope(const SdfAsset& asset, const CpuParallel& parallel);
+// sdf_slope in two parts: the cells' maxima over the cells that hold a voxel of `voxels` (maxima
+// of any cells combine by SdfSlopeMaxima::add, so after a change in a box a map adds that box's
+// cells to what it had: the bound may then exceed the whole grid's, never fall below it), and the
+// bound from maxima.
+SdfSlopeMaxima sdf_slope_maxima(const SdfAsset& asset, const VoxelBox& voxels, const CpuParallel& parallel);
+SdfSlope sdf_slope_from(const SdfAsset& asset, const SdfSlopeMaxima& maxima);
 
 }  // namespace sph

@@ -6,13 +6,16 @@
 // axis is not the same):
 //   - changed_voxels finds exactly the bounding box of the voxels whose distance changed;
 //   - the update gives the map a whole recomputation gives, bit for bit (every channel of every
-//     voxel), for a dent inside the grid and one against its faces;
+//     voxel), for a dent inside the grid and one against its faces, with the slope bound the cache
+//     uses (the old cells' maxima and the changed box's cells', at least the whole grid's bound);
 //   - the claim it rests on, checked directly against two whole computations: every voxel outside
 //     the box the update recomputed keeps its correction, and outside that box grown by one its
 //     slopes; and the update's reach is needed: some voxels outside the changed box but inside the
 //     recomputed one do change (so a reach of zero would fail the comparison above);
-//   - the cache: an asset's first change recomputes the whole map, the next ones only their boxes
-//     (voxels_computed), a velocity-only change none, and the map is the whole computation's.
+//   - the cache: a change's recorded box recomputes its reach (the asset's first change too), a
+//     velocity-only change nothing, a change of unknown extent the whole map, after which the map
+//     keeps its distances and narrows a whole-grid change to what moved; the map is always the
+//     whole computation's; and the asset's record of its changes.
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -130,7 +133,6 @@ sph::VoxelBox dent(sph::SdfAsset& a, const int32_t centre[3], float radius) {
           box.lo[ax] = std::min(box.lo[ax], at[ax]), box.hi[ax] = std::max(box.hi[ax], at[ax] + 1);
       }
   assert_true(any);
-  a.touch();
   return box;
 }
 
@@ -138,14 +140,21 @@ sph::VoxelBox dent(sph::SdfAsset& a, const int32_t centre[3], float radius) {
 void check_dent(sph::SdfAsset& asset, float level, const int32_t centre[3], float radius, const char* name) {
   const sph::HostVector<sph::Float4> before = sph::compute_boundary_map(asset, kH, level, kWorkers);
   const sph::HostVector<float> distances = asset.distance();
+  sph::SdfSlopeMaxima maxima = sph::sdf_slope_maxima(asset, asset.whole_grid(), kWorkers);
   const sph::VoxelBox expected = dent(asset, centre, radius);
-  const sph::VoxelBox changed = sph::changed_voxels(asset, distances, kWorkers);
+  const sph::VoxelBox changed = sph::changed_voxels(asset, distances, asset.whole_grid(), kWorkers);
   for (int a = 0; a < 3; ++a) {
     assert_int_equal(changed.lo[a], expected.lo[a]);
     assert_int_equal(changed.hi[a], expected.hi[a]);
   }
+  // The bound the cache uses: the old cells' maxima and the changed box's cells' (at least the
+  // whole grid's now).
+  maxima.add(sph::sdf_slope_maxima(asset, changed, kWorkers));
+  const sph::SdfSlope slope = sph::sdf_slope_from(asset, maxima);
+  assert_true(slope.bound >= sph::sdf_slope(asset, kWorkers).bound);
   sph::HostVector<sph::Float4> updated = before;
-  const sph::VoxelBox recomputed = sph::update_boundary_map(asset, kH, level, kWorkers, changed, updated);
+  const sph::VoxelBox recomputed =
+      sph::update_boundary_map(asset, kH, level, kWorkers, changed, slope, updated);
   const sph::HostVector<sph::Float4> after = sph::compute_boundary_map(asset, kH, level, kWorkers);
   size_t differing = 0, kept_wrongly = 0, moved_outside = 0, reached = 0;
   for (int32_t k = 0; k < asset.nz(); ++k)
@@ -196,43 +205,83 @@ void test_sheared_grid(void**) {
   check_dent(*asset, -0.01f, side, 0.02f, "rippled ball, sheared");
 }
 
-// The cache: the first change recomputes all, later ones their reach, a velocity-only change nothing.
+// The cache, against whole computations: a change's recorded box recomputes its reach (the first
+// change too), a velocity-only change nothing, a change of unknown extent (touch) the whole map and
+// from then on the map keeps its distances, so that a later whole-grid change is narrowed to what
+// moved; more changes than the asset records between two steps recompute the whole map.
 void test_cache(void**) {
   const auto asset = tank();
   const float level = 0.007f;
   sph::CpuBoundaryMaps maps;
+  const sph::Float4* map = nullptr;
   auto frame = [&]() {
     maps.begin_frame();
-    const sph::Float4* map = maps.bind(*asset, kH, level, kWorkers);
+    map = maps.bind(*asset, kH, level, kWorkers);
     maps.end_frame();
-    return map;
+  };
+  auto expect_whole_map = [&]() {
+    const sph::HostVector<sph::Float4> whole = sph::compute_boundary_map(*asset, kH, level, kWorkers);
+    assert_int_equal(std::memcmp(map, whole.data(), whole.size() * sizeof(sph::Float4)), 0);
   };
   frame();
   const uint64_t voxels = asset->voxel_count();
   assert_int_equal(maps.builds(), 1);
   assert_int_equal(maps.voxels_computed(), voxels);
   assert_int_equal(maps.bytes(), voxels * sizeof(sph::Float4));
+  uint64_t computed = voxels;
+
   const int32_t a[3] = {asset->nx() / 2, 4, asset->nz() / 2}, b[3] = {4, asset->ny() / 2, 4};
-  dent(*asset, a, 0.015f);
-  frame();  // the first change: no distances kept to compare with, the whole map
-  assert_int_equal(maps.builds(), 2);
-  assert_int_equal(maps.voxels_computed(), 2 * voxels);
-  assert_int_equal(maps.bytes(), voxels * (sizeof(sph::Float4) + sizeof(float)));
-  dent(*asset, b, 0.01f);
-  const sph::Float4* map = frame();
-  assert_int_equal(maps.builds(), 2);
-  const uint64_t partial = maps.voxels_computed() - 2 * voxels;
-  std::printf("cache: %llu voxels, the second change recomputed %llu\n",
-              static_cast<unsigned long long>(voxels), static_cast<unsigned long long>(partial));
-  assert_true(partial > 0 && partial < voxels / 2);
-  const sph::HostVector<sph::Float4> whole = sph::compute_boundary_map(*asset, kH, level, kWorkers);
-  assert_int_equal(std::memcmp(map, whole.data(), voxels * sizeof(sph::Float4)), 0);
-  // A change of the velocity channel alone (version bumped, distances the same): nothing recomputed.
-  asset->touch();
+  asset->record_change(dent(*asset, a, 0.015f));  // as sph_sdf_update records its box
   frame();
+  const uint64_t first = maps.voxels_computed() - computed;
+  computed += first;
+  std::printf("cache: %llu voxels; a recorded dent recomputed %llu\n",
+              static_cast<unsigned long long>(voxels), static_cast<unsigned long long>(first));
+  assert_int_equal(maps.builds(), 1);
+  assert_true(first > 0 && first < voxels / 2);
+  assert_int_equal(maps.bytes(), voxels * sizeof(sph::Float4));  // no distances kept
+  expect_whole_map();
+
+  asset->record_change(sph::VoxelBox{});  // the velocity or friction channel
+  frame();
+  assert_int_equal(maps.voxels_computed(), computed);
+  assert_int_equal(maps.builds(), 1);
+
+  asset->touch();  // unknown extent: the whole map, and the distances kept from now on
+  frame();
+  computed += voxels;
+  assert_int_equal(maps.voxels_computed(), computed);
   assert_int_equal(maps.builds(), 2);
-  assert_int_equal(maps.voxels_computed(), 2 * voxels + partial);
-  // Another kernel radius: the whole map, and no distances kept until that map's asset changes.
+  assert_int_equal(maps.bytes(), voxels * (sizeof(sph::Float4) + sizeof(float)));
+
+  dent(*asset, b, 0.01f);
+  asset->record_change(asset->whole_grid());  // the whole grid re-sent, one dent in it
+  frame();
+  const uint64_t narrowed = maps.voxels_computed() - computed;
+  computed += narrowed;
+  std::printf("cache: the whole grid re-sent with one dent recomputed %llu\n",
+              static_cast<unsigned long long>(narrowed));
+  assert_int_equal(maps.builds(), 2);
+  assert_true(narrowed > 0 && narrowed < voxels / 2);
+  expect_whole_map();
+
+  // More changes than the asset records, each a small box, between two steps: the whole map (the
+  // kept distances narrow it only when they are kept; a fresh cache here keeps none).
+  sph::CpuBoundaryMaps fresh;
+  fresh.begin_frame();
+  fresh.bind(*asset, kH, level, kWorkers);
+  fresh.end_frame();
+  for (int change = 0; change < 17; ++change) {
+    const int32_t at[3] = {6 + change, 6, 6};
+    asset->record_change(dent(*asset, at, 0.004f));
+  }
+  fresh.begin_frame();
+  map = fresh.bind(*asset, kH, level, kWorkers);
+  fresh.end_frame();
+  assert_int_equal(fresh.builds(), 2);
+  expect_whole_map();
+
+  // Another kernel radius: the whole map, and no distances kept until it changes.
   maps.begin_frame();
   maps.bind(*asset, 0.03f, level, kWorkers);
   maps.end_frame();
@@ -240,14 +289,38 @@ void test_cache(void**) {
   assert_int_equal(maps.bytes(), voxels * sizeof(sph::Float4));
 }
 
+// The asset's record of its changes (SdfAsset::distance_changed_since).
+void test_change_record(void**) {
+  const auto asset = solid_box();
+  const uint64_t v0 = asset->version();
+  sph::VoxelBox box;
+  assert_true(asset->distance_changed_since(v0, &box));
+  assert_true(box.empty());
+  sph::VoxelBox one, two;
+  one.lo[0] = 1, one.lo[1] = 2, one.lo[2] = 3, one.hi[0] = 4, one.hi[1] = 5, one.hi[2] = 6;
+  two.lo[0] = 10, two.lo[1] = 0, two.lo[2] = 4, two.hi[0] = 11, two.hi[1] = 1, two.hi[2] = 9;
+  asset->record_change(one);
+  asset->record_change(sph::VoxelBox{});
+  asset->record_change(two);
+  assert_int_equal(asset->version(), v0 + 3);
+  assert_true(asset->distance_changed_since(v0, &box));
+  const int32_t lo[3] = {1, 0, 3}, hi[3] = {11, 5, 9};
+  for (int a = 0; a < 3; ++a) assert_true(box.lo[a] == lo[a] && box.hi[a] == hi[a]);
+  assert_true(asset->distance_changed_since(v0 + 1, &box));
+  for (int a = 0; a < 3; ++a) assert_true(box.lo[a] == two.lo[a] && box.hi[a] == two.hi[a]);
+  for (int change = 0; change < 16; ++change) asset->record_change(sph::VoxelBox{});
+  assert_false(asset->distance_changed_since(v0, &box));  // 19 changes ago: no longer all recorded
+  assert_true(asset->distance_changed_since(v0 + 3, &box));
+  assert_true(box.empty());
+  assert_false(asset->distance_changed_since(asset->version() + 1, &box));  // a version not reached
+}
+
 }  // namespace
 
 int main() {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_tank),
-      cmocka_unit_test(test_solid_box),
-      cmocka_unit_test(test_sheared_grid),
-      cmocka_unit_test(test_cache),
+      cmocka_unit_test(test_tank),  cmocka_unit_test(test_solid_box),     cmocka_unit_test(test_sheared_grid),
+      cmocka_unit_test(test_cache), cmocka_unit_test(test_change_record),
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);
 }

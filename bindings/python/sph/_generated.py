@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'e9bdd3aa3396b58a9e7b5377e362598f0685fc43b1c5960364fd6908c514d704', 'include/sph_cuda.h': '10c29a1a1f3946f310c4a23105ed7fb70ffea9fa1a9eee03d59ab41a55b122b9', 'include/sph_mpi.h': '874c27d442b57c1afcf7bef1d57f602681dcc63634995dedcc2a1290615e064c', 'include/sph_vdb.h': '256d341729fa5ee56f09a7349d822c42a134d4a948ac22870a64546345e3e434'}
+HEADERS = {'include/sph_c.h': '67dc8ad1a775ed5b7e4743cd8e4e9ecf24380be81cc4c705179159ce27f326ec', 'include/sph_cuda.h': '10c29a1a1f3946f310c4a23105ed7fb70ffea9fa1a9eee03d59ab41a55b122b9', 'include/sph_mpi.h': '874c27d442b57c1afcf7bef1d57f602681dcc63634995dedcc2a1290615e064c', 'include/sph_vdb.h': '256d341729fa5ee56f09a7349d822c42a134d4a948ac22870a64546345e3e434'}
 VERSION = (0, 2, 0)
 VERSION_STRING = "0.2.0"
 ABI_VERSION = 0
@@ -59,9 +59,9 @@ SPH_FEATURE_SPRINGS = 4
 #: (48-77 % low without). Edges and corners read high when a lattice is placed into them
 #: (docs/physics.md). The maps are computed per asset and kernel radius when a collider first steps
 #: with the asset and after sph_sdf_update of its distances (16 bytes per SDF voxel; on the device
-#: for CUDA; the CPU recomputes, from an asset's second change on, only the voxels within reach of
-#: those that changed, keeping 4 bytes more per voxel). The collision response stays the no-
-#: penetration safeguard. Costs one SDF sample per particle and collider in each density pass.
+#: for CUDA; the CPU recomputes only the voxels within reach of the updated box). The collision
+#: response stays the no-penetration safeguard. Costs one SDF sample per particle and collider in
+#: each density pass.
 SPH_FEATURE_BOUNDARY_DENSITY = 8
 #: Loads on colliders: the force and torque of the fluid on each collider over every step
 #: (sph_collider_get_loads): the collision response's contact impulses and, with
@@ -2300,7 +2300,7 @@ FUNCTIONS = {
     'sph_sdf_create_from_mesh': (sph_result, (_c.POINTER(sph_context), _c.POINTER(sph_mesh_desc), _c.POINTER(_c.POINTER(sph_sdf))), ('context', 'desc', 'out'),
         "Builds an SDF asset from a triangle mesh (the arrays are read during the call, not kept): a grid of voxel_size over the mesh's bounds plus padding, axis-aligned, voxel (0, 0, 0) centred at the bounds' minimum corner less padding_voxels voxels (index_to_local is a scale by voxel_size and that translation); exact distances to the nearest triangle within band_width voxels of the surface, the nearest triangle swept outward beyond; negative inside by the generalised winding number. Host memory only; no OpenVDB needed. Blocking; costs about (triangles * (2 band_width + 1)^3 + voxels) distance evaluations. Thread-safe with respect to other SDF calls on the context. Errors: INVALID_ARGUMENT (NULL arrays, counts, an index out of range, a non-finite vertex, a size out of range, reserved0, a grid (bounds plus padding) reaching past +-3.4e38 or over 1.7e38 across, where float distances overflow, a voxel_size whose inverse overflows float), CAPACITY (more than 2^31 voxels: a larger voxel_size is needed), OUT_OF_HOST_MEMORY.", 'sph'),
     'sph_sdf_update': (sph_result, (_c.POINTER(sph_sdf), sph_sdf_channel, _c.POINTER(_c.c_uint32), _c.POINTER(_c.c_uint32), _c.POINTER(_c.c_float), sph_memory_kind), ('sdf', 'channel', 'origin', 'size', 'data', 'memory'),
-        "Overwrites the box [origin, origin + size) of one channel with data (size[0] * size[1] * size[2] * components floats, i fastest, copied). Updating the velocity or friction channel of an asset created without it creates it (zero elsewhere). Do not update an asset while a world that uses it is inside sph_world_step on another thread. With SPH_FEATURE_BOUNDARY_DENSITY a change of the distances makes the next step recompute the asset's boundary map: on the CPU backend, from the asset's second change on, only the voxels within a kernel radius of those whose value changed (a dug terrain pays for the dig alone; a velocity-only update for nothing), on CUDA the whole map. Errors: INVALID_ARGUMENT (box outside the grid, NULL or non-finite data), UNSUPPORTED (unknown channel or memory).", 'sph'),
+        "Overwrites the box [origin, origin + size) of one channel with data (size[0] * size[1] * size[2] * components floats, i fastest, copied). Updating the velocity or friction channel of an asset created without it creates it (zero elsewhere). Do not update an asset while a world that uses it is inside sph_world_step on another thread. With SPH_FEATURE_BOUNDARY_DENSITY a change of the distances makes the next step recompute the asset's boundary map: on the CPU backend only the voxels within about a kernel radius of the box (send the box that changed: a dug terrain then pays for the dig alone; an asset re-sent whole every frame is compared with the last values, 4 bytes a voxel, to find what moved; a velocity or friction update costs nothing), on CUDA the whole map. Errors: INVALID_ARGUMENT (box outside the grid, NULL or non-finite data), UNSUPPORTED (unknown channel or memory).", 'sph'),
     'sph_sdf_get_dims': (sph_result, (_c.POINTER(sph_sdf), _c.POINTER(_c.c_uint32)), ('sdf', 'out_dims'),
         'Grid dimensions of an asset.', 'sph'),
     'sph_sdf_sample': (sph_result, (_c.POINTER(sph_sdf), sph_vec3, _c.POINTER(_c.c_float)), ('sdf', 'local_point', 'out_distance'),
