@@ -2311,7 +2311,9 @@ namespace Sph
         }
 
         /// <summary>Overwrites the box [origin, origin + size) of one channel (i fastest; 3
-        /// floats per voxel for velocity). Updating a channel the asset lacks creates it.</summary>
+        /// floats per voxel for velocity). Updating a channel the asset lacks creates it. With
+        /// the walls in the density, send only the box that changed: the CPU backend's next step
+        /// recomputes only that box's reach of the asset's boundary map.</summary>
         public void Update(SdfChannel channel, uint[] origin, uint[] size, float[] data)
         {
             // The library reads size[0] * size[1] * size[2] * components floats from data, and

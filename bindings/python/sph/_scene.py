@@ -251,7 +251,9 @@ class Sdf:
     def update(self, channel, data, origin=(0, 0, 0), *, memory="host", size=None):
         """Overwrites a box of one channel starting at grid index origin (i, j, k) with data
         of shape (sk, sj, si) or, for the velocity channel, (sk, sj, si, 3) (sph_sdf_update).
-        Updating a channel the asset lacks creates it.
+        Updating a channel the asset lacks creates it. With the walls in the density, send only
+        the box that changed: the CPU backend's next step recomputes only that box's reach of the
+        asset's boundary map.
 
         memory="cuda" (MemoryKind.CUDA_DEVICE; CUDA contexts only): data is a device address of
         the context's device (an int, or an object with ``__cuda_array_interface__``: its data
