@@ -177,13 +177,17 @@ class Program {
     }
     return sdfs_[*slot].ptr;
   }
-  // An id: one of this kind's (maybe destroyed, maybe of another world), null, or random bits.
+  // An id: one of this kind's (maybe destroyed, maybe of another world), null, random bits, or
+  // one of this kind's with another world tag (the same object's slot and generation: what a
+  // world whose ids ignored their tag would take for its own; expect_foreign_id_refused).
   uint64_t id_arg(IdSlot* ids) {
     switch (in_.u8() % 8) {
       case 0:
         return 0;
       case 1:
         return in_.u64();
+      case 2:
+        return ids[in_.u8() % kIds].bits ^ (static_cast<uint64_t>(in_.u8() | 1u) << 16);
       default:
         return ids[in_.u8() % kIds].bits;
     }
