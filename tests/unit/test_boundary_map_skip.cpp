@@ -32,6 +32,7 @@ extern "C" {
 #include "core/sdf_shapes.h"
 #include "cpu/cpu_boundary_maps.h"
 #include "physics/boundary_map.h"
+#include "rippled_ball.h"
 
 namespace {
 
@@ -45,44 +46,6 @@ std::shared_ptr<sph::SdfAsset> shape(sph::ShapeKind kind, float voxel) {
   s.voxel_size = voxel;
   if (kind == sph::ShapeKind::Box && voxel > 0.006f) s.wall_thickness = 0.02f, s.open_top = true;
   return sph::build_shape_sdf(s, 1u << 22);
-}
-
-// Not a distance: 2.5 times a ball's distance plus a ripple, on a grid rotated about (1, 2, 3),
-// sheared, with voxels of 4, 5 and 6 mm.
-std::shared_ptr<sph::SdfAsset> rippled_ball() {
-  const double angle = 0.7, n[3] = {1.0 / std::sqrt(14.0), 2.0 / std::sqrt(14.0), 3.0 / std::sqrt(14.0)};
-  const double c = std::cos(angle), s = std::sin(angle);
-  double rotation[3][3];
-  for (int r = 0; r < 3; ++r)
-    for (int k = 0; k < 3; ++k) {
-      const double cross = r == k ? 0.0 : ((r + 1) % 3 == k ? -n[3 - r - k] : n[3 - r - k]);
-      rotation[r][k] = (r == k ? c : 0.0) + (1.0 - c) * n[r] * n[k] + s * cross;
-    }
-  const double scale[3] = {0.004, 0.005, 0.006}, shear = 0.3;
-  sph::Affine3x4 to_local{};
-  const int n_axis[3] = {24, 20, 18};
-  for (int r = 0; r < 3; ++r) {
-    for (int k = 0; k < 3; ++k) {
-      const double column = rotation[r][k] * scale[k] + (k == 1 ? shear * rotation[r][0] * scale[0] : 0.0);
-      to_local.m[4 * r + k] = static_cast<float>(column);
-    }
-    // Centre the grid on the local origin.
-    double centre = 0.0;
-    for (int k = 0; k < 3; ++k) centre += static_cast<double>(to_local.m[4 * r + k]) * 0.5 * (n_axis[k] - 1);
-    to_local.m[4 * r + 3] = static_cast<float>(-centre);
-  }
-  auto asset = std::make_shared<sph::SdfAsset>(n_axis[0], n_axis[1], n_axis[2], to_local);
-  for (int k = 0; k < n_axis[2]; ++k)
-    for (int j = 0; j < n_axis[1]; ++j)
-      for (int i = 0; i < n_axis[0]; ++i) {
-        const sph::Vec3 p = sph::apply_affine(
-            to_local, sph::Vec3{static_cast<float>(i), static_cast<float>(j), static_cast<float>(k)});
-        const double r = std::sqrt(static_cast<double>(p.x) * p.x + static_cast<double>(p.y) * p.y +
-                                   static_cast<double>(p.z) * p.z);
-        asset->distance()[static_cast<size_t>(i) + n_axis[0] * (j + static_cast<size_t>(n_axis[1]) * k)] =
-            static_cast<float>(2.5 * (r - 0.03) + 0.002 * std::sin(300.0 * p.x));
-      }
-  return asset;
 }
 
 // The bound against random pairs of nearby points; returns the largest slope seen over L.
@@ -169,7 +132,8 @@ void test_distances(void** state) {
 
 void test_not_a_distance(void** state) {
   (void)state;
-  const auto asset = rippled_ball();
+  const int dims[3] = {24, 20, 18};
+  const auto asset = rippled_ball(dims, 0.03);
   check_bound(*asset, "rippled ball, sheared grid");
   check_same_map(*asset, -0.01f);
   check_same_map(*asset, 0.01f);

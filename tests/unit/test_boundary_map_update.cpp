@@ -33,6 +33,7 @@ extern "C" {
 #include "core/sdf_shapes.h"
 #include "cpu/cpu_boundary_maps.h"
 #include "physics/boundary_map.h"
+#include "rippled_ball.h"
 
 namespace {
 
@@ -55,43 +56,6 @@ std::shared_ptr<sph::SdfAsset> solid_box() {
   s.half_extents = sph::Vec3{0.07f, 0.05f, 0.06f};
   s.voxel_size = 0.0055f;
   return sph::build_shape_sdf(s, 1u << 22);
-}
-
-// Not a distance: 2.5 times a ball's distance plus a ripple, on a grid rotated about (1, 2, 3),
-// sheared, with voxels of 4, 5 and 6 mm (as test_boundary_map_skip's, larger).
-std::shared_ptr<sph::SdfAsset> rippled_ball() {
-  const double angle = 0.7, n[3] = {1.0 / std::sqrt(14.0), 2.0 / std::sqrt(14.0), 3.0 / std::sqrt(14.0)};
-  const double c = std::cos(angle), s = std::sin(angle);
-  double rotation[3][3];
-  for (int r = 0; r < 3; ++r)
-    for (int k = 0; k < 3; ++k) {
-      const double cross = r == k ? 0.0 : ((r + 1) % 3 == k ? -n[3 - r - k] : n[3 - r - k]);
-      rotation[r][k] = (r == k ? c : 0.0) + (1.0 - c) * n[r] * n[k] + s * cross;
-    }
-  const double scale[3] = {0.004, 0.005, 0.006}, shear = 0.3;
-  sph::Affine3x4 to_local{};
-  const int n_axis[3] = {40, 32, 28};
-  for (int r = 0; r < 3; ++r) {
-    for (int k = 0; k < 3; ++k) {
-      const double column = rotation[r][k] * scale[k] + (k == 1 ? shear * rotation[r][0] * scale[0] : 0.0);
-      to_local.m[4 * r + k] = static_cast<float>(column);
-    }
-    double centre = 0.0;
-    for (int k = 0; k < 3; ++k) centre += static_cast<double>(to_local.m[4 * r + k]) * 0.5 * (n_axis[k] - 1);
-    to_local.m[4 * r + 3] = static_cast<float>(-centre);
-  }
-  auto asset = std::make_shared<sph::SdfAsset>(n_axis[0], n_axis[1], n_axis[2], to_local);
-  for (int k = 0; k < n_axis[2]; ++k)
-    for (int j = 0; j < n_axis[1]; ++j)
-      for (int i = 0; i < n_axis[0]; ++i) {
-        const sph::Vec3 p = sph::apply_affine(
-            to_local, sph::Vec3{static_cast<float>(i), static_cast<float>(j), static_cast<float>(k)});
-        const double r = std::sqrt(static_cast<double>(p.x) * p.x + static_cast<double>(p.y) * p.y +
-                                   static_cast<double>(p.z) * p.z);
-        asset->distance()[static_cast<size_t>(i) + n_axis[0] * (j + static_cast<size_t>(n_axis[1]) * k)] =
-            static_cast<float>(2.5 * (r - 0.045) + 0.002 * std::sin(300.0 * p.x));
-      }
-  return asset;
 }
 
 size_t voxel_index(const sph::SdfAsset& a, int32_t i, int32_t j, int32_t k) {
@@ -200,7 +164,8 @@ void test_solid_box(void**) {
 }
 
 void test_sheared_grid(void**) {
-  const auto asset = rippled_ball();
+  const int dims[3] = {40, 32, 28};
+  const auto asset = rippled_ball(dims, 0.045);
   const int32_t side[3] = {asset->nx() - 8, asset->ny() / 2, asset->nz() / 2};
   check_dent(*asset, -0.01f, side, 0.02f, "rippled ball, sheared");
 }
