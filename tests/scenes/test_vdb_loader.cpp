@@ -118,12 +118,58 @@ void test_loader_errors(void**) {
   std::remove(path.c_str());
 }
 
+// A file cut short anywhere (a copy interrupted, a cache still being written) is refused with
+// one clear message and no asset. io::File went on past the end with the offsets and lengths it
+// had failed to read: 91 bytes of this sphere (the end of the grid's type name) made it allocate
+// gigabytes without end.
+void test_truncated_files(void**) {
+  const std::string path = temp_path("whole.vdb"), cut = temp_path("cut.vdb");
+  write_sphere(path);
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  assert_non_null(f);
+  std::string bytes;
+  char buffer[4096];
+  for (size_t n; (n = std::fread(buffer, 1, sizeof buffer, f)) > 0;) bytes.append(buffer, n);
+  std::fclose(f);
+  assert_true(bytes.size() > 1000);
+
+  sph_context* context = nullptr;
+  assert_int_equal(sph_test_context_create(&context), SPH_OK);
+  int cuts = 0;
+  // Every length through the header and the grid's descriptor, then every 97th.
+  for (size_t length = 0; length < bytes.size(); length += length < 400 ? 1 : 97) {
+    std::FILE* o = std::fopen(cut.c_str(), "wb");
+    assert_non_null(o);
+    assert_int_equal(std::fwrite(bytes.data(), 1, length, o), length);
+    std::fclose(o);
+    sph_sdf* sdf = nullptr;
+    const sph_result r = sph_vdb_load_sdf(context, cut.c_str(), nullptr, &sdf);
+    if (r != SPH_ERROR_INVALID_ARGUMENT || !std::strstr(sph_vdb_get_last_error(), "ends early"))
+      fail_msg("%zu of %zu bytes: result %d, \"%s\"", length, bytes.size(), static_cast<int>(r),
+               sph_vdb_get_last_error());
+    assert_null(sdf);
+    ++cuts;
+  }
+  assert_true(cuts > 700);
+  // The whole file still loads.
+  std::FILE* o = std::fopen(cut.c_str(), "wb");
+  assert_int_equal(std::fwrite(bytes.data(), 1, bytes.size(), o), bytes.size());
+  std::fclose(o);
+  sph_sdf* sdf = nullptr;
+  assert_int_equal(sph_vdb_load_sdf(context, cut.c_str(), nullptr, &sdf), SPH_OK);
+  assert_int_equal(sph_sdf_destroy(sdf), SPH_OK);
+  assert_int_equal(sph_context_destroy(context), SPH_OK);
+  std::remove(path.c_str());
+  std::remove(cut.c_str());
+}
+
 }  // namespace
 
 int main() {
   const CMUnitTest tests[] = {
       cmocka_unit_test(test_level_set_round_trip),
       cmocka_unit_test(test_loader_errors),
+      cmocka_unit_test(test_truncated_files),
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
