@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Loads an OpenVDB level set into a dense SDF asset through the public C API. OpenVDB stays in
 // this library (libsph_vdb); libsph never sees it.
-#include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
 #include <sys/stat.h>
 
@@ -10,12 +9,12 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
-#include <fstream>
 #include <mutex>
 #include <string>
 #include <vector>
 
 #include "sph_vdb.h"
+#include "vdb_read_grids.h"
 
 namespace {
 
@@ -80,36 +79,9 @@ SPH_API sph_result SPH_CALL sph_vdb_load_sdf(sph_context* context, const char* p
                     "without end)");
   try {
     initialize_openvdb();
-    // OpenVDB reads the file through this stream, which throws at the first read that comes up
-    // short. OpenVDB checks few of its reads: in a file cut short after a grid's descriptor
-    // (91 bytes of a sphere) io::File went on with the offsets and string lengths it failed to
-    // read, and allocated gigabytes without end. io::Stream reads every grid in order and
-    // loads no grid lazily (delayLoad false), so nothing is memory-mapped either: OpenVDB's
-    // delayed loading trusts a file's "file_delayed_load" metadata, indexing its mask table with
-    // the leaf count without a bounds check, and a file truncated by someone else later would
-    // raise SIGBUS on a read of the mapping.
-    std::ifstream stream(path, std::ios::in | std::ios::binary);
-    if (!stream)
-      return fail(SPH_ERROR_INVALID_ARGUMENT,
-                  std::string("path: cannot open '") + path + "' (" + std::strerror(errno) + ")");
-    openvdb::GridPtrVecPtr grids;
-    try {
-      stream.exceptions(std::ios::failbit | std::ios::badbit);
-      grids = openvdb::io::Stream(stream, /*delayLoad=*/false).getGrids();
-    } catch (const std::bad_alloc&) {
-      throw;
-    } catch (const std::exception& e) {
-      // libstdc++'s own ios_base::failure may not match a catch of it (GCC bug 66145), so the
-      // stream's state tells a short read from OpenVDB's errors.
-      if (stream.fail() || stream.bad())
-        return fail(SPH_ERROR_INVALID_ARGUMENT,
-                    std::string("path: cannot read '") + path +
-                        "' as a VDB file: it ends early (a truncated file, or not "
-                        "a VDB file)");
-      return fail(SPH_ERROR_INVALID_ARGUMENT,
-                  std::string("path: cannot read '") + path + "' as a VDB file (" + e.what() + ")");
-    }
     std::string error;
+    const openvdb::GridPtrVecPtr grids = sph_io::read_vdb_grids(path, &error);
+    if (!grids) return fail(SPH_ERROR_INVALID_ARGUMENT, "path: " + error);
     openvdb::FloatGrid::Ptr grid = find_level_set(grids, grid_name, error);
     if (!grid) return fail(SPH_ERROR_INVALID_ARGUMENT, error);
     if (!grid->transform().isLinear())
