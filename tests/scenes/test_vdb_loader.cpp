@@ -114,6 +114,16 @@ void test_loader_errors(void**) {
   assert_int_equal(sph_vdb_load_sdf(context, path.c_str(), nullptr, &sdf), SPH_ERROR_INVALID_ARGUMENT);
   assert_null(sdf);
   assert_int_equal(sph_vdb_load_sdf(context, path.c_str(), "sphere", &sdf), SPH_ERROR_INVALID_ARGUMENT);
+  // A level set with no active voxels (sph-run's surface of a frame without particles).
+  openvdb::FloatGrid::Ptr empty = openvdb::FloatGrid::create(0.03f);
+  empty->setGridClass(openvdb::GRID_LEVEL_SET);
+  empty->setName("surface");
+  openvdb::io::File file(path);
+  file.write(openvdb::GridPtrVec{empty});
+  file.close();
+  assert_int_equal(sph_vdb_load_sdf(context, path.c_str(), nullptr, &sdf), SPH_ERROR_INVALID_ARGUMENT);
+  assert_non_null(std::strstr(sph_vdb_get_last_error(), "no active voxels"));
+  assert_null(sdf);
   assert_int_equal(sph_context_destroy(context), SPH_OK);
   std::remove(path.c_str());
 }
