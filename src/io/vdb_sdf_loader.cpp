@@ -51,8 +51,20 @@ openvdb::FloatGrid::Ptr find_level_set(const openvdb::GridPtrVecPtr& grids, cons
     }
     return grid;
   }
+  // Say what the file holds: a distance field saved with class "unknown", a fog volume or a
+  // particle file given by mistake is then plain to see.
+  std::string held;
+  for (const openvdb::GridBase::Ptr& base : *grids) {
+    if (held.size() > 400) {
+      held += ", ...";
+      break;
+    }
+    held += std::string(held.empty() ? "" : ", ") + "'" + base->getName() + "' (" + base->valueType() + ", " +
+            openvdb::GridBase::gridClassToString(base->getGridClass()) + ")";
+  }
   error = grid_name && grid_name[0] ? std::string("grid_name: no grid named '") + grid_name + "'"
                                     : std::string("path: the file holds no float level set");
+  error += held.empty() ? std::string(" (it holds no grids)") : " (it holds " + held + ")";
   return nullptr;
 }
 

@@ -114,6 +114,19 @@ void test_loader_errors(void**) {
   assert_int_equal(sph_vdb_load_sdf(context, path.c_str(), nullptr, &sdf), SPH_ERROR_INVALID_ARGUMENT);
   assert_null(sdf);
   assert_int_equal(sph_vdb_load_sdf(context, path.c_str(), "sphere", &sdf), SPH_ERROR_INVALID_ARGUMENT);
+  // A fog volume alone: the message says what the file holds.
+  openvdb::FloatGrid::Ptr fog = openvdb::FloatGrid::create(0.0f);
+  fog->setGridClass(openvdb::GRID_FOG_VOLUME);
+  fog->setName("density");
+  {
+    openvdb::io::File file(path);
+    file.write(openvdb::GridPtrVec{fog});
+  }
+  assert_int_equal(sph_vdb_load_sdf(context, path.c_str(), nullptr, &sdf), SPH_ERROR_INVALID_ARGUMENT);
+  assert_non_null(
+      std::strstr(sph_vdb_get_last_error(), "no float level set (it holds 'density' (float, fog volume))"));
+  assert_int_equal(sph_vdb_load_sdf(context, path.c_str(), "sphere", &sdf), SPH_ERROR_INVALID_ARGUMENT);
+  assert_non_null(std::strstr(sph_vdb_get_last_error(), "no grid named 'sphere' (it holds 'density'"));
   // A level set with no active voxels (sph-run's surface of a frame without particles).
   openvdb::FloatGrid::Ptr empty = openvdb::FloatGrid::create(0.03f);
   empty->setGridClass(openvdb::GRID_LEVEL_SET);
