@@ -118,8 +118,9 @@ SPH_API sph_result SPH_CALL sph_vdb_load_sdf(sph_context* context, const char* p
     box.expand(1);
     const openvdb::Coord dim = box.dim();
     if (voxels > 2147483648.0)
-      return fail(SPH_ERROR_CAPACITY,
-                  "the dense grid would have " + std::to_string(voxels) + " voxels (over 2^31)");
+      return fail(SPH_ERROR_CAPACITY, "the dense grid would have " +
+                                          std::to_string(static_cast<uint64_t>(voxels)) +
+                                          " voxels (over 2^31)");
 
     std::vector<float> dense(static_cast<size_t>(voxels));
     openvdb::FloatGrid::ConstAccessor access = grid->getConstAccessor();

@@ -127,6 +127,18 @@ void test_loader_errors(void**) {
       std::strstr(sph_vdb_get_last_error(), "no float level set (it holds 'density' (float, fog volume))"));
   assert_int_equal(sph_vdb_load_sdf(context, path.c_str(), "sphere", &sdf), SPH_ERROR_INVALID_ARGUMENT);
   assert_non_null(std::strstr(sph_vdb_get_last_error(), "no grid named 'sphere' (it holds 'density'"));
+  // Two voxels 2000 apart: a dense grid of 2003^3 voxels, over 2^31, counted in whole voxels.
+  openvdb::FloatGrid::Ptr far = openvdb::FloatGrid::create(0.3f);
+  far->setGridClass(openvdb::GRID_LEVEL_SET);
+  far->tree().setValue(openvdb::Coord(0, 0, 0), -0.1f);
+  far->tree().setValue(openvdb::Coord(2000, 2000, 2000), 0.1f);
+  {
+    openvdb::io::File file(path);
+    file.write(openvdb::GridPtrVec{far});
+  }
+  assert_int_equal(sph_vdb_load_sdf(context, path.c_str(), nullptr, &sdf), SPH_ERROR_CAPACITY);
+  assert_non_null(std::strstr(sph_vdb_get_last_error(), "would have 8036054027 voxels (over 2^31)"));
+  assert_null(sdf);
   // A level set with no active voxels (sph-run's surface of a frame without particles).
   openvdb::FloatGrid::Ptr empty = openvdb::FloatGrid::create(0.03f);
   empty->setGridClass(openvdb::GRID_LEVEL_SET);
