@@ -87,6 +87,12 @@ void test_level_set_round_trip(void**) {
     assert_true(std::fabs(d - static_cast<float>((w - openvdb::Vec3d(0.3, -0.2, 0.05)).length() - 0.1)) <
                 5e-4f);
   }
+  // Deeper inside than the band (3 voxels, 0.015 m), as the header says: the background, flat.
+  for (const float depth : {0.03f, 0.06f, 0.1f}) {
+    float d = 0.0f;
+    assert_int_equal(sph_sdf_sample(sdf, sph_vec3{0.3f, -0.2f + (0.1f - depth), 0.05f}, &d), SPH_OK);
+    assert_float_equal(d, -grid->background(), 1e-7f);
+  }
   assert_int_equal(sph_sdf_destroy(sdf), SPH_OK);
   assert_int_equal(sph_context_destroy(context), SPH_OK);
   std::remove(path.c_str());
