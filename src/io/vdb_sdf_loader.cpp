@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -127,7 +128,20 @@ SPH_API sph_result SPH_CALL sph_vdb_load_sdf(sph_context* context, const char* p
     size_t at = 0;
     for (int k = 0; k < dim.z(); ++k)
       for (int j = 0; j < dim.y(); ++j)
-        for (int i = 0; i < dim.x(); ++i) dense[at++] = access.getValue(box.min() + openvdb::Coord(i, j, k));
+        for (int i = 0; i < dim.x(); ++i) {
+          const openvdb::Coord ijk = box.min() + openvdb::Coord(i, j, k);
+          const float value = access.getValue(ijk);
+          // Named here by the file's own voxel: sph_sdf_create would name an index of our copy.
+          if (!std::isfinite(value)) {
+            const openvdb::Vec3d w = grid->indexToWorld(ijk);
+            char where[160];
+            std::snprintf(where, sizeof where, "voxel (%d, %d, %d) at (%g, %g, %g)", ijk.x(), ijk.y(),
+                          ijk.z(), w.x(), w.y(), w.z());
+            return fail(SPH_ERROR_INVALID_ARGUMENT, "the level set's value at " + std::string(where) +
+                                                        " is not finite (" + std::to_string(value) + ")");
+          }
+          dense[at++] = value;
+        }
 
     // OpenVDB maps index to world with row vectors: world = (i, j, k, 1) * M. Our dense index
     // (i, j, k) is the VDB index box.min() + (i, j, k).

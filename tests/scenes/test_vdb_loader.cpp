@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <string>
 
 extern "C" {
@@ -144,6 +145,17 @@ void test_loader_errors(void**) {
   }
   assert_int_equal(sph_vdb_load_sdf(context, path.c_str(), nullptr, &sdf), SPH_ERROR_CAPACITY);
   assert_non_null(std::strstr(sph_vdb_get_last_error(), "would have 8036054027 voxels (over 2^31)"));
+  assert_null(sdf);
+  // A non-finite distance is named by the file's voxel and its world position.
+  openvdb::FloatGrid::Ptr bad = write_sphere(path);
+  bad->tree().setValueOn(openvdb::Coord(80, -40, 10), std::numeric_limits<float>::quiet_NaN());
+  {
+    openvdb::io::File file(path);
+    file.write(openvdb::GridPtrVec{bad});
+  }
+  assert_int_equal(sph_vdb_load_sdf(context, path.c_str(), nullptr, &sdf), SPH_ERROR_INVALID_ARGUMENT);
+  assert_non_null(std::strstr(sph_vdb_get_last_error(),
+                              "value at voxel (80, -40, 10) at (0.4, -0.2, 0.05) is not finite"));
   assert_null(sdf);
   // A level set with no active voxels (sph-run's surface of a frame without particles).
   openvdb::FloatGrid::Ptr empty = openvdb::FloatGrid::create(0.03f);
