@@ -306,7 +306,7 @@ void test_special_input_files_are_scene_errors(void**) {
 // A level-set file cut short (a copy interrupted, a cache still being written): OpenVDB's
 // io::File went on past its end with offsets and lengths it had failed to read, and sph-run
 // (the preview's bounds, then sph_vdb_load_sdf) allocated gigabytes without end. Now a scene
-// error that names the file, at once.
+// error that names the file, at once; so is a file whose delayed-load metadata lies.
 void test_truncated_level_set_is_a_scene_error(void**) {
 #ifndef CLI_TEST_NO_OPENVDB
   const std::string dir = cli_test::make_temp_dir("cutvdb");
@@ -325,6 +325,14 @@ void test_truncated_level_set_is_a_scene_error(void**) {
   assert_int_equal(run({scene, "--out", dir + "/out2", "--backend", "cpu", "--frames", "0"}, &output, 60), 3);
   assert_true(contains(output, "cut.vdb' as a VDB file: it ends early"));
   assert_true(std::chrono::steady_clock::now() - t0 < std::chrono::seconds(20));
+  // fuzz_vdb's delayed-load regression (its selector byte dropped): the preview's bounds read it
+  // with io::File's delayed loading, whose mask-table assertion aborted sph-run (status 134).
+  const std::string planted =
+      cli_test::read_text(g_scenes + "/../../fuzz/regressions/vdb/delayed-load-mask-index-assert.vdb");
+  assert_true(planted.size() > 1);
+  cli_test::write_text(dir + "/cut.vdb", planted.substr(1));
+  assert_int_equal(run({scene, "--out", dir + "/out3", "--backend", "cpu", "--frames", "0"}, &output, 60), 3);
+  assert_true(contains(output, "cut.vdb"));
 #endif
 }
 
