@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "sph_vdb.h"
+#include "vdb_read_grids.h"
 
 namespace {
 
@@ -29,8 +31,8 @@ void initialize_openvdb() {
   std::call_once(once, [] { openvdb::initialize(); });
 }
 
-openvdb::FloatGrid::Ptr find_level_set(openvdb::io::File& file, const char* grid_name, std::string& error) {
-  openvdb::GridPtrVecPtr grids = file.getGrids();
+openvdb::FloatGrid::Ptr find_level_set(const openvdb::GridPtrVecPtr& grids, const char* grid_name,
+                                       std::string& error) {
   for (const openvdb::GridBase::Ptr& base : *grids) {
     if (grid_name && grid_name[0] && base->getName() != grid_name) continue;
     openvdb::FloatGrid::Ptr grid = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
@@ -50,8 +52,20 @@ openvdb::FloatGrid::Ptr find_level_set(openvdb::io::File& file, const char* grid
     }
     return grid;
   }
+  // Say what the file holds: a distance field saved with class "unknown", a fog volume or a
+  // particle file given by mistake is then plain to see.
+  std::string held;
+  for (const openvdb::GridBase::Ptr& base : *grids) {
+    if (held.size() > 400) {
+      held += ", ...";
+      break;
+    }
+    held += std::string(held.empty() ? "" : ", ") + "'" + base->getName() + "' (" + base->valueType() + ", " +
+            openvdb::GridBase::gridClassToString(base->getGridClass()) + ")";
+  }
   error = grid_name && grid_name[0] ? std::string("grid_name: no grid named '") + grid_name + "'"
                                     : std::string("path: the file holds no float level set");
+  error += held.empty() ? std::string(" (it holds no grids)") : " (it holds " + held + ")";
   return nullptr;
 }
 
@@ -78,21 +92,10 @@ SPH_API sph_result SPH_CALL sph_vdb_load_sdf(sph_context* context, const char* p
                     "without end)");
   try {
     initialize_openvdb();
-    openvdb::io::File file(path);
-    try {
-      // No delayed loading: every voxel is read now anyway (into the dense grid), and OpenVDB's
-      // delayed-load path trusts the file's "file_delayed_load" metadata, indexing its mask table
-      // with the leaf count without a bounds check (an assertion, i.e. abort(), in Debian's
-      // libopenvdb; a read past the table otherwise) and leaves file data memory-mapped, where
-      // a file truncated by someone else would raise SIGBUS on a later read.
-      file.open(/*delayLoad=*/false);
-    } catch (const std::exception& e) {
-      return fail(SPH_ERROR_INVALID_ARGUMENT,
-                  std::string("path: cannot open '") + path + "' as a VDB file (" + e.what() + ")");
-    }
     std::string error;
-    openvdb::FloatGrid::Ptr grid = find_level_set(file, grid_name, error);
-    file.close();
+    const openvdb::GridPtrVecPtr grids = sph_io::read_vdb_grids(path, &error);
+    if (!grids) return fail(SPH_ERROR_INVALID_ARGUMENT, "path: " + error);
+    openvdb::FloatGrid::Ptr grid = find_level_set(grids, grid_name, error);
     if (!grid) return fail(SPH_ERROR_INVALID_ARGUMENT, error);
     if (!grid->transform().isLinear())
       return fail(SPH_ERROR_INVALID_ARGUMENT,
@@ -116,15 +119,29 @@ SPH_API sph_result SPH_CALL sph_vdb_load_sdf(sph_context* context, const char* p
     box.expand(1);
     const openvdb::Coord dim = box.dim();
     if (voxels > 2147483648.0)
-      return fail(SPH_ERROR_CAPACITY,
-                  "the dense grid would have " + std::to_string(voxels) + " voxels (over 2^31)");
+      return fail(SPH_ERROR_CAPACITY, "the dense grid would have " +
+                                          std::to_string(static_cast<uint64_t>(voxels)) +
+                                          " voxels (over 2^31)");
 
     std::vector<float> dense(static_cast<size_t>(voxels));
     openvdb::FloatGrid::ConstAccessor access = grid->getConstAccessor();
     size_t at = 0;
     for (int k = 0; k < dim.z(); ++k)
       for (int j = 0; j < dim.y(); ++j)
-        for (int i = 0; i < dim.x(); ++i) dense[at++] = access.getValue(box.min() + openvdb::Coord(i, j, k));
+        for (int i = 0; i < dim.x(); ++i) {
+          const openvdb::Coord ijk = box.min() + openvdb::Coord(i, j, k);
+          const float value = access.getValue(ijk);
+          // Named here by the file's own voxel: sph_sdf_create would name an index of our copy.
+          if (!std::isfinite(value)) {
+            const openvdb::Vec3d w = grid->indexToWorld(ijk);
+            char where[160];
+            std::snprintf(where, sizeof where, "voxel (%d, %d, %d) at (%g, %g, %g)", ijk.x(), ijk.y(),
+                          ijk.z(), w.x(), w.y(), w.z());
+            return fail(SPH_ERROR_INVALID_ARGUMENT, "the level set's value at " + std::string(where) +
+                                                        " is not finite (" + std::to_string(value) + ")");
+          }
+          dense[at++] = value;
+        }
 
     // OpenVDB maps index to world with row vectors: world = (i, j, k, 1) * M. Our dense index
     // (i, j, k) is the VDB index box.min() + (i, j, k).

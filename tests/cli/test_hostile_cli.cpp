@@ -303,6 +303,39 @@ void test_special_input_files_are_scene_errors(void**) {
 #endif
 }
 
+// A level-set file cut short (a copy interrupted, a cache still being written): OpenVDB's
+// io::File went on past its end with offsets and lengths it had failed to read, and sph-run
+// (the preview's bounds, then sph_vdb_load_sdf) allocated gigabytes without end. Now a scene
+// error that names the file, at once; so is a file whose delayed-load metadata lies.
+void test_truncated_level_set_is_a_scene_error(void**) {
+#ifndef CLI_TEST_NO_OPENVDB
+  const std::string dir = cli_test::make_temp_dir("cutvdb");
+  std::vector<std::string> args = tiny(dir + "/out", "0", "none");
+  args.push_back("--surface");
+  std::string output;
+  assert_int_equal(run(args, &output), 0);
+  const std::string whole = cli_test::read_text(dir + "/out/surface_0000.vdb");
+  // Cut just after the grid's type name, before its offsets.
+  const size_t at = whole.find("Tree_float_5_4_3");
+  assert_true(at != std::string::npos);
+  cli_test::write_text(dir + "/cut.vdb", whole.substr(0, at + 16));
+  const std::string scene = dir + "/cut.json";
+  cli_test::write_text(scene, R"({"colliders": [{"shape": {"type": "vdb", "file": "cut.vdb"}}]})");
+  const auto t0 = std::chrono::steady_clock::now();
+  assert_int_equal(run({scene, "--out", dir + "/out2", "--backend", "cpu", "--frames", "0"}, &output, 60), 3);
+  assert_true(contains(output, "cut.vdb' as a VDB file: it ends early"));
+  assert_true(std::chrono::steady_clock::now() - t0 < std::chrono::seconds(20));
+  // fuzz_vdb's delayed-load regression (its selector byte dropped): the preview's bounds read it
+  // with io::File's delayed loading, whose mask-table assertion aborted sph-run (status 134).
+  const std::string planted =
+      cli_test::read_text(g_scenes + "/../../fuzz/regressions/vdb/delayed-load-mask-index-assert.vdb");
+  assert_true(planted.size() > 1);
+  cli_test::write_text(dir + "/cut.vdb", planted.substr(1));
+  assert_int_equal(run({scene, "--out", dir + "/out3", "--backend", "cpu", "--frames", "0"}, &output, 60), 3);
+  assert_true(contains(output, "cut.vdb"));
+#endif
+}
+
 // ---- item 8: --stats-json that cannot be written ------------------------------------------
 void test_unwritable_stats_json_fails(void**) {
   const std::string out = cli_test::make_temp_dir("stats");
@@ -373,6 +406,7 @@ int main(int argc, char** argv) {
       cmocka_unit_test(test_earlier_run_tables_are_replaced),
       cmocka_unit_test(test_repeated_format_is_refused),
       cmocka_unit_test(test_special_input_files_are_scene_errors),
+      cmocka_unit_test(test_truncated_level_set_is_a_scene_error),
       cmocka_unit_test(test_unwritable_stats_json_fails),
       cmocka_unit_test(test_file_size_limit_is_an_error),
       cmocka_unit_test(test_runtime_scene_values_are_scene_errors),

@@ -33,7 +33,7 @@ void write_seed(const std::string& path, uint8_t selector, openvdb::GridPtrVec g
 
 openvdb::FloatGrid::Ptr sphere(const char* name, float radius, float voxel, float half_width) {
   auto grid = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
-      radius, openvdb::Vec3f(0.01f, 0.0f, -0.02f), voxel, half_width);
+      radius, openvdb::Vec3f(0.15f, 0.15f, 0.15f), voxel, half_width);
   grid->setName(name);
   return grid;
 }
@@ -48,10 +48,10 @@ int main(int argc, char** argv) {
   openvdb::initialize();
   const std::string dir = argv[1];
   // 0: the first float level set (grid_name NULL), active-mask compression only.
-  write_seed(dir + "/sphere_active_mask.vdb", 0, {sphere("ls", 0.05f, 0.04f, 1.5f)},
+  write_seed(dir + "/sphere_active_mask.vdb", 0, {sphere("ls", 0.08f, 0.04f, 1.5f)},
              openvdb::io::COMPRESS_ACTIVE_MASK);
   // 2: grid "ls" by name, zip and active-mask compression (OpenVDB's usual file).
-  write_seed(dir + "/sphere_zip.vdb", 2, {sphere("ls", 0.05f, 0.04f, 1.5f)},
+  write_seed(dir + "/sphere_zip.vdb", 2, {sphere("ls", 0.08f, 0.04f, 1.5f)},
              openvdb::io::COMPRESS_ZIP | openvdb::io::COMPRESS_ACTIVE_MASK);
   // 3: "sphere" after a fog volume (not a level set) and a vector grid, which are skipped.
   auto fog = openvdb::FloatGrid::create(0.0f);
@@ -61,12 +61,12 @@ int main(int argc, char** argv) {
   auto vec = openvdb::Vec3SGrid::create();
   vec->setName("v");
   vec->tree().setValue(openvdb::Coord(0, 0, 0), openvdb::Vec3s(1.0f, 0.0f, 0.0f));
-  write_seed(dir + "/three_grids.vdb", 3, {fog, vec, sphere("sphere", 0.05f, 0.04f, 1.5f)},
+  write_seed(dir + "/three_grids.vdb", 3, {fog, vec, sphere("sphere", 0.08f, 0.04f, 1.5f)},
              openvdb::io::COMPRESS_ACTIVE_MASK);
   // 4: "density" asked for by name: a float grid that is not a level set (an error).
   write_seed(dir + "/fog_by_name.vdb", 4, {fog}, openvdb::io::COMPRESS_ACTIVE_MASK);
   // 1: a rotated, scaled transform.
-  auto turned = sphere("ls", 0.05f, 0.04f, 1.5f);
+  auto turned = sphere("ls", 0.08f, 0.04f, 1.5f);
   openvdb::math::Transform::Ptr xform = openvdb::math::Transform::createLinearTransform(0.04);
   xform->preRotate(0.5, openvdb::math::Y_AXIS);
   turned->setTransform(xform);

@@ -7,6 +7,9 @@
 
 #include <cmath>
 #include <mutex>
+#include <string>
+
+#include "vdb_read_grids.h"
 #endif
 
 namespace sph_tools {
@@ -22,17 +25,20 @@ void fill_one(ShapeDesc* shape) {
   static std::once_flag once;
   std::call_once(once, [] { openvdb::initialize(); });
   try {
-    openvdb::io::File file(shape->vdb_file);
-    file.open();
+    // The file is read as sph_vdb_load_sdf reads it (a file cut short is an error, not a
+    // runaway read); this is before the world is built, so the same file reaches the loader next.
+    std::string error;
+    const openvdb::GridPtrVecPtr grids = sph_io::read_vdb_grids(shape->vdb_file, &error);
+    if (!grids) return;
     openvdb::FloatGrid::Ptr grid;
-    for (auto it = file.beginName(); it != file.endName() && !grid; ++it) {
-      if (!shape->vdb_grid.empty() && it.gridName() != shape->vdb_grid) continue;
-      openvdb::FloatGrid::Ptr candidate =
-          openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(it.gridName()));
-      if (candidate && (!shape->vdb_grid.empty() || candidate->getGridClass() == openvdb::GRID_LEVEL_SET))
+    for (const openvdb::GridBase::Ptr& base : *grids) {
+      if (!shape->vdb_grid.empty() && base->getName() != shape->vdb_grid) continue;
+      openvdb::FloatGrid::Ptr candidate = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
+      if (candidate && (!shape->vdb_grid.empty() || candidate->getGridClass() == openvdb::GRID_LEVEL_SET)) {
         grid = candidate;
+        break;
+      }
     }
-    file.close();
     if (!grid) return;
     const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
     if (box.empty()) return;
