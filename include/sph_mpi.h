@@ -153,8 +153,9 @@ SPH_API sph_result SPH_CALL sph_mpi_world_get_counts(const sph_world* world, sph
  * COLLECTIVE. Gathers every rank's particles onto rank `root`, ordered by id: positions and
  * velocities (3 x float32 each, packed) and ids (uint32), each array NULL to skip it. On root
  * the arrays hold `capacity` particles; *out_count (may be NULL) gets the world's count there
- * (0 elsewhere); other ranks pass NULL arrays. Errors: INVALID_ARGUMENT (root out of range;
- * on root, capacity below the world's count), UNSUPPORTED (not a distributed world). A rank's
+ * (0 elsewhere); other ranks pass NULL arrays. Errors: INVALID_ARGUMENT (root out of range or
+ * not the same on every rank: every rank refuses; on root, capacity below the world's count),
+ * UNSUPPORTED (not a distributed world). A rank's
  * own particles read with sph_world_copy_attribute, without the others.
  */
 SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t root, float* positions,
@@ -167,7 +168,8 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t
  * order. On root: writes up to `capacity` ids, sets *out_count to the world's number of removed
  * ids and returns SPH_INCOMPLETE when capacity was too small (call again, collectively, with a
  * larger array); other ranks may pass NULL ids, capacity 0 and a NULL out_count. Errors:
- * INVALID_ARGUMENT (root out of range; on root, a NULL out_count, or NULL ids with capacity > 0),
+ * INVALID_ARGUMENT (root out of range or not the same on every rank: every rank refuses; on root,
+ * a NULL out_count, or NULL ids with capacity > 0),
  * UNSUPPORTED (not a distributed world).
  */
 SPH_API sph_result SPH_CALL sph_mpi_world_gather_removed_ids(const sph_world* world, int32_t root,

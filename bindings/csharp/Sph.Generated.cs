@@ -3683,9 +3683,10 @@ namespace Sph
         /// COLLECTIVE. Gathers every rank's particles onto rank `root`, ordered by id: positions and
         /// velocities (3 x float32 each, packed) and ids (uint32), each array NULL to skip it. On root
         /// the arrays hold `capacity` particles; *out_count (may be NULL) gets the world's count there
-        /// (0 elsewhere); other ranks pass NULL arrays. Errors: INVALID_ARGUMENT (root out of range; on
-        /// root, capacity below the world's count), UNSUPPORTED (not a distributed world). A rank's own
-        /// particles read with sph_world_copy_attribute, without the others.
+        /// (0 elsewhere); other ranks pass NULL arrays. Errors: INVALID_ARGUMENT (root out of range or
+        /// not the same on every rank: every rank refuses; on root, capacity below the world's count),
+        /// UNSUPPORTED (not a distributed world). A rank's own particles read with
+        /// sph_world_copy_attribute, without the others.
         /// </summary>
         [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_mpi_world_gather(WorldHandle world, int root, ref float positions, ref float velocities, [In, Out] uint[] ids, ulong capacity, out ulong outCount);
@@ -3698,8 +3699,9 @@ namespace Sph
         /// ascending order. On root: writes up to `capacity` ids, sets *out_count to the world's number
         /// of removed ids and returns SPH_INCOMPLETE when capacity was too small (call again,
         /// collectively, with a larger array); other ranks may pass NULL ids, capacity 0 and a NULL
-        /// out_count. Errors: INVALID_ARGUMENT (root out of range; on root, a NULL out_count, or NULL
-        /// ids with capacity &gt; 0), UNSUPPORTED (not a distributed world).
+        /// out_count. Errors: INVALID_ARGUMENT (root out of range or not the same on every rank: every
+        /// rank refuses; on root, a NULL out_count, or NULL ids with capacity &gt; 0), UNSUPPORTED (not
+        /// a distributed world).
         /// </summary>
         [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_mpi_world_gather_removed_ids(WorldHandle world, int root, [In, Out] uint[] ids, uint capacity, out uint outCount);

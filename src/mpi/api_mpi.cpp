@@ -28,6 +28,18 @@ void require_root(const RankTransport& ranks, int32_t root) {
                 "root: must be a rank of the world's communicator, got " + std::to_string(root));
 }
 
+// COLLECTIVE. A gather's root, the same on every rank: ranks that named different roots would
+// each wait in MPI_Gather for messages sent to another root (a hang), so they all refuse instead.
+void require_same_root(const RankTransport& ranks, int32_t root) {
+  const int64_t mine = root;
+  bool same = true;
+  compare_over_ranks(ranks, &mine, 1, &same);
+  if (!same)
+    throw Error(Status::InvalidArgument,
+                "root: this rank's " + std::to_string(root) +
+                    " differs from another rank's: every rank must pass the same root");
+}
+
 constexpr uint32_t kDefaultRebalancePercent = 20;
 constexpr uint32_t kMaxRebalancePercent = 10000;
 
@@ -203,7 +215,6 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t
     sph::require_world(world);
     sph::WorldLock lock(world, sph::WorldLock::kAgreeDeviceLoss);
     const sph::RankTransport& ranks = sph::ranks_of(world);
-    sph::require_root(ranks, root);
     struct Record {
       uint32_t id;
       float x[3], v[3];
@@ -215,6 +226,7 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t
     // was lost before the call) must not leave the others waiting in the gather.
     sph::agreed(ranks, [&] {
       sph::WorldLock::require_device_not_lost(world);
+      sph::require_root(ranks, root);
       mine.resize(n);
       if (n > 0) {
         b.copy_attribute(sph::AttributeKind::Id, 0, n, &mine[0].id, sizeof(Record));
@@ -222,6 +234,7 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t
         b.copy_attribute(sph::AttributeKind::Velocity, 0, n, mine[0].v, sizeof(Record));
       }
     });
+    sph::require_same_root(ranks, root);
     const unsigned char* bytes = reinterpret_cast<const unsigned char*>(mine.data());
     const std::vector<sph::RankBytes> all =
         ranks.gather(sph::RankBytes(bytes, bytes + n * sizeof(Record)), root);
@@ -256,14 +269,15 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather_removed_ids(const sph_world* wo
     sph::require_world(world);
     sph::WorldLock lock(world, sph::WorldLock::kAgreeDeviceLoss);
     const sph::RankTransport& ranks = sph::ranks_of(world);
-    sph::require_root(ranks, root);
     sph::RankBytes packed;
     sph::agreed(ranks, [&] {
       sph::WorldLock::require_device_not_lost(world);
+      sph::require_root(ranks, root);
       const sph::HostVector<uint32_t>& mine = world->world->removed_ids();
       const unsigned char* bytes = reinterpret_cast<const unsigned char*>(mine.data());
       packed.assign(bytes, bytes + mine.size() * sizeof(uint32_t));
     });
+    sph::require_same_root(ranks, root);
     const std::vector<sph::RankBytes> all = ranks.gather(packed, root);
     if (ranks.rank() != root) {
       if (out_count) *out_count = 0;
