@@ -91,8 +91,9 @@ SPH_API sph_result SPH_CALL sph_mpi_world_create(sph_context* context, const sph
  * would. Particles may be anywhere: each moves to the rank that owns its slab in the next step.
  * All-or-nothing over the ranks: if any rank's particles are refused (INVALID_ARGUMENT as
  * sph_world_spawn's, CAPACITY), every rank returns SPH_ERROR_INVALID_ARGUMENT (the refusing
- * rank its own code) and no rank adds any. *out_first_id (may be NULL): this rank's first id.
- * sph_world_spawn and the fills of sph_c.h return UNSUPPORTED on a distributed world.
+ * rank its own code, the others' messages naming the lowest refusing rank) and no rank adds
+ * any. *out_first_id (may be NULL): this rank's first id. sph_world_spawn and the fills of
+ * sph_c.h return UNSUPPORTED on a distributed world.
  */
 SPH_API sph_result SPH_CALL sph_mpi_world_add_particles(sph_world* world, const float* positions,
                                                         const float* velocities, uint32_t count,

@@ -162,13 +162,15 @@ SPH_API sph_result SPH_CALL sph_mpi_world_add_particles(sph_world* world, const 
       status = e.status();
       message = e.what();
     }
-    int64_t any_refused = refused ? 1 : 0;
-    ranks.all_max(&any_refused, 1);
+    // The lowest refusing rank (its rank + 1; 0: none), so the others' messages can name it.
+    int64_t refusing = refused ? -(static_cast<int64_t>(ranks.rank()) + 1) : 0;
+    ranks.all_min(&refusing, 1);
     if (refused) throw Error(status, message);
-    if (any_refused) {
+    if (refusing != 0) {
       w.undo_rank_particles(count_before, next_id_before);
       throw Error(Status::InvalidArgument,
-                  "another rank's particles were refused (its error says why); no rank added any");
+                  "rank " + std::to_string(-refusing - 1) +
+                      "'s particles were refused (its error says why); no rank added any");
     }
     if (out_first_id) *out_first_id = next_id_before + static_cast<uint32_t>(below);
     return SPH_OK;
