@@ -166,9 +166,10 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t
 /**
  * COLLECTIVE. Gathers the ids every rank's sinks removed in the last step (each rank's
  * sph_world_get_removed_ids, which holds only its own particles) onto rank `root`, in ascending
- * order. On root: writes up to `capacity` ids, sets *out_count to the world's number of removed
- * ids and returns SPH_INCOMPLETE when capacity was too small (call again, collectively, with a
- * larger array); other ranks may pass NULL ids, capacity 0 and a NULL out_count. Errors:
+ * order. On root: writes up to `capacity` ids and sets *out_count to the world's number of removed
+ * ids; when root's capacity was too small every rank returns SPH_INCOMPLETE (call again, every
+ * rank, with a larger array on root); other ranks may pass NULL ids, capacity 0 and a NULL
+ * out_count. Root's argument errors are every rank's. Errors:
  * INVALID_ARGUMENT (root out of range or not the same on every rank: every rank refuses; on root,
  * a NULL out_count, or NULL ids with capacity > 0),
  * UNSUPPORTED (not a distributed world).

@@ -275,18 +275,26 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather_removed_ids(const sph_world* wo
     sph::agreed(ranks, [&] {
       sph::WorldLock::require_device_not_lost(world);
       sph::require_root(ranks, root);
+      if (ranks.rank() == root && !out_count) throw Error(Status::InvalidArgument, "out_count: is NULL");
+      if (ranks.rank() == root && capacity > 0 && !ids)
+        throw Error(Status::InvalidArgument, "ids: is NULL but capacity > 0");
       const sph::HostVector<uint32_t>& mine = world->world->removed_ids();
       const unsigned char* bytes = reinterpret_cast<const unsigned char*>(mine.data());
       packed.assign(bytes, bytes + mine.size() * sizeof(uint32_t));
     });
     sph::require_same_root(ranks, root);
     const std::vector<sph::RankBytes> all = ranks.gather(packed, root);
+    // Whether root's array was too small, on every rank: "call again, collectively" needs every
+    // rank to know (before, the others returned SPH_OK, and a caller that retried on
+    // SPH_INCOMPLETE retried on root alone, whose next collective then met the others' next call).
+    size_t world_removed = 0;
+    for (const sph::RankBytes& r : all) world_removed += r.size() / sizeof(uint32_t);
+    int64_t incomplete = ranks.rank() == root && world_removed > capacity ? 1 : 0;
+    ranks.all_max(&incomplete, 1);
     if (ranks.rank() != root) {
       if (out_count) *out_count = 0;
-      return SPH_OK;
+      return incomplete ? SPH_INCOMPLETE : SPH_OK;
     }
-    if (!out_count) throw Error(Status::InvalidArgument, "out_count: is NULL");
-    if (capacity > 0 && !ids) throw Error(Status::InvalidArgument, "ids: is NULL but capacity > 0");
     sph::HostVector<uint32_t> removed;
     for (const sph::RankBytes& r : all) {
       const size_t at = removed.size();
