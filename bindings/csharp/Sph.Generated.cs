@@ -3640,8 +3640,9 @@ namespace Sph
         /// would. Particles may be anywhere: each moves to the rank that owns its slab in the next
         /// step. All-or-nothing over the ranks: if any rank's particles are refused (INVALID_ARGUMENT
         /// as sph_world_spawn's, CAPACITY), every rank returns SPH_ERROR_INVALID_ARGUMENT (the refusing
-        /// rank its own code) and no rank adds any. *out_first_id (may be NULL): this rank's first id.
-        /// sph_world_spawn and the fills of sph_c.h return UNSUPPORTED on a distributed world.
+        /// rank its own code, the others' messages naming the lowest refusing rank) and no rank adds
+        /// any. *out_first_id (may be NULL): this rank's first id. sph_world_spawn and the fills of
+        /// sph_c.h return UNSUPPORTED on a distributed world.
         /// </summary>
         [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_mpi_world_add_particles(WorldHandle world, [In] float[] positions, [In] float[] velocities, uint count, out uint outFirstId);
@@ -3683,9 +3684,10 @@ namespace Sph
         /// COLLECTIVE. Gathers every rank's particles onto rank `root`, ordered by id: positions and
         /// velocities (3 x float32 each, packed) and ids (uint32), each array NULL to skip it. On root
         /// the arrays hold `capacity` particles; *out_count (may be NULL) gets the world's count there
-        /// (0 elsewhere); other ranks pass NULL arrays. Errors: INVALID_ARGUMENT (root out of range; on
-        /// root, capacity below the world's count), UNSUPPORTED (not a distributed world). A rank's own
-        /// particles read with sph_world_copy_attribute, without the others.
+        /// (0 elsewhere); other ranks pass NULL arrays. Errors: INVALID_ARGUMENT (root out of range or
+        /// not the same on every rank: every rank refuses; on root, capacity below the world's count),
+        /// UNSUPPORTED (not a distributed world). A rank's own particles read with
+        /// sph_world_copy_attribute, without the others.
         /// </summary>
         [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_mpi_world_gather(WorldHandle world, int root, ref float positions, ref float velocities, [In, Out] uint[] ids, ulong capacity, out ulong outCount);
@@ -3695,11 +3697,13 @@ namespace Sph
         /// <summary>
         /// COLLECTIVE. Gathers the ids every rank's sinks removed in the last step (each rank's
         /// sph_world_get_removed_ids, which holds only its own particles) onto rank `root`, in
-        /// ascending order. On root: writes up to `capacity` ids, sets *out_count to the world's number
-        /// of removed ids and returns SPH_INCOMPLETE when capacity was too small (call again,
-        /// collectively, with a larger array); other ranks may pass NULL ids, capacity 0 and a NULL
-        /// out_count. Errors: INVALID_ARGUMENT (root out of range; on root, a NULL out_count, or NULL
-        /// ids with capacity &gt; 0), UNSUPPORTED (not a distributed world).
+        /// ascending order. On root: writes up to `capacity` ids and sets *out_count to the world's
+        /// number of removed ids; when root's capacity was too small every rank returns SPH_INCOMPLETE
+        /// (call again, every rank, with a larger array on root); other ranks may pass NULL ids,
+        /// capacity 0 and a NULL out_count. Root's argument errors are every rank's. Errors:
+        /// INVALID_ARGUMENT (root out of range or not the same on every rank: every rank refuses; on
+        /// root, a NULL out_count, or NULL ids with capacity &gt; 0), UNSUPPORTED (not a distributed
+        /// world).
         /// </summary>
         [DllImport(LibrarySphMpi, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_mpi_world_gather_removed_ids(WorldHandle world, int root, [In, Out] uint[] ids, uint capacity, out uint outCount);

@@ -90,8 +90,8 @@ uint32_t World::spawn(const HostVector<Vec3>& positions, const HostVector<Vec3>*
   if (backend_->distributed() && !rank_add_)
     throw Error(Status::Unsupported,
                 "world: it is distributed over MPI ranks (sph_mpi.h): add its particles with "
-                "sph_mpi_world_add_particles, which numbers them across the ranks (fills and sources do not "
-                "work distributed yet)");
+                "sph_mpi_world_add_particles, which numbers them across the ranks (the fills do not work "
+                "distributed: fill an undivided world and add its particles; sources do)");
   if (static_cast<uint64_t>(next_id_) + n > UINT32_MAX)
     throw Error(Status::Capacity, "spawn: the world has used up its 2^32 particle ids");
   const uint32_t first = next_id_;

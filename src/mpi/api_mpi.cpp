@@ -28,6 +28,18 @@ void require_root(const RankTransport& ranks, int32_t root) {
                 "root: must be a rank of the world's communicator, got " + std::to_string(root));
 }
 
+// COLLECTIVE. A gather's root, the same on every rank: ranks that named different roots would
+// each wait in MPI_Gather for messages sent to another root (a hang), so they all refuse instead.
+void require_same_root(const RankTransport& ranks, int32_t root) {
+  const int64_t mine = root;
+  bool same = true;
+  compare_over_ranks(ranks, &mine, 1, &same);
+  if (!same)
+    throw Error(Status::InvalidArgument,
+                "root: this rank's " + std::to_string(root) +
+                    " differs from another rank's: every rank must pass the same root");
+}
+
 constexpr uint32_t kDefaultRebalancePercent = 20;
 constexpr uint32_t kMaxRebalancePercent = 10000;
 
@@ -150,13 +162,15 @@ SPH_API sph_result SPH_CALL sph_mpi_world_add_particles(sph_world* world, const 
       status = e.status();
       message = e.what();
     }
-    int64_t any_refused = refused ? 1 : 0;
-    ranks.all_max(&any_refused, 1);
+    // The lowest refusing rank (its rank + 1; 0: none), so the others' messages can name it.
+    int64_t refusing = refused ? -(static_cast<int64_t>(ranks.rank()) + 1) : 0;
+    ranks.all_min(&refusing, 1);
     if (refused) throw Error(status, message);
-    if (any_refused) {
+    if (refusing != 0) {
       w.undo_rank_particles(count_before, next_id_before);
       throw Error(Status::InvalidArgument,
-                  "another rank's particles were refused (its error says why); no rank added any");
+                  "rank " + std::to_string(-refusing - 1) +
+                      "'s particles were refused (its error says why); no rank added any");
     }
     if (out_first_id) *out_first_id = next_id_before + static_cast<uint32_t>(below);
     return SPH_OK;
@@ -203,7 +217,6 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t
     sph::require_world(world);
     sph::WorldLock lock(world, sph::WorldLock::kAgreeDeviceLoss);
     const sph::RankTransport& ranks = sph::ranks_of(world);
-    sph::require_root(ranks, root);
     struct Record {
       uint32_t id;
       float x[3], v[3];
@@ -215,6 +228,7 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t
     // was lost before the call) must not leave the others waiting in the gather.
     sph::agreed(ranks, [&] {
       sph::WorldLock::require_device_not_lost(world);
+      sph::require_root(ranks, root);
       mine.resize(n);
       if (n > 0) {
         b.copy_attribute(sph::AttributeKind::Id, 0, n, &mine[0].id, sizeof(Record));
@@ -222,6 +236,7 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather(const sph_world* world, int32_t
         b.copy_attribute(sph::AttributeKind::Velocity, 0, n, mine[0].v, sizeof(Record));
       }
     });
+    sph::require_same_root(ranks, root);
     const unsigned char* bytes = reinterpret_cast<const unsigned char*>(mine.data());
     const std::vector<sph::RankBytes> all =
         ranks.gather(sph::RankBytes(bytes, bytes + n * sizeof(Record)), root);
@@ -256,21 +271,30 @@ SPH_API sph_result SPH_CALL sph_mpi_world_gather_removed_ids(const sph_world* wo
     sph::require_world(world);
     sph::WorldLock lock(world, sph::WorldLock::kAgreeDeviceLoss);
     const sph::RankTransport& ranks = sph::ranks_of(world);
-    sph::require_root(ranks, root);
     sph::RankBytes packed;
     sph::agreed(ranks, [&] {
       sph::WorldLock::require_device_not_lost(world);
+      sph::require_root(ranks, root);
+      if (ranks.rank() == root && !out_count) throw Error(Status::InvalidArgument, "out_count: is NULL");
+      if (ranks.rank() == root && capacity > 0 && !ids)
+        throw Error(Status::InvalidArgument, "ids: is NULL but capacity > 0");
       const sph::HostVector<uint32_t>& mine = world->world->removed_ids();
       const unsigned char* bytes = reinterpret_cast<const unsigned char*>(mine.data());
       packed.assign(bytes, bytes + mine.size() * sizeof(uint32_t));
     });
+    sph::require_same_root(ranks, root);
     const std::vector<sph::RankBytes> all = ranks.gather(packed, root);
+    // Whether root's array was too small, on every rank: "call again, collectively" needs every
+    // rank to know (before, the others returned SPH_OK, and a caller that retried on
+    // SPH_INCOMPLETE retried on root alone, whose next collective then met the others' next call).
+    size_t world_removed = 0;
+    for (const sph::RankBytes& r : all) world_removed += r.size() / sizeof(uint32_t);
+    int64_t incomplete = ranks.rank() == root && world_removed > capacity ? 1 : 0;
+    ranks.all_max(&incomplete, 1);
     if (ranks.rank() != root) {
       if (out_count) *out_count = 0;
-      return SPH_OK;
+      return incomplete ? SPH_INCOMPLETE : SPH_OK;
     }
-    if (!out_count) throw Error(Status::InvalidArgument, "out_count: is NULL");
-    if (capacity > 0 && !ids) throw Error(Status::InvalidArgument, "ids: is NULL but capacity > 0");
     sph::HostVector<uint32_t> removed;
     for (const sph::RankBytes& r : all) {
       const size_t at = removed.size();

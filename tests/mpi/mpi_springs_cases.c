@@ -321,6 +321,12 @@ static void check_refused_add(sph_context* context, uint32_t capacity) {
   before = read_rank_file(path, &size_before);
   r = sph_mpi_world_add_particles(world, g_rank == g_size - 1 ? bad : good, NULL, 1, NULL);
   CHECK(r == SPH_ERROR_INVALID_ARGUMENT, "springs: a NaN on the last rank refuses the add: %d", (int)r);
+  if (g_rank != g_size - 1) { /* the others' message names the refusing rank */
+    char expected[64];
+    snprintf(expected, sizeof expected, "rank %d's particles were refused", g_size - 1);
+    CHECK(strstr(sph_get_last_error(), expected) != NULL, "the refused add's message: %s",
+          sph_get_last_error());
+  }
   REQUIRE(sph_mpi_world_save_file(world, path) == SPH_OK, "save: %s", sph_get_last_error());
   after = read_rank_file(path, &size_after);
   CHECK(size_after == size_before && memcmp(before, after, (size_t)size_before) == 0,

@@ -25,7 +25,9 @@
  * same terms may be added in other lanes (docs/distributed.md): asserted within the issue's bound
  * for a non-canonical order, 1e-6 of the tank's 0.4 m in position after 20 substeps, the count of
  * particles not bit for bit equal printed (and each id once, the counts and halos as above).
- * Also: what does not work distributed is refused with SPH_ERROR_UNSUPPORTED. */
+ * Also: what does not work distributed is refused with SPH_ERROR_UNSUPPORTED, and a gather's root
+ * outside the communicator or differing between the ranks with SPH_ERROR_INVALID_ARGUMENT on every
+ * rank. */
 #include <math.h>
 #include <mpi.h>
 #include <stdio.h>
@@ -124,6 +126,22 @@ static void run_scene(sph_context* context, const char* name, float stir_speed, 
   CHECK(sph_mpi_world_gather(world, g_size, mid, NULL, NULL, n, &gathered) == SPH_ERROR_INVALID_ARGUMENT &&
             sph_mpi_world_gather(world, -1, mid, NULL, NULL, n, &gathered) == SPH_ERROR_INVALID_ARGUMENT,
         "a gather's root outside the communicator");
+  if (g_size > 1) {
+    /* Roots that differ between the ranks (each its own; one rank's out of range) are refused on
+     * every rank; before, each rank waited in MPI_Gather for another root's messages (a hang). */
+    uint32_t removed = 0;
+    const int32_t one_out = g_rank == g_size - 1 ? g_size : 0;
+    sph_result own = sph_mpi_world_gather(world, g_rank, mid, NULL, NULL, n, &gathered);
+    sph_result out = sph_mpi_world_gather(world, one_out, mid, NULL, NULL, n, &gathered);
+    CHECK(own == SPH_ERROR_INVALID_ARGUMENT && out == SPH_ERROR_INVALID_ARGUMENT,
+          "gathers to roots that differ between the ranks: %d and %d, expected INVALID_ARGUMENT", (int)own,
+          (int)out);
+    own = sph_mpi_world_gather_removed_ids(world, g_rank, NULL, 0, &removed);
+    out = sph_mpi_world_gather_removed_ids(world, one_out, NULL, 0, &removed);
+    CHECK(own == SPH_ERROR_INVALID_ARGUMENT && out == SPH_ERROR_INVALID_ARGUMENT,
+          "removed ids gathered to roots that differ between the ranks: %d and %d, expected INVALID_ARGUMENT",
+          (int)own, (int)out);
+  }
   if (g_rank == 0) mpi_test_step(single, 1, 0);
   mpi_test_step(world, 1, 1);
 
