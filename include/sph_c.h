@@ -74,7 +74,8 @@ typedef enum sph_result {
   SPH_ERROR_VERSION_MISMATCH = -3,     /* struct_size or header_version not accepted */
   SPH_ERROR_UNSUPPORTED = -4,          /* not compiled in, no such device, unknown enum value */
   SPH_ERROR_FEATURE_DISABLED = -5,     /* the feature was not enabled in the world's def */
-  SPH_ERROR_CAPACITY = -6,             /* more particles than the world may hold (max_capacity) */
+  SPH_ERROR_CAPACITY = -6,             /* a size limit: more particles than the world may hold (max_capacity),
+                                          too many in one cell, a grid too large; the message names it */
   SPH_ERROR_OUT_OF_HOST_MEMORY = -7,   /* a host allocation failed */
   SPH_ERROR_OUT_OF_DEVICE_MEMORY = -8, /* a device allocation failed */
   SPH_ERROR_WORLD_LOCKED = -9,         /* the world is in use by another call */

@@ -194,7 +194,10 @@ namespace Sph
         ErrorUnsupported = -4,
         /// <summary>the feature was not enabled in the world's def</summary>
         ErrorFeatureDisabled = -5,
-        /// <summary>more particles than the world may hold (max_capacity)</summary>
+        /// <summary>
+        /// a size limit: more particles than the world may hold (max_capacity), too many in one cell, a
+        /// grid too large; the message names it
+        /// </summary>
         ErrorCapacity = -6,
         /// <summary>a host allocation failed</summary>
         ErrorOutOfHostMemory = -7,
@@ -5075,7 +5078,7 @@ namespace Sph
             { "SPH_ERROR_VERSION_MISMATCH", "struct_size or header_version not accepted" },
             { "SPH_ERROR_UNSUPPORTED", "not compiled in, no such device, unknown enum value" },
             { "SPH_ERROR_FEATURE_DISABLED", "the feature was not enabled in the world's def" },
-            { "SPH_ERROR_CAPACITY", "more particles than the world may hold (max_capacity)" },
+            { "SPH_ERROR_CAPACITY", "a size limit: more particles than the world may hold (max_capacity), too many in one cell, a grid too large; the message names it" },
             { "SPH_ERROR_OUT_OF_HOST_MEMORY", "a host allocation failed" },
             { "SPH_ERROR_OUT_OF_DEVICE_MEMORY", "a device allocation failed" },
             { "SPH_ERROR_WORLD_LOCKED", "the world is in use by another call" },

@@ -57,7 +57,9 @@ SPH_API const char* SPH_CALL sph_result_string(sph_result result) {
     case SPH_ERROR_FEATURE_DISABLED:
       return "SPH_ERROR_FEATURE_DISABLED: the feature is off in the world's def";
     case SPH_ERROR_CAPACITY:
-      return "SPH_ERROR_CAPACITY: more particles than the world may hold (max_capacity)";
+      return "SPH_ERROR_CAPACITY: a size limit was exceeded (particles beyond max_capacity, too many in one "
+             "cell, a "
+             "grid too large)";
     case SPH_ERROR_OUT_OF_HOST_MEMORY:
       return "SPH_ERROR_OUT_OF_HOST_MEMORY: a host allocation failed";
     case SPH_ERROR_OUT_OF_DEVICE_MEMORY:

@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': '67dc8ad1a775ed5b7e4743cd8e4e9ecf24380be81cc4c705179159ce27f326ec', 'include/sph_cuda.h': '10c29a1a1f3946f310c4a23105ed7fb70ffea9fa1a9eee03d59ab41a55b122b9', 'include/sph_mpi.h': 'cd3105ce9e1d48cdb4bbe600917d457583605674287a3c291a8e0a59b5f6a5c4', 'include/sph_vdb.h': 'ec76a0b58067466b8035a7ff7553c3e6ca99ec4240b6dad014b0ae8ae6ec4a4c'}
+HEADERS = {'include/sph_c.h': 'b30e23ffff94d0e00eb7bb5b3f1b4a03929ec1259077ee6eb487a29f3d0c0b7a', 'include/sph_cuda.h': '10c29a1a1f3946f310c4a23105ed7fb70ffea9fa1a9eee03d59ab41a55b122b9', 'include/sph_mpi.h': 'cd3105ce9e1d48cdb4bbe600917d457583605674287a3c291a8e0a59b5f6a5c4', 'include/sph_vdb.h': 'ec76a0b58067466b8035a7ff7553c3e6ca99ec4240b6dad014b0ae8ae6ec4a4c'}
 VERSION = (0, 2, 0)
 VERSION_STRING = "0.2.0"
 ABI_VERSION = 0
@@ -135,7 +135,7 @@ SPH_ERROR_INVALID_HANDLE = -2  # a NULL, destroyed or foreign object
 SPH_ERROR_VERSION_MISMATCH = -3  # struct_size or header_version not accepted
 SPH_ERROR_UNSUPPORTED = -4  # not compiled in, no such device, unknown enum value
 SPH_ERROR_FEATURE_DISABLED = -5  # the feature was not enabled in the world's def
-SPH_ERROR_CAPACITY = -6  # more particles than the world may hold (max_capacity)
+SPH_ERROR_CAPACITY = -6  # a size limit: more particles than the world may hold (max_capacity), too many in one cell, a grid too large; the message names it
 SPH_ERROR_OUT_OF_HOST_MEMORY = -7  # a host allocation failed
 SPH_ERROR_OUT_OF_DEVICE_MEMORY = -8  # a device allocation failed
 SPH_ERROR_WORLD_LOCKED = -9  # the world is in use by another call
@@ -165,7 +165,8 @@ class Result(_enum.IntEnum):
     ERROR_UNSUPPORTED = -4
     #: the feature was not enabled in the world's def
     ERROR_FEATURE_DISABLED = -5
-    #: more particles than the world may hold (max_capacity)
+    #: a size limit: more particles than the world may hold (max_capacity), too many in one cell, a
+    #: grid too large; the message names it
     ERROR_CAPACITY = -6
     #: a host allocation failed
     ERROR_OUT_OF_HOST_MEMORY = -7
@@ -648,7 +649,7 @@ ENUM_MEMBER_DOCS = {
     'SPH_ERROR_VERSION_MISMATCH': 'struct_size or header_version not accepted',
     'SPH_ERROR_UNSUPPORTED': 'not compiled in, no such device, unknown enum value',
     'SPH_ERROR_FEATURE_DISABLED': "the feature was not enabled in the world's def",
-    'SPH_ERROR_CAPACITY': 'more particles than the world may hold (max_capacity)',
+    'SPH_ERROR_CAPACITY': 'a size limit: more particles than the world may hold (max_capacity), too many in one cell, a grid too large; the message names it',
     'SPH_ERROR_OUT_OF_HOST_MEMORY': 'a host allocation failed',
     'SPH_ERROR_OUT_OF_DEVICE_MEMORY': 'a device allocation failed',
     'SPH_ERROR_WORLD_LOCKED': 'the world is in use by another call',
