@@ -966,7 +966,8 @@ SPH_API sph_result SPH_CALL sph_world_get_step_budget(const sph_world* world, do
  * without a step budget or sinks, sees it only at its end). The one call that may run on another thread while
  * a step holds the world: it never blocks and never answers WORLD_LOCKED. A request made while no step runs
  * stops the next step before its first substep (that step changes nothing and reports 0
- * substeps); a step that stops for it clears it. Errors: INVALID_HANDLE (NULL or destroyed:
+ * substeps); a step that stops for it clears it. It belongs to the handle, as the step budget
+ * does: sph_world_restore keeps a pending request. Errors: INVALID_HANDLE (NULL or destroyed:
  * safe to call racing sph_world_destroy).
  */
 SPH_API sph_result SPH_CALL sph_world_cancel_step(sph_world* world);

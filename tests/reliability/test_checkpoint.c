@@ -987,6 +987,23 @@ static void test_failed_restore_changes_nothing(void** state) {
   EXPECT_OK(sph_world_destroy(world));
 }
 
+/* A pending sph_world_cancel_step belongs to the handle, as the step budget does: a restore
+ * keeps it, so the first step after the restore stops before its first substep. */
+static void test_restore_keeps_a_pending_cancel(void** state) {
+  damaged_fixture* d = (damaged_fixture*)*state;
+  scene_ids ids;
+  sph_world* world = build_scene(d->context, &ids);
+  sph_stats stats;
+  EXPECT_OK(sph_world_cancel_step(world));
+  EXPECT_OK(sph_world_restore(world, d->checkpoint, d->size));
+  assert_int_equal(sph_world_step(world, 1.0f / 60.0f), SPH_INCOMPLETE);
+  sph_stats_init(&stats);
+  EXPECT_OK(sph_world_get_stats(world, &stats));
+  assert_int_equal(stats.substeps, 0);
+  EXPECT_OK(sph_world_step(world, 1.0f / 60.0f));
+  EXPECT_OK(sph_world_destroy(world));
+}
+
 /* ---- (c) atomic files ----------------------------------------------------------------------- */
 static void write_text(const char* path, const char* text) {
   FILE* f = fopen(path, "wb");
@@ -1219,6 +1236,7 @@ int main(void) {
       cmocka_unit_test(test_forged_fast_source_region_is_refused),
       cmocka_unit_test(test_wrong_magic_future_version_and_trailing_bytes),
       cmocka_unit_test(test_failed_restore_changes_nothing),
+      cmocka_unit_test(test_restore_keeps_a_pending_cancel),
   };
   int failed = cmocka_run_group_tests_name("checkpoint", continuation, NULL, NULL);
   failed += cmocka_run_group_tests_name("damaged checkpoints", damaged, damaged_setup, damaged_teardown);
