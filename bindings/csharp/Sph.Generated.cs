@@ -3481,9 +3481,12 @@ namespace Sph
         /// a world loaded from it on the same context, and keeps its handle, with one difference: a
         /// collider, source, sink or force field whose asset in the checkpoint holds the same bits as
         /// the caller's asset the same object uses now keeps the caller's asset (it follows
-        /// sph_sdf_update again, and on the CPU keeps its boundary-density maps); one whose asset
-        /// changed since the save holds the checkpoint's copy, as a loaded world does. All-or-nothing:
-        /// on any error the world is unchanged. Errors: as sph_world_load, and WORLD_LOCKED.
+        /// sph_sdf_update again, and on the CPU keeps its boundary-density maps); one the restore
+        /// brings back (an undo of its deletion) takes the caller's asset of the same bits that another
+        /// object uses now; one whose asset changed since the save holds the checkpoint's copy, as a
+        /// loaded world does (so does one whose asset no object uses now: the world no longer knows
+        /// it). All-or-nothing: on any error the world is unchanged. Errors: as sph_world_load, and
+        /// WORLD_LOCKED.
         /// </summary>
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)]
         public static extern Result sph_world_restore(WorldHandle world, IntPtr data, ulong size);

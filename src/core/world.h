@@ -204,7 +204,9 @@ class World {
   // Where an object of `before` with the same id uses an asset holding the same bits as this
   // world's copy (a restore of a checkpoint whose assets the caller has not changed since), this
   // world's object takes `before`'s asset instead of its copy: it follows the caller's
-  // sph_sdf_update again, and its boundary maps are found (Backend::adopt_asset_caches).
+  // sph_sdf_update again, and its boundary maps are found (Backend::adopt_asset_caches). An object
+  // with no namesake in `before` (an undone deletion) takes any asset of `before`'s objects with
+  // the same bits.
   void keep_caller_assets(const World& before);
 
   // Read-only views; everything that changes the scene goes through the entry points above.

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
 // The world's entry points for its scene: colliders, sources, sinks and force fields made from
 // specs (rules in scene_build.h), their setters, and the restore of a saved scene.
+#include <algorithm>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "field_checks.h"
 #include "field_error.h"
@@ -66,6 +68,33 @@ void take_same_assets(SlotMap<T>& mine, const SlotMap<T>& before, std::shared_pt
   });
 }
 
+using AssetList = std::vector<std::shared_ptr<const SdfAsset>>;
+
+// The distinct assets the objects of `map` use, in the map's order.
+template <class T>
+void add_assets(const SlotMap<T>& map, std::shared_ptr<const SdfAsset> T::*asset, AssetList& out) {
+  map.for_each([&](uint64_t, const T& object) {
+    const std::shared_ptr<const SdfAsset>& a = object.*asset;
+    if (a && std::find(out.begin(), out.end(), a) == out.end()) out.push_back(a);
+  });
+}
+
+// Each live object of `mine` still holding an asset that is none of `theirs` takes the first of
+// them with the same bits (an object the restore brought back, whose namesake was gone).
+template <class T>
+void take_any_same_asset(SlotMap<T>& mine, const AssetList& theirs,
+                         std::shared_ptr<const SdfAsset> T::*asset) {
+  mine.for_each([&](uint64_t, T& object) {
+    std::shared_ptr<const SdfAsset>& ours = object.*asset;
+    if (!ours || std::find(theirs.begin(), theirs.end(), ours) != theirs.end()) return;
+    for (const std::shared_ptr<const SdfAsset>& candidate : theirs)
+      if (same_asset(*ours, *candidate)) {
+        ours = candidate;
+        return;
+      }
+  });
+}
+
 }  // namespace
 
 void World::keep_caller_assets(const World& before) {
@@ -73,6 +102,18 @@ void World::keep_caller_assets(const World& before) {
   take_same_assets(sources_, before.sources_, &Source::region);
   take_same_assets(sinks_, before.sinks_, &Sink::region);
   take_same_assets(force_fields_, before.force_fields_, &ForceField::region);
+  // Then an object with no namesake in `before` (an undo of its deletion) takes any asset of
+  // `before`'s objects with the same bits: the caller's asset another object still uses.
+  AssetList theirs;
+  add_assets(before.colliders_, &Collider::sdf, theirs);
+  add_assets(before.sources_, &Source::region, theirs);
+  add_assets(before.sinks_, &Sink::region, theirs);
+  add_assets(before.force_fields_, &ForceField::region, theirs);
+  if (theirs.empty()) return;
+  take_any_same_asset(colliders_, theirs, &Collider::sdf);
+  take_any_same_asset(sources_, theirs, &Source::region);
+  take_any_same_asset(sinks_, theirs, &Sink::region);
+  take_any_same_asset(force_fields_, theirs, &ForceField::region);
 }
 
 void World::keep_issued_ids(const World& before) {

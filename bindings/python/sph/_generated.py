@@ -11,7 +11,7 @@ import enum as _enum
 from ._struct import Opaque as _Opaque, SphStruct as _SphStruct
 
 #: The headers these declarations come from, with their SHA-256.
-HEADERS = {'include/sph_c.h': 'd20c65b5ed8533dab10aa6ce65d5e2bf5409e5bc0e3a22558fa7a3e2032b3135', 'include/sph_cuda.h': '10c29a1a1f3946f310c4a23105ed7fb70ffea9fa1a9eee03d59ab41a55b122b9', 'include/sph_mpi.h': 'cd3105ce9e1d48cdb4bbe600917d457583605674287a3c291a8e0a59b5f6a5c4', 'include/sph_vdb.h': 'ec76a0b58067466b8035a7ff7553c3e6ca99ec4240b6dad014b0ae8ae6ec4a4c'}
+HEADERS = {'include/sph_c.h': '80bad13ea348e4426a9de35eeb2617739dfd1e14b71ccbcaf8ddba33bf976d2a', 'include/sph_cuda.h': '10c29a1a1f3946f310c4a23105ed7fb70ffea9fa1a9eee03d59ab41a55b122b9', 'include/sph_mpi.h': 'cd3105ce9e1d48cdb4bbe600917d457583605674287a3c291a8e0a59b5f6a5c4', 'include/sph_vdb.h': 'ec76a0b58067466b8035a7ff7553c3e6ca99ec4240b6dad014b0ae8ae6ec4a4c'}
 VERSION = (0, 2, 0)
 VERSION_STRING = "0.2.0"
 ABI_VERSION = 0
@@ -2383,7 +2383,7 @@ FUNCTIONS = {
     'sph_world_load_file': (sph_result, (_c.POINTER(sph_context), _c.c_char_p, _c.POINTER(_c.POINTER(sph_world))), ('context', 'path', 'out'),
         'sph_world_load from a file. INVALID_ARGUMENT also when the file cannot be opened or read, is not a regular file (a FIFO, a device such as /dev/zero, a directory: refused without reading) or is larger than 256 GiB.', 'sph'),
     'sph_world_restore': (sph_result, (_c.POINTER(sph_world), _c.c_void_p, _c.c_uint64), ('world', 'data', 'size'),
-        "Replaces a world's whole state with a checkpoint's (undo, retry): afterwards the world is as a world loaded from it on the same context, and keeps its handle, with one difference: a collider, source, sink or force field whose asset in the checkpoint holds the same bits as the caller's asset the same object uses now keeps the caller's asset (it follows sph_sdf_update again, and on the CPU keeps its boundary-density maps); one whose asset changed since the save holds the checkpoint's copy, as a loaded world does. All-or-nothing: on any error the world is unchanged. Errors: as sph_world_load, and WORLD_LOCKED.", 'sph'),
+        "Replaces a world's whole state with a checkpoint's (undo, retry): afterwards the world is as a world loaded from it on the same context, and keeps its handle, with one difference: a collider, source, sink or force field whose asset in the checkpoint holds the same bits as the caller's asset the same object uses now keeps the caller's asset (it follows sph_sdf_update again, and on the CPU keeps its boundary-density maps); one the restore brings back (an undo of its deletion) takes the caller's asset of the same bits that another object uses now; one whose asset changed since the save holds the checkpoint's copy, as a loaded world does (so does one whose asset no object uses now: the world no longer knows it). All-or-nothing: on any error the world is unchanged. Errors: as sph_world_load, and WORLD_LOCKED.", 'sph'),
     'sph_cuda_attribute_view_init_sized': (sph_result, (_c.POINTER(sph_cuda_attribute_view), _c.c_uint32), ('view', 'size'),
         'Zeroes *view and sets struct_size (size = sizeof(*view)). Prefer sph_cuda_attribute_view_init.', 'sph'),
     'sph_cuda_world_get_attribute': (sph_result, (_c.POINTER(sph_world), sph_attribute, _c.POINTER(sph_cuda_attribute_view)), ('world', 'attribute', 'out'),
