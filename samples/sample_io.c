@@ -43,9 +43,23 @@ int sample_parse_args(int argc, char** argv, const char* name, const char** out_
   sample_name = name;
   for (i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--frames") == 0 && i + 1 < argc) {
-      *frames = atoi(argv[++i]);
+      /* a whole positive number: "abc" or "-5" used to run 0 frames and report success */
+      char* end = NULL;
+      long value;
+      errno = 0;
+      value = strtol(argv[++i], &end, 10);
+      if (errno != 0 || end == argv[i] || *end != '\0' || value < 1 || value > 1000000) {
+        fprintf(stderr, "%s: --frames %s: expected a whole number from 1 to 1000000\n", name, argv[i]);
+        return 2;
+      }
+      *frames = (int)value;
     } else if (strcmp(argv[i], "--backend") == 0 && i + 1 < argc) {
-      *backend = support_backend_from_name(argv[++i], SPH_BACKEND_AUTO);
+      /* an unknown name used to fall back to auto silently */
+      *backend = support_backend_from_name(argv[++i], SPH_BACKEND_FORCE32);
+      if (*backend == SPH_BACKEND_FORCE32) {
+        fprintf(stderr, "%s: --backend %s: expected auto, cpu or cuda\n", name, argv[i]);
+        return 2;
+      }
     } else if (argv[i][0] != '-') {
       *out_dir = argv[i];
     } else {
