@@ -54,10 +54,6 @@ bool empty_and_remove(const std::string& dir) {
   return ::rmdir(dir.c_str()) == 0;
 }
 
-}  // namespace
-
-namespace {
-
 // A character of an object's name that its table's file name keeps (any other becomes '_').
 bool kept_in_table_name(char ch) {
   return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '-';
