@@ -544,6 +544,20 @@ static void reseal(uint8_t* data, size_t size) {
   put_u64(data + 32, h);
 }
 
+/* Forges a checkpoint: the one float of the payload (after the 48-byte header) whose bits are
+ * `marker` becomes `value`, and the checksum is made right again. The marker must occur once. */
+static void forge_float(uint8_t* data, uint64_t size, float marker, float value) {
+  uint64_t at;
+  int found = 0;
+  for (at = 48; at + 4 <= size; ++at)
+    if (memcmp(data + at, &marker, 4) == 0) {
+      memcpy(data + at, &value, 4);
+      ++found;
+    }
+  assert_int_equal(found, 1);
+  reseal(data, (size_t)size);
+}
+
 typedef struct damaged_fixture {
   sph_context* context;
   uint8_t* checkpoint;
@@ -908,8 +922,7 @@ static void test_forged_fast_source_region_is_refused(void** state) {
   float distance[8] = {-1, -1, -1, -1, -1, -1, -1, -1}, speeds[24] = {0};
   const float marker = 1234.5f, fast = 3e19f;
   uint8_t* data;
-  uint64_t size, at;
-  int found = 0;
+  uint64_t size;
 
   sph_world_def_init(&def);
   def.capacity = 300;
@@ -930,13 +943,7 @@ static void test_forged_fast_source_region_is_refused(void** state) {
   source.flags = SPH_SOURCE_FLAG_VELOCITY_FROM_FIELD;
   EXPECT_OK(sph_source_create(world, &source, &source_id));
   data = save_to_memory(world, &size);
-  for (at = 48; at + 4 <= size; ++at)
-    if (memcmp(data + at, &marker, 4) == 0) {
-      memcpy(data + at, &fast, 4);
-      ++found;
-    }
-  assert_int_equal(found, 1);
-  reseal(data, (size_t)size);
+  forge_float(data, size, marker, fast);
   EXPECT_ERROR(SPH_ERROR_CORRUPT_DATA, "region has a speed above 1.8e19",
                sph_world_load(d->context, data, size, &loaded));
   assert_null(loaded);
@@ -1175,10 +1182,9 @@ static void test_kernel_radius_bounds_round_trip(void** state) {
   sph_context* context = NULL;
   sph_world *world = NULL, *loaded = NULL;
   sph_world_def def;
-  uint64_t size = 0, at;
+  uint64_t size = 0;
   uint8_t* checkpoint;
   const float spacing = 0.02f, marker = 0.0271828f;
-  int found = 0;
   (void)state;
 
   EXPECT_OK(sph_test_context_create(&context));
@@ -1198,13 +1204,7 @@ static void test_kernel_radius_bounds_round_trip(void** state) {
   def.kernel_radius = marker;
   EXPECT_OK(sph_world_create(context, &def, &world));
   checkpoint = save_to_memory(world, &size);
-  for (at = 48; at + 4 <= size; ++at)
-    if (memcmp(checkpoint + at, &marker, 4) == 0) {
-      memcpy(checkpoint + at, &spacing, 4);
-      ++found;
-    }
-  assert_int_equal(found, 1);
-  reseal(checkpoint, (size_t)size);
+  forge_float(checkpoint, size, marker, spacing);
   EXPECT_ERROR(SPH_ERROR_CORRUPT_DATA, "too close to the particle spacing",
                sph_world_load(context, checkpoint, size, &loaded));
   assert_null(loaded);
